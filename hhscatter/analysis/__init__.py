@@ -1,0 +1,1 @@
+"""Analysis of the engine's tables (lifetimes, snapshots, sections): pure functions, no I/O."""

@@ -1,0 +1,369 @@
+"""Energy decay of the dissipative ensemble (paper Sec. III.A.1, Fig. 3).
+
+With linear drag the energy of every orbit decays as dE/dt = −γ v², Eq.
+(eqn:energy_diffeq).  Approximating the potential, on average along an orbit,
+by V = (μ/2) E gives the homogeneous law, Eq. (eqn:energy_exp_decay),
+
+    E(t) = E0 exp(−μ γ t),
+
+with μ ≈ 1 (exactly 1 for damped oscillations about the stable fixed point).
+The paper fits ⟨E⟩(t), the mean over orbits still inside Ω at t, by least
+squares on log⟨E⟩ and reports μ = 0.91 on t ∈ [0, 200] for (E0, γ) =
+(0.3, 0.01), arguing that the local exponent tends to 1 at late times.
+
+Functions here are pure (no file I/O, no plotting):
+
+* :func:`mean_energy` / :func:`mean_energy_arrays` — ⟨E⟩, σ_E and its standard
+  error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
+* :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the paper's
+  model) and with a free intercept (the local exponent);
+* :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
+* :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
+
+Units: the model's natural units (unit mass); t in time units, E in energy
+units, γ in 1/time; μ is dimensionless.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "EnergyDecayFit",
+    "EnergyHistograms",
+    "energy_histograms",
+    "energy_histograms_arrays",
+    "fit_energy_decay",
+    "fit_energy_decay_table",
+    "mean_energy",
+    "mean_energy_arrays",
+    "mu_by_window",
+]
+
+
+# ---------------------------------------------------------------------------
+# mean energy per grid time
+# ---------------------------------------------------------------------------
+def mean_energy_arrays(t, energy) -> pd.DataFrame:
+    """mean_energy_arrays(t, energy) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    Groups the samples ``energy`` by their (exactly equal) grid time ``t`` and
+    returns, sorted by t, one row per grid time with
+
+    * ``n``        number of orbits alive at t (int),
+    * ``mean_E``   ⟨E⟩(t), the ensemble mean energy,
+    * ``std_E``    sample standard deviation of E (ddof = 1; NaN when n = 1),
+    * ``sem_E``    standard error of the mean, std_E / √n,
+    * ``lo_3sigma``, ``hi_3sigma``  ⟨E⟩ ∓ 3 std_E, the ribbon of Fig. 3.
+
+    NaN energies are ignored.  Energy in model units, t in time units.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if t.shape != e.shape:
+        raise ValueError(f"t and energy differ in length: {t.size} != {e.size}")
+    ok = np.isfinite(e) & np.isfinite(t)
+    t, e = t[ok], e[ok]
+    grid, inv = np.unique(t, return_inverse=True)
+    n = np.bincount(inv, minlength=grid.size)
+    s1 = np.bincount(inv, weights=e, minlength=grid.size)
+    mean = s1 / np.maximum(n, 1)
+    dev2 = np.bincount(inv, weights=(e - mean[inv]) ** 2, minlength=grid.size)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = np.where(n > 1, np.sqrt(dev2 / np.maximum(n - 1, 1)), np.nan)
+        sem = std / np.sqrt(n)
+    return pd.DataFrame(
+        {
+            "t": grid,
+            "n": n.astype(np.int64),
+            "mean_E": mean,
+            "std_E": std,
+            "sem_E": sem,
+            "lo_3sigma": mean - 3 * std,
+            "hi_3sigma": mean + 3 * std,
+        }
+    )
+
+
+def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
+    """mean_energy(snapshots) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    DataFrame wrapper of :func:`mean_energy_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).  The table holds only
+    orbits still alive (neither escaped nor settled) at each grid time, so
+    ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
+    Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
+    """
+    return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
+
+
+# ---------------------------------------------------------------------------
+# fitting μ
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EnergyDecayFit:
+    """Result of :func:`fit_energy_decay` (all μ dimensionless).
+
+    Fixed intercept, the paper's Eq. (eqn:energy_exp_decay) with E(0) = E0:
+        ``mu``, ``mu_err``, ``rms_log_residual``.
+    Free intercept, log⟨E⟩ = a − μ γ t (the local decay exponent):
+        ``mu_free``, ``mu_free_err``, ``log_E0_free``, ``log_E0_free_err``,
+        ``rms_log_residual_free``.
+    ``window`` is the (t_lo, t_hi) used, ``n_points`` the number of grid times
+    in it.  Errors are 1σ (NaN when not determinable, e.g. too few points).
+    """
+
+    mu: float
+    mu_err: float
+    mu_free: float
+    mu_free_err: float
+    log_E0_free: float
+    log_E0_free_err: float
+    window: tuple
+    n_points: int
+    rms_log_residual: float
+    rms_log_residual_free: float
+
+    @property
+    def E0_free(self) -> float:
+        """exp(log_E0_free): the fitted E(0) of the free-intercept fit."""
+        return float(np.exp(self.log_E0_free))
+
+
+def fit_energy_decay(
+    t,
+    mean_E,
+    E0: float,
+    gamma: float,
+    window=(0.0, 200.0),
+    weights=None,
+    *,
+    absolute_sigma: bool = False,
+) -> EnergyDecayFit:
+    """fit_energy_decay(t, mean_E, E0, gamma, window=(0, 200), weights=None) -> EnergyDecayFit.
+
+    Weighted least squares of the log-transformed mean energy against the
+    exponential law of Eq. (eqn:energy_exp_decay):
+
+    * fixed intercept (the paper's fit):  log⟨E⟩ − log E0 = −μ γ t,
+    * free intercept (local exponent):    log⟨E⟩ = a − μ γ t.
+
+    Parameters
+    ----------
+    t, mean_E : arrays
+        Grid times and ⟨E⟩(t) (e.g. columns of :func:`mean_energy`).  Points
+        with non-finite or non-positive ⟨E⟩ are dropped.
+    E0 : float
+        Initial energy (intercept of the fixed fit).
+    gamma : float
+        Drag coefficient γ > 0; μ is the fitted slope divided by −γ.
+    window : (t_lo, t_hi)
+        Inclusive time window of the fit.  Paper: (0, 200) gives μ = 0.91.
+    weights : array or None
+        Inverse variances of log⟨E⟩ per point, e.g. (mean_E / sem_E)²;
+        None = unit weights (ordinary least squares, as in the paper).
+    absolute_sigma : bool
+        If True (only meaningful with ``weights``) the errors use the weights
+        as absolute variances; otherwise (default) the covariance is scaled
+        by the reduced χ² of the fit, as in ``scipy.optimize.curve_fit``.
+
+    Returns
+    -------
+    EnergyDecayFit with μ and 1σ errors of both variants.
+    """
+    if not gamma > 0:
+        raise ValueError(f"gamma must be > 0, got {gamma!r}")
+    if not E0 > 0:
+        raise ValueError(f"E0 must be > 0, got {E0!r}")
+    t = np.asarray(t, dtype=float).ravel()
+    m = np.asarray(mean_E, dtype=float).ravel()
+    w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
+    if not (t.shape == m.shape == w.shape):
+        raise ValueError("t, mean_E and weights must have the same length")
+    t_lo, t_hi = float(window[0]), float(window[1])
+    sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
+    t, y, w = t[sel], np.log(m[sel]), w[sel]
+    n = t.size
+    absolute = absolute_sigma and weights is not None
+    nan = float("nan")
+
+    # fixed intercept: y - log E0 = -beta t
+    yr = y - np.log(E0)
+    stt = np.sum(w * t * t)
+    if n >= 1 and stt > 0:
+        beta = -np.sum(w * t * yr) / stt
+        res = yr + beta * t
+        if absolute:
+            var_b = 1.0 / stt
+        else:
+            var_b = np.sum(w * res**2) / (n - 1) / stt if n > 1 else nan
+        mu, mu_err = beta / gamma, np.sqrt(var_b) / gamma
+        rms = float(np.sqrt(np.mean(res**2)))
+    else:
+        mu = mu_err = rms = nan
+
+    # free intercept: y = a - beta t
+    if n >= 2 and np.ptp(t) > 0:
+        X = np.column_stack([np.ones(n), -t])
+        sw = np.sqrt(w)
+        coef, *_ = np.linalg.lstsq(X * sw[:, None], y * sw, rcond=None)
+        res = y - X @ coef
+        cov = np.linalg.inv(X.T @ (X * w[:, None]))
+        if not absolute:
+            cov = cov * (np.sum(w * res**2) / (n - 2) if n > 2 else nan)
+        a, beta_f = coef
+        mu_free, mu_free_err = beta_f / gamma, np.sqrt(cov[1, 1]) / gamma
+        a_err = np.sqrt(cov[0, 0])
+        rms_f = float(np.sqrt(np.mean(res**2)))
+    else:
+        mu_free = mu_free_err = a = a_err = rms_f = nan
+
+    return EnergyDecayFit(
+        mu=float(mu),
+        mu_err=float(mu_err),
+        mu_free=float(mu_free),
+        mu_free_err=float(mu_free_err),
+        log_E0_free=float(a),
+        log_E0_free_err=float(a_err),
+        window=(t_lo, t_hi),
+        n_points=int(n),
+        rms_log_residual=float(rms),
+        rms_log_residual_free=float(rms_f),
+    )
+
+
+def fit_energy_decay_table(
+    table: pd.DataFrame,
+    E0: float,
+    gamma: float,
+    window=(0.0, 200.0),
+    *,
+    weighted: bool = False,
+) -> EnergyDecayFit:
+    """fit_energy_decay_table(table, E0, gamma, window=(0, 200), weighted=False) -> EnergyDecayFit.
+
+    Wrapper of :func:`fit_energy_decay` for the output of :func:`mean_energy`.
+    ``weighted=True`` uses inverse-variance weights (mean_E / sem_E)² of
+    log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
+    unweighted log fit of Eq. (eqn:energy_exp_decay).
+    """
+    weights = None
+    if weighted:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            weights = (table["mean_E"].to_numpy() / table["sem_E"].to_numpy()) ** 2
+        weights = np.where(np.isfinite(weights), weights, 0.0)
+    return fit_energy_decay(
+        table["t"].to_numpy(), table["mean_E"].to_numpy(), E0, gamma, window, weights
+    )
+
+
+def mu_by_window(
+    t,
+    mean_E,
+    E0: float,
+    gamma: float,
+    windows,
+    weights=None,
+    *,
+    absolute_sigma: bool = False,
+) -> pd.DataFrame:
+    """mu_by_window(t, mean_E, E0, gamma, windows, weights=None) -> DataFrame.
+
+    Runs :func:`fit_energy_decay` on each (t_lo, t_hi) of ``windows`` and
+    returns one row per window with columns ``t_lo, t_hi, n_points, mu,
+    mu_err, mu_free, mu_free_err``.
+
+    ``mu_free`` is the local exponent on the window, −d log⟨E⟩/d(γt); it is
+    the quantity for testing the paper's claim (Sec. III.A.1, below Eq.
+    (eqn:energy_exp_decay)) that μ → 1 at late times.  ``mu`` (intercept tied
+    to E0) is the cumulative mean exponent ln(E0/⟨E⟩)/(γt) weighted over the
+    window and lags behind the local value.
+    """
+    rows = []
+    for lo, hi in windows:
+        f = fit_energy_decay(t, mean_E, E0, gamma, (lo, hi), weights, absolute_sigma=absolute_sigma)
+        rows.append(
+            {
+                "t_lo": float(lo),
+                "t_hi": float(hi),
+                "n_points": f.n_points,
+                "mu": f.mu,
+                "mu_err": f.mu_err,
+                "mu_free": f.mu_free,
+                "mu_free_err": f.mu_free_err,
+            }
+        )
+    return pd.DataFrame(rows, columns=["t_lo", "t_hi", "n_points", "mu", "mu_err", "mu_free", "mu_free_err"])
+
+
+# ---------------------------------------------------------------------------
+# energy histograms
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EnergyHistograms:
+    """Result of :func:`energy_histograms`.
+
+    ``t_requested`` (k,) the requested times; ``t`` (k,) the snapshot grid time
+    actually used for each (the nearest one); ``edges`` (b+1,) common energy
+    bin edges; ``counts`` (k, b) orbit counts per bin; ``density`` (k, b)
+    normalised so that Σ density·Δedge = 1 per row (NaN row if nobody alive);
+    ``n_alive`` (k,) orbits alive at t; ``mean_E`` (k,) their mean energy.
+    """
+
+    t_requested: np.ndarray
+    t: np.ndarray
+    edges: np.ndarray
+    counts: np.ndarray
+    density: np.ndarray
+    n_alive: np.ndarray
+    mean_E: np.ndarray
+
+
+def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
+    """energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms.
+
+    Histograms of the energies of orbits alive at each requested time (the
+    inset of the paper's Fig. 3; they estimate the density ρ(E(t)) of Eq.
+    (eqn:c-measure_model)).  Each requested time is mapped to the nearest
+    snapshot grid time.  ``bins`` is a number of bins (then common edges span
+    the min..max energy over the selected times) or an array of edges.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    grid = np.unique(t[np.isfinite(t)])
+    if grid.size == 0:
+        raise ValueError("no snapshot times")
+    idx = np.clip(np.searchsorted(grid, times), 1, grid.size - 1) if grid.size > 1 else np.zeros(times.size, int)
+    if grid.size > 1:
+        left, right = grid[idx - 1], grid[idx]
+        idx = np.where(np.abs(times - left) <= np.abs(right - times), idx - 1, idx)
+    used = grid[idx]
+    samples = [e[(t == tk) & np.isfinite(e)] for tk in used]
+    if np.ndim(bins) == 0:
+        allv = np.concatenate(samples) if samples else np.array([])
+        lo, hi = (float(allv.min()), float(allv.max())) if allv.size else (0.0, 1.0)
+        if hi <= lo:
+            lo, hi = lo - 0.5e-3 * max(abs(lo), 1.0), hi + 0.5e-3 * max(abs(hi), 1.0)
+        edges = np.linspace(lo, hi, int(bins) + 1)
+    else:
+        edges = np.asarray(bins, dtype=float)
+    counts = np.array([np.histogram(s, edges)[0] for s in samples], dtype=np.int64).reshape(used.size, -1)
+    widths = np.diff(edges)
+    tot = counts.sum(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        density = np.where(tot > 0, counts / (tot * widths), np.nan)
+    n_alive = np.array([s.size for s in samples], dtype=np.int64)
+    means = np.array([s.mean() if s.size else np.nan for s in samples])
+    return EnergyHistograms(times, used, edges, counts, density, n_alive, means)
+
+
+def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistograms:
+    """energy_histograms(snapshots, times, bins=50) -> EnergyHistograms.
+
+    DataFrame wrapper of :func:`energy_histograms_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).
+    """
+    return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)

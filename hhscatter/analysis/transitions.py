@@ -1,0 +1,195 @@
+"""Survival curves and the transition times τ1, τ2 (paper Sec. III.A.2, III.B.1, Fig. 6b).
+
+* τ0 — end of the irregular, ensemble-dependent initial decay; independent of
+  γ, an input here.
+* τ1 — start of enhanced trapping, Eq. (eqn:tau1):
+      τ1 = min{ t ≥ τ0 : P_γ(t) = α P_0(t) },  α > 1 (paper: α = 2).
+* τ2 — end of the escape regime.  Predicted, Eq. (eq:tau2):
+      τ2 = ln(E0/E_c) / (μ γ);
+  observed (Fig. 6b caption): "the first time at which the energy of a
+  non-escaping orbit dropped below E_c", i.e. the smallest settling time.
+
+The survival probability P(t) counts both ways of leaving: escape through a
+channel and settling (E(t) reaching E_c inside Ω), as in the paper's Fig. 5.
+
+Units: model time units for all times; energies in model units.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "survival_curve",
+    "survival_from_lifetimes",
+    "tau1",
+    "tau1_from_lifetimes",
+    "tau2_observed",
+    "tau2_observed_arrays",
+    "tau2_predicted",
+]
+
+
+# ---------------------------------------------------------------------------
+# survival probability from lifetimes
+# ---------------------------------------------------------------------------
+def survival_curve(t_end, outcome, t_grid):
+    """survival_curve(t_end, outcome, t_grid) -> (P, P_err, n_alive) arrays on t_grid.
+
+    P(t) = #{orbits with lifetime > t} / N, lifetime = ``t_end`` of escaped
+    and settled orbits.  Censored orbits (alive at t_max = their ``t_end``)
+    count as alive up to their censoring time; beyond the earliest censoring
+    time P is unknown and returned as NaN when any orbit is censored.
+    ``P_err`` = √(P(1−P)/N) is the binomial standard error of each point
+    (points of one curve are correlated; this is the marginal error).
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    outcome = np.asarray(outcome).ravel()
+    tg = np.asarray(t_grid, dtype=float)
+    N = t_end.size
+    if N == 0:
+        raise ValueError("empty lifetimes")
+    censored = outcome == "censored"
+    life = np.sort(t_end[~censored])
+    n_done = np.searchsorted(life, tg, side="right")  # lifetimes <= t
+    n_alive = N - n_done
+    P = n_alive / N
+    if censored.any():
+        t_cens = float(np.min(t_end[censored]))
+        P = np.where(tg > t_cens, np.nan, P)
+    P_err = np.sqrt(P * (1 - P) / N)
+    return P, P_err, n_alive
+
+
+def survival_from_lifetimes(lifetimes: pd.DataFrame, t_grid) -> pd.DataFrame:
+    """survival_from_lifetimes(lifetimes, t_grid) -> DataFrame[t, P, P_err, n_alive].
+
+    DataFrame wrapper of :func:`survival_curve` for the engine's ``lifetimes``
+    table (columns ``t_end``, ``outcome``).
+    """
+    P, P_err, n = survival_curve(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy(), t_grid)
+    return pd.DataFrame({"t": np.asarray(t_grid, dtype=float), "P": P, "P_err": P_err, "n_alive": n})
+
+
+# ---------------------------------------------------------------------------
+# τ1
+# ---------------------------------------------------------------------------
+def _log_ratio(P_gamma, P_0, alpha):
+    """D = ln P_γ − ln(α P_0), with +inf where P_0 = 0 < P_γ and NaN where both vanish."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        D = np.log(P_gamma) - np.log(alpha * P_0)
+    D = np.where((P_0 <= 0) & (P_gamma > 0), np.inf, D)
+    D = np.where((P_gamma <= 0) & (P_0 > 0), -np.inf, D)
+    return D
+
+
+def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
+    """tau1(t, P_gamma, P_0, tau0, alpha=2.0) -> float or None.
+
+    First time t ≥ τ0 at which P_γ(t) ≥ α P_0(t), Eq. (eqn:tau1).
+
+    ``P_gamma`` and ``P_0`` are sampled on the common grid ``t`` (increasing);
+    ``P_0`` may instead be a callable P_0(t).  The crossing is located on
+    the logarithmic scale: D(t) = ln P_γ − ln(α P_0) is linearly
+    interpolated between the last grid point with D < 0 and the first with
+    D ≥ 0 (exact for curves that are piecewise exponential between grid
+    points).  D at τ0 itself is interpolated from the neighbouring points; if
+    D(τ0) ≥ 0 the result is τ0.  Where P_0 = 0 < P_γ the condition counts as
+    met and the crossing is put at that grid point; NaN points (e.g. beyond
+    censoring) are skipped.  Returns None if the condition is never met on
+    [τ0, t[-1]] (e.g. no escaping orbits left, Fig. 6b large γ).
+    """
+    if not alpha > 0:
+        raise ValueError(f"alpha must be > 0, got {alpha!r}")
+    t = np.asarray(t, dtype=float).ravel()
+    Pg = np.asarray(P_gamma, dtype=float).ravel()
+    P0 = np.asarray(P_0(t) if callable(P_0) else P_0, dtype=float).ravel()
+    if not (t.shape == Pg.shape == P0.shape):
+        raise ValueError("t, P_gamma and P_0 must have the same length")
+    if t.size and np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing")
+    D = _log_ratio(Pg, P0, alpha)
+    keep = ~np.isnan(D)
+    t, D = t[keep], D[keep]
+    if t.size == 0 or t[-1] < tau0:
+        return None
+    # value at tau0 (log-linear interpolation between the neighbours)
+    i0 = int(np.searchsorted(t, tau0, side="left"))
+    if i0 < t.size and t[i0] == tau0:
+        D0 = D[i0]
+    elif i0 == 0:
+        D0 = D[0]
+        tau0 = float(t[0]) if t[0] > tau0 else tau0
+    else:
+        a, b = D[i0 - 1], D[i0]
+        if np.isfinite(a) and np.isfinite(b):
+            D0 = a + (b - a) * (tau0 - t[i0 - 1]) / (t[i0] - t[i0 - 1])
+        else:
+            D0 = a  # an infinite end point: keep the value left of tau0
+    if D0 >= 0:
+        return float(tau0)
+    tt = np.concatenate([[tau0], t[t > tau0]])
+    DD = np.concatenate([[D0], D[t > tau0]])
+    hit = np.flatnonzero(DD >= 0)
+    if hit.size == 0:
+        return None
+    j = int(hit[0])
+    a, b = DD[j - 1], DD[j]
+    if not (np.isfinite(a) and np.isfinite(b)):
+        return float(tt[j])
+    return float(tt[j - 1] + (tt[j] - tt[j - 1]) * (-a) / (b - a))
+
+
+def tau1_from_lifetimes(lifetimes_gamma: pd.DataFrame, lifetimes_0: pd.DataFrame, t_grid, tau0: float, alpha: float = 2.0):
+    """tau1_from_lifetimes(lifetimes_gamma, lifetimes_0, t_grid, tau0, alpha=2.0) -> float or None.
+
+    Observed τ1 (Fig. 6b symbols): :func:`tau1` applied to the survival
+    curves of a dissipative (γ > 0) and the conservative (γ = 0) ensemble,
+    both evaluated by :func:`survival_curve` on ``t_grid``.
+    """
+    Pg, _, _ = survival_curve(lifetimes_gamma["t_end"].to_numpy(), lifetimes_gamma["outcome"].to_numpy(), t_grid)
+    P0, _, _ = survival_curve(lifetimes_0["t_end"].to_numpy(), lifetimes_0["outcome"].to_numpy(), t_grid)
+    return tau1(t_grid, Pg, P0, tau0, alpha)
+
+
+# ---------------------------------------------------------------------------
+# τ2
+# ---------------------------------------------------------------------------
+def tau2_observed_arrays(t_end, outcome):
+    """tau2_observed_arrays(t_end, outcome) -> float or None.
+
+    Observed τ2 (paper Fig. 6b caption): the first time at which the energy
+    of a non-escaping orbit dropped below E_c.  The engine records for a
+    settled orbit the time at which E(t) reaches E_c (``t_end``), so this is
+    min t_end over orbits with outcome 'settled'.  None if no orbit settled.
+    Escaped orbits (whose energy also falls below E_c, but outside Ω) and
+    censored orbits are not used.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    settled = (np.asarray(outcome).ravel() == "settled") & np.isfinite(t_end)
+    return float(t_end[settled].min()) if settled.any() else None
+
+
+def tau2_observed(lifetimes: pd.DataFrame):
+    """tau2_observed(lifetimes) -> float or None: min ``t_end`` over settled orbits, see :func:`tau2_observed_arrays`."""
+    return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy())
+
+
+def tau2_predicted(E0, E_c, mu, gamma):
+    """tau2_predicted(E0, E_c, mu, gamma) -> float or array.
+
+    Predicted end of the escape regime, Eq. (eq:tau2):
+        τ2 = ln(E0 / E_c) / (μ γ),
+    the time at which the homogeneous energy law E(t) = E0 e^{−μγt}, Eq.
+    (eqn:energy_exp_decay), reaches E_c.  Broadcasts over arrays.  Returns
+    0 where E0 ≤ E_c (no escape regime at all) and +inf where μγ = 0 (< 0 is
+    rejected).  Time in model units.
+    """
+    E0, E_c, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E_c, mu, gamma)))
+    rate = mu * gamma
+    if np.any(rate < 0) or np.any(E_c <= 0):
+        raise ValueError("need mu*gamma >= 0 and E_c > 0")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.log(E0 / E_c) / rate
+    out = np.where(E0 <= E_c, 0.0, np.where(rate == 0, np.inf, out))
+    return float(out) if out.ndim == 0 else out

@@ -1,0 +1,115 @@
+"""Initial conditions on the section ṙ = 0, φ̇ > 0 (paper, App. "Initial Conditions").
+
+Positions are uniform in area in a region; velocities are tangential with
+the speed fixed by the energy:
+
+    ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V)).
+
+Determinism: orbits are generated in fixed blocks of ``BLOCK`` orbits; block
+b draws from ``numpy.random.Generator(PCG64(SeedSequence(seed, spawn_key=(b,))))``.
+Orbit i is therefore fixed by (seed, i) alone, whatever the chunk size or the
+number of workers.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .scene import Scene, SceneError
+
+BLOCK = 4096
+
+
+def _block_rng(seed: int, block: int) -> np.random.Generator:
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(block,))))
+
+
+def _candidates(rng, region, radius, saddle_radius, m):
+    if region == "disk":
+        r = radius * np.sqrt(rng.random(m))
+        phi = 2 * np.pi * rng.random(m)
+        return r * np.cos(phi), r * np.sin(phi)
+    # 'well': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
+    xy = saddle_radius * (2 * rng.random((2, m)) - 1)
+    return xy[0], xy[1]
+
+
+def section_velocities(model, x, y, energy):
+    """section_velocities(model, x, y, E) -> (px, py): tangential, φ̇ > 0, |p|² = 2(E − V)."""
+    r = np.hypot(x, y)
+    v = np.sqrt(2.0 * (energy - model.potential(x, y)))
+    return -y / r * v, x / r * v
+
+
+def sample_block(scene: Scene, block: int) -> np.ndarray:
+    """sample_block(scene, block) -> array (BLOCK, 4) of states (x, y, px, py).
+
+    Candidates with V ≥ E, r = 0 or (region 'well') outside the saddle triangle
+    are rejected and redrawn from the same block generator.
+    """
+    model = scene.model
+    rng = _block_rng(scene.seed, block)
+    xs, ys, have = [], [], 0
+    while have < BLOCK:
+        x, y = _candidates(rng, scene.region, scene.radius, model.saddle_radius, BLOCK)
+        ok = (model.potential(x, y) < scene.energy) & ((x != 0) | (y != 0))
+        if scene.region == "well":
+            ok &= model.inside_triangle(x, y)
+        xs.append(x[ok])
+        ys.append(y[ok])
+        have += int(ok.sum())
+    x = np.concatenate(xs)[:BLOCK]
+    y = np.concatenate(ys)[:BLOCK]
+    px, py = section_velocities(model, x, y, scene.energy)
+    return np.column_stack([x, y, px, py])
+
+
+def region_ics(scene: Scene, start: int, stop: int) -> np.ndarray:
+    """region_ics(scene, start, stop) -> array (stop − start, 4) for orbits start..stop−1."""
+    blocks = range(start // BLOCK, (stop - 1) // BLOCK + 1)
+    arr = np.concatenate([sample_block(scene, b) for b in blocks])
+    off = start - blocks[0] * BLOCK
+    return arr[off : off + (stop - start)]
+
+
+def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
+    """read_ics_table(path) -> (states (n, 4), traj_id (n,) int64) from Parquet or CSV.
+
+    Required columns: x, y, px, py (float); optional traj_id (unique int).
+    Missing columns, non-finite values or duplicate ids raise SceneError.
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if not path.exists():
+        raise SceneError(f"ics: file not found: {path}")
+    try:
+        if path.suffix.lower() in (".parquet", ".pq"):
+            df = pd.read_parquet(path)
+        else:
+            df = pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is the user's file
+        raise SceneError(f"ics: cannot read {path}: {exc}") from None
+    missing = [c for c in ("x", "y", "px", "py") if c not in df.columns]
+    if missing:
+        raise SceneError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")
+    if len(df) == 0:
+        raise SceneError(f"ics: table {path} has no rows")
+    try:
+        states = df[["x", "y", "px", "py"]].to_numpy(dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"ics: columns x, y, px, py must be numeric: {exc}") from None
+    bad = ~np.isfinite(states).all(axis=1)
+    if bad.any():
+        raise SceneError(f"ics: {int(bad.sum())} row(s) have non-finite values (first at row {int(np.argmax(bad))})")
+    if "traj_id" in df.columns:
+        ids = df["traj_id"].to_numpy()
+        if not np.issubdtype(ids.dtype, np.integer):
+            raise SceneError("ics: traj_id must be integers")
+        if len(np.unique(ids)) != len(ids):
+            raise SceneError("ics: traj_id values must be unique")
+        ids = ids.astype(np.int64)
+    else:
+        ids = np.arange(len(df), dtype=np.int64)
+    return states, ids

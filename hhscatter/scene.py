@@ -1,0 +1,302 @@
+"""Scenes: what one simulation computes, as a frozen, validated dataclass.
+
+A scene is loaded from ``studies/<name>/scene.toml`` (table ``[scene]``, and
+optionally ``[sections]``, ``[snapshots]`` and ``[scale.<name>]`` overrides)
+or built from CLI flags. Every bad value is refused before any work with a
+``SceneError`` naming the parameter and its allowed range.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .model import HenonHeiles
+
+REGIONS = ("disk", "well")
+TOL_RANGE = (1e-18, 1e-6)
+
+
+class SceneError(ValueError):
+    """A scene parameter is outside its allowed range."""
+
+
+def _finite(name, value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class SectionWindow:
+    """SectionWindow(t_from=0, t_to=inf, e_min=-inf, e_max=inf, first_only=False).
+
+    Which crossings of the section ṙ = 0, φ̇ > 0 to record (paper, App.
+    "Initial Conditions"): those at orbit times t_from ≤ t ≤ t_to whose energy
+    lies in [e_min, e_max]; with ``first_only`` only the first such crossing
+    of each orbit. Examples: the first crossing after t* is
+    ``SectionWindow(t_from=t_star, first_only=True)``; the first crossing in an
+    energy band is ``SectionWindow(e_min=0.295, e_max=0.305, first_only=True)``.
+    The initial point itself (t = 0) is never recorded.
+    """
+
+    t_from: float = 0.0
+    t_to: float = math.inf
+    e_min: float = -math.inf
+    e_max: float = math.inf
+    first_only: bool = False
+
+    def __post_init__(self):
+        for name in ("t_from", "t_to", "e_min", "e_max"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or math.isnan(v):
+                raise SceneError(f"sections.{name} must be a number, got {v!r}")
+        if self.t_from < 0 or math.isinf(self.t_from):
+            raise SceneError(f"sections.t_from must be finite and ≥ 0, got {self.t_from}")
+        if not self.t_to > self.t_from:
+            raise SceneError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
+        if not self.e_max > self.e_min:
+            raise SceneError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Scene(energy, n, gamma=0, seed=0, ...) -> one ensemble simulation.
+
+    Parameters (natural units of the model):
+      energy      E0, the initial energy of every orbit (must exceed E_c)
+      n           number of orbits N (> 0)
+      gamma       drag γ ≥ 0 (γ = 0: conservative)
+      seed        integer ≥ 0; with the orbit index it fixes every initial condition
+      region      'disk' (uniform in area in r < radius) or 'well' (uniform in the
+                  saddle triangle where V < E); velocities tangential on the section
+      radius      disk radius R (default 0.5, as in the authors' code)
+      r_esc       escape radius (default 1.03), > saddle distance ω²/λ
+      r_far       dissipative runs: radius beyond which an escaped orbit is
+                  stopped (default max(10 ω²/λ, 2 r_esc))
+      t_max       maximum orbit time (default 5000); orbits alive then are censored
+      tol         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15)
+      omega, lam  potential parameters ω, λ > 0 (default 1, 1)
+      chunk_size  orbits per part file (default 10000); results do not depend on it
+      batch_size  SIMD lanes (default: heyoka's recommended size); no effect on results
+      ics         optional path of a Parquet/CSV table with columns x, y, px, py
+      sections    SectionWindow or None (no section table)
+      snapshots   tuple of orbit times for energy snapshots, or None
+    """
+
+    energy: float | None
+    n: int
+    gamma: float = 0.0
+    seed: int = 0
+    region: str = "disk"
+    radius: float = 0.5
+    r_esc: float = 1.03
+    r_far: float | None = None
+    t_max: float = 5000.0
+    tol: float = 1e-15
+    omega: float = 1.0
+    lam: float = 1.0
+    chunk_size: int = 10000
+    batch_size: int | None = None
+    ics: str | None = None
+    sections: SectionWindow | None = None
+    snapshots: tuple | None = None
+    name: str = "scene"
+    _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        try:
+            model = HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+        object.__setattr__(self, "_model", model)
+        self._validate()
+
+    @property
+    def model(self) -> HenonHeiles:
+        return self._model
+
+    @property
+    def dissipative(self) -> bool:
+        return self.gamma > 0
+
+    # -- validation ---------------------------------------------------------
+    def _validate(self):
+        m = self.model
+        gamma = _finite("gamma", self.gamma)
+        if gamma < 0:
+            raise SceneError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
+        if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
+            raise SceneError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
+        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise SceneError(f"seed must be an integer ≥ 0, got {self.seed!r}")
+        tol = _finite("tol", self.tol)
+        if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
+            raise SceneError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
+        t_max = _finite("t_max", self.t_max)
+        if t_max <= 0:
+            raise SceneError(f"t_max must be > 0, got {t_max}")
+        r_esc = _finite("r_esc", self.r_esc)
+        if r_esc <= m.saddle_radius:
+            raise SceneError(
+                f"r_esc must be > the saddle distance ω²/λ = {m.saddle_radius:g} "
+                f"(outside the Lyapunov orbits), got {r_esc}"
+            )
+        if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
+            raise SceneError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
+        if self.region not in REGIONS:
+            raise SceneError(f"region must be one of {REGIONS}, got {self.region!r}")
+        radius = _finite("radius", self.radius)
+        if radius <= 0:
+            raise SceneError(f"radius must be > 0, got {radius}")
+        if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
+            raise SceneError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
+        if self.batch_size is not None and (
+            not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
+        ):
+            raise SceneError(f"batch_size must be an integer in [1, 64], got {self.batch_size!r}")
+        if self.ics is None:
+            if self.energy is None:
+                raise SceneError("energy is required unless initial conditions come from a table (ics)")
+            energy = _finite("energy", self.energy)
+            # the region's minimum of V is V(0, 0) = 0 (the origin is in both regions)
+            if energy <= 0:
+                raise SceneError(
+                    f"energy must be > 0 = min V over the {self.region!r} region "
+                    f"(no point of the region is accessible), got {energy}"
+                )
+            if energy <= m.critical_energy:
+                what = "dissipative" if gamma > 0 else "conservative escape"
+                raise SceneError(
+                    f"energy must be > E_c = {m.critical_energy:.10g} in a {what} scene "
+                    f"(no escape is possible below it), got {energy}"
+                )
+        elif self.energy is not None:
+            raise SceneError("energy must not be given with ics: each orbit's energy comes from its table row")
+        if self.sections is not None and not isinstance(self.sections, SectionWindow):
+            raise SceneError("sections must be a SectionWindow or None")
+        if self.snapshots is not None:
+            snaps = tuple(float(s) for s in self.snapshots)
+            if not snaps:
+                raise SceneError("snapshots must be a non-empty list of times or omitted")
+            if not all(math.isfinite(s) and 0 <= s <= t_max for s in snaps):
+                raise SceneError(f"snapshots times must be finite and in [0, t_max = {t_max}]")
+            if any(b <= a for a, b in zip(snaps, snaps[1:])):
+                raise SceneError("snapshots times must be strictly increasing")
+            object.__setattr__(self, "snapshots", snaps)
+
+    # -- identity -----------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
+        d["sections"] = dataclasses.asdict(self.sections) if self.sections else None
+        d["snapshots"] = list(self.snapshots) if self.snapshots else None
+        return d
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, default=_json_default)
+
+    def result_hash(self) -> str:
+        """sha256 of everything that determines the tables (not name, batch size)."""
+        d = self.to_dict()
+        for k in ("name", "batch_size"):
+            d.pop(k)
+        if self.ics is not None:
+            d["ics"] = hashlib.sha256(Path(self.ics).read_bytes()).hexdigest()
+        return hashlib.sha256(json.dumps(d, sort_keys=True, default=_json_default).encode()).hexdigest()
+
+    def replace(self, **changes) -> "Scene":
+        return dataclasses.replace(self, **changes)
+
+
+def _json_default(v):
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if isinstance(v, np.generic):
+        return v.item()
+    raise TypeError(f"not JSON serialisable: {v!r}")
+
+
+def _inf(v):
+    if isinstance(v, str) and v.lower() in ("inf", "+inf", "-inf"):
+        return float(v)
+    return v
+
+
+def scene_from_dict(d: dict) -> Scene:
+    """scene_from_dict(d) -> Scene; inverse of ``Scene.to_dict``; unknown keys are refused."""
+    d = dict(d)
+    sec = d.pop("sections", None)
+    if sec is not None:
+        if not isinstance(sec, dict):
+            raise SceneError("sections must be a table")
+        unknown = set(sec) - {f.name for f in dataclasses.fields(SectionWindow)}
+        if unknown:
+            raise SceneError(f"unknown sections keys: {sorted(unknown)}")
+        d["sections"] = SectionWindow(**{k: _inf(v) for k, v in sec.items()})
+    snaps = d.pop("snapshots", None)
+    if isinstance(snaps, dict):
+        unknown = set(snaps) - {"times", "start", "stop", "step"}
+        if unknown:
+            raise SceneError(f"unknown snapshots keys: {sorted(unknown)}")
+        if "times" in snaps:
+            snaps = snaps["times"]
+        else:
+            try:
+                start, stop, step = (float(snaps[k]) for k in ("start", "stop", "step"))
+            except KeyError as exc:
+                raise SceneError(f"snapshots needs 'times' or start/stop/step (missing {exc})") from None
+            if not step > 0:
+                raise SceneError(f"snapshots.step must be > 0, got {step}")
+            snaps = list(np.arange(start, stop + 0.5 * step, step))
+    if snaps is not None:
+        d["snapshots"] = tuple(snaps)
+    known = {f.name for f in dataclasses.fields(Scene) if f.init}
+    unknown = set(d) - known
+    if unknown:
+        raise SceneError(f"unknown scene keys: {sorted(unknown)}; allowed: {sorted(known)}")
+    if "n" not in d:
+        raise SceneError("a scene needs 'n' (number of orbits)")
+    d.setdefault("energy", None)
+    return Scene(**d)
+
+
+def load_scene(path, scale: str | None = None, **overrides) -> Scene:
+    """load_scene(path, scale=None, **overrides) -> Scene from a TOML file.
+
+    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow
+    fields), ``[snapshots]`` (``times = [...]`` or ``start/stop/step``) and
+    ``[scale.<name>]`` tables whose keys override ``[scene]`` when ``scale``
+    is given. Keyword overrides are applied last.
+    """
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"scene file not found: {path}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"scene file {path} is not valid TOML: {exc}") from None
+    if "scene" not in doc:
+        raise SceneError(f"scene file {path} has no [scene] table")
+    d = dict(doc["scene"])
+    d.setdefault("name", path.parent.name)
+    if "sections" in doc:
+        d["sections"] = doc["sections"]
+    if "snapshots" in doc:
+        d["snapshots"] = doc["snapshots"]
+    if scale is not None and scale != "quick":
+        scales = doc.get("scale", {})
+        if scale not in scales:
+            raise SceneError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
+        d.update(scales[scale])
+    d.update({k: v for k, v in overrides.items() if v is not None})
+    return scene_from_dict(d)
