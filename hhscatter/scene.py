@@ -203,7 +203,8 @@ class Scene:
         return d
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), sort_keys=True, default=_json_default)
+        """Strict JSON (infinities written as the strings "inf"/"-inf")."""
+        return json.dumps(_clean(self.to_dict()), sort_keys=True, allow_nan=False, default=_json_default)
 
     def result_hash(self) -> str:
         """sha256 of everything that determines the tables (not name, batch size)."""
@@ -212,10 +213,20 @@ class Scene:
             d.pop(k)
         if self.ics is not None:
             d["ics"] = hashlib.sha256(Path(self.ics).read_bytes()).hexdigest()
-        return hashlib.sha256(json.dumps(d, sort_keys=True, default=_json_default).encode()).hexdigest()
+        return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()
 
     def replace(self, **changes) -> "Scene":
         return dataclasses.replace(self, **changes)
+
+
+def _clean(v):
+    if isinstance(v, dict):
+        return {k: _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return v
 
 
 def _json_default(v):

@@ -1,0 +1,373 @@
+"""Distances between point sets on the surface of section (paper Sec. III.B.2, Fig. 4).
+
+The paper compares, by eye, the section crossings (x, y) of dissipative orbits
+alive at t* with the conservative c-measure μ_c^{E1}, and claims that "the
+agreement is expected to hold up to a finite spatial scale, which becomes
+increasingly small as the time for the distributions to relax increases"
+(below Eq. (eqn:c-measure_model)).  This module makes that comparison
+quantitative.
+
+Distances provided
+------------------
+* Box-counting histograms on a common partition of boxes of side ε:
+  total variation TV = ½ Σ|p_i − q_i| ∈ [0, 1] and Hellinger
+  H = (½ Σ(√p_i − √q_i)²)^{1/2} ∈ [0, 1] (:func:`histogram_distance`), and
+  their dependence on ε (:func:`distance_vs_scale`).  They obey
+  H² ≤ TV ≤ √2 H.
+* Sliced Wasserstein SW_p (:func:`sliced_wasserstein`): the W_p distance of
+  1-D projections averaged over directions; in units of x, y.
+* :func:`bootstrap_distance` (resampling spread) and
+  :func:`split_half_baseline` (finite-sample noise floor).
+
+Which distance to headline
+--------------------------
+**Hellinger on box histograms, as a function of ε.**  The paper's claim is
+scale-resolved — agreement "up to a finite spatial scale" — and so is
+H(ε): at box side ε it is blind to structure finer than ε and sensitive to
+everything coarser, so the curve H(ε) against its noise floor yields the
+agreement scale directly (:func:`agreement_scale`).  Hellinger is preferred
+over TV because (i) it is a sum of per-box terms whose finite-sample bias is
+nearly independent of the box masses, E[H²] ≈ B/8 (1/n_P + 1/n_Q) for B
+occupied boxes with many counts, so the split-half noise floor is clean and
+predictable; (ii) it weights low-mass boxes (thin filaments of the unstable
+manifold, where supports differ) more than TV does, which is where a
+fractal c-measure and a noisier dissipative distribution disagree; (iii) it is
+bounded and a metric, so values are comparable across ε and data sets.  TV is
+reported alongside (same information, more common interpretation: the
+largest difference in probability of any set of boxes).
+
+The sliced Wasserstein distance is scale-free: one number in units of
+length, dominated by where the bulk of the mass is, and nearly insensitive to
+fine filaments (moving mass by δ costs only ~δ).  It is a good global check
+(e.g. that μ_c^{E1} is closer than μ_c^{E2}, Fig. 4a vs Fig. 1b) but cannot
+by itself say down to which scale two sets agree.
+
+Finite-sample baseline and the agreement scale
+----------------------------------------------
+Histogram distances between two finite samples are biased upwards: two
+independent samples of the *same* distribution have H(ε) > 0, growing as ε
+shrinks (fewer points per box) until H → 1 when boxes hold ≤ 1 point.
+:func:`distance_vs_scale` (with ``n_splits`` > 0) therefore compares like with
+like at a common sample size m = ⌊min(n_P, n_Q)/2⌋: for random disjoint halves
+P1, P2 of P and Q1, Q2 of Q it records d_PQ = mean(d(P1,Q1), d(P2,Q2)) and the
+noise floor d_noise = mean(d(P1,P2), d(Q1,Q2)), each averaged over
+``n_splits`` random splits (their spread over splits is reported as *_std).
+If P and Q come from one distribution, d_PQ and d_noise have the same
+expectation.  The two sets are said to *agree at scale ε* when
+d_PQ ≤ d_noise + z·std(d_noise) (z = 2 by default) and the scale is
+*informative* when d_noise ≤ noise_max (default 0.5; beyond it the boxes are
+so sparsely filled that any two samples look different).  The agreement scale
+ε* (:func:`agreement_scale`) is the smallest ε such that the sets agree at
+every informative box size ≥ ε.  Since the noise floor shrinks with sample
+size, ε* is a statement about the data at hand: with more points a real
+difference becomes detectable at coarser ε.
+
+Inputs are arrays of shape (n, 2) with columns (x, y) (any 2-D coordinates).
+Outputs: dimensionless for TV/H, length units for SW.
+"""
+from __future__ import annotations
+
+from typing import Callable, NamedTuple
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "BootstrapResult",
+    "agreement_scale",
+    "bootstrap_distance",
+    "box_histograms",
+    "distance_vs_scale",
+    "hellinger",
+    "histogram_distance",
+    "points",
+    "sliced_wasserstein",
+    "split_half_baseline",
+    "total_variation",
+    "wasserstein_1d",
+]
+
+KINDS = ("hellinger", "tv")
+
+
+class BootstrapResult(NamedTuple):
+    """(mean, std) of a resampled distance."""
+
+    mean: float
+    std: float
+
+
+def points(df: pd.DataFrame, columns=("x", "y")) -> np.ndarray:
+    """points(df, columns=("x", "y")) -> (n, 2) float array, e.g. from the engine's ``sections`` table."""
+    return np.column_stack([df[c].to_numpy(dtype=float) for c in columns])
+
+
+def _as_points(X) -> np.ndarray:
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 2 or X.shape[1] != 2:
+        raise ValueError(f"expected an (n, 2) array of points, got shape {X.shape}")
+    if X.shape[0] == 0:
+        raise ValueError("empty point set")
+    return X
+
+
+def _extent_of(*sets, pad=1e-9):
+    allp = np.vstack(sets)
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    w = np.maximum(hi - lo, 1e-12)
+    return (lo[0] - pad * w[0], hi[0] + pad * w[0], lo[1] - pad * w[1], hi[1] + pad * w[1])
+
+
+def _cells(X, box, extent):
+    """Box index of each point; −1 for points outside ``extent`` (one overflow cell)."""
+    x0, x1, y0, y1 = map(float, extent)
+    if not (x1 > x0 and y1 > y0):
+        raise ValueError(f"bad extent {extent!r}")
+    if not box > 0:
+        raise ValueError(f"box size must be > 0, got {box!r}")
+    nx = int(np.floor((x1 - x0) / box)) + 1
+    ny = int(np.floor((y1 - y0) / box)) + 1
+    ix = np.floor((X[:, 0] - x0) / box)
+    iy = np.floor((X[:, 1] - y0) / box)
+    inside = (X[:, 0] >= x0) & (X[:, 0] <= x1) & (X[:, 1] >= y0) & (X[:, 1] <= y1)
+    return np.where(inside, ix.astype(np.int64) * ny + iy.astype(np.int64), -1)
+
+
+def box_histograms(P, Q, box: float, extent=None, weights_P=None, weights_Q=None):
+    """box_histograms(P, Q, box, extent=None) -> (p, q) probability vectors on the occupied boxes.
+
+    Common partition of ``extent`` = (x_min, x_max, y_min, y_max) (default:
+    bounding box of P ∪ Q) into squares of side ``box`` anchored at
+    (x_min, y_min); points outside ``extent`` share one overflow cell so that
+    no mass is lost.  Only boxes occupied by P or Q are returned (memory does
+    not grow with 1/ε²).  Optional non-negative weights per point.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    if extent is None:
+        extent = _extent_of(P, Q)
+    cp, cq = _cells(P, box, extent), _cells(Q, box, extent)
+    uniq, inv = np.unique(np.concatenate([cp, cq]), return_inverse=True)
+    wp = np.ones(P.shape[0]) if weights_P is None else np.asarray(weights_P, dtype=float)
+    wq = np.ones(Q.shape[0]) if weights_Q is None else np.asarray(weights_Q, dtype=float)
+    p = np.bincount(inv[: P.shape[0]], weights=wp, minlength=uniq.size)
+    q = np.bincount(inv[P.shape[0]:], weights=wq, minlength=uniq.size)
+    return p / p.sum(), q / q.sum()
+
+
+def total_variation(p, q) -> float:
+    """total_variation(p, q) -> ½ Σ|p_i − q_i| ∈ [0, 1] for probability vectors."""
+    return float(0.5 * np.sum(np.abs(np.asarray(p) - np.asarray(q))))
+
+
+def hellinger(p, q) -> float:
+    """hellinger(p, q) -> (½ Σ(√p_i − √q_i)²)^{1/2} ∈ [0, 1] for probability vectors."""
+    d = np.sqrt(np.asarray(p, dtype=float)) - np.sqrt(np.asarray(q, dtype=float))
+    return float(np.sqrt(min(0.5 * np.sum(d * d), 1.0)))
+
+
+def histogram_distance(P, Q, box: float, extent=None, kind: str = "hellinger", *, weights_P=None, weights_Q=None) -> float:
+    """histogram_distance(P, Q, box, extent, kind="hellinger") -> float in [0, 1].
+
+    Hellinger (``kind="hellinger"``) or total-variation (``kind="tv"``)
+    distance between the box histograms of the point sets P, Q ((n, 2)
+    arrays) on the common partition of ``extent`` into boxes of side ``box``
+    (see :func:`box_histograms`).  Dimensionless; H² ≤ TV ≤ √2 H.
+    """
+    p, q = box_histograms(P, Q, box, extent, weights_P, weights_Q)
+    if kind == "hellinger":
+        return hellinger(p, q)
+    if kind == "tv":
+        return total_variation(p, q)
+    raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+
+
+def distance_vs_scale(
+    P,
+    Q,
+    boxes,
+    extent=None,
+    *,
+    kinds=KINDS,
+    n_splits: int = 8,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """distance_vs_scale(P, Q, boxes, extent=None, *, kinds=("hellinger", "tv"), n_splits=8, seed=0) -> DataFrame.
+
+    One row per box side ε in ``boxes`` (sorted decreasing) with columns
+
+    * ``box`` and, per kind, ``<kind>``: the distance between the full sets;
+    * if ``n_splits`` > 0, at the common sample size m = ⌊min(n_P, n_Q)/2⌋
+      (column ``m``): ``<kind>_pq`` (mean of d(P1,Q1), d(P2,Q2)),
+      ``<kind>_pq_std``, ``<kind>_noise`` (split-half noise floor, mean of
+      d(P1,P2), d(Q1,Q2)), ``<kind>_noise_std`` and ``<kind>_excess`` =
+      pq − noise, over ``n_splits`` random splits (module docstring).
+
+    ``extent`` defaults to the bounding box of P ∪ Q; the same partition is
+    used for every comparison.  Deterministic for a given ``seed``.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    if extent is None:
+        extent = _extent_of(P, Q)
+    boxes = np.sort(np.asarray(boxes, dtype=float).ravel())[::-1]
+    for k in kinds:
+        if k not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got {k!r}")
+    fn = {"hellinger": hellinger, "tv": total_variation}
+    rows = []
+    for eps in boxes:
+        p, q = box_histograms(P, Q, eps, extent)
+        rows.append({"box": float(eps), **{k: fn[k](p, q) for k in kinds}})
+    out = pd.DataFrame(rows)
+    if n_splits > 0:
+        m = min(P.shape[0], Q.shape[0]) // 2
+        if m < 1:
+            raise ValueError("need at least 2 points in each set for the split-half baseline")
+        rng = np.random.default_rng(seed)
+        pq = np.empty((n_splits, boxes.size, len(kinds)))
+        nz = np.empty_like(pq)
+        for s in range(n_splits):
+            ip, iq = rng.permutation(P.shape[0]), rng.permutation(Q.shape[0])
+            P1, P2 = P[ip[:m]], P[ip[m : 2 * m]]
+            Q1, Q2 = Q[iq[:m]], Q[iq[m : 2 * m]]
+            for j, eps in enumerate(boxes):
+                for i, k in enumerate(kinds):
+                    d = lambda A, B: fn[k](*box_histograms(A, B, eps, extent))  # noqa: E731
+                    pq[s, j, i] = 0.5 * (d(P1, Q1) + d(P2, Q2))
+                    nz[s, j, i] = 0.5 * (d(P1, P2) + d(Q1, Q2))
+        out["m"] = m
+        ddof = 1 if n_splits > 1 else 0
+        for i, k in enumerate(kinds):
+            out[f"{k}_pq"] = pq[:, :, i].mean(axis=0)
+            out[f"{k}_pq_std"] = pq[:, :, i].std(axis=0, ddof=ddof)
+            out[f"{k}_noise"] = nz[:, :, i].mean(axis=0)
+            out[f"{k}_noise_std"] = nz[:, :, i].std(axis=0, ddof=ddof)
+            out[f"{k}_excess"] = out[f"{k}_pq"] - out[f"{k}_noise"]
+    return out
+
+
+def agreement_scale(table: pd.DataFrame, kind: str = "hellinger", z: float = 2.0, noise_max: float = 0.5):
+    """agreement_scale(table, kind="hellinger", z=2.0, noise_max=0.5) -> float or None.
+
+    From a :func:`distance_vs_scale` table computed with ``n_splits`` ≥ 2:
+    the smallest box side ε* such that at every informative box size
+    ε ≥ ε* (noise floor ``<kind>_noise`` ≤ ``noise_max``) the sets agree
+    within sampling noise, ``<kind>_pq`` ≤ ``<kind>_noise`` + z·``<kind>_noise_std``.
+    None if they already disagree at the coarsest informative scale (or no
+    scale is informative).  Same units as the boxes.
+    """
+    need = {f"{kind}_pq", f"{kind}_noise", f"{kind}_noise_std"}
+    if not need <= set(table.columns):
+        raise ValueError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
+    tab = table.sort_values("box", ascending=False)
+    tab = tab[tab[f"{kind}_noise"] <= noise_max]
+    best = None
+    for _, r in tab.iterrows():
+        if r[f"{kind}_pq"] <= r[f"{kind}_noise"] + z * r[f"{kind}_noise_std"]:
+            best = float(r["box"])
+        else:
+            break
+    return best
+
+
+# ---------------------------------------------------------------------------
+# sliced Wasserstein
+# ---------------------------------------------------------------------------
+def _w1d_sorted(xs, ys, p):
+    """W_p^p between sorted samples along axis 0 (columns = projections)."""
+    n, m = xs.shape[0], ys.shape[0]
+    if n == m:
+        return np.mean(np.abs(xs - ys) ** p, axis=0)
+    u = np.union1d(np.arange(1, n + 1) / n, np.arange(1, m + 1) / m)
+    du = np.diff(np.concatenate([[0.0], u]))
+    mid = u - 0.5 * du
+    ix = np.minimum((mid * n).astype(np.int64), n - 1)
+    iy = np.minimum((mid * m).astype(np.int64), m - 1)
+    return du @ (np.abs(xs[ix] - ys[iy]) ** p)
+
+
+def wasserstein_1d(x, y, p: float = 1) -> float:
+    """wasserstein_1d(x, y, p=1) -> W_p between two 1-D empirical distributions (exact, via quantile functions)."""
+    xs = np.sort(np.asarray(x, dtype=float).ravel())[:, None]
+    ys = np.sort(np.asarray(y, dtype=float).ravel())[:, None]
+    return float(_w1d_sorted(xs, ys, p)[0] ** (1.0 / p))
+
+
+def sliced_wasserstein(P, Q, n_proj: int = 128, seed: int = 0, *, p: float = 1, directions: str = "stratified") -> float:
+    """sliced_wasserstein(P, Q, n_proj=128, seed=0, *, p=1, directions="stratified") -> float.
+
+    SW_p(P, Q) = ( mean_θ W_p(⟨P,θ⟩, ⟨Q,θ⟩)^p )^{1/p} over ``n_proj`` unit
+    directions θ in the plane (θ and −θ are equivalent, so angles lie in
+    [0, π)).  ``directions="stratified"`` (default) uses equally spaced
+    angles with a random common offset (error O(1/n_proj²) for smooth
+    integrands); ``"random"`` draws i.i.d. uniform angles.  Deterministic for
+    a given ``seed``.  The 1-D distances are exact for unequal sample sizes.
+    Units of the coordinates.  For Q = P + s (pure translation) and p = 1,
+    SW_1 = E_θ|⟨s,θ⟩| = 2|s|/π; for p = 2, SW_2 = |s|/√2.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    n_proj = int(n_proj)
+    if n_proj < 1:
+        raise ValueError("n_proj must be >= 1")
+    rng = np.random.default_rng(seed)
+    if directions == "stratified":
+        ang = rng.uniform(0.0, np.pi / n_proj) + np.pi * np.arange(n_proj) / n_proj
+    elif directions == "random":
+        ang = rng.uniform(0.0, np.pi, n_proj)
+    else:
+        raise ValueError("directions must be 'stratified' or 'random'")
+    dirs = np.column_stack([np.cos(ang), np.sin(ang)])
+    total = 0.0
+    chunk = max(1, int(4_000_000 // max(P.shape[0] + Q.shape[0], 1)))
+    for s in range(0, n_proj, chunk):
+        D = dirs[s : s + chunk].T
+        xs = np.sort(P @ D, axis=0)
+        ys = np.sort(Q @ D, axis=0)
+        total += float(np.sum(_w1d_sorted(xs, ys, p)))
+    return float((total / n_proj) ** (1.0 / p))
+
+
+# ---------------------------------------------------------------------------
+# resampling
+# ---------------------------------------------------------------------------
+def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> BootstrapResult:
+    """bootstrap_distance(P, Q, fn, n_boot=100, seed=0) -> BootstrapResult(mean, std).
+
+    Resamples P and Q independently with replacement ``n_boot`` times and
+    returns the mean and standard deviation (ddof = 1) of fn(P*, Q*), e.g.
+    ``fn = lambda A, B: histogram_distance(A, B, 0.01, extent)``.  The std
+    is the sampling error of fn(P, Q).  Note that resampling with replacement
+    duplicates points, which biases histogram distances upwards (fewer
+    distinct points); judge closeness against :func:`split_half_baseline`,
+    not against zero.  Deterministic for a given ``seed``.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    rng = np.random.default_rng(seed)
+    vals = np.empty(int(n_boot))
+    for i in range(vals.size):
+        vals[i] = fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
+    return BootstrapResult(float(vals.mean()), float(vals.std(ddof=1)) if vals.size > 1 else 0.0)
+
+
+def split_half_baseline(P, fn: Callable, n_splits: int = 20, seed: int = 0, size: int | None = None) -> BootstrapResult:
+    """split_half_baseline(P, fn, n_splits=20, seed=0, size=None) -> BootstrapResult(mean, std).
+
+    Finite-sample noise floor of the distance ``fn``: mean and std (ddof = 1)
+    of fn(A, B) over ``n_splits`` random splits of P into two disjoint
+    subsets A, B of ``size`` points each (default ⌊n/2⌋).  A and B are
+    independent samples of the same distribution, so fn(A, B) is what fn
+    returns for two sets that agree perfectly at that sample size.  Compare
+    with fn on two *different* sets subsampled to the same size (as
+    :func:`distance_vs_scale` does), since the floor decreases with size
+    (for Hellinger with well-filled boxes, E[H²] ≈ B/8 · (1/n_A + 1/n_B)).
+    Deterministic for a given ``seed``.
+    """
+    P = _as_points(P)
+    h = P.shape[0] // 2 if size is None else int(size)
+    if h < 1 or 2 * h > P.shape[0]:
+        raise ValueError(f"cannot split {P.shape[0]} points into two halves of {h}")
+    rng = np.random.default_rng(seed)
+    vals = np.empty(int(n_splits))
+    for i in range(vals.size):
+        perm = rng.permutation(P.shape[0])
+        vals[i] = fn(P[perm[:h]], P[perm[h : 2 * h]])
+    return BootstrapResult(float(vals.mean()), float(vals.std(ddof=1)) if vals.size > 1 else 0.0)

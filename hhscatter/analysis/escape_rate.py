@@ -1,0 +1,802 @@
+"""Escape rate κ of the conservative Hénon–Heiles system (paper Sec. II, Fig. 2).
+
+* :func:`choose_windows` — data-driven τ0 and the 4 fitting windows of the
+  exponential regime of Eq. (eqn:kappa_hyperbolic);
+* :func:`escape_rate` — κ as the mean of 4 least-squares fits of log P(t)
+  (Fig. 2b caption), with τ0, the windows, an MLE cross-check and the optional
+  power-law tail / crossover time τ* of Eq. (eqn:kappa_nonhyperbolic);
+* :func:`escape_rate_mle` — constant-hazard maximum likelihood on [t_start, t_stop];
+* :func:`escape_rate_from_lifetimes` — DataFrame wrapper;
+* :func:`fit_kappa_energy` — the piecewise κ(E) law of Fig. 2b with an
+  estimated break energy;
+* :func:`kappa_from_cmeasure` — κ from the c-measure of the true-time map,
+  Eq. (eqn:kappa_cmeasure_truetime); :func:`cmeasure_sample_from_sections`
+  builds its input from the engine's ``sections`` table.
+
+Pure functions (no I/O, no plotting).  Times in the model's natural time units,
+κ in 1/time, energies in the model's energy units (E_c = 1/6 for ω = λ = 1).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+from scipy.special import logsumexp
+
+from .survival import (
+    ExponentialFit,
+    PowerLawFit,
+    SurvivalCurve,
+    _floor_time,
+    _resolve_n_total,
+    crossover_time,
+    detect_power_law_tail,
+    fit_exponential,
+    lifetimes_to_arrays,
+    survival_curve,
+)
+
+__all__ = [
+    "CMeasureKappa",
+    "EscapeRateResult",
+    "KappaEnergyFit",
+    "MLERate",
+    "WindowChoice",
+    "choose_windows",
+    "cmeasure_sample_from_sections",
+    "escape_rate",
+    "escape_rate_from_lifetimes",
+    "escape_rate_mle",
+    "fit_kappa_energy",
+    "kappa_from_cmeasure",
+]
+
+E_C_HH = 1.0 / 6.0  # critical energy of the Hénon–Heiles potential with ω = λ = 1
+
+
+# ---------------------------------------------------------------------------
+# window choice
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class WindowChoice:
+    """Result of :func:`choose_windows` (all times in time units).
+
+    tau0        end of the irregular initial regime of Eq. (eqn:kappa_hyperbolic)
+    t_stop      end of the exponential regime used for fitting
+    windows     4 (t_lo, t_hi): full, first half, second half, middle half of [tau0, t_stop]
+    kappa_ref   median local slope on the selected plateau (1/time)
+    width       smoothing width w of the local slope
+    t_floor     last time with ≥ min_survivors survivors
+    converged   False if the iteration hit max_iter
+    slope_t, slope, slope_err   the local-slope curve s(t) and its Poisson error (diagnostics)
+    """
+
+    tau0: float
+    t_stop: float
+    windows: tuple
+    kappa_ref: float
+    width: float
+    t_floor: float
+    converged: bool
+    slope_t: np.ndarray = field(repr=False)
+    slope: np.ndarray = field(repr=False)
+    slope_err: np.ndarray = field(repr=False)
+
+
+def _step(t, P, x):
+    """Right-continuous step function (t, P) evaluated at x ≥ t[0]."""
+    idx = np.searchsorted(t, x, side="right") - 1
+    return P[np.clip(idx, 0, None)]
+
+
+def _local_slope(t, P, N, w, t_floor):
+    """Secant slope s(c) = [log P(c − w/2) − log P(c + w/2)]/w at grid centres c, and its Poisson error.
+
+    s is the mean hazard over the window (the MLE of a constant rate there);
+    its error is s/√d with d = N (P(c − w/2) − P(c + w/2)) leaving orbits.
+    """
+    c = t[(t - 0.5 * w >= t[0]) & (t + 0.5 * w <= t_floor)]
+    Pa, Pb = _step(t, P, c - 0.5 * w), _step(t, P, c + 0.5 * w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (np.log(Pa) - np.log(Pb)) / w
+        d = N * (Pa - Pb)
+        err = np.where(d > 0, np.abs(s) / np.sqrt(d), np.inf)
+    return c, s, err
+
+
+def _runs(c, inside, gap):
+    """Maximal runs (start, end) of indices with inside=True, merging holes shorter than ``gap`` in c."""
+    idx = np.flatnonzero(inside)
+    if idx.size == 0:
+        return []
+    cut = np.flatnonzero(np.diff(c[idx]) > gap)
+    starts = np.concatenate([[idx[0]], idx[cut + 1]])
+    ends = np.concatenate([idx[cut], [idx[-1]]])
+    return list(zip(starts.tolist(), ends.tolist()))
+
+
+def choose_windows(
+    t,
+    P,
+    P_err=None,
+    *,
+    n_total=None,
+    min_survivors: float = 100.0,
+    p_start: float = 0.1,
+    core_decades: float = 2.0,
+    rel_tol: float = 0.1,
+    n_sigma: float = 3.0,
+    min_width: float = 2.0 * math.pi,
+    max_iter: int = 20,
+) -> WindowChoice:
+    """choose_windows(t, P, P_err=None, *, n_total=None, ...) -> WindowChoice(tau0, t_stop, windows, ...).
+
+    Data-driven τ0 (end of the irregular regime) and 4 fitting windows for the
+    exponential regime f0 e^{−κt} of Eq. (eqn:kappa_hyperbolic), from a survival
+    curve (t, P) on an increasing grid (time units).  The same rule, with the
+    same defaults, is meant for every energy: nothing is tuned per energy.
+
+    Rule
+    ----
+    0. *Floor.*  Only times with at least ``min_survivors`` survivors are used:
+       t_floor = last t with N·P(t) ≥ min_survivors (N = ``n_total``, or
+       estimated from binomial ``P_err``).  Below it the counting noise of
+       log P exceeds ~10 % per e-fold.
+    1. *Pilot.*  t_a = first time with P ≤ ``p_start`` (0.1), t_b = first time
+       with P ≤ max(P_floor, p_start·10^−core_decades) (two decades lower);
+       κ_p = log(P(t_a)/P(t_b)) / (t_b − t_a).  [t_a, t_b] is the *core*, which
+       for the paper's curves lies inside the exponential regime.
+    2. *Local slope.*  s(t) = [log P(t − w/2) − log P(t + w/2)]/w, the mean
+       hazard over a window of width w = max(``min_width``, 1/κ) (one e-fold,
+       but at least 2π = one period of the small oscillations for ω = 1, so
+       the period-modulated, bursty escape of the flow is averaged out; capped
+       at a third of [t[0], t_floor] for very short curves), with Poisson
+       error σ_s = s/√d (d = orbits leaving in the window).
+    3. *Plateau.*  κ_ref = median of s over the core.  A centre t is *inside*
+       when |s(t) − κ_ref| ≤ max(``rel_tol``·κ_ref, ``n_sigma``·σ_s(t)) (10 %,
+       or 3σ where counting noise is larger).  Inside points form runs;
+       excursions shorter than w are tolerated (merged).  The plateau is the
+       run overlapping most with the core (later: with the previous plateau).
+    4. *Iterate* steps 2–3 with κ_ref = median of s on the plateau and
+       w = max(min_width, 1/κ_ref) until the plateau ends move by ≤ w/20 and
+       κ_ref by ≤ 1 % (κ_ref only sets the band and w, not the result; at
+       most ``max_iter`` times).
+    5. τ0 = first centre of the plateau, i.e. the first time after which the
+       local slope *stays* within tolerance (t[0] if that is the first centre
+       available); t_stop = last centre of the plateau, i.e. where the slope
+       leaves the band for good (the onset of a power-law tail, or any other
+       change of regime), or t_floor when the plateau reaches the floor.
+    6. Windows, with L = t_stop − τ0: full [τ0, t_stop], first half
+       [τ0, τ0 + L/2], second half [τ0 + L/2, t_stop], middle half
+       [τ0 + L/4, τ0 + 3L/4].  Their spread measures the residual curvature of
+       log P (systematics) on top of the statistical error.
+
+    The grid should resolve the decay (spacing ≪ w).  Warns, and returns the
+    core as the window, when no plateau is found.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    P = np.asarray(P, dtype=float).ravel()
+    if t.shape != P.shape:
+        raise ValueError("t and P differ in length")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing")
+    N = _resolve_n_total(P, P_err, n_total)
+    t_floor = _floor_time(t, P, N, min_survivors)
+    if t_floor is None or t_floor <= t[0]:
+        raise ValueError(f"fewer than {min_survivors} survivors at every grid time: nothing to fit")
+    use = np.flatnonzero((t <= t_floor) & np.isfinite(P))
+    tu, Pu = t[use], P[use]
+    P_floor = min_survivors / N
+
+    ia = np.flatnonzero(Pu <= p_start)
+    ia = int(ia[0]) if ia.size else 0
+    ib = np.flatnonzero(Pu <= max(P_floor, p_start * 10.0 ** (-core_decades)))
+    ib = int(ib[0]) if ib.size else tu.size - 1
+    if ib <= ia:
+        ia, ib = 0, tu.size - 1
+    t_a, t_b = float(tu[ia]), float(tu[ib])
+    kappa_p = math.log(Pu[ia] / Pu[ib]) / (t_b - t_a)
+    w_max = (t_floor - t[0]) / 3.0
+
+    def width(k):
+        w = max(min_width, 1.0 / k) if k > 0 else min_width
+        return min(w, w_max)
+
+    w = width(kappa_p)
+    c, s, se = _local_slope(t, P, N, w, t_floor)
+    core = (c >= t_a) & (c <= t_b) & np.isfinite(s)
+    kappa_ref = float(np.median(s[core])) if core.any() else kappa_p
+    target = (t_a, t_b)
+    prev = None
+    converged = False
+    for _ in range(max_iter):
+        c, s, se = _local_slope(t, P, N, w, t_floor)
+        tol = np.maximum(rel_tol * abs(kappa_ref), n_sigma * se)
+        inside = np.isfinite(s) & (np.abs(s - kappa_ref) <= tol)
+        runs = _runs(c, inside, w)
+        if not runs:
+            warnings.warn("no exponential plateau found; using the core [t_a, t_b] as the fitting range")
+            tau0, t_stop = t_a, t_b
+            break
+        overlap = [max(0.0, min(c[e], target[1]) - max(c[b], target[0])) for b, e in runs]
+        length = [c[e] - c[b] for b, e in runs]
+        k = max(range(len(runs)), key=lambda i: (overlap[i], length[i], -i))
+        b, e = runs[k]
+        tau0 = float(t[0]) if b == 0 else float(c[b])
+        t_stop = float(t_floor) if e == c.size - 1 else float(c[e])
+        sel = inside[b : e + 1]
+        new_kappa = float(np.median(s[b : e + 1][sel]))
+        new_w = width(new_kappa)
+        state = (tau0, t_stop)
+        if (
+            prev is not None
+            and abs(tau0 - prev[0]) <= 0.05 * w
+            and abs(t_stop - prev[1]) <= 0.05 * w
+            and abs(new_kappa - kappa_ref) <= 0.01 * abs(kappa_ref)
+        ):
+            converged = True
+            break
+        prev, target = state, (float(c[b]), float(c[e]))
+        kappa_ref, w = new_kappa, new_w
+    if not t_stop > tau0:
+        raise ValueError(f"degenerate exponential range [{tau0}, {t_stop}]")
+    L = t_stop - tau0
+    windows = (
+        (tau0, t_stop),
+        (tau0, tau0 + 0.5 * L),
+        (tau0 + 0.5 * L, t_stop),
+        (tau0 + 0.25 * L, tau0 + 0.75 * L),
+    )
+    return WindowChoice(
+        tau0=tau0,
+        t_stop=t_stop,
+        windows=windows,
+        kappa_ref=kappa_ref,
+        width=w,
+        t_floor=float(t_floor),
+        converged=converged,
+        slope_t=c,
+        slope=s,
+        slope_err=se,
+    )
+
+
+# ---------------------------------------------------------------------------
+# escape rate
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MLERate:
+    """Result of :func:`escape_rate_mle`: κ = events / exposure on [t_start, t_stop].
+
+    kappa, kappa_err (1/time; err = κ/√events), n_events, exposure (orbit·time),
+    n_at_risk (orbits alive at t_start), t_start, t_stop.
+    """
+
+    kappa: float
+    kappa_err: float
+    n_events: int
+    exposure: float
+    n_at_risk: int
+    t_start: float
+    t_stop: float
+
+
+def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
+    """escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate(kappa, kappa_err, ...).
+
+    Maximum-likelihood escape rate of Eq. (eqn:kappa_hyperbolic) assuming a
+    constant hazard κ on [t_start, t_stop] (time units), for left-truncated
+    (only orbits alive at t_start count) and right-censored data (orbits
+    censored before t_stop, and every orbit still alive at t_stop):
+
+        κ̂ = D / X,   D = #{observed, t_start < t_end ≤ t_stop},
+        X = Σ_{t_end > t_start} (min(t_end, t_stop) − t_start),
+
+    with standard error κ̂/√D (Fisher information D/κ²).  Unlike least
+    squares on the cumulative P(t) it uses independent information only, so
+    its error is the statistical benchmark.  O(N).
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed).ravel()
+    if observed.dtype != bool:
+        raise TypeError("observed must be a boolean mask")
+    if not t_stop > t_start:
+        raise ValueError("need t_start < t_stop")
+    at_risk = t_end > t_start
+    exposure = float(np.sum(np.minimum(t_end[at_risk], t_stop) - t_start))
+    D = int(np.count_nonzero(observed & at_risk & (t_end <= t_stop)))
+    kappa = D / exposure if exposure > 0 else math.nan
+    err = kappa / math.sqrt(D) if D > 0 else math.nan
+    return MLERate(kappa, err, D, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop))
+
+
+@dataclass(frozen=True)
+class EscapeRateResult:
+    """Result of :func:`escape_rate` (κ in 1/time, times in time units).
+
+    kappa           mean of the 4 window fits (Fig. 2b caption)
+    kappa_err       √(spread² + stat²)
+    kappa_spread    sample std (ddof=1) of the 4 window estimates (systematics)
+    kappa_stat      statistical error of the full-window fit (correlation-aware)
+    tau0, t_stop, windows   from :func:`choose_windows`
+    fits            the 4 :class:`ExponentialFit` (full, first half, second half, middle half)
+    mle             :class:`MLERate` on [tau0, t_stop] (cross-check)
+    tail            :class:`PowerLawFit` of a detected power-law tail, or None
+    tau_star        crossover time τ* (NaN without tail)
+    window_choice   the full :class:`WindowChoice`
+    curve           the :class:`SurvivalCurve` on the analysis grid
+    n_total         N
+    """
+
+    kappa: float
+    kappa_err: float
+    kappa_spread: float
+    kappa_stat: float
+    tau0: float
+    t_stop: float
+    windows: tuple
+    fits: tuple
+    mle: MLERate
+    tail: PowerLawFit | None
+    tau_star: float
+    window_choice: WindowChoice = field(repr=False)
+    curve: SurvivalCurve = field(repr=False)
+    n_total: int = 0
+
+
+def _default_grid(t_end, n_grid):
+    k = min(10, t_end.size)
+    t_hi = float(np.partition(t_end, t_end.size - k)[t_end.size - k])
+    if t_hi <= 0:
+        t_hi = float(t_end.max()) or 1.0
+    return np.linspace(0.0, t_hi, int(n_grid))
+
+
+def escape_rate(
+    t_end,
+    observed,
+    t_grid=None,
+    *,
+    n_grid: int = 20001,
+    detect_tail: bool = True,
+    tail_kwargs: dict | None = None,
+    **window_kwargs,
+) -> EscapeRateResult:
+    """escape_rate(t_end, observed, t_grid=None, *, n_grid=20001, detect_tail=True, **window_kwargs) -> EscapeRateResult.
+
+    Escape rate κ of Eq. (eqn:kappa_hyperbolic) (or the effective κ of the
+    exponential stage of Eq. (eqn:kappa_nonhyperbolic)) from lifetimes
+    ``t_end`` (time units) and the ``observed`` mask (False = right-censored):
+
+    1. P(t) by Kaplan–Meier (:func:`survival_curve`) on ``t_grid`` (default: a
+       uniform grid of ``n_grid`` points from 0 to the 10th-largest t_end);
+    2. τ0 and 4 windows by :func:`choose_windows` (``window_kwargs`` go there);
+    3. κ_i by weighted least squares of log P on each window
+       (:func:`fit_exponential`); κ = mean of the 4 (paper, Fig. 2b caption);
+       kappa_err = √(std(κ_i)² + σ_stat²), σ_stat the correlation-aware error of
+       the full-window fit;
+    4. cross-check :func:`escape_rate_mle` on [τ0, t_stop];
+    5. with ``detect_tail``, :func:`detect_power_law_tail` after τ0 and, if a
+       tail is found, τ* = :func:`crossover_time` of the full-window
+       exponential and the tail power law.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed).ravel()
+    grid = _default_grid(t_end, n_grid) if t_grid is None else np.asarray(t_grid, dtype=float)
+    curve = survival_curve(t_end, observed, grid)
+    N = t_end.size
+    ok = np.isfinite(curve.P)
+    t, P, E = curve.t[ok], curve.P[ok], curve.P_err[ok]
+    wc = choose_windows(t, P, E, n_total=N, **window_kwargs)
+    fits = tuple(fit_exponential(t, P, w, E) for w in wc.windows)
+    ks = np.array([f.kappa for f in fits])
+    kappa = float(ks.mean())
+    spread = float(ks.std(ddof=1))
+    stat = fits[0].kappa_err
+    mle = escape_rate_mle(t_end, observed, wc.tau0, wc.t_stop)
+    tail, tau_star = None, math.nan
+    if detect_tail:
+        kw = {"min_survivors": window_kwargs.get("min_survivors", 100.0)}
+        kw.update(tail_kwargs or {})
+        tail = detect_power_law_tail(t, P, wc.tau0, E, n_total=N, **kw)
+        if tail is not None:
+            tau_star = crossover_time(t, P, fits[0], tail)
+    return EscapeRateResult(
+        kappa=kappa,
+        kappa_err=float(math.hypot(spread, stat)),
+        kappa_spread=spread,
+        kappa_stat=float(stat),
+        tau0=wc.tau0,
+        t_stop=wc.t_stop,
+        windows=wc.windows,
+        fits=fits,
+        mle=mle,
+        tail=tail,
+        tau_star=float(tau_star),
+        window_choice=wc,
+        curve=curve,
+        n_total=N,
+    )
+
+
+def escape_rate_from_lifetimes(lifetimes, t_grid=None, **kwargs) -> EscapeRateResult:
+    """escape_rate_from_lifetimes(lifetimes, t_grid=None, **kwargs) -> EscapeRateResult.
+
+    :func:`escape_rate` on one (e0, gamma) ensemble of the engine's ``lifetimes``
+    table ('escaped'/'settled' leave, 'censored' is right-censored).
+    """
+    t_end, observed = lifetimes_to_arrays(lifetimes)
+    return escape_rate(t_end, observed, t_grid, **kwargs)
+
+
+# ---------------------------------------------------------------------------
+# κ(E): piecewise law of Fig. 2b
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class KappaEnergyFit:
+    """Result of :func:`fit_kappa_energy`; with x = E − E_c,
+
+        κ = a x² + b x   for E < E_b   (non-linear regime),
+        κ = c x          for E ≥ E_b   (linear regime).
+
+    a (1/(time·energy²)), b, c (1/(time·energy)), E_b (energy) and their 1σ
+    errors from the fit covariance (``cov``, order a, b, c, E_b; scaled by
+    χ²/dof when no κ errors were given) and from the bootstrap over points
+    (``boot_err``, same order; ``boot`` holds the replicates).  ``continuous``
+    tells which model was fitted (then c = a x_b + b).  ``chi2``/``dof`` of the best fit.
+    """
+
+    a: float
+    b: float
+    c: float
+    E_b: float
+    a_err: float
+    b_err: float
+    c_err: float
+    E_b_err: float
+    E_c: float
+    continuous: bool
+    chi2: float
+    dof: int
+    cov: np.ndarray = field(repr=False)
+    boot: np.ndarray = field(repr=False)
+    boot_err: tuple = ()
+
+    def predict(self, E):
+        """predict(E) -> κ(E) (1/time); 0 for E ≤ E_c, where no escape is possible."""
+        x = np.asarray(E, dtype=float) - self.E_c
+        xb = self.E_b - self.E_c
+        k = np.where(x < xb, self.a * x**2 + self.b * x, self.c * x)
+        return np.where(x > 0, k, 0.0)
+
+
+def _wls(M, y, w):
+    """Weighted linear least squares, returns (params, chi2, (MᵀWM)^{-1})."""
+    MtW = M.T * w
+    F = MtW @ M
+    p = np.linalg.solve(F, MtW @ y)
+    r = y - M @ p
+    return p, float(np.sum(w * r * r)), np.linalg.inv(F)
+
+
+def _continuous_profile(x, y, w, xb):
+    """χ² of κ = b x + a x min(x, x_b) for each x_b (vectorised closed-form WLS); returns (chi2, a, b)."""
+    M1 = x[None, :] * np.minimum(x[None, :], xb[:, None])
+    M2 = x[None, :]
+    S11 = (w * M1 * M1).sum(1)
+    S12 = (w * M1 * M2).sum(1)
+    S22 = float((w * x * x).sum())
+    r1 = (w * M1 * y).sum(1)
+    r2 = float((w * x * y).sum())
+    det = S11 * S22 - S12**2
+    a = (S22 * r1 - S12 * r2) / det
+    b = (S11 * r2 - S12 * r1) / det
+    chi2 = (w * (y - a[:, None] * M1 - b[:, None] * M2) ** 2).sum(1)
+    return chi2, a, b
+
+
+def _fit_continuous(x, y, w, n_grid):
+    xs = np.sort(np.unique(x))
+    if xs.size < 4:
+        raise ValueError("need at least 4 distinct energies")
+    grid = np.linspace(xs[1], xs[-2], n_grid)
+    chi2, _, _ = _continuous_profile(x, y, w, grid)
+    i = int(np.nanargmin(chi2))
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, n_grid - 1)]
+    res = optimize.minimize_scalar(
+        lambda v: float(_continuous_profile(x, y, w, np.array([v]))[0][0]),
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": 1e-10},
+    )
+    xb = float(res.x) if res.fun <= chi2[i] else float(grid[i])
+    chi2_b, a, b = (v[0] for v in _continuous_profile(x, y, w, np.array([xb])))
+    return float(a), float(b), float(a * xb + b), xb, float(chi2_b)
+
+
+def _fit_discontinuous(x, y, w):
+    order = np.argsort(x)
+    xs, ys, ws = x[order], y[order], w[order]
+    best = None
+    for k in range(2, xs.size):
+        if xs[k] == xs[k - 1]:
+            continue
+        if np.unique(xs[:k]).size < 2:
+            continue
+        p1, c1, F1 = _wls(np.column_stack([xs[:k] ** 2, xs[:k]]), ys[:k], ws[:k])
+        p2, c2, F2 = _wls(xs[k:, None], ys[k:], ws[k:])
+        if best is None or c1 + c2 < best[0]:
+            best = (c1 + c2, k, p1, p2, F1, F2)
+    if best is None:
+        raise ValueError("no admissible break between the energies")
+    chi2, k, p1, p2, F1, F2 = best
+    xb = 0.5 * (xs[k - 1] + xs[k])
+    var_xb = (xs[k] - xs[k - 1]) ** 2 / 12.0  # uniform over the gap where χ² is flat
+    return float(p1[0]), float(p1[1]), float(p2[0]), float(xb), float(chi2), F1, F2, var_xb
+
+
+def fit_kappa_energy(
+    E,
+    kappa,
+    kappa_err=None,
+    E_c: float = E_C_HH,
+    *,
+    continuous: bool = True,
+    n_grid: int = 400,
+    n_boot: int = 200,
+    rng=None,
+) -> KappaEnergyFit:
+    """fit_kappa_energy(E, kappa, kappa_err=None, E_c=1/6, *, continuous=True, n_boot=200, rng=None) -> KappaEnergyFit.
+
+    Piecewise fit of the escape rate against energy (paper Fig. 2b, x = E − E_c,
+    energies in energy units, κ in 1/time):
+
+        κ = a x² + b x  (E < E_b),     κ = c x  (E ≥ E_b).
+
+    Paper values for ω = λ = 1: a = 13.63, b = 0.03, c = 1.41, E_b ≈ 0.27.
+    The break E_b is estimated, not imposed:
+
+    * ``continuous=True`` (default): κ(x) = b x + a x·min(x, x_b), i.e. the two
+      laws are forced to meet at the break (c = a x_b + b; the paper's separate
+      fits meet within 2 % at 0.27).  For each x_b the model is linear in
+      (a, b), so the weighted χ² is profiled over x_b on a fine grid between
+      the second and second-to-last energy, refined by bounded minimisation;
+      covariance of (a, b, x_b) from the Gauss–Newton matrix (JᵀWJ)⁻¹ and
+      propagated to c.
+    * ``continuous=False``: independent fits on either side, the χ² profiled
+      over the partitions of the points; E_b is the midpoint of the gap
+      between the two points bracketing the best break (its variance
+      gap²/12); a, b and c errors from the two linear fits.
+
+    Weights 1/kappa_err² (all 1 and covariance scaled by χ²/dof if omitted).
+    ``boot_err`` comes from ``n_boot`` pairs-bootstrap refits over points
+    (``rng``: seed or numpy Generator).
+    """
+    E = np.asarray(E, dtype=float).ravel()
+    y = np.asarray(kappa, dtype=float).ravel()
+    if E.shape != y.shape:
+        raise ValueError("E and kappa differ in length")
+    x = E - E_c
+    if np.any(x <= 0):
+        raise ValueError("all energies must exceed E_c (no escape below)")
+    given = kappa_err is not None
+    sig = np.asarray(kappa_err, dtype=float).ravel() if given else np.ones_like(y)
+    if np.any(~(sig > 0)):
+        raise ValueError("kappa_err must be positive")
+    w = 1.0 / sig**2
+    n = x.size
+
+    if continuous:
+        a, b, c, xb, chi2 = _fit_continuous(x, y, w, n_grid)
+        J = np.column_stack([x * np.minimum(x, xb), x, a * x * (x > xb)])
+        cov3 = np.linalg.pinv((J.T * w) @ J)
+        dof = n - 3
+        if not given:
+            cov3 = cov3 * (chi2 / dof if dof > 0 else np.nan)
+        T = np.array([[1.0, 0, 0], [0, 1.0, 0], [xb, 1.0, a], [0, 0, 1.0]])
+        cov = T @ cov3 @ T.T
+    else:
+        a, b, c, xb, chi2, F1, F2, var_xb = _fit_discontinuous(x, y, w)
+        dof = n - 4
+        s = (chi2 / dof if dof > 0 else np.nan) if not given else 1.0
+        cov = np.zeros((4, 4))
+        cov[:2, :2] = F1 * s
+        cov[2, 2] = F2[0, 0] * s
+        cov[3, 3] = var_xb
+
+    gen = np.random.default_rng(rng)
+    boot = np.full((int(n_boot), 4), np.nan)
+    for i in range(int(n_boot)):
+        idx = gen.integers(0, n, n)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                if continuous:
+                    r = _fit_continuous(x[idx], y[idx], w[idx], max(n_grid // 4, 50))
+                    boot[i] = r[:4]
+                else:
+                    r = _fit_discontinuous(x[idx], y[idx], w[idx])
+                    boot[i] = r[:4]
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+    boot[:, 3] += E_c
+    boot_err = tuple(float(v) for v in np.nanstd(boot, axis=0, ddof=1)) if n_boot > 1 else ()
+    err = np.sqrt(np.diag(cov))
+    return KappaEnergyFit(
+        a=a,
+        b=b,
+        c=c,
+        E_b=xb + E_c,
+        a_err=float(err[0]),
+        b_err=float(err[1]),
+        c_err=float(err[2]),
+        E_b_err=float(err[3]),
+        E_c=float(E_c),
+        continuous=continuous,
+        chi2=chi2,
+        dof=dof,
+        cov=cov,
+        boot=boot,
+        boot_err=boot_err,
+    )
+
+
+# ---------------------------------------------------------------------------
+# κ from the c-measure of the true-time map
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CMeasureKappa:
+    """Result of :func:`kappa_from_cmeasure` (κ in 1/time).
+
+    kappa, kappa_err (bootstrap std), kappa_err_delta (delta method),
+    mu_exit = n_exit/M (the c-measure of the exit set, μ_c(𝓔)), n_samples M,
+    n_exit, boot (bootstrap replicates of κ).
+    """
+
+    kappa: float
+    kappa_err: float
+    kappa_err_delta: float
+    mu_exit: float
+    n_samples: int
+    n_exit: int
+    boot: np.ndarray = field(repr=False)
+
+
+def _solve_renewal(T, M):
+    """Root κ > 0 of log Σ_i e^{κ T_i} = log M (returning points only)."""
+    if T.size == 0:
+        return math.inf
+    if T.size >= M:
+        return 0.0
+    logM = math.log(M)
+
+    def h(k):
+        return float(logsumexp(k * T)) - logM
+
+    hi = 1.0 / max(float(np.mean(T)), 1e-300)
+    while h(hi) <= 0:
+        hi *= 2.0
+        if hi > 1e300:
+            return math.inf
+    return float(optimize.brentq(h, 0.0, hi, xtol=1e-14, rtol=1e-12))
+
+
+def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) -> CMeasureKappa:
+    """kappa_from_cmeasure(return_times, n_exit, *, n_boot=200, rng=None) -> CMeasureKappa(kappa, kappa_err, ...).
+
+    Escape rate κ (1/time) from section data via the true-time-map relation
+    Eq. (eqn:kappa_cmeasure_truetime),  ∫_Ω e^{κT} dμ_c = 1 + μ_c(𝓔).
+
+    Input: a sample of M points on the Poincaré section distributed by the
+    c-measure μ_c; ``return_times`` are the times T_i (time units) to the next
+    section crossing of the points that return, ``n_exit`` the number of
+    sample points that leave Ω before crossing again (the set 𝓔), so
+    M = len(return_times) + n_exit.
+
+    Estimator
+    ---------
+        (1/M) Σ_{i returns} e^{κ T_i} = 1,      κ > 0 its unique root,
+
+    equivalently (1/M)[Σ_{returns} e^{κT_i} + Σ_{exits} e^{κ·0}] = 1 + n_exit/M,
+    the sample version of Eq. (eqn:kappa_cmeasure_truetime) in which exiting
+    points carry T = 0 (their exit times do not enter).
+
+    Derivation.  In the asymptotic regime the flux of section crossings
+    decays as the survival probability: crossings at y during [t, t + dt]
+    occur at rate j(y, t) = e^{−κt} ρ(y), and μ_c (dμ_c = ρ dy / ∫ρ) is the
+    distribution of crossing points, conditionally invariant under the flow.
+    Every crossing at x ∉ 𝓔 at time t produces the crossing h(x) at time
+    t + T(x); crossings at x ∈ 𝓔 produce none.  Conservation of crossings,
+    j(y, t) = Σ_{h(x)=y} j(x, t − T(x)) |Dh(x)|⁻¹, integrated over y, gives
+        ∫ρ = ∫_{Ω∖𝓔} ρ(x) e^{κT(x)} dx   ⇔   ∫_{Ω∖𝓔} e^{κT} dμ_c = 1,
+    which is Eq. (eqn:kappa_cmeasure_truetime) once 𝓔 is included with T = 0
+    (∫_𝓔 e^{0} dμ_c = μ_c(𝓔)).  Checks: for T ≡ 1 (a plain map) it gives
+    e^κ (1 − μ_c(𝓔)) = 1, i.e. Eq. (eqn:kappa_cmeasure_discrete); for a renewal
+    process (return with probability q after T ~ F, else exit) it is the
+    Lotka equation q E_F[e^{κT}] = 1 of the exponential decay of P(t).
+    Exit times are irrelevant provided they are short compared with 1/κ
+    (light-tailed).
+
+    Sampling.  The measure is the *flux* measure: take every section crossing
+    of the ensemble that occurs in a late time window [t1, t2] (t1 ≫ τ0) as
+    one sample point (see :func:`cmeasure_sample_from_sections`).  Taking
+    instead the first crossing after t* of each survivor (sprinkler method)
+    weights a point by 1 − e^{−κ T_back} (T_back: time since its previous
+    crossing), which is harmless only when T_back and T are uncorrelated.
+
+    Errors: ``kappa_err`` is the std of ``n_boot`` bootstrap replicates
+    (resampling the M points, exits included; ``rng`` seed or Generator);
+    ``kappa_err_delta`` the delta-method value
+    √(Var(Y)/M) / mean(T Y), Y_i = e^{κT_i} (0 for exits).
+    """
+    T = np.asarray(return_times, dtype=float).ravel()
+    if np.any(~np.isfinite(T)) or np.any(T <= 0):
+        raise ValueError("return times must be finite and > 0")
+    n_exit = int(n_exit)
+    if n_exit < 0:
+        raise ValueError("n_exit must be ≥ 0")
+    M = T.size + n_exit
+    if M == 0:
+        raise ValueError("empty sample")
+    kappa = _solve_renewal(T, M)
+    if math.isfinite(kappa) and kappa > 0:
+        Y = np.exp(kappa * T)
+        var_Y = (float(np.sum(Y * Y)) / M) - (float(np.sum(Y)) / M) ** 2
+        slope = float(np.sum(T * Y)) / M
+        err_delta = math.sqrt(max(var_Y, 0.0) / M) / slope
+    else:
+        err_delta = math.nan if not math.isfinite(kappa) else 0.0
+    gen = np.random.default_rng(rng)
+    boot = np.empty(int(n_boot))
+    for i in range(int(n_boot)):
+        ne = int(gen.binomial(M, n_exit / M))
+        Tb = T[gen.integers(0, T.size, M - ne)] if T.size else T
+        boot[i] = _solve_renewal(Tb, M)
+    err = float(np.std(boot, ddof=1)) if n_boot > 1 else math.nan
+    return CMeasureKappa(
+        kappa=float(kappa),
+        kappa_err=err,
+        kappa_err_delta=float(err_delta),
+        mu_exit=n_exit / M,
+        n_samples=M,
+        n_exit=n_exit,
+        boot=boot,
+    )
+
+
+def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=math.inf):
+    """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf) -> (return_times, n_exit, n_undetermined).
+
+    Builds the input of :func:`kappa_from_cmeasure` from the engine's tables
+    (one conservative ensemble).  Every crossing in ``sections`` with
+    t_from ≤ t ≤ t_to (time units) is a sample point of the flux c-measure;
+    its return time is the time to the same orbit's next recorded crossing.
+    A crossing with no later crossing is an *exit* if the orbit left
+    ('escaped'/'settled') at t_end ≤ ``t_record_end`` (the end of the section
+    recording, ``SectionWindow.t_to``), otherwise *undetermined* (censored, or
+    a crossing after the recording may have been missed) and dropped — choose
+    t_to well before min(t_record_end, t_max) so that this count is ~0.
+    ``sections`` must hold every crossing (SectionWindow without energy
+    filter and first_only=False) from t_from to t_record_end.
+    """
+    s = sections[["traj_id", "t"]].sort_values(["traj_id", "t"], kind="stable")
+    nxt = s.groupby("traj_id", sort=False)["t"].shift(-1)
+    s = s.assign(t_next=nxt.to_numpy())
+    s = s[(s["t"] >= t_from) & (s["t"] <= t_to)]
+    ret = s["t_next"].notna().to_numpy()
+    T = (s["t_next"] - s["t"]).to_numpy()[ret]
+    last = s.loc[~ret, ["traj_id"]]
+    lt = lifetimes[["traj_id", "outcome", "t_end"]].copy()
+    lt["outcome"] = lt["outcome"].astype(object)
+    last = last.merge(lt, on="traj_id", how="left")
+    if last["outcome"].isna().any():
+        raise ValueError("sections refer to traj_ids missing from lifetimes")
+    leaves = last["outcome"].isin(["escaped", "settled"]).to_numpy() & (last["t_end"].to_numpy() <= t_record_end)
+    n_exit = int(np.count_nonzero(leaves))
+    n_und = int(leaves.size - n_exit)
+    if n_und:
+        warnings.warn(f"{n_und} sample crossings have an undetermined fate and were dropped")
+    return T.astype(float), n_exit, n_und

@@ -1,0 +1,1137 @@
+"""Survival-probability models of dissipative scattering (paper Sec. III.B.3, Eq. (eqn:surv_prob_model)).
+
+Homogeneous model (the paper's)
+-------------------------------
+All orbits are assumed to share the energy path of Eq. (eqn:energy_exp_decay),
+E(t) = E0 e^{−μγt}, and hence the time-dependent escape rate
+κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate (paper Fig. 2b:
+κ0 = 13.63 ΔE² + 0.03 ΔE for E < 0.27 and 1.41 ΔE above, ΔE = E − E_c,
+zero for E ≤ E_c; :class:`PiecewiseKappa`).  Then, Eq. (eqn:surv_prob_model),
+
+    P_γ(t) = NaN ("irregular")                          t < τ0
+           = f_ne + f_e exp(−κ_γ(t) (t − τ0))             τ0 ≤ t ≤ τ2
+           = f_ne exp(−g(t, γ) (t − τ2))                  t > τ2
+    g(t, γ) = L / (1 + exp(−b (t − τ2)))²,
+    f_ne + f_e = P(τ0),   τ2 = ln(E0/E_c)/(μγ)  (Eq. (eq:tau2)).
+
+Caveat, ``hazard`` option.  Taken literally ("paper", the default), the
+escape factor exp(−κ_γ(t)(t−τ0)) uses the *instantaneous* rate times the
+elapsed time.  Because κ0(E(t)) → 0 as E(t) → E_c, this factor is not
+monotone: it returns to 1 as t → τ2, so the literal P(t) rises back to
+f_ne + f_e = P(τ0) just before τ2 and then jumps down to f_ne (when τ2 is tied
+to μ by Eq. (eq:tau2), E(τ2) = E_c exactly).  A survival function cannot
+increase; the physically consistent reading of "exponential decay with a
+time-dependent rate", Eq. (eqn:Pt_escape_generic), is the cumulative hazard
+exp(−∫_{τ0}^{t} κ0(E(s)) ds), selected with ``hazard="integrated"``.  Both
+coincide for constant κ.  Which one reproduces the paper's Fig. 6a is for the
+data to decide; the fitting code supports both.
+
+Mixture model (the paper's proposed extension, end of Sec. III.B.3)
+-------------------------------------------------------------------
+"An improved agreement would be obtained by avoiding the approximation of
+homogeneous energy decay ... a mixture model for P(t) involving multiple
+sub-ensembles, each with their own energy decay exponent μ."  Design:
+
+1. Reference time t_ref (default τ0).  Every orbit alive at t_ref (snapshot
+   table) gets its own decay law ln E_i(t) = a_i − μ_i γ t, least squares over
+   its snapshot energies.
+2. The orbits alive at t_ref are split into K sub-ensembles by the quantiles
+   of their energy E_i(t_ref) (``by="energy"``, default: the fractions w_k,
+   Σ w_k = 1, discretise the measured density ρ(E(t_ref)) of Eq.
+   (eqn:c-measure_model)) or of their exponent μ_i (``by="rate"``).  Each
+   sub-ensemble gets μ_k = ⟨μ_i⟩_k and A_k = exp⟨a_i⟩_k, i.e. an energy path
+   E_k(t) = A_k e^{−μ_k γ t}, a rate κ0(E_k(t)) and a settling time
+   τ2,k = ln(A_k/E_c)/(μ_k γ).  Per-orbit exponents are averaged (instead of
+   fitting the sub-ensemble's mean energy) to avoid survivor bias: once the
+   fast members settle, the mean over the survivors follows the slow ones.
+3. Every sub-ensemble follows Eq. (eqn:surv_prob_model) with its own path:
+
+       P(t) = Σ_k P_k(t),
+       P_k(t) = f_ne,k + f_e,k exp(−X_k(t))           τ0 ≤ t ≤ τ2,k
+              = f_ne,k exp(−g_k(t)(t − τ2,k))          t > τ2,k
+       f_ne,k + f_e,k = w_k P(τ0),   g_k = L/(1 + e^{−b(t−τ2,k)})²,
+
+   with X_k the (instantaneous or integrated) escape exponent along E_k(t).
+   Free parameters: the K trapped fractions f_ne,k (``fne_mode="free"``) or a
+   single trapped fraction φ with f_ne,k = φ w_k P(τ0) (``fne_mode="shared"``,
+   as many free parameters as the homogeneous model), and the shared L, b.
+   The component paths (A_k, μ_k) are measured, not fitted to P(t).
+
+With t_ref = τ0 the constraint Σ_k (f_ne,k + f_e,k) = P(τ0) is exact; with a
+later t_ref the weights refer to the population at t_ref (an approximation).
+K = 1 with A = E0 reproduces the homogeneous model with a measured μ.
+
+Both fits return :class:`SurvivalFit` with the same goodness-of-fit measures
+(χ², dof, χ²/dof, RMS of log residuals, AIC) on the same data selection, so
+that :func:`compare_fits` can tabulate them side by side.
+
+Units: time in model units, energies in model units, rates in 1/time.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, special
+
+from .decay import fit_energy_decay
+from .transitions import tau2_predicted
+
+__all__ = [
+    "E_C",
+    "PAPER_KAPPA",
+    "MixtureComponents",
+    "MixtureModelParams",
+    "PiecewiseKappa",
+    "SurvivalFit",
+    "SurvivalModelParams",
+    "compare_fits",
+    "energy_path",
+    "fit_mixture_model",
+    "fit_survival_model",
+    "mixture_components",
+    "mixture_components_arrays",
+    "mixture_survival_model",
+    "predict_tau1",
+    "settling_rate",
+    "survival_model",
+]
+
+E_C = 1.0 / 6.0
+"""Critical energy of the Hénon–Heiles potential with ω = λ = 1."""
+
+HAZARDS = ("paper", "integrated")
+
+
+# ---------------------------------------------------------------------------
+# building blocks
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PiecewiseKappa:
+    """PiecewiseKappa(a2=13.63, a1=0.03, slope=1.41, E_switch=0.27, E_c=1/6) -> callable κ0(E).
+
+    Conservative escape rate as a function of energy (paper Fig. 2b), with
+    ΔE = E − E_c:
+
+        κ0 = a2 ΔE² + a1 ΔE   for E_c < E < E_switch   (non-hyperbolic regime)
+        κ0 = slope · ΔE       for E ≥ E_switch         (hyperbolic, linear regime)
+        κ0 = 0                for E ≤ E_c              (no escape)
+
+    Defaults are the paper's fits.  Calling it on an array returns an array
+    (rates in 1/time).  Note the two branches do not join exactly at
+    E_switch (0.1486 vs 0.1457 with the defaults).
+    """
+
+    a2: float = 13.63
+    a1: float = 0.03
+    slope: float = 1.41
+    E_switch: float = 0.27
+    E_c: float = E_C
+
+    def __call__(self, E):
+        E = np.asarray(E, dtype=float)
+        d = E - self.E_c
+        k = np.where(E < self.E_switch, self.a2 * d * d + self.a1 * d, self.slope * d)
+        return np.where(d > 0, k, 0.0)
+
+
+PAPER_KAPPA = PiecewiseKappa()
+"""κ0(E) with the paper's fitted coefficients (Fig. 2b)."""
+
+
+def energy_path(t, E0: float, mu: float, gamma: float):
+    """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
+    return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
+
+
+def settling_rate(t, tau2: float, L: float, b: float):
+    """settling_rate(t, tau2, L, b) -> g(t) = L / (1 + exp(−b (t − τ2)))² (Eq. (eqn:surv_prob_model), t > τ2 branch).
+
+    Increases monotonically from L/4 at t = τ2 to L; rate in 1/time.
+    """
+    return L * special.expit(b * (np.asarray(t, dtype=float) - tau2)) ** 2
+
+
+def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
+    """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0) ("paper") or ∫_{τ0}^t κ0(E(s))ds ("integrated")."""
+    t = np.asarray(t, dtype=float)
+    if hazard == "paper":
+        return np.asarray(kappa_of_E(energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
+    if hazard == "integrated":
+        if t.size == 0:
+            return t.copy()
+        t_hi = float(np.max(t))
+        if t_hi <= tau0:
+            return np.zeros_like(t)
+        s = np.linspace(tau0, t_hi, n_int)
+        k = np.asarray(kappa_of_E(energy_path(s, A, mu, gamma)), dtype=float)
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
+        return np.interp(t, s, cum)
+    raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+
+
+def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard):
+    """One (sub-)ensemble of Eq. (eqn:surv_prob_model); NaN for t < τ0."""
+    t = np.asarray(t, dtype=float)
+    out = np.full(t.shape, np.nan)
+    mid = (t >= tau0) & (t <= tau2)
+    late = (t > tau2) & (t >= tau0)
+    if mid.any():
+        out[mid] = f_ne + f_e * np.exp(-_escape_exponent(t[mid], kappa_of_E, A, mu, gamma, tau0, hazard))
+    if late.any():
+        tl = t[late]
+        out[late] = f_ne * np.exp(-settling_rate(tl, tau2, L, b) * (tl - tau2))
+    return out
+
+
+# ---------------------------------------------------------------------------
+# homogeneous model
+# ---------------------------------------------------------------------------
+def survival_model(
+    t,
+    *,
+    kappa_of_E: Callable,
+    E0: float,
+    mu: float,
+    gamma: float,
+    tau0: float,
+    tau2: float | None = None,
+    f_ne: float,
+    f_e: float,
+    L: float,
+    b: float,
+    E_c: float = E_C,
+    hazard: str = "paper",
+):
+    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c=1/6, hazard="paper") -> P(t).
+
+    The paper's survival model, Eq. (eqn:surv_prob_model), with
+    κ_γ(t) = κ0(E(t)) and E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)):
+
+        t < τ0        NaN  (the "irregular" initial regime is not modelled)
+        τ0 ≤ t ≤ τ2   f_ne + f_e exp(−κ_γ(t)(t − τ0))       [hazard="paper"]
+                      f_ne + f_e exp(−∫_{τ0}^t κ_γ ds)      [hazard="integrated"]
+        t > τ2        f_ne exp(−g(t)(t − τ2)),  g = L/(1 + e^{−b(t−τ2)})²
+
+    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. :data:`PAPER_KAPPA`);
+    ``tau2=None`` uses Eq. (eq:tau2), ln(E0/E_c)/(μγ).  See the module
+    docstring for why the literal ("paper") escape factor is non-monotone.
+    Returns an array shaped like ``t`` (float if ``t`` is scalar).
+    """
+    if tau2 is None:
+        tau2 = tau2_predicted(E0, E_c, mu, gamma)
+    out = _component(t, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
+    return float(out) if np.ndim(t) == 0 else out
+
+
+@dataclass(frozen=True)
+class SurvivalModelParams:
+    """All inputs of :func:`survival_model`; calling it evaluates P(t)."""
+
+    kappa_of_E: Callable
+    E0: float
+    mu: float
+    gamma: float
+    tau0: float
+    tau2: float
+    f_ne: float
+    f_e: float
+    L: float
+    b: float
+    E_c: float = E_C
+    hazard: str = "paper"
+
+    def __call__(self, t):
+        return survival_model(
+            t,
+            kappa_of_E=self.kappa_of_E,
+            E0=self.E0,
+            mu=self.mu,
+            gamma=self.gamma,
+            tau0=self.tau0,
+            tau2=self.tau2,
+            f_ne=self.f_ne,
+            f_e=self.f_e,
+            L=self.L,
+            b=self.b,
+            E_c=self.E_c,
+            hazard=self.hazard,
+        )
+
+
+@dataclass
+class SurvivalFit:
+    """Result of :func:`fit_survival_model` / :func:`fit_mixture_model`.
+
+    ``params``     callable model with the best-fit values (P(t) = params(t));
+    ``values``     dict of all parameter values (free, fixed and derived);
+    ``errors``     dict of 1σ errors (0 for fixed parameters; derived ones
+                   propagated from the covariance);
+    ``free``       names of the fitted parameters, ``cov`` their covariance;
+    ``chi2, dof, chi2_red``  Σ r², n − k, χ²/dof of the normalised residuals r
+                   in the fitted ``space`` ("log": (ln P_model − ln P)/(σ_P/P));
+    ``rms_log_residual``  √mean (ln P_model − ln P)² over the fitted points;
+    ``aic``        χ² + 2k (for comparing models with different k);
+    ``t_fit, residuals``  fitted times and normalised residuals.
+    """
+
+    params: object
+    values: dict
+    errors: dict
+    free: tuple
+    cov: np.ndarray
+    chi2: float
+    dof: int
+    chi2_red: float
+    rms_log_residual: float
+    aic: float
+    n_points: int
+    space: str
+    t_fit: np.ndarray = field(repr=False)
+    residuals: np.ndarray = field(repr=False)
+    success: bool = True
+    message: str = ""
+
+    def predict(self, t):
+        """predict(t) -> P_model(t) with the best-fit parameters."""
+        return self.params(t)
+
+
+# ---------------------------------------------------------------------------
+# generic weighted least squares
+# ---------------------------------------------------------------------------
+def _select(t, P, P_err, tau0, t_max, P_min):
+    t = np.asarray(t, dtype=float).ravel()
+    P = np.asarray(P, dtype=float).ravel()
+    P_err = np.asarray(P_err, dtype=float).ravel()
+    if not (t.shape == P.shape == P_err.shape):
+        raise ValueError("t, P and P_err must have the same length")
+    sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
+    if t_max is not None:
+        sel &= t <= t_max
+    return t[sel], P[sel], P_err[sel]
+
+
+def _p_at(t, P, P_err, t0):
+    """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
+    t = np.asarray(t, dtype=float)
+    P = np.asarray(P, dtype=float)
+    E = np.asarray(P_err, dtype=float)
+    ok = np.isfinite(P) & (P > 0)
+    t, P, E = t[ok], P[ok], E[ok]
+    if t.size == 0 or t0 < t[0] or t0 > t[-1]:
+        raise ValueError("cannot interpolate P at tau0 from the data; pass P_tau0")
+    return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
+
+
+def _residual_fn(curve, P, sig, space):
+    if space == "log":
+        y, s = np.log(P), sig / P
+
+        def res(theta):
+            m = curve(theta)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                lm = np.log(np.where(m > 0, m, 1e-300))
+            lm = np.where(np.isfinite(lm), lm, -700.0)
+            return (lm - y) / s
+
+    elif space == "linear":
+
+        def res(theta):
+            m = curve(theta)
+            return (np.where(np.isfinite(m), m, 0.0) - P) / sig
+
+    else:
+        raise ValueError(f"space must be 'log' or 'linear', got {space!r}")
+    return res
+
+
+def _lsq(res, starts, lo, hi):
+    """Best least_squares solution over several starting points."""
+    best = None
+    for x0 in starts:
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
+        try:
+            r = optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
+        except ValueError:
+            continue
+        if best is None or r.cost < best.cost:
+            best = r
+    if best is None:
+        raise RuntimeError("survival fit failed for all starting points")
+    return best
+
+
+def _covariance(J, chi2_red, absolute_sigma):
+    cov = np.linalg.pinv(J.T @ J)
+    if not absolute_sigma:
+        cov = cov * chi2_red
+    return cov
+
+
+def _goodness(curve_vals, t, P, res_norm, k):
+    n = t.size
+    chi2 = float(np.sum(res_norm**2))
+    dof = n - k
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lr = np.log(curve_vals) - np.log(P)
+    lr = lr[np.isfinite(lr)]
+    rms = float(np.sqrt(np.mean(lr**2))) if lr.size else float("nan")
+    return chi2, dof, (chi2 / dof if dof > 0 else float("nan")), rms, chi2 + 2 * k
+
+
+# ---------------------------------------------------------------------------
+# homogeneous fit
+# ---------------------------------------------------------------------------
+_HOMOG = ("f_ne", "f_e", "L", "b", "tau2")
+
+
+def fit_survival_model(
+    t,
+    P,
+    P_err,
+    *,
+    kappa_of_E: Callable,
+    E0: float,
+    mu: float,
+    gamma: float,
+    tau0: float,
+    tau2: float | None = None,
+    E_c: float = E_C,
+    fixed: dict | None = None,
+    fit_tau2: bool = False,
+    p0: dict | None = None,
+    P_tau0: float | None = None,
+    constrain_total: bool = True,
+    space: str = "log",
+    P_min: float = 0.0,
+    t_max: float | None = None,
+    hazard: str = "paper",
+    absolute_sigma: bool = True,
+) -> SurvivalFit:
+    """fit_survival_model(t, P, P_err, *, kappa_of_E, E0, mu, gamma, tau0, ...) -> SurvivalFit.
+
+    Weighted least-squares fit of Eq. (eqn:surv_prob_model) to a measured
+    survival curve P(t) ± P_err (e.g. from
+    :func:`hhscatter.analysis.transitions.survival_curve`) on τ0 ≤ t ≤ t_max.
+
+    Parameters: f_ne, f_e, L, b and τ2.  The energy path (E0, μ, γ) and κ0(E)
+    are inputs (measured elsewhere: :func:`~hhscatter.analysis.decay.fit_energy_decay`
+    and the conservative study).
+
+    * ``constrain_total`` (default True): f_e = P(τ0) − f_ne as in the paper;
+      P(τ0) is ``P_tau0`` or, if None, log-linearly interpolated from the data
+      (its error is added in quadrature to that of f_e).
+    * τ2 is fixed at ``tau2`` (None: Eq. (eq:tau2)) unless ``fit_tau2``; then
+      it is fitted by profiling χ² over τ2 (the model jumps at τ2, so χ² is
+      only piecewise smooth there) and its error is the half-width of the
+      Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``).
+    * ``fixed``: dict name → value holding any of f_ne, f_e, L, b fixed.
+    * ``p0``: dict of starting values (defaults are data-driven, with a few
+      starts for b).
+    * ``space``: "log" (residuals (ln P_model − ln P)/(σ_P/P), default) or
+      "linear" ((P_model − P)/σ_P).  Points with P ≤ ``P_min`` are dropped
+      (log residuals need counts ≫ 1: use P_min ≈ 20/N).
+    * ``absolute_sigma`` (default True): P_err are true standard deviations
+      (binomial errors); False rescales the covariance by χ²/dof.
+
+    Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
+    AIC, ...).
+    """
+    fixed = dict(fixed or {})
+    unknown = set(fixed) - set(_HOMOG)
+    if unknown:
+        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+    if hazard not in HAZARDS:
+        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    t_all = np.asarray(t, dtype=float)
+    if P_tau0 is None:
+        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
+    else:
+        P_tau0_err = 0.0
+    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
+    if tf.size < 3:
+        raise ValueError("fewer than 3 data points selected")
+    tau2_eq = tau2_predicted(E0, E_c, mu, gamma) if tau2 is None else float(tau2)
+    if "tau2" in fixed:
+        tau2_eq, fit_tau2 = float(fixed.pop("tau2")), False
+
+    free = [n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total)]
+    p0 = dict(p0 or {})
+
+    # data-driven starting values
+    def p_near(tq):
+        return float(np.exp(np.interp(tq, tf, np.log(Pf))))
+
+    fne0 = p0.get("f_ne", fixed.get("f_ne", min(max(p_near(tau2_eq), 1e-8), 0.9 * P_tau0)))
+    fe0 = p0.get("f_e", fixed.get("f_e", max(P_tau0 - fne0, 1e-8)))
+    late = tf > tau2_eq
+    if late.sum() >= 3:
+        hl = tf[late] >= np.median(tf[late])
+        slope = -np.polyfit(tf[late][hl], np.log(Pf[late][hl]), 1)[0] if hl.sum() >= 2 else 0.05
+        L0 = p0.get("L", max(slope, 1e-3))
+    else:
+        L0 = p0.get("L", 0.05)
+    b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
+
+    bounds = {
+        "f_ne": (0.0, P_tau0 if constrain_total else 1.0),
+        "f_e": (0.0, 1.0),
+        "L": (1e-9, 1e3),
+        "b": (1e-6, 1e3),
+    }
+    lo = np.array([bounds[n][0] for n in free], dtype=float)
+    hi = np.array([bounds[n][1] for n in free], dtype=float)
+
+    def unpack(theta, tau2v):
+        v = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b_starts[0]}
+        v.update(fixed)
+        v.update(dict(zip(free, theta)))
+        if constrain_total and "f_e" not in fixed:
+            v["f_e"] = P_tau0 - v["f_ne"]
+        v["tau2"] = tau2v
+        return v
+
+    def make(v):
+        return SurvivalModelParams(kappa_of_E, E0, mu, gamma, tau0, v["tau2"], v["f_ne"], v["f_e"], v["L"], v["b"], E_c, hazard)
+
+    def starts_for(prev=None, warm_only=False):
+        out = []
+        if prev is not None:
+            out.append(prev)
+            if warm_only:
+                return out
+        for b0 in b_starts:
+            guess = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b0}
+            out.append([guess[n] for n in free])
+        return out
+
+    def fit_at(tau2v, prev=None, warm_only=False):
+        curve = lambda th: make(unpack(th, tau2v))(tf)  # noqa: E731
+        res = _residual_fn(curve, Pf, sf, space)
+        if not free:
+            r = res(np.array([]))
+            return None, float(np.sum(r**2)), res
+        sol = _lsq(res, starts_for(prev, warm_only), lo, hi)
+        return sol, float(2 * sol.cost), res
+
+    tau2_err = 0.0
+    if fit_tau2:
+        t_lo_b, t_hi_b = tau0 + 1e-9, float(tf[-1])
+        # profile chi2 over tau2: coarse scan (warm-started), then a fine scan
+        # around the best coarse point
+        # (each point: warm start from the neighbour plus the default starts)
+        def profile(taus):
+            prof, sols, prev = [], [], None
+            for tv in taus:
+                sol, c2, _ = fit_at(tv, prev)
+                prev = None if sol is None else sol.x
+                prof.append(c2)
+                sols.append(prev)
+            return np.array(prof), sols
+
+        grid = np.linspace(t_lo_b, t_hi_b, 25)
+        prof, sols = profile(grid)
+        i = int(np.argmin(prof))
+        fine = np.linspace(grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)], 21)
+        fprof, fsols = profile(fine)
+        j = int(np.argmin(fprof))
+        tau2_best = float(fine[j])
+        sol, c2min, res = fit_at(tau2_best, fsols[j])
+        dof = tf.size - len(free) - 1
+        scale = 1.0 if absolute_sigma else max(c2min / max(dof, 1), 1e-300)
+        inside = fine[fprof <= min(c2min, fprof.min()) + scale]
+        step = fine[1] - fine[0]
+        tau2_err = float(max((inside.max() - inside.min()) / 2, step / 2)) if inside.size else float("nan")
+        tau2_fit = tau2_best
+    else:
+        tau2_fit = tau2_eq
+        sol, c2min, res = fit_at(tau2_fit)
+
+    k = len(free) + (1 if fit_tau2 else 0)
+    theta = sol.x if sol is not None else np.array([])
+    v = unpack(theta, tau2_fit)
+    model = make(v)
+    curve_vals = model(tf)
+    r = res(theta)
+    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, tf, Pf, r, k)
+    if sol is not None:
+        cov = _covariance(sol.jac, chi2_red, absolute_sigma)
+    else:
+        cov = np.zeros((0, 0))
+    errors = {n: 0.0 for n in _HOMOG}
+    for i, n in enumerate(free):
+        errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
+    if constrain_total and "f_e" not in fixed:
+        errors["f_e"] = float(np.hypot(errors["f_ne"], P_tau0_err))
+    errors["tau2"] = tau2_err
+    values = dict(v)
+    values["P_tau0"] = P_tau0
+    errors["P_tau0"] = P_tau0_err
+    return SurvivalFit(
+        params=model,
+        values=values,
+        errors=errors,
+        free=tuple(free) + (("tau2",) if fit_tau2 else ()),
+        cov=cov,
+        chi2=chi2,
+        dof=dof,
+        chi2_red=chi2_red,
+        rms_log_residual=rms,
+        aic=aic,
+        n_points=int(tf.size),
+        space=space,
+        t_fit=tf,
+        residuals=r,
+        success=bool(sol.success) if sol is not None else True,
+        message=str(sol.message) if sol is not None else "no free parameters",
+    )
+
+
+# ---------------------------------------------------------------------------
+# τ1 from the model
+# ---------------------------------------------------------------------------
+def _as_curve(P_0):
+    if callable(P_0):
+        return P_0
+    tg, Pg = (np.asarray(a, dtype=float) for a in P_0)
+    ok = np.isfinite(Pg) & (Pg > 0)
+    tg, lg = tg[ok], np.log(Pg[ok])
+
+    def f(t):
+        t = np.asarray(t, dtype=float)
+        out = np.exp(np.interp(t, tg, lg))
+        return np.where((t < tg[0]) | (t > tg[-1]), np.nan, out)
+
+    f.t_end = float(tg[-1])
+    return f
+
+
+def predict_tau1(params, P_0, alpha: float = 2.0, *, t_max: float | None = None, n_grid: int = 20001):
+    """predict_tau1(params, P_0, alpha=2.0, *, t_max=None) -> float or None.
+
+    Predicted τ1 (Fig. 6b dashed line): solves Eq. (eqn:tau1),
+    min{t ≥ τ0 : P_model(t) = α P_0(t)}, with P_model given by ``params``
+    (a :class:`SurvivalModelParams`, :class:`MixtureModelParams`, a
+    :class:`SurvivalFit`, or any object with ``tau0`` that is callable on t).
+
+    ``P_0`` is the conservative survival curve: a callable P_0(t) or a pair
+    (t_grid, P0_values), interpolated linearly in log P (NaN outside the
+    grid).  The condition is scanned on ``n_grid`` points in [τ0, t_max]
+    (default: the end of the P_0 grid, or τ0 + 3(τ2 − τ0) for a callable)
+    and the first sign change of ln P_model − ln(α P_0) is refined with
+    Brent's method.  Returns τ0 if the condition already holds at τ0, None if
+    it never does.
+    """
+    if hasattr(params, "params") and not hasattr(params, "tau0"):
+        params = params.params
+    tau0 = float(params.tau0)
+    f0 = _as_curve(P_0)
+    if t_max is None:
+        if hasattr(f0, "t_end"):
+            t_max = f0.t_end
+        else:
+            tau2 = params.tau2_k if hasattr(params, "tau2_k") else params.tau2
+            tau2 = float(np.max(np.atleast_1d(tau2)))
+            t_max = tau0 + 3 * max(tau2 - tau0, 1.0)
+    if t_max <= tau0:
+        return None
+    tt = np.linspace(tau0, t_max, n_grid)
+
+    def D(x):
+        pm = np.asarray(params(x), dtype=float)
+        p0 = np.asarray(f0(x), dtype=float)
+        return _log_ratio_d(pm, p0, alpha)
+
+    d = D(tt)
+    if d[0] >= 0:
+        return tau0
+    hit = np.flatnonzero(d >= 0)
+    if hit.size == 0:
+        return None
+    j = int(hit[0])
+    a, b = tt[j - 1], tt[j]
+    if not np.isfinite(d[j]) or not np.isfinite(d[j - 1]):
+        return float(b)
+    try:
+        return float(optimize.brentq(lambda x: float(D(x)), a, b, xtol=1e-10))
+    except ValueError:
+        return float(b)
+
+
+def _log_ratio_d(pm, p0, alpha):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.log(pm) - np.log(alpha * p0)
+    d = np.where((p0 <= 0) & (pm > 0), np.inf, d)
+    return np.where(np.isnan(d), -np.inf, d)
+
+
+# ---------------------------------------------------------------------------
+# mixture model
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MixtureComponents:
+    """Energy sub-ensembles measured from the snapshots (see module docstring).
+
+    ``t_ref``    snapshot grid time at which the sub-ensembles are defined;
+    ``by``       "energy" or "rate": the quantity binned into quantiles;
+    ``edges``    (K+1,) its quantile edges;
+    ``weights``  (K,) fractions w_k of the orbits alive at t_ref (Σ = 1);
+    ``n_ref``    (K,) their counts; ``E_ref`` (K,) mean energy at t_ref;
+    ``A, mu, mu_err``  (K,) paths E_k(t) = A_k exp(−μ_k γ t);
+    ``fit_window`` time window of the per-orbit fits; ``gamma`` the drag.
+    Build with :func:`mixture_components`, or directly for known paths.
+    """
+
+    t_ref: float
+    by: str
+    edges: np.ndarray
+    weights: np.ndarray
+    n_ref: np.ndarray
+    E_ref: np.ndarray
+    A: np.ndarray
+    mu: np.ndarray
+    mu_err: np.ndarray
+    fit_window: tuple
+    gamma: float
+
+    @property
+    def K(self) -> int:
+        """Number of sub-ensembles."""
+        return int(self.weights.size)
+
+    def energy(self, t):
+        """energy(t) -> (K, len(t)) array of E_k(t)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return self.A[:, None] * np.exp(-self.mu[:, None] * self.gamma * t[None, :])
+
+    def tau2(self, E_c: float = E_C):
+        """tau2(E_c) -> (K,) τ2,k = ln(A_k/E_c)/(μ_k γ), Eq. (eq:tau2) per sub-ensemble."""
+        return np.asarray(tau2_predicted(self.A, E_c, self.mu, self.gamma), dtype=float)
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per sub-ensemble: bin_lo, bin_hi (of ``by``), weight, n_ref, E_ref, A, mu, mu_err, tau2."""
+        return pd.DataFrame(
+            {
+                "bin_lo": self.edges[:-1],
+                "bin_hi": self.edges[1:],
+                "weight": self.weights,
+                "n_ref": self.n_ref,
+                "E_ref": self.E_ref,
+                "A": self.A,
+                "mu": self.mu,
+                "mu_err": self.mu_err,
+                "tau2": self.tau2(),
+            }
+        )
+
+
+def _per_orbit_decay(ids, t, e, lo, hi):
+    """Per-orbit least squares of ln E = a − β t on lo ≤ t ≤ hi: (unique ids, a, β, n points)."""
+    ok = (t >= lo) & (t <= hi) & np.isfinite(e) & (e > 0)
+    ids, t, y = ids[ok], t[ok], np.log(e[ok])
+    uid, inv = np.unique(ids, return_inverse=True)
+    m = uid.size
+    n = np.bincount(inv, minlength=m).astype(float)
+    st = np.bincount(inv, weights=t, minlength=m)
+    sy = np.bincount(inv, weights=y, minlength=m)
+    stt = np.bincount(inv, weights=t * t, minlength=m)
+    sty = np.bincount(inv, weights=t * y, minlength=m)
+    den = n * stt - st * st
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = np.where(den > 0, (n * sty - st * sy) / den, np.nan)
+        a = np.where(n > 0, (sy - slope * st) / n, np.nan)
+    return uid, a, -slope, n
+
+
+def mixture_components_arrays(
+    traj_id,
+    t,
+    energy,
+    *,
+    gamma: float,
+    t_ref: float,
+    n_components: int = 4,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+) -> MixtureComponents:
+    """mixture_components_arrays(traj_id, t, energy, *, gamma, t_ref, n_components=4, by="energy", fit_window=(0, inf)) -> MixtureComponents.
+
+    Sub-ensembles of the orbits alive at the snapshot grid time nearest
+    ``t_ref``:
+
+    1. every such orbit gets its own decay law ln E_i(t) = a_i − μ_i γ t,
+       least squares over its snapshots in ``fit_window`` (default: its whole
+       record; needs ≥ 2 snapshots, otherwise μ_i is undefined);
+    2. the orbits are split into ``n_components`` quantile bins of their
+       energy E_i(t_ref) (``by="energy"``: the bins discretise ρ(E(t_ref)) of
+       Eq. (eqn:c-measure_model)) or of their exponent μ_i (``by="rate"``:
+       sub-ensembles "each with their own energy decay exponent μ"; orbits
+       with undefined μ_i are left out);
+    3. each sub-ensemble k gets w_k = n_k / Σ n, μ_k = mean of its members'
+       μ_i (error: standard error of that mean) and A_k = exp(mean a_i), i.e.
+       the path E_k(t) = A_k e^{−μ_k γ t}, Eq. (eqn:energy_exp_decay).
+
+    Averaging per-orbit exponents, rather than fitting the sub-ensemble's
+    mean energy ⟨E⟩_k(t), avoids survivor bias: as the members with fast
+    decay settle, ⟨E⟩_k(t) over those still alive is pulled towards the slow
+    ones and its slope underestimates the members' decay.
+    """
+    ids = np.asarray(traj_id).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if not (ids.shape == t.shape == e.shape):
+        raise ValueError("traj_id, t and energy must have the same length")
+    if by not in ("energy", "rate"):
+        raise ValueError("by must be 'energy' or 'rate'")
+    K = int(n_components)
+    if K < 1:
+        raise ValueError("n_components must be >= 1")
+    grid = np.unique(t[np.isfinite(t)])
+    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
+    at = (t == t_used) & np.isfinite(e)
+    ids_ref, e_ref = ids[at], e[at]
+    order = np.argsort(ids_ref)
+    ids_ref, e_ref = ids_ref[order], e_ref[order]
+    # per-orbit decay laws of the orbits alive at t_ref
+    member_rows = np.isin(ids, ids_ref)
+    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
+    pos = np.searchsorted(uid, ids_ref)
+    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
+    mu_i = np.full(ids_ref.size, np.nan)
+    a_ref = np.full(ids_ref.size, np.nan)
+    mu_i[has] = beta_i[pos[has]] / gamma
+    a_ref[has] = a_i[pos[has]]
+    key = e_ref if by == "energy" else mu_i
+    use = np.isfinite(key)
+    if use.sum() < K:
+        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
+    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
+    comp = np.full(ids_ref.size, -1)
+    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
+    n_ref = np.bincount(comp[use], minlength=K)
+    if np.any(n_ref == 0):
+        raise ValueError("empty sub-ensemble (ties); use fewer components")
+    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
+    for k in range(K):
+        sel = comp == k
+        E_mean[k] = float(e_ref[sel].mean())
+        good = sel & np.isfinite(mu_i)
+        if not good.any():
+            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
+        mu[k] = float(mu_i[good].mean())
+        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
+        A[k] = float(np.exp(a_ref[good].mean()))
+    return MixtureComponents(
+        t_ref=t_used,
+        by=by,
+        edges=edges,
+        weights=n_ref / n_ref.sum(),
+        n_ref=n_ref.astype(np.int64),
+        E_ref=E_mean,
+        A=A,
+        mu=mu,
+        mu_err=mu_err,
+        fit_window=(float(fit_window[0]), float(fit_window[1])),
+        gamma=float(gamma),
+    )
+
+
+def mixture_components(
+    snapshots: pd.DataFrame,
+    *,
+    gamma: float,
+    t_ref: float,
+    n_components: int = 4,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+) -> MixtureComponents:
+    """mixture_components(snapshots, *, gamma, t_ref, n_components=4, by="energy", fit_window=(0, inf)) -> MixtureComponents.
+
+    DataFrame wrapper of :func:`mixture_components_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).
+    """
+    return mixture_components_arrays(
+        snapshots["traj_id"].to_numpy(),
+        snapshots["t"].to_numpy(),
+        snapshots["energy"].to_numpy(),
+        gamma=gamma,
+        t_ref=t_ref,
+        n_components=n_components,
+        by=by,
+        fit_window=fit_window,
+    )
+
+
+def mixture_survival_model(
+    t,
+    *,
+    kappa_of_E: Callable,
+    components: MixtureComponents,
+    tau0: float,
+    f_ne,
+    P_tau0: float,
+    L: float,
+    b: float,
+    E_c: float = E_C,
+    hazard: str = "paper",
+    tau2=None,
+):
+    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c=1/6, hazard="paper") -> P(t).
+
+    Mixture generalisation of Eq. (eqn:surv_prob_model):
+    P(t) = Σ_k P_k(t), each sub-ensemble k following the homogeneous model
+    along its own energy path E_k(t) = A_k e^{−μ_k γ t} (rate κ0(E_k(t))),
+    with trapped fraction ``f_ne[k]``, escaping fraction
+    f_e,k = w_k P_tau0 − f_ne[k], settling time τ2,k (``tau2`` (K,) or, if
+    None, Eq. (eq:tau2) per sub-ensemble) and shared settling parameters L, b.
+    NaN for t < τ0.
+    """
+    c = components
+    f_ne = np.broadcast_to(np.asarray(f_ne, dtype=float), (c.K,))
+    tau2_k = c.tau2(E_c) if tau2 is None else np.broadcast_to(np.asarray(tau2, dtype=float), (c.K,))
+    f_e = c.weights * P_tau0 - f_ne
+    t_arr = np.asarray(t, dtype=float)
+    out = np.zeros(t_arr.shape)
+    for k in range(c.K):
+        out = out + _component(t_arr, kappa_of_E, c.A[k], c.mu[k], c.gamma, tau0, tau2_k[k], f_ne[k], f_e[k], L, b, hazard)
+    return float(out) if np.ndim(t) == 0 else out
+
+
+@dataclass(frozen=True)
+class MixtureModelParams:
+    """All inputs of :func:`mixture_survival_model`; calling it evaluates P(t)."""
+
+    kappa_of_E: Callable
+    components: MixtureComponents
+    tau0: float
+    f_ne_k: np.ndarray
+    P_tau0: float
+    L: float
+    b: float
+    E_c: float = E_C
+    hazard: str = "paper"
+
+    @property
+    def tau2_k(self):
+        """(K,) settling times τ2,k of the sub-ensembles."""
+        return self.components.tau2(self.E_c)
+
+    def __call__(self, t):
+        return mixture_survival_model(
+            t,
+            kappa_of_E=self.kappa_of_E,
+            components=self.components,
+            tau0=self.tau0,
+            f_ne=self.f_ne_k,
+            P_tau0=self.P_tau0,
+            L=self.L,
+            b=self.b,
+            E_c=self.E_c,
+            hazard=self.hazard,
+        )
+
+
+def fit_mixture_model(
+    t,
+    P,
+    P_err,
+    components,
+    *,
+    kappa_of_E: Callable,
+    tau0: float,
+    gamma: float | None = None,
+    E_c: float = E_C,
+    n_components: int = 4,
+    t_ref: float | None = None,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+    fne_mode: str = "free",
+    fixed: dict | None = None,
+    p0: dict | None = None,
+    P_tau0: float | None = None,
+    space: str = "log",
+    P_min: float = 0.0,
+    t_max: float | None = None,
+    hazard: str = "paper",
+    absolute_sigma: bool = True,
+) -> SurvivalFit:
+    """fit_mixture_model(t, P, P_err, components, *, kappa_of_E, tau0, ...) -> SurvivalFit.
+
+    Weighted least-squares fit of the mixture model (module docstring,
+    :func:`mixture_survival_model`) to P(t) ± P_err, with the same data
+    selection (τ0 ≤ t ≤ t_max, P > P_min), residual ``space`` and
+    goodness-of-fit measures as :func:`fit_survival_model`, so that the two
+    can be compared with :func:`compare_fits`.
+
+    ``components`` is a :class:`MixtureComponents` or the ``snapshots``
+    DataFrame, from which the sub-ensembles are built by
+    :func:`mixture_components` (needs ``gamma``; ``t_ref`` defaults to τ0).
+    The component energy paths are measured inputs, not fitted.
+
+    Free parameters: ``fne_mode="free"``: f_ne_0 … f_ne_{K−1} (bounded to
+    [0, w_k P(τ0)]), L, b; ``fne_mode="shared"``: phi (f_ne,k = phi w_k P(τ0),
+    0 ≤ phi ≤ 1), L, b.  ``fixed`` may hold L, b, phi or f_ne_k values.
+    Derived values reported: f_ne = Σ f_ne,k and f_e = P(τ0) − f_ne (with
+    propagated errors), τ2_k.  P(τ0) is ``P_tau0`` or interpolated from the
+    data.
+    """
+    if isinstance(components, pd.DataFrame):
+        if gamma is None:
+            raise ValueError("gamma is needed to build the components from snapshots")
+        components = mixture_components(
+            components,
+            gamma=gamma,
+            t_ref=tau0 if t_ref is None else t_ref,
+            n_components=n_components,
+            by=by,
+            fit_window=fit_window,
+        )
+    c = components
+    K = c.K
+    if fne_mode not in ("free", "shared"):
+        raise ValueError("fne_mode must be 'free' or 'shared'")
+    if hazard not in HAZARDS:
+        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    fixed = dict(fixed or {})
+    p0 = dict(p0 or {})
+    t_all = np.asarray(t, dtype=float)
+    if P_tau0 is None:
+        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
+    else:
+        P_tau0_err = 0.0
+    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
+    if tf.size < 3:
+        raise ValueError("fewer than 3 data points selected")
+
+    fne_names = [f"f_ne_{k}" for k in range(K)] if fne_mode == "free" else ["phi"]
+    names = fne_names + ["L", "b"]
+    unknown = set(fixed) - set(names)
+    if unknown:
+        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+    free = [n for n in names if n not in fixed]
+
+    # starting values: trapped fraction from P at the earliest settling time
+    tau2_k = c.tau2(E_c)
+    t_first = float(np.clip(np.min(tau2_k), tf[0], tf[-1]))
+    phi0 = float(np.clip(np.exp(np.interp(t_first, tf, np.log(Pf))) / P_tau0, 1e-6, 0.9))
+    late = tf > np.max(tau2_k)
+    if late.sum() >= 3:
+        hl = tf[late] >= np.median(tf[late])
+        slope = -np.polyfit(tf[late][hl], np.log(Pf[late][hl]), 1)[0] if hl.sum() >= 2 else 0.05
+        L0 = max(slope, 1e-3)
+    else:
+        L0 = 0.05
+    guess = {"phi": phi0, "L": p0.get("L", L0)}
+    for k in range(K):
+        guess[f"f_ne_{k}"] = phi0 * c.weights[k] * P_tau0
+    guess.update({k: v for k, v in p0.items() if k != "b"})
+    b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
+
+    def bound(n):
+        if n == "phi":
+            return (0.0, 1.0)
+        if n.startswith("f_ne_"):
+            return (0.0, float(c.weights[int(n[5:])] * P_tau0))
+        return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
+
+    lo = np.array([bound(n)[0] for n in free], dtype=float)
+    hi = np.array([bound(n)[1] for n in free], dtype=float)
+
+    def unpack(theta):
+        v = dict(guess)
+        v["b"] = b_starts[0]
+        v.update(fixed)
+        v.update(dict(zip(free, theta)))
+        if fne_mode == "free":
+            fk = np.array([v[f"f_ne_{k}"] for k in range(K)])
+        else:
+            fk = v["phi"] * c.weights * P_tau0
+        return v, fk
+
+    def make(theta):
+        v, fk = unpack(theta)
+        return MixtureModelParams(kappa_of_E, c, tau0, fk, P_tau0, v["L"], v["b"], E_c, hazard)
+
+    res = _residual_fn(lambda th: make(th)(tf), Pf, sf, space)
+    starts = []
+    for b0 in b_starts:
+        g = dict(guess, b=b0)
+        starts.append([g[n] for n in free])
+    if free:
+        sol = _lsq(res, starts, lo, hi)
+        theta = sol.x
+    else:
+        sol, theta = None, np.array([])
+    model = make(theta)
+    r = res(theta)
+    k_free = len(free)
+    chi2, dof, chi2_red, rms, aic = _goodness(model(tf), tf, Pf, r, k_free)
+    cov = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+
+    v, fk = unpack(theta)
+    values = {n: float(v[n]) for n in names}
+    errors = {n: 0.0 for n in names}
+    for i, n in enumerate(free):
+        errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
+    # derived: total trapped fraction and its error (linear in the parameters)
+    grad = np.zeros(len(free))
+    for i, n in enumerate(free):
+        if n.startswith("f_ne_"):
+            grad[i] = 1.0
+        elif n == "phi":
+            grad[i] = P_tau0
+    f_ne_err = float(np.sqrt(max(grad @ cov @ grad, 0.0))) if free else 0.0
+    values.update(
+        f_ne=float(fk.sum()),
+        f_e=float(P_tau0 - fk.sum()),
+        P_tau0=P_tau0,
+        tau2_k=tau2_k,
+        f_ne_k=fk,
+        f_e_k=c.weights * P_tau0 - fk,
+    )
+    errors.update(f_ne=f_ne_err, f_e=float(np.hypot(f_ne_err, P_tau0_err)), P_tau0=P_tau0_err)
+    return SurvivalFit(
+        params=model,
+        values=values,
+        errors=errors,
+        free=tuple(free),
+        cov=cov,
+        chi2=chi2,
+        dof=dof,
+        chi2_red=chi2_red,
+        rms_log_residual=rms,
+        aic=aic,
+        n_points=int(tf.size),
+        space=space,
+        t_fit=tf,
+        residuals=r,
+        success=bool(sol.success) if sol is not None else True,
+        message=str(sol.message) if sol is not None else "no free parameters",
+    )
+
+
+def compare_fits(fits: dict) -> pd.DataFrame:
+    """compare_fits({name: SurvivalFit, ...}) -> DataFrame of goodness of fit, one row per model.
+
+    Columns: n_points, n_free, chi2, dof, chi2_red, rms_log_residual, aic.
+    The comparison is meaningful only for fits on the same data selection
+    (equal n_points, same τ0, t_max, P_min and residual space).
+    """
+    rows = []
+    for name, f in fits.items():
+        rows.append(
+            {
+                "model": name,
+                "n_points": f.n_points,
+                "n_free": len(f.free),
+                "chi2": f.chi2,
+                "dof": f.dof,
+                "chi2_red": f.chi2_red,
+                "rms_log_residual": f.rms_log_residual,
+                "aic": f.aic,
+            }
+        )
+    return pd.DataFrame(rows).set_index("model")
