@@ -20,9 +20,12 @@ def plot_survival(curves, path, *, title=None, logx=False):
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.2), constrained_layout=True)
     for c in curves:
-        (line,) = ax.step(c["t"], c["P"], where="post", label=c["label"], lw=1.4)
+        keep = c["P"] > 0  # log axis: the final P = 0 step is not drawable
+        t, P = c["t"][keep], c["P"][keep]
+        (line,) = ax.step(t, P, where="post", label=c["label"], lw=1.4)
         if c.get("P_err") is not None:
-            ax.fill_between(c["t"], c["P"] - c["P_err"], c["P"] + c["P_err"], step="post",
+            err = c["P_err"][keep]
+            ax.fill_between(t, (P - err).clip(min=P * 0.05), P + err, step="post",
                             color=line.get_color(), alpha=0.25, lw=0)
     ax.set_yscale("log")
     if logx:

@@ -54,8 +54,8 @@ noise floor d_noise = mean(d(P1,P2), d(Q1,Q2)), each averaged over
 ``n_splits`` random splits (their spread over splits is reported as *_std).
 If P and Q come from one distribution, d_PQ and d_noise have the same
 expectation.  The two sets are said to *agree at scale ε* when
-d_PQ ≤ d_noise + z·std(d_noise) (z = 2 by default) and the scale is
-*informative* when d_noise ≤ noise_max (default 0.5; beyond it the boxes are
+d_PQ ≤ d_noise + z·σ, with σ the combined split-to-split spread of d_PQ and
+d_noise (z = 2 by default), and the scale is *informative* when d_noise ≤ noise_max (default 0.5; beyond it the boxes are
 so sparsely filled that any two samples look different).  The agreement scale
 ε* (:func:`agreement_scale`) is the smallest ε such that the sets agree at
 every informative box size ≥ ε.  Since the noise floor shrinks with sample
@@ -251,18 +251,22 @@ def agreement_scale(table: pd.DataFrame, kind: str = "hellinger", z: float = 2.0
     From a :func:`distance_vs_scale` table computed with ``n_splits`` ≥ 2:
     the smallest box side ε* such that at every informative box size
     ε ≥ ε* (noise floor ``<kind>_noise`` ≤ ``noise_max``) the sets agree
-    within sampling noise, ``<kind>_pq`` ≤ ``<kind>_noise`` + z·``<kind>_noise_std``.
+    within sampling noise, ``<kind>_pq`` ≤ ``<kind>_noise`` + z·σ with
+    σ = √(``<kind>_noise_std``² + ``<kind>_pq_std``²) (the split-to-split
+    spreads; for two independent samples of one distribution the resulting
+    z-scores have a spread ≲ 1, so z = 2 rarely flags a false disagreement).
     None if they already disagree at the coarsest informative scale (or no
     scale is informative).  Same units as the boxes.
     """
-    need = {f"{kind}_pq", f"{kind}_noise", f"{kind}_noise_std"}
+    need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
     if not need <= set(table.columns):
         raise ValueError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
     tab = table.sort_values("box", ascending=False)
     tab = tab[tab[f"{kind}_noise"] <= noise_max]
     best = None
     for _, r in tab.iterrows():
-        if r[f"{kind}_pq"] <= r[f"{kind}_noise"] + z * r[f"{kind}_noise_std"]:
+        sigma = np.hypot(r[f"{kind}_noise_std"], r[f"{kind}_pq_std"])
+        if r[f"{kind}_pq"] <= r[f"{kind}_noise"] + z * sigma:
             best = float(r["box"])
         else:
             break

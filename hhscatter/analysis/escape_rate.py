@@ -36,6 +36,7 @@ from .survival import (
     detect_power_law_tail,
     fit_exponential,
     lifetimes_to_arrays,
+    mean_kappa_stat_err,
     survival_curve,
 )
 
@@ -318,9 +319,10 @@ class EscapeRateResult:
     """Result of :func:`escape_rate` (κ in 1/time, times in time units).
 
     kappa           mean of the 4 window fits (Fig. 2b caption)
-    kappa_err       √(spread² + stat²)
+    kappa_err       √(spread² + stat²) (conservative: the spread also contains noise)
     kappa_spread    sample std (ddof=1) of the 4 window estimates (systematics)
-    kappa_stat      statistical error of the full-window fit (correlation-aware)
+    kappa_stat      statistical error of the mean of the 4 fits (correlation-aware,
+                    :func:`~hhscatter.analysis.survival.mean_kappa_stat_err`)
     tau0, t_stop, windows   from :func:`choose_windows`
     fits            the 4 :class:`ExponentialFit` (full, first half, second half, middle half)
     mle             :class:`MLERate` on [tau0, t_stop] (cross-check)
@@ -376,8 +378,8 @@ def escape_rate(
     2. τ0 and 4 windows by :func:`choose_windows` (``window_kwargs`` go there);
     3. κ_i by weighted least squares of log P on each window
        (:func:`fit_exponential`); κ = mean of the 4 (paper, Fig. 2b caption);
-       kappa_err = √(std(κ_i)² + σ_stat²), σ_stat the correlation-aware error of
-       the full-window fit;
+       kappa_err = √(std(κ_i)² + σ_stat²), σ_stat the statistical error of
+       that mean (Kaplan–Meier correlations and window overlaps included);
     4. cross-check :func:`escape_rate_mle` on [τ0, t_stop];
     5. with ``detect_tail``, :func:`detect_power_law_tail` after τ0 and, if a
        tail is found, τ* = :func:`crossover_time` of the full-window
@@ -395,7 +397,7 @@ def escape_rate(
     ks = np.array([f.kappa for f in fits])
     kappa = float(ks.mean())
     spread = float(ks.std(ddof=1))
-    stat = fits[0].kappa_err
+    stat = mean_kappa_stat_err(t, P, E, wc.windows)
     mle = escape_rate_mle(t_end, observed, wc.tau0, wc.t_stop)
     tail, tau_star = None, math.nan
     if detect_tail:

@@ -422,8 +422,9 @@ def fit_survival_model(
     and the conservative study).
 
     * ``constrain_total`` (default True): f_e = P(τ0) − f_ne as in the paper;
-      P(τ0) is ``P_tau0`` or, if None, log-linearly interpolated from the data
-      (its error is added in quadrature to that of f_e).
+      P(τ0) is ``P_tau0`` (taken as exact) or, if None, log-linearly
+      interpolated from the data; its error is then propagated into the
+      errors and ``cov`` by re-fitting at P(τ0) + σ (linear sensitivity).
     * τ2 is fixed at ``tau2`` (None: Eq. (eq:tau2)) unless ``fit_tau2``; then
       it is fitted by profiling χ² over τ2 (the model jumps at τ2, so χ² is
       only piecewise smooth there) and its error is the half-width of the
@@ -476,21 +477,23 @@ def fit_survival_model(
         L0 = p0.get("L", 0.05)
     b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
 
-    bounds = {
-        "f_ne": (0.0, P_tau0 if constrain_total else 1.0),
-        "f_e": (0.0, 1.0),
-        "L": (1e-9, 1e3),
-        "b": (1e-6, 1e3),
-    }
-    lo = np.array([bounds[n][0] for n in free], dtype=float)
-    hi = np.array([bounds[n][1] for n in free], dtype=float)
+    derive_fe = constrain_total and "f_e" not in fixed
 
-    def unpack(theta, tau2v):
+    def limits(P0v):
+        bounds = {
+            "f_ne": (0.0, P0v if constrain_total else 1.0),
+            "f_e": (0.0, 1.0),
+            "L": (1e-9, 1e3),
+            "b": (1e-6, 1e3),
+        }
+        return (np.array([bounds[n][0] for n in free], dtype=float), np.array([bounds[n][1] for n in free], dtype=float))
+
+    def unpack(theta, tau2v, P0v=P_tau0):
         v = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b_starts[0]}
         v.update(fixed)
         v.update(dict(zip(free, theta)))
-        if constrain_total and "f_e" not in fixed:
-            v["f_e"] = P_tau0 - v["f_ne"]
+        if derive_fe:
+            v["f_e"] = P0v - v["f_ne"]
         v["tau2"] = tau2v
         return v
 
@@ -508,13 +511,13 @@ def fit_survival_model(
             out.append([guess[n] for n in free])
         return out
 
-    def fit_at(tau2v, prev=None, warm_only=False):
-        curve = lambda th: make(unpack(th, tau2v))(tf)  # noqa: E731
+    def fit_at(tau2v, prev=None, warm_only=False, P0v=P_tau0):
+        curve = lambda th: make(unpack(th, tau2v, P0v))(tf)  # noqa: E731
         res = _residual_fn(curve, Pf, sf, space)
         if not free:
             r = res(np.array([]))
             return None, float(np.sum(r**2)), res
-        sol = _lsq(res, starts_for(prev, warm_only), lo, hi)
+        sol = _lsq(res, starts_for(prev, warm_only), *limits(P0v))
         return sol, float(2 * sol.cost), res
 
     tau2_err = 0.0
@@ -561,11 +564,21 @@ def fit_survival_model(
         cov = _covariance(sol.jac, chi2_red, absolute_sigma)
     else:
         cov = np.zeros((0, 0))
+    # propagate the error of the measured P(τ0) through the constraint
+    sens = np.zeros(len(free))
+    if derive_fe and P_tau0_err > 0 and sol is not None:
+        sol_p, _, _ = fit_at(tau2_fit, sol.x, warm_only=True, P0v=P_tau0 + P_tau0_err)
+        sens = (sol_p.x - sol.x) / P_tau0_err
+    cov_fit = cov
+    cov = cov_fit + np.outer(sens, sens) * P_tau0_err**2
     errors = {n: 0.0 for n in _HOMOG}
     for i, n in enumerate(free):
         errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
-    if constrain_total and "f_e" not in fixed:
-        errors["f_e"] = float(np.hypot(errors["f_ne"], P_tau0_err))
+    if derive_fe:
+        i_f = free.index("f_ne") if "f_ne" in free else None
+        var_fit = cov_fit[i_f, i_f] if i_f is not None else 0.0
+        dfe_dP = 1.0 - (sens[i_f] if i_f is not None else 0.0)
+        errors["f_e"] = float(np.sqrt(max(var_fit, 0.0) + (dfe_dP * P_tau0_err) ** 2))
     errors["tau2"] = tau2_err
     values = dict(v)
     values["P_tau0"] = P_tau0
@@ -974,9 +987,10 @@ def fit_mixture_model(
     Free parameters: ``fne_mode="free"``: f_ne_0 … f_ne_{K−1} (bounded to
     [0, w_k P(τ0)]), L, b; ``fne_mode="shared"``: phi (f_ne,k = phi w_k P(τ0),
     0 ≤ phi ≤ 1), L, b.  ``fixed`` may hold L, b, phi or f_ne_k values.
-    Derived values reported: f_ne = Σ f_ne,k and f_e = P(τ0) − f_ne (with
-    propagated errors), τ2_k.  P(τ0) is ``P_tau0`` or interpolated from the
-    data.
+    Derived values reported: f_ne = Σ f_ne,k, f_e = P(τ0) − f_ne, the arrays
+    f_ne_k, f_e_k (with propagated errors) and τ2_k.  P(τ0) is ``P_tau0``
+    (exact) or interpolated from the data, its error then being propagated
+    into the errors and ``cov`` by re-fitting at P(τ0) + σ.
     """
     if isinstance(components, pd.DataFrame):
         if gamma is None:
@@ -1030,17 +1044,17 @@ def fit_mixture_model(
     guess.update({k: v for k, v in p0.items() if k != "b"})
     b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
 
-    def bound(n):
-        if n == "phi":
-            return (0.0, 1.0)
-        if n.startswith("f_ne_"):
-            return (0.0, float(c.weights[int(n[5:])] * P_tau0))
-        return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
+    def limits(P0v):
+        def bound(n):
+            if n == "phi":
+                return (0.0, 1.0)
+            if n.startswith("f_ne_"):
+                return (0.0, float(c.weights[int(n[5:])] * P0v))
+            return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
 
-    lo = np.array([bound(n)[0] for n in free], dtype=float)
-    hi = np.array([bound(n)[1] for n in free], dtype=float)
+        return (np.array([bound(n)[0] for n in free], dtype=float), np.array([bound(n)[1] for n in free], dtype=float))
 
-    def unpack(theta):
+    def unpack(theta, P0v=P_tau0):
         v = dict(guess)
         v["b"] = b_starts[0]
         v.update(fixed)
@@ -1048,42 +1062,62 @@ def fit_mixture_model(
         if fne_mode == "free":
             fk = np.array([v[f"f_ne_{k}"] for k in range(K)])
         else:
-            fk = v["phi"] * c.weights * P_tau0
+            fk = v["phi"] * c.weights * P0v
         return v, fk
 
-    def make(theta):
-        v, fk = unpack(theta)
-        return MixtureModelParams(kappa_of_E, c, tau0, fk, P_tau0, v["L"], v["b"], E_c, hazard)
+    def make(theta, P0v=P_tau0):
+        v, fk = unpack(theta, P0v)
+        return MixtureModelParams(kappa_of_E, c, tau0, fk, P0v, v["L"], v["b"], E_c, hazard)
 
-    res = _residual_fn(lambda th: make(th)(tf), Pf, sf, space)
+    def solve(starts, P0v=P_tau0):
+        res = _residual_fn(lambda th: make(th, P0v)(tf), Pf, sf, space)
+        return (_lsq(res, starts, *limits(P0v)) if free else None), res
+
     starts = []
     for b0 in b_starts:
         g = dict(guess, b=b0)
         starts.append([g[n] for n in free])
-    if free:
-        sol = _lsq(res, starts, lo, hi)
-        theta = sol.x
-    else:
-        sol, theta = None, np.array([])
+    sol, res = solve(starts)
+    theta = sol.x if sol is not None else np.array([])
     model = make(theta)
     r = res(theta)
     k_free = len(free)
     chi2, dof, chi2_red, rms, aic = _goodness(model(tf), tf, Pf, r, k_free)
-    cov = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
+    sens = np.zeros(k_free)
+    if P_tau0_err > 0 and sol is not None:
+        sol_p, _ = solve([sol.x], P_tau0 + P_tau0_err)
+        sens = (sol_p.x - sol.x) / P_tau0_err
+    cov = cov_fit + np.outer(sens, sens) * P_tau0_err**2
 
     v, fk = unpack(theta)
     values = {n: float(v[n]) for n in names}
     errors = {n: 0.0 for n in names}
     for i, n in enumerate(free):
         errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
-    # derived: total trapped fraction and its error (linear in the parameters)
-    grad = np.zeros(len(free))
+    # derived: total trapped fraction f_ne(θ, P) and f_e = P − f_ne
+    grad = np.zeros(k_free)
     for i, n in enumerate(free):
         if n.startswith("f_ne_"):
             grad[i] = 1.0
         elif n == "phi":
             grad[i] = P_tau0
-    f_ne_err = float(np.sqrt(max(grad @ cov @ grad, 0.0))) if free else 0.0
+    dfne_dP = float(grad @ sens) + (v["phi"] if fne_mode == "shared" else 0.0)
+    var_fit = float(grad @ cov_fit @ grad) if k_free else 0.0
+    f_ne_err = float(np.sqrt(max(var_fit, 0.0) + (dfne_dP * P_tau0_err) ** 2))
+    f_e_err = float(np.sqrt(max(var_fit, 0.0) + ((1.0 - dfne_dP) * P_tau0_err) ** 2))
+    fk_err = np.zeros(K)
+    if fne_mode == "free":
+        for k in range(K):
+            fk_err[k] = errors[f"f_ne_{k}"]
+    else:
+        i_phi = free.index("phi") if "phi" in free else None
+        for k in range(K):
+            g_k = c.weights[k] * P_tau0
+            vfit = g_k**2 * cov_fit[i_phi, i_phi] if i_phi is not None else 0.0
+            dP = g_k * (sens[i_phi] if i_phi is not None else 0.0) + c.weights[k] * v["phi"]
+            fk_err[k] = float(np.sqrt(max(vfit, 0.0) + (dP * P_tau0_err) ** 2))
     values.update(
         f_ne=float(fk.sum()),
         f_e=float(P_tau0 - fk.sum()),
@@ -1092,7 +1126,7 @@ def fit_mixture_model(
         f_ne_k=fk,
         f_e_k=c.weights * P_tau0 - fk,
     )
-    errors.update(f_ne=f_ne_err, f_e=float(np.hypot(f_ne_err, P_tau0_err)), P_tau0=P_tau0_err)
+    errors.update(f_ne=f_ne_err, f_e=f_e_err, P_tau0=P_tau0_err, f_ne_k=fk_err)
     return SurvivalFit(
         params=model,
         values=values,

@@ -58,6 +58,7 @@ __all__ = [
     "fit_exponential",
     "fit_power_law_tail",
     "lifetimes_to_arrays",
+    "mean_kappa_stat_err",
     "observed_from_outcome",
     "survival_curve",
     "survival_from_lifetimes",
@@ -98,23 +99,27 @@ def _km_steps(t_end, observed):
     if np.any(t_end < 0):
         raise ValueError("t_end must be ≥ 0")
 
-    order = np.argsort(t_end, kind="stable")
-    ts = t_end[order]
-    obs = observed[order]
-    first = np.empty(n_total, dtype=bool)
-    first[0] = True
-    np.not_equal(ts[1:], ts[:-1], out=first[1:])
-    start = np.flatnonzero(first)  # index of the first orbit of each distinct time
-    times = ts[start]
-    d = np.add.reduceat(obs.astype(np.int64), start)  # events at each distinct time
-    n = n_total - start  # number at risk: orbits with t_end ≥ time
-    ev = d > 0
-    te, de, ne = times[ev], d[ev].astype(float), n[ev].astype(float)
+    # two plain sorts (≈10× faster than a stable argsort of everything)
+    ev = np.sort(t_end[observed])
+    ce = np.sort(t_end[~observed])
+    t_last = float(max(ev[-1] if ev.size else -np.inf, ce[-1] if ce.size else -np.inf))
+    if ev.size:
+        first = np.empty(ev.size, dtype=bool)
+        first[0] = True
+        np.not_equal(ev[1:], ev[:-1], out=first[1:])
+        start = np.flatnonzero(first)  # first event of each distinct event time
+    else:
+        start = np.zeros(0, dtype=np.int64)
+    te = ev[start]
+    de = np.diff(np.append(start, ev.size)).astype(float)  # events at each distinct time
+    # at risk: orbits with t_end ≥ te (censored at te count as at risk)
+    ne = (ev.size - start) + (ce.size - np.searchsorted(ce, te, side="left"))
+    ne = ne.astype(float)
     with np.errstate(divide="ignore", invalid="ignore"):
         log_S = np.cumsum(np.log1p(-de / ne))
         var_log = np.cumsum(de / (ne * (ne - de)))
     S = np.exp(log_S)
-    return te, S, var_log, float(ts[-1]), n_total
+    return te, S, var_log, t_last, n_total
 
 
 def survival_curve(t_end, observed, t_grid=None) -> SurvivalCurve:
@@ -147,8 +152,8 @@ def survival_curve(t_end, observed, t_grid=None) -> SurvivalCurve:
 
     Ties: orbits censored at an event time are counted at risk at that time.
     When all censoring happens at a common t_max, P(t) equals the plain
-    fraction #{t_end > t}/N for t < t_max.  Cost O(N log N) (one sort), fully
-    vectorised; N = 10^7 takes ~1–2 s.
+    fraction #{t_end > t}/N for t < t_max.  Cost O(N log N) (two plain sorts),
+    fully vectorised; N = 10^7 takes well under a second on a grid.
     """
     te, S, var_log, t_last, _ = _km_steps(t_end, observed)
     with np.errstate(invalid="ignore"):
@@ -294,6 +299,35 @@ def _prepare(t, P, P_err, window, log_t):
     if tt.size < 3:
         raise ValueError(f"fewer than 3 usable points (P > 0{', P_err > 0' if P_err is not None else ''}) in window {window}")
     return tt, PP, sig, (lo, hi)
+
+
+def mean_kappa_stat_err(t, P, P_err, windows) -> float:
+    """mean_kappa_stat_err(t, P, P_err, windows) -> σ (1/time) of the mean of the κ fits over ``windows``.
+
+    Statistical standard error of (1/W) Σ_w κ_w, κ_w the weighted least-squares
+    slopes of :func:`fit_exponential` on each window (same point selection and
+    weights).  The mean is one linear functional of log P; its variance is
+    evaluated under the independent-increment covariance of Kaplan–Meier
+    log-survival estimates (module docstring), so the overlap of the windows
+    (they share data) is accounted for exactly.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    P = np.asarray(P, dtype=float).ravel()
+    E = np.asarray(P_err, dtype=float).ravel()
+    order = np.argsort(t, kind="stable")
+    t, P, E = t[order], P[order], E[order]
+    valid = np.isfinite(t) & np.isfinite(P) & (P > 0) & np.isfinite(E) & (E > 0)
+    tv, sv = t[valid], E[valid] / P[valid]
+    total = np.zeros(tv.size)
+    for lo, hi in windows:
+        m = (tv >= lo) & (tv <= hi)
+        if np.count_nonzero(m) < 3:
+            raise ValueError(f"fewer than 3 usable points in window {(lo, hi)}")
+        X = np.column_stack([tv[m], np.ones(np.count_nonzero(m))])
+        XtW = X.T / sv[m] ** 2
+        total[m] += np.linalg.solve(XtW @ X, XtW)[0]
+    total /= len(windows)
+    return float(np.sqrt(_independent_increment_cov(total[None, :], sv**2)[0, 0]))
 
 
 @dataclass(frozen=True)
