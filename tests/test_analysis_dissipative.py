@@ -63,7 +63,8 @@ def test_mu_noisy_decay_within_errors_and_errors_calibrated():
     pulls_fixed, pulls_free = [], []
     for _ in range(300):
         logE = np.log(E0) - MU * GAMMA * t + sig * rng.standard_normal(t.size)
-        f = decay.fit_energy_decay(t, np.exp(logE), E0, GAMMA, (0, 200), np.full(t.size, sig**-2), absolute_sigma=True)
+        w = np.full(t.size, sig**-2)
+        f = decay.fit_energy_decay(t, np.exp(logE), E0, GAMMA, (0, 200), w, absolute_sigma=True)
         pulls_fixed.append((f.mu - MU) / f.mu_err)
         pulls_free.append((f.mu_free - MU) / f.mu_free_err)
     # the analytic error of the fixed-intercept slope
@@ -141,7 +142,7 @@ def test_tau2_predicted_closed_form():
     assert transitions.tau2_predicted(E0, EC, MU, 0.0) == math.inf
 
 
-def test_tau2_observed_and_survival_from_lifetimes():
+def test_tau2_observed():
     lt = pd.DataFrame(
         {
             "traj_id": np.arange(6),
@@ -151,10 +152,16 @@ def test_tau2_observed_and_survival_from_lifetimes():
     )
     assert transitions.tau2_observed(lt) == 65.5
     assert transitions.tau2_observed(lt[lt.outcome != "settled"]) is None
-    s = transitions.survival_from_lifetimes(lt, [0.0, 2.0, 5.0, 66.0, 80.0, 100.0, 120.0])
-    np.testing.assert_allclose(s["P"][:6], [1, 5 / 6, 4 / 6, 2 / 6, 1 / 6, 1 / 6])
-    assert np.isnan(s["P"].iloc[6])  # beyond the censoring time
-    np.testing.assert_allclose(s["P_err"][1], np.sqrt(5 / 6 / 6 / 6))
+
+
+def test_tau1_from_lifetime_tables():
+    """Deterministic 'lifetimes' with exact quantiles: P_0 = e^{−0.1t}, P_γ = e^{−0.05t}."""
+    n = 200_000
+    u = (np.arange(n) + 0.5) / n
+    lt0 = pd.DataFrame({"t_end": -np.log(u) / 0.1, "outcome": "escaped"})
+    ltg = pd.DataFrame({"t_end": -np.log(u) / 0.05, "outcome": np.where(u < 0.3, "settled", "escaped")})
+    tg = np.arange(0.0, 40.0, 0.5)
+    assert transitions.tau1_from_lifetimes(ltg, lt0, tg, tau0=5.0) == pytest.approx(20 * math.log(2), abs=0.01)
 
 
 # ---------------------------------------------------------------------------
@@ -214,6 +221,22 @@ def test_survival_fit_recovers_parameters(hazard):
     np.testing.assert_allclose(f.predict(t[10:]), f.params(t[10:]))
 
 
+def test_survival_fit_errors_are_calibrated():
+    """Pulls (fit − true)/σ over independent noisy curves have mean ≈ 0 and spread ≈ 1."""
+    t = np.arange(0.0, 301.0)
+    P_true = model.survival_model(t, **KW, **TRUE)
+    pulls = {name: [] for name in TRUE}
+    for seed in range(40):
+        P, P_err = binomial_sample(P_true, N_ORBITS, np.random.default_rng(500 + seed))
+        f = model.fit_survival_model(t, P, P_err, **KW, P_min=20 / N_ORBITS)
+        for name, val in TRUE.items():
+            pulls[name].append((f.values[name] - val) / f.errors[name])
+    for name, p in pulls.items():
+        p = np.asarray(p)
+        assert abs(p.mean()) < 0.6, (name, p.mean())
+        assert 0.6 < p.std() < 1.4, (name, p.std())
+
+
 def test_survival_fit_with_free_tau2():
     t = np.arange(0.0, 301.0)
     rng = np.random.default_rng(9)
@@ -266,10 +289,18 @@ def two_population_snapshots():
 
 def true_components():
     return model.MixtureComponents(
-        t_ref=TAU0, by="rate", edges=np.array([0.0, 1.0, 2.0]), weights=np.array([0.5, 0.5]),
-        n_ref=np.array([1, 1]), E_ref=np.array([E0, E0]), A=np.array([E0, E0]), mu=MIX_MU,
-        mu_err=np.zeros(2), fit_window=(0.0, 1.0), gamma=GAMMA,
-    )  # fmt: skip
+        t_ref=TAU0,
+        by="rate",
+        edges=np.array([0.0, 1.0, 2.0]),
+        weights=np.array([0.5, 0.5]),
+        n_ref=np.array([1, 1]),
+        E_ref=np.array([E0, E0]),
+        A=np.array([E0, E0]),
+        mu=MIX_MU,
+        mu_err=np.zeros(2),
+        fit_window=(0.0, 1.0),
+        gamma=GAMMA,
+    )
 
 
 @pytest.mark.parametrize("by", ["energy", "rate"])
@@ -283,12 +314,14 @@ def test_mixture_components_recover_sub_ensembles(two_population_snapshots, by):
 
 
 def test_mixture_with_one_component_is_the_homogeneous_model():
-    c = model.MixtureComponents(TAU0, "energy", np.array([0.0, 1.0]), np.array([1.0]), np.array([1]),
-                                np.array([E0]), np.array([E0]), np.array([MU]), np.zeros(1), (0.0, 1.0), GAMMA)  # fmt: skip
+    one = np.ones(1)
+    c = model.MixtureComponents(TAU0, "energy", np.array([0.0, 1.0]), one, one, E0 * one, E0 * one, MU * one,
+                                0 * one, (0.0, 1.0), GAMMA)
     t = np.arange(0.0, 200.0, 0.5)
     for hz in ("paper", "integrated"):
-        Pm = model.mixture_survival_model(t, kappa_of_E=model.PAPER_KAPPA, components=c, tau0=TAU0, f_ne=0.1,
-                                          P_tau0=0.5, L=0.1, b=0.2, hazard=hz)  # fmt: skip
+        Pm = model.mixture_survival_model(
+            t, kappa_of_E=model.PAPER_KAPPA, components=c, tau0=TAU0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2, hazard=hz
+        )
         np.testing.assert_allclose(Pm, model.survival_model(t, **KW, **TRUE, hazard=hz), equal_nan=True)
 
 
@@ -298,8 +331,10 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     t = np.arange(0.0, 301.0)
     rng = np.random.default_rng(21)
     f_ne_true = np.array([0.03, 0.12])  # slow (μ = 0.6), fast (μ = 1.3)
-    P_true = model.mixture_survival_model(t, kappa_of_E=model.PAPER_KAPPA, components=true_components(), tau0=TAU0,
-                                          f_ne=f_ne_true, P_tau0=0.5, L=0.1, b=0.2, hazard=hazard)  # fmt: skip
+    P_true = model.mixture_survival_model(
+        t, kappa_of_E=model.PAPER_KAPPA, components=true_components(), tau0=TAU0,
+        f_ne=f_ne_true, P_tau0=0.5, L=0.1, b=0.2, hazard=hazard,
+    )
     P, P_err = binomial_sample(P_true, N_ORBITS, rng)
     # homogeneous model with the paper's procedure: μ from ⟨E⟩ on [0, 200]
     m = decay.mean_energy(snaps)
@@ -317,7 +352,8 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     order = np.argsort(mix.params.components.mu)
     assert np.all(np.abs(mix.values["f_ne_k"][order] - f_ne_true) < 3 * mix.errors["f_ne_k"][order])
     for name, val in (("L", 0.1), ("b", 0.2), ("f_ne", 0.15), ("f_e", 0.35)):
-        assert abs(mix.values[name] - val) < 3 * mix.errors[name], (name, mix.values[name], mix.errors[name])
+        # 3.5σ: six comparisons per case, and the component paths are estimates
+        assert abs(mix.values[name] - val) < 3.5 * mix.errors[name], (name, mix.values[name], mix.errors[name])
 
 
 # ---------------------------------------------------------------------------
@@ -335,10 +371,11 @@ def test_distances_zero_for_identical_sets_and_symmetric():
     P, Q = gaussian_blob(3000, rng), gaussian_blob(2000, rng, centre=(0.55, 0.5))
     for kind in ("hellinger", "tv"):
         assert distance.histogram_distance(P, P, 0.05, UNIT, kind) == 0.0
-        assert distance.histogram_distance(P, Q, 0.05, UNIT, kind) == pytest.approx(
-            distance.histogram_distance(Q, P, 0.05, UNIT, kind), abs=1e-15)  # fmt: skip
+        d_pq = distance.histogram_distance(P, Q, 0.05, UNIT, kind)
+        assert d_pq > 0.05 and d_pq == pytest.approx(distance.histogram_distance(Q, P, 0.05, UNIT, kind), abs=1e-15)
     assert distance.sliced_wasserstein(P, P, 64, 1) == 0.0
-    assert distance.sliced_wasserstein(P, Q, 64, 1) == pytest.approx(distance.sliced_wasserstein(Q, P, 64, 1), rel=1e-12)
+    sw = distance.sliced_wasserstein(P, Q, 64, 1)
+    assert sw > 0 and sw == pytest.approx(distance.sliced_wasserstein(Q, P, 64, 1), rel=1e-12)
     # disjoint supports: maximal distance
     assert distance.histogram_distance(P, P + 5.0, 0.05, None, "tv") == pytest.approx(1.0)
     assert distance.histogram_distance(P, P + 5.0, 0.05, None, "hellinger") == pytest.approx(1.0)
@@ -395,7 +432,8 @@ def test_split_half_baseline_matches_hellinger_noise_floor():
     X = rng.uniform(0, 1, (20000, 2))
     for box in (0.1, 0.05):
         B = round(1 / box) ** 2
-        r = distance.split_half_baseline(X, lambda A, C: distance.histogram_distance(A, C, box, UNIT) ** 2, 40, seed=1)
+        h2 = lambda A, C: distance.histogram_distance(A, C, box, UNIT) ** 2  # noqa: E731
+        r = distance.split_half_baseline(X, h2, 40, seed=1)
         assert r.mean == pytest.approx((B - 1) / 8 * (2 / 10000), rel=0.15)
         assert r.std > 0
     # floor decreases with sample size

@@ -1,4 +1,4 @@
-"""Energy decay of the dissipative ensemble (paper Sec. III.A.1, Fig. 3).
+"""Energy decay of the dissipative ensemble (paper Sec. III.A.1, Fig. 3 = fig:energy_decay).
 
 With linear drag the energy of every orbit decays as dE/dt = −γ v², Eq.
 (eqn:energy_diffeq).  Approximating the potential, on average along an orbit,

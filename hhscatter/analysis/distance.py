@@ -1,4 +1,4 @@
-"""Distances between point sets on the surface of section (paper Sec. III.B.2, Fig. 4).
+"""Distances between point sets on the surface of section (paper Sec. III.B.2, Fig. 5 = fig:um_comparison).
 
 The paper compares, by eye, the section crossings (x, y) of dissipative orbits
 alive at t* with the conservative c-measure μ_c^{E1}, and claims that "the
@@ -39,7 +39,7 @@ largest difference in probability of any set of boxes).
 The sliced Wasserstein distance is scale-free: one number in units of
 length, dominated by where the bulk of the mass is, and nearly insensitive to
 fine filaments (moving mass by δ costs only ~δ).  It is a good global check
-(e.g. that μ_c^{E1} is closer than μ_c^{E2}, Fig. 4a vs Fig. 1b) but cannot
+(e.g. that μ_c^{E1} is closer than μ_c^{E2}, Fig. 5a vs Fig. 1b) but cannot
 by itself say down to which scale two sets agree.
 
 Finite-sample baseline and the agreement scale
@@ -55,8 +55,9 @@ noise floor d_noise = mean(d(P1,P2), d(Q1,Q2)), each averaged over
 If P and Q come from one distribution, d_PQ and d_noise have the same
 expectation.  The two sets are said to *agree at scale ε* when
 d_PQ ≤ d_noise + z·σ, with σ the combined split-to-split spread of d_PQ and
-d_noise (z = 2 by default), and the scale is *informative* when d_noise ≤ noise_max (default 0.5; beyond it the boxes are
-so sparsely filled that any two samples look different).  The agreement scale
+d_noise (z = 2 by default), and the scale is *informative* when
+d_noise ≤ noise_max (default 0.5; beyond it the boxes are so sparsely filled
+that any two samples look different).  The agreement scale
 ε* (:func:`agreement_scale`) is the smallest ε such that the sets agree at
 every informative box size ≥ ε.  Since the noise floor shrinks with sample
 size, ε* is a statement about the data at hand: with more points a real
@@ -165,7 +166,9 @@ def hellinger(p, q) -> float:
     return float(np.sqrt(min(0.5 * np.sum(d * d), 1.0)))
 
 
-def histogram_distance(P, Q, box: float, extent=None, kind: str = "hellinger", *, weights_P=None, weights_Q=None) -> float:
+def histogram_distance(
+    P, Q, box: float, extent=None, kind: str = "hellinger", *, weights_P=None, weights_Q=None
+) -> float:
     """histogram_distance(P, Q, box, extent, kind="hellinger") -> float in [0, 1].
 
     Hellinger (``kind="hellinger"``) or total-variation (``kind="tv"``)
@@ -296,7 +299,9 @@ def wasserstein_1d(x, y, p: float = 1) -> float:
     return float(_w1d_sorted(xs, ys, p)[0] ** (1.0 / p))
 
 
-def sliced_wasserstein(P, Q, n_proj: int = 128, seed: int = 0, *, p: float = 1, directions: str = "stratified") -> float:
+def sliced_wasserstein(
+    P, Q, n_proj: int = 128, seed: int = 0, *, p: float = 1, directions: str = "stratified"
+) -> float:
     """sliced_wasserstein(P, Q, n_proj=128, seed=0, *, p=1, directions="stratified") -> float.
 
     SW_p(P, Q) = ( mean_θ W_p(⟨P,θ⟩, ⟨Q,θ⟩)^p )^{1/p} over ``n_proj`` unit
@@ -352,7 +357,9 @@ def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> 
     return BootstrapResult(float(vals.mean()), float(vals.std(ddof=1)) if vals.size > 1 else 0.0)
 
 
-def split_half_baseline(P, fn: Callable, n_splits: int = 20, seed: int = 0, size: int | None = None) -> BootstrapResult:
+def split_half_baseline(
+    P, fn: Callable, n_splits: int = 20, seed: int = 0, size: int | None = None
+) -> BootstrapResult:
     """split_half_baseline(P, fn, n_splits=20, seed=0, size=None) -> BootstrapResult(mean, std).
 
     Finite-sample noise floor of the distance ``fn``: mean and std (ddof = 1)

@@ -27,7 +27,6 @@ from scipy import optimize
 from scipy.special import logsumexp
 
 from .survival import (
-    ExponentialFit,
     PowerLawFit,
     SurvivalCurve,
     _floor_time,
@@ -108,15 +107,21 @@ def _local_slope(t, P, N, w, t_floor):
     return c, s, err
 
 
-def _runs(c, inside, gap):
-    """Maximal runs (start, end) of indices with inside=True, merging holes shorter than ``gap`` in c."""
+def _runs_arrays(c, inside, gap):
+    """Maximal runs of indices with inside=True, merging holes shorter than ``gap`` in c: (starts, ends)."""
     idx = np.flatnonzero(inside)
     if idx.size == 0:
-        return []
+        return idx, idx
     cut = np.flatnonzero(np.diff(c[idx]) > gap)
     starts = np.concatenate([[idx[0]], idx[cut + 1]])
     ends = np.concatenate([idx[cut], [idx[-1]]])
-    return list(zip(starts.tolist(), ends.tolist()))
+    return starts, ends
+
+
+def _runs(c, inside, gap):
+    """Runs of :func:`_runs_arrays` as a list of (start, end)."""
+    st, en = _runs_arrays(c, inside, gap)
+    return list(zip(st.tolist(), en.tolist()))
 
 
 def choose_windows(
@@ -131,6 +136,7 @@ def choose_windows(
     rel_tol: float = 0.1,
     n_sigma: float = 3.0,
     min_width: float = 2.0 * math.pi,
+    n_levels: int = 200,
     max_iter: int = 20,
 ) -> WindowChoice:
     """choose_windows(t, P, P_err=None, *, n_total=None, ...) -> WindowChoice(tau0, t_stop, windows, ...).
@@ -146,25 +152,31 @@ def choose_windows(
        t_floor = last t with N·P(t) ≥ min_survivors (N = ``n_total``, or
        estimated from binomial ``P_err``).  Below it the counting noise of
        log P exceeds ~10 % per e-fold.
-    1. *Pilot.*  t_a = first time with P ≤ ``p_start`` (0.1), t_b = first time
-       with P ≤ max(P_floor, p_start·10^−core_decades) (two decades lower);
-       κ_p = log(P(t_a)/P(t_b)) / (t_b − t_a).  [t_a, t_b] is the *core*, which
-       for the paper's curves lies inside the exponential regime.
+    1. *Pilot rate* (only sets the first smoothing width): κ_p =
+       log(P(t_a)/P(t_b)) / (t_b − t_a), t_a = first time with P ≤ ``p_start``
+       (0.1), t_b = first time with P ≤ max(P_floor, p_start·10^−core_decades).
     2. *Local slope.*  s(t) = [log P(t − w/2) − log P(t + w/2)]/w, the mean
        hazard over a window of width w = max(``min_width``, 1/κ) (one e-fold,
        but at least 2π = one period of the small oscillations for ω = 1, so
        the period-modulated, bursty escape of the flow is averaged out; capped
        at a third of [t[0], t_floor] for very short curves), with Poisson
        error σ_s = s/√d (d = orbits leaving in the window).
-    3. *Plateau.*  κ_ref = median of s over the core.  A centre t is *inside*
-       when |s(t) − κ_ref| ≤ max(``rel_tol``·κ_ref, ``n_sigma``·σ_s(t)) (10 %,
-       or 3σ where counting noise is larger).  Inside points form runs;
-       excursions shorter than w are tolerated (merged).  The plateau is the
-       run overlapping most with the core (later: with the previous plateau).
+    3. *Plateau.*  For a level κ_ref a centre t is *inside* when
+       |s(t) − κ_ref| ≤ max(``rel_tol``·κ_ref, ``n_sigma``·σ_s(t)) (10 %, or 3σ
+       where counting noise is larger); inside points form runs, excursions
+       shorter than w being tolerated (merged).  Scanning ``n_levels`` levels
+       (quantiles of s), the plateau is the run that covers the most e-folds
+       of P, log P(start) − log P(end): the exponential regime is the one that
+       carries the decay.  (Measuring in e-folds, not in time, keeps a slow
+       power-law tail — whose local slope z/t stays in a 10 % band only over
+       a factor 1.2 in t — or the irregular start from winning; a median over
+       a fixed P range, e.g. 10^−1…floor, fails when a tail or a second, slower
+       component starts inside that range.)
     4. *Iterate* steps 2–3 with κ_ref = median of s on the plateau and
        w = max(min_width, 1/κ_ref) until the plateau ends move by ≤ w/20 and
        κ_ref by ≤ 1 % (κ_ref only sets the band and w, not the result; at
-       most ``max_iter`` times).
+       most ``max_iter`` times); each time the plateau is the run overlapping
+       most with the previous one.
     5. τ0 = first centre of the plateau, i.e. the first time after which the
        local slope *stays* within tolerance (t[0] if that is the first centre
        available); t_stop = last centre of the plateau, i.e. where the slope
@@ -176,7 +188,7 @@ def choose_windows(
        log P (systematics) on top of the statistical error.
 
     The grid should resolve the decay (spacing ≪ w).  Warns, and returns the
-    core as the window, when no plateau is found.
+    pilot range [t_a, t_b] as the window, if the band ever becomes empty.
     """
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
@@ -208,9 +220,22 @@ def choose_windows(
 
     w = width(kappa_p)
     c, s, se = _local_slope(t, P, N, w, t_floor)
-    core = (c >= t_a) & (c <= t_b) & np.isfinite(s)
-    kappa_ref = float(np.median(s[core])) if core.any() else kappa_p
-    target = (t_a, t_b)
+    fin = np.isfinite(s) & (s > 0)
+    if not fin.any():
+        raise ValueError("the survival curve does not decay above the counting floor")
+    # plateau search: the level whose band holds the run covering most e-folds of P
+    logPc = np.log(_step(t, P, c))
+    best = (-1.0, kappa_p, 0, c.size - 1)
+    for level in np.unique(np.quantile(s[fin], np.linspace(0.0, 1.0, n_levels))):
+        inside = fin & (np.abs(s - level) <= np.maximum(rel_tol * level, n_sigma * se))
+        st, en = _runs_arrays(c, inside, w)
+        if st.size:
+            efolds = logPc[st] - logPc[en]
+            i = int(np.argmax(efolds))
+            if efolds[i] > best[0]:
+                best = (float(efolds[i]), float(level), int(st[i]), int(en[i]))
+    _, kappa_ref, b, e = best
+    target = (float(c[b]), float(c[e]))
     prev = None
     converged = False
     for _ in range(max_iter):
@@ -219,7 +244,7 @@ def choose_windows(
         inside = np.isfinite(s) & (np.abs(s - kappa_ref) <= tol)
         runs = _runs(c, inside, w)
         if not runs:
-            warnings.warn("no exponential plateau found; using the core [t_a, t_b] as the fitting range")
+            warnings.warn("no exponential plateau found; using the pilot range [t_a, t_b]")
             tau0, t_stop = t_a, t_b
             break
         overlap = [max(0.0, min(c[e], target[1]) - max(c[b], target[0])) for b, e in runs]

@@ -4,7 +4,7 @@ Homogeneous model (the paper's)
 -------------------------------
 All orbits are assumed to share the energy path of Eq. (eqn:energy_exp_decay),
 E(t) = E0 e^{−μγt}, and hence the time-dependent escape rate
-κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate (paper Fig. 2b:
+κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate (paper Fig. 2b = fig:kappa-E-dependence:
 κ0 = 13.63 ΔE² + 0.03 ΔE for E < 0.27 and 1.41 ΔE above, ΔE = E − E_c,
 zero for E ≤ E_c; :class:`PiecewiseKappa`).  Then, Eq. (eqn:surv_prob_model),
 
@@ -76,7 +76,6 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, special
 
-from .decay import fit_energy_decay
 from .transitions import tau2_predicted
 
 __all__ = [
@@ -438,6 +437,14 @@ def fit_survival_model(
     * ``absolute_sigma`` (default True): P_err are true standard deviations
       (binomial errors); False rescales the covariance by χ²/dof.
 
+    Error model: points are treated as independent (diagonal weights).  The
+    points of one empirical survival curve are positively correlated
+    (log P is a cumulative sum of increments), so on a fine time grid the
+    χ²/dof and the parameter errors of such a fit are not calibrated (the
+    errors are too small); use a coarse grid, or resample orbits (bootstrap
+    over the lifetimes table) for honest errors.  With independent
+    per-point noise (tests) the errors are calibrated.
+
     Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
     AIC, ...).
     """
@@ -486,7 +493,8 @@ def fit_survival_model(
             "L": (1e-9, 1e3),
             "b": (1e-6, 1e3),
         }
-        return (np.array([bounds[n][0] for n in free], dtype=float), np.array([bounds[n][1] for n in free], dtype=float))
+        lo_b = np.array([bounds[n][0] for n in free], dtype=float)
+        return lo_b, np.array([bounds[n][1] for n in free], dtype=float)
 
     def unpack(theta, tau2v, P0v=P_tau0):
         v = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b_starts[0]}
@@ -498,7 +506,9 @@ def fit_survival_model(
         return v
 
     def make(v):
-        return SurvivalModelParams(kappa_of_E, E0, mu, gamma, tau0, v["tau2"], v["f_ne"], v["f_e"], v["L"], v["b"], E_c, hazard)
+        return SurvivalModelParams(
+            kappa_of_E, E0, mu, gamma, tau0, v["tau2"], v["f_ne"], v["f_e"], v["L"], v["b"], E_c, hazard
+        )
 
     def starts_for(prev=None, warm_only=False):
         out = []
@@ -909,7 +919,9 @@ def mixture_survival_model(
     t_arr = np.asarray(t, dtype=float)
     out = np.zeros(t_arr.shape)
     for k in range(c.K):
-        out = out + _component(t_arr, kappa_of_E, c.A[k], c.mu[k], c.gamma, tau0, tau2_k[k], f_ne[k], f_e[k], L, b, hazard)
+        out = out + _component(
+            t_arr, kappa_of_E, c.A[k], c.mu[k], c.gamma, tau0, tau2_k[k], f_ne[k], f_e[k], L, b, hazard
+        )
     return float(out) if np.ndim(t) == 0 else out
 
 
@@ -990,7 +1002,9 @@ def fit_mixture_model(
     Derived values reported: f_ne = Σ f_ne,k, f_e = P(τ0) − f_ne, the arrays
     f_ne_k, f_e_k (with propagated errors) and τ2_k.  P(τ0) is ``P_tau0``
     (exact) or interpolated from the data, its error then being propagated
-    into the errors and ``cov`` by re-fitting at P(τ0) + σ.
+    into the errors and ``cov`` by re-fitting at P(τ0) + σ.  The uncertainty
+    of the measured component paths (A_k, μ_k) is not propagated, and the
+    error model (independent points) is that of :func:`fit_survival_model`.
     """
     if isinstance(components, pd.DataFrame):
         if gamma is None:
@@ -1052,7 +1066,8 @@ def fit_mixture_model(
                 return (0.0, float(c.weights[int(n[5:])] * P0v))
             return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
 
-        return (np.array([bound(n)[0] for n in free], dtype=float), np.array([bound(n)[1] for n in free], dtype=float))
+        lo_b = np.array([bound(n)[0] for n in free], dtype=float)
+        return lo_b, np.array([bound(n)[1] for n in free], dtype=float)
 
     def unpack(theta, P0v=P_tau0):
         v = dict(guess)

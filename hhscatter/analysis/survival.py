@@ -15,6 +15,8 @@ Functions here are pure (no file I/O, no plotting) and vectorised:
 * :func:`lifetimes_to_arrays`, :func:`survival_from_lifetimes` — the same from
   the engine's ``lifetimes`` table;
 * :func:`fit_exponential` — least squares of log P on t (κ, f0);
+* :func:`mean_kappa_stat_err` — statistical error of a mean of such fits over
+  overlapping windows;
 * :func:`fit_power_law_tail` — least squares of log P on log t (z, f*);
 * :func:`crossover_time` — τ*, where the fitted exponential and power law meet;
 * :func:`detect_power_law_tail` — data-driven decision "is there a power-law
@@ -514,6 +516,12 @@ def _floor_time(t, P, n_total, min_survivors):
     return float(t[np.flatnonzero(ok)[-1]])
 
 
+def _step_eval(t, P, x):
+    """Right-continuous step function (t, P) (t increasing) evaluated at x ≥ t[0]."""
+    idx = np.searchsorted(t, x, side="right") - 1
+    return P[np.clip(idx, 0, None)]
+
+
 def _segment_ll(d, expo, logH):
     """Poisson log-likelihood (up to model-independent terms) of one-parameter hazards, maximised.
 
@@ -538,6 +546,8 @@ def detect_power_law_tail(
     min_delta_aic: float = 10.0,
     min_hazard_exponent: float = 0.5,
     min_events: float = 50.0,
+    bin_width=None,
+    min_width: float = 2.0 * math.pi,
 ):
     """detect_power_law_tail(t, P, tau0, P_err=None, *, n_total=None, ...) -> PowerLawFit or None.
 
@@ -548,45 +558,68 @@ def detect_power_law_tail(
 
     Rule.  Only times in [τ0, t_floor] are used, t_floor being the last time
     with at least ``min_survivors`` survivors (N·P ≥ min_survivors; N =
-    ``n_total``, or estimated from binomial ``P_err``).  Between consecutive
-    grid times the numbers at risk n_k = N P(t_k) and of leaving orbits
-    d_k = N (P(t_k) − P(t_{k+1})) give a Poisson likelihood of the hazard h(t),
-    in which the normalisations f0, f* drop out:
+    ``n_total``, or estimated from binomial ``P_err``).  P is read at bin
+    edges τ0, τ0 + Δ, τ0 + 2Δ, … with Δ = ``bin_width`` (default
+    max(``min_width`` = 2π, 1/κ̂), κ̂ the exponential MLE on [τ0, t_floor]), so
+    that escape modulated at the orbital period averages out.  The numbers at
+    risk n_k = N P(t_k) and of leaving orbits d_k = N (P(t_k) − P(t_{k+1}))
+    give a Poisson likelihood of the hazard h(t) in which the normalisations
+    f0, f* drop out:
 
     1. *Change point*: the model "h = κ on [τ0, τc), h = z/t on [τc, t_floor]"
-       (MLEs in closed form for every τc, via cumulative sums) must beat a
-       single exponential (h = κ) on [τ0, t_floor] by ΔAIC ≥ ``min_delta_aic``
+       (closed-form MLEs for every τc on the bin edges) must beat a single
+       exponential (h = κ) on [τ0, t_floor] by ΔAIC ≥ ``min_delta_aic``
        (2 extra parameters: z, τc).  τc is the maximum-likelihood change point
        among those leaving ≥ ``min_events`` events on each side and a tail
        spanning t_floor/τc ≥ ``min_span``.
     2. *The tail is algebraic*: on [τc, t_floor] the power law must beat an
        exponential by ΔAIC ≥ ``min_delta_aic``, and the MLE exponent β of a
        hazard ∝ t^{−β} must be ≥ ``min_hazard_exponent`` (β = 1 for a power
-       law, 0 for an exponential) — this rejects slow drifts of an
+       law, 0 for an exponential) — this rejects drifts or modulations of an
        exponential's rate that a huge sample would otherwise flag.
 
-    If both hold, the tail is fitted by least squares of log P on log t over
-    [τc, t_floor] (:func:`fit_power_law_tail`, weighted by ``P_err`` if given),
-    with the likelihood diagnostics attached.  The grid should resolve the
-    decay (spacing ≪ 1/κ); the Poisson counts assume censoring only at the end
-    (N·P = number at risk).
+    If both hold, τc is refined on the full grid within one bin of the coarse
+    change point (same split likelihood), and the tail is fitted by least
+    squares of log P on log t over [τc, t_floor] on the full grid (:func:`fit_power_law_tail`, weighted by
+    ``P_err`` if given), with the likelihood diagnostics attached.  The counts
+    assume censoring only at the end (N·P = number at risk).  Caveat: within a
+    finite range, the crossover between two exponentials with very different
+    rates also has β ≈ 1 and is reported as a tail; the answer is a statement
+    about the observed range.
     """
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
     N = _resolve_n_total(P, P_err, n_total)
     t_floor = _floor_time(t, P, N, min_survivors)
-    if t_floor is None:
+    tau0 = max(float(tau0), float(t[np.isfinite(t)].min()))
+    if t_floor is None or not t_floor > tau0:
         return None
-    m = (t >= max(float(tau0), 0.0)) & (t <= t_floor) & np.isfinite(P) & (t > 0)
-    tt, PP = t[m], P[m]
-    if tt.size < 6 or t_floor / tt[0] < min_span:
+    ok = np.isfinite(t) & np.isfinite(P)
+    tf, Pf = t[ok], P[ok]
+    # exponential MLE on the whole range (sets the default bin width)
+    m = (tf >= tau0) & (tf <= t_floor)
+    if np.count_nonzero(m) < 3:
         return None
-    n = N * PP[:-1]
-    d = np.clip(N * (PP[:-1] - PP[1:]), 0.0, None)
-    dt = np.diff(tt)
-    dlt = np.diff(np.log(tt))
-    # cumulative sums with a leading zero: index j ↔ bins [0, j)
-    c = lambda a: np.concatenate([[0.0], np.cumsum(a)])  # noqa: E731
+    tt, PP = tf[m], Pf[m]
+    D_all = N * (PP[0] - PP[-1])
+    X_all = float(np.sum(N * PP[:-1] * np.diff(tt)))
+    if D_all <= 0 or X_all <= 0:
+        return None
+    dw = float(bin_width) if bin_width is not None else max(min_width, X_all / D_all)
+    edges = np.arange(tau0, t_floor, dw)
+    edges = np.append(edges, t_floor) if t_floor - edges[-1] > 0.5 * dw else np.append(edges[:-1], t_floor)
+    edges = edges[edges > 0]
+    if edges.size < 4:
+        return None
+    Pe = _step_eval(tf, Pf, edges)
+    n = N * Pe[:-1]
+    d = np.clip(N * (Pe[:-1] - Pe[1:]), 0.0, None)
+    dt = np.diff(edges)
+    dlt = np.diff(np.log(edges))
+
+    def c(a):
+        return np.concatenate([[0.0], np.cumsum(a)])
+
     D = c(d)
     Xe, Xp = c(n * dt), c(n * dlt)
     Le, Lp = c(xlogy(d, dt)), c(xlogy(d, dlt))
@@ -596,31 +629,54 @@ def detect_power_law_tail(
     head = _segment_ll(D[j], Xe[j], Le[j])
     tail_pow = _segment_ll(D[K] - D[j], Xp[K] - Xp[j], Lp[K] - Lp[j])
     tail_exp = _segment_ll(D[K] - D[j], Xe[K] - Xe[j], Le[K] - Le[j])
-    ok = (D[j] >= min_events) & (D[K] - D[j] >= min_events) & (t_floor / tt[j] >= min_span)
-    if not ok.any():
+    admissible = (D[j] >= min_events) & (D[K] - D[j] >= min_events) & (t_floor / edges[j] >= min_span)
+    if not admissible.any():
         return None
-    ll_split = np.where(ok, head + tail_pow, -np.inf)
+    ll_split = np.where(admissible, head + tail_pow, -np.inf)
     jb = int(j[np.argmax(ll_split)])
     d_aic_split = 2.0 * (float(np.max(ll_split)) - ll_exp_all) - 2.0 * 2
     d_aic_tail = 2.0 * float(tail_pow[jb - 1] - tail_exp[jb - 1])
 
-    # hazard ∝ t^{−β} on the tail, β by profile likelihood
+    # hazard ∝ t^{−β} on the tail: exact bin integrals, β by profile likelihood
     dk, nk = d[jb:], n[jb:]
-    tm = np.sqrt(tt[jb:-1] * tt[jb + 1:])
-    dtk = dt[jb:]
+    lo, hi = edges[jb:-1], edges[jb + 1:]
 
     def neg_ll(beta):
-        H = dtk * tm ** (-beta)
+        if abs(1.0 - beta) < 1e-8:
+            H = np.log(hi / lo)
+        else:
+            H = (hi ** (1.0 - beta) - lo ** (1.0 - beta)) / (1.0 - beta)
         return -float(_segment_ll(dk.sum(), (nk * H).sum(), xlogy(dk, H).sum()))
 
     beta_hat = float(optimize.minimize_scalar(neg_ll, bounds=(-3.0, 5.0), method="bounded").x)
 
     if not (d_aic_split >= min_delta_aic and d_aic_tail >= min_delta_aic and beta_hat >= min_hazard_exponent):
         return None
-    tau_c = float(tt[jb])
+    # refine τc on the full grid within one bin of the coarse change point
+    fe = tf[(tf >= tau0) & (tf <= t_floor) & (tf > 0)]
+    if fe[-1] < t_floor:
+        fe = np.append(fe, t_floor)
+    Pfe = _step_eval(tf, Pf, fe)
+    nf = N * Pfe[:-1]
+    df = np.clip(N * (Pfe[:-1] - Pfe[1:]), 0.0, None)
+    Df, Xef, Xpf = c(df), c(nf * np.diff(fe)), c(nf * np.diff(np.log(fe)))
+    Lef, Lpf = c(xlogy(df, np.diff(fe))), c(xlogy(df, np.diff(np.log(fe))))
+    Kf = df.size
+    jf = np.flatnonzero((fe >= edges[jb - 1]) & (fe <= edges[min(jb + 1, K)]))
+    jf = jf[(jf >= 1) & (jf < Kf)]
+    if jf.size:
+        llf = _segment_ll(Df[jf], Xef[jf], Lef[jf]) + _segment_ll(
+            Df[Kf] - Df[jf], Xpf[Kf] - Xpf[jf], Lpf[Kf] - Lpf[jf]
+        )
+        jr = int(jf[np.argmax(llf)])
+        tau_c = float(fe[jr])
+        D_tail = Df[Kf] - Df[jr]
+        z_mle = D_tail / (Xpf[Kf] - Xpf[jr])
+    else:
+        tau_c = float(edges[jb])
+        D_tail = D[K] - D[jb]
+        z_mle = D_tail / (Xp[K] - Xp[jb])
     fit = fit_power_law_tail(t, P, (tau_c, t_floor), P_err)
-    D_tail = D[K] - D[jb]
-    z_mle = D_tail / (Xp[K] - Xp[jb])
     return PowerLawFit(
         **{
             **fit.__dict__,

@@ -1,4 +1,4 @@
-"""Survival curves and the transition times τ1, τ2 (paper Sec. III.A.2, III.B.1, Fig. 6b).
+"""Transition times τ1, τ2 (paper Sec. III.A.2, III.B.1, Fig. 6b = fig:model_data_comparison).
 
 * τ0 — end of the irregular, ensemble-dependent initial decay; independent of
   γ, an input here.
@@ -10,7 +10,8 @@
   non-escaping orbit dropped below E_c", i.e. the smallest settling time.
 
 The survival probability P(t) counts both ways of leaving: escape through a
-channel and settling (E(t) reaching E_c inside Ω), as in the paper's Fig. 5.
+channel and settling (E(t) reaching E_c inside Ω), as in the paper's Fig. 4 (fig:survprob);
+survival curves themselves come from :mod:`hhscatter.analysis.survival`.
 
 Units: model time units for all times; energies in model units.
 """
@@ -20,55 +21,12 @@ import numpy as np
 import pandas as pd
 
 __all__ = [
-    "survival_curve",
-    "survival_from_lifetimes",
     "tau1",
     "tau1_from_lifetimes",
     "tau2_observed",
     "tau2_observed_arrays",
     "tau2_predicted",
 ]
-
-
-# ---------------------------------------------------------------------------
-# survival probability from lifetimes
-# ---------------------------------------------------------------------------
-def survival_curve(t_end, outcome, t_grid):
-    """survival_curve(t_end, outcome, t_grid) -> (P, P_err, n_alive) arrays on t_grid.
-
-    P(t) = #{orbits with lifetime > t} / N, lifetime = ``t_end`` of escaped
-    and settled orbits.  Censored orbits (alive at t_max = their ``t_end``)
-    count as alive up to their censoring time; beyond the earliest censoring
-    time P is unknown and returned as NaN when any orbit is censored.
-    ``P_err`` = √(P(1−P)/N) is the binomial standard error of each point
-    (points of one curve are correlated; this is the marginal error).
-    """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    outcome = np.asarray(outcome).ravel()
-    tg = np.asarray(t_grid, dtype=float)
-    N = t_end.size
-    if N == 0:
-        raise ValueError("empty lifetimes")
-    censored = outcome == "censored"
-    life = np.sort(t_end[~censored])
-    n_done = np.searchsorted(life, tg, side="right")  # lifetimes <= t
-    n_alive = N - n_done
-    P = n_alive / N
-    if censored.any():
-        t_cens = float(np.min(t_end[censored]))
-        P = np.where(tg > t_cens, np.nan, P)
-    P_err = np.sqrt(P * (1 - P) / N)
-    return P, P_err, n_alive
-
-
-def survival_from_lifetimes(lifetimes: pd.DataFrame, t_grid) -> pd.DataFrame:
-    """survival_from_lifetimes(lifetimes, t_grid) -> DataFrame[t, P, P_err, n_alive].
-
-    DataFrame wrapper of :func:`survival_curve` for the engine's ``lifetimes``
-    table (columns ``t_end``, ``outcome``).
-    """
-    P, P_err, n = survival_curve(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy(), t_grid)
-    return pd.DataFrame({"t": np.asarray(t_grid, dtype=float), "P": P, "P_err": P_err, "n_alive": n})
 
 
 # ---------------------------------------------------------------------------
@@ -140,15 +98,21 @@ def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
     return float(tt[j - 1] + (tt[j] - tt[j - 1]) * (-a) / (b - a))
 
 
-def tau1_from_lifetimes(lifetimes_gamma: pd.DataFrame, lifetimes_0: pd.DataFrame, t_grid, tau0: float, alpha: float = 2.0):
+def tau1_from_lifetimes(
+    lifetimes_gamma: pd.DataFrame, lifetimes_0: pd.DataFrame, t_grid, tau0: float, alpha: float = 2.0
+):
     """tau1_from_lifetimes(lifetimes_gamma, lifetimes_0, t_grid, tau0, alpha=2.0) -> float or None.
 
     Observed τ1 (Fig. 6b symbols): :func:`tau1` applied to the survival
     curves of a dissipative (γ > 0) and the conservative (γ = 0) ensemble,
-    both evaluated by :func:`survival_curve` on ``t_grid``.
+    both estimated on ``t_grid`` by
+    :func:`hhscatter.analysis.survival.survival_from_lifetimes` (Kaplan–Meier;
+    'escaped' and 'settled' leave, 'censored' is right-censored).
     """
-    Pg, _, _ = survival_curve(lifetimes_gamma["t_end"].to_numpy(), lifetimes_gamma["outcome"].to_numpy(), t_grid)
-    P0, _, _ = survival_curve(lifetimes_0["t_end"].to_numpy(), lifetimes_0["outcome"].to_numpy(), t_grid)
+    from .survival import survival_from_lifetimes
+
+    Pg = survival_from_lifetimes(lifetimes_gamma, t_grid).P
+    P0 = survival_from_lifetimes(lifetimes_0, t_grid).P
     return tau1(t_grid, Pg, P0, tau0, alpha)
 
 
