@@ -150,7 +150,6 @@ class _Lanes:
     """Per-lane bookkeeping and the event handlers of one chunk."""
 
     def __init__(self, scene, ta, ics, names, nt_names):
-        self.scene = scene
         self.model = scene.model
         self.ta = ta
         self.B = ta.batch_size
@@ -161,7 +160,6 @@ class _Lanes:
         self.next = 0
         self.r_s = self.model.saddle_radius
         self.t_max = scene.t_max
-        self.dissipative = scene.gamma > 0
         self.half_w2 = 0.5 * self.model.omega**2
         self.lam = self.model.lam
 

@@ -12,7 +12,7 @@ import os
 import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +38,6 @@ class RunSummary:
     chunks_done: int = 0
     chunks_skipped: int = 0
     workers: int = 1
-    extra: dict = field(default_factory=dict)
 
     def add(self, other: "RunSummary"):
         for k in ("n", "escaped", "settled", "censored", "n_sections", "n_snapshots", "compute_seconds"):
