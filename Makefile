@@ -42,10 +42,44 @@ $(RUNS)/demo/survival.png: $(RUNS)/demo/conservative/.done $(RUNS)/demo/dissipat
 
 demo: $(RUNS)/demo/survival.png ## run two small real scenes (1e5 orbits each), write Parquet + P(t) PNG
 
+# -- studies: raw runs → derived tables + <name>.json → <name>.png ------------
+# `make fig2` (quick scale, minutes on 2 cores) or `make fig2 SCALE=paper` (the paper's N).
+SCALE ?= quick
+HH := $(VENV)/bin/hhscatter
+ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py) hhscatter/studies/__init__.py
+so = studies/$(1)/out/$(SCALE)
+
+# $(1): study name; $(2): files its analysis also reads (other studies' outputs)
+define study_rules
+$(call so,$(1))/raw/done.json: studies/$(1)/study.toml hhscatter/studies/$(1).py $(STAMP)
+	$(HH) study $(1) simulate --scale $(SCALE) $(W)
+$(call so,$(1))/$(1).json: $(call so,$(1))/raw/done.json $(ANALYSIS_SRC) $(2)
+	$(HH) study $(1) analyze --scale $(SCALE)
+$(call so,$(1))/$(1).png: $(call so,$(1))/$(1).json $(wildcard hhscatter/plotting/*.py)
+	$(HH) study $(1) plot --scale $(SCALE)
+endef
+
+$(eval $(call study_rules,fig1,))
+$(eval $(call study_rules,fig2,))
+$(eval $(call study_rules,resc,))
+$(eval $(call study_rules,fig3,))
+$(eval $(call study_rules,fig4,))
+$(eval $(call study_rules,fig5,$(call so,fig1)/raw/done.json))
+$(eval $(call study_rules,fig6,$(call so,fig2)/fig2.json $(call so,fig3)/fig3.json $(call so,fig4)/fig4.json))
+
+fig1: $(call so,fig1)/fig1.png ## Fig 1: potential contours; c-measure support at E=0.35, 0.30 (sprinkler)
+fig2: $(call so,fig2)/fig2.png ## Fig 2: P(t) at E=0.23, 0.27; κ(E) with piecewise fit; κ from the c-measure
+resc: $(call so,resc)/resc.png ## escape-criterion check: κ vs r_esc, returns after escape, exit channels
+fig3: $(call so,fig3)/fig3.png ## Fig 3: ⟨E⟩(t) and μ at (E0, γ) = (0.3, 0.01); energy histograms
+fig4: $(call so,fig4)/fig4.png ## Fig 4: P(t) for several γ at E0=0.3 with τ0, τ1, τ2
+fig5: $(call so,fig5)/fig5.png ## Fig 5: dissipative section points vs the conservative c-measure; distances
+fig6: $(call so,fig6)/fig6.png ## Fig 6: survival model vs simulations; τ1, τ2 vs γ; mixture model
+studies: fig1 fig2 resc fig3 fig4 fig5 fig6 ## all studies at SCALE (default quick)
+
 bench-engine: $(STAMP) ## µs per orbit of the engine (1 and all workers), time inside heyoka
 	$(PY) -m hhscatter.bench_engine $(BENCH_ARGS)
 
 clean-runs: ## delete simulation outputs under runs/
 	rm -rf $(RUNS)
 
-.PHONY: help venv test test-slow demo bench-engine clean-runs
+.PHONY: help venv test test-slow demo bench-engine clean-runs studies fig1 fig2 resc fig3 fig4 fig5 fig6

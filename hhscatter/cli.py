@@ -60,6 +60,18 @@ def build_parser():
     v.add_argument("runs", nargs="+", help="run directories (outputs of simulate)")
     v.add_argument("--png", required=True, help="output PNG path")
     v.add_argument("--labels", nargs="*", help="curve labels (default: from the scenes)")
+
+    st = sub.add_parser(
+        "study",
+        help="run one stage of a study (simulate → analyze → plot)",
+        description="Run a stage of a study in studies/<name>/: 'simulate' writes raw Parquet runs, "
+        "'analyze' derived tables and <name>.json, 'plot' <name>.png; 'all' runs the three.",
+    )
+    st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2")
+    st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
+    st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
+    st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    st.add_argument("--quiet", action="store_true", help="no progress bars")
     return p
 
 
@@ -127,12 +139,19 @@ def cmd_survival(a):
     return 0
 
 
+def cmd_study(a):
+    from .studies import run_stage
+
+    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=not a.quiet)
+    return 0
+
+
 def main(argv=None):
     from .scene import SceneError
 
     a = build_parser().parse_args(argv)
     try:
-        return {"simulate": cmd_simulate, "survival": cmd_survival}[a.command](a)
+        return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
     except SceneError as exc:
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2

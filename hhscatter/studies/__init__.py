@@ -1,0 +1,253 @@
+"""Studies: one per figure of the reference paper (and the checks beyond it).
+
+A study is a folder ``studies/<name>/`` whose ``study.toml`` is the one place
+its parameters live, and a module ``hhscatter.studies.<name>`` with three
+stages that make runs as separate targets:
+
+``simulate(study, workers)``
+    integrates the study's scenes into immutable raw run directories
+    ``studies/<name>/out/<scale>/raw/<key>/`` (Parquet, see :mod:`hhscatter.tables`);
+``analyze(study)``
+    turns raw tables into derived tables under ``.../derived/`` and the study's
+    numbers ``.../<name>.json`` with the pure functions of :mod:`hhscatter.analysis`;
+``plot(study)``
+    draws ``.../<name>.png`` from the derived tables only (it computes nothing).
+
+``study.toml`` layout::
+
+    [scene]              # base Scene fields shared by the study's scenes
+    [sections]           # optional SectionWindow fields
+    [study]              # study parameters (energy grids, windows, ...)
+    [scale.paper.scene]  # overrides per scale; 'quick' is the default scale,
+    [scale.paper.study]  # 'tiny' the scale of the end-to-end tests
+
+The numbers JSON follows one convention so the report can tabulate it: a value
+with an uncertainty is ``{"value": v, "err": e}``, and the list
+``"paper_comparison"`` holds rows ``{quantity, ours, err, paper, verdict, note}``.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..scene import Scene, SceneError, scene_from_dict
+
+STUDY_NAMES = ("fig1", "fig2", "resc", "fig3", "fig4", "fig5", "fig6")
+STAGES = ("simulate", "analyze", "plot")
+DEFAULT_SCALE = "quick"
+
+
+def studies_root() -> Path:
+    """studies_root() -> Path of the ``studies/`` folder (env ``HHSCATTER_STUDIES`` overrides)."""
+    env = os.environ.get("HHSCATTER_STUDIES")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[2] / "studies"
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _jsonable(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    if isinstance(v, dict):
+        return {str(k): _jsonable(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_jsonable(x) for x in v]
+    if hasattr(v, "item") and callable(v.item) and getattr(v, "ndim", 1) == 0:
+        return _jsonable(v.item())
+    if hasattr(v, "tolist"):
+        return _jsonable(v.tolist())
+    return v
+
+
+def write_json_atomic(path: Path, obj) -> None:
+    """Write ``obj`` as indented JSON to ``path`` via a temporary file and rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp.write_text(json.dumps(_jsonable(obj), indent=2, sort_keys=False, allow_nan=False) + "\n")
+    os.replace(tmp, path)
+
+
+@dataclass
+class Study:
+    """A study at one scale: its merged configuration and its output paths.
+
+    ``config`` is ``study.toml`` with the scale's overrides applied; ``out`` is
+    ``studies/<name>/out/<scale>/``.
+    """
+
+    name: str
+    scale: str
+    config: dict
+    root: Path
+    comparisons: list = field(default_factory=list)
+
+    @property
+    def out(self) -> Path:
+        return self.root / "out" / self.scale
+
+    @property
+    def params(self) -> dict:
+        """The ``[study]`` table (after scale overrides)."""
+        return self.config.get("study", {})
+
+    def param(self, key, default=None):
+        """param(key, default=None) -> value of ``[study].key``; a missing key without default is an error."""
+        p = self.params
+        if key in p:
+            return p[key]
+        if default is None:
+            raise SceneError(f"{self.root / 'study.toml'}: [study] needs '{key}'")
+        return default
+
+    def scene(self, key: str, **overrides) -> Scene:
+        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
+        d = dict(self.config.get("scene", {}))
+        for extra in ("sections", "snapshots"):
+            if extra in self.config:
+                d[extra] = copy.deepcopy(self.config[extra])
+        d.update(overrides)
+        d = {k: v for k, v in d.items() if v is not None or k in ("sections", "snapshots")}
+        d["name"] = f"{self.name}/{key}"
+        return scene_from_dict(d)
+
+    def raw(self, key: str) -> Path:
+        return self.out / "raw" / key
+
+    def derived(self, fname: str) -> Path:
+        p = self.out / "derived" / fname
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return p
+
+    @property
+    def numbers_path(self) -> Path:
+        return self.out / f"{self.name}.json"
+
+    @property
+    def figure_path(self) -> Path:
+        return self.out / f"{self.name}.png"
+
+    def run(self, key: str, scene: Scene, *, workers=None, progress=True) -> Path:
+        """run(key, scene, workers=None) -> raw run directory, integrating only what is missing.
+
+        A finished run of the same scene is kept (chunks verified), an
+        interrupted one resumed; a run of a different scene (the study file
+        changed) is replaced.
+        """
+        from ..runner import SCENE_FILE, simulate
+
+        out = self.raw(key)
+        resume, overwrite = False, False
+        sj = out / SCENE_FILE
+        if sj.exists():
+            old = json.loads(sj.read_text()).get("scene_hash")
+            resume = old == scene.result_hash()
+            overwrite = not resume
+        summary = simulate(scene, out, workers=workers, overwrite=overwrite, resume=resume, progress=progress)
+        if summary.chunks_done:
+            print(f"  {self.name}/{key}: {summary.line()}", flush=True)
+        return out
+
+    def compare(self, quantity: str, ours, err=None, paper=None, *, unit: str = "", note: str = "",
+                verdict: str | None = None) -> dict:
+        """Record one row of the paper-vs-ours table; ``verdict`` defaults to an |Δ| ≤ 2σ test."""
+        if verdict is None and paper is not None and ours is not None and err is not None:
+            try:
+                verdict = "agrees within 2σ" if abs(float(ours) - float(paper)) <= 2 * float(err) else "differs"
+            except (TypeError, ValueError):
+                verdict = None
+        row = {"quantity": quantity, "ours": ours, "err": err, "paper": paper, "unit": unit,
+               "verdict": verdict, "note": note}
+        self.comparisons.append(row)
+        return row
+
+    def write_numbers(self, numbers: dict) -> Path:
+        """Write the study's numbers JSON (with its comparisons, scale and provenance)."""
+        from ..tables import provenance
+
+        doc = {"study": self.name, "scale": self.scale, **numbers,
+               "paper_comparison": list(self.comparisons), "config": self.config,
+               "provenance": provenance()}
+        write_json_atomic(self.numbers_path, doc)
+        return self.numbers_path
+
+    def read_numbers(self, other: str | None = None) -> dict:
+        """read_numbers(other=None) -> numbers JSON of this study or of study ``other`` at the same scale."""
+        path = self.numbers_path if other is None else load_study(other, self.scale, root=self.root.parent).numbers_path
+        if not path.exists():
+            raise FileNotFoundError(f"{path} is missing: run `make {other or self.name} SCALE={self.scale}` first")
+        return json.loads(path.read_text())
+
+    def write_table(self, df, fname: str, **meta) -> Path:
+        """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""
+        import pyarrow as pa
+
+        from ..tables import META_KEY, provenance, write_part
+
+        table = pa.Table.from_pandas(df, preserve_index=False)
+        doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
+        path = self.derived(fname)
+        write_part(path, table, _jsonable(doc))
+        return path
+
+
+def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) -> Study:
+    """load_study(name, scale='quick', root=None) -> Study from ``<root>/<name>/study.toml``."""
+    root = Path(root) if root is not None else studies_root()
+    path = root / name / "study.toml"
+    if not path.exists():
+        known = sorted(p.parent.name for p in root.glob("*/study.toml"))
+        raise SceneError(f"study must be one of {known}, got {name!r}")
+    try:
+        doc = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path} is not valid TOML: {exc}") from None
+    scales = doc.pop("scale", {})
+    if scale != DEFAULT_SCALE:
+        if scale not in scales:
+            raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
+        doc = _merge(doc, scales[scale])
+    return Study(name=name, scale=scale, config=doc, root=root / name)
+
+
+def stage_module(name: str):
+    import importlib
+
+    return importlib.import_module(f"hhscatter.studies.{name}")
+
+
+def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
+              root: Path | None = None):
+    """run_stage(name, stage, scale='quick', workers=None) -> None; stage in simulate/analyze/plot/all."""
+    if stage not in (*STAGES, "all"):
+        raise SceneError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
+    study = load_study(name, scale, root=root)
+    mod = stage_module(name)
+    stages = STAGES if stage == "all" else (stage,)
+    for st in stages:
+        study.comparisons = []
+        if st == "simulate":
+            mod.simulate(study, workers=workers, progress=progress)
+            write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
+        elif st == "analyze":
+            mod.analyze(study)
+        else:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            mod.plot(study)
