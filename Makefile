@@ -76,10 +76,16 @@ fig5: $(call so,fig5)/fig5.png ## Fig 5: dissipative section points vs the conse
 fig6: $(call so,fig6)/fig6.png ## Fig 6: survival model vs simulations; τ1, τ2 vs γ; mixture model
 studies: fig1 fig2 resc fig3 fig4 fig5 fig6 ## all studies at SCALE (default quick)
 
+REPORT_INPUTS := $(foreach s,fig1 fig2 resc fig3 fig4 fig5 fig6,$(call so,$(s))/$(s).png)
+reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py
+	$(PY) -m hhscatter.report --scale $(SCALE)
+
+report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown) from the study outputs, running what is missing
+
 bench-engine: $(STAMP) ## µs per orbit of the engine (1 and all workers), time inside heyoka
 	$(PY) -m hhscatter.bench_engine $(BENCH_ARGS)
 
 clean-runs: ## delete simulation outputs under runs/
 	rm -rf $(RUNS)
 
-.PHONY: help venv test test-slow demo bench-engine clean-runs studies fig1 fig2 resc fig3 fig4 fig5 fig6
+.PHONY: help venv test test-slow demo bench-engine clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6

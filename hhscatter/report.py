@@ -1,0 +1,313 @@
+"""Reproduction report: every figure and number of the paper beside ours.
+
+``build_report(scale='quick', out=None)`` reads what the studies left on disk
+(``studies/<name>/out/<scale>/<name>.json`` and ``<name>.png``; the benchmark
+summary under ``studies/bench/out/``) and writes one self-contained HTML file
+(figures embedded as data URIs) and the same content as Markdown beside its
+PNG files. It computes no physics: every number comes from a study's numbers
+JSON, so the report and the study outputs cannot disagree.
+"""
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import json
+import math
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from .studies import STUDY_NAMES, load_study, studies_root, write_json_atomic
+
+PAPER_FIGURES = {
+    "fig1": ("Figure 1", "Potential contours, saddles and the support of the conservative c-measure "
+                         "(sprinkler method) at E = 0.35 and E = 0.30."),
+    "fig2": ("Figure 2", "Survival probability P(t) at E = 0.23 and 0.27, and the escape rate κ0(E) with its "
+                         "piecewise fit; κ from the c-measure (beyond the paper)."),
+    "fig3": ("Figure 3", "Mean energy ⟨E⟩(t) of the orbits inside Ω for (E0, γ) = (0.3, 0.01) with the fit "
+                         "E0·exp(−μγt) and energy histograms."),
+    "fig4": ("Figure 4", "P(t) for several γ at E0 = 0.3 with the transition times τ0, τ1, τ2."),
+    "fig5": ("Figure 5", "Section points of the dissipative ensemble after t* over the conservative c-measure; "
+                         "quantitative distances (beyond the paper)."),
+    "fig6": ("Figure 6", "Survival model against simulations; predicted vs observed τ1 and τ2; mixture model "
+                         "(beyond the paper)."),
+}
+BEYOND = {
+    "resc": ("Escape criterion", "κ against the escape radius r_esc, returns after escape, exit-channel "
+                                 "fractions."),
+}
+
+
+@dataclass
+class Section:
+    key: str
+    title: str
+    caption: str
+    figure: Path | None
+    numbers: dict | None
+
+
+def _fmt(v, err=None) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, dict) and "value" in v:
+        return _fmt(v["value"], v.get("err"))
+    if isinstance(v, (bool, int)) and err is None:
+        return str(v)
+    if isinstance(v, (int, float)):
+        if isinstance(v, float) and not math.isfinite(v):
+            return str(v)
+        if err is None or not isinstance(err, (int, float)) or not math.isfinite(err) or err <= 0:
+            return f"{v:.4g}"
+        # one significant digit of the error, two when it starts with 1 or 2 (as particle-data tables do)
+        exp10 = int(math.floor(math.log10(err)))
+        digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
+        if abs(v) >= 1e4 or (v != 0 and abs(v) < 1e-3):
+            return f"{v:.3e} ± {err:.1e}"
+        return f"{v:.{digits}f} ± {err:.{digits}f}"
+    if isinstance(v, (list, tuple)):
+        if len(v) <= 6 and all(isinstance(x, (int, float)) for x in v):
+            return "[" + ", ".join(_fmt(x) for x in v) + "]"
+        return f"[{len(v)} values]"
+    return str(v)
+
+
+def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
+    """headline_numbers(numbers) -> [(name, formatted)] of the scalar and value±err entries of a numbers JSON."""
+    skip = {"study", "scale", "paper_comparison", "config", "provenance"}
+    rows = []
+
+    def walk(prefix, d, depth):
+        for k, v in d.items():
+            if k in skip or len(rows) >= limit:
+                continue
+            name = f"{prefix}{k}"
+            if isinstance(v, dict) and "value" in v:
+                rows.append((name, _fmt(v)))
+            elif isinstance(v, (int, float, bool)) or (isinstance(v, str) and len(v) < 80):
+                rows.append((name, _fmt(v)))
+            elif isinstance(v, dict) and depth < 1:
+                walk(f"{name}.", v, depth + 1)
+
+    walk("", numbers, 0)
+    return rows
+
+
+def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
+    """collect(scale, root=None) -> [Section] for the paper's figures and the studies beyond them."""
+    root = Path(root) if root is not None else studies_root()
+    sections = []
+    for key in STUDY_NAMES:
+        title, caption = PAPER_FIGURES.get(key) or BEYOND[key]
+        try:
+            st = load_study(key, scale, root=root)
+        except Exception:  # a study folder may be missing in a partial checkout
+            sections.append(Section(key, title, caption, None, None))
+            continue
+        fig = st.figure_path if st.figure_path.exists() else None
+        nums = json.loads(st.numbers_path.read_text()) if st.numbers_path.exists() else None
+        sections.append(Section(key, title, caption, fig, nums))
+    return sections
+
+
+def comparison_rows(sections) -> list[dict]:
+    rows = []
+    for s in sections:
+        for r in (s.numbers or {}).get("paper_comparison", []):
+            rows.append({"study": s.key, **r})
+    return rows
+
+
+def _verdict_class(v):
+    if not v:
+        return ""
+    v = v.lower()
+    if v.startswith("agree") or v.startswith("consistent") or v.startswith("reproduced"):
+        return "ok"
+    if v.startswith("differ") or v.startswith("not"):
+        return "bad"
+    return "meh"
+
+
+def _img_uri(path: Path) -> str:
+    return "data:image/png;base64," + base64.b64encode(path.read_bytes()).decode()
+
+
+def _provenance(sections):
+    for s in sections:
+        if s.numbers and "provenance" in s.numbers:
+            return s.numbers["provenance"]
+    return {}
+
+
+def _bench(root: Path):
+    out = root / "bench" / "out"
+    md = next(iter(sorted(out.glob("**/summary.md"))), None) if out.exists() else None
+    pngs = sorted(out.glob("**/*.png")) if out.exists() else []
+    return md, pngs
+
+
+def render_markdown(sections, scale, root, assets: Path) -> str:
+    rows = comparison_rows(sections)
+    prov = _provenance(sections)
+    lines = [f"# hhscatter reproduction report ({scale} scale)", "",
+             "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
+             "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
+             "studies' numbers JSON files; see `make help` for the targets that made them.", "",
+             f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
+             f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str))}.", "",
+             "## The paper's numbers beside ours", "",
+             "| study | quantity | paper | ours | verdict | note |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['study']} | {r['quantity']} | {_fmt(r.get('paper'))} | {_fmt(r.get('ours'), r.get('err'))}"
+                     f" | {r.get('verdict') or '—'} | {(r.get('note') or '').replace('|', '/')} |")
+    if not rows:
+        lines.append("| — | no study outputs found | | | | |")
+    for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
+        lines += ["", f"## {group}", ""]
+        for s in (s for s in sections if s.key in keys):
+            lines += [f"### {s.title} (`make {s.key}`)", "", s.caption, ""]
+            if s.figure:
+                shutil.copyfile(s.figure, assets / f"{s.key}.png")
+                lines += [f"![{s.title}]({assets.name}/{s.key}.png)", ""]
+            else:
+                lines += [f"*Not generated yet: run `make {s.key} SCALE={scale}`.*", ""]
+            if s.numbers:
+                lines += ["| number | value |", "|---|---|"]
+                lines += [f"| {k} | {v} |" for k, v in headline_numbers(s.numbers)]
+                lines.append("")
+    md, pngs = _bench(root)
+    lines += ["## Work–precision and stress", ""]
+    if md:
+        lines += [md.read_text(), ""]
+        for p in pngs:
+            shutil.copyfile(p, assets / p.name)
+            lines += [f"![{p.stem}]({assets.name}/{p.name})", ""]
+    else:
+        lines += ["*Not generated yet: run `make bench`.*", ""]
+    return "\n".join(lines) + "\n"
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;
+padding:0 1em;color:#1a1a1a;line-height:1.45}
+h1{border-bottom:2px solid #333;padding-bottom:.2em} h2{margin-top:2em;border-bottom:1px solid #ccc}
+table{border-collapse:collapse;margin:1em 0;font-size:.92em} th,td{border:1px solid #ccc;padding:.3em .6em;
+vertical-align:top} th{background:#f3f3f3} td.ok{background:#e6f4e6} td.bad{background:#fbe4e4}
+td.meh{background:#fff6d8} img{max-width:100%;border:1px solid #ddd} .caption{color:#444;font-style:italic}
+pre{background:#f7f7f7;padding:.6em;overflow-x:auto} .missing{color:#a00}
+"""
+
+
+def _md_table_to_html(text: str) -> str:
+    """The benchmark summary is Markdown; render its tables and paragraphs minimally (no extra dependency)."""
+    out, table = [], []
+
+    def flush():
+        if table:
+            cells = [[c.strip() for c in r.strip().strip("|").split("|")] for r in table]
+            head, body = cells[0], [r for r in cells[2:]]
+            out.append("<table><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in head) + "</tr>" +
+                       "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in body)
+                       + "</table>")
+            table.clear()
+
+    for line in text.splitlines():
+        if line.strip().startswith("|"):
+            table.append(line)
+            continue
+        flush()
+        if line.startswith("#"):
+            level = min(len(line) - len(line.lstrip("#")) + 2, 6)
+            out.append(f"<h{level}>{html.escape(line.lstrip('#').strip())}</h{level}>")
+        elif line.strip():
+            out.append(f"<p>{html.escape(line)}</p>")
+    flush()
+    return "\n".join(out)
+
+
+def render_html(sections, scale, root) -> str:
+    rows = comparison_rows(sections)
+    prov = _provenance(sections)
+    e = html.escape
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report ({e(scale)})"
+             f"</title><style>{_CSS}</style></head><body>",
+             f"<h1>hhscatter reproduction report <small>({e(scale)} scale)</small></h1>",
+             "<p>Reproduction of Burton, Dullin &amp; Altmann, <i>Dissipative chaotic scattering</i> (Hénon–Heiles "
+             "with linear drag), with exact event times from heyoka's Taylor integrator. Every number below is read "
+             "from the studies' numbers JSON files.</p>",
+             f"<p>Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; versions: "
+             f"{e(', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str)))}.</p>",
+             "<h2>The paper's numbers beside ours</h2><table><tr><th>study</th><th>quantity</th><th>paper</th>"
+             "<th>ours</th><th>verdict</th><th>note</th></tr>"]
+    for r in rows:
+        parts.append(f"<tr><td>{e(r['study'])}</td><td>{e(str(r['quantity']))}</td><td>{e(_fmt(r.get('paper')))}</td>"
+                     f"<td>{e(_fmt(r.get('ours'), r.get('err')))}</td>"
+                     f"<td class='{_verdict_class(r.get('verdict'))}'>{e(r.get('verdict') or '—')}</td>"
+                     f"<td>{e(r.get('note') or '')}</td></tr>")
+    if not rows:
+        parts.append("<tr><td colspan=6 class='missing'>no study outputs found</td></tr>")
+    parts.append("</table>")
+    for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
+        parts.append(f"<h2>{e(group)}</h2>")
+        for s in (s for s in sections if s.key in keys):
+            parts.append(f"<h3>{e(s.title)} <code>make {e(s.key)}</code></h3><p class='caption'>{e(s.caption)}</p>")
+            if s.figure:
+                parts.append(f"<img alt='{e(s.title)}' src='{_img_uri(s.figure)}'>")
+            else:
+                parts.append(f"<p class='missing'>Not generated yet: run <code>make {e(s.key)} SCALE={e(scale)}"
+                             f"</code>.</p>")
+            if s.numbers:
+                parts.append("<table><tr><th>number</th><th>value</th></tr>" + "".join(
+                    f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in headline_numbers(s.numbers)) + "</table>")
+    md, pngs = _bench(root)
+    parts.append("<h2>Work–precision and stress</h2>")
+    if md:
+        parts.append(_md_table_to_html(md.read_text()))
+        parts += [f"<img alt='{e(p.stem)}' src='{_img_uri(p)}'>" for p in pngs]
+    else:
+        parts.append("<p class='missing'>Not generated yet: run <code>make bench</code>.</p>")
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def build_report(scale: str = "quick", out: Path | None = None, root: Path | None = None) -> dict:
+    """build_report(scale='quick', out=None, root=None) -> {'html', 'markdown', 'missing', 'rows'}.
+
+    Writes ``<out>/report.html`` (self-contained) and ``<out>/report.md`` (+ ``<out>/assets/*.png``);
+    ``out`` defaults to ``reports/<scale>``. ``missing`` lists the studies with no figure or numbers.
+    """
+    root = Path(root) if root is not None else studies_root()
+    out = Path(out) if out is not None else root.parent / "reports" / scale
+    assets = out / "assets"
+    assets.mkdir(parents=True, exist_ok=True)
+    sections = collect(scale, root)
+    md = render_markdown(sections, scale, root, assets)
+    page = render_html(sections, scale, root)
+    for name, text in (("report.md", md), ("report.html", page)):
+        tmp = out / f".{name}.tmp"
+        tmp.write_text(text)
+        tmp.replace(out / name)
+    missing = [s.key for s in sections if s.figure is None or s.numbers is None]
+    rows = comparison_rows(sections)
+    write_json_atomic(out / "comparison.json", rows)
+    return {"html": out / "report.html", "markdown": out / "report.md", "missing": missing, "rows": len(rows)}
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    p = argparse.ArgumentParser(prog="python -m hhscatter.report", description=__doc__.splitlines()[0])
+    p.add_argument("--scale", default="quick")
+    p.add_argument("--out", help="output folder (default reports/<scale>)")
+    a = p.parse_args(argv)
+    res = build_report(a.scale, a.out)
+    print(f"wrote {res['html']} and {res['markdown']} ({res['rows']} comparison rows)")
+    if res["missing"]:
+        print(f"missing outputs: {', '.join(res['missing'])}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

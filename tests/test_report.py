@@ -1,0 +1,54 @@
+"""The reproduction report tabulates exactly what the studies wrote, and says what is missing."""
+import json
+
+import pytest
+
+from hhscatter.report import _fmt, build_report
+
+
+def _fake_study(root, name, rows, with_figure=True):
+    d = root / name
+    (d / "out" / "quick").mkdir(parents=True)
+    (d / "study.toml").write_text('[scene]\nn = 10\nenergy = 0.3\n')
+    doc = {"study": name, "scale": "quick", "kappa": {"value": 0.153, "err": 0.004}, "n_points": 31000,
+           "paper_comparison": rows, "provenance": {"heyoka": "7.13.2"}}
+    (d / "out" / "quick" / f"{name}.json").write_text(json.dumps(doc))
+    if with_figure:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(2, 2))
+        ax.plot([0, 1], [1, 0])
+        fig.savefig(d / "out" / "quick" / f"{name}.png")
+        plt.close(fig)
+
+
+def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
+    root = tmp_path / "studies"
+    _fake_study(root, "fig2", [
+        {"quantity": "κ fit a", "ours": 13.1, "err": 0.4, "paper": 13.63, "unit": "", "verdict": "agrees within 2σ",
+         "note": ""},
+        {"quantity": "break energy", "ours": 0.31, "err": 0.01, "paper": 0.27, "unit": "", "verdict": "differs",
+         "note": "continuous fit"},
+    ])
+    _fake_study(root, "fig3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
+                                "verdict": "agrees within 2σ", "note": ""}], with_figure=False)
+    res = build_report("quick", out=tmp_path / "rep", root=root)
+    page = res["html"].read_text()
+    md = res["markdown"].read_text()
+    assert res["rows"] == 3
+    assert "13.1 ± 0.4" in page and "13.63" in page and "class='bad'>differs" in page
+    assert page.count("data:image/png;base64,") == 1  # fig2 only; fig3 has numbers but no figure
+    assert set(res["missing"]) == {"fig1", "resc", "fig3", "fig4", "fig5", "fig6"}
+    assert "| fig2 | break energy | 0.27 | 0.310 ± 0.010 | differs | continuous fit |" in md
+    assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
+    assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
+    assert json.loads((tmp_path / "rep" / "comparison.json").read_text())[2]["study"] == "fig3"
+
+
+@pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),
+                                        (2.5e-14, 1e-15, "2.500e-14 ± 1.0e-15"), (152.0, 7.0, "152 ± 7")])
+def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
+    assert _fmt(v, err) == want
