@@ -18,6 +18,13 @@ def _float(s):
         raise argparse.ArgumentTypeError(f"not a number: {s!r}") from None
 
 
+def _floats(s):
+    """One number, or a comma-separated list of numbers (a grid axis)."""
+    if "," not in s:
+        return _float(s)
+    return [_float(x.strip()) for x in s.split(",") if x.strip()]
+
+
 def _int(s):
     try:
         return int(s)
@@ -37,20 +44,23 @@ def build_parser():
     )
     s.add_argument("scene", nargs="?", help="scene TOML file (flags below override its values)")
     s.add_argument("--scale", help="named scale in the scene file, e.g. 'paper' (default: quick)")
-    s.add_argument("--energy", type=_float, help="initial energy E0 (> E_c = 1/6 for ω=λ=1)")
-    s.add_argument("--gamma", type=_float, help="drag γ ≥ 0 (0 = conservative)")
+    s.add_argument("--energy", type=_floats,
+                   help="initial energy E0 (> E_c = 1/6 for ω=λ=1); a list 0.25,0.3 makes a grid run")
+    s.add_argument("--gamma", type=_floats, help="drag γ ≥ 0 (0 = conservative); a list 0,0.01 makes a grid run")
     s.add_argument("-n", type=_int, help="number of orbits N > 0")
     s.add_argument("--seed", type=_int, help="seed ≥ 0 (with the orbit index it fixes every orbit)")
     s.add_argument("--region", choices=["disk", "well"], help="initial-condition region")
     s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
-    s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default 1.03)")
+    s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default 1.5; the paper used 1.03, see study resc)")
     s.add_argument("--t-max", type=_float, dest="t_max", help="maximum orbit time (default 5000)")
     s.add_argument("--tol", type=_float, help="integrator tolerance in [1e-18, 1e-6] (default 1e-15)")
     s.add_argument("--chunk-size", type=_int, dest="chunk_size", help="orbits per part file (default 10000)")
     s.add_argument("--batch-size", type=_int, dest="batch_size", help="SIMD lanes (default: heyoka's choice)")
     s.add_argument("--ics", help="Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]")
-    s.add_argument("--out", required=True, help="output directory")
+    s.add_argument("--out", required=True, help="output directory, or a URL pyarrow/fsspec can write (s3://…)")
     s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    s.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
+                   "or a scheduler address tcp://HOST:PORT (needs the 'dask' extra)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--overwrite", action="store_true", help="replace the tables in a non-empty --out")
     g.add_argument("--resume", action="store_true", help="keep verified finished chunks in --out, redo the rest")
@@ -76,7 +86,9 @@ def build_parser():
 
 
 def _scene_from_args(a):
-    from .scene import SceneError, load_scene, scene_from_dict
+    """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
+    from .grid import load_run, run_from_dict
+    from .scene import SceneError
 
     flags = {
         k: getattr(a, k)
@@ -84,8 +96,9 @@ def _scene_from_args(a):
                   "batch_size")
     }
     for k, v in flags.items():
-        if isinstance(v, float) and not math.isfinite(v):
-            raise SceneError(f"{k.replace('_', '-')} must be finite, got {v}")
+        for x in v if isinstance(v, list) else [v]:
+            if isinstance(x, float) and not math.isfinite(x):
+                raise SceneError(f"{k.replace('_', '-')} must be finite, got {x}")
     if a.ics:
         from .ics import read_ics_table
 
@@ -95,7 +108,7 @@ def _scene_from_args(a):
         flags["n"] = len(states)
         flags["ics"] = str(Path(a.ics).resolve())
     if a.scene:
-        return load_scene(a.scene, scale=a.scale, **flags)
+        return load_run(a.scene, scale=a.scale, **flags)
     if a.scale:
         raise SceneError("--scale needs a scene file")
     d = {k: v for k, v in flags.items() if v is not None}
@@ -104,7 +117,7 @@ def _scene_from_args(a):
         raise SceneError("n (number of orbits) is required: give -n or a scene file")
     if "energy" not in d and not a.ics:
         raise SceneError("energy is required: give --energy or a scene file")
-    return scene_from_dict(d)
+    return run_from_dict(d)
 
 
 def cmd_simulate(a):
@@ -112,7 +125,7 @@ def cmd_simulate(a):
 
     scene = _scene_from_args(a)
     summary = simulate(scene, a.out, workers=a.workers, overwrite=a.overwrite, resume=a.resume,
-                       progress=not a.quiet)
+                       progress=not a.quiet, scheduler=a.scheduler)
     print(summary.line())
     return 0
 
@@ -147,6 +160,7 @@ def cmd_study(a):
 
 
 def main(argv=None):
+    from .runner import RunError
     from .scene import SceneError
 
     a = build_parser().parse_args(argv)
@@ -155,6 +169,9 @@ def main(argv=None):
     except SceneError as exc:
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
+    except RunError as exc:
+        print(f"hhscatter: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
         return 130

@@ -1,26 +1,52 @@
-"""Run a scene: chunk planning, worker processes, part files, resume, progress.
+"""Run a scene or a grid: chunk planning, backends, part files, resume, progress.
 
-``simulate(scene, out, workers=None, overwrite=False, resume=False)`` checks
-everything it can before any work (output directory writable and empty or
-explicitly overwritten/resumed, initial conditions valid), then integrates
-the chunks on a process pool and writes one part file per chunk and table.
+``simulate(run, out, workers=None, overwrite=False, resume=False, scheduler=None)``
+checks everything it can before any work (output location writable and empty
+or explicitly overwritten/resumed, initial conditions valid), then integrates
+the chunks and writes one part file per chunk and table.
+
+Backends (results are byte-identical whichever runs the chunks):
+
+* ``workers=1``: in this process;
+* default: a local process pool (``workers`` processes, default all cores);
+* ``scheduler='local'``: a ``dask.distributed.LocalCluster`` of ``workers``
+  single-threaded worker processes; ``scheduler='tcp://HOST:PORT'``: an
+  existing Dask cluster (see :mod:`hhscatter.dask_backend`).
+
+Every task is one (point, chunk): the worker integrates it, writes its part
+files straight to the output location and returns a small
+:class:`RunSummary`; the client keeps at most a few tasks per worker in
+flight, so its memory does not grow with N.
+
+Crash safety. A part file appears under its final name only when complete
+(temporary name, fsync, rename; :mod:`hhscatter.store`); within a chunk the
+``lifetimes`` part is written last. Each part's metadata records the scene,
+its hash, the chunk, its orbit range and its row count: that is the record of
+finished work (no separate manifest that could disagree with the files).
+``resume=True`` re-reads every existing part in full (page checksums, row
+counts, scene hash), keeps the good ones, deletes temporaries left by killed
+writers and redoes the rest; a run directory made by another scene is refused.
+A failed write (disk full, permission lost) stops the run with a
+:class:`RunError` that names the file; finished parts stay intact.
 """
 from __future__ import annotations
 
 import json
 import os
-import shutil
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from .scene import Scene, SceneError, scene_from_dict
-from .tables import TABLES, part_name, read_meta
+from .store import Store
+from .tables import TABLES, part_name, read_meta, verify_part
 
 SCENE_FILE = "scene.json"
+
+
+class RunError(RuntimeError):
+    """A run could not complete (e.g. a part file could not be written); finished chunks are kept."""
 
 
 @dataclass
@@ -38,20 +64,24 @@ class RunSummary:
     chunks_done: int = 0
     chunks_skipped: int = 0
     workers: int = 1
+    backend: str = "local"
 
-    def add(self, other: "RunSummary"):
+    def add(self, other: RunSummary):
         for k in ("n", "escaped", "settled", "censored", "n_sections", "n_snapshots", "compute_seconds"):
             setattr(self, k, getattr(self, k) + getattr(other, k))
         self.chunks_done += 1
 
     def line(self) -> str:
+        if self.n == 0 and self.chunks_skipped:
+            return f"nothing to do: all {self.chunks_skipped} chunk(s) verified complete and kept"
         us = 1e6 * self.wall_seconds / max(self.n, 1)
         us_core = 1e6 * self.compute_seconds / max(self.n, 1)
         skipped = f", {self.chunks_skipped} chunk(s) resumed" if self.chunks_skipped else ""
+        where = "" if self.backend == "local" else f" on {self.backend}"
         return (
             f"{self.n} orbits: escaped {self.escaped}, settled {self.settled}, censored {self.censored}"
             f" | wall {self.wall_seconds:.2f} s, {us:.2f} µs/orbit, {us_core:.2f} µs/orbit/core"
-            f" ({self.workers} worker{'s' if self.workers != 1 else ''}{skipped})"
+            f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
         )
 
 
@@ -70,6 +100,20 @@ def tables_of(scene: Scene):
     return names
 
 
+def points_of(run):
+    """points_of(run) -> [(scene, partition)]: ('', the scene) for a Scene, one per grid point for a Grid."""
+    from .grid import Grid
+
+    if isinstance(run, Grid):
+        return [(p, Grid.partition(p)) for p in run.points]
+    return [(run, "")]
+
+
+def part_rel(name: str, partition: str, chunk: int) -> str:
+    """Relative path of a part file: '<table>/[<partition>/]part-<chunk>.parquet'."""
+    return "/".join(x for x in (name, partition, part_name(chunk)) if x)
+
+
 def _chunk_ics(scene, start, stop, table_ics):
     if table_ics is not None:
         states, ids = table_ics
@@ -79,12 +123,19 @@ def _chunk_ics(scene, start, stop, table_ics):
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
 
 
-def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out: str, ics=None, ids=None):
-    """Worker entry: integrate one chunk, write its part files, return a RunSummary."""
+def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition=""):
+    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='') -> RunSummary.
+
+    Worker entry (local pool or Dask): integrate orbits start..stop−1 of the
+    scene, write the chunk's part files under ``out`` (path or URL) and
+    return the chunk's counts. An OSError while writing is re-raised naming
+    the file.
+    """
     from .engine import run_chunk
     from .tables import provenance, to_arrow, write_part
 
     scene = scene_from_dict(_decode(json.loads(scene_json)))
+    store = Store(out)
     if ics is None:
         ics, ids = _chunk_ics(scene, start, stop, None)
     t0 = time.perf_counter()
@@ -101,7 +152,11 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out: str, 
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):
         table = to_arrow(name, rows[name])
-        write_part(Path(out) / name / part_name(chunk), table, {**meta, "table": name, "rows": table.num_rows})
+        rel = part_rel(name, partition, chunk)
+        try:
+            write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
+        except OSError as exc:
+            raise OSError(exc.errno, f"cannot write {store.display(rel)}: {exc.strerror or exc}") from None
     oc = np.bincount(res.lifetimes["outcome"], minlength=3)
     return RunSummary(
         n=stop - start,
@@ -122,135 +177,242 @@ def _decode(d):
     return d
 
 
-def chunk_complete(scene: Scene, out: Path, chunk: int, start: int, stop: int) -> bool:
-    """True if every part file of ``chunk`` exists, is readable, has the scene's hash and its row count."""
-    import pyarrow.parquet as pq
+def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partition: str = "") -> bool:
+    """chunk_complete(scene, out, chunk, start, stop, partition='') -> bool.
 
+    True if every part file of ``chunk`` exists, reads in full with valid page
+    checksums, and has this scene's hash, orbit range and row count. Raises
+    SceneError if a part was made by another scene.
+    """
+    store = Store(out)
     want = scene.result_hash()
     for name in tables_of(scene):
-        p = out / name / part_name(chunk)
-        if not p.exists():
+        rel = part_rel(name, partition, chunk)
+        if not store.exists(rel):
             return False
         try:
-            meta = read_meta(p)
-            rows = pq.ParquetFile(p).metadata.num_rows
+            meta = read_meta(store.path(rel), filesystem=store.filesystem)
         except Exception:  # noqa: BLE001 - a damaged file is redone, whatever the damage
             return False
         if meta.get("scene_hash") != want:
             raise SceneError(
-                f"cannot resume: {p} was made by a different scene (hash {meta.get('scene_hash', '?')[:12]}…, "
-                f"this scene {want[:12]}…); use --overwrite or another --out"
+                f"cannot resume: {store.display(rel)} was made by a different scene (hash "
+                f"{str(meta.get('scene_hash', '?'))[:12]}…, this scene {want[:12]}…); "
+                "use --overwrite or another --out"
             )
-        if rows != meta.get("rows") or meta.get("orbits") != [start, stop]:
+        if meta.get("orbits") != [start, stop] or meta.get("chunk") != chunk:
             return False
-        if name == "lifetimes" and rows != stop - start:
+        source = store.open_input(rel)
+        try:
+            verify_part(source, expect_rows=stop - start if name == "lifetimes" else None)
+        except Exception:  # noqa: BLE001 - truncated, damaged page, wrong row count: redo
             return False
+        finally:
+            if not isinstance(source, str):
+                source.close()
     return True
 
 
-def prepare_output(scene: Scene, out: Path, *, overwrite: bool, resume: bool):
-    """Check and prepare the output directory before any work; raise SceneError if unusable."""
+def _diff(old: dict, new: dict) -> str:
+    keys = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k) and k not in ("name", "batch_size"))
+    return ", ".join(f"{k}: {old.get(k)!r} → {new.get(k)!r}" for k in keys[:6])
+
+
+def prepare_output(run, out, *, overwrite: bool, resume: bool):
+    """Check and prepare the output location before any work; raise SceneError if unusable."""
     if overwrite and resume:
         raise SceneError("--overwrite and --resume exclude each other")
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise SceneError(f"out: {out} exists and is not a directory")
-    if out.exists() and any(out.iterdir()):
+    try:
+        store = Store(out)
+    except ValueError as exc:
+        raise SceneError(str(exc)) from None
+    if store.exists() and not store.is_dir():
+        raise SceneError(f"out: {store.display()} exists and is not a directory")
+    if store.listdir():
         if overwrite:
             for name in (*TABLES, SCENE_FILE):
-                p = out / name
-                if p.is_dir():
-                    shutil.rmtree(p)
-                elif p.exists():
-                    p.unlink()
+                store.remove(name)
         elif resume:
-            sj = out / SCENE_FILE
-            if sj.exists():
-                old = json.loads(sj.read_text())
-                if old.get("scene_hash") != scene.result_hash():
+            if store.exists(SCENE_FILE):
+                old = json.loads(store.read_text(SCENE_FILE))
+                if old.get("scene_hash") != run.result_hash():
+                    what = _diff(old.get("scene", {}), json.loads(run.to_json()))
                     raise SceneError(
-                        f"cannot resume into {out}: it holds a different scene; use --overwrite or another --out"
+                        f"cannot resume into {store.display()}: it holds a different scene"
+                        f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"
                     )
+            for name in TABLES:
+                store.remove_temporaries(name)
         else:
-            raise SceneError(f"out: {out} is not empty; pass --overwrite to replace it or --resume to continue it")
+            raise SceneError(
+                f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
+            )
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".write-test-{os.getpid()}"
-        probe.write_bytes(b"")
-        probe.unlink()
+        store.makedirs()
+        probe = f".write-test-{os.getpid()}"
+        store.write_text(probe, "")
+        store.remove(probe)
     except OSError as exc:
-        raise SceneError(f"out: {out} is not writable ({exc.strerror or exc})") from None
-    doc = {"scene": json.loads(scene.to_json()), "scene_hash": scene.result_hash()}
-    tmp = out / f".{SCENE_FILE}.tmp"
-    tmp.write_text(json.dumps(doc, indent=2, sort_keys=True))
-    os.replace(tmp, out / SCENE_FILE)
+        raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+    doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
+    from .grid import Grid
+
+    if isinstance(run, Grid):
+        doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
+        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points_of(run)]
+    store.write_json(SCENE_FILE, doc)
+    return store
 
 
 def default_workers() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 
-def simulate(scene: Scene, out, *, workers=None, overwrite=False, resume=False, progress=True) -> RunSummary:
-    """simulate(scene, out, workers=None, overwrite=False, resume=False, progress=True) -> RunSummary.
+def _drain(submit, wait_first, tasks, window, on_done, cancel):
+    """Run ``tasks`` keeping at most ``window`` in flight; on_done(task, result) as each finishes.
 
-    Writes the scene's tables under ``out`` (see :mod:`hhscatter.tables`).
-    ``workers``: processes (default: all cores). Tables are byte-identical for
-    any number of workers. With ``resume``, complete chunks are verified and
-    kept, the rest redone.
+    On any error the tasks not yet finished are cancelled (``cancel``) and the
+    error propagates; finished tasks have already been reported.
+    """
+    it = iter(tasks)
+    pending = {}
+    try:
+        for task in it:
+            pending[submit(task)] = task
+            if len(pending) >= window:
+                break
+        while pending:
+            for fut in wait_first(list(pending)):
+                task = pending.pop(fut)
+                on_done(task, fut.result())
+                nxt = next(it, None)
+                if nxt is not None:
+                    pending[submit(nxt)] = nxt
+    except BaseException:
+        cancel(list(pending))
+        raise
+
+
+def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=True,
+             scheduler=None) -> RunSummary:
+    """simulate(run, out, workers=None, overwrite=False, resume=False, progress=True, scheduler=None) -> RunSummary.
+
+    Writes the tables of ``run`` (a Scene, or a :class:`hhscatter.grid.Grid`)
+    under ``out`` (a directory or URL; see :mod:`hhscatter.tables`).
+    ``workers``: processes (default: all cores; with ``scheduler='local'`` the
+    LocalCluster's worker processes). ``scheduler``: None (local pool),
+    ``'local'`` or a Dask scheduler address ``'tcp://host:port'``. Tables are
+    byte-identical for any backend and number of workers. With ``resume``,
+    complete chunks are verified and kept, the rest redone.
+    Raises SceneError on bad input (before any work), RunError when a chunk
+    cannot be written.
     """
     from tqdm.auto import tqdm
 
-    out = Path(out)
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers must be an integer ≥ 1, got {workers!r}")
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
+        raise SceneError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
+    points = points_of(run)
     table_ics = None
-    if scene.ics is not None:
+    if points[0][0].ics is not None:
         from .ics import read_ics_table
 
+        scene = points[0][0]
         table_ics = read_ics_table(scene.ics)
         if len(table_ics[0]) != scene.n:
             raise SceneError(f"n = {scene.n} but the ics table has {len(table_ics[0])} rows")
-    prepare_output(scene, out, overwrite=overwrite, resume=resume)
-    workers = workers or default_workers()
+    if scheduler is not None:
+        from .dask_backend import check_scheduler
 
-    chunks = plan_chunks(scene)
-    summary = RunSummary(workers=workers)
+        check_scheduler(scheduler, workers)
+    store = prepare_output(run, out, overwrite=overwrite, resume=resume)
+    # workers get an absolute path (their working directory may differ) or the URL
+    out_url = store.root if store.local else store.url
+
+    summary = RunSummary()
     todo = []
-    for chunk, start, stop in chunks:
-        if resume and chunk_complete(scene, out, chunk, start, stop):
-            summary.chunks_skipped += 1
-            continue
-        todo.append((chunk, start, stop))
+    n_total = 0
+    for scene, partition in points:
+        scene_json = scene.to_json()
+        for chunk, start, stop in plan_chunks(scene):
+            n_total += stop - start
+            if resume and chunk_complete(scene, store, chunk, start, stop, partition):
+                summary.chunks_skipped += 1
+                continue
+            todo.append((scene_json, chunk, start, stop, partition))
+    done_orbits = n_total - sum(t[3] - t[2] for t in todo)
 
-    scene_json = scene.to_json()
-    t0 = time.perf_counter()
-    done_orbits = sum(stop - start for _, start, stop in chunks) - sum(stop - start for _, start, stop in todo)
-    bar = tqdm(
-        total=scene.n, initial=done_orbits, unit="orbit", unit_scale=True, disable=not progress,
-        desc=f"{scene.name}", smoothing=0.05,
-    )
-
-    def args(c, s, e):
+    def args(task):
+        scene_json, c, s, e, partition = task
         if table_ics is None:
-            return (scene_json, c, s, e, str(out))
+            return (scene_json, c, s, e, out_url, None, None, partition)
         states, ids = table_ics
-        return (scene_json, c, s, e, str(out), states[s:e], ids[s:e])
+        return (scene_json, c, s, e, out_url, states[s:e], ids[s:e], partition)
+
+    t0 = time.perf_counter()
+    bar = tqdm(total=n_total, initial=done_orbits, unit="orbit", unit_scale=True, disable=not progress,
+               desc=f"{run.name}", smoothing=0.05)
+
+    def on_done(task, result):
+        summary.add(result)
+        bar.update(task[3] - task[2])
 
     try:
-        if workers == 1 or len(todo) <= 1:
-            for c, s, e in todo:
-                summary.add(run_one_chunk(*args(c, s, e)))
-                bar.update(e - s)
-        else:
-            import multiprocessing as mp
+        if not todo:
+            summary.workers = 0
+        elif scheduler is not None:
+            from .dask_backend import dask_client
 
-            ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
-            with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx) as pool:
-                futs = {pool.submit(run_one_chunk, *args(c, s, e)): e - s for c, s, e in todo}
-                for fut in as_completed(futs):
-                    summary.add(fut.result())
-                    bar.update(futs[fut])
+            with dask_client(scheduler, workers) as client:
+                summary.workers = sum(client.nthreads().values())
+                summary.backend = f"dask {scheduler}" if scheduler != "local" else "dask LocalCluster"
+                _run_dask(client, todo, args, on_done, run.name)
+        else:
+            workers = workers or default_workers()
+            summary.workers = workers
+            if workers == 1 or len(todo) <= 1:
+                for task in todo:
+                    on_done(task, run_one_chunk(*args(task)))
+            else:
+                _run_pool(workers, todo, args, on_done)
+    except OSError as exc:
+        raise RunError(
+            f"{exc.strerror or exc}; stopped after {summary.chunks_done} new chunk(s). Finished part files "
+            f"are intact: fix the cause and rerun with --resume to do only what is missing"
+        ) from exc
     finally:
         bar.close()
     summary.wall_seconds = time.perf_counter() - t0
     return summary
+
+
+def _run_pool(workers, todo, args, on_done):
+    import multiprocessing as mp
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx)
+    try:
+        _drain(lambda t: pool.submit(run_one_chunk, *args(t)),
+               lambda fs: wait(fs, return_when=FIRST_COMPLETED).done,
+               todo, 2 * workers, on_done,
+               lambda fs: [f.cancel() for f in fs])
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _run_dask(client, todo, args, on_done, name):
+    import uuid
+
+    from distributed import wait
+
+    window = max(4, 2 * sum(client.nthreads().values()))
+    tag = uuid.uuid4().hex[:8]
+
+    def submit(task):
+        key = f"hhscatter-{name}-{task[4].replace('/', ',') + '-' if task[4] else ''}{task[1]}-{tag}"
+        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0)
+
+    _drain(submit, lambda fs: wait(fs, return_when="FIRST_COMPLETED").done, todo, window, on_done,
+           lambda fs: client.cancel(fs))

@@ -81,7 +81,9 @@ class Scene:
       region      'disk' (uniform in area in r < radius) or 'well' (uniform in the
                   saddle triangle where V < E); velocities tangential on the section
       radius      disk radius R (default 0.5, as in the authors' code)
-      r_esc       escape radius (default 1.03), > saddle distance ω²/λ
+      r_esc       escape radius (default 1.5), > saddle distance ω²/λ. 1.5 lies beyond the
+                  Lyapunov orbits of every exit up to E = 0.5 (study ``resc``); the
+                  paper's 1.03 lets 0.3–2 % of 'escaped' orbits return (E = 0.25–0.35)
       r_far       dissipative runs: radius beyond which an escaped orbit is
                   stopped (default max(10 ω²/λ, 2 r_esc))
       t_max       maximum orbit time (default 5000); orbits alive then are censored
@@ -100,7 +102,7 @@ class Scene:
     seed: int = 0
     region: str = "disk"
     radius: float = 0.5
-    r_esc: float = 1.03
+    r_esc: float = 1.5
     r_far: float | None = None
     t_max: float = 5000.0
     tol: float = 1e-15
@@ -281,13 +283,11 @@ def scene_from_dict(d: dict) -> Scene:
     return Scene(**d)
 
 
-def load_scene(path, scale: str | None = None, **overrides) -> Scene:
-    """load_scene(path, scale=None, **overrides) -> Scene from a TOML file.
+def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
+    """scene_dict_from_toml(path, scale=None, **overrides) -> the raw scene dict of a TOML file.
 
-    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow
-    fields), ``[snapshots]`` (``times = [...]`` or ``start/stop/step``) and
-    ``[scale.<name>]`` tables whose keys override ``[scene]`` when ``scale``
-    is given. Keyword overrides are applied last.
+    What :func:`load_scene` validates; values may still be lists (a grid, see
+    :mod:`hhscatter.grid`).
     """
     path = Path(path)
     try:
@@ -310,4 +310,20 @@ def load_scene(path, scale: str | None = None, **overrides) -> Scene:
             raise SceneError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
         d.update(scales[scale])
     d.update({k: v for k, v in overrides.items() if v is not None})
+    return d
+
+
+def load_scene(path, scale: str | None = None, **overrides) -> Scene:
+    """load_scene(path, scale=None, **overrides) -> Scene from a TOML file.
+
+    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow
+    fields), ``[snapshots]`` (``times = [...]`` or ``start/stop/step``) and
+    ``[scale.<name>]`` tables whose keys override ``[scene]`` when ``scale``
+    is given. Keyword overrides are applied last. A file whose ``energy`` or
+    ``gamma`` is a list is a grid: load it with :func:`hhscatter.grid.load_run`.
+    """
+    d = scene_dict_from_toml(path, scale, **overrides)
+    for k in ("energy", "gamma"):
+        if isinstance(d.get(k), (list, tuple)):
+            raise SceneError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.grid.load_run")
     return scene_from_dict(d)

@@ -7,11 +7,21 @@ A run directory holds one dataset per table, one part file per chunk::
     OUT/snapshots/part-000000.parquet    (only when the scene records snapshots)
     OUT/scene.json                       (the scene, for humans; each part carries it too)
 
+A grid run (a sweep over E0 and/or γ, see :mod:`hhscatter.grid`) is one
+hive-partitioned dataset per table, one partition per grid point::
+
+    OUT/lifetimes/energy=0.25/gamma=0.01/part-000000.parquet
+
+Readers then return the partition columns ``energy`` (the point's nominal E0;
+the per-orbit ``e0`` column keeps each orbit's computed initial energy) and
+``gamma``. ``OUT`` may be a URL (``s3://…``, any fsspec protocol).
+
 Every part file's key-value metadata holds, under the key ``hhscatter``, a
 JSON document with the full scene, its result hash, the chunk index and
 orbit range, the row count, and the versions of hhscatter, heyoka, numpy and
 pyarrow plus the git commit when available: a table alone says how it was
-made. Files are written to a temporary name and renamed when complete.
+made. Files are written to a temporary name and renamed when complete, with
+Parquet page checksums (see :func:`verify_part`).
 
 Schemas
 -------
@@ -28,7 +38,6 @@ from __future__ import annotations
 
 import functools
 import json
-import os
 import subprocess
 from pathlib import Path
 
@@ -122,51 +131,109 @@ def to_arrow(name: str, columns: dict):
     return pa.Table.from_arrays(arrays, schema=schema)
 
 
-def write_part(path: Path, table, meta: dict) -> None:
-    """Write ``table`` with metadata ``meta`` to ``path`` atomically (tmp + fsync + rename)."""
+def write_part(path, table, meta: dict, store=None) -> None:
+    """write_part(path, table, meta, store=None) -> None: write ``table`` with metadata ``meta`` atomically.
+
+    ``path`` is a local path, or, with ``store`` (a :class:`hhscatter.store.Store`),
+    a path relative to the store's root. The file is written to a temporary
+    name, fsync'ed and renamed (see :mod:`hhscatter.store`), so a part file
+    under its final name is always complete. Parquet page checksums are
+    written so that ``verify_part`` detects damaged data pages, not only a
+    damaged footer.
+    """
     import pyarrow.parquet as pq
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from .store import Store
+
+    if store is None:
+        path = Path(path)
+        store, rel = Store(path.parent), path.name
+    else:
+        rel = str(path)
     table = table.replace_schema_metadata({META_KEY: json.dumps(meta, sort_keys=True).encode()})
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    try:
+
+    def write(target, filesystem):
         # no per-file timestamps or writer-dependent fields: same rows, same bytes
-        pq.write_table(table, tmp, compression="zstd", write_statistics=True)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+        pq.write_table(table, target, filesystem=filesystem, compression="zstd", write_statistics=True,
+                       write_page_checksum=True)
+
+    store.write_atomic(rel, write)
 
 
 def part_name(chunk: int) -> str:
     return f"part-{chunk:06d}.parquet"
 
 
-def read_meta(path) -> dict:
-    """read_meta(path) -> the ``hhscatter`` metadata dict of one part file."""
+def read_meta(path, filesystem=None) -> dict:
+    """read_meta(path, filesystem=None) -> the ``hhscatter`` metadata dict of one part file."""
     import pyarrow.parquet as pq
 
-    md = pq.read_schema(path).metadata or {}
+    md = pq.read_schema(path, filesystem=filesystem).metadata or {}
     if META_KEY not in md:
         raise ValueError(f"{path} is not an hhscatter table (no '{META_KEY.decode()}' metadata)")
     return json.loads(md[META_KEY])
 
 
-def _read(run_dir, name: str, columns=None, filters=None):
+def verify_part(source, expect_rows=None) -> dict:
+    """verify_part(source, expect_rows=None) -> metadata dict, or raise ValueError/OSError.
+
+    Reads the whole file (``source``: path or open pyarrow file) with page
+    checksum verification: a truncated file, a damaged footer or data page, a
+    row count different from the metadata's (or from ``expect_rows``) raise.
+    """
+    import pyarrow.parquet as pq
+
+    pf = pq.ParquetFile(source, page_checksum_verification=True)
+    md = pf.schema_arrow.metadata or {}
+    if META_KEY not in md:
+        raise ValueError("not an hhscatter table")
+    meta = json.loads(md[META_KEY])
+    table = pf.read()
+    if table.num_rows != meta.get("rows") or (expect_rows is not None and table.num_rows != expect_rows):
+        raise ValueError(f"row count {table.num_rows} differs from the metadata's {meta.get('rows')}")
+    return meta
+
+
+#: hive partition keys of a grid run (see :mod:`hhscatter.grid`); the scene field
+#: names, not ``e0``, so the per-orbit ``e0`` column is never shadowed
+PARTITION_KEYS = ("energy", "gamma")
+
+
+def _dataset(run_dir, name: str, *, one_by_one: bool = False):
+    """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run).
+
+    ``one_by_one=True`` yields one single-file dataset per part instead: pyarrow
+    keeps each scanned file's footer while its dataset lives, so a streaming
+    scan over many thousands of parts is done file by file.
+    """
+    import pyarrow as pa
     import pyarrow.dataset as ds
 
-    base = Path(run_dir)
-    path = base / name if (base / name).is_dir() else base
-    if not path.exists():
-        raise FileNotFoundError(f"no {name} table at {path}")
-    files = sorted(str(p) for p in path.glob("part-*.parquet"))
+    from .store import Store
+
+    store = Store(run_dir)
+    rel = name if store.is_dir(name) else ""
+    if not store.exists(rel):
+        raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
+    files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
     if not files:
-        raise FileNotFoundError(f"no part files in {path}")
-    dataset = ds.dataset(files, format="parquet", schema=_schemas()[name])
-    table = dataset.to_table(columns=columns, filter=filters)
+        raise FileNotFoundError(f"no part files in {store.display(rel)}")
+    schema = _schemas()[name]
+    base = store.path(rel)
+    paths = [store.path(rel, f) for f in files]
+    kw = {"format": "parquet", "filesystem": store.filesystem}
+    if any("=" in f for f in files):  # hive-partitioned grid run: energy=…/gamma=…/part-…
+        keys = [k for k in PARTITION_KEYS if k not in schema.names]
+        schema = pa.schema(list(schema) + [pa.field(k, pa.float64()) for k in keys])
+        kw["partitioning"] = ds.partitioning(pa.schema([(k, pa.float64()) for k in PARTITION_KEYS]), flavor="hive")
+        kw["partition_base_dir"] = base
+    if one_by_one:
+        return (ds.dataset([p], schema=schema, **kw) for p in paths)
+    return ds.dataset(paths, schema=schema, **kw)
+
+
+def _read(run_dir, name: str, columns=None, filters=None):
+    table = _dataset(run_dir, name).to_table(columns=columns, filter=filters)
     df = table.to_pandas()
     if "outcome" in df.columns:
         df["outcome"] = df["outcome"].astype(str)
@@ -175,12 +242,82 @@ def _read(run_dir, name: str, columns=None, filters=None):
     return df
 
 
+def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None):
+    """read_arrow(run_dir, name='lifetimes', columns=None, filters=None) -> pyarrow.Table.
+
+    The memory-lean reader: only ``columns`` are read (column projection in
+    the Parquet reader), no pandas conversion. ``run_dir`` may be a URL.
+    """
+    return _dataset(run_dir, name).to_table(columns=columns, filter=filters)
+
+
+def survival_arrays(run_dir, filters=None):
+    """survival_arrays(run_dir, filters=None) -> (t_end float64 (N,), observed bool (N,)).
+
+    The inputs of :func:`hhscatter.analysis.survival.survival_curve`, read
+    with column projection: only ``t_end`` and the dictionary codes of
+    ``outcome`` are read and decoded, no pandas objects are made (~9 bytes per
+    orbit). ``observed`` is False for censored orbits. Memory-bounded route for
+    P(t) of 1e7+ orbits.
+    """
+    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters)
+    t_end = table.column("t_end").to_numpy()
+    observed = np.empty(len(t_end), dtype=bool)
+    pos = 0
+    for chunk in table.column("outcome").chunks:
+        censored = np.asarray(chunk.dictionary.to_pylist(), dtype=object) == "censored"
+        idx = chunk.indices.to_numpy(zero_copy_only=False)
+        observed[pos:pos + len(chunk)] = ~censored[idx]
+        pos += len(chunk)
+    return t_end, observed
+
+
+def survival_on_grid(run_dir, t_grid, filters=None):
+    """survival_on_grid(run_dir, t_grid, filters=None) -> SurvivalCurve(t, P, P_err) at the grid times.
+
+    P(t) = Pr(lifetime > t) (paper Eqs. eqn:kappa_hyperbolic/nonhyperbolic)
+    streamed over the dataset in record batches of ``t_end`` and ``outcome``
+    only: memory O(len(t_grid) + one batch), whatever N (1e9 orbits fit).
+    hhscatter censors orbits only at t_max, so for t below every censoring
+    time the Kaplan–Meier estimate is exactly the fraction #{t_end > t}/N
+    and Greenwood's error the binomial √(P(1−P)/N); this function computes
+    that, and raises ValueError if some orbit was censored before max(t_grid)
+    (use :func:`hhscatter.analysis.survival.survival_curve` then).
+    ``t_grid``: increasing times (time units).
+    """
+    from .analysis.survival import SurvivalCurve
+
+    g = np.asarray(t_grid, dtype=float)
+    if g.ndim != 1 or g.size == 0 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
+        raise ValueError("t_grid must be a non-empty, finite, strictly increasing 1-d array")
+    dead = np.zeros(g.size + 1, dtype=np.int64)  # events in (g[k-1], g[k]] at index k
+    n = 0
+    # one part file at a time (its footer is dropped with its dataset): memory is one part, however many
+    batches = (b for part in _dataset(run_dir, "lifetimes", one_by_one=True)
+               for b in part.to_batches(columns=["t_end", "outcome"], filter=filters, batch_readahead=1))
+    for batch in batches:
+        t = batch.column(0).to_numpy()
+        outcome = batch.column(1)
+        censored = (np.asarray(outcome.dictionary.to_pylist(), dtype=object) == "censored")[
+            outcome.indices.to_numpy(zero_copy_only=False)]
+        if censored.any() and t[censored].min() < g[-1]:
+            raise ValueError(f"an orbit was censored at t = {t[censored].min():g} < max(t_grid) = {g[-1]:g}: "
+                             "use survival_curve (Kaplan–Meier) for this run")
+        dead += np.bincount(np.searchsorted(g, t[~censored], side="left"), minlength=g.size + 1)
+        n += t.size
+    if n == 0:
+        raise ValueError("empty sample: no lifetimes")
+    P = 1.0 - np.cumsum(dead)[: g.size] / n
+    return SurvivalCurve(g.copy(), P, np.sqrt(np.clip(P * (1.0 - P), 0.0, None) / n))
+
+
 def read_lifetimes(run_dir, columns=None, filters=None):
     """read_lifetimes(run_dir, columns=None, filters=None) -> pandas.DataFrame of the lifetimes table.
 
     ``columns`` projects (only those columns are read); ``filters`` is a
     pyarrow.dataset expression. ``outcome`` comes back as str, ``exit_channel``
-    as nullable Int8.
+    as nullable Int8. A grid run adds the partition columns ``energy`` and
+    ``gamma`` (filter on them to read one point: ``ds.field("energy") == 0.3``).
     """
     return _read(run_dir, "lifetimes", columns, filters)
 

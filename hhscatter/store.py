@@ -1,0 +1,245 @@
+"""Where a run's files live: a local directory or any URL pyarrow/fsspec can write.
+
+``Store(out)`` wraps the output location of a run so that the runner, its
+workers (local processes or Dask workers on other machines) and the table
+readers use one set of operations:
+
+* a local path (``runs/x``, ``/data/x`` or ``file:///data/x``) is written with
+  plain ``os`` calls, each file to a temporary name, fsync'ed and renamed, and
+  the directory fsync'ed after the rename, so a crash (even a power cut) never
+  leaves a half-written file under a final name;
+* a URL (``s3://bucket/x``, ``gs://…``, ``hdfs://…``, ``memory://x`` or any
+  other protocol fsspec knows) goes through ``pyarrow.fs``: pyarrow's own
+  filesystems first, fsspec's (wrapped in ``pyarrow.fs.FSSpecHandler``) for the
+  rest. The file is written to a temporary name and moved; on object stores
+  an object only appears once its upload completes, which gives the same
+  guarantee.
+
+A ``Store`` pickles as its URL, so it travels to worker processes cheaply.
+"""
+from __future__ import annotations
+
+import json
+import os
+import posixpath
+from pathlib import Path
+
+TMP_MARK = ".tmp-"  # temporary files are ".<final name>.tmp-<pid>"
+
+
+def _is_url(out) -> bool:
+    return isinstance(out, str) and "://" in out and not out.startswith("file://")
+
+
+class Store:
+    """Store(out) -> output location; ``out`` a local path or a URL (see module doc)."""
+
+    def __init__(self, out):
+        if isinstance(out, Store):
+            out = out.url
+        self.url = str(out)
+        self.local = not _is_url(out)
+        if self.local:
+            p = self.url.removeprefix("file://")
+            self.root = str(Path(p).expanduser().resolve())
+            self._fs = None
+        else:
+            self._fs, self.root = _filesystem(self.url)
+            self.root = self.root.rstrip("/")
+
+    def __reduce__(self):
+        return (Store, (self.url,))
+
+    def __repr__(self):
+        return f"Store({self.url!r})"
+
+    # -- paths ---------------------------------------------------------------
+    def path(self, *parts) -> str:
+        """path(*parts) -> full path (local path or filesystem path) of root/parts."""
+        return posixpath.join(self.root, *[str(p) for p in parts if p]) if not self.local else \
+            os.path.join(self.root, *[str(p) for p in parts if p])
+
+    def display(self, rel: str = "") -> str:
+        """A path as the user gave it (URL kept), for messages."""
+        if not rel:
+            return self.url
+        return self.url.rstrip("/") + "/" + rel if not self.local else os.path.join(self.url, rel)
+
+    @property
+    def filesystem(self):
+        """pyarrow filesystem for pyarrow.dataset / parquet calls (None for local paths)."""
+        return self._fs
+
+    # -- queries -------------------------------------------------------------
+    def exists(self, rel: str = "") -> bool:
+        if self.local:
+            return os.path.exists(self.path(rel))
+        import pyarrow.fs as pafs
+
+        return self._fs.get_file_info(self.path(rel)).type != pafs.FileType.NotFound
+
+    def is_dir(self, rel: str = "") -> bool:
+        if self.local:
+            return os.path.isdir(self.path(rel))
+        import pyarrow.fs as pafs
+
+        return self._fs.get_file_info(self.path(rel)).type == pafs.FileType.Directory
+
+    def listdir(self, rel: str = "") -> list[str]:
+        """listdir(rel) -> names (not paths) directly under root/rel; [] if missing."""
+        if self.local:
+            try:
+                return sorted(os.listdir(self.path(rel)))
+            except (FileNotFoundError, NotADirectoryError):
+                return []
+        import pyarrow.fs as pafs
+
+        if not self.is_dir(rel):
+            return []
+        infos = self._fs.get_file_info(pafs.FileSelector(self.path(rel), recursive=False))
+        return sorted(posixpath.basename(i.path.rstrip("/")) for i in infos)
+
+    def files(self, rel: str = "", *, recursive: bool = True) -> list[str]:
+        """files(rel) -> relative paths (to root/rel) of all files below root/rel, sorted."""
+        base = self.path(rel)
+        if self.local:
+            out = []
+            for dirpath, _, names in os.walk(base):
+                for n in names:
+                    out.append(os.path.relpath(os.path.join(dirpath, n), base).replace(os.sep, "/"))
+                if not recursive:
+                    break
+            return sorted(out)
+        import pyarrow.fs as pafs
+
+        if not self.is_dir(rel):
+            return []
+        infos = self._fs.get_file_info(pafs.FileSelector(base, recursive=recursive))
+        return sorted(posixpath.relpath(i.path, base) for i in infos if i.type == pafs.FileType.File)
+
+    def read_text(self, rel: str) -> str:
+        if self.local:
+            return Path(self.path(rel)).read_text()
+        with self._fs.open_input_stream(self.path(rel)) as fh:
+            return fh.read().decode()
+
+    def open_input(self, rel: str):
+        """open_input(rel) -> a random-access file for pyarrow.parquet."""
+        if self.local:
+            return self.path(rel)
+        return self._fs.open_input_file(self.path(rel))
+
+    # -- changes -------------------------------------------------------------
+    def makedirs(self, rel: str = ""):
+        if self.local:
+            os.makedirs(self.path(rel), exist_ok=True)
+        else:
+            self._fs.create_dir(self.path(rel), recursive=True)
+
+    def remove(self, rel: str):
+        """Delete a file or a whole directory tree under root (missing: no-op)."""
+        if self.local:
+            import shutil
+
+            p = self.path(rel)
+            if os.path.isdir(p):
+                shutil.rmtree(p)
+            elif os.path.lexists(p):
+                os.unlink(p)
+            return
+        if self.is_dir(rel):
+            self._fs.delete_dir(self.path(rel))
+        elif self.exists(rel):
+            self._fs.delete_file(self.path(rel))
+
+    def write_atomic(self, rel: str, write) -> None:
+        """write_atomic(rel, write) -> None: ``write(target, filesystem)`` writes a temp file, then rename.
+
+        ``target`` is a path (local) or a path on ``filesystem``. On any
+        failure the temporary file is removed and the error propagates; a
+        previous file under the final name is never touched until the rename.
+        """
+        final = self.path(rel)
+        head, name = (os.path.split(final) if self.local else posixpath.split(final))
+        tmp = (os.path.join if self.local else posixpath.join)(head, f".{name}{TMP_MARK}{os.getpid()}")
+        self.makedirs(os.path.dirname(rel) if self.local else posixpath.dirname(rel))
+        try:
+            write(tmp, self._fs)
+            if self.local:
+                with open(tmp, "rb") as fh:
+                    os.fsync(fh.fileno())
+                os.replace(tmp, final)
+                _fsync_dir(head)
+            else:
+                self._fs.move(tmp, final)
+        except BaseException:
+            try:
+                if self.local:
+                    if os.path.exists(tmp):
+                        os.unlink(tmp)
+                elif self.exists(posixpath.relpath(tmp, self.root)):
+                    self._fs.delete_file(tmp)
+            except OSError:
+                pass
+            raise
+
+    def write_text(self, rel: str, text: str) -> None:
+        """Write a small text file atomically."""
+
+        def write(target, fs):
+            if fs is None:
+                with open(target, "w") as fh:
+                    fh.write(text)
+            else:
+                with fs.open_output_stream(target) as fh:
+                    fh.write(text.encode())
+
+        self.write_atomic(rel, write)
+
+    def write_json(self, rel: str, doc) -> None:
+        self.write_text(rel, json.dumps(doc, indent=2, sort_keys=True))
+
+    def remove_temporaries(self, rel: str = "") -> int:
+        """Delete temporary files left by killed writers below root/rel; return how many."""
+        n = 0
+        for f in self.files(rel):
+            base = posixpath.basename(f)
+            if base.startswith(".") and TMP_MARK in base:
+                self.remove(posixpath.join(rel, f) if rel else f)
+                n += 1
+        return n
+
+
+def _fsync_dir(path):
+    """fsync a directory so a rename in it survives a power cut (no-op where unsupported)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _filesystem(url: str):
+    """_filesystem(url) -> (pyarrow.fs.FileSystem, path): pyarrow's own first, then fsspec's."""
+    import pyarrow.fs as pafs
+
+    try:
+        return pafs.FileSystem.from_uri(url)
+    except Exception:  # noqa: BLE001, S110 - pyarrow lacks this protocol (or its build lacks it): try fsspec
+        pass
+    try:
+        import fsspec
+    except ImportError:
+        raise ValueError(
+            f"out: {url!r}: pyarrow cannot open this URL and fsspec is not installed (pip install fsspec)"
+        ) from None
+    try:
+        fs, path = fsspec.core.url_to_fs(url)
+    except (ValueError, ImportError) as exc:
+        raise ValueError(f"out: {url!r}: no filesystem for this URL ({exc})") from None
+    return pafs.PyFileSystem(pafs.FSSpecHandler(fs)), path
