@@ -1,0 +1,59 @@
+"""Configs of ``make bench`` / ``make stress``: ``studies/<name>/<name>.toml`` with ``[scale.<s>.*]`` overrides."""
+from __future__ import annotations
+
+import copy
+import os
+import tomllib
+from pathlib import Path
+
+SCALES = ("full", "tiny")
+
+
+def studies_root() -> Path:
+    """studies_root() -> Path of ``studies/`` (env ``HHSCATTER_STUDIES`` overrides, as the study framework)."""
+    env = os.environ.get("HHSCATTER_STUDIES")
+    return Path(env) if env else Path(__file__).resolve().parents[2] / "studies"
+
+
+def _merge(base, over):
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else copy.deepcopy(v)
+    return out
+
+
+def load_config(name: str, scale: str = "full", root=None) -> dict:
+    """load_config(name, scale='full', root=None) -> dict: ``studies/<name>/<name>.toml`` merged with its scale.
+
+    Raises ValueError naming ``scale`` for an unknown scale, FileNotFoundError for a missing file.
+    """
+    if scale not in SCALES:
+        raise ValueError(f"scale must be one of {SCALES}, got {scale!r}")
+    path = Path(root or studies_root()) / name / f"{name}.toml"
+    if not path.exists():
+        raise FileNotFoundError(f"config not found: {path}")
+    with open(path, "rb") as fh:
+        cfg = tomllib.load(fh)
+    scales = cfg.pop("scale", {})
+    if scale != "full":
+        cfg = _merge(cfg, scales.get(scale, {}))
+    cfg["_scale"] = scale
+    cfg["_path"] = str(path)
+    return cfg
+
+
+def out_dir(name: str, scale: str, root=None) -> Path:
+    """out_dir(name, scale, root=None) -> ``studies/<name>/out/<scale>/`` (created)."""
+    p = Path(root or studies_root()) / name / "out" / scale
+    p.mkdir(parents=True, exist_ok=True)
+    return p
+
+
+def machine_note() -> str:
+    """One line on the machine's state: cores and load average (timings are taken under load)."""
+    try:
+        la = os.getloadavg()
+        load = f"load average {la[0]:.2f}, {la[1]:.2f}, {la[2]:.2f}"
+    except OSError:
+        load = "load average unknown"
+    return f"{os.cpu_count()} cores, {load}"
