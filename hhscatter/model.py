@@ -20,6 +20,10 @@ import numpy as np
 class HenonHeiles:
     """HenonHeiles(omega=1.0, lam=1.0) -> the potential's constants.
 
+    The potential V of Eq. (eqn:hh_potential) and the Hamiltonian H of
+    Eq. (eq:H); the paper fixes ω = λ = 1 (Sec. II.B "Model System"), for which
+    E_c = 1/6 and the saddles lie at distance 1 (Sec. II.B "Scattering dynamics").
+
     Requires ω > 0 and λ > 0 (for λ < 0 the potential is the mirror image
     y → −y; use λ > 0 and reflect the data instead).
     """
@@ -121,7 +125,11 @@ def equations(model: HenonHeiles, gamma_par=None):
 
 
 def hamilton_equations(model: HenonHeiles):
-    """hamilton_equations(model) -> [(x, ∂H/∂px), ..., (py, −∂H/∂y)] straight from ``hy.diff``."""
+    """hamilton_equations(model) -> [(x, ∂H/∂px), ..., (py, −∂H/∂y)] straight from ``hy.diff``.
+
+    Hamilton's equations of H, Eq. (eqn:hh_ham), derived symbolically: the
+    reference against which the hand-simplified :func:`equations` is tested.
+    """
     import heyoka as hy
 
     (x, y, px, py), _, H = model.expressions()

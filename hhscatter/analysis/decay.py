@@ -15,9 +15,12 @@ Functions here are pure (no file I/O, no plotting):
 
 * :func:`mean_energy` / :func:`mean_energy_arrays` — ⟨E⟩, σ_E and its standard
   error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
+* :func:`pool_mean_energy` — the same statistics pooled over several tables
+  (e.g. one per part file, so that N = 10^7 never sits in memory at once);
 * :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the paper's
   model) and with a free intercept (the local exponent);
 * :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
+* :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits);
 * :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
 
 Units: the model's natural units (unit mass); t in time units, E in energy
@@ -33,6 +36,7 @@ import pandas as pd
 __all__ = [
     "EnergyDecayFit",
     "EnergyHistograms",
+    "bootstrap_mu",
     "energy_histograms",
     "energy_histograms_arrays",
     "fit_energy_decay",
@@ -40,6 +44,7 @@ __all__ = [
     "mean_energy",
     "mean_energy_arrays",
     "mu_by_window",
+    "pool_mean_energy",
 ]
 
 
@@ -97,6 +102,37 @@ def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
     Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
     """
     return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
+
+
+def pool_mean_energy(tables) -> pd.DataFrame:
+    """pool_mean_energy(tables) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    Combines outputs of :func:`mean_energy` computed on disjoint sets of
+    snapshot rows (e.g. one per part file) into the statistics of their
+    union, exactly (up to rounding) as :func:`mean_energy` of the
+    concatenated rows: per grid time n = Σ n_i, mean = Σ n_i m_i / n and the
+    pooled sum of squared deviations Σ [(n_i − 1) s_i² + n_i (m_i − mean)²]
+    (Chan et al.'s parallel variance), so memory stays O(grid) for any N.
+    """
+    tabs = [t for t in tables if len(t)]
+    cols = ["t", "n", "mean_E", "std_E", "sem_E", "lo_3sigma", "hi_3sigma"]
+    if not tabs:
+        return pd.DataFrame({c: pd.Series(dtype=float) for c in cols})
+    d = pd.concat([t[["t", "n", "mean_E", "std_E"]] for t in tabs], ignore_index=True)
+    d["n"] = d["n"].astype(float)
+    d["s1"] = d["n"] * d["mean_E"]
+    d["m2"] = np.where(d["n"] > 1, (d["n"] - 1) * d["std_E"].fillna(0.0) ** 2, 0.0)
+    g = d.groupby("t", sort=True)
+    n_s = g["n"].sum()
+    mean_s = g["s1"].sum() / n_s
+    d["dev"] = d["n"] * (d["mean_E"] - d["t"].map(mean_s)) ** 2
+    m2 = (d.groupby("t", sort=True)["m2"].sum() + d.groupby("t", sort=True)["dev"].sum()).to_numpy()
+    n, mean = n_s.to_numpy(), mean_s.to_numpy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = np.where(n > 1, np.sqrt(m2 / np.maximum(n - 1, 1)), np.nan)
+        sem = std / np.sqrt(n)
+    return pd.DataFrame({"t": n_s.index.to_numpy(dtype=float), "n": n.astype(np.int64), "mean_E": mean,
+                         "std_E": std, "sem_E": sem, "lo_3sigma": mean - 3 * std, "hi_3sigma": mean + 3 * std})
 
 
 # ---------------------------------------------------------------------------
@@ -367,3 +403,59 @@ def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistogra
     ``snapshots`` table (columns ``traj_id, t, energy``).
     """
     return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)
+
+
+# ---------------------------------------------------------------------------
+# bootstrap over orbits
+# ---------------------------------------------------------------------------
+def bootstrap_mu(
+    traj_id,
+    t,
+    energy,
+    E0: float,
+    gamma: float,
+    windows,
+    *,
+    n_boot: int = 200,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """bootstrap_mu(traj_id, t, energy, E0, gamma, windows, n_boot=200, seed=0) -> DataFrame.
+
+    Bootstrap over orbits of the unweighted log fits of :func:`fit_energy_decay`
+    (Eq. (eqn:energy_exp_decay)) on each window: every replicate redraws the
+    ensemble by giving each orbit (all its snapshot rows together) a
+    Poisson(1) multiplicity — the large-N limit of resampling N orbits with
+    replacement, which keeps the correlation of one orbit's energies across
+    times — recomputes ⟨E⟩(t) and refits.  The standard deviation of a column
+    over replicates is the statistical (sampling) error of that estimate;
+    the fit's own ``mu_err`` measures the misfit of the model instead.
+
+    Parameters: ``traj_id``, ``t``, ``energy`` the rows of a snapshots table
+    (orbit id, grid time, energy); ``windows`` a list of (t_lo, t_hi).
+    Returns one row per (replicate, window): ``replicate, t_lo, t_hi, mu,
+    mu_free`` (dimensionless).
+    """
+    if n_boot < 1:
+        raise ValueError(f"n_boot must be ≥ 1, got {n_boot!r}")
+    tid = np.asarray(traj_id).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if not (tid.shape == t.shape == e.shape):
+        raise ValueError("traj_id, t and energy must have the same length")
+    ok = np.isfinite(t) & np.isfinite(e)
+    tid, t, e = tid[ok], t[ok], e[ok]
+    _, orb = np.unique(tid, return_inverse=True)
+    grid, ti = np.unique(t, return_inverse=True)
+    n_orb = int(orb.max()) + 1 if orb.size else 0
+    rng = np.random.default_rng(seed)
+    rows = []
+    for b in range(n_boot):
+        w = rng.poisson(1.0, n_orb).astype(float)[orb]
+        n_t = np.bincount(ti, weights=w, minlength=grid.size)
+        s_t = np.bincount(ti, weights=w * e, minlength=grid.size)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(n_t > 0, s_t / n_t, np.nan)
+        for lo, hi in windows:
+            f = fit_energy_decay(grid, mean, E0, gamma, (lo, hi))
+            rows.append({"replicate": b, "t_lo": float(lo), "t_hi": float(hi), "mu": f.mu, "mu_free": f.mu_free})
+    return pd.DataFrame(rows, columns=["replicate", "t_lo", "t_hi", "mu", "mu_free"])

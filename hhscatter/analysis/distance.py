@@ -76,9 +76,12 @@ import pandas as pd
 __all__ = [
     "BootstrapResult",
     "agreement_scale",
+    "agreement_scale_debiased",
     "bootstrap_distance",
     "box_histograms",
+    "debiased_distance",
     "distance_vs_scale",
+    "first_crossings",
     "hellinger",
     "histogram_distance",
     "points",
@@ -101,6 +104,33 @@ class BootstrapResult(NamedTuple):
 def points(df: pd.DataFrame, columns=("x", "y")) -> np.ndarray:
     """points(df, columns=("x", "y")) -> (n, 2) float array, e.g. from the engine's ``sections`` table."""
     return np.column_stack([df[c].to_numpy(dtype=float) for c in columns])
+
+
+def first_crossings(sections: pd.DataFrame, t_from: float, *, e_min: float = -np.inf,
+                    e_max: float = np.inf) -> pd.DataFrame:
+    """first_crossings(sections, t_from, *, e_min=-inf, e_max=inf) -> DataFrame, one row per orbit.
+
+    For each ``traj_id`` of the engine's ``sections`` table (columns traj_id,
+    t, x, y, px, py, energy), its first crossing of the section ṙ = 0, φ̇ > 0
+    at orbit time t ≥ ``t_from``; orbits without such a crossing (escaped or
+    settled before it) are absent.  This is the sprinkler sample of the paper's
+    Fig. 1b (t_from = recording time) and the "first intersection for
+    t ≥ t*" of Fig. 5a (t_from = t*).  The energy filter is applied *after*
+    choosing the first crossing (Fig. 5b keeps "only the surviving points
+    whose energy at time of crossing t ≥ t* was in the interval"), so it
+    selects among the rows of Fig. 5a, it does not look further in time.
+    Requires every crossing after ``t_from`` to be in the table (a section
+    window starting at or before ``t_from``, not ``first_only`` with a later
+    start).  Rows sorted by traj_id.
+    """
+    need = {"traj_id", "t"}
+    if not need <= set(sections.columns):
+        raise ValueError(f"sections needs columns {sorted(need)}, has {sorted(sections.columns)}")
+    s = sections[sections["t"] >= t_from]
+    s = s.sort_values(["traj_id", "t"], kind="stable").drop_duplicates("traj_id", keep="first")
+    if "energy" in s.columns and (np.isfinite(e_min) or np.isfinite(e_max)):
+        s = s[(s["energy"] >= e_min) & (s["energy"] <= e_max)]
+    return s.reset_index(drop=True)
 
 
 def _as_points(X) -> np.ndarray:
@@ -193,8 +223,9 @@ def distance_vs_scale(
     kinds=KINDS,
     n_splits: int = 8,
     seed: int = 0,
+    m: int | None = None,
 ) -> pd.DataFrame:
-    """distance_vs_scale(P, Q, boxes, extent=None, *, kinds=("hellinger", "tv"), n_splits=8, seed=0) -> DataFrame.
+    """distance_vs_scale(P, Q, boxes, extent=None, *, kinds=("hellinger", "tv"), n_splits=8, seed=0, m=None) -> DataFrame.
 
     One row per box side ε in ``boxes`` (sorted decreasing) with columns
 
@@ -204,6 +235,12 @@ def distance_vs_scale(
       ``<kind>_pq_std``, ``<kind>_noise`` (split-half noise floor, mean of
       d(P1,P2), d(Q1,Q2)), ``<kind>_noise_std`` and ``<kind>_excess`` =
       pq − noise, over ``n_splits`` random splits (module docstring).
+
+    ``m`` fixes the common sample size of the split-half comparison (default
+    ⌊min(n_P, n_Q)/2⌋; it must not exceed that).  Since the noise floor and
+    hence the agreement scale depend on the sample size, comparisons of
+    several pairs of sets (e.g. several dissipation rates, Fig. 5) must use
+    one common ``m`` to be comparable.
 
     ``extent`` defaults to the bounding box of P ∪ Q; the same partition is
     used for every comparison.  Deterministic for a given ``seed``.
@@ -222,9 +259,14 @@ def distance_vs_scale(
         rows.append({"box": float(eps), **{k: fn[k](p, q) for k in kinds}})
     out = pd.DataFrame(rows)
     if n_splits > 0:
-        m = min(P.shape[0], Q.shape[0]) // 2
-        if m < 1:
+        m_max = min(P.shape[0], Q.shape[0]) // 2
+        if m_max < 1:
             raise ValueError("need at least 2 points in each set for the split-half baseline")
+        if m is None:
+            m = m_max
+        elif not 1 <= int(m) <= m_max:
+            raise ValueError(f"m must be in [1, {m_max}] = [1, ⌊min(n_P, n_Q)/2⌋], got {m!r}")
+        m = int(m)
         rng = np.random.default_rng(seed)
         pq = np.empty((n_splits, boxes.size, len(kinds)))
         nz = np.empty_like(pq)
@@ -233,10 +275,11 @@ def distance_vs_scale(
             P1, P2 = P[ip[:m]], P[ip[m : 2 * m]]
             Q1, Q2 = Q[iq[:m]], Q[iq[m : 2 * m]]
             for j, eps in enumerate(boxes):
+                # one histogram pair per comparison, shared by all kinds
+                h = [box_histograms(A, B, eps, extent) for A, B in ((P1, Q1), (P2, Q2), (P1, P2), (Q1, Q2))]
                 for i, k in enumerate(kinds):
-                    d = lambda A, B: fn[k](*box_histograms(A, B, eps, extent))  # noqa: E731
-                    pq[s, j, i] = 0.5 * (d(P1, Q1) + d(P2, Q2))
-                    nz[s, j, i] = 0.5 * (d(P1, P2) + d(Q1, Q2))
+                    pq[s, j, i] = 0.5 * (fn[k](*h[0]) + fn[k](*h[1]))
+                    nz[s, j, i] = 0.5 * (fn[k](*h[2]) + fn[k](*h[3]))
         out["m"] = m
         ddof = 1 if n_splits > 1 else 0
         for i, k in enumerate(kinds):
@@ -271,6 +314,59 @@ def agreement_scale(table: pd.DataFrame, kind: str = "hellinger", z: float = 2.0
         sigma = np.hypot(r[f"{kind}_noise_std"], r[f"{kind}_pq_std"])
         if r[f"{kind}_pq"] <= r[f"{kind}_noise"] + z * sigma:
             best = float(r["box"])
+        else:
+            break
+    return best
+
+
+def debiased_distance(table: pd.DataFrame, kind: str = "hellinger"):
+    """debiased_distance(table, kind="hellinger") -> (d, d_lo, d_hi) arrays, one per row (box side).
+
+    Finite-sample-corrected distance at each box side from a
+    :func:`distance_vs_scale` table: d = √max(d_pq² − d_noise², 0), the
+    split-half noise floor removed in quadrature, with a 1σ band (d_lo, d_hi)
+    from σ(d²) = 2 √((d_pq σ_pq)² + (d_noise σ_noise)²).  For Hellinger and
+    boxes holding many points, E[H²_pq] ≈ H²_true + E[H²_noise] when P ≈ Q
+    (both bias terms are B/8 · 2/m for B commonly occupied boxes), so d
+    estimates the distance between the two underlying distributions
+    coarse-grained at ε, nearly independent of the sample size m — unlike
+    d_pq − d_noise.  Where the supports differ, boxes occupied by one set only
+    carry no bias and d is slightly underestimated (by ≈ (B_noise − B_pq)/(4m)
+    in H²).  Dimensionless.
+    """
+    need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
+    if not need <= set(table.columns):
+        raise ValueError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
+    pq, sp = table[f"{kind}_pq"].to_numpy(float), table[f"{kind}_pq_std"].to_numpy(float)
+    nz, sn = table[f"{kind}_noise"].to_numpy(float), table[f"{kind}_noise_std"].to_numpy(float)
+    d2 = pq**2 - nz**2
+    s2 = 2.0 * np.hypot(pq * sp, nz * sn)
+    return (np.sqrt(np.maximum(d2, 0.0)), np.sqrt(np.maximum(d2 - s2, 0.0)), np.sqrt(np.maximum(d2 + s2, 0.0)))
+
+
+def agreement_scale_debiased(table: pd.DataFrame, delta: float = 0.1, kind: str = "hellinger",
+                             noise_max: float = 0.5):
+    """agreement_scale_debiased(table, delta=0.1, kind="hellinger", noise_max=0.5) -> float or None.
+
+    Like :func:`agreement_scale`, but with a tolerance instead of a
+    significance test: the smallest box side ε such that the
+    finite-sample-corrected distance (:func:`debiased_distance`) is ≤
+    ``delta`` at every informative box size ≥ ε (noise floor ≤ ``noise_max``).
+    Unlike the significance test, whose answer shrinks towards the
+    finest resolvable scale as samples grow, this estimates a property of the
+    two distributions ("they differ by less than δ down to scale ε*"), and so
+    can be compared between data sets of different sizes.  None if already
+    d > δ at the coarsest informative scale.  Units of the boxes.
+    """
+    d, _, _ = debiased_distance(table, kind)
+    order = np.argsort(-table["box"].to_numpy(float))
+    noise = table[f"{kind}_noise"].to_numpy(float)
+    best = None
+    for i in order:
+        if noise[i] > noise_max:
+            continue
+        if d[i] <= delta:
+            best = float(table["box"].to_numpy(float)[i])
         else:
             break
     return best

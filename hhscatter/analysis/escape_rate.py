@@ -9,6 +9,10 @@
 * :func:`escape_rate_from_lifetimes` — DataFrame wrapper;
 * :func:`fit_kappa_energy` — the piecewise κ(E) law of Fig. 2b with an
   estimated break energy;
+* :func:`choose_t_max` — a per-energy integration time t_max from a small pilot
+  ensemble, bounding the cost of long-lived and KAM-trapped orbits;
+* :func:`escaping_tail` — the power-law tail and τ* of Eq. (eqn:kappa_nonhyperbolic)
+  on the orbits that leave before t_max (KAM-trapped orbits removed);
 * :func:`kappa_from_cmeasure` — κ from the c-measure of the true-time map,
   Eq. (eqn:kappa_cmeasure_truetime); :func:`cmeasure_sample_from_sections`
   builds its input from the engine's ``sections`` table.
@@ -42,16 +46,20 @@ from .survival import (
 __all__ = [
     "CMeasureKappa",
     "EscapeRateResult",
+    "EscapingTail",
     "KappaEnergyFit",
     "MLERate",
     "WindowChoice",
+    "choose_t_max",
     "choose_windows",
     "cmeasure_sample_from_sections",
     "escape_rate",
     "escape_rate_from_lifetimes",
     "escape_rate_mle",
+    "escaping_tail",
     "fit_kappa_energy",
     "kappa_from_cmeasure",
+    "power_law_exponent_mle",
 ]
 
 E_C_HH = 1.0 / 6.0  # critical energy of the Hénon–Heiles potential with ω = λ = 1
@@ -118,6 +126,25 @@ def _runs_arrays(c, inside, gap):
     return starts, ends
 
 
+def _first_long_segment(c, inside, b, e, min_len):
+    """Start index of the first unbroken inside-segment of length ≥ min_len (in c) within the run [b, e].
+
+    Runs merge holes shorter than the smoothing width; at the *start* of a run
+    that lets a short accidental agreement (e.g. the secant over the flat
+    first time units and the fast early escape averaging to κ) be joined to
+    the true plateau across the hole of the early regime, which would put τ0
+    inside the irregular regime.  Returns b when no segment is long enough.
+    """
+    idx = np.flatnonzero(inside[b : e + 1]) + b
+    if idx.size == 0:
+        return b
+    cut = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.concatenate([[idx[0]], idx[cut + 1]])
+    ends = np.concatenate([idx[cut], [idx[-1]]])
+    long_enough = np.flatnonzero(c[ends] - c[starts] >= min_len)
+    return int(starts[long_enough[0]]) if long_enough.size else b
+
+
 def _runs(c, inside, gap):
     """Runs of :func:`_runs_arrays` as a list of (start, end)."""
     st, en = _runs_arrays(c, inside, gap)
@@ -179,7 +206,10 @@ def choose_windows(
        most with the previous one.
     5. τ0 = first centre of the plateau, i.e. the first time after which the
        local slope *stays* within tolerance (t[0] if that is the first centre
-       available); t_stop = last centre of the plateau, i.e. where the slope
+       available): leading pieces of the run shorter than w/2 that are joined
+       to the rest only across a hole are dropped (an accidental agreement of
+       the secant over the flat start and the fast early escape must not
+       pull τ0 back into the irregular regime); t_stop = last centre of the plateau, i.e. where the slope
        leaves the band for good (the onset of a power-law tail, or any other
        change of regime), or t_floor when the plateau reaches the floor.
     6. Windows, with L = t_stop − τ0: full [τ0, t_stop], first half
@@ -251,6 +281,7 @@ def choose_windows(
         length = [c[e] - c[b] for b, e in runs]
         k = max(range(len(runs)), key=lambda i: (overlap[i], length[i], -i))
         b, e = runs[k]
+        b = _first_long_segment(c, inside, b, e, 0.5 * w)
         tau0 = float(t[0]) if b == 0 else float(c[b])
         t_stop = float(t_floor) if e == c.size - 1 else float(c[e])
         sel = inside[b : e + 1]
@@ -337,6 +368,25 @@ def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
     kappa = D / exposure if exposure > 0 else math.nan
     err = kappa / math.sqrt(D) if D > 0 else math.nan
     return MLERate(kappa, err, D, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop))
+
+
+def power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate:
+    """power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate with ``kappa`` = z, ``kappa_err``.
+
+    Maximum-likelihood exponent z of an algebraic survival P ∝ t^{−z}
+    (Eq. (eqn:kappa_nonhyperbolic), hazard z/t) on [t_start, t_stop] (time
+    units, t_start > 0), left-truncated at t_start and right-censored at
+    t_stop or at the orbit's censoring time: the constant-hazard MLE of
+    :func:`escape_rate_mle` in the variable log t,
+
+        ẑ = D / Σ_{t_end > t_start} log(min(t_end, t_stop)/t_start),   σ = ẑ/√D.
+
+    The result's ``exposure`` is that sum (dimensionless).
+    """
+    if not t_start > 0:
+        raise ValueError(f"t_start must be > 0 for a power law, got {t_start}")
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    return escape_rate_mle(np.log(np.maximum(t_end, 1e-300)), observed, math.log(t_start), math.log(t_stop))
 
 
 @dataclass(frozen=True)
@@ -457,6 +507,161 @@ def escape_rate_from_lifetimes(lifetimes, t_grid=None, **kwargs) -> EscapeRateRe
     """
     t_end, observed = lifetimes_to_arrays(lifetimes)
     return escape_rate(t_end, observed, t_grid, **kwargs)
+
+
+# ---------------------------------------------------------------------------
+# integration time per energy, and the tail of the escaping orbits
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TMaxChoice:
+    """Result of :func:`choose_t_max` (times in time units, κ in 1/time).
+
+    t_max          the chosen maximum orbit time of the main run
+    t_half         pilot median lifetime (first t with P ≤ 1/2)
+    t_tenth        first t with P ≤ 1/10 in the pilot (NaN if never reached)
+    kappa_pilot    constant-hazard MLE of the pilot on [t_half, t_tenth] (NaN if not measurable)
+    t_floor_pred   predicted time at which the main run keeps ``min_survivors`` survivors
+    reason         'rule' (formula used), 'cap' (formula exceeded t_cap) or 'slow'
+                   (the pilot never decayed to 1/10: t_cap)
+    """
+
+    t_max: float
+    t_half: float
+    t_tenth: float
+    kappa_pilot: float
+    t_floor_pred: float
+    reason: str
+
+
+def choose_t_max(
+    t_end,
+    observed,
+    n_main: int,
+    *,
+    min_survivors: float = 100.0,
+    margin_efolds: float = 3.0,
+    t_min: float = 100.0,
+    t_cap: float = 5000.0,
+    step: float = 10.0,
+) -> TMaxChoice:
+    """choose_t_max(t_end, observed, n_main, *, min_survivors=100, margin_efolds=3, t_min=100, t_cap=5000, step=10) -> TMaxChoice.
+
+    Maximum orbit time (time units) for a main run of ``n_main`` orbits at one
+    energy, from the lifetimes of a small pilot ensemble at the same energy.
+    It bounds the cost of the orbits that live long (near E_c) or never leave
+    (KAM-trapped orbits run to t_max) while keeping the whole range that the
+    κ fit of :func:`escape_rate` can use (it stops where fewer than
+    ``min_survivors`` orbits are left, :func:`choose_windows` step 0).
+
+    Rule
+    ----
+    1. Kaplan–Meier P(t) of the pilot; t_half = first t with P ≤ 1/2,
+       t_tenth = first t with P ≤ 1/10.  If the pilot never reaches 1/10,
+       t_max = ``t_cap`` (reason 'slow').
+    2. κ_p = constant-hazard MLE (:func:`escape_rate_mle`) on [t_half, t_tenth].
+    3. Assuming P = ½ e^{−κ_p (t − t_half)} after t_half, the main run keeps
+       ``min_survivors`` orbits until t_floor = t_half + ln(n_main / (2 min_survivors))/κ_p.
+    4. t_max = t_floor + ``margin_efolds``/κ_p, rounded up to a multiple of
+       ``step`` and clipped to [``t_min``, ``t_cap``].
+
+    If the decay slows down later than the pilot shows (stickiness), the fit
+    windows simply end earlier: censoring at t_max is handled by Kaplan–Meier,
+    never biasing P(t).
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed).ravel()
+    if not (isinstance(n_main, (int, np.integer)) and n_main > 0):
+        raise ValueError(f"n_main must be an integer > 0, got {n_main!r}")
+    if not (0 < t_min <= t_cap and step > 0 and margin_efolds >= 0 and min_survivors > 0):
+        raise ValueError("need 0 < t_min ≤ t_cap, step > 0, margin_efolds ≥ 0, min_survivors > 0")
+    curve = survival_curve(t_end, observed)
+    t, P = curve.t, curve.P
+
+    def first_below(level):
+        i = np.flatnonzero(P <= level)
+        return float(t[i[0]]) if i.size else math.nan
+
+    t_half, t_tenth = first_below(0.5), first_below(0.1)
+    if not math.isfinite(t_tenth) or not t_tenth > t_half:
+        return TMaxChoice(float(t_cap), t_half, t_tenth, math.nan, math.nan, "slow")
+    kp = escape_rate_mle(t_end, observed, t_half, t_tenth).kappa
+    if not (math.isfinite(kp) and kp > 0):
+        return TMaxChoice(float(t_cap), t_half, t_tenth, kp, math.nan, "slow")
+    t_floor = t_half + math.log(max(n_main / (2.0 * min_survivors), 1.0)) / kp
+    raw = t_floor + margin_efolds / kp
+    t_max = min(max(math.ceil(raw / step) * step, t_min), t_cap)
+    return TMaxChoice(float(t_max), t_half, t_tenth, float(kp), float(t_floor), "cap" if raw > t_cap else "rule")
+
+
+@dataclass(frozen=True)
+class EscapingTail:
+    """Result of :func:`escaping_tail`.
+
+    tail        :class:`PowerLawFit` of the algebraic tail of P_esc (None if not detected)
+    tau_star    crossover time τ* (time units) of ``exp_fit`` and the tail (NaN without either)
+    n_escaping  orbits that left before t_max;  n_trapped  orbits still inside at t_max
+    curve       the :class:`SurvivalCurve` P_esc(t) on the analysis grid
+    """
+
+    tail: PowerLawFit | None
+    tau_star: float
+    n_escaping: int
+    n_trapped: int
+    curve: SurvivalCurve = field(repr=False)
+
+
+def escaping_tail(
+    t_end,
+    observed,
+    tau0,
+    exp_fit=None,
+    t_grid=None,
+    *,
+    n_grid: int = 20001,
+    min_survivors: float = 30.0,
+    **tail_kwargs,
+) -> EscapingTail:
+    """escaping_tail(t_end, observed, tau0, exp_fit=None, t_grid=None, *, min_survivors=30, **tail_kwargs) -> EscapingTail.
+
+    Power-law tail f* t^{−z} and crossover time τ* of Eq.
+    (eqn:kappa_nonhyperbolic) measured on the orbits that leave before t_max.
+
+    Orbits on KAM tori never leave: with censoring at a common t_max they
+    add a constant P∞ to P(t), which ends every tail in a plateau and makes a
+    power-law fit meaningless once P ~ P∞.  Stickiness is a property of the
+    escaping orbits, so the tail is sought in
+
+        P_esc(t) = Pr(lifetime > t | leaves before t_max) = (P(t) − P∞)/(1 − P∞)
+
+    (the plain fraction of the observed lifetimes above t; exact when all
+    censoring happens at t_max).  :func:`detect_power_law_tail` decides after
+    ``tau0`` (time units) with a survivor floor ``min_survivors`` (default 30,
+    lower than the 100 of the κ windows because the tail lives in the last
+    thousands of orbits; Poisson error of log P ≤ 18 % there).  τ* =
+    :func:`crossover_time` of ``exp_fit`` (an :class:`ExponentialFit` of the
+    exponential regime, where P∞ ≪ P so that P and P_esc coincide) and the tail.
+    ``t_grid`` defaults to ``n_grid`` uniform points from 0 to the
+    10th-largest escape time.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed).ravel()
+    if observed.dtype != bool:
+        raise TypeError("observed must be a boolean mask")
+    t_esc = t_end[observed]
+    if t_esc.size < 10:
+        raise ValueError(f"escaping_tail needs ≥ 10 escaping orbits, got {t_esc.size}")
+    grid = _default_grid(t_esc, n_grid) if t_grid is None else np.asarray(t_grid, dtype=float)
+    curve = survival_curve(t_esc, np.ones(t_esc.size, dtype=bool), grid)
+    ok = np.isfinite(curve.P)
+    t, P, E = curve.t[ok], curve.P[ok], curve.P_err[ok]
+    kw = {"min_survivors": float(min_survivors), **tail_kwargs}
+    tail = detect_power_law_tail(t, P, tau0, E, n_total=t_esc.size, **kw)
+    tau_star = math.nan
+    if tail is not None and exp_fit is not None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            tau_star = crossover_time(t, P, exp_fit, tail)
+    return EscapingTail(tail, float(tau_star), int(t_esc.size), int(t_end.size - t_esc.size), curve)
 
 
 # ---------------------------------------------------------------------------
@@ -794,8 +999,9 @@ def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) ->
     )
 
 
-def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=math.inf):
-    """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf) -> (return_times, n_exit, n_undetermined).
+def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=math.inf,
+                                  drop_censored: bool = False):
+    """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf, drop_censored=False) -> (return_times, n_exit, n_undetermined).
 
     Builds the input of :func:`kappa_from_cmeasure` from the engine's tables
     (one conservative ensemble).  Every crossing in ``sections`` with
@@ -808,7 +1014,16 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
     t_to well before min(t_record_end, t_max) so that this count is ~0.
     ``sections`` must hold every crossing (SectionWindow without energy
     filter and first_only=False) from t_from to t_record_end.
+
+    ``drop_censored=True`` removes every orbit that is still inside at its
+    t_end (outcome 'censored') before sampling.  With t_max ≫ t_record_end
+    these are the orbits on KAM tori: they cross the section for ever, are
+    not part of the c-measure of the chaotic saddle, and would bias κ low by
+    their share of the late crossings.
     """
+    if drop_censored:
+        keep = lifetimes.loc[lifetimes["outcome"].astype(object) != "censored", "traj_id"]
+        sections = sections[sections["traj_id"].isin(keep)]
     s = sections[["traj_id", "t"]].sort_values(["traj_id", "t"], kind="stable")
     nxt = s.groupby("traj_id", sort=False)["t"].shift(-1)
     s = s.assign(t_next=nxt.to_numpy())

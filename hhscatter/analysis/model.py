@@ -96,6 +96,7 @@ __all__ = [
     "predict_tau1",
     "settling_rate",
     "survival_model",
+    "time_to_energy",
 ]
 
 E_C = 1.0 / 6.0
@@ -143,6 +144,22 @@ PAPER_KAPPA = PiecewiseKappa()
 def energy_path(t, E0: float, mu: float, gamma: float):
     """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
     return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
+
+
+def time_to_energy(E0, E1, mu, gamma):
+    """time_to_energy(E0, E1, mu, gamma) -> t* with E0 exp(−μγt*) = E1, i.e. ln(E0/E1)/(μγ).
+
+    Inverse of Eq. (eqn:energy_exp_decay); the paper's Fig. 5 time t* ≈ 17
+    for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
+    special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
+    """
+    E0, E1, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E1, mu, gamma)))
+    if np.any(E1 <= 0) or np.any(E0 < E1):
+        raise ValueError("need E0 >= E1 > 0")
+    if np.any(mu * gamma <= 0):
+        raise ValueError("need mu*gamma > 0")
+    out = np.log(E0 / E1) / (mu * gamma)
+    return float(out) if out.ndim == 0 else out
 
 
 def settling_rate(t, tau2: float, L: float, b: float):
@@ -984,6 +1001,9 @@ def fit_mixture_model(
     absolute_sigma: bool = True,
 ) -> SurvivalFit:
     """fit_mixture_model(t, P, P_err, components, *, kappa_of_E, tau0, ...) -> SurvivalFit.
+
+    The mixture model the paper proposes at the end of Sec. III.B.3: sub-ensembles
+    with their own energy-decay exponent μ, each following Eq. (eqn:surv_prob_model).
 
     Weighted least-squares fit of the mixture model (module docstring,
     :func:`mixture_survival_model`) to P(t) ± P_err, with the same data

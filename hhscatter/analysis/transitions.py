@@ -11,7 +11,10 @@
 
 The survival probability P(t) counts both ways of leaving: escape through a
 channel and settling (E(t) reaching E_c inside Ω), as in the paper's Fig. 4 (fig:survprob);
-survival curves themselves come from :mod:`hhscatter.analysis.survival`.
+survival curves themselves come from :mod:`hhscatter.analysis.survival`;
+:func:`survival_on_grid` is a weighted, binned variant used by
+:func:`bootstrap_transition_times` (paired bootstrap over orbits of τ0, τ1,
+τ2 for ensembles sharing their initial conditions).
 
 Units: model time units for all times; energies in model units.
 """
@@ -21,6 +24,9 @@ import numpy as np
 import pandas as pd
 
 __all__ = [
+    "bootstrap_transition_times",
+    "settle_time_quantiles",
+    "survival_on_grid",
     "tau1",
     "tau1_from_lifetimes",
     "tau2_observed",
@@ -135,7 +141,11 @@ def tau2_observed_arrays(t_end, outcome):
 
 
 def tau2_observed(lifetimes: pd.DataFrame):
-    """tau2_observed(lifetimes) -> float or None: min ``t_end`` over settled orbits, see :func:`tau2_observed_arrays`."""
+    """tau2_observed(lifetimes) -> float or None: min ``t_end`` over settled orbits, see :func:`tau2_observed_arrays`.
+
+    The observed τ2 of the paper's Fig. 6b caption: "the first time at which
+    the energy of a non-escaping orbit dropped below E_c".
+    """
     return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy())
 
 
@@ -157,3 +167,125 @@ def tau2_predicted(E0, E_c, mu, gamma):
         out = np.log(E0 / E_c) / rate
     out = np.where(E0 <= E_c, 0.0, np.where(rate == 0, np.inf, out))
     return float(out) if out.ndim == 0 else out
+
+
+# ---------------------------------------------------------------------------
+# survival on a grid with orbit weights, and the bootstrap of τ0, τ1, τ2
+# ---------------------------------------------------------------------------
+def survival_on_grid(t_end, observed, grid, weights=None):
+    """survival_on_grid(t_end, observed, grid, weights=None) -> array P(grid).
+
+    Kaplan–Meier survival probability P(t) = Pr(lifetime > t) on an
+    increasing ``grid`` (time units), with optional non-negative orbit
+    ``weights`` (e.g. bootstrap multiplicities); O(N) with binning.  An
+    orbit leaving at t_end counts as gone at every grid time ≥ t_end
+    (right-continuous P).  Censoring is resolved to the grid: an orbit
+    censored inside (g[j−1], g[j]] is at risk for that whole bin.  Without
+    censoring before grid[-1] (all of this project's dissipative runs, and
+    t_max-censoring in general) the result is exactly the weighted fraction
+    Σ w·1(t_end > g) / Σ w, i.e. :func:`hhscatter.analysis.survival.survival_curve`
+    at the grid times.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed, dtype=bool).ravel()
+    g = np.asarray(grid, dtype=float).ravel()
+    if t_end.shape != observed.shape:
+        raise ValueError("t_end and observed differ in length")
+    if g.size and np.any(np.diff(g) <= 0):
+        raise ValueError("grid must be strictly increasing")
+    w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
+    if w.shape != t_end.shape or np.any(w < 0):
+        raise ValueError("weights must be non-negative and as long as t_end")
+    j = np.searchsorted(g, t_end, side="left")  # g[j-1] < t_end <= g[j]
+    nb = g.size + 1
+    d = np.bincount(j[observed], weights=w[observed], minlength=nb)[: g.size]
+    c = np.bincount(j[~observed], weights=w[~observed], minlength=nb)[: g.size]
+    at_risk = w.sum() - np.concatenate([[0.0], np.cumsum(d + c)[:-1]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q = np.where(at_risk > 0, 1.0 - d / at_risk, 1.0)
+    return np.cumprod(np.clip(q, 0.0, 1.0))
+
+
+def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
+    """settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None) -> array or None.
+
+    (Weighted) quantiles of the settling times (t_end of 'settled' orbits):
+    a robust companion of the observed τ2, whose minimum depends on the
+    ensemble size N (the first of N·f_ne settlers).  None if nobody settled.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    s = np.asarray(outcome).ravel() == "settled"
+    w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
+    s &= w > 0
+    if not s.any():
+        return None
+    order = np.argsort(t_end[s])
+    ts, ws = t_end[s][order], w[s][order]
+    cw = np.cumsum(ws) / ws.sum()
+    idx = np.minimum(np.searchsorted(cw, np.asarray(qs, dtype=float), side="left"), ts.size - 1)
+    return ts[idx]
+
+
+def bootstrap_transition_times(
+    curves: dict,
+    reference,
+    grid,
+    *,
+    tau0,
+    alpha: float = 2.0,
+    n_boot: int = 200,
+    seed: int = 0,
+    settle_q=(0.01, 0.5),
+) -> pd.DataFrame:
+    """bootstrap_transition_times(curves, reference, grid, *, tau0, alpha=2, n_boot=200, seed=0) -> DataFrame.
+
+    Paired bootstrap over orbits of τ0, τ1 (Eq. (eqn:tau1)) and the observed τ2
+    for ensembles that share their initial conditions (the same seed for
+    every γ, as in the paper's Fig. 4): each replicate gives orbit i the same
+    Poisson(1) multiplicity in every ensemble, so the correlation between
+    P_γ and P_0 built from the same orbits is kept.
+
+    ``curves``: {label: (t_end, outcome)} with arrays aligned by orbit (same
+    length N, same order); ``reference``: the label of the conservative
+    ensemble (P_0).  ``tau0``: a float, or a callable ``tau0(grid, P_0, n)``
+    returning τ0 from the replicate's P_0 (n = effective ensemble size) —
+    e.g. the data-driven rule of :func:`hhscatter.analysis.escape_rate.choose_windows`.
+    Returns one row per (replicate, label != reference): ``replicate, label,
+    tau0, tau1, tau2_obs, t_settle_q<q>...`` (NaN where undefined).
+    """
+    if reference not in curves:
+        raise ValueError(f"reference {reference!r} is not one of the curves {list(curves)}")
+    if n_boot < 1:
+        raise ValueError(f"n_boot must be ≥ 1, got {n_boot!r}")
+    arrs = {}
+    n = None
+    for lab, (t_end, outcome) in curves.items():
+        t_end = np.asarray(t_end, dtype=float).ravel()
+        outcome = np.asarray(outcome).ravel()
+        if n is None:
+            n = t_end.size
+        if t_end.size != n or outcome.size != n:
+            raise ValueError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
+        arrs[lab] = (t_end, outcome, outcome != "censored")
+    g = np.asarray(grid, dtype=float)
+    rng = np.random.default_rng(seed)
+    qcols = [f"t_settle_q{q:g}" for q in settle_q]
+    rows = []
+    for b in range(n_boot):
+        w = rng.poisson(1.0, n).astype(float)
+        t_r, _, obs_r = arrs[reference]
+        P0 = survival_on_grid(t_r, obs_r, g, w)
+        t0 = float(tau0(g, P0, float(w.sum()))) if callable(tau0) else float(tau0)
+        for lab, (t_end, outcome, obs) in arrs.items():
+            if lab == reference:
+                continue
+            Pg = survival_on_grid(t_end, obs, g, w)
+            t1 = tau1(g, Pg, P0, t0, alpha)
+            sel = (outcome == "settled") & (w > 0)
+            t2 = float(t_end[sel].min()) if sel.any() else np.nan
+            qv = settle_time_quantiles(t_end, outcome, settle_q, w)
+            row = {"replicate": b, "label": lab, "tau0": t0, "tau1": np.nan if t1 is None else t1, "tau2_obs": t2}
+            vals = [np.nan] * len(qcols) if qv is None else [float(v) for v in qv]
+            row.update(dict(zip(qcols, vals)))
+            rows.append(row)
+    return pd.DataFrame(rows, columns=["replicate", "label", "tau0", "tau1", "tau2_obs", *qcols])

@@ -1,0 +1,96 @@
+"""Fig 3 (paper fig:energy_decay): ⟨E⟩(t) with a 3σ ribbon, the exponential fit, energy histograms,
+and the local decay exponent μ(t).  Plot functions draw what they are given and compute nothing."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _pyplot
+
+E_C = 1.0 / 6.0
+HIST_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")
+
+
+def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
+    """plot_fig3(me, tab, hist, numbers, path) -> None; writes the two-panel Fig. 3.
+
+    ``me``: table fig3_mean_energy (t, mean_E, lo_3sem, hi_3sem, fit_E,
+    mean_E_above, n, n_above); ``tab``: fig3_mu_windows (kind, t_lo, t_hi,
+    t_mid, mu, mu_err, mu_free, mu_free_err); ``hist``: fig3_histograms (long
+    format, t, e_lo, e_hi, density_log10E); ``numbers``: fig3.json;
+    ``t_max``: right end of the time axis (default: the last grid time).
+    (a) ⟨E⟩(t) on a log axis, ribbon ±3 standard errors, dashed fit
+    E0 e^{−μγt} on the fit window, E_c dotted, coloured dots at the histogram
+    times; inset: histograms of log10 E at those times.  (b) local exponent
+    μ (free-intercept slope of log⟨E⟩ on sliding windows) against t, with
+    the fitted μ on [0, 200], the paper's 0.91 and the linear-regime value 1.
+    """
+    plt = _pyplot()
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(6.4, 7.4), height_ratios=[2.3, 1], sharex=True,
+                                 constrained_layout=True)
+    mu = numbers["mu"]["value"]
+    mu_err = numbers["mu"]["err"]
+    E0, gamma = numbers["E0"], numbers["gamma"]
+    w_lo, w_hi = numbers["fit_window"]
+
+    t = me["t"].to_numpy()
+    ax.fill_between(t, me["lo_3sem"], me["hi_3sem"], color="#4f81bd", alpha=0.35, lw=0,
+                    label=r"$\pm 3\sigma$ (std. error of the mean)")
+    ax.plot(t, me["mean_E"], color="#0b2f6b", lw=1.6, label=r"$\langle E\rangle(t)$, orbits inside $\Omega$")
+    above = me["n_above"].to_numpy() >= 20
+    ax.plot(t[above], me["mean_E_above"].to_numpy()[above], color="#2ca02c", lw=1.2, ls="-.", zorder=4,
+            label=r"orbits with $E>E_c$ only")
+    inwin = (t >= w_lo) & (t <= w_hi)
+    ax.plot(t[inwin], me["fit_E"].to_numpy()[inwin], "--", color="#d62728", lw=1.6,
+            label=rf"$E_0e^{{-\mu\gamma t}}$, $\mu={mu:.4f}\pm{mu_err:.4f}$ on [{w_lo:g}, {w_hi:g}]")
+    ax.plot(t[t > w_hi], me["fit_E"].to_numpy()[t > w_hi], ":", color="#d62728", lw=1.0)
+    ax.axhline(E_C, color="k", ls=":", lw=0.9)
+    t_right = float(t[-1] if t_max is None else t_max)
+    ax.set_xlim(-0.01 * t_right, t_right)
+    vis = t <= t_right
+    ax.set_ylim(0.6 * float(me["mean_E"][vis].min()), 0.45)
+    ax.text(0.3 * t_right, E_C * 1.04, r"$E_c=1/6$", ha="left", va="bottom", fontsize=8)
+    ts = sorted(hist["t"].unique())
+    for k, tk in enumerate(ts):
+        i = int(np.argmin(np.abs(t - tk)))
+        ax.plot(t[i], me["mean_E"].iloc[i], "o", ms=6.5, color=HIST_COLORS[k % 6], mec="k", mew=0.6, zorder=5)
+    ax.set_yscale("log")
+    ax.set_ylabel(r"$\langle E\rangle$")
+    ax.set_title(rf"$(E_0,\gamma)=({E0:g},\,{gamma:g})$, $N={numbers['n_orbits']:,}$", fontsize=10)
+    ax.legend(loc="lower left", fontsize=7.5, framealpha=0.9)
+    ax.grid(True, which="major", alpha=0.3)
+
+    ins = ax.inset_axes([0.55, 0.55, 0.43, 0.42])
+    for k, tk in enumerate(ts):
+        h = hist[hist["t"] == tk]
+        edges = np.append(h["e_lo"].to_numpy(), h["e_hi"].to_numpy()[-1])
+        ins.stairs(h["density_log10E"].to_numpy(), edges, color=HIST_COLORS[k % 6], lw=1.2,
+                   fill=True, alpha=0.35)
+        ins.stairs(h["density_log10E"].to_numpy(), edges, color=HIST_COLORS[k % 6], lw=1.0,
+                   label=rf"$t={tk:g}$")
+    ins.axvline(E_C, color="k", ls=":", lw=0.8)
+    ins.set_xscale("log")
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    ins.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 3.0)))
+    ins.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ins.xaxis.set_minor_formatter(NullFormatter())
+    ins.set_xlabel(r"$E$", fontsize=8, labelpad=1)
+    ins.set_ylabel(r"density in $\log_{10}E$", fontsize=7)
+    ins.tick_params(labelsize=7)
+    ins.legend(fontsize=6, loc="upper left", frameon=False)
+
+    s = tab[tab["kind"] == "sliding"]
+    bx.errorbar(s["t_mid"], s["mu_free"], yerr=3 * s["mu_free_err"], fmt="o-", ms=3, lw=1, color="#0b2f6b",
+                capsize=2, label=r"local $\mu$ (slope of $\log\langle E\rangle$), $\pm3\sigma$")
+    bx.axhline(1.0, color="k", lw=0.9, ls="-", label=r"$\mu=1$ (linearised)")
+    bx.axhline(numbers["paper_mu"], color="#d62728", lw=0.9, ls="--", label="paper: 0.91 on [0, 200]")
+    bx.axhline(mu, color="#ff7f0e", lw=0.9, ls="-.", label=f"ours: {mu:.3f} on [0, 200]")
+    bx.set_xlim(-0.01 * t_right, t_right)
+    bx.set_xlabel(r"$t$")
+    bx.set_ylabel(r"$\mu$")
+    bx.legend(fontsize=7, loc="lower right", ncol=2)
+    bx.grid(True, alpha=0.3)
+    ax.text(0.01, 0.985, "(a)", transform=ax.transAxes, va="top", fontsize=10, fontweight="bold")
+    bx.text(0.01, 0.96, "(b)", transform=bx.transAxes, va="top", fontsize=10, fontweight="bold")
+    fig.savefig(path, dpi=200)
+    plt.close(fig)

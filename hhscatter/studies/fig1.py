@@ -1,0 +1,213 @@
+"""Study fig1 — paper Fig. 1: potential contours and the support of the c-measure.
+
+Stages (``hhscatter study fig1 simulate|analyze|plot [--scale S]``):
+
+``simulate(study, workers=None, progress=True)``
+    For each energy E of ``[study].energies`` (0.35, 0.30): a pilot ensemble
+    (raw key ``pilot_E0.35``) whose Kaplan–Meier P(t) gives κ and τ0
+    (:func:`hhscatter.analysis.escape_rate.escape_rate`, the 4-window rule of
+    Fig. 2b), the recording time
+
+        t_rec = ceil(τ0 + rec_efolds/κ)        (sprinkler rule, t_rec ≫ 1/κ),
+
+    and the main ensemble (raw key ``E0.35`` / ``E0.30``): ``n`` orbits uniform
+    in the disk r < radius with the section velocities of the initial
+    conditions (paper, App. "Initial Conditions"), recording the first crossing
+    of the section ṙ = 0, φ̇ > 0 at t ≥ t_rec of every orbit still inside
+    (``SectionWindow(t_from=t_rec, first_only=True)``), t_max = t_rec + t_after.
+
+``analyze(study)``
+    Derived tables ``cmeasure_points.parquet`` (energy, traj_id, t, x, y, px,
+    py: the c-measure sample) and ``potential_grid.parquet`` (x, y, V on a
+    square grid for Fig. 1a); numbers ``fig1.json`` with, per energy, t_rec,
+    the κ and τ0 used, survivors at t_rec and the number of points.
+
+``plot(study)``
+    ``fig1.png`` via :func:`hhscatter.plotting.fig1.plot_fig1`.
+
+c-measure sample for other studies (fig5): the conservative c-measure at
+E = 0.30 and 0.35 is *every row* of the ``sections`` table of the raw runs
+``raw/E0.30`` and ``raw/E0.35`` (``hhscatter.tables.read_sections``); all rows
+have t ≥ t_rec by construction (first_only). The same points are in the
+derived ``cmeasure_points.parquet``. ``fig1.json["cmeasure_sample"]`` says so
+and gives t_rec per energy.
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..model import HenonHeiles
+from ..runner import SCENE_FILE
+
+E_C = HenonHeiles().critical_energy
+
+
+def energy_key(energy: float) -> str:
+    """energy_key(E) -> raw-run key 'E0.30' of the main run at energy E (two decimals)."""
+    return f"E{energy:.2f}"
+
+
+def _pilot_scene(study, energy):
+    return study.scene(
+        f"pilot_{energy_key(energy)}",
+        energy=float(energy),
+        n=int(study.param("pilot_n")),
+        seed=int(study.param("pilot_seed")),
+        t_max=float(study.param("pilot_t_max")),
+        sections=None,
+        snapshots=None,
+    )
+
+
+def _pilot_rate(pilot_dir):
+    """κ, τ0 (and the full EscapeRateResult) of a pilot run."""
+    from ..analysis.escape_rate import escape_rate_from_lifetimes
+    from ..tables import read_lifetimes
+
+    lt = read_lifetimes(pilot_dir, columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
+    return escape_rate_from_lifetimes(lt, detect_tail=False)
+
+
+def recording_time(kappa: float, tau0: float, rec_efolds: float) -> float:
+    """recording_time(κ, τ0, n) -> t_rec = ceil(τ0 + n/κ) (time units), the sprinkler rule."""
+    if not (math.isfinite(kappa) and kappa > 0):
+        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
+    return float(math.ceil(tau0 + rec_efolds / kappa))
+
+
+def _main_scene(study, energy, t_rec):
+    return study.scene(
+        energy_key(energy),
+        energy=float(energy),
+        t_max=float(t_rec + float(study.param("t_after"))),
+        sections={"t_from": float(t_rec), "first_only": True},
+        snapshots=None,
+    )
+
+
+def _choices_path(study):
+    return study.out / "raw" / "fig1_choices.json"
+
+
+def simulate(study, workers=None, progress=True):
+    """simulate(study, workers=None, progress=True) -> None; pilot and main runs per energy.
+
+    The κ, τ0 and t_rec actually used are written to ``raw/fig1_choices.json``.
+    """
+    from . import write_json_atomic
+
+    choices = {}
+    for energy in study.param("energies"):
+        pdir = study.run(f"pilot_{energy_key(energy)}", _pilot_scene(study, energy), workers=workers,
+                         progress=progress)
+        r = _pilot_rate(pdir)
+        t_rec = recording_time(r.kappa, r.tau0, float(study.param("rec_efolds")))
+        print(f"  fig1 E={energy}: pilot κ = {r.kappa:.4f} ± {r.kappa_err:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}",
+              flush=True)
+        study.run(energy_key(energy), _main_scene(study, energy, t_rec), workers=workers, progress=progress)
+        choices[energy_key(energy)] = {"energy": float(energy), "t_rec": t_rec, "kappa": r.kappa,
+                                       "kappa_err": r.kappa_err, "tau0": r.tau0, "t_stop": r.t_stop,
+                                       "n_pilot": int(r.n_total)}
+    write_json_atomic(_choices_path(study), choices)
+
+
+def contour_levels(n: int, e_max: float = 0.5) -> np.ndarray:
+    """contour_levels(n) -> n energies k·e_max/(n+1), k = 1..n, in (0, e_max); n = 20 contains E_c = 1/6 (k = 7)."""
+    return e_max * np.arange(1, n + 1) / (n + 1)
+
+
+def analyze(study):
+    """analyze(study) -> None; writes cmeasure_points.parquet, potential_grid.parquet and fig1.json."""
+    import pandas as pd
+
+    from ..analysis.escape_rate import escape_rate_from_lifetimes
+    from ..tables import read_lifetimes, read_sections
+
+    model = HenonHeiles()
+    rec_efolds = float(study.param("rec_efolds"))
+    choices = json.loads(_choices_path(study).read_text())
+    per_energy, points = {}, []
+    for energy in study.param("energies"):
+        key = energy_key(energy)
+        ch = choices[key]
+        t_rec = float(ch["t_rec"])
+        scene = json.loads((study.raw(key) / SCENE_FILE).read_text())["scene"]
+        if abs(float(scene["sections"]["t_from"]) - t_rec) > 1e-9:
+            raise RuntimeError(f"{key}: raw run's t_rec = {scene['sections']['t_from']} is not the recorded "
+                               f"choice {t_rec}; re-run the simulate stage")
+        # the rule with the current analysis code (differs only if escape_rate changed since simulate)
+        r = _pilot_rate(study.raw(f"pilot_{key}"))
+        t_rec_now = recording_time(r.kappa, r.tau0, rec_efolds)
+        lt = read_lifetimes(study.raw(key), columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
+        sec = read_sections(study.raw(key))
+        if (sec["t"] < t_rec).any() or sec["traj_id"].duplicated().any():
+            raise RuntimeError(f"{key}: sections must hold one crossing per orbit at t ≥ t_rec")
+        alive = int(np.count_nonzero(lt["t_end"].to_numpy() > t_rec))
+        own = escape_rate_from_lifetimes(lt, detect_tail=False)
+        e_dev = float(np.max(np.abs(sec["energy"].to_numpy() - energy))) if len(sec) else 0.0
+        per_energy[key] = {
+            "energy": float(energy),
+            "t_rec": t_rec,
+            "t_max": float(scene["t_max"]),
+            "kappa_used": {"value": ch["kappa"], "err": ch["kappa_err"]},
+            "tau0_used": ch["tau0"],
+            "fit_window_pilot": [ch["tau0"], ch["t_stop"]],
+            "t_rec_times_kappa": t_rec * ch["kappa"],
+            "t_rec_rule_with_current_code": t_rec_now,
+            "n_pilot": int(ch["n_pilot"]),
+            "n_orbits": len(lt),
+            "n_survivors_at_t_rec": alive,
+            "n_points": len(sec),
+            "kappa_main_run": {"value": own.kappa, "err": own.kappa_err},
+            "max_energy_deviation": e_dev,
+            "raw_run": f"raw/{key}",
+        }
+        pts = sec[["traj_id", "t", "x", "y", "px", "py"]].copy()
+        pts.insert(0, "energy", float(energy))
+        points.append(pts)
+        # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
+        study.compare(f"kappa(E={energy:.2f}) used for t_rec", ch["kappa"], ch["kappa_err"], 1.41 * (energy - E_C),
+                      unit="1/time", note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b")
+    study.write_table(pd.concat(points, ignore_index=True), "cmeasure_points.parquet",
+                      description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec")
+
+    h = float(study.param("grid_half_width"))
+    m = int(study.param("grid_points"))
+    g = np.linspace(-h, h, m)
+    X, Y = np.meshgrid(g, g)
+    study.write_table(pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": model.potential(X, Y).ravel()}),
+                      "potential_grid.parquet", description=f"V(x, y) on a {m}×{m} grid, Eq. (eqn:hh_potential)")
+    levels = contour_levels(int(study.param("n_contours")))
+    study.write_numbers({
+        "sprinkler_rule": "t_rec = ceil(tau0 + rec_efolds/kappa), kappa and tau0 from the pilot run's Kaplan-Meier "
+                          "P(t) (escape_rate: mean of 4 window fits); main run records the first section crossing "
+                          "at t >= t_rec (SectionWindow first_only=True), t_max = t_rec + t_after",
+        "rec_efolds": rec_efolds,
+        "energies": per_energy,
+        "cmeasure_sample": {
+            "how": "every row of the 'sections' table of raw run raw/E0.30 (raw/E0.35) "
+                   "(hhscatter.tables.read_sections(study.raw('E0.30'))); all rows have t >= t_rec; "
+                   "also derived/cmeasure_points.parquet filtered by energy",
+            "raw_keys": {k: v["raw_run"] for k, v in per_energy.items()},
+            "t_rec": {k: v["t_rec"] for k, v in per_energy.items()},
+            "n_points": {k: v["n_points"] for k, v in per_energy.items()},
+        },
+        "contour_levels": levels,
+        "E_c": E_C,
+        "saddles": model.saddles,
+    })
+
+
+def plot(study):
+    """plot(study) -> None; draws fig1.png from the derived tables and fig1.json."""
+    import pandas as pd
+
+    from ..plotting.fig1 import plot_fig1
+
+    numbers = study.read_numbers()
+    grid = pd.read_parquet(study.out / "derived" / "potential_grid.parquet")
+    pts = pd.read_parquet(study.out / "derived" / "cmeasure_points.parquet")
+    plot_fig1(grid, pts, numbers, study.figure_path)

@@ -1,0 +1,467 @@
+"""Study fig2 — paper Fig. 2: P(t), κ0(E) with its piecewise law, and κ from the c-measure.
+
+Stages (``hhscatter study fig2 simulate|analyze|plot [--scale S]``); all
+parameters in ``studies/fig2/study.toml``.
+
+``simulate(study, workers=None, progress=True)``
+    1. κ(E) grid: for every E in ``grid_energies`` a pilot (raw ``pilot_E0.175``,
+       ``pilot_n`` orbits, t_max = ``pilot_t_max``) fixes the main run's t_max
+       by :func:`hhscatter.analysis.escape_rate.choose_t_max` (bounds the cost
+       of long-lived orbits near E_c and of KAM-trapped orbits), then the main
+       run (raw ``grid_E0.175``, ``grid_n`` orbits).
+    2. Fig. 2a: ``pt_n`` orbits at each of ``pt_energies`` (raw ``pt_E0.23``),
+       t_max = ``pt_t_max`` (5000, paper App. A) so that the sticky tail shows.
+    3. c-measure runs (raw ``cm_E0.30``): κ and τ0 of the grid run at that
+       energy give t_rec = ceil(τ0 + cm_rec_efolds/κ), a sample window
+       [t_rec, t_rec + cm_sample_efolds/κ] and the recording end t_rec +
+       cm_sample_efolds/κ + cm_margin; every section crossing (ṙ = 0, φ̇ > 0)
+       in [t_rec, recording end] is recorded (first_only = False); orbits run
+       to ``cm_t_max`` so that KAM-trapped ones can be recognised (censored).
+
+``analyze(study)``
+    Derived tables (``studies/fig2/out/<scale>/derived/``):
+    ``kappa_energy.parquet`` (one row per grid energy: κ, its error, the 4
+    window estimates, τ0, windows, MLE cross-check, t_max, censored count),
+    ``kappa_fit_curve.parquet`` (fitted laws on a grid of x = E − E_c),
+    ``survival_curves.parquet`` and ``pt_fit_lines.parquet`` (Fig. 2a),
+    ``kappa_cmeasure.parquet`` (κ from Eq. (eqn:kappa_cmeasure_truetime) vs
+    the P(t) κ); numbers in ``fig2.json`` with the paper comparison of a, b, c,
+    E_b, τ*.
+
+``plot(study)``
+    ``fig2.png`` via :func:`hhscatter.plotting.fig2.plot_fig2`.
+"""
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import numpy as np
+
+from ..model import HenonHeiles
+from ..runner import SCENE_FILE
+
+E_C = HenonHeiles().critical_energy
+PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
+LIFETIME_COLUMNS = ["traj_id", "e0", "gamma", "outcome", "t_end"]
+
+
+def grid_key(energy: float) -> str:
+    """grid_key(E) -> raw key of the κ(E) run, e.g. 'grid_E0.175'."""
+    return f"grid_E{energy:.3f}"
+
+
+def pt_key(energy: float) -> str:
+    """pt_key(E) -> raw key of a Fig. 2a run, e.g. 'pt_E0.23'."""
+    return f"pt_E{energy:.2f}"
+
+
+def cm_key(energy: float) -> str:
+    """cm_key(E) -> raw key of a c-measure section run, e.g. 'cm_E0.30'."""
+    return f"cm_E{energy:.2f}"
+
+
+def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds: float, margin: float,
+                     max_shift_efolds: float = 0.0):
+    """cmeasure_windows(κ, τ0, n_rec, n_sample, margin, max_shift=0) -> (t_rec, t_sample_end, t_record_end).
+
+    Times in time units.  t_rec = ceil(τ0 + n_rec/κ): the ensemble is in its
+    exponential regime and relaxed towards μ_c; sample crossings in
+    [t_rec, t_sample_end = t_rec + n_sample/κ]; recording continues to
+    t_record_end = t_sample_end + max_shift/κ + margin, so that the same
+    sample window started up to ``max_shift_efolds``/κ later (convergence
+    check) still sees every sampled crossing's next crossing or exit.
+    """
+    if not (math.isfinite(kappa) and kappa > 0):
+        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
+    t_rec = float(math.ceil(tau0 + rec_efolds / kappa))
+    t_sample_end = t_rec + sample_efolds / kappa
+    return t_rec, float(t_sample_end), float(t_sample_end + max_shift_efolds / kappa + margin)
+
+
+# ---------------------------------------------------------------------------
+# simulate
+# ---------------------------------------------------------------------------
+def _lifetimes(path):
+    from ..tables import read_lifetimes
+
+    return read_lifetimes(path, columns=LIFETIME_COLUMNS)
+
+
+def _t_max_choice(study, pilot_dir):
+    from ..analysis.escape_rate import choose_t_max
+    from ..analysis.survival import lifetimes_to_arrays
+
+    t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
+    return choose_t_max(
+        t_end, obs, int(study.param("grid_n")),
+        min_survivors=float(study.param("min_survivors")),
+        margin_efolds=float(study.param("margin_efolds")),
+        t_min=float(study.param("t_max_min")),
+        t_cap=float(study.param("t_max_cap")),
+    )
+
+
+def _grid_rate(study, energy):
+    from ..analysis.escape_rate import escape_rate_from_lifetimes
+
+    return escape_rate_from_lifetimes(_lifetimes(study.raw(grid_key(energy))), detect_tail=False,
+                                      min_survivors=float(study.param("min_survivors")))
+
+
+def _cm_windows(study, energy):
+    r = _grid_rate(study, energy)
+    shifts = [float(v) for v in study.param("cm_start_shifts", [0.0])]
+    return r, cmeasure_windows(r.kappa, r.tau0, float(study.param("cm_rec_efolds")),
+                               float(study.param("cm_sample_efolds")), float(study.param("cm_margin")),
+                               max(shifts))
+
+
+def _choices_path(study):
+    return study.out / "raw" / "fig2_choices.json"
+
+
+def simulate(study, workers=None, progress=True):
+    """simulate(study, workers=None, progress=True) -> None; pilots, κ(E) grid, Fig. 2a and c-measure runs.
+
+    The t_max of every grid run and the c-measure windows actually used are
+    written to ``raw/fig2_choices.json``.
+    """
+    from dataclasses import asdict
+
+    from . import write_json_atomic
+
+    choices = {"t_max": {}, "cmeasure": {}}
+    grid = [float(e) for e in study.param("grid_energies")]
+    missing = [e for e in study.param("cm_energies") if not np.isclose(grid, e).any()]
+    if missing:
+        raise ValueError(f"[study].cm_energies must be among grid_energies (t_rec comes from their κ); {missing} are not")
+    for energy in grid:
+        pilot = study.scene(f"pilot_E{energy:.3f}", energy=energy, n=int(study.param("pilot_n")),
+                            seed=int(study.param("pilot_seed")), t_max=float(study.param("pilot_t_max")))
+        pdir = study.run(f"pilot_E{energy:.3f}", pilot, workers=workers, progress=progress)
+        choice = _t_max_choice(study, pdir)
+        choices["t_max"][grid_key(energy)] = asdict(choice)
+        scene = study.scene(grid_key(energy), energy=energy, n=int(study.param("grid_n")), t_max=choice.t_max)
+        study.run(grid_key(energy), scene, workers=workers, progress=progress)
+    for energy, n in zip(study.param("pt_energies"), study.param("pt_n")):
+        scene = study.scene(pt_key(energy), energy=float(energy), n=int(n), seed=int(study.param("pt_seed")),
+                            t_max=float(study.param("pt_t_max")))
+        study.run(pt_key(energy), scene, workers=workers, progress=progress)
+    for energy in study.param("cm_energies"):
+        energy = float(energy)
+        r, (t_rec, t_samp, t_rec_end) = _cm_windows(study, energy)
+        choices["cmeasure"][cm_key(energy)] = {"energy": energy, "kappa": r.kappa, "tau0": r.tau0, "t_rec": t_rec,
+                                               "t_sample_end": t_samp, "t_record_end": t_rec_end}
+        print(f"  fig2 c-measure E={energy}: κ = {r.kappa:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}, "
+              f"recording to {t_rec_end:.2f}", flush=True)
+        scene = study.scene(cm_key(energy), energy=energy, n=int(study.param("cm_n")),
+                            seed=int(study.param("cm_seed")), t_max=float(study.param("cm_t_max")),
+                            sections={"t_from": t_rec, "t_to": t_rec_end, "first_only": False})
+        study.run(cm_key(energy), scene, workers=workers, progress=progress)
+    write_json_atomic(_choices_path(study), choices)
+
+
+# ---------------------------------------------------------------------------
+# analyze
+# ---------------------------------------------------------------------------
+def _scene_of(path):
+    return json.loads((path / SCENE_FILE).read_text())["scene"]
+
+
+def _ve(v, e):
+    return {"value": float(v), "err": float(e)}
+
+
+def _plot_grid(t_last, n_lin=4001, n_log=600):
+    """Times at which P(t) is tabulated for the figure: linear and logarithmic, up to t_last."""
+    return np.unique(np.concatenate([np.linspace(0.0, t_last, n_lin), np.geomspace(0.1, t_last, n_log)]))
+
+
+def _analyze_grid(study):
+    import pandas as pd
+
+    from ..analysis.escape_rate import fit_kappa_energy
+
+    rows = []
+    tmax_choices = json.loads(_choices_path(study).read_text())["t_max"]
+    for energy in study.param("grid_energies"):
+        energy = float(energy)
+        path = study.raw(grid_key(energy))
+        tch = tmax_choices[grid_key(energy)]
+        lt = _lifetimes(path)
+        r = _grid_rate(study, energy)
+        t_max = float(_scene_of(path)["t_max"])
+        rows.append({
+            "energy": energy, "x": energy - E_C, "kappa": r.kappa, "kappa_err": r.kappa_err,
+            "kappa_spread": r.kappa_spread, "kappa_stat": r.kappa_stat,
+            **{f"kappa_w{i + 1}": f.kappa for i, f in enumerate(r.fits)},
+            **{f"window_w{i + 1}": f"{w[0]:.3f}-{w[1]:.3f}" for i, w in enumerate(r.windows)},
+            "tau0": r.tau0, "t_stop": r.t_stop, "kappa_mle": r.mle.kappa, "kappa_mle_err": r.mle.kappa_err,
+            "n": len(lt), "t_max": t_max, "t_max_reason": tch["reason"],
+            "kappa_pilot": tch["kappa_pilot"] if tch["kappa_pilot"] is not None else math.nan,
+            "n_censored": int((lt["outcome"] == "censored").sum()),
+            "window_reaches_t_max": bool(r.t_stop >= t_max - r.window_choice.width),
+        })
+    df = pd.DataFrame(rows)
+    study.write_table(df, "kappa_energy.parquet",
+                      description="κ0(E): mean of 4 least-squares fits of log P(t) (escape_rate), Fig. 2b")
+    seed = int(study.param("fit_seed"))
+    n_boot = int(study.param("n_boot"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fit = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=True,
+                               n_boot=n_boot, rng=seed)
+        sep = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=False,
+                               n_boot=n_boot, rng=seed)
+    return df, fit, sep
+
+
+def _fit_json(fit):
+    boot = fit.boot_err if fit.boot_err else (math.nan,) * 4
+    out = {}
+    for i, name in enumerate(("a", "b", "c", "E_b")):
+        cov_err = getattr(fit, f"{name}_err")
+        out[name] = {"value": float(getattr(fit, name)), "err": float(max(cov_err, boot[i])),
+                     "err_cov": float(cov_err), "err_boot": float(boot[i])}
+    out.update(continuous=fit.continuous, chi2=fit.chi2, dof=fit.dof,
+               chi2_per_dof=fit.chi2 / fit.dof if fit.dof > 0 else math.nan)
+    return out
+
+
+def _fit_curve_table(fit, sep, x_max):
+    import pandas as pd
+
+    x = np.linspace(0.0, x_max * 1.03, 400)
+    xb = fit.E_b - E_C
+    xs = sep.E_b - E_C
+    parts = []
+    for name, f, lo_hi in (("continuous", fit, xb), ("separate", sep, xs)):
+        nonlin = x <= lo_hi * 1.15
+        lin = x >= lo_hi * 0.85
+        parts.append(pd.DataFrame({"model": name, "regime": "nonlinear", "x": x[nonlin],
+                                   "kappa": f.a * x[nonlin] ** 2 + f.b * x[nonlin]}))
+        parts.append(pd.DataFrame({"model": name, "regime": "linear", "x": x[lin], "kappa": f.c * x[lin]}))
+    # the paper's two laws (Fig. 2b caption) for comparison
+    xp = PAPER["E_b"] - E_C
+    parts.append(pd.DataFrame({"model": "paper", "regime": "nonlinear", "x": x[x <= xp * 1.15],
+                               "kappa": PAPER["a"] * x[x <= xp * 1.15] ** 2 + PAPER["b"] * x[x <= xp * 1.15]}))
+    parts.append(pd.DataFrame({"model": "paper", "regime": "linear", "x": x[x >= xp * 0.85],
+                               "kappa": PAPER["c"] * x[x >= xp * 0.85]}))
+    return pd.concat(parts, ignore_index=True)
+
+
+def _analyze_pt(study):
+    import pandas as pd
+
+    from ..analysis.escape_rate import (
+        escape_rate,
+        escaping_tail,
+        power_law_exponent_mle,
+    )
+    from ..analysis.survival import lifetimes_to_arrays, survival_curve
+
+    curves, lines, numbers = [], [], {}
+    for energy in study.param("pt_energies"):
+        energy = float(energy)
+        key = pt_key(energy)
+        t_end, obs = lifetimes_to_arrays(_lifetimes(study.raw(key)))
+        t_max = float(_scene_of(study.raw(key))["t_max"])
+        r = escape_rate(t_end, obs, detect_tail=False, min_survivors=float(study.param("min_survivors")))
+        tail = escaping_tail(t_end, obs, r.tau0, r.fits[0], min_survivors=float(study.param("tail_min_survivors")))
+        # P(t) of all orbits (Kaplan–Meier) and of the escaping ones, for the figure
+        t_last = float(np.max(t_end))
+        g = _plot_grid(t_last)
+        km = survival_curve(t_end, obs, g)
+        esc = survival_curve(t_end[obs], np.ones(int(obs.sum()), bool), g)
+        curves.append(pd.DataFrame({"energy": energy, "t": g, "P": km.P, "P_err": km.P_err,
+                                    "P_esc": esc.P, "P_esc_err": esc.P_err}))
+        f = r.fits[0]
+        te = np.linspace(0.0, r.t_stop * 1.25, 300)
+        lines.append(pd.DataFrame({"energy": energy, "kind": "exponential", "t": te, "P": f.predict(te)}))
+        entry = {
+            "n": int(t_end.size), "t_max": t_max, "n_trapped": tail.n_trapped,
+            "trapped_fraction": tail.n_trapped / t_end.size,
+            "kappa": _ve(r.kappa, r.kappa_err), "kappa_windows": [fi.kappa for fi in r.fits],
+            "kappa_mle": _ve(r.mle.kappa, r.mle.kappa_err), "tau0": r.tau0, "t_stop": r.t_stop,
+            "windows": [list(w) for w in r.windows], "f0": f.f0,
+            "t_floor": r.window_choice.t_floor,
+        }
+        if tail.tail is not None:
+            tl = tail.tail
+            tp = np.geomspace(tl.window[0] * 0.6, tl.window[1] * 1.5, 200)
+            lines.append(pd.DataFrame({"energy": energy, "kind": "power_law", "t": tp, "P": tl.predict(tp)}))
+            entry.update(
+                tail_detected=True, z=_ve(tl.z, tl.z_err), z_mle=_ve(tl.z_mle, tl.z_mle_err),
+                tail_window=list(tl.window), f_star=tl.f_star, tau_c=tl.window[0],
+                tau_star=tail.tau_star if math.isfinite(tail.tau_star) else None,
+                tau_star_definition="crossing of the fitted exponential and power law (crossover_time)"
+                if math.isfinite(tail.tau_star) else "the laws do not cross; use tau_c, the likelihood change point",
+                hazard_exponent=tl.hazard_exponent, delta_aic_split=tl.delta_aic_split,
+            )
+            # beyond the tail window, down to t_max: the last (sticky) escapes, below the tail's survivor floor
+            # the orbits still inside at t_max are either on KAM tori (never leave: remove them, z too high
+            # if some are merely sticky) or sticky (censored: keep them at risk, z too low): both bounds
+            lo = power_law_exponent_mle(t_end, obs, tl.window[1], t_max)
+            hi = power_law_exponent_mle(t_end[obs], np.ones(int(obs.sum()), bool), tl.window[1], t_max)
+            entry.update(late_tail={"t_window": [tl.window[1], t_max], "n_events": lo.n_events,
+                                    "z_mle_trapped_censored": _ve(lo.kappa, lo.kappa_err),
+                                    "z_mle_trapped_removed": _ve(hi.kappa, hi.kappa_err)})
+        else:
+            entry.update(tail_detected=False)
+        numbers[pt_key(energy)] = entry
+        paper_k = PAPER["a"] * (energy - E_C) ** 2 + PAPER["b"] * (energy - E_C) if energy < PAPER["E_b"] \
+            else PAPER["c"] * (energy - E_C)
+        study.compare(f"kappa(E0={energy:.2f}) [Fig. 2a]", r.kappa, r.kappa_err, paper_k, unit="1/time",
+                      note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)")
+        if tail.tail is not None:
+            tl = tail.tail
+            if math.isfinite(tail.tau_star):
+                # systematic error of τ*: distance between its two definitions (crossing, change point)
+                ts, ts_err = tail.tau_star, abs(tail.tau_star - tl.window[0])
+                note = "crossing of the exponential and power-law fits; err = |crossing − change point τ_c|"
+            else:
+                ts, ts_err = tl.window[0], None
+                note = "the fitted laws do not cross: τ* = τ_c, the likelihood change point of the hazard"
+            verdict = None if ts_err else ("agrees within 20 %" if abs(ts / PAPER["tau_star"] - 1) <= 0.2
+                                           else "differs")
+            study.compare(f"tau* (E0={energy:.2f})", ts, ts_err, PAPER["tau_star"], unit="time", note=note,
+                          verdict=verdict)
+            study.compare(f"z (E0={energy:.2f})", tl.z, tl.z_err, None, note="power-law exponent of the sticky "
+                          "tail (the paper annotates it in Fig. 2a; no number in the text)")
+    study.write_table(pd.concat(curves, ignore_index=True), "survival_curves.parquet",
+                      description="Kaplan–Meier P(t) (all orbits) and P_esc(t) (orbits leaving before t_max), Fig. 2a")
+    study.write_table(pd.concat(lines, ignore_index=True), "pt_fit_lines.parquet",
+                      description="fitted exponential f0 e^{-κt} and power law f* t^{-z} of Fig. 2a")
+    return numbers
+
+
+def _analyze_cmeasure(study, grid_df):
+    import pandas as pd
+
+    from ..analysis.escape_rate import (
+        cmeasure_sample_from_sections,
+        escape_rate_from_lifetimes,
+        kappa_from_cmeasure,
+    )
+    from ..tables import read_sections
+
+    rows = []
+    n_boot = int(study.param("n_boot"))
+    choices = json.loads(_choices_path(study).read_text())["cmeasure"]
+    for energy in study.param("cm_energies"):
+        energy = float(energy)
+        key = cm_key(energy)
+        ch = choices[key]
+        t_rec, t_samp, t_rec_end = ch["t_rec"], ch["t_sample_end"], ch["t_record_end"]
+        win = _scene_of(study.raw(key))["sections"]
+        if abs(float(win["t_from"]) - t_rec) > 1e-9 or abs(float(win["t_to"]) - t_rec_end) > 1e-6:
+            raise RuntimeError(f"{key}: raw run's section window {win} is not the recorded choice "
+                               f"[{t_rec}, {t_rec_end}]; re-run the simulate stage")
+        r = _grid_rate(study, energy)  # the Fig. 2b κ at this energy (current analysis)
+        lt = _lifetimes(study.raw(key))
+        sec = read_sections(study.raw(key), columns=["traj_id", "t"])
+        own = escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=float(study.param("min_survivors")))
+        span = t_samp - t_rec
+        for shift in study.param("cm_start_shifts"):
+            t0 = t_rec + float(shift) / ch["kappa"]
+            t1 = t0 + span
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                T, n_exit, n_und = cmeasure_sample_from_sections(sec, lt, t0, t1, t_record_end=t_rec_end,
+                                                                 drop_censored=True)
+            if T.size + n_exit == 0:
+                continue
+            k = kappa_from_cmeasure(T, n_exit, n_boot=n_boot, rng=int(study.param("fit_seed")))
+            rows.append({
+                "energy": energy, "x": energy - E_C, "shift_efolds": float(shift), "t_from": t0, "t_to": t1,
+                "t_record_end": t_rec_end, "n_samples": k.n_samples, "n_exit": k.n_exit, "n_undetermined": n_und,
+                "mu_exit": k.mu_exit, "T_mean": float(T.mean()) if T.size else math.nan,
+                "T_max": float(T.max()) if T.size else math.nan,
+                "kappa_cm": k.kappa, "kappa_cm_err": k.kappa_err, "kappa_cm_err_delta": k.kappa_err_delta,
+                "kappa_pt_grid": r.kappa, "kappa_pt_grid_err": r.kappa_err,
+                "kappa_pt_same_run": own.kappa, "kappa_pt_same_run_err": own.kappa_err,
+                "n_trapped_dropped": int((lt["outcome"] == "censored").sum()),
+            })
+    df = pd.DataFrame(rows)
+    df["z_vs_grid"] = (df["kappa_cm"] - df["kappa_pt_grid"]) / np.hypot(df["kappa_cm_err"], df["kappa_pt_grid_err"])
+    df["z_vs_same_run"] = (df["kappa_cm"] - df["kappa_pt_same_run"]) / np.hypot(df["kappa_cm_err"],
+                                                                                df["kappa_pt_same_run_err"])
+    study.write_table(df, "kappa_cmeasure.parquet",
+                      description="κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), vs κ from P(t)")
+    df.to_csv(study.derived("kappa_cmeasure.csv"), index=False, float_format="%.6g")  # the same, for reading
+    main = df[df["shift_efolds"] == 0.0]
+    numbers = {}
+    for _, row in main.iterrows():
+        numbers[cm_key(row["energy"])] = {
+            "energy": row["energy"], "t_window": [row["t_from"], row["t_to"]], "t_record_end": row["t_record_end"],
+            "n_samples": int(row["n_samples"]), "n_exit": int(row["n_exit"]),
+            "n_undetermined": int(row["n_undetermined"]), "mu_exit": row["mu_exit"],
+            "kappa_cm": _ve(row["kappa_cm"], row["kappa_cm_err"]),
+            "kappa_pt_grid": _ve(row["kappa_pt_grid"], row["kappa_pt_grid_err"]),
+            "kappa_pt_same_run": _ve(row["kappa_pt_same_run"], row["kappa_pt_same_run_err"]),
+            "z_vs_grid": row["z_vs_grid"], "z_vs_same_run": row["z_vs_same_run"],
+            "kappa_cm_later_starts": {f"+{s:g}/kappa": v for s, v in
+                                      df[(df["energy"] == row["energy"]) & (df["shift_efolds"] > 0)]
+                                      [["shift_efolds", "kappa_cm"]].itertuples(index=False)},
+        }
+    return numbers
+
+
+def analyze(study):
+    """analyze(study) -> None; derived tables and fig2.json (see the module docstring)."""
+    grid_df, fit, sep = _analyze_grid(study)
+    study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max())), "kappa_fit_curve.parquet",
+                      description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
+    fj, sj = _fit_json(fit), _fit_json(sep)
+    for name in ("a", "b", "c", "E_b"):
+        study.compare(f"{name} (κ(E) law, continuous fit)", fj[name]["value"], fj[name]["err"], PAPER[name],
+                      unit={"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)",
+                            "E_b": "energy"}[name],
+                      note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
+                           "err = max(covariance, bootstrap)")
+    for name in ("a", "b", "c", "E_b"):
+        study.compare(f"{name} (κ(E) law, separate fits)", sj[name]["value"], sj[name]["err"], PAPER[name],
+                      note="the two laws fitted independently on either side of the best partition (as the paper)")
+    pt = _analyze_pt(study)
+    cm = _analyze_cmeasure(study, grid_df)
+    study.write_numbers({
+        "rules": {
+            "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "
+                     "covering most e-folds, floor of min_survivors survivors); kappa = mean of the 4 weighted "
+                     "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
+            "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
+                     " clipped to [t_max_min, t_max_cap]",
+            "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
+                    "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
+            "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
+                        "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
+                        "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
+        },
+        "E_c": E_C,
+        "kappa_fit": fj,
+        "kappa_fit_separate": sj,
+        "paper": PAPER,
+        "kappa_energy": grid_df.to_dict(orient="records"),
+        "Pt": pt,
+        "cmeasure": cm,
+    })
+
+
+def plot(study):
+    """plot(study) -> None; draws fig2.png from the derived tables and fig2.json."""
+    import pandas as pd
+
+    from ..plotting.fig2 import plot_fig2
+
+    d = study.out / "derived"
+    plot_fig2(
+        pd.read_parquet(d / "survival_curves.parquet"),
+        pd.read_parquet(d / "pt_fit_lines.parquet"),
+        pd.read_parquet(d / "kappa_energy.parquet"),
+        pd.read_parquet(d / "kappa_fit_curve.parquet"),
+        pd.read_parquet(d / "kappa_cmeasure.parquet"),
+        study.read_numbers(),
+        study.figure_path,
+    )

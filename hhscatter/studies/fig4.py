@@ -1,0 +1,332 @@
+"""Study fig4: P(t) for several γ at E0 = 0.3 and the times τ0, τ1, τ2 (paper Fig. 4 = fig:survprob).
+
+Paper: survival probability P(t) of the dissipative Hénon–Heiles system for
+several small γ with the conservative curve (γ = 0) for comparison; for
+γ = 10⁻² the times τ0, τ1, τ2 are marked.  A settled orbit (energy reached
+E_c inside Ω) leaves at its settling time, an escaped one at its escape time.
+
+Definitions used here (all times in model units):
+
+* τ0 — end of the irregular initial regime; the paper says it is
+  effectively independent of γ, so it is measured once, on the conservative
+  curve P_0, by the data-driven rule of
+  :func:`hhscatter.analysis.escape_rate.choose_windows` (the first time after
+  which the local escape rate stays within 10 % / 3σ of its plateau value;
+  the same rule as the Fig. 2 escape-rate fits).
+* τ1 — Eq. (eqn:tau1): first t ≥ τ0 with P_γ(t) = α P_0(t), α = 2
+  (:func:`hhscatter.analysis.transitions.tau1` on a fine grid, log-linear
+  interpolation).  ``n0_at_tau1`` = N·P_0(τ1) tells whether P_0 is still
+  resolved there (flag ``tau1_resolved``: at least ``min_ref_orbits`` orbits).
+* τ2 observed — "the first time at which the energy of a non-escaping orbit
+  dropped below E_c" (Fig. 6b caption): the smallest settling time.  Being a
+  minimum over N·f_settled orbits it decreases with N (the paper used N =
+  10⁷); the 1 % and 50 % quantiles of the settling times are given as
+  N-independent companions.
+* τ2 predicted — Eq. (eq:tau2), ln(E0/E_c)/(μγ), with μ measured by this
+  study on its own γ = ``mu_gamma`` run exactly as in study fig3 (⟨E⟩ over
+  orbits not escaped, settled orbits continued, log fit on ``mu_window``),
+  one μ for all γ as in the paper (τ2 ∝ 1/γ).  Also given with the paper's
+  μ = 0.91, and fig3's μ is recorded if fig3.json exists at the same scale.
+
+Errors: paired bootstrap over orbits (every γ shares the same initial
+conditions, orbit i gets the same multiplicity in every ensemble).
+
+Raw runs (read by study fig6): ``raw/gamma<γ:g>`` — ``gamma0``,
+``gamma0.001``, ``gamma0.002``, ``gamma0.005``, ``gamma0.01``, ``gamma0.02``;
+the μ run also has ``raw/gamma<γ:g>_settled`` (settled-orbit continuation).
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+
+from .fig3 import snapshot_grid
+
+E_C = 1.0 / 6.0
+
+
+def raw_key(gamma: float) -> str:
+    """raw_key(gamma) -> 'gamma<γ:g>', e.g. raw_key(0.001) == 'gamma0.001', raw_key(0) == 'gamma0'."""
+    return f"gamma{float(gamma):g}"
+
+
+def _gammas(study):
+    gs = [float(g) for g in study.param("gammas")]
+    if 0.0 not in gs:
+        raise ValueError("fig4 [study].gammas must contain 0 (the conservative reference P_0)")
+    if sorted(gs) != gs or len(set(gs)) != len(gs):
+        raise ValueError(f"fig4 [study].gammas must be increasing and distinct, got {gs}")
+    mg = float(study.param("mu_gamma"))
+    if mg not in gs:
+        raise ValueError(f"fig4 [study].mu_gamma = {mg} must be one of gammas {gs}")
+    return gs, mg
+
+
+def simulate(study, workers=None, progress=True):
+    """simulate(study, workers=None) -> None: one engine run per γ (same ICs); snapshots + continuation for mu_gamma."""
+    from ..tables import read_lifetimes
+    from ._settled import continue_settled
+
+    gs, mg = _gammas(study)
+    grid = snapshot_grid(study.param("snapshot_grid"))
+    for g in gs:
+        key = raw_key(g)
+        snaps = tuple(grid) if g == mg else None
+        scene = study.scene(key, gamma=g, snapshots=snaps)
+        out = study.run(key, scene, workers=workers, progress=progress)
+        if g == mg:
+            lt = read_lifetimes(out, columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
+            continue_settled(scene, lt, grid, study.raw(key + "_settled"), workers=workers, progress=progress)
+
+
+def _tau0_rule(grid, P0, n):
+    from ..analysis.escape_rate import choose_windows
+
+    return choose_windows(grid, P0, n_total=n).tau0
+
+
+def _plot_grid(t_last):
+    """Log-spaced grid for drawing P(t): 0.2 … t_last."""
+    return np.unique(np.round(np.geomspace(0.2, max(t_last, 1.0), 1500), 6))
+
+
+def analyze(study):
+    """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
+    from ..analysis.decay import fit_energy_decay
+    from ..analysis.survival import survival_from_lifetimes
+    from ..analysis.transitions import (
+        bootstrap_transition_times,
+        settle_time_quantiles,
+        survival_on_grid,
+        tau1,
+        tau2_observed,
+        tau2_predicted,
+    )
+    from ..scene import SceneError
+    from ..tables import read_lifetimes
+    from .fig3 import bootstrap_subset, inside_mean_energy
+
+    gs, mg = _gammas(study)
+    E0 = float(study.config["scene"]["energy"])
+    alpha = float(study.param("alpha"))
+    dt = float(study.param("tau_grid_step"))
+    lts, ref = {}, None
+    for g in gs:
+        lt = read_lifetimes(study.raw(raw_key(g)), columns=["traj_id", "x0", "y0", "outcome", "t_end"])
+        lt = lt.sort_values("traj_id").reset_index(drop=True)
+        xy = lt[["x0", "y0"]].to_numpy()
+        if ref is None:
+            ref = xy
+        elif xy.shape != ref.shape or not np.array_equal(xy, ref):
+            raise ValueError(f"fig4: run {raw_key(g)} does not share the initial conditions of {raw_key(gs[0])}")
+        # keep only what the analysis needs (N = 1e7 per curve at paper scale)
+        lts[g] = pd.DataFrame({"t_end": lt["t_end"].to_numpy(), "outcome": lt["outcome"].astype("category")})
+    N = len(ref)
+    del ref
+    t_last = max(float(lt["t_end"].max()) for lt in lts.values())
+
+    # fine grid for τ0/τ1 (P on it is exact: no censoring before t_max in these runs)
+    grid = np.round(np.arange(0.0, t_last + dt, dt), 9)
+    obs = {g: (lt["outcome"] != "censored").to_numpy() for g, lt in lts.items()}
+    P = {g: survival_on_grid(lts[g]["t_end"].to_numpy(), obs[g], grid) for g in gs}
+    tau0 = float(_tau0_rule(grid, P[0.0], N))
+
+    # μ from this study's own mu_gamma run (fig3's definition), bootstrap error
+    me, _, cont = inside_mean_energy(study, raw_key(mg))
+    win = tuple(float(v) for v in study.param("mu_window"))
+    mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
+    nb = int(study.param("n_boot"))
+    bm, mu_scale = bootstrap_subset(study, raw_key(mg), N, [win], E0, mg, nb, int(study.param("boot_seed")))
+    mu_err = float(bm["mu"].std(ddof=1)) * mu_scale
+    mu_fig3 = None
+    try:
+        f3 = study.read_numbers("fig3")
+        mu_fig3 = f3["mu"]
+    except (FileNotFoundError, KeyError, SceneError):  # fig3 is optional here (cross-check only)
+        mu_fig3 = None
+    paper_mu = float(study.param("paper_mu"))
+
+    # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
+    K = min(int(study.param("n_boot_orbits")), N)
+    boot = bootstrap_transition_times(
+        {g: (lts[g]["t_end"].to_numpy()[:K], lts[g]["outcome"].to_numpy()[:K]) for g in gs}, 0.0, grid,
+        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=int(study.param("boot_seed")) + 1,
+    )
+    bscale = float(np.sqrt(K / N))
+    min_ref = float(study.param("min_ref_orbits"))
+    rows = []
+    for g in gs:
+        lt = lts[g]
+        oc = lt["outcome"].to_numpy()
+        b = boot[boot["label"] == g] if g > 0 else None
+        t1 = tau1(grid, P[g], P[0.0], tau0, alpha) if g > 0 else None
+        n0 = float(N * np.interp(t1, grid, P[0.0])) if t1 is not None else np.nan
+        t2 = tau2_observed(lt) if g > 0 else None
+        q = settle_time_quantiles(lt["t_end"].to_numpy(), oc, (0.01, 0.5)) if g > 0 else None
+        pred = float(tau2_predicted(E0, E_C, mu, g)) if g > 0 else np.inf
+        pred_p = float(tau2_predicted(E0, E_C, paper_mu, g)) if g > 0 else np.inf
+
+        def sd(col, b=b):
+            if b is None:
+                return np.nan
+            v = b[col].to_numpy(float)
+            v = v[np.isfinite(v)]
+            return float(np.std(v, ddof=1)) * bscale if v.size > 1 else np.nan
+
+        rows.append({
+            "gamma": g, "key": raw_key(g), "n": N,
+            "f_escaped": float(np.mean(oc == "escaped")), "f_settled": float(np.mean(oc == "settled")),
+            "f_censored": float(np.mean(oc == "censored")),
+            "tau0": tau0, "tau0_err": sd("tau0") if g > 0 else float(boot["tau0"].std(ddof=1)) * bscale,
+            "tau1": np.nan if t1 is None else t1, "tau1_err": sd("tau1"),
+            "tau1_boot_defined": float(np.isfinite(b["tau1"]).mean()) if b is not None else np.nan,
+            "n0_at_tau1": n0, "tau1_resolved": bool(np.isfinite(n0) and n0 >= min_ref),
+            "tau2_obs": np.nan if t2 is None else t2, "tau2_obs_err": sd("tau2_obs"),
+            "t_settle_q01": np.nan if q is None else float(q[0]), "t_settle_q01_err": sd("t_settle_q0.01"),
+            "t_settle_q50": np.nan if q is None else float(q[1]), "t_settle_q50_err": sd("t_settle_q0.5"),
+            "tau2_pred": pred, "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
+            "tau2_pred_paper_mu": pred_p,
+        })
+    taus = pd.DataFrame(rows)
+
+    # P(t) for the figure: exact Kaplan–Meier at log-spaced times, and P_γ/P_0 on the τ grid
+    pg = _plot_grid(t_last)
+    surv = []
+    for g in gs:
+        c = survival_from_lifetimes(lts[g][["t_end", "outcome"]], pg)
+        surv.append(pd.DataFrame({"gamma": g, "key": raw_key(g), "t": c.t, "P": c.P, "P_err": c.P_err}))
+    surv = pd.concat(surv, ignore_index=True)
+    keep = (grid > 0) & (np.arange(grid.size) % max(1, round(0.5 / dt)) == 0)
+    ratio = []
+    for g in gs[1:]:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = P[g][keep] / P[0.0][keep]
+        ok = P[0.0][keep] * N >= 1
+        ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok],
+                                   "n0": (P[0.0][keep] * N)[ok]}))
+    ratio = pd.concat(ratio, ignore_index=True)
+
+    meta = {"E0": E0, "alpha": alpha, "tau0_rule": "choose_windows on P_0"}
+    study.write_table(taus, "fig4_tau.parquet", **meta)
+    study.write_table(surv, "fig4_survival.parquet", **meta)
+    study.write_table(ratio, "fig4_ratio.parquet", **meta)
+
+    # paper comparisons (the paper gives τ's only in figures; its statements are checked)
+    d = taus[taus["gamma"] > 0]
+    t1v = d["tau1"].to_numpy()
+    ok1 = np.isfinite(t1v)
+    mono1 = bool(np.all(np.diff(t1v[ok1]) <= 0)) if ok1.sum() > 1 else None
+    p_exp, p_err = _gamma_exponent(d["gamma"], d["tau2_obs"], d["tau2_obs_err"])
+    p50, p50_err = _gamma_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
+    res = d[d["tau1_resolved"]]
+    p1, p1_err = _gamma_exponent(res["gamma"], res["tau1"], res["tau1_err"])
+    study.compare(f"μ used for τ2 (own γ={mg:g} run, [{win[0]:g}, {win[1]:g}])", mu, mu_err, paper_mu,
+                  note="same definition as study fig3")
+    if mu_fig3 is not None:
+        study.compare("μ: fig4's own vs fig3", mu, mu_err, mu_fig3.get("value"),
+                      note="consistency check between studies (same seed; grids differ)")
+    r01 = taus[taus["gamma"] == 0.01]
+    if len(r01):
+        r = r01.iloc[0]
+        study.compare("τ2 predicted at γ = 0.01", r["tau2_pred"], r["tau2_pred_err"],
+                      float(tau2_predicted(E0, E_C, paper_mu, 0.01)), unit="time",
+                      note="paper value from its μ = 0.91 via Eq. (eq:tau2)")
+        study.compare("τ2 observed (first settling) at γ = 0.01", r["tau2_obs"], r["tau2_obs_err"], None,
+                      unit="time", note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
+                                        f"{round(r['f_settled'] * N)} settlers, decreases with N")
+    study.compare("τ1 increases as γ decreases", mono1, None, True,
+                  verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
+                  note="paper: 'both τ1 and τ2 increase with decreasing γ'")
+    if p1 is not None:
+        study.compare("p1 in τ1 ∝ γ^−p1", p1, p1_err, None,
+                      note="not in the paper; a linear κ0(E) with E = E0 e^{−μγt} gives P_γ/P_0 ≈ "
+                           "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2")
+    if p_exp is not None:
+        study.compare("p in τ2,obs ∝ γ^−p", p_exp, p_err, 1.0,
+                      note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); weighted log-log fit over γ with settlers")
+    if p50 is not None:
+        study.compare("p in median settling time ∝ γ^−p", p50, p50_err, 1.0,
+                      note="N-independent companion of τ2,obs (same fit)")
+    study.compare("τ0 (data-driven, on P_0)", tau0, float(boot["tau0"].std(ddof=1)) * bscale, None, unit="time",
+                  note="paper: τ0 effectively independent of γ; no value given")
+
+    def vu(v, e):
+        return {"value": None if not np.isfinite(v) else float(v), "err": None if not np.isfinite(e) else float(e)}
+
+    study.write_numbers({
+        "E0": E0,
+        "n_orbits_per_curve": N,
+        "gammas": gs,
+        "alpha": alpha,
+        "raw_keys": {f"{g:g}": raw_key(g) for g in gs},
+        "raw_key_naming": ("raw runs are studies/fig4/out/<scale>/raw/gamma<γ formatted with %g>: gamma0 (conservative "
+                           "reference), gamma0.001, gamma0.002, gamma0.005, gamma0.01, gamma0.02; every run has the "
+                           "same initial conditions (seed, n); raw/gamma<mu_gamma>_settled holds the energies of that "
+                           "run's settled orbits after settling (snapshots schema)"),
+        "tau0_rule": ("τ0 = choose_windows(P_0).tau0: first time after which the local escape rate of the conservative "
+                      "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.escape_rate)"),
+        "tau1_definition": f"first t ≥ τ0 with P_γ(t) = α P_0(t), α = {alpha:g} (Eq. eqn:tau1), grid step {dt:g}",
+        "tau2_obs_definition": "min settling time (first E = E_c inside Ω); depends on N",
+        "tau2_pred_definition": f"ln(E0/E_c)/(μγ) with μ from this study's γ = {mg:g} run on [{win[0]:g}, {win[1]:g}]",
+        "mu": {"value": float(mu), "err": mu_err},
+        "mu_gamma": mg,
+        "mu_window": list(win),
+        "mu_fig3": mu_fig3,
+        "paper_mu": paper_mu,
+        "continuation": {k: v for k, v in cont.items() if k != "key"},
+        "tau0": vu(tau0, float(boot["tau0"].std(ddof=1)) * bscale),
+        "taus": [
+            {
+                "gamma": r.gamma, "key": r.key,
+                "f_escaped": r.f_escaped, "f_settled": r.f_settled, "f_censored": r.f_censored,
+                "tau1": vu(r.tau1, r.tau1_err), "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
+                "tau1_resolved": r.tau1_resolved,
+                "tau2_obs": vu(r.tau2_obs, r.tau2_obs_err),
+                "t_settle_q01": vu(r.t_settle_q01, r.t_settle_q01_err),
+                "t_settle_q50": vu(r.t_settle_q50, r.t_settle_q50_err),
+                "tau2_pred": vu(r.tau2_pred, r.tau2_pred_err),
+                "tau2_pred_paper_mu": None if not np.isfinite(r.tau2_pred_paper_mu) else r.tau2_pred_paper_mu,
+            }
+            for r in taus.itertuples()
+        ],
+        "tau2_gamma_exponent": None if p_exp is None else {"value": p_exp, "err": p_err},
+        "settle_median_gamma_exponent": None if p50 is None else {"value": p50, "err": p50_err},
+        "tau1_gamma_exponent": None if p1 is None else {"value": p1, "err": p1_err},
+        "n_boot": nb,
+        "n_boot_orbits": K,
+        "errors": ("paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
+                   "scaled by sqrt(n_boot_orbits/N); for the minimum τ2,obs this is only indicative"),
+    })
+
+
+def _gamma_exponent(gamma, tau, tau_err):
+    """(p, σ_p) of a weighted least-squares fit log τ = c − p log γ over finite τ (None, None if < 2 points)."""
+    g, t, e = (np.asarray(v, dtype=float) for v in (gamma, tau, tau_err))
+    ok = np.isfinite(t) & (t > 0) & (g > 0)
+    if ok.sum() < 2:
+        return None, None
+    x, y = np.log(g[ok]), np.log(t[ok])
+    s = e[ok] / t[ok]
+    good = np.isfinite(s) & (s > 0)
+    s = np.where(good, s, s[good].max() if good.any() else 1.0)
+    A = np.column_stack([np.ones_like(x), x]) / s[:, None]
+    coef, *_ = np.linalg.lstsq(A, y / s, rcond=None)
+    cov = np.linalg.inv(A.T @ A)
+    dof = x.size - 2
+    if dof > 0:  # inflate by the reduced χ² when the points scatter more than their errors
+        chi2 = float(np.sum((A @ coef - y / s) ** 2)) / dof
+        cov = cov * max(1.0, chi2)
+    return float(-coef[1]), float(np.sqrt(cov[1, 1]))
+
+
+def plot(study):
+    """plot(study) -> None: fig4.png from the derived tables and fig4.json."""
+    from ..plotting.fig4 import plot_fig4
+
+    surv = pd.read_parquet(study.derived("fig4_survival.parquet"))
+    ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))
+    taus = pd.read_parquet(study.derived("fig4_tau.parquet"))
+    numbers = json.loads(study.numbers_path.read_text())
+    plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=float(study.param("mark_gamma")))

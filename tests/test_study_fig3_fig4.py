@@ -1,0 +1,238 @@
+"""Studies fig3 (energy decay, μ) and fig4 (P(t) vs γ, τ0/τ1/τ2): analysis additions on synthetic data
+with known answers, and tiny end-to-end runs checked against direct counts from the raw tables."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.analysis.decay import bootstrap_mu
+from hhscatter.analysis.survival import survival_curve
+from hhscatter.analysis.transitions import (
+    bootstrap_transition_times,
+    settle_time_quantiles,
+    survival_on_grid,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+E_C = 1.0 / 6.0
+
+
+# ---------------------------------------------------------------------------
+# synthetic data
+# ---------------------------------------------------------------------------
+def _ensemble(rng, m, mu, gamma, grid, E0=0.3, spread=0.0, rate=0.0):
+    """m orbits with E_i(t) = E0 exp(−μ_i γ t), μ_i = mu (1 + spread·N(0,1)), leaving at Exp(rate) times."""
+    mus = mu * (1 + spread * rng.standard_normal(m))
+    leave = rng.exponential(1 / rate, m) if rate > 0 else np.full(m, np.inf)
+    tid, t, e = [], [], []
+    for i in range(m):
+        g = grid[grid <= leave[i]]
+        tid.append(np.full(g.size, i))
+        t.append(g)
+        e.append(E0 * np.exp(-mus[i] * gamma * g))
+    return np.concatenate(tid), np.concatenate(t), np.concatenate(e)
+
+
+def test_bootstrap_mu_exact_exponential_has_no_spread():
+    rng = np.random.default_rng(0)
+    grid = np.arange(0.0, 200.5, 2.0)
+    tid, t, e = _ensemble(rng, 50, 0.93, 0.01, grid, rate=0.05)
+    b = bootstrap_mu(tid, t, e, 0.3, 0.01, [(0, 200), (50, 150)], n_boot=20, seed=1)
+    assert len(b) == 40 and set(b.columns) >= {"replicate", "t_lo", "t_hi", "mu", "mu_free"}
+    np.testing.assert_allclose(b["mu"], 0.93, rtol=1e-10)
+    np.testing.assert_allclose(b["mu_free"], 0.93, rtol=1e-10)
+
+
+def test_bootstrap_mu_error_matches_spread_of_independent_ensembles():
+    """The bootstrap σ of μ must match the scatter of μ over independent ensembles (the true sampling error)."""
+    from hhscatter.analysis.decay import fit_energy_decay, mean_energy_arrays
+
+    grid = np.arange(0.0, 200.5, 4.0)
+    rng = np.random.default_rng(3)
+    fits, boots = [], []
+    for k in range(40):
+        tid, t, e = _ensemble(rng, 150, 0.95, 0.01, grid, spread=0.15, rate=0.01)
+        me = mean_energy_arrays(t, e)
+        fits.append(fit_energy_decay(me["t"], me["mean_E"], 0.3, 0.01, (0, 200)).mu)
+        if k < 8:
+            boots.append(bootstrap_mu(tid, t, e, 0.3, 0.01, [(0, 200)], n_boot=80, seed=k)["mu"].std(ddof=1))
+    true_sd = np.std(fits, ddof=1)
+    assert 0.6 * true_sd < np.mean(boots) < 1.5 * true_sd
+    assert abs(np.mean(fits) - 0.95) < 0.05  # heterogeneous μ_i: the ensemble mean decays near the mean rate
+
+
+def test_pool_mean_energy_equals_statistics_of_the_union():
+    from hhscatter.analysis.decay import mean_energy_arrays, pool_mean_energy
+
+    rng = np.random.default_rng(2)
+    t = rng.integers(0, 15, 4000).astype(float)
+    e = 0.3 * rng.random(4000)
+    parts = [mean_energy_arrays(t[k::4], e[k::4]) for k in range(4)] + [mean_energy_arrays([99.0], [0.1])]
+    p = pool_mean_energy(parts)
+    for tk in (0.0, 7.0, 14.0):  # closed-form reference: numpy on all rows at that time
+        row = p[p["t"] == tk].iloc[0]
+        assert row["n"] == (t == tk).sum()
+        assert row["mean_E"] == pytest.approx(e[t == tk].mean(), rel=1e-13)
+        assert row["std_E"] == pytest.approx(e[t == tk].std(ddof=1), rel=1e-12)
+        assert row["sem_E"] == pytest.approx(e[t == tk].std(ddof=1) / np.sqrt((t == tk).sum()), rel=1e-12)
+    last = p[p["t"] == 99.0].iloc[0]
+    assert last["n"] == 1 and last["mean_E"] == 0.1 and np.isnan(last["std_E"])
+
+
+def test_survival_on_grid_matches_kaplan_meier_and_weights():
+    rng = np.random.default_rng(5)
+    n = 3000
+    grid = np.round(np.arange(0.0, 40.0, 0.5), 9)
+    t_end = rng.exponential(8.0, n)
+    observed = np.ones(n, bool)
+    # censoring at grid times (ties at risk, as Kaplan–Meier counts them)
+    cidx = rng.choice(n, 300, replace=False)
+    t_end[cidx] = rng.choice(grid[1:], 300)
+    observed[cidx] = False
+    np.testing.assert_allclose(survival_on_grid(t_end, observed, grid), survival_curve(t_end, observed, grid).P,
+                               rtol=1e-12, atol=1e-15)
+    # integer weights = replicated orbits; without censoring P is the weighted fraction with t_end > t
+    w = rng.integers(0, 4, n).astype(float)
+    obs = np.ones(n, bool)
+    direct = np.array([(w * (t_end > g)).sum() / w.sum() for g in grid])
+    np.testing.assert_allclose(survival_on_grid(t_end, obs, grid, w), direct, rtol=1e-12, atol=1e-15)
+    with pytest.raises(ValueError, match="weights"):
+        survival_on_grid(t_end, obs, grid, -w)
+
+
+def test_settle_time_quantiles():
+    t = np.array([5.0, 1.0, 3.0, 2.0, 4.0, 100.0])
+    oc = np.array(["settled"] * 5 + ["escaped"])
+    np.testing.assert_allclose(settle_time_quantiles(t, oc, (0.0, 0.5, 1.0)), [1.0, 3.0, 5.0])
+    assert settle_time_quantiles(t, np.array(["escaped"] * 6)) is None
+    w = np.array([0, 1, 1, 1, 1, 1.0])  # orbit with t = 5 absent
+    assert settle_time_quantiles(t, oc, (1.0,), w)[0] == 4.0
+
+
+def test_bootstrap_transition_times_on_paired_exponentials():
+    """P_0 = e^{−κt}, P_γ = e^{−κ't} from the same uniforms: τ1 = ln 2/(κ − κ'); σ_boot ≈ true scatter."""
+    kappa, kappa_g, n = 0.2, 0.15, 20000
+    exact = np.log(2.0) / (kappa - kappa_g)
+    grid = np.round(np.arange(0.0, 60.0, 0.05), 9)
+    rng = np.random.default_rng(11)
+    from hhscatter.analysis.transitions import tau1
+
+    pts, calls = [], []
+
+    def rule(g, P, neff):
+        calls.append(neff)
+        return 2.0
+
+    for k in range(12):
+        u = rng.random(n)
+        t0, tg = -np.log(u) / kappa, -np.log(u) / kappa_g
+        oc0 = np.array(["escaped"] * n, dtype=object)
+        ocg = np.where(rng.random(n) < 0.01, "settled", "escaped").astype(object)
+        P0 = survival_on_grid(t0, np.ones(n, bool), grid)
+        Pg = survival_on_grid(tg, np.ones(n, bool), grid)
+        pts.append(tau1(grid, Pg, P0, 2.0))
+        if k == 0:
+            b = bootstrap_transition_times({"0": (t0, oc0), "g": (tg, ocg)}, "0", grid, tau0=rule, n_boot=40, seed=2)
+            assert len(calls) == 40 and all(abs(c - n) < 5 * np.sqrt(n) for c in calls)
+            assert set(b["label"]) == {"g"} and (b["tau0"] == 2.0).all()
+            # τ2_obs of each replicate is the minimum over the settled orbits it drew
+            assert (b["tau2_obs"] >= tg[ocg == "settled"].min()).all()
+            sd_boot = b["tau1"].std(ddof=1)
+    pts = np.array(pts)
+    assert abs(pts.mean() - exact) < 4 * pts.std(ddof=1) / np.sqrt(pts.size) + 0.1
+    assert 0.5 * pts.std(ddof=1) < sd_boot < 2.0 * pts.std(ddof=1)
+    with pytest.raises(ValueError, match="paired"):
+        bootstrap_transition_times({"0": (t0, oc0), "g": (tg[:10], ocg[:10])}, "0", grid, tau0=2.0, n_boot=2)
+
+
+def test_snapshot_grid_pieces():
+    from hhscatter.studies.fig3 import snapshot_grid
+
+    g = snapshot_grid([[0, 2, 0.5], [3, 9, 3]])
+    np.testing.assert_array_equal(g, [0, 0.5, 1, 1.5, 2, 3, 6, 9])
+    with pytest.raises(ValueError, match="increasing"):
+        snapshot_grid([[0, 2, 0.5], [1, 3, 1]])
+    from hhscatter.studies.fig4 import raw_key
+
+    assert [raw_key(g) for g in (0, 0.001, 0.01, 2e-2)] == ["gamma0", "gamma0.001", "gamma0.01", "gamma0.02"]
+
+
+# ---------------------------------------------------------------------------
+# tiny end-to-end runs
+# ---------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def tiny_root(tmp_path_factory):
+    from hhscatter.studies import run_stage
+
+    root = tmp_path_factory.mktemp("studies")
+    for name in ("fig3", "fig4"):
+        (root / name).mkdir()
+        shutil.copy(ROOT / "studies" / name / "study.toml", root / name / "study.toml")
+    for name in ("fig3", "fig4"):
+        run_stage(name, "all", "tiny", workers=1, progress=False, root=root)
+    return root
+
+
+def test_fig3_tiny_end_to_end(tiny_root):
+    from hhscatter.tables import read_lifetimes, read_snapshots
+
+    out = tiny_root / "fig3" / "out" / "tiny"
+    nums = json.loads((out / "fig3.json").read_text())
+    assert (out / "fig3.png").stat().st_size > 10_000
+    lt = read_lifetimes(out / "raw" / "e0.3_gamma0.01")
+    N = len(lt)
+    me = pd.read_parquet(out / "derived" / "fig3_mean_energy.parquet")
+    # ⟨E⟩(0) = E0 exactly (all orbits start on the energy shell); n(t) = N − #escaped before t
+    assert me["n"].iloc[0] == N and abs(me["mean_E"].iloc[0] - 0.3) < 1e-12
+    esc = np.sort(lt.loc[lt["outcome"] == "escaped", "t_end"].to_numpy())
+    expect = N - np.searchsorted(esc, me["t"].to_numpy(), side="left")
+    np.testing.assert_array_equal(me["n"].to_numpy(), expect)
+    # the continuation: settled orbits below E_c, energy non-increasing in t (dE/dt = −γ v² ≤ 0)
+    cont = read_snapshots(out / "raw" / "e0.3_gamma0.01_settled").sort_values(["traj_id", "t"])
+    assert set(cont["traj_id"]) == set(lt.loc[lt["outcome"] == "settled", "traj_id"])
+    assert (cont["energy"] < E_C).all()
+    assert (cont.groupby("traj_id")["energy"].diff().dropna() <= 1e-15).all()
+    assert nums["continuation"]["n_failed"] == 0
+    assert 0.85 < nums["mu"]["value"] < 1.0 and 0 < nums["mu"]["err"] < 0.05
+    # local exponent approaches 1 late (paper's claim; holds already at this size)
+    lw = nums["mu_later_windows"]
+    assert lw[-1]["mu_local"]["value"] > lw[0]["mu_local"]["value"]
+    rows = {r["quantity"]: r for r in nums["paper_comparison"]}
+    assert rows["μ on [0, 200] (log fit, E(0)=E0)"]["paper"] == 0.91
+    hist = pd.read_parquet(out / "derived" / "fig3_histograms.parquet")
+    assert hist.groupby("t")["count"].sum().to_dict() == hist.groupby("t")["n_inside"].first().to_dict()
+
+
+def test_fig4_tiny_end_to_end(tiny_root):
+    from hhscatter.tables import read_lifetimes
+
+    out = tiny_root / "fig4" / "out" / "tiny"
+    nums = json.loads((out / "fig4.json").read_text())
+    assert (out / "fig4.png").stat().st_size > 10_000
+    assert nums["raw_keys"] == {"0": "gamma0", "0.01": "gamma0.01", "0.02": "gamma0.02"}
+    lts = {g: read_lifetimes(out / "raw" / k).sort_values("traj_id") for g, k in nums["raw_keys"].items()}
+    np.testing.assert_array_equal(lts["0"]["x0"].to_numpy(), lts["0.02"]["x0"].to_numpy())
+    taus = pd.read_parquet(out / "derived" / "fig4_tau.parquet").set_index("key")
+    dt = 0.05
+    grid = np.round(np.arange(0.0, 200.0, dt), 9)
+    cnt = {g: np.array([(lt["t_end"].to_numpy() > t).sum() for t in grid]) for g, lt in lts.items()}
+    tau0 = nums["tau0"]["value"]
+    for g in ("0.01", "0.02"):
+        r = taus.loc[f"gamma{g}"]
+        # τ1 from direct counting: first grid time ≥ τ0 with N_γ(t) ≥ 2 N_0(t)
+        hit = np.flatnonzero((grid >= tau0) & (cnt[g] >= 2 * cnt["0"]))[0]
+        assert grid[hit] - dt - 1e-9 <= r["tau1"] <= grid[hit] + 1e-9
+        lt = lts[g]
+        assert r["tau2_obs"] == lt.loc[lt["outcome"] == "settled", "t_end"].min()
+        mu = nums["mu"]["value"]
+        assert r["tau2_pred"] == pytest.approx(np.log(0.3 / E_C) / (mu * float(g)), rel=1e-12)
+    # survival table: P(t) equals the fraction of orbits with t_end > t
+    s = pd.read_parquet(out / "derived" / "fig4_survival.parquet")
+    s = s[s["gamma"] == 0.02].iloc[::97]
+    t_end = lts["0.02"]["t_end"].to_numpy()
+    np.testing.assert_allclose(s["P"], [(t_end > t).mean() for t in s["t"]], rtol=0, atol=1e-12)

@@ -1,0 +1,241 @@
+"""Studies fig5 (c-measure comparison) and fig6 (survival model): new analysis helpers and tiny end-to-end runs.
+
+The analysis functions are tested against closed forms and constructed data;
+the end-to-end tests run both studies at scale ``tiny`` in a temporary
+studies root, with the upstream inputs made here: real tiny simulations in
+the layout of studies fig1/fig4 and minimal numbers JSONs carrying the
+paper's values (μ = 0.91, κ0 fit 13.63/0.03/1.41/0.27) as stated inputs.
+"""
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.analysis import distance as dist
+from hhscatter.analysis.model import E_C, time_to_energy
+from hhscatter.analysis.transitions import tau2_predicted
+from hhscatter.studies import _upstream as up
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+# ---------------------------------------------------------------------------
+# analysis helpers
+# ---------------------------------------------------------------------------
+def test_time_to_energy_inverts_the_exponential_law():
+    # paper: E2 = 0.35 → E1 = 0.30 with μ = 0.91, γ = 0.01 gives t* ≈ 17
+    ts = time_to_energy(0.35, 0.30, 0.91, 0.01)
+    assert ts == pytest.approx(math.log(0.35 / 0.30) / 0.0091, rel=1e-14)
+    assert 0.35 * math.exp(-0.91 * 0.01 * ts) == pytest.approx(0.30, rel=1e-14)
+    assert round(ts) == 17
+    # Eq. (eq:tau2) is the special case E1 = E_c
+    g = np.array([1e-3, 1e-2, 2e-2])
+    np.testing.assert_allclose(time_to_energy(0.3, E_C, 0.9, g), tau2_predicted(0.3, E_C, 0.9, g), rtol=1e-14)
+    with pytest.raises(ValueError, match="E0 >= E1"):
+        time_to_energy(0.2, 0.3, 1.0, 0.01)
+    with pytest.raises(ValueError, match="mu\\*gamma"):
+        time_to_energy(0.35, 0.3, 1.0, 0.0)
+
+
+def test_first_crossings_picks_first_after_t_from_then_filters_energy():
+    sec = pd.DataFrame({
+        "traj_id": [1, 1, 1, 2, 2, 3, 4],
+        "t": [5.0, 17.5, 19.0, 16.0, 18.0, 30.0, 10.0],
+        "x": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7],
+        "y": 0.0,
+        "energy": [0.33, 0.31, 0.299, 0.30, 0.30, 0.28, 0.32],
+    })
+    out = dist.first_crossings(sec.sample(frac=1.0, random_state=3), 17.0)  # order must not matter
+    assert out["traj_id"].tolist() == [1, 2, 3]  # orbit 4 has no crossing after t*
+    assert out["t"].tolist() == [17.5, 18.0, 30.0]
+    # the band filter acts on the first crossing: orbit 1's first crossing (E = 0.31) is out of
+    # the band, and its later in-band crossing (E = 0.299) must NOT be taken instead
+    band = dist.first_crossings(sec, 17.0, e_min=0.295, e_max=0.305)
+    assert band["traj_id"].tolist() == [2]
+    with pytest.raises(ValueError, match="columns"):
+        dist.first_crossings(sec.drop(columns="t"), 1.0)
+
+
+def test_distance_vs_scale_common_sample_size():
+    rng = np.random.default_rng(4)
+    P = rng.random((4000, 2))
+    Q = rng.random((1000, 2))  # same distribution, fewer points
+    boxes = [0.25, 0.125]
+    small = dist.distance_vs_scale(P, Q, boxes, (0, 1, 0, 1), n_splits=6, seed=1, m=100)
+    full = dist.distance_vs_scale(P, Q, boxes, (0, 1, 0, 1), n_splits=6, seed=1)
+    assert (small["m"] == 100).all() and (full["m"] == 500).all()
+    # finite-sample noise floor E[H²] ≈ B/8 (1/m + 1/m) for B boxes with many counts each
+    # (B = 16 boxes of side 0.25: ≥ 6 points per box at m = 100): shrinks as 1/√m
+    for tab, m in ((small, 100), (full, 500)):
+        assert tab["hellinger_noise"].iloc[0] == pytest.approx(math.sqrt(16 / 8 * 2 / m), rel=0.2)
+        # same distribution: the cross distance sits on the noise floor
+        z = (tab["hellinger_pq"] - tab["hellinger_noise"]) / np.hypot(tab["hellinger_pq_std"],
+                                                                      tab["hellinger_noise_std"])
+        assert (np.abs(z) < 3).all()
+    assert (small["hellinger_noise"] > full["hellinger_noise"]).all()
+    with pytest.raises(ValueError, match="m must be in"):
+        dist.distance_vs_scale(P, Q, boxes, (0, 1, 0, 1), n_splits=2, m=501)
+
+
+def test_debiased_hellinger_recovers_exact_distance_of_shifted_uniforms():
+    # P uniform on [0,1]², Q uniform on [0.1,1.1]×[0,1]; on boxes anchored at x = 0 the exact
+    # Hellinger distance of the coarse-grained distributions is H² = 1 − Σ√(p q):
+    #   ε = 0.1: 90 of 100 cells shared with p = q = 0.01 → H² = 0.1
+    #   ε = 0.2: per column Σ√(pq) = √(0.2·0.1) + 4·0.2 → H² = 0.2 − √0.02
+    exact = {0.2: math.sqrt(0.2 - math.sqrt(0.02)), 0.1: math.sqrt(0.1)}
+    rng = np.random.default_rng(11)
+    n = 8000
+    P = rng.random((n, 2))
+    Q = rng.random((n, 2)) + [0.1, 0.0]
+    ext = (0.0, 1.1 + 1e-9, 0.0, 1.0 + 1e-9)
+    for m in (600, 4000):
+        tab = dist.distance_vs_scale(P, Q, [0.2, 0.1], ext, kinds=("hellinger",), n_splits=6, seed=3, m=m)
+        d, lo, hi = dist.debiased_distance(tab)
+        for box, dv, lv, hv, raw in zip(tab["box"], d, lo, hi, tab["hellinger_pq"]):
+            # the correction is exact for shared cells with p = q; the edge cells (p ≠ q) and the
+            # finite full sample leave a few per cent, against 7–20 % bias of the raw value at m = 600
+            assert dv == pytest.approx(exact[box], rel=0.06), (m, box)
+            assert lv <= dv <= hv
+            assert raw - exact[box] > abs(dv - exact[box])  # the raw split-half value is biased upwards
+        assert dist.agreement_scale_debiased(tab, delta=0.28) == 0.2  # 0.242 ≤ δ < 0.316
+        assert dist.agreement_scale_debiased(tab, delta=0.2) is None
+    # identical distributions: the corrected distance is compatible with 0 at every scale
+    same = dist.distance_vs_scale(P, rng.random((n, 2)), [0.2, 0.1, 0.05], ext, kinds=("hellinger",),
+                                  n_splits=6, seed=3)
+    d, lo, hi = dist.debiased_distance(same)
+    assert (lo == 0).all() and (d < 0.05).all()
+    assert dist.agreement_scale_debiased(same, delta=0.05) == 0.05
+
+
+def test_upstream_lookup_dotted_keys_and_errors():
+    doc = {"energies": {"E0.30": {"t_rec": 24.0}}, "mu": {"value": 0.93, "err": 0.01},
+           "taus": [{"gamma": 0.01, "tau1": {"value": 17.0, "err": 1.0}}]}
+    assert up.lookup(doc, "energies.E0.30.t_rec")[0] == 24.0
+    assert up.lookup(doc, "mu") == (0.93, 0.01)
+    assert up.lookup(doc, "taus.0.tau1") == (17.0, 1.0)
+    with pytest.raises(up.UpstreamError, match="present: \\['energies', 'mu', 'taus'\\]"):
+        up.lookup(doc, "kappa_fit.a")
+
+
+# ---------------------------------------------------------------------------
+# tiny end-to-end runs
+# ---------------------------------------------------------------------------
+def _copy_toml(root: Path, name: str):
+    (root / name).mkdir(parents=True, exist_ok=True)
+    shutil.copy(REPO / "studies" / name / "study.toml", root / name / "study.toml")
+
+
+def _write_numbers(root: Path, name: str, doc: dict):
+    out = root / name / "out" / "tiny"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{name}.json").write_text(json.dumps(doc))
+
+
+def _run(scene, out):
+    from hhscatter.runner import simulate
+
+    simulate(scene, out, workers=1, overwrite=True, progress=False)
+
+
+@pytest.fixture(scope="module")
+def tiny_root(tmp_path_factory):
+    """Studies root with fig5/fig6 study files and minimal upstream outputs (real tiny runs)."""
+    from hhscatter.scene import Scene, SectionWindow
+
+    root = tmp_path_factory.mktemp("studies")
+    for name in ("fig1", "fig2", "fig3", "fig4", "fig5", "fig6"):
+        _copy_toml(root, name)
+    # fig1: sprinkler samples at E = 0.30, 0.35, first crossing at t >= t_rec (fig1's layout)
+    t_rec = {"E0.30": 12.0, "E0.35": 10.0}
+    for key, E in (("E0.30", 0.30), ("E0.35", 0.35)):
+        _run(Scene(energy=E, n=5000, seed=31, t_max=60.0, chunk_size=2500,
+                   sections=SectionWindow(t_from=t_rec[key], first_only=True)),
+             root / "fig1" / "out" / "tiny" / "raw" / key)
+    _write_numbers(root, "fig1", {"energies": {k: {"t_rec": v} for k, v in t_rec.items()}})
+    # fig2 / fig3: the paper's fitted values as stated inputs
+    _write_numbers(root, "fig2", {"kappa_fit": {k: {"value": v, "err": 0.0} for k, v in
+                                                (("a", 13.63), ("b", 0.03), ("c", 1.41), ("E_b", 0.27))}})
+    _write_numbers(root, "fig3", {"mu": {"value": 0.91, "err": 0.01}})
+    # fig4: P(t) runs at E0 = 0.3 (γ = 0 and 0.02) and its τ table
+    for g in (0.0, 0.02):
+        _run(Scene(energy=0.3, gamma=g, n=600, seed=41, t_max=150.0, chunk_size=300),
+             root / "fig4" / "out" / "tiny" / "raw" / f"gamma{g:g}")
+    _write_numbers(root, "fig4", {"tau0": {"value": 3.0, "err": 0.1},
+                                  "taus": [{"gamma": 0.02, "tau1": {"value": 12.0, "err": 1.0},
+                                            "tau2_obs": {"value": 29.0, "err": 0.5}}]})
+    return root
+
+
+def test_fig5_tiny_end_to_end(tiny_root):
+    from hhscatter.studies import load_study, run_stage
+
+    run_stage("fig5", "all", "tiny", workers=1, progress=False, root=tiny_root)
+    study = load_study("fig5", "tiny", root=tiny_root)
+    nums = json.loads(study.numbers_path.read_text())
+    assert study.figure_path.stat().st_size > 10_000
+    assert nums["dev_fallback"] is False
+    assert nums["inputs"]["mu"]["source"] == "fig3.json:mu"
+    # t* from μ = 0.91 (Eq. (eqn:energy_exp_decay)) for each γ
+    for g in (0.03, 0.02):
+        assert nums["t_star"][f"gamma{g:g}"]["value"] == pytest.approx(math.log(0.35 / 0.30) / (0.91 * g))
+    pts = pd.read_parquet(study.out / "derived" / "points.parquet")
+    per = {r["gamma"]: r for r in nums["per_gamma"]}
+    for g in (0.03, 0.02):
+        a = pts[(pts["gamma"] == g) & (pts["set"] == "a")]
+        b = pts[(pts["gamma"] == g) & (pts["set"] == "b")]
+        assert len(a) == per[g]["n_a"] > 0
+        assert (a["t"] >= per[g]["t_star"]).all() and a["traj_id"].is_unique
+        assert set(b["traj_id"]) <= set(a["traj_id"])
+        assert ((b["energy"] >= 0.295) & (b["energy"] <= 0.305)).all()
+        # energy of a crossing lies below E2 and above E_c (the orbit still scatters)
+        assert (a["energy"] < 0.35).all() and (a["energy"] > E_C).all()
+    summ = pd.read_parquet(study.out / "derived" / "distance_summary.parquet")
+    assert {"sw1", "sw1_err", "hellinger", "hellinger_err", "agreement_scale"} <= set(summ.columns)
+    assert ((summ["hellinger"] >= 0) & (summ["hellinger"] <= 1)).all()
+    assert any(r["quantity"].startswith("t*") for r in nums["paper_comparison"])
+
+
+def test_fig5_fails_clearly_without_fig1(tiny_root, tmp_path, monkeypatch):
+    from hhscatter.studies import run_stage
+
+    monkeypatch.delenv(up.DEV_ENV, raising=False)
+    for name in ("fig3", "fig5"):
+        shutil.copytree(tiny_root / name, tmp_path / name)
+    _copy_toml(tmp_path, "fig1")
+    with pytest.raises(up.UpstreamError, match="fig1"):
+        run_stage("fig5", "analyze", "tiny", root=tmp_path)
+
+
+def test_fig6_tiny_end_to_end(tiny_root):
+    from hhscatter.studies import load_study, run_stage
+
+    run_stage("fig6", "all", "tiny", workers=1, progress=False, root=tiny_root)
+    study = load_study("fig6", "tiny", root=tiny_root)
+    nums = json.loads(study.numbers_path.read_text())
+    assert study.figure_path.stat().st_size > 10_000
+    assert nums["dev_fallback"] is False
+    assert nums["kappa0"]["a"] == 13.63 and nums["tau0"] == 3.0
+    fits = pd.DataFrame(nums["fits"])
+    assert set(fits["model"]) == {"homogeneous", "mixture_tau0", "mixture_free"}
+    # a shared-φ mixture has as many free parameters as the homogeneous model, a free one K − 1 more
+    nf = fits.groupby("model")["n_free"].max()
+    assert nf["mixture_tau0"] == nf["homogeneous"] == 3 and nf["mixture_free"] == 3 + 2 - 1
+    assert set(fits["hazard"]) == {"paper", "integrated"}
+    assert (fits["n_points"] > 3).all()
+    # all models are compared on the same points
+    for (_, _), grp in fits.groupby(["pair", "hazard"]):
+        assert grp["n_points"].nunique() == 1
+    # constraint f_ne + f_e = P(τ0) of Eq. (eqn:surv_prob_model)
+    hom = fits[fits["model"] == "homogeneous"]
+    np.testing.assert_allclose(hom["f_ne"] + hom["f_e"], hom["P_tau0"], rtol=1e-12)
+    taus = pd.DataFrame(nums["tau_vs_gamma"])
+    row = taus[taus["gamma"] == 0.02].iloc[0]
+    assert row["tau2_predicted"] == pytest.approx(math.log(0.3 / E_C) / (0.91 * 0.02))
+    assert row["tau1_observed"] == 12.0 and row["tau2_observed"] == 29.0
+    assert row["tau1_pred_integrated"] is None or row["tau1_pred_integrated"] >= 3.0
