@@ -76,7 +76,9 @@ fig5: $(call so,fig5)/fig5.png ## Fig 5: dissipative section points vs the conse
 fig6: $(call so,fig6)/fig6.png ## Fig 6: survival model vs simulations; τ1, τ2 vs γ; mixture model
 studies: fig1 fig2 resc fig3 fig4 fig5 fig6 ## all studies at SCALE (default quick)
 
-REPORT_INPUTS := $(foreach s,fig1 fig2 resc fig3 fig4 fig5 fig6,$(call so,$(s))/$(s).png)
+BENCH_SUMMARY := studies/bench/out/full/summary.md
+STRESS_SUMMARY := studies/stress/out/full/summary.md
+REPORT_INPUTS := $(foreach s,fig1 fig2 resc fig3 fig4 fig5 fig6,$(call so,$(s))/$(s).png) $(BENCH_SUMMARY) $(STRESS_SUMMARY)
 reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py
 	$(PY) -m hhscatter.report --scale $(SCALE)
 
@@ -85,7 +87,46 @@ report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown) fr
 bench-engine: $(STAMP) ## µs per orbit of the engine (1 and all workers), time inside heyoka
 	$(PY) -m hhscatter.bench_engine $(BENCH_ARGS)
 
+bench-memory: $(STAMP) ## peak RSS of simulate + P(t) at E=0.27, N=1e5,1e6,1e7, 1 worker (1e7: ~5-10 CPU-min)
+	$(PY) -m hhscatter.bench_memory $(MEMORY_ARGS)
+
+BENCH_STAMP := $(VENV)/.bench-stamp
+$(BENCH_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet -e '.[bench]'
+	@touch $@
+
+bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput → studies/bench/out/ (CSV, PNG, summary.md)
+	$(PY) -m hhscatter.bench $(BENCH_ARGS)
+
+# the report runs the benchmarks only when their summaries are missing or their code changed
+$(BENCH_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/bench/bench.toml | $(BENCH_STAMP)
+	$(PY) -m hhscatter.bench
+$(STRESS_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/stress/stress.toml | $(BENCH_STAMP)
+	$(PY) -m hhscatter.bench.stress
+
+stress: $(BENCH_STAMP) ## numerical stress tests (drift, threshold, grazing events, γ extremes, KS) → studies/stress/out/
+	$(PY) -m hhscatter.bench.stress $(STRESS_ARGS)
+
 clean-runs: ## delete simulation outputs under runs/
 	rm -rf $(RUNS)
 
-.PHONY: help venv test test-slow demo bench-engine clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6
+# -- documentation: mkdocs --strict, offline (docs/, mkdocs.yml) ----------------
+DOCS_STAMP := $(VENV)/.docs-stamp
+MKDOCS := NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs
+
+$(DOCS_STAMP): $(STAMP) pyproject.toml
+	$(PY) -m pip install --quiet -e '.[docs]'
+	@touch $@
+
+docs: $(DOCS_STAMP) ## build the documentation site into site/ (mkdocs --strict: warnings are errors)
+	$(MKDOCS) build --strict --clean --site-dir site
+
+docs-serve: $(DOCS_STAMP) ## serve the docs with live reload at http://127.0.0.1:8000
+	$(MKDOCS) serve --strict
+
+docs-assets: ## copy the studies' quick-scale figures/numbers and bench summaries into docs/
+	$(PYTHON) docs/gen_studies.py
+
+.PHONY: docs docs-serve docs-assets
+
+.PHONY: help venv test test-slow demo bench-engine bench-memory bench stress clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6

@@ -63,8 +63,8 @@ def _fmt(v, err=None) -> str:
         # one significant digit of the error, two when it starts with 1 or 2 (as particle-data tables do)
         exp10 = int(math.floor(math.log10(err)))
         digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
-        if abs(v) >= 1e4 or (v != 0 and abs(v) < 1e-3):
-            return f"{v:.3e} ± {err:.1e}"
+        if abs(v) >= 1e4 or digits > 5:
+            return f"{v:.3g} ± {err:.1e}" if v != 0 else f"0 ± {err:.1e}"
         return f"{v:.{digits}f} ± {err:.{digits}f}"
     if isinstance(v, (list, tuple)):
         if len(v) <= 6 and all(isinstance(x, (int, float)) for x in v):
@@ -141,29 +141,59 @@ def _provenance(sections):
     return {}
 
 
-def _bench(root: Path):
-    out = root / "bench" / "out"
-    md = next(iter(sorted(out.glob("**/summary.md"))), None) if out.exists() else None
-    pngs = sorted(out.glob("**/*.png")) if out.exists() else []
-    return md, pngs
+BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
+               ("stress", "Numerical stress tests (`make stress`)"))
+
+
+def _bench(root: Path, name: str = "bench"):
+    """_bench(root, name) -> (summary.md or None, [png]) of the full-scale benchmark/stress output."""
+    out = root / name / "out" / "full"
+    md = out / "summary.md"
+    return (md if md.exists() else None), (sorted(out.glob("*.png")) if out.exists() else [])
+
+
+def split_rows(rows):
+    """split_rows(rows) -> (paper_rows, beyond_rows): rows with a number the paper states vs the rest."""
+    paper = [r for r in rows if r["study"] in PAPER_FIGURES and r.get("paper") is not None]
+    beyond = [r for r in rows if not (r["study"] in PAPER_FIGURES and r.get("paper") is not None)]
+    return paper, beyond
+
+
+def verdict_counts(rows) -> dict:
+    counts = {"ok": 0, "bad": 0, "meh": 0, "": 0}
+    for r in rows:
+        counts[_verdict_class(r.get("verdict"))] += 1
+    return counts
+
+
+def _md_rows(rows):
+    out = ["| study | quantity | paper | ours | verdict | note |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['study']} | {r['quantity']} | {_fmt(r.get('paper'))} | {_fmt(r.get('ours'), r.get('err'))}"
+                   f" | {r.get('verdict') or '—'} | {(r.get('note') or '').replace('|', '/')} |")
+    if not rows:
+        out.append("| — | no study outputs found | | | | |")
+    return out
+
+
+def _count_line(rows):
+    c = verdict_counts(rows)
+    return f"{len(rows)} numbers: {c['ok']} agree, {c['bad']} differ, {c['meh'] + c['']} qualitative or not comparable."
 
 
 def render_markdown(sections, scale, root, assets: Path) -> str:
-    rows = comparison_rows(sections)
+    paper_rows, beyond_rows = split_rows(comparison_rows(sections))
     prov = _provenance(sections)
     lines = [f"# hhscatter reproduction report ({scale} scale)", "",
              "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
              "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
-             "studies' numbers JSON files; see `make help` for the targets that made them.", "",
+             "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: |ours − paper| "
+             "≤ 2σ (our statistical error) unless the row says otherwise.", "",
              f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
              f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str))}.", "",
-             "## The paper's numbers beside ours", "",
-             "| study | quantity | paper | ours | verdict | note |", "|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(f"| {r['study']} | {r['quantity']} | {_fmt(r.get('paper'))} | {_fmt(r.get('ours'), r.get('err'))}"
-                     f" | {r.get('verdict') or '—'} | {(r.get('note') or '').replace('|', '/')} |")
-    if not rows:
-        lines.append("| — | no study outputs found | | | | |")
+             "## The paper's numbers beside ours", "", _count_line(paper_rows), "", *_md_rows(paper_rows), "",
+             "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
+             *_md_rows(beyond_rows)]
     for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
         lines += ["", f"## {group}", ""]
         for s in (s for s in sections if s.key in keys):
@@ -177,15 +207,16 @@ def render_markdown(sections, scale, root, assets: Path) -> str:
                 lines += ["| number | value |", "|---|---|"]
                 lines += [f"| {k} | {v} |" for k, v in headline_numbers(s.numbers)]
                 lines.append("")
-    md, pngs = _bench(root)
-    lines += ["## Work–precision and stress", ""]
-    if md:
-        lines += [md.read_text(), ""]
-        for p in pngs:
-            shutil.copyfile(p, assets / p.name)
-            lines += [f"![{p.stem}]({assets.name}/{p.name})", ""]
-    else:
-        lines += ["*Not generated yet: run `make bench`.*", ""]
+    for name, title in BENCH_PARTS:
+        md, pngs = _bench(root, name)
+        lines += [f"## {title}", ""]
+        if md:
+            lines += [md.read_text(), ""]
+            for p in pngs:
+                shutil.copyfile(p, assets / f"{name}-{p.name}")
+                lines += [f"![{p.stem}]({assets.name}/{name}-{p.name})", ""]
+        else:
+            lines += [f"*Not generated yet: run `make {name}`.*", ""]
     return "\n".join(lines) + "\n"
 
 
@@ -227,20 +258,9 @@ def _md_table_to_html(text: str) -> str:
     return "\n".join(out)
 
 
-def render_html(sections, scale, root) -> str:
-    rows = comparison_rows(sections)
-    prov = _provenance(sections)
+def _html_rows(rows):
     e = html.escape
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report ({e(scale)})"
-             f"</title><style>{_CSS}</style></head><body>",
-             f"<h1>hhscatter reproduction report <small>({e(scale)} scale)</small></h1>",
-             "<p>Reproduction of Burton, Dullin &amp; Altmann, <i>Dissipative chaotic scattering</i> (Hénon–Heiles "
-             "with linear drag), with exact event times from heyoka's Taylor integrator. Every number below is read "
-             "from the studies' numbers JSON files.</p>",
-             f"<p>Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; versions: "
-             f"{e(', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str)))}.</p>",
-             "<h2>The paper's numbers beside ours</h2><table><tr><th>study</th><th>quantity</th><th>paper</th>"
-             "<th>ours</th><th>verdict</th><th>note</th></tr>"]
+    parts = ["<table><tr><th>study</th><th>quantity</th><th>paper</th><th>ours</th><th>verdict</th><th>note</th></tr>"]
     for r in rows:
         parts.append(f"<tr><td>{e(r['study'])}</td><td>{e(str(r['quantity']))}</td><td>{e(_fmt(r.get('paper')))}</td>"
                      f"<td>{e(_fmt(r.get('ours'), r.get('err')))}</td>"
@@ -249,6 +269,26 @@ def render_html(sections, scale, root) -> str:
     if not rows:
         parts.append("<tr><td colspan=6 class='missing'>no study outputs found</td></tr>")
     parts.append("</table>")
+    return "".join(parts)
+
+
+def render_html(sections, scale, root) -> str:
+    paper_rows, beyond_rows = split_rows(comparison_rows(sections))
+    prov = _provenance(sections)
+    e = html.escape
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report ({e(scale)})"
+             f"</title><style>{_CSS}</style></head><body>",
+             f"<h1>hhscatter reproduction report <small>({e(scale)} scale)</small></h1>",
+             "<p>Reproduction of Burton, Dullin &amp; Altmann, <i>Dissipative chaotic scattering</i> (Hénon–Heiles "
+             "with linear drag), with exact event times from heyoka's Taylor integrator. Every number below is read "
+             "from the studies' numbers JSON files. Verdicts: |ours − paper| ≤ 2σ (our statistical error) unless "
+             "the row says otherwise.</p>",
+             f"<p>Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; versions: "
+             f"{e(', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str)))}.</p>",
+             "<h2>The paper's numbers beside ours</h2>", f"<p>{e(_count_line(paper_rows))}</p>",
+             _html_rows(paper_rows),
+             "<h2>Beyond the paper: checks and numbers the paper does not state</h2>",
+             f"<p>{e(_count_line(beyond_rows))}</p>", _html_rows(beyond_rows)]
     for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
         parts.append(f"<h2>{e(group)}</h2>")
         for s in (s for s in sections if s.key in keys):
@@ -261,13 +301,14 @@ def render_html(sections, scale, root) -> str:
             if s.numbers:
                 parts.append("<table><tr><th>number</th><th>value</th></tr>" + "".join(
                     f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in headline_numbers(s.numbers)) + "</table>")
-    md, pngs = _bench(root)
-    parts.append("<h2>Work–precision and stress</h2>")
-    if md:
-        parts.append(_md_table_to_html(md.read_text()))
-        parts += [f"<img alt='{e(p.stem)}' src='{_img_uri(p)}'>" for p in pngs]
-    else:
-        parts.append("<p class='missing'>Not generated yet: run <code>make bench</code>.</p>")
+    for name, title in BENCH_PARTS:
+        md, pngs = _bench(root, name)
+        parts.append(f"<h2>{e(title)}</h2>")
+        if md:
+            parts.append(_md_table_to_html(md.read_text()))
+            parts += [f"<img alt='{e(p.stem)}' src='{_img_uri(p)}'>" for p in pngs]
+        else:
+            parts.append(f"<p class='missing'>Not generated yet: run <code>make {e(name)}</code>.</p>")
     parts.append("</body></html>")
     return "\n".join(parts)
 

@@ -35,20 +35,27 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     ])
     _fake_study(root, "fig3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
                                 "verdict": "agrees within 2σ", "note": ""}], with_figure=False)
+    _fake_study(root, "resc", [{"quantity": "returns at r_esc=1.03", "ours": 0.011, "err": 0.0004, "paper": 0.0,
+                                "verdict": "differs", "note": ""}])
     res = build_report("quick", out=tmp_path / "rep", root=root)
     page = res["html"].read_text()
     md = res["markdown"].read_text()
-    assert res["rows"] == 3
+    assert res["rows"] == 4
+    paper_part, beyond_part = md.split("## Beyond the paper: checks")[0], md.split("## Beyond the paper: checks")[1]
+    assert "break energy" in paper_part and "returns at r_esc" not in paper_part
+    assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
+    assert "3 numbers: 2 agree, 1 differ" in paper_part
     assert "13.1 ± 0.4" in page and "13.63" in page and "class='bad'>differs" in page
-    assert page.count("data:image/png;base64,") == 1  # fig2 only; fig3 has numbers but no figure
-    assert set(res["missing"]) == {"fig1", "resc", "fig3", "fig4", "fig5", "fig6"}
+    assert page.count("data:image/png;base64,") == 2  # fig2 and resc; fig3 has numbers but no figure
+    assert set(res["missing"]) == {"fig1", "fig3", "fig4", "fig5", "fig6"}
     assert "| fig2 | break energy | 0.27 | 0.310 ± 0.010 | differs | continuous fit |" in md
     assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
-    assert json.loads((tmp_path / "rep" / "comparison.json").read_text())[2]["study"] == "fig3"
+    assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [
+        "fig2", "fig2", "resc", "fig3"]
 
 
 @pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),
-                                        (2.5e-14, 1e-15, "2.500e-14 ± 1.0e-15"), (152.0, 7.0, "152 ± 7")])
+                                        (2.5e-14, 1e-15, "2.5e-14 ± 1.0e-15"), (0.0, 8.3e-6, "0 ± 8.3e-06"), (-9.2e-4, 5.2e-4, "-0.0009 ± 0.0005"), (152.0, 7.0, "152 ± 7")])
 def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
     assert _fmt(v, err) == want

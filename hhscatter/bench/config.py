@@ -38,7 +38,8 @@ def load_config(name: str, scale: str = "full", root=None) -> dict:
     if scale != "full":
         cfg = _merge(cfg, scales.get(scale, {}))
     cfg["_scale"] = scale
-    cfg["_path"] = str(path)
+    # relative to the repository, so a summary reads the same on every machine
+    cfg["_path"] = f"studies/{name}/{name}.toml" if root is None else str(path)
     return cfg
 
 

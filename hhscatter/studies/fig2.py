@@ -394,6 +394,11 @@ def _analyze_cmeasure(study, grid_df):
     main = df[df["shift_efolds"] == 0.0]
     numbers = {}
     for _, row in main.iterrows():
+        z = row["z_vs_grid"]
+        study.compare(f"κ from the c-measure (E={row['energy']:.2f})", row["kappa_cm"], row["kappa_cm_err"], None,
+                      unit="1/time", verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
+                      note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
+                           f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper")
         numbers[cm_key(row["energy"])] = {
             "energy": row["energy"], "t_window": [row["t_from"], row["t_to"]], "t_record_end": row["t_record_end"],
             "n_samples": int(row["n_samples"]), "n_exit": int(row["n_exit"]),

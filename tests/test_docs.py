@@ -1,0 +1,232 @@
+"""The documentation's generated parts: the MkDocs hook (docs/_hooks/studies.py),
+the asset copier (docs/gen_studies.py) and the consistency of mkdocs.yml with
+the pages and modules. The site build itself (`make docs`, mkdocs --strict)
+runs in CI; these tests need no docs extra and take well under a second.
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+def _load(path: Path, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def hook():
+    return _load(DOCS / "_hooks" / "studies.py", "hh_docs_hook")
+
+
+@pytest.fixture(scope="module")
+def gen():
+    return _load(DOCS / "gen_studies.py", "hh_docs_gen")
+
+
+# -- number formatting ----------------------------------------------------------
+@pytest.mark.parametrize(
+    "v, err, want",
+    [
+        (0.12345, 0.00678, "0.1235 ± 0.0068"),  # err to 2 significant digits, v to the same place
+        (13.63, 1.234, "13.6 ± 1.2"),
+        (1.41, 0.05, "1.410 ± 0.050"),
+        (-0.00017021, 0.00106, "-0.0002 ± 0.0011"),
+        (250.0, 31.0, "250 ± 31"),
+        (0.5, None, "0.5"),
+        (0.5, 0.0, "0.5 ± 0"),
+    ],
+)
+def test_fmt_err(hook, v, err, want):
+    assert hook.fmt_err(v, err) == want
+
+
+def test_fmt_value_shapes(hook):
+    assert hook.fmt_value({"value": 0.339, "lo": 0.3285, "hi": 0.3497}) == "0.339 [0.3285, 0.3497]"
+    assert hook.fmt_value({"value": None, "err": None}) == "—"
+    assert hook.fmt_value([1.03, 1.1]) == "[1.03, 1.1]"
+    assert "20 entries" in hook.fmt_value(list(range(20)))
+    assert hook.fmt_num(2.5e-9) == "2.500×10<sup>-9</sup>"
+    assert hook.fmt_num(True) == "true"
+
+
+def test_comparison_table_escapes_pipes_and_keeps_every_row(hook):
+    rows = [
+        {"quantity": "a | b", "ours": 1.0, "err": 0.1, "paper": 1.1, "verdict": "agrees within 2σ", "note": "n"},
+        {"quantity": "c", "ours": "yes", "err": None, "paper": "yes", "verdict": None, "note": ""},
+    ]
+    table = hook.comparison_table(rows)
+    lines = table.strip().splitlines()
+    assert len(lines) == 2 + len(rows)
+    assert "a \\| b" in lines[2] and "1.00 ± 0.10" in lines[2]
+    # every body row has as many cells as the header
+    n = lines[0].count(" | ")
+    assert all(line.replace("\\|", "").count(" | ") == n for line in lines[2:])
+
+
+# -- the CLI reference ------------------------------------------------------------
+def test_cli_reference_lists_every_flag_of_every_subcommand(hook):
+    import argparse
+
+    from hhscatter.cli import build_parser
+
+    parser = build_parser()
+    text = hook.cli_reference(parser)
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    assert set(sub.choices) >= {"simulate", "survival", "study"}
+    for name, p in sub.choices.items():
+        assert f"## `hhscatter {name}`" in text
+        for a in p._actions:
+            for opt in a.option_strings:
+                if opt not in ("-h", "--help"):
+                    assert f"`{opt}" in text or f", {opt}" in text, (name, opt)
+
+
+# -- study pages: present and missing assets ---------------------------------------
+def _page(tmp_path, hook, text, src_uri="studies/x.md"):
+    docs = tmp_path / "docs"
+    (docs / "studies" / "assets").mkdir(parents=True, exist_ok=True)
+    (tmp_path / "mkdocs.yml").write_text("site_name: t\n")
+
+    class File:
+        pass
+
+    class Page:
+        file = File()
+
+    Page.file.src_uri = src_uri
+    config = {"docs_dir": str(docs), "config_file_path": str(tmp_path / "mkdocs.yml")}
+    return hook.on_page_markdown(text, page=Page(), config=config, files=None), docs
+
+
+def test_missing_assets_give_a_note_not_a_link(tmp_path, hook):
+    md = "\n".join(f"<!-- hh:{k} fig2 -->" for k in ("study-params", "study-figure", "study-numbers", "study-module"))
+    md += "\n<!-- hh:bench bench -->\n<!-- hh:comparison-all -->\n"
+    out, _ = _page(tmp_path, hook, md)
+    assert "<!-- hh:" not in out
+    assert out.count('"Not yet generated"') == 5  # params, figure, numbers, module, bench
+    assert "assets/" not in out  # no link to a file that is not there
+    assert "*Not yet generated: " in out  # comparison-all lists the studies without numbers
+
+
+def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
+    (tmp_path / "studies" / "fig2").mkdir(parents=True)
+    (tmp_path / "studies" / "fig2" / "study.toml").write_text("[scene]\nn = 10  # orbits\n")
+    docs = tmp_path / "docs"
+    assets = docs / "studies" / "assets"
+    assets.mkdir(parents=True)
+    (assets / "fig2.png").write_bytes(b"\x89PNG")
+    doc = {
+        "study": "fig2", "scale": "quick",
+        "a": {"value": 13.1, "err": 0.52},
+        "tau0_rule": "τ0 is where the local slope settles within 10 % of its plateau (documented rule)",
+        "per_gamma": [{"gamma": 0.01, "tau1": {"value": 17.2, "err": 1.0}}, {"gamma": 0.02, "tau1": None}],
+        "paper_comparison": [{"quantity": "a", "ours": 13.1, "err": 0.52, "paper": 13.63, "unit": "",
+                              "verdict": "agrees within 2σ", "note": ""}],
+        "config": {}, "provenance": {"hhscatter": "0.1.0", "git_commit": "0123456789abcdef"},
+    }
+    (assets / "fig2.json").write_text(json.dumps(doc))
+    md = "<!-- hh:study-params fig2 -->\n<!-- hh:study-figure fig2 -->\n<!-- hh:study-numbers fig2 -->\n"
+    out, _ = _page(tmp_path, hook, md)
+    assert "n = 10  # orbits" in out
+    assert "](assets/fig2.png)" in out
+    assert "| a | 13.10 ± 0.52 | 13.63 | agrees within 2σ |" in out
+    assert "`tau0_rule`\n:   τ0 is where" in out
+    assert "| `gamma` | `tau1` |" in out and "| 0.01 | 17.2 ± 1.0 |" in out
+    assert "scale **quick**" in out and "commit `0123456789ab`" in out
+    assert "](assets/fig2.json)" in out
+
+
+def test_unknown_marker_fails_the_build(tmp_path, hook):
+    with pytest.raises(ValueError, match="hh:no-such-thing"):
+        _page(tmp_path, hook, "<!-- hh:no-such-thing -->\n")
+
+
+def test_embedded_summary_links_are_rebased_or_dropped(tmp_path, hook):
+    assets = tmp_path / "assets" / "bench"
+    assets.mkdir(parents=True)
+    (assets / "wp.png").write_bytes(b"")
+    text = "# Title\n![plot](wp.png) and [the csv](missing.csv) and [web](https://example.org)\n"
+    out = hook._embed_markdown(text, assets, lambda p: "assets/bench/" + p.name)
+    assert out.startswith("### Title")
+    assert "![plot](assets/bench/wp.png)" in out
+    assert "the csv" in out and "missing.csv" not in out
+    assert "[web](https://example.org)" in out
+
+
+def test_sphinx_roles_become_inline_code():
+    pytest.importorskip("griffe")
+    roles = _load(DOCS / "_hooks" / "griffe_roles.py", "hh_docs_roles")
+    text = "see :func:`survival_curve`, :class:`~hhscatter.scene.Scene` and ``x``"
+    assert roles.roles_to_code(text) == "see `survival_curve`, `Scene` and ``x``"
+
+
+def test_embedded_summary_tables_survive_abs_bars_and_plain_text(hook, tmp_path):
+    text = (
+        "| case | finding |\n|---|---|\n| drift | max |ΔH|/H = 4.5e-10 |\n\n"
+        "         tol     t\n1.0e-09   1.0\n1.0e-12   2.0\n"
+    )
+    out = hook._embed_markdown(text, tmp_path, lambda p: p.name)
+    rows = out.splitlines()
+    assert rows[2] == "| drift | max \\|ΔH\\|/H = 4.5e-10 |"  # still 2 cells
+    assert rows[1] == "|---|---|"
+    i = rows.index("```text")
+    assert rows[i + 1].strip().startswith("tol") and rows[i + 3] == "1.0e-12   2.0" and rows[i + 4] == "```"
+
+
+# -- the asset copier ---------------------------------------------------------------
+def test_gen_studies_copies_what_exists_and_reports_the_rest(tmp_path, gen, monkeypatch):
+    monkeypatch.setattr(gen, "ROOT", tmp_path)
+    monkeypatch.setattr(gen, "DOCS", tmp_path / "docs")
+    out = tmp_path / "studies" / "fig3" / "out" / "quick"
+    out.mkdir(parents=True)
+    (out / "fig3.png").write_bytes(b"png")
+    (out / "fig3.json").write_text("{}")
+    bench = tmp_path / "studies" / "bench" / "out" / "full"
+    bench.mkdir(parents=True)
+    (bench / "summary.md").write_text("# s\n")
+    (bench / "big.csv").write_bytes(b"x" * (gen.CSV_MAX_BYTES + 1))
+    (bench / "ref.npz").write_bytes(b"")
+    assert gen.main(["--scale", "quick"]) == 0
+    assets = tmp_path / "docs" / "studies" / "assets"
+    assert sorted(p.name for p in assets.iterdir()) == ["fig3.json", "fig3.png"]
+    assert sorted(p.name for p in (tmp_path / "docs" / "benchmarks" / "assets" / "bench").iterdir()) == ["summary.md"]
+    assert gen.main(["--check"]) == 0
+    (out / "fig3.json").write_text('{"changed": 1}')
+    assert gen.main(["--check"]) == 1
+
+
+# -- mkdocs.yml against the pages and the package -------------------------------------
+def test_nav_pages_and_api_modules_exist():
+    yaml = pytest.importorskip("yaml")
+    cfg = yaml.safe_load((ROOT / "mkdocs.yml").read_text())
+
+    def pages(node):
+        if isinstance(node, str):
+            yield node
+        elif isinstance(node, list):
+            for x in node:
+                yield from pages(x)
+        elif isinstance(node, dict):
+            for x in node.values():
+                yield from pages(x)
+
+    nav = list(pages(cfg["nav"]))
+    for p in nav:
+        assert (DOCS / p).exists(), p
+    for md in DOCS.rglob("*.md"):
+        for mod in re.findall(r"^::: ([\w.]+)", md.read_text(), flags=re.M):
+            path = ROOT / Path(*mod.split("."))
+            assert path.with_suffix(".py").exists() or (path / "__init__.py").exists(), (md, mod)
+    assert cfg["theme"]["font"] is False  # no Google Fonts: the build and the site stay offline
