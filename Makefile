@@ -6,6 +6,8 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
+BENCH_STAMP := $(VENV)/.bench-stamp
+DOCS_STAMP := $(VENV)/.docs-stamp
 RUNS := runs
 WORKERS ?=
 W := $(if $(WORKERS),--workers $(WORKERS),)
@@ -21,10 +23,10 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP) ## create .venv and install hhscatter with its dev extra
 
-test: $(STAMP) ## run the default test suite (creates .venv if missing)
+test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the default test suite (creates .venv with the dev, bench and docs extras)
 	$(PY) -m pytest -q
 
-test-slow: $(STAMP) ## run the slow accuracy/stress cases too
+test-slow: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the slow accuracy/stress cases too
 	$(PY) -m pytest -q -m "slow or not slow"
 
 # -- demo: two real scenes end to end -----------------------------------------
@@ -90,7 +92,6 @@ bench-engine: $(STAMP) ## µs per orbit of the engine (1 and all workers), time 
 bench-memory: $(STAMP) ## peak RSS of simulate + P(t) at E=0.27, N=1e5,1e6,1e7, 1 worker (1e7: ~5-10 CPU-min)
 	$(PY) -m hhscatter.bench_memory $(MEMORY_ARGS)
 
-BENCH_STAMP := $(VENV)/.bench-stamp
 $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
 	@touch $@
@@ -111,7 +112,6 @@ clean-runs: ## delete simulation outputs under runs/
 	rm -rf $(RUNS)
 
 # -- documentation: mkdocs --strict, offline (docs/, mkdocs.yml) ----------------
-DOCS_STAMP := $(VENV)/.docs-stamp
 MKDOCS := NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs
 
 $(DOCS_STAMP): $(STAMP) pyproject.toml
