@@ -404,6 +404,51 @@ def _goodness(curve_vals, t, P, res_norm, k):
 _HOMOG = ("f_ne", "f_e", "L", "b", "tau2")
 
 
+@dataclass(frozen=True)
+class _FitStats:
+    """Post-fit statistics shared by the homogeneous and the mixture fit."""
+
+    chi2: float
+    dof: int
+    chi2_red: float
+    rms: float
+    aic: float
+    cov_fit: np.ndarray  # covariance of the free parameters from the fit alone
+    sens: np.ndarray  # ∂θ/∂P(τ0) from a re-fit at P(τ0) + σ_P(τ0)
+    cov: np.ndarray  # cov_fit plus the propagated error of the measured P(τ0)
+
+
+def _fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> _FitStats:
+    """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
+    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, t, P, r, k)
+    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    sens = np.zeros(0 if sol is None else sol.x.size)
+    if refit is not None and P_tau0_err > 0 and sol is not None:
+        sens = (refit(P_tau0_err).x - sol.x) / P_tau0_err
+    return _FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
+
+
+def _survival_fit(model, values, errors, free, st: _FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
+    return SurvivalFit(
+        params=model,
+        values=values,
+        errors=errors,
+        free=tuple(free),
+        cov=st.cov,
+        chi2=st.chi2,
+        dof=st.dof,
+        chi2_red=st.chi2_red,
+        rms_log_residual=st.rms,
+        aic=st.aic,
+        n_points=int(t_fit.size),
+        space=space,
+        t_fit=t_fit,
+        residuals=residuals,
+        success=bool(sol.success) if sol is not None else True,
+        message=str(sol.message) if sol is not None else "no free parameters",
+    )
+
+
 def fit_survival_model(
     t,
     P,
@@ -586,18 +631,10 @@ def fit_survival_model(
     model = make(v)
     curve_vals = model(tf)
     r = res(theta)
-    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, tf, Pf, r, k)
-    if sol is not None:
-        cov = _covariance(sol.jac, chi2_red, absolute_sigma)
-    else:
-        cov = np.zeros((0, 0))
     # propagate the error of the measured P(τ0) through the constraint
-    sens = np.zeros(len(free))
-    if derive_fe and P_tau0_err > 0 and sol is not None:
-        sol_p, _, _ = fit_at(tau2_fit, sol.x, warm_only=True, P0v=P_tau0 + P_tau0_err)
-        sens = (sol_p.x - sol.x) / P_tau0_err
-    cov_fit = cov
-    cov = cov_fit + np.outer(sens, sens) * P_tau0_err**2
+    refit = (lambda dP: fit_at(tau2_fit, sol.x, warm_only=True, P0v=P_tau0 + dP)[0]) if derive_fe else None
+    st = _fit_stats(sol, curve_vals, tf, Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    cov_fit, sens, cov = st.cov_fit, st.sens, st.cov
     errors = {n: 0.0 for n in _HOMOG}
     for i, n in enumerate(free):
         errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
@@ -610,24 +647,8 @@ def fit_survival_model(
     values = dict(v)
     values["P_tau0"] = P_tau0
     errors["P_tau0"] = P_tau0_err
-    return SurvivalFit(
-        params=model,
-        values=values,
-        errors=errors,
-        free=tuple(free) + (("tau2",) if fit_tau2 else ()),
-        cov=cov,
-        chi2=chi2,
-        dof=dof,
-        chi2_red=chi2_red,
-        rms_log_residual=rms,
-        aic=aic,
-        n_points=int(tf.size),
-        space=space,
-        t_fit=tf,
-        residuals=r,
-        success=bool(sol.success) if sol is not None else True,
-        message=str(sol.message) if sol is not None else "no free parameters",
-    )
+    return _survival_fit(model, values, errors, tuple(free) + (("tau2",) if fit_tau2 else ()), st, tf, r, sol,
+                         space)
 
 
 # ---------------------------------------------------------------------------
@@ -1117,14 +1138,10 @@ def fit_mixture_model(
     model = make(theta)
     r = res(theta)
     k_free = len(free)
-    chi2, dof, chi2_red, rms, aic = _goodness(model(tf), tf, Pf, r, k_free)
-    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
     # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
-    sens = np.zeros(k_free)
-    if P_tau0_err > 0 and sol is not None:
-        sol_p, _ = solve([sol.x], P_tau0 + P_tau0_err)
-        sens = (sol_p.x - sol.x) / P_tau0_err
-    cov = cov_fit + np.outer(sens, sens) * P_tau0_err**2
+    st = _fit_stats(sol, model(tf), tf, Pf, r, k_free, absolute_sigma, P_tau0_err,
+                    lambda dP: solve([sol.x], P_tau0 + dP)[0])
+    cov_fit, sens, cov = st.cov_fit, st.sens, st.cov
 
     v, fk = unpack(theta)
     values = {n: float(v[n]) for n in names}
@@ -1162,24 +1179,7 @@ def fit_mixture_model(
         f_e_k=c.weights * P_tau0 - fk,
     )
     errors.update(f_ne=f_ne_err, f_e=f_e_err, P_tau0=P_tau0_err, f_ne_k=fk_err)
-    return SurvivalFit(
-        params=model,
-        values=values,
-        errors=errors,
-        free=tuple(free),
-        cov=cov,
-        chi2=chi2,
-        dof=dof,
-        chi2_red=chi2_red,
-        rms_log_residual=rms,
-        aic=aic,
-        n_points=int(tf.size),
-        space=space,
-        t_fit=tf,
-        residuals=r,
-        success=bool(sol.success) if sol is not None else True,
-        message=str(sol.message) if sol is not None else "no free parameters",
-    )
+    return _survival_fit(model, values, errors, free, st, tf, r, sol, space)
 
 
 def compare_fits(fits: dict) -> pd.DataFrame:
