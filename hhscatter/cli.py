@@ -133,14 +133,14 @@ def cmd_simulate(a):
 def cmd_survival(a):
     import json
 
-    from .analysis.survival import survival_curve
+    from .analysis.survival import observed_from_outcome, survival_curve
     from .plotting import plot_survival
     from .tables import read_lifetimes
 
     curves = []
     for i, run in enumerate(a.runs):
         df = read_lifetimes(run, columns=["outcome", "t_end"])
-        t, P, err = survival_curve(df["t_end"].to_numpy(), (df["outcome"] != "censored").to_numpy())
+        t, P, err = survival_curve(df["t_end"].to_numpy(), observed_from_outcome(df["outcome"]))
         if a.labels and i < len(a.labels):
             label = a.labels[i]
         else:

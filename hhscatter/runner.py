@@ -57,6 +57,7 @@ class RunSummary:
     escaped: int = 0
     settled: int = 0
     censored: int = 0
+    stopped: int = 0
     n_sections: int = 0
     n_snapshots: int = 0
     compute_seconds: float = 0.0  # time spent in chunks, summed over workers
@@ -67,7 +68,7 @@ class RunSummary:
     backend: str = "local"
 
     def add(self, other: RunSummary):
-        for k in ("n", "escaped", "settled", "censored", "n_sections", "n_snapshots", "compute_seconds"):
+        for k in ("n", "escaped", "settled", "censored", "stopped", "n_sections", "n_snapshots", "compute_seconds"):
             setattr(self, k, getattr(self, k) + getattr(other, k))
         self.chunks_done += 1
 
@@ -80,6 +81,7 @@ class RunSummary:
         where = "" if self.backend == "local" else f" on {self.backend}"
         return (
             f"{self.n} orbits: escaped {self.escaped}, settled {self.settled}, censored {self.censored}"
+            f"{f', stopped {self.stopped}' if self.stopped else ''}"
             f" | wall {self.wall_seconds:.2f} s, {us:.2f} µs/orbit, {us_core:.2f} µs/orbit/core"
             f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
         )
@@ -97,6 +99,8 @@ def tables_of(scene: Scene):
         names.append("sections")
     if scene.snapshots:
         names.append("snapshots")
+    if scene.follow is not None:
+        names.append("crossings")
     return names
 
 
@@ -148,7 +152,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         "orbits": [start, stop],
         **provenance(),
     }
-    rows = {"lifetimes": res.lifetimes, "sections": res.sections, "snapshots": res.snapshots}
+    rows = res.tables()
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):
         table = to_arrow(name, rows[name])
@@ -157,12 +161,13 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
             write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
         except OSError as exc:
             raise OSError(exc.errno, f"cannot write {store.display(rel)}: {exc.strerror or exc}") from None
-    oc = np.bincount(res.lifetimes["outcome"], minlength=3)
+    oc = np.bincount(res.lifetimes["outcome"], minlength=4)
     return RunSummary(
         n=stop - start,
         escaped=int(oc[0]),
         settled=int(oc[1]),
         censored=int(oc[2]),
+        stopped=int(oc[3]),
         n_sections=len(res.sections["t"]),
         n_snapshots=len(res.snapshots["t"]),
         compute_seconds=elapsed,

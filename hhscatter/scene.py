@@ -55,8 +55,12 @@ class SectionWindow:
     e_min: float = -math.inf
     e_max: float = math.inf
     first_only: bool = False
+    stop: bool = False
 
     def __post_init__(self):
+        for name in ("first_only", "stop"):
+            if not isinstance(getattr(self, name), bool):
+                raise SceneError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
         for name in ("t_from", "t_to", "e_min", "e_max"):
             v = getattr(self, name)
             if not isinstance(v, (int, float)) or math.isnan(v):
@@ -67,6 +71,34 @@ class SectionWindow:
             raise SceneError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
         if not self.e_max > self.e_min:
             raise SceneError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
+        if self.stop and not (self.first_only or math.isfinite(self.t_to)):
+            raise SceneError("sections.stop needs first_only = true or a finite t_to "
+                             "(otherwise the window never closes and the orbit is always needed)")
+
+
+@dataclass(frozen=True)
+class Follow:
+    """Follow(radii) -> keep integrating escaped orbits (conservative scenes).
+
+    After its escape (the outward r_esc crossing, which stays the orbit's
+    t_end) the orbit is followed until it reaches r_far or t_max, and every
+    crossing of a circle r = R for R in ``radii`` and of r_esc (both directions,
+    from t = 0) goes to the ``crossings`` table: the check that an 'escaped' orbit does
+    not come back (study ``resc``).
+    """
+
+    radii: tuple = ()
+
+    def __post_init__(self):
+        try:
+            radii = tuple(float(r) for r in self.radii)
+        except (TypeError, ValueError):
+            raise SceneError(f"follow.radii must be a list of numbers, got {self.radii!r}") from None
+        if not radii or not all(math.isfinite(r) and r > 0 for r in radii):
+            raise SceneError(f"follow.radii must be a non-empty list of finite radii > 0, got {self.radii!r}")
+        if any(b <= a for a, b in zip(radii, radii[1:])):
+            raise SceneError("follow.radii must be strictly increasing")
+        object.__setattr__(self, "radii", radii)
 
 
 @dataclass(frozen=True)
@@ -94,6 +126,11 @@ class Scene:
       ics         optional path of a Parquet/CSV table with columns x, y, px, py
       sections    SectionWindow or None (no section table)
       snapshots   tuple of orbit times for energy snapshots, or None
+      follow      Follow or None: escaped orbits followed to r_far (conservative;
+                  table ``crossings``)
+      continue_settled  dissipative scenes with snapshots: settled orbits go on
+                  past E_c to the last snapshot time, and their energies there are
+                  snapshot rows after t_end (for ⟨E⟩(t), paper Fig. 3)
     """
 
     energy: float | None
@@ -113,6 +150,8 @@ class Scene:
     ics: str | None = None
     sections: SectionWindow | None = None
     snapshots: tuple | None = None
+    follow: Follow | None = None
+    continue_settled: bool = False
     name: str = "scene"
     _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
 
@@ -197,11 +236,36 @@ class Scene:
                 raise SceneError("snapshots times must be strictly increasing")
             object.__setattr__(self, "snapshots", snaps)
 
+        if self.follow is not None:
+            if not isinstance(self.follow, Follow):
+                raise SceneError("follow must be a Follow or None")
+            if gamma > 0:
+                raise SceneError("follow is for conservative scenes (gamma = 0): dissipative escapes "
+                                 "are already final (the orbit is followed to E_c or r_far)")
+            rf = self.r_far if self.r_far is not None else max(10.0 * m.saddle_radius, 2.0 * r_esc)
+            if max(self.follow.radii) >= rf:
+                raise SceneError(f"follow.radii must all be < r_far = {rf:g}, got {max(self.follow.radii):g}")
+        if not isinstance(self.continue_settled, bool):
+            raise SceneError(f"continue_settled must be true or false, got {self.continue_settled!r}")
+        if self.continue_settled and not (gamma > 0 and self.snapshots):
+            raise SceneError("continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
+                             "it records settled orbits' energies after settling")
+
     # -- identity -----------------------------------------------------------
     def to_dict(self) -> dict:
+        """to_dict() -> plain dict; options at their defaults that older scenes did not have are left
+        out, so every existing scene keeps its result_hash (and its runs on disk resume)."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
         d["sections"] = dataclasses.asdict(self.sections) if self.sections else None
+        if d["sections"] is not None and not d["sections"]["stop"]:
+            del d["sections"]["stop"]
         d["snapshots"] = list(self.snapshots) if self.snapshots else None
+        if self.follow is None:
+            del d["follow"]
+        else:
+            d["follow"] = {"radii": list(self.follow.radii)}
+        if not self.continue_settled:
+            del d["continue_settled"]
         return d
 
     def to_json(self) -> str:
@@ -256,6 +320,16 @@ def scene_from_dict(d: dict) -> Scene:
         if unknown:
             raise SceneError(f"unknown sections keys: {sorted(unknown)}")
         d["sections"] = SectionWindow(**{k: _inf(v) for k, v in sec.items()})
+    fol = d.pop("follow", None)
+    if isinstance(fol, Follow):
+        d["follow"] = fol
+    elif fol is not None:
+        if not isinstance(fol, dict):
+            raise SceneError("follow must be a table with key 'radii'")
+        unknown = set(fol) - {"radii"}
+        if unknown:
+            raise SceneError(f"unknown follow keys: {sorted(unknown)}; allowed: ['radii']")
+        d["follow"] = Follow(**fol)
     snaps = d.pop("snapshots", None)
     if isinstance(snaps, dict):
         unknown = set(snaps) - {"times", "start", "stop", "step"}
@@ -304,6 +378,8 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
         d["sections"] = doc["sections"]
     if "snapshots" in doc:
         d["snapshots"] = doc["snapshots"]
+    if "follow" in doc:
+        d["follow"] = doc["follow"]
     if scale is not None and scale != "quick":
         scales = doc.get("scale", {})
         if scale not in scales:

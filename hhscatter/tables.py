@@ -26,13 +26,16 @@ Parquet page checksums (see :func:`verify_part`).
 Schemas
 -------
 lifetimes: traj_id int64, x0 y0 px0 py0 e0 gamma float64,
-           outcome dictionary<string> ('escaped' | 'settled' | 'censored'),
+           outcome dictionary<string> ('escaped' | 'settled' | 'censored' | 'stopped'),
            t_end float64 (escape time: root of the r = r_esc crossing; settling
            time: root of E = E_c; or t_max), exit_channel int8 (null unless
            escaped; channel k is centred on the angle π/2 + 2πk/3),
            e_end float64 (energy at t_end)
 sections:  traj_id int64, t x y px py energy float64
-snapshots: traj_id int64, t energy float64
+snapshots: traj_id int64, t energy float64 (with ``continue_settled``: also settled
+           orbits after t_end)
+crossings: traj_id int64, t radius float64, direction int8 (+1 outward, −1 inward);
+           follow scenes only: every crossing of the follow radii
 """
 from __future__ import annotations
 
@@ -44,7 +47,8 @@ from pathlib import Path
 import numpy as np
 
 META_KEY = b"hhscatter"
-TABLES = ("lifetimes", "sections", "snapshots")
+CENSORING_OUTCOMES = ("censored", "stopped")  # right-censored lifetimes (hhscatter.analysis.survival)
+TABLES = ("lifetimes", "sections", "snapshots", "crossings")
 
 
 def _schemas():
@@ -71,6 +75,7 @@ def _schemas():
             [("traj_id", pa.int64())] + [(c, f64) for c in ("t", "x", "y", "px", "py", "energy")]
         ),
         "snapshots": pa.schema([("traj_id", pa.int64()), ("t", f64), ("energy", f64)]),
+        "crossings": pa.schema([("traj_id", pa.int64()), ("t", f64), ("radius", f64), ("direction", pa.int8())]),
     }
 
 
@@ -116,7 +121,7 @@ def to_arrow(name: str, columns: dict):
     for field in schema:
         col = columns[field.name]
         if name == "lifetimes" and field.name == "outcome":
-            from .engine import OUTCOMES
+            from .events import OUTCOMES
 
             codes = np.asarray(col, dtype=np.int8)
             arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, pa.int8()), pa.array(OUTCOMES)))
@@ -265,7 +270,7 @@ def survival_arrays(run_dir, filters=None):
     observed = np.empty(len(t_end), dtype=bool)
     pos = 0
     for chunk in table.column("outcome").chunks:
-        censored = np.asarray(chunk.dictionary.to_pylist(), dtype=object) == "censored"
+        censored = np.isin(np.asarray(chunk.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)
         idx = chunk.indices.to_numpy(zero_copy_only=False)
         observed[pos:pos + len(chunk)] = ~censored[idx]
         pos += len(chunk)
@@ -298,7 +303,7 @@ def survival_on_grid(run_dir, t_grid, filters=None):
     for batch in batches:
         t = batch.column(0).to_numpy()
         outcome = batch.column(1)
-        censored = (np.asarray(outcome.dictionary.to_pylist(), dtype=object) == "censored")[
+        censored = np.isin(np.asarray(outcome.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)[
             outcome.indices.to_numpy(zero_copy_only=False)]
         if censored.any() and t[censored].min() < g[-1]:
             raise ValueError(f"an orbit was censored at t = {t[censored].min():g} < max(t_grid) = {g[-1]:g}: "
@@ -330,3 +335,8 @@ def read_sections(run_dir, columns=None, filters=None):
 def read_snapshots(run_dir, columns=None, filters=None):
     """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy."""
     return _read(run_dir, "snapshots", columns, filters)
+
+
+def read_crossings(run_dir, columns=None, filters=None):
+    """read_crossings(run_dir, ...) -> DataFrame traj_id, t, radius, direction (follow scenes)."""
+    return _read(run_dir, "crossings", columns, filters)

@@ -193,11 +193,18 @@ def test_fig3_tiny_end_to_end(tiny_root):
     expect = N - np.searchsorted(esc, me["t"].to_numpy(), side="left")
     np.testing.assert_array_equal(me["n"].to_numpy(), expect)
     # the continuation: settled orbits below E_c, energy non-increasing in t (dE/dt = −γ v² ≤ 0)
-    cont = read_snapshots(out / "raw" / "e0.3_gamma0.01_settled").sort_values(["traj_id", "t"])
+    # (the engine's continue_settled: rows after t_end, in the run's own snapshots table)
+    snap = read_snapshots(out / "raw" / "e0.3_gamma0.01").merge(lt[["traj_id", "t_end", "outcome"]], on="traj_id")
+    cont = snap[snap["t"] > snap["t_end"]].sort_values(["traj_id", "t"])
     assert set(cont["traj_id"]) == set(lt.loc[lt["outcome"] == "settled", "traj_id"])
-    assert (cont["energy"] < E_C).all()
+    assert (cont["outcome"] == "settled").all() and (cont["energy"] < E_C).all()
     assert (cont.groupby("traj_id")["energy"].diff().dropna() <= 1e-15).all()
-    assert nums["continuation"]["n_failed"] == 0
+    # every settled orbit has a row at every grid time after its settling, to the last one
+    grid = np.sort(snap["t"].unique())
+    per = cont.groupby("traj_id").agg(n=("t", "size"), t_end=("t_end", "first"), last=("t", "max"))
+    assert (per["last"] == grid[-1]).all()
+    np.testing.assert_array_equal(per["n"], [(grid > te).sum() for te in per["t_end"]])
+    assert nums["continuation"]["rows_below_ec"] == len(cont)
     assert 0.85 < nums["mu"]["value"] < 1.0 and 0 < nums["mu"]["err"] < 0.05
     # local exponent approaches 1 late (paper's claim; holds already at this size)
     lw = nums["mu_later_windows"]

@@ -16,17 +16,16 @@ import pytest
 from scipy import integrate, optimize
 
 from hhscatter.analysis.escape_check import (
-    CENSORED,
-    FAR,
     channel_fractions,
-    follow_orbits,
     lyapunov_orbit,
     paired_mle_shift,
     return_statistics,
     survival_ratio_slope,
     wilson_interval,
 )
+from hhscatter.events import CENSORED, ESCAPED
 from hhscatter.model import HenonHeiles
+from hhscatter.scene import SceneError
 
 E_C = 1.0 / 6.0
 
@@ -122,20 +121,31 @@ def _time_to_turning(E, a, yt):
     return integrate.quad(g, -a, st, weight="alg", wvar=(0.0, -0.5), epsabs=1e-14, epsrel=1e-13)[0]
 
 
+def _follow(ics, radii, r_far=10.0, t_max=100.0, r_esc=1.03):
+    """The engine's follow mode (batch driver) on these initial conditions: (lifetimes, crossings)."""
+    from hhscatter.engine import run_chunk
+    from hhscatter.scene import Follow, Scene
+
+    ics = np.atleast_2d(np.asarray(ics, dtype=float))
+    sc = Scene(energy=0.3, n=len(ics), r_esc=r_esc, r_far=r_far, t_max=t_max, follow=Follow(tuple(radii)))
+    res = run_chunk(sc, ics, np.arange(len(ics)))
+    return res.lifetimes, res.crossings
+
+
 def test_follow_straight_out_never_returns():
     # along the channel-0 axis beyond the saddle, moving outward: it only goes out
     E = 0.3
     y0 = 1.01
     ic = [0.0, y0, 0.0, math.sqrt(2 * (E - _v_axis(y0)))]
-    fr = follow_orbits([ic], [1.0, 1.03, 1.5, 2.0], r_far=10.0, t_max=100.0)
-    assert fr.outcome[0] == FAR
-    assert np.all(fr.direction == 1)
-    np.testing.assert_allclose(fr.radius, [1.03, 1.5, 2.0])
+    lt, cr = _follow([ic], [1.0, 1.03, 1.5, 2.0])
+    assert lt["outcome"][0] == ESCAPED
+    assert np.all(cr["direction"] == 1)
+    np.testing.assert_allclose(cr["radius"], [1.03, 1.5, 2.0])
     expect = [_time_between(E, y0, R) for R in (1.03, 1.5, 2.0)]
-    np.testing.assert_allclose(fr.t, expect, rtol=1e-10, atol=1e-12)
-    assert fr.t_end[0] == pytest.approx(_time_between(E, y0, 10.0), rel=1e-9)
-    assert fr.energy_error[0] < 1e-9 * E
-    s = return_statistics(fr.orbit, fr.t, fr.radius, fr.direction, 1, 1.03)
+    np.testing.assert_allclose(cr["t"], expect, rtol=1e-10, atol=1e-12)
+    assert lt["t_end"][0] == cr["t"][0]  # the escape time is the first outward r_esc crossing
+    assert abs(lt["e_end"][0] - E) < 1e-12
+    s = return_statistics(cr["traj_id"], cr["t"], cr["radius"], cr["direction"], 1, 1.03)
     assert not s["returned"][0]
 
 
@@ -146,46 +156,54 @@ def test_follow_known_return_through_the_wall():
     yt = optimize.brentq(lambda y: _v_axis(y) - E, -3.0, -0.5, xtol=1e-15)
     assert yt < -1.03
     ic = [0.0, 0.0, 0.0, -math.sqrt(2 * E)]
-    fr = follow_orbits([ic], [1.0, 1.03], r_far=10.0, t_max=100.0)
-    assert fr.outcome[0] == FAR
-    s = return_statistics(fr.orbit, fr.t, fr.radius, fr.direction, 1, 1.03)
+    lt, cr = _follow([ic], [1.0, 1.03])
+    s = return_statistics(cr["traj_id"], cr["t"], cr["radius"], cr["direction"], 1, 1.03)
     t_out_1, t_out_103 = _time_between(E, 0.0, -1.0), _time_between(E, 0.0, -1.03)
     t_turn = _time_between(E, 0.0, -1.03) + _time_to_turning(E, -1.03, yt)
     t_back_1 = 2 * t_turn - t_out_1
     t_origin = 2 * t_turn
     t_up_103 = t_origin + _time_between(E, 0.0, 1.03)
     assert s["returned"][0]
+    assert lt["t_end"][0] == pytest.approx(t_out_103, rel=1e-10)
     assert s["t_esc"][0] == pytest.approx(t_out_103, rel=1e-10)
     assert s["t_return"][0] == pytest.approx(t_back_1, rel=1e-9)
     assert s["t_reesc"][0] == pytest.approx(t_up_103, rel=1e-9)
     # the crossing sequence: out 1, out 1.03, in 1.03, in 1, out 1, out 1.03
-    np.testing.assert_array_equal(fr.direction, [1, 1, -1, -1, 1, 1])
-    np.testing.assert_allclose(fr.radius, [1.0, 1.03, 1.03, 1.0, 1.0, 1.03])
+    np.testing.assert_array_equal(cr["direction"], [1, 1, -1, -1, 1, 1])
+    np.testing.assert_allclose(cr["radius"], [1.0, 1.03, 1.03, 1.0, 1.0, 1.03])
 
 
 def test_follow_censors_bounded_orbit_and_checks_input():
     # below E_c the orbit never reaches r = 1: censored at t_max, no crossing
-    fr = follow_orbits([[0.1, 0.0, 0.0, 0.3]], [1.0, 1.03], t_max=50.0)
-    assert fr.outcome[0] == CENSORED and fr.t_end[0] == 50.0 and fr.t.size == 0
-    with pytest.raises(ValueError, match="r_far"):
-        follow_orbits([[0.1, 0.0, 0.0, 0.3]], [1.0, 20.0], r_far=10.0)
+    lt, cr = _follow([[0.1, 0.0, 0.0, 0.3]], [1.0, 1.03], t_max=50.0)
+    assert lt["outcome"][0] == CENSORED and lt["t_end"][0] == 50.0 and cr["t"].size == 0
+    with pytest.raises(SceneError, match="r_far"):
+        _follow([[0.1, 0.0, 0.0, 0.3]], [1.0, 20.0], r_far=10.0)
 
 
-def test_follow_first_crossing_matches_engine_escape_times():
-    # two independent drivers (batch engine with lane refill vs scalar propagate) agree on escape
-    # times of short-lived orbits (chaos amplifies rounding differences only slowly before t ≈ 15)
-    from hhscatter.engine import run_chunk
+def test_follow_matches_the_scalar_reference_and_plain_escape_times():
+    # the batch follow mode against the scalar driver in long double (same events, independent
+    # precision), and its escape times against a plain run (follow compiles more events, which
+    # enter step-size control, so only short orbits agree to rounding)
+    from hhscatter.engine import run_chunk, simulate_orbit
     from hhscatter.ics import region_ics
-    from hhscatter.scene import Scene
+    from hhscatter.scene import Follow, Scene
 
-    sc = Scene(energy=0.3, n=120, seed=5, r_esc=1.03, t_max=200.0)
+    sc = Scene(energy=0.3, n=120, seed=5, r_esc=1.03, t_max=200.0, follow=Follow((1.0, 1.03, 1.5)))
     ics = region_ics(sc, 0, sc.n)
-    eng = run_chunk(sc, ics, np.arange(sc.n)).lifetimes
-    fr = follow_orbits(ics, [1.03], t_max=200.0)
-    s = return_statistics(fr.orbit, fr.t, fr.radius, fr.direction, fr.n, 1.03)
-    short = eng["t_end"] < 15
+    res = run_chunk(sc, ics, np.arange(sc.n))
+    plain = run_chunk(sc.replace(follow=None), ics, np.arange(sc.n)).lifetimes
+    lt, cr = res.lifetimes, res.crossings
+    short = lt["t_end"] < 15
     assert short.sum() > 40
-    np.testing.assert_allclose(s["t_esc"][short], eng["t_end"][short], rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(lt["t_end"][short], plain["t_end"][short], rtol=1e-8, atol=1e-9)
+    for k in np.flatnonzero(short)[:12]:
+        ref = simulate_orbit(sc, ics[k], fp_type=np.longdouble)
+        mine = cr["t"][cr["traj_id"] == k]
+        theirs = np.array([float(c[0]) for c in ref.crossings])
+        assert len(mine) == len(theirs), k
+        np.testing.assert_allclose(mine, theirs, rtol=1e-9, atol=1e-10)
+        assert float(ref.t_end) == pytest.approx(lt["t_end"][k], rel=1e-9)
 
 
 # ---------------------------------------------------------------------------

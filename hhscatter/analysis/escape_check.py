@@ -9,10 +9,8 @@ module measures how well r_esc approximates it:
 
 * :func:`lyapunov_orbit` — the Lyapunov (brake) orbit of exit channel 0 at
   energy E: its radial extent r_min … r_max and period;
-* :func:`follow_orbits` — integrates orbits from their initial conditions past
-  their first escape, recording every crossing of a set of radii, until they
-  reach r_far (gone) or t_max;
-* :func:`return_statistics` — from those crossings: for a given r_esc, the
+* :func:`return_statistics` — from the crossings of a set of radii recorded
+  by the engine's ``follow`` scenes (table ``crossings``): for a given r_esc, the
   first escape time, whether the orbit comes back inside r < r_in, when, and
   when it escapes again;
 * :func:`wilson_interval`, :func:`channel_fractions` — binomial fractions with
@@ -40,20 +38,16 @@ from ..model import HenonHeiles
 
 __all__ = [
     "ChannelFractions",
-    "FollowResult",
     "LyapunovOrbit",
     "PairedShift",
     "RatioSlope",
     "channel_fractions",
-    "follow_orbits",
     "lyapunov_orbit",
     "paired_mle_shift",
     "return_statistics",
     "survival_ratio_slope",
     "wilson_interval",
 ]
-
-FAR, CENSORED = 0, 1  # outcomes of :func:`follow_orbits`
 
 
 # ---------------------------------------------------------------------------
@@ -227,123 +221,6 @@ def lyapunov_orbit(energy: float, model: HenonHeiles | None = None, *, rtol: flo
 # ---------------------------------------------------------------------------
 # following orbits past their escape
 # ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class FollowResult:
-    """Result of :func:`follow_orbits`.
-
-    Crossings (one row each, ordered by orbit then time): ``orbit`` (index
-    into the ICs), ``t`` (orbit time), ``radius`` (which radius), ``direction``
-    (+1 outward, −1 inward).  Per orbit: ``outcome`` (0 = reached r_far,
-    1 = still inside r_far at t_max), ``t_end`` (time of r_far or t_max),
-    ``energy_error`` (max |H − H0| at the end, a check of the integration).
-    """
-
-    orbit: np.ndarray
-    t: np.ndarray
-    radius: np.ndarray
-    direction: np.ndarray
-    outcome: np.ndarray
-    t_end: np.ndarray
-    energy_error: np.ndarray
-    radii: tuple
-    r_far: float
-    t_max: float
-
-    @property
-    def n(self) -> int:
-        return int(self.outcome.size)
-
-
-def follow_orbits(ics, radii, *, model: HenonHeiles | None = None, r_far: float = 10.0,
-                  t_max: float = 500.0, tol: float = 1e-15) -> FollowResult:
-    """follow_orbits(ics, radii, *, model=None, r_far=10, t_max=500, tol=1e-15) -> FollowResult.
-
-    Integrates each initial state (rows x, y, p_x, p_y of ``ics``) of the
-    conservative system (paper Eq. (eqn:hh_ham)) with heyoka's Taylor
-    integrator and records every crossing of the circles r = R for R in
-    ``radii`` (both directions, exact event roots), until the orbit reaches
-    ``r_far`` (terminal event; an orbit that far down a channel is
-    accelerating towards the finite-time blow-up of the cubic potential and
-    never comes back) or the orbit time ``t_max``.  Unlike the engine it does
-    not stop at r_esc, so an orbit that crosses r_esc and returns is followed
-    through its return.  A non-finite state raises FloatingPointError (it
-    cannot happen before r_far is reached).
-    """
-    import heyoka as hy
-
-    from ..model import equations
-
-    model = model or HenonHeiles()
-    ics = np.ascontiguousarray(np.asarray(ics, dtype=float).reshape(-1, 4))
-    if not np.all(np.isfinite(ics)):
-        raise ValueError("ics must be finite")
-    radii = tuple(float(R) for R in radii)
-    if not radii or any(not (R > 0) for R in radii):
-        raise ValueError(f"radii must be positive, got {radii}")
-    if not r_far > max(radii):
-        raise ValueError(f"r_far must be > max(radii) = {max(radii)}, got {r_far}")
-    if not t_max > 0:
-        raise ValueError(f"t_max must be > 0, got {t_max}")
-    (x, y, _, _), _, _ = model.expressions()
-    r2 = x**2 + y**2
-    rec = []
-
-    def make_cb(k):
-        def cb(ta, t, d_sgn):
-            rec.append((t, k, int(d_sgn)))
-        return cb
-
-    nt = [hy.nt_event(r2 - R * R, make_cb(k)) for k, R in enumerate(radii)]
-    te = [hy.t_event(r2 - r_far * r_far, direction=hy.event_direction.positive)]
-    ta = hy.taylor_adaptive(equations(model), [0.0] * 4, tol=tol, t_events=te, nt_events=nt)
-
-    n = len(ics)
-    rows_o, rows_t, rows_k, rows_d = [], [], [], []
-    outcome = np.empty(n, dtype=np.int8)
-    t_end = np.empty(n)
-    e_err = np.empty(n)
-    e0 = model.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3])
-    tl = hy.taylor_outcome.time_limit
-    for i in range(n):
-        ta.time = 0.0
-        ta.state[:] = ics[i]
-        ta.reset_cooldowns()
-        rec.clear()
-        res = ta.propagate_until(t_max)
-        oc = res[0]
-        st = ta.state
-        if not np.all(np.isfinite(st)) or oc == hy.taylor_outcome.err_nf_state:
-            raise FloatingPointError(f"non-finite state for orbit {i} (raise r_far's margin or lower t_max)")
-        if oc == tl:
-            outcome[i] = CENSORED
-        elif int(oc) == -1:  # terminal event 0: r_far
-            outcome[i] = FAR
-        else:
-            raise RuntimeError(f"unexpected integrator outcome {oc} for orbit {i}")
-        t_end[i] = ta.time
-        e_err[i] = abs(float(model.energy(*st)) - e0[i])
-        for t, k, d in rec:
-            rows_o.append(i)
-            rows_t.append(t)
-            rows_k.append(k)
-            rows_d.append(d)
-    orbit = np.asarray(rows_o, dtype=np.int64)
-    t = np.asarray(rows_t, dtype=float)
-    order = np.lexsort((t, orbit))
-    return FollowResult(
-        orbit=orbit[order],
-        t=t[order],
-        radius=np.asarray(radii, dtype=float)[np.asarray(rows_k, dtype=np.int64)][order] if rows_k else np.empty(0),
-        direction=np.asarray(rows_d, dtype=np.int8)[order],
-        outcome=outcome,
-        t_end=t_end,
-        energy_error=e_err,
-        radii=radii,
-        r_far=float(r_far),
-        t_max=float(t_max),
-    )
-
-
 def return_statistics(orbit, t, radius, direction, n_orbits: int, r_esc: float, r_in: float = 1.0) -> dict:
     """return_statistics(orbit, t, radius, direction, n_orbits, r_esc, r_in=1.0) -> dict of per-orbit arrays.
 

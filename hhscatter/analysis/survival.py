@@ -51,6 +51,7 @@ from scipy.special import xlogy
 
 __all__ = [
     "CENSORED_OUTCOME",
+    "CENSORING_OUTCOMES",
     "LEAVING_OUTCOMES",
     "ExponentialFit",
     "PowerLawFit",
@@ -67,6 +68,9 @@ __all__ = [
 ]
 
 LEAVING_OUTCOMES = ("escaped", "settled")
+# 'stopped': the engine stopped the orbit because nothing more was needed from it
+# (hhscatter.events); for a lifetime it is right-censoring at t_end, like 'censored'
+CENSORING_OUTCOMES = ("censored", "stopped")
 CENSORED_OUTCOME = "censored"
 
 
@@ -190,13 +194,13 @@ def survival_curve(t_end, observed, t_grid=None) -> SurvivalCurve:
 
 
 def observed_from_outcome(outcome) -> np.ndarray:
-    """observed_from_outcome(outcome) -> bool array: True for 'escaped'/'settled', False for 'censored'.
+    """observed_from_outcome(outcome) -> bool array: True for 'escaped'/'settled', False for 'censored'/'stopped'.
 
     Raises ValueError on any other (or missing) outcome label.
     """
     o = np.asarray(outcome, dtype=object).ravel()
     leaving = np.isin(o, LEAVING_OUTCOMES)
-    censored = o == CENSORED_OUTCOME
+    censored = np.isin(o, CENSORING_OUTCOMES)
     bad = ~(leaving | censored)
     if bad.any():
         raise ValueError(f"unknown outcome labels: {sorted({repr(v) for v in o[bad]})[:5]}")

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from .survival import observed_from_outcome
 
 __all__ = [
     "bootstrap_transition_times",
@@ -266,7 +267,7 @@ def bootstrap_transition_times(
             n = t_end.size
         if t_end.size != n or outcome.size != n:
             raise ValueError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
-        arrs[lab] = (t_end, outcome, outcome != "censored")
+        arrs[lab] = (t_end, outcome, observed_from_outcome(outcome))
     g = np.asarray(grid, dtype=float)
     rng = np.random.default_rng(seed)
     qcols = [f"t_settle_q{q:g}" for q in settle_q]

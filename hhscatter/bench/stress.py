@@ -77,14 +77,10 @@ def _disk_ics(energy, n, seed, gamma=0.0):
 
 
 def backward(state, T):
-    """backward(state, T) -> float64 state at time −T (heyoka long double, conservative, no events)."""
-    import heyoka as hy
+    """backward(state, T) -> float64 state at time −T (long double, conservative, no events)."""
+    from ..engine import state_at
 
-    from ..model import equations
-
-    ta = hy.taylor_adaptive(equations(MODEL), np.asarray(state, dtype=np.longdouble), fp_type=np.longdouble)
-    ta.propagate_until(np.longdouble(-T))
-    return np.array(ta.state, dtype=float)
+    return np.asarray(state_at(Scene(energy=0.3, n=1), state, -T, fp_type=np.longdouble), dtype=float)
 
 
 # -- long integrations ----------------------------------------------------------
@@ -357,26 +353,16 @@ def _skim_points(etas, radii=(0.45, 0.6, 0.75), n_phi=4):
 
 
 def reference_section_times(ic, t_max, r_esc=1.03):
-    """reference_section_times(ic, t_max) -> array of times of all crossings ṙ = 0 with φ̇ > 0 (long double)."""
-    import heyoka as hy
+    """reference_section_times(ic, t_max) -> array of times of all crossings ṙ = 0 with φ̇ > 0.
 
-    from ..model import equations
+    The engine's scalar driver in long double (tolerance its epsilon, ~1e-19),
+    with every crossing recorded (no window).
+    """
+    from ..engine import simulate_orbit
 
-    (x, y, px, py), _, _ = MODEL.expressions()
-    times = []
-
-    def cb(ta, t, d):
-        ta.update_d_output(t)
-        s = ta.d_output
-        if t > np.longdouble(1e-10) and s[0] * s[3] - s[1] * s[2] > 0:
-            times.append(float(t))
-
-    ta = hy.taylor_adaptive(equations(MODEL), np.asarray(ic, dtype=np.longdouble), fp_type=np.longdouble,
-                            t_events=[hy.t_event(x**2 + y**2 - r_esc**2, direction=hy.event_direction.positive,
-                                                 fp_type=np.longdouble)],
-                            nt_events=[hy.nt_event(x * px + y * py, cb, fp_type=np.longdouble)])
-    ta.propagate_until(np.longdouble(t_max))
-    return np.array(times)
+    sc = Scene(energy=0.3, n=1, r_esc=r_esc, t_max=t_max, sections=SectionWindow())
+    res = simulate_orbit(sc, ic, fp_type=np.longdouble)
+    return np.array([float(r[0]) for r in res.sections])
 
 
 def case_section_skim(etas=(1e-2, 1e-5, 1e-8, 1e-11, 1e-13, -1e-13, -1e-11, -1e-8, -1e-5, -1e-2),

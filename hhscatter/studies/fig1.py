@@ -83,7 +83,8 @@ def _main_scene(study, energy, t_rec):
         energy_key(energy),
         energy=float(energy),
         t_max=float(t_rec + float(study.param("t_after"))),
-        sections={"t_from": float(t_rec), "first_only": True},
+        # the first crossing after t_rec is all this run needs: the orbit stops there
+        sections={"t_from": float(t_rec), "first_only": True, "stop": True},
         snapshots=None,
     )
 

@@ -11,8 +11,9 @@ Which orbits count at time t.  An orbit is *inside Ω at t* unless it has
 escaped by t.  Escaped orbits leave the average at their escape time (the
 engine's t_end, the last outward crossing of r_esc).  Settled orbits
 (energy reached E_c inside Ω; trapped for ever) stay in it: the engine stops
-them at settling, so :mod:`hhscatter.studies._settled` re-integrates them and
-supplies their energies at the later grid times.  This is the only reading
+them at settling unless asked otherwise, so this study's scene sets
+``continue_settled``: the engine integrates settled orbits on to the last
+grid time and writes their energies there as snapshot rows after t_end.  This is the only reading
 consistent with the paper's numbers: with μ = 0.91, ⟨E⟩(200) ≈ 0.049 < E_c =
 1/6, impossible for an average over orbits above E_c, and the paper says
 that after t ≈ 200 "the only remaining orbits will be slowly collapsing
@@ -23,8 +24,8 @@ Ribbon: ⟨E⟩ ± 3σ with σ the standard error of the mean (std/√n).
 Errors of μ: bootstrap over orbits (statistical); the least-squares error
 of the fit itself measures the model misfit and is reported separately.
 
-Stages: ``simulate`` (engine run with snapshots on a uniform grid, then the
-settled-orbit continuation), ``analyze`` (derived tables ``fig3_mean_energy``,
+Stages: ``simulate`` (one engine run with snapshots on the grid, settled
+orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
 ``fig3_mu_windows``, ``fig3_histograms`` and fig3.json), ``plot`` (fig3.png).
 """
 from __future__ import annotations
@@ -65,18 +66,13 @@ def _key(study) -> str:
 
 
 def simulate(study, workers=None, progress=True):
-    """simulate(study, workers=None) -> None: the engine run with snapshots, then the settled continuation."""
-    from ..tables import read_lifetimes
-    from ._settled import continue_settled
-
+    """simulate(study, workers=None) -> None: one engine run with snapshots, settled orbits continued."""
     grid = snapshot_grid(study.param("snapshot_grid"))
     key = _key(study)
-    scene = study.scene(key, snapshots=tuple(grid))
+    scene = study.scene(key, snapshots=tuple(grid), continue_settled=True)
     if not scene.dissipative:
         raise ValueError(f"fig3 needs gamma > 0 in [scene], got {scene.gamma}")
-    out = study.run(key, scene, workers=workers, progress=progress)
-    lt = read_lifetimes(out, columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
-    continue_settled(scene, lt, grid, study.raw(key + "_settled"), workers=workers, progress=progress)
+    study.run(key, scene, workers=workers, progress=progress)
 
 
 def _parts(run_dir):
@@ -84,25 +80,29 @@ def _parts(run_dir):
 
 
 def inside_mean_energy(study, key: str):
-    """inside_mean_energy(study, key) -> (inside, above, continuation summary).
+    """inside_mean_energy(study, key) -> (inside, above, continuation counts).
 
     ⟨E⟩(t) statistics (columns of :func:`hhscatter.analysis.decay.mean_energy`)
-    of every orbit not escaped at t (``inside``: engine snapshots + settled
-    continuation) and of the engine's rows alone (``above``: orbits neither
-    escaped nor settled, E > E_c).  Computed part file by part file and
-    pooled, so memory stays O(grid) for any N.
+    of every orbit not escaped at t (``inside``: the run's snapshots, settled
+    orbits continued past t_end) and of the orbits still above E_c
+    (``above``: neither escaped nor settled; E decreases monotonically for
+    γ > 0, so these are the rows with E > E_c). Computed part file by part
+    file and pooled, so memory stays O(grid) for any N.
     """
     import pyarrow.parquet as pq
 
     from ..analysis.decay import mean_energy, pool_mean_energy
 
-    def stats(paths):
-        return [mean_energy(pq.read_table(p, columns=["t", "energy"]).to_pandas()) for p in paths]
-
-    above = stats(_parts(study.raw(key)))
-    cont = stats(_parts(study.raw(key + "_settled")))
-    summary = json.loads((study.raw(key + "_settled") / "continuation.json").read_text())
-    return pool_mean_energy(above + cont), pool_mean_energy(above), summary
+    ec = study.scene(key).model.critical_energy
+    inside, above = [], []
+    n_rows_after = 0
+    for p in _parts(study.raw(key)):
+        df = pq.read_table(p, columns=["t", "energy"]).to_pandas()
+        up = df["energy"] > ec
+        inside.append(mean_energy(df))
+        above.append(mean_energy(df[up]))
+        n_rows_after += int((~up).sum())
+    return pool_mean_energy(inside), pool_mean_energy(above), {"rows_below_ec": n_rows_after}
 
 
 def read_inside(study, key: str, filters=None) -> pd.DataFrame:
@@ -113,8 +113,7 @@ def read_inside(study, key: str, filters=None) -> pd.DataFrame:
     """
     from ..tables import read_snapshots
 
-    return pd.concat([read_snapshots(study.raw(key), filters=filters),
-                      read_snapshots(study.raw(key + "_settled"), filters=filters)], ignore_index=True)
+    return read_snapshots(study.raw(key), filters=filters)
 
 
 def bootstrap_subset(study, key: str, n_orbits: int, windows, E0, gamma, n_boot, seed):
@@ -233,7 +232,7 @@ def analyze(study):
         "f_settled": n_settled / n_orbits,
         "definition": ("⟨E⟩(t): mean energy over orbits not escaped by t; settled orbits (E reached E_c inside Ω) "
                        "continued past settling by re-integration; ribbon ±3 standard errors of the mean"),
-        "raw_keys": {"engine": key, "settled_continuation": key + "_settled"},
+        "raw_keys": {"engine": key},
         "continuation": {k: v for k, v in cont.items() if k != "key"},
         "fit_window": list(window),
         "mu": {"value": float(p["mu"]), "err": float(p["mu_err"])},

@@ -33,7 +33,7 @@ conditions, orbit i gets the same multiplicity in every ensemble).
 
 Raw runs (read by study fig6): ``raw/gamma<γ:g>`` — ``gamma0``,
 ``gamma0.001``, ``gamma0.002``, ``gamma0.005``, ``gamma0.01``, ``gamma0.02``;
-the μ run also has ``raw/gamma<γ:g>_settled`` (settled-orbit continuation).
+the μ run's snapshots include its settled orbits, continued past E_c.
 """
 from __future__ import annotations
 
@@ -65,20 +65,14 @@ def _gammas(study):
 
 
 def simulate(study, workers=None, progress=True):
-    """simulate(study, workers=None) -> None: one engine run per γ (same ICs); snapshots + continuation for mu_gamma."""
-    from ..tables import read_lifetimes
-    from ._settled import continue_settled
-
+    """simulate(study, workers=None) -> None: one engine run per γ (same ICs); for mu_gamma with snapshots,
+    settled orbits continued to the last grid time."""
     gs, mg = _gammas(study)
     grid = snapshot_grid(study.param("snapshot_grid"))
     for g in gs:
         key = raw_key(g)
-        snaps = tuple(grid) if g == mg else None
-        scene = study.scene(key, gamma=g, snapshots=snaps)
-        out = study.run(key, scene, workers=workers, progress=progress)
-        if g == mg:
-            lt = read_lifetimes(out, columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
-            continue_settled(scene, lt, grid, study.raw(key + "_settled"), workers=workers, progress=progress)
+        extra = {"snapshots": tuple(grid), "continue_settled": True} if g == mg else {"snapshots": None}
+        study.run(key, study.scene(key, gamma=g, **extra), workers=workers, progress=progress)
 
 
 def _tau0_rule(grid, P0, n):
@@ -95,7 +89,7 @@ def _plot_grid(t_last):
 def analyze(study):
     """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
     from ..analysis.decay import fit_energy_decay
-    from ..analysis.survival import survival_from_lifetimes
+    from ..analysis.survival import observed_from_outcome, survival_from_lifetimes
     from ..analysis.transitions import (
         bootstrap_transition_times,
         settle_time_quantiles,
@@ -129,7 +123,7 @@ def analyze(study):
 
     # fine grid for τ0/τ1 (P on it is exact: no censoring before t_max in these runs)
     grid = np.round(np.arange(0.0, t_last + dt, dt), 9)
-    obs = {g: (lt["outcome"] != "censored").to_numpy() for g, lt in lts.items()}
+    obs = {g: observed_from_outcome(lt["outcome"]) for g, lt in lts.items()}
     P = {g: survival_on_grid(lts[g]["t_end"].to_numpy(), obs[g], grid) for g in gs}
     tau0 = float(_tau0_rule(grid, P[0.0], N))
 
@@ -263,7 +257,7 @@ def analyze(study):
         "raw_keys": {f"{g:g}": raw_key(g) for g in gs},
         "raw_key_naming": ("raw runs are studies/fig4/out/<scale>/raw/gamma<γ formatted with %g>: gamma0 (conservative "
                            "reference), gamma0.001, gamma0.002, gamma0.005, gamma0.01, gamma0.02; every run has the "
-                           "same initial conditions (seed, n); raw/gamma<mu_gamma>_settled holds the energies of that "
+                           "same initial conditions (seed, n); raw/gamma<mu_gamma> also holds the energies of that "
                            "run's settled orbits after settling (snapshots schema)"),
         "tau0_rule": ("τ0 = choose_windows(P_0).tau0: first time after which the local escape rate of the conservative "
                       "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.escape_rate)"),

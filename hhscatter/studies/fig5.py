@@ -82,7 +82,9 @@ def _scene_for(study, g):
     E1 = float(study.param("E1"))
     t_lo = time_to_energy(E2, E1, float(study.param("mu_max")), g)
     t_hi = time_to_energy(E2, E1, float(study.param("mu_min")), g) + float(study.param("section_pad"))
-    return study.scene(gamma_key(g), gamma=float(g), sections={"t_from": float(t_lo), "t_to": float(t_hi)})
+    # nothing is needed from an orbit after the window: it stops there (outcome 'stopped')
+    return study.scene(gamma_key(g), gamma=float(g),
+                       sections={"t_from": float(t_lo), "t_to": float(t_hi), "stop": True})
 
 
 def simulate(study, workers=None, progress=True):

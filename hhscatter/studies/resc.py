@@ -21,8 +21,8 @@ observations.  This study measures, at E = 0.25, 0.30, 0.35:
    dominated by the window's first e-fold and so sensitive to the
    period-scale modulation of the hazard).  Delays: the mean flight time
    from r_ref to r on identical trajectories and the delay of P(t).
-2. Returns: orbits followed past their escape
-   (:func:`~hhscatter.analysis.escape_check.follow_orbits`); the fraction
+2. Returns: orbits followed past their escape (the engine's ``follow``
+   scene option, table ``crossings``); the fraction
    that comes back inside r < 1 after crossing r_esc outward (Wilson
    intervals) and how fast those escape again; the radial extent of the
    Lyapunov orbit (the exact boundary of Ω) at each energy.
@@ -36,8 +36,6 @@ resc.json, resc.png.
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 
 import numpy as np
@@ -63,72 +61,15 @@ def _follow_radii(study):
 
 
 # -- simulate ---------------------------------------------------------------
-def _follow_chunk(args):
-    ics, radii, r_far, t_max, tol, omega, lam = args
-    from ..analysis.escape_check import follow_orbits
-    from ..model import HenonHeiles
-
-    return follow_orbits(ics, radii, model=HenonHeiles(omega, lam), r_far=r_far, t_max=t_max, tol=tol)
-
-
-def _run_follow(study, E, workers=None, progress=True):
-    """Follow the first n_follow orbits of the (E, r_ref) ensemble past their escape; raw/<follow key>/."""
-    import time
-
-    from ..ics import region_ics
-    from ..runner import default_workers
+def _follow_scene(study, E):
+    """The first n_follow orbits of the (E, r_ref) ensemble, followed past their escape (scene option
+    ``follow``): every crossing of the follow radii, until r_far or t_max."""
+    from ..scene import Follow
 
     r_ref = float(study.param("r_ref"))
-    scene = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
-    n = min(int(study.param("n_follow")), scene.n)
-    radii = _follow_radii(study)
-    r_far = float(study.param("r_far", 10.0))
-    params = {"scene_hash": scene.result_hash(), "n_follow": n, "radii": list(radii), "r_far": r_far}
-    tag = hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()[:16]
-    out = study.raw(_follow_key(E))
-    done = out / "params.json"
-    if done.exists() and json.loads(done.read_text()).get("tag") == tag:
-        return out
-    out.mkdir(parents=True, exist_ok=True)
-    ics = region_ics(scene, 0, n)
-    workers = workers or default_workers()
-    step = max(1, min(10000, -(-n // max(1, 4 * workers))))
-    jobs = [(ics[s:s + step], radii, r_far, scene.t_max, scene.tol, scene.omega, scene.lam)
-            for s in range(0, n, step)]
-    t0, c0 = time.perf_counter(), time.process_time()
-    if workers == 1 or len(jobs) == 1:
-        parts = [_follow_chunk(j) for j in jobs]
-        cpu = time.process_time() - c0
-    else:
-        import multiprocessing as mp
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=mp.get_context("spawn")) as pool:
-            parts = list(pool.map(_follow_chunk, jobs))
-        cpu = math.nan  # children's CPU time is not visible here; wall × workers bounds it
-    wall = time.perf_counter() - t0
-    offs = np.cumsum([0] + [p.n for p in parts])
-    cross = pd.DataFrame({
-        "traj_id": np.concatenate([p.orbit + o for p, o in zip(parts, offs)]).astype(np.int64),
-        "t": np.concatenate([p.t for p in parts]),
-        "radius": np.concatenate([p.radius for p in parts]),
-        "direction": np.concatenate([p.direction for p in parts]).astype(np.int8),
-    })
-    ends = pd.DataFrame({
-        "traj_id": np.arange(n, dtype=np.int64),
-        "outcome": np.concatenate([p.outcome for p in parts]),
-        "t_end": np.concatenate([p.t_end for p in parts]),
-        "energy_error": np.concatenate([p.energy_error for p in parts]),
-    })
-    cross.to_parquet(out / "crossings.parquet", index=False)
-    ends.to_parquet(out / "ends.parquet", index=False)
-    done.write_text(json.dumps({**params, "tag": tag, "wall_seconds": wall, "cpu_seconds": cpu,
-                                "workers": workers}, indent=2))
-    if progress:
-        print(f"  resc/{_follow_key(E)}: {n} orbits followed | wall {wall:.1f} s, "
-              f"{1e6 * wall * (1 if workers == 1 else min(workers, len(jobs))) / n:.0f} µs/orbit/core "
-              f"({workers} worker{'s' if workers != 1 else ''})", flush=True)
-    return out
+    base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
+    return study.scene(_follow_key(E), energy=E, r_esc=r_ref, n=min(int(study.param("n_follow")), base.n),
+                       r_far=float(study.param("r_far", 10.0)), follow=Follow(_follow_radii(study)))
 
 
 def simulate(study, workers=None, progress=True):
@@ -137,7 +78,7 @@ def simulate(study, workers=None, progress=True):
     for E in energies:
         for r in radii:
             study.run(_key(E, r), study.scene(_key(E, r), energy=E, r_esc=r), workers=workers, progress=progress)
-        _run_follow(study, E, workers=workers, progress=progress)
+        study.run(_follow_key(E), _follow_scene(study, E), workers=workers, progress=progress)
 
 
 # -- analyze ----------------------------------------------------------------
@@ -168,6 +109,7 @@ def analyze(study):
     )
     from ..analysis.escape_rate import escape_rate, escape_rate_mle
     from ..analysis.survival import survival_curve
+    from ..tables import read_crossings, read_lifetimes
 
     energies, radii = _grid(study)
     r_ref = float(study.param("r_ref"))
@@ -228,8 +170,10 @@ def analyze(study):
             win = (t_p, t_hi)
         # follow runs: returns and flight times on identical trajectories
         fdir = study.raw(_follow_key(E))
-        cross = pd.read_parquet(fdir / "crossings.parquet")
-        ends = pd.read_parquet(fdir / "ends.parquet")
+        cross = read_crossings(fdir).sort_values(["traj_id", "t"], kind="stable")
+        ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"]).sort_values("traj_id")
+        # a followed orbit that never escapes is censored at t_max (its t_end)
+        ends["energy_error"] = (ends["e_end"] - ends["e0"]).abs()
         nf = len(ends)
         rs = {r: return_statistics(cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(),
                                    cross.direction.to_numpy(), nf, r, r_in) for r in radii}
@@ -309,7 +253,7 @@ def analyze(study):
                 "frac_fast_hi": float(fhi),
                 "lyap_r_min": lyapE.r_min, "lyap_r_max": lyapE.r_max,
                 "energy_error_max": float(ends.energy_error.max()),
-                "n_censored_follow": int((ends.outcome == 1).sum()),
+                "n_censored_follow": int((ends.outcome == "censored").sum()),
             })
             # exit channels
             ch = chans[r]
