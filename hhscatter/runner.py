@@ -132,7 +132,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     the file.
     """
     from .engine import run_chunk
-    from .tables import provenance, to_arrow, write_part
+    from .tables import add_point_columns, provenance, to_arrow, write_part
 
     scene = scene_from_dict(_decode(json.loads(scene_json)))
     store = Store(out)
@@ -152,6 +152,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):
         table = to_arrow(name, rows[name])
+        if partition and "=" not in partition:  # a grid point's files name their point (hhscatter.tables)
+            table = add_point_columns(name, table, scene)
         rel = part_rel(name, partition, chunk)
         try:
             write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
@@ -259,9 +261,22 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool):
 
     if isinstance(run, Grid):
         doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
-        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points_of(run)]
+        points = resumed_points(store, points_of(run)) if resume else points_of(run)
+        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points]
     store.write_json(SCENE_FILE, doc)
     return store
+
+
+def resumed_points(store, points):
+    """resumed_points(store, points) -> points with the folder names the run at ``store`` was started with.
+
+    A grid run begun by hhscatter ≤ 0.1.0 keeps its ``energy=…/gamma=…`` folders when resumed, so that it
+    stays one dataset in one layout (:mod:`hhscatter.tables` reads both).
+    """
+    if not store.exists(SCENE_FILE):
+        return points
+    old = {p.get("scene_hash"): p.get("partition") for p in json.loads(store.read_text(SCENE_FILE)).get("points", [])}
+    return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]
 
 
 def default_workers() -> int:
@@ -327,6 +342,8 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
 
         check_scheduler(scheduler, workers)
     store = prepare_output(run, out, overwrite=overwrite, resume=resume)
+    if resume:
+        points = resumed_points(store, points)
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
