@@ -318,12 +318,12 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
     LocalCluster's worker processes). ``scheduler``: None (local pool),
     ``'local'`` or a Dask scheduler address ``'tcp://host:port'``. Tables are
     byte-identical for any backend and number of workers. With ``resume``,
-    complete chunks are verified and kept, the rest redone.
+    complete chunks are verified and kept, the rest redone. ``progress``:
+    True (a tqdm bar), ``'plain'`` (a plain line on stderr at most every 10 s,
+    for logs: no carriage returns) or False.
     Raises SceneError on bad input (before any work), RunError when a chunk
     cannot be written.
     """
-    from tqdm.auto import tqdm
-
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers must be an integer ≥ 1, got {workers!r}")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
@@ -368,8 +368,7 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         return (scene_json, c, s, e, out_url, states[s:e], ids[s:e], partition)
 
     t0 = time.perf_counter()
-    bar = tqdm(total=n_total, initial=done_orbits, unit="orbit", unit_scale=True, disable=not progress,
-               desc=f"{run.name}", smoothing=0.05)
+    bar = progress_bar(progress, n_total, done_orbits, run.name)
 
     def on_done(task, result):
         summary.add(result)
@@ -402,6 +401,38 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         bar.close()
     summary.wall_seconds = time.perf_counter() - t0
     return summary
+
+
+class PlainProgress:
+    """Progress for logs: a plain line on stderr at most every ``every`` seconds and at the end, no '\\r'."""
+
+    def __init__(self, total, initial=0, desc="", every=10.0, file=None):
+        import sys
+
+        self.total, self.n, self.desc, self.every = total, initial, desc, every
+        self.file = file or sys.stderr
+        self.t0 = self.last = time.perf_counter()
+
+    def update(self, k):
+        self.n += k
+        now = time.perf_counter()
+        if now - self.last >= self.every or self.n >= self.total:
+            self.last = now
+            print(f"{self.desc}: {self.n}/{self.total} orbits ({100 * self.n / max(self.total, 1):.0f} %), "
+                  f"{now - self.t0:.0f} s", file=self.file, flush=True)
+
+    def close(self):
+        pass
+
+
+def progress_bar(progress, total, initial, desc):
+    """progress_bar(progress, total, initial, desc) -> object with update(n)/close(): tqdm, PlainProgress or silent."""
+    if progress == "plain":
+        return PlainProgress(total, initial, desc)
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, initial=initial, unit="orbit", unit_scale=True, disable=not progress, desc=desc,
+                smoothing=0.05)
 
 
 def _run_pool(workers, todo, args, on_done):

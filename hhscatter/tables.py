@@ -404,3 +404,38 @@ def read_sections(run_dir, columns=None, filters=None):
 def read_snapshots(run_dir, columns=None, filters=None):
     """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy [, point_energy, point_gamma] (as read_sections)."""
     return _read(run_dir, "snapshots", columns, filters)
+
+
+def describe_run(run_dir) -> dict:
+    """describe_run(run_dir) -> {'rows': {table: rows}, 'points': [{energy, gamma, escaped, settled, censored}]}.
+
+    What a run directory holds, from the files themselves (so resumed chunks
+    count too): the row count of each table present (from the Parquet
+    footers) and the outcome counts per grid point (one entry for a plain run,
+    whose ``energy`` is the scene's E0, None for runs from an IC table).
+    """
+    from .store import Store
+
+    store = Store(run_dir)
+    rows = {}
+    for name in TABLES:
+        if store.is_dir(name):
+            try:
+                rows[name] = _dataset(run_dir, name).count_rows()
+            except FileNotFoundError:
+                continue
+    if "lifetimes" not in rows:
+        raise FileNotFoundError(f"no lifetimes table at {store.display('lifetimes')}")
+    dset = _dataset(run_dir, "lifetimes")
+    keys = [k for k in ("energy", "gamma") if k in dset.schema.names]
+    table = dset.to_table(columns=[*keys, "outcome"])
+    counts = table.group_by([*keys, "outcome"]).aggregate([([], "count_all")]).to_pylist()
+    points = {}
+    for r in counts:
+        key = tuple(r[k] for k in keys)
+        points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0})[r["outcome"]] = r["count_all"]
+    if "energy" not in keys:  # a plain run: its one point is the scene's
+        meta = read_meta(next(iter(dset.files)), filesystem=store.filesystem)["scene"]
+        points = {(meta.get("energy"), meta.get("gamma")): c for c in points.values()}
+    return {"rows": rows,
+            "points": [{"energy": k[0], "gamma": k[1], **v} for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])]}
