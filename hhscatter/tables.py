@@ -268,7 +268,8 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False):
         raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
     files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
     if not files:
-        raise FileNotFoundError(f"no part files in {store.display(rel)}")
+        where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
+        raise FileNotFoundError(f"no {name} table: no part files in {where}")
     grid = any("/" in f for f in files)
     schema = schema_of(name, grid)
     paths = [store.path(rel, f) for f in files]
