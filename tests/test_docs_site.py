@@ -2,23 +2,10 @@
 MathJax is served from the site (offline), and the concept pages agree with the code's defaults."""
 from __future__ import annotations
 
-import importlib.util
 import re
-import sys
-from pathlib import Path
 
 import pytest
-
-ROOT = Path(__file__).resolve().parents[1]
-DOCS = ROOT / "docs"
-
-
-def _load(path: Path, name: str):
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+from test_docs import DOCS, ROOT, _load  # the docs tests' module loader and paths
 
 
 @pytest.fixture(scope="module")
