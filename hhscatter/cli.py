@@ -294,7 +294,7 @@ def main(argv=None):
     a = build_parser().parse_args(argv)
     try:
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
-    except (SceneError, UsageError) as exc:
+    except (SceneError, UsageError, FileNotFoundError) as exc:  # bad input, or a run/file that is not there
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
     except RunError as exc:

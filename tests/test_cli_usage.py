@@ -104,8 +104,10 @@ def test_survival_of_a_grid_run_draws_one_curve_per_point(tmp_path, capsys):
     (["survival", "{tmp}/missing", "--png", "{tmp}/p.png"], "does not exist"),
     (["survival", "{tmp}", "--png", "{tmp}/p.png"], "no lifetimes table"),
     (["survival", "{tmp}", "--png", "{tmp}/no/such/dir/p.png"], "--png: folder"),
+    (["study", "fig6", "analyze", "--scale", "nosuchscale"], "scale"),
 ])
 def test_user_errors_exit_2_without_traceback(tmp_path, args, message):
+    """A missing run, an empty folder, a --png folder that does not exist: message, status 2, no traceback."""
     r = _run(*[a.format(tmp=tmp_path) for a in args])
     assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr
 
