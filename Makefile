@@ -29,6 +29,16 @@ test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the default test suite (creat
 test-slow: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the slow accuracy/stress cases too
 	$(PY) -m pytest -q -m "slow or not slow"
 
+# the floors of pyproject.toml, tested: every dependency (core, dev, bench) at the lowest version allowed
+MIN_VENV := .venv-min
+test-min: ## run the test suite against the lowest dependency versions pyproject.toml allows (in .venv-min)
+	@test -x $(MIN_VENV)/bin/python || $(PYTHON) -m venv $(MIN_VENV)
+	$(MIN_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(PYTHON) tools/min_requirements.py dev bench > $(MIN_VENV)/constraints.txt
+	$(MIN_VENV)/bin/python -m pip install --quiet -c $(MIN_VENV)/constraints.txt -e '.[dev,bench,docs]'
+	$(MIN_VENV)/bin/python -m pip list --format=freeze | grep -iE '^(numpy|scipy|pandas|pyarrow|matplotlib|heyoka|duckdb|polars)=='
+	$(MIN_VENV)/bin/python -m pytest -q -p no:cacheprovider
+
 # -- demo: two real scenes end to end -----------------------------------------
 $(RUNS)/demo/conservative/.done: studies/demo/conservative.toml $(STAMP)
 	$(VENV)/bin/hhscatter simulate $< --out $(@D) --overwrite $(W)
@@ -129,4 +139,4 @@ docs-assets: ## copy the studies' quick-scale figures/numbers and bench summarie
 
 .PHONY: docs docs-serve docs-assets
 
-.PHONY: help venv test test-slow demo bench-engine bench-memory bench stress clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6
+.PHONY: help venv test test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6

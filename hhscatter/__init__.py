@@ -2,25 +2,46 @@
 in the Hénon–Heiles potential, on heyoka's batch Taylor integrator.
 
 Public entry points (imported lazily, so ``import hhscatter`` is cheap and has
-no side effects):
+no side effects; ``dir(hhscatter)`` lists them):
 
-- :class:`Scene`, :class:`SectionWindow`, :func:`load_scene` — what to compute
-- :func:`simulate` — run a scene, write Parquet tables
+- :class:`Scene`, :class:`SectionWindow`, :func:`load_scene`, :class:`Grid`,
+  :func:`load_run` — what to compute (one scene, or a grid over E0 and γ)
+- :func:`simulate` — run a scene or a grid, write Parquet tables
 - :func:`read_lifetimes`, :func:`read_sections`, :func:`read_snapshots` — read them
+- :func:`survival`, :func:`escape_rates` — P(t) and κ per grid point of a
+  lifetimes DataFrame (results with ``.to_frame()`` and ``.plot(ax=)``)
+- :func:`plot_survival`, :func:`plot_escape_rates` — draw on your matplotlib axes
 - :class:`HenonHeiles` — the model's closed forms (E_c, saddles, channels)
+
+``__version__`` is the installed distribution's version (``pyproject.toml`` is
+its only source).
 """
 
-__version__ = "0.1.0"
+from importlib.metadata import PackageNotFoundError, version
+
+try:
+    __version__ = version("hhscatter")
+except PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
+del version, PackageNotFoundError
 
 _EXPORTS = {
     "Scene": "scene",
     "SectionWindow": "scene",
     "SceneError": "scene",
     "load_scene": "scene",
+    "Grid": "grid",
+    "load_run": "grid",
     "simulate": "runner",
     "read_lifetimes": "tables",
     "read_sections": "tables",
     "read_snapshots": "tables",
+    "survival": "analysis.frames",
+    "escape_rates": "analysis.frames",
+    "plot_survival": "analysis.frames",
+    "plot_escape_rates": "analysis.frames",
+    "SurvivalCurves": "analysis.frames",
+    "EscapeRates": "analysis.frames",
     "HenonHeiles": "model",
 }
 
@@ -33,3 +54,7 @@ def __getattr__(name):
 
         return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
     raise AttributeError(f"module 'hhscatter' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))

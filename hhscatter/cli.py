@@ -1,7 +1,8 @@
-"""Command line: ``hhscatter simulate`` and ``hhscatter survival``.
+"""Command line: ``hhscatter simulate``, ``hhscatter survival`` and ``hhscatter study``.
 
 Exit status: 0 on success, 2 on bad input (the message names the parameter and
-its allowed range; nothing has been computed), 1 on other failures.
+its allowed range; nothing has been computed; no traceback), 1 on other
+failures.
 """
 from __future__ import annotations
 
@@ -9,6 +10,24 @@ import argparse
 import math
 import sys
 from pathlib import Path
+
+DESCRIPTION = (
+    "Exact-event ensemble simulations of (dissipative) chaotic scattering in the Hénon–Heiles potential: "
+    "integrate ensembles into Parquet tables (simulate), plot their survival probability (survival), and "
+    "run the paper's studies (study)."
+)
+EPILOG = """examples:
+  hhscatter simulate --energy 0.27 -n 1e5 --out runs/e027
+  hhscatter simulate --energy 0.25,0.3 --gamma 0,0.01 -n 1e4 --out runs/grid
+  hhscatter simulate --out runs/grid --resume        # continue a killed run (scene from runs/grid/scene.json)
+  hhscatter survival runs/grid --png grid.png        # one P(t) per grid point
+  hhscatter study fig2 all --scale quick
+
+'hhscatter COMMAND --help' lists a command's options."""
+
+
+class UsageError(Exception):
+    """Bad command-line input found after parsing (exit status 2, no traceback)."""
 
 
 def _float(s):
@@ -26,15 +45,38 @@ def _floats(s):
 
 
 def _int(s):
+    """An integer, also written as a float with an integral value (1e5, 2.0e4); 1.5 or nan are refused."""
     try:
         return int(s)
     except ValueError:
+        pass
+    try:
+        v = float(s)
+    except ValueError:
         raise argparse.ArgumentTypeError(f"not an integer: {s!r}") from None
+    if not math.isfinite(v) or v != int(v):
+        raise argparse.ArgumentTypeError(f"not an integer: {s!r} (a count must be a whole number)")
+    return int(v)
+
+
+def _snapshots(s):
+    """'START:STOP:STEP' (both ends included) or a comma-separated list of times."""
+    if ":" in s:
+        parts = s.split(":")
+        if len(parts) != 3:
+            raise argparse.ArgumentTypeError(f"snapshots: expected START:STOP:STEP, got {s!r}")
+        return dict(zip(("start", "stop", "step"), (_float(x) for x in parts)))
+    v = _floats(s)
+    return {"times": v if isinstance(v, list) else [v]}
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="hhscatter", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    from . import __version__
+
+    p = argparse.ArgumentParser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"hhscatter {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     s = sub.add_parser(
         "simulate",
@@ -42,12 +84,13 @@ def build_parser():
         description="Integrate an ensemble of Hénon–Heiles orbits (exact event times) and write "
         "the lifetimes (and, if asked, sections/snapshots) tables as Parquet datasets.",
     )
-    s.add_argument("scene", nargs="?", help="scene TOML file (flags below override its values)")
+    s.add_argument("scene", nargs="?", help="scene TOML file (flags below override its values); with --resume and "
+                   "no scene file, the scene is read from OUT/scene.json")
     s.add_argument("--scale", help="named scale in the scene file, e.g. 'paper' (default: quick)")
     s.add_argument("--energy", type=_floats,
                    help="initial energy E0 (> E_c = 1/6 for ω=λ=1); a list 0.25,0.3 makes a grid run")
     s.add_argument("--gamma", type=_floats, help="drag γ ≥ 0 (0 = conservative); a list 0,0.01 makes a grid run")
-    s.add_argument("-n", type=_int, help="number of orbits N > 0")
+    s.add_argument("-n", type=_int, help="number of orbits N > 0 (per grid point); 1e5 is accepted")
     s.add_argument("--seed", type=_int, help="seed ≥ 0 (with the orbit index it fixes every orbit)")
     s.add_argument("--region", choices=["disk", "well"], help="initial-condition region")
     s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
@@ -56,6 +99,21 @@ def build_parser():
     s.add_argument("--tol", type=_float, help="integrator tolerance in [1e-18, 1e-6] (default 1e-15)")
     s.add_argument("--chunk-size", type=_int, dest="chunk_size", help="orbits per part file (default 10000)")
     s.add_argument("--batch-size", type=_int, dest="batch_size", help="SIMD lanes (default: heyoka's choice)")
+    sec = s.add_argument_group("sections", "record crossings of the section ṙ = 0, φ̇ > 0 (any of these flags "
+                                "turns it on; they override the scene file's [sections])")
+    sec.add_argument("--sections", action="store_true", help="record every crossing (t > 0)")
+    sec.add_argument("--sections-t-from", type=_float, dest="sections_t_from", metavar="T",
+                     help="only crossings at orbit time ≥ T")
+    sec.add_argument("--sections-t-to", type=_float, dest="sections_t_to", metavar="T",
+                     help="only crossings at orbit time ≤ T")
+    sec.add_argument("--sections-e-min", type=_float, dest="sections_e_min", metavar="E",
+                     help="only crossings with energy ≥ E")
+    sec.add_argument("--sections-e-max", type=_float, dest="sections_e_max", metavar="E",
+                     help="only crossings with energy ≤ E")
+    sec.add_argument("--sections-first-only", action="store_true", dest="sections_first_only",
+                     help="only the first crossing in the window per orbit")
+    s.add_argument("--snapshots", type=_snapshots, metavar="START:STOP:STEP|T1,T2,…",
+                   help="record the energy of every live orbit at these orbit times (overrides [snapshots])")
     s.add_argument("--ics", help="Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]")
     s.add_argument("--out", required=True, help="output directory, or a URL pyarrow/fsspec can write (s3://…)")
     s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
@@ -64,12 +122,14 @@ def build_parser():
     g = s.add_mutually_exclusive_group()
     g.add_argument("--overwrite", action="store_true", help="replace the tables in a non-empty --out")
     g.add_argument("--resume", action="store_true", help="keep verified finished chunks in --out, redo the rest")
-    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    _progress_flags(s)
 
-    v = sub.add_parser("survival", help="plot P(t) of one or more runs to a PNG")
+    v = sub.add_parser("survival", help="plot P(t) of one or more runs to a PNG (one curve per grid point)",
+                       description="Plot the Kaplan–Meier survival probability P(t) of one or more runs; a grid "
+                       "run gives one curve per (E0, γ) point.")
     v.add_argument("runs", nargs="+", help="run directories (outputs of simulate)")
-    v.add_argument("--png", required=True, help="output PNG path")
-    v.add_argument("--labels", nargs="*", help="curve labels (default: from the scenes)")
+    v.add_argument("--png", required=True, help="output PNG path (its folder must exist)")
+    v.add_argument("--labels", nargs="*", help="curve labels, one per curve in order (default: E0, γ and N)")
 
     st = sub.add_parser(
         "study",
@@ -81,14 +141,46 @@ def build_parser():
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
     st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
-    st.add_argument("--quiet", action="store_true", help="no progress bars")
+    _progress_flags(st)
     return p
+
+
+def _progress_flags(parser):
+    g = parser.add_mutually_exclusive_group()
+    g.add_argument("--progress", action="store_true",
+                   help="show progress even when stderr is not a terminal (then as plain lines, no carriage returns)")
+    g.add_argument("--no-progress", "--quiet", action="store_true", dest="quiet",
+                   help="no progress (default when stderr is not a terminal)")
+
+
+def _progress(a):
+    """True (a bar) on a terminal, 'plain' lines in logs with --progress, else False."""
+    if a.quiet:
+        return False
+    if sys.stderr.isatty():
+        return True
+    return "plain" if a.progress else False
+
+
+def _resumed_scene(out):
+    """The scene dict of OUT/scene.json (what --resume without a scene file continues), or None."""
+    import json
+
+    from .store import Store
+
+    try:
+        store = Store(out)
+        if not store.exists("scene.json"):
+            return None
+        return json.loads(store.read_text("scene.json"))["scene"]
+    except (ValueError, KeyError, OSError) as exc:
+        raise UsageError(f"--resume: cannot read the scene of {out}/scene.json ({exc})") from None
 
 
 def _scene_from_args(a):
     """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
-    from .grid import load_run, run_from_dict
-    from .scene import SceneError
+    from .grid import run_from_dict
+    from .scene import SceneError, scene_dict_from_toml
 
     flags = {
         k: getattr(a, k)
@@ -108,54 +200,90 @@ def _scene_from_args(a):
         flags["n"] = len(states)
         flags["ics"] = str(Path(a.ics).resolve())
     if a.scene:
-        return load_run(a.scene, scale=a.scale, **flags)
-    if a.scale:
+        d = scene_dict_from_toml(a.scene, a.scale)
+    elif a.scale:
         raise SceneError("--scale needs a scene file")
-    d = {k: v for k, v in flags.items() if v is not None}
-    d.setdefault("name", Path(a.out).name)
-    if "n" not in d:
-        raise SceneError("n (number of orbits) is required: give -n or a scene file")
-    if "energy" not in d and not a.ics:
-        raise SceneError("energy is required: give --energy or a scene file")
+    elif a.resume and (old := _resumed_scene(a.out)) is not None:
+        d = old  # flags given as well still override it (a different scene is then refused by the hash check)
+    else:
+        d = {"name": Path(a.out).name}
+        if flags["n"] is None:
+            hint = " (--resume found no scene.json in --out)" if a.resume else ""
+            raise SceneError(f"n (number of orbits) is required: give -n or a scene file{hint}")
+        if flags["energy"] is None and not a.ics:
+            raise SceneError("energy is required: give --energy or a scene file")
+    d.update({k: v for k, v in flags.items() if v is not None})
+    window = {k: getattr(a, f"sections_{k}") for k in ("t_from", "t_to", "e_min", "e_max")}
+    window = {k: v for k, v in window.items() if v is not None}
+    if a.sections_first_only:
+        window["first_only"] = True
+    if window or a.sections:
+        d["sections"] = {**(d.get("sections") or {}), **window}
+    if a.snapshots is not None:
+        d["snapshots"] = a.snapshots
     return run_from_dict(d)
 
 
 def cmd_simulate(a):
     from .runner import simulate
+    from .store import Store
+    from .tables import describe_run
 
     scene = _scene_from_args(a)
     summary = simulate(scene, a.out, workers=a.workers, overwrite=a.overwrite, resume=a.resume,
-                       progress=not a.quiet, scheduler=a.scheduler)
+                       progress=_progress(a), scheduler=a.scheduler)
     print(summary.line())
+    store = Store(a.out)
+    print(run_report(store.root if store.local else store.url, describe_run(a.out)))
     return 0
 
 
-def cmd_survival(a):
-    import json
+def run_report(out, info: dict) -> str:
+    """The closing lines of ``simulate``: where the tables are, their row counts, outcomes per grid point."""
+    rows = ", ".join(f"{name} {n} rows" for name, n in info["rows"].items())
+    lines = [f"wrote {out}: {rows}"]
+    for p in info["points"]:
+        e = "E0 from the IC table" if p["energy"] is None else f"E0={p['energy']:g}"
+        lines.append(f"  {e}, γ={p['gamma']:g}: escaped {p['escaped']}, settled {p['settled']}, "
+                     f"censored {p['censored']}" + (f", stopped {p['stopped']}" if p.get("stopped") else ""))
+    return "\n".join(lines)
 
-    from .analysis.survival import observed_from_outcome, survival_curve
-    from .plotting import plot_survival
+
+def cmd_survival(a):
+    from matplotlib.figure import Figure  # no pyplot: no backend is chosen or changed
+
+    from .analysis.frames import plot_survival, survival
     from .tables import read_lifetimes
 
+    png = Path(a.png)
+    if not png.parent.is_dir():
+        raise UsageError(f"--png: folder {png.parent} does not exist")
     curves = []
-    for i, run in enumerate(a.runs):
-        df = read_lifetimes(run, columns=["outcome", "t_end"])
-        t, P, err = survival_curve(df["t_end"].to_numpy(), observed_from_outcome(df["outcome"]))
-        if a.labels and i < len(a.labels):
-            label = a.labels[i]
-        else:
-            sc = json.loads((Path(run) / "scene.json").read_text())["scene"]
-            label = f"E0={sc['energy']}, γ={sc['gamma']} (N={len(df)})"
-        curves.append({"t": t, "P": P, "P_err": err, "label": label})
-    plot_survival(curves, a.png, title="Survival probability")
-    print(f"wrote {a.png}")
+    for run in a.runs:
+        if not Path(run).is_dir() and "://" not in run:
+            raise UsageError(f"run {run!r} does not exist (give a directory written by hhscatter simulate)")
+        try:
+            df = read_lifetimes(run)
+        except FileNotFoundError as exc:
+            raise UsageError(f"run {run!r}: {exc}") from None
+        curves.append(survival(df))
+    n_curves = sum(len(c) for c in curves)
+    if a.labels and len(a.labels) != n_curves:
+        raise UsageError(f"--labels: {len(a.labels)} label(s) for {n_curves} curve(s) "
+                         f"({', '.join(f'{r}: {len(c)}' for r, c in zip(a.runs, curves))})")
+    fig = Figure(figsize=(6, 4.2), constrained_layout=True)
+    ax = plot_survival(curves, ax=fig.subplots(), labels=a.labels or None)
+    ax.set_title("Survival probability")
+    ax.grid(True, which="both", alpha=0.3)
+    fig.savefig(png, dpi=150)
+    print(f"wrote {png} ({n_curves} curve{'s' if n_curves != 1 else ''})")
     return 0
 
 
 def cmd_study(a):
     from .studies import run_stage
 
-    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=not a.quiet)
+    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a))
     return 0
 
 
@@ -166,7 +294,7 @@ def main(argv=None):
     a = build_parser().parse_args(argv)
     try:
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
-    except SceneError as exc:
+    except (SceneError, UsageError, FileNotFoundError) as exc:  # bad input, or a run/file that is not there
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
     except RunError as exc:

@@ -320,7 +320,7 @@ class _Stream(_BatchRules):
         method calls cost ~3 µs per orbit, more than half the integration of a
         conservative orbit at E = 0.27).
         """
-        orbit, phase, last_out = self.orbit, self.phase, self.last_out
+        orbit, last_out = self.orbit, self.last_out
         hi, lo, t0h, t0l, tfo, tf = self.time_hi, self.time_lo, self.t0_hi, self.t0_lo, self.tf_orbit, self.tf
         st, ics, ta = self.state, self.ics, self.ta
         oc, te, es = self.outcome, self.t_end, self.end_state

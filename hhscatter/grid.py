@@ -1,4 +1,4 @@
-"""Grid runs: one job over every (E0, γ) of a sweep, written as a hive-partitioned dataset.
+"""Grid runs: one job over every (E0, γ) of a sweep, written as one dataset per table.
 
 A scene whose ``energy`` and/or ``gamma`` is a list is a grid, e.g. in TOML::
 
@@ -11,15 +11,21 @@ or on the command line ``hhscatter simulate --energy 0.25,0.3 --gamma 0,0.01 …
 Its points are the Cartesian product (energy-major order), each an ordinary
 :class:`~hhscatter.scene.Scene` that differs from the others only in
 ``energy`` and ``gamma``. The runner schedules the tasks (energy, γ, chunk)
-of all points as one job and writes each point to its partition::
+of all points as one job and writes each point to its own folder::
 
-    OUT/lifetimes/energy=0.25/gamma=0.01/part-000000.parquet
+    OUT/lifetimes/E0.25_gamma0.01/part-000000.parquet
 
-each part carrying its own point's scene and hash in its metadata. Readers
-(:func:`hhscatter.tables.read_lifetimes`, ``pyarrow.dataset`` with hive
-partitioning) return the partition columns ``energy`` and ``gamma``. The key is
-``energy``, not ``e0``: a hive key equal to a column name replaces that column
-on reading (pyarrow), and ``e0`` is each orbit's computed initial energy.
+each part carrying its own point's scene and hash in its metadata, and its
+point as float64 columns (``energy`` and ``gamma`` in ``lifetimes``;
+``point_energy`` and ``point_gamma`` in ``sections`` and ``snapshots``). The
+folder names are deliberately not hive ``key=value`` pairs: a hive key is
+typed as a string (or dictionary) by pyarrow, pandas and DuckDB, and clashes
+with a file column of the same name, so the runs of hhscatter ≤ 0.1.0
+(``energy=0.25/gamma=0.01/``) did not open in those readers. With the point in
+the files, pandas, pyarrow, DuckDB and polars read the same numeric frame
+(see :mod:`hhscatter.tables`). The column is ``energy``, not ``e0``: ``e0`` is
+each orbit's computed initial energy, which differs from the nominal E0 in
+the last bits, so group by ``energy``, never by ``e0``.
 
 Seeds and pairing: every point uses the scene's ``seed``, so orbit i of every
 point is drawn from the same random numbers (:mod:`hhscatter.ics`). Across γ
@@ -96,8 +102,8 @@ class Grid:
 
     @staticmethod
     def partition(scene: Scene) -> str:
-        """partition(scene) -> 'energy=<E0>/gamma=<γ>' (Python repr of the floats: exact round trip)."""
-        return f"energy={float(scene.energy)!r}/gamma={float(scene.gamma)!r}"
+        """partition(scene) -> folder of a point, 'E<E0>_gamma<γ>' (Python repr of the floats; no '=', see module doc)."""
+        return f"E{float(scene.energy)!r}_gamma{float(scene.gamma)!r}"
 
     def to_dict(self) -> dict:
         d = self.base.to_dict()

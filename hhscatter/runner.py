@@ -136,7 +136,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     the file.
     """
     from .engine import run_chunk
-    from .tables import provenance, to_arrow, write_part
+    from .tables import add_point_columns, provenance, to_arrow, write_part
 
     scene = scene_from_dict(_decode(json.loads(scene_json)))
     store = Store(out)
@@ -156,6 +156,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):
         table = to_arrow(name, rows[name])
+        if partition and "=" not in partition:  # a grid point's files name their point (hhscatter.tables)
+            table = add_point_columns(name, table, scene)
         rel = part_rel(name, partition, chunk)
         try:
             write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
@@ -264,9 +266,22 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool):
 
     if isinstance(run, Grid):
         doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
-        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points_of(run)]
+        points = resumed_points(store, points_of(run)) if resume else points_of(run)
+        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points]
     store.write_json(SCENE_FILE, doc)
     return store
+
+
+def resumed_points(store, points):
+    """resumed_points(store, points) -> points with the folder names the run at ``store`` was started with.
+
+    A grid run begun by hhscatter ≤ 0.1.0 keeps its ``energy=…/gamma=…`` folders when resumed, so that it
+    stays one dataset in one layout (:mod:`hhscatter.tables` reads both).
+    """
+    if not store.exists(SCENE_FILE):
+        return points
+    old = {p.get("scene_hash"): p.get("partition") for p in json.loads(store.read_text(SCENE_FILE)).get("points", [])}
+    return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]
 
 
 def default_workers() -> int:
@@ -308,12 +323,12 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
     LocalCluster's worker processes). ``scheduler``: None (local pool),
     ``'local'`` or a Dask scheduler address ``'tcp://host:port'``. Tables are
     byte-identical for any backend and number of workers. With ``resume``,
-    complete chunks are verified and kept, the rest redone.
+    complete chunks are verified and kept, the rest redone. ``progress``:
+    True (a tqdm bar), ``'plain'`` (a plain line on stderr at most every 10 s,
+    for logs: no carriage returns) or False.
     Raises SceneError on bad input (before any work), RunError when a chunk
     cannot be written.
     """
-    from tqdm.auto import tqdm
-
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers must be an integer ≥ 1, got {workers!r}")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
@@ -332,6 +347,8 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
 
         check_scheduler(scheduler, workers)
     store = prepare_output(run, out, overwrite=overwrite, resume=resume)
+    if resume:
+        points = resumed_points(store, points)
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
@@ -356,8 +373,7 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         return (scene_json, c, s, e, out_url, states[s:e], ids[s:e], partition)
 
     t0 = time.perf_counter()
-    bar = tqdm(total=n_total, initial=done_orbits, unit="orbit", unit_scale=True, disable=not progress,
-               desc=f"{run.name}", smoothing=0.05)
+    bar = progress_bar(progress, n_total, done_orbits, run.name)
 
     def on_done(task, result):
         summary.add(result)
@@ -390,6 +406,38 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         bar.close()
     summary.wall_seconds = time.perf_counter() - t0
     return summary
+
+
+class PlainProgress:
+    """Progress for logs: a plain line on stderr at most every ``every`` seconds and at the end, no '\\r'."""
+
+    def __init__(self, total, initial=0, desc="", every=10.0, file=None):
+        import sys
+
+        self.total, self.n, self.desc, self.every = total, initial, desc, every
+        self.file = file or sys.stderr
+        self.t0 = self.last = time.perf_counter()
+
+    def update(self, k):
+        self.n += k
+        now = time.perf_counter()
+        if now - self.last >= self.every or self.n >= self.total:
+            self.last = now
+            print(f"{self.desc}: {self.n}/{self.total} orbits ({100 * self.n / max(self.total, 1):.0f} %), "
+                  f"{now - self.t0:.0f} s", file=self.file, flush=True)
+
+    def close(self):
+        pass
+
+
+def progress_bar(progress, total, initial, desc):
+    """progress_bar(progress, total, initial, desc) -> object with update(n)/close(): tqdm, PlainProgress or silent."""
+    if progress == "plain":
+        return PlainProgress(total, initial, desc)
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, initial=initial, unit="orbit", unit_scale=True, disable=not progress, desc=desc,
+                smoothing=0.05)
 
 
 def _run_pool(workers, todo, args, on_done):

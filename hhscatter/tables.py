@@ -7,14 +7,31 @@ A run directory holds one dataset per table, one part file per chunk::
     OUT/snapshots/part-000000.parquet    (only when the scene records snapshots)
     OUT/scene.json                       (the scene, for humans; each part carries it too)
 
-A grid run (a sweep over E0 and/or γ, see :mod:`hhscatter.grid`) is one
-hive-partitioned dataset per table, one partition per grid point::
+A grid run (a sweep over E0 and/or γ, see :mod:`hhscatter.grid`) has one
+folder per grid point in each table, and every file carries its point as
+ordinary numeric columns::
 
-    OUT/lifetimes/energy=0.25/gamma=0.01/part-000000.parquet
+    OUT/lifetimes/E0.25_gamma0.01/part-000000.parquet
 
-Readers then return the partition columns ``energy`` (the point's nominal E0;
-the per-orbit ``e0`` column keeps each orbit's computed initial energy) and
-``gamma``. ``OUT`` may be a URL (``s3://…``, any fsspec protocol).
+The folder names contain no ``=``: they are not hive partition keys, so no
+reader derives a (string-typed, column-shadowing) key from them, and every
+reader -- :func:`read_lifetimes`, ``pandas.read_parquet(OUT/"lifetimes")``,
+``pyarrow.dataset.dataset(…, partitioning="hive")``, DuckDB
+``read_parquet('OUT/lifetimes/**/*.parquet', hive_partitioning=true)`` and
+polars ``scan_parquet(…, hive_partitioning=True)`` -- returns the same rows
+with float64 point columns: ``energy`` (the point's nominal E0; the per-orbit
+``e0`` column keeps each orbit's computed initial energy, which differs from
+it in the last bits) and ``gamma`` in ``lifetimes``; ``point_energy`` and
+``point_gamma`` in ``sections`` and ``snapshots``, whose ``energy`` column is
+the orbit's energy at ``t``. Select a point with a filter on these columns
+(Parquet statistics skip the other points' files). A plain (single-scene)
+run has no point folders and no extra columns. ``OUT`` may be a URL
+(``s3://…``, any fsspec protocol; ``pip install 'hhscatter[cloud]'``).
+
+Runs written before this layout (hhscatter ≤ 0.1.0 grid runs, hive folders
+``energy=0.25/gamma=0.01/`` whose keys clash with the files' columns) are
+still read by the functions here, which give them the same columns as the new
+layout; ``--resume`` continues such a run in its own layout.
 
 Every part file's key-value metadata holds, under the key ``hhscatter``, a
 JSON document with the full scene, its result hash, the chunk index and
@@ -199,20 +216,55 @@ def verify_part(source, expect_rows=None) -> dict:
     return meta
 
 
-#: hive partition keys of a grid run (see :mod:`hhscatter.grid`); the scene field
-#: names, not ``e0``, so the per-orbit ``e0`` column is never shadowed
-PARTITION_KEYS = ("energy", "gamma")
+#: folder keys of grid runs written by hhscatter ≤ 0.1.0 (``energy=…/gamma=…``), read by :func:`_dataset`
+LEGACY_PARTITION_KEYS = ("energy", "gamma")
+
+#: the columns a grid run's files carry to name their point: (column, Scene field) per table
+POINT_COLUMNS = {
+    "lifetimes": (("energy", "energy"),),  # ``gamma`` is a lifetimes column already
+    "sections": (("point_energy", "energy"), ("point_gamma", "gamma")),
+    "snapshots": (("point_energy", "energy"), ("point_gamma", "gamma")),
+    "crossings": (("point_energy", "energy"), ("point_gamma", "gamma")),
+}
+
+
+def schema_of(name: str, grid: bool = False):
+    """schema_of(name, grid=False) -> pyarrow.Schema of a table (with the point columns of a grid run)."""
+    import pyarrow as pa
+
+    schema = _schemas()[name]
+    if grid:
+        schema = pa.schema(list(schema) + [pa.field(c, pa.float64()) for c, _ in POINT_COLUMNS[name]])
+    return schema
+
+
+def add_point_columns(name: str, table, scene):
+    """add_point_columns(name, table, scene) -> ``table`` with the grid point's constant columns appended."""
+    import pyarrow as pa
+
+    for col, key in POINT_COLUMNS[name]:
+        table = table.append_column(pa.field(col, pa.float64()),
+                                    pa.array(np.full(table.num_rows, float(getattr(scene, key)))))
+    return table
+
+
+def legacy_point(rel: str):
+    """legacy_point('energy=0.25/gamma=0.01/part-….parquet') -> (0.25, 0.01), or None if not that layout."""
+    keys = dict(seg.split("=", 1) for seg in rel.split("/")[:-1] if "=" in seg)
+    if set(keys) != set(LEGACY_PARTITION_KEYS):
+        return None
+    return tuple(float(keys[k]) for k in LEGACY_PARTITION_KEYS)
 
 
 def _dataset(run_dir, name: str, *, one_by_one: bool = False):
-    """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run).
+    """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run, either layout).
 
     ``one_by_one=True`` yields one single-file dataset per part instead: pyarrow
     keeps each scanned file's footer while its dataset lives, so a streaming
     scan over many thousands of parts is done file by file.
     """
-    import pyarrow as pa
     import pyarrow.dataset as ds
+    import pyarrow.fs as pafs
 
     from .store import Store
 
@@ -222,19 +274,36 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False):
         raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
     files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
     if not files:
-        raise FileNotFoundError(f"no part files in {store.display(rel)}")
-    schema = _schemas()[name]
-    base = store.path(rel)
+        where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
+        raise FileNotFoundError(f"no {name} table: no part files in {where}")
+    grid = any("/" in f for f in files)
+    schema = schema_of(name, grid)
     paths = [store.path(rel, f) for f in files]
-    kw = {"format": "parquet", "filesystem": store.filesystem}
-    if any("=" in f for f in files):  # hive-partitioned grid run: energy=…/gamma=…/part-…
-        keys = [k for k in PARTITION_KEYS if k not in schema.names]
-        schema = pa.schema(list(schema) + [pa.field(k, pa.float64()) for k in keys])
-        kw["partitioning"] = ds.partitioning(pa.schema([(k, pa.float64()) for k in PARTITION_KEYS]), flavor="hive")
-        kw["partition_base_dir"] = base
+    fmt = ds.ParquetFileFormat()
+    fs = store.filesystem or pafs.LocalFileSystem()
+    legacy = [legacy_point(f) for f in files]
+    if any(p is not None for p in legacy):
+        # old hive layout: the point is in the folder names only (and the key 'gamma' clashes with the
+        # lifetimes column, 'energy' with the sections/snapshots column); give each file its point as a
+        # partition expression on the new column names, which pyarrow materialises as constant columns
+        if None in legacy:
+            raise ValueError(f"{store.display(rel)} mixes part files of two layouts")
+        cols = dict(POINT_COLUMNS[name])
+        if name == "lifetimes":
+            cols["gamma"] = "gamma"
+        inv = {v: k for k, v in cols.items()}
+        exprs = [(ds.field(inv["energy"]) == e) & (ds.field(inv["gamma"]) == g) for e, g in legacy]
+
+        def make(ps, es):
+            return ds.FileSystemDataset.from_paths(ps, schema=schema, format=fmt, filesystem=fs, partitions=es)
+    else:
+        exprs = [ds.scalar(True)] * len(paths)
+
+        def make(ps, es):
+            return ds.dataset(ps, schema=schema, format=fmt, filesystem=store.filesystem)
     if one_by_one:
-        return (ds.dataset([p], schema=schema, **kw) for p in paths)
-    return ds.dataset(paths, schema=schema, **kw)
+        return (make([p], [e]) for p, e in zip(paths, exprs))
+    return make(paths, exprs)
 
 
 def _read(run_dir, name: str, columns=None, filters=None):
@@ -321,22 +390,65 @@ def read_lifetimes(run_dir, columns=None, filters=None):
 
     ``columns`` projects (only those columns are read); ``filters`` is a
     pyarrow.dataset expression. ``outcome`` comes back as str, ``exit_channel``
-    as nullable Int8. A grid run adds the partition columns ``energy`` and
-    ``gamma`` (filter on them to read one point: ``ds.field("energy") == 0.3``).
+    as nullable Int8. A grid run has the column ``energy`` (the point's
+    nominal E0) besides ``gamma``; filter on them to read one point:
+    ``filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)``.
+    Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…`` folders)
+    come back with the same columns.
     """
     return _read(run_dir, "lifetimes", columns, filters)
 
 
 def read_sections(run_dir, columns=None, filters=None):
-    """read_sections(run_dir, ...) -> DataFrame traj_id, t, x, y, px, py, energy."""
+    """read_sections(run_dir, ...) -> DataFrame traj_id, t, x, y, px, py, energy [, point_energy, point_gamma].
+
+    ``energy`` is the orbit's energy at the crossing; a grid run adds its
+    point's nominal E0 and γ as ``point_energy`` and ``point_gamma``.
+    """
     return _read(run_dir, "sections", columns, filters)
 
 
 def read_snapshots(run_dir, columns=None, filters=None):
-    """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy."""
+    """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy [, point_energy, point_gamma] (as read_sections)."""
     return _read(run_dir, "snapshots", columns, filters)
 
 
 def read_crossings(run_dir, columns=None, filters=None):
     """read_crossings(run_dir, ...) -> DataFrame traj_id, t, radius, direction (follow scenes)."""
     return _read(run_dir, "crossings", columns, filters)
+
+
+def describe_run(run_dir) -> dict:
+    """describe_run(run_dir) -> {'rows': {table: rows}, 'points': [{energy, gamma, escaped, settled, censored}]}.
+
+    What a run directory holds, from the files themselves (so resumed chunks
+    count too): the row count of each table present (from the Parquet
+    footers) and the outcome counts per grid point (one entry for a plain run,
+    whose ``energy`` is the scene's E0, None for runs from an IC table).
+    """
+    from .store import Store
+
+    store = Store(run_dir)
+    rows = {}
+    for name in TABLES:
+        if store.is_dir(name):
+            try:
+                rows[name] = _dataset(run_dir, name).count_rows()
+            except FileNotFoundError:
+                continue
+    if "lifetimes" not in rows:
+        raise FileNotFoundError(f"no lifetimes table at {store.display('lifetimes')}")
+    dset = _dataset(run_dir, "lifetimes")
+    keys = [k for k in ("energy", "gamma") if k in dset.schema.names]
+    table = dset.to_table(columns=[*keys, "outcome"])
+    counts = table.group_by([*keys, "outcome"]).aggregate([([], "count_all")]).to_pylist()
+    points = {}
+    for r in counts:
+        key = tuple(r[k] for k in keys)
+        points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0, "stopped": 0})[r["outcome"]] = \
+            r["count_all"]
+    if "energy" not in keys:  # a plain run: its one point is the scene's
+        meta = read_meta(next(iter(dset.files)), filesystem=store.filesystem)["scene"]
+        points = {(meta.get("energy"), meta.get("gamma")): c for c in points.values()}
+    return {"rows": rows,
+            "points": [{"energy": k[0], "gamma": k[1], **v} for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])]}

@@ -1,6 +1,5 @@
-"""Grid runs: lists of energies/γ → one job, hive-partitioned dataset, paired ICs, resume."""
+"""Grid runs: lists of energies/γ → one job, one folder per point (no hive keys), paired ICs, resume."""
 import numpy as np
-import pyarrow as pa
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 import pytest
@@ -38,7 +37,7 @@ def test_toml_lists_make_a_grid_and_scalars_a_scene(tmp_path):
     g = load_run(p)
     assert isinstance(g, Grid) and g.n == 400
     assert [(s.energy, s.gamma) for s in g.points] == [(0.25, 0.0), (0.25, 0.01), (0.3, 0.0), (0.3, 0.01)]
-    assert [Grid.partition(s) for s in g.points][1] == "energy=0.25/gamma=0.01"
+    assert [Grid.partition(s) for s in g.points][1] == "E0.25_gamma0.01"
     with pytest.raises(SceneError, match="that is a grid run"):
         load_scene(p)
     p.write_text("[scene]\nenergy = 0.3\nn = 100\n")
@@ -60,8 +59,9 @@ def test_bad_grids_name_the_parameter(energies, gammas, message):
 def test_layout_metadata_and_partition_columns(grid, grid_run):
     parts = sorted(p.relative_to(grid_run).as_posix() for p in grid_run.rglob("part-*.parquet"))
     assert len(parts) == 16
-    assert "lifetimes/energy=0.3/gamma=0.01/part-000001.parquet" in parts
-    assert "sections/energy=0.25/gamma=0.0/part-000000.parquet" in parts
+    assert "lifetimes/E0.3_gamma0.01/part-000001.parquet" in parts
+    assert "sections/E0.25_gamma0.0/part-000000.parquet" in parts
+    assert not any("=" in p for p in parts)  # no hive keys to clash with the files' columns
     for scene in grid.points:
         meta = read_meta(grid_run / "lifetimes" / Grid.partition(scene) / "part-000000.parquet")
         assert (meta["scene"]["energy"], meta["scene"]["gamma"]) == (scene.energy, scene.gamma)
@@ -73,25 +73,31 @@ def test_layout_metadata_and_partition_columns(grid, grid_run):
     # the per-orbit e0 is the orbit's own computed energy, not shadowed by the partition value
     assert np.allclose(lt["e0"], lt["energy"], rtol=0, atol=1e-14)
     assert (lt["e0"] != lt["energy"]).any()
-    # plain pyarrow with hive partitioning reads the same dataset
-    part = ds.partitioning(pa.schema([("energy", pa.float64()), ("gamma", pa.float64())]), flavor="hive")
-    t = ds.dataset(grid_run / "lifetimes", format="parquet", partitioning=part).to_table(
+    # plain pyarrow reads the same dataset, the point columns from the files
+    t = ds.dataset(grid_run / "lifetimes", format="parquet", partitioning="hive").to_table(
         filter=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01), columns=["traj_id", "t_end"])
     assert t.num_rows == 160
     one = read_lifetimes(grid_run, columns=["traj_id", "t_end"],
                          filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01))
     assert one.sort_values("traj_id")["t_end"].tolist() == t.sort_by("traj_id").column("t_end").to_pylist()
     sec = read_sections(grid_run)
-    assert {"energy", "gamma"} <= set(sec.columns) and (sec["t"] >= 2.0).all()
+    assert {"point_energy", "point_gamma"} <= set(sec.columns) and (sec["t"] >= 2.0).all()
+    assert sec.groupby(["point_energy", "point_gamma"]).ngroups == 4
+    # the crossing energy is the orbit's own (below E0 with drag), not the point's nominal E0
+    diss = sec[sec["point_gamma"] > 0]
+    assert (diss["energy"] < diss["point_energy"] - 1e-6).all()
 
 
 def test_each_point_equals_a_plain_run_of_that_scene(tmp_path, grid, grid_run):
     scene = grid.points[3]  # E0 = 0.3, γ = 0.01
     simulate(scene, tmp_path / "plain", workers=1, progress=False)
-    for name in ("lifetimes", "sections"):
-        a = (tmp_path / "plain" / name / "part-000001.parquet").read_bytes()
-        b = (grid_run / name / Grid.partition(scene) / "part-000001.parquet").read_bytes()
-        assert a == b
+    for name, extra in (("lifetimes", ["energy"]), ("sections", ["point_energy", "point_gamma"])):
+        a = pq.read_table(tmp_path / "plain" / name / "part-000001.parquet")
+        b = pq.read_table(grid_run / name / Grid.partition(scene) / "part-000001.parquet")
+        assert b.column_names == a.column_names + extra
+        assert b.drop_columns(extra).equals(a) and a.schema.metadata == b.schema.metadata
+        for col, key in zip(extra, ("energy", "gamma")):
+            assert set(b.column(col).to_pylist()) == {getattr(scene, key)}
 
 
 def test_paired_initial_conditions(grid_run):
@@ -116,7 +122,7 @@ def test_grid_resume_and_refusal(tmp_path, grid, grid_run):
     out = tmp_path / "g"
     shutil.copytree(grid_run, out)
     before = {p: p.read_bytes() for p in out.rglob("part-*.parquet")}
-    victim = out / "lifetimes" / "energy=0.25/gamma=0.01" / "part-000001.parquet"
+    victim = out / "lifetimes" / "E0.25_gamma0.01" / "part-000001.parquet"
     victim.unlink()
     s = simulate(grid, out, workers=1, resume=True, progress=False)
     assert s.chunks_done == 1 and s.chunks_skipped == 7

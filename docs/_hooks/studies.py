@@ -185,7 +185,7 @@ class Renderer:
         if prov.get("git_commit"):
             bits.append(f"commit `{str(prov['git_commit'])[:12]}`")
         link = self._rel(self.study_asset(name, "json"))
-        out.append(f"*Made at {', '.join(bits)}. The full record, with the configuration: [{name}.json]({link}).*\n")
+        out.append(f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: [{name}.json]({link}).*\n")
         return "\n".join(out)
 
     def study_module(self, name: str) -> str:

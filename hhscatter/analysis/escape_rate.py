@@ -499,12 +499,22 @@ def escape_rate(
     )
 
 
-def escape_rate_from_lifetimes(lifetimes, t_grid=None, **kwargs) -> EscapeRateResult:
-    """escape_rate_from_lifetimes(lifetimes, t_grid=None, **kwargs) -> EscapeRateResult.
+def escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=False, **kwargs) -> EscapeRateResult:
+    """escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=False, **kwargs) -> EscapeRateResult.
 
-    :func:`escape_rate` on one (e0, gamma) ensemble of the engine's ``lifetimes``
-    table ('escaped'/'settled' leave, 'censored' is right-censored).
+    :func:`escape_rate` on one (energy, gamma) ensemble of the engine's ``lifetimes``
+    table ('escaped'/'settled' leave, 'censored' is right-censored); for every
+    point of a grid run at once see :func:`hhscatter.escape_rates`.
+    κ is the escape rate of the conservative system (Eq. (eqn:kappa_hyperbolic)):
+    a dissipative ensemble (``gamma`` > 0), whose P(t) is not exponential, raises
+    ValueError, or with ``allow_dissipative=True`` is fitted with a UserWarning.
     """
+    if "gamma" in lifetimes.columns and len(lifetimes) and float(lifetimes["gamma"].max()) > 0:
+        msg = (f"escape_rate_from_lifetimes: this ensemble is dissipative (gamma = {float(lifetimes['gamma'].max()):g}"
+               " > 0); κ is the conservative escape rate and its exponential fit does not describe P(t) with drag")
+        if not allow_dissipative:
+            raise ValueError(msg + " (pass allow_dissipative=True to fit it anyway)")
+        warnings.warn(msg, UserWarning, stacklevel=2)
     t_end, observed = lifetimes_to_arrays(lifetimes)
     return escape_rate(t_end, observed, t_grid, **kwargs)
 

@@ -212,19 +212,23 @@ def lifetimes_to_arrays(lifetimes, *, check_single_ensemble: bool = True):
 
     Converts the engine's ``lifetimes`` table (columns ``t_end``, ``outcome``;
     optionally ``e0``, ``gamma``) to the arrays used by the survival functions.
-    With ``check_single_ensemble`` a table mixing several (e0, gamma)
-    ensembles raises ValueError: select one first, e.g. with
-    ``lifetimes.groupby(['e0', 'gamma'])``.
+    With ``check_single_ensemble`` a table mixing several ensembles (grid
+    points: values of ``energy``, ``gamma`` or, beyond the last bits, ``e0``)
+    raises ValueError: analyse all points with :func:`hhscatter.survival` /
+    :func:`hhscatter.escape_rates`, or select one first, e.g.
+    ``lifetimes.groupby(['energy', 'gamma'])`` (never by ``e0``, which
+    differs from orbit to orbit in the last bits).
     """
     if check_single_ensemble:
-        for col in ("e0", "gamma"):
+        for col in ("energy", "e0", "gamma"):
             # e0 is recomputed from each initial state, so one ensemble's values differ in the
             # last bits: compare with a relative tolerance, not by exact uniqueness
             v = lifetimes[col].to_numpy(dtype=float) if col in lifetimes.columns else np.zeros(0)
             if v.size and (np.isnan(v).any() or np.ptp(v) > 1e-9 * max(1.0, float(np.max(np.abs(v))))):
                 raise ValueError(
-                    f"lifetimes mixes several values of {col!r}; analyse one ensemble at a time "
-                    "(e.g. lifetimes.groupby(['e0', 'gamma']))"
+                    f"lifetimes mixes several values of {col!r} (several grid points): use hhscatter.survival"
+                    "(lifetimes) / hhscatter.escape_rates(lifetimes) for one result per point, or select one "
+                    "point, e.g. lifetimes.groupby(['energy', 'gamma']) (not by 'e0', which differs per orbit)"
                 )
     t_end = lifetimes["t_end"].to_numpy(dtype=float)
     observed = observed_from_outcome(lifetimes["outcome"].astype(object).to_numpy())

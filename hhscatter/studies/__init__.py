@@ -244,10 +244,15 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
         if st == "simulate":
             mod.simulate(study, workers=workers, progress=progress)
             write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
+            print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
         elif st == "analyze":
             mod.analyze(study)
+            derived = study.out / "derived"
+            extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
+            print(f"{name} analyze: wrote {study.numbers_path}{extra}", flush=True)
         else:
             import matplotlib
 
             matplotlib.use("Agg")
             mod.plot(study)
+            print(f"{name} plot: wrote {study.figure_path}", flush=True)

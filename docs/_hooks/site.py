@@ -1,0 +1,113 @@
+"""MkDocs hook: maths, the paper's equation and figure labels, and the commit in the footer.
+
+* **Maths, offline.** ``pymdownx.arithmatex`` (generic mode) marks the LaTeX
+  of the pages; MathJax 3 typesets it in the browser. The MathJax files are
+  not fetched from a CDN: ``on_files`` adds them to the site from the
+  ``django-static-mathjax`` wheel (a plain copy of MathJax 3, part of the
+  ``docs`` extra), so the build and the site work without a network.
+* **Equation references.** Docstrings and pages cite the paper's equations by
+  their LaTeX labels, ``Eq. (eqn:kappa_hyperbolic)``; ``on_page_content``
+  turns each such label into the equation's number, linked to its entry on
+  ``equations.md`` (which is the one list of labels and numbers), and drops
+  figure labels (``fig:survprob``) beside the figure number they repeat.
+* **Footer.** ``on_config`` writes the commit (and date) the site was built
+  from into the footer, so a page's numbers can be traced to their code.
+"""
+from __future__ import annotations
+
+import datetime
+import importlib.util
+import re
+import subprocess
+from pathlib import Path
+
+MATHJAX_DEST = "javascripts/mathjax"
+#: what tex-chtml.js loads: itself, its fonts, TeX extensions (autoload), the menu and accessibility parts
+MATHJAX_PARTS = ("tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y")
+
+_HEADING = re.compile(r"^###\s+\((\d+)\).*\{#([\w-]+)\}\s*$", re.M)
+_EQREF = re.compile(r"\((eqn?:[\w-]+)\)")
+_FIGREF_DUP = re.compile(r"\s*(?:\(fig:[\w-]+\)|= fig:[\w-]+|, fig:[\w-]+)")
+_FIGREF = re.compile(r"\bfig:([\w-]+)")
+_PRE = re.compile(r"(<pre\b.*?</pre>|<code\b.*?</code>)", re.S)
+
+#: the paper's figures in order (labels from its LaTeX source)
+FIGURES = ("contour_two_manifolds", "kappa-E-dependence", "energy_decay", "survprob", "um_comparison",
+           "model_data_comparison")
+
+
+def mathjax_dir() -> Path:
+    """The ``es5`` folder of the installed MathJax 3 copy (django-static-mathjax)."""
+    spec = importlib.util.find_spec("mathjax")
+    if spec is None or not spec.submodule_search_locations:
+        raise RuntimeError("the docs need MathJax from the 'docs' extra: pip install -e '.[docs]' "
+                           "(django-static-mathjax)")
+    es5 = Path(next(iter(spec.submodule_search_locations))) / "static" / "mathjax" / "es5"
+    if not (es5 / "tex-chtml.js").is_file():
+        raise RuntimeError(f"{es5}/tex-chtml.js is missing: reinstall django-static-mathjax")
+    return es5
+
+
+def equation_numbers(docs_dir: Path) -> dict[str, str]:
+    """{'eqn:kappa_hyperbolic': '2', …} from the ``### (N) … {#eqn-…}`` headings of equations.md."""
+    text = (Path(docs_dir) / "equations.md").read_text()
+    return {anchor.replace("-", ":", 1): num for num, anchor in _HEADING.findall(text)}
+
+
+def link_labels(html: str, numbers: dict, prefix: str) -> str:
+    """Equation labels → linked numbers, figure labels → 'Fig. N' (outside <pre> and <code>)."""
+    def eq(m):
+        label = m.group(1)
+        if label not in numbers:
+            return m.group(0)
+        anchor = label.replace(":", "-", 1)
+        return f'(<a href="{prefix}equations.html#{anchor}" title="{label}">{numbers[label]}</a>)'
+
+    def fig(m):
+        name = m.group(1)
+        return f"Fig. {FIGURES.index(name) + 1}" if name in FIGURES else m.group(0)
+
+    parts = _PRE.split(html)
+    for i in range(0, len(parts), 2):  # even indices: outside code
+        parts[i] = _FIGREF.sub(fig, _FIGREF_DUP.sub("", _EQREF.sub(eq, parts[i])))
+    return "".join(parts)
+
+
+def build_commit(root: Path) -> str:
+    try:
+        out = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=root, capture_output=True,
+                             text=True, timeout=10, check=False)
+        if out.returncode != 0:
+            return "unknown commit"
+        commit = out.stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               capture_output=True, text=True, timeout=10, check=False)
+        return commit + ("-dirty" if dirty.stdout.strip() else "")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown commit"
+
+
+# -- MkDocs entry points ---------------------------------------------------------
+def on_config(config, **kwargs):
+    root = Path(config["config_file_path"]).resolve().parent
+    today = datetime.date.today().isoformat()
+    config["copyright"] = f"Site built from commit {build_commit(root)} on {today}."
+    return config
+
+
+def on_files(files, config, **kwargs):
+    from mkdocs.structure.files import File
+
+    es5 = mathjax_dir()
+    for part in MATHJAX_PARTS:
+        src = es5 / part
+        for p in [src] if src.is_file() else sorted(q for q in src.rglob("*") if q.is_file()):
+            rel = p.relative_to(es5).as_posix()
+            files.append(File.generated(config, f"{MATHJAX_DEST}/{rel}", abs_src_path=str(p)))
+    return files
+
+
+def on_page_content(html, page, config, files, **kwargs):
+    numbers = equation_numbers(config["docs_dir"])
+    prefix = "../" * page.file.url.count("/")
+    return link_labels(html, numbers, prefix)

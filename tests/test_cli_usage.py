@@ -1,0 +1,144 @@
+"""The CLI as a new user meets it: python -m, --version, help, counts, --resume with only --out, section and
+snapshot flags, survival of grid runs, errors without tracebacks, the closing summary, progress in logs."""
+import json
+import subprocess
+import sys
+import types
+
+import numpy as np
+import pytest
+
+from hhscatter import __version__, read_lifetimes, read_sections, read_snapshots
+from hhscatter.cli import build_parser, main
+
+
+def _run(*args):
+    return subprocess.run([sys.executable, "-m", "hhscatter", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_python_m_version_and_top_level_help():
+    r = _run("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"hhscatter {__version__}"
+    r = _run("--help")
+    assert r.returncode == 0
+    for cmd in ("simulate", "survival", "study"):
+        assert f"\n    {cmd} " in r.stdout, cmd
+    assert "``" not in r.stdout and ":func:" not in r.stdout  # no raw reStructuredText
+
+
+@pytest.mark.parametrize("text,value", [("100000", 100000), ("1e5", 100000), ("2.0e3", 2000)])
+def test_counts_accept_integral_floats(text, value):
+    a = build_parser().parse_args(["simulate", "--energy", "0.3", "-n", text, "--chunk-size", text, "--out", "x"])
+    assert a.n == value and a.chunk_size == value
+
+
+@pytest.mark.parametrize("text", ["1.5", "1e-3", "nan", "inf", "ten"])
+def test_counts_refuse_non_integral_values(text, capsys):
+    with pytest.raises(SystemExit) as exc:
+        build_parser().parse_args(["simulate", "--energy", "0.3", "-n", text, "--out", "x"])
+    assert exc.value.code == 2
+    assert f"argument -n: not an integer: {text!r}" in capsys.readouterr().err
+
+
+def test_resume_with_only_out_reads_the_scene_and_summary_tells(tmp_path, capsys):
+    out = tmp_path / "g"
+    assert main(["simulate", "--energy", "0.27,0.3", "--gamma", "0,0.01", "-n", "2e2", "--chunk-size", "100",
+                 "--seed", "4", "--out", str(out), "--workers", "1", "--sections-t-from", "3",
+                 "--sections-first-only", "--snapshots", "0:4:2"]) == 0
+    first = capsys.readouterr().out
+    before = {p: p.read_bytes() for p in out.rglob("part-*.parquet")}
+    assert len(before) == 3 * 8
+    # the closing summary: absolute path, rows per table, outcomes per grid point
+    lt, sec, snap = read_lifetimes(out), read_sections(out), read_snapshots(out)
+    assert f"wrote {out.resolve()}: lifetimes 800 rows, sections {len(sec)} rows, snapshots {len(snap)} rows" in first
+    for (e, g), d in lt.groupby(["energy", "gamma"]):
+        oc = d["outcome"].value_counts()
+        line = (f"  E0={e:g}, γ={g:g}: escaped {oc.get('escaped', 0)}, settled {oc.get('settled', 0)}, "
+                f"censored {oc.get('censored', 0)}")
+        assert line in first.splitlines(), line
+    for p in list(before)[::5]:
+        p.unlink()
+    assert main(["simulate", "--out", str(out), "--resume", "--workers", "1"]) == 0
+    again = capsys.readouterr().out
+    assert "chunk(s) resumed" in again and "lifetimes 800 rows" in again
+    assert {p: p.read_bytes() for p in out.rglob("part-*.parquet")} == before
+    # a flag that changes the scene is still refused (names the key), without a traceback
+    assert main(["simulate", "--out", str(out), "--resume", "-n", "300"]) == 2
+    err = capsys.readouterr().err
+    assert "different scene (n: 200 → 300)" in err and "Traceback" not in err
+
+
+def test_resume_without_scene_json_says_so(tmp_path, capsys):
+    assert main(["simulate", "--out", str(tmp_path / "none"), "--resume"]) == 2
+    assert "--resume found no scene.json in --out" in capsys.readouterr().err
+
+
+def test_section_and_snapshot_flags_override_the_scene_file(tmp_path):
+    toml = tmp_path / "s.toml"
+    toml.write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 60\nseed = 2\n[sections]\nt_from = 1.0\n"
+                    "[snapshots]\ntimes = [0.0, 1.0]\n")
+    out = tmp_path / "o"
+    assert main(["simulate", str(toml), "--out", str(out), "--workers", "1", "--sections-t-to", "8",
+                 "--sections-e-max", "0.29", "--sections-first-only", "--snapshots", "0,2.5,5"]) == 0
+    scene = json.loads((out / "scene.json").read_text())["scene"]
+    assert scene["sections"] == {"t_from": 1.0, "t_to": 8.0, "e_min": "-inf", "e_max": 0.29, "first_only": True}
+    assert scene["snapshots"] == [0.0, 2.5, 5.0]
+    sec = read_sections(out)
+    assert len(sec) and sec["t"].between(1.0, 8.0).all() and (sec["energy"] <= 0.29).all()
+    assert not sec["traj_id"].duplicated().any()
+    assert set(read_snapshots(out)["t"]) <= {0.0, 2.5, 5.0}
+
+
+def test_survival_of_a_grid_run_draws_one_curve_per_point(tmp_path, capsys):
+    out = tmp_path / "g"
+    assert main(["simulate", "--energy", "0.27,0.3", "-n", "100", "--out", str(out), "--workers", "1"]) == 0
+    capsys.readouterr()
+    png = tmp_path / "p.png"
+    assert main(["survival", str(out), "--png", str(png)]) == 0
+    assert "(2 curves)" in capsys.readouterr().out and png.stat().st_size > 10_000
+    assert main(["survival", str(out), "--png", str(png), "--labels", "only one"]) == 2
+    assert "1 label(s) for 2 curve(s)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args,message", [
+    (["survival", "{tmp}/missing", "--png", "{tmp}/p.png"], "does not exist"),
+    (["survival", "{tmp}", "--png", "{tmp}/p.png"], "no lifetimes table"),
+    (["survival", "{tmp}", "--png", "{tmp}/no/such/dir/p.png"], "--png: folder"),
+    (["study", "fig6", "analyze", "--scale", "nosuchscale"], "scale"),
+])
+def test_user_errors_exit_2_without_traceback(tmp_path, args, message):
+    """A missing run, an empty folder, a --png folder that does not exist: message, status 2, no traceback."""
+    r = _run(*[a.format(tmp=tmp_path) for a in args])
+    assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr
+
+
+def test_progress_is_off_in_logs_unless_asked_and_then_plain(tmp_path):
+    base = ["simulate", "--energy", "0.3", "-n", "40", "--chunk-size", "20", "--workers", "1"]
+    quiet = _run(*base, "--out", str(tmp_path / "a"))  # stderr is a pipe: no progress at all
+    assert quiet.returncode == 0 and quiet.stderr == ""
+    asked = _run(*base, "--out", str(tmp_path / "b"), "--progress")
+    assert asked.returncode == 0 and "\r" not in asked.stderr
+    assert asked.stderr.strip().splitlines()[-1].startswith("b: 40/40 orbits (100 %)")
+    off = _run(*base, "--out", str(tmp_path / "c"), "--no-progress")
+    assert off.returncode == 0 and off.stderr == ""
+
+
+def test_study_stages_say_what_they_wrote(tmp_path, monkeypatch, capsys):
+    import hhscatter.studies as studies
+
+    (tmp_path / "fake").mkdir()
+    (tmp_path / "fake" / "study.toml").write_text("[scene]\nenergy = 0.3\nn = 10\n[study]\nx = 1\n")
+
+    def analyze(study):
+        study.write_numbers({"x": 1})
+        study.derived("t.parquet").write_bytes(b"")
+
+    fake = types.SimpleNamespace(simulate=lambda study, workers=None, progress=True: None, analyze=analyze,
+                                 plot=lambda study: study.figure_path.write_bytes(np.zeros(4).tobytes()))
+    monkeypatch.setattr(studies, "stage_module", lambda name: fake)
+    studies.run_stage("fake", "all", "quick", root=tmp_path)
+    out = capsys.readouterr().out.splitlines()
+    where = tmp_path / "fake" / "out" / "quick"
+    assert out == [f"fake simulate: raw runs in {where / 'raw'}",
+                   f"fake analyze: wrote {where / 'fake.json'} and 1 derived table(s) in {where / 'derived'}",
+                   f"fake plot: wrote {where / 'fake.png'}"]
