@@ -56,41 +56,41 @@ demo: $(RUNS)/demo/survival.png ## run two small real scenes (1e5 orbits each), 
 
 # -- studies: raw runs → derived tables + <name>.json → <name>.png ------------
 # `make fig2` (quick scale, minutes on 2 cores) or `make fig2 SCALE=paper` (the paper's N).
+# The studies and their dependencies are the folders studies/<name>/ (study.toml: [about], [needs]);
+# hhscatter/studies/graph.py turns them into the rules below (build/studies.mk), nothing lists them here.
 SCALE ?= quick
 HH := $(VENV)/bin/hhscatter
-ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py) hhscatter/studies/__init__.py
+ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py hhscatter/studies/*.py)
 so = studies/$(1)/out/$(SCALE)
+study_code = $(wildcard studies/$(1)/*.py hhscatter/studies/$(1).py hhscatter/plotting/$(1).py)
 
-# $(1): study name; $(2): files its analysis also reads (other studies' outputs)
+# $(1): study name; $(2): the studies it needs (their numbers JSON are inputs of its analysis)
 define study_rules
-$(call so,$(1))/raw/done.json: studies/$(1)/study.toml hhscatter/studies/$(1).py $(STAMP)
+$(call so,$(1))/raw/done.json: studies/$(1)/study.toml $(call study_code,$(1)) $(STAMP)
 	$(HH) study $(1) simulate --scale $(SCALE) $(W)
-$(call so,$(1))/$(1).json: $(call so,$(1))/raw/done.json $(ANALYSIS_SRC) $(2)
+$(call so,$(1))/$(1).json: $(call so,$(1))/raw/done.json $(ANALYSIS_SRC) $(call study_code,$(1)) $(foreach u,$(2),$(call so,$(u))/$(u).json)
 	$(HH) study $(1) analyze --scale $(SCALE)
-$(call so,$(1))/$(1).png: $(call so,$(1))/$(1).json $(wildcard hhscatter/plotting/*.py)
+$(call so,$(1))/$(1).png: $(call so,$(1))/$(1).json $(call study_code,$(1)) $(wildcard hhscatter/plotting/*.py)
 	$(HH) study $(1) plot --scale $(SCALE)
 endef
 
-$(eval $(call study_rules,fig1,))
-$(eval $(call study_rules,fig2,))
-$(eval $(call study_rules,resc,))
-$(eval $(call study_rules,fig3,))
-$(eval $(call study_rules,fig4,))
-$(eval $(call study_rules,fig5,$(call so,fig1)/raw/done.json))
-$(eval $(call study_rules,fig6,$(call so,fig2)/fig2.json $(call so,fig3)/fig3.json $(call so,fig4)/fig4.json))
+STUDIES_MK := build/studies.mk
+STUDY_TOMLS := $(sort $(wildcard studies/*/study.toml))
+$(STUDIES_MK): $(STUDY_TOMLS) hhscatter/studies/graph.py
+	@mkdir -p $(@D)
+	$(PYTHON) hhscatter/studies/graph.py make > $@.tmp && mv $@.tmp $@
+include $(STUDIES_MK)
+# a study folder added or removed: regenerate (the file records the study.toml files it was made from)
+ifneq ($(STUDIES_MK_TOMLS),$(STUDY_TOMLS))
+$(STUDIES_MK): FORCE
+endif
+FORCE:
 
-fig1: $(call so,fig1)/fig1.png ## Fig 1: potential contours; c-measure support at E=0.35, 0.30 (sprinkler)
-fig2: $(call so,fig2)/fig2.png ## Fig 2: P(t) at E=0.23, 0.27; κ(E) with piecewise fit; κ from the c-measure
-resc: $(call so,resc)/resc.png ## escape-criterion check: κ vs r_esc, returns after escape, exit channels
-fig3: $(call so,fig3)/fig3.png ## Fig 3: ⟨E⟩(t) and μ at (E0, γ) = (0.3, 0.01); energy histograms
-fig4: $(call so,fig4)/fig4.png ## Fig 4: P(t) for several γ at E0=0.3 with τ0, τ1, τ2
-fig5: $(call so,fig5)/fig5.png ## Fig 5: dissipative section points vs the conservative c-measure; distances
-fig6: $(call so,fig6)/fig6.png ## Fig 6: survival model vs simulations; τ1, τ2 vs γ; mixture model
-studies: fig1 fig2 resc fig3 fig4 fig5 fig6 ## all studies at SCALE (default quick)
+studies: $(STUDY_NAMES) ## all studies at SCALE (default quick), each after the studies it needs
 
 BENCH_SUMMARY := studies/bench/out/full/summary.md
 STRESS_SUMMARY := studies/stress/out/full/summary.md
-REPORT_INPUTS := $(foreach s,fig1 fig2 resc fig3 fig4 fig5 fig6,$(call so,$(s))/$(s).png) $(BENCH_SUMMARY) $(STRESS_SUMMARY)
+REPORT_INPUTS := $(foreach s,$(STUDY_NAMES),$(call so,$(s))/$(s).png) $(BENCH_SUMMARY) $(STRESS_SUMMARY)
 reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py
 	$(PY) -m hhscatter.report --scale $(SCALE)
 
@@ -139,4 +139,4 @@ docs-assets: ## copy the studies' quick-scale figures/numbers and bench summarie
 
 .PHONY: docs docs-serve docs-assets
 
-.PHONY: help venv test test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies fig1 fig2 resc fig3 fig4 fig5 fig6
+.PHONY: help venv test test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies

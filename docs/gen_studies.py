@@ -2,7 +2,7 @@
 
     python docs/gen_studies.py [--scale quick] [--check]
 
-For each study (fig1, fig2, resc, fig3, fig4, fig5, fig6) it copies
+For each study folder (``studies/<name>/study.toml``) it copies
 ``studies/<name>/out/<scale>/<name>.png`` and ``<name>.json`` to
 ``docs/studies/assets/``; for the benchmarks and stress tests, the markdown
 summaries, PNG figures and small CSV files of ``studies/bench/out/<s>/`` and
@@ -20,13 +20,23 @@ from __future__ import annotations
 
 import argparse
 import filecmp
+import importlib.util
 import shutil
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
-STUDY_NAMES = ("fig1", "fig2", "resc", "fig3", "fig4", "fig5", "fig6")
+GRAPH = ROOT / "hhscatter" / "studies" / "graph.py"
+
+
+def study_names(root: Path) -> list:
+    """The study folders of ``root/studies`` (hhscatter/studies/graph.py, loaded by path: stdlib only)."""
+    spec = importlib.util.spec_from_file_location("hh_study_graph", GRAPH)
+    graph = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
+    spec.loader.exec_module(graph)
+    return [s.name for s in graph.studies(root / "studies")]
+
 BENCHES = ("bench", "stress")
 CSV_MAX_BYTES = 200_000  # larger CSVs stay out of the repository's docs
 JSON_WARN_BYTES = 500_000
@@ -48,7 +58,7 @@ def _bench_dir(base: Path, bench_scale):
 def plan(scale: str, bench_scale=None):
     """plan(scale, bench_scale=None) -> (pairs [(src, dst)], missing [str]) of the files to copy."""
     pairs, missing = [], []
-    for name in STUDY_NAMES:
+    for name in study_names(ROOT):
         out = ROOT / "studies" / name / "out" / scale
         for ext in ("png", "json"):
             src = out / f"{name}.{ext}"

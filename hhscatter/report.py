@@ -18,25 +18,8 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from .studies import STUDY_NAMES, load_study, studies_root, write_json_atomic
-
-PAPER_FIGURES = {
-    "fig1": ("Figure 1", "Potential contours, saddles and the support of the conservative c-measure "
-                         "(sprinkler method) at E = 0.35 and E = 0.30."),
-    "fig2": ("Figure 2", "Survival probability P(t) at E = 0.23 and 0.27, and the escape rate κ0(E) with its "
-                         "piecewise fit; κ from the c-measure (beyond the paper)."),
-    "fig3": ("Figure 3", "Mean energy ⟨E⟩(t) of the orbits inside Ω for (E0, γ) = (0.3, 0.01) with the fit "
-                         "E0·exp(−μγt) and energy histograms."),
-    "fig4": ("Figure 4", "P(t) for several γ at E0 = 0.3 with the transition times τ0, τ1, τ2."),
-    "fig5": ("Figure 5", "Section points of the dissipative ensemble after t* over the conservative c-measure; "
-                         "quantitative distances (beyond the paper)."),
-    "fig6": ("Figure 6", "Survival model against simulations; predicted vs observed τ1 and τ2; mixture model "
-                         "(beyond the paper)."),
-}
-BEYOND = {
-    "resc": ("Escape criterion", "κ against the escape radius r_esc, returns after escape, exit-channel "
-                                 "fractions."),
-}
+from .studies import studies_root, write_json_atomic
+from .studies.graph import studies as study_folders
 
 
 @dataclass
@@ -46,6 +29,7 @@ class Section:
     caption: str
     figure: Path | None
     numbers: dict | None
+    paper: str = ""  # the paper's figure this study reproduces ("" for a study beyond the paper)
 
 
 def _fmt(v, err=None) -> str:
@@ -95,19 +79,18 @@ def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
 
 
 def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
-    """collect(scale, root=None) -> [Section] for the paper's figures and the studies beyond them."""
+    """collect(scale, root=None) -> [Section], one per study folder of ``root`` (in dependency order).
+
+    Titles and captions come from each study's ``[about]`` table; a study
+    with ``paper = ""`` goes to the part beyond the paper.
+    """
     root = Path(root) if root is not None else studies_root()
     sections = []
-    for key in STUDY_NAMES:
-        title, caption = PAPER_FIGURES.get(key) or BEYOND[key]
-        try:
-            st = load_study(key, scale, root=root)
-        except Exception:  # a study folder may be missing in a partial checkout
-            sections.append(Section(key, title, caption, None, None))
-            continue
-        fig = st.figure_path if st.figure_path.exists() else None
-        nums = json.loads(st.numbers_path.read_text()) if st.numbers_path.exists() else None
-        sections.append(Section(key, title, caption, fig, nums))
+    for info in study_folders(root):
+        out = root / info.name / "out" / scale
+        fig, nums = out / f"{info.name}.png", out / f"{info.name}.json"
+        sections.append(Section(info.name, info.title, info.summary, fig if fig.exists() else None,
+                                json.loads(nums.read_text()) if nums.exists() else None, info.paper))
     return sections
 
 
@@ -152,10 +135,12 @@ def _bench(root: Path, name: str = "bench"):
     return (md if md.exists() else None), (sorted(out.glob("*.png")) if out.exists() else [])
 
 
-def split_rows(rows):
-    """split_rows(rows) -> (paper_rows, beyond_rows): rows with a number the paper states vs the rest."""
-    paper = [r for r in rows if r["study"] in PAPER_FIGURES and r.get("paper") is not None]
-    beyond = [r for r in rows if not (r["study"] in PAPER_FIGURES and r.get("paper") is not None)]
+def split_rows(rows, sections):
+    """split_rows(rows, sections) -> (paper_rows, beyond_rows): rows of a paper figure's study with a number the
+    paper states vs the rest."""
+    of_paper = {s.key for s in sections if s.paper}
+    paper = [r for r in rows if r["study"] in of_paper and r.get("paper") is not None]
+    beyond = [r for r in rows if not (r["study"] in of_paper and r.get("paper") is not None)]
     return paper, beyond
 
 
@@ -182,7 +167,7 @@ def _count_line(rows):
 
 
 def render_markdown(sections, scale, root, assets: Path) -> str:
-    paper_rows, beyond_rows = split_rows(comparison_rows(sections))
+    paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
     prov = _provenance(sections)
     lines = [f"# hhscatter reproduction report ({scale} scale)", "",
              "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
@@ -194,9 +179,9 @@ def render_markdown(sections, scale, root, assets: Path) -> str:
              "## The paper's numbers beside ours", "", _count_line(paper_rows), "", *_md_rows(paper_rows), "",
              "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
              *_md_rows(beyond_rows)]
-    for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
+    for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
         lines += ["", f"## {group}", ""]
-        for s in (s for s in sections if s.key in keys):
+        for s in (s for s in sections if bool(s.paper) == of_paper):
             lines += [f"### {s.title} (`make {s.key}`)", "", s.caption, ""]
             if s.figure:
                 shutil.copyfile(s.figure, assets / f"{s.key}.png")
@@ -273,7 +258,7 @@ def _html_rows(rows):
 
 
 def render_html(sections, scale, root) -> str:
-    paper_rows, beyond_rows = split_rows(comparison_rows(sections))
+    paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
     prov = _provenance(sections)
     e = html.escape
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report ({e(scale)})"
@@ -289,9 +274,9 @@ def render_html(sections, scale, root) -> str:
              _html_rows(paper_rows),
              "<h2>Beyond the paper: checks and numbers the paper does not state</h2>",
              f"<p>{e(_count_line(beyond_rows))}</p>", _html_rows(beyond_rows)]
-    for group, keys in (("Figures of the paper", PAPER_FIGURES), ("Beyond the paper", BEYOND)):
+    for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
         parts.append(f"<h2>{e(group)}</h2>")
-        for s in (s for s in sections if s.key in keys):
+        for s in (s for s in sections if bool(s.paper) == of_paper):
             parts.append(f"<h3>{e(s.title)} <code>make {e(s.key)}</code></h3><p class='caption'>{e(s.caption)}</p>")
             if s.figure:
                 parts.append(f"<img alt='{e(s.title)}' src='{_img_uri(s.figure)}'>")

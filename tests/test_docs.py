@@ -113,11 +113,13 @@ def _page(tmp_path, hook, text, src_uri="studies/x.md"):
 def test_missing_assets_give_a_note_not_a_link(tmp_path, hook):
     md = "\n".join(f"<!-- hh:{k} fig2 -->" for k in ("study-params", "study-figure", "study-numbers", "study-module"))
     md += "\n<!-- hh:bench bench -->\n<!-- hh:comparison-all -->\n"
+    (tmp_path / "studies" / "figx").mkdir(parents=True)  # a study folder (the list comes from the folders)
+    (tmp_path / "studies" / "figx" / "study.toml").write_text("[scene]\nn = 1\n")
     out, _ = _page(tmp_path, hook, md)
     assert "<!-- hh:" not in out
     assert out.count('"Not yet generated"') == 5  # params, figure, numbers, module, bench
     assert "assets/" not in out  # no link to a file that is not there
-    assert "*Not yet generated: " in out  # comparison-all lists the studies without numbers
+    assert "*Not yet generated: [figx](figx.md).*" in out  # comparison-all lists the study folders without numbers
 
 
 def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
@@ -193,6 +195,7 @@ def test_gen_studies_copies_what_exists_and_reports_the_rest(tmp_path, gen, monk
     out.mkdir(parents=True)
     (out / "fig3.png").write_bytes(b"png")
     (out / "fig3.json").write_text("{}")
+    (out.parents[1] / "study.toml").write_text("[scene]\nn = 1\n")  # a study is a folder with a study.toml
     bench = tmp_path / "studies" / "bench" / "out" / "full"
     bench.mkdir(parents=True)
     (bench / "summary.md").write_text("# s\n")

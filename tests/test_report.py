@@ -6,10 +6,12 @@ import pytest
 from hhscatter.report import _fmt, build_report
 
 
-def _fake_study(root, name, rows, with_figure=True):
+def _fake_study(root, name, rows, with_figure=True, paper=None):
     d = root / name
     (d / "out" / "quick").mkdir(parents=True)
-    (d / "study.toml").write_text('[scene]\nn = 10\nenergy = 0.3\n')
+    paper = f"Fig. {name[-1]}" if paper is None else paper
+    (d / "study.toml").write_text(f'[about]\ntitle = "{name} title"\npaper = "{paper}"\nsummary = "{name} caption"\n'
+                                  '[scene]\nn = 10\nenergy = 0.3\n')
     doc = {"study": name, "scale": "quick", "kappa": {"value": 0.153, "err": 0.004}, "n_points": 31000,
            "paper_comparison": rows, "provenance": {"heyoka": "7.13.2"}}
     (d / "out" / "quick" / f"{name}.json").write_text(json.dumps(doc))
@@ -36,7 +38,9 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     _fake_study(root, "fig3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
                                 "verdict": "agrees within 2σ", "note": ""}], with_figure=False)
     _fake_study(root, "resc", [{"quantity": "returns at r_esc=1.03", "ours": 0.011, "err": 0.0004, "paper": 0.0,
-                                "verdict": "differs", "note": ""}])
+                                "verdict": "differs", "note": ""}], paper="")
+    _fake_study(root, "fig1", [], with_figure=False)
+    (root / "fig1" / "out" / "quick" / "fig1.json").unlink()  # a study folder that has not run yet
     res = build_report("quick", out=tmp_path / "rep", root=root)
     page = res["html"].read_text()
     md = res["markdown"].read_text()
@@ -47,12 +51,14 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "3 numbers: 2 agree, 1 differ" in paper_part
     assert "13.1 ± 0.4" in page and "13.63" in page and "class='bad'>differs" in page
     assert page.count("data:image/png;base64,") == 2  # fig2 and resc; fig3 has numbers but no figure
-    assert set(res["missing"]) == {"fig1", "fig3", "fig4", "fig5", "fig6"}
+    assert set(res["missing"]) == {"fig1", "fig3"}  # the study folders of the root without figure or numbers
+    assert "### fig2 title (`make fig2`)" in md and "fig2 caption" in md  # titles and captions from [about]
+    assert md.index("### resc title") > md.index("## Beyond the paper\n")
     assert "| fig2 | break energy | 0.27 | 0.310 ± 0.010 | differs | continuous fit |" in md
     assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
     assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [
-        "fig2", "fig2", "resc", "fig3"]
+        "fig2", "fig2", "fig3", "resc"]
 
 
 @pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),

@@ -7,9 +7,14 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:study-numbers fig2 -->   docs/studies/assets/fig2.json as tables
     <!-- hh:study-module fig2 -->    API of hhscatter.studies.fig2 (if it exists)
     <!-- hh:comparison-all -->       every study's paper-vs-ours rows in one table
+    <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
     <!-- hh:bench stress -->         docs/benchmarks/assets/stress/*summary.md (+ figures)
     <!-- hh:cli -->                  every subcommand and flag of `hhscatter`
     <!-- hh:schemas -->              the Parquet schemas of hhscatter.tables
+
+The "Studies" section of the navigation is made from the study folders
+(``studies/<name>/study.toml``, table ``[about]``) by ``on_config``: a new
+study folder gets its page in the nav without editing mkdocs.yml.
 
 Everything is read from files in the repository (no study is run, nothing is
 fetched), so the build works offline from a fresh clone. A missing asset gives
@@ -200,11 +205,21 @@ class Renderer:
             "      heading_level: 3\n"
         )
 
+    def studies_table(self, _arg=None) -> str:
+        from hhscatter.studies.graph import studies
+
+        out = ["| study | paper | what | needs |", "|---|---|---|---|"]
+        for s in studies(self.root / "studies"):
+            needs = ", ".join(f"[{u}]({u}.md)" for u in s.upstream)
+            out.append(f"| [{s.name}]({s.name}.md) | {_cell(s.paper or 'beyond the paper')} | {_cell(s.summary)} "
+                       f"| {needs} |")
+        return "\n".join(out) + "\n"
+
     def comparison_all(self, _arg=None) -> str:
-        from hhscatter.studies import STUDY_NAMES
+        from hhscatter.studies.graph import studies
 
         out, missing = [], []
-        for name in STUDY_NAMES:
+        for name in (s.name for s in studies(self.root / "studies")):
             doc = self._numbers(name)
             rows = (doc or {}).get("paper_comparison") or []
             if doc is None:
@@ -401,7 +416,26 @@ def cli_reference(parser) -> str:
     return "\n".join(out)
 
 
-# -- MkDocs entry point --------------------------------------------------------
+# -- MkDocs entry points -------------------------------------------------------
+STUDIES_NAV = "Studies"
+
+
+def study_nav(root: Path) -> list:
+    """The nav of the Studies section: its index page, then one page per study folder (dependency order)."""
+    from hhscatter.studies.graph import studies
+
+    return ["studies/index.md", *({s.title: f"studies/{s.name}.md"} for s in studies(root / "studies"))]
+
+
+def on_config(config, **kwargs):
+    """Fill the nav's Studies section from the study folders (mkdocs.yml lists only its index page)."""
+    root = Path(config["config_file_path"]).resolve().parent
+    for item in config["nav"] or []:
+        if isinstance(item, dict) and STUDIES_NAV in item:
+            item[STUDIES_NAV] = study_nav(root)
+    return config
+
+
 def on_page_markdown(markdown, page, config, files, **kwargs):
     """Replace every ``<!-- hh:... -->`` marker of a page with its generated Markdown."""
     if "<!-- hh:" not in markdown:

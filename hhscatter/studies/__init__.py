@@ -15,6 +15,8 @@ stages that make runs as separate targets:
 
 ``study.toml`` layout::
 
+    [about]              # title, paper figure, summary (make help, docs nav, report)
+    [needs]              # role = upstream study (hhscatter.studies.graph: the one dependency graph)
     [scene]              # base Scene fields shared by the study's scenes
     [sections]           # optional SectionWindow fields
     [study]              # study parameters (energy grids, windows, ...)
@@ -36,8 +38,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..scene import Scene, SceneError, scene_from_dict
+from .graph import HEADER_TABLES, GraphError, StudyInfo, study_info
 
-STUDY_NAMES = ("fig1", "fig2", "resc", "fig3", "fig4", "fig5", "fig6")
 STAGES = ("simulate", "analyze", "plot")
 DEFAULT_SCALE = "quick"
 
@@ -48,6 +50,16 @@ def studies_root() -> Path:
     if env:
         return Path(env)
     return Path(__file__).resolve().parents[2] / "studies"
+
+
+def study_names(root: Path | None = None) -> list[str]:
+    """study_names(root=None) -> names of the study folders (with a study.toml), each after the studies it needs."""
+    from .graph import studies
+
+    try:
+        return [s.name for s in studies(root if root is not None else studies_root())]
+    except GraphError as exc:
+        raise SceneError(str(exc)) from None
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -96,6 +108,19 @@ class Study:
     config: dict
     root: Path
     comparisons: list = field(default_factory=list)
+    info: StudyInfo | None = None
+
+    @property
+    def needs(self) -> dict:
+        """The ``[needs]`` table: role -> name of the upstream study whose published outputs this study reads."""
+        return dict(self.info.needs) if self.info else {}
+
+    def upstream(self, role: str) -> str:
+        """upstream(role) -> the study declared for ``role`` in ``[needs]``; a missing role is an error."""
+        if role not in self.needs:
+            raise SceneError(f"{self.root / 'study.toml'}: [needs] must name the study for {role!r} "
+                             f"(has {sorted(self.needs)})")
+        return self.needs[role]
 
     @property
     def out(self) -> Path:
@@ -217,12 +242,32 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
         doc = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path} is not valid TOML: {exc}") from None
+    try:
+        info = study_info(root, name, doc)
+    except GraphError as exc:
+        raise SceneError(str(exc)) from None
+    for key in HEADER_TABLES:  # what the study is and needs; not parameters of its runs
+        doc.pop(key, None)
     scales = doc.pop("scale", {})
     if scale != DEFAULT_SCALE:
         if scale not in scales:
             raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
         doc = _merge(doc, scales[scale])
-    return Study(name=name, scale=scale, config=doc, root=root / name)
+    return Study(name=name, scale=scale, config=doc, root=root / name, info=info)
+
+
+def missing_upstream(study: Study) -> list[str]:
+    """missing_upstream(study) -> the declared upstream studies whose numbers JSON (same scale) is not there yet."""
+    out = []
+    for other in sorted(set(study.needs.values())):
+        try:
+            path = load_study(other, study.scale, root=study.root.parent).numbers_path
+        except SceneError:
+            out.append(other)
+            continue
+        if not path.exists():
+            out.append(other)
+    return out
 
 
 def stage_module(name: str):
@@ -246,6 +291,13 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
             write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
             print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
         elif st == "analyze":
+            from ._upstream import UpstreamError, dev_fallback_enabled
+
+            missing = [] if dev_fallback_enabled() else missing_upstream(study)
+            if missing:
+                raise UpstreamError(
+                    f"{name} needs the published outputs of {', '.join(missing)} (declared in [needs] of "
+                    f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first")
             mod.analyze(study)
             derived = study.out / "derived"
             extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""

@@ -136,7 +136,7 @@ def analyze(study):
     mu_err = float(bm["mu"].std(ddof=1)) * mu_scale
     mu_fig3 = None
     try:
-        f3 = study.read_numbers("fig3")
+        f3 = study.read_numbers(study.upstream("mu_crosscheck"))
         mu_fig3 = f3["mu"]
     except (FileNotFoundError, KeyError, SceneError):  # fig3 is optional here (cross-check only)
         mu_fig3 = None

@@ -100,7 +100,7 @@ def _cmeasure_points(study, inputs):
     """Conservative c-measure samples at E1 and E2 from study fig1 (first crossing after t_rec)."""
     from ..tables import read_sections
 
-    other = study.param("cmeasure_study")
+    other = study.upstream("cmeasure")
     doc = up.numbers(study, other)
     out, t_rec = {}, {}
     for label in ("E1", "E2"):
@@ -170,7 +170,7 @@ def analyze(study):
     g_main = float(study.param("gamma_main"))
     if g_main not in gammas:
         raise ValueError(f"[study] gamma_main = {g_main} must be one of gammas = {gammas}")
-    mu, mu_err = up.value_or_fallback(study, study.param("mu_study"), study.param("mu_key"), PAPER_MU, inputs, "mu")
+    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
     mu = float(mu)
     mu_err = float(mu_err) if mu_err is not None else math.nan
     if not float(study.param("mu_min")) <= mu <= float(study.param("mu_max")):

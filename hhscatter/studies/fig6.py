@@ -76,7 +76,7 @@ def simulate(study, workers=None, progress=True):
 # ---------------------------------------------------------------------------
 def _inputs(study):
     inputs = {}
-    ks = study.param("kappa_study")
+    ks = study.upstream("kappa")
     kv = {}
     for name in ("a", "b", "c", "E_b"):
         key = study.param("kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
@@ -84,8 +84,8 @@ def _inputs(study):
     E_c = float(study.param("E_c"))
     kappa = mdl.PiecewiseKappa(a2=float(kv["a"]), a1=float(kv["b"]), slope=float(kv["c"]),
                                E_switch=float(kv["E_b"]), E_c=E_c)
-    mu, mu_err = up.value_or_fallback(study, study.param("mu_study"), study.param("mu_key"), PAPER_MU, inputs, "mu")
-    tau0, _ = up.value_or_fallback(study, study.param("tau_study"), study.param("tau0_key"), DEV_TAU0, inputs, "tau0")
+    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
+    tau0, _ = up.value_or_fallback(study, study.upstream("tau"), study.param("tau0_key"), DEV_TAU0, inputs, "tau0")
     return inputs, kappa, float(mu), float(mu_err if mu_err is not None else math.nan), float(tau0), E_c
 
 
@@ -296,7 +296,7 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
     from ..tables import read_lifetimes
 
     E0 = float(study.param("fig4_E0"))
-    other = study.param("tau_study")
+    other = study.upstream("tau")
     try:
         doc = up.numbers(study, other)
         table, _ = up.lookup(doc, study.param("tau_table_key"), what=f"{other}.json")

@@ -1,0 +1,106 @@
+"""The studies' one declared dependency graph (study.toml [about], [needs]) and what is derived from it:
+the Makefile's rules, the build order, the report and the docs navigation."""
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hhscatter.studies import graph
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = ROOT / "studies"
+
+
+def _study(root: Path, name: str, needs: dict | None = None, paper: str = "Fig. 1"):
+    (root / name).mkdir(parents=True)
+    lines = ["[about]", f'title = "{name}"', f'paper = "{paper}"', f'summary = "what {name} does"']
+    if needs:
+        lines += ["[needs]", *(f'{k} = "{v}"' for k, v in needs.items())]
+    (root / name / "study.toml").write_text("\n".join([*lines, "[scene]", "n = 1", ""]))
+
+
+def test_every_study_folder_declares_what_it_is_and_needs():
+    infos = graph.studies(STUDIES)
+    names = [s.name for s in infos]
+    assert set(names) == {p.parent.name for p in STUDIES.glob("*/study.toml")}
+    for s in infos:
+        assert s.title and s.summary, s.name
+        # every study comes after the studies it needs
+        assert all(names.index(u) < names.index(s.name) for u in s.upstream), s.name
+    by = {s.name: s for s in infos}
+    assert by["fig5"].upstream == ("fig1", "fig3") and by["fig6"].upstream == ("fig2", "fig3", "fig4")
+    assert by["resc"].beyond_paper and not by["fig1"].beyond_paper
+    assert graph.upstream_closure("fig6", STUDIES) == ["fig2", "fig3", "fig4", "fig6"]
+
+
+def test_graph_refuses_unknown_upstreams_and_cycles(tmp_path):
+    _study(tmp_path / "a", "x", {"mu": "nope"})
+    with pytest.raises(graph.GraphError, match="needs 'nope', which is not a study folder"):
+        graph.studies(tmp_path / "a")
+    _study(tmp_path / "b", "x", {"p": "y"})
+    _study(tmp_path / "b", "y", {"p": "x"})
+    with pytest.raises(graph.GraphError, match="cycle"):
+        graph.studies(tmp_path / "b")
+    _study(tmp_path / "c", "x", {"p": "z"})
+    _study(tmp_path / "c", "z")
+    _study(tmp_path / "c", "a", {"q": "x"})
+    assert [s.name for s in graph.studies(tmp_path / "c")] == ["z", "x", "a"]
+
+
+def _repo(tmp_path: Path) -> Path:
+    """A copy of the Makefile, the graph module and the study folders' study.toml."""
+    work = tmp_path / "repo"
+    (work / "hhscatter" / "studies").mkdir(parents=True)
+    shutil.copy(ROOT / "Makefile", work / "Makefile")
+    (work / "pyproject.toml").touch()
+    shutil.copy(ROOT / "hhscatter" / "studies" / "graph.py", work / "hhscatter" / "studies" / "graph.py")
+    for toml in STUDIES.glob("*/study.toml"):
+        (work / "studies" / toml.parent.name).mkdir(parents=True)
+        shutil.copy(toml, work / "studies" / toml.parent.name / "study.toml")
+    return work
+
+
+def _dry_run(work: Path, target: str) -> list[str]:
+    """`make -n -B <target> SCALE=tiny` in ``work``: the study stage commands, in order."""
+    r = subprocess.run(["make", "-n", "-B", target, "SCALE=tiny", f"PYTHON={sys.executable}"], cwd=work,
+                       capture_output=True, text=True, check=True)
+    return re.findall(r"hhscatter study (\w+) (simulate|analyze|plot) --scale tiny", r.stdout)
+
+
+def test_make_builds_the_studies_a_study_needs_first(tmp_path):
+    steps = _dry_run(_repo(tmp_path), "fig6")
+    assert {s for s, _ in steps} == {"fig2", "fig3", "fig4", "fig6"}
+    at = {step: i for i, step in enumerate(steps)}
+    for up in ("fig2", "fig3", "fig4"):
+        assert at[(up, "analyze")] < at[("fig6", "analyze")]
+    assert ("fig2", "plot") not in at  # an upstream's numbers are needed, not its figure
+    assert at[("fig3", "analyze")] < at[("fig4", "analyze")]  # fig4 reads fig3's μ too
+
+
+def test_a_new_study_folder_gets_make_rules_without_editing_the_makefile(tmp_path):
+    work = _repo(tmp_path)
+    assert _dry_run(work, "help") == []
+    _study(work / "studies", "figx", {"c": "fig1"})
+    steps = _dry_run(work, "figx")
+    assert ("fig1", "analyze") in steps and steps[-1] == ("figx", "plot")
+    help_text = subprocess.run(["make", "help", f"PYTHON={sys.executable}"], cwd=work,
+                               capture_output=True, text=True, check=True).stdout
+    assert "figx" in help_text and "what figx does (needs fig1)" in help_text
+
+
+def test_report_and_docs_nav_list_the_study_folders():
+    from hhscatter.report import collect
+
+    assert [s.key for s in collect("tiny", STUDIES)] == [s.name for s in graph.studies(STUDIES)]
+    spec_path = ROOT / "docs" / "_hooks" / "studies.py"
+    from test_docs import _load
+
+    hook = _load(spec_path, "hh_docs_hook_graph")
+    nav = hook.study_nav(ROOT)
+    assert nav[0] == "studies/index.md"
+    assert [next(iter(d.values())) for d in nav[1:]] == [f"studies/{s.name}.md" for s in graph.studies(STUDIES)]
