@@ -385,6 +385,15 @@ def survival_on_grid(run_dir, t_grid, filters=None):
     return SurvivalCurve(g.copy(), P, np.sqrt(np.clip(P * (1.0 - P), 0.0, None) / n))
 
 
+def iter_parts(run_dir, name: str, columns=None):
+    """iter_parts(run_dir, name, columns=None) -> pandas.DataFrame per part file of table ``name``, in file order.
+
+    For statistics pooled part by part (memory: one part at a time, whatever N).
+    """
+    for part in _dataset(run_dir, name, one_by_one=True):
+        yield part.to_table(columns=columns).to_pandas()
+
+
 def read_lifetimes(run_dir, columns=None, filters=None):
     """read_lifetimes(run_dir, columns=None, filters=None) -> pandas.DataFrame of the lifetimes table.
 

@@ -1,3 +1,5 @@
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -17,3 +19,23 @@ def diss_scene():
 
     return Scene(energy=0.3, gamma=0.01, n=300, seed=12, chunk_size=120,
                  sections=SectionWindow(t_from=5.0, t_to=40.0), snapshots=tuple(np.arange(0.0, 100.0, 10.0)))
+
+
+@pytest.fixture(scope="session")
+def tiny_studies(tmp_path_factory):
+    """A studies root with every study of the repository built at scale 'tiny' from an empty out/,
+    one after the other in the order of the declared graph (study.toml [needs]), as `make studies` does."""
+    import shutil
+
+    from hhscatter.studies import run_stage
+    from hhscatter.studies.graph import studies
+
+    repo = Path(__file__).resolve().parents[1] / "studies"
+    root = tmp_path_factory.mktemp("studies")
+    order = [s.name for s in studies(repo)]
+    for name in order:
+        (root / name).mkdir()
+        shutil.copy(repo / name / "study.toml", root / name / "study.toml")
+    for name in order:
+        run_stage(name, "all", "tiny", workers=1, progress=False, root=root)
+    return root

@@ -479,3 +479,57 @@ def test_distance_vs_scale_and_agreement_scale():
     assert eps_star is not None and eps_star > 2 * 0.01
     fine = blur[blur["box"] <= 0.0125]
     assert (fine["hellinger_excess"] > 10 * fine["hellinger_noise_std"]).all()
+
+
+def test_box_distances_bootstrap_of_several_distances_and_two_set_noise_floor():
+    rng = np.random.default_rng(8)
+    P, Q = gaussian_blob(800, rng), gaussian_blob(600, rng, centre=(0.55, 0.5))
+    boxes = [0.25, 0.1]
+    d = distance.box_distances(P, Q, boxes, UNIT)
+    assert d.shape == (2, 2)
+    assert d[1, 0] == distance.histogram_distance(P, Q, 0.1, UNIT, "hellinger")
+    assert d[0, 1] == distance.histogram_distance(P, Q, 0.25, UNIT, "tv")
+    # several distances of the same resamples: each part as if bootstrapped alone with the same seed
+    both = distance.bootstrap_distance(P, Q, lambda A, B: (distance.box_distances(A, B, boxes, UNIT),
+                                                          distance.sliced_wasserstein(A, B, 16, 1)), 7, seed=4)
+    alone = distance.bootstrap_distance(P, Q, lambda A, B: distance.sliced_wasserstein(A, B, 16, 1), 7, seed=4)
+    assert both.mean[1] == alone.mean and both.std[1] == alone.std
+    assert both.std[0].shape == (2, 2) and (both.std[0] > 0).all()
+    # the two-set noise floor is distance_vs_scale's, split for split
+    tab = distance.distance_vs_scale(P, Q, boxes, UNIT, kinds=("hellinger",), n_splits=5, seed=9, m=250)
+    for j, box in enumerate(sorted(boxes, reverse=True)):
+        nz = distance.split_half_noise(P, Q, lambda A, B, box=box: distance.histogram_distance(A, B, box, UNIT),
+                                       m=250, n_splits=5, seed=9)
+        assert nz.mean == pytest.approx(tab["hellinger_noise"].iloc[j], rel=1e-12)
+        assert nz.std == pytest.approx(tab["hellinger_noise_std"].iloc[j], rel=1e-12)
+    with pytest.raises(ValueError, match="m must be in"):
+        distance.split_half_noise(P, Q, lambda A, B: 0.0, m=301)
+
+
+def test_inside_mean_energy_pools_parts_and_splits_at_ec():
+    rng = np.random.default_rng(3)
+    rows = pd.DataFrame({"traj_id": np.repeat(np.arange(60), 5), "t": np.tile(np.arange(5.0), 60),
+                         "energy": rng.uniform(0.1, 0.3, 300)})
+    parts = [rows.iloc[:120], rows.iloc[120:]]
+    r = decay.inside_mean_energy(parts, EC)
+    whole = decay.mean_energy(rows)
+    np.testing.assert_allclose(r.inside["mean_E"], whole["mean_E"], rtol=1e-13)
+    np.testing.assert_array_equal(r.inside["n"], whole["n"])
+    np.testing.assert_allclose(r.above["mean_E"], decay.mean_energy(rows[rows["energy"] > EC])["mean_E"], rtol=1e-13)
+    assert r.rows_below_ec == int((rows["energy"] <= EC).sum())
+
+
+def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
+    rng = np.random.default_rng(4)
+    t = np.arange(0.0, 100.0, 5.0)
+    n = 400
+    mu_i = rng.normal(MU, 0.05, n)
+    rows = pd.DataFrame({"traj_id": np.repeat(np.arange(n), t.size), "t": np.tile(t, n),
+                         "energy": (E0 * np.exp(-np.outer(mu_i, GAMMA * t))).ravel()})
+    boot, scale = decay.bootstrap_mu_first_orbits(rows, n, 100, E0, GAMMA, [(0.0, 95.0)], n_boot=5, seed=2)
+    sub = rows[rows["traj_id"] < 100]
+    direct = decay.bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, GAMMA, [(0.0, 95.0)], n_boot=5, seed=2)
+    pd.testing.assert_frame_equal(boot, direct)
+    assert scale == 0.5
+    with pytest.raises(ValueError, match="k must be in"):
+        decay.bootstrap_mu_first_orbits(rows, n, 0, E0, GAMMA, [(0.0, 95.0)])

@@ -8,7 +8,6 @@ the section, the sign and size of κ).
 """
 import json
 import math
-import shutil
 import warnings
 from pathlib import Path
 
@@ -156,12 +155,8 @@ def test_recording_rules_closed_form():
 # end to end at scale 'tiny'
 # ---------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def tiny_root(tmp_path_factory):
-    root = tmp_path_factory.mktemp("studies")
-    for name in ("fig1", "fig2"):
-        (root / name).mkdir()
-        shutil.copy(REPO / "studies" / name / "study.toml", root / name / "study.toml")
-    return root
+def tiny_root(tiny_studies):
+    return tiny_studies  # every study built at scale tiny in graph order (conftest.py)
 
 
 def _finite_numbers(obj):
@@ -176,10 +171,9 @@ def _finite_numbers(obj):
 
 
 def test_fig1_tiny_end_to_end(tiny_root):
-    from hhscatter.studies import load_study, run_stage
+    from hhscatter.studies import load_study
     from hhscatter.tables import read_sections
 
-    run_stage("fig1", "all", "tiny", workers=1, progress=False, root=tiny_root)
     study = load_study("fig1", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 20_000
     doc = json.loads(study.numbers_path.read_text())
@@ -206,9 +200,8 @@ def test_fig1_tiny_end_to_end(tiny_root):
 
 
 def test_fig2_tiny_end_to_end(tiny_root):
-    from hhscatter.studies import load_study, run_stage
+    from hhscatter.studies import load_study
 
-    run_stage("fig2", "all", "tiny", workers=1, progress=False, root=tiny_root)
     study = load_study("fig2", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 30_000
     doc = json.loads(study.numbers_path.read_text())

@@ -3,7 +3,6 @@ with known answers, and tiny end-to-end runs checked against direct counts from 
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -151,7 +150,7 @@ def test_bootstrap_transition_times_on_paired_exponentials():
 
 
 def test_snapshot_grid_pieces():
-    from hhscatter.studies.fig3 import snapshot_grid
+    from hhscatter.analysis.decay import snapshot_grid
 
     g = snapshot_grid([[0, 2, 0.5], [3, 9, 3]])
     np.testing.assert_array_equal(g, [0, 0.5, 1, 1.5, 2, 3, 6, 9])
@@ -166,16 +165,8 @@ def test_snapshot_grid_pieces():
 # tiny end-to-end runs
 # ---------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def tiny_root(tmp_path_factory):
-    from hhscatter.studies import run_stage
-
-    root = tmp_path_factory.mktemp("studies")
-    for name in ("fig3", "fig4"):
-        (root / name).mkdir()
-        shutil.copy(ROOT / "studies" / name / "study.toml", root / name / "study.toml")
-    for name in ("fig3", "fig4"):
-        run_stage(name, "all", "tiny", workers=1, progress=False, root=root)
-    return root
+def tiny_root(tiny_studies):
+    return tiny_studies  # every study built at scale tiny in graph order (conftest.py)
 
 
 def test_fig3_tiny_end_to_end(tiny_root):

@@ -124,66 +124,31 @@ def test_upstream_lookup_dotted_keys_and_errors():
 
 
 # ---------------------------------------------------------------------------
-# tiny end-to-end runs
+# tiny end-to-end runs (every study built at scale tiny in graph order: conftest.py)
 # ---------------------------------------------------------------------------
-def _copy_toml(root: Path, name: str):
-    (root / name).mkdir(parents=True, exist_ok=True)
-    shutil.copy(REPO / "studies" / name / "study.toml", root / name / "study.toml")
+def _numbers(root: Path, name: str) -> dict:
+    return json.loads((root / name / "out" / "tiny" / f"{name}.json").read_text())
 
 
-def _write_numbers(root: Path, name: str, doc: dict):
-    out = root / name / "out" / "tiny"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"{name}.json").write_text(json.dumps(doc))
+def test_fig5_tiny_end_to_end(tiny_studies):
+    from hhscatter.studies import load_study
 
-
-def _run(scene, out):
-    from hhscatter.runner import simulate
-
-    simulate(scene, out, workers=1, overwrite=True, progress=False)
-
-
-@pytest.fixture(scope="module")
-def tiny_root(tmp_path_factory):
-    """Studies root with fig5/fig6 study files and minimal upstream outputs (real tiny runs)."""
-    from hhscatter.scene import Scene, SectionWindow
-
-    root = tmp_path_factory.mktemp("studies")
-    for name in ("fig1", "fig2", "fig3", "fig4", "fig5", "fig6"):
-        _copy_toml(root, name)
-    # fig1: sprinkler samples at E = 0.30, 0.35, first crossing at t >= t_rec (fig1's layout)
-    t_rec = {"E0.30": 12.0, "E0.35": 10.0}
-    for key, E in (("E0.30", 0.30), ("E0.35", 0.35)):
-        _run(Scene(energy=E, n=5000, seed=31, t_max=60.0, chunk_size=2500,
-                   sections=SectionWindow(t_from=t_rec[key], first_only=True)),
-             root / "fig1" / "out" / "tiny" / "raw" / key)
-    _write_numbers(root, "fig1", {"energies": {k: {"t_rec": v} for k, v in t_rec.items()}})
-    # fig2 / fig3: the paper's fitted values as stated inputs
-    _write_numbers(root, "fig2", {"kappa_fit": {k: {"value": v, "err": 0.0} for k, v in
-                                                (("a", 13.63), ("b", 0.03), ("c", 1.41), ("E_b", 0.27))}})
-    _write_numbers(root, "fig3", {"mu": {"value": 0.91, "err": 0.01}})
-    # fig4: P(t) runs at E0 = 0.3 (γ = 0 and 0.02) and its τ table
-    for g in (0.0, 0.02):
-        _run(Scene(energy=0.3, gamma=g, n=600, seed=41, t_max=150.0, chunk_size=300),
-             root / "fig4" / "out" / "tiny" / "raw" / f"gamma{g:g}")
-    _write_numbers(root, "fig4", {"tau0": {"value": 3.0, "err": 0.1},
-                                  "taus": [{"gamma": 0.02, "tau1": {"value": 12.0, "err": 1.0},
-                                            "tau2_obs": {"value": 29.0, "err": 0.5}}]})
-    return root
-
-
-def test_fig5_tiny_end_to_end(tiny_root):
-    from hhscatter.studies import load_study, run_stage
-
-    run_stage("fig5", "all", "tiny", workers=1, progress=False, root=tiny_root)
-    study = load_study("fig5", "tiny", root=tiny_root)
+    study = load_study("fig5", "tiny", root=tiny_studies)
     nums = json.loads(study.numbers_path.read_text())
     assert study.figure_path.stat().st_size > 10_000
     assert nums["dev_fallback"] is False
     assert nums["inputs"]["mu"]["source"] == "fig3.json:mu"
-    # t* from μ = 0.91 (Eq. (eqn:energy_exp_decay)) for each γ
+    mu = _numbers(tiny_studies, "fig3")["mu"]["value"]
+    assert nums["mu"]["value"] == mu
+    # t* from fig3's μ (Eq. (eqn:energy_exp_decay)) for each γ
     for g in (0.03, 0.02):
-        assert nums["t_star"][f"gamma{g:g}"]["value"] == pytest.approx(math.log(0.35 / 0.30) / (0.91 * g))
+        assert nums["t_star"][f"gamma{g:g}"]["value"] == pytest.approx(math.log(0.35 / 0.30) / (mu * g))
+    # the c-measure samples are fig1's published points (its derived table), not its raw runs
+    fig1 = pd.read_parquet(tiny_studies / "fig1" / "out" / "tiny" / "derived" / "cmeasure_points.parquet")
+    for label, E in (("E1", 0.30), ("E2", 0.35)):
+        src = nums["inputs"][f"cmeasure_{label}"]
+        assert src["source"].startswith("fig1: derived/cmeasure_points.parquet")
+        assert src["n_points"] == int(np.isclose(fig1["energy"], E).sum())
     pts = pd.read_parquet(study.out / "derived" / "points.parquet")
     per = {r["gamma"]: r for r in nums["per_gamma"]}
     for g in (0.03, 0.02):
@@ -201,26 +166,29 @@ def test_fig5_tiny_end_to_end(tiny_root):
     assert any(r["quantity"].startswith("t*") for r in nums["paper_comparison"])
 
 
-def test_fig5_fails_clearly_without_fig1(tiny_root, tmp_path, monkeypatch):
+def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch):
     from hhscatter.studies import run_stage
 
     monkeypatch.delenv(up.DEV_ENV, raising=False)
     for name in ("fig3", "fig5"):
-        shutil.copytree(tiny_root / name, tmp_path / name)
-    _copy_toml(tmp_path, "fig1")
-    with pytest.raises(up.UpstreamError, match="fig1"):
+        shutil.copytree(tiny_studies / name, tmp_path / name)
+    (tmp_path / "fig1").mkdir()
+    shutil.copy(REPO / "studies" / "fig1" / "study.toml", tmp_path / "fig1" / "study.toml")
+    with pytest.raises(up.UpstreamError, match="fig5 needs the published outputs of fig1 .*make fig5 SCALE=tiny"):
         run_stage("fig5", "analyze", "tiny", root=tmp_path)
 
 
-def test_fig6_tiny_end_to_end(tiny_root):
-    from hhscatter.studies import load_study, run_stage
+def test_fig6_tiny_end_to_end(tiny_studies):
+    from hhscatter.studies import load_study
 
-    run_stage("fig6", "all", "tiny", workers=1, progress=False, root=tiny_root)
-    study = load_study("fig6", "tiny", root=tiny_root)
+    study = load_study("fig6", "tiny", root=tiny_studies)
     nums = json.loads(study.numbers_path.read_text())
     assert study.figure_path.stat().st_size > 10_000
     assert nums["dev_fallback"] is False
-    assert nums["kappa0"]["a"] == 13.63 and nums["tau0"] == 3.0
+    fig2, fig3, fig4 = (_numbers(tiny_studies, n) for n in ("fig2", "fig3", "fig4"))
+    assert nums["kappa0"]["a"] == fig2["kappa_fit"]["a"]["value"] and nums["tau0"] == fig4["tau0"]["value"]
+    assert nums["mu"]["value"] == fig3["mu"]["value"]
+    assert nums["inputs"]["tau_lifetimes"]["source"] == "fig4: derived/fig4_lifetimes.parquet"
     fits = pd.DataFrame(nums["fits"])
     assert set(fits["model"]) == {"homogeneous", "mixture_tau0", "mixture_free"}
     # a shared-φ mixture has as many free parameters as the homogeneous model, a free one K − 1 more
@@ -236,6 +204,7 @@ def test_fig6_tiny_end_to_end(tiny_root):
     np.testing.assert_allclose(hom["f_ne"] + hom["f_e"], hom["P_tau0"], rtol=1e-12)
     taus = pd.DataFrame(nums["tau_vs_gamma"])
     row = taus[taus["gamma"] == 0.02].iloc[0]
-    assert row["tau2_predicted"] == pytest.approx(math.log(0.3 / E_C) / (0.91 * 0.02))
-    assert row["tau1_observed"] == 12.0 and row["tau2_observed"] == 29.0
-    assert row["tau1_pred_integrated"] is None or row["tau1_pred_integrated"] >= 3.0
+    assert row["tau2_predicted"] == pytest.approx(math.log(0.3 / E_C) / (fig3["mu"]["value"] * 0.02))
+    t4 = next(r for r in fig4["taus"] if r["gamma"] == 0.02)
+    assert row["tau1_observed"] == t4["tau1"]["value"] and row["tau2_observed"] == t4["tau2_obs"]["value"]
+    assert row["tau1_pred_integrated"] is None or row["tau1_pred_integrated"] >= nums["tau0"]

@@ -104,3 +104,47 @@ def test_report_and_docs_nav_list_the_study_folders():
     nav = hook.study_nav(ROOT)
     assert nav[0] == "studies/index.md"
     assert [next(iter(d.values())) for d in nav[1:]] == [f"studies/{s.name}.md" for s in graph.studies(STUDIES)]
+
+
+def _study_code(name: str) -> list[Path]:
+    """The Python files of one study: its folder's modules (and the package modules named after it)."""
+    files = sorted((STUDIES / name).glob("*.py"))
+    files += [p for p in (ROOT / "hhscatter" / "studies" / f"{name}.py", ROOT / "hhscatter" / "plotting" / f"{name}.py")
+              if p.exists()]
+    return files
+
+
+def _imported_modules(path: Path, package: str) -> set[str]:
+    """Absolute names of every module a file imports (relative imports resolved against ``package``)."""
+    import ast
+
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*parts, *([base] if base else [])])
+            out.add(base)
+            out |= {f"{base}.{a.name}" for a in node.names}
+    return out
+
+
+def test_no_study_imports_another_or_reads_its_raw_runs():
+    from hhscatter.studies import _upstream
+
+    names = [s.name for s in graph.studies(STUDIES)]
+    for name in names:
+        others = [o for o in names if o != name]
+        for path in _study_code(name):
+            package = "hhscatter.plotting" if path.parent.name == "plotting" else "hhscatter.studies"
+            mods = _imported_modules(path, package)
+            bad = {m for m in mods for o in others
+                   if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m) or m.endswith(f"studies.{o}")}
+            assert not bad, f"{path.relative_to(ROOT)} imports another study: {sorted(bad)}"
+            text = path.read_text()
+            # other studies are reached through their published outputs only (_upstream.numbers / table)
+            assert "load_study(" not in text, path
+    assert not hasattr(_upstream, "raw_dir")

@@ -8,8 +8,6 @@ samples with known rates, and the engine's own escape times.
 from __future__ import annotations
 
 import math
-import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -278,18 +276,12 @@ def test_paired_shift_independent_samples_error():
 # ---------------------------------------------------------------------------
 # end to end at scale 'tiny'
 # ---------------------------------------------------------------------------
-def test_resc_study_tiny_end_to_end(tmp_path):
+def test_resc_study_tiny_end_to_end(tiny_studies):
     import json
 
     import pandas as pd
 
-    from hhscatter.studies import run_stage
-
-    src = Path(__file__).resolve().parents[1] / "studies" / "resc" / "study.toml"
-    (tmp_path / "resc").mkdir()
-    shutil.copy(src, tmp_path / "resc" / "study.toml")
-    run_stage("resc", "all", "tiny", workers=1, progress=False, root=tmp_path)
-    out = tmp_path / "resc" / "out" / "tiny"
+    out = tiny_studies / "resc" / "out" / "tiny"
     assert (out / "resc.png").stat().st_size > 10000
     doc = json.loads((out / "resc.json").read_text())
     assert doc["default_r_esc"]["recommended"] > doc["default_r_esc"]["lyapunov_r_max_at_max_energy"]

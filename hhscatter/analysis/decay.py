@@ -17,10 +17,14 @@ Functions here are pure (no file I/O, no plotting):
   error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
 * :func:`pool_mean_energy` — the same statistics pooled over several tables
   (e.g. one per part file, so that N = 10^7 never sits in memory at once);
+* :func:`inside_mean_energy` — ⟨E⟩(t) of every orbit not escaped by t and of
+  those still above E_c, pooled over the part tables of one run;
+* :func:`snapshot_grid` — the snapshot times of a study, from [start, stop, step] pieces;
 * :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the paper's
   model) and with a free intercept (the local exponent);
 * :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
-* :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits);
+* :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits),
+  :func:`bootstrap_mu_first_orbits` on the first K orbits with errors scaled to N;
 * :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
 
 Units: the model's natural units (unit mass); t in time units, E in energy
@@ -36,16 +40,42 @@ import pandas as pd
 __all__ = [
     "EnergyDecayFit",
     "EnergyHistograms",
+    "InsideMeanEnergy",
     "bootstrap_mu",
+    "bootstrap_mu_first_orbits",
     "energy_histograms",
     "energy_histograms_arrays",
     "fit_energy_decay",
     "fit_energy_decay_table",
     "mean_energy",
     "mean_energy_arrays",
+    "inside_mean_energy",
     "mu_by_window",
     "pool_mean_energy",
+    "snapshot_grid",
 ]
+
+
+def snapshot_grid(pieces) -> np.ndarray:
+    """snapshot_grid(pieces) -> increasing array of times from [[start, stop, step], ...].
+
+    Each piece is the uniform grid start, start + step, ..., ≤ stop (values
+    rounded to 1e-9 so that equal times compare equal across tables).
+    Pieces must not overlap.
+    """
+    out = []
+    for p in pieces:
+        if len(p) != 3:
+            raise ValueError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
+        start, stop, step = (float(v) for v in p)
+        if not step > 0 or stop < start:
+            raise ValueError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
+        k = np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
+        out.append(np.round(start + step * k, 9))
+    g = np.concatenate(out) if out else np.empty(0)
+    if g.size == 0 or np.any(np.diff(g) <= 0):
+        raise ValueError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
+    return g
 
 
 # ---------------------------------------------------------------------------
@@ -133,6 +163,40 @@ def pool_mean_energy(tables) -> pd.DataFrame:
         sem = std / np.sqrt(n)
     return pd.DataFrame({"t": n_s.index.to_numpy(dtype=float), "n": n.astype(np.int64), "mean_E": mean,
                          "std_E": std, "sem_E": sem, "lo_3sigma": mean - 3 * std, "hi_3sigma": mean + 3 * std})
+
+
+@dataclass(frozen=True)
+class InsideMeanEnergy:
+    """⟨E⟩(t) statistics of one run (columns of :func:`mean_energy`).
+
+    inside         every orbit not escaped by t (settled orbits continued past E_c
+                   count: the scene option ``continue_settled``)
+    above          the orbits still above E_c at t (neither escaped nor settled)
+    rows_below_ec  number of snapshot rows at or below E_c (the continued settled orbits)
+    """
+
+    inside: pd.DataFrame
+    above: pd.DataFrame
+    rows_below_ec: int
+
+
+def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
+    """inside_mean_energy(parts, e_c) -> InsideMeanEnergy pooled over snapshot tables (columns t, energy).
+
+    ``parts``: an iterable of DataFrames, e.g. one per part file of a run
+    whose settled orbits were continued (paper Fig. 3: ⟨E⟩ over the orbits
+    "inside Ω at time t"); E decreases monotonically for γ > 0, so the rows
+    with E > E_c are those of orbits neither escaped nor settled. Memory stays
+    O(grid + one part) for any N.
+    """
+    inside, above = [], []
+    n_below = 0
+    for df in parts:
+        up = df["energy"] > e_c
+        inside.append(mean_energy(df))
+        above.append(mean_energy(df[up]))
+        n_below += int((~up).sum())
+    return InsideMeanEnergy(pool_mean_energy(inside), pool_mean_energy(above), n_below)
 
 
 # ---------------------------------------------------------------------------
@@ -459,3 +523,20 @@ def bootstrap_mu(
             f = fit_energy_decay(grid, mean, E0, gamma, (lo, hi))
             rows.append({"replicate": b, "t_lo": float(lo), "t_hi": float(hi), "mu": f.mu, "mu_free": f.mu_free})
     return pd.DataFrame(rows, columns=["replicate", "t_lo", "t_hi", "mu", "mu_free"])
+
+
+def bootstrap_mu_first_orbits(rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, windows, *,
+                              n_boot: int = 200, seed: int = 0):
+    """bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot, seed) -> (replicates, scale).
+
+    :func:`bootstrap_mu` on the snapshot rows (traj_id, t, energy) of the
+    orbits traj_id < k only; their standard deviations times ``scale`` =
+    √(k/N) are those of the N orbits (i.i.d. orbits: errors ∝ 1/√N), which
+    keeps the bootstrap affordable at N = 10^7. ``rows`` may already be
+    restricted to those orbits (e.g. by a filter pushed down to the reader).
+    """
+    if not 1 <= k <= n_orbits:
+        raise ValueError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
+    sub = rows[rows["traj_id"] < k]
+    boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
+    return boot, float(np.sqrt(k / n_orbits))

@@ -16,8 +16,10 @@ Distances provided
   H² ≤ TV ≤ √2 H.
 * Sliced Wasserstein SW_p (:func:`sliced_wasserstein`): the W_p distance of
   1-D projections averaged over directions; in units of x, y.
-* :func:`bootstrap_distance` (resampling spread) and
-  :func:`split_half_baseline` (finite-sample noise floor).
+* :func:`bootstrap_distance` (resampling spread; one or several distances per
+  resample), :func:`split_half_baseline` (finite-sample noise floor of one set)
+  and :func:`split_half_noise` (the same for two sets, as
+  :func:`distance_vs_scale` uses it).
 
 Which distance to headline
 --------------------------
@@ -78,6 +80,7 @@ __all__ = [
     "agreement_scale",
     "agreement_scale_debiased",
     "bootstrap_distance",
+    "box_distances",
     "box_histograms",
     "debiased_distance",
     "distance_vs_scale",
@@ -87,6 +90,7 @@ __all__ = [
     "points",
     "sliced_wasserstein",
     "split_half_baseline",
+    "split_half_noise",
     "total_variation",
     "wasserstein_1d",
 ]
@@ -214,6 +218,50 @@ def histogram_distance(
     raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
 
 
+_DISTANCE = {"hellinger": hellinger, "tv": total_variation}
+
+
+def _check_kinds(kinds):
+    for k in kinds:
+        if k not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got {k!r}")
+
+
+def box_distances(P, Q, boxes, extent=None, kinds=KINDS) -> np.ndarray:
+    """box_distances(P, Q, boxes, extent=None, kinds=("hellinger", "tv")) -> array (len(boxes), len(kinds)).
+
+    :func:`histogram_distance` of the point sets P, Q at every box side of
+    ``boxes`` (in the given order), every kind from one histogram pair per box.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    _check_kinds(kinds)
+    if extent is None:
+        extent = _extent_of(P, Q)
+    out = np.empty((len(boxes), len(kinds)))
+    for j, eps in enumerate(boxes):
+        p, q = box_histograms(P, Q, eps, extent)
+        out[j] = [_DISTANCE[k](p, q) for k in kinds]
+    return out
+
+
+def _split_halves(P, Q, m: int, n_splits: int, rng):
+    """(P1, P2, Q1, Q2) per split: disjoint random halves of m points of P and of Q (one permutation each)."""
+    for _ in range(n_splits):
+        ip, iq = rng.permutation(P.shape[0]), rng.permutation(Q.shape[0])
+        yield P[ip[:m]], P[ip[m : 2 * m]], Q[iq[:m]], Q[iq[m : 2 * m]]
+
+
+def _common_m(P, Q, m):
+    m_max = min(P.shape[0], Q.shape[0]) // 2
+    if m_max < 1:
+        raise ValueError("need at least 2 points in each set for the split-half baseline")
+    if m is None:
+        return m_max
+    if not 1 <= int(m) <= m_max:
+        raise ValueError(f"m must be in [1, {m_max}] = [1, ⌊min(n_P, n_Q)/2⌋], got {m!r}")
+    return int(m)
+
+
 def distance_vs_scale(
     P,
     Q,
@@ -249,31 +297,16 @@ def distance_vs_scale(
     if extent is None:
         extent = _extent_of(P, Q)
     boxes = np.sort(np.asarray(boxes, dtype=float).ravel())[::-1]
-    for k in kinds:
-        if k not in KINDS:
-            raise ValueError(f"kind must be one of {KINDS}, got {k!r}")
-    fn = {"hellinger": hellinger, "tv": total_variation}
-    rows = []
-    for eps in boxes:
-        p, q = box_histograms(P, Q, eps, extent)
-        rows.append({"box": float(eps), **{k: fn[k](p, q) for k in kinds}})
-    out = pd.DataFrame(rows)
+    _check_kinds(kinds)
+    fn = _DISTANCE
+    full = box_distances(P, Q, boxes, extent, kinds)
+    out = pd.DataFrame({"box": boxes.astype(float), **{k: full[:, i] for i, k in enumerate(kinds)}})
     if n_splits > 0:
-        m_max = min(P.shape[0], Q.shape[0]) // 2
-        if m_max < 1:
-            raise ValueError("need at least 2 points in each set for the split-half baseline")
-        if m is None:
-            m = m_max
-        elif not 1 <= int(m) <= m_max:
-            raise ValueError(f"m must be in [1, {m_max}] = [1, ⌊min(n_P, n_Q)/2⌋], got {m!r}")
-        m = int(m)
+        m = _common_m(P, Q, m)
         rng = np.random.default_rng(seed)
         pq = np.empty((n_splits, boxes.size, len(kinds)))
         nz = np.empty_like(pq)
-        for s in range(n_splits):
-            ip, iq = rng.permutation(P.shape[0]), rng.permutation(Q.shape[0])
-            P1, P2 = P[ip[:m]], P[ip[m : 2 * m]]
-            Q1, Q2 = Q[iq[:m]], Q[iq[m : 2 * m]]
+        for s, (P1, P2, Q1, Q2) in enumerate(_split_halves(P, Q, m, n_splits, rng)):
             for j, eps in enumerate(boxes):
                 # one histogram pair per comparison, shared by all kinds
                 h = [box_histograms(A, B, eps, extent) for A, B in ((P1, Q1), (P2, Q2), (P1, P2), (Q1, Q2))]
@@ -440,17 +473,57 @@ def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> 
     Resamples P and Q independently with replacement ``n_boot`` times and
     returns the mean and standard deviation (ddof = 1) of fn(P*, Q*), e.g.
     ``fn = lambda A, B: histogram_distance(A, B, 0.01, extent)``.  The std
-    is the sampling error of fn(P, Q).  Note that resampling with replacement
-    duplicates points, which biases histogram distances upwards (fewer
-    distinct points); judge closeness against :func:`split_half_baseline`,
-    not against zero.  Deterministic for a given ``seed``.
+    is the sampling error of fn(P, Q).  ``fn`` may return an array (mean and
+    std are then arrays of its shape) or a tuple of values and arrays (then
+    tuples): several distances of the same resamples, e.g.
+    ``lambda A, B: (box_distances(A, B, boxes, extent), sliced_wasserstein(A, B))``.
+    Note that resampling with replacement duplicates points, which biases
+    histogram distances upwards (fewer distinct points); judge closeness
+    against :func:`split_half_baseline`, not against zero.  Deterministic for
+    a given ``seed``.
     """
     P, Q = _as_points(P), _as_points(Q)
+    if int(n_boot) < 1:
+        raise ValueError(f"n_boot must be >= 1, got {n_boot!r}")
     rng = np.random.default_rng(seed)
-    vals = np.empty(int(n_boot))
-    for i in range(vals.size):
-        vals[i] = fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
-    return BootstrapResult(float(vals.mean()), float(vals.std(ddof=1)) if vals.size > 1 else 0.0)
+    draws = [fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
+             for _ in range(int(n_boot))]
+    return _mean_std(draws)
+
+
+def _mean_std(draws) -> BootstrapResult:
+    """Mean and std (ddof = 1; 0 for one draw) over draws of a scalar, an array or a tuple of them."""
+    ddof = 1 if len(draws) > 1 else 0
+
+    def one(vals):
+        a = np.asarray(vals, dtype=float)
+        mean, std = a.mean(axis=0), a.std(axis=0, ddof=ddof)
+        return (float(mean), float(std)) if a.ndim == 1 else (mean, std)
+
+    if isinstance(draws[0], tuple):
+        parts = [one([d[k] for d in draws]) for k in range(len(draws[0]))]
+        return BootstrapResult(tuple(m for m, _ in parts), tuple(s for _, s in parts))
+    return BootstrapResult(*one(draws))
+
+
+def split_half_noise(P, Q, fn: Callable, m: int | None = None, n_splits: int = 8, seed: int = 0) -> BootstrapResult:
+    """split_half_noise(P, Q, fn, m=None, n_splits=8, seed=0) -> BootstrapResult(mean, std).
+
+    Finite-sample noise floor of the distance ``fn`` at the sample size m
+    (default ⌊min(n_P, n_Q)/2⌋) for a comparison of P with Q: over
+    ``n_splits`` random splits of each set into disjoint halves P1, P2 and
+    Q1, Q2 of m points, the mean and std of ½ (fn(P1, P2) + fn(Q1, Q2)) — the
+    value of fn for two sets that agree perfectly, each as large as the
+    halves :func:`distance_vs_scale` compares. The splits are those of
+    :func:`distance_vs_scale` with the same ``seed`` and ``m``.
+    """
+    P, Q = _as_points(P), _as_points(Q)
+    m = _common_m(P, Q, m)
+    if int(n_splits) < 1:
+        raise ValueError(f"n_splits must be >= 1, got {n_splits!r}")
+    rng = np.random.default_rng(seed)
+    vals = [0.5 * (fn(P1, P2) + fn(Q1, Q2)) for P1, P2, Q1, Q2 in _split_halves(P, Q, m, int(n_splits), rng)]
+    return _mean_std(vals)
 
 
 def split_half_baseline(

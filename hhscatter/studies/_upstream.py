@@ -1,7 +1,8 @@
-"""Reading other studies' outputs (numbers JSON, raw runs) for the studies that build on them.
+"""Reading other studies' published outputs (numbers JSON, derived tables) for the studies that build on them.
 
 Figs 5 and 6 combine results of Figs 1–4 (the conservative c-measure, the
-κ0(E) fit, μ, the τ table).  Their key names are parameters of the reading
+κ0(E) fit, μ, the τ table and lifetimes). Which study plays which role is
+declared once, in the reading study's ``[needs]`` table.  Their key names are parameters of the reading
 study's ``study.toml`` (dotted paths into the other study's JSON), so a
 renamed key is a one-line change there, and a missing file or key fails with
 a message that names the study, the path and the keys that do exist.
@@ -16,7 +17,6 @@ from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 
 from ..scene import SceneError
 
@@ -80,23 +80,27 @@ def numbers(study, other: str) -> dict:
         raise UpstreamError(f"{study.name} needs the outputs of study {other!r}: {exc}") from None
 
 
-def raw_dir(study, other: str, key: str) -> Path:
-    """raw_dir(study, other, key) -> path of study ``other``'s raw run ``key`` (same scale); must exist."""
+def table(study, other: str, name: str, filters=None):
+    """table(study, other, name, filters=None) -> pandas.DataFrame of study ``other``'s published derived table.
+
+    ``name`` is a file of ``studies/<other>/out/<scale>/derived/`` (same scale);
+    ``filters`` as for :func:`pandas.read_parquet`. A study reads other studies'
+    published outputs (numbers JSON, derived tables), never their raw runs.
+    """
+    import pandas as pd
+
     from . import load_study
 
     try:
         o = load_study(other, study.scale, root=study.root.parent)
     except SceneError as exc:
         raise UpstreamError(f"{study.name} needs study {other!r}: {exc}") from None
-    p = o.raw(key)
-    if not (p / "lifetimes").is_dir():
-        have = sorted(d.name for d in (o.out / "raw").glob("*") if d.is_dir()) if (o.out / "raw").is_dir() else []
-        raise UpstreamError(
-            f"{study.name} needs the raw run {p} of study {other!r} (present: {have}); "
-            f"run `make {other} SCALE={study.scale}` first (or set [study] keys in "
-            f"{study.root / 'study.toml'} if {other} names its runs differently)"
-        )
-    return p
+    path = o.out / "derived" / name
+    if not path.exists():
+        have = sorted(p.name for p in path.parent.glob("*")) if path.parent.is_dir() else []
+        raise UpstreamError(f"{study.name} needs {path}, a derived table of study {other!r} (present: {have}); "
+                            f"run `make {study.name} SCALE={study.scale}`, which builds {other} first")
+    return pd.read_parquet(path, filters=filters)
 
 
 def value_or_fallback(study, other: str, path: str, paper_value, inputs: dict, name: str):

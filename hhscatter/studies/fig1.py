@@ -18,7 +18,7 @@ Stages (``hhscatter study fig1 simulate|analyze|plot [--scale S]``):
 
 ``analyze(study)``
     Derived tables ``cmeasure_points.parquet`` (energy, traj_id, t, x, y, px,
-    py: the c-measure sample) and ``potential_grid.parquet`` (x, y, V on a
+    py, e_cross: the c-measure sample, published for other studies) and ``potential_grid.parquet`` (x, y, V on a
     square grid for Fig. 1a); numbers ``fig1.json`` with, per energy, t_rec,
     the κ and τ0 used, survivors at t_rec and the number of points.
 
@@ -26,11 +26,12 @@ Stages (``hhscatter study fig1 simulate|analyze|plot [--scale S]``):
     ``fig1.png`` via :func:`hhscatter.plotting.fig1.plot_fig1`.
 
 c-measure sample for other studies (fig5): the conservative c-measure at
-E = 0.30 and 0.35 is *every row* of the ``sections`` table of the raw runs
-``raw/E0.30`` and ``raw/E0.35`` (``hhscatter.tables.read_sections``); all rows
-have t ≥ t_rec by construction (first_only). The same points are in the
-derived ``cmeasure_points.parquet``. ``fig1.json["cmeasure_sample"]`` says so
-and gives t_rec per energy.
+E = 0.30 and 0.35 is published as the derived table ``cmeasure_points.parquet``
+(columns energy = the run's E, traj_id, t, x, y, px, py and e_cross, the
+orbit's energy at the crossing): every row of the ``sections`` table of the
+raw runs ``raw/E0.30`` and ``raw/E0.35``; all rows have t ≥ t_rec by
+construction (first_only). ``fig1.json`` names the table (``tables``) and
+gives t_rec per energy (``cmeasure_sample``).
 """
 from __future__ import annotations
 
@@ -43,6 +44,7 @@ from ..model import HenonHeiles
 from ..runner import SCENE_FILE
 
 E_C = HenonHeiles().critical_energy
+CMEASURE_TABLE = "cmeasure_points.parquet"  # published: other studies read it (derived/), never the raw runs
 
 
 def energy_key(energy: float) -> str:
@@ -168,12 +170,14 @@ def analyze(study):
         }
         pts = sec[["traj_id", "t", "x", "y", "px", "py"]].copy()
         pts.insert(0, "energy", float(energy))
+        pts["e_cross"] = sec["energy"].to_numpy()  # the orbit's energy at the crossing (E up to rounding)
         points.append(pts)
         # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
         study.compare(f"kappa(E={energy:.2f}) used for t_rec", ch["kappa"], ch["kappa_err"], 1.41 * (energy - E_C),
                       unit="1/time", note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b")
-    study.write_table(pd.concat(points, ignore_index=True), "cmeasure_points.parquet",
-                      description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec")
+    study.write_table(pd.concat(points, ignore_index=True), CMEASURE_TABLE,
+                      description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec; "
+                                  "energy = the run's E, e_cross = the orbit's energy at the crossing")
 
     h = float(study.param("grid_half_width"))
     m = int(study.param("grid_points"))
@@ -188,10 +192,10 @@ def analyze(study):
                           "at t >= t_rec (SectionWindow first_only=True), t_max = t_rec + t_after",
         "rec_efolds": rec_efolds,
         "energies": per_energy,
+        "tables": {"cmeasure_points": CMEASURE_TABLE, "potential_grid": "potential_grid.parquet"},
         "cmeasure_sample": {
-            "how": "every row of the 'sections' table of raw run raw/E0.30 (raw/E0.35) "
-                   "(hhscatter.tables.read_sections(study.raw('E0.30'))); all rows have t >= t_rec; "
-                   "also derived/cmeasure_points.parquet filtered by energy",
+            "how": f"the rows of derived/{CMEASURE_TABLE} with energy = E (published for other studies), i.e. every "
+                   "row of the 'sections' table of raw run raw/E0.30 (raw/E0.35); all rows have t >= t_rec",
             "raw_keys": {k: v["raw_run"] for k, v in per_energy.items()},
             "t_rec": {k: v["t_rec"] for k, v in per_energy.items()},
             "n_points": {k: v["n_points"] for k, v in per_energy.items()},
@@ -210,5 +214,5 @@ def plot(study):
 
     numbers = study.read_numbers()
     grid = pd.read_parquet(study.out / "derived" / "potential_grid.parquet")
-    pts = pd.read_parquet(study.out / "derived" / "cmeasure_points.parquet")
+    pts = pd.read_parquet(study.out / "derived" / CMEASURE_TABLE)
     plot_fig1(grid, pts, numbers, study.figure_path)

@@ -35,29 +35,7 @@ import json
 import numpy as np
 import pandas as pd
 
-E_C = 1.0 / 6.0
-
-
-def snapshot_grid(pieces) -> np.ndarray:
-    """snapshot_grid(pieces) -> increasing array of times from [[start, stop, step], ...].
-
-    Each piece is the uniform grid start, start + step, ..., ≤ stop (values
-    rounded to 1e-9 so that equal times compare equal across tables).
-    Pieces must not overlap.
-    """
-    out = []
-    for p in pieces:
-        if len(p) != 3:
-            raise ValueError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
-        start, stop, step = (float(v) for v in p)
-        if not step > 0 or stop < start:
-            raise ValueError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
-        k = np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
-        out.append(np.round(start + step * k, 9))
-    g = np.concatenate(out) if out else np.empty(0)
-    if g.size == 0 or np.any(np.diff(g) <= 0):
-        raise ValueError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
-    return g
+from ..analysis.decay import snapshot_grid
 
 
 def _key(study) -> str:
@@ -75,75 +53,32 @@ def simulate(study, workers=None, progress=True):
     study.run(key, scene, workers=workers, progress=progress)
 
 
-def _parts(run_dir):
-    return sorted((run_dir / "snapshots").glob("part-*.parquet"))
-
-
-def inside_mean_energy(study, key: str):
-    """inside_mean_energy(study, key) -> (inside, above, continuation counts).
-
-    ⟨E⟩(t) statistics (columns of :func:`hhscatter.analysis.decay.mean_energy`)
-    of every orbit not escaped at t (``inside``: the run's snapshots, settled
-    orbits continued past t_end) and of the orbits still above E_c
-    (``above``: neither escaped nor settled; E decreases monotonically for
-    γ > 0, so these are the rows with E > E_c). Computed part file by part
-    file and pooled, so memory stays O(grid) for any N.
-    """
-    import pyarrow.parquet as pq
-
-    from ..analysis.decay import mean_energy, pool_mean_energy
-
-    ec = study.scene(key).model.critical_energy
-    inside, above = [], []
-    n_rows_after = 0
-    for p in _parts(study.raw(key)):
-        df = pq.read_table(p, columns=["t", "energy"]).to_pandas()
-        up = df["energy"] > ec
-        inside.append(mean_energy(df))
-        above.append(mean_energy(df[up]))
-        n_rows_after += int((~up).sum())
-    return pool_mean_energy(inside), pool_mean_energy(above), {"rows_below_ec": n_rows_after}
-
-
-def read_inside(study, key: str, filters=None) -> pd.DataFrame:
-    """read_inside(study, key, filters=None) -> snapshot rows (traj_id, t, energy) of orbits not escaped.
-
-    ``filters``: a pyarrow.dataset expression pushed down to the reader (e.g.
-    a subset of orbits for the bootstrap, or the histogram times).
-    """
+def _snapshot_rows(study, key: str, filters=None) -> pd.DataFrame:
+    """Snapshot rows (traj_id, t, energy) of orbits not escaped; ``filters`` pushed down to the reader."""
     from ..tables import read_snapshots
 
     return read_snapshots(study.raw(key), filters=filters)
-
-
-def bootstrap_subset(study, key: str, n_orbits: int, windows, E0, gamma, n_boot, seed):
-    """bootstrap_subset(...) -> (bootstrap DataFrame, scale): :func:`bootstrap_mu` on the orbits traj_id < K.
-
-    K = ``[study].n_boot_orbits``; for N > K the standard deviations must be
-    multiplied by ``scale`` = √(K/N) (the orbits are i.i.d., errors ∝ 1/√N),
-    which keeps the bootstrap affordable at N = 10^7.
-    """
-    import pyarrow.dataset as ds
-
-    from ..analysis.decay import bootstrap_mu
-
-    k = min(int(study.param("n_boot_orbits")), n_orbits)
-    rows = read_inside(study, key, filters=ds.field("traj_id") < k)
-    boot = bootstrap_mu(rows["traj_id"], rows["t"], rows["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
-    return boot, float(np.sqrt(k / n_orbits))
 
 
 def analyze(study):
     """analyze(study) -> None: ⟨E⟩(t), μ fits (+ bootstrap), later windows, histograms, fig3.json."""
     import pyarrow.dataset as ds
 
-    from ..analysis.decay import energy_histograms, fit_energy_decay, mu_by_window
-    from ..tables import read_lifetimes
+    from ..analysis.decay import (
+        bootstrap_mu_first_orbits,
+        energy_histograms,
+        fit_energy_decay,
+        inside_mean_energy,
+        mu_by_window,
+    )
+    from ..tables import iter_parts, read_lifetimes
 
     key = _key(study)
     scene = study.scene(key)
     E0, gamma = float(scene.energy), float(scene.gamma)
-    me, ma, cont = inside_mean_energy(study, key)
+    E_C = scene.model.critical_energy
+    ime = inside_mean_energy(iter_parts(study.raw(key), "snapshots", ["t", "energy"]), E_C)
+    me, ma, cont = ime.inside, ime.above, {"rows_below_ec": ime.rows_below_ec}
     lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"])
     n_orbits = len(lt)
 
@@ -167,7 +102,9 @@ def analyze(study):
     tab["kind"] = kinds
     tab = tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
     n_boot = int(study.param("n_boot"))
-    boot, scale = bootstrap_subset(study, key, n_orbits, windows, E0, gamma, n_boot, int(study.param("boot_seed")))
+    k = min(int(study.param("n_boot_orbits")), n_orbits)
+    boot, scale = bootstrap_mu_first_orbits(_snapshot_rows(study, key, ds.field("traj_id") < k), n_orbits, k, E0,
+                                            gamma, windows, n_boot=n_boot, seed=int(study.param("boot_seed")))
     boot["w"] = np.tile(np.arange(len(windows)), n_boot)
     err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
     tab["mu_err"] = err["mu"].to_numpy() * scale
@@ -178,7 +115,7 @@ def analyze(study):
 
     # inset: histograms of log10 E at the marked times
     hist_times = [float(v) for v in study.param("hist_times")]
-    at = read_inside(study, key, filters=ds.field("t").isin(list(_nearest(me["t"].to_numpy(), hist_times))))
+    at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(_nearest(me["t"].to_numpy(), hist_times))))
     lo = max(float(at["energy"].min()), 1e-12)
     edges = np.geomspace(lo * 0.98, E0 * 1.001, int(study.param("hist_bins")) + 1)
     h = energy_histograms(at, hist_times, bins=edges)

@@ -26,14 +26,16 @@ Definitions used here (all times in model units):
   study on its own γ = ``mu_gamma`` run exactly as in study fig3 (⟨E⟩ over
   orbits not escaped, settled orbits continued, log fit on ``mu_window``),
   one μ for all γ as in the paper (τ2 ∝ 1/γ).  Also given with the paper's
-  μ = 0.91, and fig3's μ is recorded if fig3.json exists at the same scale.
+  μ = 0.91, and fig3's μ is recorded beside it (``[needs] mu_crosscheck``).
 
 Errors: paired bootstrap over orbits (every γ shares the same initial
 conditions, orbit i gets the same multiplicity in every ensemble).
 
-Raw runs (read by study fig6): ``raw/gamma<γ:g>`` — ``gamma0``,
-``gamma0.001``, ``gamma0.002``, ``gamma0.005``, ``gamma0.01``, ``gamma0.02``;
-the μ run's snapshots include its settled orbits, continued past E_c.
+Raw runs: ``raw/gamma<γ:g>`` — ``gamma0``, ``gamma0.001``, ``gamma0.002``,
+``gamma0.005``, ``gamma0.01``, ``gamma0.02``; the μ run's snapshots include
+its settled orbits, continued past E_c.  Published for other studies (fig6
+reads them, never the raw runs): ``fig4.json`` and the derived tables, among
+them ``fig4_lifetimes.parquet`` (γ, t_end, outcome of every orbit).
 """
 from __future__ import annotations
 
@@ -42,9 +44,10 @@ import json
 import numpy as np
 import pandas as pd
 
-from .fig3 import snapshot_grid
+from ..analysis.decay import snapshot_grid
+from . import _upstream as up
 
-E_C = 1.0 / 6.0
+LIFETIMES_TABLE = "fig4_lifetimes.parquet"  # published: other studies read it (derived/), never the raw runs
 
 
 def raw_key(gamma: float) -> str:
@@ -88,7 +91,9 @@ def _plot_grid(t_last):
 
 def analyze(study):
     """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
-    from ..analysis.decay import fit_energy_decay
+    import pyarrow.dataset as ds
+
+    from ..analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
     from ..analysis.survival import observed_from_outcome, survival_from_lifetimes
     from ..analysis.transitions import (
         bootstrap_transition_times,
@@ -98,12 +103,11 @@ def analyze(study):
         tau2_observed,
         tau2_predicted,
     )
-    from ..scene import SceneError
-    from ..tables import read_lifetimes
-    from .fig3 import bootstrap_subset, inside_mean_energy
+    from ..tables import iter_parts, read_lifetimes, read_snapshots
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
+    E_C = study.scene(raw_key(mg), gamma=mg).model.critical_energy
     alpha = float(study.param("alpha"))
     dt = float(study.param("tau_grid_step"))
     lts, ref = {}, None
@@ -128,18 +132,18 @@ def analyze(study):
     tau0 = float(_tau0_rule(grid, P[0.0], N))
 
     # μ from this study's own mu_gamma run (fig3's definition), bootstrap error
-    me, _, cont = inside_mean_energy(study, raw_key(mg))
+    ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]), E_C)
+    me, cont = ime.inside, {"rows_below_ec": ime.rows_below_ec}
     win = tuple(float(v) for v in study.param("mu_window"))
     mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
     nb = int(study.param("n_boot"))
-    bm, mu_scale = bootstrap_subset(study, raw_key(mg), N, [win], E0, mg, nb, int(study.param("boot_seed")))
+    k_mu = min(int(study.param("n_boot_orbits")), N)
+    rows_mu = read_snapshots(study.raw(raw_key(mg)), filters=ds.field("traj_id") < k_mu)
+    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=nb,
+                                             seed=int(study.param("boot_seed")))
     mu_err = float(bm["mu"].std(ddof=1)) * mu_scale
-    mu_fig3 = None
-    try:
-        f3 = study.read_numbers(study.upstream("mu_crosscheck"))
-        mu_fig3 = f3["mu"]
-    except (FileNotFoundError, KeyError, SceneError):  # fig3 is optional here (cross-check only)
-        mu_fig3 = None
+    # fig3's μ beside this study's own (a declared need: [needs].mu_crosscheck)
+    mu_fig3 = up.numbers(study, study.upstream("mu_crosscheck")).get("mu")
     paper_mu = float(study.param("paper_mu"))
 
     # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
@@ -206,6 +210,11 @@ def analyze(study):
     study.write_table(taus, "fig4_tau.parquet", **meta)
     study.write_table(surv, "fig4_survival.parquet", **meta)
     study.write_table(ratio, "fig4_ratio.parquet", **meta)
+    # published for the studies that build on fig4 (fig6): every orbit's lifetime per γ, orbit order
+    study.write_table(pd.concat([lts[g].assign(gamma=g)[["gamma", "t_end", "outcome"]] for g in gs],
+                                ignore_index=True), LIFETIMES_TABLE, **meta,
+                      description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
+                                  "the same initial conditions for every γ")
 
     # paper comparisons (the paper gives τ's only in figures; its statements are checked)
     d = taus[taus["gamma"] > 0]
@@ -255,6 +264,7 @@ def analyze(study):
         "gammas": gs,
         "alpha": alpha,
         "raw_keys": {f"{g:g}": raw_key(g) for g in gs},
+        "tables": {"lifetimes": LIFETIMES_TABLE, "tau": "fig4_tau.parquet", "survival": "fig4_survival.parquet"},
         "raw_key_naming": ("raw runs are studies/fig4/out/<scale>/raw/gamma<γ formatted with %g>: gamma0 (conservative "
                            "reference), gamma0.001, gamma0.002, gamma0.005, gamma0.01, gamma0.02; every run has the "
                            "same initial conditions (seed, n); raw/gamma<mu_gamma> also holds the energies of that "

@@ -16,8 +16,9 @@ simulate   one dissipative run per γ in ``gammas`` (raw key ``gamma<γ>``), all
            section crossings in [t*(μ_max), t*(μ_min) + pad] recorded, so that
            t* is fixed at analysis time from fig3's μ.
 analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
-           samples at E1 and E2 from study fig1's raw runs (first crossing
-           after fig1's recording time t_rec); distances (see
+           samples at E1 and E2 from study fig1's published points
+           (derived/cmeasure_points.parquet: first crossing after fig1's
+           recording time t_rec); distances (see
            :mod:`hhscatter.analysis.distance`): Hellinger and TV on box
            histograms vs box side ε (full samples with bootstrap errors, and
            split-half comparisons at one common sample size m with their
@@ -96,27 +97,28 @@ def simulate(study, workers=None, progress=True):
 # ---------------------------------------------------------------------------
 # analysis
 # ---------------------------------------------------------------------------
-def _cmeasure_points(study, inputs):
-    """Conservative c-measure samples at E1 and E2 from study fig1 (first crossing after t_rec)."""
-    from ..tables import read_sections
-
+def _cmeasure_points(study, inputs, E1, E2):
+    """Conservative c-measure samples at E1 and E2 (first crossing after t_rec), from the study [needs].cmeasure:
+    its published table of points (fig1: derived/cmeasure_points.parquet) and its t_rec (numbers JSON)."""
     other = study.upstream("cmeasure")
     doc = up.numbers(study, other)
+    name = doc.get("tables", {}).get("cmeasure_points")
+    if not name:
+        raise up.UpstreamError(f"{other}.json names no published c-measure table ('tables': {{'cmeasure_points': …}})")
+    cm = up.table(study, other, name)
     out, t_rec = {}, {}
-    for label in ("E1", "E2"):
-        key = study.param(f"cmeasure_{label}_key")
+    for label, E in (("E1", E1), ("E2", E2)):
         tpath = study.param(f"t_rec_{label}_key")
         t_rec[label] = float(up.lookup(doc, tpath, what=f"{other}.json")[0])
-        raw = up.raw_dir(study, other, key)
-        if not (raw / "sections").is_dir():
-            raise up.UpstreamError(f"{raw} has no sections table: study {other} must record section crossings")
-        sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
-        # fig1 records only the first crossing at t ≥ t_rec; selecting it again is a no-op then
+        sec = cm[np.isclose(cm["energy"], E, rtol=0.0, atol=1e-12)]
+        sec = sec[["traj_id", "t", "x", "y", "e_cross"]].rename(columns={"e_cross": "energy"})
+        # the table holds the first crossing at t ≥ t_rec of each orbit; selecting it again is a no-op then
         pts = dist.first_crossings(sec, t_rec[label])
         if len(pts) < 2:
-            raise up.UpstreamError(f"{raw}: only {len(pts)} crossings after t_rec = {t_rec[label]}")
+            raise up.UpstreamError(f"{other}'s {name}: only {len(pts)} points at E = {E:g} after t_rec = {t_rec[label]}")
         out[label] = pts
-        inputs[f"cmeasure_{label}"] = {"source": f"{other}: raw/{key}, t_rec from {other}.json:{tpath}",
+        inputs[f"cmeasure_{label}"] = {"source": f"{other}: derived/{name} (energy = {E:g}), t_rec from "
+                                                 f"{other}.json:{tpath}",
                                        "t_rec": t_rec[label], "n_points": len(pts),
                                        "mean_energy": float(pts["energy"].mean())}
     return out, t_rec
@@ -128,34 +130,6 @@ def _cap(df, n_cap, seed):
         return df.reset_index(drop=True)
     idx = np.sort(np.random.default_rng(seed).choice(len(df), n_cap, replace=False))
     return df.iloc[idx].reset_index(drop=True)
-
-
-def _sw_noise(P, Q, m, n_proj, seed, n_splits):
-    """Sliced-Wasserstein noise floor at sample size m: mean of SW1(P1, P2), SW1(Q1, Q2) over random splits."""
-    rng = np.random.default_rng(seed + 2)
-    vals = []
-    for _ in range(max(int(n_splits), 1)):
-        ip, iq = rng.permutation(len(P)), rng.permutation(len(Q))
-        vals.append(0.5 * (dist.sliced_wasserstein(P[ip[:m]], P[ip[m:2 * m]], n_proj=n_proj, seed=seed)
-                           + dist.sliced_wasserstein(Q[iq[:m]], Q[iq[m:2 * m]], n_proj=n_proj, seed=seed)))
-    return float(np.mean(vals))
-
-
-def _bootstrap_rows(P, Q, boxes, extent, n_boot, seed, n_proj):
-    """Full-sample Hellinger/TV at each box and SW1, each with its bootstrap std."""
-    rng = np.random.default_rng(seed)
-    nb = int(n_boot)
-    vals = np.full((nb, len(boxes), 2), np.nan)
-    sw = np.full(nb, np.nan)
-    for i in range(nb):
-        Pb = P[rng.integers(0, len(P), len(P))]
-        Qb = Q[rng.integers(0, len(Q), len(Q))]
-        for j, eps in enumerate(boxes):
-            p, q = dist.box_histograms(Pb, Qb, eps, extent)
-            vals[i, j] = dist.hellinger(p, q), dist.total_variation(p, q)
-        sw[i] = dist.sliced_wasserstein(Pb, Qb, n_proj=n_proj, seed=seed)
-    ddof = 1 if nb > 1 else 0
-    return vals.std(axis=0, ddof=ddof), float(sw.std(ddof=ddof))
 
 
 def analyze(study):
@@ -176,7 +150,7 @@ def analyze(study):
     if not float(study.param("mu_min")) <= mu <= float(study.param("mu_max")):
         raise ValueError(f"μ = {mu} lies outside the recorded window [mu_min, mu_max] = "
                          f"[{study.param('mu_min')}, {study.param('mu_max')}]: widen it in study.toml and re-simulate")
-    cm, t_rec = _cmeasure_points(study, inputs)
+    cm, t_rec = _cmeasure_points(study, inputs, E1, E2)
     extent = tuple(float(v) for v in study.param("extent"))
     boxes = np.sort(np.asarray(study.param("boxes"), dtype=float))[::-1]
     seed = int(study.param("seed"))
@@ -237,12 +211,19 @@ def analyze(study):
         m = m_common if key in usable and ref == "E1" else None
         tab = dist.distance_vs_scale(P, Q, boxes, extent, n_splits=int(study.param("n_splits")),
                                      seed=seed, m=m)
-        hb, sw_err = _bootstrap_rows(P, Q, boxes, extent, n_boot, seed + 1, n_proj)
+        # full-sample Hellinger/TV at every box and SW1, each with its bootstrap std (same resamples)
+        _, (hb, sw_err) = dist.bootstrap_distance(
+            P, Q, lambda A, B: (dist.box_distances(A, B, boxes, extent),
+                                dist.sliced_wasserstein(A, B, n_proj=n_proj, seed=seed + 1)),
+            n_boot=n_boot, seed=seed + 1)
         tab["hellinger_boot_err"] = hb[:, 0]
         tab["tv_boot_err"] = hb[:, 1]
         tab["common_m"] = m is not None
         sw = dist.sliced_wasserstein(P, Q, n_proj=n_proj, seed=seed)
-        sw_noise = _sw_noise(P, Q, int(tab["m"].iloc[0]), n_proj, seed, int(study.param("n_splits")))
+        # sliced-Wasserstein noise floor at the comparison's sample size m
+        sw_noise = dist.split_half_noise(P, Q, lambda A, B: dist.sliced_wasserstein(A, B, n_proj=n_proj, seed=seed),
+                                         m=int(tab["m"].iloc[0]), n_splits=max(int(study.param("n_splits")), 1),
+                                         seed=seed + 2).mean
         eps_star = dist.agreement_scale(tab, "hellinger", z=float(study.param("z")),
                                         noise_max=float(study.param("noise_max")))
         eps_deb = dist.agreement_scale_debiased(tab, delta, "hellinger", noise_max=float(study.param("noise_max")))

@@ -16,8 +16,9 @@ Stages
 ------
 simulate   one run per (E0, γ) in ``pairs`` with energy snapshots (raw keys
            ``E<E0>_g<γ>``).
-analyze    inputs κ0(E) (fig2.json), μ (fig3.json), τ0 and the observed τ
-           table (fig4.json) and fig4's raw P(t) runs at E0 = 0.3.  Per pair:
+analyze    inputs (the studies of ``[needs]``, their published outputs only):
+           κ0(E) (fig2.json), μ (fig3.json), τ0 and the observed τ table
+           (fig4.json) and fig4's lifetimes at E0 = 0.3 (its derived table).  Per pair:
            Kaplan–Meier P(t); fits of the homogeneous model with the paper's
            literal escape factor (hazard "paper") and with the cumulative
            hazard exp(−∫κ0) ("integrated") — free f_ne, L, b; f_e = P(τ0) − f_ne;
@@ -310,19 +311,26 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
                             "tau1_observed": [_val(v)[0] for v in obs[t1]], "tau1_err": [_val(v)[1] for v in obs[t1]],
                             "tau2_observed": [_val(v)[0] for v in obs[t2]], "tau2_err": [_val(v)[1] for v in obs[t2]]})
         inputs["tau_table"] = {"source": f"{other}.json:{study.param('tau_table_key')}"}
-        prefix = study.param("fig4_raw_prefix")
-        lt0 = read_lifetimes(up.raw_dir(study, other, f"{prefix}0"), columns=["t_end", "outcome"])
-        t0c, P0c, _ = _curve(lt0, dt)
-        runs = {g: up.raw_dir(study, other, f"{prefix}{g:g}") for g in obs["gamma"] if g > 0}
+        # P(t) of the τ study's runs from its published lifetimes table (never its raw runs)
+        tname = doc.get("tables", {}).get("lifetimes")
+        if not tname:
+            raise up.UpstreamError(f"{other}.json names no published lifetimes table ('tables': {{'lifetimes': …}})")
+        life = up.table(study, other, tname)
+        inputs["tau_lifetimes"] = {"source": f"{other}: derived/{tname}"}
+        by_gamma = {float(g): d[["t_end", "outcome"]].reset_index(drop=True) for g, d in life.groupby("gamma")}
+        if 0.0 not in by_gamma:
+            raise up.UpstreamError(f"{other}'s {tname} has no γ = 0 rows (the conservative reference)")
+        t0c, P0c, _ = _curve(by_gamma[0.0], dt)
+        lifetimes = {g: by_gamma[g] for g in obs["gamma"] if g > 0 and g in by_gamma}
     except up.UpstreamError:
         if not up.dev_fallback_enabled():
             raise
         # development only: observed τ2 from this study's own E0 = 0.3 runs, no τ1 (no γ = 0 run)
         inputs["tau_table"] = {"source": up.DEV_SOURCE + ": own E0 runs, τ1 not available"}
-        runs = {g: study.raw(pair_key(e, g)) for e, g in _pairs(study) if abs(e - E0) < 1e-12}
-        obs = pd.DataFrame({"gamma": sorted(runs), "tau1_observed": None, "tau1_err": None, "tau2_err": None,
-                            "tau2_observed": [tau2_observed(read_lifetimes(runs[g], columns=["t_end", "outcome"]))
-                                              for g in sorted(runs)]})
+        lifetimes = {g: read_lifetimes(study.raw(pair_key(e, g)), columns=["t_end", "outcome"])
+                     for e, g in _pairs(study) if abs(e - E0) < 1e-12}
+        obs = pd.DataFrame({"gamma": sorted(lifetimes), "tau1_observed": None, "tau1_err": None, "tau2_err": None,
+                            "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)]})
         t0c = P0c = None
     rows = []
     for r in obs[obs["gamma"] > 0].sort_values("gamma").itertuples():
@@ -332,7 +340,7 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
                "tau2_observed": _num(r.tau2_observed), "tau2_observed_err": _num(r.tau2_err),
                "tau2_predicted": tau2_pred,
                "tau2_predicted_err": tau2_pred * mu_err / mu if math.isfinite(mu_err) else math.nan}
-        lt = read_lifetimes(runs[g], columns=["t_end", "outcome"]) if g in runs else None
+        lt = lifetimes.get(g)
         for h in hazards:
             row[f"tau1_pred_{h}"] = None
             row[f"f_ne_{h}"] = None
