@@ -62,7 +62,7 @@ SCALE ?= quick
 HH := $(VENV)/bin/hhscatter
 ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py hhscatter/studies/*.py)
 so = studies/$(1)/out/$(SCALE)
-study_code = $(wildcard studies/$(1)/*.py hhscatter/studies/$(1).py hhscatter/plotting/$(1).py)
+study_code = $(wildcard studies/$(1)/*.py)
 
 # $(1): study name; $(2): the studies it needs (their numbers JSON are inputs of its analysis)
 define study_rules

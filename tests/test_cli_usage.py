@@ -135,7 +135,7 @@ def test_study_stages_say_what_they_wrote(tmp_path, monkeypatch, capsys):
 
     fake = types.SimpleNamespace(simulate=lambda study, workers=None, progress=True: None, analyze=analyze,
                                  plot=lambda study: study.figure_path.write_bytes(np.zeros(4).tobytes()))
-    monkeypatch.setattr(studies, "stage_module", lambda name: fake)
+    monkeypatch.setattr(studies, "stage_module", lambda name, root=None: fake)
     studies.run_stage("fake", "all", "quick", root=tmp_path)
     out = capsys.readouterr().out.splitlines()
     where = tmp_path / "fake" / "out" / "quick"

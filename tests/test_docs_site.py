@@ -18,11 +18,12 @@ def test_every_cited_equation_label_has_a_number(site):
     assert numbers["eqn:kappa_hyperbolic"] == "2" and numbers["eq:tau2"] == "12"
     assert numbers["eqn:surv_prob_model"] == "18" and len(set(numbers.values())) == len(numbers)
     cited = set()
-    for path in [*ROOT.joinpath("hhscatter").rglob("*.py"), *DOCS.rglob("*.md")]:
+    code = [*ROOT.joinpath("hhscatter").rglob("*.py"), *ROOT.joinpath("studies").glob("*/*.py")]
+    for path in [*code, *DOCS.rglob("*.md"), *ROOT.joinpath("studies").glob("*/page.md")]:
         cited |= set(re.findall(r"\((eqn?:[\w-]+)\)", path.read_text()))
     assert cited and cited <= set(numbers), sorted(cited - set(numbers))
     figures = set()
-    for path in ROOT.joinpath("hhscatter").rglob("*.py"):
+    for path in code:
         figures |= set(re.findall(r"\bfig:([\w-]+)", path.read_text()))
     assert figures <= set(site.FIGURES), sorted(figures - set(site.FIGURES))
 

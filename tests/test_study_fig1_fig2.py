@@ -139,8 +139,8 @@ def test_lifetimes_to_arrays_accepts_rounding_in_e0_but_not_two_ensembles():
 
 
 def test_recording_rules_closed_form():
-    from hhscatter.studies.fig1 import contour_levels, recording_time
-    from hhscatter.studies.fig2 import cmeasure_windows
+    from hhscatter.studies.fig1.study import contour_levels, recording_time
+    from hhscatter.studies.fig2.study import cmeasure_windows
 
     assert recording_time(0.2, 3.4, 4.0) == 24.0  # ceil(3.4 + 20)
     t_rec, t_s, t_e = cmeasure_windows(0.25, 2.5, 2.0, 2.0, 40.0, 1.0)

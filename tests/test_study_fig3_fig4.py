@@ -156,7 +156,7 @@ def test_snapshot_grid_pieces():
     np.testing.assert_array_equal(g, [0, 0.5, 1, 1.5, 2, 3, 6, 9])
     with pytest.raises(ValueError, match="increasing"):
         snapshot_grid([[0, 2, 0.5], [1, 3, 1]])
-    from hhscatter.studies.fig4 import raw_key
+    from hhscatter.studies.fig4.study import raw_key
 
     assert [raw_key(g) for g in (0, 0.001, 0.01, 2e-2)] == ["gamma0", "gamma0.001", "gamma0.01", "gamma0.02"]
 

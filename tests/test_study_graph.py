@@ -101,17 +101,14 @@ def test_report_and_docs_nav_list_the_study_folders():
     from test_docs import _load
 
     hook = _load(spec_path, "hh_docs_hook_graph")
-    nav = hook.study_nav(ROOT)
-    assert nav[0] == "studies/index.md"
-    assert [next(iter(d.values())) for d in nav[1:]] == [f"studies/{s.name}.md" for s in graph.studies(STUDIES)]
+    nav = hook.study_pages(ROOT)
+    assert [next(iter(d.values())) for d in nav] == [f"studies/{s.name}.md" for s in graph.studies(STUDIES)]
+    assert [next(iter(d)) for d in nav] == [s.title for s in graph.studies(STUDIES)]
 
 
 def _study_code(name: str) -> list[Path]:
-    """The Python files of one study: its folder's modules (and the package modules named after it)."""
-    files = sorted((STUDIES / name).glob("*.py"))
-    files += [p for p in (ROOT / "hhscatter" / "studies" / f"{name}.py", ROOT / "hhscatter" / "plotting" / f"{name}.py")
-              if p.exists()]
-    return files
+    """The Python files of one study: the modules of its folder (hhscatter.studies.<name>.*)."""
+    return sorted((STUDIES / name).glob("*.py"))
 
 
 def _imported_modules(path: Path, package: str) -> set[str]:
@@ -138,9 +135,10 @@ def test_no_study_imports_another_or_reads_its_raw_runs():
     names = [s.name for s in graph.studies(STUDIES)]
     for name in names:
         others = [o for o in names if o != name]
-        for path in _study_code(name):
-            package = "hhscatter.plotting" if path.parent.name == "plotting" else "hhscatter.studies"
-            mods = _imported_modules(path, package)
+        files = _study_code(name)
+        assert files, f"studies/{name} has no modules"
+        for path in files:
+            mods = _imported_modules(path, f"hhscatter.studies.{name}")
             bad = {m for m in mods for o in others
                    if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m) or m.endswith(f"studies.{o}")}
             assert not bad, f"{path.relative_to(ROOT)} imports another study: {sorted(bad)}"
@@ -148,3 +146,18 @@ def test_no_study_imports_another_or_reads_its_raw_runs():
             # other studies are reached through their published outputs only (_upstream.numbers / table)
             assert "load_study(" not in text, path
     assert not hasattr(_upstream, "raw_dir")
+
+
+def test_a_study_is_one_folder():
+    """Everything a study is lives in studies/<name>/: parameters, stages, figure code and docs page."""
+    from hhscatter.studies import stage_module
+
+    for s in graph.studies(STUDIES):
+        folder = STUDIES / s.name
+        assert {"study.toml", "study.py", "figure.py", "page.md"} <= {p.name for p in folder.iterdir()}, s.name
+        mod = stage_module(s.name)
+        assert Path(mod.__file__) == folder / "study.py"
+        assert all(callable(getattr(mod, st)) for st in ("simulate", "analyze", "plot"))
+        assert not (ROOT / "hhscatter" / "studies" / f"{s.name}.py").exists()
+        assert not (ROOT / "hhscatter" / "plotting" / f"{s.name}.py").exists()
+        assert not (ROOT / "docs" / "studies" / f"{s.name}.md").exists()

@@ -194,11 +194,11 @@ class Renderer:
         return "\n".join(out)
 
     def study_module(self, name: str) -> str:
-        mod = self.root / "hhscatter" / "studies" / f"{name}.py"
+        mod = self.root / "studies" / name / "study.py"
         if not mod.exists():
-            return self.missing(f"The module `hhscatter.studies.{name}`", "It has not been added yet.")
+            return self.missing(f"The module `studies/{name}/study.py`", "It has not been added yet.")
         return (
-            f"::: hhscatter.studies.{name}\n"
+            f"::: studies.{name}.study\n"
             "    options:\n"
             "      show_root_heading: false\n"
             "      show_root_toc_entry: false\n"
@@ -420,20 +420,32 @@ def cli_reference(parser) -> str:
 STUDIES_NAV = "Studies"
 
 
-def study_nav(root: Path) -> list:
-    """The nav of the Studies section: its index page, then one page per study folder (dependency order)."""
+def study_pages(root: Path) -> list:
+    """Nav entries {title: 'studies/<name>.md'}, one per study folder of ``root/studies`` (dependency order)."""
     from hhscatter.studies.graph import studies
 
-    return ["studies/index.md", *({s.title: f"studies/{s.name}.md"} for s in studies(root / "studies"))]
+    return [{s.title: f"studies/{s.name}.md"} for s in studies(root / "studies")]
 
 
 def on_config(config, **kwargs):
-    """Fill the nav's Studies section from the study folders (mkdocs.yml lists only its index page)."""
+    """Fill the nav's Studies section from the study folders (mkdocs.yml lists only its index pages)."""
     root = Path(config["config_file_path"]).resolve().parent
     for item in config["nav"] or []:
         if isinstance(item, dict) and STUDIES_NAV in item:
-            item[STUDIES_NAV] = study_nav(root)
+            item[STUDIES_NAV] = [*item[STUDIES_NAV], *study_pages(root)]
+    config["watch"] = [*config.get("watch", []), str(root / "studies")]  # `make docs-serve` sees page.md edits
     return config
+
+
+def on_files(files, config, **kwargs):
+    """Each study's page text lives in its folder (studies/<name>/page.md); it is served as studies/<name>.md."""
+    from mkdocs.structure.files import File
+
+    root = Path(config["config_file_path"]).resolve().parent
+    for page in sorted((root / "studies").glob("*/page.md")):
+        if (page.parent / "study.toml").exists():
+            files.append(File.generated(config, f"studies/{page.parent.name}.md", abs_src_path=str(page)))
+    return files
 
 
 def on_page_markdown(markdown, page, config, files, **kwargs):

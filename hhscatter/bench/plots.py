@@ -14,9 +14,9 @@ def plot_workprecision(csv_path, png_path):
     """
     import pandas as pd
 
-    from ..plotting import _pyplot
+    from ..plotting import agg_pyplot
 
-    plt = _pyplot()
+    plt = agg_pyplot()
     df = pd.read_csv(csv_path)
     scenes = list(dict.fromkeys(df.scene))
     fig, axes = plt.subplots(2, len(scenes), figsize=(6.2 * len(scenes), 8.5), squeeze=False)
@@ -57,9 +57,9 @@ def plot_energy_drift(csv_path, png_path):
     """plot_energy_drift(csv, png) -> png path: max relative energy error vs t per tolerance (log–log)."""
     import pandas as pd
 
-    from ..plotting import _pyplot
+    from ..plotting import agg_pyplot
 
-    plt = _pyplot()
+    plt = agg_pyplot()
     df = pd.read_csv(csv_path)
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for tol, g in df.groupby("tol"):

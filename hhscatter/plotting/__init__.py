@@ -1,4 +1,5 @@
-"""Figures of the studies. Plot functions draw what they are given and compute nothing.
+"""What the studies' figures share. Each study draws its figure in its own folder (``studies/<name>/figure.py``);
+plot functions draw what they are given and compute nothing.
 
 These write files from the ``study … plot`` stage (Agg backend). To draw on
 your own axes in a notebook use :func:`hhscatter.plot_survival` and
@@ -7,7 +8,8 @@ your own axes in a notebook use :func:`hhscatter.plot_survival` and
 from __future__ import annotations
 
 
-def _pyplot():
+def agg_pyplot():
+    """agg_pyplot() -> matplotlib.pyplot with the file-writing Agg backend selected."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -1,8 +1,16 @@
 """Studies: one per figure of the reference paper (and the checks beyond it).
 
-A study is a folder ``studies/<name>/`` whose ``study.toml`` is the one place
-its parameters live, and a module ``hhscatter.studies.<name>`` with three
-stages that make runs as separate targets:
+A study is one folder ``studies/<name>/`` (adding a study is making a folder):
+
+``study.toml``  its parameters, the one place they live, with ``[about]`` (what it
+                is) and ``[needs]`` (the studies whose published outputs it reads:
+                the one declared dependency graph, :mod:`hhscatter.studies.graph`);
+``study.py``    its three stages (the module ``hhscatter.studies.<name>.study``: the
+                study folders are subpackages of this package);
+``figure.py``   its figure code; ``page.md`` its page of the docs;
+``out/<scale>/`` what it makes.
+
+The stages make runs as separate targets:
 
 ``simulate(study, workers)``
     integrates the study's scenes into immutable raw run directories
@@ -10,6 +18,8 @@ stages that make runs as separate targets:
 ``analyze(study)``
     turns raw tables into derived tables under ``.../derived/`` and the study's
     numbers ``.../<name>.json`` with the pure functions of :mod:`hhscatter.analysis`;
+    other studies' outputs are read only as published (their JSON and derived
+    tables, :mod:`hhscatter.studies._upstream`), never their raw runs or code;
 ``plot(study)``
     draws ``.../<name>.png`` from the derived tables only (it computes nothing).
 
@@ -50,6 +60,9 @@ def studies_root() -> Path:
     if env:
         return Path(env)
     return Path(__file__).resolve().parents[2] / "studies"
+
+
+_OWN_MODULES = ("graph", "_upstream")
 
 
 def study_names(root: Path | None = None) -> list[str]:
@@ -270,10 +283,29 @@ def missing_upstream(study: Study) -> list[str]:
     return out
 
 
-def stage_module(name: str):
+def _add_to_path(root: Path) -> None:
+    """Make the study folders of ``root`` importable as ``hhscatter.studies.<name>`` (after the repository's)."""
+    r = str(Path(root).resolve())
+    if r not in __path__:
+        __path__.append(r)
+
+
+def stage_module(name: str, root: Path | None = None):
+    """stage_module(name, root=None) -> the module ``studies/<name>/study.py`` (``hhscatter.studies.<name>.study``).
+
+    A study folder is a namespace package inside ``hhscatter.studies`` (this
+    package's ``__path__`` holds the studies root), so its modules import each
+    other relatively (``from .figure import …``) and the library absolutely.
+    The repository's study folders come first; a folder that exists only in
+    ``root`` is found there.
+    """
     import importlib
 
-    return importlib.import_module(f"hhscatter.studies.{name}")
+    if name in _OWN_MODULES:
+        raise SceneError(f"a study cannot be named {name!r}: hhscatter.studies.{name} is part of the framework")
+    if root is not None:
+        _add_to_path(root)
+    return importlib.import_module(f"hhscatter.studies.{name}.study")
 
 
 def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
@@ -282,7 +314,7 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
     if stage not in (*STAGES, "all"):
         raise SceneError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
     study = load_study(name, scale, root=root)
-    mod = stage_module(name)
+    mod = stage_module(name, root)
     stages = STAGES if stage == "all" else (stage,)
     for st in stages:
         study.comparisons = []
@@ -308,3 +340,7 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
             matplotlib.use("Agg")
             mod.plot(study)
             print(f"{name} plot: wrote {study.figure_path}", flush=True)
+
+
+# the study folders are subpackages of this package: studies/<name>/study.py is hhscatter.studies.<name>.study
+_add_to_path(studies_root())

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
@@ -31,7 +31,7 @@ def plot_resc(kappa, returns, channels, lyapunov, path, *, r_ref=1.03, scale="")
     r_ref with the 1/3 of the three-fold symmetry.  Inputs are the study's
     derived tables (pandas DataFrames).
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     energies = sorted(kappa.energy.unique())
     radii = sorted(kappa.r_esc.unique())
     col = {E: COLORS[i % len(COLORS)] for i, E in enumerate(energies)}

@@ -29,7 +29,7 @@ parameters in ``studies/fig2/study.toml``.
     E_b, τ*.
 
 ``plot(study)``
-    ``fig2.png`` via :func:`hhscatter.plotting.fig2.plot_fig2`.
+    ``fig2.png`` via ``plot_fig2`` of the folder's ``figure.py``.
 """
 from __future__ import annotations
 
@@ -39,8 +39,8 @@ import warnings
 
 import numpy as np
 
-from ..model import HenonHeiles
-from ..runner import SCENE_FILE
+from hhscatter.model import HenonHeiles
+from hhscatter.runner import SCENE_FILE
 
 E_C = HenonHeiles().critical_energy
 PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
@@ -84,14 +84,14 @@ def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds
 # simulate
 # ---------------------------------------------------------------------------
 def _lifetimes(path):
-    from ..tables import read_lifetimes
+    from hhscatter.tables import read_lifetimes
 
     return read_lifetimes(path, columns=LIFETIME_COLUMNS)
 
 
 def _t_max_choice(study, pilot_dir):
-    from ..analysis.escape_rate import choose_t_max
-    from ..analysis.survival import lifetimes_to_arrays
+    from hhscatter.analysis.escape_rate import choose_t_max
+    from hhscatter.analysis.survival import lifetimes_to_arrays
 
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
     return choose_t_max(
@@ -104,7 +104,7 @@ def _t_max_choice(study, pilot_dir):
 
 
 def _grid_rate(study, energy):
-    from ..analysis.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
 
     return escape_rate_from_lifetimes(_lifetimes(study.raw(grid_key(energy))), detect_tail=False,
                                       min_survivors=float(study.param("min_survivors")))
@@ -130,7 +130,7 @@ def simulate(study, workers=None, progress=True):
     """
     from dataclasses import asdict
 
-    from . import write_json_atomic
+    from hhscatter.studies import write_json_atomic
 
     choices = {"t_max": {}, "cmeasure": {}}
     grid = [float(e) for e in study.param("grid_energies")]
@@ -182,7 +182,7 @@ def _plot_grid(t_last, n_lin=4001, n_log=600):
 def _analyze_grid(study):
     import pandas as pd
 
-    from ..analysis.escape_rate import fit_kappa_energy
+    from hhscatter.analysis.escape_rate import fit_kappa_energy
 
     rows = []
     tmax_choices = json.loads(_choices_path(study).read_text())["t_max"]
@@ -255,12 +255,12 @@ def _fit_curve_table(fit, sep, x_max):
 def _analyze_pt(study):
     import pandas as pd
 
-    from ..analysis.escape_rate import (
+    from hhscatter.analysis.escape_rate import (
         escape_rate,
         escaping_tail,
         power_law_exponent_mle,
     )
-    from ..analysis.survival import lifetimes_to_arrays, survival_curve
+    from hhscatter.analysis.survival import lifetimes_to_arrays, survival_curve
 
     curves, lines, numbers = [], [], {}
     for energy in study.param("pt_energies"):
@@ -340,12 +340,12 @@ def _analyze_pt(study):
 def _analyze_cmeasure(study, grid_df):
     import pandas as pd
 
-    from ..analysis.escape_rate import (
+    from hhscatter.analysis.escape_rate import (
         cmeasure_sample_from_sections,
         escape_rate_from_lifetimes,
         kappa_from_cmeasure,
     )
-    from ..tables import read_sections
+    from hhscatter.tables import read_sections
 
     rows = []
     n_boot = int(study.param("n_boot"))
@@ -458,7 +458,7 @@ def plot(study):
     """plot(study) -> None; draws fig2.png from the derived tables and fig2.json."""
     import pandas as pd
 
-    from ..plotting.fig2 import plot_fig2
+    from .figure import plot_fig2
 
     d = study.out / "derived"
     plot_fig2(

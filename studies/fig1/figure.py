@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 # paper's colours: E = 0.35 orange, E = 0.30 black
 POINT_COLOURS = {"E0.35": "tab:orange", "E0.30": "black"}
@@ -23,7 +23,7 @@ def plot_fig1(grid, points, numbers, path):
     DataFrame energy, x, y (c-measure samples); ``numbers``: fig1.json
     (contour_levels, E_c, saddles, energies{key: t_rec, n_points, kappa_used}).
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     from matplotlib.lines import Line2D
 
     xs, ys, V = _grid_arrays(grid)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 PT_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
 
@@ -130,7 +130,7 @@ def plot_fig2(curves, lines, kappa_e, fit_curve, cm, numbers, path):
     Inputs are fig2's derived tables (survival_curves, pt_fit_lines,
     kappa_energy, kappa_fit_curve, kappa_cmeasure) and fig2.json.
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(7.0, 10.0), constrained_layout=True)
     _panel_a(axes[0], curves, lines, numbers)
     _panel_b(axes[1], kappa_e, fit_curve, cm, numbers)

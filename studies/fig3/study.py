@@ -35,7 +35,7 @@ import json
 import numpy as np
 import pandas as pd
 
-from ..analysis.decay import snapshot_grid
+from hhscatter.analysis.decay import snapshot_grid
 
 
 def _key(study) -> str:
@@ -55,7 +55,7 @@ def simulate(study, workers=None, progress=True):
 
 def _snapshot_rows(study, key: str, filters=None) -> pd.DataFrame:
     """Snapshot rows (traj_id, t, energy) of orbits not escaped; ``filters`` pushed down to the reader."""
-    from ..tables import read_snapshots
+    from hhscatter.tables import read_snapshots
 
     return read_snapshots(study.raw(key), filters=filters)
 
@@ -64,14 +64,14 @@ def analyze(study):
     """analyze(study) -> None: ⟨E⟩(t), μ fits (+ bootstrap), later windows, histograms, fig3.json."""
     import pyarrow.dataset as ds
 
-    from ..analysis.decay import (
+    from hhscatter.analysis.decay import (
         bootstrap_mu_first_orbits,
         energy_histograms,
         fit_energy_decay,
         inside_mean_energy,
         mu_by_window,
     )
-    from ..tables import iter_parts, read_lifetimes
+    from hhscatter.tables import iter_parts, read_lifetimes
 
     key = _key(study)
     scene = study.scene(key)
@@ -198,7 +198,7 @@ def _nearest(grid, times):
 
 def plot(study):
     """plot(study) -> None: fig3.png from the derived tables and fig3.json."""
-    from ..plotting.fig3 import plot_fig3
+    from .figure import plot_fig3
 
     me = pd.read_parquet(study.derived("fig3_mean_energy.parquet"))
     tab = pd.read_parquet(study.derived("fig3_mu_windows.parquet"))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 RED = "#c0392b"
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#17becf"]
@@ -61,7 +61,7 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     noise floor vs box side at the paper's γ; (d) the same for Fig. 5a against
     μ_c^{E1} at every γ with the agreement scales ε*.
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     E1, E2, g0 = float(nums["E1"]), float(nums["E2"]), float(nums["gamma_main"])
     band = nums["band"]
     per_gamma = {float(r["gamma"]): r for r in nums["per_gamma"]}

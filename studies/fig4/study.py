@@ -44,8 +44,8 @@ import json
 import numpy as np
 import pandas as pd
 
-from ..analysis.decay import snapshot_grid
-from . import _upstream as up
+from hhscatter.analysis.decay import snapshot_grid
+from hhscatter.studies import _upstream as up
 
 LIFETIMES_TABLE = "fig4_lifetimes.parquet"  # published: other studies read it (derived/), never the raw runs
 
@@ -79,7 +79,7 @@ def simulate(study, workers=None, progress=True):
 
 
 def _tau0_rule(grid, P0, n):
-    from ..analysis.escape_rate import choose_windows
+    from hhscatter.analysis.escape_rate import choose_windows
 
     return choose_windows(grid, P0, n_total=n).tau0
 
@@ -93,9 +93,9 @@ def analyze(study):
     """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
     import pyarrow.dataset as ds
 
-    from ..analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
-    from ..analysis.survival import observed_from_outcome, survival_from_lifetimes
-    from ..analysis.transitions import (
+    from hhscatter.analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
+    from hhscatter.analysis.survival import observed_from_outcome, survival_from_lifetimes
+    from hhscatter.analysis.transitions import (
         bootstrap_transition_times,
         settle_time_quantiles,
         survival_on_grid,
@@ -103,7 +103,7 @@ def analyze(study):
         tau2_observed,
         tau2_predicted,
     )
-    from ..tables import iter_parts, read_lifetimes, read_snapshots
+    from hhscatter.tables import iter_parts, read_lifetimes, read_snapshots
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
@@ -327,7 +327,7 @@ def _gamma_exponent(gamma, tau, tau_err):
 
 def plot(study):
     """plot(study) -> None: fig4.png from the derived tables and fig4.json."""
-    from ..plotting.fig4 import plot_fig4
+    from .figure import plot_fig4
 
     surv = pd.read_parquet(study.derived("fig4_survival.parquet"))
     ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))

@@ -63,9 +63,9 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..analysis import distance as dist
-from ..analysis.model import time_to_energy
-from . import _upstream as up
+from hhscatter.analysis import distance as dist
+from hhscatter.analysis.model import time_to_energy
+from hhscatter.studies import _upstream as up
 
 PAPER_T_STAR = 17.0
 PAPER_MU = 0.91
@@ -134,7 +134,7 @@ def _cap(df, n_cap, seed):
 
 def analyze(study):
     """analyze(study) -> None; writes derived tables (points, distances) and fig5.json."""
-    from ..tables import read_lifetimes, read_sections
+    from hhscatter.tables import read_lifetimes, read_sections
 
     inputs = {}
     E2 = float(study.config["scene"]["energy"])
@@ -351,7 +351,7 @@ def plot(study):
     """plot(study) -> None; Fig. 5 from the derived tables and fig5.json."""
     import pyarrow.parquet as pq
 
-    from ..plotting.fig5 import plot_fig5
+    from .figure import plot_fig5
 
     nums = study.read_numbers()
     read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()

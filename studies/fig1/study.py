@@ -23,7 +23,7 @@ Stages (``hhscatter study fig1 simulate|analyze|plot [--scale S]``):
     the κ and τ0 used, survivors at t_rec and the number of points.
 
 ``plot(study)``
-    ``fig1.png`` via :func:`hhscatter.plotting.fig1.plot_fig1`.
+    ``fig1.png`` via ``plot_fig1`` of the folder's ``figure.py``.
 
 c-measure sample for other studies (fig5): the conservative c-measure at
 E = 0.30 and 0.35 is published as the derived table ``cmeasure_points.parquet``
@@ -40,8 +40,8 @@ import math
 
 import numpy as np
 
-from ..model import HenonHeiles
-from ..runner import SCENE_FILE
+from hhscatter.model import HenonHeiles
+from hhscatter.runner import SCENE_FILE
 
 E_C = HenonHeiles().critical_energy
 CMEASURE_TABLE = "cmeasure_points.parquet"  # published: other studies read it (derived/), never the raw runs
@@ -66,8 +66,8 @@ def _pilot_scene(study, energy):
 
 def _pilot_rate(pilot_dir):
     """κ, τ0 (and the full EscapeRateResult) of a pilot run."""
-    from ..analysis.escape_rate import escape_rate_from_lifetimes
-    from ..tables import read_lifetimes
+    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.tables import read_lifetimes
 
     lt = read_lifetimes(pilot_dir, columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
     return escape_rate_from_lifetimes(lt, detect_tail=False)
@@ -100,7 +100,7 @@ def simulate(study, workers=None, progress=True):
 
     The κ, τ0 and t_rec actually used are written to ``raw/fig1_choices.json``.
     """
-    from . import write_json_atomic
+    from hhscatter.studies import write_json_atomic
 
     choices = {}
     for energy in study.param("energies"):
@@ -126,8 +126,8 @@ def analyze(study):
     """analyze(study) -> None; writes cmeasure_points.parquet, potential_grid.parquet and fig1.json."""
     import pandas as pd
 
-    from ..analysis.escape_rate import escape_rate_from_lifetimes
-    from ..tables import read_lifetimes, read_sections
+    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.tables import read_lifetimes, read_sections
 
     model = HenonHeiles()
     rec_efolds = float(study.param("rec_efolds"))
@@ -210,7 +210,7 @@ def plot(study):
     """plot(study) -> None; draws fig1.png from the derived tables and fig1.json."""
     import pandas as pd
 
-    from ..plotting.fig1 import plot_fig1
+    from .figure import plot_fig1
 
     numbers = study.read_numbers()
     grid = pd.read_parquet(study.out / "derived" / "potential_grid.parquet")

@@ -64,7 +64,7 @@ def _follow_radii(study):
 def _follow_scene(study, E):
     """The first n_follow orbits of the (E, r_ref) ensemble, followed past their escape (scene option
     ``follow``): every crossing of the follow radii, until r_far or t_max."""
-    from ..scene import Follow
+    from hhscatter.scene import Follow
 
     r_ref = float(study.param("r_ref"))
     base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
@@ -84,8 +84,8 @@ def simulate(study, workers=None, progress=True):
 # -- analyze ----------------------------------------------------------------
 def _lifetimes(study, E, r):
     """(traj_id, t_end, observed, exit_channel) arrays of run (E, r), sorted by traj_id (channel −1: none)."""
-    from ..analysis.survival import lifetimes_to_arrays
-    from ..tables import read_lifetimes
+    from hhscatter.analysis.survival import lifetimes_to_arrays
+    from hhscatter.tables import read_lifetimes
 
     lt = read_lifetimes(study.raw(_key(E, r)), columns=["traj_id", "outcome", "t_end", "exit_channel"])
     lt = lt.sort_values("traj_id", kind="stable").reset_index(drop=True)
@@ -99,7 +99,7 @@ def analyze(study):
     """analyze(study) -> None: derived tables and resc.json (see the module docstring)."""
     import warnings
 
-    from ..analysis.escape_check import (
+    from hhscatter.analysis.escape_check import (
         channel_fractions,
         lyapunov_orbit,
         paired_mle_shift,
@@ -107,9 +107,9 @@ def analyze(study):
         survival_ratio_slope,
         wilson_interval,
     )
-    from ..analysis.escape_rate import escape_rate, escape_rate_mle
-    from ..analysis.survival import survival_curve
-    from ..tables import read_crossings, read_lifetimes
+    from hhscatter.analysis.escape_rate import escape_rate, escape_rate_mle
+    from hhscatter.analysis.survival import survival_curve
+    from hhscatter.tables import read_crossings, read_lifetimes
 
     energies, radii = _grid(study)
     r_ref = float(study.param("r_ref"))
@@ -346,7 +346,7 @@ def _recommend(kap, ret, lyap, r_ref):
 # -- plot -------------------------------------------------------------------
 def plot(study):
     """plot(study) -> None: resc.png from the derived tables."""
-    from ..plotting.resc import plot_resc
+    from .figure import plot_resc
 
     d = study.out / "derived"
     plot_resc(

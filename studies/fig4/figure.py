@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294",
                 0.02: "#d62728"}
@@ -40,7 +40,7 @@ def plot_fig4(surv, ratio, taus, numbers, path, *, mark_gamma=0.01):
     are marked.  (b) P_γ/P_0 with the threshold α; dots at τ1 (open dots
     where N·P_0(τ1) is below the resolution threshold).
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     gammas = sorted(surv["gamma"].unique())
     col = _colors(gammas)
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11.5, 4.6), width_ratios=[1.35, 1], constrained_layout=True)

@@ -41,10 +41,10 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..analysis import model as mdl
-from ..analysis.survival import survival_from_lifetimes
-from ..analysis.transitions import tau2_observed, tau2_predicted
-from . import _upstream as up
+from hhscatter.analysis import model as mdl
+from hhscatter.analysis.survival import survival_from_lifetimes
+from hhscatter.analysis.transitions import tau2_observed, tau2_predicted
+from hhscatter.studies import _upstream as up
 
 PAPER_KAPPA = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27}
 PAPER_MU = 0.91
@@ -187,7 +187,7 @@ def analyze(study):
     """analyze(study) -> None; model fits, τ predictions, derived tables and fig6.json."""
     import pyarrow.dataset as pads
 
-    from ..tables import read_lifetimes, read_snapshots
+    from hhscatter.tables import read_lifetimes, read_snapshots
 
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
     hazards = list(study.param("hazards"))
@@ -294,7 +294,7 @@ def analyze(study):
 
 def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_dt, min_count):
     """Panel (b): observed τ1, τ2 from fig4's table; model τ1 from fits to fig4's P(t); τ2 from Eq. (eq:tau2)."""
-    from ..tables import read_lifetimes
+    from hhscatter.tables import read_lifetimes
 
     E0 = float(study.param("fig4_E0"))
     other = study.upstream("tau")
@@ -386,7 +386,7 @@ def plot(study):
     """plot(study) -> None; Fig. 6 from the derived tables and fig6.json."""
     import pyarrow.parquet as pq
 
-    from ..plotting.fig6 import plot_fig6
+    from .figure import plot_fig6
 
     nums = study.read_numbers()
     read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()

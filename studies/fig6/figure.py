@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"]
 LS = {"paper": (0, (5, 2)), "integrated": (0, (1.5, 1.5))}
@@ -53,7 +53,7 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path):
     (c) the mixture model on the same data; (d) RMS of the log residuals per
     pair and model.
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     hazards = list(nums["config"]["study"].get("hazards", ["paper", "integrated"]))
     tau0 = float(nums["tau0"])
     fig, axs = plt.subplots(2, 2, figsize=(12, 10), constrained_layout=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _pyplot
+from hhscatter.plotting import agg_pyplot
 
 E_C = 1.0 / 6.0
 HIST_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")
@@ -24,7 +24,7 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     μ (free-intercept slope of log⟨E⟩ on sliding windows) against t, with
     the fitted μ on [0, 200], the paper's 0.91 and the linear-regime value 1.
     """
-    plt = _pyplot()
+    plt = agg_pyplot()
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(6.4, 7.4), height_ratios=[2.3, 1], sharex=True,
                                  constrained_layout=True)
     mu = numbers["mu"]["value"]
