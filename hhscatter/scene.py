@@ -28,6 +28,9 @@ class SceneError(ValueError):
 
 
 def _finite(name, value):
+    # a number, never text or a boolean ("0.3" would pass float() and fail deep inside the engine)
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise SceneError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -372,6 +375,9 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
         raise SceneError(f"scene file {path} is not valid TOML: {exc}") from None
     if "scene" not in doc:
         raise SceneError(f"scene file {path} has no [scene] table")
+    from .config import validate_scene_file
+
+    validate_scene_file(doc, str(path))  # every table, key and type, before any work
     d = dict(doc["scene"])
     d.setdefault("name", path.parent.name)
     if "sections" in doc:

@@ -159,6 +159,6 @@ def test_scene_toml_and_scales(tmp_path):
     with pytest.raises(SceneError, match="scale must be one of"):
         load_scene(p, scale="huge")
     p.write_text("[scene]\nenergy = 0.3\nn = 100\nbogus = 1\n")
-    with pytest.raises(SceneError, match="unknown scene keys"):
+    with pytest.raises(SceneError, match=r"\[scene\] unknown key .bogus.; allowed keys: batch_size"):
         load_scene(p)
     assert json.loads(sc.to_json())["sections"]["t_to"] == "inf"

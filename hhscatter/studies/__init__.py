@@ -49,6 +49,7 @@ from pathlib import Path
 
 from ..scene import Scene, SceneError, scene_from_dict
 from .graph import HEADER_TABLES, GraphError, StudyInfo, study_info
+from .graph import default_root as _graph_default_root
 
 STAGES = ("simulate", "analyze", "plot")
 DEFAULT_SCALE = "quick"
@@ -122,6 +123,7 @@ class Study:
     root: Path
     comparisons: list = field(default_factory=list)
     info: StudyInfo | None = None
+    params_model: type | None = None  # the study's Params (hhscatter.config.StudyParams) of its [study] table
 
     @property
     def needs(self) -> dict:
@@ -145,13 +147,33 @@ class Study:
         return self.config.get("study", {})
 
     def param(self, key, default=None):
-        """param(key, default=None) -> value of ``[study].key``; a missing key without default is an error."""
+        """param(key) -> value of ``[study].key`` as written in study.toml, else the default its ``Params`` declares.
+
+        A key the study's ``Params`` does not declare is an error (the study
+        file was checked against it when loaded, so this catches code that
+        reads a key under another name). Without ``Params``, ``default`` is
+        used and a missing key without default is an error.
+        """
         p = self.params
         if key in p:
             return p[key]
-        if default is None:
-            raise SceneError(f"{self.root / 'study.toml'}: [study] needs '{key}'")
-        return default
+        if self.params_model is not None:
+            f = self.params_model.model_fields.get(key)
+            if f is None:
+                raise SceneError(f"study {self.name} reads [study] {key!r}, which its Params does not declare")
+            if not f.is_required():
+                return copy.deepcopy(f.default)
+        elif default is not None:
+            return default
+        raise SceneError(f"{self.root / 'study.toml'}: [study] needs '{key}'")
+
+    @property
+    def model(self):
+        """The Hénon–Heiles model of the study's ``[scene]`` (ω, λ): E_c, saddles, potential."""
+        from ..model import HenonHeiles
+
+        sc = self.config.get("scene", {})
+        return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
         """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
@@ -255,6 +277,10 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
         doc = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path} is not valid TOML: {exc}") from None
+    params = _params_model(name, root)
+    from ..config import validate_study_file
+
+    validate_study_file(doc, _shown(path), params)  # every table, key and type, at every scale, before any work
     try:
         info = study_info(root, name, doc)
     except GraphError as exc:
@@ -266,7 +292,26 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
         if scale not in scales:
             raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
         doc = _merge(doc, scales[scale])
-    return Study(name=name, scale=scale, config=doc, root=root / name, info=info)
+    return Study(name=name, scale=scale, config=doc, root=root / name, info=info, params_model=params)
+
+
+def _shown(path: Path) -> str:
+    """A path as the user would type it: relative to the working directory when it lies below it."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def _params_model(name: str, root: Path):
+    """The ``Params`` model of the study's module (None: a study folder without code, or without Params)."""
+    try:
+        mod = stage_module(name, root)
+    except ModuleNotFoundError as exc:
+        if exc.name in (f"hhscatter.studies.{name}", f"hhscatter.studies.{name}.study"):
+            return None
+        raise
+    return getattr(mod, "Params", None)
 
 
 def missing_upstream(study: Study) -> list[str]:
@@ -343,4 +388,6 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
 
 
 # the study folders are subpackages of this package: studies/<name>/study.py is hhscatter.studies.<name>.study
+# (the repository's folders first, then those of HHSCATTER_STUDIES if it is set)
+_add_to_path(_graph_default_root())
 _add_to_path(studies_root())

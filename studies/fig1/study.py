@@ -40,8 +40,24 @@ import math
 
 import numpy as np
 
+from hhscatter.config import Integer, Number, Numbers, StudyParams
 from hhscatter.model import HenonHeiles
 from hhscatter.runner import SCENE_FILE
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig1/study.toml."""
+
+    energies: Numbers            # E of the main runs (c-measure samples)
+    pilot_n: Integer             # orbits of the pilot runs (κ, τ0 → t_rec)
+    pilot_seed: Integer
+    pilot_t_max: Number
+    rec_efolds: Number           # t_rec = ceil(τ0 + rec_efolds/κ)
+    t_after: Number              # main runs: t_max = t_rec + t_after
+    n_contours: Integer          # Fig. 1a contour levels k/(n+1)·0.5
+    grid_half_width: Number      # potential grid [-h, h]²
+    grid_points: Integer
+
 
 E_C = HenonHeiles().critical_energy
 CMEASURE_TABLE = "cmeasure_points.parquet"  # published: other studies read it (derived/), never the raw runs

@@ -39,8 +39,39 @@ import warnings
 
 import numpy as np
 
+from hhscatter.config import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.model import HenonHeiles
 from hhscatter.runner import SCENE_FILE
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig2/study.toml (rules in its header comment)."""
+
+    grid_energies: Numbers
+    grid_n: Integer
+    pilot_n: Integer
+    pilot_seed: Integer
+    pilot_t_max: Number
+    min_survivors: Number
+    margin_efolds: Number
+    t_max_min: Number
+    t_max_cap: Number
+    pt_energies: Numbers
+    pt_n: Integers
+    pt_seed: Integer
+    pt_t_max: Number
+    tail_min_survivors: Number
+    cm_energies: Numbers
+    cm_n: Integer
+    cm_seed: Integer
+    cm_t_max: Number
+    cm_rec_efolds: Number
+    cm_sample_efolds: Number
+    cm_margin: Number
+    cm_start_shifts: Numbers = [0.0]
+    n_boot: Integer
+    fit_seed: Integer
+
 
 E_C = HenonHeiles().critical_energy
 PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
@@ -112,7 +143,7 @@ def _grid_rate(study, energy):
 
 def _cm_windows(study, energy):
     r = _grid_rate(study, energy)
-    shifts = [float(v) for v in study.param("cm_start_shifts", [0.0])]
+    shifts = [float(v) for v in study.param("cm_start_shifts")]
     return r, cmeasure_windows(r.kappa, r.tau0, float(study.param("cm_rec_efolds")),
                                float(study.param("cm_sample_efolds")), float(study.param("cm_margin")),
                                max(shifts))

@@ -36,6 +36,23 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.decay import snapshot_grid
+from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig3/study.toml."""
+
+    snapshot_grid: NumberLists   # pieces [start, stop, step]
+    fit_window: Numbers          # [t_lo, t_hi] of the paper's μ fit
+    later_windows: NumberLists
+    sliding_window: Numbers      # [width, stride]
+    hist_times: Numbers
+    hist_bins: Integer
+    plot_t_max: Number = None    # time axis of the figure (None: the whole grid)
+    n_boot: Integer
+    n_boot_orbits: Integer
+    boot_seed: Integer
+    paper_mu: Number
 
 
 def _key(study) -> str:
@@ -76,7 +93,7 @@ def analyze(study):
     key = _key(study)
     scene = study.scene(key)
     E0, gamma = float(scene.energy), float(scene.gamma)
-    E_C = scene.model.critical_energy
+    E_C = study.model.critical_energy
     ime = inside_mean_energy(iter_parts(study.raw(key), "snapshots", ["t", "energy"]), E_C)
     me, ma, cont = ime.inside, ime.above, {"rows_below_ec": ime.rows_below_ec}
     lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"])
@@ -204,4 +221,4 @@ def plot(study):
     tab = pd.read_parquet(study.derived("fig3_mu_windows.parquet"))
     hist = pd.read_parquet(study.derived("fig3_histograms.parquet"))
     numbers = json.loads(study.numbers_path.read_text())
-    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.param("plot_t_max", None))
+    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.param("plot_t_max"))

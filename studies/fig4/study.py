@@ -45,7 +45,26 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.decay import snapshot_grid
+from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig4/study.toml."""
+
+    gammas: Numbers              # increasing, with 0 (the conservative reference)
+    mark_gamma: Number
+    alpha: Number
+    tau_grid_step: Number
+    min_ref_orbits: Number
+    mu_gamma: Number
+    snapshot_grid: NumberLists
+    mu_window: Numbers
+    paper_mu: Number
+    n_boot: Integer
+    n_boot_orbits: Integer
+    boot_seed: Integer
+
 
 LIFETIMES_TABLE = "fig4_lifetimes.parquet"  # published: other studies read it (derived/), never the raw runs
 
@@ -93,8 +112,15 @@ def analyze(study):
     """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
     import pyarrow.dataset as ds
 
-    from hhscatter.analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
-    from hhscatter.analysis.survival import observed_from_outcome, survival_from_lifetimes
+    from hhscatter.analysis.decay import (
+        bootstrap_mu_first_orbits,
+        fit_energy_decay,
+        inside_mean_energy,
+    )
+    from hhscatter.analysis.survival import (
+        observed_from_outcome,
+        survival_from_lifetimes,
+    )
     from hhscatter.analysis.transitions import (
         bootstrap_transition_times,
         settle_time_quantiles,
@@ -107,7 +133,7 @@ def analyze(study):
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
-    E_C = study.scene(raw_key(mg), gamma=mg).model.critical_energy
+    E_C = study.model.critical_energy
     alpha = float(study.param("alpha"))
     dt = float(study.param("tau_grid_step"))
     lts, ref = {}, None

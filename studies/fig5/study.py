@@ -65,7 +65,36 @@ import pandas as pd
 
 from hhscatter.analysis import distance as dist
 from hhscatter.analysis.model import time_to_energy
+from hhscatter.config import Integer, Number, Numbers, StudyParams, Text
 from hhscatter.studies import _upstream as up
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig5/study.toml."""
+
+    E1: Number
+    gammas: Numbers
+    gamma_main: Number
+    band: Numbers
+    mu_min: Number
+    mu_max: Number
+    section_pad: Number
+    mu_key: Text
+    t_rec_E1_key: Text
+    t_rec_E2_key: Text
+    extent: Numbers
+    boxes: Numbers
+    box_headline: Number
+    n_splits: Integer
+    n_boot: Integer
+    n_proj: Integer
+    z: Number
+    delta: Number
+    noise_max: Number
+    n_cap: Integer
+    m_min: Integer
+    seed: Integer
+
 
 PAPER_T_STAR = 17.0
 PAPER_MU = 0.91

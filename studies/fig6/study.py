@@ -44,7 +44,56 @@ import pandas as pd
 from hhscatter.analysis import model as mdl
 from hhscatter.analysis.survival import survival_from_lifetimes
 from hhscatter.analysis.transitions import tau2_observed, tau2_predicted
+from hhscatter.config import (
+    Bool,
+    Integer,
+    Number,
+    NumberLists,
+    NumberOr,
+    Numbers,
+    OneOf,
+    StudyParams,
+    Text,
+    Texts,
+)
 from hhscatter.studies import _upstream as up
+
+
+class Mixture(StudyParams):
+    """One entry of ``[study] mixtures``."""
+
+    name: Text
+    by: OneOf("energy", "rate")
+    t_ref: NumberOr("tau0")
+    fne_mode: OneOf("shared", "free")
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/fig6/study.toml."""
+
+    pairs: NumberLists           # [[E0, γ], ...]
+    dt: Number
+    fit_dt: Number
+    min_count: Number
+    hazards: Texts
+    fit_tau2: Bool = False
+    n_components: Integer
+    mixtures: list[Mixture]
+    mixture_fit_window: Numbers
+    mixture_plotted: Text = None
+    alpha: Number
+    kappa_a_key: Text
+    kappa_b_key: Text
+    kappa_c_key: Text
+    kappa_Eb_key: Text
+    mu_key: Text
+    tau0_key: Text
+    tau_table_key: Text
+    tau_gamma_field: Text
+    tau1_field: Text
+    tau2_field: Text
+    fig4_E0: Number
+
 
 PAPER_KAPPA = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27}
 PAPER_MU = 0.91
@@ -82,7 +131,7 @@ def _inputs(study):
     for name in ("a", "b", "c", "E_b"):
         key = study.param("kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
         kv[name], _ = up.value_or_fallback(study, ks, key, PAPER_KAPPA[name], inputs, f"kappa_{name}")
-    E_c = float(study.param("E_c"))
+    E_c = study.model.critical_energy  # E_c = ω⁶/(6λ²) of the scene's model
     kappa = mdl.PiecewiseKappa(a2=float(kv["a"]), a1=float(kv["b"]), slope=float(kv["c"]),
                                E_switch=float(kv["E_b"]), E_c=E_c)
     mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
@@ -193,7 +242,7 @@ def analyze(study):
     hazards = list(study.param("hazards"))
     dt, fit_dt = float(study.param("dt")), float(study.param("fit_dt"))
     min_count = float(study.param("min_count"))
-    fit_tau2 = bool(study.param("fit_tau2", False))
+    fit_tau2 = bool(study.param("fit_tau2"))
     K = int(study.param("n_components"))
     mixtures = _mixture_variants(study)
     w_hi = float(study.param("mixture_fit_window")[1])

@@ -41,6 +41,24 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.config import Integer, Number, Numbers, StudyParams
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/resc/study.toml."""
+
+    energies: Numbers
+    r_esc: Numbers
+    r_ref: Number
+    r_in: Number = 1.0
+    r_far: Number = 10.0
+    n_follow: Integer
+    z: Number = 1.0
+    p_start: Number = 0.1
+    n_groups: Integer = 16
+    reesc_fast: Number = 10.0
+    lyapunov_energies: Numbers = []
+
 
 # -- keys -------------------------------------------------------------------
 def _key(E, r):
@@ -57,7 +75,7 @@ def _grid(study):
 
 def _follow_radii(study):
     _, radii = _grid(study)
-    return tuple(sorted({float(study.param("r_in", 1.0)), *radii}))
+    return tuple(sorted({float(study.param("r_in")), *radii}))
 
 
 # -- simulate ---------------------------------------------------------------
@@ -69,7 +87,7 @@ def _follow_scene(study, E):
     r_ref = float(study.param("r_ref"))
     base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
     return study.scene(_follow_key(E), energy=E, r_esc=r_ref, n=min(int(study.param("n_follow")), base.n),
-                       r_far=float(study.param("r_far", 10.0)), follow=Follow(_follow_radii(study)))
+                       r_far=float(study.param("r_far")), follow=Follow(_follow_radii(study)))
 
 
 def simulate(study, workers=None, progress=True):
@@ -115,11 +133,11 @@ def analyze(study):
     r_ref = float(study.param("r_ref"))
     if r_ref not in radii:
         raise ValueError(f"[study] r_ref = {r_ref} must be one of r_esc = {radii}")
-    r_in = float(study.param("r_in", 1.0))
-    z = float(study.param("z", 1.0))
-    fast = float(study.param("reesc_fast", 10.0))
+    r_in = float(study.param("r_in"))
+    z = float(study.param("z"))
+    fast = float(study.param("reesc_fast"))
 
-    lyap_E = sorted({*map(float, study.param("lyapunov_energies", [])), *energies})
+    lyap_E = sorted({*map(float, study.param("lyapunov_energies")), *energies})
     lyap_rows = []
     for E in lyap_E:
         L = lyapunov_orbit(E)
@@ -160,7 +178,7 @@ def analyze(study):
         # no earlier than where the reference P(t) has fallen to p_start: a prompt-escape
         # transient inside the window (hazard peak at t ≈ 5, ringing for a few periods) would be
         # shifted in or out by the flight time and masquerade as a κ shift
-        p_start = float(study.param("p_start", 0.1))
+        p_start = float(study.param("p_start"))
         below = np.flatnonzero(curves[r_ref].P <= p_start)
         t_p = float(grid[below[0]]) if below.size else 0.0
         tau0s = [own[r].tau0 for r in radii if own[r] is not None]
@@ -191,7 +209,7 @@ def analyze(study):
             ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
             mle = escape_rate_mle(t_alt, obs_alt, *win)
             rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win,
-                                       n_groups=int(study.param("n_groups", 16)))
+                                       n_groups=int(study.param("n_groups")))
             # delay of P(t) at the window start: log(P_alt/P_ref)(t_lo)/κ_ref (the flight time, plus the
             # premature escapes of r_ref accumulated up to t_lo)
             tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
@@ -208,7 +226,7 @@ def analyze(study):
                 tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], ends.t_end.to_numpy())
                 try:
                     rf = survival_ratio_slope(tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]),
-                                              win, n_groups=int(study.param("n_groups", 16)))
+                                              win, n_groups=int(study.param("n_groups")))
                     fol = rf.shift, rf.shift_err
                 except ValueError:
                     pass

@@ -1,0 +1,208 @@
+"""Strict configuration (hhscatter.config): every bad table, key or value type of a study.toml or scene file
+exits with status 2 and one exact message before any work, and the checks change no scene's result_hash."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from hhscatter.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = "f701897"  # main before the strict configuration (and the study rooms) of issue 12
+
+
+def _files(root: Path) -> list[str]:
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*"))
+
+
+def _study_root(tmp_path: Path, name: str, edit) -> Path:
+    """A studies root with the study's study.toml, changed by ``edit(text) -> text``."""
+    root = tmp_path / "studies"
+    (root / name).mkdir(parents=True)
+    text = (ROOT / "studies" / name / "study.toml").read_text()
+    new = edit(text)
+    assert new != text, "the edit did not apply"
+    (root / name / "study.toml").write_text(new)
+    return root
+
+
+def _run_study(root: Path, name: str, capsys, monkeypatch, tmp_path) -> tuple[int, str]:
+    monkeypatch.setenv("HHSCATTER_STUDIES", str(root))
+    monkeypatch.chdir(tmp_path)
+    before = _files(tmp_path)
+    rc = main(["study", name, "simulate", "--scale", "tiny", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert _files(tmp_path) == before, "a refused configuration left files behind"
+    assert "Traceback" not in err
+    return rc, err.strip()
+
+
+BAD_STUDY_FILES = [
+    # (study, edit of its study.toml, exact message after "hhscatter: error: studies/<study>/study.toml: ")
+    ("fig1", lambda t: t + '\n[sections]\nfirst_only = "no"\n',
+     "[sections] first_only must be true or false, got 'no'"),
+    ("fig3", lambda t: t.replace("seed = 2026 ", "seed = true ", 1),
+     "[scene] seed must be an integer, got true"),
+    ("fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1),
+     "[scene] energy must be a number, got '0.3'"),
+    ("fig6", lambda t: t.replace("[snapshots]", "[snapshot]", 1),
+     "unknown table [snapshot]; allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
+     "[snapshots], [study]"),
+    ("fig3", lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
+     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot'; allowed keys: boot_seed, "
+     "fit_window, hist_bins, hist_times, later_windows, n_boot, n_boot_orbits, paper_mu, plot_t_max, "
+     "sliding_window, snapshot_grid"),
+    ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
+     "[scale.tiny.scene] unknown key 'chunk'; allowed keys: batch_size, chunk_size, continue_settled, energy, "
+     "gamma, ics, lam, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
+    ("fig6", lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
+     "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'"),
+    ("resc", lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
+     "[scale.tiny.study] n_follow must be an integer, got '300'"),
+    ("fig5", lambda t: t.replace('summary = ', 'summry = ', 1),
+     "[about] unknown key 'summry'; allowed keys: paper, summary, title"),
+    ("fig4", lambda t: t.replace("\nmu_gamma = 0.01", "\n", 1),
+     "[study] needs 'mu_gamma'"),
+]
+
+
+@pytest.mark.parametrize("name, edit, message", BAD_STUDY_FILES)
+def test_bad_study_file_exits_2_with_its_exact_message(name, edit, message, tmp_path, capsys, monkeypatch):
+    root = _study_root(tmp_path, name, edit)
+    rc, err = _run_study(root, name, capsys, monkeypatch, tmp_path)
+    assert rc == 2
+    assert err == f"hhscatter: error: studies/{name}/study.toml: {message}"
+
+
+def test_every_problem_of_a_file_is_named_once(tmp_path, capsys, monkeypatch):
+    root = _study_root(tmp_path, "fig3", lambda t: t.replace("seed = 2026 ", "seed = true ", 1)
+                       .replace("tol = 1e-15", "tol = 1e-15\nt_mx = 3", 1))
+    rc, err = _run_study(root, "fig3", capsys, monkeypatch, tmp_path)
+    assert rc == 2
+    lines = err.splitlines()
+    assert len(lines) == 2
+    assert lines[0] == "hhscatter: error: studies/fig3/study.toml: [scene] seed must be an integer, got true"
+    assert lines[1].startswith("studies/fig3/study.toml: [scene] unknown key 't_mx'; allowed keys: batch_size")
+
+
+BAD_SCENE_FILES = [
+    ("[scene]\nenergy = 0.3\nn = 40\n[sections]\nfirst_only = \"no\"\n",
+     "[sections] first_only must be true or false, got 'no'"),
+    ("[scene]\nenergy = 0.3\nn = 40\nseed = true\n", "[scene] seed must be an integer, got true"),
+    ("[scene]\nenergy = \"0.3\"\nn = 40\n", "[scene] energy must be a number or a list of numbers, got '0.3'"),
+    ("[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
+     "unknown table [snapshot]; allowed tables: [follow], [scale], [scene], [sections], [snapshots]"),
+    ("[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",
+     "[snapshots] needs 'times' or all of start, stop and step"),
+    ("[scene]\nenergy = [0.3, 0.35]\nn = 40\ngamma = [0, true]\n",
+     "[scene] gamma must be a number or a list of numbers, got [0, true]"),
+    ("[scene]\nenergy = 0.3\nn = 40\n[scale.paper]\nn = 1e7\n", "[scale.paper] n must be an integer, got 10000000.0"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD_SCENE_FILES)
+def test_bad_scene_file_exits_2_with_its_exact_message(text, message, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scene.toml").write_text(text)
+    before = _files(tmp_path)
+    rc = main(["simulate", "scene.toml", "--out", "run", "--workers", "1"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err == f"hhscatter: error: scene.toml: {message}"
+    assert _files(tmp_path) == before  # no run folder, no scene.json
+
+
+def test_text_for_a_number_is_refused_by_the_scene_itself():
+    """A scene built in code gets the same answer (energy = "0.3" used to pass float() and crash in the engine)."""
+    from hhscatter.scene import Scene, SceneError, SectionWindow
+
+    with pytest.raises(SceneError, match="energy must be a number, got '0.3'"):
+        Scene(energy="0.3", n=10)
+    with pytest.raises(SceneError, match="gamma must be a number, got True"):
+        Scene(energy=0.3, n=10, gamma=True)
+    with pytest.raises(SceneError, match="first_only must be true or false"):
+        SectionWindow(first_only="no")
+
+
+def test_a_refused_study_file_in_a_subprocess_prints_no_traceback(tmp_path):
+    root = _study_root(tmp_path, "fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1))
+    env = {**os.environ, "HHSCATTER_STUDIES": str(root)}
+    r = subprocess.run([sys.executable, "-m", "hhscatter", "study", "fig3", "simulate", "--scale", "tiny"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip() == "hhscatter: error: studies/fig3/study.toml: [scene] energy must be a number, got '0.3'"
+    assert _files(root) == ["fig3", "fig3/study.toml"]
+
+
+def test_every_study_declares_its_study_table():
+    from hhscatter.config import StudyParams
+    from hhscatter.studies import load_study, study_names
+
+    for name in study_names():
+        s = load_study(name, "tiny")
+        assert s.params_model is not None and issubclass(s.params_model, StudyParams), name
+        with pytest.raises(Exception, match="does not declare"):
+            s.param("no_such_key")
+
+
+# -- the checks change no scene: result_hash at every scale, against the code of main before them --------------
+_HASHES = textwrap.dedent('''
+    """Print {study/scale/key: result_hash} of the scenes each study's simulate stage makes (runs not executed)."""
+    import json, sys
+    import hhscatter.studies as st
+
+    class Stop(Exception):
+        pass
+
+    out = {}
+    names = [p.parent.name for p in sorted(st.studies_root().glob("*/study.toml"))]
+    for name in names:
+        for scale in ("quick", "tiny", "paper"):
+            study = st.load_study(name, scale)
+            base = dict(study.config.get("scene", {}))
+            extra = {} if "energy" in base else {"energy": 0.3}
+            out[f"{name}/{scale}/<base>"] = study.scene("base", **extra).result_hash()
+
+            def run(key, scene, workers=None, progress=True, _n=name, _s=scale):
+                out[f"{_n}/{_s}/{key}"] = scene.result_hash()
+                return study.out / "no-such-run"  # stages that read a run's results stop here
+
+            study.run = run
+            try:
+                st.stage_module(name).simulate(study, workers=1, progress=False)
+            except Exception:
+                pass
+    json.dump(out, sys.stdout, sort_keys=True)
+''')
+
+
+def _scene_hashes(code_root: Path, cwd: Path) -> dict:
+    script = cwd / "hashes.py"
+    script.write_text(_HASHES)
+    env = {**os.environ, "PYTHONPATH": str(code_root)}
+    env.pop("HHSCATTER_STUDIES", None)
+    r = subprocess.run([sys.executable, str(script)], cwd=cwd, env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return json.loads(r.stdout)
+
+
+def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_checks(tmp_path):
+    if shutil.which("git") is None or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT,
+                                                     capture_output=True).returncode != 0:
+        pytest.skip(f"needs the git history with {BASE}")
+    old = tmp_path / "old"
+    old.mkdir()
+    archive = subprocess.run(["git", "archive", BASE, "hhscatter", "studies"], cwd=ROOT, capture_output=True,
+                             check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
+    before = _scene_hashes(old, old)
+    after = _scene_hashes(ROOT, tmp_path)
+    assert set(before) == set(after)
+    assert len(before) >= 7 * 3 * 2  # every study, every scale: its base scene and at least one run
+    assert after == before
