@@ -339,11 +339,15 @@ def survival_arrays(run_dir, filters=None):
     observed = np.empty(len(t_end), dtype=bool)
     pos = 0
     for chunk in table.column("outcome").chunks:
-        censored = np.isin(np.asarray(chunk.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)
-        idx = chunk.indices.to_numpy(zero_copy_only=False)
-        observed[pos:pos + len(chunk)] = ~censored[idx]
+        observed[pos:pos + len(chunk)] = _observed(chunk)
         pos += len(chunk)
     return t_end, observed
+
+
+def _observed(outcome) -> np.ndarray:
+    """The 'observed' mask (left Ω, not censored) of a dictionary-encoded Arrow ``outcome`` array."""
+    censored = np.isin(np.asarray(outcome.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)
+    return ~censored[outcome.indices.to_numpy(zero_copy_only=False)]
 
 
 def survival_on_grid(run_dir, t_grid, filters=None):
@@ -351,38 +355,27 @@ def survival_on_grid(run_dir, t_grid, filters=None):
 
     P(t) = Pr(lifetime > t) (paper Eqs. eqn:kappa_hyperbolic/nonhyperbolic)
     streamed over the dataset in record batches of ``t_end`` and ``outcome``
-    only: memory O(len(t_grid) + one batch), whatever N (1e9 orbits fit).
+    only, into :class:`hhscatter.analysis.kaplan_meier.KaplanMeierGrid`:
+    memory O(len(t_grid) + one batch), whatever N (1e9 orbits fit).
     hhscatter censors orbits only at t_max, so for t below every censoring
-    time the Kaplan–Meier estimate is exactly the fraction #{t_end > t}/N
-    and Greenwood's error the binomial √(P(1−P)/N); this function computes
-    that, and raises ValueError if some orbit was censored before max(t_grid)
-    (use :func:`hhscatter.analysis.survival.survival_curve` then).
+    time the estimate is exact (the fraction #{t_end > t}/N, Greenwood's error
+    the binomial √(P(1−P)/N)); this function raises ValueError if some orbit
+    was censored before max(t_grid) (use
+    :func:`hhscatter.analysis.survival.survival_curve` then).
     ``t_grid``: increasing times (time units).
     """
-    from .analysis.survival import SurvivalCurve
+    from .analysis.kaplan_meier import KaplanMeierGrid
 
-    g = np.asarray(t_grid, dtype=float)
-    if g.ndim != 1 or g.size == 0 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
-        raise ValueError("t_grid must be a non-empty, finite, strictly increasing 1-d array")
-    dead = np.zeros(g.size + 1, dtype=np.int64)  # events in (g[k-1], g[k]] at index k
-    n = 0
+    km = KaplanMeierGrid(t_grid)
     # one part file at a time (its footer is dropped with its dataset): memory is one part, however many
     batches = (b for part in _dataset(run_dir, "lifetimes", one_by_one=True)
                for b in part.to_batches(columns=["t_end", "outcome"], filter=filters, batch_readahead=1))
     for batch in batches:
-        t = batch.column(0).to_numpy()
-        outcome = batch.column(1)
-        censored = np.isin(np.asarray(outcome.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)[
-            outcome.indices.to_numpy(zero_copy_only=False)]
-        if censored.any() and t[censored].min() < g[-1]:
-            raise ValueError(f"an orbit was censored at t = {t[censored].min():g} < max(t_grid) = {g[-1]:g}: "
-                             "use survival_curve (Kaplan–Meier) for this run")
-        dead += np.bincount(np.searchsorted(g, t[~censored], side="left"), minlength=g.size + 1)
-        n += t.size
-    if n == 0:
-        raise ValueError("empty sample: no lifetimes")
-    P = 1.0 - np.cumsum(dead)[: g.size] / n
-    return SurvivalCurve(g.copy(), P, np.sqrt(np.clip(P * (1.0 - P), 0.0, None) / n))
+        km.add(batch.column(0).to_numpy(), _observed(batch.column(1)))
+        if km.first_censoring < km.grid[-1]:
+            raise ValueError(f"an orbit was censored at t = {km.first_censoring:g} < max(t_grid) = "
+                             f"{km.grid[-1]:g}: use survival_curve (Kaplan–Meier) for this run")
+    return km.curve()
 
 
 def iter_parts(run_dir, name: str, columns=None):

@@ -11,7 +11,8 @@ scattering region Ω as
 Functions here are pure (no file I/O, no plotting) and vectorised:
 
 * :func:`survival_curve` — Kaplan–Meier estimate of P(t) with Greenwood errors
-  from lifetimes ``t_end`` and a boolean ``observed`` mask (False = right-censored);
+  from lifetimes ``t_end`` and a boolean ``observed`` mask (False = right-censored)
+  (defined in :mod:`hhscatter.analysis.kaplan_meier`, the one estimator);
 * :func:`lifetimes_to_arrays`, :func:`survival_from_lifetimes` — the same from
   the engine's ``lifetimes`` table;
 * :func:`fit_exponential` — least squares of log P on t (κ, f0);
@@ -43,11 +44,12 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 from scipy import optimize
 from scipy.special import xlogy
+
+from .kaplan_meier import SurvivalCurve, survival_curve
 
 __all__ = [
     "CENSORED_OUTCOME",
@@ -75,124 +77,8 @@ CENSORED_OUTCOME = "censored"
 
 
 # ---------------------------------------------------------------------------
-# Kaplan–Meier survival curve
+# Kaplan–Meier survival curve: hhscatter.analysis.kaplan_meier (the one estimator), lifetimes tables in
 # ---------------------------------------------------------------------------
-class SurvivalCurve(NamedTuple):
-    """(t, P, P_err): times (time units), survival probability, 1σ standard error."""
-
-    t: np.ndarray
-    P: np.ndarray
-    P_err: np.ndarray
-
-
-def _km_steps(t_end, observed):
-    """Kaplan–Meier jumps: (event_times, S_after, var_log_S, t_last, n_total).
-
-    ``S_after[k]`` = P(t) for t in [event_times[k], event_times[k+1]);
-    ``var_log_S[k]`` is Greenwood's Σ d/(n(n−d)) (variance of log S; inf once S = 0).
-    """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed).ravel()
-    if observed.dtype != bool:
-        raise TypeError(f"observed must be a boolean mask, got dtype {observed.dtype}")
-    if t_end.shape != observed.shape:
-        raise ValueError(f"t_end and observed differ in length: {t_end.size} vs {observed.size}")
-    n_total = t_end.size
-    if n_total == 0:
-        raise ValueError("empty sample: no lifetimes")
-    if not np.all(np.isfinite(t_end)):
-        raise ValueError("t_end contains non-finite values")
-    if np.any(t_end < 0):
-        raise ValueError("t_end must be ≥ 0")
-
-    # two plain sorts (≈10× faster than a stable argsort of everything)
-    ev = np.sort(t_end[observed])
-    ce = np.sort(t_end[~observed])
-    t_last = float(max(ev[-1] if ev.size else -np.inf, ce[-1] if ce.size else -np.inf))
-    if ev.size:
-        first = np.empty(ev.size, dtype=bool)
-        first[0] = True
-        np.not_equal(ev[1:], ev[:-1], out=first[1:])
-        start = np.flatnonzero(first)  # first event of each distinct event time
-    else:
-        start = np.zeros(0, dtype=np.int64)
-    te = ev[start]
-    de = np.diff(np.append(start, ev.size)).astype(float)  # events at each distinct time
-    # at risk: orbits with t_end ≥ te (censored at te count as at risk)
-    ne = (ev.size - start) + (ce.size - np.searchsorted(ce, te, side="left"))
-    ne = ne.astype(float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_S = np.cumsum(np.log1p(-de / ne))
-        var_log = np.cumsum(de / (ne * (ne - de)))
-    S = np.exp(log_S)
-    return te, S, var_log, t_last, n_total
-
-
-def survival_curve(t_end, observed, t_grid=None) -> SurvivalCurve:
-    """survival_curve(t_end, observed, t_grid=None) -> SurvivalCurve(t, P, P_err).
-
-    Kaplan–Meier estimate of the survival probability P(t) = Pr(lifetime > t)
-    of Eqs. (eqn:kappa_hyperbolic) / (eqn:kappa_nonhyperbolic).
-
-    Parameters
-    ----------
-    t_end : array (N,), time units, ≥ 0
-        Leaving time of observed orbits, censoring time of the others.
-    observed : bool array (N,)
-        True if the orbit left Ω at ``t_end`` (escaped or settled), False if it
-        was right-censored there (still inside at t_max).
-    t_grid : array, optional
-        Times at which to evaluate P.  P is the right-continuous step function
-        (an orbit with t_end = t no longer counts at t).  Grid times beyond the
-        largest ``t_end`` give NaN (P unknown) unless P has already reached 0.
-
-    Returns
-    -------
-    SurvivalCurve(t, P, P_err)
-        Without ``t_grid``: t = 0 followed by the distinct event times (and the
-        largest censoring time when it exceeds the last event), P the value on
-        [t_k, t_{k+1}).  ``P_err`` is Greenwood's standard error
-        P √(Σ_{t_i ≤ t} d_i / (n_i (n_i − d_i))), which reduces exactly to the
-        binomial √(P(1−P)/N) when nothing was censored before t (0 where P = 0
-        or before the first event).
-
-    Ties: orbits censored at an event time are counted at risk at that time.
-    When all censoring happens at a common t_max, P(t) equals the plain
-    fraction #{t_end > t}/N for t < t_max.  Cost O(N log N) (two plain sorts),
-    fully vectorised; N = 10^7 takes well under a second on a grid.
-    """
-    te, S, var_log, t_last, _ = _km_steps(t_end, observed)
-    with np.errstate(invalid="ignore"):
-        err = np.where(S > 0, S * np.sqrt(var_log), 0.0)
-
-    if t_grid is None:
-        t_parts, P_parts, E_parts = [], [], []
-        if te.size == 0 or te[0] > 0:
-            t_parts.append([0.0]), P_parts.append([1.0]), E_parts.append([0.0])
-        t_parts.append(te), P_parts.append(S), E_parts.append(err)
-        if te.size == 0 or t_last > te[-1]:
-            P_last = S[-1] if S.size else 1.0
-            e_last = err[-1] if err.size else 0.0
-            t_parts.append([t_last]), P_parts.append([P_last]), E_parts.append([e_last])
-        return SurvivalCurve(
-            np.concatenate(t_parts).astype(float),
-            np.concatenate(P_parts).astype(float),
-            np.concatenate(E_parts).astype(float),
-        )
-
-    g = np.asarray(t_grid, dtype=float)
-    idx = np.searchsorted(te, g, side="right") - 1
-    safe = np.clip(idx, 0, None)
-    P = np.where(idx < 0, 1.0, S[safe] if S.size else 1.0)
-    P_err = np.where(idx < 0, 0.0, err[safe] if err.size else 0.0)
-    P_final = S[-1] if S.size else 1.0
-    if P_final > 0:
-        beyond = g > t_last
-        P = np.where(beyond, np.nan, P)
-        P_err = np.where(beyond, np.nan, P_err)
-    return SurvivalCurve(g.copy(), P.astype(float), P_err.astype(float))
-
-
 def observed_from_outcome(outcome) -> np.ndarray:
     """observed_from_outcome(outcome) -> bool array: True for 'escaped'/'settled', False for 'censored'/'stopped'.
 

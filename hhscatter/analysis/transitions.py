@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from .kaplan_meier import survival_on_grid
 from .survival import observed_from_outcome
 
 __all__ = [
@@ -173,40 +174,6 @@ def tau2_predicted(E0, E_c, mu, gamma):
 # ---------------------------------------------------------------------------
 # survival on a grid with orbit weights, and the bootstrap of τ0, τ1, τ2
 # ---------------------------------------------------------------------------
-def survival_on_grid(t_end, observed, grid, weights=None):
-    """survival_on_grid(t_end, observed, grid, weights=None) -> array P(grid).
-
-    Kaplan–Meier survival probability P(t) = Pr(lifetime > t) on an
-    increasing ``grid`` (time units), with optional non-negative orbit
-    ``weights`` (e.g. bootstrap multiplicities); O(N) with binning.  An
-    orbit leaving at t_end counts as gone at every grid time ≥ t_end
-    (right-continuous P).  Censoring is resolved to the grid: an orbit
-    censored inside (g[j−1], g[j]] is at risk for that whole bin.  Without
-    censoring before grid[-1] (all of this project's dissipative runs, and
-    t_max-censoring in general) the result is exactly the weighted fraction
-    Σ w·1(t_end > g) / Σ w, i.e. :func:`hhscatter.analysis.survival.survival_curve`
-    at the grid times.
-    """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed, dtype=bool).ravel()
-    g = np.asarray(grid, dtype=float).ravel()
-    if t_end.shape != observed.shape:
-        raise ValueError("t_end and observed differ in length")
-    if g.size and np.any(np.diff(g) <= 0):
-        raise ValueError("grid must be strictly increasing")
-    w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
-    if w.shape != t_end.shape or np.any(w < 0):
-        raise ValueError("weights must be non-negative and as long as t_end")
-    j = np.searchsorted(g, t_end, side="left")  # g[j-1] < t_end <= g[j]
-    nb = g.size + 1
-    d = np.bincount(j[observed], weights=w[observed], minlength=nb)[: g.size]
-    c = np.bincount(j[~observed], weights=w[~observed], minlength=nb)[: g.size]
-    at_risk = w.sum() - np.concatenate([[0.0], np.cumsum(d + c)[:-1]])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        q = np.where(at_risk > 0, 1.0 - d / at_risk, 1.0)
-    return np.cumprod(np.clip(q, 0.0, 1.0))
-
-
 def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
     """settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None) -> array or None.
 

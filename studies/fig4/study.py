@@ -227,7 +227,7 @@ def analyze(study):
     for g in gs[1:]:
         with np.errstate(divide="ignore", invalid="ignore"):
             r = P[g][keep] / P[0.0][keep]
-        ok = P[0.0][keep] * N >= 1
+        ok = np.rint(P[0.0][keep] * N) >= 1  # at least one reference orbit left (a count: rounding-proof)
         ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok],
                                    "n0": (P[0.0][keep] * N)[ok]}))
     ratio = pd.concat(ratio, ignore_index=True)
