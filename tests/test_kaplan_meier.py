@@ -85,3 +85,45 @@ def test_wilson_interval_matches_scipy_binomtest():
         p, lo, hi = wilson_interval(k, n, stats.norm.ppf(0.975))
         assert p == k / n
         assert lo == pytest.approx(ci.low, rel=1e-9, abs=1e-12) and hi == pytest.approx(ci.high, rel=1e-9, abs=1e-12)
+
+
+def test_weighted_least_squares_matches_scipy_curve_fit():
+    from scipy.optimize import curve_fit
+
+    from hhscatter.analysis.least_squares import least_squares_operator, weighted_least_squares
+
+    rng = np.random.default_rng(5)
+    x = np.linspace(0.0, 10.0, 40)
+    sigma = 0.05 + 0.02 * x
+    y = 1.5 - 0.3 * x + 0.01 * x**2 + sigma * rng.standard_normal(x.size)
+    X = np.column_stack([np.ones_like(x), x, x**2])
+
+    def model(xx, a, b, c):
+        return a + b * xx + c * xx**2
+
+    for absolute in (True, False):
+        popt, pcov = curve_fit(model, x, y, sigma=sigma, absolute_sigma=absolute)
+        fit = weighted_least_squares(X, y, 1.0 / sigma**2, errors="absolute" if absolute else "scaled")
+        np.testing.assert_allclose(fit.coef, popt, rtol=1e-7, atol=1e-10)
+        np.testing.assert_allclose(fit.cov, pcov, rtol=1e-6)
+    # unweighted: ordinary least squares with residual-scaled errors
+    popt, pcov = curve_fit(model, x, y)
+    ols = weighted_least_squares(X, y, errors="scaled")
+    np.testing.assert_allclose(ols.coef, popt, rtol=1e-7, atol=1e-10)
+    np.testing.assert_allclose(ols.cov, pcov, rtol=1e-6)
+    assert ols.dof == x.size - 3 and ols.chi2 == pytest.approx(np.sum(ols.resid**2))
+    # the operator maps any data to its fit; 'inflated' never shrinks the absolute errors
+    A, F = least_squares_operator(X, 1.0 / sigma**2)
+    np.testing.assert_allclose(A @ y, weighted_least_squares(X, y, 1.0 / sigma**2).coef, rtol=1e-12)
+    tight = weighted_least_squares(X, y, 1.0 / (10 * sigma) ** 2, errors="inflated")
+    np.testing.assert_allclose(tight.cov, np.linalg.inv(X.T @ (X / (10 * sigma[:, None]) ** 2)), rtol=1e-12)
+
+
+def test_power_law_exponent_recovers_one_over_gamma():
+    from hhscatter.analysis.transitions import power_law_exponent, tau2_predicted
+
+    g = np.array([0.001, 0.002, 0.005, 0.01, 0.02])
+    tau = tau2_predicted(0.3, 1 / 6, 0.9, g)
+    p, err = power_law_exponent(g, tau, 0.01 * tau)
+    assert p == pytest.approx(1.0, rel=1e-12) and err > 0
+    assert power_law_exponent(g[:1], tau[:1], tau[:1]) == (None, None)

@@ -37,6 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .least_squares import weighted_least_squares
+
 __all__ = [
     "EnergyDecayFit",
     "EnergyHistograms",
@@ -289,34 +291,22 @@ def fit_energy_decay(
     absolute = absolute_sigma and weights is not None
     nan = float("nan")
 
+    errors = "absolute" if absolute else "scaled"
     # fixed intercept: y - log E0 = -beta t
-    yr = y - np.log(E0)
-    stt = np.sum(w * t * t)
-    if n >= 1 and stt > 0:
-        beta = -np.sum(w * t * yr) / stt
-        res = yr + beta * t
-        if absolute:
-            var_b = 1.0 / stt
-        else:
-            var_b = np.sum(w * res**2) / (n - 1) / stt if n > 1 else nan
-        mu, mu_err = beta / gamma, np.sqrt(var_b) / gamma
-        rms = float(np.sqrt(np.mean(res**2)))
+    if n >= 1 and np.sum(w * t * t) > 0:
+        fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
+        mu, mu_err = fit.coef[0] / gamma, fit.err[0] / gamma
+        rms = float(np.sqrt(np.mean(fit.resid**2)))
     else:
         mu = mu_err = rms = nan
 
     # free intercept: y = a - beta t
     if n >= 2 and np.ptp(t) > 0:
-        X = np.column_stack([np.ones(n), -t])
-        sw = np.sqrt(w)
-        coef, *_ = np.linalg.lstsq(X * sw[:, None], y * sw, rcond=None)
-        res = y - X @ coef
-        cov = np.linalg.inv(X.T @ (X * w[:, None]))
-        if not absolute:
-            cov = cov * (np.sum(w * res**2) / (n - 2) if n > 2 else nan)
-        a, beta_f = coef
-        mu_free, mu_free_err = beta_f / gamma, np.sqrt(cov[1, 1]) / gamma
-        a_err = np.sqrt(cov[0, 0])
-        rms_f = float(np.sqrt(np.mean(res**2)))
+        fit = weighted_least_squares(np.column_stack([np.ones(n), -t]), y, w, errors=errors)
+        a, beta_f = fit.coef
+        mu_free, mu_free_err = beta_f / gamma, fit.err[1] / gamma
+        a_err = fit.err[0]
+        rms_f = float(np.sqrt(np.mean(fit.resid**2)))
     else:
         mu_free = mu_free_err = a = a_err = rms_f = nan
 

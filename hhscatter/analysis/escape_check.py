@@ -35,6 +35,7 @@ import numpy as np
 from scipy import integrate, optimize, stats
 
 from ..model import HenonHeiles
+from .least_squares import weighted_least_squares
 
 __all__ = [
     "ChannelFractions",
@@ -361,7 +362,8 @@ def _log_ratio_fit(t_ref, obs_ref, t_alt, obs_alt, grid):
     ok = (p0 > 0) & (p1 > 0)
     if np.count_nonzero(ok) < 3:
         return math.nan, math.nan
-    slope, icpt = np.polyfit(grid[ok] - grid[0], np.log(p1[ok] / p0[ok]), 1)
+    x = grid[ok] - grid[0]
+    slope, icpt = weighted_least_squares(np.column_stack([x, np.ones(x.size)]), np.log(p1[ok] / p0[ok])).coef
     return -float(slope), float(icpt)
 
 

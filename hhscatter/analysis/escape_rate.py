@@ -30,6 +30,7 @@ import numpy as np
 from scipy import optimize
 from scipy.special import logsumexp
 
+from .least_squares import weighted_least_squares
 from .survival import (
     PowerLawFit,
     SurvivalCurve,
@@ -717,11 +718,8 @@ class KappaEnergyFit:
 
 def _wls(M, y, w):
     """Weighted linear least squares, returns (params, chi2, (MᵀWM)^{-1})."""
-    MtW = M.T * w
-    F = MtW @ M
-    p = np.linalg.solve(F, MtW @ y)
-    r = y - M @ p
-    return p, float(np.sum(w * r * r)), np.linalg.inv(F)
+    fit = weighted_least_squares(M, y, w)
+    return fit.coef, fit.chi2, fit.cov
 
 
 def _continuous_profile(x, y, w, xb):

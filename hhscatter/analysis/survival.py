@@ -50,6 +50,7 @@ from scipy import optimize
 from scipy.special import xlogy
 
 from .kaplan_meier import SurvivalCurve, survival_curve
+from .least_squares import least_squares_operator, weighted_least_squares
 
 __all__ = [
     "CENSORED_OUTCOME",
@@ -160,19 +161,15 @@ def _fit_log_linear(x, y, sigma_y):
     """
     n = x.size
     X = np.column_stack([x, np.ones(n)])
-    w = np.ones(n) if sigma_y is None else 1.0 / sigma_y**2
-    XtW = X.T * w
-    A = np.linalg.solve(XtW @ X, XtW)  # (2, n): rows give β and α
-    beta, alpha = A @ y
-    resid = y - (alpha + beta * x)
-    rms = float(np.sqrt(np.mean(resid**2)))
     if sigma_y is None:
-        s2 = float(resid @ resid) / (n - 2) if n > 2 else np.nan
-        cov_naive = np.linalg.inv(X.T @ X) * s2
-        cov_corr = cov_naive
+        fit = weighted_least_squares(X, y, errors="scaled")
+        cov_naive = cov_corr = fit.cov
     else:
-        cov_naive = np.linalg.inv(XtW @ X)
-        cov_corr = _independent_increment_cov(A, sigma_y**2)
+        fit = weighted_least_squares(X, y, 1.0 / sigma_y**2)
+        cov_naive = fit.cov
+        cov_corr = _independent_increment_cov(fit.operator, sigma_y**2)
+    beta, alpha = fit.coef
+    rms = float(np.sqrt(np.mean(fit.resid**2)))
     return float(beta), float(alpha), cov_corr, cov_naive, n, rms
 
 
@@ -225,8 +222,7 @@ def mean_kappa_stat_err(t, P, P_err, windows) -> float:
         if np.count_nonzero(m) < 3:
             raise ValueError(f"fewer than 3 usable points in window {(lo, hi)}")
         X = np.column_stack([tv[m], np.ones(np.count_nonzero(m))])
-        XtW = X.T / sv[m] ** 2
-        total[m] += np.linalg.solve(XtW @ X, XtW)[0]
+        total[m] += least_squares_operator(X, 1.0 / sv[m] ** 2)[0][0]
     total /= len(windows)
     return float(np.sqrt(_independent_increment_cov(total[None, :], sv**2)[0, 0]))
 

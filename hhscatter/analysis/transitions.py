@@ -22,13 +22,16 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+
 from .kaplan_meier import survival_on_grid
+from .least_squares import weighted_least_squares
 from .survival import observed_from_outcome
 
 __all__ = [
     "bootstrap_transition_times",
     "settle_time_quantiles",
     "survival_on_grid",
+    "power_law_exponent",
     "tau1",
     "tau1_from_lifetimes",
     "tau2_observed",
@@ -257,3 +260,23 @@ def bootstrap_transition_times(
             row.update(dict(zip(qcols, vals)))
             rows.append(row)
     return pd.DataFrame(rows, columns=["replicate", "label", "tau0", "tau1", "tau2_obs", *qcols])
+
+
+def power_law_exponent(gamma, tau, tau_err):
+    """power_law_exponent(gamma, tau, tau_err) -> (p, σ_p) of τ ∝ γ^−p, or (None, None) with < 2 usable points.
+
+    Weighted least squares of log τ = c − p log γ over the finite τ > 0 (γ > 0),
+    weights 1/(σ_τ/τ)² (points without a usable error get the largest error of
+    the others); σ_p inflated by the reduced χ² when the points scatter more
+    than their errors. E.g. τ2 ∝ 1/γ, Eq. (eq:tau2), is p = 1.
+    """
+    g, t, e = (np.asarray(v, dtype=float) for v in (gamma, tau, tau_err))
+    ok = np.isfinite(t) & (t > 0) & (g > 0)
+    if ok.sum() < 2:
+        return None, None
+    x, y = np.log(g[ok]), np.log(t[ok])
+    s = e[ok] / t[ok]
+    good = np.isfinite(s) & (s > 0)
+    s = np.where(good, s, s[good].max() if good.any() else 1.0)
+    fit = weighted_least_squares(np.column_stack([np.ones_like(x), x]), y, 1.0 / s**2, errors="inflated")
+    return float(-fit.coef[1]), float(fit.err[1])

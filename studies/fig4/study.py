@@ -123,6 +123,7 @@ def analyze(study):
     )
     from hhscatter.analysis.transitions import (
         bootstrap_transition_times,
+        power_law_exponent,
         settle_time_quantiles,
         survival_on_grid,
         tau1,
@@ -247,10 +248,10 @@ def analyze(study):
     t1v = d["tau1"].to_numpy()
     ok1 = np.isfinite(t1v)
     mono1 = bool(np.all(np.diff(t1v[ok1]) <= 0)) if ok1.sum() > 1 else None
-    p_exp, p_err = _gamma_exponent(d["gamma"], d["tau2_obs"], d["tau2_obs_err"])
-    p50, p50_err = _gamma_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
+    p_exp, p_err = power_law_exponent(d["gamma"], d["tau2_obs"], d["tau2_obs_err"])
+    p50, p50_err = power_law_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
     res = d[d["tau1_resolved"]]
-    p1, p1_err = _gamma_exponent(res["gamma"], res["tau1"], res["tau1_err"])
+    p1, p1_err = power_law_exponent(res["gamma"], res["tau1"], res["tau1_err"])
     study.compare(f"μ used for τ2 (own γ={mg:g} run, [{win[0]:g}, {win[1]:g}])", mu, mu_err, paper_mu,
                   note="same definition as study fig3")
     if mu_fig3 is not None:
@@ -329,26 +330,6 @@ def analyze(study):
         "errors": ("paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
                    "scaled by sqrt(n_boot_orbits/N); for the minimum τ2,obs this is only indicative"),
     })
-
-
-def _gamma_exponent(gamma, tau, tau_err):
-    """(p, σ_p) of a weighted least-squares fit log τ = c − p log γ over finite τ (None, None if < 2 points)."""
-    g, t, e = (np.asarray(v, dtype=float) for v in (gamma, tau, tau_err))
-    ok = np.isfinite(t) & (t > 0) & (g > 0)
-    if ok.sum() < 2:
-        return None, None
-    x, y = np.log(g[ok]), np.log(t[ok])
-    s = e[ok] / t[ok]
-    good = np.isfinite(s) & (s > 0)
-    s = np.where(good, s, s[good].max() if good.any() else 1.0)
-    A = np.column_stack([np.ones_like(x), x]) / s[:, None]
-    coef, *_ = np.linalg.lstsq(A, y / s, rcond=None)
-    cov = np.linalg.inv(A.T @ A)
-    dof = x.size - 2
-    if dof > 0:  # inflate by the reduced χ² when the points scatter more than their errors
-        chi2 = float(np.sum((A @ coef - y / s) ** 2)) / dof
-        cov = cov * max(1.0, chi2)
-    return float(-coef[1]), float(np.sqrt(cov[1, 1]))
 
 
 def plot(study):
