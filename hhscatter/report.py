@@ -2,10 +2,12 @@
 
 ``build_report(scale='quick', out=None)`` reads what the studies left on disk
 (``studies/<name>/out/<scale>/<name>.json`` and ``<name>.png``; the benchmark
-summary under ``studies/bench/out/``) and writes one self-contained HTML file
-(figures embedded as data URIs) and the same content as Markdown beside its
-PNG files. It computes no physics: every number comes from a study's numbers
-JSON, so the report and the study outputs cannot disagree.
+summary under ``studies/bench/out/``) and writes the report as Markdown
+beside its PNG files and, from the same Markdown rendered by Python-Markdown,
+one self-contained HTML file (figures embedded as data URIs). It computes no
+physics: every number comes from a study's numbers JSON, so the report and
+the study outputs cannot disagree. Numbers and the paper-vs-ours tables are
+formatted by :mod:`hhscatter.formatting`, as in the docs.
 """
 from __future__ import annotations
 
@@ -13,11 +15,17 @@ import base64
 import datetime as _dt
 import html
 import json
-import math
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from .formatting import (
+    comparison_table,
+    embed_markdown,
+    format_value,
+    markdown_to_html,
+    md_cell,
+)
 from .studies import studies_root, write_json_atomic
 from .studies.graph import studies as study_folders
 
@@ -32,31 +40,6 @@ class Section:
     paper: str = ""  # the paper's figure this study reproduces ("" for a study beyond the paper)
 
 
-def _fmt(v, err=None) -> str:
-    if v is None:
-        return "—"
-    if isinstance(v, dict) and "value" in v:
-        return _fmt(v["value"], v.get("err"))
-    if isinstance(v, (bool, int)) and err is None:
-        return str(v)
-    if isinstance(v, (int, float)):
-        if isinstance(v, float) and not math.isfinite(v):
-            return str(v)
-        if err is None or not isinstance(err, (int, float)) or not math.isfinite(err) or err <= 0:
-            return f"{v:.4g}"
-        # one significant digit of the error, two when it starts with 1 or 2 (as particle-data tables do)
-        exp10 = int(math.floor(math.log10(err)))
-        digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
-        if abs(v) >= 1e4 or digits > 5:
-            return f"{v:.3g} ± {err:.1e}" if v != 0 else f"0 ± {err:.1e}"
-        return f"{v:.{digits}f} ± {err:.{digits}f}"
-    if isinstance(v, (list, tuple)):
-        if len(v) <= 6 and all(isinstance(x, (int, float)) for x in v):
-            return "[" + ", ".join(_fmt(x) for x in v) + "]"
-        return f"[{len(v)} values]"
-    return str(v)
-
-
 def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
     """headline_numbers(numbers) -> [(name, formatted)] of the scalar and value±err entries of a numbers JSON."""
     skip = {"study", "scale", "paper_comparison", "config", "provenance"}
@@ -68,9 +51,9 @@ def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
                 continue
             name = f"{prefix}{k}"
             if isinstance(v, dict) and "value" in v:
-                rows.append((name, _fmt(v)))
+                rows.append((name, format_value(v)))
             elif isinstance(v, (int, float, bool)) or (isinstance(v, str) and len(v) < 80):
-                rows.append((name, _fmt(v)))
+                rows.append((name, format_value(v)))
             elif isinstance(v, dict) and depth < 1:
                 walk(f"{name}.", v, depth + 1)
 
@@ -151,22 +134,28 @@ def verdict_counts(rows) -> dict:
     return counts
 
 
-def _md_rows(rows):
-    out = ["| study | quantity | paper | ours | verdict | note |", "|---|---|---|---|---|---|"]
-    for r in rows:
-        out.append(f"| {r['study']} | {r['quantity']} | {_fmt(r.get('paper'))} | {_fmt(r.get('ours'), r.get('err'))}"
-                   f" | {r.get('verdict') or '—'} | {(r.get('note') or '').replace('|', '/')} |")
-    if not rows:
-        out.append("| — | no study outputs found | | | | |")
-    return out
-
-
 def _count_line(rows):
     c = verdict_counts(rows)
     return f"{len(rows)} numbers: {c['ok']} agree, {c['bad']} differ, {c['meh'] + c['']} qualitative or not comparable."
 
 
-def render_markdown(sections, scale, root, assets: Path) -> str:
+def _rows_table(rows, html_verdicts: bool) -> str:
+    """The paper-vs-ours rows of several studies (:func:`hhscatter.formatting.comparison_table`); in the HTML
+    flavour the verdicts are coloured spans."""
+    def verdict(v):
+        cls = _verdict_class(v)
+        return f'<span class="{cls}">{html.escape(v)}</span>' if html_verdicts and cls else md_cell(v)
+
+    return comparison_table(rows, study=True, verdict=verdict)
+
+
+def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False) -> str:
+    """render_markdown(sections, scale, root, image) -> the report in Markdown.
+
+    ``image(path, name)`` returns the link target of a figure (a file copied
+    beside report.md, or a data URI for the HTML); ``html_verdicts`` colours
+    the verdicts (for the HTML page).
+    """
     paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
     prov = _provenance(sections)
     lines = [f"# hhscatter reproduction report ({scale} scale)", "",
@@ -176,30 +165,29 @@ def render_markdown(sections, scale, root, assets: Path) -> str:
              "≤ 2σ (our statistical error) unless the row says otherwise.", "",
              f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
              f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str))}.", "",
-             "## The paper's numbers beside ours", "", _count_line(paper_rows), "", *_md_rows(paper_rows), "",
+             "## The paper's numbers beside ours", "", _count_line(paper_rows), "",
+             _rows_table(paper_rows, html_verdicts), "",
              "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
-             *_md_rows(beyond_rows)]
+             _rows_table(beyond_rows, html_verdicts)]
     for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
         lines += ["", f"## {group}", ""]
         for s in (s for s in sections if bool(s.paper) == of_paper):
-            lines += [f"### {s.title} (`make {s.key}`)", "", s.caption, ""]
+            lines += [f"### {s.title} (`make {s.key}`)", "", f"*{s.caption}*" if s.caption else "", ""]
             if s.figure:
-                shutil.copyfile(s.figure, assets / f"{s.key}.png")
-                lines += [f"![{s.title}]({assets.name}/{s.key}.png)", ""]
+                lines += [f"![{s.title}]({image(s.figure, f'{s.key}.png')})", ""]
             else:
                 lines += [f"*Not generated yet: run `make {s.key} SCALE={scale}`.*", ""]
             if s.numbers:
                 lines += ["| number | value |", "|---|---|"]
-                lines += [f"| {k} | {v} |" for k, v in headline_numbers(s.numbers)]
+                lines += [f"| {md_cell(k)} | {md_cell(v)} |" for k, v in headline_numbers(s.numbers)]
                 lines.append("")
     for name, title in BENCH_PARTS:
         md, pngs = _bench(root, name)
         lines += [f"## {title}", ""]
         if md:
-            lines += [md.read_text(), ""]
-            for p in pngs:
-                shutil.copyfile(p, assets / f"{name}-{p.name}")
-                lines += [f"![{p.stem}]({assets.name}/{name}-{p.name})", ""]
+            # a summary written for its own folder: headings demoted, plain tables fenced, |x| in cells escaped
+            lines += [embed_markdown(md.read_text()), ""]
+            lines += [f"![{p.stem}]({image(p, f'{name}-{p.name}')})\n" for p in pngs]
         else:
             lines += [f"*Not generated yet: run `make {name}`.*", ""]
     return "\n".join(lines) + "\n"
@@ -210,92 +198,19 @@ body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max
 padding:0 1em;color:#1a1a1a;line-height:1.45}
 h1{border-bottom:2px solid #333;padding-bottom:.2em} h2{margin-top:2em;border-bottom:1px solid #ccc}
 table{border-collapse:collapse;margin:1em 0;font-size:.92em} th,td{border:1px solid #ccc;padding:.3em .6em;
-vertical-align:top} th{background:#f3f3f3} td.ok{background:#e6f4e6} td.bad{background:#fbe4e4}
-td.meh{background:#fff6d8} img{max-width:100%;border:1px solid #ddd} .caption{color:#444;font-style:italic}
-pre{background:#f7f7f7;padding:.6em;overflow-x:auto} .missing{color:#a00}
+vertical-align:top} th{background:#f3f3f3} span.ok{background:#e6f4e6} span.bad{background:#fbe4e4}
+span.meh{background:#fff6d8} img{max-width:100%;border:1px solid #ddd}
+pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 """
 
 
-def _md_table_to_html(text: str) -> str:
-    """The benchmark summary is Markdown; render its tables and paragraphs minimally (no extra dependency)."""
-    out, table = [], []
-
-    def flush():
-        if table:
-            cells = [[c.strip() for c in r.strip().strip("|").split("|")] for r in table]
-            head, body = cells[0], [r for r in cells[2:]]
-            out.append("<table><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in head) + "</tr>" +
-                       "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in body)
-                       + "</table>")
-            table.clear()
-
-    for line in text.splitlines():
-        if line.strip().startswith("|"):
-            table.append(line)
-            continue
-        flush()
-        if line.startswith("#"):
-            level = min(len(line) - len(line.lstrip("#")) + 2, 6)
-            out.append(f"<h{level}>{html.escape(line.lstrip('#').strip())}</h{level}>")
-        elif line.strip():
-            out.append(f"<p>{html.escape(line)}</p>")
-    flush()
-    return "\n".join(out)
-
-
-def _html_rows(rows):
-    e = html.escape
-    parts = ["<table><tr><th>study</th><th>quantity</th><th>paper</th><th>ours</th><th>verdict</th><th>note</th></tr>"]
-    for r in rows:
-        parts.append(f"<tr><td>{e(r['study'])}</td><td>{e(str(r['quantity']))}</td><td>{e(_fmt(r.get('paper')))}</td>"
-                     f"<td>{e(_fmt(r.get('ours'), r.get('err')))}</td>"
-                     f"<td class='{_verdict_class(r.get('verdict'))}'>{e(r.get('verdict') or '—')}</td>"
-                     f"<td>{e(r.get('note') or '')}</td></tr>")
-    if not rows:
-        parts.append("<tr><td colspan=6 class='missing'>no study outputs found</td></tr>")
-    parts.append("</table>")
-    return "".join(parts)
-
-
 def render_html(sections, scale, root) -> str:
-    paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
-    prov = _provenance(sections)
-    e = html.escape
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report ({e(scale)})"
-             f"</title><style>{_CSS}</style></head><body>",
-             f"<h1>hhscatter reproduction report <small>({e(scale)} scale)</small></h1>",
-             "<p>Reproduction of Burton, Dullin &amp; Altmann, <i>Dissipative chaotic scattering</i> (Hénon–Heiles "
-             "with linear drag), with exact event times from heyoka's Taylor integrator. Every number below is read "
-             "from the studies' numbers JSON files. Verdicts: |ours − paper| ≤ 2σ (our statistical error) unless "
-             "the row says otherwise.</p>",
-             f"<p>Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; versions: "
-             f"{e(', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str)))}.</p>",
-             "<h2>The paper's numbers beside ours</h2>", f"<p>{e(_count_line(paper_rows))}</p>",
-             _html_rows(paper_rows),
-             "<h2>Beyond the paper: checks and numbers the paper does not state</h2>",
-             f"<p>{e(_count_line(beyond_rows))}</p>", _html_rows(beyond_rows)]
-    for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
-        parts.append(f"<h2>{e(group)}</h2>")
-        for s in (s for s in sections if bool(s.paper) == of_paper):
-            parts.append(f"<h3>{e(s.title)} <code>make {e(s.key)}</code></h3><p class='caption'>{e(s.caption)}</p>")
-            if s.figure:
-                parts.append(f"<img alt='{e(s.title)}' src='{_img_uri(s.figure)}'>")
-            else:
-                parts.append(f"<p class='missing'>Not generated yet: run <code>make {e(s.key)} SCALE={e(scale)}"
-                             f"</code>.</p>")
-            if s.numbers:
-                parts.append("<table><tr><th>number</th><th>value</th></tr>" + "".join(
-                    f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in headline_numbers(s.numbers)) + "</table>")
-    for name, title in BENCH_PARTS:
-        md, pngs = _bench(root, name)
-        parts.append(f"<h2>{e(title)}</h2>")
-        if md:
-            parts.append(_md_table_to_html(md.read_text()))
-            parts += [f"<img alt='{e(p.stem)}' src='{_img_uri(p)}'>" for p in pngs]
-        else:
-            parts.append(f"<p class='missing'>Not generated yet: run <code>make {e(name)}</code>.</p>")
-    parts.append("</body></html>")
-    return "\n".join(parts)
+    """render_html(sections, scale, root) -> one self-contained HTML page: the report's Markdown (figures as
+    data URIs) rendered by Python-Markdown."""
+    body = markdown_to_html(render_markdown(sections, scale, root, lambda path, name: _img_uri(path),
+                                            html_verdicts=True))
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
+            f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n")
 
 
 def build_report(scale: str = "quick", out: Path | None = None, root: Path | None = None) -> dict:
@@ -309,7 +224,12 @@ def build_report(scale: str = "quick", out: Path | None = None, root: Path | Non
     assets = out / "assets"
     assets.mkdir(parents=True, exist_ok=True)
     sections = collect(scale, root)
-    md = render_markdown(sections, scale, root, assets)
+
+    def copy_asset(path: Path, name: str) -> str:
+        shutil.copyfile(path, assets / name)
+        return f"{assets.name}/{name}"
+
+    md = render_markdown(sections, scale, root, copy_asset)
     page = render_html(sections, scale, root)
     for name, text in (("report.md", md), ("report.html", page)):
         tmp = out / f".{name}.tmp"

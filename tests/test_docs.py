@@ -39,9 +39,9 @@ def gen():
 @pytest.mark.parametrize(
     "v, err, want",
     [
-        (0.12345, 0.00678, "0.1235 ± 0.0068"),  # err to 2 significant digits, v to the same place
+        (0.12345, 0.00678, "0.123 ± 0.007"),  # err to 1 significant digit (2 if it starts with 1 or 2), v alike
         (13.63, 1.234, "13.6 ± 1.2"),
-        (1.41, 0.05, "1.410 ± 0.050"),
+        (1.41, 0.05, "1.41 ± 0.05"),
         (-0.00017021, 0.00106, "-0.0002 ± 0.0011"),
         (250.0, 31.0, "250 ± 31"),
         (0.5, None, "0.5"),
@@ -143,7 +143,7 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     out, _ = _page(tmp_path, hook, md)
     assert "n = 10  # orbits" in out
     assert "](assets/fig2.png)" in out
-    assert "| a | 13.10 ± 0.52 | 13.63 | agrees within 2σ |" in out
+    assert "| a | 13.1 ± 0.5 | 13.63 | agrees within 2σ |" in out
     assert "`tau0_rule`\n:   τ0 is where" in out
     assert "| `gamma` | `tau1` |" in out and "| 0.01 | 17.2 ± 1.0 |" in out
     assert "scale **quick**" in out and "commit `0123456789ab`" in out

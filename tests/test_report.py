@@ -3,7 +3,8 @@ import json
 
 import pytest
 
-from hhscatter.report import _fmt, build_report
+from hhscatter.formatting import format_value_err
+from hhscatter.report import build_report
 
 
 def _fake_study(root, name, rows, with_figure=True, paper=None):
@@ -49,12 +50,12 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "break energy" in paper_part and "returns at r_esc" not in paper_part
     assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
     assert "3 numbers: 2 agree, 1 differ" in paper_part
-    assert "13.1 ± 0.4" in page and "13.63" in page and "class='bad'>differs" in page
+    assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs</span>' in page
     assert page.count("data:image/png;base64,") == 2  # fig2 and resc; fig3 has numbers but no figure
     assert set(res["missing"]) == {"fig1", "fig3"}  # the study folders of the root without figure or numbers
     assert "### fig2 title (`make fig2`)" in md and "fig2 caption" in md  # titles and captions from [about]
     assert md.index("### resc title") > md.index("## Beyond the paper\n")
-    assert "| fig2 | break energy | 0.27 | 0.310 ± 0.010 | differs | continuous fit |" in md
+    assert "| fig2 | break energy | 0.310 ± 0.010 | 0.27 | differs | continuous fit |" in md
     assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
     assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [
@@ -64,4 +65,4 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
 @pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),
                                         (2.5e-14, 1e-15, "2.5e-14 ± 1.0e-15"), (0.0, 8.3e-6, "0 ± 8.3e-06"), (-9.2e-4, 5.2e-4, "-0.0009 ± 0.0005"), (152.0, 7.0, "152 ± 7")])
 def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
-    assert _fmt(v, err) == want
+    assert format_value_err(v, err) == want

@@ -25,7 +25,6 @@ assets from the studies' quick-scale outputs.
 from __future__ import annotations
 
 import json
-import math
 import re
 from pathlib import Path
 
@@ -33,68 +32,36 @@ _MARKER = re.compile(r"^<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->\s*$", re.M)
 _SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
 
 
-# -- number formatting --------------------------------------------------------
+# -- number formatting: hhscatter.formatting, shared with the report and the figures ---------------------
 def _is_num(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
 def fmt_num(v, sig: int = 4) -> str:
-    """fmt_num(v) -> v with ``sig`` significant digits (plain or scientific)."""
-    if v is None:
-        return "—"
-    if isinstance(v, str):
-        return v
-    if isinstance(v, bool):
-        return str(v).lower()
-    if isinstance(v, int):
-        return str(v)
-    if not math.isfinite(v):
-        return str(v)
-    if v == 0:
-        return "0"
-    a = abs(v)
-    if 1e-3 <= a < 1e5:
-        return f"{v:.{sig}g}"
-    m, e = f"{v:.{sig - 1}e}".split("e")
-    return f"{m}×10<sup>{int(e)}</sup>"
+    """fmt_num(v) -> v with ``sig`` significant digits (a×10<sup>b</sup> outside [1e-3, 1e5))."""
+    from hhscatter.formatting import format_number
+
+    return format_number(v, sig, html=True)
 
 
 def fmt_err(v, err) -> str:
-    """fmt_err(v, err) -> "v ± err" with err to 2 significant digits and v to the same decimal place."""
-    if not _is_num(v):
-        return fmt_num(v)
-    if not _is_num(err) or not math.isfinite(err) or err <= 0 or not math.isfinite(v):
-        return fmt_num(v) + ("" if err is None else f" ± {fmt_num(err)}")
-    exp = math.floor(math.log10(err)) - 1  # last digit kept: 2 significant digits of err
-    if -6 <= exp <= 4 and abs(v) < 1e6:
-        nd = max(0, -exp)
-        return f"{round(v, nd):.{nd}f} ± {round(err, nd):.{nd}f}"
-    return f"{fmt_num(v)} ± {fmt_num(err, 2)}"
+    """fmt_err(v, err) -> "v ± err" rounded to the uncertainty (hhscatter.formatting.format_value_err)."""
+    from hhscatter.formatting import format_value_err
+
+    return format_value_err(v, err)
 
 
 def fmt_value(v) -> str:
     """fmt_value(v) -> Markdown for one JSON value ({value, err} or {value, lo, hi} dicts, short lists, scalars)."""
-    if isinstance(v, dict) and "value" in v:
-        if v.get("value") is None:
-            return "—"
-        if _is_num(v.get("lo")) and _is_num(v.get("hi")):
-            return f"{fmt_num(v['value'])} [{fmt_num(v['lo'])}, {fmt_num(v['hi'])}]"
-        return fmt_err(v.get("value"), v.get("err"))
-    if isinstance(v, list):
-        if len(v) <= 8 and all(_is_num(x) or isinstance(x, str) or x is None for x in v):
-            return "[" + ", ".join(fmt_num(x) for x in v) + "]"
-        if len(v) <= 8 and all(isinstance(x, dict) and "value" in x for x in v):
-            return "[" + ", ".join(fmt_value(x) for x in v) + "]"
-        if len(v) <= 4 and all(isinstance(x, list) and len(x) <= 4 for x in v):
-            return "[" + ", ".join(fmt_value(x) for x in v) + "]"
-        return f"*({len(v)} entries; see the JSON)*"
-    if isinstance(v, dict):
-        return f"*({len(v)} fields; see the JSON)*"
-    return fmt_num(v)
+    from hhscatter.formatting import format_value
+
+    return format_value(v, html=True)
 
 
 def _cell(s) -> str:
-    return str(s).replace("|", "\\|").replace("\n", " ")
+    from hhscatter.formatting import md_cell
+
+    return md_cell(s)
 
 
 # -- renderers -----------------------------------------------------------------
@@ -301,65 +268,17 @@ def _indent(text: str, n: int = 4) -> str:
 
 def comparison_table(rows) -> str:
     """Markdown table of paper-vs-ours rows {quantity, ours, err, paper, unit, verdict, note}."""
-    out = ["| quantity | ours | paper | verdict | note |", "|---|---|---|---|---|"]
-    for r in rows:
-        unit = f" {r['unit']}" if r.get("unit") else ""
-        ours = fmt_err(r.get("ours"), r.get("err")) if _is_num(r.get("ours")) else fmt_value(r.get("ours"))
-        paper = fmt_value(r.get("paper"))
-        out.append(
-            f"| {_cell(r.get('quantity', ''))} | {_cell(ours + unit)} | {_cell(paper)} | "
-            f"{_cell(r.get('verdict') or '—')} | {_cell(r.get('note') or '')} |"
-        )
-    return "\n".join(out) + "\n"
+    from hhscatter.formatting import comparison_table as table
 
-
-def _fix_table_row(line: str) -> str:
-    """Escape the bars of |x| inside a table row: a cell separator has spaces (or the line end) on both sides."""
-    if re.match(r"^\|[\s:|-]+\|\s*$", line):  # the header separator |---|---|
-        return line
-    out = []
-    for i, ch in enumerate(line):
-        if ch == "|" and 0 < i < len(line.rstrip()) - 1 and (line[i - 1] == "\\" or not (
-                line[i - 1] == " " and line[i + 1] == " ")):
-            out.append(ch if line[i - 1] == "\\" else "\\|")
-        else:
-            out.append(ch)
-    return "".join(out)
-
-
-def _fence_plain_tables(text: str) -> str:
-    """Fence plain-text tables (e.g. pandas ``to_string``: a paragraph whose first line is indented)."""
-    out, block, in_fence = [], [], False
-
-    def flush():
-        if block and block[0].startswith("  ") and len(block) > 1 and not block[0].lstrip().startswith(("-", "*", "|")):
-            out.extend(["```text", *block, "```"])
-        else:
-            out.extend(block)
-        block.clear()
-
-    for line in text.splitlines():
-        if line.lstrip().startswith(("```", "~~~")):
-            flush()
-            in_fence = not in_fence
-            out.append(line)
-        elif in_fence:
-            out.append(line)
-        elif line.strip():
-            block.append(line)
-        else:
-            flush()
-            out.append(line)
-    flush()
-    return "\n".join(out) + "\n"
+    return table(rows)
 
 
 def _embed_markdown(text: str, assets: Path, rel) -> str:
     """A summary written for its own folder, embedded in a page: headings demoted, links re-based,
-    ``|x|`` inside table cells escaped, plain-text tables fenced."""
-    text = _fence_plain_tables(text)
-    text = "\n".join(_fix_table_row(ln) if ln.startswith("|") else ln for ln in text.split("\n"))
-    text = re.sub(r"^(#{1,4}) ", lambda m: "#" * (len(m.group(1)) + 2) + " ", text, flags=re.M)
+    ``|x|`` inside table cells escaped, plain-text tables fenced (hhscatter.formatting.embed_markdown)."""
+    from hhscatter.formatting import embed_markdown
+
+    text = embed_markdown(text)
 
     def link(m):
         label, target = m.group(1), m.group(2)

@@ -3,17 +3,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from hhscatter.formatting import format_value_err
 from hhscatter.plotting import agg_pyplot
 
 PT_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
 
 
 def _fmt_err(v, e):
-    """'0.0612 ± 0.0014' with the precision set by the error's first significant digit."""
-    if not (e and np.isfinite(e) and e > 0):
-        return f"{v:.3g}"
-    d = max(0, 1 - int(np.floor(np.log10(e))))
-    return f"{v:.{d}f} ± {e:.{d}f}"
+    """'0.061 ± 0.014': hhscatter.formatting.format_value_err (the report's and the docs' rounding)."""
+    return format_value_err(v, e)
 
 
 def _sci(n):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hhscatter.formatting import format_value_err
 from hhscatter.plotting import agg_pyplot
 
 E_C = 1.0 / 6.0
@@ -40,8 +41,9 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     ax.plot(t[above], me["mean_E_above"].to_numpy()[above], color="#2ca02c", lw=1.2, ls="-.", zorder=4,
             label=r"orbits with $E>E_c$ only")
     inwin = (t >= w_lo) & (t <= w_hi)
+    mu_text = format_value_err(mu, mu_err, sep=r"\pm")
     ax.plot(t[inwin], me["fit_E"].to_numpy()[inwin], "--", color="#d62728", lw=1.6,
-            label=rf"$E_0e^{{-\mu\gamma t}}$, $\mu={mu:.4f}\pm{mu_err:.4f}$ on [{w_lo:g}, {w_hi:g}]")
+            label=rf"$E_0e^{{-\mu\gamma t}}$, $\mu={mu_text}$ on [{w_lo:g}, {w_hi:g}]")
     ax.plot(t[t > w_hi], me["fit_E"].to_numpy()[t > w_hi], ":", color="#d62728", lw=1.0)
     ax.axhline(E_C, color="k", ls=":", lw=0.9)
     t_right = float(t[-1] if t_max is None else t_max)

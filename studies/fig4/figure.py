@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hhscatter.formatting import format_value_err
 from hhscatter.plotting import agg_pyplot
 
 FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294",
@@ -23,11 +24,8 @@ def _colors(gammas):
 
 
 def _pm(v, e):
-    """'v \\pm e' with e to 2 significant digits and v to the same decimals (v to 3 digits without e)."""
-    if not np.isfinite(e) or e <= 0:
-        return f"{v:.3g}"
-    d = max(0, 1 - int(np.floor(np.log10(e))))
-    return rf"{v:.{d}f} \pm {e:.{d}f}"
+    """'v \\pm e' for a LaTeX label: hhscatter.formatting.format_value_err (the report's and the docs' rounding)."""
+    return format_value_err(v, e, sep=r" \pm ")
 
 
 def plot_fig4(surv, ratio, taus, numbers, path, *, mark_gamma=0.01):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hhscatter.formatting import format_value_err
 from hhscatter.plotting import agg_pyplot
 
 RED = "#c0392b"
@@ -87,13 +88,13 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
             row = summary[(summary["gamma"] == g0) & (summary["set"] == s) & (summary["ref"] == ref)].iloc[0]
             Eref = E1 if ref == "E1" else E2
             _debiased(ax, tab, f"Fig. 5{s} vs $\\mu_c^{{{Eref:g}}}$ (m={int(tab['m'].iloc[0])}; "
-                      f"SW$_1$={row['sw1']:.3f}±{row['sw1_err']:.3f}, floor {row['sw1_noise_m']:.3f})",
+                      f"SW$_1$={format_value_err(row['sw1'], row['sw1_err'], sep='±')}, floor {row['sw1_noise_m']:.3f})",
                       col, mk, ls, noise_max)
     ref_tab = dist_tab[dist_tab["set"] == "cm_E2"]
     if len(ref_tab):
         row = summary[summary["set"] == "cm_E2"].iloc[0]
         _debiased(ax, ref_tab, f"$\\mu_c^{{{E2:g}}}$ vs $\\mu_c^{{{E1:g}}}$ (m={int(ref_tab['m'].iloc[0])}; "
-                  f"SW$_1$={row['sw1']:.3f}±{row['sw1_err']:.3f})", "0.45", "^", "-.", noise_max)
+                  f"SW$_1$={format_value_err(row['sw1'], row['sw1_err'], sep='±')})", "0.45", "^", "-.", noise_max)
     ax.axhline(delta, color="k", lw=0.8, ls=":")
     _box_axis(ax, boxes)
     ax.set_ylim(0, 1.3 * ax.get_ylim()[1])  # room for the legend

@@ -1,0 +1,215 @@
+"""Numbers as text: the one ``value ± err`` formatter and the one paper-vs-ours table, for the report, the docs
+and the figures.
+
+* :func:`format_value_err` — ``v ± err`` rounded to the uncertainty (the
+  particle-data convention: one significant digit of the error, two when it
+  starts with 1 or 2; v to the same decimal place);
+* :func:`format_number` — a number alone (4 significant digits);
+* :func:`format_value` — any leaf of a study's numbers JSON (``{value, err}``,
+  ``{value, lo, hi}``, short lists, scalars);
+* :func:`comparison_table` — the Markdown table of a study's
+  ``paper_comparison`` rows (with a study column for several studies);
+* :func:`escape_table_bars` — ``|x|`` inside the cells of a Markdown table
+  written by hand (e.g. ``|ΔH|`` in the benchmark summaries) escaped, so that
+  a Markdown parser sees as many cells as the header; :func:`embed_markdown`
+  — a document written to stand alone (a benchmark summary) made fit to be
+  embedded in another: headings demoted, plain-text tables fenced, bars escaped;
+* :func:`markdown_to_html` — Python-Markdown with the extensions the report needs.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+__all__ = [
+    "comparison_table",
+    "embed_markdown",
+    "escape_table_bars",
+    "format_number",
+    "format_value",
+    "format_value_err",
+    "markdown_to_html",
+    "md_cell",
+]
+
+
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def format_number(v, sig: int = 4, *, html: bool = False) -> str:
+    """format_number(v, sig=4, *, html=False) -> v to ``sig`` significant digits; "—" for None.
+
+    Integers are written in full, booleans as true/false. With ``html``,
+    magnitudes outside [1e-3, 1e5) are written a×10<sup>b</sup> (web pages),
+    otherwise in Python's e-notation (plain text, figures).
+    """
+    if v is None:
+        return "—"
+    if isinstance(v, str):
+        return v
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if not _is_num(v):
+        return str(v)
+    v = float(v)
+    if not math.isfinite(v):
+        return str(v)
+    if v == 0:
+        return "0"
+    if html and not 1e-3 <= abs(v) < 1e5:
+        m, e = f"{v:.{sig - 1}e}".split("e")
+        return f"{m}×10<sup>{int(e)}</sup>"
+    return f"{v:.{sig}g}"
+
+
+def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
+    """format_value_err(v, err=None, *, sep=" ± ") -> "v ± err" rounded to the uncertainty.
+
+    One significant digit of ``err``, two when it starts with 1 or 2 (e.g.
+    0.912 ± 0.003, 0.310 ± 0.012, 152 ± 7); v to the same decimal place.
+    Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15).
+    Without a usable error (None, NaN, < 0) the value alone; an error of 0 is
+    written "± 0". ``sep`` e.g. r" \\pm " inside LaTeX labels of figures.
+    """
+    if not _is_num(v) or (isinstance(v, float) and not math.isfinite(v)):
+        return format_number(v)
+    if not _is_num(err) or not math.isfinite(err) or err < 0:
+        return format_number(v)
+    if err == 0:
+        return f"{format_number(v)}{sep}0"
+    exp10 = int(math.floor(math.log10(err)))
+    digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
+    if abs(v) >= 1e4 or digits > 5:
+        return f"{v:.3g}{sep}{err:.1e}" if v != 0 else f"0{sep}{err:.1e}"
+    return f"{v:.{digits}f}{sep}{err:.{digits}f}"
+
+
+def format_value(v, *, html: bool = False) -> str:
+    """format_value(v) -> text of one numbers-JSON leaf: {value, err} → v ± err, {value, lo, hi} → v [lo, hi],
+    short lists element by element, longer lists and tables by their size."""
+    if isinstance(v, dict) and "value" in v:
+        if v.get("value") is None:
+            return "—"
+        if _is_num(v.get("lo")) and _is_num(v.get("hi")):
+            return (f"{format_number(v['value'], html=html)} [{format_number(v['lo'], html=html)}, "
+                    f"{format_number(v['hi'], html=html)}]")
+        return format_value_err(v.get("value"), v.get("err"))
+    if isinstance(v, (list, tuple)):
+        if len(v) <= 8 and all(_is_num(x) or isinstance(x, str) or x is None for x in v):
+            return "[" + ", ".join(format_number(x, html=html) for x in v) + "]"
+        if len(v) <= 8 and all(isinstance(x, dict) and "value" in x for x in v):
+            return "[" + ", ".join(format_value(x, html=html) for x in v) + "]"
+        if len(v) <= 4 and all(isinstance(x, (list, tuple)) and len(x) <= 4 for x in v):
+            return "[" + ", ".join(format_value(x, html=html) for x in v) + "]"
+        return f"*({len(v)} entries; see the JSON)*"
+    if isinstance(v, dict):
+        return f"*({len(v)} fields; see the JSON)*"
+    return format_number(v, html=html)
+
+
+def md_cell(s) -> str:
+    """Text for one cell of a Markdown table: bars escaped, on one line."""
+    return str(s).replace("|", "\\|").replace("\n", " ")
+
+
+def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) -> str:
+    """comparison_table(rows, *, study=False, quantity=None, verdict=None) -> Markdown table.
+
+    ``rows``: paper-vs-ours rows {quantity, ours, err, paper, unit, verdict,
+    note} (and ``study`` for a leading study column). ``quantity`` and
+    ``verdict`` may map a row / a verdict to the text of their cell (e.g. a
+    link, or a coloured span in HTML). Columns: quantity, ours, paper,
+    verdict, note.
+    """
+    head = ["study"] * study + ["quantity", "ours", "paper", "verdict", "note"]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        unit = f" {r['unit']}" if r.get("unit") else ""
+        ours = (format_value_err(r.get("ours"), r.get("err")) if _is_num(r.get("ours"))
+                else format_value(r.get("ours")))
+        v = r.get("verdict") or "—"
+        cells = [r.get("study", "")] * study + [
+            quantity(r) if quantity else md_cell(r.get("quantity", "")),
+            md_cell(ours + unit), md_cell(format_value(r.get("paper"))),
+            verdict(v) if verdict else md_cell(v), md_cell(r.get("note") or "")]
+        out.append("| " + " | ".join(str(c) for c in cells) + " |")
+    if not rows:
+        out.append("| " + " | ".join(["—"] * study + ["no study outputs found", "", "", "", ""]) + " |")
+    return "\n".join(out) + "\n"
+
+
+_SEPARATOR = re.compile(r"^\|[\s:|-]+\|\s*$")
+
+
+def _escape_row(line: str) -> str:
+    """Escape the bars of |x| inside a table row: a cell separator has spaces (or the line end) on both sides."""
+    if _SEPARATOR.match(line):
+        return line
+    out = []
+    end = len(line.rstrip()) - 1
+    for i, ch in enumerate(line):
+        if ch == "|" and 0 < i < end and (line[i - 1] == "\\" or not (line[i - 1] == " " and line[i + 1] == " ")):
+            out.append(ch if line[i - 1] == "\\" else "\\|")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+def escape_table_bars(text: str) -> str:
+    """escape_table_bars(markdown) -> the same text with ``|x|`` inside table cells escaped (``\\|x\\|``)."""
+    return "\n".join(_escape_row(ln) if ln.startswith("|") else ln for ln in text.split("\n"))
+
+
+def _fence_plain_tables(text: str) -> str:
+    """Fence plain-text tables (e.g. pandas ``to_string``: a paragraph whose first line is indented)."""
+    out, block, in_fence = [], [], False
+
+    def flush():
+        if block and block[0].startswith("  ") and len(block) > 1 and not block[0].lstrip().startswith(("-", "*", "|")):
+            out.extend(["```text", *block, "```"])
+        else:
+            out.extend(block)
+        block.clear()
+
+    for line in text.splitlines():
+        if line.lstrip().startswith(("```", "~~~")):
+            flush()
+            in_fence = not in_fence
+            out.append(line)
+        elif in_fence:
+            out.append(line)
+        elif line.strip():
+            block.append(line)
+        else:
+            flush()
+            out.append(line)
+    flush()
+    return "\n".join(out) + "\n"
+
+
+def embed_markdown(text: str, demote: int = 2) -> str:
+    """embed_markdown(text, demote=2) -> a standalone Markdown document fit to be embedded in another.
+
+    Plain-text tables fenced, ``|x|`` inside table cells escaped, headings
+    (levels 1–4, outside code) demoted by ``demote`` levels.
+    """
+    text = escape_table_bars(_fence_plain_tables(text))
+    out, in_fence = [], False
+    for line in text.split("\n"):
+        if line.lstrip().startswith(("```", "~~~")):
+            in_fence = not in_fence
+        elif not in_fence:
+            line = re.sub(r"^(#{1,4}) ", lambda m: "#" * (len(m.group(1)) + demote) + " ", line)
+        out.append(line)
+    return "\n".join(out)
+
+
+def markdown_to_html(text: str) -> str:
+    """markdown_to_html(text) -> HTML by Python-Markdown (tables, fenced code, attribute lists, raw HTML kept)."""
+    import markdown
+
+    return markdown.markdown(text, extensions=["tables", "fenced_code", "attr_list", "sane_lists"],
+                             output_format="html")
