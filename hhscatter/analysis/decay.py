@@ -13,6 +13,8 @@ squares on log⟨E⟩ and reports μ = 0.91 on t ∈ [0, 200] for (E0, γ) =
 
 Functions here are pure (no file I/O, no plotting):
 
+* :func:`energy_path`, :func:`time_to_energy` — the law itself and its
+  inverse (t* of Fig. 5; τ2 of Eq. (eq:tau2) is the case E1 = E_c);
 * :func:`mean_energy` / :func:`mean_energy_arrays` — ⟨E⟩, σ_E and its standard
   error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
 * :func:`pool_mean_energy` — the same statistics pooled over several tables
@@ -45,6 +47,7 @@ __all__ = [
     "InsideMeanEnergy",
     "bootstrap_mu",
     "bootstrap_mu_first_orbits",
+    "energy_path",
     "energy_histograms",
     "energy_histograms_arrays",
     "fit_energy_decay",
@@ -55,6 +58,7 @@ __all__ = [
     "mu_by_window",
     "pool_mean_energy",
     "snapshot_grid",
+    "time_to_energy",
 ]
 
 
@@ -78,6 +82,30 @@ def snapshot_grid(pieces) -> np.ndarray:
     if g.size == 0 or np.any(np.diff(g) <= 0):
         raise ValueError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
     return g
+
+
+# ---------------------------------------------------------------------------
+# the homogeneous law E(t) = E0 exp(−μγt)
+# ---------------------------------------------------------------------------
+def energy_path(t, E0: float, mu: float, gamma: float):
+    """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
+    return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
+
+
+def time_to_energy(E0, E1, mu, gamma):
+    """time_to_energy(E0, E1, mu, gamma) -> t* with E0 exp(−μγt*) = E1, i.e. ln(E0/E1)/(μγ).
+
+    Inverse of Eq. (eqn:energy_exp_decay); the paper's Fig. 5 time t* ≈ 17
+    for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
+    special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
+    """
+    E0, E1, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E1, mu, gamma)))
+    if np.any(E1 <= 0) or np.any(E0 < E1):
+        raise ValueError("need E0 >= E1 > 0")
+    if np.any(mu * gamma <= 0):
+        raise ValueError("need mu*gamma > 0")
+    out = np.log(E0 / E1) / (mu * gamma)
+    return float(out) if out.ndim == 0 else out
 
 
 # ---------------------------------------------------------------------------

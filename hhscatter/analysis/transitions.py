@@ -220,7 +220,7 @@ def bootstrap_transition_times(
     length N, same order); ``reference``: the label of the conservative
     ensemble (P_0).  ``tau0``: a float, or a callable ``tau0(grid, P_0, n)``
     returning τ0 from the replicate's P_0 (n = effective ensemble size) —
-    e.g. the data-driven rule of :func:`hhscatter.analysis.escape_rate.choose_windows`.
+    e.g. the data-driven rule of :func:`hhscatter.analysis.windows.choose_windows`.
     Returns one row per (replicate, label != reference): ``replicate, label,
     tau0, tau1, tau2_obs, t_settle_q<q>...`` (NaN where undefined).
     """

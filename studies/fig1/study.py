@@ -41,7 +41,6 @@ import math
 import numpy as np
 
 from hhscatter.config import Integer, Number, Numbers, StudyParams
-from hhscatter.model import HenonHeiles
 from hhscatter.runner import SCENE_FILE
 
 
@@ -59,7 +58,6 @@ class Params(StudyParams):
     grid_points: Integer
 
 
-E_C = HenonHeiles().critical_energy
 CMEASURE_TABLE = "cmeasure_points.parquet"  # published: other studies read it (derived/), never the raw runs
 
 
@@ -145,7 +143,8 @@ def analyze(study):
     from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
     from hhscatter.tables import read_lifetimes, read_sections
 
-    model = HenonHeiles()
+    model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
+    E_C = model.critical_energy
     rec_efolds = float(study.param("rec_efolds"))
     choices = json.loads(_choices_path(study).read_text())
     per_energy, points = {}, []

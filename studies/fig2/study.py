@@ -40,7 +40,6 @@ import warnings
 import numpy as np
 
 from hhscatter.config import Integer, Integers, Number, Numbers, StudyParams
-from hhscatter.model import HenonHeiles
 from hhscatter.runner import SCENE_FILE
 
 
@@ -73,7 +72,6 @@ class Params(StudyParams):
     fit_seed: Integer
 
 
-E_C = HenonHeiles().critical_energy
 PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
 LIFETIME_COLUMNS = ["traj_id", "e0", "gamma", "outcome", "t_end"]
 
@@ -213,8 +211,9 @@ def _plot_grid(t_last, n_lin=4001, n_log=600):
 def _analyze_grid(study):
     import pandas as pd
 
-    from hhscatter.analysis.escape_rate import fit_kappa_energy
+    from hhscatter.analysis.kappa_energy import fit_kappa_energy
 
+    E_C = study.model.critical_energy
     rows = []
     tmax_choices = json.loads(_choices_path(study).read_text())["t_max"]
     for energy in study.param("grid_energies"):
@@ -261,7 +260,7 @@ def _fit_json(fit):
     return out
 
 
-def _fit_curve_table(fit, sep, x_max):
+def _fit_curve_table(fit, sep, x_max, E_C):
     import pandas as pd
 
     x = np.linspace(0.0, x_max * 1.03, 400)
@@ -293,6 +292,7 @@ def _analyze_pt(study):
     )
     from hhscatter.analysis.survival import lifetimes_to_arrays, survival_curve
 
+    E_C = study.model.critical_energy
     curves, lines, numbers = [], [], {}
     for energy in study.param("pt_energies"):
         energy = float(energy)
@@ -371,12 +371,11 @@ def _analyze_pt(study):
 def _analyze_cmeasure(study, grid_df):
     import pandas as pd
 
-    from hhscatter.analysis.escape_rate import (
-        cmeasure_sample_from_sections,
-        escape_rate_from_lifetimes,
-        kappa_from_cmeasure,
-    )
+    from hhscatter.analysis.cmeasure import cmeasure_sample_from_sections, kappa_from_cmeasure
+    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
     from hhscatter.tables import read_sections
+
+    E_C = study.model.critical_energy
 
     rows = []
     n_boot = int(study.param("n_boot"))
@@ -447,8 +446,9 @@ def _analyze_cmeasure(study, grid_df):
 
 def analyze(study):
     """analyze(study) -> None; derived tables and fig2.json (see the module docstring)."""
+    E_C = study.model.critical_energy
     grid_df, fit, sep = _analyze_grid(study)
-    study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max())), "kappa_fit_curve.parquet",
+    study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
                       description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
     fj, sj = _fit_json(fit), _fit_json(sep)
     for name in ("a", "b", "c", "E_b"):

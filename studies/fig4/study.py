@@ -10,7 +10,7 @@ Definitions used here (all times in model units):
 * τ0 — end of the irregular initial regime; the paper says it is
   effectively independent of γ, so it is measured once, on the conservative
   curve P_0, by the data-driven rule of
-  :func:`hhscatter.analysis.escape_rate.choose_windows` (the first time after
+  :func:`hhscatter.analysis.windows.choose_windows` (the first time after
   which the local escape rate stays within 10 % / 3σ of its plateau value;
   the same rule as the Fig. 2 escape-rate fits).
 * τ1 — Eq. (eqn:tau1): first t ≥ τ0 with P_γ(t) = α P_0(t), α = 2
@@ -98,7 +98,7 @@ def simulate(study, workers=None, progress=True):
 
 
 def _tau0_rule(grid, P0, n):
-    from hhscatter.analysis.escape_rate import choose_windows
+    from hhscatter.analysis.windows import choose_windows
 
     return choose_windows(grid, P0, n_total=n).tau0
 

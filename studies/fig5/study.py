@@ -64,7 +64,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis import distance as dist
-from hhscatter.analysis.model import time_to_energy
+from hhscatter.analysis.decay import time_to_energy
 from hhscatter.config import Integer, Number, Numbers, StudyParams, Text
 from hhscatter.studies import _upstream as up
 

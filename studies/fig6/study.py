@@ -26,7 +26,7 @@ analyze    inputs (the studies of ``[needs]``, their published outputs only):
            number of free parameters (K energy quantiles at t_ref = τ0,
            per-orbit μ_i from the snapshots, one shared trapped fraction φ).
            For fig4's γ values: the homogeneous fit and the model's τ1
-           (:func:`hhscatter.analysis.model.predict_tau1` against fig4's γ = 0
+           (:func:`hhscatter.analysis.survival_model.predict_tau1` against fig4's γ = 0
            curve), τ2 = ln(E0/E_c)/(μγ).  Writes derived tables and fig6.json.
 plot       Fig. 6 from the derived tables.
 
@@ -41,7 +41,9 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis import model as mdl
+from hhscatter.analysis import mixture
+from hhscatter.analysis import survival_model as sm
+from hhscatter.analysis.kappa_law import PiecewiseKappa
 from hhscatter.analysis.survival import survival_from_lifetimes
 from hhscatter.analysis.transitions import tau2_observed, tau2_predicted
 from hhscatter.config import (
@@ -132,7 +134,7 @@ def _inputs(study):
         key = study.param("kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
         kv[name], _ = up.value_or_fallback(study, ks, key, PAPER_KAPPA[name], inputs, f"kappa_{name}")
     E_c = study.model.critical_energy  # E_c = ω⁶/(6λ²) of the scene's model
-    kappa = mdl.PiecewiseKappa(a2=float(kv["a"]), a1=float(kv["b"]), slope=float(kv["c"]),
+    kappa = PiecewiseKappa(a2=float(kv["a"]), a1=float(kv["b"]), slope=float(kv["c"]),
                                E_switch=float(kv["E_b"]), E_c=E_c)
     mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
     tau0, _ = up.value_or_fallback(study, study.upstream("tau"), study.param("tau0_key"), DEV_TAU0, inputs, "tau0")
@@ -195,7 +197,7 @@ def _homogeneous_fits(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, tau0, E_
     starts = [None, {"f_ne": fne, "L": 1.0, "b": 1.0}, {"f_ne": fne, "L": 3.0, "b": 0.3}]
     fits = {}
     for h in hazards:
-        fits[h] = _best(lambda p0, h=h: mdl.fit_survival_model(
+        fits[h] = _best(lambda p0, h=h: sm.fit_survival_model(
             tf, Pf, sf, kappa_of_E=kappa, E0=E0, mu=mu, gamma=gamma, tau0=tau0, E_c=E_c, hazard=h,
             fit_tau2=fit_tau2, P_min=P_min, P_tau0=P_tau0, p0=p0), starts)
     return fits
@@ -227,7 +229,7 @@ def _mixture_fits(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, mode, P
             alt[f"f_ne_{k}"] = max(min(left, cap), 1e-9)
             left -= min(left, cap)
     starts = [None, {**alt, "L": 1.0, "b": 1.0}, {**alt, "L": 3.0, "b": 0.3}]
-    return {h: _best(lambda p0, h=h: mdl.fit_mixture_model(
+    return {h: _best(lambda p0, h=h: mixture.fit_mixture_model(
         tf, Pf, sf, comps, kappa_of_E=kappa, tau0=tau0, E_c=E_c, P_tau0=P_tau0, fne_mode=mode, hazard=h,
         P_min=P_min, p0=p0), starts) for h in hazards}
 
@@ -262,7 +264,7 @@ def analyze(study):
         mixes = {}
         for var in mixtures:
             t_ref = tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
-            comps = mdl.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=K, by=var["by"],
+            comps = mixture.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=K, by=var["by"],
                                            fit_window=(tau0, w_hi))
             comp_rows.append(comps.to_frame().assign(pair=label, E0=E0, gamma=g, model=var["name"]))
             mixes[var["name"]] = _mixture_fits(t, P, tf, Pf, sf, comps, kappa=kappa, tau0=tau0, E_c=E_c,
@@ -275,7 +277,7 @@ def analyze(study):
             for name, f in models.items():
                 fit_rows.append(_fit_row(label, name, h, f, extra))
                 cur[f"{name}_{h}"] = f.predict(t)
-            cmp = mdl.compare_fits(models).reset_index()
+            cmp = sm.compare_fits(models).reset_index()
             cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
         curves.append(cur.assign(pair=label, E0=E0, gamma=g, N=n))
     curves = pd.concat(curves, ignore_index=True)
@@ -404,7 +406,7 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
                     row[f"f_ne_{h}"] = float(fits[h].values["f_ne"])
                     row[f"rms_{h}"] = float(fits[h].rms_log_residual)
                     if t0c is not None:
-                        row[f"tau1_pred_{h}"] = mdl.predict_tau1(fits[h], (t0c, P0c), float(study.param("alpha")))
+                        row[f"tau1_pred_{h}"] = sm.predict_tau1(fits[h], (t0c, P0c), float(study.param("alpha")))
         rows.append(row)
     taus = pd.DataFrame(rows)
     gg = np.geomspace(min(taus["gamma"].min(), 1e-3) * 0.8, max(taus["gamma"].max(), 0.02) * 1.25, 200) \

@@ -7,7 +7,7 @@ observations.  This study measures, at E = 0.25, 0.30, 0.35:
 1. κ for r_esc ∈ {1.03, 1.1, 1.5, 2.0} on the *same* initial conditions
    (paired), every cell by the same rules.  One common window per energy:
    the median of the four cells' exponential-regime windows found by
-   :func:`~hhscatter.analysis.escape_rate.choose_windows` (the paper's rule),
+   :func:`~hhscatter.analysis.windows.choose_windows` (the paper's rule),
    started no earlier than the time where the r_ref curve has fallen to
    ``p_start`` = 0.1 (the prompt-escape transient, whose hazard peak at
    t ≈ 5 and ringing would otherwise be shifted in and out of the window by
