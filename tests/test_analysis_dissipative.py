@@ -533,3 +533,33 @@ def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
     assert scale == 0.5
     with pytest.raises(ValueError, match="k must be in"):
         decay.bootstrap_mu_first_orbits(rows, n, 0, E0, GAMMA, [(0.0, 95.0)])
+
+
+def test_homogeneous_fit_steps_alone():
+    """The steps of fit_survival_model (start values, bounds, parameters from θ, starts, one fit at fixed τ2)."""
+    from hhscatter.analysis.survival_model import HomogeneousProblem, homogeneous_start
+
+    t = np.arange(0.0, 301.0)
+    P = model.survival_model(t, **KW, **TRUE, hazard="paper")
+    sel = (t >= KW["tau0"]) & np.isfinite(P) & (P > 1e-4)
+    tf, Pf = t[sel], P[sel]
+    sf = 1e-3 * Pf
+    P_tau0 = float(np.interp(KW["tau0"], t[np.isfinite(P)], P[np.isfinite(P)]))
+    tau2 = transitions.tau2_predicted(KW["E0"], EC, KW["mu"], KW["gamma"])
+    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2, P_tau0, {}, None)
+    assert 0 < fne0 <= 0.9 * P_tau0 and fe0 == pytest.approx(P_tau0 - fne0) and L0 > 0
+    assert b_starts == (0.02, 0.1, 0.5)
+    assert homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
+    prob = HomogeneousProblem(tf, Pf, sf, KW["kappa_of_E"], KW["E0"], KW["mu"], KW["gamma"], KW["tau0"], EC,
+                              "paper", "log", ("f_ne", "L", "b"), {}, {"f_ne": fne0, "f_e": fe0, "L": L0},
+                              b_starts, True, P_tau0)
+    lo, hi = prob.bounds()
+    assert hi[0] == P_tau0 and lo[1] == 1e-9 and hi[2] == 1e3
+    v = prob.values([0.2, 0.3, 0.4], tau2)
+    assert v["f_e"] == pytest.approx(P_tau0 - 0.2) and v["tau2"] == tau2 and (v["L"], v["b"]) == (0.3, 0.4)
+    assert len(prob.starts()) == 3 and prob.starts([1, 2, 3], warm_only=True) == [[1, 2, 3]]
+    sol, chi2, res = prob.fit_at(tau2)
+    fitted = prob.values(sol.x, tau2)
+    for name in ("f_ne", "L", "b"):
+        assert fitted[name] == pytest.approx(TRUE[name], rel=1e-4), name
+    assert chi2 < 1e-6 and np.allclose(prob.model(fitted)(tf), Pf, rtol=1e-6)

@@ -49,10 +49,12 @@ from .transitions import tau2_predicted
 __all__ = [
     "E_C",
     "HAZARDS",
+    "HomogeneousProblem",
     "SurvivalFit",
     "SurvivalModelParams",
     "compare_fits",
     "fit_survival_model",
+    "homogeneous_start",
     "predict_tau1",
     "settling_rate",
     "survival_model",
@@ -430,127 +432,175 @@ def fit_survival_model(
     if "tau2" in fixed:
         tau2_eq, fit_tau2 = float(fixed.pop("tau2")), False
 
-    free = [n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total)]
+    free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
+    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
+    prob = HomogeneousProblem(tf, Pf, sf, kappa_of_E, E0, mu, gamma, tau0, E_c, hazard, space, free, fixed,
+                              {"f_ne": fne0, "f_e": fe0, "L": L0}, b_starts, constrain_total, P_tau0)
+
+    tau2_err = 0.0
+    if fit_tau2:
+        tau2_fit, tau2_err, sol, c2min, res = prob.fit_tau2(absolute_sigma)
+    else:
+        tau2_fit = tau2_eq
+        sol, c2min, res = prob.fit_at(tau2_fit)
+
+    k = len(free) + (1 if fit_tau2 else 0)
+    theta = sol.x if sol is not None else np.array([])
+    v = prob.values(theta, tau2_fit)
+    model = prob.model(v)
+    curve_vals = model(tf)
+    r = res(theta)
+    # propagate the error of the measured P(τ0) through the constraint
+    refit = ((lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0])
+             if prob.derive_fe else None)
+    st = _fit_stats(sol, curve_vals, tf, Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
+    errors["tau2"] = tau2_err
+    values = dict(v)
+    values["P_tau0"] = P_tau0
+    errors["P_tau0"] = P_tau0_err
+    return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, space)
+
+
+def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
+    """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
+    values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
+    L ≈ the late log-slope of P, and three starts for b unless given."""
     p0 = dict(p0 or {})
 
-    # data-driven starting values
     def p_near(tq):
         return float(np.exp(np.interp(tq, tf, np.log(Pf))))
 
-    fne0 = p0.get("f_ne", fixed.get("f_ne", min(max(p_near(tau2_eq), 1e-8), 0.9 * P_tau0)))
+    fne0 = p0.get("f_ne", fixed.get("f_ne", min(max(p_near(tau2), 1e-8), 0.9 * P_tau0)))
     fe0 = p0.get("f_e", fixed.get("f_e", max(P_tau0 - fne0, 1e-8)))
-    late = tf > tau2_eq
+    late = tf > tau2
     if late.sum() >= 3:
         hl = tf[late] >= np.median(tf[late])
         slope = -np.polyfit(tf[late][hl], np.log(Pf[late][hl]), 1)[0] if hl.sum() >= 2 else 0.05
         L0 = p0.get("L", max(slope, 1e-3))
     else:
         L0 = p0.get("L", 0.05)
-    b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
+    b_starts = (p0["b"],) if "b" in p0 else (0.02, 0.1, 0.5)
+    return fne0, fe0, L0, b_starts
 
-    derive_fe = constrain_total and "f_e" not in fixed
 
-    def limits(P0v):
-        bounds = {
-            "f_ne": (0.0, P0v if constrain_total else 1.0),
-            "f_e": (0.0, 1.0),
-            "L": (1e-9, 1e3),
-            "b": (1e-6, 1e3),
-        }
-        lo_b = np.array([bounds[n][0] for n in free], dtype=float)
-        return lo_b, np.array([bounds[n][1] for n in free], dtype=float)
+@dataclass(frozen=True)
+class HomogeneousProblem:
+    """The least-squares problem of :func:`fit_survival_model` on its selected points (tf, Pf ± sf).
 
-    def unpack(theta, tau2v, P0v=P_tau0):
-        v = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b_starts[0]}
-        v.update(fixed)
-        v.update(dict(zip(free, theta)))
-        if derive_fe:
-            v["f_e"] = P0v - v["f_ne"]
-        v["tau2"] = tau2v
+    ``free`` the fitted parameters (in order: θ), ``fixed`` the held ones,
+    ``start`` the starting f_ne, f_e, L and ``b_starts`` the starts for b;
+    with ``constrain_total`` (and f_e not fixed) f_e = P(τ0) − f_ne. Each step
+    of the fit is a method, testable alone.
+    """
+
+    tf: np.ndarray
+    Pf: np.ndarray
+    sf: np.ndarray
+    kappa_of_E: Callable
+    E0: float
+    mu: float
+    gamma: float
+    tau0: float
+    E_c: float
+    hazard: str
+    space: str
+    free: tuple
+    fixed: dict
+    start: dict
+    b_starts: tuple
+    constrain_total: bool
+    P_tau0: float
+
+    @property
+    def derive_fe(self) -> bool:
+        return self.constrain_total and "f_e" not in self.fixed
+
+    def bounds(self, P0=None):
+        """(lo, hi) of θ: 0 ≤ f_ne ≤ P(τ0) (or 1), 0 ≤ f_e ≤ 1, L ∈ [1e-9, 1e3], b ∈ [1e-6, 1e3]."""
+        P0 = self.P_tau0 if P0 is None else P0
+        bounds = {"f_ne": (0.0, P0 if self.constrain_total else 1.0), "f_e": (0.0, 1.0), "L": (1e-9, 1e3),
+                  "b": (1e-6, 1e3)}
+        return (np.array([bounds[n][0] for n in self.free], dtype=float),
+                np.array([bounds[n][1] for n in self.free], dtype=float))
+
+    def values(self, theta, tau2, P0=None) -> dict:
+        """All parameters from θ: the starts, overridden by ``fixed``, then θ; f_e derived; τ2 set."""
+        v = {**self.start, "b": self.b_starts[0]}
+        v.update(self.fixed)
+        v.update(dict(zip(self.free, theta)))
+        if self.derive_fe:
+            v["f_e"] = (self.P_tau0 if P0 is None else P0) - v["f_ne"]
+        v["tau2"] = tau2
         return v
 
-    def make(v):
-        return SurvivalModelParams(
-            kappa_of_E, E0, mu, gamma, tau0, v["tau2"], v["f_ne"], v["f_e"], v["L"], v["b"], E_c, hazard
-        )
+    def model(self, v: dict) -> "SurvivalModelParams":
+        return SurvivalModelParams(self.kappa_of_E, self.E0, self.mu, self.gamma, self.tau0, v["tau2"], v["f_ne"],
+                                   v["f_e"], v["L"], v["b"], self.E_c, self.hazard)
 
-    def starts_for(prev=None, warm_only=False):
+    def starts(self, prev=None, warm_only: bool = False) -> list:
+        """Starting θ: a previous solution (warm start) first, then one per start of b."""
         out = []
         if prev is not None:
             out.append(prev)
             if warm_only:
                 return out
-        for b0 in b_starts:
-            guess = {"f_ne": fne0, "f_e": fe0, "L": L0, "b": b0}
-            out.append([guess[n] for n in free])
+        for b0 in self.b_starts:
+            guess = {**self.start, "b": b0}
+            out.append([guess[n] for n in self.free])
         return out
 
-    def fit_at(tau2v, prev=None, warm_only=False, P0v=P_tau0):
-        curve = lambda th: make(unpack(th, tau2v, P0v))(tf)  # noqa: E731
-        res = _residual_fn(curve, Pf, sf, space)
-        if not free:
+    def fit_at(self, tau2, prev=None, warm_only: bool = False, P0=None):
+        """(solution or None, χ², residual function) of the fit with τ2 held at ``tau2``."""
+        curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)  # noqa: E731
+        res = _residual_fn(curve, self.Pf, self.sf, self.space)
+        if not self.free:
             r = res(np.array([]))
             return None, float(np.sum(r**2)), res
-        sol = _lsq(res, starts_for(prev, warm_only), *limits(P0v))
+        sol = _lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
         return sol, float(2 * sol.cost), res
 
-    tau2_err = 0.0
-    if fit_tau2:
-        t_lo_b, t_hi_b = tau0 + 1e-9, float(tf[-1])
-        # profile chi2 over tau2: coarse scan (warm-started), then a fine scan
-        # around the best coarse point
-        # (each point: warm start from the neighbour plus the default starts)
-        def profile(taus):
-            prof, sols, prev = [], [], None
-            for tv in taus:
-                sol, c2, _ = fit_at(tv, prev)
-                prev = None if sol is None else sol.x
-                prof.append(c2)
-                sols.append(prev)
-            return np.array(prof), sols
+    def profile(self, taus):
+        """χ² profile over τ2 (each point warm-started from its neighbour): (χ² array, solutions)."""
+        prof, sols, prev = [], [], None
+        for tv in taus:
+            sol, c2, _ = self.fit_at(tv, prev)
+            prev = None if sol is None else sol.x
+            prof.append(c2)
+            sols.append(prev)
+        return np.array(prof), sols
 
-        grid = np.linspace(t_lo_b, t_hi_b, 25)
-        prof, sols = profile(grid)
+    def fit_tau2(self, absolute_sigma: bool = True):
+        """τ2 fitted by profiling χ²: a coarse scan over [τ0, t_last], then a fine one around its minimum; the
+        error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``).
+        Returns (τ2, σ_τ2, solution, χ², residual function)."""
+        grid = np.linspace(self.tau0 + 1e-9, float(self.tf[-1]), 25)
+        prof, _ = self.profile(grid)
         i = int(np.argmin(prof))
         fine = np.linspace(grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)], 21)
-        fprof, fsols = profile(fine)
+        fprof, fsols = self.profile(fine)
         j = int(np.argmin(fprof))
         tau2_best = float(fine[j])
-        sol, c2min, res = fit_at(tau2_best, fsols[j])
-        dof = tf.size - len(free) - 1
+        sol, c2min, res = self.fit_at(tau2_best, fsols[j])
+        dof = self.tf.size - len(self.free) - 1
         scale = 1.0 if absolute_sigma else max(c2min / max(dof, 1), 1e-300)
         inside = fine[fprof <= min(c2min, fprof.min()) + scale]
         step = fine[1] - fine[0]
-        tau2_err = float(max((inside.max() - inside.min()) / 2, step / 2)) if inside.size else float("nan")
-        tau2_fit = tau2_best
-    else:
-        tau2_fit = tau2_eq
-        sol, c2min, res = fit_at(tau2_fit)
+        err = float(max((inside.max() - inside.min()) / 2, step / 2)) if inside.size else float("nan")
+        return tau2_best, err, sol, c2min, res
 
-    k = len(free) + (1 if fit_tau2 else 0)
-    theta = sol.x if sol is not None else np.array([])
-    v = unpack(theta, tau2_fit)
-    model = make(v)
-    curve_vals = model(tf)
-    r = res(theta)
-    # propagate the error of the measured P(τ0) through the constraint
-    refit = (lambda dP: fit_at(tau2_fit, sol.x, warm_only=True, P0v=P_tau0 + dP)[0]) if derive_fe else None
-    st = _fit_stats(sol, curve_vals, tf, Pf, r, k, absolute_sigma, P_tau0_err, refit)
-    cov_fit, sens, cov = st.cov_fit, st.sens, st.cov
+
+def _homogeneous_errors(free, st, derive_fe: bool, P_tau0_err: float) -> dict:
+    """1σ errors of f_ne, f_e, L, b from the fit statistics; f_e = P(τ0) − f_ne carries P(τ0)'s error."""
     errors = {n: 0.0 for n in _HOMOG}
     for i, n in enumerate(free):
-        errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
+        errors[n] = float(np.sqrt(max(st.cov[i, i], 0.0)))
     if derive_fe:
         i_f = free.index("f_ne") if "f_ne" in free else None
-        var_fit = cov_fit[i_f, i_f] if i_f is not None else 0.0
-        dfe_dP = 1.0 - (sens[i_f] if i_f is not None else 0.0)
+        var_fit = st.cov_fit[i_f, i_f] if i_f is not None else 0.0
+        dfe_dP = 1.0 - (st.sens[i_f] if i_f is not None else 0.0)
         errors["f_e"] = float(np.sqrt(max(var_fit, 0.0) + (dfe_dP * P_tau0_err) ** 2))
-    errors["tau2"] = tau2_err
-    values = dict(v)
-    values["P_tau0"] = P_tau0
-    errors["P_tau0"] = P_tau0_err
-    return _survival_fit(model, values, errors, tuple(free) + (("tau2",) if fit_tau2 else ()), st, tf, r, sol,
-                         space)
+    return errors
 
 
 # ---------------------------------------------------------------------------
