@@ -109,34 +109,64 @@ def _plot_grid(t_last):
 
 
 def analyze(study):
-    """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json."""
-    import pyarrow.dataset as ds
+    """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json.
 
-    from hhscatter.analysis.decay import (
-        bootstrap_mu_first_orbits,
-        fit_energy_decay,
-        inside_mean_energy,
-    )
-    from hhscatter.analysis.survival import (
-        observed_from_outcome,
-        survival_from_lifetimes,
-    )
-    from hhscatter.analysis.transitions import (
-        bootstrap_transition_times,
-        power_law_exponent,
-        settle_time_quantiles,
-        survival_on_grid,
-        tau1,
-        tau2_observed,
-        tau2_predicted,
-    )
-    from hhscatter.tables import iter_parts, read_lifetimes, read_snapshots
+    Steps: the paired lifetimes (:func:`_read_lifetimes`), P(t) on the τ grid and
+    τ0, the study's own μ (:func:`_own_mu`), the paired bootstrap, the τ table
+    (:func:`_tau_table`), the figure's tables (:func:`_figure_tables`), the
+    paper comparison (:func:`_compare`) and the numbers (:func:`_numbers`).
+    """
+    from hhscatter.analysis.survival import observed_from_outcome
+    from hhscatter.analysis.transitions import bootstrap_transition_times, survival_on_grid
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
-    E_C = study.model.critical_energy
     alpha = float(study.param("alpha"))
     dt = float(study.param("tau_grid_step"))
+    lts, N, t_last = _read_lifetimes(study, gs)
+
+    # fine grid for τ0/τ1 (P on it is exact: no censoring before t_max in these runs)
+    grid = np.round(np.arange(0.0, t_last + dt, dt), 9)
+    obs = {g: observed_from_outcome(lt["outcome"]) for g, lt in lts.items()}
+    P = {g: survival_on_grid(lts[g]["t_end"].to_numpy(), obs[g], grid) for g in gs}
+    tau0 = float(_tau0_rule(grid, P[0.0], N))
+
+    mu, mu_err, cont, win = _own_mu(study, mg, E0, N)
+    # fig3's μ beside this study's own (a declared need: [needs].mu_crosscheck)
+    mu_fig3 = up.numbers(study, study.upstream("mu_crosscheck")).get("mu")
+
+    # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
+    nb = int(study.param("n_boot"))
+    K = min(int(study.param("n_boot_orbits")), N)
+    boot = bootstrap_transition_times(
+        {g: (lts[g]["t_end"].to_numpy()[:K], lts[g]["outcome"].to_numpy()[:K]) for g in gs}, 0.0, grid,
+        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=int(study.param("boot_seed")) + 1,
+    )
+    bscale = float(np.sqrt(K / N))
+    taus = _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha)
+    surv, ratio = _figure_tables(lts, grid, P, dt, t_last, N)
+
+    meta = {"E0": E0, "alpha": alpha, "tau0_rule": "choose_windows on P_0"}
+    study.write_table(taus, "fig4_tau.parquet", **meta)
+    study.write_table(surv, "fig4_survival.parquet", **meta)
+    study.write_table(ratio, "fig4_ratio.parquet", **meta)
+    # published for the studies that build on fig4 (fig6): every orbit's lifetime per γ, orbit order
+    study.write_table(pd.concat([lts[g].assign(gamma=g)[["gamma", "t_end", "outcome"]] for g in gs],
+                                ignore_index=True), LIFETIMES_TABLE, **meta,
+                      description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
+                                  "the same initial conditions for every γ")
+
+    tau0_err = float(boot["tau0"].std(ddof=1)) * bscale
+    exponents = _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err)
+    study.write_numbers(_numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0,
+                                 tau0_err, exponents, nb, K))
+
+
+def _read_lifetimes(study, gs):
+    """({γ: DataFrame(t_end, outcome) in traj_id order}, N, last t_end): the runs must share their initial
+    conditions (paired ensembles); only what the analysis needs is kept (N = 1e7 per curve at paper scale)."""
+    from hhscatter.tables import read_lifetimes
+
     lts, ref = {}, None
     for g in gs:
         lt = read_lifetimes(study.raw(raw_key(g)), columns=["traj_id", "x0", "y0", "outcome", "t_end"])
@@ -146,44 +176,41 @@ def analyze(study):
             ref = xy
         elif xy.shape != ref.shape or not np.array_equal(xy, ref):
             raise ValueError(f"fig4: run {raw_key(g)} does not share the initial conditions of {raw_key(gs[0])}")
-        # keep only what the analysis needs (N = 1e7 per curve at paper scale)
         lts[g] = pd.DataFrame({"t_end": lt["t_end"].to_numpy(), "outcome": lt["outcome"].astype("category")})
-    N = len(ref)
-    del ref
     t_last = max(float(lt["t_end"].max()) for lt in lts.values())
+    return lts, len(ref), t_last
 
-    # fine grid for τ0/τ1 (P on it is exact: no censoring before t_max in these runs)
-    grid = np.round(np.arange(0.0, t_last + dt, dt), 9)
-    obs = {g: observed_from_outcome(lt["outcome"]) for g, lt in lts.items()}
-    P = {g: survival_on_grid(lts[g]["t_end"].to_numpy(), obs[g], grid) for g in gs}
-    tau0 = float(_tau0_rule(grid, P[0.0], N))
 
-    # μ from this study's own mu_gamma run (fig3's definition), bootstrap error
-    ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]), E_C)
+def _own_mu(study, mg, E0, N):
+    """(μ, σ_μ, continuation counts, window): μ from this study's own γ = mu_gamma run, fig3's definition
+    (⟨E⟩ over orbits not escaped, settled ones continued; log fit on mu_window), bootstrap error."""
+    import pyarrow.dataset as ds
+
+    from hhscatter.analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
+    from hhscatter.tables import iter_parts, read_snapshots
+
+    ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]),
+                             study.model.critical_energy)
     me, cont = ime.inside, {"rows_below_ec": ime.rows_below_ec}
     win = tuple(float(v) for v in study.param("mu_window"))
     mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
-    nb = int(study.param("n_boot"))
     k_mu = min(int(study.param("n_boot_orbits")), N)
     rows_mu = read_snapshots(study.raw(raw_key(mg)), filters=ds.field("traj_id") < k_mu)
-    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=nb,
+    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=int(study.param("n_boot")),
                                              seed=int(study.param("boot_seed")))
-    mu_err = float(bm["mu"].std(ddof=1)) * mu_scale
-    # fig3's μ beside this study's own (a declared need: [needs].mu_crosscheck)
-    mu_fig3 = up.numbers(study, study.upstream("mu_crosscheck")).get("mu")
-    paper_mu = float(study.param("paper_mu"))
+    return mu, float(bm["mu"].std(ddof=1)) * mu_scale, cont, win
 
-    # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
-    K = min(int(study.param("n_boot_orbits")), N)
-    boot = bootstrap_transition_times(
-        {g: (lts[g]["t_end"].to_numpy()[:K], lts[g]["outcome"].to_numpy()[:K]) for g in gs}, 0.0, grid,
-        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=int(study.param("boot_seed")) + 1,
-    )
-    bscale = float(np.sqrt(K / N))
+
+def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha) -> pd.DataFrame:
+    """One row per γ: outcome fractions, τ0, τ1 (Eq. (eqn:tau1)), τ2 observed (+ settling-time quantiles) and
+    predicted (Eq. (eq:tau2)), each with its bootstrap error (σ over replicates × bscale)."""
+    from hhscatter.analysis.transitions import settle_time_quantiles, tau1, tau2_observed, tau2_predicted
+
+    E_C = study.model.critical_energy
+    paper_mu = float(study.param("paper_mu"))
     min_ref = float(study.param("min_ref_orbits"))
     rows = []
-    for g in gs:
-        lt = lts[g]
+    for g, lt in lts.items():
         oc = lt["outcome"].to_numpy()
         b = boot[boot["label"] == g] if g > 0 else None
         t1 = tau1(grid, P[g], P[0.0], tau0, alpha) if g > 0 else None
@@ -214,9 +241,14 @@ def analyze(study):
             "tau2_pred": pred, "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
             "tau2_pred_paper_mu": pred_p,
         })
-    taus = pd.DataFrame(rows)
+    return pd.DataFrame(rows)
 
-    # P(t) for the figure: exact Kaplan–Meier at log-spaced times, and P_γ/P_0 on the τ grid
+
+def _figure_tables(lts, grid, P, dt, t_last, N):
+    """(P(t) per γ, exact Kaplan–Meier at log-spaced times; P_γ/P_0 on the τ grid while reference orbits remain)."""
+    from hhscatter.analysis.survival import survival_from_lifetimes
+
+    gs = list(lts)
     pg = _plot_grid(t_last)
     surv = []
     for g in gs:
@@ -231,19 +263,16 @@ def analyze(study):
         ok = np.rint(P[0.0][keep] * N) >= 1  # at least one reference orbit left (a count: rounding-proof)
         ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok],
                                    "n0": (P[0.0][keep] * N)[ok]}))
-    ratio = pd.concat(ratio, ignore_index=True)
+    return surv, pd.concat(ratio, ignore_index=True)
 
-    meta = {"E0": E0, "alpha": alpha, "tau0_rule": "choose_windows on P_0"}
-    study.write_table(taus, "fig4_tau.parquet", **meta)
-    study.write_table(surv, "fig4_survival.parquet", **meta)
-    study.write_table(ratio, "fig4_ratio.parquet", **meta)
-    # published for the studies that build on fig4 (fig6): every orbit's lifetime per γ, orbit order
-    study.write_table(pd.concat([lts[g].assign(gamma=g)[["gamma", "t_end", "outcome"]] for g in gs],
-                                ignore_index=True), LIFETIMES_TABLE, **meta,
-                      description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
-                                  "the same initial conditions for every γ")
 
-    # paper comparisons (the paper gives τ's only in figures; its statements are checked)
+def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -> dict:
+    """The paper comparison (the paper gives τ's only in figures; its statements are checked); returns the
+    fitted exponents {name: (p, σ_p)} of τ ∝ γ^−p."""
+    from hhscatter.analysis.transitions import power_law_exponent, tau2_predicted
+
+    E_C = study.model.critical_energy
+    paper_mu = float(study.param("paper_mu"))
     d = taus[taus["gamma"] > 0]
     t1v = d["tau1"].to_numpy()
     ok1 = np.isfinite(t1v)
@@ -279,13 +308,23 @@ def analyze(study):
     if p50 is not None:
         study.compare("p in median settling time ∝ γ^−p", p50, p50_err, 1.0,
                       note="N-independent companion of τ2,obs (same fit)")
-    study.compare("τ0 (data-driven, on P_0)", tau0, float(boot["tau0"].std(ddof=1)) * bscale, None, unit="time",
+    study.compare("τ0 (data-driven, on P_0)", tau0, tau0_err, None, unit="time",
                   note="paper: τ0 effectively independent of γ; no value given")
+    return {"tau2": (p_exp, p_err), "settle_median": (p50, p50_err), "tau1": (p1, p1_err)}
 
-    def vu(v, e):
-        return {"value": None if not np.isfinite(v) else float(v), "err": None if not np.isfinite(e) else float(e)}
 
-    study.write_numbers({
+def _vu(v, e):
+    return {"value": None if not np.isfinite(v) else float(v), "err": None if not np.isfinite(e) else float(e)}
+
+
+def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents,
+             nb, K) -> dict:
+    """The content of fig4.json (definitions stated with the numbers)."""
+    def exponent(name):
+        p, e = exponents[name]
+        return None if p is None else {"value": p, "err": e}
+
+    return {
         "E0": E0,
         "n_orbits_per_curve": N,
         "gammas": gs,
@@ -305,31 +344,31 @@ def analyze(study):
         "mu_gamma": mg,
         "mu_window": list(win),
         "mu_fig3": mu_fig3,
-        "paper_mu": paper_mu,
+        "paper_mu": float(study.param("paper_mu")),
         "continuation": {k: v for k, v in cont.items() if k != "key"},
-        "tau0": vu(tau0, float(boot["tau0"].std(ddof=1)) * bscale),
+        "tau0": _vu(tau0, tau0_err),
         "taus": [
             {
                 "gamma": r.gamma, "key": r.key,
                 "f_escaped": r.f_escaped, "f_settled": r.f_settled, "f_censored": r.f_censored,
-                "tau1": vu(r.tau1, r.tau1_err), "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
+                "tau1": _vu(r.tau1, r.tau1_err), "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
                 "tau1_resolved": r.tau1_resolved,
-                "tau2_obs": vu(r.tau2_obs, r.tau2_obs_err),
-                "t_settle_q01": vu(r.t_settle_q01, r.t_settle_q01_err),
-                "t_settle_q50": vu(r.t_settle_q50, r.t_settle_q50_err),
-                "tau2_pred": vu(r.tau2_pred, r.tau2_pred_err),
+                "tau2_obs": _vu(r.tau2_obs, r.tau2_obs_err),
+                "t_settle_q01": _vu(r.t_settle_q01, r.t_settle_q01_err),
+                "t_settle_q50": _vu(r.t_settle_q50, r.t_settle_q50_err),
+                "tau2_pred": _vu(r.tau2_pred, r.tau2_pred_err),
                 "tau2_pred_paper_mu": None if not np.isfinite(r.tau2_pred_paper_mu) else r.tau2_pred_paper_mu,
             }
             for r in taus.itertuples()
         ],
-        "tau2_gamma_exponent": None if p_exp is None else {"value": p_exp, "err": p_err},
-        "settle_median_gamma_exponent": None if p50 is None else {"value": p50, "err": p50_err},
-        "tau1_gamma_exponent": None if p1 is None else {"value": p1, "err": p1_err},
+        "tau2_gamma_exponent": exponent("tau2"),
+        "settle_median_gamma_exponent": exponent("settle_median"),
+        "tau1_gamma_exponent": exponent("tau1"),
         "n_boot": nb,
         "n_boot_orbits": K,
         "errors": ("paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
                    "scaled by sqrt(n_boot_orbits/N); for the minimum τ2,obs this is only indicative"),
-    })
+    }
 
 
 def plot(study):

@@ -162,34 +162,75 @@ def _cap(df, n_cap, seed):
 
 
 def analyze(study):
-    """analyze(study) -> None; writes derived tables (points, distances) and fig5.json."""
-    from hhscatter.tables import read_lifetimes, read_sections
+    """analyze(study) -> None; writes derived tables (points, distances) and fig5.json.
 
+    Steps: μ from the study [needs].mu (:func:`_mu`), the c-measure samples
+    (:func:`_cmeasure_points`), the Fig. 5a/b point sets per γ
+    (:func:`_point_sets`), the common split-half sample size
+    (:func:`_common_sample_size`), the distances (:func:`_distances`), the
+    paper comparison (:func:`_compare`).
+    """
     inputs = {}
     E2 = float(study.config["scene"]["energy"])
     E1 = float(study.param("E1"))
-    band = tuple(float(b) for b in study.param("band"))
     gammas = [float(g) for g in study.param("gammas")]
     g_main = float(study.param("gamma_main"))
     if g_main not in gammas:
         raise ValueError(f"[study] gamma_main = {g_main} must be one of gammas = {gammas}")
+    mu, mu_err = _mu(study, inputs)
+    cm, t_rec = _cmeasure_points(study, inputs, E1, E2)
+    extent = tuple(float(v) for v in study.param("extent"))
+    seed = int(study.param("seed"))
+    n_cap = int(study.param("n_cap"))
+    cm = {k: _cap(v, n_cap, seed) for k, v in cm.items()}
+    refs = {"E1": dist.points(cm["E1"]), "E2": dist.points(cm["E2"])}
+    sets, pg, point_tables = _point_sets(study, gammas, E1, E2, mu, mu_err)
+    usable, m_common = _common_sample_size(study, sets, refs)
+    dtab, stab = _distances(study, sets, refs, usable, m_common, extent)
+
+    study.write_table(pd.concat(point_tables, ignore_index=True), "points.parquet")
+    cm_tab = pd.concat([cm["E1"].assign(E=E1), cm["E2"].assign(E=E2)], ignore_index=True)
+    study.write_table(cm_tab[["E", "traj_id", "t", "x", "y", "energy"]], "cmeasure_points.parquet",
+                      t_rec_E1=t_rec["E1"], t_rec_E2=t_rec["E2"])
+    study.write_table(dtab, "distance_vs_scale.parquet", extent=list(extent), m_common=m_common)
+    study.write_table(stab, "distance_summary.parquet")
+    study.write_table(pg, "per_gamma.parquet")
+
+    delta = float(study.param("delta"))
+    verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
+    study.write_numbers({
+        "inputs": inputs,
+        "dev_fallback": up.any_fallback(inputs),
+        "mu": {"value": mu, "err": mu_err},
+        "E1": E1, "E2": E2, "band": [float(b) for b in study.param("band")], "gamma_main": g_main,
+        "t_star": {gamma_key(r.gamma): {"value": r.t_star, "err": r.t_star_err} for r in pg.itertuples()},
+        "per_gamma": pg.to_dict(orient="records"),
+        "m_common": m_common,
+        "delta": delta,
+        "distances": stab.to_dict(orient="records"),
+        "closer_to_E1": verdicts,
+    })
+
+
+def _mu(study, inputs):
+    """(μ, σ_μ) of Eq. (eqn:energy_exp_decay) from the study [needs].mu; it must lie in the window of μ the
+    section recording was made for."""
     mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
     mu = float(mu)
     mu_err = float(mu_err) if mu_err is not None else math.nan
     if not float(study.param("mu_min")) <= mu <= float(study.param("mu_max")):
         raise ValueError(f"μ = {mu} lies outside the recorded window [mu_min, mu_max] = "
                          f"[{study.param('mu_min')}, {study.param('mu_max')}]: widen it in study.toml and re-simulate")
-    cm, t_rec = _cmeasure_points(study, inputs, E1, E2)
-    extent = tuple(float(v) for v in study.param("extent"))
-    boxes = np.sort(np.asarray(study.param("boxes"), dtype=float))[::-1]
-    seed = int(study.param("seed"))
-    n_proj = int(study.param("n_proj"))
-    n_boot = int(study.param("n_boot"))
-    n_cap = int(study.param("n_cap"))
-    cm = {k: _cap(v, n_cap, seed) for k, v in cm.items()}
-    refs = {"E1": dist.points(cm["E1"]), "E2": dist.points(cm["E2"])}
+    return mu, mu_err
 
-    # -- point sets per γ -----------------------------------------------------
+
+def _point_sets(study, gammas, E1, E2, mu, mu_err):
+    """({(γ, 'a'|'b'): points}, per-γ DataFrame, point tables): the first crossing after t* of each surviving
+    orbit (Fig. 5a) and those in the energy band (Fig. 5b), capped at n_cap points."""
+    from hhscatter.tables import read_lifetimes, read_sections
+
+    band = tuple(float(b) for b in study.param("band"))
+    n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))
     sets, per_gamma, point_tables = {}, [], []
     for g in gammas:
         raw = study.raw(gamma_key(g))
@@ -215,9 +256,13 @@ def analyze(study):
             point_tables.append(df.assign(gamma=g, set=sel)[["gamma", "set", "traj_id", "t", "x", "y", "energy"]])
     pg = pd.DataFrame(per_gamma)
 
-    # common split-half sample size: the smallest usable comparison
-    # (comparisons with μ_c^{E1}, whose agreement scales are compared across γ
-    # and between Fig. 5a and 5b; those with μ_c^{E2} use their own largest m)
+    return sets, pg, point_tables
+
+
+def _common_sample_size(study, sets, refs):
+    """({set: m}, m_common): the split-half sample size of each comparison with μ_c^{E1} that has at least
+    m_min points per half, and the smallest of them, common to all (agreement scales are compared across γ
+    and between Fig. 5a and 5b; comparisons with μ_c^{E2} use their own largest m)."""
     m_min = int(study.param("m_min"))
     sizes = {k: min(len(v), len(refs["E1"])) // 2 for k, v in sets.items()}
     usable = {k: s for k, s in sizes.items() if s >= m_min}
@@ -225,7 +270,17 @@ def analyze(study):
         raise ValueError(f"no point set has ≥ 2·m_min = {2 * m_min} points; raise n or lower m_min")
     m_common = min(usable.values())
 
-    # -- distances -------------------------------------------------------------
+    return usable, m_common
+
+
+def _distances(study, sets, refs, usable, m_common, extent):
+    """(distance vs box side table, summary table): Hellinger/TV vs ε with split-half noise floors and
+    bootstrap errors, the agreement scales, sliced Wasserstein with its error and noise floor, for every
+    point set against μ_c^{E1} and μ_c^{E2} (and μ_c^{E2} against μ_c^{E1})."""
+    boxes = np.sort(np.asarray(study.param("boxes"), dtype=float))[::-1]
+    seed = int(study.param("seed"))
+    n_proj = int(study.param("n_proj"))
+    n_boot = int(study.param("n_boot"))
     delta = float(study.param("delta"))
     rows, summary = [], []
     comps = [(k, ref) for k in sets for ref in ("E1", "E2")] + [(("ref", "E2"), "E1")]
@@ -278,16 +333,14 @@ def analyze(study):
     dtab = pd.concat(rows, ignore_index=True)
     stab = pd.DataFrame(summary)
 
-    # -- tables ----------------------------------------------------------------
-    study.write_table(pd.concat(point_tables, ignore_index=True), "points.parquet")
-    cm_tab = pd.concat([cm["E1"].assign(E=E1), cm["E2"].assign(E=E2)], ignore_index=True)
-    study.write_table(cm_tab[["E", "traj_id", "t", "x", "y", "energy"]], "cmeasure_points.parquet",
-                      t_rec_E1=t_rec["E1"], t_rec_E2=t_rec["E2"])
-    study.write_table(dtab, "distance_vs_scale.parquet", extent=list(extent), m_common=m_common)
-    study.write_table(stab, "distance_summary.parquet")
-    study.write_table(pg, "per_gamma.parquet")
+    return dtab, stab
 
-    # -- numbers and paper comparison -----------------------------------------
+
+def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> dict:
+    """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer (SW1 and
+    debiased Hellinger) in Fig. 5a and 5b, and whether the agreement scale shrinks with t*. Returns
+    {'a'|'b': closer to μ_c^{E1}}."""
+    E1 = float(study.param("E1"))
     def srow(g, s, ref):
         r = stab[(stab["gamma"] == g) & (stab["set"] == s) & (stab["ref"] == ref)]
         return r.iloc[0] if len(r) else None
@@ -359,18 +412,7 @@ def analyze(study):
                       "convergence to μ_c^{E(t)} with relaxation time",
                       verdict="agrees" if np.all(np.diff(dh) < 0) else "not shown")
 
-    study.write_numbers({
-        "inputs": inputs,
-        "dev_fallback": up.any_fallback(inputs),
-        "mu": {"value": mu, "err": mu_err},
-        "E1": E1, "E2": E2, "band": list(band), "gamma_main": g_main,
-        "t_star": {gamma_key(r.gamma): {"value": r.t_star, "err": r.t_star_err} for r in pg.itertuples()},
-        "per_gamma": pg.to_dict(orient="records"),
-        "m_common": m_common,
-        "delta": delta,
-        "distances": stab.to_dict(orient="records"),
-        "closer_to_E1": verdicts,
-    })
+    return verdicts
 
 
 # ---------------------------------------------------------------------------

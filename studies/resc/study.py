@@ -114,174 +114,32 @@ def _lifetimes(study, E, r):
 
 
 def analyze(study):
-    """analyze(study) -> None: derived tables and resc.json (see the module docstring)."""
-    import warnings
+    """analyze(study) -> None: derived tables and resc.json (see the module docstring).
 
-    from hhscatter.analysis.escape_check import (
-        channel_fractions,
-        lyapunov_orbit,
-        paired_mle_shift,
-        return_statistics,
-        survival_ratio_slope,
-        wilson_interval,
-    )
-    from hhscatter.analysis.escape_rate import escape_rate, escape_rate_mle
-    from hhscatter.analysis.survival import survival_curve
-    from hhscatter.tables import read_crossings, read_lifetimes
-
+    Steps per energy: the paired runs (:func:`_paired_runs`), the common κ
+    window (:func:`_common_window`), the follow runs' returns
+    (:func:`_follow_returns`), then per r_esc the κ row (:func:`_kappa_row`),
+    the returns row (:func:`_returns_row`) and the exit channels
+    (:func:`_channel_rows`); then the numbers and the comparison
+    (:func:`_numbers_and_comparison`).
+    """
     energies, radii = _grid(study)
     r_ref = float(study.param("r_ref"))
     if r_ref not in radii:
         raise ValueError(f"[study] r_ref = {r_ref} must be one of r_esc = {radii}")
-    r_in = float(study.param("r_in"))
-    z = float(study.param("z"))
-    fast = float(study.param("reesc_fast"))
-
-    lyap_E = sorted({*map(float, study.param("lyapunov_energies")), *energies})
-    lyap_rows = []
-    for E in lyap_E:
-        L = lyapunov_orbit(E)
-        lyap_rows.append({"energy": E, "r_min": L.r_min, "r_max": L.r_max, "y_axis": L.y_axis,
-                          "period": L.period})
-    lyap = pd.DataFrame(lyap_rows)
+    lyap = _lyapunov_table(study, energies)
     lyap_at = {row.energy: row for row in lyap.itertuples()}
 
     k_rows, ret_rows, ch_rows = [], [], []
-    numbers = {"energies": energies, "r_esc": radii, "r_ref": r_ref, "kappa": {}, "returns": {},
-               "channels": {}, "lyapunov": {}}
     for E in energies:
-        arrs, chans = {}, {}
-        ids_ref = None
-        for r in sorted(radii, key=lambda v: v != r_ref):
-            ids, t_, o_, chans[r] = _lifetimes(study, E, r)
-            arrs[r] = (t_, o_)
-            if ids_ref is None:
-                ids_ref = ids
-            elif not np.array_equal(ids, ids_ref):
-                raise ValueError(f"E={E}: runs r_esc={r} and {r_ref} do not hold the same orbits")
-        t_ref, obs_ref = arrs[r_ref]
-        n_tot = t_ref.size
-        t_hi = float(np.quantile(t_ref, 1 - 10 / n_tot)) if n_tot > 20 else float(t_ref.max())
-        grid = np.linspace(0.0, t_hi, 20001)
-        curves = {r: survival_curve(*arrs[r], grid) for r in radii}
-        # (a) the paper's rule (mean of 4 LSQ fits) with each cell's own windows
-        own = {}
+        arrs, chans = _paired_runs(study, E, radii, r_ref)
+        grid, own, win = _common_window(study, arrs, radii, r_ref)
+        ends, rs, recross = _follow_returns(study, E, radii)
         for r in radii:
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    own[r] = escape_rate(*arrs[r], grid, detect_tail=False)
-            except ValueError:
-                own[r] = None
-        # (b) one common window per energy for the paired estimators: the median of the four
-        # cells' own windows (robust to one cell's plateau search picking an outlying τ0), started
-        # no earlier than where the reference P(t) has fallen to p_start: a prompt-escape
-        # transient inside the window (hazard peak at t ≈ 5, ringing for a few periods) would be
-        # shifted in or out by the flight time and masquerade as a κ shift
-        p_start = float(study.param("p_start"))
-        below = np.flatnonzero(curves[r_ref].P <= p_start)
-        t_p = float(grid[below[0]]) if below.size else 0.0
-        tau0s = [own[r].tau0 for r in radii if own[r] is not None]
-        stops = [own[r].t_stop for r in radii if own[r] is not None]
-        win = (max(t_p, float(np.median(tau0s)) if tau0s else 0.0), float(np.median(stops)) if stops else t_hi)
-        if not win[1] > win[0]:
-            win = (t_p, t_hi)
-        # follow runs: returns and flight times on identical trajectories
-        fdir = study.raw(_follow_key(E))
-        cross = read_crossings(fdir).sort_values(["traj_id", "t"], kind="stable")
-        ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"]).sort_values("traj_id")
-        # a followed orbit that never escapes is censored at t_max (its t_end)
-        ends["energy_error"] = (ends["e_end"] - ends["e0"]).abs()
-        nf = len(ends)
-        rs = {r: return_statistics(cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(),
-                                   cross.direction.to_numpy(), nf, r, r_in) for r in radii}
-        # broader: back inside r_esc itself (not necessarily inside r_in) after the first escape
-        recross = {r: return_statistics(cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(),
-                                        cross.direction.to_numpy(), nf, r, r)["returned"] for r in radii}
-        lyapE = lyap_at[E]
-        for r in radii:
-            t_alt, obs_alt = arrs[r]
-            res = own[r]
-            if res is not None:
-                k_lsq, k_lsq_err, tau0, t_stop = res.kappa, res.kappa_err, res.tau0, res.t_stop
-            else:
-                k_lsq = k_lsq_err = tau0 = t_stop = math.nan
-            ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
-            mle = escape_rate_mle(t_alt, obs_alt, *win)
-            rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win,
-                                       n_groups=int(study.param("n_groups")))
-            # delay of P(t) at the window start: log(P_alt/P_ref)(t_lo)/κ_ref (the flight time, plus the
-            # premature escapes of r_ref accumulated up to t_lo)
-            tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
-            both = obs_alt & obs_ref
-            dt = t_alt[both] - t_ref[both]
-            s_ref, s = rs[r_ref], rs[r]
-            ok = np.isfinite(s["t_esc"]) & np.isfinite(s_ref["t_esc"])
-            flight = s["t_esc"][ok] - s_ref["t_esc"][ok]
-            # the same shift on the follow runs: both criteria on one and the same trajectory
-            # (no divergence of the paired runs), smaller sample
-            fol = math.nan, math.nan
-            if r != r_ref:
-                tf_ref = np.where(np.isfinite(s_ref["t_esc"]), s_ref["t_esc"], ends.t_end.to_numpy())
-                tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], ends.t_end.to_numpy())
-                try:
-                    rf = survival_ratio_slope(tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]),
-                                              win, n_groups=int(study.param("n_groups")))
-                    fol = rf.shift, rf.shift_err
-                except ValueError:
-                    pass
-            k_rows.append({
-                "energy": E, "r_esc": r, "n": n_tot, "n_escaped": int(obs_alt.sum()),
-                "kappa": ps.kappa_alt, "kappa_err": ps.kappa_alt_err, "n_events": mle.n_events,
-                "t_start": win[0], "t_stop": win[1],
-                "kappa_shift": rsl.shift if r != r_ref else 0.0,
-                "kappa_shift_err": rsl.shift_err if r != r_ref else 0.0,
-                "kappa_shift_follow": fol[0], "kappa_shift_follow_err": fol[1],
-                "mle_shift": ps.shift, "mle_shift_err": ps.shift_err,
-                "mle_shift_err_unpaired": ps.shift_err_unpaired, "mle_correlation": ps.correlation,
-                "kappa_lsq": k_lsq, "kappa_lsq_err": k_lsq_err, "tau0_own": tau0, "t_stop_own": t_stop,
-                "time_shift": tshift,
-                "flight_mean": float(flight.mean()) if flight.size else math.nan,
-                "flight_err": float(flight.std(ddof=1) / math.sqrt(flight.size)) if flight.size > 1 else math.nan,
-                "flight_median": float(np.median(flight)) if flight.size else math.nan,
-                "dt_end_mean": float(dt.mean()) if dt.size else math.nan,
-                "dt_end_err": float(dt.std(ddof=1) / math.sqrt(dt.size)) if dt.size > 1 else math.nan,
-            })
-            # returns: all escapes, and those after the transient (t_esc > window start)
-            esc = np.isfinite(s["t_esc"])
-            late = esc & (s["t_esc"] > win[0])
-            n_esc, n_ret = int(esc.sum()), int(s["returned"].sum())
-            n_late, n_ret_late = int(late.sum()), int((s["returned"] & late).sum())
-            p, lo, hi = wilson_interval(n_ret, n_esc, z)
-            pl, lol, hil = wilson_interval(n_ret_late, n_late, z) if n_late else (math.nan,) * 3
-            stay = s["t_reesc"][s["returned"]] - s["t_return"][s["returned"]]
-            n_re = int(np.isfinite(stay).sum())
-            n_fast = int(np.count_nonzero(stay <= fast))
-            pf, flo, fhi = wilson_interval(n_fast, n_ret, z) if n_ret else (math.nan,) * 3
-            ret_rows.append({
-                "energy": E, "r_esc": r, "n_followed": nf, "n_escaped": n_esc, "n_returned": n_ret,
-                "frac": float(p), "lo": float(lo), "hi": float(hi),
-                "upper95": float(wilson_interval(n_ret, n_esc, 1.96)[2]),
-                "n_recrossed": int(recross[r].sum()),
-                "t_late": win[0], "n_escaped_late": n_late, "n_returned_late": n_ret_late,
-                "frac_late": float(pl), "lo_late": float(lol), "hi_late": float(hil),
-                "n_reescaped": n_re, "stay_median": float(np.nanmedian(stay)) if n_re else math.nan,
-                "stay_mean": float(np.nanmean(stay)) if n_re else math.nan,
-                "kappa_ref": ps.kappa_ref, "n_fast": n_fast, "frac_fast": float(pf), "frac_fast_lo": float(flo),
-                "frac_fast_hi": float(fhi),
-                "lyap_r_min": lyapE.r_min, "lyap_r_max": lyapE.r_max,
-                "energy_error_max": float(ends.energy_error.max()),
-                "n_censored_follow": int((ends.outcome == "censored").sum()),
-            })
-            # exit channels
-            ch = chans[r]
-            for subset, m in (("all", np.ones(n_tot, bool)), ("early", t_alt <= win[0]), ("late", t_alt > win[0])):
-                cf = channel_fractions(ch[m], 3, z)
-                for k in range(3):
-                    ch_rows.append({"energy": E, "r_esc": r, "subset": subset, "channel": k,
-                                    "count": int(cf.counts[k]), "n": cf.n, "frac": float(cf.frac[k]),
-                                    "lo": float(cf.lo[k]), "hi": float(cf.hi[k]), "chi2": cf.chi2,
-                                    "p_value": cf.p_value})
+            k_row, ps = _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends)
+            k_rows.append(k_row)
+            ret_rows.append(_returns_row(study, E, r, rs[r], recross[r], win, ps, lyap_at[E], ends))
+            ch_rows.extend(_channel_rows(study, E, r, chans[r], arrs[r][0], win))
     kap = pd.DataFrame(k_rows)
     ret = pd.DataFrame(ret_rows)
     chan = pd.DataFrame(ch_rows)
@@ -289,8 +147,214 @@ def analyze(study):
     study.write_table(ret, "returns.parquet")
     study.write_table(chan, "channels.parquet")
     study.write_table(lyap, "lyapunov.parquet")
+    study.write_numbers(_numbers_and_comparison(study, energies, radii, r_ref, kap, ret, chan, lyap))
 
-    # numbers and comparisons
+
+def _lyapunov_table(study, energies) -> pd.DataFrame:
+    """The Lyapunov orbit of the exits (the exact boundary of Ω) at every energy of the study and of
+    ``lyapunov_energies``: radial extent r_min, r_max, y on the axis, period."""
+    from hhscatter.analysis.escape_check import lyapunov_orbit
+
+    rows = []
+    for E in sorted({*map(float, study.param("lyapunov_energies")), *energies}):
+        L = lyapunov_orbit(E)
+        rows.append({"energy": E, "r_min": L.r_min, "r_max": L.r_max, "y_axis": L.y_axis, "period": L.period})
+    return pd.DataFrame(rows)
+
+
+def _paired_runs(study, E, radii, r_ref):
+    """({r: (t_end, observed)}, {r: exit channel}) of the runs at energy E, which must hold the same orbits."""
+    arrs, chans = {}, {}
+    ids_ref = None
+    for r in sorted(radii, key=lambda v: v != r_ref):
+        ids, t_, o_, chans[r] = _lifetimes(study, E, r)
+        arrs[r] = (t_, o_)
+        if ids_ref is None:
+            ids_ref = ids
+        elif not np.array_equal(ids, ids_ref):
+            raise ValueError(f"E={E}: runs r_esc={r} and {r_ref} do not hold the same orbits")
+    return arrs, chans
+
+
+def _common_window(study, arrs, radii, r_ref):
+    """(grid, {r: EscapeRateResult or None}, window) of one energy.
+
+    (a) the paper's rule (mean of 4 LSQ fits) with each cell's own windows;
+    (b) one common window for the paired estimators: the median of the cells'
+    own windows (robust to one cell's plateau search picking an outlying τ0),
+    started no earlier than where the reference P(t) has fallen to p_start: a
+    prompt-escape transient inside the window (hazard peak at t ≈ 5, ringing
+    for a few periods) would be shifted in or out by the flight time and
+    masquerade as a κ shift.
+    """
+    import warnings
+
+    from hhscatter.analysis.escape_rate import escape_rate
+    from hhscatter.analysis.survival import survival_curve
+
+    t_ref, _ = arrs[r_ref]
+    n_tot = t_ref.size
+    t_hi = float(np.quantile(t_ref, 1 - 10 / n_tot)) if n_tot > 20 else float(t_ref.max())
+    grid = np.linspace(0.0, t_hi, 20001)
+    curves = {r: survival_curve(*arrs[r], grid) for r in radii}
+    own = {}
+    for r in radii:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                own[r] = escape_rate(*arrs[r], grid, detect_tail=False)
+        except ValueError:
+            own[r] = None
+    p_start = float(study.param("p_start"))
+    below = np.flatnonzero(curves[r_ref].P <= p_start)
+    t_p = float(grid[below[0]]) if below.size else 0.0
+    tau0s = [own[r].tau0 for r in radii if own[r] is not None]
+    stops = [own[r].t_stop for r in radii if own[r] is not None]
+    win = (max(t_p, float(np.median(tau0s)) if tau0s else 0.0), float(np.median(stops)) if stops else t_hi)
+    if not win[1] > win[0]:
+        win = (t_p, t_hi)
+    return grid, own, win
+
+
+def _follow_returns(study, E, radii):
+    """(follow-run lifetimes, {r: return statistics back inside r_in}, {r: back inside r itself}) at energy E:
+    returns and flight times on identical trajectories (the follow runs' ``crossings``)."""
+    from hhscatter.analysis.escape_check import return_statistics
+    from hhscatter.tables import read_crossings, read_lifetimes
+
+    r_in = float(study.param("r_in"))
+    fdir = study.raw(_follow_key(E))
+    cross = read_crossings(fdir).sort_values(["traj_id", "t"], kind="stable")
+    ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"]).sort_values("traj_id")
+    # a followed orbit that never escapes is censored at t_max (its t_end)
+    ends["energy_error"] = (ends["e_end"] - ends["e0"]).abs()
+    nf = len(ends)
+    cols = (cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(), cross.direction.to_numpy())
+    rs = {r: return_statistics(*cols, nf, r, r_in) for r in radii}
+    # broader: back inside r_esc itself (not necessarily inside r_in) after the first escape
+    recross = {r: return_statistics(*cols, nf, r, r)["returned"] for r in radii}
+    return ends, rs, recross
+
+
+def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
+    """(row of kappa.parquet, PairedShift) of cell (E, r): κ by the MLE on the common window, its shift from
+    r_ref (paired log-survival-ratio slope; on the follow runs too), the paper's LSQ κ, delays and flight
+    times."""
+    from hhscatter.analysis.escape_check import paired_mle_shift, survival_ratio_slope
+    from hhscatter.analysis.escape_rate import escape_rate_mle
+
+    t_ref, obs_ref = arrs[r_ref]
+    n_tot = t_ref.size
+    t_alt, obs_alt = arrs[r]
+    res = own[r]
+    if res is not None:
+        k_lsq, k_lsq_err, tau0, t_stop = res.kappa, res.kappa_err, res.tau0, res.t_stop
+    else:
+        k_lsq = k_lsq_err = tau0 = t_stop = math.nan
+    ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
+    mle = escape_rate_mle(t_alt, obs_alt, *win)
+    rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win,
+                               n_groups=int(study.param("n_groups")))
+    # delay of P(t) at the window start: log(P_alt/P_ref)(t_lo)/κ_ref (the flight time, plus the
+    # premature escapes of r_ref accumulated up to t_lo)
+    tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
+    both = obs_alt & obs_ref
+    dt = t_alt[both] - t_ref[both]
+    s_ref, s = rs[r_ref], rs[r]
+    ok = np.isfinite(s["t_esc"]) & np.isfinite(s_ref["t_esc"])
+    flight = s["t_esc"][ok] - s_ref["t_esc"][ok]
+    # the same shift on the follow runs: both criteria on one and the same trajectory
+    # (no divergence of the paired runs), smaller sample
+    fol = math.nan, math.nan
+    if r != r_ref:
+        tf_ref = np.where(np.isfinite(s_ref["t_esc"]), s_ref["t_esc"], ends.t_end.to_numpy())
+        tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], ends.t_end.to_numpy())
+        try:
+            rf = survival_ratio_slope(tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]),
+                                      win, n_groups=int(study.param("n_groups")))
+            fol = rf.shift, rf.shift_err
+        except ValueError:
+            pass
+    row = {
+        "energy": E, "r_esc": r, "n": n_tot, "n_escaped": int(obs_alt.sum()),
+        "kappa": ps.kappa_alt, "kappa_err": ps.kappa_alt_err, "n_events": mle.n_events,
+        "t_start": win[0], "t_stop": win[1],
+        "kappa_shift": rsl.shift if r != r_ref else 0.0,
+        "kappa_shift_err": rsl.shift_err if r != r_ref else 0.0,
+        "kappa_shift_follow": fol[0], "kappa_shift_follow_err": fol[1],
+        "mle_shift": ps.shift, "mle_shift_err": ps.shift_err,
+        "mle_shift_err_unpaired": ps.shift_err_unpaired, "mle_correlation": ps.correlation,
+        "kappa_lsq": k_lsq, "kappa_lsq_err": k_lsq_err, "tau0_own": tau0, "t_stop_own": t_stop,
+        "time_shift": tshift,
+        "flight_mean": float(flight.mean()) if flight.size else math.nan,
+        "flight_err": float(flight.std(ddof=1) / math.sqrt(flight.size)) if flight.size > 1 else math.nan,
+        "flight_median": float(np.median(flight)) if flight.size else math.nan,
+        "dt_end_mean": float(dt.mean()) if dt.size else math.nan,
+        "dt_end_err": float(dt.std(ddof=1) / math.sqrt(dt.size)) if dt.size > 1 else math.nan,
+    }
+    return row, ps
+
+
+def _returns_row(study, E, r, s, recrossed, win, ps, lyapE, ends) -> dict:
+    """Row of returns.parquet of cell (E, r): the fraction of escapes that come back inside r_in (all, and after
+    the window start) with Wilson intervals, how fast they escape again, the Lyapunov orbit's extent."""
+    from hhscatter.analysis.escape_check import wilson_interval
+
+    z = float(study.param("z"))
+    fast = float(study.param("reesc_fast"))
+    nf = len(ends)
+    esc = np.isfinite(s["t_esc"])
+    late = esc & (s["t_esc"] > win[0])
+    n_esc, n_ret = int(esc.sum()), int(s["returned"].sum())
+    n_late, n_ret_late = int(late.sum()), int((s["returned"] & late).sum())
+    p, lo, hi = wilson_interval(n_ret, n_esc, z)
+    pl, lol, hil = wilson_interval(n_ret_late, n_late, z) if n_late else (math.nan,) * 3
+    stay = s["t_reesc"][s["returned"]] - s["t_return"][s["returned"]]
+    n_re = int(np.isfinite(stay).sum())
+    n_fast = int(np.count_nonzero(stay <= fast))
+    pf, flo, fhi = wilson_interval(n_fast, n_ret, z) if n_ret else (math.nan,) * 3
+    return {
+        "energy": E, "r_esc": r, "n_followed": nf, "n_escaped": n_esc, "n_returned": n_ret,
+        "frac": float(p), "lo": float(lo), "hi": float(hi),
+        "upper95": float(wilson_interval(n_ret, n_esc, 1.96)[2]),
+        "n_recrossed": int(recrossed.sum()),
+        "t_late": win[0], "n_escaped_late": n_late, "n_returned_late": n_ret_late,
+        "frac_late": float(pl), "lo_late": float(lol), "hi_late": float(hil),
+        "n_reescaped": n_re, "stay_median": float(np.nanmedian(stay)) if n_re else math.nan,
+        "stay_mean": float(np.nanmean(stay)) if n_re else math.nan,
+        "kappa_ref": ps.kappa_ref, "n_fast": n_fast, "frac_fast": float(pf), "frac_fast_lo": float(flo),
+        "frac_fast_hi": float(fhi),
+        "lyap_r_min": lyapE.r_min, "lyap_r_max": lyapE.r_max,
+        "energy_error_max": float(ends.energy_error.max()),
+        "n_censored_follow": int((ends.outcome == "censored").sum()),
+    }
+
+
+def _channel_rows(study, E, r, ch, t_alt, win) -> list:
+    """Rows of channels.parquet of cell (E, r): escape fractions per exit channel with Wilson intervals and the
+    χ² test of equal thirds, for all escapes and for those before / after the window start."""
+    from hhscatter.analysis.escape_check import channel_fractions
+
+    z = float(study.param("z"))
+    n_tot = t_alt.size
+    rows = []
+    for subset, m in (("all", np.ones(n_tot, bool)), ("early", t_alt <= win[0]), ("late", t_alt > win[0])):
+        cf = channel_fractions(ch[m], 3, z)
+        for k in range(3):
+            rows.append({"energy": E, "r_esc": r, "subset": subset, "channel": k,
+                         "count": int(cf.counts[k]), "n": cf.n, "frac": float(cf.frac[k]),
+                         "lo": float(cf.lo[k]), "hi": float(cf.hi[k]), "chi2": cf.chi2,
+                         "p_value": cf.p_value})
+    return rows
+
+
+def _numbers_and_comparison(study, energies, radii, r_ref, kap, ret, chan, lyap) -> dict:
+    """resc.json's numbers from the tables, the paper comparison (κ shifts, returns, channels), the default
+    r_esc recommended."""
+    r_in = float(study.param("r_in"))
+    fast = float(study.param("reesc_fast"))
+    numbers = {"energies": energies, "r_esc": radii, "r_ref": r_ref, "kappa": {}, "returns": {},
+               "channels": {}, "lyapunov": {}}
     for row in kap.itertuples():
         key = f"E={row.energy:.2f}"
         numbers["kappa"].setdefault(key, {})[f"r_esc={row.r_esc:g}"] = {
@@ -341,7 +405,7 @@ def analyze(study):
         numbers["lyapunov"][f"E={row.energy:.2f}"] = {"r_min": row.r_min, "r_max": row.r_max,
                                                       "period": row.period}
     numbers["default_r_esc"] = _recommend(kap, ret, lyap, r_ref)
-    study.write_numbers(numbers)
+    return numbers
 
 
 def _recommend(kap, ret, lyap, r_ref):
