@@ -311,11 +311,13 @@ def _validate(model, doc: dict, source: str, suffix: str = "") -> None:
         raise ConfigError("\n".join(lines)) from None
 
 
-def _merge(base: dict, over: dict) -> dict:
+def merge_tables(base: dict, over: dict) -> dict:
+    """merge_tables(base, over) -> a copy of ``base`` with the (nested) tables of ``over`` laid over it: how a
+    ``[scale.<s>]`` table overrides a study.toml."""
     out = copy.deepcopy(base)
     for k, v in over.items():
         if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
+            out[k] = merge_tables(out[k], v)
         else:
             out[k] = copy.deepcopy(v)
     return out
@@ -341,4 +343,4 @@ def validate_study_file(doc: dict, source: str, params: type[BaseModel] | None =
     _validate(model, doc, str(source))
     base = {k: v for k, v in doc.items() if k != "scale"}
     for name, over in (doc.get("scale") or {}).items():
-        _validate(model, _merge(base, over), str(source), f" (at scale {name!r})")
+        _validate(model, merge_tables(base, over), str(source), f" (at scale {name!r})")

@@ -76,16 +76,6 @@ def study_names(root: Path | None = None) -> list[str]:
         raise SceneError(str(exc)) from None
 
 
-def _merge(base: dict, over: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in over.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
-        else:
-            out[k] = copy.deepcopy(v)
-    return out
-
-
 def _jsonable(v):
     if isinstance(v, float) and not math.isfinite(v):
         return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
@@ -278,7 +268,7 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path} is not valid TOML: {exc}") from None
     params = _params_model(name, root)
-    from ..config import validate_study_file
+    from ..config import merge_tables, validate_study_file
 
     validate_study_file(doc, _shown(path), params)  # every table, key and type, at every scale, before any work
     try:
@@ -291,7 +281,7 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     if scale != DEFAULT_SCALE:
         if scale not in scales:
             raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
-        doc = _merge(doc, scales[scale])
+        doc = merge_tables(doc, scales[scale])
     return Study(name=name, scale=scale, config=doc, root=root / name, info=info, params_model=params)
 
 
