@@ -161,3 +161,21 @@ def test_a_study_is_one_folder():
         assert not (ROOT / "hhscatter" / "studies" / f"{s.name}.py").exists()
         assert not (ROOT / "hhscatter" / "plotting" / f"{s.name}.py").exists()
         assert not (ROOT / "docs" / "studies" / f"{s.name}.md").exists()
+
+
+def test_the_analysis_layer_is_pure():
+    """No heyoka, no engine or runner, no file I/O under hhscatter/analysis: arrays or DataFrames in, results out."""
+    import ast
+
+    banned_modules = ("heyoka", "pyarrow", "hhscatter.engine", "hhscatter.runner", "hhscatter.tables",
+                      "hhscatter.store", "hhscatter.studies")
+    banned_calls = {"open", "read_text", "write_text", "read_bytes", "write_bytes", "read_parquet", "to_parquet",
+                    "to_csv", "read_csv", "savefig"}
+    for path in sorted((ROOT / "hhscatter" / "analysis").glob("*.py")):
+        mods = _imported_modules(path, "hhscatter.analysis")
+        bad = {m for m in mods for b in banned_modules if m == b or m.startswith(b + ".")}
+        assert not bad, f"{path.name} imports {sorted(bad)}"
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call):
+                name = getattr(node.func, "attr", getattr(node.func, "id", None))
+                assert name not in banned_calls, f"{path.name}:{node.lineno} calls {name}()"
