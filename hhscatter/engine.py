@@ -52,6 +52,7 @@ LIVE, FOLLOWING, CONTINUING = 0, 1, 2  # phase of the orbit in a lane
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
+_NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
 
 @dataclass
@@ -152,6 +153,11 @@ class _Rules:
     def record(self, lane, outcome, t, state):
         raise NotImplementedError
 
+    def end_censored(self, lane):
+        """Alive at t_max: censored there (t_end = t_max exactly, the state where the orbit is)."""
+        self.record(lane, CENSORED, self.scene.t_max, self.state4(lane))
+        return self.release(lane)
+
     def commit(self, lane, t_end, continuing):
         """Move the orbit's pending rows to the output (rows after t_end belong to no table)."""
         if self.pending_sec[lane]:
@@ -238,6 +244,11 @@ class _Rules:
         targets = self.targets
         # the root of σ lands within rounding (~ulp(1)·G) of its target, on either side
         while i < len(targets) and targets[i][0] <= t + 1e-12 * self.G:
+            if targets[i][1] == "censor":  # t_max, which the stream scheduler leaves to the clock
+                self.clock_i[lane] = i + 1
+                if self.phase[lane] == LIVE:
+                    return self.end_censored(lane)
+                return self.release(lane)
             if targets[i][1] == "open":
                 if not self.sec_found[lane]:
                     self.set_gate(lane, 1.0)
@@ -311,6 +322,8 @@ class _Stream(_BatchRules):
         self.tf_orbit = [0.0] * self.B
         self.n_restarts = 0
         self.n_loads = 0
+        # with the clock censoring at t_max, no lane needs a bound: one call runs the chunk
+        self.clock_censor = any(a == "censor" for _, a in self.targets)
 
     def fast_handlers(self):
         """Lean closures for the hot handlers of plain scenes (no sections, no follow).
@@ -420,7 +433,7 @@ class _Stream(_BatchRules):
         self.put(lane, k)
         hi = self.time_hi.item(lane)
         self.t0_hi[lane], self.t0_lo[lane] = hi, self.time_lo.item(lane)
-        self.tf_orbit[lane] = hi + self.t_max
+        self.tf_orbit[lane] = _NO_BOUND if self.clock_censor else hi + self.t_max
         # a lane at its bound idles until the call returns; checking costs ~1 µs,
         # so look every 8th load (idle time ≲ 8 orbit ends, once per t_max)
         self.n_loads += 1

@@ -130,7 +130,8 @@ def clock_targets(scene) -> tuple:
 
     Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
     that opens late could miss a crossing) and 'close' it (at t_to +
-    CLOCK_MARGIN); the section rule itself checks the exact window.
+    CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
+    with such a clock and no snapshots also 'censor' with it at t_max.
     """
     w = scene.sections
     if w is None:
@@ -140,7 +141,11 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    return tuple(out)
+    if out and not scene.snapshots:
+        # the clock is compiled in anyway: it also ends the orbit at t_max, so the stream
+        # scheduler needs no per-orbit propagation bound (whose stale copies forced reruns)
+        out.append((float(scene.t_max), "censor"))
+    return tuple(sorted(out))
 
 
 def follow_radii(scene) -> tuple:

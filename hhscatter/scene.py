@@ -121,7 +121,7 @@ class Scene:
       t_max       maximum orbit time (default 5000); orbits alive then are censored
       tol         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15)
       omega, lam  potential parameters ω, λ > 0 (default 1, 1)
-      chunk_size  orbits per part file (default 10000); results do not depend on it
+      chunk_size  orbits per part file (default 10000); tables do not depend on it (bitwise)
       batch_size  SIMD lanes (default: heyoka's recommended size); no effect on results
       ics         optional path of a Parquet/CSV table with columns x, y, px, py
       sections    SectionWindow or None (no section table)
