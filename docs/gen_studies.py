@@ -27,7 +27,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 STUDY_NAMES = ("fig1", "fig2", "resc", "fig3", "fig4", "fig5", "fig6")
-BENCHES = ("bench", "stress")
+BENCHES = ("bench", "stress", "engine")
 CSV_MAX_BYTES = 200_000  # larger CSVs stay out of the repository's docs
 JSON_WARN_BYTES = 500_000
 

@@ -52,6 +52,7 @@ LIVE, FOLLOWING, CONTINUING = 0, 1, 2  # phase of the orbit in a lane
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
+PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
 
@@ -278,6 +279,9 @@ class _BatchRules(_Rules):
         self.next = 0
         self.t_max = scene.t_max
         # Python lists (an element write costs a fifth of numpy's), arrays once per chunk
+        self.count_steps = False  # set by run_chunk(count_steps=True): the epoch loop then reads every lane's result
+        self.progress = None  # run_chunk(progress=f): f(k) after every PROGRESS_EVERY orbits loaded
+        self.ticks = 0
         self.outcome = [-1] * self.n
         self.t_end = [math.nan] * self.n
         # state at t_end; energies and exit channels are computed from it once per chunk
@@ -298,15 +302,25 @@ class _BatchRules(_Rules):
         self.t_end[k] = t
         self.end_state[k] = state
 
+    def tick(self):
+        """Report progress every PROGRESS_EVERY loaded orbits (``run_chunk(progress=...)``)."""
+        self.ticks += 1
+        if self.ticks >= PROGRESS_EVERY:
+            self.progress(self.ticks)
+            self.ticks = 0
+
     def put(self, lane, k):
         """Initial condition k into ``lane`` (state, rules, cooldowns)."""
+        if self.progress is not None:
+            self.tick()
         self.state[:4, lane] = self.ics[k]
         self.start_orbit(lane, k)
         self.ta.reset_cooldowns(lane)
 
     def finish_rows(self, lane):
-        k = self.orbit[lane]
-        self.commit(lane, self.t_end[k], self.phase[lane] == CONTINUING)
+        if self.pending_sec[lane] or self.pending_cross[lane]:
+            k = self.orbit[lane]
+            self.commit(lane, self.t_end[k], self.phase[lane] == CONTINUING)
 
 
 class _Stream(_BatchRules):
@@ -339,6 +353,7 @@ class _Stream(_BatchRules):
         oc, te, es = self.outcome, self.t_end, self.end_state
         n, t_max = self.n, self.t_max
         r_s2 = self.r_s * self.r_s
+        progress = self.progress
         reset = ta.reset_cooldowns
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
@@ -360,6 +375,8 @@ class _Stream(_BatchRules):
             counter[0] = self.next = k + 1
             orbit[lane] = k
             last_out[lane] = None
+            if progress is not None:
+                self.tick()
             st[:4, lane] = ics[k]
             h = hi_(lane)
             t0h[lane], t0l[lane] = h, lo_(lane)
@@ -470,7 +487,7 @@ class _Stream(_BatchRules):
                 break
             ta.propagate_until(tf)
             n_returns += 1
-            n_steps += _check(ta, self)
+            n_steps += _check(ta, self)  # once per return (a handful per chunk)
         return n_returns, n_steps, self.n_restarts, _no_snapshots()
 
 
@@ -502,15 +519,6 @@ class _Epochs(_BatchRules):
         if self.lay.gate is not None:
             self.set_gate(lane, 0.0)
         return True
-
-    def horizon(self, lane):
-        """Epochs the lane's orbit still needs after this one ends (0: it ends now)."""
-        k = self.epoch - self.e0[lane] + 1  # epochs completed at this epoch's end
-        if k >= self.n_epochs_max:
-            return 0
-        if self.phase[lane] == CONTINUING and k * self.P >= self.s_last:
-            return 0
-        return 1
 
     def _tables(self):
         """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
@@ -554,35 +562,44 @@ class _Epochs(_BatchRules):
         self.has = ~np.isnan(tt).all(axis=1)
 
     def run(self):
-        B, ta = self.B, self.ta
+        B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
         self._tables()
-        TAU, _S, has = self.TAU, self.S, self.has
+        TAU, has = self.TAU, self.has
+        orbit, phase, e0, st = self.orbit, self.phase, self.e0, self.state
+        s_last = self.s_last
         buf, rows = [], []
         n_returns = n_steps = 0
-        for lane in range(B):
+        lanes = range(B)
+        for lane in lanes:
             self._load(lane)
-        while any(k >= 0 for k in self.orbit):
+        while any(k >= 0 for k in orbit):
             ta.set_time(self.zeros)
-            kv = np.array([self.epoch - self.e0[lane] if self.orbit[lane] >= 0 else -1 for lane in range(B)])
+            epoch = self.epoch
+            kv = np.array([epoch - e0[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
             if has[kv].any():
-                ids = np.array(self.orbit, dtype=np.int64)  # before the call: orbits end during it
+                ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
                 out = ta.propagate_grid(np.ascontiguousarray(TAU[kv].T))[1]
                 buf.append((out[:, :4, :], kv, ids))
                 if len(buf) >= 256:
                     rows.append(self._snapshot_rows(buf))
                     buf = []
             else:
-                ta.propagate_until(self.P)
+                ta.propagate_until(P)
             n_returns += 1
-            n_steps += _check(ta, self)
-            for lane in range(B):
-                if self.orbit[lane] >= 0 and not self.horizon(lane):
-                    if self.phase[lane] == LIVE:
-                        self.record(lane, CENSORED, self.t_max, self.state4(lane))
-                    self.release(lane)
-            self.epoch += 1
-            for lane in range(B):
-                if self.orbit[lane] < 0:
+            if self.count_steps:
+                n_steps += _check(ta, self)
+            elif not np.isfinite(st).all():
+                _check(ta, self)
+            for lane in lanes:  # orbits that need nothing after this epoch end here
+                if orbit[lane] >= 0:
+                    k = epoch - e0[lane] + 1  # epochs completed
+                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                        if phase[lane] == LIVE:
+                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                        self.release(lane)
+            self.epoch = epoch + 1
+            for lane in lanes:
+                if orbit[lane] < 0:
                     self._load(lane)
         if buf:
             rows.append(self._snapshot_rows(buf))
@@ -636,13 +653,18 @@ def scheduler(scene) -> str:
     return "epochs" if scene.snapshots else "stream"
 
 
-def run_chunk(scene, ics, traj_ids, *, batch_size=None) -> ChunkResult:
-    """run_chunk(scene, ics, traj_ids, batch_size=None) -> ChunkResult.
+def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+    """run_chunk(scene, ics, traj_ids, batch_size=None, count_steps=False, progress=None) -> ChunkResult.
 
     ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
     array (n,). Returns the table rows of this chunk, ordered by traj_id (and
     time). ``batch_size`` (default: the scene's, else 8 lanes for the stream
-    scheduler and 16 for epochs) has no effect on the results.
+    scheduler and 8 for epochs) has no effect on the results. ``count_steps``:
+    fill ``ChunkResult.n_steps`` (the epoch scheduler otherwise skips reading
+    heyoka's per-lane results every epoch; the stream scheduler always counts).
+    ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
+    that many more orbits of the chunk have started (an orbit rerun after a
+    stale bound counts again), so long chunks show progress.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     n = len(ics)
@@ -650,6 +672,8 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None) -> ChunkResult:
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
     ta, specs, lay = events.build_batch(scene, B, _Callback)
     lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, lay, ics)
+    lanes.count_steps = count_steps
+    lanes.progress = progress
     fast = lanes.fast_handlers() if kind == "stream" and scene.sections is None and scene.follow is None else {}
     _bind(ta, specs, lanes, fast)
     try:

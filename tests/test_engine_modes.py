@@ -232,3 +232,38 @@ def test_follow_and_conservative_lifetimes_agree_on_outcomes():
         m = (cr["traj_id"] == k) & (cr["radius"] == 1.03) & (cr["direction"] == 1)
         assert cr["t"][m][0] == fol.lifetimes["t_end"][k]
     assert (fol.lifetimes["outcome"] != CENSORED).any()
+
+
+# -- progress from inside a chunk ------------------------------------------------------
+
+@pytest.mark.parametrize("kw", [{}, {"gamma": 0.01, "snapshots": (0.0, 5.0, 10.0)}], ids=["stream", "epochs"])
+def test_progress_is_reported_from_inside_a_chunk(kw):
+    from hhscatter.engine import PROGRESS_EVERY
+
+    sc = Scene(energy=0.3, n=5000, seed=40, r_esc=1.03, **kw)
+    ics = region_ics(sc, 0, sc.n)
+    seen = []
+    res = run_chunk(sc, ics, np.arange(sc.n), progress=seen.append)
+    assert seen == [PROGRESS_EVERY] * (sc.n // PROGRESS_EVERY)  # (no reruns at t_max = 5000 here)
+    plain = run_chunk(sc, ics, np.arange(sc.n))
+    assert np.array_equal(res.lifetimes["t_end"], plain.lifetimes["t_end"])  # progress changes nothing
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_runner_progress_moves_within_chunks_and_totals_exactly(tmp_path, monkeypatch, workers):
+    import hhscatter.runner as runner
+
+    updates = []
+
+    class Bar:
+        def update(self, k):
+            updates.append(k)
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(runner, "progress_bar", lambda *a, **k: Bar())
+    sc = Scene(energy=0.3, n=6000, seed=41, r_esc=1.03, chunk_size=3000)
+    runner.simulate(sc, tmp_path / "run", workers=workers, progress=True)
+    assert sum(updates) == sc.n
+    assert len(updates) > 2  # more than one update per chunk
