@@ -132,6 +132,8 @@ class _Rules:
         self.pending_sec = [[] for _ in range(n_lanes)]
         self.pending_cross = [[] for _ in range(n_lanes)]
         self.sec_rows, self.cross_rows = [], []
+        self.migrate_at_open = False  # first phase of a two-phase scene: hand orbits on at t_from
+        self.migrants = []
 
     def energy(self, x, y, px, py):
         """H at one point in plain float arithmetic (numpy calls cost µs per scalar)."""
@@ -251,6 +253,10 @@ class _Rules:
                     return self.end_censored(lane)
                 return self.release(lane)
             if targets[i][1] == "open":
+                if self.migrate_at_open:  # the window opens: the orbit goes on in the second phase
+                    self.migrants.append((self.orbit[lane], self.state4(lane), t, i + 1, self.last_out[lane],
+                                          self.phase[lane]))
+                    return self.release(lane)
                 if not self.sec_found[lane]:
                     self.set_gate(lane, 1.0)
             else:
@@ -273,6 +279,7 @@ class _BatchRules(_Rules):
         self.setup(scene, lay, self.B)
         self.state = ta.state  # live views into the integrator
         self.pars = ta.pars if lay.n_pars else None
+        self.gate_live = lay.gate is not None and lay.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
         self.ics = ics.tolist()
         self.n = len(ics)
@@ -291,7 +298,8 @@ class _BatchRules(_Rules):
         return tuple(self.state[:4, lane].tolist())
 
     def set_gate(self, lane, g):
-        self.pars[self.lay.gate, lane] = g
+        if self.gate_live:  # (a first phase has no section event, hence no gate)
+            self.pars[self.lay.gate, lane] = g
 
     def set_clock(self, lane, sigma):
         self.state[self.lay.clock, lane] = sigma
@@ -338,9 +346,10 @@ class _Stream(_BatchRules):
         self.n_loads = 0
         # with the clock censoring at t_max, no lane needs a bound: one call runs the chunk
         self.clock_censor = any(a == "censor" for _, a in self.targets)
+        self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
 
     def fast_handlers(self):
-        """Lean closures for the hot handlers of plain scenes (no sections, no follow).
+        """Lean closures for the hot handlers of plain scenes (no section event, no follow).
 
         The same rules as the methods of :class:`_Rules`, with the per-orbit
         Python cut to a few list operations (measured: the generic chain of
@@ -355,6 +364,10 @@ class _Stream(_BatchRules):
         r_s2 = self.r_s * self.r_s
         progress = self.progress
         reset = ta.reset_cooldowns
+        # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
+        clock, phase, clock_i = self.lay.clock, self.phase, self.clock_i
+        sigma0 = self.targets[0][0] / self.G if self.targets else 1.0
+        no_bound = self.clock_censor
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
 
@@ -378,9 +391,13 @@ class _Stream(_BatchRules):
             if progress is not None:
                 self.tick()
             st[:4, lane] = ics[k]
+            if clock is not None:
+                st[clock, lane] = sigma0
+                clock_i[lane] = 0
+                phase[lane] = LIVE
             h = hi_(lane)
             t0h[lane], t0l[lane] = h, lo_(lane)
-            tfo[lane] = h + t_max
+            tfo[lane] = _NO_BOUND if no_bound else h + t_max
             reset(lane)
             counter[1] += 1
             return (counter[1] & 7) or not (hi >= tf).any()
@@ -431,7 +448,8 @@ class _Stream(_BatchRules):
         s = a + b
         bb = s - a
         err = (a - (s - bb)) + (b - bb)
-        return s + (err + (self.time_lo.item(lane) - self.t0_lo[lane]))
+        # + the orbit time at which it entered this integrator (0 but in a second phase)
+        return (s + (err + (self.time_lo.item(lane) - self.t0_lo[lane]))) + self.t_off[lane]
 
     def load(self, lane, k=None):
         """Put orbit ``k`` (default: the next one) into ``lane``; park the lane if none is left.
@@ -478,9 +496,6 @@ class _Stream(_BatchRules):
         n_returns = n_steps = 0
         while True:
             for lane in range(B):
-                if self.orbit[lane] >= 0 and self.time_hi[lane] >= tf[lane]:
-                    self.at_bound(lane)
-            for lane in range(B):
                 # parked lanes hold still at their current time
                 tf[lane] = self.tf_orbit[lane] if self.orbit[lane] >= 0 else self.time_hi[lane]
             if all(k < 0 for k in self.orbit):
@@ -488,7 +503,41 @@ class _Stream(_BatchRules):
             ta.propagate_until(tf)
             n_returns += 1
             n_steps += _check(ta, self)  # once per return (a handful per chunk)
+            for lane in range(B):
+                if self.orbit[lane] >= 0 and self.time_hi[lane] >= tf[lane]:
+                    self.at_bound(lane)
         return n_returns, n_steps, self.n_restarts, _no_snapshots()
+
+
+class _SecondPhase(_Stream):
+    """The second phase of a two-phase stream scene: the orbits handed on at t_from, with the
+    section event compiled in. Loads a migrant's state, orbit time and rule state instead of an
+    initial condition; shares the outcome arrays and rows with the first phase."""
+
+    def __init__(self, scene, ta, lay, first):
+        self.migrants_in = first.migrants
+        super().__init__(scene, ta, lay, np.zeros((len(first.migrants), 4)))
+        for name in ("outcome", "t_end", "end_state", "sec_rows", "cross_rows"):
+            setattr(self, name, getattr(first, name))
+        self.progress = None  # the first phase reported these orbits already
+        self.src = [-1] * self.B
+
+    def put(self, lane, j):
+        k, state, t_mig, clock_i, last_out, phase = self.migrants_in[j]
+        self.src[lane] = j
+        self.state[:4, lane] = state
+        self.start_orbit(lane, k)
+        self.last_out[lane], self.phase[lane] = last_out, phase
+        self.t_off[lane] = t_mig
+        self.set_gate(lane, 1.0)
+        self.clock_i[lane] = clock_i
+        targets = self.targets
+        self.set_clock(lane, (targets[clock_i][0] - t_mig) / self.G if clock_i < len(targets) else 1.0)
+        self.ta.reset_cooldowns(lane)
+
+    def load(self, lane, k=None):
+        # a rerun (k given, after a stale bound) restarts the migrant, not an initial condition
+        return super().load(lane, None if k is None else self.src[lane])
 
 
 class _Epochs(_BatchRules):
@@ -670,17 +719,31 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     n = len(ics)
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
-    ta, specs, lay = events.build_batch(scene, B, _Callback)
+    phases = kind == "stream" and events.two_phase(scene)
+    # first (or only) phase: without the section event when the window opens late
+    ta, specs, lay = events.build_batch(scene, B, _Callback, without=("section",) if phases else ())
     lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, lay, ics)
     lanes.count_steps = count_steps
     lanes.progress = progress
-    fast = lanes.fast_handlers() if kind == "stream" and scene.sections is None and scene.follow is None else {}
+    lanes.migrate_at_open = phases
+    # the lean handlers serve stream scenes with no section event in this integrator and no follow
+    lean = kind == "stream" and scene.follow is None and (scene.sections is None or phases)
+    fast = lanes.fast_handlers() if lean else {}
     _bind(ta, specs, lanes, fast)
     try:
         n_returns, n_steps, n_restarts, (s_ids, s_t, s_e) = lanes.run()
     finally:
         _unbind(ta)
         lanes.__dict__.pop("load", None)  # the fast path's closure refers back to the lanes: free them now
+    if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
+        ta2, specs2, _ = events.build_batch(scene, B, _Callback)
+        second = _SecondPhase(scene, ta2, lay, lanes)
+        _bind(ta2, specs2, second)
+        try:
+            r2, s2, x2, _ = second.run()
+        finally:
+            _unbind(ta2)
+        n_returns, n_steps, n_restarts = n_returns + r2, n_steps + s2, n_restarts + x2
     outcome = np.array(lanes.outcome, dtype=np.int8)
     if (outcome < 0).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")

@@ -215,25 +215,39 @@ def system(scene, lay: Layout):
     return sys
 
 
-def build_batch(scene, batch_size: int, make_callback, *, tol=None):
-    """build_batch(scene, batch_size, make_callback) -> (taylor_adaptive_batch, specs, layout).
+def two_phase(scene) -> bool:
+    """two_phase(scene) -> True if the section event is compiled only into an orbit's second phase.
+
+    Scenes without snapshots whose section window opens late (t_from > 0):
+    orbits run without the section event until the clock opens the window,
+    then move to an integrator that has it (hhscatter.engine). Snapshot scenes
+    switch the event off per lane instead (all lanes share one grid there).
+    """
+    return scene.sections is not None and scene.sections.t_from > 0 and not scene.snapshots
+
+
+def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
+    """build_batch(scene, batch_size, make_callback, without=()) -> (taylor_adaptive_batch, specs, layout).
 
     ``make_callback(spec)`` returns the callback object of one event (heyoka
     deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
+    ``without``: names of events left out (an orbit phase that does not need them).
     """
     import heyoka as hy
     import numpy as np
 
     lay = layout(scene)
-    specs = scene_events(scene)
+    specs = tuple(s for s in scene_events(scene) if s.name not in without)
     sym = Symbols(scene, lay)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     events = [hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction])
               for s in specs]
-    pars = np.zeros((lay.n_pars, batch_size))
+    # the gate is the last parameter: without the section event heyoka's system has none
+    n_pars = lay.n_pars - (1 if lay.gate is not None and "section" in without else 0)
+    pars = np.zeros((n_pars, batch_size))
     if lay.gamma is not None:
         pars[lay.gamma] = scene.gamma
-    kw = {"pars": pars} if lay.n_pars else {}
+    kw = {"pars": pars} if n_pars else {}
     ta = hy.taylor_adaptive_batch(system(scene, lay), np.zeros((lay.n_state, batch_size)),
                                   tol=scene.tol if tol is None else tol, t_events=events, **kw)
     return ta, specs, lay
@@ -304,5 +318,5 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
 
 
 __all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "build_batch",
-           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events",
+           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
            "section_accepts", "system"]

@@ -42,6 +42,8 @@ def test_only_the_events_module_constructs_heyoka_events():
     ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2"]),
 ])
 def test_scene_events_compile_only_what_the_scene_needs(kw, names):
+    # (a stream scene whose window opens late compiles the section event only into the
+    # orbits' second phase: events.two_phase, tested bitwise and against the reference below)
     sc = Scene(energy=0.3, n=1, r_esc=1.5, **kw)
     assert [e.name for e in events.scene_events(sc)] == names
     lay = events.layout(sc)
@@ -206,7 +208,8 @@ def test_section_window_stop_at_t_to():
     {"gamma": 0.01, "energy": 0.3, "snapshots": tuple(np.arange(0.0, 40.01, 0.5)),
      "sections": SectionWindow(t_from=5.0, first_only=True)},
     {"gamma": 0.0, "energy": 0.3, "follow": Follow((1.0, 2.0))},
-], ids=["dissipative", "epochs+sections", "follow"])
+    {"gamma": 0.01, "energy": 0.35, "sections": SectionWindow(t_from=6.0, t_to=30.0)},
+], ids=["dissipative", "epochs+sections", "follow", "two-phase sections"])
 def test_tables_do_not_depend_on_chunking_or_lanes(kw):
     """Bitwise, for γ > 0 too: event roots end heyoka's step, so times come from the orbit's own clock."""
     sc = Scene(n=240, seed=38, r_esc=1.03, **kw)
