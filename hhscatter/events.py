@@ -31,8 +31,9 @@ radius_k   any    r² − R_k²                                   follow: crossi
                                                               outward r_esc one is the escape
 section    any    g·(x p_x + y p_y − 10⁻³⁰⁰) + (1 − g)         ṙ = 0, kept where φ̇ > 0 and the
                                                               window admits it; g = 0/1 per lane
-                                                              (runtime parameter): the event is
-                                                              switched off outside its window
+                                                              (runtime parameter) switches it off;
+                                                              a late window compiles it only into
+                                                              the orbits' second phase (two_phase)
 clock      −      σ  (dσ/dt = −1/G)                           orbit-time schedule: opens/closes
                                                               the section window at t_from/t_to
 =========  =====  ==========================================  =====================================
