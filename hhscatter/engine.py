@@ -52,6 +52,8 @@ LIVE, FOLLOWING, CONTINUING = 0, 1, 2  # phase of the orbit in a lane
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
+SECTION_COLUMNS = ("traj_id", "t", "x", "y", "px", "py", "energy")
+CROSSING_COLUMNS = ("traj_id", "t", "radius", "direction")
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
@@ -716,6 +718,10 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     stale bound counts again), so long chunks show progress.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
+    traj_ids = np.asarray(traj_ids, dtype=np.int64)
+    outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
+    if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
+        return _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress)
     n = len(ics)
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
@@ -751,7 +757,6 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     model = scene.model
     end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
     t_end = np.array(lanes.t_end, dtype=float)
-    traj_ids = np.asarray(traj_ids, dtype=np.int64)
     channel = np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1)
     lifetimes = {
         "traj_id": traj_ids,
@@ -766,13 +771,47 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
         "exit_channel": channel.astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
-    sections = _rows_to_columns(lanes.sec_rows, ("traj_id", "t", "x", "y", "px", "py", "energy"), traj_ids)
-    crossings = _rows_to_columns(lanes.cross_rows, ("traj_id", "t", "radius", "direction"), traj_ids)
+    sections = _rows_to_columns(lanes.sec_rows, SECTION_COLUMNS, traj_ids)
+    crossings = _rows_to_columns(lanes.cross_rows, CROSSING_COLUMNS, traj_ids)
     crossings["direction"] = crossings["direction"].astype(np.int8)
     order = np.lexsort((s_t, s_ids))
     snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
     return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
                        n_restarts=n_restarts)
+
+
+def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress):
+    """run_chunk for a chunk with orbits that start at r ≥ r_esc: those are escaped at t = 0
+    (the authors' square ICs); the others run as usual. Rows keep traj_id order."""
+    inside = ~outside
+    model = scene.model
+    if inside.any():
+        res = run_chunk(scene, ics[inside], traj_ids[inside], batch_size=batch_size, count_steps=count_steps,
+                        progress=progress)
+    else:
+        res = ChunkResult({}, _rows_to_columns([], SECTION_COLUMNS, traj_ids),
+                          _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids),
+                          _rows_to_columns([], CROSSING_COLUMNS, traj_ids))
+        res.crossings["direction"] = res.crossings["direction"].astype(np.int8)
+    x, y, px, py = ics.T
+    lt = {
+        "traj_id": traj_ids, "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
+        "e0": model.energy(x, y, px, py), "gamma": np.full(len(ics), scene.gamma),
+        "outcome": np.full(len(ics), ESCAPED, np.int8), "t_end": np.zeros(len(ics)),
+        "exit_channel": model.exit_channel(x, y).astype(np.int8), "e_end": model.energy(x, y, px, py),
+    }
+    if inside.any():
+        for col in ("outcome", "t_end", "exit_channel", "e_end"):
+            lt[col][inside] = res.lifetimes[col]
+    snaps = res.snapshots
+    if scene.snapshots and scene.snapshots[0] == 0.0:  # a snapshot at t = 0 ≤ t_end of the escaped ones
+        ids = np.concatenate([snaps["traj_id"], traj_ids[outside]])
+        t = np.concatenate([snaps["t"], np.zeros(int(outside.sum()))])
+        e = np.concatenate([snaps["energy"], lt["e0"][outside]])
+        order = np.lexsort((t, ids))
+        snaps = {"traj_id": ids[order], "t": t[order], "energy": e[order]}
+    return ChunkResult(lt, res.sections, snaps, res.crossings, n_returns=res.n_returns, n_steps=res.n_steps,
+                       n_restarts=res.n_restarts)
 
 
 def _rows_to_columns(rows, columns, traj_ids):
@@ -851,6 +890,10 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     """
     import heyoka as hy
 
+    ic = np.asarray(ic, dtype=float)
+    if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
+        snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []
+        return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
     ta, specs, lay = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
     rules = _Scalar(scene, ta, lay, fp_type)
     _bind(ta, specs, rules)

@@ -30,7 +30,7 @@ def _candidates(rng, region, radius, saddle_radius, m):
         r = radius * np.sqrt(rng.random(m))
         phi = 2 * np.pi * rng.random(m)
         return r * np.cos(phi), r * np.sin(phi)
-    # 'well': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
+    # 'well' and 'square': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
     xy = saddle_radius * (2 * rng.random((2, m)) - 1)
     return xy[0], xy[1]
 
@@ -46,7 +46,10 @@ def sample_block(scene: Scene, block: int) -> np.ndarray:
     """sample_block(scene, block) -> array (BLOCK, 4) of states (x, y, px, py).
 
     Candidates with V ≥ E, r = 0 or (region 'well') outside the saddle triangle
-    are rejected and redrawn from the same block generator.
+    are rejected and redrawn from the same block generator. Region 'square' is
+    the authors' ``goodICs`` (uniform in [−r_s, r_s]² where V < E): it keeps
+    points beyond the saddles, even beyond r_esc (the engine records those as
+    escaped at t = 0).
     """
     model = scene.model
     rng = _block_rng(scene.seed, block)

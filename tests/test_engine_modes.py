@@ -270,3 +270,51 @@ def test_runner_progress_moves_within_chunks_and_totals_exactly(tmp_path, monkey
     runner.simulate(sc, tmp_path / "run", workers=workers, progress=True)
     assert sum(updates) == sc.n
     assert len(updates) > 2  # more than one update per chunk
+
+
+# -- the authors' square initial conditions ----------------------------------------------
+
+def test_square_region_is_uniform_in_the_allowed_square_and_on_the_energy_shell():
+    from scipy import stats
+
+    E = 0.3
+    m = HenonHeiles()
+    sc = Scene(energy=E, n=20000, seed=42, region="square", r_esc=1.03)
+    ics = region_ics(sc, 0, sc.n)
+    x, y, px, py = ics.T
+    assert (np.abs(x) <= 1).all() and (np.abs(y) <= 1).all()
+    np.testing.assert_allclose(m.energy(x, y, px, py), E, rtol=0, atol=4e-16)
+    assert np.abs(x * px + y * py).max() < 1e-15 and (x * py - y * px > 0).all()  # ṙ = 0, φ̇ > 0
+    # the x marginal against the allowed area {V < E} ∩ [−1, 1]², from an independent fine grid
+    g = np.linspace(-1, 1, 4001)
+    X, Y = np.meshgrid(g, g, indexing="ij")
+    allowed = (m.potential(X, Y) < E).sum(axis=1).astype(float)
+    cdf_x = np.concatenate([[0.0], np.cumsum(0.5 * (allowed[1:] + allowed[:-1]))])
+    cdf_x /= cdf_x[-1]
+    assert stats.kstest(x, lambda v: np.interp(v, g, cdf_x)).pvalue > 0.01
+    # and points beyond the saddle triangle are there (the disk and the well have none)
+    assert (~m.inside_triangle(x, y)).mean() > 0.01
+
+
+@pytest.mark.parametrize("gamma", [0.0, 0.01])
+def test_orbits_starting_beyond_r_esc_are_escaped_at_t0(gamma):
+    sc = Scene(energy=0.3, gamma=gamma, n=3000, seed=43, region="square", r_esc=1.03,
+               snapshots=(0.0, 1.0, 2.0) if gamma else None)
+    ics = region_ics(sc, 0, sc.n)
+    out = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= 1.03**2
+    assert out.sum() > 20
+    res = run_chunk(sc, ics, np.arange(sc.n) + 100)
+    lt = res.lifetimes
+    np.testing.assert_array_equal(lt["traj_id"], np.arange(sc.n) + 100)
+    assert (lt["outcome"][out] == ESCAPED).all() and (lt["t_end"][out] == 0.0).all()
+    assert (lt["t_end"][~out] > 0).all()
+    np.testing.assert_array_equal(lt["exit_channel"][out], HenonHeiles().exit_channel(ics[out, 0], ics[out, 1]))
+    # the others exactly as in a run without them
+    alone = run_chunk(sc, ics[~out], np.flatnonzero(~out) + 100).lifetimes
+    np.testing.assert_array_equal(lt["t_end"][~out], alone["t_end"])
+    if gamma:  # their one snapshot, at t = 0 ≤ t_end
+        sn = res.snapshots
+        rows = np.isin(sn["traj_id"], np.flatnonzero(out) + 100)
+        assert (sn["t"][rows] == 0.0).all() and rows.sum() == out.sum()
+    k = int(np.flatnonzero(out)[0])
+    assert simulate_orbit(sc, ics[k]).outcome == ESCAPED and simulate_orbit(sc, ics[k]).t_end == 0.0
