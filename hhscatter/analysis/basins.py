@@ -81,9 +81,11 @@ any break above the upper end is excluded at z σ.  With β free the break can
 mimic the single law at every x_c, so no useful upper bound can be given.
 The errors of α and β come from the expected information of (ln c, α, β, x_c)
 and so include the uncertainty of the break.  The break is not a regular
-parameter (ℓ(x_c) has kinks at the sampled ε): the tests find the ±1σ
-interval of ε_c and the errors of α and β to cover the truth in about 68 %
-of synthetic replicates, somewhat less when ε_c sits on a sampled ε.  The
+parameter (ℓ(x_c) has kinks at the sampled ε): in synthetic replicates of
+a sharply broken law (13 ε over 4 decades, 2·10^4 ICs each) the ±1σ
+interval of ε_c and the errors of α (β fixed, tested) and of β (β free,
+measured) cover the truth in about 68 % of cases, down to ≈ 60 % when ε_c
+lies next to a sampled ε.  The
 interval presumes that both laws describe the data (check the χ² of the
 single fit above and below ε_c); a smooth crossover fitted by a sharp break
 gives an interval that is too narrow.
