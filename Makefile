@@ -96,8 +96,8 @@ reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py
 
 report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown) from the study outputs, running what is missing
 
-bench-engine: $(STAMP) ## µs per orbit of the engine (1 and all workers), time inside heyoka
-	$(PY) -m hhscatter.bench_engine $(BENCH_ARGS)
+bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → studies/engine/out/full/
+	$(PY) -m hhscatter.bench_engine $(ENGINE_ARGS)
 
 bench-memory: $(STAMP) ## peak RSS of simulate + P(t) at E=0.27, N=1e5,1e6,1e7, 1 worker (1e7: ~5-10 CPU-min)
 	$(PY) -m hhscatter.bench_memory $(MEMORY_ARGS)
@@ -106,8 +106,9 @@ $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
 	@touch $@
 
-bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput → studies/bench/out/ (CSV, PNG, summary.md)
+bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets → studies/{bench,engine}/out/
 	$(PY) -m hhscatter.bench $(BENCH_ARGS)
+	$(PY) -m hhscatter.bench_engine -n 30000 --repeat 2
 
 # the report runs the benchmarks only when their summaries are missing or their code changed
 $(BENCH_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/bench/bench.toml | $(BENCH_STAMP)

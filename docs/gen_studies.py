@@ -37,7 +37,7 @@ def study_names(root: Path) -> list:
     spec.loader.exec_module(graph)
     return [s.name for s in graph.studies(root / "studies")]
 
-BENCHES = ("bench", "stress")
+BENCHES = ("bench", "stress", "engine")
 CSV_MAX_BYTES = 200_000  # larger CSVs stay out of the repository's docs
 JSON_WARN_BYTES = 500_000
 

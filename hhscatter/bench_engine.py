@@ -21,7 +21,8 @@ absolute times, are the result). Rows:
 * a cProfile split of the recording scene: time inside heyoka's compiled
   propagation against Python callbacks and bookkeeping.
 
-Writes ``studies/bench/out/engine/engine.csv`` and ``engine.md``. Not a
+Writes ``studies/engine/out/<full|quick>/engine.csv`` and ``engine_summary.md``
+(``make docs-assets`` copies them to the benchmarks page). Not a
 test: numbers vary with the machine; the ratios are what is reported.
 """
 from __future__ import annotations
@@ -102,6 +103,73 @@ def yardstick(ics, *, r_esc=1.03, t_max=5000.0, tol=1e-15, batch_size=None):
     return t_end
 
 
+def design_choices(batch_size=8, epochs=400, epoch=8.0):
+    """design_choices() -> {name: ns per lane-step}: what each way of recording costs in heyoka.
+
+    Trapped orbits (E = 0.12, no event), ``epochs`` calls of one epoch each, as
+    the epoch scheduler makes them: ``propagate_until`` (no recording),
+    ``propagate_grid`` with 2 and 17 points per epoch (what snapshots every 0.5
+    cost), a Python step callback copying the Taylor coefficients (the
+    alternative to a grid), and ``c_output=True`` (continuous output). The
+    engine uses ``propagate_grid`` for snapshot scenes and ``propagate_until``
+    otherwise.
+    """
+    import heyoka as hy
+
+    from .events import system
+    from .ics import section_velocities
+    from .model import HenonHeiles
+    from .scene import Scene
+
+    m = HenonHeiles()
+    rng = np.random.default_rng(7)
+    r = 0.3 * np.sqrt(rng.random(batch_size))
+    phi = 2 * np.pi * rng.random(batch_size)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    px, py = section_velocities(m, x, y, 0.12)
+    st0 = np.vstack([x, y, px, py])
+    sc = Scene(energy=0.3, n=1)
+    from .events import layout
+
+    sys = system(sc, layout(sc))
+    zeros = np.zeros(batch_size)
+    g2 = np.repeat(np.array([0.0, epoch])[:, None], batch_size, axis=1)
+    g17 = np.repeat(np.linspace(0.0, epoch, 17)[:, None], batch_size, axis=1)
+
+    def run(kind):
+        ta = hy.taylor_adaptive_batch(sys, st0.copy(), tol=1e-15)
+        tc = ta.tc
+        buf = []
+
+        def cb(ta_):
+            buf.append(tc.copy())
+            return True
+
+        steps = 0
+        t0 = time.perf_counter()
+        for _ in range(epochs if kind != "c_output" else max(epochs // 20, 5)):
+            ta.set_time(zeros)
+            if kind == "until":
+                ta.propagate_until(epoch)
+            elif kind == "grid2":
+                ta.propagate_grid(g2)
+            elif kind == "grid17":
+                ta.propagate_grid(g17)
+            elif kind == "step callback":
+                ta.propagate_until(epoch, callback=cb)
+                buf.clear()
+            else:
+                ta.propagate_until(epoch, c_output=True)
+            steps += sum(int(res[3]) for res in ta.propagate_res)
+        return 1e9 * (time.perf_counter() - t0) / steps
+
+    out = {}
+    for kind in ("until", "grid2", "grid17", "step callback", "c_output"):
+        run(kind)  # compile outside the measurement
+        out[kind] = min(run(kind) for _ in range(2))
+    return out
+
+
 def _best(fn, repeat):
     fn()  # JIT compilation and caches outside the measurement
     best = np.inf
@@ -116,7 +184,7 @@ def _best(fn, repeat):
 def _engine(scene, ics, **kw):
     from .engine import run_chunk
 
-    return lambda: run_chunk(scene, ics, np.arange(len(ics)), **kw)
+    return lambda: run_chunk(scene, ics, np.arange(len(ics)), count_steps=True, **kw)
 
 
 def main(argv=None):
@@ -127,7 +195,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--out", default="studies/bench/out/engine")
+    ap.add_argument("--out", default=None, help="output folder (default studies/engine/out/full, "
+                    "or .../quick for N < 1e5)")
     a = ap.parse_args(argv)
     n, rep = a.n, a.repeat
     rows = []
@@ -198,7 +267,16 @@ def main(argv=None):
     row("profile", "recording: share inside heyoka's compiled propagation", inside / total, "",
         "self time of propagate_*; the rest is Python (callbacks, epochs, numpy)")
 
-    out = Path(a.out)
+    # -- the design choices behind the epoch scheduler -------------------------------------
+    dc = design_choices()
+    for kind, label in (("until", "propagate_until (no recording)"), ("grid2", "propagate_grid, 2 points/epoch"),
+                        ("grid17", "propagate_grid, 17 points/epoch (snapshots every 0.5)"),
+                        ("step callback", "Python step callback copying the Taylor coefficients"),
+                        ("c_output", "propagate_until with c_output=True")):
+        row("design", f"ns per lane-step: {label}", dc[kind], "",
+            f"{dc[kind] / dc['until']:.2f}× propagate_until")
+
+    out = Path(a.out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
     out.mkdir(parents=True, exist_ok=True)
     import pandas as pd
 
@@ -206,8 +284,10 @@ def main(argv=None):
     df.to_csv(out / "engine.csv", index=False)
     lines = ["| target | measure | value | goal | note |", "|---|---|---|---|---|"]
     lines += [f"| {r.target} | {r.measure} | {r.value:.3g} | {r.goal} | {r.note} |" for r in df.itertuples()]
-    (out / "engine.md").write_text(f"N = {n} per measurement (1 core, best of {rep})\n\n" + "\n".join(lines) + "\n")
-    print(f"wrote {out / 'engine.csv'} and {out / 'engine.md'}")
+    (out / "engine_summary.md").write_text(
+        f"Engine targets (issue 11), N = {n} per measurement, 1 core, best of {rep}; every ratio is "
+        "measured side by side in one run.\n\n" + "\n".join(lines) + "\n")
+    print(f"wrote {out / 'engine.csv'} and {out / 'engine_summary.md'}")
 
 
 if __name__ == "__main__":

@@ -92,7 +92,9 @@ def build_parser():
     s.add_argument("--gamma", type=_floats, help="drag γ ≥ 0 (0 = conservative); a list 0,0.01 makes a grid run")
     s.add_argument("-n", type=_int, help="number of orbits N > 0 (per grid point); 1e5 is accepted")
     s.add_argument("--seed", type=_int, help="seed ≥ 0 (with the orbit index it fixes every orbit)")
-    s.add_argument("--region", choices=["disk", "well"], help="initial-condition region")
+    s.add_argument("--region", choices=["disk", "well", "square"],
+                   help="initial-condition region: disk (r < radius), well (saddle triangle), square (the authors' "
+                        "[-1, 1]² with V < E; orbits starting at r ≥ r_esc are escaped at t = 0)")
     s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
     s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default 1.5; the paper used 1.03, see study resc)")
     s.add_argument("--t-max", type=_float, dest="t_max", help="maximum orbit time (default 5000)")

@@ -35,7 +35,7 @@ from pydantic import (
     model_validator,
 )
 
-from .scene import SceneError
+from .scene import REGIONS, SceneError
 
 __all__ = [
     "Bool",
@@ -158,7 +158,7 @@ class SceneTable(_Table):
     gamma: NumberOrNumbers = None
     n: Integer = None
     seed: Integer = None
-    region: OneOf("disk", "well") = None
+    region: OneOf(*REGIONS) = None
     radius: Number = None
     r_esc: Number = None
     r_far: Number = None

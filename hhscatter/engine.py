@@ -52,6 +52,10 @@ LIVE, FOLLOWING, CONTINUING = 0, 1, 2  # phase of the orbit in a lane
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
+SECTION_COLUMNS = ("traj_id", "t", "x", "y", "px", "py", "energy")
+CROSSING_COLUMNS = ("traj_id", "t", "radius", "direction")
+PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
+_NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
 
 @dataclass
@@ -130,6 +134,8 @@ class _Rules:
         self.pending_sec = [[] for _ in range(n_lanes)]
         self.pending_cross = [[] for _ in range(n_lanes)]
         self.sec_rows, self.cross_rows = [], []
+        self.migrate_at_open = False  # first phase of a two-phase scene: hand orbits on at t_from
+        self.migrants = []
 
     def energy(self, x, y, px, py):
         """H at one point in plain float arithmetic (numpy calls cost µs per scalar)."""
@@ -151,6 +157,11 @@ class _Rules:
 
     def record(self, lane, outcome, t, state):
         raise NotImplementedError
+
+    def end_censored(self, lane):
+        """Alive at t_max: censored there (t_end = t_max exactly, the state where the orbit is)."""
+        self.record(lane, CENSORED, self.scene.t_max, self.state4(lane))
+        return self.release(lane)
 
     def commit(self, lane, t_end, continuing):
         """Move the orbit's pending rows to the output (rows after t_end belong to no table)."""
@@ -238,7 +249,16 @@ class _Rules:
         targets = self.targets
         # the root of σ lands within rounding (~ulp(1)·G) of its target, on either side
         while i < len(targets) and targets[i][0] <= t + 1e-12 * self.G:
+            if targets[i][1] == "censor":  # t_max, which the stream scheduler leaves to the clock
+                self.clock_i[lane] = i + 1
+                if self.phase[lane] == LIVE:
+                    return self.end_censored(lane)
+                return self.release(lane)
             if targets[i][1] == "open":
+                if self.migrate_at_open:  # the window opens: the orbit goes on in the second phase
+                    self.migrants.append((self.orbit[lane], self.state4(lane), t, i + 1, self.last_out[lane],
+                                          self.phase[lane]))
+                    return self.release(lane)
                 if not self.sec_found[lane]:
                     self.set_gate(lane, 1.0)
             else:
@@ -261,12 +281,16 @@ class _BatchRules(_Rules):
         self.setup(scene, lay, self.B)
         self.state = ta.state  # live views into the integrator
         self.pars = ta.pars if lay.n_pars else None
+        self.gate_live = lay.gate is not None and lay.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
         self.ics = ics.tolist()
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
         # Python lists (an element write costs a fifth of numpy's), arrays once per chunk
+        self.count_steps = False  # set by run_chunk(count_steps=True): the epoch loop then reads every lane's result
+        self.progress = None  # run_chunk(progress=f): f(k) after every PROGRESS_EVERY orbits loaded
+        self.ticks = 0
         self.outcome = [-1] * self.n
         self.t_end = [math.nan] * self.n
         # state at t_end; energies and exit channels are computed from it once per chunk
@@ -276,7 +300,8 @@ class _BatchRules(_Rules):
         return tuple(self.state[:4, lane].tolist())
 
     def set_gate(self, lane, g):
-        self.pars[self.lay.gate, lane] = g
+        if self.gate_live:  # (a first phase has no section event, hence no gate)
+            self.pars[self.lay.gate, lane] = g
 
     def set_clock(self, lane, sigma):
         self.state[self.lay.clock, lane] = sigma
@@ -287,15 +312,25 @@ class _BatchRules(_Rules):
         self.t_end[k] = t
         self.end_state[k] = state
 
+    def tick(self):
+        """Report progress every PROGRESS_EVERY loaded orbits (``run_chunk(progress=...)``)."""
+        self.ticks += 1
+        if self.ticks >= PROGRESS_EVERY:
+            self.progress(self.ticks)
+            self.ticks = 0
+
     def put(self, lane, k):
         """Initial condition k into ``lane`` (state, rules, cooldowns)."""
+        if self.progress is not None:
+            self.tick()
         self.state[:4, lane] = self.ics[k]
         self.start_orbit(lane, k)
         self.ta.reset_cooldowns(lane)
 
     def finish_rows(self, lane):
-        k = self.orbit[lane]
-        self.commit(lane, self.t_end[k], self.phase[lane] == CONTINUING)
+        if self.pending_sec[lane] or self.pending_cross[lane]:
+            k = self.orbit[lane]
+            self.commit(lane, self.t_end[k], self.phase[lane] == CONTINUING)
 
 
 class _Stream(_BatchRules):
@@ -311,9 +346,12 @@ class _Stream(_BatchRules):
         self.tf_orbit = [0.0] * self.B
         self.n_restarts = 0
         self.n_loads = 0
+        # with the clock censoring at t_max, no lane needs a bound: one call runs the chunk
+        self.clock_censor = any(a == "censor" for _, a in self.targets)
+        self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
 
     def fast_handlers(self):
-        """Lean closures for the hot handlers of plain scenes (no sections, no follow).
+        """Lean closures for the hot handlers of plain scenes (no section event, no follow).
 
         The same rules as the methods of :class:`_Rules`, with the per-orbit
         Python cut to a few list operations (measured: the generic chain of
@@ -326,7 +364,12 @@ class _Stream(_BatchRules):
         oc, te, es = self.outcome, self.t_end, self.end_state
         n, t_max = self.n, self.t_max
         r_s2 = self.r_s * self.r_s
+        progress = self.progress
         reset = ta.reset_cooldowns
+        # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
+        clock, phase, clock_i = self.lay.clock, self.phase, self.clock_i
+        sigma0 = self.targets[0][0] / self.G if self.targets else 1.0
+        no_bound = self.clock_censor
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
 
@@ -347,10 +390,16 @@ class _Stream(_BatchRules):
             counter[0] = self.next = k + 1
             orbit[lane] = k
             last_out[lane] = None
+            if progress is not None:
+                self.tick()
             st[:4, lane] = ics[k]
+            if clock is not None:
+                st[clock, lane] = sigma0
+                clock_i[lane] = 0
+                phase[lane] = LIVE
             h = hi_(lane)
             t0h[lane], t0l[lane] = h, lo_(lane)
-            tfo[lane] = h + t_max
+            tfo[lane] = _NO_BOUND if no_bound else h + t_max
             reset(lane)
             counter[1] += 1
             return (counter[1] & 7) or not (hi >= tf).any()
@@ -401,7 +450,8 @@ class _Stream(_BatchRules):
         s = a + b
         bb = s - a
         err = (a - (s - bb)) + (b - bb)
-        return s + (err + (self.time_lo.item(lane) - self.t0_lo[lane]))
+        # + the orbit time at which it entered this integrator (0 but in a second phase)
+        return (s + (err + (self.time_lo.item(lane) - self.t0_lo[lane]))) + self.t_off[lane]
 
     def load(self, lane, k=None):
         """Put orbit ``k`` (default: the next one) into ``lane``; park the lane if none is left.
@@ -420,7 +470,7 @@ class _Stream(_BatchRules):
         self.put(lane, k)
         hi = self.time_hi.item(lane)
         self.t0_hi[lane], self.t0_lo[lane] = hi, self.time_lo.item(lane)
-        self.tf_orbit[lane] = hi + self.t_max
+        self.tf_orbit[lane] = _NO_BOUND if self.clock_censor else hi + self.t_max
         # a lane at its bound idles until the call returns; checking costs ~1 µs,
         # so look every 8th load (idle time ≲ 8 orbit ends, once per t_max)
         self.n_loads += 1
@@ -448,17 +498,48 @@ class _Stream(_BatchRules):
         n_returns = n_steps = 0
         while True:
             for lane in range(B):
-                if self.orbit[lane] >= 0 and self.time_hi[lane] >= tf[lane]:
-                    self.at_bound(lane)
-            for lane in range(B):
                 # parked lanes hold still at their current time
                 tf[lane] = self.tf_orbit[lane] if self.orbit[lane] >= 0 else self.time_hi[lane]
             if all(k < 0 for k in self.orbit):
                 break
             ta.propagate_until(tf)
             n_returns += 1
-            n_steps += _check(ta, self)
+            n_steps += _check(ta, self)  # once per return (a handful per chunk)
+            for lane in range(B):
+                if self.orbit[lane] >= 0 and self.time_hi[lane] >= tf[lane]:
+                    self.at_bound(lane)
         return n_returns, n_steps, self.n_restarts, _no_snapshots()
+
+
+class _SecondPhase(_Stream):
+    """The second phase of a two-phase stream scene: the orbits handed on at t_from, with the
+    section event compiled in. Loads a migrant's state, orbit time and rule state instead of an
+    initial condition; shares the outcome arrays and rows with the first phase."""
+
+    def __init__(self, scene, ta, lay, first):
+        self.migrants_in = first.migrants
+        super().__init__(scene, ta, lay, np.zeros((len(first.migrants), 4)))
+        for name in ("outcome", "t_end", "end_state", "sec_rows", "cross_rows"):
+            setattr(self, name, getattr(first, name))
+        self.progress = None  # the first phase reported these orbits already
+        self.src = [-1] * self.B
+
+    def put(self, lane, j):
+        k, state, t_mig, clock_i, last_out, phase = self.migrants_in[j]
+        self.src[lane] = j
+        self.state[:4, lane] = state
+        self.start_orbit(lane, k)
+        self.last_out[lane], self.phase[lane] = last_out, phase
+        self.t_off[lane] = t_mig
+        self.set_gate(lane, 1.0)
+        self.clock_i[lane] = clock_i
+        targets = self.targets
+        self.set_clock(lane, (targets[clock_i][0] - t_mig) / self.G if clock_i < len(targets) else 1.0)
+        self.ta.reset_cooldowns(lane)
+
+    def load(self, lane, k=None):
+        # a rerun (k given, after a stale bound) restarts the migrant, not an initial condition
+        return super().load(lane, None if k is None else self.src[lane])
 
 
 class _Epochs(_BatchRules):
@@ -489,15 +570,6 @@ class _Epochs(_BatchRules):
         if self.lay.gate is not None:
             self.set_gate(lane, 0.0)
         return True
-
-    def horizon(self, lane):
-        """Epochs the lane's orbit still needs after this one ends (0: it ends now)."""
-        k = self.epoch - self.e0[lane] + 1  # epochs completed at this epoch's end
-        if k >= self.n_epochs_max:
-            return 0
-        if self.phase[lane] == CONTINUING and k * self.P >= self.s_last:
-            return 0
-        return 1
 
     def _tables(self):
         """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
@@ -541,35 +613,44 @@ class _Epochs(_BatchRules):
         self.has = ~np.isnan(tt).all(axis=1)
 
     def run(self):
-        B, ta = self.B, self.ta
+        B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
         self._tables()
-        TAU, _S, has = self.TAU, self.S, self.has
+        TAU, has = self.TAU, self.has
+        orbit, phase, e0, st = self.orbit, self.phase, self.e0, self.state
+        s_last = self.s_last
         buf, rows = [], []
         n_returns = n_steps = 0
-        for lane in range(B):
+        lanes = range(B)
+        for lane in lanes:
             self._load(lane)
-        while any(k >= 0 for k in self.orbit):
+        while any(k >= 0 for k in orbit):
             ta.set_time(self.zeros)
-            kv = np.array([self.epoch - self.e0[lane] if self.orbit[lane] >= 0 else -1 for lane in range(B)])
+            epoch = self.epoch
+            kv = np.array([epoch - e0[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
             if has[kv].any():
-                ids = np.array(self.orbit, dtype=np.int64)  # before the call: orbits end during it
+                ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
                 out = ta.propagate_grid(np.ascontiguousarray(TAU[kv].T))[1]
                 buf.append((out[:, :4, :], kv, ids))
                 if len(buf) >= 256:
                     rows.append(self._snapshot_rows(buf))
                     buf = []
             else:
-                ta.propagate_until(self.P)
+                ta.propagate_until(P)
             n_returns += 1
-            n_steps += _check(ta, self)
-            for lane in range(B):
-                if self.orbit[lane] >= 0 and not self.horizon(lane):
-                    if self.phase[lane] == LIVE:
-                        self.record(lane, CENSORED, self.t_max, self.state4(lane))
-                    self.release(lane)
-            self.epoch += 1
-            for lane in range(B):
-                if self.orbit[lane] < 0:
+            if self.count_steps:
+                n_steps += _check(ta, self)
+            elif not np.isfinite(st).all():
+                _check(ta, self)
+            for lane in lanes:  # orbits that need nothing after this epoch end here
+                if orbit[lane] >= 0:
+                    k = epoch - e0[lane] + 1  # epochs completed
+                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                        if phase[lane] == LIVE:
+                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                        self.release(lane)
+            self.epoch = epoch + 1
+            for lane in lanes:
+                if orbit[lane] < 0:
                     self._load(lane)
         if buf:
             rows.append(self._snapshot_rows(buf))
@@ -623,27 +704,52 @@ def scheduler(scene) -> str:
     return "epochs" if scene.snapshots else "stream"
 
 
-def run_chunk(scene, ics, traj_ids, *, batch_size=None) -> ChunkResult:
-    """run_chunk(scene, ics, traj_ids, batch_size=None) -> ChunkResult.
+def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+    """run_chunk(scene, ics, traj_ids, batch_size=None, count_steps=False, progress=None) -> ChunkResult.
 
     ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
     array (n,). Returns the table rows of this chunk, ordered by traj_id (and
     time). ``batch_size`` (default: the scene's, else 8 lanes for the stream
-    scheduler and 16 for epochs) has no effect on the results.
+    scheduler and 8 for epochs) has no effect on the results. ``count_steps``:
+    fill ``ChunkResult.n_steps`` (the epoch scheduler otherwise skips reading
+    heyoka's per-lane results every epoch; the stream scheduler always counts).
+    ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
+    that many more orbits of the chunk have started (an orbit rerun after a
+    stale bound counts again), so long chunks show progress.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
+    traj_ids = np.asarray(traj_ids, dtype=np.int64)
+    outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
+    if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
+        return _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress)
     n = len(ics)
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
-    ta, specs, lay = events.build_batch(scene, B, _Callback)
+    phases = kind == "stream" and events.two_phase(scene)
+    # first (or only) phase: without the section event when the window opens late
+    ta, specs, lay = events.build_batch(scene, B, _Callback, without=("section",) if phases else ())
     lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, lay, ics)
-    fast = lanes.fast_handlers() if kind == "stream" and scene.sections is None and scene.follow is None else {}
+    lanes.count_steps = count_steps
+    lanes.progress = progress
+    lanes.migrate_at_open = phases
+    # the lean handlers serve stream scenes with no section event in this integrator and no follow
+    lean = kind == "stream" and scene.follow is None and (scene.sections is None or phases)
+    fast = lanes.fast_handlers() if lean else {}
     _bind(ta, specs, lanes, fast)
     try:
         n_returns, n_steps, n_restarts, (s_ids, s_t, s_e) = lanes.run()
     finally:
         _unbind(ta)
         lanes.__dict__.pop("load", None)  # the fast path's closure refers back to the lanes: free them now
+    if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
+        ta2, specs2, _ = events.build_batch(scene, B, _Callback)
+        second = _SecondPhase(scene, ta2, lay, lanes)
+        _bind(ta2, specs2, second)
+        try:
+            r2, s2, x2, _ = second.run()
+        finally:
+            _unbind(ta2)
+        n_returns, n_steps, n_restarts = n_returns + r2, n_steps + s2, n_restarts + x2
     outcome = np.array(lanes.outcome, dtype=np.int8)
     if (outcome < 0).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
@@ -651,7 +757,6 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None) -> ChunkResult:
     model = scene.model
     end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
     t_end = np.array(lanes.t_end, dtype=float)
-    traj_ids = np.asarray(traj_ids, dtype=np.int64)
     channel = np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1)
     lifetimes = {
         "traj_id": traj_ids,
@@ -666,13 +771,47 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None) -> ChunkResult:
         "exit_channel": channel.astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
-    sections = _rows_to_columns(lanes.sec_rows, ("traj_id", "t", "x", "y", "px", "py", "energy"), traj_ids)
-    crossings = _rows_to_columns(lanes.cross_rows, ("traj_id", "t", "radius", "direction"), traj_ids)
+    sections = _rows_to_columns(lanes.sec_rows, SECTION_COLUMNS, traj_ids)
+    crossings = _rows_to_columns(lanes.cross_rows, CROSSING_COLUMNS, traj_ids)
     crossings["direction"] = crossings["direction"].astype(np.int8)
     order = np.lexsort((s_t, s_ids))
     snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
     return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
                        n_restarts=n_restarts)
+
+
+def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress):
+    """run_chunk for a chunk with orbits that start at r ≥ r_esc: those are escaped at t = 0
+    (the authors' square ICs); the others run as usual. Rows keep traj_id order."""
+    inside = ~outside
+    model = scene.model
+    if inside.any():
+        res = run_chunk(scene, ics[inside], traj_ids[inside], batch_size=batch_size, count_steps=count_steps,
+                        progress=progress)
+    else:
+        res = ChunkResult({}, _rows_to_columns([], SECTION_COLUMNS, traj_ids),
+                          _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids),
+                          _rows_to_columns([], CROSSING_COLUMNS, traj_ids))
+        res.crossings["direction"] = res.crossings["direction"].astype(np.int8)
+    x, y, px, py = ics.T
+    lt = {
+        "traj_id": traj_ids, "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
+        "e0": model.energy(x, y, px, py), "gamma": np.full(len(ics), scene.gamma),
+        "outcome": np.full(len(ics), ESCAPED, np.int8), "t_end": np.zeros(len(ics)),
+        "exit_channel": model.exit_channel(x, y).astype(np.int8), "e_end": model.energy(x, y, px, py),
+    }
+    if inside.any():
+        for col in ("outcome", "t_end", "exit_channel", "e_end"):
+            lt[col][inside] = res.lifetimes[col]
+    snaps = res.snapshots
+    if scene.snapshots and scene.snapshots[0] == 0.0:  # a snapshot at t = 0 ≤ t_end of the escaped ones
+        ids = np.concatenate([snaps["traj_id"], traj_ids[outside]])
+        t = np.concatenate([snaps["t"], np.zeros(int(outside.sum()))])
+        e = np.concatenate([snaps["energy"], lt["e0"][outside]])
+        order = np.lexsort((t, ids))
+        snaps = {"traj_id": ids[order], "t": t[order], "energy": e[order]}
+    return ChunkResult(lt, res.sections, snaps, res.crossings, n_returns=res.n_returns, n_steps=res.n_steps,
+                       n_restarts=res.n_restarts)
 
 
 def _rows_to_columns(rows, columns, traj_ids):
@@ -751,6 +890,10 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     """
     import heyoka as hy
 
+    ic = np.asarray(ic, dtype=float)
+    if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
+        snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []
+        return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
     ta, specs, lay = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
     rules = _Scalar(scene, ta, lay, fp_type)
     _bind(ta, specs, rules)

@@ -31,8 +31,9 @@ radius_k   any    r² − R_k²                                   follow: crossi
                                                               outward r_esc one is the escape
 section    any    g·(x p_x + y p_y − 10⁻³⁰⁰) + (1 − g)         ṙ = 0, kept where φ̇ > 0 and the
                                                               window admits it; g = 0/1 per lane
-                                                              (runtime parameter): the event is
-                                                              switched off outside its window
+                                                              (runtime parameter) switches it off;
+                                                              a late window compiles it only into
+                                                              the orbits' second phase (two_phase)
 clock      −      σ  (dσ/dt = −1/G)                           orbit-time schedule: opens/closes
                                                               the section window at t_from/t_to
 =========  =====  ==========================================  =====================================
@@ -130,7 +131,8 @@ def clock_targets(scene) -> tuple:
 
     Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
     that opens late could miss a crossing) and 'close' it (at t_to +
-    CLOCK_MARGIN); the section rule itself checks the exact window.
+    CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
+    with such a clock and no snapshots also 'censor' with it at t_max.
     """
     w = scene.sections
     if w is None:
@@ -140,7 +142,11 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    return tuple(out)
+    if out and not scene.snapshots:
+        # the clock is compiled in anyway: it also ends the orbit at t_max, so the stream
+        # scheduler needs no per-orbit propagation bound (whose stale copies forced reruns)
+        out.append((float(scene.t_max), "censor"))
+    return tuple(sorted(out))
 
 
 def follow_radii(scene) -> tuple:
@@ -210,25 +216,39 @@ def system(scene, lay: Layout):
     return sys
 
 
-def build_batch(scene, batch_size: int, make_callback, *, tol=None):
-    """build_batch(scene, batch_size, make_callback) -> (taylor_adaptive_batch, specs, layout).
+def two_phase(scene) -> bool:
+    """two_phase(scene) -> True if the section event is compiled only into an orbit's second phase.
+
+    Scenes without snapshots whose section window opens late (t_from > 0):
+    orbits run without the section event until the clock opens the window,
+    then move to an integrator that has it (hhscatter.engine). Snapshot scenes
+    switch the event off per lane instead (all lanes share one grid there).
+    """
+    return scene.sections is not None and scene.sections.t_from > 0 and not scene.snapshots
+
+
+def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
+    """build_batch(scene, batch_size, make_callback, without=()) -> (taylor_adaptive_batch, specs, layout).
 
     ``make_callback(spec)`` returns the callback object of one event (heyoka
     deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
+    ``without``: names of events left out (an orbit phase that does not need them).
     """
     import heyoka as hy
     import numpy as np
 
     lay = layout(scene)
-    specs = scene_events(scene)
+    specs = tuple(s for s in scene_events(scene) if s.name not in without)
     sym = Symbols(scene, lay)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     events = [hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction])
               for s in specs]
-    pars = np.zeros((lay.n_pars, batch_size))
+    # the gate is the last parameter: without the section event heyoka's system has none
+    n_pars = lay.n_pars - (1 if lay.gate is not None and "section" in without else 0)
+    pars = np.zeros((n_pars, batch_size))
     if lay.gamma is not None:
         pars[lay.gamma] = scene.gamma
-    kw = {"pars": pars} if lay.n_pars else {}
+    kw = {"pars": pars} if n_pars else {}
     ta = hy.taylor_adaptive_batch(system(scene, lay), np.zeros((lay.n_state, batch_size)),
                                   tol=scene.tol if tol is None else tol, t_events=events, **kw)
     return ta, specs, lay
@@ -299,5 +319,5 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
 
 
 __all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "build_batch",
-           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events",
+           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
            "section_accepts", "system"]

@@ -30,7 +30,7 @@ def _candidates(rng, region, radius, saddle_radius, m):
         r = radius * np.sqrt(rng.random(m))
         phi = 2 * np.pi * rng.random(m)
         return r * np.cos(phi), r * np.sin(phi)
-    # 'well': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
+    # 'well' and 'square': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
     xy = saddle_radius * (2 * rng.random((2, m)) - 1)
     return xy[0], xy[1]
 
@@ -46,7 +46,10 @@ def sample_block(scene: Scene, block: int) -> np.ndarray:
     """sample_block(scene, block) -> array (BLOCK, 4) of states (x, y, px, py).
 
     Candidates with V ≥ E, r = 0 or (region 'well') outside the saddle triangle
-    are rejected and redrawn from the same block generator.
+    are rejected and redrawn from the same block generator. Region 'square' is
+    the authors' ``goodICs`` (uniform in [−r_s, r_s]² where V < E): it keeps
+    points beyond the saddles, even beyond r_esc (the engine records those as
+    escaped at t = 0).
     """
     model = scene.model
     rng = _block_rng(scene.seed, block)
@@ -113,3 +116,47 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
     else:
         ids = np.arange(len(df), dtype=np.int64)
     return states, ids
+
+
+def section_grid(model, energy: float, extent, shape):
+    """section_grid(model, E, extent, shape) -> (x (nx,), y (ny,), allowed (ny, nx), states (m, 4), cell (m,)).
+
+    Initial conditions on a regular grid of the section ṙ = 0, φ̇ > 0 at
+    energy E (paper, App. "Initial Conditions"): cell centres
+    x_i = x0 + (i + ½)Δx, y_j = y0 + (j + ½)Δy over ``extent`` = (x0, x1, y0,
+    y1) with ``shape`` = (ny, nx) cells; the allowed cells (V < E, r > 0) get
+    the tangential velocity of :func:`section_velocities`. ``cell`` is each
+    state's flat index into the (ny, nx) grid (row-major), so outcomes map
+    back to a basin image as ``image.flat[cell] = outcome``.
+    """
+    x0, x1, y0, y1 = (float(v) for v in extent)
+    ny, nx = (int(v) for v in shape)
+    if not (x1 > x0 and y1 > y0):
+        raise ValueError(f"extent must be (x0, x1, y0, y1) with x1 > x0 and y1 > y0, got {extent!r}")
+    if nx < 1 or ny < 1:
+        raise ValueError(f"shape must be (ny, nx) with positive sizes, got {shape!r}")
+    x = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+    y = y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny
+    X, Y = np.meshgrid(x, y)
+    allowed = (model.potential(X, Y) < energy) & ((X != 0) | (Y != 0))
+    cell = np.flatnonzero(allowed)
+    px, py = section_velocities(model, X.flat[cell], Y.flat[cell], energy)
+    return x, y, allowed, np.column_stack([X.flat[cell], Y.flat[cell], px, py]), cell
+
+
+def perturbed_on_section(model, states, energy: float, dx: float = 0.0, dy: float = 0.0):
+    """perturbed_on_section(model, states, E, dx, dy) -> (states (m, 4), ok (m,)): positions moved by (dx, dy),
+    still on the section at energy E (tangential velocity recomputed).
+
+    The uncertainty algorithm's perturbed copies of a set of initial
+    conditions: each position (x, y) → (x + dx, y + dy) and a new tangential
+    velocity at E. ``ok`` is False where the moved point is not allowed (V ≥ E
+    or r = 0); those rows are NaN.
+    """
+    s = np.asarray(states, dtype=float)
+    x, y = s[:, 0] + dx, s[:, 1] + dy
+    ok = (model.potential(x, y) < energy) & ((x != 0) | (y != 0))
+    out = np.full((len(s), 4), np.nan)
+    px, py = section_velocities(model, x[ok], y[ok], energy)
+    out[ok] = np.column_stack([x[ok], y[ok], px, py])
+    return out, ok

@@ -127,13 +127,16 @@ def _chunk_ics(scene, start, stop, table_ics):
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
 
 
-def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition=""):
-    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='') -> RunSummary.
+def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition="",
+                  progress=None):
+    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None)
+    -> RunSummary.
 
     Worker entry (local pool or Dask): integrate orbits start..stop−1 of the
     scene, write the chunk's part files under ``out`` (path or URL) and
     return the chunk's counts. An OSError while writing is re-raised naming
-    the file.
+    the file. ``progress``: a callable f(k), or a queue that gets (chunk, k)
+    (another process's), told as orbits of the chunk start.
     """
     from .engine import run_chunk
     from .tables import add_point_columns, provenance, to_arrow, write_part
@@ -142,8 +145,11 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     store = Store(out)
     if ics is None:
         ics, ids = _chunk_ics(scene, start, stop, None)
+    if progress is not None and not callable(progress):
+        queue, key = progress, (partition, chunk)
+        progress = lambda k: queue.put((key, k))  # noqa: E731 - a queue proxy of the parent's Manager
     t0 = time.perf_counter()
-    res = run_chunk(scene, ics, ids)
+    res = run_chunk(scene, ics, ids, progress=progress)
     elapsed = time.perf_counter() - t0
     meta = {
         "scene": json.loads(scene_json),
@@ -375,9 +381,15 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
     t0 = time.perf_counter()
     bar = progress_bar(progress, n_total, done_orbits, run.name)
 
+    reported = {}  # orbits of an unfinished chunk already shown (progress from inside chunks)
+
     def on_done(task, result):
         summary.add(result)
-        bar.update(task[3] - task[2])
+        bar.update(max(0, task[3] - task[2] - reported.pop((task[4], task[1]), 0)))
+
+    def on_progress(key, k):
+        reported[key] = reported.get(key, 0) + k
+        bar.update(k)
 
     try:
         if not todo:
@@ -394,9 +406,11 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
             summary.workers = workers
             if workers == 1 or len(todo) <= 1:
                 for task in todo:
-                    on_done(task, run_one_chunk(*args(task)))
+                    key = (task[4], task[1])
+                    tell = (lambda k, key=key: on_progress(key, k)) if progress else None
+                    on_done(task, run_one_chunk(*args(task), progress=tell))
             else:
-                _run_pool(workers, todo, args, on_done)
+                _run_pool(workers, todo, args, on_done, on_progress if progress else None)
     except OSError as exc:
         raise RunError(
             f"{exc.strerror or exc}; stopped after {summary.chunks_done} new chunk(s). Finished part files "
@@ -440,19 +454,39 @@ def progress_bar(progress, total, initial, desc):
                 smoothing=0.05)
 
 
-def _run_pool(workers, todo, args, on_done):
+def _run_pool(workers, todo, args, on_done, on_progress=None):
     import multiprocessing as mp
+    import queue as queue_mod
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
     pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx)
+    manager = ctx.Manager() if on_progress is not None else None
+    q = manager.Queue() if manager is not None else None
+
+    def relay():
+        while q is not None:
+            try:
+                key, k = q.get_nowait()
+            except queue_mod.Empty:
+                return
+            on_progress(key, k)
+
+    def wait_first(fs):
+        while True:  # progress messages from inside the chunks every 0.5 s at most
+            done = wait(fs, timeout=0.5 if q is not None else None, return_when=FIRST_COMPLETED).done
+            relay()
+            if done:
+                return done
+
     try:
-        _drain(lambda t: pool.submit(run_one_chunk, *args(t)),
-               lambda fs: wait(fs, return_when=FIRST_COMPLETED).done,
-               todo, 2 * workers, on_done,
+        _drain(lambda t: pool.submit(run_one_chunk, *args(t), progress=q),
+               wait_first, todo, 2 * workers, on_done,
                lambda fs: [f.cancel() for f in fs])
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+        if manager is not None:
+            manager.shutdown()
 
 
 def _run_dask(client, todo, args, on_done, name):

@@ -19,7 +19,7 @@ import numpy as np
 
 from .model import HenonHeiles
 
-REGIONS = ("disk", "well")
+REGIONS = ("disk", "well", "square")
 TOL_RANGE = (1e-18, 1e-6)
 
 
@@ -113,8 +113,11 @@ class Scene:
       n           number of orbits N (> 0)
       gamma       drag γ ≥ 0 (γ = 0: conservative)
       seed        integer ≥ 0; with the orbit index it fixes every initial condition
-      region      'disk' (uniform in area in r < radius) or 'well' (uniform in the
-                  saddle triangle where V < E); velocities tangential on the section
+      region      'disk' (uniform in area in r < radius), 'well' (uniform in the
+                  saddle triangle where V < E) or 'square' (the authors' ``goodICs``:
+                  uniform in [−r_s, r_s]² where V < E, no radius cut; orbits that
+                  start at r ≥ r_esc are escaped at t = 0); velocities tangential
+                  on the section
       radius      disk radius R (default 0.5, as in the authors' code)
       r_esc       escape radius (default 1.5), > saddle distance ω²/λ. 1.5 lies beyond the
                   Lyapunov orbits of every exit up to E = 0.5 (study ``resc``); the
@@ -124,7 +127,7 @@ class Scene:
       t_max       maximum orbit time (default 5000); orbits alive then are censored
       tol         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15)
       omega, lam  potential parameters ω, λ > 0 (default 1, 1)
-      chunk_size  orbits per part file (default 10000); results do not depend on it
+      chunk_size  orbits per part file (default 10000); tables do not depend on it (bitwise)
       batch_size  SIMD lanes (default: heyoka's recommended size); no effect on results
       ics         optional path of a Parquet/CSV table with columns x, y, px, py
       sections    SectionWindow or None (no section table)
@@ -213,7 +216,7 @@ class Scene:
             if self.energy is None:
                 raise SceneError("energy is required unless initial conditions come from a table (ics)")
             energy = _finite("energy", self.energy)
-            # the region's minimum of V is V(0, 0) = 0 (the origin is in both regions)
+            # the region's minimum of V is V(0, 0) = 0 (the origin is in every region)
             if energy <= 0:
                 raise SceneError(
                     f"energy must be > 0 = min V over the {self.region!r} region "

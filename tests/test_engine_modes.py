@@ -42,6 +42,8 @@ def test_only_the_events_module_constructs_heyoka_events():
     ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2"]),
 ])
 def test_scene_events_compile_only_what_the_scene_needs(kw, names):
+    # (a stream scene whose window opens late compiles the section event only into the
+    # orbits' second phase: events.two_phase, tested bitwise and against the reference below)
     sc = Scene(energy=0.3, n=1, r_esc=1.5, **kw)
     assert [e.name for e in events.scene_events(sc)] == names
     lay = events.layout(sc)
@@ -206,7 +208,8 @@ def test_section_window_stop_at_t_to():
     {"gamma": 0.01, "energy": 0.3, "snapshots": tuple(np.arange(0.0, 40.01, 0.5)),
      "sections": SectionWindow(t_from=5.0, first_only=True)},
     {"gamma": 0.0, "energy": 0.3, "follow": Follow((1.0, 2.0))},
-], ids=["dissipative", "epochs+sections", "follow"])
+    {"gamma": 0.01, "energy": 0.35, "sections": SectionWindow(t_from=6.0, t_to=30.0)},
+], ids=["dissipative", "epochs+sections", "follow", "two-phase sections"])
 def test_tables_do_not_depend_on_chunking_or_lanes(kw):
     """Bitwise, for γ > 0 too: event roots end heyoka's step, so times come from the orbit's own clock."""
     sc = Scene(n=240, seed=38, r_esc=1.03, **kw)
@@ -232,3 +235,86 @@ def test_follow_and_conservative_lifetimes_agree_on_outcomes():
         m = (cr["traj_id"] == k) & (cr["radius"] == 1.03) & (cr["direction"] == 1)
         assert cr["t"][m][0] == fol.lifetimes["t_end"][k]
     assert (fol.lifetimes["outcome"] != CENSORED).any()
+
+
+# -- progress from inside a chunk ------------------------------------------------------
+
+@pytest.mark.parametrize("kw", [{}, {"gamma": 0.01, "snapshots": (0.0, 5.0, 10.0)}], ids=["stream", "epochs"])
+def test_progress_is_reported_from_inside_a_chunk(kw):
+    from hhscatter.engine import PROGRESS_EVERY
+
+    sc = Scene(energy=0.3, n=5000, seed=40, r_esc=1.03, **kw)
+    ics = region_ics(sc, 0, sc.n)
+    seen = []
+    res = run_chunk(sc, ics, np.arange(sc.n), progress=seen.append)
+    assert seen == [PROGRESS_EVERY] * (sc.n // PROGRESS_EVERY)  # (no reruns at t_max = 5000 here)
+    plain = run_chunk(sc, ics, np.arange(sc.n))
+    assert np.array_equal(res.lifetimes["t_end"], plain.lifetimes["t_end"])  # progress changes nothing
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_runner_progress_moves_within_chunks_and_totals_exactly(tmp_path, monkeypatch, workers):
+    import hhscatter.runner as runner
+
+    updates = []
+
+    class Bar:
+        def update(self, k):
+            updates.append(k)
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(runner, "progress_bar", lambda *a, **k: Bar())
+    sc = Scene(energy=0.3, n=6000, seed=41, r_esc=1.03, chunk_size=3000)
+    runner.simulate(sc, tmp_path / "run", workers=workers, progress=True)
+    assert sum(updates) == sc.n
+    assert len(updates) > 2  # more than one update per chunk
+
+
+# -- the authors' square initial conditions ----------------------------------------------
+
+def test_square_region_is_uniform_in_the_allowed_square_and_on_the_energy_shell():
+    from scipy import stats
+
+    E = 0.3
+    m = HenonHeiles()
+    sc = Scene(energy=E, n=20000, seed=42, region="square", r_esc=1.03)
+    ics = region_ics(sc, 0, sc.n)
+    x, y, px, py = ics.T
+    assert (np.abs(x) <= 1).all() and (np.abs(y) <= 1).all()
+    np.testing.assert_allclose(m.energy(x, y, px, py), E, rtol=0, atol=4e-16)
+    assert np.abs(x * px + y * py).max() < 1e-15 and (x * py - y * px > 0).all()  # ṙ = 0, φ̇ > 0
+    # the x marginal against the allowed area {V < E} ∩ [−1, 1]², from an independent fine grid
+    g = np.linspace(-1, 1, 4001)
+    X, Y = np.meshgrid(g, g, indexing="ij")
+    allowed = (m.potential(X, Y) < E).sum(axis=1).astype(float)
+    cdf_x = np.concatenate([[0.0], np.cumsum(0.5 * (allowed[1:] + allowed[:-1]))])
+    cdf_x /= cdf_x[-1]
+    assert stats.kstest(x, lambda v: np.interp(v, g, cdf_x)).pvalue > 0.01
+    # and points beyond the saddle triangle are there (the disk and the well have none)
+    assert (~m.inside_triangle(x, y)).mean() > 0.01
+
+
+@pytest.mark.parametrize("gamma", [0.0, 0.01])
+def test_orbits_starting_beyond_r_esc_are_escaped_at_t0(gamma):
+    sc = Scene(energy=0.3, gamma=gamma, n=3000, seed=43, region="square", r_esc=1.03,
+               snapshots=(0.0, 1.0, 2.0) if gamma else None)
+    ics = region_ics(sc, 0, sc.n)
+    out = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= 1.03**2
+    assert out.sum() > 20
+    res = run_chunk(sc, ics, np.arange(sc.n) + 100)
+    lt = res.lifetimes
+    np.testing.assert_array_equal(lt["traj_id"], np.arange(sc.n) + 100)
+    assert (lt["outcome"][out] == ESCAPED).all() and (lt["t_end"][out] == 0.0).all()
+    assert (lt["t_end"][~out] > 0).all()
+    np.testing.assert_array_equal(lt["exit_channel"][out], HenonHeiles().exit_channel(ics[out, 0], ics[out, 1]))
+    # the others exactly as in a run without them
+    alone = run_chunk(sc, ics[~out], np.flatnonzero(~out) + 100).lifetimes
+    np.testing.assert_array_equal(lt["t_end"][~out], alone["t_end"])
+    if gamma:  # their one snapshot, at t = 0 ≤ t_end
+        sn = res.snapshots
+        rows = np.isin(sn["traj_id"], np.flatnonzero(out) + 100)
+        assert (sn["t"][rows] == 0.0).all() and rows.sum() == out.sum()
+    k = int(np.flatnonzero(out)[0])
+    assert simulate_orbit(sc, ics[k]).outcome == ESCAPED and simulate_orbit(sc, ics[k]).t_end == 0.0

@@ -206,7 +206,8 @@ class Renderer:
         if not summaries:
             return self.missing(
                 f"The {which} summary",
-                f"Run `make {which}` and then `make docs-assets` to copy `studies/{which}/out/` here.",
+                f"Run `make {'bench-engine' if which == 'engine' else which}` and then `make docs-assets` "
+                f"to copy `studies/{which}/out/` here.",
             )
         text = "\n\n".join(_embed_markdown(s.read_text(), assets, self._rel) for s in summaries)
         # figures that no summary shows as an image are appended
