@@ -206,3 +206,16 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
     assert set(before) == set(after)
     assert len(before) >= 7 * 3 * 2  # every study, every scale: its base scene and at least one run
     assert after == before
+
+
+def test_the_engine_options_are_accepted_in_files(tmp_path):
+    """sections.stop, [follow] radii and continue_settled pass the strict checks (and build their scenes)."""
+    from hhscatter.scene import load_scene
+
+    (tmp_path / "a.toml").write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 10\ncontinue_settled = true\n"
+                                     "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n"
+                                     "[sections]\nt_from = 2.0\nfirst_only = true\nstop = true\n")
+    s = load_scene(tmp_path / "a.toml")
+    assert s.continue_settled and s.sections.stop and s.snapshots == (0.0, 5.0, 10.0)
+    (tmp_path / "b.toml").write_text("[scene]\nenergy = 0.3\nn = 10\nregion = \"square\"\n[follow]\nradii = [1.0, 2.0]\n")
+    assert load_scene(tmp_path / "b.toml").follow.radii == (1.0, 2.0)
