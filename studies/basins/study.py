@@ -60,6 +60,7 @@ class Params(StudyParams):
     fit_min_count: Integer = 10
     wada_r: Integer = 3
     wada_min_share: Number = 0.005
+    symmetry_radius: Number = 0.9
 
 
 # -- keys and grids ----------------------------------------------------------------
@@ -235,7 +236,11 @@ def analyze(study):
             ent_rows.append(ent)
             present = [c for c, share in zip(CODES, fr.frac) if share >= float(study.param("wada_min_share"))]
             wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
-            chans = channel_fractions(img[(img >= 0) & (img <= 2)].ravel())
+            # the potential is three-fold symmetric, the square [−1, 1]² is not: test the exits' shares on
+            # a rotation-invariant part of the map, the allowed cells with r < symmetry_radius
+            gx, gy = _map_states(study, E, extent, n)[:2]
+            r = np.hypot(*np.meshgrid(gx, gy))
+            chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < float(study.param("symmetry_radius")))])
             unc = _uncertainty(study, E, g, eps)
             unc_tabs.append(unc)
             ok = unc["k"] >= int(study.param("fit_min_count"))
@@ -254,6 +259,7 @@ def analyze(study):
                               zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
                 "n_cells": int(fr.n),
                 "channel_symmetry_p": float(chans.p_value),
+                "channel_shares_r_sym": [float(v) for v in chans.frac],
                 "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
                 "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
                 "log2_fractal": bool(head.log2_fractal) if head is not None else None,
