@@ -58,3 +58,51 @@ def test_the_orbit_bootstrap_needs_the_orbit_of_every_point():
 
     with pytest.raises(ValueError, match="orbit of each"):
         kappa_from_cmeasure(np.ones(3), 2, orbits=[0, 1], exit_orbits=[2, 3], n_boot=5)
+
+
+# -- τ2 observed: order-statistic interval of a low quantile of the settling time ----------------------------
+def _settling_ensemble(rng, n, f_settle, tau):
+    """N orbits; a share f_settle settles at t ~ Exp(τ), the others escape. F(t) = f(1 − e^{−t/τ})."""
+    t = rng.exponential(tau, n)
+    return t, np.where(rng.random(n) < f_settle, "settled", "escaped")
+
+
+def _truth_quantile(p, f_settle, tau):
+    return -tau * math.log1p(-p / f_settle)
+
+
+import pytest  # noqa: E402
+
+
+@pytest.mark.parametrize("rank", [1, 20])  # the first settling time (the paper's τ2,obs), and the 20th
+def test_the_order_statistic_interval_of_tau2_covers_the_quantile(rank):
+    from hhscatter.analysis.transitions import settle_quantile_interval
+
+    n, f, tau = 2000, 0.3, 100.0
+    p = rank / n
+    truth = _truth_quantile(p, f, tau)
+    rng = np.random.default_rng(4242 + rank)
+    hits, stated = [], set()
+    for _ in range(300):
+        t, oc = _settling_ensemble(rng, n, f, tau)
+        iv = settle_quantile_interval(t, oc, p)
+        stated.add(round(iv.coverage, 12))
+        hits.append(iv.lo <= truth < iv.hi)
+        assert iv.lo <= iv.value <= iv.hi
+    (cov,) = stated  # the ranks depend on N and p only: one exact coverage
+    print(f"τ2 order-statistic interval, rank {rank}: stated {cov:.3f}, measured {np.mean(hits):.3f}")
+    assert ONE_SIGMA <= cov < ONE_SIGMA + 0.08
+    assert stats.binomtest(int(np.sum(hits)), len(hits), cov).pvalue > P_3SIGMA  # its exact coverage
+    assert _covers_as_1sigma(hits)                                               # and about 68 %
+
+
+def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
+    import pandas as pd
+
+    from hhscatter.analysis.transitions import tau2_observed, tau2_observed_interval
+
+    lt = pd.DataFrame({"t_end": [5.0, 3.0, 9.0, 1.0, 7.0], "outcome": ["settled", "settled", "escaped", "escaped",
+                                                                        "censored"]})
+    iv = tau2_observed_interval(lt)
+    assert iv.value == tau2_observed(lt) == 3.0 and (iv.r, iv.s) == (0, 2) and (iv.lo, iv.hi) == (0.0, 5.0)
+    assert iv.n_settled == 2 and iv.coverage == pytest.approx(0.8 ** 5 + 5 * 0.2 * 0.8 ** 4)
