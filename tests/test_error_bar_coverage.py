@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import stats
+from scipy import optimize, stats
 
 from hhscatter.analysis.cmeasure import kappa_from_cmeasure
 
@@ -106,3 +106,42 @@ def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
     iv = tau2_observed_interval(lt)
     assert iv.value == tau2_observed(lt) == 3.0 and (iv.r, iv.s) == (0, 2) and (iv.lo, iv.hi) == (0.0, 5.0)
     assert iv.n_settled == 2 and iv.coverage == pytest.approx(0.8 ** 5 + 5 * 0.2 * 0.8 ** 4)
+
+
+# -- τ2 from the survival model: the Δχ² = 1 ends of its profile by root-finding ---------------------------------
+def test_the_profile_interval_by_root_finding_covers_the_truth():
+    """y = A e^{−t/τ} + N(0, σ²), A profiled out (linear): the Δχ² = 1 interval of τ must cover τ_true ≈ 68 %."""
+    from hhscatter.analysis.survival_model import profile_interval
+
+    t = np.linspace(0.0, 10.0, 40)
+    A, tau, sigma = 1.0, 3.0, 0.05
+    rng = np.random.default_rng(2626)
+    hits, widths = [], []
+    for _ in range(300):
+        y = A * np.exp(-t / tau) + rng.normal(0, sigma, t.size)
+
+        def chi2(x, y=y):
+            f = np.exp(-t / x)
+            a = (f @ y) / (f @ f)
+            return float(np.sum((y - a * f) ** 2)) / sigma**2
+
+        grid = np.linspace(0.5, 20.0, 25)  # a coarse scan, as fit_tau2 does; then the ends by root-finding
+        best = float(optimize.minimize_scalar(chi2, bounds=(0.5, 20.0), method="bounded",
+                                              options={"xatol": 1e-10}).x)
+        lo, hi = profile_interval(chi2, best, chi2(best), 0.5, 20.0, step=grid[1] - grid[0])
+        assert chi2(lo) == pytest.approx(chi2(best) + 1, abs=1e-6) and chi2(hi) == pytest.approx(chi2(best) + 1,
+                                                                                                abs=1e-6)
+        hits.append(lo <= tau <= hi)
+        widths.append((hi - lo) / 2)
+    print(f"τ profile interval 1σ coverage: {np.mean(hits):.3f} (mean half-width {np.mean(widths):.3f}, "
+          f"grid step {grid[1] - grid[0]:.3f})")
+    assert _covers_as_1sigma(hits)
+    # the interval is not bounded by the scan's step: the old cap would have been ±1 grid step
+    assert np.mean(widths) < grid[1] - grid[0]
+
+
+def test_an_unbounded_side_of_the_profile_ends_at_its_edge():
+    from hhscatter.analysis.survival_model import profile_interval
+
+    lo, hi = profile_interval(lambda x: (x - 2.0) ** 2 if x < 2.0 else 0.0, 2.0, 0.0, 0.0, 10.0)
+    assert lo == pytest.approx(1.0) and hi == 10.0
