@@ -63,10 +63,11 @@ HH := $(VENV)/bin/hhscatter
 ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py hhscatter/studies/*.py)
 so = studies/$(1)/out/$(SCALE)
 study_code = $(wildcard studies/$(1)/*.py)
+CONVENTIONS := $(wildcard studies/conventions.toml)  # scene keys the figure studies share (convention = "paper")
 
 # $(1): study name; $(2): the studies it needs (their numbers JSON are inputs of its analysis)
 define study_rules
-$(call so,$(1))/raw/done.json: studies/$(1)/study.toml $(call study_code,$(1)) $(STAMP)
+$(call so,$(1))/raw/done.json: studies/$(1)/study.toml $(CONVENTIONS) $(call study_code,$(1)) $(STAMP)
 	$(HH) study $(1) simulate --scale $(SCALE) $(W)
 $(call so,$(1))/$(1).json: $(call so,$(1))/raw/done.json $(ANALYSIS_SRC) $(call study_code,$(1)) $(foreach u,$(2),$(call so,$(u))/$(u).json)
 	$(HH) study $(1) analyze --scale $(SCALE)

@@ -51,6 +51,8 @@ __all__ = [
     "StudyParams",
     "Text",
     "Texts",
+    "apply_convention",
+    "validate_conventions_file",
     "validate_scene_file",
     "validate_study_file",
 ]
@@ -221,7 +223,8 @@ def study_file_model(params: type[BaseModel] | None):
     scale = create_model("StudyScale", __base__=_Table, scene=(StudySceneTable, None),
                          **{k: (_partial(m) if m is not FollowTable else m, None) for k, m in _SCENE_TABLES.items()},
                          study=(override, None))
-    return create_model("StudyFile", __base__=_Table, about=(AboutTable, None), needs=(dict[str, Text], None),
+    return create_model("StudyFile", __base__=_Table, convention=(Text, None),
+                        about=(AboutTable, None), needs=(dict[str, Text], None),
                         scene=(StudySceneTable, ...), **tables, study=(study, None if params is None else ...),
                         scale=(dict[str, scale], None))
 
@@ -258,6 +261,10 @@ def _child(node, key):
     return None
 
 
+def _is_table(node) -> bool:
+    return (isinstance(node, type) and issubclass(node, BaseModel)) or getattr(node, "__origin__", None) is dict
+
+
 def _split(model, loc):
     """(table path, key path, node of the table) of an error location: tables nest through models and dicts."""
     node, table = model, []
@@ -286,8 +293,12 @@ def _message(model, err: dict) -> str:
     if kind == "extra_forbidden":
         allowed = _fields(node) or []
         if not table and len(key) == 1:
-            return (f"unknown table [{key[0]}]; allowed tables: "
-                    + ", ".join(f"[{k}]" for k in sorted(allowed)))
+            tables = [k for k in allowed if _is_table(_child(node, k))]
+            if isinstance(err.get("input"), dict) or not set(allowed) - set(tables):
+                return (f"unknown table [{key[0]}]; allowed tables: "
+                        + ", ".join(f"[{k}]" for k in sorted(tables)))
+            return (f"unknown key {key[0]!r} before the first table; allowed keys there: "
+                    + ", ".join(sorted(set(allowed) - set(tables))))
         return f"{where} unknown key {_key_path(key)!r}; allowed keys: {', '.join(sorted(allowed))}".strip()
     if kind == "missing":
         return f"{where} needs {_key_path(key)!r}" if key else f"needs a {where} table"
@@ -344,3 +355,39 @@ def validate_study_file(doc: dict, source: str, params: type[BaseModel] | None =
     base = {k: v for k, v in doc.items() if k != "scale"}
     for name, over in (doc.get("scale") or {}).items():
         _validate(model, merge_tables(base, over), str(source), f" (at scale {name!r})")
+
+
+# -- conventions: scene keys declared once (studies/conventions.toml), inherited by `convention = "<name>"` ------
+def validate_conventions_file(doc: dict, source: str) -> None:
+    """validate_conventions_file(doc, source) -> None or ConfigError: each table ``[<name>]`` of the conventions
+    file holds ``[scene]`` keys of a study (strictly typed, no other key)."""
+    model = create_model("ConventionsFile", __base__=_Table,
+                         **{str(k): (StudySceneTable, None) for k in doc})
+    _validate(model, doc, str(source))
+
+
+def apply_convention(doc: dict, conventions: dict, source: str, conventions_source: str) -> dict:
+    """apply_convention(doc, conventions, source, conventions_source) -> the study file ``doc`` with the scene
+    keys of its ``convention`` laid under its own ``[scene]`` (a copy; ``doc`` unchanged).
+
+    A study without ``convention`` is returned as it is. An unknown convention
+    name, or a study that sets again, in ``[scene]`` or in a scale's
+    ``[scale.<s>.scene]``, a key its convention provides (the convention is
+    the one place of it, so it cannot drift), is a :class:`ConfigError`.
+    """
+    name = doc.get("convention")
+    if name is None:
+        return copy.deepcopy(doc)
+    if name not in conventions:
+        raise ConfigError(f"{source}: unknown convention {name!r}; conventions in {conventions_source}: "
+                          + ", ".join(repr(k) for k in sorted(conventions)))
+    given = dict(conventions[name])
+    clashes = [f"[scene] {k}" for k in doc.get("scene", {}) if k in given]
+    for s, over in (doc.get("scale") or {}).items():
+        clashes += [f"[scale.{s}.scene] {k}" for k in (over.get("scene") or {}) if k in given]
+    if clashes:
+        raise ConfigError("\n".join(f"{source}: {c} is set by convention {name!r} ({conventions_source}); "
+                                     f"remove it here" for c in clashes))
+    out = copy.deepcopy(doc)
+    out["scene"] = {**copy.deepcopy(given), **out.get("scene", {})}
+    return out

@@ -162,10 +162,12 @@ _HASHES = textwrap.dedent('''
 
     out = {}
     names = [p.parent.name for p in sorted(st.studies_root().glob("*/study.toml"))]
-    only = sys.argv[1].split(",") if len(sys.argv) > 1 else names  # studies that exist in both trees
+    only = sys.argv[1].split(",") if len(sys.argv) > 1 and sys.argv[1] else names  # studies in both trees
+    patch = json.loads(sys.argv[2]) if len(sys.argv) > 2 else {}  # {study: {scene key: value}} laid over [scene]
     for name in [n for n in names if n in only]:
         for scale in ("quick", "tiny", "paper"):
             study = st.load_study(name, scale)
+            study.config.setdefault("scene", {}).update(patch.get(name, {}))
             base = dict(study.config.get("scene", {}))
             extra = {} if "energy" in base else {"energy": 0.3}
             out[f"{name}/{scale}/<base>"] = study.scene("base", **extra).result_hash()
@@ -183,15 +185,20 @@ _HASHES = textwrap.dedent('''
 ''')
 
 
-def _scene_hashes(code_root: Path, cwd: Path, only=None) -> dict:
+def _scene_hashes(code_root: Path, cwd: Path, only=None, patch=None) -> dict:
     script = cwd / "hashes.py"
     script.write_text(_HASHES)
     env = {**os.environ, "PYTHONPATH": str(code_root)}
     env.pop("HHSCATTER_STUDIES", None)
-    r = subprocess.run([sys.executable, str(script), *([",".join(only)] if only else [])], cwd=cwd, env=env,
-                       capture_output=True, text=True)
+    args = [",".join(only or []), *([json.dumps(patch)] if patch else [])]
+    r = subprocess.run([sys.executable, str(script), *args], cwd=cwd, env=env, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr[-3000:]
     return json.loads(r.stdout)
+
+
+# the studies whose scenes the shared convention "paper" (studies/conventions.toml) changed: they ran with the
+# tool's default r_esc = 1.5 before it; every other study (fig1-fig4 set 1.03 themselves, resc, basins) is unchanged
+CONVENTION_CHANGED = {"fig5": {"r_esc": 1.03}, "fig6": {"r_esc": 1.03}}
 
 
 def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_checks(tmp_path):
@@ -209,7 +216,16 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
     after = _scene_hashes(ROOT, tmp_path, only=then)
     assert set(before) == set(after)
     assert len(before) >= 7 * 3 * 2  # every study, every scale: its base scene and at least one run
-    assert after == before
+    moved = {k.split("/")[0] for k in CONVENTION_CHANGED}
+    assert {"fig1", "fig2", "fig3", "fig4", "resc"} <= set(then) and moved <= set(then)
+    # every other study keeps every scene
+    assert {k: v for k, v in after.items() if k.split("/")[0] not in moved} == \
+        {k: v for k, v in before.items() if k.split("/")[0] not in moved}
+    # fig5 and fig6: every scene changed, and by r_esc only (the old code with r_esc = 1.03 gives the new hashes)
+    changed = {k for k in before if k.split("/")[0] in moved}
+    assert changed and all(after[k] != before[k] for k in changed)
+    patched = _scene_hashes(old, old, only=sorted(moved), patch=CONVENTION_CHANGED)
+    assert patched == {k: after[k] for k in changed}
 
 
 def test_the_engine_options_are_accepted_in_files(tmp_path):

@@ -227,6 +227,10 @@ def test_fig4_tiny_end_to_end(tiny_root):
         assert grid[hit] - dt - 1e-9 <= r["tau1"] <= grid[hit] + 1e-9
         lt = lts[g]
         assert r["tau2_obs"] == lt.loc[lt["outcome"] == "settled", "t_end"].min()
+        # its interval: the order statistics of the quantile t_1/N, [0, second settling time] (≥ 68 %)
+        second = np.sort(lt.loc[lt["outcome"] == "settled", "t_end"].to_numpy())[1]
+        assert (r["tau2_obs_lo"], r["tau2_obs_hi"]) == (0.0, second) and r["tau2_obs_coverage"] >= 0.6827
+        assert r["tau2_obs_err"] == pytest.approx(second / 2)
         mu = nums["mu"]["value"]
         assert r["tau2_pred"] == pytest.approx(np.log(0.3 / E_C) / (mu * float(g)), rel=1e-12)
     # survival table: P(t) equals the fraction of orbits with t_end > t

@@ -90,11 +90,17 @@ class Renderer:
         if not toml.exists():
             return self.missing(f"`studies/{name}/study.toml`", "The study has not been added to the repository.")
         text = toml.read_text().rstrip("\n")
-        return (
+        out = (
             f"The study's parameters, verbatim from `studies/{name}/study.toml` "
             "(`[scale.<s>.…]` tables override the quick defaults at `SCALE=<s>`):\n\n"
             f'```toml title="studies/{name}/study.toml"\n{text}\n```\n'
         )
+        conv = self.root / "studies" / "conventions.toml"
+        if conv.exists() and re.search(r'(?m)^convention\s*=', text):
+            out += ("\nIts `convention` lays these scene keys under its `[scene]`, from the one file that declares "
+                    "them for every figure study:\n\n"
+                    f'```toml title="studies/conventions.toml"\n{conv.read_text().rstrip()}\n```\n')
+        return out
 
     def study_figure(self, name: str) -> str:
         png = self.study_asset(name, "png")

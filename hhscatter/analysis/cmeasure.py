@@ -41,16 +41,17 @@ class CMeasureKappa:
     boot: np.ndarray = field(repr=False)
 
 
-def _solve_renewal(T, M):
-    """Root κ > 0 of log Σ_i e^{κ T_i} = log M (returning points only)."""
-    if T.size == 0:
+def _solve_renewal(T, M, w=None):
+    """Root κ > 0 of log Σ_i w_i e^{κ T_i} = log M (returning points only; weights w_i ≥ 0, default 1)."""
+    n_ret = T.size if w is None else float(np.sum(w))
+    if n_ret == 0:
         return math.inf
-    if T.size >= M:
+    if n_ret >= M:
         return 0.0
     logM = math.log(M)
 
     def h(k):
-        return float(logsumexp(k * T)) - logM
+        return float(logsumexp(k * T, b=w)) - logM
 
     hi = 1.0 / max(float(np.mean(T)), 1e-300)
     while h(hi) <= 0:
@@ -60,8 +61,9 @@ def _solve_renewal(T, M):
     return float(optimize.brentq(h, 0.0, hi, xtol=1e-14, rtol=1e-12))
 
 
-def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) -> CMeasureKappa:
-    """kappa_from_cmeasure(return_times, n_exit, *, n_boot=200, rng=None) -> CMeasureKappa(kappa, kappa_err, ...).
+def kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, n_boot: int = 200,
+                        rng=None) -> CMeasureKappa:
+    """kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, n_boot=200, rng=None) -> CMeasureKappa.
 
     Escape rate κ (1/time) from section data via the true-time-map relation
     Eq. (eqn:kappa_cmeasure_truetime),  ∫_Ω e^{κT} dμ_c = 1 + μ_c(𝓔).
@@ -104,9 +106,15 @@ def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) ->
     crossing), which is harmless only when T_back and T are uncorrelated.
 
     Errors: ``kappa_err`` is the std of ``n_boot`` bootstrap replicates
-    (resampling the M points, exits included; ``rng`` seed or Generator);
-    ``kappa_err_delta`` the delta-method value
-    √(Var(Y)/M) / mean(T Y), Y_i = e^{κT_i} (0 for exits).
+    (``rng`` seed or Generator). With ``orbits`` (the orbit of each return
+    time) and ``exit_orbits`` (the orbit of each exit point, ``n_exit`` of
+    them) the bootstrap resamples *orbits*, the independent unit: one orbit
+    gives several section crossings whose return times are correlated, and
+    resampling crossings as if independent makes the error too small. Without
+    them it resamples the M points (exits included), right only when every
+    point comes from its own orbit. ``kappa_err_delta`` is the delta-method
+    value √(Var(Y)/M) / mean(T Y), Y_i = e^{κT_i} (0 for exits), which also
+    treats the points as independent.
     """
     T = np.asarray(return_times, dtype=float).ravel()
     if np.any(~np.isfinite(T)) or np.any(T <= 0):
@@ -126,11 +134,14 @@ def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) ->
     else:
         err_delta = math.nan if not math.isfinite(kappa) else 0.0
     gen = np.random.default_rng(rng)
-    boot = np.empty(int(n_boot))
-    for i in range(int(n_boot)):
-        ne = int(gen.binomial(M, n_exit / M))
-        Tb = T[gen.integers(0, T.size, M - ne)] if T.size else T
-        boot[i] = _solve_renewal(Tb, M)
+    if orbits is not None or exit_orbits is not None:
+        boot = _orbit_bootstrap(T, n_exit, orbits, exit_orbits, int(n_boot), gen)
+    else:
+        boot = np.empty(int(n_boot))
+        for i in range(int(n_boot)):
+            ne = int(gen.binomial(M, n_exit / M))
+            Tb = T[gen.integers(0, T.size, M - ne)] if T.size else T
+            boot[i] = _solve_renewal(Tb, M)
     err = float(np.std(boot, ddof=1)) if n_boot > 1 else math.nan
     return CMeasureKappa(
         kappa=float(kappa),
@@ -143,9 +154,26 @@ def kappa_from_cmeasure(return_times, n_exit, *, n_boot: int = 200, rng=None) ->
     )
 
 
+def _orbit_bootstrap(T, n_exit, orbits, exit_orbits, n_boot, gen) -> np.ndarray:
+    """κ replicates from resampling orbits with replacement (each orbit brings all its sample points)."""
+    orbits = np.asarray([] if orbits is None else orbits).ravel()
+    exit_orbits = np.asarray([] if exit_orbits is None else exit_orbits).ravel()
+    if orbits.size != T.size or exit_orbits.size != n_exit:
+        raise ValueError(f"orbits must give the orbit of each of the {T.size} return times and exit_orbits of "
+                         f"each of the {n_exit} exits, got {orbits.size} and {exit_orbits.size}")
+    ids, inv = np.unique(np.concatenate([orbits, exit_orbits]), return_inverse=True)
+    of_T = inv[:T.size]
+    points = np.bincount(inv, minlength=ids.size)  # sample points (returns and exits) per orbit
+    boot = np.empty(n_boot)
+    for i in range(n_boot):
+        c = np.bincount(gen.integers(0, ids.size, ids.size), minlength=ids.size)
+        boot[i] = _solve_renewal(T, float(c @ points), c[of_T].astype(float))
+    return boot
+
+
 def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=math.inf,
-                                  drop_censored: bool = False):
-    """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf, drop_censored=False) -> (return_times, n_exit, n_undetermined).
+                                  drop_censored: bool = False, with_orbits: bool = False):
+    """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf, drop_censored=False, with_orbits=False) -> (return_times, n_exit, n_undetermined[, orbits, exit_orbits]).
 
     Builds the input of :func:`kappa_from_cmeasure` from the engine's tables
     (one conservative ensemble).  Every crossing in ``sections`` with
@@ -164,6 +192,10 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
     these are the orbits on KAM tori: they cross the section for ever, are
     not part of the c-measure of the chaotic saddle, and would bias κ low by
     their share of the late crossings.
+
+    ``with_orbits=True`` also returns the orbit (``traj_id``) of each return
+    time and of each exit, for the bootstrap over orbits of
+    :func:`kappa_from_cmeasure`.
     """
     if drop_censored:
         keep = lifetimes.loc[lifetimes["outcome"].astype(object) != "censored", "traj_id"]
@@ -185,5 +217,8 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
     n_und = int(leaves.size - n_exit)
     if n_und:
         warnings.warn(f"{n_und} sample crossings have an undetermined fate and were dropped")
+    if with_orbits:
+        return (T.astype(float), n_exit, n_und, s["traj_id"].to_numpy()[ret],
+                last["traj_id"].to_numpy()[leaves])
     return T.astype(float), n_exit, n_und
 

@@ -56,6 +56,7 @@ __all__ = [
     "fit_survival_model",
     "homogeneous_start",
     "predict_tau1",
+    "profile_interval",
     "settling_rate",
     "survival_model",
 ]
@@ -572,7 +573,8 @@ class HomogeneousProblem:
 
     def fit_tau2(self, absolute_sigma: bool = True):
         """τ2 fitted by profiling χ²: a coarse scan over [τ0, t_last], then a fine one around its minimum; the
-        error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``).
+        error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``), its two ends
+        found by root-finding on the profile (:func:`profile_interval`), not bounded by the scan's steps.
         Returns (τ2, σ_τ2, solution, χ², residual function)."""
         grid = np.linspace(self.tau0 + 1e-9, float(self.tf[-1]), 25)
         prof, _ = self.profile(grid)
@@ -584,10 +586,46 @@ class HomogeneousProblem:
         sol, c2min, res = self.fit_at(tau2_best, fsols[j])
         dof = self.tf.size - len(self.free) - 1
         scale = 1.0 if absolute_sigma else max(c2min / max(dof, 1), 1e-300)
-        inside = fine[fprof <= min(c2min, fprof.min()) + scale]
-        step = fine[1] - fine[0]
-        err = float(max((inside.max() - inside.min()) / 2, step / 2)) if inside.size else float("nan")
-        return tau2_best, err, sol, c2min, res
+        warm = None if sol is None else sol.x
+
+        def chi2_at(tv):
+            return self.fit_at(float(tv), warm)[1]
+
+        lo, hi = profile_interval(chi2_at, tau2_best, c2min, grid[0], grid[-1], delta=scale,
+                                  step=fine[1] - fine[0])
+        return tau2_best, float((hi - lo) / 2), sol, c2min, res
+
+
+def profile_interval(chi2_of, best: float, chi2_min: float, lo_edge: float, hi_edge: float, *, delta: float = 1.0,
+                     step: float | None = None, xtol: float = 1e-9) -> tuple[float, float]:
+    """profile_interval(chi2_of, best, chi2_min, lo_edge, hi_edge, *, delta=1, step=None) -> (lo, hi): the ends of
+    the region χ²(x) ≤ χ²_min + Δ of a profile χ²(x) around its minimum ``best``, by root-finding on each side.
+
+    From ``best`` each side steps outward (``step``, default 1 % of the range,
+    doubling) until the profile exceeds χ²_min + Δ, then
+    :func:`scipy.optimize.brentq` finds the crossing. A side whose profile does
+    not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
+    the allowed range on that side: the data do not bound it).
+    """
+    target = float(chi2_min) + float(delta)
+
+    def g(x):
+        return float(chi2_of(x)) - target
+
+    step = float(step) if step else 0.01 * (hi_edge - lo_edge)
+    ends = []
+    for sign, edge in ((-1.0, lo_edge), (1.0, hi_edge)):
+        inner, h, end = float(best), step, None
+        while end is None:
+            outer = float(best) + sign * h
+            if sign * (outer - edge) >= 0:
+                end = edge if g(edge) <= 0 else float(optimize.brentq(g, *sorted((inner, edge)), xtol=xtol))
+            elif g(outer) > 0:
+                end = float(optimize.brentq(g, *sorted((inner, outer)), xtol=xtol))
+            else:
+                inner, h = outer, 2 * h
+        ends.append(end)
+    return ends[0], ends[1]
 
 
 def _homogeneous_errors(free, st, derive_fe: bool, P_tau0_err: float) -> dict:

@@ -20,6 +20,9 @@ Units: model time units for all times; energies in model units.
 """
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
@@ -34,8 +37,11 @@ __all__ = [
     "power_law_exponent",
     "tau1",
     "tau1_from_lifetimes",
+    "OrderStatisticInterval",
+    "settle_quantile_interval",
     "tau2_observed",
     "tau2_observed_arrays",
+    "tau2_observed_interval",
     "tau2_predicted",
 ]
 
@@ -152,6 +158,88 @@ def tau2_observed(lifetimes: pd.DataFrame):
     the energy of a non-escaping orbit dropped below E_c".
     """
     return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy())
+
+
+@dataclass(frozen=True)
+class OrderStatisticInterval:
+    """Result of :func:`settle_quantile_interval` (times in time units).
+
+    p: the quantile of the settling-time distribution over all N orbits;
+    value: the ⌈Np⌉-th settling time (the first settling time for p = 1/N);
+    lo, hi: the order statistics X_(r), X_(s) bracketing the quantile, with
+    X_(0) = 0 (no orbit settles before t = 0) and X_(s) = inf when fewer
+    than s orbits settled; r, s their ranks; coverage: the exact probability
+    P(X_(r) ≤ t_p < X_(s)) (≥ the requested level; the ranks are integers);
+    n: N, n_settled.
+    """
+
+    p: float
+    value: float
+    lo: float
+    hi: float
+    r: int
+    s: int
+    coverage: float
+    n: int
+    n_settled: int
+
+
+def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.6826894921370859) -> OrderStatisticInterval:
+    """settle_quantile_interval(t_end, outcome, p, level=0.6827) -> OrderStatisticInterval: the distribution-free
+    interval [X_(r), X_(s)] of the quantile t_p of the settling time.
+
+    The settling times of the N orbits (``outcome == 'settled'``; an orbit
+    that escapes or is censored never settles: +inf) are ordered X_(1) ≤ X_(2)
+    ≤ …; F(t) = P(an orbit settles before t) is defective (not every orbit
+    settles) and t_p is where F = p. The number C of orbits settled before t_p
+    is Binomial(N, p) whatever F is, so [X_(r), X_(s)] covers t_p exactly
+    when r ≤ C ≤ s − 1: its coverage Σ_{c=r}^{s−1} Binom(c; N, p) is exact and
+    distribution-free. The ranks start at the most probable count and grow on
+    the side that adds more probability until the coverage reaches ``level``
+    (1σ: 0.6827), so the interval covers at least that.
+
+    For p = 1/N this is the interval of the first settling time (the paper's
+    observed τ2, a sample minimum, which estimates the quantile t_{1/N} and
+    therefore depends on N): with C ≈ Poisson(1) it is [0, X_(2)], 74 % —
+    the first settling time bounds the low tail from above and nothing more.
+    A bootstrap of a minimum cannot give this: resampled minima are never
+    below the observed one.
+    """
+    from scipy import stats
+
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    settled = (np.asarray(outcome).ravel() == "settled") & np.isfinite(t_end)
+    x = np.sort(t_end[settled])
+    n = int(t_end.size)
+    if not 0 < p < 1 or n == 0:
+        raise ValueError(f"p must be in (0, 1) and the ensemble not empty, got p = {p}, N = {n}")
+    pmf = stats.binom(n, p).pmf
+    r = s = int(np.floor((n + 1) * p))  # the mode of C: the interval [X_(r), X_(r+1)] holds C = r
+    s += 1
+    cov = float(pmf(r))
+    while cov < level:
+        left = float(pmf(r - 1)) if r > 0 else -1.0
+        right = float(pmf(s)) if s <= n else -1.0
+        if left >= right:
+            r -= 1
+            cov += left
+        else:
+            cov += right
+            s += 1
+
+    def order(j):
+        return 0.0 if j == 0 else (float(x[j - 1]) if j <= x.size else math.inf)
+
+    k = max(1, math.ceil(n * p - 1e-12))
+    return OrderStatisticInterval(p=float(p), value=order(k), lo=order(r), hi=order(s), r=r, s=s, coverage=cov,
+                                  n=n, n_settled=int(x.size))
+
+
+def tau2_observed_interval(lifetimes: pd.DataFrame, level: float = 0.6826894921370859) -> OrderStatisticInterval:
+    """tau2_observed_interval(lifetimes) -> :func:`settle_quantile_interval` at p = 1/N: the observed τ2 (first
+    settling time) and the order-statistic interval of the quantile it estimates."""
+    return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy(),
+                                    1.0 / len(lifetimes), level)
 
 
 def tau2_predicted(E0, E_c, mu, gamma):

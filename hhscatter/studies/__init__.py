@@ -25,6 +25,8 @@ The stages make runs as separate targets:
 
 ``study.toml`` layout::
 
+    convention = "paper" # optional: scene keys shared by several studies, declared once in
+                         # studies/conventions.toml (a study cannot set them again)
     [about]              # title, paper figure, summary (make help, docs nav, report)
     [needs]              # role = upstream study (hhscatter.studies.graph: the one dependency graph)
     [scene]              # base Scene fields shared by the study's scenes
@@ -268,9 +270,12 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path} is not valid TOML: {exc}") from None
     params = _params_model(name, root)
-    from ..config import merge_tables, validate_study_file
+    from ..config import apply_convention, merge_tables, validate_study_file
 
     validate_study_file(doc, _shown(path), params)  # every table, key and type, at every scale, before any work
+    if "convention" in doc:  # the shared scene keys (studies/conventions.toml) under the study's own [scene]
+        cpath = conventions_path(root)
+        doc = apply_convention(doc, load_conventions(cpath), _shown(path), _shown(cpath))
     try:
         info = study_info(root, name, doc)
     except GraphError as exc:
@@ -283,6 +288,31 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
             raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
         doc = merge_tables(doc, scales[scale])
     return Study(name=name, scale=scale, config=doc, root=root / name, info=info, params_model=params)
+
+
+CONVENTIONS_FILE = "conventions.toml"
+
+
+def conventions_path(root: Path | None = None) -> Path:
+    """conventions_path(root=None) -> ``<root>/conventions.toml``, or the repository's when ``root`` has none."""
+    root = Path(root) if root is not None else studies_root()
+    own = root / CONVENTIONS_FILE
+    return own if own.exists() else _graph_default_root() / CONVENTIONS_FILE
+
+
+def load_conventions(path: Path | None = None) -> dict:
+    """load_conventions(path=None) -> {name: {scene key: value}} of the conventions file, strictly checked."""
+    from ..config import validate_conventions_file
+
+    path = Path(path) if path is not None else conventions_path()
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"{_shown(path)} is missing (the shared conventions of the studies)") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{_shown(path)} is not valid TOML: {exc}") from None
+    validate_conventions_file(doc, _shown(path))
+    return doc
 
 
 def _shown(path: Path) -> str:

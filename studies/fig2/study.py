@@ -399,11 +399,13 @@ def _analyze_cmeasure(study, grid_df):
             t1 = t0 + span
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                T, n_exit, n_und = cmeasure_sample_from_sections(sec, lt, t0, t1, t_record_end=t_rec_end,
-                                                                 drop_censored=True)
+                T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
+                    sec, lt, t0, t1, t_record_end=t_rec_end, drop_censored=True, with_orbits=True)
             if T.size + n_exit == 0:
                 continue
-            k = kappa_from_cmeasure(T, n_exit, n_boot=n_boot, rng=int(study.param("fit_seed")))
+            # bootstrap over orbits (the independent unit), not over their correlated section crossings
+            k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot,
+                                    rng=int(study.param("fit_seed")))
             rows.append({
                 "energy": energy, "x": energy - E_C, "shift_efolds": float(shift), "t_from": t0, "t_to": t1,
                 "t_record_end": t_rec_end, "n_samples": k.n_samples, "n_exit": k.n_exit, "n_undetermined": n_und,

@@ -21,14 +21,19 @@ Definitions used here (all times in model units):
   dropped below E_c" (Fig. 6b caption): the smallest settling time.  Being a
   minimum over N·f_settled orbits it decreases with N (the paper used N =
   10⁷); the 1 % and 50 % quantiles of the settling times are given as
-  N-independent companions.
+  N-independent companions. Its interval is the distribution-free
+  order-statistic interval of the quantile it estimates, t_{1/N}
+  (:func:`~hhscatter.analysis.transitions.tau2_observed_interval`, ≥ 68 %:
+  ``tau2_obs_lo``, ``tau2_obs_hi``; ``tau2_obs_err`` is its half-width), not
+  a bootstrap of the minimum; the exponent of τ2,obs ∝ γ^−p is an
+  unweighted log-log fit (a minimum has no error to weight by).
 * τ2 predicted — Eq. (eq:tau2), ln(E0/E_c)/(μγ), with μ measured by this
   study on its own γ = ``mu_gamma`` run exactly as in study fig3 (⟨E⟩ over
   orbits not escaped, settled orbits continued, log fit on ``mu_window``),
   one μ for all γ as in the paper (τ2 ∝ 1/γ).  Also given with the paper's
   μ = 0.91, and fig3's μ is recorded beside it (``[needs] mu_crosscheck``).
 
-Errors: paired bootstrap over orbits (every γ shares the same initial
+Other errors: paired bootstrap over orbits (every γ shares the same initial
 conditions, orbit i gets the same multiplicity in every ensemble).
 
 Raw runs: ``raw/gamma<γ:g>`` — ``gamma0``, ``gamma0.001``, ``gamma0.002``,
@@ -204,7 +209,7 @@ def _own_mu(study, mg, E0, N):
 def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha) -> pd.DataFrame:
     """One row per γ: outcome fractions, τ0, τ1 (Eq. (eqn:tau1)), τ2 observed (+ settling-time quantiles) and
     predicted (Eq. (eq:tau2)), each with its bootstrap error (σ over replicates × bscale)."""
-    from hhscatter.analysis.transitions import settle_time_quantiles, tau1, tau2_observed, tau2_predicted
+    from hhscatter.analysis.transitions import settle_time_quantiles, tau1, tau2_observed_interval, tau2_predicted
 
     E_C = study.model.critical_energy
     paper_mu = float(study.param("paper_mu"))
@@ -215,7 +220,8 @@ def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha
         b = boot[boot["label"] == g] if g > 0 else None
         t1 = tau1(grid, P[g], P[0.0], tau0, alpha) if g > 0 else None
         n0 = float(N * np.interp(t1, grid, P[0.0])) if t1 is not None else np.nan
-        t2 = tau2_observed(lt) if g > 0 else None
+        t2 = tau2_observed_interval(lt) if g > 0 else None  # first settling time, order-statistic interval
+        t2 = None if t2 is None or t2.n_settled == 0 else t2
         q = settle_time_quantiles(lt["t_end"].to_numpy(), oc, (0.01, 0.5)) if g > 0 else None
         pred = float(tau2_predicted(E0, E_C, mu, g)) if g > 0 else np.inf
         pred_p = float(tau2_predicted(E0, E_C, paper_mu, g)) if g > 0 else np.inf
@@ -235,7 +241,10 @@ def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha
             "tau1": np.nan if t1 is None else t1, "tau1_err": sd("tau1"),
             "tau1_boot_defined": float(np.isfinite(b["tau1"]).mean()) if b is not None else np.nan,
             "n0_at_tau1": n0, "tau1_resolved": bool(np.isfinite(n0) and n0 >= min_ref),
-            "tau2_obs": np.nan if t2 is None else t2, "tau2_obs_err": sd("tau2_obs"),
+            "tau2_obs": np.nan if t2 is None else t2.value,
+            "tau2_obs_err": np.nan if t2 is None else (t2.hi - t2.lo) / 2 if np.isfinite(t2.hi) else np.nan,
+            "tau2_obs_lo": np.nan if t2 is None else t2.lo, "tau2_obs_hi": np.nan if t2 is None else t2.hi,
+            "tau2_obs_coverage": np.nan if t2 is None else t2.coverage,
             "t_settle_q01": np.nan if q is None else float(q[0]), "t_settle_q01_err": sd("t_settle_q0.01"),
             "t_settle_q50": np.nan if q is None else float(q[1]), "t_settle_q50_err": sd("t_settle_q0.5"),
             "tau2_pred": pred, "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
@@ -277,7 +286,8 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
     t1v = d["tau1"].to_numpy()
     ok1 = np.isfinite(t1v)
     mono1 = bool(np.all(np.diff(t1v[ok1]) <= 0)) if ok1.sum() > 1 else None
-    p_exp, p_err = power_law_exponent(d["gamma"], d["tau2_obs"], d["tau2_obs_err"])
+    # unweighted: the first settling time is a minimum, its interval no Gaussian error to weight by
+    p_exp, p_err = power_law_exponent(d["gamma"], d["tau2_obs"], np.full(len(d), np.nan))
     p50, p50_err = power_law_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
     res = d[d["tau1_resolved"]]
     p1, p1_err = power_law_exponent(res["gamma"], res["tau1"], res["tau1_err"])
@@ -294,7 +304,9 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
                       note="paper value from its μ = 0.91 via Eq. (eq:tau2)")
         study.compare("τ2 observed (first settling) at γ = 0.01", r["tau2_obs"], r["tau2_obs_err"], None,
                       unit="time", note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
-                                        f"{round(r['f_settled'] * N)} settlers, decreases with N")
+                                        f"{round(r['f_settled'] * N)} settlers, decreases with N; err: half-width "
+                                        f"of the order-statistic interval [{r['tau2_obs_lo']:.4g}, "
+                                        f"{r['tau2_obs_hi']:.4g}] of the quantile t_1/N")
     study.compare("τ1 increases as γ decreases", mono1, None, True,
                   verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
                   note="paper: 'both τ1 and τ2 increase with decreasing γ'")
@@ -304,7 +316,7 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
                            "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2")
     if p_exp is not None:
         study.compare("p in τ2,obs ∝ γ^−p", p_exp, p_err, 1.0,
-                      note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); weighted log-log fit over γ with settlers")
+                      note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); unweighted log-log fit over γ with settlers")
     if p50 is not None:
         study.compare("p in median settling time ∝ γ^−p", p50, p50_err, 1.0,
                       note="N-independent companion of τ2,obs (same fit)")
@@ -313,8 +325,12 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
     return {"tau2": (p_exp, p_err), "settle_median": (p50, p50_err), "tau1": (p1, p1_err)}
 
 
+def _fin(v):
+    return None if not np.isfinite(v) else float(v)
+
+
 def _vu(v, e):
-    return {"value": None if not np.isfinite(v) else float(v), "err": None if not np.isfinite(e) else float(e)}
+    return {"value": _fin(v), "err": _fin(e)}
 
 
 def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents,
@@ -353,7 +369,8 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
                 "f_escaped": r.f_escaped, "f_settled": r.f_settled, "f_censored": r.f_censored,
                 "tau1": _vu(r.tau1, r.tau1_err), "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
                 "tau1_resolved": r.tau1_resolved,
-                "tau2_obs": _vu(r.tau2_obs, r.tau2_obs_err),
+                "tau2_obs": {**_vu(r.tau2_obs, r.tau2_obs_err), "lo": _fin(r.tau2_obs_lo), "hi": _fin(r.tau2_obs_hi),
+                             "coverage": _fin(r.tau2_obs_coverage)},
                 "t_settle_q01": _vu(r.t_settle_q01, r.t_settle_q01_err),
                 "t_settle_q50": _vu(r.t_settle_q50, r.t_settle_q50_err),
                 "tau2_pred": _vu(r.tau2_pred, r.tau2_pred_err),
@@ -367,7 +384,9 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
         "n_boot": nb,
         "n_boot_orbits": K,
         "errors": ("paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
-                   "scaled by sqrt(n_boot_orbits/N); for the minimum τ2,obs this is only indicative"),
+                   "scaled by sqrt(n_boot_orbits/N); τ2,obs (a minimum): the distribution-free order-statistic "
+                   "interval [lo, hi] of the quantile t_1/N it estimates (exact coverage given), err its half-width; "
+                   "its γ exponent from an unweighted fit"),
     }
 
 
