@@ -127,3 +127,19 @@ def test_power_law_exponent_recovers_one_over_gamma():
     p, err = power_law_exponent(g, tau, 0.01 * tau)
     assert p == pytest.approx(1.0, rel=1e-12) and err > 0
     assert power_law_exponent(g[:1], tau[:1], tau[:1]) == (None, None)
+
+
+def test_power_law_exponent_without_errors_takes_its_error_from_the_scatter():
+    """No usable τ errors (e.g. τ2 observed, whose order-statistic interval is not a Gaussian σ): the fit is
+    unweighted and σ_p is the residual-scatter error of a straight line in log–log, checked against curve_fit."""
+    from scipy.optimize import curve_fit
+
+    from hhscatter.analysis.transitions import power_law_exponent
+
+    g = np.array([0.005, 0.01, 0.02, 0.04])
+    tau = 0.5 / g ** 1.05 * np.array([1.01, 0.98, 1.02, 0.99])
+    p, err = power_law_exponent(g, tau, np.full(g.size, np.nan))
+    (c, slope), cov = curve_fit(lambda x, c, s: c + s * x, np.log(g), np.log(tau))  # unweighted, scaled
+    assert p == pytest.approx(-slope, rel=1e-8)  # curve_fit iterates to its xtol = 1.5e-8
+    assert err == pytest.approx(np.sqrt(cov[1, 1]), rel=1e-6)  # curve_fit: finite-difference Jacobian
+    assert 0 < err < 0.1  # not the σ = 1 of a made-up weight

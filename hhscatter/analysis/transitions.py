@@ -356,7 +356,8 @@ def power_law_exponent(gamma, tau, tau_err):
     Weighted least squares of log τ = c − p log γ over the finite τ > 0 (γ > 0),
     weights 1/(σ_τ/τ)² (points without a usable error get the largest error of
     the others); σ_p inflated by the reduced χ² when the points scatter more
-    than their errors. E.g. τ2 ∝ 1/γ, Eq. (eq:tau2), is p = 1.
+    than their errors. With no usable error at all the fit is unweighted and
+    σ_p comes from the residual scatter. E.g. τ2 ∝ 1/γ, Eq. (eq:tau2), is p = 1.
     """
     g, t, e = (np.asarray(v, dtype=float) for v in (gamma, tau, tau_err))
     ok = np.isfinite(t) & (t > 0) & (g > 0)
@@ -365,6 +366,9 @@ def power_law_exponent(gamma, tau, tau_err):
     x, y = np.log(g[ok]), np.log(t[ok])
     s = e[ok] / t[ok]
     good = np.isfinite(s) & (s > 0)
-    s = np.where(good, s, s[good].max() if good.any() else 1.0)
+    if not good.any():  # no errors at all: an unweighted fit, its error from the residual scatter
+        fit = weighted_least_squares(np.column_stack([np.ones_like(x), x]), y, np.ones_like(y), errors="scaled")
+        return float(-fit.coef[1]), float(fit.err[1])
+    s = np.where(good, s, s[good].max())
     fit = weighted_least_squares(np.column_stack([np.ones_like(x), x]), y, 1.0 / s**2, errors="inflated")
     return float(-fit.coef[1]), float(fit.err[1])
