@@ -208,3 +208,27 @@ def test_fig6_tiny_end_to_end(tiny_studies):
     t4 = next(r for r in fig4["taus"] if r["gamma"] == 0.02)
     assert row["tau1_observed"] == t4["tau1"]["value"] and row["tau2_observed"] == t4["tau2_obs"]["value"]
     assert row["tau1_pred_integrated"] is None or row["tau1_pred_integrated"] >= nums["tau0"]
+
+
+def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministically(tiny_studies):
+    """The authors' Fig. 5 convention: square ICs (goodICs) at E2, their windows, r < 1 — built from runs
+    whose scenes say so, and the same numbers when the analysis runs again."""
+    from hhscatter.studies import load_study, run_stage
+    from hhscatter.tables import read_sections
+
+    study = load_study("fig5", "tiny", root=tiny_studies)
+    nums = json.loads(study.numbers_path.read_text())
+    auth = nums["authors_convention"]
+    g = nums["gamma_main"]
+    for key, check in (("5a_authors", lambda s: (s["t"] > 17.0) & (s["t"] < 30.0)),
+                       ("5b_authors", lambda s: (s["energy"] >= 0.295) & (s["energy"] <= 0.305))):
+        scene = json.loads((study.raw(key) / "scene.json").read_text())["scene"]
+        assert scene["region"] == "square" and scene["gamma"] == g and scene["sections"]["first_only"]
+        sec = read_sections(study.raw(key))
+        assert sec["traj_id"].is_unique and check(sec).all()  # one crossing per orbit, in the window
+        assert auth["n_points"][key] == int((np.hypot(sec["x"], sec["y"]) < 1).sum())
+    rows = {r["quantity"]: r for r in nums["paper_comparison"]}
+    assert "Fig. 5b closer to μ_c^0.30 than 5a, both in the authors' convention" in rows or auth["rows"] is None
+    run_stage("fig5", "analyze", "tiny", root=tiny_studies)
+    again = json.loads(study.numbers_path.read_text())["authors_convention"]
+    assert again == auth

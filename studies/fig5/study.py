@@ -93,6 +93,7 @@ class Params(StudyParams):
     noise_max: Number
     n_cap: Integer
     m_min: Integer
+    authors_window: Numbers = [17.0, 30.0]  # the authors' Fig 5a: first crossing with 17 < t < 30
     seed: Integer
 
 
@@ -117,10 +118,58 @@ def _scene_for(study, g):
                        sections={"t_from": float(t_lo), "t_to": float(t_hi), "stop": True})
 
 
+AUTHORS = {"5a_authors": "Fig. 5a, the authors' convention", "5b_authors": "Fig. 5b, the authors' convention"}
+
+
+def _authors_scene(study, key):
+    """The authors' Fig. 5 runs (their code: goodICs, i.e. region 'square', at E2, γ = gamma_main): 5a is the
+    first crossing with t in ``authors_window``; 5b the first crossing whose energy is in ``band``, at any
+    time. The r < 1 cut is applied in the analysis. Each orbit stops once it has its crossing."""
+    g = float(study.param("gamma_main"))
+    if key == "5a_authors":
+        t0, t1 = (float(v) for v in study.param("authors_window"))
+        sec = {"t_from": t0, "t_to": t1, "first_only": True, "stop": True}
+    else:
+        lo, hi = (float(v) for v in study.param("band"))
+        sec = {"e_min": lo, "e_max": hi, "first_only": True, "stop": True}
+    return study.scene(key, gamma=g, region="square", sections=sec)
+
+
 def simulate(study, workers=None, progress=True):
-    """simulate(study, workers=None) -> None; one raw run per γ (sections in the t* window)."""
+    """simulate(study, workers=None) -> None; one raw run per γ (sections in the t* window), and the two runs
+    of the authors' Fig. 5 convention (square ICs, their windows)."""
     for g in study.param("gammas"):
         study.run(gamma_key(g), _scene_for(study, g), workers=workers, progress=progress)
+    for key in AUTHORS:
+        study.run(key, _authors_scene(study, key), workers=workers, progress=progress)
+
+
+def _authors_sets(study):
+    """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < 1
+    (their plots), capped at n_cap points."""
+    from hhscatter.tables import read_sections
+
+    n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))
+    out = {}
+    for key in AUTHORS:
+        sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "energy"])
+        sec = sec[np.hypot(sec["x"], sec["y"]) < 1.0].reset_index(drop=True)
+        out[("authors", key)] = _cap(sec, n_cap, seed)
+    return out
+
+
+def _authors_distances(study, refs, extent):
+    """Summary rows (distances at the headline box to μ_c^{E1} and μ_c^{E2}, with bootstrap errors and the
+    debiased Hellinger interval) of the authors' 5a and 5b sets, each at its own common sample size; None if
+    the sets are too small (tiny scale)."""
+    sets = _authors_sets(study)
+    try:
+        usable, m = _common_sample_size(study, sets, refs)
+    except ValueError:
+        return None, {k[1]: len(v) for k, v in sets.items()}
+    _, stab = _distances(study, sets, refs, usable, m, extent)
+    stab = stab[stab["set"] != "cm_E2"].reset_index(drop=True)
+    return stab, {k[1]: len(v) for k, v in sets.items()}
 
 
 # ---------------------------------------------------------------------------
@@ -198,6 +247,8 @@ def analyze(study):
 
     delta = float(study.param("delta"))
     verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
+    astab, n_auth = _authors_distances(study, refs, extent)
+    authors = _compare_authors(study, astab, n_auth, E1)
     study.write_numbers({
         "inputs": inputs,
         "dev_fallback": up.any_fallback(inputs),
@@ -209,7 +260,42 @@ def analyze(study):
         "delta": delta,
         "distances": stab.to_dict(orient="records"),
         "closer_to_E1": verdicts,
+        "authors_convention": authors,
     })
+
+
+def _compare_authors(study, astab, n_auth, E1) -> dict:
+    """Rows of the paper comparison under the authors' own Fig. 5 convention (square ICs; 5a: first crossing
+    with 17 < t < 30; 5b: first crossing in the energy band at any time; r < 1), and the JSON record."""
+    out = {"convention": "region 'square' (goodICs), γ = gamma_main, r < 1; 5a: first crossing with "
+                         f"{study.param('authors_window')[0]:g} < t < {study.param('authors_window')[1]:g}; "
+                         f"5b: first crossing with E in {list(study.param('band'))} at any time",
+           "n_points": n_auth, "rows": None}
+    if astab is None:
+        return out
+    out["rows"] = astab.to_dict(orient="records")
+
+    def h(key, ref):
+        r = astab[(astab["set"] == key) & (astab["ref"] == ref)].iloc[0]
+        return float(r["hellinger_debiased"]), float(r["hellinger_debiased_lo"]), float(r["hellinger_debiased_hi"])
+
+    for key, label in AUTHORS.items():
+        (a1, lo1, hi1), (a2, _, _) = h(key, "E1"), h(key, "E2")
+        study.compare(f"{label}: debiased Hellinger to μ_c^{E1:g} vs to μ_c^0.35", f"{a1:.3f} [{lo1:.3f}, "
+                      f"{hi1:.3f}] vs {a2:.3f}", None, "closer to μ_c^0.30",
+                      verdict="agrees" if a1 < a2 else "differs",
+                      note=f"{n_auth[key]} points; {out['convention']}")
+    (a, alo, ahi), (b, blo, bhi) = h("5a_authors", "E1"), h("5b_authors", "E1")
+    closer = b < a
+    overlap = not (bhi < alo or ahi < blo)
+    study.compare("Fig. 5b closer to μ_c^0.30 than 5a, both in the authors' convention", f"{b:.3f} (b) vs {a:.3f} (a)",
+                  None, "yes", verdict="equal within errors" if overlap else ("agrees" if closer else "differs"),
+                  note="debiased Hellinger at the headline box; the paper's claim under its own construction "
+                       "of 5b (a different set from 5a, not 5a filtered)" +
+                       (f"; the intervals [{blo:.3f}, {bhi:.3f}] and [{alo:.3f}, {ahi:.3f}] overlap" if overlap else ""))
+    out["b_closer_than_a"] = bool(closer)
+    out["intervals_overlap"] = bool(overlap)
+    return out
 
 
 def _mu(study, inputs):
