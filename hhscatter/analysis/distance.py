@@ -160,7 +160,6 @@ def _cells(X, box, extent):
         raise ValueError(f"bad extent {extent!r}")
     if not box > 0:
         raise ValueError(f"box size must be > 0, got {box!r}")
-    nx = int(np.floor((x1 - x0) / box)) + 1
     ny = int(np.floor((y1 - y0) / box)) + 1
     ix = np.floor((X[:, 0] - x0) / box)
     iy = np.floor((X[:, 1] - y0) / box)

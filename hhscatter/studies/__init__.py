@@ -249,7 +249,7 @@ class Study:
         """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""
         import pyarrow as pa
 
-        from ..tables import META_KEY, provenance, write_part
+        from ..tables import provenance, write_part
 
         table = pa.Table.from_pandas(df, preserve_index=False)
         doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
