@@ -121,10 +121,11 @@ def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) 
     ``rows``: paper-vs-ours rows {quantity, ours, err, paper, unit, verdict,
     note} (and ``study`` for a leading study column). ``quantity`` and
     ``verdict`` may map a row / a verdict to the text of their cell (e.g. a
-    link, or a coloured span in HTML). Columns: quantity, ours, paper,
-    verdict, note.
+    link, or a coloured span in HTML). Columns: quantity, ours, convention
+    (how our number was made, when a row says), paper, verdict, note.
     """
-    head = ["study"] * study + ["quantity", "ours", "paper", "verdict", "note"]
+    conv = any(r.get("convention") for r in rows)
+    head = ["study"] * study + ["quantity", "ours"] + ["convention (ours)"] * conv + ["paper", "verdict", "note"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         unit = f" {r['unit']}" if r.get("unit") else ""
@@ -133,11 +134,12 @@ def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) 
         v = r.get("verdict") or "—"
         cells = [r.get("study", "")] * study + [
             quantity(r) if quantity else md_cell(r.get("quantity", "")),
-            md_cell(ours + unit), md_cell(format_value(r.get("paper"))),
+            md_cell(ours + unit)] + [md_cell(r.get("convention") or "—")] * conv + [
+            md_cell(format_value(r.get("paper"))),
             verdict(v) if verdict else md_cell(v), md_cell(r.get("note") or "")]
         out.append("| " + " | ".join(str(c) for c in cells) + " |")
     if not rows:
-        out.append("| " + " | ".join(["—"] * study + ["no study outputs found", "", "", "", ""]) + " |")
+        out.append("| " + " | ".join(["—"] * study + ["no study outputs found", "", "", "", ""] + [""] * conv) + " |")
     return "\n".join(out) + "\n"
 
 

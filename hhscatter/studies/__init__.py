@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..scene import Scene, SceneError, scene_from_dict
+from .cost import meter, record
 from .graph import HEADER_TABLES, GraphError, StudyInfo, study_info
 from .graph import default_root as _graph_default_root
 
@@ -115,6 +116,8 @@ class Study:
     root: Path
     comparisons: list = field(default_factory=list)
     info: StudyInfo | None = None
+    orbits_run: int = 0       # orbits integrated by this process's run() calls (the cost record)
+    chunks_resumed: int = 0   # chunks found complete and kept by run()
     params_model: type | None = None  # the study's Params (hhscatter.config.StudyParams) of its [study] table
 
     @property
@@ -211,22 +214,44 @@ class Study:
             resume = old == scene.result_hash()
             overwrite = not resume
         summary = simulate(scene, out, workers=workers, overwrite=overwrite, resume=resume, progress=progress)
+        self.orbits_run += summary.n
+        self.chunks_resumed += summary.chunks_skipped
         if summary.chunks_done:
             print(f"  {self.name}/{key}: {summary.line()}", flush=True)
         return out
 
     def compare(self, quantity: str, ours, err=None, paper=None, *, unit: str = "", note: str = "",
-                verdict: str | None = None) -> dict:
-        """Record one row of the paper-vs-ours table; ``verdict`` defaults to an |Δ| ≤ 2σ test."""
+                verdict: str | None = None, convention: str | None = None, authors: bool = False) -> dict:
+        """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
+
+        One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test. ``convention`` says how
+        *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
+        row computed in the authors' own convention (their IC region, window or selection rule), so that a
+        "differs" can be checked against it. The paper's number is always in the authors' convention.
+        """
         if verdict is None and paper is not None and ours is not None and err is not None:
             try:
                 verdict = "agrees within 2σ" if abs(float(ours) - float(paper)) <= 2 * float(err) else "differs"
             except (TypeError, ValueError):
                 verdict = None
+        conv = convention if convention is not None else self.convention_label
+        if authors and not conv.startswith("authors"):
+            conv = f"authors': {conv}"
         row = {"quantity": quantity, "ours": ours, "err": err, "paper": paper, "unit": unit,
-               "verdict": verdict, "note": note}
+               "verdict": verdict, "note": note, "convention": conv, "authors": bool(authors)}
         self.comparisons.append(row)
         return row
+
+    @property
+    def convention_label(self) -> str:
+        """The study's own setup in a few words: IC region and escape radius of its ``[scene]``."""
+        sc = self.config.get("scene", {})
+        region = sc.get("region", "disk")
+        where = f"disk r < {sc.get('radius', 0.5):g}" if region == "disk" else f"{region} ICs"
+        r_esc = sc.get("r_esc")
+        name = self.config.get("convention")
+        head = f"{name} setup: " if name else ""
+        return f"{head}{where}, r_esc {r_esc:g}" if r_esc is not None else f"{head}{where}"
 
     def write_numbers(self, numbers: dict) -> Path:
         """Write the study's numbers JSON (with its comparisons, scale and provenance)."""
@@ -383,28 +408,40 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
     stages = STAGES if stage == "all" else (stage,)
     for st in stages:
         study.comparisons = []
-        if st == "simulate":
-            mod.simulate(study, workers=workers, progress=progress)
-            write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
-            print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
-        elif st == "analyze":
-            from ._upstream import UpstreamError, dev_fallback_enabled
+        study.orbits_run, study.chunks_resumed = 0, 0
+        try:
+            with meter(st, workers) as cost:
+                _run_one(study, mod, st, name, scale, workers, progress)
+                cost.completed = True
+        finally:  # an interrupted stage is recorded too: its resumed continuation adds to it
+            cost.orbits, cost.chunks_resumed = study.orbits_run, study.chunks_resumed
+            if study.out.is_dir():
+                record(study.out, cost)
 
-            missing = [] if dev_fallback_enabled() else missing_upstream(study)
-            if missing:
-                raise UpstreamError(
-                    f"{name} needs the published outputs of {', '.join(missing)} (declared in [needs] of "
-                    f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first")
-            mod.analyze(study)
-            derived = study.out / "derived"
-            extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
-            print(f"{name} analyze: wrote {study.numbers_path}{extra}", flush=True)
-        else:
-            import matplotlib
 
-            matplotlib.use("Agg")
-            mod.plot(study)
-            print(f"{name} plot: wrote {study.figure_path}", flush=True)
+def _run_one(study, mod, st, name, scale, workers, progress):
+    if st == "simulate":
+        mod.simulate(study, workers=workers, progress=progress)
+        write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
+        print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
+    elif st == "analyze":
+        from ._upstream import UpstreamError, dev_fallback_enabled
+
+        missing = [] if dev_fallback_enabled() else missing_upstream(study)
+        if missing:
+            raise UpstreamError(
+                f"{name} needs the published outputs of {', '.join(missing)} (declared in [needs] of "
+                f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first")
+        mod.analyze(study)
+        derived = study.out / "derived"
+        extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
+        print(f"{name} analyze: wrote {study.numbers_path}{extra}", flush=True)
+    else:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        mod.plot(study)
+        print(f"{name} plot: wrote {study.figure_path}", flush=True)
 
 
 # the study folders are subpackages of this package: studies/<name>/study.py is hhscatter.studies.<name>.study

@@ -1,0 +1,41 @@
+"""The cost record of a study stage (hhscatter.studies.cost): CPU of children counted, invocations added."""
+import json
+import multiprocessing as mp
+
+from hhscatter.studies.cost import StageCost, meter, record, totals
+
+
+def _burn(n):
+    s = 0
+    for i in range(n):
+        s += i * i
+    return s
+
+
+def test_meter_counts_the_cpu_of_waited_children(tmp_path):
+    ctx = mp.get_context("spawn")
+    with meter("simulate") as cost:
+        p = ctx.Process(target=_burn, args=(3_000_000,))
+        p.start()
+        p.join()
+    # the child's loop alone takes ≥ 0.05 s of CPU on any machine; a meter of this process only would miss it
+    with meter("simulate") as self_only:
+        pass
+    assert cost.cpu_s > 0.05 > self_only.cpu_s
+    assert cost.wall_s >= cost.cpu_s * 0.5
+    assert cost.rss_self_mb > 1 and cost.rss_children_mb > 1
+
+
+def test_record_adds_resumed_invocations_and_a_fresh_run_replaces_them(tmp_path):
+    a = StageCost("simulate", wall_s=10, cpu_s=18, orbits=100, rss_self_mb=200, rss_children_mb=300)
+    b = StageCost("simulate", wall_s=5, cpu_s=9, orbits=50, chunks_resumed=2, rss_self_mb=250, rss_children_mb=100)
+    record(tmp_path, a)
+    record(tmp_path, b)
+    record(tmp_path, StageCost("analyze", wall_s=3, cpu_s=3))
+    t = totals(json.loads((tmp_path / "cost.json").read_text()))
+    assert t["simulate"] == {"wall_s": 15, "cpu_s": 27, "orbits": 150, "rss_self_mb": 250,
+                             "rss_children_mb": 300, "invocations": 2}
+    assert t["analyze"]["invocations"] == 1
+    record(tmp_path, StageCost("simulate", wall_s=1, cpu_s=2, orbits=7))  # a fresh run: nothing resumed
+    t = totals(json.loads((tmp_path / "cost.json").read_text()))
+    assert t["simulate"]["orbits"] == 7 and t["simulate"]["invocations"] == 1
