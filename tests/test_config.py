@@ -218,6 +218,13 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
     added = {f"fig5/{scale}/{key}" for scale in ("quick", "tiny", "paper") for key in ("5a_authors", "5b_authors")}
     assert set(before) <= set(after) and set(after) - set(before) == added
     after = {k: after[k] for k in before}
+    # changed on purpose for the paper scale (issue 15): fig1's pilot keeps its quick-scale size (it fixes t_rec).
+    # (fig2's runs after its pilots, e.g. the square-IC runs and the paper-scale N per energy, need a pilot's
+    # result and are not reached here: their scenes are tested in test_study_fig1_fig2.)
+    by_design = {k for k in before if k.startswith("fig1/paper/pilot_E")}
+    assert by_design and all(after[k] != before[k] for k in by_design)
+    before = {k: v for k, v in before.items() if k not in by_design}
+    after = {k: v for k, v in after.items() if k not in by_design}
     assert len(before) >= 7 * 3 * 2  # every study, every scale: its base scene and at least one run
     moved = {k.split("/")[0] for k in CONVENTION_CHANGED}
     assert {"fig1", "fig2", "fig3", "fig4", "resc"} <= set(then) and moved <= set(then)

@@ -237,6 +237,42 @@ def test_fig2_tiny_end_to_end(tiny_root):
         assert v["kappa_cm"]["value"] > 0 and v["kappa_cm"]["err"] > 0
 
 
+def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministically(tiny_root):
+    """κ(E) under 4 conventions: the square runs are the disk runs with region = 'square' (same n, seed, t_max),
+    the P-level windows sit at the P levels of the run's own Kaplan–Meier curve, the law rows use only stable
+    energies, and the analysis gives the same numbers twice."""
+    from hhscatter.analysis.survival import lifetimes_to_arrays, survival_curve
+    from hhscatter.studies import load_study, run_stage
+    from hhscatter.tables import read_lifetimes
+
+    study = load_study("fig2", "tiny", root=tiny_root)
+    doc = json.loads(study.numbers_path.read_text())
+    conv = doc["kappa_conventions"]
+    table = pd.read_parquet(study.out / "derived" / "kappa_conventions.parquet")
+    for e in study.params["square_energies"]:
+        disk = json.loads((study.raw(f"grid_E{e:.3f}") / "scene.json").read_text())["scene"]
+        sq = json.loads((study.raw(f"sq_grid_E{e:.3f}") / "scene.json").read_text())["scene"]
+        assert sq["region"] == "square" and disk["region"] == "disk"
+        assert {k: v for k, v in sq.items() if k not in ("region", "name")} == \
+            {k: v for k, v in disk.items() if k not in ("region", "name")}
+        # P-level window: starts where the square run's own KM curve first falls to 0.5
+        t_end, obs = lifetimes_to_arrays(read_lifetimes(study.raw(f"sq_grid_E{e:.3f}")))
+        row = table[(table["energy"] == e) & (table["convention"] == "square_plevel")].iloc[0]
+        if np.isfinite(row["t_lo"]):
+            km = survival_curve(t_end, obs, np.array([row["t_lo"] - 0.2, row["t_lo"] + 0.2]))
+            assert km.P[0] > 0.5 >= km.P[1]
+        assert row["n_escaped_at_start"] == int(((t_end == 0) & obs).sum()) > 0  # square corners beyond r_esc
+    assert set(table["convention"]) == set(conv["conventions"])
+    for name, info in conv["fits"].items():
+        assert set(info["energies"]) <= set(conv["stable_energies"])
+    undefined = table[~table["defined"]]
+    assert (undefined["reason"].str.len() > 0).all()
+    rows = {r["quantity"]: r for r in doc["paper_comparison"]}
+    assert rows["κ(E) points ill-defined by the trapped plateau"]["ours"] == len(undefined)
+    run_stage("fig2", "analyze", "tiny", root=tiny_root)
+    assert json.loads(study.numbers_path.read_text())["kappa_conventions"] == conv
+
+
 def test_power_law_exponent_mle_recovers_pareto_exponent():
     from hhscatter.analysis.escape_rate import power_law_exponent_mle
 
@@ -252,3 +288,19 @@ def test_power_law_exponent_mle_recovers_pareto_exponent():
     assert abs(res2.kappa - z) < 3 * res2.kappa_err
     with pytest.raises(ValueError, match="t_start"):
         power_law_exponent_mle(t, obs, 0.0, t_max)
+
+
+def test_fig2_paper_n_per_energy_is_declared_per_grid_energy():
+    """The paper scale's κ(E) runs: N per energy from grid_n_by_energy (same order as grid_energies); a list of
+    the wrong length is refused by name."""
+    from hhscatter.studies import load_study
+    from hhscatter.studies.fig2.study import grid_n
+
+    paper = load_study("fig2", "paper")
+    grid, per = paper.params["grid_energies"], paper.params["grid_n_by_energy"]
+    assert [grid_n(paper, e) for e in grid] == per and grid_n(paper, 0.18) == 750000
+    assert all(n >= 100000 for n in per)
+    assert grid_n(load_study("fig2", "quick"), 0.18) == 30000  # no list: grid_n everywhere
+    paper.config["study"]["grid_n_by_energy"] = per[:-1]
+    with pytest.raises(ValueError, match="grid_n_by_energy"):
+        grid_n(paper, 0.2)

@@ -122,15 +122,72 @@ def _panel_b(ax, kappa_e, fit_curve, cm, numbers):
     ax.grid(True, alpha=0.3)
 
 
-def plot_fig2(curves, lines, kappa_e, fit_curve, cm, numbers, path):
-    """plot_fig2(curves, lines, kappa_e, fit_curve, cm, numbers, path) -> None; writes the Fig. 2 PNG.
+CONVENTION_STYLE = {  # marker, colour, offset in x (so that the 4 bars do not overlap)
+    "disk_plateau": ("o", "tab:blue", -0.0015),
+    "disk_plevel": ("s", "tab:cyan", -0.0005),
+    "square_plateau": ("^", "tab:red", 0.0005),
+    "square_plevel": ("v", "tab:orange", 0.0015),
+}
+
+
+def _panel_c(ax, conv_table, numbers):
+    """κ0 near E_c under the 4 conventions; ill-defined points as crosses on the axis, unstable energies shaded."""
+    conv = numbers["kappa_conventions"]
+    x_max = 0.30 - numbers["E_c"]
+    near = conv_table[conv_table["x"] <= x_max + 1e-9]
+    for name, label in conv["conventions"].items():
+        m, colour, dx = CONVENTION_STYLE[name]
+        d = near[near["convention"] == name]
+        ok = d[d["defined"]]
+        ax.errorbar(ok["x"] + dx, ok["kappa"], yerr=ok["kappa_err"], fmt=m, ms=4.5, color=colour, capsize=2,
+                    mfc="none" if "plevel" in name else colour, label=label, zorder=4)
+        bad = d[~d["defined"]]
+        if len(bad):
+            ax.plot(bad["x"] + dx, np.zeros(len(bad)), "x", color=colour, ms=8, mew=2, clip_on=False, zorder=5)
+    for e in conv["unstable_energies"]:
+        x = e - numbers["E_c"]
+        if x <= x_max:
+            ax.axvspan(x - 0.003, x + 0.003, color="0.85", zorder=0)
+    law = conv.get("law") or {}
+    xs = np.linspace(0, x_max, 200)
+    if law:
+        a, b, c = law["a"]["value"], law["b"]["value"], law["c"]["value"]
+        xb = law["E_b"]["value"] - numbers["E_c"]
+        lo, hi = xs[xs <= xb], xs[xs >= xb]
+        ax.plot(lo, a * lo**2 + b * lo, "-", color="k", lw=1.2,
+                label=rf"law across conventions: $a = {_fmt_err(a, law['a']['err'])}$, "
+                      rf"$b = {_fmt_err(b, law['b']['err'])}$, $c = {_fmt_err(c, law['c']['err'])}$")
+        ax.plot(hi, c * hi, "-", color="k", lw=1.2)
+    xp = 0.27 - numbers["E_c"]
+    ax.plot(xs[xs <= xp], 13.63 * xs[xs <= xp]**2 + 0.03 * xs[xs <= xp], ":", color="0.45", lw=1.0,
+            label="paper: $13.63x^2 + 0.03x$; $1.41x$")
+    ax.plot(xs[xs >= xp], 1.41 * xs[xs >= xp], ":", color="0.45", lw=1.0)
+    ax.plot([], [], "x", color="0.3", ms=7, mew=2, label="κ ill-defined (trapped plateau): excluded")
+    ax.fill_between([], [], color="0.85", label=f"unstable across conventions (> {conv['stable_rel_tol']:.0%})")
+    ax.set_xlim(0, x_max + 0.006)
+    ax.set_ylim(0, None)
+    ax.set_xlabel(r"$E_0 - E_c$")
+    ax.set_ylabel(r"$\kappa_0$ (1/time)")
+    ax.legend(loc="upper left", fontsize=7.5)
+    ax.set_title(r"(c) $\kappa_0$ near $E_c$: IC region (disk, authors' square) $\times$ windows "
+                 rf"(plateau, $P = {conv['p_levels'][0]:g} \to {conv['p_levels'][1]:g}$)", loc="left", fontsize=10)
+    ax.grid(True, alpha=0.3)
+
+
+def plot_fig2(curves, lines, kappa_e, fit_curve, cm, numbers, path, conv_table=None):
+    """plot_fig2(curves, lines, kappa_e, fit_curve, cm, numbers, path, conv_table=None) -> None; writes the PNG.
 
     Inputs are fig2's derived tables (survival_curves, pt_fit_lines,
-    kappa_energy, kappa_fit_curve, kappa_cmeasure) and fig2.json.
+    kappa_energy, kappa_fit_curve, kappa_cmeasure, kappa_conventions) and
+    fig2.json. Panel (c), κ0 near E_c under the 4 conventions, is drawn when
+    ``conv_table`` is given.
     """
     plt = agg_pyplot()
-    fig, axes = plt.subplots(2, 1, figsize=(7.0, 10.0), constrained_layout=True)
+    rows = 3 if conv_table is not None else 2
+    fig, axes = plt.subplots(rows, 1, figsize=(7.0, 5.0 * rows), constrained_layout=True)
     _panel_a(axes[0], curves, lines, numbers)
     _panel_b(axes[1], kappa_e, fit_curve, cm, numbers)
+    if conv_table is not None:
+        _panel_c(axes[2], conv_table, numbers)
     fig.savefig(path, dpi=180)
     plt.close(fig)

@@ -70,6 +70,12 @@ class Params(StudyParams):
     cm_start_shifts: Numbers = [0.0]
     n_boot: Integer
     fit_seed: Integer
+    # -- κ(E) near E_c under several conventions (the authors' square ICs, windows fixed by P levels) --
+    grid_n_by_energy: Integers = None  # orbits per grid energy (same order as grid_energies); None: grid_n for all
+    square_energies: Numbers = []      # grid energies also run with the authors' square ICs (raw sq_grid_E…)
+    p_levels: Numbers = [0.5, 0.01]    # [p_hi, p_lo] of the P-level windows
+    max_plateau_bias: Number = 0.1     # κ ill-defined when the trapped fraction is > this share of P at the window end
+    stable_rel_tol: Number = 0.1       # κ(E) stable: (max − min)/mean over the defined conventions ≤ this
 
 
 PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
@@ -84,6 +90,22 @@ def grid_key(energy: float) -> str:
 def pt_key(energy: float) -> str:
     """pt_key(E) -> raw key of a Fig. 2a run, e.g. 'pt_E0.23'."""
     return f"pt_E{energy:.2f}"
+
+
+def sq_key(energy: float) -> str:
+    """sq_key(E) -> raw key of the square-IC κ(E) run, e.g. 'sq_grid_E0.175'."""
+    return f"sq_{grid_key(energy)}"
+
+
+def grid_n(study, energy: float) -> int:
+    """grid_n(study, E) -> orbits of the κ(E) run at E: [study].grid_n_by_energy if given, else grid_n."""
+    per = study.param("grid_n_by_energy")
+    if per is None:
+        return int(study.param("grid_n"))
+    grid = [float(e) for e in study.param("grid_energies")]
+    if len(per) != len(grid):
+        raise ValueError(f"[study].grid_n_by_energy has {len(per)} entries, grid_energies {len(grid)}")
+    return int(per[int(np.argmin(np.abs(np.asarray(grid) - energy)))])
 
 
 def cm_key(energy: float) -> str:
@@ -118,13 +140,13 @@ def _lifetimes(path):
     return read_lifetimes(path, columns=LIFETIME_COLUMNS)
 
 
-def _t_max_choice(study, pilot_dir):
+def _t_max_choice(study, pilot_dir, n):
     from hhscatter.analysis.escape_rate import choose_t_max
     from hhscatter.analysis.survival import lifetimes_to_arrays
 
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
     return choose_t_max(
-        t_end, obs, int(study.param("grid_n")),
+        t_end, obs, n,
         min_survivors=float(study.param("min_survivors")),
         margin_efolds=float(study.param("margin_efolds")),
         t_min=float(study.param("t_max_min")),
@@ -163,6 +185,9 @@ def simulate(study, workers=None, progress=True):
 
     choices = {"t_max": {}, "cmeasure": {}}
     grid = [float(e) for e in study.param("grid_energies")]
+    off = [e for e in study.param("square_energies") if not np.isclose(grid, e).any()]
+    if off:
+        raise ValueError(f"[study].square_energies must be among grid_energies; {off} are not")
     missing = [e for e in study.param("cm_energies") if not np.isclose(grid, e).any()]
     if missing:
         raise ValueError(f"[study].cm_energies must be among grid_energies (t_rec comes from their κ); {missing} are not")
@@ -170,10 +195,15 @@ def simulate(study, workers=None, progress=True):
         pilot = study.scene(f"pilot_E{energy:.3f}", energy=energy, n=int(study.param("pilot_n")),
                             seed=int(study.param("pilot_seed")), t_max=float(study.param("pilot_t_max")))
         pdir = study.run(f"pilot_E{energy:.3f}", pilot, workers=workers, progress=progress)
-        choice = _t_max_choice(study, pdir)
+        n = grid_n(study, energy)
+        choice = _t_max_choice(study, pdir, n)
         choices["t_max"][grid_key(energy)] = asdict(choice)
-        scene = study.scene(grid_key(energy), energy=energy, n=int(study.param("grid_n")), t_max=choice.t_max)
+        scene = study.scene(grid_key(energy), energy=energy, n=n, t_max=choice.t_max)
         study.run(grid_key(energy), scene, workers=workers, progress=progress)
+        if any(np.isclose(energy, e) for e in study.param("square_energies")):
+            # the authors' square ICs (goodICs), same n, seed and t_max: KAM-trapped orbits run to t_max
+            sq = study.scene(sq_key(energy), energy=energy, n=n, t_max=choice.t_max, region="square")
+            study.run(sq_key(energy), sq, workers=workers, progress=progress)
     for energy, n in zip(study.param("pt_energies"), study.param("pt_n")):
         scene = study.scene(pt_key(energy), energy=float(energy), n=int(n), seed=int(study.param("pt_seed")),
                             t_max=float(study.param("pt_t_max")))
@@ -446,6 +476,93 @@ def _analyze_cmeasure(study, grid_df):
     return numbers
 
 
+CONVENTIONS = (  # (name, IC region, window rule, label)
+    ("disk_plateau", "disk", "plateau", "paper setup (disk r < 0.5), our plateau windows"),
+    ("disk_plevel", "disk", "plevel", "paper setup (disk r < 0.5), P-level windows"),
+    ("square_plateau", "square", "plateau", "authors' square ICs (goodICs), our plateau windows"),
+    ("square_plevel", "square", "plevel", "authors' square ICs (goodICs), P-level windows"),
+)
+
+
+def _analyze_conventions(study, grid_df):
+    """κ(E) under the 4 conventions of CONVENTIONS, the stable energies and the law per convention.
+
+    Returns (table, stability, numbers). Conventions: IC region (disk, the
+    authors' square) × window rule (our data-driven plateau, windows fixed by
+    P levels); κ is *ill-defined* where the trapped fraction biases the slope
+    at the window end by more than max_plateau_bias (kappa_conventions).
+    """
+    import pandas as pd
+
+    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.kappa_conventions import (
+        escape_rate_p_levels,
+        law_spread,
+        plateau_rate,
+        stable_energies,
+    )
+    from hhscatter.analysis.kappa_energy import fit_kappa_energy
+    from hhscatter.analysis.survival import lifetimes_to_arrays
+
+    E_C = study.model.critical_energy
+    p_hi, p_lo = (float(v) for v in study.param("p_levels"))
+    max_bias = float(study.param("max_plateau_bias"))
+    min_surv = float(study.param("min_survivors"))
+    squares = [float(e) for e in study.param("square_energies")]
+    rows = []
+    for energy in (float(e) for e in study.param("grid_energies")):
+        runs = {"disk": study.raw(grid_key(energy))}
+        if any(np.isclose(energy, e) for e in squares):
+            runs["square"] = study.raw(sq_key(energy))
+        for region, path in runs.items():
+            lt = _lifetimes(path)
+            t_end, obs = lifetimes_to_arrays(lt)
+            res = escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv)
+            rates = {"plateau": plateau_rate(res, t_end, obs, max_bias=max_bias),
+                     "plevel": escape_rate_p_levels(t_end, obs, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)}
+            for rule, r in rates.items():
+                rows.append({"energy": energy, "x": energy - E_C, "convention": f"{region}_{rule}",
+                             "region": region, "windows": rule, "n": int(t_end.size),
+                             "n_escaped_at_start": int(((t_end == 0) & obs).sum()),
+                             "kappa": r.kappa, "kappa_err": r.kappa_err, "kappa_stat": r.kappa_stat,
+                             "kappa_spread": r.kappa_spread, "t_lo": r.t_lo, "t_hi": r.t_hi,
+                             "trapped_fraction": r.trapped_fraction, "bias_at_end": r.bias_at_end,
+                             "defined": bool(r.defined), "reason": r.reason})
+    table = pd.DataFrame(rows)
+    stab = stable_energies(table, rel_tol=float(study.param("stable_rel_tol")))
+    table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
+    study.write_table(table, "kappa_conventions.parquet",
+                      description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
+                                  "defined = False where the trapped plateau makes κ ill-defined")
+    stable = set(stab.loc[stab["stable"], "energy"])
+    fits, fit_info = {}, {}
+    seed, n_boot = int(study.param("fit_seed")), int(study.param("n_boot"))
+    for name, *_ in CONVENTIONS:
+        d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(stable)]
+        fit_info[name] = {"energies": [float(e) for e in d["energy"]]}
+        if len(d) < 5:  # a, b and the break (c = a x_b + b) need points on both sides
+            fit_info[name]["fit"] = None
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            f = fit_kappa_energy(d["energy"], d["kappa"], d["kappa_err"], E_C, continuous=True,
+                                 n_boot=n_boot, rng=seed)
+        fits[name] = f
+        fit_info[name]["fit"] = _fit_json(f)
+    law = law_spread(fits) if fits else {}
+    numbers = {
+        "conventions": {name: label for name, _, _, label in CONVENTIONS},
+        "p_levels": [p_hi, p_lo], "max_plateau_bias": max_bias,
+        "stable_rel_tol": float(study.param("stable_rel_tol")),
+        "stable_energies": sorted(float(e) for e in stable),
+        "unstable_energies": sorted(float(e) for e in stab.loc[~stab["stable"], "energy"]),
+        "ill_defined": [{"energy": r.energy, "convention": r.convention, "reason": r.reason}
+                        for r in table[~table["defined"]].itertuples()],
+        "fits": fit_info, "law": law,
+    }
+    return table, stab, numbers
+
+
 def analyze(study):
     """analyze(study) -> None; derived tables and fig2.json (see the module docstring)."""
     E_C = study.model.critical_energy
@@ -453,12 +570,34 @@ def analyze(study):
     study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
                       description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
     fj, sj = _fit_json(fit), _fit_json(sep)
+    conv_table, _, conv = _analyze_conventions(study, grid_df)
+    units = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
+    law = conv["law"]
     for name in ("a", "b", "c", "E_b"):
+        # "differs" only if it survives the spread of the law across conventions (the authors' square ICs among them)
+        verdict = None
+        if abs(fj[name]["value"] - PAPER[name]) > 2 * fj[name]["err"] and name in law:
+            inside = abs(law[name]["value"] - PAPER[name]) <= 2 * law[name]["err"]
+            verdict = ("differs in this convention only; within the spread across conventions" if inside
+                       else "differs")
         study.compare(f"{name} (κ(E) law, continuous fit)", fj[name]["value"], fj[name]["err"], PAPER[name],
-                      unit={"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)",
-                            "E_b": "energy"}[name],
+                      unit=units[name], verdict=verdict,
                       note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
-                           "err = max(covariance, bootstrap)")
+                           "err = max(covariance, bootstrap); all grid energies")
+    for name in ("a", "b", "c", "E_b"):
+        if name not in law:
+            continue
+        L = law[name]
+        study.compare(f"{name} (κ(E) law across conventions)", L["value"], L["err"], PAPER[name], unit=units[name],
+                      convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
+                      authors=True,
+                      note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
+                           + ", ".join(f"{k} {v:.4g}" for k, v in L["per_convention"].items()))
+    ill = conv_table[~conv_table["defined"]]
+    study.compare("κ(E) points ill-defined by the trapped plateau", int(len(ill)), None, None,
+                  convention="all 4 conventions",
+                  note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
+                  verdict="excluded from the law, not returned as κ ≈ 0")
     for name in ("a", "b", "c", "E_b"):
         study.compare(f"{name} (κ(E) law, separate fits)", sj[name]["value"], sj[name]["err"], PAPER[name],
                       note="the two laws fitted independently on either side of the best partition (as the paper)")
@@ -482,6 +621,7 @@ def analyze(study):
         "kappa_fit_separate": sj,
         "paper": PAPER,
         "kappa_energy": grid_df.to_dict(orient="records"),
+        "kappa_conventions": conv,
         "Pt": pt,
         "cmeasure": cm,
     })
@@ -502,4 +642,6 @@ def plot(study):
         pd.read_parquet(d / "kappa_cmeasure.parquet"),
         study.read_numbers(),
         study.figure_path,
+        conv_table=pd.read_parquet(d / "kappa_conventions.parquet") if (d / "kappa_conventions.parquet").exists()
+        else None,
     )

@@ -1,0 +1,99 @@
+"""κ(E) under several conventions (hhscatter.analysis.kappa_conventions), on synthetic lifetimes with a known κ."""
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.analysis.escape_rate import escape_rate
+from hhscatter.analysis.kappa_conventions import (
+    escape_rate_p_levels,
+    law_spread,
+    p_level_windows,
+    plateau_check,
+    plateau_rate,
+    stable_energies,
+    trapped_fraction,
+)
+
+
+def _lifetimes(kappa, n, f_trapped=0.0, t_max=400.0, seed=0):
+    """Exponential lifetimes (rate κ) and a fraction f_trapped that never escapes (censored at t_max)."""
+    rng = np.random.default_rng(seed)
+    t = rng.exponential(1 / kappa, n)
+    trapped = rng.random(n) < f_trapped
+    t[trapped] = t_max
+    obs = ~trapped & (t < t_max)
+    return np.minimum(t, t_max), obs
+
+
+def test_p_level_windows_of_an_exponential_are_at_its_levels():
+    kappa = 0.2
+    t = np.linspace(0, 60, 60001)
+    w = p_level_windows(t, np.exp(-kappa * t), 0.5, 0.01)
+    assert w[0][0] == pytest.approx(math.log(2) / kappa, abs=2e-3)
+    assert w[0][1] == pytest.approx(math.log(100) / kappa, abs=2e-3)
+    L = w[0][1] - w[0][0]
+    assert w[1] == pytest.approx((w[0][0], w[0][0] + L / 2)) and w[3] == pytest.approx((w[0][0] + L / 4, w[0][0] + 3 * L / 4))
+    assert p_level_windows(t, 0.05 + 0.95 * np.exp(-kappa * t), 0.5, 0.01) is None  # a plateau above p_lo
+    with pytest.raises(ValueError, match="p_lo"):
+        p_level_windows(t, np.exp(-t), 0.01, 0.5)
+
+
+def test_p_level_rate_covers_the_true_kappa():
+    """1σ intervals of 40 independent ensembles cover the true κ about 68 % of the time (binomial ±3σ)."""
+    kappa, hits, n_rep = 0.15, 0, 40
+    for seed in range(n_rep):
+        t, obs = _lifetimes(kappa, 4000, seed=seed)
+        r = escape_rate_p_levels(t, obs, p_hi=0.5, p_lo=0.01)
+        assert r.defined
+        hits += abs(r.kappa - kappa) <= r.kappa_err
+    p = 0.683
+    assert abs(hits - p * n_rep) <= 3 * math.sqrt(n_rep * p * (1 - p)) + 1
+
+
+def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
+    """With 6.5 % never escaping (square ICs at E = 0.18) P never reaches 1 %: no κ; our window rule's κ is
+    flagged when its window ends on the plateau; without trapped orbits both are defined."""
+    kappa = 0.1
+    t, obs = _lifetimes(kappa, 20000, f_trapped=0.065, seed=3)
+    assert trapped_fraction(t, obs) == pytest.approx(0.065, abs=0.005)
+    r = escape_rate_p_levels(t, obs)
+    assert not r.defined and "never falls" in r.reason and math.isnan(r.kappa)
+    res = escape_rate(t, obs, detect_tail=False)
+    pr = plateau_rate(res, t, obs)
+    P_end = float(np.interp(res.t_stop, res.curve.t, res.curve.P))
+    assert pr.defined == (0.065 / P_end <= 0.1)
+    assert pr.bias_at_end == pytest.approx(trapped_fraction(t, obs) / P_end)
+    t0, obs0 = _lifetimes(kappa, 20000, seed=3)
+    assert escape_rate_p_levels(t0, obs0).defined and plateau_rate(escape_rate(t0, obs0, detect_tail=False),
+                                                                     t0, obs0).defined
+
+
+def test_plateau_check_threshold():
+    assert plateau_check(0.1, 0.005)[0] and not plateau_check(0.1, 0.02)[0]
+    assert plateau_check(0.1, 0.02)[1] == pytest.approx(0.2)
+    assert not plateau_check(0.0, 0.0)[0]
+
+
+def test_stable_energies_need_agreement_of_the_defined_conventions():
+    rows = []
+    for e, ks, defined in ((0.2, [0.020, 0.021, 0.030, 0.0], [1, 1, 1, 0]),   # 40 % range: unstable
+                           (0.3, [0.200, 0.205, 0.198, 0.0], [1, 1, 1, 0]),   # 3.5 %: stable (undefined one ignored)
+                           (0.4, [0.3, 0.0, 0.0, 0.0], [1, 0, 0, 0])):        # one convention only: unstable
+        rows += [{"energy": e, "kappa": k, "defined": bool(d)} for k, d in zip(ks, defined)]
+    s = stable_energies(pd.DataFrame(rows), rel_tol=0.1).set_index("energy")
+    assert list(s["stable"]) == [False, True, False]
+    assert s.loc[0.3, "rel_range"] == pytest.approx((0.205 - 0.198) / np.mean([0.2, 0.205, 0.198]))
+    assert list(s["n_defined"]) == [3, 3, 1]
+
+
+def test_law_spread_is_half_the_range_across_conventions():
+    def fit(a, err):
+        return SimpleNamespace(a=a, b=0.1, c=1.4, E_b=0.27, a_err=err, b_err=0.01, c_err=0.02, E_b_err=0.005)
+
+    out = law_spread({"one": fit(10.0, 1.0), "two": fit(14.0, 2.0)})
+    assert out["a"]["value"] == 12.0 and out["a"]["spread"] == 2.0 and out["a"]["err_stat"] == 2.0
+    assert out["a"]["err"] == pytest.approx(math.hypot(2.0, 2.0))
+    assert out["c"]["spread"] == 0.0 and out["a"]["per_convention"] == {"one": 10.0, "two": 14.0}
