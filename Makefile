@@ -91,11 +91,17 @@ studies: $(STUDY_NAMES) ## all studies at SCALE (default quick), each after the 
 
 BENCH_SUMMARY := studies/bench/out/full/summary.md
 STRESS_SUMMARY := studies/stress/out/full/summary.md
+# quick: the report runs what is missing; any other scale (paper): it is built from the committed results in
+# docs/studies/assets/<scale>/ (make docs-assets SCALE=paper copies them there) and never starts a simulation
+ifeq ($(SCALE),quick)
 REPORT_INPUTS := $(foreach s,$(STUDY_NAMES),$(call so,$(s))/$(s).png) $(BENCH_SUMMARY) $(STRESS_SUMMARY)
-reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py
+else
+REPORT_INPUTS := $(wildcard docs/studies/assets/$(SCALE)/*.json)
+endif
+reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py $(STAMP)
 	$(PY) -m hhscatter.report --scale $(SCALE)
 
-report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown) from the study outputs, running what is missing
+report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown): quick runs what is missing; SCALE=paper reads the committed results
 
 bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → studies/engine/out/full/
 	$(PY) -m hhscatter.bench_engine $(ENGINE_ARGS)
@@ -136,8 +142,8 @@ docs: $(DOCS_STAMP) ## build the documentation site into site/ (mkdocs --strict:
 docs-serve: $(DOCS_STAMP) ## serve the docs with live reload at http://127.0.0.1:8000
 	$(MKDOCS) serve --strict
 
-docs-assets: ## copy the studies' quick-scale figures/numbers and bench summaries into docs/
-	$(PYTHON) docs/gen_studies.py
+docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with the bench summaries) into docs/
+	$(PYTHON) docs/gen_studies.py --scale $(SCALE)
 
 .PHONY: docs docs-serve docs-assets
 

@@ -3,8 +3,11 @@
     python docs/gen_studies.py [--scale quick] [--check]
 
 For each study folder (``studies/<name>/study.toml``) it copies
-``studies/<name>/out/<scale>/<name>.png`` and ``<name>.json`` to
-``docs/studies/assets/``; for the benchmarks and stress tests, the markdown
+``studies/<name>/out/<scale>/<name>.png``, ``<name>.json`` and the stage
+costs ``cost.json`` (as ``<name>.cost.json``) to ``docs/studies/assets/``
+(quick scale) or ``docs/studies/assets/<scale>/`` (any other scale, e.g.
+``paper``: the committed paper-scale results the docs and
+``make report SCALE=paper`` read); for the benchmarks and stress tests, the markdown
 summaries, PNG figures and small CSV files of ``studies/bench/out/<s>/`` and
 ``studies/stress/out/<s>/`` (``<s>`` = ``--bench-scale``, default ``full``,
 else ``quick``) to ``docs/benchmarks/assets/<bench|stress>/``.
@@ -55,17 +58,26 @@ def _bench_dir(base: Path, bench_scale):
     return None
 
 
-def plan(scale: str, bench_scale=None):
+def assets_dir(scale: str) -> Path:
+    """assets_dir(scale) -> docs/studies/assets (quick) or docs/studies/assets/<scale>."""
+    base = DOCS / "studies" / "assets"
+    return base if scale == "quick" else base / scale
+
+
+def plan(scale: str, bench_scale=None, studies_only: bool = False):
     """plan(scale, bench_scale=None) -> (pairs [(src, dst)], missing [str]) of the files to copy."""
     pairs, missing = [], []
+    dst = assets_dir(scale)
     for name in study_names(ROOT):
         out = ROOT / "studies" / name / "out" / scale
-        for ext in ("png", "json"):
-            src = out / f"{name}.{ext}"
+        for src, target in ((out / f"{name}.png", f"{name}.png"), (out / f"{name}.json", f"{name}.json"),
+                            (out / "cost.json", f"{name}.cost.json")):
             if src.exists():
-                pairs.append((src, DOCS / "studies" / "assets" / f"{name}.{ext}"))
-            else:
+                pairs.append((src, dst / target))
+            elif src.name != "cost.json":
                 missing.append(str(src.relative_to(ROOT)))
+    if studies_only or scale != "quick":  # the benchmarks have scales of their own (full, quick)
+        return pairs, missing
     for which in BENCHES:
         base = ROOT / "studies" / which / "out"
         out = _bench_dir(base, bench_scale)
@@ -88,9 +100,10 @@ def main(argv=None) -> int:
     ap.add_argument("--scale", default="quick", help="study scale whose outputs to copy (default: quick)")
     ap.add_argument("--bench-scale", help="scale folder of studies/bench|stress/out to copy (default: full, else quick)")
     ap.add_argument("--check", action="store_true", help="copy nothing; exit 1 if an asset is stale")
+    ap.add_argument("--studies-only", action="store_true", help="copy the studies' outputs, not the benchmarks'")
     a = ap.parse_args(argv)
 
-    pairs, missing = plan(a.scale, a.bench_scale)
+    pairs, missing = plan(a.scale, a.bench_scale, studies_only=a.studies_only)
     stale = [(s, d) for s, d in pairs if not (d.exists() and filecmp.cmp(s, d, shallow=False))]
     if a.check:
         for s, d in stale:

@@ -38,6 +38,7 @@ class Section:
     figure: Path | None
     numbers: dict | None
     paper: str = ""  # the paper's figure this study reproduces ("" for a study beyond the paper)
+    cost: dict | None = None  # the stage costs (hhscatter.studies.cost), if recorded
 
 
 def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
@@ -61,19 +62,41 @@ def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
     return rows
 
 
+def committed_assets(root: Path, scale: str) -> Path:
+    """committed_assets(studies root, scale) -> the docs folder of the committed study outputs at ``scale``
+    (``docs/studies/assets`` for quick, ``docs/studies/assets/<scale>`` otherwise; docs/gen_studies.py)."""
+    base = Path(root).parent / "docs" / "studies" / "assets"
+    return base if scale == "quick" else base / scale
+
+
+def _study_files(root: Path, name: str, scale: str):
+    """(figure, numbers, cost) paths of a study: its out/<scale>/ if it made them here, else the committed copies."""
+    out = root / name / "out" / scale
+    assets = committed_assets(root, scale)
+    pick = []
+    for here, there in ((out / f"{name}.png", assets / f"{name}.png"), (out / f"{name}.json", assets / f"{name}.json"),
+                        (out / "cost.json", assets / f"{name}.cost.json")):
+        pick.append(here if here.exists() else there if there.exists() else None)
+    return tuple(pick)
+
+
 def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
     """collect(scale, root=None) -> [Section], one per study folder of ``root`` (in dependency order).
 
     Titles and captions come from each study's ``[about]`` table; a study
-    with ``paper = ""`` goes to the part beyond the paper.
+    with ``paper = ""`` goes to the part beyond the paper. A study's outputs
+    are read from ``studies/<name>/out/<scale>/`` when it made them on this
+    machine, else from the committed copies in the docs (:func:`committed_assets`),
+    so a report of the committed paper-scale results needs no simulation.
     """
     root = Path(root) if root is not None else studies_root()
     sections = []
     for info in study_folders(root):
-        out = root / info.name / "out" / scale
-        fig, nums = out / f"{info.name}.png", out / f"{info.name}.json"
-        sections.append(Section(info.name, info.title, info.summary, fig if fig.exists() else None,
-                                json.loads(nums.read_text()) if nums.exists() else None, info.paper))
+        fig, nums, cost = _study_files(root, info.name, scale)
+        sec = Section(info.name, info.title, info.summary, fig,
+                      json.loads(nums.read_text()) if nums else None, info.paper)
+        sec.cost = json.loads(cost.read_text()) if cost else None
+        sections.append(sec)
     return sections
 
 
@@ -112,10 +135,48 @@ BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
 
 
 def _bench(root: Path, name: str = "bench"):
-    """_bench(root, name) -> (summary.md or None, [png]) of the full-scale benchmark/stress output."""
-    out = root / name / "out" / "full"
-    md = out / "summary.md"
-    return (md if md.exists() else None), (sorted(out.glob("*.png")) if out.exists() else [])
+    """_bench(root, name) -> (summary.md or None, [png]) of the full-scale benchmark/stress output (else the
+    copy committed in docs/benchmarks/assets/<name>/)."""
+    for out in (root / name / "out" / "full", root.parent / "docs" / "benchmarks" / "assets" / name):
+        md = out / "summary.md"
+        if md.exists():
+            return md, sorted(out.glob("*.png"))
+    return None, []
+
+
+def cost_rows(sections) -> list[dict]:
+    """cost_rows(sections) -> one row per study with a cost record: wall and CPU hours, orbits, peak RSS (MB)."""
+    from .studies.cost import totals
+
+    rows = []
+    for s in sections:
+        if not s.cost:
+            continue
+        t = totals(s.cost)
+        sim = t.get("simulate", {})
+        rows.append({
+            "study": s.key,
+            "wall_h": sum(v["wall_s"] for v in t.values()) / 3600,
+            "cpu_h": sum(v["cpu_s"] for v in t.values()) / 3600,
+            "simulate_cpu_h": sim.get("cpu_s", 0.0) / 3600,
+            "orbits": sim.get("orbits", 0),
+            "rss_mb": max(max(v["rss_self_mb"], v["rss_children_mb"]) for v in t.values()),
+        })
+    return rows
+
+
+def cost_table(rows) -> str:
+    """cost_table(rows of :func:`cost_rows`) -> Markdown table with a total row."""
+    out = ["| study | wall (h) | CPU (h) | of which simulate (h) | orbits integrated | peak RSS per process (MB) |",
+           "|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['study']} | {r['wall_h']:.2f} | {r['cpu_h']:.2f} | {r['simulate_cpu_h']:.2f} | "
+                   f"{r['orbits']:.3g} | {r['rss_mb']:.0f} |")
+    if rows:
+        out.append(f"| **total** | **{sum(r['wall_h'] for r in rows):.2f}** | **{sum(r['cpu_h'] for r in rows):.2f}** |"
+                   f" {sum(r['simulate_cpu_h'] for r in rows):.2f} | {sum(r['orbits'] for r in rows):.3g} | "
+                   f"{max(r['rss_mb'] for r in rows):.0f} |")
+    return "\n".join(out) + "\n"
 
 
 def split_rows(rows, sections):
@@ -169,6 +230,12 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
              _rows_table(paper_rows, html_verdicts), "",
              "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
              _rows_table(beyond_rows, html_verdicts)]
+    costs = cost_rows(sections)
+    if costs:
+        lines += ["", f"## What it cost ({scale} scale)", "",
+                  "Measured by the study stages (`studies/<name>/out/<scale>/cost.json`): wall and CPU time of "
+                  "simulate + analyze + plot (CPU includes the worker processes), orbits integrated, and the peak "
+                  "resident memory of one process.", "", cost_table(costs)]
     for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
         lines += ["", f"## {group}", ""]
         for s in (s for s in sections if bool(s.paper) == of_paper):

@@ -210,6 +210,21 @@ def test_gen_studies_copies_what_exists_and_reports_the_rest(tmp_path, gen, monk
     assert gen.main(["--check"]) == 1
 
 
+def test_gen_studies_puts_another_scale_in_its_own_folder_with_the_costs(tmp_path, gen, monkeypatch):
+    monkeypatch.setattr(gen, "ROOT", tmp_path)
+    monkeypatch.setattr(gen, "DOCS", tmp_path / "docs")
+    out = tmp_path / "studies" / "fig3" / "out" / "paper"
+    out.mkdir(parents=True)
+    for name, text in (("fig3.png", "png"), ("fig3.json", "{}"), ("cost.json", '{"simulate": []}')):
+        (out / name).write_text(text)
+    (out.parents[1] / "study.toml").write_text("[scene]\nn = 1\n")
+    assert gen.main(["--scale", "paper"]) == 0
+    paper = tmp_path / "docs" / "studies" / "assets" / "paper"
+    assert sorted(p.name for p in paper.iterdir()) == ["fig3.cost.json", "fig3.json", "fig3.png"]
+    assert not (tmp_path / "docs" / "benchmarks").exists()  # the benchmarks have scales of their own
+    assert not any(p.is_file() for p in (tmp_path / "docs" / "studies" / "assets").iterdir())
+
+
 # -- mkdocs.yml against the pages and the package -------------------------------------
 def test_nav_pages_and_api_modules_exist():
     yaml = pytest.importorskip("yaml")

@@ -82,8 +82,9 @@ class Renderer:
     def missing(what: str, how: str) -> str:
         return f'!!! warning "Not yet generated"\n    {what} is not in the docs yet. {how}\n'
 
-    def study_asset(self, name: str, ext: str) -> Path:
-        return self.docs / "studies" / "assets" / f"{name}.{ext}"
+    def study_asset(self, name: str, ext: str, scale: str = "quick") -> Path:
+        base = self.docs / "studies" / "assets"
+        return (base if scale == "quick" else base / scale) / f"{name}.{ext}"
 
     def study_params(self, name: str) -> str:
         toml = self.root / "studies" / name / "study.toml"
@@ -104,18 +105,30 @@ class Renderer:
 
     def study_figure(self, name: str) -> str:
         png = self.study_asset(name, "png")
-        if not png.exists():
+        paper = self.study_asset(name, "png", "paper")
+        if not png.exists() and not paper.exists():
             return self.missing(
                 f"The figure `{name}.png`",
                 f"Run `make {name}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
-        scale = self._scale_of(name)
-        cap = f"`make {name}`" + (f" at scale *{scale}*" if scale else "")
-        src = self._rel(png)
-        return f"[![{name}: figure made by {cap}]({src})]({src})\n\n*Figure made by {cap} (click for full size).*\n"
+        if not paper.exists():
+            scale = self._scale_of(name)
+            cap = f"`make {name}`" + (f" at scale *{scale}*" if scale else "")
+            src = self._rel(png)
+            return f"[![{name}: figure made by {cap}]({src})]({src})\n\n*Figure made by {cap} (click for full size).*\n"
+        # both scales, side by side (click for full size)
+        cells = []
+        for path, scale in ((png, "quick"), (paper, "paper")):
+            if not path.exists():
+                continue
+            src = self._rel(path)
+            cells.append(f'<figure markdown="span">\n[![{name} at scale {scale}]({src})]({src})\n'
+                         f"<figcaption><code>make {name} SCALE={scale}</code></figcaption>\n</figure>")
+        return ('<div class="hh-scales" markdown>\n' + "\n".join(cells) + "\n</div>\n\n"
+                "*Left: quick scale; right: the paper's scale (click for full size).*\n")
 
-    def _numbers(self, name: str):
-        path = self.study_asset(name, "json")
+    def _numbers(self, name: str, scale: str = "quick"):
+        path = self.study_asset(name, "json", scale)
         if not path.exists():
             return None
         return json.loads(path.read_text())
@@ -123,6 +136,29 @@ class Renderer:
     def _scale_of(self, name: str):
         doc = self._numbers(name)
         return doc.get("scale") if doc else None
+
+    def _both_scales(self, quick_rows, paper_rows) -> str:
+        """The paper-vs-ours rows at both scales in one table, matched by quantity."""
+        from hhscatter.formatting import format_value, format_value_err
+
+        def ours(r):
+            if r is None:
+                return "—"
+            unit = f" {r['unit']}" if r.get("unit") else ""
+            v = r.get("ours")
+            return (format_value_err(v, r.get("err")) if _is_num(v) else format_value(v)) + unit
+
+        q = {r["quantity"]: r for r in quick_rows}
+        order = [r["quantity"] for r in paper_rows] + [k for k in q if k not in {r["quantity"] for r in paper_rows}]
+        p = {r["quantity"]: r for r in paper_rows}
+        out = ["| quantity | ours, quick | ours, paper scale | convention (ours) | paper | verdict (paper scale) |",
+               "|---|---|---|---|---|---|"]
+        for k in order:
+            a, b = q.get(k), p.get(k)
+            r = b or a
+            out.append(f"| {_cell(k)} | {_cell(ours(a))} | {_cell(ours(b))} | {_cell(r.get('convention') or '—')} | "
+                       f"{_cell(format_value(r.get('paper')))} | {_cell((b or {}).get('verdict') or '—')} |")
+        return "\n".join(out) + "\n"
 
     def study_numbers(self, name: str) -> str:
         doc = self._numbers(name)
@@ -133,6 +169,14 @@ class Renderer:
             )
         out = []
         rows = doc.get("paper_comparison") or []
+        paper_doc = self._numbers(name, "paper")
+        if paper_doc is not None:
+            out.append("Against the paper, at both scales (± is 1σ of our estimate; the paper gives no "
+                       "uncertainties; the verdict is the paper-scale one):\n")
+            out.append(self._both_scales(rows, paper_doc.get("paper_comparison") or []))
+            link = self._rel(self.study_asset(name, "json", "paper"))
+            out.append(f"*The full paper-scale record, with its configuration: [{name}.json (paper)]({link}).*\n")
+            out.append("Quick scale in detail:\n")
         if rows:
             out.append("Against the paper (± is 1σ of our estimate; the paper gives no uncertainties):\n")
             out.append(comparison_table(rows))
@@ -221,6 +265,77 @@ class Renderer:
             if f"]({self._rel(png)})" not in text:
                 text += f"\n\n![{png.stem}]({self._rel(png)})\n\n*{png.name}*\n"
         return text
+
+    def _costs(self, scale: str) -> dict:
+        from hhscatter.studies.cost import totals
+        from hhscatter.studies.graph import studies
+
+        out = {}
+        for st in studies(self.root / "studies"):
+            path = self.study_asset(st.name, "cost.json", scale)
+            if path.exists():
+                out[st.name] = totals(json.loads(path.read_text()))
+        return out
+
+    def cost_table(self, _arg=None) -> str:
+        """Per study, quick and paper scale: CPU hours, wall hours, orbits, peak RSS, and the ratios."""
+        quick, paper = self._costs("quick"), self._costs("paper")
+        names = [n for n in paper] + [n for n in quick if n not in paper]
+        if not names:
+            return self.missing("The cost records", "Run the studies, then `make docs-assets` (SCALE=quick, paper).")
+
+        def agg(t):
+            if not t:
+                return None
+            return {"cpu": sum(v["cpu_s"] for v in t.values()) / 3600, "wall": sum(v["wall_s"] for v in t.values()) / 3600,
+                    "orbits": t.get("simulate", {}).get("orbits", 0),
+                    "rss": max(max(v["rss_self_mb"], v["rss_children_mb"]) for v in t.values()),
+                    "analysis": sum(v["cpu_s"] for k, v in t.items() if k != "simulate") / 3600}
+
+        def f(x, fmt):
+            return "—" if x is None else format(x, fmt)
+
+        out = ["| study | CPU h (quick → paper) | wall h (quick → paper) | orbits (quick → paper) | ratio of orbits | "
+               "ratio of CPU | analysis + plot CPU h (paper) | peak RSS MB (quick → paper) |", "|---|---|---|---|---|---|---|---|"]
+        tot = {"q": 0.0, "p": 0.0, "qw": 0.0, "pw": 0.0}
+        for n in names:
+            q, p = agg(quick.get(n)), agg(paper.get(n))
+            ro = p["orbits"] / q["orbits"] if p and q and q["orbits"] else None
+            rc = p["cpu"] / q["cpu"] if p and q and q["cpu"] else None
+            out.append(f"| [{n}]({n}.md) | {f(q and q['cpu'], '.3f')} → {f(p and p['cpu'], '.2f')} | "
+                       f"{f(q and q['wall'], '.3f')} → {f(p and p['wall'], '.2f')} | {f(q and q['orbits'], '.3g')} → "
+                       f"{f(p and p['orbits'], '.3g')} | {f(ro, '.0f')} | {f(rc, '.0f')} | {f(p and p['analysis'], '.3f')} | "
+                       f"{f(q and q['rss'], '.0f')} → {f(p and p['rss'], '.0f')} |")
+            tot["q"] += q["cpu"] if q else 0.0
+            tot["p"] += p["cpu"] if p else 0.0
+            tot["qw"] += q["wall"] if q else 0.0
+            tot["pw"] += p["wall"] if p else 0.0
+        out.append(f"| **total** | **{tot['q']:.2f} → {tot['p']:.2f}** | {tot['qw']:.2f} → {tot['pw']:.2f} | | | | | |")
+        return "\n".join(out) + "\n"
+
+    def scale_changes(self, _arg=None) -> str:
+        """Every paper-vs-ours number that moved between quick and paper scale by more than its quick-scale error."""
+        from hhscatter.studies.graph import studies
+
+        out = ["| study | quantity | quick | paper scale | change / σ_quick |", "|---|---|---|---|---|"]
+        n = 0
+        for st in studies(self.root / "studies"):
+            q, p = self._numbers(st.name), self._numbers(st.name, "paper")
+            if not q or not p:
+                continue
+            qr = {r["quantity"]: r for r in q.get("paper_comparison") or []}
+            for r in p.get("paper_comparison") or []:
+                a = qr.get(r["quantity"])
+                if not a or not (_is_num(a.get("ours")) and _is_num(r.get("ours")) and _is_num(a.get("err"))):
+                    continue
+                if not a["err"] or abs(r["ours"] - a["ours"]) <= a["err"]:
+                    continue
+                n += 1
+                out.append(f"| [{st.name}]({st.name}.md) | {_cell(r['quantity'])} | {fmt_err(a['ours'], a['err'])} | "
+                           f"{fmt_err(r['ours'], r.get('err'))} | {(r['ours'] - a['ours']) / a['err']:+.1f} |")
+        if n == 0:
+            return "*No paper-scale number differs from its quick-scale value by more than the quick-scale error.*\n"
+        return "\n".join(out) + "\n"
 
     def cli(self, _arg=None) -> str:
         from hhscatter.cli import build_parser
