@@ -31,11 +31,12 @@ def test_record_adds_resumed_invocations_and_a_fresh_run_replaces_them(tmp_path)
     b = StageCost("simulate", wall_s=5, cpu_s=9, orbits=50, chunks_resumed=2, rss_self_mb=250, rss_children_mb=100)
     record(tmp_path, a)
     record(tmp_path, b)
-    record(tmp_path, StageCost("analyze", wall_s=3, cpu_s=3))
+    record(tmp_path, StageCost("analyze", wall_s=4, cpu_s=4))
+    record(tmp_path, StageCost("analyze", wall_s=3, cpu_s=3))  # analyze starts over: the last one counts
     t = totals(json.loads((tmp_path / "cost.json").read_text()))
     assert t["simulate"] == {"wall_s": 15, "cpu_s": 27, "orbits": 150, "rss_self_mb": 250,
                              "rss_children_mb": 300, "invocations": 2}
-    assert t["analyze"]["invocations"] == 1
+    assert t["analyze"]["invocations"] == 1 and t["analyze"]["cpu_s"] == 3
     record(tmp_path, StageCost("simulate", wall_s=1, cpu_s=2, orbits=7))  # a fresh run: nothing resumed
     t = totals(json.loads((tmp_path / "cost.json").read_text()))
     assert t["simulate"]["orbits"] == 7 and t["simulate"]["invocations"] == 1

@@ -77,9 +77,10 @@ def record(out: Path, cost: StageCost) -> Path:
 
     path = Path(out) / COST_FILE
     doc = json.loads(path.read_text()) if path.exists() else {}
-    if cost.stage == "simulate" and cost.chunks_resumed == 0 and cost.orbits > 0:
-        # a fresh simulation (nothing resumed): earlier invocations measured other runs
-        doc.pop("simulate", None)
+    if cost.stage != "simulate" or (cost.chunks_resumed == 0 and cost.orbits > 0):
+        # analyze and plot start over each time; a simulation that resumed nothing is fresh: either way the
+        # earlier invocations measured work that is no longer part of the outputs
+        doc.pop(cost.stage, None)
     doc.setdefault(cost.stage, []).append(asdict(cost))
     write_json_atomic(path, doc)
     return path
