@@ -249,6 +249,29 @@ def test_survival_fit_with_free_tau2():
     assert free.chi2_red < 1.5 < fixed.chi2_red
 
 
+@pytest.mark.parametrize("hazard", ["paper", "integrated"])
+def test_better_fit_names_the_constants_that_made_the_data(hazard):
+    """Data made with one (κ0, μ); the same model fitted with those and with other constants (our quick-scale
+    fig2/fig3 values): the generating constants have the smaller RMS log residual, whatever the dict order."""
+    t = np.arange(0.0, 301.0)
+    P, P_err = binomial_sample(model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS,
+                               np.random.default_rng(21))
+    other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709)
+    common = {"P_min": 20 / N_ORBITS, "hazard": hazard}
+    right = model.fit_survival_model(t, P, P_err, **KW, **common)
+    wrong = model.fit_survival_model(t, P, P_err, **dict(KW, kappa_of_E=other, mu=0.939), **common)
+    assert right.rms_log_residual < wrong.rms_log_residual  # the premise, computed here independently
+    assert model.better_fit({"generating": right, "other": wrong}) == "generating"
+    assert model.better_fit({"other": wrong, "generating": right}) == "generating"
+    assert model.better_fit({"a": right, "b": right}) is None  # a tie names neither
+    shorter = model.fit_survival_model(t, P, P_err, **KW, **common, t_max=100.0)
+    assert shorter.n_points < right.n_points
+    with pytest.raises(ValueError, match="other points"):
+        model.better_fit({"generating": right, "shorter": shorter})
+    with pytest.raises(ValueError, match="at least two"):
+        model.better_fit({"generating": right})
+
+
 def test_predict_tau1_solves_eq_tau1():
     params = model.SurvivalModelParams(model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2)
     k0 = float(model.PAPER_KAPPA(E0))

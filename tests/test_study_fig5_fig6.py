@@ -232,3 +232,124 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
     run_stage("fig5", "analyze", "tiny", root=tiny_studies)
     again = json.loads(study.numbers_path.read_text())["authors_convention"]
     assert again == auth
+
+
+# ---------------------------------------------------------------------------
+# fig6: the survival model with the paper's own constants beside ours
+# ---------------------------------------------------------------------------
+def test_fig6_paper_constant_kappa_law_is_the_fig2b_caption():
+    """κ0(E) built from study.toml's paper_* keys against the caption of the paper's Fig. 2b, by hand:
+    13.63 x² + 0.03 x below E = 0.27 and 1.41 x from there on, x = E − 1/6; no escape at or below E_c."""
+    from hhscatter.studies import load_study, stage_module
+
+    mod = stage_module("fig6")
+    for scale in ("tiny", "quick", "paper"):
+        study = load_study("fig6", scale)
+        pc = mod.paper_constants(study)
+        assert pc["mu"] == 0.91
+        kappa = mod.kappa_law(pc, study.model.critical_energy)
+        E = np.array([0.1, 1 / 6, 0.2, 0.25, 0.2699, 0.27, 0.3, 0.35, 0.4])
+        x = E - 1 / 6
+        by_hand = [0.0, 0.0,
+                   13.63 * x[2] ** 2 + 0.03 * x[2], 13.63 * x[3] ** 2 + 0.03 * x[3], 13.63 * x[4] ** 2 + 0.03 * x[4],
+                   1.41 * x[5], 1.41 * x[6], 1.41 * x[7], 1.41 * x[8]]
+        np.testing.assert_allclose(kappa(E), by_hand, rtol=1e-12, atol=1e-15)
+        # e.g. κ0(0.3) = 1.41 · 2/15 = 0.188 and κ0(0.25) = 13.63/144 + 0.0025
+        assert float(kappa(0.3)) == pytest.approx(0.188, rel=1e-12)
+        assert float(kappa(0.25)) == pytest.approx(13.63 / 144 + 0.0025, rel=1e-12)
+
+
+def _fig6_pc(nums):
+    """The rows made with the paper's constants: the JSON key and the comparison rows marked authors=True."""
+    return nums["paper_constants"], [r for r in nums["paper_comparison"] if r["authors"]]
+
+
+def test_fig6_paper_constant_rows_recompute_deterministically(tiny_studies):
+    from hhscatter.studies import load_study, run_stage
+
+    study = load_study("fig6", "tiny", root=tiny_studies)
+    nums = json.loads(study.numbers_path.read_text())
+    pc, rows = _fig6_pc(nums)
+    assert {k: pc["constants"][k] for k in ("a", "b", "c", "E_b", "mu")} == \
+        {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "mu": 0.91}
+    ours = pd.DataFrame(nums["fits"])
+    ours = ours[ours["model"] == "homogeneous"].set_index(["pair", "hazard"])
+    assert sorted((v["pair"], v["hazard"]) for v in pc["fits"]) == sorted(ours.index)  # every pair and hazard
+    for v in pc["fits"]:
+        # Eq. (eq:tau2) with μ = 0.91, by hand
+        assert v["tau2_predicted"] == pytest.approx(math.log(v["E0"] / E_C) / (0.91 * v["gamma"]), rel=1e-12)
+        mine = ours.loc[(v["pair"], v["hazard"])]
+        # same fitted points as our constants' fit, and "better" is the smaller of the two residuals
+        assert v["n_points"] == mine["n_points"] and v["rms_log_residual_ours"] == mine["rms_log_residual"]
+        want = ("ours" if v["rms_log_residual_ours"] < v["rms_log_residual"] else
+                "paper_constants" if v["rms_log_residual"] < v["rms_log_residual_ours"] else "tie")
+        assert v["better"] == want
+    assert rows and all(r["convention"].startswith("authors': paper's constants (a, b, c, E_b, μ) = "
+                                                   "(13.63, 0.03, 1.41, 0.27, 0.91)")
+                        or r["convention"].startswith("authors': paper's μ = 0.91") for r in rows)
+    assert not any(str(r["verdict"]).startswith("differ") for r in rows)
+    # the curves of panel (a): one per hazard with the paper's constants, beside ours
+    curves = pd.read_parquet(study.out / "derived" / "curves.parquet")
+    assert {"paper_constants_paper", "paper_constants_integrated"} <= set(curves.columns)
+    run_stage("fig6", "analyze", "tiny", root=tiny_studies)
+    again = json.loads(study.numbers_path.read_text())
+    assert _fig6_pc(again) == (pc, rows)
+
+
+def test_fig6_changing_a_paper_constant_changes_only_its_rows(tiny_studies, tmp_path):
+    from hhscatter.studies import load_study, run_stage
+
+    for name in ("fig2", "fig3", "fig4", "fig6"):
+        shutil.copytree(tiny_studies / name, tmp_path / name)
+    before = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
+    toml = tmp_path / "fig6" / "study.toml"
+    text = toml.read_text()
+    assert text.count("paper_mu = 0.91\n") == 1 and text.count("paper_kappa_a = 13.63\n") == 1
+    toml.write_text(text.replace("paper_mu = 0.91\n", "paper_mu = 0.8\n")
+                    .replace("paper_kappa_a = 13.63\n", "paper_kappa_a = 20.0\n"))
+    run_stage("fig6", "analyze", "tiny", root=tmp_path)
+    after = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
+    pc0, rows0 = _fig6_pc(before)
+    pc1, rows1 = _fig6_pc(after)
+    assert pc1["constants"]["mu"] == 0.8 and pc1["constants"]["a"] == 20.0
+    assert len(pc1["fits"]) == len(pc0["fits"]) > 0
+    for v, v0 in zip(pc1["fits"], pc0["fits"]):
+        assert (v["pair"], v["hazard"]) == (v0["pair"], v0["hazard"])
+        assert v["tau2_predicted"] == pytest.approx(math.log(v["E0"] / E_C) / (0.8 * v["gamma"]), rel=1e-12)
+        assert v["rms_log_residual"] != v0["rms_log_residual"]
+        assert v["rms_log_residual_ours"] == v0["rms_log_residual_ours"]
+    assert [r["ours"] for r in rows1] != [r["ours"] for r in rows0]
+    assert all("0.8" in r["convention"] for r in rows1) and not any("0.91" in r["convention"] for r in rows1)
+    # the rows with our constants are not touched
+    for key in ("fits", "tau_vs_gamma", "kappa0", "mu", "compare_fits"):
+        assert after[key] == before[key], key
+
+
+def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_path):
+    """The two arms differ by the constants alone: with the paper_* keys set to our fitted κ0(E) and μ (fig2, fig3
+    at tiny scale), each fit with "the paper's constants" is our fit (same points, starts and free parameters), a tie."""
+    from hhscatter.studies import load_study, run_stage
+
+    for name in ("fig2", "fig3", "fig4", "fig6"):
+        shutil.copytree(tiny_studies / name, tmp_path / name)
+    k = _numbers(tmp_path, "fig2")["kappa_fit"]
+    mine = {"paper_kappa_a": k["a"]["value"], "paper_kappa_b": k["b"]["value"], "paper_kappa_c": k["c"]["value"],
+            "paper_kappa_Eb": k["E_b"]["value"], "paper_mu": _numbers(tmp_path, "fig3")["mu"]["value"]}
+    toml = tmp_path / "fig6" / "study.toml"
+    text = toml.read_text()
+    for key, paper in (("paper_kappa_a", "13.63"), ("paper_kappa_b", "0.03"), ("paper_kappa_c", "1.41"),
+                       ("paper_kappa_Eb", "0.27"), ("paper_mu", "0.91")):
+        assert text.count(f"\n{key} = {paper}\n") == 1, key
+        text = text.replace(f"\n{key} = {paper}\n", f"\n{key} = {mine[key]!r}\n")
+    toml.write_text(text)
+    run_stage("fig6", "analyze", "tiny", root=tmp_path)
+    nums = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
+    pc = nums["paper_constants"]
+    assert pc["constants"]["mu"] == mine["paper_mu"] == nums["mu"]["value"]
+    assert pc["fits"]
+    for v in pc["fits"]:
+        assert v["tau2_predicted"] == v["tau2_predicted_ours"]
+        assert v["rms_log_residual"] == v["rms_log_residual_ours"] and v["better"] == "tie"
+    curves = pd.read_parquet(tmp_path / "fig6" / "out" / "tiny" / "derived" / "curves.parquet")
+    for h in ("paper", "integrated"):
+        np.testing.assert_array_equal(curves[f"paper_constants_{h}"], curves[f"homogeneous_{h}"])

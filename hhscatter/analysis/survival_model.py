@@ -52,6 +52,7 @@ __all__ = [
     "HomogeneousProblem",
     "SurvivalFit",
     "SurvivalModelParams",
+    "better_fit",
     "compare_fits",
     "fit_survival_model",
     "homogeneous_start",
@@ -741,3 +742,30 @@ def compare_fits(fits: dict) -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows).set_index("model")
+
+
+def better_fit(fits: dict) -> str | None:
+    """better_fit({name: SurvivalFit, ...}) -> name of the fit with the smallest RMS log residual (None on a tie).
+
+    For the same model, Eq. (eqn:surv_prob_model), fitted with different
+    fixed inputs (e.g. the κ0(E) law and μ fitted by us or stated by the
+    paper): the RMS of ln P_model − ln P (dimensionless) says which inputs
+    reproduce the simulated P(t) better.  The RMS rather than χ² because the
+    Kaplan–Meier points are correlated and χ² is only indicative (see
+    :class:`SurvivalFit`); both fits have the same free parameters here.
+    The fits must share their fitted points (same ``t_fit``), else the
+    comparison means nothing: ValueError.
+    """
+    if len(fits) < 2:
+        raise ValueError("better_fit needs at least two fits")
+    items = list(fits.items())
+    t_ref = np.asarray(items[0][1].t_fit)
+    for name, f in items[1:]:
+        if not np.array_equal(np.asarray(f.t_fit), t_ref):
+            raise ValueError(f"fit {name!r} was made on other points than {items[0][0]!r}; "
+                             "compare fits on the same data selection only")
+    rms = np.array([f.rms_log_residual for _, f in items], dtype=float)
+    if not np.isfinite(rms).all():
+        raise ValueError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
+    best = np.flatnonzero(rms == rms.min())
+    return None if best.size > 1 else items[int(best[0])][0]

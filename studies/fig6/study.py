@@ -28,6 +28,14 @@ analyze    inputs (the studies of ``[needs]``, their published outputs only):
            For fig4's γ values: the homogeneous fit and the model's τ1
            (:func:`hhscatter.analysis.survival_model.predict_tau1` against fig4's γ = 0
            curve), τ2 = ln(E0/E_c)/(μγ).  Writes derived tables and fig6.json.
+
+           The paper's own constants beside ours (``[study] paper_*``: κ0(E) of
+           the Fig. 2b caption, μ = 0.91 of Sec. III.A): the same homogeneous
+           fits (free f_ne, L, b; τ0 ours, the paper gives none) with κ0 and μ
+           held at the paper's values, on the same fitted points, in both
+           hazard forms; their RMS log residuals beside ours, which of the two
+           fits the simulation better, and the τ1, τ2 they predict (fig6.json
+           key ``paper_constants``; comparison rows with ``authors=True``).
 plot       Fig. 6 from the derived tables.
 
 Errors: the fit errors treat the points of one Kaplan–Meier curve as
@@ -37,6 +45,7 @@ independent (``absolute_sigma``); the points are positively correlated, so
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -84,6 +93,11 @@ class Params(StudyParams):
     mixture_fit_window: Numbers
     mixture_plotted: Text = None
     alpha: Number
+    paper_kappa_a: Number        # the paper's κ0(E) law (Fig. 2b caption): a x² + b x below E_b, c x above,
+    paper_kappa_b: Number        #   x = E − E_c; a in 1/(time·energy²), b and c in 1/(time·energy), E_b an energy
+    paper_kappa_c: Number
+    paper_kappa_Eb: Number
+    paper_mu: Number             # the paper's energy-decay exponent (Sec. III.A, Fig. 3), dimensionless
     kappa_a_key: Text
     kappa_b_key: Text
     kappa_c_key: Text
@@ -97,9 +111,8 @@ class Params(StudyParams):
     fig4_E0: Number
 
 
-PAPER_KAPPA = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27}
-PAPER_MU = 0.91
 DEV_TAU0 = 5.0  # development fallback only (the paper gives no number for τ0)
+PC = "paper_constants"  # name of the model evaluated with the paper's constants (columns, tables, JSON key)
 
 
 def pair_key(E0: float, g: float) -> str:
@@ -126,17 +139,44 @@ def simulate(study, workers=None, progress=True):
 # ---------------------------------------------------------------------------
 # analysis helpers
 # ---------------------------------------------------------------------------
+def paper_constants(study) -> dict:
+    """paper_constants(study) -> {a, b, c, E_b, mu}: the paper's constants as ``[study] paper_*`` states them.
+
+    κ0(E) = a x² + b x for E < E_b and c x for E ≥ E_b, x = E − E_c (paper
+    Fig. 2b = fig:kappa-E-dependence, caption; κ0 in 1/time, E_b an energy),
+    and μ (Eq. (eqn:energy_exp_decay), dimensionless; Sec. III.A, Fig. 3 =
+    fig:energy_decay).  Read from study.toml, never written in the code.
+    """
+    return {"a": float(study.param("paper_kappa_a")), "b": float(study.param("paper_kappa_b")),
+            "c": float(study.param("paper_kappa_c")), "E_b": float(study.param("paper_kappa_Eb")),
+            "mu": float(study.param("paper_mu"))}
+
+
+def kappa_law(const: dict, E_c: float) -> PiecewiseKappa:
+    """kappa_law({a, b, c, E_b, ...}, E_c) -> the piecewise κ0(E) of paper Fig. 2b with these coefficients."""
+    return PiecewiseKappa(a2=float(const["a"]), a1=float(const["b"]), slope=float(const["c"]),
+                          E_switch=float(const["E_b"]), E_c=float(E_c))
+
+
+def _constants_label(const: dict, hazard: str, ours: bool) -> str:
+    """How a model curve was made: whose constants (a, b, c, E_b, μ) and which hazard form (comparison rows)."""
+    vals = ", ".join(f"{const[k]:.4g}" for k in ("a", "b", "c", "E_b", "mu"))
+    who = "our fitted constants (fig2, fig3)" if ours else "paper's constants"
+    return f"{who} (a, b, c, E_b, μ) = ({vals}), hazard '{hazard}'"
+
+
 def _inputs(study):
     inputs = {}
     ks = study.upstream("kappa")
     kv = {}
+    # the paper's values stand in only under the development fallback (labelled in inputs and the figure)
+    pc = paper_constants(study)
     for name in ("a", "b", "c", "E_b"):
         key = study.param("kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
-        kv[name], _ = up.value_or_fallback(study, ks, key, PAPER_KAPPA[name], inputs, f"kappa_{name}")
+        kv[name], _ = up.value_or_fallback(study, ks, key, pc[name], inputs, f"kappa_{name}")
     E_c = study.model.critical_energy  # E_c = ω⁶/(6λ²) of the scene's model
-    kappa = PiecewiseKappa(a2=float(kv["a"]), a1=float(kv["b"]), slope=float(kv["c"]),
-                               E_switch=float(kv["E_b"]), E_c=E_c)
-    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
+    kappa = kappa_law(kv, E_c)
+    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), pc["mu"], inputs, "mu")
     tau0, _ = up.value_or_fallback(study, study.upstream("tau"), study.param("tau0_key"), DEV_TAU0, inputs, "tau0")
     return inputs, kappa, float(mu), float(mu_err if mu_err is not None else math.nan), float(tau0), E_c
 
@@ -241,6 +281,9 @@ def analyze(study):
     from hhscatter.tables import read_lifetimes, read_snapshots
 
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
+    ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": mu}
+    pc = paper_constants(study)
+    kappa_pc = kappa_law(pc, E_c)
     hazards = list(study.param("hazards"))
     dt, fit_dt = float(study.param("dt")), float(study.param("fit_dt"))
     min_count = float(study.param("min_count"))
@@ -249,7 +292,7 @@ def analyze(study):
     mixtures = _mixture_variants(study)
     w_hi = float(study.param("mixture_fit_window")[1])
 
-    curves, fit_rows, comp_rows, cmp_rows = [], [], [], []
+    curves, fit_rows, comp_rows, cmp_rows, pc_rows = [], [], [], [], []
     for E0, g in _pairs(study):
         label = pair_key(E0, g)
         raw = study.raw(label)
@@ -260,6 +303,10 @@ def analyze(study):
         P_min = min_count / n * 0.999
         homog = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa, E0=E0, mu=mu, gamma=g, tau0=tau0, E_c=E_c,
                                   hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
+        # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
+        # so the two RMS log residuals compare the constants alone
+        homog_pc = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa_pc, E0=E0, mu=pc["mu"], gamma=g,
+                                     tau0=tau0, E_c=E_c, hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
         snaps = read_snapshots(raw, filters=pads.field("t") >= tau0)
         mixes = {}
         for var in mixtures:
@@ -279,14 +326,25 @@ def analyze(study):
                 cur[f"{name}_{h}"] = f.predict(t)
             cmp = sm.compare_fits(models).reset_index()
             cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
+        for h in hazards:
+            cur[f"{PC}_{h}"] = homog_pc[h].predict(t)
+            pc_rows.append(_pc_row(homog[h], homog_pc[h], pair=label, E0=E0, gamma=g, hazard=h,
+                                   tau2_ours=tau2_predicted(E0, E_c, mu, g),
+                                   tau2_pc=tau2_predicted(E0, E_c, pc["mu"], g)))
         curves.append(cur.assign(pair=label, E0=E0, gamma=g, N=n))
     curves = pd.concat(curves, ignore_index=True)
     fits = pd.DataFrame(fit_rows)
     comps = pd.concat(comp_rows, ignore_index=True)
     cmps = pd.concat(cmp_rows, ignore_index=True)
+    pcf = pd.DataFrame(pc_rows)
 
-    taus, tau_curves = _tau_vs_gamma(study, inputs, kappa=kappa, mu=mu, mu_err=mu_err, tau0=tau0, E_c=E_c,
-                                     hazards=hazards, dt=dt, fit_dt=fit_dt, min_count=min_count)
+    ref = _fig4_reference(study, inputs, dt)
+    tau_kw = {"tau0": tau0, "E_c": E_c, "hazards": hazards, "dt": dt, "fit_dt": fit_dt, "min_count": min_count,
+              "alpha": float(study.param("alpha"))}
+    taus, tau_fits = _tau_rows(ref, kappa=kappa, mu=mu, mu_err=mu_err, **tau_kw)
+    taus_pc, tau_fits_pc = _tau_rows(ref, kappa=kappa_pc, mu=pc["mu"], mu_err=math.nan, **tau_kw)
+    pct = _pc_taus(taus, taus_pc, tau_fits, tau_fits_pc, hazards)
+    tau_curves = _tau2_curve(taus, ref.E0, E_c, mu, mu_err, pc["mu"])
 
     study.write_table(curves, "curves.parquet", tau0=tau0, mu=mu)
     study.write_table(fits, "fits.parquet")
@@ -294,13 +352,16 @@ def analyze(study):
     study.write_table(cmps, "compare_fits.parquet")
     study.write_table(taus, "tau_vs_gamma.parquet")
     study.write_table(tau_curves, "tau2_curve.parquet")
+    study.write_table(pcf, f"{PC}_fits.parquet", constants=pc)
+    study.write_table(pct, f"{PC}_taus.parquet", constants=pc)
 
     # -- paper comparison --------------------------------------------------------
-    study.compare("μ used (from fig3)", mu, mu_err, PAPER_MU, note=inputs["mu"]["source"])
+    study.compare("μ used (from fig3)", mu, mu_err, pc["mu"], note=inputs["mu"]["source"])
     for r in fits.itertuples():
         if r.model == "homogeneous":
             study.compare(f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual", r.rms_log_residual, None,
-                          None, verdict=None,
+                          None, verdict=None, convention=f"{_constants_label(ours_const, r.hazard, ours=True)}; "
+                                                         f"{study.convention_label}",
                           note=f"χ²/dof = {r.chi2_red:.3g} ({r.n_points} points); paper: 'satisfying agreement'")
     for h in hazards:
         c = cmps[cmps["hazard"] == h].pivot(index="pair", columns="model", values="rms_log_residual")
@@ -329,6 +390,7 @@ def analyze(study):
                 study.compare(f"τ1(γ={r.gamma:g}) observed vs model ({h})", r.tau1_observed, None, None,
                               verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
                               note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)")
+    _compare_paper_constants(study, pc, tau0, pcf, pct, hazards)
 
     study.write_numbers({
         "inputs": inputs,
@@ -340,11 +402,146 @@ def analyze(study):
         "compare_fits": cmps.to_dict(orient="records"),
         "mixture_components": comps.to_dict(orient="records"),
         "tau_vs_gamma": taus.to_dict(orient="records"),
+        PC: _pc_numbers(pc, E_c, tau0, pcf, pct, hazards),
     })
 
 
-def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_dt, min_count):
-    """Panel (b): observed τ1, τ2 from fig4's table; model τ1 from fits to fig4's P(t); τ2 from Eq. (eq:tau2)."""
+# ---------------------------------------------------------------------------
+# the paper's constants beside ours
+# ---------------------------------------------------------------------------
+def _pc_row(ours, theirs, *, pair, E0, gamma, hazard, tau2_ours, tau2_pc) -> dict:
+    """One (pair, hazard) row: the fit with the paper's constants beside ours on the same points."""
+    best = sm.better_fit({"ours": ours, PC: theirs})
+    row = {"pair": pair, "E0": E0, "gamma": gamma, "hazard": hazard, "n_points": theirs.n_points,
+           "rms_log_residual": theirs.rms_log_residual, "rms_log_residual_ours": ours.rms_log_residual,
+           "better": best if best is not None else "tie",
+           "chi2_red": theirs.chi2_red, "chi2_red_ours": ours.chi2_red, "aic": theirs.aic, "aic_ours": ours.aic,
+           "tau2_predicted": tau2_pc, "tau2_predicted_ours": tau2_ours, "success": theirs.success}
+    for k in ("f_ne", "f_e", "L", "b"):
+        row[k] = float(theirs.values[k])
+        row[f"{k}_err"] = float(theirs.errors.get(k, math.nan))
+    return row
+
+
+def _pc_taus(ours, theirs, fits_ours, fits_pc, hazards) -> pd.DataFrame:
+    """Per γ of fig4's table: τ1 (model fitted to fig4's P(t)) and τ2 (Eq. (eq:tau2)) predicted with the
+    paper's constants, beside ours (suffix ``_ours``) and the observed ones; RMS log residuals of both fits."""
+    if list(ours["gamma"]) != list(theirs["gamma"]):
+        raise RuntimeError("τ tables of our and the paper's constants cover different γ")  # same fig4 table
+    rows = []
+    for o, p in zip(ours.to_dict("records"), theirs.to_dict("records")):
+        g = o["gamma"]
+        row = {"gamma": g, "tau1_observed": o["tau1_observed"], "tau2_observed": o["tau2_observed"],
+               "tau2_predicted": p["tau2_predicted"], "tau2_predicted_ours": o["tau2_predicted"]}
+        for h in hazards:
+            row[f"tau1_pred_{h}"] = p[f"tau1_pred_{h}"]
+            row[f"tau1_pred_{h}_ours"] = o[f"tau1_pred_{h}"]
+            both = g in fits_ours and g in fits_pc
+            row[f"rms_{h}"] = float(fits_pc[g][h].rms_log_residual) if both else None
+            row[f"rms_{h}_ours"] = float(fits_ours[g][h].rms_log_residual) if both else None
+            best = sm.better_fit({"ours": fits_ours[g][h], PC: fits_pc[g][h]}) if both else None
+            row[f"better_{h}"] = (best or "tie") if both else None
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _better_text(best, rms_ours, rms_pc) -> str:
+    """Verdict of a row of the paper's constants: which constants fit the simulation better, with both RMS."""
+    if best == PC:
+        return f"paper's constants fit better: rms {rms_pc:.3f} vs {rms_ours:.3f} with ours"
+    if best == "ours":
+        return f"our constants fit better: rms {rms_ours:.3f} vs {rms_pc:.3f} with the paper's"
+    return f"equal fit: rms {rms_ours:.3f} with both"
+
+
+def _pct(x, ref):
+    return f"{100 * (x - ref) / ref:+.0f}%"
+
+
+def _compare_paper_constants(study, pc, tau0, pcf, pct, hazards):
+    """Comparison rows made with the paper's constants (authors=True): per pair and hazard the RMS log residual
+    and which constants fit better; per hazard the count; per γ of fig4 the τ2 and τ1 they predict."""
+    setup = study.convention_label
+    for r in pcf.itertuples():
+        study.compare(f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual, paper's constants",
+                      r.rms_log_residual, None, None,
+                      verdict=_better_text(r.better, r.rms_log_residual_ours, r.rms_log_residual),
+                      convention=f"{_constants_label(pc, r.hazard, ours=False)}; {setup}", authors=True,
+                      note=(f"same {r.n_points} points, free f_ne, L, b and τ0 = {tau0:g} (ours, fig4: the paper "
+                            f"gives none) as the row with our constants; χ²/dof = {r.chi2_red:.3g} "
+                            f"(ours {r.chi2_red_ours:.3g})"))
+    for h in hazards:
+        sub = pcf[pcf["hazard"] == h]
+        n_pc, n_ours = int((sub["better"] == PC).sum()), int((sub["better"] == "ours").sum())
+        if n_pc == n_ours:
+            verdict = f"neither: the paper's constants fit better on {n_pc}, ours on {n_ours} of {len(sub)} pairs"
+        else:
+            who = "the paper's" if n_pc > n_ours else "our"
+            verdict = f"{who} constants fit better on {max(n_pc, n_ours)} of {len(sub)} pairs"
+        study.compare(f"Fig. 6a ({h} hazard): pairs the paper's constants fit better than ours",
+                      f"{n_pc} of {len(sub)}", None, None, verdict=verdict,
+                      convention=f"{_constants_label(pc, h, ours=False)}; {setup}", authors=True,
+                      note="smaller rms log residual on the same points; rms ours → paper's: " + ", ".join(
+                          f"{q.pair}: {q.rms_log_residual_ours:.3f} → {q.rms_log_residual:.3f}"
+                          for q in sub.itertuples()))
+    for r in pct.itertuples():
+        g = r.gamma
+        if r.tau2_observed is not None and np.isfinite(r.tau2_observed):
+            closer = ("paper's μ" if abs(r.tau2_observed - r.tau2_predicted) < abs(r.tau2_observed
+                                                                                    - r.tau2_predicted_ours)
+                      else "our μ")
+            study.compare(f"τ2(γ={g:g}) Eq. (eq:tau2) with the paper's μ vs observed", r.tau2_predicted, None, None,
+                          verdict=(f"observed {r.tau2_observed:.1f} is {_pct(r.tau2_observed, r.tau2_predicted)} "
+                                   f"from it ({_pct(r.tau2_observed, r.tau2_predicted_ours)} from "
+                                   f"{r.tau2_predicted_ours:.1f} with our μ): {closer} closer"),
+                          convention=f"paper's μ = {pc['mu']:g}; {setup}", authors=True,
+                          note="observed: first settling time (fig4); τ2 = ln(E0/E_c)/(μγ)")
+        for h in hazards:
+            pred, pred_o = getattr(r, f"tau1_pred_{h}"), getattr(r, f"tau1_pred_{h}_ours")
+            obs = r.tau1_observed
+            if not all(v is not None and np.isfinite(v) for v in (pred, pred_o, obs)):
+                continue
+            closer = "paper's constants" if abs(pred - obs) < abs(pred_o - obs) else "our constants"
+            study.compare(f"τ1(γ={g:g}) model with the paper's constants ({h}) vs observed", pred, None, None,
+                          verdict=(f"{_pct(pred, obs)} from observed {obs:.1f}; our constants {pred_o:.1f} "
+                                   f"({_pct(pred_o, obs)}): {closer} closer"),
+                          convention=f"{_constants_label(pc, h, ours=False)}; {setup}", authors=True,
+                          note=(f"Eq. (eqn:surv_prob_model) fitted to fig4's P(t) with the paper's κ0 and μ, solved "
+                                f"for P = α P_0 (Eq. (eqn:tau1), α = 2); rms log residual {getattr(r, f'rms_{h}'):.3f} "
+                                f"(ours {getattr(r, f'rms_{h}_ours'):.3f})"))
+
+
+def _pc_numbers(pc, E_c, tau0, pcf, pct, hazards) -> dict:
+    """The ``paper_constants`` key of fig6.json: the constants; ``fits``, one row per pair and hazard (the fit with
+    them beside ours: RMS log residuals, which is smaller, τ2 of Eq. (eq:tau2) with both μ); ``tau_vs_gamma``, per
+    γ of fig4 the τ1, τ2 they predict beside ours and the observed ones."""
+    return {"constants": {**pc, "E_c": E_c,
+                          "source": "study.toml [study] paper_kappa_a, paper_kappa_b, paper_kappa_c, paper_kappa_Eb, "
+                                    "paper_mu (paper: Fig. 2b caption; Sec. III.A, Fig. 3)"},
+            "tau0": tau0,
+            "method": ("the homogeneous model, Eq. (eqn:surv_prob_model), in hazard forms "
+                       f"{', '.join(hazards)}, with κ0(E) and μ held at these values; free f_ne, L, b "
+                       "(f_e = P(τ0) − f_ne) fitted on the same points as with our constants; τ0 ours (fig4): "
+                       "the paper gives none; 'better': the smaller rms log residual (columns '_ours': our "
+                       "constants)"),
+            "fits": pcf.to_dict(orient="records"),
+            "tau_vs_gamma": pct.to_dict(orient="records")}
+
+
+# ---------------------------------------------------------------------------
+# panel (b): τ1, τ2 against γ at fig4's E0
+# ---------------------------------------------------------------------------
+class _Fig4Ref(NamedTuple):
+    """fig4's observed τ table, its P(t) lifetimes per γ > 0 and the γ = 0 curve P_0 (None without it)."""
+
+    obs: pd.DataFrame
+    lifetimes: dict
+    P_0: tuple | None
+    E0: float
+
+
+def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
+    """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)."""
     from hhscatter.tables import read_lifetimes
 
     E0 = float(study.param("fig4_E0"))
@@ -373,6 +570,7 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
             raise up.UpstreamError(f"{other}'s {tname} has no γ = 0 rows (the conservative reference)")
         t0c, P0c, _ = _curve(by_gamma[0.0], dt)
         lifetimes = {g: by_gamma[g] for g in obs["gamma"] if g > 0 and g in by_gamma}
+        P_0 = (t0c, P0c)
     except up.UpstreamError:
         if not up.dev_fallback_enabled():
             raise
@@ -382,16 +580,22 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
                      for e, g in _pairs(study) if abs(e - E0) < 1e-12}
         obs = pd.DataFrame({"gamma": sorted(lifetimes), "tau1_observed": None, "tau1_err": None, "tau2_err": None,
                             "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)]})
-        t0c = P0c = None
-    rows = []
-    for r in obs[obs["gamma"] > 0].sort_values("gamma").itertuples():
+        P_0 = None
+    return _Fig4Ref(obs, lifetimes, P_0, E0)
+
+
+def _tau_rows(ref: _Fig4Ref, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_dt, min_count, alpha):
+    """Panel (b) with one set of constants (κ0(E), μ): observed τ1, τ2 (fig4); model τ1 from fits to fig4's P(t),
+    τ2 from Eq. (eq:tau2).  Returns (table, {γ: {hazard: SurvivalFit}})."""
+    rows, fits_by_gamma = [], {}
+    for r in ref.obs[ref.obs["gamma"] > 0].sort_values("gamma").itertuples():
         g = float(r.gamma)
-        tau2_pred = tau2_predicted(E0, E_c, mu, g)
+        tau2_pred = tau2_predicted(ref.E0, E_c, mu, g)
         row = {"gamma": g, "tau1_observed": _num(r.tau1_observed), "tau1_observed_err": _num(r.tau1_err),
                "tau2_observed": _num(r.tau2_observed), "tau2_observed_err": _num(r.tau2_err),
                "tau2_predicted": tau2_pred,
                "tau2_predicted_err": tau2_pred * mu_err / mu if math.isfinite(mu_err) else math.nan}
-        lt = lifetimes.get(g)
+        lt = ref.lifetimes.get(g)
         for h in hazards:
             row[f"tau1_pred_{h}"] = None
             row[f"f_ne_{h}"] = None
@@ -399,23 +603,28 @@ def _tau_vs_gamma(study, inputs, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, f
             t, P, P_err = _curve(lt, dt)
             tf, Pf, sf = _fit_points(t, P, P_err, tau0, fit_dt, len(lt), min_count)
             if tf.size >= 5:
-                fits = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa, E0=E0, mu=mu, gamma=g, tau0=tau0,
+                fits = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa, E0=ref.E0, mu=mu, gamma=g, tau0=tau0,
                                          E_c=E_c, hazards=hazards, fit_tau2=False,
                                          P_min=min_count / len(lt) * 0.999)
+                fits_by_gamma[g] = fits
                 for h in hazards:
                     row[f"f_ne_{h}"] = float(fits[h].values["f_ne"])
                     row[f"rms_{h}"] = float(fits[h].rms_log_residual)
-                    if t0c is not None:
-                        row[f"tau1_pred_{h}"] = sm.predict_tau1(fits[h], (t0c, P0c), float(study.param("alpha")))
+                    if ref.P_0 is not None:
+                        row[f"tau1_pred_{h}"] = sm.predict_tau1(fits[h], ref.P_0, alpha)
         rows.append(row)
-    taus = pd.DataFrame(rows)
+    return pd.DataFrame(rows), fits_by_gamma
+
+
+def _tau2_curve(taus, E0, E_c, mu, mu_err, mu_pc) -> pd.DataFrame:
+    """Eq. (eq:tau2) on a fine γ grid: with our μ (and its ±1σ band) and with the paper's μ."""
     gg = np.geomspace(min(taus["gamma"].min(), 1e-3) * 0.8, max(taus["gamma"].max(), 0.02) * 1.25, 200) \
         if len(taus) else np.geomspace(1e-3, 0.03, 200)
     t2 = tau2_predicted(E0, E_c, mu, gg)
-    curve = pd.DataFrame({"gamma": gg, "tau2_predicted": t2,
-                          "tau2_lo": t2 / (1 + mu_err / mu) if math.isfinite(mu_err) else t2,
-                          "tau2_hi": t2 / (1 - mu_err / mu) if math.isfinite(mu_err) else t2})
-    return taus, curve
+    return pd.DataFrame({"gamma": gg, "tau2_predicted": t2,
+                         "tau2_lo": t2 / (1 + mu_err / mu) if math.isfinite(mu_err) else t2,
+                         "tau2_hi": t2 / (1 - mu_err / mu) if math.isfinite(mu_err) else t2,
+                         f"tau2_predicted_{PC}": tau2_predicted(E0, E_c, mu_pc, gg)})
 
 
 def _val(v):
@@ -442,4 +651,5 @@ def plot(study):
     nums = study.read_numbers()
     read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()
     plot_fig6(read("curves.parquet"), read("fits.parquet"), read("tau_vs_gamma.parquet"),
-              read("tau2_curve.parquet"), read("compare_fits.parquet"), nums, study.figure_path)
+              read("tau2_curve.parquet"), read("compare_fits.parquet"), nums, study.figure_path,
+              pc_fits=read(f"{PC}_fits.parquet"), pc_taus=read(f"{PC}_taus.parquet"))
