@@ -56,9 +56,9 @@ BAD_STUDY_FILES = [
      "unknown table [snapshot]; allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
      "[snapshots], [study]"),
     ("fig3", lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
-     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot'; allowed keys: boot_seed, "
-     "fit_window, hist_bins, hist_times, later_windows, n_boot, n_boot_orbits, paper_mu, plot_t_max, "
-     "sliding_window, snapshot_grid"),
+     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot'; allowed keys: alt_window, "
+     "authors_selection, authors_window, boot_seed, fit_window, hist_bins, hist_times, later_windows, n_boot, "
+     "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid"),
     ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
      "[scale.tiny.scene] unknown key 'chunk'; allowed keys: batch_size, chunk_size, continue_settled, energy, "
      "gamma, ics, lam, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),

@@ -206,6 +206,149 @@ def test_fig3_tiny_end_to_end(tiny_root):
     assert hist.groupby("t")["count"].sum().to_dict() == hist.groupby("t")["n_inside"].first().to_dict()
 
 
+def _fixed_intercept_mu(t, mean_E, E0, gamma, window):
+    """Closed-form least squares of log(⟨E⟩/E0) = −μγt on the window (unweighted, through the origin): the
+    paper's fit of Eq. (eqn:energy_exp_decay), written out here independently of the code under test."""
+    t, m = np.asarray(t, float), np.asarray(mean_E, float)
+    sel = (t >= window[0]) & (t <= window[1]) & np.isfinite(m) & (m > 0)
+    y = -np.log(m[sel] / E0)
+    return float(np.sum(t[sel] * y) / (gamma * np.sum(t[sel] ** 2)))
+
+
+def test_fig3_mu_verdict_rule():
+    """The verdict of a μ row against the paper's "0.91": 2σ, then the paper's quoting precision; and our row's
+    "differs" is kept only when no authors'-convention row agrees."""
+    from hhscatter.studies.fig3.study import mu_verdict, verdict_beside_authors
+
+    assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"           # |Δ| = 0.0005 ≤ 2σ
+    assert mu_verdict(0.9139, 0.0005, 0.91, 0.005) == "agrees to the paper's quoted digits"  # prints as 0.91
+    assert mu_verdict(0.9139, 0.0005, 0.91, 0.0) == "differs"                       # 7.8σ, no rounding allowed
+    assert mu_verdict(0.9393, 0.0004, 0.91, 0.005) == "differs"                     # 0.029 ≫ 2σ + 0.005
+    assert mu_verdict(0.93, 0.0101, 0.91, 0.0) == "agrees within 2σ"                # |Δ| = 0.02 ≤ 0.0202
+    rows = [{"label": "inside, fit [0, 100]", "verdict": "agrees within 2σ"},
+            {"label": "above, fit [0, 200]", "verdict": "differs"}]
+    assert verdict_beside_authors("differs", rows) == \
+        "differs in our convention only; agrees under the authors' (inside, fit [0, 100])"
+    assert verdict_beside_authors("differs", rows[1:]) == "differs"  # the difference survives their convention
+    assert verdict_beside_authors("differs", []) == "differs"
+    assert verdict_beside_authors("agrees within 2σ", rows) == "agrees within 2σ"
+
+
+def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
+    """Each μ row of authors_convention is the log fit of a mean computed here from the raw snapshot table: the
+    E > E_c mean leaves out exactly the settled-and-continued rows (t > t_end of a settled orbit), the other
+    keeps every row; the comparison rows carry the same numbers, flags and the verdict rule."""
+    from hhscatter.tables import read_lifetimes, read_snapshots
+
+    out = tiny_root / "fig3" / "out" / "tiny"
+    raw = out / "raw" / "e0.3_gamma0.01"
+    nums = json.loads((out / "fig3.json").read_text())
+    auth = nums["authors_convention"]
+    lt = read_lifetimes(raw)
+    snap = read_snapshots(raw).merge(lt[["traj_id", "t_end", "outcome"]], on="traj_id")
+    continued = (snap["outcome"] == "settled") & (snap["t"] > snap["t_end"])
+    assert continued.sum() > 100  # the selections differ on this run (18 settled orbits at scale tiny)
+    direct = {"inside": snap.groupby("t")["energy"].agg(["size", "mean"]),
+              "above": snap[~continued].groupby("t")["energy"].agg(["size", "mean"])}
+    me = pd.read_parquet(out / "derived" / "fig3_mean_energy.parquet").set_index("t")
+    up = direct["above"].reindex(me.index)
+    np.testing.assert_array_equal(me["n_above"], up["size"].fillna(0).astype(int))
+    np.testing.assert_allclose(me["mean_E_above"], up["mean"], rtol=1e-12)  # NaN where nobody is above E_c
+    assert auth["t_end_above"] == up["size"].dropna().index.max()
+    assert (me.loc[me.index > auth["t_end_above"], "n"] > 0).all()  # the inside mean goes on after it
+
+    E0, gamma, paper = nums["E0"], nums["gamma"], nums["paper_mu"]
+    rows = {r["quantity"]: r for r in nums["paper_comparison"]}
+    assert len(auth["mu"]) == 4 and sum(r["ours"] for r in auth["mu"]) == 1
+    for r in auth["mu"]:
+        d = direct[r["selection"]]
+        assert r["value"] == pytest.approx(_fixed_intercept_mu(d.index, d["mean"], E0, gamma, r["window"]),
+                                           rel=1e-10)
+        assert 0 < r["err"] < 0.05  # bootstrap over orbits
+        dev = abs(r["value"] - paper)
+        rule = ("agrees within 2σ" if dev <= 2 * r["err"] else
+                "agrees to the paper's quoted digits" if dev <= 2 * r["err"] + auth["paper_mu_half_unit"] else
+                "differs")
+        assert r["verdict"].startswith(rule)
+        c = rows[r["quantity"]]
+        assert (c["ours"], c["err"], c["paper"], c["verdict"]) == (r["value"], r["err"], paper, r["verdict"])
+        assert c["authors"] == r["authors"] == (r["selection"] == auth["authors_selection"]
+                                                and r["window"] == auth["authors_window"])
+        assert c["convention"].startswith("authors'") == c["authors"]
+    ours = next(r for r in auth["mu"] if r["ours"])
+    assert (ours["value"], ours["err"]) == (nums["mu"]["value"], nums["mu"]["err"])  # key mu unchanged
+
+
+def test_fig3_ribbons_sd_and_sem(tiny_root):
+    """Both ribbons from the raw energies: ± 3 SD of E (the paper's) is √n times ± 3 SEM (ours)."""
+    from hhscatter.tables import read_snapshots
+
+    out = tiny_root / "fig3" / "out" / "tiny"
+    nums = json.loads((out / "fig3.json").read_text())
+    rib = nums["authors_convention"]["ribbon"]
+    snap = read_snapshots(out / "raw" / "e0.3_gamma0.01")
+    e = snap.loc[snap["t"] == rib["t"], "energy"].to_numpy()
+    assert rib["n"] == e.size > 1
+    assert rib["half_width_3sd"] == pytest.approx(3 * e.std(ddof=1), rel=1e-9)
+    assert rib["half_width_3sem"] == pytest.approx(3 * e.std(ddof=1) / np.sqrt(e.size), rel=1e-9)
+    me = pd.read_parquet(out / "derived" / "fig3_mean_energy.parquet")
+    # (at t = 0 every E is E0 up to rounding: a 1e-14 spread, lost in hi − ⟨E⟩)
+    me = me[(me["n"] > 1) & (me["std_E"] > 1e-9 * me["mean_E"])]
+    assert len(me) > 50
+    sd = me["hi_3sigma"] - me["mean_E"]
+    sem = me["hi_3sem"] - me["mean_E"]
+    np.testing.assert_allclose(sd / sem, np.sqrt(me["n"]), rtol=1e-9)
+    np.testing.assert_allclose(me["mean_E"] - me["lo_3sigma"], sd, rtol=1e-9)  # symmetric about ⟨E⟩
+    rows = {r["quantity"]: r for r in nums["paper_comparison"]}
+    r_sd = next(r for q, r in rows.items() if q.startswith("ribbon") and "standard deviations" in q)
+    r_sem = next(r for q, r in rows.items() if q.startswith("ribbon") and "standard errors" in q)
+    assert (r_sd["ours"], r_sd["authors"], r_sem["ours"], r_sem["authors"]) == \
+        (rib["half_width_3sd"], True, rib["half_width_3sem"], False)
+
+
+def test_fig3_authors_rows_recompute_deterministically(tiny_root):
+    from hhscatter.studies import load_study, run_stage
+
+    study = load_study("fig3", "tiny", root=tiny_root)
+    before = json.loads(study.numbers_path.read_text())
+    run_stage("fig3", "analyze", "tiny", root=tiny_root)
+    after = json.loads(study.numbers_path.read_text())
+    assert after["authors_convention"] == before["authors_convention"]
+    assert after["paper_comparison"] == before["paper_comparison"]
+    assert after["mu"] == before["mu"]
+
+
+def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path):
+    """With [0, 100] declared the authors' window and the paper's μ set to our μ there, our [0, 200] row
+    (farther than 2σ from it) must say that it differs in our convention only."""
+    import shutil
+
+    from hhscatter.studies import run_stage
+
+    src = tiny_root / "fig3"
+    dst = tmp_path / "fig3"
+    shutil.copytree(src / "out" / "tiny" / "raw", dst / "out" / "tiny" / "raw")
+    nums = json.loads((src / "out" / "tiny" / "fig3.json").read_text())
+    mu = {tuple(r["window"]): r for r in nums["authors_convention"]["mu"] if r["selection"] == "inside"}
+    m200, m100 = mu[(0.0, 200.0)], mu[(0.0, 100.0)]
+    assert abs(m200["value"] - m100["value"]) > 2 * m200["err"]  # the premise: the windows disagree at tiny
+    toml = (src / "study.toml").read_text()
+    for old, new in (("authors_window = [0.0, 200.0]", "authors_window = [0.0, 100.0]"),
+                     ("paper_mu = 0.91", f"paper_mu = {m100['value']!r}"),
+                     ("paper_mu_half_unit = 0.005", "paper_mu_half_unit = 0.0")):
+        assert old in toml
+        toml = toml.replace(old, new)
+    (dst / "study.toml").write_text(toml)
+    run_stage("fig3", "analyze", "tiny", root=tmp_path)
+    got = json.loads((dst / "out" / "tiny" / "fig3.json").read_text())
+    rows = {r["quantity"]: r for r in got["paper_comparison"]}
+    ours = rows["μ on [0, 200] (log fit, E(0)=E0)"]
+    alt = rows["μ on [0, 100], every orbit inside Ω"]
+    assert (ours["authors"], alt["authors"]) == (False, True)
+    assert alt["verdict"] == "agrees within 2σ"
+    assert ours["verdict"] == "differs in our convention only; agrees under the authors' (inside, fit [0, 100])"
+
+
 def test_fig4_tiny_end_to_end(tiny_root):
     from hhscatter.tables import read_lifetimes
 

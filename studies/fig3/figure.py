@@ -1,5 +1,6 @@
-"""Fig 3 (paper fig:energy_decay): ⟨E⟩(t) with a 3σ ribbon, the exponential fit, energy histograms,
-and the local decay exponent μ(t).  Plot functions draw what they are given and compute nothing."""
+"""Fig 3 (paper fig:energy_decay): ⟨E⟩(t) with two ribbons (3 standard deviations of E, as the paper draws it;
+3 standard errors of ⟨E⟩, ours), the exponential fit, energy histograms, and the local decay exponent μ(t)
+beside the fitted μ of each convention.  Plot functions draw what they are given and compute nothing."""
 from __future__ import annotations
 
 import numpy as np
@@ -14,19 +15,24 @@ HIST_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")
 def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     """plot_fig3(me, tab, hist, numbers, path) -> None; writes the two-panel Fig. 3.
 
-    ``me``: table fig3_mean_energy (t, mean_E, lo_3sem, hi_3sem, fit_E,
-    mean_E_above, n, n_above); ``tab``: fig3_mu_windows (kind, t_lo, t_hi,
-    t_mid, mu, mu_err, mu_free, mu_free_err); ``hist``: fig3_histograms (long
-    format, t, e_lo, e_hi, density_log10E); ``numbers``: fig3.json;
+    ``me``: table fig3_mean_energy (t, mean_E, lo_3sigma, hi_3sigma (± 3 standard
+    deviations of E), lo_3sem, hi_3sem, fit_E, mean_E_above, n, n_above);
+    ``tab``: fig3_mu_windows (kind, t_lo, t_hi, t_mid, mu, mu_err, mu_free,
+    mu_free_err); ``hist``: fig3_histograms (long format, t, e_lo, e_hi,
+    density_log10E); ``numbers``: fig3.json (``mu``, ``authors_convention``);
     ``t_max``: right end of the time axis (default: the last grid time).
-    (a) ⟨E⟩(t) on a log axis, ribbon ±3 standard errors, dashed fit
-    E0 e^{−μγt} on the fit window, E_c dotted, coloured dots at the histogram
-    times; inset: histograms of log10 E at those times.  (b) local exponent
-    μ (free-intercept slope of log⟨E⟩ on sliding windows) against t, with
-    the fitted μ on [0, 200], the paper's 0.91 and the linear-regime value 1.
+    (a) ⟨E⟩(t) on a log axis with two ribbons, light: ± 3 standard deviations
+    of the energies (the spread of the ensemble; the ribbon of the paper's
+    caption), dark: ± 3 standard errors of the mean (ours; √n narrower), the
+    dashed fit E0 e^{−μγt} on the fit window, E_c dotted, coloured dots at the
+    histogram times; inset: histograms of log10 E at those times.  (b) local
+    exponent μ (free-intercept slope of log⟨E⟩ on sliding windows) against t;
+    the fitted μ of every convention of ``authors_convention.mu`` as a
+    segment over the times its fit used, the paper's 0.91 over [0, 200] and
+    the linear-regime value 1.
     """
     plt = agg_pyplot()
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(6.4, 7.4), height_ratios=[2.3, 1], sharex=True,
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(6.4, 8.2), height_ratios=[2.3, 1.1], sharex=True,
                                  constrained_layout=True)
     mu = numbers["mu"]["value"]
     mu_err = numbers["mu"]["err"]
@@ -34,8 +40,12 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     w_lo, w_hi = numbers["fit_window"]
 
     t = me["t"].to_numpy()
-    ax.fill_between(t, me["lo_3sem"], me["hi_3sem"], color="#4f81bd", alpha=0.35, lw=0,
-                    label=r"$\pm 3\sigma$ (std. error of the mean)")
+    rib = numbers["authors_convention"]["ribbon"]
+    sd_pct, sem_pct = 100 * rib["max_rel_half_width_3sd"], 100 * rib["max_rel_half_width_3sem"]
+    ax.fill_between(t, me["lo_3sigma"], me["hi_3sigma"], color="#9ab8de", alpha=0.55, lw=0,
+                    label=rf"$\pm3$ SD of $E$ (spread; the paper's ribbon): $\leq${sd_pct:.0f}% of $\langle E\rangle$")
+    ax.fill_between(t, me["lo_3sem"], me["hi_3sem"], color="#2f5f9e", alpha=0.8, lw=0,
+                    label=rf"$\pm3$ SEM of $\langle E\rangle$ (ours): $\leq${sem_pct:.1f}%, within the line")
     ax.plot(t, me["mean_E"], color="#0b2f6b", lw=1.6, label=r"$\langle E\rangle(t)$, orbits inside $\Omega$")
     above = me["n_above"].to_numpy() >= 20
     ax.plot(t[above], me["mean_E_above"].to_numpy()[above], color="#2ca02c", lw=1.2, ls="-.", zorder=4,
@@ -85,12 +95,28 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     bx.errorbar(s["t_mid"], s["mu_free"], yerr=3 * s["mu_free_err"], fmt="o-", ms=3, lw=1, color="#0b2f6b",
                 capsize=2, label=r"local $\mu$ (slope of $\log\langle E\rangle$), $\pm3\sigma$")
     bx.axhline(1.0, color="k", lw=0.9, ls="-", label=r"$\mu=1$ (linearised)")
-    bx.axhline(numbers["paper_mu"], color="#d62728", lw=0.9, ls="--", label="paper: 0.91 on [0, 200]")
-    bx.axhline(mu, color="#ff7f0e", lw=0.9, ls="-.", label=f"ours: {mu:.3f} on [0, 200]")
+    bx.hlines(numbers["paper_mu"], w_lo, w_hi, color="#d62728", lw=1.4, ls="--",
+              label=f"paper: {numbers['paper_mu']:g} on [{w_lo:g}, {w_hi:g}]")
+    # fitted μ of each convention, drawn over the times its fit used (the E > E_c curve ends early)
+    styles = {("inside", True): ("#ff7f0e", "-"), ("inside", False): ("#9467bd", "-"),
+              ("above", True): ("#2ca02c", "-."), ("above", False): ("#2ca02c", "-.")}
+    drawn = set()
+    for r in numbers["authors_convention"]["mu"]:
+        lo, hi = r["window"][0], r["t_last"]
+        if (r["selection"], lo, hi) in drawn:  # the E > E_c fits coincide once its curve has ended
+            continue
+        drawn.add((r["selection"], lo, hi))
+        color, ls = styles[(r["selection"], r["window"] == [w_lo, w_hi])]
+        who = {(True, True): "ours = authors': ", (True, False): "ours: ", (False, True): "authors': "}.get(
+            (r["ours"], r["authors"]), "")
+        sel = r"$E>E_c$ only" if r["selection"] == "above" else "all inside"
+        bx.hlines(r["value"], lo, hi, color=color, lw=1.8, ls=ls,
+                  label=f"{who}{sel}, {format_value_err(r['value'], r['err'])} on [{lo:g}, {hi:g}]")
     bx.set_xlim(-0.01 * t_right, t_right)
     bx.set_xlabel(r"$t$")
     bx.set_ylabel(r"$\mu$")
-    bx.legend(fontsize=7, loc="lower right", ncol=2)
+    # below the panel: inside it the legend would hide the short segments near μ ≈ 0.87–0.92
+    bx.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
     bx.grid(True, alpha=0.3)
     ax.text(0.01, 0.985, "(a)", transform=ax.transAxes, va="top", fontsize=10, fontweight="bold")
     bx.text(0.01, 0.96, "(b)", transform=bx.transAxes, va="top", fontsize=10, fontweight="bold")

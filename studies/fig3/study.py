@@ -20,9 +20,23 @@ that after t ≈ 200 "the only remaining orbits will be slowly collapsing
 towards the origin".  The average over orbits still above E_c (the engine's
 snapshots alone) is kept as a secondary curve.
 
-Ribbon: ⟨E⟩ ± 3σ with σ the standard error of the mean (std/√n).
+Ribbons: ours is ⟨E⟩ ± 3 standard errors of the mean (std/√n: how well
+⟨E⟩ is known); the paper's caption says "3 standard deviations", the spread
+of the ensemble's energies (± 3 std), wider by √n.  Both are drawn.
 Errors of μ: bootstrap over orbits (statistical); the least-squares error
 of the fit itself measures the model misfit and is reported separately.
+
+The authors' conventions beside ours (issue 13).  Besides our μ (every orbit
+not escaped, fit on [0, 200]) the study fits μ on ``alt_window`` = [0, 100]
+and fits the average over orbits with E > E_c only on both windows; each is a
+row of its own (key ``authors_convention`` of fig3.json).  ``[study]``
+``authors_selection`` / ``authors_window`` say which of them is the
+authors' reading (default: the paper's own words, every orbit inside Ω on
+[0, 200]); rows in it carry ``authors=True``.  Verdicts: agreement within 2σ
+of the bootstrap error, or within 2σ plus half a unit of the last digit the
+paper quotes (0.91 stands for [0.905, 0.915]); our row's "differs" names an
+authors'-convention row that agrees, if there is one (:func:`mu_verdict`,
+:func:`verdict_beside_authors`).
 
 Stages: ``simulate`` (one engine run with snapshots on the grid, settled
 orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
@@ -36,7 +50,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.decay import snapshot_grid
-from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams
+from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams, Text
 
 
 class Params(StudyParams):
@@ -44,6 +58,11 @@ class Params(StudyParams):
 
     snapshot_grid: NumberLists   # pieces [start, stop, step]
     fit_window: Numbers          # [t_lo, t_hi] of the paper's μ fit
+    alt_window: Numbers          # [t_lo, t_hi] of the second μ fit (beside the paper's window)
+    authors_selection: Text      # "inside" or "above": the authors' reading of "inside Ω at t"
+    authors_window: Numbers      # fit_window or alt_window: the authors' fit window
+    paper_mu_half_unit: Number   # half a unit of the last digit of the paper's μ (quoting precision)
+    ribbon_t: Number             # time of the ribbon rows (3 SD vs 3 SEM)
     later_windows: NumberLists
     sliding_window: Numbers      # [width, stride]
     hist_times: Numbers
@@ -113,15 +132,24 @@ def analyze(study):
     width, stride = (float(v) for v in study.param("sliding_window"))
     t_last = float(me["t"].max())
     sliding = [(lo, lo + width) for lo in np.arange(0.0, t_last - width + 1e-9, stride)]
-    windows = [window] + later + sliding
-    kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding)
+    alt = tuple(float(v) for v in study.param("alt_window"))
+    windows = [window] + later + sliding + [alt]
+    kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding) + ["alt"]
     tab = mu_by_window(me["t"], me["mean_E"], E0, gamma, windows)
     tab["kind"] = kinds
     tab = tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
     n_boot = int(study.param("n_boot"))
     k = min(int(study.param("n_boot_orbits")), n_orbits)
-    boot, scale = bootstrap_mu_first_orbits(_snapshot_rows(study, key, ds.field("traj_id") < k), n_orbits, k, E0,
-                                            gamma, windows, n_boot=n_boot, seed=int(study.param("boot_seed")))
+    rows = _snapshot_rows(study, key, ds.field("traj_id") < k)
+    boot, scale = bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot=n_boot,
+                                            seed=int(study.param("boot_seed")))
+    # the same bootstrap for the average over orbits with E > E_c only: E decreases monotonically, so these
+    # are the rows before settling (the continued rows are all below E_c). Every orbit keeps its row at
+    # t = 0 (E = E0 > E_c), so the orbits, their order and, with the same seed, their Poisson
+    # multiplicities are those of the replicates above: the two curves are resampled together.
+    boot_up, _ = bootstrap_mu_first_orbits(rows[rows["energy"] > E_C], n_orbits, k, E0, gamma, [window, alt],
+                                           n_boot=n_boot, seed=int(study.param("boot_seed")))
+    del rows
     boot["w"] = np.tile(np.arange(len(windows)), n_boot)
     err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
     tab["mu_err"] = err["mu"].to_numpy() * scale
@@ -163,8 +191,18 @@ def analyze(study):
     tau2_pred = float(np.log(E0 / E_C) / (p["mu"] * gamma))
     tau2_pred_err = float(tau2_pred * p["mu_err"] / p["mu"])
 
-    study.compare("μ on [0, 200] (log fit, E(0)=E0)", float(p["mu"]), float(p["mu_err"]), paper_mu,
-                  note=f"bootstrap (orbits) error; fit misfit error {p['mu_fit_err']:.2g}; N = {n_orbits}")
+    alt_row = tab[tab["kind"] == "alt"].iloc[0]
+    boot_err = {("inside", window): float(p["mu_err"]), ("inside", alt): float(alt_row["mu_err"])}
+    err_up = boot_up.assign(w=np.tile(np.arange(2), n_boot)).groupby("w")["mu"].std(ddof=1).to_numpy() * scale
+    boot_err.update({("above", window): float(err_up[0]), ("above", alt): float(err_up[1])})
+    authors = _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits)
+    ribbon = _ribbons(study, me)
+    for r in authors["mu"]:
+        study.compare(r["quantity"], r["value"], r["err"], paper_mu, verdict=r["verdict"],
+                      convention=r["convention"], authors=r["authors"], note=r["note"])
+    for r in ribbon["rows"]:
+        study.compare(r["quantity"], r["value"], None, None, unit="energy", convention=r["convention"],
+                      authors=r["authors"], note=r["note"])
     study.compare("μ free intercept on [0, 200]", float(p["mu_free"]), float(p["mu_free_err"]), None,
                   note="log⟨E⟩ = a − μγt; not in the paper")
     study.compare(f"local μ on [{last['t_lo']:g}, {last['t_hi']:g}] (μ → 1 claim)", float(last["mu_free"]),
@@ -204,7 +242,142 @@ def analyze(study):
         "n_boot": n_boot,
         "n_boot_orbits": min(int(study.param("n_boot_orbits")), n_orbits),
         "paper_mu": paper_mu,
+        "authors_convention": {**authors, "ribbon": {k: v for k, v in ribbon.items() if k != "rows"}},
     })
+
+
+SELECTIONS = {  # which orbits ⟨E⟩(t) averages over; the keys of [study] authors_selection
+    "inside": "every orbit not escaped by t (settled ones continued below E_c)",
+    "above": "orbits with E > E_c only (an orbit leaves at settling, as for P(t))",
+}
+
+
+WHO = {"inside": "every orbit inside Ω", "above": "orbits with E > E_c only"}  # short, for row names
+
+
+def mu_verdict(value: float, err: float, paper: float, half_unit: float) -> str:
+    """mu_verdict(value, err, paper, half_unit) -> verdict of a fitted μ against the paper's quoted μ.
+
+    μ of Eq. (eqn:energy_exp_decay) is dimensionless; ``err`` is its 1σ
+    (bootstrap over orbits) error; ``half_unit`` is half a unit of the last
+    digit the paper prints (0.005 for its "0.91", which stands for any μ in
+    [0.905, 0.915)).  Returns "agrees within 2σ" if |μ − paper| ≤ 2 err,
+    else "agrees to the paper's quoted digits" if |μ − paper| ≤ 2 err +
+    half_unit (our error is far below the paper's rounding: a 2σ test alone
+    would fail a μ that prints as the paper's), else "differs".
+    """
+    d = abs(float(value) - float(paper))
+    if d <= 2 * float(err):
+        return "agrees within 2σ"
+    if d <= 2 * float(err) + float(half_unit):
+        return "agrees to the paper's quoted digits"
+    return "differs"
+
+
+def verdict_beside_authors(verdict: str, authors_rows) -> str:
+    """verdict_beside_authors(verdict, authors_rows) -> our row's verdict, knowing the authors'-convention rows.
+
+    The project's rule: "differs" is kept for a difference that survives
+    the authors' convention.  If ``verdict`` is "differs" and one of
+    ``authors_rows`` (dicts with ``verdict`` and ``label``) agrees, the
+    verdict says that the difference is in our convention only and names
+    the rows under which it agrees; otherwise it is returned unchanged.
+    """
+    if verdict != "differs":
+        return verdict
+    agree = [r["label"] for r in authors_rows if str(r.get("verdict", "")).startswith("agrees")]
+    if not agree:
+        return verdict
+    return f"differs in our convention only; agrees under the authors' ({'; '.join(agree)})"
+
+
+def _window_text(w) -> str:
+    return f"[{w[0]:g}, {w[1]:g}]"
+
+
+def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -> dict:
+    """μ of Eq. (eqn:energy_exp_decay) in each selection × window, flagged and judged (key authors_convention).
+
+    ``me``: the fig3_mean_energy table (columns t, mean_E, mean_E_above, n_above); ``boot_err``: {(selection,
+    window): 1σ bootstrap error}.  Selection "inside" averages every orbit not escaped by t, "above" only
+    the orbits with E > E_c (its curve ends when the last orbit settles: its fit uses the points up to then,
+    whatever the window says).  Each fit is the unweighted log fit with E(0) = E0 (:func:`fit_energy_decay`).
+    The row in (fit_window, "inside") is ours, the one that fig3.json ``mu`` holds.
+    """
+    from hhscatter.analysis.decay import fit_energy_decay
+
+    paper_mu = float(study.param("paper_mu"))
+    half = float(study.param("paper_mu_half_unit"))
+    a_sel = str(study.param("authors_selection"))
+    a_win = tuple(float(v) for v in study.param("authors_window"))
+    if a_sel not in SELECTIONS:
+        raise ValueError(f"[study] authors_selection must be one of {sorted(SELECTIONS)}, got {a_sel!r}")
+    if a_win not in (window, alt):
+        raise ValueError(f"[study] authors_window must be fit_window {list(window)} or alt_window {list(alt)}, "
+                         f"got {list(a_win)}")
+    column = {"inside": "mean_E", "above": "mean_E_above"}
+    t = me["t"].to_numpy()
+    t_end_above = float(t[me["n_above"].to_numpy() > 0].max())
+    out = []
+    for sel in ("inside", "above"):
+        for w in (window, alt):
+            f = fit_energy_decay(t, me[column[sel]].to_numpy(), E0, gamma, w)
+            used = (t >= w[0]) & (t <= w[1]) & np.isfinite(me[column[sel]].to_numpy())
+            t_last = float(t[used].max())
+            is_ours = sel == "inside" and w == window
+            is_authors = sel == a_sel and w == a_win
+            who = "authors' and ours" if is_ours and is_authors else (
+                "authors'" if is_authors else ("ours" if is_ours else "alternative"))
+            ends = (f" (its points end at t = {t_last:g}: no orbit is above E_c later)"
+                    if t_last < w[1] else "")
+            label = f"{sel}, fit {_window_text(w)}"
+            err = boot_err[(sel, w)]
+            out.append({
+                "selection": sel, "window": list(w), "label": label,
+                "quantity": (f"μ on {_window_text(w)} (log fit, E(0)=E0)" if is_ours else
+                             f"μ on {_window_text(w)}, {WHO[sel]}"),
+                "value": f.mu, "err": err, "fit_err": f.mu_err, "n_points": f.n_points, "t_last": t_last,
+                "ours": is_ours, "authors": is_authors,
+                "convention": (f"{who}: {SELECTIONS[sel]}; unweighted log fit on {_window_text(w)}{ends}; "
+                               f"{study.convention_label}"),
+                "verdict": mu_verdict(f.mu, err, paper_mu, half),
+                "note": (f"bootstrap (orbits) error; fit misfit error {f.mu_err:.2g}; N = {n_orbits}; "
+                         f"{abs(f.mu - paper_mu) / err:.1f}σ from {paper_mu:g}"),
+            })
+    ours = next(r for r in out if r["ours"])
+    ours["verdict"] = verdict_beside_authors(ours["verdict"], [r for r in out if r["authors"] and not r["ours"]])
+    return {"authors_selection": a_sel, "authors_window": list(a_win), "selections": SELECTIONS,
+            "reading": ("the paper's Fig. 3: μ = 0.91 on [0, 200] of ⟨E⟩ 'over an ensemble of trajectories "
+                        "inside Ω at time t'; selection and window flagged authors=True: [study] "
+                        "authors_selection, authors_window"),
+            "paper_mu": paper_mu, "paper_mu_half_unit": half, "t_end_above": t_end_above, "mu": out}
+
+
+def _ribbons(study, me) -> dict:
+    """The two ribbons of Fig. 3 at [study] ribbon_t: ± 3 SD of the energies (the caption's "3 standard
+    deviations", the ensemble's spread) and ± 3 SEM (ours, = 3 SD/√n: how well ⟨E⟩ is known); energies in
+    model units.  Also the largest half-width relative to ⟨E⟩ of each over the figure's time axis."""
+    t = me["t"].to_numpy()
+    i = int(np.argmin(np.abs(t - float(study.param("ribbon_t")))))
+    r = me.iloc[i]
+    t_max = study.param("plot_t_max")
+    vis = t <= (t[-1] if t_max is None else float(t_max))
+    rel_sd = float((3 * me["std_E"] / me["mean_E"])[vis].max())
+    rel_sem = float((3 * me["sem_E"] / me["mean_E"])[vis].max())
+    n = int(r["n"])
+    tr = f"t = {float(r['t']):g}"
+    rows = [
+        {"quantity": f"ribbon half-width at {tr}: 3 standard deviations of E", "value": float(3 * r["std_E"]),
+         "authors": True, "convention": "authors': ± 3 standard deviations of the energies of the orbits inside Ω "
+                                        "(the ensemble's spread; Fig. 3 caption)",
+         "note": f"{3 * r['std_E'] / r['mean_E']:.2%} of ⟨E⟩ = {r['mean_E']:.4g}; n = {n} orbits"},
+        {"quantity": f"ribbon half-width at {tr}: 3 standard errors of ⟨E⟩", "value": float(3 * r["sem_E"]),
+         "authors": False, "convention": "ours: ± 3 standard errors of the mean ⟨E⟩ (= 3 SD/√n)",
+         "note": f"{3 * r['sem_E'] / r['mean_E']:.3%} of ⟨E⟩; SD/SEM = {r['std_E'] / r['sem_E']:.4g} = √n"},
+    ]
+    return {"t": float(r["t"]), "n": n, "mean_E": float(r["mean_E"]), "half_width_3sd": float(3 * r["std_E"]),
+            "half_width_3sem": float(3 * r["sem_E"]), "max_rel_half_width_3sd": rel_sd,
+            "max_rel_half_width_3sem": rel_sem, "rows": rows}
 
 
 def _nearest(grid, times):
