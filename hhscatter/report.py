@@ -114,6 +114,9 @@ def _verdict_class(v):
     v = v.lower()
     if v.startswith("agree") or v.startswith("consistent") or v.startswith("reproduced"):
         return "ok"
+    if v.startswith("differs in") and "only" in v:
+        # a difference that does not survive the authors' convention: not counted as one
+        return "meh"
     if v.startswith("differ") or v.startswith("not"):
         return "bad"
     return "meh"
@@ -223,7 +226,11 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
              "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
              "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
              "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: |ours − paper| "
-             "≤ 2σ (our statistical error) unless the row says otherwise.", "",
+             "≤ 2σ (our statistical error) unless the row says otherwise. The paper's numbers are in the authors' "
+             "convention; the column *convention (ours)* says how each of ours was made (\"authors'\" marks a row "
+             "made in the authors' own convention). \"Differs\" is kept for differences that survive the authors' "
+             "convention; one that does not reads \"differs in our convention only\" and is not counted as a "
+             "difference.", "",
              f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
              f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str))}.", "",
              "## The paper's numbers beside ours", "", _count_line(paper_rows), "",

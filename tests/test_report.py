@@ -66,3 +66,13 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
                                         (2.5e-14, 1e-15, "2.5e-14 ± 1.0e-15"), (0.0, 8.3e-6, "0 ± 8.3e-06"), (-9.2e-4, 5.2e-4, "-0.0009 ± 0.0005"), (152.0, 7.0, "152 ± 7")])
 def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
     assert format_value_err(v, err) == want
+
+
+def test_a_difference_only_in_our_convention_is_not_counted_as_one():
+    from hhscatter.report import verdict_counts
+
+    rows = [{"verdict": "differs"}, {"verdict": "differs in our convention only; agrees under the authors' ([0, 100])"},
+            {"verdict": "differs in this convention only; within the spread across conventions"},
+            {"verdict": "agrees within 2σ"}]
+    c = verdict_counts(rows)
+    assert (c["bad"], c["meh"], c["ok"]) == (1, 2, 1)

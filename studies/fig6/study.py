@@ -91,6 +91,7 @@ class Params(StudyParams):
     n_components: Integer
     mixtures: list[Mixture]
     mixture_fit_window: Numbers
+    mixture_max_orbits: Integer = None  # the mixture model uses the snapshots of orbits traj_id < this (None: all)
     mixture_plotted: Text = None
     alpha: Number
     paper_kappa_a: Number        # the paper's κ0(E) law (Fig. 2b caption): a x² + b x below E_b, c x above,
@@ -307,7 +308,13 @@ def analyze(study):
         # so the two RMS log residuals compare the constants alone
         homog_pc = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa_pc, E0=E0, mu=pc["mu"], gamma=g,
                                      tau0=tau0, E_c=E_c, hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
-        snaps = read_snapshots(raw, filters=pads.field("t") >= tau0)
+        # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
+        # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
+        cap = study.param("mixture_max_orbits")
+        keep = pads.field("t") >= tau0
+        if cap is not None:
+            keep = keep & (pads.field("traj_id") < int(cap))
+        snaps = read_snapshots(raw, filters=keep)
         mixes = {}
         for var in mixtures:
             t_ref = tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
