@@ -45,7 +45,7 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     ax.fill_between(t, me["lo_3sigma"], me["hi_3sigma"], color="#9ab8de", alpha=0.55, lw=0,
                     label=rf"$\pm3$ SD of $E$ (spread; the paper's ribbon): $\leq${sd_pct:.0f}% of $\langle E\rangle$")
     ax.fill_between(t, me["lo_3sem"], me["hi_3sem"], color="#2f5f9e", alpha=0.8, lw=0,
-                    label=rf"$\pm3$ SEM of $\langle E\rangle$ (ours): $\leq${sem_pct:.1f}%, within the line")
+                    label=rf"$\pm3$ SEM of $\langle E\rangle$ (ours): $\leq${sem_pct:.2g}%, within the line")
     ax.plot(t, me["mean_E"], color="#0b2f6b", lw=1.6, label=r"$\langle E\rangle(t)$, orbits inside $\Omega$")
     above = me["n_above"].to_numpy() >= 20
     ax.plot(t[above], me["mean_E_above"].to_numpy()[above], color="#2ca02c", lw=1.2, ls="-.", zorder=4,
