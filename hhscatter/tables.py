@@ -182,6 +182,42 @@ def write_part(path, table, meta: dict, store=None) -> None:
     store.write_atomic(rel, write)
 
 
+def write_parts_streamed(path, tables, meta: dict) -> int:
+    """write_parts_streamed(path, tables, meta) -> rows written: one Parquet file from an iterable of Arrow tables.
+
+    The tables (same columns and types; dictionary columns may have different
+    dictionaries) are written one row group after the other with a
+    ``ParquetWriter``, so only one of them is in memory at a time, and the
+    file appears atomically under ``path`` (as :func:`write_part`, with the
+    same options and metadata key).
+    """
+    import pyarrow.parquet as pq
+
+    from .store import Store
+
+    path = Path(path)
+    store, rows = Store(path.parent), [0]
+
+    def write(target, filesystem):
+        writer = None
+        try:
+            for t in tables:
+                if writer is None:
+                    schema = t.schema.with_metadata({META_KEY: json.dumps(meta, sort_keys=True).encode()})
+                    writer = pq.ParquetWriter(target, schema, filesystem=filesystem, compression="zstd",
+                                              write_statistics=True, write_page_checksum=True)
+                writer.write_table(t.replace_schema_metadata(schema.metadata))
+                rows[0] += t.num_rows
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise ValueError(f"{path}: no table to write")
+
+    store.write_atomic(path.name, write)
+    return rows[0]
+
+
 def part_name(chunk: int) -> str:
     return f"part-{chunk:06d}.parquet"
 

@@ -40,3 +40,27 @@ def test_record_adds_resumed_invocations_and_a_fresh_run_replaces_them(tmp_path)
     record(tmp_path, StageCost("simulate", wall_s=1, cpu_s=2, orbits=7))  # a fresh run: nothing resumed
     t = totals(json.loads((tmp_path / "cost.json").read_text()))
     assert t["simulate"]["orbits"] == 7 and t["simulate"]["invocations"] == 1
+
+
+def test_streamed_table_is_one_file_with_a_row_group_per_part(tmp_path):
+    """write_parts_streamed: the parts in order, their dictionaries may differ, the metadata is the study's."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from hhscatter.tables import read_meta, write_parts_streamed
+
+    dic = pa.dictionary(pa.int8(), pa.string())
+    parts = [pa.table({"g": pa.array([0.0, 0.0]), "o": pa.array(["escaped", "censored"]).cast(dic)}),
+             pa.table({"g": pa.array([1.0]), "o": pa.array(["settled"]).cast(dic)})]
+    path = tmp_path / "t.parquet"
+    assert write_parts_streamed(path, iter(parts), {"study": "x"}) == 3
+    f = pq.ParquetFile(path)
+    assert f.num_row_groups == 2 and read_meta(path) == {"study": "x"}
+    back = pq.read_table(path).to_pandas()
+    assert list(back["o"].astype(str)) == ["escaped", "censored", "settled"] and list(back["g"]) == [0, 0, 1]
+    assert str(back["o"].dtype) == "category"
+    import pytest
+
+    with pytest.raises(ValueError, match="no table"):
+        write_parts_streamed(tmp_path / "empty.parquet", iter([]), {})
+    assert not (tmp_path / "empty.parquet").exists()

@@ -282,6 +282,16 @@ class Study:
         write_part(path, table, _jsonable(doc))
         return path
 
+    def write_table_streamed(self, tables, fname: str, **meta) -> Path:
+        """write_table_streamed(iterable of Arrow tables, fname, **meta) -> path: a derived table too large to hold
+        at once (e.g. one part per γ of 1e7 rows), written part by part with the study's metadata."""
+        from ..tables import provenance, write_parts_streamed
+
+        doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
+        path = self.derived(fname)
+        write_parts_streamed(path, tables, _jsonable(doc))
+        return path
+
 
 def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) -> Study:
     """load_study(name, scale='quick', root=None) -> Study from ``<root>/<name>/study.toml``."""

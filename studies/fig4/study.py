@@ -144,7 +144,8 @@ def analyze(study):
     nb = int(study.param("n_boot"))
     K = min(int(study.param("n_boot_orbits")), N)
     boot = bootstrap_transition_times(
-        {g: (lts[g]["t_end"].to_numpy()[:K], lts[g]["outcome"].to_numpy()[:K]) for g in gs}, 0.0, grid,
+        # slice before converting: a view of a converted 1e7 object array would keep all of it alive (690 MB per γ)
+        {g: (lts[g]["t_end"].iloc[:K].to_numpy(), lts[g]["outcome"].iloc[:K].to_numpy()) for g in gs}, 0.0, grid,
         tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=int(study.param("boot_seed")) + 1,
     )
     bscale = float(np.sqrt(K / N))
@@ -156,10 +157,10 @@ def analyze(study):
     study.write_table(surv, "fig4_survival.parquet", **meta)
     study.write_table(ratio, "fig4_ratio.parquet", **meta)
     # published for the studies that build on fig4 (fig6): every orbit's lifetime per γ, orbit order
-    study.write_table(pd.concat([lts[g].assign(gamma=g)[["gamma", "t_end", "outcome"]] for g in gs],
-                                ignore_index=True), LIFETIMES_TABLE, **meta,
-                      description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
-                                  "the same initial conditions for every γ")
+    # one row group per γ, written one after the other (6 × 1e7 rows at paper scale: never concatenated)
+    study.write_table_streamed((_lifetimes_arrow(g, lts[g]) for g in gs), LIFETIMES_TABLE, **meta,
+                               description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
+                                           "the same initial conditions for every γ; one row group per γ")
 
     tau0_err = float(boot["tau0"].std(ddof=1)) * bscale
     exponents = _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err)
@@ -167,23 +168,44 @@ def analyze(study):
                                  tau0_err, exponents, nb, K))
 
 
+def _lifetimes_arrow(g, lt):
+    """Arrow table (gamma, t_end, outcome) of one γ; outcome dictionary-encoded (pandas reads it as a category)."""
+    import pyarrow as pa
+
+    n = len(lt)
+    return pa.table({"gamma": pa.array(np.full(n, float(g))), "t_end": pa.array(lt["t_end"].to_numpy()),
+                     "outcome": pa.array(lt["outcome"]).cast(pa.dictionary(pa.int8(), pa.string()))})
+
+
 def _read_lifetimes(study, gs):
     """({γ: DataFrame(t_end, outcome) in traj_id order}, N, last t_end): the runs must share their initial
-    conditions (paired ensembles); only what the analysis needs is kept (N = 1e7 per curve at paper scale)."""
-    from hhscatter.tables import read_lifetimes
+    conditions (paired ensembles); only what the analysis needs is kept (N = 1e7 per curve at paper scale).
+
+    Read as Arrow columns (no Python string per orbit: ``outcome`` stays a categorical of 1 byte per orbit),
+    so memory is ~40 bytes per orbit while one run is read and ~9 bytes per orbit and γ kept.
+    """
+    from hhscatter.tables import read_arrow
 
     lts, ref = {}, None
     for g in gs:
-        lt = read_lifetimes(study.raw(raw_key(g)), columns=["traj_id", "x0", "y0", "outcome", "t_end"])
-        lt = lt.sort_values("traj_id").reset_index(drop=True)
-        xy = lt[["x0", "y0"]].to_numpy()
+        t = read_arrow(study.raw(raw_key(g)), "lifetimes", columns=["traj_id", "x0", "y0", "outcome", "t_end"])
+        ids = t.column("traj_id").to_numpy()
+        # the engine writes parts in orbit order: no reordering (and no copies) unless they came otherwise
+        order = slice(None) if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
+        del ids
+        xy = (t.column("x0").to_numpy()[order], t.column("y0").to_numpy()[order])
         if ref is None:
             ref = xy
-        elif xy.shape != ref.shape or not np.array_equal(xy, ref):
+        elif xy[0].shape != ref[0].shape or not (np.array_equal(xy[0], ref[0]) and np.array_equal(xy[1], ref[1])):
             raise ValueError(f"fig4: run {raw_key(g)} does not share the initial conditions of {raw_key(gs[0])}")
-        lts[g] = pd.DataFrame({"t_end": lt["t_end"].to_numpy(), "outcome": lt["outcome"].astype("category")})
+        outcome = pd.Series(t.column("outcome").to_pandas(), copy=False)  # categorical (dictionary-encoded)
+        if not isinstance(outcome.dtype, pd.CategoricalDtype):
+            outcome = outcome.astype("category")
+        lts[g] = pd.DataFrame({"t_end": t.column("t_end").to_numpy()[order],
+                               "outcome": outcome.iloc[order].reset_index(drop=True)})
+        del t, xy
     t_last = max(float(lt["t_end"].max()) for lt in lts.values())
-    return lts, len(ref), t_last
+    return lts, len(ref[0]), t_last
 
 
 def _own_mu(study, mg, E0, N):

@@ -570,9 +570,13 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
         tname = doc.get("tables", {}).get("lifetimes")
         if not tname:
             raise up.UpstreamError(f"{other}.json names no published lifetimes table ('tables': {{'lifetimes': …}})")
-        life = up.table(study, other, tname)
         inputs["tau_lifetimes"] = {"source": f"{other}: derived/{tname}"}
-        by_gamma = {float(g): d[["t_end", "outcome"]].reset_index(drop=True) for g, d in life.groupby("gamma")}
+        # one γ at a time (6 × 1e7 rows at paper scale): only the γ of the τ table and the reference γ = 0
+        by_gamma = {}
+        for g in sorted({0.0, *(float(v) for v in obs["gamma"])}):
+            d = up.table(study, other, tname, filters=[("gamma", "==", g)])
+            if len(d):
+                by_gamma[g] = d[["t_end", "outcome"]].reset_index(drop=True)
         if 0.0 not in by_gamma:
             raise up.UpstreamError(f"{other}'s {tname} has no γ = 0 rows (the conservative reference)")
         t0c, P0c, _ = _curve(by_gamma[0.0], dt)
