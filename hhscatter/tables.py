@@ -342,10 +342,10 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False):
     return make(paths, exprs)
 
 
-def _read(run_dir, name: str, columns=None, filters=None):
+def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False):
     table = _dataset(run_dir, name).to_table(columns=columns, filter=filters)
     df = table.to_pandas()
-    if "outcome" in df.columns:
+    if "outcome" in df.columns and not categorical:
         df["outcome"] = df["outcome"].astype(str)
     if "exit_channel" in df.columns:
         df["exit_channel"] = df["exit_channel"].astype("Int8")
@@ -423,18 +423,19 @@ def iter_parts(run_dir, name: str, columns=None):
         yield part.to_table(columns=columns).to_pandas()
 
 
-def read_lifetimes(run_dir, columns=None, filters=None):
-    """read_lifetimes(run_dir, columns=None, filters=None) -> pandas.DataFrame of the lifetimes table.
+def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = False):
+    """read_lifetimes(run_dir, columns=None, filters=None, *, categorical=False) -> pandas.DataFrame.
 
-    ``columns`` projects (only those columns are read); ``filters`` is a
-    pyarrow.dataset expression. ``outcome`` comes back as str, ``exit_channel``
+    The lifetimes table. ``columns`` projects (only those columns are read); ``filters`` is a
+    pyarrow.dataset expression. ``outcome`` comes back as str (``categorical=True``: as a pandas
+    categorical, 1 byte per orbit instead of a Python string, for 1e7 orbits and more), ``exit_channel``
     as nullable Int8. A grid run has the column ``energy`` (the point's
     nominal E0) besides ``gamma``; filter on them to read one point:
     ``filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)``.
     Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…`` folders)
     come back with the same columns.
     """
-    return _read(run_dir, "lifetimes", columns, filters)
+    return _read(run_dir, "lifetimes", columns, filters, categorical)
 
 
 def read_sections(run_dir, columns=None, filters=None):

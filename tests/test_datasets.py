@@ -141,3 +141,17 @@ def test_old_layout_run_resumes_in_its_own_layout(grid, old_run, tmp_path):
         assert table.equals(before[k][0]) and meta == before[k][1], k
     assert [p["partition"] for p in json.loads((out / "scene.json").read_text())["points"]][1] == \
         "energy=0.25/gamma=0.01"
+
+
+def test_read_lifetimes_categorical_is_the_same_table_at_one_byte_per_outcome(run):
+    """categorical=True (the route for 1e7 orbits): the same labels, as a pandas categorical."""
+    import pandas as pd
+
+    from hhscatter.tables import read_lifetimes
+
+    plain = read_lifetimes(run)
+    cat = read_lifetimes(run, categorical=True)
+    assert isinstance(cat["outcome"].dtype, pd.CategoricalDtype) and plain["outcome"].dtype == object
+    assert list(cat["outcome"].astype(str)) == list(plain["outcome"])
+    assert cat["outcome"].cat.codes.dtype.itemsize == 1
+    pd.testing.assert_frame_equal(cat.drop(columns="outcome"), plain.drop(columns="outcome"))

@@ -83,8 +83,21 @@ CENSORED_OUTCOME = "censored"
 def observed_from_outcome(outcome) -> np.ndarray:
     """observed_from_outcome(outcome) -> bool array: True for 'escaped'/'settled', False for 'censored'/'stopped'.
 
-    Raises ValueError on any other (or missing) outcome label.
+    Raises ValueError on any other (or missing) outcome label. A pandas categorical is mapped through its
+    categories (one label test per category, then the codes: no Python object per orbit).
     """
+    import pandas as pd
+
+    cat = outcome.array if isinstance(outcome, pd.Series) else outcome
+    if isinstance(cat, pd.Categorical):
+        labels = np.asarray(cat.categories, dtype=object)
+        leaving_c = np.isin(labels, LEAVING_OUTCOMES)
+        bad_c = ~(leaving_c | np.isin(labels, CENSORING_OUTCOMES))
+        codes = np.asarray(cat.codes)
+        if (codes < 0).any() or bad_c[codes].any():
+            seen = {repr(v) for v in labels[np.unique(codes[codes >= 0])][bad_c[np.unique(codes[codes >= 0])]]}
+            raise ValueError(f"unknown outcome labels: {sorted(seen | ({'nan'} if (codes < 0).any() else set()))[:5]}")
+        return leaving_c[codes]
     o = np.asarray(outcome, dtype=object).ravel()
     leaving = np.isin(o, LEAVING_OUTCOMES)
     censored = np.isin(o, CENSORING_OUTCOMES)

@@ -49,6 +49,19 @@ __all__ = [
 # ---------------------------------------------------------------------------
 # τ1
 # ---------------------------------------------------------------------------
+
+def outcome_is(outcome, value: str) -> np.ndarray:
+    """outcome_is(outcome, value) -> bool array: outcome == value, without a Python string per orbit.
+
+    ``outcome``: an array of labels, or a pandas Series/Categorical (compared on its codes: a categorical of
+    1e7 orbits would otherwise become a 1e7-element object array).
+    """
+    import pandas as pd
+
+    if isinstance(outcome, (pd.Series, pd.Categorical, pd.Index)):
+        return np.array(outcome == value, dtype=bool).ravel()  # a writable copy (callers combine masks in place)
+    return np.asarray(outcome).ravel() == value
+
 def _log_ratio(P_gamma, P_0, alpha):
     """D = ln P_γ − ln(α P_0), with +inf where P_0 = 0 < P_γ and NaN where both vanish."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -147,7 +160,7 @@ def tau2_observed_arrays(t_end, outcome):
     censored orbits are not used.
     """
     t_end = np.asarray(t_end, dtype=float).ravel()
-    settled = (np.asarray(outcome).ravel() == "settled") & np.isfinite(t_end)
+    settled = outcome_is(outcome, "settled") & np.isfinite(t_end)
     return float(t_end[settled].min()) if settled.any() else None
 
 
@@ -157,7 +170,7 @@ def tau2_observed(lifetimes: pd.DataFrame):
     The observed τ2 of the paper's Fig. 6b caption: "the first time at which
     the energy of a non-escaping orbit dropped below E_c".
     """
-    return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy())
+    return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"])
 
 
 @dataclass(frozen=True)
@@ -208,7 +221,7 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
     from scipy import stats
 
     t_end = np.asarray(t_end, dtype=float).ravel()
-    settled = (np.asarray(outcome).ravel() == "settled") & np.isfinite(t_end)
+    settled = outcome_is(outcome, "settled") & np.isfinite(t_end)
     x = np.sort(t_end[settled])
     n = int(t_end.size)
     if not 0 < p < 1 or n == 0:
@@ -238,7 +251,7 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
 def tau2_observed_interval(lifetimes: pd.DataFrame, level: float = 0.6826894921370859) -> OrderStatisticInterval:
     """tau2_observed_interval(lifetimes) -> :func:`settle_quantile_interval` at p = 1/N: the observed τ2 (first
     settling time) and the order-statistic interval of the quantile it estimates."""
-    return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"].to_numpy(),
+    return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"],
                                     1.0 / len(lifetimes), level)
 
 
@@ -273,7 +286,7 @@ def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
     ensemble size N (the first of N·f_ne settlers).  None if nobody settled.
     """
     t_end = np.asarray(t_end, dtype=float).ravel()
-    s = np.asarray(outcome).ravel() == "settled"
+    s = outcome_is(outcome, "settled")
     w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
     s &= w > 0
     if not s.any():

@@ -159,7 +159,7 @@ def analyze(study):
         # the rule with the current analysis code (differs only if escape_rate changed since simulate)
         r = _pilot_rate(study.raw(f"pilot_{key}"))
         t_rec_now = recording_time(r.kappa, r.tau0, rec_efolds)
-        lt = read_lifetimes(study.raw(key), columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
+        lt = read_lifetimes(study.raw(key), columns=["traj_id", "e0", "gamma", "outcome", "t_end"], categorical=True)
         sec = read_sections(study.raw(key))
         if (sec["t"] < t_rec).any() or sec["traj_id"].duplicated().any():
             raise RuntimeError(f"{key}: sections must hold one crossing per orbit at t ≥ t_rec")

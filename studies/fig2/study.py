@@ -137,7 +137,7 @@ def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds
 def _lifetimes(path):
     from hhscatter.tables import read_lifetimes
 
-    return read_lifetimes(path, columns=LIFETIME_COLUMNS)
+    return read_lifetimes(path, columns=LIFETIME_COLUMNS, categorical=True)  # 1e7 orbits: no str per orbit
 
 
 def _t_max_choice(study, pilot_dir, n):

@@ -115,7 +115,7 @@ def analyze(study):
     E_C = study.model.critical_energy
     ime = inside_mean_energy(iter_parts(study.raw(key), "snapshots", ["t", "energy"]), E_C)
     me, ma, cont = ime.inside, ime.above, {"rows_below_ec": ime.rows_below_ec}
-    lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"])
+    lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"], categorical=True)
     n_orbits = len(lt)
 
     me["lo_3sem"] = me["mean_E"] - 3 * me["sem_E"]

@@ -297,7 +297,7 @@ def analyze(study):
     for E0, g in _pairs(study):
         label = pair_key(E0, g)
         raw = study.raw(label)
-        lt = read_lifetimes(raw, columns=["traj_id", "t_end", "outcome", "e0", "gamma"])
+        lt = read_lifetimes(raw, columns=["traj_id", "t_end", "outcome", "e0", "gamma"], categorical=True)
         n = len(lt)
         t, P, P_err = _curve(lt, dt)
         tf, Pf, sf = _fit_points(t, P, P_err, tau0, fit_dt, n, min_count)
@@ -587,7 +587,7 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
             raise
         # development only: observed τ2 from this study's own E0 = 0.3 runs, no τ1 (no γ = 0 run)
         inputs["tau_table"] = {"source": up.DEV_SOURCE + ": own E0 runs, τ1 not available"}
-        lifetimes = {g: read_lifetimes(study.raw(pair_key(e, g)), columns=["t_end", "outcome"])
+        lifetimes = {g: read_lifetimes(study.raw(pair_key(e, g)), columns=["t_end", "outcome"], categorical=True)
                      for e, g in _pairs(study) if abs(e - E0) < 1e-12}
         obs = pd.DataFrame({"gamma": sorted(lifetimes), "tau1_observed": None, "tau1_err": None, "tau2_err": None,
                             "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)]})

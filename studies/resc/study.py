@@ -105,7 +105,7 @@ def _lifetimes(study, E, r):
     from hhscatter.analysis.survival import lifetimes_to_arrays
     from hhscatter.tables import read_lifetimes
 
-    lt = read_lifetimes(study.raw(_key(E, r)), columns=["traj_id", "outcome", "t_end", "exit_channel"])
+    lt = read_lifetimes(study.raw(_key(E, r)), columns=["traj_id", "outcome", "t_end", "exit_channel"], categorical=True)
     lt = lt.sort_values("traj_id", kind="stable").reset_index(drop=True)
     t, obs = lifetimes_to_arrays(lt, check_single_ensemble=False)  # one run = one ensemble
     ch = lt.exit_channel.astype("Float64").to_numpy(dtype=float, na_value=np.nan)
