@@ -298,7 +298,7 @@ def test_fig2_paper_n_per_energy_is_declared_per_grid_energy():
 
     paper = load_study("fig2", "paper")
     grid, per = paper.params["grid_energies"], paper.params["grid_n_by_energy"]
-    assert [grid_n(paper, e) for e in grid] == per and grid_n(paper, 0.18) == 750000
+    assert [grid_n(paper, e) for e in grid] == per and grid_n(paper, 0.18) == 750000 and grid_n(paper, 0.4) == 250000
     assert all(n >= 100000 for n in per)
     assert grid_n(load_study("fig2", "quick"), 0.18) == 30000  # no list: grid_n everywhere
     paper.config["study"]["grid_n_by_energy"] = per[:-1]
