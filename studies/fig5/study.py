@@ -333,6 +333,8 @@ def _mu(study, inputs):
 def _point_sets(study, gammas, E1, E2, mu, mu_err):
     """({(γ, 'a'|'b'): points}, per-γ DataFrame, point tables): the first crossing after t* of each surviving
     orbit (Fig. 5a) and those in the energy band (Fig. 5b), capped at n_cap points."""
+    import pyarrow.dataset as pads
+
     from hhscatter.tables import read_lifetimes, read_sections
 
     band = tuple(float(b) for b in study.param("band"))
@@ -343,7 +345,9 @@ def _point_sets(study, gammas, E1, E2, mu, mu_err):
         t_star = time_to_energy(E2, E1, mu, g)
         t_star_err = t_star * mu_err / mu if math.isfinite(mu_err) else math.nan
         lt = read_lifetimes(raw, columns=["traj_id", "t_end"])
-        sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
+        # only crossings at or after t* can be a first crossing after t* (pushed down to the reader: at N = 1e7
+        # the whole recorded window [t*(μ_max), t*(μ_min) + pad] is ~1e7 rows)
+        sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"], filters=pads.field("t") >= t_star)
         win = _scene_for(study, g).sections
         if not win.t_from <= t_star <= win.t_to:
             raise ValueError(f"t* = {t_star:.3f} outside the recorded section window [{win.t_from}, {win.t_to}]")
