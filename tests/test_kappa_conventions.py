@@ -97,3 +97,13 @@ def test_law_spread_is_half_the_range_across_conventions():
     assert out["a"]["value"] == 12.0 and out["a"]["spread"] == 2.0 and out["a"]["err_stat"] == 2.0
     assert out["a"]["err"] == pytest.approx(math.hypot(2.0, 2.0))
     assert out["c"]["spread"] == 0.0 and out["a"]["per_convention"] == {"one": 10.0, "two": 14.0}
+
+
+def test_quoted_verdict_uses_the_papers_printed_precision():
+    from hhscatter.analysis.verdicts import half_unit, quoted_verdict
+
+    assert half_unit(0.27) == pytest.approx(0.005) and half_unit(13.63) == pytest.approx(0.005)
+    assert half_unit(100.0) == 0.5 and half_unit(1.0) == 0.5
+    assert quoted_verdict(0.2705, 0.001, 0.27, 0.005) == "agrees within 2σ"
+    assert quoted_verdict(0.2750, 0.0021, 0.27, 0.005) == "agrees to the paper's quoted digits"
+    assert quoted_verdict(0.2800, 0.0021, 0.27, 0.005) == "differs"

@@ -39,6 +39,7 @@ import warnings
 
 import numpy as np
 
+from hhscatter.analysis.verdicts import half_unit, quoted_verdict
 from hhscatter.config import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.runner import SCENE_FILE
 
@@ -584,11 +585,12 @@ def analyze(study):
     law = conv["law"]
     for name in ("a", "b", "c", "E_b"):
         # "differs" only if it survives the spread of the law across conventions (the authors' square ICs among them)
-        verdict = None
-        if abs(fj[name]["value"] - PAPER[name]) > 2 * fj[name]["err"] and name in law:
-            inside = abs(law[name]["value"] - PAPER[name]) <= 2 * law[name]["err"]
-            verdict = ("differs in this convention only; within the spread across conventions" if inside
-                       else "differs")
+        # 2σ, then the paper's printed precision (it gives no errors: 0.27 stands for [0.265, 0.275))
+        verdict = quoted_verdict(fj[name]["value"], fj[name]["err"], PAPER[name], half_unit(PAPER[name]))
+        if verdict == "differs" and name in law:
+            across = quoted_verdict(law[name]["value"], law[name]["err"], PAPER[name], half_unit(PAPER[name]))
+            if across != "differs":
+                verdict = f"differs in this convention only; across conventions: {across}"
         study.compare(f"{name} (κ(E) law, continuous fit)", fj[name]["value"], fj[name]["err"], PAPER[name],
                       unit=units[name], verdict=verdict,
                       note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
@@ -598,6 +600,7 @@ def analyze(study):
             continue
         L = law[name]
         study.compare(f"{name} (κ(E) law across conventions)", L["value"], L["err"], PAPER[name], unit=units[name],
+                      verdict=quoted_verdict(L["value"], L["err"], PAPER[name], half_unit(PAPER[name])),
                       convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
                       authors=True,
                       note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
@@ -609,6 +612,7 @@ def analyze(study):
                   verdict="excluded from the law, not returned as κ ≈ 0")
     for name in ("a", "b", "c", "E_b"):
         study.compare(f"{name} (κ(E) law, separate fits)", sj[name]["value"], sj[name]["err"], PAPER[name],
+                      verdict=quoted_verdict(sj[name]["value"], sj[name]["err"], PAPER[name], half_unit(PAPER[name])),
                       note="the two laws fitted independently on either side of the best partition (as the paper)")
     pt = _analyze_pt(study)
     cm = _analyze_cmeasure(study, grid_df)

@@ -50,6 +50,8 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.decay import snapshot_grid
+from hhscatter.analysis.verdicts import quoted_verdict as mu_verdict
+from hhscatter.analysis.verdicts import verdict_beside_authors
 from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams, Text
 
 
@@ -253,42 +255,6 @@ SELECTIONS = {  # which orbits ⟨E⟩(t) averages over; the keys of [study] aut
 
 
 WHO = {"inside": "every orbit inside Ω", "above": "orbits with E > E_c only"}  # short, for row names
-
-
-def mu_verdict(value: float, err: float, paper: float, half_unit: float) -> str:
-    """mu_verdict(value, err, paper, half_unit) -> verdict of a fitted μ against the paper's quoted μ.
-
-    μ of Eq. (eqn:energy_exp_decay) is dimensionless; ``err`` is its 1σ
-    (bootstrap over orbits) error; ``half_unit`` is half a unit of the last
-    digit the paper prints (0.005 for its "0.91", which stands for any μ in
-    [0.905, 0.915)).  Returns "agrees within 2σ" if |μ − paper| ≤ 2 err,
-    else "agrees to the paper's quoted digits" if |μ − paper| ≤ 2 err +
-    half_unit (our error is far below the paper's rounding: a 2σ test alone
-    would fail a μ that prints as the paper's), else "differs".
-    """
-    d = abs(float(value) - float(paper))
-    if d <= 2 * float(err):
-        return "agrees within 2σ"
-    if d <= 2 * float(err) + float(half_unit):
-        return "agrees to the paper's quoted digits"
-    return "differs"
-
-
-def verdict_beside_authors(verdict: str, authors_rows) -> str:
-    """verdict_beside_authors(verdict, authors_rows) -> our row's verdict, knowing the authors'-convention rows.
-
-    The project's rule: "differs" is kept for a difference that survives
-    the authors' convention.  If ``verdict`` is "differs" and one of
-    ``authors_rows`` (dicts with ``verdict`` and ``label``) agrees, the
-    verdict says that the difference is in our convention only and names
-    the rows under which it agrees; otherwise it is returned unchanged.
-    """
-    if verdict != "differs":
-        return verdict
-    agree = [r["label"] for r in authors_rows if str(r.get("verdict", "")).startswith("agrees")]
-    if not agree:
-        return verdict
-    return f"differs in our convention only; agrees under the authors' ({'; '.join(agree)})"
 
 
 def _window_text(w) -> str:
