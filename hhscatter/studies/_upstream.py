@@ -80,11 +80,12 @@ def numbers(study, other: str) -> dict:
         raise UpstreamError(f"{study.name} needs the outputs of study {other!r}: {exc}") from None
 
 
-def table(study, other: str, name: str, filters=None):
-    """table(study, other, name, filters=None) -> pandas.DataFrame of study ``other``'s published derived table.
+def table(study, other: str, name: str, filters=None, columns=None):
+    """table(study, other, name, filters=None, columns=None) -> pandas.DataFrame of study ``other``'s derived table.
 
     ``name`` is a file of ``studies/<other>/out/<scale>/derived/`` (same scale);
-    ``filters`` as for :func:`pandas.read_parquet`. A study reads other studies'
+    ``filters`` and ``columns`` as for :func:`pandas.read_parquet` (read only what is needed: some
+    published tables have 6e7 rows at paper scale). A study reads other studies'
     published outputs (numbers JSON, derived tables), never their raw runs.
     """
     import pandas as pd
@@ -100,7 +101,7 @@ def table(study, other: str, name: str, filters=None):
         have = sorted(p.name for p in path.parent.glob("*")) if path.parent.is_dir() else []
         raise UpstreamError(f"{study.name} needs {path}, a derived table of study {other!r} (present: {have}); "
                             f"run `make {study.name} SCALE={study.scale}`, which builds {other} first")
-    return pd.read_parquet(path, filters=filters)
+    return pd.read_parquet(path, filters=filters, columns=columns)
 
 
 def value_or_fallback(study, other: str, path: str, paper_value, inputs: dict, name: str):

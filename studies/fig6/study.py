@@ -279,6 +279,8 @@ def analyze(study):
     """analyze(study) -> None; model fits, τ predictions, derived tables and fig6.json."""
     import pyarrow.dataset as pads
 
+    import pyarrow as pa
+
     from hhscatter.tables import read_lifetimes, read_snapshots
 
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
@@ -297,7 +299,7 @@ def analyze(study):
     for E0, g in _pairs(study):
         label = pair_key(E0, g)
         raw = study.raw(label)
-        lt = read_lifetimes(raw, columns=["traj_id", "t_end", "outcome", "e0", "gamma"], categorical=True)
+        lt = read_lifetimes(raw, columns=["t_end", "outcome"], categorical=True)  # 9 bytes per orbit
         n = len(lt)
         t, P, P_err = _curve(lt, dt)
         tf, Pf, sf = _fit_points(t, P, P_err, tau0, fit_dt, n, min_count)
@@ -339,6 +341,8 @@ def analyze(study):
                                    tau2_ours=tau2_predicted(E0, E_c, mu, g),
                                    tau2_pc=tau2_predicted(E0, E_c, pc["mu"], g)))
         curves.append(cur.assign(pair=label, E0=E0, gamma=g, N=n))
+        del lt, snaps  # 1e7 lifetimes and 1e6 orbits' snapshots per pair at paper scale: not kept for the next
+        pa.default_memory_pool().release_unused()
     curves = pd.concat(curves, ignore_index=True)
     fits = pd.DataFrame(fit_rows)
     comps = pd.concat(comp_rows, ignore_index=True)
@@ -549,6 +553,8 @@ class _Fig4Ref(NamedTuple):
 
 def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
     """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)."""
+    import pyarrow as pa
+
     from hhscatter.tables import read_lifetimes
 
     E0 = float(study.param("fig4_E0"))
@@ -574,9 +580,11 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
         # one γ at a time (6 × 1e7 rows at paper scale): only the γ of the τ table and the reference γ = 0
         by_gamma = {}
         for g in sorted({0.0, *(float(v) for v in obs["gamma"])}):
-            d = up.table(study, other, tname, filters=[("gamma", "==", g)])
+            d = up.table(study, other, tname, filters=[("gamma", "==", g)], columns=["t_end", "outcome"])
             if len(d):
-                by_gamma[g] = d[["t_end", "outcome"]].reset_index(drop=True)
+                by_gamma[g] = d.reset_index(drop=True)
+            del d
+            pa.default_memory_pool().release_unused()
         if 0.0 not in by_gamma:
             raise up.UpstreamError(f"{other}'s {tname} has no γ = 0 rows (the conservative reference)")
         t0c, P0c, _ = _curve(by_gamma[0.0], dt)
