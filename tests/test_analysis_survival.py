@@ -387,3 +387,21 @@ def test_lifetimes_wrappers():
         lifetimes_to_arrays(df.assign(outcome=np.where(np.arange(n) == 0, "lost", outcome)))
     with pytest.raises(ValueError):
         lifetimes_to_arrays(df.assign(e0=np.where(np.arange(n) == 0, 0.25, 0.3)))
+
+
+def test_observed_from_outcome_on_a_categorical_is_the_label_test():
+    """The categorical route (1e7 orbits: codes, no Python object per orbit) gives the same mask and errors."""
+    import numpy as np
+    import pandas as pd
+    import pytest
+
+    from hhscatter.analysis.survival import observed_from_outcome
+
+    labels = ["escaped", "censored", "settled", "stopped"] * 3
+    cat = pd.Series(labels).astype("category")
+    np.testing.assert_array_equal(observed_from_outcome(cat), observed_from_outcome(np.array(labels, dtype=object)))
+    np.testing.assert_array_equal(observed_from_outcome(cat.array), [True, False, True, False] * 3)
+    with pytest.raises(ValueError, match="bogus"):
+        observed_from_outcome(pd.Series(["escaped", "bogus"]).astype("category"))
+    with pytest.raises(ValueError, match="nan"):
+        observed_from_outcome(pd.Categorical(["escaped", None]))
