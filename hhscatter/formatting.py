@@ -115,6 +115,13 @@ def md_cell(s) -> str:
     return str(s).replace("|", "\\|").replace("\n", " ")
 
 
+def ours_cell(row) -> str:
+    """ours_cell(paper-vs-ours row) -> our number as printed: 'value ± err unit' (or the value as text)."""
+    unit = f" {row['unit']}" if row.get("unit") else ""
+    ours = row.get("ours")
+    return (format_value_err(ours, row.get("err")) if _is_num(ours) else format_value(ours)) + unit
+
+
 def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) -> str:
     """comparison_table(rows, *, study=False, quantity=None, verdict=None) -> Markdown table.
 
@@ -128,13 +135,10 @@ def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) 
     head = ["study"] * study + ["quantity", "ours"] + ["convention (ours)"] * conv + ["paper", "verdict", "note"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        unit = f" {r['unit']}" if r.get("unit") else ""
-        ours = (format_value_err(r.get("ours"), r.get("err")) if _is_num(r.get("ours"))
-                else format_value(r.get("ours")))
         v = r.get("verdict") or "—"
         cells = [r.get("study", "")] * study + [
             quantity(r) if quantity else md_cell(r.get("quantity", "")),
-            md_cell(ours + unit)] + [md_cell(r.get("convention") or "—")] * conv + [
+            md_cell(ours_cell(r))] + [md_cell(r.get("convention") or "—")] * conv + [
             md_cell(format_value(r.get("paper"))),
             verdict(v) if verdict else md_cell(v), md_cell(r.get("note") or "")]
         out.append("| " + " | ".join(str(c) for c in cells) + " |")

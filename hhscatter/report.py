@@ -149,22 +149,15 @@ def _bench(root: Path, name: str = "bench"):
 
 def cost_rows(sections) -> list[dict]:
     """cost_rows(sections) -> one row per study with a cost record: wall and CPU hours, orbits, peak RSS (MB)."""
-    from .studies.cost import totals
+    from .studies.cost import summary
 
     rows = []
     for s in sections:
         if not s.cost:
             continue
-        t = totals(s.cost)
-        sim = t.get("simulate", {})
-        rows.append({
-            "study": s.key,
-            "wall_h": sum(v["wall_s"] for v in t.values()) / 3600,
-            "cpu_h": sum(v["cpu_s"] for v in t.values()) / 3600,
-            "simulate_cpu_h": sim.get("cpu_s", 0.0) / 3600,
-            "orbits": sim.get("orbits", 0),
-            "rss_mb": max(max(v["rss_self_mb"], v["rss_children_mb"]) for v in t.values()),
-        })
+        c = summary(s.cost)
+        rows.append({"study": s.key, "wall_h": c["wall_s"] / 3600, "cpu_h": c["cpu_s"] / 3600,
+                     "simulate_cpu_h": c["simulate_cpu_s"] / 3600, "orbits": c["orbits"], "rss_mb": c["rss_mb"]})
     return rows
 
 

@@ -83,8 +83,9 @@ class Renderer:
         return f'!!! warning "Not yet generated"\n    {what} is not in the docs yet. {how}\n'
 
     def study_asset(self, name: str, ext: str, scale: str = "quick") -> Path:
-        base = self.docs / "studies" / "assets"
-        return (base if scale == "quick" else base / scale) / f"{name}.{ext}"
+        from hhscatter.report import committed_assets
+
+        return committed_assets(self.root / "studies", scale) / f"{name}.{ext}"
 
     def study_params(self, name: str) -> str:
         toml = self.root / "studies" / name / "study.toml"
@@ -139,14 +140,10 @@ class Renderer:
 
     def _both_scales(self, quick_rows, paper_rows) -> str:
         """The paper-vs-ours rows at both scales in one table, matched by quantity."""
-        from hhscatter.formatting import format_value, format_value_err
+        from hhscatter.formatting import format_value, ours_cell
 
         def ours(r):
-            if r is None:
-                return "—"
-            unit = f" {r['unit']}" if r.get("unit") else ""
-            v = r.get("ours")
-            return (format_value_err(v, r.get("err")) if _is_num(v) else format_value(v)) + unit
+            return "—" if r is None else ours_cell(r)
 
         q = {r["quantity"]: r for r in quick_rows}
         order = [r["quantity"] for r in paper_rows] + [k for k in q if k not in {r["quantity"] for r in paper_rows}]
@@ -267,14 +264,15 @@ class Renderer:
         return text
 
     def _costs(self, scale: str) -> dict:
-        from hhscatter.studies.cost import totals
+        """{study: hhscatter.studies.cost.summary of its committed cost record at ``scale``}."""
+        from hhscatter.studies.cost import summary
         from hhscatter.studies.graph import studies
 
         out = {}
         for st in studies(self.root / "studies"):
             path = self.study_asset(st.name, "cost.json", scale)
             if path.exists():
-                out[st.name] = totals(json.loads(path.read_text()))
+                out[st.name] = summary(json.loads(path.read_text()))
         return out
 
     def cost_table(self, _arg=None) -> str:
@@ -284,13 +282,11 @@ class Renderer:
         if not names:
             return self.missing("The cost records", "Run the studies, then `make docs-assets` (SCALE=quick, paper).")
 
-        def agg(t):
-            if not t:
+        def agg(c):
+            if not c:
                 return None
-            return {"cpu": sum(v["cpu_s"] for v in t.values()) / 3600, "wall": sum(v["wall_s"] for v in t.values()) / 3600,
-                    "orbits": t.get("simulate", {}).get("orbits", 0),
-                    "rss": max(max(v["rss_self_mb"], v["rss_children_mb"]) for v in t.values()),
-                    "analysis": sum(v["cpu_s"] for k, v in t.items() if k != "simulate") / 3600}
+            return {"cpu": c["cpu_s"] / 3600, "wall": c["wall_s"] / 3600, "orbits": c["orbits"], "rss": c["rss_mb"],
+                    "analysis": c["analysis_cpu_s"] / 3600}
 
         def f(x, fmt):
             return "—" if x is None else format(x, fmt)

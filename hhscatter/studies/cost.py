@@ -12,9 +12,11 @@ filled when the block ends:
   These are per-process peaks: the whole-job peak is at most their sum times the
   number of workers.
 
-:func:`record` appends one invocation of a stage to ``out/<scale>/cost.json``
-(a stage interrupted and resumed has several invocations, their costs add up);
-:func:`totals` sums a cost document per stage. The numbers are measurements of a
+:func:`record` writes one invocation of a stage to ``out/<scale>/cost.json``
+(a simulation interrupted and resumed has several invocations, their costs add
+up; analyze and plot start over, so their last invocation replaces the earlier);
+:func:`totals` sums a cost document per stage and :func:`summary` over the
+stages. The numbers are measurements of a
 shared machine: wall time depends on the load, CPU time much less.
 """
 from __future__ import annotations
@@ -104,3 +106,20 @@ def totals(doc: dict) -> dict:
             "invocations": len(runs),
         }
     return out
+
+
+def summary(doc: dict) -> dict:
+    """summary(cost document) -> {wall_s, cpu_s, simulate_cpu_s, analysis_cpu_s, orbits, rss_mb} over all stages.
+
+    ``analysis_cpu_s`` is every stage but simulate; ``rss_mb`` the largest per-process peak of any stage.
+    """
+    t = totals(doc)
+    sim = t.get("simulate", {})
+    return {
+        "wall_s": sum(v["wall_s"] for v in t.values()),
+        "cpu_s": sum(v["cpu_s"] for v in t.values()),
+        "simulate_cpu_s": sim.get("cpu_s", 0.0),
+        "analysis_cpu_s": sum(v["cpu_s"] for k, v in t.items() if k != "simulate"),
+        "orbits": sim.get("orbits", 0),
+        "rss_mb": max((max(v["rss_self_mb"], v["rss_children_mb"]) for v in t.values()), default=0.0),
+    }
