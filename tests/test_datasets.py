@@ -156,3 +156,19 @@ def test_read_lifetimes_categorical_is_the_same_table_at_one_byte_per_outcome(ru
     assert list(cat["outcome"].astype(str)) == list(plain["outcome"])
     assert cat["outcome"].cat.codes.dtype.itemsize == 1
     pd.testing.assert_frame_equal(cat.drop(columns="outcome"), plain.drop(columns="outcome"))
+
+
+def test_read_by_orbit_is_the_lifetimes_table_in_orbit_order(run):
+    """read_by_orbit: numpy columns in traj_id order, outcome as a 1-byte categorical, null channels as −1."""
+    import pandas as pd
+
+    from hhscatter.tables import read_by_orbit, read_lifetimes
+
+    ref = read_lifetimes(run).sort_values("traj_id", kind="stable").reset_index(drop=True)
+    c = read_by_orbit(run, ["t_end", "outcome", "exit_channel"])
+    assert set(c) == {"traj_id", "t_end", "outcome", "exit_channel"}
+    np.testing.assert_array_equal(c["traj_id"], ref["traj_id"].to_numpy())
+    np.testing.assert_array_equal(c["t_end"], ref["t_end"].to_numpy())
+    assert isinstance(c["outcome"], pd.Categorical) and list(c["outcome"].astype(str)) == list(ref["outcome"])
+    want = ref["exit_channel"].astype("Float64").to_numpy(dtype=float, na_value=-1.0)
+    np.testing.assert_array_equal(c["exit_channel"].astype(float), want)

@@ -23,6 +23,11 @@ def _sci(n):
     return (f"{a:.3g}" + r"\times" if abs(a - 1) > 1e-9 else "") + f"10^{{{b}}}"
 
 
+def _paper_law_label(pp):
+    """Legend text of the paper's κ(E) law from fig2.json's "paper" constants."""
+    return f"paper: ${pp['a']:g}x^2 + {pp['b']:g}x$; ${pp['c']:g}x$"
+
+
 def _panel_a(ax, curves, lines, numbers):
     pt = numbers["Pt"]
     t_right = 0.0
@@ -109,7 +114,7 @@ def _panel_b(ax, kappa_e, fit_curve, cm, numbers):
         ax.plot(f["x"], f["kappa"], ls, color=colour, lw=1.6, label=lab)
         p = fit_curve[(fit_curve["model"] == "paper") & (fit_curve["regime"] == regime)]
         ax.plot(p["x"], p["kappa"], ":", color="0.45", lw=1.0,
-                label="paper: $13.63x^2 + 0.03x$; $1.41x$" if regime == "linear" else None)
+                label=_paper_law_label(numbers["paper"]) if regime == "linear" else None)
     xb = fit["E_b"]["value"] - numbers["E_c"]
     ax.axvline(xb, color="tab:purple", ls="-.", lw=1.2,
                label=rf"break $E_b = {_fmt_err(fit['E_b']['value'], fit['E_b']['err'])}$")
@@ -158,10 +163,11 @@ def _panel_c(ax, conv_table, numbers):
                 label=rf"law across conventions: $a = {_fmt_err(a, law['a']['err'])}$, "
                       rf"$b = {_fmt_err(b, law['b']['err'])}$, $c = {_fmt_err(c, law['c']['err'])}$")
         ax.plot(hi, c * hi, "-", color="k", lw=1.2)
-    xp = 0.27 - numbers["E_c"]
-    ax.plot(xs[xs <= xp], 13.63 * xs[xs <= xp]**2 + 0.03 * xs[xs <= xp], ":", color="0.45", lw=1.0,
-            label="paper: $13.63x^2 + 0.03x$; $1.41x$")
-    ax.plot(xs[xs >= xp], 1.41 * xs[xs >= xp], ":", color="0.45", lw=1.0)
+    pp = numbers["paper"]  # the paper's law (Fig. 2b caption), as the study recorded it
+    xp = pp["E_b"] - numbers["E_c"]
+    ax.plot(xs[xs <= xp], pp["a"] * xs[xs <= xp]**2 + pp["b"] * xs[xs <= xp], ":", color="0.45", lw=1.0,
+            label=_paper_law_label(pp))
+    ax.plot(xs[xs >= xp], pp["c"] * xs[xs >= xp], ":", color="0.45", lw=1.0)
     ax.plot([], [], "x", color="0.3", ms=7, mew=2, label="κ ill-defined (trapped plateau): excluded")
     ax.fill_between([], [], color="0.85", label=f"unstable across conventions (> {conv['stable_rel_tol']:.0%})")
     ax.set_xlim(0, x_max + 0.006)

@@ -155,11 +155,12 @@ def _t_max_choice(study, pilot_dir, n):
     )
 
 
-def _grid_rate(study, energy):
+def _grid_rate(study, energy, lifetimes=None):
+    """EscapeRateResult of the κ(E) run at E (its lifetimes read here unless given)."""
     from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
 
-    return escape_rate_from_lifetimes(_lifetimes(study.raw(grid_key(energy))), detect_tail=False,
-                                      min_survivors=float(study.param("min_survivors")))
+    lt = _lifetimes(study.raw(grid_key(energy))) if lifetimes is None else lifetimes
+    return escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=float(study.param("min_survivors")))
 
 
 def _cm_windows(study, energy):
@@ -245,14 +246,15 @@ def _analyze_grid(study):
     from hhscatter.analysis.kappa_energy import fit_kappa_energy
 
     E_C = study.model.critical_energy
-    rows = []
+    rows, runs = [], {}
     tmax_choices = json.loads(_choices_path(study).read_text())["t_max"]
     for energy in study.param("grid_energies"):
         energy = float(energy)
         path = study.raw(grid_key(energy))
         tch = tmax_choices[grid_key(energy)]
         lt = _lifetimes(path)
-        r = _grid_rate(study, energy)
+        r = _grid_rate(study, energy, lt)
+        runs[energy] = (lt, r)  # read and fitted once: the conventions and the c-measure use them again
         t_max = float(_scene_of(path)["t_max"])
         rows.append({
             "energy": energy, "x": energy - E_C, "kappa": r.kappa, "kappa_err": r.kappa_err,
@@ -276,7 +278,7 @@ def _analyze_grid(study):
                                n_boot=n_boot, rng=seed)
         sep = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=False,
                                n_boot=n_boot, rng=seed)
-    return df, fit, sep
+    return df, fit, sep, runs
 
 
 def _fit_json(fit):
@@ -403,7 +405,7 @@ def _analyze_pt(study):
     return numbers
 
 
-def _analyze_cmeasure(study, grid_df):
+def _analyze_cmeasure(study, grid_runs):
     import pandas as pd
 
     from hhscatter.analysis.cmeasure import (
@@ -428,7 +430,7 @@ def _analyze_cmeasure(study, grid_df):
         if abs(float(win["t_from"]) - t_rec) > 1e-9 or abs(float(win["t_to"]) - t_rec_end) > 1e-6:
             raise RuntimeError(f"{key}: raw run's section window {win} is not the recorded choice "
                                f"[{t_rec}, {t_rec_end}]; re-run the simulate stage")
-        r = _grid_rate(study, energy)  # the Fig. 2b κ at this energy (current analysis)
+        r = grid_runs[min(grid_runs, key=lambda e: abs(e - energy))][1]  # the Fig. 2b κ at this energy (a grid E)
         lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "t_end"], categorical=True)
         sec = read_sections(study.raw(key), columns=["traj_id", "t"])
         own = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
@@ -494,7 +496,7 @@ CONVENTIONS = (  # (name, IC region, window rule, label)
 )
 
 
-def _analyze_conventions(study, grid_df):
+def _analyze_conventions(study, grid_runs):
     """κ(E) under the 4 conventions of CONVENTIONS, the stable energies and the law per convention.
 
     Returns (table, stability, numbers). Conventions: IC region (disk, the
@@ -521,13 +523,12 @@ def _analyze_conventions(study, grid_df):
     squares = [float(e) for e in study.param("square_energies")]
     rows = []
     for energy in (float(e) for e in study.param("grid_energies")):
-        runs = {"disk": study.raw(grid_key(energy))}
+        runs = {"disk": grid_runs[energy]}  # the Fig. 2b run, already read and fitted
         if any(np.isclose(energy, e) for e in squares):
-            runs["square"] = study.raw(sq_key(energy))
-        for region, path in runs.items():
-            lt = _lifetimes(path)
+            lt = _lifetimes(study.raw(sq_key(energy)))
+            runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv))
+        for region, (lt, res) in runs.items():
             t_end, obs = lifetimes_to_arrays(lt)
-            res = escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv)
             rates = {"plateau": plateau_rate(res, t_end, obs, max_bias=max_bias),
                      "plevel": escape_rate_p_levels(t_end, obs, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)}
             for rule, r in rates.items():
@@ -576,11 +577,11 @@ def _analyze_conventions(study, grid_df):
 def analyze(study):
     """analyze(study) -> None; derived tables and fig2.json (see the module docstring)."""
     E_C = study.model.critical_energy
-    grid_df, fit, sep = _analyze_grid(study)
+    grid_df, fit, sep, grid_runs = _analyze_grid(study)
     study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
                       description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
     fj, sj = _fit_json(fit), _fit_json(sep)
-    conv_table, _, conv = _analyze_conventions(study, grid_df)
+    conv_table, _, conv = _analyze_conventions(study, grid_runs)
     units = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
     law = conv["law"]
     for name in ("a", "b", "c", "E_b"):
@@ -615,7 +616,7 @@ def analyze(study):
                       verdict=quoted_verdict(sj[name]["value"], sj[name]["err"], PAPER[name], half_unit(PAPER[name])),
                       note="the two laws fitted independently on either side of the best partition (as the paper)")
     pt = _analyze_pt(study)
-    cm = _analyze_cmeasure(study, grid_df)
+    cm = _analyze_cmeasure(study, grid_runs)
     study.write_numbers({
         "rules": {
             "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "

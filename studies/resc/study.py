@@ -106,25 +106,13 @@ def _lifetimes(study, E, r):
     Read as Arrow columns into numpy (no pandas frame, no Python object per orbit): 1e7 orbits per run at
     paper scale, 4 runs per energy held at once.
     """
-    import pandas as pd
-    import pyarrow as pa
-    import pyarrow.compute as pc
-
     from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.tables import read_arrow
+    from hhscatter.tables import read_by_orbit
 
-    tab = read_arrow(study.raw(_key(E, r)), "lifetimes", columns=["traj_id", "outcome", "t_end", "exit_channel"])
-    ids = tab.column("traj_id").to_numpy()
-    order = None if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
-    t = tab.column("t_end").to_numpy()
-    obs = observed_from_outcome(pd.Series(tab.column("outcome").to_pandas(), copy=False))
-    ch = pc.fill_null(tab.column("exit_channel"), -1).to_numpy().astype(np.int8)
-    ch = np.where(obs, ch, np.int8(-1)).astype(np.int8)
-    del tab
-    pa.default_memory_pool().release_unused()
-    if order is not None:
-        ids, t, obs, ch = ids[order], t[order], obs[order], ch[order]
-    return ids, t, obs, ch
+    c = read_by_orbit(study.raw(_key(E, r)), ["outcome", "t_end", "exit_channel"])
+    obs = observed_from_outcome(c["outcome"])
+    ch = np.where(obs, c["exit_channel"], -1).astype(np.int8)
+    return c["traj_id"], c["t_end"], obs, ch
 
 
 def analyze(study):
