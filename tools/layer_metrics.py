@@ -1,0 +1,191 @@
+"""Layering metrics of the package (issue "layers"): import circles, function-level imports,
+casts of study parameters and long functions, measured from the source with :mod:`ast`.
+
+Run from the repository root::
+
+    python tools/layer_metrics.py            # summary
+    python tools/layer_metrics.py --details  # plus every circle, deferred import and long function
+
+Import circles are the strongly connected components (more than one module) of the graph of
+imports between the package's own modules, module-level and function-level imports alike (a
+function-level import hides a circle from Python, not from the design). A module imports its
+package's ``__init__`` implicitly; those edges are left out, since every submodule would otherwise
+sit in a circle with a package that re-exports it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import sys
+from pathlib import Path
+
+LONG = 80  # lines: a function longer than this counts as long
+
+
+def module_name(path: Path, root: Path) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def resolve(node: ast.ImportFrom, mod: str, is_pkg: bool) -> str:
+    if node.level == 0:
+        return node.module or ""
+    base = mod.split(".")
+    base = base if is_pkg else base[:-1]
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def targets(node: ast.AST, mod: str, is_pkg: bool, known: set[str]) -> list[str]:
+    """The package modules an import statement names (``from . import x`` names submodule x)."""
+    out: list[str] = []
+    if isinstance(node, ast.Import):
+        out = [a.name for a in node.names]
+    elif isinstance(node, ast.ImportFrom):
+        base = resolve(node, mod, is_pkg)
+        for a in node.names:
+            sub = f"{base}.{a.name}"
+            out.append(sub if sub in known else base)
+    return [t for t in out if t in known]
+
+
+def scc(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Tarjan's strongly connected components, iterative."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    comps: list[list[str]] = []
+    counter = 0
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            advanced = False
+            for w in it:
+                if w not in index:
+                    index[w] = low[w] = counter
+                    counter += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(graph[w]))))
+                    advanced = True
+                    break
+                if w in on:
+                    low[v] = min(low[v], index[w])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    comps.append(sorted(comp))
+    return comps
+
+
+def is_param_cast(node: ast.AST) -> bool:
+    """``float(x.param(...))``, ``int(params[...])`` and the like: a cast of a study parameter."""
+    if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)):
+        return False
+    if node.func.id not in {"float", "int", "bool", "str"} or len(node.args) != 1:
+        return False
+    arg = node.args[0]
+    if isinstance(arg, ast.Call) and isinstance(arg.func, ast.Attribute):
+        return arg.func.attr in {"param", "get_param"}
+    if isinstance(arg, ast.Subscript) and isinstance(arg.value, (ast.Name, ast.Attribute)):
+        name = arg.value.id if isinstance(arg.value, ast.Name) else arg.value.attr
+        return name in {"params", "p", "cfg", "config"}
+    return False
+
+
+def measure(root: Path, package: str, extra: list[Path]) -> dict:
+    files = sorted((root / package).rglob("*.py"))
+    mods = {module_name(f, root): f for f in files}
+    known = set(mods)
+    graph: dict[str, set[str]] = {m: set() for m in mods}
+    deferred, deferred_own, casts, long_funcs = [], [], [], []
+    for mod, f in mods.items():
+        tree = ast.parse(f.read_text(), filename=str(f))
+        is_pkg = f.name == "__init__.py"
+        parents = {mod.rsplit(".", k)[0] for k in range(1, mod.count(".") + 1)}
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = node.end_lineno - node.lineno + 1
+                if n > LONG:
+                    long_funcs.append((n, f"{f.relative_to(root)}:{node.lineno} {node.name}"))
+                for sub in ast.walk(node):
+                    if isinstance(sub, (ast.Import, ast.ImportFrom)):
+                        where = f"{f.relative_to(root)}:{sub.lineno}"
+                        deferred.append(where)
+                        if targets(sub, mod, is_pkg, known):
+                            deferred_own.append(where)
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                for t in targets(node, mod, is_pkg, known):
+                    if t != mod and t not in parents:
+                        graph[mod].add(t)
+        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n)]
+    for f in extra:
+        tree = ast.parse(f.read_text(), filename=str(f))
+        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n)]
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = node.end_lineno - node.lineno + 1
+                if n > LONG:
+                    long_funcs.append((n, f"{f.relative_to(root)}:{node.lineno} {node.name}"))
+    # deferred imports are counted once per statement (ast.walk visits nested functions twice)
+    deferred, deferred_own = sorted(set(deferred)), sorted(set(deferred_own))
+    return {
+        "modules": len(mods),
+        "circles": scc(graph),
+        "function_level_imports": deferred,
+        "function_level_own_imports": deferred_own,
+        "param_casts": casts,
+        "long_functions": sorted(set(long_funcs), reverse=True),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--root", type=Path, default=Path("."))
+    ap.add_argument("--package", default="hhscatter")
+    ap.add_argument("--details", action="store_true")
+    args = ap.parse_args(argv)
+    extra = sorted((args.root / "studies").rglob("*.py"))
+    m = measure(args.root, args.package, extra)
+    print(f"modules: {m['modules']}")
+    print(f"import circles: {len(m['circles'])}")
+    print(f"function-level imports: {len(m['function_level_imports'])} "
+          f"({len(m['function_level_own_imports'])} of the package's own modules)")
+    print(f"casts of study parameters: {len(m['param_casts'])}")
+    print(f"functions over {LONG} lines: {len(m['long_functions'])}")
+    if args.details:
+        for c in m["circles"]:
+            print("circle:", " -> ".join(c))
+        for n, where in m["long_functions"]:
+            print(f"long: {n:4d} {where}")
+        for where in m["function_level_own_imports"]:
+            print("deferred own import:", where)
+        for where in m["param_casts"]:
+            print("cast:", where)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
