@@ -305,6 +305,11 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # `hhscatter … | head -1`: the reader left; the run itself is complete
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        return 141
 
 
 if __name__ == "__main__":

@@ -21,6 +21,9 @@ import logging
 
 from .scene import SceneError
 
+#: the address protocols of dask.distributed's communication layer
+SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
+
 
 def check_available() -> None:
     """check_available() -> None; SceneError naming the extra if dask.distributed is missing."""
@@ -38,8 +41,10 @@ def check_scheduler(scheduler: str, workers: int | None) -> None:
     check_available()
     if scheduler == "local":
         return
-    if "://" not in scheduler:
-        raise SceneError(f"scheduler must be 'local' or an address like tcp://host:8786, got {scheduler!r}")
+    scheme = scheduler.split("://", 1)[0] if "://" in scheduler else None
+    if scheme not in SCHEMES:
+        raise SceneError(f"scheduler must be 'local' or an address like tcp://host:8786 (protocols: "
+                         f"{', '.join(SCHEMES)}), got {scheduler!r}")
     if workers is not None:
         raise SceneError("workers: the number of workers is the cluster's when --scheduler is an address")
 
@@ -70,11 +75,14 @@ def dask_client(scheduler: str, workers: int | None = None):
         return
     try:
         client = Client(scheduler, timeout="20s")
-    except (OSError, TimeoutError) as exc:
-        raise SceneError(f"scheduler: cannot connect to {scheduler} ({exc})") from None
+    except Exception as exc:  # noqa: BLE001 - any failure to connect is the address's: say so, no traceback
+        raise SceneError(f"scheduler: cannot connect to {scheduler} ({type(exc).__name__}: {exc})") from None
     try:
         if not client.nthreads():
-            client.wait_for_workers(1, timeout=60)
+            try:
+                client.wait_for_workers(1, timeout=60)
+            except TimeoutError:
+                raise SceneError(f"scheduler: {scheduler} has no workers (waited 60 s)") from None
         yield client
     finally:
         client.close()

@@ -118,6 +118,45 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
     return states, ids
 
 
+def check_ics(scene: Scene, states: np.ndarray) -> None:
+    """check_ics(scene, states) -> None; SceneError before any work if a table row cannot be run honestly.
+
+    Bounds (the reasons of :mod:`hhscatter.scene`): every row's position within R_ESC_MAX ω²/λ of the
+    origin and energy H = |p|²/2 + V ≤ E0_MAX·E_c (energy conservation, overflow). Rows below E_c inside
+    Ω (r < r_esc) in a dissipative scene are refused: drag only lowers the energy, so such an orbit can
+    neither escape nor cross E = E_c from above: it has "settled" before it starts, and none of the
+    outcomes (whose settling time is the root of E = E_c) describes it. Conservative rows below E_c are
+    fine: they stay inside Ω and are censored at t_max, which is the correct outcome.
+    Example: ``check_ics(scene, np.array([[0.1, 0.0, 0.0, 0.8]]))``.
+    """
+    from .scene import E0_MAX, R_ESC_MAX
+
+    m = scene.model
+    x, y, px, py = (states[:, k] for k in range(4))
+    r = np.hypot(x, y)
+    far = r > R_ESC_MAX * m.saddle_radius
+    if far.any():
+        i = int(np.argmax(far))
+        raise SceneError(f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
+                         f"r = {r[i]:.3g}); energy conservation fails that far out")
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = m.energy(x, y, px, py)
+    high = ~(e <= E0_MAX * m.critical_energy)
+    if high.any():
+        i = int(np.argmax(high))
+        raise SceneError(f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
+                         f"{E0_MAX * m.critical_energy:.6g} (first: row {i}, E = {e[i]:.3g}; momenta too large: "
+                         "every orbit leaves at once, p² overflows near 1e308)")
+    if scene.gamma > 0:
+        low = (e <= m.critical_energy) & (r < scene.r_esc)
+        if low.any():
+            i = int(np.argmax(low))
+            raise SceneError(
+                f"ics: {int(low.sum())} row(s) start below E_c = {m.critical_energy:.10g} inside r_esc with drag "
+                f"γ = {scene.gamma:g} (first: row {i}, E = {e[i]:.6g}): such an orbit can never escape and never "
+                "crosses E_c from above, so it has no outcome; drop these rows (they are trapped from t = 0)")
+
+
 def section_grid(model, energy: float, extent, shape):
     """section_grid(model, E, extent, shape) -> (x (nx,), y (ny,), allowed (ny, nx), states (m, 4), cell (m,)).
 

@@ -43,7 +43,7 @@ class Section:
 
 def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
     """headline_numbers(numbers) -> [(name, formatted)] of the scalar and value±err entries of a numbers JSON."""
-    skip = {"study", "scale", "paper_comparison", "config", "provenance"}
+    skip = {"study", "scale", "paper_comparison", "config", "provenance", "raw_runs"}
     rows = []
 
     def walk(prefix, d, depth):
@@ -147,6 +147,14 @@ def _bench(root: Path, name: str = "bench"):
     return None, []
 
 
+def raw_runs_line(runs: dict) -> str:
+    """raw_runs_line({key: {scene_hash, orbits, complete}}) -> one line naming the raw runs a study's numbers
+    were made from, their completeness and scene hashes (checked by the analyze stage)."""
+    parts = [f"`{k}` ({r.get('orbits') or '?'} orbits, {'complete' if r.get('complete') else 'INCOMPLETE'}, "
+             f"scene {str(r.get('scene_hash'))[:10]}…)" for k, r in sorted(runs.items())]
+    return f"*Made from {len(runs)} raw run(s):* " + "; ".join(parts) + "."
+
+
 def cost_rows(sections) -> list[dict]:
     """cost_rows(sections) -> one row per study with a cost record: wall and CPU hours, orbits, peak RSS (MB)."""
     from .studies.cost import summary
@@ -244,6 +252,8 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
                 lines += [f"![{s.title}]({image(s.figure, f'{s.key}.png')})", ""]
             else:
                 lines += [f"*Not generated yet: run `make {s.key} SCALE={scale}`.*", ""]
+            if s.numbers and s.numbers.get("raw_runs"):
+                lines += [raw_runs_line(s.numbers["raw_runs"]), ""]
             if s.numbers:
                 lines += ["| number | value |", "|---|---|"]
                 lines += [f"| {md_cell(k)} | {md_cell(v)} |" for k, v in headline_numbers(s.numbers)]

@@ -39,10 +39,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .scene import Scene, SceneError, scene_from_dict
-from .store import Store
+from .store import LOCK_FILE, TMP_MARK, LockedError, Store
 from .tables import TABLES, part_name, read_meta, verify_part
 
 SCENE_FILE = "scene.json"
+#: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.runner._run_dask)
+DASK_NO_WORKER_TIMEOUT = 60.0
 
 
 class RunError(RuntimeError):
@@ -88,9 +90,10 @@ class RunSummary:
 
 
 def plan_chunks(scene: Scene):
-    """plan_chunks(scene) -> [(chunk, start, stop)] covering orbits 0..n−1."""
-    c = scene.chunk_size
-    return [(i, s, min(s + c, scene.n)) for i, s in enumerate(range(0, scene.n, c))]
+    """plan_chunks(scene) -> iterator of (chunk, start, stop) covering orbits 0..n−1 (made lazily: no list
+    of one tuple per chunk is held)."""
+    c, n = scene.chunk_size, scene.n
+    return ((i, s, min(s + c, n)) for i, s in enumerate(range(0, n, c)))
 
 
 def tables_of(scene: Scene):
@@ -128,15 +131,16 @@ def _chunk_ics(scene, start, stop, table_ics):
 
 
 def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition="",
-                  progress=None):
-    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None)
-    -> RunSummary.
+                  progress=None, scene_hash=None):
+    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None,
+    scene_hash=None) -> RunSummary.
 
     Worker entry (local pool or Dask): integrate orbits start..stop−1 of the
     scene, write the chunk's part files under ``out`` (path or URL) and
     return the chunk's counts. An OSError while writing is re-raised naming
     the file. ``progress``: a callable f(k), or a queue that gets (chunk, k)
-    (another process's), told as orbits of the chunk start.
+    (another process's), told as orbits of the chunk start. ``scene_hash``: the scene's result hash as
+    the client computed it once per run (default: computed here, which re-reads an IC table).
     """
     from .engine import run_chunk
     from .tables import add_point_columns, provenance, to_arrow, write_part
@@ -153,7 +157,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     elapsed = time.perf_counter() - t0
     meta = {
         "scene": json.loads(scene_json),
-        "scene_hash": scene.result_hash(),
+        "scene_hash": scene_hash or scene.result_hash(),
         "chunk": chunk,
         "orbits": [start, stop],
         **provenance(),
@@ -190,15 +194,15 @@ def _decode(d):
     return d
 
 
-def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partition: str = "") -> bool:
-    """chunk_complete(scene, out, chunk, start, stop, partition='') -> bool.
+def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partition: str = "", want=None) -> bool:
+    """chunk_complete(scene, out, chunk, start, stop, partition='', want=None) -> bool.
 
     True if every part file of ``chunk`` exists, reads in full with valid page
     checksums, and has this scene's hash, orbit range and row count. Raises
     SceneError if a part was made by another scene.
     """
     store = Store(out)
-    want = scene.result_hash()
+    want = want or scene.result_hash()
     for name in tables_of(scene):
         rel = part_rel(name, partition, chunk)
         if not store.exists(rel):
@@ -231,8 +235,41 @@ def _diff(old: dict, new: dict) -> str:
     return ", ".join(f"{k}: {old.get(k)!r} → {new.get(k)!r}" for k in keys[:6])
 
 
-def prepare_output(run, out, *, overwrite: bool, resume: bool):
-    """Check and prepare the output location before any work; raise SceneError if unusable."""
+def manifest_of(points, tables) -> dict:
+    """manifest_of([(scene, partition, scene_hash)], tables) -> the run's plan, as stored in scene.json.
+
+    ``{"tables": [...], "points": [{"partition", "scene_hash", "n", "chunk_size"}]}``: the part files a
+    complete run has are exactly part_rel(table, partition, chunk) for chunk < ceil(n/chunk_size), each
+    carrying ``scene_hash`` and its orbit range in its metadata (:func:`hhscatter.tables.run_parts`).
+    """
+    return {"tables": list(tables),
+            "points": [{"partition": part, "scene_hash": h, "n": int(sc.n), "chunk_size": int(sc.chunk_size)}
+                       for sc, part, h in points]}
+
+
+def _extra_parts(store, manifest) -> list[str]:
+    """Part files under the table folders that the manifest does not plan (duplicates, junk, other runs)."""
+    planned = {part_rel(name, p["partition"], c) for name in manifest["tables"] for p in manifest["points"]
+               for c in range(-(-p["n"] // p["chunk_size"]))}
+    extra = []
+    for name in TABLES:
+        for f in store.files(name):
+            base = f.rsplit("/", 1)[-1]
+            if base.startswith(".") and TMP_MARK in base:
+                continue
+            if f"{name}/{f}" not in planned:
+                extra.append(f"{name}/{f}")
+    return extra
+
+
+def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
+    """Check and prepare the output location before any work; raise SceneError if unusable.
+
+    Takes the run directory's write lock (one writer per directory, :meth:`hhscatter.store.Store.lock`):
+    returns (store, lock, points), the lock to be released with ``Store.unlock`` when the run ends. ``points``:
+    [(scene, partition, scene_hash)] (default: from ``run``). If a check fails, nothing is left behind
+    (a directory made here is removed again).
+    """
     if overwrite and resume:
         raise SceneError("--overwrite and --resume exclude each other")
     try:
@@ -241,41 +278,81 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool):
         raise SceneError(str(exc)) from None
     if store.exists() and not store.is_dir():
         raise SceneError(f"out: {store.display()} exists and is not a directory")
-    if store.listdir():
-        if overwrite:
-            for name in (*TABLES, SCENE_FILE):
-                store.remove(name)
-        elif resume:
-            if store.exists(SCENE_FILE):
-                old = json.loads(store.read_text(SCENE_FILE))
-                if old.get("scene_hash") != run.result_hash():
-                    what = _diff(old.get("scene", {}), json.loads(run.to_json()))
-                    raise SceneError(
-                        f"cannot resume into {store.display()}: it holds a different scene"
-                        f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"
-                    )
-            for name in TABLES:
-                store.remove_temporaries(name)
-        else:
-            raise SceneError(
-                f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
-            )
+    if points is None:
+        points = [(sc, part, sc.result_hash()) for sc, part in points_of(run)]
+    created = not store.exists()
+    lock = None
     try:
-        store.makedirs()
-        probe = f".write-test-{os.getpid()}"
-        store.write_text(probe, "")
-        store.remove(probe)
-    except OSError as exc:
-        raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
-    doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
-    from .grid import Grid
+        try:
+            lock = store.lock()
+        except LockedError as exc:
+            raise SceneError(f"out: {exc}; one writer per run directory: wait for it or use another --out") \
+                from None
+        except OSError as exc:
+            raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+        _check_and_clear(run, store, points, overwrite=overwrite, resume=resume)
+        if resume:
+            points = resumed_points(store, points)
+        try:
+            store.makedirs()
+            probe = f".write-test-{os.getpid()}"
+            store.write_text(probe, "")
+            store.remove(probe)
+        except OSError as exc:
+            raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+        doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
+        from .grid import Grid
 
-    if isinstance(run, Grid):
-        doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
-        points = resumed_points(store, points_of(run)) if resume else points_of(run)
-        doc["points"] = [{"partition": part, "scene_hash": p.result_hash()} for p, part in points]
-    store.write_json(SCENE_FILE, doc)
-    return store
+        if isinstance(run, Grid):
+            doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
+            doc["points"] = [{"partition": part, "scene_hash": h} for _, part, h in points]
+        doc["manifest"] = manifest_of(points, tables_of(points[0][0]))
+        try:
+            store.write_json(SCENE_FILE, doc)
+        except OSError as exc:
+            raise SceneError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
+                             "nothing was computed") from None
+    except BaseException:
+        Store.unlock(lock)
+        if created and store.local:
+            import shutil
+
+            shutil.rmtree(store.root, ignore_errors=True)
+        raise
+    return store, lock, points
+
+
+def _check_and_clear(run, store, points, *, overwrite, resume):
+    """The emptiness / same-scene checks of prepare_output, under the lock; --overwrite clears the old run."""
+    entries = [e for e in store.listdir() if e != LOCK_FILE]
+    if not entries:
+        return
+    if overwrite:
+        # the whole old run: its tables, its scene, its temporaries (other files are not ours: kept)
+        for name in entries:
+            if name in (*TABLES, SCENE_FILE) or (name.startswith(".") and TMP_MARK in name):
+                store.remove(name)
+        return
+    if not resume:
+        raise SceneError(
+            f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
+        )
+    if store.exists(SCENE_FILE):
+        old = json.loads(store.read_text(SCENE_FILE))
+        if old.get("scene_hash") != run.result_hash():
+            what = _diff(old.get("scene", {}), json.loads(run.to_json()))
+            raise SceneError(
+                f"cannot resume into {store.display()}: it holds a different scene"
+                f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"
+            )
+    extra = _extra_parts(store, manifest_of(resumed_points(store, points), tables_of(points[0][0])))
+    if extra:
+        raise SceneError(
+            f"cannot resume into {store.display()}: {len(extra)} part file(s) are not in this run's chunk plan "
+            f"(first: {store.display(extra[0])}); remove them, or use --overwrite or another --out"
+        )
+    for name in TABLES:
+        store.remove_temporaries(name)
 
 
 def resumed_points(store, points):
@@ -287,6 +364,8 @@ def resumed_points(store, points):
     if not store.exists(SCENE_FILE):
         return points
     old = {p.get("scene_hash"): p.get("partition") for p in json.loads(store.read_text(SCENE_FILE)).get("points", [])}
+    if points and len(points[0]) == 3:
+        return [(scene, old.get(h) or part, h) for scene, part, h in points]
     return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]
 
 
@@ -342,37 +421,52 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
     points = points_of(run)
     table_ics = None
     if points[0][0].ics is not None:
-        from .ics import read_ics_table
+        from .ics import check_ics, read_ics_table
 
         scene = points[0][0]
         table_ics = read_ics_table(scene.ics)
         if len(table_ics[0]) != scene.n:
             raise SceneError(f"n = {scene.n} but the ics table has {len(table_ics[0])} rows")
+        for sc, _ in points:
+            check_ics(sc, table_ics[0])
     if scheduler is not None:
         from .dask_backend import check_scheduler
 
         check_scheduler(scheduler, workers)
-    store = prepare_output(run, out, overwrite=overwrite, resume=resume)
-    if resume:
-        points = resumed_points(store, points)
+    # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
+    points = [(sc, part, sc.result_hash()) for sc, part in points]
+    store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
+    try:
+        return _simulate(run, store, points, table_ics, workers, resume, progress, scheduler)
+    finally:
+        Store.unlock(lock)
+
+
+def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler) -> RunSummary:
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
     summary = RunSummary()
+    n_total = sum(sc.n for sc, _, _ in points)
+    n_chunks = sum(-(-sc.n // sc.chunk_size) for sc, _, _ in points)
     todo = []
-    n_total = 0
-    for scene, partition in points:
-        scene_json = scene.to_json()
-        for chunk, start, stop in plan_chunks(scene):
-            n_total += stop - start
-            if resume and chunk_complete(scene, store, chunk, start, stop, partition):
-                summary.chunks_skipped += 1
-                continue
-            todo.append((scene_json, chunk, start, stop, partition))
-    done_orbits = n_total - sum(t[3] - t[2] for t in todo)
+    if resume:  # verify the finished chunks first: the bar then starts where the run stopped
+        for scene, partition, h in points:
+            scene_json = scene.to_json()
+            for chunk, start, stop in plan_chunks(scene):
+                if chunk_complete(scene, store, chunk, start, stop, partition, want=h):
+                    summary.chunks_skipped += 1
+                    continue
+                todo.append((scene_json, chunk, start, stop, partition, h))
+        done_orbits = n_total - sum(t[3] - t[2] for t in todo)
+        n_todo = len(todo)
+    else:  # planned lazily: one task tuple per chunk in flight, not per chunk of the run
+        todo = ((scene.to_json(), chunk, start, stop, partition, h) for scene, partition, h in points
+                for chunk, start, stop in plan_chunks(scene))
+        done_orbits, n_todo = 0, n_chunks
 
     def args(task):
-        scene_json, c, s, e, partition = task
+        scene_json, c, s, e, partition, _ = task
         if table_ics is None:
             return (scene_json, c, s, e, out_url, None, None, partition)
         states, ids = table_ics
@@ -392,7 +486,7 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         bar.update(k)
 
     try:
-        if not todo:
+        if not n_todo:
             summary.workers = 0
         elif scheduler is not None:
             from .dask_backend import dask_client
@@ -404,13 +498,13 @@ def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=
         else:
             workers = workers or default_workers()
             summary.workers = workers
-            if workers == 1 or len(todo) <= 1:
+            if workers == 1 or n_todo <= 1:
                 for task in todo:
                     key = (task[4], task[1])
                     tell = (lambda k, key=key: on_progress(key, k)) if progress else None
-                    on_done(task, run_one_chunk(*args(task), progress=tell))
+                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task[5]))
             else:
-                _run_pool(workers, todo, args, on_done, on_progress if progress else None)
+                _run_pool(min(workers, n_todo), todo, args, on_done, on_progress if progress else None)
     except OSError as exc:
         raise RunError(
             f"{exc.strerror or exc}; stopped after {summary.chunks_done} new chunk(s). Finished part files "
@@ -454,14 +548,51 @@ def progress_bar(progress, total, initial, desc):
                 smoothing=0.05)
 
 
+def die_with_parent(parent_pid: int) -> None:
+    """die_with_parent(parent_pid) -> None: make this (worker) process die when its parent does.
+
+    Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)``, which the kernel applies however the parent ends
+    (SIGTERM, SIGINT, kill -9), so no worker keeps computing and writing parts for a run that is gone.
+    Elsewhere: a daemon thread that polls the parent every second. The pool's and the progress
+    manager's initializer.
+    """
+    import signal
+    import sys
+    import threading
+
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        PR_SET_PDEATHSIG = 1
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+            if os.getppid() != parent_pid:  # the parent died before prctl: nobody will signal us
+                os._exit(1)
+            return
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="hhscatter-parent-watch").start()
+
+
 def _run_pool(workers, todo, args, on_done, on_progress=None):
     import multiprocessing as mp
     import queue as queue_mod
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
+    from multiprocessing.managers import SyncManager
+
     ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx)
-    manager = ctx.Manager() if on_progress is not None else None
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=die_with_parent,
+                               initargs=(os.getpid(),))
+    manager = None
+    if on_progress is not None:
+        manager = SyncManager(ctx=ctx)
+        manager.start(initializer=die_with_parent, initargs=(os.getpid(),))
     q = manager.Queue() if manager is not None else None
 
     def relay():
@@ -480,7 +611,7 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
                 return done
 
     try:
-        _drain(lambda t: pool.submit(run_one_chunk, *args(t), progress=q),
+        _drain(lambda t: pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5]),
                wait_first, todo, 2 * workers, on_done,
                lambda fs: [f.cancel() for f in fs])
     finally:
@@ -499,7 +630,22 @@ def _run_dask(client, todo, args, on_done, name):
 
     def submit(task):
         key = f"hhscatter-{name}-{task[4].replace('/', ',') + '-' if task[4] else ''}{task[1]}-{tag}"
-        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0)
+        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task[5])
 
-    _drain(submit, lambda fs: wait(fs, return_when="FIRST_COMPLETED").done, todo, window, on_done,
-           lambda fs: client.cancel(fs))
+    def wait_first(fs):
+        alone_since = None
+        while True:
+            try:
+                return wait(fs, timeout=2.0, return_when="FIRST_COMPLETED").done
+            except TimeoutError:
+                pass
+            if client.nthreads():
+                alone_since = None
+            elif alone_since is None:
+                alone_since = time.monotonic()
+            elif time.monotonic() - alone_since > DASK_NO_WORKER_TIMEOUT:
+                raise RunError(
+                    f"the Dask cluster has had no workers for {DASK_NO_WORKER_TIMEOUT:g} s; stopped. Finished "
+                    "part files are intact: start workers and rerun with --resume")
+
+    _drain(submit, wait_first, todo, window, on_done, lambda fs: client.cancel(fs))

@@ -8,6 +8,7 @@ or built from CLI flags. Every bad value is refused before any work with a
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import math
@@ -22,9 +23,61 @@ from .model import HenonHeiles
 REGIONS = ("disk", "well", "square")
 TOL_RANGE = (1e-18, 1e-6)
 
+# Upper bounds, each with its reason (checked before any work; hhscatter.scene.Scene._validate):
+#: r_esc ≤ R_ESC_MAX · ω²/λ: far out |V| ≈ λr³/3 ≫ E, and the energy error of the escape decision grows like
+#: tol·λr³/E (cancellation between kinetic and potential energy): 2e-4 at r = 1e4 already.
+#: r_far ≤ R_FAR_MAX · ω²/λ: an escaped orbit is only followed on towards its blow-up; the stress study
+#: checks that outcomes and times do not change up to r_far = 1e8 (tests/test_stress.py), not beyond
+R_ESC_MAX, R_FAR_MAX = 100.0, 1e8
+#: E0 ≤ E0_MAX · E_c: far above the saddle every orbit leaves within a fraction of a period (nothing to
+#: scatter), and p² = 2(E − V) overflows float64 near 1e308
+E0_MAX = 1000.0
+#: γ ≤ GAMMA_MAX · ω: beyond, the motion is overdamped (an orbit loses its energy above E_c within a small
+#: fraction of an oscillation period) and the equations only become stiff
+GAMMA_MAX = 10.0
+#: n ≤ N_MAX orbits per run: a lifetimes table of 1e9 orbits is ≈ 90 GB when read into memory; split larger
+#: ensembles into several runs (other seeds)
+N_MAX = 10**9
+#: at most CHUNKS_MAX part files per table and run point (file-system limits, one task per chunk)
+CHUNKS_MAX = 100_000
+#: at most SNAPSHOTS_MAX snapshot times: every live orbit writes one row per time (24 B), a chunk's
+#: snapshot rows are held in memory until written
+SNAPSHOTS_MAX = 100_000
+#: a start/stop/step snapshot grid longer than this is stored (scene.json, part metadata, hash) as its
+#: definition, not as every time (shorter grids are stored as their times, as before: same hashes)
+SNAPSHOT_LIST_MAX = 1000
+
 
 class SceneError(ValueError):
     """A scene parameter is outside its allowed range."""
+
+
+class SnapshotGrid(tuple):
+    """SnapshotGrid(start, stop, step) -> the times start, start + step, … ≤ stop (both ends included).
+
+    A tuple of the times (what the engine uses) that remembers its definition, so that a long grid is
+    stored as ``{"start", "stop", "step"}`` (see :data:`SNAPSHOT_LIST_MAX`). The count is checked against
+    :data:`SNAPSHOTS_MAX` before any time is made. Example: ``SnapshotGrid(0, 10, 2.5)`` is
+    (0.0, 2.5, 5.0, 7.5, 10.0).
+    """
+
+    def __new__(cls, start, stop, step):
+        start, stop, step = (_finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop),
+                                                                       ("step", step)))
+        if not step > 0:
+            raise SceneError(f"snapshots.step must be > 0, got {step}")
+        count = math.floor((stop - start) / step + 0.5) + 1
+        if count > SNAPSHOTS_MAX:
+            raise SceneError(f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
+                             f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
+                             "in memory): use a larger step")
+        self = super().__new__(cls, (float(t) for t in np.arange(start, stop + 0.5 * step, step)))
+        self.definition = {"start": start, "stop": stop, "step": step}
+        return self
+
+    def __reduce__(self):
+        d = self.definition
+        return (SnapshotGrid, (d["start"], d["stop"], d["step"]))
 
 
 def _finite(name, value):
@@ -183,8 +236,14 @@ class Scene:
         gamma = _finite("gamma", self.gamma)
         if gamma < 0:
             raise SceneError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
+        if gamma > GAMMA_MAX * m.omega:
+            raise SceneError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.omega:g}, got {gamma:g} (beyond, "
+                             "the motion is overdamped: orbits settle within a fraction of a period)")
         if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
             raise SceneError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
+        if self.n > N_MAX:
+            raise SceneError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
+                             "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds")
         if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
             raise SceneError(f"seed must be an integer ≥ 0, got {self.seed!r}")
         tol = _finite("tol", self.tol)
@@ -199,15 +258,30 @@ class Scene:
                 f"r_esc must be > the saddle distance ω²/λ = {m.saddle_radius:g} "
                 f"(outside the Lyapunov orbits), got {r_esc}"
             )
+        if r_esc > R_ESC_MAX * m.saddle_radius:
+            raise SceneError(f"r_esc must be ≤ {R_ESC_MAX:g} ω²/λ = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
+                             "(energy conservation: far out |V| ≈ λr³/3 ≫ E and the energy error grows like "
+                             "tol·λr³/E)")
         if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
             raise SceneError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
+        if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
+            raise SceneError(f"r_far must be ≤ {R_FAR_MAX:g} ω²/λ = {R_FAR_MAX * m.saddle_radius:g}, got "
+                             f"{self.r_far:g} (the range checked by the stress study; V ≈ λr³/3 heads for "
+                             "float64 overflow beyond)")
         if self.region not in REGIONS:
             raise SceneError(f"region must be one of {REGIONS}, got {self.region!r}")
         radius = _finite("radius", self.radius)
         if radius <= 0:
             raise SceneError(f"radius must be > 0, got {radius}")
+        if radius > r_esc:
+            raise SceneError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
+                             "escaped already, and the sampler would reject almost every draw: V < E only "
+                             "holds near the saddle triangle)")
         if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
             raise SceneError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
+        if -(-self.n // self.chunk_size) > CHUNKS_MAX:
+            raise SceneError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
+                             f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size")
         if self.batch_size is not None and (
             not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
         ):
@@ -222,6 +296,10 @@ class Scene:
                     f"energy must be > 0 = min V over the {self.region!r} region "
                     f"(no point of the region is accessible), got {energy}"
                 )
+            if energy > E0_MAX * m.critical_energy:
+                raise SceneError(f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
+                                 f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
+                                 "near 1e308)")
             if energy <= m.critical_energy:
                 what = "dissipative" if gamma > 0 else "conservative escape"
                 raise SceneError(
@@ -233,7 +311,11 @@ class Scene:
         if self.sections is not None and not isinstance(self.sections, SectionWindow):
             raise SceneError("sections must be a SectionWindow or None")
         if self.snapshots is not None:
-            snaps = tuple(float(s) for s in self.snapshots)
+            if not isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOTS_MAX:
+                raise SceneError(f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
+                                 "orbit writes one row per time; a chunk holds them in memory)")
+            snaps = self.snapshots if isinstance(self.snapshots, SnapshotGrid) else \
+                tuple(float(s) for s in self.snapshots)
             if not snaps:
                 raise SceneError("snapshots must be a non-empty list of times or omitted")
             if not all(math.isfinite(s) and 0 <= s <= t_max for s in snaps):
@@ -266,6 +348,8 @@ class Scene:
         if d["sections"] is not None and not d["sections"]["stop"]:
             del d["sections"]["stop"]
         d["snapshots"] = list(self.snapshots) if self.snapshots else None
+        if isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOT_LIST_MAX:
+            d["snapshots"] = dict(self.snapshots.definition)  # small metadata (see SNAPSHOT_LIST_MAX)
         if self.follow is None:
             del d["follow"]
         else:
@@ -284,11 +368,30 @@ class Scene:
         for k in ("name", "batch_size"):
             d.pop(k)
         if self.ics is not None:
-            d["ics"] = hashlib.sha256(Path(self.ics).read_bytes()).hexdigest()
+            d["ics"] = file_sha256(self.ics)
         return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()
 
     def replace(self, **changes) -> "Scene":
         return dataclasses.replace(self, **changes)
+
+
+def file_sha256(path) -> str:
+    """file_sha256(path) -> sha256 hex digest of a file, computed once per (path, size, mtime) per process.
+
+    The IC table's hash is part of a scene's ``result_hash``; the cache keeps it at one read of the table
+    per run, however many chunks ask for it (a changed file has another size or mtime and is hashed anew).
+    """
+    st = Path(path).stat()
+    return _file_sha256(str(Path(path).resolve()), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _file_sha256(path: str, size: int, mtime_ns: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 22), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def _clean(v):
@@ -345,14 +448,12 @@ def scene_from_dict(d: dict) -> Scene:
             snaps = snaps["times"]
         else:
             try:
-                start, stop, step = (float(snaps[k]) for k in ("start", "stop", "step"))
+                start, stop, step = (snaps[k] for k in ("start", "stop", "step"))
             except KeyError as exc:
                 raise SceneError(f"snapshots needs 'times' or start/stop/step (missing {exc})") from None
-            if not step > 0:
-                raise SceneError(f"snapshots.step must be > 0, got {step}")
-            snaps = list(np.arange(start, stop + 0.5 * step, step))
+            snaps = SnapshotGrid(start, stop, step)
     if snaps is not None:
-        d["snapshots"] = tuple(snaps)
+        d["snapshots"] = snaps if isinstance(snaps, SnapshotGrid) else tuple(snaps)
     known = {f.name for f in dataclasses.fields(Scene) if f.init}
     unknown = set(d) - known
     if unknown:

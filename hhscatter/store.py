@@ -25,6 +25,11 @@ import posixpath
 from pathlib import Path
 
 TMP_MARK = ".tmp-"  # temporary files are ".<final name>.tmp-<pid>"
+LOCK_FILE = ".hhscatter.lock"  # one writer per run directory (Store.lock)
+
+
+class LockedError(RuntimeError):
+    """Another process holds the run directory's write lock."""
 
 
 def _is_url(out) -> bool:
@@ -128,6 +133,36 @@ class Store:
         if self.local:
             return self.path(rel)
         return self._fs.open_input_file(self.path(rel))
+
+    # -- one writer ----------------------------------------------------------
+    def lock(self) -> int | None:
+        """lock() -> file descriptor holding an exclusive ``flock`` on root/.hhscatter.lock (local paths).
+
+        The kernel drops the lock when the holder exits, however it ends (kill -9 included), so a killed
+        run never leaves it stuck. Raises :class:`LockedError` naming the holder's pid if another process
+        holds it. Release with :meth:`unlock`. URLs (object stores) have no such lock: returns None.
+        """
+        if not self.local:
+            return None
+        import fcntl
+
+        self.makedirs()
+        fd = os.open(self.path(LOCK_FILE), os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            raise LockedError(f"{self.display()} is being written by another process (pid {holder})") from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, str(os.getpid()).encode(), 0)
+        return fd
+
+    @staticmethod
+    def unlock(fd) -> None:
+        """unlock(fd) -> None: release a lock taken by :meth:`lock` (None: no-op)."""
+        if fd is not None:
+            os.close(fd)
 
     # -- changes -------------------------------------------------------------
     def makedirs(self, rel: str = ""):

@@ -63,6 +63,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .scene import SceneError
+
 META_KEY = b"hhscatter"
 CENSORING_OUTCOMES = ("censored", "stopped")  # right-censored lifetimes (hhscatter.analysis.survival)
 TABLES = ("lifetimes", "sections", "snapshots", "crossings")
@@ -292,10 +294,130 @@ def legacy_point(rel: str):
     return tuple(float(keys[k]) for k in LEGACY_PARTITION_KEYS)
 
 
-def _dataset(run_dir, name: str, *, one_by_one: bool = False):
+class RunIntegrityError(SceneError):
+    """A run directory does not hold what its manifest plans: a table or part missing, a part not in the plan,
+    a part of another scene, a damaged part (page checksum), or unfinished chunks (:class:`IncompleteRunError`)."""
+
+
+class IncompleteRunError(RunIntegrityError):
+    """Some chunks of the run are not finished (killed run, full disk): read with ``allow_partial=True``."""
+
+
+def run_manifest(run_dir) -> dict | None:
+    """run_manifest(run_dir) -> the run's plan from OUT/scene.json (hhscatter.runner.manifest_of), or None.
+
+    None for a directory without scene.json or a run written before manifests (read as before, by
+    listing its part files).
+    """
+    from .store import Store
+
+    store = Store(run_dir)
+    if not store.exists("scene.json"):
+        return None
+    return json.loads(store.read_text("scene.json")).get("manifest")
+
+
+def run_status(run_dir) -> dict:
+    """run_status(run_dir) -> {'complete', 'chunks', 'chunks_done', 'orbits', 'orbits_done', 'scene_hash'}.
+
+    From the manifest and the presence of the ``lifetimes`` parts (written last in every chunk); cheap
+    (no file is opened). A run without manifest counts as complete if it has lifetimes parts.
+    """
+    from .store import Store
+
+    store = Store(run_dir)
+    doc = json.loads(store.read_text("scene.json")) if store.exists("scene.json") else {}
+    man = doc.get("manifest")
+    if man is None:
+        n = len(store.files("lifetimes"))
+        return {"complete": n > 0, "chunks": n, "chunks_done": n, "orbits": None, "orbits_done": None,
+                "scene_hash": doc.get("scene_hash")}
+    have = set(store.files("lifetimes"))
+    chunks = done = orbits = orbits_done = 0
+    for p in man["points"]:
+        for c in range(-(-p["n"] // p["chunk_size"])):
+            k = min(p["chunk_size"], p["n"] - c * p["chunk_size"])
+            chunks, orbits = chunks + 1, orbits + k
+            if "/".join(x for x in (p["partition"], part_name(c)) if x) in have:
+                done, orbits_done = done + 1, orbits_done + k
+    return {"complete": done == chunks, "chunks": chunks, "chunks_done": done, "orbits": orbits,
+            "orbits_done": orbits_done, "scene_hash": doc.get("scene_hash")}
+
+
+def _planned_files(store, man: dict, name: str, allow_partial: bool):
+    """The part files of table ``name`` that the manifest plans and the run has finished, as
+    [(file relative to the table folder, point dict, chunk)]; RunIntegrityError on anything else."""
+    run = store.display()
+    if name not in man["tables"]:
+        raise FileNotFoundError(f"no {name} table: the run at {run} does not record it "
+                                f"(its tables: {', '.join(man['tables'])})")
+    if not store.is_dir(name):
+        raise RunIntegrityError(f"the {name} table of the run at {run} is missing ({store.display(name)} "
+                                "does not exist); the run is damaged: simulate it again with --overwrite")
+    present = {f for f in store.files(name) if not f.rsplit("/", 1)[-1].startswith(".")}
+    finished = present if name == "lifetimes" else {f for f in store.files("lifetimes")}
+    planned, missing_chunks, missing_orbits, chunks, orbits = [], 0, 0, 0, 0
+    expected = set()
+    for p in man["points"]:
+        for c in range(-(-p["n"] // p["chunk_size"])):
+            rel = "/".join(x for x in (p["partition"], part_name(c)) if x)
+            expected.add(rel)
+            k = min(p["chunk_size"], p["n"] - c * p["chunk_size"])
+            chunks, orbits = chunks + 1, orbits + k
+            if rel not in finished:
+                missing_chunks, missing_orbits = missing_chunks + 1, missing_orbits + k
+                continue
+            if rel not in present:
+                raise RunIntegrityError(f"{store.display(name + '/' + rel)} is missing, but its chunk is "
+                                        "finished; the run is damaged: simulate it again with --overwrite")
+            planned.append((rel, p, c))
+    extra = sorted(present - expected)
+    if extra:
+        raise RunIntegrityError(f"{len(extra)} file(s) in {store.display(name)} are not in the run's chunk plan "
+                                f"(first: {extra[0]}); remove them or simulate the run again with --overwrite")
+    if missing_chunks:
+        what = (f"the run at {run} is incomplete: {missing_chunks} of {chunks} chunk(s) "
+                f"({missing_orbits} of {orbits} orbits) are not finished")
+        if not allow_partial:
+            raise IncompleteRunError(f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
+                                     "the finished chunks with allow_partial=True")
+        import warnings
+
+        warnings.warn(f"{what}; reading the {orbits - missing_orbits} orbits of the finished chunks "
+                      "(allow_partial=True)", stacklevel=4)
+    return planned
+
+
+def _check_fragment(store, name, frag, point, chunk):
+    """A part's own metadata must say it is this chunk of this scene, with as many rows as it holds."""
+    md = frag.metadata
+    kv = md.metadata or {}
+    where = frag.path
+    if META_KEY not in kv:
+        raise RunIntegrityError(f"{where} is not an hhscatter table (no '{META_KEY.decode()}' metadata)")
+    meta = json.loads(kv[META_KEY])
+    if meta.get("scene_hash") != point["scene_hash"]:
+        raise RunIntegrityError(f"{where} was made by another scene (hash {str(meta.get('scene_hash'))[:12]}…, "
+                                f"this run {point['scene_hash'][:12]}…); simulate the run again with --overwrite")
+    c, k = point["chunk_size"], chunk * point["chunk_size"]
+    want = [k, min(k + c, point["n"])]
+    if meta.get("chunk") != chunk or meta.get("orbits") != want or meta.get("table") not in (None, name) \
+            or meta.get("rows") != md.num_rows:
+        raise RunIntegrityError(f"{where} does not hold chunk {chunk} (orbits {want}) of the {name} table "
+                                f"(its metadata: chunk {meta.get('chunk')}, orbits {meta.get('orbits')}, "
+                                f"rows {meta.get('rows')} of {md.num_rows})")
+
+
+def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: bool = False):
     """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run, either layout).
 
-    ``one_by_one=True`` yields one single-file dataset per part instead: pyarrow
+    A run with a manifest (scene.json, hhscatter.runner.manifest_of) is read as exactly its planned and
+    finished part files: each part's metadata is checked against the plan (scene hash, chunk, orbit range,
+    row count; :func:`_check_fragment`, one footer per part) and every data page's checksum is verified as
+    it is read. A missing table or part, a part not in the plan or of another scene raise
+    :class:`RunIntegrityError`; unfinished chunks :class:`IncompleteRunError` unless ``allow_partial``
+    (then only the finished chunks are read, in every table alike, with a warning saying how much is
+    missing). ``one_by_one=True`` yields one single-file dataset per part instead: pyarrow
     keeps each scanned file's footer while its dataset lives, so a streaming
     scan over many thousands of parts is done file by file.
     """
@@ -305,17 +427,29 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False):
     from .store import Store
 
     store = Store(run_dir)
-    rel = name if store.is_dir(name) else ""
-    if not store.exists(rel):
-        raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
-    files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
-    if not files:
-        where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
-        raise FileNotFoundError(f"no {name} table: no part files in {where}")
+    man = run_manifest(run_dir)
+    checks = None
+    if man is not None:
+        rel = name
+        planned = _planned_files(store, man, name, allow_partial)
+        files = [f for f, _, _ in planned]
+        checks = [(p, c) for _, p, c in planned]
+        if not files:
+            raise IncompleteRunError(f"no {name} table: no chunk of the run at {store.display()} is finished")
+    else:
+        rel = name if store.is_dir(name) or store.exists("scene.json") else ""
+        if not store.exists(rel):
+            raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
+        files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
+        if not files:
+            where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
+            raise FileNotFoundError(f"no {name} table: no part files in {where}")
     grid = any("/" in f for f in files)
     schema = schema_of(name, grid)
     paths = [store.path(rel, f) for f in files]
-    fmt = ds.ParquetFileFormat()
+    # every data page's CRC (written by write_part) is verified as it is read
+    fmt = ds.ParquetFileFormat(default_fragment_scan_options=ds.ParquetFragmentScanOptions(
+        page_checksum_verification=True))
     fs = store.filesystem or pafs.LocalFileSystem()
     legacy = [legacy_point(f) for f in files]
     if any(p is not None for p in legacy):
@@ -337,13 +471,39 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False):
 
         def make(ps, es):
             return ds.dataset(ps, schema=schema, format=fmt, filesystem=store.filesystem)
+    def checked(dset, which):
+        if checks is not None:
+            for frag, (point, chunk) in zip(dset.get_fragments(), which):
+                _check_fragment(store, name, frag, point, chunk)
+        return dset
+
     if one_by_one:
-        return (make([p], [e]) for p, e in zip(paths, exprs))
-    return make(paths, exprs)
+        return (checked(make([p], [e]), [checks[i]] if checks else None) for i, (p, e) in enumerate(zip(paths, exprs)))
+    return checked(make(paths, exprs), checks)
 
 
-def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False):
-    table = _dataset(run_dir, name).to_table(columns=columns, filter=filters)
+def _scan(dset, run_dir, name, scan):
+    """scan(dset) with a damaged data page (page checksum mismatch) reported as RunIntegrityError naming the
+    part file (found by verifying the dataset's files one by one: only on this error path)."""
+    try:
+        return scan(dset)
+    except OSError as exc:
+        if "checksum" not in str(exc).lower():
+            raise
+        bad = "?"
+        for path in dset.files:
+            try:
+                verify_part(dset.filesystem.open_input_file(path))
+            except (OSError, ValueError):
+                bad = path
+                break
+        raise RunIntegrityError(f"{bad} is damaged: a data page fails its checksum ({exc}); delete it and "
+                                f"rerun `hhscatter simulate --out {run_dir} --resume`") from None
+
+
+def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False, allow_partial: bool = False):
+    table = _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
+                  lambda d: d.to_table(columns=columns, filter=filters))
     df = table.to_pandas()
     if "outcome" in df.columns and not categorical:
         df["outcome"] = df["outcome"].astype(str)
@@ -352,16 +512,19 @@ def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = Fa
     return df
 
 
-def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None):
+def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, allow_partial: bool = False):
     """read_arrow(run_dir, name='lifetimes', columns=None, filters=None) -> pyarrow.Table.
 
     The memory-lean reader: only ``columns`` are read (column projection in
-    the Parquet reader), no pandas conversion. ``run_dir`` may be a URL.
+    the Parquet reader), no pandas conversion. ``run_dir`` may be a URL. Every reader here reads exactly
+    the run's planned, finished and verified parts (:func:`_dataset`); an incomplete run is an error unless
+    ``allow_partial=True``.
     """
-    return _dataset(run_dir, name).to_table(columns=columns, filter=filters)
+    return _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
+                 lambda d: d.to_table(columns=columns, filter=filters))
 
 
-def survival_arrays(run_dir, filters=None):
+def survival_arrays(run_dir, filters=None, *, allow_partial: bool = False):
     """survival_arrays(run_dir, filters=None) -> (t_end float64 (N,), observed bool (N,)).
 
     The inputs of :func:`hhscatter.analysis.survival.survival_curve`, read
@@ -370,7 +533,8 @@ def survival_arrays(run_dir, filters=None):
     orbit). ``observed`` is False for censored orbits. Memory-bounded route for
     P(t) of 1e7+ orbits.
     """
-    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters)
+    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters,
+                       allow_partial=allow_partial)
     t_end = table.column("t_end").to_numpy()
     observed = np.empty(len(t_end), dtype=bool)
     pos = 0
@@ -386,7 +550,7 @@ def _observed(outcome) -> np.ndarray:
     return ~censored[outcome.indices.to_numpy(zero_copy_only=False)]
 
 
-def survival_on_grid(run_dir, t_grid, filters=None):
+def survival_on_grid(run_dir, t_grid, filters=None, *, allow_partial: bool = False):
     """survival_on_grid(run_dir, t_grid, filters=None) -> SurvivalCurve(t, P, P_err) at the grid times.
 
     P(t) = Pr(lifetime > t) (paper Eqs. eqn:kappa_hyperbolic/nonhyperbolic)
@@ -404,8 +568,9 @@ def survival_on_grid(run_dir, t_grid, filters=None):
 
     km = KaplanMeierGrid(t_grid)
     # one part file at a time (its footer is dropped with its dataset): memory is one part, however many
-    batches = (b for part in _dataset(run_dir, "lifetimes", one_by_one=True)
-               for b in part.to_batches(columns=["t_end", "outcome"], filter=filters, batch_readahead=1))
+    batches = (b for part in _dataset(run_dir, "lifetimes", one_by_one=True, allow_partial=allow_partial)
+               for b in _scan(part, run_dir, "lifetimes", lambda d: d.to_table(
+                   columns=["t_end", "outcome"], filter=filters).to_batches()))
     for batch in batches:
         km.add(batch.column(0).to_numpy(), _observed(batch.column(1)))
         if km.first_censoring < km.grid[-1]:
@@ -414,16 +579,16 @@ def survival_on_grid(run_dir, t_grid, filters=None):
     return km.curve()
 
 
-def iter_parts(run_dir, name: str, columns=None):
+def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False):
     """iter_parts(run_dir, name, columns=None) -> pandas.DataFrame per part file of table ``name``, in file order.
 
     For statistics pooled part by part (memory: one part at a time, whatever N).
     """
-    for part in _dataset(run_dir, name, one_by_one=True):
-        yield part.to_table(columns=columns).to_pandas()
+    for part in _dataset(run_dir, name, one_by_one=True, allow_partial=allow_partial):
+        yield _scan(part, run_dir, name, lambda d: d.to_table(columns=columns)).to_pandas()
 
 
-def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = False):
+def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = False, allow_partial: bool = False):
     """read_lifetimes(run_dir, columns=None, filters=None, *, categorical=False) -> pandas.DataFrame.
 
     The lifetimes table. ``columns`` projects (only those columns are read); ``filters`` is a
@@ -435,10 +600,10 @@ def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = F
     Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…`` folders)
     come back with the same columns.
     """
-    return _read(run_dir, "lifetimes", columns, filters, categorical)
+    return _read(run_dir, "lifetimes", columns, filters, categorical, allow_partial)
 
 
-def read_by_orbit(run_dir, columns, name: str = "lifetimes") -> dict:
+def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: bool = False) -> dict:
     """read_by_orbit(run_dir, columns, name='lifetimes') -> {column: array}, rows in traj_id order.
 
     The memory-lean reader for 1e7 orbits and more: Arrow columns straight to numpy, no pandas frame and
@@ -450,7 +615,7 @@ def read_by_orbit(run_dir, columns, name: str = "lifetimes") -> dict:
     import pyarrow.compute as pc
 
     names = ["traj_id", *(c for c in columns if c != "traj_id")]
-    tab = read_arrow(run_dir, name, columns=names)
+    tab = read_arrow(run_dir, name, columns=names, allow_partial=allow_partial)
     ids = tab.column("traj_id").to_numpy()
     order = None if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
     out = {}
@@ -468,23 +633,23 @@ def read_by_orbit(run_dir, columns, name: str = "lifetimes") -> dict:
     return out
 
 
-def read_sections(run_dir, columns=None, filters=None):
+def read_sections(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
     """read_sections(run_dir, ...) -> DataFrame traj_id, t, x, y, px, py, energy [, point_energy, point_gamma].
 
     ``energy`` is the orbit's energy at the crossing; a grid run adds its
     point's nominal E0 and γ as ``point_energy`` and ``point_gamma``.
     """
-    return _read(run_dir, "sections", columns, filters)
+    return _read(run_dir, "sections", columns, filters, allow_partial=allow_partial)
 
 
-def read_snapshots(run_dir, columns=None, filters=None):
+def read_snapshots(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
     """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy [, point_energy, point_gamma] (as read_sections)."""
-    return _read(run_dir, "snapshots", columns, filters)
+    return _read(run_dir, "snapshots", columns, filters, allow_partial=allow_partial)
 
 
-def read_crossings(run_dir, columns=None, filters=None):
+def read_crossings(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
     """read_crossings(run_dir, ...) -> DataFrame traj_id, t, radius, direction (follow scenes)."""
-    return _read(run_dir, "crossings", columns, filters)
+    return _read(run_dir, "crossings", columns, filters, allow_partial=allow_partial)
 
 
 def describe_run(run_dir) -> dict:
@@ -499,8 +664,9 @@ def describe_run(run_dir) -> dict:
 
     store = Store(run_dir)
     rows = {}
+    man = run_manifest(run_dir)
     for name in TABLES:
-        if store.is_dir(name):
+        if (name in man["tables"]) if man is not None else store.is_dir(name):
             try:
                 rows[name] = _dataset(run_dir, name).count_rows()
             except FileNotFoundError:

@@ -95,6 +95,7 @@ def _to_old_layout(run, dest):
     for p in doc["points"]:
         e, g = p["partition"].removeprefix("E").split("_gamma")
         p["partition"] = f"energy={e}/gamma={g}"
+    doc.pop("manifest")  # hhscatter 0.1.0 wrote no manifest (its runs are read by listing their parts)
     (dest / "scene.json").write_text(json.dumps(doc))
     return dest
 

@@ -119,6 +119,8 @@ class Study:
     orbits_run: int = 0       # orbits integrated by this process's run() calls (the cost record)
     chunks_resumed: int = 0   # chunks found complete and kept by run()
     params_model: type | None = None  # the study's Params (hhscatter.config.StudyParams) of its [study] table
+    raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
+    params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
 
     @property
     def needs(self) -> dict:
@@ -149,6 +151,8 @@ class Study:
         reads a key under another name). Without ``Params``, ``default`` is
         used and a missing key without default is an error.
         """
+        if self.params_read is not None:
+            self.params_read.add(key)
         p = self.params
         if key in p:
             return p[key]
@@ -214,6 +218,7 @@ class Study:
             resume = old == scene.result_hash()
             overwrite = not resume
         summary = simulate(scene, out, workers=workers, overwrite=overwrite, resume=resume, progress=progress)
+        self.raw_runs[key] = {"scene_hash": scene.result_hash(), "orbits": int(scene.n), "complete": True}
         self.orbits_run += summary.n
         self.chunks_resumed += summary.chunks_skipped
         if summary.chunks_done:
@@ -259,7 +264,7 @@ class Study:
 
         doc = {"study": self.name, "scale": self.scale, **numbers,
                "paper_comparison": list(self.comparisons), "config": self.config,
-               "provenance": provenance()}
+               "raw_runs": dict(self.raw_runs), "provenance": provenance()}
         write_json_atomic(self.numbers_path, doc)
         return self.numbers_path
 
@@ -429,10 +434,69 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
                 record(study.out, cost)
 
 
+#: the study.toml tables every raw run's scene is made from (Study.scene, Study.model)
+SCENE_TABLES = ("scene", "sections", "snapshots", "follow")
+
+
+def simulate_inputs(study, keys) -> dict:
+    """simulate_inputs(study, keys) -> what the simulate stage made its runs from: the scene tables of
+    study.toml (this scale) and the values of the ``[study]`` keys it read (``keys``). Analysis-only keys
+    (a paper constant, a fit window) are not in it: changing them needs no new simulation."""
+    return _jsonable({"tables": {t: study.config.get(t) for t in SCENE_TABLES},
+                      "study": {k: study.param(k) for k in sorted(keys)}})
+
+
+def checked_raw_runs(study) -> dict:
+    """checked_raw_runs(study) -> {key: {scene_hash, orbits, complete}} of the raw runs analyze may read.
+
+    SceneError (exit 2, before any analysis) if the simulate stage did not finish for the current
+    study.toml (``raw/done.json`` missing, or made from another configuration), or if a raw run it made
+    is incomplete or now holds another scene. A study without raw runs (one that reads only upstream
+    outputs) passes.
+    """
+    from ..tables import run_status
+
+    raw = study.out / "raw"
+    done = raw / "done.json"
+    again = f"run `hhscatter study {study.name} simulate --scale {study.scale}` first"
+    if not done.exists():
+        if raw.is_dir() and any((p / "scene.json").exists() for p in raw.iterdir() if p.is_dir()):
+            raise SceneError(f"{study.name} analyze: the simulate stage has not finished ({done} is missing); "
+                             f"{again}")
+        return {}
+    rec = json.loads(done.read_text())
+    was = rec.get("inputs") or {}
+    now = simulate_inputs(study, (was.get("study") or {}).keys())
+    changed = [f"[{t}]" for t in SCENE_TABLES if (was.get("tables") or {}).get(t) != now["tables"][t]]
+    changed += [f"[study] {k} ({v!r} → {now['study'][k]!r})" for k, v in (was.get("study") or {}).items()
+                if v != now["study"][k]]
+    if "inputs" not in rec or changed:
+        raise SceneError(f"{study.name} analyze: the raw runs in {raw} were made from another study.toml "
+                         f"({', '.join(changed) or 'no record of its inputs'} changed since simulate); {again}")
+    runs = {}
+    for key, want in rec.get("runs", {}).items():
+        st = run_status(raw / key)
+        if st["scene_hash"] != want["scene_hash"]:
+            raise SceneError(f"{study.name} analyze: raw run {raw / key} holds another scene than simulate made "
+                             f"(hash {str(st['scene_hash'])[:12]}…, expected {want['scene_hash'][:12]}…); {again}")
+        if not st["complete"]:
+            raise SceneError(f"{study.name} analyze: raw run {raw / key} is incomplete ({st['chunks_done']} of "
+                             f"{st['chunks']} chunks finished); {again}")
+        runs[key] = {"scene_hash": want["scene_hash"], "orbits": st["orbits"], "complete": True}
+    return runs
+
+
 def _run_one(study, mod, st, name, scale, workers, progress):
     if st == "simulate":
-        mod.simulate(study, workers=workers, progress=progress)
-        write_json_atomic(study.out / "raw" / "done.json", {"study": name, "scale": scale})
+        done = study.out / "raw" / "done.json"
+        done.unlink(missing_ok=True)  # the record of a finished simulate stage: invalid until this one ends
+        study.raw_runs, study.params_read = {}, set()
+        try:
+            mod.simulate(study, workers=workers, progress=progress)
+        finally:
+            read, study.params_read = study.params_read, None
+        write_json_atomic(done, {"study": name, "scale": scale, "inputs": simulate_inputs(study, read),
+                                 "runs": study.raw_runs})
         print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
     elif st == "analyze":
         from ._upstream import UpstreamError, dev_fallback_enabled
@@ -442,6 +506,7 @@ def _run_one(study, mod, st, name, scale, workers, progress):
             raise UpstreamError(
                 f"{name} needs the published outputs of {', '.join(missing)} (declared in [needs] of "
                 f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first")
+        study.raw_runs = checked_raw_runs(study)
         mod.analyze(study)
         derived = study.out / "derived"
         extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
