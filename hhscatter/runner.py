@@ -21,13 +21,30 @@ flight, so its memory does not grow with N.
 Crash safety. A part file appears under its final name only when complete
 (temporary name, fsync, rename; :mod:`hhscatter.store`); within a chunk the
 ``lifetimes`` part is written last. Each part's metadata records the scene,
-its hash, the chunk, its orbit range and its row count: that is the record of
-finished work (no separate manifest that could disagree with the files).
+its hash, the chunk, its orbit range and its row count.
 ``resume=True`` re-reads every existing part in full (page checksums, row
 counts, scene hash), keeps the good ones, deletes temporaries left by killed
-writers and redoes the rest; a run directory made by another scene is refused.
+writers and redoes the rest; a run directory made by another scene, or holding
+part files outside the chunk plan, is refused.
 A failed write (disk full, permission lost) stops the run with a
 :class:`RunError` that names the file; finished parts stay intact.
+
+A run is a manifest. ``scene.json`` holds the plan (:func:`manifest_of`: the
+tables, and per point its scene hash, n and chunk size, hence every part file
+and its orbit range); the readers of :mod:`hhscatter.tables` read exactly the
+planned parts whose chunk is finished, check each part's metadata against the
+plan and verify the page checksums, and refuse anything else. An unfinished
+chunk (no ``lifetimes`` part) makes the run incomplete: an error for readers
+unless they pass ``allow_partial=True``.
+
+One writer per run directory: ``simulate`` holds an exclusive ``flock`` on
+``OUT/.hhscatter.lock`` (:meth:`hhscatter.store.Store.lock`) from its checks to
+its end; the kernel releases it however the process ends. ``overwrite=True``
+removes the old run (its tables, scene.json, temporaries) under that lock
+before anything is written. Pool workers (and the progress manager) die with
+the process that started them (:func:`die_with_parent`); a Dask run whose
+cluster has had no worker for :data:`DASK_NO_WORKER_TIMEOUT` seconds fails with
+a :class:`RunError`.
 """
 from __future__ import annotations
 
@@ -583,7 +600,6 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
     import multiprocessing as mp
     import queue as queue_mod
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-
     from multiprocessing.managers import SyncManager
 
     ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state

@@ -33,6 +33,17 @@ Runs written before this layout (hhscatter ≤ 0.1.0 grid runs, hive folders
 still read by the functions here, which give them the same columns as the new
 layout; ``--resume`` continues such a run in its own layout.
 
+Reading is verified (:func:`_dataset`): a run read by these functions is read
+as exactly the part files its manifest (``scene.json``) plans and that are
+finished, each checked against the plan (scene hash, chunk, orbit range, row
+count) with its data pages' checksums verified. A missing table or part, a part
+outside the plan, of another scene or damaged raise :class:`RunIntegrityError`
+(exit status 2 in the CLI); an unfinished run raises :class:`IncompleteRunError`
+unless ``allow_partial=True``, which reads the finished chunks of every table
+alike (so sections/snapshots never hold an orbit without a lifetimes row) and
+warns how much is missing. Readers outside hhscatter (pandas, DuckDB, polars)
+see the files but none of these checks.
+
 Every part file's key-value metadata holds, under the key ``hhscatter``, a
 JSON document with the full scene, its result hash, the chunk index and
 orbit range, the row count, and the versions of hhscatter, heyoka, numpy and

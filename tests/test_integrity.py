@@ -23,11 +23,16 @@ import pytest
 from hhscatter.cli import main
 from hhscatter.runner import simulate
 from hhscatter.scene import Scene, SceneError, SectionWindow, scene_from_dict
-from hhscatter.tables import (IncompleteRunError, RunIntegrityError, read_lifetimes, read_sections,
-                              read_snapshots)
+from hhscatter.tables import (
+    IncompleteRunError,
+    RunIntegrityError,
+    read_lifetimes,
+    read_sections,
+    read_snapshots,
+)
 
-SCENE = dict(energy=0.3, gamma=0.01, n=400, seed=11, chunk_size=100, sections=SectionWindow(),
-             snapshots=(0.0, 5.0, 50.0))
+SCENE = {"energy": 0.3, "gamma": 0.01, "n": 400, "seed": 11, "chunk_size": 100, "sections": SectionWindow(),
+         "snapshots": (0.0, 5.0, 50.0)}
 
 
 def _hh(*args):
@@ -161,7 +166,7 @@ def test_5_pool_workers_die_with_their_parent(tmp_path, sig):
     finally:
         os.kill(proc.pid, sig)
         proc.wait()
-    gone, alive = psutil.wait_procs(kids, timeout=10)
+    _, alive = psutil.wait_procs(kids, timeout=10)
     for p in alive:  # clean up before failing: only processes this test started
         p.kill()
     assert not alive, f"{len(alive)} worker(s) outlived their parent"
