@@ -189,8 +189,12 @@ def write_part(path, table, meta: dict, store=None) -> None:
 
     def write(target, filesystem):
         # no per-file timestamps or writer-dependent fields: same rows, same bytes
-        pq.write_table(table, target, filesystem=filesystem, compression="zstd", write_statistics=True,
-                       write_page_checksum=True)
+        opts = {"compression": "zstd", "write_statistics": True, "write_page_checksum": True}
+        if filesystem is None:  # our own handle, closed even when the write fails (a full disk): a worker
+            with open(target, "wb") as fh:  # that keeps the error must not keep the unlinked file open
+                pq.write_table(table, fh, **opts)
+        else:
+            pq.write_table(table, target, filesystem=filesystem, **opts)
 
     store.write_atomic(rel, write)
 
