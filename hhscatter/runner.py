@@ -478,8 +478,8 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
         done_orbits = n_total - sum(t[3] - t[2] for t in todo)
         n_todo = len(todo)
     else:  # planned lazily: one task tuple per chunk in flight, not per chunk of the run
-        todo = ((scene.to_json(), chunk, start, stop, partition, h) for scene, partition, h in points
-                for chunk, start, stop in plan_chunks(scene))
+        todo = ((sj, chunk, start, stop, partition, h) for scene, partition, h in points
+                for sj in (scene.to_json(),) for chunk, start, stop in plan_chunks(scene))
         done_orbits, n_todo = 0, n_chunks
 
     def args(task):

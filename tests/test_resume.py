@@ -126,7 +126,10 @@ def test_write_failure_is_clear_and_keeps_finished_parts(tmp_path, monkeypatch, 
     def failing(table, where, **kw):
         calls.append(where)
         if len(calls) == 3:  # the third part file: a partial file, then the error, as a real full disk does
-            Path(where).write_bytes(b"PAR1 partial")
+            if hasattr(where, "write"):  # local parts are written through an open file (hhscatter.tables)
+                where.write(b"PAR1 partial")
+            else:
+                Path(where).write_bytes(b"PAR1 partial")
             raise OSError(code, os.strerror(code))
         return real(table, where, **kw)
 
