@@ -307,6 +307,8 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
                 from None
         except OSError as exc:
             raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+        # ours to remove on failure only if it was not there and still holds nothing but our lock
+        created = created and not [e for e in store.listdir() if e != LOCK_FILE]
         _check_and_clear(run, store, points, overwrite=overwrite, resume=resume)
         if resume:
             points = resumed_points(store, points)
@@ -330,11 +332,11 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
             raise SceneError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
                              "nothing was computed") from None
     except BaseException:
-        Store.unlock(lock)
-        if created and store.local:
+        if lock is not None and created:  # never a directory another writer made or holds
             import shutil
 
             shutil.rmtree(store.root, ignore_errors=True)
+        Store.unlock(lock)
         raise
     return store, lock, points
 

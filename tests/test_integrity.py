@@ -141,6 +141,19 @@ def test_4_second_writer_is_refused_while_the_first_runs(tmp_path, capsys):
     assert "nothing to do" in simulate(b, out, workers=1, progress=False, resume=True).line()
 
 
+def test_4_the_refused_writer_never_removes_the_holders_directory(tmp_path):
+    from hhscatter.store import Store
+
+    out = tmp_path / "fresh"
+    fd = Store(out).lock()  # another writer has just made the directory and holds it (empty so far)
+    try:
+        with pytest.raises(SceneError, match=rf"being written by another process \(pid {os.getpid()}\)"):
+            simulate(Scene(energy=0.3, n=10), out, workers=1, progress=False)
+        assert out.is_dir() and (out / ".hhscatter.lock").exists()
+    finally:
+        Store.unlock(fd)
+
+
 # 5 -- workers die with their parent (kill -9 and SIGTERM alike)
 def _children(pid):
     import psutil
