@@ -61,6 +61,10 @@ class Params(StudyParams):
     wada_r: Integer = 3
     wada_min_share: Number = 0.005
     symmetry_radius: Number = 0.9
+    scan_energies: Numbers = ()
+    scan_grid: Integer = 200
+    scan_eps: Numbers = ()
+    scan_n_uncertainty: Integer = 4000
 
 
 # -- keys and grids ----------------------------------------------------------------
@@ -78,6 +82,27 @@ def zoom_key(E, g, factor):
 
 def unc_key(E, g, i):
     return f"unc{i}_{_tag(E, g)}"
+
+
+def scan_map_key(E):
+    return f"scan_map_{_tag(E, 0.0)}"
+
+
+def scan_unc_key(E, i):
+    return f"scan_unc{i}_{_tag(E, 0.0)}"
+
+
+def _scan(study):
+    """(energies, ε) of the γ = 0 energy scan (issue 25, point 5); energies must lie above E_c."""
+    energies = [float(E) for E in study.param("scan_energies")]
+    eps = np.asarray(study.param("scan_eps"), dtype=float)
+    if energies:
+        ec = study.model.critical_energy
+        if min(energies) <= ec:
+            raise ValueError(f"basins [study].scan_energies must lie above E_c = {ec:.6g}")
+        if not (eps.size >= 2 and np.all(eps > 0) and np.all(np.diff(eps) < 0)):
+            raise ValueError("basins [study].scan_eps must be decreasing positive numbers")
+    return energies, eps
 
 
 def _eps(study):
@@ -119,20 +144,28 @@ def _map_states(study, E, extent, n):
     return section_grid(study.model, E, extent, (n, n))
 
 
-def _uncertainty_states(study, E, i, eps):
+def _uncertainty_states(study, E, i, eps, n=None, seed_offset=0):
     """Fresh reference ICs for ε index i (uniform on the allowed square) and their copies shifted by ε in x."""
     from hhscatter.ics import perturbed_on_section, region_ics
 
-    seed = int(study.config["scene"]["seed"]) * 100 + i
-    ref = region_ics(study.scene("unc", energy=E, region="square", n=int(study.param("n_uncertainty")),
-                                 seed=seed), 0, int(study.param("n_uncertainty")))
+    n = int(study.param("n_uncertainty")) if n is None else int(n)
+    seed = int(study.config["scene"]["seed"]) * 100 + seed_offset + i
+    ref = region_ics(study.scene("unc", energy=E, region="square", n=n, seed=seed), 0, n)
     moved, ok = perturbed_on_section(study.model, ref, E, dx=float(eps))
     return np.concatenate([ref[ok], moved[ok]])
 
 
-def zoom_centre(labels, extent, box=5):
-    """zoom_centre(labels, extent, box=5) -> (x, y): centre of the most mixed box (highest Gibbs entropy;
-    first in row-major order on ties), away from the map's edge and from forbidden cells."""
+def zoom_centre(labels, extent, box=5, clearance=0):
+    """zoom_centre(labels, extent, box=5, clearance=0) -> (x, y): centre of the most mixed box (highest Gibbs
+    entropy; first in row-major order on ties), away from the map's edge and from forbidden cells.
+
+    ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
+    forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
+    cells around the centre is wholly allowed (issue 25: the unconstrained choice sat at the edge of the
+    allowed region, where the zooms showed mostly forbidden cells).
+    """
+    from scipy import ndimage
+
     from hhscatter.analysis.basins import basin_entropy
 
     ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
@@ -143,10 +176,25 @@ def zoom_centre(labels, extent, box=5):
     grid[valid] = ent.box_entropy
     grid[[0, -1], :] = np.nan
     grid[:, [0, -1]] = np.nan
+    if clearance > 0:
+        # distance of every cell to the nearest forbidden cell or to the map's edge (padded as forbidden)
+        dist = ndimage.distance_transform_edt(np.pad(labels != OUTSIDE, 1))[1:-1, 1:-1]
+        centres = dist[box // 2::box, box // 2::box][:nr, :nc]
+        grid[centres < clearance] = np.nan
+        if np.all(np.isnan(grid)):
+            raise ValueError(f"zoom_centre: no mixed box lies {clearance} cells inside the allowed region")
     i, j = np.unravel_index(np.nanargmax(grid), grid.shape)
     x0, x1, y0, y1 = extent
     return (x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1],
             y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0])
+
+
+def _zoom_centre(study, extent, n):
+    """The zooms' centre: the most mixed box of the γ = 0 map at zoom_energy whose widest zoom window (the
+    smallest factor) lies wholly in the allowed region."""
+    Ez = float(study.param("zoom_energy"))
+    clearance = math.ceil(math.sqrt(2.0) * n / (2.0 * min(float(f) for f in study.param("zoom_factors"))))
+    return zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
 
 
 def _zoom_extent(extent, centre, factor):
@@ -177,12 +225,19 @@ def simulate(study, workers=None, progress=True):
             for i, e in enumerate(eps):
                 _run_table(study, unc_key(E, g, i), _uncertainty_states(study, E, i, e), g, workers, progress)
     Ez = float(study.param("zoom_energy"))
-    centre = zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent)
+    centre = _zoom_centre(study, extent, n)
     for g in study.param("zoom_gammas"):
         for f in study.param("zoom_factors"):
             ext = _zoom_extent(extent, centre, f)
             _run_table(study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, int(study.param("zoom_grid")))[3],
                        g, workers, progress)
+    scan_E, scan_eps = _scan(study)
+    ns = int(study.param("scan_grid"))
+    for E in scan_E:
+        _run_table(study, scan_map_key(E), _map_states(study, E, extent, ns)[3], 0.0, workers, progress)
+        for i, e in enumerate(scan_eps):
+            _run_table(study, scan_unc_key(E, i), _uncertainty_states(study, E, i, e, int(study.param(
+                "scan_n_uncertainty")), seed_offset=50), 0.0, workers, progress)
 
 
 # -- analyze ---------------------------------------------------------------------------
@@ -284,7 +339,7 @@ def analyze(study):
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
     zooms = []
     Ez = float(study.param("zoom_energy"))
-    centre = zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent)
+    centre = _zoom_centre(study, extent, n)
     for g in study.param("zoom_gammas"):
         for f in study.param("zoom_factors"):
             ext = _zoom_extent(extent, centre, f)
