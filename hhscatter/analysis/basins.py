@@ -156,6 +156,7 @@ __all__ = [
     "local_exponent",
     "predicted_cutoff",
     "slim_fractal",
+    "weighted_line",
 ]
 
 LOG2 = math.log(2.0)
@@ -816,6 +817,30 @@ def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_w
 # ---------------------------------------------------------------------------
 # Scale-dependent dimension, decision times and the cut-off (issue 25)
 # ---------------------------------------------------------------------------
+def weighted_line(x, y, err):
+    """weighted_line(x, y, err) -> (intercept, slope, cov (2, 2), chi2, dof): weighted least-squares line.
+
+    Weights 1/err²; the covariance is scaled by χ²/dof when the points scatter
+    more than their errors (never narrowed).
+
+    Examples
+    --------
+    >>> b0, b1, cov, chi2, dof = weighted_line([0, 1, 2], [1, 3, 5], [0.1, 0.1, 0.1])
+    >>> round(b1, 6), dof
+    (2.0, 1)
+    """
+    x, y, err = (np.asarray(v, dtype=float).ravel() for v in (x, y, err))
+    w = 1.0 / err ** 2
+    X = np.column_stack([np.ones_like(x), x])
+    cov = np.linalg.inv(X.T @ (w[:, None] * X))
+    b = cov @ (X.T @ (w * y))
+    dof = x.size - 2
+    chi2 = float(np.sum(w * (y - X @ b) ** 2))
+    if dof > 0:
+        cov = cov * max(1.0, chi2 / dof)
+    return float(b[0]), float(b[1]), cov, chi2, dof
+
+
 def local_exponent(eps, k, n) -> pd.DataFrame:
     """local_exponent(eps, k, n) -> DataFrame(eps_lo, eps_hi, eps_mid, alpha, alpha_err, d, d_err).
 
@@ -887,19 +912,13 @@ def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
     if len(t) < 2:
         return out
     t = t.sort_values("eps_mid", ascending=False)
-    x, y, w = np.log10(t["eps_mid"].to_numpy()), t["d"].to_numpy(), 1.0 / t["d_err"].to_numpy() ** 2
-    X = np.column_stack([np.ones_like(x), x])
-    cov = np.linalg.inv(X.T @ (w[:, None] * X))
-    b = cov @ (X.T @ (w * y))
-    # scale the errors by the reduced χ² when the points scatter more than their errors (never below)
-    dof = len(t) - 2
-    chi2 = float(np.sum(w * (y - X @ b) ** 2))
-    infl = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    se = math.sqrt(cov[1, 1] * infl)
-    out.update(slope=float(b[1]), slope_err=se, d_coarse=float(y[0]), d_coarse_err=float(t["d_err"].iloc[0]),
+    y = t["d"].to_numpy()
+    _, slope, cov, _, _ = weighted_line(np.log10(t["eps_mid"].to_numpy()), y, t["d_err"].to_numpy())
+    se = math.sqrt(cov[1, 1])
+    out.update(slope=slope, slope_err=se, d_coarse=float(y[0]), d_coarse_err=float(t["d_err"].iloc[0]),
                d_fine=float(y[-1]), d_fine_err=float(t["d_err"].iloc[-1]))
     out["fractal_coarse"] = bool(y[0] - 1.0 > z * out["d_coarse_err"])
-    out["slim"] = bool(out["fractal_coarse"] and b[1] > z * se)
+    out["slim"] = bool(out["fractal_coarse"] and slope > z * se)
     return out
 
 
@@ -950,19 +969,11 @@ def decision_rate(eps, times) -> DecisionRate:
     tab = pd.DataFrame(rows, columns=["eps", "x", "t_mean", "t_sem", "m"])
     if len(tab) < 2 or tab["x"].nunique() < 2:
         raise ValueError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
-    x, y = tab["x"].to_numpy(), tab["t_mean"].to_numpy()
-    w = 1.0 / np.maximum(tab["t_sem"].to_numpy(), 1e-12) ** 2
-    X = np.column_stack([np.ones_like(x), x])
-    cov = np.linalg.inv(X.T @ (w[:, None] * X))
-    b = cov @ (X.T @ (w * y))
-    dof = len(tab) - 2
-    chi2 = float(np.sum(w * (y - X @ b) ** 2))
-    if dof > 0:
-        cov = cov * max(1.0, chi2 / dof)  # scatter beyond the errors widens them, never narrows
-    slope, s_err = float(b[1]), float(math.sqrt(cov[1, 1]))
+    t0, slope, cov, chi2, dof = weighted_line(tab["x"], tab["t_mean"], np.maximum(tab["t_sem"], 1e-12))
+    s_err = float(math.sqrt(cov[1, 1]))
     if not slope > 0:
         raise ValueError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
-    return DecisionRate(lam=1.0 / slope, lam_err=s_err / slope ** 2, t0=float(b[0]),
+    return DecisionRate(lam=1.0 / slope, lam_err=s_err / slope ** 2, t0=t0,
                         t0_err=float(math.sqrt(cov[0, 0])), chi2=chi2, dof=dof, table=tab)
 
 

@@ -517,13 +517,10 @@ def _energy_trend(scan, E_b, smooth_chi2=2.0):
                            (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
     ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
     if ok.sum() >= 3:
-        x, y, w = scan.energy[ok].to_numpy(), scan.alpha[ok].to_numpy(), 1 / scan.alpha_err[ok].to_numpy() ** 2
-        X = np.column_stack([np.ones_like(x), x])
-        cov = np.linalg.inv(X.T @ (w[:, None] * X))
-        b = cov @ (X.T @ (w * y))
-        chi2 = float(np.sum(w * (y - X @ b) ** 2))
-        infl = max(1.0, chi2 / max(len(x) - 2, 1))
-        out["alpha_slope"] = {"value": float(b[1]), "err": float(math.sqrt(cov[1, 1] * infl))}
+        from hhscatter.analysis.basins import weighted_line
+
+        _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
+        out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
     return out
 
 
