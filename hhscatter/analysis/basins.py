@@ -138,6 +138,8 @@ from .escape_check import wilson_interval
 __all__ = [
     "BasinEntropy",
     "BasinFractions",
+    "BoxCountingDimension",
+    "DecisionRate",
     "UncertaintyCutoff",
     "UncertaintyExponent",
     "UncertaintyFraction",
@@ -145,17 +147,15 @@ __all__ = [
     "basin_entropy",
     "basin_entropy_table",
     "basin_fractions",
-    "uncertainty_cutoff",
-    "uncertainty_exponent",
-    "uncertainty_fraction",
-    "wada_merging",
-    "BoxCountingDimension",
-    "DecisionRate",
     "box_counting_dimension",
     "decision_rate",
     "local_exponent",
     "predicted_cutoff",
     "slim_fractal",
+    "uncertainty_cutoff",
+    "uncertainty_exponent",
+    "uncertainty_fraction",
+    "wada_merging",
     "weighted_line",
 ]
 
@@ -908,7 +908,7 @@ def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
     t = local[np.isfinite(local["d"]) & np.isfinite(local["d_err"]) & (local["d_err"] > 0)]
     out = {"slope": math.nan, "slope_err": math.nan, "d_coarse": math.nan, "d_coarse_err": math.nan,
            "d_fine": math.nan, "d_fine_err": math.nan, "slim": False, "fractal_coarse": False,
-           "n_points": int(len(t))}
+           "n_points": len(t)}
     if len(t) < 2:
         return out
     t = t.sort_values("eps_mid", ascending=False)

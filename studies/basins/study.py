@@ -275,11 +275,12 @@ def analyze(study):
     from hhscatter.analysis.basins import (
         basin_entropy_table,
         basin_fractions,
+        local_exponent,
+        slim_fractal,
         uncertainty_cutoff,
         uncertainty_exponent,
         wada_merging,
     )
-    from hhscatter.analysis.basins import local_exponent, slim_fractal
     from hhscatter.analysis.escape_check import channel_fractions
 
     extent = tuple(float(v) for v in study.param("extent"))
@@ -437,7 +438,12 @@ def _rate(eps, times):
 
 def _energy_scan(study, extent, boxes, hb, E_b):
     """γ = 0 energy scan (issue 25, point 5): per E0, S_b, S_bb, the exits' Wada test, α and λ."""
-    from hhscatter.analysis.basins import basin_entropy_table, basin_fractions, uncertainty_exponent, wada_merging
+    from hhscatter.analysis.basins import (
+        basin_entropy_table,
+        basin_fractions,
+        uncertainty_exponent,
+        wada_merging,
+    )
 
     energies, eps = _scan(study)
     ns = int(study.param("scan_grid"))
