@@ -204,5 +204,10 @@ def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
         ax.axvline(E_b, color="0.4", lw=0.8, ls="--")
         ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
         ax2 = ax.twinx()
-        ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3")
+        ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3",
+                     label="$\\lambda$, decision rate")
+        if "lam_kg" in scan:
+            ax2.errorbar(scan.energy, scan.lam_kg, yerr=scan.lam_kg_err, fmt="^:", ms=3, color="C1",
+                         label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)")
+        ax2.legend(fontsize=6, loc="lower right")
         ax2.set_ylabel("decision rate $\\lambda$ (1/time)", color="C3")

@@ -66,6 +66,7 @@ class Params(StudyParams):
     scan_eps: Numbers = ()
     scan_n_uncertainty: Integer = 4000
     E_b_key: str = "kappa_fit.E_b"
+    kappa_energy_key: str = "kappa_energy"
     mu_key: str = "mu"
 
 
@@ -364,6 +365,7 @@ def analyze(study):
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
     study.write_table(pd.concat(loc_tabs, ignore_index=True), "basins_local_exponent.parquet")
     scan, scan_unc = _energy_scan(study, extent, boxes, hb, E_b)
+    scan = _kantz_grassberger(study, scan)
     study.write_table(scan, "basins_energy_scan.parquet")
     study.write_table(scan_unc, "basins_energy_scan_uncertainty.parquet")
     cut_pred = _cutoff_prediction(per, scan, mu, mu_err, ec)
@@ -479,6 +481,26 @@ def _energy_scan(study, extent, boxes, hb, E_b):
             pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]))
 
 
+def _kantz_grassberger(study, scan):
+    """λ_KG = κ(E)/α(E) beside the decision rate: for a hyperbolic saddle the uncertainty exponent of the
+    section is α = κ/λ (Kantz & Grassberger, Physica D 17, 75 (1985)), κ the escape rate of study fig2
+    (its own runs, interpolated linearly in E; NaN outside its energies)."""
+    from hhscatter.studies import _upstream as up
+
+    rows, _ = up.lookup(up.numbers(study, study.upstream("kappa")), study.param("kappa_energy_key"),
+                        what=f"{study.upstream('kappa')}.json")
+    k = pd.DataFrame(rows).sort_values("energy")
+    if scan.empty:
+        return scan.assign(kappa=[], lam_kg=[], lam_kg_err=[])
+    inside = (scan.energy >= k.energy.min()) & (scan.energy <= k.energy.max())
+    kap = np.where(inside, np.interp(scan.energy, k.energy, k.kappa), np.nan)
+    kap_err = np.where(inside, np.interp(scan.energy, k.energy, k.kappa_err), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = kap / scan.alpha
+        err = np.abs(lam) * np.hypot(kap_err / kap, scan.alpha_err / scan.alpha)
+    return scan.assign(kappa=kap, lam_kg=lam, lam_kg_err=err)
+
+
 def _smooth_chi2(E, y, err):
     """χ²/dof of a quadratic in E through (E, y ± err): ≈ 1 for a smooth curve, ≫ 1 when y fluctuates."""
     ok = np.isfinite(y) & np.isfinite(err) & (err > 0)
@@ -544,6 +566,8 @@ def _cutoff_prediction(per, scan, mu, mu_err, ec):
         pred = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam, ec)
         lo = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam + lam_E.lam_err, ec)
         hi = predicted_cutoff(E0, g, mu, lam_E.energy, np.maximum(lam_E.lam - lam_E.lam_err, 0), ec)
+        kg = scan[np.isfinite(scan.lam_kg)]
+        pred_kg = predicted_cutoff(E0, g, mu, kg.energy, kg.lam_kg, ec) if len(kg) else None
         det = bool(c and c["detected"])
         rec = {"E0": E0, "gamma": g,
                "eps_c": c["eps_c"] if det else None,
@@ -551,6 +575,7 @@ def _cutoff_prediction(per, scan, mu, mu_err, ec):
                "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
                "detected": det,
                "eps_c_predicted": pred, "eps_c_predicted_interval": [lo, hi],
+               "eps_c_predicted_kantz_grassberger": pred_kg,
                "tau2": math.log(E0 / ec) / (mu * g),
                "smallest_resolved_eps": p["smallest_resolved_eps"]}
         if det and pred > 0:
