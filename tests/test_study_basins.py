@@ -36,3 +36,20 @@ def test_basins_tiny_end_to_end(tiny_studies):
     for _, u in unc.groupby(["energy", "gamma"]):
         u = u.sort_values("eps")
         assert u.f.iloc[-1] > u.f.iloc[0]
+    # issue 25: like-for-like Wada, local exponents, energy scan, the cut-off prediction, E_b and μ from upstream
+    fig2 = json.loads((tiny_studies / "fig2" / "out" / "tiny" / "fig2.json").read_text())
+    assert nums["E_b"]["value"] == fig2["kappa_fit"]["E_b"]["value"]
+    fig3 = json.loads((tiny_studies / "fig3" / "out" / "tiny" / "fig3.json").read_text())
+    assert nums["mu"]["value"] == fig3["mu"]["value"]
+    for p in nums["per_point"]:
+        assert "wada_exits" in p and "local_d" in p and "slim_fractal" in p
+        if p["gamma"] == 0:
+            assert p["wada_exits"] is None or p["wada_exits"]["basins"] == ["exit 0", "exit 1", "exit 2"]
+    recs = nums["cutoff_prediction"]
+    assert {(r["E0"], r["gamma"]) for r in recs} == {(p["energy"], p["gamma"]) for p in nums["per_point"]
+                                                      if p["gamma"] > 0}
+    for r in recs:
+        assert {"E0", "gamma", "eps_c", "eps_c_err", "eps_c_predicted"} <= set(r)
+        assert 0 <= r["eps_c_predicted"] < 1
+    scan = pd.read_parquet(out / "derived" / "basins_energy_scan.parquet")
+    assert sorted(scan.energy) == [0.2, 0.3] and (scan.above_E_b == (scan.energy > nums["E_b"]["value"])).all()

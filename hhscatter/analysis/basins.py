@@ -138,6 +138,8 @@ from .escape_check import wilson_interval
 __all__ = [
     "BasinEntropy",
     "BasinFractions",
+    "BoxCountingDimension",
+    "DecisionRate",
     "UncertaintyCutoff",
     "UncertaintyExponent",
     "UncertaintyFraction",
@@ -145,10 +147,16 @@ __all__ = [
     "basin_entropy",
     "basin_entropy_table",
     "basin_fractions",
+    "box_counting_dimension",
+    "decision_rate",
+    "local_exponent",
+    "predicted_cutoff",
+    "slim_fractal",
     "uncertainty_cutoff",
     "uncertainty_exponent",
     "uncertainty_fraction",
     "wada_merging",
+    "weighted_line",
 ]
 
 LOG2 = math.log(2.0)
@@ -804,3 +812,251 @@ def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_w
     slope = (float(np.polyfit(-np.log(table["step"].to_numpy(float)[ok]), np.log(h[ok]), 1)[0])
              if np.count_nonzero(ok) >= 2 else math.nan)
     return WadaTest(wada, keys, r, W, covered, haus, nb, r_wada, float(tol), slope, table)
+
+
+# ---------------------------------------------------------------------------
+# Scale-dependent dimension, decision times and the cut-off (issue 25)
+# ---------------------------------------------------------------------------
+def weighted_line(x, y, err):
+    """weighted_line(x, y, err) -> (intercept, slope, cov (2, 2), chi2, dof): weighted least-squares line.
+
+    Weights 1/err²; the covariance is scaled by χ²/dof when the points scatter
+    more than their errors (never narrowed).
+
+    Examples
+    --------
+    >>> b0, b1, cov, chi2, dof = weighted_line([0, 1, 2], [1, 3, 5], [0.1, 0.1, 0.1])
+    >>> round(b1, 6), dof
+    (2.0, 1)
+    """
+    x, y, err = (np.asarray(v, dtype=float).ravel() for v in (x, y, err))
+    w = 1.0 / err ** 2
+    X = np.column_stack([np.ones_like(x), x])
+    cov = np.linalg.inv(X.T @ (w[:, None] * X))
+    b = cov @ (X.T @ (w * y))
+    dof = x.size - 2
+    chi2 = float(np.sum(w * (y - X @ b) ** 2))
+    if dof > 0:
+        cov = cov * max(1.0, chi2 / dof)
+    return float(b[0]), float(b[1]), cov, chi2, dof
+
+
+def local_exponent(eps, k, n) -> pd.DataFrame:
+    """local_exponent(eps, k, n) -> DataFrame(eps_lo, eps_hi, eps_mid, alpha, alpha_err, d, d_err).
+
+    The local uncertainty exponent between consecutive resolutions,
+    α(ε) = ln(f_{i+1}/f_i) / ln(ε_{i+1}/ε_i) with f_i = k_i/n_i, at the
+    geometric mid-point ε_mid = √(ε_i ε_{i+1}); d(ε) = 2 − α(ε) is the
+    dimension of the boundary measured at resolution ε (Chen, Nishikawa and
+    Motter, PRX 7, 021040 (2017): constant for a fractal, falling towards 1
+    as ε → 0 for a "slim fractal").  The errors assume independent initial
+    conditions at each ε (fresh samples per ε, the independent unit): the
+    delta method on the two binomial counts,
+    σ_α² = [(1 − f_i)/k_i + (1 − f_{i+1})/k_{i+1}] / ln²(ε_{i+1}/ε_i).
+    Pairs with a zero count give NaN.
+
+    Parameters
+    ----------
+    eps : array of ε (any order; sorted decreasing here), same units as the initial conditions.
+    k, n : uncertain counts and sample sizes per ε.
+
+    Examples
+    --------
+    >>> local_exponent([1e-2, 1e-4], [1000, 100], [10000, 10000]).alpha.round(3).tolist()
+    [0.5]
+    """
+    eps = np.asarray(eps, dtype=float).ravel()
+    k = np.asarray(k, dtype=float).ravel()
+    n = np.broadcast_to(np.asarray(n, dtype=float), k.shape).astype(float)
+    if eps.size != k.size or eps.size < 2:
+        raise ValueError("eps and k must have the same length ≥ 2")
+    if np.any(eps <= 0) or not np.all(np.isfinite(eps)) or np.unique(eps).size != eps.size:
+        raise ValueError("eps must be distinct, finite and > 0")
+    if np.any(k < 0) or np.any(k > n) or np.any(n < 1):
+        raise ValueError("need 0 ≤ k ≤ n and n ≥ 1")
+    o = np.argsort(-eps)
+    eps, k, n = eps[o], k[o], n[o]
+    f = k / n
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lx = np.log(eps[1:] / eps[:-1])
+        alpha = np.log(f[1:] / f[:-1]) / lx
+        var = ((1 - f[:-1]) / k[:-1] + (1 - f[1:]) / k[1:]) / lx ** 2
+    bad = (k[:-1] == 0) | (k[1:] == 0)
+    alpha[bad] = np.nan
+    err = np.sqrt(np.where(bad, np.nan, var))
+    return pd.DataFrame({"eps_lo": eps[1:], "eps_hi": eps[:-1], "eps_mid": np.sqrt(eps[1:] * eps[:-1]),
+                         "alpha": alpha, "alpha_err": err, "d": 2.0 - alpha, "d_err": err})
+
+
+def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
+    """slim_fractal(local_exponent table) -> dict(slope, slope_err, d_coarse, d_fine, slim, fractal_coarse).
+
+    Chen, Nishikawa and Motter's "slim fractal" test on the local dimension
+    d(ε) of :func:`local_exponent`: the weighted least-squares slope of d
+    against log10 ε (per decade; > 0 when the dimension measured at
+    resolution ε decreases as the resolution increases) and its error;
+    ``slim`` when the slope is positive by more than ``z`` σ while the
+    coarsest resolved d exceeds 1 by more than z σ (fractal-looking at coarse
+    resolution, thinning at fine resolution).  NaN rows are ignored.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"eps_mid": [1e-2, 1e-4, 1e-6], "d": [1.8, 1.8, 1.8], "d_err": [0.01] * 3})
+    >>> slim_fractal(t)["slim"]
+    False
+    """
+    t = local[np.isfinite(local["d"]) & np.isfinite(local["d_err"]) & (local["d_err"] > 0)]
+    out = {"slope": math.nan, "slope_err": math.nan, "d_coarse": math.nan, "d_coarse_err": math.nan,
+           "d_fine": math.nan, "d_fine_err": math.nan, "slim": False, "fractal_coarse": False,
+           "n_points": len(t)}
+    if len(t) < 2:
+        return out
+    t = t.sort_values("eps_mid", ascending=False)
+    y = t["d"].to_numpy()
+    _, slope, cov, _, _ = weighted_line(np.log10(t["eps_mid"].to_numpy()), y, t["d_err"].to_numpy())
+    se = math.sqrt(cov[1, 1])
+    out.update(slope=slope, slope_err=se, d_coarse=float(y[0]), d_coarse_err=float(t["d_err"].iloc[0]),
+               d_fine=float(y[-1]), d_fine_err=float(t["d_err"].iloc[-1]))
+    out["fractal_coarse"] = bool(y[0] - 1.0 > z * out["d_coarse_err"])
+    out["slim"] = bool(out["fractal_coarse"] and slope > z * se)
+    return out
+
+
+@dataclass(frozen=True)
+class DecisionRate:
+    """Result of :func:`decision_rate`: rate λ (1/time) with its error, offset t0 (time), per-ε table."""
+
+    lam: float
+    lam_err: float
+    t0: float
+    t0_err: float
+    chi2: float
+    dof: int
+    table: pd.DataFrame = field(repr=False)
+
+
+def decision_rate(eps, times) -> DecisionRate:
+    """decision_rate(eps, times) -> DecisionRate(lam, lam_err, t0, ...): the rate at which pairs decide.
+
+    Two initial conditions a distance ε apart separate as ε e^{λt} on a
+    chaotic saddle with Lyapunov exponent λ; their outcomes part when the
+    separation reaches O(1), at t ≈ t0 + ln(1/ε)/λ.  Given, for each ε, the
+    decision times of the pairs whose outcomes differ (``times``: a list of
+    arrays, e.g. the time until the first orbit of the pair leaves), this fits
+    mean t(ε) = t0 + ln(1/ε)/λ by weighted least squares with the standard
+    error of each mean (pairs independent, fresh per ε), and returns λ = 1 /
+    slope with the delta-method error.  ε with fewer than 3 times are left
+    out; at least 2 ε must remain.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> eps = [1e-2, 1e-4, 1e-6]
+    >>> ts = [5 + np.log(1 / e) / 0.5 + rng.normal(0, 1, 400) for e in eps]
+    >>> round(decision_rate(eps, ts).lam, 2)
+    0.5
+    """
+    eps = np.asarray(eps, dtype=float).ravel()
+    if len(times) != eps.size:
+        raise ValueError("times must hold one array per ε")
+    rows = []
+    for e, t in zip(eps, times):
+        t = np.asarray(t, dtype=float)
+        t = t[np.isfinite(t)]
+        if t.size >= 3 and e > 0:
+            rows.append({"eps": e, "x": math.log(1.0 / e), "t_mean": float(t.mean()),
+                         "t_sem": float(t.std(ddof=1) / math.sqrt(t.size)), "m": int(t.size)})
+    tab = pd.DataFrame(rows, columns=["eps", "x", "t_mean", "t_sem", "m"])
+    if len(tab) < 2 or tab["x"].nunique() < 2:
+        raise ValueError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
+    t0, slope, cov, chi2, dof = weighted_line(tab["x"], tab["t_mean"], np.maximum(tab["t_sem"], 1e-12))
+    s_err = float(math.sqrt(cov[1, 1]))
+    if not slope > 0:
+        raise ValueError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
+    return DecisionRate(lam=1.0 / slope, lam_err=s_err / slope ** 2, t0=t0,
+                        t0_err=float(math.sqrt(cov[0, 0])), chi2=chi2, dof=dof, table=tab)
+
+
+def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: float) -> float:
+    """predicted_cutoff(E0, γ, μ, energies, λ(energies), E_c) -> ε_c predicted by the probabilistic description.
+
+    The paper's description (Eqs. (eqn:energy_exp_decay), (eq:tau2)): the
+    energy of a surviving orbit decays as E(t) = E0 e^{−μγt} and scattering
+    ends at τ2 = ln(E0/E_c)/(μγ), when E(t) = E_c; meanwhile the orbit follows
+    the conservative saddle of energy E(t), where nearby orbits separate at
+    the rate λ(E).  Two initial conditions ε apart can reach different exits
+    only if they separate to O(1) before τ2, i.e. if
+    ln(1/ε) < Λ = ∫_0^{τ2} λ(E(t)) dt = (1/(μγ)) ∫_{E_c}^{E0} λ(E)/E dE.
+    Below ε_c = e^{−Λ} the outcome is decided by the settling alone and the
+    power law of f(ε) must end.  λ(E) is interpolated linearly in E between
+    the given ``energies`` (held constant beyond them); the integral uses
+    the trapezoidal rule on a fine grid.  γ = 0 gives ε_c = 0 (no cut-off).
+
+    Examples
+    --------
+    >>> round(math.log(1 / predicted_cutoff(0.3, 0.01, 1.0, [0.2, 0.3], [0.5, 0.5], 0.15)), 3)
+    34.657
+    """
+    E0, gamma, mu, e_c = float(E0), float(gamma), float(mu), float(e_c)
+    if not (E0 > e_c > 0 and gamma >= 0 and mu > 0):
+        raise ValueError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
+    if gamma == 0:
+        return 0.0
+    En = np.asarray(energies, dtype=float).ravel()
+    lam = np.asarray(lam, dtype=float).ravel()
+    ok = np.isfinite(En) & np.isfinite(lam)
+    if np.count_nonzero(ok) < 1:
+        raise ValueError("predicted_cutoff: no finite λ(E) given")
+    o = np.argsort(En[ok])
+    grid = np.linspace(e_c, E0, 2001)
+    val = np.interp(grid, En[ok][o], lam[ok][o]) / grid
+    big_lambda = float(np.sum(0.5 * (val[1:] + val[:-1]) * np.diff(grid))) / (mu * gamma)
+    return float(math.exp(-big_lambda))
+
+
+@dataclass(frozen=True)
+class BoxCountingDimension:
+    """Result of :func:`box_counting_dimension`: dimension D (slope of ln N(s) against ln(1/s)), its error,
+    the box sizes (cells) and counts N(s) of boxes that hold the boundary."""
+
+    D: float
+    D_err: float
+    sizes: np.ndarray
+    counts: np.ndarray
+
+
+def box_counting_dimension(labels, sizes=(2, 4, 8, 16, 32), *, outside: int = -1) -> BoxCountingDimension:
+    """box_counting_dimension(labels, sizes) -> BoxCountingDimension(D, D_err, sizes, counts).
+
+    Box-counting dimension of the basin boundary of a 2-D map: N(s), the
+    number of s × s boxes that hold cells of more than one valid label, scales
+    as s^{−D}; D is the least-squares slope of ln N against ln(1/s) and D_err
+    its standard error from the scatter about the line (a fit error, not a
+    sampling one).  Boxes with any ``outside`` cell are left out.  The
+    resolution bounds what it sees: sizes must be ≥ 2 cells.
+
+    Examples
+    --------
+    >>> lab = np.zeros((64, 64), int); lab[:, 33:] = 1
+    >>> round(box_counting_dimension(lab, (2, 4, 8)).D, 3)
+    1.0
+    """
+    lab = _int_labels(labels, "labels", ndim=2)
+    s = np.array(sorted({_positive_int(v, "sizes", 2) for v in np.atleast_1d(sizes)}))
+    if s.size < 2:
+        raise ValueError("sizes: need at least 2 box sizes")
+    counts = []
+    for b in s:
+        nr, nc = lab.shape[0] // b, lab.shape[1] // b
+        if nr == 0 or nc == 0:
+            raise ValueError(f"sizes: box {b} exceeds the map {lab.shape}")
+        blk = lab[:nr * b, :nc * b].reshape(nr, b, nc, b).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
+        valid = (blk != outside).all(axis=-1)
+        mixed = blk.min(axis=-1) != blk.max(axis=-1)
+        counts.append(int(np.count_nonzero(valid & mixed)))
+    counts = np.array(counts)
+    if np.any(counts == 0):
+        raise ValueError("box_counting_dimension: no boundary at some box size")
+    x, y = np.log(1.0 / s), np.log(counts)
+    (slope, _), cov = np.polyfit(x, y, 1, cov=True) if s.size > 2 else (np.polyfit(x, y, 1), np.zeros((2, 2)))
+    return BoxCountingDimension(float(slope), float(math.sqrt(cov[0, 0])), s, counts)

@@ -15,14 +15,18 @@ def _image(ax, labels, extent, cmap, norm):
     return ax.imshow(img, origin="lower", extent=extent, cmap=cmap, norm=norm, interpolation="nearest")
 
 
-def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
+def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", local=None, scan=None):
     """plot_basins(maps, zooms, entropy, uncertainty, numbers, path) -> None; writes basins.png.
 
     Rows 1–2: the basin maps of each (E0, γ) with a discrete legend; row 3:
     the zoom of one boundary region at two magnifications (γ as listed);
     row 4: (a) f(ε) on log–log axes with the fitted power laws, (b) S_b and
     S_bb against γ with ln 2, (c) the uncertainty dimension d = 2 − α
-    against γ.
+    against γ; row 5 (issue 25, when ``local`` and ``scan`` are given): the
+    local dimension d(ε) against ε for every γ at each E0, the measured and
+    predicted cut-off ε_c against γ, the Wada fraction of the exit basins
+    (settled masked) and of all basins against γ, and the γ = 0 energy scan
+    (S_b, S_bb, d = 2 − α and λ against E0, with fig2's break energy E_b).
     """
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
@@ -36,8 +40,9 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
     ext = numbers["extent"]
     zg = sorted(zooms.gamma.unique())
     zf = sorted(zooms.factor.unique())
-    ncol = max(len(gammas), len(zg) * len(zf), 3)
-    nrow = len(energies) + 2
+    extra = local is not None and scan is not None
+    ncol = max(len(gammas), len(zg) * len(zf), 3, 6 if extra else 0)
+    nrow = len(energies) + 2 + int(extra)
     fig = plt.figure(figsize=(3.0 * ncol, 3.0 * nrow), constrained_layout=True)
     gs = fig.add_gridspec(nrow, ncol)
     for i, E in enumerate(energies):
@@ -62,8 +67,9 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
         ax.ticklabel_format(useOffset=False)
         ax.tick_params(labelsize=7)
     per = numbers["per_point"]
+    last = nrow - 1 - int(extra)
     # (a) f(ε)
-    ax = fig.add_subplot(gs[-1, 0])
+    ax = fig.add_subplot(gs[last, 0])
     for k, ((E, g), u) in enumerate(uncertainty.groupby(["energy", "gamma"])):
         ok = u.k > 0
         err = np.vstack([u.f[ok] - u.f_lo[ok], u.f_hi[ok] - u.f[ok]])
@@ -80,7 +86,7 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
     ax.set_ylabel("uncertain fraction $f(\\varepsilon)$")
     ax.legend(fontsize=6, ncol=1)
     # (b) S_b, S_bb against γ at the headline box
-    ax = fig.add_subplot(gs[-1, 1])
+    ax = fig.add_subplot(gs[last, 1])
     hb = per[0]["box_headline"]
     gx = np.array([max(g, 1e-4) for g in gammas])
     for E in energies:
@@ -95,7 +101,7 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
     ax.set_ylabel(f"basin entropy (box {hb}×{hb} cells)")
     ax.legend(fontsize=6)
     # (c) d = 2 − α against γ
-    ax = fig.add_subplot(gs[-1, 2])
+    ax = fig.add_subplot(gs[last, 2])
     for E in energies:
         rows = [q for q in per if q["energy"] == E and q["d"]]
         ax.errorbar([max(q["gamma"], 1e-4) for q in rows], [q["d"]["value"] for q in rows],
@@ -105,6 +111,8 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
     ax.set_ylabel("uncertainty dimension $d = 2 - \\alpha$")
     ax.legend(fontsize=7)
+    if extra:
+        _issue25_row(fig, gs, nrow - 1, ncol, energies, gammas, local, scan, numbers)
     fig.legend(handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)] +
                [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
                loc="outside lower center", ncol=6, fontsize=9)
@@ -112,3 +120,94 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale=""):
                  f"({n}×{n} cells, $r_{{esc}}=1.5$){' — ' + scale if scale else ''}", fontsize=11)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
+    """Scale-dependent dimension, cut-off prediction, like-for-like Wada and the γ = 0 energy scan."""
+    import matplotlib.pyplot as plt
+
+    cm = plt.get_cmap("viridis")
+    col = 0
+    for E in energies[:2]:
+        ax = fig.add_subplot(gs[row, col])
+        col += 1
+        for i, g in enumerate(gammas):
+            t = local[(local.energy == E) & (local.gamma == g) & np.isfinite(local.d) & (local.d_err < 0.3)]
+            ax.errorbar(t.eps_mid, t.d, yerr=t.d_err, fmt="o-", ms=3, lw=0.8, capsize=2,
+                        color=cm(i / max(len(gammas) - 1, 1)), label=f"$\\gamma={g:g}$")
+        ax.axhline(1.0, color="k", lw=0.8, ls=":")
+        ax.set_xscale("log")
+        ax.set_ylim(0.8, 2.05)
+        ax.set_xlabel("resolution $\\varepsilon$")
+        ax.set_ylabel("local dimension $d(\\varepsilon) = 2 - \\alpha(\\varepsilon)$ (σ < 0.3)")
+        ax.set_title(f"$E_0={E:g}$", fontsize=10)
+        ax.legend(fontsize=6, ncol=2)
+    # measured against predicted ε_c
+    ax = fig.add_subplot(gs[row, col])
+    col += 1
+    for k, E in enumerate(energies):
+        recs = [r for r in numbers.get("cutoff_prediction", []) if r["E0"] == E]
+        if not recs:
+            continue
+        g = np.array([r["gamma"] for r in recs])
+        pred = np.array([r["eps_c_predicted"] for r in recs])
+        lo = np.array([r["eps_c_predicted_interval"][0] for r in recs])
+        hi = np.array([r["eps_c_predicted_interval"][1] for r in recs])
+        c = f"C{k}"
+        ax.fill_between(g, lo, hi, color=c, alpha=0.2)
+        ax.plot(g, pred, "--", color=c, label=f"predicted, $E_0={E:g}$")
+        for r in recs:
+            if r["detected"]:
+                lo_m, hi_m = r["eps_c_interval"]
+                ax.errorbar([r["gamma"]], [r["eps_c"]], yerr=[[r["eps_c"] - lo_m], [hi_m - r["eps_c"]]],
+                            fmt="o", color=c, capsize=2)
+            elif r["eps_c_interval"]:
+                ax.plot([r["gamma"]], [r["eps_c_interval"][1]], "v", color=c, mfc="none")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(1e-12, 1.0)  # the measured range of ε; smaller predictions lie below the frame
+    ax.set_xlabel("$\\gamma$")
+    ax.set_ylabel("cut-off $\\varepsilon_c$ (o measured, ▽ upper bound)")
+    ax.legend(fontsize=6)
+    # Wada fraction: exits with settled masked, against all basins
+    ax = fig.add_subplot(gs[row, col])
+    col += 1
+    per = numbers["per_point"]
+    for k, E in enumerate(energies):
+        rows = [q for q in per if q["energy"] == E]
+        gx = [max(q["gamma"], 1e-4) for q in rows]
+        ax.plot(gx, [q["wada"]["W_at_r"] for q in rows], "s--", color=f"C{k}", mfc="none",
+                label=f"all basins (settled a basin), $E_0={E:g}$")
+        ax.plot(gx, [q["wada_exits"]["W_at_r"] if q["wada_exits"] else np.nan for q in rows], "o-",
+                color=f"C{k}", label=f"exit basins (settled masked), $E_0={E:g}$")
+    ax.axhline(0.99, color="k", lw=0.8, ls=":", label="Wada threshold")
+    ax.set_xscale("log")
+    ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
+    ax.set_ylabel("Wada fraction $W(r)$")
+    ax.legend(fontsize=5)
+    # energy scan at γ = 0
+    E_b = numbers["E_b"]["value"]
+    ax = fig.add_subplot(gs[row, col])
+    col += 1
+    ax.errorbar(scan.energy, scan.S_b, yerr=scan.S_b_err, fmt="o-", ms=3, label="$S_b$")
+    ax.errorbar(scan.energy, scan.S_bb, yerr=scan.S_bb_err, fmt="s-", ms=3, label="$S_{bb}$")
+    ax.axhline(np.log(2), color="k", lw=0.8, ls=":", label="ln 2")
+    ax.axvline(E_b, color="0.4", lw=0.8, ls="--", label="$E_b$ (fig2)")
+    ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
+    ax.set_ylabel("basin entropy")
+    ax.legend(fontsize=6)
+    if col < ncol:
+        ax = fig.add_subplot(gs[row, col])
+        ax.errorbar(scan.energy, 2 - scan.alpha, yerr=scan.alpha_err, fmt="o-", ms=3, color="C2",
+                    label="$d = 2 - \\alpha$")
+        ax.set_ylabel("uncertainty dimension $d$", color="C2")
+        ax.axvline(E_b, color="0.4", lw=0.8, ls="--")
+        ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
+        ax2 = ax.twinx()
+        ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3",
+                     label="$\\lambda$, decision rate")
+        if "lam_kg" in scan:
+            ax2.errorbar(scan.energy, scan.lam_kg, yerr=scan.lam_kg_err, fmt="^:", ms=3, color="C1",
+                         label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)")
+        ax2.legend(fontsize=6, loc="lower right")
+        ax2.set_ylabel("decision rate $\\lambda$ (1/time)", color="C3")

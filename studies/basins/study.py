@@ -61,6 +61,13 @@ class Params(StudyParams):
     wada_r: Integer = 3
     wada_min_share: Number = 0.005
     symmetry_radius: Number = 0.9
+    scan_energies: Numbers = ()
+    scan_grid: Integer = 200
+    scan_eps: Numbers = ()
+    scan_n_uncertainty: Integer = 4000
+    E_b_key: str = "kappa_fit.E_b"
+    kappa_energy_key: str = "kappa_energy"
+    mu_key: str = "mu"
 
 
 # -- keys and grids ----------------------------------------------------------------
@@ -78,6 +85,27 @@ def zoom_key(E, g, factor):
 
 def unc_key(E, g, i):
     return f"unc{i}_{_tag(E, g)}"
+
+
+def scan_map_key(E):
+    return f"scan_map_E{E:g}_g0"  # full precision: scan energies such as 0.17 and 0.175 stay apart
+
+
+def scan_unc_key(E, i):
+    return f"scan_unc{i}_E{E:g}_g0"
+
+
+def _scan(study):
+    """(energies, ε) of the γ = 0 energy scan (issue 25, point 5); energies must lie above E_c."""
+    energies = [float(E) for E in study.param("scan_energies")]
+    eps = np.asarray(study.param("scan_eps"), dtype=float)
+    if energies:
+        ec = study.model.critical_energy
+        if min(energies) <= ec:
+            raise ValueError(f"basins [study].scan_energies must lie above E_c = {ec:.6g}")
+        if not (eps.size >= 2 and np.all(eps > 0) and np.all(np.diff(eps) < 0)):
+            raise ValueError("basins [study].scan_eps must be decreasing positive numbers")
+    return energies, eps
 
 
 def _eps(study):
@@ -119,20 +147,28 @@ def _map_states(study, E, extent, n):
     return section_grid(study.model, E, extent, (n, n))
 
 
-def _uncertainty_states(study, E, i, eps):
+def _uncertainty_states(study, E, i, eps, n=None, seed_offset=0):
     """Fresh reference ICs for ε index i (uniform on the allowed square) and their copies shifted by ε in x."""
     from hhscatter.ics import perturbed_on_section, region_ics
 
-    seed = int(study.config["scene"]["seed"]) * 100 + i
-    ref = region_ics(study.scene("unc", energy=E, region="square", n=int(study.param("n_uncertainty")),
-                                 seed=seed), 0, int(study.param("n_uncertainty")))
+    n = int(study.param("n_uncertainty")) if n is None else int(n)
+    seed = int(study.config["scene"]["seed"]) * 100 + seed_offset + i
+    ref = region_ics(study.scene("unc", energy=E, region="square", n=n, seed=seed), 0, n)
     moved, ok = perturbed_on_section(study.model, ref, E, dx=float(eps))
     return np.concatenate([ref[ok], moved[ok]])
 
 
-def zoom_centre(labels, extent, box=5):
-    """zoom_centre(labels, extent, box=5) -> (x, y): centre of the most mixed box (highest Gibbs entropy;
-    first in row-major order on ties), away from the map's edge and from forbidden cells."""
+def zoom_centre(labels, extent, box=5, clearance=0):
+    """zoom_centre(labels, extent, box=5, clearance=0) -> (x, y): centre of the most mixed box (highest Gibbs
+    entropy; first in row-major order on ties), away from the map's edge and from forbidden cells.
+
+    ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
+    forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
+    cells around the centre is wholly allowed (issue 25: the unconstrained choice sat at the edge of the
+    allowed region, where the zooms showed mostly forbidden cells).
+    """
+    from scipy import ndimage
+
     from hhscatter.analysis.basins import basin_entropy
 
     ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
@@ -143,10 +179,25 @@ def zoom_centre(labels, extent, box=5):
     grid[valid] = ent.box_entropy
     grid[[0, -1], :] = np.nan
     grid[:, [0, -1]] = np.nan
+    if clearance > 0:
+        # distance of every cell to the nearest forbidden cell or to the map's edge (padded as forbidden)
+        dist = ndimage.distance_transform_edt(np.pad(labels != OUTSIDE, 1))[1:-1, 1:-1]
+        centres = dist[box // 2::box, box // 2::box][:nr, :nc]
+        grid[centres < clearance] = np.nan
+        if np.all(np.isnan(grid)):
+            raise ValueError(f"zoom_centre: no mixed box lies {clearance} cells inside the allowed region")
     i, j = np.unravel_index(np.nanargmax(grid), grid.shape)
     x0, x1, y0, y1 = extent
     return (x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1],
             y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0])
+
+
+def _zoom_centre(study, extent, n):
+    """The zooms' centre: the most mixed box of the γ = 0 map at zoom_energy whose widest zoom window (the
+    smallest factor) lies wholly in the allowed region."""
+    Ez = float(study.param("zoom_energy"))
+    clearance = math.ceil(math.sqrt(2.0) * n / (2.0 * min(float(f) for f in study.param("zoom_factors"))))
+    return zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
 
 
 def _zoom_extent(extent, centre, factor):
@@ -177,12 +228,19 @@ def simulate(study, workers=None, progress=True):
             for i, e in enumerate(eps):
                 _run_table(study, unc_key(E, g, i), _uncertainty_states(study, E, i, e), g, workers, progress)
     Ez = float(study.param("zoom_energy"))
-    centre = zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent)
+    centre = _zoom_centre(study, extent, n)
     for g in study.param("zoom_gammas"):
         for f in study.param("zoom_factors"):
             ext = _zoom_extent(extent, centre, f)
             _run_table(study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, int(study.param("zoom_grid")))[3],
                        g, workers, progress)
+    scan_E, scan_eps = _scan(study)
+    ns = int(study.param("scan_grid"))
+    for E in scan_E:
+        _run_table(study, scan_map_key(E), _map_states(study, E, extent, ns)[3], 0.0, workers, progress)
+        for i, e in enumerate(scan_eps):
+            _run_table(study, scan_unc_key(E, i), _uncertainty_states(study, E, i, e, int(study.param(
+                "scan_n_uncertainty")), seed_offset=50), 0.0, workers, progress)
 
 
 # -- analyze ---------------------------------------------------------------------------
@@ -190,20 +248,24 @@ def _ve(v, e):
     return {"value": float(v), "err": float(e)}
 
 
-def _uncertainty(study, E, g, eps):
-    """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε."""
+def _uncertainty(study, E, g, eps, keys=None, times=None):
+    """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
+    the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ)."""
     from hhscatter.analysis.basins import uncertainty_fraction
     from hhscatter.tables import read_lifetimes
 
     rows = []
+    keys = [unc_key(E, g, i) for i in range(len(eps))] if keys is None else keys
     for i, e in enumerate(eps):
-        lt = read_lifetimes(study.raw(unc_key(E, g, i)), columns=["traj_id", "outcome", "exit_channel", "t_end"])
+        lt = read_lifetimes(study.raw(keys[i]), columns=["traj_id", "outcome", "exit_channel", "t_end"])
         code = outcome_codes(lt)
         m = len(code) // 2
         uf = uncertainty_fraction(code[:m], code[m:])
         t = lt.sort_values("traj_id")["t_end"].to_numpy()
         changed = code[:m] != code[m:]
         t_dec = np.minimum(t[:m], t[m:])[changed]  # until one of the pair leaves
+        if times is not None:
+            times.append(t_dec)
         rows.append({"energy": E, "gamma": g, "eps": e, "f": uf.f, "f_lo": uf.lo, "f_hi": uf.hi, "k": uf.k,
                      "n": uf.n, "t_decide_median": float(np.median(t_dec)) if t_dec.size else math.nan})
     return pd.DataFrame(rows)
@@ -214,6 +276,8 @@ def analyze(study):
     from hhscatter.analysis.basins import (
         basin_entropy_table,
         basin_fractions,
+        local_exponent,
+        slim_fractal,
         uncertainty_cutoff,
         uncertainty_exponent,
         wada_merging,
@@ -226,7 +290,9 @@ def analyze(study):
     ec = study.model.critical_energy
     boxes = [int(b) for b in study.param("boxes")]
     hb = int(study.param("box_headline"))
-    maps, ent_rows, unc_tabs, per = [], [], [], []
+    maps, ent_rows, unc_tabs, per, loc_tabs = [], [], [], [], []
+    E_b, E_b_err = _upstream_value(study, "kappa", "E_b_key")
+    mu, mu_err = _upstream_value(study, "mu", "mu_key")
     for E in study.param("energies"):
         for g in study.param("gammas"):
             img = basin_image(study, map_key(E, g), E, extent, n)
@@ -241,8 +307,18 @@ def analyze(study):
             gx, gy = _map_states(study, E, extent, n)[:2]
             r = np.hypot(*np.meshgrid(gx, gy))
             chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < float(study.param("symmetry_radius")))])
-            unc = _uncertainty(study, E, g, eps)
+            times = []
+            unc = _uncertainty(study, E, g, eps, times=times)
             unc_tabs.append(unc)
+            # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
+            # settled (and trapped) cells masked as outside
+            exits = [c for c in present if c in (0, 1, 2)]
+            wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
+                      if len(exits) >= 3 else None)
+            loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
+            loc_tabs.append(loc)
+            slim = slim_fractal(loc)
+            rate = _rate(eps, times) if g == 0 else None
             ok = unc["k"] >= int(study.param("fit_min_count"))
             fit = cut = None
             if ok.sum() >= 3:
@@ -267,6 +343,11 @@ def analyze(study):
                 "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in present],
                          "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
                          "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
+                "wada_exits": _wada_dict(wada_x, exits),
+                "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
+                            for r in loc.itertuples() if np.isfinite(r.d)],
+                "slim_fractal": slim,
+                "lyapunov_decision": rate,
                 "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
                 "d": _ve(fit.d, fit.d_err) if fit else None,
                 "alpha_fit_range": list(fit.eps_range) if fit else None,
@@ -282,9 +363,16 @@ def analyze(study):
     study.write_table(pd.concat(maps, ignore_index=True), "basins_maps.parquet", grid=n, extent=list(extent))
     study.write_table(pd.concat(ent_rows, ignore_index=True), "basins_entropy.parquet")
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
+    study.write_table(pd.concat(loc_tabs, ignore_index=True), "basins_local_exponent.parquet")
+    scan, scan_unc = _energy_scan(study, extent, boxes, hb, E_b)
+    scan = _kantz_grassberger(study, scan)
+    study.write_table(scan, "basins_energy_scan.parquet")
+    study.write_table(scan_unc, "basins_energy_scan_uncertainty.parquet")
+    cut_pred = _cutoff_prediction(per, scan, mu, mu_err, ec)
+    trend = _energy_trend(scan, E_b)
     zooms = []
     Ez = float(study.param("zoom_energy"))
-    centre = zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent)
+    centre = _zoom_centre(study, extent, n)
     for g in study.param("zoom_gammas"):
         for f in study.param("zoom_factors"):
             ext = _zoom_extent(extent, centre, f)
@@ -312,8 +400,188 @@ def analyze(study):
         "codes": dict(zip(CODE_NAMES, CODES)),
         "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
         "zoom_centre": list(centre), "per_point": per,
+        "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
+                                                           f"{study.param('E_b_key')}"},
+        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.param('mu_key')}"},
+        "cutoff_prediction": cut_pred,
+        "energy_scan": scan.to_dict(orient="records"),
+        "energy_trend": trend,
         "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
     })
+
+
+def _upstream_value(study, role, key_param):
+    """(value, err) of a number in the JSON of the study [needs].role, at the dotted path [study].key_param."""
+    from hhscatter.studies import _upstream as up
+
+    v, e = up.lookup(up.numbers(study, study.upstream(role)), study.param(key_param),
+                     what=f"{study.upstream(role)}.json")
+    return float(v), float(e)
+
+
+def _wada_dict(w, basins):
+    if w is None:
+        return None
+    return {"verdict": bool(w.wada), "basins": [CODE_NAMES[c] for c in basins],
+            "W_at_r": float(w.wada_fraction[min(w.r_wada, len(w.wada_fraction) - 1)]), "r": int(w.r_wada),
+            "hausdorff_slope": float(w.hausdorff_slope)}
+
+
+def _rate(eps, times):
+    """λ from the pairs' decision times (:func:`hhscatter.analysis.basins.decision_rate`), or None."""
+    from hhscatter.analysis.basins import decision_rate
+
+    try:
+        r = decision_rate(eps, times)
+    except ValueError:
+        return None
+    return {"value": r.lam, "err": r.lam_err, "t0": r.t0, "chi2": r.chi2, "dof": r.dof}
+
+
+def _energy_scan(study, extent, boxes, hb, E_b):
+    """γ = 0 energy scan (issue 25, point 5): per E0, S_b, S_bb, the exits' Wada test, α and λ."""
+    from hhscatter.analysis.basins import (
+        basin_entropy_table,
+        basin_fractions,
+        uncertainty_exponent,
+        wada_merging,
+    )
+
+    energies, eps = _scan(study)
+    ns = int(study.param("scan_grid"))
+    rows, uncs = [], []
+    for E in energies:
+        img = basin_image(study, scan_map_key(E), E, extent, ns)
+        fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
+        ent = basin_entropy_table(img, [b for b in boxes if b <= ns // 4], outside=OUTSIDE).set_index("box")
+        exits = [c for c in (0, 1, 2) if fr.frac[c] >= float(study.param("wada_min_share"))]
+        w = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
+             if len(exits) >= 3 else None)
+        times = []
+        unc = _uncertainty(study, E, 0.0, eps, keys=[scan_unc_key(E, i) for i in range(len(eps))], times=times)
+        uncs.append(unc)
+        ok = unc["k"] >= int(study.param("fit_min_count"))
+        fit = None
+        if ok.sum() >= 3:
+            fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"],
+                                       eps_range=(float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max())))
+        rate = _rate(eps, times)
+        h = ent.loc[hb] if hb in ent.index else ent.iloc[-1]
+        rows.append({"energy": E, "above_E_b": bool(E > E_b), "S_b": float(h.S_b), "S_b_err": float(h.S_b_err),
+                     "S_bb": float(h.S_bb), "S_bb_err": float(h.S_bb_err), "log2_fractal": bool(h.log2_fractal),
+                     "trapped": float(fr.frac[TRAPPED_CODE]),
+                     "wada_exits": bool(w.wada) if w else False,
+                     "W_exits": float(w.wada_fraction[w.r_wada]) if w else math.nan,
+                     "alpha": fit.alpha if fit else math.nan, "alpha_err": fit.alpha_err if fit else math.nan,
+                     "alpha_p": fit.p_value if fit else math.nan,
+                     "lam": rate["value"] if rate else math.nan, "lam_err": rate["err"] if rate else math.nan})
+    cols = ["energy", "above_E_b", "S_b", "S_b_err", "S_bb", "S_bb_err", "log2_fractal", "trapped", "wada_exits",
+            "W_exits", "alpha", "alpha_err", "alpha_p", "lam", "lam_err"]
+    return (pd.DataFrame(rows, columns=cols),
+            pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]))
+
+
+def _kantz_grassberger(study, scan):
+    """λ_KG = κ(E)/α(E) beside the decision rate: for a hyperbolic saddle the uncertainty exponent of the
+    section is α = κ/λ (Kantz & Grassberger, Physica D 17, 75 (1985)), κ the escape rate of study fig2
+    (its own runs, interpolated linearly in E; NaN outside its energies)."""
+    from hhscatter.studies import _upstream as up
+
+    rows, _ = up.lookup(up.numbers(study, study.upstream("kappa")), study.param("kappa_energy_key"),
+                        what=f"{study.upstream('kappa')}.json")
+    k = pd.DataFrame(rows).sort_values("energy")
+    if scan.empty:
+        return scan.assign(kappa=[], lam_kg=[], lam_kg_err=[])
+    inside = (scan.energy >= k.energy.min()) & (scan.energy <= k.energy.max())
+    kap = np.where(inside, np.interp(scan.energy, k.energy, k.kappa), np.nan)
+    kap_err = np.where(inside, np.interp(scan.energy, k.energy, k.kappa_err), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = kap / scan.alpha
+        err = np.abs(lam) * np.hypot(kap_err / kap, scan.alpha_err / scan.alpha)
+    return scan.assign(kappa=kap, lam_kg=lam, lam_kg_err=err)
+
+
+def _smooth_chi2(E, y, err):
+    """χ²/dof of a quadratic in E through (E, y ± err): ≈ 1 for a smooth curve, ≫ 1 when y fluctuates."""
+    ok = np.isfinite(y) & np.isfinite(err) & (err > 0)
+    E, y, err = np.asarray(E)[ok], np.asarray(y)[ok], np.asarray(err)[ok]
+    if E.size < 5:
+        return {"chi2_dof": math.nan, "n": int(E.size)}
+    c = np.polyfit(E, y, 2, w=1.0 / err)
+    chi2 = float(np.sum(((y - np.polyval(c, E)) / err) ** 2))
+    return {"chi2_dof": chi2 / (E.size - 3), "n": int(E.size)}
+
+
+def _energy_trend(scan, E_b, smooth_chi2=2.0):
+    """Nieto et al. 2020 (S_b fluctuates while KAM islands remain, smooth once hyperbolic) and Daza et al. 2016
+    (α rises with E) on the energy scan, each side of fig2's break energy E_b."""
+    if scan.empty:
+        return None
+    lo, hi = scan[~scan.above_E_b], scan[scan.above_E_b]
+    out = {"E_b": E_b}
+    for name, part in (("below_E_b", lo), ("above_E_b", hi)):
+        out[name] = {"S_b": _smooth_chi2(part.energy, part.S_b, part.S_b_err),
+                     "S_bb": _smooth_chi2(part.energy, part.S_bb, part.S_bb_err),
+                     "trapped_max": float(part.trapped.max()) if len(part) else math.nan,
+                     "wada_exits_all": bool(part.wada_exits.all()) if len(part) else None,
+                     "log2_all": bool(part.log2_fractal.all()) if len(part) else None}
+    # where the change happens: the lowest scan energy E* from which on S_b(E) is smooth (a quadratic with
+    # χ²/dof < smooth_chi2 on every energy ≥ E*, at least 5 of them), to be set beside E_b
+    for q in ("S_b", "S_bb"):
+        e_star = math.nan
+        for E in sorted(scan.energy)[::-1]:
+            part = scan[scan.energy >= E]
+            c = _smooth_chi2(part.energy, part[q], part[q + "_err"])
+            if c["n"] >= 5 and not c["chi2_dof"] < smooth_chi2:
+                break
+            if c["n"] >= 5:
+                e_star = float(E)
+        out[f"E_smooth_{q}"] = e_star
+    # the KAM islands' share (orbits alive at t_max at γ = 0): the lowest energy from which none remain
+    srt = scan.sort_values("energy")
+    trapped = srt.trapped.to_numpy() > 0
+    out["E_no_trapped"] = (float(srt.energy.iloc[np.flatnonzero(trapped).max() + 1])
+                           if trapped.any() and not trapped[-1] else
+                           (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
+    ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
+    if ok.sum() >= 3:
+        from hhscatter.analysis.basins import weighted_line
+
+        _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
+        out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
+    return out
+
+
+def _cutoff_prediction(per, scan, mu, mu_err, ec):
+    """Records {E0, gamma, eps_c, eps_c_err, eps_c_predicted, ...} of the measured and predicted cut-off."""
+    from hhscatter.analysis.basins import predicted_cutoff
+
+    lam_E = scan[np.isfinite(scan.lam)] if len(scan) else scan
+    out = []
+    for p in per:
+        if p["gamma"] <= 0 or lam_E is None or len(lam_E) == 0:
+            continue
+        E0, g = p["energy"], p["gamma"]
+        c = p["cutoff"]
+        pred = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam, ec)
+        lo = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam + lam_E.lam_err, ec)
+        hi = predicted_cutoff(E0, g, mu, lam_E.energy, np.maximum(lam_E.lam - lam_E.lam_err, 0), ec)
+        kg = scan[np.isfinite(scan.lam_kg)]
+        pred_kg = predicted_cutoff(E0, g, mu, kg.energy, kg.lam_kg, ec) if len(kg) else None
+        det = bool(c and c["detected"])
+        rec = {"E0": E0, "gamma": g,
+               "eps_c": c["eps_c"] if det else None,
+               "eps_c_err": 0.5 * (c["eps_c_hi"] - c["eps_c_lo"]) if det else None,
+               "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
+               "detected": det,
+               "eps_c_predicted": pred, "eps_c_predicted_interval": [lo, hi],
+               "eps_c_predicted_kantz_grassberger": pred_kg,
+               "tau2": math.log(E0 / ec) / (mu * g),
+               "smallest_resolved_eps": p["smallest_resolved_eps"]}
+        if det and pred > 0:
+            rec["log10_ratio"] = math.log10(c["eps_c"] / pred)
+        out.append(rec)
+    return out
 
 
 # -- plot -----------------------------------------------------------------------------------
@@ -325,4 +593,6 @@ def plot(study):
                 pd.read_parquet(study.derived("basins_zooms.parquet")),
                 pd.read_parquet(study.derived("basins_entropy.parquet")),
                 pd.read_parquet(study.derived("basins_uncertainty.parquet")),
-                study.read_numbers(), study.figure_path, scale=study.scale)
+                study.read_numbers(), study.figure_path, scale=study.scale,
+                local=pd.read_parquet(study.derived("basins_local_exponent.parquet")),
+                scan=pd.read_parquet(study.derived("basins_energy_scan.parquet")))
