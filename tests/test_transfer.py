@@ -99,6 +99,10 @@ def test_closed_class_has_no_root_and_is_separated():
     assert len(closed) == 1 and closed[0].label == labels[2]
     keep, _ = tf.saddle_class(tr)
     assert keep.tolist() == [True, True, False, False]
+    # a sample of weight 0 is no transition: with the escape of state 1 weighted 0, {0, 1} still leaks via 0
+    w0 = tf.Transitions(src, dst, np.ones(8), 4, np.array([1, 1, 0, 1, 0, 1, 1, 1.0]))
+    lab0, cl0 = tf.communicating_classes(w0)
+    assert lab0[0] == lab0[1] and [c.closed for c in cl0 if c.label == lab0[0]] == [False]
     sub = tr.subset(keep)  # transitions into the island become leaks of the saddle class
     P = tf.transfer_matrix(sub).toarray()
     assert P.tolist() == [[0.0, 1 / 3], [0.5, 0.0]]
@@ -140,6 +144,31 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     # first crossing at or after t* = 2.5 (step 25): the crossing at t = 4 of the q² that are still there
     fc = tf.first_crossing_after(n, K, L, 25)
     assert fc[0] == pytest.approx(q * q)
+    w = tf.first_crossing_weights(n, tr, dt, 25)
+    assert w.sum() == pytest.approx(q * q) and np.all(w[dst < 0] == 0)
+    # a lag cap of 15 steps brings the returns forward to t = 1.5: P then drops by q every 1.5 time units
+    Kc, Hc, Lc = tf.lag_kernels(tr, t_end, dt, max_lag=15)
+    assert Lc == 15 and tf.capped_share(tr, dt, 15) == 1.0 and tf.capped_share(tr, dt, 20) == 0.0
+    Pc = tf.survival(tf.propagate([1.0], Kc, Lc, 45), Hc)
+    assert Pc[44] == pytest.approx(q ** 3)
+
+
+def test_first_crossing_weights_sum_to_the_state_distribution():
+    rng = np.random.default_rng(5)
+    n_s, m = 6, 400
+    src = rng.integers(0, n_s, m)
+    dst = np.where(rng.random(m) < 0.8, rng.integers(0, n_s, m), -1)
+    T = rng.uniform(0.5, 3.0, m)
+    tr = tf.Transitions(src, dst, T, n_s, rng.uniform(0.5, 2.0, m))
+    K, H, L = tf.lag_kernels(tr, np.where(dst >= 0, T, rng.uniform(0.1, 2.0, m)), 0.1)
+    n = tf.propagate(np.full(n_s, 1.0 / n_s), K, L, 120)
+    w = tf.first_crossing_weights(n, tr, 0.1, 77)
+    by_dst = np.bincount(dst[dst >= 0], weights=w[dst >= 0], minlength=n_s)
+    assert np.allclose(by_dst, tf.first_crossing_after(n, K, L, 77), rtol=1e-12, atol=1e-15)
+    # survival by the FFT convolution equals the direct sum Σ_k' n(k')·H(k − k')
+    P = tf.survival(n, H)
+    direct = [sum(n[kp] @ H[k - kp] for kp in range(k + 1) if k - kp < H.shape[0]) for k in (0, 13, 60, 120)]
+    assert np.allclose(P[[0, 13, 60, 120]], direct, atol=1e-12)
 
 
 def test_flux_density_of_a_radial_potential():
@@ -168,3 +197,21 @@ def test_bad_input_is_refused():
         tf.Transitions([2], [0], [1.0], 2)
     with pytest.raises(ValueError, match="return times"):
         tf.Transitions([0], [0], [0.0], 1)
+
+
+def test_saddle_measure_covers_the_downstream_states_and_not_the_island():
+    # class {0, 1}: 0 → 0, 1, 2, 3 (1/4 each); 1 → 0 (1/2), else escape; state 2 (downstream) returns to
+    # itself with 1/4, else escapes; state 3 is an island (always back to itself). T ≡ 1.
+    src = np.array([0, 0, 0, 0, 1, 1, 2, 2, 2, 2, 3])
+    dst = np.array([0, 1, 2, 3, 0, -1, 2, -1, -1, -1, 3])
+    tr = tf.Transitions(src, dst, np.ones(11), 4)
+    keep, _ = tf.saddle_class(tr)
+    assert keep.tolist() == [True, True, False, False]
+    k = tf.true_time_kappa(tr.subset(keep))
+    assert k == pytest.approx(math.log(2.0))  # ρ([[1/4, 1/4], [1/2, 0]]) = 1/2 per step
+    nu, lam = tf.saddle_measure(tr, k, keep)
+    assert lam == pytest.approx(1.0)
+    M = tf.transfer_matrix(tr, k).toarray()
+    assert np.allclose((nu @ M)[:3], nu[:3])
+    # closed form with e^κ = 2: ν1 = ν0/2 and ν2 = ν0/2 + ν2/2, so ν = (1, 1/2, 1, 0)/(5/2)
+    assert np.allclose(nu, [0.4, 0.2, 0.4, 0.0])

@@ -61,8 +61,8 @@ from scipy import optimize
 from scipy.sparse import csgraph
 from scipy.sparse.linalg import eigs
 
-__all__ = ["DENSE_MAX", "ClassInfo", "Transitions", "box_index", "communicating_classes", "first_crossing_after",
-           "lag_kernels", "leading_left", "map_escape_rate", "propagate", "saddle_class", "section_flux_density",
+__all__ = ["DENSE_MAX", "ClassInfo", "Transitions", "box_index", "capped_share", "communicating_classes", "first_crossing_after",
+           "first_crossing_weights", "lag_kernels", "leading_left", "map_escape_rate", "propagate", "saddle_class", "saddle_measure", "section_flux_density",
            "spectral_radius", "sprinkler_weights", "survival", "transfer_matrix", "true_time_kappa"]
 
 DENSE_MAX = 64  # below this many states the dense LAPACK eigensolver is used (ARPACK needs k < n − 1)
@@ -142,7 +142,9 @@ def transfer_matrix(tr: Transitions, kappa: float = 0.0) -> sp.csr_matrix:
     val = tr.w[ret] * inv[tr.src[ret]]
     if kappa != 0.0:
         val = val * np.exp(kappa * tr.T[ret])
-    return sp.csr_matrix((val, (tr.src[ret], tr.dst[ret])), shape=(tr.n_states, tr.n_states))
+    M = sp.csr_matrix((val, (tr.src[ret], tr.dst[ret])), shape=(tr.n_states, tr.n_states))
+    M.eliminate_zeros()  # a sample of weight 0 is no edge of the transition graph
+    return M
 
 
 def _dense_leading(A):
@@ -272,14 +274,44 @@ def communicating_classes(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]
 def saddle_class(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]:
     """saddle_class(tr) -> (keep (bool, n_states), classes): the states of the chaotic saddle's class.
 
-    The open class (not closed) of largest sample weight. Closed classes (invariant: KAM islands, eigenvalue
-    1) are excluded; the escape rate of the saddle is :func:`true_time_kappa` of ``tr.subset(keep)``.
+    The largest open class (not closed; most states, then most sample weight). Closed classes (invariant:
+    KAM islands, eigenvalue 1) are excluded; the escape rate of the saddle is :func:`true_time_kappa` of
+    ``tr.subset(keep)``. (By states, not weight: a transient box whose few samples carry a large weight is
+    a class of its own with ρ = 0.)
     """
     labels, infos = communicating_classes(tr)
-    open_ = [c for c in infos if not c.closed and c.weight > 0]
+    open_ = sorted((c for c in infos if not c.closed and c.weight > 0), key=lambda c: (-c.size, -c.weight, c.label))
     if not open_:
         raise ValueError("every communicating class is closed: no escape")
     return labels == open_[0].label, infos
+
+
+def saddle_measure(tr: Transitions, kappa: float, keep) -> tuple[np.ndarray, float]:
+    """saddle_measure(tr, κ, keep) -> (ν over all states, λ): the saddle's c-measure on the section.
+
+    The left Perron vector of M(κ) on the saddle's class ``keep`` and every state downstream of it (reachable
+    from it: orbits on their way out cross the section too), closed classes left out (an island's vector
+    would win with eigenvalue ≥ 1). At the root κ of the class, λ = 1. If a downstream class has a larger
+    root (λ > 1: a sticky, nearly closed set), the vector is taken on ``keep`` alone and λ is reported.
+    """
+    keep = np.asarray(keep, dtype=bool)
+    labels, infos = communicating_classes(tr)
+    closed = np.isin(labels, [c.label for c in infos if c.closed])
+    A = (transfer_matrix(tr) > 0).astype(np.int8).T.tocsr()  # A[j, i] = 1: an edge i → j
+    reach = keep.copy()
+    while True:
+        new = reach | (A @ reach.astype(np.int8) > 0)
+        if new.sum() == reach.sum():
+            break
+        reach = new
+    sel = reach & ~closed
+    lam, v = leading_left(transfer_matrix(tr.subset(sel), kappa))
+    if lam > 1.0 + 1e-6:
+        sel = keep
+        lam, v = leading_left(transfer_matrix(tr.subset(sel), kappa))
+    nu = np.zeros(tr.n_states)
+    nu[sel] = v
+    return nu, lam
 
 
 def sprinkler_weights(tr: Transitions, nu: np.ndarray, kappa: float) -> np.ndarray:
@@ -335,10 +367,12 @@ def box_index(x, y, extent, box: float) -> tuple[np.ndarray, int, int]:
 # ---------------------------------------------------------------------------
 # dissipative ensembles: the operator carried forward in time
 # ---------------------------------------------------------------------------
-def lag_kernels(tr: Transitions, t_end, dt: float) -> tuple[sp.csr_matrix, np.ndarray, int]:
-    """lag_kernels(tr, t_end, dt) -> (K, H, L): the true-time operator binned in time steps of ``dt``.
+def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -> tuple[sp.csr_matrix, np.ndarray, int]:
+    """lag_kernels(tr, t_end, dt, max_lag=None) -> (K, H, L): the true-time operator binned in time steps of ``dt``.
 
-    Each sample's return time T_s becomes a lag ℓ_s = max(1, round(T_s/dt)); ``K`` (n × n·L, csr) holds
+    Each sample's return time T_s becomes a lag ℓ_s = max(1, round(T_s/dt)), at most ``max_lag`` (a longer
+    return arrives early, at max_lag·dt: it bounds the memory, n·L per step; report the weight it moves
+    with :func:`capped_share`); ``K`` (n × n·L, csr) holds
     the blocks K_ℓ (ℓ = 1 … L side by side): (K_ℓ)_ij = Σ_{s: i→j, ℓ_s = ℓ} w_s / W_i. ``t_end`` is each
     sample's time to its next event (return, escape, settling); H (L + 1, n) is the weighted share of
     state i's samples whose next event lies beyond lag ℓ, H_ℓ,i = Σ_{s ∈ i: t_end,s > ℓ dt} w_s / W_i
@@ -354,6 +388,8 @@ def lag_kernels(tr: Transitions, t_end, dt: float) -> tuple[sp.csr_matrix, np.nd
     inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)
     ret = tr.dst >= 0
     lag = np.maximum(1, np.rint(tr.T[ret] / dt).astype(np.int64))
+    if max_lag is not None:
+        lag = np.minimum(lag, int(max_lag))
     L = int(lag.max()) if lag.size else 1
     val = tr.w[ret] * inv[tr.src[ret]]
     K = sp.csr_matrix((val, (tr.src[ret], (lag - 1) * n + tr.dst[ret])), shape=(n, n * L))
@@ -366,6 +402,15 @@ def lag_kernels(tr: Transitions, t_end, dt: float) -> tuple[sp.csr_matrix, np.nd
     H = 1.0 - np.cumsum(H, axis=0)  # H[ℓ] = share with end > ℓ
     H[:, rw == 0] = 0.0
     return K, np.clip(H, 0.0, 1.0), L
+
+
+def capped_share(tr: Transitions, dt: float, max_lag: int) -> float:
+    """capped_share(tr, dt, max_lag) -> the share of the returning sample weight whose lag exceeds max_lag."""
+    ret = tr.dst >= 0
+    if not ret.any():
+        return 0.0
+    lag = np.rint(tr.T[ret] / dt)
+    return float(tr.w[ret][lag > max_lag].sum() / tr.w[ret].sum())
 
 
 def propagate(n0, K: sp.csr_matrix, L: int, n_steps: int) -> np.ndarray:
@@ -390,14 +435,37 @@ def survival(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
     """survival(crossings, H) -> P(t_k), k = 0 … n_steps: the share of the ensemble not yet gone.
 
     An orbit is alive at step k if its last crossing was at k' ≤ k and its next event lies beyond k − k':
-    P(k) = Σ_{k' ≤ k} n(k') · H_{k − k'} (H beyond its last row: 0).
+    P(k) = Σ_{k' ≤ k} n(k') · H_{k − k'} (H beyond its last row: 0), one convolution per state
+    (scipy.signal.fftconvolve).
     """
+    from scipy.signal import fftconvolve
+
     steps, n = crossings.shape
-    Lh = H.shape[0]
+    Hs = np.zeros((steps, n))
+    m = min(steps, H.shape[0])
+    Hs[:m] = H[:m]
+    live = np.flatnonzero(crossings.any(axis=0) & Hs.any(axis=0))
     P = np.zeros(steps)
-    for ell in range(min(Lh, steps)):
-        P[ell:] += crossings[: steps - ell] @ H[ell]
-    return P
+    for i in range(0, live.size, 1024):  # a block of states at a time bounds the FFT's memory
+        cols = live[i : i + 1024]
+        P += fftconvolve(crossings[:, cols], Hs[:, cols], axes=0)[:steps].sum(axis=1)
+    return np.clip(P, 0.0, None)
+
+
+def first_crossing_weights(crossings: np.ndarray, tr: Transitions, dt: float, k_star: int) -> np.ndarray:
+    """first_crossing_weights(crossings, tr, dt, k*) -> weight of each sample's image point in the first
+    crossing at or after step k* (0 for escapes): ν-weighted like :func:`first_crossing_after`, per sample,
+    so that the images give the distribution below the box scale. Σ over samples into j = that function's
+    entry j.
+    """
+    cs = np.vstack([np.zeros((1, crossings.shape[1])), np.cumsum(crossings[:k_star], axis=0)])
+    ret = tr.dst >= 0
+    lag = np.maximum(1, np.rint(np.where(ret, tr.T, dt) / dt).astype(np.int64))
+    lo = np.maximum(0, k_star - lag)
+    C = cs[k_star, tr.src] - cs[lo, tr.src]
+    rw = tr.row_weight
+    inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)
+    return np.where(ret, C * tr.w * inv[tr.src], 0.0)
 
 
 def first_crossing_after(crossings: np.ndarray, K: sp.csr_matrix, L: int, k_star: int) -> np.ndarray:
