@@ -78,7 +78,8 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
     dd.axvline(dn["t_star"], color="0.5", lw=0.8)
     lo = max(1.0 / dn["sim_orbits"], 1e-6)
     dd.set_ylim(lo / 3, 1.2)
-    dd.set_xlim(0, surv["t"].max())
+    t_hi = dn.get("compared_until") or surv["t"].max()
+    dd.set_xlim(0, min(float(surv["t"].max()), 1.5 * float(t_hi)))
     dd.set(xlabel="t", ylabel="P(t)", title=f"(d) dissipative: E0 = {dn['energy']:g}, γ = {dn['gamma']:g}")
     dd.legend(fontsize=8)
     # (e) energies of the first crossing after t*

@@ -438,11 +438,7 @@ def _cmeasure_distances(study, results, inputs):
     from hhscatter.analysis import distance as dist
 
     other = study.upstream("cmeasure")
-    doc = up.numbers(study, other)
-    name = doc.get("tables", {}).get("cmeasure_points")
-    if not name:
-        raise up.UpstreamError(f"{other}.json names no published c-measure table")
-    cm = up.table(study, other, name)
+    cm, name = up.published_table(study, other, "cmeasure_points")
     boxes = [float(b) for b in study.param("cm_boxes")]
     head = float(study.param("cm_box_headline"))
     rng = np.random.default_rng(int(study.param("seed")) + 5)
@@ -755,10 +751,8 @@ def plot(study):
     cm_pts = study.out / "derived" / "ulam_measure_points.parquet"
     fig1_pts = None
     try:
-        other = study.upstream("cmeasure")
-        doc = up.numbers(study, other)
-        fig1_pts = up.table(study, other, doc["tables"]["cmeasure_points"])
-    except (up.UpstreamError, KeyError, FileNotFoundError):
+        fig1_pts, _ = up.published_table(study, study.upstream("cmeasure"), "cmeasure_points")
+    except up.UpstreamError:  # the figure then shows the operator's measure alone
         pass
     plot_operator(study.read_numbers(), read("convergence.parquet"), read("survival.parquet"),
                   read("t_star_points.parquet"), read("ulam_measure_points.parquet") if cm_pts.exists() else None,
