@@ -215,3 +215,28 @@ def test_saddle_measure_covers_the_downstream_states_and_not_the_island():
     assert np.allclose((nu @ M)[:3], nu[:3])
     # closed form with e^κ = 2: ν1 = ν0/2 and ν2 = ν0/2 + ν2/2, so ν = (1, 1/2, 1, 0)/(5/2)
     assert np.allclose(nu, [0.4, 0.2, 0.4, 0.0])
+
+
+def test_bootstrap_error_matches_the_spread_of_independent_estimates():
+    # a 12-state open chain with known transition probabilities and return times T ~ 1 + Exp(1); M = 30
+    # samples per state. The Poisson bootstrap's std must match the spread of κ over independent sample sets.
+    rng = np.random.default_rng(11)
+    n, m = 12, 30
+    P = rng.random((n, n)) * (rng.random((n, n)) < 0.4)
+    P = 0.8 * P / P.sum(axis=1, keepdims=True)  # 20 % escape per return
+    cum = np.cumsum(np.c_[P, 1 - P.sum(axis=1)], axis=1)
+
+    def draw(g):
+        src = np.repeat(np.arange(n), m)
+        u = g.random(src.size)
+        j = np.array([np.searchsorted(cum[i], x, side="right") for i, x in zip(src, u)])
+        return tf.Transitions(src, np.where(j < n, j, -1), 1.0 + g.exponential(1.0, src.size), n)
+
+    est, boot_sd = [], []
+    for r in range(40):
+        tr = draw(np.random.default_rng(100 + r))
+        est.append(tf.true_time_kappa(tr.subset(tf.saddle_class(tr)[0])))
+        if r < 8:
+            boot_sd.append(np.std(tf.bootstrap_kappa(tr, 40, rng=r), ddof=1))
+    ratio = np.mean(boot_sd) / np.std(est, ddof=1)
+    assert 0.7 < ratio < 1.4, ratio

@@ -272,7 +272,7 @@ def _coarse(cell, nx, c):
     return (iy // c) * ncx + ix // c
 
 
-def transitions(tab, study, c=1, m_max=None, weights=None, ebins=None):
+def transitions(tab, study, c=1, m_max=None, ebins=None):
     """transitions(tab, study, c=1, m_max=None) -> (Transitions, state ids): the samples on boxes merged
     c × c (finest side ``box``), only the first ``m_max`` ranks per finest box; censored samples dropped.
     With ``ebins`` (n_bins, edges) the states are (box, energy bin): id = bin·n_cells + box."""
@@ -296,8 +296,7 @@ def transitions(tab, study, c=1, m_max=None, weights=None, ebins=None):
     s_new = inv[: src.size]
     d_new = np.full(dst.size, -1)
     d_new[dst >= 0] = inv[src.size:]
-    w = t["w"].to_numpy() if weights is None else np.asarray(weights, dtype=float)[mask]
-    return tf.Transitions(s_new, d_new, np.where(ret, t["T"], 1.0), ids.size, w), ids, t
+    return tf.Transitions(s_new, d_new, np.where(ret, t["T"], 1.0), ids.size, t["w"].to_numpy()), ids, t
 
 
 def saddle_kappa(tr):
@@ -311,16 +310,6 @@ def saddle_kappa(tr):
             "closed_classes": len(closed), "closed_states": int(sum(c.size for c in closed)),
             "closed_weight_share": float(sum(c.weight for c in closed) / W) if W > 0 else 0.0}
     return kappa, tf.map_escape_rate(sub), info, keep, sub
-
-
-def _boot_kappa(tab, study, n_boot, seed):
-    rng = np.random.default_rng(seed)
-    out = []
-    for _ in range(n_boot):
-        w = tab["w"].to_numpy() * rng.poisson(1.0, len(tab))
-        tr, _, _ = transitions(tab, study, weights=w)
-        out.append(saddle_kappa(tr)[0])
-    return np.array(out)
 
 
 def _ulam_energy(study, E):
@@ -340,12 +329,12 @@ def _ulam_energy(study, E):
         kap, kmap, info, _, _ = saddle_kappa(tr)
         rows.append({"energy": E, "box": box, "samples": int(m), "kappa": kap, "kappa_map": kmap,
                      "vary": "samples", **info})
-    boot = _boot_kappa(tab, study, int(study.param("n_boot")), int(study.param("seed")) + int(E * 1000))
     tr, ids, t = transitions(tab, study)
+    boot = tf.bootstrap_kappa(tr, int(study.param("n_boot")), rng=int(study.param("seed")) + int(E * 1000))
     kap, kmap, info, keep, sub = saddle_kappa(tr)
     full_classes = tf.communicating_classes(tr)[1]
     ok = ~tab["censored"]
-    cost = {"orbit_time": float(tab.loc[ok, "t_end"].sum() + tab.loc[~ok, "t_end"].sum()),
+    cost = {"orbit_time": float(tab["t_end"].sum()),
             "orbits": int(len(tab)), "censored": int((~ok).sum()),
             "mean_return_time": float(np.average(tab.loc[tab["ret"], "T"], weights=tab.loc[tab["ret"], "w"]))}
     islands = _islands(study, E, df, tr, ids, keep, sub, t)
@@ -498,7 +487,11 @@ def _cmeasure_convergence(study, results, cm, boxes, head):
 # ---------------------------------------------------------------------------
 def _initial_density(study, ids, n_cells, top_bin):
     """The initial ensemble (uniform in the scene's disk at E0, on the section) on the operator's states."""
-    R = float(study.config["scene"].get("radius", 0.5))
+    sc = _sim_scene(study)
+    if sc.region != "disk":
+        raise ValueError(f"operator: the dissipative comparison needs region 'disk' (its initial density is the "
+                         f"disk's), got {sc.region!r}")
+    R = float(sc.radius)
     g = (np.arange(600) + 0.5) / 600 * 2 * R - R
     X, Y = np.meshgrid(g, g)
     inside = np.hypot(X, Y) < R
@@ -600,7 +593,7 @@ def _dissipative(study, inputs):
     d, lo, hi = dist.debiased_distance(dtab, "hellinger")
     dtab = dtab.assign(hellinger_debiased=d, lo=lo, hi=hi)
     j = int(np.argmin(np.abs(dtab["box"].to_numpy() - float(study.param("cm_box_headline")))))
-    sig = P_sim * 0 + np.sqrt(np.maximum(P_sim * (1 - P_sim), 1e-300) / N)
+    sig = np.sqrt(np.maximum(P_sim * (1 - P_sim), 0.0) / N)
     at = [5.0, 10.0, float(study.param("t_star")), 25.0, 40.0, 60.0, 80.0, 100.0, 150.0]
     at = [a for a in at if a <= grid[-1]]
     ix = [int(round(a / dt)) for a in at]
