@@ -80,6 +80,16 @@ def numbers(study, other: str) -> dict:
         raise UpstreamError(f"{study.name} needs the outputs of study {other!r}: {exc}") from None
 
 
+def published_table(study, other: str, key: str, doc: dict | None = None):
+    """published_table(study, other, key, doc=None) -> (DataFrame, file name): the derived table that study
+    ``other`` publishes under ``"tables": {key: name}`` in its numbers JSON (``doc``, read if not given)."""
+    doc = numbers(study, other) if doc is None else doc
+    name = doc.get("tables", {}).get(key)
+    if not name:
+        raise UpstreamError(f"{other}.json names no published table {key!r} ('tables': {{'{key}': …}})")
+    return table(study, other, name), name
+
+
 def table(study, other: str, name: str, filters=None, columns=None):
     """table(study, other, name, filters=None, columns=None) -> pandas.DataFrame of study ``other``'s derived table.
 

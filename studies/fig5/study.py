@@ -198,10 +198,7 @@ def _cmeasure_points(study, inputs, E1, E2):
     its published table of points (fig1: derived/cmeasure_points.parquet) and its t_rec (numbers JSON)."""
     other = study.upstream("cmeasure")
     doc = up.numbers(study, other)
-    name = doc.get("tables", {}).get("cmeasure_points")
-    if not name:
-        raise up.UpstreamError(f"{other}.json names no published c-measure table ('tables': {{'cmeasure_points': …}})")
-    cm = up.table(study, other, name)
+    cm, name = up.published_table(study, other, "cmeasure_points", doc)
     out, t_rec = {}, {}
     for label, E in (("E1", E1), ("E2", E2)):
         tpath = study.param(f"t_rec_{label}_key")

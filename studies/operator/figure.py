@@ -1,0 +1,109 @@
+"""Figure of study operator: κ(E) by Ulam's method against fig2, convergence, μ_c, the dissipative P(t), the
+energies at t* and the cost comparison (drawn from operator.json and the derived tables; nothing computed)."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(2, 3, figsize=(15, 9.2))
+    recs = nums["kappa_ulam"]
+    E = np.array([r["energy"] for r in recs])
+    # (a) κ(E)
+    a = ax[0, 0]
+    f2 = [(r["energy"], r["fig2_kappa"], r["fig2_err"]) for r in recs if r.get("fig2_kappa") is not None]
+    if f2:
+        e2, k2, s2 = map(np.array, zip(*f2))
+        a.errorbar(e2, k2, s2, fmt="s", color="k", mfc="none", ms=7, capsize=3, label="fig2: κ0 from P(t)")
+    cm = [(r["energy"], r["fig2_kappa_cm"], r["fig2_kappa_cm_err"]) for r in recs if r.get("fig2_kappa_cm") is not None]
+    if cm:
+        ec, kc, sc = map(np.array, zip(*cm))
+        a.errorbar(ec + 0.004, kc, sc, fmt="D", color="C0", mfc="none", ms=6, capsize=3,
+                   label="fig2: κ from long-run crossings (true-time rel.)")
+    a.errorbar(E, [r["kappa"] for r in recs], [r["err"] for r in recs], fmt="o", color="C3", capsize=3,
+               label=f"Ulam, box {recs[0]['box']:g} (err: stat ⊕ bias)")
+    a.plot(E, [r["kappa_extrapolated"] for r in recs], "x", color="C3", label="Ulam, linear box → 0")
+    for m in nums.get("mixed_phase_space", []):
+        rec = m.get("record")
+        if rec:
+            a.errorbar([rec["energy"]], [rec["kappa"]], [rec["err"]], fmt="o", color="0.6", capsize=3,
+                       label=f"Ulam at E = {rec['energy']:g} (mixed)")
+            if rec.get("fig2_kappa") is not None:
+                a.errorbar([rec["energy"]], [rec["fig2_kappa"]], [rec["fig2_err"]], fmt="s", color="0.6", mfc="none")
+    a.set(xlabel="E", ylabel="κ (1/time)", title="(a) escape rate: ρ(M(κ)) = 1 against P(t)")
+    a.legend(fontsize=8)
+    # (b) convergence in box side and samples
+    b = ax[0, 1]
+    cb = conv[conv["vary"] == "box"]
+    for i, (e, g) in enumerate(cb.groupby("energy")):
+        g = g.sort_values("box")
+        ref = next((r.get("fig2_kappa") for r in recs if np.isclose(r["energy"], e)), None)
+        if ref is None:
+            continue
+        b.plot(g["box"], g["kappa"] / ref, "o-", color=f"C{i}", ms=4, label=f"E = {e:g}")
+        cs = conv[(conv["vary"] == "samples") & np.isclose(conv["energy"], e)]
+        b.plot(cs["box"] * (1 + 0.12 * np.log2(cs["samples"] / cs["samples"].max())), cs["kappa"] / ref, "^",
+               color=f"C{i}", ms=4, mfc="none")
+    b.axhline(1, color="k", lw=0.8)
+    b.set_xscale("log")
+    b.set(xlabel="box side (M per finest box: triangles, left = fewer)", ylabel="κ_Ulam / κ0(fig2)",
+          title="(b) discretisation bias: κ vs box side")
+    b.legend(fontsize=7, ncol=2)
+    # (c) μ_c: the operator's sprinkler measure and fig1's points
+    c = ax[0, 2]
+    if ulam_pts is not None and len(ulam_pts):
+        e0 = float(ulam_pts["energy"].iloc[0])
+        u = ulam_pts[np.isclose(ulam_pts["energy"], e0)]
+        h, xe, ye = np.histogram2d(u["x"], u["y"], bins=220, range=[[-1.05, 1.05], [-1.05, 1.05]])
+        c.imshow(np.log10(h.T + 1), origin="lower", extent=[-1.05, 1.05, -1.05, 1.05], cmap="Greys")
+        if fig1_pts is not None:
+            f = fig1_pts[np.isclose(fig1_pts["energy"], e0)]
+            c.plot(f["x"], f["y"], ".", color="C3", ms=1.2, alpha=0.6, label=f"fig1 sprinkler points ({len(f)})")
+            c.legend(fontsize=8, loc="lower left", markerscale=6)
+        d = [r for r in nums["cmeasure_distances"] if np.isclose(r["fig1_energy"], e0)
+             and np.isclose(r["operator_energy"], e0) and r["measure"] == "sprinkler"]
+        t = f"(c) μ_c at E = {e0:g}: operator (grey) vs fig1"
+        if d:
+            t += f"\ndebiased H(ε={d[0]['box']:g}) = {d[0]['hellinger_debiased']:.3f}"
+        c.set(xlabel="x", ylabel="y", title=t)
+        c.set_aspect("equal")
+    # (d) P(t)
+    dd = ax[1, 0]
+    dn = nums["dissipative"]
+    dd.semilogy(surv["t"], surv["sim"], "k-", lw=1.6, label=f"simulated (N = {dn['sim_orbits']})")
+    dd.semilogy(surv["t"], surv["operator"], "--", color="C3", lw=1.4, label="operator on (box × E bin)")
+    dd.semilogy(surv["t"], np.maximum(surv["reduced"], 1e-12), ":", color="C0", lw=1.6, label="reduced operator on ρ(E)")
+    dd.axvline(dn["t_star"], color="0.5", lw=0.8)
+    lo = max(1.0 / dn["sim_orbits"], 1e-6)
+    dd.set_ylim(lo / 3, 1.2)
+    t_hi = dn.get("compared_until") or surv["t"].max()
+    dd.set_xlim(0, min(float(surv["t"].max()), 1.5 * float(t_hi)))
+    dd.set(xlabel="t", ylabel="P(t)", title=f"(d) dissipative: E0 = {dn['energy']:g}, γ = {dn['gamma']:g}")
+    dd.legend(fontsize=8)
+    # (e) energies of the first crossing after t*
+    e = ax[1, 1]
+    op, sim = pts[pts["set"] == "operator"], pts[pts["set"] == "sim"]
+    bins = np.linspace(min(op["energy"].min(), sim["energy"].min() if len(sim) else 1), dn["energy"], 40)
+    e.hist(op["energy"], bins=bins, weights=op["w"] / op["w"].sum(), histtype="step", color="C3", lw=1.5,
+           label="operator")
+    if len(sim):
+        e.hist(sim["energy"], bins=bins, weights=np.full(len(sim), 1.0 / len(sim)), histtype="step", color="k",
+               lw=1.5, label=f"simulated ({len(sim)} orbits)")
+    e.set(xlabel="E at the first crossing after t*", ylabel="share",
+          title=f"(e) survivors at t* = {dn['t_star']:g}: energy")
+    e.legend(fontsize=8)
+    # (f) cost
+    f = ax[1, 2]
+    cost = nums["cost"]
+    x = np.arange(len(cost))
+    f.bar(x - 0.2, [r["pt_orbit_time_1pct"] for r in cost], 0.4, color="0.4", label="P(t) route (fig2's rule)")
+    f.bar(x + 0.2, [r.get("op_orbit_time_1pct", np.nan) for r in cost], 0.4, color="C3", label="Ulam operator")
+    f.set_yscale("log")
+    f.set_xticks(x, [f"E = {r['energy']:g}" for r in cost])
+    f.set(ylabel="orbit-time for κ at 1 % (time units)", title="(f) cost of κ at 1 %")
+    f.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
