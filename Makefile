@@ -23,8 +23,17 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP) ## create .venv and install hhscatter with its dev extra
 
-test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the default test suite (creates .venv with the dev, bench and docs extras)
+test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) chromium ## run the default test suite (creates .venv with the dev, bench and docs extras)
 	$(PY) -m pytest -q
+
+# the docs' browser tests (tests/test_docs_browser.py) open the built site in Debian's Chromium, driven by the
+# playwright package of the docs extra (never `playwright install`: its browser downloads are not used). Installed
+# here when missing (as root, with apt); where it cannot be, those tests skip and say why.
+CHROMIUM := /usr/bin/chromium
+chromium: ## install Debian's chromium for the docs' browser tests when missing (root + apt-get)
+	@test -x $(CHROMIUM) || { command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] \
+	  && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	  || echo "make chromium: could not install Debian's chromium (needs root and apt-get): the browser tests of the docs will be skipped"; }
 
 test-slow: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the slow accuracy/stress cases too
 	$(PY) -m pytest -q -m "slow or not slow"
@@ -147,4 +156,4 @@ docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with th
 
 .PHONY: docs docs-serve docs-assets
 
-.PHONY: help venv test test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies
+.PHONY: help venv test chromium test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies
