@@ -179,3 +179,12 @@ def test_the_analysis_layer_is_pure():
             if isinstance(node, ast.Call):
                 name = getattr(node.func, "attr", getattr(node.func, "id", None))
                 assert name not in banned_calls, f"{path.name}:{node.lineno} calls {name}()"
+
+
+def test_convention_label_says_the_studys_own_setup():
+    """A study whose ICs are not its [scene]'s region says so ([about] setup); the others name the region."""
+    from hhscatter.studies import load_study
+
+    basins = load_study("basins", "quick").convention_label
+    assert "disk" not in basins and basins.startswith("grid over the square") and basins.endswith("r_esc 1.5")
+    assert load_study("fig2", "quick").convention_label.endswith("disk r < 0.5, r_esc 1.03")

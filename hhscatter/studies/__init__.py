@@ -244,10 +244,14 @@ class Study:
 
     @property
     def convention_label(self) -> str:
-        """The study's own setup in a few words: IC region and escape radius of its ``[scene]``."""
+        """The study's own setup in a few words: its ICs and the escape radius of its ``[scene]``. The ICs are
+        ``[about] setup`` when the study says it (ICs that are not the ``[scene]``'s region, e.g. a grid on the
+        section), else the ``[scene]``'s region."""
         sc = self.config.get("scene", {})
         region = sc.get("region", "disk")
         where = f"disk r < {sc.get('radius', 0.5):g}" if region == "disk" else f"{region} ICs"
+        if self.info is not None and self.info.setup:
+            where = self.info.setup
         r_esc = sc.get("r_esc")
         name = self.config.get("convention")
         head = f"{name} setup: " if name else ""
