@@ -151,9 +151,12 @@ docs: $(DOCS_STAMP) ## build the documentation site into site/ (mkdocs --strict:
 docs-serve: $(DOCS_STAMP) ## serve the docs with live reload at http://127.0.0.1:8000
 	$(MKDOCS) serve --strict
 
+tutorial: $(DOCS_STAMP) ## re-execute docs/tutorial.ipynb (~20 s) and store its outputs, which the docs page shows
+	$(PY) tools/execute_notebook.py docs/tutorial.ipynb
+
 docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with the bench summaries) into docs/
 	$(PYTHON) docs/gen_studies.py --scale $(SCALE)
 
-.PHONY: docs docs-serve docs-assets
+.PHONY: docs docs-serve docs-assets tutorial
 
 .PHONY: help venv test chromium test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies

@@ -262,3 +262,18 @@ def test_kappa_cmeasure_agrees_with_kappa_from_pt_on_a_real_run(tmp_path):
     assert 0.15 < row.kappa_cm < 0.23 and row.kappa_cm_err < 0.02
     assert abs(row.kappa_cm - row.kappa_pt) < 2.5 * math.hypot(row.kappa_cm_err, row.kappa_pt_err)
     assert 0.3 < row.mu_exit < 0.5  # μ_c(𝓔): a third or more of the late crossings exit before the next one
+
+
+def test_progress_goes_to_a_log_as_plain_lines_never_as_a_bar(tmp_path):
+    """The API's default progress=True, with stderr a file (a log): plain lines, no carriage return, no tqdm."""
+    import subprocess
+    import sys
+
+    code = ("import hhscatter\nif __name__ == '__main__':\n"
+            "    hhscatter.simulate(hhscatter.Scene(energy=0.3, n=200, seed=1, t_max=50.0), 'run', workers=1)\n")
+    (tmp_path / "s.py").write_text(code)
+    with open(tmp_path / "log.txt", "w") as log:
+        subprocess.run([sys.executable, "s.py"], cwd=tmp_path, stderr=log, stdout=log, check=True, timeout=300)
+    text = (tmp_path / "log.txt").read_text()
+    assert "\r" not in text and "it/s" not in text and "orbit/s" not in text
+    assert "200/200 orbits (100 %)" in text

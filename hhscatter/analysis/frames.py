@@ -878,12 +878,14 @@ def cmeasure_distances(points, reference, boxes=(0.4, 0.2, 0.1, 0.05), *, n_spli
     boxes : sequence of float
         Box sides ε (position units).
     n_splits, seed, m
-        Split-half repetitions, their seed, the common sample size (default ⌊min(n_P, n_Q)/2⌋).
+        Split-half repetitions, their seed, the common sample size of the split halves (default: the smallest
+        ⌊min(n_P, n_Q)/2⌋ over the points, one m for all, so that their distances and noise floors compare).
 
     Returns
     -------
     CMeasureDistances
-        ``.to_frame()`` one row per (point, box side), ``.plot(ax=)`` distance against ε.
+        ``.to_frame()`` one row per (point, box side), ``.plot(ax=)`` distance against ε. A point with fewer
+        than 4 section points is left out, with a ``UserWarning`` naming it.
 
     Examples
     --------
@@ -899,12 +901,20 @@ def cmeasure_distances(points, reference, boxes=(0.4, 0.2, 0.1, 0.05), *, n_spli
     from .distance import agreement_scale, distance_vs_scale, points as xy
 
     Q = xy(reference) if hasattr(reference, "columns") else np.asarray(reference, dtype=float)
-    tables, scales = {}, {}
+    tables, scales, few = {}, {}, []
+    if m is None and n_splits > 0:  # one sample size for every point, so their noise floors compare
+        sizes = [min(len(df), len(Q)) // 2 for df in points.points.values() if len(df) >= 4]
+        m = min(sizes) if sizes else None
     for key, df in points.points.items():
+        if n_splits > 0 and len(df) < 4:  # the split-half noise floor needs two points per half
+            few.append(f"{_label(key)} ({len(df)} points)")
+            continue
         t = distance_vs_scale(xy(df), Q, boxes, n_splits=n_splits, seed=seed, m=m)
         tables[key] = t
         eps = agreement_scale(t) if n_splits >= 2 else None
         scales[key] = math.nan if eps is None else float(eps)
+    if few:
+        warnings.warn(f"cmeasure_distances: left out, too few points: {'; '.join(few)}", UserWarning, stacklevel=2)
     return CMeasureDistances(tables, scales)
 
 
