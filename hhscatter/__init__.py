@@ -48,7 +48,7 @@ _EXPORTS = {
     "plot_escape_rates": "analysis.frames",
     "SurvivalCurves": "analysis.frames",
     "EscapeRates": "analysis.frames",
-    "kappa_cmeasure": "analysis.frames",
+    "kappa_cmeasure": "notebook",
     "transition_times": "analysis.frames",
     "energy_decay": "analysis.frames",
     "cmeasure_points": "analysis.frames",

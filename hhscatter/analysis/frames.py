@@ -374,20 +374,6 @@ def _split_like(table, keys, *, energy=None, gamma=None, what="table"):
                      "or the lifetimes of that one run")
 
 
-def _run_section_window(run):
-    """(sections dict, t_max) of a run directory, from its scene.json (the window its sections were recorded in)."""
-    import json
-
-    from ..runner import SCENE_FILE, _decode
-    from ..store import Store
-
-    store = Store(run)
-    if not store.exists(SCENE_FILE):
-        raise ValueError(f"{run}: no {SCENE_FILE}: not a run directory written by hhscatter.simulate")
-    scene = _decode(json.loads(store.read_text(SCENE_FILE))["scene"])
-    return scene.get("sections"), float(scene["t_max"])
-
-
 @dataclass(frozen=True)
 class CMeasureRates:
     """Result of :func:`kappa_cmeasure`: κ from the c-measure beside κ from P(t), per grid point.
@@ -428,24 +414,30 @@ class CMeasureRates:
         return ax
 
 
-def kappa_cmeasure(run, *, t_from=None, t_to=None, rec_efolds: float = 2.0, margin: float = 40.0,
-                   n_boot: int = 200, seed: int = 0) -> CMeasureRates:
+def kappa_cmeasure(lifetimes, sections, *, window, t_max: float, t_from=None, t_to=None, rec_efolds: float = 2.0,
+                   margin: float = 40.0, n_boot: int = 200, seed: int = 0) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
 
     Solves ∫_Ω e^{κT} dμ_c = 1 + μ_c(𝓔), Eq. (eqn:kappa_cmeasure_truetime), with every section crossing of
     the run in a late window [t_from, t_to] as a sample point of μ_c, T its time to the orbit's next crossing
     and 𝓔 the crossings after which the orbit leaves (:func:`~hhscatter.analysis.cmeasure.kappa_from_cmeasure`,
-    bootstrap over orbits). The run's requirements are checked here, from its ``scene.json``: its sections
+    bootstrap over orbits). The run's requirements are checked here, from its section window: its sections
     must hold *every* crossing (a ``SectionWindow`` without energy filter, not ``first_only``) and the
     recording must go on after t_to (its end, ``t_record_end`` = min(window ``t_to``, ``t_max``), closes the
     sample: a crossing whose next one would come after it is undetermined, dropped and counted). Orbits still
     inside at ``t_max`` are left out when ``t_max`` > t_record_end (they sit on KAM tori and are not part of the
-    c-measure of the chaotic saddle); run with t_max ≫ t_record_end for that.
+    c-measure of the chaotic saddle); run with t_max ≫ t_record_end for that. ``hhscatter.kappa_cmeasure(run)``
+    reads all of this from a run directory (:func:`hhscatter.notebook.kappa_cmeasure`).
 
     Parameters
     ----------
-    run : str or Path
-        A run directory of :func:`hhscatter.simulate` (a scene or a grid; γ > 0 points get NaN and a note).
+    lifetimes, sections : DataFrame
+        :func:`hhscatter.read_lifetimes` and :func:`hhscatter.read_sections` of one run (a scene or a grid;
+        γ > 0 points get NaN and a note).
+    window : SectionWindow or dict
+        The section window the run recorded (``Scene.sections``).
+    t_max : float
+        The run's ``t_max`` (time units).
     t_from, t_to : float, optional
         The sampling window (time units). Default per point: t_from = max(window start, ⌈τ0 + rec_efolds/κ⌉)
         with τ0, κ from P(t) of the same point, t_to = t_record_end − ``margin``.
@@ -471,25 +463,29 @@ def kappa_cmeasure(run, *, t_from=None, t_to=None, rec_efolds: float = 2.0, marg
     >>> scene = hhscatter.Scene(energy=0.3, n=400, seed=1, t_max=1000.0, sections=window)
     >>> run = tempfile.mkdtemp()
     >>> _ = hhscatter.simulate(scene, run, overwrite=True, workers=1, progress=False)
-    >>> row = hhscatter.kappa_cmeasure(run).to_frame().iloc[0]
+    >>> lt, sec = hhscatter.read_lifetimes(run), hhscatter.read_sections(run)
+    >>> from hhscatter.analysis.frames import kappa_cmeasure
+    >>> row = kappa_cmeasure(lt, sec, window=window, t_max=1000.0).to_frame().iloc[0]
     >>> bool(abs(row.kappa_cm - row.kappa_pt) < 3 * (row.kappa_cm_err + row.kappa_pt_err))
     True
     """
-    from ..tables import read_lifetimes, read_sections
+    import dataclasses
+
     from .cmeasure import cmeasure_sample_from_sections, kappa_from_cmeasure
 
-    window, t_max = _run_section_window(run)
+    if window is not None and dataclasses.is_dataclass(window):
+        window = dataclasses.asdict(window)
     if not window:
-        raise ValueError(f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
-                         "t_to=…) (every crossing, no energy filter)")
+        raise ValueError("the run recorded no sections; simulate with sections=SectionWindow(t_from=…, t_to=…) "
+                         "(every crossing, no energy filter)")
     if window.get("first_only") or math.isfinite(window.get("e_min", -math.inf)) or \
             math.isfinite(window.get("e_max", math.inf)):
-        raise ValueError(f"{run}: the c-measure needs every section crossing; this run's window {window} filters "
-                         "them (first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)")
+        raise ValueError(f"the c-measure needs every section crossing; the run's window {window} filters them "
+                         "(first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)")
+    t_max = float(t_max)
     t_record_end = min(float(window.get("t_to", math.inf)), t_max)
     drop_trapped = t_max > t_record_end
-    lt = read_lifetimes(run)
-    sec = read_sections(run, columns=None)
+    lt, sec = lifetimes, sections
     rates = escape_rates(lt) if any(g == 0 for (_, g), _ in split_points(lt)) else EscapeRates({}, {}, {})
     keys = [k for k, _ in split_points(lt)]
     sec_by = _split_like(sec, keys, what="sections table")

@@ -66,6 +66,21 @@ def studies_root() -> Path:
     return Path(__file__).resolve().parents[2] / "studies"
 
 
+def outputs_root(root: Path) -> Path:
+    """outputs_root(root) -> the folder under which the studies of ``root`` write ``<name>/out/<scale>/``.
+
+    ``root`` itself, except for the repository's own ``studies/`` folder used from another directory than the
+    repository: then ``./studies`` of the current directory, so that ``hhscatter study …`` run elsewhere
+    (an installed package, a notebook's folder) never writes into the source tree. From the repository root,
+    as ``make`` runs it, the outputs are the study folders' own ``out/`` as before.
+    """
+    own = Path(__file__).resolve().parents[2] / "studies"
+    root = Path(root)
+    if root.resolve() == own and Path.cwd().resolve() != own.parent:
+        return Path.cwd() / "studies"
+    return root
+
+
 _OWN_MODULES = ("graph", "_upstream")
 
 
@@ -134,7 +149,8 @@ class Study:
 
     @property
     def out(self) -> Path:
-        return self.root / "out" / self.scale
+        """``<studies>/<name>/out/<scale>``; see :func:`outputs_root` for a command run outside the repository."""
+        return outputs_root(self.root.parent) / self.name / "out" / self.scale
 
     @property
     def params(self) -> dict:
@@ -302,8 +318,10 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
+        from ..config import did_you_mean
+
         known = sorted(p.parent.name for p in root.glob("*/study.toml"))
-        raise SceneError(f"study must be one of {known}, got {name!r}")
+        raise SceneError(f"study must be one of {known}, got {name!r}{did_you_mean(name, known)}")
     try:
         doc = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
