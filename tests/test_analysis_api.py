@@ -1,5 +1,5 @@
 """The notebook API: hhscatter.survival / escape_rates / plot helpers on lifetimes DataFrames, and the
-"Analyse your own run" page, whose code is executed here exactly as printed."""
+"Analyze your own run" page, whose code is executed here exactly as printed."""
 import importlib.metadata
 import math
 import os
@@ -277,3 +277,15 @@ def test_progress_goes_to_a_log_as_plain_lines_never_as_a_bar(tmp_path):
     text = (tmp_path / "log.txt").read_text()
     assert "\r" not in text and "it/s" not in text and "orbit/s" not in text
     assert "200/200 orbits (100 %)" in text
+
+
+def test_read_lifetimes_takes_a_list_of_runs(tmp_path):
+    a = hhscatter.Scene(energy=0.27, n=300, seed=1, t_max=100.0)
+    hhscatter.simulate(a, tmp_path / "a", workers=1, progress=False)
+    hhscatter.simulate(hhscatter.Grid(a, energies=[0.3], gammas=[0.0, 0.01]), tmp_path / "g", workers=1,
+                       progress=False)
+    both = hhscatter.read_lifetimes([tmp_path / "a", str(tmp_path / "g")])
+    assert len(both) == 900
+    curves = hhscatter.survival(both)
+    assert sorted(curves.curves) == [(0.27, 0.0), (0.3, 0.0), (0.3, 0.01)]
+    assert all(n == 300 for n in curves.n.values())
