@@ -82,7 +82,7 @@ class RunSummary:
         return (
             f"{self.n} orbits: escaped {self.escaped}, settled {self.settled}, censored {self.censored}"
             f"{f', stopped {self.stopped}' if self.stopped else ''}"
-            f" | wall {self.wall_seconds:.2f} s, {us:.2f} µs/orbit, {us_core:.2f} µs/orbit/core"
+            f" | wall {self.wall_seconds:.2f} s ({us:.2f} µs per orbit; {us_core:.2f} µs per orbit in the workers' chunks)"
             f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
         )
 
