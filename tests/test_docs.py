@@ -265,3 +265,18 @@ def test_study_pages_put_the_figure_first_and_fold_the_configuration(hook):
     folded = r.study_params("fig2")
     assert folded.startswith('??? abstract "Configuration: `studies/fig2/study.toml`')
     assert all(not line or line.startswith("    ") for line in folded.splitlines()[1:])  # all of it inside
+
+
+def test_citation_and_licence_agree_with_pyproject():
+    import tomllib
+
+    yaml = pytest.importorskip("yaml")
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["type"] == "software" and cff["authors"]
+    assert cff["version"] == project["version"] and cff["license"] == project["license"] == "MIT"
+    paper = cff["references"][0]
+    assert paper["title"] == "Probabilistic description of dissipative chaotic scattering"
+    assert [a["family-names"] for a in paper["authors"]] == ["Burton", "Dullin", "Altmann"]
+    assert "doi" not in paper  # none is known: the manuscript names none (add it when published)
+    assert (ROOT / "LICENSE").read_text().startswith("MIT License")
