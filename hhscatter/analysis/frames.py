@@ -375,14 +375,8 @@ def _split_like(table, keys, *, energy=None, gamma=None, what="table"):
 
 
 @dataclass(frozen=True)
-class CMeasureRates:
-    """Result of :func:`kappa_cmeasure`: κ from the c-measure beside κ from P(t), per grid point.
-
-    Attributes
-    ----------
-    rows : dict
-        (energy, gamma) → dict of the point's numbers (the columns of :meth:`to_frame`).
-    """
+class _PointRows:
+    """A result made of one row of numbers per grid point: ``rows[(energy, gamma)]`` → dict."""
 
     rows: dict
 
@@ -390,15 +384,25 @@ class CMeasureRates:
         return self.rows[key]
 
     def to_frame(self):
-        """to_frame() -> DataFrame, one row per point.
-
-        Columns: energy, gamma, n, kappa_cm, kappa_cm_err (bootstrap over orbits, 1σ), mu_exit (μ_c(𝓔)),
-        n_samples, n_exit, n_undetermined, t_from, t_to (the sampling window), t_record_end, kappa_pt,
-        kappa_pt_err (κ from P(t) of the same run, :func:`escape_rates`), note (why κ is NaN, else empty).
-        """
+        """to_frame() -> DataFrame, one row per point (sorted by energy, then γ)."""
         import pandas as pd
 
         return pd.DataFrame([self.rows[k] for k in _sorted_keys(self.rows)])
+
+
+@dataclass(frozen=True)
+class CMeasureRates(_PointRows):
+    """Result of :func:`kappa_cmeasure`: κ from the c-measure beside κ from P(t), per grid point.
+
+    ``.to_frame()`` columns: energy, gamma, n, kappa_cm, kappa_cm_err (bootstrap over orbits, 1σ), mu_exit
+    (μ_c(𝓔)), n_samples, n_exit, n_undetermined, t_from, t_to (the sampling window), t_record_end, kappa_pt,
+    kappa_pt_err (κ from P(t) of the same run, :func:`escape_rates`), note (why κ is NaN, else empty).
+
+    Attributes
+    ----------
+    rows : dict
+        (energy, gamma) → dict of the point's numbers (the columns of :meth:`to_frame`).
+    """
 
     def plot(self, ax=None, **errorbar_kwargs):
         """plot(ax=None, **errorbar_kwargs) -> ax: κ from the c-measure and from P(t) against E0."""
@@ -524,25 +528,16 @@ def kappa_cmeasure(lifetimes, sections, *, window, t_max: float, t_from=None, t_
 
 
 @dataclass(frozen=True)
-class TransitionTimes:
+class TransitionTimes(_PointRows):
     """Result of :func:`transition_times`: τ0, τ1, τ2 per dissipative grid point.
+
+    ``.to_frame()`` columns: energy, gamma, n, tau0, tau1, tau2, tau2_lo, tau2_hi, note (one row per γ > 0).
 
     Attributes
     ----------
     rows : dict
         (energy, gamma) → dict of the point's numbers (the columns of :meth:`to_frame`).
     """
-
-    rows: dict
-
-    def __getitem__(self, key):
-        return self.rows[key]
-
-    def to_frame(self):
-        """to_frame() -> DataFrame energy, gamma, n, tau0, tau1, tau2, tau2_lo, tau2_hi, note (one row per γ > 0)."""
-        import pandas as pd
-
-        return pd.DataFrame([self.rows[k] for k in _sorted_keys(self.rows)])
 
     def plot(self, ax=None, **plot_kwargs):
         """plot(ax=None, **plot_kwargs) -> ax: τ1 (circles) and τ2 (squares) against γ, log–log, one colour per E0."""
