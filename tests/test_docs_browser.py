@@ -50,7 +50,7 @@ def site(tmp_path_factory):
     out = tmp_path_factory.mktemp("site")
     env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
     mkdocs = [sys.executable, "-m", "mkdocs", "build", "--strict", "--quiet", "--site-dir", str(out)]
-    proc = subprocess.run(mkdocs, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(mkdocs, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600, check=False)
     assert proc.returncode == 0, proc.stderr[-3000:]
     return out
 
@@ -171,7 +171,7 @@ def test_the_site_loads_nothing_from_the_network(site):
     """Offline: no page links a script, stylesheet or image from another host (CDNs, fonts, the search shim)."""
     import re
 
-    remote = re.compile(r"""<(?:script|img|link)\b[^>]*\b(?:src|href)=["'](?:https?:)?//""", re.I)
+    remote = re.compile(r"""<(?:script|img|link)\b[^>]*\b(?:src|href)=["'](?:https?:)?//""", re.IGNORECASE)
     hits = [f"{p.relative_to(site)}: {m.group(0)[:120]}" for p in _pages(site)
             for m in remote.finditer(p.read_text(errors="replace"))
             if "rel=\"canonical\"" not in m.group(0)]
@@ -182,7 +182,7 @@ def test_api_pages_show_no_literal_bullet_stars(site):
     """Docstring lists written with '*' render as lists (docs/_hooks/griffe_roles.py), not as '* item' text."""
     import re
 
-    hidden = re.compile(r"<script\b.*?</script>|<pre\b.*?</pre>|<code\b.*?</code>", re.S)
+    hidden = re.compile(r"<script\b.*?</script>|<pre\b.*?</pre>|<code\b.*?</code>", re.DOTALL)
     star = re.compile(r"(?:<p>|<br ?/?>|\n)\s*\\?\*\s+\S[^<\n]{0,50}")
     hits = {p.relative_to(site).as_posix(): star.findall(hidden.sub("", p.read_text(errors="replace")))[:2]
             for p in _pages(site)}

@@ -18,7 +18,7 @@ def _kappa_rows(nb):
     for cell in nb.cells:
         if cell.cell_type == "code" and "hhscatter.escape_rates(lt)" in cell.source:
             text = "".join(o.get("data", {}).get("text/plain", "") for o in cell.outputs)
-            rows = re.findall(r"^\d+\s+([\d.]+)\s+\d+\s+([\d.]+)\s+([\d.]+)", text, re.M)
+            rows = re.findall(r"^\d+\s+([\d.]+)\s+\d+\s+([\d.]+)\s+([\d.]+)", text, re.MULTILINE)
             return {float(e): (float(k), float(s)) for e, k, s in rows}
     raise AssertionError("no escape_rates cell")
 

@@ -31,7 +31,7 @@ def main(argv=None) -> int:
 
     args = list(sys.argv[1:] if argv is None else argv)
     check = "--check" in args
-    path = Path([a for a in args if a != "--check"][0]).resolve()
+    path = Path(next(a for a in args if a != "--check")).resolve()
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         nb = execute(path, Path(tmp))

@@ -889,7 +889,8 @@ def cmeasure_distances(points, reference, boxes=(0.4, 0.2, 0.1, 0.05), *, n_spli
     >>> bool((d.to_frame()["hellinger_excess"].abs() < 0.05).all())
     True
     """
-    from .distance import agreement_scale, distance_vs_scale, points as xy
+    from .distance import agreement_scale, distance_vs_scale
+    from .distance import points as xy
 
     Q = xy(reference) if hasattr(reference, "columns") else np.asarray(reference, dtype=float)
     tables, scales, few = {}, {}, []
