@@ -23,8 +23,17 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP) ## create .venv and install hhscatter with its dev extra
 
-test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the default test suite (creates .venv with the dev, bench and docs extras)
+test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) chromium ## run the default test suite (creates .venv with the dev, bench and docs extras)
 	$(PY) -m pytest -q
+
+# the docs' browser tests (tests/test_docs_browser.py) open the built site in Debian's Chromium, driven by the
+# playwright package of the docs extra (never `playwright install`: its browser downloads are not used). Installed
+# here when missing (as root, with apt); where it cannot be, those tests skip and say why.
+CHROMIUM := /usr/bin/chromium
+chromium: ## install Debian's chromium for the docs' browser tests when missing (root + apt-get)
+	@test -x $(CHROMIUM) || { command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] \
+	  && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	  || echo "make chromium: could not install Debian's chromium (needs root and apt-get): the browser tests of the docs will be skipped"; }
 
 test-slow: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) ## run the slow accuracy/stress cases too
 	$(PY) -m pytest -q -m "slow or not slow"
@@ -142,9 +151,12 @@ docs: $(DOCS_STAMP) ## build the documentation site into site/ (mkdocs --strict:
 docs-serve: $(DOCS_STAMP) ## serve the docs with live reload at http://127.0.0.1:8000
 	$(MKDOCS) serve --strict
 
+tutorial: $(DOCS_STAMP) ## re-execute docs/tutorial.ipynb (~20 s) and store its outputs, which the docs page shows
+	$(PY) tools/execute_notebook.py docs/tutorial.ipynb
+
 docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with the bench summaries) into docs/
 	$(PYTHON) docs/gen_studies.py --scale $(SCALE)
 
-.PHONY: docs docs-serve docs-assets
+.PHONY: docs docs-serve docs-assets tutorial
 
-.PHONY: help venv test test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies
+.PHONY: help venv test chromium test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies

@@ -9,7 +9,13 @@ no side effects; ``dir(hhscatter)`` lists them):
 - :func:`simulate` — run a scene or a grid, write Parquet tables
 - :func:`read_lifetimes`, :func:`read_sections`, :func:`read_snapshots` — read them
 - :func:`survival`, :func:`escape_rates` — P(t) and κ per grid point of a
-  lifetimes DataFrame (results with ``.to_frame()`` and ``.plot(ax=)``)
+  lifetimes DataFrame (results with ``.to_frame()`` and ``.plot(ax=)``, as for every function below)
+- :func:`kappa_cmeasure` — κ from the c-measure of a run's section crossings, beside κ from P(t)
+- :func:`transition_times` — τ0, τ1, τ2 of each dissipative point against its γ = 0 partner
+- :func:`energy_decay` — ⟨E⟩(t) of the orbits inside and μ of E0·e^{−μγt}
+- :func:`cmeasure_points`, :func:`cmeasure_distances` — section points of the c-measure, and their
+  distances to a reference set against the box scale
+- :func:`basin_measures` — exit-basin maps of a grid of ICs, basin shares, basin entropy, Wada test
 - :func:`plot_survival`, :func:`plot_escape_rates` — draw on your matplotlib axes
 - :class:`HenonHeiles` — the model's closed forms (E_c, saddles, channels)
 
@@ -42,6 +48,12 @@ _EXPORTS = {
     "plot_escape_rates": "analysis.frames",
     "SurvivalCurves": "analysis.frames",
     "EscapeRates": "analysis.frames",
+    "kappa_cmeasure": "notebook",
+    "transition_times": "analysis.frames",
+    "energy_decay": "analysis.frames",
+    "cmeasure_points": "analysis.frames",
+    "cmeasure_distances": "analysis.frames",
+    "basin_measures": "analysis.frames",
     "HenonHeiles": "model",
 }
 

@@ -8,8 +8,12 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
 from pathlib import Path
+
+re_unrecognized = re.compile(r"unrecognized arguments: (.*)")
+re_choice = re.compile(r"invalid choice: '([^']*)' \(choose from (.*)\)")
 
 DESCRIPTION = (
     "Exact-event ensemble simulations of (dissipative) chaotic scattering in the Hénon–Heiles potential: "
@@ -28,6 +32,32 @@ EPILOG = """examples:
 
 class UsageError(Exception):
     """Bad command-line input found after parsing (exit status 2, no traceback)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with "did you mean" for a mistyped flag, subcommand or choice (Python < 3.14 has none)."""
+
+    def _all_options(self):
+        opts = set(self._option_string_actions)
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for sub in action.choices.values():
+                    opts |= set(sub._option_string_actions)
+        return opts
+
+    def error(self, message):
+        from .config import did_you_mean
+
+        m = re_unrecognized.match(message)
+        if m:
+            hints = [did_you_mean(a.split("=", 1)[0], self._all_options())
+                     for a in m.group(1).split() if a.startswith("-")]
+            message += "".join(h.replace(" (", "; ", 1).rstrip(")") for h in hints if h)
+        m = re_choice.search(message)
+        if m:
+            hint = did_you_mean(m.group(1), re.findall(r"'([^']+)'", m.group(2)))
+            message += hint.replace(" (", "; ", 1).rstrip(")") if hint else ""
+        super().error(message)
 
 
 def _float(s):
@@ -73,8 +103,8 @@ def _snapshots(s):
 def build_parser():
     from . import __version__
 
-    p = argparse.ArgumentParser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _Parser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"hhscatter {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -138,13 +168,29 @@ def build_parser():
         help="run one stage of a study (simulate → analyze → plot)",
         description="Run a stage of a study in studies/<name>/: 'simulate' writes raw Parquet runs, "
         "'analyze' derived tables and <name>.json, 'plot' <name>.png; 'all' runs the three.",
+        epilog=_studies_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2")
+    st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2; listed below")
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
     st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
     _progress_flags(st)
     return p
+
+
+def _studies_epilog() -> str:
+    """The studies, one line each (name, title, summary), from the study folders; empty if there are none."""
+    try:
+        from .studies.graph import studies
+
+        infos = studies()
+    except Exception:  # noqa: BLE001 - --help must work even if a study.toml is broken
+        return ""
+    if not infos:
+        return ""
+    width = max(len(s.name) for s in infos)
+    lines = [f"  {s.name:<{width}}  {s.title}" + (f" — {s.summary}" if s.summary else "") for s in infos]
+    return "studies:\n" + "\n".join(lines)
 
 
 def _progress_flags(parser):

@@ -188,6 +188,7 @@ class AboutTable(_Table):
     title: Text = None
     paper: Text = None
     summary: Text = None
+    setup: Text = None  # the study's own setup in a few words, when its ICs are not the [scene]'s region
 
 
 class StudyParams(_Table):
@@ -285,6 +286,14 @@ def _key_path(parts) -> str:
     return out
 
 
+def did_you_mean(name, choices) -> str:
+    """did_you_mean('summry', ['summary', 'title']) -> " (did you mean 'summary'?)", or "" if nothing is close."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 def _message(model, err: dict) -> str:
     loc = tuple(err["loc"])
     kind = err["type"]
@@ -295,11 +304,13 @@ def _message(model, err: dict) -> str:
         if not table and len(key) == 1:
             tables = [k for k in allowed if _is_table(_child(node, k))]
             if isinstance(err.get("input"), dict) or not set(allowed) - set(tables):
-                return (f"unknown table [{key[0]}]; allowed tables: "
+                return (f"unknown table [{key[0]}]{did_you_mean(key[0], tables)}; allowed tables: "
                         + ", ".join(f"[{k}]" for k in sorted(tables)))
-            return (f"unknown key {key[0]!r} before the first table; allowed keys there: "
+            return (f"unknown key {key[0]!r}{did_you_mean(key[0], set(allowed) - set(tables))} before the first "
+                    "table; allowed keys there: "
                     + ", ".join(sorted(set(allowed) - set(tables))))
-        return f"{where} unknown key {_key_path(key)!r}; allowed keys: {', '.join(sorted(allowed))}".strip()
+        return (f"{where} unknown key {_key_path(key)!r}{did_you_mean(key[-1], allowed)}; "
+                f"allowed keys: {', '.join(sorted(allowed))}").strip()
     if kind == "missing":
         return f"{where} needs {_key_path(key)!r}" if key else f"needs a {where} table"
     if kind in ("model_type", "dict_type"):

@@ -133,6 +133,24 @@ def _provenance(sections):
     return {}
 
 
+def commits_line(sections) -> str:
+    """commits_line(sections) -> "Numbers made at commit abc123 (fig1, fig2), def456-dirty (fig3) …".
+
+    Each study's numbers carry the commit they were made at; one study's commit is not the report's. A
+    ``-dirty`` commit is said in words: that run's work tree had uncommitted changes.
+    """
+    by = {}
+    for s in sections:
+        c = ((s.numbers or {}).get("provenance") or {}).get("git_commit")
+        if c:
+            by.setdefault(str(c), []).append(s.key)
+    if not by:
+        return ""
+    parts = [f"`{c.split('-')[0][:12]}`{' (uncommitted changes)' if c.endswith('-dirty') else ''}: "
+             f"{', '.join(names)}" for c, names in sorted(by.items(), key=lambda kv: -len(kv[1]))]
+    return "Numbers made at commit " + "; ".join(parts) + "."
+
+
 BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
                ("stress", "Numerical stress tests (`make stress`)"))
 
@@ -233,7 +251,8 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
              "convention; one that does not reads \"differs in our convention only\" and is not counted as a "
              "difference.", "",
              f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
-             f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str))}.", "",
+             f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str) and k != 'git_commit')}. "
+             f"{commits_line(sections)}", "",
              "## The paper's numbers beside ours", "", _count_line(paper_rows), "",
              _rows_table(paper_rows, html_verdicts), "",
              "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",

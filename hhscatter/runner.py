@@ -101,7 +101,7 @@ class RunSummary:
         return (
             f"{self.n} orbits: escaped {self.escaped}, settled {self.settled}, censored {self.censored}"
             f"{f', stopped {self.stopped}' if self.stopped else ''}"
-            f" | wall {self.wall_seconds:.2f} s, {us:.2f} µs/orbit, {us_core:.2f} µs/orbit/core"
+            f" | wall {self.wall_seconds:.2f} s ({us:.2f} µs per orbit; {us_core:.2f} µs per orbit in the workers' chunks)"
             f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
         )
 
@@ -558,13 +558,34 @@ class PlainProgress:
 
 
 def progress_bar(progress, total, initial, desc):
-    """progress_bar(progress, total, initial, desc) -> object with update(n)/close(): tqdm, PlainProgress or silent."""
-    if progress == "plain":
-        return PlainProgress(total, initial, desc)
-    from tqdm.auto import tqdm
+    """progress_bar(progress, total, initial, desc) -> object with update(n)/close(): tqdm, PlainProgress or silent.
 
-    return tqdm(total=total, initial=initial, unit="orbit", unit_scale=True, disable=not progress, desc=desc,
-                smoothing=0.05)
+    ``progress=True`` draws a tqdm bar only where one can be seen: on a terminal (stderr a TTY) or in a
+    Jupyter kernel (a widget if ipywidgets is installed, else text); into a log file or a pipe it writes the
+    plain lines of ``'plain'`` instead (no carriage returns). ``False``: silent, tqdm not even imported.
+    """
+    import sys
+
+    if progress == "plain" or (progress and not sys.stderr.isatty() and "ipykernel" not in sys.modules):
+        return PlainProgress(total, initial, desc)
+    if not progress:
+        return _Silent()
+    import importlib.util
+
+    if sys.stderr.isatty() or importlib.util.find_spec("ipywidgets") is None:
+        from tqdm.std import tqdm  # text bar (tqdm.auto would warn in a kernel without ipywidgets)
+    else:
+        from tqdm.auto import tqdm
+
+    return tqdm(total=total, initial=initial, unit="orbit", unit_scale=True, desc=desc, smoothing=0.05)
+
+
+class _Silent:
+    def update(self, n=1):
+        pass
+
+    def close(self):
+        pass
 
 
 def die_with_parent(parent_pid: int) -> None:

@@ -215,6 +215,10 @@ class Scene:
     _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        for name in ("n", "seed", "chunk_size"):  # counts written as floats (n=2e4), like the CLI's -n 2e4
+            v = getattr(self, name)
+            if isinstance(v, (float, np.floating)) and math.isfinite(v) and v == int(v):
+                object.__setattr__(self, name, int(v))
         try:
             model = HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
         except ValueError as exc:

@@ -604,7 +604,7 @@ def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False)
 
 
 def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = False, allow_partial: bool = False):
-    """read_lifetimes(run_dir, columns=None, filters=None, *, categorical=False) -> pandas.DataFrame.
+    """read_lifetimes(run_dir, columns=None, filters=None, *, categorical=False, allow_partial=False) -> pandas.DataFrame.
 
     The lifetimes table. ``columns`` projects (only those columns are read); ``filters`` is a
     pyarrow.dataset expression. ``outcome`` comes back as str (``categorical=True``: as a pandas
@@ -613,9 +613,25 @@ def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = F
     nominal E0) besides ``gamma``; filter on them to read one point:
     ``filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)``.
     Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…`` folders)
-    come back with the same columns.
+    come back with the same columns. ``run_dir`` may be a list of runs: their frames are concatenated
+    (a plain run among grid runs gets its ``energy`` column from its orbits' ``e0``, so that
+    :func:`hhscatter.survival` and friends see one point per run and grid point).
     """
+    if isinstance(run_dir, (list, tuple)):
+        return _concat_runs([_read(r, "lifetimes", columns, filters, categorical, allow_partial) for r in run_dir])
     return _read(run_dir, "lifetimes", columns, filters, categorical, allow_partial)
+
+
+def _concat_runs(frames):
+    """One frame of several runs' lifetimes; plain runs get ``energy`` (their median e0, 12 digits) if any has it."""
+    import pandas as pd
+
+    if not frames:
+        raise ValueError("no runs given")
+    if any("energy" in f.columns for f in frames):
+        frames = [f if "energy" in f.columns or "e0" not in f.columns or not len(f)
+                  else f.assign(energy=float(f"{np.median(f['e0'].to_numpy(dtype=float)):.12g}")) for f in frames]
+    return pd.concat(frames, ignore_index=True)
 
 
 def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: bool = False) -> dict:

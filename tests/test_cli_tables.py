@@ -77,7 +77,7 @@ def test_cli_simulate_and_survival(tmp_path, capsys):
                "--workers", "1"])
     assert rc == 0
     line = capsys.readouterr().out
-    assert "500 orbits: escaped" in line and "µs/orbit" in line
+    assert "500 orbits: escaped" in line and "µs per orbit" in line
     rc = main(["survival", str(out), "--png", str(tmp_path / "p.png")])
     assert rc == 0 and (tmp_path / "p.png").stat().st_size > 1000
 

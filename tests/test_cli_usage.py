@@ -142,3 +142,39 @@ def test_study_stages_say_what_they_wrote(tmp_path, monkeypatch, capsys):
     assert out == [f"fake simulate: raw runs in {where / 'raw'}",
                    f"fake analyze: wrote {where / 'fake.json'} and 1 derived table(s) in {where / 'derived'}",
                    f"fake plot: wrote {where / 'fake.png'}"]
+
+
+@pytest.mark.parametrize("argv, hint", [
+    (["simulate", "--energy", "0.3", "--wokers", "2", "--out", "x"], "unrecognized arguments: --wokers; did you mean '--workers'?"),
+    (["study", "fig2", "analyse"], "did you mean 'analyze'?"),
+    (["simulat"], "did you mean 'simulate'?"),
+])
+def test_a_mistyped_flag_or_choice_gets_a_suggestion(argv, hint, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2 and hint in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_study_help_lists_the_studies_and_a_mistyped_name_is_answered(capsys, tmp_path, monkeypatch):
+    from hhscatter.studies.graph import studies
+
+    with pytest.raises(SystemExit):
+        main(["study", "--help"])
+    out = capsys.readouterr().out
+    names = [s.name for s in studies()]
+    assert "fig2" in names and all(f"\n  {n} " in out for n in names)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "fgi2", "plot"]) == 2
+    assert "got 'fgi2' (did you mean 'fig2'?)" in capsys.readouterr().err
+
+
+def test_scene_takes_an_integral_float_count_like_the_cli():
+    from hhscatter import Scene, SceneError
+
+    s = Scene(energy=0.3, n=2e4, seed=1.0)
+    assert s.n == 20000 and type(s.n) is int and s.result_hash() == Scene(energy=0.3, n=20000, seed=1).result_hash()
+    for bad in (2.5, float("nan"), float("inf")):
+        with pytest.raises(SceneError, match="n \\(number of orbits\\) must be an integer > 0"):
+            Scene(energy=0.3, n=bad)

@@ -53,21 +53,21 @@ BAD_STUDY_FILES = [
     ("fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1),
      "[scene] energy must be a number, got '0.3'"),
     ("fig6", lambda t: t.replace("[snapshots]", "[snapshot]", 1),
-     "unknown table [snapshot]; allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
+     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
      "[snapshots], [study]"),
     ("fig3", lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
-     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot'; allowed keys: alt_window, "
+     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot' (did you mean 'n_boot'?); allowed keys: alt_window, "
      "authors_selection, authors_window, boot_seed, fit_window, hist_bins, hist_times, later_windows, n_boot, "
      "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid"),
     ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
-     "[scale.tiny.scene] unknown key 'chunk'; allowed keys: batch_size, chunk_size, continue_settled, energy, "
+     "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
      "gamma, ics, lam, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
     ("fig6", lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
      "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'"),
     ("resc", lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
      "[scale.tiny.study] n_follow must be an integer, got '300'"),
     ("fig5", lambda t: t.replace('summary = ', 'summry = ', 1),
-     "[about] unknown key 'summry'; allowed keys: paper, summary, title"),
+     "[about] unknown key 'summry' (did you mean 'summary'?); allowed keys: paper, setup, summary, title"),
     ("fig4", lambda t: t.replace("\nmu_gamma = 0.01", "\n", 1),
      "[study] needs 'mu_gamma'"),
 ]
@@ -89,7 +89,7 @@ def test_every_problem_of_a_file_is_named_once(tmp_path, capsys, monkeypatch):
     lines = err.splitlines()
     assert len(lines) == 2
     assert lines[0] == "hhscatter: error: studies/fig3/study.toml: [scene] seed must be an integer, got true"
-    assert lines[1].startswith("studies/fig3/study.toml: [scene] unknown key 't_mx'; allowed keys: batch_size")
+    assert lines[1].startswith("studies/fig3/study.toml: [scene] unknown key 't_mx' (did you mean 't_max'?); allowed keys: batch_size")
 
 
 BAD_SCENE_FILES = [
@@ -98,7 +98,7 @@ BAD_SCENE_FILES = [
     ("[scene]\nenergy = 0.3\nn = 40\nseed = true\n", "[scene] seed must be an integer, got true"),
     ("[scene]\nenergy = \"0.3\"\nn = 40\n", "[scene] energy must be a number or a list of numbers, got '0.3'"),
     ("[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
-     "unknown table [snapshot]; allowed tables: [follow], [scale], [scene], [sections], [snapshots]"),
+     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots]"),
     ("[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",
      "[snapshots] needs 'times' or all of start, stop and step"),
     ("[scene]\nenergy = [0.3, 0.35]\nn = 40\ngamma = [0, true]\n",

@@ -67,7 +67,7 @@ REFUSED = [
     (lambda t: t.replace('convention = "paper"', 'convention = "papr"', 1),
      "studies/fig3/study.toml: unknown convention 'papr'; conventions in "),
     (lambda t: t.replace('convention = "paper"', 'conventon = "paper"', 1),
-     "studies/fig3/study.toml: unknown key 'conventon' before the first table; allowed keys there: convention"),
+     "studies/fig3/study.toml: unknown key 'conventon' (did you mean 'convention'?) before the first table; allowed keys there: convention"),
     (lambda t: t.replace('convention = "paper"', 'convention = 1', 1),
      "studies/fig3/study.toml: convention must be a string (in quotes), got 1"),
     (lambda t: t.replace("seed = 2026 ", "r_esc = 1.5\nseed = 2026 ", 1),
@@ -86,7 +86,7 @@ def test_a_bad_convention_exits_2_naming_it(edit, message, tmp_path, capsys, mon
 
 
 @pytest.mark.parametrize("text, message", [
-    ('[paper]\nregion = "disk"\nradius = 0.5\nr_ecs = 1.03\n', "[paper] unknown key 'r_ecs'; allowed keys: "),
+    ('[paper]\nregion = "disk"\nradius = 0.5\nr_ecs = 1.03\n', "[paper] unknown key 'r_ecs' (did you mean 'r_esc'?); allowed keys: "),
     ('[paper]\nr_esc = "1.03"\n', "[paper] r_esc must be a number, got '1.03'"),
     ('[paper]\nregion = "disc"\n', "[paper] region must be one of "),
     ('paper = 1.03\n', "[paper] must be a table, got 1.03"),

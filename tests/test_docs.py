@@ -248,3 +248,35 @@ def test_nav_pages_and_api_modules_exist():
             path = ROOT / Path(*mod.split("."))
             assert path.with_suffix(".py").exists() or (path / "__init__.py").exists(), (md, mod)
     assert cfg["theme"]["font"] is False  # no Google Fonts: the build and the site stay offline
+
+
+def test_study_pages_put_the_figure_first_and_fold_the_configuration(hook):
+    page = ("# Fig 9\n\nintro line\n\n## What it computes\n\nprose\n\n```text\n## not a heading\n```\n\n"
+            "## Parameters\n\n<!-- hh:study-params fig9 -->\n\n## Figure\n\n<!-- hh:study-figure fig9 -->\n\n"
+            "## Numbers\n\n<!-- hh:study-numbers fig9 -->\n\n## Implementation\n\n<!-- hh:study-module fig9 -->\n")
+    out = hook.figure_first(page, "what fig 9 shows")
+    order = [out.index(s) for s in ("intro line", "**What it shows:** what fig 9 shows.", "## Figure",
+                                    "## What it computes", "## not a heading", "## Numbers", "## Parameters",
+                                    "## Implementation")]
+    assert order == sorted(order), out
+    assert sorted(out.split("\n")) == sorted((page + "\n**What it shows:** what fig 9 shows.\n\n").split("\n"))
+    assert hook.figure_first("# no sections\n") == "# no sections\n"
+    r = hook.Renderer(ROOT, DOCS, DOCS / "studies")
+    folded = r.study_params("fig2")
+    assert folded.startswith('??? abstract "Configuration: `studies/fig2/study.toml`')
+    assert all(not line or line.startswith("    ") for line in folded.splitlines()[1:])  # all of it inside
+
+
+def test_citation_and_licence_agree_with_pyproject():
+    import tomllib
+
+    yaml = pytest.importorskip("yaml")
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["type"] == "software" and cff["authors"]
+    assert cff["version"] == project["version"] and cff["license"] == project["license"] == "MIT"
+    paper = cff["references"][0]
+    assert paper["title"] == "Probabilistic description of dissipative chaotic scattering"
+    assert [a["family-names"] for a in paper["authors"]] == ["Burton", "Dullin", "Altmann"]
+    assert "doi" not in paper  # none is known: the manuscript names none (add it when published)
+    assert (ROOT / "LICENSE").read_text().startswith("MIT License")

@@ -76,3 +76,13 @@ def test_a_difference_only_in_our_convention_is_not_counted_as_one():
             {"verdict": "agrees within 2σ"}]
     c = verdict_counts(rows)
     assert (c["bad"], c["meh"], c["ok"]) == (1, 2, 1)
+
+
+def test_report_header_names_each_studys_commit_and_says_dirty_in_words():
+    from hhscatter.report import Section, commits_line
+
+    secs = [Section(k, k, "", None, {"provenance": {"git_commit": c}}) for k, c in
+            (("fig1", "a" * 40 + "-dirty"), ("fig2", "b" * 40), ("fig3", "b" * 40), ("fig4", None))]
+    line = commits_line(secs)
+    assert line == f"Numbers made at commit `{'b' * 12}`: fig2, fig3; `{'a' * 12}` (uncommitted changes): fig1."
+    assert "-dirty" not in line and commits_line([]) == ""

@@ -179,3 +179,28 @@ def test_the_analysis_layer_is_pure():
             if isinstance(node, ast.Call):
                 name = getattr(node.func, "attr", getattr(node.func, "id", None))
                 assert name not in banned_calls, f"{path.name}:{node.lineno} calls {name}()"
+
+
+def test_convention_label_says_the_studys_own_setup():
+    """A study whose ICs are not its [scene]'s region says so ([about] setup); the others name the region."""
+    from hhscatter.studies import load_study
+
+    basins = load_study("basins", "quick").convention_label
+    assert "disk" not in basins and basins.startswith("grid over the square") and basins.endswith("r_esc 1.5")
+    assert load_study("fig2", "quick").convention_label.endswith("disk r < 0.5, r_esc 1.03")
+
+
+def test_a_study_run_from_another_directory_writes_there_not_into_the_source_tree(tmp_path, monkeypatch):
+    from hhscatter.studies import load_study
+
+    monkeypatch.delenv("HHSCATTER_STUDIES", raising=False)
+    monkeypatch.chdir(ROOT)
+    assert load_study("fig2").out == ROOT / "studies" / "fig2" / "out" / "quick"  # make's layout, unchanged
+    monkeypatch.chdir(tmp_path)
+    study = load_study("fig2", "paper")
+    assert study.out == tmp_path / "studies" / "fig2" / "out" / "paper"
+    assert study.numbers_path.parent == study.out and study.raw("x").is_relative_to(tmp_path)
+    own = tmp_path / "mine"
+    (own / "fig2").mkdir(parents=True)
+    (own / "fig2" / "study.toml").write_text((ROOT / "studies" / "fig2" / "study.toml").read_text())
+    assert load_study("fig2", root=own).out == own / "fig2" / "out" / "quick"  # a studies folder of one's own

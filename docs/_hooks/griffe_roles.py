@@ -12,6 +12,11 @@ Markdown three things went wrong, and this extension rewrites them:
 * Field lists of dataclasses and parameters (a name, two or more spaces, its
   description, continuation lines indented further) ran together into one
   paragraph: they become bullet lists.
+* Bullet lists written with ``*`` showed their stars as text, run into the
+  paragraph before them: they become Markdown lists (``bullet_lists``).
+
+The docstrings' numpy sections (Parameters, Returns, Examples) are parsed by
+griffe (``docstring_style: numpy`` in mkdocs.yml).
 """
 from __future__ import annotations
 
@@ -121,9 +126,35 @@ def field_lists(text: str) -> str:
     return "\n".join(out)
 
 
+_BULLET = re.compile(r"^(\s*)[*•] (?=\S)")
+
+
+def bullet_lists(text: str) -> str:
+    """bullet_lists(text) -> text whose ``* item`` lines are Markdown list items (``- item``), each list set off
+    from the paragraph before it by a blank line (Python-Markdown starts no list inside a paragraph).
+
+    The docstrings write lists with ``*`` for ``help()``; left as they were, the star escaping below saw a
+    literal star and the page showed ``* item`` run into the paragraph. Code (fenced or indented) is untouched.
+    """
+    out, fenced, prev_bullet = [], False, False
+    for line in text.split("\n"):
+        if line.lstrip().startswith("```"):
+            fenced = not fenced
+        m = None if fenced else _BULLET.match(line)
+        if m and len(m.group(1)) < 4:
+            if out and out[-1].strip() and not prev_bullet:
+                out.append("")
+            line = f"{m.group(1)}- {line[m.end():]}"
+            prev_bullet = True
+        elif not line.strip() or not line.startswith(" "):
+            prev_bullet = prev_bullet and line.startswith(" ")
+        out.append(line)
+    return "\n".join(out)
+
+
 def clean_docstring(text: str) -> str:
-    """All three rewrites of the module doc, in order."""
-    return field_lists(escape_literal_stars(roles_to_code(text)))
+    """The rewrites of the module doc, in order: roles to code, bullet lists, literal stars, field lists."""
+    return field_lists(escape_literal_stars(bullet_lists(roles_to_code(text))))
 
 
 class SphinxRolesToCode(griffe.Extension):

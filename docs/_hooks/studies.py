@@ -102,7 +102,8 @@ class Renderer:
             out += ("\nIts `convention` lays these scene keys under its `[scene]`, from the one file that declares "
                     "them for every figure study:\n\n"
                     f'```toml title="studies/conventions.toml"\n{conv.read_text().rstrip()}\n```\n')
-        return out
+        # folded: the configuration is there for who looks for it, not in the way of the figure (click to open)
+        return f'??? abstract "Configuration: `studies/{name}/study.toml` (click to open)"\n\n' + _indent(out) + "\n"
 
     def study_figure(self, name: str) -> str:
         png = self.study_asset(name, "png")
@@ -485,10 +486,51 @@ def on_files(files, config, **kwargs):
     return files
 
 
+_H2 = re.compile(r"^## ", re.M)
+_FENCE = re.compile(r"^(```|~~~).*?^\1\s*$", re.M | re.S)
+
+
+def figure_first(markdown: str, summary: str = "") -> str:
+    """A study page in reading order: what it shows, the figure, the rest, then the configuration folded.
+
+    The ``## `` section that holds the ``hh:study-figure`` marker moves up to just after the page's
+    preamble (title and first lines); the one that holds ``hh:study-params`` moves down to just before
+    the implementation (``hh:study-module``) or to the end, and is folded (``study-params`` renders as a
+    closed ``???`` block). Other sections keep their order. Headings inside code fences are not split on.
+    ``summary`` (the study.toml's ``[about] summary``) is said in one line above the figure.
+    """
+    fenced = [m.span() for m in _FENCE.finditer(markdown)]
+    cuts = [m.start() for m in _H2.finditer(markdown) if not any(a <= m.start() < b for a, b in fenced)]
+    if not cuts:
+        return markdown
+    head, parts = markdown[:cuts[0]], [markdown[a:b] for a, b in zip(cuts, [*cuts[1:], len(markdown)])]
+    parts = [p if p.endswith("\n\n") else p.rstrip("\n") + "\n\n" for p in parts]
+
+    def take(marker):
+        hit = [p for p in parts if f"<!-- hh:{marker} " in p]
+        for p in hit:
+            parts.remove(p)
+        return hit
+
+    figure, params = take("study-figure"), take("study-params")
+    module = [i for i, p in enumerate(parts) if "<!-- hh:study-module " in p]
+    at = module[0] if module else len(parts)
+    parts[at:at] = params
+    if summary:
+        head = head.rstrip("\n") + f"\n\n**What it shows:** {summary}.\n\n"
+    return head + "".join(figure + parts)
+
+
 def on_page_markdown(markdown, page, config, files, **kwargs):
-    """Replace every ``<!-- hh:... -->`` marker of a page with its generated Markdown."""
+    """Replace every ``<!-- hh:... -->`` marker of a page with its generated Markdown (study pages: figure first)."""
     if "<!-- hh:" not in markdown:
         return markdown
+    fig = re.search(r"<!--\s*hh:study-figure\s+([\w.-]+)", markdown)
+    if fig:
+        from hhscatter.studies.graph import studies
+
+        about = {s.name: s.summary for s in studies(Path(config["config_file_path"]).resolve().parent / "studies")}
+        markdown = figure_first(markdown, about.get(fig.group(1), ""))
     docs = Path(config["docs_dir"])
     root = Path(config["config_file_path"]).resolve().parent
     page_dir = (docs / page.file.src_uri).parent

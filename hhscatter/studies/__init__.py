@@ -66,6 +66,21 @@ def studies_root() -> Path:
     return Path(__file__).resolve().parents[2] / "studies"
 
 
+def outputs_root(root: Path) -> Path:
+    """outputs_root(root) -> the folder under which the studies of ``root`` write ``<name>/out/<scale>/``.
+
+    ``root`` itself, except for the repository's own ``studies/`` folder used from another directory than the
+    repository: then ``./studies`` of the current directory, so that ``hhscatter study …`` run elsewhere
+    (an installed package, a notebook's folder) never writes into the source tree. From the repository root,
+    as ``make`` runs it, the outputs are the study folders' own ``out/`` as before.
+    """
+    own = Path(__file__).resolve().parents[2] / "studies"
+    root = Path(root)
+    if root.resolve() == own and Path.cwd().resolve() != own.parent:
+        return Path.cwd() / "studies"
+    return root
+
+
 _OWN_MODULES = ("graph", "_upstream")
 
 
@@ -136,7 +151,8 @@ class Study:
 
     @property
     def out(self) -> Path:
-        return self.root / "out" / self.scale
+        """``<studies>/<name>/out/<scale>``; see :func:`outputs_root` for a command run outside the repository."""
+        return outputs_root(self.root.parent) / self.name / "out" / self.scale
 
     @property
     def params(self) -> dict:
@@ -249,10 +265,14 @@ class Study:
 
     @property
     def convention_label(self) -> str:
-        """The study's own setup in a few words: IC region and escape radius of its ``[scene]``."""
+        """The study's own setup in a few words: its ICs and the escape radius of its ``[scene]``. The ICs are
+        ``[about] setup`` when the study says it (ICs that are not the ``[scene]``'s region, e.g. a grid on the
+        section), else the ``[scene]``'s region."""
         sc = self.config.get("scene", {})
         region = sc.get("region", "disk")
         where = f"disk r < {sc.get('radius', 0.5):g}" if region == "disk" else f"{region} ICs"
+        if self.info is not None and self.info.setup:
+            where = self.info.setup
         r_esc = sc.get("r_esc")
         name = self.config.get("convention")
         head = f"{name} setup: " if name else ""
@@ -303,8 +323,10 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
+        from ..config import did_you_mean
+
         known = sorted(p.parent.name for p in root.glob("*/study.toml"))
-        raise SceneError(f"study must be one of {known}, got {name!r}")
+        raise SceneError(f"study must be one of {known}, got {name!r}{did_you_mean(name, known)}")
     try:
         doc = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:

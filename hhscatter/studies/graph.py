@@ -36,7 +36,7 @@ class GraphError(ValueError):
 
 @dataclass(frozen=True)
 class StudyInfo:
-    """StudyInfo(name, title, paper, summary, needs) -> the header of one study folder.
+    """StudyInfo(name, title, paper, summary, needs, setup) -> the header of one study folder.
 
     ``needs`` maps a role (what the study uses the upstream for) to the
     upstream study's name; ``upstream`` is the sorted set of those names.
@@ -47,6 +47,7 @@ class StudyInfo:
     paper: str = ""
     summary: str = ""
     needs: dict = field(default_factory=dict)
+    setup: str = ""
 
     @property
     def upstream(self) -> tuple:
@@ -82,7 +83,8 @@ def study_info(root: Path, name: str, doc: dict | None = None) -> StudyInfo:
         if not isinstance(other, str):
             raise GraphError(f"{path}: [needs] {role} must be the name of a study (a string), got {other!r}")
     return StudyInfo(name=name, title=str(about.get("title", name)), paper=str(about.get("paper", "")),
-                     summary=str(about.get("summary", "")), needs=dict(needs))
+                     summary=str(about.get("summary", "")), needs=dict(needs),
+                     setup=str(about.get("setup", "")))
 
 
 def topological(infos: dict) -> list:
