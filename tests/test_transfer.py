@@ -240,3 +240,55 @@ def test_bootstrap_error_matches_the_spread_of_independent_estimates():
             boot_sd.append(np.std(tf.bootstrap_kappa(tr, 40, rng=r), ddof=1))
     ratio = np.mean(boot_sd) / np.std(est, ddof=1)
     assert 0.7 < ratio < 1.4, ratio
+
+
+def test_long_cycle_has_its_perron_root_and_vector():
+    """Eigenvalues of equal modulus on a circle, ρ·e^{2πik/n}: largest *magnitude* is ambiguous (ARPACK
+    stalled with a bare ArpackNoConvergence, or returned a complex root), largest real part converges
+    (with the retry on 64 Lanczos vectors). Closed form: a cycle of n = 200 states scaled by 0.9 and
+    conjugated by a positive diagonal D has ρ = 0.9 and left Perron vector ∝ diag(D)."""
+    n = 200
+    C = sp.csr_matrix((np.full(n, 0.9), (np.arange(n), (np.arange(n) + 1) % n)), shape=(n, n))
+    d = np.exp(np.random.default_rng(0).normal(size=n))
+    A = (sp.diags(1.0 / d) @ C @ sp.diags(d)).tocsr()
+    assert A.shape[0] > tf.DENSE_MAX            # the ARPACK path
+    assert tf.spectral_radius(A) == pytest.approx(0.9, abs=1e-10)
+    lam, v = tf.leading_left(A)
+    assert lam == pytest.approx(0.9, abs=1e-10)
+    np.testing.assert_allclose(v, d / d.sum(), rtol=1e-8)
+
+
+def test_arpack_stall_is_a_clear_error_not_a_wrong_root(monkeypatch):
+    """If ARPACK stalls twice (a spectrum too close to a circle), the caller gets a ValueError saying so."""
+    def stall(*a, **k):
+        raise sp.linalg.ArpackNoConvergence("stalled", np.empty(0), np.empty((0, 0)))
+
+    monkeypatch.setattr(tf, "eigs", stall)
+    A = sp.random(100, 100, density=0.1, random_state=1, format="csr")
+    for f in (tf.spectral_radius, tf.leading_left):
+        with pytest.raises(ValueError, match="no Perron root of this 100-state matrix"):
+            f(A)
+
+
+def test_three_block_cycle_matches_lapack():
+    """Three blocks visited in turn (the three-exit section's Ulam matrices come close to this): the spectrum
+    has the 3-fold symmetry λ → λ·e^{2πi/3}, so three roots share the largest modulus. Independent reference:
+    dense LAPACK on the same matrix."""
+    import scipy.linalg
+
+    rng = np.random.default_rng(3)
+    n, m = 300, 100
+    A = np.zeros((n, n))
+    for b in range(3):
+        c = (b + 1) % 3
+        A[b * m:(b + 1) * m, c * m:(c + 1) * m] = rng.random((m, m)) * (rng.random((m, m)) < 0.05)
+    vals, left = scipy.linalg.eig(A.T)
+    top = np.abs(vals) > np.abs(vals).max() * (1 - 1e-9)
+    assert top.sum() == 3                        # the ambiguity is really there
+    j = int(np.argmax(vals.real))
+    ref = np.abs(left[:, j].real) / np.abs(left[:, j].real).sum()
+    S = sp.csr_matrix(A)
+    assert tf.spectral_radius(S) == pytest.approx(vals[j].real, rel=1e-10)
+    lam, v = tf.leading_left(S)
+    assert lam == pytest.approx(vals[j].real, rel=1e-10)
+    np.testing.assert_allclose(v, ref, rtol=1e-7, atol=1e-12)

@@ -153,13 +153,43 @@ def _dense_leading(A):
     return vals[k], left[:, k]
 
 
+def _arpack_leading(A, tol: float, *, vector: bool):
+    """(λ, left vector or None) of the Perron root of a non-negative sparse A by ARPACK.
+
+    The Perron root ρ is the eigenvalue of largest *real part* (Re λ ≤ |λ| ≤ ρ, with Re λ = ρ only at
+    λ = ρ), so ARPACK is asked for ``which="LR"``. Largest *magnitude* ("LM") is ambiguous on these
+    matrices: Ulam matrices of the three-exit section have eigenvalues close to ρ·e^{±2πi/3}, and "LM"
+    returned one of them (|λ| 0.9335 against ρ = 0.93495 at E = 0.2, box 0.00625) or stalled. ARPACK starts
+    from the uniform vector. A stall is retried with 64 Lanczos vectors instead of 20; then a ValueError
+    is raised (never a wrong root).
+    """
+    At = A.T.tocsr()
+    n = A.shape[0]
+    # start from the uniform vector: it overlaps every non-negative Perron vector, and fixes ARPACK's
+    # otherwise random start, so that the result does not depend on earlier calls in the process
+    kw = dict(k=1, which="LR", tol=tol, maxiter=max(2000, 20 * n), return_eigenvectors=vector,
+              v0=np.full(n, 1.0 / math.sqrt(n)))
+    try:
+        out = eigs(At, **kw)
+    except sp.linalg.ArpackNoConvergence:
+        try:
+            out = eigs(At, ncv=min(n - 1, 64), **kw)
+        except sp.linalg.ArpackNoConvergence as e:
+            raise ValueError(f"ARPACK found no Perron root of this {n}-state matrix (largest real part, "
+                             "64 Lanczos vectors): its spectrum is too close to a circle") from e
+    if vector:
+        vals, vecs = out
+        return vals[0], vecs[:, 0]
+    return out[0], None
+
+
 def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     """leading_left(A) -> (λ, v): the Perron root of a non-negative square matrix and its left eigenvector.
 
     v A = λ v, normalised to v ≥ 0 and Σ v = 1 (a probability vector; ARPACK and LAPACK return an
     eigenvector of arbitrary sign and scale). λ = ρ(A) is real for a non-negative matrix; the eigensolver
     returns it with a tiny imaginary part, which is dropped (a sizable one is an error). A zero matrix
-    gives (0, uniform). Uses ARPACK (scipy.sparse.linalg.eigs, largest magnitude) above
+    gives (0, uniform). Uses ARPACK (scipy.sparse.linalg.eigs, largest real part) above
     :data:`DENSE_MAX` states, dense LAPACK below.
     """
     A = sp.csr_matrix(A)
@@ -173,11 +203,7 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     if n <= DENSE_MAX:
         lam, v = _dense_leading(A)
     else:
-        try:
-            vals, vecs = eigs(A.T.tocsr(), k=1, which="LM", tol=tol, maxiter=max(2000, 20 * n))
-            lam, v = vals[0], vecs[:, 0]
-        except sp.linalg.ArpackNoConvergence:  # pragma: no cover - fall back on LAPACK if ARPACK stalls
-            lam, v = _dense_leading(A)
+        lam, v = _arpack_leading(A, tol, vector=True)
     if abs(lam.imag) > 1e-8 * max(abs(lam.real), 1e-300):
         raise ValueError(f"leading eigenvalue {lam} is not real: A is not non-negative or ARPACK failed")
     # a Perron vector has one phase: rotate it onto the positive reals
@@ -198,8 +224,7 @@ def spectral_radius(A) -> float:
         return 0.0
     if A.shape[0] <= DENSE_MAX:
         return float(abs(_dense_leading(A)[0]))
-    return float(abs(eigs(A.T.tocsr(), k=1, which="LM", return_eigenvectors=False,
-                          tol=1e-12, maxiter=max(2000, 20 * A.shape[0]))[0]))
+    return float(abs(_arpack_leading(A, 1e-12, vector=False)[0]))
 
 
 def map_escape_rate(tr: Transitions) -> float:
