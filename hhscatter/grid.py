@@ -41,6 +41,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 from dataclasses import dataclass, field
 
 from .scene import Scene, SceneError, scene_dict_from_toml, scene_from_dict
@@ -67,10 +68,32 @@ def _values(name, v) -> tuple:
 
 @dataclass(frozen=True)
 class Grid:
-    """Grid(base, energies, gammas) -> the points base.replace(energy=E, gamma=γ), E-major.
+    """A sweep of scenes over E0 and/or γ: the points base.replace(energy=E, gamma=γ), E-major.
 
-    ``base`` carries every other scene field (n per point, seed, chunk_size…).
-    Each point is validated as a scene when the grid is made.
+    ``base`` carries every other scene field (n per point, seed, chunk_size…). Each point is validated as
+    a scene when the grid is made. :func:`hhscatter.simulate` writes one run for the whole grid; its
+    tables carry the point's nominal ``energy`` and ``gamma``.
+
+    Parameters
+    ----------
+    base : Scene
+        Every field but energy and γ.
+    energies : tuple of float
+        Initial energies E0 (units of the potential; E0 > E_c = ω⁶/(6λ²), Eq. (eqn:hh_potential)).
+    gammas : tuple of float
+        Drag coefficients γ ≥ 0 (1/time).
+
+    Raises
+    ------
+    SceneError
+        A point is not a valid scene (e.g. E0 ≤ E_c), or the lists are empty.
+
+    Examples
+    --------
+    >>> import hhscatter
+    >>> grid = hhscatter.Grid(hhscatter.Scene(energy=0.3, n=1000), energies=(0.25, 0.3), gammas=(0.0, 0.01))
+    >>> [(p.energy, p.gamma) for p in grid.points]
+    [(0.25, 0.0), (0.25, 0.01), (0.3, 0.0), (0.3, 0.01)]
     """
 
     base: Scene
@@ -134,6 +157,34 @@ def run_from_dict(d: dict):
     return Grid(scene_from_dict(d), energies, gammas)
 
 
-def load_run(path, scale: str | None = None, **overrides):
-    """load_run(path, scale=None, **overrides) -> Scene or Grid from a scene TOML file (see module doc)."""
+def load_run(path: str | os.PathLike[str], scale: str | None = None, **overrides: object) -> Scene | Grid:
+    """A Scene, or a Grid when ``energy`` or ``gamma`` is a list, from a scene TOML file.
+
+    Parameters
+    ----------
+    path : path
+        The TOML file: ``[scene]`` (Scene fields), optional ``[sections]``, ``[snapshots]`` and
+        ``[scale.<name>]`` tables (see :func:`hhscatter.load_scene`).
+    scale : str, optional
+        A ``[scale.<name>]`` table whose keys override ``[scene]``.
+    **overrides
+        Scene fields applied last.
+
+    Returns
+    -------
+    Scene or Grid
+
+    Raises
+    ------
+    SceneError
+        An unknown table or key (with a did-you-mean), or a value out of range.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, hhscatter
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "scene.toml"
+    >>> _ = f.write_text("[scene]\\nenergy = [0.25, 0.3]\\nn = 1000\\n")
+    >>> type(hhscatter.load_run(f)).__name__, len(hhscatter.load_run(f).points)
+    ('Grid', 2)
+    """
     return run_from_dict(scene_dict_from_toml(path, scale, **overrides))

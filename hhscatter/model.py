@@ -18,14 +18,32 @@ import numpy as np
 
 @dataclass(frozen=True)
 class HenonHeiles:
-    """HenonHeiles(omega=1.0, lam=1.0) -> the potential's constants.
+    """The Hénon–Heiles potential V = ω²(x² + y²)/2 + λ(x²y − y³/3), Eq. (eqn:hh_potential), and H, Eq. (eq:H).
 
-    The potential V of Eq. (eqn:hh_potential) and the Hamiltonian H of
-    Eq. (eq:H); the paper fixes ω = λ = 1 (Sec. II.B "Model System"), for which
-    E_c = 1/6 and the saddles lie at distance 1 (Sec. II.B "Scattering dynamics").
+    The paper fixes ω = λ = 1 (Sec. II.B "Model System"), for which E_c = 1/6 and the three saddles lie
+    at distance 1 (Sec. II.B "Scattering dynamics").
 
-    Requires ω > 0 and λ > 0 (for λ < 0 the potential is the mirror image
-    y → −y; use λ > 0 and reflect the data instead).
+    Parameters
+    ----------
+    omega : float
+        ω > 0, the harmonic frequency (1/time).
+    lam : float
+        λ > 0, the cubic coupling (for λ < 0 the potential is the mirror image y → −y; use λ > 0 and
+        reflect the data instead).
+
+    Raises
+    ------
+    ValueError
+        ω or λ not positive and finite.
+
+    Examples
+    --------
+    >>> from hhscatter import HenonHeiles
+    >>> hh = HenonHeiles()
+    >>> round(hh.critical_energy, 12), round(hh.saddle_radius, 12)
+    (0.166666666667, 1.0)
+    >>> [round(float(v), 12) for v in hh.potential(hh.saddles[:, 0], hh.saddles[:, 1])]   # V = E_c at every saddle
+    [0.166666666667, 0.166666666667, 0.166666666667]
     """
 
     omega: float = 1.0

@@ -6,6 +6,11 @@ recorded with (its ``scene.json``), and hands them to :func:`hhscatter.analysis.
 from __future__ import annotations
 
 import json
+import os
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # annotations only
+    from .analysis.frames import CMeasureRates
 
 __all__ = ["kappa_cmeasure", "run_scene"]
 
@@ -24,7 +29,7 @@ def run_scene(run) -> dict:
     return _decode(json.loads(store.read_text(SCENE_FILE))["scene"])
 
 
-def kappa_cmeasure(run, **kwargs):
+def kappa_cmeasure(run: str | os.PathLike[str], **kwargs: Any) -> CMeasureRates:
     """κ from the c-measure of a run's section crossings, per conservative grid point, beside κ from P(t).
 
     Parameters

@@ -52,12 +52,16 @@ import json
 import os
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .scene import Scene, SceneError, scene_from_dict
 from .store import LOCK_FILE, TMP_MARK, LockedError, Store
 from .tables import TABLES, part_name, read_meta, verify_part
+
+if TYPE_CHECKING:  # annotations only (grid imports runner's neighbours)
+    from .grid import Grid
 
 SCENE_FILE = "scene.json"
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.runner._run_dask)
@@ -417,21 +421,59 @@ def _drain(submit, wait_first, tasks, window, on_done, cancel):
         raise
 
 
-def simulate(run, out, *, workers=None, overwrite=False, resume=False, progress=True,
-             scheduler=None) -> RunSummary:
-    """simulate(run, out, workers=None, overwrite=False, resume=False, progress=True, scheduler=None) -> RunSummary.
+def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | None = None,
+             overwrite: bool = False, resume: bool = False, progress: bool | str = True,
+             scheduler: str | None = None) -> RunSummary:
+    """Integrate an ensemble and write its tables (lifetimes, and sections/snapshots if asked) as Parquet.
 
-    Writes the tables of ``run`` (a Scene, or a :class:`hhscatter.grid.Grid`)
-    under ``out`` (a directory or URL; see :mod:`hhscatter.tables`).
-    ``workers``: processes (default: all cores; with ``scheduler='local'`` the
-    LocalCluster's worker processes). ``scheduler``: None (local pool),
-    ``'local'`` or a Dask scheduler address ``'tcp://host:port'``. Tables are
-    byte-identical for any backend and number of workers. With ``resume``,
-    complete chunks are verified and kept, the rest redone. ``progress``:
-    True (a tqdm bar), ``'plain'`` (a plain line on stderr at most every 10 s,
-    for logs: no carriage returns) or False.
-    Raises SceneError on bad input (before any work), RunError when a chunk
-    cannot be written.
+    Every orbit runs to its end by exact events: escape at r = r_esc (then followed to r_far for the
+    no-return rule), settling at E = E_c inside Ω with drag (Eq. (eqn:energy_diffeq)), or t_max (censored);
+    the Hamiltonian flow of Eq. (eq:H) with the potential of Eq. (eqn:hh_potential) and drag −γp.
+
+    Parameters
+    ----------
+    run : Scene or Grid
+        What to integrate: one ensemble, or a sweep over E0 and/or γ (:class:`hhscatter.Grid`).
+    out : path or URL
+        Output directory (created), or a URL pyarrow/fsspec can write (``s3://…``); see
+        :mod:`hhscatter.tables` for the layout.
+    workers : int, optional
+        Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes).
+    overwrite : bool
+        Replace the tables of a non-empty ``out`` (the old run is removed first, under the run's lock).
+    resume : bool
+        Verify and keep the complete chunks of an interrupted run of the same scene; redo the rest.
+    progress : bool or 'plain'
+        True: a tqdm bar on a terminal; ``'plain'``: a plain line on stderr at most every 10 s (for logs);
+        False: none.
+    scheduler : str, optional
+        None (local process pool), ``'local'`` (a Dask LocalCluster) or a Dask scheduler address
+        ``'tcp://host:port'``.
+
+    Returns
+    -------
+    RunSummary
+        Orbits per outcome, rows written, compute and wall seconds, chunks done and resumed.
+
+    Raises
+    ------
+    SceneError
+        Bad input, before any work and before anything is written (exit 2 on the CLI).
+    RunError
+        A chunk cannot be written (e.g. a full disk), or a Dask cluster lost all its workers.
+
+    Notes
+    -----
+    Tables are byte-identical for any backend, number of workers and chunk size: the seed and the orbit
+    index fix every orbit.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> summary = hhscatter.simulate(hhscatter.Scene(energy=0.3, n=200, seed=1, t_max=200.0),
+    ...                              tempfile.mkdtemp(), workers=1, progress=False)
+    >>> summary.n, summary.escaped + summary.settled + summary.censored
+    (200, 200)
     """
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers must be an integer ≥ 1, got {workers!r}")

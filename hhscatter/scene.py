@@ -12,6 +12,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,7 +50,19 @@ SNAPSHOT_LIST_MAX = 1000
 
 
 class SceneError(ValueError):
-    """A scene parameter is outside its allowed range."""
+    """A scene parameter is outside its allowed range (or a scene file is malformed).
+
+    Raised before any work and before anything is written; the CLI prints its message and exits with 2.
+
+    Examples
+    --------
+    >>> import hhscatter
+    >>> try:
+    ...     hhscatter.Scene(energy=0.3, n=0)
+    ... except hhscatter.SceneError as e:
+    ...     print(e)
+    n (number of orbits) must be an integer > 0, got 0
+    """
 
 
 class SnapshotGrid(tuple):
@@ -95,15 +108,36 @@ def _finite(name, value):
 
 @dataclass(frozen=True)
 class SectionWindow:
-    """SectionWindow(t_from=0, t_to=inf, e_min=-inf, e_max=inf, first_only=False).
+    """Which crossings of the section ṙ = 0, φ̇ > 0 a scene records (paper, App. "Initial Conditions").
 
-    Which crossings of the section ṙ = 0, φ̇ > 0 to record (paper, App.
-    "Initial Conditions"): those at orbit times t_from ≤ t ≤ t_to whose energy
-    lies in [e_min, e_max]; with ``first_only`` only the first such crossing
-    of each orbit. Examples: the first crossing after t* is
-    ``SectionWindow(t_from=t_star, first_only=True)``; the first crossing in an
-    energy band is ``SectionWindow(e_min=0.295, e_max=0.305, first_only=True)``.
-    The initial point itself (t = 0) is never recorded.
+    Those at orbit times t_from ≤ t ≤ t_to whose energy lies in [e_min, e_max]; with ``first_only`` only the
+    first such crossing of each orbit. The initial point itself (t = 0) is never recorded.
+
+    Parameters
+    ----------
+    t_from, t_to : float
+        Orbit-time window (time units), 0 ≤ t_from < t_to ≤ ∞.
+    e_min, e_max : float
+        Energy window of the crossing (units of the potential); with drag, a band around a target energy.
+    first_only : bool
+        Only the first crossing in the window, per orbit.
+    stop : bool
+        With ``first_only``: end the orbit at that crossing (one-return runs, e.g. Ulam's method).
+
+    Raises
+    ------
+    SceneError
+        A value that is not a number, or an empty window.
+
+    Examples
+    --------
+    The first crossing after t* = 17 (paper Fig. 5a), and the first crossing in an energy band (Fig. 5b):
+
+    >>> import hhscatter
+    >>> a = hhscatter.SectionWindow(t_from=17.0, first_only=True)
+    >>> b = hhscatter.SectionWindow(e_min=0.295, e_max=0.305, first_only=True)
+    >>> a.t_to, b.e_max
+    (inf, 0.305)
     """
 
     t_from: float = 0.0
@@ -159,37 +193,73 @@ class Follow:
 
 @dataclass(frozen=True)
 class Scene:
-    """Scene(energy, n, gamma=0, seed=0, ...) -> one ensemble simulation.
+    """One ensemble simulation: N orbits of the Hénon–Heiles flow with drag, Eqs. (eq:H), (eqn:hh_potential).
 
-    Parameters (natural units of the model):
-      energy      E0, the initial energy of every orbit (must exceed E_c)
-      n           number of orbits N (> 0)
-      gamma       drag γ ≥ 0 (γ = 0: conservative)
-      seed        integer ≥ 0; with the orbit index it fixes every initial condition
-      region      'disk' (uniform in area in r < radius), 'well' (uniform in the
-                  saddle triangle where V < E) or 'square' (the authors' ``goodICs``:
-                  uniform in [−r_s, r_s]² where V < E, no radius cut; orbits that
-                  start at r ≥ r_esc are escaped at t = 0); velocities tangential
-                  on the section
-      radius      disk radius R (default 0.5, as in the authors' code)
-      r_esc       escape radius (default 1.5), > saddle distance ω²/λ. 1.5 lies beyond the
-                  Lyapunov orbits of every exit up to E = 0.5 (study ``resc``); the
-                  paper's 1.03 lets 0.3–2 % of 'escaped' orbits return (E = 0.25–0.35)
-      r_far       dissipative runs: radius beyond which an escaped orbit is
-                  stopped (default max(10 ω²/λ, 2 r_esc))
-      t_max       maximum orbit time (default 5000); orbits alive then are censored
-      tol         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15)
-      omega, lam  potential parameters ω, λ > 0 (default 1, 1)
-      chunk_size  orbits per part file (default 10000); tables do not depend on it (bitwise)
-      batch_size  SIMD lanes (default: heyoka's recommended size); no effect on results
-      ics         optional path of a Parquet/CSV table with columns x, y, px, py
-      sections    SectionWindow or None (no section table)
-      snapshots   tuple of orbit times for energy snapshots, or None
-      follow      Follow or None: escaped orbits followed to r_far (conservative;
-                  table ``crossings``)
-      continue_settled  dissipative scenes with snapshots: settled orbits go on
-                  past E_c to the last snapshot time, and their energies there are
-                  snapshot rows after t_end (for ⟨E⟩(t), paper Fig. 3)
+    Frozen and validated when made (every bound with its reason). Units are the model's natural units
+    (ω = λ = 1 in the paper): energies in units of the potential, times in 1/ω.
+
+    Parameters
+    ----------
+    energy : float
+        E0, the initial energy of every orbit; must exceed E_c = ω⁶/(6λ²) (1/6 in the paper). None only
+        with ``ics`` (the table fixes the energies).
+    n : int
+        Number of orbits N > 0 (an integral float such as 2e4 is accepted).
+    gamma : float
+        Drag γ ≥ 0 (1/time) of the force −γp; γ = 0 is the conservative system.
+    seed : int
+        ≥ 0; with the orbit index it fixes every initial condition.
+    region : {'disk', 'well', 'square'}
+        'disk': uniform in area in r < radius; 'well': uniform in the saddle triangle where V < E;
+        'square': the authors' ``goodICs``, uniform in [−r_s, r_s]² where V < E, no radius cut (orbits
+        that start at r ≥ r_esc are escaped at t = 0). Velocities are tangential on the section.
+    radius : float
+        Disk radius R (default 0.5, as in the authors' code).
+    r_esc : float
+        Escape radius (default 1.5), > the saddle distance ω²/λ. 1.5 lies beyond the Lyapunov orbits of
+        every exit up to E = 0.5 (study ``resc``); the paper's 1.03 lets 0.3–2 % of 'escaped' orbits
+        return (E = 0.25–0.35).
+    r_far : float, optional
+        Dissipative runs: radius beyond which an escaped orbit is stopped (default max(10 ω²/λ, 2 r_esc)).
+    t_max : float
+        Maximum orbit time (default 5000); orbits alive then are censored.
+    tol : float
+        Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15).
+    omega, lam : float
+        Potential parameters ω, λ > 0 (default 1, 1).
+    chunk_size : int
+        Orbits per part file (default 10000); the tables do not depend on it (bitwise).
+    batch_size : int, optional
+        SIMD lanes (default: heyoka's recommended size); no effect on results.
+    ics : str, optional
+        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id].
+    sections : SectionWindow, optional
+        Which crossings of the section ṙ = 0, φ̇ > 0 to record (default: no sections table).
+    snapshots : tuple of float, optional
+        Orbit times at which the energy of every live orbit is recorded.
+    follow : Follow, optional
+        Conservative runs: escaped orbits followed to r_far (table ``crossings``).
+    continue_settled : bool
+        Dissipative scenes with snapshots: settled orbits go on past E_c to the last snapshot time, and
+        their energies there are snapshot rows after t_end (for ⟨E⟩(t), paper Fig. 3).
+    name : str
+        A label for progress lines and the tables' metadata.
+
+    Raises
+    ------
+    SceneError
+        A value out of range, with the key and the reason (before any work).
+
+    Examples
+    --------
+    >>> import hhscatter
+    >>> scene = hhscatter.Scene(energy=0.3, n=2e4, gamma=0.01, seed=1)
+    >>> scene.n, round(scene.model.critical_energy, 12)
+    (20000, 0.166666666667)
+    >>> hhscatter.Scene(energy=0.1, n=10)
+    Traceback (most recent call last):
+    ...
+    hhscatter.scene.SceneError: energy must be > E_c = 0.1666666667 in a conservative escape scene (no escape is possible below it), got 0.1
     """
 
     energy: float | None
@@ -503,14 +573,39 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
     return d
 
 
-def load_scene(path, scale: str | None = None, **overrides) -> Scene:
-    """load_scene(path, scale=None, **overrides) -> Scene from a TOML file.
+def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrides: object) -> Scene:
+    """A Scene from a TOML file.
 
-    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow
-    fields), ``[snapshots]`` (``times = [...]`` or ``start/stop/step``) and
-    ``[scale.<name>]`` tables whose keys override ``[scene]`` when ``scale``
-    is given. Keyword overrides are applied last. A file whose ``energy`` or
-    ``gamma`` is a list is a grid: load it with :func:`hhscatter.grid.load_run`.
+    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow fields), ``[snapshots]``
+    (``times = [...]`` or ``start/stop/step``) and ``[scale.<name>]`` tables whose keys override
+    ``[scene]`` when ``scale`` is given. A file whose ``energy`` or ``gamma`` is a list is a grid: load it
+    with :func:`hhscatter.load_run`.
+
+    Parameters
+    ----------
+    path : path
+        The TOML file.
+    scale : str, optional
+        Name of a ``[scale.<name>]`` table to apply.
+    **overrides
+        Scene fields applied last.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        An unknown table or key (with a did-you-mean), a value out of range, or a grid file.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, hhscatter
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "scene.toml"
+    >>> _ = f.write_text("[scene]\\nenergy = 0.3\\nn = 1000\\n[scale.paper]\\nn = 10000000\\n")
+    >>> hhscatter.load_scene(f).n, hhscatter.load_scene(f, "paper").n, hhscatter.load_scene(f, n=5).n
+    (1000, 10000000, 5)
     """
     d = scene_dict_from_toml(path, scale, **overrides)
     for k in ("energy", "gamma"):

@@ -69,12 +69,20 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 import subprocess
 from pathlib import Path
+from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
 from .scene import SceneError
+
+if TYPE_CHECKING:  # annotations only
+    import pandas
+    import pyarrow.dataset
+
+RunPath = Union[str, "os.PathLike[str]"]  # a run directory (or a URL pyarrow/fsspec can read)
 
 META_KEY = b"hhscatter"
 CENSORING_OUTCOMES = ("censored", "stopped")  # right-censored lifetimes (hhscatter.analysis.survival)
@@ -603,19 +611,55 @@ def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False)
         yield _scan(part, run_dir, name, lambda d: d.to_table(columns=columns)).to_pandas()
 
 
-def read_lifetimes(run_dir, columns=None, filters=None, *, categorical: bool = False, allow_partial: bool = False):
-    """read_lifetimes(run_dir, columns=None, filters=None, *, categorical=False, allow_partial=False) -> pandas.DataFrame.
+def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None = None,
+                   filters: pyarrow.dataset.Expression | None = None, *, categorical: bool = False,
+                   allow_partial: bool = False) -> pandas.DataFrame:
+    """The lifetimes table of a run: one row per orbit.
 
-    The lifetimes table. ``columns`` projects (only those columns are read); ``filters`` is a
-    pyarrow.dataset expression. ``outcome`` comes back as str (``categorical=True``: as a pandas
-    categorical, 1 byte per orbit instead of a Python string, for 1e7 orbits and more), ``exit_channel``
-    as nullable Int8. A grid run has the column ``energy`` (the point's
-    nominal E0) besides ``gamma``; filter on them to read one point:
-    ``filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)``.
-    Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…`` folders)
-    come back with the same columns. ``run_dir`` may be a list of runs: their frames are concatenated
-    (a plain run among grid runs gets its ``energy`` column from its orbits' ``e0``, so that
-    :func:`hhscatter.survival` and friends see one point per run and grid point).
+    Columns: ``traj_id``, ``t_end`` (time of the orbit's end, time units), ``outcome`` ('escaped',
+    'settled' — E reached E_c inside Ω, Eq. (eqn:energy_diffeq) — or 'censored' at t_max), ``exit_channel``
+    (0, 1, 2 for escapes, else null), the initial state ``x0, y0, px0, py0``, ``e0`` (initial energy),
+    ``e_end`` (energy at the end) and ``gamma``; a grid run adds ``energy`` (the point's nominal E0). Only the parts of the run's
+    chunk plan are read, each verified (:mod:`hhscatter.tables`, "A run is its manifest").
+
+    Parameters
+    ----------
+    run_dir : path or URL, or list of them
+        A run directory written by :func:`hhscatter.simulate`. A list of runs gives their frames
+        concatenated (a plain run among grid runs gets its ``energy`` column from its orbits' ``e0``, so
+        that :func:`hhscatter.survival` and friends see one point per run and grid point).
+    columns : list of str, optional
+        Read only these columns (projection).
+    filters : pyarrow.dataset.Expression, optional
+        Row filter, e.g. ``(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)`` to read one grid
+        point.
+    categorical : bool
+        ``outcome`` as a pandas categorical (1 byte per orbit, for 1e7 orbits and more) instead of str.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning saying how much is missing.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``exit_channel`` as nullable Int8. Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…``
+        folders) come back with the same columns.
+
+    Raises
+    ------
+    RunIntegrityError
+        A table or planned part is missing, a part is damaged or not in the run's plan.
+    IncompleteRunError
+        Chunks are unfinished and ``allow_partial`` is False.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> _ = hhscatter.simulate(hhscatter.Scene(energy=0.3, n=100, seed=1, t_max=100.0), run,
+    ...                        overwrite=True, workers=1, progress=False)
+    >>> lt = hhscatter.read_lifetimes(run, columns=["traj_id", "t_end", "outcome"])
+    >>> len(lt), sorted(set(lt.outcome) - {"escaped", "censored"})
+    (100, [])
     """
     if isinstance(run_dir, (list, tuple)):
         return _concat_runs([_read(r, "lifetimes", columns, filters, categorical, allow_partial) for r in run_dir])
@@ -664,17 +708,83 @@ def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: b
     return out
 
 
-def read_sections(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
-    """read_sections(run_dir, ...) -> DataFrame traj_id, t, x, y, px, py, energy [, point_energy, point_gamma].
+def read_sections(run_dir: RunPath, columns: list[str] | None = None,
+                  filters: pyarrow.dataset.Expression | None = None, *,
+                  allow_partial: bool = False) -> pandas.DataFrame:
+    """The sections table of a run: one row per crossing of the section ṙ = 0, φ̇ > 0.
 
-    ``energy`` is the orbit's energy at the crossing; a grid run adds its
-    point's nominal E0 and γ as ``point_energy`` and ``point_gamma``.
+    Parameters
+    ----------
+    run_dir : path or URL
+        A run directory of a scene that recorded sections (``Scene(sections=SectionWindow(...))``).
+    columns : list of str, optional
+        Read only these columns.
+    filters : pyarrow.dataset.Expression, optional
+        Row filter.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``traj_id``, ``t`` (crossing time), ``x, y, px, py``, ``energy`` (the orbit's energy at the
+        crossing); a grid run adds its point's nominal E0 and γ as ``point_energy`` and ``point_gamma``.
+
+    Raises
+    ------
+    RunIntegrityError
+        The run has no sections table (it was not recorded), or a part is missing or damaged.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> scene = hhscatter.Scene(energy=0.3, n=50, seed=1, t_max=100.0, sections=hhscatter.SectionWindow())
+    >>> _ = hhscatter.simulate(scene, run, overwrite=True, workers=1, progress=False)
+    >>> sec = hhscatter.read_sections(run)
+    >>> bool(((sec.x * sec.px + sec.y * sec.py).abs() < 1e-10).all())     # ṙ = 0 at every crossing
+    True
     """
     return _read(run_dir, "sections", columns, filters, allow_partial=allow_partial)
 
 
-def read_snapshots(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
-    """read_snapshots(run_dir, ...) -> DataFrame traj_id, t, energy [, point_energy, point_gamma] (as read_sections)."""
+def read_snapshots(run_dir: RunPath, columns: list[str] | None = None,
+                   filters: pyarrow.dataset.Expression | None = None, *,
+                   allow_partial: bool = False) -> pandas.DataFrame:
+    """The snapshots table of a run: the energy of every orbit still alive at each snapshot time.
+
+    Parameters
+    ----------
+    run_dir : path or URL
+        A run directory of a scene that recorded snapshots (``Scene(snapshots=[t1, t2, …])``).
+    columns : list of str, optional
+        Read only these columns.
+    filters : pyarrow.dataset.Expression, optional
+        Row filter.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``traj_id``, ``t`` (snapshot time), ``energy``; a grid run adds ``point_energy``, ``point_gamma``.
+        With drag, ⟨E⟩(t) of these rows is the paper's Fig. 3 (Eq. (eqn:energy_exp_decay)).
+
+    Raises
+    ------
+    RunIntegrityError
+        The run has no snapshots table, or a part is missing or damaged.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> scene = hhscatter.Scene(energy=0.3, gamma=0.01, n=50, seed=1, t_max=50.0, snapshots=[0.0, 10.0])
+    >>> _ = hhscatter.simulate(scene, run, overwrite=True, workers=1, progress=False)
+    >>> snaps = hhscatter.read_snapshots(run)
+    >>> bool((snaps.groupby("t").energy.mean().diff().dropna() < 0).all())   # drag: ⟨E⟩ falls
+    True
+    """
     return _read(run_dir, "snapshots", columns, filters, allow_partial=allow_partial)
 
 

@@ -30,8 +30,14 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
+    import pandas
+    from matplotlib.axes import Axes
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "BasinMeasures",
@@ -119,8 +125,21 @@ def _label(key) -> str:
 class SurvivalCurves:
     """Result of :func:`survival`: one Kaplan–Meier P(t) per grid point.
 
-    - ``curves``: dict (energy, gamma) → :class:`~hhscatter.analysis.survival.SurvivalCurve` (t, P, P_err)
-    - ``n``: dict (energy, gamma) → number of orbits N
+    Attributes
+    ----------
+    curves : dict
+        (energy, gamma) → :class:`~hhscatter.analysis.survival.SurvivalCurve` with arrays ``t`` (time
+        units), ``P`` and its Greenwood error ``P_err``.
+    n : dict
+        (energy, gamma) → number of orbits N of that point.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd, hhscatter
+    >>> lt = pd.DataFrame({"t_end": [1.0, 2.0, 3.0, 4.0], "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    >>> curves = hhscatter.survival(lt, t_grid=[0.0, 2.5])
+    >>> len(curves), curves.to_frame()["P"].round(12).tolist()
+    (1, [1.0, 0.5])
     """
 
     curves: dict
@@ -154,15 +173,38 @@ class SurvivalCurves:
         return plot_survival(self, ax=ax, **kwargs)
 
 
-def survival(lifetimes, t_grid=None) -> SurvivalCurves:
-    """survival(lifetimes, t_grid=None) -> SurvivalCurves, one P(t) per grid point.
+def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> SurvivalCurves:
+    """Survival probability P(t), one Kaplan–Meier curve per grid point.
 
-    Kaplan–Meier P(t) = Pr(lifetime > t) (paper Eqs. (1), (2)) with Greenwood
-    errors (:func:`~hhscatter.analysis.survival.survival_curve`) of each
-    ensemble of ``lifetimes`` (see :func:`split_points`); 'escaped' and
-    'settled' end a lifetime, 'censored' orbits are right-censored. Without
-    ``t_grid`` each curve has a step at every distinct event time; with it,
-    P at those times (time units).
+    Kaplan–Meier P(t) = Pr(lifetime > t) (paper Eqs. (eqn:kappa_hyperbolic), (eqn:kappa_nonhyperbolic)) with
+    Greenwood errors (:func:`~hhscatter.analysis.survival.survival_curve`) of each ensemble of
+    ``lifetimes`` (see :func:`split_points`); 'escaped' and 'settled' end a lifetime, 'censored' orbits
+    are right-censored.
+
+    Parameters
+    ----------
+    lifetimes : DataFrame
+        :func:`hhscatter.read_lifetimes` of a run (columns ``t_end``, ``outcome``, ``gamma`` and
+        ``energy`` or ``e0``), or any frame with those columns.
+    t_grid : array_like of float, optional
+        Times (time units) at which P is given. Default: a step at every distinct event time.
+
+    Returns
+    -------
+    SurvivalCurves
+        One curve per (energy, γ); ``.to_frame()`` a tidy frame (energy, gamma, t, P, P_err),
+        ``.plot(ax=)`` the curves.
+
+    Examples
+    --------
+    >>> import pandas as pd, hhscatter
+    >>> lt = pd.DataFrame({"t_end": [1.0, 2.0, 3.0, 4.0], "e0": 0.3, "gamma": 0.0,
+    ...                    "outcome": ["escaped", "escaped", "censored", "escaped"]})
+    >>> hhscatter.survival(lt, t_grid=[0.0, 1.5, 3.5]).to_frame()["P"].round(12).tolist()
+    [1.0, 0.75, 0.5]
+
+    (By hand: 3 of 4 at risk survive t = 1, then 2 of 3 survive t = 2, so P(3.5) = 3/4 · 2/3 = 1/2; the
+    orbit censored at t = 3 is not counted as escaped, which would give 1/4.)
     """
     from .survival import observed_from_outcome, survival_curve
 
@@ -184,10 +226,24 @@ DISSIPATIVE_NOTE = "dissipative (γ > 0): P(t) is not exponential, no κ fitted"
 class EscapeRates:
     """Result of :func:`escape_rates`: κ per grid point.
 
-    - ``results``: dict (energy, gamma) → :class:`~hhscatter.analysis.escape_rate.EscapeRateResult`
-      (only the conservative points that were fitted)
-    - ``n``: dict (energy, gamma) → N
-    - ``notes``: dict (energy, gamma) → why a point has no κ
+    Attributes
+    ----------
+    results : dict
+        (energy, gamma) → :class:`~hhscatter.analysis.escape_rate.EscapeRateResult` (only the
+        conservative points that were fitted): κ (1/time), its error, τ0, the fit windows.
+    n : dict
+        (energy, gamma) → number of orbits N.
+    notes : dict
+        (energy, gamma) → why a point has no κ (dissipative, too few orbits, …).
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd, hhscatter
+    >>> t = np.random.default_rng(1).exponential(1 / 0.2, 20000)            # κ = 0.2 exactly
+    >>> lt = pd.DataFrame({"t_end": t, "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    >>> rates = hhscatter.escape_rates(lt, detect_tail=False)
+    >>> bool(abs(rates.to_frame().kappa.iloc[0] - 0.2) < 4 * rates.to_frame().kappa_err.iloc[0])
+    True
     """
 
     results: dict
@@ -230,18 +286,41 @@ class EscapeRates:
         return plot_escape_rates(self, ax=ax, **kwargs)
 
 
-def escape_rates(lifetimes, t_grid=None, **kwargs) -> EscapeRates:
-    """escape_rates(lifetimes, t_grid=None, **kwargs) -> EscapeRates: κ ± error, τ0, windows per grid point.
+def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, **kwargs: Any) -> EscapeRates:
+    """Escape rate κ ± error, τ0 and the fit windows, per conservative grid point.
 
     For each conservative (γ = 0) ensemble of ``lifetimes`` (:func:`split_points`),
-    :func:`~hhscatter.analysis.escape_rate.escape_rate`: τ0 and 4 fit windows
-    chosen from the data, κ the mean of 4 weighted least-squares fits of
-    log P(t) (paper Fig. 2b), its error, an MLE cross-check and the power-law
-    tail / τ* when there is one. ``kwargs`` go to that function (e.g.
-    ``detect_tail=False``, ``min_survivors=…``). Dissipative points (γ > 0) are
-    not fitted (module doc): their rows have NaN and a note, and a
-    ``UserWarning`` names them. A point whose fit fails (too few orbits for
-    the window choice) gets NaN and the reason as its note.
+    :func:`~hhscatter.analysis.escape_rate.escape_rate`: τ0 and 4 fit windows chosen from the data, κ
+    (1/time) the mean of 4 weighted least-squares fits of log P(t) = log f0 − κt
+    (Eq. (eqn:kappa_hyperbolic), paper Fig. 2b), its error, an MLE cross-check and the power-law tail /
+    τ* when there is one (Eq. (eqn:kappa_nonhyperbolic)). Dissipative points (γ > 0) are not fitted (module
+    doc): their rows have NaN and a note, and a ``UserWarning`` names them. A point whose fit fails (too
+    few orbits for the window choice) gets NaN and the reason as its note.
+
+    Parameters
+    ----------
+    lifetimes : DataFrame
+        :func:`hhscatter.read_lifetimes` of a run, or any frame with its columns (see :func:`survival`).
+    t_grid : array_like of float, optional
+        Times (time units) of the P(t) that is fitted. Default: every distinct event time.
+    **kwargs
+        Passed to :func:`~hhscatter.analysis.escape_rate.escape_rate` (e.g. ``detect_tail=False``,
+        ``min_survivors=…``).
+
+    Returns
+    -------
+    EscapeRates
+        ``.to_frame()`` one row per point (energy, gamma, n, kappa, kappa_err, tau0, windows, tau_star,
+        note), ``.plot(ax=)`` κ against E.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd, hhscatter
+    >>> t = np.random.default_rng(1).exponential(1 / 0.2, 20000)            # κ = 0.2 exactly
+    >>> lt = pd.DataFrame({"t_end": t, "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    >>> row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
+    >>> bool(abs(row.kappa - 0.2) < 4 * row.kappa_err)
+    True
     """
     from .escape_rate import escape_rate
     from .survival import observed_from_outcome
@@ -278,15 +357,40 @@ def _axes(ax):
     return plt.subplots(figsize=(6, 4.2), constrained_layout=True)[1]
 
 
-def plot_survival(curves, ax=None, *, labels=None, band=True, logy=True, **line_kwargs):
-    """plot_survival(curves, ax=None, *, labels=None, band=True, logy=True, **line_kwargs) -> ax.
+def plot_survival(curves: Any, ax: Axes | None = None, *, labels: list[str] | None = None, band: bool = True,
+                  logy: bool = True, **line_kwargs: Any) -> Axes:
+    """Draw P(t) as steps, one line per curve, with a ±1σ band.
 
-    Draws P(t) as steps, one line per curve, with a ±1σ band (``band``), on
-    ``ax`` (default: a new pyplot figure). ``curves``: a :class:`SurvivalCurves`,
-    one :class:`~hhscatter.analysis.survival.SurvivalCurve`, or a list of
-    either. ``labels``: one per curve (default "E0=…, γ=…"). Log-scale P by
-    default (the final P = 0 step is not drawn). Does not change the
-    matplotlib backend, does not save or show the figure.
+    Log-scale P by default (the final P = 0 step is not drawn). Does not change the matplotlib backend,
+    does not save or show the figure.
+
+    Parameters
+    ----------
+    curves : SurvivalCurves, SurvivalCurve or list of either
+        What :func:`survival` returns, or curves of :mod:`hhscatter.analysis.survival`.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new pyplot figure).
+    labels : list of str, optional
+        One per curve (default "E0=…, γ=…").
+    band : bool
+        Draw the ±1σ Greenwood band.
+    logy : bool
+        Log-scale P axis.
+    **line_kwargs
+        Passed to ``ax.step``.
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import matplotlib; matplotlib.use("Agg")
+    >>> import pandas as pd, hhscatter
+    >>> lt = pd.DataFrame({"t_end": [1.0, 2.0, 3.0], "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    >>> ax = hhscatter.plot_survival(hhscatter.survival(lt))
+    >>> ax.get_ylabel()
+    'P(t)'
     """
     items = []
     for c in curves if isinstance(curves, list) else [curves]:
@@ -317,13 +421,34 @@ def plot_survival(curves, ax=None, *, labels=None, band=True, logy=True, **line_
     return ax
 
 
-def plot_escape_rates(rates, ax=None, *, x="energy", **errorbar_kwargs):
-    """plot_escape_rates(rates, ax=None, *, x='energy', **errorbar_kwargs) -> ax.
+def plot_escape_rates(rates: EscapeRates | pandas.DataFrame, ax: Axes | None = None, *, x: str = "energy",
+                      **errorbar_kwargs: Any) -> Axes:
+    """Draw κ ± its error against the energy (or another column), one series per γ.
 
-    κ ± kappa_err against ``x`` (a column of ``rates.to_frame()``, default the
-    energy), one series per γ, on ``ax`` (default: a new pyplot figure).
-    ``rates``: an :class:`EscapeRates` or its ``to_frame()``. Points without κ
-    are skipped. Does not change the matplotlib backend.
+    Points without κ are skipped. Does not change the matplotlib backend.
+
+    Parameters
+    ----------
+    rates : EscapeRates or DataFrame
+        What :func:`escape_rates` returns, or its ``to_frame()``.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new pyplot figure).
+    x : str
+        Column of ``rates.to_frame()`` on the horizontal axis (default the energy E0).
+    **errorbar_kwargs
+        Passed to ``ax.errorbar``.
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import matplotlib; matplotlib.use("Agg")
+    >>> import pandas as pd, hhscatter
+    >>> rates = pd.DataFrame({"energy": [0.25, 0.3], "gamma": 0.0, "kappa": [0.1, 0.2], "kappa_err": 0.01})
+    >>> hhscatter.plot_escape_rates(rates).get_xlabel()
+    'E0'
     """
     df = rates.to_frame() if isinstance(rates, EscapeRates) else rates
     df = df[np.isfinite(df["kappa"].to_numpy(dtype=float))]
@@ -418,7 +543,8 @@ class CMeasureRates(_PointRows):
         return ax
 
 
-def kappa_cmeasure(lifetimes, sections, *, window, t_max: float, t_from=None, t_to=None, rec_efolds: float = 2.0,
+def kappa_cmeasure(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *, window: tuple[float, float],
+                   t_max: float, t_from: float | None = None, t_to: float | None = None, rec_efolds: float = 2.0,
                    margin: float = 40.0, n_boot: int = 200, seed: int = 0) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
 
@@ -555,7 +681,8 @@ class TransitionTimes(_PointRows):
         return ax
 
 
-def transition_times(lifetimes, *, alpha: float = 2.0, t_grid=None) -> TransitionTimes:
+def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
+                     t_grid: ArrayLike | None = None) -> TransitionTimes:
     """τ0, τ1 and τ2 of each dissipative grid point, against the conservative point of the same E0.
 
     * τ0: end of the irregular start of the conservative P_0(t) (:func:`escape_rates` of the γ = 0 point);
@@ -675,7 +802,8 @@ class EnergyDecay:
         return ax
 
 
-def energy_decay(snapshots, *, window=(0.0, 200.0), energy=None, gamma=None) -> EnergyDecay:
+def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (0.0, 200.0),
+                 energy: float | None = None, gamma: float | None = None) -> EnergyDecay:
     """⟨E⟩(t) of the orbits still inside, and μ of E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)), per point.
 
     ⟨E⟩(t) is the mean energy over the orbits still inside Ω at each snapshot time (the paper's Fig. 3);
@@ -759,8 +887,9 @@ class CMeasurePoints:
         return ax
 
 
-def cmeasure_points(sections, *, t_from: float, t_to: float = math.inf, first_only: bool = False,
-                    e_min: float = -math.inf, e_max: float = math.inf, lifetimes=None) -> CMeasurePoints:
+def cmeasure_points(sections: pandas.DataFrame, *, t_from: float, t_to: float = math.inf, first_only: bool = False,
+                    e_min: float = -math.inf, e_max: float = math.inf,
+                    lifetimes: pandas.DataFrame | None = None) -> CMeasurePoints:
     """Points of the c-measure on the section ṙ = 0, φ̇ > 0: the crossings of the survivors after ``t_from``.
 
     With ``first_only=False`` every crossing in [t_from, t_to] (the flux measure, paper Fig. 1b); with
@@ -849,8 +978,9 @@ class CMeasureDistances:
         return ax
 
 
-def cmeasure_distances(points, reference, boxes=(0.4, 0.2, 0.1, 0.05), *, n_splits: int = 8, seed: int = 0,
-                       m=None) -> CMeasureDistances:
+def cmeasure_distances(points: CMeasurePoints, reference: pandas.DataFrame | np.ndarray,
+                       boxes: tuple[float, ...] = (0.4, 0.2, 0.1, 0.05), *, n_splits: int = 8, seed: int = 0,
+                       m: int | None = None) -> CMeasureDistances:
     """Hellinger and total-variation distances between each point's section points and a reference set, vs scale.
 
     Box histograms of the two sets over a common partition at each box side ε, the distance of the full sets,
@@ -984,7 +1114,9 @@ class BasinMeasures:
         return ax
 
 
-def basin_measures(lifetimes, cell, shape, *, boxes=(2, 5, 10), extent=None, wada: bool = True) -> BasinMeasures:
+def basin_measures(lifetimes: pandas.DataFrame, cell: ArrayLike, shape: tuple[int, int], *,
+                   boxes: tuple[int, ...] = (2, 5, 10), extent: tuple[float, float, float, float] | None = None,
+                   wada: bool = True) -> BasinMeasures:
     """Exit-basin maps of a grid of initial conditions, per grid point, with their basin measures.
 
     Each cell of a (ny, nx) grid of initial conditions (e.g. :func:`hhscatter.ics.section_grid`, which also gives

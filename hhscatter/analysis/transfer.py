@@ -46,7 +46,7 @@ Example
 >>> import numpy as np
 >>> src, dst, T = np.array([0, 0, 1, 1]), np.array([1, -1, 0, -1]), np.array([1.0, 1.0, 2.0, 2.0])
 >>> tr = Transitions(src, dst, T, n_states=2)
->>> round(true_time_kappa(tr), 6) == round(-np.log(0.25) / 3.0, 6)
+>>> bool(round(true_time_kappa(tr), 6) == round(-np.log(0.25) / 3.0, 6))
 True
 """
 from __future__ import annotations
