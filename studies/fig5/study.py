@@ -95,6 +95,10 @@ class Params(StudyParams):
     m_min: Integer
     authors_window: Numbers = [17.0, 30.0]  # the authors' Fig 5a: first crossing with 17 < t < 30
     seed: Integer
+    verdict_offsets: Integer = 4
+    verdict_boot: Integer = 100
+    verdict_level: Number = 0.95
+    r_cut: Number = 1.0
 
 
 PAPER_T_STAR = 17.0
@@ -163,7 +167,7 @@ def simulate(study, workers=None, progress=True):
 
 
 def _authors_sets(study):
-    """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < 1
+    """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < r_cut
     (their plots), capped at n_cap points."""
     from hhscatter.tables import read_sections
 
@@ -171,9 +175,80 @@ def _authors_sets(study):
     out = {}
     for key in AUTHORS:
         sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "energy"])
-        sec = sec[np.hypot(sec["x"], sec["y"]) < 1.0].reset_index(drop=True)
-        out[("authors", key)] = _cap(sec, n_cap, seed)
+        out[("authors", key)] = _cap(_r_cut(sec, float(study.param("r_cut"))), n_cap, seed)
     return out
+
+
+def _r_cut(df, r_cut):
+    """The rows with r = √(x² + y²) < r_cut (the authors' plots), re-indexed."""
+    return df[np.hypot(df["x"], df["y"]) < r_cut].reset_index(drop=True)
+
+
+VERDICT_ROWS = (
+    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction before issue 28)", 1),
+    ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
+    ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
+    ("ours", "our construction (disk ICs; 5a: first crossing after t*, 5b: those in the band; no cut on any set), "
+             "averaged over grid offsets", None),
+)
+
+
+def _verdict_5b(study, cm_full, E1, ours):
+    """The 5b − 5a verdict (issue 28) in every construction of VERDICT_ROWS: debiased Hellinger distances to
+    μ_c^{E1} at box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every
+    set, the reference included (:func:`~hhscatter.analysis.distance.paired_hellinger_difference`). Sets of
+    one comparison are cut alike. Returns the JSON record, or None when the sets are too small (tiny scale)."""
+    box = float(study.param("box_headline"))
+    extent = tuple(float(v) for v in study.param("extent"))
+    k = int(study.param("verdict_offsets"))
+    n_boot, level = int(study.param("verdict_boot")), float(study.param("verdict_level"))
+    n_cap, seed, r_cut = int(study.param("n_cap")), int(study.param("seed")), float(study.param("r_cut"))
+    ref_all = _cap(cm_full, n_cap, seed)
+    ref_cut = _cap(_r_cut(cm_full, r_cut), n_cap, seed)
+    auth = _authors_sets(study)
+    a_auth, b_auth = auth[("authors", "5a_authors")], auth[("authors", "5b_authors")]
+    sets = {"old": (a_auth, b_auth, ref_all), "cut": (a_auth, b_auth, ref_cut),
+            "cut_offsets": (a_auth, b_auth, ref_cut), "ours": (ours[0], ours[1], ref_all)}
+    rows = []
+    for key, label, offs in VERDICT_ROWS:
+        A, B, R = sets[key]
+        try:
+            r = dist.paired_hellinger_difference(
+                dist.points(A), dist.points(B), dist.points(R), box, extent, units_a=A["traj_id"].to_numpy(),
+                units_b=B["traj_id"].to_numpy(), units_r=R["traj_id"].to_numpy(), offsets=offs or k,
+                n_boot=n_boot, level=level, seed=seed)
+        except ValueError as e:  # too few points (tiny scale)
+            rows.append({"construction": key, "label": label, "note": str(e)})
+            continue
+        rows.append({"construction": key, "label": label, "offsets": (offs or k) ** 2, "box": box,
+                     "n_5a": len(A), "n_5b": len(B), "n_ref": len(R),
+                     "d_5a": r.d_a, "d_5a_interval": list(r.d_a_interval), "d_5b": r.d_b,
+                     "d_5b_interval": list(r.d_b_interval), "delta": r.delta, "delta_interval": [r.lo, r.hi],
+                     "offset_spread_of_delta": r.offset_spread})
+    return {"reference": f"μ_c^{E1:g} (fig1's sprinkler points)", "level": level, "n_boot": n_boot,
+            "method": "paired half-sampling over orbits of every set (reference included); H² debiased with the "
+                      "complementary halves; averaged over offsets² placements of the box grid",
+            "like_for_like": "in every row but 'old' the three sets are cut alike (r < 1 for the authors' sets, "
+                             "no cut for ours)",
+            "not_computed": "random-direction initial momenta (the other momentum convention) need an IC option "
+                            "of the engine; not yet built",
+            "rows": rows}
+
+
+def _compare_verdict(study, verdict):
+    """One paper-comparison row per construction: is 5b closer to μ_c^{E1} than 5a (paired Δ < 0)?"""
+    for r in verdict["rows"]:
+        if "delta" not in r:
+            continue
+        lo, hi = r["delta_interval"]
+        v = "agrees" if hi < 0 else ("differs" if lo > 0 else "no significant difference")
+        study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
+                      f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
+                      "agreement)", verdict=v,
+                      note=f"d(5a) {r['d_5a']:.3f}, d(5b) {r['d_5b']:.3f} (debiased Hellinger, ε = {r['box']:g}, "
+                           f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
+                           f"{int(verdict['level'] * 100)} % interval from {verdict['n_boot']} paired half-samples "
+                           "over orbits")
 
 
 def _authors_distances(study, refs, extent):
@@ -246,6 +321,7 @@ def analyze(study):
     extent = tuple(float(v) for v in study.param("extent"))
     seed = int(study.param("seed"))
     n_cap = int(study.param("n_cap"))
+    cm_full = cm
     cm = {k: _cap(v, n_cap, seed) for k, v in cm.items()}
     refs = {"E1": dist.points(cm["E1"]), "E2": dist.points(cm["E2"])}
     sets, pg, point_tables = _point_sets(study, gammas, E1, E2, mu, mu_err)
@@ -264,6 +340,8 @@ def analyze(study):
     verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
     astab, n_auth = _authors_distances(study, refs, extent)
     authors = _compare_authors(study, astab, n_auth, E1)
+    verdict = _verdict_5b(study, cm_full["E1"], E1, (sets[(g_main, "a")], sets[(g_main, "b")]))
+    _compare_verdict(study, verdict)
     _qualify_our_5b(study.comparisons)
     study.write_numbers({
         "inputs": inputs,
@@ -277,6 +355,7 @@ def analyze(study):
         "distances": stab.to_dict(orient="records"),
         "closer_to_E1": verdicts,
         "authors_convention": authors,
+        "verdict_5b": verdict,
     })
 
 
