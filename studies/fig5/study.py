@@ -230,8 +230,12 @@ def _verdict_5b(study, cm_full, E1, ours):
                       "complementary halves; averaged over offsets² placements of the box grid",
             "like_for_like": "in every row but 'old' the three sets are cut alike (r < 1 for the authors' sets, "
                              "no cut for ours)",
-            "not_computed": "random-direction initial momenta (the other momentum convention) need an IC option "
-                            "of the engine; not yet built",
+            "momentum_convention": "tangential, ṙ = 0 and φ̇ > 0: the authors' goodICs sets (dx, dy) = (−y, x)/|q|·"
+                                   "√(2(E − V)) (LnBn/DissipativeScattering@0868eff, "
+                                   "src/dissipative_scattering_functions.jl lines 421–422, in goodICs, line 410), "
+                                   "as region 'square' does here",
+            "not_computed": "the other momentum convention (random directions) as a sensitivity row: it needs an IC "
+                            "option of the engine; not yet built",
             "rows": rows}
 
 
