@@ -241,14 +241,21 @@ def _verdict_5b(study, cm_full, E1, ours):
 
 def _compare_verdict(study, verdict):
     """One paper-comparison row per construction: is 5b closer to μ_c^{E1} than 5a (paired Δ < 0)?"""
+    def verdict_of(r):
+        lo, hi = r["delta_interval"]
+        return "agrees" if hi < 0 else ("differs" if lo > 0 else "no significant difference")
+
+    like = {r["construction"]: r for r in verdict["rows"] if "delta" in r}.get("cut_offsets")
     for r in verdict["rows"]:
         if "delta" not in r:
             continue
         lo, hi = r["delta_interval"]
-        v = "agrees" if hi < 0 else ("differs" if lo > 0 else "no significant difference")
+        v = verdict_of(r)
+        if r["construction"] == "ours" and v == "differs" and like is not None and verdict_of(like) != "differs":
+            v = f"differs in our convention only; in the authors' construction, like for like: {verdict_of(like)}"
         study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
                       f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
-                      "agreement)", verdict=v,
+                      "agreement)", verdict=v, authors=r["construction"] != "ours",
                       note=f"d(5a) {r['d_5a']:.3f}, d(5b) {r['d_5b']:.3f} (debiased Hellinger, ε = {r['box']:g}, "
                            f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
                            f"{int(verdict['level'] * 100)} % interval from {verdict['n_boot']} paired half-samples "
