@@ -123,6 +123,8 @@ def _scene_for(study, g):
 
 
 AUTHORS = {"5a_authors": "Fig. 5a, the authors' convention", "5b_authors": "Fig. 5b, the authors' convention"}
+AUTHORS_CONVENTION = ("region 'square' (goodICs), γ = gamma_main, r < 1; 5a: first crossing with {w[0]:g} < t < {w[1]:g}; "
+                      "5b: first crossing with E in {band} at any time")
 
 
 def _qualify_our_5b(rows) -> None:
@@ -256,6 +258,8 @@ def _compare_verdict(study, verdict):
         study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
                       f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
                       "agreement)", verdict=v, authors=r["construction"] != "ours",
+                      convention=(AUTHORS_CONVENTION.format(w=study.param("authors_window"), band=list(study.param("band")))
+                                  if r["construction"] != "ours" else None),
                       note=f"d(5a) {r['d_5a']:.3f}, d(5b) {r['d_5b']:.3f} (debiased Hellinger, ε = {r['box']:g}, "
                            f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
                            f"{int(verdict['level'] * 100)} % interval from {verdict['n_boot']} paired half-samples "
@@ -373,9 +377,7 @@ def analyze(study):
 def _compare_authors(study, astab, n_auth, E1) -> dict:
     """Rows of the paper comparison under the authors' own Fig. 5 convention (square ICs; 5a: first crossing
     with 17 < t < 30; 5b: first crossing in the energy band at any time; r < 1), and the JSON record."""
-    out = {"convention": "region 'square' (goodICs), γ = gamma_main, r < 1; 5a: first crossing with "
-                         f"{study.param('authors_window')[0]:g} < t < {study.param('authors_window')[1]:g}; "
-                         f"5b: first crossing with E in {list(study.param('band'))} at any time",
+    out = {"convention": AUTHORS_CONVENTION.format(w=study.param("authors_window"), band=list(study.param("band"))),
            "n_points": n_auth, "rows": None}
     if astab is None:
         return out
