@@ -12,8 +12,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:  # annotations only
+    from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -77,26 +81,26 @@ class HenonHeiles:
         return self.saddle_radius * np.column_stack([np.cos(a), np.sin(a)])
 
     # -- numpy evaluations ------------------------------------------------
-    def potential(self, x, y):
+    def potential(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """V(x, y), Eq. (eqn:hh_potential)."""
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         return 0.5 * self.omega**2 * (x * x + y * y) + self.lam * (x * x * y - y**3 / 3.0)
 
-    def energy(self, x, y, px, py):
+    def energy(self, x: ArrayLike, y: ArrayLike, px: ArrayLike, py: ArrayLike) -> np.ndarray:
         """H(x, y, p_x, p_y), Eq. (eq:H)."""
         px = np.asarray(px, dtype=float)
         py = np.asarray(py, dtype=float)
         return 0.5 * (px * px + py * py) + self.potential(x, y)
 
-    def exit_channel(self, x, y):
+    def exit_channel(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """exit_channel(x, y) -> int8 array: index of the channel whose axis is nearest in angle."""
         phi = np.arctan2(np.asarray(y, dtype=float), np.asarray(x, dtype=float))
         # channel k is centred on π/2 + 2πk/3; shift so that each channel owns a 120° sector
         k = np.floor(((phi - np.pi / 2 + np.pi / 3) % (2 * np.pi)) / (2 * np.pi / 3))
         return (k.astype(np.int8)) % 3
 
-    def inside_triangle(self, x, y):
+    def inside_triangle(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """True where (x, y) lies strictly inside the triangle spanned by the three saddles."""
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
@@ -108,7 +112,7 @@ class HenonHeiles:
         return inside
 
     # -- heyoka -----------------------------------------------------------
-    def expressions(self):
+    def expressions(self) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
         """(state_vars, V, H) as heyoka expressions; state order x, y, px, py."""
         import heyoka as hy
 

@@ -16,6 +16,7 @@ import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -445,7 +446,7 @@ class Scene:
             d["ics"] = file_sha256(self.ics)
         return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()
 
-    def replace(self, **changes) -> "Scene":
+    def replace(self, **changes: Any) -> Scene:
         return dataclasses.replace(self, **changes)
 
 

@@ -191,3 +191,16 @@ def test_api_pages_show_no_literal_bullet_stars(site):
     frames = (site / "api" / "analysis" / "frames.html").read_text()
     for section in ("Parameters:", "Returns:", "Examples:"):
         assert section in frames, section  # numpy sections parsed by griffe
+
+
+def test_api_examples_show_their_code_as_written(site):
+    """A docstring example's ``4 * err`` shows as written, not ``4 \\* err`` (the star escaping skips doctests)."""
+    import html
+    import re
+
+    code = re.compile(r"<code\b[^>]*>(.*?)</code>", re.DOTALL)
+    hits = [f"{p.relative_to(site).as_posix()}: {line.strip()[:100]}" for p in _pages(site) if "/api/" in p.as_posix()
+            for block in code.findall(p.read_text(errors="replace"))
+            for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()
+            if ">>>" in line and "\\*" in line]
+    assert not hits, "\n".join(hits[:20])

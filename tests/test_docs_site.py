@@ -60,6 +60,8 @@ def test_docstrings_keep_symbol_stars_and_field_lists():
                                        "- `tau0`: end of the irregular regime\n\n\nAfter.")
     code = "Example:\n\n    a  = 1\n    bb = 2\n"
     assert roles.escape_literal_stars(code + "    x * y\n") == code + "    x * y\n"  # code blocks untouched
+    doc = "Twice τ* of x.\n\nExamples\n--------\n>>> 4 * 2\n8\n>>> [0] * 2\n[0, 0]\n\nThen 2 * x."
+    assert roles.clean_docstring(doc) == doc.replace("τ*", "τ\\*").replace("2 * x", "2 \\* x")  # doctests kept
 
 
 def test_concept_pages_state_the_code_defaults():

@@ -152,9 +152,32 @@ def bullet_lists(text: str) -> str:
     return "\n".join(out)
 
 
+_DOCTEST = re.compile(r"^[ \t]*>>>")
+
+
+def _prose_and_doctests(text: str) -> list[tuple[bool, str]]:
+    """[(is a doctest, lines)]: a doctest runs from a ``>>>`` line to the next blank line (its output included).
+
+    The Examples sections of numpy docstrings are not indented, so the rewrites below would take them for prose
+    (``4 * err`` showed as ``4 \\* err`` on the page, the code block is shown verbatim).
+    """
+    blocks: list[tuple[bool, list[str]]] = []
+    for line in text.split("\n"):
+        doctest = bool(_DOCTEST.match(line)) or bool(blocks and blocks[-1][0] and line.strip())
+        if blocks and blocks[-1][0] == doctest:
+            blocks[-1][1].append(line)
+        else:
+            blocks.append((doctest, [line]))
+    return [(d, "\n".join(lines)) for d, lines in blocks]
+
+
 def clean_docstring(text: str) -> str:
-    """The rewrites of the module doc, in order: roles to code, bullet lists, literal stars, field lists."""
-    return field_lists(escape_literal_stars(bullet_lists(roles_to_code(text))))
+    """The rewrites of the module doc, in order: roles to code, bullet lists, literal stars, field lists.
+
+    Doctest blocks (``>>>`` lines and their output) are code and kept as they are.
+    """
+    return "\n".join(block if doctest else field_lists(escape_literal_stars(bullet_lists(roles_to_code(block))))
+                     for doctest, block in _prose_and_doctests(text))
 
 
 class SphinxRolesToCode(griffe.Extension):

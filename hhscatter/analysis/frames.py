@@ -160,7 +160,7 @@ class SurvivalCurves:
             return self.curves[hits[0]]
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd
 
@@ -168,7 +168,7 @@ class SurvivalCurves:
                  for k, c in self.curves.items()]
         return pd.concat(parts, ignore_index=True)
 
-    def plot(self, ax=None, **kwargs):
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """plot(ax=None, **kwargs) -> ax: :func:`plot_survival` of these curves."""
         return plot_survival(self, ax=ax, **kwargs)
 
@@ -253,7 +253,7 @@ class EscapeRates:
     def __getitem__(self, key):
         return self.results[key]
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per point.
 
         Columns: energy, gamma, n, kappa, kappa_err (1σ: spread of the 4 window
@@ -281,7 +281,7 @@ class EscapeRates:
             rows.append(row)
         return pd.DataFrame(rows)
 
-    def plot(self, ax=None, **kwargs):
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """plot(ax=None, **kwargs) -> ax: :func:`plot_escape_rates` of these rates."""
         return plot_escape_rates(self, ax=ax, **kwargs)
 
@@ -508,7 +508,7 @@ class _PointRows:
     def __getitem__(self, key):
         return self.rows[key]
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per point (sorted by energy, then γ)."""
         import pandas as pd
 
@@ -529,7 +529,7 @@ class CMeasureRates(_PointRows):
         (energy, gamma) → dict of the point's numbers (the columns of :meth:`to_frame`).
     """
 
-    def plot(self, ax=None, **errorbar_kwargs):
+    def plot(self, ax: Axes | None = None, **errorbar_kwargs: Any) -> Axes:
         """plot(ax=None, **errorbar_kwargs) -> ax: κ from the c-measure and from P(t) against E0."""
         df = self.to_frame()
         ax = _axes(ax)
@@ -665,7 +665,7 @@ class TransitionTimes(_PointRows):
         (energy, gamma) → dict of the point's numbers (the columns of :meth:`to_frame`).
     """
 
-    def plot(self, ax=None, **plot_kwargs):
+    def plot(self, ax: Axes | None = None, **plot_kwargs: Any) -> Axes:
         """plot(ax=None, **plot_kwargs) -> ax: τ1 (circles) and τ2 (squares) against γ, log–log, one colour per E0."""
         df = self.to_frame()
         ax = _axes(ax)
@@ -770,7 +770,7 @@ class EnergyDecay:
     curves: dict
     fits: dict
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per point: energy, gamma, mu, mu_err, mu_free, mu_free_err, t_lo, t_hi."""
         import pandas as pd
 
@@ -785,7 +785,7 @@ class EnergyDecay:
 
         return pd.concat([c.assign(energy=k[0], gamma=k[1]) for k, c in self.curves.items()], ignore_index=True)
 
-    def plot(self, ax=None, **plot_kwargs):
+    def plot(self, ax: Axes | None = None, **plot_kwargs: Any) -> Axes:
         """plot(ax=None, **plot_kwargs) -> ax: ⟨E⟩(t) per point (log y) with the fitted E0·e^{−μγt} dashed."""
         ax = _axes(ax)
         for key in _sorted_keys(self.curves):
@@ -866,14 +866,15 @@ class CMeasurePoints:
             return self.points[hits[0]]
         raise KeyError(f"no point {key!r}; points: {list(self.points)}")
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame point_energy, point_gamma, traj_id, t, x, y, … (every selected crossing)."""
         import pandas as pd
 
         return pd.concat([p.assign(point_energy=k[0], point_gamma=k[1]) for k, p in self.points.items()],
                          ignore_index=True)
 
-    def plot(self, ax=None, *, key=None, s=0.5, **scatter_kwargs):
+    def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None, s: float = 0.5,
+             **scatter_kwargs: Any) -> Axes:
         """plot(ax=None, *, key=None, s=0.5, **scatter_kwargs) -> ax: the points in (x, y), one colour per point
         (or only point ``key``)."""
         ax = _axes(ax)
@@ -955,14 +956,14 @@ class CMeasureDistances:
     tables: dict
     scales: dict
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame energy, gamma, box, hellinger, tv, …_noise, …_excess, agreement_scale."""
         import pandas as pd
 
         return pd.concat([self.tables[k].assign(energy=k[0], gamma=k[1], agreement_scale=self.scales[k])
                           for k in _sorted_keys(self.tables)], ignore_index=True)
 
-    def plot(self, ax=None, *, kind: str = "hellinger", **plot_kwargs):
+    def plot(self, ax: Axes | None = None, *, kind: str = "hellinger", **plot_kwargs: Any) -> Axes:
         """plot(ax=None, *, kind='hellinger') -> ax: distance and its split-half noise floor against the box side."""
         ax = _axes(ax)
         for k in _sorted_keys(self.tables):
@@ -1073,7 +1074,7 @@ class BasinMeasures:
     wada: dict
     extent: tuple | None = None
 
-    def to_frame(self):
+    def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per (point, box side): energy, gamma, box, S_b, S_b_err, S_bb, S_bb_err,
         a column ``share <basin>`` per basin, wada (verdict, or None)."""
         import pandas as pd
@@ -1087,7 +1088,8 @@ class BasinMeasures:
         df = pd.concat(parts, ignore_index=True)
         return df[["energy", "gamma", *[c for c in df.columns if c not in ("energy", "gamma")]]]
 
-    def plot(self, ax=None, *, key=None, **imshow_kwargs):
+    def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None,
+             **imshow_kwargs: Any) -> Axes:
         """plot(ax=None, *, key=None, **imshow_kwargs) -> ax: the basin map of point ``key`` (default: the first),
         one colour per basin, forbidden cells blank."""
         from matplotlib.colors import ListedColormap
