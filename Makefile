@@ -107,16 +107,16 @@ REPORT_INPUTS := $(foreach s,$(STUDY_NAMES),$(call so,$(s))/$(s).png) $(BENCH_SU
 else
 REPORT_INPUTS := $(wildcard docs/studies/assets/$(SCALE)/*.json)
 endif
-reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/report.py $(STAMP)
-	$(PY) -m hhscatter.report --scale $(SCALE)
+reports/$(SCALE)/report.html: $(REPORT_INPUTS) hhscatter/publish/report.py $(STAMP)
+	$(PY) -m hhscatter.publish.report --scale $(SCALE)
 
 report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown): quick runs what is missing; SCALE=paper reads the committed results
 
 bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → studies/engine/out/full/
-	$(PY) -m hhscatter.bench_engine $(ENGINE_ARGS)
+	$(PY) -m hhscatter.bench.engine $(ENGINE_ARGS)
 
 bench-memory: $(STAMP) ## peak RSS of simulate + P(t) at E=0.27, N=1e5,1e6,1e7, 1 worker (1e7: ~5-10 CPU-min)
-	$(PY) -m hhscatter.bench_memory $(MEMORY_ARGS)
+	$(PY) -m hhscatter.bench.memory $(MEMORY_ARGS)
 
 $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
@@ -124,7 +124,7 @@ $(BENCH_STAMP): $(STAMP)
 
 bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets → studies/{bench,engine}/out/
 	$(PY) -m hhscatter.bench $(BENCH_ARGS)
-	$(PY) -m hhscatter.bench_engine -n 30000 --repeat 2
+	$(PY) -m hhscatter.bench.engine -n 30000 --repeat 2
 
 # the report runs the benchmarks only when their summaries are missing or their code changed
 $(BENCH_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/bench/bench.toml | $(BENCH_STAMP)

@@ -1,6 +1,6 @@
 """``python -m hhscatter`` = the ``hhscatter`` command."""
 import sys
 
-from .cli import main
+from hhscatter.cli import main
 
 sys.exit(main())

@@ -46,7 +46,7 @@ class _Parser(argparse.ArgumentParser):
         return opts
 
     def error(self, message):
-        from .config import did_you_mean
+        from hhscatter.scene.schema import did_you_mean
 
         m = re_unrecognized.match(message)
         if m:
@@ -101,7 +101,7 @@ def _snapshots(s):
 
 
 def build_parser():
-    from . import __version__
+    from hhscatter import __version__
 
     p = _Parser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -181,7 +181,7 @@ def build_parser():
 def _studies_epilog() -> str:
     """The studies, one line each (name, title, summary), from the study folders; empty if there are none."""
     try:
-        from .studies.graph import studies
+        from hhscatter.studies.graph import studies
 
         infos = studies()
     except Exception:  # noqa: BLE001 - --help must work even if a study.toml is broken
@@ -214,7 +214,7 @@ def _resumed_scene(out):
     """The scene dict of OUT/scene.json (what --resume without a scene file continues), or None."""
     import json
 
-    from .store import Store
+    from hhscatter.data.store import Store
 
     try:
         store = Store(out)
@@ -227,8 +227,8 @@ def _resumed_scene(out):
 
 def _scene_from_args(a):
     """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
-    from .grid import run_from_dict
-    from .scene import SceneError, scene_dict_from_toml
+    from hhscatter.scene.grid import run_from_dict
+    from hhscatter.scene.scene import SceneError, scene_dict_from_toml
 
     flags = {
         k: getattr(a, k)
@@ -240,7 +240,7 @@ def _scene_from_args(a):
             if isinstance(x, float) and not math.isfinite(x):
                 raise SceneError(f"{k.replace('_', '-')} must be finite, got {x}")
     if a.ics:
-        from .ics import read_ics_table
+        from hhscatter.scene.ics import read_ics_table
 
         states, _ = read_ics_table(a.ics)
         if flags["n"] is not None and flags["n"] != len(states):
@@ -273,9 +273,9 @@ def _scene_from_args(a):
 
 
 def cmd_simulate(a):
-    from .runner import simulate
-    from .store import Store
-    from .tables import describe_run
+    from hhscatter.run.runner import simulate
+    from hhscatter.data.store import Store
+    from hhscatter.data.tables import describe_run
 
     scene = _scene_from_args(a)
     summary = simulate(scene, a.out, workers=a.workers, overwrite=a.overwrite, resume=a.resume,
@@ -300,8 +300,8 @@ def run_report(out, info: dict) -> str:
 def cmd_survival(a):
     from matplotlib.figure import Figure  # no pyplot: no backend is chosen or changed
 
-    from .analysis.frames import plot_survival, survival
-    from .tables import read_lifetimes
+    from hhscatter.api import plot_survival, survival
+    from hhscatter.data.tables import read_lifetimes
 
     png = Path(a.png)
     if not png.parent.is_dir():
@@ -329,15 +329,15 @@ def cmd_survival(a):
 
 
 def cmd_study(a):
-    from .studies import run_stage
+    from hhscatter.studies import run_stage
 
     run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a))
     return 0
 
 
 def main(argv=None):
-    from .runner import RunError
-    from .scene import SceneError
+    from hhscatter.run.runner import RunError
+    from hhscatter.scene.scene import SceneError
 
     a = build_parser().parse_args(argv)
     try:

@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 import hhscatter
-from hhscatter.analysis.survival import survival_curve
+from hhscatter.analysis.survival.fits import survival_curve
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 EPS = np.finfo(float).eps
@@ -42,7 +42,7 @@ def test_public_names_are_listed_and_version_comes_from_metadata():
 
 
 def test_points_are_grouped_by_energy_never_by_e0():
-    from hhscatter.analysis.frames import split_points
+    from hhscatter.api import split_points
 
     lt = _frame([(0.27, 0.0, 0.15), (0.3, 0.0, 0.2), (0.3, 0.01, 0.1)], n=500)
     assert lt.groupby(["e0", "gamma"]).ngroups > 3  # what the old error message suggested
@@ -86,8 +86,8 @@ def test_escape_rates_per_point_and_no_kappa_for_dissipative_points():
 
 
 def test_single_ensemble_escape_rate_refuses_a_dissipative_run():
-    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.analysis.survival import lifetimes_to_arrays
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     lt = _frame([(0.3, 0.01, 0.1)], n=5000)
     with pytest.raises(ValueError, match="dissipative"):
@@ -127,7 +127,7 @@ def test_each_concept_has_one_top_level_function_with_a_frame_and_a_plot():
     for name in ("kappa_cmeasure", "transition_times", "energy_decay", "cmeasure_points", "cmeasure_distances",
                  "basin_measures"):
         fn = getattr(hhscatter, name)
-        assert name in hhscatter.__all__ and fn.__module__ in ("hhscatter.analysis.frames", "hhscatter.notebook"), name
+        assert name in hhscatter.__all__ and fn.__module__ in ("hhscatter.api", "hhscatter.api"), name
         doc = fn.__doc__
         assert all(s in doc for s in ("Parameters\n", "Returns\n", "Examples\n", ">>> ")), name
     # one synthetic frame per concept, drawn on a given axes
@@ -198,7 +198,7 @@ def test_basin_measures_maps_outcomes_to_cells():
                        "exit_channel": pd.array([2, None, None, 1, 0, 0], dtype="Int8")})
     m = hhscatter.basin_measures(lt, cell, shape, boxes=[2], wada=False, extent=(-1, 1, -1, 1))
     lab = m.maps[(0.3, 0.01)]
-    F = hhscatter.analysis.frames
+    F = hhscatter.api
     want = np.full(16, F.OUTSIDE_BASIN)
     want[cell] = [0, 0, 1, F.TRAPPED_BASIN, F.SETTLED_BASIN, 2]
     assert (lab.ravel() == want).all()

@@ -1,4 +1,4 @@
-"""Tests of the basin-map measures (hhscatter.analysis.basins) on synthetic maps with known answers.
+"""Tests of the basin-map measures (hhscatter.analysis.geometry.basins) on synthetic maps with known answers.
 
 Every random input is seeded.  Known answers: closed forms (straight
 boundaries), constructions whose exponent or Wada property is derived in the
@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from hhscatter.analysis import basins
-from hhscatter.analysis.escape_check import wilson_interval
+from hhscatter.analysis.geometry import basins
+from hhscatter.analysis.stats.intervals import wilson_interval
 
 LN2, LN3 = math.log(2.0), math.log(3.0)
 CANTOR_ALPHA = 1.0 - LN2 / LN3  # 1 − D0, D0 = log 2 / log 3 the box dimension of the Cantor set

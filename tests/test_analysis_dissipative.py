@@ -10,7 +10,9 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from hhscatter.analysis import decay, distance, model, transitions
+from hhscatter.analysis.dissipative import decay, transitions
+from hhscatter.analysis.dissipative import models as model
+from hhscatter.analysis.geometry import distance
 
 E0, GAMMA, MU, TAU0, EC = 0.3, 0.01, 0.91, 5.0, 1.0 / 6.0
 N_ORBITS = 100_000
@@ -560,7 +562,7 @@ def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
 
 def test_homogeneous_fit_steps_alone():
     """The steps of fit_survival_model (start values, bounds, parameters from θ, starts, one fit at fixed τ2)."""
-    from hhscatter.analysis.survival_model import HomogeneousProblem, homogeneous_start
+    from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, homogeneous_start
 
     t = np.arange(0.0, 301.0)
     P = model.survival_model(t, **KW, **TRUE, hazard="paper")

@@ -1,4 +1,4 @@
-"""Tests of hhscatter.analysis.survival / escape_rate on synthetic data with known answers.
+"""Tests of hhscatter.analysis.survival.fits / escape_rate on synthetic data with known answers.
 
 Every statistical test uses a fixed seed and compares with an independent
 closed-form truth (the survival function the sample was drawn from, the
@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 from scipy import integrate, optimize, stats
 
-from hhscatter.analysis.escape_rate import (
+from hhscatter.analysis.survival.escape_rate import (
     choose_windows,
     cmeasure_sample_from_sections,
     escape_rate,
@@ -21,7 +21,7 @@ from hhscatter.analysis.escape_rate import (
     fit_kappa_energy,
     kappa_from_cmeasure,
 )
-from hhscatter.analysis.survival import (
+from hhscatter.analysis.survival.fits import (
     crossover_time,
     detect_power_law_tail,
     fit_exponential,
@@ -395,7 +395,7 @@ def test_observed_from_outcome_on_a_categorical_is_the_label_test():
     import pandas as pd
     import pytest
 
-    from hhscatter.analysis.survival import observed_from_outcome
+    from hhscatter.analysis.survival.fits import observed_from_outcome
 
     labels = ["escaped", "censored", "settled", "stopped"] * 3
     cat = pd.Series(labels).astype("category")

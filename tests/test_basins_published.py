@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis import basins as B
+from hhscatter.analysis.geometry import basins as B
 
 ROOTS3 = np.exp(2j * np.pi * np.arange(3) / 3)
 

@@ -11,8 +11,8 @@ numba = pytest.importorskip("numba")
 
 from hhscatter.bench import peers
 from hhscatter.bench.reference import reference_orbits
-from hhscatter.engine import state_at
-from hhscatter.scene import Scene
+from hhscatter.integrate.engine import state_at
+from hhscatter.scene.scene import Scene
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,9 @@ import pytest
 
 from hhscatter import read_lifetimes, read_sections, read_snapshots
 from hhscatter.cli import main
-from hhscatter.runner import simulate
-from hhscatter.scene import Scene, SceneError, SectionWindow
-from hhscatter.tables import read_meta
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SceneError, SectionWindow
+from hhscatter.data.tables import read_meta
 
 
 def _files(d):
@@ -83,7 +83,7 @@ def test_cli_simulate_and_survival(tmp_path, capsys):
 
 
 def test_cli_ics_table(tmp_path):
-    from hhscatter.ics import region_ics
+    from hhscatter.scene.ics import region_ics
 
     sc = Scene(energy=0.3, n=50, seed=8)
     ics = region_ics(sc, 0, 50)
@@ -148,7 +148,7 @@ def test_bad_output_and_ics(tmp_path, capsys):
 
 
 def test_scene_toml_and_scales(tmp_path):
-    from hhscatter.scene import load_scene
+    from hhscatter.scene.scene import load_scene
 
     p = tmp_path / "scene.toml"
     p.write_text('[scene]\nenergy = 0.3\nn = 100\ngamma = 0.01\n[sections]\nt_from = 17.0\nfirst_only = true\n'

@@ -1,4 +1,4 @@
-"""Strict configuration (hhscatter.config): every bad table, key or value type of a study.toml or scene file
+"""Strict configuration (hhscatter.scene.schema): every bad table, key or value type of a study.toml or scene file
 exits with status 2 and one exact message before any work, and the checks change no scene's result_hash."""
 from __future__ import annotations
 
@@ -120,7 +120,7 @@ def test_bad_scene_file_exits_2_with_its_exact_message(text, message, tmp_path, 
 
 def test_text_for_a_number_is_refused_by_the_scene_itself():
     """A scene built in code gets the same answer (energy = "0.3" used to pass float() and crash in the engine)."""
-    from hhscatter.scene import Scene, SceneError, SectionWindow
+    from hhscatter.scene.scene import Scene, SceneError, SectionWindow
 
     with pytest.raises(SceneError, match="energy must be a number, got '0.3'"):
         Scene(energy="0.3", n=10)
@@ -141,7 +141,7 @@ def test_a_refused_study_file_in_a_subprocess_prints_no_traceback(tmp_path):
 
 
 def test_every_study_declares_its_study_table():
-    from hhscatter.config import StudyParams
+    from hhscatter.scene.schema import StudyParams
     from hhscatter.studies import load_study, study_names
 
     for name in study_names():
@@ -240,7 +240,7 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
 
 def test_the_engine_options_are_accepted_in_files(tmp_path):
     """sections.stop, [follow] radii and continue_settled pass the strict checks (and build their scenes)."""
-    from hhscatter.scene import load_scene
+    from hhscatter.scene.scene import load_scene
 
     (tmp_path / "a.toml").write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 10\ncontinue_settled = true\n"
                                      "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n"

@@ -52,7 +52,7 @@ def test_the_convention_file_is_the_one_place_of_the_escape_radius_of_the_figure
 
 def test_a_study_file_with_a_convention_is_the_merged_scene():
     """A study made of the convention and a few keys of its own: the convention lies under its [scene]."""
-    from hhscatter.config import apply_convention
+    from hhscatter.scene.schema import apply_convention
 
     conv = {"paper": {"region": "disk", "radius": 0.5, "r_esc": 1.03}}
     doc = {"convention": "paper", "scene": {"n": 10, "energy": 0.3}}

@@ -2,8 +2,8 @@
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.runner import simulate
-from hhscatter.scene import Scene, SceneError, SectionWindow
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SceneError, SectionWindow
 
 distributed = pytest.importorskip("distributed")
 
@@ -121,7 +121,7 @@ def test_fsspec_url_output_resume_and_read(tmp_path, scene, reference):
     """A URL --out goes through pyarrow.fs/fsspec (here fsspec's in-memory filesystem, this process only)."""
     import fsspec
 
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     url = "memory://hhscatter-test/run"
     try:

@@ -9,10 +9,10 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter import read_lifetimes, read_sections, read_snapshots
-from hhscatter.grid import Grid
-from hhscatter.runner import simulate
-from hhscatter.scene import Scene, SectionWindow
-from hhscatter.tables import read_meta, survival_arrays, write_part
+from hhscatter.scene.grid import Grid
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SectionWindow
+from hhscatter.data.tables import read_meta, survival_arrays, write_part
 
 KEYS = ["energy", "gamma", "traj_id"]
 COLS = ["traj_id", "energy", "gamma", "e0", "x0", "outcome", "t_end", "e_end"]
@@ -148,7 +148,7 @@ def test_read_lifetimes_categorical_is_the_same_table_at_one_byte_per_outcome(ru
     """categorical=True (the route for 1e7 orbits): the same labels, as a pandas categorical."""
     import pandas as pd
 
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     plain = read_lifetimes(run)
     cat = read_lifetimes(run, categorical=True)
@@ -163,7 +163,7 @@ def test_read_by_orbit_is_the_lifetimes_table_in_orbit_order(run):
     """read_by_orbit: numpy columns in traj_id order, outcome as a 1-byte categorical, null channels as −1."""
     import pandas as pd
 
-    from hhscatter.tables import read_by_orbit, read_lifetimes
+    from hhscatter.data.tables import read_by_orbit, read_lifetimes
 
     ref = read_lifetimes(run).sort_values("traj_id", kind="stable").reset_index(drop=True)
     c = read_by_orbit(run, ["t_end", "outcome", "exit_channel"])

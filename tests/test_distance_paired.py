@@ -10,7 +10,7 @@ the marked units of A (as Fig. 5b is a subset of the orbits of 5a).
 import numpy as np
 import pytest
 
-from hhscatter.analysis.distance import _offset_extents, paired_hellinger_difference
+from hhscatter.analysis.geometry.distance import _offset_extents, paired_hellinger_difference
 
 EXTENT = (0.0, 1.0, 0.0, 1.0)
 WIDE, CORNER = (0.0, 1.0, 0.0, 1.0), (0.0, 0.5, 0.0, 0.5)

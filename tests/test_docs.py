@@ -170,7 +170,7 @@ def test_embedded_summary_links_are_rebased_or_dropped(tmp_path, hook):
 def test_sphinx_roles_become_inline_code():
     pytest.importorskip("griffe")
     roles = _load(DOCS / "_hooks" / "griffe_roles.py", "hh_docs_roles")
-    text = "see :func:`survival_curve`, :class:`~hhscatter.scene.Scene` and ``x``"
+    text = "see :func:`survival_curve`, :class:`~hhscatter.scene.scene.Scene` and ``x``"
     assert roles.roles_to_code(text) == "see `survival_curve`, `Scene` and ``x``"
 
 

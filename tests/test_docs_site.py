@@ -65,7 +65,7 @@ def test_docstrings_keep_symbol_stars_and_field_lists():
 
 
 def test_concept_pages_state_the_code_defaults():
-    from hhscatter.scene import Scene
+    from hhscatter.scene.scene import Scene
 
     r_esc = Scene(energy=0.3, n=1).r_esc
     assert r_esc == 1.5

@@ -4,10 +4,10 @@ import heyoka as hy
 import numpy as np
 import pytest
 
-from hhscatter.engine import CENSORED, ESCAPED, SETTLED, run_chunk, simulate_orbit, state_at
-from hhscatter.ics import region_ics, section_velocities
+from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk, simulate_orbit, state_at
+from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.model import HenonHeiles, equations
-from hhscatter.scene import Scene, SectionWindow
+from hhscatter.scene.scene import Scene, SectionWindow
 
 EPS = np.finfo(float).eps
 

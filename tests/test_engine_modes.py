@@ -1,4 +1,4 @@
-"""Every mode of the one engine, built from the one event declaration (hhscatter.events):
+"""Every mode of the one engine, built from the one event declaration (hhscatter.integrate.events):
 against the scalar long-double reference driver (same events and rules, independent precision),
 for invariance under chunking and lanes, and for what each scene option promises."""
 from __future__ import annotations
@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hhscatter import events
-from hhscatter.analysis.survival import observed_from_outcome
-from hhscatter.engine import CENSORED, ESCAPED, SETTLED, STOPPED, run_chunk, scheduler, simulate_orbit
-from hhscatter.ics import region_ics, section_velocities
+from hhscatter.integrate import events
+from hhscatter.analysis.survival.fits import observed_from_outcome
+from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, STOPPED, run_chunk, scheduler, simulate_orbit
+from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.model import HenonHeiles
-from hhscatter.scene import Follow, Scene, SceneError, SectionWindow
+from hhscatter.scene.scene import Follow, Scene, SceneError, SectionWindow
 
 ROOT = Path(__file__).resolve().parents[1]
 OLD_HASH = "4e97917dd6101d2cc772e8ceb545ee8f6dd47b4ed183576388f7feba3d9c93c5"  # computed by scene.py at 6a7a794
@@ -31,7 +31,7 @@ def _run(scene, n=None, ics=None, **kw):
 def test_only_the_events_module_constructs_heyoka_events():
     pat = re.compile(r"\b(t_event|nt_event|t_event_batch|nt_event_batch)\(")
     users = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "hhscatter").rglob("*.py") if pat.search(p.read_text()))
-    assert users == ["hhscatter/events.py"]
+    assert users == ["hhscatter/integrate/events.py"]
 
 
 @pytest.mark.parametrize("kw, names", [
@@ -241,7 +241,7 @@ def test_follow_and_conservative_lifetimes_agree_on_outcomes():
 
 @pytest.mark.parametrize("kw", [{}, {"gamma": 0.01, "snapshots": (0.0, 5.0, 10.0)}], ids=["stream", "epochs"])
 def test_progress_is_reported_from_inside_a_chunk(kw):
-    from hhscatter.engine import PROGRESS_EVERY
+    from hhscatter.integrate.engine import PROGRESS_EVERY
 
     sc = Scene(energy=0.3, n=5000, seed=40, r_esc=1.03, **kw)
     ics = region_ics(sc, 0, sc.n)
@@ -254,7 +254,7 @@ def test_progress_is_reported_from_inside_a_chunk(kw):
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_runner_progress_moves_within_chunks_and_totals_exactly(tmp_path, monkeypatch, workers):
-    import hhscatter.runner as runner
+    import hhscatter.run.runner as runner
 
     updates = []
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 from scipy import optimize, stats
 
-from hhscatter.analysis.cmeasure import kappa_from_cmeasure
+from hhscatter.analysis.survival.cmeasure import kappa_from_cmeasure
 
 ONE_SIGMA = math.erf(1 / math.sqrt(2))  # 0.6827: the chance that a 1σ interval covers the truth
 P_3SIGMA = 2 * stats.norm.sf(3.0)       # 0.0027
@@ -76,7 +76,7 @@ import pytest  # noqa: E402
 
 @pytest.mark.parametrize("rank", [1, 20])  # the first settling time (the paper's τ2,obs), and the 20th
 def test_the_order_statistic_interval_of_tau2_covers_the_quantile(rank):
-    from hhscatter.analysis.transitions import settle_quantile_interval
+    from hhscatter.analysis.dissipative.transitions import settle_quantile_interval
 
     n, f, tau = 2000, 0.3, 100.0
     p = rank / n
@@ -99,7 +99,7 @@ def test_the_order_statistic_interval_of_tau2_covers_the_quantile(rank):
 def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
     import pandas as pd
 
-    from hhscatter.analysis.transitions import tau2_observed, tau2_observed_interval
+    from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_observed_interval
 
     lt = pd.DataFrame({"t_end": [5.0, 3.0, 9.0, 1.0, 7.0], "outcome": ["settled", "settled", "escaped", "escaped",
                                                                         "censored"]})
@@ -111,7 +111,7 @@ def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
 # -- τ2 from the survival model: the Δχ² = 1 ends of its profile by root-finding ---------------------------------
 def test_the_profile_interval_by_root_finding_covers_the_truth():
     """y = A e^{−t/τ} + N(0, σ²), A profiled out (linear): the Δχ² = 1 interval of τ must cover τ_true ≈ 68 %."""
-    from hhscatter.analysis.survival_model import profile_interval
+    from hhscatter.analysis.dissipative.survival_model import profile_interval
 
     t = np.linspace(0.0, 10.0, 40)
     A, tau, sigma = 1.0, 3.0, 0.05
@@ -141,7 +141,7 @@ def test_the_profile_interval_by_root_finding_covers_the_truth():
 
 
 def test_an_unbounded_side_of_the_profile_ends_at_its_edge():
-    from hhscatter.analysis.survival_model import profile_interval
+    from hhscatter.analysis.dissipative.survival_model import profile_interval
 
     lo, hi = profile_interval(lambda x: (x - 2.0) ** 2 if x < 2.0 else 0.0, 2.0, 0.0, 0.0, 10.0)
     assert lo == pytest.approx(1.0) and hi == 10.0

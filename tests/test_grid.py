@@ -5,18 +5,18 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.grid import Grid, load_run
+from hhscatter.scene.grid import Grid, load_run
 from hhscatter.model import HenonHeiles
-from hhscatter.runner import simulate
-from hhscatter.scene import Scene, SceneError, load_scene
-from hhscatter.tables import read_lifetimes, read_meta, read_sections
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SceneError, load_scene
+from hhscatter.data.tables import read_lifetimes, read_meta, read_sections
 
 ENERGIES, GAMMAS = (0.25, 0.3), (0.0, 0.01)
 
 
 @pytest.fixture(scope="module")
 def grid():
-    from hhscatter.scene import SectionWindow
+    from hhscatter.scene.scene import SectionWindow
 
     base = Scene(energy=0.25, n=160, seed=17, chunk_size=80, sections=SectionWindow(t_from=2.0, first_only=True),
                  name="sweep")
@@ -145,12 +145,12 @@ def test_cli_grid_lists(tmp_path, capsys):
 
 def test_streamed_survival_of_one_grid_point(grid_run):
     """survival_on_grid with a partition filter = Kaplan–Meier of that point's rows."""
-    from hhscatter.analysis.survival import survival_curve
-    from hhscatter.tables import survival_on_grid
+    from hhscatter.analysis.survival.fits import survival_curve
+    from hhscatter.api import stream_survival
 
     point = (ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)
     g = np.linspace(0.0, 30.0, 31)
-    got = survival_on_grid(grid_run, g, filters=point)
+    got = stream_survival(grid_run, g, filters=point)
     lt = read_lifetimes(grid_run, columns=["t_end", "outcome"], filters=point)
     assert len(lt) == 160
     ref = survival_curve(lt["t_end"].to_numpy(), (lt["outcome"] != "censored").to_numpy(), t_grid=g)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from hhscatter.ics import perturbed_on_section, section_grid
+from hhscatter.scene.ics import perturbed_on_section, section_grid
 from hhscatter.model import HenonHeiles
 
 M = HenonHeiles()

@@ -21,9 +21,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.runner import simulate
-from hhscatter.scene import Scene, SceneError, SectionWindow, scene_from_dict
-from hhscatter.tables import (
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SceneError, SectionWindow, scene_from_dict
+from hhscatter.data.tables import (
     IncompleteRunError,
     RunIntegrityError,
     read_lifetimes,
@@ -142,7 +142,7 @@ def test_4_second_writer_is_refused_while_the_first_runs(tmp_path, capsys):
 
 
 def test_4_the_refused_writer_never_removes_the_holders_directory(tmp_path):
-    from hhscatter.store import Store
+    from hhscatter.data.store import Store
 
     out = tmp_path / "fresh"
     fd = Store(out).lock()  # another writer has just made the directory and holds it (empty so far)
@@ -307,7 +307,7 @@ def test_9_huge_momenta_in_an_ic_table_are_refused(tmp_path, capsys):
 
 # 10 -- ENOSPC on scene.json, a bad scheduler, a broken pipe, a Dask cluster without workers
 def test_10_enospc_on_scene_json_is_clear_and_leaves_nothing(tmp_path, capsys, monkeypatch):
-    from hhscatter.store import Store
+    from hhscatter.data.store import Store
 
     def full(self, rel, doc):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
@@ -338,7 +338,7 @@ def test_10_broken_pipe_is_quiet(tmp_path):
 
 def test_10_dask_run_without_workers_fails_after_the_timeout(monkeypatch):
     distributed = pytest.importorskip("distributed")
-    from hhscatter import runner
+    from hhscatter.run import runner
 
     class NoWorkers:  # a cluster whose last worker died: futures never finish
         def nthreads(self):
@@ -384,8 +384,8 @@ def test_11_snapshot_grid_metadata_stays_small(tmp_path):
 
 # 12 -- the IC table is read and hashed once per run, not per chunk
 def test_12_ic_table_is_hashed_once_per_run(tmp_path, monkeypatch):
-    from hhscatter import scene as scene_mod
-    from hhscatter.ics import region_ics
+    from hhscatter.scene import scene as scene_mod
+    from hhscatter.scene.ics import region_ics
 
     ref = Scene(energy=0.3, n=60, seed=3, chunk_size=5)
     states = region_ics(ref, 0, ref.n)

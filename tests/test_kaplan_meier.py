@@ -1,4 +1,4 @@
-"""The one Kaplan–Meier estimator (hhscatter.analysis.kaplan_meier) against library implementations,
+"""The one Kaplan–Meier estimator (hhscatter.analysis.survival.kaplan_meier) against library implementations,
 with weights and streamed, and the other reference checks of the analysis (Wilson intervals)."""
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from hhscatter.analysis.kaplan_meier import KaplanMeierGrid, km_steps, survival_curve, survival_on_grid
+from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid, km_steps, survival_curve, survival_on_grid
 
 
 def _sample(rng, n=3000):
@@ -78,7 +78,7 @@ def test_grid_with_censoring_inside_bins_stays_close_to_the_exact_estimator():
 
 
 def test_wilson_interval_matches_scipy_binomtest():
-    from hhscatter.analysis.escape_check import wilson_interval
+    from hhscatter.analysis.stats.intervals import wilson_interval
 
     for k, n in ((0, 50), (3, 50), (17, 40), (40, 40), (1234, 100000)):
         ci = stats.binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
@@ -90,7 +90,7 @@ def test_wilson_interval_matches_scipy_binomtest():
 def test_weighted_least_squares_matches_scipy_curve_fit():
     from scipy.optimize import curve_fit
 
-    from hhscatter.analysis.least_squares import least_squares_operator, weighted_least_squares
+    from hhscatter.analysis.stats.least_squares import least_squares_operator, weighted_least_squares
 
     rng = np.random.default_rng(5)
     x = np.linspace(0.0, 10.0, 40)
@@ -120,7 +120,7 @@ def test_weighted_least_squares_matches_scipy_curve_fit():
 
 
 def test_power_law_exponent_recovers_one_over_gamma():
-    from hhscatter.analysis.transitions import power_law_exponent, tau2_predicted
+    from hhscatter.analysis.dissipative.transitions import power_law_exponent, tau2_predicted
 
     g = np.array([0.001, 0.002, 0.005, 0.01, 0.02])
     tau = tau2_predicted(0.3, 1 / 6, 0.9, g)
@@ -134,7 +134,7 @@ def test_power_law_exponent_without_errors_takes_its_error_from_the_scatter():
     unweighted and σ_p is the residual-scatter error of a straight line in log–log, checked against curve_fit."""
     from scipy.optimize import curve_fit
 
-    from hhscatter.analysis.transitions import power_law_exponent
+    from hhscatter.analysis.dissipative.transitions import power_law_exponent
 
     g = np.array([0.005, 0.01, 0.02, 0.04])
     tau = 0.5 / g ** 1.05 * np.array([1.01, 0.98, 1.02, 0.99])

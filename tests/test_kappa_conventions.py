@@ -1,4 +1,4 @@
-"""κ(E) under several conventions (hhscatter.analysis.kappa_conventions), on synthetic lifetimes with a known κ."""
+"""κ(E) under several conventions (hhscatter.analysis.survival.kappa_conventions), on synthetic lifetimes with a known κ."""
 import math
 from types import SimpleNamespace
 
@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.escape_rate import escape_rate
-from hhscatter.analysis.kappa_conventions import (
+from hhscatter.analysis.survival.escape_rate import escape_rate
+from hhscatter.analysis.survival.kappa_conventions import (
     escape_rate_p_levels,
     law_spread,
     p_level_windows,
@@ -100,7 +100,7 @@ def test_law_spread_is_half_the_range_across_conventions():
 
 
 def test_quoted_verdict_uses_the_papers_printed_precision():
-    from hhscatter.analysis.verdicts import half_unit, quoted_verdict
+    from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
 
     assert half_unit(0.27) == pytest.approx(0.005) and half_unit(13.63) == pytest.approx(0.005)
     assert half_unit(100.0) == 0.5 and half_unit(1.0) == 0.5

@@ -10,8 +10,8 @@ from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 import numpy as np
 import pytest
 
-from hhscatter.runner import _drain, simulate
-from hhscatter.scene import Scene
+from hhscatter.run.runner import _drain, simulate
+from hhscatter.scene.scene import Scene
 
 
 def test_client_keeps_a_bounded_window_of_tasks():
@@ -84,19 +84,20 @@ def test_simulation_memory_does_not_grow_with_n(tmp_path):
 _READ = """
 import sys
 import numpy as np, pandas, pyarrow.dataset, pyarrow.parquet
-from hhscatter.tables import read_lifetimes, survival_arrays, survival_on_grid
-from hhscatter.analysis.survival import survival_curve
+from hhscatter.api import stream_survival
+from hhscatter.data.tables import read_lifetimes, survival_arrays
+from hhscatter.analysis.survival.fits import survival_curve
 def status(key):
     for line in open('/proc/self/status'):
         if line.startswith(key):
             return int(line.split()[1])
 grid = np.linspace(0, 50, 51)
-read = {'lean': survival_arrays, 'full': read_lifetimes, 'grid': lambda d: survival_on_grid(d, grid)}[sys.argv[2]]
+read = {'lean': survival_arrays, 'full': read_lifetimes, 'grid': lambda d: stream_survival(d, grid)}[sys.argv[2]]
 read(sys.argv[3])  # warm up the reading path (libraries, thread pools) on a one-part dataset
 open('/proc/self/clear_refs', 'w').write('5')  # reset the peak RSS (VmHWM) to the current RSS
 before = status('VmRSS:')
 if sys.argv[2] == 'grid':
-    c = survival_on_grid(sys.argv[1], grid)
+    c = stream_survival(sys.argv[1], grid)
     print(status('VmHWM:') - before, -1, -1, c.P[10])
     sys.exit()
 if sys.argv[2] == 'lean':
@@ -113,7 +114,7 @@ print(extra, int(t.size), int((~obs).sum()), c.P[10])
 @pytest.mark.skipif(not os.access("/proc/self/clear_refs", os.W_OK), reason="needs Linux /proc/self/clear_refs")
 def test_survival_inputs_are_read_with_column_projection(tmp_path):
     """P(t) from survival_arrays / survival_on_grid equals P(t) from the full table, at a fraction of the memory."""
-    from hhscatter.tables import part_name, to_arrow, write_part
+    from hhscatter.data.tables import part_name, to_arrow, write_part
 
     rng = np.random.default_rng(0)
     n_part, parts = 100_000, 4
@@ -154,8 +155,9 @@ def test_survival_inputs_are_read_with_column_projection(tmp_path):
 
 def test_survival_on_grid_equals_kaplan_meier(tmp_path):
     """Streamed counts vs survival_curve (Kaplan–Meier) on the same lifetimes, with ties and censoring at t_max."""
-    from hhscatter.analysis.survival import survival_curve
-    from hhscatter.tables import part_name, survival_on_grid, to_arrow, write_part
+    from hhscatter.analysis.survival.fits import survival_curve
+    from hhscatter.api import stream_survival
+    from hhscatter.data.tables import part_name, to_arrow, write_part
 
     rng = np.random.default_rng(3)
     t_all, obs_all = [], []
@@ -172,8 +174,8 @@ def test_survival_on_grid_equals_kaplan_meier(tmp_path):
         t_all.append(t)
         obs_all.append(outcome != 2)
     g = np.array([0.0, 0.5, 1.0, 2.0, 3.0, 10.0, 20.0, 49.5, 50.0])
-    got = survival_on_grid(tmp_path, g)
+    got = stream_survival(tmp_path, g)
     ref = survival_curve(np.concatenate(t_all), np.concatenate(obs_all), t_grid=g)
     assert np.allclose(got.P, ref.P, rtol=0, atol=1e-15) and np.allclose(got.P_err, ref.P_err, rtol=1e-12)
     with pytest.raises(ValueError, match="censored at t = 50 < max"):
-        survival_on_grid(tmp_path, [1.0, 60.0])
+        stream_survival(tmp_path, [1.0, 60.0])

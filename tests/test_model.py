@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from hhscatter.ics import BLOCK, region_ics
+from hhscatter.scene.ics import BLOCK, region_ics
 from hhscatter.model import HenonHeiles, equations, hamilton_equations
-from hhscatter.scene import Scene
+from hhscatter.scene.scene import Scene
 
 
 @pytest.mark.parametrize("omega,lam", [(1.0, 1.0), (1.3, 0.7)])

@@ -3,8 +3,8 @@ import json
 
 import pytest
 
-from hhscatter.formatting import format_value_err
-from hhscatter.report import build_report
+from hhscatter.publish.formatting import format_value_err
+from hhscatter.publish.report import build_report
 
 
 def _fake_study(root, name, rows, with_figure=True, paper=None):
@@ -69,7 +69,7 @@ def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
 
 
 def test_a_difference_only_in_our_convention_is_not_counted_as_one():
-    from hhscatter.report import verdict_counts
+    from hhscatter.publish.report import verdict_counts
 
     rows = [{"verdict": "differs"}, {"verdict": "differs in our convention only; agrees under the authors' ([0, 100])"},
             {"verdict": "differs in this convention only; within the spread across conventions"},
@@ -79,7 +79,7 @@ def test_a_difference_only_in_our_convention_is_not_counted_as_one():
 
 
 def test_report_header_names_each_studys_commit_and_says_dirty_in_words():
-    from hhscatter.report import Section, commits_line
+    from hhscatter.publish.report import Section, commits_line
 
     secs = [Section(k, k, "", None, {"provenance": {"git_commit": c}}) for k, c in
             (("fig1", "a" * 40 + "-dirty"), ("fig2", "b" * 40), ("fig3", "b" * 40), ("fig4", None))]

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.runner import RunError, simulate
-from hhscatter.scene import Scene, SceneError, SectionWindow, load_scene
-from hhscatter.tables import verify_part
+from hhscatter.run.runner import RunError, simulate
+from hhscatter.scene.scene import Scene, SceneError, SectionWindow, load_scene
+from hhscatter.data.tables import verify_part
 
 TOML = """[scene]
 energy = 0.3
@@ -126,7 +126,7 @@ def test_write_failure_is_clear_and_keeps_finished_parts(tmp_path, monkeypatch, 
     def failing(table, where, **kw):
         calls.append(where)
         if len(calls) == 3:  # the third part file: a partial file, then the error, as a real full disk does
-            if hasattr(where, "write"):  # local parts are written through an open file (hhscatter.tables)
+            if hasattr(where, "write"):  # local parts are written through an open file (hhscatter.data.tables)
                 where.write(b"PAR1 partial")
             else:
                 Path(where).write_bytes(b"PAR1 partial")

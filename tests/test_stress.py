@@ -97,9 +97,9 @@ def test_dissipation_extremes_and_far_radius_small():
 
 def test_far_radius_does_not_change_results():
     """Escape/settle times do not depend on r_far (it only decides when an escaped orbit is dropped)."""
-    from hhscatter.engine import run_chunk
-    from hhscatter.ics import region_ics
-    from hhscatter.scene import Scene
+    from hhscatter.integrate.engine import run_chunk
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import Scene
 
     base = Scene(energy=0.3, gamma=0.05, n=16, seed=3)
     ics = region_ics(base, 0, 16)

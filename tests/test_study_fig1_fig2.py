@@ -15,13 +15,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.escape_rate import (
+from hhscatter.analysis.survival.escape_rate import (
     choose_t_max,
     cmeasure_sample_from_sections,
     escaping_tail,
     fit_exponential,
 )
-from hhscatter.analysis.survival import lifetimes_to_arrays
+from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -172,7 +172,7 @@ def _finite_numbers(obj):
 
 def test_fig1_tiny_end_to_end(tiny_root):
     from hhscatter.studies import load_study
-    from hhscatter.tables import read_sections
+    from hhscatter.data.tables import read_sections
 
     study = load_study("fig1", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 20_000
@@ -241,9 +241,9 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
     """κ(E) under 4 conventions: the square runs are the disk runs with region = 'square' (same n, seed, t_max),
     the P-level windows sit at the P levels of the run's own Kaplan–Meier curve, the law rows use only stable
     energies, and the analysis gives the same numbers twice."""
-    from hhscatter.analysis.survival import lifetimes_to_arrays, survival_curve
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays, survival_curve
     from hhscatter.studies import load_study, run_stage
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     study = load_study("fig2", "tiny", root=tiny_root)
     doc = json.loads(study.numbers_path.read_text())
@@ -274,7 +274,7 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
 
 
 def test_power_law_exponent_mle_recovers_pareto_exponent():
-    from hhscatter.analysis.escape_rate import power_law_exponent_mle
+    from hhscatter.analysis.survival.escape_rate import power_law_exponent_mle
 
     rng = np.random.default_rng(21)
     z, a, t_max = 1.5, 100.0, 5000.0

@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.decay import bootstrap_mu
-from hhscatter.analysis.survival import survival_curve
-from hhscatter.analysis.transitions import (
+from hhscatter.analysis.dissipative.decay import bootstrap_mu
+from hhscatter.analysis.survival.fits import survival_curve
+from hhscatter.analysis.dissipative.transitions import (
     bootstrap_transition_times,
     settle_time_quantiles,
     survival_on_grid,
@@ -49,7 +49,7 @@ def test_bootstrap_mu_exact_exponential_has_no_spread():
 
 def test_bootstrap_mu_error_matches_spread_of_independent_ensembles():
     """The bootstrap σ of μ must match the scatter of μ over independent ensembles (the true sampling error)."""
-    from hhscatter.analysis.decay import fit_energy_decay, mean_energy_arrays
+    from hhscatter.analysis.dissipative.decay import fit_energy_decay, mean_energy_arrays
 
     grid = np.arange(0.0, 200.5, 4.0)
     rng = np.random.default_rng(3)
@@ -66,7 +66,7 @@ def test_bootstrap_mu_error_matches_spread_of_independent_ensembles():
 
 
 def test_pool_mean_energy_equals_statistics_of_the_union():
-    from hhscatter.analysis.decay import mean_energy_arrays, pool_mean_energy
+    from hhscatter.analysis.dissipative.decay import mean_energy_arrays, pool_mean_energy
 
     rng = np.random.default_rng(2)
     t = rng.integers(0, 15, 4000).astype(float)
@@ -119,7 +119,7 @@ def test_bootstrap_transition_times_on_paired_exponentials():
     exact = np.log(2.0) / (kappa - kappa_g)
     grid = np.round(np.arange(0.0, 60.0, 0.05), 9)
     rng = np.random.default_rng(11)
-    from hhscatter.analysis.transitions import tau1
+    from hhscatter.analysis.dissipative.transitions import tau1
 
     pts, calls = [], []
 
@@ -150,7 +150,7 @@ def test_bootstrap_transition_times_on_paired_exponentials():
 
 
 def test_snapshot_grid_pieces():
-    from hhscatter.analysis.decay import snapshot_grid
+    from hhscatter.analysis.dissipative.decay import snapshot_grid
 
     g = snapshot_grid([[0, 2, 0.5], [3, 9, 3]])
     np.testing.assert_array_equal(g, [0, 0.5, 1, 1.5, 2, 3, 6, 9])
@@ -170,7 +170,7 @@ def tiny_root(tiny_studies):
 
 
 def test_fig3_tiny_end_to_end(tiny_root):
-    from hhscatter.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.tables import read_lifetimes, read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     nums = json.loads((out / "fig3.json").read_text())
@@ -238,7 +238,7 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
     """Each μ row of authors_convention is the log fit of a mean computed here from the raw snapshot table: the
     E > E_c mean leaves out exactly the settled-and-continued rows (t > t_end of a settled orbit), the other
     keeps every row; the comparison rows carry the same numbers, flags and the verdict rule."""
-    from hhscatter.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.tables import read_lifetimes, read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     raw = out / "raw" / "e0.3_gamma0.01"
@@ -281,7 +281,7 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
 
 def test_fig3_ribbons_sd_and_sem(tiny_root):
     """Both ribbons from the raw energies: ± 3 SD of E (the paper's) is √n times ± 3 SEM (ours)."""
-    from hhscatter.tables import read_snapshots
+    from hhscatter.data.tables import read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     nums = json.loads((out / "fig3.json").read_text())
@@ -350,7 +350,7 @@ def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path):
 
 
 def test_fig4_tiny_end_to_end(tiny_root):
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     out = tiny_root / "fig4" / "out" / "tiny"
     nums = json.loads((out / "fig4.json").read_text())

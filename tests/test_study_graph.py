@@ -94,7 +94,7 @@ def test_a_new_study_folder_gets_make_rules_without_editing_the_makefile(tmp_pat
 
 
 def test_report_and_docs_nav_list_the_study_folders():
-    from hhscatter.report import collect
+    from hhscatter.publish.report import collect
 
     assert [s.key for s in collect("tiny", STUDIES)] == [s.name for s in graph.studies(STUDIES)]
     spec_path = ROOT / "docs" / "_hooks" / "studies.py"
@@ -167,8 +167,8 @@ def test_the_analysis_layer_is_pure():
     """No heyoka, no engine or runner, no file I/O under hhscatter/analysis: arrays or DataFrames in, results out."""
     import ast
 
-    banned_modules = ("heyoka", "pyarrow", "hhscatter.engine", "hhscatter.runner", "hhscatter.tables",
-                      "hhscatter.store", "hhscatter.studies")
+    banned_modules = ("heyoka", "pyarrow", "hhscatter.integrate.engine", "hhscatter.run.runner", "hhscatter.data.tables",
+                      "hhscatter.data.store", "hhscatter.studies")
     banned_calls = {"open", "read_text", "write_text", "read_bytes", "write_bytes", "read_parquet", "to_parquet",
                     "to_csv", "read_csv", "savefig"}
     for path in sorted((ROOT / "hhscatter" / "analysis").glob("*.py")):

@@ -1,4 +1,4 @@
-"""Tests of the escape-criterion study ``resc`` and of hhscatter.analysis.escape_check.
+"""Tests of the escape-criterion study ``resc`` and of hhscatter.analysis.geometry.channels.
 
 References are independent of the code under test: closed forms (Wilson
 interval), 1-D quadratures of motion along a symmetry axis of the potential,
@@ -13,17 +13,14 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from hhscatter.analysis.escape_check import (
-    channel_fractions,
-    lyapunov_orbit,
-    paired_mle_shift,
-    return_statistics,
-    survival_ratio_slope,
-    wilson_interval,
-)
-from hhscatter.events import CENSORED, ESCAPED
+from hhscatter.analysis.geometry.channels import channel_fractions, lyapunov_orbit, return_statistics
+
+from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
+
+from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.integrate.events import CENSORED, ESCAPED
 from hhscatter.model import HenonHeiles
-from hhscatter.scene import SceneError
+from hhscatter.scene.scene import SceneError
 
 E_C = 1.0 / 6.0
 
@@ -121,8 +118,8 @@ def _time_to_turning(E, a, yt):
 
 def _follow(ics, radii, r_far=10.0, t_max=100.0, r_esc=1.03):
     """The engine's follow mode (batch driver) on these initial conditions: (lifetimes, crossings)."""
-    from hhscatter.engine import run_chunk
-    from hhscatter.scene import Follow, Scene
+    from hhscatter.integrate.engine import run_chunk
+    from hhscatter.scene.scene import Follow, Scene
 
     ics = np.atleast_2d(np.asarray(ics, dtype=float))
     sc = Scene(energy=0.3, n=len(ics), r_esc=r_esc, r_far=r_far, t_max=t_max, follow=Follow(tuple(radii)))
@@ -183,9 +180,9 @@ def test_follow_matches_the_scalar_reference_and_plain_escape_times():
     # the batch follow mode against the scalar driver in long double (same events, independent
     # precision), and its escape times against a plain run (follow compiles more events, which
     # enter step-size control, so only short orbits agree to rounding)
-    from hhscatter.engine import run_chunk, simulate_orbit
-    from hhscatter.ics import region_ics
-    from hhscatter.scene import Follow, Scene
+    from hhscatter.integrate.engine import run_chunk, simulate_orbit
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import Follow, Scene
 
     sc = Scene(energy=0.3, n=120, seed=5, r_esc=1.03, t_max=200.0, follow=Follow((1.0, 1.03, 1.5)))
     ics = region_ics(sc, 0, sc.n)

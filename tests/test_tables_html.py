@@ -59,7 +59,7 @@ def _summaries(root: Path):
 
 
 def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
-    from hhscatter.report import build_report
+    from hhscatter.publish.report import build_report
 
     root = tmp_path / "studies"
     _summaries(root)
@@ -79,7 +79,7 @@ def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
     tables = assert_rows_match_headers(res["html"].read_text(), at_least=6)
     assert [6, 6] in tables and [6] * 4 in tables  # the comparison tables: study, quantity, ours, paper, verdict, note
     # the Markdown report is the same text: Python-Markdown renders it with the same cells
-    from hhscatter.formatting import markdown_to_html
+    from hhscatter.publish.formatting import markdown_to_html
 
     assert_rows_match_headers(markdown_to_html(res["markdown"].read_text()), at_least=6)
 

@@ -1,4 +1,4 @@
-"""Transfer operators (hhscatter.analysis.transfer) on exact cases: open maps with closed-form escape rates and
+"""Transfer operators (hhscatter.analysis.geometry.transfer) on exact cases: open maps with closed-form escape rates and
 conditionally invariant densities, the true-time root of a two-state chain, the time-binned propagation of a
 renewal process, and the Perron-vector conventions."""
 import math
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from hhscatter.analysis import transfer as tf
+from hhscatter.analysis.geometry import transfer as tf
 
 
 def _ulam_1d(f, n_boxes, m):

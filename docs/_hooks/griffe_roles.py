@@ -3,7 +3,7 @@
 The package's docstrings are plain prose written for ``help()``; rendered as
 Markdown three things went wrong, and this extension rewrites them:
 
-* Sphinx roles (``:func:`survival_curve```, ``:mod:`hhscatter.tables```):
+* Sphinx roles (``:func:`survival_curve```, ``:mod:`hhscatter.data.tables```):
   Markdown has no roles, so they become inline code. Names are not turned
   into links: an unresolvable cross-reference would be a warning, and the
   docs build is strict.

@@ -10,7 +10,7 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
     <!-- hh:bench stress -->         docs/benchmarks/assets/stress/*summary.md (+ figures)
     <!-- hh:cli -->                  every subcommand and flag of `hhscatter`
-    <!-- hh:schemas -->              the Parquet schemas of hhscatter.tables
+    <!-- hh:schemas -->              the Parquet schemas of hhscatter.data.tables
 
 The "Studies" section of the navigation is made from the study folders
 (``studies/<name>/study.toml``, table ``[about]``) by ``on_config``: a new
@@ -32,34 +32,34 @@ _MARKER = re.compile(r"^<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->\s*$", re.M)
 _SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
 
 
-# -- number formatting: hhscatter.formatting, shared with the report and the figures ---------------------
+# -- number formatting: hhscatter.publish.formatting, shared with the report and the figures ---------------------
 def _is_num(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
 def fmt_num(v, sig: int = 4) -> str:
     """fmt_num(v) -> v with ``sig`` significant digits (a×10<sup>b</sup> outside [1e-3, 1e5))."""
-    from hhscatter.formatting import format_number
+    from hhscatter.publish.formatting import format_number
 
     return format_number(v, sig, html=True)
 
 
 def fmt_err(v, err) -> str:
-    """fmt_err(v, err) -> "v ± err" rounded to the uncertainty (hhscatter.formatting.format_value_err)."""
-    from hhscatter.formatting import format_value_err
+    """fmt_err(v, err) -> "v ± err" rounded to the uncertainty (hhscatter.publish.formatting.format_value_err)."""
+    from hhscatter.publish.formatting import format_value_err
 
     return format_value_err(v, err)
 
 
 def fmt_value(v) -> str:
     """fmt_value(v) -> Markdown for one JSON value ({value, err} or {value, lo, hi} dicts, short lists, scalars)."""
-    from hhscatter.formatting import format_value
+    from hhscatter.publish.formatting import format_value
 
     return format_value(v, html=True)
 
 
 def _cell(s) -> str:
-    from hhscatter.formatting import md_cell
+    from hhscatter.publish.formatting import md_cell
 
     return md_cell(s)
 
@@ -83,7 +83,7 @@ class Renderer:
         return f'!!! warning "Not yet generated"\n    {what} is not in the docs yet. {how}\n'
 
     def study_asset(self, name: str, ext: str, scale: str = "quick") -> Path:
-        from hhscatter.report import committed_assets
+        from hhscatter.publish.report import committed_assets
 
         return committed_assets(self.root / "studies", scale) / f"{name}.{ext}"
 
@@ -141,7 +141,7 @@ class Renderer:
 
     def _both_scales(self, quick_rows, paper_rows) -> str:
         """The paper-vs-ours rows at both scales in one table, matched by quantity."""
-        from hhscatter.formatting import format_value, ours_cell
+        from hhscatter.publish.formatting import format_value, ours_cell
 
         def ours(r):
             return "—" if r is None else ours_cell(r)
@@ -340,7 +340,7 @@ class Renderer:
         return cli_reference(build_parser())
 
     def schemas(self, _arg=None) -> str:
-        from hhscatter.tables import _schemas
+        from hhscatter.data.tables import _schemas
 
         out = []
         for name, schema in _schemas().items():
@@ -387,15 +387,15 @@ def _indent(text: str, n: int = 4) -> str:
 
 def comparison_table(rows) -> str:
     """Markdown table of paper-vs-ours rows {quantity, ours, err, paper, unit, verdict, note}."""
-    from hhscatter.formatting import comparison_table as table
+    from hhscatter.publish.formatting import comparison_table as table
 
     return table(rows)
 
 
 def _embed_markdown(text: str, assets: Path, rel) -> str:
     """A summary written for its own folder, embedded in a page: headings demoted, links re-based,
-    ``|x|`` inside table cells escaped, plain-text tables fenced (hhscatter.formatting.embed_markdown)."""
-    from hhscatter.formatting import embed_markdown
+    ``|x|`` inside table cells escaped, plain-text tables fenced (hhscatter.publish.formatting.embed_markdown)."""
+    from hhscatter.publish.formatting import embed_markdown
 
     text = embed_markdown(text)
 

@@ -16,7 +16,7 @@ kind  g                       ġ
 2     x px + y py             |p|² + x fx + y fy   (section ṙ = 0)
 ====  ======================  =====================================
 
-Outcome codes follow :mod:`hhscatter.engine`: 0 escaped, 1 settled,
+Outcome codes follow :mod:`hhscatter.integrate.engine`: 0 escaped, 1 settled,
 2 censored; 3 = "section found" (section mode), −1 = inconsistent end (an
 orbit reached r_far without a recorded outward r_esc crossing).
 """

@@ -2,7 +2,7 @@
 
 All peers integrate the same Hénon–Heiles system (ω = λ = 1, paper
 Eq. (eqn:hh_ham), drag −γp) from the same initial conditions with the
-engine's escape rules (:mod:`hhscatter.engine`), and return the same arrays:
+engine's escape rules (:mod:`hhscatter.integrate.engine`), and return the same arrays:
 ``PeerResult(outcome, t_end, state_end, n_steps)``.
 
 * :func:`kahanli8` — the paper's conservative integrator (App. "Integrators":
@@ -25,7 +25,7 @@ engine's escape rules (:mod:`hhscatter.engine`), and return the same arrays:
   runs; DOP853 is the compiled adaptive high-order RK offered by the issue.
 * :func:`scipy_dop853` — ``scipy.integrate.solve_ivp(method="DOP853")`` with
   terminal events (pure Python overhead; run on a subset).
-* :func:`engine` — hhscatter's batch Taylor engine (:func:`hhscatter.engine.run_chunk`).
+* :func:`engine` — hhscatter's batch Taylor engine (:func:`hhscatter.integrate.engine.run_chunk`).
 
 numba is a benchmark-only dependency (extra ``bench``); it is imported on
 first use only.
@@ -86,7 +86,7 @@ def kahanli8_coefficients():
 
 def _kernels():
     try:
-        from . import _kernels as k
+        from hhscatter.bench import _kernels as k
     except ImportError as exc:  # numba missing
         raise ImportError(
             "the benchmark peers need numba: pip install -e '.[bench]' (or `make bench`)"
@@ -228,14 +228,14 @@ def scipy_dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0) -
 def engine(ics, tol, *, gamma=0.0, energy=None, r_esc=1.03, t_max=5000.0, batch_size=4, section=False) -> PeerResult:
     """engine(ics, tol, gamma=0, energy=None, ..., batch_size=4, section=False) -> PeerResult.
 
-    hhscatter's engine (:func:`hhscatter.engine.run_chunk`) on these ICs in one
+    hhscatter's engine (:func:`hhscatter.integrate.engine.run_chunk`) on these ICs in one
     process. ``section=True`` records the first section crossing (window
     ``first_only``); its outcome is then 3 where a crossing was found and the
     state/time are the crossing's.
     """
-    from ..engine import run_chunk
-    from ..model import HenonHeiles
-    from ..scene import Scene, SectionWindow
+    from hhscatter.integrate.engine import run_chunk
+    from hhscatter.model import HenonHeiles
+    from hhscatter.scene.scene import Scene, SectionWindow
 
     ics = _check_ics(ics)
     if energy is None:

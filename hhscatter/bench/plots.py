@@ -14,7 +14,7 @@ def plot_workprecision(csv_path, png_path):
     """
     import pandas as pd
 
-    from ..plotting import agg_pyplot
+    from hhscatter.publish.figures import agg_pyplot
 
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)
@@ -57,7 +57,7 @@ def plot_energy_drift(csv_path, png_path):
     """plot_energy_drift(csv, png) -> png path: max relative energy error vs t per tolerance (log–log)."""
     import pandas as pd
 
-    from ..plotting import agg_pyplot
+    from hhscatter.publish.figures import agg_pyplot
 
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)

@@ -3,8 +3,8 @@
 :func:`reference_orbits` integrates each orbit alone on heyoka's scalar Taylor
 integrator in ``numpy.longdouble`` (64-bit mantissa, ε ≈ 1.1e-19) or
 ``heyoka.real128`` (ε ≈ 1.9e-34), with exact (Taylor-polynomial) event
-location and the engine's events and rules (:mod:`hhscatter.events`), through
-the engine's scalar driver :func:`hhscatter.engine.simulate_orbit`:
+location and the engine's events and rules (:mod:`hhscatter.integrate.events`), through
+the engine's scalar driver :func:`hhscatter.integrate.engine.simulate_orbit`:
 
 * conservative: escape at the first outward crossing of r = r_esc;
 * dissipative: closure at H = E_c (settled if r ≤ r_s, else escaped at the
@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..engine import CENSORED, ESCAPED, SETTLED, STOPPED, simulate_orbit
-from ..model import HenonHeiles
-from ..scene import Scene, SectionWindow
+from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, STOPPED, simulate_orbit
+from hhscatter.model import HenonHeiles
+from hhscatter.scene.scene import Scene, SectionWindow
 
 SECTION = STOPPED  # outcome of ``section=True``: stopped at the first section crossing
 
@@ -31,8 +31,8 @@ def reference_orbit(ic, *, gamma=0.0, r_esc=1.03, t_max=5000.0, fp_type=np.longd
     """reference_orbit(ic, gamma=0, r_esc=1.03, t_max=5000, fp_type=longdouble, tol=None, section=False)
     -> (outcome, t_end, state_end (4,), n_steps).
 
-    The engine's scalar driver :func:`hhscatter.engine.simulate_orbit` (same
-    events and rules, :mod:`hhscatter.events`) in ``fp_type``. ``tol``
+    The engine's scalar driver :func:`hhscatter.integrate.engine.simulate_orbit` (same
+    events and rules, :mod:`hhscatter.integrate.events`) in ``fp_type``. ``tol``
     defaults to heyoka's default for ``fp_type`` (its epsilon).
     ``section=True`` stops at the first section crossing (outcome
     ``SECTION``) and returns its state.

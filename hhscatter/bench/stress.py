@@ -1,7 +1,7 @@
 """Numerical stress tests of the engine (``make stress``, issue 5).
 
 Each case is a function that takes its size as arguments, runs the engine
-(:func:`hhscatter.engine.run_chunk` or :func:`hhscatter.runner.simulate`)
+(:func:`hhscatter.integrate.engine.run_chunk` or :func:`hhscatter.run.runner.simulate`)
 and an independent reference (heyoka long double, :mod:`.reference`), and
 returns a :class:`CaseResult` (table rows, a one-line finding, and ``ok``:
 whether the case's acceptance rule holds). ``tests/test_stress.py`` calls the
@@ -35,10 +35,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..engine import CENSORED, ESCAPED, SETTLED, run_chunk
-from ..model import HenonHeiles
-from ..scene import Scene, SectionWindow
-from .reference import reference_orbits
+from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk
+from hhscatter.model import HenonHeiles
+from hhscatter.scene.scene import Scene, SectionWindow
+from hhscatter.bench.reference import reference_orbits
 
 MODEL = HenonHeiles()
 E_C = MODEL.critical_energy
@@ -71,14 +71,14 @@ def _run(ics, *, tol, energy=None, gamma=0.0, t_max=5000.0, r_esc=1.03, r_far=No
 
 
 def _disk_ics(energy, n, seed, gamma=0.0):
-    from ..ics import region_ics
+    from hhscatter.scene.ics import region_ics
 
     return region_ics(Scene(energy=energy, gamma=gamma, n=n, seed=seed), 0, n)
 
 
 def backward(state, T):
     """backward(state, T) -> float64 state at time −T (long double, conservative, no events)."""
-    from ..engine import state_at
+    from hhscatter.integrate.engine import state_at
 
     return np.asarray(state_at(Scene(energy=0.3, n=1), state, -T, fp_type=np.longdouble), dtype=float)
 
@@ -97,7 +97,7 @@ def kam_trapped_ics(energy=0.2, n_want=8, n_try=600, seed=4, t_sel=5000.0):
 
 @functools.lru_cache(maxsize=8)
 def _kam_trapped(energy, n_want, n_try, seed, t_sel):
-    from ..ics import region_ics
+    from hhscatter.scene.ics import region_ics
 
     ics = region_ics(Scene(energy=energy, n=n_try, seed=seed, region="well"), 0, n_try)
     res = _run(ics, tol=1e-15, energy=energy, t_max=t_sel)
@@ -358,7 +358,7 @@ def reference_section_times(ic, t_max, r_esc=1.03):
     The engine's scalar driver in long double (tolerance its epsilon, ~1e-19),
     with every crossing recorded (no window).
     """
-    from ..engine import simulate_orbit
+    from hhscatter.integrate.engine import simulate_orbit
 
     sc = Scene(energy=0.3, n=1, r_esc=r_esc, t_max=t_max, sections=SectionWindow())
     res = simulate_orbit(sc, ic, fp_type=np.longdouble)
@@ -414,7 +414,7 @@ def case_section_skim(etas=(1e-2, 1e-5, 1e-8, 1e-11, 1e-13, -1e-13, -1e-11, -1e-
 
 def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3, 1e8), r_far_gamma=1e-1,
                               n_ref=20, t_max=5000.0, seed=6, tol=1e-15):
-    """case_dissipation_extremes(...) -> CaseResult: runs through :func:`hhscatter.runner.simulate` and its Parquet tables.
+    """case_dissipation_extremes(...) -> CaseResult: runs through :func:`hhscatter.run.runner.simulate` and its Parquet tables.
 
     Acceptance: every float column of every table is finite; outcomes valid;
     settled orbits end at H = E_c within 1e-12; escaped orbits have
@@ -423,8 +423,8 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
     (at γ = r_far_gamma) follows escaping orbits towards their finite-time
     blow-up before they are stopped.
     """
-    from ..runner import simulate
-    from ..tables import read_lifetimes
+    from hhscatter.run.runner import simulate
+    from hhscatter.data.tables import read_lifetimes
 
     cases = [(g, None) for g in gammas] + [(r_far_gamma, rf) for rf in r_fars if rf is not None]
     rows, ok = [], True
@@ -440,7 +440,7 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
                 err = f"{type(exc).__name__}: {exc}"
             wall = time.perf_counter() - t0
             if err is None:
-                from ..tables import read_sections, read_snapshots
+                from hhscatter.data.tables import read_sections, read_snapshots
 
                 lt = read_lifetimes(d)
                 tabs = {"lifetimes": lt, "sections": read_sections(d), "snapshots": read_snapshots(d)}
@@ -457,7 +457,7 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
         rise = float((ee[esc] - e0[esc]).max()) if esc.any() else math.nan
         ids = lt["traj_id"].to_numpy()
         order = np.argsort(ids)[:n_ref]
-        from ..ics import region_ics
+        from hhscatter.scene.ics import region_ics
 
         # the reference stops at the default r_far: an escaped orbit never returns, so the
         # outcome and the escape time (last outward r_esc crossing) do not depend on r_far
@@ -490,7 +490,7 @@ def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0
     """case_statistics(...) -> CaseResult: P(t) at two tolerances on the same ICs.
 
     Conservative E = 0.27: two-sample KS test of the escape times, κ by
-    maximum likelihood (:func:`hhscatter.analysis.escape_rate.escape_rate_mle`)
+    maximum likelihood (:func:`hhscatter.analysis.survival.escape_rate.escape_rate_mle`)
     on ``cons_window``, and the fraction of orbits whose t_end differ by more
     than 1e-6 relative. Dissipative E0 = 0.3, γ = 0.01: KS of t_end and the
     fraction of outcomes that differ. Acceptance: KS p > 0.01 and
@@ -498,7 +498,7 @@ def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0
     """
     from scipy.stats import ks_2samp
 
-    from ..analysis.escape_rate import escape_rate_mle
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 
     rows, ok = [], True
     for kind, E, g, nn in (("conservative", 0.27, 0.0, n), ("dissipative", 0.3, diss_gamma, n_diss)):
@@ -530,12 +530,12 @@ def case_cmeasure_distance(n=100000, tols=(1e-12, 1e-15), energy=0.35, gamma=0.0
 
     The dissipative ensemble of study fig5 (E2 = 0.35, γ = 0.01): position of
     each survivor's first section crossing after t* ≈ 17 (paper). The sliced
-    Wasserstein distance (:func:`hhscatter.analysis.distance.sliced_wasserstein`)
+    Wasserstein distance (:func:`hhscatter.analysis.geometry.distance.sliced_wasserstein`)
     between the sets at tol 1e-12 and 1e-15 is compared with the split-half
     noise of the 1e-15 set (mean over ``n_splits`` random halves). Acceptance:
     distance between tolerances < split-half noise.
     """
-    from ..analysis.distance import sliced_wasserstein
+    from hhscatter.analysis.geometry.distance import sliced_wasserstein
 
     ics = _disk_ics(energy, n, seed, gamma)
     sets, ids = [], []
@@ -585,8 +585,8 @@ def main(argv=None):
 
     import pandas as pd
 
-    from .config import load_config, machine_note, out_dir
-    from .plots import plot_energy_drift
+    from hhscatter.bench.config import load_config, machine_note, out_dir
+    from hhscatter.bench.plots import plot_energy_drift
 
     ap = argparse.ArgumentParser(description="hhscatter numerical stress tests (make stress)")
     ap.add_argument("--scale", default="full")

@@ -21,9 +21,9 @@ def _warm(scene_json):
     """Pool initializer: compile the scene's integrator in this process (outside the timing)."""
     import json
 
-    from ..engine import run_chunk
-    from ..ics import region_ics
-    from ..scene import scene_from_dict
+    from hhscatter.integrate.engine import run_chunk
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import scene_from_dict
 
     sc = scene_from_dict(json.loads(scene_json))
     run_chunk(sc, region_ics(sc, 0, 16), np.arange(16))
@@ -37,9 +37,9 @@ def _hold(seconds):
 def _chunk(scene_json, start, stop):
     import json
 
-    from ..engine import run_chunk
-    from ..ics import region_ics
-    from ..scene import scene_from_dict
+    from hhscatter.integrate.engine import run_chunk
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import scene_from_dict
 
     sc = scene_from_dict(json.loads(scene_json))
     ics = region_ics(sc, start, stop)
@@ -71,8 +71,8 @@ def measure_throughput(cfg, *, progress=True):
     """measure_throughput(cfg) -> DataFrame, one row per (scene, workers)."""
     import pandas as pd
 
-    from ..runner import default_workers
-    from ..scene import Scene
+    from hhscatter.run.runner import default_workers
+    from hhscatter.scene.scene import Scene
 
     tp = cfg["throughput"]
     b = cfg["bench"]

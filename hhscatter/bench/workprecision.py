@@ -1,7 +1,7 @@
 """Work–precision of hhscatter's engine against the paper's integrators (``make bench``, issue 5).
 
 Two scenes, the same initial conditions for every method (disk ICs of
-:mod:`hhscatter.ics`, fixed seed) and the same escape rule:
+:mod:`hhscatter.scene.ics`, fixed seed) and the same escape rule:
 
 * conservative, E = 0.27 (paper Fig. 2a): escape at r = r_esc;
 * dissipative, E0 = 0.3, γ = 0.01 (paper Figs. 3–4): closure at E_c, escape
@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import peers
-from .config import load_config, machine_note, out_dir
+from hhscatter.bench import peers
+from hhscatter.bench.config import load_config, machine_note, out_dir
 
 SHORT_T = 20.0
 
@@ -58,9 +58,9 @@ class Method:
 
 
 def scene_ics(energy, gamma, n, seed):
-    """scene_ics(E0, γ, n, seed) -> array (n, 4) of disk ICs (the engine's, :func:`hhscatter.ics.region_ics`)."""
-    from ..ics import region_ics
-    from ..scene import Scene
+    """scene_ics(E0, γ, n, seed) -> array (n, 4) of disk ICs (the engine's, :func:`hhscatter.scene.ics.region_ics`)."""
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import Scene
 
     return region_ics(Scene(energy=energy, gamma=gamma, n=n, seed=seed), 0, n)
 
@@ -117,7 +117,7 @@ def _key(ics, **kw):
 
 def cached_reference(ics, cache_dir, *, progress=False, **kw):
     """cached_reference(ics, cache_dir, **kw of reference_orbit) -> dict of arrays (cached as .npz by content hash)."""
-    from .reference import reference_orbits
+    from hhscatter.bench.reference import reference_orbits
 
     path = cache_dir / f"ref_{_key(ics, **{k: str(v) for k, v in kw.items()})}.npz"
     if path.exists():
@@ -365,7 +365,7 @@ def summary_markdown(df, checks, ratios, pratios, note_start, note_end, seconds,
         L.append(f"| {r.scene} | {r.peer} | {_fmt(r.peer_err)} | {r.peer_us:.1f} | {r.engine} | {_fmt(r.engine_err)} |"
                  f" {r.engine_us:.1f} | {r.ratio:.2f} |")
     if throughput is not None:
-        from .throughput import throughput_markdown
+        from hhscatter.bench.throughput import throughput_markdown
 
         L += ["", throughput_markdown(throughput, cfg)]
     return "\n".join(L) + "\n"
@@ -375,8 +375,8 @@ def main(argv=None):
     """``python -m hhscatter.bench [--scale full|tiny] [--root DIR] [--no-throughput]``: writes CSV, PNG, summary.md."""
     import argparse
 
-    from .plots import plot_workprecision
-    from .throughput import measure_throughput
+    from hhscatter.bench.plots import plot_workprecision
+    from hhscatter.bench.throughput import measure_throughput
 
     ap = argparse.ArgumentParser(description="hhscatter work–precision benchmark (make bench)")
     ap.add_argument("--scale", default="full", help="full (default) or tiny")

@@ -14,7 +14,7 @@ The stages make runs as separate targets:
 
 ``simulate(study, workers)``
     integrates the study's scenes into immutable raw run directories
-    ``studies/<name>/out/<scale>/raw/<key>/`` (Parquet, see :mod:`hhscatter.tables`);
+    ``studies/<name>/out/<scale>/raw/<key>/`` (Parquet, see :mod:`hhscatter.data.tables`);
 ``analyze(study)``
     turns raw tables into derived tables under ``.../derived/`` and the study's
     numbers ``.../<name>.json`` with the pure functions of :mod:`hhscatter.analysis`;
@@ -49,10 +49,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..scene import Scene, SceneError, scene_from_dict
-from .cost import meter, record
-from .graph import HEADER_TABLES, GraphError, StudyInfo, study_info
-from .graph import default_root as _graph_default_root
+from hhscatter.scene.scene import Scene, SceneError, scene_from_dict
+from hhscatter.studies.cost import meter, record
+from hhscatter.studies.graph import HEADER_TABLES, GraphError, StudyInfo, study_info
+from hhscatter.studies.graph import default_root as _graph_default_root
 
 STAGES = ("simulate", "analyze", "plot")
 DEFAULT_SCALE = "quick"
@@ -86,7 +86,7 @@ _OWN_MODULES = ("graph", "_upstream")
 
 def study_names(root: Path | None = None) -> list[str]:
     """study_names(root=None) -> names of the study folders (with a study.toml), each after the studies it needs."""
-    from .graph import studies
+    from hhscatter.studies.graph import studies
 
     try:
         return [s.name for s in studies(root if root is not None else studies_root())]
@@ -133,7 +133,7 @@ class Study:
     info: StudyInfo | None = None
     orbits_run: int = 0       # orbits integrated by this process's run() calls (the cost record)
     chunks_resumed: int = 0   # chunks found complete and kept by run()
-    params_model: type | None = None  # the study's Params (hhscatter.config.StudyParams) of its [study] table
+    params_model: type | None = None  # the study's Params (hhscatter.scene.schema.StudyParams) of its [study] table
     raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
     params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
 
@@ -185,7 +185,7 @@ class Study:
     @property
     def model(self):
         """The Hénon–Heiles model of the study's ``[scene]`` (ω, λ): E_c, saddles, potential."""
-        from ..model import HenonHeiles
+        from hhscatter.model import HenonHeiles
 
         sc = self.config.get("scene", {})
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
@@ -224,7 +224,7 @@ class Study:
         interrupted one resumed; a run of a different scene (the study file
         changed) is replaced.
         """
-        from ..runner import SCENE_FILE, simulate
+        from hhscatter.run.runner import SCENE_FILE, simulate
 
         out = self.raw(key)
         resume, overwrite = False, False
@@ -280,7 +280,7 @@ class Study:
 
     def write_numbers(self, numbers: dict) -> Path:
         """Write the study's numbers JSON (with its comparisons, scale and provenance)."""
-        from ..tables import provenance
+        from hhscatter.data.tables import provenance
 
         doc = {"study": self.name, "scale": self.scale, **numbers,
                "paper_comparison": list(self.comparisons), "config": self.config,
@@ -299,7 +299,7 @@ class Study:
         """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""
         import pyarrow as pa
 
-        from ..tables import provenance, write_part
+        from hhscatter.data.tables import provenance, write_part
 
         table = pa.Table.from_pandas(df, preserve_index=False)
         doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
@@ -310,7 +310,7 @@ class Study:
     def write_table_streamed(self, tables, fname: str, **meta) -> Path:
         """write_table_streamed(iterable of Arrow tables, fname, **meta) -> path: a derived table too large to hold
         at once (e.g. one part per γ of 1e7 rows), written part by part with the study's metadata."""
-        from ..tables import provenance, write_parts_streamed
+        from hhscatter.data.tables import provenance, write_parts_streamed
 
         doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
         path = self.derived(fname)
@@ -323,7 +323,7 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
-        from ..config import did_you_mean
+        from hhscatter.scene.schema import did_you_mean
 
         known = sorted(p.parent.name for p in root.glob("*/study.toml"))
         raise SceneError(f"study must be one of {known}, got {name!r}{did_you_mean(name, known)}")
@@ -332,7 +332,7 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path} is not valid TOML: {exc}") from None
     params = _params_model(name, root)
-    from ..config import apply_convention, merge_tables, validate_study_file
+    from hhscatter.scene.schema import apply_convention, merge_tables, validate_study_file
 
     validate_study_file(doc, _shown(path), params)  # every table, key and type, at every scale, before any work
     if "convention" in doc:  # the shared scene keys (studies/conventions.toml) under the study's own [scene]
@@ -364,7 +364,7 @@ def conventions_path(root: Path | None = None) -> Path:
 
 def load_conventions(path: Path | None = None) -> dict:
     """load_conventions(path=None) -> {name: {scene key: value}} of the conventions file, strictly checked."""
-    from ..config import validate_conventions_file
+    from hhscatter.scene.schema import validate_conventions_file
 
     path = Path(path) if path is not None else conventions_path()
     try:
@@ -476,7 +476,7 @@ def checked_raw_runs(study) -> dict:
     is incomplete or now holds another scene. A study without raw runs (one that reads only upstream
     outputs) passes.
     """
-    from ..tables import run_status
+    from hhscatter.data.tables import run_status
 
     raw = study.out / "raw"
     done = raw / "done.json"
@@ -521,7 +521,7 @@ def _run_one(study, mod, st, name, scale, workers, progress):
                                  "runs": study.raw_runs})
         print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
     elif st == "analyze":
-        from ._upstream import UpstreamError, dev_fallback_enabled
+        from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
 
         missing = [] if dev_fallback_enabled() else missing_upstream(study)
         if missing:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import os
 
-from ..scene import SceneError
+from hhscatter.scene.scene import SceneError
 
 DEV_ENV = "HHSCATTER_DEV_FALLBACK"
 DEV_SOURCE = "paper fallback (DEVELOPMENT ONLY)"
@@ -100,7 +100,7 @@ def table(study, other: str, name: str, filters=None, columns=None):
     """
     import pandas as pd
 
-    from . import load_study
+    from hhscatter.studies import load_study
 
     try:
         o = load_study(other, study.scale, root=study.root.parent)

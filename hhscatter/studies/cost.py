@@ -75,7 +75,7 @@ def meter(stage: str, workers=None):
 
 def record(out: Path, cost: StageCost) -> Path:
     """record(out, cost) -> path of ``out/cost.json`` after appending ``cost`` to its stage's invocations."""
-    from . import write_json_atomic
+    from hhscatter.studies import write_json_atomic
 
     path = Path(out) / COST_FILE
     doc = json.loads(path.read_text()) if path.exists() else {}

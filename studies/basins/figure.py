@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot
 
 #: colour per outcome code 0, 1, 2 (exit channels), 3 (settled), 4 (trapped); forbidden cells white
 COLORS = ("#d7301f", "#2171b5", "#238b45", "#fdb863", "#3f3f3f")

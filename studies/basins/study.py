@@ -7,20 +7,20 @@ on the standard figures of chaotic scattering (Aguirre, Vallejo & Sanjuán,
 PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
 
 1. **Basin maps.** Initial conditions on the section ṙ = 0, φ̇ > 0 at E0
-   (:func:`hhscatter.ics.section_grid`, tangential velocities) on a regular
+   (:func:`hhscatter.scene.ics.section_grid`, tangential velocities) on a regular
    grid over the authors' square [−1, 1]²; each cell coloured by its outcome
    (exit channel 0/1/2, settled, trapped at t_max), from the engine's exact
    event outcomes with r_esc = 1.5 (beyond every exit's Lyapunov orbit, study
    resc). Two magnifications of one boundary region, centred on the most
    mixed cell of the γ = 0 map.
-2. **Measures** per (E0, γ) (:mod:`hhscatter.analysis.basins`): basin
+2. **Measures** per (E0, γ) (:mod:`hhscatter.analysis.geometry.basins`): basin
    fractions (Wilson), basin entropy S_b and boundary basin entropy S_bb over
    box sizes with the log 2 test, the Wada merging test, and the uncertainty
    exponent α from f(ε), the fraction of initial conditions whose outcome
    changes under a shift ε of x (fresh initial conditions at each ε, down to
    ε = 1e-9: exact event times and tol 1e-15 resolve it); d = 2 − α.
 3. **The paper's cut-off.** A broken power law against the single one for
-   f(ε) (:func:`~hhscatter.analysis.basins.uncertainty_cutoff`): ε_c(γ) or an
+   f(ε) (:func:`~hhscatter.analysis.geometry.basins.uncertainty_cutoff`): ε_c(γ) or an
    upper bound; and the lifetimes of the orbits that decide the outcome at
    the smallest ε, against τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1, the
    late-time exponent of study fig3).
@@ -35,7 +35,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.config import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 
 SETTLED_CODE, TRAPPED_CODE, OUTSIDE = 3, 4, -1
 CODES = (0, 1, 2, SETTLED_CODE, TRAPPED_CODE)
@@ -142,14 +142,14 @@ def _run_table(study, key, states, gamma, workers, progress):
 
 
 def _map_states(study, E, extent, n):
-    from hhscatter.ics import section_grid
+    from hhscatter.scene.ics import section_grid
 
     return section_grid(study.model, E, extent, (n, n))
 
 
 def _uncertainty_states(study, E, i, eps, n=None, seed_offset=0):
     """Fresh reference ICs for ε index i (uniform on the allowed square) and their copies shifted by ε in x."""
-    from hhscatter.ics import perturbed_on_section, region_ics
+    from hhscatter.scene.ics import perturbed_on_section, region_ics
 
     n = int(study.param("n_uncertainty")) if n is None else int(n)
     seed = int(study.config["scene"]["seed"]) * 100 + seed_offset + i
@@ -169,7 +169,7 @@ def zoom_centre(labels, extent, box=5, clearance=0):
     """
     from scipy import ndimage
 
-    from hhscatter.analysis.basins import basin_entropy
+    from hhscatter.analysis.geometry.basins import basin_entropy
 
     ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
     nr, nc = labels.shape[0] // box, labels.shape[1] // box
@@ -208,7 +208,7 @@ def _zoom_extent(extent, centre, factor):
 
 def basin_image(study, key, E, extent, n):
     """basin_image(study, key, E, extent, n) -> (n, n) int8 outcome codes (−1 forbidden) of a map run."""
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     _, _, allowed, _, cell = _map_states(study, E, extent, n)
     lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "exit_channel"])
@@ -251,8 +251,8 @@ def _ve(v, e):
 def _uncertainty(study, E, g, eps, keys=None, times=None):
     """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
     the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ)."""
-    from hhscatter.analysis.basins import uncertainty_fraction
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.analysis.geometry.basins import uncertainty_fraction
+    from hhscatter.data.tables import read_lifetimes
 
     rows = []
     keys = [unc_key(E, g, i) for i in range(len(eps))] if keys is None else keys
@@ -273,7 +273,7 @@ def _uncertainty(study, E, g, eps, keys=None, times=None):
 
 def analyze(study):
     """analyze(study) -> None: derived tables (maps, entropies, f(ε)) and basins.json."""
-    from hhscatter.analysis.basins import (
+    from hhscatter.analysis.geometry.basins import (
         basin_entropy_table,
         basin_fractions,
         local_exponent,
@@ -282,7 +282,7 @@ def analyze(study):
         uncertainty_exponent,
         wada_merging,
     )
-    from hhscatter.analysis.escape_check import channel_fractions
+    from hhscatter.analysis.geometry.channels import channel_fractions
 
     extent = tuple(float(v) for v in study.param("extent"))
     n = int(study.param("grid"))
@@ -428,8 +428,8 @@ def _wada_dict(w, basins):
 
 
 def _rate(eps, times):
-    """λ from the pairs' decision times (:func:`hhscatter.analysis.basins.decision_rate`), or None."""
-    from hhscatter.analysis.basins import decision_rate
+    """λ from the pairs' decision times (:func:`hhscatter.analysis.geometry.basins.decision_rate`), or None."""
+    from hhscatter.analysis.geometry.basins import decision_rate
 
     try:
         r = decision_rate(eps, times)
@@ -440,7 +440,7 @@ def _rate(eps, times):
 
 def _energy_scan(study, extent, boxes, hb, E_b):
     """γ = 0 energy scan (issue 25, point 5): per E0, S_b, S_bb, the exits' Wada test, α and λ."""
-    from hhscatter.analysis.basins import (
+    from hhscatter.analysis.geometry.basins import (
         basin_entropy_table,
         basin_fractions,
         uncertainty_exponent,
@@ -545,7 +545,7 @@ def _energy_trend(scan, E_b, smooth_chi2=2.0):
                            (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
     ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
     if ok.sum() >= 3:
-        from hhscatter.analysis.basins import weighted_line
+        from hhscatter.analysis.geometry.basins import weighted_line
 
         _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
         out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
@@ -554,7 +554,7 @@ def _energy_trend(scan, E_b, smooth_chi2=2.0):
 
 def _cutoff_prediction(per, scan, mu, mu_err, ec):
     """Records {E0, gamma, eps_c, eps_c_err, eps_c_predicted, ...} of the measured and predicted cut-off."""
-    from hhscatter.analysis.basins import predicted_cutoff
+    from hhscatter.analysis.geometry.basins import predicted_cutoff
 
     lam_E = scan[np.isfinite(scan.lam)] if len(scan) else scan
     out = []

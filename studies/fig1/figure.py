@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot
 
 # paper's colours: E = 0.35 orange, E = 0.30 black
 POINT_COLOURS = {"E0.35": "tab:orange", "E0.30": "black"}

@@ -5,7 +5,7 @@ Stages (``hhscatter study fig1 simulate|analyze|plot [--scale S]``):
 ``simulate(study, workers=None, progress=True)``
     For each energy E of ``[study].energies`` (0.35, 0.30): a pilot ensemble
     (raw key ``pilot_E0.35``) whose Kaplan–Meier P(t) gives κ and τ0
-    (:func:`hhscatter.analysis.escape_rate.escape_rate`, the 4-window rule of
+    (:func:`hhscatter.analysis.survival.escape_rate.escape_rate`, the 4-window rule of
     Fig. 2b), the recording time
 
         t_rec = ceil(τ0 + rec_efolds/κ)        (sprinkler rule, t_rec ≫ 1/κ),
@@ -40,8 +40,8 @@ import math
 
 import numpy as np
 
-from hhscatter.config import Integer, Number, Numbers, StudyParams
-from hhscatter.runner import SCENE_FILE
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.run.runner import SCENE_FILE
 
 
 class Params(StudyParams):
@@ -80,8 +80,8 @@ def _pilot_scene(study, energy):
 
 def _pilot_rate(pilot_dir):
     """κ, τ0 (and the full EscapeRateResult) of a pilot run."""
-    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     lt = read_lifetimes(pilot_dir, columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
     return escape_rate_from_lifetimes(lt, detect_tail=False)
@@ -140,8 +140,8 @@ def analyze(study):
     """analyze(study) -> None; writes cmeasure_points.parquet, potential_grid.parquet and fig1.json."""
     import pandas as pd
 
-    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
     E_C = model.critical_energy

@@ -3,14 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.formatting import format_value_err
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
+from hhscatter.publish.figures import agg_pyplot
 
 PT_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
 
 
 def _fmt_err(v, e):
-    """'0.061 ± 0.014': hhscatter.formatting.format_value_err (the report's and the docs' rounding)."""
+    """'0.061 ± 0.014': hhscatter.publish.formatting.format_value_err (the report's and the docs' rounding)."""
     return format_value_err(v, e)
 
 

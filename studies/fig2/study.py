@@ -6,7 +6,7 @@ parameters in ``studies/fig2/study.toml``.
 ``simulate(study, workers=None, progress=True)``
     1. κ(E) grid: for every E in ``grid_energies`` a pilot (raw ``pilot_E0.175``,
        ``pilot_n`` orbits, t_max = ``pilot_t_max``) fixes the main run's t_max
-       by :func:`hhscatter.analysis.escape_rate.choose_t_max` (bounds the cost
+       by :func:`hhscatter.analysis.survival.escape_rate.choose_t_max` (bounds the cost
        of long-lived orbits near E_c and of KAM-trapped orbits), then the main
        run (raw ``grid_E0.175``, ``grid_n`` orbits).
     2. Fig. 2a: ``pt_n`` orbits at each of ``pt_energies`` (raw ``pt_E0.23``),
@@ -39,9 +39,9 @@ import warnings
 
 import numpy as np
 
-from hhscatter.analysis.verdicts import half_unit, quoted_verdict
-from hhscatter.config import Integer, Integers, Number, Numbers, StudyParams
-from hhscatter.runner import SCENE_FILE
+from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.run.runner import SCENE_FILE
 
 
 class Params(StudyParams):
@@ -136,14 +136,14 @@ def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds
 # simulate
 # ---------------------------------------------------------------------------
 def _lifetimes(path):
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     return read_lifetimes(path, columns=LIFETIME_COLUMNS, categorical=True)  # 1e7 orbits: no str per orbit
 
 
 def _t_max_choice(study, pilot_dir, n):
-    from hhscatter.analysis.escape_rate import choose_t_max
-    from hhscatter.analysis.survival import lifetimes_to_arrays
+    from hhscatter.analysis.survival.escape_rate import choose_t_max
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
     return choose_t_max(
@@ -157,7 +157,7 @@ def _t_max_choice(study, pilot_dir, n):
 
 def _grid_rate(study, energy, lifetimes=None):
     """EscapeRateResult of the κ(E) run at E (its lifetimes read here unless given)."""
-    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
     lt = _lifetimes(study.raw(grid_key(energy))) if lifetimes is None else lifetimes
     return escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=float(study.param("min_survivors")))
@@ -243,7 +243,7 @@ def _plot_grid(t_last, n_lin=4001, n_log=600):
 def _analyze_grid(study):
     import pandas as pd
 
-    from hhscatter.analysis.kappa_energy import fit_kappa_energy
+    from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
 
     E_C = study.model.critical_energy
     rows, runs = [], {}
@@ -319,13 +319,13 @@ def _analyze_pt(study):
     import pandas as pd
     import pyarrow as pa
 
-    from hhscatter.analysis.escape_rate import (
+    from hhscatter.analysis.survival.escape_rate import (
         escape_rate,
         escaping_tail,
         power_law_exponent_mle,
     )
-    from hhscatter.analysis.survival import survival_curve
-    from hhscatter.tables import survival_arrays
+    from hhscatter.analysis.survival.fits import survival_curve
+    from hhscatter.data.tables import survival_arrays
 
     E_C = study.model.critical_energy
     curves, lines, numbers = [], [], {}
@@ -408,13 +408,13 @@ def _analyze_pt(study):
 def _analyze_cmeasure(study, grid_runs):
     import pandas as pd
 
-    from hhscatter.analysis.cmeasure import (
+    from hhscatter.analysis.survival.cmeasure import (
         cmeasure_sample_from_sections,
         kappa_from_cmeasure,
     )
-    from hhscatter.analysis.escape_rate import escape_rate
-    from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.analysis.survival.escape_rate import escape_rate
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     E_C = study.model.critical_energy
 
@@ -506,15 +506,15 @@ def _analyze_conventions(study, grid_runs):
     """
     import pandas as pd
 
-    from hhscatter.analysis.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.analysis.kappa_conventions import (
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.survival.kappa_conventions import (
         escape_rate_p_levels,
         law_spread,
         plateau_rate,
         stable_energies,
     )
-    from hhscatter.analysis.kappa_energy import fit_kappa_energy
-    from hhscatter.analysis.survival import lifetimes_to_arrays
+    from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     E_C = study.model.critical_energy
     p_hi, p_lo = (float(v) for v in study.param("p_levels"))

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.formatting import format_value_err
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
+from hhscatter.publish.figures import agg_pyplot
 
 E_C = 1.0 / 6.0
 HIST_COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")

@@ -49,10 +49,10 @@ import json
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.decay import snapshot_grid
-from hhscatter.analysis.verdicts import quoted_verdict as mu_verdict
-from hhscatter.analysis.verdicts import verdict_beside_authors
-from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams, Text
+from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.analysis.stats.verdicts import quoted_verdict as mu_verdict
+from hhscatter.analysis.stats.verdicts import verdict_beside_authors
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
 
 
 class Params(StudyParams):
@@ -93,7 +93,7 @@ def simulate(study, workers=None, progress=True):
 
 def _snapshot_rows(study, key: str, filters=None) -> pd.DataFrame:
     """Snapshot rows (traj_id, t, energy) of orbits not escaped; ``filters`` pushed down to the reader."""
-    from hhscatter.tables import read_snapshots
+    from hhscatter.data.tables import read_snapshots
 
     return read_snapshots(study.raw(key), filters=filters)
 
@@ -102,14 +102,14 @@ def analyze(study):
     """analyze(study) -> None: ⟨E⟩(t), μ fits (+ bootstrap), later windows, histograms, fig3.json."""
     import pyarrow.dataset as ds
 
-    from hhscatter.analysis.decay import (
+    from hhscatter.analysis.dissipative.decay import (
         bootstrap_mu_first_orbits,
         energy_histograms,
         fit_energy_decay,
         inside_mean_energy,
         mu_by_window,
     )
-    from hhscatter.tables import iter_parts, read_lifetimes
+    from hhscatter.data.tables import iter_parts, read_lifetimes
 
     key = _key(study)
     scene = study.scene(key)
@@ -270,7 +270,7 @@ def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -
     whatever the window says).  Each fit is the unweighted log fit with E(0) = E0 (:func:`fit_energy_decay`).
     The row in (fit_window, "inside") is ours, the one that fig3.json ``mu`` holds.
     """
-    from hhscatter.analysis.decay import fit_energy_decay
+    from hhscatter.analysis.dissipative.decay import fit_energy_decay
 
     paper_mu = float(study.param("paper_mu"))
     half = float(study.param("paper_mu_half_unit"))

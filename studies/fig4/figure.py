@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.formatting import format_value_err
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
+from hhscatter.publish.figures import agg_pyplot
 
 FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294",
                 0.02: "#d62728"}
@@ -24,7 +24,7 @@ def _colors(gammas):
 
 
 def _pm(v, e):
-    """'v \\pm e' for a LaTeX label: hhscatter.formatting.format_value_err (the report's and the docs' rounding)."""
+    """'v \\pm e' for a LaTeX label: hhscatter.publish.formatting.format_value_err (the report's and the docs' rounding)."""
     return format_value_err(v, e, sep=r" \pm ")
 
 

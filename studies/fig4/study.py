@@ -10,11 +10,11 @@ Definitions used here (all times in model units):
 * τ0 — end of the irregular initial regime; the paper says it is
   effectively independent of γ, so it is measured once, on the conservative
   curve P_0, by the data-driven rule of
-  :func:`hhscatter.analysis.windows.choose_windows` (the first time after
+  :func:`hhscatter.analysis.survival.windows.choose_windows` (the first time after
   which the local escape rate stays within 10 % / 3σ of its plateau value;
   the same rule as the Fig. 2 escape-rate fits).
 * τ1 — Eq. (eqn:tau1): first t ≥ τ0 with P_γ(t) = α P_0(t), α = 2
-  (:func:`hhscatter.analysis.transitions.tau1` on a fine grid, log-linear
+  (:func:`hhscatter.analysis.dissipative.transitions.tau1` on a fine grid, log-linear
   interpolation).  ``n0_at_tau1`` = N·P_0(τ1) tells whether P_0 is still
   resolved there (flag ``tau1_resolved``: at least ``min_ref_orbits`` orbits).
 * τ2 observed — "the first time at which the energy of a non-escaping orbit
@@ -23,7 +23,7 @@ Definitions used here (all times in model units):
   10⁷); the 1 % and 50 % quantiles of the settling times are given as
   N-independent companions. Its interval is the distribution-free
   order-statistic interval of the quantile it estimates, t_{1/N}
-  (:func:`~hhscatter.analysis.transitions.tau2_observed_interval`, ≥ 68 %:
+  (:func:`~hhscatter.analysis.dissipative.transitions.tau2_observed_interval`, ≥ 68 %:
   ``tau2_obs_lo``, ``tau2_obs_hi``; ``tau2_obs_err`` is its half-width), not
   a bootstrap of the minimum; the exponent of τ2,obs ∝ γ^−p is an
   unweighted log-log fit (a minimum has no error to weight by).
@@ -49,8 +49,8 @@ import json
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.decay import snapshot_grid
-from hhscatter.config import Integer, Number, NumberLists, Numbers, StudyParams
+from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
 
 
@@ -103,7 +103,7 @@ def simulate(study, workers=None, progress=True):
 
 
 def _tau0_rule(grid, P0, n):
-    from hhscatter.analysis.windows import choose_windows
+    from hhscatter.analysis.survival.windows import choose_windows
 
     return choose_windows(grid, P0, n_total=n).tau0
 
@@ -121,8 +121,8 @@ def analyze(study):
     (:func:`_tau_table`), the figure's tables (:func:`_figure_tables`), the
     paper comparison (:func:`_compare`) and the numbers (:func:`_numbers`).
     """
-    from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.analysis.transitions import bootstrap_transition_times, survival_on_grid
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.analysis.dissipative.transitions import bootstrap_transition_times, survival_on_grid
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
@@ -184,7 +184,7 @@ def _read_lifetimes(study, gs):
     Read as Arrow columns (no Python string per orbit: ``outcome`` stays a categorical of 1 byte per orbit),
     so memory is ~40 bytes per orbit while one run is read and ~9 bytes per orbit and γ kept.
     """
-    from hhscatter.tables import read_by_orbit
+    from hhscatter.data.tables import read_by_orbit
 
     lts, ref = {}, None
     for g in gs:
@@ -205,8 +205,8 @@ def _own_mu(study, mg, E0, N):
     (⟨E⟩ over orbits not escaped, settled ones continued; log fit on mu_window), bootstrap error."""
     import pyarrow.dataset as ds
 
-    from hhscatter.analysis.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
-    from hhscatter.tables import iter_parts, read_snapshots
+    from hhscatter.analysis.dissipative.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
+    from hhscatter.data.tables import iter_parts, read_snapshots
 
     ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]),
                              study.model.critical_energy)
@@ -223,7 +223,7 @@ def _own_mu(study, mg, E0, N):
 def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha) -> pd.DataFrame:
     """One row per γ: outcome fractions, τ0, τ1 (Eq. (eqn:tau1)), τ2 observed (+ settling-time quantiles) and
     predicted (Eq. (eq:tau2)), each with its bootstrap error (σ over replicates × bscale)."""
-    from hhscatter.analysis.transitions import settle_time_quantiles, tau1, tau2_observed_interval, tau2_predicted
+    from hhscatter.analysis.dissipative.transitions import settle_time_quantiles, tau1, tau2_observed_interval, tau2_predicted
 
     E_C = study.model.critical_energy
     paper_mu = float(study.param("paper_mu"))
@@ -269,7 +269,7 @@ def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha
 
 def _figure_tables(lts, grid, P, dt, t_last, N):
     """(P(t) per γ, exact Kaplan–Meier at log-spaced times; P_γ/P_0 on the τ grid while reference orbits remain)."""
-    from hhscatter.analysis.survival import survival_from_lifetimes
+    from hhscatter.analysis.survival.fits import survival_from_lifetimes
 
     gs = list(lts)
     pg = _plot_grid(t_last)
@@ -292,7 +292,7 @@ def _figure_tables(lts, grid, P, dt, t_last, N):
 def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -> dict:
     """The paper comparison (the paper gives τ's only in figures; its statements are checked); returns the
     fitted exponents {name: (p, σ_p)} of τ ∝ γ^−p."""
-    from hhscatter.analysis.transitions import power_law_exponent, tau2_predicted
+    from hhscatter.analysis.dissipative.transitions import power_law_exponent, tau2_predicted
 
     E_C = study.model.critical_energy
     paper_mu = float(study.param("paper_mu"))
@@ -366,7 +366,7 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
                            "same initial conditions (seed, n); raw/gamma<mu_gamma> also holds the energies of that "
                            "run's settled orbits after settling (snapshots schema)"),
         "tau0_rule": ("τ0 = choose_windows(P_0).tau0: first time after which the local escape rate of the conservative "
-                      "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.escape_rate)"),
+                      "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.survival.escape_rate)"),
         "tau1_definition": f"first t ≥ τ0 with P_γ(t) = α P_0(t), α = {alpha:g} (Eq. eqn:tau1), grid step {dt:g}",
         "tau2_obs_definition": "min settling time (first E = E_c inside Ω); depends on N",
         "tau2_pred_definition": f"ln(E0/E_c)/(μγ) with μ from this study's γ = {mg:g} run on [{win[0]:g}, {win[1]:g}]",

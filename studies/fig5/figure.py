@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.formatting import format_value_err
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
+from hhscatter.publish.figures import agg_pyplot
 
 RED = "#c0392b"
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#17becf"]

@@ -19,7 +19,7 @@ analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            samples at E1 and E2 from study fig1's published points
            (derived/cmeasure_points.parquet: first crossing after fig1's
            recording time t_rec); distances (see
-           :mod:`hhscatter.analysis.distance`): Hellinger and TV on box
+           :mod:`hhscatter.analysis.geometry.distance`): Hellinger and TV on box
            histograms vs box side ε (full samples with bootstrap errors, and
            split-half comparisons at one common sample size m with their
            noise floor, giving the agreement scale ε*), sliced Wasserstein with
@@ -30,17 +30,17 @@ Why Hellinger vs ε is the headline distance: the paper's claim is
 scale-resolved; H(ε) against its own split-half noise floor gives the scale
 down to which two samples are indistinguishable, and H weighs the thin
 low-mass filaments where a fractal c-measure and a blurred one differ
-(module docstring of :mod:`hhscatter.analysis.distance`).  The sliced
+(module docstring of :mod:`hhscatter.analysis.geometry.distance`).  The sliced
 Wasserstein distance (units of length) is the scale-free global check that
 μ_c^{E1} is closer than μ_c^{E2}.
 
 Two agreement scales are reported for each comparison, both at one common
 split-half sample size m (the c-measure sample of fig1 limits m):
 
-* ε*_2σ (:func:`~hhscatter.analysis.distance.agreement_scale`): the smallest
+* ε*_2σ (:func:`~hhscatter.analysis.geometry.distance.agreement_scale`): the smallest
   box side down to which H_pq is within 2σ of the noise floor — a
   significance statement, which moves to coarser scales as samples grow;
-* ε*_δ (:func:`~hhscatter.analysis.distance.agreement_scale_debiased`): the
+* ε*_δ (:func:`~hhscatter.analysis.geometry.distance.agreement_scale_debiased`): the
   smallest box side down to which the noise-corrected distance
   √(H_pq² − H_noise²) stays ≤ δ (default 0.1) — an estimate of a property of
   the two distributions, comparable across γ and sample sizes.  Panel (d)
@@ -63,9 +63,9 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis import distance as dist
-from hhscatter.analysis.decay import time_to_energy
-from hhscatter.config import Integer, Number, Numbers, StudyParams, Text
+from hhscatter.analysis.geometry import distance as dist
+from hhscatter.analysis.dissipative.decay import time_to_energy
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams, Text
 from hhscatter.studies import _upstream as up
 
 
@@ -171,7 +171,7 @@ def simulate(study, workers=None, progress=True):
 def _authors_sets(study):
     """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < r_cut
     (their plots), capped at n_cap points."""
-    from hhscatter.tables import read_sections
+    from hhscatter.data.tables import read_sections
 
     n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))
     out = {}
@@ -198,7 +198,7 @@ VERDICT_ROWS = (
 def _verdict_5b(study, cm_full, E1, ours):
     """The 5b − 5a verdict (issue 28) in every construction of VERDICT_ROWS: debiased Hellinger distances to
     μ_c^{E1} at box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every
-    set, the reference included (:func:`~hhscatter.analysis.distance.paired_hellinger_difference`). Sets of
+    set, the reference included (:func:`~hhscatter.analysis.geometry.distance.paired_hellinger_difference`). Sets of
     one comparison are cut alike. Returns the JSON record, or None when the sets are too small (tiny scale)."""
     box = float(study.param("box_headline"))
     extent = tuple(float(v) for v in study.param("extent"))
@@ -424,7 +424,7 @@ def _point_sets(study, gammas, E1, E2, mu, mu_err):
     orbit (Fig. 5a) and those in the energy band (Fig. 5b), capped at n_cap points."""
     import pyarrow.dataset as pads
 
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     band = tuple(float(b) for b in study.param("band"))
     n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))

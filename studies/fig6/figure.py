@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot
 
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"]
 LS = {"paper": (0, (5, 2)), "integrated": (0, (1.5, 1.5))}

@@ -26,7 +26,7 @@ analyze    inputs (the studies of ``[needs]``, their published outputs only):
            number of free parameters (K energy quantiles at t_ref = τ0,
            per-orbit μ_i from the snapshots, one shared trapped fraction φ).
            For fig4's γ values: the homogeneous fit and the model's τ1
-           (:func:`hhscatter.analysis.survival_model.predict_tau1` against fig4's γ = 0
+           (:func:`hhscatter.analysis.dissipative.survival_model.predict_tau1` against fig4's γ = 0
            curve), τ2 = ln(E0/E_c)/(μγ).  Writes derived tables and fig6.json.
 
            The paper's own constants beside ours (``[study] paper_*``: κ0(E) of
@@ -50,12 +50,12 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis import mixture
-from hhscatter.analysis import survival_model as sm
-from hhscatter.analysis.kappa_law import PiecewiseKappa
-from hhscatter.analysis.survival import survival_from_lifetimes
-from hhscatter.analysis.transitions import tau2_observed, tau2_predicted
-from hhscatter.config import (
+from hhscatter.analysis.dissipative import mixture
+from hhscatter.analysis.dissipative import survival_model as sm
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.analysis.survival.fits import survival_from_lifetimes
+from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
+from hhscatter.scene.schema import (
     Bool,
     Integer,
     Number,
@@ -281,7 +281,7 @@ def analyze(study):
 
     import pyarrow as pa
 
-    from hhscatter.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.tables import read_lifetimes, read_snapshots
 
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
     ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": mu}
@@ -555,7 +555,7 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
     """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)."""
     import pyarrow as pa
 
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     E0 = float(study.param("fig4_E0"))
     other = study.upstream("tau")

@@ -3,14 +3,14 @@
 The paper's second open question (Discussion): "extend the probabilistic description for the dynamics of
 ensembles of initial conditions using an operator-theoretic formalism … spectral approaches considering
 Perron–Frobenius (or similar) operators acting on these densities". The pure functions are in
-:mod:`hhscatter.analysis.transfer`; every orbit runs through the engine (runner + an initial-condition table
+:mod:`hhscatter.analysis.geometry.transfer`; every orbit runs through the engine (runner + an initial-condition table
 + a one-return section scene, ``sections.first_only`` and ``stop``).
 
 1. **Ulam's method, conservative, per energy E.** The section inside Ω (r < r_esc, V < E) is cut into
    squares of side ``box`` in (x, y) — the coordinates in which fig1 and fig5 plot the c-measure, so that the
    boxes and the distances share one partition. The return map does not preserve area in (x, y): its
    invariant measure (the Liouville flux through the section, the symplectic form restricted to it) has the
-   density |ṗ_r|/v (:func:`~hhscatter.analysis.transfer.section_flux_density`). It *is* Lebesgue in
+   density |ṗ_r|/v (:func:`~hhscatter.analysis.geometry.transfer.section_flux_density`). It *is* Lebesgue in
    (φ, p_φ), but p_φ = r v is not monotone along a ray (it vanishes at r = 0 and at V = E), so (φ, p_φ) is not
    a chart of the section. So the boxes are sampled in (x, y), stratified (k × k jittered points per box),
    each point weighted by |ṗ_r|/v: the rows of Ulam's matrix are then averages over the invariant measure
@@ -24,7 +24,7 @@ Perron–Frobenius (or similar) operators acting on these densities". The pure f
 2. **μ_c against fig1's sprinkler points** at E = 0.30, 0.35: the flux c-measure ν (left vector of M(κ)),
    carried one exact return forward to the samples' image points, with the sprinkler weight (e^{κT} − 1)/κ
    (the first crossing after a late time); also the flux measure itself and the map's c-measure (left vector
-   of P) for contrast. Debiased Hellinger distances of :mod:`hhscatter.analysis.distance`.
+   of P) for contrast. Debiased Hellinger distances of :mod:`hhscatter.analysis.geometry.distance`.
 3. **Dissipative**: the operator on (box × energy bin), sampled with drag γ, carried forward in time steps
    dt (return times binned): P(t) and the first crossing after t*, against an ensemble simulated here
    (disk ICs at E0, the fig4/fig5 setup). Then the **reduced operator on ρ(E) alone**: each energy bin's
@@ -39,8 +39,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis import transfer as tf
-from hhscatter.config import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.analysis.geometry import transfer as tf
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
 
 
@@ -119,7 +119,7 @@ def section_samples(model, energy, extent, box, k, r_esc, rng, *, e_width=0.0) -
     E + e_width/2]), w (the flux density |ṗ_r|/v, the return map's invariant measure) and the section
     state px, py.
     """
-    from hhscatter.ics import section_velocities
+    from hhscatter.scene.ics import section_velocities
 
     x0, x1, y0, y1 = extent
     nx, ny = int(math.ceil((x1 - x0) / box - 1e-9)), int(math.ceil((y1 - y0) / box - 1e-9))
@@ -243,7 +243,7 @@ def _grid_shape(study, box):
 def one_return_table(study, key, df) -> pd.DataFrame:
     """The samples of ``df`` (in traj_id order) with their fate: ``ret`` (crossed again), ``T`` (time of the
     crossing), ``t_end`` (time of the next event), ``x1, y1, e1`` (the crossing), ``censored``."""
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     raw = study.raw(key)
     lt = read_lifetimes(raw, columns=["traj_id", "outcome", "t_end"]).sort_values("traj_id")
@@ -348,7 +348,7 @@ def _islands(study, E, df, tr, ids, keep, sub, t):
     of P on the saddle's class with their mass on trapped boxes, and κ with the trapped boxes taken out."""
     from scipy.sparse.linalg import eigs
 
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.data.tables import read_lifetimes
 
     pr = _probe_ics(df)
     lt = read_lifetimes(study.raw(probe_key(E)), columns=["traj_id", "outcome"]).sort_values("traj_id")
@@ -424,7 +424,7 @@ def measure_points(res, kind, n, rng):
 
 
 def _cmeasure_distances(study, results, inputs):
-    from hhscatter.analysis import distance as dist
+    from hhscatter.analysis.geometry import distance as dist
 
     other = study.upstream("cmeasure")
     cm, name = up.published_table(study, other, "cmeasure_points")
@@ -458,7 +458,7 @@ def _cmeasure_distances(study, results, inputs):
 def _cmeasure_convergence(study, results, cm, boxes, head):
     """The debiased Hellinger distance (at the headline box) of the operator's sprinkler measure to fig1's
     points at the first cm energy, for merged boxes and fewer samples per box: the eigenvector's convergence."""
-    from hhscatter.analysis import distance as dist
+    from hhscatter.analysis.geometry import distance as dist
 
     E = float(study.param("cm_energies")[0])
     if E not in results:
@@ -541,9 +541,9 @@ def _empirical_survival(t_end, leaving, grid):
 
 
 def _dissipative(study, inputs):
-    from hhscatter.analysis import distance as dist
-    from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.tables import read_lifetimes, read_sections
+    from hhscatter.analysis.geometry import distance as dist
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.data.tables import read_lifetimes, read_sections
 
     edges = _diss_bins(study)
     n_bins = len(edges) - 1
@@ -632,9 +632,9 @@ def _dissipative(study, inputs):
 # cost: orbit-time for κ at 1 %
 # ---------------------------------------------------------------------------
 def _cost(study, records, kappa0):
-    from hhscatter.analysis.escape_rate import escape_rate
-    from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.tables import read_lifetimes
+    from hhscatter.analysis.survival.escape_rate import escape_rate
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.data.tables import read_lifetimes
 
     target = float(study.param("target_rel"))
     rows = []

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.plotting import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 

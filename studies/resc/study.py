@@ -7,16 +7,16 @@ observations.  This study measures, at E = 0.25, 0.30, 0.35:
 1. κ for r_esc ∈ {1.03, 1.1, 1.5, 2.0} on the *same* initial conditions
    (paired), every cell by the same rules.  One common window per energy:
    the median of the four cells' exponential-regime windows found by
-   :func:`~hhscatter.analysis.windows.choose_windows` (the paper's rule),
+   :func:`~hhscatter.analysis.survival.windows.choose_windows` (the paper's rule),
    started no earlier than the time where the r_ref curve has fallen to
    ``p_start`` = 0.1 (the prompt-escape transient, whose hazard peak at
    t ≈ 5 and ringing would otherwise be shifted in and out of the window by
    the flight time).  Reported per cell: κ by the constant-hazard MLE
-   (:func:`~hhscatter.analysis.escape_rate.escape_rate_mle`) on that window;
+   (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_mle`) on that window;
    κ by the paper's mean of 4 least-squares fits with the cell's own windows
    (Fig. 2b caption); and the shift κ(r) − κ(r_ref) from the slope of the
    paired log-survival ratio
-   (:func:`~hhscatter.analysis.escape_check.survival_ratio_slope`), the
+   (:func:`~hhscatter.analysis.survival.paired.survival_ratio_slope`), the
    main estimator (the MLE difference is kept as a cross-check: it is
    dominated by the window's first e-fold and so sensitive to the
    period-scale modulation of the hazard).  Delays: the mean flight time
@@ -41,7 +41,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.config import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
@@ -82,7 +82,7 @@ def _follow_radii(study):
 def _follow_scene(study, E):
     """The first n_follow orbits of the (E, r_ref) ensemble, followed past their escape (scene option
     ``follow``): every crossing of the follow radii, until r_far or t_max."""
-    from hhscatter.scene import Follow
+    from hhscatter.scene.scene import Follow
 
     r_ref = float(study.param("r_ref"))
     base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
@@ -106,8 +106,8 @@ def _lifetimes(study, E, r):
     Read as Arrow columns into numpy (no pandas frame, no Python object per orbit): 1e7 orbits per run at
     paper scale, 4 runs per energy held at once.
     """
-    from hhscatter.analysis.survival import observed_from_outcome
-    from hhscatter.tables import read_by_orbit
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.data.tables import read_by_orbit
 
     c = read_by_orbit(study.raw(_key(E, r)), ["outcome", "t_end", "exit_channel"])
     obs = observed_from_outcome(c["outcome"])
@@ -156,7 +156,7 @@ def analyze(study):
 def _lyapunov_table(study, energies) -> pd.DataFrame:
     """The Lyapunov orbit of the exits (the exact boundary of Ω) at every energy of the study and of
     ``lyapunov_energies``: radial extent r_min, r_max, y on the axis, period."""
-    from hhscatter.analysis.escape_check import lyapunov_orbit
+    from hhscatter.analysis.geometry.channels import lyapunov_orbit
 
     rows = []
     for E in sorted({*map(float, study.param("lyapunov_energies")), *energies}):
@@ -192,8 +192,8 @@ def _common_window(study, arrs, radii, r_ref):
     """
     import warnings
 
-    from hhscatter.analysis.escape_rate import escape_rate
-    from hhscatter.analysis.survival import survival_curve
+    from hhscatter.analysis.survival.escape_rate import escape_rate
+    from hhscatter.analysis.survival.fits import survival_curve
 
     t_ref, _ = arrs[r_ref]
     n_tot = t_ref.size
@@ -222,8 +222,8 @@ def _common_window(study, arrs, radii, r_ref):
 def _follow_returns(study, E, radii):
     """(follow-run lifetimes, {r: return statistics back inside r_in}, {r: back inside r itself}) at energy E:
     returns and flight times on identical trajectories (the follow runs' ``crossings``)."""
-    from hhscatter.analysis.escape_check import return_statistics
-    from hhscatter.tables import read_crossings, read_lifetimes
+    from hhscatter.analysis.geometry.channels import return_statistics
+    from hhscatter.data.tables import read_crossings, read_lifetimes
 
     r_in = float(study.param("r_in"))
     fdir = study.raw(_follow_key(E))
@@ -243,8 +243,8 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
     """(row of kappa.parquet, PairedShift) of cell (E, r): κ by the MLE on the common window, its shift from
     r_ref (paired log-survival-ratio slope; on the follow runs too), the paper's LSQ κ, delays and flight
     times."""
-    from hhscatter.analysis.escape_check import paired_mle_shift, survival_ratio_slope
-    from hhscatter.analysis.escape_rate import escape_rate_mle
+    from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 
     t_ref, obs_ref = arrs[r_ref]
     n_tot = t_ref.size
@@ -301,7 +301,7 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
 def _returns_row(study, E, r, s, recrossed, win, ps, lyapE, ends) -> dict:
     """Row of returns.parquet of cell (E, r): the fraction of escapes that come back inside r_in (all, and after
     the window start) with Wilson intervals, how fast they escape again, the Lyapunov orbit's extent."""
-    from hhscatter.analysis.escape_check import wilson_interval
+    from hhscatter.analysis.stats.intervals import wilson_interval
 
     z = float(study.param("z"))
     fast = float(study.param("reesc_fast"))
@@ -336,7 +336,7 @@ def _returns_row(study, E, r, s, recrossed, win, ps, lyapE, ends) -> dict:
 def _channel_rows(study, E, r, ch, t_alt, win) -> list:
     """Rows of channels.parquet of cell (E, r): escape fractions per exit channel with Wilson intervals and the
     χ² test of equal thirds, for all escapes and for those before / after the window start."""
-    from hhscatter.analysis.escape_check import channel_fractions
+    from hhscatter.analysis.geometry.channels import channel_fractions
 
     z = float(study.param("z"))
     n_tot = t_alt.size

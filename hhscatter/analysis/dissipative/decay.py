@@ -1,0 +1,560 @@
+"""Energy decay of the dissipative ensemble (paper Sec. III.A.1, Fig. 3 = fig:energy_decay).
+
+With linear drag the energy of every orbit decays as dE/dt = −γ v², Eq.
+(eqn:energy_diffeq).  Approximating the potential, on average along an orbit,
+by V = (μ/2) E gives the homogeneous law, Eq. (eqn:energy_exp_decay),
+
+    E(t) = E0 exp(−μ γ t),
+
+with μ ≈ 1 (exactly 1 for damped oscillations about the stable fixed point).
+The paper fits ⟨E⟩(t), the mean over orbits still inside Ω at t, by least
+squares on log⟨E⟩ and reports μ = 0.91 on t ∈ [0, 200] for (E0, γ) =
+(0.3, 0.01), arguing that the local exponent tends to 1 at late times.
+
+Functions here are pure (no file I/O, no plotting):
+
+* :func:`energy_path`, :func:`time_to_energy` — the law itself and its
+  inverse (t* of Fig. 5; τ2 of Eq. (eq:tau2) is the case E1 = E_c);
+* :func:`mean_energy` / :func:`mean_energy_arrays` — ⟨E⟩, σ_E and its standard
+  error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
+* :func:`pool_mean_energy` — the same statistics pooled over several tables
+  (e.g. one per part file, so that N = 10^7 never sits in memory at once);
+* :func:`inside_mean_energy` — ⟨E⟩(t) of every orbit not escaped by t and of
+  those still above E_c, pooled over the part tables of one run;
+* :func:`snapshot_grid` — the snapshot times of a study, from [start, stop, step] pieces;
+* :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the paper's
+  model) and with a free intercept (the local exponent);
+* :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
+* :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits),
+  :func:`bootstrap_mu_first_orbits` on the first K orbits with errors scaled to N;
+* :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
+
+Units: the model's natural units (unit mass); t in time units, E in energy
+units, γ in 1/time; μ is dimensionless.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.stats.least_squares import weighted_least_squares
+
+__all__ = [
+    "EnergyDecayFit",
+    "EnergyHistograms",
+    "InsideMeanEnergy",
+    "bootstrap_mu",
+    "bootstrap_mu_first_orbits",
+    "energy_path",
+    "energy_histograms",
+    "energy_histograms_arrays",
+    "fit_energy_decay",
+    "fit_energy_decay_table",
+    "mean_energy",
+    "mean_energy_arrays",
+    "inside_mean_energy",
+    "mu_by_window",
+    "pool_mean_energy",
+    "snapshot_grid",
+    "time_to_energy",
+]
+
+
+def snapshot_grid(pieces) -> np.ndarray:
+    """snapshot_grid(pieces) -> increasing array of times from [[start, stop, step], ...].
+
+    Each piece is the uniform grid start, start + step, ..., ≤ stop (values
+    rounded to 1e-9 so that equal times compare equal across tables).
+    Pieces must not overlap.
+    """
+    out = []
+    for p in pieces:
+        if len(p) != 3:
+            raise ValueError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
+        start, stop, step = (float(v) for v in p)
+        if not step > 0 or stop < start:
+            raise ValueError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
+        k = np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
+        out.append(np.round(start + step * k, 9))
+    g = np.concatenate(out) if out else np.empty(0)
+    if g.size == 0 or np.any(np.diff(g) <= 0):
+        raise ValueError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
+    return g
+
+
+# ---------------------------------------------------------------------------
+# the homogeneous law E(t) = E0 exp(−μγt)
+# ---------------------------------------------------------------------------
+def energy_path(t, E0: float, mu: float, gamma: float):
+    """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
+    return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
+
+
+def time_to_energy(E0, E1, mu, gamma):
+    """time_to_energy(E0, E1, mu, gamma) -> t* with E0 exp(−μγt*) = E1, i.e. ln(E0/E1)/(μγ).
+
+    Inverse of Eq. (eqn:energy_exp_decay); the paper's Fig. 5 time t* ≈ 17
+    for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
+    special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
+    """
+    E0, E1, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E1, mu, gamma)))
+    if np.any(E1 <= 0) or np.any(E0 < E1):
+        raise ValueError("need E0 >= E1 > 0")
+    if np.any(mu * gamma <= 0):
+        raise ValueError("need mu*gamma > 0")
+    out = np.log(E0 / E1) / (mu * gamma)
+    return float(out) if out.ndim == 0 else out
+
+
+# ---------------------------------------------------------------------------
+# mean energy per grid time
+# ---------------------------------------------------------------------------
+def mean_energy_arrays(t, energy) -> pd.DataFrame:
+    """mean_energy_arrays(t, energy) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    Groups the samples ``energy`` by their (exactly equal) grid time ``t`` and
+    returns, sorted by t, one row per grid time with
+
+    * ``n``        number of orbits alive at t (int),
+    * ``mean_E``   ⟨E⟩(t), the ensemble mean energy,
+    * ``std_E``    sample standard deviation of E (ddof = 1; NaN when n = 1),
+    * ``sem_E``    standard error of the mean, std_E / √n,
+    * ``lo_3sigma``, ``hi_3sigma``  ⟨E⟩ ∓ 3 std_E, the ribbon of Fig. 3.
+
+    NaN energies are ignored.  Energy in model units, t in time units.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if t.shape != e.shape:
+        raise ValueError(f"t and energy differ in length: {t.size} != {e.size}")
+    ok = np.isfinite(e) & np.isfinite(t)
+    t, e = t[ok], e[ok]
+    grid, inv = np.unique(t, return_inverse=True)
+    n = np.bincount(inv, minlength=grid.size)
+    s1 = np.bincount(inv, weights=e, minlength=grid.size)
+    mean = s1 / np.maximum(n, 1)
+    dev2 = np.bincount(inv, weights=(e - mean[inv]) ** 2, minlength=grid.size)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = np.where(n > 1, np.sqrt(dev2 / np.maximum(n - 1, 1)), np.nan)
+        sem = std / np.sqrt(n)
+    return pd.DataFrame(
+        {
+            "t": grid,
+            "n": n.astype(np.int64),
+            "mean_E": mean,
+            "std_E": std,
+            "sem_E": sem,
+            "lo_3sigma": mean - 3 * std,
+            "hi_3sigma": mean + 3 * std,
+        }
+    )
+
+
+def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
+    """mean_energy(snapshots) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    DataFrame wrapper of :func:`mean_energy_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).  The table holds only
+    orbits still alive (neither escaped nor settled) at each grid time, so
+    ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
+    Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
+    """
+    return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
+
+
+def pool_mean_energy(tables) -> pd.DataFrame:
+    """pool_mean_energy(tables) -> DataFrame[t, n, mean_E, std_E, sem_E, lo_3sigma, hi_3sigma].
+
+    Combines outputs of :func:`mean_energy` computed on disjoint sets of
+    snapshot rows (e.g. one per part file) into the statistics of their
+    union, exactly (up to rounding) as :func:`mean_energy` of the
+    concatenated rows: per grid time n = Σ n_i, mean = Σ n_i m_i / n and the
+    pooled sum of squared deviations Σ [(n_i − 1) s_i² + n_i (m_i − mean)²]
+    (Chan et al.'s parallel variance), so memory stays O(grid) for any N.
+    """
+    tabs = [t for t in tables if len(t)]
+    cols = ["t", "n", "mean_E", "std_E", "sem_E", "lo_3sigma", "hi_3sigma"]
+    if not tabs:
+        return pd.DataFrame({c: pd.Series(dtype=float) for c in cols})
+    d = pd.concat([t[["t", "n", "mean_E", "std_E"]] for t in tabs], ignore_index=True)
+    d["n"] = d["n"].astype(float)
+    d["s1"] = d["n"] * d["mean_E"]
+    d["m2"] = np.where(d["n"] > 1, (d["n"] - 1) * d["std_E"].fillna(0.0) ** 2, 0.0)
+    g = d.groupby("t", sort=True)
+    n_s = g["n"].sum()
+    mean_s = g["s1"].sum() / n_s
+    d["dev"] = d["n"] * (d["mean_E"] - d["t"].map(mean_s)) ** 2
+    m2 = (d.groupby("t", sort=True)["m2"].sum() + d.groupby("t", sort=True)["dev"].sum()).to_numpy()
+    n, mean = n_s.to_numpy(), mean_s.to_numpy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = np.where(n > 1, np.sqrt(m2 / np.maximum(n - 1, 1)), np.nan)
+        sem = std / np.sqrt(n)
+    return pd.DataFrame({"t": n_s.index.to_numpy(dtype=float), "n": n.astype(np.int64), "mean_E": mean,
+                         "std_E": std, "sem_E": sem, "lo_3sigma": mean - 3 * std, "hi_3sigma": mean + 3 * std})
+
+
+@dataclass(frozen=True)
+class InsideMeanEnergy:
+    """⟨E⟩(t) statistics of one run (columns of :func:`mean_energy`).
+
+    inside         every orbit not escaped by t (settled orbits continued past E_c
+                   count: the scene option ``continue_settled``)
+    above          the orbits still above E_c at t (neither escaped nor settled)
+    rows_below_ec  number of snapshot rows at or below E_c (the continued settled orbits)
+    """
+
+    inside: pd.DataFrame
+    above: pd.DataFrame
+    rows_below_ec: int
+
+
+def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
+    """inside_mean_energy(parts, e_c) -> InsideMeanEnergy pooled over snapshot tables (columns t, energy).
+
+    ``parts``: an iterable of DataFrames, e.g. one per part file of a run
+    whose settled orbits were continued (paper Fig. 3: ⟨E⟩ over the orbits
+    "inside Ω at time t"); E decreases monotonically for γ > 0, so the rows
+    with E > E_c are those of orbits neither escaped nor settled. Memory stays
+    O(grid + one part) for any N.
+    """
+    inside, above = [], []
+    n_below = 0
+    for df in parts:
+        up = df["energy"] > e_c
+        inside.append(mean_energy(df))
+        above.append(mean_energy(df[up]))
+        n_below += int((~up).sum())
+    return InsideMeanEnergy(pool_mean_energy(inside), pool_mean_energy(above), n_below)
+
+
+# ---------------------------------------------------------------------------
+# fitting μ
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EnergyDecayFit:
+    """Result of :func:`fit_energy_decay` (all μ dimensionless).
+
+    Fixed intercept, the paper's Eq. (eqn:energy_exp_decay) with E(0) = E0:
+        ``mu``, ``mu_err``, ``rms_log_residual``.
+    Free intercept, log⟨E⟩ = a − μ γ t (the local decay exponent):
+        ``mu_free``, ``mu_free_err``, ``log_E0_free``, ``log_E0_free_err``,
+        ``rms_log_residual_free``.
+    ``window`` is the (t_lo, t_hi) used, ``n_points`` the number of grid times
+    in it.  Errors are 1σ (NaN when not determinable, e.g. too few points).
+    """
+
+    mu: float
+    mu_err: float
+    mu_free: float
+    mu_free_err: float
+    log_E0_free: float
+    log_E0_free_err: float
+    window: tuple
+    n_points: int
+    rms_log_residual: float
+    rms_log_residual_free: float
+
+    @property
+    def E0_free(self) -> float:
+        """exp(log_E0_free): the fitted E(0) of the free-intercept fit."""
+        return float(np.exp(self.log_E0_free))
+
+
+def fit_energy_decay(
+    t,
+    mean_E,
+    E0: float,
+    gamma: float,
+    window=(0.0, 200.0),
+    weights=None,
+    *,
+    absolute_sigma: bool = False,
+) -> EnergyDecayFit:
+    """fit_energy_decay(t, mean_E, E0, gamma, window=(0, 200), weights=None) -> EnergyDecayFit.
+
+    Weighted least squares of the log-transformed mean energy against the
+    exponential law of Eq. (eqn:energy_exp_decay):
+
+    * fixed intercept (the paper's fit):  log⟨E⟩ − log E0 = −μ γ t,
+    * free intercept (local exponent):    log⟨E⟩ = a − μ γ t.
+
+    Parameters
+    ----------
+    t, mean_E : arrays
+        Grid times and ⟨E⟩(t) (e.g. columns of :func:`mean_energy`).  Points
+        with non-finite or non-positive ⟨E⟩ are dropped.
+    E0 : float
+        Initial energy (intercept of the fixed fit).
+    gamma : float
+        Drag coefficient γ > 0; μ is the fitted slope divided by −γ.
+    window : (t_lo, t_hi)
+        Inclusive time window of the fit.  Paper: (0, 200) gives μ = 0.91.
+    weights : array or None
+        Inverse variances of log⟨E⟩ per point, e.g. (mean_E / sem_E)²;
+        None = unit weights (ordinary least squares, as in the paper).
+    absolute_sigma : bool
+        If True (only meaningful with ``weights``) the errors use the weights
+        as absolute variances; otherwise (default) the covariance is scaled
+        by the reduced χ² of the fit, as in ``scipy.optimize.curve_fit``.
+
+    Returns
+    -------
+    EnergyDecayFit with μ and 1σ errors of both variants.
+    """
+    if not gamma > 0:
+        raise ValueError(f"gamma must be > 0, got {gamma!r}")
+    if not E0 > 0:
+        raise ValueError(f"E0 must be > 0, got {E0!r}")
+    t = np.asarray(t, dtype=float).ravel()
+    m = np.asarray(mean_E, dtype=float).ravel()
+    w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
+    if not (t.shape == m.shape == w.shape):
+        raise ValueError("t, mean_E and weights must have the same length")
+    t_lo, t_hi = float(window[0]), float(window[1])
+    sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
+    t, y, w = t[sel], np.log(m[sel]), w[sel]
+    n = t.size
+    absolute = absolute_sigma and weights is not None
+    nan = float("nan")
+
+    errors = "absolute" if absolute else "scaled"
+    # fixed intercept: y - log E0 = -beta t
+    if n >= 1 and np.sum(w * t * t) > 0:
+        fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
+        mu, mu_err = fit.coef[0] / gamma, fit.err[0] / gamma
+        rms = float(np.sqrt(np.mean(fit.resid**2)))
+    else:
+        mu = mu_err = rms = nan
+
+    # free intercept: y = a - beta t
+    if n >= 2 and np.ptp(t) > 0:
+        fit = weighted_least_squares(np.column_stack([np.ones(n), -t]), y, w, errors=errors)
+        a, beta_f = fit.coef
+        mu_free, mu_free_err = beta_f / gamma, fit.err[1] / gamma
+        a_err = fit.err[0]
+        rms_f = float(np.sqrt(np.mean(fit.resid**2)))
+    else:
+        mu_free = mu_free_err = a = a_err = rms_f = nan
+
+    return EnergyDecayFit(
+        mu=float(mu),
+        mu_err=float(mu_err),
+        mu_free=float(mu_free),
+        mu_free_err=float(mu_free_err),
+        log_E0_free=float(a),
+        log_E0_free_err=float(a_err),
+        window=(t_lo, t_hi),
+        n_points=int(n),
+        rms_log_residual=float(rms),
+        rms_log_residual_free=float(rms_f),
+    )
+
+
+def fit_energy_decay_table(
+    table: pd.DataFrame,
+    E0: float,
+    gamma: float,
+    window=(0.0, 200.0),
+    *,
+    weighted: bool = False,
+) -> EnergyDecayFit:
+    """fit_energy_decay_table(table, E0, gamma, window=(0, 200), weighted=False) -> EnergyDecayFit.
+
+    Wrapper of :func:`fit_energy_decay` for the output of :func:`mean_energy`.
+    ``weighted=True`` uses inverse-variance weights (mean_E / sem_E)² of
+    log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
+    unweighted log fit of Eq. (eqn:energy_exp_decay).
+    """
+    weights = None
+    if weighted:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            weights = (table["mean_E"].to_numpy() / table["sem_E"].to_numpy()) ** 2
+        weights = np.where(np.isfinite(weights), weights, 0.0)
+    return fit_energy_decay(
+        table["t"].to_numpy(), table["mean_E"].to_numpy(), E0, gamma, window, weights
+    )
+
+
+def mu_by_window(
+    t,
+    mean_E,
+    E0: float,
+    gamma: float,
+    windows,
+    weights=None,
+    *,
+    absolute_sigma: bool = False,
+) -> pd.DataFrame:
+    """mu_by_window(t, mean_E, E0, gamma, windows, weights=None) -> DataFrame.
+
+    Runs :func:`fit_energy_decay` on each (t_lo, t_hi) of ``windows`` and
+    returns one row per window with columns ``t_lo, t_hi, n_points, mu,
+    mu_err, mu_free, mu_free_err``.
+
+    ``mu_free`` is the local exponent on the window, −d log⟨E⟩/d(γt); it is
+    the quantity for testing the paper's claim (Sec. III.A.1, below Eq.
+    (eqn:energy_exp_decay)) that μ → 1 at late times.  ``mu`` (intercept tied
+    to E0) is the cumulative mean exponent ln(E0/⟨E⟩)/(γt) weighted over the
+    window and lags behind the local value.
+    """
+    rows = []
+    for lo, hi in windows:
+        f = fit_energy_decay(t, mean_E, E0, gamma, (lo, hi), weights, absolute_sigma=absolute_sigma)
+        rows.append(
+            {
+                "t_lo": float(lo),
+                "t_hi": float(hi),
+                "n_points": f.n_points,
+                "mu": f.mu,
+                "mu_err": f.mu_err,
+                "mu_free": f.mu_free,
+                "mu_free_err": f.mu_free_err,
+            }
+        )
+    return pd.DataFrame(rows, columns=["t_lo", "t_hi", "n_points", "mu", "mu_err", "mu_free", "mu_free_err"])
+
+
+# ---------------------------------------------------------------------------
+# energy histograms
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class EnergyHistograms:
+    """Result of :func:`energy_histograms`.
+
+    ``t_requested`` (k,) the requested times; ``t`` (k,) the snapshot grid time
+    actually used for each (the nearest one); ``edges`` (b+1,) common energy
+    bin edges; ``counts`` (k, b) orbit counts per bin; ``density`` (k, b)
+    normalised so that Σ density·Δedge = 1 per row (NaN row if nobody alive);
+    ``n_alive`` (k,) orbits alive at t; ``mean_E`` (k,) their mean energy.
+    """
+
+    t_requested: np.ndarray
+    t: np.ndarray
+    edges: np.ndarray
+    counts: np.ndarray
+    density: np.ndarray
+    n_alive: np.ndarray
+    mean_E: np.ndarray
+
+
+def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
+    """energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms.
+
+    Histograms of the energies of orbits alive at each requested time (the
+    inset of the paper's Fig. 3; they estimate the density ρ(E(t)) of Eq.
+    (eqn:c-measure_model)).  Each requested time is mapped to the nearest
+    snapshot grid time.  ``bins`` is a number of bins (then common edges span
+    the min..max energy over the selected times) or an array of edges.
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    grid = np.unique(t[np.isfinite(t)])
+    if grid.size == 0:
+        raise ValueError("no snapshot times")
+    idx = np.clip(np.searchsorted(grid, times), 1, grid.size - 1) if grid.size > 1 else np.zeros(times.size, int)
+    if grid.size > 1:
+        left, right = grid[idx - 1], grid[idx]
+        idx = np.where(np.abs(times - left) <= np.abs(right - times), idx - 1, idx)
+    used = grid[idx]
+    samples = [e[(t == tk) & np.isfinite(e)] for tk in used]
+    if np.ndim(bins) == 0:
+        allv = np.concatenate(samples) if samples else np.array([])
+        lo, hi = (float(allv.min()), float(allv.max())) if allv.size else (0.0, 1.0)
+        if hi <= lo:
+            lo, hi = lo - 0.5e-3 * max(abs(lo), 1.0), hi + 0.5e-3 * max(abs(hi), 1.0)
+        edges = np.linspace(lo, hi, int(bins) + 1)
+    else:
+        edges = np.asarray(bins, dtype=float)
+    counts = np.array([np.histogram(s, edges)[0] for s in samples], dtype=np.int64).reshape(used.size, -1)
+    widths = np.diff(edges)
+    tot = counts.sum(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        density = np.where(tot > 0, counts / (tot * widths), np.nan)
+    n_alive = np.array([s.size for s in samples], dtype=np.int64)
+    means = np.array([s.mean() if s.size else np.nan for s in samples])
+    return EnergyHistograms(times, used, edges, counts, density, n_alive, means)
+
+
+def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistograms:
+    """energy_histograms(snapshots, times, bins=50) -> EnergyHistograms.
+
+    DataFrame wrapper of :func:`energy_histograms_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).
+    """
+    return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)
+
+
+# ---------------------------------------------------------------------------
+# bootstrap over orbits
+# ---------------------------------------------------------------------------
+def bootstrap_mu(
+    traj_id,
+    t,
+    energy,
+    E0: float,
+    gamma: float,
+    windows,
+    *,
+    n_boot: int = 200,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """bootstrap_mu(traj_id, t, energy, E0, gamma, windows, n_boot=200, seed=0) -> DataFrame.
+
+    Bootstrap over orbits of the unweighted log fits of :func:`fit_energy_decay`
+    (Eq. (eqn:energy_exp_decay)) on each window: every replicate redraws the
+    ensemble by giving each orbit (all its snapshot rows together) a
+    Poisson(1) multiplicity — the large-N limit of resampling N orbits with
+    replacement, which keeps the correlation of one orbit's energies across
+    times — recomputes ⟨E⟩(t) and refits.  The standard deviation of a column
+    over replicates is the statistical (sampling) error of that estimate;
+    the fit's own ``mu_err`` measures the misfit of the model instead.
+
+    Parameters: ``traj_id``, ``t``, ``energy`` the rows of a snapshots table
+    (orbit id, grid time, energy); ``windows`` a list of (t_lo, t_hi).
+    Returns one row per (replicate, window): ``replicate, t_lo, t_hi, mu,
+    mu_free`` (dimensionless).
+    """
+    if n_boot < 1:
+        raise ValueError(f"n_boot must be ≥ 1, got {n_boot!r}")
+    tid = np.asarray(traj_id).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if not (tid.shape == t.shape == e.shape):
+        raise ValueError("traj_id, t and energy must have the same length")
+    ok = np.isfinite(t) & np.isfinite(e)
+    tid, t, e = tid[ok], t[ok], e[ok]
+    _, orb = np.unique(tid, return_inverse=True)
+    grid, ti = np.unique(t, return_inverse=True)
+    n_orb = int(orb.max()) + 1 if orb.size else 0
+    rng = np.random.default_rng(seed)
+    rows = []
+    for b in range(n_boot):
+        w = rng.poisson(1.0, n_orb).astype(float)[orb]
+        n_t = np.bincount(ti, weights=w, minlength=grid.size)
+        s_t = np.bincount(ti, weights=w * e, minlength=grid.size)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(n_t > 0, s_t / n_t, np.nan)
+        for lo, hi in windows:
+            f = fit_energy_decay(grid, mean, E0, gamma, (lo, hi))
+            rows.append({"replicate": b, "t_lo": float(lo), "t_hi": float(hi), "mu": f.mu, "mu_free": f.mu_free})
+    return pd.DataFrame(rows, columns=["replicate", "t_lo", "t_hi", "mu", "mu_free"])
+
+
+def bootstrap_mu_first_orbits(rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, windows, *,
+                              n_boot: int = 200, seed: int = 0):
+    """bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot, seed) -> (replicates, scale).
+
+    :func:`bootstrap_mu` on the snapshot rows (traj_id, t, energy) of the
+    orbits traj_id < k only; their standard deviations times ``scale`` =
+    √(k/N) are those of the N orbits (i.i.d. orbits: errors ∝ 1/√N), which
+    keeps the bootstrap affordable at N = 10^7. ``rows`` may already be
+    restricted to those orbits (e.g. by a filter pushed down to the reader).
+    """
+    if not 1 <= k <= n_orbits:
+        raise ValueError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
+    sub = rows[rows["traj_id"] < k]
+    boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
+    return boot, float(np.sqrt(k / n_orbits))

@@ -1,0 +1,523 @@
+"""Mixture model (the paper's proposed extension, end of Sec. III.B.3)
+-------------------------------------------------------------------
+"An improved agreement would be obtained by avoiding the approximation of
+homogeneous energy decay ... a mixture model for P(t) involving multiple
+sub-ensembles, each with their own energy decay exponent μ."  Design:
+
+1. Reference time t_ref (default τ0).  Every orbit alive at t_ref (snapshot
+   table) gets its own decay law ln E_i(t) = a_i − μ_i γ t, least squares over
+   its snapshot energies.
+2. The orbits alive at t_ref are split into K sub-ensembles by the quantiles
+   of their energy E_i(t_ref) (``by="energy"``, default: the fractions w_k,
+   Σ w_k = 1, discretise the measured density ρ(E(t_ref)) of Eq.
+   (eqn:c-measure_model)) or of their exponent μ_i (``by="rate"``).  Each
+   sub-ensemble gets μ_k = ⟨μ_i⟩_k and A_k = exp⟨a_i⟩_k, i.e. an energy path
+   E_k(t) = A_k e^{−μ_k γ t}, a rate κ0(E_k(t)) and a settling time
+   τ2,k = ln(A_k/E_c)/(μ_k γ).  Per-orbit exponents are averaged (instead of
+   fitting the sub-ensemble's mean energy) to avoid survivor bias: once the
+   fast members settle, the mean over the survivors follows the slow ones.
+3. Every sub-ensemble follows Eq. (eqn:surv_prob_model) with its own path:
+
+       P(t) = Σ_k P_k(t),
+       P_k(t) = f_ne,k + f_e,k exp(−X_k(t))           τ0 ≤ t ≤ τ2,k
+              = f_ne,k exp(−g_k(t)(t − τ2,k))          t > τ2,k
+       f_ne,k + f_e,k = w_k P(τ0),   g_k = L/(1 + e^{−b(t−τ2,k)})²,
+
+   with X_k the (instantaneous or integrated) escape exponent along E_k(t).
+   Free parameters: the K trapped fractions f_ne,k (``fne_mode="free"``) or a
+   single trapped fraction φ with f_ne,k = φ w_k P(τ0) (``fne_mode="shared"``,
+   as many free parameters as the homogeneous model), and the shared L, b.
+   The component paths (A_k, μ_k) are measured, not fitted to P(t).
+
+With t_ref = τ0 the constraint Σ_k (f_ne,k + f_e,k) = P(τ0) is exact; with a
+later t_ref the weights refer to the population at t_ref (an approximation).
+K = 1 with A = E0 reproduces the homogeneous model with a measured μ.
+
+The fit returns a :class:`~hhscatter.analysis.dissipative.survival_model.SurvivalFit` with the same goodness-of-fit
+measures as the homogeneous model (:func:`~hhscatter.analysis.dissipative.survival_model.compare_fits`).
+
+Units: time in model units, energies in model units, rates in 1/time.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.survival.kappa_law import E_C
+from hhscatter.analysis.dissipative.survival_model import (
+    HAZARDS,
+    SurvivalFit,
+    _component,
+    _fit_stats,
+    _lsq,
+    _p_at,
+    _residual_fn,
+    _select,
+    _survival_fit,
+)
+from hhscatter.analysis.dissipative.transitions import tau2_predicted
+
+__all__ = [
+    "MixtureComponents",
+    "MixtureModelParams",
+    "fit_mixture_model",
+    "mixture_components",
+    "mixture_components_arrays",
+    "mixture_survival_model",
+]
+
+
+# ---------------------------------------------------------------------------
+# mixture model
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MixtureComponents:
+    """Energy sub-ensembles measured from the snapshots (see module docstring).
+
+    ``t_ref``    snapshot grid time at which the sub-ensembles are defined;
+    ``by``       "energy" or "rate": the quantity binned into quantiles;
+    ``edges``    (K+1,) its quantile edges;
+    ``weights``  (K,) fractions w_k of the orbits alive at t_ref (Σ = 1);
+    ``n_ref``    (K,) their counts; ``E_ref`` (K,) mean energy at t_ref;
+    ``A, mu, mu_err``  (K,) paths E_k(t) = A_k exp(−μ_k γ t);
+    ``fit_window`` time window of the per-orbit fits; ``gamma`` the drag.
+    Build with :func:`mixture_components`, or directly for known paths.
+    """
+
+    t_ref: float
+    by: str
+    edges: np.ndarray
+    weights: np.ndarray
+    n_ref: np.ndarray
+    E_ref: np.ndarray
+    A: np.ndarray
+    mu: np.ndarray
+    mu_err: np.ndarray
+    fit_window: tuple
+    gamma: float
+
+    @property
+    def K(self) -> int:
+        """Number of sub-ensembles."""
+        return int(self.weights.size)
+
+    def energy(self, t):
+        """energy(t) -> (K, len(t)) array of E_k(t)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return self.A[:, None] * np.exp(-self.mu[:, None] * self.gamma * t[None, :])
+
+    def tau2(self, E_c: float = E_C):
+        """tau2(E_c) -> (K,) τ2,k = ln(A_k/E_c)/(μ_k γ), Eq. (eq:tau2) per sub-ensemble."""
+        return np.asarray(tau2_predicted(self.A, E_c, self.mu, self.gamma), dtype=float)
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per sub-ensemble: bin_lo, bin_hi (of ``by``), weight, n_ref, E_ref, A, mu, mu_err, tau2."""
+        return pd.DataFrame(
+            {
+                "bin_lo": self.edges[:-1],
+                "bin_hi": self.edges[1:],
+                "weight": self.weights,
+                "n_ref": self.n_ref,
+                "E_ref": self.E_ref,
+                "A": self.A,
+                "mu": self.mu,
+                "mu_err": self.mu_err,
+                "tau2": self.tau2(),
+            }
+        )
+
+
+def _per_orbit_decay(ids, t, e, lo, hi):
+    """Per-orbit least squares of ln E = a − β t on lo ≤ t ≤ hi: (unique ids, a, β, n points)."""
+    ok = (t >= lo) & (t <= hi) & np.isfinite(e) & (e > 0)
+    ids, t, y = ids[ok], t[ok], np.log(e[ok])
+    uid, inv = np.unique(ids, return_inverse=True)
+    m = uid.size
+    n = np.bincount(inv, minlength=m).astype(float)
+    st = np.bincount(inv, weights=t, minlength=m)
+    sy = np.bincount(inv, weights=y, minlength=m)
+    stt = np.bincount(inv, weights=t * t, minlength=m)
+    sty = np.bincount(inv, weights=t * y, minlength=m)
+    den = n * stt - st * st
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = np.where(den > 0, (n * sty - st * sy) / den, np.nan)
+        a = np.where(n > 0, (sy - slope * st) / n, np.nan)
+    return uid, a, -slope, n
+
+
+def mixture_components_arrays(
+    traj_id,
+    t,
+    energy,
+    *,
+    gamma: float,
+    t_ref: float,
+    n_components: int = 4,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+) -> MixtureComponents:
+    """mixture_components_arrays(traj_id, t, energy, *, gamma, t_ref, n_components=4, by="energy", fit_window=(0, inf)) -> MixtureComponents.
+
+    Sub-ensembles of the orbits alive at the snapshot grid time nearest
+    ``t_ref``:
+
+    1. every such orbit gets its own decay law ln E_i(t) = a_i − μ_i γ t,
+       least squares over its snapshots in ``fit_window`` (default: its whole
+       record; needs ≥ 2 snapshots, otherwise μ_i is undefined);
+    2. the orbits are split into ``n_components`` quantile bins of their
+       energy E_i(t_ref) (``by="energy"``: the bins discretise ρ(E(t_ref)) of
+       Eq. (eqn:c-measure_model)) or of their exponent μ_i (``by="rate"``:
+       sub-ensembles "each with their own energy decay exponent μ"; orbits
+       with undefined μ_i are left out);
+    3. each sub-ensemble k gets w_k = n_k / Σ n, μ_k = mean of its members'
+       μ_i (error: standard error of that mean) and A_k = exp(mean a_i), i.e.
+       the path E_k(t) = A_k e^{−μ_k γ t}, Eq. (eqn:energy_exp_decay).
+
+    Averaging per-orbit exponents, rather than fitting the sub-ensemble's
+    mean energy ⟨E⟩_k(t), avoids survivor bias: as the members with fast
+    decay settle, ⟨E⟩_k(t) over those still alive is pulled towards the slow
+    ones and its slope underestimates the members' decay.
+    """
+    ids = np.asarray(traj_id).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if not (ids.shape == t.shape == e.shape):
+        raise ValueError("traj_id, t and energy must have the same length")
+    if by not in ("energy", "rate"):
+        raise ValueError("by must be 'energy' or 'rate'")
+    K = int(n_components)
+    if K < 1:
+        raise ValueError("n_components must be >= 1")
+    grid = np.unique(t[np.isfinite(t)])
+    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
+    at = (t == t_used) & np.isfinite(e)
+    ids_ref, e_ref = ids[at], e[at]
+    order = np.argsort(ids_ref)
+    ids_ref, e_ref = ids_ref[order], e_ref[order]
+    # per-orbit decay laws of the orbits alive at t_ref
+    member_rows = np.isin(ids, ids_ref)
+    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
+    pos = np.searchsorted(uid, ids_ref)
+    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
+    mu_i = np.full(ids_ref.size, np.nan)
+    a_ref = np.full(ids_ref.size, np.nan)
+    mu_i[has] = beta_i[pos[has]] / gamma
+    a_ref[has] = a_i[pos[has]]
+    key = e_ref if by == "energy" else mu_i
+    use = np.isfinite(key)
+    if use.sum() < K:
+        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
+    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
+    comp = np.full(ids_ref.size, -1)
+    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
+    n_ref = np.bincount(comp[use], minlength=K)
+    if np.any(n_ref == 0):
+        raise ValueError("empty sub-ensemble (ties); use fewer components")
+    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
+    for k in range(K):
+        sel = comp == k
+        E_mean[k] = float(e_ref[sel].mean())
+        good = sel & np.isfinite(mu_i)
+        if not good.any():
+            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
+        mu[k] = float(mu_i[good].mean())
+        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
+        A[k] = float(np.exp(a_ref[good].mean()))
+    return MixtureComponents(
+        t_ref=t_used,
+        by=by,
+        edges=edges,
+        weights=n_ref / n_ref.sum(),
+        n_ref=n_ref.astype(np.int64),
+        E_ref=E_mean,
+        A=A,
+        mu=mu,
+        mu_err=mu_err,
+        fit_window=(float(fit_window[0]), float(fit_window[1])),
+        gamma=float(gamma),
+    )
+
+
+def mixture_components(
+    snapshots: pd.DataFrame,
+    *,
+    gamma: float,
+    t_ref: float,
+    n_components: int = 4,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+) -> MixtureComponents:
+    """mixture_components(snapshots, *, gamma, t_ref, n_components=4, by="energy", fit_window=(0, inf)) -> MixtureComponents.
+
+    DataFrame wrapper of :func:`mixture_components_arrays` for the engine's
+    ``snapshots`` table (columns ``traj_id, t, energy``).
+    """
+    return mixture_components_arrays(
+        snapshots["traj_id"].to_numpy(),
+        snapshots["t"].to_numpy(),
+        snapshots["energy"].to_numpy(),
+        gamma=gamma,
+        t_ref=t_ref,
+        n_components=n_components,
+        by=by,
+        fit_window=fit_window,
+    )
+
+
+def mixture_survival_model(
+    t,
+    *,
+    kappa_of_E: Callable,
+    components: MixtureComponents,
+    tau0: float,
+    f_ne,
+    P_tau0: float,
+    L: float,
+    b: float,
+    E_c: float = E_C,
+    hazard: str = "paper",
+    tau2=None,
+):
+    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c=1/6, hazard="paper") -> P(t).
+
+    Mixture generalisation of Eq. (eqn:surv_prob_model):
+    P(t) = Σ_k P_k(t), each sub-ensemble k following the homogeneous model
+    along its own energy path E_k(t) = A_k e^{−μ_k γ t} (rate κ0(E_k(t))),
+    with trapped fraction ``f_ne[k]``, escaping fraction
+    f_e,k = w_k P_tau0 − f_ne[k], settling time τ2,k (``tau2`` (K,) or, if
+    None, Eq. (eq:tau2) per sub-ensemble) and shared settling parameters L, b.
+    NaN for t < τ0.
+    """
+    c = components
+    f_ne = np.broadcast_to(np.asarray(f_ne, dtype=float), (c.K,))
+    tau2_k = c.tau2(E_c) if tau2 is None else np.broadcast_to(np.asarray(tau2, dtype=float), (c.K,))
+    f_e = c.weights * P_tau0 - f_ne
+    t_arr = np.asarray(t, dtype=float)
+    out = np.zeros(t_arr.shape)
+    for k in range(c.K):
+        out = out + _component(
+            t_arr, kappa_of_E, c.A[k], c.mu[k], c.gamma, tau0, tau2_k[k], f_ne[k], f_e[k], L, b, hazard
+        )
+    return float(out) if np.ndim(t) == 0 else out
+
+
+@dataclass(frozen=True)
+class MixtureModelParams:
+    """All inputs of :func:`mixture_survival_model`; calling it evaluates P(t)."""
+
+    kappa_of_E: Callable
+    components: MixtureComponents
+    tau0: float
+    f_ne_k: np.ndarray
+    P_tau0: float
+    L: float
+    b: float
+    E_c: float = E_C
+    hazard: str = "paper"
+
+    @property
+    def tau2_k(self):
+        """(K,) settling times τ2,k of the sub-ensembles."""
+        return self.components.tau2(self.E_c)
+
+    def __call__(self, t):
+        return mixture_survival_model(
+            t,
+            kappa_of_E=self.kappa_of_E,
+            components=self.components,
+            tau0=self.tau0,
+            f_ne=self.f_ne_k,
+            P_tau0=self.P_tau0,
+            L=self.L,
+            b=self.b,
+            E_c=self.E_c,
+            hazard=self.hazard,
+        )
+
+
+def fit_mixture_model(
+    t,
+    P,
+    P_err,
+    components,
+    *,
+    kappa_of_E: Callable,
+    tau0: float,
+    gamma: float | None = None,
+    E_c: float = E_C,
+    n_components: int = 4,
+    t_ref: float | None = None,
+    by: str = "energy",
+    fit_window=(0.0, np.inf),
+    fne_mode: str = "free",
+    fixed: dict | None = None,
+    p0: dict | None = None,
+    P_tau0: float | None = None,
+    space: str = "log",
+    P_min: float = 0.0,
+    t_max: float | None = None,
+    hazard: str = "paper",
+    absolute_sigma: bool = True,
+) -> SurvivalFit:
+    """fit_mixture_model(t, P, P_err, components, *, kappa_of_E, tau0, ...) -> SurvivalFit.
+
+    The mixture model the paper proposes at the end of Sec. III.B.3: sub-ensembles
+    with their own energy-decay exponent μ, each following Eq. (eqn:surv_prob_model).
+
+    Weighted least-squares fit of the mixture model (module docstring,
+    :func:`mixture_survival_model`) to P(t) ± P_err, with the same data
+    selection (τ0 ≤ t ≤ t_max, P > P_min), residual ``space`` and
+    goodness-of-fit measures as :func:`fit_survival_model`, so that the two
+    can be compared with :func:`compare_fits`.
+
+    ``components`` is a :class:`MixtureComponents` or the ``snapshots``
+    DataFrame, from which the sub-ensembles are built by
+    :func:`mixture_components` (needs ``gamma``; ``t_ref`` defaults to τ0).
+    The component energy paths are measured inputs, not fitted.
+
+    Free parameters: ``fne_mode="free"``: f_ne_0 … f_ne_{K−1} (bounded to
+    [0, w_k P(τ0)]), L, b; ``fne_mode="shared"``: phi (f_ne,k = phi w_k P(τ0),
+    0 ≤ phi ≤ 1), L, b.  ``fixed`` may hold L, b, phi or f_ne_k values.
+    Derived values reported: f_ne = Σ f_ne,k, f_e = P(τ0) − f_ne, the arrays
+    f_ne_k, f_e_k (with propagated errors) and τ2_k.  P(τ0) is ``P_tau0``
+    (exact) or interpolated from the data, its error then being propagated
+    into the errors and ``cov`` by re-fitting at P(τ0) + σ.  The uncertainty
+    of the measured component paths (A_k, μ_k) is not propagated, and the
+    error model (independent points) is that of :func:`fit_survival_model`.
+    """
+    if isinstance(components, pd.DataFrame):
+        if gamma is None:
+            raise ValueError("gamma is needed to build the components from snapshots")
+        components = mixture_components(
+            components,
+            gamma=gamma,
+            t_ref=tau0 if t_ref is None else t_ref,
+            n_components=n_components,
+            by=by,
+            fit_window=fit_window,
+        )
+    c = components
+    K = c.K
+    if fne_mode not in ("free", "shared"):
+        raise ValueError("fne_mode must be 'free' or 'shared'")
+    if hazard not in HAZARDS:
+        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    fixed = dict(fixed or {})
+    p0 = dict(p0 or {})
+    t_all = np.asarray(t, dtype=float)
+    if P_tau0 is None:
+        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
+    else:
+        P_tau0_err = 0.0
+    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
+    if tf.size < 3:
+        raise ValueError("fewer than 3 data points selected")
+
+    fne_names = [f"f_ne_{k}" for k in range(K)] if fne_mode == "free" else ["phi"]
+    names = fne_names + ["L", "b"]
+    unknown = set(fixed) - set(names)
+    if unknown:
+        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+    free = [n for n in names if n not in fixed]
+
+    # starting values: trapped fraction from P at the earliest settling time
+    tau2_k = c.tau2(E_c)
+    t_first = float(np.clip(np.min(tau2_k), tf[0], tf[-1]))
+    phi0 = float(np.clip(np.exp(np.interp(t_first, tf, np.log(Pf))) / P_tau0, 1e-6, 0.9))
+    late = tf > np.max(tau2_k)
+    if late.sum() >= 3:
+        hl = tf[late] >= np.median(tf[late])
+        slope = -np.polyfit(tf[late][hl], np.log(Pf[late][hl]), 1)[0] if hl.sum() >= 2 else 0.05
+        L0 = max(slope, 1e-3)
+    else:
+        L0 = 0.05
+    guess = {"phi": phi0, "L": p0.get("L", L0)}
+    for k in range(K):
+        guess[f"f_ne_{k}"] = phi0 * c.weights[k] * P_tau0
+    guess.update({k: v for k, v in p0.items() if k != "b"})
+    b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
+
+    def limits(P0v):
+        def bound(n):
+            if n == "phi":
+                return (0.0, 1.0)
+            if n.startswith("f_ne_"):
+                return (0.0, float(c.weights[int(n[5:])] * P0v))
+            return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
+
+        lo_b = np.array([bound(n)[0] for n in free], dtype=float)
+        return lo_b, np.array([bound(n)[1] for n in free], dtype=float)
+
+    def unpack(theta, P0v=P_tau0):
+        v = dict(guess)
+        v["b"] = b_starts[0]
+        v.update(fixed)
+        v.update(dict(zip(free, theta)))
+        if fne_mode == "free":
+            fk = np.array([v[f"f_ne_{k}"] for k in range(K)])
+        else:
+            fk = v["phi"] * c.weights * P0v
+        return v, fk
+
+    def make(theta, P0v=P_tau0):
+        v, fk = unpack(theta, P0v)
+        return MixtureModelParams(kappa_of_E, c, tau0, fk, P0v, v["L"], v["b"], E_c, hazard)
+
+    def solve(starts, P0v=P_tau0):
+        res = _residual_fn(lambda th: make(th, P0v)(tf), Pf, sf, space)
+        return (_lsq(res, starts, *limits(P0v)) if free else None), res
+
+    starts = []
+    for b0 in b_starts:
+        g = dict(guess, b=b0)
+        starts.append([g[n] for n in free])
+    sol, res = solve(starts)
+    theta = sol.x if sol is not None else np.array([])
+    model = make(theta)
+    r = res(theta)
+    k_free = len(free)
+    # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
+    st = _fit_stats(sol, model(tf), tf, Pf, r, k_free, absolute_sigma, P_tau0_err,
+                    lambda dP: solve([sol.x], P_tau0 + dP)[0])
+    cov_fit, sens, cov = st.cov_fit, st.sens, st.cov
+
+    v, fk = unpack(theta)
+    values = {n: float(v[n]) for n in names}
+    errors = {n: 0.0 for n in names}
+    for i, n in enumerate(free):
+        errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
+    # derived: total trapped fraction f_ne(θ, P) and f_e = P − f_ne
+    grad = np.zeros(k_free)
+    for i, n in enumerate(free):
+        if n.startswith("f_ne_"):
+            grad[i] = 1.0
+        elif n == "phi":
+            grad[i] = P_tau0
+    dfne_dP = float(grad @ sens) + (v["phi"] if fne_mode == "shared" else 0.0)
+    var_fit = float(grad @ cov_fit @ grad) if k_free else 0.0
+    f_ne_err = float(np.sqrt(max(var_fit, 0.0) + (dfne_dP * P_tau0_err) ** 2))
+    f_e_err = float(np.sqrt(max(var_fit, 0.0) + ((1.0 - dfne_dP) * P_tau0_err) ** 2))
+    fk_err = np.zeros(K)
+    if fne_mode == "free":
+        for k in range(K):
+            fk_err[k] = errors[f"f_ne_{k}"]
+    else:
+        i_phi = free.index("phi") if "phi" in free else None
+        for k in range(K):
+            g_k = c.weights[k] * P_tau0
+            vfit = g_k**2 * cov_fit[i_phi, i_phi] if i_phi is not None else 0.0
+            dP = g_k * (sens[i_phi] if i_phi is not None else 0.0) + c.weights[k] * v["phi"]
+            fk_err[k] = float(np.sqrt(max(vfit, 0.0) + (dP * P_tau0_err) ** 2))
+    values.update(
+        f_ne=float(fk.sum()),
+        f_e=float(P_tau0 - fk.sum()),
+        P_tau0=P_tau0,
+        tau2_k=tau2_k,
+        f_ne_k=fk,
+        f_e_k=c.weights * P_tau0 - fk,
+    )
+    errors.update(f_ne=f_ne_err, f_e=f_e_err, P_tau0=P_tau0_err, f_ne_k=fk_err)
+    return _survival_fit(model, values, errors, free, st, tf, r, sol, space)

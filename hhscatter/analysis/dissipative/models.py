@@ -1,0 +1,57 @@
+"""The survival models of dissipative scattering (paper Sec. III.B.3, Eq. (eqn:surv_prob_model)), by concept:
+
+* :mod:`hhscatter.analysis.survival.kappa_law` — κ0(E), the conservative escape-rate law (Fig. 2b);
+* :mod:`hhscatter.analysis.dissipative.decay` — the energy path E(t) = E0 e^{−μγt} and its inverse t*;
+* :mod:`hhscatter.analysis.dissipative.survival_model` — the homogeneous model, its fit, the
+  τ1 it predicts, and the comparison of fits;
+* :mod:`hhscatter.analysis.dissipative.mixture` — the mixture of sub-ensembles with their own
+  measured energy paths (the paper's proposed extension).
+
+This module only gathers their names (``from hhscatter.analysis.dissipative import models``).
+"""
+from __future__ import annotations
+
+from hhscatter.analysis.dissipative.decay import energy_path, time_to_energy
+from hhscatter.analysis.survival.kappa_law import E_C, PAPER_KAPPA, PiecewiseKappa
+from hhscatter.analysis.dissipative.mixture import (
+    MixtureComponents,
+    MixtureModelParams,
+    fit_mixture_model,
+    mixture_components,
+    mixture_components_arrays,
+    mixture_survival_model,
+)
+from hhscatter.analysis.dissipative.survival_model import (
+    HAZARDS,
+    SurvivalFit,
+    SurvivalModelParams,
+    better_fit,
+    compare_fits,
+    fit_survival_model,
+    predict_tau1,
+    settling_rate,
+    survival_model,
+)
+
+__all__ = [
+    "E_C",
+    "HAZARDS",
+    "PAPER_KAPPA",
+    "MixtureComponents",
+    "MixtureModelParams",
+    "PiecewiseKappa",
+    "SurvivalFit",
+    "SurvivalModelParams",
+    "better_fit",
+    "compare_fits",
+    "energy_path",
+    "fit_mixture_model",
+    "fit_survival_model",
+    "mixture_components",
+    "mixture_components_arrays",
+    "mixture_survival_model",
+    "predict_tau1",
+    "settling_rate",
+    "survival_model",
+    "time_to_energy",
+]

@@ -1,0 +1,771 @@
+"""The homogeneous survival model of dissipative scattering (paper Sec. III.B.3, Eq. (eqn:surv_prob_model)), its fit
+and the τ1 it predicts; the sub-ensemble version is :mod:`hhscatter.analysis.dissipative.mixture`.
+
+Homogeneous model (the paper's)
+-------------------------------
+All orbits are assumed to share the energy path of Eq. (eqn:energy_exp_decay),
+E(t) = E0 e^{−μγt}, and hence the time-dependent escape rate
+κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate (paper Fig. 2b = fig:kappa-E-dependence:
+κ0 = 13.63 ΔE² + 0.03 ΔE for E < 0.27 and 1.41 ΔE above, ΔE = E − E_c,
+zero for E ≤ E_c; :class:`~hhscatter.analysis.survival.kappa_law.PiecewiseKappa`).  Then, Eq. (eqn:surv_prob_model),
+
+    P_γ(t) = NaN ("irregular")                          t < τ0
+           = f_ne + f_e exp(−κ_γ(t) (t − τ0))             τ0 ≤ t ≤ τ2
+           = f_ne exp(−g(t, γ) (t − τ2))                  t > τ2
+    g(t, γ) = L / (1 + exp(−b (t − τ2)))²,
+    f_ne + f_e = P(τ0),   τ2 = ln(E0/E_c)/(μγ)  (Eq. (eq:tau2)).
+
+Caveat, ``hazard`` option.  Taken literally ("paper", the default), the
+escape factor exp(−κ_γ(t)(t−τ0)) uses the *instantaneous* rate times the
+elapsed time.  Because κ0(E(t)) → 0 as E(t) → E_c, this factor is not
+monotone: it returns to 1 as t → τ2, so the literal P(t) rises back to
+f_ne + f_e = P(τ0) just before τ2 and then jumps down to f_ne (when τ2 is tied
+to μ by Eq. (eq:tau2), E(τ2) = E_c exactly).  A survival function cannot
+increase; the physically consistent reading of "exponential decay with a
+time-dependent rate", Eq. (eqn:Pt_escape_generic), is the cumulative hazard
+exp(−∫_{τ0}^{t} κ0(E(s)) ds), selected with ``hazard="integrated"``.  Both
+coincide for constant κ.  Which one reproduces the paper's Fig. 6a is for the
+data to decide; the fitting code supports both.
+
+Both fits return :class:`SurvivalFit` with the same goodness-of-fit measures
+(χ², dof, χ²/dof, RMS of log residuals, AIC) on the same data selection, so
+that :func:`compare_fits` can tabulate them side by side.
+
+Units: time in model units, energies in model units, rates in 1/time.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, special
+
+from hhscatter.analysis.dissipative.decay import energy_path
+from hhscatter.analysis.survival.kappa_law import E_C
+from hhscatter.analysis.dissipative.transitions import tau2_predicted
+
+__all__ = [
+    "E_C",
+    "HAZARDS",
+    "HomogeneousProblem",
+    "SurvivalFit",
+    "SurvivalModelParams",
+    "better_fit",
+    "compare_fits",
+    "fit_survival_model",
+    "homogeneous_start",
+    "predict_tau1",
+    "profile_interval",
+    "settling_rate",
+    "survival_model",
+]
+
+HAZARDS = ("paper", "integrated")
+
+
+# ---------------------------------------------------------------------------
+# building blocks
+# ---------------------------------------------------------------------------
+def settling_rate(t, tau2: float, L: float, b: float):
+    """settling_rate(t, tau2, L, b) -> g(t) = L / (1 + exp(−b (t − τ2)))² (Eq. (eqn:surv_prob_model), t > τ2 branch).
+
+    Increases monotonically from L/4 at t = τ2 to L; rate in 1/time.
+    """
+    return L * special.expit(b * (np.asarray(t, dtype=float) - tau2)) ** 2
+
+
+def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
+    """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0) ("paper") or ∫_{τ0}^t κ0(E(s))ds ("integrated")."""
+    t = np.asarray(t, dtype=float)
+    if hazard == "paper":
+        return np.asarray(kappa_of_E(energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
+    if hazard == "integrated":
+        if t.size == 0:
+            return t.copy()
+        t_hi = float(np.max(t))
+        if t_hi <= tau0:
+            return np.zeros_like(t)
+        s = np.linspace(tau0, t_hi, n_int)
+        k = np.asarray(kappa_of_E(energy_path(s, A, mu, gamma)), dtype=float)
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
+        return np.interp(t, s, cum)
+    raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+
+
+def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard):
+    """One (sub-)ensemble of Eq. (eqn:surv_prob_model); NaN for t < τ0."""
+    t = np.asarray(t, dtype=float)
+    out = np.full(t.shape, np.nan)
+    mid = (t >= tau0) & (t <= tau2)
+    late = (t > tau2) & (t >= tau0)
+    if mid.any():
+        out[mid] = f_ne + f_e * np.exp(-_escape_exponent(t[mid], kappa_of_E, A, mu, gamma, tau0, hazard))
+    if late.any():
+        tl = t[late]
+        out[late] = f_ne * np.exp(-settling_rate(tl, tau2, L, b) * (tl - tau2))
+    return out
+
+
+# ---------------------------------------------------------------------------
+# homogeneous model
+# ---------------------------------------------------------------------------
+def survival_model(
+    t,
+    *,
+    kappa_of_E: Callable,
+    E0: float,
+    mu: float,
+    gamma: float,
+    tau0: float,
+    tau2: float | None = None,
+    f_ne: float,
+    f_e: float,
+    L: float,
+    b: float,
+    E_c: float = E_C,
+    hazard: str = "paper",
+):
+    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c=1/6, hazard="paper") -> P(t).
+
+    The paper's survival model, Eq. (eqn:surv_prob_model), with
+    κ_γ(t) = κ0(E(t)) and E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)):
+
+        t < τ0        NaN  (the "irregular" initial regime is not modelled)
+        τ0 ≤ t ≤ τ2   f_ne + f_e exp(−κ_γ(t)(t − τ0))       [hazard="paper"]
+                      f_ne + f_e exp(−∫_{τ0}^t κ_γ ds)      [hazard="integrated"]
+        t > τ2        f_ne exp(−g(t)(t − τ2)),  g = L/(1 + e^{−b(t−τ2)})²
+
+    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. :data:`~hhscatter.analysis.survival.kappa_law.PAPER_KAPPA`);
+    ``tau2=None`` uses Eq. (eq:tau2), ln(E0/E_c)/(μγ).  See the module
+    docstring for why the literal ("paper") escape factor is non-monotone.
+    Returns an array shaped like ``t`` (float if ``t`` is scalar).
+    """
+    if tau2 is None:
+        tau2 = tau2_predicted(E0, E_c, mu, gamma)
+    out = _component(t, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
+    return float(out) if np.ndim(t) == 0 else out
+
+
+@dataclass(frozen=True)
+class SurvivalModelParams:
+    """All inputs of :func:`survival_model`; calling it evaluates P(t)."""
+
+    kappa_of_E: Callable
+    E0: float
+    mu: float
+    gamma: float
+    tau0: float
+    tau2: float
+    f_ne: float
+    f_e: float
+    L: float
+    b: float
+    E_c: float = E_C
+    hazard: str = "paper"
+
+    def __call__(self, t):
+        return survival_model(
+            t,
+            kappa_of_E=self.kappa_of_E,
+            E0=self.E0,
+            mu=self.mu,
+            gamma=self.gamma,
+            tau0=self.tau0,
+            tau2=self.tau2,
+            f_ne=self.f_ne,
+            f_e=self.f_e,
+            L=self.L,
+            b=self.b,
+            E_c=self.E_c,
+            hazard=self.hazard,
+        )
+
+
+@dataclass
+class SurvivalFit:
+    """Result of :func:`fit_survival_model` / :func:`fit_mixture_model`.
+
+    ``params``     callable model with the best-fit values (P(t) = params(t));
+    ``values``     dict of all parameter values (free, fixed and derived);
+    ``errors``     dict of 1σ errors (0 for fixed parameters; derived ones
+                   propagated from the covariance);
+    ``free``       names of the fitted parameters, ``cov`` their covariance;
+    ``chi2, dof, chi2_red``  Σ r², n − k, χ²/dof of the normalised residuals r
+                   in the fitted ``space`` ("log": (ln P_model − ln P)/(σ_P/P));
+    ``rms_log_residual``  √mean (ln P_model − ln P)² over the fitted points;
+    ``aic``        χ² + 2k (for comparing models with different k);
+    ``t_fit, residuals``  fitted times and normalised residuals.
+    """
+
+    params: object
+    values: dict
+    errors: dict
+    free: tuple
+    cov: np.ndarray
+    chi2: float
+    dof: int
+    chi2_red: float
+    rms_log_residual: float
+    aic: float
+    n_points: int
+    space: str
+    t_fit: np.ndarray = field(repr=False)
+    residuals: np.ndarray = field(repr=False)
+    success: bool = True
+    message: str = ""
+
+    def predict(self, t):
+        """predict(t) -> P_model(t) with the best-fit parameters."""
+        return self.params(t)
+
+
+# ---------------------------------------------------------------------------
+# generic weighted least squares
+# ---------------------------------------------------------------------------
+def _select(t, P, P_err, tau0, t_max, P_min):
+    t = np.asarray(t, dtype=float).ravel()
+    P = np.asarray(P, dtype=float).ravel()
+    P_err = np.asarray(P_err, dtype=float).ravel()
+    if not (t.shape == P.shape == P_err.shape):
+        raise ValueError("t, P and P_err must have the same length")
+    sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
+    if t_max is not None:
+        sel &= t <= t_max
+    return t[sel], P[sel], P_err[sel]
+
+
+def _p_at(t, P, P_err, t0):
+    """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
+    t = np.asarray(t, dtype=float)
+    P = np.asarray(P, dtype=float)
+    E = np.asarray(P_err, dtype=float)
+    ok = np.isfinite(P) & (P > 0)
+    t, P, E = t[ok], P[ok], E[ok]
+    if t.size == 0 or t0 < t[0] or t0 > t[-1]:
+        raise ValueError("cannot interpolate P at tau0 from the data; pass P_tau0")
+    return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
+
+
+def _residual_fn(curve, P, sig, space):
+    if space == "log":
+        y, s = np.log(P), sig / P
+
+        def res(theta):
+            m = curve(theta)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                lm = np.log(np.where(m > 0, m, 1e-300))
+            lm = np.where(np.isfinite(lm), lm, -700.0)
+            return (lm - y) / s
+
+    elif space == "linear":
+
+        def res(theta):
+            m = curve(theta)
+            return (np.where(np.isfinite(m), m, 0.0) - P) / sig
+
+    else:
+        raise ValueError(f"space must be 'log' or 'linear', got {space!r}")
+    return res
+
+
+def _lsq(res, starts, lo, hi):
+    """Best least_squares solution over several starting points."""
+    best = None
+    for x0 in starts:
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
+        try:
+            r = optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
+        except ValueError:
+            continue
+        if best is None or r.cost < best.cost:
+            best = r
+    if best is None:
+        raise RuntimeError("survival fit failed for all starting points")
+    return best
+
+
+def _covariance(J, chi2_red, absolute_sigma):
+    cov = np.linalg.pinv(J.T @ J)
+    if not absolute_sigma:
+        cov = cov * chi2_red
+    return cov
+
+
+def _goodness(curve_vals, t, P, res_norm, k):
+    n = t.size
+    chi2 = float(np.sum(res_norm**2))
+    dof = n - k
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lr = np.log(curve_vals) - np.log(P)
+    lr = lr[np.isfinite(lr)]
+    rms = float(np.sqrt(np.mean(lr**2))) if lr.size else float("nan")
+    return chi2, dof, (chi2 / dof if dof > 0 else float("nan")), rms, chi2 + 2 * k
+
+
+# ---------------------------------------------------------------------------
+# homogeneous fit
+# ---------------------------------------------------------------------------
+_HOMOG = ("f_ne", "f_e", "L", "b", "tau2")
+
+
+@dataclass(frozen=True)
+class _FitStats:
+    """Post-fit statistics shared by the homogeneous and the mixture fit."""
+
+    chi2: float
+    dof: int
+    chi2_red: float
+    rms: float
+    aic: float
+    cov_fit: np.ndarray  # covariance of the free parameters from the fit alone
+    sens: np.ndarray  # ∂θ/∂P(τ0) from a re-fit at P(τ0) + σ_P(τ0)
+    cov: np.ndarray  # cov_fit plus the propagated error of the measured P(τ0)
+
+
+def _fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> _FitStats:
+    """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
+    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, t, P, r, k)
+    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    sens = np.zeros(0 if sol is None else sol.x.size)
+    if refit is not None and P_tau0_err > 0 and sol is not None:
+        sens = (refit(P_tau0_err).x - sol.x) / P_tau0_err
+    return _FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
+
+
+def _survival_fit(model, values, errors, free, st: _FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
+    return SurvivalFit(
+        params=model,
+        values=values,
+        errors=errors,
+        free=tuple(free),
+        cov=st.cov,
+        chi2=st.chi2,
+        dof=st.dof,
+        chi2_red=st.chi2_red,
+        rms_log_residual=st.rms,
+        aic=st.aic,
+        n_points=int(t_fit.size),
+        space=space,
+        t_fit=t_fit,
+        residuals=residuals,
+        success=bool(sol.success) if sol is not None else True,
+        message=str(sol.message) if sol is not None else "no free parameters",
+    )
+
+
+def fit_survival_model(
+    t,
+    P,
+    P_err,
+    *,
+    kappa_of_E: Callable,
+    E0: float,
+    mu: float,
+    gamma: float,
+    tau0: float,
+    tau2: float | None = None,
+    E_c: float = E_C,
+    fixed: dict | None = None,
+    fit_tau2: bool = False,
+    p0: dict | None = None,
+    P_tau0: float | None = None,
+    constrain_total: bool = True,
+    space: str = "log",
+    P_min: float = 0.0,
+    t_max: float | None = None,
+    hazard: str = "paper",
+    absolute_sigma: bool = True,
+) -> SurvivalFit:
+    """fit_survival_model(t, P, P_err, *, kappa_of_E, E0, mu, gamma, tau0, ...) -> SurvivalFit.
+
+    Weighted least-squares fit of Eq. (eqn:surv_prob_model) to a measured
+    survival curve P(t) ± P_err (e.g. from
+    :func:`hhscatter.analysis.dissipative.transitions.survival_curve`) on τ0 ≤ t ≤ t_max.
+
+    Parameters: f_ne, f_e, L, b and τ2.  The energy path (E0, μ, γ) and κ0(E)
+    are inputs (measured elsewhere: :func:`~hhscatter.analysis.dissipative.decay.fit_energy_decay`
+    and the conservative study).
+
+    * ``constrain_total`` (default True): f_e = P(τ0) − f_ne as in the paper;
+      P(τ0) is ``P_tau0`` (taken as exact) or, if None, log-linearly
+      interpolated from the data; its error is then propagated into the
+      errors and ``cov`` by re-fitting at P(τ0) + σ (linear sensitivity).
+    * τ2 is fixed at ``tau2`` (None: Eq. (eq:tau2)) unless ``fit_tau2``; then
+      it is fitted by profiling χ² over τ2 (the model jumps at τ2, so χ² is
+      only piecewise smooth there) and its error is the half-width of the
+      Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``).
+    * ``fixed``: dict name → value holding any of f_ne, f_e, L, b fixed.
+    * ``p0``: dict of starting values (defaults are data-driven, with a few
+      starts for b).
+    * ``space``: "log" (residuals (ln P_model − ln P)/(σ_P/P), default) or
+      "linear" ((P_model − P)/σ_P).  Points with P ≤ ``P_min`` are dropped
+      (log residuals need counts ≫ 1: use P_min ≈ 20/N).
+    * ``absolute_sigma`` (default True): P_err are true standard deviations
+      (binomial errors); False rescales the covariance by χ²/dof.
+
+    Error model: points are treated as independent (diagonal weights).  The
+    points of one empirical survival curve are positively correlated
+    (log P is a cumulative sum of increments), so on a fine time grid the
+    χ²/dof and the parameter errors of such a fit are not calibrated (the
+    errors are too small); use a coarse grid, or resample orbits (bootstrap
+    over the lifetimes table) for honest errors.  With independent
+    per-point noise (tests) the errors are calibrated.
+
+    Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
+    AIC, ...).
+    """
+    fixed = dict(fixed or {})
+    unknown = set(fixed) - set(_HOMOG)
+    if unknown:
+        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+    if hazard not in HAZARDS:
+        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    t_all = np.asarray(t, dtype=float)
+    if P_tau0 is None:
+        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
+    else:
+        P_tau0_err = 0.0
+    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
+    if tf.size < 3:
+        raise ValueError("fewer than 3 data points selected")
+    tau2_eq = tau2_predicted(E0, E_c, mu, gamma) if tau2 is None else float(tau2)
+    if "tau2" in fixed:
+        tau2_eq, fit_tau2 = float(fixed.pop("tau2")), False
+
+    free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
+    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
+    prob = HomogeneousProblem(tf, Pf, sf, kappa_of_E, E0, mu, gamma, tau0, E_c, hazard, space, free, fixed,
+                              {"f_ne": fne0, "f_e": fe0, "L": L0}, b_starts, constrain_total, P_tau0)
+
+    tau2_err = 0.0
+    if fit_tau2:
+        tau2_fit, tau2_err, sol, c2min, res = prob.fit_tau2(absolute_sigma)
+    else:
+        tau2_fit = tau2_eq
+        sol, c2min, res = prob.fit_at(tau2_fit)
+
+    k = len(free) + (1 if fit_tau2 else 0)
+    theta = sol.x if sol is not None else np.array([])
+    v = prob.values(theta, tau2_fit)
+    model = prob.model(v)
+    curve_vals = model(tf)
+    r = res(theta)
+    # propagate the error of the measured P(τ0) through the constraint
+    refit = ((lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0])
+             if prob.derive_fe else None)
+    st = _fit_stats(sol, curve_vals, tf, Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
+    errors["tau2"] = tau2_err
+    values = dict(v)
+    values["P_tau0"] = P_tau0
+    errors["P_tau0"] = P_tau0_err
+    return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, space)
+
+
+def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
+    """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
+    values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
+    L ≈ the late log-slope of P, and three starts for b unless given."""
+    p0 = dict(p0 or {})
+
+    def p_near(tq):
+        return float(np.exp(np.interp(tq, tf, np.log(Pf))))
+
+    fne0 = p0.get("f_ne", fixed.get("f_ne", min(max(p_near(tau2), 1e-8), 0.9 * P_tau0)))
+    fe0 = p0.get("f_e", fixed.get("f_e", max(P_tau0 - fne0, 1e-8)))
+    late = tf > tau2
+    if late.sum() >= 3:
+        hl = tf[late] >= np.median(tf[late])
+        slope = -np.polyfit(tf[late][hl], np.log(Pf[late][hl]), 1)[0] if hl.sum() >= 2 else 0.05
+        L0 = p0.get("L", max(slope, 1e-3))
+    else:
+        L0 = p0.get("L", 0.05)
+    b_starts = (p0["b"],) if "b" in p0 else (0.02, 0.1, 0.5)
+    return fne0, fe0, L0, b_starts
+
+
+@dataclass(frozen=True)
+class HomogeneousProblem:
+    """The least-squares problem of :func:`fit_survival_model` on its selected points (tf, Pf ± sf).
+
+    ``free`` the fitted parameters (in order: θ), ``fixed`` the held ones,
+    ``start`` the starting f_ne, f_e, L and ``b_starts`` the starts for b;
+    with ``constrain_total`` (and f_e not fixed) f_e = P(τ0) − f_ne. Each step
+    of the fit is a method, testable alone.
+    """
+
+    tf: np.ndarray
+    Pf: np.ndarray
+    sf: np.ndarray
+    kappa_of_E: Callable
+    E0: float
+    mu: float
+    gamma: float
+    tau0: float
+    E_c: float
+    hazard: str
+    space: str
+    free: tuple
+    fixed: dict
+    start: dict
+    b_starts: tuple
+    constrain_total: bool
+    P_tau0: float
+
+    @property
+    def derive_fe(self) -> bool:
+        return self.constrain_total and "f_e" not in self.fixed
+
+    def bounds(self, P0=None):
+        """(lo, hi) of θ: 0 ≤ f_ne ≤ P(τ0) (or 1), 0 ≤ f_e ≤ 1, L ∈ [1e-9, 1e3], b ∈ [1e-6, 1e3]."""
+        P0 = self.P_tau0 if P0 is None else P0
+        bounds = {"f_ne": (0.0, P0 if self.constrain_total else 1.0), "f_e": (0.0, 1.0), "L": (1e-9, 1e3),
+                  "b": (1e-6, 1e3)}
+        return (np.array([bounds[n][0] for n in self.free], dtype=float),
+                np.array([bounds[n][1] for n in self.free], dtype=float))
+
+    def values(self, theta, tau2, P0=None) -> dict:
+        """All parameters from θ: the starts, overridden by ``fixed``, then θ; f_e derived; τ2 set."""
+        v = {**self.start, "b": self.b_starts[0]}
+        v.update(self.fixed)
+        v.update(dict(zip(self.free, theta)))
+        if self.derive_fe:
+            v["f_e"] = (self.P_tau0 if P0 is None else P0) - v["f_ne"]
+        v["tau2"] = tau2
+        return v
+
+    def model(self, v: dict) -> "SurvivalModelParams":
+        return SurvivalModelParams(self.kappa_of_E, self.E0, self.mu, self.gamma, self.tau0, v["tau2"], v["f_ne"],
+                                   v["f_e"], v["L"], v["b"], self.E_c, self.hazard)
+
+    def starts(self, prev=None, warm_only: bool = False) -> list:
+        """Starting θ: a previous solution (warm start) first, then one per start of b."""
+        out = []
+        if prev is not None:
+            out.append(prev)
+            if warm_only:
+                return out
+        for b0 in self.b_starts:
+            guess = {**self.start, "b": b0}
+            out.append([guess[n] for n in self.free])
+        return out
+
+    def fit_at(self, tau2, prev=None, warm_only: bool = False, P0=None):
+        """(solution or None, χ², residual function) of the fit with τ2 held at ``tau2``."""
+        curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)  # noqa: E731
+        res = _residual_fn(curve, self.Pf, self.sf, self.space)
+        if not self.free:
+            r = res(np.array([]))
+            return None, float(np.sum(r**2)), res
+        sol = _lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
+        return sol, float(2 * sol.cost), res
+
+    def profile(self, taus):
+        """χ² profile over τ2 (each point warm-started from its neighbour): (χ² array, solutions)."""
+        prof, sols, prev = [], [], None
+        for tv in taus:
+            sol, c2, _ = self.fit_at(tv, prev)
+            prev = None if sol is None else sol.x
+            prof.append(c2)
+            sols.append(prev)
+        return np.array(prof), sols
+
+    def fit_tau2(self, absolute_sigma: bool = True):
+        """τ2 fitted by profiling χ²: a coarse scan over [τ0, t_last], then a fine one around its minimum; the
+        error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``), its two ends
+        found by root-finding on the profile (:func:`profile_interval`), not bounded by the scan's steps.
+        Returns (τ2, σ_τ2, solution, χ², residual function)."""
+        grid = np.linspace(self.tau0 + 1e-9, float(self.tf[-1]), 25)
+        prof, _ = self.profile(grid)
+        i = int(np.argmin(prof))
+        fine = np.linspace(grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)], 21)
+        fprof, fsols = self.profile(fine)
+        j = int(np.argmin(fprof))
+        tau2_best = float(fine[j])
+        sol, c2min, res = self.fit_at(tau2_best, fsols[j])
+        dof = self.tf.size - len(self.free) - 1
+        scale = 1.0 if absolute_sigma else max(c2min / max(dof, 1), 1e-300)
+        warm = None if sol is None else sol.x
+
+        def chi2_at(tv):
+            return self.fit_at(float(tv), warm)[1]
+
+        lo, hi = profile_interval(chi2_at, tau2_best, c2min, grid[0], grid[-1], delta=scale,
+                                  step=fine[1] - fine[0])
+        return tau2_best, float((hi - lo) / 2), sol, c2min, res
+
+
+def profile_interval(chi2_of, best: float, chi2_min: float, lo_edge: float, hi_edge: float, *, delta: float = 1.0,
+                     step: float | None = None, xtol: float = 1e-9) -> tuple[float, float]:
+    """profile_interval(chi2_of, best, chi2_min, lo_edge, hi_edge, *, delta=1, step=None) -> (lo, hi): the ends of
+    the region χ²(x) ≤ χ²_min + Δ of a profile χ²(x) around its minimum ``best``, by root-finding on each side.
+
+    From ``best`` each side steps outward (``step``, default 1 % of the range,
+    doubling) until the profile exceeds χ²_min + Δ, then
+    :func:`scipy.optimize.brentq` finds the crossing. A side whose profile does
+    not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
+    the allowed range on that side: the data do not bound it).
+    """
+    target = float(chi2_min) + float(delta)
+
+    def g(x):
+        return float(chi2_of(x)) - target
+
+    step = float(step) if step else 0.01 * (hi_edge - lo_edge)
+    ends = []
+    for sign, edge in ((-1.0, lo_edge), (1.0, hi_edge)):
+        inner, h, end = float(best), step, None
+        while end is None:
+            outer = float(best) + sign * h
+            if sign * (outer - edge) >= 0:
+                end = edge if g(edge) <= 0 else float(optimize.brentq(g, *sorted((inner, edge)), xtol=xtol))
+            elif g(outer) > 0:
+                end = float(optimize.brentq(g, *sorted((inner, outer)), xtol=xtol))
+            else:
+                inner, h = outer, 2 * h
+        ends.append(end)
+    return ends[0], ends[1]
+
+
+def _homogeneous_errors(free, st, derive_fe: bool, P_tau0_err: float) -> dict:
+    """1σ errors of f_ne, f_e, L, b from the fit statistics; f_e = P(τ0) − f_ne carries P(τ0)'s error."""
+    errors = {n: 0.0 for n in _HOMOG}
+    for i, n in enumerate(free):
+        errors[n] = float(np.sqrt(max(st.cov[i, i], 0.0)))
+    if derive_fe:
+        i_f = free.index("f_ne") if "f_ne" in free else None
+        var_fit = st.cov_fit[i_f, i_f] if i_f is not None else 0.0
+        dfe_dP = 1.0 - (st.sens[i_f] if i_f is not None else 0.0)
+        errors["f_e"] = float(np.sqrt(max(var_fit, 0.0) + (dfe_dP * P_tau0_err) ** 2))
+    return errors
+
+
+# ---------------------------------------------------------------------------
+# τ1 from the model
+# ---------------------------------------------------------------------------
+def _as_curve(P_0):
+    if callable(P_0):
+        return P_0
+    tg, Pg = (np.asarray(a, dtype=float) for a in P_0)
+    ok = np.isfinite(Pg) & (Pg > 0)
+    tg, lg = tg[ok], np.log(Pg[ok])
+
+    def f(t):
+        t = np.asarray(t, dtype=float)
+        out = np.exp(np.interp(t, tg, lg))
+        return np.where((t < tg[0]) | (t > tg[-1]), np.nan, out)
+
+    f.t_end = float(tg[-1])
+    return f
+
+
+def predict_tau1(params, P_0, alpha: float = 2.0, *, t_max: float | None = None, n_grid: int = 20001):
+    """predict_tau1(params, P_0, alpha=2.0, *, t_max=None) -> float or None.
+
+    Predicted τ1 (Fig. 6b dashed line): solves Eq. (eqn:tau1),
+    min{t ≥ τ0 : P_model(t) = α P_0(t)}, with P_model given by ``params``
+    (a :class:`SurvivalModelParams`, :class:`MixtureModelParams`, a
+    :class:`SurvivalFit`, or any object with ``tau0`` that is callable on t).
+
+    ``P_0`` is the conservative survival curve: a callable P_0(t) or a pair
+    (t_grid, P0_values), interpolated linearly in log P (NaN outside the
+    grid).  The condition is scanned on ``n_grid`` points in [τ0, t_max]
+    (default: the end of the P_0 grid, or τ0 + 3(τ2 − τ0) for a callable)
+    and the first sign change of ln P_model − ln(α P_0) is refined with
+    Brent's method.  Returns τ0 if the condition already holds at τ0, None if
+    it never does.
+    """
+    if hasattr(params, "params") and not hasattr(params, "tau0"):
+        params = params.params
+    tau0 = float(params.tau0)
+    f0 = _as_curve(P_0)
+    if t_max is None:
+        if hasattr(f0, "t_end"):
+            t_max = f0.t_end
+        else:
+            tau2 = params.tau2_k if hasattr(params, "tau2_k") else params.tau2
+            tau2 = float(np.max(np.atleast_1d(tau2)))
+            t_max = tau0 + 3 * max(tau2 - tau0, 1.0)
+    if t_max <= tau0:
+        return None
+    tt = np.linspace(tau0, t_max, n_grid)
+
+    def D(x):
+        pm = np.asarray(params(x), dtype=float)
+        p0 = np.asarray(f0(x), dtype=float)
+        return _log_ratio_d(pm, p0, alpha)
+
+    d = D(tt)
+    if d[0] >= 0:
+        return tau0
+    hit = np.flatnonzero(d >= 0)
+    if hit.size == 0:
+        return None
+    j = int(hit[0])
+    a, b = tt[j - 1], tt[j]
+    if not np.isfinite(d[j]) or not np.isfinite(d[j - 1]):
+        return float(b)
+    try:
+        return float(optimize.brentq(lambda x: float(D(x)), a, b, xtol=1e-10))
+    except ValueError:
+        return float(b)
+
+
+def _log_ratio_d(pm, p0, alpha):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.log(pm) - np.log(alpha * p0)
+    d = np.where((p0 <= 0) & (pm > 0), np.inf, d)
+    return np.where(np.isnan(d), -np.inf, d)
+
+
+def compare_fits(fits: dict) -> pd.DataFrame:
+    """compare_fits({name: SurvivalFit, ...}) -> DataFrame of goodness of fit, one row per model.
+
+    Columns: n_points, n_free, chi2, dof, chi2_red, rms_log_residual, aic.
+    The comparison is meaningful only for fits on the same data selection
+    (equal n_points, same τ0, t_max, P_min and residual space).
+    """
+    rows = []
+    for name, f in fits.items():
+        rows.append(
+            {
+                "model": name,
+                "n_points": f.n_points,
+                "n_free": len(f.free),
+                "chi2": f.chi2,
+                "dof": f.dof,
+                "chi2_red": f.chi2_red,
+                "rms_log_residual": f.rms_log_residual,
+                "aic": f.aic,
+            }
+        )
+    return pd.DataFrame(rows).set_index("model")
+
+
+def better_fit(fits: dict) -> str | None:
+    """better_fit({name: SurvivalFit, ...}) -> name of the fit with the smallest RMS log residual (None on a tie).
+
+    For the same model, Eq. (eqn:surv_prob_model), fitted with different
+    fixed inputs (e.g. the κ0(E) law and μ fitted by us or stated by the
+    paper): the RMS of ln P_model − ln P (dimensionless) says which inputs
+    reproduce the simulated P(t) better.  The RMS rather than χ² because the
+    Kaplan–Meier points are correlated and χ² is only indicative (see
+    :class:`SurvivalFit`); both fits have the same free parameters here.
+    The fits must share their fitted points (same ``t_fit``), else the
+    comparison means nothing: ValueError.
+    """
+    if len(fits) < 2:
+        raise ValueError("better_fit needs at least two fits")
+    items = list(fits.items())
+    t_ref = np.asarray(items[0][1].t_fit)
+    for name, f in items[1:]:
+        if not np.array_equal(np.asarray(f.t_fit), t_ref):
+            raise ValueError(f"fit {name!r} was made on other points than {items[0][0]!r}; "
+                             "compare fits on the same data selection only")
+    rms = np.array([f.rms_log_residual for _, f in items], dtype=float)
+    if not np.isfinite(rms).all():
+        raise ValueError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
+    best = np.flatnonzero(rms == rms.min())
+    return None if best.size > 1 else items[int(best[0])][0]

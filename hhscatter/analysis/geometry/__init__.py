@@ -1,0 +1,1 @@
+"""Phase-space geometry: distances of section-point sets, exit basins (fractality, Wada), the transfer operator, exit channels."""

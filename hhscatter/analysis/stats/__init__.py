@@ -1,0 +1,1 @@
+"""Statistics shared by the analyses: weighted least squares, binomial intervals, verdict wording."""

@@ -1,0 +1,190 @@
+"""κ0(E) under several conventions, and the κ(E) law with its spread across them.
+
+The escape rate of Eq. (eqn:kappa_hyperbolic) near E_c depends on how it is
+defined: the IC region (disk r < 0.5, or the authors' square [−1, 1]² with
+V < E) and the fitting windows move κ at E ≤ 0.23 by more than the
+disagreement with the paper, and square ICs bring a plateau of KAM-trapped
+orbits (P∞ = 6.5 % at E = 0.18) on which a local-slope window rule locks,
+returning κ ≈ 0. This module holds the pure pieces (arrays and DataFrames in,
+results out):
+
+* :func:`p_level_windows` — the 4 windows (full, halves, middle) between the
+  times where P(t) first falls to ``p_hi`` and to ``p_lo``: a rule fixed by
+  P levels, beside the data-driven plateau of
+  :func:`hhscatter.analysis.survival.windows.choose_windows`;
+* :func:`escape_rate_p_levels` — κ = mean of the 4 least-squares fits of
+  log P on those windows, error √(spread² + stat²), as
+  :func:`hhscatter.analysis.survival.escape_rate.escape_rate`;
+* :func:`plateau_check` — whether the trapped fraction makes κ of a window
+  ill-defined: with a fraction f∞ of orbits that never escape, log P(t) of
+  the Kaplan–Meier curve flattens and its slope underestimates κ by
+  f∞/P(t) at time t; a window ending where this exceeds ``max_bias`` gives
+  no κ;
+* :func:`stable_energies` — energies where every defined convention agrees
+  within ``rel_tol``;
+* :func:`law_spread` — the parameters of the κ(E) law fitted per convention
+  and their spread, the systematic uncertainty of "the κ(E) law".
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hhscatter.analysis.survival.fits import fit_exponential, mean_kappa_stat_err, survival_curve
+
+
+@dataclass(frozen=True)
+class ConventionRate:
+    """κ of one convention at one energy (1/time); ``defined`` False with a ``reason`` when ill-defined."""
+
+    kappa: float
+    kappa_err: float
+    kappa_stat: float
+    kappa_spread: float
+    t_lo: float
+    t_hi: float
+    trapped_fraction: float
+    bias_at_end: float  # f∞/P(t_hi): relative underestimate of the local slope at the window end
+    defined: bool
+    reason: str = ""
+
+
+def trapped_fraction(t_end, observed) -> float:
+    """trapped_fraction(t_end, observed) -> fraction of orbits still inside at the end (censored), in [0, 1].
+
+    An upper bound of the KAM-trapped fraction P∞ (long sticky orbits censored
+    at t_max count too).
+    """
+    observed = np.asarray(observed, dtype=bool).ravel()
+    return float((~observed).sum() / max(observed.size, 1))
+
+
+def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
+    """p_level_windows(t, P, p_hi=0.5, p_lo=1e-2) -> 4 windows (t_lo, t_hi) or None (time units).
+
+    t_a = first t with P ≤ ``p_hi``, t_b = first t with P ≤ ``p_lo``; windows
+    [t_a, t_b], its halves and its middle half (the layout of
+    :func:`hhscatter.analysis.survival.windows.choose_windows`). None when P never
+    falls to ``p_lo`` (e.g. a plateau of trapped orbits above it).
+    """
+    if not 0 < p_lo < p_hi < 1:
+        raise ValueError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
+    t = np.asarray(t, dtype=float)
+    P = np.asarray(P, dtype=float)
+    ia, ib = np.flatnonzero(P <= p_hi), np.flatnonzero(P <= p_lo)
+    if ia.size == 0 or ib.size == 0:
+        return None
+    ta, tb = float(t[ia[0]]), float(t[ib[0]])
+    if tb <= ta:
+        return None
+    L = tb - ta
+    return ((ta, tb), (ta, ta + L / 2), (ta + L / 2, tb), (ta + L / 4, ta + 3 * L / 4))
+
+
+def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
+    """plateau_check(P(t_hi), f∞, max_bias=0.1) -> (defined, bias, reason).
+
+    bias = f∞/P(t_hi): at the window end that share of the survivors never
+    escapes, so the slope of log P there is (1 − bias) κ. Above ``max_bias``
+    the window measures the plateau, not κ. f∞ counts every orbit still
+    inside at t_max, sticky ones included: near E_c, where the power-law
+    tail starts early, the check also flags windows that reach into it
+    (the decay there is no longer the exponential of κ either).
+    """
+    bias = f_trapped / P_end if P_end > 0 else math.inf
+    if bias > max_bias:
+        return False, bias, (f"plateau: orbits still inside at t_max (KAM-trapped or sticky) are {f_trapped:.2%}, "
+                             f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined")
+    return True, bias, ""
+
+
+def _windows_rate(t, P, E, windows):
+    fits = [fit_exponential(t, P, w, E) for w in windows]
+    ks = np.array([f.kappa for f in fits])
+    spread = float(ks.std(ddof=1))
+    stat = float(mean_kappa_stat_err(t, P, E, windows))
+    return float(ks.mean()), spread, stat
+
+
+def escape_rate_p_levels(t_end, observed, *, p_hi: float = 0.5, p_lo: float = 1e-2, max_bias: float = 0.1,
+                         n_grid: int = 20001) -> ConventionRate:
+    """escape_rate_p_levels(t_end, observed, *, p_hi=0.5, p_lo=1e-2, max_bias=0.1) -> ConventionRate.
+
+    κ (1/time) of Eq. (eqn:kappa_hyperbolic) on windows fixed by P levels
+    (:func:`p_level_windows`), from lifetimes ``t_end`` (time units) and the
+    ``observed`` mask (False = censored). Undefined when P never reaches
+    ``p_lo`` or the plateau check fails at the window end.
+    """
+    t_end = np.asarray(t_end, dtype=float).ravel()
+    observed = np.asarray(observed, dtype=bool).ravel()
+    f_inf = trapped_fraction(t_end, observed)
+    grid = np.linspace(0.0, float(t_end.max()) if t_end.size else 1.0, int(n_grid))
+    curve = survival_curve(t_end, observed, grid)
+    ok = np.isfinite(curve.P)
+    t, P, E = curve.t[ok], curve.P[ok], curve.P_err[ok]
+    wins = p_level_windows(t, P, p_hi, p_lo)
+    if wins is None:
+        return ConventionRate(math.nan, math.nan, math.nan, math.nan, math.nan, math.nan, f_inf, math.inf, False,
+                              f"P(t) never falls to {p_lo:g} (trapped fraction {f_inf:.2%})")
+    defined, bias, reason = plateau_check(float(np.interp(wins[0][1], t, P)), f_inf, max_bias)
+    kappa, spread, stat = _windows_rate(t, P, E, wins)
+    return ConventionRate(kappa, float(math.hypot(spread, stat)), stat, spread, wins[0][0], wins[0][1], f_inf, bias,
+                          defined, reason)
+
+
+def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> ConventionRate:
+    """plateau_rate(EscapeRateResult, t_end, observed, *, max_bias=0.1) -> ConventionRate of the window rule.
+
+    The κ of :func:`hhscatter.analysis.survival.escape_rate.escape_rate` (data-driven
+    plateau windows), with the plateau check at its window end t_stop.
+    """
+    f_inf = trapped_fraction(t_end, observed)
+    P_end = float(np.interp(result.t_stop, result.curve.t, result.curve.P))
+    defined, bias, reason = plateau_check(P_end, f_inf, max_bias)
+    return ConventionRate(result.kappa, result.kappa_err, result.kappa_stat, result.kappa_spread, result.tau0,
+                          result.t_stop, f_inf, bias, defined, reason)
+
+
+def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
+    """stable_energies(table, *, rel_tol=0.1, min_defined=2) -> DataFrame: energy, n_defined, rel_range, stable.
+
+    ``table``: one row per (energy, convention) with columns ``energy``,
+    ``kappa``, ``defined``. κ at an energy is *stable* when at least
+    ``min_defined`` conventions define it and (max − min)/mean of their κ is
+    ≤ ``rel_tol``.
+    """
+    import pandas as pd
+
+    rows = []
+    for energy, g in table.groupby("energy", sort=True):
+        k = g.loc[g["defined"].astype(bool), "kappa"].to_numpy(float)
+        rel = float((k.max() - k.min()) / k.mean()) if k.size >= 1 and k.mean() > 0 else math.nan
+        rows.append({"energy": float(energy), "n_defined": int(k.size), "rel_range": rel,
+                     "stable": bool(k.size >= min_defined and rel <= rel_tol)})
+    return pd.DataFrame(rows)
+
+
+LAW_PARAMETERS = ("a", "b", "c", "E_b")
+
+
+def law_spread(fits: dict) -> dict:
+    """law_spread({convention: KappaEnergyFit}) -> {param: {value, err_stat, spread, err, per_convention}}.
+
+    ``value`` = mean over conventions; ``spread`` = half the range across
+    conventions (the systematic uncertainty of the law from its definition);
+    ``err_stat`` = the largest statistical error of one convention's fit;
+    ``err`` = √(spread² + err_stat²).
+    """
+    out = {}
+    for p in LAW_PARAMETERS:
+        vals = {name: float(getattr(f, p)) for name, f in fits.items()}
+        errs = [float(getattr(f, f"{p}_err", math.nan)) for f in fits.values()]
+        v = np.array(list(vals.values()))
+        spread = float((v.max() - v.min()) / 2) if v.size else math.nan
+        stat = float(np.nanmax(errs)) if errs and np.isfinite(errs).any() else math.nan
+        out[p] = {"value": float(v.mean()) if v.size else math.nan, "err_stat": stat, "spread": spread,
+                  "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
+                  "per_convention": vals}
+    return out

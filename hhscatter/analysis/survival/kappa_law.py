@@ -1,0 +1,52 @@
+"""The conservative escape-rate law κ0(E) as a callable (paper Fig. 2b), the input of the survival models.
+
+:class:`PiecewiseKappa` holds the piecewise law κ0 = a2 ΔE² + a1 ΔE below
+E_switch and slope·ΔE above (ΔE = E − E_c, zero below E_c); the coefficients
+are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` (study
+fig2) or are the paper's (:data:`PAPER_KAPPA`). E_c comes from the model.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hhscatter.model import HenonHeiles
+
+__all__ = ["E_C", "PAPER_KAPPA", "PiecewiseKappa"]
+
+E_C = HenonHeiles().critical_energy  # E_c = ω⁶/(6λ²) with ω = λ = 1 (default; pass the scene's model's)
+"""Critical energy of the Hénon–Heiles potential with ω = λ = 1 (from :class:`hhscatter.model.HenonHeiles`)."""
+
+
+@dataclass(frozen=True)
+class PiecewiseKappa:
+    """PiecewiseKappa(a2=13.63, a1=0.03, slope=1.41, E_switch=0.27, E_c=1/6) -> callable κ0(E).
+
+    Conservative escape rate as a function of energy (paper Fig. 2b), with
+    ΔE = E − E_c:
+
+        κ0 = a2 ΔE² + a1 ΔE   for E_c < E < E_switch   (non-hyperbolic regime)
+        κ0 = slope · ΔE       for E ≥ E_switch         (hyperbolic, linear regime)
+        κ0 = 0                for E ≤ E_c              (no escape)
+
+    Defaults are the paper's fits.  Calling it on an array returns an array
+    (rates in 1/time).  Note the two branches do not join exactly at
+    E_switch (0.1486 vs 0.1457 with the defaults).
+    """
+
+    a2: float = 13.63
+    a1: float = 0.03
+    slope: float = 1.41
+    E_switch: float = 0.27
+    E_c: float = E_C
+
+    def __call__(self, E):
+        E = np.asarray(E, dtype=float)
+        d = E - self.E_c
+        k = np.where(E < self.E_switch, self.a2 * d * d + self.a1 * d, self.slope * d)
+        return np.where(d > 0, k, 0.0)
+
+
+PAPER_KAPPA = PiecewiseKappa()
+"""κ0(E) with the paper's fitted coefficients (Fig. 2b)."""

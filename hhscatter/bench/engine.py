@@ -1,0 +1,294 @@
+"""``make bench-engine``: the engine's targets as ratios measured side by side in one run.
+
+    python -m hhscatter.bench.engine [-n N] [--repeat R] [--out DIR]
+
+One process, one core, the same initial conditions for every contender,
+best of ``--repeat`` timings each (the machine is shared: ratios, not
+absolute times, are the result). Rows:
+
+* **yardstick** — a minimal refill-in-callback driver (heyoka batch, one
+  escape event whose callback records the time and loads the next initial
+  condition, the t_max bound, nothing else), at heyoka's recommended batch
+  size; the engine's bare conservative scene against it (target ≤ 1, aim 0.8);
+* **dissipative** — E0 = 0.3, γ = 0.01 against the conservative scene at
+  E = 0.3 on the same ICs (target ≤ 1.6), with steps per orbit for both, so
+  what the physics costs (longer lives) is told apart from overhead;
+* **loose tolerance** — the engine at tol 1e-9 against numba DOP853 at tol
+  1e-7 (``make bench``'s peer), conservative and dissipative (target ≥ 2×);
+* **recording** — energy snapshots every 0.5 to t = 200 plus the first
+  section crossing after t = 17 (E0 = 0.3, γ = 0.01) against the same scene
+  bare (target ≤ 2), and the marginal cost per recorded row (target ≤ 2 µs);
+* a cProfile split of the recording scene: time inside heyoka's compiled
+  propagation against Python callbacks and bookkeeping.
+
+Writes ``studies/engine/out/<full|quick>/engine.csv`` and ``engine_summary.md``
+(``make docs-assets`` copies them to the benchmarks page). Not a
+test: numbers vary with the machine; the ratios are what is reported.
+"""
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import time
+from pathlib import Path
+
+import numpy as np
+
+RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))
+
+
+def yardstick(ics, *, r_esc=1.03, t_max=5000.0, tol=1e-15, batch_size=None):
+    """yardstick(ics, ...) -> escape times: the minimal refill-in-callback driver (no sections,
+    snapshots, reruns or bookkeeping beyond recording the time and loading the next orbit).
+
+    Its event is built from the engine's declaration (:mod:`hhscatter.integrate.events`) so that both
+    integrate the same events; only the driver differs.
+    """
+    import heyoka as hy
+
+    from hhscatter.integrate.events import build_batch
+    from hhscatter.scene.scene import Scene
+
+    B = int(batch_size or hy.recommended_simd_size())
+    sc = Scene(energy=0.3, n=1, r_esc=r_esc, t_max=t_max, tol=tol)
+    state = {}
+
+    class Cb:
+        def __init__(self, spec=None):
+            pass
+
+        def __call__(self, ta, d, lane):
+            return state["on_escape"](lane)
+
+    ta, _, _ = build_batch(sc, B, Cb)
+    ics_l = np.ascontiguousarray(ics, dtype=float).tolist()
+    n = len(ics_l)
+    t_end = np.full(n, t_max)
+    orbit = [-1] * B
+    t0 = [0.0] * B
+    nxt = [0]
+    st = ta.state
+    hi = ta.dtime[0]
+
+    def load(lane):
+        k = nxt[0]
+        if k >= n:
+            orbit[lane] = -1
+            return False
+        nxt[0] = k + 1
+        orbit[lane] = k
+        st[:, lane] = ics_l[k]
+        t0[lane] = hi[lane]
+        ta.reset_cooldowns(lane)
+        return True
+
+    def on_escape(lane):
+        t_end[orbit[lane]] = hi[lane] - t0[lane]
+        return load(lane)
+
+    state["on_escape"] = on_escape
+    for lane in range(B):
+        load(lane)
+    tf = np.zeros(B)
+    while any(k >= 0 for k in orbit):
+        for lane in range(B):
+            if orbit[lane] >= 0 and hi[lane] >= tf[lane] and tf[lane] > 0:
+                load(lane)  # reached t_max: censored
+            tf[lane] = t0[lane] + t_max if orbit[lane] >= 0 else hi[lane]
+        if all(k < 0 for k in orbit):
+            break
+        ta.propagate_until(tf)
+    state.clear()  # break the cycle integrator → callback → closure → integrator
+    return t_end
+
+
+def design_choices(batch_size=8, epochs=400, epoch=8.0):
+    """design_choices() -> {name: ns per lane-step}: what each way of recording costs in heyoka.
+
+    Trapped orbits (E = 0.12, no event), ``epochs`` calls of one epoch each, as
+    the epoch scheduler makes them: ``propagate_until`` (no recording),
+    ``propagate_grid`` with 2 and 17 points per epoch (what snapshots every 0.5
+    cost), a Python step callback copying the Taylor coefficients (the
+    alternative to a grid), and ``c_output=True`` (continuous output). The
+    engine uses ``propagate_grid`` for snapshot scenes and ``propagate_until``
+    otherwise.
+    """
+    import heyoka as hy
+
+    from hhscatter.integrate.events import system
+    from hhscatter.scene.ics import section_velocities
+    from hhscatter.model import HenonHeiles
+    from hhscatter.scene.scene import Scene
+
+    m = HenonHeiles()
+    rng = np.random.default_rng(7)
+    r = 0.3 * np.sqrt(rng.random(batch_size))
+    phi = 2 * np.pi * rng.random(batch_size)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    px, py = section_velocities(m, x, y, 0.12)
+    st0 = np.vstack([x, y, px, py])
+    sc = Scene(energy=0.3, n=1)
+    from hhscatter.integrate.events import layout
+
+    sys = system(sc, layout(sc))
+    zeros = np.zeros(batch_size)
+    g2 = np.repeat(np.array([0.0, epoch])[:, None], batch_size, axis=1)
+    g17 = np.repeat(np.linspace(0.0, epoch, 17)[:, None], batch_size, axis=1)
+
+    def run(kind):
+        ta = hy.taylor_adaptive_batch(sys, st0.copy(), tol=1e-15)
+        tc = ta.tc
+        buf = []
+
+        def cb(ta_):
+            buf.append(tc.copy())
+            return True
+
+        steps = 0
+        t0 = time.perf_counter()
+        for _ in range(epochs if kind != "c_output" else max(epochs // 20, 5)):
+            ta.set_time(zeros)
+            if kind == "until":
+                ta.propagate_until(epoch)
+            elif kind == "grid2":
+                ta.propagate_grid(g2)
+            elif kind == "grid17":
+                ta.propagate_grid(g17)
+            elif kind == "step callback":
+                ta.propagate_until(epoch, callback=cb)
+                buf.clear()
+            else:
+                ta.propagate_until(epoch, c_output=True)
+            steps += sum(int(res[3]) for res in ta.propagate_res)
+        return 1e9 * (time.perf_counter() - t0) / steps
+
+    out = {}
+    for kind in ("until", "grid2", "grid17", "step callback", "c_output"):
+        run(kind)  # compile outside the measurement
+        out[kind] = min(run(kind) for _ in range(2))
+    return out
+
+
+def _best(fn, repeat):
+    fn()  # JIT compilation and caches outside the measurement
+    best = np.inf
+    out = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def _engine(scene, ics, **kw):
+    from hhscatter.integrate.engine import run_chunk
+
+    return lambda: run_chunk(scene, ics, np.arange(len(ics)), count_steps=True, **kw)
+
+
+def main(argv=None):
+    from hhscatter.bench import peers
+    from hhscatter.scene.ics import region_ics
+    from hhscatter.scene.scene import Scene, SectionWindow
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out", default=None, help="output folder (default studies/engine/out/full, "
+                    "or .../quick for N < 1e5)")
+    a = ap.parse_args(argv)
+    n, rep = a.n, a.repeat
+    rows = []
+
+    def row(target, what, value, goal, note=""):
+        rows.append({"target": target, "measure": what, "value": value, "goal": goal, "note": note})
+        print(f"{target:16s} {what:58s} {value:10.3f}  {goal:>8s}  {note}", flush=True)
+
+    print(f"# hhscatter engine benchmark: N = {n} per measurement, 1 core, best of {rep}")
+    # -- bare conservative vs the yardstick ----------------------------------------------
+    cons = Scene(energy=0.27, n=n, seed=1, r_esc=1.03)
+    ics = region_ics(cons, 0, n)
+    t_y, ty = _best(lambda: yardstick(ics), rep)
+    t_e, res = _best(_engine(cons, ics), rep)
+    lt = res.lifetimes
+    agree = np.mean(np.abs(lt["t_end"] - ty) <= 1e-9 * np.maximum(1.0, ty))
+    row("bare", "yardstick µs/orbit (recommended batch size)", 1e6 * t_y / n, "")
+    row("bare", "engine µs/orbit", 1e6 * t_e / n, "")
+    row("bare", "engine / yardstick", t_e / t_y, "≤ 1 (0.8)", f"same t_end (1e-9) on {100 * agree:.1f} % of orbits")
+    # -- dissipative vs conservative at the same energy -----------------------------------
+    c3 = Scene(energy=0.3, n=n, seed=2, r_esc=1.03)
+    d3 = c3.replace(gamma=0.01)
+    ics3 = region_ics(c3, 0, n)
+    t_c, rc = _best(_engine(c3, ics3), rep)
+    t_d, rd = _best(_engine(d3, ics3), rep)
+    sc_, sd_ = rc.n_steps / n, rd.n_steps / n
+    row("dissipative", "conservative E = 0.3: µs/orbit", 1e6 * t_c / n, "", f"{sc_:.1f} steps/orbit")
+    row("dissipative", "dissipative E0 = 0.3, γ = 0.01: µs/orbit", 1e6 * t_d / n, "", f"{sd_:.1f} steps/orbit")
+    row("dissipative", "dissipative / conservative", t_d / t_c, "≤ 1.6",
+        f"per step: {(t_d / rd.n_steps) / (t_c / rc.n_steps):.2f}×")
+    # -- loose tolerance vs numba DOP853 ----------------------------------------------------
+    m = min(n, 20_000)
+    for label, gamma in (("conservative", 0.0), ("dissipative", 0.01)):
+        sc = c3.replace(gamma=gamma, tol=1e-9, n=m)
+        t_l, _ = _best(_engine(sc, ics3[:m]), rep)
+        t_p, _ = _best(lambda g=gamma: peers.dop853(ics3[:m], 1e-7, gamma=g, r_esc=1.03), rep)
+        row("loose tol", f"{label}: numba DOP853 (1e-7) / engine (1e-9)", t_p / t_l, "≥ 2",
+            f"engine {1e6 * t_l / m:.2f}, DOP853 {1e6 * t_p / m:.2f} µs/orbit")
+    # -- recording scene ---------------------------------------------------------------------
+    m = min(n, 20_000)
+    bare = Scene(energy=0.3, gamma=0.01, n=m, seed=3, r_esc=1.03)
+    rec = bare.replace(snapshots=RECORD_SNAPSHOTS, sections=SectionWindow(t_from=17.0, first_only=True))
+    icr = region_ics(bare, 0, m)
+    t_b, rb = _best(_engine(bare, icr), rep)
+    t_r, rr = _best(_engine(rec, icr), rep)
+    n_rows = len(rr.snapshots["t"]) + len(rr.sections["t"])
+    row("recording", "bare µs/orbit", 1e6 * t_b / m, "", f"{rb.n_steps / m:.1f} steps/orbit")
+    row("recording", "recording µs/orbit", 1e6 * t_r / m, "",
+        f"{rr.n_steps / m:.1f} steps/orbit, {n_rows / m:.1f} rows/orbit")
+    row("recording", "recording / bare", t_r / t_b, "≤ 2")
+    row("recording", "marginal µs per recorded row", 1e6 * (t_r - t_b) / max(n_rows, 1), "≤ 2")
+    only_snap = bare.replace(snapshots=RECORD_SNAPSHOTS)
+    t_s, rs = _best(_engine(only_snap, icr), rep)
+    row("recording", "snapshots only / bare", t_s / t_b, "", "epoch scheduler: propagate_grid")
+    only_sec = bare.replace(sections=SectionWindow(t_from=17.0, first_only=True))
+    t_x, _ = _best(_engine(only_sec, icr), rep)
+    row("recording", "first section after t = 17 only / bare", t_x / t_b, "", "gated section event + clock")
+    # -- where the recording scene's time goes --------------------------------------------
+    prof = cProfile.Profile()
+    fn = _engine(rec, icr)
+    prof.enable()
+    fn()
+    prof.disable()
+    stats = pstats.Stats(prof).stats
+    total = sum(v[2] for v in stats.values())
+    inside = sum(v[2] for k, v in stats.items() if k[2] in ("propagate_grid", "propagate_until")
+                 or "propagate_grid" in k[2] or "propagate_until" in k[2])
+    row("profile", "recording: share inside heyoka's compiled propagation", inside / total, "",
+        "self time of propagate_*; the rest is Python (callbacks, epochs, numpy)")
+
+    # -- the design choices behind the epoch scheduler -------------------------------------
+    dc = design_choices()
+    for kind, label in (("until", "propagate_until (no recording)"), ("grid2", "propagate_grid, 2 points/epoch"),
+                        ("grid17", "propagate_grid, 17 points/epoch (snapshots every 0.5)"),
+                        ("step callback", "Python step callback copying the Taylor coefficients"),
+                        ("c_output", "propagate_until with c_output=True")):
+        row("design", f"ns per lane-step: {label}", dc[kind], "",
+            f"{dc[kind] / dc['until']:.2f}× propagate_until")
+
+    out = Path(a.out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
+    out.mkdir(parents=True, exist_ok=True)
+    import pandas as pd
+
+    df = pd.DataFrame(rows)
+    df.to_csv(out / "engine.csv", index=False)
+    lines = ["| target | measure | value | goal | note |", "|---|---|---|---|---|"]
+    lines += [f"| {r.target} | {r.measure} | {r.value:.3g} | {r.goal} | {r.note} |" for r in df.itertuples()]
+    (out / "engine_summary.md").write_text(
+        f"Engine targets (issue 11), N = {n} per measurement, 1 core, best of {rep}; every ratio is "
+        "measured side by side in one run.\n\n" + "\n".join(lines) + "\n")
+    print(f"wrote {out / 'engine.csv'} and {out / 'engine_summary.md'}")
+
+
+if __name__ == "__main__":
+    main()

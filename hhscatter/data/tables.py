@@ -1,0 +1,814 @@
+"""Parquet tables: the contract for external analysis.
+
+A run directory holds one dataset per table, one part file per chunk::
+
+    OUT/lifetimes/part-000000.parquet
+    OUT/sections/part-000000.parquet     (only when the scene records sections)
+    OUT/snapshots/part-000000.parquet    (only when the scene records snapshots)
+    OUT/scene.json                       (the scene, for humans; each part carries it too)
+
+A grid run (a sweep over E0 and/or γ, see :mod:`hhscatter.scene.grid`) has one
+folder per grid point in each table, and every file carries its point as
+ordinary numeric columns::
+
+    OUT/lifetimes/E0.25_gamma0.01/part-000000.parquet
+
+The folder names contain no ``=``: they are not hive partition keys, so no
+reader derives a (string-typed, column-shadowing) key from them, and every
+reader -- :func:`read_lifetimes`, ``pandas.read_parquet(OUT/"lifetimes")``,
+``pyarrow.dataset.dataset(…, partitioning="hive")``, DuckDB
+``read_parquet('OUT/lifetimes/**/*.parquet', hive_partitioning=true)`` and
+polars ``scan_parquet(…, hive_partitioning=True)`` -- returns the same rows
+with float64 point columns: ``energy`` (the point's nominal E0; the per-orbit
+``e0`` column keeps each orbit's computed initial energy, which differs from
+it in the last bits) and ``gamma`` in ``lifetimes``; ``point_energy`` and
+``point_gamma`` in ``sections`` and ``snapshots``, whose ``energy`` column is
+the orbit's energy at ``t``. Select a point with a filter on these columns
+(Parquet statistics skip the other points' files). A plain (single-scene)
+run has no point folders and no extra columns. ``OUT`` may be a URL
+(``s3://…``, any fsspec protocol; ``pip install 'hhscatter[cloud]'``).
+
+Runs written before this layout (hhscatter ≤ 0.1.0 grid runs, hive folders
+``energy=0.25/gamma=0.01/`` whose keys clash with the files' columns) are
+still read by the functions here, which give them the same columns as the new
+layout; ``--resume`` continues such a run in its own layout.
+
+Reading is verified (:func:`_dataset`): a run read by these functions is read
+as exactly the part files its manifest (``scene.json``) plans and that are
+finished, each checked against the plan (scene hash, chunk, orbit range, row
+count) with its data pages' checksums verified. A missing table or part, a part
+outside the plan, of another scene or damaged raise :class:`RunIntegrityError`
+(exit status 2 in the CLI); an unfinished run raises :class:`IncompleteRunError`
+unless ``allow_partial=True``, which reads the finished chunks of every table
+alike (so sections/snapshots never hold an orbit without a lifetimes row) and
+warns how much is missing. Readers outside hhscatter (pandas, DuckDB, polars)
+see the files but none of these checks.
+
+Every part file's key-value metadata holds, under the key ``hhscatter``, a
+JSON document with the full scene, its result hash, the chunk index and
+orbit range, the row count, and the versions of hhscatter, heyoka, numpy and
+pyarrow plus the git commit when available: a table alone says how it was
+made. Files are written to a temporary name and renamed when complete, with
+Parquet page checksums (see :func:`verify_part`).
+
+Schemas
+-------
+lifetimes: traj_id int64, x0 y0 px0 py0 e0 gamma float64,
+           outcome dictionary<string> ('escaped' | 'settled' | 'censored' | 'stopped'),
+           t_end float64 (escape time: root of the r = r_esc crossing; settling
+           time: root of E = E_c; or t_max), exit_channel int8 (null unless
+           escaped; channel k is centred on the angle π/2 + 2πk/3),
+           e_end float64 (energy at t_end)
+sections:  traj_id int64, t x y px py energy float64
+snapshots: traj_id int64, t energy float64 (with ``continue_settled``: also settled
+           orbits after t_end)
+crossings: traj_id int64, t radius float64, direction int8 (+1 outward, −1 inward);
+           follow scenes only: every crossing of the follow radii
+"""
+from __future__ import annotations
+
+import functools
+import json
+import os
+import subprocess
+from pathlib import Path
+from typing import TYPE_CHECKING, Union
+
+import numpy as np
+
+from hhscatter.scene.scene import SceneError
+
+if TYPE_CHECKING:  # annotations only
+    import pandas
+    import pyarrow.dataset
+
+RunPath = Union[str, "os.PathLike[str]"]  # a run directory (or a URL pyarrow/fsspec can read)
+
+META_KEY = b"hhscatter"
+CENSORING_OUTCOMES = ("censored", "stopped")  # right-censored lifetimes (hhscatter.analysis.survival.fits)
+TABLES = ("lifetimes", "sections", "snapshots", "crossings")
+
+
+def _schemas():
+    import pyarrow as pa
+
+    f64 = pa.float64()
+    return {
+        "lifetimes": pa.schema(
+            [
+                ("traj_id", pa.int64()),
+                ("x0", f64),
+                ("y0", f64),
+                ("px0", f64),
+                ("py0", f64),
+                ("e0", f64),
+                ("gamma", f64),
+                ("outcome", pa.dictionary(pa.int8(), pa.string())),
+                ("t_end", f64),
+                ("exit_channel", pa.int8()),
+                ("e_end", f64),
+            ]
+        ),
+        "sections": pa.schema(
+            [("traj_id", pa.int64())] + [(c, f64) for c in ("t", "x", "y", "px", "py", "energy")]
+        ),
+        "snapshots": pa.schema([("traj_id", pa.int64()), ("t", f64), ("energy", f64)]),
+        "crossings": pa.schema([("traj_id", pa.int64()), ("t", f64), ("radius", f64), ("direction", pa.int8())]),
+    }
+
+
+@functools.lru_cache(maxsize=1)
+def provenance() -> dict:
+    """Versions of the software that made a table, and the git commit if known."""
+    import heyoka
+    import pyarrow
+
+    from hhscatter import __version__
+
+    commit = None
+    try:
+        here = Path(__file__).resolve().parent
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=here, capture_output=True, text=True, timeout=5, check=False
+        )
+        if out.returncode == 0:
+            commit = out.stdout.strip()
+            dirty = subprocess.run(
+                ["git", "status", "--porcelain", "--untracked-files=no"],
+                cwd=here, capture_output=True, text=True, timeout=5, check=False,
+            )
+            if dirty.returncode == 0 and dirty.stdout.strip():
+                commit += "-dirty"
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return {
+        "hhscatter": __version__,
+        "heyoka": heyoka.__version__,
+        "numpy": np.__version__,
+        "pyarrow": pyarrow.__version__,
+        "git_commit": commit,
+    }
+
+
+def to_arrow(name: str, columns: dict):
+    """to_arrow(name, columns) -> pyarrow.Table with the table's fixed schema."""
+    import pyarrow as pa
+
+    schema = _schemas()[name]
+    arrays = []
+    for field in schema:
+        col = columns[field.name]
+        if name == "lifetimes" and field.name == "outcome":
+            from hhscatter.integrate.events import OUTCOMES
+
+            codes = np.asarray(col, dtype=np.int8)
+            arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, pa.int8()), pa.array(OUTCOMES)))
+        elif name == "lifetimes" and field.name == "exit_channel":
+            ch = np.asarray(col, dtype=np.int8)
+            arrays.append(pa.array(ch, pa.int8(), mask=ch < 0))
+        else:
+            arr = np.asarray(col)
+            if arr.dtype.kind == "f" and not np.isfinite(arr).all():
+                raise FloatingPointError(f"{name}.{field.name}: non-finite values must never reach a table")
+            arrays.append(pa.array(arr, field.type))
+    return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def write_part(path, table, meta: dict, store=None) -> None:
+    """write_part(path, table, meta, store=None) -> None: write ``table`` with metadata ``meta`` atomically.
+
+    ``path`` is a local path, or, with ``store`` (a :class:`hhscatter.data.store.Store`),
+    a path relative to the store's root. The file is written to a temporary
+    name, fsync'ed and renamed (see :mod:`hhscatter.data.store`), so a part file
+    under its final name is always complete. Parquet page checksums are
+    written so that ``verify_part`` detects damaged data pages, not only a
+    damaged footer.
+    """
+    import pyarrow.parquet as pq
+
+    from hhscatter.data.store import Store
+
+    if store is None:
+        path = Path(path)
+        store, rel = Store(path.parent), path.name
+    else:
+        rel = str(path)
+    table = table.replace_schema_metadata({META_KEY: json.dumps(meta, sort_keys=True).encode()})
+
+    def write(target, filesystem):
+        # no per-file timestamps or writer-dependent fields: same rows, same bytes
+        opts = {"compression": "zstd", "write_statistics": True, "write_page_checksum": True}
+        if filesystem is None:  # our own handle, closed even when the write fails (a full disk): a worker
+            with open(target, "wb") as fh:  # that keeps the error must not keep the unlinked file open
+                pq.write_table(table, fh, **opts)
+        else:
+            pq.write_table(table, target, filesystem=filesystem, **opts)
+
+    store.write_atomic(rel, write)
+
+
+def write_parts_streamed(path, tables, meta: dict) -> int:
+    """write_parts_streamed(path, tables, meta) -> rows written: one Parquet file from an iterable of Arrow tables.
+
+    The tables (same columns and types; dictionary columns may have different
+    dictionaries) are written one row group after the other with a
+    ``ParquetWriter``, so only one of them is in memory at a time, and the
+    file appears atomically under ``path`` (as :func:`write_part`, with the
+    same options and metadata key).
+    """
+    import pyarrow.parquet as pq
+
+    from hhscatter.data.store import Store
+
+    path = Path(path)
+    store, rows = Store(path.parent), [0]
+
+    def write(target, filesystem):
+        writer = None
+        try:
+            for t in tables:
+                if writer is None:
+                    schema = t.schema.with_metadata({META_KEY: json.dumps(meta, sort_keys=True).encode()})
+                    writer = pq.ParquetWriter(target, schema, filesystem=filesystem, compression="zstd",
+                                              write_statistics=True, write_page_checksum=True)
+                writer.write_table(t.replace_schema_metadata(schema.metadata))
+                rows[0] += t.num_rows
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise ValueError(f"{path}: no table to write")
+
+    store.write_atomic(path.name, write)
+    return rows[0]
+
+
+def part_name(chunk: int) -> str:
+    return f"part-{chunk:06d}.parquet"
+
+
+def read_meta(path, filesystem=None) -> dict:
+    """read_meta(path, filesystem=None) -> the ``hhscatter`` metadata dict of one part file."""
+    import pyarrow.parquet as pq
+
+    md = pq.read_schema(path, filesystem=filesystem).metadata or {}
+    if META_KEY not in md:
+        raise ValueError(f"{path} is not an hhscatter table (no '{META_KEY.decode()}' metadata)")
+    return json.loads(md[META_KEY])
+
+
+def verify_part(source, expect_rows=None) -> dict:
+    """verify_part(source, expect_rows=None) -> metadata dict, or raise ValueError/OSError.
+
+    Reads the whole file (``source``: path or open pyarrow file) with page
+    checksum verification: a truncated file, a damaged footer or data page, a
+    row count different from the metadata's (or from ``expect_rows``) raise.
+    """
+    import pyarrow.parquet as pq
+
+    pf = pq.ParquetFile(source, page_checksum_verification=True)
+    md = pf.schema_arrow.metadata or {}
+    if META_KEY not in md:
+        raise ValueError("not an hhscatter table")
+    meta = json.loads(md[META_KEY])
+    table = pf.read()
+    if table.num_rows != meta.get("rows") or (expect_rows is not None and table.num_rows != expect_rows):
+        raise ValueError(f"row count {table.num_rows} differs from the metadata's {meta.get('rows')}")
+    return meta
+
+
+#: folder keys of grid runs written by hhscatter ≤ 0.1.0 (``energy=…/gamma=…``), read by :func:`_dataset`
+LEGACY_PARTITION_KEYS = ("energy", "gamma")
+
+#: the columns a grid run's files carry to name their point: (column, Scene field) per table
+POINT_COLUMNS = {
+    "lifetimes": (("energy", "energy"),),  # ``gamma`` is a lifetimes column already
+    "sections": (("point_energy", "energy"), ("point_gamma", "gamma")),
+    "snapshots": (("point_energy", "energy"), ("point_gamma", "gamma")),
+    "crossings": (("point_energy", "energy"), ("point_gamma", "gamma")),
+}
+
+
+def schema_of(name: str, grid: bool = False):
+    """schema_of(name, grid=False) -> pyarrow.Schema of a table (with the point columns of a grid run)."""
+    import pyarrow as pa
+
+    schema = _schemas()[name]
+    if grid:
+        schema = pa.schema(list(schema) + [pa.field(c, pa.float64()) for c, _ in POINT_COLUMNS[name]])
+    return schema
+
+
+def add_point_columns(name: str, table, scene):
+    """add_point_columns(name, table, scene) -> ``table`` with the grid point's constant columns appended."""
+    import pyarrow as pa
+
+    for col, key in POINT_COLUMNS[name]:
+        table = table.append_column(pa.field(col, pa.float64()),
+                                    pa.array(np.full(table.num_rows, float(getattr(scene, key)))))
+    return table
+
+
+def legacy_point(rel: str):
+    """legacy_point('energy=0.25/gamma=0.01/part-….parquet') -> (0.25, 0.01), or None if not that layout."""
+    keys = dict(seg.split("=", 1) for seg in rel.split("/")[:-1] if "=" in seg)
+    if set(keys) != set(LEGACY_PARTITION_KEYS):
+        return None
+    return tuple(float(keys[k]) for k in LEGACY_PARTITION_KEYS)
+
+
+class RunIntegrityError(SceneError):
+    """A run directory does not hold what its manifest plans: a table or part missing, a part not in the plan,
+    a part of another scene, a damaged part (page checksum), or unfinished chunks (:class:`IncompleteRunError`)."""
+
+
+class IncompleteRunError(RunIntegrityError):
+    """Some chunks of the run are not finished (killed run, full disk): read with ``allow_partial=True``."""
+
+
+def run_manifest(run_dir) -> dict | None:
+    """run_manifest(run_dir) -> the run's plan from OUT/scene.json (hhscatter.run.runner.manifest_of), or None.
+
+    None for a directory without scene.json or a run written before manifests (read as before, by
+    listing its part files).
+    """
+    from hhscatter.data.store import Store
+
+    store = Store(run_dir)
+    if not store.exists("scene.json"):
+        return None
+    return json.loads(store.read_text("scene.json")).get("manifest")
+
+
+def run_status(run_dir) -> dict:
+    """run_status(run_dir) -> {'complete', 'chunks', 'chunks_done', 'orbits', 'orbits_done', 'scene_hash'}.
+
+    From the manifest and the presence of the ``lifetimes`` parts (written last in every chunk); cheap
+    (no file is opened). A run without manifest counts as complete if it has lifetimes parts.
+    """
+    from hhscatter.data.store import Store
+
+    store = Store(run_dir)
+    doc = json.loads(store.read_text("scene.json")) if store.exists("scene.json") else {}
+    man = doc.get("manifest")
+    if man is None:
+        n = len(store.files("lifetimes"))
+        return {"complete": n > 0, "chunks": n, "chunks_done": n, "orbits": None, "orbits_done": None,
+                "scene_hash": doc.get("scene_hash")}
+    have = set(store.files("lifetimes"))
+    chunks = done = orbits = orbits_done = 0
+    for p in man["points"]:
+        for c in range(-(-p["n"] // p["chunk_size"])):
+            k = min(p["chunk_size"], p["n"] - c * p["chunk_size"])
+            chunks, orbits = chunks + 1, orbits + k
+            if "/".join(x for x in (p["partition"], part_name(c)) if x) in have:
+                done, orbits_done = done + 1, orbits_done + k
+    return {"complete": done == chunks, "chunks": chunks, "chunks_done": done, "orbits": orbits,
+            "orbits_done": orbits_done, "scene_hash": doc.get("scene_hash")}
+
+
+def _planned_files(store, man: dict, name: str, allow_partial: bool):
+    """The part files of table ``name`` that the manifest plans and the run has finished, as
+    [(file relative to the table folder, point dict, chunk)]; RunIntegrityError on anything else."""
+    run = store.display()
+    if name not in man["tables"]:
+        raise FileNotFoundError(f"no {name} table: the run at {run} does not record it "
+                                f"(its tables: {', '.join(man['tables'])})")
+    if not store.is_dir(name):
+        raise RunIntegrityError(f"the {name} table of the run at {run} is missing ({store.display(name)} "
+                                "does not exist); the run is damaged: simulate it again with --overwrite")
+    present = {f for f in store.files(name) if not f.rsplit("/", 1)[-1].startswith(".")}
+    finished = present if name == "lifetimes" else {f for f in store.files("lifetimes")}
+    planned, missing_chunks, missing_orbits, chunks, orbits = [], 0, 0, 0, 0
+    expected = set()
+    for p in man["points"]:
+        for c in range(-(-p["n"] // p["chunk_size"])):
+            rel = "/".join(x for x in (p["partition"], part_name(c)) if x)
+            expected.add(rel)
+            k = min(p["chunk_size"], p["n"] - c * p["chunk_size"])
+            chunks, orbits = chunks + 1, orbits + k
+            if rel not in finished:
+                missing_chunks, missing_orbits = missing_chunks + 1, missing_orbits + k
+                continue
+            if rel not in present:
+                raise RunIntegrityError(f"{store.display(name + '/' + rel)} is missing, but its chunk is "
+                                        "finished; the run is damaged: simulate it again with --overwrite")
+            planned.append((rel, p, c))
+    extra = sorted(present - expected)
+    if extra:
+        raise RunIntegrityError(f"{len(extra)} file(s) in {store.display(name)} are not in the run's chunk plan "
+                                f"(first: {extra[0]}); remove them or simulate the run again with --overwrite")
+    if missing_chunks:
+        what = (f"the run at {run} is incomplete: {missing_chunks} of {chunks} chunk(s) "
+                f"({missing_orbits} of {orbits} orbits) are not finished")
+        if not allow_partial:
+            raise IncompleteRunError(f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
+                                     "the finished chunks with allow_partial=True")
+        import warnings
+
+        warnings.warn(f"{what}; reading the {orbits - missing_orbits} orbits of the finished chunks "
+                      "(allow_partial=True)", stacklevel=4)
+    return planned
+
+
+def _check_fragment(store, name, frag, point, chunk):
+    """A part's own metadata must say it is this chunk of this scene, with as many rows as it holds."""
+    md = frag.metadata
+    kv = md.metadata or {}
+    where = frag.path
+    if META_KEY not in kv:
+        raise RunIntegrityError(f"{where} is not an hhscatter table (no '{META_KEY.decode()}' metadata)")
+    meta = json.loads(kv[META_KEY])
+    if meta.get("scene_hash") != point["scene_hash"]:
+        raise RunIntegrityError(f"{where} was made by another scene (hash {str(meta.get('scene_hash'))[:12]}…, "
+                                f"this run {point['scene_hash'][:12]}…); simulate the run again with --overwrite")
+    c, k = point["chunk_size"], chunk * point["chunk_size"]
+    want = [k, min(k + c, point["n"])]
+    if meta.get("chunk") != chunk or meta.get("orbits") != want or meta.get("table") not in (None, name) \
+            or meta.get("rows") != md.num_rows:
+        raise RunIntegrityError(f"{where} does not hold chunk {chunk} (orbits {want}) of the {name} table "
+                                f"(its metadata: chunk {meta.get('chunk')}, orbits {meta.get('orbits')}, "
+                                f"rows {meta.get('rows')} of {md.num_rows})")
+
+
+def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: bool = False):
+    """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run, either layout).
+
+    A run with a manifest (scene.json, hhscatter.run.runner.manifest_of) is read as exactly its planned and
+    finished part files: each part's metadata is checked against the plan (scene hash, chunk, orbit range,
+    row count; :func:`_check_fragment`, one footer per part) and every data page's checksum is verified as
+    it is read. A missing table or part, a part not in the plan or of another scene raise
+    :class:`RunIntegrityError`; unfinished chunks :class:`IncompleteRunError` unless ``allow_partial``
+    (then only the finished chunks are read, in every table alike, with a warning saying how much is
+    missing). ``one_by_one=True`` yields one single-file dataset per part instead: pyarrow
+    keeps each scanned file's footer while its dataset lives, so a streaming
+    scan over many thousands of parts is done file by file.
+    """
+    import pyarrow.dataset as ds
+    import pyarrow.fs as pafs
+
+    from hhscatter.data.store import Store
+
+    store = Store(run_dir)
+    man = run_manifest(run_dir)
+    checks = None
+    if man is not None:
+        rel = name
+        planned = _planned_files(store, man, name, allow_partial)
+        files = [f for f, _, _ in planned]
+        checks = [(p, c) for _, p, c in planned]
+        if not files:
+            raise IncompleteRunError(f"no {name} table: no chunk of the run at {store.display()} is finished")
+    else:
+        rel = name if store.is_dir(name) or store.exists("scene.json") else ""
+        if not store.exists(rel):
+            raise FileNotFoundError(f"no {name} table at {store.display(rel)}")
+        files = [f for f in store.files(rel) if f.rsplit("/", 1)[-1].startswith("part-") and f.endswith(".parquet")]
+        if not files:
+            where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
+            raise FileNotFoundError(f"no {name} table: no part files in {where}")
+    grid = any("/" in f for f in files)
+    schema = schema_of(name, grid)
+    paths = [store.path(rel, f) for f in files]
+    # every data page's CRC (written by write_part) is verified as it is read
+    fmt = ds.ParquetFileFormat(default_fragment_scan_options=ds.ParquetFragmentScanOptions(
+        page_checksum_verification=True))
+    fs = store.filesystem or pafs.LocalFileSystem()
+    legacy = [legacy_point(f) for f in files]
+    if any(p is not None for p in legacy):
+        # old hive layout: the point is in the folder names only (and the key 'gamma' clashes with the
+        # lifetimes column, 'energy' with the sections/snapshots column); give each file its point as a
+        # partition expression on the new column names, which pyarrow materialises as constant columns
+        if None in legacy:
+            raise ValueError(f"{store.display(rel)} mixes part files of two layouts")
+        cols = dict(POINT_COLUMNS[name])
+        if name == "lifetimes":
+            cols["gamma"] = "gamma"
+        inv = {v: k for k, v in cols.items()}
+        exprs = [(ds.field(inv["energy"]) == e) & (ds.field(inv["gamma"]) == g) for e, g in legacy]
+
+        def make(ps, es):
+            return ds.FileSystemDataset.from_paths(ps, schema=schema, format=fmt, filesystem=fs, partitions=es)
+    else:
+        exprs = [ds.scalar(True)] * len(paths)
+
+        def make(ps, es):
+            return ds.dataset(ps, schema=schema, format=fmt, filesystem=store.filesystem)
+    def checked(dset, which):
+        if checks is not None:
+            for frag, (point, chunk) in zip(dset.get_fragments(), which):
+                _check_fragment(store, name, frag, point, chunk)
+        return dset
+
+    if one_by_one:
+        return (checked(make([p], [e]), [checks[i]] if checks else None) for i, (p, e) in enumerate(zip(paths, exprs)))
+    return checked(make(paths, exprs), checks)
+
+
+def _scan(dset, run_dir, name, scan):
+    """scan(dset) with a damaged data page (page checksum mismatch) reported as RunIntegrityError naming the
+    part file (found by verifying the dataset's files one by one: only on this error path)."""
+    try:
+        return scan(dset)
+    except OSError as exc:
+        if "checksum" not in str(exc).lower():
+            raise
+        bad = "?"
+        for path in dset.files:
+            try:
+                verify_part(dset.filesystem.open_input_file(path))
+            except (OSError, ValueError):
+                bad = path
+                break
+        raise RunIntegrityError(f"{bad} is damaged: a data page fails its checksum ({exc}); delete it and "
+                                f"rerun `hhscatter simulate --out {run_dir} --resume`") from None
+
+
+def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False, allow_partial: bool = False):
+    table = _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
+                  lambda d: d.to_table(columns=columns, filter=filters))
+    df = table.to_pandas()
+    if "outcome" in df.columns and not categorical:
+        df["outcome"] = df["outcome"].astype(str)
+    if "exit_channel" in df.columns:
+        df["exit_channel"] = df["exit_channel"].astype("Int8")
+    return df
+
+
+def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, allow_partial: bool = False):
+    """read_arrow(run_dir, name='lifetimes', columns=None, filters=None) -> pyarrow.Table.
+
+    The memory-lean reader: only ``columns`` are read (column projection in
+    the Parquet reader), no pandas conversion. ``run_dir`` may be a URL. Every reader here reads exactly
+    the run's planned, finished and verified parts (:func:`_dataset`); an incomplete run is an error unless
+    ``allow_partial=True``.
+    """
+    return _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
+                 lambda d: d.to_table(columns=columns, filter=filters))
+
+
+def survival_arrays(run_dir, filters=None, *, allow_partial: bool = False):
+    """survival_arrays(run_dir, filters=None) -> (t_end float64 (N,), observed bool (N,)).
+
+    The inputs of :func:`hhscatter.analysis.survival.fits.survival_curve`, read
+    with column projection: only ``t_end`` and the dictionary codes of
+    ``outcome`` are read and decoded, no pandas objects are made (~9 bytes per
+    orbit). ``observed`` is False for censored orbits. Memory-bounded route for
+    P(t) of 1e7+ orbits.
+    """
+    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters,
+                       allow_partial=allow_partial)
+    t_end = table.column("t_end").to_numpy()
+    observed = np.empty(len(t_end), dtype=bool)
+    pos = 0
+    for chunk in table.column("outcome").chunks:
+        observed[pos:pos + len(chunk)] = _observed(chunk)
+        pos += len(chunk)
+    return t_end, observed
+
+
+def _observed(outcome) -> np.ndarray:
+    """The 'observed' mask (left Ω, not censored) of a dictionary-encoded Arrow ``outcome`` array."""
+    censored = np.isin(np.asarray(outcome.dictionary.to_pylist(), dtype=object), CENSORING_OUTCOMES)
+    return ~censored[outcome.indices.to_numpy(zero_copy_only=False)]
+
+
+def iter_survival_batches(run_dir, filters=None, *, allow_partial: bool = False):
+    """iter_survival_batches(run_dir, filters=None) -> (t_end float64, observed bool) arrays per record batch.
+
+    The lifetimes table streamed in record batches of ``t_end`` and the decoded ``outcome`` only, one part file at
+    a time (its footer is dropped with its dataset): memory is one batch, whatever N. ``observed`` is False for
+    censored orbits. The input of a streaming Kaplan–Meier (:func:`hhscatter.api.stream_survival`).
+    """
+    for part in _dataset(run_dir, "lifetimes", one_by_one=True, allow_partial=allow_partial):
+        for batch in _scan(part, run_dir, "lifetimes", lambda d: d.to_table(
+                columns=["t_end", "outcome"], filter=filters).to_batches()):
+            yield batch.column(0).to_numpy(), _observed(batch.column(1))
+
+
+def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False):
+    """iter_parts(run_dir, name, columns=None) -> pandas.DataFrame per part file of table ``name``, in file order.
+
+    For statistics pooled part by part (memory: one part at a time, whatever N).
+    """
+    for part in _dataset(run_dir, name, one_by_one=True, allow_partial=allow_partial):
+        yield _scan(part, run_dir, name, lambda d: d.to_table(columns=columns)).to_pandas()
+
+
+def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None = None,
+                   filters: pyarrow.dataset.Expression | None = None, *, categorical: bool = False,
+                   allow_partial: bool = False) -> pandas.DataFrame:
+    """The lifetimes table of a run: one row per orbit.
+
+    Columns: ``traj_id``, ``t_end`` (time of the orbit's end, time units), ``outcome`` ('escaped',
+    'settled' — E reached E_c inside Ω, Eq. (eqn:energy_diffeq) — or 'censored' at t_max), ``exit_channel``
+    (0, 1, 2 for escapes, else null), the initial state ``x0, y0, px0, py0``, ``e0`` (initial energy),
+    ``e_end`` (energy at the end) and ``gamma``; a grid run adds ``energy`` (the point's nominal E0). Only the parts of the run's
+    chunk plan are read, each verified (:mod:`hhscatter.data.tables`, "A run is its manifest").
+
+    Parameters
+    ----------
+    run_dir : path or URL, or list of them
+        A run directory written by :func:`hhscatter.simulate`. A list of runs gives their frames
+        concatenated (a plain run among grid runs gets its ``energy`` column from its orbits' ``e0``, so
+        that :func:`hhscatter.survival` and friends see one point per run and grid point).
+    columns : list of str, optional
+        Read only these columns (projection).
+    filters : pyarrow.dataset.Expression, optional
+        Row filter, e.g. ``(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)`` to read one grid
+        point.
+    categorical : bool
+        ``outcome`` as a pandas categorical (1 byte per orbit, for 1e7 orbits and more) instead of str.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning saying how much is missing.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``exit_channel`` as nullable Int8. Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…``
+        folders) come back with the same columns.
+
+    Raises
+    ------
+    RunIntegrityError
+        A table or planned part is missing, a part is damaged or not in the run's plan.
+    IncompleteRunError
+        Chunks are unfinished and ``allow_partial`` is False.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> _ = hhscatter.simulate(hhscatter.Scene(energy=0.3, n=100, seed=1, t_max=100.0), run,
+    ...                        overwrite=True, workers=1, progress=False)
+    >>> lt = hhscatter.read_lifetimes(run, columns=["traj_id", "t_end", "outcome"])
+    >>> len(lt), sorted(set(lt.outcome) - {"escaped", "censored"})
+    (100, [])
+    """
+    if isinstance(run_dir, (list, tuple)):
+        return _concat_runs([_read(r, "lifetimes", columns, filters, categorical, allow_partial) for r in run_dir])
+    return _read(run_dir, "lifetimes", columns, filters, categorical, allow_partial)
+
+
+def _concat_runs(frames):
+    """One frame of several runs' lifetimes; plain runs get ``energy`` (their median e0, 12 digits) if any has it."""
+    import pandas as pd
+
+    if not frames:
+        raise ValueError("no runs given")
+    if any("energy" in f.columns for f in frames):
+        frames = [f if "energy" in f.columns or "e0" not in f.columns or not len(f)
+                  else f.assign(energy=float(f"{np.median(f['e0'].to_numpy(dtype=float)):.12g}")) for f in frames]
+    return pd.concat(frames, ignore_index=True)
+
+
+def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: bool = False) -> dict:
+    """read_by_orbit(run_dir, columns, name='lifetimes') -> {column: array}, rows in traj_id order.
+
+    The memory-lean reader for 1e7 orbits and more: Arrow columns straight to numpy, no pandas frame and
+    no Python object per orbit. Dictionary columns (``outcome``) come back as ``pandas.Categorical`` (1 byte
+    per orbit); integer columns with nulls (``exit_channel``) with the nulls as −1. ``traj_id`` is always
+    returned. The engine writes parts in orbit order, so the rows are reordered (copied) only if they are not.
+    """
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    names = ["traj_id", *(c for c in columns if c != "traj_id")]
+    tab = read_arrow(run_dir, name, columns=names, allow_partial=allow_partial)
+    ids = tab.column("traj_id").to_numpy()
+    order = None if bool(np.all(ids[1:] > ids[:-1])) else np.argsort(ids, kind="stable")
+    out = {}
+    for c in names:
+        col = tab.column(c)
+        if pa.types.is_dictionary(col.type):
+            v = col.to_pandas().array
+        elif col.null_count and pa.types.is_integer(col.type):
+            v = pc.fill_null(col, -1).to_numpy()
+        else:
+            v = col.to_numpy()
+        out[c] = v if order is None else v[order]
+    del tab
+    pa.default_memory_pool().release_unused()  # Arrow's allocator keeps freed buffers otherwise
+    return out
+
+
+def read_sections(run_dir: RunPath, columns: list[str] | None = None,
+                  filters: pyarrow.dataset.Expression | None = None, *,
+                  allow_partial: bool = False) -> pandas.DataFrame:
+    """The sections table of a run: one row per crossing of the section ṙ = 0, φ̇ > 0.
+
+    Parameters
+    ----------
+    run_dir : path or URL
+        A run directory of a scene that recorded sections (``Scene(sections=SectionWindow(...))``).
+    columns : list of str, optional
+        Read only these columns.
+    filters : pyarrow.dataset.Expression, optional
+        Row filter.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``traj_id``, ``t`` (crossing time), ``x, y, px, py``, ``energy`` (the orbit's energy at the
+        crossing); a grid run adds its point's nominal E0 and γ as ``point_energy`` and ``point_gamma``.
+
+    Raises
+    ------
+    RunIntegrityError
+        The run has no sections table (it was not recorded), or a part is missing or damaged.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> scene = hhscatter.Scene(energy=0.3, n=50, seed=1, t_max=100.0, sections=hhscatter.SectionWindow())
+    >>> _ = hhscatter.simulate(scene, run, overwrite=True, workers=1, progress=False)
+    >>> sec = hhscatter.read_sections(run)
+    >>> bool(((sec.x * sec.px + sec.y * sec.py).abs() < 1e-10).all())     # ṙ = 0 at every crossing
+    True
+    """
+    return _read(run_dir, "sections", columns, filters, allow_partial=allow_partial)
+
+
+def read_snapshots(run_dir: RunPath, columns: list[str] | None = None,
+                   filters: pyarrow.dataset.Expression | None = None, *,
+                   allow_partial: bool = False) -> pandas.DataFrame:
+    """The snapshots table of a run: the energy of every orbit still alive at each snapshot time.
+
+    Parameters
+    ----------
+    run_dir : path or URL
+        A run directory of a scene that recorded snapshots (``Scene(snapshots=[t1, t2, …])``).
+    columns : list of str, optional
+        Read only these columns.
+    filters : pyarrow.dataset.Expression, optional
+        Row filter.
+    allow_partial : bool
+        Read the finished chunks of an unfinished run, with a warning.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``traj_id``, ``t`` (snapshot time), ``energy``; a grid run adds ``point_energy``, ``point_gamma``.
+        With drag, ⟨E⟩(t) of these rows is the paper's Fig. 3 (Eq. (eqn:energy_exp_decay)).
+
+    Raises
+    ------
+    RunIntegrityError
+        The run has no snapshots table, or a part is missing or damaged.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> scene = hhscatter.Scene(energy=0.3, gamma=0.01, n=50, seed=1, t_max=50.0, snapshots=[0.0, 10.0])
+    >>> _ = hhscatter.simulate(scene, run, overwrite=True, workers=1, progress=False)
+    >>> snaps = hhscatter.read_snapshots(run)
+    >>> bool((snaps.groupby("t").energy.mean().diff().dropna() < 0).all())   # drag: ⟨E⟩ falls
+    True
+    """
+    return _read(run_dir, "snapshots", columns, filters, allow_partial=allow_partial)
+
+
+def read_crossings(run_dir, columns=None, filters=None, *, allow_partial: bool = False):
+    """read_crossings(run_dir, ...) -> DataFrame traj_id, t, radius, direction (follow scenes)."""
+    return _read(run_dir, "crossings", columns, filters, allow_partial=allow_partial)
+
+
+def describe_run(run_dir) -> dict:
+    """describe_run(run_dir) -> {'rows': {table: rows}, 'points': [{energy, gamma, escaped, settled, censored}]}.
+
+    What a run directory holds, from the files themselves (so resumed chunks
+    count too): the row count of each table present (from the Parquet
+    footers) and the outcome counts per grid point (one entry for a plain run,
+    whose ``energy`` is the scene's E0, None for runs from an IC table).
+    """
+    from hhscatter.data.store import Store
+
+    store = Store(run_dir)
+    rows = {}
+    man = run_manifest(run_dir)
+    for name in TABLES:
+        if (name in man["tables"]) if man is not None else store.is_dir(name):
+            try:
+                rows[name] = _dataset(run_dir, name).count_rows()
+            except FileNotFoundError:
+                continue
+    if "lifetimes" not in rows:
+        raise FileNotFoundError(f"no lifetimes table at {store.display('lifetimes')}")
+    dset = _dataset(run_dir, "lifetimes")
+    keys = [k for k in ("energy", "gamma") if k in dset.schema.names]
+    table = dset.to_table(columns=[*keys, "outcome"])
+    counts = table.group_by([*keys, "outcome"]).aggregate([([], "count_all")]).to_pylist()
+    points = {}
+    for r in counts:
+        key = tuple(r[k] for k in keys)
+        points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0, "stopped": 0})[r["outcome"]] = \
+            r["count_all"]
+    if "energy" not in keys:  # a plain run: its one point is the scene's
+        meta = read_meta(next(iter(dset.files)), filesystem=store.filesystem)["scene"]
+        points = {(meta.get("energy"), meta.get("gamma")): c for c in points.values()}
+    return {"rows": rows,
+            "points": [{"energy": k[0], "gamma": k[1], **v} for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])]}

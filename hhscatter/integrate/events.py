@@ -1,0 +1,323 @@
+"""Events and outcome rules, declared once (paper App. "Escape Condition").
+
+``scene_events(scene) -> tuple[EventSpec, ...]`` is the one place where the
+events of a scene are declared: each is plain data (name, direction, the
+expression whose root is the event, what it is for). Every driver builds its
+heyoka events from it: the batch engine (:mod:`hhscatter.integrate.engine`), the
+scalar reference driver (:func:`hhscatter.integrate.engine.simulate_orbit`, which the
+benchmarks and stress tests use in long double or real128) and every
+continuation. No other module constructs a heyoka event.
+
+All events are heyoka *terminal* events with a callback: heyoka then ends the
+step exactly at the root, so the state and the orbit time of every recorded
+event are the integrator's own (no dense-output evaluation, no rounding on a
+lane clock: event times and states do not depend on how orbits share lanes).
+The callback decides, by the outcome rules below, whether the orbit ends.
+
+=========  =====  ==========================================  =====================================
+event      dir.   expression (root)                           role
+=========  =====  ==========================================  =====================================
+escape     +      r² − r_esc²                                 conservative: escaped at the first
+                                                              outward crossing (t_end = its root)
+closure    −      H − E_c                                     dissipative: settled if r ≤ r_s there,
+                                                              else escaped at the last outward
+                                                              r_esc crossing
+far        +      r²/r_far² − 1                               dissipative, and conservative follow:
+                                                              the orbit is gone (never returns)
+resc       any    r² − r_esc²                                 dissipative: remembers the last
+                                                              outward crossing (the escape time)
+radius_k   any    r² − R_k²                                   follow: crossings of the radii R_k
+                                                              and r_esc (table ``crossings``); the
+                                                              outward r_esc one is the escape
+section    any    g·(x p_x + y p_y − 10⁻³⁰⁰) + (1 − g)         ṙ = 0, kept where φ̇ > 0 and the
+                                                              window admits it; g = 0/1 per lane
+                                                              (runtime parameter) switches it off;
+                                                              a late window compiles it only into
+                                                              the orbits' second phase (two_phase)
+clock      −      σ  (dσ/dt = −1/G)                           orbit-time schedule: opens/closes
+                                                              the section window at t_from/t_to
+=========  =====  ==========================================  =====================================
+
+Normalisation: event values enter heyoka's step-size control, so each is
+O(1) where it matters (r²/r_far² − 1 rather than r² − r_far²; the clock σ
+counts down in [0, 1] rather than carrying the orbit time, whose size would
+loosen the tolerance of the whole state). There is never an event on the
+integrator's time ``t − t_max``: time limits are propagation bounds.
+
+Outcome rules (the paper's, App. "Escape Condition"):
+
+* conservative: ``escaped`` at the first outward r_esc crossing; ``censored``
+  at t_max;
+* dissipative: the orbit is followed until E = E_c. Inside Ω (r ≤ r_s, the
+  saddle distance) it is ``settled`` at that root (it can never leave);
+  outside it is ``escaped``, with t_end its *last* outward r_esc crossing;
+  an orbit that reaches r_far is escaped the same way; ``censored`` at t_max;
+* ``stopped``: nothing more was needed from the orbit (a section window with
+  ``stop = true`` is done); t_end is the stop time. Analyses treat it as
+  censoring at t_end.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+ESCAPED, SETTLED, CENSORED, STOPPED = 0, 1, 2, 3
+OUTCOMES = ("escaped", "settled", "censored", "stopped")
+
+# Every initial condition lies on the section (x px + y py = 0 exactly in
+# double). With the event value exactly 0 at the start of a step, heyoka's root
+# isolation reported the root at t = 0 twice and lost the next crossing in the
+# same (first) step (issue 5). A constant offset of 1e-300 makes the start
+# value non-zero; it moves a crossing by 1e-300/|d(x px + y py)/dt|.
+SECTION_OFFSET = 1e-300
+T_INITIAL = 1e-10  # section crossings before this orbit time are the initial point itself
+CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
+
+
+@dataclass(frozen=True)
+class EventSpec:
+    """EventSpec(name, direction, expression, role): one event of a scene, as data.
+
+    ``direction``: +1 (upward roots only), −1 (downward) or 0 (both);
+    ``expression``: callable (Symbols) -> heyoka expression whose root is the event.
+    """
+
+    name: str
+    direction: int
+    expression: Callable
+    role: str
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where a scene's extra state and parameters live in the integrator.
+
+    ``clock``: index of the clock variable σ in the state (None: no clock);
+    ``gate``: index of the section gate in the runtime parameters (None: no
+    sections); ``gamma``: index of γ (None: conservative); ``clock_scale``: G.
+    """
+
+    n_state: int
+    clock: int | None
+    gate: int | None
+    gamma: int | None
+    n_pars: int
+    clock_scale: float
+
+
+class Symbols:
+    """The heyoka expressions events are written in (built lazily: no heyoka at import)."""
+
+    def __init__(self, scene, layout: Layout):
+        import heyoka as hy
+
+        (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions()
+        self.r2 = self.x**2 + self.y**2
+        self.clock = hy.make_vars("sigma") if layout.clock is not None else None
+        self.gate = hy.par[layout.gate] if layout.gate is not None else None
+        self.gamma = hy.par[layout.gamma] if layout.gamma is not None else None
+
+
+def far_radius(scene) -> float:
+    """far_radius(scene) -> r_far: the scene's, or max(10 r_s, 2 r_esc)."""
+    if scene.r_far is not None:
+        return float(scene.r_far)
+    return max(10.0 * scene.model.saddle_radius, 2.0 * scene.r_esc)
+
+
+def clock_targets(scene) -> tuple:
+    """clock_targets(scene) -> ((orbit time, action), ...): when the clock acts, in order.
+
+    Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
+    that opens late could miss a crossing) and 'close' it (at t_to +
+    CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
+    with such a clock and no snapshots also 'censor' with it at t_max.
+    """
+    w = scene.sections
+    if w is None:
+        return ()
+    out = []
+    if w.t_from > 0:
+        out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
+    if math.isfinite(w.t_to):
+        out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
+    if out and not scene.snapshots:
+        # the clock is compiled in anyway: it also ends the orbit at t_max, so the stream
+        # scheduler needs no per-orbit propagation bound (whose stale copies forced reruns)
+        out.append((float(scene.t_max), "censor"))
+    return tuple(sorted(out))
+
+
+def follow_radii(scene) -> tuple:
+    """follow_radii(scene) -> the radii whose crossings a follow scene records: its own and r_esc."""
+    return tuple(sorted(set(scene.follow.radii) | {float(scene.r_esc)}))
+
+
+def layout(scene) -> Layout:
+    """layout(scene) -> Layout: state and parameter slots the scene's events need."""
+    targets = clock_targets(scene)
+    clock = 4 if targets else None
+    n_pars = 0
+    gamma = gate = None
+    if scene.gamma > 0:
+        gamma, n_pars = n_pars, n_pars + 1
+    if scene.sections is not None:
+        gate, n_pars = n_pars, n_pars + 1
+    scale = max(1.0, max(t for t, _ in targets)) if targets else 1.0
+    return Layout(5 if clock is not None else 4, clock, gate, gamma, n_pars, scale)
+
+
+def scene_events(scene) -> tuple:
+    """scene_events(scene) -> tuple[EventSpec, ...]: the events a scene needs, in callback order.
+
+    Only what the scene needs is compiled: the section event only for scenes
+    with a section window (and switched off per lane outside it), the clock
+    only for windows that open late or close, the follow radii only for
+    follow scenes.
+    """
+    r_esc2 = scene.r_esc**2
+    rf2 = far_radius(scene) ** 2
+    ec = scene.model.critical_energy
+    ev = []
+    if scene.gamma > 0:
+        ev.append(EventSpec("closure", -1, lambda s: s.H - ec, "dissipative: E = E_c, settled or escaped"))
+        ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "escaped orbit far away"))
+        ev.append(EventSpec("resc", 0, lambda s: s.r2 - r_esc2, "last outward r_esc crossing"))
+    elif scene.follow is None:
+        ev.append(EventSpec("escape", +1, lambda s: s.r2 - r_esc2, "conservative escape"))
+    else:
+        # each root is declared once: two terminal events with the same root in one lane lose
+        # one of them in batch mode (measured), so the r_esc radius is also the escape event
+        ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "followed orbit far away"))
+        for k, R in enumerate(follow_radii(scene)):
+            ev.append(EventSpec(f"radius{k}", 0, (lambda R2: lambda s: s.r2 - R2)(R * R),
+                                f"follow: crossing of r = {R:g}" + (" (outward: the escape)" if R == scene.r_esc
+                                                                   else "")))
+    if scene.sections is not None:
+        ev.append(EventSpec(
+            "section", 0,
+            lambda s: s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate),
+            "section ṙ = 0 (gated)"))
+    if clock_targets(scene):
+        ev.append(EventSpec("clock", -1, lambda s: s.clock, "orbit-time schedule"))
+    return tuple(ev)
+
+
+def system(scene, lay: Layout):
+    """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock)."""
+    import heyoka as hy
+
+    from hhscatter.model import equations
+
+    sys = equations(scene.model, hy.par[lay.gamma] if lay.gamma is not None else None)
+    if lay.clock is not None:
+        sys.append((hy.make_vars("sigma"), hy.expression(-1.0 / lay.clock_scale)))
+    return sys
+
+
+def two_phase(scene) -> bool:
+    """two_phase(scene) -> True if the section event is compiled only into an orbit's second phase.
+
+    Scenes without snapshots whose section window opens late (t_from > 0):
+    orbits run without the section event until the clock opens the window,
+    then move to an integrator that has it (hhscatter.integrate.engine). Snapshot scenes
+    switch the event off per lane instead (all lanes share one grid there).
+    """
+    return scene.sections is not None and scene.sections.t_from > 0 and not scene.snapshots
+
+
+def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
+    """build_batch(scene, batch_size, make_callback, without=()) -> (taylor_adaptive_batch, specs, layout).
+
+    ``make_callback(spec)`` returns the callback object of one event (heyoka
+    deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
+    ``without``: names of events left out (an orbit phase that does not need them).
+    """
+    import heyoka as hy
+    import numpy as np
+
+    lay = layout(scene)
+    specs = tuple(s for s in scene_events(scene) if s.name not in without)
+    sym = Symbols(scene, lay)
+    dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
+    events = [hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction])
+              for s in specs]
+    # the gate is the last parameter: without the section event heyoka's system has none
+    n_pars = lay.n_pars - (1 if lay.gate is not None and "section" in without else 0)
+    pars = np.zeros((n_pars, batch_size))
+    if lay.gamma is not None:
+        pars[lay.gamma] = scene.gamma
+    kw = {"pars": pars} if n_pars else {}
+    ta = hy.taylor_adaptive_batch(system(scene, lay), np.zeros((lay.n_state, batch_size)),
+                                  tol=scene.tol if tol is None else tol, t_events=events, **kw)
+    return ta, specs, lay
+
+
+def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
+    """build_scalar(scene, make_callback, fp_type=float, tol=None) -> (taylor_adaptive, specs, layout).
+
+    The same events on heyoka's scalar integrator, in ``fp_type`` (float,
+    numpy.longdouble or heyoka.real128). ``tol`` defaults to the scene's for
+    float and to the type's epsilon otherwise.
+    """
+    import heyoka as hy
+
+    lay = layout(scene)
+    specs = scene_events(scene)
+    sym = Symbols(scene, lay)
+    dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
+    cast = caster(fp_type)
+    events = [hy.t_event(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction],
+                         fp_type=fp_type) for s in specs]
+    pars = [0.0] * lay.n_pars
+    if lay.gamma is not None:
+        pars[lay.gamma] = scene.gamma
+    kw = {}
+    if tol is not None or fp_type is float:
+        t = scene.tol if tol is None else tol
+        kw["tol"] = fp_type(t) if fp_type is not float else t
+    ta = hy.taylor_adaptive(system(scene, lay), cast([0.0] * lay.n_state), pars=cast(pars) if pars else [],
+                            t_events=events, fp_type=fp_type, **kw)
+    return ta, specs, lay
+
+
+def caster(fp_type):
+    """caster(fp_type) -> function turning a list/array of floats into what heyoka's constructor takes."""
+    import numpy as np
+
+    if fp_type is float:
+        return lambda v: np.asarray(v, dtype=float)
+    if fp_type is np.longdouble:
+        return lambda v: np.asarray(v, dtype=np.longdouble)
+    return lambda v: [fp_type(float(a)) for a in np.asarray(v, dtype=float)]
+
+
+# -- outcome rules ---------------------------------------------------------------
+
+def closure_rule(r2: float, r_s: float, last_out) -> int | None:
+    """closure_rule(r², r_s, last_out) -> SETTLED, ESCAPED or None (carry on).
+
+    At E = E_c: inside Ω (r ≤ r_s) the orbit can never leave: settled at this
+    root. Outside, it is escaped at its last outward r_esc crossing; with no
+    such crossing yet it is outside Ω below E_c, cannot come back, and the
+    r_esc (then r_far) crossing ends it.
+    """
+    if r2 <= r_s * r_s:
+        return SETTLED
+    return ESCAPED if last_out is not None else None
+
+
+def section_accepts(window, t: float, x: float, y: float, px: float, py: float, energy: float) -> bool:
+    """section_accepts(window, t, x, y, px, py, E) -> bool: is this ṙ = 0 root a recorded section point?
+
+    φ̇ > 0 (x p_y − y p_x > 0), orbit time in [t_from, t_to] and after the
+    initial point, energy in [e_min, e_max].
+    """
+    return (x * py - y * px > 0 and t >= T_INITIAL and window.t_from <= t <= window.t_to
+            and window.e_min <= energy <= window.e_max)
+
+
+__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "build_batch",
+           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
+           "section_accepts", "system"]

@@ -1,0 +1,355 @@
+"""Reproduction report: every figure and number of the paper beside ours.
+
+``build_report(scale='quick', out=None)`` reads what the studies left on disk
+(``studies/<name>/out/<scale>/<name>.json`` and ``<name>.png``; the benchmark
+summary under ``studies/bench/out/``) and writes the report as Markdown
+beside its PNG files and, from the same Markdown rendered by Python-Markdown,
+one self-contained HTML file (figures embedded as data URIs). It computes no
+physics: every number comes from a study's numbers JSON, so the report and
+the study outputs cannot disagree. Numbers and the paper-vs-ours tables are
+formatted by :mod:`hhscatter.publish.formatting`, as in the docs.
+"""
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from hhscatter.publish.formatting import (
+    comparison_table,
+    embed_markdown,
+    format_value,
+    markdown_to_html,
+    md_cell,
+)
+from hhscatter.studies import studies_root, write_json_atomic
+from hhscatter.studies.graph import studies as study_folders
+
+
+@dataclass
+class Section:
+    key: str
+    title: str
+    caption: str
+    figure: Path | None
+    numbers: dict | None
+    paper: str = ""  # the paper's figure this study reproduces ("" for a study beyond the paper)
+    cost: dict | None = None  # the stage costs (hhscatter.studies.cost), if recorded
+
+
+def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
+    """headline_numbers(numbers) -> [(name, formatted)] of the scalar and value±err entries of a numbers JSON."""
+    skip = {"study", "scale", "paper_comparison", "config", "provenance", "raw_runs"}
+    rows = []
+
+    def walk(prefix, d, depth):
+        for k, v in d.items():
+            if k in skip or len(rows) >= limit:
+                continue
+            name = f"{prefix}{k}"
+            if isinstance(v, dict) and "value" in v:
+                rows.append((name, format_value(v)))
+            elif isinstance(v, (int, float, bool)) or (isinstance(v, str) and len(v) < 80):
+                rows.append((name, format_value(v)))
+            elif isinstance(v, dict) and depth < 1:
+                walk(f"{name}.", v, depth + 1)
+
+    walk("", numbers, 0)
+    return rows
+
+
+def committed_assets(root: Path, scale: str) -> Path:
+    """committed_assets(studies root, scale) -> the docs folder of the committed study outputs at ``scale``
+    (``docs/studies/assets`` for quick, ``docs/studies/assets/<scale>`` otherwise; docs/gen_studies.py)."""
+    base = Path(root).parent / "docs" / "studies" / "assets"
+    return base if scale == "quick" else base / scale
+
+
+def _study_files(root: Path, name: str, scale: str):
+    """(figure, numbers, cost) paths of a study: its out/<scale>/ if it made them here, else the committed copies."""
+    out = root / name / "out" / scale
+    assets = committed_assets(root, scale)
+    pick = []
+    for here, there in ((out / f"{name}.png", assets / f"{name}.png"), (out / f"{name}.json", assets / f"{name}.json"),
+                        (out / "cost.json", assets / f"{name}.cost.json")):
+        pick.append(here if here.exists() else there if there.exists() else None)
+    return tuple(pick)
+
+
+def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
+    """collect(scale, root=None) -> [Section], one per study folder of ``root`` (in dependency order).
+
+    Titles and captions come from each study's ``[about]`` table; a study
+    with ``paper = ""`` goes to the part beyond the paper. A study's outputs
+    are read from ``studies/<name>/out/<scale>/`` when it made them on this
+    machine, else from the committed copies in the docs (:func:`committed_assets`),
+    so a report of the committed paper-scale results needs no simulation.
+    """
+    root = Path(root) if root is not None else studies_root()
+    sections = []
+    for info in study_folders(root):
+        fig, nums, cost = _study_files(root, info.name, scale)
+        sec = Section(info.name, info.title, info.summary, fig,
+                      json.loads(nums.read_text()) if nums else None, info.paper)
+        sec.cost = json.loads(cost.read_text()) if cost else None
+        sections.append(sec)
+    return sections
+
+
+def comparison_rows(sections) -> list[dict]:
+    rows = []
+    for s in sections:
+        for r in (s.numbers or {}).get("paper_comparison", []):
+            rows.append({"study": s.key, **r})
+    return rows
+
+
+def _verdict_class(v):
+    if not v:
+        return ""
+    v = v.lower()
+    if v.startswith("agree") or v.startswith("consistent") or v.startswith("reproduced"):
+        return "ok"
+    if v.startswith("differs in") and "only" in v:
+        # a difference that does not survive the authors' convention: not counted as one
+        return "meh"
+    if v.startswith("differ") or v.startswith("not"):
+        return "bad"
+    return "meh"
+
+
+def _img_uri(path: Path) -> str:
+    return "data:image/png;base64," + base64.b64encode(path.read_bytes()).decode()
+
+
+def _provenance(sections):
+    for s in sections:
+        if s.numbers and "provenance" in s.numbers:
+            return s.numbers["provenance"]
+    return {}
+
+
+def commits_line(sections) -> str:
+    """commits_line(sections) -> "Numbers made at commit abc123 (fig1, fig2), def456-dirty (fig3) …".
+
+    Each study's numbers carry the commit they were made at; one study's commit is not the report's. A
+    ``-dirty`` commit is said in words: that run's work tree had uncommitted changes.
+    """
+    by = {}
+    for s in sections:
+        c = ((s.numbers or {}).get("provenance") or {}).get("git_commit")
+        if c:
+            by.setdefault(str(c), []).append(s.key)
+    if not by:
+        return ""
+    parts = [f"`{c.split('-')[0][:12]}`{' (uncommitted changes)' if c.endswith('-dirty') else ''}: "
+             f"{', '.join(names)}" for c, names in sorted(by.items(), key=lambda kv: -len(kv[1]))]
+    return "Numbers made at commit " + "; ".join(parts) + "."
+
+
+BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
+               ("stress", "Numerical stress tests (`make stress`)"))
+
+
+def _bench(root: Path, name: str = "bench"):
+    """_bench(root, name) -> (summary.md or None, [png]) of the full-scale benchmark/stress output (else the
+    copy committed in docs/benchmarks/assets/<name>/)."""
+    for out in (root / name / "out" / "full", root.parent / "docs" / "benchmarks" / "assets" / name):
+        md = out / "summary.md"
+        if md.exists():
+            return md, sorted(out.glob("*.png"))
+    return None, []
+
+
+def raw_runs_line(runs: dict) -> str:
+    """raw_runs_line({key: {scene_hash, orbits, complete}}) -> one line naming the raw runs a study's numbers
+    were made from, their completeness and scene hashes (checked by the analyze stage)."""
+    parts = [f"`{k}` ({r.get('orbits') or '?'} orbits, {'complete' if r.get('complete') else 'INCOMPLETE'}, "
+             f"scene {str(r.get('scene_hash'))[:10]}…)" for k, r in sorted(runs.items())]
+    return f"*Made from {len(runs)} raw run(s):* " + "; ".join(parts) + "."
+
+
+def cost_rows(sections) -> list[dict]:
+    """cost_rows(sections) -> one row per study with a cost record: wall and CPU hours, orbits, peak RSS (MB)."""
+    from hhscatter.studies.cost import summary
+
+    rows = []
+    for s in sections:
+        if not s.cost:
+            continue
+        c = summary(s.cost)
+        rows.append({"study": s.key, "wall_h": c["wall_s"] / 3600, "cpu_h": c["cpu_s"] / 3600,
+                     "simulate_cpu_h": c["simulate_cpu_s"] / 3600, "orbits": c["orbits"], "rss_mb": c["rss_mb"]})
+    return rows
+
+
+def cost_table(rows) -> str:
+    """cost_table(rows of :func:`cost_rows`) -> Markdown table with a total row."""
+    out = ["| study | wall (h) | CPU (h) | of which simulate (h) | orbits integrated | peak RSS per process (MB) |",
+           "|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['study']} | {r['wall_h']:.2f} | {r['cpu_h']:.2f} | {r['simulate_cpu_h']:.2f} | "
+                   f"{r['orbits']:.3g} | {r['rss_mb']:.0f} |")
+    if rows:
+        out.append(f"| **total** | **{sum(r['wall_h'] for r in rows):.2f}** | **{sum(r['cpu_h'] for r in rows):.2f}** |"
+                   f" {sum(r['simulate_cpu_h'] for r in rows):.2f} | {sum(r['orbits'] for r in rows):.3g} | "
+                   f"{max(r['rss_mb'] for r in rows):.0f} |")
+    return "\n".join(out) + "\n"
+
+
+def split_rows(rows, sections):
+    """split_rows(rows, sections) -> (paper_rows, beyond_rows): rows of a paper figure's study with a number the
+    paper states vs the rest."""
+    of_paper = {s.key for s in sections if s.paper}
+    paper = [r for r in rows if r["study"] in of_paper and r.get("paper") is not None]
+    beyond = [r for r in rows if not (r["study"] in of_paper and r.get("paper") is not None)]
+    return paper, beyond
+
+
+def verdict_counts(rows) -> dict:
+    counts = {"ok": 0, "bad": 0, "meh": 0, "": 0}
+    for r in rows:
+        counts[_verdict_class(r.get("verdict"))] += 1
+    return counts
+
+
+def _count_line(rows):
+    c = verdict_counts(rows)
+    return f"{len(rows)} numbers: {c['ok']} agree, {c['bad']} differ, {c['meh'] + c['']} qualitative or not comparable."
+
+
+def _rows_table(rows, html_verdicts: bool) -> str:
+    """The paper-vs-ours rows of several studies (:func:`hhscatter.publish.formatting.comparison_table`); in the HTML
+    flavour the verdicts are coloured spans."""
+    def verdict(v):
+        cls = _verdict_class(v)
+        return f'<span class="{cls}">{html.escape(v)}</span>' if html_verdicts and cls else md_cell(v)
+
+    return comparison_table(rows, study=True, verdict=verdict)
+
+
+def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False) -> str:
+    """render_markdown(sections, scale, root, image) -> the report in Markdown.
+
+    ``image(path, name)`` returns the link target of a figure (a file copied
+    beside report.md, or a data URI for the HTML); ``html_verdicts`` colours
+    the verdicts (for the HTML page).
+    """
+    paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
+    prov = _provenance(sections)
+    lines = [f"# hhscatter reproduction report ({scale} scale)", "",
+             "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
+             "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
+             "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: |ours − paper| "
+             "≤ 2σ (our statistical error) unless the row says otherwise. The paper's numbers are in the authors' "
+             "convention; the column *convention (ours)* says how each of ours was made (\"authors'\" marks a row "
+             "made in the authors' own convention). \"Differs\" is kept for differences that survive the authors' "
+             "convention; one that does not reads \"differs in our convention only\" and is not counted as a "
+             "difference.", "",
+             f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
+             f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str) and k != 'git_commit')}. "
+             f"{commits_line(sections)}", "",
+             "## The paper's numbers beside ours", "", _count_line(paper_rows), "",
+             _rows_table(paper_rows, html_verdicts), "",
+             "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
+             _rows_table(beyond_rows, html_verdicts)]
+    costs = cost_rows(sections)
+    if costs:
+        lines += ["", f"## What it cost ({scale} scale)", "",
+                  "Measured by the study stages (`studies/<name>/out/<scale>/cost.json`): wall and CPU time of "
+                  "simulate + analyze + plot (CPU includes the worker processes), orbits integrated, and the peak "
+                  "resident memory of one process.", "", cost_table(costs)]
+    for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
+        lines += ["", f"## {group}", ""]
+        for s in (s for s in sections if bool(s.paper) == of_paper):
+            lines += [f"### {s.title} (`make {s.key}`)", "", f"*{s.caption}*" if s.caption else "", ""]
+            if s.figure:
+                lines += [f"![{s.title}]({image(s.figure, f'{s.key}.png')})", ""]
+            else:
+                lines += [f"*Not generated yet: run `make {s.key} SCALE={scale}`.*", ""]
+            if s.numbers and s.numbers.get("raw_runs"):
+                lines += [raw_runs_line(s.numbers["raw_runs"]), ""]
+            if s.numbers:
+                lines += ["| number | value |", "|---|---|"]
+                lines += [f"| {md_cell(k)} | {md_cell(v)} |" for k, v in headline_numbers(s.numbers)]
+                lines.append("")
+    for name, title in BENCH_PARTS:
+        md, pngs = _bench(root, name)
+        lines += [f"## {title}", ""]
+        if md:
+            # a summary written for its own folder: headings demoted, plain tables fenced, |x| in cells escaped
+            lines += [embed_markdown(md.read_text()), ""]
+            lines += [f"![{p.stem}]({image(p, f'{name}-{p.name}')})\n" for p in pngs]
+        else:
+            lines += [f"*Not generated yet: run `make {name}`.*", ""]
+    return "\n".join(lines) + "\n"
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;
+padding:0 1em;color:#1a1a1a;line-height:1.45}
+h1{border-bottom:2px solid #333;padding-bottom:.2em} h2{margin-top:2em;border-bottom:1px solid #ccc}
+table{border-collapse:collapse;margin:1em 0;font-size:.92em} th,td{border:1px solid #ccc;padding:.3em .6em;
+vertical-align:top} th{background:#f3f3f3} span.ok{background:#e6f4e6} span.bad{background:#fbe4e4}
+span.meh{background:#fff6d8} img{max-width:100%;border:1px solid #ddd}
+pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
+"""
+
+
+def render_html(sections, scale, root) -> str:
+    """render_html(sections, scale, root) -> one self-contained HTML page: the report's Markdown (figures as
+    data URIs) rendered by Python-Markdown."""
+    body = markdown_to_html(render_markdown(sections, scale, root, lambda path, name: _img_uri(path),
+                                            html_verdicts=True))
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
+            f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n")
+
+
+def build_report(scale: str = "quick", out: Path | None = None, root: Path | None = None) -> dict:
+    """build_report(scale='quick', out=None, root=None) -> {'html', 'markdown', 'missing', 'rows'}.
+
+    Writes ``<out>/report.html`` (self-contained) and ``<out>/report.md`` (+ ``<out>/assets/*.png``);
+    ``out`` defaults to ``reports/<scale>``. ``missing`` lists the studies with no figure or numbers.
+    """
+    root = Path(root) if root is not None else studies_root()
+    out = Path(out) if out is not None else root.parent / "reports" / scale
+    assets = out / "assets"
+    assets.mkdir(parents=True, exist_ok=True)
+    sections = collect(scale, root)
+
+    def copy_asset(path: Path, name: str) -> str:
+        shutil.copyfile(path, assets / name)
+        return f"{assets.name}/{name}"
+
+    md = render_markdown(sections, scale, root, copy_asset)
+    page = render_html(sections, scale, root)
+    for name, text in (("report.md", md), ("report.html", page)):
+        tmp = out / f".{name}.tmp"
+        tmp.write_text(text)
+        tmp.replace(out / name)
+    missing = [s.key for s in sections if s.figure is None or s.numbers is None]
+    rows = comparison_rows(sections)
+    write_json_atomic(out / "comparison.json", rows)
+    return {"html": out / "report.html", "markdown": out / "report.md", "missing": missing, "rows": len(rows)}
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    p = argparse.ArgumentParser(prog="python -m hhscatter.publish.report", description=__doc__.splitlines()[0])
+    p.add_argument("--scale", default="quick")
+    p.add_argument("--out", help="output folder (default reports/<scale>)")
+    a = p.parse_args(argv)
+    res = build_report(a.scale, a.out)
+    print(f"wrote {res['html']} and {res['markdown']} ({res['rows']} comparison rows)")
+    if res["missing"]:
+        print(f"missing outputs: {', '.join(res['missing'])}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

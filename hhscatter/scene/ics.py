@@ -1,0 +1,201 @@
+"""Initial conditions on the section ṙ = 0, φ̇ > 0 (paper, App. "Initial Conditions").
+
+Positions are uniform in area in a region; velocities are tangential with
+the speed fixed by the energy:
+
+    ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V)).
+
+Determinism: orbits are generated in fixed blocks of ``BLOCK`` orbits; block
+b draws from ``numpy.random.Generator(PCG64(SeedSequence(seed, spawn_key=(b,))))``.
+Orbit i is therefore fixed by (seed, i) alone, whatever the chunk size or the
+number of workers.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from hhscatter.scene.scene import Scene, SceneError
+
+BLOCK = 4096
+
+
+def _block_rng(seed: int, block: int) -> np.random.Generator:
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(block,))))
+
+
+def _candidates(rng, region, radius, saddle_radius, m):
+    if region == "disk":
+        r = radius * np.sqrt(rng.random(m))
+        phi = 2 * np.pi * rng.random(m)
+        return r * np.cos(phi), r * np.sin(phi)
+    # 'well' and 'square': uniform in the square [-r_s, r_s]² (= [-1, 1]² for ω = λ = 1)
+    xy = saddle_radius * (2 * rng.random((2, m)) - 1)
+    return xy[0], xy[1]
+
+
+def section_velocities(model, x, y, energy):
+    """section_velocities(model, x, y, E) -> (px, py): tangential, φ̇ > 0, |p|² = 2(E − V)."""
+    r = np.hypot(x, y)
+    v = np.sqrt(2.0 * (energy - model.potential(x, y)))
+    return -y / r * v, x / r * v
+
+
+def sample_block(scene: Scene, block: int) -> np.ndarray:
+    """sample_block(scene, block) -> array (BLOCK, 4) of states (x, y, px, py).
+
+    Candidates with V ≥ E, r = 0 or (region 'well') outside the saddle triangle
+    are rejected and redrawn from the same block generator. Region 'square' is
+    the authors' ``goodICs`` (uniform in [−r_s, r_s]² where V < E): it keeps
+    points beyond the saddles, even beyond r_esc (the engine records those as
+    escaped at t = 0).
+    """
+    model = scene.model
+    rng = _block_rng(scene.seed, block)
+    xs, ys, have = [], [], 0
+    while have < BLOCK:
+        x, y = _candidates(rng, scene.region, scene.radius, model.saddle_radius, BLOCK)
+        ok = (model.potential(x, y) < scene.energy) & ((x != 0) | (y != 0))
+        if scene.region == "well":
+            ok &= model.inside_triangle(x, y)
+        xs.append(x[ok])
+        ys.append(y[ok])
+        have += int(ok.sum())
+    x = np.concatenate(xs)[:BLOCK]
+    y = np.concatenate(ys)[:BLOCK]
+    px, py = section_velocities(model, x, y, scene.energy)
+    return np.column_stack([x, y, px, py])
+
+
+def region_ics(scene: Scene, start: int, stop: int) -> np.ndarray:
+    """region_ics(scene, start, stop) -> array (stop − start, 4) for orbits start..stop−1."""
+    blocks = range(start // BLOCK, (stop - 1) // BLOCK + 1)
+    arr = np.concatenate([sample_block(scene, b) for b in blocks])
+    off = start - blocks[0] * BLOCK
+    return arr[off : off + (stop - start)]
+
+
+def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
+    """read_ics_table(path) -> (states (n, 4), traj_id (n,) int64) from Parquet or CSV.
+
+    Required columns: x, y, px, py (float); optional traj_id (unique int).
+    Missing columns, non-finite values or duplicate ids raise SceneError.
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if not path.exists():
+        raise SceneError(f"ics: file not found: {path}")
+    try:
+        if path.suffix.lower() in (".parquet", ".pq"):
+            df = pd.read_parquet(path)
+        else:
+            df = pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is the user's file
+        raise SceneError(f"ics: cannot read {path}: {exc}") from None
+    missing = [c for c in ("x", "y", "px", "py") if c not in df.columns]
+    if missing:
+        raise SceneError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")
+    if len(df) == 0:
+        raise SceneError(f"ics: table {path} has no rows")
+    try:
+        states = df[["x", "y", "px", "py"]].to_numpy(dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"ics: columns x, y, px, py must be numeric: {exc}") from None
+    bad = ~np.isfinite(states).all(axis=1)
+    if bad.any():
+        raise SceneError(f"ics: {int(bad.sum())} row(s) have non-finite values (first at row {int(np.argmax(bad))})")
+    if "traj_id" in df.columns:
+        ids = df["traj_id"].to_numpy()
+        if not np.issubdtype(ids.dtype, np.integer):
+            raise SceneError("ics: traj_id must be integers")
+        if len(np.unique(ids)) != len(ids):
+            raise SceneError("ics: traj_id values must be unique")
+        ids = ids.astype(np.int64)
+    else:
+        ids = np.arange(len(df), dtype=np.int64)
+    return states, ids
+
+
+def check_ics(scene: Scene, states: np.ndarray) -> None:
+    """check_ics(scene, states) -> None; SceneError before any work if a table row cannot be run honestly.
+
+    Bounds (the reasons of :mod:`hhscatter.scene.scene`): every row's position within R_ESC_MAX ω²/λ of the
+    origin and energy H = |p|²/2 + V ≤ E0_MAX·E_c (energy conservation, overflow). Rows below E_c inside
+    Ω (r < r_esc) in a dissipative scene are refused: drag only lowers the energy, so such an orbit can
+    neither escape nor cross E = E_c from above: it has "settled" before it starts, and none of the
+    outcomes (whose settling time is the root of E = E_c) describes it. Conservative rows below E_c are
+    fine: they stay inside Ω and are censored at t_max, which is the correct outcome.
+    Example: ``check_ics(scene, np.array([[0.1, 0.0, 0.0, 0.8]]))``.
+    """
+    from hhscatter.scene.scene import E0_MAX, R_ESC_MAX
+
+    m = scene.model
+    x, y, px, py = (states[:, k] for k in range(4))
+    r = np.hypot(x, y)
+    far = r > R_ESC_MAX * m.saddle_radius
+    if far.any():
+        i = int(np.argmax(far))
+        raise SceneError(f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
+                         f"r = {r[i]:.3g}); energy conservation fails that far out")
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = m.energy(x, y, px, py)
+    high = ~(e <= E0_MAX * m.critical_energy)
+    if high.any():
+        i = int(np.argmax(high))
+        raise SceneError(f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
+                         f"{E0_MAX * m.critical_energy:.6g} (first: row {i}, E = {e[i]:.3g}; momenta too large: "
+                         "every orbit leaves at once, p² overflows near 1e308)")
+    if scene.gamma > 0:
+        low = (e <= m.critical_energy) & (r < scene.r_esc)
+        if low.any():
+            i = int(np.argmax(low))
+            raise SceneError(
+                f"ics: {int(low.sum())} row(s) start below E_c = {m.critical_energy:.10g} inside r_esc with drag "
+                f"γ = {scene.gamma:g} (first: row {i}, E = {e[i]:.6g}): such an orbit can never escape and never "
+                "crosses E_c from above, so it has no outcome; drop these rows (they are trapped from t = 0)")
+
+
+def section_grid(model, energy: float, extent, shape):
+    """section_grid(model, E, extent, shape) -> (x (nx,), y (ny,), allowed (ny, nx), states (m, 4), cell (m,)).
+
+    Initial conditions on a regular grid of the section ṙ = 0, φ̇ > 0 at
+    energy E (paper, App. "Initial Conditions"): cell centres
+    x_i = x0 + (i + ½)Δx, y_j = y0 + (j + ½)Δy over ``extent`` = (x0, x1, y0,
+    y1) with ``shape`` = (ny, nx) cells; the allowed cells (V < E, r > 0) get
+    the tangential velocity of :func:`section_velocities`. ``cell`` is each
+    state's flat index into the (ny, nx) grid (row-major), so outcomes map
+    back to a basin image as ``image.flat[cell] = outcome``.
+    """
+    x0, x1, y0, y1 = (float(v) for v in extent)
+    ny, nx = (int(v) for v in shape)
+    if not (x1 > x0 and y1 > y0):
+        raise ValueError(f"extent must be (x0, x1, y0, y1) with x1 > x0 and y1 > y0, got {extent!r}")
+    if nx < 1 or ny < 1:
+        raise ValueError(f"shape must be (ny, nx) with positive sizes, got {shape!r}")
+    x = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+    y = y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny
+    X, Y = np.meshgrid(x, y)
+    allowed = (model.potential(X, Y) < energy) & ((X != 0) | (Y != 0))
+    cell = np.flatnonzero(allowed)
+    px, py = section_velocities(model, X.flat[cell], Y.flat[cell], energy)
+    return x, y, allowed, np.column_stack([X.flat[cell], Y.flat[cell], px, py]), cell
+
+
+def perturbed_on_section(model, states, energy: float, dx: float = 0.0, dy: float = 0.0):
+    """perturbed_on_section(model, states, E, dx, dy) -> (states (m, 4), ok (m,)): positions moved by (dx, dy),
+    still on the section at energy E (tangential velocity recomputed).
+
+    The uncertainty algorithm's perturbed copies of a set of initial
+    conditions: each position (x, y) → (x + dx, y + dy) and a new tangential
+    velocity at E. ``ok`` is False where the moved point is not allowed (V ≥ E
+    or r = 0); those rows are NaN.
+    """
+    s = np.asarray(states, dtype=float)
+    x, y = s[:, 0] + dx, s[:, 1] + dy
+    ok = (model.potential(x, y) < energy) & ((x != 0) | (y != 0))
+    out = np.full((len(s), 4), np.nan)
+    px, py = section_velocities(model, x[ok], y[ok], energy)
+    out[ok] = np.column_stack([x[ok], y[ok], px, py])
+    return out, ok

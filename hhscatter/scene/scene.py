@@ -1,0 +1,615 @@
+"""Scenes: what one simulation computes, as a frozen, validated dataclass.
+
+A scene is loaded from ``studies/<name>/scene.toml`` (table ``[scene]``, and
+optionally ``[sections]``, ``[snapshots]`` and ``[scale.<name>]`` overrides)
+or built from CLI flags. Every bad value is refused before any work with a
+``SceneError`` naming the parameter and its allowed range.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import json
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hhscatter.model import HenonHeiles
+
+REGIONS = ("disk", "well", "square")
+TOL_RANGE = (1e-18, 1e-6)
+
+# Upper bounds, each with its reason (checked before any work; hhscatter.scene.scene.Scene._validate):
+#: r_esc ≤ R_ESC_MAX · ω²/λ: far out |V| ≈ λr³/3 ≫ E, and the energy error of the escape decision grows like
+#: tol·λr³/E (cancellation between kinetic and potential energy): 2e-4 at r = 1e4 already.
+#: r_far ≤ R_FAR_MAX · ω²/λ: an escaped orbit is only followed on towards its blow-up; the stress study
+#: checks that outcomes and times do not change up to r_far = 1e8 (tests/test_stress.py), not beyond
+R_ESC_MAX, R_FAR_MAX = 100.0, 1e8
+#: E0 ≤ E0_MAX · E_c: far above the saddle every orbit leaves within a fraction of a period (nothing to
+#: scatter), and p² = 2(E − V) overflows float64 near 1e308
+E0_MAX = 1000.0
+#: γ ≤ GAMMA_MAX · ω: beyond, the motion is overdamped (an orbit loses its energy above E_c within a small
+#: fraction of an oscillation period) and the equations only become stiff
+GAMMA_MAX = 10.0
+#: n ≤ N_MAX orbits per run: a lifetimes table of 1e9 orbits is ≈ 90 GB when read into memory; split larger
+#: ensembles into several runs (other seeds)
+N_MAX = 10**9
+#: at most CHUNKS_MAX part files per table and run point (file-system limits, one task per chunk)
+CHUNKS_MAX = 100_000
+#: at most SNAPSHOTS_MAX snapshot times: every live orbit writes one row per time (24 B), a chunk's
+#: snapshot rows are held in memory until written
+SNAPSHOTS_MAX = 100_000
+#: a start/stop/step snapshot grid longer than this is stored (scene.json, part metadata, hash) as its
+#: definition, not as every time (shorter grids are stored as their times, as before: same hashes)
+SNAPSHOT_LIST_MAX = 1000
+
+
+class SceneError(ValueError):
+    """A scene parameter is outside its allowed range (or a scene file is malformed).
+
+    Raised before any work and before anything is written; the CLI prints its message and exits with 2.
+
+    Examples
+    --------
+    >>> import hhscatter
+    >>> try:
+    ...     hhscatter.Scene(energy=0.3, n=0)
+    ... except hhscatter.SceneError as e:
+    ...     print(e)
+    n (number of orbits) must be an integer > 0, got 0
+    """
+
+
+class SnapshotGrid(tuple):
+    """SnapshotGrid(start, stop, step) -> the times start, start + step, … ≤ stop (both ends included).
+
+    A tuple of the times (what the engine uses) that remembers its definition, so that a long grid is
+    stored as ``{"start", "stop", "step"}`` (see :data:`SNAPSHOT_LIST_MAX`). The count is checked against
+    :data:`SNAPSHOTS_MAX` before any time is made. Example: ``SnapshotGrid(0, 10, 2.5)`` is
+    (0.0, 2.5, 5.0, 7.5, 10.0).
+    """
+
+    def __new__(cls, start, stop, step):
+        start, stop, step = (_finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop),
+                                                                       ("step", step)))
+        if not step > 0:
+            raise SceneError(f"snapshots.step must be > 0, got {step}")
+        count = math.floor((stop - start) / step + 0.5) + 1
+        if count > SNAPSHOTS_MAX:
+            raise SceneError(f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
+                             f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
+                             "in memory): use a larger step")
+        self = super().__new__(cls, (float(t) for t in np.arange(start, stop + 0.5 * step, step)))
+        self.definition = {"start": start, "stop": stop, "step": step}
+        return self
+
+    def __reduce__(self):
+        d = self.definition
+        return (SnapshotGrid, (d["start"], d["stop"], d["step"]))
+
+
+def _finite(name, value):
+    # a number, never text or a boolean ("0.3" would pass float() and fail deep inside the engine)
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise SceneError(f"{name} must be a number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class SectionWindow:
+    """Which crossings of the section ṙ = 0, φ̇ > 0 a scene records (paper, App. "Initial Conditions").
+
+    Those at orbit times t_from ≤ t ≤ t_to whose energy lies in [e_min, e_max]; with ``first_only`` only the
+    first such crossing of each orbit. The initial point itself (t = 0) is never recorded.
+
+    Parameters
+    ----------
+    t_from, t_to : float
+        Orbit-time window (time units), 0 ≤ t_from < t_to ≤ ∞.
+    e_min, e_max : float
+        Energy window of the crossing (units of the potential); with drag, a band around a target energy.
+    first_only : bool
+        Only the first crossing in the window, per orbit.
+    stop : bool
+        With ``first_only``: end the orbit at that crossing (one-return runs, e.g. Ulam's method).
+
+    Raises
+    ------
+    SceneError
+        A value that is not a number, or an empty window.
+
+    Examples
+    --------
+    The first crossing after t* = 17 (paper Fig. 5a), and the first crossing in an energy band (Fig. 5b):
+
+    >>> import hhscatter
+    >>> a = hhscatter.SectionWindow(t_from=17.0, first_only=True)
+    >>> b = hhscatter.SectionWindow(e_min=0.295, e_max=0.305, first_only=True)
+    >>> a.t_to, b.e_max
+    (inf, 0.305)
+    """
+
+    t_from: float = 0.0
+    t_to: float = math.inf
+    e_min: float = -math.inf
+    e_max: float = math.inf
+    first_only: bool = False
+    stop: bool = False
+
+    def __post_init__(self):
+        for name in ("first_only", "stop"):
+            if not isinstance(getattr(self, name), bool):
+                raise SceneError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
+        for name in ("t_from", "t_to", "e_min", "e_max"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or math.isnan(v):
+                raise SceneError(f"sections.{name} must be a number, got {v!r}")
+        if self.t_from < 0 or math.isinf(self.t_from):
+            raise SceneError(f"sections.t_from must be finite and ≥ 0, got {self.t_from}")
+        if not self.t_to > self.t_from:
+            raise SceneError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
+        if not self.e_max > self.e_min:
+            raise SceneError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
+        if self.stop and not (self.first_only or math.isfinite(self.t_to)):
+            raise SceneError("sections.stop needs first_only = true or a finite t_to "
+                             "(otherwise the window never closes and the orbit is always needed)")
+
+
+@dataclass(frozen=True)
+class Follow:
+    """Follow(radii) -> keep integrating escaped orbits (conservative scenes).
+
+    After its escape (the outward r_esc crossing, which stays the orbit's
+    t_end) the orbit is followed until it reaches r_far or t_max, and every
+    crossing of a circle r = R for R in ``radii`` and of r_esc (both directions,
+    from t = 0) goes to the ``crossings`` table: the check that an 'escaped' orbit does
+    not come back (study ``resc``).
+    """
+
+    radii: tuple = ()
+
+    def __post_init__(self):
+        try:
+            radii = tuple(float(r) for r in self.radii)
+        except (TypeError, ValueError):
+            raise SceneError(f"follow.radii must be a list of numbers, got {self.radii!r}") from None
+        if not radii or not all(math.isfinite(r) and r > 0 for r in radii):
+            raise SceneError(f"follow.radii must be a non-empty list of finite radii > 0, got {self.radii!r}")
+        if any(b <= a for a, b in zip(radii, radii[1:])):
+            raise SceneError("follow.radii must be strictly increasing")
+        object.__setattr__(self, "radii", radii)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One ensemble simulation: N orbits of the Hénon–Heiles flow with drag, Eqs. (eq:H), (eqn:hh_potential).
+
+    Frozen and validated when made (every bound with its reason). Units are the model's natural units
+    (ω = λ = 1 in the paper): energies in units of the potential, times in 1/ω.
+
+    Parameters
+    ----------
+    energy : float
+        E0, the initial energy of every orbit; must exceed E_c = ω⁶/(6λ²) (1/6 in the paper). None only
+        with ``ics`` (the table fixes the energies).
+    n : int
+        Number of orbits N > 0 (an integral float such as 2e4 is accepted).
+    gamma : float
+        Drag γ ≥ 0 (1/time) of the force −γp; γ = 0 is the conservative system.
+    seed : int
+        ≥ 0; with the orbit index it fixes every initial condition.
+    region : {'disk', 'well', 'square'}
+        'disk': uniform in area in r < radius; 'well': uniform in the saddle triangle where V < E;
+        'square': the authors' ``goodICs``, uniform in [−r_s, r_s]² where V < E, no radius cut (orbits
+        that start at r ≥ r_esc are escaped at t = 0). Velocities are tangential on the section.
+    radius : float
+        Disk radius R (default 0.5, as in the authors' code).
+    r_esc : float
+        Escape radius (default 1.5), > the saddle distance ω²/λ. 1.5 lies beyond the Lyapunov orbits of
+        every exit up to E = 0.5 (study ``resc``); the paper's 1.03 lets 0.3–2 % of 'escaped' orbits
+        return (E = 0.25–0.35).
+    r_far : float, optional
+        Dissipative runs: radius beyond which an escaped orbit is stopped (default max(10 ω²/λ, 2 r_esc)).
+    t_max : float
+        Maximum orbit time (default 5000); orbits alive then are censored.
+    tol : float
+        Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15).
+    omega, lam : float
+        Potential parameters ω, λ > 0 (default 1, 1).
+    chunk_size : int
+        Orbits per part file (default 10000); the tables do not depend on it (bitwise).
+    batch_size : int, optional
+        SIMD lanes (default: heyoka's recommended size); no effect on results.
+    ics : str, optional
+        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id].
+    sections : SectionWindow, optional
+        Which crossings of the section ṙ = 0, φ̇ > 0 to record (default: no sections table).
+    snapshots : tuple of float, optional
+        Orbit times at which the energy of every live orbit is recorded.
+    follow : Follow, optional
+        Conservative runs: escaped orbits followed to r_far (table ``crossings``).
+    continue_settled : bool
+        Dissipative scenes with snapshots: settled orbits go on past E_c to the last snapshot time, and
+        their energies there are snapshot rows after t_end (for ⟨E⟩(t), paper Fig. 3).
+    name : str
+        A label for progress lines and the tables' metadata.
+
+    Raises
+    ------
+    SceneError
+        A value out of range, with the key and the reason (before any work).
+
+    Examples
+    --------
+    >>> import hhscatter
+    >>> scene = hhscatter.Scene(energy=0.3, n=2e4, gamma=0.01, seed=1)
+    >>> scene.n, round(scene.model.critical_energy, 12)
+    (20000, 0.166666666667)
+    >>> hhscatter.Scene(energy=0.1, n=10)
+    Traceback (most recent call last):
+    ...
+    hhscatter.scene.scene.SceneError: energy must be > E_c = 0.1666666667 in a conservative escape scene (no escape is possible below it), got 0.1
+    """
+
+    energy: float | None
+    n: int
+    gamma: float = 0.0
+    seed: int = 0
+    region: str = "disk"
+    radius: float = 0.5
+    r_esc: float = 1.5
+    r_far: float | None = None
+    t_max: float = 5000.0
+    tol: float = 1e-15
+    omega: float = 1.0
+    lam: float = 1.0
+    chunk_size: int = 10000
+    batch_size: int | None = None
+    ics: str | None = None
+    sections: SectionWindow | None = None
+    snapshots: tuple | None = None
+    follow: Follow | None = None
+    continue_settled: bool = False
+    name: str = "scene"
+    _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        for name in ("n", "seed", "chunk_size"):  # counts written as floats (n=2e4), like the CLI's -n 2e4
+            v = getattr(self, name)
+            if isinstance(v, (float, np.floating)) and math.isfinite(v) and v == int(v):
+                object.__setattr__(self, name, int(v))
+        try:
+            model = HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+        object.__setattr__(self, "_model", model)
+        self._validate()
+
+    @property
+    def model(self) -> HenonHeiles:
+        return self._model
+
+    @property
+    def dissipative(self) -> bool:
+        return self.gamma > 0
+
+    # -- validation ---------------------------------------------------------
+    def _validate(self):
+        m = self.model
+        gamma = _finite("gamma", self.gamma)
+        if gamma < 0:
+            raise SceneError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
+        if gamma > GAMMA_MAX * m.omega:
+            raise SceneError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.omega:g}, got {gamma:g} (beyond, "
+                             "the motion is overdamped: orbits settle within a fraction of a period)")
+        if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
+            raise SceneError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
+        if self.n > N_MAX:
+            raise SceneError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
+                             "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds")
+        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise SceneError(f"seed must be an integer ≥ 0, got {self.seed!r}")
+        tol = _finite("tol", self.tol)
+        if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
+            raise SceneError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
+        t_max = _finite("t_max", self.t_max)
+        if t_max <= 0:
+            raise SceneError(f"t_max must be > 0, got {t_max}")
+        r_esc = _finite("r_esc", self.r_esc)
+        if r_esc <= m.saddle_radius:
+            raise SceneError(
+                f"r_esc must be > the saddle distance ω²/λ = {m.saddle_radius:g} "
+                f"(outside the Lyapunov orbits), got {r_esc}"
+            )
+        if r_esc > R_ESC_MAX * m.saddle_radius:
+            raise SceneError(f"r_esc must be ≤ {R_ESC_MAX:g} ω²/λ = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
+                             "(energy conservation: far out |V| ≈ λr³/3 ≫ E and the energy error grows like "
+                             "tol·λr³/E)")
+        if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
+            raise SceneError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
+        if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
+            raise SceneError(f"r_far must be ≤ {R_FAR_MAX:g} ω²/λ = {R_FAR_MAX * m.saddle_radius:g}, got "
+                             f"{self.r_far:g} (the range checked by the stress study; V ≈ λr³/3 heads for "
+                             "float64 overflow beyond)")
+        if self.region not in REGIONS:
+            raise SceneError(f"region must be one of {REGIONS}, got {self.region!r}")
+        radius = _finite("radius", self.radius)
+        if radius <= 0:
+            raise SceneError(f"radius must be > 0, got {radius}")
+        if radius > r_esc:
+            raise SceneError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
+                             "escaped already, and the sampler would reject almost every draw: V < E only "
+                             "holds near the saddle triangle)")
+        if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
+            raise SceneError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
+        if -(-self.n // self.chunk_size) > CHUNKS_MAX:
+            raise SceneError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
+                             f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size")
+        if self.batch_size is not None and (
+            not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
+        ):
+            raise SceneError(f"batch_size must be an integer in [1, 64], got {self.batch_size!r}")
+        if self.ics is None:
+            if self.energy is None:
+                raise SceneError("energy is required unless initial conditions come from a table (ics)")
+            energy = _finite("energy", self.energy)
+            # the region's minimum of V is V(0, 0) = 0 (the origin is in every region)
+            if energy <= 0:
+                raise SceneError(
+                    f"energy must be > 0 = min V over the {self.region!r} region "
+                    f"(no point of the region is accessible), got {energy}"
+                )
+            if energy > E0_MAX * m.critical_energy:
+                raise SceneError(f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
+                                 f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
+                                 "near 1e308)")
+            if energy <= m.critical_energy:
+                what = "dissipative" if gamma > 0 else "conservative escape"
+                raise SceneError(
+                    f"energy must be > E_c = {m.critical_energy:.10g} in a {what} scene "
+                    f"(no escape is possible below it), got {energy}"
+                )
+        elif self.energy is not None:
+            raise SceneError("energy must not be given with ics: each orbit's energy comes from its table row")
+        if self.sections is not None and not isinstance(self.sections, SectionWindow):
+            raise SceneError("sections must be a SectionWindow or None")
+        if self.snapshots is not None:
+            if not isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOTS_MAX:
+                raise SceneError(f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
+                                 "orbit writes one row per time; a chunk holds them in memory)")
+            snaps = self.snapshots if isinstance(self.snapshots, SnapshotGrid) else \
+                tuple(float(s) for s in self.snapshots)
+            if not snaps:
+                raise SceneError("snapshots must be a non-empty list of times or omitted")
+            if not all(math.isfinite(s) and 0 <= s <= t_max for s in snaps):
+                raise SceneError(f"snapshots times must be finite and in [0, t_max = {t_max}]")
+            if any(b <= a for a, b in zip(snaps, snaps[1:])):
+                raise SceneError("snapshots times must be strictly increasing")
+            object.__setattr__(self, "snapshots", snaps)
+
+        if self.follow is not None:
+            if not isinstance(self.follow, Follow):
+                raise SceneError("follow must be a Follow or None")
+            if gamma > 0:
+                raise SceneError("follow is for conservative scenes (gamma = 0): dissipative escapes "
+                                 "are already final (the orbit is followed to E_c or r_far)")
+            rf = self.r_far if self.r_far is not None else max(10.0 * m.saddle_radius, 2.0 * r_esc)
+            if max(self.follow.radii) >= rf:
+                raise SceneError(f"follow.radii must all be < r_far = {rf:g}, got {max(self.follow.radii):g}")
+        if not isinstance(self.continue_settled, bool):
+            raise SceneError(f"continue_settled must be true or false, got {self.continue_settled!r}")
+        if self.continue_settled and not (gamma > 0 and self.snapshots):
+            raise SceneError("continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
+                             "it records settled orbits' energies after settling")
+
+    # -- identity -----------------------------------------------------------
+    def to_dict(self) -> dict:
+        """to_dict() -> plain dict; options at their defaults that older scenes did not have are left
+        out, so every existing scene keeps its result_hash (and its runs on disk resume)."""
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
+        d["sections"] = dataclasses.asdict(self.sections) if self.sections else None
+        if d["sections"] is not None and not d["sections"]["stop"]:
+            del d["sections"]["stop"]
+        d["snapshots"] = list(self.snapshots) if self.snapshots else None
+        if isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOT_LIST_MAX:
+            d["snapshots"] = dict(self.snapshots.definition)  # small metadata (see SNAPSHOT_LIST_MAX)
+        if self.follow is None:
+            del d["follow"]
+        else:
+            d["follow"] = {"radii": list(self.follow.radii)}
+        if not self.continue_settled:
+            del d["continue_settled"]
+        return d
+
+    def to_json(self) -> str:
+        """Strict JSON (infinities written as the strings "inf"/"-inf")."""
+        return json.dumps(_clean(self.to_dict()), sort_keys=True, allow_nan=False, default=_json_default)
+
+    def result_hash(self) -> str:
+        """sha256 of everything that determines the tables (not name, batch size)."""
+        d = self.to_dict()
+        for k in ("name", "batch_size"):
+            d.pop(k)
+        if self.ics is not None:
+            d["ics"] = file_sha256(self.ics)
+        return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()
+
+    def replace(self, **changes: Any) -> Scene:
+        return dataclasses.replace(self, **changes)
+
+
+def file_sha256(path) -> str:
+    """file_sha256(path) -> sha256 hex digest of a file, computed once per (path, size, mtime) per process.
+
+    The IC table's hash is part of a scene's ``result_hash``; the cache keeps it at one read of the table
+    per run, however many chunks ask for it (a changed file has another size or mtime and is hashed anew).
+    """
+    st = Path(path).stat()
+    return _file_sha256(str(Path(path).resolve()), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _file_sha256(path: str, size: int, mtime_ns: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 22), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _clean(v):
+    if isinstance(v, dict):
+        return {k: _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return v
+
+
+def _json_default(v):
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if isinstance(v, np.generic):
+        return v.item()
+    raise TypeError(f"not JSON serialisable: {v!r}")
+
+
+def _inf(v):
+    if isinstance(v, str) and v.lower() in ("inf", "+inf", "-inf"):
+        return float(v)
+    return v
+
+
+def scene_from_dict(d: dict) -> Scene:
+    """scene_from_dict(d) -> Scene; inverse of ``Scene.to_dict``; unknown keys are refused."""
+    d = dict(d)
+    sec = d.pop("sections", None)
+    if sec is not None:
+        if not isinstance(sec, dict):
+            raise SceneError("sections must be a table")
+        unknown = set(sec) - {f.name for f in dataclasses.fields(SectionWindow)}
+        if unknown:
+            raise SceneError(f"unknown sections keys: {sorted(unknown)}")
+        d["sections"] = SectionWindow(**{k: _inf(v) for k, v in sec.items()})
+    fol = d.pop("follow", None)
+    if isinstance(fol, Follow):
+        d["follow"] = fol
+    elif fol is not None:
+        if not isinstance(fol, dict):
+            raise SceneError("follow must be a table with key 'radii'")
+        unknown = set(fol) - {"radii"}
+        if unknown:
+            raise SceneError(f"unknown follow keys: {sorted(unknown)}; allowed: ['radii']")
+        d["follow"] = Follow(**fol)
+    snaps = d.pop("snapshots", None)
+    if isinstance(snaps, dict):
+        unknown = set(snaps) - {"times", "start", "stop", "step"}
+        if unknown:
+            raise SceneError(f"unknown snapshots keys: {sorted(unknown)}")
+        if "times" in snaps:
+            snaps = snaps["times"]
+        else:
+            try:
+                start, stop, step = (snaps[k] for k in ("start", "stop", "step"))
+            except KeyError as exc:
+                raise SceneError(f"snapshots needs 'times' or start/stop/step (missing {exc})") from None
+            snaps = SnapshotGrid(start, stop, step)
+    if snaps is not None:
+        d["snapshots"] = snaps if isinstance(snaps, SnapshotGrid) else tuple(snaps)
+    known = {f.name for f in dataclasses.fields(Scene) if f.init}
+    unknown = set(d) - known
+    if unknown:
+        raise SceneError(f"unknown scene keys: {sorted(unknown)}; allowed: {sorted(known)}")
+    if "n" not in d:
+        raise SceneError("a scene needs 'n' (number of orbits)")
+    d.setdefault("energy", None)
+    return Scene(**d)
+
+
+def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
+    """scene_dict_from_toml(path, scale=None, **overrides) -> the raw scene dict of a TOML file.
+
+    What :func:`load_scene` validates; values may still be lists (a grid, see
+    :mod:`hhscatter.scene.grid`).
+    """
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"scene file not found: {path}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"scene file {path} is not valid TOML: {exc}") from None
+    if "scene" not in doc:
+        raise SceneError(f"scene file {path} has no [scene] table")
+    from hhscatter.scene.schema import validate_scene_file
+
+    validate_scene_file(doc, str(path))  # every table, key and type, before any work
+    d = dict(doc["scene"])
+    d.setdefault("name", path.parent.name)
+    if "sections" in doc:
+        d["sections"] = doc["sections"]
+    if "snapshots" in doc:
+        d["snapshots"] = doc["snapshots"]
+    if "follow" in doc:
+        d["follow"] = doc["follow"]
+    if scale is not None and scale != "quick":
+        scales = doc.get("scale", {})
+        if scale not in scales:
+            raise SceneError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
+        d.update(scales[scale])
+    d.update({k: v for k, v in overrides.items() if v is not None})
+    return d
+
+
+def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrides: object) -> Scene:
+    """A Scene from a TOML file.
+
+    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow fields), ``[snapshots]``
+    (``times = [...]`` or ``start/stop/step``) and ``[scale.<name>]`` tables whose keys override
+    ``[scene]`` when ``scale`` is given. A file whose ``energy`` or ``gamma`` is a list is a grid: load it
+    with :func:`hhscatter.load_run`.
+
+    Parameters
+    ----------
+    path : path
+        The TOML file.
+    scale : str, optional
+        Name of a ``[scale.<name>]`` table to apply.
+    **overrides
+        Scene fields applied last.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        An unknown table or key (with a did-you-mean), a value out of range, or a grid file.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, hhscatter
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "scene.toml"
+    >>> _ = f.write_text("[scene]\\nenergy = 0.3\\nn = 1000\\n[scale.paper]\\nn = 10000000\\n")
+    >>> hhscatter.load_scene(f).n, hhscatter.load_scene(f, "paper").n, hhscatter.load_scene(f, n=5).n
+    (1000, 10000000, 5)
+    """
+    d = scene_dict_from_toml(path, scale, **overrides)
+    for k in ("energy", "gamma"):
+        if isinstance(d.get(k), (list, tuple)):
+            raise SceneError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
+    return scene_from_dict(d)
