@@ -18,23 +18,26 @@ no side effects; ``dir(hhscatter)`` lists them):
 - :func:`basin_measures` — exit-basin maps of a grid of ICs, basin shares, basin entropy, Wada test
 - :func:`plot_survival`, :func:`plot_escape_rates` — draw on your matplotlib axes
 - :class:`HenonHeiles` — the model's closed forms (E_c, saddles, channels)
+- :class:`HHScatterError` and its family (:mod:`hhscatter.errors`): :class:`ConfigError` (alias
+  :class:`SceneError`), :class:`RunIntegrityError`, :class:`StudyError`, :class:`RunError`
 
 ``__version__`` is the installed distribution's version (``pyproject.toml`` is
 its only source).
 """
 
-from importlib.metadata import PackageNotFoundError, version
+import importlib
 
-try:
-    __version__ = version("hhscatter")
-except PackageNotFoundError:  # a source tree that was never installed
-    __version__ = "0+unknown"
-del version, PackageNotFoundError
+from hhscatter._version import __version__ as __version__  # re-exported
 
 _EXPORTS = {
     "Scene": "scene.scene",
     "SectionWindow": "scene.scene",
-    "SceneError": "scene.scene",
+    "SceneError": "errors",
+    "HHScatterError": "errors",
+    "ConfigError": "errors",
+    "RunError": "errors",
+    "StudyError": "errors",
+    "RunIntegrityError": "errors",
     "load_scene": "scene.scene",
     "Grid": "scene.grid",
     "load_run": "scene.grid",
@@ -62,7 +65,6 @@ __all__ = sorted(_EXPORTS)
 
 def __getattr__(name):
     if name in _EXPORTS:
-        import importlib
 
         return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
     raise AttributeError(f"module 'hhscatter' has no attribute {name!r}")

@@ -30,6 +30,7 @@ Both result objects have ``.to_frame()`` (a tidy pandas DataFrame) and
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -38,6 +39,10 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
+from hhscatter.data.store import Store
+from hhscatter.data.tables import iter_survival_batches, read_lifetimes, read_sections
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -170,7 +175,7 @@ class SurvivalCurves:
 
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         parts = [pd.DataFrame({"energy": k[0], "gamma": k[1], "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
                  for k, c in self.curves.items()]
@@ -214,7 +219,10 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
     (By hand: 3 of 4 at risk survive t = 1, then 2 of 3 survive t = 2, so P(3.5) = 3/4 · 2/3 = 1/2; the
     orbit censored at t = 3 is not counted as escaped, which would give 1/4.)
     """
-    from hhscatter.analysis.survival.fits import observed_from_outcome, survival_curve
+    from hhscatter.analysis.survival.fits import (  # deferred: scipy loads on first use
+        observed_from_outcome,
+        survival_curve,
+    )
 
     curves, n = {}, {}
     for key, df in split_points(lifetimes):
@@ -270,7 +278,7 @@ class EscapeRates:
         likelihood on [tau0, t_stop]), tau_star (NaN without power-law tail),
         note (why κ is NaN, else empty).
         """
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         rows = []
         for key in sorted(self.n, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1])):
@@ -330,8 +338,8 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     >>> bool(abs(row.kappa - 0.2) < 4 * row.kappa_err)
     True
     """
-    from hhscatter.analysis.survival.escape_rate import escape_rate
-    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.analysis.survival.escape_rate import escape_rate  # deferred: scipy loads on first use
+    from hhscatter.analysis.survival.fits import observed_from_outcome  # deferred: scipy loads on first use
 
     results, n, notes = {}, {}, {}
     for key, df in split_points(lifetimes):
@@ -360,7 +368,7 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
 def _axes(ax):
     if ax is not None:
         return ax
-    import matplotlib.pyplot as plt  # the user's backend, whatever it is
+    import matplotlib.pyplot as plt  # the user's backend, whatever it is  # deferred: matplotlib loads on first use
 
     return plt.subplots(figsize=(6, 4.2), constrained_layout=True)[1]
 
@@ -518,7 +526,7 @@ class _PointRows:
 
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per point (sorted by energy, then γ)."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         return pd.DataFrame([self.rows[k] for k in _sorted_keys(self.rows)])
 
@@ -607,9 +615,11 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     >>> bool(abs(row.kappa_cm - row.kappa_pt) < 3 * (row.kappa_cm_err + row.kappa_pt_err))
     True
     """
-    import dataclasses
 
-    from hhscatter.analysis.survival.cmeasure import cmeasure_sample_from_sections, kappa_from_cmeasure
+    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
+        cmeasure_sample_from_sections,
+        kappa_from_cmeasure,
+    )
 
     if window is not None and dataclasses.is_dataclass(window):
         window = dataclasses.asdict(window)
@@ -731,8 +741,12 @@ def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
     >>> bool(20 < row.tau1 < 40), bool(row.tau2 > 30)
     (True, True)
     """
-    from hhscatter.analysis.survival.fits import survival_from_lifetimes
-    from hhscatter.analysis.dissipative.transitions import tau1, tau2_observed, tau2_observed_interval
+    from hhscatter.analysis.dissipative.transitions import (  # deferred: pandas, pyarrow, scipy load on first use
+        tau1,
+        tau2_observed,
+        tau2_observed_interval,
+    )
+    from hhscatter.analysis.survival.fits import survival_from_lifetimes  # deferred: scipy loads on first use
 
     points = dict(split_points(lifetimes))
     conservative = lifetimes[lifetimes["gamma"] == 0] if "gamma" in lifetimes.columns else lifetimes
@@ -780,7 +794,7 @@ class EnergyDecay:
 
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per point: energy, gamma, mu, mu_err, mu_free, mu_free_err, t_lo, t_hi."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         rows = [{"energy": k[0], "gamma": k[1], "mu": f.mu, "mu_err": f.mu_err, "mu_free": f.mu_free,
                  "mu_free_err": f.mu_free_err, "t_lo": f.window[0], "t_hi": f.window[1]}
@@ -789,7 +803,7 @@ class EnergyDecay:
 
     def curves_frame(self):
         """curves_frame() -> DataFrame energy, gamma, t, n, mean_E, sem_E … (all ⟨E⟩(t) curves, tidy)."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([c.assign(energy=k[0], gamma=k[1]) for k, c in self.curves.items()], ignore_index=True)
 
@@ -843,7 +857,10 @@ def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (
     >>> print(f"{fit.mu:.6f} {fit.mu_free:.6f}")
     0.900000 0.900000
     """
-    from hhscatter.analysis.dissipative.decay import fit_energy_decay, mean_energy
+    from hhscatter.analysis.dissipative.decay import (  # deferred: pandas, pyarrow load on first use
+        fit_energy_decay,
+        mean_energy,
+    )
 
     curves, fits = {}, {}
     for key, df in _split_like(snapshots, None, energy=energy, gamma=gamma, what="snapshots table").items():
@@ -876,7 +893,7 @@ class CMeasurePoints:
 
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame point_energy, point_gamma, traj_id, t, x, y, … (every selected crossing)."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([p.assign(point_energy=k[0], point_gamma=k[1]) for k, p in self.points.items()],
                          ignore_index=True)
@@ -933,7 +950,7 @@ def cmeasure_points(sections: pandas.DataFrame, *, t_from: float, t_to: float = 
     >>> pts[(0.3, 0.0)]["x"].tolist()
     [0.2, 0.3]
     """
-    from hhscatter.analysis.geometry.distance import first_crossings
+    from hhscatter.analysis.geometry.distance import first_crossings  # deferred: pandas, pyarrow load on first use
 
     keys = [k for k, _ in split_points(lifetimes)] if lifetimes is not None else None
     out = {}
@@ -966,7 +983,7 @@ class CMeasureDistances:
 
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame energy, gamma, box, hellinger, tv, …_noise, …_excess, agreement_scale."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([self.tables[k].assign(energy=k[0], gamma=k[1], agreement_scale=self.scales[k])
                           for k in _sorted_keys(self.tables)], ignore_index=True)
@@ -1028,8 +1045,11 @@ def cmeasure_distances(points: CMeasurePoints, reference: pandas.DataFrame | np.
     >>> bool((d.to_frame()["hellinger_excess"].abs() < 0.05).all())
     True
     """
-    from hhscatter.analysis.geometry.distance import agreement_scale, distance_vs_scale
-    from hhscatter.analysis.geometry.distance import points as xy
+    from hhscatter.analysis.geometry.distance import (  # deferred: pandas, pyarrow load on first use
+        agreement_scale,
+        distance_vs_scale,
+    )
+    from hhscatter.analysis.geometry.distance import points as xy  # deferred: pandas, pyarrow load on first use
 
     Q = xy(reference) if hasattr(reference, "columns") else np.asarray(reference, dtype=float)
     tables, scales, few = {}, {}, []
@@ -1085,7 +1105,7 @@ class BasinMeasures:
     def to_frame(self) -> pandas.DataFrame:
         """to_frame() -> DataFrame, one row per (point, box side): energy, gamma, box, S_b, S_b_err, S_bb, S_bb_err,
         a column ``share <basin>`` per basin, wada (verdict, or None)."""
-        import pandas as pd
+        import pandas as pd  # deferred: pandas loads on first use
 
         parts = []
         for k in _sorted_keys(self.maps):
@@ -1100,8 +1120,8 @@ class BasinMeasures:
              **imshow_kwargs: Any) -> Axes:
         """plot(ax=None, *, key=None, **imshow_kwargs) -> ax: the basin map of point ``key`` (default: the first),
         one colour per basin, forbidden cells blank."""
-        from matplotlib.colors import ListedColormap
-        from matplotlib.patches import Patch
+        from matplotlib.colors import ListedColormap  # deferred: matplotlib loads on first use
+        from matplotlib.patches import Patch  # deferred: matplotlib loads on first use
 
         ax = _axes(ax)
         k = key if key is not None else _sorted_keys(self.maps)[0]
@@ -1169,7 +1189,11 @@ def basin_measures(lifetimes: pandas.DataFrame, cell: ArrayLike, shape: tuple[in
     >>> m.maps[(0.3, 0.0)][0, :3].tolist(), m.to_frame()[["box", "share exit 0"]].values.tolist()
     ([0, 0, 0], [[4.0, 0.5]])
     """
-    from hhscatter.analysis.geometry.basins import basin_entropy_table, basin_fractions, wada_merging
+    from hhscatter.analysis.geometry.basins import (  # deferred: pandas, pyarrow, scipy load on first use
+        basin_entropy_table,
+        basin_fractions,
+        wada_merging,
+    )
 
     cell = np.asarray(cell, dtype=np.int64).ravel()
     ny, nx = (int(v) for v in shape)
@@ -1202,8 +1226,10 @@ def run_scene(run) -> dict:
 
     Raises ValueError if ``run`` holds no ``scene.json`` (not a run of :func:`hhscatter.simulate`).
     """
-    from hhscatter.run.runner import SCENE_FILE, _decode
-    from hhscatter.data.store import Store
+    from hhscatter.run.runner import (  # deferred: pydantic loads on first use
+        SCENE_FILE,
+        _decode,
+    )
 
     store = Store(run)
     if not store.exists(SCENE_FILE):
@@ -1239,8 +1265,6 @@ def kappa_cmeasure(run: str | os.PathLike[str], **kwargs: Any) -> CMeasureRates:
     >>> hhscatter.kappa_cmeasure(run).to_frame()[["energy", "t_record_end", "note"]].values.tolist()
     [[0.3, 70.0, '']]
     """
-    from hhscatter.data.tables import read_lifetimes, read_sections
-
     scene = run_scene(run)
     if not scene.get("sections"):
         raise ValueError(f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
@@ -1280,8 +1304,6 @@ def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any
     ValueError
         If some orbit was censored before max(t_grid) (use :func:`hhscatter.survival` then).
     """
-    from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
-    from hhscatter.data.tables import iter_survival_batches
 
     km = KaplanMeierGrid(t_grid)
     for t_end, observed in iter_survival_batches(run, filters, allow_partial=allow_partial):

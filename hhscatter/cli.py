@@ -8,9 +8,13 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import re
 import sys
 from pathlib import Path
+
+from hhscatter.errors import ConfigError, HHScatterError
+from hhscatter.studies.graph import studies
 
 re_unrecognized = re.compile(r"unrecognized arguments: (.*)")
 re_choice = re.compile(r"invalid choice: '([^']*)' \(choose from (.*)\)")
@@ -30,7 +34,7 @@ EPILOG = """examples:
 'hhscatter COMMAND --help' lists a command's options."""
 
 
-class UsageError(Exception):
+class UsageError(HHScatterError):
     """Bad command-line input found after parsing (exit status 2, no traceback)."""
 
 
@@ -46,7 +50,7 @@ class _Parser(argparse.ArgumentParser):
         return opts
 
     def error(self, message):
-        from hhscatter.scene.schema import did_you_mean
+        from hhscatter.scene.schema import did_you_mean  # deferred: `hhscatter --help` starts without the engine and tables
 
         m = re_unrecognized.match(message)
         if m:
@@ -101,7 +105,7 @@ def _snapshots(s):
 
 
 def build_parser():
-    from hhscatter import __version__
+    from hhscatter import __version__  # deferred: `hhscatter --help` starts without the engine and tables
 
     p = _Parser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -181,7 +185,6 @@ def build_parser():
 def _studies_epilog() -> str:
     """The studies, one line each (name, title, summary), from the study folders; empty if there are none."""
     try:
-        from hhscatter.studies.graph import studies
 
         infos = studies()
     except Exception:  # noqa: BLE001 - --help must work even if a study.toml is broken
@@ -212,9 +215,9 @@ def _progress(a):
 
 def _resumed_scene(out):
     """The scene dict of OUT/scene.json (what --resume without a scene file continues), or None."""
-    import json
+    import json  # deferred: `hhscatter --help` starts without the engine and tables
 
-    from hhscatter.data.store import Store
+    from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
 
     try:
         store = Store(out)
@@ -227,8 +230,8 @@ def _resumed_scene(out):
 
 def _scene_from_args(a):
     """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
-    from hhscatter.scene.grid import run_from_dict
-    from hhscatter.scene.scene import SceneError, scene_dict_from_toml
+    from hhscatter.scene.grid import run_from_dict  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.scene.scene import scene_dict_from_toml  # deferred: `hhscatter --help` starts without the engine and tables
 
     flags = {
         k: getattr(a, k)
@@ -238,28 +241,28 @@ def _scene_from_args(a):
     for k, v in flags.items():
         for x in v if isinstance(v, list) else [v]:
             if isinstance(x, float) and not math.isfinite(x):
-                raise SceneError(f"{k.replace('_', '-')} must be finite, got {x}")
+                raise ConfigError(f"{k.replace('_', '-')} must be finite, got {x}")
     if a.ics:
-        from hhscatter.scene.ics import read_ics_table
+        from hhscatter.scene.ics import read_ics_table  # deferred: `hhscatter --help` starts without numpy and pydantic
 
         states, _ = read_ics_table(a.ics)
         if flags["n"] is not None and flags["n"] != len(states):
-            raise SceneError(f"n = {flags['n']} but the ics table has {len(states)} rows")
+            raise ConfigError(f"n = {flags['n']} but the ics table has {len(states)} rows")
         flags["n"] = len(states)
         flags["ics"] = str(Path(a.ics).resolve())
     if a.scene:
         d = scene_dict_from_toml(a.scene, a.scale)
     elif a.scale:
-        raise SceneError("--scale needs a scene file")
+        raise ConfigError("--scale needs a scene file")
     elif a.resume and (old := _resumed_scene(a.out)) is not None:
         d = old  # flags given as well still override it (a different scene is then refused by the hash check)
     else:
         d = {"name": Path(a.out).name}
         if flags["n"] is None:
             hint = " (--resume found no scene.json in --out)" if a.resume else ""
-            raise SceneError(f"n (number of orbits) is required: give -n or a scene file{hint}")
+            raise ConfigError(f"n (number of orbits) is required: give -n or a scene file{hint}")
         if flags["energy"] is None and not a.ics:
-            raise SceneError("energy is required: give --energy or a scene file")
+            raise ConfigError("energy is required: give --energy or a scene file")
     d.update({k: v for k, v in flags.items() if v is not None})
     window = {k: getattr(a, f"sections_{k}") for k in ("t_from", "t_to", "e_min", "e_max")}
     window = {k: v for k, v in window.items() if v is not None}
@@ -273,9 +276,9 @@ def _scene_from_args(a):
 
 
 def cmd_simulate(a):
-    from hhscatter.run.runner import simulate
-    from hhscatter.data.store import Store
-    from hhscatter.data.tables import describe_run
+    from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.data.tables import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)
     summary = simulate(scene, a.out, workers=a.workers, overwrite=a.overwrite, resume=a.resume,
@@ -298,10 +301,13 @@ def run_report(out, info: dict) -> str:
 
 
 def cmd_survival(a):
-    from matplotlib.figure import Figure  # no pyplot: no backend is chosen or changed
+    from matplotlib.figure import Figure  # no pyplot: no backend is chosen or changed  # deferred: `hhscatter --help` starts without the engine and tables
 
-    from hhscatter.api import plot_survival, survival
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.api import (  # deferred: `hhscatter --help` starts without the engine and tables
+        plot_survival,
+        survival,
+    )
+    from hhscatter.data.tables import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
 
     png = Path(a.png)
     if not png.parent.is_dir():
@@ -329,30 +335,26 @@ def cmd_survival(a):
 
 
 def cmd_study(a):
-    from hhscatter.studies import run_stage
+    from hhscatter.studies import run_stage  # deferred: `hhscatter --help` starts without the engine and tables
 
     run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a))
     return 0
 
 
 def main(argv=None):
-    from hhscatter.run.runner import RunError
-    from hhscatter.scene.scene import SceneError
-
     a = build_parser().parse_args(argv)
     try:
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
-    except (SceneError, UsageError, FileNotFoundError) as exc:  # bad input, or a run/file that is not there
+    except HHScatterError as exc:  # bad input (2, before any work), or a run that could not complete (1)
+        print(f"hhscatter: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except FileNotFoundError as exc:  # a run or file that is not there
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
-    except RunError as exc:
-        print(f"hhscatter: error: {exc}", file=sys.stderr)
-        return 1
     except KeyboardInterrupt:
         print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
         return 130
     except BrokenPipeError:  # `hhscatter … | head -1`: the reader left; the run itself is complete
-        import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return 141

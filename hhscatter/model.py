@@ -114,7 +114,7 @@ class HenonHeiles:
     # -- heyoka -----------------------------------------------------------
     def expressions(self) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
         """(state_vars, V, H) as heyoka expressions; state order x, y, px, py."""
-        import heyoka as hy
+        import heyoka as hy  # deferred: heyoka loads on first use
 
         x, y, px, py = hy.make_vars("x", "y", "px", "py")
         w2, lam = self.omega**2, self.lam
@@ -152,7 +152,7 @@ def hamilton_equations(model: HenonHeiles):
     Hamilton's equations of H, Eq. (eqn:hh_ham), derived symbolically: the
     reference against which the hand-simplified :func:`equations` is tested.
     """
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     (x, y, px, py), _, H = model.expressions()
     return [(x, hy.diff(H, px)), (y, hy.diff(H, py)), (px, -hy.diff(H, x)), (py, -hy.diff(H, y))]

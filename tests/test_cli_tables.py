@@ -9,6 +9,7 @@ import pytest
 from hhscatter import read_lifetimes, read_sections, read_snapshots
 from hhscatter.cli import main
 from hhscatter.run.runner import simulate
+from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SceneError, SectionWindow
 from hhscatter.data.tables import read_meta
 
@@ -67,7 +68,7 @@ def test_resume_skips_verified_chunks_and_redoes_damaged(tmp_path):
     s = simulate(sc, out, workers=1, resume=True, progress=False)
     assert s.chunks_skipped == 1 and s.chunks_done == 2
     assert _files(out) == before
-    with pytest.raises(SceneError, match="different scene"):
+    with pytest.raises(OutputError, match="different scene"):
         simulate(sc.replace(seed=4), out, workers=1, resume=True, progress=False)
 
 

@@ -3,7 +3,8 @@ import pytest
 
 from hhscatter.cli import main
 from hhscatter.run.runner import simulate
-from hhscatter.scene.scene import Scene, SceneError, SectionWindow
+from hhscatter.errors import OutputError, SetupError
+from hhscatter.scene.scene import Scene, SectionWindow
 
 distributed = pytest.importorskip("distributed")
 
@@ -112,7 +113,7 @@ def test_missing_dask_is_a_clear_error(tmp_path, monkeypatch):
         return real(name, *a, **k)
 
     monkeypatch.setattr(builtins, "__import__", no_dask)
-    with pytest.raises(SceneError, match=r"pip install 'hhscatter\[dask\]'"):
+    with pytest.raises(SetupError, match=r"pip install 'hhscatter\[dask\]'"):
         simulate(Scene(energy=0.3, n=10), tmp_path / "o", scheduler="local", progress=False)
     assert not (tmp_path / "o").exists()
 
@@ -139,7 +140,7 @@ def test_fsspec_url_output_resume_and_read(tmp_path, scene, reference):
         lt = read_lifetimes(url)
         assert len(lt) == 450 and lt.equals(read_lifetimes(tmp_path / "local"))
         assert len(read_sections(url)) > 0
-        with pytest.raises(SceneError, match="not empty"):
+        with pytest.raises(OutputError, match="not empty"):
             simulate(scene, url, workers=1, progress=False)
     finally:
         fsspec.filesystem("memory").rm("/hhscatter-test", recursive=True)

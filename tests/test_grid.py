@@ -8,6 +8,7 @@ from hhscatter.cli import main
 from hhscatter.scene.grid import Grid, load_run
 from hhscatter.model import HenonHeiles
 from hhscatter.run.runner import simulate
+from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SceneError, load_scene
 from hhscatter.data.tables import read_lifetimes, read_meta, read_sections
 
@@ -127,7 +128,7 @@ def test_grid_resume_and_refusal(tmp_path, grid, grid_run):
     s = simulate(grid, out, workers=1, resume=True, progress=False)
     assert s.chunks_done == 1 and s.chunks_skipped == 7
     assert {p: p.read_bytes() for p in out.rglob("part-*.parquet")} == before
-    with pytest.raises(SceneError, match="different scene"):
+    with pytest.raises(OutputError, match="different scene"):
         simulate(Grid(grid.base, ENERGIES, (0.0, 0.02)), out, workers=1, resume=True, progress=False)
 
 

@@ -22,10 +22,9 @@ import pytest
 
 from hhscatter.cli import main
 from hhscatter.run.runner import simulate
-from hhscatter.scene.scene import Scene, SceneError, SectionWindow, scene_from_dict
+from hhscatter.errors import IncompleteRunError, OutputError, RunIntegrityError, StudyError
+from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 from hhscatter.data.tables import (
-    IncompleteRunError,
-    RunIntegrityError,
     read_lifetimes,
     read_sections,
     read_snapshots,
@@ -103,7 +102,7 @@ def test_3_parts_outside_the_plan_are_refused(run, tmp_path, capsys, what):
     if what == "foreign":
         with pytest.raises(RunIntegrityError, match=r"part-000001.parquet was made by another scene"):
             read_lifetimes(run)
-        with pytest.raises(SceneError, match=r"cannot resume: .*part-000001.parquet was made by a different scene"):
+        with pytest.raises(RunIntegrityError, match=r"cannot resume: .*part-000001.parquet was made by a different scene"):
             simulate(Scene(**SCENE), run, workers=1, progress=False, resume=True)
         return
     extra = "part-000099.parquet" if what == "duplicate" else "part-junk.parquet"
@@ -147,7 +146,7 @@ def test_4_the_refused_writer_never_removes_the_holders_directory(tmp_path):
     out = tmp_path / "fresh"
     fd = Store(out).lock()  # another writer has just made the directory and holds it (empty so far)
     try:
-        with pytest.raises(SceneError, match=rf"being written by another process \(pid {os.getpid()}\)"):
+        with pytest.raises(OutputError, match=rf"being written by another process \(pid {os.getpid()}\)"):
             simulate(Scene(energy=0.3, n=10), out, workers=1, progress=False)
         assert out.is_dir() and (out / ".hhscatter.lock").exists()
     finally:
@@ -220,17 +219,17 @@ def test_6_analyze_refuses_stale_or_incomplete_raw_runs(tmp_path, base_run):
     study.config = {**config, "study": {"x": 1, "paper_mu": 0.8}}  # an analysis-only key: no new simulation
     assert list(checked_raw_runs(study)) == ["E0.30"]
     study.config = {**config, "study": {"x": 2, "paper_mu": 0.91}}  # study.toml changed since simulate
-    with pytest.raises(SceneError, match=r"were made from another study.toml \(\[study\] x \(1 → 2\) changed"):
+    with pytest.raises(StudyError, match=r"were made from another study.toml \(\[study\] x \(1 → 2\) changed"):
         checked_raw_runs(study)
     study.config = {**config, "scene": {"energy": 0.35}}
-    with pytest.raises(SceneError, match=r"another study.toml \(\[scene\] changed since simulate\)"):
+    with pytest.raises(StudyError, match=r"another study.toml \(\[scene\] changed since simulate\)"):
         checked_raw_runs(study)
     study.config = config
     (raw / "E0.30" / "lifetimes" / "part-000003.parquet").unlink()  # a re-simulate killed halfway
-    with pytest.raises(SceneError, match=r"raw run .*E0.30 is incomplete \(3 of 4 chunks finished\)"):
+    with pytest.raises(StudyError, match=r"raw run .*E0.30 is incomplete \(3 of 4 chunks finished\)"):
         checked_raw_runs(study)
     (raw / "done.json").unlink()  # simulate removes it before it starts
-    with pytest.raises(SceneError, match=r"the simulate stage has not finished \(.*done.json is missing\)"):
+    with pytest.raises(StudyError, match=r"the simulate stage has not finished \(.*done.json is missing\)"):
         checked_raw_runs(study)
 
 

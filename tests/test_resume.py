@@ -12,7 +12,8 @@ import pytest
 
 from hhscatter.cli import main
 from hhscatter.run.runner import RunError, simulate
-from hhscatter.scene.scene import Scene, SceneError, SectionWindow, load_scene
+from hhscatter.errors import OutputError
+from hhscatter.scene.scene import Scene, SectionWindow, load_scene
 from hhscatter.data.tables import verify_part
 
 TOML = """[scene]
@@ -106,7 +107,7 @@ def test_resume_of_another_scene_is_refused_and_names_the_difference(tmp_path, c
     out = tmp_path / "r"
     simulate(sc, out, workers=1, progress=False)
     before = _files(out)
-    with pytest.raises(SceneError, match=r"different scene \(seed: 3 → 4\)"):
+    with pytest.raises(OutputError, match=r"different scene \(seed: 3 → 4\)"):
         simulate(sc.replace(seed=4), out, workers=1, resume=True, progress=False)
     rc = main(["simulate", "--energy", "0.27", "-n", "200", "--seed", "3", "--chunk-size", "50", "--out", str(out),
                "--resume", "--quiet"])

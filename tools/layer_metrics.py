@@ -9,8 +9,9 @@ Run from the repository root::
 Import circles are the strongly connected components (more than one module) of the graph of
 imports between the package's own modules, module-level and function-level imports alike (a
 function-level import hides a circle from Python, not from the design). A module imports its
-package's ``__init__`` implicitly; those edges are left out, since every submodule would otherwise
-sit in a circle with a package that re-exports it.
+package's ``__init__`` implicitly; those edges are left out (they are not in the source), but an explicit
+``from package import name`` in a submodule is an edge: with a package that imports the submodule back it is
+a circle that Python reports as a partially initialised module.
 """
 
 from __future__ import annotations
@@ -120,11 +121,12 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
     mods = {module_name(f, root): f for f in files}
     known = set(mods)
     graph: dict[str, set[str]] = {m: set() for m in mods}
-    deferred, deferred_own, casts, long_funcs = [], [], [], []
+    deferred, deferred_own, casts, long_funcs, unexplained = [], [], [], [], []
     for mod, f in mods.items():
-        tree = ast.parse(f.read_text(), filename=str(f))
+        text = f.read_text()
+        lines = text.split("\n")
+        tree = ast.parse(text, filename=str(f))
         is_pkg = f.name == "__init__.py"
-        parents = {mod.rsplit(".", k)[0] for k in range(1, mod.count(".") + 1)}
         for node in ast.walk(tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = node.end_lineno - node.lineno + 1
@@ -134,12 +136,14 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
                     if isinstance(sub, (ast.Import, ast.ImportFrom)):
                         where = f"{f.relative_to(root)}:{sub.lineno}"
                         deferred.append(where)
+                        if "# deferred" not in lines[sub.lineno - 1]:
+                            unexplained.append(where)
                         if targets(sub, mod, is_pkg, known):
                             deferred_own.append(where)
             if isinstance(node, (ast.Import, ast.ImportFrom)):
                 for t in targets(node, mod, is_pkg, known):
-                    if t != mod and t not in parents:
-                        graph[mod].add(t)
+                    if t != mod:  # an explicit import of a parent package is an edge too (a real circle if it
+                        graph[mod].add(t)  # imports this module back)
         casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n)]
     for f in extra:
         tree = ast.parse(f.read_text(), filename=str(f))
@@ -156,9 +160,55 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
         "circles": scc(graph),
         "function_level_imports": deferred,
         "function_level_own_imports": deferred_own,
+        "function_level_imports_without_reason": sorted(set(unexplained)),
         "param_casts": casts,
         "long_functions": sorted(set(long_funcs), reverse=True),
+        "graph": graph,
     }
+
+
+# The layers of hhscatter, bottom up, and the layers each may import (besides itself). A module's layer is its
+# first package component below hhscatter (``hhscatter.scene.grid`` -> ``scene``); ``errors`` and ``outcomes``
+# are the bottom.
+BASE = {"errors", "outcomes", "_version"}  # what every layer shares: the error family, the outcome names,
+# the version
+LAYERS = {
+    "errors": set(),
+    "outcomes": set(),
+    "_version": set(),
+    "model": BASE,
+    "scene": BASE | {"model"},
+    "integrate": BASE | {"model", "scene"},
+    "data": BASE | {"model", "scene"},
+    "run": BASE | {"model", "scene", "integrate", "data"},
+    "analysis": BASE | {"model"},
+    "api": BASE | {"model", "scene", "data", "run", "analysis"},
+    "studies": BASE | {"model", "scene", "integrate", "data", "run", "analysis", "api"},
+    "publish": BASE | {"model", "scene", "data", "analysis", "api", "studies"},
+}
+TOP = {"", "__main__", "cli", "bench"}  # the package's door, the CLI and the benchmarks may import any layer
+
+
+def layer_of(mod: str, package: str = "hhscatter") -> str:
+    rest = mod[len(package) + 1:] if mod.startswith(package + ".") else ""
+    return rest.split(".")[0]
+
+
+def layer_violations(graph: dict[str, set[str]], package: str = "hhscatter") -> list[str]:
+    """layer_violations(graph) -> "a -> b (layer x may not import layer y)" for every import against LAYERS."""
+    out = []
+    for mod, deps in sorted(graph.items()):
+        src = layer_of(mod, package)
+        if src in TOP:
+            continue
+        if src not in LAYERS:
+            out.append(f"{mod}: not in a declared layer")
+            continue
+        for dep in sorted(deps):
+            dst = layer_of(dep, package)
+            if dst != src and dst not in LAYERS[src]:
+                out.append(f"{mod} -> {dep} (layer {src} may not import layer {dst or package})")
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -172,16 +222,24 @@ def main(argv: list[str] | None = None) -> int:
     print(f"modules: {m['modules']}")
     print(f"import circles: {len(m['circles'])}")
     print(f"function-level imports: {len(m['function_level_imports'])} "
-          f"({len(m['function_level_own_imports'])} of the package's own modules)")
+          f"({len(m['function_level_own_imports'])} of the package's own modules, "
+          f"{len(m['function_level_imports_without_reason'])} without a '# deferred: reason' comment)")
     print(f"casts of study parameters: {len(m['param_casts'])}")
     print(f"functions over {LONG} lines: {len(m['long_functions'])}")
+    if args.package == "hhscatter":
+        print(f"imports against the layers: {len(layer_violations(m['graph']))}")
     if args.details:
         for c in m["circles"]:
             print("circle:", " -> ".join(c))
+        if args.package == "hhscatter":
+            for v in layer_violations(m["graph"]):
+                print("against the layers:", v)
         for n, where in m["long_functions"]:
             print(f"long: {n:4d} {where}")
         for where in m["function_level_own_imports"]:
             print("deferred own import:", where)
+        for where in m["function_level_imports_without_reason"]:
+            print("deferred import without a reason:", where)
         for where in m["param_casts"]:
             print("cast:", where)
     return 0

@@ -35,6 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
+from hhscatter.bench import peers
+from hhscatter.integrate.engine import run_chunk
+from hhscatter.integrate.events import build_batch, layout, system
+from hhscatter.model import HenonHeiles
+
 RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))
 
 
@@ -45,10 +50,9 @@ def yardstick(ics, *, r_esc=1.03, t_max=5000.0, tol=1e-15, batch_size=None):
     Its event is built from the engine's declaration (:mod:`hhscatter.integrate.events`) so that both
     integrate the same events; only the driver differs.
     """
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
-    from hhscatter.integrate.events import build_batch
-    from hhscatter.scene.scene import Scene
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     B = int(batch_size or hy.recommended_simd_size())
     sc = Scene(energy=0.3, n=1, r_esc=r_esc, t_max=t_max, tol=tol)
@@ -114,12 +118,10 @@ def design_choices(batch_size=8, epochs=400, epoch=8.0):
     engine uses ``propagate_grid`` for snapshot scenes and ``propagate_until``
     otherwise.
     """
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
-    from hhscatter.integrate.events import system
-    from hhscatter.scene.ics import section_velocities
-    from hhscatter.model import HenonHeiles
-    from hhscatter.scene.scene import Scene
+    from hhscatter.scene.ics import section_velocities  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     m = HenonHeiles()
     rng = np.random.default_rng(7)
@@ -129,7 +131,6 @@ def design_choices(batch_size=8, epochs=400, epoch=8.0):
     px, py = section_velocities(m, x, y, 0.12)
     st0 = np.vstack([x, y, px, py])
     sc = Scene(energy=0.3, n=1)
-    from hhscatter.integrate.events import layout
 
     sys = system(sc, layout(sc))
     zeros = np.zeros(batch_size)
@@ -182,15 +183,15 @@ def _best(fn, repeat):
 
 
 def _engine(scene, ics, **kw):
-    from hhscatter.integrate.engine import run_chunk
-
     return lambda: run_chunk(scene, ics, np.arange(len(ics)), count_steps=True, **kw)
 
 
 def main(argv=None):
-    from hhscatter.bench import peers
-    from hhscatter.scene.ics import region_ics
-    from hhscatter.scene.scene import Scene, SectionWindow
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import (  # deferred: pydantic loads on first use
+        Scene,
+        SectionWindow,
+    )
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
@@ -278,7 +279,7 @@ def main(argv=None):
 
     out = Path(a.out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
     out.mkdir(parents=True, exist_ok=True)
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     df = pd.DataFrame(rows)
     df.to_csv(out / "engine.csv", index=False)

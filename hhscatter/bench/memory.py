@@ -30,10 +30,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 _SNIPPETS = {
     "baseline": (
@@ -91,7 +94,6 @@ def main(argv=None):
     a = p.parse_args(argv)
     base = Path(a.dir)
     base.mkdir(parents=True, exist_ok=True)
-    import shutil
 
     rows = []
     b = measure("baseline", energy=a.energy)
@@ -120,7 +122,6 @@ def main(argv=None):
     doc = {"energy": a.energy, "workers": a.workers, "chunk_size": a.chunk, "baseline_peak_mb": b["peak_mb"],
            "rows": rows}
     if len(rows) >= 2:
-        import numpy as np
 
         ns = np.array([r["n"] for r in rows], float)
         for key in ("sim_peak_mb", "analysis_peak_mb", "streamed_peak_mb"):

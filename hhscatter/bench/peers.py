@@ -36,6 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.integrate.engine import run_chunk
+from hhscatter.model import HenonHeiles
+
 # Kahan & Li (1997) s17odr8a weights, as in OrdinaryDiffEq.jl's KahanLi8ConstantCache
 # (γ1..γ8, then the middle weight γ9; the composition is γ1..γ8, γ9, γ8..γ1).
 KAHANLI8_GAMMA = (
@@ -50,7 +53,7 @@ KAHANLI8_GAMMA = (
     -0.60550853383003451169892108,
 )
 
-E_C = 1.0 / 6.0  # critical energy for ω = λ = 1
+E_C = HenonHeiles().critical_energy  # E_c of the model (ω = λ = 1: 1/6)
 R_SADDLE = 1.0
 
 
@@ -86,7 +89,7 @@ def kahanli8_coefficients():
 
 def _kernels():
     try:
-        from hhscatter.bench import _kernels as k
+        from hhscatter.bench import _kernels as k  # deferred: numba compiles the kernels on import (optional [bench] extra)
     except ImportError as exc:  # numba missing
         raise ImportError(
             "the benchmark peers need numba: pip install -e '.[bench]' (or `make bench`)"
@@ -123,7 +126,7 @@ def kahanli8_propagate(state, dt, nsteps):
 
 
 def _dop_tables():
-    from scipy.integrate._ivp import dop853_coefficients as d
+    from scipy.integrate._ivp import dop853_coefficients as d  # deferred: scipy loads on first use
 
     A = np.ascontiguousarray(d.A[:12, :12])
     return A, np.ascontiguousarray(d.B), np.ascontiguousarray(d.C[:12]), np.ascontiguousarray(d.E3), \
@@ -165,7 +168,7 @@ def scipy_dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0) -
     rtol = atol = tol. Orbits that the closure leaves outside Ω are continued
     to r_far as in the engine.
     """
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp  # deferred: scipy loads on first use
 
     ics = _check_ics(ics)
     n = len(ics)
@@ -233,9 +236,10 @@ def engine(ics, tol, *, gamma=0.0, energy=None, r_esc=1.03, t_max=5000.0, batch_
     ``first_only``); its outcome is then 3 where a crossing was found and the
     state/time are the crossing's.
     """
-    from hhscatter.integrate.engine import run_chunk
-    from hhscatter.model import HenonHeiles
-    from hhscatter.scene.scene import Scene, SectionWindow
+    from hhscatter.scene.scene import (  # deferred: pydantic loads on first use
+        Scene,
+        SectionWindow,
+    )
 
     ics = _check_ics(ics)
     if energy is None:

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from hhscatter.publish.figures import agg_pyplot
+
 _FLOOR = 1e-17  # errors of exactly 0 are drawn at this floor
 
 
@@ -12,9 +14,8 @@ def plot_workprecision(csv_path, png_path):
     Columns: scenes (conservative, dissipative); rows: median and 99th
     percentile of the relative escape-time error. Error bars: min–max µs/orbit.
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
-    from hhscatter.publish.figures import agg_pyplot
 
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)
@@ -55,9 +56,8 @@ def plot_workprecision(csv_path, png_path):
 
 def plot_energy_drift(csv_path, png_path):
     """plot_energy_drift(csv, png) -> png path: max relative energy error vs t per tolerance (log–log)."""
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
-    from hhscatter.publish.figures import agg_pyplot
 
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)

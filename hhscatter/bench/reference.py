@@ -19,7 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, STOPPED, simulate_orbit
+from hhscatter.integrate.engine import (
+    CENSORED,
+    ESCAPED,
+    SETTLED,
+    STOPPED,
+    simulate_orbit,
+)
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.scene import Scene, SectionWindow
 

@@ -27,6 +27,7 @@ Cases:
 """
 from __future__ import annotations
 
+import argparse
 import functools
 import math
 import tempfile
@@ -35,10 +36,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk
-from hhscatter.model import HenonHeiles
-from hhscatter.scene.scene import Scene, SectionWindow
+from hhscatter.bench.config import load_config, machine_note, out_dir
+from hhscatter.bench.plots import plot_energy_drift
 from hhscatter.bench.reference import reference_orbits
+from hhscatter.data.tables import read_lifetimes, read_sections, read_snapshots
+from hhscatter.integrate.engine import (
+    CENSORED,
+    ESCAPED,
+    SETTLED,
+    run_chunk,
+    simulate_orbit,
+    state_at,
+)
+from hhscatter.model import HenonHeiles
+from hhscatter.run.runner import simulate
+from hhscatter.scene.ics import region_ics
+from hhscatter.scene.scene import Scene, SectionWindow
 
 MODEL = HenonHeiles()
 E_C = MODEL.critical_energy
@@ -71,14 +84,11 @@ def _run(ics, *, tol, energy=None, gamma=0.0, t_max=5000.0, r_esc=1.03, r_far=No
 
 
 def _disk_ics(energy, n, seed, gamma=0.0):
-    from hhscatter.scene.ics import region_ics
-
     return region_ics(Scene(energy=energy, gamma=gamma, n=n, seed=seed), 0, n)
 
 
 def backward(state, T):
     """backward(state, T) -> float64 state at time −T (long double, conservative, no events)."""
-    from hhscatter.integrate.engine import state_at
 
     return np.asarray(state_at(Scene(energy=0.3, n=1), state, -T, fp_type=np.longdouble), dtype=float)
 
@@ -97,8 +107,6 @@ def kam_trapped_ics(energy=0.2, n_want=8, n_try=600, seed=4, t_sel=5000.0):
 
 @functools.lru_cache(maxsize=8)
 def _kam_trapped(energy, n_want, n_try, seed, t_sel):
-    from hhscatter.scene.ics import region_ics
-
     ics = region_ics(Scene(energy=energy, n=n_try, seed=seed, region="well"), 0, n_try)
     res = _run(ics, tol=1e-15, energy=energy, t_max=t_sel)
     keep = np.flatnonzero(res.lifetimes["outcome"] == CENSORED)[:n_want]
@@ -266,7 +274,7 @@ def _tangent_points(energy=0.27, r_t=1.03, rdd=-0.02):
     In polar form V = r²/2 + r³ sin(3φ)/3; r̈ = v²/r − ∂V/∂r with v² = 2(E − V).
     φ is solved on both sides of each channel axis; both senses of rotation.
     """
-    from scipy.optimize import brentq
+    from scipy.optimize import brentq  # deferred: scipy loads on first use
 
     def rddot(phi):
         V = r_t**2 / 2 + r_t**3 * math.sin(3 * phi) / 3
@@ -358,8 +366,6 @@ def reference_section_times(ic, t_max, r_esc=1.03):
     The engine's scalar driver in long double (tolerance its epsilon, ~1e-19),
     with every crossing recorded (no window).
     """
-    from hhscatter.integrate.engine import simulate_orbit
-
     sc = Scene(energy=0.3, n=1, r_esc=r_esc, t_max=t_max, sections=SectionWindow())
     res = simulate_orbit(sc, ic, fp_type=np.longdouble)
     return np.array([float(r[0]) for r in res.sections])
@@ -423,8 +429,6 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
     (at γ = r_far_gamma) follows escaping orbits towards their finite-time
     blow-up before they are stopped.
     """
-    from hhscatter.run.runner import simulate
-    from hhscatter.data.tables import read_lifetimes
 
     cases = [(g, None) for g in gammas] + [(r_far_gamma, rf) for rf in r_fars if rf is not None]
     rows, ok = [], True
@@ -440,7 +444,6 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
                 err = f"{type(exc).__name__}: {exc}"
             wall = time.perf_counter() - t0
             if err is None:
-                from hhscatter.data.tables import read_sections, read_snapshots
 
                 lt = read_lifetimes(d)
                 tabs = {"lifetimes": lt, "sections": read_sections(d), "snapshots": read_snapshots(d)}
@@ -457,7 +460,6 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
         rise = float((ee[esc] - e0[esc]).max()) if esc.any() else math.nan
         ids = lt["traj_id"].to_numpy()
         order = np.argsort(ids)[:n_ref]
-        from hhscatter.scene.ics import region_ics
 
         # the reference stops at the default r_far: an escaped orbit never returns, so the
         # outcome and the escape time (last outward r_esc crossing) do not depend on r_far
@@ -496,9 +498,9 @@ def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0
     fraction of outcomes that differ. Acceptance: KS p > 0.01 and
     |Δκ| < κ_err (the statistical error of one run).
     """
-    from scipy.stats import ks_2samp
+    from scipy.stats import ks_2samp  # deferred: scipy loads on first use
 
-    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle  # deferred: scipy loads on first use
 
     rows, ok = [], True
     for kind, E, g, nn in (("conservative", 0.27, 0.0, n), ("dissipative", 0.3, diss_gamma, n_diss)):
@@ -535,7 +537,7 @@ def case_cmeasure_distance(n=100000, tols=(1e-12, 1e-15), energy=0.35, gamma=0.0
     noise of the 1e-15 set (mean over ``n_splits`` random halves). Acceptance:
     distance between tolerances < split-half noise.
     """
-    from hhscatter.analysis.geometry.distance import sliced_wasserstein
+    from hhscatter.analysis.geometry.distance import sliced_wasserstein  # deferred: pandas, pyarrow load on first use
 
     ics = _disk_ics(energy, n, seed, gamma)
     sets, ids = [], []
@@ -581,12 +583,8 @@ def _kw(d):
 
 def main(argv=None):
     """``python -m hhscatter.bench.stress [--scale full|tiny] [--only CASE ...]``: writes CSVs, PNG, summary.md."""
-    import argparse
+    import pandas as pd  # deferred: pandas loads on first use
 
-    import pandas as pd
-
-    from hhscatter.bench.config import load_config, machine_note, out_dir
-    from hhscatter.bench.plots import plot_energy_drift
 
     ap = argparse.ArgumentParser(description="hhscatter numerical stress tests (make stress)")
     ap.add_argument("--scale", default="full")
@@ -631,7 +629,7 @@ def main(argv=None):
 
 def _has_tabulate():
     try:
-        import tabulate  # noqa: F401
+        import tabulate  # noqa: F401  # deferred: tabulate loads on first use
     except ImportError:
         return False
     return True

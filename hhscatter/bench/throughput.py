@@ -10,20 +10,20 @@ orbits (linear in N: orbits are independent).
 """
 from __future__ import annotations
 
+import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from hhscatter.integrate.engine import run_chunk
+
 
 def _warm(scene_json):
     """Pool initializer: compile the scene's integrator in this process (outside the timing)."""
-    import json
-
-    from hhscatter.integrate.engine import run_chunk
-    from hhscatter.scene.ics import region_ics
-    from hhscatter.scene.scene import scene_from_dict
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import scene_from_dict  # deferred: pydantic loads on first use
 
     sc = scene_from_dict(json.loads(scene_json))
     run_chunk(sc, region_ics(sc, 0, 16), np.arange(16))
@@ -35,11 +35,8 @@ def _hold(seconds):
 
 
 def _chunk(scene_json, start, stop):
-    import json
-
-    from hhscatter.integrate.engine import run_chunk
-    from hhscatter.scene.ics import region_ics
-    from hhscatter.scene.scene import scene_from_dict
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import scene_from_dict  # deferred: pydantic loads on first use
 
     sc = scene_from_dict(json.loads(scene_json))
     ics = region_ics(sc, start, stop)
@@ -69,10 +66,10 @@ def measure_one(scene, workers):
 
 def measure_throughput(cfg, *, progress=True):
     """measure_throughput(cfg) -> DataFrame, one row per (scene, workers)."""
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
-    from hhscatter.run.runner import default_workers
-    from hhscatter.scene.scene import Scene
+    from hhscatter.run.runner import default_workers  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     tp = cfg["throughput"]
     b = cfg["bench"]

@@ -32,6 +32,7 @@ Metrics per method and setting, against the reference:
 """
 from __future__ import annotations
 
+import argparse
 import hashlib
 import time
 from collections.abc import Callable
@@ -41,6 +42,8 @@ import numpy as np
 
 from hhscatter.bench import peers
 from hhscatter.bench.config import load_config, machine_note, out_dir
+from hhscatter.bench.plots import plot_workprecision
+from hhscatter.bench.throughput import measure_throughput, throughput_markdown
 
 SHORT_T = 20.0
 
@@ -59,8 +62,8 @@ class Method:
 
 def scene_ics(energy, gamma, n, seed):
     """scene_ics(E0, γ, n, seed) -> array (n, 4) of disk ICs (the engine's, :func:`hhscatter.scene.ics.region_ics`)."""
-    from hhscatter.scene.ics import region_ics
-    from hhscatter.scene.scene import Scene
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     return region_ics(Scene(energy=energy, gamma=gamma, n=n, seed=seed), 0, n)
 
@@ -117,7 +120,7 @@ def _key(ics, **kw):
 
 def cached_reference(ics, cache_dir, *, progress=False, **kw):
     """cached_reference(ics, cache_dir, **kw of reference_orbit) -> dict of arrays (cached as .npz by content hash)."""
-    from hhscatter.bench.reference import reference_orbits
+    from hhscatter.bench.reference import reference_orbits  # deferred: pydantic loads on first use
 
     path = cache_dir / f"ref_{_key(ics, **{k: str(v) for k, v in kw.items()})}.npz"
     if path.exists():
@@ -134,7 +137,7 @@ def cached_reference(ics, cache_dir, *, progress=False, **kw):
 
 def check_reference(ics, ref, cache_dir, **kw):
     """check_reference(ics, ref, cache_dir, **kw) -> dict: long double vs real128 on ``ics`` (first orbits of ref)."""
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     q = cached_reference(ics, cache_dir, fp_type=hy.real128, **kw)
     n = len(ics)
@@ -203,7 +206,7 @@ def section_accuracy(res, ref):
 
 def run(cfg, out, *, progress=True):
     """run(cfg, out, progress=True) -> (DataFrame of rows, dict of reference checks). Writes nothing."""
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     b = cfg["bench"]
     rng = np.random.default_rng(b["seed"])
@@ -269,7 +272,7 @@ def speed_ratios(df, metric="rel_err_median"):
     ≤ the engine row's (equal or better accuracy); NaN when no setting of
     the family is that accurate. Ratios > 1: the engine is faster.
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     out = []
     for scene, d in df.groupby("scene", sort=False):
@@ -292,7 +295,7 @@ def speed_ratios(df, metric="rel_err_median"):
 
 def peer_ratios(df, metric="rel_err_median"):
     """peer_ratios(df, metric) -> DataFrame: for each peer row, t_peer / t(fastest engine row with metric ≤ peer's)."""
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     out = []
     for scene, d in df.groupby("scene", sort=False):
@@ -365,7 +368,6 @@ def summary_markdown(df, checks, ratios, pratios, note_start, note_end, seconds,
         L.append(f"| {r.scene} | {r.peer} | {_fmt(r.peer_err)} | {r.peer_us:.1f} | {r.engine} | {_fmt(r.engine_err)} |"
                  f" {r.engine_us:.1f} | {r.ratio:.2f} |")
     if throughput is not None:
-        from hhscatter.bench.throughput import throughput_markdown
 
         L += ["", throughput_markdown(throughput, cfg)]
     return "\n".join(L) + "\n"
@@ -373,10 +375,7 @@ def summary_markdown(df, checks, ratios, pratios, note_start, note_end, seconds,
 
 def main(argv=None):
     """``python -m hhscatter.bench [--scale full|tiny] [--root DIR] [--no-throughput]``: writes CSV, PNG, summary.md."""
-    import argparse
 
-    from hhscatter.bench.plots import plot_workprecision
-    from hhscatter.bench.throughput import measure_throughput
 
     ap = argparse.ArgumentParser(description="hhscatter work–precision benchmark (make bench)")
     ap.add_argument("--scale", default="full", help="full (default) or tiny")

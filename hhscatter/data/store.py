@@ -19,16 +19,20 @@ A ``Store`` pickles as its URL, so it travels to worker processes cheaply.
 """
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import posixpath
+import shutil
 from pathlib import Path
+
+from hhscatter.errors import OutputError
 
 TMP_MARK = ".tmp-"  # temporary files are ".<final name>.tmp-<pid>"
 LOCK_FILE = ".hhscatter.lock"  # one writer per run directory (Store.lock)
 
 
-class LockedError(RuntimeError):
+class LockedError(OutputError):
     """Another process holds the run directory's write lock."""
 
 
@@ -79,14 +83,14 @@ class Store:
     def exists(self, rel: str = "") -> bool:
         if self.local:
             return os.path.exists(self.path(rel))
-        import pyarrow.fs as pafs
+        import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
         return self._fs.get_file_info(self.path(rel)).type != pafs.FileType.NotFound
 
     def is_dir(self, rel: str = "") -> bool:
         if self.local:
             return os.path.isdir(self.path(rel))
-        import pyarrow.fs as pafs
+        import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
         return self._fs.get_file_info(self.path(rel)).type == pafs.FileType.Directory
 
@@ -97,7 +101,7 @@ class Store:
                 return sorted(os.listdir(self.path(rel)))
             except (FileNotFoundError, NotADirectoryError):
                 return []
-        import pyarrow.fs as pafs
+        import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
         if not self.is_dir(rel):
             return []
@@ -115,7 +119,7 @@ class Store:
                 if not recursive:
                     break
             return sorted(out)
-        import pyarrow.fs as pafs
+        import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
         if not self.is_dir(rel):
             return []
@@ -144,7 +148,6 @@ class Store:
         """
         if not self.local:
             return None
-        import fcntl
 
         self.makedirs()
         fd = os.open(self.path(LOCK_FILE), os.O_RDWR | os.O_CREAT, 0o644)
@@ -174,7 +177,6 @@ class Store:
     def remove(self, rel: str):
         """Delete a file or a whole directory tree under root (missing: no-op)."""
         if self.local:
-            import shutil
 
             p = self.path(rel)
             if os.path.isdir(p):
@@ -220,7 +222,6 @@ class Store:
 
     def write_text(self, rel: str, text: str) -> None:
         """Write a small text file atomically."""
-
         def write(target, fs):
             if fs is None:
                 with open(target, "w") as fh:
@@ -261,14 +262,14 @@ def _fsync_dir(path):
 
 def _filesystem(url: str):
     """_filesystem(url) -> (pyarrow.fs.FileSystem, path): pyarrow's own first, then fsspec's."""
-    import pyarrow.fs as pafs
+    import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
     try:
         return pafs.FileSystem.from_uri(url)
     except Exception:  # noqa: BLE001, S110 - pyarrow lacks this protocol (or its build lacks it): try fsspec
         pass
     try:
-        import fsspec
+        import fsspec  # deferred: fsspec loads on first use
     except ImportError:
         raise ValueError(
             f"out: {url!r}: pyarrow cannot open this URL and fsspec is not installed (pip install fsspec)"

@@ -71,12 +71,16 @@ import functools
 import json
 import os
 import subprocess
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from hhscatter.scene.scene import SceneError
+from hhscatter.data.store import Store
+from hhscatter.errors import IncompleteRunError, RunIntegrityError
+from hhscatter.outcomes import CENSORING_OUTCOMES, OUTCOMES
+from hhscatter._version import __version__
 
 if TYPE_CHECKING:  # annotations only
     import pandas
@@ -85,12 +89,11 @@ if TYPE_CHECKING:  # annotations only
 RunPath = Union[str, "os.PathLike[str]"]  # a run directory (or a URL pyarrow/fsspec can read)
 
 META_KEY = b"hhscatter"
-CENSORING_OUTCOMES = ("censored", "stopped")  # right-censored lifetimes (hhscatter.analysis.survival.fits)
 TABLES = ("lifetimes", "sections", "snapshots", "crossings")
 
 
 def _schemas():
-    import pyarrow as pa
+    import pyarrow as pa  # deferred: pyarrow loads on first use
 
     f64 = pa.float64()
     return {
@@ -120,10 +123,9 @@ def _schemas():
 @functools.lru_cache(maxsize=1)
 def provenance() -> dict:
     """Versions of the software that made a table, and the git commit if known."""
-    import heyoka
-    import pyarrow
+    import heyoka  # deferred: heyoka loads on first use
+    import pyarrow  # deferred: pyarrow loads on first use
 
-    from hhscatter import __version__
 
     commit = None
     try:
@@ -152,15 +154,13 @@ def provenance() -> dict:
 
 def to_arrow(name: str, columns: dict):
     """to_arrow(name, columns) -> pyarrow.Table with the table's fixed schema."""
-    import pyarrow as pa
+    import pyarrow as pa  # deferred: pyarrow loads on first use
 
     schema = _schemas()[name]
     arrays = []
     for field in schema:
         col = columns[field.name]
         if name == "lifetimes" and field.name == "outcome":
-            from hhscatter.integrate.events import OUTCOMES
-
             codes = np.asarray(col, dtype=np.int8)
             arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, pa.int8()), pa.array(OUTCOMES)))
         elif name == "lifetimes" and field.name == "exit_channel":
@@ -184,9 +184,8 @@ def write_part(path, table, meta: dict, store=None) -> None:
     written so that ``verify_part`` detects damaged data pages, not only a
     damaged footer.
     """
-    import pyarrow.parquet as pq
+    import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
-    from hhscatter.data.store import Store
 
     if store is None:
         path = Path(path)
@@ -216,9 +215,8 @@ def write_parts_streamed(path, tables, meta: dict) -> int:
     file appears atomically under ``path`` (as :func:`write_part`, with the
     same options and metadata key).
     """
-    import pyarrow.parquet as pq
+    import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
-    from hhscatter.data.store import Store
 
     path = Path(path)
     store, rows = Store(path.parent), [0]
@@ -249,7 +247,7 @@ def part_name(chunk: int) -> str:
 
 def read_meta(path, filesystem=None) -> dict:
     """read_meta(path, filesystem=None) -> the ``hhscatter`` metadata dict of one part file."""
-    import pyarrow.parquet as pq
+    import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
     md = pq.read_schema(path, filesystem=filesystem).metadata or {}
     if META_KEY not in md:
@@ -264,7 +262,7 @@ def verify_part(source, expect_rows=None) -> dict:
     checksum verification: a truncated file, a damaged footer or data page, a
     row count different from the metadata's (or from ``expect_rows``) raise.
     """
-    import pyarrow.parquet as pq
+    import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
     pf = pq.ParquetFile(source, page_checksum_verification=True)
     md = pf.schema_arrow.metadata or {}
@@ -291,7 +289,7 @@ POINT_COLUMNS = {
 
 def schema_of(name: str, grid: bool = False):
     """schema_of(name, grid=False) -> pyarrow.Schema of a table (with the point columns of a grid run)."""
-    import pyarrow as pa
+    import pyarrow as pa  # deferred: pyarrow loads on first use
 
     schema = _schemas()[name]
     if grid:
@@ -301,7 +299,7 @@ def schema_of(name: str, grid: bool = False):
 
 def add_point_columns(name: str, table, scene):
     """add_point_columns(name, table, scene) -> ``table`` with the grid point's constant columns appended."""
-    import pyarrow as pa
+    import pyarrow as pa  # deferred: pyarrow loads on first use
 
     for col, key in POINT_COLUMNS[name]:
         table = table.append_column(pa.field(col, pa.float64()),
@@ -317,13 +315,7 @@ def legacy_point(rel: str):
     return tuple(float(keys[k]) for k in LEGACY_PARTITION_KEYS)
 
 
-class RunIntegrityError(SceneError):
-    """A run directory does not hold what its manifest plans: a table or part missing, a part not in the plan,
-    a part of another scene, a damaged part (page checksum), or unfinished chunks (:class:`IncompleteRunError`)."""
-
-
-class IncompleteRunError(RunIntegrityError):
-    """Some chunks of the run are not finished (killed run, full disk): read with ``allow_partial=True``."""
+# RunIntegrityError, IncompleteRunError: hhscatter.errors (importable from here, as before)
 
 
 def run_manifest(run_dir) -> dict | None:
@@ -332,8 +324,6 @@ def run_manifest(run_dir) -> dict | None:
     None for a directory without scene.json or a run written before manifests (read as before, by
     listing its part files).
     """
-    from hhscatter.data.store import Store
-
     store = Store(run_dir)
     if not store.exists("scene.json"):
         return None
@@ -346,8 +336,6 @@ def run_status(run_dir) -> dict:
     From the manifest and the presence of the ``lifetimes`` parts (written last in every chunk); cheap
     (no file is opened). A run without manifest counts as complete if it has lifetimes parts.
     """
-    from hhscatter.data.store import Store
-
     store = Store(run_dir)
     doc = json.loads(store.read_text("scene.json")) if store.exists("scene.json") else {}
     man = doc.get("manifest")
@@ -404,7 +392,6 @@ def _planned_files(store, man: dict, name: str, allow_partial: bool):
         if not allow_partial:
             raise IncompleteRunError(f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
                                      "the finished chunks with allow_partial=True")
-        import warnings
 
         warnings.warn(f"{what}; reading the {orbits - missing_orbits} orbits of the finished chunks "
                       "(allow_partial=True)", stacklevel=4)
@@ -444,10 +431,9 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
     keeps each scanned file's footer while its dataset lives, so a streaming
     scan over many thousands of parts is done file by file.
     """
-    import pyarrow.dataset as ds
-    import pyarrow.fs as pafs
+    import pyarrow.dataset as ds  # deferred: pyarrow loads on first use
+    import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
-    from hhscatter.data.store import Store
 
     store = Store(run_dir)
     man = run_manifest(run_dir)
@@ -652,7 +638,7 @@ def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None =
 
 def _concat_runs(frames):
     """One frame of several runs' lifetimes; plain runs get ``energy`` (their median e0, 12 digits) if any has it."""
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     if not frames:
         raise ValueError("no runs given")
@@ -670,8 +656,8 @@ def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: b
     per orbit); integer columns with nulls (``exit_channel``) with the nulls as −1. ``traj_id`` is always
     returned. The engine writes parts in orbit order, so the rows are reordered (copied) only if they are not.
     """
-    import pyarrow as pa
-    import pyarrow.compute as pc
+    import pyarrow as pa  # deferred: pyarrow loads on first use
+    import pyarrow.compute as pc  # deferred: pyarrow loads on first use
 
     names = ["traj_id", *(c for c in columns if c != "traj_id")]
     tab = read_arrow(run_dir, name, columns=names, allow_partial=allow_partial)
@@ -785,8 +771,6 @@ def describe_run(run_dir) -> dict:
     footers) and the outcome counts per grid point (one entry for a plain run,
     whose ``energy`` is the scene's E0, None for runs from an IC table).
     """
-    from hhscatter.data.store import Store
-
     store = Store(run_dir)
     rows = {}
     man = run_manifest(run_dir)

@@ -2,7 +2,7 @@
 
 One block of orbits runs on one ``heyoka.taylor_adaptive_batch`` whose
 events come from :mod:`hhscatter.integrate.events` (declared there once, as data). The
-same rules (:class:`_Rules`) drive the scalar reference driver
+same rules (:class:`LaneRules`) drive the scalar reference driver
 :func:`simulate_orbit` (long double, real128) used by the tests, the
 benchmarks and the stress cases.
 
@@ -39,6 +39,7 @@ events with callbacks), so event states and times are the integrator's own.
 """
 from __future__ import annotations
 
+import abc
 import functools
 import math
 from dataclasses import dataclass, field
@@ -46,7 +47,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hhscatter.integrate import events
-from hhscatter.integrate.events import CENSORED, ESCAPED, OUTCOMES, SETTLED, STOPPED, caster
+from hhscatter.integrate.events import (
+    CENSORED,
+    ESCAPED,
+    OUTCOMES,
+    SETTLED,
+    STOPPED,
+    caster,
+)
 
 LIVE, FOLLOWING, CONTINUING = 0, 1, 2  # phase of the orbit in a lane
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
@@ -87,14 +95,13 @@ class _Callback:
         return self.handler(lane, d_sgn)
 
 
-def _bind(ta, specs, rules, fast=None):
+def _bind(ta, specs, rules, inlined=None):
+    """Bind each event's callback to the handler of its rule (``inlined``: {rule: closure} that replace some)."""
     for spec, ev in zip(specs, ta.t_events):
-        if fast and spec.name in fast:
-            ev.callback.handler = fast[spec.name]
-        elif spec.name.startswith("radius"):
-            ev.callback.handler = functools.partial(rules.on_radius, int(spec.name[6:]))
+        if inlined and spec.rule in inlined:
+            ev.callback.handler = inlined[spec.rule]
         else:
-            ev.callback.handler = getattr(rules, "on_" + spec.name)
+            ev.callback.handler = rules.handler(spec)
 
 
 def _unbind(ta):
@@ -104,28 +111,58 @@ def _unbind(ta):
         ev.callback.handler = None
 
 
-class _Rules:
+class LaneRules(abc.ABC):
     """Event handlers = the outcome rules of :mod:`hhscatter.integrate.events`, per lane.
 
-    Subclasses supply the integrator access: ``elapsed(lane)``, ``state4(lane)``
-    (x, y, px, py as floats), ``set_gate``, ``set_clock`` and ``release(lane)``
-    (what the orbit's end does: load the next orbit, park the lane, or stop).
+    The rules are written once, here; a scheduler (a batch integrator's lanes, or one scalar orbit) subclasses
+    this and supplies the integrator access below (the abstract methods). :meth:`handler` gives the handler of an
+    event's rule (:attr:`hhscatter.integrate.events.EventSpec.rule`); each handler takes (lane, direction) and
+    returns whether the propagation continues.
     """
 
-    def setup(self, scene, lay, n_lanes):
+    # -- the integrator access a scheduler supplies ------------------------------
+    @abc.abstractmethod
+    def elapsed(self, lane: int) -> float:
+        """The orbit time of ``lane`` now (time units)."""
+    @abc.abstractmethod
+    def state4(self, lane: int) -> tuple:
+        """(x, y, px, py) of ``lane`` now, as Python floats."""
+    @abc.abstractmethod
+    def set_gate(self, lane: int, g: float) -> None:
+        """Open (1.0) or close (0.0) the section event of ``lane``."""
+    @abc.abstractmethod
+    def set_clock(self, lane: int, sigma: float) -> None:
+        """Set the clock variable σ of ``lane`` (its root is the next clock target)."""
+    @abc.abstractmethod
+    def record(self, lane: int, outcome: int, t: float, state) -> None:
+        """Record the orbit's outcome (a code of :mod:`hhscatter.outcomes`), its end time and end state."""
+    @abc.abstractmethod
+    def release(self, lane: int) -> bool:
+        """The orbit of ``lane`` needs nothing more: load the next orbit, park the lane, or stop.
+
+        Returns what the event callback returns (False stops the propagation).
+        """
+    def handler(self, spec):
+        """handler(spec) -> the callable (lane, direction) -> continue? of the event ``spec``'s rule."""
+        rules = {"escape": self.on_escape, "closure": self.on_closure, "far": self.on_far, "resc": self.on_resc,
+                 "radius": self.on_radius, "section": self.on_section, "clock": self.on_clock}
+        h = rules[spec.rule]
+        return functools.partial(h, spec.index) if spec.index is not None else h
+
+    def setup(self, scene, layout, n_lanes):
         self.scene = scene
         self.model = scene.model
         self.r_s = self.model.saddle_radius
         self.half_w2 = 0.5 * self.model.omega**2
         self.lam = self.model.lam
-        self.lay = lay
+        self.layout = layout
         self.win = scene.sections
         self.follow = scene.follow is not None
         self.radii = events.follow_radii(scene) if self.follow else ()
         self.r_esc = float(scene.r_esc)
         self.continue_settled = bool(scene.continue_settled)
         self.targets = events.clock_targets(scene)
-        self.G = lay.clock_scale
+        self.clock_scale = layout.clock_scale
         self.orbit = [-1] * n_lanes
         self.phase = [LIVE] * n_lanes
         self.last_out = [None] * n_lanes
@@ -153,10 +190,7 @@ class _Rules:
         if self.win is not None:
             self.set_gate(lane, 1.0 if self.win.t_from <= 0 else 0.0)
         if self.targets:
-            self.set_clock(lane, self.targets[0][0] / self.G)
-
-    def record(self, lane, outcome, t, state):
-        raise NotImplementedError
+            self.set_clock(lane, self.targets[0][0] / self.clock_scale)
 
     def end_censored(self, lane):
         """Alive at t_max: censored there (t_end = t_max exactly, the state where the orbit is)."""
@@ -248,7 +282,7 @@ class _Rules:
         i = self.clock_i[lane]
         targets = self.targets
         # the root of σ lands within rounding (~ulp(1)·G) of its target, on either side
-        while i < len(targets) and targets[i][0] <= t + 1e-12 * self.G:
+        while i < len(targets) and targets[i][0] <= t + 1e-12 * self.clock_scale:
             if targets[i][1] == "censor":  # t_max, which the stream scheduler leaves to the clock
                 self.clock_i[lane] = i + 1
                 if self.phase[lane] == LIVE:
@@ -268,20 +302,20 @@ class _Rules:
                     return self.end(lane, STOPPED, t, self.state4(lane))
             i += 1
         self.clock_i[lane] = i
-        self.set_clock(lane, (targets[i][0] - t) / self.G if i < len(targets) else 1.0)
+        self.set_clock(lane, (targets[i][0] - t) / self.clock_scale if i < len(targets) else 1.0)
         return True
 
 
-class _BatchRules(_Rules):
+class _BatchRules(LaneRules):
     """Lanes of one batch integrator: the part shared by both schedulers."""
 
-    def __init__(self, scene, ta, lay, ics):
+    def __init__(self, scene, ta, layout, ics):
         self.ta = ta
         self.B = ta.batch_size
-        self.setup(scene, lay, self.B)
+        self.setup(scene, layout, self.B)
         self.state = ta.state  # live views into the integrator
-        self.pars = ta.pars if lay.n_pars else None
-        self.gate_live = lay.gate is not None and lay.gate < len(ta.pars)
+        self.pars = ta.pars if layout.n_pars else None
+        self.gate_live = layout.gate is not None and layout.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
         self.ics = ics.tolist()
         self.n = len(ics)
@@ -301,10 +335,10 @@ class _BatchRules(_Rules):
 
     def set_gate(self, lane, g):
         if self.gate_live:  # (a first phase has no section event, hence no gate)
-            self.pars[self.lay.gate, lane] = g
+            self.pars[self.layout.gate, lane] = g
 
     def set_clock(self, lane, sigma):
-        self.state[self.lay.clock, lane] = sigma
+        self.state[self.layout.clock, lane] = sigma
 
     def record(self, lane, outcome, t, state):
         k = self.orbit[lane]
@@ -336,48 +370,48 @@ class _BatchRules(_Rules):
 class _Stream(_BatchRules):
     """Stream scheduler: the next orbit is loaded in the callback that ends one."""
 
-    def __init__(self, scene, ta, lay, ics):
-        super().__init__(scene, ta, lay, ics)
-        self.t0_hi = [0.0] * self.B
-        self.t0_lo = [0.0] * self.B
+    def __init__(self, scene, ta, layout, ics):
+        super().__init__(scene, ta, layout, ics)
+        self.start_hi = [0.0] * self.B
+        self.start_lo = [0.0] * self.B
         # bound of the running propagate_until call (read by callbacks) and the bound each
         # lane's current orbit needs
-        self.tf = np.zeros(self.B)
-        self.tf_orbit = [0.0] * self.B
+        self.bound = np.zeros(self.B)
+        self.orbit_bound = [0.0] * self.B
         self.n_restarts = 0
         self.n_loads = 0
         # with the clock censoring at t_max, no lane needs a bound: one call runs the chunk
         self.clock_censor = any(a == "censor" for _, a in self.targets)
         self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
 
-    def fast_handlers(self):
+    def inlined_handlers(self):
         """Lean closures for the hot handlers of plain scenes (no section event, no follow).
 
-        The same rules as the methods of :class:`_Rules`, with the per-orbit
+        The same rules as the methods of :class:`LaneRules`, with the per-orbit
         Python cut to a few list operations (measured: the generic chain of
         method calls cost ~3 µs per orbit, more than half the integration of a
         conservative orbit at E = 0.27).
         """
         orbit, last_out = self.orbit, self.last_out
-        hi, lo, t0h, t0l, tfo, tf = self.time_hi, self.time_lo, self.t0_hi, self.t0_lo, self.tf_orbit, self.tf
+        hi, lo, starts_hi, starts_lo, orbit_bounds, bound = self.time_hi, self.time_lo, self.start_hi, self.start_lo, self.orbit_bound, self.bound
         st, ics, ta = self.state, self.ics, self.ta
-        oc, te, es = self.outcome, self.t_end, self.end_state
+        outcomes, t_ends, end_states = self.outcome, self.t_end, self.end_state
         n, t_max = self.n, self.t_max
         r_s2 = self.r_s * self.r_s
         progress = self.progress
         reset = ta.reset_cooldowns
         # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
-        clock, phase, clock_i = self.lay.clock, self.phase, self.clock_i
-        sigma0 = self.targets[0][0] / self.G if self.targets else 1.0
+        clock, phase, clock_i = self.layout.clock, self.phase, self.clock_i
+        sigma0 = self.targets[0][0] / self.clock_scale if self.targets else 1.0
         no_bound = self.clock_censor
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
 
         def elapsed(lane):
-            a, b = hi_(lane), -t0h[lane]
+            a, b = hi_(lane), -starts_hi[lane]
             s = a + b
             bb = s - a
-            return s + (((a - (s - bb)) + (b - bb)) + (lo_(lane) - t0l[lane]))
+            return s + (((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane]))
 
         counter = [self.next, self.n_loads]
 
@@ -398,15 +432,15 @@ class _Stream(_BatchRules):
                 clock_i[lane] = 0
                 phase[lane] = LIVE
             h = hi_(lane)
-            t0h[lane], t0l[lane] = h, lo_(lane)
-            tfo[lane] = _NO_BOUND if no_bound else h + t_max
+            starts_hi[lane], starts_lo[lane] = h, lo_(lane)
+            orbit_bounds[lane] = _NO_BOUND if no_bound else h + t_max
             reset(lane)
             counter[1] += 1
-            return (counter[1] & 7) or not (hi >= tf).any()
+            return (counter[1] & 7) or not (hi >= bound).any()
 
         def finish(lane, outcome, t, state):
             k = orbit[lane]
-            oc[k], te[k], es[k] = outcome, t, state
+            outcomes[k], t_ends[k], end_states[k] = outcome, t, state
             return next_orbit(lane)
 
         def on_escape(lane, d):
@@ -446,12 +480,12 @@ class _Stream(_BatchRules):
 
     def elapsed(self, lane):
         """Orbit time of ``lane`` now: the double nearest (hi + lo) − (hi0 + lo0), via TwoSum."""
-        a, b = self.time_hi.item(lane), -self.t0_hi[lane]
+        a, b = self.time_hi.item(lane), -self.start_hi[lane]
         s = a + b
         bb = s - a
         err = (a - (s - bb)) + (b - bb)
         # + the orbit time at which it entered this integrator (0 but in a second phase)
-        return (s + (err + (self.time_lo.item(lane) - self.t0_lo[lane]))) + self.t_off[lane]
+        return (s + (err + (self.time_lo.item(lane) - self.start_lo[lane]))) + self.t_off[lane]
 
     def load(self, lane, k=None):
         """Put orbit ``k`` (default: the next one) into ``lane``; park the lane if none is left.
@@ -463,18 +497,18 @@ class _Stream(_BatchRules):
             k = self.next
             if k >= self.n:
                 self.orbit[lane] = -1
-                if self.lay.gate is not None:
+                if self.layout.gate is not None:
                     self.set_gate(lane, 0.0)
                 return False
             self.next = k + 1
         self.put(lane, k)
         hi = self.time_hi.item(lane)
-        self.t0_hi[lane], self.t0_lo[lane] = hi, self.time_lo.item(lane)
-        self.tf_orbit[lane] = _NO_BOUND if self.clock_censor else hi + self.t_max
+        self.start_hi[lane], self.start_lo[lane] = hi, self.time_lo.item(lane)
+        self.orbit_bound[lane] = _NO_BOUND if self.clock_censor else hi + self.t_max
         # a lane at its bound idles until the call returns; checking costs ~1 µs,
         # so look every 8th load (idle time ≲ 8 orbit ends, once per t_max)
         self.n_loads += 1
-        return (self.n_loads & 7) or not (self.time_hi >= self.tf).any()
+        return (self.n_loads & 7) or not (self.time_hi >= self.bound).any()
 
     def release(self, lane):
         self.finish_rows(lane)
@@ -482,7 +516,7 @@ class _Stream(_BatchRules):
 
     def at_bound(self, lane):
         """After a return: handle a lane that reached its propagation bound."""
-        if self.tf[lane] == self.tf_orbit[lane]:
+        if self.bound[lane] == self.orbit_bound[lane]:
             if self.phase[lane] == LIVE:
                 self.record(lane, CENSORED, self.t_max, self.state4(lane))
             self.release(lane)
@@ -491,22 +525,21 @@ class _Stream(_BatchRules):
             self.load(lane, self.orbit[lane])
 
     def run(self):
-
-        B, ta, tf = self.B, self.ta, self.tf
+        B, ta, bound = self.B, self.ta, self.bound
         for lane in range(B):
             self.load(lane)
         n_returns = n_steps = 0
         while True:
             for lane in range(B):
                 # parked lanes hold still at their current time
-                tf[lane] = self.tf_orbit[lane] if self.orbit[lane] >= 0 else self.time_hi[lane]
+                bound[lane] = self.orbit_bound[lane] if self.orbit[lane] >= 0 else self.time_hi[lane]
             if all(k < 0 for k in self.orbit):
                 break
-            ta.propagate_until(tf)
+            ta.propagate_until(bound)
             n_returns += 1
             n_steps += _check(ta, self)  # once per return (a handful per chunk)
             for lane in range(B):
-                if self.orbit[lane] >= 0 and self.time_hi[lane] >= tf[lane]:
+                if self.orbit[lane] >= 0 and self.time_hi[lane] >= bound[lane]:
                     self.at_bound(lane)
         return n_returns, n_steps, self.n_restarts, _no_snapshots()
 
@@ -516,9 +549,9 @@ class _SecondPhase(_Stream):
     section event compiled in. Loads a migrant's state, orbit time and rule state instead of an
     initial condition; shares the outcome arrays and rows with the first phase."""
 
-    def __init__(self, scene, ta, lay, first):
+    def __init__(self, scene, ta, layout, first):
         self.migrants_in = first.migrants
-        super().__init__(scene, ta, lay, np.zeros((len(first.migrants), 4)))
+        super().__init__(scene, ta, layout, np.zeros((len(first.migrants), 4)))
         for name in ("outcome", "t_end", "end_state", "sec_rows", "cross_rows"):
             setattr(self, name, getattr(first, name))
         self.progress = None  # the first phase reported these orbits already
@@ -534,7 +567,7 @@ class _SecondPhase(_Stream):
         self.set_gate(lane, 1.0)
         self.clock_i[lane] = clock_i
         targets = self.targets
-        self.set_clock(lane, (targets[clock_i][0] - t_mig) / self.G if clock_i < len(targets) else 1.0)
+        self.set_clock(lane, (targets[clock_i][0] - t_mig) / self.clock_scale if clock_i < len(targets) else 1.0)
         self.ta.reset_cooldowns(lane)
 
     def load(self, lane, k=None):
@@ -545,8 +578,8 @@ class _SecondPhase(_Stream):
 class _Epochs(_BatchRules):
     """Epoch scheduler: all lanes advance together; snapshots from ``propagate_grid``."""
 
-    def __init__(self, scene, ta, lay, ics):
-        super().__init__(scene, ta, lay, ics)
+    def __init__(self, scene, ta, layout, ics):
+        super().__init__(scene, ta, layout, ics)
         t_max = scene.t_max
         # P divides t_max, so censoring falls on an epoch's end
         self.n_epochs_max = max(1, math.ceil(t_max / EPOCH))
@@ -554,29 +587,29 @@ class _Epochs(_BatchRules):
         self.snaps = np.asarray(scene.snapshots or (), dtype=float)
         self.s_last = float(self.snaps[-1]) if self.snaps.size else -math.inf
         self.epoch = 0
-        self.e0 = [0] * self.B
+        self.start_epoch = [0] * self.B
         self.zeros = np.zeros(self.B)
 
     def elapsed(self, lane):
-        return ((self.epoch - self.e0[lane]) * self.P + self.time_hi.item(lane)) + self.time_lo.item(lane)
+        return ((self.epoch - self.start_epoch[lane]) * self.P + self.time_hi.item(lane)) + self.time_lo.item(lane)
 
     def release(self, lane):
         """Park the lane at the origin (a fixed point) until the epoch ends."""
         self.finish_rows(lane)
         self.orbit[lane] = -1
         self.state[:, lane] = 0.0
-        if self.lay.clock is not None:
+        if self.layout.clock is not None:
             self.set_clock(lane, 1.0)
-        if self.lay.gate is not None:
+        if self.layout.gate is not None:
             self.set_gate(lane, 0.0)
         return True
 
     def _tables(self):
         """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
 
-        Row k of ``TAU`` holds the lane times of the snapshots s in [kP, (k+1)P)
+        Row k of ``grid_times`` holds the lane times of the snapshots s in [kP, (k+1)P)
         (the last epoch before t_max also (k+1)P), padded with fillers (strictly
-        increasing, evaluated and discarded) to a common length; ``S`` holds the
+        increasing, evaluated and discarded) to a common length; ``snap_times`` holds the
         snapshot times, NaN at fillers. Row −1 (parked lanes) is all fillers.
         Computed once per chunk, so an epoch's grid is a gather, not a loop.
         """
@@ -609,14 +642,14 @@ class _Epochs(_BatchRules):
                 tt[k, 0] = s[0]
             if len(t) and t[-1] == P:
                 tt[k, -1] = s[-1]
-        self.TAU, self.S = tau, tt
-        self.has = ~np.isnan(tt).all(axis=1)
+        self.grid_times, self.snap_times = tau, tt
+        self.has_snapshots = ~np.isnan(tt).all(axis=1)
 
     def run(self):
         B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
         self._tables()
-        TAU, has = self.TAU, self.has
-        orbit, phase, e0, st = self.orbit, self.phase, self.e0, self.state
+        grid_times, has_snapshots = self.grid_times, self.has_snapshots
+        orbit, phase, start_epoch, st = self.orbit, self.phase, self.start_epoch, self.state
         s_last = self.s_last
         buf, rows = [], []
         n_returns = n_steps = 0
@@ -626,11 +659,11 @@ class _Epochs(_BatchRules):
         while any(k >= 0 for k in orbit):
             ta.set_time(self.zeros)
             epoch = self.epoch
-            kv = np.array([epoch - e0[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
-            if has[kv].any():
+            epoch_index = np.array([epoch - start_epoch[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
+            if has_snapshots[epoch_index].any():
                 ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
-                out = ta.propagate_grid(np.ascontiguousarray(TAU[kv].T))[1]
-                buf.append((out[:, :4, :], kv, ids))
+                out = ta.propagate_grid(np.ascontiguousarray(grid_times[epoch_index].T))[1]
+                buf.append((out[:, :4, :], epoch_index, ids))
                 if len(buf) >= 256:
                     rows.append(self._snapshot_rows(buf))
                     buf = []
@@ -643,7 +676,7 @@ class _Epochs(_BatchRules):
                 _check(ta, self)
             for lane in lanes:  # orbits that need nothing after this epoch end here
                 if orbit[lane] >= 0:
-                    k = epoch - e0[lane] + 1  # epochs completed
+                    k = epoch - start_epoch[lane] + 1  # epochs completed
                     if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
                         if phase[lane] == LIVE:
                             self.record(lane, CENSORED, self.t_max, self.state4(lane))
@@ -666,9 +699,9 @@ class _Epochs(_BatchRules):
     def _snapshot_rows(self, buf):
         """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows."""
         out = np.stack([b[0] for b in buf])  # (epochs, n, 4, B)
-        kv = np.stack([b[1] for b in buf])  # (epochs, B)
+        epoch_index = np.stack([b[1] for b in buf])  # (epochs, B)
         ids = np.stack([b[2] for b in buf])
-        tt = self.S[kv].transpose(0, 2, 1)  # (epochs, n, B)
+        tt = self.snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
         ok = ~np.isnan(tt) & (ids >= 0)[:, None, :]
         x, y, px, py = (out[:, :, i, :][ok] for i in range(4))
         return (np.broadcast_to(ids[:, None, :], tt.shape)[ok], tt[ok], self.model.energy(x, y, px, py))
@@ -678,12 +711,12 @@ class _Epochs(_BatchRules):
         if k >= self.n:
             return
         self.next = k + 1
-        self.e0[lane] = self.epoch
+        self.start_epoch[lane] = self.epoch
         self.put(lane, k)
 
 
 def _check(ta, rules):
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     steps = 0
     for lane, res in enumerate(ta.propagate_res):
@@ -727,23 +760,23 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
     # first (or only) phase: without the section event when the window opens late
-    ta, specs, lay = events.build_batch(scene, B, _Callback, without=("section",) if phases else ())
-    lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, lay, ics)
+    ta, specs, layout = events.build_batch(scene, B, _Callback, without=("section",) if phases else ())
+    lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, layout, ics)
     lanes.count_steps = count_steps
     lanes.progress = progress
     lanes.migrate_at_open = phases
-    # the lean handlers serve stream scenes with no section event in this integrator and no follow
-    lean = kind == "stream" and scene.follow is None and (scene.sections is None or phases)
-    fast = lanes.fast_handlers() if lean else {}
-    _bind(ta, specs, lanes, fast)
+    # the inlined handlers serve stream scenes with no section event in this integrator and no follow
+    use_inlined = kind == "stream" and scene.follow is None and (scene.sections is None or phases)
+    inlined = lanes.inlined_handlers() if use_inlined else {}
+    _bind(ta, specs, lanes, inlined)
     try:
         n_returns, n_steps, n_restarts, (s_ids, s_t, s_e) = lanes.run()
     finally:
         _unbind(ta)
-        lanes.__dict__.pop("load", None)  # the fast path's closure refers back to the lanes: free them now
+        lanes.__dict__.pop("load", None)  # the inlined path's closure refers back to the lanes: free them now
     if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
         ta2, specs2, _ = events.build_batch(scene, B, _Callback)
-        second = _SecondPhase(scene, ta2, lay, lanes)
+        second = _SecondPhase(scene, ta2, layout, lanes)
         _bind(ta2, specs2, second)
         try:
             r2, s2, x2, _ = second.run()
@@ -844,13 +877,13 @@ class OrbitResult:
     n_steps: int = 0
 
 
-class _Scalar(_Rules):
+class _Scalar(LaneRules):
     """The rules on heyoka's scalar integrator (one orbit; any fp type)."""
 
-    def __init__(self, scene, ta, lay, fp_type):
+    def __init__(self, scene, ta, layout, fp_type):
         self.ta = ta
         self.fp = fp_type
-        self.setup(scene, lay, 1)
+        self.setup(scene, layout, 1)
         self.result = None
 
     def elapsed(self, lane):
@@ -863,10 +896,10 @@ class _Scalar(_Rules):
         return super().energy(*(float(v) for v in (x, y, px, py)))
 
     def set_gate(self, lane, g):
-        self.ta.pars[self.lay.gate] = self.fp(g)
+        self.ta.pars[self.layout.gate] = self.fp(g)
 
     def set_clock(self, lane, sigma):
-        self.ta.state[self.lay.clock] = self.fp(sigma)
+        self.ta.state[self.layout.clock] = self.fp(sigma)
 
     def record(self, lane, outcome, t, state):
         self.result = (outcome, t, np.array(state))
@@ -888,17 +921,17 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     epsilon). Snapshots at ``scene.snapshots`` come from stopping at each
     time (so its steps differ from the engine's, as a reference's should).
     """
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     ic = np.asarray(ic, dtype=float)
     if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
         snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []
         return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
-    ta, specs, lay = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
-    rules = _Scalar(scene, ta, lay, fp_type)
+    ta, specs, layout = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
+    rules = _Scalar(scene, ta, layout, fp_type)
     _bind(ta, specs, rules)
     cast = caster(fp_type)
-    st = np.zeros(lay.n_state)
+    st = np.zeros(layout.n_state)
     st[:4] = np.asarray(ic, dtype=float)
     ta.state[:] = cast(st)
     rules.start_orbit(0, 0)
@@ -937,15 +970,15 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
 
 def state_at(scene, ic, t, *, fp_type=float, tol=None):
     """state_at(scene, ic, t) -> state (4,) at orbit time t from a fresh scalar run (no events)."""
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = events.Layout(4, None, None, 0 if scene.gamma > 0 else None, 1 if scene.gamma > 0 else 0, 1.0)
+    layout = events.Layout(4, None, None, 0 if scene.gamma > 0 else None, 1 if scene.gamma > 0 else 0, 1.0)
     cast = caster(fp_type)
     kw = {}
     if tol is not None:
         kw["tol"] = fp_type(tol) if fp_type is not float else tol
     ta = hy.taylor_adaptive(
-        events.system(scene, lay),
+        events.system(scene, layout),
         cast(np.asarray(ic, dtype=float)),
         pars=cast(np.array([scene.gamma])) if scene.gamma > 0 else [],
         fp_type=fp_type,
@@ -955,5 +988,5 @@ def state_at(scene, ic, t, *, fp_type=float, tol=None):
     return np.array(ta.state[:4])
 
 
-__all__ = ["run_chunk", "simulate_orbit", "state_at", "scheduler", "ChunkResult", "OrbitResult", "OUTCOMES",
+__all__ = ["LaneRules", "run_chunk", "simulate_orbit", "state_at", "scheduler", "ChunkResult", "OrbitResult", "OUTCOMES",
            "ESCAPED", "SETTLED", "CENSORED", "STOPPED"]

@@ -62,8 +62,16 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-ESCAPED, SETTLED, CENSORED, STOPPED = 0, 1, 2, 3
-OUTCOMES = ("escaped", "settled", "censored", "stopped")
+import numpy as np
+
+from hhscatter.model import equations
+from hhscatter.outcomes import (  # re-exported for the engine
+    CENSORED,
+    ESCAPED,
+    OUTCOMES,
+    SETTLED,
+    STOPPED,
+)
 
 # Every initial condition lies on the section (x px + y py = 0 exactly in
 # double). With the event value exactly 0 at the start of a step, heyoka's root
@@ -75,18 +83,33 @@ T_INITIAL = 1e-10  # section crossings before this orbit time are the initial po
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
 
+#: the outcome rules an event can trigger (each a handler of :class:`hhscatter.integrate.engine.LaneRules`)
+RULES = ("escape", "closure", "far", "resc", "radius", "section", "clock")
+
+
 @dataclass(frozen=True)
 class EventSpec:
-    """EventSpec(name, direction, expression, role): one event of a scene, as data.
+    """EventSpec(name, direction, expression, role, rule=name, index=None): one event of a scene, as data.
 
     ``direction``: +1 (upward roots only), −1 (downward) or 0 (both);
-    ``expression``: callable (Symbols) -> heyoka expression whose root is the event.
+    ``expression``: callable (Symbols) -> heyoka expression whose root is the event;
+    ``rule``: the outcome rule its root triggers (one of :data:`RULES`; the handler
+    :meth:`hhscatter.integrate.engine.LaneRules.handler` binds); ``index``: the rule's argument (the radius
+    number of a follow radius), or None.
     """
 
     name: str
     direction: int
     expression: Callable
     role: str
+    rule: str = ""
+    index: int | None = None
+
+    def __post_init__(self):
+        if not self.rule:
+            object.__setattr__(self, "rule", self.name)
+        if self.rule not in RULES:
+            raise ValueError(f"event {self.name!r}: rule must be one of {RULES}, got {self.rule!r}")
 
 
 @dataclass(frozen=True)
@@ -110,7 +133,7 @@ class Symbols:
     """The heyoka expressions events are written in (built lazily: no heyoka at import)."""
 
     def __init__(self, scene, layout: Layout):
-        import heyoka as hy
+        import heyoka as hy  # deferred: heyoka loads on first use
 
         (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions()
         self.r2 = self.x**2 + self.y**2
@@ -193,7 +216,7 @@ def scene_events(scene) -> tuple:
         for k, R in enumerate(follow_radii(scene)):
             ev.append(EventSpec(f"radius{k}", 0, (lambda R2: lambda s: s.r2 - R2)(R * R),
                                 f"follow: crossing of r = {R:g}" + (" (outward: the escape)" if R == scene.r_esc
-                                                                   else "")))
+                                                                   else ""), rule="radius", index=k))
     if scene.sections is not None:
         ev.append(EventSpec(
             "section", 0,
@@ -206,9 +229,8 @@ def scene_events(scene) -> tuple:
 
 def system(scene, lay: Layout):
     """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock)."""
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
-    from hhscatter.model import equations
 
     sys = equations(scene.model, hy.par[lay.gamma] if lay.gamma is not None else None)
     if lay.clock is not None:
@@ -234,8 +256,7 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
     deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
     ``without``: names of events left out (an orbit phase that does not need them).
     """
-    import heyoka as hy
-    import numpy as np
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     lay = layout(scene)
     specs = tuple(s for s in scene_events(scene) if s.name not in without)
@@ -261,7 +282,7 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
     numpy.longdouble or heyoka.real128). ``tol`` defaults to the scene's for
     float and to the type's epsilon otherwise.
     """
-    import heyoka as hy
+    import heyoka as hy  # deferred: heyoka loads on first use
 
     lay = layout(scene)
     specs = scene_events(scene)
@@ -284,8 +305,6 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
 
 def caster(fp_type):
     """caster(fp_type) -> function turning a list/array of floats into what heyoka's constructor takes."""
-    import numpy as np
-
     if fp_type is float:
         return lambda v: np.asarray(v, dtype=float)
     if fp_type is np.longdouble:
@@ -318,6 +337,6 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
             and window.e_min <= energy <= window.e_max)
 
 
-__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "build_batch",
+__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "RULES", "build_batch",
            "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
            "section_accepts", "system"]

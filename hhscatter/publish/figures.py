@@ -10,9 +10,9 @@ from __future__ import annotations
 
 def agg_pyplot():
     """agg_pyplot() -> matplotlib.pyplot with the file-writing Agg backend selected."""
-    import matplotlib
+    import matplotlib  # deferred: matplotlib loads on first use
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: matplotlib loads on first use
 
     return plt

@@ -215,7 +215,7 @@ def embed_markdown(text: str, demote: int = 2) -> str:
 
 def markdown_to_html(text: str) -> str:
     """markdown_to_html(text) -> HTML by Python-Markdown (tables, fenced code, attribute lists, raw HTML kept)."""
-    import markdown
+    import markdown  # deferred: markdown loads on first use
 
     return markdown.markdown(text, extensions=["tables", "fenced_code", "attr_list", "sane_lists"],
                              output_format="html")

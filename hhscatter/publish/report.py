@@ -11,6 +11,7 @@ formatted by :mod:`hhscatter.publish.formatting`, as in the docs.
 """
 from __future__ import annotations
 
+import argparse
 import base64
 import datetime as _dt
 import html
@@ -26,8 +27,10 @@ from hhscatter.publish.formatting import (
     markdown_to_html,
     md_cell,
 )
-from hhscatter.studies import studies_root, write_json_atomic
+from hhscatter.studies import studies_root
+from hhscatter.studies.cost import summary
 from hhscatter.studies.graph import studies as study_folders
+from hhscatter.studies.jsonio import write_json_atomic
 
 
 @dataclass
@@ -175,8 +178,6 @@ def raw_runs_line(runs: dict) -> str:
 
 def cost_rows(sections) -> list[dict]:
     """cost_rows(sections) -> one row per study with a cost record: wall and CPU hours, orbits, peak RSS (MB)."""
-    from hhscatter.studies.cost import summary
-
     rows = []
     for s in sections:
         if not s.cost:
@@ -338,7 +339,6 @@ def build_report(scale: str = "quick", out: Path | None = None, root: Path | Non
 
 
 def main(argv=None) -> int:
-    import argparse
 
     p = argparse.ArgumentParser(prog="python -m hhscatter.publish.report", description=__doc__.splitlines()[0])
     p.add_argument("--scale", default="quick")

@@ -19,34 +19,35 @@ from __future__ import annotations
 import contextlib
 import logging
 
-from hhscatter.scene.scene import SceneError
+from hhscatter.errors import ConfigError, SetupError
+from hhscatter.run.workers import default_workers
 
 #: the address protocols of dask.distributed's communication layer
 SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
 
 
 def check_available() -> None:
-    """check_available() -> None; SceneError naming the extra if dask.distributed is missing."""
+    """check_available() -> None; SetupError naming the extra if dask.distributed is missing."""
     try:
-        import distributed  # noqa: F401
+        import distributed  # noqa: F401  # deferred: distributed loads on first use
     except ImportError:
-        raise SceneError(
+        raise SetupError(
             "scheduler: dask.distributed is not installed; pip install 'hhscatter[dask]' "
             "(or run without --scheduler to use the local process pool)"
         ) from None
 
 
 def check_scheduler(scheduler: str, workers: int | None) -> None:
-    """check_scheduler(scheduler, workers) -> None; SceneError on a bad value, before any work."""
+    """check_scheduler(scheduler, workers) -> None; ConfigError on a bad value, before any work."""
     check_available()
     if scheduler == "local":
         return
     scheme = scheduler.split("://", 1)[0] if "://" in scheduler else None
     if scheme not in SCHEMES:
-        raise SceneError(f"scheduler must be 'local' or an address like tcp://host:8786 (protocols: "
+        raise ConfigError(f"scheduler must be 'local' or an address like tcp://host:8786 (protocols: "
                          f"{', '.join(SCHEMES)}), got {scheduler!r}")
     if workers is not None:
-        raise SceneError("workers: the number of workers is the cluster's when --scheduler is an address")
+        raise ConfigError("workers: the number of workers is the cluster's when --scheduler is an address")
 
 
 @contextlib.contextmanager
@@ -60,11 +61,12 @@ def dask_client(scheduler: str, workers: int | None = None):
     there (the cluster decides).
     """
     check_scheduler(scheduler, workers)
-    from distributed import Client, LocalCluster
+    from distributed import (  # deferred: distributed loads on first use
+        Client,
+        LocalCluster,
+    )
 
     if scheduler == "local":
-        from hhscatter.run.runner import default_workers
-
         cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
                                dashboard_address=":0", silence_logs=logging.ERROR)
         try:
@@ -76,13 +78,13 @@ def dask_client(scheduler: str, workers: int | None = None):
     try:
         client = Client(scheduler, timeout="20s")
     except Exception as exc:  # noqa: BLE001 - any failure to connect is the address's: say so, no traceback
-        raise SceneError(f"scheduler: cannot connect to {scheduler} ({type(exc).__name__}: {exc})") from None
+        raise ConfigError(f"scheduler: cannot connect to {scheduler} ({type(exc).__name__}: {exc})") from None
     try:
         if not client.nthreads():
             try:
                 client.wait_for_workers(1, timeout=60)
             except TimeoutError:
-                raise SceneError(f"scheduler: {scheduler} has no workers (waited 60 s)") from None
+                raise ConfigError(f"scheduler: {scheduler} has no workers (waited 60 s)") from None
         yield client
     finally:
         client.close()

@@ -48,17 +48,42 @@ a :class:`RunError`.
 """
 from __future__ import annotations
 
+import importlib.util
 import json
+import multiprocessing as mp
 import os
+import queue as queue_mod
+import shutil
+import signal
+import sys
+import threading
 import time
+import uuid
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
+from multiprocessing.managers import SyncManager
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from hhscatter.scene.scene import Scene, SceneError, scene_from_dict
 from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
-from hhscatter.data.tables import TABLES, part_name, read_meta, verify_part
+from hhscatter.data.tables import (
+    TABLES,
+    add_point_columns,
+    part_name,
+    provenance,
+    read_meta,
+    to_arrow,
+    verify_part,
+    write_part,
+)
+from hhscatter.errors import ConfigError, OutputError, RunError, RunIntegrityError  # noqa: F401 (RunError: re-exported)
+from hhscatter.integrate.engine import run_chunk
+from hhscatter.run.dask_backend import check_scheduler, dask_client
+from hhscatter.run.workers import default_workers
+from hhscatter.scene.grid import Grid
+from hhscatter.scene.ics import check_ics, read_ics_table, region_ics
+from hhscatter.scene.scene import Scene, scene_from_dict
 
 if TYPE_CHECKING:  # annotations only (grid imports runner's neighbours)
     from hhscatter.scene.grid import Grid
@@ -66,10 +91,6 @@ if TYPE_CHECKING:  # annotations only (grid imports runner's neighbours)
 SCENE_FILE = "scene.json"
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
 DASK_NO_WORKER_TIMEOUT = 60.0
-
-
-class RunError(RuntimeError):
-    """A run could not complete (e.g. a part file could not be written); finished chunks are kept."""
 
 
 @dataclass
@@ -130,8 +151,6 @@ def tables_of(scene: Scene):
 
 def points_of(run):
     """points_of(run) -> [(scene, partition)]: ('', the scene) for a Scene, one per grid point for a Grid."""
-    from hhscatter.scene.grid import Grid
-
     if isinstance(run, Grid):
         return [(p, Grid.partition(p)) for p in run.points]
     return [(run, "")]
@@ -146,7 +165,6 @@ def _chunk_ics(scene, start, stop, table_ics):
     if table_ics is not None:
         states, ids = table_ics
         return states[start:stop], ids[start:stop]
-    from hhscatter.scene.ics import region_ics
 
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
 
@@ -163,8 +181,6 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     (another process's), told as orbits of the chunk start. ``scene_hash``: the scene's result hash as
     the client computed it once per run (default: computed here, which re-reads an IC table).
     """
-    from hhscatter.integrate.engine import run_chunk
-    from hhscatter.data.tables import add_point_columns, provenance, to_arrow, write_part
 
     scene = scene_from_dict(_decode(json.loads(scene_json)))
     store = Store(out)
@@ -220,7 +236,7 @@ def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partiti
 
     True if every part file of ``chunk`` exists, reads in full with valid page
     checksums, and has this scene's hash, orbit range and row count. Raises
-    SceneError if a part was made by another scene.
+    RunIntegrityError if a part was made by another scene.
     """
     store = Store(out)
     want = want or scene.result_hash()
@@ -233,7 +249,7 @@ def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partiti
         except Exception:  # noqa: BLE001 - a damaged file is redone, whatever the damage
             return False
         if meta.get("scene_hash") != want:
-            raise SceneError(
+            raise RunIntegrityError(
                 f"cannot resume: {store.display(rel)} was made by a different scene (hash "
                 f"{str(meta.get('scene_hash', '?'))[:12]}…, this scene {want[:12]}…); "
                 "use --overwrite or another --out"
@@ -284,7 +300,7 @@ def _extra_parts(store, manifest) -> list[str]:
 
 
 def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
-    """Check and prepare the output location before any work; raise SceneError if unusable.
+    """Check and prepare the output location before any work; raise OutputError if unusable.
 
     Takes the run directory's write lock (one writer per directory, :meth:`hhscatter.data.store.Store.lock`):
     returns (store, lock, points), the lock to be released with ``Store.unlock`` when the run ends. ``points``:
@@ -292,13 +308,13 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
     (a directory made here is removed again).
     """
     if overwrite and resume:
-        raise SceneError("--overwrite and --resume exclude each other")
+        raise ConfigError("--overwrite and --resume exclude each other")
     try:
         store = Store(out)
     except ValueError as exc:
-        raise SceneError(str(exc)) from None
+        raise OutputError(str(exc)) from None
     if store.exists() and not store.is_dir():
-        raise SceneError(f"out: {store.display()} exists and is not a directory")
+        raise OutputError(f"out: {store.display()} exists and is not a directory")
     if points is None:
         points = [(sc, part, sc.result_hash()) for sc, part in points_of(run)]
     created = not store.exists()
@@ -307,10 +323,10 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
         try:
             lock = store.lock()
         except LockedError as exc:
-            raise SceneError(f"out: {exc}; one writer per run directory: wait for it or use another --out") \
+            raise OutputError(f"out: {exc}; one writer per run directory: wait for it or use another --out") \
                 from None
         except OSError as exc:
-            raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+            raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
         # ours to remove on failure only if it was not there and still holds nothing but our lock
         created = created and not [e for e in store.listdir() if e != LOCK_FILE]
         _check_and_clear(run, store, points, overwrite=overwrite, resume=resume)
@@ -322,9 +338,8 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
             store.write_text(probe, "")
             store.remove(probe)
         except OSError as exc:
-            raise SceneError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+            raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
         doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
-        from hhscatter.scene.grid import Grid
 
         if isinstance(run, Grid):
             doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
@@ -333,11 +348,10 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
         try:
             store.write_json(SCENE_FILE, doc)
         except OSError as exc:
-            raise SceneError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
+            raise OutputError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
                              "nothing was computed") from None
     except BaseException:
         if lock is not None and created:  # never a directory another writer made or holds
-            import shutil
 
             shutil.rmtree(store.root, ignore_errors=True)
         Store.unlock(lock)
@@ -357,20 +371,20 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
                 store.remove(name)
         return
     if not resume:
-        raise SceneError(
+        raise OutputError(
             f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
         )
     if store.exists(SCENE_FILE):
         old = json.loads(store.read_text(SCENE_FILE))
         if old.get("scene_hash") != run.result_hash():
             what = _diff(old.get("scene", {}), json.loads(run.to_json()))
-            raise SceneError(
+            raise OutputError(
                 f"cannot resume into {store.display()}: it holds a different scene"
                 f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"
             )
     extra = _extra_parts(store, manifest_of(resumed_points(store, points), tables_of(points[0][0])))
     if extra:
-        raise SceneError(
+        raise OutputError(
             f"cannot resume into {store.display()}: {len(extra)} part file(s) are not in this run's chunk plan "
             f"(first: {store.display(extra[0])}); remove them, or use --overwrite or another --out"
         )
@@ -390,10 +404,6 @@ def resumed_points(store, points):
     if points and len(points[0]) == 3:
         return [(scene, old.get(h) or part, h) for scene, part, h in points]
     return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]
-
-
-def default_workers() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 
 def _drain(submit, wait_first, tasks, window, on_done, cancel):
@@ -457,8 +467,10 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
 
     Raises
     ------
-    SceneError
+    ConfigError
         Bad input, before any work and before anything is written (exit 2 on the CLI).
+    OutputError
+        The output location cannot take the run (not empty, another scene, locked, not writable); exit 2.
     RunError
         A chunk cannot be written (e.g. a full disk), or a Dask cluster lost all its workers.
 
@@ -476,22 +488,20 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
     (200, 200)
     """
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SceneError(f"workers must be an integer ≥ 1, got {workers!r}")
+        raise ConfigError(f"workers must be an integer ≥ 1, got {workers!r}")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
-        raise SceneError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
+        raise ConfigError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
     points = points_of(run)
     table_ics = None
     if points[0][0].ics is not None:
-        from hhscatter.scene.ics import check_ics, read_ics_table
 
         scene = points[0][0]
         table_ics = read_ics_table(scene.ics)
         if len(table_ics[0]) != scene.n:
-            raise SceneError(f"n = {scene.n} but the ics table has {len(table_ics[0])} rows")
+            raise ConfigError(f"n = {scene.n} but the ics table has {len(table_ics[0])} rows")
         for sc, _ in points:
             check_ics(sc, table_ics[0])
     if scheduler is not None:
-        from hhscatter.run.dask_backend import check_scheduler
 
         check_scheduler(scheduler, workers)
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
@@ -550,7 +560,6 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
         if not n_todo:
             summary.workers = 0
         elif scheduler is not None:
-            from hhscatter.run.dask_backend import dask_client
 
             with dask_client(scheduler, workers) as client:
                 summary.workers = sum(client.nthreads().values())
@@ -581,8 +590,6 @@ class PlainProgress:
     """Progress for logs: a plain line on stderr at most every ``every`` seconds and at the end, no '\\r'."""
 
     def __init__(self, total, initial=0, desc="", every=10.0, file=None):
-        import sys
-
         self.total, self.n, self.desc, self.every = total, initial, desc, every
         self.file = file or sys.stderr
         self.t0 = self.last = time.perf_counter()
@@ -606,18 +613,15 @@ def progress_bar(progress, total, initial, desc):
     Jupyter kernel (a widget if ipywidgets is installed, else text); into a log file or a pipe it writes the
     plain lines of ``'plain'`` instead (no carriage returns). ``False``: silent, tqdm not even imported.
     """
-    import sys
-
     if progress == "plain" or (progress and not sys.stderr.isatty() and "ipykernel" not in sys.modules):
         return PlainProgress(total, initial, desc)
     if not progress:
         return _Silent()
-    import importlib.util
 
     if sys.stderr.isatty() or importlib.util.find_spec("ipywidgets") is None:
-        from tqdm.std import tqdm  # text bar (tqdm.auto would warn in a kernel without ipywidgets)
+        from tqdm.std import tqdm  # text bar (tqdm.auto would warn in a kernel without ipywidgets)  # deferred: tqdm loads on first use
     else:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # deferred: tqdm loads on first use
 
     return tqdm(total=total, initial=initial, unit="orbit", unit_scale=True, desc=desc, smoothing=0.05)
 
@@ -638,12 +642,8 @@ def die_with_parent(parent_pid: int) -> None:
     Elsewhere: a daemon thread that polls the parent every second. The pool's and the progress
     manager's initializer.
     """
-    import signal
-    import sys
-    import threading
-
     if sys.platform.startswith("linux"):
-        import ctypes
+        import ctypes  # deferred: Linux-only (prctl), imported where it is used
 
         PR_SET_PDEATHSIG = 1
         libc = ctypes.CDLL(None, use_errno=True)
@@ -662,11 +662,6 @@ def die_with_parent(parent_pid: int) -> None:
 
 
 def _run_pool(workers, todo, args, on_done, on_progress=None):
-    import multiprocessing as mp
-    import queue as queue_mod
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-    from multiprocessing.managers import SyncManager
-
     ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=die_with_parent,
                                initargs=(os.getpid(),))
@@ -702,9 +697,7 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
 
 
 def _run_dask(client, todo, args, on_done, name):
-    import uuid
-
-    from distributed import wait
+    from distributed import wait  # deferred: distributed loads on first use
 
     window = max(4, 2 * sum(client.nthreads().values()))
     tag = uuid.uuid4().hex[:8]

@@ -44,7 +44,14 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from hhscatter.scene.scene import Scene, SceneError, scene_dict_from_toml, scene_from_dict
+from hhscatter.errors import ConfigError
+from hhscatter.scene.scene import (
+    Scene,
+    _clean,
+    _json_default,
+    scene_dict_from_toml,
+    scene_from_dict,
+)
 
 AXES = ("energy", "gamma")
 
@@ -52,17 +59,17 @@ AXES = ("energy", "gamma")
 def _values(name, v) -> tuple:
     vals = tuple(v) if isinstance(v, (list, tuple)) else (v,)
     if not vals:
-        raise SceneError(f"{name} must be a number or a non-empty list of numbers")
+        raise ConfigError(f"{name} must be a number or a non-empty list of numbers")
     out = []
     for x in vals:
         if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise SceneError(f"{name} must be a number or a list of numbers, got {x!r}")
+            raise ConfigError(f"{name} must be a number or a list of numbers, got {x!r}")
         x = float(x)
         if not math.isfinite(x):
-            raise SceneError(f"{name} must be finite, got {x}")
+            raise ConfigError(f"{name} must be finite, got {x}")
         out.append(x)
     if len(set(out)) != len(out):
-        raise SceneError(f"{name} lists a value twice: {out}")
+        raise ConfigError(f"{name} lists a value twice: {out}")
     return tuple(out)
 
 
@@ -85,7 +92,7 @@ class Grid:
 
     Raises
     ------
-    SceneError
+    ConfigError
         A point is not a valid scene (e.g. E0 ≤ E_c), or the lists are empty.
 
     Examples
@@ -103,7 +110,7 @@ class Grid:
 
     def __post_init__(self):
         if self.base.ics is not None:
-            raise SceneError("a grid needs energy-based initial conditions: ics tables cannot be swept")
+            raise ConfigError("a grid needs energy-based initial conditions: ics tables cannot be swept")
         es, gs = _values("energy", self.energies), _values("gamma", self.gammas)
         object.__setattr__(self, "energies", es)
         object.__setattr__(self, "gammas", gs)
@@ -134,7 +141,6 @@ class Grid:
         return d
 
     def to_json(self) -> str:
-        from hhscatter.scene.scene import _clean, _json_default
 
         return json.dumps(_clean(self.to_dict()), sort_keys=True, allow_nan=False, default=_json_default)
 
@@ -176,7 +182,7 @@ def load_run(path: str | os.PathLike[str], scale: str | None = None, **overrides
 
     Raises
     ------
-    SceneError
+    ConfigError
         An unknown table or key (with a did-you-mean), or a value out of range.
 
     Examples

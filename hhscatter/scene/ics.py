@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hhscatter.scene.scene import Scene, SceneError
+from hhscatter.errors import ConfigError
+from hhscatter.scene.scene import E0_MAX, R_ESC_MAX, Scene
 
 BLOCK = 4096
 
@@ -80,38 +81,38 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
     """read_ics_table(path) -> (states (n, 4), traj_id (n,) int64) from Parquet or CSV.
 
     Required columns: x, y, px, py (float); optional traj_id (unique int).
-    Missing columns, non-finite values or duplicate ids raise SceneError.
+    Missing columns, non-finite values or duplicate ids raise ConfigError.
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     path = Path(path)
     if not path.exists():
-        raise SceneError(f"ics: file not found: {path}")
+        raise ConfigError(f"ics: file not found: {path}")
     try:
         if path.suffix.lower() in (".parquet", ".pq"):
             df = pd.read_parquet(path)
         else:
             df = pd.read_csv(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the user's file
-        raise SceneError(f"ics: cannot read {path}: {exc}") from None
+        raise ConfigError(f"ics: cannot read {path}: {exc}") from None
     missing = [c for c in ("x", "y", "px", "py") if c not in df.columns]
     if missing:
-        raise SceneError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")
+        raise ConfigError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")
     if len(df) == 0:
-        raise SceneError(f"ics: table {path} has no rows")
+        raise ConfigError(f"ics: table {path} has no rows")
     try:
         states = df[["x", "y", "px", "py"]].to_numpy(dtype=float)
     except (TypeError, ValueError) as exc:
-        raise SceneError(f"ics: columns x, y, px, py must be numeric: {exc}") from None
+        raise ConfigError(f"ics: columns x, y, px, py must be numeric: {exc}") from None
     bad = ~np.isfinite(states).all(axis=1)
     if bad.any():
-        raise SceneError(f"ics: {int(bad.sum())} row(s) have non-finite values (first at row {int(np.argmax(bad))})")
+        raise ConfigError(f"ics: {int(bad.sum())} row(s) have non-finite values (first at row {int(np.argmax(bad))})")
     if "traj_id" in df.columns:
         ids = df["traj_id"].to_numpy()
         if not np.issubdtype(ids.dtype, np.integer):
-            raise SceneError("ics: traj_id must be integers")
+            raise ConfigError("ics: traj_id must be integers")
         if len(np.unique(ids)) != len(ids):
-            raise SceneError("ics: traj_id values must be unique")
+            raise ConfigError("ics: traj_id values must be unique")
         ids = ids.astype(np.int64)
     else:
         ids = np.arange(len(df), dtype=np.int64)
@@ -119,7 +120,7 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_ics(scene: Scene, states: np.ndarray) -> None:
-    """check_ics(scene, states) -> None; SceneError before any work if a table row cannot be run honestly.
+    """check_ics(scene, states) -> None; ConfigError before any work if a table row cannot be run honestly.
 
     Bounds (the reasons of :mod:`hhscatter.scene.scene`): every row's position within R_ESC_MAX ω²/λ of the
     origin and energy H = |p|²/2 + V ≤ E0_MAX·E_c (energy conservation, overflow). Rows below E_c inside
@@ -129,29 +130,27 @@ def check_ics(scene: Scene, states: np.ndarray) -> None:
     fine: they stay inside Ω and are censored at t_max, which is the correct outcome.
     Example: ``check_ics(scene, np.array([[0.1, 0.0, 0.0, 0.8]]))``.
     """
-    from hhscatter.scene.scene import E0_MAX, R_ESC_MAX
-
     m = scene.model
     x, y, px, py = (states[:, k] for k in range(4))
     r = np.hypot(x, y)
     far = r > R_ESC_MAX * m.saddle_radius
     if far.any():
         i = int(np.argmax(far))
-        raise SceneError(f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
+        raise ConfigError(f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
                          f"r = {r[i]:.3g}); energy conservation fails that far out")
     with np.errstate(over="ignore", invalid="ignore"):
         e = m.energy(x, y, px, py)
     high = ~(e <= E0_MAX * m.critical_energy)
     if high.any():
         i = int(np.argmax(high))
-        raise SceneError(f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
+        raise ConfigError(f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
                          f"{E0_MAX * m.critical_energy:.6g} (first: row {i}, E = {e[i]:.3g}; momenta too large: "
                          "every orbit leaves at once, p² overflows near 1e308)")
     if scene.gamma > 0:
         low = (e <= m.critical_energy) & (r < scene.r_esc)
         if low.any():
             i = int(np.argmax(low))
-            raise SceneError(
+            raise ConfigError(
                 f"ics: {int(low.sum())} row(s) start below E_c = {m.critical_energy:.10g} inside r_esc with drag "
                 f"γ = {scene.gamma:g} (first: row {i}, E = {e[i]:.6g}): such an orbit can never escape and never "
                 "crosses E_c from above, so it has no outcome; drop these rows (they are trapped from t = 0)")

@@ -3,7 +3,7 @@
 A scene is loaded from ``studies/<name>/scene.toml`` (table ``[scene]``, and
 optionally ``[sections]``, ``[snapshots]`` and ``[scale.<name>]`` overrides)
 or built from CLI flags. Every bad value is refused before any work with a
-``SceneError`` naming the parameter and its allowed range.
+``ConfigError`` naming the parameter and its allowed range.
 """
 from __future__ import annotations
 
@@ -20,9 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles
+from hhscatter.scene.schema import REGIONS, validate_scene_file
 
-REGIONS = ("disk", "well", "square")
 TOL_RANGE = (1e-18, 1e-6)
 
 # Upper bounds, each with its reason (checked before any work; hhscatter.scene.scene.Scene._validate):
@@ -50,22 +51,6 @@ SNAPSHOTS_MAX = 100_000
 SNAPSHOT_LIST_MAX = 1000
 
 
-class SceneError(ValueError):
-    """A scene parameter is outside its allowed range (or a scene file is malformed).
-
-    Raised before any work and before anything is written; the CLI prints its message and exits with 2.
-
-    Examples
-    --------
-    >>> import hhscatter
-    >>> try:
-    ...     hhscatter.Scene(energy=0.3, n=0)
-    ... except hhscatter.SceneError as e:
-    ...     print(e)
-    n (number of orbits) must be an integer > 0, got 0
-    """
-
-
 class SnapshotGrid(tuple):
     """SnapshotGrid(start, stop, step) -> the times start, start + step, … ≤ stop (both ends included).
 
@@ -79,10 +64,10 @@ class SnapshotGrid(tuple):
         start, stop, step = (_finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop),
                                                                        ("step", step)))
         if not step > 0:
-            raise SceneError(f"snapshots.step must be > 0, got {step}")
+            raise ConfigError(f"snapshots.step must be > 0, got {step}")
         count = math.floor((stop - start) / step + 0.5) + 1
         if count > SNAPSHOTS_MAX:
-            raise SceneError(f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
+            raise ConfigError(f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
                              f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
                              "in memory): use a larger step")
         self = super().__new__(cls, (float(t) for t in np.arange(start, stop + 0.5 * step, step)))
@@ -97,13 +82,13 @@ class SnapshotGrid(tuple):
 def _finite(name, value):
     # a number, never text or a boolean ("0.3" would pass float() and fail deep inside the engine)
     if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise SceneError(f"{name} must be a number, got {value!r}")
+        raise ConfigError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a number, got {value!r}") from None
+        raise ConfigError(f"{name} must be a number, got {value!r}") from None
     if not math.isfinite(v):
-        raise SceneError(f"{name} must be finite, got {value!r}")
+        raise ConfigError(f"{name} must be finite, got {value!r}")
     return v
 
 
@@ -127,7 +112,7 @@ class SectionWindow:
 
     Raises
     ------
-    SceneError
+    ConfigError
         A value that is not a number, or an empty window.
 
     Examples
@@ -151,19 +136,19 @@ class SectionWindow:
     def __post_init__(self):
         for name in ("first_only", "stop"):
             if not isinstance(getattr(self, name), bool):
-                raise SceneError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
+                raise ConfigError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
         for name in ("t_from", "t_to", "e_min", "e_max"):
             v = getattr(self, name)
             if not isinstance(v, (int, float)) or math.isnan(v):
-                raise SceneError(f"sections.{name} must be a number, got {v!r}")
+                raise ConfigError(f"sections.{name} must be a number, got {v!r}")
         if self.t_from < 0 or math.isinf(self.t_from):
-            raise SceneError(f"sections.t_from must be finite and ≥ 0, got {self.t_from}")
+            raise ConfigError(f"sections.t_from must be finite and ≥ 0, got {self.t_from}")
         if not self.t_to > self.t_from:
-            raise SceneError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
+            raise ConfigError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
         if not self.e_max > self.e_min:
-            raise SceneError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
+            raise ConfigError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
         if self.stop and not (self.first_only or math.isfinite(self.t_to)):
-            raise SceneError("sections.stop needs first_only = true or a finite t_to "
+            raise ConfigError("sections.stop needs first_only = true or a finite t_to "
                              "(otherwise the window never closes and the orbit is always needed)")
 
 
@@ -184,11 +169,11 @@ class Follow:
         try:
             radii = tuple(float(r) for r in self.radii)
         except (TypeError, ValueError):
-            raise SceneError(f"follow.radii must be a list of numbers, got {self.radii!r}") from None
+            raise ConfigError(f"follow.radii must be a list of numbers, got {self.radii!r}") from None
         if not radii or not all(math.isfinite(r) and r > 0 for r in radii):
-            raise SceneError(f"follow.radii must be a non-empty list of finite radii > 0, got {self.radii!r}")
+            raise ConfigError(f"follow.radii must be a non-empty list of finite radii > 0, got {self.radii!r}")
         if any(b <= a for a, b in zip(radii, radii[1:])):
-            raise SceneError("follow.radii must be strictly increasing")
+            raise ConfigError("follow.radii must be strictly increasing")
         object.__setattr__(self, "radii", radii)
 
 
@@ -248,7 +233,7 @@ class Scene:
 
     Raises
     ------
-    SceneError
+    ConfigError
         A value out of range, with the key and the reason (before any work).
 
     Examples
@@ -260,7 +245,7 @@ class Scene:
     >>> hhscatter.Scene(energy=0.1, n=10)
     Traceback (most recent call last):
     ...
-    hhscatter.scene.scene.SceneError: energy must be > E_c = 0.1666666667 in a conservative escape scene (no escape is possible below it), got 0.1
+    hhscatter.errors.ConfigError: energy must be > E_c = 0.1666666667 in a conservative escape scene (no escape is possible below it), got 0.1
     """
 
     energy: float | None
@@ -293,7 +278,7 @@ class Scene:
         try:
             model = HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
         except ValueError as exc:
-            raise SceneError(str(exc)) from None
+            raise ConfigError(str(exc)) from None
         object.__setattr__(self, "_model", model)
         self._validate()
 
@@ -310,108 +295,108 @@ class Scene:
         m = self.model
         gamma = _finite("gamma", self.gamma)
         if gamma < 0:
-            raise SceneError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
+            raise ConfigError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
         if gamma > GAMMA_MAX * m.omega:
-            raise SceneError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.omega:g}, got {gamma:g} (beyond, "
+            raise ConfigError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.omega:g}, got {gamma:g} (beyond, "
                              "the motion is overdamped: orbits settle within a fraction of a period)")
         if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
-            raise SceneError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
+            raise ConfigError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
         if self.n > N_MAX:
-            raise SceneError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
+            raise ConfigError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
                              "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds")
         if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise SceneError(f"seed must be an integer ≥ 0, got {self.seed!r}")
+            raise ConfigError(f"seed must be an integer ≥ 0, got {self.seed!r}")
         tol = _finite("tol", self.tol)
         if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
-            raise SceneError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
+            raise ConfigError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
         t_max = _finite("t_max", self.t_max)
         if t_max <= 0:
-            raise SceneError(f"t_max must be > 0, got {t_max}")
+            raise ConfigError(f"t_max must be > 0, got {t_max}")
         r_esc = _finite("r_esc", self.r_esc)
         if r_esc <= m.saddle_radius:
-            raise SceneError(
+            raise ConfigError(
                 f"r_esc must be > the saddle distance ω²/λ = {m.saddle_radius:g} "
                 f"(outside the Lyapunov orbits), got {r_esc}"
             )
         if r_esc > R_ESC_MAX * m.saddle_radius:
-            raise SceneError(f"r_esc must be ≤ {R_ESC_MAX:g} ω²/λ = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
+            raise ConfigError(f"r_esc must be ≤ {R_ESC_MAX:g} ω²/λ = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
                              "(energy conservation: far out |V| ≈ λr³/3 ≫ E and the energy error grows like "
                              "tol·λr³/E)")
         if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
-            raise SceneError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
+            raise ConfigError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
         if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
-            raise SceneError(f"r_far must be ≤ {R_FAR_MAX:g} ω²/λ = {R_FAR_MAX * m.saddle_radius:g}, got "
+            raise ConfigError(f"r_far must be ≤ {R_FAR_MAX:g} ω²/λ = {R_FAR_MAX * m.saddle_radius:g}, got "
                              f"{self.r_far:g} (the range checked by the stress study; V ≈ λr³/3 heads for "
                              "float64 overflow beyond)")
         if self.region not in REGIONS:
-            raise SceneError(f"region must be one of {REGIONS}, got {self.region!r}")
+            raise ConfigError(f"region must be one of {REGIONS}, got {self.region!r}")
         radius = _finite("radius", self.radius)
         if radius <= 0:
-            raise SceneError(f"radius must be > 0, got {radius}")
+            raise ConfigError(f"radius must be > 0, got {radius}")
         if radius > r_esc:
-            raise SceneError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
+            raise ConfigError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
                              "escaped already, and the sampler would reject almost every draw: V < E only "
                              "holds near the saddle triangle)")
         if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
-            raise SceneError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
+            raise ConfigError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
         if -(-self.n // self.chunk_size) > CHUNKS_MAX:
-            raise SceneError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
+            raise ConfigError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
                              f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size")
         if self.batch_size is not None and (
             not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
         ):
-            raise SceneError(f"batch_size must be an integer in [1, 64], got {self.batch_size!r}")
+            raise ConfigError(f"batch_size must be an integer in [1, 64], got {self.batch_size!r}")
         if self.ics is None:
             if self.energy is None:
-                raise SceneError("energy is required unless initial conditions come from a table (ics)")
+                raise ConfigError("energy is required unless initial conditions come from a table (ics)")
             energy = _finite("energy", self.energy)
             # the region's minimum of V is V(0, 0) = 0 (the origin is in every region)
             if energy <= 0:
-                raise SceneError(
+                raise ConfigError(
                     f"energy must be > 0 = min V over the {self.region!r} region "
                     f"(no point of the region is accessible), got {energy}"
                 )
             if energy > E0_MAX * m.critical_energy:
-                raise SceneError(f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
+                raise ConfigError(f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
                                  f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
                                  "near 1e308)")
             if energy <= m.critical_energy:
                 what = "dissipative" if gamma > 0 else "conservative escape"
-                raise SceneError(
+                raise ConfigError(
                     f"energy must be > E_c = {m.critical_energy:.10g} in a {what} scene "
                     f"(no escape is possible below it), got {energy}"
                 )
         elif self.energy is not None:
-            raise SceneError("energy must not be given with ics: each orbit's energy comes from its table row")
+            raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
         if self.sections is not None and not isinstance(self.sections, SectionWindow):
-            raise SceneError("sections must be a SectionWindow or None")
+            raise ConfigError("sections must be a SectionWindow or None")
         if self.snapshots is not None:
             if not isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOTS_MAX:
-                raise SceneError(f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
+                raise ConfigError(f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
                                  "orbit writes one row per time; a chunk holds them in memory)")
             snaps = self.snapshots if isinstance(self.snapshots, SnapshotGrid) else \
                 tuple(float(s) for s in self.snapshots)
             if not snaps:
-                raise SceneError("snapshots must be a non-empty list of times or omitted")
+                raise ConfigError("snapshots must be a non-empty list of times or omitted")
             if not all(math.isfinite(s) and 0 <= s <= t_max for s in snaps):
-                raise SceneError(f"snapshots times must be finite and in [0, t_max = {t_max}]")
+                raise ConfigError(f"snapshots times must be finite and in [0, t_max = {t_max}]")
             if any(b <= a for a, b in zip(snaps, snaps[1:])):
-                raise SceneError("snapshots times must be strictly increasing")
+                raise ConfigError("snapshots times must be strictly increasing")
             object.__setattr__(self, "snapshots", snaps)
 
         if self.follow is not None:
             if not isinstance(self.follow, Follow):
-                raise SceneError("follow must be a Follow or None")
+                raise ConfigError("follow must be a Follow or None")
             if gamma > 0:
-                raise SceneError("follow is for conservative scenes (gamma = 0): dissipative escapes "
+                raise ConfigError("follow is for conservative scenes (gamma = 0): dissipative escapes "
                                  "are already final (the orbit is followed to E_c or r_far)")
             rf = self.r_far if self.r_far is not None else max(10.0 * m.saddle_radius, 2.0 * r_esc)
             if max(self.follow.radii) >= rf:
-                raise SceneError(f"follow.radii must all be < r_far = {rf:g}, got {max(self.follow.radii):g}")
+                raise ConfigError(f"follow.radii must all be < r_far = {rf:g}, got {max(self.follow.radii):g}")
         if not isinstance(self.continue_settled, bool):
-            raise SceneError(f"continue_settled must be true or false, got {self.continue_settled!r}")
+            raise ConfigError(f"continue_settled must be true or false, got {self.continue_settled!r}")
         if self.continue_settled and not (gamma > 0 and self.snapshots):
-            raise SceneError("continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
+            raise ConfigError("continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
                              "it records settled orbits' energies after settling")
 
     # -- identity -----------------------------------------------------------
@@ -499,42 +484,42 @@ def scene_from_dict(d: dict) -> Scene:
     sec = d.pop("sections", None)
     if sec is not None:
         if not isinstance(sec, dict):
-            raise SceneError("sections must be a table")
+            raise ConfigError("sections must be a table")
         unknown = set(sec) - {f.name for f in dataclasses.fields(SectionWindow)}
         if unknown:
-            raise SceneError(f"unknown sections keys: {sorted(unknown)}")
+            raise ConfigError(f"unknown sections keys: {sorted(unknown)}")
         d["sections"] = SectionWindow(**{k: _inf(v) for k, v in sec.items()})
     fol = d.pop("follow", None)
     if isinstance(fol, Follow):
         d["follow"] = fol
     elif fol is not None:
         if not isinstance(fol, dict):
-            raise SceneError("follow must be a table with key 'radii'")
+            raise ConfigError("follow must be a table with key 'radii'")
         unknown = set(fol) - {"radii"}
         if unknown:
-            raise SceneError(f"unknown follow keys: {sorted(unknown)}; allowed: ['radii']")
+            raise ConfigError(f"unknown follow keys: {sorted(unknown)}; allowed: ['radii']")
         d["follow"] = Follow(**fol)
     snaps = d.pop("snapshots", None)
     if isinstance(snaps, dict):
         unknown = set(snaps) - {"times", "start", "stop", "step"}
         if unknown:
-            raise SceneError(f"unknown snapshots keys: {sorted(unknown)}")
+            raise ConfigError(f"unknown snapshots keys: {sorted(unknown)}")
         if "times" in snaps:
             snaps = snaps["times"]
         else:
             try:
                 start, stop, step = (snaps[k] for k in ("start", "stop", "step"))
             except KeyError as exc:
-                raise SceneError(f"snapshots needs 'times' or start/stop/step (missing {exc})") from None
+                raise ConfigError(f"snapshots needs 'times' or start/stop/step (missing {exc})") from None
             snaps = SnapshotGrid(start, stop, step)
     if snaps is not None:
         d["snapshots"] = snaps if isinstance(snaps, SnapshotGrid) else tuple(snaps)
     known = {f.name for f in dataclasses.fields(Scene) if f.init}
     unknown = set(d) - known
     if unknown:
-        raise SceneError(f"unknown scene keys: {sorted(unknown)}; allowed: {sorted(known)}")
+        raise ConfigError(f"unknown scene keys: {sorted(unknown)}; allowed: {sorted(known)}")
     if "n" not in d:
-        raise SceneError("a scene needs 'n' (number of orbits)")
+        raise ConfigError("a scene needs 'n' (number of orbits)")
     d.setdefault("energy", None)
     return Scene(**d)
 
@@ -549,13 +534,11 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
     try:
         doc = tomllib.loads(path.read_text())
     except FileNotFoundError:
-        raise SceneError(f"scene file not found: {path}") from None
+        raise ConfigError(f"scene file not found: {path}") from None
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"scene file {path} is not valid TOML: {exc}") from None
+        raise ConfigError(f"scene file {path} is not valid TOML: {exc}") from None
     if "scene" not in doc:
-        raise SceneError(f"scene file {path} has no [scene] table")
-    from hhscatter.scene.schema import validate_scene_file
-
+        raise ConfigError(f"scene file {path} has no [scene] table")
     validate_scene_file(doc, str(path))  # every table, key and type, before any work
     d = dict(doc["scene"])
     d.setdefault("name", path.parent.name)
@@ -568,7 +551,7 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
     if scale is not None and scale != "quick":
         scales = doc.get("scale", {})
         if scale not in scales:
-            raise SceneError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
+            raise ConfigError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
         d.update(scales[scale])
     d.update({k: v for k, v in overrides.items() if v is not None})
     return d
@@ -597,7 +580,7 @@ def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrid
 
     Raises
     ------
-    SceneError
+    ConfigError
         An unknown table or key (with a did-you-mean), a value out of range, or a grid file.
 
     Examples
@@ -611,5 +594,5 @@ def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrid
     d = scene_dict_from_toml(path, scale, **overrides)
     for k in ("energy", "gamma"):
         if isinstance(d.get(k), (list, tuple)):
-            raise SceneError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
+            raise ConfigError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
     return scene_from_dict(d)

@@ -8,7 +8,7 @@ value of the wrong type is refused, never converted (``first_only = "no"``,
 code uses are the file's own, unchanged, so every scene keeps its
 ``result_hash()`` and runs on disk still resume.
 
-A failure raises :class:`ConfigError` (a :class:`~hhscatter.scene.scene.SceneError`:
+A failure raises :class:`ConfigError` (a :class:`~hhscatter.scene.scene.ConfigError`:
 the CLI prints it and exits with status 2, no traceback) with one line per
 problem::
 
@@ -23,6 +23,7 @@ for the optional ones.
 from __future__ import annotations
 
 import copy
+import difflib
 from functools import lru_cache
 from typing import Annotated, Any
 
@@ -35,7 +36,10 @@ from pydantic import (
     model_validator,
 )
 
-from hhscatter.scene.scene import REGIONS, SceneError
+from hhscatter.errors import ConfigError
+
+#: the initial-condition regions of a scene (hhscatter.scene.ics)
+REGIONS = ("disk", "well", "square")
 
 __all__ = [
     "Bool",
@@ -58,8 +62,6 @@ __all__ = [
 ]
 
 
-class ConfigError(SceneError):
-    """A configuration file has an unknown table or key, a value of the wrong type, or lacks a key."""
 
 
 # -- strict leaf types (the raw value is kept, never converted) ----------------------------------
@@ -288,8 +290,6 @@ def _key_path(parts) -> str:
 
 def did_you_mean(name, choices) -> str:
     """did_you_mean('summry', ['summary', 'title']) -> " (did you mean 'summary'?)", or "" if nothing is close."""
-    import difflib
-
     close = difflib.get_close_matches(str(name), [str(c) for c in choices], n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
 

@@ -41,405 +41,54 @@ with an uncertainty is ``{"value": v, "err": e}``, and the list
 """
 from __future__ import annotations
 
-import copy
 import json
-import math
-import os
-import tomllib
-from dataclasses import dataclass, field
 from pathlib import Path
 
-from hhscatter.scene.scene import Scene, SceneError, scene_from_dict
+from hhscatter.data.tables import run_status
+from hhscatter.errors import StudyError
+from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
 from hhscatter.studies.cost import meter, record
-from hhscatter.studies.graph import HEADER_TABLES, GraphError, StudyInfo, study_info
-from hhscatter.studies.graph import default_root as _graph_default_root
-
-STAGES = ("simulate", "analyze", "plot")
-DEFAULT_SCALE = "quick"
-
-
-def studies_root() -> Path:
-    """studies_root() -> Path of the ``studies/`` folder (env ``HHSCATTER_STUDIES`` overrides)."""
-    env = os.environ.get("HHSCATTER_STUDIES")
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[2] / "studies"
-
-
-def outputs_root(root: Path) -> Path:
-    """outputs_root(root) -> the folder under which the studies of ``root`` write ``<name>/out/<scale>/``.
-
-    ``root`` itself, except for the repository's own ``studies/`` folder used from another directory than the
-    repository: then ``./studies`` of the current directory, so that ``hhscatter study …`` run elsewhere
-    (an installed package, a notebook's folder) never writes into the source tree. From the repository root,
-    as ``make`` runs it, the outputs are the study folders' own ``out/`` as before.
-    """
-    own = Path(__file__).resolve().parents[2] / "studies"
-    root = Path(root)
-    if root.resolve() == own and Path.cwd().resolve() != own.parent:
-        return Path.cwd() / "studies"
-    return root
-
-
-_OWN_MODULES = ("graph", "_upstream")
-
-
-def study_names(root: Path | None = None) -> list[str]:
-    """study_names(root=None) -> names of the study folders (with a study.toml), each after the studies it needs."""
-    from hhscatter.studies.graph import studies
-
-    try:
-        return [s.name for s in studies(root if root is not None else studies_root())]
-    except GraphError as exc:
-        raise SceneError(str(exc)) from None
-
-
-def _jsonable(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
-    if isinstance(v, dict):
-        return {str(k): _jsonable(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [_jsonable(x) for x in v]
-    if hasattr(v, "item") and callable(v.item) and getattr(v, "ndim", 1) == 0:
-        return _jsonable(v.item())
-    if hasattr(v, "tolist"):
-        return _jsonable(v.tolist())
-    return v
-
-
-def write_json_atomic(path: Path, obj) -> None:
-    """Write ``obj`` as indented JSON to ``path`` via a temporary file and rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text(json.dumps(_jsonable(obj), indent=2, sort_keys=False, allow_nan=False) + "\n")
-    os.replace(tmp, path)
-
-
-@dataclass
-class Study:
-    """A study at one scale: its merged configuration and its output paths.
-
-    ``config`` is ``study.toml`` with the scale's overrides applied; ``out`` is
-    ``studies/<name>/out/<scale>/``.
-    """
-
-    name: str
-    scale: str
-    config: dict
-    root: Path
-    comparisons: list = field(default_factory=list)
-    info: StudyInfo | None = None
-    orbits_run: int = 0       # orbits integrated by this process's run() calls (the cost record)
-    chunks_resumed: int = 0   # chunks found complete and kept by run()
-    params_model: type | None = None  # the study's Params (hhscatter.scene.schema.StudyParams) of its [study] table
-    raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
-    params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
-
-    @property
-    def needs(self) -> dict:
-        """The ``[needs]`` table: role -> name of the upstream study whose published outputs this study reads."""
-        return dict(self.info.needs) if self.info else {}
-
-    def upstream(self, role: str) -> str:
-        """upstream(role) -> the study declared for ``role`` in ``[needs]``; a missing role is an error."""
-        if role not in self.needs:
-            raise SceneError(f"{self.root / 'study.toml'}: [needs] must name the study for {role!r} "
-                             f"(has {sorted(self.needs)})")
-        return self.needs[role]
-
-    @property
-    def out(self) -> Path:
-        """``<studies>/<name>/out/<scale>``; see :func:`outputs_root` for a command run outside the repository."""
-        return outputs_root(self.root.parent) / self.name / "out" / self.scale
-
-    @property
-    def params(self) -> dict:
-        """The ``[study]`` table (after scale overrides)."""
-        return self.config.get("study", {})
-
-    def param(self, key, default=None):
-        """param(key) -> value of ``[study].key`` as written in study.toml, else the default its ``Params`` declares.
-
-        A key the study's ``Params`` does not declare is an error (the study
-        file was checked against it when loaded, so this catches code that
-        reads a key under another name). Without ``Params``, ``default`` is
-        used and a missing key without default is an error.
-        """
-        if self.params_read is not None:
-            self.params_read.add(key)
-        p = self.params
-        if key in p:
-            return p[key]
-        if self.params_model is not None:
-            f = self.params_model.model_fields.get(key)
-            if f is None:
-                raise SceneError(f"study {self.name} reads [study] {key!r}, which its Params does not declare")
-            if not f.is_required():
-                return copy.deepcopy(f.default)
-        elif default is not None:
-            return default
-        raise SceneError(f"{self.root / 'study.toml'}: [study] needs '{key}'")
-
-    @property
-    def model(self):
-        """The Hénon–Heiles model of the study's ``[scene]`` (ω, λ): E_c, saddles, potential."""
-        from hhscatter.model import HenonHeiles
-
-        sc = self.config.get("scene", {})
-        return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
-
-    def scene(self, key: str, **overrides) -> Scene:
-        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
-        d = dict(self.config.get("scene", {}))
-        for extra in ("sections", "snapshots"):
-            if extra in self.config:
-                d[extra] = copy.deepcopy(self.config[extra])
-        d.update(overrides)
-        d = {k: v for k, v in d.items() if v is not None or k in ("sections", "snapshots")}
-        d["name"] = f"{self.name}/{key}"
-        return scene_from_dict(d)
-
-    def raw(self, key: str) -> Path:
-        return self.out / "raw" / key
-
-    def derived(self, fname: str) -> Path:
-        p = self.out / "derived" / fname
-        p.parent.mkdir(parents=True, exist_ok=True)
-        return p
-
-    @property
-    def numbers_path(self) -> Path:
-        return self.out / f"{self.name}.json"
-
-    @property
-    def figure_path(self) -> Path:
-        return self.out / f"{self.name}.png"
-
-    def run(self, key: str, scene: Scene, *, workers=None, progress=True) -> Path:
-        """run(key, scene, workers=None) -> raw run directory, integrating only what is missing.
-
-        A finished run of the same scene is kept (chunks verified), an
-        interrupted one resumed; a run of a different scene (the study file
-        changed) is replaced.
-        """
-        from hhscatter.run.runner import SCENE_FILE, simulate
-
-        out = self.raw(key)
-        resume, overwrite = False, False
-        sj = out / SCENE_FILE
-        if sj.exists():
-            old = json.loads(sj.read_text()).get("scene_hash")
-            resume = old == scene.result_hash()
-            overwrite = not resume
-        summary = simulate(scene, out, workers=workers, overwrite=overwrite, resume=resume, progress=progress)
-        self.raw_runs[key] = {"scene_hash": scene.result_hash(), "orbits": int(scene.n), "complete": True}
-        self.orbits_run += summary.n
-        self.chunks_resumed += summary.chunks_skipped
-        if summary.chunks_done:
-            print(f"  {self.name}/{key}: {summary.line()}", flush=True)
-        return out
-
-    def compare(self, quantity: str, ours, err=None, paper=None, *, unit: str = "", note: str = "",
-                verdict: str | None = None, convention: str | None = None, authors: bool = False) -> dict:
-        """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
-
-        One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test. ``convention`` says how
-        *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
-        row computed in the authors' own convention (their IC region, window or selection rule), so that a
-        "differs" can be checked against it. The paper's number is always in the authors' convention.
-        """
-        if verdict is None and paper is not None and ours is not None and err is not None:
-            try:
-                verdict = "agrees within 2σ" if abs(float(ours) - float(paper)) <= 2 * float(err) else "differs"
-            except (TypeError, ValueError):
-                verdict = None
-        conv = convention if convention is not None else self.convention_label
-        if authors and not conv.startswith("authors"):
-            conv = f"authors': {conv}"
-        row = {"quantity": quantity, "ours": ours, "err": err, "paper": paper, "unit": unit,
-               "verdict": verdict, "note": note, "convention": conv, "authors": bool(authors)}
-        self.comparisons.append(row)
-        return row
-
-    @property
-    def convention_label(self) -> str:
-        """The study's own setup in a few words: its ICs and the escape radius of its ``[scene]``. The ICs are
-        ``[about] setup`` when the study says it (ICs that are not the ``[scene]``'s region, e.g. a grid on the
-        section), else the ``[scene]``'s region."""
-        sc = self.config.get("scene", {})
-        region = sc.get("region", "disk")
-        where = f"disk r < {sc.get('radius', 0.5):g}" if region == "disk" else f"{region} ICs"
-        if self.info is not None and self.info.setup:
-            where = self.info.setup
-        r_esc = sc.get("r_esc")
-        name = self.config.get("convention")
-        head = f"{name} setup: " if name else ""
-        return f"{head}{where}, r_esc {r_esc:g}" if r_esc is not None else f"{head}{where}"
-
-    def write_numbers(self, numbers: dict) -> Path:
-        """Write the study's numbers JSON (with its comparisons, scale and provenance)."""
-        from hhscatter.data.tables import provenance
-
-        doc = {"study": self.name, "scale": self.scale, **numbers,
-               "paper_comparison": list(self.comparisons), "config": self.config,
-               "raw_runs": dict(self.raw_runs), "provenance": provenance()}
-        write_json_atomic(self.numbers_path, doc)
-        return self.numbers_path
-
-    def read_numbers(self, other: str | None = None) -> dict:
-        """read_numbers(other=None) -> numbers JSON of this study or of study ``other`` at the same scale."""
-        path = self.numbers_path if other is None else load_study(other, self.scale, root=self.root.parent).numbers_path
-        if not path.exists():
-            raise FileNotFoundError(f"{path} is missing: run `make {other or self.name} SCALE={self.scale}` first")
-        return json.loads(path.read_text())
-
-    def write_table(self, df, fname: str, **meta) -> Path:
-        """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""
-        import pyarrow as pa
-
-        from hhscatter.data.tables import provenance, write_part
-
-        table = pa.Table.from_pandas(df, preserve_index=False)
-        doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
-        path = self.derived(fname)
-        write_part(path, table, _jsonable(doc))
-        return path
-
-    def write_table_streamed(self, tables, fname: str, **meta) -> Path:
-        """write_table_streamed(iterable of Arrow tables, fname, **meta) -> path: a derived table too large to hold
-        at once (e.g. one part per γ of 1e7 rows), written part by part with the study's metadata."""
-        from hhscatter.data.tables import provenance, write_parts_streamed
-
-        doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
-        path = self.derived(fname)
-        write_parts_streamed(path, tables, _jsonable(doc))
-        return path
-
-
-def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) -> Study:
-    """load_study(name, scale='quick', root=None) -> Study from ``<root>/<name>/study.toml``."""
-    root = Path(root) if root is not None else studies_root()
-    path = root / name / "study.toml"
-    if not path.exists():
-        from hhscatter.scene.schema import did_you_mean
-
-        known = sorted(p.parent.name for p in root.glob("*/study.toml"))
-        raise SceneError(f"study must be one of {known}, got {name!r}{did_you_mean(name, known)}")
-    try:
-        doc = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path} is not valid TOML: {exc}") from None
-    params = _params_model(name, root)
-    from hhscatter.scene.schema import apply_convention, merge_tables, validate_study_file
-
-    validate_study_file(doc, _shown(path), params)  # every table, key and type, at every scale, before any work
-    if "convention" in doc:  # the shared scene keys (studies/conventions.toml) under the study's own [scene]
-        cpath = conventions_path(root)
-        doc = apply_convention(doc, load_conventions(cpath), _shown(path), _shown(cpath))
-    try:
-        info = study_info(root, name, doc)
-    except GraphError as exc:
-        raise SceneError(str(exc)) from None
-    for key in HEADER_TABLES:  # what the study is and needs; not parameters of its runs
-        doc.pop(key, None)
-    scales = doc.pop("scale", {})
-    if scale != DEFAULT_SCALE:
-        if scale not in scales:
-            raise SceneError(f"scale must be one of {[DEFAULT_SCALE, *scales]}, got {scale!r}")
-        doc = merge_tables(doc, scales[scale])
-    return Study(name=name, scale=scale, config=doc, root=root / name, info=info, params_model=params)
-
-
-CONVENTIONS_FILE = "conventions.toml"
-
-
-def conventions_path(root: Path | None = None) -> Path:
-    """conventions_path(root=None) -> ``<root>/conventions.toml``, or the repository's when ``root`` has none."""
-    root = Path(root) if root is not None else studies_root()
-    own = root / CONVENTIONS_FILE
-    return own if own.exists() else _graph_default_root() / CONVENTIONS_FILE
-
-
-def load_conventions(path: Path | None = None) -> dict:
-    """load_conventions(path=None) -> {name: {scene key: value}} of the conventions file, strictly checked."""
-    from hhscatter.scene.schema import validate_conventions_file
-
-    path = Path(path) if path is not None else conventions_path()
-    try:
-        doc = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SceneError(f"{_shown(path)} is missing (the shared conventions of the studies)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{_shown(path)} is not valid TOML: {exc}") from None
-    validate_conventions_file(doc, _shown(path))
-    return doc
-
-
-def _shown(path: Path) -> str:
-    """A path as the user would type it: relative to the working directory when it lies below it."""
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
-
-
-def _params_model(name: str, root: Path):
-    """The ``Params`` model of the study's module (None: a study folder without code, or without Params)."""
-    try:
-        mod = stage_module(name, root)
-    except ModuleNotFoundError as exc:
-        if exc.name in (f"hhscatter.studies.{name}", f"hhscatter.studies.{name}.study"):
-            return None
-        raise
-    return getattr(mod, "Params", None)
-
-
-def missing_upstream(study: Study) -> list[str]:
-    """missing_upstream(study) -> the declared upstream studies whose numbers JSON (same scale) is not there yet."""
-    out = []
-    for other in sorted(set(study.needs.values())):
-        try:
-            path = load_study(other, study.scale, root=study.root.parent).numbers_path
-        except SceneError:
-            out.append(other)
-            continue
-        if not path.exists():
-            out.append(other)
-    return out
-
-
-def _add_to_path(root: Path) -> None:
-    """Make the study folders of ``root`` importable as ``hhscatter.studies.<name>`` (after the repository's)."""
-    r = str(Path(root).resolve())
-    if r not in __path__:
-        __path__.append(r)
-
-
-def stage_module(name: str, root: Path | None = None):
-    """stage_module(name, root=None) -> the module ``studies/<name>/study.py`` (``hhscatter.studies.<name>.study``).
-
-    A study folder is a namespace package inside ``hhscatter.studies`` (this
-    package's ``__path__`` holds the studies root), so its modules import each
-    other relatively (``from .figure import …``) and the library absolutely.
-    The repository's study folders come first; a folder that exists only in
-    ``root`` is found there.
-    """
-    import importlib
-
-    if name in _OWN_MODULES:
-        raise SceneError(f"a study cannot be named {name!r}: hhscatter.studies.{name} is part of the framework")
-    if root is not None:
-        _add_to_path(root)
-    return importlib.import_module(f"hhscatter.studies.{name}.study")
-
+from hhscatter.studies.jsonio import write_json_atomic
+from hhscatter.studies.study import (
+    DEFAULT_SCALE,
+    SCENE_TABLES,
+    STAGES,
+    Study,
+    conventions_path,
+    load_conventions,
+    load_study,
+    missing_upstream,
+    outputs_root,
+    simulate_inputs,
+    stage_module,
+    studies_root,
+    study_names,
+)
+
+__all__ = [
+    "DEFAULT_SCALE",
+    "SCENE_TABLES",
+    "STAGES",
+    "Study",
+    "checked_raw_runs",
+    "conventions_path",
+    "load_conventions",
+    "load_study",
+    "missing_upstream",
+    "outputs_root",
+    "run_stage",
+    "simulate_inputs",
+    "stage_module",
+    "studies_root",
+    "study_names",
+    "write_json_atomic",
+]
 
 def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
               root: Path | None = None):
     """run_stage(name, stage, scale='quick', workers=None) -> None; stage in simulate/analyze/plot/all."""
     if stage not in (*STAGES, "all"):
-        raise SceneError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
+        raise StudyError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
     study = load_study(name, scale, root=root)
     mod = stage_module(name, root)
     stages = STAGES if stage == "all" else (stage,)
@@ -456,34 +105,20 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
                 record(study.out, cost)
 
 
-#: the study.toml tables every raw run's scene is made from (Study.scene, Study.model)
-SCENE_TABLES = ("scene", "sections", "snapshots", "follow")
-
-
-def simulate_inputs(study, keys) -> dict:
-    """simulate_inputs(study, keys) -> what the simulate stage made its runs from: the scene tables of
-    study.toml (this scale) and the values of the ``[study]`` keys it read (``keys``). Analysis-only keys
-    (a paper constant, a fit window) are not in it: changing them needs no new simulation."""
-    return _jsonable({"tables": {t: study.config.get(t) for t in SCENE_TABLES},
-                      "study": {k: study.param(k) for k in sorted(keys)}})
-
-
 def checked_raw_runs(study) -> dict:
     """checked_raw_runs(study) -> {key: {scene_hash, orbits, complete}} of the raw runs analyze may read.
 
-    SceneError (exit 2, before any analysis) if the simulate stage did not finish for the current
+    StudyError (exit 2, before any analysis) if the simulate stage did not finish for the current
     study.toml (``raw/done.json`` missing, or made from another configuration), or if a raw run it made
     is incomplete or now holds another scene. A study without raw runs (one that reads only upstream
     outputs) passes.
     """
-    from hhscatter.data.tables import run_status
-
     raw = study.out / "raw"
     done = raw / "done.json"
     again = f"run `hhscatter study {study.name} simulate --scale {study.scale}` first"
     if not done.exists():
         if raw.is_dir() and any((p / "scene.json").exists() for p in raw.iterdir() if p.is_dir()):
-            raise SceneError(f"{study.name} analyze: the simulate stage has not finished ({done} is missing); "
+            raise StudyError(f"{study.name} analyze: the simulate stage has not finished ({done} is missing); "
                              f"{again}")
         return {}
     rec = json.loads(done.read_text())
@@ -493,16 +128,16 @@ def checked_raw_runs(study) -> dict:
     changed += [f"[study] {k} ({v!r} → {now['study'][k]!r})" for k, v in (was.get("study") or {}).items()
                 if v != now["study"][k]]
     if "inputs" not in rec or changed:
-        raise SceneError(f"{study.name} analyze: the raw runs in {raw} were made from another study.toml "
+        raise StudyError(f"{study.name} analyze: the raw runs in {raw} were made from another study.toml "
                          f"({', '.join(changed) or 'no record of its inputs'} changed since simulate); {again}")
     runs = {}
     for key, want in rec.get("runs", {}).items():
         st = run_status(raw / key)
         if st["scene_hash"] != want["scene_hash"]:
-            raise SceneError(f"{study.name} analyze: raw run {raw / key} holds another scene than simulate made "
+            raise StudyError(f"{study.name} analyze: raw run {raw / key} holds another scene than simulate made "
                              f"(hash {str(st['scene_hash'])[:12]}…, expected {want['scene_hash'][:12]}…); {again}")
         if not st["complete"]:
-            raise SceneError(f"{study.name} analyze: raw run {raw / key} is incomplete ({st['chunks_done']} of "
+            raise StudyError(f"{study.name} analyze: raw run {raw / key} is incomplete ({st['chunks_done']} of "
                              f"{st['chunks']} chunks finished); {again}")
         runs[key] = {"scene_hash": want["scene_hash"], "orbits": st["orbits"], "complete": True}
     return runs
@@ -521,7 +156,6 @@ def _run_one(study, mod, st, name, scale, workers, progress):
                                  "runs": study.raw_runs})
         print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
     elif st == "analyze":
-        from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
 
         missing = [] if dev_fallback_enabled() else missing_upstream(study)
         if missing:
@@ -534,14 +168,8 @@ def _run_one(study, mod, st, name, scale, workers, progress):
         extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
         print(f"{name} analyze: wrote {study.numbers_path}{extra}", flush=True)
     else:
-        import matplotlib
+        import matplotlib  # deferred: matplotlib loads on first use
 
         matplotlib.use("Agg")
         mod.plot(study)
         print(f"{name} plot: wrote {study.figure_path}", flush=True)
-
-
-# the study folders are subpackages of this package: studies/<name>/study.py is hhscatter.studies.<name>.study
-# (the repository's folders first, then those of HHSCATTER_STUDIES if it is set)
-_add_to_path(_graph_default_root())
-_add_to_path(studies_root())

@@ -18,7 +18,8 @@ from __future__ import annotations
 import math
 import os
 
-from hhscatter.scene.scene import SceneError
+from hhscatter.errors import HHScatterError, StudyError
+from hhscatter.studies.study import load_study
 
 DEV_ENV = "HHSCATTER_DEV_FALLBACK"
 DEV_SOURCE = "paper fallback (DEVELOPMENT ONLY)"
@@ -29,7 +30,7 @@ def dev_fallback_enabled() -> bool:
     return os.environ.get(DEV_ENV, "") == "1"
 
 
-class UpstreamError(FileNotFoundError):
+class UpstreamError(StudyError, FileNotFoundError):
     """Another study's output is missing or lacks an expected key."""
 
 
@@ -76,7 +77,7 @@ def numbers(study, other: str) -> dict:
     """numbers(study, other) -> the numbers JSON of study ``other`` at ``study``'s scale, or UpstreamError."""
     try:
         return study.read_numbers(other)
-    except (FileNotFoundError, SceneError) as exc:
+    except (FileNotFoundError, HHScatterError) as exc:
         raise UpstreamError(f"{study.name} needs the outputs of study {other!r}: {exc}") from None
 
 
@@ -98,13 +99,12 @@ def table(study, other: str, name: str, filters=None, columns=None):
     published tables have 6e7 rows at paper scale). A study reads other studies'
     published outputs (numbers JSON, derived tables), never their raw runs.
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
-    from hhscatter.studies import load_study
 
     try:
         o = load_study(other, study.scale, root=study.root.parent)
-    except SceneError as exc:
+    except StudyError as exc:
         raise UpstreamError(f"{study.name} needs study {other!r}: {exc}") from None
     path = o.out / "derived" / name
     if not path.exists():

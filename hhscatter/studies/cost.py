@@ -31,6 +31,8 @@ from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 
+from hhscatter.studies.jsonio import write_json_atomic
+
 COST_FILE = "cost.json"
 _KB = 1024.0 if sys.platform != "darwin" else 1024.0 * 1024.0  # ru_maxrss unit: KB on Linux, bytes on macOS
 
@@ -75,8 +77,6 @@ def meter(stage: str, workers=None):
 
 def record(out: Path, cost: StageCost) -> Path:
     """record(out, cost) -> path of ``out/cost.json`` after appending ``cost`` to its stage's invocations."""
-    from hhscatter.studies import write_json_atomic
-
     path = Path(out) / COST_FILE
     doc = json.loads(path.read_text()) if path.exists() else {}
     if cost.stage != "simulate" or (cost.chunks_resumed == 0 and cost.orbits > 0):

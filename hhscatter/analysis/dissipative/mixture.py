@@ -46,7 +46,6 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.survival.kappa_law import E_C
 from hhscatter.analysis.dissipative.survival_model import (
     HAZARDS,
     SurvivalFit,
@@ -59,6 +58,7 @@ from hhscatter.analysis.dissipative.survival_model import (
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.survival.kappa_law import E_C
 
 __all__ = [
     "MixtureComponents",

@@ -12,7 +12,6 @@ This module only gathers their names (``from hhscatter.analysis.dissipative impo
 from __future__ import annotations
 
 from hhscatter.analysis.dissipative.decay import energy_path, time_to_energy
-from hhscatter.analysis.survival.kappa_law import E_C, PAPER_KAPPA, PiecewiseKappa
 from hhscatter.analysis.dissipative.mixture import (
     MixtureComponents,
     MixtureModelParams,
@@ -32,6 +31,7 @@ from hhscatter.analysis.dissipative.survival_model import (
     settling_rate,
     survival_model,
 )
+from hhscatter.analysis.survival.kappa_law import E_C, PAPER_KAPPA, PiecewiseKappa
 
 __all__ = [
     "E_C",

@@ -43,8 +43,8 @@ import pandas as pd
 from scipy import optimize, special
 
 from hhscatter.analysis.dissipative.decay import energy_path
-from hhscatter.analysis.survival.kappa_law import E_C
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.survival.kappa_law import E_C
 
 __all__ = [
     "E_C",

@@ -26,9 +26,12 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.survival.kaplan_meier import survival_on_grid
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
-from hhscatter.analysis.survival.fits import observed_from_outcome
+from hhscatter.analysis.survival.fits import (
+    observed_from_outcome,
+    survival_from_lifetimes,
+)
+from hhscatter.analysis.survival.kaplan_meier import survival_on_grid
 
 __all__ = [
     "bootstrap_transition_times",
@@ -56,7 +59,7 @@ def outcome_is(outcome, value: str) -> np.ndarray:
     ``outcome``: an array of labels, or a pandas Series/Categorical (compared on its codes: a categorical of
     1e7 orbits would otherwise become a 1e7-element object array).
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     if isinstance(outcome, (pd.Series, pd.Categorical, pd.Index)):
         return np.array(outcome == value, dtype=bool).ravel()  # a writable copy (callers combine masks in place)
@@ -139,7 +142,6 @@ def tau1_from_lifetimes(
     :func:`hhscatter.analysis.survival.fits.survival_from_lifetimes` (Kaplan–Meier;
     'escaped' and 'settled' leave, 'censored' is right-censored).
     """
-    from hhscatter.analysis.survival.fits import survival_from_lifetimes
 
     Pg = survival_from_lifetimes(lifetimes_gamma, t_grid).P
     P0 = survival_from_lifetimes(lifetimes_0, t_grid).P
@@ -218,7 +220,7 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
     A bootstrap of a minimum cannot give this: resampled minima are never
     below the observed one.
     """
-    from scipy import stats
+    from scipy import stats  # deferred: scipy loads on first use
 
     t_end = np.asarray(t_end, dtype=float).ravel()
     settled = outcome_is(outcome, "settled") & np.isfinite(t_end)

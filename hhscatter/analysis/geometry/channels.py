@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import integrate, optimize, stats
 
-from hhscatter.model import HenonHeiles
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.model import HenonHeiles
 
 __all__ = [
     "ChannelFractions",

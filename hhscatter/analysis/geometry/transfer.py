@@ -480,7 +480,7 @@ def survival(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
     P(k) = Σ_{k' ≤ k} n(k') · H_{k − k'} (H beyond its last row: 0), one convolution per state
     (scipy.signal.fftconvolve).
     """
-    from scipy.signal import fftconvolve
+    from scipy.signal import fftconvolve  # deferred: scipy loads on first use
 
     steps, n = crossings.shape
     Hs = np.zeros((steps, n))

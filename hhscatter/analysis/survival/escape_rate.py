@@ -28,8 +28,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hhscatter.analysis.survival.cmeasure import CMeasureKappa, cmeasure_sample_from_sections, kappa_from_cmeasure
-from hhscatter.analysis.survival.kappa_energy import KappaEnergyFit, fit_kappa_energy
+from hhscatter.analysis.survival.cmeasure import (
+    CMeasureKappa,
+    cmeasure_sample_from_sections,
+    kappa_from_cmeasure,
+)
 from hhscatter.analysis.survival.fits import (
     PowerLawFit,
     SurvivalCurve,
@@ -40,6 +43,7 @@ from hhscatter.analysis.survival.fits import (
     mean_kappa_stat_err,
     survival_curve,
 )
+from hhscatter.analysis.survival.kappa_energy import KappaEnergyFit, fit_kappa_energy
 from hhscatter.analysis.survival.windows import WindowChoice, choose_windows
 
 # the window choice, the κ(E) law and the c-measure estimator live in their own modules; their names stay

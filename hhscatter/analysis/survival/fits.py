@@ -49,8 +49,12 @@ import numpy as np
 from scipy import optimize
 from scipy.special import xlogy
 
+from hhscatter.analysis.stats.least_squares import (
+    least_squares_operator,
+    weighted_least_squares,
+)
 from hhscatter.analysis.survival.kaplan_meier import SurvivalCurve, survival_curve
-from hhscatter.analysis.stats.least_squares import least_squares_operator, weighted_least_squares
+from hhscatter.outcomes import CENSORED, CENSORING_OUTCOMES, LEAVING_OUTCOMES, OUTCOMES
 
 __all__ = [
     "CENSORED_OUTCOME",
@@ -70,11 +74,9 @@ __all__ = [
     "survival_from_lifetimes",
 ]
 
-LEAVING_OUTCOMES = ("escaped", "settled")
 # 'stopped': the engine stopped the orbit because nothing more was needed from it
 # (hhscatter.integrate.events); for a lifetime it is right-censoring at t_end, like 'censored'
-CENSORING_OUTCOMES = ("censored", "stopped")
-CENSORED_OUTCOME = "censored"
+CENSORED_OUTCOME = OUTCOMES[CENSORED]
 
 
 # ---------------------------------------------------------------------------
@@ -86,7 +88,7 @@ def observed_from_outcome(outcome) -> np.ndarray:
     Raises ValueError on any other (or missing) outcome label. A pandas categorical is mapped through its
     categories (one label test per category, then the codes: no Python object per orbit).
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     cat = outcome.array if isinstance(outcome, pd.Series) else outcome
     if isinstance(cat, pd.Categorical):

@@ -32,7 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hhscatter.analysis.survival.fits import fit_exponential, mean_kappa_stat_err, survival_curve
+from hhscatter.analysis.survival.fits import (
+    fit_exponential,
+    mean_kappa_stat_err,
+    survival_curve,
+)
 
 
 @dataclass(frozen=True)
@@ -155,7 +159,7 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
     ``min_defined`` conventions define it and (max − min)/mean of their κ is
     ≤ ``rel_tol``.
     """
-    import pandas as pd
+    import pandas as pd  # deferred: pandas loads on first use
 
     rows = []
     for energy, g in table.groupby("energy", sort=True):

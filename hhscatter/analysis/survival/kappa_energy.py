@@ -14,12 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
-from hhscatter.model import HenonHeiles
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.survival.kappa_law import E_C  # E_c of the paper's model: the default of the fits
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy"]
-
-E_C_HH = HenonHeiles().critical_energy  # E_c = ω⁶/(6λ²) of the model with ω = λ = 1 (the default of the fits)
 
 
 # ---------------------------------------------------------------------------
@@ -129,7 +127,7 @@ def fit_kappa_energy(
     E,
     kappa,
     kappa_err=None,
-    E_c: float = E_C_HH,
+    E_c: float = E_C,
     *,
     continuous: bool = True,
     n_grid: int = 400,

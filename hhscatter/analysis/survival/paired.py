@@ -109,7 +109,6 @@ class RatioSlope:
 
 
 def _log_ratio_fit(t_ref, obs_ref, t_alt, obs_alt, grid):
-
     p0 = survival_curve(t_ref, obs_ref, grid).P
     p1 = survival_curve(t_alt, obs_alt, grid).P
     ok = (p0 > 0) & (p1 > 0)
