@@ -38,7 +38,7 @@ _EXPORTS = {
     "RunError": "errors",
     "StudyError": "errors",
     "RunIntegrityError": "errors",
-    "load_scene": "scene.scene",
+    "load_scene": "scene.schema",
     "Grid": "scene.grid",
     "load_run": "scene.grid",
     "simulate": "run.runner",

@@ -231,7 +231,7 @@ def _resumed_scene(out):
 def _scene_from_args(a):
     """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
     from hhscatter.scene.grid import run_from_dict  # deferred: `hhscatter --help` starts without the engine and tables
-    from hhscatter.scene.scene import scene_dict_from_toml  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.scene.schema import scene_dict_from_toml  # deferred: `hhscatter --help` starts without the engine and tables
 
     flags = {
         k: getattr(a, k)

@@ -149,7 +149,7 @@ def test_bad_output_and_ics(tmp_path, capsys):
 
 
 def test_scene_toml_and_scales(tmp_path):
-    from hhscatter.scene.scene import load_scene
+    from hhscatter.scene.schema import load_scene
 
     p = tmp_path / "scene.toml"
     p.write_text('[scene]\nenergy = 0.3\nn = 100\ngamma = 0.01\n[sections]\nt_from = 17.0\nfirst_only = true\n'

@@ -240,7 +240,7 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
 
 def test_the_engine_options_are_accepted_in_files(tmp_path):
     """sections.stop, [follow] radii and continue_settled pass the strict checks (and build their scenes)."""
-    from hhscatter.scene.scene import load_scene
+    from hhscatter.scene.schema import load_scene
 
     (tmp_path / "a.toml").write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 10\ncontinue_settled = true\n"
                                      "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n"
@@ -249,3 +249,44 @@ def test_the_engine_options_are_accepted_in_files(tmp_path):
     assert s.continue_settled and s.sections.stop and s.snapshots == (0.0, 5.0, 10.0)
     (tmp_path / "b.toml").write_text("[scene]\nenergy = 0.3\nn = 10\nregion = \"square\"\n[follow]\nradii = [1.0, 2.0]\n")
     assert load_scene(tmp_path / "b.toml").follow.radii == (1.0, 2.0)
+
+
+def test_study_code_receives_typed_params():
+    """study.params.<key> has the declared Python type, whatever TOML wrote (1 for a Number is 1.0)."""
+    from hhscatter.studies import load_study
+
+    s = load_study("fig1", "tiny")
+    assert all(type(e) is float for e in s.params.energies)
+    assert type(s.params.pilot_n) is int and type(s.params.pilot_t_max) is float
+    assert s.params.pilot_t_max == s.param("pilot_t_max")  # the raw value, equal
+    with pytest.raises(Exception, match="does not declare"):
+        s.params.no_such_key
+    s.params_read = set()
+    s.params.pilot_n
+    assert s.params_read == {"pilot_n"}
+
+
+def test_typed_params_converts_each_leaf_type():
+    from hhscatter.scene.schema import (
+        Integer,
+        Integers,
+        NumberLists,
+        NumberOr,
+        Numbers,
+        StudyParams,
+        Text,
+        typed_params,
+    )
+
+    class Params(StudyParams):
+        a: Integer
+        b: Numbers
+        c: NumberLists
+        d: NumberOr("tau0")
+        e: Integers = [1, 2]
+        f: Text = "x"
+
+    p = typed_params(Params, {"a": 3, "b": [1, 2.5], "c": [[0, 1]], "d": 2})
+    assert (p.a, p.b, p.c, p.d, p.e, p.f) == (3, [1.0, 2.5], [[0.0, 1.0]], 2.0, [1, 2], "x")
+    assert [type(x) for x in p.b] == [float, float] and type(p.d) is float
+    assert typed_params(Params, {"a": 1, "b": [], "c": [], "d": "tau0"}).d == "tau0"

@@ -9,7 +9,8 @@ from hhscatter.scene.grid import Grid, load_run
 from hhscatter.model import HenonHeiles
 from hhscatter.run.runner import simulate
 from hhscatter.errors import OutputError
-from hhscatter.scene.scene import Scene, SceneError, load_scene
+from hhscatter.scene.scene import Scene, SceneError
+from hhscatter.scene.schema import load_scene
 from hhscatter.data.tables import read_lifetimes, read_meta, read_sections
 
 ENERGIES, GAMMAS = (0.25, 0.3), (0.0, 0.01)

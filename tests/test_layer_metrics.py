@@ -38,3 +38,21 @@ def test_no_circle_without_a_back_edge(tmp_path):
     (root / "pkg" / "b.py").write_text("def g():\n    return 1\n")
     (root / "pkg" / "sub" / "d.py").write_text("def h():\n    return 1\n")
     assert lm.measure(root, "pkg", [])["circles"] == []
+
+
+def test_casts_of_study_parameters_are_told_from_other_casts(tmp_path):
+    p = tmp_path / "pkg"
+    p.mkdir()
+    (p / "__init__.py").write_text("")
+    (p / "s.py").write_text(
+        "def f(study, row):\n"
+        "    a = float(study.param('x'))\n"             # a cast: counted
+        "    b = int(study.params.n)\n"                 # counted
+        "    c = [float(v) for v in study.params.e]\n"  # element-wise: counted
+        "    d = tuple(float(v) for v in study.params.w)\n"  # counted
+        "    e = list(map(float, study.params.e))\n"    # counted
+        "    g = float(row['mu'])\n"                    # a DataFrame row: not a study parameter
+        "    h = study.params.e\n"                      # typed, no cast
+        "    return a, b, c, d, e, g, h\n")
+    m = lm.measure(tmp_path, "pkg", [])
+    assert sorted(int(w.rsplit(":", 1)[1]) for w in m["param_casts"]) == [2, 3, 4, 5, 6]

@@ -13,7 +13,8 @@ import pytest
 from hhscatter.cli import main
 from hhscatter.run.runner import RunError, simulate
 from hhscatter.errors import OutputError
-from hhscatter.scene.scene import Scene, SectionWindow, load_scene
+from hhscatter.scene.scene import Scene, SectionWindow
+from hhscatter.scene.schema import load_scene
 from hhscatter.data.tables import verify_part
 
 TOML = """[scene]

@@ -182,7 +182,7 @@ def test_fig1_tiny_end_to_end(tiny_root):
         E = info["energy"]
         k = info["kappa_used"]["value"]
         assert 0.5 * 1.41 * (E - 1 / 6) < k < 2 * 1.41 * (E - 1 / 6)  # the right order of magnitude
-        assert info["t_rec"] == math.ceil(info["tau0_used"] + study.params["rec_efolds"] / k)
+        assert info["t_rec"] == math.ceil(info["tau0_used"] + study.params.rec_efolds / k)
         assert 0 < info["n_points"] <= info["n_survivors_at_t_rec"] < info["n_orbits"]
         # the raw sections table is the c-measure sample: one crossing per orbit, after t_rec, on the section
         sec = read_sections(study.raw(key))
@@ -205,7 +205,7 @@ def test_fig2_tiny_end_to_end(tiny_root):
     study = load_study("fig2", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 30_000
     doc = json.loads(study.numbers_path.read_text())
-    grid = study.params["grid_energies"]
+    grid = study.params.grid_energies
     ke = pd.read_parquet(study.out / "derived" / "kappa_energy.parquet")
     assert len(ke) == len(grid)
     assert (ke["kappa"] > 0).all() and (ke["kappa_err"] > 0).all()
@@ -229,7 +229,7 @@ def test_fig2_tiny_end_to_end(tiny_root):
     # κ from the c-measure: an independent estimator of the same rate
     cm = pd.read_parquet(study.out / "derived" / "kappa_cmeasure.parquet")
     main = cm[cm["shift_efolds"] == 0.0]
-    assert len(main) == len(study.params["cm_energies"])
+    assert len(main) == len(study.params.cm_energies)
     assert (main["n_undetermined"] == 0).all()
     assert ((main["mu_exit"] > 0) & (main["mu_exit"] < 1)).all()
     assert (np.abs(main["z_vs_same_run"]) < 4).all()
@@ -249,7 +249,7 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
     doc = json.loads(study.numbers_path.read_text())
     conv = doc["kappa_conventions"]
     table = pd.read_parquet(study.out / "derived" / "kappa_conventions.parquet")
-    for e in study.params["square_energies"]:
+    for e in study.params.square_energies:
         disk = json.loads((study.raw(f"grid_E{e:.3f}") / "scene.json").read_text())["scene"]
         sq = json.loads((study.raw(f"sq_grid_E{e:.3f}") / "scene.json").read_text())["scene"]
         assert sq["region"] == "square" and disk["region"] == "disk"
@@ -297,7 +297,7 @@ def test_fig2_paper_n_per_energy_is_declared_per_grid_energy():
     from hhscatter.studies.fig2.study import grid_n
 
     paper = load_study("fig2", "paper")
-    grid, per = paper.params["grid_energies"], paper.params["grid_n_by_energy"]
+    grid, per = paper.params.grid_energies, paper.params.grid_n_by_energy
     assert [grid_n(paper, e) for e in grid] == per and grid_n(paper, 0.18) == 750000 and grid_n(paper, 0.4) == 250000
     assert all(n >= 100000 for n in per)
     assert grid_n(load_study("fig2", "quick"), 0.18) == 30000  # no list: grid_n everywhere

@@ -101,18 +101,43 @@ def scc(graph: dict[str, set[str]]) -> list[list[str]]:
     return comps
 
 
-def is_param_cast(node: ast.AST) -> bool:
-    """``float(x.param(...))``, ``int(params[...])`` and the like: a cast of a study parameter."""
-    if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)):
-        return False
-    if node.func.id not in {"float", "int", "bool", "str"} or len(node.args) != 1:
-        return False
-    arg = node.args[0]
+def _is_study_param(arg: ast.AST) -> bool:
+    """``x.param(...)``, ``x.params.key``, ``x.params[...]``, ``x.raw_params[...]``: a study parameter."""
     if isinstance(arg, ast.Call) and isinstance(arg.func, ast.Attribute):
         return arg.func.attr in {"param", "get_param"}
-    if isinstance(arg, ast.Subscript) and isinstance(arg.value, (ast.Name, ast.Attribute)):
-        name = arg.value.id if isinstance(arg.value, ast.Name) else arg.value.attr
-        return name in {"params", "p", "cfg", "config"}
+    if isinstance(arg, (ast.Attribute, ast.Subscript)) and isinstance(arg.value, ast.Attribute):
+        return arg.value.attr in {"params", "raw_params"}
+    return False
+
+
+def is_param_cast(node: ast.AST) -> bool:
+    """``float(study.param(...))``, ``int(study.params.n)``, ``float(v) for v in study.params.x`` and the like: a
+    cast of a study parameter (study code receives its typed Params and never casts)."""
+    if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)):
+        return False
+    if node.func.id not in {"float", "int", "bool", "str", "tuple", "list"} or len(node.args) != 1:
+        return False
+    arg = node.args[0]
+    if node.func.id in {"float", "int", "bool", "str"} and _is_study_param(arg):
+        return True
+    # a cast applied to every element: float(v) for v in study.params.x; map(float, study.params.x)
+    if isinstance(arg, ast.GeneratorExp):
+        gen = arg.generators[0]
+        elt = arg.elt
+        return (_is_study_param(gen.iter) and isinstance(elt, ast.Call) and isinstance(elt.func, ast.Name)
+                and elt.func.id in {"float", "int"})
+    return False
+
+
+def _is_elementwise_cast(node: ast.AST) -> bool:
+    """``[float(v) for v in study.params.x]`` or ``map(float, study.params.x)``."""
+    if isinstance(node, ast.ListComp):
+        elt, it = node.elt, node.generators[0].iter
+        return (_is_study_param(it) and isinstance(elt, ast.Call) and isinstance(elt.func, ast.Name)
+                and elt.func.id in {"float", "int"})
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "map" and len(node.args) == 2:
+        f, it = node.args
+        return isinstance(f, ast.Name) and f.id in {"float", "int"} and _is_study_param(it)
     return False
 
 
@@ -144,10 +169,10 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
                 for t in targets(node, mod, is_pkg, known):
                     if t != mod:  # an explicit import of a parent package is an edge too (a real circle if it
                         graph[mod].add(t)  # imports this module back)
-        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n)]
+        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)]
     for f in extra:
         tree = ast.parse(f.read_text(), filename=str(f))
-        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n)]
+        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)]
         for node in ast.walk(tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = node.end_lineno - node.lineno + 1

@@ -45,13 +45,8 @@ import os
 from dataclasses import dataclass, field
 
 from hhscatter.errors import ConfigError
-from hhscatter.scene.scene import (
-    Scene,
-    _clean,
-    _json_default,
-    scene_dict_from_toml,
-    scene_from_dict,
-)
+from hhscatter.scene.scene import Scene, _clean, _json_default, scene_from_dict
+from hhscatter.scene.schema import scene_dict_from_toml
 
 AXES = ("energy", "gamma")
 

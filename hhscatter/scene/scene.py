@@ -12,8 +12,6 @@ import functools
 import hashlib
 import json
 import math
-import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,7 +20,6 @@ import numpy as np
 
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles
-from hhscatter.scene.schema import REGIONS, validate_scene_file
 
 TOL_RANGE = (1e-18, 1e-6)
 
@@ -49,6 +46,10 @@ SNAPSHOTS_MAX = 100_000
 #: a start/stop/step snapshot grid longer than this is stored (scene.json, part metadata, hash) as its
 #: definition, not as every time (shorter grids are stored as their times, as before: same hashes)
 SNAPSHOT_LIST_MAX = 1000
+
+
+#: the initial-condition regions of a scene (hhscatter.scene.ics)
+REGIONS = ("disk", "well", "square")
 
 
 class SnapshotGrid(tuple):
@@ -522,77 +523,3 @@ def scene_from_dict(d: dict) -> Scene:
         raise ConfigError("a scene needs 'n' (number of orbits)")
     d.setdefault("energy", None)
     return Scene(**d)
-
-
-def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
-    """scene_dict_from_toml(path, scale=None, **overrides) -> the raw scene dict of a TOML file.
-
-    What :func:`load_scene` validates; values may still be lists (a grid, see
-    :mod:`hhscatter.scene.grid`).
-    """
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise ConfigError(f"scene file not found: {path}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"scene file {path} is not valid TOML: {exc}") from None
-    if "scene" not in doc:
-        raise ConfigError(f"scene file {path} has no [scene] table")
-    validate_scene_file(doc, str(path))  # every table, key and type, before any work
-    d = dict(doc["scene"])
-    d.setdefault("name", path.parent.name)
-    if "sections" in doc:
-        d["sections"] = doc["sections"]
-    if "snapshots" in doc:
-        d["snapshots"] = doc["snapshots"]
-    if "follow" in doc:
-        d["follow"] = doc["follow"]
-    if scale is not None and scale != "quick":
-        scales = doc.get("scale", {})
-        if scale not in scales:
-            raise ConfigError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
-        d.update(scales[scale])
-    d.update({k: v for k, v in overrides.items() if v is not None})
-    return d
-
-
-def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrides: object) -> Scene:
-    """A Scene from a TOML file.
-
-    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow fields), ``[snapshots]``
-    (``times = [...]`` or ``start/stop/step``) and ``[scale.<name>]`` tables whose keys override
-    ``[scene]`` when ``scale`` is given. A file whose ``energy`` or ``gamma`` is a list is a grid: load it
-    with :func:`hhscatter.load_run`.
-
-    Parameters
-    ----------
-    path : path
-        The TOML file.
-    scale : str, optional
-        Name of a ``[scale.<name>]`` table to apply.
-    **overrides
-        Scene fields applied last.
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    ConfigError
-        An unknown table or key (with a did-you-mean), a value out of range, or a grid file.
-
-    Examples
-    --------
-    >>> import pathlib, tempfile, hhscatter
-    >>> f = pathlib.Path(tempfile.mkdtemp()) / "scene.toml"
-    >>> _ = f.write_text("[scene]\\nenergy = 0.3\\nn = 1000\\n[scale.paper]\\nn = 10000000\\n")
-    >>> hhscatter.load_scene(f).n, hhscatter.load_scene(f, "paper").n, hhscatter.load_scene(f, n=5).n
-    (1000, 10000000, 5)
-    """
-    d = scene_dict_from_toml(path, scale, **overrides)
-    for k in ("energy", "gamma"):
-        if isinstance(d.get(k), (list, tuple)):
-            raise ConfigError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
-    return scene_from_dict(d)

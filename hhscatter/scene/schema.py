@@ -23,8 +23,12 @@ for the optional ones.
 from __future__ import annotations
 
 import copy
+import dataclasses
+import os
+import tomllib
 import difflib
 from functools import lru_cache
+from pathlib import Path
 from typing import Annotated, Any
 
 from pydantic import (
@@ -37,11 +41,13 @@ from pydantic import (
 )
 
 from hhscatter.errors import ConfigError
-
-#: the initial-condition regions of a scene (hhscatter.scene.ics)
-REGIONS = ("disk", "well", "square")
+from hhscatter.scene.scene import REGIONS, Follow, Scene, SectionWindow, scene_from_dict
 
 __all__ = [
+    "load_scene",
+    "scene_dict_from_toml",
+    "table_of",
+    "typed_params",
     "Bool",
     "ConfigError",
     "Integer",
@@ -64,14 +70,27 @@ __all__ = [
 
 
 
-# -- strict leaf types (the raw value is kept, never converted) ----------------------------------
-def _strict(what: str, ok) -> Any:
+# -- strict leaf types ------------------------------------------------------------------------------
+# A file is checked as written: the raw value is kept (a TOML 1 stays an int where a number is allowed), so that
+# messages and records show what the file says. Each leaf type also declares what the value means in Python
+# (Number -> float, Integer -> int, Numbers -> list of floats, ...): typed_params() converts a study's [study]
+# table with it, so study code receives typed values and never casts.
+class _Convert:
+    """The Python type of a leaf (metadata of its Annotated type; read by :func:`typed_params`)."""
+
+    __slots__ = ("to",)
+
+    def __init__(self, to):
+        self.to = to
+
+
+def _strict(what: str, ok, to=None) -> Any:
     def check(v):
         if not ok(v):
             raise ValueError(f"must be {what}")
         return v
 
-    return Annotated[Any, AfterValidator(check)]
+    return Annotated[Any, AfterValidator(check), _Convert(to)]
 
 
 def _is_num(v) -> bool:
@@ -82,53 +101,100 @@ def _is_nums(v) -> bool:
     return isinstance(v, list) and all(_is_num(x) for x in v)
 
 
-#: a TOML integer or float (not a boolean, not a string)
-Number = _strict("a number", _is_num)
-#: a TOML integer
-Integer = _strict("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool))
+def _floats(v) -> list:
+    return [float(x) for x in v]
+
+
+#: a TOML integer or float (not a boolean, not a string); in Python a float
+Number = _strict("a number", _is_num, float)
+#: a TOML integer; in Python an int
+Integer = _strict("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool), int)
 #: true or false
-Bool = _strict("true or false", lambda v: isinstance(v, bool))
+Bool = _strict("true or false", lambda v: isinstance(v, bool), bool)
 #: a string
-Text = _strict("a string (in quotes)", lambda v: isinstance(v, str))
-#: a list of numbers
-Numbers = _strict("a list of numbers", _is_nums)
+Text = _strict("a string (in quotes)", lambda v: isinstance(v, str), str)
+#: a list of numbers; in Python a list of floats
+Numbers = _strict("a list of numbers", _is_nums, _floats)
 #: a list of integers
 Integers = _strict("a list of integers",
-                   lambda v: isinstance(v, list) and all(isinstance(x, int) and not isinstance(x, bool) for x in v))
+                   lambda v: isinstance(v, list) and all(isinstance(x, int) and not isinstance(x, bool) for x in v),
+                   lambda v: [int(x) for x in v])
 #: a list of strings
-Texts = _strict("a list of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v))
-#: a list of lists of numbers (e.g. windows [[t_lo, t_hi], …])
-NumberLists = _strict("a list of lists of numbers", lambda v: isinstance(v, list) and all(_is_nums(x) for x in v))
-#: a number, or a list of numbers (a grid axis of a scene file)
-NumberOrNumbers = _strict("a number or a list of numbers", lambda v: _is_num(v) or (_is_nums(v) and len(v) > 0))
+Texts = _strict("a list of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v), list)
+#: a list of lists of numbers (e.g. windows [[t_lo, t_hi], …]); in Python a list of lists of floats
+NumberLists = _strict("a list of lists of numbers", lambda v: isinstance(v, list) and all(_is_nums(x) for x in v),
+                      lambda v: [_floats(x) for x in v])
+#: a number, or a list of numbers (a grid axis of a scene file); in Python a float or a list of floats
+NumberOrNumbers = _strict("a number or a list of numbers", lambda v: _is_num(v) or (_is_nums(v) and len(v) > 0),
+                          lambda v: _floats(v) if isinstance(v, list) else float(v))
+
+
+def _number_or_keep(v):
+    return float(v) if _is_num(v) else v
+
+
+def _show(v) -> str:
+    """A value as TOML writes it (true/false, quoted strings, [lists])."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, dict):
+        return "a table"
+    if isinstance(v, list):
+        return "[" + ", ".join(_show(x) for x in v) + "]"
+    return repr(v)
 
 
 def OneOf(*values) -> Any:
     """OneOf('a', 'b') -> a leaf type that accepts exactly these values."""
     return _strict("one of " + ", ".join(_show(v) for v in values), lambda v: any(v == x and type(v) is type(x)
-                                                                               for x in values))
+                                                                               for x in values))  # kept as is
 
 
 def NumberOr(*values) -> Any:
     """NumberOr('tau0') -> a number, or one of these values."""
     return _strict("a number or one of " + ", ".join(_show(v) for v in values),
-                   lambda v: _is_num(v) or any(v == x and type(v) is type(x) for x in values))
+                   lambda v: _is_num(v) or any(v == x and type(v) is type(x) for x in values), _number_or_keep)
 
 
 class _Table(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
-# -- the tables of a scene ----------------------------------------------------------------------
-class SectionsTable(_Table):
-    """``[sections]``: which crossings of the section to record (hhscatter.scene.scene.SectionWindow)."""
+# -- the tables of a scene: derived from the dataclasses (one declaration of every field) -----------
+#: the leaf type of a file value, by the dataclass annotation of its field
+_LEAF_OF = {"float": Number, "float | None": Number, "int": Integer, "int | None": Integer, "bool": Bool,
+            "str": Text, "str | None": Text, "tuple": Numbers}
 
-    t_from: Number = None
-    t_to: Number = None
-    e_min: Number = None
-    e_max: Number = None
-    first_only: Bool = None
-    stop: Bool = None
+
+def table_of(cls, name: str, doc: str, *, leaves: dict | None = None, exclude=(), required=()) -> type[BaseModel]:
+    """table_of(dataclass, name, doc) -> the strict model of its file table: one key per dataclass field.
+
+    Each field's leaf type follows from its annotation (``float`` → :data:`Number`, ``int`` → :data:`Integer`,
+    ``bool`` → :data:`Bool`, ``str`` → :data:`Text`, ``tuple`` → :data:`Numbers`); ``leaves`` overrides it
+    per field (e.g. a list of energies: a grid). Keys are optional unless in ``required`` (the dataclass
+    applies its own defaults and range checks when the Scene is built). An annotation without a leaf type is an
+    error at import: a new field must say how a file writes it.
+    """
+    leaves = leaves or {}
+    fields = {}
+    for f in dataclasses.fields(cls):
+        if f.name in exclude or not f.init:
+            continue
+        leaf = leaves.get(f.name) or _LEAF_OF.get(str(f.type))
+        if leaf is None:
+            raise TypeError(f"{cls.__name__}.{f.name}: no file type for annotation {f.type!r} (add it to _LEAF_OF "
+                            "or pass leaves=)")
+        fields[f.name] = (leaf, ... if f.name in required else None)
+    return create_model(name, __base__=_Table, __doc__=doc, **fields)
+
+
+SectionsTable = table_of(SectionWindow, "SectionsTable",
+                         "``[sections]``: which crossings of the section to record (SectionWindow's fields).")
+FollowTable = table_of(Follow, "FollowTable", "``[follow]``: escaped orbits followed to r_far (conservative "
+                       "scenes), crossings of these radii recorded (Follow's fields).", required=("radii",))
+SceneTable = table_of(Scene, "SceneTable", "``[scene]`` of a scene file: the Scene fields (energy and gamma may be "
+                      "lists: a grid).", exclude=("sections", "snapshots", "follow"),
+                      leaves={"energy": NumberOrNumbers, "gamma": NumberOrNumbers, "region": OneOf(*REGIONS)})
 
 
 class SnapshotsTable(_Table):
@@ -149,39 +215,9 @@ class SnapshotsTable(_Table):
         return self
 
 
-class FollowTable(_Table):
-    """``[follow]``: escaped orbits followed to r_far (conservative scenes), crossings of these radii recorded."""
-
-    radii: Numbers
-
-
-class SceneTable(_Table):
-    """``[scene]`` of a scene file: the Scene fields (energy and gamma may be lists: a grid)."""
-
-    energy: NumberOrNumbers = None
-    gamma: NumberOrNumbers = None
-    n: Integer = None
-    seed: Integer = None
-    region: OneOf(*REGIONS) = None
-    radius: Number = None
-    r_esc: Number = None
-    r_far: Number = None
-    t_max: Number = None
-    tol: Number = None
-    omega: Number = None
-    lam: Number = None
-    chunk_size: Integer = None
-    batch_size: Integer = None
-    ics: Text = None
-    continue_settled: Bool = None
-    name: Text = None
-
-
-class StudySceneTable(SceneTable):
-    """``[scene]`` of a study.toml: one scene's fields (no grid: a study makes its runs itself)."""
-
-    energy: Number = None
-    gamma: Number = None
+StudySceneTable = table_of(Scene, "StudySceneTable", "``[scene]`` of a study.toml: one scene's fields (no grid: "
+                           "a study makes its runs itself).", exclude=("sections", "snapshots", "follow"),
+                           leaves={"region": OneOf(*REGIONS)})
 
 
 class AboutTable(_Table):
@@ -194,7 +230,41 @@ class AboutTable(_Table):
 
 
 class StudyParams(_Table):
-    """Base of a study's ``Params``: the keys of its ``[study]`` table, strictly typed; no other key is allowed."""
+    """Base of a study's ``Params``: the keys of its ``[study]`` table, strictly typed; no other key is allowed.
+
+    A study declares ``class Params(StudyParams)`` with one field per key (leaf types :data:`Number`,
+    :data:`Integer`, :data:`Numbers`, …, a default where the key is optional); study.toml is checked against it
+    when the study is loaded, and the study's code reads ``study.params.<key>``, converted by
+    :func:`typed_params` (Number → float, Integer → int, Numbers → list of floats, …).
+    """
+
+
+def typed_params(model: type[BaseModel], raw: dict) -> BaseModel:
+    """typed_params(Params, raw) -> a ``Params`` instance: each key of ``raw`` (a checked ``[study]`` table), or the
+    field's default, converted to the Python type its leaf type declares. ``raw`` must have passed the file check
+    (:func:`validate_study_file`); a required key missing from it is a :class:`ConfigError`.
+
+    Examples
+    --------
+    >>> from hhscatter.scene.schema import Integer, Numbers, StudyParams, typed_params
+    >>> class Params(StudyParams):
+    ...     energies: Numbers
+    ...     n: Integer = 10
+    >>> p = typed_params(Params, {"energies": [0.3, 1]})
+    >>> p.energies, p.n
+    ([0.3, 1.0], 10)
+    """
+    values = {}
+    for name, f in model.model_fields.items():
+        if name in raw:
+            v = raw[name]
+        elif not f.is_required():
+            v = copy.deepcopy(f.default)
+        else:
+            raise ConfigError(f"[study] needs {name!r} ({model.__name__} declares it without a default)")
+        conv = next((m.to for m in f.metadata if isinstance(m, _Convert)), None)
+        values[name] = conv(v) if conv is not None and v is not None else v
+    return model.model_construct(**values)
 
 
 _SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable}
@@ -233,17 +303,6 @@ def study_file_model(params: type[BaseModel] | None):
 
 
 # -- messages ------------------------------------------------------------------------------------
-def _show(v) -> str:
-    """A value as TOML writes it (true/false, quoted strings, [lists])."""
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, dict):
-        return "a table"
-    if isinstance(v, list):
-        return "[" + ", ".join(_show(x) for x in v) + "]"
-    return repr(v)
-
-
 def _fields(node) -> list | None:
     """The keys a model (or dict[str, model] value) allows, or None for a leaf."""
     if isinstance(node, type) and issubclass(node, BaseModel):
@@ -402,3 +461,78 @@ def apply_convention(doc: dict, conventions: dict, source: str, conventions_sour
     out = copy.deepcopy(doc)
     out["scene"] = {**copy.deepcopy(given), **out.get("scene", {})}
     return out
+
+
+# -- scene files -> Scene --------------------------------------------------------------------------
+def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
+    """scene_dict_from_toml(path, scale=None, **overrides) -> the raw scene dict of a TOML file.
+
+    What :func:`load_scene` validates; values may still be lists (a grid, see
+    :mod:`hhscatter.scene.grid`).
+    """
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"scene file not found: {path}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"scene file {path} is not valid TOML: {exc}") from None
+    if "scene" not in doc:
+        raise ConfigError(f"scene file {path} has no [scene] table")
+    validate_scene_file(doc, str(path))  # every table, key and type, before any work
+    d = dict(doc["scene"])
+    d.setdefault("name", path.parent.name)
+    if "sections" in doc:
+        d["sections"] = doc["sections"]
+    if "snapshots" in doc:
+        d["snapshots"] = doc["snapshots"]
+    if "follow" in doc:
+        d["follow"] = doc["follow"]
+    if scale is not None and scale != "quick":
+        scales = doc.get("scale", {})
+        if scale not in scales:
+            raise ConfigError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
+        d.update(scales[scale])
+    d.update({k: v for k, v in overrides.items() if v is not None})
+    return d
+
+
+def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrides: object) -> Scene:
+    """A Scene from a TOML file.
+
+    Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow fields), ``[snapshots]``
+    (``times = [...]`` or ``start/stop/step``) and ``[scale.<name>]`` tables whose keys override
+    ``[scene]`` when ``scale`` is given. A file whose ``energy`` or ``gamma`` is a list is a grid: load it
+    with :func:`hhscatter.load_run`.
+
+    Parameters
+    ----------
+    path : path
+        The TOML file.
+    scale : str, optional
+        Name of a ``[scale.<name>]`` table to apply.
+    **overrides
+        Scene fields applied last.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ConfigError
+        An unknown table or key (with a did-you-mean), a value out of range, or a grid file.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, hhscatter
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "scene.toml"
+    >>> _ = f.write_text("[scene]\\nenergy = 0.3\\nn = 1000\\n[scale.paper]\\nn = 10000000\\n")
+    >>> hhscatter.load_scene(f).n, hhscatter.load_scene(f, "paper").n, hhscatter.load_scene(f, n=5).n
+    (1000, 10000000, 5)
+    """
+    d = scene_dict_from_toml(path, scale, **overrides)
+    for k in ("energy", "gamma"):
+        if isinstance(d.get(k), (list, tuple)):
+            raise ConfigError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
+    return scene_from_dict(d)

@@ -21,6 +21,7 @@ from hhscatter.run.runner import SCENE_FILE, simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
 from hhscatter.scene.schema import (
     apply_convention,
+    typed_params,
     did_you_mean,
     merge_tables,
     validate_conventions_file,
@@ -72,6 +73,35 @@ def study_names(root: Path | None = None) -> list[str]:
         raise StudyError(str(exc)) from None
 
 
+class ParamsView:
+    """A study's typed ``Params`` (attribute access), recording each key read while ``study.params_read`` is a set.
+
+    Without a ``Params`` model (a study folder without code) the keys are the raw ``[study]`` table's.
+    """
+
+    __slots__ = ("_study", "_typed", "_raw")
+
+    def __init__(self, study, typed, raw: dict):
+        self._study, self._typed, self._raw = study, typed, raw
+
+    def __getattr__(self, key: str):
+        study, typed = self._study, self._typed
+        if typed is not None:
+            if key not in type(typed).model_fields:
+                raise StudyError(f"study {study.name} reads [study] {key!r}, which its Params does not declare")
+            value = getattr(typed, key)
+        elif key in self._raw:
+            value = self._raw[key]
+        else:
+            raise StudyError(f"{study.root / 'study.toml'}: [study] needs '{key}'")
+        if study.params_read is not None:
+            study.params_read.add(key)
+        return value
+
+    def __repr__(self) -> str:
+        return f"ParamsView({self._typed!r})" if self._typed is not None else f"ParamsView({self._raw!r})"
+
+
 @dataclass
 class Study:
     """A study at one scale: its merged configuration and its output paths.
@@ -110,12 +140,23 @@ class Study:
         return outputs_root(self.root.parent) / self.name / "out" / self.scale
 
     @property
-    def params(self) -> dict:
-        """The ``[study]`` table (after scale overrides)."""
+    def raw_params(self) -> dict:
+        """The ``[study]`` table as written in study.toml (after scale overrides)."""
         return self.config.get("study", {})
+
+    @property
+    def params(self) -> ParamsView:
+        """The study's typed parameters: ``study.params.<key>`` is ``[study].<key>`` (or the default its ``Params``
+        declares) converted to the declared type (Number → float, Integer → int, Numbers → list of floats, …;
+        :func:`hhscatter.scene.schema.typed_params`). A key ``Params`` does not declare is a :class:`StudyError`;
+        keys read while the simulate stage runs are recorded (``raw/done.json``)."""
+        raw = self.raw_params  # made on each access: a fresh view of the current table (its lists are copies)
+        return ParamsView(self, typed_params(self.params_model, raw) if self.params_model is not None else None, raw)
 
     def param(self, key, default=None):
         """param(key) -> value of ``[study].key`` as written in study.toml, else the default its ``Params`` declares.
+
+        The raw value (a TOML 1 is an int); study code reads :attr:`params` instead, typed.
 
         A key the study's ``Params`` does not declare is an error (the study
         file was checked against it when loaded, so this catches code that
@@ -124,7 +165,7 @@ class Study:
         """
         if self.params_read is not None:
             self.params_read.add(key)
-        p = self.params
+        p = self.raw_params
         if key in p:
             return p[key]
         if self.params_model is not None:

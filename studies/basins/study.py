@@ -97,8 +97,8 @@ def scan_unc_key(E, i):
 
 def _scan(study):
     """(energies, ε) of the γ = 0 energy scan (issue 25, point 5); energies must lie above E_c."""
-    energies = [float(E) for E in study.param("scan_energies")]
-    eps = np.asarray(study.param("scan_eps"), dtype=float)
+    energies = list(study.params.scan_energies)
+    eps = np.asarray(study.params.scan_eps)
     if energies:
         ec = study.model.critical_energy
         if min(energies) <= ec:
@@ -109,7 +109,7 @@ def _scan(study):
 
 
 def _eps(study):
-    eps = np.asarray(study.param("eps"), dtype=float)
+    eps = np.asarray(study.params.eps)
     if not (eps.size >= 2 and np.all(eps > 0) and np.all(np.diff(eps) < 0)):
         raise ValueError("basins [study].eps must be decreasing positive numbers")
     return eps
@@ -151,7 +151,7 @@ def _uncertainty_states(study, E, i, eps, n=None, seed_offset=0):
     """Fresh reference ICs for ε index i (uniform on the allowed square) and their copies shifted by ε in x."""
     from hhscatter.scene.ics import perturbed_on_section, region_ics
 
-    n = int(study.param("n_uncertainty")) if n is None else int(n)
+    n = study.params.n_uncertainty if n is None else int(n)
     seed = int(study.config["scene"]["seed"]) * 100 + seed_offset + i
     ref = region_ics(study.scene("unc", energy=E, region="square", n=n, seed=seed), 0, n)
     moved, ok = perturbed_on_section(study.model, ref, E, dx=float(eps))
@@ -195,8 +195,8 @@ def zoom_centre(labels, extent, box=5, clearance=0):
 def _zoom_centre(study, extent, n):
     """The zooms' centre: the most mixed box of the γ = 0 map at zoom_energy whose widest zoom window (the
     smallest factor) lies wholly in the allowed region."""
-    Ez = float(study.param("zoom_energy"))
-    clearance = math.ceil(math.sqrt(2.0) * n / (2.0 * min(float(f) for f in study.param("zoom_factors"))))
+    Ez = study.params.zoom_energy
+    clearance = math.ceil(math.sqrt(2.0) * n / (2.0 * min(study.params.zoom_factors)))
     return zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
 
 
@@ -219,28 +219,27 @@ def basin_image(study, key, E, extent, n):
 
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None: basin maps, zooms and uncertainty runs, each through the runner."""
-    extent = tuple(float(v) for v in study.param("extent"))
-    n = int(study.param("grid"))
+    extent = tuple(study.params.extent)
+    n = study.params.grid
     eps = _eps(study)
-    for E in study.param("energies"):
-        for g in study.param("gammas"):
+    for E in study.params.energies:
+        for g in study.params.gammas:
             _run_table(study, map_key(E, g), _map_states(study, E, extent, n)[3], g, workers, progress)
             for i, e in enumerate(eps):
                 _run_table(study, unc_key(E, g, i), _uncertainty_states(study, E, i, e), g, workers, progress)
-    Ez = float(study.param("zoom_energy"))
+    Ez = study.params.zoom_energy
     centre = _zoom_centre(study, extent, n)
-    for g in study.param("zoom_gammas"):
-        for f in study.param("zoom_factors"):
+    for g in study.params.zoom_gammas:
+        for f in study.params.zoom_factors:
             ext = _zoom_extent(extent, centre, f)
-            _run_table(study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, int(study.param("zoom_grid")))[3],
+            _run_table(study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, study.params.zoom_grid)[3],
                        g, workers, progress)
     scan_E, scan_eps = _scan(study)
-    ns = int(study.param("scan_grid"))
+    ns = study.params.scan_grid
     for E in scan_E:
         _run_table(study, scan_map_key(E), _map_states(study, E, extent, ns)[3], 0.0, workers, progress)
         for i, e in enumerate(scan_eps):
-            _run_table(study, scan_unc_key(E, i), _uncertainty_states(study, E, i, e, int(study.param(
-                "scan_n_uncertainty")), seed_offset=50), 0.0, workers, progress)
+            _run_table(study, scan_unc_key(E, i), _uncertainty_states(study, E, i, e, study.params.scan_n_uncertainty, seed_offset=50), 0.0, workers, progress)
 
 
 # -- analyze ---------------------------------------------------------------------------
@@ -284,42 +283,42 @@ def analyze(study):
     )
     from hhscatter.analysis.geometry.channels import channel_fractions
 
-    extent = tuple(float(v) for v in study.param("extent"))
-    n = int(study.param("grid"))
+    extent = tuple(study.params.extent)
+    n = study.params.grid
     eps = _eps(study)
     ec = study.model.critical_energy
-    boxes = [int(b) for b in study.param("boxes")]
-    hb = int(study.param("box_headline"))
+    boxes = list(study.params.boxes)
+    hb = study.params.box_headline
     maps, ent_rows, unc_tabs, per, loc_tabs = [], [], [], [], []
     E_b, E_b_err = _upstream_value(study, "kappa", "E_b_key")
     mu, mu_err = _upstream_value(study, "mu", "mu_key")
-    for E in study.param("energies"):
-        for g in study.param("gammas"):
+    for E in study.params.energies:
+        for g in study.params.gammas:
             img = basin_image(study, map_key(E, g), E, extent, n)
             maps.append(pd.DataFrame({"energy": E, "gamma": g, "label": img.ravel()}))
             fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
             ent = basin_entropy_table(img, boxes, outside=OUTSIDE).assign(energy=E, gamma=g)
             ent_rows.append(ent)
-            present = [c for c, share in zip(CODES, fr.frac) if share >= float(study.param("wada_min_share"))]
-            wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
+            present = [c for c, share in zip(CODES, fr.frac) if share >= study.params.wada_min_share]
+            wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=study.params.wada_r)
             # the potential is three-fold symmetric, the square [−1, 1]² is not: test the exits' shares on
             # a rotation-invariant part of the map, the allowed cells with r < symmetry_radius
             gx, gy = _map_states(study, E, extent, n)[:2]
             r = np.hypot(*np.meshgrid(gx, gy))
-            chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < float(study.param("symmetry_radius")))])
+            chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < study.params.symmetry_radius)])
             times = []
             unc = _uncertainty(study, E, g, eps, times=times)
             unc_tabs.append(unc)
             # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
             # settled (and trapped) cells masked as outside
             exits = [c for c in present if c in (0, 1, 2)]
-            wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
+            wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
                       if len(exits) >= 3 else None)
             loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
             loc_tabs.append(loc)
             slim = slim_fractal(loc)
             rate = _rate(eps, times) if g == 0 else None
-            ok = unc["k"] >= int(study.param("fit_min_count"))
+            ok = unc["k"] >= study.params.fit_min_count
             fit = cut = None
             if ok.sum() >= 3:
                 rng = (float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max()))
@@ -371,15 +370,15 @@ def analyze(study):
     cut_pred = _cutoff_prediction(per, scan, mu, mu_err, ec)
     trend = _energy_trend(scan, E_b)
     zooms = []
-    Ez = float(study.param("zoom_energy"))
+    Ez = study.params.zoom_energy
     centre = _zoom_centre(study, extent, n)
-    for g in study.param("zoom_gammas"):
-        for f in study.param("zoom_factors"):
+    for g in study.params.zoom_gammas:
+        for f in study.params.zoom_factors:
             ext = _zoom_extent(extent, centre, f)
-            img = basin_image(study, zoom_key(Ez, g, f), Ez, ext, int(study.param("zoom_grid")))
+            img = basin_image(study, zoom_key(Ez, g, f), Ez, ext, study.params.zoom_grid)
             zooms.append(pd.DataFrame({"gamma": g, "factor": f, "x0": ext[0], "x1": ext[1], "y0": ext[2],
                                        "y1": ext[3], "label": img.ravel()}))
-    study.write_table(pd.concat(zooms, ignore_index=True), "basins_zooms.parquet", grid=int(study.param("zoom_grid")))
+    study.write_table(pd.concat(zooms, ignore_index=True), "basins_zooms.parquet", grid=study.params.zoom_grid)
     for p in per:
         tag = f"E0={p['energy']:g}, γ={p['gamma']:g}"
         if p["alpha"]:
@@ -401,8 +400,8 @@ def analyze(study):
         "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
         "zoom_centre": list(centre), "per_point": per,
         "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
-                                                           f"{study.param('E_b_key')}"},
-        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.param('mu_key')}"},
+                                                           f"{study.params.E_b_key}"},
+        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
         "cutoff_prediction": cut_pred,
         "energy_scan": scan.to_dict(orient="records"),
         "energy_trend": trend,
@@ -414,7 +413,7 @@ def _upstream_value(study, role, key_param):
     """(value, err) of a number in the JSON of the study [needs].role, at the dotted path [study].key_param."""
     from hhscatter.studies import _upstream as up
 
-    v, e = up.lookup(up.numbers(study, study.upstream(role)), study.param(key_param),
+    v, e = up.lookup(up.numbers(study, study.upstream(role)), getattr(study.params, key_param),
                      what=f"{study.upstream(role)}.json")
     return float(v), float(e)
 
@@ -448,19 +447,19 @@ def _energy_scan(study, extent, boxes, hb, E_b):
     )
 
     energies, eps = _scan(study)
-    ns = int(study.param("scan_grid"))
+    ns = study.params.scan_grid
     rows, uncs = [], []
     for E in energies:
         img = basin_image(study, scan_map_key(E), E, extent, ns)
         fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
         ent = basin_entropy_table(img, [b for b in boxes if b <= ns // 4], outside=OUTSIDE).set_index("box")
-        exits = [c for c in (0, 1, 2) if fr.frac[c] >= float(study.param("wada_min_share"))]
-        w = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=int(study.param("wada_r")))
+        exits = [c for c in (0, 1, 2) if fr.frac[c] >= study.params.wada_min_share]
+        w = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
              if len(exits) >= 3 else None)
         times = []
         unc = _uncertainty(study, E, 0.0, eps, keys=[scan_unc_key(E, i) for i in range(len(eps))], times=times)
         uncs.append(unc)
-        ok = unc["k"] >= int(study.param("fit_min_count"))
+        ok = unc["k"] >= study.params.fit_min_count
         fit = None
         if ok.sum() >= 3:
             fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"],
@@ -487,7 +486,7 @@ def _kantz_grassberger(study, scan):
     (its own runs, interpolated linearly in E; NaN outside its energies)."""
     from hhscatter.studies import _upstream as up
 
-    rows, _ = up.lookup(up.numbers(study, study.upstream("kappa")), study.param("kappa_energy_key"),
+    rows, _ = up.lookup(up.numbers(study, study.upstream("kappa")), study.params.kappa_energy_key,
                         what=f"{study.upstream('kappa')}.json")
     k = pd.DataFrame(rows).sort_values("energy")
     if scan.empty:

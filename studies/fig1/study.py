@@ -70,9 +70,9 @@ def _pilot_scene(study, energy):
     return study.scene(
         f"pilot_{energy_key(energy)}",
         energy=float(energy),
-        n=int(study.param("pilot_n")),
-        seed=int(study.param("pilot_seed")),
-        t_max=float(study.param("pilot_t_max")),
+        n=study.params.pilot_n,
+        seed=study.params.pilot_seed,
+        t_max=study.params.pilot_t_max,
         sections=None,
         snapshots=None,
     )
@@ -98,7 +98,7 @@ def _main_scene(study, energy, t_rec):
     return study.scene(
         energy_key(energy),
         energy=float(energy),
-        t_max=float(t_rec + float(study.param("t_after"))),
+        t_max=float(t_rec + study.params.t_after),
         # the first crossing after t_rec is all this run needs: the orbit stops there
         sections={"t_from": float(t_rec), "first_only": True, "stop": True},
         snapshots=None,
@@ -117,11 +117,11 @@ def simulate(study, workers=None, progress=True):
     from hhscatter.studies import write_json_atomic
 
     choices = {}
-    for energy in study.param("energies"):
+    for energy in study.params.energies:
         pdir = study.run(f"pilot_{energy_key(energy)}", _pilot_scene(study, energy), workers=workers,
                          progress=progress)
         r = _pilot_rate(pdir)
-        t_rec = recording_time(r.kappa, r.tau0, float(study.param("rec_efolds")))
+        t_rec = recording_time(r.kappa, r.tau0, study.params.rec_efolds)
         print(f"  fig1 E={energy}: pilot κ = {r.kappa:.4f} ± {r.kappa_err:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}",
               flush=True)
         study.run(energy_key(energy), _main_scene(study, energy, t_rec), workers=workers, progress=progress)
@@ -145,10 +145,10 @@ def analyze(study):
 
     model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
     E_C = model.critical_energy
-    rec_efolds = float(study.param("rec_efolds"))
+    rec_efolds = study.params.rec_efolds
     choices = json.loads(_choices_path(study).read_text())
     per_energy, points = {}, []
-    for energy in study.param("energies"):
+    for energy in study.params.energies:
         key = energy_key(energy)
         ch = choices[key]
         t_rec = float(ch["t_rec"])
@@ -194,13 +194,13 @@ def analyze(study):
                       description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec; "
                                   "energy = the run's E, e_cross = the orbit's energy at the crossing")
 
-    h = float(study.param("grid_half_width"))
-    m = int(study.param("grid_points"))
+    h = study.params.grid_half_width
+    m = study.params.grid_points
     g = np.linspace(-h, h, m)
     X, Y = np.meshgrid(g, g)
     study.write_table(pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": model.potential(X, Y).ravel()}),
                       "potential_grid.parquet", description=f"V(x, y) on a {m}×{m} grid, Eq. (eqn:hh_potential)")
-    levels = contour_levels(int(study.param("n_contours")))
+    levels = contour_levels(study.params.n_contours)
     study.write_numbers({
         "sprinkler_rule": "t_rec = ceil(tau0 + rec_efolds/kappa), kappa and tau0 from the pilot run's Kaplan-Meier "
                           "P(t) (escape_rate: mean of 4 window fits); main run records the first section crossing "

@@ -100,10 +100,10 @@ def sq_key(energy: float) -> str:
 
 def grid_n(study, energy: float) -> int:
     """grid_n(study, E) -> orbits of the κ(E) run at E: [study].grid_n_by_energy if given, else grid_n."""
-    per = study.param("grid_n_by_energy")
+    per = study.params.grid_n_by_energy
     if per is None:
-        return int(study.param("grid_n"))
-    grid = [float(e) for e in study.param("grid_energies")]
+        return study.params.grid_n
+    grid = list(study.params.grid_energies)
     if len(per) != len(grid):
         raise ValueError(f"[study].grid_n_by_energy has {len(per)} entries, grid_energies {len(grid)}")
     return int(per[int(np.argmin(np.abs(np.asarray(grid) - energy)))])
@@ -148,10 +148,10 @@ def _t_max_choice(study, pilot_dir, n):
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
     return choose_t_max(
         t_end, obs, n,
-        min_survivors=float(study.param("min_survivors")),
-        margin_efolds=float(study.param("margin_efolds")),
-        t_min=float(study.param("t_max_min")),
-        t_cap=float(study.param("t_max_cap")),
+        min_survivors=study.params.min_survivors,
+        margin_efolds=study.params.margin_efolds,
+        t_min=study.params.t_max_min,
+        t_cap=study.params.t_max_cap,
     )
 
 
@@ -160,14 +160,14 @@ def _grid_rate(study, energy, lifetimes=None):
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
     lt = _lifetimes(study.raw(grid_key(energy))) if lifetimes is None else lifetimes
-    return escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=float(study.param("min_survivors")))
+    return escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=study.params.min_survivors)
 
 
 def _cm_windows(study, energy):
     r = _grid_rate(study, energy)
-    shifts = [float(v) for v in study.param("cm_start_shifts")]
-    return r, cmeasure_windows(r.kappa, r.tau0, float(study.param("cm_rec_efolds")),
-                               float(study.param("cm_sample_efolds")), float(study.param("cm_margin")),
+    shifts = list(study.params.cm_start_shifts)
+    return r, cmeasure_windows(r.kappa, r.tau0, study.params.cm_rec_efolds,
+                               study.params.cm_sample_efolds, study.params.cm_margin,
                                max(shifts))
 
 
@@ -186,39 +186,39 @@ def simulate(study, workers=None, progress=True):
     from hhscatter.studies import write_json_atomic
 
     choices = {"t_max": {}, "cmeasure": {}}
-    grid = [float(e) for e in study.param("grid_energies")]
-    off = [e for e in study.param("square_energies") if not np.isclose(grid, e).any()]
+    grid = list(study.params.grid_energies)
+    off = [e for e in study.params.square_energies if not np.isclose(grid, e).any()]
     if off:
         raise ValueError(f"[study].square_energies must be among grid_energies; {off} are not")
-    missing = [e for e in study.param("cm_energies") if not np.isclose(grid, e).any()]
+    missing = [e for e in study.params.cm_energies if not np.isclose(grid, e).any()]
     if missing:
         raise ValueError(f"[study].cm_energies must be among grid_energies (t_rec comes from their κ); {missing} are not")
     for energy in grid:
-        pilot = study.scene(f"pilot_E{energy:.3f}", energy=energy, n=int(study.param("pilot_n")),
-                            seed=int(study.param("pilot_seed")), t_max=float(study.param("pilot_t_max")))
+        pilot = study.scene(f"pilot_E{energy:.3f}", energy=energy, n=study.params.pilot_n,
+                            seed=study.params.pilot_seed, t_max=study.params.pilot_t_max)
         pdir = study.run(f"pilot_E{energy:.3f}", pilot, workers=workers, progress=progress)
         n = grid_n(study, energy)
         choice = _t_max_choice(study, pdir, n)
         choices["t_max"][grid_key(energy)] = asdict(choice)
         scene = study.scene(grid_key(energy), energy=energy, n=n, t_max=choice.t_max)
         study.run(grid_key(energy), scene, workers=workers, progress=progress)
-        if any(np.isclose(energy, e) for e in study.param("square_energies")):
+        if any(np.isclose(energy, e) for e in study.params.square_energies):
             # the authors' square ICs (goodICs), same n, seed and t_max: KAM-trapped orbits run to t_max
             sq = study.scene(sq_key(energy), energy=energy, n=n, t_max=choice.t_max, region="square")
             study.run(sq_key(energy), sq, workers=workers, progress=progress)
-    for energy, n in zip(study.param("pt_energies"), study.param("pt_n")):
-        scene = study.scene(pt_key(energy), energy=float(energy), n=int(n), seed=int(study.param("pt_seed")),
-                            t_max=float(study.param("pt_t_max")))
+    for energy, n in zip(study.params.pt_energies, study.params.pt_n):
+        scene = study.scene(pt_key(energy), energy=float(energy), n=int(n), seed=study.params.pt_seed,
+                            t_max=study.params.pt_t_max)
         study.run(pt_key(energy), scene, workers=workers, progress=progress)
-    for energy in study.param("cm_energies"):
+    for energy in study.params.cm_energies:
         energy = float(energy)
         r, (t_rec, t_samp, t_rec_end) = _cm_windows(study, energy)
         choices["cmeasure"][cm_key(energy)] = {"energy": energy, "kappa": r.kappa, "tau0": r.tau0, "t_rec": t_rec,
                                                "t_sample_end": t_samp, "t_record_end": t_rec_end}
         print(f"  fig2 c-measure E={energy}: κ = {r.kappa:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}, "
               f"recording to {t_rec_end:.2f}", flush=True)
-        scene = study.scene(cm_key(energy), energy=energy, n=int(study.param("cm_n")),
-                            seed=int(study.param("cm_seed")), t_max=float(study.param("cm_t_max")),
+        scene = study.scene(cm_key(energy), energy=energy, n=study.params.cm_n,
+                            seed=study.params.cm_seed, t_max=study.params.cm_t_max,
                             sections={"t_from": t_rec, "t_to": t_rec_end, "first_only": False})
         study.run(cm_key(energy), scene, workers=workers, progress=progress)
     write_json_atomic(_choices_path(study), choices)
@@ -248,7 +248,7 @@ def _analyze_grid(study):
     E_C = study.model.critical_energy
     rows, runs = [], {}
     tmax_choices = json.loads(_choices_path(study).read_text())["t_max"]
-    for energy in study.param("grid_energies"):
+    for energy in study.params.grid_energies:
         energy = float(energy)
         path = study.raw(grid_key(energy))
         tch = tmax_choices[grid_key(energy)]
@@ -270,8 +270,8 @@ def _analyze_grid(study):
     df = pd.DataFrame(rows)
     study.write_table(df, "kappa_energy.parquet",
                       description="κ0(E): mean of 4 least-squares fits of log P(t) (escape_rate), Fig. 2b")
-    seed = int(study.param("fit_seed"))
-    n_boot = int(study.param("n_boot"))
+    seed = study.params.fit_seed
+    n_boot = study.params.n_boot
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fit = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=True,
@@ -329,15 +329,15 @@ def _analyze_pt(study):
 
     E_C = study.model.critical_energy
     curves, lines, numbers = [], [], {}
-    for energy in study.param("pt_energies"):
+    for energy in study.params.pt_energies:
         energy = float(energy)
         key = pt_key(energy)
         # the lean route (t_end and the observed mask only, 9 bytes per orbit): these runs have 1e7 orbits
         t_end, obs = survival_arrays(study.raw(key))
         pa.default_memory_pool().release_unused()
         t_max = float(_scene_of(study.raw(key))["t_max"])
-        r = escape_rate(t_end, obs, detect_tail=False, min_survivors=float(study.param("min_survivors")))
-        tail = escaping_tail(t_end, obs, r.tau0, r.fits[0], min_survivors=float(study.param("tail_min_survivors")))
+        r = escape_rate(t_end, obs, detect_tail=False, min_survivors=study.params.min_survivors)
+        tail = escaping_tail(t_end, obs, r.tau0, r.fits[0], min_survivors=study.params.tail_min_survivors)
         # P(t) of all orbits (Kaplan–Meier) and of the escaping ones, for the figure
         t_last = float(np.max(t_end))
         g = _plot_grid(t_last)
@@ -419,9 +419,9 @@ def _analyze_cmeasure(study, grid_runs):
     E_C = study.model.critical_energy
 
     rows = []
-    n_boot = int(study.param("n_boot"))
+    n_boot = study.params.n_boot
     choices = json.loads(_choices_path(study).read_text())["cmeasure"]
-    for energy in study.param("cm_energies"):
+    for energy in study.params.cm_energies:
         energy = float(energy)
         key = cm_key(energy)
         ch = choices[key]
@@ -434,9 +434,9 @@ def _analyze_cmeasure(study, grid_runs):
         lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "t_end"], categorical=True)
         sec = read_sections(study.raw(key), columns=["traj_id", "t"])
         own = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
-                          min_survivors=float(study.param("min_survivors")))
+                          min_survivors=study.params.min_survivors)
         span = t_samp - t_rec
-        for shift in study.param("cm_start_shifts"):
+        for shift in study.params.cm_start_shifts:
             t0 = t_rec + float(shift) / ch["kappa"]
             t1 = t0 + span
             with warnings.catch_warnings():
@@ -447,7 +447,7 @@ def _analyze_cmeasure(study, grid_runs):
                 continue
             # bootstrap over orbits (the independent unit), not over their correlated section crossings
             k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot,
-                                    rng=int(study.param("fit_seed")))
+                                    rng=study.params.fit_seed)
             rows.append({
                 "energy": energy, "x": energy - E_C, "shift_efolds": float(shift), "t_from": t0, "t_to": t1,
                 "t_record_end": t_rec_end, "n_samples": k.n_samples, "n_exit": k.n_exit, "n_undetermined": n_und,
@@ -517,12 +517,12 @@ def _analyze_conventions(study, grid_runs):
     from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     E_C = study.model.critical_energy
-    p_hi, p_lo = (float(v) for v in study.param("p_levels"))
-    max_bias = float(study.param("max_plateau_bias"))
-    min_surv = float(study.param("min_survivors"))
-    squares = [float(e) for e in study.param("square_energies")]
+    p_hi, p_lo = study.params.p_levels
+    max_bias = study.params.max_plateau_bias
+    min_surv = study.params.min_survivors
+    squares = list(study.params.square_energies)
     rows = []
-    for energy in (float(e) for e in study.param("grid_energies")):
+    for energy in study.params.grid_energies:
         runs = {"disk": grid_runs[energy]}  # the Fig. 2b run, already read and fitted
         if any(np.isclose(energy, e) for e in squares):
             lt = _lifetimes(study.raw(sq_key(energy)))
@@ -540,14 +540,14 @@ def _analyze_conventions(study, grid_runs):
                              "trapped_fraction": r.trapped_fraction, "bias_at_end": r.bias_at_end,
                              "defined": bool(r.defined), "reason": r.reason})
     table = pd.DataFrame(rows)
-    stab = stable_energies(table, rel_tol=float(study.param("stable_rel_tol")))
+    stab = stable_energies(table, rel_tol=study.params.stable_rel_tol)
     table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
     study.write_table(table, "kappa_conventions.parquet",
                       description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
                                   "defined = False where the trapped plateau makes κ ill-defined")
     stable = set(stab.loc[stab["stable"], "energy"])
     fits, fit_info = {}, {}
-    seed, n_boot = int(study.param("fit_seed")), int(study.param("n_boot"))
+    seed, n_boot = study.params.fit_seed, study.params.n_boot
     for name, *_ in CONVENTIONS:
         d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(stable)]
         fit_info[name] = {"energies": [float(e) for e in d["energy"]]}
@@ -564,7 +564,7 @@ def _analyze_conventions(study, grid_runs):
     numbers = {
         "conventions": {name: label for name, _, _, label in CONVENTIONS},
         "p_levels": [p_hi, p_lo], "max_plateau_bias": max_bias,
-        "stable_rel_tol": float(study.param("stable_rel_tol")),
+        "stable_rel_tol": study.params.stable_rel_tol,
         "stable_energies": sorted(float(e) for e in stable),
         "unstable_energies": sorted(float(e) for e in stab.loc[~stab["stable"], "energy"]),
         "ill_defined": [{"energy": r.energy, "convention": r.convention, "reason": r.reason}

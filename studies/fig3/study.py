@@ -83,7 +83,7 @@ def _key(study) -> str:
 
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None: one engine run with snapshots, settled orbits continued."""
-    grid = snapshot_grid(study.param("snapshot_grid"))
+    grid = snapshot_grid(study.params.snapshot_grid)
     key = _key(study)
     scene = study.scene(key, snapshots=tuple(grid), continue_settled=True)
     if not scene.dissipative:
@@ -126,31 +126,31 @@ def analyze(study):
     me = me.merge(ma[["t", "n_above", "mean_E_above", "sem_E_above"]], on="t", how="left")
     me["n_above"] = me["n_above"].fillna(0).astype(np.int64)
 
-    window = tuple(float(v) for v in study.param("fit_window"))
+    window = tuple(study.params.fit_window)
     fit = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, window)
     me["fit_E"] = E0 * np.exp(-fit.mu * gamma * me["t"])
 
-    later = [tuple(map(float, w)) for w in study.param("later_windows")]
-    width, stride = (float(v) for v in study.param("sliding_window"))
+    later = [tuple(w) for w in study.params.later_windows]
+    width, stride = study.params.sliding_window
     t_last = float(me["t"].max())
     sliding = [(lo, lo + width) for lo in np.arange(0.0, t_last - width + 1e-9, stride)]
-    alt = tuple(float(v) for v in study.param("alt_window"))
+    alt = tuple(study.params.alt_window)
     windows = [window] + later + sliding + [alt]
     kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding) + ["alt"]
     tab = mu_by_window(me["t"], me["mean_E"], E0, gamma, windows)
     tab["kind"] = kinds
     tab = tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
-    n_boot = int(study.param("n_boot"))
-    k = min(int(study.param("n_boot_orbits")), n_orbits)
+    n_boot = study.params.n_boot
+    k = min(study.params.n_boot_orbits, n_orbits)
     rows = _snapshot_rows(study, key, ds.field("traj_id") < k)
     boot, scale = bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot=n_boot,
-                                            seed=int(study.param("boot_seed")))
+                                            seed=study.params.boot_seed)
     # the same bootstrap for the average over orbits with E > E_c only: E decreases monotonically, so these
     # are the rows before settling (the continued rows are all below E_c). Every orbit keeps its row at
     # t = 0 (E = E0 > E_c), so the orbits, their order and, with the same seed, their Poisson
     # multiplicities are those of the replicates above: the two curves are resampled together.
     boot_up, _ = bootstrap_mu_first_orbits(rows[rows["energy"] > E_C], n_orbits, k, E0, gamma, [window, alt],
-                                           n_boot=n_boot, seed=int(study.param("boot_seed")))
+                                           n_boot=n_boot, seed=study.params.boot_seed)
     del rows
     boot["w"] = np.tile(np.arange(len(windows)), n_boot)
     err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
@@ -161,10 +161,10 @@ def analyze(study):
     tab["mean_E_mid"] = np.interp(tab["t_mid"], me["t"], me["mean_E"])
 
     # inset: histograms of log10 E at the marked times
-    hist_times = [float(v) for v in study.param("hist_times")]
+    hist_times = list(study.params.hist_times)
     at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(_nearest(me["t"].to_numpy(), hist_times))))
     lo = max(float(at["energy"].min()), 1e-12)
-    edges = np.geomspace(lo * 0.98, E0 * 1.001, int(study.param("hist_bins")) + 1)
+    edges = np.geomspace(lo * 0.98, E0 * 1.001, study.params.hist_bins + 1)
     h = energy_histograms(at, hist_times, bins=edges)
     dlog = np.diff(np.log10(edges))
     hrows = []
@@ -189,7 +189,7 @@ def analyze(study):
     resid = np.log(me["fit_E"] / me["mean_E"])
     late = (me["t"] >= 0.75 * window[1]) & (me["t"] <= window[1])
     over = float(resid[late].mean())
-    paper_mu = float(study.param("paper_mu"))
+    paper_mu = study.params.paper_mu
     tau2_pred = float(np.log(E0 / E_C) / (p["mu"] * gamma))
     tau2_pred_err = float(tau2_pred * p["mu_err"] / p["mu"])
 
@@ -242,7 +242,7 @@ def analyze(study):
         "tau2_predicted": {"value": tau2_pred, "err": tau2_pred_err},
         "hist_times": [float(v) for v in h.t],
         "n_boot": n_boot,
-        "n_boot_orbits": min(int(study.param("n_boot_orbits")), n_orbits),
+        "n_boot_orbits": min(study.params.n_boot_orbits, n_orbits),
         "paper_mu": paper_mu,
         "authors_convention": {**authors, "ribbon": {k: v for k, v in ribbon.items() if k != "rows"}},
     })
@@ -272,10 +272,10 @@ def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -
     """
     from hhscatter.analysis.dissipative.decay import fit_energy_decay
 
-    paper_mu = float(study.param("paper_mu"))
-    half = float(study.param("paper_mu_half_unit"))
-    a_sel = str(study.param("authors_selection"))
-    a_win = tuple(float(v) for v in study.param("authors_window"))
+    paper_mu = study.params.paper_mu
+    half = study.params.paper_mu_half_unit
+    a_sel = study.params.authors_selection
+    a_win = tuple(study.params.authors_window)
     if a_sel not in SELECTIONS:
         raise ValueError(f"[study] authors_selection must be one of {sorted(SELECTIONS)}, got {a_sel!r}")
     if a_win not in (window, alt):
@@ -324,9 +324,9 @@ def _ribbons(study, me) -> dict:
     deviations", the ensemble's spread) and ± 3 SEM (ours, = 3 SD/√n: how well ⟨E⟩ is known); energies in
     model units.  Also the largest half-width relative to ⟨E⟩ of each over the figure's time axis."""
     t = me["t"].to_numpy()
-    i = int(np.argmin(np.abs(t - float(study.param("ribbon_t")))))
+    i = int(np.argmin(np.abs(t - study.params.ribbon_t)))
     r = me.iloc[i]
-    t_max = study.param("plot_t_max")
+    t_max = study.params.plot_t_max
     vis = t <= (t[-1] if t_max is None else float(t_max))
     rel_sd = float((3 * me["std_E"] / me["mean_E"])[vis].max())
     rel_sem = float((3 * me["sem_E"] / me["mean_E"])[vis].max())
@@ -360,4 +360,4 @@ def plot(study):
     tab = pd.read_parquet(study.derived("fig3_mu_windows.parquet"))
     hist = pd.read_parquet(study.derived("fig3_histograms.parquet"))
     numbers = json.loads(study.numbers_path.read_text())
-    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.param("plot_t_max"))
+    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.params.plot_t_max)

@@ -80,12 +80,12 @@ def raw_key(gamma: float) -> str:
 
 
 def _gammas(study):
-    gs = [float(g) for g in study.param("gammas")]
+    gs = list(study.params.gammas)
     if 0.0 not in gs:
         raise ValueError("fig4 [study].gammas must contain 0 (the conservative reference P_0)")
     if sorted(gs) != gs or len(set(gs)) != len(gs):
         raise ValueError(f"fig4 [study].gammas must be increasing and distinct, got {gs}")
-    mg = float(study.param("mu_gamma"))
+    mg = study.params.mu_gamma
     if mg not in gs:
         raise ValueError(f"fig4 [study].mu_gamma = {mg} must be one of gammas {gs}")
     return gs, mg
@@ -95,7 +95,7 @@ def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None: one engine run per γ (same ICs); for mu_gamma with snapshots,
     settled orbits continued to the last grid time."""
     gs, mg = _gammas(study)
-    grid = snapshot_grid(study.param("snapshot_grid"))
+    grid = snapshot_grid(study.params.snapshot_grid)
     for g in gs:
         key = raw_key(g)
         extra = {"snapshots": tuple(grid), "continue_settled": True} if g == mg else {"snapshots": None}
@@ -126,8 +126,8 @@ def analyze(study):
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
-    alpha = float(study.param("alpha"))
-    dt = float(study.param("tau_grid_step"))
+    alpha = study.params.alpha
+    dt = study.params.tau_grid_step
     lts, N, t_last = _read_lifetimes(study, gs)
 
     # fine grid for τ0/τ1 (P on it is exact: no censoring before t_max in these runs)
@@ -141,12 +141,12 @@ def analyze(study):
     mu_fig3 = up.numbers(study, study.upstream("mu_crosscheck")).get("mu")
 
     # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
-    nb = int(study.param("n_boot"))
-    K = min(int(study.param("n_boot_orbits")), N)
+    nb = study.params.n_boot
+    K = min(study.params.n_boot_orbits, N)
     boot = bootstrap_transition_times(
         # slice before converting: a view of a converted 1e7 object array would keep all of it alive (690 MB per γ)
         {g: (lts[g]["t_end"].iloc[:K].to_numpy(), lts[g]["outcome"].iloc[:K].to_numpy()) for g in gs}, 0.0, grid,
-        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=int(study.param("boot_seed")) + 1,
+        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=study.params.boot_seed + 1,
     )
     bscale = float(np.sqrt(K / N))
     taus = _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha)
@@ -211,12 +211,12 @@ def _own_mu(study, mg, E0, N):
     ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]),
                              study.model.critical_energy)
     me, cont = ime.inside, {"rows_below_ec": ime.rows_below_ec}
-    win = tuple(float(v) for v in study.param("mu_window"))
+    win = tuple(study.params.mu_window)
     mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
-    k_mu = min(int(study.param("n_boot_orbits")), N)
+    k_mu = min(study.params.n_boot_orbits, N)
     rows_mu = read_snapshots(study.raw(raw_key(mg)), filters=ds.field("traj_id") < k_mu)
-    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=int(study.param("n_boot")),
-                                             seed=int(study.param("boot_seed")))
+    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=study.params.n_boot,
+                                             seed=study.params.boot_seed)
     return mu, float(bm["mu"].std(ddof=1)) * mu_scale, cont, win
 
 
@@ -226,8 +226,8 @@ def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha
     from hhscatter.analysis.dissipative.transitions import settle_time_quantiles, tau1, tau2_observed_interval, tau2_predicted
 
     E_C = study.model.critical_energy
-    paper_mu = float(study.param("paper_mu"))
-    min_ref = float(study.param("min_ref_orbits"))
+    paper_mu = study.params.paper_mu
+    min_ref = study.params.min_ref_orbits
     rows = []
     for g, lt in lts.items():
         oc = lt["outcome"]  # categorical: compared on its codes
@@ -295,7 +295,7 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
     from hhscatter.analysis.dissipative.transitions import power_law_exponent, tau2_predicted
 
     E_C = study.model.critical_energy
-    paper_mu = float(study.param("paper_mu"))
+    paper_mu = study.params.paper_mu
     d = taus[taus["gamma"] > 0]
     t1v = d["tau1"].to_numpy()
     ok1 = np.isfinite(t1v)
@@ -374,7 +374,7 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
         "mu_gamma": mg,
         "mu_window": list(win),
         "mu_fig3": mu_fig3,
-        "paper_mu": float(study.param("paper_mu")),
+        "paper_mu": study.params.paper_mu,
         "continuation": {k: v for k, v in cont.items() if k != "key"},
         "tau0": _vu(tau0, tau0_err),
         "taus": [
@@ -412,4 +412,4 @@ def plot(study):
     ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))
     taus = pd.read_parquet(study.derived("fig4_tau.parquet"))
     numbers = json.loads(study.numbers_path.read_text())
-    plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=float(study.param("mark_gamma")))
+    plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=study.params.mark_gamma)

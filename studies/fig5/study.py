@@ -114,9 +114,9 @@ def gamma_key(g: float) -> str:
 
 def _scene_for(study, g):
     E2 = float(study.config["scene"]["energy"])
-    E1 = float(study.param("E1"))
-    t_lo = time_to_energy(E2, E1, float(study.param("mu_max")), g)
-    t_hi = time_to_energy(E2, E1, float(study.param("mu_min")), g) + float(study.param("section_pad"))
+    E1 = study.params.E1
+    t_lo = time_to_energy(E2, E1, study.params.mu_max, g)
+    t_hi = time_to_energy(E2, E1, study.params.mu_min, g) + study.params.section_pad
     # nothing is needed from an orbit after the window: it stops there (outcome 'stopped')
     return study.scene(gamma_key(g), gamma=float(g),
                        sections={"t_from": float(t_lo), "t_to": float(t_hi), "stop": True})
@@ -149,12 +149,12 @@ def _authors_scene(study, key):
     """The authors' Fig. 5 runs (their code: goodICs, i.e. region 'square', at E2, γ = gamma_main): 5a is the
     first crossing with t in ``authors_window``; 5b the first crossing whose energy is in ``band``, at any
     time. The r < 1 cut is applied in the analysis. Each orbit stops once it has its crossing."""
-    g = float(study.param("gamma_main"))
+    g = study.params.gamma_main
     if key == "5a_authors":
-        t0, t1 = (float(v) for v in study.param("authors_window"))
+        t0, t1 = study.params.authors_window
         sec = {"t_from": t0, "t_to": t1, "first_only": True, "stop": True}
     else:
-        lo, hi = (float(v) for v in study.param("band"))
+        lo, hi = study.params.band
         sec = {"e_min": lo, "e_max": hi, "first_only": True, "stop": True}
     return study.scene(key, gamma=g, region="square", sections=sec)
 
@@ -162,7 +162,7 @@ def _authors_scene(study, key):
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None; one raw run per γ (sections in the t* window), and the two runs
     of the authors' Fig. 5 convention (square ICs, their windows)."""
-    for g in study.param("gammas"):
+    for g in study.params.gammas:
         study.run(gamma_key(g), _scene_for(study, g), workers=workers, progress=progress)
     for key in AUTHORS:
         study.run(key, _authors_scene(study, key), workers=workers, progress=progress)
@@ -173,11 +173,11 @@ def _authors_sets(study):
     (their plots), capped at n_cap points."""
     from hhscatter.data.tables import read_sections
 
-    n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))
+    n_cap, seed = study.params.n_cap, study.params.seed
     out = {}
     for key in AUTHORS:
         sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "energy"])
-        out[("authors", key)] = _cap(_r_cut(sec, float(study.param("r_cut"))), n_cap, seed)
+        out[("authors", key)] = _cap(_r_cut(sec, study.params.r_cut), n_cap, seed)
     return out
 
 
@@ -200,11 +200,11 @@ def _verdict_5b(study, cm_full, E1, ours):
     μ_c^{E1} at box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every
     set, the reference included (:func:`~hhscatter.analysis.geometry.distance.paired_hellinger_difference`). Sets of
     one comparison are cut alike. Returns the JSON record, or None when the sets are too small (tiny scale)."""
-    box = float(study.param("box_headline"))
-    extent = tuple(float(v) for v in study.param("extent"))
-    k = int(study.param("verdict_offsets"))
-    n_boot, level = int(study.param("verdict_boot")), float(study.param("verdict_level"))
-    n_cap, seed, r_cut = int(study.param("n_cap")), int(study.param("seed")), float(study.param("r_cut"))
+    box = study.params.box_headline
+    extent = tuple(study.params.extent)
+    k = study.params.verdict_offsets
+    n_boot, level = study.params.verdict_boot, study.params.verdict_level
+    n_cap, seed, r_cut = study.params.n_cap, study.params.seed, study.params.r_cut
     ref_all = _cap(cm_full, n_cap, seed)
     ref_cut = _cap(_r_cut(cm_full, r_cut), n_cap, seed)
     auth = _authors_sets(study)
@@ -258,7 +258,7 @@ def _compare_verdict(study, verdict):
         study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
                       f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
                       "agreement)", verdict=v, authors=r["construction"] != "ours",
-                      convention=(AUTHORS_CONVENTION.format(w=study.param("authors_window"), band=list(study.param("band")))
+                      convention=(AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band))
                                   if r["construction"] != "ours" else None),
                       note=f"d(5a) {r['d_5a']:.3f}, d(5b) {r['d_5b']:.3f} (debiased Hellinger, ε = {r['box']:g}, "
                            f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
@@ -291,7 +291,7 @@ def _cmeasure_points(study, inputs, E1, E2):
     cm, name = up.published_table(study, other, "cmeasure_points", doc)
     out, t_rec = {}, {}
     for label, E in (("E1", E1), ("E2", E2)):
-        tpath = study.param(f"t_rec_{label}_key")
+        tpath = getattr(study.params, f"t_rec_{label}_key")
         t_rec[label] = float(up.lookup(doc, tpath, what=f"{other}.json")[0])
         sec = cm[np.isclose(cm["energy"], E, rtol=0.0, atol=1e-12)]
         sec = sec[["traj_id", "t", "x", "y", "e_cross"]].rename(columns={"e_cross": "energy"})
@@ -326,16 +326,16 @@ def analyze(study):
     """
     inputs = {}
     E2 = float(study.config["scene"]["energy"])
-    E1 = float(study.param("E1"))
-    gammas = [float(g) for g in study.param("gammas")]
-    g_main = float(study.param("gamma_main"))
+    E1 = study.params.E1
+    gammas = list(study.params.gammas)
+    g_main = study.params.gamma_main
     if g_main not in gammas:
         raise ValueError(f"[study] gamma_main = {g_main} must be one of gammas = {gammas}")
     mu, mu_err = _mu(study, inputs)
     cm, t_rec = _cmeasure_points(study, inputs, E1, E2)
-    extent = tuple(float(v) for v in study.param("extent"))
-    seed = int(study.param("seed"))
-    n_cap = int(study.param("n_cap"))
+    extent = tuple(study.params.extent)
+    seed = study.params.seed
+    n_cap = study.params.n_cap
     cm_full = cm
     cm = {k: _cap(v, n_cap, seed) for k, v in cm.items()}
     refs = {"E1": dist.points(cm["E1"]), "E2": dist.points(cm["E2"])}
@@ -351,7 +351,7 @@ def analyze(study):
     study.write_table(stab, "distance_summary.parquet")
     study.write_table(pg, "per_gamma.parquet")
 
-    delta = float(study.param("delta"))
+    delta = study.params.delta
     verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
     astab, n_auth = _authors_distances(study, refs, extent)
     authors = _compare_authors(study, astab, n_auth, E1)
@@ -362,7 +362,7 @@ def analyze(study):
         "inputs": inputs,
         "dev_fallback": up.any_fallback(inputs),
         "mu": {"value": mu, "err": mu_err},
-        "E1": E1, "E2": E2, "band": [float(b) for b in study.param("band")], "gamma_main": g_main,
+        "E1": E1, "E2": E2, "band": list(study.params.band), "gamma_main": g_main,
         "t_star": {gamma_key(r.gamma): {"value": r.t_star, "err": r.t_star_err} for r in pg.itertuples()},
         "per_gamma": pg.to_dict(orient="records"),
         "m_common": m_common,
@@ -377,7 +377,7 @@ def analyze(study):
 def _compare_authors(study, astab, n_auth, E1) -> dict:
     """Rows of the paper comparison under the authors' own Fig. 5 convention (square ICs; 5a: first crossing
     with 17 < t < 30; 5b: first crossing in the energy band at any time; r < 1), and the JSON record."""
-    out = {"convention": AUTHORS_CONVENTION.format(w=study.param("authors_window"), band=list(study.param("band"))),
+    out = {"convention": AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band)),
            "n_points": n_auth, "rows": None}
     if astab is None:
         return out
@@ -410,12 +410,12 @@ def _compare_authors(study, astab, n_auth, E1) -> dict:
 def _mu(study, inputs):
     """(μ, σ_μ) of Eq. (eqn:energy_exp_decay) from the study [needs].mu; it must lie in the window of μ the
     section recording was made for."""
-    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), PAPER_MU, inputs, "mu")
+    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.params.mu_key, PAPER_MU, inputs, "mu")
     mu = float(mu)
     mu_err = float(mu_err) if mu_err is not None else math.nan
-    if not float(study.param("mu_min")) <= mu <= float(study.param("mu_max")):
+    if not study.params.mu_min <= mu <= study.params.mu_max:
         raise ValueError(f"μ = {mu} lies outside the recorded window [mu_min, mu_max] = "
-                         f"[{study.param('mu_min')}, {study.param('mu_max')}]: widen it in study.toml and re-simulate")
+                         f"[{study.params.mu_min}, {study.params.mu_max}]: widen it in study.toml and re-simulate")
     return mu, mu_err
 
 
@@ -426,8 +426,8 @@ def _point_sets(study, gammas, E1, E2, mu, mu_err):
 
     from hhscatter.data.tables import read_lifetimes, read_sections
 
-    band = tuple(float(b) for b in study.param("band"))
-    n_cap, seed = int(study.param("n_cap")), int(study.param("seed"))
+    band = tuple(study.params.band)
+    n_cap, seed = study.params.n_cap, study.params.seed
     sets, per_gamma, point_tables = {}, [], []
     for g in gammas:
         raw = study.raw(gamma_key(g))
@@ -462,7 +462,7 @@ def _common_sample_size(study, sets, refs):
     """({set: m}, m_common): the split-half sample size of each comparison with μ_c^{E1} that has at least
     m_min points per half, and the smallest of them, common to all (agreement scales are compared across γ
     and between Fig. 5a and 5b; comparisons with μ_c^{E2} use their own largest m)."""
-    m_min = int(study.param("m_min"))
+    m_min = study.params.m_min
     sizes = {k: min(len(v), len(refs["E1"])) // 2 for k, v in sets.items()}
     usable = {k: s for k, s in sizes.items() if s >= m_min}
     if not usable:
@@ -476,11 +476,11 @@ def _distances(study, sets, refs, usable, m_common, extent):
     """(distance vs box side table, summary table): Hellinger/TV vs ε with split-half noise floors and
     bootstrap errors, the agreement scales, sliced Wasserstein with its error and noise floor, for every
     point set against μ_c^{E1} and μ_c^{E2} (and μ_c^{E2} against μ_c^{E1})."""
-    boxes = np.sort(np.asarray(study.param("boxes"), dtype=float))[::-1]
-    seed = int(study.param("seed"))
-    n_proj = int(study.param("n_proj"))
-    n_boot = int(study.param("n_boot"))
-    delta = float(study.param("delta"))
+    boxes = np.sort(np.asarray(study.params.boxes))[::-1]
+    seed = study.params.seed
+    n_proj = study.params.n_proj
+    n_boot = study.params.n_boot
+    delta = study.params.delta
     rows, summary = [], []
     comps = [(k, ref) for k in sets for ref in ("E1", "E2")] + [(("ref", "E2"), "E1")]
     for (key, ref) in comps:
@@ -492,7 +492,7 @@ def _distances(study, sets, refs, usable, m_common, extent):
                 continue
         Q = refs[ref]
         m = m_common if key in usable and ref == "E1" else None
-        tab = dist.distance_vs_scale(P, Q, boxes, extent, n_splits=int(study.param("n_splits")),
+        tab = dist.distance_vs_scale(P, Q, boxes, extent, n_splits=study.params.n_splits,
                                      seed=seed, m=m)
         # full-sample Hellinger/TV at every box and SW1, each with its bootstrap std (same resamples)
         _, (hb, sw_err) = dist.bootstrap_distance(
@@ -505,16 +505,16 @@ def _distances(study, sets, refs, usable, m_common, extent):
         sw = dist.sliced_wasserstein(P, Q, n_proj=n_proj, seed=seed)
         # sliced-Wasserstein noise floor at the comparison's sample size m
         sw_noise = dist.split_half_noise(P, Q, lambda A, B: dist.sliced_wasserstein(A, B, n_proj=n_proj, seed=seed),
-                                         m=int(tab["m"].iloc[0]), n_splits=max(int(study.param("n_splits")), 1),
+                                         m=int(tab["m"].iloc[0]), n_splits=max(study.params.n_splits, 1),
                                          seed=seed + 2).mean
-        eps_star = dist.agreement_scale(tab, "hellinger", z=float(study.param("z")),
-                                        noise_max=float(study.param("noise_max")))
-        eps_deb = dist.agreement_scale_debiased(tab, delta, "hellinger", noise_max=float(study.param("noise_max")))
+        eps_star = dist.agreement_scale(tab, "hellinger", z=study.params.z,
+                                        noise_max=study.params.noise_max)
+        eps_deb = dist.agreement_scale_debiased(tab, delta, "hellinger", noise_max=study.params.noise_max)
         tab["hellinger_debiased"], tab["hellinger_debiased_lo"], tab["hellinger_debiased_hi"] = \
             dist.debiased_distance(tab, "hellinger")
         tab = tab.assign(gamma=label_g, set=label_s, ref=ref, n_P=len(P), n_Q=len(Q))
         rows.append(tab)
-        jh = int(np.argmin(np.abs(tab["box"].to_numpy() - float(study.param("box_headline")))))
+        jh = int(np.argmin(np.abs(tab["box"].to_numpy() - study.params.box_headline)))
         summary.append({
             "gamma": label_g, "set": label_s, "ref": ref, "n_P": len(P), "n_Q": len(Q),
             "m": int(tab["m"].iloc[0]), "common_m": m is not None,
@@ -539,7 +539,7 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> di
     """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer (SW1 and
     debiased Hellinger) in Fig. 5a and 5b, and whether the agreement scale shrinks with t*. Returns
     {'a'|'b': closer to μ_c^{E1}}."""
-    E1 = float(study.param("E1"))
+    E1 = study.params.E1
     def srow(g, s, ref):
         r = stab[(stab["gamma"] == g) & (stab["set"] == s) & (stab["ref"] == ref)]
         return r.iloc[0] if len(r) else None
@@ -595,7 +595,7 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> di
             return f"{e:.3g}" if e is not None and np.isfinite(e) else "none"
 
         for col, what in (("agreement_scale_debiased", f"debiased H ≤ δ = {delta:g}"),
-                          ("agreement_scale", f"H_pq ≤ H_noise + {study.param('z')}σ")):
+                          ("agreement_scale", f"H_pq ≤ H_noise + {study.params.z}σ")):
             eps = np.array([np.nan if v is None else float(v) for v in scales[col]])[order]
             e_sorted = np.where(np.isfinite(eps), eps, np.inf)
             # non-increasing with t* ("none" = inf: no agreement at any informative scale)

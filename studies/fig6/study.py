@@ -123,7 +123,7 @@ def pair_key(E0: float, g: float) -> str:
 
 def _pairs(study):
     out = []
-    for p in study.param("pairs"):
+    for p in study.params.pairs:
         if len(p) != 2:
             raise ValueError(f"[study] pairs must hold [E0, gamma] pairs, got {p!r}")
         out.append((float(p[0]), float(p[1])))
@@ -148,9 +148,9 @@ def paper_constants(study) -> dict:
     and μ (Eq. (eqn:energy_exp_decay), dimensionless; Sec. III.A, Fig. 3 =
     fig:energy_decay).  Read from study.toml, never written in the code.
     """
-    return {"a": float(study.param("paper_kappa_a")), "b": float(study.param("paper_kappa_b")),
-            "c": float(study.param("paper_kappa_c")), "E_b": float(study.param("paper_kappa_Eb")),
-            "mu": float(study.param("paper_mu"))}
+    return {"a": study.params.paper_kappa_a, "b": study.params.paper_kappa_b,
+            "c": study.params.paper_kappa_c, "E_b": study.params.paper_kappa_Eb,
+            "mu": study.params.paper_mu}
 
 
 def kappa_law(const: dict, E_c: float) -> PiecewiseKappa:
@@ -173,12 +173,12 @@ def _inputs(study):
     # the paper's values stand in only under the development fallback (labelled in inputs and the figure)
     pc = paper_constants(study)
     for name in ("a", "b", "c", "E_b"):
-        key = study.param("kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
+        key = getattr(study.params, "kappa_Eb_key" if name == "E_b" else f"kappa_{name}_key")
         kv[name], _ = up.value_or_fallback(study, ks, key, pc[name], inputs, f"kappa_{name}")
     E_c = study.model.critical_energy  # E_c = ω⁶/(6λ²) of the scene's model
     kappa = kappa_law(kv, E_c)
-    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.param("mu_key"), pc["mu"], inputs, "mu")
-    tau0, _ = up.value_or_fallback(study, study.upstream("tau"), study.param("tau0_key"), DEV_TAU0, inputs, "tau0")
+    mu, mu_err = up.value_or_fallback(study, study.upstream("mu"), study.params.mu_key, pc["mu"], inputs, "mu")
+    tau0, _ = up.value_or_fallback(study, study.upstream("tau"), study.params.tau0_key, DEV_TAU0, inputs, "tau0")
     return inputs, kappa, float(mu), float(mu_err if mu_err is not None else math.nan), float(tau0), E_c
 
 
@@ -247,7 +247,7 @@ def _homogeneous_fits(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, tau0, E_
 def _mixture_variants(study):
     """The [study] mixtures list: dicts with name, by ("energy"/"rate"), t_ref ("tau0" or a time), fne_mode."""
     out = []
-    for v in study.param("mixtures"):
+    for v in study.params.mixtures:
         missing = {"name", "by", "t_ref", "fne_mode"} - set(v)
         if missing:
             raise ValueError(f"[study] mixtures entries need {sorted(missing)}: {v!r}")
@@ -287,13 +287,13 @@ def analyze(study):
     ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": mu}
     pc = paper_constants(study)
     kappa_pc = kappa_law(pc, E_c)
-    hazards = list(study.param("hazards"))
-    dt, fit_dt = float(study.param("dt")), float(study.param("fit_dt"))
-    min_count = float(study.param("min_count"))
-    fit_tau2 = bool(study.param("fit_tau2"))
-    K = int(study.param("n_components"))
+    hazards = list(study.params.hazards)
+    dt, fit_dt = study.params.dt, study.params.fit_dt
+    min_count = study.params.min_count
+    fit_tau2 = study.params.fit_tau2
+    K = study.params.n_components
     mixtures = _mixture_variants(study)
-    w_hi = float(study.param("mixture_fit_window")[1])
+    w_hi = float(study.params.mixture_fit_window[1])
 
     curves, fit_rows, comp_rows, cmp_rows, pc_rows = [], [], [], [], []
     for E0, g in _pairs(study):
@@ -312,7 +312,7 @@ def analyze(study):
                                      tau0=tau0, E_c=E_c, hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
         # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
         # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
-        cap = study.param("mixture_max_orbits")
+        cap = study.params.mixture_max_orbits
         keep = pads.field("t") >= tau0
         if cap is not None:
             keep = keep & (pads.field("traj_id") < int(cap))
@@ -351,7 +351,7 @@ def analyze(study):
 
     ref = _fig4_reference(study, inputs, dt)
     tau_kw = {"tau0": tau0, "E_c": E_c, "hazards": hazards, "dt": dt, "fit_dt": fit_dt, "min_count": min_count,
-              "alpha": float(study.param("alpha"))}
+              "alpha": study.params.alpha}
     taus, tau_fits = _tau_rows(ref, kappa=kappa, mu=mu, mu_err=mu_err, **tau_kw)
     taus_pc, tau_fits_pc = _tau_rows(ref, kappa=kappa_pc, mu=pc["mu"], mu_err=math.nan, **tau_kw)
     pct = _pc_taus(taus, taus_pc, tau_fits, tau_fits_pc, hazards)
@@ -557,21 +557,21 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
 
     from hhscatter.data.tables import read_lifetimes
 
-    E0 = float(study.param("fig4_E0"))
+    E0 = study.params.fig4_E0
     other = study.upstream("tau")
     try:
         doc = up.numbers(study, other)
-        table, _ = up.lookup(doc, study.param("tau_table_key"), what=f"{other}.json")
+        table, _ = up.lookup(doc, study.params.tau_table_key, what=f"{other}.json")
         obs = pd.DataFrame(table)
-        gcol, t1, t2 = (study.param(k) for k in ("tau_gamma_field", "tau1_field", "tau2_field"))
+        gcol, t1, t2 = (getattr(study.params, k) for k in ("tau_gamma_field", "tau1_field", "tau2_field"))
         missing = {gcol, t1, t2} - set(obs.columns)
         if missing:
-            raise up.UpstreamError(f"{other}.json:{study.param('tau_table_key')} rows lack {sorted(missing)}; "
+            raise up.UpstreamError(f"{other}.json:{study.params.tau_table_key} rows lack {sorted(missing)}; "
                                    f"have {sorted(obs.columns)}")
         obs = pd.DataFrame({"gamma": obs[gcol].astype(float),
                             "tau1_observed": [_val(v)[0] for v in obs[t1]], "tau1_err": [_val(v)[1] for v in obs[t1]],
                             "tau2_observed": [_val(v)[0] for v in obs[t2]], "tau2_err": [_val(v)[1] for v in obs[t2]]})
-        inputs["tau_table"] = {"source": f"{other}.json:{study.param('tau_table_key')}"}
+        inputs["tau_table"] = {"source": f"{other}.json:{study.params.tau_table_key}"}
         # P(t) of the τ study's runs from its published lifetimes table (never its raw runs)
         tname = doc.get("tables", {}).get("lifetimes")
         if not tname:

@@ -146,7 +146,7 @@ def section_samples(model, energy, extent, box, k, r_esc, rng, *, e_width=0.0) -
 
 
 def _samples(study, E, box, k, salt, e_width=0.0):
-    rng = np.random.default_rng([int(study.param("seed")), int(round(E * 1e6)), salt])
+    rng = np.random.default_rng([study.params.seed, int(round(E * 1e6)), salt])
     return section_samples(study.model, E, _extent(study), box, k, _r_esc(study), rng, e_width=e_width)
 
 
@@ -167,19 +167,19 @@ def _one_return(study, key, df, gamma, workers, progress):
 def _diss_bins(study):
     """Energy bin edges from E_c (the model's) to E0 + ΔE/2: E0 is the centre of the top bin."""
     Ec = study.model.critical_energy
-    E0 = float(study.param("diss_energy"))
-    nb = int(study.param("diss_bins"))
+    E0 = study.params.diss_energy
+    nb = study.params.diss_bins
     dE = (E0 - Ec) / (nb - 0.5)
     return Ec + dE * np.arange(nb + 1)
 
 
 def _diss_samples(study):
     edges = _diss_bins(study)
-    k = _k(int(study.param("diss_samples")), "diss_samples")
+    k = _k(study.params.diss_samples, "diss_samples")
     parts = []
     for b in range(len(edges) - 1):
         c, wdt = 0.5 * (edges[b] + edges[b + 1]), edges[b + 1] - edges[b]
-        df = _samples(study, c, float(study.param("diss_box")), k, 7 + b, e_width=wdt)
+        df = _samples(study, c, study.params.diss_box, k, 7 + b, e_width=wdt)
         parts.append(df.assign(ebin=b))
     return pd.concat(parts, ignore_index=True)
 
@@ -200,35 +200,35 @@ def _probe_scene(study, E, df):
                         "y": pr["y"].to_numpy(), "px": pr["px"].to_numpy(), "py": pr["py"].to_numpy()})
     if not path.exists() or not pd.read_parquet(path).equals(ics):
         ics.to_parquet(path, index=False)
-    return study.scene(probe_key(E), ics=str(path), n=len(ics), t_max=float(study.param("probe_t_max")))
+    return study.scene(probe_key(E), ics=str(path), n=len(ics), t_max=study.params.probe_t_max)
 
 
 def _sim_scene(study):
-    E0, g = float(study.param("diss_energy")), float(study.param("diss_gamma"))
-    return study.scene(SIM_KEY, energy=E0, n=int(study.param("sim_n")), gamma=g,
-                       t_max=float(study.param("t_horizon")),
-                       sections={"t_from": float(study.param("t_star")), "first_only": True})
+    E0, g = study.params.diss_energy, study.params.diss_gamma
+    return study.scene(SIM_KEY, energy=E0, n=study.params.sim_n, gamma=g,
+                       t_max=study.params.t_horizon,
+                       sections={"t_from": study.params.t_star, "first_only": True})
 
 
 def _cost_scene(study, E):
-    return study.scene(cost_key(E), energy=float(E), n=int(study.param("cost_n")), seed=2602, t_max=5000.0)
+    return study.scene(cost_key(E), energy=float(E), n=study.params.cost_n, seed=2602, t_max=5000.0)
 
 
 def _ulam_energies(study):
-    return sorted(set(float(e) for e in study.param("energies")) | set(float(e) for e in study.param("mixed_energies")))
+    return sorted(set(study.params.energies) | set(study.params.mixed_energies))
 
 
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None: one-return runs of the Ulam samples per energy, the dissipative
     samples, the dissipative comparison ensemble and the P(t)-route runs of the cost comparison."""
-    k = _k(int(study.param("samples")), "samples")
+    k = _k(study.params.samples, "samples")
     for E in _ulam_energies(study):
-        df = _samples(study, E, float(study.param("box")), k, 0)
+        df = _samples(study, E, study.params.box, k, 0)
         _one_return(study, ulam_key(E), df, 0.0, workers, progress)
         study.run(probe_key(E), _probe_scene(study, E, df), workers=workers, progress=progress)
-    _one_return(study, DISS_KEY, _diss_samples(study), float(study.param("diss_gamma")), workers, progress)
+    _one_return(study, DISS_KEY, _diss_samples(study), study.params.diss_gamma, workers, progress)
     study.run(SIM_KEY, _sim_scene(study), workers=workers, progress=progress)
-    for E in study.param("cost_energies"):
+    for E in study.params.cost_energies:
         study.run(cost_key(E), _cost_scene(study, E), workers=workers, progress=progress)
 
 
@@ -276,7 +276,7 @@ def transitions(tab, study, c=1, m_max=None, ebins=None):
     """transitions(tab, study, c=1, m_max=None) -> (Transitions, state ids): the samples on boxes merged
     c × c (finest side ``box``), only the first ``m_max`` ranks per finest box; censored samples dropped.
     With ``ebins`` (n_bins, edges) the states are (box, energy bin): id = bin·n_cells + box."""
-    box = float(study.param("box")) if ebins is None else float(study.param("diss_box"))
+    box = study.params.box if ebins is None else study.params.diss_box
     nx, _ = _grid_shape(study, box)
     mask = ~tab["censored"].to_numpy()
     if m_max is not None:
@@ -314,23 +314,23 @@ def saddle_kappa(tr):
 
 def _ulam_energy(study, E):
     """Every number of one energy: κ at every box side and sample count, bootstrap, classes, cost."""
-    k = _k(int(study.param("samples")), "samples")
-    box = float(study.param("box"))
+    k = _k(study.params.samples, "samples")
+    box = study.params.box
     df = _samples(study, E, box, k, 0)
     tab = one_return_table(study, ulam_key(E), df)
     rows = []
-    for c in study.param("coarsen"):
+    for c in study.params.coarsen:
         tr, _, _ = transitions(tab, study, c=int(c))
         kap, kmap, info, _, _ = saddle_kappa(tr)
         rows.append({"energy": E, "box": box * int(c), "samples": int(k * k * c * c), "kappa": kap,
                      "kappa_map": kmap, "vary": "box", **info})
-    for m in study.param("sample_subsets"):
+    for m in study.params.sample_subsets:
         tr, _, _ = transitions(tab, study, m_max=int(m))
         kap, kmap, info, _, _ = saddle_kappa(tr)
         rows.append({"energy": E, "box": box, "samples": int(m), "kappa": kap, "kappa_map": kmap,
                      "vary": "samples", **info})
     tr, ids, t = transitions(tab, study)
-    boot = tf.bootstrap_kappa(tr, int(study.param("n_boot")), rng=int(study.param("seed")) + int(E * 1000))
+    boot = tf.bootstrap_kappa(tr, study.params.n_boot, rng=study.params.seed + int(E * 1000))
     kap, kmap, info, keep, sub = saddle_kappa(tr)
     full_classes = tf.communicating_classes(tr)[1]
     ok = ~tab["censored"]
@@ -391,7 +391,7 @@ def kappa_record(study, E, res):
     stat = float(np.std(boot, ddof=1)) if boot.size > 1 else math.nan
     bias = float(k_inf - res["kappa"])
     return {"energy": E, "kappa": res["kappa"], "err": float(math.hypot(stat, bias)), "boxes": int(res["sub"].n_states),
-            "samples": int(study.param("samples")), "box": float(study.param("box")), "kappa_stat_err": stat,
+            "samples": study.params.samples, "box": study.params.box, "kappa_stat_err": stat,
             "discretisation_bias": bias, "kappa_extrapolated": float(k_inf), "bias_slope": float(slope),
             "kappa_map_per_return": res["kappa_map"], "mean_return_time": res["cost"]["mean_return_time"],
             "orbit_time": res["cost"]["orbit_time"], "orbits": res["cost"]["orbits"],
@@ -428,19 +428,19 @@ def _cmeasure_distances(study, results, inputs):
 
     other = study.upstream("cmeasure")
     cm, name = up.published_table(study, other, "cmeasure_points")
-    boxes = [float(b) for b in study.param("cm_boxes")]
-    head = float(study.param("cm_box_headline"))
-    rng = np.random.default_rng(int(study.param("seed")) + 5)
+    boxes = list(study.params.cm_boxes)
+    head = study.params.cm_box_headline
+    rng = np.random.default_rng(study.params.seed + 5)
     rows, tabs = [], []
-    for E in [float(e) for e in study.param("cm_energies")]:
+    for E in list(study.params.cm_energies):
         Q = cm[np.isclose(cm["energy"], E, rtol=0, atol=1e-9)][["x", "y"]].to_numpy()
         inputs[f"cmeasure_E{E:.2f}"] = {"source": f"{other}: derived/{name}", "n_points": int(len(Q))}
-        for ref_E in [e for e in results if any(np.isclose(e, c) for c in study.param("cm_energies"))]:
+        for ref_E in [e for e in results if any(np.isclose(e, c) for c in study.params.cm_energies)]:
             kinds = ("sprinkler", "flux", "map") if np.isclose(ref_E, E) else ("sprinkler",)
             for kind in kinds:
                 P = measure_points(results[ref_E], kind, len(Q), rng)
-                tab = dist.distance_vs_scale(P, Q, boxes, _extent(study), n_splits=int(study.param("n_splits")),
-                                             seed=int(study.param("seed")))
+                tab = dist.distance_vs_scale(P, Q, boxes, _extent(study), n_splits=study.params.n_splits,
+                                             seed=study.params.seed)
                 d, lo, hi = dist.debiased_distance(tab, "hellinger")
                 tab = tab.assign(hellinger_debiased=d, lo=lo, hi=hi, fig1_energy=E, operator_energy=ref_E, kind=kind)
                 tabs.append(tab)
@@ -460,23 +460,23 @@ def _cmeasure_convergence(study, results, cm, boxes, head):
     points at the first cm energy, for merged boxes and fewer samples per box: the eigenvector's convergence."""
     from hhscatter.analysis.geometry import distance as dist
 
-    E = float(study.param("cm_energies")[0])
+    E = float(study.params.cm_energies[0])
     if E not in results:
         return []
     Q = cm[np.isclose(cm["energy"], E, rtol=0, atol=1e-9)][["x", "y"]].to_numpy()
     tab = results[E]["tab"]
     out = []
-    for c in [int(c) for c in study.param("coarsen")][:3]:
-        for m in [int(m) for m in study.param("sample_subsets")]:
+    for c in list(study.params.coarsen)[:3]:
+        for m in list(study.params.sample_subsets):
             tr, _, t = transitions(tab, study, c=c, m_max=m)
             kap, _, _, keep, sub = saddle_kappa(tr)
             res = {"sub": sub, "t": t, "keep": keep, "tr": tr, "kappa": kap}
-            P = measure_points(res, "sprinkler", len(Q), np.random.default_rng(int(study.param("seed")) + 6))
-            d = dist.distance_vs_scale(P, Q, boxes, _extent(study), n_splits=int(study.param("n_splits")),
-                                       seed=int(study.param("seed")))
+            P = measure_points(res, "sprinkler", len(Q), np.random.default_rng(study.params.seed + 6))
+            d = dist.distance_vs_scale(P, Q, boxes, _extent(study), n_splits=study.params.n_splits,
+                                       seed=study.params.seed)
             h, lo, hi = dist.debiased_distance(d, "hellinger")
             j = int(np.argmin(np.abs(d["box"].to_numpy() - head)))
-            out.append({"energy": E, "box": float(study.param("box")) * c, "samples_per_box": m * c * c,
+            out.append({"energy": E, "box": study.params.box * c, "samples_per_box": m * c * c,
                         "kappa": kap, "eps": float(d["box"].iloc[j]), "hellinger_debiased": float(h[j]),
                         "lo": float(lo[j]), "hi": float(hi[j])})
     return out
@@ -495,7 +495,7 @@ def _initial_density(study, ids, n_cells, top_bin):
     g = (np.arange(600) + 0.5) / 600 * 2 * R - R
     X, Y = np.meshgrid(g, g)
     inside = np.hypot(X, Y) < R
-    cell, _, _ = tf.box_index(X[inside], Y[inside], _extent(study), float(study.param("diss_box")))
+    cell, _, _ = tf.box_index(X[inside], Y[inside], _extent(study), study.params.diss_box)
     state = top_bin * n_cells + cell
     pos = np.searchsorted(ids, state)
     ok = (pos < ids.size) & (ids[np.minimum(pos, ids.size - 1)] == state)
@@ -547,16 +547,16 @@ def _dissipative(study, inputs):
 
     edges = _diss_bins(study)
     n_bins = len(edges) - 1
-    dt = float(study.param("dt"))
-    steps = int(round(float(study.param("t_horizon")) / dt))
-    k_star = int(round(float(study.param("t_star")) / dt))
+    dt = study.params.dt
+    steps = int(round(study.params.t_horizon / dt))
+    k_star = int(round(study.params.t_star / dt))
     df = _diss_samples(study)
     tab = one_return_table(study, DISS_KEY, df)
     tr, ids, t = transitions(tab, study, ebins=edges)
-    nx, _ = _grid_shape(study, float(study.param("diss_box")))
+    nx, _ = _grid_shape(study, study.params.diss_box)
     n_cells = nx * nx
     n0, lost = _initial_density(study, ids, n_cells, n_bins - 1)
-    max_lag = int(round(float(study.param("max_return_time")) / dt))
+    max_lag = int(round(study.params.max_return_time / dt))
     K, H, L = tf.lag_kernels(tr, t["t_end"].to_numpy(), dt, max_lag=max_lag)
     cross = tf.propagate(n0, K, L, steps)
     P_op = tf.survival(cross, H)
@@ -577,32 +577,32 @@ def _dissipative(study, inputs):
     leaving = observed_from_outcome(lt["outcome"])
     P_sim = _empirical_survival(lt["t_end"].to_numpy(), leaving, grid)
     sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
-    sim_pts = dist.first_crossings(sec, float(study.param("t_star")))
+    sim_pts = dist.first_crossings(sec, study.params.t_star)
     N = len(lt)
     # comparisons
     ok = P_sim * N >= 30
     lr = np.log(np.where(ok, P_op, 1.0) / np.where(ok, P_sim, 1.0))
     lr2 = np.log(np.where(ok, np.maximum(P_red, 1e-300), 1.0) / np.where(ok, P_sim, 1.0))
     t_ok = grid[ok]
-    rng = np.random.default_rng(int(study.param("seed")) + 9)
+    rng = np.random.default_rng(study.params.seed + 9)
     n_draw = max(len(sim_pts), 4)
     draw = pred.iloc[rng.choice(len(pred), size=n_draw, p=pred["w"] / pred["w"].sum())]
-    boxes = [float(b) for b in study.param("cm_boxes")]
+    boxes = list(study.params.cm_boxes)
     dtab = dist.distance_vs_scale(draw[["x", "y"]].to_numpy(), dist.points(sim_pts), boxes, _extent(study),
-                                  n_splits=int(study.param("n_splits")), seed=int(study.param("seed")))
+                                  n_splits=study.params.n_splits, seed=study.params.seed)
     d, lo, hi = dist.debiased_distance(dtab, "hellinger")
     dtab = dtab.assign(hellinger_debiased=d, lo=lo, hi=hi)
-    j = int(np.argmin(np.abs(dtab["box"].to_numpy() - float(study.param("cm_box_headline")))))
+    j = int(np.argmin(np.abs(dtab["box"].to_numpy() - study.params.cm_box_headline)))
     sig = np.sqrt(np.maximum(P_sim * (1 - P_sim), 0.0) / N)
-    at = [5.0, 10.0, float(study.param("t_star")), 25.0, 40.0, 60.0, 80.0, 100.0, 150.0]
+    at = [5.0, 10.0, study.params.t_star, 25.0, 40.0, 60.0, 80.0, 100.0, 150.0]
     at = [a for a in at if a <= grid[-1]]
     ix = [int(round(a / dt)) for a in at]
     wE = pred["w"] / pred["w"].sum()
     mE_pred = float(np.sum(wE * pred["energy"]))
     sE_pred = float(np.sqrt(np.sum(wE * (pred["energy"] - mE_pred) ** 2)))
     numbers = {
-        "energy": float(study.param("diss_energy")), "gamma": float(study.param("diss_gamma")),
-        "t_star": float(study.param("t_star")), "dt": dt, "energy_bins": edges.tolist(),
+        "energy": study.params.diss_energy, "gamma": study.params.diss_gamma,
+        "t_star": study.params.t_star, "dt": dt, "energy_bins": edges.tolist(),
         "states": int(tr.n_states), "samples": int(len(tab)), "initial_mass_lost": lost,
         "returns_capped_share": tf.capped_share(tr, dt, max_lag), "max_return_time": max_lag * dt,
         "operator_orbit_time": float(tab["t_end"].sum()), "sim_orbits": int(N),
@@ -636,9 +636,9 @@ def _cost(study, records, kappa0):
     from hhscatter.analysis.survival.fits import observed_from_outcome
     from hhscatter.data.tables import read_lifetimes
 
-    target = float(study.param("target_rel"))
+    target = study.params.target_rel
     rows = []
-    for E in [float(e) for e in study.param("cost_energies")]:
+    for E in list(study.params.cost_energies):
         lt = read_lifetimes(study.raw(cost_key(E)), columns=["outcome", "t_end"])
         r = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
                         min_survivors=100.0)
@@ -702,7 +702,7 @@ def analyze(study):
         isl = res["islands"]
         mixed.append({"energy": E, **{k: v for k, v in isl.items() if k != "modes_P"}, "modes_P": isl["modes_P"],
                       "largest_classes": res["largest_classes"]})
-        if any(np.isclose(E, e) for e in study.param("energies")):
+        if any(np.isclose(E, e) for e in study.params.energies):
             records.append(rec)
         else:
             rec["note"] = "mixed phase space (below the κ grid)"
@@ -722,7 +722,7 @@ def analyze(study):
     study.write_table(pts, "t_star_points.parquet")
     study.write_table(dtab, "t_star_distances.parquet")
     img = []
-    for E in [float(e) for e in study.param("cm_energies")]:
+    for E in list(study.params.cm_energies):
         if E in results:
             P = measure_points(results[E], "sprinkler", 200000, np.random.default_rng(3))
             img.append(pd.DataFrame({"energy": E, "x": P[:, 0], "y": P[:, 1]}))

@@ -70,12 +70,12 @@ def _follow_key(E):
 
 
 def _grid(study):
-    return [float(e) for e in study.param("energies")], [float(r) for r in study.param("r_esc")]
+    return list(study.params.energies), list(study.params.r_esc)
 
 
 def _follow_radii(study):
     _, radii = _grid(study)
-    return tuple(sorted({float(study.param("r_in")), *radii}))
+    return tuple(sorted({study.params.r_in, *radii}))
 
 
 # -- simulate ---------------------------------------------------------------
@@ -84,10 +84,10 @@ def _follow_scene(study, E):
     ``follow``): every crossing of the follow radii, until r_far or t_max."""
     from hhscatter.scene.scene import Follow
 
-    r_ref = float(study.param("r_ref"))
+    r_ref = study.params.r_ref
     base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
-    return study.scene(_follow_key(E), energy=E, r_esc=r_ref, n=min(int(study.param("n_follow")), base.n),
-                       r_far=float(study.param("r_far")), follow=Follow(_follow_radii(study)))
+    return study.scene(_follow_key(E), energy=E, r_esc=r_ref, n=min(study.params.n_follow, base.n),
+                       r_far=study.params.r_far, follow=Follow(_follow_radii(study)))
 
 
 def simulate(study, workers=None, progress=True):
@@ -126,7 +126,7 @@ def analyze(study):
     (:func:`_numbers_and_comparison`).
     """
     energies, radii = _grid(study)
-    r_ref = float(study.param("r_ref"))
+    r_ref = study.params.r_ref
     if r_ref not in radii:
         raise ValueError(f"[study] r_ref = {r_ref} must be one of r_esc = {radii}")
     lyap = _lyapunov_table(study, energies)
@@ -159,7 +159,7 @@ def _lyapunov_table(study, energies) -> pd.DataFrame:
     from hhscatter.analysis.geometry.channels import lyapunov_orbit
 
     rows = []
-    for E in sorted({*map(float, study.param("lyapunov_energies")), *energies}):
+    for E in sorted({*study.params.lyapunov_energies, *energies}):
         L = lyapunov_orbit(E)
         rows.append({"energy": E, "r_min": L.r_min, "r_max": L.r_max, "y_axis": L.y_axis, "period": L.period})
     return pd.DataFrame(rows)
@@ -208,7 +208,7 @@ def _common_window(study, arrs, radii, r_ref):
                 own[r] = escape_rate(*arrs[r], grid, detect_tail=False)
         except ValueError:
             own[r] = None
-    p_start = float(study.param("p_start"))
+    p_start = study.params.p_start
     below = np.flatnonzero(curves[r_ref].P <= p_start)
     t_p = float(grid[below[0]]) if below.size else 0.0
     tau0s = [own[r].tau0 for r in radii if own[r] is not None]
@@ -225,7 +225,7 @@ def _follow_returns(study, E, radii):
     from hhscatter.analysis.geometry.channels import return_statistics
     from hhscatter.data.tables import read_crossings, read_lifetimes
 
-    r_in = float(study.param("r_in"))
+    r_in = study.params.r_in
     fdir = study.raw(_follow_key(E))
     cross = read_crossings(fdir).sort_values(["traj_id", "t"], kind="stable")
     ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"]).sort_values("traj_id")
@@ -257,7 +257,7 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
     ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
     mle = escape_rate_mle(t_alt, obs_alt, *win)
     rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win,
-                               n_groups=int(study.param("n_groups")))
+                               n_groups=study.params.n_groups)
     # delay of P(t) at the window start: log(P_alt/P_ref)(t_lo)/κ_ref (the flight time, plus the
     # premature escapes of r_ref accumulated up to t_lo)
     tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
@@ -274,7 +274,7 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
         tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], ends.t_end.to_numpy())
         try:
             rf = survival_ratio_slope(tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]),
-                                      win, n_groups=int(study.param("n_groups")))
+                                      win, n_groups=study.params.n_groups)
             fol = rf.shift, rf.shift_err
         except ValueError:
             pass
@@ -303,8 +303,8 @@ def _returns_row(study, E, r, s, recrossed, win, ps, lyapE, ends) -> dict:
     the window start) with Wilson intervals, how fast they escape again, the Lyapunov orbit's extent."""
     from hhscatter.analysis.stats.intervals import wilson_interval
 
-    z = float(study.param("z"))
-    fast = float(study.param("reesc_fast"))
+    z = study.params.z
+    fast = study.params.reesc_fast
     nf = len(ends)
     esc = np.isfinite(s["t_esc"])
     late = esc & (s["t_esc"] > win[0])
@@ -338,7 +338,7 @@ def _channel_rows(study, E, r, ch, t_alt, win) -> list:
     χ² test of equal thirds, for all escapes and for those before / after the window start."""
     from hhscatter.analysis.geometry.channels import channel_fractions
 
-    z = float(study.param("z"))
+    z = study.params.z
     n_tot = t_alt.size
     rows = []
     for subset, m in (("all", np.ones(n_tot, bool)), ("early", t_alt <= win[0]), ("late", t_alt > win[0])):
@@ -354,8 +354,8 @@ def _channel_rows(study, E, r, ch, t_alt, win) -> list:
 def _numbers_and_comparison(study, energies, radii, r_ref, kap, ret, chan, lyap) -> dict:
     """resc.json's numbers from the tables, the paper comparison (κ shifts, returns, channels), the default
     r_esc recommended."""
-    r_in = float(study.param("r_in"))
-    fast = float(study.param("reesc_fast"))
+    r_in = study.params.r_in
+    fast = study.params.reesc_fast
     numbers = {"energies": energies, "r_esc": radii, "r_ref": r_ref, "kappa": {}, "returns": {},
                "channels": {}, "lyapunov": {}}
     for row in kap.itertuples():
@@ -440,6 +440,6 @@ def plot(study):
         channels=pd.read_parquet(d / "channels.parquet"),
         lyapunov=pd.read_parquet(d / "lyapunov.parquet"),
         path=study.figure_path,
-        r_ref=float(study.param("r_ref")),
+        r_ref=study.params.r_ref,
         scale=study.scale,
     )
