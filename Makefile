@@ -26,7 +26,7 @@ venv: $(STAMP) ## create .venv and install hhscatter with its dev extra
 test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) chromium ## run the default test suite (creates .venv with the dev, bench and docs extras)
 	$(PY) -m pytest -q
 
-# the docs' browser tests (tests/test_docs_browser.py) open the built site in Debian's Chromium, driven by the
+# the docs' browser tests (tests/docs/test_docs_browser.py) open the built site in Debian's Chromium, driven by the
 # playwright package of the docs extra (never `playwright install`: its browser downloads are not used). Installed
 # here when missing (as root, with apt); where it cannot be, those tests skip and say why.
 CHROMIUM := /usr/bin/chromium

@@ -14,7 +14,7 @@ engine's escape rules (:mod:`hhscatter.integrate.engine`), and return the same a
   (Kahan & Li, Math. Comp. 66 (1997) 1089, scheme "s17odr8a"); in
   OrdinaryDiffEq's kick/drift form the drift coefficients are
   a = (γ1…γ9…γ1, 0) and the kicks b_i = (a_{i−1} + a_i)/2. Not the 15-stage
-  "s15odr8" set. Order 8 is checked numerically in tests/test_bench_peers.py.
+  "s15odr8" set. Order 8 is checked numerically in tests/bench/test_bench_peers.py.
   Escape is checked at step ends (``rootfind=False``: t_end = the first step end
   with r > r_esc, as the authors' fixed-step runs) or root-found inside that
   step by Newton on re-integrated partial steps (``rootfind=True``).

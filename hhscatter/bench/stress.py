@@ -4,7 +4,7 @@ Each case is a function that takes its size as arguments, runs the engine
 (:func:`hhscatter.integrate.engine.run_chunk` or :func:`hhscatter.run.runner.simulate`)
 and an independent reference (heyoka long double, :mod:`.reference`), and
 returns a :class:`CaseResult` (table rows, a one-line finding, and ``ok``:
-whether the case's acceptance rule holds). ``tests/test_stress.py`` calls the
+whether the case's acceptance rule holds). ``tests/bench/test_stress.py`` calls the
 same functions at small size; ``python -m hhscatter.bench.stress`` runs them at
 the sizes of ``studies/stress/stress.toml`` and writes CSVs, a PNG and
 ``summary.md`` under ``studies/stress/out/<scale>/``.

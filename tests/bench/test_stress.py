@@ -147,7 +147,7 @@ def test_stress_tiny_end_to_end(tmp_path):
     import shutil
     from pathlib import Path
 
-    src = Path(__file__).resolve().parents[1] / "studies" / "stress" / "stress.toml"
+    src = Path(__file__).resolve().parents[2] / "studies" / "stress" / "stress.toml"
     (tmp_path / "stress").mkdir()
     shutil.copy(src, tmp_path / "stress" / "stress.toml")
     rc = stress.main(["--scale", "tiny", "--root", str(tmp_path), "--only", "saddle_starts", "statistics"])

@@ -22,7 +22,7 @@ from hhscatter.analysis.dissipative.models import E_C, time_to_energy
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 from hhscatter.studies import _upstream as up
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 # ---------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 spec = importlib.util.spec_from_file_location(
-    "behaviour_snapshot", Path(__file__).resolve().parents[1] / "tools" / "behaviour_snapshot.py")
+    "behaviour_snapshot", Path(__file__).resolve().parents[2] / "tools" / "behaviour_snapshot.py")
 bs = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(bs)
 

@@ -16,7 +16,7 @@ from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.scene import Follow, Scene, SceneError, SectionWindow
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 OLD_HASH = "4e97917dd6101d2cc772e8ceb545ee8f6dd47b4ed183576388f7feba3d9c93c5"  # computed by scene.py at 6a7a794
 
 

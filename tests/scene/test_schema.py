@@ -14,7 +14,7 @@ import pytest
 
 from hhscatter.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BASE = "f701897"  # main before the strict configuration (and the study rooms) of issue 12
 
 

@@ -23,7 +23,7 @@ from hhscatter.analysis.survival.escape_rate import (
 )
 from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 # ---------------------------------------------------------------------------

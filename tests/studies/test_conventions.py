@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.test_config import _run_study, _study_root
+from tests.scene.test_schema import _run_study, _study_root
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 STUDIES = ROOT / "studies"
 FIGURES = ("fig1", "fig2", "fig3", "fig4", "fig5", "fig6")
 

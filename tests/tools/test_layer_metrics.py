@@ -4,7 +4,7 @@ import importlib.util
 from pathlib import Path
 
 spec = importlib.util.spec_from_file_location(
-    "layer_metrics", Path(__file__).resolve().parents[1] / "tools" / "layer_metrics.py")
+    "layer_metrics", Path(__file__).resolve().parents[2] / "tools" / "layer_metrics.py")
 lm = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(lm)
 

@@ -169,7 +169,7 @@ def test_workprecision_tiny_end_to_end(tmp_path, monkeypatch):
 
     from hhscatter.bench import workprecision
 
-    src = Path(__file__).resolve().parents[1] / "studies" / "bench" / "bench.toml"
+    src = Path(__file__).resolve().parents[2] / "studies" / "bench" / "bench.toml"
     (tmp_path / "bench").mkdir()
     shutil.copy(src, tmp_path / "bench" / "bench.toml")
     workprecision.main(["--scale", "tiny", "--root", str(tmp_path), "--no-throughput"])

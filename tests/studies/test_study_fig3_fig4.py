@@ -17,7 +17,7 @@ from hhscatter.analysis.dissipative.transitions import (
     survival_on_grid,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 E_C = 1.0 / 6.0
 
 
