@@ -42,7 +42,7 @@ import numpy as np
 
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
 from hhscatter.data.store import Store
-from hhscatter.data.tables import iter_survival_batches, read_lifetimes, read_sections
+from hhscatter.data.read import iter_survival_batches, read_lifetimes, read_sections
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -1278,7 +1278,7 @@ def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any
     """stream_survival(run, t_grid, filters=None) -> SurvivalCurve(t, P, P_err) of a run's lifetimes at the grid times.
 
     P(t) = Pr(lifetime > t) (paper Eqs. (eqn:kappa_hyperbolic), (eqn:kappa_nonhyperbolic)) streamed over the run's
-    lifetimes table in record batches (:func:`hhscatter.data.tables.iter_survival_batches`) into
+    lifetimes table in record batches (:func:`hhscatter.data.read.iter_survival_batches`) into
     :class:`hhscatter.analysis.survival.kaplan_meier.KaplanMeierGrid`: memory O(len(t_grid) + one batch), whatever
     N (1e9 orbits fit). hhscatter censors orbits only at t_max, so for t below every censoring time the estimate is
     exact (the fraction #{t_end > t}/N, Greenwood's error the binomial √(P(1−P)/N)).

@@ -277,7 +277,7 @@ def _scene_from_args(a):
 
 def cmd_simulate(a):
     from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
-    from hhscatter.data.tables import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.data.read import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)
@@ -307,7 +307,7 @@ def cmd_survival(a):
         plot_survival,
         survival,
     )
-    from hhscatter.data.tables import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.data.read import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
 
     png = Path(a.png)
     if not png.parent.is_dir():

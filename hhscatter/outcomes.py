@@ -1,7 +1,7 @@
 """The vocabulary of an orbit's fate, declared once: outcome codes and names, and which outcomes censor.
 
 The engine decides an orbit's outcome at an exact event root (:mod:`hhscatter.integrate.events`), the tables store
-it as a dictionary-encoded ``outcome`` column (:mod:`hhscatter.data.tables`), and the survival analysis reads it
+it as a dictionary-encoded ``outcome`` column (:mod:`hhscatter.data.schema`), and the survival analysis reads it
 (:func:`hhscatter.analysis.survival.fits.observed_from_outcome`): all three use these names.
 
 * ``escaped``: left Ω through an exit (r > r_esc);

@@ -11,7 +11,7 @@ from hhscatter.cli import main
 from hhscatter.run.runner import simulate
 from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SceneError, SectionWindow
-from hhscatter.data.tables import read_meta
+from hhscatter.data.read import read_meta
 
 
 def _files(d):

@@ -10,7 +10,7 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
     <!-- hh:bench stress -->         docs/benchmarks/assets/stress/*summary.md (+ figures)
     <!-- hh:cli -->                  every subcommand and flag of `hhscatter`
-    <!-- hh:schemas -->              the Parquet schemas of hhscatter.data.tables
+    <!-- hh:schemas -->              the Parquet schemas of hhscatter.data.schema
 
 The "Studies" section of the navigation is made from the study folders
 (``studies/<name>/study.toml``, table ``[about]``) by ``on_config``: a new
@@ -340,7 +340,7 @@ class Renderer:
         return cli_reference(build_parser())
 
     def schemas(self, _arg=None) -> str:
-        from hhscatter.data.tables import _schemas
+        from hhscatter.data.schema import _schemas
 
         out = []
         for name, schema in _schemas().items():

@@ -9,7 +9,7 @@ process, not the sum over the pool):
 
 * ``simulate``: ``hhscatter simulate --energy E -n N --workers W`` (disk ICs,
   γ = 0, t_max = 5000, the engine's defaults);
-* ``analysis``: :func:`hhscatter.data.tables.survival_arrays` (column projection:
+* ``analysis``: :func:`hhscatter.data.read.survival_arrays` (column projection:
   ``t_end`` and ``outcome`` only) → Kaplan–Meier P(t) at every event time →
   exponential fit of κ over t ∈ [5, 40] (paper Eq. eqn:kappa_hyperbolic);
 * ``streamed``: :func:`hhscatter.api.stream_survival` (P(t) on a grid of
@@ -50,7 +50,7 @@ _SNIPPETS = {
         "'--chunk-size', '{chunk}', '--out', '{out}', '--quiet', '--overwrite']))"
     ),
     "analysis": (
-        "import json; from hhscatter.data.tables import survival_arrays;"
+        "import json; from hhscatter.data.read import survival_arrays;"
         "from hhscatter.analysis.survival.fits import survival_curve, fit_exponential;"
         "t, obs = survival_arrays('{out}'); c = survival_curve(t, obs);"
         "f = fit_exponential(c.t, c.P, (5.0, 40.0), P_err=c.P_err);"

@@ -39,7 +39,7 @@ import numpy as np
 from hhscatter.bench.config import load_config, machine_note, out_dir
 from hhscatter.bench.plots import plot_energy_drift
 from hhscatter.bench.reference import reference_orbits
-from hhscatter.data.tables import read_lifetimes, read_sections, read_snapshots
+from hhscatter.data.read import read_lifetimes, read_sections, read_snapshots
 from hhscatter.integrate.engine import (
     CENSORED,
     ESCAPED,

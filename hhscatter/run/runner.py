@@ -31,7 +31,7 @@ A failed write (disk full, permission lost) stops the run with a
 
 A run is a manifest. ``scene.json`` holds the plan (:func:`manifest_of`: the
 tables, and per point its scene hash, n and chunk size, hence every part file
-and its orbit range); the readers of :mod:`hhscatter.data.tables` read exactly the
+and its orbit range); the readers of :mod:`hhscatter.data.schema` read exactly the
 planned parts whose chunk is finished, check each part's metadata against the
 plan and verify the page checksums, and refuse anything else. An unfinished
 chunk (no ``lifetimes`` part) makes the run incomplete: an error for readers
@@ -67,16 +67,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
-from hhscatter.data.tables import (
-    TABLES,
-    add_point_columns,
-    part_name,
-    provenance,
-    read_meta,
-    to_arrow,
-    verify_part,
-    write_part,
-)
+from hhscatter.data.schema import TABLES, add_point_columns, part_name, provenance, to_arrow
+from hhscatter.data.read import read_meta, verify_part
+from hhscatter.data.write import write_part
 from hhscatter.errors import ConfigError, OutputError, RunError, RunIntegrityError  # noqa: F401 (RunError: re-exported)
 from hhscatter.integrate.engine import run_chunk
 from hhscatter.run.dask_backend import check_scheduler, dask_client
@@ -203,7 +196,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):
         table = to_arrow(name, rows[name])
-        if partition and "=" not in partition:  # a grid point's files name their point (hhscatter.data.tables)
+        if partition and "=" not in partition:  # a grid point's files name their point (hhscatter.data.schema)
             table = add_point_columns(name, table, scene)
         rel = part_rel(name, partition, chunk)
         try:
@@ -277,7 +270,7 @@ def manifest_of(points, tables) -> dict:
 
     ``{"tables": [...], "points": [{"partition", "scene_hash", "n", "chunk_size"}]}``: the part files a
     complete run has are exactly part_rel(table, partition, chunk) for chunk < ceil(n/chunk_size), each
-    carrying ``scene_hash`` and its orbit range in its metadata (:func:`hhscatter.data.tables.run_parts`).
+    carrying ``scene_hash`` and its orbit range in its metadata (:func:`hhscatter.data.read.run_parts`).
     """
     return {"tables": list(tables),
             "points": [{"partition": part, "scene_hash": h, "n": int(sc.n), "chunk_size": int(sc.chunk_size)}
@@ -396,7 +389,7 @@ def resumed_points(store, points):
     """resumed_points(store, points) -> points with the folder names the run at ``store`` was started with.
 
     A grid run begun by hhscatter ≤ 0.1.0 keeps its ``energy=…/gamma=…`` folders when resumed, so that it
-    stays one dataset in one layout (:mod:`hhscatter.data.tables` reads both).
+    stays one dataset in one layout (:mod:`hhscatter.data.schema` reads both).
     """
     if not store.exists(SCENE_FILE):
         return points
@@ -446,7 +439,7 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
         What to integrate: one ensemble, or a sweep over E0 and/or γ (:class:`hhscatter.Grid`).
     out : path or URL
         Output directory (created), or a URL pyarrow/fsspec can write (``s3://…``); see
-        :mod:`hhscatter.data.tables` for the layout.
+        :mod:`hhscatter.data.schema` for the layout.
     workers : int, optional
         Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes).
     overwrite : bool

@@ -23,7 +23,7 @@ typed as a string (or dictionary) by pyarrow, pandas and DuckDB, and clashes
 with a file column of the same name, so the runs of hhscatter ≤ 0.1.0
 (``energy=0.25/gamma=0.01/``) did not open in those readers. With the point in
 the files, pandas, pyarrow, DuckDB and polars read the same numeric frame
-(see :mod:`hhscatter.data.tables`). The column is ``energy``, not ``e0``: ``e0`` is
+(see :mod:`hhscatter.data.schema`). The column is ``energy``, not ``e0``: ``e0`` is
 each orbit's computed initial energy, which differs from the nominal E0 in
 the last bits, so group by ``energy``, never by ``e0``.
 

@@ -14,7 +14,7 @@ The stages make runs as separate targets:
 
 ``simulate(study, workers)``
     integrates the study's scenes into immutable raw run directories
-    ``studies/<name>/out/<scale>/raw/<key>/`` (Parquet, see :mod:`hhscatter.data.tables`);
+    ``studies/<name>/out/<scale>/raw/<key>/`` (Parquet, see :mod:`hhscatter.data.schema`);
 ``analyze(study)``
     turns raw tables into derived tables under ``.../derived/`` and the study's
     numbers ``.../<name>.json`` with the pure functions of :mod:`hhscatter.analysis`;
@@ -44,7 +44,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from hhscatter.data.tables import run_status
+from hhscatter.data.read import run_status
 from hhscatter.errors import StudyError
 from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
 from hhscatter.studies.cost import meter, record

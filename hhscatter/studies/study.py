@@ -14,7 +14,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from hhscatter.data.tables import provenance, write_part, write_parts_streamed
+from hhscatter.data.schema import provenance
+from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
 from hhscatter.model import HenonHeiles
 from hhscatter.run.runner import SCENE_FILE, simulate

@@ -208,7 +208,7 @@ def _zoom_extent(extent, centre, factor):
 
 def basin_image(study, key, E, extent, n):
     """basin_image(study, key, E, extent, n) -> (n, n) int8 outcome codes (−1 forbidden) of a map run."""
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     _, _, allowed, _, cell = _map_states(study, E, extent, n)
     lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "exit_channel"])
@@ -251,7 +251,7 @@ def _uncertainty(study, E, g, eps, keys=None, times=None):
     """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
     the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ)."""
     from hhscatter.analysis.geometry.basins import uncertainty_fraction
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     rows = []
     keys = [unc_key(E, g, i) for i in range(len(eps))] if keys is None else keys

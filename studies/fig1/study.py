@@ -81,7 +81,7 @@ def _pilot_scene(study, energy):
 def _pilot_rate(pilot_dir):
     """κ, τ0 (and the full EscapeRateResult) of a pilot run."""
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     lt = read_lifetimes(pilot_dir, columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
     return escape_rate_from_lifetimes(lt, detect_tail=False)
@@ -141,7 +141,7 @@ def analyze(study):
     import pandas as pd
 
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
     E_C = model.critical_energy

@@ -136,7 +136,7 @@ def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds
 # simulate
 # ---------------------------------------------------------------------------
 def _lifetimes(path):
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     return read_lifetimes(path, columns=LIFETIME_COLUMNS, categorical=True)  # 1e7 orbits: no str per orbit
 
@@ -325,7 +325,7 @@ def _analyze_pt(study):
         power_law_exponent_mle,
     )
     from hhscatter.analysis.survival.fits import survival_curve
-    from hhscatter.data.tables import survival_arrays
+    from hhscatter.data.read import survival_arrays
 
     E_C = study.model.critical_energy
     curves, lines, numbers = [], [], {}
@@ -414,7 +414,7 @@ def _analyze_cmeasure(study, grid_runs):
     )
     from hhscatter.analysis.survival.escape_rate import escape_rate
     from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     E_C = study.model.critical_energy
 

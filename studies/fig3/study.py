@@ -93,7 +93,7 @@ def simulate(study, workers=None, progress=True):
 
 def _snapshot_rows(study, key: str, filters=None) -> pd.DataFrame:
     """Snapshot rows (traj_id, t, energy) of orbits not escaped; ``filters`` pushed down to the reader."""
-    from hhscatter.data.tables import read_snapshots
+    from hhscatter.data.read import read_snapshots
 
     return read_snapshots(study.raw(key), filters=filters)
 
@@ -109,7 +109,7 @@ def analyze(study):
         inside_mean_energy,
         mu_by_window,
     )
-    from hhscatter.data.tables import iter_parts, read_lifetimes
+    from hhscatter.data.read import iter_parts, read_lifetimes
 
     key = _key(study)
     scene = study.scene(key)

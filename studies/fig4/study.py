@@ -184,7 +184,7 @@ def _read_lifetimes(study, gs):
     Read as Arrow columns (no Python string per orbit: ``outcome`` stays a categorical of 1 byte per orbit),
     so memory is ~40 bytes per orbit while one run is read and ~9 bytes per orbit and γ kept.
     """
-    from hhscatter.data.tables import read_by_orbit
+    from hhscatter.data.read import read_by_orbit
 
     lts, ref = {}, None
     for g in gs:
@@ -206,7 +206,7 @@ def _own_mu(study, mg, E0, N):
     import pyarrow.dataset as ds
 
     from hhscatter.analysis.dissipative.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
-    from hhscatter.data.tables import iter_parts, read_snapshots
+    from hhscatter.data.read import iter_parts, read_snapshots
 
     ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]),
                              study.model.critical_energy)

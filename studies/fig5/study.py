@@ -171,7 +171,7 @@ def simulate(study, workers=None, progress=True):
 def _authors_sets(study):
     """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < r_cut
     (their plots), capped at n_cap points."""
-    from hhscatter.data.tables import read_sections
+    from hhscatter.data.read import read_sections
 
     n_cap, seed = study.params.n_cap, study.params.seed
     out = {}
@@ -424,7 +424,7 @@ def _point_sets(study, gammas, E1, E2, mu, mu_err):
     orbit (Fig. 5a) and those in the energy band (Fig. 5b), capped at n_cap points."""
     import pyarrow.dataset as pads
 
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     band = tuple(study.params.band)
     n_cap, seed = study.params.n_cap, study.params.seed

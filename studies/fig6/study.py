@@ -281,7 +281,7 @@ def analyze(study):
 
     import pyarrow as pa
 
-    from hhscatter.data.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.read import read_lifetimes, read_snapshots
 
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
     ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": mu}
@@ -555,7 +555,7 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
     """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)."""
     import pyarrow as pa
 
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     E0 = study.params.fig4_E0
     other = study.upstream("tau")

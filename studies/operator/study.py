@@ -243,7 +243,7 @@ def _grid_shape(study, box):
 def one_return_table(study, key, df) -> pd.DataFrame:
     """The samples of ``df`` (in traj_id order) with their fate: ``ret`` (crossed again), ``T`` (time of the
     crossing), ``t_end`` (time of the next event), ``x1, y1, e1`` (the crossing), ``censored``."""
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     raw = study.raw(key)
     lt = read_lifetimes(raw, columns=["traj_id", "outcome", "t_end"]).sort_values("traj_id")
@@ -348,7 +348,7 @@ def _islands(study, E, df, tr, ids, keep, sub, t):
     of P on the saddle's class with their mass on trapped boxes, and κ with the trapped boxes taken out."""
     from scipy.sparse.linalg import eigs
 
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     pr = _probe_ics(df)
     lt = read_lifetimes(study.raw(probe_key(E)), columns=["traj_id", "outcome"]).sort_values("traj_id")
@@ -543,7 +543,7 @@ def _empirical_survival(t_end, leaving, grid):
 def _dissipative(study, inputs):
     from hhscatter.analysis.geometry import distance as dist
     from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     edges = _diss_bins(study)
     n_bins = len(edges) - 1
@@ -634,7 +634,7 @@ def _dissipative(study, inputs):
 def _cost(study, records, kappa0):
     from hhscatter.analysis.survival.escape_rate import escape_rate
     from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     target = study.params.target_rel
     rows = []

@@ -107,7 +107,7 @@ def _lifetimes(study, E, r):
     paper scale, 4 runs per energy held at once.
     """
     from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.tables import read_by_orbit
+    from hhscatter.data.read import read_by_orbit
 
     c = read_by_orbit(study.raw(_key(E, r)), ["outcome", "t_end", "exit_channel"])
     obs = observed_from_outcome(c["outcome"])
@@ -223,7 +223,7 @@ def _follow_returns(study, E, radii):
     """(follow-run lifetimes, {r: return statistics back inside r_in}, {r: back inside r itself}) at energy E:
     returns and flight times on identical trajectories (the follow runs' ``crossings``)."""
     from hhscatter.analysis.geometry.channels import return_statistics
-    from hhscatter.data.tables import read_crossings, read_lifetimes
+    from hhscatter.data.read import read_crossings, read_lifetimes
 
     r_in = study.params.r_in
     fdir = study.raw(_follow_key(E))

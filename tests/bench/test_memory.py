@@ -85,7 +85,7 @@ _READ = """
 import sys
 import numpy as np, pandas, pyarrow.dataset, pyarrow.parquet
 from hhscatter.api import stream_survival
-from hhscatter.data.tables import read_lifetimes, survival_arrays
+from hhscatter.data.read import read_lifetimes, survival_arrays
 from hhscatter.analysis.survival.fits import survival_curve
 def status(key):
     for line in open('/proc/self/status'):
@@ -114,7 +114,8 @@ print(extra, int(t.size), int((~obs).sum()), c.P[10])
 @pytest.mark.skipif(not os.access("/proc/self/clear_refs", os.W_OK), reason="needs Linux /proc/self/clear_refs")
 def test_survival_inputs_are_read_with_column_projection(tmp_path):
     """P(t) from survival_arrays / survival_on_grid equals P(t) from the full table, at a fraction of the memory."""
-    from hhscatter.data.tables import part_name, to_arrow, write_part
+    from hhscatter.data.schema import part_name, to_arrow
+    from hhscatter.data.write import write_part
 
     rng = np.random.default_rng(0)
     n_part, parts = 100_000, 4
@@ -157,7 +158,8 @@ def test_survival_on_grid_equals_kaplan_meier(tmp_path):
     """Streamed counts vs survival_curve (Kaplan–Meier) on the same lifetimes, with ties and censoring at t_max."""
     from hhscatter.analysis.survival.fits import survival_curve
     from hhscatter.api import stream_survival
-    from hhscatter.data.tables import part_name, to_arrow, write_part
+    from hhscatter.data.schema import part_name, to_arrow
+    from hhscatter.data.write import write_part
 
     rng = np.random.default_rng(3)
     t_all, obs_all = [], []

@@ -24,11 +24,7 @@ from hhscatter.cli import main
 from hhscatter.run.runner import simulate
 from hhscatter.errors import IncompleteRunError, OutputError, RunIntegrityError, StudyError
 from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
-from hhscatter.data.tables import (
-    read_lifetimes,
-    read_sections,
-    read_snapshots,
-)
+from hhscatter.data.read import read_lifetimes, read_sections, read_snapshots
 
 SCENE = {"energy": 0.3, "gamma": 0.01, "n": 400, "seed": 11, "chunk_size": 100, "sections": SectionWindow(),
          "snapshots": (0.0, 5.0, 50.0)}

@@ -12,7 +12,8 @@ from hhscatter import read_lifetimes, read_sections, read_snapshots
 from hhscatter.scene.grid import Grid
 from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, SectionWindow
-from hhscatter.data.tables import read_meta, survival_arrays, write_part
+from hhscatter.data.read import read_meta, survival_arrays
+from hhscatter.data.write import write_part
 
 KEYS = ["energy", "gamma", "traj_id"]
 COLS = ["traj_id", "energy", "gamma", "e0", "x0", "outcome", "t_end", "e_end"]
@@ -148,7 +149,7 @@ def test_read_lifetimes_categorical_is_the_same_table_at_one_byte_per_outcome(ru
     """categorical=True (the route for 1e7 orbits): the same labels, as a pandas categorical."""
     import pandas as pd
 
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     plain = read_lifetimes(run)
     cat = read_lifetimes(run, categorical=True)
@@ -163,7 +164,7 @@ def test_read_by_orbit_is_the_lifetimes_table_in_orbit_order(run):
     """read_by_orbit: numpy columns in traj_id order, outcome as a 1-byte categorical, null channels as −1."""
     import pandas as pd
 
-    from hhscatter.data.tables import read_by_orbit, read_lifetimes
+    from hhscatter.data.read import read_by_orbit, read_lifetimes
 
     ref = read_lifetimes(run).sort_values("traj_id", kind="stable").reset_index(drop=True)
     c = read_by_orbit(run, ["t_end", "outcome", "exit_channel"])

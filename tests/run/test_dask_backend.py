@@ -122,7 +122,7 @@ def test_fsspec_url_output_resume_and_read(tmp_path, scene, reference):
     """A URL --out goes through pyarrow.fs/fsspec (here fsspec's in-memory filesystem, this process only)."""
     import fsspec
 
-    from hhscatter.data.tables import read_lifetimes, read_sections
+    from hhscatter.data.read import read_lifetimes, read_sections
 
     url = "memory://hhscatter-test/run"
     try:

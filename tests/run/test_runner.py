@@ -15,7 +15,7 @@ from hhscatter.run.runner import RunError, simulate
 from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SectionWindow
 from hhscatter.scene.schema import load_scene
-from hhscatter.data.tables import verify_part
+from hhscatter.data.read import verify_part
 
 TOML = """[scene]
 energy = 0.3
@@ -128,7 +128,7 @@ def test_write_failure_is_clear_and_keeps_finished_parts(tmp_path, monkeypatch, 
     def failing(table, where, **kw):
         calls.append(where)
         if len(calls) == 3:  # the third part file: a partial file, then the error, as a real full disk does
-            if hasattr(where, "write"):  # local parts are written through an open file (hhscatter.data.tables)
+            if hasattr(where, "write"):  # local parts are written through an open file (hhscatter.data.write)
                 where.write(b"PAR1 partial")
             else:
                 Path(where).write_bytes(b"PAR1 partial")

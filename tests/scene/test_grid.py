@@ -11,7 +11,7 @@ from hhscatter.run.runner import simulate
 from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SceneError
 from hhscatter.scene.schema import load_scene
-from hhscatter.data.tables import read_lifetimes, read_meta, read_sections
+from hhscatter.data.read import read_lifetimes, read_meta, read_sections
 
 ENERGIES, GAMMAS = (0.25, 0.3), (0.0, 0.01)
 

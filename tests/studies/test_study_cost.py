@@ -47,7 +47,8 @@ def test_streamed_table_is_one_file_with_a_row_group_per_part(tmp_path):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from hhscatter.data.tables import read_meta, write_parts_streamed
+    from hhscatter.data.read import read_meta
+    from hhscatter.data.write import write_parts_streamed
 
     dic = pa.dictionary(pa.int8(), pa.string())
     parts = [pa.table({"g": pa.array([0.0, 0.0]), "o": pa.array(["escaped", "censored"]).cast(dic)}),

@@ -172,7 +172,7 @@ def _finite_numbers(obj):
 
 def test_fig1_tiny_end_to_end(tiny_root):
     from hhscatter.studies import load_study
-    from hhscatter.data.tables import read_sections
+    from hhscatter.data.read import read_sections
 
     study = load_study("fig1", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 20_000
@@ -243,7 +243,7 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
     energies, and the analysis gives the same numbers twice."""
     from hhscatter.analysis.survival.fits import lifetimes_to_arrays, survival_curve
     from hhscatter.studies import load_study, run_stage
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     study = load_study("fig2", "tiny", root=tiny_root)
     doc = json.loads(study.numbers_path.read_text())

@@ -170,7 +170,7 @@ def tiny_root(tiny_studies):
 
 
 def test_fig3_tiny_end_to_end(tiny_root):
-    from hhscatter.data.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.read import read_lifetimes, read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     nums = json.loads((out / "fig3.json").read_text())
@@ -238,7 +238,7 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
     """Each μ row of authors_convention is the log fit of a mean computed here from the raw snapshot table: the
     E > E_c mean leaves out exactly the settled-and-continued rows (t > t_end of a settled orbit), the other
     keeps every row; the comparison rows carry the same numbers, flags and the verdict rule."""
-    from hhscatter.data.tables import read_lifetimes, read_snapshots
+    from hhscatter.data.read import read_lifetimes, read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     raw = out / "raw" / "e0.3_gamma0.01"
@@ -281,7 +281,7 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
 
 def test_fig3_ribbons_sd_and_sem(tiny_root):
     """Both ribbons from the raw energies: ± 3 SD of E (the paper's) is √n times ± 3 SEM (ours)."""
-    from hhscatter.data.tables import read_snapshots
+    from hhscatter.data.read import read_snapshots
 
     out = tiny_root / "fig3" / "out" / "tiny"
     nums = json.loads((out / "fig3.json").read_text())
@@ -350,7 +350,7 @@ def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path):
 
 
 def test_fig4_tiny_end_to_end(tiny_root):
-    from hhscatter.data.tables import read_lifetimes
+    from hhscatter.data.read import read_lifetimes
 
     out = tiny_root / "fig4" / "out" / "tiny"
     nums = json.loads((out / "fig4.json").read_text())

@@ -214,7 +214,7 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
     """The authors' Fig. 5 convention: square ICs (goodICs) at E2, their windows, r < 1 — built from runs
     whose scenes say so, and the same numbers when the analysis runs again."""
     from hhscatter.studies import load_study, run_stage
-    from hhscatter.data.tables import read_sections
+    from hhscatter.data.read import read_sections
 
     study = load_study("fig5", "tiny", root=tiny_studies)
     nums = json.loads(study.numbers_path.read_text())

@@ -167,7 +167,7 @@ def test_the_analysis_layer_is_pure():
     """No heyoka, no engine or runner, no file I/O under hhscatter/analysis: arrays or DataFrames in, results out."""
     import ast
 
-    banned_modules = ("heyoka", "pyarrow", "hhscatter.integrate.engine", "hhscatter.run.runner", "hhscatter.data.tables",
+    banned_modules = ("heyoka", "pyarrow", "hhscatter.integrate.engine", "hhscatter.run.runner", "hhscatter.data.read", "hhscatter.data.write", "hhscatter.data.schema",
                       "hhscatter.data.store", "hhscatter.studies")
     banned_calls = {"open", "read_text", "write_text", "read_bytes", "write_bytes", "read_parquet", "to_parquet",
                     "to_csv", "read_csv", "savefig"}

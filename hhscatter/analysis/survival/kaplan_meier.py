@@ -18,7 +18,7 @@ t_k. The inputs differ only in what the t_k are:
   non-negative orbit ``weights`` (e.g. bootstrap multiplicities);
 * :class:`KaplanMeierGrid` — the bins (g_{j−1}, g_j] of a fixed grid,
   filled batch by batch (``add``): P(t) of any number of orbits in memory
-  O(grid) (``hhscatter.data.tables.survival_on_grid`` streams part files into
+  O(grid) (``hhscatter.data.read.survival_on_grid`` streams part files into
   it). Exact at the grid times when nothing is censored inside the grid
   (``first_censoring``), e.g. censoring only at t_max; otherwise an orbit
   censored inside a bin counts at risk for that whole bin;
