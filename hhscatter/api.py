@@ -1226,10 +1226,7 @@ def run_scene(run) -> dict:
 
     Raises ValueError if ``run`` holds no ``scene.json`` (not a run of :func:`hhscatter.simulate`).
     """
-    from hhscatter.run.runner import (  # deferred: pydantic loads on first use
-        SCENE_FILE,
-        _decode,
-    )
+    from hhscatter.run.plan import SCENE_FILE, _decode  # deferred: pydantic loads on first use
 
     store = Store(run)
     if not store.exists(SCENE_FILE):

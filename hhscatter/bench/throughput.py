@@ -68,7 +68,7 @@ def measure_throughput(cfg, *, progress=True):
     """measure_throughput(cfg) -> DataFrame, one row per (scene, workers)."""
     import pandas as pd  # deferred: pandas loads on first use
 
-    from hhscatter.run.runner import default_workers  # deferred: pydantic loads on first use
+    from hhscatter.run.worker import default_workers  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     tp = cfg["throughput"]

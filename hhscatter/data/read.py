@@ -65,7 +65,7 @@ def verify_part(source, expect_rows=None) -> dict:
 
 
 def run_manifest(run_dir) -> dict | None:
-    """run_manifest(run_dir) -> the run's plan from OUT/scene.json (hhscatter.run.runner.manifest_of), or None.
+    """run_manifest(run_dir) -> the run's plan from OUT/scene.json (hhscatter.run.plan.manifest_of), or None.
 
     None for a directory without scene.json or a run written before manifests (read as before, by
     listing its part files).
@@ -167,7 +167,7 @@ def _check_fragment(store, name, frag, point, chunk):
 def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: bool = False):
     """_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run, either layout).
 
-    A run with a manifest (scene.json, hhscatter.run.runner.manifest_of) is read as exactly its planned and
+    A run with a manifest (scene.json, hhscatter.run.plan.manifest_of) is read as exactly its planned and
     finished part files: each part's metadata is checked against the plan (scene hash, chunk, orbit range,
     row count; :func:`_check_fragment`, one footer per part) and every data page's checksum is verified as
     it is read. A missing table or part, a part not in the plan or of another scene raise

@@ -20,7 +20,7 @@ import contextlib
 import logging
 
 from hhscatter.errors import ConfigError, SetupError
-from hhscatter.run.workers import default_workers
+from hhscatter.run.worker import default_workers
 
 #: the address protocols of dask.distributed's communication layer
 SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")

@@ -18,7 +18,8 @@ from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
 from hhscatter.model import HenonHeiles
-from hhscatter.run.runner import SCENE_FILE, simulate
+from hhscatter.run.plan import SCENE_FILE
+from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
 from hhscatter.scene.schema import (
     apply_convention,

@@ -41,7 +41,7 @@ import math
 import numpy as np
 
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
-from hhscatter.run.runner import SCENE_FILE
+from hhscatter.run.plan import SCENE_FILE
 
 
 class Params(StudyParams):

@@ -41,7 +41,7 @@ import numpy as np
 
 from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
-from hhscatter.run.runner import SCENE_FILE
+from hhscatter.run.plan import SCENE_FILE
 
 
 class Params(StudyParams):

@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.run.runner import RunError, simulate
+from hhscatter.errors import RunError
+from hhscatter.run.runner import simulate
 from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SectionWindow
 from hhscatter.scene.schema import load_scene

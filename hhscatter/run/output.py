@@ -1,0 +1,142 @@
+"""The output location of a run, checked and prepared before any work: empty, overwritten or resumed (the same
+scene, no part outside the plan), locked for one writer."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+
+
+from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
+from hhscatter.data.schema import TABLES
+from hhscatter.errors import ConfigError, OutputError
+from hhscatter.scene.grid import Grid
+from hhscatter.run.plan import SCENE_FILE, manifest_of, part_rel, points_of, tables_of
+
+
+
+def _diff(old: dict, new: dict) -> str:
+    keys = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k) and k not in ("name", "batch_size"))
+    return ", ".join(f"{k}: {old.get(k)!r} → {new.get(k)!r}" for k in keys[:6])
+
+
+def _extra_parts(store, manifest) -> list[str]:
+    """Part files under the table folders that the manifest does not plan (duplicates, junk, other runs)."""
+    planned = {part_rel(name, p["partition"], c) for name in manifest["tables"] for p in manifest["points"]
+               for c in range(-(-p["n"] // p["chunk_size"]))}
+    extra = []
+    for name in TABLES:
+        for f in store.files(name):
+            base = f.rsplit("/", 1)[-1]
+            if base.startswith(".") and TMP_MARK in base:
+                continue
+            if f"{name}/{f}" not in planned:
+                extra.append(f"{name}/{f}")
+    return extra
+
+
+def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
+    """Check and prepare the output location before any work; raise OutputError if unusable.
+
+    Takes the run directory's write lock (one writer per directory, :meth:`hhscatter.data.store.Store.lock`):
+    returns (store, lock, points), the lock to be released with ``Store.unlock`` when the run ends. ``points``:
+    [(scene, partition, scene_hash)] (default: from ``run``). If a check fails, nothing is left behind
+    (a directory made here is removed again).
+    """
+    if overwrite and resume:
+        raise ConfigError("--overwrite and --resume exclude each other")
+    try:
+        store = Store(out)
+    except ValueError as exc:
+        raise OutputError(str(exc)) from None
+    if store.exists() and not store.is_dir():
+        raise OutputError(f"out: {store.display()} exists and is not a directory")
+    if points is None:
+        points = [(sc, part, sc.result_hash()) for sc, part in points_of(run)]
+    created = not store.exists()
+    lock = None
+    try:
+        try:
+            lock = store.lock()
+        except LockedError as exc:
+            raise OutputError(f"out: {exc}; one writer per run directory: wait for it or use another --out") \
+                from None
+        except OSError as exc:
+            raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+        # ours to remove on failure only if it was not there and still holds nothing but our lock
+        created = created and not [e for e in store.listdir() if e != LOCK_FILE]
+        _check_and_clear(run, store, points, overwrite=overwrite, resume=resume)
+        if resume:
+            points = resumed_points(store, points)
+        try:
+            store.makedirs()
+            probe = f".write-test-{os.getpid()}"
+            store.write_text(probe, "")
+            store.remove(probe)
+        except OSError as exc:
+            raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
+        doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
+
+        if isinstance(run, Grid):
+            doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
+            doc["points"] = [{"partition": part, "scene_hash": h} for _, part, h in points]
+        doc["manifest"] = manifest_of(points, tables_of(points[0][0]))
+        try:
+            store.write_json(SCENE_FILE, doc)
+        except OSError as exc:
+            raise OutputError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
+                             "nothing was computed") from None
+    except BaseException:
+        if lock is not None and created:  # never a directory another writer made or holds
+
+            shutil.rmtree(store.root, ignore_errors=True)
+        Store.unlock(lock)
+        raise
+    return store, lock, points
+
+
+def _check_and_clear(run, store, points, *, overwrite, resume):
+    """The emptiness / same-scene checks of prepare_output, under the lock; --overwrite clears the old run."""
+    entries = [e for e in store.listdir() if e != LOCK_FILE]
+    if not entries:
+        return
+    if overwrite:
+        # the whole old run: its tables, its scene, its temporaries (other files are not ours: kept)
+        for name in entries:
+            if name in (*TABLES, SCENE_FILE) or (name.startswith(".") and TMP_MARK in name):
+                store.remove(name)
+        return
+    if not resume:
+        raise OutputError(
+            f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
+        )
+    if store.exists(SCENE_FILE):
+        old = json.loads(store.read_text(SCENE_FILE))
+        if old.get("scene_hash") != run.result_hash():
+            what = _diff(old.get("scene", {}), json.loads(run.to_json()))
+            raise OutputError(
+                f"cannot resume into {store.display()}: it holds a different scene"
+                f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"
+            )
+    extra = _extra_parts(store, manifest_of(resumed_points(store, points), tables_of(points[0][0])))
+    if extra:
+        raise OutputError(
+            f"cannot resume into {store.display()}: {len(extra)} part file(s) are not in this run's chunk plan "
+            f"(first: {store.display(extra[0])}); remove them, or use --overwrite or another --out"
+        )
+    for name in TABLES:
+        store.remove_temporaries(name)
+
+
+def resumed_points(store, points):
+    """resumed_points(store, points) -> points with the folder names the run at ``store`` was started with.
+
+    A grid run begun by hhscatter ≤ 0.1.0 keeps its ``energy=…/gamma=…`` folders when resumed, so that it
+    stays one dataset in one layout (:mod:`hhscatter.data.schema` reads both).
+    """
+    if not store.exists(SCENE_FILE):
+        return points
+    old = {p.get("scene_hash"): p.get("partition") for p in json.loads(store.read_text(SCENE_FILE)).get("points", [])}
+    if points and len(points[0]) == 3:
+        return [(scene, old.get(h) or part, h) for scene, part, h in points]
+    return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]

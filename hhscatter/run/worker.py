@@ -1,0 +1,153 @@
+"""The worker side of a run: integrate one (point, chunk) and write its part files; check a finished chunk;
+workers that die with the process that started them."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sys
+import threading
+import time
+
+import numpy as np
+
+from hhscatter.data.store import Store
+from hhscatter.data.schema import add_point_columns, provenance, to_arrow
+from hhscatter.data.read import read_meta, verify_part
+from hhscatter.data.write import write_part
+from hhscatter.errors import RunIntegrityError
+from hhscatter.integrate.engine import run_chunk
+from hhscatter.scene.ics import region_ics
+from hhscatter.scene.scene import Scene, scene_from_dict
+from hhscatter.run.plan import RunSummary, _decode, part_rel, tables_of
+
+
+
+def _chunk_ics(scene, start, stop, table_ics):
+    if table_ics is not None:
+        states, ids = table_ics
+        return states[start:stop], ids[start:stop]
+
+    return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
+
+
+def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition="",
+                  progress=None, scene_hash=None):
+    """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None,
+    scene_hash=None) -> RunSummary.
+
+    Worker entry (local pool or Dask): integrate orbits start..stop−1 of the
+    scene, write the chunk's part files under ``out`` (path or URL) and
+    return the chunk's counts. An OSError while writing is re-raised naming
+    the file. ``progress``: a callable f(k), or a queue that gets (chunk, k)
+    (another process's), told as orbits of the chunk start. ``scene_hash``: the scene's result hash as
+    the client computed it once per run (default: computed here, which re-reads an IC table).
+    """
+
+    scene = scene_from_dict(_decode(json.loads(scene_json)))
+    store = Store(out)
+    if ics is None:
+        ics, ids = _chunk_ics(scene, start, stop, None)
+    if progress is not None and not callable(progress):
+        queue, key = progress, (partition, chunk)
+        progress = lambda k: queue.put((key, k))  # noqa: E731 - a queue proxy of the parent's Manager
+    t0 = time.perf_counter()
+    res = run_chunk(scene, ics, ids, progress=progress)
+    elapsed = time.perf_counter() - t0
+    meta = {
+        "scene": json.loads(scene_json),
+        "scene_hash": scene_hash or scene.result_hash(),
+        "chunk": chunk,
+        "orbits": [start, stop],
+        **provenance(),
+    }
+    rows = res.tables()
+    # lifetimes last: its presence marks a complete chunk
+    for name in reversed(tables_of(scene)):
+        table = to_arrow(name, rows[name])
+        if partition and "=" not in partition:  # a grid point's files name their point (hhscatter.data.schema)
+            table = add_point_columns(name, table, scene)
+        rel = part_rel(name, partition, chunk)
+        try:
+            write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
+        except OSError as exc:
+            raise OSError(exc.errno, f"cannot write {store.display(rel)}: {exc.strerror or exc}") from None
+    oc = np.bincount(res.lifetimes["outcome"], minlength=4)
+    return RunSummary(
+        n=stop - start,
+        escaped=int(oc[0]),
+        settled=int(oc[1]),
+        censored=int(oc[2]),
+        stopped=int(oc[3]),
+        n_sections=len(res.sections["t"]),
+        n_snapshots=len(res.snapshots["t"]),
+        compute_seconds=elapsed,
+    )
+
+
+def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partition: str = "", want=None) -> bool:
+    """chunk_complete(scene, out, chunk, start, stop, partition='', want=None) -> bool.
+
+    True if every part file of ``chunk`` exists, reads in full with valid page
+    checksums, and has this scene's hash, orbit range and row count. Raises
+    RunIntegrityError if a part was made by another scene.
+    """
+    store = Store(out)
+    want = want or scene.result_hash()
+    for name in tables_of(scene):
+        rel = part_rel(name, partition, chunk)
+        if not store.exists(rel):
+            return False
+        try:
+            meta = read_meta(store.path(rel), filesystem=store.filesystem)
+        except Exception:  # noqa: BLE001 - a damaged file is redone, whatever the damage
+            return False
+        if meta.get("scene_hash") != want:
+            raise RunIntegrityError(
+                f"cannot resume: {store.display(rel)} was made by a different scene (hash "
+                f"{str(meta.get('scene_hash', '?'))[:12]}…, this scene {want[:12]}…); "
+                "use --overwrite or another --out"
+            )
+        if meta.get("orbits") != [start, stop] or meta.get("chunk") != chunk:
+            return False
+        source = store.open_input(rel)
+        try:
+            verify_part(source, expect_rows=stop - start if name == "lifetimes" else None)
+        except Exception:  # noqa: BLE001 - truncated, damaged page, wrong row count: redo
+            return False
+        finally:
+            if not isinstance(source, str):
+                source.close()
+    return True
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """die_with_parent(parent_pid) -> None: make this (worker) process die when its parent does.
+
+    Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)``, which the kernel applies however the parent ends
+    (SIGTERM, SIGINT, kill -9), so no worker keeps computing and writing parts for a run that is gone.
+    Elsewhere: a daemon thread that polls the parent every second. The pool's and the progress
+    manager's initializer.
+    """
+    if sys.platform.startswith("linux"):
+        import ctypes  # deferred: Linux-only (prctl), imported where it is used
+
+        PR_SET_PDEATHSIG = 1
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+            if os.getppid() != parent_pid:  # the parent died before prctl: nobody will signal us
+                os._exit(1)
+            return
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="hhscatter-parent-watch").start()
+
+
+def default_workers() -> int:
+    """default_workers() -> the number of CPUs this process may use (its affinity mask), at least 1."""
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
