@@ -191,41 +191,10 @@ def mixture_components_arrays(
     K = int(n_components)
     if K < 1:
         raise ValueError("n_components must be >= 1")
-    grid = np.unique(t[np.isfinite(t)])
-    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
-    at = (t == t_used) & np.isfinite(e)
-    ids_ref, e_ref = ids[at], e[at]
-    order = np.argsort(ids_ref)
-    ids_ref, e_ref = ids_ref[order], e_ref[order]
-    # per-orbit decay laws of the orbits alive at t_ref
-    member_rows = np.isin(ids, ids_ref)
-    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
-    pos = np.searchsorted(uid, ids_ref)
-    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
-    mu_i = np.full(ids_ref.size, np.nan)
-    a_ref = np.full(ids_ref.size, np.nan)
-    mu_i[has] = beta_i[pos[has]] / gamma
-    a_ref[has] = a_i[pos[has]]
-    key = e_ref if by == "energy" else mu_i
-    use = np.isfinite(key)
-    if use.sum() < K:
-        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
-    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
-    comp = np.full(ids_ref.size, -1)
-    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
-    n_ref = np.bincount(comp[use], minlength=K)
-    if np.any(n_ref == 0):
-        raise ValueError("empty sub-ensemble (ties); use fewer components")
-    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
-    for k in range(K):
-        sel = comp == k
-        E_mean[k] = float(e_ref[sel].mean())
-        good = sel & np.isfinite(mu_i)
-        if not good.any():
-            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
-        mu[k] = float(mu_i[good].mean())
-        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
-        A[k] = float(np.exp(a_ref[good].mean()))
+    t_used, ids_ref, e_ref = _orbits_at(ids, t, e, t_ref)
+    mu_i, a_ref = _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window)
+    edges, comp, n_ref = _quantile_bins(e_ref if by == "energy" else mu_i, K, t_used)
+    A, mu, mu_err, E_mean = _sub_ensemble_paths(comp, e_ref, mu_i, a_ref, K)
     return MixtureComponents(
         t_ref=t_used,
         by=by,
@@ -239,6 +208,59 @@ def mixture_components_arrays(
         fit_window=(float(fit_window[0]), float(fit_window[1])),
         gamma=float(gamma),
     )
+
+
+# the steps of mixture_components_arrays (its docstring's steps 1-3)
+def _orbits_at(ids, t, e, t_ref):
+    """The orbits alive at the snapshot grid time nearest ``t_ref``: (that time, their ids (sorted), energies)."""
+    grid = np.unique(t[np.isfinite(t)])
+    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
+    at = (t == t_used) & np.isfinite(e)
+    ids_ref, e_ref = ids[at], e[at]
+    order = np.argsort(ids_ref)
+    return t_used, ids_ref[order], e_ref[order]
+
+
+def _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window):
+    """Step 1, each orbit's decay law ln E_i = a_i − μ_i γ t over ``fit_window``: (μ_i, a_i), NaN if undefined."""
+    member_rows = np.isin(ids, ids_ref)
+    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
+    pos = np.searchsorted(uid, ids_ref)
+    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
+    mu_i = np.full(ids_ref.size, np.nan)
+    a_ref = np.full(ids_ref.size, np.nan)
+    mu_i[has] = beta_i[pos[has]] / gamma
+    a_ref[has] = a_i[pos[has]]
+    return mu_i, a_ref
+
+
+def _quantile_bins(key, K, t_used):
+    """Step 2, K quantile bins of ``key`` (E_i(t_ref) or μ_i): (edges (K+1,), bin of each orbit (−1: unusable), counts)."""
+    use = np.isfinite(key)
+    if use.sum() < K:
+        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
+    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
+    comp = np.full(key.size, -1)
+    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
+    n_ref = np.bincount(comp[use], minlength=K)
+    if np.any(n_ref == 0):
+        raise ValueError("empty sub-ensemble (ties); use fewer components")
+    return edges, comp, n_ref
+
+
+def _sub_ensemble_paths(comp, e_ref, mu_i, a_ref, K):
+    """Step 3, each sub-ensemble's path E_k(t) = A_k e^{−μ_k γ t}: (A_k, μ_k, σ(μ_k), mean E at t_ref), each (K,)."""
+    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
+    for k in range(K):
+        sel = comp == k
+        E_mean[k] = float(e_ref[sel].mean())
+        good = sel & np.isfinite(mu_i)
+        if not good.any():
+            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
+        mu[k] = float(mu_i[good].mean())
+        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
+        A[k] = float(np.exp(a_ref[good].mean()))
+    return A, mu, mu_err, E_mean
 
 
 def mixture_components(
