@@ -50,11 +50,10 @@ from hhscatter.analysis.dissipative.survival_model import (
     HAZARDS,
     SurvivalFit,
     _component,
+    _fit_data,
     _fit_stats,
     _lsq,
-    _p_at,
     _residual_fn,
-    _select,
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
@@ -191,41 +190,10 @@ def mixture_components_arrays(
     K = int(n_components)
     if K < 1:
         raise ValueError("n_components must be >= 1")
-    grid = np.unique(t[np.isfinite(t)])
-    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
-    at = (t == t_used) & np.isfinite(e)
-    ids_ref, e_ref = ids[at], e[at]
-    order = np.argsort(ids_ref)
-    ids_ref, e_ref = ids_ref[order], e_ref[order]
-    # per-orbit decay laws of the orbits alive at t_ref
-    member_rows = np.isin(ids, ids_ref)
-    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
-    pos = np.searchsorted(uid, ids_ref)
-    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
-    mu_i = np.full(ids_ref.size, np.nan)
-    a_ref = np.full(ids_ref.size, np.nan)
-    mu_i[has] = beta_i[pos[has]] / gamma
-    a_ref[has] = a_i[pos[has]]
-    key = e_ref if by == "energy" else mu_i
-    use = np.isfinite(key)
-    if use.sum() < K:
-        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
-    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
-    comp = np.full(ids_ref.size, -1)
-    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
-    n_ref = np.bincount(comp[use], minlength=K)
-    if np.any(n_ref == 0):
-        raise ValueError("empty sub-ensemble (ties); use fewer components")
-    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
-    for k in range(K):
-        sel = comp == k
-        E_mean[k] = float(e_ref[sel].mean())
-        good = sel & np.isfinite(mu_i)
-        if not good.any():
-            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
-        mu[k] = float(mu_i[good].mean())
-        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
-        A[k] = float(np.exp(a_ref[good].mean()))
+    t_used, ids_ref, e_ref = _orbits_at(ids, t, e, t_ref)
+    mu_i, a_ref = _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window)
+    edges, comp, n_ref = _quantile_bins(e_ref if by == "energy" else mu_i, K, t_used)
+    A, mu, mu_err, E_mean = _sub_ensemble_paths(comp, e_ref, mu_i, a_ref, K)
     return MixtureComponents(
         t_ref=t_used,
         by=by,
@@ -239,6 +207,59 @@ def mixture_components_arrays(
         fit_window=(float(fit_window[0]), float(fit_window[1])),
         gamma=float(gamma),
     )
+
+
+# the steps of mixture_components_arrays (its docstring's steps 1-3)
+def _orbits_at(ids, t, e, t_ref):
+    """The orbits alive at the snapshot grid time nearest ``t_ref``: (that time, their ids (sorted), energies)."""
+    grid = np.unique(t[np.isfinite(t)])
+    t_used = float(grid[np.argmin(np.abs(grid - t_ref))])
+    at = (t == t_used) & np.isfinite(e)
+    ids_ref, e_ref = ids[at], e[at]
+    order = np.argsort(ids_ref)
+    return t_used, ids_ref[order], e_ref[order]
+
+
+def _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window):
+    """Step 1, each orbit's decay law ln E_i = a_i − μ_i γ t over ``fit_window``: (μ_i, a_i), NaN if undefined."""
+    member_rows = np.isin(ids, ids_ref)
+    uid, a_i, beta_i, _ = _per_orbit_decay(ids[member_rows], t[member_rows], e[member_rows], *map(float, fit_window))
+    pos = np.searchsorted(uid, ids_ref)
+    has = (pos < uid.size) & (uid[np.minimum(pos, uid.size - 1)] == ids_ref)
+    mu_i = np.full(ids_ref.size, np.nan)
+    a_ref = np.full(ids_ref.size, np.nan)
+    mu_i[has] = beta_i[pos[has]] / gamma
+    a_ref[has] = a_i[pos[has]]
+    return mu_i, a_ref
+
+
+def _quantile_bins(key, K, t_used):
+    """Step 2, K quantile bins of ``key`` (E_i(t_ref) or μ_i): (edges (K+1,), bin of each orbit (−1: unusable), counts)."""
+    use = np.isfinite(key)
+    if use.sum() < K:
+        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
+    edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
+    comp = np.full(key.size, -1)
+    comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
+    n_ref = np.bincount(comp[use], minlength=K)
+    if np.any(n_ref == 0):
+        raise ValueError("empty sub-ensemble (ties); use fewer components")
+    return edges, comp, n_ref
+
+
+def _sub_ensemble_paths(comp, e_ref, mu_i, a_ref, K):
+    """Step 3, each sub-ensemble's path E_k(t) = A_k e^{−μ_k γ t}: (A_k, μ_k, σ(μ_k), mean E at t_ref), each (K,)."""
+    A, mu, mu_err, E_mean = (np.full(K, np.nan) for _ in range(4))
+    for k in range(K):
+        sel = comp == k
+        E_mean[k] = float(e_ref[sel].mean())
+        good = sel & np.isfinite(mu_i)
+        if not good.any():
+            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
+        mu[k] = float(mu_i[good].mean())
+        mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
+        A[k] = float(np.exp(a_ref[good].mean()))
+    return A, mu, mu_err, E_mean
 
 
 def mixture_components(
@@ -388,6 +409,33 @@ def fit_mixture_model(
     of the measured component paths (A_k, μ_k) is not propagated, and the
     error model (independent points) is that of :func:`fit_survival_model`.
     """
+    c = _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window)
+    if fne_mode not in ("free", "shared"):
+        raise ValueError("fne_mode must be 'free' or 'shared'")
+    if hazard not in HAZARDS:
+        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    fixed = dict(fixed or {})
+    p0 = dict(p0 or {})
+    P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
+    names, free = _mixture_parameters(c.K, fne_mode, fixed)
+    tau2_k = c.tau2(E_c)
+    guess, b_starts = _mixture_start(tf, Pf, tau2_k, c.weights, P_tau0, p0)
+    prob = _MixtureProblem(tf, Pf, sf, kappa_of_E, c, tau0, E_c, hazard, space, fne_mode, free, fixed, guess,
+                           b_starts)
+    sol, res = prob.solve(prob.starts(), P_tau0)
+    theta = sol.x if sol is not None else np.array([])
+    model = prob.model(theta, P_tau0)
+    r = res(theta)
+    # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
+    st = _fit_stats(sol, model(tf), tf, Pf, r, len(free), absolute_sigma, P_tau0_err,
+                    lambda dP: prob.solve([sol.x], P_tau0 + dP)[0])
+    values, errors = _mixture_values_errors(prob, theta, names, st, P_tau0, P_tau0_err, tau2_k)
+    return _survival_fit(model, values, errors, free, st, tf, r, sol, space)
+
+
+# the steps of fit_mixture_model
+def _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window) -> MixtureComponents:
+    """``components`` as given, or built from a snapshots DataFrame by :func:`mixture_components` (t_ref: τ0)."""
     if isinstance(components, pd.DataFrame):
         if gamma is None:
             raise ValueError("gamma is needed to build the components from snapshots")
@@ -399,32 +447,24 @@ def fit_mixture_model(
             by=by,
             fit_window=fit_window,
         )
-    c = components
-    K = c.K
-    if fne_mode not in ("free", "shared"):
-        raise ValueError("fne_mode must be 'free' or 'shared'")
-    if hazard not in HAZARDS:
-        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
-    fixed = dict(fixed or {})
-    p0 = dict(p0 or {})
-    t_all = np.asarray(t, dtype=float)
-    if P_tau0 is None:
-        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
-    else:
-        P_tau0_err = 0.0
-    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
-    if tf.size < 3:
-        raise ValueError("fewer than 3 data points selected")
+    return components
 
+
+def _mixture_parameters(K, fne_mode, fixed):
+    """(all parameter names, the free ones): f_ne_0 … f_ne_{K−1} ("free") or phi ("shared"), then L, b."""
     fne_names = [f"f_ne_{k}" for k in range(K)] if fne_mode == "free" else ["phi"]
     names = fne_names + ["L", "b"]
     unknown = set(fixed) - set(names)
     if unknown:
         raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
-    free = [n for n in names if n not in fixed]
+    return names, [n for n in names if n not in fixed]
 
-    # starting values: trapped fraction from P at the earliest settling time
-    tau2_k = c.tau2(E_c)
+
+def _mixture_start(tf, Pf, tau2_k, weights, P_tau0, p0):
+    """Starting values (``p0`` wins): trapped share φ ≈ P(first τ2,k)/P(τ0), L ≈ late log-slope of P (1/time).
+
+    Returns (guess dict of phi, L and every f_ne_k = φ w_k P(τ0); the starts for b).
+    """
     t_first = float(np.clip(np.min(tau2_k), tf[0], tf[-1]))
     phi0 = float(np.clip(np.exp(np.interp(t_first, tf, np.log(Pf))) / P_tau0, 1e-6, 0.9))
     late = tf > np.max(tau2_k)
@@ -435,61 +475,106 @@ def fit_mixture_model(
     else:
         L0 = 0.05
     guess = {"phi": phi0, "L": p0.get("L", L0)}
-    for k in range(K):
-        guess[f"f_ne_{k}"] = phi0 * c.weights[k] * P_tau0
+    for k in range(weights.size):
+        guess[f"f_ne_{k}"] = phi0 * weights[k] * P_tau0
     guess.update({k: v for k, v in p0.items() if k != "b"})
-    b_starts = [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
+    return guess, [p0["b"]] if "b" in p0 else [0.02, 0.1, 0.5]
 
-    def limits(P0v):
+
+@dataclass(frozen=True)
+class _MixtureProblem:
+    """The least-squares problem of :func:`fit_mixture_model` on its selected points (tf, Pf ± sf).
+
+    ``free`` the fitted parameters (in order: θ), ``fixed`` the held ones, ``guess`` the starting values and
+    ``b_starts`` the starts for b. Every method takes P(τ0) (``P0``), which the error propagation shifts.
+    """
+
+    tf: np.ndarray
+    Pf: np.ndarray
+    sf: np.ndarray
+    kappa_of_E: Callable
+    components: MixtureComponents
+    tau0: float
+    E_c: float
+    hazard: str
+    space: str
+    fne_mode: str
+    free: list
+    fixed: dict
+    guess: dict
+    b_starts: list
+
+    def bounds(self, P0):
+        """(lo, hi) of θ: 0 ≤ f_ne_k ≤ w_k P(τ0), 0 ≤ phi ≤ 1, L ∈ [1e-9, 1e3], b ∈ [1e-6, 1e3]."""
         def bound(n):
             if n == "phi":
                 return (0.0, 1.0)
             if n.startswith("f_ne_"):
-                return (0.0, float(c.weights[int(n[5:])] * P0v))
+                return (0.0, float(self.components.weights[int(n[5:])] * P0))
             return {"L": (1e-9, 1e3), "b": (1e-6, 1e3)}[n]
 
-        lo_b = np.array([bound(n)[0] for n in free], dtype=float)
-        return lo_b, np.array([bound(n)[1] for n in free], dtype=float)
+        lo_b = np.array([bound(n)[0] for n in self.free], dtype=float)
+        return lo_b, np.array([bound(n)[1] for n in self.free], dtype=float)
 
-    def unpack(theta, P0v=P_tau0):
-        v = dict(guess)
-        v["b"] = b_starts[0]
-        v.update(fixed)
-        v.update(dict(zip(free, theta)))
-        if fne_mode == "free":
-            fk = np.array([v[f"f_ne_{k}"] for k in range(K)])
+    def unpack(self, theta, P0):
+        """(all parameter values, the trapped fractions f_ne,k (K,)) from θ: guess, then ``fixed``, then θ."""
+        c = self.components
+        v = dict(self.guess)
+        v["b"] = self.b_starts[0]
+        v.update(self.fixed)
+        v.update(dict(zip(self.free, theta)))
+        if self.fne_mode == "free":
+            fk = np.array([v[f"f_ne_{k}"] for k in range(c.K)])
         else:
-            fk = v["phi"] * c.weights * P0v
+            fk = v["phi"] * c.weights * P0
         return v, fk
 
-    def make(theta, P0v=P_tau0):
-        v, fk = unpack(theta, P0v)
-        return MixtureModelParams(kappa_of_E, c, tau0, fk, P0v, v["L"], v["b"], E_c, hazard)
+    def model(self, theta, P0) -> MixtureModelParams:
+        """The mixture model P(t) of θ."""
+        v, fk = self.unpack(theta, P0)
+        return MixtureModelParams(self.kappa_of_E, self.components, self.tau0, fk, P0, v["L"], v["b"], self.E_c,
+                                  self.hazard)
 
-    def solve(starts, P0v=P_tau0):
-        res = _residual_fn(lambda th: make(th, P0v)(tf), Pf, sf, space)
-        return (_lsq(res, starts, *limits(P0v)) if free else None), res
+    def starts(self) -> list:
+        """Starting θ, one per start of b."""
+        starts = []
+        for b0 in self.b_starts:
+            g = dict(self.guess, b=b0)
+            starts.append([g[n] for n in self.free])
+        return starts
 
-    starts = []
-    for b0 in b_starts:
-        g = dict(guess, b=b0)
-        starts.append([g[n] for n in free])
-    sol, res = solve(starts)
-    theta = sol.x if sol is not None else np.array([])
-    model = make(theta)
-    r = res(theta)
-    k_free = len(free)
-    # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
-    st = _fit_stats(sol, model(tf), tf, Pf, r, k_free, absolute_sigma, P_tau0_err,
-                    lambda dP: solve([sol.x], P_tau0 + dP)[0])
-    cov_fit, sens, cov = st.cov_fit, st.sens, st.cov
+    def solve(self, starts, P0):
+        """(best solution over ``starts``, or None without free parameters; residual function)."""
+        res = _residual_fn(lambda th: self.model(th, P0)(self.tf), self.Pf, self.sf, self.space)
+        return (_lsq(res, starts, *self.bounds(P0)) if self.free else None), res
 
-    v, fk = unpack(theta)
+
+def _mixture_values_errors(prob: _MixtureProblem, theta, names, st, P_tau0, P_tau0_err, tau2_k):
+    """Values and 1σ errors of the fitted, fixed and derived parameters (f_ne, f_e, f_ne_k, f_e_k, τ2_k)."""
+    c, free = prob.components, prob.free
+    v, fk = prob.unpack(theta, P_tau0)
     values = {n: float(v[n]) for n in names}
     errors = {n: 0.0 for n in names}
     for i, n in enumerate(free):
-        errors[n] = float(np.sqrt(max(cov[i, i], 0.0)))
-    # derived: total trapped fraction f_ne(θ, P) and f_e = P − f_ne
+        errors[n] = float(np.sqrt(max(st.cov[i, i], 0.0)))
+    f_ne_err, f_e_err = _total_fraction_errors(free, prob.fne_mode, v, st, P_tau0, P_tau0_err)
+    fk_err = _component_fraction_errors(free, prob.fne_mode, v, errors, c.weights, st, P_tau0, P_tau0_err)
+    values.update(
+        f_ne=float(fk.sum()),
+        f_e=float(P_tau0 - fk.sum()),
+        P_tau0=P_tau0,
+        tau2_k=tau2_k,
+        f_ne_k=fk,
+        f_e_k=c.weights * P_tau0 - fk,
+    )
+    errors.update(f_ne=f_ne_err, f_e=f_e_err, P_tau0=P_tau0_err, f_ne_k=fk_err)
+    return values, errors
+
+
+def _total_fraction_errors(free, fne_mode, v, st, P_tau0, P_tau0_err):
+    """1σ errors of the total trapped fraction f_ne = Σ f_ne,k and of f_e = P(τ0) − f_ne (fit and P(τ0) parts)."""
+    cov_fit, sens = st.cov_fit, st.sens
+    k_free = len(free)
     grad = np.zeros(k_free)
     for i, n in enumerate(free):
         if n.startswith("f_ne_"):
@@ -500,6 +585,13 @@ def fit_mixture_model(
     var_fit = float(grad @ cov_fit @ grad) if k_free else 0.0
     f_ne_err = float(np.sqrt(max(var_fit, 0.0) + (dfne_dP * P_tau0_err) ** 2))
     f_e_err = float(np.sqrt(max(var_fit, 0.0) + ((1.0 - dfne_dP) * P_tau0_err) ** 2))
+    return f_ne_err, f_e_err
+
+
+def _component_fraction_errors(free, fne_mode, v, errors, weights, st, P_tau0, P_tau0_err):
+    """(K,) 1σ errors of the trapped fractions f_ne,k: their own ("free") or φ w_k P(τ0)'s ("shared")."""
+    cov_fit, sens = st.cov_fit, st.sens
+    K = weights.size
     fk_err = np.zeros(K)
     if fne_mode == "free":
         for k in range(K):
@@ -507,17 +599,8 @@ def fit_mixture_model(
     else:
         i_phi = free.index("phi") if "phi" in free else None
         for k in range(K):
-            g_k = c.weights[k] * P_tau0
+            g_k = weights[k] * P_tau0
             vfit = g_k**2 * cov_fit[i_phi, i_phi] if i_phi is not None else 0.0
-            dP = g_k * (sens[i_phi] if i_phi is not None else 0.0) + c.weights[k] * v["phi"]
+            dP = g_k * (sens[i_phi] if i_phi is not None else 0.0) + weights[k] * v["phi"]
             fk_err[k] = float(np.sqrt(max(vfit, 0.0) + (dP * P_tau0_err) ** 2))
-    values.update(
-        f_ne=float(fk.sum()),
-        f_e=float(P_tau0 - fk.sum()),
-        P_tau0=P_tau0,
-        tau2_k=tau2_k,
-        f_ne_k=fk,
-        f_e_k=c.weights * P_tau0 - fk,
-    )
-    errors.update(f_ne=f_ne_err, f_e=f_e_err, P_tau0=P_tau0_err, f_ne_k=fk_err)
-    return _survival_fit(model, values, errors, free, st, tf, r, sol, space)
+    return fk_err

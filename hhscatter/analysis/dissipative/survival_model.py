@@ -416,12 +416,34 @@ def fit_survival_model(
     Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
     AIC, ...).
     """
+    fixed = _checked_fixed(fixed, hazard)
+    P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
+    tau2_eq, fit_tau2 = _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2)
+    free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
+    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
+    prob = HomogeneousProblem(tf, Pf, sf, kappa_of_E, E0, mu, gamma, tau0, E_c, hazard, space, free, fixed,
+                              {"f_ne": fne0, "f_e": fe0, "L": L0}, b_starts, constrain_total, P_tau0)
+    tau2_fit, tau2_err, sol, res = _fit_settling_time(prob, tau2_eq, fit_tau2, absolute_sigma)
+    return _homogeneous_result(prob, sol, res, tau2_fit, tau2_err, fit_tau2, P_tau0_err, absolute_sigma)
+
+
+# the steps of fit_survival_model (and, for the data, of fit_mixture_model)
+def _checked_fixed(fixed, hazard) -> dict:
+    """A copy of ``fixed`` (name → value) after checking its names and the ``hazard`` option."""
     fixed = dict(fixed or {})
     unknown = set(fixed) - set(_HOMOG)
     if unknown:
         raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
     if hazard not in HAZARDS:
         raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    return fixed
+
+
+def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
+    """P(τ0) and its error (0 when given, else interpolated), and the points fitted: (P_tau0, σ, tf, Pf, sf).
+
+    The points are those with τ0 ≤ t ≤ t_max (time units), P > P_min and a positive error; at least 3.
+    """
     t_all = np.asarray(t, dtype=float)
     if P_tau0 is None:
         P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
@@ -430,22 +452,35 @@ def fit_survival_model(
     tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
     if tf.size < 3:
         raise ValueError("fewer than 3 data points selected")
+    return P_tau0, P_tau0_err, tf, Pf, sf
+
+
+def _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2):
+    """τ2 (time units) to hold or start from: ``fixed["tau2"]`` (popped; then not fitted), ``tau2`` or Eq. (eq:tau2).
+
+    Returns (τ2, whether τ2 is fitted).
+    """
     tau2_eq = tau2_predicted(E0, E_c, mu, gamma) if tau2 is None else float(tau2)
     if "tau2" in fixed:
         tau2_eq, fit_tau2 = float(fixed.pop("tau2")), False
+    return tau2_eq, fit_tau2
 
-    free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
-    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
-    prob = HomogeneousProblem(tf, Pf, sf, kappa_of_E, E0, mu, gamma, tau0, E_c, hazard, space, free, fixed,
-                              {"f_ne": fne0, "f_e": fe0, "L": L0}, b_starts, constrain_total, P_tau0)
 
+def _fit_settling_time(prob: HomogeneousProblem, tau2_eq, fit_tau2, absolute_sigma):
+    """The fit with τ2 profiled (``fit_tau2``) or held at ``tau2_eq``: (τ2, σ_τ2 (time), solution, residual fn)."""
     tau2_err = 0.0
     if fit_tau2:
-        tau2_fit, tau2_err, sol, c2min, res = prob.fit_tau2(absolute_sigma)
+        tau2_fit, tau2_err, sol, _, res = prob.fit_tau2(absolute_sigma)
     else:
         tau2_fit = tau2_eq
-        sol, c2min, res = prob.fit_at(tau2_fit)
+        sol, _, res = prob.fit_at(tau2_fit)
+    return tau2_fit, tau2_err, sol, res
 
+
+def _homogeneous_result(prob: HomogeneousProblem, sol, res, tau2_fit, tau2_err, fit_tau2, P_tau0_err,
+                        absolute_sigma) -> SurvivalFit:
+    """The SurvivalFit of a solution: goodness of fit, errors with P(τ0)'s error propagated through the constraint."""
+    free, tf, P_tau0 = prob.free, prob.tf, prob.P_tau0
     k = len(free) + (1 if fit_tau2 else 0)
     theta = sol.x if sol is not None else np.array([])
     v = prob.values(theta, tau2_fit)
@@ -455,13 +490,13 @@ def fit_survival_model(
     # propagate the error of the measured P(τ0) through the constraint
     refit = ((lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0])
              if prob.derive_fe else None)
-    st = _fit_stats(sol, curve_vals, tf, Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    st = _fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
     errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
     errors["tau2"] = tau2_err
     values = dict(v)
     values["P_tau0"] = P_tau0
     errors["P_tau0"] = P_tau0_err
-    return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, space)
+    return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, prob.space)
 
 
 def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):

@@ -634,14 +634,7 @@ def paired_hellinger_difference(
     >>> bool(r.lo < 0 < r.hi), bool(abs(r.delta) < 0.05)     # B is a random half of A: no difference
     (True, True)
     """
-    A, B, R = _as_points(A), _as_points(B), _as_points(R)
-    ua, ub, ur = (np.asarray(u) for u in (units_a, units_b, units_r))
-    if ua.shape[0] != A.shape[0] or ub.shape[0] != B.shape[0] or ur.shape[0] != R.shape[0]:
-        raise ValueError("units_a, units_b, units_r must have one entry per point of A, B, R")
-    if int(offsets) < 1 or int(n_boot) < 2:
-        raise ValueError(f"need offsets ≥ 1 and n_boot ≥ 2, got {offsets!r}, {n_boot!r}")
-    if not 0 < level < 1:
-        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    A, B, R, ua, ub, ur = _checked_paired_inputs(A, B, R, units_a, units_b, units_r, offsets, n_boot, level)
     extents = _offset_extents(extent, float(box), int(offsets))
     run_units = np.unique(np.concatenate([ua, ub]))
     ref_units = np.unique(ur)
@@ -652,17 +645,7 @@ def paired_hellinger_difference(
     for b in range(int(n_boot)):
         half = rng.permutation(run_units)[: run_units.size // 2]
         ref_half = rng.permutation(ref_units)[: ref_units.size // 2]
-        ina, inb, inr = np.isin(ua, half), np.isin(ub, half), np.isin(ur, ref_half)
-        Rh, Rc = R[inr], R[~inr]
-        noise_r = _h2(Rh, Rc, box, extents)
-        out = []
-        for X, inx in ((A, ina), (B, inb)):
-            Xh, Xc = X[inx], X[~inx]
-            if Xh.shape[0] == 0 or Xc.shape[0] == 0:
-                raise ValueError("a half-sample of A or B is empty: too few units")
-            h2 = _h2(Xh, Rh, box, extents) - 0.5 * _h2(Xh, Xc, box, extents) - 0.5 * noise_r
-            out.append(float(np.sqrt(max(h2.mean(), 0.0))))
-        da[b], db[b] = out
+        da[b], db[b] = _half_sample_distances(A, B, R, ua, ub, ur, half, ref_half, box, extents)
     q = (1 - level) / 2
     delta = db - da
     full = np.sqrt(_h2(B, R, box, extents)) - np.sqrt(_h2(A, R, box, extents))
@@ -672,3 +655,36 @@ def paired_hellinger_difference(
         d_a_interval=(float(np.quantile(da, q)), float(np.quantile(da, 1 - q))),
         d_b_interval=(float(np.quantile(db, q)), float(np.quantile(db, 1 - q))),
         offset_spread=float(full.std(ddof=1)) if full.size > 1 else 0.0, n_boot=int(n_boot))
+
+
+# the steps of paired_hellinger_difference
+def _checked_paired_inputs(A, B, R, units_a, units_b, units_r, offsets, n_boot, level):
+    """The point sets A, B, R as (n, 2) arrays and their units (one per point), checked with the options."""
+    A, B, R = _as_points(A), _as_points(B), _as_points(R)
+    ua, ub, ur = (np.asarray(u) for u in (units_a, units_b, units_r))
+    if ua.shape[0] != A.shape[0] or ub.shape[0] != B.shape[0] or ur.shape[0] != R.shape[0]:
+        raise ValueError("units_a, units_b, units_r must have one entry per point of A, B, R")
+    if int(offsets) < 1 or int(n_boot) < 2:
+        raise ValueError(f"need offsets ≥ 1 and n_boot ≥ 2, got {offsets!r}, {n_boot!r}")
+    if not 0 < level < 1:
+        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    return A, B, R, ua, ub, ur
+
+
+def _half_sample_distances(A, B, R, ua, ub, ur, half, ref_half, box, extents):
+    """One replicate: the debiased, offset-averaged Hellinger distances (H(A_h, R_h), H(B_h, R_h)) (dimensionless).
+
+    ``half`` holds the units of A ∪ B in the half-sample, ``ref_half`` those of R; the complementary halves
+    remove the finite-sample bias, H²_deb(X, R) = H²(X_h, R_h) − ½ H²(X_h, X_c) − ½ H²(R_h, R_c).
+    """
+    ina, inb, inr = np.isin(ua, half), np.isin(ub, half), np.isin(ur, ref_half)
+    Rh, Rc = R[inr], R[~inr]
+    noise_r = _h2(Rh, Rc, box, extents)
+    out = []
+    for X, inx in ((A, ina), (B, inb)):
+        Xh, Xc = X[inx], X[~inx]
+        if Xh.shape[0] == 0 or Xc.shape[0] == 0:
+            raise ValueError("a half-sample of A or B is empty: too few units")
+        h2 = _h2(Xh, Rh, box, extents) - 0.5 * _h2(Xh, Xc, box, extents) - 0.5 * noise_r
+        out.append(float(np.sqrt(max(h2.mean(), 0.0))))
+    return out[0], out[1]

@@ -116,32 +116,14 @@ def kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, 
     value √(Var(Y)/M) / mean(T Y), Y_i = e^{κT_i} (0 for exits), which also
     treats the points as independent.
     """
-    T = np.asarray(return_times, dtype=float).ravel()
-    if np.any(~np.isfinite(T)) or np.any(T <= 0):
-        raise ValueError("return times must be finite and > 0")
-    n_exit = int(n_exit)
-    if n_exit < 0:
-        raise ValueError("n_exit must be ≥ 0")
-    M = T.size + n_exit
-    if M == 0:
-        raise ValueError("empty sample")
+    T, n_exit, M = _checked_sample(return_times, n_exit)
     kappa = _solve_renewal(T, M)
-    if math.isfinite(kappa) and kappa > 0:
-        Y = np.exp(kappa * T)
-        var_Y = (float(np.sum(Y * Y)) / M) - (float(np.sum(Y)) / M) ** 2
-        slope = float(np.sum(T * Y)) / M
-        err_delta = math.sqrt(max(var_Y, 0.0) / M) / slope
-    else:
-        err_delta = math.nan if not math.isfinite(kappa) else 0.0
+    err_delta = _delta_method_error(T, M, kappa)
     gen = np.random.default_rng(rng)
     if orbits is not None or exit_orbits is not None:
         boot = _orbit_bootstrap(T, n_exit, orbits, exit_orbits, int(n_boot), gen)
     else:
-        boot = np.empty(int(n_boot))
-        for i in range(int(n_boot)):
-            ne = int(gen.binomial(M, n_exit / M))
-            Tb = T[gen.integers(0, T.size, M - ne)] if T.size else T
-            boot[i] = _solve_renewal(Tb, M)
+        boot = _point_bootstrap(T, n_exit, M, int(n_boot), gen)
     err = float(np.std(boot, ddof=1)) if n_boot > 1 else math.nan
     return CMeasureKappa(
         kappa=float(kappa),
@@ -152,6 +134,41 @@ def kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, 
         n_exit=n_exit,
         boot=boot,
     )
+
+
+# the steps of kappa_from_cmeasure
+def _checked_sample(return_times, n_exit):
+    """The checked c-measure sample: (return times T (time units), number of exits, sample size M)."""
+    T = np.asarray(return_times, dtype=float).ravel()
+    if np.any(~np.isfinite(T)) or np.any(T <= 0):
+        raise ValueError("return times must be finite and > 0")
+    n_exit = int(n_exit)
+    if n_exit < 0:
+        raise ValueError("n_exit must be ≥ 0")
+    M = T.size + n_exit
+    if M == 0:
+        raise ValueError("empty sample")
+    return T, n_exit, M
+
+
+def _delta_method_error(T, M, kappa):
+    """Delta-method error of κ (1/time): √(Var(Y)/M) / mean(T Y), Y_i = e^{κT_i} (0 for exits); NaN if κ = ∞."""
+    if math.isfinite(kappa) and kappa > 0:
+        Y = np.exp(kappa * T)
+        var_Y = (float(np.sum(Y * Y)) / M) - (float(np.sum(Y)) / M) ** 2
+        slope = float(np.sum(T * Y)) / M
+        return math.sqrt(max(var_Y, 0.0) / M) / slope
+    return math.nan if not math.isfinite(kappa) else 0.0
+
+
+def _point_bootstrap(T, n_exit, M, n_boot, gen) -> np.ndarray:
+    """κ replicates from resampling the M sample points (exits: a binomial count), as if each were its own orbit."""
+    boot = np.empty(n_boot)
+    for i in range(n_boot):
+        ne = int(gen.binomial(M, n_exit / M))
+        Tb = T[gen.integers(0, T.size, M - ne)] if T.size else T
+        boot[i] = _solve_renewal(Tb, M)
+    return boot
 
 
 def _orbit_bootstrap(T, n_exit, orbits, exit_orbits, n_boot, gen) -> np.ndarray:
@@ -221,4 +238,3 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
         return (T.astype(float), n_exit, n_und, s["traj_id"].to_numpy()[ret],
                 last["traj_id"].to_numpy()[leaves])
     return T.astype(float), n_exit, n_und
-

@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from scipy import optimize
@@ -499,14 +500,45 @@ def detect_power_law_tail(
     """
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
+    observed = _tail_range(t, P, tau0, P_err, n_total, min_survivors)
+    if observed is None:
+        return None
+    N, t_floor, tau0, tf, Pf = observed
+    edges = _bin_edges(tf, Pf, N, tau0, t_floor, bin_width, min_width)
+    if edges is None:
+        return None
+    bins = _hazard_bins(tf, Pf, N, edges)
+    split = _change_point(bins, edges, t_floor, min_events, min_span)
+    if split is None:
+        return None
+    jb, d_aic_split, d_aic_tail = split
+    beta_hat = _hazard_exponent(bins, edges, jb)
+    if not (d_aic_split >= min_delta_aic and d_aic_tail >= min_delta_aic and beta_hat >= min_hazard_exponent):
+        return None
+    tau_c, D_tail, z_mle = _refined_change_point(tf, Pf, N, tau0, t_floor, edges, bins, jb)
+    fit = fit_power_law_tail(t, P, (tau_c, t_floor), P_err)
+    return PowerLawFit(**{**fit.__dict__, "z_mle": float(z_mle), "z_mle_err": float(z_mle / math.sqrt(D_tail)),
+                          "hazard_exponent": beta_hat, "delta_aic_split": float(d_aic_split),
+                          "delta_aic_tail": float(d_aic_tail)})
+
+
+# the steps of detect_power_law_tail (its docstring's rule, step by step)
+def _tail_range(t, P, tau0, P_err, n_total, min_survivors):
+    """The observed range [τ0, t_floor] (time units): (N, t_floor, τ0, finite t, finite P), or None if empty."""
     N = _resolve_n_total(P, P_err, n_total)
     t_floor = _floor_time(t, P, N, min_survivors)
     tau0 = max(float(tau0), float(t[np.isfinite(t)].min()))
     if t_floor is None or not t_floor > tau0:
         return None
     ok = np.isfinite(t) & np.isfinite(P)
-    tf, Pf = t[ok], P[ok]
-    # exponential MLE on the whole range (sets the default bin width)
+    return N, t_floor, tau0, t[ok], P[ok]
+
+
+def _bin_edges(tf, Pf, N, tau0, t_floor, bin_width, min_width):
+    """Bin edges τ0, τ0 + Δ, …, t_floor (time units), Δ = bin_width or max(min_width, 1/κ̂); None if < 4 edges.
+
+    κ̂ = D/X is the exponential MLE on [τ0, t_floor] (D orbits leaving over the exposure X).
+    """
     m = (tf >= tau0) & (tf <= t_floor)
     if np.count_nonzero(m) < 3:
         return None
@@ -521,24 +553,70 @@ def detect_power_law_tail(
     edges = edges[edges > 0]
     if edges.size < 4:
         return None
+    return edges
+
+
+def _cum0(a):
+    """Cumulative sum with a leading 0: entry j is the sum over the first j bins."""
+    return np.concatenate([[0.0], np.cumsum(a)])
+
+
+class _HazardBins(NamedTuple):
+    """Counts of a survival curve read at bin edges, per bin and cumulated from the first edge (leading 0).
+
+    n, d: orbits at risk and leaving per bin; D, Xe, Xp, Le, Lp: cumulative d, n Δt (time), n Δlog t,
+    d log Δt and d log Δlog t (the sufficient statistics of the hazards h = κ and h = z/t).
+    """
+
+    n: np.ndarray
+    d: np.ndarray
+    D: np.ndarray
+    Xe: np.ndarray
+    Xp: np.ndarray
+    Le: np.ndarray
+    Lp: np.ndarray
+
+    @property
+    def K(self) -> int:
+        """Number of bins."""
+        return self.d.size
+
+
+def _hazard_bins(tf, Pf, N, edges) -> _HazardBins:
+    """Numbers at risk n_k = N P(t_k) and leaving d_k = N (P(t_k) − P(t_{k+1})) between ``edges`` (time units)."""
     Pe = _step_eval(tf, Pf, edges)
     n = N * Pe[:-1]
     d = np.clip(N * (Pe[:-1] - Pe[1:]), 0.0, None)
     dt = np.diff(edges)
     dlt = np.diff(np.log(edges))
+    return _HazardBins(n, d, _cum0(d), _cum0(n * dt), _cum0(n * dlt), _cum0(xlogy(d, dt)), _cum0(xlogy(d, dlt)))
 
-    def c(a):
-        return np.concatenate([[0.0], np.cumsum(a)])
 
-    D = c(d)
-    Xe, Xp = c(n * dt), c(n * dlt)
-    Le, Lp = c(xlogy(d, dt)), c(xlogy(d, dlt))
-    K = d.size
-    ll_exp_all = _segment_ll(D[K], Xe[K], Le[K])
+def _exp_ll(bins: _HazardBins, j):
+    """Maximised Poisson log-likelihood of a constant hazard h = κ on the first j bins."""
+    return _segment_ll(bins.D[j], bins.Xe[j], bins.Le[j])
+
+
+def _tail_ll(bins: _HazardBins, j, power: bool):
+    """Maximised Poisson log-likelihood on the bins from j on of h = z/t (``power``) or of h = κ."""
+    K = bins.K
+    X, L = (bins.Xp, bins.Lp) if power else (bins.Xe, bins.Le)
+    return _segment_ll(bins.D[K] - bins.D[j], X[K] - X[j], L[K] - L[j])
+
+
+def _change_point(bins: _HazardBins, edges, t_floor, min_events, min_span):
+    """Rule step 1, the change point h = κ → h = z/t: (bin index j_c, ΔAIC split vs exponential, ΔAIC tail).
+
+    j_c maximises the split likelihood among the admissible edges (≥ min_events events on each side, a tail
+    spanning t_floor/τc ≥ min_span); the tail ΔAIC compares power law and exponential on [τc, t_floor].
+    None if no edge is admissible.
+    """
+    D, K = bins.D, bins.K
+    ll_exp_all = _exp_ll(bins, K)
     j = np.arange(1, K)
-    head = _segment_ll(D[j], Xe[j], Le[j])
-    tail_pow = _segment_ll(D[K] - D[j], Xp[K] - Xp[j], Lp[K] - Lp[j])
-    tail_exp = _segment_ll(D[K] - D[j], Xe[K] - Xe[j], Le[K] - Le[j])
+    head = _exp_ll(bins, j)
+    tail_pow = _tail_ll(bins, j, power=True)
+    tail_exp = _tail_ll(bins, j, power=False)
     admissible = (D[j] >= min_events) & (D[K] - D[j] >= min_events) & (t_floor / edges[j] >= min_span)
     if not admissible.any():
         return None
@@ -546,9 +624,15 @@ def detect_power_law_tail(
     jb = int(j[np.argmax(ll_split)])
     d_aic_split = 2.0 * (float(np.max(ll_split)) - ll_exp_all) - 2.0 * 2
     d_aic_tail = 2.0 * float(tail_pow[jb - 1] - tail_exp[jb - 1])
+    return jb, d_aic_split, d_aic_tail
 
-    # hazard ∝ t^{−β} on the tail: exact bin integrals, β by profile likelihood
-    dk, nk = d[jb:], n[jb:]
+
+def _hazard_exponent(bins: _HazardBins, edges, jb):
+    """Rule step 2, the MLE exponent β (dimensionless) of a hazard ∝ t^{−β} on the bins from jb on.
+
+    Exact bin integrals of t^{−β}, β by profile likelihood in [−3, 5]: 1 for a power law, 0 for an exponential.
+    """
+    dk, nk = bins.d[jb:], bins.n[jb:]
     lo, hi = edges[jb:-1], edges[jb + 1:]
 
     def neg_ll(beta):
@@ -558,42 +642,22 @@ def detect_power_law_tail(
             H = (hi ** (1.0 - beta) - lo ** (1.0 - beta)) / (1.0 - beta)
         return -float(_segment_ll(dk.sum(), (nk * H).sum(), xlogy(dk, H).sum()))
 
-    beta_hat = float(optimize.minimize_scalar(neg_ll, bounds=(-3.0, 5.0), method="bounded").x)
+    return float(optimize.minimize_scalar(neg_ll, bounds=(-3.0, 5.0), method="bounded").x)
 
-    if not (d_aic_split >= min_delta_aic and d_aic_tail >= min_delta_aic and beta_hat >= min_hazard_exponent):
-        return None
-    # refine τc on the full grid within one bin of the coarse change point
+
+def _refined_change_point(tf, Pf, N, tau0, t_floor, edges, coarse: _HazardBins, jb):
+    """τc refined on the full grid within one bin of the coarse change point: (τc (time), tail events, z MLE)."""
     fe = tf[(tf >= tau0) & (tf <= t_floor) & (tf > 0)]
     if fe[-1] < t_floor:
         fe = np.append(fe, t_floor)
-    Pfe = _step_eval(tf, Pf, fe)
-    nf = N * Pfe[:-1]
-    df = np.clip(N * (Pfe[:-1] - Pfe[1:]), 0.0, None)
-    Df, Xef, Xpf = c(df), c(nf * np.diff(fe)), c(nf * np.diff(np.log(fe)))
-    Lef, Lpf = c(xlogy(df, np.diff(fe))), c(xlogy(df, np.diff(np.log(fe))))
-    Kf = df.size
+    fine = _hazard_bins(tf, Pf, N, fe)
+    K, Kf = coarse.K, fine.K
     jf = np.flatnonzero((fe >= edges[jb - 1]) & (fe <= edges[min(jb + 1, K)]))
     jf = jf[(jf >= 1) & (jf < Kf)]
     if jf.size:
-        llf = _segment_ll(Df[jf], Xef[jf], Lef[jf]) + _segment_ll(
-            Df[Kf] - Df[jf], Xpf[Kf] - Xpf[jf], Lpf[Kf] - Lpf[jf]
-        )
+        llf = _exp_ll(fine, jf) + _tail_ll(fine, jf, power=True)
         jr = int(jf[np.argmax(llf)])
-        tau_c = float(fe[jr])
-        D_tail = Df[Kf] - Df[jr]
-        z_mle = D_tail / (Xpf[Kf] - Xpf[jr])
-    else:
-        tau_c = float(edges[jb])
-        D_tail = D[K] - D[jb]
-        z_mle = D_tail / (Xp[K] - Xp[jb])
-    fit = fit_power_law_tail(t, P, (tau_c, t_floor), P_err)
-    return PowerLawFit(
-        **{
-            **fit.__dict__,
-            "z_mle": float(z_mle),
-            "z_mle_err": float(z_mle / math.sqrt(D_tail)),
-            "hazard_exponent": beta_hat,
-            "delta_aic_split": float(d_aic_split),
-            "delta_aic_tail": float(d_aic_tail),
-        }
-    )
+        D_tail = fine.D[Kf] - fine.D[jr]
+        return float(fe[jr]), D_tail, D_tail / (fine.Xp[Kf] - fine.Xp[jr])
+    D_tail = coarse.D[K] - coarse.D[jb]
+    return float(edges[jb]), D_tail, D_tail / (coarse.Xp[K] - coarse.Xp[jb])

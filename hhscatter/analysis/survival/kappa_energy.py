@@ -160,53 +160,15 @@ def fit_kappa_energy(
     ``boot_err`` comes from ``n_boot`` pairs-bootstrap refits over points
     (``rng``: seed or numpy Generator).
     """
-    E = np.asarray(E, dtype=float).ravel()
-    y = np.asarray(kappa, dtype=float).ravel()
-    if E.shape != y.shape:
-        raise ValueError("E and kappa differ in length")
-    x = E - E_c
-    if np.any(x <= 0):
-        raise ValueError("all energies must exceed E_c (no escape below)")
-    given = kappa_err is not None
-    sig = np.asarray(kappa_err, dtype=float).ravel() if given else np.ones_like(y)
-    if np.any(~(sig > 0)):
-        raise ValueError("kappa_err must be positive")
-    w = 1.0 / sig**2
+    x, y, w, given = _kappa_points(E, kappa, kappa_err, E_c)
     n = x.size
-
     if continuous:
         a, b, c, xb, chi2 = _fit_continuous(x, y, w, n_grid)
-        J = np.column_stack([x * np.minimum(x, xb), x, a * x * (x > xb)])
-        cov3 = np.linalg.pinv((J.T * w) @ J)
-        dof = n - 3
-        if not given:
-            cov3 = cov3 * (chi2 / dof if dof > 0 else np.nan)
-        T = np.array([[1.0, 0, 0], [0, 1.0, 0], [xb, 1.0, a], [0, 0, 1.0]])
-        cov = T @ cov3 @ T.T
+        cov, dof = _continuous_covariance(x, w, a, xb, chi2, given)
     else:
         a, b, c, xb, chi2, F1, F2, var_xb = _fit_discontinuous(x, y, w)
-        dof = n - 4
-        s = (chi2 / dof if dof > 0 else np.nan) if not given else 1.0
-        cov = np.zeros((4, 4))
-        cov[:2, :2] = F1 * s
-        cov[2, 2] = F2[0, 0] * s
-        cov[3, 3] = var_xb
-
-    gen = np.random.default_rng(rng)
-    boot = np.full((int(n_boot), 4), np.nan)
-    for i in range(int(n_boot)):
-        idx = gen.integers(0, n, n)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                if continuous:
-                    r = _fit_continuous(x[idx], y[idx], w[idx], max(n_grid // 4, 50))
-                    boot[i] = r[:4]
-                else:
-                    r = _fit_discontinuous(x[idx], y[idx], w[idx])
-                    boot[i] = r[:4]
-        except (ValueError, np.linalg.LinAlgError):
-            continue
+        cov, dof = _discontinuous_covariance(F1, F2, var_xb, chi2, n, given)
+    boot = _bootstrap_replicates(x, y, w, continuous, n_grid, n_boot, rng)
     boot[:, 3] += E_c
     boot_err = tuple(float(v) for v in np.nanstd(boot, axis=0, ddof=1)) if n_boot > 1 else ()
     err = np.sqrt(np.diag(cov))
@@ -229,3 +191,67 @@ def fit_kappa_energy(
     )
 
 
+# the steps of fit_kappa_energy
+def _kappa_points(E, kappa, kappa_err, E_c):
+    """The checked κ(E) points: (x = E − E_c (energy), κ (1/time), weights 1/σ², whether σ was given)."""
+    E = np.asarray(E, dtype=float).ravel()
+    y = np.asarray(kappa, dtype=float).ravel()
+    if E.shape != y.shape:
+        raise ValueError("E and kappa differ in length")
+    x = E - E_c
+    if np.any(x <= 0):
+        raise ValueError("all energies must exceed E_c (no escape below)")
+    given = kappa_err is not None
+    sig = np.asarray(kappa_err, dtype=float).ravel() if given else np.ones_like(y)
+    if np.any(~(sig > 0)):
+        raise ValueError("kappa_err must be positive")
+    return x, y, 1.0 / sig**2, given
+
+
+def _continuous_covariance(x, w, a, xb, chi2, given):
+    """Covariance of (a, b, c, x_b) of the continuous law: Gauss–Newton (JᵀWJ)⁻¹ of (a, b, x_b), c = a x_b + b.
+
+    Scaled by χ²/dof when no κ errors were ``given``; returns (cov (4, 4), dof).
+    """
+    J = np.column_stack([x * np.minimum(x, xb), x, a * x * (x > xb)])
+    cov3 = np.linalg.pinv((J.T * w) @ J)
+    dof = x.size - 3
+    if not given:
+        cov3 = cov3 * (chi2 / dof if dof > 0 else np.nan)
+    T = np.array([[1.0, 0, 0], [0, 1.0, 0], [xb, 1.0, a], [0, 0, 1.0]])
+    return T @ cov3 @ T.T, dof
+
+
+def _discontinuous_covariance(F1, F2, var_xb, chi2, n, given):
+    """Covariance of (a, b, c, x_b) of the two separate fits (x_b: uniform over the gap); returns (cov, dof).
+
+    Scaled by χ²/dof when no κ errors were ``given``.
+    """
+    dof = n - 4
+    s = (chi2 / dof if dof > 0 else np.nan) if not given else 1.0
+    cov = np.zeros((4, 4))
+    cov[:2, :2] = F1 * s
+    cov[2, 2] = F2[0, 0] * s
+    cov[3, 3] = var_xb
+    return cov, dof
+
+
+def _bootstrap_replicates(x, y, w, continuous, n_grid, n_boot, rng):
+    """(n_boot, 4) pairs-bootstrap refits (a, b, c, x_b) over the points; NaN rows where a refit fails."""
+    n = x.size
+    gen = np.random.default_rng(rng)
+    boot = np.full((int(n_boot), 4), np.nan)
+    for i in range(int(n_boot)):
+        idx = gen.integers(0, n, n)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                if continuous:
+                    r = _fit_continuous(x[idx], y[idx], w[idx], max(n_grid // 4, 50))
+                    boot[i] = r[:4]
+                else:
+                    r = _fit_discontinuous(x[idx], y[idx], w[idx])
+                    boot[i] = r[:4]
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+    return boot

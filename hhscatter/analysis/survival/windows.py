@@ -177,6 +177,21 @@ def choose_windows(
     The grid should resolve the decay (spacing ≪ w).  Warns, and returns the
     pilot range [t_a, t_b] as the window, if the band ever becomes empty.
     """
+    t, P, N, t_floor = _checked_curve(t, P, P_err, n_total, min_survivors)
+    t_a, t_b, kappa_p = _pilot_rate(t, P, N, t_floor, min_survivors, p_start, core_decades)
+    w_max = (t_floor - t[0]) / 3.0
+    w = _smoothing_width(kappa_p, min_width, w_max)
+    kappa_ref, target = _plateau_level(t, P, N, w, t_floor, kappa_p, rel_tol, n_sigma, n_levels)
+    tau0, t_stop, kappa_ref, w, (c, s, se), converged = _iterate_plateau(
+        t, P, N, t_floor, w, kappa_ref, target, (t_a, t_b), rel_tol, n_sigma, min_width, w_max, max_iter
+    )
+    return WindowChoice(tau0=tau0, t_stop=t_stop, windows=_fitting_windows(tau0, t_stop), kappa_ref=kappa_ref,
+                        width=w, t_floor=float(t_floor), converged=converged, slope_t=c, slope=s, slope_err=se)
+
+
+# the steps of choose_windows (its docstring's rule, step by step)
+def _checked_curve(t, P, P_err, n_total, min_survivors):
+    """Rule step 0, the floor: (t, P) as checked float arrays, the ensemble size N and t_floor (time units)."""
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
     if t.shape != P.shape:
@@ -187,10 +202,14 @@ def choose_windows(
     t_floor = _floor_time(t, P, N, min_survivors)
     if t_floor is None or t_floor <= t[0]:
         raise ValueError(f"fewer than {min_survivors} survivors at every grid time: nothing to fit")
+    return t, P, N, t_floor
+
+
+def _pilot_rate(t, P, N, t_floor, min_survivors, p_start, core_decades):
+    """Rule step 1, the pilot rate κ_p = log(P(t_a)/P(t_b))/(t_b − t_a) (1/time): (t_a, t_b, κ_p)."""
     use = np.flatnonzero((t <= t_floor) & np.isfinite(P))
     tu, Pu = t[use], P[use]
     P_floor = min_survivors / N
-
     ia = np.flatnonzero(Pu <= p_start)
     ia = int(ia[0]) if ia.size else 0
     ib = np.flatnonzero(Pu <= max(P_floor, p_start * 10.0 ** (-core_decades)))
@@ -198,19 +217,25 @@ def choose_windows(
     if ib <= ia:
         ia, ib = 0, tu.size - 1
     t_a, t_b = float(tu[ia]), float(tu[ib])
-    kappa_p = math.log(Pu[ia] / Pu[ib]) / (t_b - t_a)
-    w_max = (t_floor - t[0]) / 3.0
+    return t_a, t_b, math.log(Pu[ia] / Pu[ib]) / (t_b - t_a)
 
-    def width(k):
-        w = max(min_width, 1.0 / k) if k > 0 else min_width
-        return min(w, w_max)
 
-    w = width(kappa_p)
+def _smoothing_width(k, min_width, w_max):
+    """Rule step 2, the smoothing width w = max(min_width, 1/κ) capped at w_max (time units; κ in 1/time)."""
+    w = max(min_width, 1.0 / k) if k > 0 else min_width
+    return min(w, w_max)
+
+
+def _plateau_level(t, P, N, w, t_floor, kappa_p, rel_tol, n_sigma, n_levels):
+    """Rule step 3, the plateau: the level κ_ref (1/time) whose band holds the run covering most e-folds of P.
+
+    Scans ``n_levels`` quantiles of the local slope s(t) at width w; returns (κ_ref, (first, last centre of
+    that run) in time units), or (κ_p, the whole slope range) when no band holds a run.
+    """
     c, s, se = _local_slope(t, P, N, w, t_floor)
     fin = np.isfinite(s) & (s > 0)
     if not fin.any():
         raise ValueError("the survival curve does not decay above the counting floor")
-    # plateau search: the level whose band holds the run covering most e-folds of P
     logPc = np.log(_step(t, P, c))
     best = (-1.0, kappa_p, 0, c.size - 1)
     for level in np.unique(np.quantile(s[fin], np.linspace(0.0, 1.0, n_levels))):
@@ -222,7 +247,23 @@ def choose_windows(
             if efolds[i] > best[0]:
                 best = (float(efolds[i]), float(level), int(st[i]), int(en[i]))
     _, kappa_ref, b, e = best
-    target = (float(c[b]), float(c[e]))
+    return kappa_ref, (float(c[b]), float(c[e]))
+
+
+def _overlapping_run(c, runs, target):
+    """The run (start, end) overlapping most (in time) with ``target``; ties: the longer, then the earlier."""
+    overlap = [max(0.0, min(c[e], target[1]) - max(c[b], target[0])) for b, e in runs]
+    length = [c[e] - c[b] for b, e in runs]
+    k = max(range(len(runs)), key=lambda i: (overlap[i], length[i], -i))
+    return runs[k]
+
+
+def _iterate_plateau(t, P, N, t_floor, w, kappa_ref, target, pilot, rel_tol, n_sigma, min_width, w_max, max_iter):
+    """Rule steps 4-5, the plateau iterated to convergence: τ0 and t_stop (time units), κ_ref (1/time), w.
+
+    Returns (tau0, t_stop, kappa_ref, width, (slope_t, slope, slope_err), converged); warns and returns the
+    ``pilot`` range (t_a, t_b) if the band ever becomes empty.
+    """
     prev = None
     converged = False
     for _ in range(max_iter):
@@ -232,18 +273,15 @@ def choose_windows(
         runs = _runs(c, inside, w)
         if not runs:
             warnings.warn("no exponential plateau found; using the pilot range [t_a, t_b]")
-            tau0, t_stop = t_a, t_b
+            tau0, t_stop = pilot
             break
-        overlap = [max(0.0, min(c[e], target[1]) - max(c[b], target[0])) for b, e in runs]
-        length = [c[e] - c[b] for b, e in runs]
-        k = max(range(len(runs)), key=lambda i: (overlap[i], length[i], -i))
-        b, e = runs[k]
+        b, e = _overlapping_run(c, runs, target)
         b = _first_long_segment(c, inside, b, e, 0.5 * w)
         tau0 = float(t[0]) if b == 0 else float(c[b])
         t_stop = float(t_floor) if e == c.size - 1 else float(c[e])
         sel = inside[b : e + 1]
         new_kappa = float(np.median(s[b : e + 1][sel]))
-        new_w = width(new_kappa)
+        new_w = _smoothing_width(new_kappa, min_width, w_max)
         state = (tau0, t_stop)
         if (
             prev is not None
@@ -255,26 +293,17 @@ def choose_windows(
             break
         prev, target = state, (float(c[b]), float(c[e]))
         kappa_ref, w = new_kappa, new_w
+    return tau0, t_stop, kappa_ref, w, (c, s, se), converged
+
+
+def _fitting_windows(tau0, t_stop):
+    """Rule step 6, the 4 fitting windows of [τ0, t_stop]: full, first half, second half, middle half (time units)."""
     if not t_stop > tau0:
         raise ValueError(f"degenerate exponential range [{tau0}, {t_stop}]")
     L = t_stop - tau0
-    windows = (
+    return (
         (tau0, t_stop),
         (tau0, tau0 + 0.5 * L),
         (tau0 + 0.5 * L, t_stop),
         (tau0 + 0.25 * L, tau0 + 0.75 * L),
     )
-    return WindowChoice(
-        tau0=tau0,
-        t_stop=t_stop,
-        windows=windows,
-        kappa_ref=kappa_ref,
-        width=w,
-        t_floor=float(t_floor),
-        converged=converged,
-        slope_t=c,
-        slope=s,
-        slope_err=se,
-    )
-
-
