@@ -560,8 +560,9 @@ class CMeasureRates(_PointRows):
 
 
 def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *, window: tuple[float, float],
-                   t_max: float, t_from: float | None = None, t_to: float | None = None, rec_efolds: float = 2.0,
-                   margin: float = 40.0, n_boot: int = 200, seed: int = 0) -> CMeasureRates:
+                          t_max: float, t_from: float | None = None, t_to: float | None = None,
+                          rec_efolds: float = 2.0, margin: float = 40.0, n_boot: int = 200,
+                          seed: int = 0) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
 
     Solves ∫_Ω e^{κT} dμ_c = 1 + μ_c(𝓔), Eq. (eqn:kappa_cmeasure_truetime), with every section crossing of
@@ -616,11 +617,22 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     True
     """
 
-    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
-        cmeasure_sample_from_sections,
-        kappa_from_cmeasure,
-    )
+    window = _checked_cmeasure_window(window)
+    t_max = float(t_max)
+    t_record_end = min(float(window.get("t_to", math.inf)), t_max)
+    lt, sec = lifetimes, sections
+    rates = escape_rates(lt) if any(g == 0 for (_, g), _ in split_points(lt)) else EscapeRates({}, {}, {})
+    keys = [k for k, _ in split_points(lt)]
+    sec_by = _split_like(sec, keys, what="sections table")
+    rows = {}
+    for key, df in split_points(lt):
+        rows[key] = _cmeasure_point_row(key, df, sec_by.get(key, sec.iloc[:0]), rates, window, t_max, t_record_end,
+                                        t_from, t_to, rec_efolds, margin, n_boot, seed)
+    return CMeasureRates(rows)
 
+
+def _checked_cmeasure_window(window) -> dict:
+    """The run's section window as a dict, refused unless it records every crossing (no filter, not first_only)."""
     if window is not None and dataclasses.is_dataclass(window):
         window = dataclasses.asdict(window)
     if not window:
@@ -630,45 +642,46 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
             math.isfinite(window.get("e_max", math.inf)):
         raise ValueError(f"the c-measure needs every section crossing; the run's window {window} filters them "
                          "(first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)")
-    t_max = float(t_max)
-    t_record_end = min(float(window.get("t_to", math.inf)), t_max)
-    drop_trapped = t_max > t_record_end
-    lt, sec = lifetimes, sections
-    rates = escape_rates(lt) if any(g == 0 for (_, g), _ in split_points(lt)) else EscapeRates({}, {}, {})
-    keys = [k for k, _ in split_points(lt)]
-    sec_by = _split_like(sec, keys, what="sections table")
-    rows = {}
-    for key, df in split_points(lt):
-        row = {"energy": key[0], "gamma": key[1], "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
-               "mu_exit": math.nan, "n_samples": 0, "n_exit": 0, "n_undetermined": 0, "t_from": math.nan,
-               "t_to": math.nan, "t_record_end": t_record_end, "kappa_pt": math.nan, "kappa_pt_err": math.nan,
-               "note": ""}
-        rows[key] = row
-        r = rates.results.get(key)
-        if r is None:
-            row["note"] = DISSIPATIVE_NOTE if key[1] > 0 else rates.notes.get(key, "no κ from P(t)")
-            continue
-        row.update(kappa_pt=r.kappa, kappa_pt_err=r.kappa_err)
-        t0 = float(t_from) if t_from is not None else max(float(window.get("t_from", 0.0)),
-                                                           math.ceil(r.tau0 + rec_efolds / r.kappa))
-        t1 = float(t_to) if t_to is not None else t_record_end - margin
-        row.update(t_from=t0, t_to=t1)
-        if not t1 > t0 or t0 < float(window.get("t_from", 0.0)) or t1 > t_record_end:
-            row["note"] = (f"sampling window [{t0:g}, {t1:g}] does not fit the recording [{window.get('t_from', 0)}, "
-                           f"{t_record_end:g}]: record sections until ≥ {t0 + margin + 2 / r.kappa:.0f}")
-            continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the undetermined count is a column
-            T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
-                sec_by.get(key, sec.iloc[:0]), df, t0, t1, t_record_end=t_record_end, drop_censored=drop_trapped,
-                with_orbits=True)
-        if T.size + n_exit == 0:
-            row["note"] = "no section crossing in the sampling window"
-            continue
-        k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot, rng=seed)
-        row.update(kappa_cm=k.kappa, kappa_cm_err=k.kappa_err, mu_exit=k.mu_exit, n_samples=k.n_samples,
-                   n_exit=k.n_exit, n_undetermined=n_und)
-    return CMeasureRates(rows)
+    return window
+
+
+def _cmeasure_point_row(key, df, sec, rates, window, t_max, t_record_end, t_from, t_to, rec_efolds, margin,
+                        n_boot, seed) -> dict:
+    """One grid point's row of :func:`kappa_cmeasure_tables`: its sampling window (time units) from τ0 and κ of
+    P(t), the c-measure sample of its crossings in it, κ_cm ± err (1/time) beside κ from P(t), or a note."""
+    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
+        cmeasure_sample_from_sections,
+        kappa_from_cmeasure,
+    )
+
+    row = {"energy": key[0], "gamma": key[1], "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
+           "mu_exit": math.nan, "n_samples": 0, "n_exit": 0, "n_undetermined": 0, "t_from": math.nan,
+           "t_to": math.nan, "t_record_end": t_record_end, "kappa_pt": math.nan, "kappa_pt_err": math.nan,
+           "note": ""}
+    r = rates.results.get(key)
+    if r is None:
+        row["note"] = DISSIPATIVE_NOTE if key[1] > 0 else rates.notes.get(key, "no κ from P(t)")
+        return row
+    row.update(kappa_pt=r.kappa, kappa_pt_err=r.kappa_err)
+    t0 = float(t_from) if t_from is not None else max(float(window.get("t_from", 0.0)),
+                                                       math.ceil(r.tau0 + rec_efolds / r.kappa))
+    t1 = float(t_to) if t_to is not None else t_record_end - margin
+    row.update(t_from=t0, t_to=t1)
+    if not t1 > t0 or t0 < float(window.get("t_from", 0.0)) or t1 > t_record_end:
+        row["note"] = (f"sampling window [{t0:g}, {t1:g}] does not fit the recording [{window.get('t_from', 0)}, "
+                       f"{t_record_end:g}]: record sections until ≥ {t0 + margin + 2 / r.kappa:.0f}")
+        return row
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the undetermined count is a column
+        T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
+            sec, df, t0, t1, t_record_end=t_record_end, drop_censored=t_max > t_record_end, with_orbits=True)
+    if T.size + n_exit == 0:
+        row["note"] = "no section crossing in the sampling window"
+        return row
+    k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot, rng=seed)
+    row.update(kappa_cm=k.kappa, kappa_cm_err=k.kappa_err, mu_exit=k.mu_exit, n_samples=k.n_samples,
+               n_exit=k.n_exit, n_undetermined=n_und)
+    return row
 
 
 @dataclass(frozen=True)

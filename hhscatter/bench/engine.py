@@ -187,12 +187,6 @@ def _engine(scene, ics, **kw):
 
 
 def main(argv=None):
-    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
-    from hhscatter.scene.scene import (  # deferred: pydantic loads on first use
-        Scene,
-        SectionWindow,
-    )
-
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
     ap.add_argument("--repeat", type=int, default=3)
@@ -207,6 +201,19 @@ def main(argv=None):
         print(f"{target:16s} {what:58s} {value:10.3f}  {goal:>8s}  {note}", flush=True)
 
     print(f"# hhscatter engine benchmark: N = {n} per measurement, 1 core, best of {rep}")
+    _bare_rows(row, n, rep)
+    c3, ics3 = _dissipative_rows(row, n, rep)
+    _loose_tolerance_rows(row, n, rep, c3, ics3)
+    rec, icr = _recording_rows(row, n, rep)
+    _profile_row(row, rec, icr)
+    _design_rows(row)
+    _write_outputs(rows, a.out, n, rep)
+
+
+def _bare_rows(row, n, rep):
+    """The bare conservative scene against the yardstick driver (µs/orbit and their ratio)."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
     # -- bare conservative vs the yardstick ----------------------------------------------
     cons = Scene(energy=0.27, n=n, seed=1, r_esc=1.03)
     ics = region_ics(cons, 0, n)
@@ -217,6 +224,12 @@ def main(argv=None):
     row("bare", "yardstick µs/orbit (recommended batch size)", 1e6 * t_y / n, "")
     row("bare", "engine µs/orbit", 1e6 * t_e / n, "")
     row("bare", "engine / yardstick", t_e / t_y, "≤ 1 (0.8)", f"same t_end (1e-9) on {100 * agree:.1f} % of orbits")
+
+
+def _dissipative_rows(row, n, rep):
+    """Dissipative against conservative at E0 = 0.3 on the same ICs; returns that scene and its ICs."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
     # -- dissipative vs conservative at the same energy -----------------------------------
     c3 = Scene(energy=0.3, n=n, seed=2, r_esc=1.03)
     d3 = c3.replace(gamma=0.01)
@@ -228,6 +241,11 @@ def main(argv=None):
     row("dissipative", "dissipative E0 = 0.3, γ = 0.01: µs/orbit", 1e6 * t_d / n, "", f"{sd_:.1f} steps/orbit")
     row("dissipative", "dissipative / conservative", t_d / t_c, "≤ 1.6",
         f"per step: {(t_d / rd.n_steps) / (t_c / rc.n_steps):.2f}×")
+    return c3, ics3
+
+
+def _loose_tolerance_rows(row, n, rep, c3, ics3):
+    """The engine at tol 1e-9 against numba DOP853 at 1e-7, conservative and dissipative."""
     # -- loose tolerance vs numba DOP853 ----------------------------------------------------
     m = min(n, 20_000)
     for label, gamma in (("conservative", 0.0), ("dissipative", 0.01)):
@@ -236,6 +254,12 @@ def main(argv=None):
         t_p, _ = _best(lambda g=gamma: peers.dop853(ics3[:m], 1e-7, gamma=g, r_esc=1.03), rep)
         row("loose tol", f"{label}: numba DOP853 (1e-7) / engine (1e-9)", t_p / t_l, "≥ 2",
             f"engine {1e6 * t_l / m:.2f}, DOP853 {1e6 * t_p / m:.2f} µs/orbit")
+
+
+def _recording_rows(row, n, rep):
+    """Snapshots and the first section crossing against the bare scene; returns the recording scene and ICs."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene, SectionWindow  # deferred: pydantic loads on first use
     # -- recording scene ---------------------------------------------------------------------
     m = min(n, 20_000)
     bare = Scene(energy=0.3, gamma=0.01, n=m, seed=3, r_esc=1.03)
@@ -255,6 +279,11 @@ def main(argv=None):
     only_sec = bare.replace(sections=SectionWindow(t_from=17.0, first_only=True))
     t_x, _ = _best(_engine(only_sec, icr), rep)
     row("recording", "first section after t = 17 only / bare", t_x / t_b, "", "gated section event + clock")
+    return rec, icr
+
+
+def _profile_row(row, rec, icr):
+    """cProfile of the recording scene: the share of time inside heyoka's compiled propagation."""
     # -- where the recording scene's time goes --------------------------------------------
     prof = cProfile.Profile()
     fn = _engine(rec, icr)
@@ -268,6 +297,9 @@ def main(argv=None):
     row("profile", "recording: share inside heyoka's compiled propagation", inside / total, "",
         "self time of propagate_*; the rest is Python (callbacks, epochs, numpy)")
 
+
+def _design_rows(row):
+    """ns per lane-step of the propagation modes behind the epoch scheduler."""
     # -- the design choices behind the epoch scheduler -------------------------------------
     dc = design_choices()
     for kind, label in (("until", "propagate_until (no recording)"), ("grid2", "propagate_grid, 2 points/epoch"),
@@ -277,7 +309,10 @@ def main(argv=None):
         row("design", f"ns per lane-step: {label}", dc[kind], "",
             f"{dc[kind] / dc['until']:.2f}× propagate_until")
 
-    out = Path(a.out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
+
+def _write_outputs(rows, out, n, rep):
+    """engine.csv and engine_summary.md in ``out`` (default studies/engine/out/full or quick)."""
+    out = Path(out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
     out.mkdir(parents=True, exist_ok=True)
     import pandas as pd  # deferred: pandas loads on first use
 

@@ -385,19 +385,62 @@ class _Stream(_BatchRules):
         self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
 
     def inlined_handlers(self):
-        """Lean closures for the hot handlers of plain scenes (no section event, no follow).
+        """Lean closures for the hot handlers of plain scenes (no section event, no follow): {rule: handler}.
 
         The same rules as the methods of :class:`LaneRules`, with the per-orbit
         Python cut to a few list operations (measured: the generic chain of
         method calls cost ~3 µs per orbit, more than half the integration of a
         conservative orbit at E = 0.27).
         """
+        elapsed, finish, next_orbit = self._inlined_orbit_steps()
+        orbit, last_out, st = self.orbit, self.last_out, self.state
+        r_s2 = self.r_s * self.r_s
+
+        def on_escape(lane, d):
+            if orbit[lane] < 0:
+                return True
+            return finish(lane, ESCAPED, elapsed(lane), st[:4, lane].tolist())
+
+        def on_resc(lane, d):
+            if orbit[lane] >= 0:
+                last_out[lane] = (elapsed(lane), st[:4, lane].tolist()) if d > 0 else None
+            return True
+
+        def on_closure(lane, d):
+            if orbit[lane] < 0:
+                return True
+            x, y, px, py = state = st[:4, lane].tolist()
+            if x * x + y * y <= r_s2:  # events.closure_rule, inlined
+                return finish(lane, SETTLED, elapsed(lane), state)
+            out = last_out[lane]
+            return finish(lane, ESCAPED, *out) if out is not None else True
+
+        def on_far(lane, d):
+            if orbit[lane] < 0:
+                return True
+            out = last_out[lane]
+            if out is None:  # unreachable: r_far > r_esc; kept as a guard
+                raise RuntimeError("orbit reached r_far without crossing r_esc")
+            return finish(lane, ESCAPED, *out)
+
+        def load(lane, k=None):
+            if k is None:
+                return next_orbit(lane)
+            return _Stream.load(self, lane, k)  # a rerun: the orbit's own index
+
+        self.load = load
+        return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
+
+    def _inlined_orbit_steps(self):
+        """The closures the inlined handlers share: the orbit time of a lane (TwoSum of the double-double lane
+        time minus the orbit's start), the end of an orbit (record, then load the next) and the loading of the
+        next orbit (returns what a callback returns); all state captured once, as lists and Python floats."""
         orbit, last_out = self.orbit, self.last_out
-        hi, lo, starts_hi, starts_lo, orbit_bounds, bound = self.time_hi, self.time_lo, self.start_hi, self.start_lo, self.orbit_bound, self.bound
+        hi, lo, starts_hi, starts_lo = self.time_hi, self.time_lo, self.start_hi, self.start_lo
+        orbit_bounds, bound = self.orbit_bound, self.bound
         st, ics, ta = self.state, self.ics, self.ta
         outcomes, t_ends, end_states = self.outcome, self.t_end, self.end_state
         n, t_max = self.n, self.t_max
-        r_s2 = self.r_s * self.r_s
         progress = self.progress
         reset = ta.reset_cooldowns
         # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
@@ -443,40 +486,7 @@ class _Stream(_BatchRules):
             outcomes[k], t_ends[k], end_states[k] = outcome, t, state
             return next_orbit(lane)
 
-        def on_escape(lane, d):
-            if orbit[lane] < 0:
-                return True
-            return finish(lane, ESCAPED, elapsed(lane), st[:4, lane].tolist())
-
-        def on_resc(lane, d):
-            if orbit[lane] >= 0:
-                last_out[lane] = (elapsed(lane), st[:4, lane].tolist()) if d > 0 else None
-            return True
-
-        def on_closure(lane, d):
-            if orbit[lane] < 0:
-                return True
-            x, y, px, py = state = st[:4, lane].tolist()
-            if x * x + y * y <= r_s2:  # events.closure_rule, inlined
-                return finish(lane, SETTLED, elapsed(lane), state)
-            out = last_out[lane]
-            return finish(lane, ESCAPED, *out) if out is not None else True
-
-        def on_far(lane, d):
-            if orbit[lane] < 0:
-                return True
-            out = last_out[lane]
-            if out is None:  # unreachable: r_far > r_esc; kept as a guard
-                raise RuntimeError("orbit reached r_far without crossing r_esc")
-            return finish(lane, ESCAPED, *out)
-
-        def load(lane, k=None):
-            if k is None:
-                return next_orbit(lane)
-            return _Stream.load(self, lane, k)  # a rerun: the orbit's own index
-
-        self.load = load
-        return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
+        return elapsed, finish, next_orbit
 
     def elapsed(self, lane):
         """Orbit time of ``lane`` now: the double nearest (hi + lo) − (hi0 + lo0), via TwoSum."""

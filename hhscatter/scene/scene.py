@@ -293,6 +293,15 @@ class Scene:
 
     # -- validation ---------------------------------------------------------
     def _validate(self):
+        """Every field in range, checked in this order (the first bad one is the error); snapshots normalised."""
+        gamma, t_max = self._check_dynamics()
+        r_esc = self._check_radii()
+        self._check_chunks()
+        self._check_energy(gamma)
+        self._check_recording(gamma, t_max, r_esc)
+
+    def _check_dynamics(self):
+        """γ, n, seed, tol and t_max; returns (γ, t_max)."""
         m = self.model
         gamma = _finite("gamma", self.gamma)
         if gamma < 0:
@@ -313,6 +322,11 @@ class Scene:
         t_max = _finite("t_max", self.t_max)
         if t_max <= 0:
             raise ConfigError(f"t_max must be > 0, got {t_max}")
+        return gamma, t_max
+
+    def _check_radii(self):
+        """r_esc, r_far, the IC region and its radius; returns r_esc."""
+        m = self.model
         r_esc = _finite("r_esc", self.r_esc)
         if r_esc <= m.saddle_radius:
             raise ConfigError(
@@ -338,6 +352,10 @@ class Scene:
             raise ConfigError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
                              "escaped already, and the sampler would reject almost every draw: V < E only "
                              "holds near the saddle triangle)")
+        return r_esc
+
+    def _check_chunks(self):
+        """chunk_size (and the number of part files it makes) and batch_size."""
         if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
             raise ConfigError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
         if -(-self.n // self.chunk_size) > CHUNKS_MAX:
@@ -347,6 +365,10 @@ class Scene:
             not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
         ):
             raise ConfigError(f"batch_size must be an integer in [1, 64], got {self.batch_size!r}")
+
+    def _check_energy(self, gamma):
+        """E0 against the region's minimum of V, E_c and its upper bound (or ics without energy)."""
+        m = self.model
         if self.ics is None:
             if self.energy is None:
                 raise ConfigError("energy is required unless initial conditions come from a table (ics)")
@@ -369,6 +391,10 @@ class Scene:
                 )
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
+
+    def _check_recording(self, gamma, t_max, r_esc):
+        """sections, snapshots (normalised to a sorted tuple), follow and continue_settled."""
+        m = self.model
         if self.sections is not None and not isinstance(self.sections, SectionWindow):
             raise ConfigError("sections must be a SectionWindow or None")
         if self.snapshots is not None:
