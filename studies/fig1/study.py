@@ -140,72 +140,86 @@ def analyze(study):
     """analyze(study) -> None; writes cmeasure_points.parquet, potential_grid.parquet and fig1.json."""
     import pandas as pd
 
-    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.data.read import read_lifetimes, read_sections
-
-    model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
-    E_C = model.critical_energy
-    rec_efolds = study.params.rec_efolds
     choices = json.loads(_choices_path(study).read_text())
     per_energy, points = {}, []
     for energy in study.params.energies:
         key = energy_key(energy)
-        ch = choices[key]
-        t_rec = float(ch["t_rec"])
-        scene = json.loads((study.raw(key) / SCENE_FILE).read_text())["scene"]
-        if abs(float(scene["sections"]["t_from"]) - t_rec) > 1e-9:
-            raise RuntimeError(f"{key}: raw run's t_rec = {scene['sections']['t_from']} is not the recorded "
-                               f"choice {t_rec}; re-run the simulate stage")
-        # the rule with the current analysis code (differs only if escape_rate changed since simulate)
-        r = _pilot_rate(study.raw(f"pilot_{key}"))
-        t_rec_now = recording_time(r.kappa, r.tau0, rec_efolds)
-        lt = read_lifetimes(study.raw(key), columns=["traj_id", "e0", "gamma", "outcome", "t_end"], categorical=True)
-        sec = read_sections(study.raw(key))
-        if (sec["t"] < t_rec).any() or sec["traj_id"].duplicated().any():
-            raise RuntimeError(f"{key}: sections must hold one crossing per orbit at t ≥ t_rec")
-        alive = int(np.count_nonzero(lt["t_end"].to_numpy() > t_rec))
-        own = escape_rate_from_lifetimes(lt, detect_tail=False)
-        e_dev = float(np.max(np.abs(sec["energy"].to_numpy() - energy))) if len(sec) else 0.0
-        per_energy[key] = {
-            "energy": float(energy),
-            "t_rec": t_rec,
-            "t_max": float(scene["t_max"]),
-            "kappa_used": {"value": ch["kappa"], "err": ch["kappa_err"]},
-            "tau0_used": ch["tau0"],
-            "fit_window_pilot": [ch["tau0"], ch["t_stop"]],
-            "t_rec_times_kappa": t_rec * ch["kappa"],
-            "t_rec_rule_with_current_code": t_rec_now,
-            "n_pilot": int(ch["n_pilot"]),
-            "n_orbits": len(lt),
-            "n_survivors_at_t_rec": alive,
-            "n_points": len(sec),
-            "kappa_main_run": {"value": own.kappa, "err": own.kappa_err},
-            "max_energy_deviation": e_dev,
-            "raw_run": f"raw/{key}",
-        }
-        pts = sec[["traj_id", "t", "x", "y", "px", "py"]].copy()
-        pts.insert(0, "energy", float(energy))
-        pts["e_cross"] = sec["energy"].to_numpy()  # the orbit's energy at the crossing (E up to rounding)
+        per_energy[key], pts = _energy_run(study, energy, key, choices[key])
         points.append(pts)
-        # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
-        study.compare(f"kappa(E={energy:.2f}) used for t_rec", ch["kappa"], ch["kappa_err"], 1.41 * (energy - E_C),
-                      unit="1/time", note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b")
     study.write_table(pd.concat(points, ignore_index=True), CMEASURE_TABLE,
                       description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec; "
                                   "energy = the run's E, e_cross = the orbit's energy at the crossing")
+    _write_potential_grid(study)
+    study.write_numbers(_numbers(study, per_energy))
+
+
+def _energy_run(study, energy: float, key: str, ch: dict):
+    """One energy's main run: checked against the recorded choice, its numbers and c-measure points; κ compared."""
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.data.read import read_lifetimes, read_sections
+
+    t_rec = float(ch["t_rec"])
+    scene = json.loads((study.raw(key) / SCENE_FILE).read_text())["scene"]
+    if abs(float(scene["sections"]["t_from"]) - t_rec) > 1e-9:
+        raise RuntimeError(f"{key}: raw run's t_rec = {scene['sections']['t_from']} is not the recorded "
+                           f"choice {t_rec}; re-run the simulate stage")
+    # the rule with the current analysis code (differs only if escape_rate changed since simulate)
+    r = _pilot_rate(study.raw(f"pilot_{key}"))
+    t_rec_now = recording_time(r.kappa, r.tau0, study.params.rec_efolds)
+    lt = read_lifetimes(study.raw(key), columns=["traj_id", "e0", "gamma", "outcome", "t_end"], categorical=True)
+    sec = read_sections(study.raw(key))
+    if (sec["t"] < t_rec).any() or sec["traj_id"].duplicated().any():
+        raise RuntimeError(f"{key}: sections must hold one crossing per orbit at t ≥ t_rec")
+    alive = int(np.count_nonzero(lt["t_end"].to_numpy() > t_rec))
+    own = escape_rate_from_lifetimes(lt, detect_tail=False)
+    e_dev = float(np.max(np.abs(sec["energy"].to_numpy() - energy))) if len(sec) else 0.0
+    entry = {
+        "energy": energy,
+        "t_rec": t_rec,
+        "t_max": float(scene["t_max"]),
+        "kappa_used": {"value": ch["kappa"], "err": ch["kappa_err"]},
+        "tau0_used": ch["tau0"],
+        "fit_window_pilot": [ch["tau0"], ch["t_stop"]],
+        "t_rec_times_kappa": t_rec * ch["kappa"],
+        "t_rec_rule_with_current_code": t_rec_now,
+        "n_pilot": int(ch["n_pilot"]),
+        "n_orbits": len(lt),
+        "n_survivors_at_t_rec": alive,
+        "n_points": len(sec),
+        "kappa_main_run": {"value": own.kappa, "err": own.kappa_err},
+        "max_energy_deviation": e_dev,
+        "raw_run": f"raw/{key}",
+    }
+    pts = sec[["traj_id", "t", "x", "y", "px", "py"]].copy()
+    pts.insert(0, "energy", energy)
+    pts["e_cross"] = sec["energy"].to_numpy()  # the orbit's energy at the crossing (E up to rounding)
+    # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
+    study.compare(f"kappa(E={energy:.2f}) used for t_rec", ch["kappa"], ch["kappa_err"],
+                  1.41 * (energy - study.model.critical_energy), unit="1/time",
+                  note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b")
+    return entry, pts
+
+
+def _write_potential_grid(study) -> None:
+    """Fig. 1a's potential V(x, y) on a square grid (derived table potential_grid.parquet)."""
+    import pandas as pd
 
     h = study.params.grid_half_width
     m = study.params.grid_points
     g = np.linspace(-h, h, m)
     X, Y = np.meshgrid(g, g)
-    study.write_table(pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": model.potential(X, Y).ravel()}),
+    study.write_table(pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": study.model.potential(X, Y).ravel()}),
                       "potential_grid.parquet", description=f"V(x, y) on a {m}×{m} grid, Eq. (eqn:hh_potential)")
-    levels = contour_levels(study.params.n_contours)
-    study.write_numbers({
+
+
+def _numbers(study, per_energy: dict) -> dict:
+    """fig1.json: the sprinkler rule, per energy its run's numbers, the published tables, contours, E_c, saddles."""
+    model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
+    return {
         "sprinkler_rule": "t_rec = ceil(tau0 + rec_efolds/kappa), kappa and tau0 from the pilot run's Kaplan-Meier "
                           "P(t) (escape_rate: mean of 4 window fits); main run records the first section crossing "
                           "at t >= t_rec (SectionWindow first_only=True), t_max = t_rec + t_after",
-        "rec_efolds": rec_efolds,
+        "rec_efolds": study.params.rec_efolds,
         "energies": per_energy,
         "tables": {"cmeasure_points": CMEASURE_TABLE, "potential_grid": "potential_grid.parquet"},
         "cmeasure_sample": {
@@ -215,10 +229,10 @@ def analyze(study):
             "t_rec": {k: v["t_rec"] for k, v in per_energy.items()},
             "n_points": {k: v["n_points"] for k, v in per_energy.items()},
         },
-        "contour_levels": levels,
-        "E_c": E_C,
+        "contour_levels": contour_levels(study.params.n_contours),
+        "E_c": model.critical_energy,
         "saddles": model.saddles,
-    })
+    }
 
 
 def plot(study):

@@ -34,6 +34,17 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     plt = agg_pyplot()
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(6.4, 8.2), height_ratios=[2.3, 1.1], sharex=True,
                                  constrained_layout=True)
+    ts, t_right = _energy_panel(ax, me, hist, numbers, t_max)
+    _histogram_inset(ax, hist, ts)
+    _mu_panel(bx, tab, numbers, t_right)
+    ax.text(0.01, 0.985, "(a)", transform=ax.transAxes, va="top", fontsize=10, fontweight="bold")
+    bx.text(0.01, 0.96, "(b)", transform=bx.transAxes, va="top", fontsize=10, fontweight="bold")
+    fig.savefig(path, dpi=200)
+    plt.close(fig)
+
+
+def _energy_panel(ax, me, hist, numbers, t_max):
+    """Panel (a): ⟨E⟩(t) with its two ribbons, the curve above E_c, the fit, E_c and the histogram times."""
     mu = numbers["mu"]["value"]
     mu_err = numbers["mu"]["err"]
     E0, gamma = numbers["E0"], numbers["gamma"]
@@ -70,6 +81,12 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     ax.set_title(rf"$(E_0,\gamma)=({E0:g},\,{gamma:g})$, $N={numbers['n_orbits']:,}$", fontsize=10)
     ax.legend(loc="lower left", fontsize=7.5, framealpha=0.9)
     ax.grid(True, which="major", alpha=0.3)
+    return ts, t_right
+
+
+def _histogram_inset(ax, hist, ts):
+    """Inset of panel (a): densities in log10 E at the histogram times ``ts``."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     ins = ax.inset_axes([0.55, 0.55, 0.43, 0.42])
     for k, tk in enumerate(ts):
@@ -81,8 +98,6 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
                    label=rf"$t={tk:g}$")
     ins.axvline(E_C, color="k", ls=":", lw=0.8)
     ins.set_xscale("log")
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
-
     ins.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 3.0)))
     ins.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ins.xaxis.set_minor_formatter(NullFormatter())
@@ -91,6 +106,10 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     ins.tick_params(labelsize=7)
     ins.legend(fontsize=6, loc="upper left", frameon=False)
 
+
+def _mu_panel(bx, tab, numbers, t_right):
+    """Panel (b): local μ on sliding windows, μ = 1, the paper's μ and the fitted μ of every convention."""
+    w_lo, w_hi = numbers["fit_window"]
     s = tab[tab["kind"] == "sliding"]
     bx.errorbar(s["t_mid"], s["mu_free"], yerr=3 * s["mu_free_err"], fmt="o-", ms=3, lw=1, color="#0b2f6b",
                 capsize=2, label=r"local $\mu$ (slope of $\log\langle E\rangle$), $\pm3\sigma$")
@@ -118,7 +137,3 @@ def plot_fig3(me, tab, hist, numbers, path, *, t_max=None):
     # below the panel: inside it the legend would hide the short segments near μ ≈ 0.87–0.92
     bx.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
     bx.grid(True, alpha=0.3)
-    ax.text(0.01, 0.985, "(a)", transform=ax.transAxes, va="top", fontsize=10, fontweight="bold")
-    bx.text(0.01, 0.96, "(b)", transform=bx.transAxes, va="top", fontsize=10, fontweight="bold")
-    fig.savefig(path, dpi=200)
-    plt.close(fig)

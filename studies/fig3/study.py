@@ -45,6 +45,7 @@ orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
 from __future__ import annotations
 
 import json
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -100,46 +101,90 @@ def _snapshot_rows(study, key: str, filters=None) -> pd.DataFrame:
 
 def analyze(study):
     """analyze(study) -> None: ⟨E⟩(t), μ fits (+ bootstrap), later windows, histograms, fig3.json."""
-    import pyarrow.dataset as ds
-
-    from hhscatter.analysis.dissipative.decay import (
-        bootstrap_mu_first_orbits,
-        energy_histograms,
-        fit_energy_decay,
-        inside_mean_energy,
-        mu_by_window,
-    )
-    from hhscatter.data.read import iter_parts, read_lifetimes
-
     key = _key(study)
     scene = study.scene(key)
     E0, gamma = float(scene.energy), float(scene.gamma)
     E_C = study.model.critical_energy
+    me, cont, lt = _mean_energy(study, key, E_C)
+    n_orbits = len(lt)
+
+    window = tuple(study.params.fit_window)
+    fit = _paper_fit(me, E0, gamma, window)
+    alt = tuple(study.params.alt_window)
+    windows, kinds = _fit_windows(window, [tuple(w) for w in study.params.later_windows],
+                                 study.params.sliding_window, alt, float(me["t"].max()))
+    tab = _mu_table(me, E0, gamma, windows, kinds)
+    boot, boot_up, scale = _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt)
+    _add_bootstrap_errors(tab, me, boot, scale, len(windows), study.params.n_boot)
+    hist, h = _histograms(study, key, me, E0)
+
+    meta = {"E0": E0, "gamma": gamma, "definition": "mean over orbits not escaped at t (settled orbits continued)"}
+    study.write_table(me, "fig3_mean_energy.parquet", **meta)
+    study.write_table(tab, "fig3_mu_windows.parquet", **meta)
+    study.write_table(hist, "fig3_histograms.parquet", **meta)
+
+    res = _results(study, me, tab, lt, boot_up, scale, window, alt, E0, gamma, E_C, n_orbits)
+    _compare_with_paper(study, res, window, E0, gamma, E_C)
+    study.write_numbers(_numbers(study, res, fit, h, cont, key, window, E0, gamma, n_orbits))
+
+
+def _mean_energy(study, key: str, E_C: float):
+    """Read inputs: the ⟨E⟩(t) table (inside Ω and above E_c, ± 3 SEM), the continuation counts, the lifetimes."""
+    from hhscatter.analysis.dissipative.decay import inside_mean_energy
+    from hhscatter.data.read import iter_parts, read_lifetimes
+
     ime = inside_mean_energy(iter_parts(study.raw(key), "snapshots", ["t", "energy"]), E_C)
     me, ma, cont = ime.inside, ime.above, {"rows_below_ec": ime.rows_below_ec}
     lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"], categorical=True)
-    n_orbits = len(lt)
 
     me["lo_3sem"] = me["mean_E"] - 3 * me["sem_E"]
     me["hi_3sem"] = me["mean_E"] + 3 * me["sem_E"]
     ma = ma.rename(columns={"n": "n_above", "mean_E": "mean_E_above", "sem_E": "sem_E_above"})
     me = me.merge(ma[["t", "n_above", "mean_E_above", "sem_E_above"]], on="t", how="left")
     me["n_above"] = me["n_above"].fillna(0).astype(np.int64)
+    return me, cont, lt
 
-    window = tuple(study.params.fit_window)
+
+def _paper_fit(me, E0: float, gamma: float, window):
+    """The paper's fit: log⟨E⟩ by E0 e^{−μγt} on the fit window (column fit_E added to ``me``)."""
+    from hhscatter.analysis.dissipative.decay import fit_energy_decay
+
     fit = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, window)
     me["fit_E"] = E0 * np.exp(-fit.mu * gamma * me["t"])
+    return fit
 
-    later = [tuple(w) for w in study.params.later_windows]
-    width, stride = study.params.sliding_window
-    t_last = float(me["t"].max())
+
+def _fit_windows(window, later, sliding_window, alt, t_last: float):
+    """The window chooser: the fit windows of μ and their kinds (paper, later, sliding, alt), times in model units.
+
+    The sliding windows ``[lo, lo + width]`` start at 0, stride, 2·stride, ... while they end by ``t_last``
+    (``sliding_window`` = [width, stride]).
+
+    >>> _fit_windows((0, 200), [(200, 400)], [100.0, 50.0], (0, 100), 250.0)[1]
+    ['paper', 'later', 'sliding', 'sliding', 'sliding', 'sliding', 'alt']
+    """
+    width, stride = sliding_window
     sliding = [(lo, lo + width) for lo in np.arange(0.0, t_last - width + 1e-9, stride)]
-    alt = tuple(study.params.alt_window)
     windows = [window] + later + sliding + [alt]
     kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding) + ["alt"]
+    return windows, kinds
+
+
+def _mu_table(me, E0: float, gamma: float, windows, kinds) -> pd.DataFrame:
+    """The fits: μ (E(0) = E0) and μ_free (free intercept) of log⟨E⟩ on every window, with their fit errors."""
+    from hhscatter.analysis.dissipative.decay import mu_by_window
+
     tab = mu_by_window(me["t"], me["mean_E"], E0, gamma, windows)
     tab["kind"] = kinds
-    tab = tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
+    return tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
+
+
+def _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt):
+    """The bootstrap over orbits of μ on every window (inside Ω), and on the fit and alt windows above E_c."""
+    import pyarrow.dataset as ds
+
+    from hhscatter.analysis.dissipative.decay import bootstrap_mu_first_orbits
+
     n_boot = study.params.n_boot
     k = min(study.params.n_boot_orbits, n_orbits)
     rows = _snapshot_rows(study, key, ds.field("traj_id") < k)
@@ -151,8 +196,12 @@ def analyze(study):
     # multiplicities are those of the replicates above: the two curves are resampled together.
     boot_up, _ = bootstrap_mu_first_orbits(rows[rows["energy"] > E_C], n_orbits, k, E0, gamma, [window, alt],
                                            n_boot=n_boot, seed=study.params.boot_seed)
-    del rows
-    boot["w"] = np.tile(np.arange(len(windows)), n_boot)
+    return boot, boot_up, scale
+
+
+def _add_bootstrap_errors(tab, me, boot, scale, n_windows, n_boot) -> None:
+    """Bootstrap errors of μ, μ_free per window (replicates' std × scale), window centres and ⟨E⟩ there."""
+    boot["w"] = np.tile(np.arange(n_windows), n_boot)
     err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
     tab["mu_err"] = err["mu"].to_numpy() * scale
     tab["mu_free_err"] = err["mu_free"].to_numpy() * scale
@@ -160,12 +209,27 @@ def analyze(study):
     # ⟨E⟩ at the window centre: where on the energy axis the local exponent is measured
     tab["mean_E_mid"] = np.interp(tab["t_mid"], me["t"], me["mean_E"])
 
-    # inset: histograms of log10 E at the marked times
+
+def _histograms(study, key, me, E0: float):
+    """The inset: histograms of log10 E at the marked times (geometric bins from the lowest energy to E0)."""
+    import pyarrow.dataset as ds
+
+    from hhscatter.analysis.dissipative.decay import energy_histograms
+
     hist_times = list(study.params.hist_times)
     at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(_nearest(me["t"].to_numpy(), hist_times))))
     lo = max(float(at["energy"].min()), 1e-12)
     edges = np.geomspace(lo * 0.98, E0 * 1.001, study.params.hist_bins + 1)
     h = energy_histograms(at, hist_times, bins=edges)
+    return _histogram_rows(h, edges), h
+
+
+def _histogram_rows(h, edges) -> pd.DataFrame:
+    """The histograms as rows (t, bin edges, count, density in log10 E: Σ density · Δlog10 E = 1 per time).
+
+    ``h``: an :func:`~hhscatter.analysis.dissipative.decay.energy_histograms` result (t_requested, t, counts
+    (times × bins), n_alive, mean_E); ``edges``: the energy bin edges (model units).
+    """
     dlog = np.diff(np.log10(edges))
     hrows = []
     for k in range(len(h.t)):
@@ -175,13 +239,25 @@ def analyze(study):
                           "count": int(h.counts[k, b]),
                           "density_log10E": h.counts[k, b] / (tot * dlog[b]) if tot else np.nan,
                           "n_inside": int(h.n_alive[k]), "mean_E": h.mean_E[k]})
-    hist = pd.DataFrame(hrows)
+    return pd.DataFrame(hrows)
 
-    meta = {"E0": E0, "gamma": gamma, "definition": "mean over orbits not escaped at t (settled orbits continued)"}
-    study.write_table(me, "fig3_mean_energy.parquet", **meta)
-    study.write_table(tab, "fig3_mu_windows.parquet", **meta)
-    study.write_table(hist, "fig3_histograms.parquet", **meta)
 
+class _Results(NamedTuple):
+    """The numbers that the comparison with the paper and fig3.json share."""
+
+    p: pd.Series          # the paper window's row of fig3_mu_windows
+    later_tab: pd.DataFrame
+    last: pd.Series       # the last later window
+    n_settled: int
+    over: float           # mean log(fit/⟨E⟩) at the end of the fit window
+    tau2_pred: float
+    tau2_pred_err: float
+    authors: dict
+    ribbon: dict
+
+
+def _results(study, me, tab, lt, boot_up, scale, window, alt, E0, gamma, E_C, n_orbits) -> _Results:
+    """Assemble the numbers: τ2 predicted, the fit's overshoot at the window's end, the authors' conventions."""
     p = tab.iloc[0]
     later_tab = tab[tab["kind"] == "later"]
     last = later_tab.iloc[-1]
@@ -189,20 +265,26 @@ def analyze(study):
     resid = np.log(me["fit_E"] / me["mean_E"])
     late = (me["t"] >= 0.75 * window[1]) & (me["t"] <= window[1])
     over = float(resid[late].mean())
-    paper_mu = study.params.paper_mu
     tau2_pred = float(np.log(E0 / E_C) / (p["mu"] * gamma))
     tau2_pred_err = float(tau2_pred * p["mu_err"] / p["mu"])
 
+    n_boot = study.params.n_boot
     alt_row = tab[tab["kind"] == "alt"].iloc[0]
     boot_err = {("inside", window): float(p["mu_err"]), ("inside", alt): float(alt_row["mu_err"])}
     err_up = boot_up.assign(w=np.tile(np.arange(2), n_boot)).groupby("w")["mu"].std(ddof=1).to_numpy() * scale
     boot_err.update({("above", window): float(err_up[0]), ("above", alt): float(err_up[1])})
     authors = _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits)
     ribbon = _ribbons(study, me)
-    for r in authors["mu"]:
+    return _Results(p, later_tab, last, n_settled, over, tau2_pred, tau2_pred_err, authors, ribbon)
+
+
+def _compare_with_paper(study, res: _Results, window, E0, gamma, E_C) -> None:
+    """Compare with the paper: μ per convention, the ribbons, μ → 1, the fit's overshoot, τ2."""
+    p, last, paper_mu = res.p, res.last, study.params.paper_mu
+    for r in res.authors["mu"]:
         study.compare(r["quantity"], r["value"], r["err"], paper_mu, verdict=r["verdict"],
                       convention=r["convention"], authors=r["authors"], note=r["note"])
-    for r in ribbon["rows"]:
+    for r in res.ribbon["rows"]:
         study.compare(r["quantity"], r["value"], None, None, unit="energy", convention=r["convention"],
                       authors=r["authors"], note=r["note"])
     study.compare("μ free intercept on [0, 200]", float(p["mu_free"]), float(p["mu_free_err"]), None,
@@ -211,14 +293,18 @@ def analyze(study):
                   float(last["mu_free_err"]), 1.0,
                   verdict="approaches 1" if abs(last["mu_free"] - 1) < abs(p["mu"] - 1) else "does not approach 1",
                   note=f"⟨E⟩ ≈ {last['mean_E_mid']:.2g} there; free-intercept slope of log⟨E⟩ on the window")
-    study.compare("fit overestimates ⟨E⟩ at the end of [0, 200]", over, None, "yes (qualitative)",
-                  verdict="agrees" if over > 0 else "differs",
+    study.compare("fit overestimates ⟨E⟩ at the end of [0, 200]", res.over, None, "yes (qualitative)",
+                  verdict="agrees" if res.over > 0 else "differs",
                   note=f"mean log(fit/⟨E⟩) over t ∈ [{0.75 * window[1]:g}, {window[1]:g}]")
-    study.compare("τ2 = ln(E0/E_c)/(μγ) at γ = 0.01", tau2_pred, tau2_pred_err,
+    study.compare("τ2 = ln(E0/E_c)/(μγ) at γ = 0.01", res.tau2_pred, res.tau2_pred_err,
                   float(np.log(E0 / E_C) / (paper_mu * gamma)), unit="time",
                   note="paper value computed from its μ = 0.91 with Eq. (eq:tau2)")
 
-    study.write_numbers({
+
+def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbits) -> dict:
+    """fig3.json: the fitted μ (bootstrap and fit errors), later windows, τ2, the authors' conventions."""
+    p, n_settled = res.p, res.n_settled
+    return {
         "E0": E0,
         "gamma": gamma,
         "n_orbits": n_orbits,
@@ -237,15 +323,15 @@ def analyze(study):
         "mu_later_windows": [
             {"t_lo": r.t_lo, "t_hi": r.t_hi, "mu": {"value": r.mu, "err": r.mu_err},
              "mu_local": {"value": r.mu_free, "err": r.mu_free_err}, "mean_E_mid": r.mean_E_mid}
-            for r in later_tab.itertuples()
+            for r in res.later_tab.itertuples()
         ],
-        "tau2_predicted": {"value": tau2_pred, "err": tau2_pred_err},
+        "tau2_predicted": {"value": res.tau2_pred, "err": res.tau2_pred_err},
         "hist_times": [float(v) for v in h.t],
-        "n_boot": n_boot,
+        "n_boot": study.params.n_boot,
         "n_boot_orbits": min(study.params.n_boot_orbits, n_orbits),
-        "paper_mu": paper_mu,
-        "authors_convention": {**authors, "ribbon": {k: v for k, v in ribbon.items() if k != "rows"}},
-    })
+        "paper_mu": study.params.paper_mu,
+        "authors_convention": {**res.authors, "ribbon": {k: v for k, v in res.ribbon.items() if k != "rows"}},
+    }
 
 
 SELECTIONS = {  # which orbits ⟨E⟩(t) averages over; the keys of [study] authors_selection

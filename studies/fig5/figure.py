@@ -75,11 +75,19 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
              f"($\\gamma={g0:g}$)", E1, E2, None)
     _scatter(axs[0, 1], cm1, pb, f"(b) as (a), crossing energy in [{band[0]:g}, {band[1]:g}]", E1, E2, None)
 
-    # (c) debiased Hellinger vs box size at gamma_main
-    ax = axs[1, 0]
     noise_max = float(nums["config"]["study"].get("noise_max", 0.5))
     delta = float(nums.get("delta", 0.1))
     boxes = sorted(dist_tab["box"].unique())
+    _distance_panel(axs[1, 0], dist_tab, summary, E1, E2, g0, boxes, noise_max, delta)
+    _agreement_panel(axs[1, 1], dist_tab, summary, nums, per_gamma, E1, boxes, noise_max, delta)
+    if nums.get("dev_fallback"):
+        fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
+    fig.savefig(path, dpi=160)
+    plt.close(fig)
+
+
+def _distance_panel(ax, dist_tab, summary, E1, E2, g0, boxes, noise_max, delta):
+    """Panel (c): debiased Hellinger distance to the c-measures vs box side at the paper's γ."""
     styles = [("a", "E1", COLORS[0], "o", "-"), ("a", "E2", COLORS[0], "s", "--"),
               ("b", "E1", COLORS[1], "o", "-"), ("b", "E2", COLORS[1], "s", "--")]
     for s, ref, col, mk, ls in styles:
@@ -103,8 +111,9 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, which="major", alpha=0.3)
 
-    # (d) agreement scale vs gamma
-    ax = axs[1, 1]
+
+def _agreement_panel(ax, dist_tab, summary, nums, per_gamma, E1, boxes, noise_max, delta):
+    """Panel (d): Fig. 5a vs μ_c^{E1} at every γ with the agreement scales ε*."""
     gammas = sorted(per_gamma)
     for i, g in enumerate(gammas):
         tab = dist_tab[(dist_tab["gamma"] == g) & (dist_tab["set"] == "a") & (dist_tab["ref"] == "E1")]
@@ -130,7 +139,3 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
                  fontsize=10, loc="left")
     ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, which="major", alpha=0.3)
-    if nums.get("dev_fallback"):
-        fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
-    fig.savefig(path, dpi=160)
-    plt.close(fig)

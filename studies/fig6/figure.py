@@ -83,8 +83,16 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path, pc_fits=None, pc
         ax.set_ylim(ymin, 3.0)
         ax.set_xlim(0, min(t_hi, 1.1 * float(np.nanmax(curves.loc[curves["P"] * curves["N"] >= 3, "t"]))))
 
-    # (b) tau vs gamma
-    ax = axs[0, 1]
+    _tau_panel(axs[0, 1], taus, tau2_curve, nums, hazards, pc, pc_taus)
+    _residuals_panel(axs[1, 1], curves, fits, pc_fits, hazards, mixes, h_mix)
+    if nums.get("dev_fallback"):
+        fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def _tau_panel(ax, taus, tau2_curve, nums, hazards, pc, pc_taus):
+    """Panel (b): τ1 and τ2 vs γ, observed (fig4) and predicted with our constants and the paper's."""
     ax.fill_between(tau2_curve["gamma"], tau2_curve["tau2_lo"], tau2_curve["tau2_hi"], color=COLORS[1], alpha=0.15,
                     lw=0)
     ax.plot(tau2_curve["gamma"], tau2_curve["tau2_predicted"], color=COLORS[1], ls="--",
@@ -122,8 +130,9 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path, pc_fits=None, pc
     ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=7)
 
-    # (d) rms log residuals
-    ax = axs[1, 1]
+
+def _residuals_panel(ax, curves, fits, pc_fits, hazards, mixes, h_mix):
+    """Panel (d): RMS log residual per pair and model on the same points, both sets of constants."""
     pairs = _pairs(curves)
     models = [("homogeneous", h) for h in hazards]
     if pc_fits is not None and len(pc_fits):
@@ -157,7 +166,3 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path, pc_fits=None, pc
     if vals_all.size:
         ax.set_ylim(vals_all.min() / 2, vals_all.max() * 8)  # room for the legend above the bars
     ax.legend(fontsize=7, ncol=2, loc="upper center")
-    if nums.get("dev_fallback"):
-        fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
-    fig.savefig(path, dpi=150)
-    plt.close(fig)

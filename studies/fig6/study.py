@@ -277,107 +277,168 @@ def _mixture_fits(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, mode, P
 
 def analyze(study):
     """analyze(study) -> None; model fits, τ predictions, derived tables and fig6.json."""
-    import pyarrow.dataset as pads
-
     import pyarrow as pa
 
-    from hhscatter.data.read import read_lifetimes, read_snapshots
-
-    inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
-    ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": mu}
-    pc = paper_constants(study)
-    kappa_pc = kappa_law(pc, E_c)
-    hazards = list(study.params.hazards)
-    dt, fit_dt = study.params.dt, study.params.fit_dt
-    min_count = study.params.min_count
-    fit_tau2 = study.params.fit_tau2
-    K = study.params.n_components
-    mixtures = _mixture_variants(study)
-    w_hi = float(study.params.mixture_fit_window[1])
-
+    s = _setup(study)
     curves, fit_rows, comp_rows, cmp_rows, pc_rows = [], [], [], [], []
     for E0, g in _pairs(study):
-        label = pair_key(E0, g)
-        raw = study.raw(label)
-        lt = read_lifetimes(raw, columns=["t_end", "outcome"], categorical=True)  # 9 bytes per orbit
-        n = len(lt)
-        t, P, P_err = _curve(lt, dt)
-        tf, Pf, sf = _fit_points(t, P, P_err, tau0, fit_dt, n, min_count)
-        P_min = min_count / n * 0.999
-        homog = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa, E0=E0, mu=mu, gamma=g, tau0=tau0, E_c=E_c,
-                                  hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
-        # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
-        # so the two RMS log residuals compare the constants alone
-        homog_pc = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa_pc, E0=E0, mu=pc["mu"], gamma=g,
-                                     tau0=tau0, E_c=E_c, hazards=hazards, fit_tau2=fit_tau2, P_min=P_min)
-        # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
-        # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
-        cap = study.params.mixture_max_orbits
-        keep = pads.field("t") >= tau0
-        if cap is not None:
-            keep = keep & (pads.field("traj_id") < int(cap))
-        snaps = read_snapshots(raw, filters=keep)
-        mixes = {}
-        for var in mixtures:
-            t_ref = tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
-            comps = mixture.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=K, by=var["by"],
-                                           fit_window=(tau0, w_hi))
-            comp_rows.append(comps.to_frame().assign(pair=label, E0=E0, gamma=g, model=var["name"]))
-            mixes[var["name"]] = _mixture_fits(t, P, tf, Pf, sf, comps, kappa=kappa, tau0=tau0, E_c=E_c,
-                                               hazards=hazards, mode=var["fne_mode"], P_min=P_min)
-        extra = {"E0": E0, "gamma": g, "N": n, "tau2_eq": tau2_predicted(E0, E_c, mu, g),
-                 "tau2_observed": tau2_observed(lt)}
-        cur = pd.DataFrame({"t": t, "P": P, "P_err": P_err})
-        for h in hazards:
-            models = {"homogeneous": homog[h], **{name: m[h] for name, m in mixes.items()}}
-            for name, f in models.items():
-                fit_rows.append(_fit_row(label, name, h, f, extra))
-                cur[f"{name}_{h}"] = f.predict(t)
-            cmp = sm.compare_fits(models).reset_index()
-            cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
-        for h in hazards:
-            cur[f"{PC}_{h}"] = homog_pc[h].predict(t)
-            pc_rows.append(_pc_row(homog[h], homog_pc[h], pair=label, E0=E0, gamma=g, hazard=h,
-                                   tau2_ours=tau2_predicted(E0, E_c, mu, g),
-                                   tau2_pc=tau2_predicted(E0, E_c, pc["mu"], g)))
-        curves.append(cur.assign(pair=label, E0=E0, gamma=g, N=n))
-        del lt, snaps  # 1e7 lifetimes and 1e6 orbits' snapshots per pair at paper scale: not kept for the next
+        cur, rows = _fit_pair(study, s, E0, g)
+        curves.append(cur)
+        for acc, new in zip((fit_rows, comp_rows, cmp_rows, pc_rows), rows):
+            acc.extend(new)
+        # 1e7 lifetimes and 1e6 orbits' snapshots per pair at paper scale (gone with _fit_pair): not kept for the next
         pa.default_memory_pool().release_unused()
     curves = pd.concat(curves, ignore_index=True)
     fits = pd.DataFrame(fit_rows)
     comps = pd.concat(comp_rows, ignore_index=True)
     cmps = pd.concat(cmp_rows, ignore_index=True)
     pcf = pd.DataFrame(pc_rows)
+    taus, tau_curves, pct = _tau_predictions(study, s)
 
-    ref = _fig4_reference(study, inputs, dt)
-    tau_kw = {"tau0": tau0, "E_c": E_c, "hazards": hazards, "dt": dt, "fit_dt": fit_dt, "min_count": min_count,
-              "alpha": study.params.alpha}
-    taus, tau_fits = _tau_rows(ref, kappa=kappa, mu=mu, mu_err=mu_err, **tau_kw)
-    taus_pc, tau_fits_pc = _tau_rows(ref, kappa=kappa_pc, mu=pc["mu"], mu_err=math.nan, **tau_kw)
-    pct = _pc_taus(taus, taus_pc, tau_fits, tau_fits_pc, hazards)
-    tau_curves = _tau2_curve(taus, ref.E0, E_c, mu, mu_err, pc["mu"])
-
-    study.write_table(curves, "curves.parquet", tau0=tau0, mu=mu)
+    study.write_table(curves, "curves.parquet", tau0=s.tau0, mu=s.mu)
     study.write_table(fits, "fits.parquet")
     study.write_table(comps, "mixture_components.parquet")
     study.write_table(cmps, "compare_fits.parquet")
     study.write_table(taus, "tau_vs_gamma.parquet")
     study.write_table(tau_curves, "tau2_curve.parquet")
-    study.write_table(pcf, f"{PC}_fits.parquet", constants=pc)
-    study.write_table(pct, f"{PC}_taus.parquet", constants=pc)
+    study.write_table(pcf, f"{PC}_fits.parquet", constants=s.pc)
+    study.write_table(pct, f"{PC}_taus.parquet", constants=s.pc)
 
-    # -- paper comparison --------------------------------------------------------
-    study.compare("μ used (from fig3)", mu, mu_err, pc["mu"], note=inputs["mu"]["source"])
+    _compare_with_paper(study, s, fits, cmps, taus, pcf, pct)
+    study.write_numbers(_numbers(s, fits, cmps, comps, taus, pcf, pct))
+
+
+class _Setup(NamedTuple):
+    """What every fit shares: the inputs (κ0(E), μ, τ0, E_c), the paper's constants, the hazards and mixtures."""
+
+    inputs: dict
+    kappa: PiecewiseKappa
+    mu: float
+    mu_err: float
+    tau0: float
+    E_c: float
+    pc: dict                  # the paper's constants (paper_constants)
+    kappa_pc: PiecewiseKappa  # κ0(E) with the paper's constants
+    hazards: list
+    mixtures: list            # [study] mixtures, checked
+
+
+def _setup(study) -> _Setup:
+    """Read inputs: κ0(E), μ and τ0 of the upstream studies, the paper's constants, the model variants."""
+    inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
+    pc = paper_constants(study)
+    kappa_pc = kappa_law(pc, E_c)
+    hazards = list(study.params.hazards)
+    return _Setup(inputs, kappa, mu, mu_err, tau0, E_c, pc, kappa_pc, hazards, _mixture_variants(study))
+
+
+def _fit_pair(study, s: _Setup, E0: float, g: float):
+    """One (E0, γ): Kaplan–Meier P(t) and the model fits; its curves and (fit, component, compare, pc) rows."""
+    from hhscatter.data.read import read_lifetimes
+
+    label = pair_key(E0, g)
+    raw = study.raw(label)
+    lt = read_lifetimes(raw, columns=["t_end", "outcome"], categorical=True)  # 9 bytes per orbit
+    n = len(lt)
+    min_count = study.params.min_count
+    t, P, P_err = _curve(lt, study.params.dt)
+    tf, Pf, sf = _fit_points(t, P, P_err, s.tau0, study.params.fit_dt, n, min_count)
+    P_min = min_count / n * 0.999
+    homog = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=s.kappa, E0=E0, mu=s.mu, gamma=g, tau0=s.tau0,
+                              E_c=s.E_c, hazards=s.hazards, fit_tau2=study.params.fit_tau2, P_min=P_min)
+    # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
+    # so the two RMS log residuals compare the constants alone
+    homog_pc = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=s.kappa_pc, E0=E0, mu=s.pc["mu"], gamma=g,
+                                 tau0=s.tau0, E_c=s.E_c, hazards=s.hazards, fit_tau2=study.params.fit_tau2,
+                                 P_min=P_min)
+    comp_rows, mixes = _mixture_pair(study, s, raw, label, E0, g, (t, P, tf, Pf, sf), P_min)
+    extra = {"E0": E0, "gamma": g, "N": n, "tau2_eq": tau2_predicted(E0, s.E_c, s.mu, g),
+             "tau2_observed": tau2_observed(lt)}
+    cur = pd.DataFrame({"t": t, "P": P, "P_err": P_err})
+    fit_rows, cmp_rows, pc_rows = _pair_rows(s, t, cur, label, homog, homog_pc, mixes, extra)
+    return cur.assign(pair=label, E0=E0, gamma=g, N=n), (fit_rows, comp_rows, cmp_rows, pc_rows)
+
+
+def _mixture_pair(study, s: _Setup, raw, label, E0, g, points, P_min):
+    """The mixture fits of one pair: sub-ensembles from the snapshots per variant of [study] mixtures."""
+    import pyarrow.dataset as pads
+
+    from hhscatter.data.read import read_snapshots
+
+    t, P, tf, Pf, sf = points
+    # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
+    # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
+    cap = study.params.mixture_max_orbits
+    keep = pads.field("t") >= s.tau0
+    if cap is not None:
+        keep = keep & (pads.field("traj_id") < cap)
+    snaps = read_snapshots(raw, filters=keep)
+    w_hi = study.params.mixture_fit_window[1]
+    comp_rows, mixes = [], {}
+    for var in s.mixtures:
+        t_ref = s.tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
+        comps = mixture.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=study.params.n_components,
+                                           by=var["by"], fit_window=(s.tau0, w_hi))
+        comp_rows.append(comps.to_frame().assign(pair=label, E0=E0, gamma=g, model=var["name"]))
+        mixes[var["name"]] = _mixture_fits(t, P, tf, Pf, sf, comps, kappa=s.kappa, tau0=s.tau0, E_c=s.E_c,
+                                           hazards=s.hazards, mode=var["fne_mode"], P_min=P_min)
+    return comp_rows, mixes
+
+
+def _pair_rows(s: _Setup, t, cur, label, homog, homog_pc, mixes, extra):
+    """Assemble one pair's rows: fit parameters, model curves (columns of ``cur``), fit comparison, pc rows."""
+    E0, g = extra["E0"], extra["gamma"]
+    fit_rows, cmp_rows, pc_rows = [], [], []
+    for h in s.hazards:
+        models = {"homogeneous": homog[h], **{name: m[h] for name, m in mixes.items()}}
+        for name, f in models.items():
+            fit_rows.append(_fit_row(label, name, h, f, extra))
+            cur[f"{name}_{h}"] = f.predict(t)
+        cmp = sm.compare_fits(models).reset_index()
+        cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
+    for h in s.hazards:
+        cur[f"{PC}_{h}"] = homog_pc[h].predict(t)
+        pc_rows.append(_pc_row(homog[h], homog_pc[h], pair=label, E0=E0, gamma=g, hazard=h,
+                               tau2_ours=tau2_predicted(E0, s.E_c, s.mu, g),
+                               tau2_pc=tau2_predicted(E0, s.E_c, s.pc["mu"], g)))
+    return fit_rows, cmp_rows, pc_rows
+
+
+def _tau_predictions(study, s: _Setup):
+    """τ1, τ2 vs γ at fig4's E0: the model fitted to fig4's P(t), with our constants and with the paper's."""
+    dt = study.params.dt
+    ref = _fig4_reference(study, s.inputs, dt)
+    tau_kw = {"tau0": s.tau0, "E_c": s.E_c, "hazards": s.hazards, "dt": dt, "fit_dt": study.params.fit_dt,
+              "min_count": study.params.min_count, "alpha": study.params.alpha}
+    taus, tau_fits = _tau_rows(ref, kappa=s.kappa, mu=s.mu, mu_err=s.mu_err, **tau_kw)
+    taus_pc, tau_fits_pc = _tau_rows(ref, kappa=s.kappa_pc, mu=s.pc["mu"], mu_err=math.nan, **tau_kw)
+    pct = _pc_taus(taus, taus_pc, tau_fits, tau_fits_pc, s.hazards)
+    tau_curves = _tau2_curve(taus, ref.E0, s.E_c, s.mu, s.mu_err, s.pc["mu"])
+    return taus, tau_curves, pct
+
+
+def _compare_with_paper(study, s: _Setup, fits, cmps, taus, pcf, pct) -> None:
+    """Compare with the paper: μ used, goodness of the homogeneous fits, the mixtures, τ1 and τ2, its constants."""
+    kappa = s.kappa
+    ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": s.mu}
+    study.compare("μ used (from fig3)", s.mu, s.mu_err, s.pc["mu"], note=s.inputs["mu"]["source"])
     for r in fits.itertuples():
         if r.model == "homogeneous":
             study.compare(f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual", r.rms_log_residual, None,
                           None, verdict=None, convention=f"{_constants_label(ours_const, r.hazard, ours=True)}; "
                                                          f"{study.convention_label}",
                           note=f"χ²/dof = {r.chi2_red:.3g} ({r.n_points} points); paper: 'satisfying agreement'")
-    for h in hazards:
+    _compare_mixtures(study, s, cmps)
+    _compare_taus(study, taus, s.hazards)
+    _compare_paper_constants(study, s.pc, s.tau0, pcf, pct, s.hazards)
+
+
+def _compare_mixtures(study, s: _Setup, cmps) -> None:
+    """Compare with the paper's expectation that a mixture model improves the agreement (per hazard, variant)."""
+    for h in s.hazards:
         c = cmps[cmps["hazard"] == h].pivot(index="pair", columns="model", values="rms_log_residual")
         a = cmps[cmps["hazard"] == h].pivot(index="pair", columns="model", values="aic")
-        for var in mixtures:
+        for var in s.mixtures:
             name, mode = var["name"], var["fne_mode"]
             better = int((c[name] < c["homogeneous"]).sum())
             better_aic = int((a[name] < a["homogeneous"]).sum())
@@ -389,6 +450,10 @@ def analyze(study):
                                 if mode == "shared" else "K trapped fractions f_ne,k: K − 1 more parameters")
                                 + "; rms " + ", ".join(f"{p}: {c.loc[p, 'homogeneous']:.3f} → {c.loc[p, name]:.3f}"
                                                        for p in c.index)))
+
+
+def _compare_taus(study, taus, hazards) -> None:
+    """Compare τ2 observed with Eq. (eq:tau2) and τ1 observed with the fitted model, per γ of fig4."""
     for r in taus.itertuples():
         if r.tau2_observed is not None and np.isfinite(r.tau2_observed):
             rel = (r.tau2_observed - r.tau2_predicted) / r.tau2_predicted
@@ -401,20 +466,23 @@ def analyze(study):
                 study.compare(f"τ1(γ={r.gamma:g}) observed vs model ({h})", r.tau1_observed, None, None,
                               verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
                               note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)")
-    _compare_paper_constants(study, pc, tau0, pcf, pct, hazards)
 
-    study.write_numbers({
-        "inputs": inputs,
-        "dev_fallback": up.any_fallback(inputs),
-        "kappa0": {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "E_c": E_c},
-        "mu": {"value": mu, "err": mu_err},
-        "tau0": tau0,
+
+def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
+    """fig6.json: the inputs, κ0(E), μ, τ0, every fit and comparison, τ vs γ, the paper's constants."""
+    kappa = s.kappa
+    return {
+        "inputs": s.inputs,
+        "dev_fallback": up.any_fallback(s.inputs),
+        "kappa0": {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "E_c": s.E_c},
+        "mu": {"value": s.mu, "err": s.mu_err},
+        "tau0": s.tau0,
         "fits": fits.to_dict(orient="records"),
         "compare_fits": cmps.to_dict(orient="records"),
         "mixture_components": comps.to_dict(orient="records"),
         "tau_vs_gamma": taus.to_dict(orient="records"),
-        PC: _pc_numbers(pc, E_c, tau0, pcf, pct, hazards),
-    })
+        PC: _pc_numbers(s.pc, s.E_c, s.tau0, pcf, pct, s.hazards),
+    }
 
 
 # ---------------------------------------------------------------------------
