@@ -358,9 +358,12 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
 def _uncertainty_fits(unc, min_count):
     """The power law f(ε) ∝ ε^α and its cut-off, fitted over the resolved ε (≥ ``min_count`` changed pairs).
 
-    Returns (resolved mask, UncertaintyFit or None below 3 resolved ε, cut-off fit or None below 5).
+    Returns (resolved mask, UncertaintyExponent or None below 3 resolved ε, UncertaintyCutoff or None below 5).
     """
-    from hhscatter.analysis.geometry.basins import uncertainty_cutoff, uncertainty_exponent
+    from hhscatter.analysis.geometry.basins import (
+        uncertainty_cutoff,
+        uncertainty_exponent,
+    )
 
     ok = unc["k"] >= min_count
     fit = cut = None

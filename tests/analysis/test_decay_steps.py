@@ -18,6 +18,7 @@ def test_window_keeps_only_usable_points_inside_the_inclusive_window():
     tw, y, ww, win = decay._decay_window(t, m, E0, GAMMA, (1, 8), w)
     np.testing.assert_array_equal(tw, [1.0, 7.0, 8.0])  # 0 and 9 outside; 2–4 bad ⟨E⟩; 5–6 bad weights
     np.testing.assert_array_equal(y, -tw)  # log⟨E⟩ exactly
+    np.testing.assert_array_equal(ww, [1.0, 1.0, 1.0])
     assert win == (1.0, 8.0) and isinstance(win[0], float)
     # weights None: unit weights
     _, _, w1, _ = decay._decay_window(t, np.ones(10), E0, GAMMA, (0, 9), None)
