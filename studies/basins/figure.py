@@ -45,6 +45,26 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     nrow = len(energies) + 2 + int(extra)
     fig = plt.figure(figsize=(3.0 * ncol, 3.0 * nrow), constrained_layout=True)
     gs = fig.add_gridspec(nrow, ncol)
+    _map_rows(fig, gs, maps, energies, gammas, n, ext, cmap, norm)
+    _zoom_row(fig, gs, len(energies), zooms, zg, zf, numbers["zoom_centre"], cmap, norm)
+    per = numbers["per_point"]
+    last = nrow - 1 - int(extra)
+    _panel_uncertainty(fig.add_subplot(gs[last, 0]), uncertainty, per)
+    _panel_entropy(fig.add_subplot(gs[last, 1]), per, energies, gammas)
+    _panel_dimension(fig.add_subplot(gs[last, 2]), per, energies)
+    if extra:
+        _issue25_row(fig, gs, nrow - 1, ncol, energies, gammas, local, scan, numbers)
+    fig.legend(handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)] +
+               [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
+               loc="outside lower center", ncol=6, fontsize=9)
+    fig.suptitle(f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ "
+                 f"({n}×{n} cells, $r_{{esc}}=1.5$){' — ' + scale if scale else ''}", fontsize=11)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _map_rows(fig, gs, maps, energies, gammas, n, ext, cmap, norm):
+    """Rows 1–2: the basin map of each (E0, γ), one row per E0."""
     for i, E in enumerate(energies):
         for j, g in enumerate(gammas):
             ax = fig.add_subplot(gs[i, j])
@@ -55,9 +75,13 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
             ax.set_xlabel("$x$")
             if j == 0:
                 ax.set_ylabel("$y$")
-    cx, cy = numbers["zoom_centre"]
+
+
+def _zoom_row(fig, gs, row, zooms, zg, zf, centre, cmap, norm):
+    """Row 3: the zooms of one boundary region, per γ and magnification."""
+    cx, cy = centre
     for j, (g, f) in enumerate((g, f) for g in zg for f in zf):
-        ax = fig.add_subplot(gs[len(energies), j])
+        ax = fig.add_subplot(gs[row, j])
         z = zooms[(zooms.gamma == g) & (zooms.factor == f)]
         m = int(round(np.sqrt(len(z))))
         e = [float(z[c].iloc[0]) for c in ("x0", "x1", "y0", "y1")]
@@ -66,10 +90,10 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
         ax.set_xlabel("$x$")
         ax.ticklabel_format(useOffset=False)
         ax.tick_params(labelsize=7)
-    per = numbers["per_point"]
-    last = nrow - 1 - int(extra)
-    # (a) f(ε)
-    ax = fig.add_subplot(gs[last, 0])
+
+
+def _panel_uncertainty(ax, uncertainty, per):
+    """Panel (a): f(ε) on log–log axes with the fitted power laws over their ε ranges."""
     for k, ((E, g), u) in enumerate(uncertainty.groupby(["energy", "gamma"])):
         ok = u.k > 0
         err = np.vstack([u.f[ok] - u.f_lo[ok], u.f_hi[ok] - u.f[ok]])
@@ -85,8 +109,10 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     ax.set_xlabel("perturbation $\\varepsilon$")
     ax.set_ylabel("uncertain fraction $f(\\varepsilon)$")
     ax.legend(fontsize=6, ncol=1)
-    # (b) S_b, S_bb against γ at the headline box
-    ax = fig.add_subplot(gs[last, 1])
+
+
+def _panel_entropy(ax, per, energies, gammas):
+    """Panel (b): S_b and S_bb against γ at the headline box, with ln 2."""
     hb = per[0]["box_headline"]
     gx = np.array([max(g, 1e-4) for g in gammas])
     for E in energies:
@@ -100,8 +126,10 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
     ax.set_ylabel(f"basin entropy (box {hb}×{hb} cells)")
     ax.legend(fontsize=6)
-    # (c) d = 2 − α against γ
-    ax = fig.add_subplot(gs[last, 2])
+
+
+def _panel_dimension(ax, per, energies):
+    """Panel (c): the uncertainty dimension d = 2 − α against γ."""
     for E in energies:
         rows = [q for q in per if q["energy"] == E and q["d"]]
         ax.errorbar([max(q["gamma"], 1e-4) for q in rows], [q["d"]["value"] for q in rows],
@@ -111,15 +139,6 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
     ax.set_ylabel("uncertainty dimension $d = 2 - \\alpha$")
     ax.legend(fontsize=7)
-    if extra:
-        _issue25_row(fig, gs, nrow - 1, ncol, energies, gammas, local, scan, numbers)
-    fig.legend(handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)] +
-               [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
-               loc="outside lower center", ncol=6, fontsize=9)
-    fig.suptitle(f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ "
-                 f"({n}×{n} cells, $r_{{esc}}=1.5$){' — ' + scale if scale else ''}", fontsize=11)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
@@ -129,22 +148,36 @@ def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
     cm = plt.get_cmap("viridis")
     col = 0
     for E in energies[:2]:
-        ax = fig.add_subplot(gs[row, col])
+        _panel_local_dimension(fig.add_subplot(gs[row, col]), E, gammas, local, cm)
         col += 1
-        for i, g in enumerate(gammas):
-            t = local[(local.energy == E) & (local.gamma == g) & np.isfinite(local.d) & (local.d_err < 0.3)]
-            ax.errorbar(t.eps_mid, t.d, yerr=t.d_err, fmt="o-", ms=3, lw=0.8, capsize=2,
-                        color=cm(i / max(len(gammas) - 1, 1)), label=f"$\\gamma={g:g}$")
-        ax.axhline(1.0, color="k", lw=0.8, ls=":")
-        ax.set_xscale("log")
-        ax.set_ylim(0.8, 2.05)
-        ax.set_xlabel("resolution $\\varepsilon$")
-        ax.set_ylabel("local dimension $d(\\varepsilon) = 2 - \\alpha(\\varepsilon)$ (σ < 0.3)")
-        ax.set_title(f"$E_0={E:g}$", fontsize=10)
-        ax.legend(fontsize=6, ncol=2)
-    # measured against predicted ε_c
-    ax = fig.add_subplot(gs[row, col])
+    _panel_cutoff(fig.add_subplot(gs[row, col]), energies, numbers)
     col += 1
+    _panel_wada(fig.add_subplot(gs[row, col]), energies, numbers["per_point"])
+    col += 1
+    E_b = numbers["E_b"]["value"]
+    _panel_scan_entropy(fig.add_subplot(gs[row, col]), scan, E_b)
+    col += 1
+    if col < ncol:
+        _panel_scan_dimension(fig.add_subplot(gs[row, col]), scan, E_b)
+
+
+def _panel_local_dimension(ax, E, gammas, local, cm):
+    """The local dimension d(ε) = 2 − α(ε) against ε at one E0, one line per γ (points with σ < 0.3)."""
+    for i, g in enumerate(gammas):
+        t = local[(local.energy == E) & (local.gamma == g) & np.isfinite(local.d) & (local.d_err < 0.3)]
+        ax.errorbar(t.eps_mid, t.d, yerr=t.d_err, fmt="o-", ms=3, lw=0.8, capsize=2,
+                    color=cm(i / max(len(gammas) - 1, 1)), label=f"$\\gamma={g:g}$")
+    ax.axhline(1.0, color="k", lw=0.8, ls=":")
+    ax.set_xscale("log")
+    ax.set_ylim(0.8, 2.05)
+    ax.set_xlabel("resolution $\\varepsilon$")
+    ax.set_ylabel("local dimension $d(\\varepsilon) = 2 - \\alpha(\\varepsilon)$ (σ < 0.3)")
+    ax.set_title(f"$E_0={E:g}$", fontsize=10)
+    ax.legend(fontsize=6, ncol=2)
+
+
+def _panel_cutoff(ax, energies, numbers):
+    """The measured cut-off ε_c (or its upper bound) against the predicted band, against γ."""
     for k, E in enumerate(energies):
         recs = [r for r in numbers.get("cutoff_prediction", []) if r["E0"] == E]
         if not recs:
@@ -169,10 +202,10 @@ def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
     ax.set_xlabel("$\\gamma$")
     ax.set_ylabel("cut-off $\\varepsilon_c$ (o measured, ▽ upper bound)")
     ax.legend(fontsize=6)
-    # Wada fraction: exits with settled masked, against all basins
-    ax = fig.add_subplot(gs[row, col])
-    col += 1
-    per = numbers["per_point"]
+
+
+def _panel_wada(ax, energies, per):
+    """Wada fraction W(r) against γ: exit basins with settled masked, against all basins."""
     for k, E in enumerate(energies):
         rows = [q for q in per if q["energy"] == E]
         gx = [max(q["gamma"], 1e-4) for q in rows]
@@ -185,10 +218,10 @@ def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
     ax.set_ylabel("Wada fraction $W(r)$")
     ax.legend(fontsize=5)
-    # energy scan at γ = 0
-    E_b = numbers["E_b"]["value"]
-    ax = fig.add_subplot(gs[row, col])
-    col += 1
+
+
+def _panel_scan_entropy(ax, scan, E_b):
+    """The γ = 0 energy scan: S_b and S_bb against E0, with ln 2 and fig2's break energy E_b."""
     ax.errorbar(scan.energy, scan.S_b, yerr=scan.S_b_err, fmt="o-", ms=3, label="$S_b$")
     ax.errorbar(scan.energy, scan.S_bb, yerr=scan.S_bb_err, fmt="s-", ms=3, label="$S_{bb}$")
     ax.axhline(np.log(2), color="k", lw=0.8, ls=":", label="ln 2")
@@ -196,18 +229,20 @@ def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
     ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
     ax.set_ylabel("basin entropy")
     ax.legend(fontsize=6)
-    if col < ncol:
-        ax = fig.add_subplot(gs[row, col])
-        ax.errorbar(scan.energy, 2 - scan.alpha, yerr=scan.alpha_err, fmt="o-", ms=3, color="C2",
-                    label="$d = 2 - \\alpha$")
-        ax.set_ylabel("uncertainty dimension $d$", color="C2")
-        ax.axvline(E_b, color="0.4", lw=0.8, ls="--")
-        ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
-        ax2 = ax.twinx()
-        ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3",
-                     label="$\\lambda$, decision rate")
-        if "lam_kg" in scan:
-            ax2.errorbar(scan.energy, scan.lam_kg, yerr=scan.lam_kg_err, fmt="^:", ms=3, color="C1",
-                         label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)")
-        ax2.legend(fontsize=6, loc="lower right")
-        ax2.set_ylabel("decision rate $\\lambda$ (1/time)", color="C3")
+
+
+def _panel_scan_dimension(ax, scan, E_b):
+    """The γ = 0 energy scan: d = 2 − α and the decision rate λ (and κ/α when present) against E0."""
+    ax.errorbar(scan.energy, 2 - scan.alpha, yerr=scan.alpha_err, fmt="o-", ms=3, color="C2",
+                label="$d = 2 - \\alpha$")
+    ax.set_ylabel("uncertainty dimension $d$", color="C2")
+    ax.axvline(E_b, color="0.4", lw=0.8, ls="--")
+    ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
+    ax2 = ax.twinx()
+    ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3",
+                 label="$\\lambda$, decision rate")
+    if "lam_kg" in scan:
+        ax2.errorbar(scan.energy, scan.lam_kg, yerr=scan.lam_kg_err, fmt="^:", ms=3, color="C1",
+                     label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)")
+    ax2.legend(fontsize=6, loc="lower right")
+    ax2.set_ylabel("decision rate $\\lambda$ (1/time)", color="C3")

@@ -272,17 +272,6 @@ def _uncertainty(study, E, g, eps, keys=None, times=None):
 
 def analyze(study):
     """analyze(study) -> None: derived tables (maps, entropies, f(ε)) and basins.json."""
-    from hhscatter.analysis.geometry.basins import (
-        basin_entropy_table,
-        basin_fractions,
-        local_exponent,
-        slim_fractal,
-        uncertainty_cutoff,
-        uncertainty_exponent,
-        wada_merging,
-    )
-    from hhscatter.analysis.geometry.channels import channel_fractions
-
     extent = tuple(study.params.extent)
     n = study.params.grid
     eps = _eps(study)
@@ -294,71 +283,12 @@ def analyze(study):
     mu, mu_err = _upstream_value(study, "mu", "mu_key")
     for E in study.params.energies:
         for g in study.params.gammas:
-            img = basin_image(study, map_key(E, g), E, extent, n)
+            img, ent, unc, loc, m = _measure_point(study, E, g, eps, extent, n, boxes)
             maps.append(pd.DataFrame({"energy": E, "gamma": g, "label": img.ravel()}))
-            fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
-            ent = basin_entropy_table(img, boxes, outside=OUTSIDE).assign(energy=E, gamma=g)
             ent_rows.append(ent)
-            present = [c for c, share in zip(CODES, fr.frac) if share >= study.params.wada_min_share]
-            wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=study.params.wada_r)
-            # the potential is three-fold symmetric, the square [−1, 1]² is not: test the exits' shares on
-            # a rotation-invariant part of the map, the allowed cells with r < symmetry_radius
-            gx, gy = _map_states(study, E, extent, n)[:2]
-            r = np.hypot(*np.meshgrid(gx, gy))
-            chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < study.params.symmetry_radius)])
-            times = []
-            unc = _uncertainty(study, E, g, eps, times=times)
             unc_tabs.append(unc)
-            # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
-            # settled (and trapped) cells masked as outside
-            exits = [c for c in present if c in (0, 1, 2)]
-            wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
-                      if len(exits) >= 3 else None)
-            loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
             loc_tabs.append(loc)
-            slim = slim_fractal(loc)
-            rate = _rate(eps, times) if g == 0 else None
-            ok = unc["k"] >= study.params.fit_min_count
-            fit = cut = None
-            if ok.sum() >= 3:
-                rng = (float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max()))
-                fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"], eps_range=rng)
-                if ok.sum() >= 5:
-                    cut = uncertainty_cutoff(unc["eps"], unc["f"], unc["n"], eps_range=rng)
-            head = ent.set_index("box").loc[hb] if hb in set(ent["box"]) else None
-            tau2 = math.log(E / ec) / g if g > 0 else math.inf
-            smallest = unc.loc[ok].tail(1)
-            per.append({
-                "energy": E, "gamma": g,
-                "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in
-                              zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
-                "n_cells": int(fr.n),
-                "channel_symmetry_p": float(chans.p_value),
-                "channel_shares_r_sym": [float(v) for v in chans.frac],
-                "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
-                "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
-                "log2_fractal": bool(head.log2_fractal) if head is not None else None,
-                "box_headline": hb,
-                "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in present],
-                         "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
-                         "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
-                "wada_exits": _wada_dict(wada_x, exits),
-                "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
-                            for r in loc.itertuples() if np.isfinite(r.d)],
-                "slim_fractal": slim,
-                "lyapunov_decision": rate,
-                "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
-                "d": _ve(fit.d, fit.d_err) if fit else None,
-                "alpha_fit_range": list(fit.eps_range) if fit else None,
-                "alpha_fit_p": float(fit.p_value) if fit else None,
-                "cutoff": ({"detected": bool(cut.detected), "eps_c": float(cut.eps_c),
-                            "eps_c_lo": float(cut.eps_c_lo), "eps_c_hi": float(cut.eps_c_hi),
-                            "delta_aic": float(cut.delta_aic)} if cut else None),
-                "tau2_mu1": tau2,
-                "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0])
-                                                 if len(smallest) else None),
-                "smallest_resolved_eps": float(smallest["eps"].iloc[0]) if len(smallest) else None,
-            })
+            per.append(_point_numbers(E, g, hb, ec, ent, unc, loc, m))
     study.write_table(pd.concat(maps, ignore_index=True), "basins_maps.parquet", grid=n, extent=list(extent))
     study.write_table(pd.concat(ent_rows, ignore_index=True), "basins_entropy.parquet")
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
@@ -369,6 +299,123 @@ def analyze(study):
     study.write_table(scan_unc, "basins_energy_scan_uncertainty.parquet")
     cut_pred = _cutoff_prediction(per, scan, mu, mu_err, ec)
     trend = _energy_trend(scan, E_b)
+    zooms, centre = _zoom_maps(study, extent, n)
+    study.write_table(zooms, "basins_zooms.parquet", grid=study.params.zoom_grid)
+    _compare_with_paper(study, per, hb)
+    study.write_numbers({
+        "codes": dict(zip(CODE_NAMES, CODES)),
+        "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
+        "zoom_centre": list(centre), "per_point": per,
+        "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
+                                                           f"{study.params.E_b_key}"},
+        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
+        "cutoff_prediction": cut_pred,
+        "energy_scan": scan.to_dict(orient="records"),
+        "energy_trend": trend,
+        "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
+    })
+
+
+def _measure_point(study, E, g, eps, extent, n, boxes):
+    """Measures of one (E0, γ) map: fractions, entropies, Wada tests, exit symmetry and f(ε) with its fits.
+
+    Returns (labels image, entropy table, f(ε) table, local-exponent table, dict of the other measures).
+    """
+    from hhscatter.analysis.geometry.basins import (
+        basin_entropy_table,
+        basin_fractions,
+        local_exponent,
+        slim_fractal,
+        wada_merging,
+    )
+    from hhscatter.analysis.geometry.channels import channel_fractions
+
+    img = basin_image(study, map_key(E, g), E, extent, n)
+    fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
+    ent = basin_entropy_table(img, boxes, outside=OUTSIDE).assign(energy=E, gamma=g)
+    present = [c for c, share in zip(CODES, fr.frac) if share >= study.params.wada_min_share]
+    wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=study.params.wada_r)
+    # the potential is three-fold symmetric, the square [−1, 1]² is not: test the exits' shares on
+    # a rotation-invariant part of the map, the allowed cells with r < symmetry_radius
+    gx, gy = _map_states(study, E, extent, n)[:2]
+    r = np.hypot(*np.meshgrid(gx, gy))
+    chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < study.params.symmetry_radius)])
+    times = []
+    unc = _uncertainty(study, E, g, eps, times=times)
+    # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
+    # settled (and trapped) cells masked as outside
+    exits = [c for c in present if c in (0, 1, 2)]
+    wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
+              if len(exits) >= 3 else None)
+    loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
+    slim = slim_fractal(loc)
+    rate = _rate(eps, times) if g == 0 else None
+    ok, fit, cut = _uncertainty_fits(unc, study.params.fit_min_count)
+    return img, ent, unc, loc, {"fr": fr, "present": present, "wada": wada, "chans": chans, "exits": exits,
+                                "wada_x": wada_x, "slim": slim, "rate": rate, "ok": ok, "fit": fit, "cut": cut}
+
+
+def _uncertainty_fits(unc, min_count):
+    """The power law f(ε) ∝ ε^α and its cut-off, fitted over the resolved ε (≥ ``min_count`` changed pairs).
+
+    Returns (resolved mask, UncertaintyExponent or None below 3 resolved ε, UncertaintyCutoff or None below 5).
+    """
+    from hhscatter.analysis.geometry.basins import (
+        uncertainty_cutoff,
+        uncertainty_exponent,
+    )
+
+    ok = unc["k"] >= min_count
+    fit = cut = None
+    if ok.sum() >= 3:
+        rng = (float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max()))
+        fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"], eps_range=rng)
+        if ok.sum() >= 5:
+            cut = uncertainty_cutoff(unc["eps"], unc["f"], unc["n"], eps_range=rng)
+    return ok, fit, cut
+
+
+def _point_numbers(E, g, hb, ec, ent, unc, loc, m):
+    """The JSON record of one (E0, γ): the measures of :func:`_measure_point` (``m``) at the headline box."""
+    fr, wada, fit, cut = m["fr"], m["wada"], m["fit"], m["cut"]
+    head = ent.set_index("box").loc[hb] if hb in set(ent["box"]) else None
+    tau2 = math.log(E / ec) / g if g > 0 else math.inf
+    smallest = unc.loc[m["ok"]].tail(1)
+    return {
+        "energy": E, "gamma": g,
+        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in
+                      zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
+        "n_cells": int(fr.n),
+        "channel_symmetry_p": float(m["chans"].p_value),
+        "channel_shares_r_sym": [float(v) for v in m["chans"].frac],
+        "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
+        "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
+        "log2_fractal": bool(head.log2_fractal) if head is not None else None,
+        "box_headline": hb,
+        "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in m["present"]],
+                 "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
+                 "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
+        "wada_exits": _wada_dict(m["wada_x"], m["exits"]),
+        "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
+                    for r in loc.itertuples() if np.isfinite(r.d)],
+        "slim_fractal": m["slim"],
+        "lyapunov_decision": m["rate"],
+        "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
+        "d": _ve(fit.d, fit.d_err) if fit else None,
+        "alpha_fit_range": list(fit.eps_range) if fit else None,
+        "alpha_fit_p": float(fit.p_value) if fit else None,
+        "cutoff": ({"detected": bool(cut.detected), "eps_c": float(cut.eps_c),
+                    "eps_c_lo": float(cut.eps_c_lo), "eps_c_hi": float(cut.eps_c_hi),
+                    "delta_aic": float(cut.delta_aic)} if cut else None),
+        "tau2_mu1": tau2,
+        "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0])
+                                         if len(smallest) else None),
+        "smallest_resolved_eps": float(smallest["eps"].iloc[0]) if len(smallest) else None,
+    }
+
+
+def _zoom_maps(study, extent, n):
+    """The zoom maps around the most mixed cell of the γ = 0 map: (table of labels per (γ, factor), centre)."""
     zooms = []
     Ez = study.params.zoom_energy
     centre = _zoom_centre(study, extent, n)
@@ -378,7 +425,11 @@ def analyze(study):
             img = basin_image(study, zoom_key(Ez, g, f), Ez, ext, study.params.zoom_grid)
             zooms.append(pd.DataFrame({"gamma": g, "factor": f, "x0": ext[0], "x1": ext[1], "y0": ext[2],
                                        "y1": ext[3], "label": img.ravel()}))
-    study.write_table(pd.concat(zooms, ignore_index=True), "basins_zooms.parquet", grid=study.params.zoom_grid)
+    return pd.concat(zooms, ignore_index=True), centre
+
+
+def _compare_with_paper(study, per, hb):
+    """The comparisons of the report: α, S_bb against ln 2 and the paper's expected cut-off ε_c for γ > 0."""
     for p in per:
         tag = f"E0={p['energy']:g}, γ={p['gamma']:g}"
         if p["alpha"]:
@@ -395,18 +446,6 @@ def analyze(study):
                           c["eps_c"] if c["detected"] else None, None,
                           note=(f"detected, 1σ [{c['eps_c_lo']:.2g}, {c['eps_c_hi']:.2g}]" if c["detected"] else
                                 f"none seen: ε_c < {c['eps_c_hi']:.2g}") + " (paper: expected for γ > 0)")
-    study.write_numbers({
-        "codes": dict(zip(CODE_NAMES, CODES)),
-        "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
-        "zoom_centre": list(centre), "per_point": per,
-        "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
-                                                           f"{study.params.E_b_key}"},
-        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
-        "cutoff_prediction": cut_pred,
-        "energy_scan": scan.to_dict(orient="records"),
-        "energy_trend": trend,
-        "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
-    })
 
 
 def _upstream_value(study, role, key_param):

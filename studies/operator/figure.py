@@ -6,13 +6,32 @@ import numpy as np
 
 
 def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
+    """plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path) -> None; writes operator.png.
+
+    Panels: (a) κ(E) by Ulam's method against fig2's; (b) its convergence in box side and samples; (c) the
+    operator's c-measure μ_c against fig1's sprinkler points; (d) the dissipative P(t): simulated, operator
+    and reduced operator; (e) the energies of the first crossing after t*; (f) the orbit-time cost of κ at 1 %.
+    Inputs: operator.json's numbers and the study's derived tables (pandas DataFrames).
+    """
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(2, 3, figsize=(15, 9.2))
     recs = nums["kappa_ulam"]
     E = np.array([r["energy"] for r in recs])
-    # (a) κ(E)
-    a = ax[0, 0]
+    _panel_kappa(ax[0, 0], nums, recs, E)
+    _panel_convergence(ax[0, 1], conv, recs)
+    _panel_cmeasure(ax[0, 2], nums, ulam_pts, fig1_pts)
+    dn = nums["dissipative"]
+    _panel_survival(ax[1, 0], dn, surv)
+    _panel_t_star_energy(ax[1, 1], dn, pts)
+    _panel_cost(ax[1, 2], nums["cost"])
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def _panel_kappa(a, nums, recs, E):
+    """(a) κ(E): Ulam's κ (and its box → 0 extrapolation) against fig2's κ0 and long-run κ."""
     f2 = [(r["energy"], r["fig2_kappa"], r["fig2_err"]) for r in recs if r.get("fig2_kappa") is not None]
     if f2:
         e2, k2, s2 = map(np.array, zip(*f2))
@@ -34,8 +53,10 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
                 a.errorbar([rec["energy"]], [rec["fig2_kappa"]], [rec["fig2_err"]], fmt="s", color="0.6", mfc="none")
     a.set(xlabel="E", ylabel="κ (1/time)", title="(a) escape rate: ρ(M(κ)) = 1 against P(t)")
     a.legend(fontsize=8)
-    # (b) convergence in box side and samples
-    b = ax[0, 1]
+
+
+def _panel_convergence(b, conv, recs):
+    """(b) discretisation bias: κ_Ulam/κ0(fig2) against the box side and the samples per box."""
     cb = conv[conv["vary"] == "box"]
     for i, (e, g) in enumerate(cb.groupby("energy")):
         g = g.sort_values("box")
@@ -51,8 +72,10 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
     b.set(xlabel="box side (M per finest box: triangles, left = fewer)", ylabel="κ_Ulam / κ0(fig2)",
           title="(b) discretisation bias: κ vs box side")
     b.legend(fontsize=7, ncol=2)
-    # (c) μ_c: the operator's sprinkler measure and fig1's points
-    c = ax[0, 2]
+
+
+def _panel_cmeasure(c, nums, ulam_pts, fig1_pts):
+    """(c) μ_c: the operator's sprinkler measure (grey) against fig1's points, with their debiased distance."""
     if ulam_pts is not None and len(ulam_pts):
         e0 = float(ulam_pts["energy"].iloc[0])
         u = ulam_pts[np.isclose(ulam_pts["energy"], e0)]
@@ -69,9 +92,10 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
             t += f"\ndebiased H(ε={d[0]['box']:g}) = {d[0]['hellinger_debiased']:.3f}"
         c.set(xlabel="x", ylabel="y", title=t)
         c.set_aspect("equal")
-    # (d) P(t)
-    dd = ax[1, 0]
-    dn = nums["dissipative"]
+
+
+def _panel_survival(dd, dn, surv):
+    """(d) the dissipative P(t): simulated, operator on (box × E bin) and reduced operator on ρ(E)."""
     dd.semilogy(surv["t"], surv["sim"], "k-", lw=1.6, label=f"simulated (N = {dn['sim_orbits']})")
     dd.semilogy(surv["t"], surv["operator"], "--", color="C3", lw=1.4, label="operator on (box × E bin)")
     dd.semilogy(surv["t"], np.maximum(surv["reduced"], 1e-12), ":", color="C0", lw=1.6, label="reduced operator on ρ(E)")
@@ -82,8 +106,10 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
     dd.set_xlim(0, min(float(surv["t"].max()), 1.5 * float(t_hi)))
     dd.set(xlabel="t", ylabel="P(t)", title=f"(d) dissipative: E0 = {dn['energy']:g}, γ = {dn['gamma']:g}")
     dd.legend(fontsize=8)
-    # (e) energies of the first crossing after t*
-    e = ax[1, 1]
+
+
+def _panel_t_star_energy(e, dn, pts):
+    """(e) energies of the survivors' first crossing after t*: operator (weighted) against the simulation."""
     op, sim = pts[pts["set"] == "operator"], pts[pts["set"] == "sim"]
     bins = np.linspace(min(op["energy"].min(), sim["energy"].min() if len(sim) else 1), dn["energy"], 40)
     e.hist(op["energy"], bins=bins, weights=op["w"] / op["w"].sum(), histtype="step", color="C3", lw=1.5,
@@ -94,9 +120,10 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
     e.set(xlabel="E at the first crossing after t*", ylabel="share",
           title=f"(e) survivors at t* = {dn['t_star']:g}: energy")
     e.legend(fontsize=8)
-    # (f) cost
-    f = ax[1, 2]
-    cost = nums["cost"]
+
+
+def _panel_cost(f, cost):
+    """(f) orbit-time for κ at 1 %: the P(t) route against the Ulam operator."""
     x = np.arange(len(cost))
     f.bar(x - 0.2, [r["pt_orbit_time_1pct"] for r in cost], 0.4, color="0.4", label="P(t) route (fig2's rule)")
     f.bar(x + 0.2, [r.get("op_orbit_time_1pct", np.nan) for r in cost], 0.4, color="C3", label="Ulam operator")
@@ -104,6 +131,3 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
     f.set_xticks(x, [f"E = {r['energy']:g}" for r in cost])
     f.set(ylabel="orbit-time for κ at 1 % (time units)", title="(f) cost of κ at 1 %")
     f.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)

@@ -541,11 +541,39 @@ def _empirical_survival(t_end, leaving, grid):
 
 
 def _dissipative(study, inputs):
-    from hhscatter.analysis.geometry import distance as dist
-    from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.read import read_lifetimes, read_sections
-
+    """The dissipative comparison at (diss_energy, diss_gamma): P(t) of the operator on (box × E bin), of the
+    reduced operator on ρ(E) and of the simulated ensemble; the energies and points of the first crossing after
+    t*. Returns (numbers, P(t) curves, t* points, t* distances)."""
     edges = _diss_bins(study)
+    dt = study.params.dt
+    op = _operator_survival(study, edges)
+    P_red, kappa_bins = _reduced_survival(study, op, edges)
+    sim = _simulated_survival(study, op["grid"])
+    P_sim, P_op, N, grid, pred = sim["P"], op["P"], sim["N"], op["grid"], op["pred"]
+    agreement = _survival_agreement(grid, dt, study.params.t_star, P_sim, P_op, P_red, N)
+    dtab, (d, lo, hi), j = _t_star_distance(study, pred, sim["pts"])
+    numbers = {
+        "energy": study.params.diss_energy, "gamma": study.params.diss_gamma,
+        "t_star": study.params.t_star, "dt": dt, "energy_bins": edges.tolist(),
+        "states": int(op["tr"].n_states), "samples": int(len(op["tab"])), "initial_mass_lost": op["lost"],
+        "returns_capped_share": tf.capped_share(op["tr"], dt, op["max_lag"]), "max_return_time": op["max_lag"] * dt,
+        "operator_orbit_time": float(op["tab"]["t_end"].sum()), "sim_orbits": int(N),
+        "sim_orbit_time": float(sim["lt"]["t_end"].sum()),
+        **agreement,
+        **_t_star_energies(pred, sim["pts"]),
+        "t_star_hellinger_debiased": {"box": float(dtab["box"].iloc[j]), "value": float(d[j]), "lo": float(lo[j]),
+                                      "hi": float(hi[j]), "noise": float(dtab["hellinger_noise"].iloc[j])},
+        "kappa_bins": [{"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(kappa_bins)],
+    }
+    curves = pd.DataFrame({"t": grid, "sim": P_sim, "operator": P_op, "reduced": P_red})
+    pts = pd.concat([pred.assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")],
+                    ignore_index=True)
+    return numbers, curves, pts, dtab
+
+
+def _operator_survival(study, edges):
+    """The operator on (box × E bin) from the one-return samples: P(t) from the disk's initial density, and the
+    weighted image points of the first crossing after t*."""
     n_bins = len(edges) - 1
     dt = study.params.dt
     steps = int(round(study.params.t_horizon / dt))
@@ -565,25 +593,41 @@ def _dissipative(study, inputs):
     wfc = tf.first_crossing_weights(cross, tr, dt, k_star)
     pred = pd.DataFrame({"x": t["x1"].to_numpy(), "y": t["y1"].to_numpy(), "energy": t["e1"].to_numpy(), "w": wfc})
     pred = pred[pred["w"] > 0].reset_index(drop=True)
-    # reduced operator on ρ(E)
-    tr_red, kappa_bins = _reduced(tr, t, ids, n_cells, n_bins, edges)
-    K2, H2, L2 = tf.lag_kernels(tr_red, t["t_end"].to_numpy(), dt, max_lag=max_lag)
+    return {"tab": tab, "tr": tr, "ids": ids, "t": t, "n_cells": n_cells, "lost": lost, "max_lag": max_lag,
+            "steps": steps, "P": P_op, "grid": grid, "pred": pred}
+
+
+def _reduced_survival(study, op, edges):
+    """P(t) of the reduced operator on ρ(E), started in the top energy bin; and the per-bin κ_a."""
+    n_bins = len(edges) - 1
+    dt = study.params.dt
+    tr_red, kappa_bins = _reduced(op["tr"], op["t"], op["ids"], op["n_cells"], n_bins, edges)
+    K2, H2, L2 = tf.lag_kernels(tr_red, op["t"]["t_end"].to_numpy(), dt, max_lag=op["max_lag"])
     n0r = np.zeros(n_bins)
     n0r[-1] = 1.0
-    P_red = tf.survival(tf.propagate(n0r, K2, L2, steps), H2)
-    # the simulated ensemble
+    return tf.survival(tf.propagate(n0r, K2, L2, op["steps"]), H2), kappa_bins
+
+
+def _simulated_survival(study, grid):
+    """The simulated ensemble: its lifetimes, empirical P(t) on ``grid``, size N and first crossings after t*."""
+    from hhscatter.analysis.geometry import distance as dist
+    from hhscatter.analysis.survival.fits import observed_from_outcome
+    from hhscatter.data.read import read_lifetimes, read_sections
+
     raw = study.raw(SIM_KEY)
     lt = read_lifetimes(raw, columns=["traj_id", "outcome", "t_end"])
     leaving = observed_from_outcome(lt["outcome"])
     P_sim = _empirical_survival(lt["t_end"].to_numpy(), leaving, grid)
     sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
     sim_pts = dist.first_crossings(sec, study.params.t_star)
-    N = len(lt)
-    # comparisons
-    ok = P_sim * N >= 30
-    lr = np.log(np.where(ok, P_op, 1.0) / np.where(ok, P_sim, 1.0))
-    lr2 = np.log(np.where(ok, np.maximum(P_red, 1e-300), 1.0) / np.where(ok, P_sim, 1.0))
-    t_ok = grid[ok]
+    return {"lt": lt, "P": P_sim, "pts": sim_pts, "N": len(lt)}
+
+
+def _t_star_distance(study, pred, sim_pts):
+    """Debiased Hellinger distance over box sizes between the operator's t* points (drawn by weight, seeded)
+    and the simulated ones: (table, (d, lo, hi), index of the headline box)."""
+    from hhscatter.analysis.geometry import distance as dist
+
     rng = np.random.default_rng(study.params.seed + 9)
     n_draw = max(len(sim_pts), 4)
     draw = pred.iloc[rng.choice(len(pred), size=n_draw, p=pred["w"] / pred["w"].sum())]
@@ -593,20 +637,21 @@ def _dissipative(study, inputs):
     d, lo, hi = dist.debiased_distance(dtab, "hellinger")
     dtab = dtab.assign(hellinger_debiased=d, lo=lo, hi=hi)
     j = int(np.argmin(np.abs(dtab["box"].to_numpy() - study.params.cm_box_headline)))
+    return dtab, (d, lo, hi), j
+
+
+def _survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
+    """P(t) of operator and reduced operator against the simulation: values at fixed times and the rms/max
+    |ln(P/P_sim)| where P_sim·N ≥ 30 (also the time up to which that holds)."""
+    ok = P_sim * N >= 30
+    lr = np.log(np.where(ok, P_op, 1.0) / np.where(ok, P_sim, 1.0))
+    lr2 = np.log(np.where(ok, np.maximum(P_red, 1e-300), 1.0) / np.where(ok, P_sim, 1.0))
+    t_ok = grid[ok]
     sig = np.sqrt(np.maximum(P_sim * (1 - P_sim), 0.0) / N)
-    at = [5.0, 10.0, study.params.t_star, 25.0, 40.0, 60.0, 80.0, 100.0, 150.0]
+    at = [5.0, 10.0, t_star, 25.0, 40.0, 60.0, 80.0, 100.0, 150.0]
     at = [a for a in at if a <= grid[-1]]
     ix = [int(round(a / dt)) for a in at]
-    wE = pred["w"] / pred["w"].sum()
-    mE_pred = float(np.sum(wE * pred["energy"]))
-    sE_pred = float(np.sqrt(np.sum(wE * (pred["energy"] - mE_pred) ** 2)))
-    numbers = {
-        "energy": study.params.diss_energy, "gamma": study.params.diss_gamma,
-        "t_star": study.params.t_star, "dt": dt, "energy_bins": edges.tolist(),
-        "states": int(tr.n_states), "samples": int(len(tab)), "initial_mass_lost": lost,
-        "returns_capped_share": tf.capped_share(tr, dt, max_lag), "max_return_time": max_lag * dt,
-        "operator_orbit_time": float(tab["t_end"].sum()), "sim_orbits": int(N),
-        "sim_orbit_time": float(lt["t_end"].sum()),
+    return {
         "P_at": [{"t": a, "sim": float(P_sim[i]), "sim_err": float(sig[i]), "operator": float(P_op[i]),
                   "reduced": float(P_red[i])} for a, i in zip(at, ix)],
         "lnP_rms_operator": float(np.sqrt(np.mean(lr[ok] ** 2))) if ok.any() else math.nan,
@@ -614,18 +659,20 @@ def _dissipative(study, inputs):
         "lnP_max_operator": float(np.max(np.abs(lr[ok]))) if ok.any() else math.nan,
         "lnP_max_reduced": float(np.max(np.abs(lr2[ok]))) if ok.any() else math.nan,
         "compared_until": float(t_ok[-1]) if ok.any() else math.nan,
+    }
+
+
+def _t_star_energies(pred, sim_pts):
+    """Mean and spread of the energy at the first crossing after t*: operator (weighted) and simulation."""
+    wE = pred["w"] / pred["w"].sum()
+    mE_pred = float(np.sum(wE * pred["energy"]))
+    sE_pred = float(np.sqrt(np.sum(wE * (pred["energy"] - mE_pred) ** 2)))
+    return {
         "t_star_points_sim": int(len(sim_pts)),
         "t_star_mean_energy": {"operator": mE_pred, "sim": float(sim_pts["energy"].mean()) if len(sim_pts) else math.nan,
                                "sim_err": float(sim_pts["energy"].std() / math.sqrt(max(len(sim_pts), 1)))},
         "t_star_std_energy": {"operator": sE_pred, "sim": float(sim_pts["energy"].std()) if len(sim_pts) > 1 else math.nan},
-        "t_star_hellinger_debiased": {"box": float(dtab["box"].iloc[j]), "value": float(d[j]), "lo": float(lo[j]),
-                                      "hi": float(hi[j]), "noise": float(dtab["hellinger_noise"].iloc[j])},
-        "kappa_bins": [{"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(kappa_bins)],
     }
-    curves = pd.DataFrame({"t": grid, "sim": P_sim, "operator": P_op, "reduced": P_red})
-    pts = pd.concat([pred.assign(set="operator"), sim_pts[["x", "y", "energy"]].assign(w=1.0, set="sim")],
-                    ignore_index=True)
-    return numbers, curves, pts, dtab
 
 
 # ---------------------------------------------------------------------------

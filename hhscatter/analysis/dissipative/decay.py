@@ -303,41 +303,11 @@ def fit_energy_decay(
     -------
     EnergyDecayFit with μ and 1σ errors of both variants.
     """
-    if not gamma > 0:
-        raise ValueError(f"gamma must be > 0, got {gamma!r}")
-    if not E0 > 0:
-        raise ValueError(f"E0 must be > 0, got {E0!r}")
-    t = np.asarray(t, dtype=float).ravel()
-    m = np.asarray(mean_E, dtype=float).ravel()
-    w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
-    if not (t.shape == m.shape == w.shape):
-        raise ValueError("t, mean_E and weights must have the same length")
-    t_lo, t_hi = float(window[0]), float(window[1])
-    sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
-    t, y, w = t[sel], np.log(m[sel]), w[sel]
+    t, y, w, (t_lo, t_hi) = _decay_window(t, mean_E, E0, gamma, window, weights)
     n = t.size
-    absolute = absolute_sigma and weights is not None
-    nan = float("nan")
-
-    errors = "absolute" if absolute else "scaled"
-    # fixed intercept: y - log E0 = -beta t
-    if n >= 1 and np.sum(w * t * t) > 0:
-        fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
-        mu, mu_err = fit.coef[0] / gamma, fit.err[0] / gamma
-        rms = float(np.sqrt(np.mean(fit.resid**2)))
-    else:
-        mu = mu_err = rms = nan
-
-    # free intercept: y = a - beta t
-    if n >= 2 and np.ptp(t) > 0:
-        fit = weighted_least_squares(np.column_stack([np.ones(n), -t]), y, w, errors=errors)
-        a, beta_f = fit.coef
-        mu_free, mu_free_err = beta_f / gamma, fit.err[1] / gamma
-        a_err = fit.err[0]
-        rms_f = float(np.sqrt(np.mean(fit.resid**2)))
-    else:
-        mu_free = mu_free_err = a = a_err = rms_f = nan
-
+    errors = "absolute" if absolute_sigma and weights is not None else "scaled"
+    mu, mu_err, rms = _fit_fixed_intercept(t, y, w, E0, gamma, errors)
+    mu_free, mu_free_err, a, a_err, rms_f = _fit_free_intercept(t, y, w, gamma, errors)
     return EnergyDecayFit(
         mu=float(mu),
         mu_err=float(mu_err),
@@ -350,6 +320,46 @@ def fit_energy_decay(
         rms_log_residual=float(rms),
         rms_log_residual_free=float(rms_f),
     )
+
+
+def _decay_window(t, mean_E, E0, gamma, window, weights):
+    """The fit's points: checked inputs, the window's usable (t, log⟨E⟩, weight) and the window (t_lo, t_hi).
+
+    Drops points outside the inclusive window, with non-finite or non-positive ⟨E⟩, or with non-finite or
+    non-positive weight; ``weights`` None gives unit weights.
+    """
+    if not gamma > 0:
+        raise ValueError(f"gamma must be > 0, got {gamma!r}")
+    if not E0 > 0:
+        raise ValueError(f"E0 must be > 0, got {E0!r}")
+    t = np.asarray(t, dtype=float).ravel()
+    m = np.asarray(mean_E, dtype=float).ravel()
+    w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
+    if not (t.shape == m.shape == w.shape):
+        raise ValueError("t, mean_E and weights must have the same length")
+    t_lo, t_hi = float(window[0]), float(window[1])
+    sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
+    return t[sel], np.log(m[sel]), w[sel], (t_lo, t_hi)
+
+
+def _fit_fixed_intercept(t, y, w, E0, gamma, errors):
+    """The paper's fit, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a usable point."""
+    nan = float("nan")
+    if t.size >= 1 and np.sum(w * t * t) > 0:
+        fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
+        return fit.coef[0] / gamma, fit.err[0] / gamma, float(np.sqrt(np.mean(fit.resid**2)))
+    return nan, nan, nan
+
+
+def _fit_free_intercept(t, y, w, gamma, errors):
+    """The local exponent, y = a − μ γ t: (μ, σ_μ, a, σ_a, rms log residual); NaN with < 2 distinct times."""
+    nan = float("nan")
+    n = t.size
+    if n >= 2 and np.ptp(t) > 0:
+        fit = weighted_least_squares(np.column_stack([np.ones(n), -t]), y, w, errors=errors)
+        a, beta_f = fit.coef
+        return beta_f / gamma, fit.err[1] / gamma, a, fit.err[0], float(np.sqrt(np.mean(fit.resid**2)))
+    return nan, nan, nan, nan, nan
 
 
 def fit_energy_decay_table(

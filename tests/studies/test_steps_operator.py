@@ -1,0 +1,61 @@
+"""Direct tests of steps of the operator study's dissipative comparison on synthetic input with known answers."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.studies import stage_module
+
+mod = stage_module("operator")
+
+
+def test_survival_agreement_on_constructed_curves():
+    """Operator P = P_sim·e^0.1 (|ln ratio| 0.1 everywhere), reduced P = P_sim·e^(−0.2 t/T); compared while
+    P_sim·N ≥ 30."""
+    dt, N = 0.5, 1000
+    grid = np.arange(0, 201) * dt  # up to t = 100
+    P_sim = np.exp(-0.05 * grid)  # P_sim·N ≥ 30 up to t = ln(1000/30)/0.05 = 70.1
+    P_op = P_sim * math.exp(0.1)
+    P_red = P_sim * np.exp(-0.2 * grid / 100)
+    out = mod._survival_agreement(grid, dt, 20.0, P_sim, P_op, P_red, N)
+    t_until = 70.0  # the last grid time with P_sim·N ≥ 30
+    assert out["compared_until"] == t_until
+    assert out["lnP_rms_operator"] == pytest.approx(0.1, rel=1e-12)
+    assert out["lnP_max_operator"] == pytest.approx(0.1, rel=1e-12)
+    assert out["lnP_max_reduced"] == pytest.approx(0.2 * t_until / 100, rel=1e-12)
+    ok = grid <= t_until
+    assert out["lnP_rms_reduced"] == pytest.approx(np.sqrt(np.mean((0.2 * grid[ok] / 100) ** 2)), rel=1e-12)
+    # the fixed times within the grid, t* among them, with the binomial error of P_sim
+    assert [r["t"] for r in out["P_at"]] == [5.0, 10.0, 20.0, 25.0, 40.0, 60.0, 80.0, 100.0]
+    r = out["P_at"][2]
+    assert r["sim"] == pytest.approx(math.exp(-1.0), rel=1e-15)
+    assert r["sim_err"] == pytest.approx(math.sqrt(math.exp(-1) * (1 - math.exp(-1)) / N), rel=1e-12)
+    assert r["operator"] == pytest.approx(math.exp(-0.9), rel=1e-12)
+
+
+def test_survival_agreement_without_comparable_times_is_nan():
+    grid = np.arange(0, 11) * 1.0
+    P = np.full(11, 0.01)
+    out = mod._survival_agreement(grid, 1.0, 5.0, P, P, P, 100)  # P·N = 1 < 30 everywhere
+    assert all(math.isnan(out[k]) for k in ("lnP_rms_operator", "lnP_max_reduced", "compared_until"))
+    assert [r["t"] for r in out["P_at"]] == [5.0, 10.0, 5.0]  # t* = 5 listed where given
+
+
+def test_t_star_energies_weighted_and_plain_moments():
+    pred = pd.DataFrame({"energy": [0.1, 0.2, 0.4], "w": [1.0, 2.0, 1.0]})
+    sim = pd.DataFrame({"energy": [0.1, 0.3]})
+    out = mod._t_star_energies(pred, sim)
+    mean = (0.1 + 0.4 + 0.4) / 4  # weights 1/4, 2/4, 1/4
+    assert out["t_star_mean_energy"]["operator"] == pytest.approx(mean, rel=1e-14)
+    var = (0.1 - mean) ** 2 / 4 + 2 * (0.2 - mean) ** 2 / 4 + (0.4 - mean) ** 2 / 4
+    assert out["t_star_std_energy"]["operator"] == pytest.approx(math.sqrt(var), rel=1e-12)
+    sd = math.sqrt(0.02)  # sample std of (0.1, 0.3)
+    assert out["t_star_mean_energy"]["sim"] == pytest.approx(0.2, rel=1e-14)
+    assert out["t_star_mean_energy"]["sim_err"] == pytest.approx(sd / math.sqrt(2), rel=1e-12)
+    assert out["t_star_std_energy"]["sim"] == pytest.approx(sd, rel=1e-12)
+    assert out["t_star_points_sim"] == 2
+    # a single simulated point: no spread
+    assert math.isnan(mod._t_star_energies(pred, sim.iloc[:1])["t_star_std_energy"]["sim"])
