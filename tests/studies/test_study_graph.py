@@ -98,7 +98,7 @@ def test_report_and_docs_nav_list_the_study_folders():
 
     assert [s.key for s in collect("tiny", STUDIES)] == [s.name for s in graph.studies(STUDIES)]
     spec_path = ROOT / "docs" / "_hooks" / "studies.py"
-    from test_docs import _load
+    from tests.docs.test_docs import _load
 
     hook = _load(spec_path, "hh_docs_hook_graph")
     nav = hook.study_pages(ROOT)
