@@ -36,6 +36,8 @@ results do not depend on chunking, lanes or batch size either.
 Everything else is the same in both: the events and outcome rules of
 :mod:`hhscatter.integrate.events`, whose roots end heyoka's step exactly (terminal
 events with callbacks), so event states and times are the integrator's own.
+A process compiles a scene's integrator once and reuses it for its later
+chunks, reset to a new one's state (:func:`_batch_integrator`).
 """
 from __future__ import annotations
 
