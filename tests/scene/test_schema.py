@@ -61,7 +61,7 @@ BAD_STUDY_FILES = [
      "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid"),
     ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
      "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
-     "gamma, ics, lam, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
+     "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
     ("fig6", lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
      "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'"),
     ("resc", lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
