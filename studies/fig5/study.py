@@ -14,7 +14,9 @@ Stages
 ------
 simulate   one dissipative run per γ in ``gammas`` (raw key ``gamma<γ>``), all
            section crossings in [t*(μ_max), t*(μ_min) + pad] recorded, so that
-           t* is fixed at analysis time from fig3's μ.
+           t* is fixed at analysis time from fig3's μ; the authors' two runs
+           (square ICs, their windows: ``5a_authors``, ``5b_authors``) and the
+           same two with momenta in random directions (``*_random``, issue 28).
 analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            samples at E1 and E2 from study fig1's published points
            (derived/cmeasure_points.parquet: first crossing after fig1's
