@@ -1,14 +1,21 @@
-"""Initial conditions on the section ṙ = 0, φ̇ > 0 (paper, App. "Initial Conditions").
+"""Initial conditions of a region: on the section ṙ = 0, φ̇ > 0 (paper, App. "Initial Conditions"), or not.
 
-Positions are uniform in area in a region; velocities are tangential with
-the speed fixed by the energy:
+Positions are uniform in area in a region; the speed is fixed by the energy,
+|p| = √(2(E − V)), and the direction by the scene's ``momentum``:
 
-    ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V)).
+- 'tangential' (default; the authors' ``goodICs``), on the section:
+  ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V));
+- 'random': ẋ0 = cos θ · √(2(E − V)), ẏ0 = sin θ · √(2(E − V)) with θ uniform
+  in [0, 2π) (issue 28's sensitivity row). These ICs are not on the section;
+  the engine records no crossing at t < T_INITIAL, and the first ṙ = 0 root
+  with φ̇ > 0 after that is the orbit's first section point.
 
 Determinism: orbits are generated in fixed blocks of ``BLOCK`` orbits; block
-b draws from ``numpy.random.Generator(PCG64(SeedSequence(seed, spawn_key=(b,))))``.
-Orbit i is therefore fixed by (seed, i) alone, whatever the chunk size or the
-number of workers.
+b draws from ``numpy.random.Generator(PCG64(SeedSequence(seed, spawn_key=(b,))))``:
+first the positions (rejection sampling), then, for 'random', the ``BLOCK``
+angles θ. Orbit i is therefore fixed by (seed, i) alone, whatever the chunk
+size or the number of workers, and its position is the same in both
+conventions.
 """
 from __future__ import annotations
 
@@ -43,6 +50,16 @@ def section_velocities(model, x, y, energy):
     return -y / r * v, x / r * v
 
 
+def random_momenta(model, x, y, energy, theta):
+    """random_momenta(model, x, y, E, θ) -> (px, py): direction θ (radians), |p|² = 2(E − V(x, y)).
+
+    Example: ``random_momenta(HenonHeiles(), np.array([0.1]), np.array([0.0]), 0.3, np.array([0.0]))`` is
+    (√(2(0.3 − V(0.1, 0))), 0).
+    """
+    v = np.sqrt(2.0 * (energy - model.potential(x, y)))
+    return np.cos(theta) * v, np.sin(theta) * v
+
+
 def sample_block(scene: Scene, block: int) -> np.ndarray:
     """sample_block(scene, block) -> array (BLOCK, 4) of states (x, y, px, py).
 
@@ -50,7 +67,8 @@ def sample_block(scene: Scene, block: int) -> np.ndarray:
     are rejected and redrawn from the same block generator. Region 'square' is
     the authors' ``goodICs`` (uniform in [−r_s, r_s]² where V < E): it keeps
     points beyond the saddles, even beyond r_esc (the engine records those as
-    escaped at t = 0).
+    escaped at t = 0). With ``scene.momentum == 'random'`` the block's angles are
+    drawn after its positions (so the positions are those of 'tangential').
     """
     model = scene.model
     rng = _block_rng(scene.seed, block)
@@ -65,7 +83,10 @@ def sample_block(scene: Scene, block: int) -> np.ndarray:
         have += int(ok.sum())
     x = np.concatenate(xs)[:BLOCK]
     y = np.concatenate(ys)[:BLOCK]
-    px, py = section_velocities(model, x, y, scene.energy)
+    if scene.momentum == "random":
+        px, py = random_momenta(model, x, y, scene.energy, 2.0 * np.pi * rng.random(BLOCK))
+    else:
+        px, py = section_velocities(model, x, y, scene.energy)
     return np.column_stack([x, y, px, py])
 
 

@@ -50,6 +50,9 @@ SNAPSHOT_LIST_MAX = 1000
 
 #: the initial-condition regions of a scene (hhscatter.scene.ics)
 REGIONS = ("disk", "well", "square")
+#: the momentum conventions of region ICs (hhscatter.scene.ics): 'tangential' on the section ṙ = 0, φ̇ > 0 (the
+#: authors' goodICs; the default, and the only one before issue 28), 'random' uniform in direction on the circle
+MOMENTA = ("tangential", "random")
 
 
 class SnapshotGrid(tuple):
@@ -199,7 +202,7 @@ class Scene:
     region : {'disk', 'well', 'square'}
         'disk': uniform in area in r < radius; 'well': uniform in the saddle triangle where V < E;
         'square': the authors' ``goodICs``, uniform in [−r_s, r_s]² where V < E, no radius cut (orbits
-        that start at r ≥ r_esc are escaped at t = 0). Velocities are tangential on the section.
+        that start at r ≥ r_esc are escaped at t = 0). Momenta follow ``momentum``.
     radius : float
         Disk radius R (default 0.5, as in the authors' code).
     r_esc : float
@@ -229,6 +232,11 @@ class Scene:
     continue_settled : bool
         Dissipative scenes with snapshots: settled orbits go on past E_c to the last snapshot time, and
         their energies there are snapshot rows after t_end (for ⟨E⟩(t), paper Fig. 3).
+    momentum : {'tangential', 'random'}
+        Direction of the initial momentum of region ICs, |p| = √(2(E0 − V)) in both: 'tangential' (default)
+        on the section ṙ = 0, φ̇ > 0 (the authors' ``goodICs``); 'random' uniform on the circle, drawn per
+        orbit from the seed (not on the section: its first recorded crossing is its first ṙ = 0 root with
+        φ̇ > 0 at t > 0). The same for every region; not with ``ics`` (the table fixes the momenta).
     name : str
         A label for progress lines and the tables' metadata.
 
@@ -268,6 +276,7 @@ class Scene:
     snapshots: tuple | None = None
     follow: Follow | None = None
     continue_settled: bool = False
+    momentum: str = "tangential"
     name: str = "scene"
     _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
 
@@ -345,6 +354,8 @@ class Scene:
                              "float64 overflow beyond)")
         if self.region not in REGIONS:
             raise ConfigError(f"region must be one of {REGIONS}, got {self.region!r}")
+        if not isinstance(self.momentum, str) or self.momentum not in MOMENTA:
+            raise ConfigError(f"momentum must be one of {MOMENTA}, got {self.momentum!r}")
         radius = _finite("radius", self.radius)
         if radius <= 0:
             raise ConfigError(f"radius must be > 0, got {radius}")
@@ -391,6 +402,9 @@ class Scene:
                 )
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
+        elif self.momentum != "tangential":
+            raise ConfigError(f"momentum = {self.momentum!r} is an option of region ICs and must not be given with "
+                             "ics: each orbit's momentum comes from its table row")
 
     def _check_recording(self, gamma, t_max, r_esc):
         """sections, snapshots (normalised to a sorted tuple), follow and continue_settled."""
@@ -443,6 +457,8 @@ class Scene:
             d["follow"] = {"radii": list(self.follow.radii)}
         if not self.continue_settled:
             del d["continue_settled"]
+        if self.momentum == "tangential":  # issue 28: the only convention before; hashes of older scenes kept
+            del d["momentum"]
         return d
 
     def to_json(self) -> str:

@@ -41,7 +41,7 @@ from pydantic import (
 )
 
 from hhscatter.errors import ConfigError
-from hhscatter.scene.scene import REGIONS, Follow, Scene, SectionWindow, scene_from_dict
+from hhscatter.scene.scene import MOMENTA, REGIONS, Follow, Scene, SectionWindow, scene_from_dict
 
 __all__ = [
     "load_scene",
@@ -194,7 +194,8 @@ FollowTable = table_of(Follow, "FollowTable", "``[follow]``: escaped orbits foll
                        "scenes), crossings of these radii recorded (Follow's fields).", required=("radii",))
 SceneTable = table_of(Scene, "SceneTable", "``[scene]`` of a scene file: the Scene fields (energy and gamma may be "
                       "lists: a grid).", exclude=("sections", "snapshots", "follow"),
-                      leaves={"energy": NumberOrNumbers, "gamma": NumberOrNumbers, "region": OneOf(*REGIONS)})
+                      leaves={"energy": NumberOrNumbers, "gamma": NumberOrNumbers, "region": OneOf(*REGIONS),
+                              "momentum": OneOf(*MOMENTA)})
 
 
 class SnapshotsTable(_Table):
@@ -217,7 +218,7 @@ class SnapshotsTable(_Table):
 
 StudySceneTable = table_of(Scene, "StudySceneTable", "``[scene]`` of a study.toml: one scene's fields (no grid: "
                            "a study makes its runs itself).", exclude=("sections", "snapshots", "follow"),
-                           leaves={"region": OneOf(*REGIONS)})
+                           leaves={"region": OneOf(*REGIONS), "momentum": OneOf(*MOMENTA)})
 
 
 class AboutTable(_Table):

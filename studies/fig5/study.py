@@ -14,7 +14,9 @@ Stages
 ------
 simulate   one dissipative run per γ in ``gammas`` (raw key ``gamma<γ>``), all
            section crossings in [t*(μ_max), t*(μ_min) + pad] recorded, so that
-           t* is fixed at analysis time from fig3's μ.
+           t* is fixed at analysis time from fig3's μ; the authors' two runs
+           (square ICs, their windows: ``5a_authors``, ``5b_authors``) and the
+           same two with momenta in random directions (``*_random``, issue 28).
 analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            samples at E1 and E2 from study fig1's published points
            (derived/cmeasure_points.parquet: first crossing after fig1's
@@ -65,7 +67,8 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.dissipative.decay import time_to_energy
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams, Text
+from hhscatter.scene.scene import MOMENTA
+from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
 from hhscatter.studies import _upstream as up
 
 
@@ -99,6 +102,8 @@ class Params(StudyParams):
     verdict_boot: Integer = 100
     verdict_level: Number = 0.95
     r_cut: Number = 1.0
+    # the authors' two runs again with this momentum convention (Scene.momentum): the verdict's sensitivity row
+    sensitivity_momentum: OneOf(*MOMENTA[1:])
 
 
 PAPER_T_STAR = 17.0
@@ -127,6 +132,20 @@ AUTHORS_CONVENTION = ("region 'square' (goodICs), γ = gamma_main, r < 1; 5a: fi
                       "5b: first crossing with E in {band} at any time")
 
 
+#: the sensitivity runs of the verdict (issue 28): the authors' runs again, momenta as ``sensitivity_momentum``
+SENSITIVITY = {"5a_authors_random": "5a_authors", "5b_authors_random": "5b_authors"}
+SENSITIVITY_CONVENTION = AUTHORS_CONVENTION + "; momenta in random directions (momentum = '{m}'), not goodICs' tangential ones"
+
+
+def _conventions(study) -> dict:
+    """{construction: its convention string} of the verdict rows (None: ours)."""
+    p = study.params
+    authors = AUTHORS_CONVENTION.format(w=p.authors_window, band=list(p.band))
+    return {"old": authors, "cut": authors, "cut_offsets": authors, "ours": None,
+            "cut_offsets_random": SENSITIVITY_CONVENTION.format(w=p.authors_window, band=list(p.band),
+                                                                m=p.sensitivity_momentum)}
+
+
 def _qualify_our_5b(rows) -> None:
     """Our Fig. 5b (our 5a filtered to the energy band) "differs" only where the authors' own 5b does too.
 
@@ -148,8 +167,12 @@ def _qualify_our_5b(rows) -> None:
 def _authors_scene(study, key):
     """The authors' Fig. 5 runs (their code: goodICs, i.e. region 'square', at E2, γ = gamma_main): 5a is the
     first crossing with t in ``authors_window``; 5b the first crossing whose energy is in ``band``, at any
-    time. The r < 1 cut is applied in the analysis. Each orbit stops once it has its crossing."""
+    time. The r < 1 cut is applied in the analysis. Each orbit stops once it has its crossing. A key of
+    :data:`SENSITIVITY` is the same run with momenta as ``sensitivity_momentum`` (the same positions)."""
     g = study.params.gamma_main
+    if key in SENSITIVITY:
+        return _authors_scene(study, SENSITIVITY[key]).replace(momentum=study.params.sensitivity_momentum,
+                                                               name=f"{study.name}/{key}")
     if key == "5a_authors":
         t0, t1 = study.params.authors_window
         sec = {"t_from": t0, "t_to": t1, "first_only": True, "stop": True}
@@ -160,22 +183,23 @@ def _authors_scene(study, key):
 
 
 def simulate(study, workers=None, progress=True):
-    """simulate(study, workers=None) -> None; one raw run per γ (sections in the t* window), and the two runs
-    of the authors' Fig. 5 convention (square ICs, their windows)."""
+    """simulate(study, workers=None) -> None; one raw run per γ (sections in the t* window), the two runs
+    of the authors' Fig. 5 convention (square ICs, their windows), and the same two with the other momentum
+    convention (:data:`SENSITIVITY`)."""
     for g in study.params.gammas:
         study.run(gamma_key(g), _scene_for(study, g), workers=workers, progress=progress)
-    for key in AUTHORS:
+    for key in (*AUTHORS, *SENSITIVITY):
         study.run(key, _authors_scene(study, key), workers=workers, progress=progress)
 
 
-def _authors_sets(study):
-    """{('authors', key): points}: the first crossing of each orbit of the authors' runs, kept where r < r_cut
-    (their plots), capped at n_cap points."""
+def _authors_sets(study, keys=tuple(AUTHORS)):
+    """{('authors', key): points}: the first crossing of each orbit of the authors' runs ``keys``, kept where
+    r < r_cut (their plots), capped at n_cap points."""
     from hhscatter.data.read import read_sections
 
     n_cap, seed = study.params.n_cap, study.params.seed
     out = {}
-    for key in AUTHORS:
+    for key in keys:
         sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "energy"])
         out[("authors", key)] = _cap(_r_cut(sec, study.params.r_cut), n_cap, seed)
     return out
@@ -190,6 +214,7 @@ VERDICT_ROWS = (
     ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction before issue 28)", 1),
     ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
     ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
+    ("cut_offsets_random", "r < 1 on every set, averaged over grid offsets, momenta in random directions", None),
     ("ours", "our construction (disk ICs; 5a: first crossing after t*, 5b: those in the band; no cut on any set), "
              "averaged over grid offsets", None),
 )
@@ -207,10 +232,12 @@ def _verdict_5b(study, cm_full, E1, ours):
     n_cap, seed, r_cut = study.params.n_cap, study.params.seed, study.params.r_cut
     ref_all = _cap(cm_full, n_cap, seed)
     ref_cut = _cap(_r_cut(cm_full, r_cut), n_cap, seed)
-    auth = _authors_sets(study)
+    auth = _authors_sets(study, (*AUTHORS, *SENSITIVITY))
     a_auth, b_auth = auth[("authors", "5a_authors")], auth[("authors", "5b_authors")]
+    a_rand, b_rand = auth[("authors", "5a_authors_random")], auth[("authors", "5b_authors_random")]
     sets = {"old": (a_auth, b_auth, ref_all), "cut": (a_auth, b_auth, ref_cut),
-            "cut_offsets": (a_auth, b_auth, ref_cut), "ours": (ours[0], ours[1], ref_all)}
+            "cut_offsets": (a_auth, b_auth, ref_cut), "cut_offsets_random": (a_rand, b_rand, ref_cut),
+            "ours": (ours[0], ours[1], ref_all)}
     rows = []
     for key, label, offs in VERDICT_ROWS:
         A, B, R = sets[key]
@@ -236,8 +263,9 @@ def _verdict_5b(study, cm_full, E1, ours):
                                    "√(2(E − V)) (LnBn/DissipativeScattering@0868eff, "
                                    "src/dissipative_scattering_functions.jl lines 421–422, in goodICs, line 410), "
                                    "as region 'square' does here",
-            "not_computed": "the other momentum convention (random directions) as a sensitivity row: it needs an IC "
-                            "option of the engine; not yet built",
+            "sensitivity_momentum": f"row 'cut_offsets_random': the authors' two runs again with momentum = "
+                                    f"{study.params.sensitivity_momentum!r} (directions uniform on the circle, "
+                                    "|p| = √(2(E − V)), the same positions), cut and compared like 'cut_offsets'",
             "rows": rows}
 
 
@@ -248,6 +276,7 @@ def _compare_verdict(study, verdict):
         return "agrees" if hi < 0 else ("differs" if lo > 0 else "no significant difference")
 
     like = {r["construction"]: r for r in verdict["rows"] if "delta" in r}.get("cut_offsets")
+    conventions = _conventions(study)
     for r in verdict["rows"]:
         if "delta" not in r:
             continue
@@ -258,8 +287,7 @@ def _compare_verdict(study, verdict):
         study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
                       f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
                       "agreement)", verdict=v, authors=r["construction"] != "ours",
-                      convention=(AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band))
-                                  if r["construction"] != "ours" else None),
+                      convention=conventions[r["construction"]],
                       note=f"d(5a) {r['d_5a']:.3f}, d(5b) {r['d_5b']:.3f} (debiased Hellinger, ε = {r['box']:g}, "
                            f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
                            f"{int(verdict['level'] * 100)} % interval from {verdict['n_boot']} paired half-samples "

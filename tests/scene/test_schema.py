@@ -61,7 +61,7 @@ BAD_STUDY_FILES = [
      "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid"),
     ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
      "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
-     "gamma, ics, lam, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
+     "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
     ("fig6", lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
      "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'"),
     ("resc", lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
@@ -70,6 +70,10 @@ BAD_STUDY_FILES = [
      "[about] unknown key 'summry' (did you mean 'summary'?); allowed keys: paper, setup, summary, title"),
     ("fig4", lambda t: t.replace("\nmu_gamma = 0.01", "\n", 1),
      "[study] needs 'mu_gamma'"),
+    ("fig5", lambda t: t.replace('sensitivity_momentum = "random"', 'sensitivity_momentum = "radial"', 1),
+     "[study] sensitivity_momentum must be one of 'random', got 'radial'"),
+    ("fig5", lambda t: t.replace("seed = 505", 'seed = 505\nmomentum = "radial"', 1),
+     "[scene] momentum must be one of 'tangential', 'random', got 'radial'"),
 ]
 
 
@@ -215,7 +219,8 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
     then = sorted({k.split("/")[0] for k in before})
     after = _scene_hashes(ROOT, tmp_path, only=then)
     # every old scene is still made; the only new ones are the runs added since, by name
-    added = {f"fig5/{scale}/{key}" for scale in ("quick", "tiny", "paper") for key in ("5a_authors", "5b_authors")}
+    added = {f"fig5/{scale}/{key}" for scale in ("quick", "tiny", "paper")
+             for key in ("5a_authors", "5b_authors", "5a_authors_random", "5b_authors_random")}
     assert set(before) <= set(after) and set(after) - set(before) == added
     after = {k: after[k] for k in before}
     # changed on purpose for the paper scale (issue 15): fig1's pilot keeps its quick-scale size (it fixes t_rec).

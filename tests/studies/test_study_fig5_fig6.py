@@ -234,6 +234,31 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
     assert again == auth
 
 
+def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_studies):
+    """Issue 28's sensitivity row: 5a/5b_authors_random are the authors' scenes but for momentum = 'random', and
+    the verdict has its row, made like 'cut_offsets' from those runs, with its own convention."""
+    from hhscatter.data.read import read_sections
+    from hhscatter.studies import load_study
+
+    study = load_study("fig5", "tiny", root=tiny_studies)
+    nums = json.loads(study.numbers_path.read_text())
+    for key in ("5a_authors", "5b_authors"):
+        base = json.loads((study.raw(key) / "scene.json").read_text())["scene"]
+        rand = json.loads((study.raw(f"{key}_random") / "scene.json").read_text())["scene"]
+        assert "momentum" not in base and rand.pop("momentum") == "random"
+        assert {k: v for k, v in rand.items() if k != "name"} == {k: v for k, v in base.items() if k != "name"}
+        sec = read_sections(study.raw(f"{key}_random"))
+        assert len(sec) and sec["traj_id"].is_unique and (sec["t"] > 0).all()
+    rows = {r["construction"]: r for r in nums["verdict_5b"]["rows"]}
+    assert set(rows) == {"old", "cut", "cut_offsets", "cut_offsets_random", "ours"}
+    r = rows["cut_offsets_random"]
+    a = read_sections(study.raw("5a_authors_random"))
+    assert r.get("n_5a", len(a)) == min(int((np.hypot(a["x"], a["y"]) < 1).sum()), study.params.n_cap)
+    assert r.get("n_ref") == rows["cut_offsets"].get("n_ref") and r.get("offsets") == rows["cut_offsets"].get("offsets")
+    comp = [c for c in nums["paper_comparison"] if "momenta in random directions" in c["quantity"]]
+    assert len(comp) == ("delta" in r) and all("momentum = 'random'" in c["convention"] for c in comp)
+
+
 # ---------------------------------------------------------------------------
 # fig6: the survival model with the paper's own constants beside ours
 # ---------------------------------------------------------------------------
