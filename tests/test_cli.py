@@ -178,3 +178,16 @@ def test_scene_takes_an_integral_float_count_like_the_cli():
     for bad in (2.5, float("nan"), float("inf")):
         with pytest.raises(SceneError, match="n \\(number of orbits\\) must be an integer > 0"):
             Scene(energy=0.3, n=bad)
+
+
+def test_the_command_starts_without_loading_the_study_framework():
+    """Every command's parser lists the studies (graph.py, stdlib only) without importing hhscatter.studies, the
+    runner, the tables or pydantic (≈ 0.25 s of start-up for every `hhscatter` call; issue 27)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, hhscatter.cli as c; c.build_parser(); "
+            "print(sorted(m for m in ('hhscatter.studies', 'hhscatter.run.runner', 'hhscatter.data.read', 'pydantic', "
+            "'pyarrow', 'heyoka') if m in sys.modules)); print('fig1' in c._studies_epilog())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert out[0] == "[]" and out[1] == "True", out
