@@ -5,21 +5,15 @@ is an :class:`HHScatterError`; the CLI prints its message, without a traceback, 
 :attr:`HHScatterError.exit_code` (2 for bad input, before any work and before anything is written; 1 for a run
 that could not complete). Anything else is a bug and keeps its traceback.
 
-======================== ============ ===============================================================
-error                    exit status  raised when
-======================== ============ ===============================================================
-:class:`ConfigError`     2            a scene, grid, study or conventions file or parameter is invalid
-                                      (alias :data:`SceneError`; also a :class:`ValueError`)
-:class:`SetupError`      2            an optional package a request needs is not installed
-:class:`OutputError`     2            the output location cannot take the run (not empty, another
-                                      scene, locked by another writer, not writable)
-:class:`RunIntegrityError` 2          a run directory's tables differ from its manifest (missing,
-                                      damaged, extra or foreign parts)
-:class:`IncompleteRunError` 2         a run directory's chunks are not all finished
-:class:`StudyError`      2            a study cannot run a stage (unknown study or stage, missing or
-                                      stale inputs, an unreadable study graph)
-:class:`RunError`        1            a run could not complete (finished chunks are kept)
-======================== ============ ===============================================================
+| error | exit status | raised when |
+|---|---|---|
+| :class:`ConfigError` (alias :data:`SceneError`; also a ValueError) | 2 | a scene, grid, study or conventions file or parameter is invalid |
+| :class:`SetupError` | 2 | an optional package a request needs is not installed |
+| :class:`OutputError` | 2 | the output location cannot take the run (not empty, another scene, locked by another writer, not writable) |
+| :class:`RunIntegrityError` | 2 | a run directory's tables differ from its manifest (missing, damaged, extra or foreign parts) |
+| :class:`IncompleteRunError` | 2 | a run directory's chunks are not all finished |
+| :class:`StudyError` | 2 | a study cannot run a stage (unknown study or stage, missing or stale inputs, an unreadable study graph) |
+| :class:`RunError` | 1 | a run could not complete (finished chunks are kept) |
 
 Examples
 --------

@@ -14,29 +14,15 @@ event are the integrator's own (no dense-output evaluation, no rounding on a
 lane clock: event times and states do not depend on how orbits share lanes).
 The callback decides, by the outcome rules below, whether the orbit ends.
 
-=========  =====  ==========================================  =====================================
-event      dir.   expression (root)                           role
-=========  =====  ==========================================  =====================================
-escape     +      r² − r_esc²                                 conservative: escaped at the first
-                                                              outward crossing (t_end = its root)
-closure    −      H − E_c                                     dissipative: settled if r ≤ r_s there,
-                                                              else escaped at the last outward
-                                                              r_esc crossing
-far        +      r²/r_far² − 1                               dissipative, and conservative follow:
-                                                              the orbit is gone (never returns)
-resc       any    r² − r_esc²                                 dissipative: remembers the last
-                                                              outward crossing (the escape time)
-radius_k   any    r² − R_k²                                   follow: crossings of the radii R_k
-                                                              and r_esc (table ``crossings``); the
-                                                              outward r_esc one is the escape
-section    any    g·(x p_x + y p_y − 10⁻³⁰⁰) + (1 − g)         ṙ = 0, kept where φ̇ > 0 and the
-                                                              window admits it; g = 0/1 per lane
-                                                              (runtime parameter) switches it off;
-                                                              a late window compiles it only into
-                                                              the orbits' second phase (two_phase)
-clock      −      σ  (dσ/dt = −1/G)                           orbit-time schedule: opens/closes
-                                                              the section window at t_from/t_to
-=========  =====  ==========================================  =====================================
+| event (rule) | dir. | expression (root) | role |
+|---|---|---|---|
+| escape | + | r² − r_esc² | conservative: escaped at the first outward crossing (t_end = its root) |
+| closure | − | H − E_c | dissipative: settled if r ≤ r_s there, else escaped at the last outward r_esc crossing |
+| far | + | r²/r_far² − 1 | dissipative, and conservative follow: the orbit is gone (never returns) |
+| resc | any | r² − r_esc² | dissipative: remembers the last outward crossing (the escape time) |
+| radius_k (radius) | any | r² − R_k² | follow: crossings of the radii R_k and r_esc (table ``crossings``); the outward r_esc one is the escape |
+| section | any | g·(x p_x + y p_y − 10⁻³⁰⁰) + (1 − g) | ṙ = 0, kept where φ̇ > 0 and the window admits it; g = 0/1 per lane (runtime parameter) switches it off; a late window compiles it only into the orbits' second phase (two_phase) |
+| clock | − | σ  (dσ/dt = −1/G) | orbit-time schedule: opens/closes the section window at t_from/t_to |
 
 Normalisation: event values enter heyoka's step-size control, so each is
 O(1) where it matters (r²/r_far² − 1 rather than r² − r_far²; the clock σ

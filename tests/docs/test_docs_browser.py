@@ -193,6 +193,20 @@ def test_api_pages_show_no_literal_bullet_stars(site):
         assert section in api_page, section  # numpy sections parsed by griffe
 
 
+def test_api_pages_show_no_literal_rst_tables(site):
+    """A docstring table renders as a table: reStructuredText "=== ===" borders would show as text (the docstrings
+    are Markdown with numpy sections; write tables with pipes)."""
+    import re
+
+    hidden = re.compile(r"<script\b.*?</script>|<pre\b.*?</pre>|<code\b.*?</code>", re.DOTALL)
+    rule = re.compile(r"={8,}")
+    hits = {p.relative_to(site).as_posix(): rule.findall(hidden.sub("", p.read_text(errors="replace")))[:1]
+            for p in _pages(site) if p.relative_to(site).parts[0] == "api"}
+    hits = {k: v for k, v in hits.items() if v}
+    assert not hits, hits
+    assert "<table" in (site / "api" / "errors.html").read_text()  # the error family's table
+
+
 def test_api_examples_show_their_code_as_written(site):
     """A docstring example's ``4 * err`` shows as written, not ``4 \\* err`` (the star escaping skips doctests)."""
     import html
