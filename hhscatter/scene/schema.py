@@ -255,17 +255,21 @@ def typed_params(model: type[BaseModel], raw: dict) -> BaseModel:
     >>> p.energies, p.n
     ([0.3, 1.0], 10)
     """
-    values = {}
-    for name, f in model.model_fields.items():
-        if name in raw:
-            v = raw[name]
-        elif not f.is_required():
-            v = copy.deepcopy(f.default)
-        else:
-            raise ConfigError(f"[study] needs {name!r} ({model.__name__} declares it without a default)")
-        conv = next((m.to for m in f.metadata if isinstance(m, _Convert)), None)
-        values[name] = conv(v) if conv is not None and v is not None else v
-    return model.model_construct(**values)
+    return model.model_construct(**{name: typed_value(model, name, raw) for name in model.model_fields})
+
+
+def typed_value(model: type[BaseModel], name: str, raw: dict) -> Any:
+    """typed_value(Params, name, raw) -> the one key ``name`` of :func:`typed_params`: ``raw[name]`` or the field's
+    default, converted to its declared Python type (KeyError if ``Params`` does not declare ``name``)."""
+    f = model.model_fields[name]
+    if name in raw:
+        v = raw[name]
+    elif not f.is_required():
+        v = copy.deepcopy(f.default)
+    else:
+        raise ConfigError(f"[study] needs {name!r} ({model.__name__} declares it without a default)")
+    conv = next((m.to for m in f.metadata if isinstance(m, _Convert)), None)
+    return conv(v) if conv is not None and v is not None else v
 
 
 _SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable}

@@ -24,6 +24,7 @@ from hhscatter.scene.scene import Scene, scene_from_dict
 from hhscatter.scene.schema import (
     apply_convention,
     typed_params,
+    typed_value,
     did_you_mean,
     merge_tables,
     validate_conventions_file,
@@ -81,17 +82,17 @@ class ParamsView:
     Without a ``Params`` model (a study folder without code) the keys are the raw ``[study]`` table's.
     """
 
-    __slots__ = ("_study", "_typed", "_raw")
+    __slots__ = ("_study", "_model", "_raw")
 
-    def __init__(self, study, typed, raw: dict):
-        self._study, self._typed, self._raw = study, typed, raw
+    def __init__(self, study, model, raw: dict):
+        self._study, self._model, self._raw = study, model, raw
 
     def __getattr__(self, key: str):
-        study, typed = self._study, self._typed
-        if typed is not None:
-            if key not in type(typed).model_fields:
+        study, model = self._study, self._model
+        if model is not None:  # one key converted per read (typed_value), not the whole table
+            if key not in model.model_fields:
                 raise StudyError(f"study {study.name} reads [study] {key!r}, which its Params does not declare")
-            value = getattr(typed, key)
+            value = typed_value(model, key, self._raw)
         elif key in self._raw:
             value = self._raw[key]
         else:
@@ -101,7 +102,9 @@ class ParamsView:
         return value
 
     def __repr__(self) -> str:
-        return f"ParamsView({self._typed!r})" if self._typed is not None else f"ParamsView({self._raw!r})"
+        if self._model is None:
+            return f"ParamsView({self._raw!r})"
+        return f"ParamsView({typed_params(self._model, self._raw)!r})"
 
 
 @dataclass
@@ -152,8 +155,7 @@ class Study:
         declares) converted to the declared type (Number → float, Integer → int, Numbers → list of floats, …;
         :func:`hhscatter.scene.schema.typed_params`). A key ``Params`` does not declare is a :class:`StudyError`;
         keys read while the simulate stage runs are recorded (``raw/done.json``)."""
-        raw = self.raw_params  # made on each access: a fresh view of the current table (its lists are copies)
-        return ParamsView(self, typed_params(self.params_model, raw) if self.params_model is not None else None, raw)
+        return ParamsView(self, self.params_model, self.raw_params)  # each read converts the current value (lists: copies)
 
     def param(self, key, default=None):
         """param(key) -> value of ``[study].key`` as written in study.toml, else the default its ``Params`` declares.
