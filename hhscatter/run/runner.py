@@ -58,16 +58,15 @@ from multiprocessing.managers import SyncManager
 
 
 from hhscatter.data.store import Store
-from hhscatter.errors import ConfigError, OutputError, RunError, RunIntegrityError  # noqa: F401 (RunError: re-exported)
+from hhscatter.errors import ConfigError, RunError
 from hhscatter.run.dask_backend import check_scheduler, dask_client
-from hhscatter.run.worker import default_workers
+from hhscatter.run.output import prepare_output
+from hhscatter.run.plan import RunSummary, plan_chunks, points_of
+from hhscatter.run.progress import progress_bar
+from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
-from hhscatter.run.output import prepare_output
-from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of  # noqa: F401 (SCENE_FILE, RunSummary: re-exported)
-from hhscatter.run.progress import progress_bar
-from hhscatter.run.worker import chunk_complete, die_with_parent, run_one_chunk
 
 
 
