@@ -16,12 +16,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.model.base import DISSIPATIONS, Exit, System
+
 if TYPE_CHECKING:  # annotations only
     from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
-class HenonHeiles:
+class HenonHeiles(System):
     """The Hénon–Heiles potential V = ω²(x² + y²)/2 + λ(x²y − y³/3), Eq. (eqn:hh_potential), and H, Eq. (eq:H).
 
     The paper fixes ω = λ = 1 (Sec. II.B "Model System"), for which E_c = 1/6 and the three saddles lie
@@ -34,11 +36,13 @@ class HenonHeiles:
     lam : float
         λ > 0, the cubic coupling (for λ < 0 the potential is the mirror image y → −y; use λ > 0 and
         reflect the data instead).
+    dissipation : {'linear', 'quadratic'}
+        The drag law for γ > 0: −γp (the paper's, default) or −γ|p|p.
 
     Raises
     ------
     ValueError
-        ω or λ not positive and finite.
+        ω or λ not positive and finite, or an unknown dissipation law.
 
     Examples
     --------
@@ -52,11 +56,31 @@ class HenonHeiles:
 
     omega: float = 1.0
     lam: float = 1.0
+    dissipation: str = "linear"
 
     def __post_init__(self):
         for name, value in (("omega", self.omega), ("lam", self.lam)):
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        if self.dissipation not in DISSIPATIONS:
+            raise ValueError(f"dissipation must be one of {DISSIPATIONS}, got {self.dissipation!r}")
+
+    # -- identity (the System contract) -------------------------------------
+    @property
+    def name(self) -> str:
+        return "henon_heiles"
+
+    @property
+    def params(self) -> dict[str, float]:
+        return {"omega": float(self.omega), "lam": float(self.lam)}
+
+    @property
+    def potential_text(self) -> str:
+        return "0.5*omega**2*(x**2 + y**2) + lam*(x**2*y - y**3/3)"
+
+    def hash_items(self):
+        """None for linear drag (ω and λ are scene fields of their own); the drag law otherwise."""
+        return None if self.dissipation == "linear" else {"dissipation": self.dissipation}
 
     # -- closed forms -----------------------------------------------------
     @property
@@ -80,6 +104,20 @@ class HenonHeiles:
         a = self.channel_angles
         return self.saddle_radius * np.column_stack([np.cos(a), np.sin(a)])
 
+    @property
+    def exits(self) -> tuple[Exit, ...]:
+        """The three exits (channels 0, 1, 2 at π/2, 7π/6, 11π/6), all opening at E_c."""
+        ec = self.critical_energy
+        return tuple(Exit(float(x), float(y), ec) for x, y in self.saddles)
+
+    def no_return_radius(self, energy: float) -> float:
+        """R(E) = √(6E)/ω (≥ r_s): beyond it −∂V/∂r > 0 wherever V ≤ E (length).
+
+        In polar form V = ω²r²/2 + λr³ sin(3φ)/3; V ≤ E gives λ sin 3φ ≤ 3E/r³ − 3ω²/(2r), which is
+        < −ω²/r (an outward radial force) exactly when r² > 6E/ω². At E = E_c it is the saddle distance.
+        """
+        return max(math.sqrt(6.0 * max(float(energy), 0.0)) / self.omega, self.saddle_radius)
+
     # -- numpy evaluations ------------------------------------------------
     def potential(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """V(x, y), Eq. (eqn:hh_potential)."""
@@ -92,6 +130,23 @@ class HenonHeiles:
         px = np.asarray(px, dtype=float)
         py = np.asarray(py, dtype=float)
         return 0.5 * (px * px + py * py) + self.potential(x, y)
+
+    def potential_expression(self, x, y):
+        """V as a heyoka expression of the variables x, y (the same arithmetic as :meth:`expressions`)."""
+        return 0.5 * self.omega**2 * (x**2 + y**2) + self.lam * (x**2 * y - y**3 / 3.0)
+
+    def inside_well(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
+        """The well's part of {V < E_c}: the open triangle of the saddles (:meth:`inside_triangle`)."""
+        return self.inside_triangle(x, y)
+
+    def scalar_energy(self):
+        """H(x, y, px, py) in plain float arithmetic for the engine's per-record path."""
+        half_w2, lam = 0.5 * self.omega**2, self.lam
+
+        def energy(x, y, px, py):
+            return 0.5 * (px * px + py * py) + half_w2 * (x * x + y * y) + lam * (x * x * y - y * y * y / 3.0)
+
+        return energy
 
     def exit_channel(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """exit_channel(x, y) -> int8 array: index of the channel whose axis is nearest in angle."""
@@ -111,19 +166,14 @@ class HenonHeiles:
             inside &= x * np.cos(a) + y * np.sin(a) < self.saddle_radius / 2
         return inside
 
-    # -- heyoka -----------------------------------------------------------
-    def expressions(self) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
-        """(state_vars, V, H) as heyoka expressions; state order x, y, px, py."""
-        import heyoka as hy  # deferred: heyoka loads on first use
-
-        x, y, px, py = hy.make_vars("x", "y", "px", "py")
+    # -- heyoka (expressions() and equations() come from System) ---------
+    def force_expressions(self, x, y):
+        """(F_x, F_y) = −∇V simplified (−ω²x − 2λxy, −ω²y − λ(x² − y²)): no redundant products per Taylor step."""
         w2, lam = self.omega**2, self.lam
-        V = 0.5 * w2 * (x**2 + y**2) + lam * (x**2 * y - y**3 / 3.0)
-        H = 0.5 * (px**2 + py**2) + V
-        return (x, y, px, py), V, H
+        return -(w2 * x) - (2.0 * lam) * (x * y), -(w2 * y) - lam * (x**2 - y**2)
 
 
-def equations(model: HenonHeiles, gamma_par=None):
+def equations(model: System, gamma_par=None):
     """equations(model, gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
 
     Hamilton's equations of H, paper Eq. (eqn:hh_ham), plus the drag −γp of the
@@ -136,17 +186,10 @@ def equations(model: HenonHeiles, gamma_par=None):
     products such as ``0.5*(2*px)`` that would cost operations on every
     Taylor step; ``tests/test_model.py`` checks both agree.
     """
-    (x, y, px, py), _, _ = model.expressions()
-    w2, lam = model.omega**2, model.lam
-    fx = -(w2 * x) - (2.0 * lam) * (x * y)
-    fy = -(w2 * y) - lam * (x**2 - y**2)
-    if gamma_par is not None:
-        fx = fx - gamma_par * px
-        fy = fy - gamma_par * py
-    return [(x, px), (y, py), (px, fx), (py, fy)]
+    return model.equations(gamma_par)
 
 
-def hamilton_equations(model: HenonHeiles):
+def hamilton_equations(model: System):
     """hamilton_equations(model) -> [(x, ∂H/∂px), ..., (py, −∂H/∂y)] straight from ``hy.diff``.
 
     Hamilton's equations of H, Eq. (eqn:hh_ham), derived symbolically: the

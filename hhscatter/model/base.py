@@ -1,0 +1,235 @@
+"""The contract of a system: an open two-degree-of-freedom potential with a dissipation law.
+
+Everything hhscatter integrates or analyses reads the system through this contract (issue 23: a system is
+data): the scene's validation, the events (escape radius, the closure E = E_c inside Ω, the section ṙ = 0,
+φ̇ > 0 about the well's minimum), the IC regions, the outcome rules and exit channels, the analysis (E_c) and
+the tables' provenance. Nothing outside a system's own definition may know which potential it is.
+
+A system is
+
+    H = (p_x² + p_y²)/2 + V(x, y)                                      Eq. (eq:H)
+    ṗ = −∇V − γ p           (dissipation = "linear", the paper's drag)
+    ṗ = −∇V − γ |p| p       (dissipation = "quadratic")
+
+with unit mass, V's well minimum at the origin with V(0, 0) = 0, and exits: saddles of V through which
+orbits from the well reach infinity. Both drag laws lower the energy (dE/dt = −γ|p|² or −γ|p|³ ≤ 0), so an
+orbit inside Ω at E = E_c stays trapped: the closure event of the paper (Eq. (eqn:energy_diffeq)) holds.
+
+A new system implements :class:`System` (a built-in such as :class:`hhscatter.model.HenonHeiles` with closed
+forms, or a declared one whose quantities are derived from its expression). The contract, member by member:
+
+| member | meaning | units |
+|---|---|---|
+| ``name`` | the built-in's name, or ``"declared"`` | — |
+| ``params`` | the potential's parameters, name → value | — |
+| ``dissipation`` | ``"linear"`` (−γp) or ``"quadratic"`` (−γ∣p∣p) | — |
+| ``potential_text`` | V as text in x, y and the parameters' names | — |
+| ``critical_energy`` | E_c: the lowest saddle energy through which orbits from the well reach infinity | energy |
+| ``exits`` | the exits (:class:`Exit`), in channel order | — |
+| ``saddle_radius`` | distance of the nearest exit saddle from the minimum: the length scale of bounds and IC regions | length |
+| ``omega_radius`` | Ω = {r ≤ omega_radius}: the closure rule's well (contains the well part of V ≤ E_c, meets no other part) | length |
+| ``potential(x, y)`` | V on numpy arrays | energy |
+| ``expressions()`` | ``((x, y, px, py), V, H)`` as heyoka expressions | — |
+| ``equations(gamma_par)`` | the heyoka ODE system, with the drag when ``gamma_par`` is given | — |
+| ``no_return_radius(E)`` | R such that an orbit of energy ≤ E at r ≥ R moving outward (ṙ > 0) never returns | length |
+| ``inside_well(x, y)`` | in the well's part of {V < E_c} (the ``well`` IC region) | — |
+| ``exit_channel(x, y)`` | index of the exit nearest in angle | — |
+| ``scalar_energy()`` | a plain-float H(x, y, px, py) for the engine's per-record path | energy |
+| ``provenance()`` | what the tables' metadata records of the system | — |
+| ``hash_items()`` | what enters a scene's hash (None: the paper's default system, left out of the hash) | — |
+"""
+from __future__ import annotations
+
+import abc
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+
+if TYPE_CHECKING:  # annotations only
+    from numpy.typing import ArrayLike
+
+#: the dissipation laws: the drag force for γ > 0
+DISSIPATIONS = ("linear", "quadratic")
+
+
+@dataclass(frozen=True)
+class Exit:
+    """One exit of a system: a saddle of V through which orbits from the well reach infinity.
+
+    Parameters
+    ----------
+    x, y : float
+        The saddle's position (length).
+    energy : float
+        V at the saddle: the exit is open for E > energy (energy).
+
+    Examples
+    --------
+    >>> e = Exit(0.0, 1.0, 1 / 6)
+    >>> round(e.angle, 6), e.distance
+    (1.570796, 1.0)
+    """
+
+    x: float
+    y: float
+    energy: float
+
+    @property
+    def angle(self) -> float:
+        """Polar angle of the saddle (rad), in (−π, π]."""
+        return math.atan2(self.y, self.x)
+
+    @property
+    def distance(self) -> float:
+        """Distance of the saddle from the well's minimum at the origin (length)."""
+        return math.hypot(self.x, self.y)
+
+
+class System(abc.ABC):
+    """A two-degree-of-freedom open system with drag: the contract every system implements (module docstring)."""
+
+    dissipation: str = "linear"
+
+    # -- identity ---------------------------------------------------------
+    @property
+    @abc.abstractmethod
+    def name(self) -> str:
+        """The built-in's name, or ``"declared"``."""
+
+    @property
+    @abc.abstractmethod
+    def params(self) -> dict[str, float]:
+        """The potential's parameters, name → value."""
+
+    @property
+    @abc.abstractmethod
+    def potential_text(self) -> str:
+        """V(x, y) as text in x, y and the parameters' names (Python syntax, ``**`` for powers)."""
+
+    # -- derived quantities ------------------------------------------------
+    @property
+    @abc.abstractmethod
+    def critical_energy(self) -> float:
+        """E_c: the lowest energy at which orbits from the well can reach infinity (energy)."""
+
+    @property
+    @abc.abstractmethod
+    def exits(self) -> tuple[Exit, ...]:
+        """The exits in channel order: channel k of the tables is ``exits[k]``."""
+
+    @property
+    def saddle_radius(self) -> float:
+        """Distance of the nearest exit saddle from the minimum (length): the length scale of bounds and IC regions."""
+        return min(e.distance for e in self.exits)
+
+    @property
+    def omega_radius(self) -> float:
+        """Ω = {r ≤ omega_radius}: contains the well's part of {V ≤ E_c} and meets no other part (length)."""
+        return self.saddle_radius
+
+    @abc.abstractmethod
+    def potential(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
+        """V(x, y) on numpy arrays (energy)."""
+
+    @abc.abstractmethod
+    def potential_expression(self, x, y):
+        """V as a heyoka expression of the heyoka variables ``x``, ``y``."""
+
+    @abc.abstractmethod
+    def no_return_radius(self, energy: float) -> float:
+        """R(E): an orbit of energy ≤ E at r ≥ R with ṙ > 0 never comes back (length).
+
+        Sufficient condition used by every implementation: at every accessible point beyond R (V ≤ E) the
+        potential's radial force is outward, −∂V/∂r > 0; then ṗ_r = −∂V/∂r + L²/r³ − γ(·)p_r keeps p_r > 0
+        under either drag law, and the energy only falls, so the accessible region only shrinks.
+        """
+
+    # -- generic implementations (a built-in may override with closed forms) ----
+    def energy(self, x: ArrayLike, y: ArrayLike, px: ArrayLike, py: ArrayLike) -> np.ndarray:
+        """H(x, y, p_x, p_y), Eq. (eq:H) (energy)."""
+        px = np.asarray(px, dtype=float)
+        py = np.asarray(py, dtype=float)
+        return 0.5 * (px * px + py * py) + self.potential(x, y)
+
+    def exit_channel(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
+        """exit_channel(x, y) -> int8 array: index of the exit whose saddle is nearest in angle."""
+        phi = np.arctan2(np.asarray(y, dtype=float), np.asarray(x, dtype=float))
+        angles = np.array([e.angle for e in self.exits])
+        d = np.abs((phi[..., None] - angles + np.pi) % (2 * np.pi) - np.pi)
+        return np.argmin(d, axis=-1).astype(np.int8)
+
+    def inside_well(self, x: ArrayLike, y: ArrayLike, samples: int = 64) -> np.ndarray:
+        """True where (x, y) is joined to the minimum by a straight segment inside {V < E_c}.
+
+        The well's part of {V < E_c} for wells star-shaped about the minimum (every built-in's); tested at
+        ``samples`` points of the segment.
+        """
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        ec = self.critical_energy
+        ok = np.ones(np.broadcast(x, y).shape, dtype=bool)
+        for s in np.linspace(1.0 / samples, 1.0, samples):
+            ok &= self.potential(s * x, s * y) < ec
+        return ok
+
+    def expressions(self) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
+        """(state_vars, V, H) as heyoka expressions; state order x, y, px, py."""
+        import heyoka as hy  # deferred: heyoka loads on first use
+
+        x, y, px, py = hy.make_vars("x", "y", "px", "py")
+        V = self.potential_expression(x, y)
+        return (x, y, px, py), V, 0.5 * (px**2 + py**2) + V
+
+    def force_expressions(self, x, y):
+        """(F_x, F_y) = −∇V as heyoka expressions (a built-in may give simplified forms)."""
+        import heyoka as hy  # deferred: heyoka loads on first use
+
+        V = self.potential_expression(x, y)
+        return -hy.diff(V, x), -hy.diff(V, y)
+
+    def equations(self, gamma_par=None) -> list:
+        """equations(gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
+
+        Hamilton's equations of H, Eq. (eqn:hh_ham) for Hénon–Heiles, plus the drag of :attr:`dissipation`
+        when ``gamma_par`` (a heyoka expression for γ, e.g. ``hy.par[0]``) is given; None builds the
+        conservative system without drag terms.
+        """
+        import heyoka as hy  # deferred: heyoka loads on first use
+
+        x, y, px, py = hy.make_vars("x", "y", "px", "py")
+        fx, fy = self.force_expressions(x, y)
+        if gamma_par is not None:
+            if self.dissipation == "linear":
+                fx, fy = fx - gamma_par * px, fy - gamma_par * py
+            else:  # quadratic: −γ |p| p
+                speed = hy.sqrt(px**2 + py**2)
+                fx, fy = fx - gamma_par * speed * px, fy - gamma_par * speed * py
+        return [(x, px), (y, py), (px, fx), (py, fy)]
+
+    def scalar_energy(self) -> Callable[[float, float, float, float], float]:
+        """A plain-float H(x, y, px, py) for the engine's per-record path (numpy costs µs per scalar)."""
+        pot = self.potential
+
+        def energy(x, y, px, py):
+            return 0.5 * (px * px + py * py) + float(pot(x, y))
+
+        return energy
+
+    def provenance(self) -> dict[str, Any]:
+        """What the tables' metadata records of the system: name, V as text, parameters, dissipation."""
+        return {"system": self.name, "potential": self.potential_text, "params": dict(self.params),
+                "dissipation": self.dissipation}
+
+    def hash_items(self) -> dict[str, Any] | None:
+        """What enters a scene's hash; None for the paper's system (Hénon–Heiles, linear drag)."""
+        return self.provenance()
+
+    def describe(self) -> str:
+        """One line: name, E_c and the exits."""
+        ex = ", ".join(f"({e.x:.4g}, {e.y:.4g}) at V = {e.energy:.6g}" for e in self.exits)
+        return f"{self.name}: V = {self.potential_text}, E_c = {self.critical_energy:.10g}, exits {ex}"
+
+
+__all__ = ["DISSIPATIONS", "Exit", "System"]
