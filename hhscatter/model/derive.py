@@ -248,7 +248,7 @@ def critical_points(land: Landscape) -> tuple[tuple[CriticalPoint, ...], str]:
         xs, ys, method = *_symbolic_candidates(land), "symbolic"
     else:
         xs, ys, method = *_numeric_candidates(land), "numeric"
-    xs, ys = land.newton(xs, ys, iterations=8 if method == "symbolic" else 20, max_step=1e9)
+    xs, ys = land.newton(xs, ys, iterations=30, max_step=1e9)
     gx, gy = land.gradient(xs, ys)
     a, b, c = land.hessian(xs, ys)
     scale = 1.0 + np.abs(a) + np.abs(b) + np.abs(c)
@@ -285,7 +285,7 @@ def check_well(land: Landscape, points: Sequence[CriticalPoint]) -> None:
         raise ConfigError(f"the origin is a {cp.kind} critical point of the potential (Hessian eigenvalues "
                           f"{cp.eigenvalues[0]:.3g}, {cp.eigenvalues[1]:.3g}), not a non-degenerate minimum: the "
                           "well's minimum must be at the origin")
-    if abs(v0) > 1e-14 * max(1.0, *(abs(p.energy) for p in points)):
+    if abs(v0) > 1e-14 * max([1.0] + [abs(p.energy) for p in points]):
         raise ConfigError(f"the well's minimum must have V = 0, but V(0, 0) = {v0!r}; subtract it from the potential")
 
 
@@ -293,23 +293,26 @@ def check_well(land: Landscape, points: Sequence[CriticalPoint]) -> None:
 def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> float:
     """R(E): the smallest R with −∂V/∂r > 0 at every point r ≥ R where V ≤ E (length).
 
-    The "bad" set {V ≤ E, x V_x + y V_y ≥ 0} is scanned on a polar grid (720 angles × 1000 radii) out to
-    r_max = 50·scale (×4 up to three times while the bad set reaches 90 % of r_max); its farthest grid point is
-    refined by maximising r over the bad set (SLSQP, both constraints), and the larger of the two is returned
-    with a relative margin of :data:`NO_RETURN_MARGIN`. 0 when the bad set is empty.
+    The "bad" set S = {V ≤ E, ρ ≥ 0} with ρ = x V_x + y V_y = r ∂V/∂r is scanned on a polar grid (720 angles ×
+    1000 radii) out to r_max = 50·scale (×4 up to three times while S reaches 90 % of r_max). S's farthest point
+    is where its boundary is farthest out: a corner (V = E and ρ = 0) or a point of the level curve V = E
+    tangent to the circle (V = E and ∂V/∂θ = 0). Grid cells across which both functions of either pair change
+    sign are polished by Newton's method; R is the farthest polished point in S, or, if a grid point of S lies
+    beyond every one (a case neither pair describes), that grid point plus one radial step. A relative margin of
+    :data:`NO_RETURN_MARGIN` is added. 0 when S is empty.
 
-    Raises ConfigError when the bad set reaches beyond 3200·scale: no no-return radius (the potential does not
-    push outward far out, e.g. it is bounded there).
+    Raises ConfigError when S reaches beyond 3200·scale: no no-return radius (the potential does not push
+    outward far out, e.g. it is bounded there).
     """
-    from scipy.optimize import minimize  # deferred: scipy.optimize loads on first use
-
     r_max = 50.0 * scale
     th = np.linspace(0, 2 * np.pi, 720, endpoint=False)
     for _ in range(4):
         r = np.linspace(0, r_max, 1001)[1:]
         R, T = np.meshgrid(r, th)
         X, Y = R * np.cos(T), R * np.sin(T)
-        bad = (land.v(X, Y) <= energy) & (land.radial(X, Y) >= 0)
+        f = land.v(X, Y) - energy
+        rho = land.radial(X, Y)
+        bad = (f <= 0) & (rho >= 0)
         if not bad.any():
             return 0.0
         rb = float(R[bad].max())
@@ -320,36 +323,55 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
         raise ConfigError(f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
                           f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits")
     dr = r[1] - r[0]
-    i = np.flatnonzero(bad.ravel())[np.argmax(R[bad])]
-    t0 = float(T.ravel()[i])
+    gx, gy = land.gradient(X, Y)
+    tau = X * gy - Y * gx  # ∂V/∂θ
 
-    def pos(z):
-        return z[0] * math.cos(z[1]), z[0] * math.sin(z[1])
+    def changes(F):  # cells (θ_i..θ_i+1, r_j..r_j+1) across which F changes sign (θ wraps round)
+        c = np.stack([F[:, :-1], F[:, 1:], np.roll(F, -1, 0)[:, :-1], np.roll(F, -1, 0)[:, 1:]])
+        return (c.min(axis=0) <= 0) & (c.max(axis=0) >= 0)
 
-    unit = max(abs(energy), 1e-300)
-
-    def jac(z, which):  # d(E − V)/d(r, θ) or d(x V_x + y V_y)/d(r, θ), over `unit`
-        x, y = pos(z)
-        c, s = math.cos(z[1]), math.sin(z[1])
-        gx, gy = (float(g) for g in land.gradient(x, y))
-        if which == 0:
-            fx, fy = -gx, -gy
-        else:
-            a, b, d = (float(h) for h in land.hessian(x, y))
-            fx, fy = gx + x * a + y * b, gy + x * b + y * d
-        return np.array([c * fx + s * fy, -y * fx + x * fy]) / unit
-
-    cons = [{"type": "ineq", "fun": lambda z: (energy - float(land.v(*pos(z)))) / unit, "jac": lambda z: jac(z, 0)},
-            {"type": "ineq", "fun": lambda z: float(land.radial(*pos(z))) / unit, "jac": lambda z: jac(z, 1)}]
-    best = rb
-    res = minimize(lambda z: -z[0], np.array([rb, t0]), jac=lambda z: np.array([-1.0, 0.0]), method="SLSQP",
-                   constraints=cons,
-                   options={"ftol": 1e-15, "maxiter": 200})
-    if res.success and abs(res.x[0] - rb) < 4 * dr and all(c["fun"](res.x) > -1e-12 for c in cons):
-        best = max(best, float(res.x[0]))
-    else:
-        best = rb + dr  # the grid's resolution bound
+    best = 0.0
+    fc = changes(f)
+    for second in (rho, tau):
+        cells = fc & changes(second)
+        cells &= R[:, :-1] >= rb - 3 * dr  # only cells near the far end of S matter
+        if not cells.any():
+            continue
+        x0, y0 = (X[:, :-1][cells] + X[:, 1:][cells]) / 2, (Y[:, :-1][cells] + Y[:, 1:][cells]) / 2
+        x, y = _polish(land, x0, y0, energy, second is rho)
+        f1 = land.v(x, y) - energy
+        r1 = land.radial(x, y)
+        ok = (np.abs(f1) <= 1e-10 * max(1.0, abs(energy))) & (r1 >= -1e-10 * max(1.0, abs(energy)))
+        ok &= np.hypot(x - x0, y - y0) < 4 * dr
+        if ok.any():
+            best = max(best, float(np.hypot(x, y)[ok].max()))
+    if rb > best:
+        best = rb + dr  # S reaches beyond every polished point: the grid's resolution bound
     return best * (1 + NO_RETURN_MARGIN)
+
+
+def _polish(land: Landscape, x, y, energy: float, corner: bool, iterations: int = 40):
+    """Newton's method on (V − E, ρ) (corner) or (V − E, ∂V/∂θ) (tangent point), vectorised over starts."""
+    x = np.array(x, dtype=float, copy=True)
+    y = np.array(y, dtype=float, copy=True)
+    for _ in range(iterations):
+        gx, gy = land.gradient(x, y)
+        a, b, c = land.hessian(x, y)
+        f1 = land.v(x, y) - energy
+        if corner:
+            f2 = x * gx + y * gy
+            j21, j22 = gx + x * a + y * b, gy + x * b + y * c
+        else:
+            f2 = x * gy - y * gx
+            j21, j22 = gy + x * b - y * a, -gx + x * c - y * b
+        with np.errstate(all="ignore"):
+            det = gx * j22 - gy * j21
+            dx = -(j22 * f1 - gy * f2) / det
+            dy = -(gx * f2 - j21 * f1) / det
+        ok = np.isfinite(dx) & np.isfinite(dy)
+        x = np.where(ok, x + np.where(ok, dx, 0.0), x)
+        y = np.where(ok, y + np.where(ok, dy, 0.0), y)
+    return x, y
 
 
 # -- exits -----------------------------------------------------------------------------------------------

@@ -173,7 +173,7 @@ def _check_sympy(expr, names: set[str]):
     """Check a sympy expression node by node against the whitelist; return it in the real symbols x, y, params."""
     import sympy as sp  # deferred: sympy takes ~0.3 s to import
 
-    allowed_functions = tuple(_sympy_functions().values())
+    allowed_functions = tuple(f for f in _sympy_functions().values() if isinstance(f, type))  # sqrt is a Pow
     x, y = symbols()
     for node in sp.preorder_traversal(expr):
         if isinstance(node, sp.Symbol):
