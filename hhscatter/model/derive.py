@@ -375,11 +375,16 @@ def _polish(land: Landscape, x, y, energy: float, corner: bool, iterations: int 
 
 
 # -- exits -----------------------------------------------------------------------------------------------
-def _descend(land: Landscape, x0: float, y0: float, r_out: float) -> tuple[float, float, bool]:
-    """Follow ẋ = −∇V/(1 + |∇V|) from (x0, y0): (end x, end y, True if it passed r_out)."""
+def _descend(land: Landscape, x0: float, y0: float, r_out: float,
+             minima: Sequence[CriticalPoint]) -> tuple[float, float, bool]:
+    """Follow ẋ = −∇V/(1 + |∇V|) from (x0, y0): (end x, end y, True if it passed r_out).
+
+    Stops beyond r_out, within 1e-6 (1 + |m|) of a known minimum m, where |∇V| falls below 1e-10, or at t = 1e5.
+    """
     from scipy.integrate import solve_ivp  # deferred: scipy.integrate loads on first use
 
     grad = land.scalar_gradient
+    mins = [(m.x, m.y, 1e-6 * (1 + m.distance)) for m in minima]
 
     def rhs(_, z):
         gx, gy = grad(z[0], z[1])
@@ -389,14 +394,16 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float) -> tuple[float
     def out(_, z):
         return math.hypot(z[0], z[1]) - r_out
 
-    out.terminal = True
+    def near(_, z):
+        return min(math.hypot(z[0] - mx, z[1] - my) - tol for mx, my, tol in mins)
 
     def still(_, z):
-        return math.hypot(*grad(z[0], z[1])) - 1e-11
+        return math.hypot(*grad(z[0], z[1])) - 1e-10
 
-    still.terminal = True
-    still.direction = -1
-    sol = solve_ivp(rhs, (0.0, 1e6), [x0, y0], events=[out, still], rtol=1e-9, atol=1e-12)
+    for ev in (out, near, still):
+        ev.terminal = True
+    near.direction = still.direction = -1
+    sol = solve_ivp(rhs, (0.0, 1e5), [x0, y0], events=[out, near, still], rtol=1e-8, atol=1e-11)
     xe, ye = sol.y[:, -1]
     return float(xe), float(ye), bool(sol.t_events[0].size)
 
@@ -435,7 +442,7 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
         r_out = max(r_nr[s.energy], 1.5 * s.distance)
         pair = []
         for sign in (1, -1):
-            xe, ye, escaped = _descend(land, s.x + sign * h * d[0], s.y + sign * h * d[1], r_out)
+            xe, ye, escaped = _descend(land, s.x + sign * h * d[0], s.y + sign * h * d[1], r_out, minima)
             if escaped:
                 pair.append(("inf", k, sign))
                 continue

@@ -79,8 +79,8 @@ def test_no_return_radius_is_a_no_return_radius():
         for E in (s.critical_energy, 1.5 * s.critical_energy):
             R = s.no_return_radius(E)
             assert R >= s.saddle_radius
-            r = np.linspace(R, 20 * R, 1500)
-            th = np.linspace(0, 2 * np.pi, 2001)
+            r = np.linspace(R, 20 * R, 700)
+            th = np.linspace(0, 2 * np.pi, 1201)
             rr, tt = np.meshgrid(r, th)
             x, y = rr * np.cos(tt), rr * np.sin(tt)
             land = s._landscape
