@@ -146,6 +146,34 @@ class System(abc.ABC):
         under either drag law, and the energy only falls, so the accessible region only shrinks.
         """
 
+    def escape_radius(self, energies) -> float:
+        """A default escape radius for a scene whose orbits start at these energies (length).
+
+        max(R(E_max), 1.5 × the farthest exit's distance), with R = :meth:`no_return_radius`. Why it is safe:
+        at the farthest point of any bounded orbit of energy ≤ E (a Lyapunov orbit of an exit among them),
+        ṙ = 0 and r̈ = v_⊥²/r − ∂V/∂r ≤ 0, so −∂V/∂r ≤ 0 there at a point with V ≤ E: such points lie within
+        R(E). Beyond R(E_max) every orbit moving outward never returns (drag only lowers E), so crossing
+        the radius is an escape. The 1.5 × saddle distance floor keeps the paper's r_esc = 1.5 for
+        Hénon–Heiles at E ≤ 3/8 (where √(6E) ≤ 1.5).
+
+        Parameters
+        ----------
+        energies : float or iterable of float
+            The scene's initial energies (energy).
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from hhscatter.model import HenonHeiles
+        >>> HenonHeiles().escape_radius([0.2, 0.3]), round(HenonHeiles().escape_radius(1.0), 12)
+        (1.5, 2.449489742783)
+        """
+        e_max = float(np.max(np.asarray(energies, dtype=float)))
+        return max(self.no_return_radius(e_max), 1.5 * max(e.distance for e in self.exits))
+
     # -- generic implementations (a built-in may override with closed forms) ----
     def energy(self, x: ArrayLike, y: ArrayLike, px: ArrayLike, py: ArrayLike) -> np.ndarray:
         """H(x, y, p_x, p_y), Eq. (eq:H) (energy)."""

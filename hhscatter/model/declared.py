@@ -132,7 +132,7 @@ class DeclaredSystem(System):
         return self._text
 
     @property
-    def expression(self):
+    def expression(self) -> Any:
         """V as a sympy expression in x, y and the parameters' symbols."""
         return self._expr
 
@@ -179,11 +179,11 @@ class DeclaredSystem(System):
         """V(x, y) on numpy arrays (energy)."""
         return self._landscape.v(x, y)
 
-    def potential_expression(self, x, y):
+    def potential_expression(self, x: Any, y: Any) -> Any:
         """V as a heyoka expression of x, y (walked from the sympy expression, parameters as constants)."""
         return to_heyoka(self._numeric, x, y)
 
-    def force_expressions(self, x, y):
+    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V from the expanded sympy gradient (no redundant products per Taylor step)."""
         import sympy as sp  # deferred: sympy takes ~0.3 s to import
 

@@ -165,3 +165,20 @@ def test_make_system_builtins_and_defaults():
 def test_make_system_errors_name_the_key(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         make_system(**kwargs)
+
+
+def test_escape_radius_lies_beyond_every_bounded_orbit(conto):
+    assert conto.escape_radius([0.5, 1.5]) == pytest.approx(max(2 * math.sqrt(1.5), 1.5 * 2.0))
+    big = conto.escape_radius(10.0)
+    assert big == pytest.approx(2 * math.sqrt(10.0), rel=1e-8) and big >= 2 * math.sqrt(10.0)
+    # the argument (base.System.escape_radius): a bounded orbit of energy E never goes beyond R(E) (here R
+    # without the saddle-distance floor, which alone would bound these orbits)
+    from hhscatter.model.derive import no_return_radius
+
+    for state in ([0.3, -0.2, 0.9, 0.5], [1.2, 0.0, 0.0, 0.6], [0.0, 0.5, 1.1, 0.1]):
+        E = conto.energy(*state)
+        R = no_return_radius(conto._landscape, E, 2.0)
+        assert E < conto.critical_energy and R < conto.saddle_radius
+        res = _ta(conto, state, tol=1e-12).propagate_grid(np.linspace(0, 300, 30001))[5]
+        r_max = np.hypot(res[:, 0], res[:, 1]).max()
+        assert 0.5 * R < r_max <= R, (E, r_max, R)

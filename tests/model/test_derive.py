@@ -73,6 +73,21 @@ def test_no_return_radius_reproduces_the_hh_closed_form(omega, lam):
         assert got >= want and got == pytest.approx(want, rel=1e-8), (E, got, want)
 
 
+@pytest.mark.parametrize("name, params, closed", [
+    # V = r²/2 + r^k g(θ) homogeneous: V_r = 0 and V = E meet at r² = 2kE/(k − 2) (k = 3: HH's √(6E))
+    ("n_exit", {"n": 4}, lambda E: math.sqrt(8 * E / 2)),
+    ("n_exit", {"n": 5}, lambda E: math.sqrt(10 * E / 3)),
+    ("contopoulos", {"eps": 0.25}, lambda E: 2 * math.sqrt(E)),
+    ("barbanis", {"eps": 0.5}, lambda E: math.sqrt(6 * E)),
+])
+def test_no_return_radius_closed_forms_of_the_builtins(name, params, closed):
+    s = make_system(name, params=params)
+    for f in (1.0, 1.5, 3.0):
+        E = f * s.critical_energy
+        got, want = s.no_return_radius(E), max(closed(E), s.saddle_radius)
+        assert got >= want and got == pytest.approx(want, rel=1e-8), (E, got, want)
+
+
 def test_no_return_radius_is_a_no_return_radius():
     """Beyond R(E), −∂V/∂r > 0 wherever V ≤ E (checked on a fine polar grid independent of the one used)."""
     for s in (make_system("contopoulos"), make_system("barbanis"), make_system("n_exit", params={"n": 5})):
