@@ -6,6 +6,7 @@ Given V(x, y) as a sympy expression in x and y (parameters substituted, :func:`h
 1. **the critical points** ∇V = 0: for a polynomial V symbolically (a lex Gröbner basis of (V_x, V_y): if it
    is not zero-dimensional the critical points form curves and nothing can be derived; otherwise the real
    roots of its two eliminants give every critical point, polished by Newton's method); for any other V
+   (a polynomial with irrational coefficients such as pi included)
    numerically (damped Newton from a polar grid of starts out to :data:`SEARCH_RADIUS`, deduplicated);
 2. **their kind** from the Hessian's eigenvalues: ``minimum``, ``saddle``, ``maximum`` or ``degenerate``
    (an eigenvalue below 1e-8 of the largest; lines of critical points and monkey saddles are degenerate);
@@ -137,7 +138,8 @@ class Landscape:
         self.expr, self.x, self.y = expr, x, y
         self.grad = (sp.diff(expr, x), sp.diff(expr, y))
         self.hess = (sp.diff(self.grad[0], x), sp.diff(self.grad[0], y), sp.diff(self.grad[1], y))
-        self.polynomial = bool(expr.is_polynomial(x, y))
+        # symbolic critical points for polynomials with rational coefficients (pi, sqrt(2)... go the numeric way)
+        self.polynomial = bool(expr.is_polynomial(x, y)) and sp.Poly(expr, x, y).domain in (sp.ZZ, sp.QQ)
         funcs = [sp.lambdify((x, y), e, "numpy") for e in (expr, *self.grad, *self.hess)]
         self._v, self._gx, self._gy, self._hxx, self._hxy, self._hyy = funcs
         #: (V_x, V_y) at one point in plain floats (the descent paths' right-hand side)

@@ -161,6 +161,15 @@ def test_a_non_polynomial_potential_is_derived_numerically():
     assert s.no_return_radius(math.atan(0.25)) == pytest.approx(math.sqrt(6 * 0.25), rel=1e-8)
 
 
+@pytest.mark.parametrize("lam_text, lam", [("sqrt(2)", math.sqrt(2)), ("pi/3", math.pi / 3)])
+def test_irrational_coefficients_go_the_numeric_way(lam_text, lam):
+    s = DeclaredSystem(f"0.5*(x**2 + y**2) + {lam_text}*(x**2*y - y**3/3)")
+    assert s.derivation.method == "numeric"
+    hh = HenonHeiles(1.0, lam)
+    assert s.critical_energy == pytest.approx(hh.critical_energy, rel=1e-14)
+    assert np.allclose([(e.x, e.y) for e in s.exits], [(e.x, e.y) for e in hh.exits], atol=1e-13)
+
+
 def test_overrides_replace_the_derivation():
     # the ring: nothing derivable, everything given
     s = DeclaredSystem("0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2", critical_energy=0.25,
