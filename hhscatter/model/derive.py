@@ -313,7 +313,8 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
         R, T = np.meshgrid(r, th)
         X, Y = R * np.cos(T), R * np.sin(T)
         f = land.v(X, Y) - energy
-        rho = land.radial(X, Y)
+        gx, gy = land.gradient(X, Y)
+        rho = X * gx + Y * gy
         bad = (f <= 0) & (rho >= 0)
         if not bad.any():
             return 0.0
@@ -325,7 +326,6 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
         raise ConfigError(f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
                           f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits")
     dr = r[1] - r[0]
-    gx, gy = land.gradient(X, Y)
     tau = X * gy - Y * gx  # ∂V/∂θ
 
     def changes(F):  # cells (θ_i..θ_i+1, r_j..r_j+1) across which F changes sign (θ wraps round)
@@ -435,8 +435,11 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
     for k, s in enumerate(saddles):
         a, b, c = (float(h) for h in land.hessian(s.x, s.y))
         w, v = np.linalg.eigh(np.array([[a, b], [b, c]]))
-        d = v[:, 0]
-        h = 1e-5 * max(1.0, s.distance)
+        # the descending eigenvector, turned by 1e-6 rad: a path started exactly on a symmetry axis could
+        # otherwise run into another saddle along its stable manifold
+        c, sn = math.cos(1e-6), math.sin(1e-6)
+        d = np.array([c * v[0, 0] - sn * v[1, 0], sn * v[0, 0] + c * v[1, 0]])
+        h = 1e-5 * s.distance
         if s.energy not in r_nr:
             value = no_return_radius(land, s.energy, scale)
             r_nr.update({p.energy: value for p in saddles
