@@ -182,3 +182,21 @@ def test_escape_radius_lies_beyond_every_bounded_orbit(conto):
         res = _ta(conto, state, tol=1e-12).propagate_grid(np.linspace(0, 300, 30001))[5]
         r_max = np.hypot(res[:, 0], res[:, 1]).max()
         assert 0.5 * R < r_max <= R, (E, r_max, R)
+
+
+@pytest.mark.parametrize("text", ["0.5*(x**2 + y**2) - 0.25*x**2*y**2", "atan(0.5*(x**2 + y**2) + x**2*y - y**3/3)",
+                                  "0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cos(y)"])
+def test_heyoka_expressions_match_numpy_and_differentiation(text):
+    import heyoka as hy
+
+    s = DeclaredSystem(text)
+    x, y = hy.make_vars("x", "y")
+    V = s.potential_expression(x, y)
+    fx, fy = s.force_expressions(x, y)
+    pts = np.random.default_rng(3).uniform(-1.2, 1.2, (2, 300))
+    v = hy.cfunc([V], vars=[x, y])(pts)[0]
+    assert np.allclose(v, s.potential(*pts), rtol=1e-14, atol=1e-15)
+    # the simplified force against heyoka's own derivative of V (an independent differentiation)
+    got = hy.cfunc([fx, fy], vars=[x, y])(pts)
+    want = hy.cfunc([-hy.diff(V, x), -hy.diff(V, y)], vars=[x, y])(pts)
+    assert np.allclose(got, want, rtol=1e-13, atol=1e-14)

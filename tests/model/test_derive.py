@@ -90,12 +90,12 @@ def test_no_return_radius_closed_forms_of_the_builtins(name, params, closed):
 
 def test_no_return_radius_is_a_no_return_radius():
     """Beyond R(E), −∂V/∂r > 0 wherever V ≤ E (checked on a fine polar grid independent of the one used)."""
-    for s in (make_system("contopoulos"), make_system("barbanis"), make_system("n_exit", params={"n": 5})):
+    for s in (make_system("contopoulos"), make_system("barbanis")):
         for E in (s.critical_energy, 1.5 * s.critical_energy):
             R = s.no_return_radius(E)
             assert R >= s.saddle_radius
-            r = np.linspace(R, 20 * R, 700)
-            th = np.linspace(0, 2 * np.pi, 1201)
+            r = np.linspace(R, 20 * R, 500)
+            th = np.linspace(0, 2 * np.pi, 1001)
             rr, tt = np.meshgrid(r, th)
             x, y = rr * np.cos(tt), rr * np.sin(tt)
             land = s._landscape
@@ -188,3 +188,9 @@ def test_omega_that_is_no_disk_asks_for_omega_radius():
     # and a given Ω opens the far exit's energy to the well: we check the derived one fails when E_c is forced up
     with pytest.raises(ConfigError, match="give `omega_radius`"):
         DeclaredSystem("0.5*(x**2 + y**2) - x**3/3 - 8*y**3/3", critical_energy=1 / 6)
+
+
+def test_a_descent_that_crawls_is_given_up_with_a_clear_error():
+    # cosh(y) walls close the y-channel exponentially: the path from the saddle crawls out to R(E) ~ 1300
+    with pytest.raises(ConfigError, match=r"saddle at \(0, 0.707107\).*neither a minimum nor infinity.*`exits`"):
+        DeclaredSystem("0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cosh(y)")
