@@ -110,6 +110,26 @@ class HenonHeiles(System):
         ec = self.critical_energy
         return tuple(Exit(float(x), float(y), ec) for x, y in self.saddles)
 
+    @property
+    def frequency(self) -> float:
+        """ω (1/time)."""
+        return self.omega
+
+    def force(self, x: ArrayLike, y: ArrayLike):
+        """(F_x, F_y) = (−ω²x − 2λxy, −ω²y − λ(x² − y²)) on numpy arrays."""
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        w2, lam = self.omega**2, self.lam
+        return -w2 * x - 2.0 * lam * x * y, -w2 * y - lam * (x * x - y * y)
+
+    def default_escape_radius(self, energy: float | None) -> float:
+        """1.5 (ω = λ = 1; 1.5 r_s when r_s > 1): beyond every exit's Lyapunov orbit up to E = 0.5 (study resc).
+
+        The project's r_esc since its first scenes; above E = 0.375 it lies inside R(E) = √(6E), where an
+        outward crossing is not yet final (the resc study measures how rarely orbits return from there).
+        """
+        return max(1.5, 1.5 * self.saddle_radius)
+
     def no_return_radius(self, energy: float) -> float:
         """R(E) = √(6E)/ω (≥ r_s): beyond it −∂V/∂r > 0 wherever V ≤ E (length).
 
