@@ -138,7 +138,7 @@ class System(abc.ABC):
         """V(x, y) on numpy arrays (energy)."""
 
     @abc.abstractmethod
-    def potential_expression(self, x, y):
+    def potential_expression(self, x: Any, y: Any) -> Any:
         """V as a heyoka expression of the heyoka variables ``x``, ``y``."""
 
     @abc.abstractmethod
@@ -224,14 +224,14 @@ class System(abc.ABC):
         V = self.potential_expression(x, y)
         return (x, y, px, py), V, 0.5 * (px**2 + py**2) + V
 
-    def force_expressions(self, x, y):
+    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V as heyoka expressions (a built-in may give simplified forms)."""
         import heyoka as hy  # deferred: heyoka loads on first use
 
         V = self.potential_expression(x, y)
         return -hy.diff(V, x), -hy.diff(V, y)
 
-    def equations(self, gamma_par=None) -> list:
+    def equations(self, gamma_par: Any = None) -> list:
         """equations(gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
 
         Hamilton's equations of H, Eq. (eqn:hh_ham) for Hénon–Heiles, plus the drag of :attr:`dissipation`
