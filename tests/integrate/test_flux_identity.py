@@ -13,14 +13,21 @@ import pytest
 from hhscatter.analysis.geometry.flux import initial_escape_rate
 from hhscatter.integrate.engine import ESCAPED, run_chunk
 from hhscatter.scene.ics import region_ics
+from hhscatter.model.spec import system_from_spec
 from hhscatter.scene.scene import Scene
 
 N = 60_000
 TAU, BINS = 0.3, 12
 
+#: (system spec, E/E_c, R/r_s)
 SYSTEMS = [
-    pytest.param(None, 0.3, 1.2, id="henon_heiles"),
-    pytest.param({"name": "henon_heiles", "params": {"lam": 1.5}}, 0.12, 0.8, id="henon_heiles-lam1.5"),
+    pytest.param(None, 1.8, 1.2, id="henon_heiles"),
+    pytest.param({"name": "henon_heiles", "params": {"lam": 1.5}}, 1.62, 1.8, id="henon_heiles-lam1.5"),
+    pytest.param({"name": "n_exit", "params": {"n": 4}}, 1.5, 1.2, id="n_exit4"),
+    pytest.param({"name": "contopoulos", "params": {"eps": 0.25}}, 1.5, 1.1, id="contopoulos"),
+    pytest.param({"name": "barbanis"}, 1.5, 1.2, id="barbanis"),
+    pytest.param({"potential": "0.5*x**2 + 0.8*y**2 - eps*x**2*y**2 + 0.1*x*y", "params": {"eps": 0.3}}, 1.4, 1.15,
+                 id="declared"),
 ]
 
 
@@ -37,8 +44,10 @@ def _intercept(t_esc, n):
     return coef[0], float(np.sqrt(cov[0, 0]))
 
 
-@pytest.mark.parametrize("system, energy, R", SYSTEMS)
-def test_initial_escape_rate_is_flux_over_shell_volume(system, energy, R):
+@pytest.mark.parametrize("system, ratio, r_ratio", SYSTEMS)
+def test_initial_escape_rate_is_flux_over_shell_volume(system, ratio, r_ratio):
+    m = system_from_spec(system) if system is not None else Scene(energy=0.3, n=1).model
+    energy, R = ratio * m.critical_energy, r_ratio * m.saddle_radius
     scene = Scene(energy=energy, n=N, region="disk", radius=R, r_esc=R, momentum="random",
                   t_max=TAU, seed=7, system=system)
     ics = region_ics(scene, 0, N)

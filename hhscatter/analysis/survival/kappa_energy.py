@@ -3,8 +3,8 @@
 :func:`fit_kappa_energy` fits the piecewise law to κ(E) points with their
 errors, continuous at E_b (the break estimated by profiling χ² over E_b) or
 as two separate laws on either side of the best partition (as the paper),
-with covariance and bootstrap errors. E_c comes from the model
-(:class:`hhscatter.model.HenonHeiles`; 1/6 for ω = λ = 1). Pure functions.
+with covariance and bootstrap errors. E_c comes from the system
+(``scene.model.critical_energy``, :class:`hhscatter.model.System`); no default. Pure functions.
 """
 from __future__ import annotations
 
