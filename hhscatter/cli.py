@@ -115,22 +115,32 @@ def build_parser():
     s = sub.add_parser(
         "simulate",
         help="integrate an ensemble and write Parquet tables",
-        description="Integrate an ensemble of Hénon–Heiles orbits (exact event times) and write "
+        description="Integrate an ensemble of orbits of a system (Hénon–Heiles by default; exact event times) and write "
         "the lifetimes (and, if asked, sections/snapshots) tables as Parquet datasets.",
     )
     s.add_argument("scene", nargs="?", help="scene TOML file (flags below override its values); with --resume and "
                    "no scene file, the scene is read from OUT/scene.json")
     s.add_argument("--scale", help="named scale in the scene file, e.g. 'paper' (default: quick)")
     s.add_argument("--energy", type=_floats,
-                   help="initial energy E0 (> E_c = 1/6 for ω=λ=1); a list 0.25,0.3 makes a grid run")
+                   help="initial energy E0 (> the system's E_c: 1/6 for Hénon–Heiles with ω=λ=1); a list 0.25,0.3 "
+                        "makes a grid run")
     s.add_argument("--gamma", type=_floats, help="drag γ ≥ 0 (0 = conservative); a list 0,0.01 makes a grid run")
     s.add_argument("-n", type=_int, help="number of orbits N > 0 (per grid point); 1e5 is accepted")
     s.add_argument("--seed", type=_int, help="seed ≥ 0 (with the orbit index it fixes every orbit)")
     s.add_argument("--region", choices=["disk", "well", "square"],
-                   help="initial-condition region: disk (r < radius), well (saddle triangle), square (the authors' "
-                        "[-1, 1]² with V < E; orbits starting at r ≥ r_esc are escaped at t = 0)")
+                   help="initial-condition region: disk (r < radius), well (the well's part of V < E_c: the saddle "
+                        "triangle of Hénon–Heiles), square (the authors' [-r_s, r_s]² with V < E; orbits starting at "
+                        "r ≥ r_esc are escaped at t = 0)")
     s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
-    s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default 1.5; the paper used 1.03, see study resc)")
+    s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default: the system's; 1.5 for Hénon–Heiles, the paper used "
+                   "1.03, see study resc)")
+    sy = s.add_argument_group("system", "the system as data (default Hénon–Heiles, ω = λ = 1, linear drag); they "
+                              "override the scene file's [system]")
+    sy.add_argument("--system", metavar="NAME|EXPR", help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
+                    "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'")
+    sy.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", default=[],
+                    help="a parameter of the system (repeatable), e.g. --param eps=0.25")
+    sy.add_argument("--dissipation", choices=["linear", "quadratic"], help="drag law: −γp (linear, default) or −γ|p|p")
     s.add_argument("--t-max", type=_float, dest="t_max", help="maximum orbit time (default 5000)")
     s.add_argument("--tol", type=_float, help="integrator tolerance in [1e-18, 1e-6] (default 1e-15)")
     s.add_argument("--chunk-size", type=_int, dest="chunk_size", help="orbits per part file (default 10000)")
@@ -284,7 +294,33 @@ def _scene_from_args(a):
         d["sections"] = {**(d.get("sections") or {}), **window}
     if a.snapshots is not None:
         d["snapshots"] = a.snapshots
+    if a.system or a.param or a.dissipation:
+        d["system"] = _system_from_args(a, d.get("system"))
     return run_from_dict(d)
+
+
+def _system_from_args(a, base: dict | None) -> dict:
+    """The [system] spec of --system/--param/--dissipation over the scene file's (hhscatter.model.spec)."""
+    spec = dict(base or {})
+    if a.system:
+        is_name = re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", a.system) and a.system not in ("x", "y")
+        spec.pop("name", None)
+        spec.pop("potential", None)
+        spec["name" if is_name else "potential"] = a.system
+    if a.param:
+        spec["params"] = {**(spec.get("params") or {}), **dict(a.param)}
+    if a.dissipation:
+        spec["dissipation"] = a.dissipation
+    if "name" not in spec and "potential" not in spec:
+        spec["name"] = "henon_heiles"
+    return spec
+
+
+def _param(s: str) -> tuple[str, float]:
+    name, eq, value = s.partition("=")
+    if not eq or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name.strip()):
+        raise argparse.ArgumentTypeError(f"param: expected NAME=VALUE, got {s!r}")
+    return name.strip(), _float(value)
 
 
 def cmd_simulate(a):

@@ -198,9 +198,8 @@ class LaneRules(abc.ABC):
     def setup(self, scene, layout, n_lanes):
         self.scene = scene
         self.model = scene.model
-        self.r_s = self.model.saddle_radius
-        self.half_w2 = 0.5 * self.model.omega**2
-        self.lam = self.model.lam
+        self.r_s = self.model.omega_radius  # Ω = {r ≤ r_s}: the closure rule's well
+        self.energy = self.model.scalar_energy()  # H of one point in plain float arithmetic
         self.layout = layout
         self.win = scene.sections
         self.follow = scene.follow is not None
@@ -219,10 +218,6 @@ class LaneRules(abc.ABC):
         self.sec_rows, self.cross_rows = [], []
         self.migrate_at_open = False  # first phase of a two-phase scene: hand orbits on at t_from
         self.migrants = []
-
-    def energy(self, x, y, px, py):
-        """H at one point in plain float arithmetic (numpy calls cost µs per scalar)."""
-        return 0.5 * (px * px + py * py) + self.half_w2 * (x * x + y * y) + self.lam * (x * x * y - y * y * y / 3.0)
 
     def start_orbit(self, lane, k):
         """Per-orbit rule state at load; sets the section gate and the clock."""
@@ -963,6 +958,8 @@ class _Scalar(LaneRules):
         self.ta = ta
         self.fp = fp_type
         self.setup(scene, layout, 1)
+        h = self.energy  # the system's plain-float H; the state here may be long double or real128
+        self.energy = lambda x, y, px, py: h(float(x), float(y), float(px), float(py))
         self.result = None
 
     def elapsed(self, lane):
@@ -970,9 +967,6 @@ class _Scalar(LaneRules):
 
     def state4(self, lane):
         return tuple(self.ta.state[:4])
-
-    def energy(self, x, y, px, py):
-        return super().energy(*(float(v) for v in (x, y, px, py)))
 
     def set_gate(self, lane, g):
         self.ta.pars[self.layout.gate] = self.fp(g)

@@ -50,7 +50,7 @@ from typing import Callable
 
 import numpy as np
 
-from hhscatter.model import equations
+
 from hhscatter.outcomes import (  # re-exported for the engine
     CENSORED,
     ESCAPED,
@@ -219,7 +219,7 @@ def system(scene, lay: Layout):
     import heyoka as hy  # deferred: heyoka loads on first use
 
 
-    sys = equations(scene.model, hy.par[lay.gamma] if lay.gamma is not None else None)
+    sys = scene.model.equations(hy.par[lay.gamma] if lay.gamma is not None else None)
     if lay.clock is not None:
         sys.append((hy.make_vars("sigma"), hy.expression(-1.0 / lay.clock_scale)))
     return sys

@@ -35,6 +35,10 @@ forms, or a declared one whose quantities are derived from its expression). The 
 | ``inside_well(x, y)`` | in the well's part of {V < E_c} (the ``well`` IC region) | — |
 | ``exit_channel(x, y)`` | index of the exit nearest in angle | — |
 | ``scalar_energy()`` | a plain-float H(x, y, px, py) for the engine's per-record path | energy |
+| ``frequency`` | √(largest eigenvalue of V's Hessian at the minimum): the time scale of bounds | 1/time |
+| ``force(x, y)`` | −∇V on numpy arrays | energy/length |
+| ``default_escape_radius(E)`` | r_esc when a scene gives none: beyond every exit's Lyapunov orbit at E | length |
+| ``spec()`` | the plain-data spec that rebuilds the system (:mod:`hhscatter.model.spec`) | — |
 | ``provenance()`` | what the tables' metadata records of the system | — |
 | ``hash_items()`` | what enters a scene's hash (None: the paper's default system, left out of the hash) | — |
 """
@@ -134,7 +138,7 @@ class System(abc.ABC):
         """V(x, y) on numpy arrays (energy)."""
 
     @abc.abstractmethod
-    def potential_expression(self, x, y):
+    def potential_expression(self, x: Any, y: Any) -> Any:
         """V as a heyoka expression of the heyoka variables ``x``, ``y``."""
 
     @abc.abstractmethod
@@ -146,35 +150,47 @@ class System(abc.ABC):
         under either drag law, and the energy only falls, so the accessible region only shrinks.
         """
 
-    def escape_radius(self, energies) -> float:
-        """A default escape radius for a scene whose orbits start at these energies (length).
-
-        max(R(E_max), 1.5 × the farthest exit's distance), with R = :meth:`no_return_radius`. Why it is safe:
-        at the farthest point of any bounded orbit of energy ≤ E (a Lyapunov orbit of an exit among them),
-        ṙ = 0 and r̈ = v_⊥²/r − ∂V/∂r ≤ 0, so −∂V/∂r ≤ 0 there at a point with V ≤ E: such points lie within
-        R(E). Beyond R(E_max) every orbit moving outward never returns (drag only lowers E), so crossing
-        the radius is an escape. The 1.5 × saddle distance floor keeps the paper's r_esc = 1.5 for
-        Hénon–Heiles at E ≤ 3/8 (where √(6E) ≤ 1.5).
-
-        Parameters
-        ----------
-        energies : float or iterable of float
-            The scene's initial energies (energy).
-
-        Returns
-        -------
-        float
-
-        Examples
-        --------
-        >>> from hhscatter.model import HenonHeiles
-        >>> HenonHeiles().escape_radius([0.2, 0.3]), round(HenonHeiles().escape_radius(1.0), 12)
-        (1.5, 2.449489742783)
-        """
-        e_max = float(np.max(np.asarray(energies, dtype=float)))
-        return max(self.no_return_radius(e_max), 1.5 * max(e.distance for e in self.exits))
-
     # -- generic implementations (a built-in may override with closed forms) ----
+    @property
+    def frequency(self) -> float:
+        """√(largest eigenvalue of V's Hessian at the minimum) (1/time): the time scale of bounds on γ.
+
+        Central differences with step 1e-4 (relative error ≈ 1e-8 for smooth potentials).
+        """
+        h = 1e-4
+        v = lambda x, y: float(self.potential(np.array(x), np.array(y)))  # noqa: E731
+        vxx = (v(h, 0) - 2 * v(0, 0) + v(-h, 0)) / h**2
+        vyy = (v(0, h) - 2 * v(0, 0) + v(0, -h)) / h**2
+        vxy = (v(h, h) - v(h, -h) - v(-h, h) + v(-h, -h)) / (4 * h * h)
+        lam_max = 0.5 * (vxx + vyy) + math.sqrt(0.25 * (vxx - vyy) ** 2 + vxy**2)
+        return math.sqrt(max(lam_max, 0.0))
+
+    def force(self, x: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(F_x, F_y) = −∇V on numpy arrays (central differences here; systems override with exact forms)."""
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        h = 1e-6 * np.maximum(1.0, np.hypot(x, y))
+        fx = -(self.potential(x + h, y) - self.potential(x - h, y)) / (2 * h)
+        fy = -(self.potential(x, y + h) - self.potential(x, y - h)) / (2 * h)
+        return fx, fy
+
+    def default_escape_radius(self, energy: float | None) -> float:
+        """r_esc when a scene gives none (length): max(1.5 r_s, R(E)) with R the no-return radius.
+
+        Beyond R(E) an outward-moving orbit never returns (:meth:`no_return_radius`), so an escape decided
+        there is final; 1.5 r_s keeps r_esc clear of the exits' Lyapunov orbits at low E. Without an energy
+        (ICs from a table) 1.5 r_s. R(E) itself lies beyond every bounded orbit of energy ≤ E, Lyapunov
+        orbits included: at an orbit's farthest point ṙ = 0 and r̈ = v_⊥²/r − ∂V/∂r ≤ 0, so −∂V/∂r ≤ 0
+        there, at a point with V ≤ E, and such points lie within R(E).
+        """
+        r = 1.5 * self.saddle_radius
+        return max(r, self.no_return_radius(energy)) if energy is not None else r
+
+    def spec(self) -> dict[str, Any]:
+        """The plain-data spec that rebuilds this system (:func:`hhscatter.model.spec.system_from_spec`)."""
+        key = ("potential", self.potential_text) if self.name == "declared" else ("name", self.name)
+        return {key[0]: key[1], "params": dict(self.params), "dissipation": self.dissipation}
+
     def energy(self, x: ArrayLike, y: ArrayLike, px: ArrayLike, py: ArrayLike) -> np.ndarray:
         """H(x, y, p_x, p_y), Eq. (eq:H) (energy)."""
         px = np.asarray(px, dtype=float)
@@ -210,14 +226,14 @@ class System(abc.ABC):
         V = self.potential_expression(x, y)
         return (x, y, px, py), V, 0.5 * (px**2 + py**2) + V
 
-    def force_expressions(self, x, y):
+    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V as heyoka expressions (a built-in may give simplified forms)."""
         import heyoka as hy  # deferred: heyoka loads on first use
 
         V = self.potential_expression(x, y)
         return -hy.diff(V, x), -hy.diff(V, y)
 
-    def equations(self, gamma_par=None) -> list:
+    def equations(self, gamma_par: Any = None) -> list:
         """equations(gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
 
         Hamilton's equations of H, Eq. (eqn:hh_ham) for Hénon–Heiles, plus the drag of :attr:`dissipation`

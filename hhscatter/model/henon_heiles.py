@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -78,7 +78,7 @@ class HenonHeiles(System):
     def potential_text(self) -> str:
         return "0.5*omega**2*(x**2 + y**2) + lam*(x**2*y - y**3/3)"
 
-    def hash_items(self):
+    def hash_items(self) -> dict[str, Any] | None:
         """None for linear drag (ω and λ are scene fields of their own); the drag law otherwise."""
         return None if self.dissipation == "linear" else {"dissipation": self.dissipation}
 
@@ -110,6 +110,26 @@ class HenonHeiles(System):
         ec = self.critical_energy
         return tuple(Exit(float(x), float(y), ec) for x, y in self.saddles)
 
+    @property
+    def frequency(self) -> float:
+        """ω (1/time)."""
+        return self.omega
+
+    def force(self, x: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(F_x, F_y) = (−ω²x − 2λxy, −ω²y − λ(x² − y²)) on numpy arrays."""
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        w2, lam = self.omega**2, self.lam
+        return -w2 * x - 2.0 * lam * x * y, -w2 * y - lam * (x * x - y * y)
+
+    def default_escape_radius(self, energy: float | None) -> float:
+        """1.5 (ω = λ = 1; 1.5 r_s when r_s > 1): beyond every exit's Lyapunov orbit up to E = 0.5 (study resc).
+
+        The project's r_esc since its first scenes; above E = 0.375 it lies inside R(E) = √(6E), where an
+        outward crossing is not yet final (the resc study measures how rarely orbits return from there).
+        """
+        return max(1.5, 1.5 * self.saddle_radius)
+
     def no_return_radius(self, energy: float) -> float:
         """R(E) = √(6E)/ω (≥ r_s): beyond it −∂V/∂r > 0 wherever V ≤ E (length).
 
@@ -131,7 +151,7 @@ class HenonHeiles(System):
         py = np.asarray(py, dtype=float)
         return 0.5 * (px * px + py * py) + self.potential(x, y)
 
-    def potential_expression(self, x, y):
+    def potential_expression(self, x: Any, y: Any) -> Any:
         """V as a heyoka expression of the variables x, y (the same arithmetic as :meth:`expressions`)."""
         return 0.5 * self.omega**2 * (x**2 + y**2) + self.lam * (x**2 * y - y**3 / 3.0)
 
@@ -139,7 +159,7 @@ class HenonHeiles(System):
         """The well's part of {V < E_c}: the open triangle of the saddles (:meth:`inside_triangle`)."""
         return self.inside_triangle(x, y)
 
-    def scalar_energy(self):
+    def scalar_energy(self) -> Callable[[float, float, float, float], float]:
         """H(x, y, px, py) in plain float arithmetic for the engine's per-record path."""
         half_w2, lam = 0.5 * self.omega**2, self.lam
 
@@ -167,7 +187,7 @@ class HenonHeiles(System):
         return inside
 
     # -- heyoka (expressions() and equations() come from System) ---------
-    def force_expressions(self, x, y):
+    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V simplified (−ω²x − 2λxy, −ω²y − λ(x² − y²)): no redundant products per Taylor step."""
         w2, lam = self.omega**2, self.lam
         return -(w2 * x) - (2.0 * lam) * (x * y), -(w2 * y) - lam * (x**2 - y**2)

@@ -61,6 +61,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         "orbits": [start, stop],
         **provenance(),
     }
+    if scene.system is not None:  # issue 23: which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
+        meta["system"] = scene.model.provenance()
     rows = res.tables()
     # lifetimes last: its presence marks a complete chunk
     for name in reversed(tables_of(scene)):

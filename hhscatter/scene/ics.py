@@ -77,7 +77,7 @@ def sample_block(scene: Scene, block: int) -> np.ndarray:
         x, y = _candidates(rng, scene.region, scene.radius, model.saddle_radius, BLOCK)
         ok = (model.potential(x, y) < scene.energy) & ((x != 0) | (y != 0))
         if scene.region == "well":
-            ok &= model.inside_triangle(x, y)
+            ok &= model.inside_well(x, y)
         xs.append(x[ok])
         ys.append(y[ok])
         have += int(ok.sum())

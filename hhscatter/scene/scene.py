@@ -19,14 +19,15 @@ from typing import Any
 import numpy as np
 
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
-from hhscatter.model import HenonHeiles
+from hhscatter.model import HenonHeiles, System
+from hhscatter.model.spec import OVERRIDES, canonical_spec, system_from_spec
 
 TOL_RANGE = (1e-18, 1e-6)
 
 # Upper bounds, each with its reason (checked before any work; hhscatter.scene.scene.Scene._validate):
-#: r_esc ≤ R_ESC_MAX · ω²/λ: far out |V| ≈ λr³/3 ≫ E, and the energy error of the escape decision grows like
+#: r_esc ≤ R_ESC_MAX · r_s (r_s the saddle distance, ω²/λ for Hénon–Heiles): far out |V| ≈ λr³/3 ≫ E, and the energy error of the escape decision grows like
 #: tol·λr³/E (cancellation between kinetic and potential energy): 2e-4 at r = 1e4 already.
-#: r_far ≤ R_FAR_MAX · ω²/λ: an escaped orbit is only followed on towards its blow-up; the stress study
+#: r_far ≤ R_FAR_MAX · r_s: an escaped orbit is only followed on towards its blow-up; the stress study
 #: checks that outcomes and times do not change up to r_far = 1e8 (tests/bench/test_stress.py), not beyond
 R_ESC_MAX, R_FAR_MAX = 100.0, 1e8
 #: E0 ≤ E0_MAX · E_c: far above the saddle every orbit leaves within a fraction of a period (nothing to
@@ -183,15 +184,16 @@ class Follow:
 
 @dataclass(frozen=True)
 class Scene:
-    """One ensemble simulation: N orbits of the Hénon–Heiles flow with drag, Eqs. (eq:H), (eqn:hh_potential).
+    """One ensemble simulation: N orbits of a system with drag (Hénon–Heiles by default), Eqs. (eq:H), (eqn:hh_potential).
 
     Frozen and validated when made (every bound with its reason). Units are the model's natural units
-    (ω = λ = 1 in the paper): energies in units of the potential, times in 1/ω.
+    (ω = λ = 1 in the paper): energies in units of the potential, times in 1/ω. Every bound that depends on
+    the system (E_c, the saddle distance r_s, the frequency ω) is read from :attr:`model`.
 
     Parameters
     ----------
     energy : float
-        E0, the initial energy of every orbit; must exceed E_c = ω⁶/(6λ²) (1/6 in the paper). None only
+        E0, the initial energy of every orbit; must exceed the system's E_c (1/6 in the paper). None only
         with ``ics`` (the table fixes the energies).
     n : int
         Number of orbits N > 0 (an integral float such as 2e4 is accepted).
@@ -200,23 +202,29 @@ class Scene:
     seed : int
         ≥ 0; with the orbit index it fixes every initial condition.
     region : {'disk', 'well', 'square'}
-        'disk': uniform in area in r < radius; 'well': uniform in the saddle triangle where V < E;
+        'disk': uniform in area in r < radius; 'well': uniform in the well's part of {V < E_c} (the saddle triangle of
+        Hénon–Heiles) where V < E;
         'square': the authors' ``goodICs``, uniform in [−r_s, r_s]² where V < E, no radius cut (orbits
         that start at r ≥ r_esc are escaped at t = 0). Momenta follow ``momentum``.
     radius : float
         Disk radius R (default 0.5, as in the authors' code).
-    r_esc : float
-        Escape radius (default 1.5), > the saddle distance ω²/λ. 1.5 lies beyond the Lyapunov orbits of
-        every exit up to E = 0.5 (study ``resc``); the paper's 1.03 lets 0.3–2 % of 'escaped' orbits
-        return (E = 0.25–0.35).
+    r_esc : float, optional
+        Escape radius, > the saddle distance r_s; default: the system's
+        :meth:`~hhscatter.model.System.default_escape_radius` at E0 (1.5 for Hénon–Heiles: beyond the
+        Lyapunov orbits of every exit up to E = 0.5, study ``resc``; the paper's 1.03 lets 0.3–2 % of
+        'escaped' orbits return at E = 0.25–0.35).
     r_far : float, optional
-        Dissipative runs: radius beyond which an escaped orbit is stopped (default max(10 ω²/λ, 2 r_esc)).
+        Dissipative runs: radius beyond which an escaped orbit is stopped (default max(10 r_s, 2 r_esc)).
     t_max : float
         Maximum orbit time (default 5000); orbits alive then are censored.
     tol : float
         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15).
     omega, lam : float
-        Potential parameters ω, λ > 0 (default 1, 1).
+        Hénon–Heiles' parameters ω, λ > 0 (default 1, 1); with another ``system`` they stay at 1.
+    system : dict or System, optional
+        The system as data (:mod:`hhscatter.model.spec`): a built-in by ``name`` or a ``potential`` in x, y,
+        with ``params`` and ``dissipation``; None is Hénon–Heiles(ω, λ) with linear drag (left out of the
+        scene's hash, as are Hénon–Heiles specs with linear drag, which become ω and λ).
     chunk_size : int
         Orbits per part file (default 10000); the tables do not depend on it (bitwise).
     batch_size : int, optional
@@ -263,7 +271,7 @@ class Scene:
     seed: int = 0
     region: str = "disk"
     radius: float = 0.5
-    r_esc: float = 1.5
+    r_esc: float | None = None
     r_far: float | None = None
     t_max: float = 5000.0
     tol: float = 1e-15
@@ -277,23 +285,45 @@ class Scene:
     follow: Follow | None = None
     continue_settled: bool = False
     momentum: str = "tangential"
+    system: dict | None = field(default=None, hash=False)
     name: str = "scene"
-    _model: HenonHeiles = field(default=None, init=False, repr=False, compare=False)
+    _model: System = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         for name in ("n", "seed", "chunk_size"):  # counts written as floats (n=2e4), like the CLI's -n 2e4
             v = getattr(self, name)
             if isinstance(v, (float, np.floating)) and math.isfinite(v) and v == int(v):
                 object.__setattr__(self, name, int(v))
-        try:
-            model = HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
-        except ValueError as exc:
-            raise ConfigError(str(exc)) from None
-        object.__setattr__(self, "_model", model)
+        object.__setattr__(self, "_model", self._make_model())
+        if self.r_esc is None:
+            e = None if self.energy is None or isinstance(self.energy, bool) else _finite("energy", self.energy)
+            object.__setattr__(self, "r_esc", float(self._model.default_escape_radius(e)))
         self._validate()
 
+    def _make_model(self) -> System:
+        """The system: Hénon–Heiles(ω, λ), or the ``system`` spec (normalised: a Hénon–Heiles spec with linear
+        drag becomes ω and λ, so that it has the hash of the same scene written without a [system] table)."""
+        if self.system is None:
+            try:
+                return HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
+            except ValueError as exc:
+                raise ConfigError(str(exc)) from None
+        if (self.omega, self.lam) != (1.0, 1.0):
+            raise ConfigError("omega and lam are Hénon–Heiles' scene keys: with a system give them in its params "
+                              "(system.params.omega, system.params.lam)")
+        model = system_from_spec(self.system)
+        given = canonical_spec(self.system)
+        spec = canonical_spec({**model.spec(), **{k: given[k] for k in OVERRIDES if k in given}})
+        if isinstance(model, HenonHeiles) and model.hash_items() is None:
+            object.__setattr__(self, "omega", model.omega)
+            object.__setattr__(self, "lam", model.lam)
+            spec = None
+        object.__setattr__(self, "system", spec)
+        return model
+
     @property
-    def model(self) -> HenonHeiles:
+    def model(self) -> System:
+        """The system (:class:`hhscatter.model.System`): potential, drag law, E_c, exits, Ω."""
         return self._model
 
     @property
@@ -315,8 +345,8 @@ class Scene:
         gamma = _finite("gamma", self.gamma)
         if gamma < 0:
             raise ConfigError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
-        if gamma > GAMMA_MAX * m.omega:
-            raise ConfigError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.omega:g}, got {gamma:g} (beyond, "
+        if gamma > GAMMA_MAX * m.frequency:
+            raise ConfigError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.frequency:g}, got {gamma:g} (beyond, "
                              "the motion is overdamped: orbits settle within a fraction of a period)")
         if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
             raise ConfigError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
@@ -339,19 +369,18 @@ class Scene:
         r_esc = _finite("r_esc", self.r_esc)
         if r_esc <= m.saddle_radius:
             raise ConfigError(
-                f"r_esc must be > the saddle distance ω²/λ = {m.saddle_radius:g} "
+                f"r_esc must be > the saddle distance r_s = {m.saddle_radius:g} "
                 f"(outside the Lyapunov orbits), got {r_esc}"
             )
         if r_esc > R_ESC_MAX * m.saddle_radius:
-            raise ConfigError(f"r_esc must be ≤ {R_ESC_MAX:g} ω²/λ = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
-                             "(energy conservation: far out |V| ≈ λr³/3 ≫ E and the energy error grows like "
-                             "tol·λr³/E)")
+            raise ConfigError(f"r_esc must be ≤ {R_ESC_MAX:g} r_s = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
+                             "(energy conservation: far out |V| ≫ E and the energy error grows like tol·|V|/E)")
         if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
             raise ConfigError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
         if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
-            raise ConfigError(f"r_far must be ≤ {R_FAR_MAX:g} ω²/λ = {R_FAR_MAX * m.saddle_radius:g}, got "
-                             f"{self.r_far:g} (the range checked by the stress study; V ≈ λr³/3 heads for "
-                             "float64 overflow beyond)")
+            raise ConfigError(f"r_far must be ≤ {R_FAR_MAX:g} r_s = {R_FAR_MAX * m.saddle_radius:g}, got "
+                             f"{self.r_far:g} (the range checked by the stress study; V heads for float64 "
+                             "overflow beyond)")
         if self.region not in REGIONS:
             raise ConfigError(f"region must be one of {REGIONS}, got {self.region!r}")
         if not isinstance(self.momentum, str) or self.momentum not in MOMENTA:
@@ -362,7 +391,7 @@ class Scene:
         if radius > r_esc:
             raise ConfigError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
                              "escaped already, and the sampler would reject almost every draw: V < E only "
-                             "holds near the saddle triangle)")
+                             "holds near the well)")
         return r_esc
 
     def _check_chunks(self):
@@ -459,6 +488,10 @@ class Scene:
             del d["continue_settled"]
         if self.momentum == "tangential":  # issue 28: the only convention before; hashes of older scenes kept
             del d["momentum"]
+        if self.system is None:  # issue 23: Hénon–Heiles with linear drag, as before; hashes kept
+            del d["system"]
+        else:
+            d["system"] = dict(self.system, params=dict(self.system["params"]))
         return d
 
     def to_json(self) -> str:

@@ -41,6 +41,7 @@ from pydantic import (
 )
 
 from hhscatter.errors import ConfigError
+from hhscatter.model import DISSIPATIONS
 from hhscatter.scene.scene import MOMENTA, REGIONS, Follow, Scene, SectionWindow, scene_from_dict
 
 __all__ = [
@@ -193,7 +194,7 @@ SectionsTable = table_of(SectionWindow, "SectionsTable",
 FollowTable = table_of(Follow, "FollowTable", "``[follow]``: escaped orbits followed to r_far (conservative "
                        "scenes), crossings of these radii recorded (Follow's fields).", required=("radii",))
 SceneTable = table_of(Scene, "SceneTable", "``[scene]`` of a scene file: the Scene fields (energy and gamma may be "
-                      "lists: a grid).", exclude=("sections", "snapshots", "follow"),
+                      "lists: a grid).", exclude=("sections", "snapshots", "follow", "system"),
                       leaves={"energy": NumberOrNumbers, "gamma": NumberOrNumbers, "region": OneOf(*REGIONS),
                               "momentum": OneOf(*MOMENTA)})
 
@@ -217,8 +218,20 @@ class SnapshotsTable(_Table):
 
 
 StudySceneTable = table_of(Scene, "StudySceneTable", "``[scene]`` of a study.toml: one scene's fields (no grid: "
-                           "a study makes its runs itself).", exclude=("sections", "snapshots", "follow"),
+                           "a study makes its runs itself).", exclude=("sections", "snapshots", "follow", "system"),
                            leaves={"region": OneOf(*REGIONS), "momentum": OneOf(*MOMENTA)})
+
+
+class SystemTable(_Table):
+    """``[system]``: the system as data (:mod:`hhscatter.model.spec`): a built-in ``name`` or a ``potential``
+    in x, y, its ``[system.params]``, the ``dissipation`` law, and overrides of derived quantities."""
+
+    name: Text = None
+    potential: Text = None
+    dissipation: OneOf(*DISSIPATIONS) = None
+    params: dict[str, Number] = None
+    critical_energy: Number = None
+    omega_radius: Number = None
 
 
 class AboutTable(_Table):
@@ -272,7 +285,8 @@ def typed_value(model: type[BaseModel], name: str, raw: dict) -> Any:
     return conv(v) if conv is not None and v is not None else v
 
 
-_SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable}
+_SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable,
+                 "system": SystemTable}
 
 
 def _scene_file_model():
@@ -491,8 +505,9 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
         d["sections"] = doc["sections"]
     if "snapshots" in doc:
         d["snapshots"] = doc["snapshots"]
-    if "follow" in doc:
-        d["follow"] = doc["follow"]
+    for table in ("follow", "system"):
+        if table in doc:
+            d[table] = doc[table]
     if scale is not None and scale != "quick":
         scales = doc.get("scale", {})
         if scale not in scales:

@@ -17,7 +17,8 @@ from pathlib import Path
 from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
-from hhscatter.model import HenonHeiles
+from hhscatter.model import HenonHeiles, System
+from hhscatter.model.spec import system_from_spec
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
@@ -183,16 +184,17 @@ class Study:
         raise StudyError(f"{self.root / 'study.toml'}: [study] needs '{key}'")
 
     @property
-    def model(self):
-        """The Hénon–Heiles model of the study's ``[scene]`` (ω, λ): E_c, saddles, potential."""
-
+    def model(self) -> System:
+        """The system of the study's ``[system]`` table, or Hénon–Heiles(ω, λ) of its ``[scene]``: E_c, exits, V."""
+        if self.config.get("system") is not None:
+            return system_from_spec(self.config["system"])
         sc = self.config.get("scene", {})
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
         """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
         d = dict(self.config.get("scene", {}))
-        for extra in ("sections", "snapshots"):
+        for extra in ("sections", "snapshots", "system"):
             if extra in self.config:
                 d[extra] = copy.deepcopy(self.config[extra])
         d.update(overrides)
@@ -403,7 +405,7 @@ def missing_upstream(study: Study) -> list[str]:
 
 
 #: the study.toml tables every raw run's scene is made from (Study.scene, Study.model)
-SCENE_TABLES = ("scene", "sections", "snapshots", "follow")
+SCENE_TABLES = ("scene", "sections", "snapshots", "follow", "system")
 
 
 def simulate_inputs(study, keys) -> dict:

@@ -379,7 +379,7 @@ def _mixture_pair(study, s: _Setup, raw, label, E0, g, points, P_min):
         t_ref = s.tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
         comps = mixture.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=study.params.n_components,
                                            by=var["by"], fit_window=(s.tau0, w_hi))
-        comp_rows.append(comps.to_frame().assign(pair=label, E0=E0, gamma=g, model=var["name"]))
+        comp_rows.append(comps.to_frame(s.E_c).assign(pair=label, E0=E0, gamma=g, model=var["name"]))
         mixes[var["name"]] = _mixture_fits(t, P, tf, Pf, sf, comps, kappa=s.kappa, tau0=s.tau0, E_c=s.E_c,
                                            hazards=s.hazards, mode=var["fne_mode"], P_min=P_min)
     return comp_rows, mixes

@@ -169,7 +169,7 @@ def test_tau1_from_lifetime_tables():
 # ---------------------------------------------------------------------------
 # homogeneous survival model
 # ---------------------------------------------------------------------------
-KW = dict(kappa_of_E=model.PAPER_KAPPA, E0=E0, mu=MU, gamma=GAMMA, tau0=TAU0)
+KW = dict(kappa_of_E=model.PAPER_KAPPA, E0=E0, mu=MU, gamma=GAMMA, tau0=TAU0, E_c=model.PAPER_KAPPA.E_c)
 TRUE = dict(f_ne=0.1, f_e=0.4, L=0.1, b=0.2)
 
 
@@ -201,7 +201,7 @@ def test_integrated_hazard_closed_forms():
     for hz in ("paper", "integrated"):
         P = model.survival_model(t, **const, **TRUE, tau2=100.0, hazard=hz)
         np.testing.assert_allclose(P, 0.1 + 0.4 * np.exp(-0.07 * (t - TAU0)), rtol=1e-9)
-    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41)  # κ = 1.41 (E − E_c)
+    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41, E_c=model.PAPER_KAPPA.E_c)  # κ = 1.41 (E − E_c)
     beta = MU * GAMMA
     K = 1.41 * (E0 * (np.exp(-beta * TAU0) - np.exp(-beta * t)) / beta - EC * (t - TAU0))
     P = model.survival_model(t, **dict(KW, kappa_of_E=lin), **TRUE, hazard="integrated")
@@ -258,7 +258,7 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
     t = np.arange(0.0, 301.0)
     P, P_err = binomial_sample(model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS,
                                np.random.default_rng(21))
-    other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709)
+    other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709, E_c=model.PAPER_KAPPA.E_c)
     common = {"P_min": 20 / N_ORBITS, "hazard": hazard}
     right = model.fit_survival_model(t, P, P_err, **KW, **common)
     wrong = model.fit_survival_model(t, P, P_err, **dict(KW, kappa_of_E=other, mu=0.939), **common)
@@ -275,7 +275,8 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
 
 
 def test_predict_tau1_solves_eq_tau1():
-    params = model.SurvivalModelParams(model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2)
+    params = model.SurvivalModelParams(model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2,
+                                       model.PAPER_KAPPA.E_c)
     k0 = float(model.PAPER_KAPPA(E0))
 
     def P0(t):  # conservative curve at E0: P(τ0) e^{−κ0(E0)(t − τ0)}
@@ -335,7 +336,7 @@ def test_mixture_components_recover_sub_ensembles(two_population_snapshots, by):
     np.testing.assert_allclose(c.mu[order], MIX_MU, rtol=2e-3)
     np.testing.assert_allclose(c.weights, [0.5, 0.5], atol=0.01)
     np.testing.assert_allclose(c.A, E0, rtol=2e-3)
-    np.testing.assert_allclose(c.tau2()[order], np.log(E0 / EC) / (MIX_MU * GAMMA), rtol=3e-3)
+    np.testing.assert_allclose(c.tau2(EC)[order], np.log(E0 / EC) / (MIX_MU * GAMMA), rtol=3e-3)
 
 
 def test_mixture_with_one_component_is_the_homogeneous_model():
@@ -345,8 +346,8 @@ def test_mixture_with_one_component_is_the_homogeneous_model():
     t = np.arange(0.0, 200.0, 0.5)
     for hz in ("paper", "integrated"):
         Pm = model.mixture_survival_model(
-            t, kappa_of_E=model.PAPER_KAPPA, components=c, tau0=TAU0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2, hazard=hz
-        )
+            t, kappa_of_E=model.PAPER_KAPPA, components=c, tau0=TAU0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2, hazard=hz,
+            E_c=EC)
         np.testing.assert_allclose(Pm, model.survival_model(t, **KW, **TRUE, hazard=hz), equal_nan=True)
 
 
@@ -358,13 +359,13 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     f_ne_true = np.array([0.03, 0.12])  # slow (μ = 0.6), fast (μ = 1.3)
     P_true = model.mixture_survival_model(
         t, kappa_of_E=model.PAPER_KAPPA, components=true_components(), tau0=TAU0,
-        f_ne=f_ne_true, P_tau0=0.5, L=0.1, b=0.2, hazard=hazard,
+        f_ne=f_ne_true, P_tau0=0.5, L=0.1, b=0.2, hazard=hazard, E_c=EC,
     )
     P, P_err = binomial_sample(P_true, N_ORBITS, rng)
     # homogeneous model with the paper's procedure: μ from ⟨E⟩ on [0, 200]
     m = decay.mean_energy(snaps)
     mu_h = decay.fit_energy_decay(m["t"], m["mean_E"], E0, GAMMA, (0, 200)).mu
-    common = dict(kappa_of_E=model.PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard)
+    common = dict(kappa_of_E=model.PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard, E_c=model.PAPER_KAPPA.E_c)
     homog = model.fit_survival_model(t, P, P_err, E0=E0, mu=mu_h, gamma=GAMMA, **common)
     mix = model.fit_mixture_model(t, P, P_err, snaps, gamma=GAMMA, n_components=2, by="rate", **common)
     table = model.compare_fits({"homogeneous": homog, "mixture": mix})

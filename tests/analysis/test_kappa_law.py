@@ -5,12 +5,16 @@ import numpy as np
 import pytest
 
 from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
-from hhscatter.analysis.survival.kappa_law import E_C, PAPER_KAPPA, PiecewiseKappa
+from hhscatter.analysis.survival.kappa_law import PAPER_KAPPA, PiecewiseKappa
+from hhscatter.model import HenonHeiles
+
+E_C = HenonHeiles().critical_energy  # E_c comes from the system
 
 
 def test_critical_energy_is_that_of_the_model():
-    """E_c = ω⁶/(6λ²) = 1/6 for ω = λ = 1 (closed form, not the model's code)."""
+    """E_c = ω⁶/(6λ²) = 1/6 for ω = λ = 1 (closed form, not the model's code), and the paper's law carries it."""
     assert E_C == pytest.approx(1.0 / 6.0, rel=1e-15)
+    assert PAPER_KAPPA.E_c == E_C
 
 
 def test_paper_law_at_known_energies():
@@ -47,9 +51,9 @@ def test_other_coefficients_and_shapes():
 def test_fitted_law_reproduces_a_continuous_piecewise_kappa():
     """κ(E) points of a PiecewiseKappa whose branches meet at E_switch: the fit's predict() is that law."""
     a2, a1, E_s = 9.0, 0.2, 0.3
-    law = PiecewiseKappa(a2=a2, a1=a1, slope=a2 * (E_s - E_C) + a1, E_switch=E_s)
+    law = PiecewiseKappa(a2=a2, a1=a1, slope=a2 * (E_s - E_C) + a1, E_switch=E_s, E_c=E_C)
     E = np.linspace(0.18, 0.5, 25)
-    fit = fit_kappa_energy(E, law(E), np.full(E.size, 1e-3), n_boot=0)
+    fit = fit_kappa_energy(E, law(E), np.full(E.size, 1e-3), E_C, n_boot=0)
     assert (fit.a, fit.b, fit.E_b) == pytest.approx((a2, a1, E_s), rel=1e-6)
     probe = np.linspace(0.1, 0.6, 101)
     np.testing.assert_allclose(fit.predict(probe), law(probe), rtol=1e-6, atol=1e-12)

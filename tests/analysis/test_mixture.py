@@ -37,8 +37,9 @@ def test_one_component_and_identical_components_are_the_homogeneous_model(hazard
     """K = 1, and K = 3 sub-ensembles on the same path with f_ne,k = w_k f_ne: both are survival_model."""
     t = np.arange(0.0, 200.0, 0.5)
     homog = survival_model(t, kappa_of_E=PAPER_KAPPA, E0=E0, mu=0.91, gamma=GAMMA, tau0=TAU0, f_ne=0.1, f_e=0.4,
-                           L=0.1, b=0.2, hazard=hazard)
-    common = {"kappa_of_E": PAPER_KAPPA, "tau0": TAU0, "P_tau0": 0.5, "L": 0.1, "b": 0.2, "hazard": hazard}
+                           L=0.1, b=0.2, hazard=hazard, E_c=PAPER_KAPPA.E_c)
+    common = {"kappa_of_E": PAPER_KAPPA, "tau0": TAU0, "P_tau0": 0.5, "L": 0.1, "b": 0.2, "hazard": hazard,
+              "E_c": PAPER_KAPPA.E_c}
     one = mixture_survival_model(t, components=components((1.0,), (0.91,), (E0,)), f_ne=0.1, **common)
     np.testing.assert_array_equal(np.isnan(one), np.isnan(homog))
     np.testing.assert_allclose(one, homog, rtol=1e-14, equal_nan=True)
@@ -154,10 +155,10 @@ def test_fit_recovers_the_generating_mixture(hazard, p0):
     t = np.arange(0.0, 301.0)
     f_ne = np.array([0.03, 0.12])
     P = mixture_survival_model(t, kappa_of_E=PAPER_KAPPA, components=c, tau0=TAU0, f_ne=f_ne, P_tau0=0.5, L=0.1,
-                               b=0.2, hazard=hazard)
+                               b=0.2, hazard=hazard, E_c=PAPER_KAPPA.E_c)
     ok = np.isfinite(P) & (P > 1e-5)
     fit = fit_mixture_model(t[ok], P[ok], 1e-3 * P[ok], c, kappa_of_E=PAPER_KAPPA, tau0=TAU0, P_tau0=0.5,
-                            hazard=hazard, p0=p0)
+                            hazard=hazard, p0=p0, E_c=PAPER_KAPPA.E_c)
     np.testing.assert_allclose(fit.values["f_ne_k"], f_ne, rtol=1e-4)
     assert (fit.values["L"], fit.values["b"]) == pytest.approx((0.1, 0.2), rel=1e-4)
     assert fit.values["f_ne"] == pytest.approx(0.15, rel=1e-4) and fit.chi2 < 1e-6

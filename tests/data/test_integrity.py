@@ -276,7 +276,7 @@ def test_8_ics_below_ec_with_drag_are_refused(tmp_path, capsys):
 
 # 9 -- bounds with reasons, before any work, nothing written
 @pytest.mark.parametrize("flags,message", [
-    (["--r-esc", "1e50"], "r_esc must be ≤ 100 ω²/λ = 100, got 1e+50 (energy conservation"),
+    (["--r-esc", "1e50"], "r_esc must be ≤ 100 r_s = 100, got 1e+50 (energy conservation"),
     (["--radius", "1e300"], "radius must be ≤ r_esc = 1.5, got 1e+300"),
     (["--energy", "1e300"], "energy must be ≤ 1000 E_c = 166.667, got 1e+300"),
     (["--gamma", "1e300"], "gamma must be ≤ 10 ω = 10, got 1e+300 (beyond, the motion is overdamped"),

@@ -69,7 +69,8 @@ def test_concept_pages_state_the_code_defaults():
 
     r_esc = Scene(energy=0.3, n=1).r_esc
     assert r_esc == 1.5
-    assert f"| `r_esc` | escape radius | {r_esc:g} " in (DOCS / "concepts" / "scenes.md").read_text()
+    assert f"| `r_esc` | escape radius | the system's: {r_esc:g} for Hénon–Heiles " in \
+        (DOCS / "concepts" / "scenes.md").read_text()
     assert f"| {r_esc:g} (default" in (DOCS / "concepts" / "index.md").read_text()
     assert f"default r_esc = {r_esc:g}" in (DOCS / "concepts" / "events.md").read_text()
     pages = [p.read_text() for p in (*DOCS.rglob("*.md"), ROOT / "README.md")]

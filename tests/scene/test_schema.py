@@ -54,7 +54,7 @@ BAD_STUDY_FILES = [
      "[scene] energy must be a number, got '0.3'"),
     ("fig6", lambda t: t.replace("[snapshots]", "[snapshot]", 1),
      "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
-     "[snapshots], [study]"),
+     "[snapshots], [study], [system]"),
     ("fig3", lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
      "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot' (did you mean 'n_boot'?); allowed keys: alt_window, "
      "authors_selection, authors_window, boot_seed, fit_window, hist_bins, hist_times, later_windows, n_boot, "
@@ -102,7 +102,7 @@ BAD_SCENE_FILES = [
     ("[scene]\nenergy = 0.3\nn = 40\nseed = true\n", "[scene] seed must be an integer, got true"),
     ("[scene]\nenergy = \"0.3\"\nn = 40\n", "[scene] energy must be a number or a list of numbers, got '0.3'"),
     ("[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
-     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots]"),
+     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots], [system]"),
     ("[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",
      "[snapshots] needs 'times' or all of start, stop and step"),
     ("[scene]\nenergy = [0.3, 0.35]\nn = 40\ngamma = [0, true]\n",

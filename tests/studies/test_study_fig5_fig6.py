@@ -18,7 +18,10 @@ import pandas as pd
 import pytest
 
 from hhscatter.analysis.geometry import distance as dist
-from hhscatter.analysis.dissipative.models import E_C, time_to_energy
+from hhscatter.analysis.dissipative.models import time_to_energy
+from hhscatter.model import HenonHeiles
+
+E_C = HenonHeiles().critical_energy  # the paper's system's E_c
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 from hhscatter.studies import _upstream as up
 

@@ -57,7 +57,6 @@ from hhscatter.analysis.dissipative.survival_model import (
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
-from hhscatter.analysis.survival.kappa_law import E_C
 
 __all__ = [
     "MixtureComponents",
@@ -108,12 +107,12 @@ class MixtureComponents:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         return self.A[:, None] * np.exp(-self.mu[:, None] * self.gamma * t[None, :])
 
-    def tau2(self, E_c: float = E_C):
+    def tau2(self, E_c: float):
         """tau2(E_c) -> (K,) τ2,k = ln(A_k/E_c)/(μ_k γ), Eq. (eq:tau2) per sub-ensemble."""
         return np.asarray(tau2_predicted(self.A, E_c, self.mu, self.gamma), dtype=float)
 
-    def to_frame(self) -> pd.DataFrame:
-        """One row per sub-ensemble: bin_lo, bin_hi (of ``by``), weight, n_ref, E_ref, A, mu, mu_err, tau2."""
+    def to_frame(self, E_c: float) -> pd.DataFrame:
+        """One row per sub-ensemble: bin_lo, bin_hi (of ``by``), weight, n_ref, E_ref, A, mu, mu_err, tau2 (at E_c)."""
         return pd.DataFrame(
             {
                 "bin_lo": self.edges[:-1],
@@ -124,7 +123,7 @@ class MixtureComponents:
                 "A": self.A,
                 "mu": self.mu,
                 "mu_err": self.mu_err,
-                "tau2": self.tau2(),
+                "tau2": self.tau2(E_c),
             }
         )
 
@@ -298,11 +297,11 @@ def mixture_survival_model(
     P_tau0: float,
     L: float,
     b: float,
-    E_c: float = E_C,
+    E_c: float,
     hazard: str = "paper",
     tau2=None,
 ):
-    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c=1/6, hazard="paper") -> P(t).
+    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c, hazard="paper") -> P(t).
 
     Mixture generalisation of Eq. (eqn:surv_prob_model):
     P(t) = Σ_k P_k(t), each sub-ensemble k following the homogeneous model
@@ -336,7 +335,7 @@ class MixtureModelParams:
     P_tau0: float
     L: float
     b: float
-    E_c: float = E_C
+    E_c: float
     hazard: str = "paper"
 
     @property
@@ -368,7 +367,7 @@ def fit_mixture_model(
     kappa_of_E: Callable,
     tau0: float,
     gamma: float | None = None,
-    E_c: float = E_C,
+    E_c: float,
     n_components: int = 4,
     t_ref: float | None = None,
     by: str = "energy",

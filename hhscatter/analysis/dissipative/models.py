@@ -31,10 +31,9 @@ from hhscatter.analysis.dissipative.survival_model import (
     settling_rate,
     survival_model,
 )
-from hhscatter.analysis.survival.kappa_law import E_C, PAPER_KAPPA, PiecewiseKappa
+from hhscatter.analysis.survival.kappa_law import PAPER_KAPPA, PiecewiseKappa
 
 __all__ = [
-    "E_C",
     "HAZARDS",
     "PAPER_KAPPA",
     "MixtureComponents",

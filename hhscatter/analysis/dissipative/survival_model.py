@@ -44,10 +44,8 @@ from scipy import optimize, special
 
 from hhscatter.analysis.dissipative.decay import energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
-from hhscatter.analysis.survival.kappa_law import E_C
 
 __all__ = [
-    "E_C",
     "HAZARDS",
     "HomogeneousProblem",
     "SurvivalFit",
@@ -124,10 +122,10 @@ def survival_model(
     f_e: float,
     L: float,
     b: float,
-    E_c: float = E_C,
+    E_c: float,
     hazard: str = "paper",
 ):
-    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c=1/6, hazard="paper") -> P(t).
+    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard="paper") -> P(t).
 
     The paper's survival model, Eq. (eqn:surv_prob_model), with
     κ_γ(t) = κ0(E(t)) and E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)):
@@ -162,7 +160,7 @@ class SurvivalModelParams:
     f_e: float
     L: float
     b: float
-    E_c: float = E_C
+    E_c: float
     hazard: str = "paper"
 
     def __call__(self, t):
@@ -366,7 +364,7 @@ def fit_survival_model(
     gamma: float,
     tau0: float,
     tau2: float | None = None,
-    E_c: float = E_C,
+    E_c: float,
     fixed: dict | None = None,
     fit_tau2: bool = False,
     p0: dict | None = None,

@@ -145,6 +145,8 @@ def lyapunov_orbit(energy: float, model: HenonHeiles | None = None, *, rtol: flo
     2π/(√3 ω), the tangential frequency there (V_xx = 3ω² at the saddle).
     """
     model = model or HenonHeiles()
+    if not isinstance(model, HenonHeiles):
+        raise TypeError(f"lyapunov_orbit uses Hénon–Heiles' channel-0 symmetry (x → −x); got the system {model.name!r}")
     E = float(energy)
     if not E > model.critical_energy:
         raise ValueError(f"energy must be > E_c = {model.critical_energy:.6g}, got {energy}")

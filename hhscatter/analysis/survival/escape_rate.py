@@ -18,7 +18,7 @@
   engine's ``sections`` table.
 
 Pure functions (no I/O, no plotting).  Times in the model's natural time units,
-κ in 1/time, energies in the model's energy units (E_c = 1/6 for ω = λ = 1).
+κ in 1/time, energies in the system's energy units (E_c from the system: ``scene.model.critical_energy``).
 """
 from __future__ import annotations
 

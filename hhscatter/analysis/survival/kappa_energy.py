@@ -3,8 +3,8 @@
 :func:`fit_kappa_energy` fits the piecewise law to κ(E) points with their
 errors, continuous at E_b (the break estimated by profiling χ² over E_b) or
 as two separate laws on either side of the best partition (as the paper),
-with covariance and bootstrap errors. E_c comes from the model
-(:class:`hhscatter.model.HenonHeiles`; 1/6 for ω = λ = 1). Pure functions.
+with covariance and bootstrap errors. E_c comes from the system
+(``scene.model.critical_energy``, :class:`hhscatter.model.System`); no default. Pure functions.
 """
 from __future__ import annotations
 
@@ -15,7 +15,6 @@ import numpy as np
 from scipy import optimize
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
-from hhscatter.analysis.survival.kappa_law import E_C  # E_c of the paper's model: the default of the fits
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy"]
 
@@ -126,15 +125,15 @@ def _fit_discontinuous(x, y, w):
 def fit_kappa_energy(
     E,
     kappa,
-    kappa_err=None,
-    E_c: float = E_C,
+    kappa_err,
+    E_c: float,
     *,
     continuous: bool = True,
     n_grid: int = 400,
     n_boot: int = 200,
     rng=None,
 ) -> KappaEnergyFit:
-    """fit_kappa_energy(E, kappa, kappa_err=None, E_c=1/6, *, continuous=True, n_boot=200, rng=None) -> KappaEnergyFit.
+    """fit_kappa_energy(E, kappa, kappa_err, E_c, *, continuous=True, n_boot=200, rng=None) -> KappaEnergyFit.
 
     Piecewise fit of the escape rate against energy (paper Fig. 2b, x = E − E_c,
     energies in energy units, κ in 1/time):

@@ -13,15 +13,13 @@ import numpy as np
 
 from hhscatter.model import HenonHeiles
 
-__all__ = ["E_C", "PAPER_KAPPA", "PiecewiseKappa"]
+__all__ = ["PAPER_KAPPA", "PiecewiseKappa"]
 
-E_C = HenonHeiles().critical_energy  # E_c = ω⁶/(6λ²) with ω = λ = 1 (default; pass the scene's model's)
-"""Critical energy of the Hénon–Heiles potential with ω = λ = 1 (from :class:`hhscatter.model.HenonHeiles`)."""
 
 
 @dataclass(frozen=True)
 class PiecewiseKappa:
-    """PiecewiseKappa(a2=13.63, a1=0.03, slope=1.41, E_switch=0.27, E_c=1/6) -> callable κ0(E).
+    """PiecewiseKappa(E_c, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27) -> callable κ0(E).
 
     Conservative escape rate as a function of energy (paper Fig. 2b), with
     ΔE = E − E_c:
@@ -30,16 +28,17 @@ class PiecewiseKappa:
         κ0 = slope · ΔE       for E ≥ E_switch         (hyperbolic, linear regime)
         κ0 = 0                for E ≤ E_c              (no escape)
 
-    Defaults are the paper's fits.  Calling it on an array returns an array
+    E_c is the system's (``scene.model.critical_energy``; no default: it comes from the system). Defaults of
+    the coefficients are the paper's fits for Hénon–Heiles (:data:`PAPER_KAPPA`).  Calling it on an array returns an array
     (rates in 1/time).  Note the two branches do not join exactly at
     E_switch (0.1486 vs 0.1457 with the defaults).
     """
 
+    E_c: float
     a2: float = 13.63
     a1: float = 0.03
     slope: float = 1.41
     E_switch: float = 0.27
-    E_c: float = E_C
 
     def __call__(self, E):
         E = np.asarray(E, dtype=float)
@@ -48,5 +47,5 @@ class PiecewiseKappa:
         return np.where(d > 0, k, 0.0)
 
 
-PAPER_KAPPA = PiecewiseKappa()
-"""κ0(E) with the paper's fitted coefficients (Fig. 2b)."""
+PAPER_KAPPA = PiecewiseKappa(E_c=HenonHeiles().critical_energy)
+"""κ0(E) with the paper's fitted coefficients (Fig. 2b), for the paper's system (Hénon–Heiles, ω = λ = 1)."""

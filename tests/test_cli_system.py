@@ -1,0 +1,64 @@
+"""The system flags of ``hhscatter simulate`` (issue 23): --system, --param, --dissipation."""
+import json
+
+import pyarrow.parquet as pq
+import pytest
+
+from hhscatter.cli import main
+
+
+def _cli(capsys, *args):
+    rc = main(list(args))
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return rc, err
+
+
+def _meta(out):
+    part = sorted(out.glob("lifetimes/**/*.parquet"))[0]
+    return json.loads(pq.read_schema(part).metadata[b"hhscatter"])
+
+
+def test_henon_heiles_by_name_writes_the_tables_of_the_default(tmp_path, capsys):
+    """--system henon_heiles --param lam=1 is the default system: same hash, same bytes, no system in the metadata."""
+    base = ["simulate", "--energy", "0.3", "-n", "40", "--workers", "1", "--quiet", "--t-max", "200"]
+    assert _cli(capsys, *base, "--out", str(tmp_path / "a"))[0] == 0
+    assert _cli(capsys, *base, "--system", "henon_heiles", "--param", "lam=1", "--out", str(tmp_path / "b"))[0] == 0
+    a, b = _meta(tmp_path / "a"), _meta(tmp_path / "b")
+    assert a["scene_hash"] == b["scene_hash"] and "system" not in b
+    pa = sorted((tmp_path / "a").glob("lifetimes/**/*.parquet"))[0]
+    pb = sorted((tmp_path / "b").glob("lifetimes/**/*.parquet"))[0]
+    assert pq.read_table(pa).equals(pq.read_table(pb))
+
+
+def test_quadratic_drag_is_recorded_in_the_metadata(tmp_path, capsys):
+    out = tmp_path / "q"
+    rc, _ = _cli(capsys, "simulate", "--energy", "0.3", "--gamma", "0.01", "-n", "20", "--workers", "1", "--quiet",
+                 "--dissipation", "quadratic", "--out", str(out))
+    assert rc == 0
+    m = _meta(out)
+    assert m["scene"]["system"]["dissipation"] == "quadratic"
+    assert m["system"] == {"system": "henon_heiles", "potential": "0.5*omega**2*(x**2 + y**2) + lam*(x**2*y - y**3/3)",
+                           "params": {"omega": 1.0, "lam": 1.0}, "dissipation": "quadratic"}
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--param", "eps"], "param: expected NAME=VALUE, got 'eps'"),
+    (["--param", "eps=big"], "argument --param: not a number: 'big'"),
+    (["--dissipation", "cubic"], "invalid choice: 'cubic'"),
+])
+def test_malformed_system_flags_exit_2(tmp_path, capsys, flags, message):
+    out = tmp_path / "o"
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "--energy", "0.3", "-n", "10", *flags, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and message in err and "Traceback" not in err, err
+    assert not out.exists()
+
+
+def test_unknown_parameter_of_a_built_in_exits_2_before_any_work(tmp_path, capsys):
+    out = tmp_path / "o"
+    rc, err = _cli(capsys, "simulate", "--energy", "0.3", "-n", "10", "--system", "henon_heiles", "--param", "mu=2",
+                   "--out", str(out))
+    assert rc == 2 and "henon_heiles has parameters ['lam', 'omega'], got ['mu']" in err, err
+    assert not out.exists()
