@@ -33,6 +33,9 @@ until the epoch ends. An orbit's time is its epoch count times P plus the
 lane time, and its steps are cut only at multiples of P of its own time, so
 results do not depend on chunking, lanes or batch size either.
 
+Dissipative escapes end at the system's no-return radius R(E0) rather than r_far (:func:`_no_return`: the
+same tables, bit for bit, in fewer steps).
+
 Everything else is the same in both: the events and outcome rules of
 :mod:`hhscatter.integrate.events`, whose roots end heyoka's step exactly (terminal
 events with callbacks), so event states and times are the integrator's own.
