@@ -14,8 +14,9 @@ if TYPE_CHECKING:  # annotations only
 from hhscatter.data.schema import META_KEY
 
 
-def write_part(path, table, meta: dict, store=None) -> None:
-    """write_part(path, table, meta, store=None) -> None: write ``table`` with metadata ``meta`` atomically.
+def write_part(path, table, meta: dict, store=None, *, sync_dir: bool = True) -> None:
+    """write_part(path, table, meta, store=None, sync_dir=True) -> None: write ``table`` with metadata ``meta``
+    atomically (``sync_dir``: :meth:`hhscatter.data.store.Store.write_atomic`'s).
 
     ``path`` is a local path, or, with ``store`` (a :class:`hhscatter.data.store.Store`),
     a path relative to the store's root. The file is written to a temporary
@@ -44,7 +45,7 @@ def write_part(path, table, meta: dict, store=None) -> None:
         else:
             pq.write_table(table, target, filesystem=filesystem, **opts)
 
-    store.write_atomic(rel, write)
+    store.write_atomic(rel, write, sync_dir=sync_dir)
 
 
 def dictionary_columns(schema) -> list:

@@ -539,7 +539,8 @@ class _Stream(_BatchRules):
             last_out[lane] = None
             if progress is not None:
                 self.tick()
-            cols[lane][:] = ics[k]
+            c = cols[lane]
+            c[0], c[1], c[2], c[3] = ics[k]  # four scalar writes: half the cost of converting the list
             if clock is not None:
                 st[clock, lane] = sigma0
                 clock_i[lane] = 0
