@@ -890,8 +890,9 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
         # when earlier orbits ended: the chunk runs again under the scene's own rule, and so do its later chunks
         _OWN_FAR.append(orig)
         del _OWN_FAR[:-_FREE_KEYS]
+        # (no progress: the first pass has told these orbits already)
         return run_chunk(orig.replace(r_far=events.far_radius(orig)), ics, traj_ids, batch_size=batch_size,
-                         count_steps=count_steps, progress=progress)
+                         count_steps=count_steps)
 
     model = scene.model
     end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
@@ -921,7 +922,7 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
         old = orig.replace(r_far=events.far_radius(orig))
         res = _merge_rerun(res, rerun, traj_ids, run_chunk(old, ics[rerun], traj_ids[rerun], batch_size=batch_size,
-                                                           count_steps=count_steps, progress=progress))
+                                                           count_steps=count_steps))
     return res
 
 

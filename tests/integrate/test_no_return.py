@@ -71,3 +71,11 @@ def test_stream_chunks_with_censored_orbits_keep_the_scene_rule(sections):
     assert sc in engine._OWN_FAR
     _, t_own = _tables(sc.replace(r_far=10.0), ics)
     _assert_same(t_fast, t_own)
+
+
+def test_a_chunk_run_again_reports_its_orbits_once():
+    sc = Scene(energy=0.3, gamma=0.01, n=1500, seed=74, r_esc=1.03, t_max=40.0)
+    ticks = []
+    res = run_chunk(sc, region_ics(sc, 0, sc.n), np.arange(sc.n), progress=ticks.append)
+    assert (res.lifetimes["outcome"] == CENSORED).any() and sc in engine._OWN_FAR
+    assert sum(ticks) == engine.PROGRESS_EVERY  # one report per 1024 orbits started, the rerun adds none
