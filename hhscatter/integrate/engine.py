@@ -73,7 +73,7 @@ CROSSING_COLUMNS = ("traj_id", "t", "radius", "direction")
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 RERUN = -2  # outcome code inside a chunk: decided at the no-return radius too close to t_max; rerun to r_far
-NO_RETURN_GRID = 1.0 / 16.0  # the no-return far radius is rounded up to this fraction of r_s (fewer compiles)
+NO_RETURN_GRID = 1.0 / 8.0  # the no-return far radius is rounded up to this fraction of r_s (fewer compiles)
 NO_RETURN_MARGIN = 0.01  # ... and lies at least this fraction beyond r_esc (its root is never r_esc's)
 
 
@@ -937,7 +937,7 @@ def _no_return(scene, ics, kind):
     no-return radius R(E) (:meth:`hhscatter.model.base.System.no_return_radius`) proves that earlier: an
     orbit of energy ≤ E at r ≥ R with ṙ > 0 never returns, under either drag law. With E the largest
     initial energy of the chunk (the energy only falls), the far event moves to max(R(E), (1 + 1 %) r_esc),
-    rounded up to r_s/16 (so that chunks share one compiled integrator); the outcome, t_end and end state are
+    rounded up to r_s/8 (so that chunks share one compiled integrator); the outcome, t_end and end state are
     the same at either radius, and no recorded row lies after t_end.
 
     The one thing r_far still decides: an orbit that has not reached r_far by t_max is censored there.
