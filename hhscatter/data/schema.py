@@ -91,6 +91,7 @@ META_KEY = b"hhscatter"
 TABLES = ("lifetimes", "sections", "snapshots", "crossings")
 
 
+@functools.lru_cache(maxsize=1)
 def _schemas():
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
@@ -161,16 +162,43 @@ def to_arrow(name: str, columns: dict):
         col = columns[field.name]
         if name == "lifetimes" and field.name == "outcome":
             codes = np.asarray(col, dtype=np.int8)
-            arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, pa.int8()), pa.array(OUTCOMES)))
+            arrays.append(pa.DictionaryArray.from_buffers(field.type, len(codes), [None, pa.py_buffer(codes)],
+                                                          _outcome_names()))
         elif name == "lifetimes" and field.name == "exit_channel":
             ch = np.asarray(col, dtype=np.int8)
-            arrays.append(pa.array(ch, pa.int8(), mask=ch < 0))
+            arrays.append(_arrow(ch, pa.int8(), mask=ch < 0))
         else:
             arr = np.asarray(col)
             if arr.dtype.kind == "f" and not np.isfinite(arr).all():
                 raise FloatingPointError(f"{name}.{field.name}: non-finite values must never reach a table")
-            arrays.append(pa.array(arr, field.type))
+            arrays.append(_arrow(arr, field.type))
     return pa.Table.from_arrays(arrays, schema=schema)
+
+
+@functools.lru_cache(maxsize=1)
+def _outcome_names():
+    """The outcome column's dictionary (``OUTCOMES``) as an Arrow string array, from its buffers (see :func:`_arrow`)."""
+    import pyarrow as pa  # deferred: pyarrow loads on first use
+
+    enc = [o.encode() for o in OUTCOMES]
+    offsets = np.concatenate([[0], np.cumsum([len(e) for e in enc])]).astype(np.int32)
+    return pa.Array.from_buffers(pa.string(), len(enc), [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(enc))])
+
+
+_NUMPY_OF = {"double": np.float64, "int64": np.int64, "int8": np.int8}  # the Arrow types of the fixed schemas
+
+
+def _arrow(arr, typ, mask=None):
+    """_arrow(arr, typ, mask=None) -> the Arrow array ``pa.array(arr, typ, mask=mask)`` made from the numpy
+    buffer itself: the same values, validity and buffers (masked slots keep their values, as in pa.array), without ``pa.array``'s check for pandas objects,
+    which imports pandas (~0.5 s of every ``simulate`` process, issue 27)."""
+    import pyarrow as pa  # deferred: pyarrow loads on first use
+
+    a = np.ascontiguousarray(arr, dtype=_NUMPY_OF[str(typ)])
+    validity, nulls = None, 0
+    if mask is not None and mask.any():
+        validity, nulls = pa.py_buffer(np.packbits(~mask, bitorder="little")), int(mask.sum())
+    return pa.Array.from_buffers(typ, len(a), [validity, pa.py_buffer(a)], null_count=nulls)
 
 
 def part_name(chunk: int) -> str:

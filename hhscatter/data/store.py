@@ -7,7 +7,8 @@ readers use one set of operations:
 * a local path (``runs/x``, ``/data/x`` or ``file:///data/x``) is written with
   plain ``os`` calls, each file to a temporary name, fsync'ed and renamed, and
   the directory fsync'ed after the rename, so a crash (even a power cut) never
-  leaves a half-written file under a final name;
+  leaves a half-written file under a final name (part files skip the directory
+  fsync: a rename a power cut undoes only makes resume redo that chunk);
 * a URL (``s3://bucket/x``, ``gs://…``, ``hdfs://…``, ``memory://x`` or any
   other protocol fsspec knows) goes through ``pyarrow.fs``: pyarrow's own
   filesystems first, fsspec's (wrapped in ``pyarrow.fs.FSSpecHandler``) for the
@@ -189,12 +190,17 @@ class Store:
         elif self.exists(rel):
             self._fs.delete_file(self.path(rel))
 
-    def write_atomic(self, rel: str, write) -> None:
-        """write_atomic(rel, write) -> None: ``write(target, filesystem)`` writes a temp file, then rename.
+    def write_atomic(self, rel: str, write, *, sync_dir: bool = True) -> None:
+        """write_atomic(rel, write, sync_dir=True) -> None: ``write(target, filesystem)`` writes a temp file,
+        then rename.
 
         ``target`` is a path (local) or a path on ``filesystem``. On any
         failure the temporary file is removed and the error propagates; a
         previous file under the final name is never touched until the rename.
+        ``sync_dir=False`` (local): the file is fsync'ed before its rename as always (a file under its final
+        name is complete), but the directory is not fsync'ed after it, so a power cut may undo the rename:
+        for files whose absence is redone on resume (part files: a chunk is complete only when all its parts
+        are there), this saves the directory fsync (5-8 ms per part measured, as much as writing it).
         """
         final = self.path(rel)
         head, name = (os.path.split(final) if self.local else posixpath.split(final))
@@ -206,7 +212,8 @@ class Store:
                 with open(tmp, "rb") as fh:
                     os.fsync(fh.fileno())
                 os.replace(tmp, final)
-                _fsync_dir(head)
+                if sync_dir:
+                    _fsync_dir(head)
             else:
                 self._fs.move(tmp, final)
         except BaseException:

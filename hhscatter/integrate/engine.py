@@ -33,6 +33,9 @@ until the epoch ends. An orbit's time is its epoch count times P plus the
 lane time, and its steps are cut only at multiples of P of its own time, so
 results do not depend on chunking, lanes or batch size either.
 
+Dissipative escapes end at the system's no-return radius R(E0) rather than r_far (:func:`_no_return`: the
+same tables, bit for bit, in fewer steps).
+
 Everything else is the same in both: the events and outcome rules of
 :mod:`hhscatter.integrate.events`, whose roots end heyoka's step exactly (terminal
 events with callbacks), so event states and times are the integrator's own.
@@ -69,6 +72,9 @@ SECTION_COLUMNS = ("traj_id", "t", "x", "y", "px", "py", "energy")
 CROSSING_COLUMNS = ("traj_id", "t", "radius", "direction")
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
+RERUN = -2  # outcome code inside a chunk: decided at the no-return radius too close to t_max; rerun to r_far
+NO_RETURN_GRID = 1.0 / 8.0  # the no-return far radius is rounded up to this fraction of r_s (fewer compiles)
+NO_RETURN_MARGIN = 0.01  # ... and lies at least this fraction beyond r_esc (its root is never r_esc's)
 
 
 @dataclass
@@ -188,6 +194,10 @@ class LaneRules(abc.ABC):
 
         Returns what the event callback returns (False stops the propagation).
         """
+    #: None, or f(t, state) -> True when an orbit at the no-return far radius might not have reached the
+    #: scene's r_far by t_max (run_chunk's no-return rule: the orbit is then rerun to r_far)
+    late = None
+
     def handler(self, spec):
         """handler(spec) -> the callable (lane, direction) -> continue? of the event ``spec``'s rule."""
         rules = {"escape": self.on_escape, "closure": self.on_closure, "far": self.on_far, "resc": self.on_resc,
@@ -281,6 +291,8 @@ class LaneRules(abc.ABC):
         if self.phase[lane] == LIVE:
             if self.last_out[lane] is None:  # unreachable: r_far > r_esc; kept as a guard
                 raise RuntimeError("orbit reached r_far without crossing r_esc")
+            if self.late is not None and self.late(self.elapsed(lane), self.state4(lane)):
+                return self.end(lane, RERUN, *self.last_out[lane])
             return self.end(lane, ESCAPED, *self.last_out[lane])
         return self.release(lane)  # a followed orbit is gone
 
@@ -457,12 +469,16 @@ class _Stream(_BatchRules):
             out = last_out[lane]
             return finish(lane, ESCAPED, *out) if out is not None else True
 
+        late = self.late
+
         def on_far(lane, d):
             if orbit[lane] < 0:
                 return True
             out = last_out[lane]
             if out is None:  # unreachable: r_far > r_esc; kept as a guard
                 raise RuntimeError("orbit reached r_far without crossing r_esc")
+            if late is not None and late(elapsed(lane), cols[lane].tolist()):
+                return finish(lane, RERUN, *out)
             return finish(lane, ESCAPED, *out)
 
         def load(lane, k=None):
@@ -518,7 +534,8 @@ class _Stream(_BatchRules):
             last_out[lane] = None
             if progress is not None:
                 self.tick()
-            cols[lane][:] = ics[k]
+            c = cols[lane]
+            c[0], c[1], c[2], c[3] = ics[k]  # four scalar writes: half the cost of converting the list
             if clock is not None:
                 st[clock, lane] = sigma0
                 clock_i[lane] = 0
@@ -832,12 +849,14 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
+    orig, (scene, late) = scene, _no_return(scene, ics, kind)  # the integration's scene: maybe an earlier far event
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
         lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, layout, ics)
         lanes.count_steps = count_steps
         lanes.progress = progress
         lanes.migrate_at_open = phases
+        lanes.late = late
         # the inlined handlers serve stream scenes with no section event in this integrator and no follow
         use_inlined = kind == "stream" and scene.follow is None and (scene.sections is None or phases)
         inlined = lanes.inlined_handlers() if use_inlined else {}
@@ -851,6 +870,7 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
         with _batch_integrator(scene, B) as (ta2, specs2, _):
             second = _SecondPhase(scene, ta2, layout, lanes)
+            second.late = late
             _bind(ta2, specs2, second)
             try:
                 r2, s2, x2, _ = second.run()
@@ -858,8 +878,16 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
                 second.ta = second.state = second.cols = second.pars = second.time_hi = second.time_lo = None
         n_returns, n_steps, n_restarts = n_returns + r2, n_steps + s2, n_restarts + x2
     outcome = np.array(lanes.outcome, dtype=np.int8)
-    if (outcome < 0).any():
+    if (outcome == -1).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
+    if late is not None and kind == "stream" and ((outcome == RERUN) | (outcome == CENSORED)).any():
+        # a stream lane's censored state depends on when its orbit started (the bound's rounding), hence on
+        # when earlier orbits ended: the chunk runs again under the scene's own rule, and so do its later chunks
+        _OWN_FAR.append(orig)
+        del _OWN_FAR[:-_FREE_KEYS]
+        # (no progress: the first pass has told these orbits already)
+        return run_chunk(orig.replace(r_far=events.far_radius(orig)), ics, traj_ids, batch_size=batch_size,
+                         count_steps=count_steps)
 
     model = scene.model
     end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
@@ -883,8 +911,87 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     crossings["direction"] = crossings["direction"].astype(np.int8)
     order = np.lexsort((s_t, s_ids))
     snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
-    return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
-                       n_restarts=n_restarts)
+    res = ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
+                      n_restarts=n_restarts)
+    rerun = outcome == RERUN
+    if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
+        old = orig.replace(r_far=events.far_radius(orig))
+        res = _merge_rerun(res, rerun, traj_ids, run_chunk(old, ics[rerun], traj_ids[rerun], batch_size=batch_size,
+                                                           count_steps=count_steps))
+    return res
+
+
+_OWN_FAR = []  # stream scenes of this process whose chunks censor orbits: they keep their r_far (run_chunk)
+
+
+def _no_return(scene, ics, kind):
+    """_no_return(scene, ics, kind) -> (scene to integrate, late): the no-return rule of dissipative scenes.
+
+    An escaped dissipative orbit is decided at its last outward r_esc crossing (t_end, its state); the scene
+    follows it on to r_far = max(10 r_s, 2 r_esc) only to know that no crossing comes after. The system's
+    no-return radius R(E) (:meth:`hhscatter.model.base.System.no_return_radius`) proves that earlier: an
+    orbit of energy ≤ E at r ≥ R with ṙ > 0 never returns, under either drag law. With E the largest
+    initial energy of the chunk (the energy only falls), the far event moves to max(R(E), (1 + 1 %) r_esc),
+    rounded up to r_s/8 (so that chunks share one compiled integrator); the outcome, t_end and end state are
+    the same at either radius, and no recorded row lies after t_end.
+
+    The one thing r_far still decides: an orbit that has not reached r_far by t_max is censored there.
+    ``late(t, state)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
+    scene's own far event (exactly as before: tables byte-identical for the same scene hash). In the stream
+    scheduler (``kind``) the state of an orbit censored at its lane's bound depends on the lane's start time,
+    i.e. on when the orbits before it ended: a stream chunk with a late or censored orbit runs again whole
+    under the scene's own rule, and the scene's later chunks in this process keep it (``_OWN_FAR``). The bound: beyond
+    R the radial force is outward, so with the linear drag ṗ_r ≥ −γ p_r, p_r(t) ≥ p_r e^{−γτ}, and r_far is
+    reached within τ = −ln(1 − γ(r_far − r)/p_r)/γ (taken with 1 % and 1e-6 of slack); an orbit for which
+    that is infinite or ends after t_max is late. Applies to linear drag with the default r_far (a scene with
+    an explicit ``r_far`` keeps it, so does quadratic drag, for which no such bound is written down).
+    """
+    m = scene.model
+    if (scene.gamma <= 0 or scene.r_far is not None or m.dissipation != "linear" or not len(ics)
+            or (kind == "stream" and scene in _OWN_FAR)):
+        return scene, None
+    r_far = events.far_radius(scene)
+    e0 = float(np.max(m.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3])))
+    grid = NO_RETURN_GRID * m.saddle_radius
+    R = max(m.no_return_radius(e0 + 1e-12 * abs(e0)) * (1.0 + 1e-9), float(scene.r_esc) * (1.0 + NO_RETURN_MARGIN))
+    R = math.ceil(R / grid) * grid
+    if R >= r_far:
+        return scene, None
+    gamma, t_max = float(scene.gamma), float(scene.t_max)
+
+    def late(t, state):
+        x, y, px, py = state
+        r = math.sqrt(x * x + y * y)
+        pr = (x * px + y * py) / r
+        a = gamma * (r_far - r)
+        if not pr > 0.0 or a >= 0.999 * pr:
+            return True
+        return t + 1.01 * (-math.log1p(-a / pr) / gamma) + 1e-9 * t_max + 1e-6 >= t_max
+
+    return scene.replace(r_far=R), late
+
+
+def _merge_rerun(res, rerun, traj_ids, again):
+    """res with the orbits ``rerun`` (mask over the chunk) replaced by their rerun ``again``: lifetimes
+    entries overwritten, their rows of the other tables taken from ``again``, rows kept in (orbit, t) order."""
+    for col, v in res.lifetimes.items():
+        v[rerun] = again.lifetimes[col]
+    srt = np.argsort(traj_ids, kind="stable")
+    sorted_ids = traj_ids[srt]
+
+    def local(ids):  # traj_id -> position in the chunk
+        return srt[np.searchsorted(sorted_ids, ids)]
+
+    tables = {}
+    for name in ("sections", "snapshots", "crossings"):
+        a, b = getattr(res, name), getattr(again, name)
+        keep = ~rerun[local(a["traj_id"])]
+        cols = {c: np.concatenate([a[c][keep], b[c].astype(a[c].dtype)]) for c in a}
+        order = np.lexsort((cols["t"], local(cols["traj_id"])))
+        tables[name] = {c: v[order] for c, v in cols.items()}
+    return ChunkResult(res.lifetimes, tables["sections"], tables["snapshots"], tables["crossings"],
+                       n_returns=res.n_returns + again.n_returns, n_steps=res.n_steps + again.n_steps,
+                       n_restarts=res.n_restarts + again.n_restarts)
 
 
 def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress):

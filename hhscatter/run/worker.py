@@ -71,7 +71,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
             table = add_point_columns(name, table, scene)
         rel = part_rel(name, partition, chunk)
         try:
-            write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store)
+            # no directory fsync per part: a rename a power cut undoes only makes resume redo the chunk
+            write_part(rel, table, {**meta, "table": name, "rows": table.num_rows}, store=store, sync_dir=False)
         except OSError as exc:
             raise OSError(exc.errno, f"cannot write {store.display(rel)}: {exc.strerror or exc}") from None
     oc = np.bincount(res.lifetimes["outcome"], minlength=4)
