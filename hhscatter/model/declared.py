@@ -1,0 +1,239 @@
+"""A system declared as data: V(x, y) as text (or a sympy/heyoka expression), its parameters and the drag law.
+
+:class:`DeclaredSystem` implements the :class:`~hhscatter.model.base.System` contract from the expression
+alone: the expression is parsed safely (:mod:`hhscatter.model.parse`), E_c, the exits and Ω are derived at
+construction (:mod:`hhscatter.model.derive`; each can be given instead), R(E) on demand. The heyoka
+expressions of V and of the force −∇V are built by walking the sympy expressions (the force from the
+expanded gradient, so a declared Hénon–Heiles costs as many operations per Taylor step as the built-in).
+"""
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from hhscatter.errors import ConfigError
+from hhscatter.model.base import DISSIPATIONS, Exit, System
+from hhscatter.model.derive import Derivation, Landscape, _given_exits, check_well, derive, no_return_radius
+from hhscatter.model.parse import check_params, parse_potential, substitute, symbols, to_heyoka
+
+if TYPE_CHECKING:  # annotations only
+    from numpy.typing import ArrayLike
+
+    from hhscatter.model.derive import CriticalPoint
+
+#: the keys that override a derived quantity (a scene file's [system] table may give them)
+OVERRIDES = ("critical_energy", "exits", "omega_radius")
+
+
+class DeclaredSystem(System):
+    """A system given by its potential V(x, y) and drag law; E_c, exits, Ω and R(E) derived (module docstring).
+
+    Immutable; equal (and hashed alike) when name, potential text, parameters, dissipation and overrides are.
+
+    Parameters
+    ----------
+    potential : str, sympy.Expr or heyoka.expression
+        V in x, y and the parameters' names, e.g. ``"0.5*(x**2 + y**2) - eps*x**2*y**2"``; V's well minimum
+        must sit at the origin with V(0, 0) = 0 (energy).
+    params : mapping of str to float, optional
+        The parameters' values: each used in V, each used one given.
+    dissipation : {'linear', 'quadratic'}
+        The drag law for γ > 0: −γp (default) or −γ|p|p.
+    name : str
+        ``"declared"``, or the built-in's name when a built-in constructs it.
+    critical_energy : float, optional
+        E_c, when the derivation cannot decide (energy).
+    exits : sequence of [x, y] or [x, y, energy], optional
+        The exits' saddles, when the derivation cannot decide (energy V(x, y) when left out).
+    omega_radius : float, optional
+        Ω's radius, when the derivation cannot decide (length).
+    builtin_params : mapping of str to float, optional
+        The built-in's own parameters when they are not the potential's (n of ``n_exit``), for the provenance.
+
+    Raises
+    ------
+    ConfigError
+        Bad potential or parameters (:func:`~hhscatter.model.parse.parse_potential`), the well not at the
+        origin, a quantity that cannot be derived (the message names the key to give), an unknown
+        dissipation law.
+
+    Examples
+    --------
+    >>> s = DeclaredSystem("0.5*(x**2 + y**2) - eps*x**2*y**2", {"eps": 0.25})
+    >>> s.critical_energy, len(s.exits), s.omega_radius
+    (1.0, 4, 2.0)
+    >>> round(s.scalar_energy()(0.5, 0.0, 0.0, 1.0), 12)
+    0.625
+    """
+
+    def __init__(self, potential: Any, params: Mapping[str, float] | None = None, dissipation: str = "linear", *,
+                 name: str = "declared", critical_energy: float | None = None, exits: Sequence | None = None,
+                 omega_radius: float | None = None, builtin_params: Mapping[str, float] | None = None):
+        if dissipation not in DISSIPATIONS:
+            raise ConfigError(f"dissipation must be one of {DISSIPATIONS}, got {dissipation!r}")
+        values = check_params(params)
+        expr = parse_potential(potential, values)
+        set_ = object.__setattr__
+        set_(self, "_name", str(name))
+        set_(self, "_params", values)
+        set_(self, "dissipation", dissipation)
+        set_(self, "_text", potential.strip() if isinstance(potential, str) else str(expr))
+        set_(self, "_expr", expr)
+        set_(self, "_numeric", substitute(expr, values))
+        set_(self, "_overrides", {k: v for k, v in (("critical_energy", critical_energy), ("exits", exits),
+                                                     ("omega_radius", omega_radius)) if v is not None})
+        set_(self, "_builtin_params", dict(builtin_params) if builtin_params is not None else None)
+        set_(self, "_derivation", derive(self._numeric, critical_energy=critical_energy, exits=exits,
+                                         omega_radius=omega_radius))
+        set_(self, "_cache", {})
+
+    # -- immutability, equality, pickling --------------------------------------------------------------------
+    def __setattr__(self, key, value):
+        raise AttributeError(f"DeclaredSystem is immutable (cannot set {key!r})")
+
+    def __delattr__(self, key):
+        raise AttributeError(f"DeclaredSystem is immutable (cannot delete {key!r})")
+
+    def _key(self) -> str:
+        return json.dumps(self.provenance(), sort_keys=True, default=repr)
+
+    def __eq__(self, other):
+        return isinstance(other, DeclaredSystem) and self._key() == other._key()
+
+    def __hash__(self):
+        return hash(self._key())
+
+    def __repr__(self):
+        extra = "".join(f", {k}={v!r}" for k, v in self._overrides.items())
+        return (f"DeclaredSystem({self._text!r}, {self._params!r}, {self.dissipation!r}, name={self._name!r}"
+                f"{extra})")
+
+    def __reduce__(self):
+        # rebuilt from its text with the derived quantities given: no second derivation in a worker
+        d = self._derivation
+        state = {"critical_energy": d.critical_energy, "omega_radius": d.omega_radius,
+                 "exits": [(e.x, e.y, e.energy) for e in d.exits]}
+        return (_restore, (self._text, self._params, self.dissipation, self._name, self._overrides,
+                           self._builtin_params, state))
+
+    # -- identity ----------------------------------------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self._name
+
+    @property
+    def params(self) -> dict[str, float]:
+        return dict(self._params)
+
+    @property
+    def potential_text(self) -> str:
+        return self._text
+
+    @property
+    def expression(self):
+        """V as a sympy expression in x, y and the parameters' symbols."""
+        return self._expr
+
+    @property
+    def derivation(self) -> Derivation:
+        """What the derivation found (critical points, method, wall time)."""
+        return self._derivation
+
+    @property
+    def critical_points(self) -> tuple[CriticalPoint, ...]:
+        """The critical points of V found by the derivation (empty when the exits were given)."""
+        return self._derivation.critical_points
+
+    # -- derived quantities --------------------------------------------------------------------------------------
+    @property
+    def critical_energy(self) -> float:
+        return self._derivation.critical_energy
+
+    @property
+    def exits(self) -> tuple[Exit, ...]:
+        return self._derivation.exits
+
+    @property
+    def omega_radius(self) -> float:
+        return self._derivation.omega_radius
+
+    @property
+    def _landscape(self) -> Landscape:
+        if "land" not in self._cache:
+            self._cache["land"] = Landscape(self._numeric)
+        return self._cache["land"]
+
+    def no_return_radius(self, energy: float) -> float:
+        """R(E) ≥ the nearest saddle's distance, from :func:`hhscatter.model.derive.no_return_radius` (cached)."""
+        energy = float(energy)
+        key = ("nrr", energy)
+        if key not in self._cache:
+            scale = max(e.distance for e in self.exits)
+            self._cache[key] = max(no_return_radius(self._landscape, energy, scale), self.saddle_radius)
+        return self._cache[key]
+
+    # -- evaluations ------------------------------------------------------------------------------------------------
+    def potential(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
+        """V(x, y) on numpy arrays (energy)."""
+        return self._landscape.v(x, y)
+
+    def potential_expression(self, x, y):
+        """V as a heyoka expression of x, y (walked from the sympy expression, parameters as constants)."""
+        return to_heyoka(self._numeric, x, y)
+
+    def force_expressions(self, x, y):
+        """(F_x, F_y) = −∇V from the expanded sympy gradient (no redundant products per Taylor step)."""
+        import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+        land = self._landscape
+        return tuple(to_heyoka(sp.expand(-g), x, y) for g in land.grad)
+
+    def scalar_energy(self) -> Callable[[float, float, float, float], float]:
+        """A plain-float H(x, y, px, py) (V lambdified with the math module from the sympy expression)."""
+        if "scalar_v" not in self._cache:
+            import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+            self._cache["scalar_v"] = sp.lambdify(symbols(), self._numeric, "math")
+        v = self._cache["scalar_v"]
+
+        def energy(x, y, px, py):
+            return 0.5 * (px * px + py * py) + v(x, y)
+
+        return energy
+
+    def provenance(self) -> dict[str, Any]:
+        """Name, V as text, parameters, dissipation; the overrides and the built-in's parameters when given."""
+        out = super().provenance()
+        if self._builtin_params is not None:
+            out["builtin_params"] = dict(self._builtin_params)
+        for k, v in self._overrides.items():
+            out[k] = [list(map(float, e)) if not isinstance(e, Exit) else [e.x, e.y, e.energy] for e in v] \
+                if k == "exits" else float(v)
+        return out
+
+    def hash_items(self) -> dict[str, Any]:
+        """The provenance: every declared system enters the scene's hash."""
+        return self.provenance()
+
+
+def _restore(text, params, dissipation, name, overrides, builtin_params, state):
+    """Unpickle a DeclaredSystem without deriving again (the derived quantities are given)."""
+    self = DeclaredSystem.__new__(DeclaredSystem)
+    values = check_params(params)
+    expr = parse_potential(text, values)
+    numeric = substitute(expr, values)
+    land = Landscape(numeric)
+    check_well(land, [])
+    derivation = Derivation((), _given_exits(land, state["exits"]), state["critical_energy"], state["omega_radius"],
+                            "given", 0.0)
+    for key, value in (("_name", name), ("_params", values), ("dissipation", dissipation), ("_text", text),
+                       ("_expr", expr), ("_numeric", numeric), ("_overrides", dict(overrides)),
+                       ("_builtin_params", builtin_params), ("_derivation", derivation),
+                       ("_cache", {"land": land})):
+        object.__setattr__(self, key, value)
+    return self
+
+
+__all__ = ["DeclaredSystem", "OVERRIDES"]
