@@ -5,7 +5,7 @@ directions); the engine's escape is their first outward crossing of r = R. At t 
 is Φ/Ω_E (hhscatter.analysis.geometry.flux, derived there), for every potential (conservative scenes: with drag
 the engine's escape is the last outward crossing, decided later). The
 density is estimated from the escape times in [0, τ] by a weighted linear fit of the binned density (its
-intercept at t = 0, with its standard error), and must agree within 3σ and 6 %.
+intercept at t = 0, with its standard error < 4 % of the rate), and must agree within 3σ (seed fixed).
 """
 import numpy as np
 import pytest
@@ -16,7 +16,7 @@ from hhscatter.scene.ics import region_ics
 from hhscatter.model.spec import system_from_spec
 from hhscatter.scene.scene import Scene
 
-N = 60_000
+N = 150_000
 TAU, BINS = 0.3, 12
 
 #: (system spec, E/E_c, R/r_s)
@@ -57,4 +57,5 @@ def test_initial_escape_rate_is_flux_over_shell_volume(system, ratio, r_ratio):
     t_esc = lt["t_end"][esc & (lt["t_end"] > 0)]  # orbits placed exactly on r = R (none here) would escape at 0
     k_hat, k_err = _intercept(t_esc, N)
     ref = initial_escape_rate(scene.model, energy, R)
-    assert abs(k_hat - ref.rate) < 3 * k_err and abs(k_hat / ref.rate - 1) < 0.06, (k_hat, k_err, ref)
+    assert k_err < 0.04 * ref.rate  # the test can tell a 12 % error at 3σ
+    assert abs(k_hat - ref.rate) < 3 * k_err, (k_hat, k_err, ref)
