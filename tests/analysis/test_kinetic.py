@@ -1,0 +1,68 @@
+"""μ predicted from the mean kinetic energy (hhscatter.analysis.dissipative.kinetic): closed forms."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hhscatter.analysis.dissipative.kinetic import (
+    decay_path,
+    kinetic_fraction_from_energies,
+    microcanonical_kinetic_fraction,
+)
+
+
+@pytest.mark.parametrize("k", [2, 4, 6])
+def test_microcanonical_fraction_is_the_virial_value_for_homogeneous_wells(k):
+    """V = r^k/k: 2⟨K⟩ = k⟨V⟩ (virial) so 2⟨K⟩/E = 2k/(k + 2): 1 for the harmonic well, 4/3 for r⁴."""
+    f = microcanonical_kinetic_fraction(lambda x, y: (x * x + y * y) ** (k / 2) / k, 0.3, 1.5, n_grid=1201)
+    assert f == pytest.approx(2 * k / (k + 2), abs=2e-3)
+
+
+def test_microcanonical_fraction_refuses_a_region_beyond_the_grid():
+    with pytest.raises(ValueError, match="edge"):
+        microcanonical_kinetic_fraction(lambda x, y: 0.5 * (x * x + y * y), 0.3, 0.5)
+
+
+def test_kinetic_fraction_recovers_known_kinetic_energies_and_weights_by_time():
+    """Orbits with constant K_i lose E at 2γK_i: the estimate is the time-weighted mean of 2K_i/E0."""
+    rng = np.random.default_rng(1)
+    g, E0 = 1e-6, 0.3
+    ids, ts, es, num, den = [], [], [], 0.0, 0.0
+    for i in range(200):
+        K = rng.uniform(0.05, 0.25)
+        life = rng.uniform(3, 40)
+        t = np.arange(0.0, np.floor(life) + 1)
+        ids.append(np.full(t.size, i))
+        ts.append(t)
+        es.append(E0 - 2 * g * K * t)
+        span = min(t[-1], 30.0) - 5.0
+        if span > 0:
+            num += 2 * K / E0 * span
+            den += span
+    r = kinetic_fraction_from_energies(np.concatenate(ids), np.concatenate(ts), np.concatenate(es), g, 5.0, 30.0,
+                                       n_boot=100, rng=2)
+    assert r.value == pytest.approx(num / den, rel=2e-4)  # E_k vs E0 in the denominator: O(γ K t/E)
+    assert 0 < r.err < 0.05
+
+
+def test_kinetic_fraction_bootstrap_error_matches_the_scatter_of_independent_ensembles():
+    g, E0 = 1e-6, 0.3
+    vals, errs = [], []
+    for s in range(30):
+        rng = np.random.default_rng(100 + s)
+        K = rng.uniform(0.05, 0.25, 100)
+        t = np.arange(0.0, 11.0)
+        ids = np.repeat(np.arange(100), t.size)
+        E = E0 - 2 * g * K[ids] * np.tile(t, 100)
+        r = kinetic_fraction_from_energies(ids, np.tile(t, 100), E, g, 0.0, 10.0, n_boot=200, rng=s)
+        vals.append(r.value)
+        errs.append(r.err)
+    assert 0.7 < np.mean(errs) / np.std(vals, ddof=1) < 1.4
+
+
+def test_decay_path_is_the_exponential_law_for_constant_mu_and_slower_for_smaller_mu_at_low_energy():
+    t = np.linspace(0, 200, 101)
+    np.testing.assert_allclose(decay_path(t, 0.3, 0.01, lambda E: 0.93 + 0 * E), 0.3 * np.exp(-0.0093 * t),
+                               rtol=1e-8)
+    slow = decay_path(t, 0.3, 0.01, lambda E: np.where(E < 0.2, 0.5, 0.93))
+    assert np.all(slow >= 0.3 * np.exp(-0.0093 * t) * (1 - 1e-9)) and slow[-1] > 1.2 * 0.3 * np.exp(-1.86)
