@@ -61,12 +61,15 @@ def _panel_mu_of_E(ax, mu, numbers):
 def _panel_mu(ax, numbers, paper_mu):
     lo, hi = 0.8, 1.1
     for name, info in numbers["systems"].items():
-        m, p = info["mu_measured"], info["mu_predicted"]
-        if m["value"] is None or p["value"] is None:
-            continue
-        ax.errorbar(p["value"], m["value"], xerr=p["err"], yerr=m["err"], fmt=MARKERS.get(name, "o"),
-                    color=COLORS.get(name, "k"), ms=6, capsize=3, label=name)
-        lo, hi = min(lo, m["value"] - 0.03, p["value"] - 0.03), max(hi, m["value"] + 0.03, p["value"] + 0.03)
+        for wname, bw in info["mu_by_window"].items():
+            m, p = bw["measured"], bw["predicted_c_measure"]
+            if m["value"] is None or p["value"] is None:
+                continue
+            w = bw["window"]
+            ax.errorbar(p["value"], m["value"], xerr=p["err"], yerr=m["err"], fmt=MARKERS.get(name, "o"),
+                        color=COLORS.get(name, "k"), ms=6, capsize=3, mfc=None if wname == "paper" else "none",
+                        label=f"{name}, t ∈ [{w[0]:g}, {w[1]:g}]")
+            lo, hi = min(lo, m["value"] - 0.03, p["value"] - 0.03), max(hi, m["value"] + 0.03, p["value"] + 0.03)
     ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
     ax.axhline(paper_mu, color="0.5", ls=":", lw=0.8)
     ax.text(lo + 0.005, paper_mu + 0.004, "paper HH μ = 0.91", fontsize=7, color="0.4")
@@ -74,7 +77,8 @@ def _panel_mu(ax, numbers, paper_mu):
     ax.set_ylim(lo, hi)
     ax.set_xlabel("μ predicted (conservative ⟨K⟩)")
     ax.set_ylabel("μ measured (⟨E⟩(t) fit)")
-    ax.set_title("(c) μ measured vs predicted", fontsize=9)
+    ax.set_title("(c) μ measured vs predicted (c-measure above E_c, microcanonical well below)\n"
+                 "filled: fig3's window [0, 200]; open: ⟨E⟩ > E_c window", fontsize=9)
     ax.legend(fontsize=7)
 
 

@@ -321,8 +321,9 @@ def _mu_of_E(mu_rows: pd.DataFrame, ec: float, shift: float = 0.0, kind: str = "
     return lambda E: np.interp(np.asarray(E) / ec, r, v)
 
 
-def _mu_measured(study, label, m, E0, n):
-    """fig3's μ: ⟨E⟩(t) of the orbits not escaped (settled continued), log fit on mu_window; bootstrap error."""
+def _mu_measured(study, label, m, E0):
+    """fig3's μ: ⟨E⟩(t) of the orbits not escaped (settled continued), log fit on each window of
+    :func:`_mu_windows`; bootstrap error over orbits. Returns ({name: (μ, σ)}, ⟨E⟩ table)."""
     from hhscatter.analysis.dissipative.decay import (
         bootstrap_mu,
         fit_energy_decay,
@@ -333,12 +334,61 @@ def _mu_measured(study, label, m, E0, n):
     p = study.params
     raw = study.raw(diss_key(label, p.mu_gamma))
     ime = inside_mean_energy(iter_parts(raw, "snapshots", ["t", "energy"]), m.critical_energy)
-    win = tuple(p.mu_window)
-    fit = fit_energy_decay(ime.inside["t"], ime.inside["mean_E"], E0, p.mu_gamma, win)
+    wins = _mu_windows(study)
     rows = read_snapshots(raw, columns=["traj_id", "t", "energy"])
-    b = bootstrap_mu(rows["traj_id"], rows["t"], rows["energy"], E0, p.mu_gamma, [win], n_boot=p.n_boot,
-                     seed=p.fit_seed)
-    return fit.mu, float(b["mu"].std(ddof=1)), ime.inside
+    b = bootstrap_mu(rows["traj_id"], rows["t"], rows["energy"], E0, p.mu_gamma, list(wins.values()),
+                     n_boot=p.n_boot, seed=p.fit_seed)
+    out = {}
+    for name, w in wins.items():
+        mu = fit_energy_decay(ime.inside["t"], ime.inside["mean_E"], E0, p.mu_gamma, w).mu
+        bw = b[(b["t_lo"] == w[0]) & (b["t_hi"] == w[1])]
+        out[name] = (mu, float(bw["mu"].std(ddof=1)))
+    return out, ime.inside, _mu_own(rows, E0, p.mu_gamma, wins)
+
+
+def _own_path_mu(rows, E0, gamma, wins):
+    """{window: μ} of the path d ln E/dt = −γ μ_K(t), μ_K the survivors' own 2⟨K⟩/⟨E⟩ (kinetic_fraction_by_time)."""
+    from hhscatter.analysis.dissipative.decay import fit_energy_decay
+    from hhscatter.analysis.dissipative.kinetic import kinetic_fraction_by_time
+
+    d = kinetic_fraction_by_time(rows["traj_id"], rows["t"], rows["energy"], gamma).dropna()
+    t = np.concatenate([[d["t_lo"].iloc[0]], d["t_hi"].to_numpy()])
+    path = E0 * np.exp(-gamma * np.concatenate([[0.0], np.cumsum(d["mu_K"] * (d["t_hi"] - d["t_lo"]))]))
+    return {name: fit_energy_decay(t, path, E0, gamma, w).mu for name, w in wins.items()}, (t, path)
+
+
+def _mu_own(rows, E0, gamma, wins, groups: int = 10):
+    """({window: (μ, σ)}, (t, path)): μ of the survivors' own ⟨K⟩ path; σ from ``groups`` disjoint groups of orbits
+    (traj_id mod groups: σ = sd/√groups), orbits being the independent unit."""
+    full, path = _own_path_mu(rows, E0, gamma, wins)
+    parts = [_own_path_mu(rows[rows["traj_id"] % groups == k], E0, gamma, wins)[0] for k in range(groups)]
+    return {name: (v, float(np.std([q[name] for q in parts], ddof=1) / math.sqrt(groups)))
+            for name, v in full.items()}, path
+
+
+def _mu_windows(study) -> dict:
+    """{'paper': mu_window (fig3's [0, 200]), 'above': [0, τ2] with τ2 = ln(e0_ratio)/(paper_mu γ) (⟨E⟩ > E_c)}."""
+    p = study.params
+    t2 = math.log(p.e0_ratio) / (p.paper_mu * p.mu_gamma)
+    return {"paper": tuple(p.mu_window), "above": (0.0, float(math.floor(t2)))}
+
+
+def _mu_predicted(study, mdf, ec, E0):
+    """{(kind, window name): (μ, σ)} of the path dE/dt = −γ μ(E) E fitted like the measured ⟨E⟩(t); σ from the
+    probe errors (all shifted by ±1σ); and the path of the c-measure kind."""
+    from hhscatter.analysis.dissipative.decay import fit_energy_decay, snapshot_grid
+    from hhscatter.analysis.dissipative.kinetic import decay_path
+
+    p = study.params
+    grid = snapshot_grid(p.snapshot_grid)
+    out, paths = {}, {}
+    for kind in ("c-measure", "all survivors"):
+        for shift in (0.0, 1.0, -1.0):
+            paths[kind, shift] = decay_path(grid, E0, p.mu_gamma, _mu_of_E(mdf, ec, shift, kind))
+        for name, w in _mu_windows(study).items():
+            v = {sh: fit_energy_decay(grid, paths[kind, sh], E0, p.mu_gamma, w).mu for sh in (0.0, 1.0, -1.0)}
+            out[kind, name] = (v[0.0], abs(v[1.0] - v[-1.0]) / 2)
+    return out, grid, paths["c-measure", 0.0]
 
 
 # ---------------------------------------------------------------------------
@@ -391,6 +441,7 @@ def _taus(study, label, m, E0, mu, mu_err):
                      "tau2_obs_lo": math.nan if t2.n_settled == 0 else t2.lo,
                      "tau2_obs_hi": math.nan if t2.n_settled == 0 else t2.hi,
                      "f_settled": float(np.mean(lts[g]["outcome"] == "settled")),
+                     "p0_trapped": float(np.mean(lts[0.0]["outcome"] == "censored")),
                      "t_settle_q50": math.nan if q is None else float(q[1]), "t_settle_q50_err": sd("t_settle_q0.5"),
                      "tau2_pred": pred, "tau2_pred_err": pred * mu_err / mu})
     return pd.DataFrame(rows)
@@ -456,27 +507,56 @@ def _claim1(claims, label, per, table):
                _z_verdict(eb[0], eb[1], HH_PAPER_BREAK, "same as the paper's HH break",
                           "differs from the paper's HH break"),
                "continuous law a ε² + b ε, c ε; the paper's E_b ≈ 0.27 for HH is ε_b = 0.62", HH_PAPER_BREAK)
+    bl = _across(per, "b")
+    if bl[0] is not None:
+        claims.add("1", "linear term b of the law at threshold (κ0 ≈ b ε)", label, bl[0], bl[1],
+                   _z_verdict(bl[0], bl[1], 0.0, "quadratic onset (b = 0)", "linear onset (b ≠ 0)"),
+                   "reduced units (κ in well frequencies, ε = E/E_c − 1); the paper's HH b = 0.03 is 0.005 here", 0.0)
     chi = prim["chi2"] / max(prim["dof"], 1)
     claims.add("1", f"law family fits (χ²/dof, {'plateau' if per.get('plateau') else 'escaping'} convention)",
                label, chi, None,
                "fits" if chi <= 3 else "poor fit (χ²/dof > 3)", f"{prim['n_points']} points, dof {prim['dof']}")
 
 
-def _claim3(claims, label, mu_m, mu_m_err, pred, mu_c0, paper_mu, is_hh, relaxed):
-    claims.add("3", "μ measured (⟨E⟩(t), fig3's fit)", label, mu_m, mu_m_err,
-               "measured" if not is_hh else _z_verdict(mu_m, mu_m_err, paper_mu, "agrees with the paper's 0.91",
-                                                       "differs from the paper's 0.91"),
-               "bootstrap over orbits; this study's setup (r_esc the system's default)", paper_mu if is_hh else None)
+def _claim3(claims, label, meas, pred, wins, mu_c0, paper_mu, is_hh, relaxed):
     how = ("dE/dt = −γ μ(E) E with μ(E) = 2⟨K⟩/E of the conservative flow ({}) above E_c and of the microcanonical "
            "well below, fitted like the measured ⟨E⟩(t)" + ("" if relaxed else
                                                           "; probe window not relaxed at some energy (clipped)"))
-    for kind, name in (("c-measure", "c-measure: trapped orbits dropped"), ("all survivors", "all survivors")):
-        v, e = pred[kind]
-        claims.add("3", f"μ predicted from the conservative system ({kind})", label, v, e,
-                   _z_verdict(v, e, mu_m, "agrees with μ measured", "differs from μ measured", mu_m_err),
-                   how.format(name), mu_m)
+    for wname, w in wins.items():
+        where = f"on [{w[0]:g}, {w[1]:g}]" + (" (fig3's window)" if wname == "paper" else " (⟨E⟩ > E_c)")
+        mu_m, mu_m_err = meas[wname]
+        claims.add("3", f"μ measured {where}", label, mu_m, mu_m_err,
+                   _z_verdict(mu_m, mu_m_err, paper_mu, "agrees with the paper's 0.91", "differs from the paper's 0.91")
+                   if is_hh and wname == "paper" else "measured",
+                   "⟨E⟩(t) of the orbits not escaped, fixed-intercept log fit (fig3's); bootstrap over orbits; this "
+                   "study's setup (r_esc the system's default)", paper_mu if is_hh and wname == "paper" else None)
+        for kind, name in (("c-measure", "c-measure: trapped orbits dropped"), ("all survivors", "all survivors")):
+            v, e = pred[kind, wname]
+            claims.add("3", f"μ predicted {where}, {kind}", label, v, e,
+                       _z_verdict(v, e, mu_m, "agrees with μ measured", "differs from μ measured", mu_m_err),
+                       how.format(name), mu_m)
     claims.add("3", "2⟨K⟩/E of the c-measure at E0", label, mu_c0, None, "for reference (instantaneous μ at E0)",
                "interpolated between probe energies")
+
+
+def _claim5(claims, label, meas, own, pred, wins):
+    """μ_meas = μ of the survivors' own ⟨K⟩ + selection (escape, settling); own ⟨K⟩ against the conservative one."""
+    for wname, w in wins.items():
+        where = f"on [{w[0]:g}, {w[1]:g}]"
+        v, e = own[wname]
+        m, me = meas[wname]
+        claims.add("5", f"μ of the survivors' own ⟨K⟩ {where} (no selection)", label, v, e,
+                   _z_verdict(m, me, v, "selection by escape/settling negligible",
+                              f"selection by escape/settling shifts μ by {m - v:+.3f}", e),
+                   "2⟨K⟩/⟨E⟩ of the dissipative survivors from their energy loss (ΔE = −2γ∫K dt), path fitted "
+                   "like ⟨E⟩(t); σ from 10 groups of orbits; reference: μ measured", m)
+        pv, pe = pred["c-measure", wname]
+        claims.add("5", f"survivors' ⟨K⟩ against the conservative c-measure's {where}", label, v - pv,
+                   math.hypot(e, pe),
+                   _z_verdict(v - pv, math.hypot(e, pe), 0.0, "survivors carry the c-measure's ⟨K⟩",
+                              "survivors' ⟨K⟩ differs from the c-measure's"),
+                   "value: μ(own ⟨K⟩) − μ predicted (c-measure above E_c, microcanonical well below): a moment test "
+                   "of claim 5 (not the distance of Fig. 5)", 0.0)
 
 
 def _claim4(claims, label, taus: pd.DataFrame, mu_gamma):
@@ -488,8 +568,14 @@ def _claim4(claims, label, taus: pd.DataFrame, mu_gamma):
     ok = np.isfinite(t1)
     mono = bool(np.all(np.diff(t1[ok]) <= 0)) if ok.sum() > 1 else None
     p1, p1e = power_law_exponent(taus["gamma"], taus["tau1"], taus["tau1_err"])
+    undefined = ", ".join(f"{g:g}" for g, v in zip(taus["gamma"], t1) if not np.isfinite(v))
     claims.add("4", "τ1 ∝ γ^−p1", label, p1, p1e,
-               "undetermined" if mono is None else ("τ1 increases as γ decreases" if mono else "τ1 not monotone in γ"),
+               (f"undetermined: P_γ never reaches α P_0 after τ0 = {taus['tau0'].iloc[0]:.0f} at γ = {undefined} "
+                f"(τ2 by Eq. (eq:tau2) = {', '.join(f'{v:.0f}' for v in taus['tau2_pred'])}: the irregular regime "
+                f"outlasts the dissipative one; P_0 keeps {taus['p0_trapped'].iloc[0]:.0%} orbits to t_max)")
+               if mono is None else
+               ("τ1 increases as γ decreases" if mono else "τ1 not monotone in γ")
+               + (f"; undefined at γ = {undefined}" if undefined and mono is not None else ""),
                "paper: τ1 and τ2 increase with decreasing γ; a linear κ0(E) gives p1 = 1/2")
     p50, p50e = power_law_exponent(taus["gamma"], taus["t_settle_q50"], taus["t_settle_q50_err"])
     claims.add("4", "median settling time ∝ γ^−p", label, p50, p50e,
@@ -498,18 +584,15 @@ def _claim4(claims, label, taus: pd.DataFrame, mu_gamma):
     if len(r) and np.isfinite(r["tau2_obs"].iloc[0]):
         r = r.iloc[0]
         ratio = r["tau2_obs"] / r["tau2_pred"]
-        claims.add("4", f"τ2 observed / Eq. (eq:tau2) at γ = {mu_gamma:g}", label, ratio,
-                   ratio * math.hypot((r["tau2_obs_hi"] - r["tau2_obs_lo"]) / 2 / r["tau2_obs"],
-                                      r["tau2_pred_err"] / r["tau2_pred"]),
+        claims.add("4", f"τ2 observed / Eq. (eq:tau2) at γ = {mu_gamma:g}", label, ratio, None,
                    "agrees within 15 %" if abs(ratio - 1) <= 0.15 else f"differs by {100 * (ratio - 1):+.0f} %",
-                   f"τ2,obs = {r['tau2_obs']:.1f} (first settling, N = {int(r['n'])}: decreases with N), "
-                   f"ln(E0/E_c)/(μγ) = {r['tau2_pred']:.1f} with μ measured", 1.0)
+                   f"τ2,obs = {r['tau2_obs']:.1f} (first settling, N = {int(r['n'])}: decreases with N; order-statistic "
+                   f"interval [{r['tau2_obs_lo']:.1f}, {r['tau2_obs_hi']:.1f}]), ln(E0/E_c)/(μγ) = "
+                   f"{r['tau2_pred']:.1f} ± {r['tau2_pred_err']:.1f} with μ measured", 1.0)
 
 
 def analyze(study):
     """analyze(study) -> None: claims 1, 3, 4 per system; derived tables and generality.json."""
-    from hhscatter.analysis.dissipative.decay import fit_energy_decay, snapshot_grid
-    from hhscatter.analysis.dissipative.kinetic import decay_path
 
     _check(study)
     p = study.params
@@ -527,24 +610,21 @@ def analyze(study):
         mrows = _mu_conservative(study, label, m, fits)
         mu_rows += mrows
         mdf = pd.DataFrame(mrows)
-        mu_m, mu_m_err, inside = _mu_measured(study, label, m, E0, p.diss_n)
-        grid = snapshot_grid(p.snapshot_grid)
-        win = tuple(p.mu_window)
-        preds = {}
-        for kind in ("c-measure", "all survivors"):
-            for shift in (0.0, 1.0, -1.0):
-                path = decay_path(grid, E0, p.mu_gamma, _mu_of_E(mdf, ec, shift, kind))
-                preds[kind, shift] = (fit_energy_decay(grid, path, E0, p.mu_gamma, win).mu, path)
-        pred = {kind: (preds[kind, 0.0][0], abs(preds[kind, 1.0][0] - preds[kind, -1.0][0]) / 2)
-                for kind in ("c-measure", "all survivors")}
-        mu_p, mu_p_err = pred["c-measure"]
+        meas, inside, (own, own_path) = _mu_measured(study, label, m, E0)
+        mu_m, mu_m_err = meas["paper"]
+        pred, grid, path = _mu_predicted(study, mdf, ec, E0)
+        mu_p, mu_p_err = pred["c-measure", "paper"]
         mu_c0 = float(_mu_of_E(mdf, ec)(E0))
         relaxed = bool(mdf.loc[mdf["kind"] == "c-measure", "relaxed"].fillna(False).astype(bool).all())
-        _claim3(claims, label, mu_m, mu_m_err, pred, mu_c0, p.paper_mu, spec["name"] == "henon_heiles", relaxed)
+        _claim3(claims, label, meas, pred, _mu_windows(study), mu_c0, p.paper_mu, spec["name"] == "henon_heiles",
+                relaxed)
+        _claim5(claims, label, meas, own, pred, _mu_windows(study))
         curves.append(pd.DataFrame({"system": label, "t": inside["t"], "mean_E_over_E0": inside["mean_E"] / E0,
                                     "kind": "measured"}))
-        curves.append(pd.DataFrame({"system": label, "t": grid, "mean_E_over_E0": preds["c-measure", 0.0][1] / E0,
+        curves.append(pd.DataFrame({"system": label, "t": grid, "mean_E_over_E0": path / E0,
                                     "kind": "predicted"}))
+        curves.append(pd.DataFrame({"system": label, "t": own_path[0], "mean_E_over_E0": own_path[1] / E0,
+                                    "kind": "survivors' own ⟨K⟩"}))
 
         taus = _taus(study, label, m, E0, mu_m, mu_m_err)
         tau_tables.append(taus)
@@ -553,7 +633,11 @@ def analyze(study):
             "spec": spec, "E_c": ec, "n_exits": len(m.exits), "saddle_radius": m.saddle_radius,
             "ic_radius": p.radius_frac * m.saddle_radius, "r_esc_at_E0": float(m.default_escape_radius(E0)),
             "E0": E0, "kappa_law": per, "mu_measured": _ve(mu_m, mu_m_err), "mu_predicted": _ve(mu_p, mu_p_err),
-            "mu_predicted_all_survivors": _ve(*pred["all survivors"]),
+            "mu_by_window": {name: {"window": list(w), "measured": _ve(*meas[name]),
+                                    "predicted_c_measure": _ve(*pred["c-measure", name]),
+                                    "predicted_all_survivors": _ve(*pred["all survivors", name]),
+                                    "survivors_own_K": _ve(*own[name])}
+                             for name, w in _mu_windows(study).items()},
             "mu_c_at_E0": mu_c0,
             "mu_conservative": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                                  for k, v in r.items()} for r in mrows],

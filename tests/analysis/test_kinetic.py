@@ -66,3 +66,28 @@ def test_decay_path_is_the_exponential_law_for_constant_mu_and_slower_for_smalle
                                rtol=1e-8)
     slow = decay_path(t, 0.3, 0.01, lambda E: np.where(E < 0.2, 0.5, 0.93))
     assert np.all(slow >= 0.3 * np.exp(-0.0093 * t) * (1 - 1e-9)) and slow[-1] > 1.2 * 0.3 * np.exp(-1.86)
+
+
+def test_kinetic_fraction_by_time_is_the_decay_rate_of_a_fixed_set_of_orbits():
+    """Orbits E_i = E0_i e^{−μ_i γ t}: μ_K = Σ μ_i E_i/Σ E_i (exactly, by the closed form of ΔE/Ē), and it ignores
+    orbits that leave: here half of them stop at t = 10."""
+    from hhscatter.analysis.dissipative.kinetic import kinetic_fraction_by_time
+
+    g, grid = 0.01, np.arange(0.0, 21.0, 1.0)
+    rng = np.random.default_rng(4)
+    e0, mus = rng.uniform(0.2, 0.4, 50), rng.uniform(0.8, 1.2, 50)
+    ids, ts, es = [], [], []
+    for i in range(50):
+        tt = grid if i % 2 else grid[grid <= 10]
+        ids.append(np.full(tt.size, i))
+        ts.append(tt)
+        es.append(e0[i] * np.exp(-mus[i] * g * tt))
+    d = kinetic_fraction_by_time(np.concatenate(ids), np.concatenate(ts), np.concatenate(es), g)
+    for row in d.itertuples():
+        alive = [i for i in range(50) if i % 2 or row.t_hi <= 10]
+        E_lo = e0[alive] * np.exp(-mus[alive] * g * row.t_lo)
+        E_hi = e0[alive] * np.exp(-mus[alive] * g * row.t_hi)
+        want = np.sum(E_lo - E_hi) / (g * (row.t_hi - row.t_lo)) / np.sum(0.5 * (E_lo + E_hi))
+        assert row.n == len(alive)
+        assert row.mu_K == pytest.approx(want, rel=1e-12)
+        assert row.mu_K == pytest.approx(np.sum(mus[alive] * E_lo) / np.sum(E_lo), rel=2e-3)
