@@ -79,6 +79,10 @@ class Params(StudyParams):
     alpha: Number
     tau_grid_step: Number
     paper_mu: Number
+    hazard_bin: Number = 5.0      # claim 7: width of the time bins of the escape hazard (time units)
+    sm_dt: Number = 0.5           # claim 6 (fig6 rule)
+    sm_fit_dt: Number = 2.0
+    sm_min_count: Number = 20.0
 
 
 # κ conventions: all orbits with the data-driven plateau windows (fig2's) or P-level windows (both ill-defined where
@@ -559,6 +563,106 @@ def _claim5(claims, label, meas, own, pred, wins):
                    "of claim 5 (not the distance of Fig. 5)", 0.0)
 
 
+def _claim6(study, claims, label, m, per, taus, E0, mu, rms_ref):
+    """The survival model, Eq. (eqn:surv_prob_model), both hazards, fig6's fitting rule, at γ = mu_gamma."""
+    from hhscatter.analysis.dissipative.survival_model import (
+        fit_homogeneous_hazards,
+        survival_fit_points,
+    )
+    from hhscatter.analysis.survival.fits import survival_from_lifetimes
+    from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+
+    p = study.params
+    conv = "plateau" if per.get("plateau") else "escaping"
+    law = per.get(conv)
+    g = p.mu_gamma
+    if law is None:
+        for h in ("paper", "integrated"):
+            claims.add("6", f"survival model ({h} hazard) at γ = {g:g}: rms log residual", label, None, None,
+                       "undetermined", "no κ0(E) law fitted (fewer than 5 defined points)")
+        return {}
+    ec = m.critical_energy
+    kappa = PiecewiseKappa(E_c=ec, a2=law["a"]["value"] / ec**2, a1=law["b"]["value"] / ec,
+                           slope=law["c"]["value"] / ec, E_switch=ec * (1 + law["eps_b"]["value"]))
+    lt = _lifetimes(study.raw(diss_key(label, g)))
+    n = len(lt)
+    c = survival_from_lifetimes(lt[["t_end", "outcome"]], np.arange(0.0, float(lt["t_end"].max()) + p.sm_dt, p.sm_dt))
+    tau0 = float(taus["tau0"].iloc[0])
+    tf, Pf, sf = survival_fit_points(c.t, c.P, c.P_err, tau0, p.sm_fit_dt, n, p.sm_min_count)
+    out, reason = {}, ""
+    tau2 = float(taus.loc[taus["gamma"] == g, "tau2_pred"].iloc[0])
+    try:
+        if tau0 >= tau2:  # the model's escape regime [τ0, τ2] is empty
+            raise ValueError(f"τ0 = {tau0:.0f} (on P_0) ≥ τ2 = {tau2:.0f} by Eq. (eq:tau2): the model has no escape "
+                             "regime")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fits = fit_homogeneous_hazards(c.t, c.P, c.P_err, tf, Pf, sf, kappa=kappa, E0=E0, mu=mu, gamma=g,
+                                           tau0=tau0, E_c=ec, hazards=["paper", "integrated"], fit_tau2=False,
+                                           P_min=p.sm_min_count / n * 0.999)
+    except (RuntimeError, ValueError) as exc:
+        fits, reason = {}, str(exc)
+    for h in ("paper", "integrated"):
+        f = fits.get(h)
+        if f is None:
+            claims.add("6", f"survival model ({h} hazard) at γ = {g:g}: rms log residual", label, None, None,
+                       f"not applicable: {reason}", "fig6's rule could not fit")
+            continue
+        ref = rms_ref.get(h)
+        verdict = ("reference (Hénon–Heiles)" if ref is None else
+                   "as good as on Hénon–Heiles (rms ≤ 1.5× its)" if f.rms_log_residual <= 1.5 * ref else
+                   f"worse than on Hénon–Heiles ({f.rms_log_residual / ref:.1f}× its rms)")
+        claims.add("6", f"survival model ({h} hazard) at γ = {g:g}: rms log residual", label, f.rms_log_residual,
+                   None, verdict, f"fig6's rule (points every {p.sm_fit_dt:g} from τ0 = {tau0:.1f} with N·P ≥ "
+                   f"{p.sm_min_count:g}, P(τ0) held, best of 3 starts); κ0(E) the {conv} law, μ measured; χ²/dof = "
+                   f"{f.chi2_red:.3g} over {f.n_points} points (correlated Kaplan–Meier points: indicative)")
+        out[h] = {"rms_log_residual": f.rms_log_residual, "chi2_red": f.chi2_red, "n_points": f.n_points,
+                  "values": {k: float(v) for k, v in f.values.items() if np.ndim(v) == 0},
+                  "curve": {"t": c.t[c.t >= tau0][::4].tolist(), "P": c.P[c.t >= tau0][::4].tolist(),
+                            "model": [float(x) for x in f.predict(c.t[c.t >= tau0][::4])]}}
+    return out
+
+
+def _claim7(study, claims, label, m, table, taus, E0, mu):
+    """κγ(t) = κ0(E(t)) for the smallest γ: escapes observed over those expected from κ0 at E0 e^{−μγt}."""
+    from hhscatter.analysis.dissipative.effective_rate import (
+        binned_hazard,
+        observed_over_expected,
+    )
+
+    p = study.params
+    g = min(x for x in p.gammas if x > 0)
+    conv = "plateau"
+    k = table[(table["convention"] == conv) & table["defined"]].sort_values("eps")
+    if len(k) < 2:
+        conv = "escaping"
+        k = table[(table["convention"] == conv) & table["defined"]].sort_values("eps")
+    lt = _lifetimes(study.raw(diss_key(label, g)))
+    t_end = lt["t_end"].to_numpy()
+    esc = (lt["outcome"] == "escaped").to_numpy()
+    tau0 = float(taus["tau0"].iloc[0])
+    t_lo_e = math.log(E0 / (m.critical_energy * (1 + float(k["eps"].min())))) / (mu * g) if len(k) else tau0
+    edges = np.arange(tau0, max(tau0, t_lo_e) + 1e-9, p.hazard_bin)
+    if len(k) < 2 or edges.size < 2:
+        why = ("κ0 defined at fewer than 2 energies" if len(k) < 2 else
+               f"τ0 = {tau0:.0f} comes after E(t) has reached the lowest defined κ0 energy (t = {t_lo_e:.0f})")
+        claims.add("7", f"κγ(t)/κ0(E(t)) at γ = {g:g} (observed/expected escapes)", label, None, None,
+                   f"undetermined: {why}", f"{conv} κ0 points")
+        return None
+    b = binned_hazard(t_end, esc, edges)
+    at_risk = b["exposure"] / p.hazard_bin
+    b = b[at_risk >= p.min_survivors]
+    eps_t = E0 * np.exp(-mu * g * b["t_mid"].to_numpy()) / m.critical_energy - 1
+    lk = np.interp(eps_t, k["eps"], np.log(k["kappa"]), left=np.nan, right=np.nan)
+    b = b.assign(eps=eps_t, kappa0=np.exp(lk))
+    r, e, expected = observed_over_expected(b, b["kappa0"])
+    claims.add("7", f"κγ(t)/κ0(E(t)) at γ = {g:g} (observed/expected escapes)", label, r, e,
+               _z_verdict(r, e, 1.0, "κγ(t) = κ0(E(t))", f"κγ differs from κ0(E(t)) by {100 * (r - 1):+.0f} %"),
+               f"bins of {p.hazard_bin:g} from τ0 = {tau0:.1f} while E(t) = E0 e^(−μγt) ≥ the lowest defined κ0 "
+               f"energy; κ0 interpolated (log) between the {conv} points; {expected:.0f} escapes expected", 1.0)
+    return b.assign(system=label, gamma=g, convention=conv)
+
+
 def _claim4(claims, label, taus: pd.DataFrame, mu_gamma):
     from hhscatter.analysis.dissipative.transitions import power_law_exponent
 
@@ -591,13 +695,42 @@ def _claim4(claims, label, taus: pd.DataFrame, mu_gamma):
                    f"{r['tau2_pred']:.1f} ± {r['tau2_pred_err']:.1f} with μ measured", 1.0)
 
 
+def _analyze_mu(study, claims, label, spec, m, E0, fits):
+    """Claims 3 and 5 of one system: (μ rows, ⟨E⟩ curves, (μ, σ) measured on fig3's window, its JSON numbers)."""
+    p = study.params
+    ec = m.critical_energy
+    mrows = _mu_conservative(study, label, m, fits)
+    mdf = pd.DataFrame(mrows)
+    meas, inside, (own, own_path) = _mu_measured(study, label, m, E0)
+    pred, grid, path = _mu_predicted(study, mdf, ec, E0)
+    mu_c0 = float(_mu_of_E(mdf, ec)(E0))
+    relaxed = bool(mdf.loc[mdf["kind"] == "c-measure", "relaxed"].fillna(False).astype(bool).all())
+    wins = _mu_windows(study)
+    _claim3(claims, label, meas, pred, wins, mu_c0, p.paper_mu, spec["name"] == "henon_heiles", relaxed)
+    _claim5(claims, label, meas, own, pred, wins)
+    curves = [pd.DataFrame({"system": label, "t": t, "mean_E_over_E0": e / E0, "kind": kind}) for t, e, kind in (
+        (inside["t"], inside["mean_E"], "measured"), (grid, path, "predicted"),
+        (own_path[0], own_path[1], "survivors' own ⟨K⟩"))]
+    numbers = {
+        "mu_measured": _ve(*meas["paper"]), "mu_predicted": _ve(*pred["c-measure", "paper"]),
+        "mu_by_window": {name: {"window": list(w), "measured": _ve(*meas[name]),
+                                "predicted_c_measure": _ve(*pred["c-measure", name]),
+                                "predicted_all_survivors": _ve(*pred["all survivors", name]),
+                                "survivors_own_K": _ve(*own[name])} for name, w in wins.items()},
+        "mu_c_at_E0": mu_c0,
+        "mu_conservative": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                             for k, v in r.items()} for r in mrows],
+    }
+    return mrows, curves, meas["paper"], numbers
+
+
 def analyze(study):
-    """analyze(study) -> None: claims 1, 3, 4 per system; derived tables and generality.json."""
+    """analyze(study) -> None: claims 1, 3, 4, 5 (as a moment), 6, 7 per system; derived tables and generality.json."""
 
     _check(study)
     p = study.params
     claims = _Claims(study)
-    kappa_rows, mu_rows, tau_tables, curves, systems = [], [], [], [], {}
+    kappa_rows, mu_rows, tau_tables, curves, hazards, systems, rms_ref = [], [], [], [], [], {}, {}
     for label, spec, m in _systems(study):
         ec = m.critical_energy
         E0 = p.e0_ratio * ec
@@ -607,41 +740,25 @@ def analyze(study):
         per = _law(study, table)
         _claim1(claims, label, per, table)
 
-        mrows = _mu_conservative(study, label, m, fits)
+        mrows, cur, (mu_m, mu_m_err), mu_numbers = _analyze_mu(study, claims, label, spec, m, E0, fits)
         mu_rows += mrows
-        mdf = pd.DataFrame(mrows)
-        meas, inside, (own, own_path) = _mu_measured(study, label, m, E0)
-        mu_m, mu_m_err = meas["paper"]
-        pred, grid, path = _mu_predicted(study, mdf, ec, E0)
-        mu_p, mu_p_err = pred["c-measure", "paper"]
-        mu_c0 = float(_mu_of_E(mdf, ec)(E0))
-        relaxed = bool(mdf.loc[mdf["kind"] == "c-measure", "relaxed"].fillna(False).astype(bool).all())
-        _claim3(claims, label, meas, pred, _mu_windows(study), mu_c0, p.paper_mu, spec["name"] == "henon_heiles",
-                relaxed)
-        _claim5(claims, label, meas, own, pred, _mu_windows(study))
-        curves.append(pd.DataFrame({"system": label, "t": inside["t"], "mean_E_over_E0": inside["mean_E"] / E0,
-                                    "kind": "measured"}))
-        curves.append(pd.DataFrame({"system": label, "t": grid, "mean_E_over_E0": path / E0,
-                                    "kind": "predicted"}))
-        curves.append(pd.DataFrame({"system": label, "t": own_path[0], "mean_E_over_E0": own_path[1] / E0,
-                                    "kind": "survivors' own ⟨K⟩"}))
+        curves += cur
 
         taus = _taus(study, label, m, E0, mu_m, mu_m_err)
         tau_tables.append(taus)
         _claim4(claims, label, taus, p.mu_gamma)
+        sm6 = _claim6(study, claims, label, m, per, taus, E0, mu_m, rms_ref)
+        if spec["name"] == "henon_heiles":
+            rms_ref.update({h: v["rms_log_residual"] for h, v in sm6.items()})
+        hz = _claim7(study, claims, label, m, table, taus, E0, mu_m)
+        if hz is not None:
+            hazards.append(hz)
         systems[label] = {
             "spec": spec, "E_c": ec, "n_exits": len(m.exits), "saddle_radius": m.saddle_radius,
             "ic_radius": p.radius_frac * m.saddle_radius, "r_esc_at_E0": float(m.default_escape_radius(E0)),
-            "E0": E0, "kappa_law": per, "mu_measured": _ve(mu_m, mu_m_err), "mu_predicted": _ve(mu_p, mu_p_err),
-            "mu_by_window": {name: {"window": list(w), "measured": _ve(*meas[name]),
-                                    "predicted_c_measure": _ve(*pred["c-measure", name]),
-                                    "predicted_all_survivors": _ve(*pred["all survivors", name]),
-                                    "survivors_own_K": _ve(*own[name])}
-                             for name, w in _mu_windows(study).items()},
-            "mu_c_at_E0": mu_c0,
-            "mu_conservative": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                                 for k, v in r.items()} for r in mrows],
+            "E0": E0, "kappa_law": per, **mu_numbers,
             "taus": taus.drop(columns=["system"]).to_dict(orient="records"),
+            "survival_model": sm6,
         }
     ktab = pd.DataFrame(kappa_rows)
     study.write_table(ktab, "kappa.parquet", description="κ0(E) per system, E/E_c and window convention")
@@ -650,6 +767,9 @@ def analyze(study):
     study.write_table(pd.concat(curves, ignore_index=True), "energy_curves.parquet",
                       description="⟨E⟩(t)/E0 measured and the predicted path dE/dt = −γ μ(E) E")
     study.write_table(pd.concat(tau_tables, ignore_index=True), "taus.parquet", description="τ0, τ1, τ2 per γ")
+    if hazards:
+        study.write_table(pd.concat(hazards, ignore_index=True), "hazard.parquet",
+                          description="claim 7: escape hazard of the smallest γ per time bin, κ0 at E0 e^(−μγt)")
     study.write_numbers({
         "rules": {
             "energies": "E = r·E_c on the grid ratios, the same for every system",
@@ -663,8 +783,8 @@ def analyze(study):
         "systems": systems,
         "claims": claims.rows,
         "kappa": ktab.replace({np.nan: None}).to_dict(orient="records"),
-        "not_done": ["claim 2 (κ from the c-measure)", "claim 5 (survivors follow the c-measure)",
-                     "claim 6 (survival model)", "claim 7 (κγ(t) = κ0(E(t)))"],
+        "not_done": ["claim 2 (κ from the c-measure)",
+                     "claim 5 as a distance of section-point distributions (Fig. 5's; here a moment test: ⟨K⟩)"],
     })
 
 
