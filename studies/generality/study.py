@@ -31,11 +31,13 @@ import warnings
 import numpy as np
 import pandas as pd
 
+from hhscatter.scene.scene import MOMENTA, REGIONS
 from hhscatter.scene.schema import (
     Integer,
     Number,
     NumberLists,
     Numbers,
+    OneOf,
     StudyParams,
     Text,
 )
@@ -54,6 +56,8 @@ class Params(StudyParams):
 
     systems: list[SystemEntry]
     radius_frac: Number
+    alt_region: OneOf(*REGIONS) = None     # a second IC convention for κ0(E): the same grid with these ICs
+    alt_momentum: OneOf(*MOMENTA) = "random"
     ratios: Numbers
     grid_n: Integer
     min_survivors: Number
@@ -94,6 +98,11 @@ HH_PAPER_BREAK = (0.27 - 1 / 6) / (1 / 6)  # the paper's E_b ≈ 0.27 for Hénon
 def grid_key(label: str, r: float) -> str:
     """grid_key('contopoulos', 1.5) -> 'contopoulos_r1.500': the κ0(E) run at E = r·E_c."""
     return f"{label}_r{r:.3f}"
+
+
+def alt_key(label: str, r: float, region: str) -> str:
+    """alt_key('barbanis', 1.5, 'well') -> 'barbanis_well_r1.500': the κ0(E) run with the alternative ICs."""
+    return f"{label}_{region}_r{r:.3f}"
 
 
 def probe_key(label: str, r: float) -> str:
@@ -145,6 +154,12 @@ def simulate(study, workers=None, progress=True):
         for r in p.ratios:
             sc = study.scene(grid_key(label, r), system=spec, energy=r * ec, n=p.grid_n, radius=radius)
             study.run(grid_key(label, r), sc, workers=workers, progress=progress)
+        if p.alt_region is not None:  # the same grid with other ICs: is a trapped plateau the ICs' doing?
+            for r in p.ratios:
+                key = alt_key(label, r, p.alt_region)
+                sc = study.scene(key, system=spec, energy=r * ec, n=p.grid_n, region=p.alt_region,
+                                 momentum=p.alt_momentum)
+                study.run(key, sc, workers=workers, progress=progress)
         for r in p.probe_ratios:
             sc = study.scene(probe_key(label, r), system=spec, energy=r * ec, n=p.probe_n, radius=radius,
                              gamma=p.probe_gamma, t_max=p.probe_t_max, snapshots=probe_times)
@@ -203,16 +218,30 @@ def _kappa_rows(study, label, m):
         except (ValueError, RuntimeError) as exc:
             rates["escaping"] = None
             reason = f"window rule failed on the escaping orbits: {exc}"
+        if p.alt_region is not None:
+            lt_a = _lifetimes(study.raw(alt_key(label, r, p.alt_region)))
+            ta, oa = lifetimes_to_arrays(lt_a)
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    res_a = escape_rate_from_lifetimes(lt_a, detect_tail=False, min_survivors=p.min_survivors)
+                rates[p.alt_region] = plateau_rate(res_a, ta, oa, max_bias=p.max_plateau_bias)
+                trapped_alt = float((~oa).mean())
+            except (ValueError, RuntimeError) as exc:
+                rates[p.alt_region] = None
+                reason = f"window rule failed with {p.alt_region} ICs: {exc}"
         for conv, c in rates.items():
             base = {"system": label, "ratio": r, "eps": r - 1.0, "energy": r * m.critical_energy,
                     "convention": conv, "n": int(t_end.size)}
             if c is None:
                 rows.append({**base, "kappa": math.nan, "kappa_err": math.nan, "tau0": math.nan,
-                             "t_lo": math.nan, "t_hi": math.nan, "trapped_fraction": float((~obs).mean()),
+                             "t_lo": math.nan, "t_hi": math.nan,
+                             "trapped_fraction": math.nan if conv == p.alt_region else float((~obs).mean()),
                              "defined": False, "reason": reason})
                 continue
             rows.append({**base, "kappa": c.kappa, "kappa_err": c.kappa_err, "tau0": c.t_lo, "t_lo": c.t_lo,
-                         "t_hi": c.t_hi, "trapped_fraction": float((~obs).mean()),
+                         "t_hi": c.t_hi,
+                         "trapped_fraction": trapped_alt if conv == p.alt_region else float((~obs).mean()),
                          "defined": bool(c.defined and c.kappa > 0), "reason": c.reason})
     return rows, fits
 
@@ -233,7 +262,7 @@ def _law(study, table):
     from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
 
     per = {}
-    for conv in CONVENTIONS:
+    for conv in [*CONVENTIONS, *([study.params.alt_region] if study.params.alt_region else [])]:
         d = table[(table["convention"] == conv) & table["defined"]].sort_values("ratio")
         if len(d) < 5:  # a, b and the break need points on both sides
             per[conv] = None
@@ -489,6 +518,16 @@ def _claim1(claims, label, per, table):
                "yes" if bad.empty else "no: ill-defined at E/E_c = " + ", ".join(f"{r:g}" for r in bad["ratio"])
                + f" (orbits still inside at t_max up to {bad['trapped_fraction'].max():.0%})",
                "value: fraction of the grid energies where κ0 is defined; the paper's convention (all orbits)")
+    alt = table[~table["convention"].isin(CONVENTIONS)]
+    if len(alt):
+        name = alt["convention"].iloc[0]
+        bad_a = alt[~alt["defined"]]
+        claims.add("1", f"κ0 well defined with {name} ICs (all orbits, plateau windows)", label,
+                   float(alt["defined"].mean()), None,
+                   "yes" if bad_a.empty else "no: ill-defined at E/E_c = " + ", ".join(f"{r:g}" for r in bad_a["ratio"])
+                   + (f" (orbits still inside at t_max up to {bad_a['trapped_fraction'].max():.0%})"
+                      if bad_a["trapped_fraction"].notna().any() else ""),
+                   "the same grid, N and t_max with ICs uniform in that region, random momentum directions")
     fitted = [k for k, v in per.items() if v]
     prim = per.get("plateau") or per.get("escaping") or per.get("plevel")
     if prim is None:
