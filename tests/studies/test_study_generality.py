@@ -32,6 +32,9 @@ def test_generality_tiny_end_to_end_writes_claims_for_every_system(tiny):
     # energies alike: every system's E0 is the same multiple of its own E_c
     ratios = {round(s["E0"] / s["E_c"], 12) for s in doc["systems"].values()}
     assert ratios == {doc["config"]["study"]["e0_ratio"]}
+    # κ0 under every convention: all orbits (plateau, P-level windows), the escaping orbits, the alternative ICs
+    assert {r["convention"] for r in doc["kappa"]} == {"plateau", "plevel", "escaping",
+                                                      doc["config"]["study"]["alt_region"]}
     for c in claims:  # a verdict is a statement, a value a number or None (never NaN in the JSON)
         assert isinstance(c["verdict"], str) and c["verdict"]
         assert c["value"] is None or math.isfinite(c["value"])

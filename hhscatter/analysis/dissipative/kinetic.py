@@ -45,6 +45,18 @@ class KineticFraction:
     n_intervals: int
 
 
+def _checked_rows(traj_id, t, energy, gamma):
+    """(traj_id, t, energy) as flat arrays of one length, and γ finite and > 0 (else ValueError)."""
+    ids = np.asarray(traj_id, dtype=np.int64).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    e = np.asarray(energy, dtype=float).ravel()
+    if not (ids.size == t.size == e.size):
+        raise ValueError("traj_id, t and energy differ in length")
+    if not (gamma > 0 and math.isfinite(gamma)):
+        raise ValueError(f"gamma must be finite and > 0, got {gamma}")
+    return ids, t, e
+
+
 def kinetic_fraction_from_energies(traj_id, t, energy, gamma_probe: float, t_from: float, t_to: float, *,
                                    keep=None, n_boot: int = 200, rng=None) -> KineticFraction:
     """kinetic_fraction_from_energies(traj_id, t, energy, γ_p, t_from, t_to, *, keep=None) -> KineticFraction.
@@ -65,13 +77,7 @@ def kinetic_fraction_from_energies(traj_id, t, energy, gamma_probe: float, t_fro
     >>> round(kinetic_fraction_from_energies(ids, t, E, 1e-6, 0.0, 4.0, n_boot=0).value, 4)
     0.9
     """
-    ids = np.asarray(traj_id, dtype=np.int64).ravel()
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
-    if not (ids.size == t.size == e.size):
-        raise ValueError("traj_id, t and energy differ in length")
-    if not (gamma_probe > 0 and math.isfinite(gamma_probe)):
-        raise ValueError(f"gamma_probe must be finite and > 0, got {gamma_probe}")
+    ids, t, e = _checked_rows(traj_id, t, energy, gamma_probe)
     if not t_to > t_from:
         raise ValueError(f"need t_to > t_from, got [{t_from}, {t_to}]")
     sel = (t >= t_from) & (t <= t_to)
@@ -117,13 +123,7 @@ def kinetic_fraction_by_time(traj_id, t, energy, gamma: float):
     """
     import pandas as pd  # deferred: pandas loads on first use
 
-    ids = np.asarray(traj_id, dtype=np.int64).ravel()
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
-    if not (ids.size == t.size == e.size):
-        raise ValueError("traj_id, t and energy differ in length")
-    if not (gamma > 0 and math.isfinite(gamma)):
-        raise ValueError(f"gamma must be finite and > 0, got {gamma}")
+    ids, t, e = _checked_rows(traj_id, t, energy, gamma)
     grid = np.unique(t)
     order = np.lexsort((t, ids))
     ids, t, e = ids[order], t[order], e[order]

@@ -272,20 +272,29 @@ def _residual_fn(curve, P, sig, space):
     return res
 
 
-def _lsq(res, starts, lo, hi):
-    """Best least_squares solution over several starting points."""
+def _best_of(fit_fn, starts, cost, errors, message):
+    """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
+    none left is a RuntimeError(``message``)."""
     best = None
     for x0 in starts:
-        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
         try:
-            r = optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
-        except ValueError:
+            r = fit_fn(x0)
+        except errors:
             continue
-        if best is None or r.cost < best.cost:
+        if best is None or cost(r) < cost(best):
             best = r
     if best is None:
-        raise RuntimeError("survival fit failed for all starting points")
+        raise RuntimeError(message)
     return best
+
+
+def _lsq(res, starts, lo, hi):
+    """Best least_squares solution over several starting points."""
+    def solve(x0):
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
+        return optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
+
+    return _best_of(solve, starts, lambda r: r.cost, ValueError, "survival fit failed for all starting points")
 
 
 def _covariance(J, chi2_red, absolute_sigma):
@@ -838,17 +847,8 @@ def best_fit(fit_fn: Callable, starts):
     The χ² surface has local minima (the settling branch can be traded for a lower trapped fraction);
     starts whose fit raises RuntimeError or ValueError are skipped; none left is a RuntimeError.
     """
-    best = None
-    for p0 in starts:
-        try:
-            f = fit_fn(p0)
-        except (RuntimeError, ValueError):
-            continue
-        if best is None or f.chi2 < best.chi2:
-            best = f
-    if best is None:
-        raise RuntimeError("survival-model fit failed from every starting point")
-    return best
+    return _best_of(fit_fn, starts, lambda f: f.chi2, (RuntimeError, ValueError),
+                    "survival-model fit failed from every starting point")
 
 
 def plateau_level(t, P, t_q: float) -> float:
