@@ -1,5 +1,6 @@
 """hhscatter: exact-event ensemble simulations of (dissipative) chaotic scattering
-in the Hénon–Heiles potential, on heyoka's batch Taylor integrator.
+in the Hénon–Heiles potential and any open two-degree-of-freedom system declared as data, on heyoka's
+batch Taylor integrator.
 
 Public entry points (imported lazily, so ``import hhscatter`` is cheap and has
 no side effects; ``dir(hhscatter)`` lists them):
@@ -17,7 +18,9 @@ no side effects; ``dir(hhscatter)`` lists them):
   distances to a reference set against the box scale
 - :func:`basin_measures` — exit-basin maps of a grid of ICs, basin shares, basin entropy, Wada test
 - :func:`plot_survival`, :func:`plot_escape_rates` — draw on your matplotlib axes
-- :class:`HenonHeiles` — the model's closed forms (E_c, saddles, channels)
+- :class:`HenonHeiles` — the paper's system, with closed forms (E_c, saddles, channels)
+- :func:`make_system`, :class:`DeclaredSystem` — any other system: a built-in by name or a potential V(x, y)
+  as an expression, its E_c, exits, Ω and no-return radius derived (pass it, or its spec, as ``Scene(system=)``)
 - :class:`HHScatterError` and its family (:mod:`hhscatter.errors`): :class:`ConfigError` (alias
   :class:`SceneError`), :class:`RunIntegrityError`, :class:`StudyError`, :class:`RunError`
 
@@ -58,6 +61,8 @@ _EXPORTS = {
     "cmeasure_distances": "api",
     "basin_measures": "api",
     "HenonHeiles": "model",
+    "make_system": "model",
+    "DeclaredSystem": "model",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -104,6 +104,17 @@ def _snapshots(s):
     return {"times": v if isinstance(v, list) else [v]}
 
 
+def _system_flags(s) -> None:
+    """--system, --param, --dissipation of ``simulate`` (hhscatter.model.spec)."""
+    sy = s.add_argument_group("system", "the system as data (default Hénon–Heiles, ω = λ = 1, linear drag); they "
+                              "override the scene file's [system]")
+    sy.add_argument("--system", metavar="NAME|EXPR", help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
+                    "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'")
+    sy.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", default=[],
+                    help="a parameter of the system (repeatable), e.g. --param eps=0.25")
+    sy.add_argument("--dissipation", choices=["linear", "quadratic"], help="drag law: −γp (linear, default) or −γ|p|p")
+
+
 def build_parser():
     from hhscatter import __version__  # deferred: `hhscatter --help` starts without the engine and tables
 
@@ -134,13 +145,7 @@ def build_parser():
     s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
     s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default: the system's; 1.5 for Hénon–Heiles, the paper used "
                    "1.03, see study resc)")
-    sy = s.add_argument_group("system", "the system as data (default Hénon–Heiles, ω = λ = 1, linear drag); they "
-                              "override the scene file's [system]")
-    sy.add_argument("--system", metavar="NAME|EXPR", help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
-                    "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'")
-    sy.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", default=[],
-                    help="a parameter of the system (repeatable), e.g. --param eps=0.25")
-    sy.add_argument("--dissipation", choices=["linear", "quadratic"], help="drag law: −γp (linear, default) or −γ|p|p")
+    _system_flags(s)
     s.add_argument("--t-max", type=_float, dest="t_max", help="maximum orbit time (default 5000)")
     s.add_argument("--tol", type=_float, help="integrator tolerance in [1e-18, 1e-6] (default 1e-15)")
     s.add_argument("--chunk-size", type=_int, dest="chunk_size", help="orbits per part file (default 10000)")

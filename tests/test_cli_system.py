@@ -62,3 +62,37 @@ def test_unknown_parameter_of_a_built_in_exits_2_before_any_work(tmp_path, capsy
                    "--out", str(out))
     assert rc == 2 and "henon_heiles has parameters ['lam', 'omega'], got ['mu']" in err, err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("system, params, energy, message", [
+    ("0.5*(x**2 + y**2) - eps*x**2*z", ["eps=0.25"], "1.5", "z"),                     # unknown symbol
+    ("0.5*(x**2 + y**2) - eps*foo(x)*y**2", ["eps=0.25"], "1.5", "foo"),              # unknown function
+    ("0.5*(x**2 + y**2) - eps*x**2*y**2", [], "1.5", "eps"),                          # missing parameter
+    ("0.5*(x**2 + y**2)", [], "1.5", "exit"),                                          # no exit
+    ("0.5*((x - 1)**2 + y**2) - 0.1*x**3", [], "1.5", "origin"),                       # well not at the origin
+    ("0.5*(x**2 + y**2) - eps*x**2*y**2", ["eps=0.25"], "0.5", "energy must be > E_c = 1"),  # E0 below E_c
+    ("__import__('os').system('echo hacked')", [], "1.5", "__import__"),               # never evaluated
+])
+def test_bad_declared_systems_exit_2_naming_the_problem(tmp_path, capsys, system, params, energy, message):
+    out = tmp_path / "o"
+    flags = [x for p in params for x in ("--param", p)]
+    rc, err = _cli(capsys, "simulate", "--energy", energy, "-n", "10", "--system", system, *flags, "--out", str(out))
+    assert rc == 2 and message in err, err
+    assert not out.exists()
+
+
+def test_declared_potential_runs_end_to_end_from_a_scene_file(tmp_path, capsys):
+    """Done means (issue 23): a scene file with [system] potential = … runs and names its system in the tables."""
+    f = tmp_path / "scene.toml"
+    f.write_text('[scene]\nenergy = 1.5\nn = 50\nt_max = 300\n[system]\n'
+                 'potential = "0.5*(x**2 + y**2) - eps*x**2*y**2"\n[system.params]\neps = 0.25\n')
+    out = tmp_path / "run"
+    rc, _ = _cli(capsys, "simulate", str(f), "--workers", "1", "--quiet", "--out", str(out))
+    assert rc == 0
+    m = _meta(out)
+    assert m["system"]["potential"] == "0.5*(x**2 + y**2) - eps*x**2*y**2" and m["system"]["params"] == {"eps": 0.25}
+    import pandas as pd
+
+    lt = pd.read_parquet(out / "lifetimes")
+    esc = lt[lt["outcome"] == "escaped"]
+    assert len(esc) > 25 and set(esc["exit_channel"].astype(int)) <= {0, 1, 2, 3}

@@ -18,17 +18,23 @@ sys.path.insert(0, str(ROOT))
 
 from hhscatter.model.spec import system_from_spec  # noqa: E402
 
-#: the built-ins shown, each at its default parameters
-GALLERY = ("henon_heiles", "n_exit", "contopoulos", "barbanis")
+#: the built-ins shown (n_exit with n = 4: n = 3 is Hénon–Heiles), the others at their default parameters
+GALLERY = ({"name": "henon_heiles"}, {"name": "n_exit", "params": {"n": 4}}, {"name": "contopoulos"},
+           {"name": "barbanis"})
+
+
+def _num(v: float) -> str:
+    return f"{0.0 if abs(v) < 1e-12 else v:.4g}"
 
 
 def table_rows():
     """(name, params, E_c, exits, omega_radius, R(1.5 E_c)) of every built-in, at its default parameters."""
     rows = []
-    for name in GALLERY:
-        m = system_from_spec({"name": name})
-        exits = "; ".join(f"({e.x:.4g}, {e.y:.4g})" for e in m.exits)
-        params = ", ".join(f"{k} = {v:g}" for k, v in m.params.items())
+    for spec in GALLERY:
+        m = system_from_spec(spec)
+        name = spec["name"]
+        exits = "; ".join(f"({_num(e.x)}, {_num(e.y)})" for e in m.exits)
+        params = ", ".join(f"{k} = {v:g}" for k, v in m.spec()["params"].items())
         rows.append((name, params, m.critical_energy, len(m.exits), exits, m.omega_radius,
                      m.no_return_radius(1.5 * m.critical_energy)))
     return rows
@@ -42,10 +48,11 @@ def markdown_table() -> str:
     return "\n".join(out)
 
 
-def figure(name: str, path: Path) -> None:
+def figure(spec: dict, path: Path) -> None:
     from matplotlib.figure import Figure
 
-    m = system_from_spec({"name": name})
+    m = system_from_spec(spec)
+    name = spec["name"] + "".join(f", {k} = {v:g}" for k, v in spec.get("params", {}).items())
     L = 1.6 * max(e.distance for e in m.exits)
     g = np.linspace(-L, L, 401)
     X, Y = np.meshgrid(g, g)
@@ -76,8 +83,8 @@ def figure(name: str, path: Path) -> None:
 def main() -> int:
     out = ROOT / "docs" / "concepts" / "systems"
     out.mkdir(parents=True, exist_ok=True)
-    for name in GALLERY:
-        figure(name, out / f"{name}.png")
+    for spec in GALLERY:
+        figure(spec, out / f"{spec['name']}.png")
     print(markdown_table())
     return 0
 

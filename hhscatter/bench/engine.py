@@ -254,6 +254,7 @@ def main(argv=None):
     rec, icr = _recording_rows(row, n, rep)
     _profile_row(row, rec, icr)
     _design_rows(row)
+    _system_rows(row, n, rep)
     _whole_rows(row, n, rep)
     _write_outputs(rows, a.out, n, rep)
 
@@ -272,6 +273,31 @@ def _bare_rows(row, n, rep):
     row("bare", "yardstick µs/orbit (recommended batch size)", 1e6 * t_y / n, "")
     row("bare", "engine µs/orbit", 1e6 * t_e / n, "")
     row("bare", "engine / yardstick", t_e / t_y, "≤ 1 (0.8)", f"same t_end (1e-9) on {100 * agree:.1f} % of orbits")
+
+
+def _system_rows(row, n, rep):
+    """Systems as data (issue 23): Hénon–Heiles declared as an expression against the built-in on the same ICs
+    (target ≤ 1.05: a declared potential costs no more per step), and ns per lane-step of the other built-ins."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
+
+    m = min(n, 50_000)
+    built = Scene(energy=0.27, n=m, seed=1, r_esc=1.5)
+    declared = built.replace(system={"potential": "0.5*(x**2 + y**2) + x**2*y - y**3/3"})
+    ics = region_ics(built, 0, m)
+    t_b, rb = _best(_engine(built, ics), rep)
+    t_d, rd = _best(_engine(declared, ics), rep)
+    same = np.mean(np.abs(rd.lifetimes["t_end"] - rb.lifetimes["t_end"]) <= 1e-9 * rb.lifetimes["t_end"])
+    row("systems", "built-in Hénon–Heiles: ns/step", 1e9 * t_b / rb.n_steps, "")
+    row("systems", "declared '0.5*(x**2 + y**2) + x**2*y - y**3/3': ns/step", 1e9 * t_d / rd.n_steps, "")
+    row("systems", "declared / built-in, per step", (t_d / rd.n_steps) / (t_b / rb.n_steps), "≤ 1.05",
+        f"same t_end (1e-9) on {100 * same:.1f} % of orbits")
+    for spec in ({"name": "contopoulos"}, {"name": "n_exit", "params": {"n": 4}}, {"name": "barbanis"}):
+        sc = Scene(energy=1.5 * 1.0, n=1, system=spec)
+        sc = sc.replace(energy=1.5 * sc.model.critical_energy, n=min(m, 20_000), r_esc=None)
+        t, r = _best(_engine(sc, region_ics(sc, 0, sc.n)), rep)
+        row("systems", f"{spec['name']} at 1.5 E_c: ns/step", 1e9 * t / r.n_steps, "",
+            f"{r.n_steps / sc.n:.1f} steps/orbit")
 
 
 def _dissipative_rows(row, n, rep):

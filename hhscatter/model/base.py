@@ -179,7 +179,9 @@ class System(abc.ABC):
 
         Beyond R(E) an outward-moving orbit never returns (:meth:`no_return_radius`), so an escape decided
         there is final; 1.5 r_s keeps r_esc clear of the exits' Lyapunov orbits at low E. Without an energy
-        (ICs from a table) 1.5 r_s.
+        (ICs from a table) 1.5 r_s. R(E) itself lies beyond every bounded orbit of energy ≤ E, Lyapunov
+        orbits included: at an orbit's farthest point ṙ = 0 and r̈ = v_⊥²/r − ∂V/∂r ≤ 0, so −∂V/∂r ≤ 0
+        there, at a point with V ≤ E, and such points lie within R(E).
         """
         r = 1.5 * self.saddle_radius
         return max(r, self.no_return_radius(energy)) if energy is not None else r

@@ -9,6 +9,7 @@ expanded gradient, so a declared Hénon–Heiles costs as many operations per Ta
 from __future__ import annotations
 
 import json
+import math
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -132,7 +133,7 @@ class DeclaredSystem(System):
         return self._text
 
     @property
-    def expression(self):
+    def expression(self) -> Any:
         """V as a sympy expression in x, y and the parameters' symbols."""
         return self._expr
 
@@ -179,11 +180,11 @@ class DeclaredSystem(System):
         """V(x, y) on numpy arrays (energy)."""
         return self._landscape.v(x, y)
 
-    def potential_expression(self, x, y):
+    def potential_expression(self, x: Any, y: Any) -> Any:
         """V as a heyoka expression of x, y (walked from the sympy expression, parameters as constants)."""
         return to_heyoka(self._numeric, x, y)
 
-    def force_expressions(self, x, y):
+    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V from the expanded sympy gradient (no redundant products per Taylor step)."""
         import sympy as sp  # deferred: sympy takes ~0.3 s to import
 
@@ -202,6 +203,34 @@ class DeclaredSystem(System):
             return 0.5 * (px * px + py * py) + v(x, y)
 
         return energy
+
+    def force(self, x: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(F_x, F_y) = −∇V on numpy arrays, from the exact gradient (energy/length)."""
+        gx, gy = self._landscape.gradient(x, y)
+        return -gx, -gy
+
+    @property
+    def frequency(self) -> float:
+        """√(largest eigenvalue of V's Hessian at the minimum) (1/time), from the exact Hessian."""
+        return math.sqrt(max(self._landscape.classify(0.0, 0.0).eigenvalues[1], 0.0))
+
+    def spec(self) -> dict[str, Any]:
+        """The plain-data spec that rebuilds this system (:func:`hhscatter.model.spec.system_from_spec`).
+
+        A built-in by name with its own parameters (n of ``n_exit``), a declared potential by its text; the
+        overrides given at construction included.
+        """
+        if self._builtin_params is not None:
+            out: dict[str, Any] = {"name": self._name, "params": dict(self._builtin_params)}
+        elif self._name != "declared":
+            out = {"name": self._name, "params": dict(self._params)}
+        else:
+            out = {"potential": self._text, "params": dict(self._params)}
+        out["dissipation"] = self.dissipation
+        for k, v in self._overrides.items():
+            out[k] = [[float(c) for c in (e if not isinstance(e, Exit) else (e.x, e.y, e.energy))] for e in v] \
+                if k == "exits" else float(v)
+        return out
 
     def provenance(self) -> dict[str, Any]:
         """Name, V as text, parameters, dissipation; the overrides and the built-in's parameters when given."""

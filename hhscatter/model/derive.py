@@ -6,6 +6,7 @@ Given V(x, y) as a sympy expression in x and y (parameters substituted, :func:`h
 1. **the critical points** ∇V = 0: for a polynomial V symbolically (a lex Gröbner basis of (V_x, V_y): if it
    is not zero-dimensional the critical points form curves and nothing can be derived; otherwise the real
    roots of its two eliminants give every critical point, polished by Newton's method); for any other V
+   (a polynomial with irrational coefficients such as pi included)
    numerically (damped Newton from a polar grid of starts out to :data:`SEARCH_RADIUS`, deduplicated);
 2. **their kind** from the Hessian's eigenvalues: ``minimum``, ``saddle``, ``maximum`` or ``degenerate``
    (an eigenvalue below 1e-8 of the largest; lines of critical points and monkey saddles are degenerate);
@@ -42,6 +43,8 @@ from hhscatter.model.parse import symbols
 SEARCH_RADIUS = 100.0
 #: a Hessian eigenvalue below this fraction of the largest |eigenvalue| makes a critical point degenerate
 DEGENERATE = 1e-8
+#: steps after which a steepest-descent path that has neither reached a minimum nor R(E) is given up
+MAX_DESCENT_STEPS = 20_000
 #: relative margin added to R(E) beyond the refined grid estimate
 NO_RETURN_MARGIN = 1e-9
 
@@ -137,8 +140,10 @@ class Landscape:
         self.expr, self.x, self.y = expr, x, y
         self.grad = (sp.diff(expr, x), sp.diff(expr, y))
         self.hess = (sp.diff(self.grad[0], x), sp.diff(self.grad[0], y), sp.diff(self.grad[1], y))
-        self.polynomial = bool(expr.is_polynomial(x, y))
-        funcs = [sp.lambdify((x, y), e, "numpy") for e in (expr, *self.grad, *self.hess)]
+        # symbolic critical points for polynomials with rational coefficients (pi, sqrt(2)... go the numeric way)
+        self.polynomial = bool(expr.is_polynomial(x, y)) and sp.Poly(expr, x, y).domain in (sp.ZZ, sp.QQ)
+        # numpy arrays; scipy.special for what numpy lacks (erf)
+        funcs = [sp.lambdify((x, y), e, ["scipy", "numpy"]) for e in (expr, *self.grad, *self.hess)]
         self._v, self._gx, self._gy, self._hxx, self._hxy, self._hyy = funcs
         #: (V_x, V_y) at one point in plain floats (the descent paths' right-hand side)
         self.scalar_gradient = sp.lambdify((x, y), self.grad, "math")
@@ -311,7 +316,9 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
         R, T = np.meshgrid(r, th)
         X, Y = R * np.cos(T), R * np.sin(T)
         f = land.v(X, Y) - energy
-        rho = land.radial(X, Y)
+        gx, gy = land.gradient(X, Y)
+        with np.errstate(all="ignore"):  # overflow far out: inf/nan compare False, as they should
+            rho = X * gx + Y * gy
         bad = (f <= 0) & (rho >= 0)
         if not bad.any():
             return 0.0
@@ -323,8 +330,8 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
         raise ConfigError(f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
                           f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits")
     dr = r[1] - r[0]
-    gx, gy = land.gradient(X, Y)
-    tau = X * gy - Y * gx  # ∂V/∂θ
+    with np.errstate(all="ignore"):
+        tau = X * gy - Y * gx  # ∂V/∂θ
 
     def changes(F):  # cells (θ_i..θ_i+1, r_j..r_j+1) across which F changes sign (θ wraps round)
         c = np.stack([F[:, :-1], F[:, 1:], np.roll(F, -1, 0)[:, :-1], np.roll(F, -1, 0)[:, 1:]])
@@ -379,7 +386,8 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float,
              minima: Sequence[CriticalPoint]) -> tuple[float, float, bool]:
     """Follow ẋ = −∇V/(1 + |∇V|) from (x0, y0): (end x, end y, True if it passed r_out).
 
-    Stops beyond r_out, within 1e-6 (1 + |m|) of a known minimum m, where |∇V| falls below 1e-10, or at t = 1e5.
+    Stops beyond r_out, within 1e-6 (1 + |m|) of a known minimum m, where |∇V| falls below 1e-10, at t = 1e5 or
+    after :data:`MAX_DESCENT_STEPS` steps.
     """
     from scipy.integrate import solve_ivp  # deferred: scipy.integrate loads on first use
 
@@ -403,9 +411,24 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float,
     for ev in (out, near, still):
         ev.terminal = True
     near.direction = still.direction = -1
-    sol = solve_ivp(rhs, (0.0, 1e5), [x0, y0], events=[out, near, still], rtol=1e-8, atol=1e-11)
+    calls = [0]
+
+    def counted(t, z):  # gives up a path that crawls (e.g. up a narrowing channel)
+        calls[0] += 1
+        if calls[0] > 6 * MAX_DESCENT_STEPS:  # RK45: 6 evaluations per step
+            raise _GiveUp(z)
+        return rhs(t, z)
+
+    try:
+        sol = solve_ivp(counted, (0.0, 1e5), [x0, y0], events=[out, near, still], rtol=1e-8, atol=1e-11)
+    except _GiveUp as e:
+        return float(e.args[0][0]), float(e.args[0][1]), False
     xe, ye = sol.y[:, -1]
     return float(xe), float(ye), bool(sol.t_events[0].size)
+
+
+class _GiveUp(Exception):
+    """A steepest-descent path took more than MAX_DESCENT_STEPS steps."""
 
 
 class _Union:
@@ -433,8 +456,11 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
     for k, s in enumerate(saddles):
         a, b, c = (float(h) for h in land.hessian(s.x, s.y))
         w, v = np.linalg.eigh(np.array([[a, b], [b, c]]))
-        d = v[:, 0]
-        h = 1e-5 * max(1.0, s.distance)
+        # the descending eigenvector, turned by 1e-6 rad: a path started exactly on a symmetry axis could
+        # otherwise run into another saddle along its stable manifold
+        c, sn = math.cos(1e-6), math.sin(1e-6)
+        d = np.array([c * v[0, 0] - sn * v[1, 0], sn * v[0, 0] + c * v[1, 0]])
+        h = 1e-5 * s.distance
         if s.energy not in r_nr:
             value = no_return_radius(land, s.energy, scale)
             r_nr.update({p.energy: value for p in saddles
@@ -625,5 +651,5 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
     return Derivation(points, found, ec, omega, method, time.perf_counter() - t0)
 
 
-__all__ = ["CriticalPoint", "DEGENERATE", "Derivation", "Landscape", "NO_RETURN_MARGIN", "SEARCH_RADIUS",
-           "check_omega", "check_well", "critical_points", "derive", "find_exits", "no_return_radius"]
+__all__ = ["CriticalPoint", "DEGENERATE", "Derivation", "Landscape", "MAX_DESCENT_STEPS", "NO_RETURN_MARGIN",
+           "SEARCH_RADIUS", "check_omega", "check_well", "critical_points", "derive", "find_exits", "no_return_radius"]

@@ -183,7 +183,7 @@ def _check_sympy(expr, names: set[str]):
         elif isinstance(node, sp.Number):
             if not node.is_finite or not node.is_real:
                 raise ConfigError(f"potential: the constant {node} is not a finite real number")
-        elif node is sp.pi or isinstance(node, (sp.Add, sp.Mul, sp.Pow)):
+        elif isinstance(node, (sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow)):  # NumberSymbol: pi, E
             if isinstance(node, sp.Pow) and node.exp.is_number and abs(float(node.exp)) > MAX_EXPONENT:
                 raise ConfigError(f"potential: the exponent {node.exp} is out of range (|exponent| ≤ {MAX_EXPONENT})")
         elif not isinstance(node, allowed_functions):
@@ -246,6 +246,8 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
             expr = _Walker(names)(tree)
         except RecursionError:
             raise ConfigError("potential: the expression is nested too deeply") from None
+        # sympy may have rewritten a part outside the whitelist (real x: sqrt(x**2) -> Abs(x)): check again
+        expr = _check_sympy(expr, names)
     else:
         mod = type(source).__module__ or ""
         if mod.startswith("heyoka"):
@@ -331,7 +333,7 @@ def to_heyoka(expr, x, y):
             if e.name not in names:
                 raise ConfigError(f"potential: symbol {e.name!r} has no value")
             return names[e.name]
-        if e.is_Number or e is sp.pi:
+        if e.is_Number or e.is_NumberSymbol:
             return hy.expression(float(e))
         if isinstance(e, sp.Add):
             terms = [walk(a) for a in _ordered(e.args)]

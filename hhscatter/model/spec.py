@@ -37,8 +37,10 @@ SYSTEM_KEYS = {
     "params": "the parameters' values, name = number",
     "critical_energy": "override: E_c, when the derivation cannot decide it",
     "omega_radius": "override: the radius of Ω (the closure rule's well), when the derivation cannot decide it",
+    "exits": "override: the exits' saddles as [[x, y], ...] or [[x, y, energy], ...], when the derivation cannot "
+             "decide them",
 }
-OVERRIDES = ("critical_energy", "omega_radius")
+OVERRIDES = ("critical_energy", "omega_radius", "exits")
 
 
 def canonical_spec(spec: dict[str, Any] | System) -> dict[str, Any]:
@@ -75,7 +77,16 @@ def canonical_spec(spec: dict[str, Any] | System) -> dict[str, Any]:
     if diss not in DISSIPATIONS:
         raise ConfigError(f"system.dissipation must be one of {list(DISSIPATIONS)}, got {diss!r}")
     out["dissipation"] = diss
-    for k in OVERRIDES:
+    if spec.get("exits") is not None:
+        ex = spec["exits"]
+        ok = isinstance(ex, (list, tuple)) and ex and all(
+            isinstance(e, (list, tuple)) and len(e) in (2, 3) and all(
+                not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(float(v)) for v in e)
+            for e in ex)
+        if not ok:
+            raise ConfigError(f"system.exits must be a list of [x, y] or [x, y, energy] (finite numbers), got {ex!r}")
+        out["exits"] = [[float(v) for v in e] for e in ex]
+    for k in ("critical_energy", "omega_radius"):
         if spec.get(k) is not None:
             v = spec[k]
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):

@@ -232,6 +232,7 @@ class SystemTable(_Table):
     params: dict[str, Number] = None
     critical_energy: Number = None
     omega_radius: Number = None
+    exits: NumberLists = None
 
 
 class AboutTable(_Table):

@@ -165,3 +165,53 @@ def test_make_system_builtins_and_defaults():
 def test_make_system_errors_name_the_key(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         make_system(**kwargs)
+
+
+def test_escape_radius_lies_beyond_every_bounded_orbit(conto):
+    assert conto.default_escape_radius(1.5) == pytest.approx(max(2 * math.sqrt(1.5), 1.5 * 2.0))
+    big = conto.default_escape_radius(10.0)
+    assert big == pytest.approx(2 * math.sqrt(10.0), rel=1e-8) and big >= 2 * math.sqrt(10.0)
+    # the argument (base.System.default_escape_radius): a bounded orbit of energy E never goes beyond R(E) (here R
+    # without the saddle-distance floor, which alone would bound these orbits)
+    from hhscatter.model.derive import no_return_radius
+
+    for state in ([0.3, -0.2, 0.9, 0.5], [1.2, 0.0, 0.0, 0.6], [0.0, 0.5, 1.1, 0.1]):
+        E = conto.energy(*state)
+        R = no_return_radius(conto._landscape, E, 2.0)
+        assert E < conto.critical_energy and R < conto.saddle_radius
+        res = _ta(conto, state, tol=1e-12).propagate_grid(np.linspace(0, 300, 30001))[5]
+        r_max = np.hypot(res[:, 0], res[:, 1]).max()
+        assert 0.5 * R < r_max <= R, (E, r_max, R)
+
+
+@pytest.mark.parametrize("text", ["0.5*(x**2 + y**2) - 0.25*x**2*y**2", "atan(0.5*(x**2 + y**2) + x**2*y - y**3/3)",
+                                  "0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cos(y)"])
+def test_heyoka_expressions_match_numpy_and_differentiation(text):
+    import heyoka as hy
+
+    s = DeclaredSystem(text)
+    x, y = hy.make_vars("x", "y")
+    V = s.potential_expression(x, y)
+    fx, fy = s.force_expressions(x, y)
+    pts = np.random.default_rng(3).uniform(-1.2, 1.2, (2, 300))
+    v = hy.cfunc([V], vars=[x, y])(pts)[0]
+    assert np.allclose(v, s.potential(*pts), rtol=1e-14, atol=1e-15)
+    # the simplified force against heyoka's own derivative of V (an independent differentiation)
+    got = hy.cfunc([fx, fy], vars=[x, y])(pts)
+    want = hy.cfunc([-hy.diff(V, x), -hy.diff(V, y)], vars=[x, y])(pts)
+    assert np.allclose(got, want, rtol=1e-13, atol=1e-14)
+
+
+def test_spec_rebuilds_the_system_and_force_frequency_are_exact(hh3, conto):
+    from hhscatter.model.spec import system_from_spec
+
+    n4 = make_system("n_exit", params={"n": 4})
+    assert n4.spec() == {"name": "n_exit", "params": {"n": 4}, "dissipation": "linear"}
+    assert conto.spec() == {"name": "contopoulos", "params": {"eps": 0.25}, "dissipation": "linear"}
+    for s in (n4, conto, DeclaredSystem("0.5*(x**2 + y**2) - eps*x*y**2", {"eps": 0.5}, "quadratic")):
+        assert system_from_spec(s.spec()) == s
+    fx, fy = hh3.force([0.3, -0.2], [0.1, 0.4])
+    want = HenonHeiles().force([0.3, -0.2], [0.1, 0.4])
+    assert np.allclose(fx, want[0], rtol=1e-9) and np.allclose(fy, want[1], rtol=1e-9)
+    assert fx[0] == -(0.3 + 2 * 0.3 * 0.1)  # exact: −V_x = −(x + 2xy)
+    assert conto.frequency == 1.0 and DeclaredSystem("0.5*x**2 + 2*y**2 - x**2*y**2").frequency == 2.0

@@ -73,14 +73,29 @@ def test_no_return_radius_reproduces_the_hh_closed_form(omega, lam):
         assert got >= want and got == pytest.approx(want, rel=1e-8), (E, got, want)
 
 
+@pytest.mark.parametrize("name, params, closed", [
+    # V = r²/2 + r^k g(θ) homogeneous: V_r = 0 and V = E meet at r² = 2kE/(k − 2) (k = 3: HH's √(6E))
+    ("n_exit", {"n": 4}, lambda E: math.sqrt(8 * E / 2)),
+    ("n_exit", {"n": 5}, lambda E: math.sqrt(10 * E / 3)),
+    ("contopoulos", {"eps": 0.25}, lambda E: 2 * math.sqrt(E)),
+    ("barbanis", {"eps": 0.5}, lambda E: math.sqrt(6 * E)),
+])
+def test_no_return_radius_closed_forms_of_the_builtins(name, params, closed):
+    s = make_system(name, params=params)
+    for f in (1.0, 1.5, 3.0):
+        E = f * s.critical_energy
+        got, want = s.no_return_radius(E), max(closed(E), s.saddle_radius)
+        assert got >= want and got == pytest.approx(want, rel=1e-8), (E, got, want)
+
+
 def test_no_return_radius_is_a_no_return_radius():
     """Beyond R(E), −∂V/∂r > 0 wherever V ≤ E (checked on a fine polar grid independent of the one used)."""
-    for s in (make_system("contopoulos"), make_system("barbanis"), make_system("n_exit", params={"n": 5})):
+    for s in (make_system("contopoulos"), make_system("barbanis")):
         for E in (s.critical_energy, 1.5 * s.critical_energy):
             R = s.no_return_radius(E)
             assert R >= s.saddle_radius
-            r = np.linspace(R, 20 * R, 700)
-            th = np.linspace(0, 2 * np.pi, 1201)
+            r = np.linspace(R, 20 * R, 500)
+            th = np.linspace(0, 2 * np.pi, 1001)
             rr, tt = np.meshgrid(r, th)
             x, y = rr * np.cos(tt), rr * np.sin(tt)
             land = s._landscape
@@ -146,6 +161,15 @@ def test_a_non_polynomial_potential_is_derived_numerically():
     assert s.no_return_radius(math.atan(0.25)) == pytest.approx(math.sqrt(6 * 0.25), rel=1e-8)
 
 
+@pytest.mark.parametrize("lam_text, lam", [("sqrt(2)", math.sqrt(2)), ("pi/3", math.pi / 3)])
+def test_irrational_coefficients_go_the_numeric_way(lam_text, lam):
+    s = DeclaredSystem(f"0.5*(x**2 + y**2) + {lam_text}*(x**2*y - y**3/3)")
+    assert s.derivation.method == "numeric"
+    hh = HenonHeiles(1.0, lam)
+    assert s.critical_energy == pytest.approx(hh.critical_energy, rel=1e-14)
+    assert np.allclose([(e.x, e.y) for e in s.exits], [(e.x, e.y) for e in hh.exits], atol=1e-13)
+
+
 def test_overrides_replace_the_derivation():
     # the ring: nothing derivable, everything given
     s = DeclaredSystem("0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2", critical_energy=0.25,
@@ -164,3 +188,9 @@ def test_omega_that_is_no_disk_asks_for_omega_radius():
     # and a given Ω opens the far exit's energy to the well: we check the derived one fails when E_c is forced up
     with pytest.raises(ConfigError, match="give `omega_radius`"):
         DeclaredSystem("0.5*(x**2 + y**2) - x**3/3 - 8*y**3/3", critical_energy=1 / 6)
+
+
+def test_a_descent_that_crawls_is_given_up_with_a_clear_error():
+    # cosh(y) walls close the y-channel exponentially: the path from the saddle crawls out to R(E) ~ 1300
+    with pytest.raises(ConfigError, match=r"saddle at \(0, 0.707107\).*neither a minimum nor infinity.*`exits`"):
+        DeclaredSystem("0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cosh(y)")

@@ -106,3 +106,15 @@ def test_drag_laws_against_an_independent_integrator(dissipation):
     np.testing.assert_allclose(ta.state, ref.y[:, -1], rtol=0, atol=1e-10)
     # the energy only falls: dE/dt = −γ|p|² (linear) or −γ|p|³ (quadratic)
     assert hh.energy(*ta.state) < hh.energy(0.1, 0.2, 0.3, -0.2)
+
+
+def test_exits_and_critical_energy_can_be_given_and_are_checked():
+    spec = {"potential": "0.5*(x**2 + y**2) - eps*x**2*y**2", "params": {"eps": 0.25},
+            "exits": [[2**0.5, 2**0.5], [-(2**0.5), 2**0.5], [-(2**0.5), -(2**0.5)], [2**0.5, -(2**0.5)]]}
+    s = Scene(energy=1.5, n=10, system=spec)
+    assert len(s.model.exits) == 4 and s.model.critical_energy == pytest.approx(1.0, rel=1e-12)
+    assert s.system["exits"][0] == [2**0.5, 2**0.5]
+    with pytest.raises(ConfigError, match="system.exits must be a list"):
+        Scene(energy=1.5, n=10, system=dict(spec, exits=[[1.0]]))
+    with pytest.raises(ConfigError, match="cannot be given for the built-in"):
+        Scene(energy=1.5, n=10, system={"name": "contopoulos", "critical_energy": 1.0})
