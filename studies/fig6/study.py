@@ -189,12 +189,8 @@ def _curve(lifetimes, dt):
     return c.t, c.P, c.P_err
 
 
-def _fit_points(t, P, P_err, tau0, fit_dt, n, min_count):
-    grid = np.arange(tau0, t[-1] + 1e-9, fit_dt)
-    idx = np.clip(np.searchsorted(t, grid), 0, t.size - 1)
-    idx = np.unique(idx)
-    sel = (P[idx] * n >= min_count) & (P_err[idx] > 0)
-    return t[idx][sel], P[idx][sel], P_err[idx][sel]
+# the fitting rule, shared with study generality: hhscatter.analysis.dissipative.survival_model
+_fit_points = sm.survival_fit_points
 
 
 def _fit_row(label, model, hazard, fit, extra):
@@ -210,38 +206,9 @@ def _fit_row(label, model, hazard, fit, extra):
     return row
 
 
-def _best(fit_fn, starts):
-    """The fit with the smallest χ² over several starting-value dicts (the χ² surface has local minima:
-    the settling branch can be traded for a lower trapped fraction)."""
-    best = None
-    for p0 in starts:
-        try:
-            f = fit_fn(p0)
-        except (RuntimeError, ValueError):
-            continue
-        if best is None or f.chi2 < best.chi2:
-            best = f
-    if best is None:
-        raise RuntimeError("survival-model fit failed from every starting point")
-    return best
-
-
-def _plateau(t, P, t_q):
-    """P at time t_q (log-linear interpolation): the trapped fraction before settling starts."""
-    return float(np.exp(np.interp(t_q, t, np.log(np.maximum(P, 1e-300)))))
-
-
-def _homogeneous_fits(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, tau0, E_c, hazards, fit_tau2, P_min):
-    P_tau0 = _plateau(t, P, tau0)
-    tau2 = tau2_predicted(E0, E_c, mu, gamma)
-    fne = min(_plateau(t, P, tau0 + 0.85 * (tau2 - tau0)), 0.95 * P_tau0)
-    starts = [None, {"f_ne": fne, "L": 1.0, "b": 1.0}, {"f_ne": fne, "L": 3.0, "b": 0.3}]
-    fits = {}
-    for h in hazards:
-        fits[h] = _best(lambda p0, h=h: sm.fit_survival_model(
-            tf, Pf, sf, kappa_of_E=kappa, E0=E0, mu=mu, gamma=gamma, tau0=tau0, E_c=E_c, hazard=h,
-            fit_tau2=fit_tau2, P_min=P_min, P_tau0=P_tau0, p0=p0), starts)
-    return fits
+_best = sm.best_fit
+_plateau = sm.plateau_level
+_homogeneous_fits = sm.fit_homogeneous_hazards
 
 
 def _mixture_variants(study):

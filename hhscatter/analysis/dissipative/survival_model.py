@@ -35,8 +35,8 @@ Units: time in model units, energies in model units, rates in 1/time.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -50,13 +50,17 @@ __all__ = [
     "HomogeneousProblem",
     "SurvivalFit",
     "SurvivalModelParams",
+    "best_fit",
     "better_fit",
     "compare_fits",
+    "fit_homogeneous_hazards",
     "fit_survival_model",
     "homogeneous_start",
+    "plateau_level",
     "predict_tau1",
     "profile_interval",
     "settling_rate",
+    "survival_fit_points",
     "survival_model",
 ]
 
@@ -268,20 +272,29 @@ def _residual_fn(curve, P, sig, space):
     return res
 
 
-def _lsq(res, starts, lo, hi):
-    """Best least_squares solution over several starting points."""
+def _best_of(fit_fn, starts, cost, errors, message):
+    """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
+    none left is a RuntimeError(``message``)."""
     best = None
     for x0 in starts:
-        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
         try:
-            r = optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
-        except ValueError:
+            r = fit_fn(x0)
+        except errors:
             continue
-        if best is None or r.cost < best.cost:
+        if best is None or cost(r) < cost(best):
             best = r
     if best is None:
-        raise RuntimeError("survival fit failed for all starting points")
+        raise RuntimeError(message)
     return best
+
+
+def _lsq(res, starts, lo, hi):
+    """Best least_squares solution over several starting points."""
+    def solve(x0):
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
+        return optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
+
+    return _best_of(solve, starts, lambda r: r.cost, ValueError, "survival fit failed for all starting points")
 
 
 def _covariance(J, chi2_red, absolute_sigma):
@@ -569,7 +582,7 @@ class HomogeneousProblem:
         v["tau2"] = tau2
         return v
 
-    def model(self, v: dict) -> "SurvivalModelParams":
+    def model(self, v: dict) -> SurvivalModelParams:
         return SurvivalModelParams(self.kappa_of_E, self.E0, self.mu, self.gamma, self.tau0, v["tau2"], v["f_ne"],
                                    v["f_e"], v["L"], v["b"], self.E_c, self.hazard)
 
@@ -587,7 +600,7 @@ class HomogeneousProblem:
 
     def fit_at(self, tau2, prev=None, warm_only: bool = False, P0=None):
         """(solution or None, χ², residual function) of the fit with τ2 held at ``tau2``."""
-        curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)  # noqa: E731
+        curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)
         res = _residual_fn(curve, self.Pf, self.sf, self.space)
         if not self.free:
             r = res(np.array([]))
@@ -802,3 +815,64 @@ def better_fit(fits: dict) -> str | None:
         raise ValueError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
     best = np.flatnonzero(rms == rms.min())
     return None if best.size > 1 else items[int(best[0])][0]
+
+
+# ---------------------------------------------------------------------------
+# the fitting rule of the figure studies (fig6; study generality applies it to other systems)
+# ---------------------------------------------------------------------------
+def survival_fit_points(t, P, P_err, tau0: float, fit_dt: float, n: int, min_count: float):
+    """survival_fit_points(t, P, P_err, τ0, fit_dt, n, min_count) -> (t, P, P_err) of the fitted points.
+
+    The curve's points nearest to the coarse grid τ0, τ0 + fit_dt, … (Kaplan–Meier points are correlated: a
+    coarse grid keeps the fit's χ² indicative), kept where N·P ≥ ``min_count`` (log residuals need counts ≫ 1)
+    and P_err > 0. Times in time units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 10.0, 0.5); P = np.exp(-0.3 * t)
+    >>> survival_fit_points(t, P, 0.01 * P, 1.0, 2.0, 1000, 20)[0].tolist()
+    [1.0, 3.0, 5.0, 7.0, 9.0]
+    """
+    grid = np.arange(tau0, t[-1] + 1e-9, fit_dt)
+    idx = np.clip(np.searchsorted(t, grid), 0, t.size - 1)
+    idx = np.unique(idx)
+    sel = (P[idx] * n >= min_count) & (P_err[idx] > 0)
+    return t[idx][sel], P[idx][sel], P_err[idx][sel]
+
+
+def best_fit(fit_fn: Callable, starts):
+    """best_fit(fit_fn, starts) -> the fit with the smallest χ² over several starting-value dicts.
+
+    The χ² surface has local minima (the settling branch can be traded for a lower trapped fraction);
+    starts whose fit raises RuntimeError or ValueError are skipped; none left is a RuntimeError.
+    """
+    return _best_of(fit_fn, starts, lambda f: f.chi2, (RuntimeError, ValueError),
+                    "survival-model fit failed from every starting point")
+
+
+def plateau_level(t, P, t_q: float) -> float:
+    """plateau_level(t, P, t_q) -> P at time t_q (log-linear interpolation): the trapped fraction before settling
+    starts, when t_q is late in the escape regime."""
+    return float(np.exp(np.interp(t_q, t, np.log(np.maximum(P, 1e-300)))))
+
+
+def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, tau0, E_c, hazards, fit_tau2, P_min):
+    """fit_homogeneous_hazards(curve, fitted points, *, κ0(E), E0, μ, γ, τ0, E_c, hazards, fit_tau2, P_min)
+    -> {hazard: SurvivalFit}: the homogeneous model, Eq. (eqn:surv_prob_model), fitted by the rule of study fig6.
+
+    ``t, P, P_err``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fraction are read from it);
+    ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`). P(τ0) is held; three starts (data-driven,
+    and f_ne = P at τ0 + 0.85 (τ2 − τ0) with (L, b) = (1, 1) and (3, 0.3)), the best χ² kept
+    (:func:`best_fit`). Units: t in time units, E in energy units, γ in 1/time.
+    """
+    P_tau0 = plateau_level(t, P, tau0)
+    tau2 = tau2_predicted(E0, E_c, mu, gamma)
+    fne = min(plateau_level(t, P, tau0 + 0.85 * (tau2 - tau0)), 0.95 * P_tau0)
+    starts = [None, {"f_ne": fne, "L": 1.0, "b": 1.0}, {"f_ne": fne, "L": 3.0, "b": 0.3}]
+    fits = {}
+    for h in hazards:
+        fits[h] = best_fit(lambda p0, h=h: fit_survival_model(
+            tf, Pf, sf, kappa_of_E=kappa, E0=E0, mu=mu, gamma=gamma, tau0=tau0, E_c=E_c, hazard=h,
+            fit_tau2=fit_tau2, P_min=P_min, P_tau0=P_tau0, p0=p0), starts)
+    return fits

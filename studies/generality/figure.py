@@ -1,0 +1,111 @@
+"""Figure of study ``generality`` (draws the derived tables and generality.json; computes nothing but the laws'
+curves from their fitted parameters)."""
+from __future__ import annotations
+
+import numpy as np
+
+from hhscatter.publish.figures import agg_pyplot
+
+COLORS = {"henon_heiles": "#2166ac", "contopoulos": "#b2182b", "barbanis": "#1b7837"}
+MARKERS = {"henon_heiles": "o", "contopoulos": "s", "barbanis": "^"}
+
+
+def _label(name, sysinfo):
+    return f"{name.replace('_', '–').title()} ({sysinfo['n_exits']} exits, $E_c$ = {sysinfo['E_c']:.4g})"
+
+
+def _panel_kappa(ax, kappa, numbers):
+    for name, info in numbers["systems"].items():
+        col, mk = COLORS.get(name, "k"), MARKERS.get(name, "o")
+        d = kappa[(kappa["system"] == name) & (kappa["convention"] == "plateau")]
+        ok = d["defined"].astype(bool)
+        ax.errorbar(d.loc[ok, "eps"], d.loc[ok, "kappa"], d.loc[ok, "kappa_err"], fmt=mk, color=col, ms=5,
+                    capsize=2, label=_label(name, info))
+        ax.plot(d.loc[~ok, "eps"], d.loc[~ok, "kappa"], "x", color=col, ms=7)  # trapped plateau: ill-defined
+        e = kappa[(kappa["system"] == name) & (kappa["convention"] == "escaping") & kappa["defined"]]
+        ax.plot(e["eps"], e["kappa"], mk, mfc="none", color=col, ms=8, alpha=0.7)
+        laws = info["kappa_law"]
+        conv = "plateau" if laws.get("plateau") else "escaping"
+        law = laws.get(conv)
+        if law:
+            a, b, c, eb = (law[k]["value"] for k in ("a", "b", "c", "eps_b"))
+            x = np.geomspace(max(float(d["eps"].min()) / 1.3, 1e-3), float(d["eps"].max()) * 1.2, 200)
+            ax.plot(x, np.where(x < eb, a * x * x + b * x, c * x), "-" if conv == "plateau" else "--", color=col,
+                    lw=1, alpha=0.8)
+            ax.axvline(eb, color=col, ls=":", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$\epsilon = (E - E_c)/E_c$")
+    ax.set_ylabel(r"$\kappa_0$ (1/time; well frequency 1)")
+    ax.set_title("(a) κ0: filled all orbits, × ill-defined (trapped plateau),\nopen escaping orbits only; "
+                 "lines: law aε²+bε | cε, dotted: break", fontsize=9)
+    ax.legend(fontsize=7, loc="lower right")
+
+
+def _panel_mu_of_E(ax, mu, numbers):
+    for name in numbers["systems"]:
+        col = COLORS.get(name, "k")
+        d = mu[mu["system"] == name]
+        w = d[d["kind"] == "microcanonical well"].sort_values("ratio")
+        ax.plot(w["ratio"], w["mu"], "-", color=col, lw=1)
+        c = d[d["kind"] == "c-measure"]
+        ax.errorbar(c["ratio"], c["mu"], c["mu_err"], fmt=MARKERS.get(name, "o"), color=col, ms=5, capsize=2)
+        a = d[d["kind"] == "all survivors"]
+        ax.plot(a["ratio"], a["mu"], MARKERS.get(name, "o"), mfc="none", color=col, ms=7, alpha=0.6)
+    ax.axvline(1.0, color="0.5", lw=0.8, ls="--")
+    ax.set_xlabel(r"$E/E_c$")
+    ax.set_ylabel(r"$2\langle K\rangle/E$ of the conservative system")
+    ax.set_title("(b) μ(E): line microcanonical well, filled c-measure, open all survivors", fontsize=9)
+
+
+def _panel_mu(ax, numbers, paper_mu):
+    lo, hi = 0.8, 1.1
+    for name, info in numbers["systems"].items():
+        for wname, bw in info["mu_by_window"].items():
+            m, p = bw["measured"], bw["predicted_c_measure"]
+            if m["value"] is None or p["value"] is None:
+                continue
+            w = bw["window"]
+            ax.errorbar(p["value"], m["value"], xerr=p["err"], yerr=m["err"], fmt=MARKERS.get(name, "o"),
+                        color=COLORS.get(name, "k"), ms=6, capsize=3, mfc=None if wname == "paper" else "none",
+                        label=f"{name}, t ∈ [{w[0]:g}, {w[1]:g}]")
+            lo, hi = min(lo, m["value"] - 0.03, p["value"] - 0.03), max(hi, m["value"] + 0.03, p["value"] + 0.03)
+    ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+    ax.axhline(paper_mu, color="0.5", ls=":", lw=0.8)
+    ax.text(lo + 0.005, paper_mu + 0.004, "paper HH μ = 0.91", fontsize=7, color="0.4")
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(lo, hi)
+    ax.set_xlabel("μ predicted (conservative ⟨K⟩)")
+    ax.set_ylabel("μ measured (⟨E⟩(t) fit)")
+    ax.set_title("(c) μ measured vs predicted (c-measure above E_c, microcanonical well below)\n"
+                 "filled: fig3's window [0, 200]; open: ⟨E⟩ > E_c window", fontsize=9)
+    ax.legend(fontsize=7)
+
+
+def _panel_curves(ax, curves, numbers, gamma):
+    for name in numbers["systems"]:
+        col = COLORS.get(name, "k")
+        d = curves[(curves["system"] == name) & (curves["t"] > 0)]
+        for kind, ls in (("measured", "-"), ("predicted", "--")):
+            k = d[d["kind"] == kind]
+            ax.plot(k["t"], -np.log(k["mean_E_over_E0"]) / (gamma * k["t"]), ls, color=col, lw=1.4 if ls == "-" else 1,
+                    label=f"{name} {kind}")
+    ax.set_xlabel("t")
+    ax.set_ylabel(r"$-\ln(\langle E\rangle/E_0)/(\gamma t)$")
+    ax.set_title(f"(d) running μ of ⟨E⟩(t), γ = {gamma:g}: measured (solid), predicted path (dashed)", fontsize=9)
+    ax.legend(fontsize=6, ncol=2)
+
+
+def plot_generality(kappa, mu, curves, numbers, path):
+    """plot_generality(κ table, μ table, ⟨E⟩ curves, numbers, path) -> None: the 4-panel figure as PNG."""
+    plt = agg_pyplot()
+    fig, axs = plt.subplots(2, 2, figsize=(11, 8.5))
+    _panel_kappa(axs[0, 0], kappa, numbers)
+    _panel_mu_of_E(axs[0, 1], mu, numbers)
+    _panel_mu(axs[1, 0], numbers, numbers["config"]["study"].get("paper_mu", 0.91))
+    _panel_curves(axs[1, 1], curves, numbers, numbers["config"]["study"]["mu_gamma"])
+    fig.suptitle(f"generality ({numbers['scale']} scale): the paper's claims on three systems at the same E/E_c",
+                 fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)

@@ -1,0 +1,107 @@
+"""Study generality (issue 24): the tiny end-to-end run, its JSON's structure, and its numbers against
+independent recomputations from the raw tables (numpy/pandas only) and exact identities."""
+from __future__ import annotations
+
+import itertools
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+SYSTEMS = {"henon_heiles", "contopoulos", "barbanis"}
+
+
+@pytest.fixture(scope="module")
+def tiny(tiny_studies):
+    out = tiny_studies / "generality" / "out" / "tiny"
+    return out, json.loads((out / "generality.json").read_text())
+
+
+def test_generality_tiny_end_to_end_writes_claims_for_every_system(tiny):
+    out, doc = tiny
+    assert (out / "generality.png").stat().st_size > 20_000
+    assert set(doc["systems"]) == SYSTEMS
+    assert {s["n_exits"] for s in doc["systems"].values()} == {2, 3, 4}  # different numbers of exits
+    claims = doc["claims"]
+    assert claims and all({"claim", "system", "value", "err", "verdict"} <= set(c) for c in claims)
+    for system in SYSTEMS:
+        got = {c["claim"] for c in claims if c["system"] == system}
+        assert {"1", "3", "4"} <= got, system
+    # energies alike: every system's E0 is the same multiple of its own E_c
+    ratios = {round(s["E0"] / s["E_c"], 12) for s in doc["systems"].values()}
+    assert ratios == {doc["config"]["study"]["e0_ratio"]}
+    # κ0 under every convention: all orbits (plateau, P-level windows), the escaping orbits, the alternative ICs
+    assert {r["convention"] for r in doc["kappa"]} == {"plateau", "plevel", "escaping",
+                                                      doc["config"]["study"]["alt_region"]}
+    for c in claims:  # a verdict is a statement, a value a number or None (never NaN in the JSON)
+        assert isinstance(c["verdict"], str) and c["verdict"]
+        assert c["value"] is None or math.isfinite(c["value"])
+
+
+def test_tau2_predicted_is_eq_tau2_with_the_measured_mu(tiny):
+    """τ2 = ln(E0/E_c)/(μγ), Eq. (eq:tau2): the same E0/E_c for every system, so τ2·γ·μ = ln(e0_ratio)."""
+    _, doc = tiny
+    e0r = doc["config"]["study"]["e0_ratio"]
+    for name, s in doc["systems"].items():
+        mu = s["mu_measured"]["value"]
+        for row in s["taus"]:
+            assert row["tau2_pred"] * row["gamma"] * mu == pytest.approx(math.log(e0r), rel=1e-12), name
+
+
+def test_mu_measured_against_a_direct_fit_of_the_raw_snapshots(tiny):
+    """μ of the JSON = least squares of log(⟨E⟩/E0) = −μγt through the origin on the window, ⟨E⟩ over every
+    snapshot row at t (orbits not escaped, settled ones continued), recomputed here with pandas and numpy."""
+    import pyarrow.parquet as pq
+
+    out, doc = tiny
+    st = doc["config"]["study"]
+    g, (lo, hi) = st["mu_gamma"], st["mu_window"]
+    for name, s in doc["systems"].items():
+        raw = out / "raw" / f"{name}_g{g:g}" / "snapshots"
+        rows = pd.concat([pq.read_table(p, columns=["t", "energy"]).to_pandas() for p in sorted(raw.glob("*.parquet"))])
+        m = rows.groupby("t")["energy"].mean()
+        m = m[(m.index >= lo) & (m.index <= hi)]
+        t, y = m.index.to_numpy(), np.log(m.to_numpy() / s["E0"])
+        mu = -float(t @ y / (t @ t)) / g
+        assert s["mu_measured"]["value"] == pytest.approx(mu, rel=1e-9), name
+
+
+def test_trapped_fractions_are_the_censored_counts_of_the_raw_lifetimes(tiny):
+    import pyarrow.parquet as pq
+
+    out, doc = tiny
+    k = pd.DataFrame(doc["kappa"])
+    for row in k[k["convention"] == "plateau"].itertuples():
+        raw = out / "raw" / f"{row.system}_r{row.ratio:.3f}" / "lifetimes"
+        oc = pd.concat([pq.read_table(p, columns=["outcome"]).to_pandas() for p in sorted(raw.glob("*.parquet"))])
+        assert row.trapped_fraction == pytest.approx(float((oc["outcome"] == "censored").mean()), abs=1e-12)
+
+
+def test_mu_below_threshold_is_the_microcanonical_well_value_and_tends_to_one_at_the_bottom(tiny):
+    """Near the minimum every built-in is harmonic with unit frequency: 2⟨K⟩/E → 1 (virial), and it decreases
+    towards E_c where the cubic/quartic terms soften the well."""
+    _, doc = tiny
+    for name, s in doc["systems"].items():
+        w = sorted((r["ratio"], r["mu"]) for r in s["mu_conservative"] if r["kind"] == "microcanonical well")
+        assert len(w) >= 2
+        assert all(0.85 < v < 1.0 for _, v in w), name
+        assert all(a[1] > b[1] for a, b in itertools.pairwise(w)), name
+
+
+def test_probe_ratios_outside_the_grid_are_refused_before_any_run(tmp_path):
+    import shutil
+    from pathlib import Path
+
+    from hhscatter.studies import run_stage
+
+    src = Path(__file__).resolve().parents[2] / "studies" / "generality" / "study.toml"
+    (tmp_path / "generality").mkdir()
+    text = src.read_text().replace("probe_ratios = [1.6]", "probe_ratios = [1.7]")
+    (tmp_path / "generality" / "study.toml").write_text(text)
+    shutil.copy(src.parent.parent / "conventions.toml", tmp_path / "conventions.toml")
+    with pytest.raises(ValueError, match="probe_ratios"):
+        run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
+    assert not (tmp_path / "generality" / "out" / "tiny" / "raw").exists() or not any(
+        (tmp_path / "generality" / "out" / "tiny" / "raw").iterdir())
