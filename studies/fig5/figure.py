@@ -58,9 +58,10 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     derived/cmeasure_points.parquet (E, x, y); ``dist_tab``: distance_vs_scale
     rows (gamma, set, ref, box, hellinger_pq, hellinger_noise, *_std);
     ``summary``: distance_summary (sw1, agreement_scale); ``nums``: fig5.json.
-    Panels (a), (b) as in the paper; (c) Hellinger excess over the split-half
-    noise floor vs box side at the paper's γ; (d) the same for Fig. 5a against
-    μ_c^{E1} at every γ with the agreement scales ε*.
+    Panels (a), (b) as in the paper; (c) debiased Hellinger distance vs box
+    side at the paper's γ; (d) the same for Fig. 5a against μ_c^{E1} at every
+    γ with the agreement scales ε*_δ; both with percentile bands over paired
+    half-samples of orbits (fig5.json ``refs_paired``, ``panel_d``).
     """
     plt = agg_pyplot()
     E1, E2, g0 = float(nums["E1"]), float(nums["E2"]), float(nums["gamma_main"])
@@ -78,7 +79,7 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     noise_max = float(nums["config"]["study"].get("noise_max", 0.5))
     delta = float(nums.get("delta", 0.1))
     boxes = sorted(dist_tab["box"].unique())
-    _distance_panel(axs[1, 0], dist_tab, summary, E1, E2, g0, boxes, noise_max, delta)
+    _distance_panel(axs[1, 0], dist_tab, summary, E1, E2, g0, boxes, noise_max, delta, nums)
     _agreement_panel(axs[1, 1], dist_tab, summary, nums, per_gamma, E1, boxes, noise_max, delta)
     if nums.get("dev_fallback"):
         fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
@@ -86,56 +87,84 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     plt.close(fig)
 
 
-def _distance_panel(ax, dist_tab, summary, E1, E2, g0, boxes, noise_max, delta):
-    """Panel (c): debiased Hellinger distance to the c-measures vs box side at the paper's γ."""
-    styles = [("a", "E1", COLORS[0], "o", "-"), ("a", "E2", COLORS[0], "s", "--"),
-              ("b", "E1", COLORS[1], "o", "-"), ("b", "E2", COLORS[1], "s", "--")]
-    for s, ref, col, mk, ls in styles:
-        tab = dist_tab[(dist_tab["gamma"] == g0) & (dist_tab["set"] == s) & (dist_tab["ref"] == ref)]
-        if len(tab):
-            row = summary[(summary["gamma"] == g0) & (summary["set"] == s) & (summary["ref"] == ref)].iloc[0]
-            Eref = E1 if ref == "E1" else E2
-            _debiased(ax, tab, f"Fig. 5{s} vs $\\mu_c^{{{Eref:g}}}$ (m={int(tab['m'].iloc[0])}; "
-                      f"SW$_1$={format_value_err(row['sw1'], row['sw1_err'], sep='±')}, floor {row['sw1_noise_m']:.3f})",
-                      col, mk, ls, noise_max)
-    ref_tab = dist_tab[dist_tab["set"] == "cm_E2"]
-    if len(ref_tab):
-        row = summary[summary["set"] == "cm_E2"].iloc[0]
-        _debiased(ax, ref_tab, f"$\\mu_c^{{{E2:g}}}$ vs $\\mu_c^{{{E1:g}}}$ (m={int(ref_tab['m'].iloc[0])}; "
-                  f"SW$_1$={format_value_err(row['sw1'], row['sw1_err'], sep='±')})", "0.45", "^", "-.", noise_max)
+def _distance_panel(ax, dist_tab, summary, E1, E2, g0, boxes, noise_max, delta, nums=None):
+    """Panel (c): debiased Hellinger distance to the c-measures vs box side at the paper's γ: the paired
+    half-sample curves of fig5.json ``refs_paired`` (percentile bands) when present, else the split-half ones."""
+    styles = {("5a", "E1"): ("a", COLORS[0], "o", "-"), ("5a", "E2"): ("a", COLORS[0], "s", "--"),
+              ("5b", "E1"): ("b", COLORS[1], "o", "-"), ("5b", "E2"): ("b", COLORS[1], "s", "--"),
+              ("E2", "E1"): (None, "0.45", "^", "-.")}
+    rec = (nums or {}).get("refs_paired") or {}
+    curves = (rec.get("curves") or {}).get("ours")
+    if curves:
+        x = np.asarray(rec["boxes"], dtype=float)
+        for c in curves:
+            s, col, mk, ls = styles[(c["set"], c["ref"])]
+            d, lo, hi = (np.asarray(c[k], dtype=float) for k in ("d", "d_lo", "d_hi"))
+            Eref = E1 if c["ref"] == "E1" else E2
+            if s is None:
+                lab = f"$\\mu_c^{{{E2:g}}}$ vs $\\mu_c^{{{E1:g}}}$"
+            else:
+                row = summary[(summary["gamma"] == g0) & (summary["set"] == s) & (summary["ref"] == c["ref"])]
+                sw = (f"; SW$_1$={format_value_err(row['sw1'].iloc[0], row['sw1_err'].iloc[0], sep='±')}"
+                      if len(row) else "")
+                lab = f"Fig. 5{s} vs $\\mu_c^{{{Eref:g}}}$" + sw
+            ax.errorbar(x, d, yerr=[d - lo, hi - d], color=col, marker=mk, ms=4, lw=1.3, ls=ls, capsize=2, label=lab)
+        title = f"(c) distance to the c-measures, $\\gamma={g0:g}$ ({int(rec['level'] * 100)} % paired bands)"
+    else:
+        for (s, ref), (short, col, mk, ls) in styles.items():
+            tab = (dist_tab[dist_tab["set"] == "cm_E2"] if short is None else
+                   dist_tab[(dist_tab["gamma"] == g0) & (dist_tab["set"] == short) & (dist_tab["ref"] == ref)])
+            if len(tab):
+                name = (f"$\\mu_c^{{{E2:g}}}$ vs $\\mu_c^{{{E1:g}}}$" if short is None else
+                        f"Fig. {s} vs $\\mu_c^{{{E1 if ref == 'E1' else E2:g}}}$")
+                _debiased(ax, tab, f"{name} (m={int(tab['m'].iloc[0])}, split halves)", col, mk, ls, noise_max)
+        title = f"(c) distance to the c-measures vs scale, $\\gamma={g0:g}$ (1σ split-half bands)"
     ax.axhline(delta, color="k", lw=0.8, ls=":")
     _box_axis(ax, boxes)
     ax.set_ylim(0, 1.3 * ax.get_ylim()[1])  # room for the legend
     ax.set_ylabel("debiased Hellinger $\\sqrt{H_{PQ}^2 - H_{\\rm noise}^2}$")
-    ax.set_title(f"(c) distance to the c-measures vs scale, $\\gamma={g0:g}$ (1σ bands)", fontsize=10, loc="left")
+    ax.set_title(title, fontsize=10, loc="left")
     ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, which="major", alpha=0.3)
 
 
 def _agreement_panel(ax, dist_tab, summary, nums, per_gamma, E1, boxes, noise_max, delta):
-    """Panel (d): Fig. 5a vs μ_c^{E1} at every γ with the agreement scales ε*."""
-    gammas = sorted(per_gamma)
-    for i, g in enumerate(gammas):
-        tab = dist_tab[(dist_tab["gamma"] == g) & (dist_tab["set"] == "a") & (dist_tab["ref"] == "E1")]
-        if not len(tab):
-            continue
-        row = summary[(summary["gamma"] == g) & (summary["set"] == "a") & (summary["ref"] == "E1")].iloc[0]
-        eps, eps_z = row["agreement_scale_debiased"], row["agreement_scale"]
-        col = COLORS[(i + 2) % len(COLORS)]
-        fmt = lambda e: f"{e:.3g}" if e is not None and np.isfinite(e) else "none"
-        lab = (f"$\\gamma={g:g}$, $t^*={per_gamma[g]['t_star']:.1f}$: $\\varepsilon^*_\\delta$={fmt(eps)}, "
-               f"$\\varepsilon^*_{{2\\sigma}}$={fmt(eps_z)}")
-        if not bool(row["common_m"]):
-            lab += " (own m)"
-        _debiased(ax, tab, lab, col, "o", "-", noise_max)
-        if eps is not None and np.isfinite(eps):
-            ax.axvline(eps, color=col, ls=":", lw=1.2)
+    """Panel (d): Fig. 5a vs μ_c^{E1} at every γ, the paired half-sample curves (fig5.json ``panel_d``) with
+    their percentile bands and the agreement scales ε*_δ with their intervals; the split-half curves (1σ) when
+    the paired record is missing (tiny scale)."""
+    rec = nums.get("panel_d") or {}
+    fmt = lambda e: f"{e:.3g}" if e is not None and np.isfinite(e) else "none"
+    if "curves" in rec:
+        x = np.asarray(rec["boxes"], dtype=float)
+        for i, c in enumerate(rec["curves"]):
+            col = COLORS[(i + 2) % len(COLORS)]
+            d, lo, hi = (np.asarray(c[k], dtype=float) for k in ("d", "d_lo", "d_hi"))
+            ok = np.asarray(c["informative"], dtype=bool)
+            e, (elo, ehi) = c["eps_delta"], c["eps_delta_interval"]
+            lab = (f"$\\gamma={c['gamma']:g}$, $t^*={c['t_star']:.1f}$ ({c['n_a']} pts): "
+                   f"$\\varepsilon^*_\\delta$={fmt(e)} [{fmt(elo)}, {fmt(ehi)}]")
+            ax.errorbar(x[ok], d[ok], yerr=[d[ok] - lo[ok], hi[ok] - d[ok]], color=col, marker="o", ms=4, lw=1.3,
+                        capsize=2, label=lab)
+            if (~ok).any():
+                ax.plot(x[~ok], d[~ok], color=col, marker="o", ms=3, lw=0, mfc="none", alpha=0.6)
+            if e is not None:
+                ax.axvline(e, color=col, ls=":", lw=1.2)
+        title = f"(d) convergence with $t^*$ ({int(rec['level'] * 100)} % paired bands)"
+    else:
+        for i, g in enumerate(sorted(per_gamma)):
+            tab = dist_tab[(dist_tab["gamma"] == g) & (dist_tab["set"] == "a") & (dist_tab["ref"] == "E1")]
+            if not len(tab):
+                continue
+            row = summary[(summary["gamma"] == g) & (summary["set"] == "a") & (summary["ref"] == "E1")].iloc[0]
+            col = COLORS[(i + 2) % len(COLORS)]
+            _debiased(ax, tab, f"$\\gamma={g:g}$, $t^*={per_gamma[g]['t_star']:.1f}$: $\\varepsilon^*_\\delta$="
+                      f"{fmt(row['agreement_scale_debiased'])} (split halves, 1σ)", col, "o", "-", noise_max)
+        title = f"(d) convergence with relaxation time $t^*$ (common m = {nums['m_common']})"
     ax.axhline(delta, color="k", lw=0.8, ls=":")
     ax.text(max(boxes), delta, f" $\\delta$ = {delta:g}", va="bottom", ha="right", fontsize=8)
     _box_axis(ax, boxes)
-    ax.set_ylim(bottom=0)
+    ax.set_ylim(0, 1.25 * ax.get_ylim()[1])  # room for the legend
     ax.set_ylabel(f"debiased Hellinger, Fig. 5a vs $\\mu_c^{{{E1:g}}}$")
-    ax.set_title(f"(d) convergence with relaxation time $t^*$ (common m = {nums['m_common']})",
-                 fontsize=10, loc="left")
-    ax.legend(fontsize=7, loc="upper right")
+    ax.set_title(title, fontsize=10, loc="left")
+    ax.legend(fontsize=7, loc="upper left")
     ax.grid(True, which="major", alpha=0.3)

@@ -25,7 +25,11 @@ analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            histograms vs box side ε (full samples with bootstrap errors, and
            split-half comparisons at one common sample size m with their
            noise floor, giving the agreement scale ε*), sliced Wasserstein with
-           bootstrap errors.  Writes derived tables and fig5.json.
+           bootstrap errors; every verdict that rests on a distance with a
+           paired interval over half-samples of the orbits of every set, the
+           references included (issue 28): 5b − 5a (``verdict_5b``), μ_c^{E1}
+           vs μ_c^{E2} (``refs_paired``), panel (d) (``panel_d``).  Writes
+           derived tables and fig5.json.
 plot       Fig. 5 (a), (b) and the distance panels from the derived tables.
 
 Why Hellinger vs ε is the headline distance: the paper's claim is
@@ -151,10 +155,13 @@ def _qualify_our_5b(rows) -> None:
 
     The paper's claims about 5b are checked in its own construction (AUTHORS); a "differs" of ours that the
     authors' construction does not reproduce is a difference of our convention only (issue 13's verdict rule).
+    The authors' rows: 5b against the two references (:func:`_compare_refs_paired`) and 5b against 5a, like for
+    like over grid placements (:func:`_compare_verdict`, construction 'cut_offsets').
     """
-    by_q = {r["quantity"]: r for r in rows}
-    auth_b = by_q.get(f"{AUTHORS['5b_authors']}: debiased Hellinger to μ_c^0.3 vs to μ_c^0.35")
-    auth_ab = by_q.get("Fig. 5b closer to μ_c^0.30 than 5a, both in the authors' convention")
+    auth = [r for r in rows if r.get("authors")]
+    auth_b = next((r for r in auth if r["quantity"].startswith(REFS_QUANTITY.format(s="5b"))), None)
+    auth_ab = next((r for r in auth if r["quantity"] == VERDICT_QUANTITY.format(
+        label={k: lab for k, lab, _ in VERDICT_ROWS}["cut_offsets"])), None)
     for r in rows:
         if r.get("authors") or r.get("verdict") != "differs" or not r["quantity"].startswith("Fig. 5b"):
             continue
@@ -209,6 +216,10 @@ def _r_cut(df, r_cut):
     """The rows with r = √(x² + y²) < r_cut (the authors' plots), re-indexed."""
     return df[np.hypot(df["x"], df["y"]) < r_cut].reset_index(drop=True)
 
+
+#: the paper-comparison rows of the paired verdicts (issue 28)
+VERDICT_QUANTITY = "Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {label}"
+REFS_QUANTITY = "Fig. {s} closer to μ_c^0.30 than to μ_c^0.35, paired Δ = d(μ_c^0.35) − d(μ_c^0.30)"
 
 VERDICT_ROWS = (
     ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction before issue 28)", 1),
@@ -284,7 +295,7 @@ def _compare_verdict(study, verdict):
         v = verdict_of(r)
         if r["construction"] == "ours" and v == "differs" and like is not None and verdict_of(like) != "differs":
             v = f"differs in our convention only; in the authors' construction, like for like: {verdict_of(like)}"
-        study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {r['label']}",
+        study.compare(VERDICT_QUANTITY.format(label=r["label"]),
                       f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]", None, "Δ < 0 (the energy filter tightens the "
                       "agreement)", verdict=v, authors=r["construction"] != "ours",
                       convention=conventions[r["construction"]],
@@ -292,6 +303,184 @@ def _compare_verdict(study, verdict):
                            f"{r['offsets']} grid placements; spread of Δ over placements {r['offset_spread_of_delta']:.3f}); "
                            f"{int(verdict['level'] * 100)} % interval from {verdict['n_boot']} paired half-samples "
                            "over orbits")
+
+
+def _interval_row(values, level):
+    """{value, interval} of replicates: their mean and percentile interval."""
+    m, lo, hi = dist.percentile_interval(values, level)
+    return {"value": m, "interval": [lo, hi]}
+
+
+def _refs_paired(study, cm_full, sets_ours, E1, E2):
+    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired (issue 28): one draw of the run's orbits serves both
+    distances, each reference's orbits drawn independently; Δ = d(μ_c^{E2}) − d(μ_c^{E1}) > 0 means closer to
+    μ_c^{E1}. Two constructions, each cut alike: ours (γ = gamma_main, no cut) and the authors' (their two runs,
+    r < r_cut on every set). The distances are computed at every box side (``curves``: panel (c)), the rows at
+    box_headline. Returns the JSON record; rows with a ``note`` where the sets are too small."""
+    p = study.params
+    box, extent, level = p.box_headline, tuple(p.extent), p.verdict_level
+    auth = _authors_sets(study)
+    cut = {k: _cap(_r_cut(v, p.r_cut), p.n_cap, p.seed) for k, v in cm_full.items()}
+    uncut = {k: _cap(v, p.n_cap, p.seed) for k, v in cm_full.items()}
+    constructions = (
+        ("ours", "our construction (disk ICs, γ = gamma_main, 5b = 5a in the band), no cut on any set",
+         {"5a": sets_ours[0], "5b": sets_ours[1]}, uncut),
+        ("authors", "the authors' 5a and 5b runs, r < 1 on every set (5a, 5b, μ_c^0.30, μ_c^0.35)",
+         {"5a": auth[("authors", "5a_authors")], "5b": auth[("authors", "5b_authors")]}, cut),
+    )
+    boxes = sorted(map(float, p.boxes), reverse=True)
+    jh = int(np.argmin(np.abs(np.array(boxes) - box)))
+    rows, panel_c = [], {}
+    for key, label, runs, refs in constructions:
+        # one seed, one id space: 5a and 5b are the same orbits (ours: 5b ⊂ 5a; the authors': two runs of the same
+        # ICs), and so are fig1's two references (the same positions at E1 and E2): each pair is drawn together
+        sets = {s: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "run") for s, df in runs.items()}
+        sets.update({r: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "cm") for r, df in refs.items()})
+        pairs = [(s, r) for s in runs for r in ("E1", "E2")] + [("E2", "E1")]
+        try:
+            curves = dist.paired_hellinger_replicates(sets, pairs, boxes, extent, offsets=p.verdict_offsets,
+                                                      n_boot=p.verdict_boot, seed=p.seed)
+        except ValueError as e:  # too few points (tiny scale)
+            rows.append({"construction": key, "label": label, "note": str(e)})
+            continue
+        reps = curves[:, :, jh]
+        q = (1 - level) / 2
+        panel_c[key] = [{"set": x, "ref": r, "d": curves[:, i].mean(axis=0).tolist(),
+                         "d_lo": np.quantile(curves[:, i], q, axis=0).tolist(),
+                         "d_hi": np.quantile(curves[:, i], 1 - q, axis=0).tolist()} for i, (x, r) in enumerate(pairs)]
+        for s in runs:
+            i1, i2 = pairs.index((s, "E1")), pairs.index((s, "E2"))
+            rows.append({"construction": key, "label": label, "set": s, "n_set": len(runs[s]),
+                         "n_E1": len(refs["E1"]), "n_E2": len(refs["E2"]),
+                         "d_E1": _interval_row(reps[:, i1], level), "d_E2": _interval_row(reps[:, i2], level),
+                         "delta": _interval_row(reps[:, i2] - reps[:, i1], level)})
+    return {"box": boxes[jh], "offsets": p.verdict_offsets ** 2, "level": level, "n_boot": p.verdict_boot,
+            "E1": E1, "E2": E2, "boxes": boxes, "curves": panel_c,
+            "method": "paired half-sampling over orbits: one draw of the run's orbits serves 5a, 5b and both "
+                      "distances, one draw of fig1's orbits both references (one seed: the same positions at E1 and "
+                      "E2), the two draws independent; debiased Hellinger averaged over grid placements",
+            "rows": rows}
+
+
+def _compare_refs_paired(study, refs):
+    """One paper-comparison row per construction and set: closer to μ_c^{E1} than to μ_c^{E2} (paired Δ > 0)?"""
+    E1, E2 = refs["E1"], refs["E2"]
+    for r in refs["rows"]:
+        if "delta" not in r:
+            continue
+        d, (lo, hi) = r["delta"]["value"], r["delta"]["interval"]
+        ours = r["construction"] == "ours"
+        study.compare(REFS_QUANTITY.format(s=r["set"]) + f": {r['label']}", f"{d:+.3f} [{lo:+.3f}, {hi:+.3f}]", None,
+                      "Δ > 0 (closer to μ_c^{E1})",
+                      verdict="agrees" if lo > 0 else ("differs" if hi < 0 else "no significant difference"),
+                      authors=not ours, convention=None if ours else _conventions(study)["cut"],
+                      note=f"d to μ_c^{E1:g} {r['d_E1']['value']:.3f} {_fmt_iv(r['d_E1']['interval'])}, to "
+                           f"μ_c^{E2:g} {r['d_E2']['value']:.3f} {_fmt_iv(r['d_E2']['interval'])} (debiased "
+                           f"Hellinger, ε = {refs['box']:g}, {refs['offsets']} grid placements; "
+                           f"{int(refs['level'] * 100)} % intervals from {refs['n_boot']} paired half-samples over "
+                           f"orbits; {r['n_set']} / {r['n_E1']} / {r['n_E2']} points)")
+
+
+def _fmt_iv(iv):
+    return f"[{iv[0]:.3f}, {iv[1]:.3f}]"
+
+
+def _panel_d_paired(study, sets, pg, dtab, E1, cm_E1):
+    """Panel (d) with paired intervals (issue 28): Fig. 5a at every γ against μ_c^{E1} on common half-samples
+    (one draw of the orbits for all γ, whose runs share their ICs, and one of the reference's): the debiased Hellinger
+    curve vs box side with percentile bands, the agreement scale ε*_δ of every replicate (its interval), the share
+    of replicates in which ε*_δ shrinks with t*, and the paired differences of d at box_headline between
+    consecutive t*. Informative box sides are those of the split-half table (noise floor ≤ noise_max)."""
+    p = study.params
+    level, delta = p.verdict_level, p.delta
+    boxes = sorted(map(float, p.boxes), reverse=True)
+    gammas = sorted(pg["gamma"], key=lambda g: float(pg.set_index("gamma").loc[g, "t_star"]))
+    gammas = [g for g in gammas if len(sets[(g, "a")]) >= 4]
+    if len(gammas) < 2:
+        return None
+    # every γ's run starts from the same ICs (one seed): one draw of the orbits serves all γ (paired across t*)
+    units = {f"a{g:g}": dist.UnitSet(dist.points(sets[(g, "a")]), sets[(g, "a")]["traj_id"].to_numpy(), "run")
+             for g in gammas}
+    units["E1"] = dist.UnitSet(dist.points(cm_E1), cm_E1["traj_id"].to_numpy(), "cm_E1")
+    pairs = [(f"a{g:g}", "E1") for g in gammas]
+    try:
+        reps = dist.paired_hellinger_replicates(units, pairs, boxes, tuple(p.extent), offsets=p.verdict_offsets,
+                                                n_boot=p.verdict_boot, seed=p.seed)
+    except ValueError as e:  # too few points (tiny scale)
+        return {"note": str(e)}
+    q = (1 - level) / 2
+    jh = int(np.argmin(np.abs(np.array(boxes) - p.box_headline)))
+    t_star = pg.set_index("gamma")["t_star"]
+    eps = np.empty((reps.shape[0], len(gammas)))
+    curves = []
+    for i, g in enumerate(gammas):
+        tab = dtab[(dtab["gamma"] == g) & (dtab["set"] == "a") & (dtab["ref"] == "E1")].set_index("box")
+        informative = np.array([float(tab.loc[b, "hellinger_noise"]) <= p.noise_max if b in tab.index else False
+                                for b in boxes])
+        eps[:, i] = [_scale_of(boxes, reps[k, i], informative, delta) for k in range(reps.shape[0])]
+        e_mean = _scale_of(boxes, reps[:, i].mean(axis=0), informative, delta)
+        curves.append({"gamma": g, "t_star": float(t_star[g]), "n_a": len(sets[(g, "a")]),
+                       "d": reps[:, i].mean(axis=0).tolist(), "d_lo": np.quantile(reps[:, i], q, axis=0).tolist(),
+                       "d_hi": np.quantile(reps[:, i], 1 - q, axis=0).tolist(), "informative": informative.tolist(),
+                       "eps_delta": _finite(e_mean),
+                       "eps_delta_interval": [_finite(np.quantile(eps[:, i], q, method="lower")),
+                                              _finite(np.quantile(eps[:, i], 1 - q, method="higher"))]})
+    # ε* = inf (no agreement at any informative scale) sorts last; shrinking: non-increasing with t*, overall smaller
+    shrinks = np.all(eps[:, 1:] <= eps[:, :-1], axis=1) & (eps[:, -1] < eps[:, 0])
+    steps = [{"t_from": float(t_star[g0]), "t_to": float(t_star[g1]), "gamma_from": g0, "gamma_to": g1,
+              **_interval_row(reps[:, i + 1, jh] - reps[:, i, jh], level)}
+             for i, (g0, g1) in enumerate(zip(gammas[:-1], gammas[1:]))]
+    return {"boxes": boxes, "box_headline": boxes[jh], "delta": delta, "level": level, "n_boot": int(reps.shape[0]),
+            "offsets": p.verdict_offsets ** 2, "n_ref": len(cm_E1), "curves": curves,
+            "eps_shrink_share": float(shrinks.mean()), "steps": steps,
+            "method": "paired half-sampling over orbits: one draw of the ICs for every γ's run (one seed), one of the "
+                      "reference's, independent; debiased Hellinger averaged over grid placements; ε*_δ per replicate"}
+
+
+def _scale_of(boxes, d, informative, delta):
+    """ε*_δ of one curve: the smallest box side down to which d ≤ δ at every informative side (boxes
+    decreasing); inf if d > δ already at the coarsest informative side (or none is informative)."""
+    best = math.inf
+    for b, v, ok in zip(boxes, d, informative):
+        if not ok:
+            continue
+        if v > delta:
+            break
+        best = b
+    return best
+
+
+def _finite(x):
+    return float(x) if np.isfinite(x) else None
+
+
+def _compare_panel_d(study, pd_rec):
+    """Paper-comparison rows of panel (d) with paired intervals: ε*_δ shrinks with t*, d decreases with t*."""
+    if not pd_rec or "curves" not in pd_rec:
+        return
+    fmt = lambda e: f"{e:.3g}" if e is not None else "none"
+    cur, level = pd_rec["curves"], int(pd_rec["level"] * 100)
+    share = pd_rec["eps_shrink_share"]
+    study.compare(f"agreement scale ε*_δ of Fig. 5a vs μ_c^0.30 shrinks with relaxation time t* (debiased H ≤ δ = "
+                  f"{pd_rec['delta']:g}, paired half-samples)",
+                  "; ".join(f"t*={c['t_star']:.1f}: {fmt(c['eps_delta'])} [{fmt(c['eps_delta_interval'][0])}, "
+                            f"{fmt(c['eps_delta_interval'][1])}]" for c in cur), None,
+                  "finite scale, smaller for longer relaxation",
+                  verdict="agrees" if share >= pd_rec["level"] else "not shown",
+                  note=f"ε*_δ of the mean curve with its {level} % interval over {pd_rec['n_boot']} paired half-samples "
+                       f"(orbits of every γ's run and of the reference); it shrinks in {share:.0%} of them")
+    steps = pd_rec["steps"]
+    all_down = all(s["interval"][1] < 0 for s in steps)
+    any_up = any(s["interval"][0] > 0 for s in steps)
+    study.compare(f"debiased Hellinger(ε={pd_rec['box_headline']:g}) of Fig. 5a to μ_c^0.30 decreases with t* "
+                  "(paired differences between consecutive t*)",
+                  ", ".join(f"t*={c['t_star']:.1f}: {c['d'][pd_rec['boxes'].index(pd_rec['box_headline'])]:.3f}"
+                            for c in cur) + "; steps " +
+                  ", ".join(f"{s['value']:+.3f} [{s['interval'][0]:+.3f}, {s['interval'][1]:+.3f}]" for s in steps),
+                  None, "convergence to μ_c^{E(t)} with relaxation time",
+                  verdict="agrees" if all_down else ("differs" if any_up else "not shown"),
+                  note=f"{level} % intervals of d(t*_(i+1)) − d(t*_i) from {pd_rec['n_boot']} paired half-samples; "
+                       f"{pd_rec['offsets']} grid placements")
 
 
 def _authors_distances(study, refs, extent):
@@ -380,11 +569,15 @@ def analyze(study):
     study.write_table(pg, "per_gamma.parquet")
 
     delta = study.params.delta
-    verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta)
+    verdicts = _compare(study, pg, stab, g_main, mu, mu_err, inputs)
     astab, n_auth = _authors_distances(study, refs, extent)
     authors = _compare_authors(study, astab, n_auth, E1)
     verdict = _verdict_5b(study, cm_full["E1"], E1, (sets[(g_main, "a")], sets[(g_main, "b")]))
     _compare_verdict(study, verdict)
+    refs_paired = _refs_paired(study, cm_full, (sets[(g_main, "a")], sets[(g_main, "b")]), E1, E2)
+    _compare_refs_paired(study, refs_paired)
+    panel_d = _panel_d_paired(study, sets, pg, dtab, E1, cm["E1"])
+    _compare_panel_d(study, panel_d)
     _qualify_our_5b(study.comparisons)
     study.write_numbers({
         "inputs": inputs,
@@ -399,39 +592,22 @@ def analyze(study):
         "closer_to_E1": verdicts,
         "authors_convention": authors,
         "verdict_5b": verdict,
+        "refs_paired": refs_paired,
+        "panel_d": panel_d,
     })
 
 
 def _compare_authors(study, astab, n_auth, E1) -> dict:
-    """Rows of the paper comparison under the authors' own Fig. 5 convention (square ICs; 5a: first crossing
-    with 17 < t < 30; 5b: first crossing in the energy band at any time; r < 1), and the JSON record."""
+    """The JSON record of the authors' own Fig. 5 convention (square ICs; 5a: first crossing with 17 < t < 30;
+    5b: first crossing in the energy band at any time; r < 1): point counts and distances with the split-half
+    columns. Its paper-comparison rows are paired (:func:`_compare_refs_paired`, :func:`_compare_verdict`)."""
     out = {"convention": AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band)),
            "n_points": n_auth, "rows": None}
     if astab is None:
         return out
     out["rows"] = astab.to_dict(orient="records")
 
-    def h(key, ref):
-        r = astab[(astab["set"] == key) & (astab["ref"] == ref)].iloc[0]
-        return float(r["hellinger_debiased"]), float(r["hellinger_debiased_lo"]), float(r["hellinger_debiased_hi"])
-
-    for key, label in AUTHORS.items():
-        (a1, lo1, hi1), (a2, _, _) = h(key, "E1"), h(key, "E2")
-        study.compare(f"{label}: debiased Hellinger to μ_c^{E1:g} vs to μ_c^0.35", f"{a1:.3f} [{lo1:.3f}, "
-                      f"{hi1:.3f}] vs {a2:.3f}", None, "closer to μ_c^0.30",
-                      verdict="agrees" if a1 < a2 else "differs", authors=True, convention=out["convention"],
-                      note=f"{n_auth[key]} points")
-    (a, alo, ahi), (b, blo, bhi) = h("5a_authors", "E1"), h("5b_authors", "E1")
-    closer = b < a
-    overlap = not (bhi < alo or ahi < blo)
-    study.compare("Fig. 5b closer to μ_c^0.30 than 5a, both in the authors' convention", f"{b:.3f} (b) vs {a:.3f} (a)",
-                  None, "yes", verdict="equal within errors" if overlap else ("agrees" if closer else "differs"),
-                  authors=True, convention=out["convention"],
-                  note="debiased Hellinger at the headline box; the paper's claim under its own construction "
-                       "of 5b (a different set from 5a, not 5a filtered)" +
-                       (f"; the intervals [{blo:.3f}, {bhi:.3f}] and [{alo:.3f}, {ahi:.3f}] overlap" if overlap else ""))
-    out["b_closer_than_a"] = bool(closer)
-    out["intervals_overlap"] = bool(overlap)
+    # its distances are compared in _compare_refs_paired and _compare_verdict, with paired intervals over orbits
     return out
 
 
@@ -563,10 +739,10 @@ def _distances(study, sets, refs, usable, m_common, extent):
     return dtab, stab
 
 
-def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> dict:
-    """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer (SW1 and
-    debiased Hellinger) in Fig. 5a and 5b, and whether the agreement scale shrinks with t*. Returns
-    {'a'|'b': closer to μ_c^{E1}}."""
+def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
+    """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer by SW1 in
+    Fig. 5a and 5b, and whether the significance agreement scale ε*_2σ shrinks with t*. Returns
+    {'a'|'b': closer to μ_c^{E1} by SW1}. The debiased-Hellinger rows are paired (issue 28)."""
     E1 = study.params.E1
     def srow(g, s, ref):
         r = stab[(stab["gamma"] == g) & (stab["set"] == s) & (stab["ref"] == ref)]
@@ -595,50 +771,9 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs, m_common, delta) -> di
                       f"{r1['sw1']:.4f}±{r1['sw1_err']:.4f} vs {r2['sw1']:.4f}±{r2['sw1_err']:.4f}", None,
                       "μ_c^{E1} better than μ_c^{E2}", verdict="agrees" if closer else "differs",
                       note="sliced Wasserstein W1 (units of x, y), bootstrap 1σ")
-        h1, h2 = r1["hellinger_debiased"], r2["hellinger_debiased"]
-        study.compare(f"Fig. 5{s}: debiased Hellinger(ε={r1['box_headline']:g}) to μ_c^0.30 vs to μ_c^0.35",
-                      f"{h1:.3f} [{r1['hellinger_debiased_lo']:.3f}, {r1['hellinger_debiased_hi']:.3f}] vs "
-                      f"{h2:.3f} [{r2['hellinger_debiased_lo']:.3f}, {r2['hellinger_debiased_hi']:.3f}]",
-                      None, "closer to μ_c^{E1}",
-                      verdict="agrees" if r1["hellinger_debiased_hi"] < r2["hellinger_debiased_lo"] else "differs",
-                      note=f"√(H_pq² − H_noise²) at m = {int(r1['m'])} / {int(r2['m'])} (noise floors "
-                           f"{r1['hellinger_noise']:.3f} / {r2['hellinger_noise']:.3f}); full-sample H "
-                           f"{r1['hellinger']:.3f}±{r1['hellinger_err']:.3f} vs {r2['hellinger']:.3f}±{r2['hellinger_err']:.3f}"
-                           " (bootstrap; biased by the different sample sizes)")
-    ra, rb = srow(g_main, "a", "E1"), srow(g_main, "b", "E1")
-    if ra is not None and rb is not None and ra["common_m"] and rb["common_m"]:
-        study.compare(f"Fig. 5b closer to μ_c^0.30 than 5a (debiased Hellinger at ε={ra['box_headline']:g})",
-                      f"{rb['hellinger_debiased']:.3f} (b) vs {ra['hellinger_debiased']:.3f} (a)", None,
-                      "(b) 'almost exactly' on the support of μ_c^{E1}",
-                      verdict="agrees" if rb["hellinger_debiased_hi"] < ra["hellinger_debiased_lo"] else
-                      ("differs" if rb["hellinger_debiased_lo"] > ra["hellinger_debiased_hi"] else "no significant difference"),
-                      note=f"common m = {m_common}; SW1 {rb['sw1']:.4f}±{rb['sw1_err']:.4f} (b) vs "
-                           f"{ra['sw1']:.4f}±{ra['sw1_err']:.4f} (a)")
-    scales = stab[(stab["ref"] == "E1") & (stab["set"] == "a") & stab["common_m"]].sort_values("gamma")
-    if len(scales) >= 2:
-        tst = pg.set_index("gamma").loc[scales["gamma"], "t_star"].to_numpy()
-        order = np.argsort(tst)
-
-        def fmt(e):
-            return f"{e:.3g}" if e is not None and np.isfinite(e) else "none"
-
-        for col, what in (("agreement_scale_debiased", f"debiased H ≤ δ = {delta:g}"),
-                          ("agreement_scale", f"H_pq ≤ H_noise + {study.params.z}σ")):
-            eps = np.array([np.nan if v is None else float(v) for v in scales[col]])[order]
-            e_sorted = np.where(np.isfinite(eps), eps, np.inf)
-            # non-increasing with t* ("none" = inf: no agreement at any informative scale)
-            shrinks = bool(np.all(e_sorted[1:] <= e_sorted[:-1]) and e_sorted[-1] < e_sorted[0])
-            study.compare(f"agreement scale ε* of Fig. 5a vs μ_c^0.30 shrinks with relaxation time t* ({what})",
-                          ", ".join(f"t*={t:.1f}: {fmt(e)}" for t, e in zip(tst[order], eps)), None,
-                          "finite scale, smaller for longer relaxation",
-                          verdict="agrees" if shrinks else "not shown",
-                          note=f"common m = {m_common}")
-        dh = scales.set_index("gamma").loc[scales["gamma"], "hellinger_debiased"].to_numpy()[order]
-        study.compare(f"debiased Hellinger(ε={float(scales['box_headline'].iloc[0]):g}) of Fig. 5a to μ_c^0.30 "
-                      "decreases with t*", ", ".join(f"t*={t:.1f}: {d:.3f}" for t, d in zip(tst[order], dh)), None,
-                      "convergence to μ_c^{E(t)} with relaxation time",
-                      verdict="agrees" if np.all(np.diff(dh) < 0) else "not shown")
-
+    # the debiased-Hellinger rows (5a/5b to μ_c^E1 vs μ_c^E2, 5b vs 5a, panel (d)) have paired intervals over
+    # orbits: _compare_refs_paired, _compare_verdict, _compare_panel_d (issue 28; their split-spread forerunners
+    # are retired)
     return verdicts
 
 

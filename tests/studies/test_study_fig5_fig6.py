@@ -231,10 +231,40 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
         assert sec["traj_id"].is_unique and check(sec).all()  # one crossing per orbit, in the window
         assert auth["n_points"][key] == int((np.hypot(sec["x"], sec["y"]) < 1).sum())
     rows = {r["quantity"]: r for r in nums["paper_comparison"]}
-    assert "Fig. 5b closer to μ_c^0.30 than 5a, both in the authors' convention" in rows or auth["rows"] is None
+    # the authors' rows are paired (issue 28): 5a and 5b against both references, one row each, like for like
+    paired = [q for q, r in rows.items() if r["authors"] and q.startswith(("Fig. 5a closer", "Fig. 5b closer"))
+              and "than to μ_c^0.35, paired" in q]
+    refs = {r["set"]: r for r in nums["refs_paired"]["rows"] if r["construction"] == "authors" and "set" in r}
+    assert len(paired) == len(refs) and all(r["n_set"] == min(auth["n_points"][f"{s}_authors"], study.params.n_cap)
+                                            for s, r in refs.items())
+    assert not any("both in the authors' convention" in q for q in rows)  # the split-spread row is retired
     run_stage("fig5", "analyze", "tiny", root=tiny_studies)
     again = json.loads(study.numbers_path.read_text())["authors_convention"]
     assert again == auth
+
+
+def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
+    """Issue 28: 5a/5b against μ_c^0.30 and μ_c^0.35 and panel (d) carry paired intervals: Δ is the difference of
+    the two distances in every replicate, so its mean is the difference of the means; panel (d) has one curve per
+    γ (ordered by t*) with its bands around the mean, and one step between consecutive t*."""
+    from hhscatter.studies import load_study
+
+    study = load_study("fig5", "tiny", root=tiny_studies)
+    nums = json.loads(study.numbers_path.read_text())
+    refs = nums["refs_paired"]
+    assert {r["construction"] for r in refs["rows"]} == {"ours", "authors"}
+    for r in refs["rows"]:
+        if "delta" in r:
+            assert r["delta"]["value"] == pytest.approx(r["d_E2"]["value"] - r["d_E1"]["value"], abs=1e-12)
+            assert r["delta"]["interval"][0] <= r["delta"]["value"] <= r["delta"]["interval"][1]
+    pdl = nums["panel_d"]
+    if pdl is None or "curves" not in pdl:
+        return
+    ts = [c["t_star"] for c in pdl["curves"]]
+    assert ts == sorted(ts) and len(pdl["steps"]) == len(ts) - 1
+    for c in pdl["curves"]:
+        assert len(c["d"]) == len(pdl["boxes"]) and all(lo <= d <= hi for lo, d, hi in zip(c["d_lo"], c["d"], c["d_hi"]))
+    assert 0.0 <= pdl["eps_shrink_share"] <= 1.0
 
 
 def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_studies):
@@ -385,13 +415,13 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
 def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
     """Issue 13's rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
-    from hhscatter.studies.fig5.study import AUTHORS, _qualify_our_5b
+    from hhscatter.studies.fig5.study import REFS_QUANTITY, _qualify_our_5b
 
     def rows(auth_verdict):
         return [
             {"quantity": "Fig. 5b: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
             {"quantity": "Fig. 5a: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {"quantity": f"{AUTHORS['5b_authors']}: debiased Hellinger to μ_c^0.3 vs to μ_c^0.35",
+            {"quantity": REFS_QUANTITY.format(s="5b") + ": the authors' 5a and 5b runs, r < 1 on every set",
              "verdict": auth_verdict, "authors": True},
         ]
 

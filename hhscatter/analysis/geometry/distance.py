@@ -78,6 +78,7 @@ import pandas as pd
 __all__ = [
     "BootstrapResult",
     "PairedDifference",
+    "UnitSet",
     "agreement_scale",
     "agreement_scale_debiased",
     "bootstrap_distance",
@@ -89,6 +90,8 @@ __all__ = [
     "hellinger",
     "histogram_distance",
     "paired_hellinger_difference",
+    "paired_hellinger_replicates",
+    "percentile_interval",
     "points",
     "sliced_wasserstein",
     "split_half_baseline",
@@ -555,8 +558,18 @@ def split_half_baseline(
 
 
 # ---------------------------------------------------------------------------
-# paired differences of distances to one reference, resampling orbits
+# paired differences of distances, resampling orbits
 # ---------------------------------------------------------------------------
+class UnitSet(NamedTuple):
+    """A point set for :func:`paired_hellinger_replicates`: its points, the independent unit of each point
+    (e.g. the orbit's ``traj_id``) and its group: sets of one group share one id space (one run, e.g. 5a and
+    5b, or a set and its subset) and are half-sampled together; different groups independently."""
+
+    points: np.ndarray   # (n, 2) points (x, y)
+    units: np.ndarray    # (n,) unit of each point
+    group: str           # the run whose units the set shares
+
+
 class PairedDifference(NamedTuple):
     """Result of :func:`paired_hellinger_difference` (Hellinger distances, dimensionless)."""
 
@@ -582,6 +595,147 @@ def _h2(P, Q, box, extents) -> np.ndarray:
     return np.array([hellinger(*box_histograms(P, Q, box, e)) ** 2 for e in extents])
 
 
+def _dense_cells(X, box: float, extent):
+    """(cell id of each point in [0, K), K): the box cells of ``extent`` numbered densely, K − 1 the overflow."""
+    x0, x1, y0, y1 = map(float, extent)
+    k = (int(np.floor((x1 - x0) / box)) + 1) * (int(np.floor((y1 - y0) / box)) + 1)
+    c = _cells(X, box, extent)
+    return np.where(c < 0, k, c).astype(np.intp), k + 1
+
+
+def _h2_counts(cp, cq) -> float:
+    """Squared Hellinger distance of two count vectors on one partition (as :func:`hellinger` ** 2)."""
+    d = np.sqrt(cp / cp.sum()) - np.sqrt(cq / cq.sum())
+    return min(0.5 * float(np.dot(d, d)), 1.0)
+
+
+def percentile_interval(values, level: float = 0.95):
+    """percentile_interval(values, level=0.95) -> (mean, lo, hi) over replicates along axis 0.
+
+    The mean and the central percentile interval of coverage ``level`` of half-sample (or bootstrap)
+    replicates, e.g. of a paired difference ``reps[:, 1] − reps[:, 0]`` of
+    :func:`paired_hellinger_replicates`. Scalars for 1-D input, arrays otherwise.
+
+    Examples
+    --------
+    >>> [round(v, 9) for v in percentile_interval(np.arange(101.0), 0.9)]
+    [50.0, 5.0, 95.0]
+    """
+    v = np.asarray(values, dtype=float)
+    if not 0 < level < 1:
+        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    q = (1 - level) / 2
+    m, lo, hi = v.mean(axis=0), np.quantile(v, q, axis=0), np.quantile(v, 1 - q, axis=0)
+    return (float(m), float(lo), float(hi)) if v.ndim == 1 else (m, lo, hi)
+
+
+def paired_hellinger_replicates(
+    sets, pairs, boxes, extent, *, offsets: int = 2, n_boot: int = 100, seed: int = 0,
+) -> np.ndarray:
+    """Debiased Hellinger distances of several pairs of sets, on common half-samples of every set's units.
+
+    Each replicate draws half of the units of every group of ``sets`` (without replacement; the groups
+    independently, in the order they first appear in ``sets``), and for every pair (X, R) of ``pairs`` and
+    every box side ε of ``boxes`` computes the debiased squared Hellinger distance of the half-samples,
+    H²_deb(X, R) = H²(X_h, R_h) − ½ H²(X_h, X_c) − ½ H²(R_h, R_c) (X_c, R_c: the complementary halves, which
+    remove the finite-sample bias), averaged over ``offsets``² placements of the box grid (shifts by
+    ε/offsets), and H = √max(H²_deb, 0). A set used in several pairs is the same half-sample in all of them,
+    so any difference of two columns is *paired*: its spread over replicates is the sampling spread of the
+    difference (for smooth statistics a half-sample's spread equals the full sample's). Use it for two sets
+    against one reference (5b vs 5a against μ_c^{E1}), one set against two references (5a against μ_c^{E1} and
+    μ_c^{E2}), or several runs against one reference (5a at several γ, panel (d)).
+
+    Parameters
+    ----------
+    sets : mapping name -> UnitSet (or a (points, units, group) tuple)
+        The point sets, each with its units and its group (the run whose id space it shares).
+    pairs : sequence of (name, name)
+        The (set, reference) pairs whose distances are wanted.
+    boxes : sequence of float
+        Box sides ε (units of x, y).
+    extent : (x0, x1, y0, y1)
+        The partition's anchor and span (every offset partition is widened by one box).
+    offsets : int
+        Grid placements per axis (1: the anchored grid only).
+    n_boot : int
+        Half-sample replicates (≥ 2).
+    seed : int
+        Seed of the replicates (deterministic).
+
+    Returns
+    -------
+    ndarray, shape (n_boot, len(pairs), len(boxes))
+        Debiased, offset-averaged Hellinger distance (dimensionless) per replicate, pair and box.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> R1, R2, A = rng.random((3000, 2)), rng.random((3000, 2)) ** 2, rng.random((3000, 2))
+    >>> ids = np.arange(3000)
+    >>> sets = {"A": UnitSet(A, ids, "run"), "R1": UnitSet(R1, ids, "r1"), "R2": UnitSet(R2, ids, "r2")}
+    >>> reps = paired_hellinger_replicates(sets, [("A", "R1"), ("A", "R2")], [0.25], (0, 1, 0, 1), n_boot=20)
+    >>> reps.shape
+    (20, 2, 1)
+    >>> d, lo, hi = percentile_interval(reps[:, 1, 0] - reps[:, 0, 0])   # A is closer to R1: Δ > 0
+    >>> bool(lo > 0)
+    True
+    """
+    sets, pairs, boxes, group_units = _checked_unit_sets(sets, pairs, boxes, offsets, n_boot)
+    extents = [_offset_extents(extent, b, int(offsets)) for b in boxes]
+    used = sorted({n for p in pairs for n in p}, key=list(sets).index)
+    # dense cell ids of every point on every partition, computed once: a replicate only counts them
+    cells = {n: [[_dense_cells(sets[n].points, b, e) for e in exts] for b, exts in zip(boxes, extents)] for n in used}
+    totals = {n: [[np.bincount(c, minlength=k) for c, k in row] for row in cells[n]] for n in used}
+    rng = np.random.default_rng(seed)
+    out = np.empty((int(n_boot), len(pairs), len(boxes)))
+    for r in range(int(n_boot)):
+        halves = {g: rng.permutation(u)[: u.size // 2] for g, u in group_units.items()}
+        counts = {n: _half_counts(n, sets[n], halves, cells[n], totals[n]) for n in used}
+        noise = {n: [np.array([_h2_counts(h, c) for h, c in row]) for row in counts[n]] for n in used}
+        for i, (x, ref) in enumerate(pairs):
+            for j in range(len(boxes)):
+                h2 = (np.array([_h2_counts(hx, hr) for (hx, _), (hr, _) in zip(counts[x][j], counts[ref][j])])
+                      - 0.5 * noise[x][j] - 0.5 * noise[ref][j])
+                out[r, i, j] = np.sqrt(max(h2.mean(), 0.0))
+    return out
+
+
+def _checked_unit_sets(sets, pairs, boxes, offsets, n_boot):
+    """(sets as UnitSets of (n, 2) points, pairs, box sides, {group: its units}), checked with the options."""
+    sets = {k: UnitSet(*v) for k, v in sets.items()}
+    pairs = [tuple(p) for p in pairs]
+    boxes = [float(b) for b in np.atleast_1d(boxes)]
+    for name, s in sets.items():
+        pts, un = _as_points(s.points), np.asarray(s.units)
+        if un.shape[0] != pts.shape[0]:
+            raise ValueError(f"set {name!r}: the units must have one entry per point ({un.shape[0]} vs {pts.shape[0]})")
+        sets[name] = UnitSet(pts, un, s.group)
+    missing = sorted({n for p in pairs for n in p} - set(sets))
+    if missing or not pairs or any(len(p) != 2 for p in pairs):
+        raise ValueError(f"pairs must be (set, reference) names of sets; unknown: {missing}")
+    if int(offsets) < 1 or int(n_boot) < 2 or not boxes or min(boxes) <= 0:
+        raise ValueError(f"need offsets ≥ 1, n_boot ≥ 2 and box sides > 0, got {offsets!r}, {n_boot!r}, {boxes!r}")
+    groups = {}
+    for s in sets.values():
+        groups.setdefault(s.group, []).append(s.units)
+    group_units = {g: np.unique(np.concatenate(u)) for g, u in groups.items()}
+    if any(u.size < 4 for u in group_units.values()):
+        raise ValueError("need at least 4 units in every group of sets")
+    return sets, pairs, boxes, group_units
+
+
+def _half_counts(name, s, halves, cells, totals):
+    """[box][offset] (counts of the half-sample, counts of its complement) of set ``s`` on every partition."""
+    inh = np.isin(s.units, halves[s.group])
+    if inh.all() or not inh.any():
+        raise ValueError(f"a half-sample of set {name!r} is empty: too few units")
+    out = []
+    for row, trow in zip(cells, totals):
+        half = [np.bincount(c[inh], minlength=k) for c, k in row]
+        out.append([(h, t - h) for h, t in zip(half, trow)])
+    return out
+
+
 def paired_hellinger_difference(
     A, B, R, box: float, extent, *, units_a, units_b, units_r, offsets: int = 2, n_boot: int = 100,
     level: float = 0.95, seed: int = 0,
@@ -598,7 +752,8 @@ def paired_hellinger_difference(
     for smooth statistics its spread equals the sampling spread of the full-sample estimate. In each
     replicate the finite-sample bias of the squared Hellinger distance is removed with the complementary
     halves, H²_deb(X, R) = H²(X_h, R_h) − ½ H²(X_h, X_c) − ½ H²(R_h, R_c), averaged over ``offsets``²
-    placements of the box grid (shifts by box/offsets), and H = √max(H²_deb, 0).
+    placements of the box grid (shifts by box/offsets), and H = √max(H²_deb, 0)
+    (:func:`paired_hellinger_replicates` with A, B in one group and R in another).
 
     Parameters
     ----------
@@ -634,57 +789,17 @@ def paired_hellinger_difference(
     >>> bool(r.lo < 0 < r.hi), bool(abs(r.delta) < 0.05)     # B is a random half of A: no difference
     (True, True)
     """
-    A, B, R, ua, ub, ur = _checked_paired_inputs(A, B, R, units_a, units_b, units_r, offsets, n_boot, level)
-    extents = _offset_extents(extent, float(box), int(offsets))
-    run_units = np.unique(np.concatenate([ua, ub]))
-    ref_units = np.unique(ur)
-    if run_units.size < 4 or ref_units.size < 4:
-        raise ValueError("need at least 4 units in A ∪ B and in R")
-    rng = np.random.default_rng(seed)
-    da, db = np.empty(int(n_boot)), np.empty(int(n_boot))
-    for b in range(int(n_boot)):
-        half = rng.permutation(run_units)[: run_units.size // 2]
-        ref_half = rng.permutation(ref_units)[: ref_units.size // 2]
-        da[b], db[b] = _half_sample_distances(A, B, R, ua, ub, ur, half, ref_half, box, extents)
-    q = (1 - level) / 2
-    delta = db - da
-    full = np.sqrt(_h2(B, R, box, extents)) - np.sqrt(_h2(A, R, box, extents))
-    return PairedDifference(
-        d_a=float(da.mean()), d_b=float(db.mean()), delta=float(delta.mean()),
-        lo=float(np.quantile(delta, q)), hi=float(np.quantile(delta, 1 - q)),
-        d_a_interval=(float(np.quantile(da, q)), float(np.quantile(da, 1 - q))),
-        d_b_interval=(float(np.quantile(db, q)), float(np.quantile(db, 1 - q))),
-        offset_spread=float(full.std(ddof=1)) if full.size > 1 else 0.0, n_boot=int(n_boot))
-
-
-# the steps of paired_hellinger_difference
-def _checked_paired_inputs(A, B, R, units_a, units_b, units_r, offsets, n_boot, level):
-    """The point sets A, B, R as (n, 2) arrays and their units (one per point), checked with the options."""
     A, B, R = _as_points(A), _as_points(B), _as_points(R)
-    ua, ub, ur = (np.asarray(u) for u in (units_a, units_b, units_r))
-    if ua.shape[0] != A.shape[0] or ub.shape[0] != B.shape[0] or ur.shape[0] != R.shape[0]:
-        raise ValueError("units_a, units_b, units_r must have one entry per point of A, B, R")
-    if int(offsets) < 1 or int(n_boot) < 2:
-        raise ValueError(f"need offsets ≥ 1 and n_boot ≥ 2, got {offsets!r}, {n_boot!r}")
     if not 0 < level < 1:
         raise ValueError(f"level must be in (0, 1), got {level!r}")
-    return A, B, R, ua, ub, ur
-
-
-def _half_sample_distances(A, B, R, ua, ub, ur, half, ref_half, box, extents):
-    """One replicate: the debiased, offset-averaged Hellinger distances (H(A_h, R_h), H(B_h, R_h)) (dimensionless).
-
-    ``half`` holds the units of A ∪ B in the half-sample, ``ref_half`` those of R; the complementary halves
-    remove the finite-sample bias, H²_deb(X, R) = H²(X_h, R_h) − ½ H²(X_h, X_c) − ½ H²(R_h, R_c).
-    """
-    ina, inb, inr = np.isin(ua, half), np.isin(ub, half), np.isin(ur, ref_half)
-    Rh, Rc = R[inr], R[~inr]
-    noise_r = _h2(Rh, Rc, box, extents)
-    out = []
-    for X, inx in ((A, ina), (B, inb)):
-        Xh, Xc = X[inx], X[~inx]
-        if Xh.shape[0] == 0 or Xc.shape[0] == 0:
-            raise ValueError("a half-sample of A or B is empty: too few units")
-        h2 = _h2(Xh, Rh, box, extents) - 0.5 * _h2(Xh, Xc, box, extents) - 0.5 * noise_r
-        out.append(float(np.sqrt(max(h2.mean(), 0.0))))
-    return out[0], out[1]
+    sets = {"A": UnitSet(A, units_a, "run"), "B": UnitSet(B, units_b, "run"), "R": UnitSet(R, units_r, "ref")}
+    reps = paired_hellinger_replicates(sets, [("A", "R"), ("B", "R")], [box], extent, offsets=offsets,
+                                       n_boot=n_boot, seed=seed)[:, :, 0]
+    da, db = reps[:, 0], reps[:, 1]
+    d, lo, hi = percentile_interval(db - da, level)
+    extents = _offset_extents(extent, float(box), int(offsets))
+    full = np.sqrt(_h2(B, R, box, extents)) - np.sqrt(_h2(A, R, box, extents))
+    return PairedDifference(
+        d_a=float(da.mean()), d_b=float(db.mean()), delta=d, lo=lo, hi=hi,
+        d_a_interval=percentile_interval(da, level)[1:], d_b_interval=percentile_interval(db, level)[1:],
+        offset_spread=float(full.std(ddof=1)) if full.size > 1 else 0.0, n_boot=int(n_boot))
