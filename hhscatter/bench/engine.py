@@ -278,6 +278,7 @@ def _bare_rows(row, n, rep):
 def _system_rows(row, n, rep):
     """Systems as data (issue 23): Hénon–Heiles declared as an expression against the built-in on the same ICs
     (target ≤ 1.05: a declared potential costs no more per step), and ns per lane-step of the other built-ins."""
+    from hhscatter.model.spec import system_from_spec  # deferred: like the scene imports beside it
     from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
@@ -293,8 +294,7 @@ def _system_rows(row, n, rep):
     row("systems", "declared / built-in, per step", (t_d / rd.n_steps) / (t_b / rb.n_steps), "≤ 1.05",
         f"same t_end (1e-9) on {100 * same:.1f} % of orbits")
     for spec in ({"name": "contopoulos"}, {"name": "n_exit", "params": {"n": 4}}, {"name": "barbanis"}):
-        sc = Scene(energy=1.5 * 1.0, n=1, system=spec)
-        sc = sc.replace(energy=1.5 * sc.model.critical_energy, n=min(m, 20_000), r_esc=None)
+        sc = Scene(energy=1.5 * system_from_spec(spec).critical_energy, n=min(m, 20_000), system=spec)
         t, r = _best(_engine(sc, region_ics(sc, 0, sc.n)), rep)
         row("systems", f"{spec['name']} at 1.5 E_c: ns/step", 1e9 * t / r.n_steps, "",
             f"{r.n_steps / sc.n:.1f} steps/orbit")

@@ -886,9 +886,20 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
         _OWN_FAR.append(orig)
         del _OWN_FAR[:-_FREE_KEYS]
         # (no progress: the first pass has told these orbits already)
-        return run_chunk(orig.replace(r_far=events.far_radius(orig)), ics, traj_ids, batch_size=batch_size,
-                         count_steps=count_steps)
+        return run_chunk(_own_far(orig), ics, traj_ids, batch_size=batch_size, count_steps=count_steps)
 
+    res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps, n_restarts)
+    rerun = outcome == RERUN
+    if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
+        res = _merge_rerun(res, rerun, traj_ids, run_chunk(_own_far(orig), ics[rerun], traj_ids[rerun],
+                                                           batch_size=batch_size, count_steps=count_steps))
+    return res
+
+
+
+def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_steps, n_restarts) -> ChunkResult:
+    """The chunk's rows from its lanes: lifetimes in orbit order, the other tables by orbit, then time."""
+    n, (s_ids, s_t, s_e) = len(ics), snaps
     model = scene.model
     end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
     t_end = np.array(lanes.t_end, dtype=float)
@@ -911,14 +922,13 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     crossings["direction"] = crossings["direction"].astype(np.int8)
     order = np.lexsort((s_t, s_ids))
     snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
-    res = ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
-                      n_restarts=n_restarts)
-    rerun = outcome == RERUN
-    if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
-        old = orig.replace(r_far=events.far_radius(orig))
-        res = _merge_rerun(res, rerun, traj_ids, run_chunk(old, ics[rerun], traj_ids[rerun], batch_size=batch_size,
-                                                           count_steps=count_steps))
-    return res
+    return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
+                       n_restarts=n_restarts)
+
+
+def _own_far(scene):
+    """The scene with its own far radius written out: integrated under the scene's rule, not the no-return one."""
+    return scene.replace(r_far=events.far_radius(scene))
 
 
 _OWN_FAR = []  # stream scenes of this process whose chunks censor orbits: they keep their r_far (run_chunk)

@@ -50,7 +50,6 @@ from typing import Callable
 
 import numpy as np
 
-
 from hhscatter.outcomes import (  # re-exported for the engine
     CENSORED,
     ESCAPED,
@@ -217,7 +216,6 @@ def scene_events(scene) -> tuple:
 def system(scene, lay: Layout):
     """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock)."""
     import heyoka as hy  # deferred: heyoka loads on first use
-
 
     sys = scene.model.equations(hy.par[lay.gamma] if lay.gamma is not None else None)
     if lay.clock is not None:

@@ -107,6 +107,17 @@ def system_from_spec(spec: dict[str, Any] | System) -> System:
     return _build(json.dumps(c, sort_keys=True))
 
 
+def resolve(spec: dict[str, Any] | System) -> tuple[System, dict[str, Any]]:
+    """resolve(spec) -> (the system, its full spec): every parameter written out (a built-in's defaults
+    included) and the overrides as given — the form a scene stores and hashes (:class:`hhscatter.scene.scene.Scene`).
+    """
+    if isinstance(spec, System):
+        return spec, canonical_spec(spec.spec())
+    given = canonical_spec(spec)
+    model = _build(json.dumps(given, sort_keys=True))
+    return model, canonical_spec({**model.spec(), **{k: given[k] for k in OVERRIDES if k in given}})
+
+
 @functools.lru_cache(maxsize=64)
 def _build(key: str) -> System:
     c = json.loads(key)
@@ -123,4 +134,4 @@ def _build(key: str) -> System:
     return make_system(**c)
 
 
-__all__ = ["OVERRIDES", "SYSTEM_KEYS", "canonical_spec", "system_from_spec"]
+__all__ = ["OVERRIDES", "SYSTEM_KEYS", "canonical_spec", "resolve", "system_from_spec"]

@@ -20,7 +20,7 @@ import numpy as np
 
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles, System
-from hhscatter.model.spec import OVERRIDES, canonical_spec, system_from_spec
+from hhscatter.model.spec import resolve
 
 TOL_RANGE = (1e-18, 1e-6)
 
@@ -311,9 +311,7 @@ class Scene:
         if (self.omega, self.lam) != (1.0, 1.0):
             raise ConfigError("omega and lam are Hénon–Heiles' scene keys: with a system give them in its params "
                               "(system.params.omega, system.params.lam)")
-        model = system_from_spec(self.system)
-        given = canonical_spec(self.system)
-        spec = canonical_spec({**model.spec(), **{k: given[k] for k in OVERRIDES if k in given}})
+        model, spec = resolve(self.system)
         if isinstance(model, HenonHeiles) and model.hash_items() is None:
             object.__setattr__(self, "omega", model.omega)
             object.__setattr__(self, "lam", model.lam)

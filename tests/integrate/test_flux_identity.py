@@ -46,7 +46,7 @@ def _intercept(t_esc, n):
 
 @pytest.mark.parametrize("system, ratio, r_ratio", SYSTEMS)
 def test_initial_escape_rate_is_flux_over_shell_volume(system, ratio, r_ratio):
-    m = system_from_spec(system) if system is not None else Scene(energy=0.3, n=1).model
+    m = system_from_spec(system or {"name": "henon_heiles"})
     energy, R = ratio * m.critical_energy, r_ratio * m.saddle_radius
     scene = Scene(energy=energy, n=N, region="disk", radius=R, r_esc=R, momentum="random",
                   t_max=TAU, seed=7, system=system)
