@@ -96,14 +96,76 @@ def _panel_curves(ax, curves, numbers, gamma):
     ax.legend(fontsize=6, ncol=2)
 
 
+def _panel_kappa_cm(ax, numbers):
+    """(e) claim 2: κ from the c-measure against κ0 of P(t) at the same E/E_c (escaping orbits; filled where the
+    paper's all-orbit κ0 is defined too)."""
+    lo, hi = np.inf, 0.0
+    for name, info in numbers["systems"].items():
+        col, mk = COLORS.get(name, "k"), MARKERS.get(name, "o")
+        for r in info.get("kappa_cmeasure", []):
+            if r["kappa_cm"] is None or r["kappa_escaping"] is None:
+                continue
+            filled = r["kappa_plateau"] is not None and r.get("ratio_minus_1_plateau") is not None
+            ax.errorbar(r["kappa_escaping"], r["kappa_cm"], xerr=r["kappa_escaping_err"], yerr=r["kappa_cm_err"],
+                        fmt=mk, color=col, mfc=None if filled else "none", ms=6, capsize=2)
+            ax.annotate(f"{r['ratio']:g}", (r["kappa_escaping"], r["kappa_cm"]), fontsize=6, color=col,
+                        xytext=(4, -8), textcoords="offset points")
+            lo, hi = min(lo, r["kappa_escaping"], r["kappa_cm"]), max(hi, r["kappa_escaping"], r["kappa_cm"])
+        ax.plot([], [], mk, color=col, label=name)
+    if hi > 0:
+        ax.plot([lo / 1.5, hi * 1.5], [lo / 1.5, hi * 1.5], "k-", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$\kappa_0$ from P(t) (escaping orbits, claim-1 run)")
+    ax.set_ylabel(r"$\kappa$ from the c-measure, $\int e^{\kappa T} d\mu_c = 1 + \mu_c(\mathcal{E})$")
+    ax.set_title("(e) claim 2: κ from the c-measure vs κ0 (labels E/E_c);\nfilled: the paper's all-orbit κ0 defined "
+                 "too, open: ill-defined (trapped plateau)", fontsize=9)
+    ax.legend(fontsize=7)
+
+
+def _panel_distance(ax, numbers):
+    """(f) claim 5: the survivors' distance to μ_c^{E(t*)} against that to μ_c^{E0} (paired intervals)."""
+    top, text = 0.05, []
+    for name, info in numbers["systems"].items():
+        col, mk = COLORS.get(name, "k"), MARKERS.get(name, "o")
+        c5 = info.get("cmeasure_distance") or {}
+        for kind, filled in (("c-measure", True), ("all", False)):
+            r = c5.get(kind) or {}
+            if "d_star" not in r:
+                if kind == "c-measure":
+                    text.append(f"{name}: undetermined")
+                continue
+            if kind == "c-measure":
+                dl = r["delta"]
+                text.append(f"{name}: Δ = {dl['value']:+.2f} [{dl['interval'][0]:+.2f}, {dl['interval'][1]:+.2f}]")
+            x, y = r["d_E0"], r["d_star"]
+            ax.errorbar(x["value"], y["value"], xerr=[[x["value"] - x["interval"][0]], [x["interval"][1] - x["value"]]],
+                        yerr=[[y["value"] - y["interval"][0]], [y["interval"][1] - y["value"]]], fmt=mk, color=col,
+                        mfc=None if filled else "none", ms=6, capsize=2,
+                        label=f"{name}, {'μ_c (trapped dropped)' if filled else 'all survivors'}")
+            top = max(top, x["interval"][1], y["interval"][1])
+    ax.plot([0, top * 1.1], [0, top * 1.1], "k-", lw=0.8)
+    ax.text(0.03, 0.80, "paired Δ = d(μ_c^E0) − d(μ_c^E(t*)), μ_c:\n" + "\n".join(text), transform=ax.transAxes,
+            ha="left", va="top", fontsize=7, bbox={"fc": "white", "ec": "0.8"})
+    ax.set_xlim(0, top * 1.1)
+    ax.set_ylim(0, top * 1.1)
+    ax.set_xlabel(r"d(survivors at t*, $\mu_c^{E_0}$)")
+    ax.set_ylabel(r"d(survivors at t*, $\mu_c^{E(t^*)}$)")
+    ax.set_title("(f) claim 5, Fig. 5's test: debiased Hellinger distances (95 % paired intervals);\n"
+                 "below the diagonal: closer to the c-measure at E(t*)", fontsize=9)
+    ax.legend(fontsize=6)
+
+
 def plot_generality(kappa, mu, curves, numbers, path):
-    """plot_generality(κ table, μ table, ⟨E⟩ curves, numbers, path) -> None: the 4-panel figure as PNG."""
+    """plot_generality(κ table, μ table, ⟨E⟩ curves, numbers, path) -> None: the 6-panel figure as PNG."""
     plt = agg_pyplot()
-    fig, axs = plt.subplots(2, 2, figsize=(11, 8.5))
+    fig, axs = plt.subplots(3, 2, figsize=(11, 12.5))
     _panel_kappa(axs[0, 0], kappa, numbers)
     _panel_mu_of_E(axs[0, 1], mu, numbers)
     _panel_mu(axs[1, 0], numbers, numbers["config"]["study"].get("paper_mu", 0.91))
     _panel_curves(axs[1, 1], curves, numbers, numbers["config"]["study"]["mu_gamma"])
+    _panel_kappa_cm(axs[2, 0], numbers)
+    _panel_distance(axs[2, 1], numbers)
     fig.suptitle(f"generality ({numbers['scale']} scale): the paper's claims on three systems at the same E/E_c",
                  fontsize=10)
     fig.tight_layout()

@@ -513,12 +513,14 @@ def _cm_sample(study, label, r):
     t_to = p.cm_t_to - p.cm_margin
     out.update(t_rec=t_rec, t_to=t_to)
     if t_rec >= p.cm_t_to:
-        out["reason"] = f"t_rec = {t_rec:g} ≥ cm_t_to = {p.cm_t_to:g}: nothing recorded after it (κ = {res.kappa:.3g})"
+        out["reason"] = (f"t_rec = ⌈τ0 + {p.cm_rec_efolds:g}/κ⌉ = {t_rec:g} ≥ cm_t_to = {p.cm_t_to:g} (escaping orbits' "
+                         f"τ0 = {res.tau0:.0f}, κ = {res.kappa:.3g}): no relaxed sample within the recording")
         return out
     out["points"] = first_crossings(sec[sec["traj_id"].isin(esc["traj_id"])], t_rec)
     out["points_all"] = first_crossings(sec, t_rec)  # the trapped orbits kept: all conservative survivors
     if not t_to > t_rec:
-        out["reason"] = f"t_rec = {t_rec:g} ≥ cm_t_to − cm_margin = {t_to:g}: no sampling window (κ = {res.kappa:.3g})"
+        out["reason"] = (f"t_rec = {t_rec:g} ≥ cm_t_to − cm_margin = {t_to:g} (escaping orbits' τ0 = {res.tau0:.0f}, "
+                         f"κ = {res.kappa:.3g}): no sampling window")
         return out
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the undetermined count is reported
