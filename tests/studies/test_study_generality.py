@@ -90,7 +90,10 @@ def test_mu_below_threshold_is_the_microcanonical_well_value_and_tends_to_one_at
         assert all(a[1] > b[1] for a, b in itertools.pairwise(w)), name
 
 
-def test_probe_ratios_outside_the_grid_are_refused_before_any_run(tmp_path):
+@pytest.mark.parametrize("edit, key", [(("probe_ratios = [1.6]", "probe_ratios = [1.7]"), "probe_ratios"),
+                                       (("c5_ratio = 1.6", "c5_ratio = 1.3"), "c5_ratio")])
+def test_ratios_outside_their_grid_are_refused_before_any_run(tmp_path, edit, key):
+    """probe_ratios must lie on the κ0 grid, c5_ratio among cm_ratios: refused, naming the key, nothing run."""
     import shutil
     from pathlib import Path
 
@@ -98,10 +101,11 @@ def test_probe_ratios_outside_the_grid_are_refused_before_any_run(tmp_path):
 
     src = Path(__file__).resolve().parents[2] / "studies" / "generality" / "study.toml"
     (tmp_path / "generality").mkdir()
-    text = src.read_text().replace("probe_ratios = [1.6]", "probe_ratios = [1.7]")
-    (tmp_path / "generality" / "study.toml").write_text(text)
+    text = src.read_text()
+    assert edit[0] in text
+    (tmp_path / "generality" / "study.toml").write_text(text.replace(*edit))
     shutil.copy(src.parent.parent / "conventions.toml", tmp_path / "conventions.toml")
-    with pytest.raises(ValueError, match="probe_ratios"):
+    with pytest.raises(ValueError, match=key):
         run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
     assert not (tmp_path / "generality" / "out" / "tiny" / "raw").exists() or not any(
         (tmp_path / "generality" / "out" / "tiny" / "raw").iterdir())
@@ -186,18 +190,3 @@ def test_claim5_distance_counts_and_verdicts_follow_the_raw_sections_and_the_int
             assert rec["verdict"].startswith("closer to μ_c^E0") == (hi < 0)
             checked += 1
     assert checked >= 1
-
-
-def test_c5_ratio_outside_cm_ratios_is_refused_before_any_run(tmp_path):
-    import shutil
-    from pathlib import Path
-
-    from hhscatter.studies import run_stage
-
-    src = Path(__file__).resolve().parents[2] / "studies" / "generality" / "study.toml"
-    (tmp_path / "generality").mkdir()
-    text = src.read_text().replace("c5_ratio = 1.6", "c5_ratio = 1.3")
-    (tmp_path / "generality" / "study.toml").write_text(text)
-    shutil.copy(src.parent.parent / "conventions.toml", tmp_path / "conventions.toml")
-    with pytest.raises(ValueError, match="c5_ratio"):
-        run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
