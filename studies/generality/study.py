@@ -12,12 +12,17 @@ Stages (``hhscatter study generality simulate|analyze|plot [--scale S]``):
     per system (raw keys prefixed with its label): the κ0(E) runs ``<label>_r<r>`` (γ = 0, ``grid_n`` orbits);
     the probe runs ``<label>_probe_r<r>`` (γ = probe_gamma, energies every probe_step: the conservative flow's
     kinetic energy); the dissipative runs ``<label>_g<γ>`` at E0 = e0_ratio·E_c, the same ICs for every γ,
-    the γ = mu_gamma run with snapshots and settled orbits continued (⟨E⟩(t)).
+    the γ = mu_gamma run with snapshots and settled orbits continued (⟨E⟩(t)); the section-recording conservative
+    runs ``<label>_cm_r<r>`` at cm_ratios and e0_ratio (every crossing of ṙ = 0, φ̇ > 0 in [0, cm_t_to]: claims 2
+    and 5) and the dissipative run ``<label>_sec_g<mu_gamma>`` recording the crossings around t* (claim 5).
 
 ``analyze(study)``
-    Claim 1 (κ0(E) law per system, two window conventions), claim 3 (μ measured, μ predicted from the
-    conservative system, :mod:`hhscatter.analysis.dissipative.kinetic`), claim 4 (τ0, τ1, τ2 against γ and
-    Eq. (eq:tau2)); derived tables and ``generality.json`` with the list ``claims`` of records
+    Claim 1 (κ0(E) law per system, two window conventions), claim 2 (κ from the c-measure,
+    Eq. (eqn:kappa_cmeasure_truetime), :mod:`hhscatter.analysis.survival.cmeasure`), claim 3 (μ measured, μ
+    predicted from the conservative system, :mod:`hhscatter.analysis.dissipative.kinetic`), claim 4 (τ0, τ1, τ2
+    against γ and Eq. (eq:tau2)), claim 5 (Fig. 5's paired distance,
+    :func:`hhscatter.analysis.geometry.distance.paired_hellinger_replicates`, and a moment test), claims 6 and 7;
+    derived tables and ``generality.json`` with the list ``claims`` of records
     {claim, quantity, system, value, err, verdict, note}.
 
 ``plot(study)``
