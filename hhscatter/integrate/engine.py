@@ -15,11 +15,15 @@ callback records the outcome and loads the next initial condition into the
 lane. Callbacks cannot change a lane's clock, so an orbit's time is the lane
 time minus its start, both double-length (hi, lo); TwoSum keeps the
 difference exact, so orbit times do not depend on how orbits share lanes.
-Censoring uses the propagation bound, never an event on time (event values
-enter heyoka's step-size control). A bound belongs to the orbit in the lane
-when ``propagate_until`` was called; an orbit loaded later that reaches the
-stale bound is rerun from its initial condition, so every orbit's steps are
-exactly those it has alone.
+Censoring is the clock's: σ = (t_max − t)/G, set at load and integrated with
+the orbit, is a terminal event at t_max in the orbit's own time (its steps
+and root do not depend on the lane's history; σ ∈ [0, 1] adds nothing to
+the step-size control: the same steps, measured). No propagation bound ever
+clamps a step: a bound (lane start + t_max) used to, and the censored state,
+and the root of any event in a step clamped by an earlier orbit's stale
+bound, then depended on when the lane's earlier orbits ended (the chunk
+size; issue 27). A chunk is one ``propagate_until`` call, so every orbit's
+steps are exactly those it has alone.
 
 *Epochs* (scenes with energy snapshots). A step callback in Python on every
 step, which snapshots used to need, cost more than the integration. Here all
@@ -87,7 +91,7 @@ class ChunkResult:
     crossings: dict
     n_returns: int = 0
     n_steps: int = 0
-    n_restarts: int = 0
+    n_restarts: int = 0  # orbits rerun inside the chunk: none since the clock censors (issue 27)
 
     def tables(self) -> dict:
         return {"lifetimes": self.lifetimes, "sections": self.sections, "snapshots": self.snapshots,
@@ -428,14 +432,10 @@ class _Stream(_BatchRules):
         super().__init__(scene, ta, layout, ics)
         self.start_hi = [0.0] * self.B
         self.start_lo = [0.0] * self.B
-        # bound of the running propagate_until call (read by callbacks) and the bound each
-        # lane's current orbit needs
+        # bound of the running propagate_until call: none for live lanes (the clock censors at t_max)
         self.bound = np.zeros(self.B)
-        self.orbit_bound = [0.0] * self.B
-        self.n_restarts = 0
-        self.n_loads = 0
-        # with the clock censoring at t_max, no lane needs a bound: one call runs the chunk
-        self.clock_censor = any(a == "censor" for _, a in self.targets)
+        if not any(a == "censor" for _, a in self.targets):
+            raise RuntimeError("internal error: a stream scene without the clock's censor target")
         self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
 
     def inlined_handlers(self):
@@ -481,12 +481,7 @@ class _Stream(_BatchRules):
                 return finish(lane, RERUN, *out)
             return finish(lane, ESCAPED, *out)
 
-        def load(lane, k=None):
-            if k is None:
-                return next_orbit(lane)
-            return _Stream.load(self, lane, k)  # a rerun: the orbit's own index
-
-        self.load = load
+        self.load = next_orbit
         return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
 
     def _inlined_orbit_steps(self):
@@ -501,16 +496,14 @@ class _Stream(_BatchRules):
         """
         orbit, last_out = self.orbit, self.last_out
         hi, lo, starts_hi, starts_lo = self.time_hi, self.time_lo, self.start_hi, self.start_lo
-        orbit_bounds, bound = self.orbit_bound, self.bound
         st, ics, ta, cols = self.state, self.ics, self.ta, self.cols
         outcomes, t_ends, end_states = self.outcome, self.t_end, self.end_state
-        n, t_max = self.n, self.t_max
+        n = self.n
         progress = self.progress
         reset = ta.reset_cooldowns
         # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
         clock, phase, clock_i = self.layout.clock, self.phase, self.clock_i
-        sigma0 = self.targets[0][0] / self.clock_scale if self.targets else 1.0
-        no_bound = self.clock_censor
+        sigma0 = self.targets[0][0] / self.clock_scale
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
 
@@ -520,7 +513,7 @@ class _Stream(_BatchRules):
             bb = s - a
             return s + (((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane]))
 
-        counter = [self.next, self.n_loads]
+        counter = [self.next]
 
         def start_next(lane, h, el):
             """Load the next orbit into ``lane``, whose time is (h, el) now."""
@@ -542,10 +535,8 @@ class _Stream(_BatchRules):
                 phase[lane] = LIVE
             starts_hi[lane] = h
             starts_lo[lane] = el
-            orbit_bounds[lane] = _NO_BOUND if no_bound else h + t_max
             reset(lane)
-            counter[1] += 1
-            return (counter[1] & 7) or not (hi >= bound).any()
+            return True
 
         def next_orbit(lane):
             return start_next(lane, hi_(lane), lo_(lane))
@@ -577,42 +568,26 @@ class _Stream(_BatchRules):
         # + the orbit time at which it entered this integrator (0 but in a second phase)
         return (s + (err + (self.time_lo.item(lane) - self.start_lo[lane]))) + self.t_off[lane]
 
-    def load(self, lane, k=None):
-        """Put orbit ``k`` (default: the next one) into ``lane``; park the lane if none is left.
+    def load(self, lane):
+        """Put the next orbit into ``lane``; park the lane if none is left.
 
-        Returns what a callback must return: False (stop the propagation) when
-        the lane is parked or some lane sits at its bound.
+        Returns what a callback must return: False (stop the propagation, so that
+        the parked lane holds still) when the lane is parked.
         """
-        if k is None:
-            k = self.next
-            if k >= self.n:
-                self.orbit[lane] = -1
-                if self.layout.gate is not None:
-                    self.set_gate(lane, 0.0)
-                return False
-            self.next = k + 1
+        k = self.next
+        if k >= self.n:
+            self.orbit[lane] = -1
+            if self.layout.gate is not None:
+                self.set_gate(lane, 0.0)
+            return False
+        self.next = k + 1
         self.put(lane, k)
-        hi = self.time_hi.item(lane)
-        self.start_hi[lane], self.start_lo[lane] = hi, self.time_lo.item(lane)
-        self.orbit_bound[lane] = _NO_BOUND if self.clock_censor else hi + self.t_max
-        # a lane at its bound idles until the call returns; checking costs ~1 µs,
-        # so look every 8th load (idle time ≲ 8 orbit ends, once per t_max)
-        self.n_loads += 1
-        return (self.n_loads & 7) or not (self.time_hi >= self.bound).any()
+        self.start_hi[lane], self.start_lo[lane] = self.time_hi.item(lane), self.time_lo.item(lane)
+        return True
 
     def release(self, lane):
         self.finish_rows(lane)
         return self.load(lane)
-
-    def at_bound(self, lane):
-        """After a return: handle a lane that reached its propagation bound."""
-        if self.bound[lane] == self.orbit_bound[lane]:
-            if self.phase[lane] == LIVE:
-                self.record(lane, CENSORED, self.t_max, self.state4(lane))
-            self.release(lane)
-        else:  # a stale bound cut this orbit's step: rerun it from its start
-            self.n_restarts += 1
-            self.load(lane, self.orbit[lane])
 
     def run(self):
         B, ta, bound = self.B, self.ta, self.bound
@@ -622,16 +597,13 @@ class _Stream(_BatchRules):
         while True:
             for lane in range(B):
                 # parked lanes hold still at their current time
-                bound[lane] = self.orbit_bound[lane] if self.orbit[lane] >= 0 else self.time_hi[lane]
+                bound[lane] = _NO_BOUND if self.orbit[lane] >= 0 else self.time_hi[lane]
             if all(k < 0 for k in self.orbit):
                 break
             ta.propagate_until(bound)
             n_returns += 1
             n_steps += _check(ta, self)  # once per return (a handful per chunk)
-            for lane in range(B):
-                if self.orbit[lane] >= 0 and self.time_hi[lane] >= bound[lane]:
-                    self.at_bound(lane)
-        return n_returns, n_steps, self.n_restarts, _no_snapshots()
+        return n_returns, n_steps, 0, _no_snapshots()
 
 
 class _SecondPhase(_Stream):
@@ -645,11 +617,9 @@ class _SecondPhase(_Stream):
         for name in ("outcome", "t_end", "end_state", "sec_rows", "cross_rows"):
             setattr(self, name, getattr(first, name))
         self.progress = None  # the first phase reported these orbits already
-        self.src = [-1] * self.B
 
     def put(self, lane, j):
         k, state, t_mig, clock_i, last_out, phase = self.migrants_in[j]
-        self.src[lane] = j
         self.state[:4, lane] = state
         self.start_orbit(lane, k)
         self.last_out[lane], self.phase[lane] = last_out, phase
@@ -659,10 +629,6 @@ class _SecondPhase(_Stream):
         targets = self.targets
         self.set_clock(lane, (targets[clock_i][0] - t_mig) / self.clock_scale if clock_i < len(targets) else 1.0)
         self.ta.reset_cooldowns(lane)
-
-    def load(self, lane, k=None):
-        # a rerun (k given, after a stale bound) restarts the migrant, not an initial condition
-        return super().load(lane, None if k is None else self.src[lane])
 
 
 class _Epochs(_BatchRules):
@@ -837,8 +803,8 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     fill ``ChunkResult.n_steps`` (the epoch scheduler otherwise skips reading
     heyoka's per-lane results every epoch; the stream scheduler always counts).
     ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
-    that many more orbits of the chunk have started (an orbit rerun after a
-    stale bound counts again), so long chunks show progress.
+    that many more orbits of the chunk have started, so long chunks show
+    progress.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
@@ -880,14 +846,6 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     outcome = np.array(lanes.outcome, dtype=np.int8)
     if (outcome == -1).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
-    if late is not None and kind == "stream" and ((outcome == RERUN) | (outcome == CENSORED)).any():
-        # a stream lane's censored state depends on when its orbit started (the bound's rounding), hence on
-        # when earlier orbits ended: the chunk runs again under the scene's own rule, and so do its later chunks
-        _OWN_FAR.append(orig)
-        del _OWN_FAR[:-_FREE_KEYS]
-        # (no progress: the first pass has told these orbits already)
-        return run_chunk(_own_far(orig), ics, traj_ids, batch_size=batch_size, count_steps=count_steps)
-
     res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps, n_restarts)
     rerun = outcome == RERUN
     if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
@@ -931,9 +889,6 @@ def _own_far(scene):
     return scene.replace(r_far=events.far_radius(scene))
 
 
-_OWN_FAR = []  # stream scenes of this process whose chunks censor orbits: they keep their r_far (run_chunk)
-
-
 def _no_return(scene, ics, kind):
     """_no_return(scene, ics, kind) -> (scene to integrate, late): the no-return rule of dissipative scenes.
 
@@ -947,10 +902,9 @@ def _no_return(scene, ics, kind):
 
     The one thing r_far still decides: an orbit that has not reached r_far by t_max is censored there.
     ``late(t, state)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
-    scene's own far event (exactly as before: tables byte-identical for the same scene hash). In the stream
-    scheduler (``kind``) the state of an orbit censored at its lane's bound depends on the lane's start time,
-    i.e. on when the orbits before it ended: a stream chunk with a late or censored orbit runs again whole
-    under the scene's own rule, and the scene's later chunks in this process keep it (``_OWN_FAR``). The bound: beyond
+    scene's own far event (exactly as before: tables byte-identical for the same scene hash). A censored orbit
+    never reached R, so its steps are the same under either far event (the clock censors it in orbit time, a
+    stream lane's history does not enter). The bound: beyond
     R the radial force is outward, so with the linear drag ṗ_r ≥ −γ p_r, p_r(t) ≥ p_r e^{−γτ}, and r_far is
     reached within τ = −ln(1 − γ(r_far − r)/p_r)/γ (taken with 1 % and 1e-6 of slack); an orbit for which
     that is infinite or ends after t_max is late. Applies to linear drag with the default r_far (a scene with
@@ -958,7 +912,7 @@ def _no_return(scene, ics, kind):
     """
     m = scene.model
     if (scene.gamma <= 0 or scene.r_far is not None or m.dissipation != "linear" or not len(ics)
-            or (kind == "stream" and scene in _OWN_FAR)):
+):
         return scene, None
     r_far = events.far_radius(scene)
     e0 = float(np.max(m.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3])))

@@ -141,19 +141,17 @@ def clock_targets(scene) -> tuple:
     Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
     that opens late could miss a crossing) and 'close' it (at t_to +
     CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
-    with such a clock and no snapshots also 'censor' with it at t_max.
+    without snapshots (the stream scheduler) also 'censor' with it at t_max:
+    in orbit time, so a censored orbit's end state does not depend on the
+    orbits before it in its lane (a propagation bound's rounding did).
     """
     w = scene.sections
-    if w is None:
-        return ()
     out = []
-    if w.t_from > 0:
+    if w is not None and w.t_from > 0:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
-    if math.isfinite(w.t_to):
+    if w is not None and math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    if out and not scene.snapshots:
-        # the clock is compiled in anyway: it also ends the orbit at t_max, so the stream
-        # scheduler needs no per-orbit propagation bound (whose stale copies forced reruns)
+    if not scene.snapshots:
         out.append((float(scene.t_max), "censor"))
     return tuple(sorted(out))
 
@@ -182,7 +180,8 @@ def scene_events(scene) -> tuple:
 
     Only what the scene needs is compiled: the section event only for scenes
     with a section window (and switched off per lane outside it), the clock
-    only for windows that open late or close, the follow radii only for
+    for windows that open late or close and for censoring in stream scenes
+    (no snapshots), the follow radii only for
     follow scenes.
     """
     r_esc2 = scene.r_esc**2

@@ -35,11 +35,12 @@ def test_only_the_events_module_constructs_heyoka_events():
 
 
 @pytest.mark.parametrize("kw, names", [
-    ({}, ["escape"]),
-    ({"gamma": 0.01}, ["closure", "far", "resc"]),
-    ({"sections": SectionWindow()}, ["escape", "section"]),
+    ({}, ["escape", "clock"]),  # stream scenes censor with the clock (orbit time: test_determinism)
+    ({"gamma": 0.01}, ["closure", "far", "resc", "clock"]),
+    ({"gamma": 0.01, "snapshots": (1.0, 2.0)}, ["closure", "far", "resc"]),  # epochs censor at an epoch's end
+    ({"sections": SectionWindow()}, ["escape", "section", "clock"]),
     ({"sections": SectionWindow(t_from=3.0, t_to=9.0)}, ["escape", "section", "clock"]),
-    ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2"]),
+    ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2", "clock"]),
 ])
 def test_scene_events_compile_only_what_the_scene_needs(kw, names):
     # (a stream scene whose window opens late compiles the section event only into the
