@@ -6,6 +6,8 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:study-figure fig2 -->    docs/studies/assets/fig2.png
     <!-- hh:study-numbers fig2 -->   docs/studies/assets/fig2.json as tables
     <!-- hh:study-module fig2 -->    API of hhscatter.studies.fig2 (if it exists)
+    <!-- hh:claims-table generality -->  its JSON's ``claims`` records as a claims × systems table
+                                     (paper scale first when committed, quick scale folded below)
     <!-- hh:comparison-all -->       every study's paper-vs-ours rows in one table
     <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
     <!-- hh:bench stress -->         docs/benchmarks/assets/stress/*summary.md (+ figures)
@@ -208,6 +210,27 @@ class Renderer:
         out.append(f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: [{name}.json]({link}).*\n")
         return "\n".join(out)
 
+    def claims_table(self, name: str) -> str:
+        """The study's ``claims`` records ({claim, quantity, system, value, err, verdict}) as one table,
+        claims × systems: the paper scale's when committed (the quick scale's folded below), else the quick's."""
+        docs = {sc: self._numbers(name, sc) for sc in ("paper", "quick")}
+        docs = {sc: d for sc, d in docs.items() if d and d.get("claims")}
+        if not docs:
+            return self.missing(f"The claims of study {name}", f"Run `make {name}`, then `make docs-assets`.")
+        out = []
+        for i, (sc, doc) in enumerate(docs.items()):
+            table = claims_table(doc)
+            link = self._rel(self.study_asset(name, "json", sc))
+            made = str((doc.get("provenance") or {}).get("git_commit") or "?")[:12]
+            caption = (f"*Scale **{sc}**: the records `claims` of [{name}.json ({sc})]({link}), made at commit "
+                       f"`{made}`; a cell is value ± 1σ: verdict (z = distance to the reference in σ).*\n")
+            if i == 0:
+                out.append(table + "\n" + caption)
+            else:
+                out.append(f'??? info "The same table at the {sc} scale (click to open)"\n\n'
+                           + _indent(table + "\n" + caption) + "\n")
+        return "\n".join(out)
+
     def study_module(self, name: str) -> str:
         mod = self.root / "studies" / name / "study.py"
         if not mod.exists():
@@ -369,6 +392,40 @@ def _is_record_list(v) -> bool:
         and all(not isinstance(y, (dict, list)) or (isinstance(y, dict) and "value" in y)
                 or (isinstance(y, list) and len(y) <= 4) for x in v for y in x.values())
     )
+
+
+def claims_table(doc) -> str:
+    """Markdown table claims × systems of a numbers JSON with a ``claims`` list and a ``systems`` dict
+    ({label: {n_exits, E_c, ...}}); rows in the order the records first appear."""
+    systems = list((doc.get("systems") or {}).keys())
+    for c in doc["claims"]:
+        if c.get("system") not in systems:
+            systems.append(c.get("system"))
+    rows: dict = {}
+    for c in doc["claims"]:
+        rows.setdefault((str(c.get("claim")), c.get("quantity", "")), {})[c.get("system")] = c
+
+    def head(label):
+        info = (doc.get("systems") or {}).get(label) or {}
+        bits = [f"{info['n_exits']} exits" if info.get("n_exits") is not None else "",
+                f"E_c = {fmt_num(info['E_c'], 4)}" if _is_num(info.get("E_c")) else ""]
+        bits = [b for b in bits if b]
+        return f"{label} ({', '.join(bits)})" if bits else str(label)
+
+    def cell(c):
+        if c is None:
+            return "—"
+        v, e = c.get("value"), c.get("err")
+        val = "n/a" if v is None else (fmt_err(v, e) if _is_num(e) else fmt_value(v) if not _is_num(v)
+                                       else fmt_num(v, 3))
+        verdict = c.get("verdict")
+        return _cell(f"{val}: {verdict}" if verdict else val)
+
+    out = ["| claim | quantity | " + " | ".join(_cell(head(s)) for s in systems) + " |",
+           "|---|---|" + "---|" * len(systems)]
+    for (claim, qty), per in rows.items():
+        out.append(f"| {_cell(claim)} | {_cell(qty)} | " + " | ".join(cell(per.get(s)) for s in systems) + " |")
+    return "\n".join(out) + "\n"
 
 
 def record_table(recs) -> str:

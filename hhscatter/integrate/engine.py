@@ -14,7 +14,12 @@ short orbit, so an orbit's end never stops the propagation: its event
 callback records the outcome and loads the next initial condition into the
 lane. Callbacks cannot change a lane's clock, so an orbit's time is the lane
 time minus its start, both double-length (hi, lo); TwoSum keeps the
-difference exact, so orbit times do not depend on how orbits share lanes.
+difference exact to ~2⁻¹⁰⁶ of the lane time, so orbit times do not depend on
+how orbits share lanes. One case remains: an orbit time whose exact value is
+a tie (halfway between two doubles; sums of steps often are) would round by
+that ~2⁻¹⁰⁶ residue, which depends on the lane's start. Orbit times within
+2⁻³⁰ of a gap of a tie round to even (:func:`_tie_to_even`), so they too are
+the same in every lane.
 Censoring is the clock's: σ = (t_max − t)/G, set at load and integrated with
 the orbit, is a terminal event at t_max in the orbit's own time (its steps
 and root do not depend on the lane's history; σ ∈ [0, 1] adds nothing to
@@ -79,6 +84,40 @@ _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_
 RERUN = -2  # outcome code inside a chunk: decided at the no-return radius too close to t_max; rerun to r_far
 NO_RETURN_GRID = 1.0 / 8.0  # the no-return far radius is rounded up to this fraction of r_s (fewer compiles)
 NO_RETURN_MARGIN = 0.01  # ... and lies at least this fraction beyond r_esc (its root is never r_esc's)
+
+
+_ulp = math.ulp
+TIE_BAND = 2.0 ** -30  # an orbit time this close (in gaps) to a tie of its rounding is a tie (>> the 2^-106 residue)
+
+
+def _tie_to_even(r: float, rem: float) -> float:
+    """The orbit time r + rem (r the double nearest it, rem the exact remainder) rounded half to even when
+    it lies within TIE_BAND gaps of the midpoint between r and its neighbour on rem's side; r otherwise.
+
+    The remainder of an orbit time carries ~2⁻¹⁰⁶ of the lane time of error that depends on the lane's
+    start, which decides a tie's rounding; rounding near-ties to even makes it the same in every lane.
+    Called only when the cheap screen in the elapsed-time functions finds ``rem`` near a half or quarter
+    ulp (the gap below a power of two is half the ulp).
+
+    >>> r = 1.0 + 2.0 ** -52                      # odd mantissa; its upper neighbour is even
+    >>> _tie_to_even(r, 2.0 ** -53 - 2.0 ** -140) == r + 2.0 ** -52
+    True
+    >>> _tie_to_even(r, 2.0 ** -55) == r          # not a tie: r is the nearest
+    True
+    """
+    n = math.nextafter(r, math.inf if rem > 0 else -math.inf)
+    gap = abs(n - r)
+    if abs(abs(rem) - 0.5 * gap) > gap * TIE_BAND:
+        return r
+    m = math.frexp(r)[0]
+    return r if int(m * 9007199254740992.0) % 2 == 0 else n  # the even mantissa of the two
+
+
+def _near_tie(r: float, rem: float) -> bool:
+    """Cheap screen: is |rem| within TIE_BAND gaps of half a gap of r (either gap size)?"""
+    u = _ulp(r)
+    h = abs(rem)
+    return abs(h - 0.5 * u) <= u * TIE_BAND or abs(h - 0.25 * u) <= u * TIE_BAND
 
 
 @dataclass
@@ -506,12 +545,16 @@ class _Stream(_BatchRules):
         sigma0 = self.targets[0][0] / self.clock_scale
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
+        near_tie = _near_tie
 
         def elapsed(lane):
             a, b = hi_(lane), -starts_hi[lane]
             s = a + b
             bb = s - a
-            return s + (((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane]))
+            c = ((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane])
+            r = s + c
+            rem = c - (r - s)
+            return _tie_to_even(r, rem) if rem and near_tie(r, rem) else r
 
         counter = [self.next]
 
@@ -553,7 +596,10 @@ class _Stream(_BatchRules):
             s = a + b
             bb = s - a
             outcomes[k] = outcome
-            t_ends[k] = s + (((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane]))  # elapsed(lane)
+            c = ((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane])  # elapsed(lane)
+            r = s + c
+            rem = c - (r - s)
+            t_ends[k] = _tie_to_even(r, rem) if rem and near_tie(r, rem) else r
             end_states[k] = cols[lane].tolist()
             return start_next(lane, a, el)
 
@@ -564,9 +610,13 @@ class _Stream(_BatchRules):
         a, b = self.time_hi.item(lane), -self.start_hi[lane]
         s = a + b
         bb = s - a
-        err = (a - (s - bb)) + (b - bb)
+        c = ((a - (s - bb)) + (b - bb)) + (self.time_lo.item(lane) - self.start_lo[lane])
+        r = s + c
+        rem = c - (r - s)
+        if rem and _near_tie(r, rem):
+            r = _tie_to_even(r, rem)
         # + the orbit time at which it entered this integrator (0 but in a second phase)
-        return (s + (err + (self.time_lo.item(lane) - self.start_lo[lane]))) + self.t_off[lane]
+        return r + self.t_off[lane]
 
     def load(self, lane):
         """Put the next orbit into ``lane``; park the lane if none is left.

@@ -150,6 +150,36 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assert "](assets/fig2.json)" in out
 
 
+def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
+    """hh:claims-table: one row per (claim, quantity), one column per system, each cell value ± err: verdict;
+    a system without a record for a row is "—"; the paper scale leads and the quick scale is folded below."""
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+
+    def doc(scale, kappa):
+        return {"study": "gx", "scale": scale, "provenance": {"git_commit": "abcdef0123456789"},
+                "systems": {"hh": {"n_exits": 3, "E_c": 1 / 6}, "two": {"n_exits": 2, "E_c": 0.5}},
+                "claims": [
+                    {"claim": "1", "quantity": "κ0", "system": "hh", "value": kappa, "err": 0.0123,
+                     "verdict": "agrees (z = +0.1)"},
+                    {"claim": "1", "quantity": "κ0", "system": "two", "value": None, "err": None,
+                     "verdict": "undetermined: 97% trapped"},
+                    {"claim": "3", "quantity": "μ", "system": "two", "value": 0.98, "err": None, "verdict": "measured"},
+                ]}
+
+    (assets / "gx.json").write_text(json.dumps(doc("quick", 0.3)))
+    out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
+    assert "| claim | quantity | hh (3 exits, E_c = 0.1667) | two (2 exits, E_c = 0.5) |" in out
+    assert "| 1 | κ0 | 0.300 ± 0.012: agrees (z = +0.1) | n/a: undetermined: 97% trapped |" in out
+    assert "| 3 | μ | — | 0.98: measured |" in out
+    assert "Scale **quick**" in out and "???" not in out
+    (assets / "paper" / "gx.json").write_text(json.dumps(doc("paper", 0.25)))
+    out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
+    first, folded = out.split("???", 1)
+    assert "0.250 ± 0.012" in first and "Scale **paper**" in first and "0.300" not in first
+    assert "0.300 ± 0.012" in folded and "Scale **quick**" in folded
+
+
 def test_unknown_marker_fails_the_build(tmp_path, hook):
     with pytest.raises(ValueError, match="hh:no-such-thing"):
         _page(tmp_path, hook, "<!-- hh:no-such-thing -->\n")
