@@ -396,7 +396,7 @@ def _is_record_list(v) -> bool:
 
 def claims_table(doc) -> str:
     """Markdown table claims × systems of a numbers JSON with a ``claims`` list and a ``systems`` dict
-    ({label: {n_exits, E_c, ...}}); rows in the order the records first appear."""
+    ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear."""
     systems = list((doc.get("systems") or {}).keys())
     for c in doc["claims"]:
         if c.get("system") not in systems:
@@ -423,7 +423,12 @@ def claims_table(doc) -> str:
 
     out = ["| claim | quantity | " + " | ".join(_cell(head(s)) for s in systems) + " |",
            "|---|---|" + "---|" * len(systems)]
-    for (claim, qty), per in rows.items():
+
+    def claim_order(item):  # by claim (numbers numerically), then in the order the records first appear
+        claim = item[0][0]
+        return (0, float(claim), "") if re.fullmatch(r"\d+(\.\d+)?", claim) else (1, 0.0, claim)
+
+    for (claim, qty), per in sorted(rows.items(), key=claim_order):
         out.append(f"| {_cell(claim)} | {_cell(qty)} | " + " | ".join(cell(per.get(s)) for s in systems) + " |")
     return "\n".join(out) + "\n"
 

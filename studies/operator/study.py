@@ -361,7 +361,9 @@ def _islands(study, E, df, tr, ids, keep, sub, t):
 
         vals, vecs = scipy.linalg.eig(P.toarray().T)
     else:
-        vals, vecs = eigs(P.T.tocsr(), k=min(4, sub.n_states - 2), which="LM", tol=1e-10)
+        # a fixed start (ARPACK's own is random): the same eigenvalues in every run, not ≤ 1e-11 apart
+        vals, vecs = eigs(P.T.tocsr(), k=min(4, sub.n_states - 2), which="LM", tol=1e-10,
+                          v0=np.full(sub.n_states, 1.0 / np.sqrt(sub.n_states)))
     order = np.argsort(-np.abs(vals))
     modes = []
     for j in order[:4]:

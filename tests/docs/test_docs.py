@@ -165,6 +165,7 @@ def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
                     {"claim": "1", "quantity": "κ0", "system": "two", "value": None, "err": None,
                      "verdict": "undetermined: 97% trapped"},
                     {"claim": "3", "quantity": "μ", "system": "two", "value": 0.98, "err": None, "verdict": "measured"},
+                    {"claim": "2", "quantity": "κ_cm", "system": "hh", "value": 0.1, "err": None, "verdict": "ok"},
                 ]}
 
     (assets / "gx.json").write_text(json.dumps(doc("quick", 0.3)))
@@ -172,6 +173,7 @@ def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
     assert "| claim | quantity | hh (3 exits, E_c = 0.1667) | two (2 exits, E_c = 0.5) |" in out
     assert "| 1 | κ0 | 0.300 ± 0.012: agrees (z = +0.1) | n/a: undetermined: 97% trapped |" in out
     assert "| 3 | μ | — | 0.98: measured |" in out
+    assert out.index("| 1 | κ0 |") < out.index("| 2 | κ_cm |") < out.index("| 3 | μ |")  # by claim
     assert "Scale **quick**" in out and "???" not in out
     (assets / "paper" / "gx.json").write_text(json.dumps(doc("paper", 0.25)))
     out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
