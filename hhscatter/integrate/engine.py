@@ -545,7 +545,7 @@ class _Stream(_BatchRules):
         sigma0 = self.targets[0][0] / self.clock_scale
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
-        near_tie = _near_tie
+        ulp, band = _ulp, TIE_BAND
 
         def elapsed(lane):
             a, b = hi_(lane), -starts_hi[lane]
@@ -554,7 +554,11 @@ class _Stream(_BatchRules):
             c = ((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane])
             r = s + c
             rem = c - (r - s)
-            return _tie_to_even(r, rem) if rem and near_tie(r, rem) else r
+            if rem:  # _near_tie, inlined (every orbit end passes here)
+                u, h = ulp(r), abs(rem)
+                if abs(h - 0.5 * u) <= u * band or abs(h - 0.25 * u) <= u * band:
+                    return _tie_to_even(r, rem)
+            return r
 
         counter = [self.next]
 
@@ -599,7 +603,11 @@ class _Stream(_BatchRules):
             c = ((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane])  # elapsed(lane)
             r = s + c
             rem = c - (r - s)
-            t_ends[k] = _tie_to_even(r, rem) if rem and near_tie(r, rem) else r
+            if rem:  # _near_tie, inlined
+                u, h = ulp(r), abs(rem)
+                if abs(h - 0.5 * u) <= u * band or abs(h - 0.25 * u) <= u * band:
+                    r = _tie_to_even(r, rem)
+            t_ends[k] = r
             end_states[k] = cols[lane].tolist()
             return start_next(lane, a, el)
 

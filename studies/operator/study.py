@@ -364,7 +364,8 @@ def _islands(study, E, df, tr, ids, keep, sub, t):
         # a fixed start (ARPACK's own is random): the same eigenvalues in every run, not ≤ 1e-11 apart
         vals, vecs = eigs(P.T.tocsr(), k=min(4, sub.n_states - 2), which="LM", tol=1e-10,
                           v0=np.full(sub.n_states, 1.0 / np.sqrt(sub.n_states)))
-    order = np.argsort(-np.abs(vals))
+    # by modulus, a conjugate pair (equal moduli up to rounding) with the positive argument first
+    order = np.lexsort((-np.angle(vals), -np.round(np.abs(vals), 10)))
     modes = []
     for j in order[:4]:
         v = np.abs(vecs[:, j])
