@@ -524,15 +524,11 @@ class _Stream(_BatchRules):
         return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
 
     def _inlined_orbit_steps(self):
-        """The closures the inlined handlers share: the orbit time of a lane (TwoSum of the double-double lane
-        time minus the orbit's start), the end of an orbit at a given time and state (record, then load the
-        next), the end of an orbit where the lane is now, and the loading of the next orbit (returns what a
-        callback returns); all state captured once, as lists, Python floats and per-lane views of the state.
-
+        """The closures the inlined handlers share: a lane's orbit time, the end of an orbit at a given time and
+        state (record, load the next), the end of an orbit where the lane is now, the loading of the next orbit
+        (returns what a callback returns); state captured once, as lists, Python floats and per-lane views.
         Per orbit end (measured, issue 27): the lane time is read once (an orbit that ends where the lane is
-        ends at the time the next one starts), the state through a per-lane view (``cols[lane]``: a third of
-        the cost of ``state[:4, lane]``), in one call frame less.
-        """
+        ends at the time the next starts), the state through ``cols[lane]`` (a third of ``state[:4, lane]``)."""
         orbit, last_out = self.orbit, self.last_out
         hi, lo, starts_hi, starts_lo = self.time_hi, self.time_lo, self.start_hi, self.start_lo
         st, ics, ta, cols = self.state, self.ics, self.ta, self.cols
@@ -547,18 +543,22 @@ class _Stream(_BatchRules):
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
         ulp, band = _ulp, TIE_BAND
 
-        def elapsed(lane):
-            a, b = hi_(lane), -starts_hi[lane]
+        def orbit_time(a, el, lane):
+            """(a, el) − the orbit's start by TwoSum, near-ties to even (_near_tie inlined: every orbit end)."""
+            b = -starts_hi[lane]
             s = a + b
             bb = s - a
-            c = ((a - (s - bb)) + (b - bb)) + (lo_(lane) - starts_lo[lane])
+            c = ((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane])
             r = s + c
             rem = c - (r - s)
-            if rem:  # _near_tie, inlined (every orbit end passes here)
+            if rem:
                 u, h = ulp(r), abs(rem)
                 if abs(h - 0.5 * u) <= u * band or abs(h - 0.25 * u) <= u * band:
                     return _tie_to_even(r, rem)
             return r
+
+        def elapsed(lane):
+            return orbit_time(hi_(lane), lo_(lane), lane)
 
         counter = [self.next]
 
@@ -596,18 +596,8 @@ class _Stream(_BatchRules):
         def end_now(lane, outcome):
             k = orbit[lane]
             a, el = hi_(lane), lo_(lane)
-            b = -starts_hi[lane]
-            s = a + b
-            bb = s - a
             outcomes[k] = outcome
-            c = ((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane])  # elapsed(lane)
-            r = s + c
-            rem = c - (r - s)
-            if rem:  # _near_tie, inlined
-                u, h = ulp(r), abs(rem)
-                if abs(h - 0.5 * u) <= u * band or abs(h - 0.25 * u) <= u * band:
-                    r = _tie_to_even(r, rem)
-            t_ends[k] = r
+            t_ends[k] = orbit_time(a, el, lane)  # elapsed(lane), the lane time read once
             end_states[k] = cols[lane].tolist()
             return start_next(lane, a, el)
 
