@@ -45,7 +45,7 @@ import numpy as np
 
 from hhscatter.bench import peers
 from hhscatter.integrate.engine import run_chunk
-from hhscatter.integrate.events import Layout, Symbols, scene_events, system
+from hhscatter.integrate.events import Layout, build_escape_only_batch, system
 from hhscatter.model import HenonHeiles
 
 RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))
@@ -75,10 +75,7 @@ def yardstick(ics, *, r_esc=1.03, t_max=5000.0, tol=1e-15, batch_size=None):
         def __call__(self, ta, d, lane):
             return state["on_escape"](lane)
 
-    lay = Layout(4, None, None, None, 0, 1.0)  # x, y, px, py: no clock, no parameters
-    (esc,) = (e for e in scene_events(sc) if e.name == "escape")
-    ev = hy.t_event_batch(esc.expression(Symbols(sc, lay)), callback=Cb(), direction=hy.event_direction.positive)
-    ta = hy.taylor_adaptive_batch(system(sc, lay), np.zeros((4, B)), tol=tol, t_events=[ev])
+    ta = build_escape_only_batch(sc, B, Cb(), tol=tol)  # x, y, px, py and the escape event alone
     ics_l = np.ascontiguousarray(ics, dtype=float).tolist()
     n = len(ics_l)
     t_end = np.full(n, t_max)

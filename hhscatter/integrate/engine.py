@@ -859,7 +859,6 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
         return _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress)
-    n = len(ics)
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)

@@ -255,6 +255,22 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
     return ta, specs, lay
 
 
+def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
+    """build_escape_only_batch(scene, batch_size, callback, tol=None) -> taylor_adaptive_batch: Hamilton's
+    equations alone (x, y, px, py: no clock, no parameters) with the scene's conservative escape event, its
+    callback ``callback``: the minimal driver of ``make bench-engine`` (hhscatter.bench.engine.yardstick),
+    which censors with its own propagation bound. The event is the engine's declaration, so both integrate
+    the same escape; ``scene`` must be conservative and without a follow."""
+    import heyoka as hy  # deferred: heyoka loads on first use
+
+    lay = Layout(4, None, None, None, 0, 1.0)
+    (esc,) = (e for e in scene_events(scene) if e.name == "escape")
+    ev = hy.t_event_batch(esc.expression(Symbols(scene, lay)), callback=callback,
+                          direction=hy.event_direction.positive)
+    return hy.taylor_adaptive_batch(system(scene, lay), np.zeros((4, batch_size)),
+                                    tol=scene.tol if tol is None else tol, t_events=[ev])
+
+
 def batch_pars(scene, lay: Layout, batch_size: int, without=()) -> np.ndarray:
     """batch_pars(scene, layout, batch_size, without=()) -> (n_pars, batch_size): the runtime parameters a
     batch integrator starts with (γ in every lane, the section gate closed)."""
@@ -346,6 +362,6 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
 
 
 __all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "RULES", "batch_key",
-           "batch_pars", "build_batch",
-           "build_scalar", "caster", "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
-           "section_accepts", "system"]
+           "batch_pars", "build_batch", "build_escape_only_batch", "build_scalar", "caster", "clock_targets",
+           "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase", "section_accepts",
+           "system"]
