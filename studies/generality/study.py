@@ -505,6 +505,8 @@ def _cm_sample(study, label, r):
     its recording time t_rec = ⌈τ0 + cm_rec_efolds/κ⌉ (κ, τ0 of the run's escaping orbits, fig1's sprinkler rule),
     the return-time sample of Eq. (eqn:kappa_cmeasure_truetime) on [t_rec, cm_t_to − cm_margin] and the first
     crossing at t ≥ t_rec of each orbit (sprinkler points). Returns a dict (κ_cm None with a reason where not)."""
+    import pyarrow.dataset as pads
+
     from hhscatter.analysis.geometry.distance import first_crossings
     from hhscatter.analysis.survival.cmeasure import cmeasure_sample_from_sections, kappa_from_cmeasure
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
@@ -513,7 +515,6 @@ def _cm_sample(study, label, r):
     p = study.params
     raw = study.raw(cm_key(label, r))
     lt = _lifetimes(raw)
-    sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
     trapped = float((lt["outcome"] == "censored").mean())
     out = {"ratio": r, "n": len(lt), "trapped_fraction": trapped, "kappa_cm": None, "kappa_cm_err": None,
            "mu_exit": None, "n_samples": 0, "n_orbits": 0, "n_undetermined": 0, "t_rec": None, "t_to": None,
@@ -533,6 +534,9 @@ def _cm_sample(study, label, r):
         out["reason"] = (f"t_rec = ⌈τ0 + {p.cm_rec_efolds:g}/κ⌉ = {t_rec:g} ≥ cm_t_to = {p.cm_t_to:g} (escaping orbits' "
                          f"τ0 = {res.tau0:.0f}, κ = {res.kappa:.3g}): no relaxed sample within the recording")
         return out
+    # only crossings at t ≥ t_rec enter (first crossings, return times: a crossing's successor is later), so the
+    # reader drops the rest (the sticky systems' tables are ~10⁷ rows at paper scale)
+    sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"], filters=pads.field("t") >= t_rec)
     out["points"] = first_crossings(sec[sec["traj_id"].isin(esc["traj_id"])], t_rec)
     out["points_all"] = first_crossings(sec, t_rec)  # the trapped orbits kept: all conservative survivors
     if not t_to > t_rec:
