@@ -96,8 +96,8 @@ def _tie_to_even(r: float, rem: float) -> float:
 
     The remainder of an orbit time carries ~2⁻¹⁰⁶ of the lane time of error that depends on the lane's
     start, which decides a tie's rounding; rounding near-ties to even makes it the same in every lane.
-    Called only when the cheap screen in the elapsed-time functions finds ``rem`` near a half or quarter
-    ulp (the gap below a power of two is half the ulp).
+    Called only when :func:`_orbit_time`'s screen finds ``rem`` near a half or quarter ulp (the gap below
+    a power of two is half the ulp).
 
     >>> r = 1.0 + 2.0 ** -52                      # odd mantissa; its upper neighbour is even
     >>> _tie_to_even(r, 2.0 ** -53 - 2.0 ** -140) == r + 2.0 ** -52
@@ -113,11 +113,21 @@ def _tie_to_even(r: float, rem: float) -> float:
     return r if int(m * 9007199254740992.0) % 2 == 0 else n  # the even mantissa of the two
 
 
-def _near_tie(r: float, rem: float) -> bool:
-    """Cheap screen: is |rem| within TIE_BAND gaps of half a gap of r (either gap size)?"""
-    u = _ulp(r)
-    h = abs(rem)
-    return abs(h - 0.5 * u) <= u * TIE_BAND or abs(h - 0.25 * u) <= u * TIE_BAND
+def _orbit_time(a: float, el: float, a0: float, el0: float) -> float:
+    """The orbit time (a + el) − (a0 + el0) of double-length lane times (hi, lo), as the double nearest it:
+    TwoSum of the high parts, the low parts added, near-ties rounded to even (:func:`_tie_to_even`; the
+    screen costs one ``math.ulp`` per call: every orbit end passes here)."""
+    b = -a0
+    s = a + b
+    bb = s - a
+    c = ((a - (s - bb)) + (b - bb)) + (el - el0)
+    r = s + c
+    rem = c - (r - s)
+    if rem:
+        u, h = _ulp(r), abs(rem)
+        if abs(h - 0.5 * u) <= u * TIE_BAND or abs(h - 0.25 * u) <= u * TIE_BAND:  # (the gap below 2^k is u/2)
+            return _tie_to_even(r, rem)
+    return r
 
 
 @dataclass
@@ -130,7 +140,6 @@ class ChunkResult:
     crossings: dict
     n_returns: int = 0
     n_steps: int = 0
-    n_restarts: int = 0  # orbits rerun inside the chunk: none since the clock censors (issue 27)
 
     def tables(self) -> dict:
         return {"lifetimes": self.lifetimes, "sections": self.sections, "snapshots": self.snapshots,
@@ -541,24 +550,10 @@ class _Stream(_BatchRules):
         sigma0 = self.targets[0][0] / self.clock_scale
 
         hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
-        ulp, band = _ulp, TIE_BAND
-
-        def orbit_time(a, el, lane):
-            """(a, el) − the orbit's start by TwoSum, near-ties to even (_near_tie inlined: every orbit end)."""
-            b = -starts_hi[lane]
-            s = a + b
-            bb = s - a
-            c = ((a - (s - bb)) + (b - bb)) + (el - starts_lo[lane])
-            r = s + c
-            rem = c - (r - s)
-            if rem:
-                u, h = ulp(r), abs(rem)
-                if abs(h - 0.5 * u) <= u * band or abs(h - 0.25 * u) <= u * band:
-                    return _tie_to_even(r, rem)
-            return r
+        orbit_time = _orbit_time
 
         def elapsed(lane):
-            return orbit_time(hi_(lane), lo_(lane), lane)
+            return orbit_time(hi_(lane), lo_(lane), starts_hi[lane], starts_lo[lane])
 
         counter = [self.next]
 
@@ -597,7 +592,7 @@ class _Stream(_BatchRules):
             k = orbit[lane]
             a, el = hi_(lane), lo_(lane)
             outcomes[k] = outcome
-            t_ends[k] = orbit_time(a, el, lane)  # elapsed(lane), the lane time read once
+            t_ends[k] = orbit_time(a, el, starts_hi[lane], starts_lo[lane])  # elapsed(lane), lane time read once
             end_states[k] = cols[lane].tolist()
             return start_next(lane, a, el)
 
@@ -605,14 +600,7 @@ class _Stream(_BatchRules):
 
     def elapsed(self, lane):
         """Orbit time of ``lane`` now: the double nearest (hi + lo) − (hi0 + lo0), via TwoSum."""
-        a, b = self.time_hi.item(lane), -self.start_hi[lane]
-        s = a + b
-        bb = s - a
-        c = ((a - (s - bb)) + (b - bb)) + (self.time_lo.item(lane) - self.start_lo[lane])
-        r = s + c
-        rem = c - (r - s)
-        if rem and _near_tie(r, rem):
-            r = _tie_to_even(r, rem)
+        r = _orbit_time(self.time_hi.item(lane), self.time_lo.item(lane), self.start_hi[lane], self.start_lo[lane])
         # + the orbit time at which it entered this integrator (0 but in a second phase)
         return r + self.t_off[lane]
 
@@ -651,7 +639,7 @@ class _Stream(_BatchRules):
             ta.propagate_until(bound)
             n_returns += 1
             n_steps += _check(ta, self)  # once per return (a handful per chunk)
-        return n_returns, n_steps, 0, _no_snapshots()
+        return n_returns, n_steps, _no_snapshots()
 
 
 class _SecondPhase(_Stream):
@@ -798,7 +786,7 @@ class _Epochs(_BatchRules):
         limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf,
                          np.array(self.t_end))
         keep = t <= limit[ids]
-        return n_returns, n_steps, 0, (ids[keep], t[keep], e[keep])
+        return n_returns, n_steps, (ids[keep], t[keep], e[keep])
 
     def _snapshot_rows(self, buf):
         """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows."""
@@ -875,7 +863,7 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
         inlined = lanes.inlined_handlers() if use_inlined else {}
         _bind(ta, specs, lanes, inlined)
         try:
-            n_returns, n_steps, n_restarts, (s_ids, s_t, s_e) = lanes.run()
+            n_returns, n_steps, (s_ids, s_t, s_e) = lanes.run()
         finally:
             lanes.__dict__.pop("load", None)  # the inlined path's closure refers back to the lanes: free them now
             # the integrator goes back to the cache: no view of it stays here
@@ -886,14 +874,14 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
             second.late = late
             _bind(ta2, specs2, second)
             try:
-                r2, s2, x2, _ = second.run()
+                r2, s2, _ = second.run()
             finally:
                 second.ta = second.state = second.cols = second.pars = second.time_hi = second.time_lo = None
-        n_returns, n_steps, n_restarts = n_returns + r2, n_steps + s2, n_restarts + x2
+        n_returns, n_steps = n_returns + r2, n_steps + s2
     outcome = np.array(lanes.outcome, dtype=np.int8)
     if (outcome == -1).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
-    res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps, n_restarts)
+    res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps)
     rerun = outcome == RERUN
     if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
         res = _merge_rerun(res, rerun, traj_ids, run_chunk(_own_far(orig), ics[rerun], traj_ids[rerun],
@@ -901,8 +889,7 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     return res
 
 
-
-def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_steps, n_restarts) -> ChunkResult:
+def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_steps) -> ChunkResult:
     """The chunk's rows from its lanes: lifetimes in orbit order, the other tables by orbit, then time."""
     n, (s_ids, s_t, s_e) = len(ics), snaps
     model = scene.model
@@ -927,8 +914,7 @@ def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_step
     crossings["direction"] = crossings["direction"].astype(np.int8)
     order = np.lexsort((s_t, s_ids))
     snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
-    return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps),
-                       n_restarts=n_restarts)
+    return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps))
 
 
 def _own_far(scene):
@@ -958,8 +944,7 @@ def _no_return(scene, ics, kind):
     an explicit ``r_far`` keeps it, so does quadratic drag, for which no such bound is written down).
     """
     m = scene.model
-    if (scene.gamma <= 0 or scene.r_far is not None or m.dissipation != "linear" or not len(ics)
-):
+    if scene.gamma <= 0 or scene.r_far is not None or m.dissipation != "linear" or not len(ics):
         return scene, None
     r_far = events.far_radius(scene)
     e0 = float(np.max(m.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3])))
@@ -1001,8 +986,7 @@ def _merge_rerun(res, rerun, traj_ids, again):
         order = np.lexsort((cols["t"], local(cols["traj_id"])))
         tables[name] = {c: v[order] for c, v in cols.items()}
     return ChunkResult(res.lifetimes, tables["sections"], tables["snapshots"], tables["crossings"],
-                       n_returns=res.n_returns + again.n_returns, n_steps=res.n_steps + again.n_steps,
-                       n_restarts=res.n_restarts + again.n_restarts)
+                       n_returns=res.n_returns + again.n_returns, n_steps=res.n_steps + again.n_steps)
 
 
 def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress):
@@ -1035,8 +1019,7 @@ def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_step
         e = np.concatenate([snaps["energy"], lt["e0"][outside]])
         order = np.lexsort((t, ids))
         snaps = {"traj_id": ids[order], "t": t[order], "energy": e[order]}
-    return ChunkResult(lt, res.sections, snaps, res.crossings, n_returns=res.n_returns, n_steps=res.n_steps,
-                       n_restarts=res.n_restarts)
+    return ChunkResult(lt, res.sections, snaps, res.crossings, n_returns=res.n_returns, n_steps=res.n_steps)
 
 
 def _rows_to_columns(rows, columns, traj_ids):
