@@ -45,7 +45,7 @@ import numpy as np
 
 from hhscatter.bench import peers
 from hhscatter.integrate.engine import run_chunk
-from hhscatter.integrate.events import Layout, build_escape_only_batch, system
+from hhscatter.integrate.events import HAMILTON_ONLY, build_escape_only_batch, system
 from hhscatter.model import HenonHeiles
 
 RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))
@@ -144,7 +144,7 @@ def design_choices(batch_size=8, epochs=400, epoch=8.0):
     st0 = np.vstack([x, y, px, py])
     sc = Scene(energy=0.3, n=1)
 
-    sys = system(sc, Layout(4, None, None, None, 0, 1.0))  # Hamilton's equations alone
+    sys = system(sc, HAMILTON_ONLY)
     zeros = np.zeros(batch_size)
     g2 = np.repeat(np.array([0.0, epoch])[:, None], batch_size, axis=1)
     g17 = np.repeat(np.linspace(0.0, epoch, 17)[:, None], batch_size, axis=1)
@@ -206,20 +206,14 @@ def driver(n, seed, out, ics_path=None) -> None:
     import pyarrow as pa  # deferred: pyarrow loads on first use
     import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
-    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.ics import read_ics_table, region_ics  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
 
     sc = Scene(energy=0.27, n=n, seed=seed)
     if ics_path is None:
         ics = region_ics(sc, 0, n)
     else:
-        t = pq.ParquetFile(ics_path).read(columns=["x", "y", "px", "py"])  # float64, no nulls (written so)
-
-        def col(name):  # from the Arrow buffers (pyarrow's to_numpy may import pandas)
-            return np.concatenate([np.frombuffer(k.buffers()[1], dtype=float, count=len(k), offset=8 * k.offset)
-                                   for k in t.column(name).chunks])
-
-        ics = np.column_stack([col(c) for c in ("x", "y", "px", "py")])
+        ics = read_ics_table(ics_path)[0]  # the reader simulate --ics uses (pyarrow, no pandas)
     t_end = yardstick(ics, r_esc=sc.r_esc, t_max=sc.t_max, tol=sc.tol)
     pq.write_table(pa.table({"traj_id": np.arange(len(ics)), "t_end": t_end}), out, compression="zstd")
 

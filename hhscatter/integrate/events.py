@@ -255,6 +255,10 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
     return ta, specs, lay
 
 
+#: the layout of Hamilton's equations alone (x, y, px, py: no clock, no parameters)
+HAMILTON_ONLY = Layout(4, None, None, None, 0, 1.0)
+
+
 def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     """build_escape_only_batch(scene, batch_size, callback, tol=None) -> taylor_adaptive_batch: Hamilton's
     equations alone (x, y, px, py: no clock, no parameters) with the scene's conservative escape event, its
@@ -263,11 +267,10 @@ def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     the same escape; ``scene`` must be conservative and without a follow."""
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = Layout(4, None, None, None, 0, 1.0)
     (esc,) = (e for e in scene_events(scene) if e.name == "escape")
-    ev = hy.t_event_batch(esc.expression(Symbols(scene, lay)), callback=callback,
+    ev = hy.t_event_batch(esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback,
                           direction=hy.event_direction.positive)
-    return hy.taylor_adaptive_batch(system(scene, lay), np.zeros((4, batch_size)),
+    return hy.taylor_adaptive_batch(system(scene, HAMILTON_ONLY), np.zeros((4, batch_size)),
                                     tol=scene.tol if tol is None else tol, t_events=[ev])
 
 
@@ -361,7 +364,7 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
             and window.e_min <= energy <= window.e_max)
 
 
-__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "Layout", "RULES", "batch_key",
-           "batch_pars", "build_batch", "build_escape_only_batch", "build_scalar", "caster", "clock_targets",
-           "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase", "section_accepts",
-           "system"]
+__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "HAMILTON_ONLY", "Layout", "RULES",
+           "batch_key", "batch_pars", "build_batch", "build_escape_only_batch", "build_scalar", "caster",
+           "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
+           "section_accepts", "system"]
