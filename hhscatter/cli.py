@@ -142,7 +142,8 @@ def build_parser():
                    help="initial-condition region: disk (r < radius), well (the well's part of V < E_c: the saddle "
                         "triangle of Hénon–Heiles), square (the authors' [-r_s, r_s]² with V < E; orbits starting at "
                         "r ≥ r_esc are escaped at t = 0)")
-    s.add_argument("--radius", type=_float, help="disk radius (default 0.5)")
+    s.add_argument("--radius", type=_float, help="disk radius (default: half the system's saddle distance r_s; 0.5 for "
+                   "Hénon–Heiles)")
     s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default: the system's; 1.5 for Hénon–Heiles, the paper used "
                    "1.03, see study resc)")
     _system_flags(s)
@@ -166,7 +167,8 @@ def build_parser():
     s.add_argument("--snapshots", type=_snapshots, metavar="START:STOP:STEP|T1,T2,…",
                    help="record the energy of every live orbit at these orbit times (overrides [snapshots])")
     s.add_argument("--ics", help="Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]")
-    s.add_argument("--out", required=True, help="output directory, or a URL pyarrow/fsspec can write (s3://…)")
+    s.add_argument("--out", required=True, help="output directory (named explicitly: '.' for the working directory), or "
+                   "a URL pyarrow/fsspec can write (s3://…)")
     s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
     s.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
                    "or a scheduler address tcp://HOST:PORT (needs the 'dask' extra)")
@@ -260,6 +262,12 @@ def _scene_from_args(a):
     from hhscatter.scene.grid import run_from_dict  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.scene.schema import scene_dict_from_toml  # deferred: `hhscatter --help` starts without the engine and tables
 
+    if a.ics is not None:
+        given = [f"--{k}" for k in ("region", "radius") if getattr(a, k) is not None]
+        if given:
+            raise UsageError(f"{' and '.join(given)} {'is' if len(given) == 1 else 'are'} for initial conditions "
+                             "sampled in a region; with --ics the table gives every initial state: drop "
+                             f"{' and '.join(given)}")
     flags = {
         k: getattr(a, k)
         for k in ("energy", "gamma", "n", "seed", "region", "radius", "r_esc", "t_max", "tol", "chunk_size",
@@ -279,6 +287,11 @@ def _scene_from_args(a):
         flags["ics"] = str(Path(a.ics).resolve())
     if a.scene:
         d = scene_dict_from_toml(a.scene, a.scale)
+        if a.ics is not None or d.get("ics") is not None:
+            given = [k for k in ("region", "radius") if k in d]
+            if given:
+                raise ConfigError(f"{a.scene}: [scene] {', '.join(given)} with ics: the IC table gives every initial "
+                                  f"state, {' and '.join(given)} would be ignored; remove {' and '.join(given)}")
     elif a.scale:
         raise ConfigError("--scale needs a scene file")
     elif a.resume and (old := _resumed_scene(a.out)) is not None:
@@ -299,7 +312,7 @@ def _scene_from_args(a):
         d["sections"] = {**(d.get("sections") or {}), **window}
     if a.snapshots is not None:
         d["snapshots"] = a.snapshots
-    if a.system or a.param or a.dissipation:
+    if a.system is not None or a.param or a.dissipation:
         d["system"] = _system_from_args(a, d.get("system"))
     return run_from_dict(d)
 
@@ -307,12 +320,18 @@ def _scene_from_args(a):
 def _system_from_args(a, base: dict | None) -> dict:
     """The [system] spec of --system/--param/--dissipation over the scene file's (hhscatter.model.spec)."""
     spec = dict(base or {})
-    if a.system:
+    if a.system is not None:
         is_name = re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", a.system) and a.system not in ("x", "y")
         spec.pop("name", None)
         spec.pop("potential", None)
         spec["name" if is_name else "potential"] = a.system
     if a.param:
+        names = [k for k, _ in a.param]
+        twice = sorted({k for k in names if names.count(k) > 1})
+        if twice:
+            values = {k: [v for n, v in a.param if n == k] for k in twice}
+            raise UsageError("--param " + "; ".join(f"{k} given {len(v)} times ({', '.join(f'{x:g}' for x in v)})"
+                                                     for k, v in values.items()) + ": give each parameter once")
         spec["params"] = {**(spec.get("params") or {}), **dict(a.param)}
     if a.dissipation:
         spec["dissipation"] = a.dissipation
@@ -394,9 +413,27 @@ def cmd_study(a):
     return 0
 
 
+#: the text options of each command (argparse names): an empty or blank value is refused, never read as "not given"
+TEXT_OPTIONS = {"simulate": ("scene", "scale", "system", "ics", "out", "scheduler"),
+                "survival": ("runs", "png", "labels"), "study": ("name", "scale")}
+
+
+def _check_text(a) -> None:
+    """UsageError for an empty or blank text option: ``--system ""`` (an unset shell variable) must not mean the
+    default system, nor ``--out ""`` the working directory."""
+    for key in TEXT_OPTIONS.get(a.command, ()):
+        value = getattr(a, key, None)
+        for v in value if isinstance(value, list) else [value]:
+            if v is not None and not v.strip():
+                flag = key if key in ("scene", "runs", "name") else f"--{key.replace('_', '-')}"
+                raise UsageError(f"{flag} must not be empty, got {v!r}"
+                                 + (" (name the working directory as '.')" if key == "out" else ""))
+
+
 def main(argv=None):
     a = build_parser().parse_args(argv)
     try:
+        _check_text(a)
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
     except HHScatterError as exc:  # bad input (2, before any work), or a run that could not complete (1)
         print(f"hhscatter: error: {exc}", file=sys.stderr)

@@ -76,14 +76,34 @@ def run_manifest(run_dir) -> dict | None:
     return json.loads(store.read_text("scene.json")).get("manifest")
 
 
+def _without_manifest(store) -> RunIntegrityError:
+    """The error for a run directory whose scene.json (its manifest) is gone: its parts cannot be told complete."""
+    hashes = set()
+    for f in store.files("lifetimes")[:1]:
+        try:
+            hashes.add(str(read_meta(store.path("lifetimes", f), filesystem=store.filesystem).get("scene_hash"))[:12])
+        except (OSError, ValueError):
+            pass
+    said = f" (its parts say they belong to scene {hashes.pop()}…)" if hashes else ""
+    return RunIntegrityError(f"the run at {store.display()} has no scene.json, its manifest{said}: without it "
+                             "nobody can tell whether the run is complete; rerun the same `hhscatter simulate` "
+                             "with --resume (it verifies the parts and writes the manifest again) or --overwrite")
+
+
 def run_status(run_dir) -> dict:
     """run_status(run_dir) -> {'complete', 'chunks', 'chunks_done', 'orbits', 'orbits_done', 'scene_hash'}.
 
     From the manifest and the presence of the ``lifetimes`` parts (written last in every chunk); cheap
-    (no file is opened). A run without manifest counts as complete if it has lifetimes parts.
+    (no file is opened). A run written before manifests (a scene.json without one) counts as complete if it has
+    lifetimes parts; a run directory without scene.json raises :class:`RunIntegrityError` (nothing says which
+    parts it should have).
     """
     store = Store(run_dir)
-    doc = json.loads(store.read_text("scene.json")) if store.exists("scene.json") else {}
+    if not store.exists("scene.json"):
+        if store.exists("lifetimes"):
+            raise _without_manifest(store)
+        raise FileNotFoundError(f"{store.display()} holds no run (no scene.json)")
+    doc = json.loads(store.read_text("scene.json"))
     man = doc.get("manifest")
     if man is None:
         n = len(store.files("lifetimes"))
@@ -135,6 +155,11 @@ def _planned_files(store, man: dict, name: str, allow_partial: bool):
     if missing_chunks:
         what = (f"the run at {run} is incomplete: {missing_chunks} of {chunks} chunk(s) "
                 f"({missing_orbits} of {orbits} orbits) are not finished")
+        if allow_partial and (pid := store.writer()) is not None:
+            # its finished chunks change from one read to the next: two tables read apart would not match
+            raise IncompleteRunError(f"{what}, and it is being written now (pid {pid}): reading its finished chunks "
+                                     "(allow_partial=True) gives each table as of another moment; wait until the "
+                                     "writer ends (or stop it), then read")
         if not allow_partial:
             raise IncompleteRunError(f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
                                      "the finished chunks with allow_partial=True")
@@ -177,6 +202,7 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
     keeps each scanned file's footer while its dataset lives, so a streaming
     scan over many thousands of parts is done file by file.
     """
+    import pyarrow as pa  # deferred: pyarrow loads on first use
     import pyarrow.dataset as ds  # deferred: pyarrow loads on first use
     import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
@@ -191,6 +217,9 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
         checks = [(p, c) for _, p, c in planned]
         if not files:
             raise IncompleteRunError(f"no {name} table: no chunk of the run at {store.display()} is finished")
+    elif not store.exists("scene.json"):
+        raise _without_manifest(store) if store.exists(name) or store.exists("lifetimes") else \
+            FileNotFoundError(f"no {name} table: {store.display()} holds no run (no scene.json)")
     else:
         rel = name if store.is_dir(name) or store.exists("scene.json") else ""
         if not store.exists(rel):
@@ -226,15 +255,21 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
 
         def make(ps, es):
             return ds.dataset(ps, schema=schema, format=fmt, filesystem=store.filesystem)
-    def checked(dset, which):
-        if checks is not None:
-            for frag, (point, chunk) in zip(dset.get_fragments(), which):
-                _check_fragment(store, name, frag, point, chunk)
+    def checked(ps, es, which):
+        try:
+            dset = make(ps, es)
+            if checks is not None:
+                for frag, (point, chunk) in zip(dset.get_fragments(), which):
+                    _check_fragment(store, name, frag, point, chunk)
+        except pa.ArrowInvalid as exc:  # a file under a part's name that is no Parquet file
+            raise RunIntegrityError(f"a part of the {name} table of the run at {store.display()} is not a "
+                                    f"readable Parquet file ({exc}); the run is damaged: rerun it with --resume "
+                                    "(damaged chunks are redone) or --overwrite") from None
         return dset
 
     if one_by_one:
-        return (checked(make([p], [e]), [checks[i]] if checks else None) for i, (p, e) in enumerate(zip(paths, exprs)))
-    return checked(make(paths, exprs), checks)
+        return (checked([p], [e], [checks[i]] if checks else None) for i, (p, e) in enumerate(zip(paths, exprs)))
+    return checked(paths, exprs, checks)
 
 
 def _scan(dset, run_dir, name, scan):
@@ -522,7 +557,11 @@ def _describe_parts(store, man):
         rows[name] = 0
         for rel, point, chunk in _planned_files(store, man, name, False):
             path = store.path(name, rel)
-            pf = pq.ParquetFile(path, page_checksum_verification=True)
+            try:
+                pf = pq.ParquetFile(path, page_checksum_verification=True)
+            except (OSError, ValueError) as exc:  # (pyarrow's ArrowInvalid is a ValueError)
+                raise RunIntegrityError(f"{path} is not a readable Parquet file ({exc}); the run is damaged: rerun "
+                                        "it with --resume (damaged chunks are redone) or --overwrite") from None
             _check_fragment(store, name, types.SimpleNamespace(metadata=pf.metadata, path=path), point, chunk)
             rows[name] += pf.metadata.num_rows
             if name != "lifetimes":

@@ -25,12 +25,14 @@ import json
 import os
 import posixpath
 import shutil
+import time
 from pathlib import Path
 
 from hhscatter.errors import OutputError
 
 TMP_MARK = ".tmp-"  # temporary files are ".<final name>.tmp-<pid>"
-LOCK_FILE = ".hhscatter.lock"  # one writer per run directory (Store.lock)
+LOCK_FILE = ".hhscatter.lock"  # the pid of the run directory's writer (the lock itself is on the directory: Store.lock)
+LOCK_TRIES = 20  # Store.lock tries this often, 10 ms apart, before the directory counts as locked
 
 
 class LockedError(OutputError):
@@ -141,26 +143,62 @@ class Store:
 
     # -- one writer ----------------------------------------------------------
     def lock(self) -> int | None:
-        """lock() -> file descriptor holding an exclusive ``flock`` on root/.hhscatter.lock (local paths).
+        """lock() -> file descriptor of root holding an exclusive ``flock`` on the run directory itself (local paths).
 
-        The kernel drops the lock when the holder exits, however it ends (kill -9 included), so a killed
-        run never leaves it stuck. Raises :class:`LockedError` naming the holder's pid if another process
-        holds it. Release with :meth:`unlock`. URLs (object stores) have no such lock: returns None.
+        The lock is on the directory, not on a file in it: deleting or replacing ``.hhscatter.lock`` (which only
+        notes the holder's pid, for messages) does not free it. The kernel drops the lock when the holder exits,
+        however it ends (kill -9 included), so a killed run never leaves it stuck. Raises :class:`LockedError`
+        naming the holder's pid if another process holds it. Release with :meth:`unlock`. URLs (object stores)
+        have no such lock: returns None.
         """
         if not self.local:
             return None
 
         self.makedirs()
-        fd = os.open(self.path(LOCK_FILE), os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+        fd = os.open(self.root, os.O_RDONLY | os.O_DIRECTORY)
+        for attempt in range(LOCK_TRIES):  # a reader's momentary shared probe (writer()) is waited out
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if attempt + 1 < LOCK_TRIES:
+                    time.sleep(0.01)
+        else:
             os.close(fd)
-            raise LockedError(f"{self.display()} is being written by another process (pid {holder})") from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, str(os.getpid()).encode(), 0)
+            raise LockedError(f"{self.display()} is being written by another process (pid {self._holder()})")
+        try:  # the holder's pid, for the message of a second writer
+            pid_fd = os.open(self.path(LOCK_FILE), os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+            try:
+                os.write(pid_fd, str(os.getpid()).encode())
+            finally:
+                os.close(pid_fd)
+        except OSError:
+            os.close(fd)
+            raise
         return fd
+
+    def _holder(self) -> str:
+        try:
+            return Path(self.path(LOCK_FILE)).read_text().strip() or "?"
+        except OSError:
+            return "?"
+
+    def writer(self) -> str | None:
+        """writer() -> the pid (text; "?" when its note is gone) of the process that holds the run directory's write
+        lock now, or None (no writer, a missing directory, or a URL).
+
+        A shared ``flock`` probe, released at once (:meth:`lock` waits such a probe out).
+        """
+        if not self.local or not os.path.isdir(self.root):
+            return None
+        fd = os.open(self.root, os.O_RDONLY | os.O_DIRECTORY)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return self._holder()
+        finally:
+            os.close(fd)  # (closing the descriptor releases the probe)
+        return None
 
     @staticmethod
     def unlock(fd) -> None:

@@ -37,6 +37,8 @@ forms, or a declared one whose quantities are derived from its expression). The 
 | ``scalar_energy()`` | a plain-float H(x, y, px, py) for the engine's per-record path | energy |
 | ``frequency`` | √(largest eigenvalue of V's Hessian at the minimum): the time scale of bounds | 1/time |
 | ``force(x, y)`` | −∇V on numpy arrays | energy/length |
+| ``nonfinite_point(r)`` | a point of the disk r ≤ r where V or −∇V is not finite, or None | length |
+| ``default_ic_radius()`` | the disk radius of region ICs when a scene gives none: r_s/2 | length |
 | ``default_escape_radius(E)`` | r_esc when a scene gives none: beyond every exit's Lyapunov orbit at E | length |
 | ``spec()`` | the plain-data spec that rebuilds the system (:mod:`hhscatter.model.spec`) | — |
 | ``provenance()`` | what the tables' metadata records of the system | — |
@@ -185,6 +187,33 @@ class System(abc.ABC):
         """
         r = 1.5 * self.saddle_radius
         return max(r, self.no_return_radius(energy)) if energy is not None else r
+
+    def nonfinite_point(self, radius: float) -> tuple[float, float] | None:
+        """A point of the disk r ≤ radius where V or the force −∇V is not finite (or not real), or None.
+
+        Checked on a polar grid (the origin, 400 radii × 720 angles): orbits that move there would stop the
+        integrator. Systems whose potential is finite everywhere (polynomials) return None at once.
+        """
+        r = np.linspace(0.0, float(radius), 401)[1:]
+        th = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+        R, T = np.meshgrid(r, th)
+        x = np.concatenate([[0.0], (R * np.cos(T)).ravel()])
+        y = np.concatenate([[0.0], (R * np.sin(T)).ravel()])
+        with np.errstate(all="ignore"):
+            fx, fy = self.force(x, y)
+            ok = np.isfinite(self.potential(x, y)) & np.isfinite(fx) & np.isfinite(fy)
+        if ok.all():
+            return None
+        k = int(np.argmin(np.where(ok, np.inf, np.hypot(x, y))))  # the nearest such point
+        return float(x[k]), float(y[k])
+
+    def default_ic_radius(self) -> float:
+        """The disk radius of region ICs when a scene gives none (length): half the saddle distance, r_s/2.
+
+        0.5 for Hénon–Heiles with ω = λ = 1 (the authors' code); for another system the same fraction of its own
+        length scale, so that the disk samples the chaotic layer below the saddles, not a regular core.
+        """
+        return 0.5 * self.saddle_radius
 
     def spec(self) -> dict[str, Any]:
         """The plain-data spec that rebuilds this system (:func:`hhscatter.model.spec.system_from_spec`)."""

@@ -166,6 +166,17 @@ class DeclaredSystem(System):
             self._cache["land"] = Landscape(self._numeric)
         return self._cache["land"]
 
+    def nonfinite_point(self, radius: float) -> tuple[float, float] | None:
+        """:meth:`System.nonfinite_point`, cached per radius; None at once for a polynomial potential."""
+        import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+        if self._numeric.is_polynomial(*symbols()) and not self._numeric.atoms(sp.Function):
+            return None
+        key = ("nonfinite", float(radius))
+        if key not in self._cache:
+            self._cache[key] = super().nonfinite_point(radius)
+        return self._cache[key]
+
     def no_return_radius(self, energy: float) -> float:
         """R(E) ≥ the nearest saddle's distance, from :func:`hhscatter.model.derive.no_return_radius` (cached)."""
         energy = float(energy)

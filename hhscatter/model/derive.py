@@ -24,7 +24,10 @@ Given V(x, y) as a sympy expression in x and y (parameters substituted, :func:`h
    from a polar grid refined by constrained optimisation (for Hénon–Heiles it reproduces √(6E)/ω).
 
 Every step that cannot decide raises a :class:`~hhscatter.errors.ConfigError` naming the ``[system]`` key
-that overrides it (``critical_energy``, ``exits``, ``omega_radius``).
+that overrides it (``critical_energy``, ``exits``, ``omega_radius``). A value given for one of them is checked
+against the derivation wherever it can decide (a contradiction is refused, naming both values), and for
+consistency where it cannot: given exits are critical points of V at their stated energy, E_c is the lowest exit's
+energy, Ω holds the well's part of {V < E_c} and meets no other part.
 """
 from __future__ import annotations
 
@@ -47,6 +50,9 @@ DEGENERATE = 1e-8
 MAX_DESCENT_STEPS = 20_000
 #: relative margin added to R(E) beyond the refined grid estimate
 NO_RETURN_MARGIN = 1e-9
+#: relative tolerance of a given override against what it is checked with (∇V = 0 at a given exit, its energy V
+#: there, a given E_c against the lowest exit's energy, a given exit against a derived one)
+GIVEN_TOL = 1e-8
 
 
 @dataclass(frozen=True)
@@ -258,6 +264,7 @@ def critical_points(land: Landscape) -> tuple[tuple[CriticalPoint, ...], str]:
     a, b, c = land.hessian(xs, ys)
     scale = 1.0 + np.abs(a) + np.abs(b) + np.abs(c)
     ok = np.isfinite(gx) & np.isfinite(gy) & (np.hypot(gx, gy) < 1e-9 * scale * (1 + np.hypot(xs, ys)))
+    ok &= np.isfinite(land.v(xs, ys)) & np.isfinite(scale)  # (not where V itself is undefined: log, sqrt)
     if method == "numeric":
         ok &= np.hypot(xs, ys) <= SEARCH_RADIUS
     pts: list[tuple[float, float]] = []
@@ -395,9 +402,15 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float,
     mins = [(m.x, m.y, 1e-6 * (1 + m.distance)) for m in minima]
 
     def rhs(_, z):
-        gx, gy = grad(z[0], z[1])
-        n = 1.0 + math.hypot(gx, gy)
-        return [-gx / n, -gy / n]
+        try:
+            gx, gy = grad(z[0], z[1])
+            n = 1.0 + math.hypot(gx, gy)
+            out = [-gx / n, -gy / n]
+        except (ValueError, ZeroDivisionError, OverflowError, TypeError):  # math.sqrt(-1), log(0), a complex value
+            raise _NotFinite(z) from None
+        if not (math.isfinite(out[0]) and math.isfinite(out[1])):
+            raise _NotFinite(z)
+        return out
 
     def out(_, z):
         return math.hypot(z[0], z[1]) - r_out
@@ -423,12 +436,20 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float,
         sol = solve_ivp(counted, (0.0, 1e5), [x0, y0], events=[out, near, still], rtol=1e-8, atol=1e-11)
     except _GiveUp as e:
         return float(e.args[0][0]), float(e.args[0][1]), False
+    except _NotFinite as e:
+        raise ConfigError(f"the potential or its gradient is not finite at ({e.args[0][0]:.6g}, {e.args[0][1]:.6g}) "
+                          f"on the steepest descent from the saddle near ({x0:.6g}, {y0:.6g}): give a potential that "
+                          "is finite and real in the plane around the well and its exits") from None
     xe, ye = sol.y[:, -1]
     return float(xe), float(ye), bool(sol.t_events[0].size)
 
 
 class _GiveUp(Exception):
     """A steepest-descent path took more than MAX_DESCENT_STEPS steps."""
+
+
+class _NotFinite(Exception):
+    """A steepest-descent path reached a point where V or its gradient is not finite (or not real)."""
 
 
 class _Union:
@@ -559,10 +580,10 @@ def check_omega(land: Landscape, radius: float, critical_energy: float, exits: S
 
 # -- everything ------------------------------------------------------------------------------------------
 def _given_exits(land: Landscape, exits) -> tuple[Exit, ...]:
-    out = []
+    rows = []
     for k, e in enumerate(exits):
         if isinstance(e, Exit):
-            out.append(e)
+            rows.append((k, e, None))
             continue
         try:
             vals = [float(v) for v in e]
@@ -570,11 +591,62 @@ def _given_exits(land: Landscape, exits) -> tuple[Exit, ...]:
             raise ConfigError(f"exits[{k}] must be [x, y] or [x, y, energy], got {e!r}") from None
         if len(vals) not in (2, 3) or not all(math.isfinite(v) for v in vals):
             raise ConfigError(f"exits[{k}] must be [x, y] or [x, y, energy] of finite numbers, got {e!r}")
-        energy = vals[2] if len(vals) == 3 else float(land.v(vals[0], vals[1]))
-        out.append(Exit(vals[0], vals[1], energy))
-    if not out:
+        rows.append((k, e, vals))
+    if not rows:
         raise ConfigError("exits: give at least one exit [x, y] (or [x, y, energy])")
+    out = []
+    for k, e, vals in rows:  # each a critical point of V at its stated energy
+        if vals is None:
+            out.append(e)
+            continue
+        v = float(land.v(vals[0], vals[1]))
+        energy = vals[2] if len(vals) == 3 else v
+        gx, gy = (float(g) for g in land.gradient(vals[0], vals[1]))
+        hess = max((abs(float(h)) for h in land.hessian(vals[0], vals[1])), default=0.0)
+        r = math.hypot(vals[0], vals[1])
+        if not (math.isfinite(v) and math.isfinite(gx) and math.isfinite(gy)) or \
+                math.hypot(gx, gy) > GIVEN_TOL * (1.0 + hess * r + abs(v)):
+            raise ConfigError(f"exits[{k}] = {e!r} is not a critical point of V (|∇V| = {math.hypot(gx, gy):.3g}, "
+                              f"V = {v:.10g} there): an exit is a saddle orbits leave through, where ∇V = 0")
+        if abs(v - energy) > GIVEN_TOL * max(1.0, abs(v)):
+            raise ConfigError(f"exits[{k}] = {e!r}: its energy {energy!r} is not V there, {v!r}")
+        out.append(Exit(vals[0], vals[1], energy))
     return tuple(_channel_order(out))
+
+
+def _derived_exits(land: Landscape) -> tuple[tuple[CriticalPoint, ...], str, tuple[Exit, ...]]:
+    """(critical points, method, exits) from the potential alone (module docstring, steps 1-4); ConfigError where
+    it cannot decide."""
+    points, method = critical_points(land)
+    check_well(land, points)
+    scale = max([p.distance for p in points if p.kind != "minimum"] or [1.0])
+    found = find_exits(land, points, scale)
+    top = max((e.energy for e in found), default=math.inf)
+    bad = [p for p in points if p.kind == "degenerate" and p.energy <= top]
+    if bad:
+        p = bad[0]
+        raise ConfigError(f"degenerate critical point at ({p.x:.6g}, {p.y:.6g}) with V = {p.energy:.6g} "
+                          f"(Hessian eigenvalues {p.eigenvalues[0]:.3g}, {p.eigenvalues[1]:.3g}): cannot tell "
+                          "whether orbits from the well leave through it; give `critical_energy` and `exits` "
+                          "in [system]")
+    if not found:
+        listed = ", ".join(f"{p.kind} at ({p.x:.4g}, {p.y:.4g}) V = {p.energy:.4g}" for p in points) or "none"
+        raise ConfigError(f"no exit: the potential has no saddle through which orbits from the well reach "
+                          f"infinity (critical points: {listed}); an escape over an asymptotic threshold, with no "
+                          "saddle, has no exit to give")
+    return points, method, found
+
+
+def _same_exits(a: Sequence[Exit], b: Sequence[Exit]) -> bool:
+    """The same saddles (positions and energies within GIVEN_TOL), whatever the order."""
+    def close(e, f):
+        return (math.hypot(e.x - f.x, e.y - f.y) <= GIVEN_TOL * (1 + e.distance) * 100
+                and abs(e.energy - f.energy) <= GIVEN_TOL * max(1.0, abs(f.energy)))
+    return len(a) == len(b) and all(any(close(e, f) for f in b) for e in a)
+
+
+def _show_exits(exits: Sequence[Exit]) -> str:
+    return "[" + ", ".join(f"[{e.x:.6g}, {e.y:.6g}, {e.energy:.6g}]" for e in exits) + "]"
 
 
 def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None = None,
@@ -586,11 +658,13 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
     expr : sympy.Expr
         V in x and y (parameters substituted: :func:`hhscatter.model.parse.substitute`).
     critical_energy : float, optional
-        E_c given: it must be > 0; with ``exits`` it replaces the derivation entirely.
+        E_c given: > 0 and equal to the lowest exit's energy (derived or given), else refused (a contradiction).
     exits : sequence of [x, y] or [x, y, energy] or Exit, optional
-        The exits given (energy V(x, y) when left out): no critical point search.
+        The exits given (energy V(x, y) when left out): each must be a critical point of V with V = its energy;
+        where the derivation can decide, they must be the derived exits.
     omega_radius : float, optional
-        Ω's radius given: not checked.
+        Ω's radius given: the disk must hold the well's part of {V < E_c} and meet no other part
+        (:func:`check_omega`).
 
     Returns
     -------
@@ -616,29 +690,25 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
         points: tuple[CriticalPoint, ...] = ()
         method = "given"
         check_well(land, [])
+        try:  # where the derivation can decide, the given exits must be the derived ones
+            derived = _derived_exits(land)[2]
+        except ConfigError:
+            derived = None
+        if derived is not None and not _same_exits(found, derived):
+            raise ConfigError(f"exits {_show_exits(found)} contradict the derivation, which finds the exits "
+                              f"{_show_exits(derived)}; leave `exits` out of [system] (it is derived) or correct it")
     else:
-        points, method = critical_points(land)
-        check_well(land, points)
-        scale = max([p.distance for p in points if p.kind != "minimum"] or [1.0])
-        found = find_exits(land, points, scale)
-        top = max((e.energy for e in found), default=math.inf)
-        bad = [p for p in points if p.kind == "degenerate" and p.energy <= top]
-        if bad:
-            p = bad[0]
-            raise ConfigError(f"degenerate critical point at ({p.x:.6g}, {p.y:.6g}) with V = {p.energy:.6g} "
-                              f"(Hessian eigenvalues {p.eigenvalues[0]:.3g}, {p.eigenvalues[1]:.3g}): cannot tell "
-                              "whether orbits from the well leave through it; give `critical_energy` and `exits` "
-                              "in [system]")
-        if not found:
-            listed = ", ".join(f"{p.kind} at ({p.x:.4g}, {p.y:.4g}) V = {p.energy:.4g}" for p in points) or "none"
-            raise ConfigError(f"no exit: the potential has no saddle through which orbits from the well reach "
-                              f"infinity (critical points: {listed}); if orbits escape over an asymptotic "
-                              "threshold give `critical_energy` and `exits` in [system]")
-    ec = min(e.energy for e in found) if critical_energy is None else float(critical_energy)
+        points, method, found = _derived_exits(land)
+    lowest = min(e.energy for e in found)
+    ec = lowest if critical_energy is None else float(critical_energy)
     if not (math.isfinite(ec) and ec > 0):
         raise ConfigError(f"critical_energy must be a finite number > 0, got {ec!r}")
+    if abs(ec - lowest) > GIVEN_TOL * max(1.0, abs(lowest)):
+        source = "given" if exits is not None else "derived"
+        raise ConfigError(f"critical_energy = {ec!r} contradicts the exits: E_c is the lowest exit's energy, "
+                          f"{lowest!r} (exits {source}); leave `critical_energy` out of [system] or correct it")
+    at_ec = [e for e in found if e.energy <= ec * (1 + 1e-12)] or list(found)
     if omega_radius is None:
-        at_ec = [e for e in found if e.energy <= ec * (1 + 1e-12)] or list(found)
         omega = max(e.distance for e in at_ec)
         why = check_omega(land, omega, ec, found)
         if why:
@@ -648,6 +718,12 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
         omega = float(omega_radius)
         if not (math.isfinite(omega) and omega > 0):
             raise ConfigError(f"omega_radius must be a finite number > 0, got {omega_radius!r}")
+        why = check_omega(land, omega, ec, found)
+        if why:
+            guess = max(e.distance for e in at_ec)
+            derived_omega = "" if check_omega(land, guess, ec, found) else f"; the derivation finds {guess:.10g}"
+            raise ConfigError(f"omega_radius = {omega!r} is not a radius of Ω, which must hold the well's part of "
+                              f"{{V < E_c}} and meet no other part: {why}{derived_omega}")
     return Derivation(points, found, ec, omega, method, time.perf_counter() - t0)
 
 

@@ -115,6 +115,10 @@ class HenonHeiles(System):
         """ω (1/time)."""
         return self.omega
 
+    def nonfinite_point(self, radius: float) -> None:
+        """None: a polynomial potential is finite everywhere."""
+        return None
+
     def force(self, x: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(F_x, F_y) = (−ω²x − 2λxy, −ω²y − λ(x² − y²)) on numpy arrays."""
         x = np.asarray(x, dtype=float)

@@ -42,6 +42,15 @@ CONSTANTS = ("pi",)
 MAX_EXPONENT = 64
 #: longest accepted potential text (characters)
 MAX_TEXT = 10_000
+#: most syntax-tree nodes and deepest nesting of a potential's text: beyond, parsing alone exhausts Python's parser
+#: (9000 nested unary minus signs: MemoryError) and the symbolic algebra slows down without bound
+MAX_NODES, MAX_DEPTH = 2_000, 200
+#: largest polynomial degree of a potential (an upper bound from its expression: sums take the largest, products
+#: add, powers multiply): the symbolic derivation's cost grows steeply with it (a dense degree-9 polynomial ≈ 7 s)
+MAX_DEGREE = 16
+#: largest magnitude of a constant, as a power of two: a double's range (≈ 1.8e308); a constant beyond it would
+#: be inf in the integrator, and exact integer powers such as ((9**64)**64)**64 run for minutes in the algebra
+MAX_CONSTANT_BITS = 1023
 
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "**"}
 
@@ -150,6 +159,9 @@ class _Walker:
                 return a / b
             if b.is_number and (not b.is_real or abs(float(b)) > MAX_EXPONENT):
                 raise ConfigError(f"potential: the exponent {b} is out of range (|exponent| ≤ {MAX_EXPONENT})")
+            if a.is_number and b.is_number and _log2_abs(a) * abs(float(b)) > MAX_CONSTANT_BITS:
+                raise ConfigError(f"potential: the constant {ast.unparse(node)[:60]!r} is out of range (beyond a "
+                                  f"double's ≈ 1.8e308 or below its smallest normal number)")
             return a**b
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitXor):
             raise ConfigError("potential: '^' is not a power in Python syntax; write x**2, not x^2")
@@ -169,6 +181,61 @@ class _Walker:
                           f"the functions {', '.join(FUNCTIONS)}")
 
 
+def _log2_abs(v) -> float:
+    """|log2 |v|| of a sympy number, without evaluating it as a double (exact integers may be huge)."""
+    if v == 0:
+        return 0.0
+    if v.is_Rational:
+        return abs(abs(int(v.p)).bit_length() - int(v.q).bit_length())
+    try:
+        return abs(math.log2(abs(float(v))))
+    except (OverflowError, ValueError):
+        return math.inf
+
+
+def _check_tree(tree: ast.AST) -> None:
+    """ConfigError for a syntax tree beyond MAX_NODES nodes or MAX_DEPTH levels (checked without recursion)."""
+    count, stack = 0, [(tree, 0)]
+    while stack:
+        node, depth = stack.pop()
+        count += 1
+        if depth > MAX_DEPTH:
+            raise ConfigError(f"potential: the expression is nested more than {MAX_DEPTH} levels deep")
+        if count > MAX_NODES:
+            raise ConfigError(f"potential: the expression has more than {MAX_NODES} terms and operations")
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+
+
+def degree_bound(expr) -> int:
+    """An upper bound of the polynomial degree of a sympy expression in x, y, from its tree: sums take the largest,
+    products add, a power multiplies by |exponent| (its ceiling), a function keeps its arguments' largest.
+
+    Examples
+    --------
+    >>> degree_bound(parse_potential("x**2/2 + y**2/2 + x**2*y - y**3/3"))
+    3
+    """
+    import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+    def deg(e) -> int:
+        if e.is_Symbol:
+            return 1 if e.name in VARIABLES else 0
+        if e.is_number:
+            return 0
+        if isinstance(e, sp.Add):
+            return max(deg(a) for a in e.args)
+        if isinstance(e, sp.Mul):
+            return sum(deg(a) for a in e.args)
+        if isinstance(e, sp.Pow):
+            base = deg(e.base)
+            if e.exp.is_number:
+                return base * math.ceil(abs(float(e.exp)))
+            return base + deg(e.exp)
+        return max((deg(a) for a in e.args), default=0)
+
+    return deg(expr)
+
+
 def _check_sympy(expr, names: set[str]):
     """Check a sympy expression node by node against the whitelist; return it in the real symbols x, y, params."""
     import sympy as sp  # deferred: sympy takes ~0.3 s to import
@@ -183,6 +250,9 @@ def _check_sympy(expr, names: set[str]):
         elif isinstance(node, sp.Number):
             if not node.is_finite or not node.is_real:
                 raise ConfigError(f"potential: the constant {node} is not a finite real number")
+            if _log2_abs(node) > MAX_CONSTANT_BITS:
+                raise ConfigError(f"potential: the constant {str(node)[:40]} is out of range (beyond a double's "
+                                  "≈ 1.8e308 or below its smallest normal number)")
         elif isinstance(node, (sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow)):  # NumberSymbol: pi, E
             if isinstance(node, sp.Pow) and node.exp.is_number and abs(float(node.exp)) > MAX_EXPONENT:
                 raise ConfigError(f"potential: the exponent {node.exp} is out of range (|exponent| ≤ {MAX_EXPONENT})")
@@ -233,7 +303,10 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
         try:
             tree = ast.parse(source.strip(), mode="eval")
         except SyntaxError as e:
-            raise ConfigError(f"potential: {source!r} is not a Python expression ({e.msg})") from None
+            raise ConfigError(f"potential: {source[:60]!r} is not a Python expression ({e.msg})") from None
+        except (MemoryError, RecursionError):  # Python's parser gives up on very deep nesting
+            raise ConfigError(f"potential: the expression is nested more than {MAX_DEPTH} levels deep") from None
+        _check_tree(tree)
         # every name the text uses, so that a missing parameter is named as such (not as an unknown symbol)
         used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
         called = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
@@ -270,6 +343,9 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
                           "(misspelt? remove them or use them)")
     if not ({s.name for s in expr.free_symbols} & set(VARIABLES)):
         raise ConfigError(f"potential: {str(expr)!r} depends on neither x nor y")
+    if (d := degree_bound(expr)) > MAX_DEGREE:
+        raise ConfigError(f"potential: its degree is up to {d}, more than {MAX_DEGREE} (the derivation's cost grows "
+                          "steeply with the degree)")
     return expr
 
 
@@ -375,5 +451,5 @@ def _ordered(args):
     return sorted(args, key=sp.default_sort_key)
 
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_EXPONENT", "VARIABLES", "check_params", "parse_potential", "substitute",
-           "symbols", "to_heyoka"]
+__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_CONSTANT_BITS", "MAX_DEGREE", "MAX_DEPTH", "MAX_EXPONENT", "MAX_NODES", "VARIABLES", "check_params", "parse_potential", "substitute",
+           "symbols", "to_heyoka", "degree_bound"]

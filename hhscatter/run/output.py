@@ -45,6 +45,8 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
     """
     if overwrite and resume:
         raise ConfigError("--overwrite and --resume exclude each other")
+    if isinstance(out, (str, bytes)) and not str(out).strip():
+        raise ConfigError(f"out must name a directory (or a URL), got {out!r}; the working directory is '.'")
     try:
         store = Store(out)
     except ValueError as exc:
@@ -101,10 +103,7 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
     if not entries:
         return
     if overwrite:
-        # the whole old run: its tables, its scene, its temporaries (other files are not ours: kept)
-        for name in entries:
-            if name in (*TABLES, SCENE_FILE) or (name.startswith(".") and TMP_MARK in name):
-                store.remove(name)
+        _remove_run(store, entries)
         return
     if not resume:
         raise OutputError(
@@ -126,6 +125,52 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
         )
     for name in TABLES:
         store.remove_temporaries(name)
+
+
+def _ours(rel: str) -> bool:
+    """A file hhscatter leaves in a run directory outside its manifest: the writer's pid note, a temporary of a
+    killed writer, a write probe."""
+    base = rel.rsplit("/", 1)[-1]
+    return rel == LOCK_FILE or (base.startswith(".") and TMP_MARK in base) or rel.startswith(".write-test-")
+
+
+def _remove_run(store, entries) -> None:
+    """--overwrite: remove exactly the files the old run's manifest lists (and the temporaries of killed writers),
+    then the table folders left empty. A folder holding anything else (a file hhscatter did not write, a run
+    without manifest) is refused before anything is removed: OutputError naming the first foreign entry."""
+    where = store.display()
+    if not store.exists(SCENE_FILE):
+        raise OutputError(f"--overwrite: {where} holds no hhscatter run (no {SCENE_FILE}: its manifest) but "
+                          f"{len(entries)} entr{'y' if len(entries) == 1 else 'ies'} (first: {entries[0]}); "
+                          "--overwrite removes only what a run's manifest lists: empty it yourself or use another --out")
+    try:
+        man = json.loads(store.read_text(SCENE_FILE))["manifest"]
+        planned = {part_rel(name, p["partition"], c) for name in man["tables"] for p in man["points"]
+                   for c in range(-(-int(p["n"]) // int(p["chunk_size"])))}
+    except (ValueError, KeyError, TypeError) as exc:
+        raise OutputError(f"--overwrite: {store.display(SCENE_FILE)} holds no readable run manifest ({exc!r}); "
+                          "--overwrite removes only what a run's manifest lists: empty the folder yourself or use "
+                          "another --out") from None
+    foreign = [e for e in entries if e not in (*TABLES, SCENE_FILE) and not _ours(e)]
+    foreign += [f"{t}/{f}" for t in TABLES if store.is_dir(t) for f in store.files(t)
+                if f"{t}/{f}" not in planned and not _ours(f"{t}/{f}")]
+    if foreign:
+        raise OutputError(f"--overwrite: {where} holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} its "
+                          f"run's manifest does not list (first: {store.display(foreign[0])}); hhscatter removes "
+                          "only what it wrote: move them away, or use another --out. Nothing was removed")
+    for t in TABLES:
+        for f in store.files(t):
+            store.remove(f"{t}/{f}")
+        subs = {f.rsplit("/", k)[0] for f in planned if f.startswith(f"{t}/") for k in range(1, f.count("/"))}
+        for sub in sorted(subs, key=lambda d: d.count("/"), reverse=True):  # point folders, deepest first
+            if store.is_dir(sub) and not store.listdir(sub):
+                store.remove(sub)
+        if store.is_dir(t) and not store.listdir(t):
+            store.remove(t)
+    for e in entries:
+        if _ours(e):
+            store.remove(e)
+    store.remove(SCENE_FILE)
 
 
 def resumed_points(store, points):

@@ -72,6 +72,8 @@ from hhscatter.scene.scene import Scene
 
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
 DASK_NO_WORKER_TIMEOUT = 60.0
+#: at most WORKERS_MAX worker processes: each is a process with its own JIT-compiled integrator (≈ 100 MB)
+WORKERS_MAX = 1024
 
 
 def _drain(submit, wait_first, tasks, window, on_done, cancel):
@@ -157,6 +159,9 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
     """
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ConfigError(f"workers must be an integer ≥ 1, got {workers!r}")
+    if workers is not None and workers > WORKERS_MAX:
+        raise ConfigError(f"workers must be ≤ {WORKERS_MAX}, got {workers} (one process each, with its own compiled "
+                          "integrator)")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
         raise ConfigError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
     points = points_of(run)

@@ -2,6 +2,7 @@
 workers that die with the process that started them."""
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import signal
@@ -55,7 +56,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     res = run_chunk(scene, ics, ids, progress=progress)
     elapsed = time.perf_counter() - t0
     meta = {
-        "scene": json.loads(scene_json),
+        "scene": footer_scene(json.loads(scene_json)),
         "scene_hash": scene_hash or scene.result_hash(),
         "chunk": chunk,
         "orbits": [start, stop],
@@ -86,6 +87,24 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         n_snapshots=len(res.snapshots["t"]),
         compute_seconds=elapsed,
     )
+
+
+#: a part's footer names at most this many snapshot times; a longer list is named by its count, ends and SHA-256
+#: (scene.json holds every time once): 10⁵ times would add ≈ 2 MB to every part
+FOOTER_TIMES_MAX = 100
+
+
+def footer_scene(d: dict) -> dict:
+    """footer_scene(scene dict) -> the scene as a part's metadata records it: a list of snapshot times longer than
+    :data:`FOOTER_TIMES_MAX` as ``{"count", "first", "last", "sha256"}`` (of the list's JSON), the rest unchanged.
+
+    Example: ``footer_scene({"snapshots": [0.0, 1.0]})`` is ``{"snapshots": [0.0, 1.0]}``.
+    """
+    times = d.get("snapshots")
+    if not isinstance(times, list) or len(times) <= FOOTER_TIMES_MAX:
+        return d
+    digest = hashlib.sha256(json.dumps(times).encode()).hexdigest()
+    return {**d, "snapshots": {"count": len(times), "first": times[0], "last": times[-1], "sha256": digest}}
 
 
 def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partition: str = "", want=None) -> bool:

@@ -59,7 +59,7 @@ def _values(name, v) -> tuple:
     for x in vals:
         if isinstance(x, bool) or not isinstance(x, (int, float)):
             raise ConfigError(f"{name} must be a number or a list of numbers, got {x!r}")
-        x = float(x)
+        x = float(x) + 0.0  # −0.0 is 0.0 (the same point: one folder, one hash)
         if not math.isfinite(x):
             raise ConfigError(f"{name} must be finite, got {x}")
         out.append(x)

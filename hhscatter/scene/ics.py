@@ -124,6 +124,11 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
             table = pcsv.read_csv(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the user's file
         raise ConfigError(f"ics: cannot read {path}: {exc}") from None
+    names = list(table.column_names)
+    twice = sorted({c for c in names if names.count(c) > 1 and c in ("x", "y", "px", "py", "traj_id")})
+    if twice:
+        raise ConfigError(f"ics: table {path} has column(s) {twice} more than once: which one holds the initial "
+                          "states is ambiguous; keep one of each")
     missing = [c for c in ("x", "y", "px", "py") if c not in table.column_names]
     if missing:
         raise ConfigError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")

@@ -44,6 +44,19 @@ CHUNKS_MAX = 100_000
 #: at most SNAPSHOTS_MAX snapshot times: every live orbit writes one row per time (24 B), a chunk's
 #: snapshot rows are held in memory until written
 SNAPSHOTS_MAX = 100_000
+#: t_max ≤ T_MAX_MAX / ω: every orbit still inside at t_max (a trapped or censored one) is integrated all the way,
+#: at a cost ∝ t_max (≈ 10 Taylor steps per unit of ωt); far beyond the paper's 5000 no window of the analyses
+#: reaches, and a value such as 1e300 would never end
+T_MAX_MAX = 1e7
+#: seed ≤ SEED_MAX: it is stored (scene.json, part metadata) and read back as a 64-bit integer by other tools
+SEED_MAX = 2**63 - 1
+#: chunk_size ≤ CHUNK_SIZE_MAX orbits: a chunk's rows (≈ 90 B per orbit, more with sections) are held in memory
+#: until its part files are written
+CHUNK_SIZE_MAX = 10**7
+#: a region scene's E0 must exceed E_c by more than EC_MARGIN·E_c: a sampled initial energy |p|²/2 + V is E0 only
+#: up to a few units of rounding (≈ 1e-16 relative), and an orbit whose computed energy is ≤ E_c has settled
+#: before it starts (the IC-table check refuses such rows, :func:`hhscatter.scene.ics.check_ics`)
+EC_MARGIN = 1e-9
 #: a start/stop/step snapshot grid longer than this is stored (scene.json, part metadata, hash) as its
 #: definition, not as every time (shorter grids are stored as their times, as before: same hashes)
 SNAPSHOT_LIST_MAX = 1000
@@ -82,6 +95,11 @@ class SnapshotGrid(tuple):
     def __reduce__(self):
         d = self.definition
         return (SnapshotGrid, (d["start"], d["stop"], d["step"]))
+
+
+def _plus_zero(v):
+    """v with a float −0.0 written as 0.0 (−0 is the same value: it must not make another scene or read "γ=-0")."""
+    return 0.0 if isinstance(v, float) and v == 0.0 else v
 
 
 def _finite(name, value):
@@ -139,6 +157,8 @@ class SectionWindow:
     stop: bool = False
 
     def __post_init__(self):
+        for name in ("t_from", "t_to", "e_min", "e_max"):
+            object.__setattr__(self, name, _plus_zero(getattr(self, name)))
         for name in ("first_only", "stop"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
@@ -206,8 +226,9 @@ class Scene:
         Hénon–Heiles) where V < E;
         'square': the authors' ``goodICs``, uniform in [−r_s, r_s]² where V < E, no radius cut (orbits
         that start at r ≥ r_esc are escaped at t = 0). Momenta follow ``momentum``.
-    radius : float
-        Disk radius R (default 0.5, as in the authors' code).
+    radius : float, optional
+        Disk radius R; default: the system's :meth:`~hhscatter.model.System.default_ic_radius`, half the saddle
+        distance r_s (0.5 for Hénon–Heiles with ω = λ = 1, as in the authors' code).
     r_esc : float, optional
         Escape radius, > the saddle distance r_s; default: the system's
         :meth:`~hhscatter.model.System.default_escape_radius` at E0 (1.5 for Hénon–Heiles: beyond the
@@ -216,11 +237,12 @@ class Scene:
     r_far : float, optional
         Dissipative runs: radius beyond which an escaped orbit is stopped (default max(10 r_s, 2 r_esc)).
     t_max : float
-        Maximum orbit time (default 5000); orbits alive then are censored.
+        Maximum orbit time (default 5000, at most :data:`T_MAX_MAX`/ω); orbits alive then are censored.
     tol : float
         Taylor integrator tolerance in [1e-18, 1e-6] (default 1e-15).
     omega, lam : float
-        Hénon–Heiles' parameters ω, λ > 0 (default 1, 1); with another ``system`` they stay at 1.
+        Hénon–Heiles' parameters ω, λ > 0 (default 1, 1); with a ``system`` they stay at 1 and are not written
+        (:meth:`to_dict`).
     system : dict or System, optional
         The system as data (:mod:`hhscatter.model.spec`): a built-in by ``name`` or a ``potential`` in x, y,
         with ``params`` and ``dissipation``; None is Hénon–Heiles(ω, λ) with linear drag (left out of the
@@ -270,7 +292,7 @@ class Scene:
     gamma: float = 0.0
     seed: int = 0
     region: str = "disk"
-    radius: float = 0.5
+    radius: float | None = None
     r_esc: float | None = None
     r_far: float | None = None
     t_max: float = 5000.0
@@ -295,6 +317,9 @@ class Scene:
             if isinstance(v, (float, np.floating)) and math.isfinite(v) and v == int(v):
                 object.__setattr__(self, name, int(v))
         object.__setattr__(self, "_model", self._make_model())
+        object.__setattr__(self, "gamma", _plus_zero(self.gamma))
+        if self.radius is None:
+            object.__setattr__(self, "radius", float(self._model.default_ic_radius()))
         if self.r_esc is None:
             e = None if self.energy is None or isinstance(self.energy, bool) else _finite("energy", self.energy)
             object.__setattr__(self, "r_esc", float(self._model.default_escape_radius(e)))
@@ -351,14 +376,20 @@ class Scene:
         if self.n > N_MAX:
             raise ConfigError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
                              "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds")
-        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
             raise ConfigError(f"seed must be an integer ≥ 0, got {self.seed!r}")
+        if self.seed > SEED_MAX:
+            raise ConfigError(f"seed must be ≤ 2**63 − 1 = {SEED_MAX}, got {self.seed} (it is stored and read back as a "
+                              "64-bit integer)")
         tol = _finite("tol", self.tol)
         if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
             raise ConfigError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
         t_max = _finite("t_max", self.t_max)
         if t_max <= 0:
             raise ConfigError(f"t_max must be > 0, got {t_max}")
+        if t_max > T_MAX_MAX / m.frequency:
+            raise ConfigError(f"t_max must be ≤ {T_MAX_MAX:g}/ω = {T_MAX_MAX / m.frequency:g}, got {t_max:g} (every orbit "
+                              "still inside at t_max is integrated all the way, at a cost ∝ t_max)")
         return gamma, t_max
 
     def _check_radii(self):
@@ -381,6 +412,17 @@ class Scene:
                              "overflow beyond)")
         if self.region not in REGIONS:
             raise ConfigError(f"region must be one of {REGIONS}, got {self.region!r}")
+        # where orbits move: inside r_esc, escaped ones followed to r_far (drag, follow), square ICs in [−r_s, r_s]²
+        what, reach = "r_esc", r_esc
+        if self.gamma > 0 or self.follow is not None:
+            what, reach = "r_far", self.r_far if self.r_far is not None else max(10.0 * m.saddle_radius, 2.0 * r_esc)
+        if self.region == "square" and math.sqrt(2.0) * m.saddle_radius > reach:
+            what, reach = "the square region", math.sqrt(2.0) * m.saddle_radius
+        bad = m.nonfinite_point(reach)
+        if bad is not None:
+            raise ConfigError(f"system.potential: V or its gradient is not finite at ({bad[0]:.6g}, {bad[1]:.6g}), "
+                              f"inside r ≤ {reach:g} ({what}) where orbits move; give a potential that is finite "
+                              f"and real there, or a smaller {what}")
         if not isinstance(self.momentum, str) or self.momentum not in MOMENTA:
             raise ConfigError(f"momentum must be one of {MOMENTA}, got {self.momentum!r}")
         radius = _finite("radius", self.radius)
@@ -394,8 +436,12 @@ class Scene:
 
     def _check_chunks(self):
         """chunk_size (and the number of part files it makes) and batch_size."""
-        if not isinstance(self.chunk_size, (int, np.integer)) or self.chunk_size <= 0:
+        if not isinstance(self.chunk_size, (int, np.integer)) or isinstance(self.chunk_size, bool) \
+                or self.chunk_size <= 0:
             raise ConfigError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
+        if self.chunk_size > CHUNK_SIZE_MAX:
+            raise ConfigError(f"chunk_size must be ≤ {CHUNK_SIZE_MAX:.0e}, got {self.chunk_size:.3g} (a chunk's rows are "
+                              "held in memory until its part files are written)")
         if -(-self.n // self.chunk_size) > CHUNKS_MAX:
             raise ConfigError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
                              f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size")
@@ -427,6 +473,16 @@ class Scene:
                     f"energy must be > E_c = {m.critical_energy:.10g} in a {what} scene "
                     f"(no escape is possible below it), got {energy}"
                 )
+            if energy - m.critical_energy <= EC_MARGIN * m.critical_energy:
+                raise ConfigError(
+                    f"energy must exceed E_c = {m.critical_energy!r} by more than {EC_MARGIN:g} E_c, got {energy!r} "
+                    f"(E0 − E_c = {energy - m.critical_energy:.3g}): a sampled initial energy |p|²/2 + V equals E0 "
+                    "only up to rounding, and an orbit that starts at or below E_c has settled before it starts")
+            if isinstance(self.sections, SectionWindow) and self.sections.e_min > energy:
+                raise ConfigError(f"sections.e_min = {self.sections.e_min:g} is above E0 = {energy:g}: the energy "
+                                  "never rises above E0, so no crossing would be recorded")
+        elif not isinstance(self.ics, (str, Path)) or not str(self.ics).strip():
+            raise ConfigError(f"ics must be the path of a Parquet/CSV table, got {self.ics!r}")
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
         elif self.momentum != "tangential":
@@ -486,10 +542,11 @@ class Scene:
             del d["continue_settled"]
         if self.momentum == "tangential":  # issue 28: the only convention before; hashes of older scenes kept
             del d["momentum"]
-        if self.system is None:  # issue 23: Hénon–Heiles with linear drag, as before; hashes kept
+        if self.system is None:  # Hénon–Heiles with linear drag, as before; hashes kept
             del d["system"]
-        else:
+        else:  # ω and λ are Hénon–Heiles' keys: a system carries its own parameters
             d["system"] = dict(self.system, params=dict(self.system["params"]))
+            del d["omega"], d["lam"]
         return d
 
     def to_json(self) -> str:
@@ -501,6 +558,8 @@ class Scene:
         d = self.to_dict()
         for k in ("name", "batch_size"):
             d.pop(k)
+        if self.system is not None:  # hashed as before ω and λ left a system's scene.json: hashes kept
+            d.update(omega=1.0, lam=1.0)
         if self.ics is not None:
             d["ics"] = file_sha256(self.ics)
         return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()

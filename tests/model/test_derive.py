@@ -183,10 +183,11 @@ def test_overrides_replace_the_derivation():
         DeclaredSystem("0.5*(x**2 + y**2) + x**2*y - y**3/3", omega_radius=-1)
 
 
-def test_omega_that_is_no_disk_asks_for_omega_radius():
-    # exits at 1/384 (r = 1/8) and at 1/6 (r = 1): with E_c the lower one the disk of the far saddle is wrong,
-    # and a given Ω opens the far exit's energy to the well: we check the derived one fails when E_c is forced up
-    with pytest.raises(ConfigError, match="give `omega_radius`"):
+def test_a_critical_energy_the_derived_exits_contradict_is_refused():
+    # exits at 1/384 (r = 1/8) and at 1/6 (r = 1): E_c is the lower one; forcing it up to the far exit's energy
+    # contradicts the derivation and is refused, naming both values
+    with pytest.raises(ConfigError, match=r"critical_energy = 0.16666666666666666 contradicts the exits: E_c is the "
+                                          r"lowest exit's energy, 0.0026041666666666\d* \(exits derived\)"):
         DeclaredSystem("0.5*(x**2 + y**2) - x**3/3 - 8*y**3/3", critical_energy=1 / 6)
 
 

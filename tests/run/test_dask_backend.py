@@ -137,6 +137,7 @@ def test_fsspec_url_output_resume_and_read(tmp_path, scene, reference):
         for rel, data in reference.items():  # the reference bytes as a local run, read the same way
             (tmp_path / "local" / rel).parent.mkdir(parents=True, exist_ok=True)
             (tmp_path / "local" / rel).write_bytes(data)
+        (tmp_path / "local" / "scene.json").write_bytes(fs.cat("/hhscatter-test/run/scene.json"))  # its manifest
         lt = read_lifetimes(url)
         assert len(lt) == 450 and lt.equals(read_lifetimes(tmp_path / "local"))
         assert len(read_sections(url)) > 0
