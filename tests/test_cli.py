@@ -191,3 +191,38 @@ def test_the_command_starts_without_loading_the_study_framework():
             "'pyarrow', 'heyoka') if m in sys.modules)); print('fig1' in c._studies_epilog())")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
     assert out[0] == "[]" and out[1] == "True", out
+
+
+SIM = ["simulate", "--energy", "0.3", "-n", "10", "--t-max", "20", "--workers", "1", "--quiet"]
+
+
+@pytest.mark.parametrize("args,message", [
+    (SIM + ["--system", "", "--out", "{tmp}/o"], "--system must not be empty, got ''"),
+    (["simulate", "--ics", "", "--out", "{tmp}/o"], "--ics must not be empty, got ''"),
+    (SIM + ["--out", ""], "--out must not be empty, got '' (name the working directory as '.')"),
+    (SIM + ["--scale", " ", "--out", "{tmp}/o"], "--scale must not be empty, got ' '"),
+    (SIM + ["--scheduler", "", "--out", "{tmp}/o"], "--scheduler must not be empty, got ''"),
+    (SIM + ["--system", "contopoulos", "--param", "eps=0.25", "--param", "eps=0.3", "--out", "{tmp}/o"],
+     "--param eps given 2 times (0.25, 0.3): give each parameter once"),
+    (["simulate", "--ics", "{tmp}/ics.csv", "--region", "square", "--out", "{tmp}/o"],
+     "--region is for initial conditions sampled in a region; with --ics the table gives every initial state"),
+    (["simulate", "--ics", "{tmp}/ics.csv", "--radius", "0.3", "--region", "disk", "--out", "{tmp}/o"],
+     "--region and --radius are for initial conditions sampled in a region"),
+    (SIM + ["--sections-e-min", "0.5", "--out", "{tmp}/o"], "sections.e_min = 0.5 is above E0 = 0.3"),
+])
+def test_empty_repeated_and_ignored_inputs_are_refused(tmp_path, monkeypatch, capsys, args, message):
+    """An empty shell variable is not the default; a flag given twice or one that would be ignored is an error."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "ics.csv").write_text("x,y,px,py\n0.1,0.05,0.6,0.1\n")
+    assert main([a.format(tmp=tmp_path) for a in args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ics.csv"]  # nothing written
+
+
+def test_minus_zero_gamma_is_the_conservative_scene(tmp_path, capsys):
+    assert main(SIM + ["--gamma", "-0", "--out", str(tmp_path / "m")]) == 0
+    out = capsys.readouterr().out
+    assert "γ=0:" in out and "γ=-0" not in out
+    assert main(SIM + ["--gamma", "0", "--out", str(tmp_path / "m"), "--resume"]) == 0  # the same scene
+    assert "nothing to do: all 1 chunk(s) verified complete" in capsys.readouterr().out

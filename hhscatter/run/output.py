@@ -56,6 +56,7 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
     if points is None:
         points = [(sc, part, sc.result_hash()) for sc, part in points_of(run)]
     created = not store.exists()
+    had_note = not created and store.exists(LOCK_FILE)
     lock = None
     try:
         try:
@@ -92,6 +93,11 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
         if lock is not None and created:  # never a directory another writer made or holds
 
             shutil.rmtree(store.root, ignore_errors=True)
+        elif lock is not None and not had_note:  # a refused folder keeps nothing of ours, not even the pid note
+            try:
+                store.remove(LOCK_FILE)
+            except OSError:
+                pass
         Store.unlock(lock)
         raise
     return store, lock, points

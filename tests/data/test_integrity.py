@@ -5,6 +5,7 @@ or in a correct result (byte-identical to an undisturbed run). Processes are sta
 killed by their own PIDs only.
 """
 import errno
+import hashlib
 import json
 import os
 import shutil
@@ -283,10 +284,14 @@ def test_8_ics_below_ec_with_drag_are_refused(tmp_path, capsys):
     (["--snapshots", "0:5000:1e-6"], "snapshots: 0:5000:1e-06 gives 5000000001 times, more than 100000"),
     (["-n", "1e12"], "n must be ≤ 1e+09 per run, got 1e+12"),
     (["-n", "1e8", "--chunk-size", "10"], "gives 10000000 chunks for n = 100000000, more than 100000 part files"),
+    (["--t-max", "1e300"], "t_max must be ≤ 1e+07/ω = 1e+07, got 1e+300 (every orbit still inside at t_max"),
+    (["--seed", "1e30"], "seed must be ≤ 2**63 − 1 = 9223372036854775807, got 1000000000000000019884624838656"),
+    (["--chunk-size", "1e12"], "chunk_size must be ≤ 1e+07, got 1e+12 (a chunk's rows are held in memory"),
+    (["--workers", "1e6"], "workers must be ≤ 1024, got 1000000 (one process each"),
 ])
 def test_9_out_of_bounds_is_refused_before_any_work(tmp_path, capsys, flags, message):
-    args = {"--energy": "0.3", "-n": "100", **dict(zip(flags[::2], flags[1::2]))}
-    rc, err = _cli(capsys, "simulate", *[x for kv in args.items() for x in kv], "--t-max", "5000",
+    args = {"--energy": "0.3", "-n": "100", "--t-max": "5000", **dict(zip(flags[::2], flags[1::2]))}
+    rc, err = _cli(capsys, "simulate", *[x for kv in args.items() for x in kv],
                    "--out", str(tmp_path / "o"), "--quiet")
     assert rc == 2 and message in err, err
     assert not (tmp_path / "o").exists()
@@ -396,3 +401,61 @@ def test_12_ic_table_is_hashed_once_per_run(tmp_path, monkeypatch):
     assert len(reads) == 1  # 12 chunks, one hash
     lt = read_lifetimes(tmp_path / "o")
     assert len(lt) == 60 and np.array_equal(lt[["x0", "y0", "px0", "py0"]].to_numpy(), states)
+
+
+# 13 -- a run whose scene.json (its manifest) is gone is refused by every reader, not read as complete
+def test_13_a_run_without_its_manifest_is_refused(run, capsys):
+    from hhscatter.data.read import run_status
+
+    (run / "scene.json").unlink()
+    (run / "lifetimes" / "part-000003.parquet").unlink()  # one chunk gone with it: nothing could tell
+    msg = r"the run at .*run has no scene.json, its manifest \(its parts say they belong to scene [0-9a-f]{12}…\)"
+    for read in (read_lifetimes, read_sections, run_status):
+        with pytest.raises(RunIntegrityError, match=msg):
+            read(run)
+    rc, err = _cli(capsys, "survival", str(run), "--png", str(run.parent / "p.png"))
+    assert rc == 2 and "has no scene.json, its manifest" in err and not (run.parent / "p.png").exists()
+    # the same simulate with --resume verifies the parts, redoes the missing chunk and writes the manifest again
+    simulate(Scene(**SCENE), run, workers=1, progress=False, resume=True)
+    assert len(read_lifetimes(run)) == SCENE["n"]
+
+
+# 14 -- a file that is no Parquet file under a planned part's name: a named error, no traceback
+def test_14_junk_under_a_part_name_is_refused(run, capsys):
+    (run / "lifetimes" / "part-000001.parquet").write_text("junk")
+    with pytest.raises(RunIntegrityError, match=r"a part of the lifetimes table of the run at .*run is not a readable "
+                                                r"Parquet file .*part-000001.parquet.*rerun it with --resume"):
+        read_lifetimes(run)
+    rc, err = _cli(capsys, "survival", str(run), "--png", str(run.parent / "p.png"))
+    assert rc == 2 and "is not a readable Parquet file" in err
+
+
+# 15 -- a run being written is not read piecemeal: finished chunks read apart would not match across tables
+def test_15_partial_reads_of_a_run_being_written_are_refused(run):
+    from hhscatter.data.store import Store
+
+    (run / "lifetimes" / "part-000003.parquet").unlink()  # its last chunk not finished yet
+    held = Store(run).lock()  # a writer at work
+    try:
+        with pytest.raises(IncompleteRunError, match=r"is incomplete: 1 of 4 chunk\(s\) .*and it is being written "
+                                                     r"now \(pid \d+\).*wait until the writer ends"):
+            read_lifetimes(run, allow_partial=True)
+    finally:
+        Store.unlock(held)
+    with pytest.warns(UserWarning, match="reading the 300 orbits of the finished chunks"):
+        lt = read_lifetimes(run, allow_partial=True)
+    with pytest.warns(UserWarning):
+        sec = read_sections(run, allow_partial=True)
+    assert set(sec.traj_id) <= set(lt.traj_id)
+
+
+# 16 -- an explicit list of snapshot times is not copied into every part's footer
+def test_16_a_long_list_of_snapshot_times_stays_out_of_the_footers(tmp_path):
+    times = [round(0.01 * k, 2) for k in range(1, 2001)]
+    scene = Scene(energy=0.3, gamma=0.01, n=20, seed=1, chunk_size=10, t_max=50.0, snapshots=times)
+    simulate(scene, tmp_path / "o", workers=1, progress=False)
+    meta = json.loads(pq.read_schema(tmp_path / "o" / "lifetimes" / "part-000000.parquet").metadata[b"hhscatter"])
+    assert meta["scene"]["snapshots"] == {"count": 2000, "first": 0.01, "last": 20.0,
+                                          "sha256": hashlib.sha256(json.dumps(times).encode()).hexdigest()}
+    assert json.loads((tmp_path / "o" / "scene.json").read_text())["scene"]["snapshots"] == times  # kept once
+    assert set(read_snapshots(tmp_path / "o").t) <= set(times)

@@ -71,3 +71,12 @@ def test_reading_imports_no_pandas(tmp_path):
             f"[read_ics_table(p) for p in {[str(p) for p in paths]!r}]; print('pandas' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+@pytest.mark.parametrize("header", ["x,y,px,py,x", "x,y,px,py,traj_id,traj_id"])
+def test_a_duplicated_column_is_refused(tmp_path, header):
+    f = tmp_path / "dup.csv"
+    f.write_text(header + "\n" + ",".join(["0.1"] * 4 + ["1"] * (len(header.split(",")) - 4)) + "\n")
+    with pytest.raises(ConfigError, match=r"ics: table .*dup.csv has column\(s\) \['(x|traj_id)'\] more than once: "
+                                          "which one holds the initial states is ambiguous"):
+        read_ics_table(f)
