@@ -18,11 +18,14 @@ The reference is ``[[study[@scale]:path[|format]]]``:
   ``quick`` (``docs/studies/assets/<study>.json``). See :func:`headline_scale`.
 * ``path`` — keys separated by dots (a key that itself holds dots, such as
   ``E0.30``, is found as it is); ``[n]`` indexes a list, ``[field=value]``
-  picks the one record of a list whose ``field`` equals ``value`` (numbers
-  compared as numbers).
+  (or ``[f=a,g=b]``) picks the one record of a list whose fields equal
+  these values (numbers compared as numbers).
 * ``format`` (see :func:`format_leaf`) — none: ``value ± err`` with the
   error's significant digits (:func:`hhscatter.publish.formatting.format_value_err`);
-  ``value`` / ``err``: one of them at those digits; ``pct``: ×100 with ``%``;
+  ``value`` / ``err``: one of them at those digits; ``ci`` / ``ci+``: value
+  [lo, hi] of an interval (a ``{value, interval}`` leaf, or a number beside
+  its ``<key>_interval``), decimals from its half-width, ``+``: signed;
+  ``pct``: ×100 with ``%``;
   ``abs``: the magnitude; ``int``: rounded, thousands separated by a thin
   space; ``sci``: a×10ᵇ; a Python format spec (``.3f``, ``.2g``, ``+.2f``).
 
@@ -50,6 +53,7 @@ __all__ = [
     "NumberRefError",
     "REF",
     "format_leaf",
+    "format_ref",
     "headline_scale",
     "prose",
     "render_refs",
@@ -153,11 +157,12 @@ def resolve(doc, path: str):
                     raise NumberRefError(f"{'.'.join(seen)}{p}: index out of range ({len(node)} items)")
                 node = node[k]
             else:
-                field, eq, want = sel.partition("=")
-                if not eq:
-                    raise NumberRefError(f"selector {p}: write [index] or [field=value]")
-                field, want = field.strip(), want.strip()
-                hits = [r for r in node if isinstance(r, dict) and field in r and _same(r[field], want)]
+                conds = [c.partition("=") for c in sel.split(",")]
+                if not all(eq for _, eq, _ in conds):
+                    raise NumberRefError(f"selector {p}: write [index], [field=value] or [field=value,field=value]")
+                conds = [(f.strip(), w.strip()) for f, _, w in conds]
+                hits = [r for r in node if isinstance(r, dict)
+                        and all(f in r and _same(r[f], w) for f, w in conds)]
                 if len(hits) != 1:
                     raise NumberRefError(f"{'.'.join(seen)}{p}: {len(hits)} records match (need exactly one)")
                 node = hits[0]
@@ -230,6 +235,8 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
         value, err = leaf["value"], leaf.get("err")
         if fmt == "" and _is_num(leaf.get("lo")) and _is_num(leaf.get("hi")) and _is_num(value):
             return f"{_num(value)} [{_num(leaf['lo'])}, {_num(leaf['hi'])}]"
+    if fmt.startswith("ci") or (isinstance(leaf, dict) and "interval" in leaf and fmt in ("", "+")):
+        return _interval(leaf, fmt)
     if isinstance(value, str) and fmt in ("", "text"):
         return value
     if isinstance(value, bool):
@@ -263,6 +270,26 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
         raise NumberRefError(f"bad format {fmt!r}: {e}") from None
 
 
+def _interval(leaf, fmt: str) -> str:
+    """``value [lo, hi]`` of ``{value, interval: [lo, hi]}`` (or ``[value, [lo, hi]]``), decimals from the
+    half-width of the interval as from an error; ``ci+`` / ``+``: signed."""
+    if isinstance(leaf, dict):
+        value, iv = leaf.get("value"), leaf.get("interval")
+    elif isinstance(leaf, (list, tuple)) and len(leaf) == 2:
+        value, iv = leaf
+    else:
+        raise NumberRefError(f"no interval here ({leaf!r:.60}): write path.to.x with a sibling x_interval, "
+                             "or a {value, interval} leaf")
+    nums = [value, *(iv or [])] if isinstance(iv, (list, tuple)) and len(iv) == 2 else None
+    if nums is None or not all(_is_num(x) and math.isfinite(x) for x in nums):
+        raise NumberRefError(f"no number or no interval here (value {value!r}, interval {iv!r})")
+    half = (nums[2] - nums[1]) / 2
+    d = _digits(half) if half > 0 else 3
+    sign = "+" if "+" in fmt else ""
+    lo, hi = nums[1], nums[2]
+    return f"{value:{sign}.{d}f} [{lo:{sign}.{d}f}, {hi:{sign}.{d}f}]".replace("-", "−")
+
+
 # -- pages ------------------------------------------------------------------------------------------------------
 _FENCE = re.compile(r"^(?P<i>[ \t]*)(?P<f>```+|~~~+).*?^(?P=i)(?P=f)[ \t]*$", re.M | re.S)
 _CODE = re.compile(r"(`+)(?!`).+?(?<!`)\1(?!`)", re.S)
@@ -280,6 +307,15 @@ def _protected(text: str) -> list[tuple[int, int]]:
     return sorted(spans)
 
 
+def format_ref(doc, path: str, fmt: str | None = None) -> str:
+    """The text of one reference: :func:`resolve` then :func:`format_leaf`; with ``ci`` a number whose interval
+    is its sibling ``<key>_interval`` (``rows[…].delta`` beside ``rows[…].delta_interval``) is written with it."""
+    leaf = resolve(doc, path)
+    if (fmt or "").strip().startswith("ci") and _is_num(leaf):
+        leaf = [leaf, resolve(doc, path.strip() + "_interval")]
+    return format_leaf(leaf, fmt)
+
+
 def render_refs(text: str, root: Path, *, where: str = "") -> str:
     """Every ``[[study:path]]`` of ``text`` (outside code) replaced by its number; NumberRefError names them all."""
     spans = _protected(text)
@@ -290,7 +326,7 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
             return m.group(0)
         try:
             doc, _ = load_numbers(root, m.group("study"), m.group("scale"))
-            return format_leaf(resolve(doc, m.group("path")), m.group("fmt"))
+            return format_ref(doc, m.group("path"), m.group("fmt"))
         except NumberRefError as e:
             errors.append(f"{m.group(0)}: {e}")
             return m.group(0)

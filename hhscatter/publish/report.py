@@ -20,6 +20,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from hhscatter.analysis.stats.verdicts import row_verdict
 from hhscatter.publish.formatting import (
     comparison_table,
     embed_markdown,
@@ -214,7 +215,7 @@ def split_rows(rows, sections):
 def verdict_counts(rows) -> dict:
     counts = {"ok": 0, "bad": 0, "meh": 0, "": 0}
     for r in rows:
-        counts[_verdict_class(r.get("verdict"))] += 1
+        counts[_verdict_class(row_verdict(r))] += 1
     return counts
 
 
