@@ -25,7 +25,8 @@ The reference is ``[[study[@scale]:path[|format]]]``:
   ``value`` / ``err``: one of them at those digits; ``ci`` / ``ci+``: value
   [lo, hi] of an interval (a ``{value, interval}`` leaf, or a number beside
   its ``<key>_interval``), decimals from its half-width, ``+``: signed;
-  ``pct``: ×100 with ``%``;
+  ``pct``: ×100 with ``%``; ``verdict``: the verdict of a paper-vs-ours row by
+  the one rule (:func:`hhscatter.analysis.stats.verdicts.row_verdict`);
   ``abs``: the magnitude; ``int``: rounded, thousands separated by a thin
   space; ``sci``: a×10ᵇ; a Python format spec (``.3f``, ``.2g``, ``+.2f``).
 
@@ -157,7 +158,7 @@ def resolve(doc, path: str):
                     raise NumberRefError(f"{'.'.join(seen)}{p}: index out of range ({len(node)} items)")
                 node = node[k]
             else:
-                conds = [c.partition("=") for c in sel.split(",")]
+                conds = [c.partition("=") for c in re.split(r",(?=\s*[\w.-]+\s*=)", sel)]
                 if not all(eq for _, eq, _ in conds):
                     raise NumberRefError(f"selector {p}: write [index], [field=value] or [field=value,field=value]")
                 conds = [(f.strip(), w.strip()) for f, _, w in conds]
@@ -311,6 +312,12 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
     """The text of one reference: :func:`resolve` then :func:`format_leaf`; with ``ci`` a number whose interval
     is its sibling ``<key>_interval`` (``rows[…].delta`` beside ``rows[…].delta_interval``) is written with it."""
     leaf = resolve(doc, path)
+    if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
+        from hhscatter.analysis.stats.verdicts import row_verdict  # deferred: only this format needs it
+
+        if not isinstance(leaf, dict) or "ours" not in leaf:
+            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours')")
+        return row_verdict(leaf, doc.get("scale") if isinstance(doc, dict) else None)
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)
@@ -332,6 +339,13 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
             return m.group(0)
 
     out = REF.sub(sub, text)
+    # what looks like a reference but did not parse (e.g. brackets inside a selector's value) is an error too
+    spans = _protected(out)
+    for m in re.finditer(r"\[\[\s*[\w-]+(?:@[\w-]+)?\s*:", out):
+        if not any(a <= m.start() < b for a, b in spans):
+            line = out[m.start():out.find("\n", m.start())][:80]
+            errors.append(f"{line}: not a reference the syntax reads ([[study[@scale]:path[|format]]]; a selector "
+                          "value may not hold brackets)")
     if errors:
         raise NumberRefError(f"{where or 'text'}: " + "; ".join(errors))
     return out
@@ -342,9 +356,9 @@ _CONVENTIONS = re.compile(r"<!--\s*conventions:(.*?)-->", re.S)
 _NUMBER = re.compile(r"(?<![\w.\-/−])[-−+]?(?:\d+(?:[.,]\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?:[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)?"
                      r"(?![\w.]*\w)")
 #: references to the paper's and the site's own parts ("Fig. 2", "Eq. (3)", "Eqs. (14)–(16)", "Table 1",
-#: "panel 2"), and the paper's arXiv id: numbers that name things, not results
+#: "panel 2"), the paper's arXiv id and years (2023): numbers that name things, not results
 _NAMING = re.compile(r"(?:\b(?:Figs?|Eqs?|Sec|Secs|Table|Tables|Ref|App)\.?\s*\(?\d+[a-z]?\)?"
-                     r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
+                     r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|(?<![\d.])(?:19|20)\d\d(?![\d.,]\d|[²³])|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
                      re.M)
 _LINK_TARGET = re.compile(r"\]\([^)]*\)|\]\[[^\]]*\]|\{[#.][^}]*\}|</?[a-zA-Z][^>]*>|\(eqn?:[\w-]+\)|fig:[\w-]+")
 #: small integers name counts, panels and exponents ("4 windows", "(2)", "t^2"): never a measured result here

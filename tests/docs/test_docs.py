@@ -144,7 +144,7 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assert "n = 10  # orbits" in out
     assert "](assets/fig2.png)" in out
     assert "| a | 13.1 ± 0.5 | 13.63 | agrees (z = −1.0) |" in out  # −0.53/√(0.52² + 0.005²): the one rule
-    assert "`tau0_rule`\n:   τ0 is where" in out
+    assert "    `tau0_rule`\n    :   τ0 is where" in out  # the rules, folded
     assert "| `gamma` | `tau1` |" in out and "| 0.01 | 17.2 ± 1.0 |" in out
     assert "scale **quick**" in out and "commit `0123456789ab`" in out
     assert "](assets/fig2.json)" in out
