@@ -308,6 +308,26 @@ class Renderer:
                 text += f"\n\n![{png.stem}]({self._rel(png)})\n\n*{png.name}*\n"
         return text
 
+    def bench_goals(self, _arg=None) -> str:
+        """The engine's goals against what was measured (docs/benchmarks/assets/engine/engine.csv, the rows with a
+        goal), with a count of the goals met: the first thing the benchmarks page says."""
+        import csv
+
+        path = self.docs / "benchmarks" / "assets" / "engine" / "engine.csv"
+        if not path.exists():
+            return self.missing("The engine's goals", "Run `make bench-engine` and then `make docs-assets`.")
+        rows = [r for r in csv.DictReader(path.open()) if (r.get("goal") or "").strip()]
+        out = ["| target | measure | goal | measured | met |", "|---|---|---|---|---|"]
+        met = 0
+        for r in rows:
+            ok = goal_met(float(r["value"]), r["goal"])
+            met += bool(ok)
+            out.append(f"| {_cell(r['target'])} | {_cell(r['measure'])} | {_cell(r['goal'])} | "
+                       f"{fmt_num(float(r['value']), 3)} | {'yes' if ok else '**no**' if ok is False else '?'} |")
+        head = (f"**{met} of {len(rows)} goals met** (`make bench-engine`, one core, best of three; the "
+                "[engine targets](#engine-targets) below give every measurement and its note):\n")
+        return head + "\n" + "\n".join(out) + "\n"
+
     def _costs(self, scale: str) -> dict:
         """{study: hhscatter.studies.cost.summary of its committed cost record at ``scale``}."""
         from hhscatter.studies.cost import summary
@@ -395,6 +415,16 @@ class Renderer:
             out.extend(f"| `{f.name}` | `{f.type}`{'' if f.nullable else ' (not null)'} |" for f in schema)
             out.append("")
         return '??? abstract "The Arrow schemas, as the code defines them"\n\n' + _indent("\n".join(out)) + "\n"
+
+
+def goal_met(value: float, goal: str):
+    """goal_met(3.1, "≤ 2 (1.5)") -> False: the first comparison of a goal text ("≤ x", "≥ x", "< x", "> x");
+    None when the goal states none."""
+    m = re.match(r"\s*(≤|≥|<|>|<=|>=)\s*([-+0-9.eE]+)", goal)
+    if not m:
+        return None
+    op, x = m.group(1), float(m.group(2))
+    return {"≤": value <= x, "<=": value <= x, "<": value < x, "≥": value >= x, ">=": value >= x, ">": value > x}[op]
 
 
 def _flatten(key, v, depth=0):

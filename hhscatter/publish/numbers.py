@@ -25,7 +25,7 @@ The reference is ``[[study[@scale]:path[|format]]]``:
   ``value`` / ``err``: one of them at those digits; ``ci`` / ``ci+``: value
   [lo, hi] of an interval (a ``{value, interval}`` leaf, or a number beside
   its ``<key>_interval``), decimals from its half-width, ``+``: signed;
-  ``pct``: ×100 with ``%``; ``verdict``: the verdict of a paper-vs-ours row by
+  ``pm``: a number ± its sibling ``<key>_err``; ``pct``: ×100 with ``%``; ``verdict``: the verdict of a paper-vs-ours row by
   the one rule (:func:`hhscatter.analysis.stats.verdicts.row_verdict`);
   ``abs``: the magnitude; ``int``: rounded, thousands separated by a thin
   space; ``sci``: a×10ᵇ; a Python format spec (``.3f``, ``.2g``, ``+.2f``).
@@ -62,9 +62,10 @@ __all__ = [
     "stray_numbers",
 ]
 
-#: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine)
-REF = re.compile(r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|]|\[[^\]]*\])+?)"
-                 r"\s*(?:\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]")
+#: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine); the bar may
+#: be written ``\|`` where the source is a Markdown table that other tools read as it is
+REF = re.compile(r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|\\]|\[[^\]]*\])+?)"
+                 r"\s*(?:\\?\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]")
 
 
 class NumberRefError(ValueError):
@@ -158,7 +159,15 @@ def resolve(doc, path: str):
                     raise NumberRefError(f"{'.'.join(seen)}{p}: index out of range ({len(node)} items)")
                 node = node[k]
             else:
-                conds = [c.partition("=") for c in re.split(r",(?=\s*[\w.-]+\s*=)", sel)]
+                fields = {k for r in node if isinstance(r, dict) for k in r}
+                conds = []
+                for c in re.split(r",(?=\s*[\w.-]+\s*=)", sel):
+                    name = c.partition("=")[0].strip()
+                    if conds and name not in fields:  # a comma inside a value ("κ(E=0.30, r_esc=1.5)")
+                        f, eq, w = conds.pop()
+                        conds.append((f, eq, w + "," + c))
+                    else:
+                        conds.append(c.partition("="))
                 if not all(eq for _, eq, _ in conds):
                     raise NumberRefError(f"selector {p}: write [index], [field=value] or [field=value,field=value]")
                 conds = [(f.strip(), w.strip()) for f, _, w in conds]
@@ -215,6 +224,14 @@ def _digits(err: float) -> int:
 
 
 def format_leaf(leaf, fmt: str | None = None) -> str:
+    """format_leaf(JSON leaf, format) -> its text; a negative number with the minus sign "−" (see _format_leaf)."""
+    out = _format_leaf(leaf, fmt)
+    if isinstance(leaf, str) or (isinstance(leaf, dict) and isinstance(leaf.get("value"), str)):
+        return out
+    return re.sub(r"(^|[\s(\[])-(?=\d)", r"\1−", out)
+
+
+def _format_leaf(leaf, fmt: str | None = None) -> str:
     """format_leaf(JSON leaf, format) -> its text (see the module doc for the formats).
 
     A ``{value, err}`` leaf is written ``value ± err`` with the error's
@@ -230,6 +247,8 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
     """
     fmt = (fmt or "").strip()
     value, err = leaf, None
+    if isinstance(leaf, dict) and "value" not in leaf and "ours" in leaf:  # a paper-vs-ours row: our number
+        leaf = {"value": leaf["ours"], "err": leaf.get("err")}
     if isinstance(leaf, dict):
         if "value" not in leaf:
             raise NumberRefError(f"a mapping with keys {sorted(leaf)[:8]}: name one of them")
@@ -249,7 +268,7 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
         value, fmt = abs(value), ""
     if fmt == "pct":
         value, err, fmt = 100 * value, (100 * err if has_err else err), ""
-        return format_leaf({"value": value, "err": err}) + " %"
+        return _format_leaf({"value": value, "err": err}) + " %"
     if fmt == "":
         return format_value_err(value, err) if has_err else _num(value)
     if fmt in ("value", "err"):
@@ -318,6 +337,8 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
         if not isinstance(leaf, dict) or "ours" not in leaf:
             raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours')")
         return row_verdict(leaf, doc.get("scale") if isinstance(doc, dict) else None)
+    if (fmt or "").strip() == "pm" and _is_num(leaf):  # a number beside its error <key>_err
+        return format_leaf({"value": leaf, "err": resolve(doc, path.strip() + "_err")})
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)

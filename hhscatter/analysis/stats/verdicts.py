@@ -17,8 +17,8 @@ from decimal import Decimal
 #: the verdict rule, stated once (the docs' studies index and the report print this text)
 RULE = ("**agrees** when |ours − reference| ≤ 2σ, σ = √(σ_ours² + σ_ref²): both uncertainties, ours (1σ, "
         "resampled over orbits) and the reference's (another study's 1σ, or, for a number the paper prints "
-        "without an error, half a unit of its last printed digit; a whole number, such as a predicted exponent 1 or "
-        "a shift 0, is exact); **differs** otherwise; z = (ours − reference)/σ. "
+        "without an error, half a unit of its last printed digit, so '≈ 17' stands for [16.5, 17.5); a reference 0 or 1 — a "
+        "predicted shift, exponent or limit — is exact); **differs** otherwise; z = (ours − reference)/σ. "
         "A cell without a number or without our uncertainty says so instead of a verdict; the tiny scale "
         "(a smoke test of a few hundred orbits) gives no verdicts.")
 #: scales whose outputs are smoke tests: their rows carry no verdict
@@ -100,8 +100,8 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
             return "undetermined: no value of ours (not measurable here)"
         return stored or "—"
     ref_err = row.get("paper_err")
-    if not _finite(ref_err):  # the paper's printed number: half a unit of its last digit; a whole number is exact
-        ref_err = half_unit(paper) if _finite(paper) and paper != int(paper) else 0.0
+    if not _finite(ref_err):  # the paper's printed number: half a unit of its last digit; 0 and 1 are exact
+        ref_err = half_unit(paper) if _finite(paper) and paper not in (0, 1) else 0.0
     v = verdict(ours, row.get("err"), paper, ref_err)
     if v.word == "differs" and stored.startswith("differs") and ";" in stored:
         return f"{v.text()}; {stored.split(';', 1)[1].strip()}"
