@@ -30,7 +30,7 @@ MATHJAX_DEST = "javascripts/mathjax"
 #: what tex-chtml.js loads: itself, its fonts, TeX extensions (autoload), the menu and accessibility parts
 MATHJAX_PARTS = ("tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y")
 
-_HEADING = re.compile(r"^###\s+\((\d+)\).*\{#([\w-]+)\}\s*$", re.M)
+_HEADING = re.compile(r"^###\s+\(([A-Z]?\d+)\).*\{#([\w-]+)\}\s*$", re.M)
 _EQREF = re.compile(r"\((eqn?:[\w-]+)\)")
 _FIGREF_DUP = re.compile(r"\s*(?:\(fig:[\w-]+\)|= fig:[\w-]+|, fig:[\w-]+)")
 _FIGREF = re.compile(r"\bfig:([\w-]+)")

@@ -74,7 +74,7 @@ def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
     0.912 ± 0.003, 0.310 ± 0.012, 152 ± 7); v to the same decimal place.
     Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15).
     Without a usable error (None, NaN, < 0) the value alone; an error of 0 is
-    written "± 0". ``sep`` e.g. r" \\pm " inside LaTeX labels of figures.
+    written "± 0". ``sep``: e.g. ``r" \\pm "`` inside the LaTeX labels of figures.
     """
     if not _is_num(v) or (isinstance(v, float) and not math.isfinite(v)):
         return format_number(v)

@@ -2,7 +2,7 @@
 
 * :data:`RULE` and :func:`verdict` — **the one rule** every table and every page applies: "agrees" when
   |ours − reference| ≤ 2σ with σ = √(σ_ours² + σ_ref²), both uncertainties; :func:`row_verdict` applies it
-  to a paper-vs-ours row and says why when it cannot (no "nan"), and gives no verdict at the tiny scale;
+  to a paper-vs-ours row and says why when it cannot (never a "not a number"), and gives no verdict at the tiny scale;
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
 * :func:`half_unit` — half a unit of the last digit of a printed number;
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
