@@ -62,6 +62,9 @@ EC_MARGIN = 1e-9
 SNAPSHOT_LIST_MAX = 1000
 
 
+#: the radius field of a scene whose region is not the disk and that gives none: no region but the disk reads it,
+#: and it keeps the value every scene had before the disk's default came from the system (so their hashes stay)
+UNUSED_RADIUS = 0.5
 #: the initial-condition regions of a scene (hhscatter.scene.ics)
 REGIONS = ("disk", "well", "square")
 #: the momentum conventions of region ICs (hhscatter.scene.ics): 'tangential' on the section ṙ = 0, φ̇ > 0 (the
@@ -228,7 +231,8 @@ class Scene:
         that start at r ≥ r_esc are escaped at t = 0). Momenta follow ``momentum``.
     radius : float, optional
         Disk radius R; default: the system's :meth:`~hhscatter.model.System.default_ic_radius`, half the saddle
-        distance r_s (0.5 for Hénon–Heiles with ω = λ = 1, as in the authors' code).
+        distance r_s (0.5 for Hénon–Heiles with ω = λ = 1, as in the authors' code). Read by the disk only (the
+        other regions keep :data:`UNUSED_RADIUS` when none is given).
     r_esc : float, optional
         Escape radius, > the saddle distance r_s; default: the system's
         :meth:`~hhscatter.model.System.default_escape_radius` at E0 (1.5 for Hénon–Heiles: beyond the
@@ -318,8 +322,9 @@ class Scene:
                 object.__setattr__(self, name, int(v))
         object.__setattr__(self, "_model", self._make_model())
         object.__setattr__(self, "gamma", _plus_zero(self.gamma))
-        if self.radius is None:
-            object.__setattr__(self, "radius", float(self._model.default_ic_radius()))
+        if self.radius is None:  # the disk's is the system's; the other regions have none (see UNUSED_RADIUS)
+            radius = self._model.default_ic_radius() if self.region == "disk" else UNUSED_RADIUS
+            object.__setattr__(self, "radius", float(radius))
         if self.r_esc is None:
             e = None if self.energy is None or isinstance(self.energy, bool) else _finite("energy", self.energy)
             object.__setattr__(self, "r_esc", float(self._model.default_escape_radius(e)))

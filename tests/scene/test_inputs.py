@@ -74,3 +74,9 @@ def test_an_energy_within_rounding_of_ec_is_refused():
 def test_an_empty_ic_path_is_refused(ics):
     with pytest.raises(ConfigError, match=f"ics must be the path of a Parquet/CSV table, got '{ics}'"):
         Scene(energy=None, n=1, ics=ics)
+
+
+def test_a_region_without_radius_keeps_the_unused_field_and_its_hash():
+    # the well and the square read no radius: their scenes keep the field's old value, hence their hashes
+    well = Scene(energy=1.2, n=10, region="well", system={"name": "contopoulos"})
+    assert well.radius == 0.5 and well.result_hash() == well.replace(radius=0.5).result_hash()
