@@ -126,6 +126,7 @@ def test_survival_inputs_are_read_with_column_projection(tmp_path):
             import shutil
 
             shutil.copy(tmp_path / "lifetimes" / part_name(0), tmp_path / "warm" / "lifetimes")
+            (tmp_path / "warm" / "scene.json").write_text("{}")  # a run written before manifests: read by listing
         t = rng.exponential(1 / 0.15, n_part)
         outcome = np.where(t > t_max, 2, 0).astype(np.int8)
         t = np.minimum(t, t_max)
@@ -133,6 +134,7 @@ def test_survival_inputs_are_read_with_column_projection(tmp_path):
         cols.update(traj_id=np.arange(k * n_part, (k + 1) * n_part), outcome=outcome, t_end=t,
                     exit_channel=np.where(outcome == 0, k % 3, -1))
         write_part(tmp_path / "lifetimes" / part_name(k), to_arrow("lifetimes", cols), {"rows": n_part})
+    (tmp_path / "scene.json").write_text("{}")  # a run written before manifests: read by listing its parts
     res = {}
     for mode in ("lean", "full", "grid"):
         out = subprocess.run([sys.executable, "-c", _READ, str(tmp_path), mode, str(tmp_path / "warm")],
@@ -176,6 +178,7 @@ def test_survival_on_grid_equals_kaplan_meier(tmp_path):
         t_all.append(t)
         obs_all.append(outcome != 2)
     g = np.array([0.0, 0.5, 1.0, 2.0, 3.0, 10.0, 20.0, 49.5, 50.0])
+    (tmp_path / "scene.json").write_text("{}")  # a run written before manifests: read by listing its parts
     got = stream_survival(tmp_path, g)
     ref = survival_curve(np.concatenate(t_all), np.concatenate(obs_all), t_grid=g)
     assert np.allclose(got.P, ref.P, rtol=0, atol=1e-15) and np.allclose(got.P_err, ref.P_err, rtol=1e-12)
