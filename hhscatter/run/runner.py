@@ -72,7 +72,7 @@ from hhscatter.scene.scene import Scene
 
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
 DASK_NO_WORKER_TIMEOUT = 60.0
-#: at most WORKERS_MAX worker processes: each is a process with its own JIT-compiled integrator (≈ 100 MB)
+#: at most WORKERS_MAX worker processes: each is a process with its own JIT-compiled integrator
 WORKERS_MAX = 1024
 
 

@@ -45,8 +45,8 @@ CHUNKS_MAX = 100_000
 #: snapshot rows are held in memory until written
 SNAPSHOTS_MAX = 100_000
 #: t_max ≤ T_MAX_MAX / ω: every orbit still inside at t_max (a trapped or censored one) is integrated all the way,
-#: at a cost ∝ t_max (≈ 10 Taylor steps per unit of ωt); far beyond the paper's 5000 no window of the analyses
-#: reaches, and a value such as 1e300 would never end
+#: at a cost ∝ t_max; 2000 times the paper's 5000, where no window of the analyses reaches, and a value such as
+#: 1e300 would never end
 T_MAX_MAX = 1e7
 #: seed ≤ SEED_MAX: it is stored (scene.json, part metadata) and read back as a 64-bit integer by other tools
 SEED_MAX = 2**63 - 1
