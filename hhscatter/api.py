@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
+from hhscatter.data.params import checked_value, plain_point, same_run
 from hhscatter.data.store import Store
 from hhscatter.data.read import iter_survival_batches, read_lifetimes, read_sections
 
@@ -94,8 +95,13 @@ def split_points(lifetimes):
     The ensembles of a lifetimes frame (module doc): by the ``energy`` and
     ``gamma`` columns when present; otherwise by clusters of ``e0`` (relative
     tolerance 1e-9; the key's energy is the cluster's median e0 to 12
-    significant digits) and ``gamma``. Raises ValueError if the frame is empty
-    or lacks ``t_end``/``outcome``.
+    significant digits) and ``gamma``. A frame of several runs
+    (:func:`hhscatter.read_lifetimes` of a list: a ``run`` column) is split per
+    run too, with keys ``(energy, gamma, run)``: one point per run and grid
+    point, unless the runs were pooled (``read_lifetimes(runs, pool=True)``).
+    Raises ValueError if the frame is empty, lacks ``t_end``/``outcome``, or
+    holds an orbit (``traj_id``) twice in one point (the same run concatenated
+    twice).
     """
     cols = set(lifetimes.columns)
     missing = {"t_end", "outcome"} - cols
@@ -103,6 +109,17 @@ def split_points(lifetimes):
         raise ValueError(f"lifetimes lacks column(s) {sorted(missing)}: pass a frame of hhscatter.read_lifetimes")
     if len(lifetimes) == 0:
         raise ValueError("lifetimes is empty: no orbits to analyse")
+    pooled = ((lifetimes.attrs.get("hhscatter") or {}).get("pooled") is not None)
+    if "run" in cols and not pooled:
+        out = [((*key, str(run)), df) for run, sub in lifetimes.groupby("run", observed=True, sort=False)
+               for key, df in _split_one(sub)]
+        return sorted(out, key=lambda kv: _sort_key(kv[0]))
+    return _split_one(lifetimes)
+
+
+def _split_one(lifetimes):
+    """split_points of the rows of one run (or of runs pooled on purpose); an orbit twice in a point refused."""
+    cols = set(lifetimes.columns)
     n = len(lifetimes)
     gamma = lifetimes["gamma"].to_numpy(dtype=float) if "gamma" in cols else np.zeros(n)
     if "energy" in cols:
@@ -120,15 +137,32 @@ def split_points(lifetimes):
     key_e = np.where(np.isnan(energy), -np.inf, energy)  # NaN sorts and compares as one value
     pairs = np.unique(np.column_stack([key_e, gamma]), axis=0)
     out = []
+    ids = ["run", "traj_id"] if "run" in cols else ["traj_id"]
     for e, g in pairs:
         mask = (key_e == e) & (gamma == g)
-        out.append(((math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]))
+        key, df = (math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]
+        if "traj_id" in cols and df.duplicated(subset=ids).any():
+            raise ValueError(f"lifetimes holds orbits twice at {_label(key)} (traj_id repeated): the same run "
+                             "concatenated twice, or several runs without a run column; read several runs with "
+                             "hhscatter.read_lifetimes([run1, run2, …]), which keeps them apart")
+        out.append((key, df))
     return out
 
 
+def _sort_key(k):
+    """Order of point keys: energy (NaN first), γ, then the run (as given)."""
+    return (float(np.nan_to_num(k[0], nan=-np.inf)), k[1], *(str(x) for x in k[2:]))
+
+
+def _key_columns(key) -> dict:
+    """The columns a point key gives a result row: energy, gamma (and run, for a frame of several runs)."""
+    return {"energy": key[0], "gamma": key[1], **({"run": key[2]} if len(key) > 2 else {})}
+
+
 def _label(key) -> str:
-    e, g = key
-    return f"E0={e:g}, γ={g:g}" if math.isfinite(e) else f"γ={g:g}"
+    e, g = key[0], key[1]
+    head = f"E0={e:g}, γ={g:g}" if math.isfinite(e) else f"γ={g:g}"
+    return f"{head} ({key[2]})" if len(key) > 2 else head
 
 
 # ---------------------------------------------------------------------------
@@ -168,7 +202,7 @@ class SurvivalCurves:
         """curves[(energy, gamma)] -> SurvivalCurve; ``curves[energy]`` if that energy has one point."""
         if key in self.curves:
             return self.curves[key]
-        hits = [k for k in self.curves if not isinstance(key, tuple) and k[0] == key]
+        hits = [k for k in self.curves if (k[0] == key if not isinstance(key, tuple) else k[:len(key)] == key)]
         if len(hits) == 1:
             return self.curves[hits[0]]
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
@@ -177,7 +211,7 @@ class SurvivalCurves:
         """to_frame() -> DataFrame energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        parts = [pd.DataFrame({"energy": k[0], "gamma": k[1], "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
+        parts = [pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
                  for k, c in self.curves.items()]
         return pd.concat(parts, ignore_index=True)
 
@@ -281,9 +315,9 @@ class EscapeRates:
         import pandas as pd  # deferred: pandas loads on first use
 
         rows = []
-        for key in sorted(self.n, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1])):
+        for key in _sorted_keys(self.n):
             r = self.results.get(key)
-            row = {"energy": key[0], "gamma": key[1], "n": self.n[key]}
+            row = {**_key_columns(key), "n": self.n[key]}
             if r is None:
                 row.update(kappa=math.nan, kappa_err=math.nan, kappa_stat=math.nan, kappa_spread=math.nan,
                            tau0=math.nan, t_stop=math.nan, windows=None, kappa_mle=math.nan,
@@ -484,12 +518,15 @@ def plot_escape_rates(rates: EscapeRates | pandas.DataFrame, ax: Axes | None = N
 # more concepts, one function each (per grid point, results with .to_frame() and .plot(ax=))
 # ---------------------------------------------------------------------------
 def _sorted_keys(keys):
-    return sorted(keys, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1]))
+    return sorted(keys, key=_sort_key)
 
 
 def _same_point(a, b) -> bool:
-    """Two (energy, gamma) keys name the same point (energies to 1e-9 relative, NaN equal to NaN)."""
-    (ea, ga), (eb, gb) = a, b
+    """Two (energy, gamma[, run]) keys name the same point (energies to 1e-9 relative, NaN equal to NaN; the
+    runs equal when both keys name one)."""
+    if len(a) > 2 and len(b) > 2 and a[2] != b[2]:
+        return False
+    (ea, ga), (eb, gb) = a[:2], b[:2]
     same_e = (math.isnan(ea) and math.isnan(eb)) or (math.isfinite(ea) and math.isfinite(eb)
                                                      and abs(ea - eb) <= E0_RTOL * max(1.0, abs(ea)))
     return same_e and ga == gb
@@ -559,8 +596,8 @@ class CMeasureRates(_PointRows):
         return ax
 
 
-def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *, window: tuple[float, float],
-                          t_max: float, t_from: float | None = None, t_to: float | None = None,
+def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *,
+                          window: tuple[float, float] | None = None, t_max: float | None = None, t_from: float | None = None, t_to: float | None = None,
                           rec_efolds: float = 2.0, margin: float = 40.0, n_boot: int = 200,
                           seed: int = 0) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
@@ -581,10 +618,11 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     lifetimes, sections : DataFrame
         :func:`hhscatter.read_lifetimes` and :func:`hhscatter.read_sections` of one run (a scene or a grid;
         γ > 0 points get NaN and a note).
-    window : SectionWindow or dict
-        The section window the run recorded (``Scene.sections``).
-    t_max : float
-        The run's ``t_max`` (time units).
+    window : SectionWindow or dict, optional
+        The section window the run recorded (``Scene.sections``). Read from the data (the run's scene.json,
+        which the readers attach); a value passed here that contradicts it raises ValueError.
+    t_max : float, optional
+        The run's ``t_max`` (time units); read from the data like ``window``.
     t_from, t_to : float, optional
         The sampling window (time units). Default per point: t_from = max(window start, ⌈τ0 + rec_efolds/κ⌉)
         with τ0, κ from P(t) of the same point, t_to = t_record_end − ``margin``.
@@ -617,11 +655,16 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     True
     """
 
+    same_run(lifetimes, sections, what="the lifetimes and sections tables")
+    window = checked_value(lifetimes, "sections", _window_dict(window), what="the section window", name="window")
+    t_max = checked_value(lifetimes, "t_max", t_max, what="t_max")
+    if window is None or t_max is None:
+        raise ValueError("pass window= and t_max= of the run (the tables carry no record of their run)")
     window = _checked_cmeasure_window(window)
     t_max = float(t_max)
     t_record_end = min(float(window.get("t_to", math.inf)), t_max)
     lt, sec = lifetimes, sections
-    rates = escape_rates(lt) if any(g == 0 for (_, g), _ in split_points(lt)) else EscapeRates({}, {}, {})
+    rates = escape_rates(lt) if any(k[1] == 0 for k, _ in split_points(lt)) else EscapeRates({}, {}, {})
     keys = [k for k, _ in split_points(lt)]
     sec_by = _split_like(sec, keys, what="sections table")
     rows = {}
@@ -629,6 +672,11 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
         rows[key] = _cmeasure_point_row(key, df, sec_by.get(key, sec.iloc[:0]), rates, window, t_max, t_record_end,
                                         t_from, t_to, rec_efolds, margin, n_boot, seed)
     return CMeasureRates(rows)
+
+
+def _window_dict(window):
+    """A SectionWindow as the dict of its fields (None and dicts as given)."""
+    return dataclasses.asdict(window) if window is not None and dataclasses.is_dataclass(window) else window
 
 
 def _checked_cmeasure_window(window) -> dict:
@@ -654,7 +702,7 @@ def _cmeasure_point_row(key, df, sec, rates, window, t_max, t_record_end, t_from
         kappa_from_cmeasure,
     )
 
-    row = {"energy": key[0], "gamma": key[1], "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
+    row = {**_key_columns(key), "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
            "mu_exit": math.nan, "n_samples": 0, "n_exit": 0, "n_undetermined": 0, "t_from": math.nan,
            "t_to": math.nan, "t_record_end": t_record_end, "kappa_pt": math.nan, "kappa_pt_err": math.nan,
            "note": ""}
@@ -770,13 +818,18 @@ def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
             continue
         t2 = tau2_observed(df)
         iv = tau2_observed_interval(df) if t2 is not None else None
-        row = {"energy": key[0], "gamma": key[1], "n": len(df), "tau0": math.nan, "tau1": math.nan,
+        row = {**_key_columns(key), "n": len(df), "tau0": math.nan, "tau1": math.nan,
                "tau2": math.nan if t2 is None else t2, "tau2_lo": math.nan if iv is None else iv.lo,
                "tau2_hi": math.nan if iv is None else iv.hi, "note": ""}
         rows[key] = row
-        ref = [k for k in rates.results if _same_point(k, (key[0], 0.0))]
+        ref = [k for k in rates.results if _same_point(k[:2], (key[0], 0.0))]
+        ref = [k for k in ref if k[2:] == key[2:]] or ref  # the same run's partner first (a grid run)
         if not ref:
             row["note"] = "no conservative (γ = 0) point at this E0 with a κ fit: τ0 and τ1 need one"
+            continue
+        if len(ref) > 1:
+            row["note"] = (f"{len(ref)} conservative points at this E0 ({', '.join(_label(k) for k in ref)}): "
+                           "τ0 and τ1 need one; read the pair alone")
             continue
         r = rates.results[ref[0]]
         grid = np.asarray(t_grid, dtype=float) if t_grid is not None else np.linspace(
@@ -853,7 +906,10 @@ def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (
     window : (float, float)
         Fit window (time units).
     energy, gamma : float, optional
-        E0 and γ of a plain (non-grid) run, whose snapshots have no ``point_energy``/``point_gamma``.
+        E0 and γ of a plain (non-grid) run, whose snapshots have no ``point_energy``/``point_gamma``: read
+        from the data (the run's scene.json, which :func:`hhscatter.read_snapshots` attaches; else E0 from
+        the snapshots' energy at t = 0). A value passed here that contradicts the data raises ValueError
+        (:func:`hhscatter.data.params.plain_point`).
 
     Returns
     -------
@@ -876,6 +932,7 @@ def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (
     )
 
     curves, fits = {}, {}
+    energy, gamma = plain_point(snapshots, energy, gamma, what="snapshots table")
     for key, df in _split_like(snapshots, None, energy=energy, gamma=gamma, what="snapshots table").items():
         c = mean_energy(df)
         curves[key] = c
