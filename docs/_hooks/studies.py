@@ -31,7 +31,7 @@ import re
 from pathlib import Path
 
 _MARKER = re.compile(r"^<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->\s*$", re.M)
-_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
+_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance", "made_from", "sha256"}
 
 
 # -- number formatting: hhscatter.publish.formatting, shared with the report and the figures ---------------------
