@@ -7,8 +7,6 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
 from hhscatter.api.plotting import plot_escape_rates, plot_survival
 from hhscatter.api.points import _key_columns, _label, _sorted_keys, split_points
