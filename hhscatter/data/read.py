@@ -7,6 +7,11 @@ checksums verified. A missing table or part, a part outside the plan, of another
 :class:`~hhscatter.errors.IncompleteRunError` unless ``allow_partial=True``, which reads the finished chunks of
 every table alike and warns how much is missing. Runs of the legacy grid layout are read with the columns of
 the current one.
+
+A frame returned here carries what it was read from in ``DataFrame.attrs["hhscatter"]`` (:func:`run_identity`:
+the run's scene and hash), where the analysis functions read E0, γ, t_max … (:mod:`hhscatter.data.params`).
+:func:`read_lifetimes` of a list of runs keeps them apart (a ``run`` column: one point per run), refuses the
+same run or scene twice, and pools them only when asked (``pool=True``, checked).
 """
 from __future__ import annotations
 

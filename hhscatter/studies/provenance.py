@@ -19,6 +19,18 @@ reproduction report -- and raises :class:`ProvenanceError` (exit status 2) namin
 
 Raw runs are checked where they are (a study's own out/ folder); the committed copies of the results in
 docs/studies/assets/ have none, and are checked for everything else.
+
+Example
+-------
+>>> config = {"study": {"fit_window": [0.0, 200.0]}}
+>>> doc = sealed({"mu": {"value": 0.9287, "err": 0.001}, "config": config,
+...               "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}})
+>>> verify_numbers(Path("fig3.json"), doc, config=config, scale="quick", upstream={})   # as written: passes
+>>> doc["mu"]["value"] = 0.91                                                            # edited by hand
+>>> verify_numbers(Path("fig3.json"), doc, config=config, scale="quick", upstream={})
+Traceback (most recent call last):
+...
+hhscatter.studies.provenance.ProvenanceError: fig3.json was edited after it was written: its content hash is ...
 """
 from __future__ import annotations
 
@@ -29,7 +41,7 @@ from pathlib import Path
 from hhscatter.errors import StudyError
 from hhscatter.studies.jsonio import _jsonable
 
-__all__ = ["ProvenanceError", "config_sha256", "content_sha256", "made_from", "verify_numbers"]
+__all__ = ["ProvenanceError", "config_sha256", "content_sha256", "made_from", "sealed", "verify_numbers"]
 
 SELF_KEY = "sha256"
 MADE_FROM = "made_from"
