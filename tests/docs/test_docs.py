@@ -363,3 +363,15 @@ def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(
 def test_an_indented_marker_is_rendered_indented(tmp_path, hook):
     out, _ = _page(tmp_path, hook, '??? note "x"\n\n    <!-- hh:verdict-rule -->\n')
     assert "\n    !!! info" in out and "both uncertainties" in out
+
+
+def test_the_outcomes_and_the_study_list_come_from_the_code(tmp_path, hook):
+    import hhscatter.outcomes as oc
+    from hhscatter.studies.graph import studies
+
+    out = hook.Renderer(ROOT, DOCS, DOCS / "concepts").outcomes()
+    assert [line.split("`")[1] for line in out.splitlines()] == list(oc.OUTCOMES)
+    assert "- `stopped`: stopped early" in out and "(censors the lifetime)" in out
+    names = hook.Renderer(ROOT, DOCS, DOCS).study_names()
+    assert all(f"[{s.name}](studies/{s.name}.md)" in names for s in studies(ROOT / "studies"))
+    assert f"builds {len(studies(ROOT / 'studies'))} studies" in names
