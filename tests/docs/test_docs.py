@@ -310,7 +310,11 @@ def test_citation_and_licence_agree_with_pyproject():
     paper = cff["references"][0]
     assert paper["title"] == "Probabilistic description of dissipative chaotic scattering"
     assert [a["family-names"] for a in paper["authors"]] == ["Burton", "Dullin", "Altmann"]
-    assert "doi" not in paper  # none is known: the manuscript names none (add it when published)
+    assert "doi" not in paper  # none is known (add it when published)
+    assert {"type": "other", "value": "arXiv:2308.13555"}.items() <= paper["identifiers"][0].items()
+    assert paper["url"] == "https://arxiv.org/abs/2308.13555" and paper["year"] == 2023
+    for where in ("README.md", "docs/index.md"):  # the paper by its arXiv id wherever it is cited first
+        assert "arXiv:2308.13555" in (ROOT / where).read_text() and ".tex" not in (ROOT / where).read_text()
     assert (ROOT / "LICENSE").read_text().startswith("MIT License")
 
 
