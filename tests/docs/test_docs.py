@@ -331,6 +331,8 @@ def test_every_library_module_has_an_api_page():
             continue  # private modules; the benchmarks and the CLI have their own pages (benchmarks, cli.md)
         if parts[-1] == "__init__":
             parts = parts[:-1]
+        if parts[:2] == ["hhscatter", "api"] and "hhscatter.api" in documented:
+            continue  # the notebook API's modules: its page shows every public name of the package
         if len(parts) > 1 and ".".join(parts) not in documented and ".".join(parts) != "hhscatter.analysis":
             missing.append(".".join(parts))
     assert not missing, f"modules without an API page (docs/api/...md with '::: module'): {missing}"
