@@ -165,7 +165,7 @@ docs: $(DOCS_STAMP) ## build the documentation site into site/ (mkdocs --strict:
 docs-serve: $(DOCS_STAMP) ## serve the docs with live reload at http://127.0.0.1:8000
 	$(MKDOCS) serve --strict
 
-tutorial: $(DOCS_STAMP) ## re-execute docs/tutorial.ipynb (~20 s) and store its outputs, which the docs page shows
+tutorial: $(DOCS_STAMP) ## re-execute docs/tutorial.ipynb (about 2 min on 2 cores) and store its outputs, which the docs page shows
 	$(PY) tools/execute_notebook.py docs/tutorial.ipynb
 
 docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with the bench summaries) into docs/

@@ -59,6 +59,7 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "break energy" in paper_part and "returns at r_esc" not in paper_part
     assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
     assert "3 numbers: 2 agree, 1 differ" in paper_part
+    assert "arXiv:2308.13555" in md.split("##")[0] and "both uncertainties" in md.split("##")[0]  # the header
     assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs (z = +3.6)</span>' in page  # the one rule: 0.04/√(0.01² + 0.005²)
     assert page.count("data:image/png;base64,") == 2  # rep2 and rescx; rep3 has numbers but no figure
     assert set(res["missing"]) == {"rep1", "rep3"}  # the study folders of the root without figure or numbers
