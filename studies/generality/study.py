@@ -108,6 +108,26 @@ class Params(StudyParams):
     c5_offsets: Integer = 2
     c5_boot: Integer = 100
     c5_level: Number = 0.95
+    # the evidence behind the claims' readings (rules in study.toml): which parts a scale runs
+    parts: list[OneOf("claims", "evidence")] = ["claims", "evidence"]
+    ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.9, 2.6, 3.5]
+    ev_ics: list[OneOf(*REGIONS)] = ["disk", "well"]   # disk: radius_frac·r_s, tangential; others: alt_momentum
+    ev_n: Integer = 2000
+    ev_t_max: Number = 2000.0
+    ev_window: Number = 100.0     # the indicator compares first crossings after ev_t_max − ev_window
+    ev_delta: Number = 1e-9
+    ev_g_max: Number = 1e4
+    ev_times: Numbers = [100.0, 200.0, 400.0, 800.0, 2000.0]
+    ev_fit_t0: Number = 100.0
+    ev_hazard_edges: Numbers = [100.0, 200.0, 400.0, 800.0, 1400.0, 2000.0]
+    ps_ratios: Numbers = [1.05, 1.5]
+    ps_n: Integer = 150
+    ps_t_max: Number = 1000.0
+    resc_values: Numbers = [1.03]   # r_esc sensitivity: these beside the default, for systems where they are valid
+    resc_ratios: Numbers = [1.2, 1.5, 1.8, 1.9, 2.6]
+    resc_n: Integer = 2000
+    resc_probe_n: Integer = 1000
+    resc_diss_n: Integer = 4000
 
 
 # κ conventions: all orbits with the data-driven plateau windows (fig2's) or P-level windows (both ill-defined where
@@ -188,6 +208,11 @@ def _check(study):
     c5 = study.params.c5_ratio
     if not np.isclose(study.params.cm_ratios, c5).any() or not 1 < c5 < study.params.e0_ratio:
         raise ValueError(f"[study].c5_ratio = {c5} must be one of cm_ratios and between 1 and e0_ratio")
+    p = study.params
+    if max(p.ev_times) > p.ev_t_max or not 0 < p.ev_window < min(p.ev_t_max, p.ps_t_max):
+        raise ValueError("[study].ev_times must be ≤ ev_t_max and ev_window inside (0, min(ev_t_max, ps_t_max))")
+    if not np.isclose(p.resc_ratios, p.e0_ratio).any():
+        raise ValueError(f"[study].resc_ratios must contain e0_ratio = {p.e0_ratio:g} (2⟨K⟩/E measured at E0)")
     if not study.params.cm_t_max > study.params.cm_t_to:
         raise ValueError("[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max are dropped as KAM-trapped)")
 
@@ -201,6 +226,10 @@ def simulate(study, workers=None, progress=True):
 
     _check(study)
     p = study.params
+    if "evidence" in p.parts:
+        _simulate_evidence(study, workers, progress)
+    if "claims" not in p.parts:
+        return
     probe_times = tuple(np.round(np.arange(0.0, p.probe_t_max + 1e-9, p.probe_step), 9))
     grid = tuple(snapshot_grid(p.snapshot_grid))
     for label, spec, m in _systems(study):
@@ -357,7 +386,7 @@ def _across(per: dict, key: str):
 # ---------------------------------------------------------------------------
 # analyze: claim 3, μ
 # ---------------------------------------------------------------------------
-def _mu_conservative(study, label, m, fits):
+def _mu_conservative(study, label, m, fits, keys=None):
     """2⟨K⟩/E of the conservative flow per probe ratio (c-measure: trapped orbits dropped; all survivors beside)
     and the microcanonical value of the well below E_c."""
     from hhscatter.analysis.dissipative.kinetic import (
@@ -370,11 +399,12 @@ def _mu_conservative(study, label, m, fits):
 
     p = study.params
     rows = []
-    for r in p.probe_ratios:
+    keys = keys or {r: probe_key(label, r) for r in p.probe_ratios}
+    for r, key in keys.items():
         # κ, τ0 of the escaping orbits of the κ0(E) run at r: defined even where a trapped plateau is not
         res = fits.get(("escaping", min((k[1] for k in fits if isinstance(k, tuple)), key=lambda x: abs(x - r),
                                         default=math.nan)))
-        raw = study.raw(probe_key(label, r))
+        raw = study.raw(key)
         t0, t1, relaxed = _probe_window(res, p)
         if t0 is None:
             rows.append({"system": label, "ratio": r, "kind": "c-measure", "mu": math.nan, "mu_err": math.nan,
@@ -421,7 +451,7 @@ def _mu_of_E(mu_rows: pd.DataFrame, ec: float, shift: float = 0.0, kind: str = "
     return lambda E: np.interp(np.asarray(E) / ec, r, v)
 
 
-def _mu_measured(study, label, m, E0):
+def _mu_measured(study, label, m, E0, key=None, n=None):
     """fig3's μ: ⟨E⟩(t) of the orbits not escaped (settled continued), log fit on each window of
     :func:`_mu_windows` (all orbits, streamed part by part); bootstrap error over orbits, as fig3 on the orbits
     traj_id < n_boot_orbits with the errors scaled by √(K/N) (the snapshot table of 10⁶ sticky orbits is
@@ -437,12 +467,13 @@ def _mu_measured(study, label, m, E0):
     from hhscatter.data.read import iter_parts, read_snapshots
 
     p = study.params
-    raw = study.raw(diss_key(label, p.mu_gamma))
+    raw = study.raw(key or diss_key(label, p.mu_gamma))
+    n = n or p.diss_n
     ime = inside_mean_energy(iter_parts(raw, "snapshots", ["t", "energy"]), m.critical_energy)
     wins = _mu_windows(study)
-    k = min(p.n_boot_orbits, p.diss_n)
+    k = min(p.n_boot_orbits, n)
     rows = read_snapshots(raw, columns=["traj_id", "t", "energy"], filters=pads.field("traj_id") < k)
-    b, scale = bootstrap_mu_first_orbits(rows, p.diss_n, k, E0, p.mu_gamma, list(wins.values()),
+    b, scale = bootstrap_mu_first_orbits(rows, n, k, E0, p.mu_gamma, list(wins.values()),
                                          n_boot=p.n_boot, seed=p.fit_seed)
     out = {}
     for name, w in wins.items():
@@ -1006,10 +1037,31 @@ def _analyze_mu(study, claims, label, spec, m, E0, fits):
 
 
 def analyze(study):
-    """analyze(study) -> None: claims 1–7 per system (5 as Fig. 5's distance and as a moment); derived tables and
-    generality.json."""
+    """analyze(study) -> None: claims 1–7 per system (5 as Fig. 5's distance and as a moment) and the evidence
+    (regular fraction, long-time escape, validity map, r_esc), per ``[study] parts``; derived tables and
+    generality.json. Evidence alone is merged into the generality.json already in the output folder (its claims
+    kept; its evidence keys replaced), so the evidence can be added to a record whose claim runs are elsewhere."""
+    from hhscatter.studies.jsonio import write_json_atomic
 
     _check(study)
+    p = study.params
+    if "claims" in p.parts:
+        numbers = _analyze_claims(study)
+    else:
+        numbers = study.read_numbers() if study.numbers_path.exists() else {}
+    if "evidence" in p.parts:
+        ev = _analyze_evidence(study, numbers)
+        if "claims" not in p.parts and numbers:  # merge: the claims' record kept, with its scale and provenance
+            numbers.update(ev, evidence_record={"scale": study.scale, "config": study.config,
+                                                "raw_runs": dict(study.raw_runs)})
+            write_json_atomic(study.numbers_path, numbers)
+            return
+        numbers.update(ev)
+    study.write_numbers(numbers)
+
+
+def _analyze_claims(study) -> dict:
+    """Claims 1–7 per system: the derived tables and the claims' part of generality.json (returned)."""
     p = study.params
     claims = _Claims(study)
     kappa_rows, mu_rows, tau_tables, curves, hazards, systems, rms_ref = [], [], [], [], [], {}, {}
@@ -1059,7 +1111,7 @@ def analyze(study):
     if hazards:
         study.write_table(pd.concat(hazards, ignore_index=True), "hazard.parquet",
                           description="claim 7: escape hazard of the smallest γ per time bin, κ0 at E0 e^(−μγt)")
-    study.write_numbers({
+    return {
         "rules": {
             "energies": "E = r·E_c on the grid ratios, the same for every system",
             "ics": "uniform in the disk r < radius_frac·r_s, tangential momenta; r_esc the system's default",
@@ -1077,7 +1129,212 @@ def analyze(study):
         "systems": systems,
         "claims": claims.rows,
         "kappa": ktab.replace({np.nan: None}).to_dict(orient="records"),
-    })
+    }
+
+
+# ---------------------------------------------------------------------------
+# evidence: regular orbits (shadow indicator), long-time escape, r_esc sensitivity
+# ---------------------------------------------------------------------------
+def ev_key(label: str, ics: str, r: float) -> str:
+    """ev_key('barbanis', 'disk', 1.5) -> 'barbanis_ev_disk_r1.500': the long conservative run (indicator window)."""
+    return f"{label}_ev_{ics}_r{r:.3f}"
+
+
+def ps_key(label: str, r: float) -> str:
+    """ps_key(label, r) -> '<label>_ps_r<r>': the run recording every section crossing (Poincaré sections)."""
+    return f"{label}_ps_r{r:.3f}"
+
+
+def resc_key(label: str, r_esc, kind: str) -> str:
+    """resc_key('henon_heiles', 1.03, 'probe_r1.800') -> 'henon_heiles_resc1.03_probe_r1.800' (None: the default)."""
+    return f"{label}_resc{'default' if r_esc is None else f'{r_esc:g}'}_{kind}"
+
+
+def _ics_kw(p, ics: str, radius: float) -> dict:
+    return {"radius": radius} if ics == "disk" else {"region": ics, "momentum": p.alt_momentum}
+
+
+def _ics_name(p, ics: str) -> str:
+    return "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"
+
+
+def _run_pair(study, key, spec, m, t_from, workers, progress, **kw):
+    """The base run ``key`` and the shadow run ``key_shadow`` of its orbits still inside at ``t_from`` (same energy
+    shell, x + ev_delta; the same r_esc, t_max and section window)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from hhscatter.analysis.geometry.regularity import shadow_ics
+    from hhscatter.data.read import read_lifetimes
+
+    sc = study.scene(key, system=spec, **kw)
+    study.run(key, sc, workers=workers, progress=progress)
+    lt = read_lifetimes(study.raw(key), columns=["traj_id", "x0", "y0", "px0", "py0", "t_end"])
+    alive = lt[lt["t_end"] > t_from]
+    if alive.empty:
+        return
+    states, d0 = shadow_ics(alive[["x0", "y0", "px0", "py0"]].to_numpy(), m.potential, study.params.ev_delta)
+    path = study.derived(f"{key}_shadow_ics.parquet")
+    cols = {"traj_id": alive["traj_id"].to_numpy(), **dict(zip(("x", "y", "px", "py"), states.T)), "d0": d0}
+    pq.write_table(pa.table(cols), path)
+    sh = study.scene(key + "_shadow", system=spec, ics=str(path), n=len(alive), t_max=sc.t_max, r_esc=sc.r_esc,
+                     sections=kw["sections"])
+    study.run(key + "_shadow", sh, workers=workers, progress=progress)
+
+
+def _resc_values(p, m):
+    """[None (the default), *resc_values valid for this system (beyond its saddle distance, not its default)]."""
+    return [None, *(R for R in p.resc_values if R > m.saddle_radius and R != m.default_escape_radius(p.e0_ratio
+                                                                                                    * m.critical_energy))]
+
+
+def _simulate_evidence(study, workers, progress):
+    p = study.params
+    t_from = p.ev_t_max - p.ev_window
+    sysl = _systems(study)
+    for ics in p.ev_ics:  # the disk ICs of every system first: the record's core
+        for label, spec, m in sysl:
+            ec, radius = m.critical_energy, p.radius_frac * m.saddle_radius
+            for r in p.ev_ratios:
+                _run_pair(study, ev_key(label, ics, r), spec, m, t_from, workers, progress, energy=r * ec, n=p.ev_n,
+                          t_max=p.ev_t_max, sections={"t_from": t_from, "t_to": p.ev_t_max}, **_ics_kw(p, ics, radius))
+        if ics != p.ev_ics[0]:
+            continue
+        for label, spec, m in sysl:
+            _simulate_resc(study, label, spec, m, workers, progress)
+        for label, spec, m in sysl:
+            for r in p.ps_ratios:
+                _run_pair(study, ps_key(label, r), spec, m, p.ps_t_max - p.ev_window, workers, progress,
+                          energy=r * m.critical_energy, n=p.ps_n, t_max=p.ps_t_max,
+                          sections={"t_from": 0.0, "t_to": p.ps_t_max}, radius=p.radius_frac * m.saddle_radius)
+
+
+def _simulate_resc(study, label, spec, m, workers, progress):
+    """κ0 (windows), probe and dissipative runs at every r_esc of :func:`_resc_values` (none with one value)."""
+    from hhscatter.analysis.dissipative.decay import snapshot_grid
+
+    p = study.params
+    ec, radius = m.critical_energy, p.radius_frac * m.saddle_radius
+    probe_times = tuple(np.round(np.arange(0.0, p.probe_t_max + 1e-9, p.probe_step), 9))
+    values = _resc_values(p, m)
+    for R in values if len(values) > 1 else ():
+        for r in p.resc_ratios:
+            key = resc_key(label, R, f"r{r:.3f}")
+            study.run(key, study.scene(key, system=spec, energy=r * ec, n=p.resc_n, radius=radius, r_esc=R),
+                      workers=workers, progress=progress)
+            key = resc_key(label, R, f"probe_r{r:.3f}")
+            sc = study.scene(key, system=spec, energy=r * ec, n=p.resc_probe_n, radius=radius, r_esc=R,
+                             gamma=p.probe_gamma, t_max=p.probe_t_max, snapshots=probe_times)
+            study.run(key, sc, workers=workers, progress=progress)
+        key = resc_key(label, R, f"g{p.mu_gamma:g}")
+        sc = study.scene(key, system=spec, energy=p.e0_ratio * ec, n=p.resc_diss_n, radius=radius, r_esc=R,
+                         gamma=p.mu_gamma, t_max=p.diss_t_max, snapshots=tuple(snapshot_grid(p.snapshot_grid)),
+                         continue_settled=True)
+        study.run(key, sc, workers=workers, progress=progress)
+
+
+def _indicator(study, key, t_from):
+    """(lifetimes, shadow indicator frame) of the pair ``key`` / ``key_shadow``."""
+    import pyarrow.dataset as pads
+    import pyarrow.parquet as pq
+
+    from hhscatter.analysis.geometry.regularity import shadow_indicator
+    from hhscatter.data.read import read_lifetimes, read_sections
+
+    lt = _lifetimes(study.raw(key))
+    shp = study.derived(f"{key}_shadow_ics.parquet")
+    if not shp.exists():
+        return lt, pd.DataFrame({"traj_id": [], "regular": [], "kind": []})
+    ics = pq.read_table(shp).to_pandas()
+    flt = pads.field("t") >= t_from
+    ind = shadow_indicator(read_sections(study.raw(key), filters=flt), read_sections(study.raw(key + "_shadow"),
+                           filters=flt), ics["traj_id"], ics["d0"], t_from, g_max=study.params.ev_g_max)
+    return lt, ind
+
+
+def _analyze_evidence(study, numbers: dict) -> dict:
+    """The evidence keys of generality.json: regular_fraction, survival_long, long_time, validity_map, resc."""
+    from hhscatter.analysis.claims.evidence import (
+        first_below,
+        long_time_record,
+        regular_record,
+        validity_map,
+    )
+    from hhscatter.analysis.geometry.regularity import INDICATOR
+    from hhscatter.data.read import read_sections
+
+    p = study.params
+    reg, surv, fits, points = [], [], [], []
+    t_from = p.ev_t_max - p.ev_window
+    for label, spec, m in _systems(study):
+        head = {"system": spec["name"], "label": label}
+        for ics in p.ev_ics:
+            for r in p.ev_ratios:
+                lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
+                at = {**head, "e_ratio": r, "ics": _ics_name(p, ics)}
+                reg.append({**at, **regular_record(lt, ind), "indicator": INDICATOR, "t_from": t_from,
+                            "g_max": p.ev_g_max, "delta": p.ev_delta})
+                rows, fit = long_time_record(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times,
+                                             p.ev_fit_t0, p.ev_hazard_edges)
+                surv += [{**at, **row} for row in rows] if ics == "disk" else []
+                fits.append({**at, **fit})
+        for r in p.ps_ratios:
+            lt, ind = _indicator(study, ps_key(label, r), p.ps_t_max - p.ev_window)
+            sec = read_sections(study.raw(ps_key(label, r)), columns=["traj_id", "t", "x", "y", "px", "py"])
+            kind = sec["traj_id"].map(ind.set_index("traj_id")["kind"]).fillna("escaped")
+            points.append(sec.assign(system=label, e_ratio=r, kind=kind.astype(str)))
+    if points:
+        study.write_table(pd.concat(points, ignore_index=True), "sections_regular.parquet",
+                          description="section crossings of the Poincaré runs with each orbit's indicator verdict")
+    study.write_table(pd.DataFrame(fits).drop(columns=["hazard_nonregular"]), "long_time.parquet",
+                      description="plateau-plus-exponential fits and the non-regular orbits' decay per system, E/E_c, ICs")
+    vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics=_ics_name(p, "disk"))
+    return {"regular_fraction": reg, "survival_long": surv, "long_time": fits, "validity_map": vmap,
+            "regular_below_1pc": first_below(reg, 0.01, ics=_ics_name(p, "disk")), "resc": _analyze_resc(study)}
+
+
+def _analyze_resc(study) -> list:
+    """μ measured, μ predicted (c-measure), the survivors' own-⟨K⟩ μ and 2⟨K⟩/E at E0 itself, per r_esc (the
+    default and resc_values), the same N and rules for each: the r_esc sensitivity of claims 3 and 5."""
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+
+    p = study.params
+    out = []
+    for label, spec, m in _systems(study):
+        Rs = _resc_values(p, m)
+        if len(Rs) < 2:
+            continue
+        ec = m.critical_energy
+        E0 = p.e0_ratio * ec
+        for R in Rs:
+            fits = {}
+            for r in p.resc_ratios:
+                lt = _lifetimes(study.raw(resc_key(label, R, f"r{r:.3f}")))
+                try:
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        fits["escaping", r] = escape_rate_from_lifetimes(lt[lt["outcome"] != "censored"],
+                                                                         detect_tail=False,
+                                                                         min_survivors=p.min_survivors)
+                except (ValueError, RuntimeError):
+                    pass
+            keys = {r: resc_key(label, R, f"probe_r{r:.3f}") for r in p.resc_ratios}
+            mdf = pd.DataFrame(_mu_conservative(study, label, m, fits, keys=keys))
+            meas, _, (own, _) = _mu_measured(study, label, m, E0, key=resc_key(label, R, f"g{p.mu_gamma:g}"),
+                                             n=p.resc_diss_n)
+            pred, _, _ = _mu_predicted(study, mdf, ec, E0)
+            c = mdf[(mdf["kind"] == "c-measure") & np.isclose(mdf["ratio"], p.e0_ratio)]
+            r_esc = float(m.default_escape_radius(E0)) if R is None else float(R)
+            for wname, w in _mu_windows(study).items():
+                (v, e), (pv, pe) = own[wname], pred["c-measure", wname]
+                out.append({"system": spec["name"], "label": label, "r_esc": r_esc, "default": R is None,
+                            "window": list(w), "mu_measured": _ve(*meas[wname]), "mu_predicted": _ve(pv, pe),
+                            "mu_own_K": _ve(v, e), "moment_test": _ve(v - pv, math.hypot(e, pe)),
+                            "kinetic_at_E0": _ve(*(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))),
+                            "kinetic_at_E0_interpolated_without_E0": float(_mu_of_E(
+                                mdf[~np.isclose(mdf["ratio"], p.e0_ratio)], ec)(E0)),
+                            "n_diss": p.resc_diss_n, "n_probe": p.resc_probe_n})
+    return out
 
 
 def plot(study):

@@ -106,7 +106,7 @@ def shadow_indicator(base_sections: pd.DataFrame, shadow_sections: pd.DataFrame,
     g_max : float
         Separation growth below which an orbit is regular.
     """
-    from hhscatter.analysis.geometry.distance import first_crossings
+    from hhscatter.analysis.geometry.distance import first_crossings  # deferred: pandas loads on first use
 
     cols = ["traj_id", "t", "x", "y", "px", "py"]
     ids = np.asarray(traj_ids, dtype=np.int64)

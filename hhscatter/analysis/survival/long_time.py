@@ -167,7 +167,7 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
 
 
 def _km_at(t, obs, t0) -> float:
-    from hhscatter.analysis.survival.kaplan_meier import survival_on_grid
+    from hhscatter.analysis.survival.kaplan_meier import survival_on_grid  # deferred: kept off import time
 
     return float(survival_on_grid(t, obs, np.array([t0]))[0])
 
@@ -201,7 +201,7 @@ def survival_at(t_end, observed, times) -> tuple[np.ndarray, np.ndarray]:
     >>> P.tolist()
     [0.75, 0.5]
     """
-    from hhscatter.analysis.survival.kaplan_meier import survival_curve
+    from hhscatter.analysis.survival.kaplan_meier import survival_curve  # deferred: kept off import time
 
     c = survival_curve(np.asarray(t_end, float), np.asarray(observed, bool), t_grid=np.asarray(times, float))
     return np.asarray(c.P, float), np.asarray(c.P_err, float)
@@ -215,6 +215,91 @@ def hazard_profile(t_end, escaped, edges):
     >>> h["events"].tolist()
     [2.0, 0.0]
     """
-    from hhscatter.analysis.dissipative.effective_rate import binned_hazard
+    from hhscatter.analysis.dissipative.effective_rate import binned_hazard  # deferred: pandas loads on first use
 
     return binned_hazard(np.asarray(t_end, float), np.asarray(escaped, bool), np.asarray(edges, float))
+
+
+@dataclass(frozen=True)
+class RateStatus:
+    """Result of :func:`rate_status`: whether a window κ is the rate of the population.
+
+    Attributes
+    ----------
+    status : str
+        'exponential' (one exponential from τ0 on, with the orbits still inside at t_max a negligible share),
+        'trapped' (orbits still inside at t_max are more than ``max_bias`` of P at the window end: the window
+        measures the plateau), or 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``).
+    trapped_fraction : float
+        Orbits still inside at the end (censored), of all.
+    p_inf, p_inf_err, kappa_inf, kappa_inf_err : float
+        The plateau-plus-exponential fit from τ0 (:func:`fit_plateau_exponential`); NaN where it fails.
+    p_value : float
+        Of one exponential from τ0 (Pearson χ², :class:`PlateauFit`); NaN where undefined.
+    note : str
+        Empty for 'exponential'; otherwise what the κ is and what to read instead.
+    """
+
+    status: str
+    trapped_fraction: float
+    p_inf: float
+    p_inf_err: float
+    kappa_inf: float
+    kappa_inf_err: float
+    p_value: float
+    note: str
+
+
+def rate_status(t_end, observed, tau0: float, t_stop: float, *, max_bias: float = 0.1,
+                p_reject: float = 1e-3) -> RateStatus:
+    """rate_status(t_end, observed, tau0, t_stop, max_bias=0.1, p_reject=1e-3) -> RateStatus.
+
+    Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' when
+    the orbits still inside at t_max are more than ``max_bias`` of P(t_stop)
+    (:func:`hhscatter.analysis.survival.kappa_conventions.plateau_check`), 'non-exponential' when one exponential
+    from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), else 'exponential'. With a plateau,
+    the note gives P∞ and κ∞ of the plateau-plus-exponential fit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(2)
+    >>> t = np.where(rng.random(5000) < 0.5, np.inf, rng.exponential(100.0, 5000))
+    >>> rate_status(np.minimum(t, 800.0), t < 800.0, 10.0, 700.0).status
+    'trapped'
+    >>> t = rng.exponential(10.0, 5000)
+    >>> rate_status(np.minimum(t, 800.0), t < 800.0, 1.0, 60.0).status
+    'exponential'
+    """
+    from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
+
+    from hhscatter.analysis.survival.kappa_conventions import plateau_check  # deferred: kept off import time
+
+    t = np.asarray(t_end, dtype=float).ravel()
+    obs = np.asarray(observed, dtype=bool).ravel()
+    f_inf = float((~obs).mean()) if obs.size else math.nan
+    P_end = _km_at(t, obs, t_stop)
+    defined, bias, _ = plateau_check(P_end, f_inf, max_bias)
+    nan = math.nan
+    try:
+        pf = fit_plateau_exponential(t, obs, tau0)
+        plat = (pf.p_inf, pf.p_inf_err, pf.kappa, pf.kappa_err)
+    except ValueError:
+        plat = (nan, nan, nan, nan)
+    try:
+        single = fit_plateau_exponential(t, obs, tau0, plateau=False)
+        p = float(chi2_dist.sf(single.chi2, single.dof)) if single.dof > 0 else nan
+    except ValueError:
+        p = nan
+    if not defined:
+        status = "trapped"
+        note = (f"not a rate of the whole population: {f_inf:.1%} of the orbits are still inside at t_max, "
+                f"{bias:.0%} of P at the window end; the window's κ is the plateau's. Plateau-plus-exponential "
+                f"from τ0: P∞ = {plat[0]:.3g} ± {plat[1]:.2g}, κ∞ = {plat[2]:.3g} ± {plat[3]:.2g} (escaping part)")
+    elif math.isfinite(p) and p < p_reject:
+        status = "non-exponential"
+        note = (f"P(t) is not one exponential from τ0 = {tau0:.3g} (censoring-aware fit rejected, p = {p:.1e}); "
+                "κ is an average over a hazard that changes with time")
+    else:
+        status, note = "exponential", ""
+    return RateStatus(status, f_inf, *plat, p, note)

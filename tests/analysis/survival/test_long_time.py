@@ -58,3 +58,27 @@ def test_hazard_profile_is_flat_for_an_exponential():
 def test_too_few_orbits_refused():
     with pytest.raises(ValueError, match="too few"):
         fit_plateau_exponential([1.0, 2.0], [True, True], 0.0)
+
+
+def test_rate_status_flags_a_plateau_with_its_p_inf():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    t, obs = _sample(20000, 0.4, 0.005, 800.0, 8)
+    s = rate_status(t, obs, 50.0, 700.0)
+    assert s.status == "trapped" and "P∞" in s.note and abs(s.p_inf - 0.4) < 4 * s.p_inf_err
+
+
+def test_rate_status_flags_a_falling_hazard_as_non_exponential():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    rng = np.random.default_rng(9)
+    t = np.concatenate([rng.exponential(10.0, 10000), rng.exponential(100.0, 10000)])  # two rates: not one
+    s = rate_status(np.minimum(t, 3000.0), t < 3000.0, 5.0, 400.0)
+    assert s.status == "non-exponential" and s.note
+
+
+def test_rate_status_passes_one_exponential():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    t, obs = _sample(20000, 0.0, 0.05, 400.0, 10)
+    assert rate_status(t, obs, 5.0, 150.0).status == "exponential"
