@@ -50,7 +50,9 @@ def regular_record(lifetimes, indicator) -> dict:
     the window: not regular. ``n_none``: inside at the window's start but crossing the section in neither run
     (their type undetermined; counted as not regular, and said).
     """
-    from hhscatter.analysis.geometry.regularity import regular_fraction  # deferred: pandas loads on first use
+    from hhscatter.analysis.geometry.regularity import (
+        regular_fraction,  # deferred: pandas loads on first use
+    )
 
     n = len(lifetimes)
     n_reg = int(indicator["regular"].sum())
