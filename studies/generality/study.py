@@ -1,32 +1,23 @@
-"""Study generality — the paper's claims tested on three open systems (issue 24; beyond the paper).
+"""Study generality — the paper's claims tested on three open systems (beyond the paper).
 
-The paper concludes with "a generally-applicable model for the study of dissipative chaotic scattering",
-tested on Hénon–Heiles only. This study runs the same chain, the system a parameter of every stage
-(``[study] systems``, issue 23's built-ins), at energies placed alike relative to each threshold
-(E = r·E_c on one grid of r), with ICs alike (disk r < radius_frac·r_s, tangential momenta) and linear drag.
-Rules in the header of ``studies/generality/study.toml``.
+The paper concludes with "a generally-applicable model for the study of dissipative chaotic scattering", tested on
+Hénon–Heiles only. This study runs the same chain, the system a parameter of every stage (``[study] systems``), at
+energies placed alike relative to each threshold (E = r·E_c), ICs alike (disk r < radius_frac·r_s, tangential
+momenta), linear drag. Rules in the header of ``studies/generality/study.toml``; the science in
+:mod:`hhscatter.analysis.claims` (this module runs and reads, the library analyses).
 
-Stages (``hhscatter study generality simulate|analyze|plot [--scale S]``):
+``simulate`` — ``[study] parts``: "claims": per system the κ0(E) runs ``<label>_r<r>``, the probe runs
+``<label>_probe_r<r>``, the dissipative runs ``<label>_g<γ>`` at E0, the section runs ``<label>_cm_r<r>`` and
+``<label>_sec_g<γ>``; "evidence": the long runs ``<label>_ev_<ics>_r<r>`` and Poincaré runs ``<label>_ps_r<r>``,
+each with the shadow run of its orbits still inside near t_max (``…_shadow``), and the r_esc runs
+``<label>_resc<R>_…``.
 
-``simulate(study, workers=None, progress=True)``
-    per system (raw keys prefixed with its label): the κ0(E) runs ``<label>_r<r>`` (γ = 0, ``grid_n`` orbits);
-    the probe runs ``<label>_probe_r<r>`` (γ = probe_gamma, energies every probe_step: the conservative flow's
-    kinetic energy); the dissipative runs ``<label>_g<γ>`` at E0 = e0_ratio·E_c, the same ICs for every γ,
-    the γ = mu_gamma run with snapshots and settled orbits continued (⟨E⟩(t)); the section-recording conservative
-    runs ``<label>_cm_r<r>`` at cm_ratios and e0_ratio (every crossing of ṙ = 0, φ̇ > 0 in [0, cm_t_to]: claims 2
-    and 5) and the dissipative run ``<label>_sec_g<mu_gamma>`` recording the crossings around t* (claim 5).
+``analyze`` — claims 1–7 (records {claim, quantity, system, value, err, verdict, note}) and the evidence
+(regular_fraction, survival_long, long_time, validity_map, resc) in ``generality.json``; evidence alone merges
+into the generality.json already in the output folder.
 
-``analyze(study)``
-    Claim 1 (κ0(E) law per system, two window conventions), claim 2 (κ from the c-measure,
-    Eq. (eqn:kappa_cmeasure_truetime), :mod:`hhscatter.analysis.survival.cmeasure`), claim 3 (μ measured, μ
-    predicted from the conservative system, :mod:`hhscatter.analysis.dissipative.kinetic`), claim 4 (τ0, τ1, τ2
-    against γ and Eq. (eq:tau2)), claim 5 (Fig. 5's paired distance,
-    :func:`hhscatter.analysis.geometry.distance.paired_hellinger_replicates`, and a moment test), claims 6 and 7;
-    derived tables and ``generality.json`` with the list ``claims`` of records
-    {claim, quantity, system, value, err, verdict, note}.
-
-``plot(study)``
-    ``generality.png`` (figure.py).
+``plot`` — ``generality.png`` (the claims) and ``generality_regular.png``, ``generality_sections.png``,
+``generality_decay.png`` (the evidence), figure.py.
 """
 from __future__ import annotations
 
@@ -450,6 +441,7 @@ def _indicator(study, key, t_from):
 def _analyze_evidence(study, numbers: dict) -> dict:
     """The evidence keys of generality.json: regular_fraction, survival_long, long_time, validity_map, resc."""
     from hhscatter.analysis.claims.evidence import (
+        decay_curves,
         first_below,
         long_time_record,
         regular_record,
@@ -459,20 +451,23 @@ def _analyze_evidence(study, numbers: dict) -> dict:
     from hhscatter.data.read import read_sections
 
     p = study.params
-    reg, surv, fits, points = [], [], [], []
+    reg, surv, fits, points, curves = [], [], [], [], []
     t_from = p.ev_t_max - p.ev_window
+    grid = np.linspace(0.0, p.ev_t_max, 401)
     for label, spec, m in _systems(study):
         head = {"system": spec["name"], "label": label}
         for ics in p.ev_ics:
             for r in p.ev_ratios:
                 lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
-                at = {**head, "e_ratio": r, "ics": _ics_name(p, ics)}
+                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": _ics_name(p, ics)}
                 reg.append({**at, **regular_record(lt, ind), "indicator": INDICATOR, "t_from": t_from,
                             "g_max": p.ev_g_max, "delta": p.ev_delta})
                 rows, fit = long_time_record(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times,
                                              p.ev_fit_t0, p.ev_hazard_edges)
-                surv += [{**at, **row} for row in rows] if ics == "disk" else []
+                surv += [{**at, **row, "id": f"{at['id']}-t{row['t']:g}"} for row in rows] if ics == "disk" else []
                 fits.append({**at, **fit})
+                curves.append(decay_curves(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], grid).assign(
+                    label=label, e_ratio=r, ics=ics))
         for r in p.ps_ratios:
             lt, ind = _indicator(study, ps_key(label, r), p.ps_t_max - p.ev_window)
             sec = read_sections(study.raw(ps_key(label, r)), columns=["traj_id", "t", "x", "y", "px", "py"])
@@ -481,17 +476,27 @@ def _analyze_evidence(study, numbers: dict) -> dict:
     if points:
         study.write_table(pd.concat(points, ignore_index=True), "sections_regular.parquet",
                           description="section crossings of the Poincaré runs with each orbit's indicator verdict")
+    study.write_table(pd.concat(curves, ignore_index=True), "survival_long.parquet",
+                      description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits")
     study.write_table(pd.DataFrame(fits).drop(columns=["hazard_nonregular"]), "long_time.parquet",
                       description="plateau-plus-exponential fits and the non-regular orbits' decay per system, E/E_c, ICs")
     vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics=_ics_name(p, "disk"))
     return {"regular_fraction": reg, "survival_long": surv, "long_time": fits, "validity_map": vmap,
-            "regular_below_1pc": first_below(reg, 0.01, ics=_ics_name(p, "disk")), "resc": resc_rows(_Runs(study), _systems(study))}
+            "regular_below_1pc": first_below(reg, 0.01, ics=_ics_name(p, "disk")),
+            "resc": resc_rows(_Runs(study), _systems(study))}
 
 
 def plot(study):
-    """plot(study) -> None: generality.png from the derived tables and generality.json."""
-    from .figure import plot_generality
+    """plot(study) -> None: generality.png (claims) and the evidence figures, from the derived tables and the JSON."""
+    from .figure import plot_decay, plot_generality, plot_regular, plot_sections
 
-    d = study.out / "derived"
-    plot_generality(pd.read_parquet(d / "kappa.parquet"), pd.read_parquet(d / "mu_conservative.parquet"),
-                    pd.read_parquet(d / "energy_curves.parquet"), study.read_numbers(), study.figure_path)
+    d, numbers, parts = study.out / "derived", study.read_numbers(), study.params.parts
+    if "claims" in parts:
+        plot_generality(pd.read_parquet(d / "kappa.parquet"), pd.read_parquet(d / "mu_conservative.parquet"),
+                        pd.read_parquet(d / "energy_curves.parquet"), numbers, study.figure_path)
+    if "evidence" in parts:
+        stem = study.figure_path.with_suffix("")
+        plot_regular(numbers, f"{stem}_regular.png")
+        if (d / "sections_regular.parquet").exists():
+            plot_sections(pd.read_parquet(d / "sections_regular.parquet"), f"{stem}_sections.png")
+        plot_decay(pd.read_parquet(d / "survival_long.parquet"), numbers, f"{stem}_decay.png")

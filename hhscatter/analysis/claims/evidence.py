@@ -100,6 +100,21 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     return rows, rec
 
 
+def decay_curves(lifetimes, regular_ids, grid):
+    """decay_curves(lifetimes, regular_ids, grid) -> DataFrame[orbits, t, P]: Kaplan–Meier P(t) on ``grid`` (time
+    units) of all orbits ('all') and of the orbits not in ``regular_ids`` ('non-regular')."""
+    import pandas as pd  # deferred: pandas loads on first use
+
+    t = lifetimes["t_end"].to_numpy(float)
+    obs = (lifetimes["outcome"].astype(str) != "censored").to_numpy()
+    nonreg = ~lifetimes["traj_id"].isin(np.asarray(regular_ids)).to_numpy()
+    out = []
+    for what, sel in (("all", np.ones(t.size, bool)), ("non-regular", nonreg)):
+        P = survival_at(t[sel], obs[sel], grid)[0] if sel.any() else np.full(len(grid), np.nan)
+        out.append(pd.DataFrame({"orbits": what, "t": np.asarray(grid, float), "P": P}))
+    return pd.concat(out, ignore_index=True)
+
+
 def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: str = "disk") -> list:
     """validity_map(regular, fits, kappa, claims, ics='disk') -> one record per (system, e_ratio) of ``regular``.
 
@@ -118,7 +133,7 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
               and f"E/E_c = {r['e_ratio']:g} (all orbits" in c.get("quantity", "")]
         f = fit_at.get(key, {})
         pinf, perr = f.get("P_inf"), f.get("P_inf_err")
-        out.append({"system": r["system"], "label": r["label"], "e_ratio": r["e_ratio"], "ics": ics,
+        out.append({"id": r.get("id"), "system": r["system"], "label": r["label"], "e_ratio": r["e_ratio"], "ics": ics,
                     "regular_fraction": r["fraction"], "regular_err": r["err"],
                     "kappa0_defined": bool(k[0]["defined"]) if k else None,
                     "claim2": c2[0]["verdict"] if c2 else None,
