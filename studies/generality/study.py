@@ -260,6 +260,7 @@ def analyze(study):
     (regular fraction, long-time escape, validity map, r_esc), per ``[study] parts``; derived tables and
     generality.json. Evidence alone is merged into the generality.json already in the output folder (its claims
     kept; its evidence keys replaced), so the evidence can be added to a record whose claim runs are elsewhere."""
+    from hhscatter.analysis.claims.records import with_ids
     from hhscatter.data.schema import provenance
     from hhscatter.studies.jsonio import write_json_atomic
 
@@ -272,7 +273,7 @@ def analyze(study):
     if "evidence" in p.parts:
         ev = _analyze_evidence(study, numbers)
         if "claims" not in p.parts and numbers:  # merge: the claims' record kept, with its scale and provenance
-            numbers.update(ev, evidence_record={"scale": study.scale, "config": study.config,
+            numbers.update(ev, claims=with_ids(numbers.get("claims", [])), evidence_record={"scale": study.scale, "config": study.config,
                                                 "provenance": provenance()})
             write_json_atomic(study.numbers_path, numbers)
             return
@@ -342,12 +343,8 @@ def _analyze_claims(study) -> dict:
 # ---------------------------------------------------------------------------
 # evidence: regular orbits (shadow indicator), long-time escape, r_esc sensitivity
 # ---------------------------------------------------------------------------
-def _ics_kw(p, ics: str, radius: float) -> dict:
+def _ics_kw(p, ics: str, radius: float) -> dict:  # disk: the study's ICs; another region: alt_momentum
     return {"radius": radius} if ics == "disk" else {"region": ics, "momentum": p.alt_momentum}
-
-
-def _ics_name(p, ics: str) -> str:
-    return "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"
 
 
 def _run_pair(study, key, spec, m, t_from, workers, progress, **kw):
@@ -459,7 +456,7 @@ def _analyze_evidence(study, numbers: dict) -> dict:
         for ics in p.ev_ics:
             for r in p.ev_ratios:
                 lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
-                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": _ics_name(p, ics)}
+                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"}
                 reg.append({**at, **regular_record(lt, ind), "indicator": INDICATOR, "t_from": t_from,
                             "g_max": p.ev_g_max, "delta": p.ev_delta})
                 rows, fit = long_time_record(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times,
@@ -480,9 +477,9 @@ def _analyze_evidence(study, numbers: dict) -> dict:
                       description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits")
     study.write_table(pd.DataFrame(fits).drop(columns=["hazard_nonregular"]), "long_time.parquet",
                       description="plateau-plus-exponential fits and the non-regular orbits' decay per system, E/E_c, ICs")
-    vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics=_ics_name(p, "disk"))
+    vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics="disk/tangential")
     return {"regular_fraction": reg, "survival_long": surv, "long_time": fits, "validity_map": vmap,
-            "regular_below_1pc": first_below(reg, 0.01, ics=_ics_name(p, "disk")),
+            "regular_below_1pc": first_below(reg, 0.01, ics="disk/tangential"),
             "resc": resc_rows(_Runs(study), _systems(study))}
 
 

@@ -45,12 +45,29 @@ class Claims:
 
     def add(self, claim, quantity, system, value, err, verdict, note="", reference=None) -> None:
         """Append one record {claim, quantity, system, value, err, reference, verdict, note}."""
-        rec = {"claim": claim, "quantity": quantity, "system": system, **ve(value, err), "reference": reference,
-               "verdict": verdict, "note": note}
+        k = sum(r["claim"] == claim and r["system"] == system for r in self.rows)
+        rec = {"id": f"{system}-{claim}-{k}", "claim": claim, "quantity": quantity, "system": system,
+               **ve(value, err), "reference": reference, "verdict": verdict, "note": note}
         self.rows.append(rec)
         if self.compare is not None:
             self.compare(f"[{claim}] {quantity} — {system}", rec["value"], rec["err"], reference, verdict=verdict,
                          note=note)
+
+
+def with_ids(rows: list) -> list:
+    """with_ids(claim records) -> the records with ``id`` = '<system>-<claim>-<k>' (k: the record's place among
+    that system's records of that claim), as :meth:`Claims.add` gives them: a page names a record by it.
+
+    >>> [r["id"] for r in with_ids([{"claim": "1", "system": "a"}, {"claim": "1", "system": "a"}])]
+    ['a-1-0', 'a-1-1']
+    """
+    seen: dict = {}
+    out = []
+    for r in rows:
+        k = seen.get((r["system"], r["claim"]), 0)
+        seen[r["system"], r["claim"]] = k + 1
+        out.append({"id": f"{r['system']}-{r['claim']}-{k}", **{a: b for a, b in r.items() if a != "id"}})
+    return out
 
 
 def across(per: dict, key: str):

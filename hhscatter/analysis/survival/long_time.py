@@ -52,7 +52,8 @@ class PlateauFit:
     p_t0 : float
         Fraction of all orbits still inside at t0 (Kaplan–Meier).
     q, q_err : float
-        Fraction of the orbits inside at t0 that never escape, and its 1σ error (q = 0 with ``plateau=False``).
+        Fraction of the orbits inside at t0 that never escape, and its 1σ error (q = 0 with ``plateau=False``;
+        q = 0 with a NaN error where the fitted plateau lies at its boundary 0).
     p_inf, p_inf_err : float
         P∞ = q·P(t0): the plateau as a fraction of all orbits.
     kappa, kappa_err : float
@@ -146,6 +147,9 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
                                                                      "maxiter": 4000}) for x0 in starts),
                    key=lambda r: r.fun)
         q, kappa = 1 / (1 + math.exp(-best.x[0])), math.exp(best.x[1])
+        if q < 1e-6:  # the plateau at its boundary: no plateau; the single exponential, q = 0 without an error
+            f0 = fit_plateau_exponential(t, obs, t0, plateau=False, n_bins=n_bins)
+            return PlateauFit(**{**f0.__dict__, "q_err": math.nan, "p_inf_err": math.nan})
         g = lambda v: _negloglik(v[0], v[1], s, esc)  # noqa: E731
         x = np.array([q, kappa])
         h = np.array([max(1e-4 * min(q, 1 - q), 1e-9), 1e-4 * kappa])
