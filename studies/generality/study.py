@@ -111,7 +111,7 @@ class Params(StudyParams):
     c5_level: Number = 0.95
     # the evidence behind the claims' readings (rules in study.toml): which parts a scale runs
     parts: list[OneOf("claims", "evidence")] = ["claims", "evidence"]
-    ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.9, 2.6, 3.5]
+    ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.9, 2.6, 3.5, 5.0]
     ev_ics: list[OneOf(*REGIONS)] = ["disk", "well"]   # disk: radius_frac·r_s, tangential; others: alt_momentum
     ev_n: Integer = 2000
     ev_t_max: Number = 2000.0

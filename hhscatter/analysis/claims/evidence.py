@@ -143,17 +143,19 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
 
 
 def first_below(regular: list, level: float = 0.01, *, ics: str = "disk") -> dict:
-    """first_below(regular, level=0.01, ics='disk') -> {system: the lowest E/E_c from which every measured regular
-    fraction lies below ``level`` (None where the highest measured energy is not below it: out of reach)}.
+    """first_below(regular, level=0.01, ics='disk') -> {system: {'from': E/E_c, 'text': …}}: the lowest E/E_c from
+    which every measured regular fraction lies below ``level`` ('from' None where the highest measured energy is
+    not below it: out of reach, and 'text' says up to where it was measured).
 
     >>> first_below([{"system": "a", "ics": "disk", "e_ratio": r, "fraction": f}
     ...              for r, f in [(1.1, 0.2), (1.5, 0.004), (2.0, 0.0)]])
-    {'a': 1.5}
+    {'a': {'from': 1.5, 'text': 'from 1.5 E_c on'}}
     """
     out = {}
     for s in dict.fromkeys(r["system"] for r in regular):
         rs = sorted((r["e_ratio"], r["fraction"]) for r in regular if r["system"] == s and r["ics"] == ics)
         above = [e for e, f in rs if f >= level]
         tail = [e for e, _ in rs if not above or e > max(above)]
-        out[s] = tail[0] if tail else None
+        out[s] = ({"from": tail[0], "text": f"from {tail[0]:g} E_c on"} if tail else
+                  {"from": None, "text": f"not reached up to {rs[-1][0]:g} E_c (the highest energy measured)"})
     return out

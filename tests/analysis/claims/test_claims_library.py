@@ -79,4 +79,6 @@ def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
                "verdict": "undetermined"}]
     (v,) = validity_map(reg, fits, kappa, claims, ics="disk/tangential")
     assert (v["kappa0_defined"], v["claim2"], v["exponential"], v["plateau"]) == (False, "undetermined", False, True)
-    assert first_below(reg + [{**reg[0], "e_ratio": 2.0, "fraction": 0.0}], ics="disk/tangential") == {"barbanis": 2.0}
+    assert first_below(reg + [{**reg[0], "e_ratio": 2.0, "fraction": 0.0}], ics="disk/tangential") == {
+        "barbanis": {"from": 2.0, "text": "from 2 E_c on"}}
+    assert first_below(reg, ics="disk/tangential")["barbanis"]["from"] is None
