@@ -273,8 +273,8 @@ def analyze(study):
     if "evidence" in p.parts:
         ev = _analyze_evidence(study, numbers)
         if "claims" not in p.parts and numbers:  # merge: the claims' record kept, with its scale and provenance
-            numbers.update(ev, claims=with_ids(numbers.get("claims", [])), evidence_record={"scale": study.scale, "config": study.config,
-                                                "provenance": provenance()})
+            rec = {"scale": study.scale, "config": study.config, "provenance": provenance()}
+            numbers.update(ev, claims=with_ids(numbers.get("claims", [])), evidence_record=rec)
             write_json_atomic(study.numbers_path, numbers)
             return
         numbers.update(ev)
@@ -456,7 +456,8 @@ def _analyze_evidence(study, numbers: dict) -> dict:
         for ics in p.ev_ics:
             for r in p.ev_ratios:
                 lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
-                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"}
+                name = "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"
+                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": name}
                 reg.append({**at, **regular_record(lt, ind), "indicator": INDICATOR, "t_from": t_from,
                             "g_max": p.ev_g_max, "delta": p.ev_delta})
                 rows, fit = long_time_record(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times,
@@ -476,7 +477,7 @@ def _analyze_evidence(study, numbers: dict) -> dict:
     study.write_table(pd.concat(curves, ignore_index=True), "survival_long.parquet",
                       description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits")
     study.write_table(pd.DataFrame(fits).drop(columns=["hazard_nonregular"]), "long_time.parquet",
-                      description="plateau-plus-exponential fits and the non-regular orbits' decay per system, E/E_c, ICs")
+                      description="plateau-plus-exponential fits and the non-regular decay per system, E/E_c, ICs")
     vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics="disk/tangential")
     return {"regular_fraction": reg, "survival_long": surv, "long_time": fits, "validity_map": vmap,
             "regular_below_1pc": first_below(reg, 0.01, ics="disk/tangential"),

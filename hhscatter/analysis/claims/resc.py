@@ -22,8 +22,8 @@ from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
 def resc_values(p, m) -> list:
     """[None (the default), *resc_values valid for this system (beyond its saddle distance, not its default)]."""
-    return [None, *(R for R in p.resc_values if R > m.saddle_radius and R != m.default_escape_radius(p.e0_ratio
-                                                                                                    * m.critical_energy))]
+    default = m.default_escape_radius(p.e0_ratio * m.critical_energy)
+    return [None, *(R for R in p.resc_values if R > m.saddle_radius and R != default)]
 
 
 def resc_rows(runs, systems) -> list:
@@ -58,7 +58,8 @@ def resc_rows(runs, systems) -> list:
             r_esc = float(m.default_escape_radius(E0)) if R is None else float(R)
             for wname, w in mu_windows(runs).items():
                 (v, e), (pv, pe) = own[wname], pred["c-measure", wname]
-                out.append({"id": f"{label}-r{r_esc:g}-{wname}", "system": spec["name"], "label": label, "r_esc": r_esc, "default": R is None,
+                out.append({"id": f"{label}-r{r_esc:g}-{wname}", "system": spec["name"], "label": label,
+                            "r_esc": r_esc, "default": R is None,
                             "window": list(w), "mu_measured": ve(*meas[wname]), "mu_predicted": ve(pv, pe),
                             "mu_own_K": ve(v, e), "moment_test": ve(v - pv, math.hypot(e, pe)),
                             "kinetic_at_E0": ve(*(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))),
