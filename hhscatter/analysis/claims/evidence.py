@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from hhscatter.analysis.geometry.regularity import regular_fraction
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
     hazard_profile,
@@ -50,10 +51,6 @@ def regular_record(lifetimes, indicator) -> dict:
     the window: not regular. ``n_none``: inside at the window's start but crossing the section in neither run
     (their type undetermined; counted as not regular, and said).
     """
-    from hhscatter.analysis.geometry.regularity import (
-        regular_fraction,  # deferred: pandas loads on first use
-    )
-
     n = len(lifetimes)
     n_reg = int(indicator["regular"].sum())
     f, e = regular_fraction(n, n_reg)
