@@ -180,7 +180,7 @@ KIND_COLORS = {"regular": "#2166ac", "chaotic": "#d6604d", "none": "#999999", "e
 
 
 def _name(label):
-    return label.replace("_", "–").title()
+    return {"henon_heiles": "Hénon–Heiles"}.get(label, label.replace("_", "–").title())
 
 
 def plot_regular(numbers, path):
@@ -234,7 +234,7 @@ def plot_sections(points, path):
                 h.set_alpha(1)
     fig.suptitle("Section crossings (ṙ = 0, φ̇ > 0) coloured by the shadow indicator of their orbit", fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
