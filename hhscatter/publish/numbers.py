@@ -18,11 +18,15 @@ The reference is ``[[study[@scale]:path[|format]]]``:
   ``quick`` (``docs/studies/assets/<study>.json``). See :func:`headline_scale`.
 * ``path`` — keys separated by dots (a key that itself holds dots, such as
   ``E0.30``, is found as it is); ``[n]`` indexes a list, ``[field=value]``
-  picks the one record of a list whose ``field`` equals ``value`` (numbers
-  compared as numbers).
+  (or ``[f=a,g=b]``) picks the one record of a list whose fields equal
+  these values (numbers compared as numbers).
 * ``format`` (see :func:`format_leaf`) — none: ``value ± err`` with the
   error's significant digits (:func:`hhscatter.publish.formatting.format_value_err`);
-  ``value`` / ``err``: one of them at those digits; ``pct``: ×100 with ``%``;
+  ``value`` / ``err``: one of them at those digits; ``ci`` / ``ci+``: value
+  [lo, hi] of an interval (a ``{value, interval}`` leaf, or a number beside
+  its ``<key>_interval``), decimals from its half-width, ``+``: signed;
+  ``pm``: a number ± its sibling ``<key>_err``; ``pct``: ×100 with ``%``; ``verdict``: the verdict of a paper-vs-ours row by
+  the one rule (:func:`hhscatter.analysis.stats.verdicts.row_verdict`);
   ``abs``: the magnitude; ``int``: rounded, thousands separated by a thin
   space; ``sci``: a×10ᵇ; a Python format spec (``.3f``, ``.2g``, ``+.2f``).
 
@@ -50,6 +54,7 @@ __all__ = [
     "NumberRefError",
     "REF",
     "format_leaf",
+    "format_ref",
     "headline_scale",
     "prose",
     "render_refs",
@@ -57,9 +62,10 @@ __all__ = [
     "stray_numbers",
 ]
 
-#: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine)
-REF = re.compile(r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|]|\[[^\]]*\])+?)"
-                 r"\s*(?:\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]")
+#: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine); the bar may
+#: be written ``\|`` where the source is a Markdown table that other tools read as it is
+REF = re.compile(r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|\\]|\[[^\]]*\])+?)"
+                 r"\s*(?:\\?\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]")
 
 
 class NumberRefError(ValueError):
@@ -153,11 +159,20 @@ def resolve(doc, path: str):
                     raise NumberRefError(f"{'.'.join(seen)}{p}: index out of range ({len(node)} items)")
                 node = node[k]
             else:
-                field, eq, want = sel.partition("=")
-                if not eq:
-                    raise NumberRefError(f"selector {p}: write [index] or [field=value]")
-                field, want = field.strip(), want.strip()
-                hits = [r for r in node if isinstance(r, dict) and field in r and _same(r[field], want)]
+                fields = {k for r in node if isinstance(r, dict) for k in r}
+                conds = []
+                for c in re.split(r",(?=\s*[\w.-]+\s*=)", sel):
+                    name = c.partition("=")[0].strip()
+                    if conds and name not in fields:  # a comma inside a value ("κ(E=0.30, r_esc=1.5)")
+                        f, eq, w = conds.pop()
+                        conds.append((f, eq, w + "," + c))
+                    else:
+                        conds.append(c.partition("="))
+                if not all(eq for _, eq, _ in conds):
+                    raise NumberRefError(f"selector {p}: write [index], [field=value] or [field=value,field=value]")
+                conds = [(f.strip(), w.strip()) for f, _, w in conds]
+                hits = [r for r in node if isinstance(r, dict)
+                        and all(f in r and _same(r[f], w) for f, w in conds)]
                 if len(hits) != 1:
                     raise NumberRefError(f"{'.'.join(seen)}{p}: {len(hits)} records match (need exactly one)")
                 node = hits[0]
@@ -209,6 +224,14 @@ def _digits(err: float) -> int:
 
 
 def format_leaf(leaf, fmt: str | None = None) -> str:
+    """format_leaf(JSON leaf, format) -> its text; a negative number with the minus sign "−" (see _format_leaf)."""
+    out = _format_leaf(leaf, fmt)
+    if isinstance(leaf, str) or (isinstance(leaf, dict) and isinstance(leaf.get("value"), str)):
+        return out
+    return re.sub(r"(^|[\s(\[])-(?=\d)", r"\1−", out)
+
+
+def _format_leaf(leaf, fmt: str | None = None) -> str:
     """format_leaf(JSON leaf, format) -> its text (see the module doc for the formats).
 
     A ``{value, err}`` leaf is written ``value ± err`` with the error's
@@ -224,12 +247,16 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
     """
     fmt = (fmt or "").strip()
     value, err = leaf, None
+    if isinstance(leaf, dict) and "value" not in leaf and "ours" in leaf:  # a paper-vs-ours row: our number
+        leaf = {"value": leaf["ours"], "err": leaf.get("err")}
     if isinstance(leaf, dict):
         if "value" not in leaf:
             raise NumberRefError(f"a mapping with keys {sorted(leaf)[:8]}: name one of them")
         value, err = leaf["value"], leaf.get("err")
         if fmt == "" and _is_num(leaf.get("lo")) and _is_num(leaf.get("hi")) and _is_num(value):
             return f"{_num(value)} [{_num(leaf['lo'])}, {_num(leaf['hi'])}]"
+    if fmt.startswith("ci") or (isinstance(leaf, dict) and "interval" in leaf and fmt in ("", "+")):
+        return _interval(leaf, fmt)
     if isinstance(value, str) and fmt in ("", "text"):
         return value
     if isinstance(value, bool):
@@ -241,7 +268,7 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
         value, fmt = abs(value), ""
     if fmt == "pct":
         value, err, fmt = 100 * value, (100 * err if has_err else err), ""
-        return format_leaf({"value": value, "err": err}) + " %"
+        return _format_leaf({"value": value, "err": err}) + " %"
     if fmt == "":
         return format_value_err(value, err) if has_err else _num(value)
     if fmt in ("value", "err"):
@@ -263,6 +290,26 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
         raise NumberRefError(f"bad format {fmt!r}: {e}") from None
 
 
+def _interval(leaf, fmt: str) -> str:
+    """``value [lo, hi]`` of ``{value, interval: [lo, hi]}`` (or ``[value, [lo, hi]]``), decimals from the
+    half-width of the interval as from an error; ``ci+`` / ``+``: signed."""
+    if isinstance(leaf, dict):
+        value, iv = leaf.get("value"), leaf.get("interval")
+    elif isinstance(leaf, (list, tuple)) and len(leaf) == 2:
+        value, iv = leaf
+    else:
+        raise NumberRefError(f"no interval here ({leaf!r:.60}): write path.to.x with a sibling x_interval, "
+                             "or a {value, interval} leaf")
+    nums = [value, *(iv or [])] if isinstance(iv, (list, tuple)) and len(iv) == 2 else None
+    if nums is None or not all(_is_num(x) and math.isfinite(x) for x in nums):
+        raise NumberRefError(f"no number or no interval here (value {value!r}, interval {iv!r})")
+    half = (nums[2] - nums[1]) / 2
+    d = _digits(half) if half > 0 else 3
+    sign = "+" if "+" in fmt else ""
+    lo, hi = nums[1], nums[2]
+    return f"{value:{sign}.{d}f} [{lo:{sign}.{d}f}, {hi:{sign}.{d}f}]".replace("-", "−")
+
+
 # -- pages ------------------------------------------------------------------------------------------------------
 _FENCE = re.compile(r"^(?P<i>[ \t]*)(?P<f>```+|~~~+).*?^(?P=i)(?P=f)[ \t]*$", re.M | re.S)
 _CODE = re.compile(r"(`+)(?!`).+?(?<!`)\1(?!`)", re.S)
@@ -280,6 +327,23 @@ def _protected(text: str) -> list[tuple[int, int]]:
     return sorted(spans)
 
 
+def format_ref(doc, path: str, fmt: str | None = None) -> str:
+    """The text of one reference: :func:`resolve` then :func:`format_leaf`; with ``ci`` a number whose interval
+    is its sibling ``<key>_interval`` (``rows[…].delta`` beside ``rows[…].delta_interval``) is written with it."""
+    leaf = resolve(doc, path)
+    if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
+        from hhscatter.analysis.stats.verdicts import row_verdict  # deferred: only this format needs it
+
+        if not isinstance(leaf, dict) or "ours" not in leaf:
+            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours')")
+        return row_verdict(leaf, doc.get("scale") if isinstance(doc, dict) else None)
+    if (fmt or "").strip() == "pm" and _is_num(leaf):  # a number beside its error <key>_err
+        return format_leaf({"value": leaf, "err": resolve(doc, path.strip() + "_err")})
+    if (fmt or "").strip().startswith("ci") and _is_num(leaf):
+        leaf = [leaf, resolve(doc, path.strip() + "_interval")]
+    return format_leaf(leaf, fmt)
+
+
 def render_refs(text: str, root: Path, *, where: str = "") -> str:
     """Every ``[[study:path]]`` of ``text`` (outside code) replaced by its number; NumberRefError names them all."""
     spans = _protected(text)
@@ -290,12 +354,19 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
             return m.group(0)
         try:
             doc, _ = load_numbers(root, m.group("study"), m.group("scale"))
-            return format_leaf(resolve(doc, m.group("path")), m.group("fmt"))
+            return format_ref(doc, m.group("path"), m.group("fmt"))
         except NumberRefError as e:
             errors.append(f"{m.group(0)}: {e}")
             return m.group(0)
 
     out = REF.sub(sub, text)
+    # what looks like a reference but did not parse (e.g. brackets inside a selector's value) is an error too
+    spans = _protected(out)
+    for m in re.finditer(r"\[\[\s*[\w-]+(?:@[\w-]+)?\s*:", out):
+        if not any(a <= m.start() < b for a, b in spans):
+            line = out[m.start():out.find("\n", m.start())][:80]
+            errors.append(f"{line}: not a reference the syntax reads ([[study[@scale]:path[|format]]]; a selector "
+                          "value may not hold brackets)")
     if errors:
         raise NumberRefError(f"{where or 'text'}: " + "; ".join(errors))
     return out
@@ -306,9 +377,9 @@ _CONVENTIONS = re.compile(r"<!--\s*conventions:(.*?)-->", re.S)
 _NUMBER = re.compile(r"(?<![\w.\-/−])[-−+]?(?:\d+(?:[.,]\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?:[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)?"
                      r"(?![\w.]*\w)")
 #: references to the paper's and the site's own parts ("Fig. 2", "Eq. (3)", "Eqs. (14)–(16)", "Table 1",
-#: "panel 2"), and the paper's arXiv id: numbers that name things, not results
+#: "panel 2"), the paper's arXiv id and years (2023): numbers that name things, not results
 _NAMING = re.compile(r"(?:\b(?:Figs?|Eqs?|Sec|Secs|Table|Tables|Ref|App)\.?\s*\(?\d+[a-z]?\)?"
-                     r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
+                     r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|(?<![\d.])(?:19|20)\d\d(?![\d.,]\d|[²³])|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
                      re.M)
 _LINK_TARGET = re.compile(r"\]\([^)]*\)|\]\[[^\]]*\]|\{[#.][^}]*\}|</?[a-zA-Z][^>]*>|\(eqn?:[\w-]+\)|fig:[\w-]+")
 #: small integers name counts, panels and exponents ("4 windows", "(2)", "t^2"): never a measured result here
