@@ -9,6 +9,8 @@ import numpy as np
 def ve(v, e=None) -> dict:
     """ve(v, e=None) -> {'value': v, 'err': e}, non-finite numbers as None (JSON).
 
+    Examples
+    --------
     >>> ve(1.5, float("nan"))
     {'value': 1.5, 'err': None}
     """
@@ -20,6 +22,8 @@ def z_verdict(value, err, ref, label_ok, label_bad, ref_err=0.0) -> str:
     """z_verdict(value, err, ref, label_ok, label_bad, ref_err=0) -> '<label> (z = …)': |z| ≤ 2 is ``label_ok``,
     z = (value − ref)/√(err² + ref_err²); 'undetermined' without a value or a finite error.
 
+    Examples
+    --------
     >>> z_verdict(1.1, 0.1, 1.0, "agrees", "differs")
     'agrees (z = +1.0)'
     """
@@ -34,6 +38,8 @@ class Claims:
     """The list of claim records ``rows``; each record is also passed to ``compare`` (a study's comparison table:
     ``compare(label, value, err, reference, verdict=, note=)``), when given.
 
+    Examples
+    --------
     >>> c = Claims()
     >>> c.add("1", "κ0 defined", "barbanis", 1.0, None, "yes")
     >>> c.rows[0]["verdict"]
@@ -58,6 +64,8 @@ def with_ids(rows: list) -> list:
     """with_ids(claim records) -> the records with ``id`` = '<system>-<claim>-<k>' (k: the record's place among
     that system's records of that claim), as :meth:`Claims.add` gives them: a page names a record by it.
 
+    Examples
+    --------
     >>> [r["id"] for r in with_ids([{"claim": "1", "system": "a"}, {"claim": "1", "system": "a"}])]
     ['a-1-0', 'a-1-1']
     """
