@@ -76,6 +76,8 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
                 pairs.append((src, dst / target))
             elif src.name != "cost.json":
                 missing.append(str(src.relative_to(ROOT)))
+        # further figures of a study (<name>_<part>.png: one panel group each, legible at full width)
+        pairs += [(src, dst / src.name) for src in sorted(out.glob(f"{name}_*.png"))]
     if studies_only or scale != "quick":  # the benchmarks have scales of their own (full, quick)
         return pairs, missing
     for which in BENCHES:

@@ -291,3 +291,21 @@ def test_read_lifetimes_takes_a_list_of_runs(tmp_path):
                                      (0.3, 0.01, str(tmp_path / "g"))]
     assert all(n == 300 for n in curves.n.values()) and curves[(0.3, 0.01)] is curves.curves[
         (0.3, 0.01, str(tmp_path / "g"))]
+
+
+def test_escape_rates_flags_a_trapped_population_instead_of_returning_its_plateau_silently():
+    # 60 % of the orbits never leave (KAM tori), the rest at κ = 0.01: the window κ is the plateau's
+    rng = np.random.default_rng(11)
+    t = np.where(rng.random(20000) < 0.6, np.inf, rng.exponential(100.0, 20000))
+    lt = pd.DataFrame({"t_end": np.minimum(t, 800.0), "outcome": np.where(t < 800.0, "escaped", "censored"),
+                       "e0": 0.3, "gamma": 0.0})
+    row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
+    assert row.status == "trapped" and "plateau" in row.note
+    assert abs(row.p_inf - 0.6) < 0.03 and abs(row.kappa_inf - 0.01) < 0.001
+
+
+def test_escape_rates_leaves_an_exponential_population_unflagged():
+    t = np.random.default_rng(12).exponential(5.0, 20000)
+    lt = pd.DataFrame({"t_end": t, "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
+    assert row.status == "exponential" and row.note == ""

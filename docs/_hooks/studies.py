@@ -7,6 +7,8 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:study-numbers fig2 -->   docs/studies/assets/fig2.json as tables
     <!-- hh:study-module fig2 -->    API of hhscatter.studies.fig2 (if it exists)
     <!-- hh:claims-table generality -->  its JSON's ``claims`` records as a claims × systems table
+    <!-- hh:evidence-tables generality -->  its JSON's regular_fraction, long_time, validity_map, resc records
+    <!-- hh:study-figure-wide generality_regular -->  a further figure of a study, as hh:study-figure
                                      (paper scale first when committed, quick scale folded below)
     <!-- hh:comparison-all -->       every study's paper-vs-ours rows in one table
     <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
@@ -242,6 +244,28 @@ class Renderer:
                 out.append(f'??? info "The same table at the {sc} scale (click to open)"\n\n'
                            + _indent(table + "\n" + caption) + "\n")
         return "\n".join(out)
+
+    def _headline(self, name: str):
+        """(numbers JSON, scale) at the headline scale: paper when committed, else quick."""
+        for sc in ("paper", "quick"):
+            doc = self._numbers(name, sc)
+            if doc:
+                return doc, sc
+        return None, None
+
+    def evidence_tables(self, name: str) -> str:
+        """The evidence records of a numbers JSON (regular fraction, long-time fits, validity map, r_esc) as
+        tables, at the headline scale."""
+        doc, sc = self._headline(name)
+        if not doc or "regular_fraction" not in doc:
+            return self.missing(f"The evidence of study {name}", f"Run `make {name}`, then `make docs-assets`.")
+        link = self._rel(self.study_asset(name, "json", sc))
+        return evidence_tables(doc) + f"\n*Scale **{sc}**: records of [{name}.json ({sc})]({link}).*\n"
+
+    def study_figure_wide(self, name: str) -> str:
+        """A further figure of a study (``<study>_<part>.png``) shown as hh:study-figure shows the main one (paper
+        scale at full width, quick folded); a marker of its own so that the main figure keeps the page's top."""
+        return self.study_figure(name)
 
     def study_module(self, name: str) -> str:
         mod = self.root / "studies" / name / "study.py"
@@ -687,3 +711,72 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
         return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 
     return _MARKER.sub(sub, markdown)
+
+
+def _pct(v, e=None) -> str:
+    if not _is_num(v):
+        return "—"
+    return fmt_err(100 * v, 100 * e) + " %" if _is_num(e) else f"{fmt_num(100 * v, 3)} %"
+
+
+def _ve_cell(d) -> str:
+    return fmt_err(d["value"], d["err"]) if d and _is_num(d.get("value")) and _is_num(d.get("err")) else (
+        fmt_num(d["value"]) if d and _is_num(d.get("value")) else "—")
+
+
+def evidence_tables(doc) -> str:
+    """Markdown tables of a generality JSON's evidence: regular fraction (systems × E/E_c per IC convention),
+    long-time escape (disk ICs), the validity map and the r_esc sensitivity."""
+    out = []
+    reg = doc["regular_fraction"]
+    ratios = sorted({r["e_ratio"] for r in reg})
+    out.append("**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ)\n")
+    out.append("| system | ICs | " + " | ".join(f"{r:g} E_c" for r in ratios) + " |")
+    out.append("|---|---|" + "---|" * len(ratios))
+    for (lab, ics) in dict.fromkeys((r["label"], r["ics"]) for r in reg):
+        cells = {r["e_ratio"]: _pct(r["fraction"], r["err"]) for r in reg if r["label"] == lab and r["ics"] == ics}
+        out.append(f"| {lab} | {ics} | " + " | ".join(cells.get(x, "—") for x in ratios) + " |")
+    P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
+    ts = sorted({r["t"] for r in doc.get("survival_long", [])})
+    out.append("\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
+               "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
+               "exponential from t0, p its χ² p-value)\n")
+    out.append("| system | E/E_c | " + " | ".join(f"P({t:g})" for t in ts)
+               + " | P∞ | κ∞ | regular share of the orbits inside at t_max | κ non-regular | p |")
+    out.append("|---|---|" + "---|" * (len(ts) + 5))
+    for f in doc["long_time"]:
+        if "disk" not in f["ics"]:
+            continue
+        ps = [P.get((f["label"], f["e_ratio"], t)) for t in ts]
+        out.append(f"| {f['label']} | {f['e_ratio']:g} | " + " | ".join(
+            fmt_err(x["P"], x["P_err"]) if x else "—" for x in ps) + " | "
+            + " | ".join([_ve_cell({"value": f.get("P_inf"), "err": f.get("P_inf_err")}),
+                          _ve_cell({"value": f.get("kappa_inf"), "err": f.get("kappa_inf_err")}),
+                          _pct(f.get("regular_fraction_of_censored")),
+                          _ve_cell({"value": f.get("kappa_nonregular"), "err": f.get("kappa_nonregular_err")}),
+                          fmt_num(f["p_nonregular"], 2) if _is_num(f.get("p_nonregular")) else "—"]) + " |")
+    vm = doc.get("validity_map", [])
+    if vm:
+        yn = {True: "yes", False: "no", None: "—"}
+        out.append("\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 defined with "
+                   "all orbits, the paper's convention) and claim 2's where tested, and whether the non-regular "
+                   "orbits decay as one exponential\n")
+        out.append("| system | E/E_c | regular fraction | κ0 defined (claim 1) | claim 2 | one exponential "
+                   "(non-regular) | plateau P∞ > 3σ |")
+        out.append("|---|---|---|---|---|---|---|")
+        for v in vm:
+            out.append(f"| {v['label']} | {v['e_ratio']:g} | {_pct(v['regular_fraction'], v['regular_err'])} | "
+                       f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | {yn[v['exponential']]} | "
+                       f"{yn[v['plateau']]} |")
+    rs = doc.get("resc", [])
+    if rs:
+        out.append("\n**r_esc sensitivity** (the same N and rules at each escape radius; windows of μ's fit)\n")
+        out.append("| system | r_esc | window | μ measured | μ predicted (c-measure) | μ own ⟨K⟩ | moment test "
+                   "(own − predicted) | 2⟨K⟩/E at E0 (measured) | at E0 interpolated (without E0) |")
+        out.append("|---|---|---|---|---|---|---|---|---|")
+        for r in rs:
+            out.append(f"| {r['label']} | {r['r_esc']:g}{' (default)' if r['default'] else ''} | "
+                       f"[{r['window'][0]:g}, {r['window'][1]:g}] | {_ve_cell(r['mu_measured'])} | "
+                       f"{_ve_cell(r['mu_predicted'])} | {_ve_cell(r['mu_own_K'])} | {_ve_cell(r['moment_test'])} | "
+                       f"{_ve_cell(r['kinetic_at_E0'])} | {fmt_num(r['kinetic_at_E0_interpolated_without_E0'])} |")
+    return "\n".join(out) + "\n"

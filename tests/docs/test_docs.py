@@ -381,3 +381,24 @@ def test_the_outcomes_and_the_study_list_come_from_the_code(tmp_path, hook):
     names = hook.Renderer(ROOT, DOCS, DOCS).study_names()
     assert all(f"[{s.name}](studies/{s.name}.md)" in names for s in studies(ROOT / "studies"))
     assert f"builds {len(studies(ROOT / 'studies'))} studies" in names
+
+
+def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook):
+    """hh:evidence-tables: the regular fraction as systems × E/E_c (per IC convention, in %), the long-time fits
+    and the r_esc rows, from the paper-scale JSON when committed."""
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    doc = {"study": "gx", "scale": "paper",
+           "regular_fraction": [{"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
+                                for r, f in ((1.05, 0.75), (1.5, 0.1))],
+           "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
+           "long_time": [{"label": "two", "e_ratio": 1.05, "ics": "disk/tangential", "P_inf": 0.751,
+                          "P_inf_err": 0.005, "kappa_inf": 0.00092, "kappa_inf_err": 0.00004}],
+           "resc": [{"label": "hh", "r_esc": 1.03, "default": False, "window": [0, 200],
+                     "mu_measured": {"value": 0.95, "err": 0.001}, "mu_predicted": {"value": 0.94, "err": 0.002},
+                     "mu_own_K": {"value": 0.951, "err": 0.001}, "moment_test": {"value": 0.011, "err": 0.002},
+                     "kinetic_at_E0": {"value": 1.018, "err": 0.002}, "kinetic_at_E0_interpolated_without_E0": 1.0}]}
+    (assets / "paper" / "gx.json").write_text(json.dumps(doc))
+    out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
+    assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out
+    assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
