@@ -1,4 +1,4 @@
-"""Study ``basins``: exit basins and their fractality under dissipation (beyond the paper; issue 16).
+"""Study ``basins``: exit basins and their fractality under dissipation (beyond the paper).
 
 The paper's conclusion expects fractal structure in dissipative scattering
 "in suitable limits of E0, γ and t", with a cut-off in the scaling coming
@@ -20,7 +20,7 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
    changes under a shift ε of x (fresh initial conditions at each ε, down to
    ε = 1e-9: exact event times and tol 1e-15 resolve it); d = 2 − α.
 3. **The paper's cut-off.** A broken power law against the single one for
-   f(ε) (:func:`~hhscatter.analysis.geometry.basins.uncertainty_cutoff`): ε_c(γ) or an
+   f(ε) (:func:`~hhscatter.analysis.geometry.uncertainty.uncertainty_cutoff`): ε_c(γ) or an
    upper bound; and the lifetimes of the orbits that decide the outcome at
    the smallest ε, against τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1, the
    late-time exponent of study fig3).
@@ -96,7 +96,7 @@ def scan_unc_key(E, i):
 
 
 def _scan(study):
-    """(energies, ε) of the γ = 0 energy scan (issue 25, point 5); energies must lie above E_c."""
+    """(energies, ε) of the γ = 0 energy scan; energies must lie above E_c."""
     energies = list(study.params.scan_energies)
     eps = np.asarray(study.params.scan_eps)
     if energies:
@@ -249,7 +249,7 @@ def analyze(study):
     study.write_numbers({
         "codes": dict(zip(CODE_NAMES, CODES)),
         "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
-        "zoom_centre": list(centre), "per_point": per,
+        "zoom_centre": list(centre), "per_point": per, "point_table": bs.point_table(per),
         "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
                                                            f"{study.params.E_b_key}"},
         "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},

@@ -469,6 +469,7 @@ def analyze(study):
     if img:
         study.write_table(pd.concat(img, ignore_index=True), "ulam_measure_points.parquet")
     study.write_numbers({"inputs": inputs, "kappa_ulam": k["records"], "kappa_convergence": k["convergence"],
+                         "kappa_convergence_summary": ulam.convergence_summary(k["convergence"]),
                          "mixed_phase_space": k["mixed"], "cmeasure_distances": cm_rows, "cmeasure_convergence": cm_conv,
                          "dissipative": diss, "cost": _cost(study, k["records"], k["kappa0"]),
                          "tables": {"convergence": "convergence.parquet", "survival": "survival.parquet"}})

@@ -120,10 +120,11 @@ def test_entropy_by_box_refuses_sides_that_are_not_whole_cells():
 
 
 def test_entropy_exponents_recover_a_power_law_and_skip_short_groups():
-    recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 400, "box_side": s, "S_b": 0.7 * s ** 0.24,
-             "S_b_err": 1e-4} for s in (0.01, 0.025, 0.05, 0.1)]
-    recs += [{"E0": 0.25, "gamma": 0.0, "map": "scan", "grid": 200, "box_side": s, "S_b": s, "S_b_err": 1e-4}
-             for s in (0.05, 0.1)]
+    recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 400, "box_side": s, "box_cells": int(round(s * 200)),
+             "S_b": 0.7 * s ** 0.24, "S_b_err": 1e-4} for s in (0.01, 0.025, 0.05, 0.1, 0.2)]
+    recs[0]["S_b"] = 0.01  # a 2-cell box: below min_cells, left out
+    recs += [{"E0": 0.25, "gamma": 0.0, "map": "scan", "grid": 200, "box_side": s, "box_cells": int(round(s * 100)),
+              "S_b": s, "S_b_err": 1e-4} for s in (0.02, 0.05, 0.1)]  # 2, 5, 10 cells: two sides left
     out = bs.entropy_exponents(recs)
     assert len(out) == 1 and out[0]["grid"] == 400
     assert out[0]["alpha"] == pytest.approx(0.24, abs=1e-12)

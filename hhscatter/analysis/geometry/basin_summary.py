@@ -38,6 +38,7 @@ __all__ = [
     "kantz_grassberger",
     "outcome_codes",
     "point_record",
+    "point_table",
     "rate_record",
     "smooth_chi2",
     "uncertainty_fits",
@@ -366,19 +367,20 @@ def cutoff_summary(records) -> dict:
             "statement": words}
 
 
-def entropy_exponents(records) -> list:
+def entropy_exponents(records, min_cells: int = 5) -> list:
     """The exponent of S_b(s) ∝ s^α over the fixed box sides s, per map and grid.
 
     ``records`` are rows of :func:`~hhscatter.analysis.geometry.basins.entropy_by_box` with E0, gamma and
     map; for a fractal boundary the basin entropy grows as the box side to the power of the uncertainty
     exponent (Daza et al., Sci. Rep. 6, 31416 (2016)), for a smooth one linearly. Weighted least squares of
-    ln S_b against ln s (errors σ(S_b)/S_b, widened by √(χ²/dof)); only groups with ≥ 3 sides and S_b > 0.
+    ln S_b against ln s (errors σ(S_b)/S_b, widened by √(χ²/dof)) over the sides of at least ``min_cells`` cells
+    (a box of 2 cells cannot hold the mixing a fractal boundary puts in it); only groups with ≥ 3 such sides.
     Returns records {E0, gamma, map, grid, alpha, alpha_err, sides}.
 
     Examples
     --------
-    >>> recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 400, "box_side": s, "S_b": 0.5 * s ** 0.3,
-    ...          "S_b_err": 1e-3} for s in (0.01, 0.02, 0.05)]
+    >>> recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 2000, "box_side": s, "box_cells": int(s * 1000),
+    ...          "S_b": 0.5 * s ** 0.3, "S_b_err": 1e-3} for s in (0.01, 0.02, 0.05)]
     >>> round(entropy_exponents(recs)[0]["alpha"], 6)
     0.3
     """
@@ -387,10 +389,33 @@ def entropy_exponents(records) -> list:
     t = pd.DataFrame(records)
     out = []
     for (E0, g, which, grid), part in t.groupby(["E0", "gamma", "map", "grid"], sort=True):
-        part = part[(part.S_b > 0) & (part.S_b_err > 0)].sort_values("box_side")
+        part = part[(part.S_b > 0) & (part.S_b_err > 0) & (part.box_cells >= min_cells)].sort_values("box_side")
         if len(part) < 3:
             continue
         _, slope, cov, _, _ = weighted_line(np.log(part.box_side), np.log(part.S_b), part.S_b_err / part.S_b)
         out.append({"E0": float(E0), "gamma": float(g), "map": which, "grid": int(grid), "alpha": float(slope),
                     "alpha_err": float(math.sqrt(cov[1, 1])), "sides": [float(v) for v in part.box_side]})
+    return out
+
+
+def point_table(per) -> list:
+    """One flat record per (E0, γ) of the point records ``per`` (:func:`point_record`), for a page's table:
+    E0, gamma, d (± d_err) of the one-law fit and its p, the local dimension at the coarsest and finest
+    resolved resolution, its slope per decade (± err) and the slim-fractal verdict, S_bb (± err) at the headline
+    box, and the Wada fraction with settled a basin and of the exits alone (settled masked)."""
+    out = []
+    for p in per:
+        s, w, wx = p.get("slim_fractal") or {}, p["wada"], p.get("wada_exits")
+        out.append({"E0": p["energy"], "gamma": p["gamma"],
+                    "d": p["d"]["value"] if p["d"] else None, "d_err": p["d"]["err"] if p["d"] else None,
+                    "fit_p": (p.get("alpha_fit_p") if p.get("alpha_fit_p") != 0 else "< 1e-300 (underflow)"),
+                    "d_coarse": s.get("d_coarse"), "d_coarse_err": s.get("d_coarse_err"),
+                    "d_fine": s.get("d_fine"), "d_fine_err": s.get("d_fine_err"),
+                    "slope": s.get("slope"), "slope_err": s.get("slope_err"),
+                    "slim": "yes" if s.get("slim") else "no",
+                    "S_bb": p["S_bb"]["value"] if p["S_bb"] else None, "S_bb_err": p["S_bb"]["err"] if p["S_bb"] else None,
+                    "box_cells": p.get("box_headline"),
+                    "wada_all": f"{'yes' if w['verdict'] else 'no'} (W = {w['W_at_r']:.3f})",
+                    "wada_exits": (f"{'yes' if wx['verdict'] else 'no'} (W = {wx['W_at_r']:.3f})" if wx else
+                                   "— (fewer than 3 exit basins)")})
     return out

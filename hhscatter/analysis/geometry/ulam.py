@@ -33,6 +33,7 @@ __all__ = [
     "coarse_index",
     "convergence_grid",
     "convergence_record",
+    "convergence_summary",
     "cost_row",
     "disk_density",
     "eigenvector_convergence",
@@ -571,4 +572,32 @@ def islands_record(trapped_cells, tr, ids, keep, sub):
             out["kappa_without_trapped_boxes"] = saddle_kappa(tr.subset(~trapped))[0]
         except ValueError:
             out["kappa_without_trapped_boxes"] = math.nan
+    return out
+
+
+def convergence_summary(records, *, z_agree: float = 2.0) -> dict:
+    """How the extrapolated κ∞ of :func:`convergence_record` compares with the references, in words and numbers.
+
+    For each reference (kappa0, kappa_cm): the energies where |z| ≤ ``z_agree`` (both errors), the largest
+    |κ∞/κ_ref − 1| and the mean residual; ``statement`` says it in one sentence per reference.
+
+    Examples
+    --------
+    >>> recs = [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]
+    >>> convergence_summary(recs)["kappa0"]["agree"]
+    [0.3]
+    """
+    out, words = {}, []
+    names = {"kappa0": "fig2's κ0 from P(t)", "kappa_cm": "fig2's κ from long-run crossings"}
+    for ref, label in names.items():
+        rs = [r for r in records if r.get("kappa_inf") is not None and r.get(f"z_{ref}") is not None]
+        if not rs:
+            continue
+        agree = [r["energy"] for r in rs if abs(r[f"z_{ref}"]) <= z_agree]
+        res = np.array([r[f"residual_{ref}"] for r in rs])
+        out[ref] = {"energies": [r["energy"] for r in rs], "agree": agree, "max_abs_residual": float(np.max(np.abs(res))),
+                    "mean_residual": float(res.mean())}
+        words.append(f"against {label}, κ∞ agrees within {z_agree:g}σ (both errors) at {len(agree)} of {len(rs)} "
+                     f"energies; |κ∞/κ_ref − 1| ≤ {100 * np.max(np.abs(res)):.2g} %, mean {100 * res.mean():+.2g} %")
+    out["statement"] = "; ".join(words) if words else "no reference to compare with"
     return out
