@@ -152,7 +152,7 @@ def plot_residuals(nums, grid, path):
             continue
         E = np.array([r["energy"] for r in rs]) + dx
         res = np.array([r[f"residual_{ref}"] for r in rs])
-        own = np.array([r["err"] / r[ref] * (1 + r[f"residual_{ref}"]) for r in rs])
+        own = np.array([r["err"] / abs(r[ref]) for r in rs])
         refe = np.array([r[f"{ref}_err"] / r[ref] for r in rs])
         a.bar(E, 2 * refe, bottom=res - refe, width=0.005, color=f"C{k}", alpha=0.25)
         a.errorbar(E, res, own, fmt="o" if k == 0 else "D", color=f"C{k}", capsize=3,

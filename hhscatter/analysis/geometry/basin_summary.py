@@ -86,7 +86,8 @@ def zoom_centre(labels, extent, box=5, clearance=0):
     The most mixed box has the highest Gibbs entropy (first in row-major order on ties).
     ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
     forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
-    cells around the centre is wholly allowed. ``extent`` = (x0, x1, y0, y1) in position units.
+    cells around the centre is wholly allowed (an unconstrained choice sits at the edge of the allowed region, where
+    the zooms show mostly forbidden cells). ``extent`` = (x0, x1, y0, y1) in position units.
 
     Examples
     --------
