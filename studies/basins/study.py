@@ -67,7 +67,7 @@ class Params(StudyParams):
     E_b_key: str = "kappa_fit.E_b"
     kappa_energy_key: str = "kappa_energy"
     mu_key: str = "mu"
-    box_sides: Numbers = (0.01, 0.02, 0.025, 0.05, 0.1, 0.2)
+    box_sides: Numbers = (0.01, 0.02, 0.025, 0.05, 0.1, 0.2)  # S_b, S_bb also at these sides (position units)
 
 
 # -- keys and grids ----------------------------------------------------------------

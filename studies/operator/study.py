@@ -37,7 +37,7 @@ class Params(StudyParams):
     samples: Integer
     sample_subsets: Integers
     n_boot: Integer
-    n_boot_grid: Integer = 8
+    n_boot_grid: Integer = 4  # bootstrap replicates of the whole extrapolation grid (each: 9 roots of ρ(M(κ)) = 1)
     seed: Integer
     cm_energies: Numbers
     cm_boxes: Numbers
