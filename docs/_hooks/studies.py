@@ -267,6 +267,41 @@ class Renderer:
         scale at full width, quick folded); a marker of its own so that the main figure keeps the page's top."""
         return self.study_figure(name)
 
+    def _scaled_docs(self, name: str, key: str):
+        """[(scale, doc)] of the study's committed JSON that hold ``key`` (dotted), paper scale first."""
+        out = []
+        for sc in ("paper", "quick"):
+            doc = self._numbers(name, sc)
+            if doc is not None and _dig(doc, key) not in (None, [], {}):
+                out.append((sc, doc))
+        return out
+
+    def study_table(self, arg: str) -> str:
+        """``<!-- hh:study-table name.key -->``: the records at ``key`` of the study's JSON as a table (columns
+        from :data:`STUDY_TABLES`; value ± error rounded to the error; a missing value "—"), the paper scale
+        first and the quick scale folded below."""
+        name, key = arg.split(".", 1)
+        docs = self._scaled_docs(name, key)
+        if not docs:
+            return self.missing(f"`{key}` of {name}.json", f"Run `make {name}`, then `make docs-assets`.")
+        out = []
+        for i, (sc, doc) in enumerate(docs):
+            link = self._rel(self.study_asset(name, "json", sc))
+            text = (spec_table(_dig(doc, key), STUDY_TABLES.get(arg)) +
+                    f"\n*Scale **{sc}**: `{key}` of [{name}.json ({sc})]({link}).*\n")
+            out.append(text if i == 0 else
+                       f'??? info "The same at the {sc} scale (click to open)"\n\n' + _indent(text) + "\n")
+        return "\n".join(out)
+
+    def study_statement(self, arg: str) -> str:
+        """``<!-- hh:study-statement name.key -->``: the ``statement`` string at ``key`` of the study's JSON, at
+        each committed scale (paper first)."""
+        name, key = arg.split(".", 1)
+        docs = self._scaled_docs(name, key)
+        if not docs:
+            return self.missing(f"`{key}` of {name}.json", f"Run `make {name}`, then `make docs-assets`.")
+        return "\n".join(f"- *{sc} scale*: {_dig(doc, key)['statement']}." for sc, doc in docs) + "\n"
+
     def study_module(self, name: str) -> str:
         mod = self.root / "studies" / name / "study.py"
         if not mod.exists():
@@ -529,6 +564,96 @@ def claims_table(doc) -> str:
 
     for (claim, qty), per in sorted(rows.items(), key=claim_order):
         out.append(f"| {_cell(claim)} | {_cell(qty)} | " + " | ".join(cell(per.get(s)) for s in systems) + " |")
+    return "\n".join(out) + "\n"
+
+
+def _dig(doc, key: str):
+    """The value at the dotted ``key`` of a JSON document (None if absent)."""
+    cur = doc
+    for part in key.split("."):
+        if not isinstance(cur, dict) or part not in cur:
+            return None
+        cur = cur[part]
+    return cur
+
+
+#: columns (key, header) of the record tables that study pages ask for with ``hh:study-table``; a key with a
+#: sibling ``<key>_err`` is shown as value ± error rounded to the error
+STUDY_TABLES = {
+    "basins.entropy_by_box": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid (cells per side)"),
+                              ("box_side", "box side s"), ("box_cells", "box (cells)"), ("S_b", "S_b"),
+                              ("S_bb", "S_bb")),
+    "basins.point_table": (("E0", "E0"), ("gamma", "γ"), ("d", "d = 2 − α, one law"), ("fit_p", "its fit p"),
+                           ("d_coarse", "d(ε) coarse"), ("d_fine", "d(ε) finest resolved"),
+                           ("slope", "slope of d per decade"), ("slim", "slim fractal"),
+                           ("S_bb", "S_bb (headline box)"), ("box_cells", "box (cells)"),
+                           ("wada_all", "Wada, settled a basin"), ("wada_exits", "Wada, exits (settled masked)")),
+    "basins.entropy_exponent_by_grid": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid"),
+                                        ("alpha", "α from S_b ∝ s^α"), ("sides", "box sides s")),
+    "basins.cutoff_prediction": (("E0", "E0"), ("gamma", "γ"), ("tau2", "τ2"), ("eps_c", "measured ε_c"),
+                                 ("eps_c_interval", "measured 1σ interval"),
+                                 ("eps_c_predicted", "predicted ε_c (decision rate λ)"),
+                                 ("eps_c_predicted_kantz_grassberger", "predicted, λ = κ/α"),
+                                 ("eps_c_predicted_interval", "predicted interval (λ ± σ, μ ± σ, κ/α)"),
+                                 ("log10_ratio", "log10(measured/predicted)"), ("statement", "how far apart")),
+    "operator.mixed_phase_space": (("energy", "E"), ("probes", "KAM probes"), ("trapped_boxes", "trapped boxes"),
+                                   ("trapped_share_of_saddle_class", "their share of the saddle's class"),
+                                   ("kappa_without_trapped_boxes", "κ without them")),
+    "operator.cmeasure_distances": (("fig1_energy", "fig1 at E"), ("operator_energy", "operator at E"),
+                                    ("measure", "operator's measure"), ("n", "fig1 points"), ("box", "ε"),
+                                    ("hellinger_debiased", "debiased Hellinger"), ("hellinger_debiased_lo", "lo"),
+                                    ("hellinger_debiased_hi", "hi"), ("hellinger_noise", "noise")),
+    "operator.cmeasure_convergence": (("energy", "E"), ("box", "box side"), ("samples_per_box", "samples per box"),
+                                      ("kappa", "κ"), ("hellinger_debiased", "debiased Hellinger (ε = 0.1)"),
+                                      ("lo", "lo"), ("hi", "hi")),
+    "operator.dissipative.P_at": (("t", "t"), ("sim", "simulated", "sim_err"), ("operator", "operator (box × E)"),
+                                  ("reduced", "reduced, ρ(E) alone")),
+    "operator.cost": (("energy", "E"), ("pt_orbit_time_1pct", "P(t) route for 1 %"),
+                      ("op_orbit_time_1pct", "operator for 1 % (lower bound)"), ("pt_rel", "P(t): its rel. error"),
+                      ("op_rel", "operator: its rel. error"), ("pt_rel_at_op_cost", "P(t) at the operator's cost")),
+    "operator.kappa_ulam": (("energy", "E"), ("box", "finest box"), ("kappa", "κ_Ulam finest boxes", "err"),
+                            ("kappa_stat_err", "σ bootstrap"), ("discretisation_bias", "linear box bias"),
+                            ("fig2_kappa", "fig2 κ0", "fig2_err"), ("z_vs_fig2", "z vs κ0 (both errors)"),
+                            ("fig2_kappa_cm", "fig2 κ crossings", "fig2_kappa_cm_err"), ("kappa_map_per_return", "−ln ρ(P) per return"),
+                            ("mean_return_time", "⟨T⟩")),
+    "operator.kappa_convergence": (("energy", "E"), ("kappa_finest", "κ finest boxes"), ("kappa_inf", "κ∞", "err"),
+                                   ("stat_err", "σ stat (bootstrap)"), ("model_err", "σ model (M^−1/2 vs M^−1)"),
+                                   ("kappa0", "fig2 κ0"), ("residual_kappa0", "κ∞/κ0 − 1"), ("z_kappa0", "z vs κ0"),
+                                   ("kappa_cm", "fig2 κ crossings"), ("residual_kappa_cm", "κ∞/κ_cm − 1"),
+                                   ("z_kappa_cm", "z vs κ_cm"), ("note", "note")),
+}
+
+
+def spec_table(recs, spec=None) -> str:
+    """Markdown table of records with the columns ``spec`` ((key, header[, error key]); default every key): a key
+    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, None or NaN as "—"."""
+    import math
+
+    if spec is None:
+        cols = []
+        for r in recs:
+            cols.extend(k for k in r if k not in cols and not k.endswith("_err"))
+        spec = [(c, c) for c in cols]
+    spec = [(c[0], c[1], c[2] if len(c) > 2 else c[0] + "_err") for c in spec]
+    spec = [c for c in spec if any(r.get(c[0]) is not None for r in recs)]
+
+    def cell(r, k, ek):
+        v, e = r.get(k), r.get(ek)
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            return "—"
+        if k.startswith("z") and _is_num(v):  # a distance in σ
+            return f"{v:+.1f}"
+        if k.startswith("residual") and _is_num(v):  # a relative difference, in per cent
+            ok = _is_num(e) and math.isfinite(e) and e > 0
+            return (fmt_err(100 * v, 100 * e) if ok else f"{100 * v:+.2f}") + " %"
+        if _is_num(v) and _is_num(e) and math.isfinite(e) and e > 0:
+            return fmt_err(v, e)
+        if isinstance(v, list):
+            return "[" + ", ".join(fmt_num(x, 3) if _is_num(x) else str(x) for x in v) + "]"
+        return fmt_num(v) if _is_num(v) else str(v)
+
+    out = ["| " + " | ".join(_cell(h) for _, h, _ in spec) + " |", "|" + "---|" * len(spec)]
+    out.extend("| " + " | ".join(_cell(cell(r, k, ek)) for k, _, ek in spec) + " |" for r in recs)
     return "\n".join(out) + "\n"
 
 
