@@ -63,7 +63,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hhscatter.integrate import events
+from hhscatter.integrate import events, heyoka_log
 from hhscatter.integrate.events import (
     CENSORED,
     ESCAPED,
@@ -140,6 +140,8 @@ class ChunkResult:
     crossings: dict
     n_returns: int = 0
     n_steps: int = 0
+    event_failures: int = 0  # heyoka's event-detection failures logged while the chunk ran (each one redone)
+    redone: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))  # traj_ids redone on the reference
 
     def tables(self) -> dict:
         return {"lifetimes": self.lifetimes, "sections": self.sections, "snapshots": self.snapshots,
@@ -841,16 +843,42 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
     that many more orbits of the chunk have started, so long chunks show
     progress.
+
+    heyoka's log is captured while the chunk runs (:mod:`hhscatter.integrate.heyoka_log`): an event whose root
+    finding failed in a step is ignored there by heyoka, so every such failure is counted
+    (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
+    on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
     outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
+    inside = ~outside
+    kind = scheduler(scene)
+    far = _no_return(scene, ics[inside], kind)  # the integration's scene (maybe an earlier far event) and `late`
+    kw = dict(batch_size=batch_size, count_steps=count_steps)
+    with heyoka_log.capture() as log:
+        res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
+    failures, redone = log.event_failures, np.empty(0, np.int64)
+    if failures:
+        local = _orbits_with_failures(lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far,
+                                                             **kw), int(inside.sum()), failures)
+        res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
+        redone = traj_ids[inside][local]
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
-        return _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress)
+        res = _with_escaped_at_start(scene, ics, traj_ids, outside, res)
+    res.event_failures, res.redone = failures, redone
+    return res
+
+
+def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+    """The chunk's orbits (all inside r_esc) on the batch engine; ``far``: :func:`_no_return`'s (scene, late),
+    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk."""
+    if not len(ics):
+        return _empty_result(traj_ids)
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
-    orig, (scene, late) = scene, _no_return(scene, ics, kind)  # the integration's scene: maybe an earlier far event
+    orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
         lanes = (_Epochs if kind == "epochs" else _Stream)(scene, ta, layout, ics)
@@ -884,9 +912,99 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps)
     rerun = outcome == RERUN
     if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
-        res = _merge_rerun(res, rerun, traj_ids, run_chunk(_own_far(orig), ics[rerun], traj_ids[rerun],
-                                                           batch_size=batch_size, count_steps=count_steps))
+        own = _own_far(orig)
+        res = _merge_rerun(res, rerun, traj_ids, _integrate(own, ics[rerun], traj_ids[rerun], (own, None),
+                                                            batch_size=batch_size, count_steps=count_steps))
     return res
+
+
+def _orbits_with_failures(integrate, n, failures) -> np.ndarray:
+    """_orbits_with_failures(integrate, n, failures) -> sorted local indices of the orbits whose integration logs
+    event-detection failures, among 0..n−1 that logged ``failures`` together.
+
+    ``integrate(idx)`` integrates the orbits ``idx`` of the chunk as the chunk did (an orbit's steps do not depend
+    on the orbits beside it: the engine's determinism), so a failure comes back with its orbit: halves are
+    integrated under capture, and the halves with failures split again (about 2n orbit integrations per failing
+    orbit). A set whose failures no half reproduces is returned whole (every orbit of it is redone).
+    """
+    def count(idx):
+        with heyoka_log.capture() as log:
+            integrate(idx)
+        return log.event_failures
+
+    found = []
+
+    def split(idx, k):
+        if len(idx) == 1:
+            found.append(idx)
+            return
+        halves = (idx[: len(idx) // 2], idx[len(idx) // 2:])
+        counts = [count(h) for h in halves]
+        if not any(counts):  # not reproduced orbit by orbit: keep the whole set
+            found.append(idx)
+            return
+        for h, c in zip(halves, counts):
+            if c:
+                split(h, c)
+
+    split(np.arange(n), failures)
+    return np.unique(np.concatenate(found))
+
+
+def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
+    """res with the orbits ``local`` (indices into the chunk) redone one by one on the reference driver
+    (:func:`simulate_orbit`) in long double, then real128, until one run logs no event-detection failure; its
+    times and states rounded to double. Raises RuntimeError if none succeeds.
+
+    (An orbit that starts on the section is on it exactly in double, x p_x + y p_y = 0; in long double the same
+    numbers carry a radial velocity of ~1e-17, which at an inflection of r puts a crossing ~1e-8 after the
+    start: within :data:`hhscatter.integrate.events.T_INITIAL`, the initial point, as in double.)"""
+    import heyoka as hy  # deferred: heyoka loads on first use
+
+    model = scene.model
+    rows = {"lifetimes": [], "sections": [], "snapshots": [], "crossings": []}
+    for j in local:
+        for fp in (np.longdouble, getattr(hy, "real128", None)):
+            if fp is None:
+                continue
+            with heyoka_log.capture() as log:
+                o = simulate_orbit(scene, ics[j], fp_type=fp)
+            if not log.event_failures:
+                break
+        else:
+            raise RuntimeError(f"orbit {traj_ids[j]}: heyoka's event detection failed in double, long double and "
+                               "real128")
+        k = traj_ids[j]
+        end = np.array([float(v) for v in o.state_end[:4]])
+        rows["lifetimes"].append((j, o.outcome, float(o.t_end), end))
+        rows["sections"] += [(k, *(float(v) for v in r)) for r in o.sections]
+        rows["snapshots"] += [(k, float(t), *(float(v) for v in st[:4])) for t, st in o.snapshots]
+        rows["crossings"] += [(k, float(t), float(R), int(d)) for t, R, d in o.crossings]
+    sel = np.array([r[0] for r in rows["lifetimes"]], dtype=np.int64)
+    end = np.array([r[3] for r in rows["lifetimes"]]).reshape(-1, 4)
+    outcome = np.array([r[1] for r in rows["lifetimes"]], dtype=np.int8)
+    x, y, px, py = ics[sel].T
+    lifetimes = {
+        "traj_id": traj_ids[sel], "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
+        "e0": model.energy(x, y, px, py), "gamma": np.full(len(sel), scene.gamma), "outcome": outcome,
+        "t_end": np.array([r[2] for r in rows["lifetimes"]], dtype=float),
+        "exit_channel": np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1).astype(np.int8),
+        "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
+    }
+    snap = np.array(rows["snapshots"], dtype=float).reshape(-1, 6)
+    snapshots = {"traj_id": snap[:, 0].astype(np.int64), "t": snap[:, 1],
+                 "energy": model.energy(snap[:, 2], snap[:, 3], snap[:, 4], snap[:, 5])}
+    sec = np.array(rows["sections"], dtype=float).reshape(-1, len(SECTION_COLUMNS))
+    sections = {c: sec[:, i] for i, c in enumerate(SECTION_COLUMNS)}
+    cr = np.array(rows["crossings"], dtype=float).reshape(-1, len(CROSSING_COLUMNS))
+    crossings = {c: cr[:, i] for i, c in enumerate(CROSSING_COLUMNS)}
+    for t in (sections, crossings):
+        t["traj_id"] = t["traj_id"].astype(np.int64)
+    crossings["direction"] = crossings["direction"].astype(np.int8)
+    mask = np.zeros(len(ics), dtype=bool)
+    mask[sel] = True
+    again = ChunkResult(lifetimes, sections, snapshots, crossings)
+    return _merge_rerun(res, mask, traj_ids, again)
 
 
 def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_steps) -> ChunkResult:
@@ -989,19 +1107,19 @@ def _merge_rerun(res, rerun, traj_ids, again):
                        n_returns=res.n_returns + again.n_returns, n_steps=res.n_steps + again.n_steps)
 
 
-def _with_escaped_at_start(scene, ics, traj_ids, outside, batch_size, count_steps, progress):
-    """run_chunk for a chunk with orbits that start at r ≥ r_esc: those are escaped at t = 0
-    (the authors' square ICs); the others run as usual. Rows keep traj_id order."""
+def _empty_result(traj_ids) -> ChunkResult:
+    """A chunk result without orbits."""
+    crossings = _rows_to_columns([], CROSSING_COLUMNS, traj_ids)
+    crossings["direction"] = crossings["direction"].astype(np.int8)
+    return ChunkResult({}, _rows_to_columns([], SECTION_COLUMNS, traj_ids),
+                       _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids), crossings)
+
+
+def _with_escaped_at_start(scene, ics, traj_ids, outside, res):
+    """The chunk's result from ``res`` (its orbits that start inside r_esc) and the orbits ``outside`` (a mask):
+    those start at r ≥ r_esc and are escaped at t = 0 (the authors' square ICs). Rows keep traj_id order."""
     inside = ~outside
     model = scene.model
-    if inside.any():
-        res = run_chunk(scene, ics[inside], traj_ids[inside], batch_size=batch_size, count_steps=count_steps,
-                        progress=progress)
-    else:
-        res = ChunkResult({}, _rows_to_columns([], SECTION_COLUMNS, traj_ids),
-                          _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids),
-                          _rows_to_columns([], CROSSING_COLUMNS, traj_ids))
-        res.crossings["direction"] = res.crossings["direction"].astype(np.int8)
     x, y, px, py = ics.T
     lt = {
         "traj_id": traj_ids, "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),

@@ -35,7 +35,10 @@ and its orbit range); the readers of :mod:`hhscatter.data.schema` read exactly t
 planned parts whose chunk is finished, check each part's metadata against the
 plan and verify the page checksums, and refuse anything else. An unfinished
 chunk (no ``lifetimes`` part) makes the run incomplete: an error for readers
-unless they pass ``allow_partial=True``.
+unless they pass ``allow_partial=True``. When the run ends, ``scene.json`` also
+gets ``event_failures``: heyoka's event-detection failures per chunk (an event
+heyoka ignored in a step; :mod:`hhscatter.integrate.heyoka_log`) and the orbits
+redone because of them (zero counts included: the key says they were checked).
 
 One writer per run directory: ``simulate`` holds an exclusive ``flock`` on
 ``OUT/.hhscatter.lock`` (:meth:`hhscatter.data.store.Store.lock`) from its checks to
@@ -48,6 +51,7 @@ a :class:`RunError`.
 """
 from __future__ import annotations
 
+import json
 import multiprocessing as mp
 import os
 import queue as queue_mod
@@ -61,7 +65,7 @@ from hhscatter.data.store import Store
 from hhscatter.errors import ConfigError, RunError
 from hhscatter.run.dask_backend import check_scheduler, dask_client
 from hhscatter.run.output import prepare_output
-from hhscatter.run.plan import RunSummary, plan_chunks, points_of
+from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
 from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
 from hhscatter.scene.grid import Grid
@@ -174,18 +178,39 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
         check_scheduler(scheduler, workers)
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
+    earlier = _earlier_event_failures(out) if resume else {}
     store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
     try:
-        return _simulate(run, store, points, table_ics, workers, resume, progress, scheduler)
+        summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier)
+        _record_event_failures(store, summary)
+        return summary
     finally:
         Store.unlock(lock)
 
 
-def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler) -> RunSummary:
+def _earlier_event_failures(out) -> dict:
+    """The per-chunk event-failure counts of the run in ``out`` (its scene.json), kept when it is resumed."""
+    try:
+        store = Store(out)
+        if not store.exists(SCENE_FILE):
+            return {}
+        return dict(json.loads(store.read_text(SCENE_FILE)).get("event_failures", {}).get("chunks", {}))
+    except (OSError, ValueError, AttributeError):
+        return {}
+
+
+def _record_event_failures(store, summary) -> None:
+    """Write the run's heyoka event-detection failures (per chunk, and the orbits redone) into its scene.json."""
+    doc = json.loads(store.read_text(SCENE_FILE))
+    doc["event_failures"] = summary.event_failures_record()
+    store.write_json(SCENE_FILE, doc)
+
+
+def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier=None) -> RunSummary:
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
-    summary = RunSummary()
+    summary = RunSummary(event_failures=dict(earlier or {}))
     n_total = sum(sc.n for sc, _, _ in points)
     n_chunks = sum(-(-sc.n // sc.chunk_size) for sc, _, _ in points)
     todo = []
