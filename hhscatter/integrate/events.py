@@ -75,7 +75,7 @@ T_INITIAL = 1e-6
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
 
-#: the outcome rules an event can trigger (each a handler of :class:`hhscatter.integrate.engine.LaneRules`)
+#: the outcome rules an event can trigger (each a handler of :class:`hhscatter.integrate.lanes.LaneRules`)
 RULES = ("escape", "closure", "far", "resc", "radius", "section", "clock")
 
 
@@ -86,7 +86,7 @@ class EventSpec:
     ``direction``: +1 (upward roots only), −1 (downward) or 0 (both);
     ``expression``: callable (Symbols) -> heyoka expression whose root is the event;
     ``rule``: the outcome rule its root triggers (one of :data:`RULES`; the handler
-    :meth:`hhscatter.integrate.engine.LaneRules.handler` binds); ``index``: the rule's argument (the radius
+    :meth:`hhscatter.integrate.lanes.LaneRules.handler` binds); ``index``: the rule's argument (the radius
     number of a follow radius), or None.
     """
 

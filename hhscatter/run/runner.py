@@ -57,6 +57,7 @@ import os
 import queue as queue_mod
 import time
 import uuid
+from typing import NamedTuple
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing.managers import SyncManager
 
@@ -72,6 +73,17 @@ from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
 
+
+
+class ChunkTask(NamedTuple):
+    """One task of a run: the orbits start..stop−1 of one point's scene, chunk ``chunk`` of its plan."""
+
+    scene_json: str  # the point's scene (Scene.to_json), what the worker rebuilds it from
+    chunk: int
+    start: int
+    stop: int
+    partition: str  # the grid point's folder ('' for a single scene)
+    scene_hash: str  # the point's result hash, computed once per run
 
 
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
@@ -221,20 +233,18 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
                 if chunk_complete(scene, store, chunk, start, stop, partition, want=h):
                     summary.chunks_skipped += 1
                     continue
-                todo.append((scene_json, chunk, start, stop, partition, h))
-        done_orbits = n_total - sum(t[3] - t[2] for t in todo)
+                todo.append(ChunkTask(scene_json, chunk, start, stop, partition, h))
+        done_orbits = n_total - sum(t.stop - t.start for t in todo)
         n_todo = len(todo)
-    else:  # planned lazily: one task tuple per chunk in flight, not per chunk of the run
-        todo = ((sj, chunk, start, stop, partition, h) for scene, partition, h in points
+    else:  # planned lazily: one task per chunk in flight, not per chunk of the run
+        todo = (ChunkTask(sj, chunk, start, stop, partition, h) for scene, partition, h in points
                 for sj in (scene.to_json(),) for chunk, start, stop in plan_chunks(scene))
         done_orbits, n_todo = 0, n_chunks
 
-    def args(task):
-        scene_json, c, s, e, partition, _ = task
-        if table_ics is None:
-            return (scene_json, c, s, e, out_url, None, None, partition)
-        states, ids = table_ics
-        return (scene_json, c, s, e, out_url, states[s:e], ids[s:e], partition)
+    def args(task: ChunkTask):
+        ics = (None, None) if table_ics is None else (table_ics[0][task.start:task.stop],
+                                                      table_ics[1][task.start:task.stop])
+        return (task.scene_json, task.chunk, task.start, task.stop, out_url, *ics, task.partition)
 
     t0 = time.perf_counter()
     bar = progress_bar(progress, n_total, done_orbits, run.name)
@@ -243,7 +253,7 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
 
     def on_done(task, result):
         summary.add(result)
-        bar.update(max(0, task[3] - task[2] - reported.pop((task[4], task[1]), 0)))
+        bar.update(max(0, task.stop - task.start - reported.pop((task.partition, task.chunk), 0)))
 
     def on_progress(key, k):
         reported[key] = reported.get(key, 0) + k
@@ -263,9 +273,9 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
             summary.workers = workers
             if workers == 1 or n_todo <= 1:
                 for task in todo:
-                    key = (task[4], task[1])
+                    key = (task.partition, task.chunk)
                     tell = (lambda k, key=key: on_progress(key, k)) if progress else None
-                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task[5]))
+                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task.scene_hash))
             else:
                 _run_pool(min(workers, n_todo), todo, args, on_done, on_progress if progress else None)
     except OSError as exc:
@@ -321,8 +331,8 @@ def _run_dask(client, todo, args, on_done, name):
     tag = uuid.uuid4().hex[:8]
 
     def submit(task):
-        key = f"hhscatter-{name}-{task[4].replace('/', ',') + '-' if task[4] else ''}{task[1]}-{tag}"
-        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task[5])
+        key = f"hhscatter-{name}-{task.partition.replace('/', ',') + '-' if task.partition else ''}{task.chunk}-{tag}"
+        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task.scene_hash)
 
     def wait_first(fs):
         alone_since = None
