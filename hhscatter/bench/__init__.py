@@ -1,4 +1,4 @@
-"""Benchmarks and stress tests (issue 5): ``make bench`` and ``make stress``.
+"""Benchmarks and stress tests: ``make bench`` and ``make stress``.
 
 Modules: :mod:`.peers` (KahanLi8 and DOP853 compiled with numba, SciPy's
 DOP853, the engine behind one interface), :mod:`.reference` (heyoka long

@@ -24,7 +24,7 @@ absolute times, are the result). Rows:
   (ICs sampled, Parquet parts written) against the minimal driver run as a
   whole process (the same ICs, the yardstick, one Parquet table of t_end;
   ``python -m hhscatter.bench.engine --driver N SEED OUT``), the two run
-  alternately, best of each (target ≤ 1.2, issue 27).
+  alternately, best of each (target ≤ 1.2).
 
 Writes ``studies/engine/out/<full|quick>/engine.csv`` and ``engine_summary.md``
 (``make docs-assets`` copies them to the benchmarks page). Not a
@@ -301,7 +301,7 @@ def _bare_rows(row, n, rep):
 
 
 def _system_rows(row, n, rep):
-    """Systems as data (issue 23): Hénon–Heiles declared as an expression against the built-in on the same ICs
+    """Systems as data: Hénon–Heiles declared as an expression against the built-in on the same ICs
     (target ≤ 1.05: a declared potential costs no more per step), and ns per lane-step of the other built-ins."""
     from hhscatter.model.spec import system_from_spec  # deferred: like the scene imports beside it
     from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
@@ -420,7 +420,7 @@ def _write_outputs(rows, out, n, rep):
     lines = ["| target | measure | value | goal | note |", "|---|---|---|---|---|"]
     lines += [f"| {r.target} | {r.measure} | {r.value:.3g} | {r.goal} | {r.note} |" for r in df.itertuples()]
     (out / "engine_summary.md").write_text(
-        f"Engine targets (issue 11), N = {n} per measurement, 1 core, best of {rep}; every ratio is "
+        f"Engine targets, N = {n} per measurement, 1 core, best of {rep}; every ratio is "
         "measured side by side in one run.\n\n" + "\n".join(lines) + "\n")
     print(f"wrote {out / 'engine.csv'} and {out / 'engine_summary.md'}")
 

@@ -1,4 +1,4 @@
-"""``make bench-memory``: peak memory of simulate + P(t) analysis as N grows (issue 6).
+"""``make bench-memory``: peak memory of simulate + P(t) analysis as N grows.
 
     python -m hhscatter.bench.memory [--n 1e5 1e6 1e7] [--energy 0.27] [--workers 1]
                                      [--chunk-size 10000] [--dir runs/bench-memory] [--keep]

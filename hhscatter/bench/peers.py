@@ -1,4 +1,4 @@
-"""Peer integrators for the work–precision benchmark (``make bench``), issue 5.
+"""Peer integrators for the work–precision benchmark (``make bench``).
 
 All peers integrate the same Hénon–Heiles system (ω = λ = 1, paper
 Eq. (eqn:hh_ham), drag −γp) from the same initial conditions with the

@@ -1,4 +1,4 @@
-"""Numerical stress tests of the engine (``make stress``, issue 5).
+"""Numerical stress tests of the engine (``make stress``).
 
 Each case is a function that takes its size as arguments, runs the engine
 (:func:`hhscatter.integrate.engine.run_chunk` or :func:`hhscatter.run.runner.simulate`)

@@ -1,4 +1,4 @@
-"""Work–precision of hhscatter's engine against the paper's integrators (``make bench``, issue 5).
+"""Work–precision of hhscatter's engine against the paper's integrators (``make bench``).
 
 Two scenes, the same initial conditions for every method (disk ICs of
 :mod:`hhscatter.scene.ics`, fixed seed) and the same escape rule:

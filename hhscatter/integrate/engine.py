@@ -27,7 +27,7 @@ the step-size control: the same steps, measured). No propagation bound ever
 clamps a step: a bound (lane start + t_max) used to, and the censored state,
 and the root of any event in a step clamped by an earlier orbit's stale
 bound, then depended on when the lane's earlier orbits ended (the chunk
-size; issue 27). A chunk is one ``propagate_until`` call, so every orbit's
+size). A chunk is one ``propagate_until`` call, so every orbit's
 steps are exactly those it has alone.
 
 *Epochs* (scenes with energy snapshots). A step callback in Python on every

@@ -64,7 +64,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
     key = f"{partition}/{chunk}" if partition else str(chunk)
     if res.event_failures:  # heyoka ignored an event in some step: counted, and the orbits hit were redone
         meta["event_failures"] = {"count": res.event_failures, "redone": [int(k) for k in res.redone]}
-    if scene.system is not None:  # issue 23: which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
+    if scene.system is not None:  # which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
         meta["system"] = scene.model.provenance()
     rows = res.tables()
     # lifetimes last: its presence marks a complete chunk

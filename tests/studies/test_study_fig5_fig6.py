@@ -231,7 +231,7 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
         assert sec["traj_id"].is_unique and check(sec).all()  # one crossing per orbit, in the window
         assert auth["n_points"][key] == int((np.hypot(sec["x"], sec["y"]) < 1).sum())
     rows = {r["quantity"]: r for r in nums["paper_comparison"]}
-    # the authors' rows are paired (issue 28): 5a and 5b against both references, one row each, like for like
+    # the authors' rows are paired: 5a and 5b against both references, one row each, like for like
     paired = [q for q, r in rows.items() if r["authors"] and q.startswith(("Fig. 5a closer", "Fig. 5b closer"))
               and "than to μ_c^0.35, paired" in q]
     refs = {r["set"]: r for r in nums["refs_paired"]["rows"] if r["construction"] == "authors" and "set" in r}
