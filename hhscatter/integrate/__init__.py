@@ -2,22 +2,20 @@
 
 One module per concern (in the manner of SciPy's ``integrate/_ivp``):
 
-==================  ====================================================================================
-``events``          the events and outcome rules of a scene, as data; builds heyoka's integrators
-``lanes``           the lane-rules contract: :class:`~hhscatter.integrate.lanes.LaneRules`, the rules as
-                    event handlers per lane, and the callbacks bound to them
-``batch``           lanes of one batch integrator, and the per-process cache of compiled integrators
-``stream``          the stream scheduler (no snapshots): an orbit's end loads the next in its callback
-``epochs``          the epoch scheduler (snapshots): all lanes advance together, ``propagate_grid``
-``orbit_time``      an orbit's time on a stream lane (TwoSum, near-ties to even)
-``chunk``           ``run_chunk``: one block of orbits, its schedulers, phases and results
-``rerun``           orbits integrated again: the no-return rule's late orbits, and those hit by an
-                    event-detection failure (found, and redone on the reference driver)
-``results``         a chunk's rows (:class:`~hhscatter.integrate.results.ChunkResult`)
-``reference``       the reference driver: one orbit on heyoka's scalar integrator, any precision
-``heyoka_log``      heyoka's log captured, event-detection failures counted
-``engine``          the public names of all of these, gathered (``run_chunk``, ``simulate_orbit``, ...)
-==================  ====================================================================================
+| module | concern |
+|---|---|
+| `events` | the events and outcome rules of a scene, as data; builds heyoka's integrators |
+| `lanes` | the lane-rules contract: `LaneRules`, the rules as event handlers per lane, their callbacks |
+| `batch` | lanes of one batch integrator, and the per-process cache of compiled integrators |
+| `stream` | the stream scheduler (no snapshots): an orbit's end loads the next in its callback |
+| `epochs` | the epoch scheduler (snapshots): all lanes advance together, `propagate_grid` |
+| `orbit_time` | an orbit's time on a stream lane (TwoSum, near-ties to even) |
+| `chunk` | `run_chunk`: one block of orbits, its schedulers, phases and results |
+| `rerun` | orbits integrated again: the no-return rule's late ones, those an event-detection failure hit |
+| `results` | a chunk's rows (`ChunkResult`) |
+| `reference` | the reference driver: one orbit on heyoka's scalar integrator, any precision |
+| `heyoka_log` | heyoka's log captured, event-detection failures counted |
+| `engine` | the public names of all of these, gathered (`run_chunk`, `simulate_orbit`, ...) |
 
 The life of an orbit in a lane, in one vocabulary (the method names of the modules above):
 

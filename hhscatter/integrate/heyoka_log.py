@@ -65,8 +65,9 @@ def capture():
     """capture() -> context manager yielding a :class:`Log`: heyoka's log while the block runs.
 
     Standard output (descriptor 1, where heyoka logs) goes to a temporary file for the block; on exit the
-    event-failure lines are counted into the Log and every other line is written back to standard output. A capture inside another
-    counts the lines of its own block; the outer one counts them too and passes the others on.
+    event-failure lines are counted into the Log and every other line is written back to standard output. A
+    capture inside another counts the lines of its own block; the outer one counts them too and passes the
+    others on.
     """
     with _LOCK:
         log = Log()
