@@ -31,7 +31,7 @@ import re
 from pathlib import Path
 
 _MARKER = re.compile(r"^([ \t]*)<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->[ \t]*$", re.M)
-_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
+_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance", "made_from", "sha256"}
 
 
 # -- number formatting: hhscatter.publish.formatting, shared with the report and the figures ---------------------
@@ -401,6 +401,27 @@ class Renderer:
             return "*No paper-scale number differs from its quick-scale value by more than the quick-scale error.*\n"
         return "\n".join(out) + "\n"
 
+    def outcomes(self, _arg=None) -> str:
+        """The outcome names and what each means, from hhscatter.outcomes (the one declaration)."""
+        import hhscatter.outcomes as oc
+
+        doc = oc.__doc__ or ""
+        out = []
+        for name in oc.OUTCOMES:
+            m = re.search(rf"^\* ``{name}``: (.*?)(?=^\* ``|^\s*$)", doc, flags=re.M | re.S)
+            what = " ".join(m.group(1).split()) if m else ""
+            censor = " (censors the lifetime)" if name in oc.CENSORING_OUTCOMES else ""
+            out.append(f"- `{name}`: {what}{censor}")
+        return "\n".join(out) + "\n"
+
+    def study_names(self, _arg=None) -> str:
+        """The studies `make studies` builds, from the study folders, in the order it builds them."""
+        from hhscatter.studies.graph import studies
+
+        names = [s.name for s in studies(self.root / "studies")]
+        links = ", ".join(f"[{n}](studies/{n}.md)" for n in names)
+        return f"`make studies` builds {len(names)} studies, one per folder, each after the ones it needs: {links}.\n"
+
     def cli(self, _arg=None) -> str:
         from hhscatter.cli import build_parser
 
@@ -647,6 +668,10 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
 
         about = {s.name: s.summary for s in studies(Path(config["config_file_path"]).resolve().parent / "studies")}
         markdown = figure_first(markdown, about.get(fig.group(1), ""))
+        # a study page gives its figure the width of the page: the table of contents (a few headings) goes
+        meta = getattr(page, "meta", None)
+        if isinstance(meta, dict):
+            meta["hide"] = [*meta.get("hide", []), "toc"]
     docs = Path(config["docs_dir"])
     root = Path(config["config_file_path"]).resolve().parent
     page_dir = (docs / page.file.src_uri).parent

@@ -7,11 +7,9 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
 from hhscatter.api.plotting import plot_escape_rates, plot_survival
-from hhscatter.api.points import _label, split_points
+from hhscatter.api.points import _key_columns, _label, _sorted_keys, split_points
 from hhscatter.data.read import iter_survival_batches
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
@@ -54,7 +52,7 @@ class SurvivalCurves:
         """curves[(energy, gamma)] -> SurvivalCurve; ``curves[energy]`` if that energy has one point."""
         if key in self.curves:
             return self.curves[key]
-        hits = [k for k in self.curves if not isinstance(key, tuple) and k[0] == key]
+        hits = [k for k in self.curves if (k[0] == key if not isinstance(key, tuple) else k[:len(key)] == key)]
         if len(hits) == 1:
             return self.curves[hits[0]]
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
@@ -63,7 +61,7 @@ class SurvivalCurves:
         """to_frame() -> DataFrame energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        parts = [pd.DataFrame({"energy": k[0], "gamma": k[1], "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
+        parts = [pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
                  for k, c in self.curves.items()]
         return pd.concat(parts, ignore_index=True)
 
@@ -164,9 +162,9 @@ class EscapeRates:
         import pandas as pd  # deferred: pandas loads on first use
 
         rows = []
-        for key in sorted(self.n, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1])):
+        for key in _sorted_keys(self.n):
             r = self.results.get(key)
-            row = {"energy": key[0], "gamma": key[1], "n": self.n[key]}
+            row = {**_key_columns(key), "n": self.n[key]}
             if r is None:
                 row.update(kappa=math.nan, kappa_err=math.nan, kappa_stat=math.nan, kappa_spread=math.nan,
                            tau0=math.nan, t_stop=math.nan, windows=None, kappa_mle=math.nan,

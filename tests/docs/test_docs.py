@@ -310,7 +310,11 @@ def test_citation_and_licence_agree_with_pyproject():
     paper = cff["references"][0]
     assert paper["title"] == "Probabilistic description of dissipative chaotic scattering"
     assert [a["family-names"] for a in paper["authors"]] == ["Burton", "Dullin", "Altmann"]
-    assert "doi" not in paper  # none is known: the manuscript names none (add it when published)
+    assert "doi" not in paper  # none is known (add it when published)
+    assert {"type": "other", "value": "arXiv:2308.13555"}.items() <= paper["identifiers"][0].items()
+    assert paper["url"] == "https://arxiv.org/abs/2308.13555" and paper["year"] == 2023
+    for where in ("README.md", "docs/index.md"):  # the paper by its arXiv id wherever it is cited first
+        assert "arXiv:2308.13555" in (ROOT / where).read_text() and ".tex" not in (ROOT / where).read_text()
     assert (ROOT / "LICENSE").read_text().startswith("MIT License")
 
 
@@ -365,3 +369,15 @@ def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(
 def test_an_indented_marker_is_rendered_indented(tmp_path, hook):
     out, _ = _page(tmp_path, hook, '??? note "x"\n\n    <!-- hh:verdict-rule -->\n')
     assert "\n    !!! info" in out and "both uncertainties" in out
+
+
+def test_the_outcomes_and_the_study_list_come_from_the_code(tmp_path, hook):
+    import hhscatter.outcomes as oc
+    from hhscatter.studies.graph import studies
+
+    out = hook.Renderer(ROOT, DOCS, DOCS / "concepts").outcomes()
+    assert [line.split("`")[1] for line in out.splitlines()] == list(oc.OUTCOMES)
+    assert "- `stopped`: stopped early" in out and "(censors the lifetime)" in out
+    names = hook.Renderer(ROOT, DOCS, DOCS).study_names()
+    assert all(f"[{s.name}](studies/{s.name}.md)" in names for s in studies(ROOT / "studies"))
+    assert f"builds {len(studies(ROOT / 'studies'))} studies" in names
