@@ -5,8 +5,7 @@ A study is one folder ``studies/<name>/`` (adding a study is making a folder):
 ``study.toml``  its parameters, the one place they live, with ``[about]`` (what it
                 is) and ``[needs]`` (the studies whose published outputs it reads:
                 the one declared dependency graph, :mod:`hhscatter.studies.graph`);
-``study.py``    its three stages (the module ``hhscatter.studies.<name>.study``: the
-                study folders are subpackages of this package);
+``study.py``    its three stages (loaded from the folder by path, :func:`stage_module`);
 ``figure.py``   its figure code; ``page.md`` its page of the docs;
 ``out/<scale>/`` what it makes.
 
@@ -58,7 +57,6 @@ from hhscatter.studies.study import (
     load_conventions,
     load_study,
     missing_upstream,
-    outputs_root,
     simulate_inputs,
     stage_module,
     studies_root,
@@ -75,7 +73,6 @@ __all__ = [
     "load_conventions",
     "load_study",
     "missing_upstream",
-    "outputs_root",
     "run_stage",
     "simulate_inputs",
     "stage_module",

@@ -86,6 +86,24 @@ def test_true_time_root_equals_the_renewal_rate_with_random_times():
     assert np.mean(np.where(dst == 0, np.exp(k * T), 0.0)) == pytest.approx(1.0, abs=1e-10)
 
 
+@pytest.mark.parametrize("n, per_state", [(10, 3), (50, 3), (400, 2)])
+def test_communicating_classes_are_the_strongly_connected_components(n, per_state):
+    """Random transition graphs with cycles and self-loops (scipy 1.13.0 with numpy 2 never returned on such graphs,
+    hence the floor scipy >= 1.13.1): the classes against reachability computed independently (i ~ j iff each
+    reaches the other, transitive closure by repeated Boolean squaring)."""
+    rng = np.random.default_rng(n)
+    m = per_state * n
+    src, dst = rng.integers(0, n, m), np.where(rng.random(m) < 0.1, -1, rng.integers(0, n, m))
+    labels, classes = tf.communicating_classes(tf.Transitions(src, dst, np.ones(m), n))
+    reach = np.eye(n, dtype=bool)
+    reach[src[dst >= 0], dst[dst >= 0]] = True
+    for _ in range(int(np.ceil(np.log2(n))) + 1):
+        reach = reach | ((reach.astype(np.int64) @ reach.astype(np.int64)) > 0)
+    same = reach & reach.T
+    assert (same == (labels[:, None] == labels[None, :])).all()
+    assert sorted(c.label for c in classes) == list(range(labels.max() + 1))
+
+
 def test_closed_class_has_no_root_and_is_separated():
     # states 0, 1 leak into each other and out; state 2 maps to itself (an 'island'); 3 → 2 (transient)
     src = np.array([0, 0, 0, 1, 1, 2, 2, 3])

@@ -169,14 +169,13 @@ def test_fig5_tiny_end_to_end(tiny_studies):
     assert any(r["quantity"].startswith("t*") for r in nums["paper_comparison"])
 
 
-def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch):
+def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch, copy_study):
     from hhscatter.studies import run_stage
 
     monkeypatch.delenv(up.DEV_ENV, raising=False)
     for name in ("fig3", "fig5"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
-    (tmp_path / "fig1").mkdir()
-    shutil.copy(REPO / "studies" / "fig1" / "study.toml", tmp_path / "fig1" / "study.toml")
+    copy_study("fig1", tmp_path)
     with pytest.raises(up.UpstreamError, match="fig5 needs the published outputs of fig1 .*make fig5 SCALE=tiny"):
         run_stage("fig5", "analyze", "tiny", root=tmp_path)
 
@@ -415,7 +414,9 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
 def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
     """Issue 13's rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
-    from hhscatter.studies.fig5.study import REFS_QUANTITY, _qualify_our_5b
+    from hhscatter.studies import stage_module
+
+    REFS_QUANTITY, _qualify_our_5b = stage_module("fig5").REFS_QUANTITY, stage_module("fig5")._qualify_our_5b
 
     def rows(auth_verdict):
         return [
