@@ -409,7 +409,7 @@ def test_distances_zero_for_identical_sets_and_symmetric():
 
 def test_histogram_distance_inequalities():
     rng = np.random.default_rng(1)
-    for i in range(30):
+    for _ in range(30):
         P = gaussian_blob(rng.integers(50, 2000), rng, sd=rng.uniform(0.05, 0.3))
         Q = gaussian_blob(rng.integers(50, 2000), rng, centre=rng.uniform(0.3, 0.7, 2), sd=rng.uniform(0.05, 0.3))
         box = rng.choice([0.02, 0.05, 0.1, 0.3])
@@ -458,7 +458,7 @@ def test_split_half_baseline_matches_hellinger_noise_floor():
     X = rng.uniform(0, 1, (20000, 2))
     for box in (0.1, 0.05):
         B = round(1 / box) ** 2
-        h2 = lambda A, C: distance.histogram_distance(A, C, box, UNIT) ** 2  # noqa: E731
+        h2 = lambda A, C, box=box: distance.histogram_distance(A, C, box, UNIT) ** 2  # noqa: E731
         r = distance.split_half_baseline(X, h2, 40, seed=1)
         assert r.mean == pytest.approx((B - 1) / 8 * (2 / 10000), rel=0.15)
         assert r.std > 0
