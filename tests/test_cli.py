@@ -183,7 +183,7 @@ def test_scene_takes_an_integral_float_count_like_the_cli():
 
 def test_the_command_starts_without_loading_the_study_framework():
     """Every command's parser lists the studies (graph.py, stdlib only) without importing hhscatter.studies, the
-    runner, the tables or pydantic (≈ 0.25 s of start-up for every `hhscatter` call; issue 27)."""
+    runner, the tables or pydantic (≈ 0.25 s of start-up for every `hhscatter` call)."""
     import subprocess
     import sys
 

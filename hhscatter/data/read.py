@@ -513,7 +513,7 @@ def _describe_parts(store, man):
     """describe_run of a local run with a manifest, from its part files one by one with ``pyarrow.parquet``
     (the same checks as :func:`_dataset`: the plan, each part's metadata, the checksums of the pages read):
     ``pyarrow.dataset`` and the pandas it imports cost ~0.5 s, which every ``simulate`` paid for its closing
-    lines (issue 27). None for a part that holds more than one grid point (then :func:`_dataset` counts)."""
+    lines. None for a part that holds more than one grid point (then :func:`_dataset` counts)."""
     import types  # deferred: only this path needs it
     import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 

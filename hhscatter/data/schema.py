@@ -191,7 +191,7 @@ _NUMPY_OF = {"double": np.float64, "int64": np.int64, "int8": np.int8}  # the Ar
 def _arrow(arr, typ, mask=None):
     """_arrow(arr, typ, mask=None) -> the Arrow array ``pa.array(arr, typ, mask=mask)`` made from the numpy
     buffer itself: the same values, validity and buffers (masked slots keep their values, as in pa.array), without ``pa.array``'s check for pandas objects,
-    which imports pandas (~0.5 s of every ``simulate`` process, issue 27)."""
+    which imports pandas (~0.5 s of every ``simulate`` process)."""
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
     a = np.ascontiguousarray(arr, dtype=_NUMPY_OF[str(typ)])

@@ -51,7 +51,7 @@ def write_part(path, table, meta: dict, store=None, *, sync_dir: bool = True) ->
 def dictionary_columns(schema) -> list:
     """dictionary_columns(schema) -> names of the columns worth Parquet's dictionary encoding: all but the
     float64 and int64 ones (orbit states, times and ids, nearly all distinct: pyarrow built a dictionary for
-    each and dropped it again, 35 % of a lifetimes part's write time, issue 27). Dictionary-typed columns
+    each and dropped it again, 35 % of a lifetimes part's write time). Dictionary-typed columns
     keep their encoding, so every table reads back the same (types included); zstd still compresses the
     plain columns (a constant column to a few bytes)."""
     import pyarrow as pa  # deferred: pyarrow loads on first use

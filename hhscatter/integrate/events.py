@@ -61,7 +61,7 @@ from hhscatter.outcomes import (  # re-exported for the engine
 # Every initial condition of the default (tangential) momentum lies on the section (x px + y py = 0 exactly in
 # double). With the event value exactly 0 at the start of a step, heyoka's root
 # isolation reported the root at t = 0 twice and lost the next crossing in the
-# same (first) step (issue 5). A constant offset of 1e-300 makes the start
+# same (first) step. A constant offset of 1e-300 makes the start
 # value non-zero; it moves a crossing by 1e-300/|d(x px + y py)/dt|. (Random-direction momenta
 # (Scene.momentum = "random") start off the section: the first root is a real crossing, after T_INITIAL.)
 SECTION_OFFSET = 1e-300

@@ -1,6 +1,6 @@
 """The contract of a system: an open two-degree-of-freedom potential with a dissipation law.
 
-Everything hhscatter integrates or analyses reads the system through this contract (issue 23: a system is
+Everything hhscatter integrates or analyses reads the system through this contract (a system is
 data): the scene's validation, the events (escape radius, the closure E = E_c inside Ω, the section ṙ = 0,
 φ̇ > 0 about the well's minimum), the IC regions, the outcome rules and exit channels, the analysis (E_c) and
 the tables' provenance. Nothing outside a system's own definition may know which potential it is.

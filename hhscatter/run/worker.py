@@ -61,7 +61,7 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         "orbits": [start, stop],
         **provenance(),
     }
-    if scene.system is not None:  # issue 23: which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
+    if scene.system is not None:  # which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
         meta["system"] = scene.model.provenance()
     rows = res.tables()
     # lifetimes last: its presence marks a complete chunk

@@ -6,7 +6,7 @@ Positions are uniform in area in a region; the speed is fixed by the energy,
 - 'tangential' (default; the authors' ``goodICs``), on the section:
   ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V));
 - 'random': ẋ0 = cos θ · √(2(E − V)), ẏ0 = sin θ · √(2(E − V)) with θ uniform
-  in [0, 2π) (issue 28's sensitivity row). These ICs are not on the section;
+  in [0, 2π) (the sensitivity row of study fig5). These ICs are not on the section;
   the engine records no crossing at t < T_INITIAL, and the first ṙ = 0 root
   with φ̇ > 0 after that is the orbit's first section point.
 
@@ -105,7 +105,7 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
     Required columns: x, y, px, py (float); optional traj_id (unique int).
     Missing columns, non-finite values or duplicate ids raise ConfigError.
     Read with pyarrow (Parquet: only these columns), not pandas, whose import
-    alone cost a third of a second of every ``simulate --ics`` (issue 27).
+    alone cost a third of a second of every ``simulate --ics``.
     Example: ``states, ids = read_ics_table("ics.parquet")``.
     """
     path = Path(path)

@@ -83,7 +83,7 @@ __all__ = [
 
 def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
               root: Path | None = None):
-    """run_stage(name, stage, scale='quick', workers=None) -> None; stage in simulate/analyze/plot/all."""
+    """Run one stage of a study (simulate, analyze, plot, or all three) at a scale, recording its cost."""
     if stage not in (*STAGES, "all"):
         raise StudyError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
     study = load_study(name, scale, root=root)
@@ -103,7 +103,7 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
 
 
 def checked_raw_runs(study) -> dict:
-    """checked_raw_runs(study) -> {key: {scene_hash, orbits, complete}} of the raw runs analyze may read.
+    """The raw runs analyze may read, {key: {scene_hash, orbits, complete}}, each checked.
 
     StudyError (exit 2, before any analysis) if the simulate stage did not finish for the current
     study.toml (``raw/done.json`` missing, or made from another configuration), or if a raw run it made

@@ -55,7 +55,7 @@ def studies_root() -> Path:
 
 
 def study_names(root: Path | None = None) -> list[str]:
-    """study_names(root=None) -> names of the study folders (with a study.toml), each after the studies it needs."""
+    """The names of the study folders (with a study.toml), each after the studies it needs."""
 
     try:
         return [s.name for s in studies(root if root is not None else studies_root())]
@@ -302,7 +302,7 @@ class Study:
 
 
 def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) -> Study:
-    """load_study(name, scale='quick', root=None) -> Study from ``<root>/<name>/study.toml``."""
+    """The study ``<root>/<name>/study.toml`` at a scale, its file checked strictly before any work."""
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
@@ -342,7 +342,7 @@ def conventions_path(root: Path | None = None) -> Path:
 
 
 def load_conventions(path: Path | None = None) -> dict:
-    """load_conventions(path=None) -> {name: {scene key: value}} of the conventions file, strictly checked."""
+    """The conventions file as {name: {scene key: value}}, strictly checked."""
 
     path = Path(path) if path is not None else conventions_path()
     try:
@@ -371,7 +371,7 @@ def _params_model(name: str, root: Path):
 
 
 def missing_upstream(study: Study) -> list[str]:
-    """missing_upstream(study) -> the declared upstream studies whose numbers JSON (same scale) is not there yet."""
+    """The declared upstream studies whose numbers JSON (same scale) is not there yet."""
     out = []
     for other in sorted(set(study.needs.values())):
         try:

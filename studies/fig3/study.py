@@ -26,7 +26,7 @@ of the ensemble's energies (± 3 std), wider by √n.  Both are drawn.
 Errors of μ: bootstrap over orbits (statistical); the least-squares error
 of the fit itself measures the model misfit and is reported separately.
 
-The authors' conventions beside ours (issue 13).  Besides our μ (every orbit
+The authors' conventions beside ours.  Besides our μ (every orbit
 not escaped, fit on [0, 200]) the study fits μ on ``alt_window`` = [0, 100]
 and fits the average over orbits with E > E_c only on both windows; each is a
 row of its own (key ``authors_convention`` of fig3.json).  ``[study]``

@@ -16,7 +16,7 @@ simulate   one dissipative run per γ in ``gammas`` (raw key ``gamma<γ>``), all
            section crossings in [t*(μ_max), t*(μ_min) + pad] recorded, so that
            t* is fixed at analysis time from fig3's μ; the authors' two runs
            (square ICs, their windows: ``5a_authors``, ``5b_authors``) and the
-           same two with momenta in random directions (``*_random``, issue 28).
+           same two with momenta in random directions (``*_random``).
 analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            samples at E1 and E2 from study fig1's published points
            (derived/cmeasure_points.parquet: first crossing after fig1's
@@ -27,7 +27,7 @@ analyze    t* from μ (fig3.json); the Fig. 5a/b point sets; the c-measure
            noise floor, giving the agreement scale ε*), sliced Wasserstein with
            bootstrap errors; every verdict that rests on a distance with a
            paired interval over half-samples of the orbits of every set, the
-           references included (issue 28): 5b − 5a (``verdict_5b``), μ_c^{E1}
+           references included: 5b − 5a (``verdict_5b``), μ_c^{E1}
            vs μ_c^{E2} (``refs_paired``), panel (d) (``panel_d``).  Writes
            derived tables and fig5.json.
 plot       Fig. 5 (a), (b) and the distance panels from the derived tables.
@@ -136,7 +136,7 @@ AUTHORS_CONVENTION = ("region 'square' (goodICs), γ = gamma_main, r < 1; 5a: fi
                       "5b: first crossing with E in {band} at any time")
 
 
-#: the sensitivity runs of the verdict (issue 28): the authors' runs again, momenta as ``sensitivity_momentum``
+#: the sensitivity runs of the verdict: the authors' runs again, momenta as ``sensitivity_momentum``
 SENSITIVITY = {"5a_authors_random": "5a_authors", "5b_authors_random": "5b_authors"}
 SENSITIVITY_CONVENTION = AUTHORS_CONVENTION + "; momenta in random directions (momentum = '{m}'), not goodICs' tangential ones"
 
@@ -154,7 +154,7 @@ def _qualify_our_5b(rows) -> None:
     """Our Fig. 5b (our 5a filtered to the energy band) "differs" only where the authors' own 5b does too.
 
     The paper's claims about 5b are checked in its own construction (AUTHORS); a "differs" of ours that the
-    authors' construction does not reproduce is a difference of our convention only (issue 13's verdict rule).
+    authors' construction does not reproduce is a difference of our convention only (the verdict rule).
     The authors' rows: 5b against the two references (:func:`_compare_refs_paired`) and 5b against 5a, like for
     like over grid placements (:func:`_compare_verdict`, construction 'cut_offsets').
     """
@@ -217,7 +217,7 @@ def _r_cut(df, r_cut):
     return df[np.hypot(df["x"], df["y"]) < r_cut].reset_index(drop=True)
 
 
-#: the paper-comparison rows of the paired verdicts (issue 28)
+#: the paper-comparison rows of the paired verdicts
 VERDICT_QUANTITY = "Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d(5a): {label}"
 REFS_QUANTITY = "Fig. {s} closer to μ_c^0.30 than to μ_c^0.35, paired Δ = d(μ_c^0.35) − d(μ_c^0.30)"
 
@@ -232,7 +232,7 @@ VERDICT_ROWS = (
 
 
 def _verdict_5b(study, cm_full, E1, ours):
-    """The 5b − 5a verdict (issue 28) in every construction of VERDICT_ROWS: debiased Hellinger distances to
+    """The 5b − 5a verdict in every construction of VERDICT_ROWS: debiased Hellinger distances to
     μ_c^{E1} at box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every
     set, the reference included (:func:`~hhscatter.analysis.geometry.distance.paired_hellinger_difference`). Sets of
     one comparison are cut alike. Returns the JSON record, or None when the sets are too small (tiny scale)."""
@@ -312,7 +312,7 @@ def _interval_row(values, level):
 
 
 def _refs_paired(study, cm_full, sets_ours, E1, E2):
-    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired (issue 28): one draw of the run's orbits serves both
+    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired: one draw of the run's orbits serves both
     distances, each reference's orbits drawn independently; Δ = d(μ_c^{E2}) − d(μ_c^{E1}) > 0 means closer to
     μ_c^{E1}. Two constructions, each cut alike: ours (γ = gamma_main, no cut) and the authors' (their two runs,
     r < r_cut on every set). The distances are computed at every box side (``curves``: panel (c)), the rows at
@@ -386,7 +386,7 @@ def _fmt_iv(iv):
 
 
 def _panel_d_paired(study, sets, pg, dtab, E1, cm_E1):
-    """Panel (d) with paired intervals (issue 28): Fig. 5a at every γ against μ_c^{E1} on common half-samples
+    """Panel (d) with paired intervals: Fig. 5a at every γ against μ_c^{E1} on common half-samples
     (one draw of the orbits for all γ, whose runs share their ICs, and one of the reference's): the debiased Hellinger
     curve vs box side with percentile bands, the agreement scale ε*_δ of every replicate (its interval), the share
     of replicates in which ε*_δ shrinks with t*, and the paired differences of d at box_headline between
@@ -742,7 +742,7 @@ def _distances(study, sets, refs, usable, m_common, extent):
 def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
     """The paper comparison: t*, the plotted fraction, ⟨E⟩ at the crossings, which c-measure is closer by SW1 in
     Fig. 5a and 5b, and whether the significance agreement scale ε*_2σ shrinks with t*. Returns
-    {'a'|'b': closer to μ_c^{E1} by SW1}. The debiased-Hellinger rows are paired (issue 28)."""
+    {'a'|'b': closer to μ_c^{E1} by SW1}. The debiased-Hellinger rows are paired."""
     E1 = study.params.E1
     def srow(g, s, ref):
         r = stab[(stab["gamma"] == g) & (stab["set"] == s) & (stab["ref"] == ref)]
@@ -772,8 +772,7 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
                       "μ_c^{E1} better than μ_c^{E2}", verdict="agrees" if closer else "differs",
                       note="sliced Wasserstein W1 (units of x, y), bootstrap 1σ")
     # the debiased-Hellinger rows (5a/5b to μ_c^E1 vs μ_c^E2, 5b vs 5a, panel (d)) have paired intervals over
-    # orbits: _compare_refs_paired, _compare_verdict, _compare_panel_d (issue 28; their split-spread forerunners
-    # are retired)
+    # orbits: _compare_refs_paired, _compare_verdict, _compare_panel_d
     return verdicts
 
 

@@ -1,4 +1,4 @@
-"""Study ``resc``: is the escape criterion r > r_esc sound? (paper App. "Escape Condition"; issue 3).
+"""Study ``resc``: is the escape criterion r > r_esc sound? (paper App. "Escape Condition").
 
 The paper deems a conservative orbit escaped at its first outward crossing of
 r_esc "slightly larger than 1" and states that all values tried gave the same

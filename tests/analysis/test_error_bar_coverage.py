@@ -1,4 +1,4 @@
-"""Coverage of the error bars (issue 13, item 4): on synthetic ensembles with a known answer, about 68 % of the
+"""Coverage of the error bars: on synthetic ensembles with a known answer, about 68 % of the
 1σ intervals must cover the truth, within the exact binomial band at 3σ over ≥ 200 replicates."""
 from __future__ import annotations
 

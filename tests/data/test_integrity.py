@@ -1,4 +1,4 @@
-"""Fault injection: the 12 cases of issue #20, each at small N, each with its exact outcome.
+"""Fault injection: 12 cases, each at small N, each with its exact outcome.
 
 Nothing wrong is read or published silently: every case ends in a clear refusal (its message asserted)
 or in a correct result (byte-identical to an undisturbed run). Processes are started by the tests and

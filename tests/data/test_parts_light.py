@@ -1,4 +1,4 @@
-"""The lighter paths of writing and describing a run (issue 27) give what the general ones give: ``to_arrow``
+"""The lighter paths of writing and describing a run give what the general ones give: ``to_arrow``
 builds its arrays from the numpy buffers (the same Arrow data as ``pa.array``, byte for byte in Arrow IPC),
 ``describe_run`` counts a manifest run from its part files (the same dict as the ``pyarrow.dataset`` scan)."""
 from __future__ import annotations

@@ -210,7 +210,7 @@ def _fresh_chunk(scene, ics, ids):
 def test_reused_integrator_gives_the_rows_of_a_new_one(kind):
     """Bitwise: a chunk on an integrator that a chunk of another scene with the same compiled system
     (another γ, other orbits, orbits ended mid-flight) left behind gives the rows of a new integrator:
-    the reset restores time, state, parameters and cooldowns (issue 27)."""
+    the reset restores time, state, parameters and cooldowns."""
     from hhscatter.integrate import engine
 
     if kind == "dissipative_recording":

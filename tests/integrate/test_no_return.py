@@ -1,4 +1,4 @@
-"""The no-return rule of dissipative scenes (issue 27): an escaped orbit stops at the system's no-return radius
+"""The no-return rule of dissipative scenes: an escaped orbit stops at the system's no-return radius
 R(E) instead of r_far = max(10 r_s, 2 r_esc), with every table bitwise what the scene's own r_far gives
 (the rule's proof: hhscatter.model.henon_heiles.HenonHeiles.no_return_radius; the engine's use of it:
 hhscatter.integrate.engine._no_return). The references are the same scenes with an explicit r_far (10, the

@@ -1,4 +1,4 @@
-"""The engine on every built-in system and a declared expression (issue 23): energy conservation, escape times
+"""The engine on every built-in system and a declared expression: energy conservation, escape times
 against a long-double reference, the closure at E = E_c inside Ω, and the exit fractions of symmetric systems."""
 import numpy as np
 import pytest

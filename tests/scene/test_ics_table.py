@@ -1,4 +1,4 @@
-"""read_ics_table: Parquet and CSV read with pyarrow (no pandas on the simulate path: issue 27), the values
+"""read_ics_table: Parquet and CSV read with pyarrow (no pandas on the simulate path), the values
 exactly those written, and the file's mistakes refused with the key named."""
 import math
 import subprocess

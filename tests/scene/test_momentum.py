@@ -1,4 +1,4 @@
-"""The momentum convention of region ICs (issue 28): 'tangential' (default, unchanged) and 'random' directions."""
+"""The momentum convention of region ICs: 'tangential' (default, unchanged) and 'random' directions."""
 from __future__ import annotations
 
 import os
@@ -17,7 +17,7 @@ from hhscatter.scene.ics import BLOCK, region_ics
 from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
-BASE = "fa21699"  # main before the momentum option (issue 28)
+BASE = "fa21699"  # main before the momentum option
 M = HenonHeiles()
 
 

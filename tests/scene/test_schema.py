@@ -15,7 +15,7 @@ import pytest
 from hhscatter.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-BASE = "f701897"  # main before the strict configuration (and the study rooms) of issue 12
+BASE = "f701897"  # main before the strict configuration (and the study rooms)
 
 
 def _files(root: Path) -> list[str]:
@@ -223,7 +223,7 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
              for key in ("5a_authors", "5b_authors", "5a_authors_random", "5b_authors_random")}
     assert set(before) <= set(after) and set(after) - set(before) == added
     after = {k: after[k] for k in before}
-    # changed on purpose for the paper scale (issue 15): fig1's pilot keeps its quick-scale size (it fixes t_rec).
+    # changed on purpose for the paper scale: fig1's pilot keeps its quick-scale size (it fixes t_rec).
     # (fig2's runs after its pilots, e.g. the square-IC runs and the paper-scale N per energy, need a pilot's
     # result and are not reached here: their scenes are tested in test_study_fig1_fig2.)
     by_design = {k for k in before if k.startswith("fig1/paper/pilot_E")}

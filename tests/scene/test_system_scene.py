@@ -1,4 +1,4 @@
-"""A scene's system as data (issue 23): the [system] table, its canonical form, the hash, the drag law."""
+"""A scene's system as data: the [system] table, its canonical form, the hash, the drag law."""
 import json
 import math
 

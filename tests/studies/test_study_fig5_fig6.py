@@ -230,7 +230,7 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
         assert sec["traj_id"].is_unique and check(sec).all()  # one crossing per orbit, in the window
         assert auth["n_points"][key] == int((np.hypot(sec["x"], sec["y"]) < 1).sum())
     rows = {r["quantity"]: r for r in nums["paper_comparison"]}
-    # the authors' rows are paired (issue 28): 5a and 5b against both references, one row each, like for like
+    # the authors' rows are paired: 5a and 5b against both references, one row each, like for like
     paired = [q for q, r in rows.items() if r["authors"] and q.startswith(("Fig. 5a closer", "Fig. 5b closer"))
               and "than to μ_c^0.35, paired" in q]
     refs = {r["set"]: r for r in nums["refs_paired"]["rows"] if r["construction"] == "authors" and "set" in r}
@@ -243,7 +243,7 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
 
 
 def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
-    """Issue 28: 5a/5b against μ_c^0.30 and μ_c^0.35 and panel (d) carry paired intervals: Δ is the difference of
+    """5a/5b against μ_c^0.30 and μ_c^0.35 and panel (d) carry paired intervals: Δ is the difference of
     the two distances in every replicate, so its mean is the difference of the means; panel (d) has one curve per
     γ (ordered by t*) with its bands around the mean, and one step between consecutive t*."""
     from hhscatter.studies import load_study
@@ -267,7 +267,7 @@ def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
 
 
 def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_studies):
-    """Issue 28's sensitivity row: 5a/5b_authors_random are the authors' scenes but for momentum = 'random', and
+    """The sensitivity row: 5a/5b_authors_random are the authors' scenes but for momentum = 'random', and
     the verdict has its row, made like 'cut_offsets' from those runs, with its own convention."""
     from hhscatter.data.read import read_sections
     from hhscatter.studies import load_study
@@ -413,7 +413,7 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
 
 def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
-    """Issue 13's rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
+    """The verdict rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
     from hhscatter.studies import stage_module
 
     REFS_QUANTITY, _qualify_our_5b = stage_module("fig5").REFS_QUANTITY, stage_module("fig5")._qualify_our_5b

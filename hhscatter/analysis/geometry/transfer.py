@@ -1,4 +1,4 @@
-"""Transfer operators from sampled transitions: Ulam's method for open maps and true-time maps (issue 26).
+"""Transfer operators from sampled transitions: Ulam's method for open maps and true-time maps.
 
 The paper's open question (Sec. "Discussion and Conclusion"): "spectral approaches considering
 Perron–Frobenius (or similar) operators acting on these densities". This module holds the pure
