@@ -1,4 +1,4 @@
-"""κ from P(t) of every built-in at E = 1.5 E_c (N = 2e4, t_max = 2000), one table.
+"""κ from P(t) of every built-in at E = 1.5 E_c (N = 2e4, t_max = 2000): a check of every built-in.
 
     .venv/bin/python tools/kappa_builtins.py      # ~4 CPU-min; prints one JSON line per system
 """

@@ -10,6 +10,11 @@
   turns each such label into the equation's number, linked to its entry on
   ``equations.md`` (which is the one list of labels and numbers), and drops
   figure labels (``fig:survprob``) beside the figure number they repeat.
+* **Exponents and indices in prose.** Plain-text formulas of pages and
+  docstrings (``E0 e^{−μγt}``, ``μ_c^{E1}``, ``Σ_{s∈i}``, written so that
+  ``help()`` reads them) are set as superscripts and subscripts
+  (``<sup>``/``<sub>``) by ``on_page_content``, outside maths and code: a
+  reader never sees a brace of TeX (:func:`scripts_outside_math`).
 * **Footer.** ``on_config`` writes the commit (and date) the site was built
   from into the footer, so a page's numbers can be traced to their code.
 """
@@ -25,7 +30,7 @@ MATHJAX_DEST = "javascripts/mathjax"
 #: what tex-chtml.js loads: itself, its fonts, TeX extensions (autoload), the menu and accessibility parts
 MATHJAX_PARTS = ("tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions", "ui", "a11y")
 
-_HEADING = re.compile(r"^###\s+\((\d+)\).*\{#([\w-]+)\}\s*$", re.M)
+_HEADING = re.compile(r"^###\s+\(([A-Z]?\d+)\).*\{#([\w-]+)\}\s*$", re.M)
 _EQREF = re.compile(r"\((eqn?:[\w-]+)\)")
 _FIGREF_DUP = re.compile(r"\s*(?:\(fig:[\w-]+\)|= fig:[\w-]+|, fig:[\w-]+)")
 _FIGREF = re.compile(r"\bfig:([\w-]+)")
@@ -73,6 +78,55 @@ def link_labels(html: str, numbers: dict, prefix: str) -> str:
     return "".join(parts)
 
 
+_TAG = re.compile(r"<(/?)([a-zA-Z][\w-]*)([^>]*)>")
+#: elements whose text is never rewritten: code, scripts, and the maths arithmatex marked for MathJax
+_KEEP = {"code", "pre", "script", "style", "textarea", "kbd", "samp"}
+_VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
+
+
+def _scripts(text: str) -> str:
+    """``x^{a}`` → x<sup>a</sup>, ``x_{a}`` → x<sub>a</sub> (braces matched, nested ones converted too)."""
+    out, i = [], 0
+    while i < len(text):
+        if text[i] in "^_" and text.startswith("{", i + 1):
+            depth, j = 0, i + 1
+            while j < len(text):
+                depth += {"{": 1, "}": -1}.get(text[j], 0)
+                if depth == 0:
+                    break
+                j += 1
+            if depth == 0:
+                tag = "sup" if text[i] == "^" else "sub"
+                out.append(f"<{tag}>{_scripts(text[i + 2:j])}</{tag}>")
+                i = j + 1
+                continue
+        out.append(text[i])
+        i += 1
+    return "".join(out)
+
+
+def scripts_outside_math(html: str) -> str:
+    """scripts_outside_math(html) -> ``^{…}``/``_{…}`` of the prose set as <sup>/<sub>; code and maths untouched."""
+    if "^{" not in html and "_{" not in html:
+        return html
+    out, pos, stack = [], 0, []
+    for m in _TAG.finditer(html):
+        text = html[pos:m.start()]
+        out.append(text if stack else _scripts(text))
+        closing, name, attrs = m.group(1), m.group(2).lower(), m.group(3)
+        if not closing and name not in _VOID and not attrs.rstrip().endswith("/"):
+            keep = name in _KEEP or "arithmatex" in attrs or name.startswith("mjx")
+            if keep or stack:
+                stack.append(name)
+        elif closing and stack and stack[-1] == name:
+            stack.pop()
+        out.append(m.group(0))
+        pos = m.end()
+    tail = html[pos:]
+    out.append(tail if stack else _scripts(tail))
+    return "".join(out)
+
+
 def build_commit(root: Path) -> str:
     try:
         out = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=root, capture_output=True,
@@ -110,4 +164,4 @@ def on_files(files, config, **kwargs):
 def on_page_content(html, page, config, files, **kwargs):
     numbers = equation_numbers(config["docs_dir"])
     prefix = "../" * page.file.url.count("/")
-    return link_labels(html, numbers, prefix)
+    return scripts_outside_math(link_labels(html, numbers, prefix))

@@ -30,7 +30,7 @@ import json
 import re
 from pathlib import Path
 
-_MARKER = re.compile(r"^<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->\s*$", re.M)
+_MARKER = re.compile(r"^([ \t]*)<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->[ \t]*$", re.M)
 _SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
 
 
@@ -108,6 +108,8 @@ class Renderer:
         return f'??? abstract "Configuration: `studies/{name}/study.toml` (click to open)"\n\n' + _indent(out) + "\n"
 
     def study_figure(self, name: str) -> str:
+        """The study's figure at the headline scale (paper where committed) at the full width of the text, a click
+        zooms it (docs/javascripts/zoom.js); the quick-scale figure folded below it."""
         png = self.study_asset(name, "png")
         paper = self.study_asset(name, "png", "paper")
         if not png.exists() and not paper.exists():
@@ -115,21 +117,19 @@ class Renderer:
                 f"The figure `{name}.png`",
                 f"Run `make {name}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
-        if not paper.exists():
-            scale = self._scale_of(name)
-            cap = f"`make {name}`" + (f" at scale *{scale}*" if scale else "")
-            src = self._rel(png)
-            return f"[![{name}: figure made by {cap}]({src})]({src})\n\n*Figure made by {cap} (click for full size).*\n"
-        # both scales, side by side (click for full size)
-        cells = []
-        for path, scale in ((png, "quick"), (paper, "paper")):
-            if not path.exists():
-                continue
+
+        def figure(path, scale, cmd):
             src = self._rel(path)
-            cells.append(f'<figure markdown="span">\n[![{name} at scale {scale}]({src})]({src})\n'
-                         f"<figcaption><code>make {name} SCALE={scale}</code></figcaption>\n</figure>")
-        return ('<div class="hh-scales" markdown>\n' + "\n".join(cells) + "\n</div>\n\n"
-                "*Left: quick scale; right: the paper's scale (click for full size).*\n")
+            return (f'<figure class="hh-figure" markdown="span">\n[![{name}, {scale} scale]({src})]({src}){{ .hh-zoom }}\n'
+                    f"<figcaption>{scale.capitalize()} scale: <code>{cmd}</code> (click to zoom)</figcaption>\n</figure>\n")
+
+        if not paper.exists():
+            return figure(png, "quick", f"make {name}")
+        out = figure(paper, "paper", f"make {name} SCALE=paper")
+        if png.exists():
+            out += ('\n??? note "The same figure at the quick scale (click to open)"\n\n'
+                    + _indent(figure(png, "quick", f"make {name}")) + "\n")
+        return out
 
     def _numbers(self, name: str, scale: str = "quick"):
         path = self.study_asset(name, "json", scale)
@@ -137,12 +137,21 @@ class Renderer:
             return None
         return json.loads(path.read_text())
 
+    def _headline(self, name: str):
+        """(numbers JSON, scale) at the headline scale: paper where committed, else quick (None, None if neither)."""
+        for scale in ("paper", "quick"):
+            doc = self._numbers(name, scale)
+            if doc is not None:
+                return doc, scale
+        return None, None
+
     def _scale_of(self, name: str):
         doc = self._numbers(name)
         return doc.get("scale") if doc else None
 
     def _both_scales(self, quick_rows, paper_rows) -> str:
         """The paper-vs-ours rows at both scales in one table, matched by quantity."""
+        from hhscatter.analysis.stats.verdicts import row_verdict
         from hhscatter.publish.formatting import format_value, ours_cell
 
         def ours(r):
@@ -157,29 +166,28 @@ class Renderer:
             a, b = q.get(k), p.get(k)
             r = b or a
             out.append(f"| {_cell(k)} | {_cell(ours(a))} | {_cell(ours(b))} | {_cell(r.get('convention') or '—')} | "
-                       f"{_cell(format_value(r.get('paper')))} | {_cell((b or {}).get('verdict') or '—')} |")
+                       f"{_cell(format_value(r.get('paper')))} | {_cell(row_verdict(b, 'paper') if b else '—')} |")
         return "\n".join(out) + "\n"
 
     def study_numbers(self, name: str) -> str:
-        doc = self._numbers(name)
+        """The paper-vs-ours rows (both scales side by side when the paper scale is committed, its verdicts by the one
+        rule) and every number the study wrote at the headline scale, folded."""
+        doc, scale = self._headline(name)
         if doc is None:
             return self.missing(
                 f"The numbers `{name}.json`",
                 f"Run `make {name}` and then `make docs-assets` to copy the quick-scale numbers here.",
             )
         out = []
+        quick = self._numbers(name, "quick")
         rows = doc.get("paper_comparison") or []
-        paper_doc = self._numbers(name, "paper")
-        if paper_doc is not None:
-            out.append("Against the paper, at both scales (± is 1σ of our estimate; the paper gives no "
-                       "uncertainties; the verdict is the paper-scale one):\n")
-            out.append(self._both_scales(rows, paper_doc.get("paper_comparison") or []))
-            link = self._rel(self.study_asset(name, "json", "paper"))
-            out.append(f"*The full paper-scale record, with its configuration: [{name}.json (paper)]({link}).*\n")
-            out.append("Quick scale in detail:\n")
-        if rows:
-            out.append("Against the paper (± is 1σ of our estimate; the paper gives no uncertainties):\n")
-            out.append(comparison_table(rows))
+        if scale == "paper" and quick is not None:
+            out.append("Against the paper, at both scales (± is 1σ of our estimate; the verdict is the paper "
+                       "scale's, by the rule of the [studies index](index.md#the-papers-numbers-beside-ours)):\n")
+            out.append(self._both_scales(quick.get("paper_comparison") or [], rows))
+        elif rows:
+            out.append(f"Against the paper, {scale} scale (± is 1σ of our estimate):\n")
+            out.append(comparison_table(rows, scale=scale))
         leaves = []
         for key, v in doc.items():
             if key not in _SKIP_KEYS:
@@ -188,8 +196,8 @@ class Renderer:
         tables = [(k, v) for k, v in leaves if _is_record_list(v)]
         scalars = [(k, v) for k, v in leaves if (k, v) not in texts and (k, v) not in tables]
         if texts:
-            out.append("Rules and definitions the study states:\n")
-            out.extend(f"`{k}`\n:   {v}\n" for k, v in texts)
+            out.append('??? abstract "Rules and definitions the study states (click to open)"\n\n'
+                       + _indent("\n".join(f"`{k}`\n:   {v}\n" for k, v in texts)) + "\n")
         body = []
         for k, recs in tables:
             body.append(f"`{k}`:\n")
@@ -200,14 +208,19 @@ class Renderer:
             body.append("")
         if body:
             inner = "\n".join(body)
-            out.append('??? info "All numbers the study wrote"\n\n' + _indent(inner) + "\n")
+            out.append(f'??? info "All numbers the study wrote, {scale} scale (click to open)"\n\n'
+                       + _indent(inner) + "\n")
         prov = doc.get("provenance") or {}
-        bits = [f"scale **{doc.get('scale', '?')}**"]
+        bits = [f"scale **{doc.get('scale', scale)}**"]
         bits += [f"{k} {v}" for k, v in prov.items() if v and k != "git_commit"]
         if prov.get("git_commit"):
             bits.append(f"commit `{str(prov['git_commit'])[:12]}`")
-        link = self._rel(self.study_asset(name, "json"))
-        out.append(f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: [{name}.json]({link}).*\n")
+        link = self._rel(self.study_asset(name, "json", scale))
+        more = ""
+        if scale == "paper" and quick is not None:
+            more = f" The quick scale's: [{name}.json (quick)]({self._rel(self.study_asset(name, 'json'))})."
+        out.append(f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: "
+                   f"[{name}.json]({link}).{more}*\n")
         return "\n".join(out)
 
     def claims_table(self, name: str) -> str:
@@ -221,9 +234,8 @@ class Renderer:
         for i, (sc, doc) in enumerate(docs.items()):
             table = claims_table(doc)
             link = self._rel(self.study_asset(name, "json", sc))
-            made = str((doc.get("provenance") or {}).get("git_commit") or "?")[:12]
-            caption = (f"*Scale **{sc}**: the records `claims` of [{name}.json ({sc})]({link}), made at commit "
-                       f"`{made}`; a cell is value ± 1σ: verdict (z = distance to the reference in σ).*\n")
+            caption = (f"*Scale **{sc}**: the records `claims` of [{name}.json ({sc})]({link}); a cell is "
+                       f"value ± 1σ: verdict (z = distance to the reference in σ).*\n")
             if i == 0:
                 out.append(table + "\n" + caption)
             else:
@@ -254,21 +266,30 @@ class Renderer:
         return "\n".join(out) + "\n"
 
     def comparison_all(self, _arg=None) -> str:
+        """Every study's paper-vs-ours rows in one table, each at its headline scale (paper where committed)."""
         from hhscatter.studies.graph import studies
 
-        out, missing = [], []
+        out, missing, scales = [], [], {}
         for name in (s.name for s in studies(self.root / "studies")):
-            doc = self._numbers(name)
-            rows = (doc or {}).get("paper_comparison") or []
+            doc, scale = self._headline(name)
             if doc is None:
                 missing.append(name)
                 continue
-            for r in rows:
-                out.append({**r, "quantity": f"[{name}]({name}.md): {r.get('quantity', '')}"})
+            scales.setdefault(scale, []).append(name)
+            for r in doc.get("paper_comparison") or []:
+                out.append({**r, "scale": scale, "quantity": f"[{name}]({name}.md): {r.get('quantity', '')}"})
         text = comparison_table(out) if out else "*No study has written paper-vs-ours rows yet.*\n"
+        said = "; ".join(f"{sc} scale: " + ", ".join(f"[{n}]({n}.md)" for n in names) for sc, names in scales.items())
+        text += f"\n*Scale of each study's rows — {said}.*\n" if said else ""
         if missing:
             text += "\n*Not yet generated: " + ", ".join(f"[{m}]({m}.md)" for m in missing) + ".*\n"
         return text
+
+    def verdict_rule(self, _arg=None) -> str:
+        """The one verdict rule, as the code states it (hhscatter.analysis.stats.verdicts.RULE)."""
+        from hhscatter.analysis.stats.verdicts import RULE
+
+        return f'!!! info "The verdict rule (every table and page)"\n    {RULE}\n'
 
     def bench(self, which=None) -> str:
         which = which or "bench"
@@ -286,6 +307,26 @@ class Renderer:
             if f"]({self._rel(png)})" not in text:
                 text += f"\n\n![{png.stem}]({self._rel(png)})\n\n*{png.name}*\n"
         return text
+
+    def bench_goals(self, _arg=None) -> str:
+        """The engine's goals against what was measured (docs/benchmarks/assets/engine/engine.csv, the rows with a
+        goal), with a count of the goals met: the first thing the benchmarks page says."""
+        import csv
+
+        path = self.docs / "benchmarks" / "assets" / "engine" / "engine.csv"
+        if not path.exists():
+            return self.missing("The engine's goals", "Run `make bench-engine` and then `make docs-assets`.")
+        rows = [r for r in csv.DictReader(path.open()) if (r.get("goal") or "").strip()]
+        out = ["| target | measure | goal | measured | met |", "|---|---|---|---|---|"]
+        met = 0
+        for r in rows:
+            ok = goal_met(float(r["value"]), r["goal"])
+            met += bool(ok)
+            out.append(f"| {_cell(r['target'])} | {_cell(r['measure'])} | {_cell(r['goal'])} | "
+                       f"{fmt_num(float(r['value']), 3)} | {'yes' if ok else '**no**' if ok is False else '?'} |")
+        head = (f"**{met} of {len(rows)} goals met** (`make bench-engine`, one core, best of three; the "
+                "[engine targets](#engine-targets) below give every measurement and its note):\n")
+        return head + "\n" + "\n".join(out) + "\n"
 
     def _costs(self, scale: str) -> dict:
         """{study: hhscatter.studies.cost.summary of its committed cost record at ``scale``}."""
@@ -333,13 +374,16 @@ class Renderer:
         out.append(f"| **total** | **{tot['q']:.2f} → {tot['p']:.2f}** | {tot['qw']:.2f} → {tot['pw']:.2f} | | | | | |")
         return "\n".join(out) + "\n"
 
-    def scale_changes(self, _arg=None) -> str:
-        """Every paper-vs-ours number that moved between quick and paper scale by more than its quick-scale error."""
+    def scale_changes(self, only=None) -> str:
+        """Every paper-vs-ours number that moved between quick and paper scale by more than its quick-scale error
+        (of one study: ``<!-- hh:scale-changes fig2 -->``, e.g. inside the page's folded quick-vs-paper note)."""
         from hhscatter.studies.graph import studies
 
         out = ["| study | quantity | quick | paper scale | change / σ_quick |", "|---|---|---|---|---|"]
         n = 0
         for st in studies(self.root / "studies"):
+            if only and st.name != only:
+                continue
             q, p = self._numbers(st.name), self._numbers(st.name, "paper")
             if not q or not p:
                 continue
@@ -371,6 +415,16 @@ class Renderer:
             out.extend(f"| `{f.name}` | `{f.type}`{'' if f.nullable else ' (not null)'} |" for f in schema)
             out.append("")
         return '??? abstract "The Arrow schemas, as the code defines them"\n\n' + _indent("\n".join(out)) + "\n"
+
+
+def goal_met(value: float, goal: str):
+    """goal_met(3.1, "≤ 2 (1.5)") -> False: the first comparison of a goal text ("≤ x", "≥ x", "< x", "> x");
+    None when the goal states none."""
+    m = re.match(r"\s*(≤|≥|<|>|<=|>=)\s*([-+0-9.eE]+)", goal)
+    if not m:
+        return None
+    op, x = m.group(1), float(m.group(2))
+    return {"≤": value <= x, "<=": value <= x, "<": value < x, "≥": value >= x, ">=": value >= x, ">": value > x}[op]
 
 
 def _flatten(key, v, depth=0):
@@ -447,11 +501,11 @@ def _indent(text: str, n: int = 4) -> str:
     return "\n".join((" " * n + line) if line.strip() else "" for line in text.splitlines())
 
 
-def comparison_table(rows) -> str:
-    """Markdown table of paper-vs-ours rows {quantity, ours, err, paper, unit, verdict, note}."""
+def comparison_table(rows, scale=None) -> str:
+    """Markdown table of paper-vs-ours rows {quantity, ours, err, paper, unit, verdict, note}; verdicts by the rule."""
     from hhscatter.publish.formatting import comparison_table as table
 
-    return table(rows)
+    return table(rows, scale=scale)
 
 
 def _embed_markdown(text: str, assets: Path, rel) -> str:
@@ -599,10 +653,12 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
     r = Renderer(root, docs, page_dir)
 
     def sub(m):
-        kind, arg = m.group(1), m.group(2)
+        indent, kind, arg = m.group(1), m.group(2), m.group(3)
         fn = getattr(r, kind.replace("-", "_"), None)
         if fn is None:
             raise ValueError(f"{page.file.src_uri}: unknown docs marker hh:{kind}")
-        return fn(arg)
+        out = fn(arg)
+        # a marker inside an admonition (indented) gets its content indented alike
+        return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 
     return _MARKER.sub(sub, markdown)

@@ -27,7 +27,7 @@ the step-size control: the same steps, measured). No propagation bound ever
 clamps a step: a bound (lane start + t_max) used to, and the censored state,
 and the root of any event in a step clamped by an earlier orbit's stale
 bound, then depended on when the lane's earlier orbits ended (the chunk
-size; issue 27). A chunk is one ``propagate_until`` call, so every orbit's
+size). A chunk is one ``propagate_until`` call, so every orbit's
 steps are exactly those it has alone.
 
 *Epochs* (scenes with energy snapshots). A step callback in Python on every
@@ -536,7 +536,7 @@ class _Stream(_BatchRules):
         """The closures the inlined handlers share: a lane's orbit time, the end of an orbit at a given time and
         state (record, load the next), the end of an orbit where the lane is now, the loading of the next orbit
         (returns what a callback returns); state captured once, as lists, Python floats and per-lane views.
-        Per orbit end (measured, issue 27): the lane time is read once (an orbit that ends where the lane is
+        Per orbit end (measured): the lane time is read once (an orbit that ends where the lane is
         ends at the time the next starts), the state through ``cols[lane]`` (a third of ``state[:4, lane]``)."""
         orbit, last_out = self.orbit, self.last_out
         hi, lo, starts_hi, starts_lo = self.time_hi, self.time_lo, self.start_hi, self.start_lo

@@ -21,6 +21,8 @@ from __future__ import annotations
 import math
 import re
 
+from hhscatter.analysis.stats.verdicts import row_verdict
+
 __all__ = [
     "comparison_table",
     "embed_markdown",
@@ -72,7 +74,7 @@ def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
     0.912 ± 0.003, 0.310 ± 0.012, 152 ± 7); v to the same decimal place.
     Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15).
     Without a usable error (None, NaN, < 0) the value alone; an error of 0 is
-    written "± 0". ``sep`` e.g. r" \\pm " inside LaTeX labels of figures.
+    written "± 0". ``sep``: e.g. ``r" \\pm "`` inside the LaTeX labels of figures.
     """
     if not _is_num(v) or (isinstance(v, float) and not math.isfinite(v)):
         return format_number(v)
@@ -122,20 +124,24 @@ def ours_cell(row) -> str:
     return (format_value_err(ours, row.get("err")) if _is_num(ours) else format_value(ours)) + unit
 
 
-def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None) -> str:
-    """comparison_table(rows, *, study=False, quantity=None, verdict=None) -> Markdown table.
+def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None, scale: str | None = None) -> str:
+    """comparison_table(rows, *, study=False, quantity=None, verdict=None, scale=None) -> Markdown table.
 
     ``rows``: paper-vs-ours rows {quantity, ours, err, paper, unit, verdict,
     note} (and ``study`` for a leading study column). ``quantity`` and
     ``verdict`` may map a row / a verdict to the text of their cell (e.g. a
     link, or a coloured span in HTML). Columns: quantity, ours, convention
-    (how our number was made, when a row says), paper, verdict, note.
+    (how our number was made, when a row says), paper, verdict, note. The
+    verdict cell is the one rule's
+    (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, both
+    uncertainties; none at the tiny ``scale``), whatever rule the row was
+    written with.
     """
     conv = any(r.get("convention") for r in rows)
     head = ["study"] * study + ["quantity", "ours"] + ["convention (ours)"] * conv + ["paper", "verdict", "note"]
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        v = r.get("verdict") or "—"
+        v = row_verdict(r, r.get("scale", scale))
         cells = [r.get("study", "")] * study + [
             quantity(r) if quantity else md_cell(r.get("quantity", "")),
             md_cell(ours_cell(r))] + [md_cell(r.get("convention") or "—")] * conv + [

@@ -20,6 +20,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from hhscatter.analysis.stats.verdicts import RULE, row_verdict
 from hhscatter.publish.formatting import (
     comparison_table,
     embed_markdown,
@@ -214,7 +215,7 @@ def split_rows(rows, sections):
 def verdict_counts(rows) -> dict:
     counts = {"ok": 0, "bad": 0, "meh": 0, "": 0}
     for r in rows:
-        counts[_verdict_class(r.get("verdict"))] += 1
+        counts[_verdict_class(row_verdict(r))] += 1
     return counts
 
 
@@ -243,10 +244,11 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
     paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
     prov = _provenance(sections)
     lines = [f"# hhscatter reproduction report ({scale} scale)", "",
-             "Reproduction of Burton, Dullin & Altmann, *Dissipative chaotic scattering* (Hénon–Heiles with linear "
+             "Reproduction of L. Burton, H. Dullin, E. G. Altmann, *Probabilistic description of dissipative "
+             "chaotic scattering*, arXiv:2308.13555 (2023) (Hénon–Heiles with linear "
              "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
-             "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: |ours − paper| "
-             "≤ 2σ (our statistical error) unless the row says otherwise. The paper's numbers are in the authors' "
+             "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: "
+             f"{RULE} The paper's numbers are in the authors' "
              "convention; the column *convention (ours)* says how each of ours was made (\"authors'\" marks a row "
              "made in the authors' own convention). \"Differs\" is kept for differences that survive the authors' "
              "convention; one that does not reads \"differs in our convention only\" and is not counted as a "

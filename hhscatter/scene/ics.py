@@ -6,7 +6,7 @@ Positions are uniform in area in a region; the speed is fixed by the energy,
 - 'tangential' (default; the authors' ``goodICs``), on the section:
   ẋ0 = −y0/r0 · √(2(E − V)),   ẏ0 = x0/r0 · √(2(E − V));
 - 'random': ẋ0 = cos θ · √(2(E − V)), ẏ0 = sin θ · √(2(E − V)) with θ uniform
-  in [0, 2π) (the sensitivity row of study fig5). These ICs are not on the section;
+  in [0, 2π), a sensitivity row of Fig. 5. These ICs are not on the section;
   the engine records no crossing at t < T_INITIAL, and the first ṙ = 0 root
   with φ̇ > 0 after that is the orbit's first section point.
 

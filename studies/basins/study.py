@@ -1,4 +1,4 @@
-"""Study ``basins``: exit basins and their fractality under dissipation (beyond the paper; issue 16).
+"""Study ``basins``: exit basins and their fractality under dissipation (beyond the paper).
 
 The paper's conclusion expects fractal structure in dissipative scattering
 "in suitable limits of E0, γ and t", with a cut-off in the scaling coming
@@ -96,7 +96,7 @@ def scan_unc_key(E, i):
 
 
 def _scan(study):
-    """(energies, ε) of the γ = 0 energy scan (issue 25, point 5); energies must lie above E_c."""
+    """(energies, ε) of the γ = 0 energy scan; energies must lie above E_c."""
     energies = list(study.params.scan_energies)
     eps = np.asarray(study.params.scan_eps)
     if energies:
@@ -164,7 +164,7 @@ def zoom_centre(labels, extent, box=5, clearance=0):
 
     ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
     forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
-    cells around the centre is wholly allowed (issue 25: the unconstrained choice sat at the edge of the
+    cells around the centre is wholly allowed (the unconstrained choice sat at the edge of the
     allowed region, where the zooms showed mostly forbidden cells).
     """
     from scipy import ndimage
@@ -477,7 +477,7 @@ def _rate(eps, times):
 
 
 def _energy_scan(study, extent, boxes, hb, E_b):
-    """γ = 0 energy scan (issue 25, point 5): per E0, S_b, S_bb, the exits' Wada test, α and λ."""
+    """γ = 0 energy scan: per E0, S_b, S_bb, the exits' Wada test, α and λ."""
     from hhscatter.analysis.geometry.basins import (
         basin_entropy_table,
         basin_fractions,

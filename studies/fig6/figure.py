@@ -70,7 +70,7 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path, pc_fits=None, pc
     models_a += [(f"{PC}_{h}", LS_PC.get(h, "-."), f"model, {h} hazard,\npaper's $\\kappa_0(E)$, $\\mu$", 0.9)
                  for h in hazards]
     _curves_panel(axs[0, 0], curves, models_a, tau0,
-                  "(a) simulations (steps) vs homogeneous model, Eq. (surv_prob_model)", ncol=2)
+                  "(a) simulations (steps) vs homogeneous model, Eq. (18)", ncol=2)
     h_mix = "integrated" if "integrated" in hazards else hazards[0]
     mixes = [v["name"] for v in nums["config"]["study"].get("mixtures", [])]
     shown = nums["config"]["study"].get("mixture_plotted") or (mixes[0] if mixes else None)

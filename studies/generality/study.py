@@ -1,8 +1,8 @@
-"""Study generality — the paper's claims tested on three open systems (issue 24; beyond the paper).
+"""Study generality — the paper's claims tested on three open systems (beyond the paper).
 
 The paper concludes with "a generally-applicable model for the study of dissipative chaotic scattering",
 tested on Hénon–Heiles only. This study runs the same chain, the system a parameter of every stage
-(``[study] systems``, issue 23's built-ins), at energies placed alike relative to each threshold
+(``[study] systems``, the built-in systems), at energies placed alike relative to each threshold
 (E = r·E_c on one grid of r), with ICs alike (disk r < radius_frac·r_s, tangential momenta) and linear drag.
 Rules in the header of ``studies/generality/study.toml``.
 

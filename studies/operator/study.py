@@ -1,4 +1,4 @@
-"""Study ``operator``: transfer operators on the section ṙ = 0, φ̇ > 0 (beyond the paper; issue 26).
+"""Study ``operator``: transfer operators on the section ṙ = 0, φ̇ > 0 (beyond the paper).
 
 The paper's second open question (Discussion): "extend the probabilistic description for the dynamics of
 ensembles of initial conditions using an operator-theoretic formalism … spectral approaches considering

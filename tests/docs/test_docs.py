@@ -143,8 +143,8 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     out, _ = _page(tmp_path, hook, md)
     assert "n = 10  # orbits" in out
     assert "](assets/fig2.png)" in out
-    assert "| a | 13.1 ± 0.5 | 13.63 | agrees within 2σ |" in out
-    assert "`tau0_rule`\n:   τ0 is where" in out
+    assert "| a | 13.1 ± 0.5 | 13.63 | agrees (z = −1.0) |" in out  # −0.53/√(0.52² + 0.005²): the one rule
+    assert "    `tau0_rule`\n    :   τ0 is where" in out  # the rules, folded
     assert "| `gamma` | `tau1` |" in out and "| 0.01 | 17.2 ± 1.0 |" in out
     assert "scale **quick**" in out and "commit `0123456789ab`" in out
     assert "](assets/fig2.json)" in out
@@ -332,3 +332,36 @@ def test_every_library_module_has_an_api_page():
         if len(parts) > 1 and ".".join(parts) not in documented and ".".join(parts) != "hhscatter.analysis":
             missing.append(".".join(parts))
     assert not missing, f"modules without an API page (docs/api/...md with '::: module'): {missing}"
+
+
+@pytest.mark.parametrize("value, goal, want", [(1.32, "≤ 1 (0.8)", False), (0.9, "≤ 1 (0.8)", True),
+                                               (1.04, "≥ 2", False), (2.0, "≥ 2", True), (3.0, "fast", None)])
+def test_a_benchmark_goal_is_read_from_its_text(hook, value, goal, want):
+    assert hook.goal_met(value, goal) is want
+
+
+def test_benchmarks_page_opens_with_goals_and_a_count(tmp_path, hook):
+    eng = tmp_path / "docs" / "benchmarks" / "assets" / "engine"
+    eng.mkdir(parents=True)
+    (eng / "engine.csv").write_text("target,measure,value,goal,note\nbare,engine µs/orbit,10.0,,\n"
+                                    "bare,engine / yardstick,1.32,≤ 1 (0.8),\nrec,marginal,1.9,≤ 2,\n")
+    out, _ = _page(tmp_path, hook, "<!-- hh:bench-goals -->\n")
+    assert "**1 of 2 goals met**" in out
+    assert "| bare | engine / yardstick | ≤ 1 (0.8) | 1.32 | **no** |" in out and "| rec | marginal | ≤ 2 | 1.9 | yes |" in out
+
+
+def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(tmp_path, hook):
+    (tmp_path / "studies" / "fig2").mkdir(parents=True)
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    (assets / "fig2.png").write_bytes(b"\x89PNG")
+    (assets / "paper" / "fig2.png").write_bytes(b"\x89PNG")
+    out, _ = _page(tmp_path, hook, "<!-- hh:study-figure fig2 -->\n")
+    main, folded = out.split("??? note")
+    assert 'class="hh-figure"' in main and "(assets/paper/fig2.png){ .hh-zoom }" in main
+    assert "(assets/fig2.png){ .hh-zoom }" in folded and "quick scale" in folded
+
+
+def test_an_indented_marker_is_rendered_indented(tmp_path, hook):
+    out, _ = _page(tmp_path, hook, '??? note "x"\n\n    <!-- hh:verdict-rule -->\n')
+    assert "\n    !!! info" in out and "both uncertainties" in out

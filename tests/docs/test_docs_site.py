@@ -53,7 +53,7 @@ def test_docstrings_keep_symbol_stars_and_field_lists():
     pytest.importorskip("griffe")
     roles = _load(DOCS / "_hooks" / "griffe_roles.py", "hh_docs_roles2")
     out = roles.clean_docstring("τ* is where f* t^{−z} meets; the *last* one; `a*b`; 2 * x")
-    assert out == "τ\\* is where f\\* t^{−z} meets; the *last* one; `a*b`; 2 \\* x"
+    assert out == "τ\\* is where f\\* t<sup>−z</sup> meets; the *last* one; `a*b`; 2 \\* x"
     text = ("Result:\n\nkappa, kappa_err      escape rate and\n                      its error\n"
             "tau0        end of the irregular regime\n\nAfter.")
     assert roles.field_lists(text) == ("Result:\n\n- `kappa`, `kappa_err`: escape rate and its error\n"

@@ -50,12 +50,12 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "break energy" in paper_part and "returns at r_esc" not in paper_part
     assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
     assert "3 numbers: 2 agree, 1 differ" in paper_part
-    assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs</span>' in page
+    assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs (z = +3.6)</span>' in page  # the one rule: 0.04/√(0.01² + 0.005²)
     assert page.count("data:image/png;base64,") == 2  # fig2 and resc; fig3 has numbers but no figure
     assert set(res["missing"]) == {"fig1", "fig3"}  # the study folders of the root without figure or numbers
     assert "### fig2 title (`make fig2`)" in md and "fig2 caption" in md  # titles and captions from [about]
     assert md.index("### resc title") > md.index("## Beyond the paper\n")
-    assert "| fig2 | break energy | 0.310 ± 0.010 | 0.27 | differs | continuous fit |" in md
+    assert "| fig2 | break energy | 0.310 ± 0.010 | 0.27 | differs (z = +3.6) | continuous fit |" in md
     assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
     assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [

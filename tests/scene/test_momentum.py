@@ -17,7 +17,7 @@ from hhscatter.scene.ics import BLOCK, region_ics
 from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
-BASE = "fa21699"  # main before the momentum option
+BASE = "fa21699"  # the code before the momentum option
 M = HenonHeiles()
 
 

@@ -15,7 +15,7 @@ import pytest
 from hhscatter.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-BASE = "f701897"  # main before the strict configuration (and the study rooms)
+BASE = "f701897"  # the code before the strict configuration (and the study rooms)
 
 
 def _files(root: Path) -> list[str]:

@@ -1,4 +1,4 @@
-"""The basin estimators against maps with published or closed-form values (issue 25, point 6).
+"""The basin estimators against maps with published or closed-form values.
 
 * Newton's method for z³ = 1 on [−1, 1]²: three Wada basins (the Julia set is
   the common boundary of all three), boundary dimension ≈ 1.42 (box-counting

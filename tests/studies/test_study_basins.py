@@ -36,7 +36,7 @@ def test_basins_tiny_end_to_end(tiny_studies):
     for _, u in unc.groupby(["energy", "gamma"]):
         u = u.sort_values("eps")
         assert u.f.iloc[-1] > u.f.iloc[0]
-    # issue 25: like-for-like Wada, local exponents, energy scan, the cut-off prediction, E_b and μ from upstream
+    # like-for-like Wada, local exponents, energy scan, the cut-off prediction, E_b and μ from upstream
     fig2 = json.loads((tiny_studies / "fig2" / "out" / "tiny" / "fig2.json").read_text())
     assert nums["E_b"]["value"] == fig2["kappa_fit"]["E_b"]["value"]
     fig3 = json.loads((tiny_studies / "fig3" / "out" / "tiny" / "fig3.json").read_text())

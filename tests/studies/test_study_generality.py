@@ -1,4 +1,4 @@
-"""Study generality (issue 24): the tiny end-to-end run, its JSON's structure, and its numbers against
+"""Study generality: the tiny end-to-end run, its JSON's structure, and its numbers against
 independent recomputations from the raw tables (numpy/pandas only) and exact identities."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Measures of exit-basin maps: fractions, basin entropy, uncertainty exponent, Wada test (issue #16).
+"""Measures of exit-basin maps: fractions, basin entropy, uncertainty exponent, Wada test.
 
 A *basin map* is a 2-D integer array of outcome labels on a regular grid of
 initial conditions (for Hénon–Heiles: exit channel 0/1/2, settled, trapped or
@@ -815,7 +815,7 @@ def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_w
 
 
 # ---------------------------------------------------------------------------
-# Scale-dependent dimension, decision times and the cut-off (issue 25)
+# Scale-dependent dimension, decision times and the cut-off
 # ---------------------------------------------------------------------------
 def weighted_line(x, y, err):
     """weighted_line(x, y, err) -> (intercept, slope, cov (2, 2), chi2, dof): weighted least-squares line.

@@ -1,5 +1,8 @@
 """Verdicts of our numbers against the paper's: pure functions of numbers (no I/O).
 
+* :data:`RULE` and :func:`verdict` — **the one rule** every table and every page applies: "agrees" when
+  |ours − reference| ≤ 2σ with σ = √(σ_ours² + σ_ref²), both uncertainties; :func:`row_verdict` applies it
+  to a paper-vs-ours row and says why when it cannot (never a "not a number"), and gives no verdict at the tiny scale;
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
 * :func:`half_unit` — half a unit of the last digit of a printed number;
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
@@ -7,7 +10,102 @@
 """
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from decimal import Decimal
+
+#: the verdict rule, stated once (the docs' studies index and the report print this text)
+RULE = ("**agrees** when |ours − reference| ≤ 2σ, σ = √(σ_ours² + σ_ref²): both uncertainties, ours (1σ, "
+        "resampled over orbits) and the reference's (another study's 1σ, or, for a number the paper prints "
+        "without an error, half a unit of its last printed digit, so '≈ 17' stands for [16.5, 17.5); a reference 0 or 1 — a "
+        "predicted shift, exponent or limit — is exact); **differs** otherwise; z = (ours − reference)/σ. "
+        "A cell without a number or without our uncertainty says so instead of a verdict; the tiny scale "
+        "(a smoke test of a few hundred orbits) gives no verdicts.")
+#: scales whose outputs are smoke tests: their rows carry no verdict
+SMOKE_SCALES = ("tiny",)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One verdict: ``word`` "agrees" / "differs" / "undetermined" / "no verdict", ``z`` (None when undefined)
+    and ``why`` (the reason of an undetermined cell)."""
+
+    word: str
+    z: float | None = None
+    why: str = ""
+
+    def text(self) -> str:
+        """The cell: "agrees (z = +1.3)", "differs (z = −4.2)", "undetermined: no uncertainty of ours"."""
+        if self.z is not None:
+            return f"{self.word} (z = {self.z:+.1f})".replace("-", "−")
+        return f"{self.word}: {self.why}" if self.why else self.word
+
+
+def _finite(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def verdict(value, err, ref, ref_err=0.0) -> Verdict:
+    """verdict(ours, its 1σ, reference, reference's 1σ) -> :class:`Verdict` by :data:`RULE`.
+
+    Examples
+    --------
+    >>> verdict(1.435, 0.017, 1.41, 0.005).text()   # |Δ| = 0.025, σ = 0.0177: z = 1.4
+    'agrees (z = +1.4)'
+    >>> verdict(10.5, 0.3, 13.63, 0.005).text()
+    'differs (z = −10.4)'
+    >>> verdict(0.2, None, 0.3).text()
+    'undetermined: no uncertainty of ours'
+    """
+    if not _finite(value):
+        return Verdict("undetermined", why="no value of ours (not measurable here)")
+    if not _finite(ref):
+        return Verdict("undetermined", why="no reference value")
+    if not _finite(err) or err < 0:
+        return Verdict("undetermined", why="no uncertainty of ours")
+    ref_err = ref_err if _finite(ref_err) and ref_err > 0 else 0.0
+    sigma = math.hypot(float(err), float(ref_err))
+    d = float(value) - float(ref)
+    if sigma == 0:
+        return Verdict("agrees" if d == 0 else "differs", None, "" if d == 0 else "exact numbers that differ")
+    z = d / sigma
+    return Verdict("agrees" if abs(z) <= 2 else "differs", z)
+
+
+def row_verdict(row: dict, scale: str | None = None) -> str:
+    """row_verdict(paper-vs-ours row, scale) -> the text of its verdict cell by :data:`RULE`.
+
+    A row with numbers (``ours``, ``err``, ``paper``; ``paper_err`` when the
+    reference has one, else half a unit of the paper's last printed digit)
+    gets the rule's verdict; a qualitative row (text, or no reference) keeps
+    the verdict its study wrote, or "—"; at a smoke scale (tiny) no verdict.
+    A "differs" that the study qualified (e.g. "differs in our convention
+    only; agrees under the authors' …") keeps its qualification.
+
+    Examples
+    --------
+    >>> row_verdict({"ours": 0.2705, "err": 0.001, "paper": 0.27})
+    'agrees (z = +0.1)'
+    >>> row_verdict({"ours": 0.2705, "err": 0.001, "paper": 0.27}, "tiny")
+    'no verdict (tiny scale: a smoke test)'
+    """
+    if scale in SMOKE_SCALES:
+        return "no verdict (tiny scale: a smoke test)"
+    ours, paper = row.get("ours"), row.get("paper")
+    stored = str(row.get("verdict") or "")
+    numeric = (isinstance(ours, (int, float)) and not isinstance(ours, bool)
+               and isinstance(paper, (int, float)) and not isinstance(paper, bool))
+    if not numeric:
+        if isinstance(ours, float) and not math.isfinite(ours):
+            return "undetermined: no value of ours (not measurable here)"
+        return stored or "—"
+    ref_err = row.get("paper_err")
+    if not _finite(ref_err):  # the paper's printed number: half a unit of its last digit; 0 and 1 are exact
+        ref_err = half_unit(paper) if _finite(paper) and paper not in (0, 1) else 0.0
+    v = verdict(ours, row.get("err"), paper, ref_err)
+    if v.word == "differs" and stored.startswith("differs") and ";" in stored:
+        return f"{v.text()}; {stored.split(';', 1)[1].strip()}"
+    return v.text()
 
 
 def half_unit(printed: float) -> float:
