@@ -590,7 +590,7 @@ def _operator_survival(study, edges):
     max_lag = int(round(study.params.max_return_time / dt))
     K, H, L = tf.lag_kernels(tr, t["t_end"].to_numpy(), dt, max_lag=max_lag)
     cross = tf.propagate(n0, K, L, steps)
-    P_op = tf.survival(cross, H)
+    P_op = tf.survival_from_crossings(cross, H)
     grid = np.arange(steps + 1) * dt
     # the first crossing after t*: image points of the samples, weighted
     wfc = tf.first_crossing_weights(cross, tr, dt, k_star)
@@ -608,7 +608,7 @@ def _reduced_survival(study, op, edges):
     K2, H2, L2 = tf.lag_kernels(tr_red, op["t"]["t_end"].to_numpy(), dt, max_lag=op["max_lag"])
     n0r = np.zeros(n_bins)
     n0r[-1] = 1.0
-    return tf.survival(tf.propagate(n0r, K2, L2, op["steps"]), H2), kappa_bins
+    return tf.survival_from_crossings(tf.propagate(n0r, K2, L2, op["steps"]), H2), kappa_bins
 
 
 def _simulated_survival(study, grid):

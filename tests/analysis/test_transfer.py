@@ -154,7 +154,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     K, H, L = tf.lag_kernels(tr, t_end, dt)
     assert L == 20
     n = tf.propagate([1.0], K, L, 100)
-    P = tf.survival(n, H)
+    P = tf.survival_from_crossings(n, H)
     k = np.arange(101)
     m, rem = k // 20, k % 20
     exact = np.where(rem < 10, q ** m, q ** (m + 1))
@@ -167,7 +167,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     # a lag cap of 15 steps brings the returns forward to t = 1.5: P then drops by q every 1.5 time units
     Kc, Hc, Lc = tf.lag_kernels(tr, t_end, dt, max_lag=15)
     assert Lc == 15 and tf.capped_share(tr, dt, 15) == 1.0 and tf.capped_share(tr, dt, 20) == 0.0
-    Pc = tf.survival(tf.propagate([1.0], Kc, Lc, 45), Hc)
+    Pc = tf.survival_from_crossings(tf.propagate([1.0], Kc, Lc, 45), Hc)
     assert Pc[44] == pytest.approx(q ** 3)
 
 
@@ -184,7 +184,7 @@ def test_first_crossing_weights_sum_to_the_state_distribution():
     by_dst = np.bincount(dst[dst >= 0], weights=w[dst >= 0], minlength=n_s)
     assert np.allclose(by_dst, tf.first_crossing_after(n, K, L, 77), rtol=1e-12, atol=1e-15)
     # survival by the FFT convolution equals the direct sum Σ_k' n(k')·H(k − k')
-    P = tf.survival(n, H)
+    P = tf.survival_from_crossings(n, H)
     direct = [sum(n[kp] @ H[k - kp] for kp in range(k + 1) if k - kp < H.shape[0]) for k in (0, 13, 60, 120)]
     assert np.allclose(P[[0, 13, 60, 120]], direct, atol=1e-12)
 
