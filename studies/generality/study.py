@@ -21,7 +21,7 @@ Stages (``hhscatter study generality simulate|analyze|plot [--scale S]``):
     Eq. (eqn:kappa_cmeasure_truetime), :mod:`hhscatter.analysis.survival.cmeasure`), claim 3 (μ measured, μ
     predicted from the conservative system, :mod:`hhscatter.analysis.dissipative.kinetic`), claim 4 (τ0, τ1, τ2
     against γ and Eq. (eq:tau2)), claim 5 (Fig. 5's paired distance,
-    :func:`hhscatter.analysis.geometry.distance.paired_hellinger_replicates`, and a moment test), claims 6 and 7;
+    :func:`hhscatter.analysis.geometry.paired_distance.paired_hellinger_replicates`, and a moment test), claims 6 and 7;
     derived tables and ``generality.json`` with the list ``claims`` of records
     {claim, quantity, system, value, err, verdict, note}.
 
@@ -605,6 +605,7 @@ def _claim5_distance(study, claims, label, m, E0, mu, samples):
 
     from hhscatter.analysis.dissipative.decay import time_to_energy
     from hhscatter.analysis.geometry import distance as dist
+    from hhscatter.analysis.geometry import paired_distance as pdist
     from hhscatter.data.read import read_lifetimes, read_sections
 
     p = study.params
@@ -634,7 +635,7 @@ def _claim5_distance(study, claims, label, m, E0, mu, samples):
             continue
         sizes = f"{len(diss)} / {len(ref_s)} / {len(ref_0)} points (survivors / E(t*) / E0)"
         rec[kind] = r = {"n_ref_star": len(ref_s), "n_ref_E0": len(ref_0)}
-        sets = {n: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "orbits")
+        sets = {n: pdist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "orbits")
                 for n, df in (("diss", diss), ("star", ref_s), ("E0", ref_0))}
         allpts = np.concatenate([x.points for x in sets.values()])
         extent = (float(allpts[:, 0].min()), float(allpts[:, 0].max()), float(allpts[:, 1].min()),
@@ -642,14 +643,14 @@ def _claim5_distance(study, claims, label, m, E0, mu, samples):
         try:
             if min(len(diss), len(ref_s), len(ref_0)) < 4:
                 raise ValueError(sizes)
-            reps = dist.paired_hellinger_replicates(sets, [("diss", "star"), ("diss", "E0")], [rec["box"]], extent,
+            reps = pdist.paired_hellinger_replicates(sets, [("diss", "star"), ("diss", "E0")], [rec["box"]], extent,
                                                     offsets=p.c5_offsets, n_boot=p.c5_boot, seed=p.fit_seed)[:, :, 0]
         except ValueError as exc:  # too few points (tiny scale, or a KAM-dominated system)
             claims.add("5", q, label, None, None, f"undetermined: too few points ({exc})", sizes, 0.0)
             continue
-        d, lo, hi = dist.percentile_interval(reps[:, 1] - reps[:, 0], p.c5_level)
-        ds, ds_lo, ds_hi = dist.percentile_interval(reps[:, 0], p.c5_level)
-        d0, d0_lo, d0_hi = dist.percentile_interval(reps[:, 1], p.c5_level)
+        d, lo, hi = pdist.percentile_interval(reps[:, 1] - reps[:, 0], p.c5_level)
+        ds, ds_lo, ds_hi = pdist.percentile_interval(reps[:, 0], p.c5_level)
+        d0, d0_lo, d0_hi = pdist.percentile_interval(reps[:, 1], p.c5_level)
         r.update(delta={"value": d, "interval": [lo, hi]}, d_star={"value": ds, "interval": [ds_lo, ds_hi]},
                  d_E0={"value": d0, "interval": [d0_lo, d0_hi]}, extent=list(extent))
         lev = int(100 * p.c5_level)
@@ -846,7 +847,7 @@ def _claim5(claims, label, meas, own, pred, wins):
 
 def _claim6(study, claims, label, m, per, taus, E0, mu, rms_ref):
     """The survival model, Eq. (eqn:surv_prob_model), both hazards, fig6's fitting rule, at γ = mu_gamma."""
-    from hhscatter.analysis.dissipative.survival_model import (
+    from hhscatter.analysis.dissipative.model_comparison import (
         fit_homogeneous_hazards,
         survival_fit_points,
     )

@@ -1,0 +1,22 @@
+"""Each analysis subpackage exports the public names of its modules, each the object its module defines."""
+import importlib
+
+import pytest
+
+
+@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry"])
+def test_subpackage_exports_its_modules_public_names(sub):
+    pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
+    assert pkg.__all__ and set(pkg.__all__) <= set(dir(pkg))
+    for name in pkg.__all__:
+        obj = getattr(pkg, name)
+        home = importlib.import_module(f"{pkg.__name__}.{pkg._EXPORTS[name]}")
+        assert getattr(home, name) is obj, name
+    with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
+        pkg.no_such_name  # noqa: B018
+
+
+def test_a_name_is_exported_from_the_module_that_defines_it():
+    from hhscatter.analysis import geometry, survival
+
+    assert survival._EXPORTS["survival_curve"] == "kaplan_meier" and geometry._EXPORTS["UnitSet"] == "paired_distance"
