@@ -24,10 +24,10 @@ from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
 from hhscatter.scene.schema import (
     apply_convention,
-    typed_params,
-    typed_value,
     did_you_mean,
     merge_tables,
+    typed_params,
+    typed_value,
     validate_conventions_file,
     validate_study_file,
 )

@@ -35,8 +35,8 @@ from hhscatter.analysis.survival.summaries import (
     survival_tables,
     tau_star_estimate,
 )
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.run.plan import SCENE_FILE
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
@@ -366,13 +366,13 @@ def _analyze_conventions(study, grid_runs):
     import pandas as pd
 
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
     from hhscatter.analysis.survival.kappa_conventions import (
         convention_rows,
         fit_laws,
         law_spread,
         stable_energies,
     )
-    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     E_C = study.model.critical_energy
     p_hi, p_lo = study.params.p_levels

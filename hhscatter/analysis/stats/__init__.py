@@ -2,7 +2,7 @@
 
 Every public name of its modules is importable from here (loaded on first use).
 """
-import importlib
+from hhscatter.analysis._exports import lazy_exports
 
 _EXPORTS = {
     "wilson_interval": "intervals",
@@ -19,12 +19,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name):
-    if name in _EXPORTS:
-        return getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -28,6 +28,7 @@ results out):
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +38,8 @@ from hhscatter.analysis.survival.fits import (
     mean_kappa_stat_err,
     survival_curve,
 )
+from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
+from hhscatter.analysis.survival.summaries import kappa_law_summary
 
 
 @dataclass(frozen=True)
@@ -227,11 +230,6 @@ def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_
     Returns (fits, info): fits {name: KappaEnergyFit} of the conventions with at least ``min_points`` energies (a,
     b and the break need points on both sides); info {name: {"energies": [...], "fit": its numbers or None}}.
     """
-    import warnings
-
-    from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
-    from hhscatter.analysis.survival.summaries import kappa_law_summary
-
     fits, info = {}, {}
     for name in names:
         d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(energies)]
