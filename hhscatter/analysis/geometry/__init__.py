@@ -73,6 +73,7 @@ _EXPORTS = {
     "section_flux_density": "transfer",
     "spectral_radius": "transfer",
     "sprinkler_weights": "transfer",
+    "survival_from_crossings": "transfer",
     "transfer_matrix": "transfer",
     "true_time_kappa": "transfer",
 }

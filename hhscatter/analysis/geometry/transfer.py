@@ -63,7 +63,7 @@ from scipy.sparse.linalg import eigs
 
 __all__ = ["DENSE_MAX", "ClassInfo", "Transitions", "bootstrap_kappa", "box_index", "capped_share", "communicating_classes", "first_crossing_after",
            "first_crossing_weights", "lag_kernels", "leading_left", "map_escape_rate", "propagate", "saddle_class", "saddle_measure", "section_flux_density",
-           "spectral_radius", "sprinkler_weights", "survival", "transfer_matrix", "true_time_kappa"]
+           "spectral_radius", "sprinkler_weights", "survival_from_crossings", "transfer_matrix", "true_time_kappa"]
 
 DENSE_MAX = 64  # below this many states the dense LAPACK eigensolver is used (ARPACK needs k < n − 1)
 
