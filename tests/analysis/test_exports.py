@@ -20,3 +20,14 @@ def test_a_name_is_exported_from_the_module_that_defines_it():
     from hhscatter.analysis import geometry, survival
 
     assert survival._EXPORTS["survival_curve"] == "kaplan_meier" and geometry._EXPORTS["UnitSet"] == "paired_distance"
+
+
+@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry"])
+def test_every_name_a_module_declares_in_all_exists(sub):
+    import pkgutil
+
+    pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
+    for info in pkgutil.iter_modules(pkg.__path__):
+        mod = importlib.import_module(f"{pkg.__name__}.{info.name}")
+        missing = [n for n in getattr(mod, "__all__", []) if not hasattr(mod, n)]
+        assert not missing, (mod.__name__, missing)
