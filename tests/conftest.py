@@ -1,7 +1,6 @@
-from pathlib import Path
-
 import numpy as np
 import pytest
+from study_copy import REPO_STUDIES, copy_study_folder
 
 EPS = np.finfo(float).eps
 
@@ -21,32 +20,10 @@ def diss_scene():
                  sections=SectionWindow(t_from=5.0, t_to=40.0), snapshots=tuple(np.arange(0.0, 100.0, 10.0)))
 
 
-REPO_STUDIES = Path(__file__).resolve().parents[1] / "studies"
-
-
-def _copy_study(name: str, root: Path, edit=None, src: Path = REPO_STUDIES) -> Path:
-    """Copy the study folder ``name`` (study.toml and code, not its outputs) and the shared conventions.toml into the
-    studies folder ``root``; ``edit(text) -> text`` changes the copy's study.toml. Returns the copied folder."""
-    import shutil
-
-    root.mkdir(parents=True, exist_ok=True)
-    shutil.copytree(src / name, root / name, ignore=shutil.ignore_patterns("out", "data", "__pycache__"),
-                    dirs_exist_ok=True)
-    if not (root / "conventions.toml").exists():
-        shutil.copy(src / "conventions.toml", root / "conventions.toml")
-    if edit is not None:
-        toml = root / name / "study.toml"
-        text = toml.read_text()
-        new = edit(text)
-        assert new != text, "the edit did not apply"
-        toml.write_text(new)
-    return root / name
-
-
 @pytest.fixture
 def copy_study():
     """copy_study(name, root, edit=None) -> a copy of a study folder of the repository in the studies folder root."""
-    return _copy_study
+    return copy_study_folder
 
 
 @pytest.fixture(scope="session")
@@ -59,7 +36,7 @@ def tiny_studies(tmp_path_factory):
     root = tmp_path_factory.mktemp("studies")
     order = [s.name for s in studies(REPO_STUDIES)]
     for name in order:
-        _copy_study(name, root)
+        copy_study_folder(name, root)
     for name in order:
         run_stage(name, "all", "tiny", workers=1, progress=False, root=root)
     return root

@@ -25,10 +25,10 @@ def _files(root: Path) -> list[str]:
 
 def _study_root(tmp_path: Path, name: str, edit) -> Path:
     """A studies root with a copy of the study's folder, its study.toml changed by ``edit(text) -> text``."""
-    from conftest import _copy_study
+    from study_copy import copy_study_folder
 
     root = tmp_path / "studies"
-    _copy_study(name, root, edit)
+    copy_study_folder(name, root, edit)
     return root
 
 
