@@ -175,6 +175,7 @@ def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch, co
     monkeypatch.delenv(up.DEV_ENV, raising=False)
     for name in ("fig3", "fig5"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     copy_study("fig1", tmp_path)
     with pytest.raises(up.UpstreamError, match="fig5 needs the published outputs of fig1 .*make fig5 SCALE=tiny"):
         run_stage("fig5", "analyze", "tiny", root=tmp_path)
@@ -358,6 +359,7 @@ def test_fig6_changing_a_paper_constant_changes_only_its_rows(tiny_studies, tmp_
 
     for name in ("fig2", "fig3", "fig4", "fig6"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     before = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
     toml = tmp_path / "fig6" / "study.toml"
     text = toml.read_text()
@@ -389,6 +391,7 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
     for name in ("fig2", "fig3", "fig4", "fig6"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     k = _numbers(tmp_path, "fig2")["kappa_fit"]
     mine = {"paper_kappa_a": k["a"]["value"], "paper_kappa_b": k["b"]["value"], "paper_kappa_c": k["c"]["value"],
             "paper_kappa_Eb": k["E_b"]["value"], "paper_mu": _numbers(tmp_path, "fig3")["mu"]["value"]}
