@@ -3,7 +3,7 @@
     python docs/gen_studies.py [--scale quick] [--check]
 
 For each study folder (``studies/<name>/study.toml``) it copies
-``studies/<name>/out/<scale>/<name>.png``, ``<name>.json`` and the stage
+``studies/<name>/out/<scale>/<name>.png`` (and its further figures ``<name>_*.png``), ``<name>.json`` and the stage
 costs ``cost.json`` (as ``<name>.cost.json``) to ``docs/studies/assets/``
 (quick scale) or ``docs/studies/assets/<scale>/`` (any other scale, e.g.
 ``paper``: the committed paper-scale results the docs and
@@ -70,12 +70,15 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
     dst = assets_dir(scale)
     for name in study_names(ROOT):
         out = ROOT / "studies" / name / "out" / scale
+        extra = [(p, p.name) for p in sorted(out.glob(f"{name}_*.png"))]  # a study's further figures
         for src, target in ((out / f"{name}.png", f"{name}.png"), (out / f"{name}.json", f"{name}.json"),
-                            (out / "cost.json", f"{name}.cost.json")):
+                            (out / "cost.json", f"{name}.cost.json"), *extra):
             if src.exists():
                 pairs.append((src, dst / target))
             elif src.name != "cost.json":
                 missing.append(str(src.relative_to(ROOT)))
+        # further figures of a study (<name>_<part>.png: one panel group each, legible at full width)
+        pairs += [(src, dst / src.name) for src in sorted(out.glob(f"{name}_*.png"))]
     if studies_only or scale != "quick":  # the benchmarks have scales of their own (full, quick)
         return pairs, missing
     for which in BENCHES:

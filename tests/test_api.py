@@ -51,7 +51,7 @@ def test_points_are_grouped_by_energy_never_by_e0():
     # plain runs concatenated (no energy column): e0 clustered within 1e-9
     assert [k for k, _ in split_points(lt.drop(columns="energy"))] == keys
     # a run from an IC table (e0 varies continuously): one ensemble per γ, energy unknown
-    ics = lt[lt.gamma == 0].drop(columns="energy").assign(e0=np.linspace(0.2, 0.4, 1000))
+    ics = lt[lt.gamma == 0].drop(columns="energy").assign(e0=np.linspace(0.2, 0.4, 1000), traj_id=np.arange(1000))
     (key, df), = split_points(ics)
     assert math.isnan(key[0]) and key[1] == 0.0 and len(df) == 1000
 
@@ -285,7 +285,27 @@ def test_read_lifetimes_takes_a_list_of_runs(tmp_path):
     hhscatter.simulate(hhscatter.Grid(a, energies=[0.3], gammas=[0.0, 0.01]), tmp_path / "g", workers=1,
                        progress=False)
     both = hhscatter.read_lifetimes([tmp_path / "a", str(tmp_path / "g")])
-    assert len(both) == 900
+    assert len(both) == 900 and list(both["run"].cat.categories) == [str(tmp_path / "a"), str(tmp_path / "g")]
     curves = hhscatter.survival(both)
-    assert sorted(curves.curves) == [(0.27, 0.0), (0.3, 0.0), (0.3, 0.01)]
-    assert all(n == 300 for n in curves.n.values())
+    assert sorted(curves.curves) == [(0.27, 0.0, str(tmp_path / "a")), (0.3, 0.0, str(tmp_path / "g")),
+                                     (0.3, 0.01, str(tmp_path / "g"))]
+    assert all(n == 300 for n in curves.n.values()) and curves[(0.3, 0.01)] is curves.curves[
+        (0.3, 0.01, str(tmp_path / "g"))]
+
+
+def test_escape_rates_flags_a_trapped_population_instead_of_returning_its_plateau_silently():
+    # 60 % of the orbits never leave (KAM tori), the rest at κ = 0.01: the window κ is the plateau's
+    rng = np.random.default_rng(11)
+    t = np.where(rng.random(20000) < 0.6, np.inf, rng.exponential(100.0, 20000))
+    lt = pd.DataFrame({"t_end": np.minimum(t, 800.0), "outcome": np.where(t < 800.0, "escaped", "censored"),
+                       "e0": 0.3, "gamma": 0.0})
+    row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
+    assert row.status == "trapped" and "plateau" in row.note
+    assert abs(row.p_inf - 0.6) < 0.03 and abs(row.kappa_inf - 0.01) < 0.001
+
+
+def test_escape_rates_leaves_an_exponential_population_unflagged():
+    t = np.random.default_rng(12).exponential(5.0, 20000)
+    lt = pd.DataFrame({"t_end": t, "outcome": "escaped", "e0": 0.3, "gamma": 0.0})
+    row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
+    assert row.status == "exponential" and row.note == ""

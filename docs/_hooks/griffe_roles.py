@@ -175,30 +175,9 @@ def scripts(text: str) -> str:
     """scripts(text) -> ``x^{a}`` and ``x_{a}`` of the prose as ``x<sup>a</sup>``, ``x<sub>a</sub>`` (code spans
     kept): plain-text formulas such as ``E0 e^{−μγt}`` read in ``help()`` and show as formulas on the page, and
     Markdown no longer takes the underscores of ``∫_{E_c}^{E0}`` for emphasis."""
-    out = []
-    for piece in _CODE_SPAN.split(text):
-        out.append(piece if piece.startswith("`") else _sub_sup(piece))
-    return "".join(out)
+    from hhscatter.publish.formatting import scripts_to_html
 
-
-def _sub_sup(text: str) -> str:
-    out, i = [], 0
-    while i < len(text):
-        if text[i] in "^_" and text.startswith("{", i + 1):
-            depth, j = 0, i + 1
-            while j < len(text):
-                depth += {"{": 1, "}": -1}.get(text[j], 0)
-                if depth == 0:
-                    break
-                j += 1
-            if depth == 0:
-                tag = "sup" if text[i] == "^" else "sub"
-                out.append(f"<{tag}>{_sub_sup(text[i + 2:j])}</{tag}>")
-                i = j + 1
-                continue
-        out.append(text[i])
-        i += 1
-    return "".join(out)
+    return "".join(p if p.startswith("`") else scripts_to_html(p) for p in _CODE_SPAN.split(text))
 
 
 def clean_docstring(text: str) -> str:

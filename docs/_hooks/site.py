@@ -84,35 +84,16 @@ _KEEP = {"code", "pre", "script", "style", "textarea", "kbd", "samp"}
 _VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
 
 
-def _scripts(text: str) -> str:
-    """``x^{a}`` → x<sup>a</sup>, ``x_{a}`` → x<sub>a</sub> (braces matched, nested ones converted too)."""
-    out, i = [], 0
-    while i < len(text):
-        if text[i] in "^_" and text.startswith("{", i + 1):
-            depth, j = 0, i + 1
-            while j < len(text):
-                depth += {"{": 1, "}": -1}.get(text[j], 0)
-                if depth == 0:
-                    break
-                j += 1
-            if depth == 0:
-                tag = "sup" if text[i] == "^" else "sub"
-                out.append(f"<{tag}>{_scripts(text[i + 2:j])}</{tag}>")
-                i = j + 1
-                continue
-        out.append(text[i])
-        i += 1
-    return "".join(out)
-
-
 def scripts_outside_math(html: str) -> str:
     """scripts_outside_math(html) -> ``^{…}``/``_{…}`` of the prose set as <sup>/<sub>; code and maths untouched."""
+    from hhscatter.publish.formatting import scripts_to_html
+
     if "^{" not in html and "_{" not in html:
         return html
     out, pos, stack = [], 0, []
     for m in _TAG.finditer(html):
         text = html[pos:m.start()]
-        out.append(text if stack else _scripts(text))
+        out.append(text if stack else scripts_to_html(text))
         closing, name, attrs = m.group(1), m.group(2).lower(), m.group(3)
         if not closing and name not in _VOID and not attrs.rstrip().endswith("/"):
             keep = name in _KEEP or "arithmatex" in attrs or name.startswith("mjx")
@@ -123,7 +104,7 @@ def scripts_outside_math(html: str) -> str:
         out.append(m.group(0))
         pos = m.end()
     tail = html[pos:]
-    out.append(tail if stack else _scripts(tail))
+    out.append(tail if stack else scripts_to_html(tail))
     return "".join(out)
 
 

@@ -7,6 +7,8 @@ A page asks for generated content with an HTML comment on a line of its own::
     <!-- hh:study-numbers fig2 -->   docs/studies/assets/fig2.json as tables
     <!-- hh:study-module fig2 -->    API of hhscatter.studies.fig2 (if it exists)
     <!-- hh:claims-table generality -->  its JSON's ``claims`` records as a claims × systems table
+    <!-- hh:evidence-tables generality -->  its JSON's regular_fraction, long_time, validity_map, resc records
+    <!-- hh:study-figure-wide generality_regular -->  a further figure of a study, as hh:study-figure
                                      (paper scale first when committed, quick scale folded below)
     <!-- hh:comparison-all -->       every study's paper-vs-ours rows in one table
     <!-- hh:studies-table -->        one row per study folder: title, paper figure, summary, what it needs
@@ -31,7 +33,7 @@ import re
 from pathlib import Path
 
 _MARKER = re.compile(r"^([ \t]*)<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->[ \t]*$", re.M)
-_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance"}
+_SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance", "made_from", "sha256"}
 
 
 # -- number formatting: hhscatter.publish.formatting, shared with the report and the figures ---------------------
@@ -243,6 +245,63 @@ class Renderer:
                            + _indent(table + "\n" + caption) + "\n")
         return "\n".join(out)
 
+    def _headline(self, name: str):
+        """(numbers JSON, scale) at the headline scale: paper when committed, else quick."""
+        for sc in ("paper", "quick"):
+            doc = self._numbers(name, sc)
+            if doc:
+                return doc, sc
+        return None, None
+
+    def evidence_tables(self, name: str) -> str:
+        """The evidence records of a numbers JSON (regular fraction, long-time fits, validity map, r_esc) as
+        tables, at the headline scale."""
+        doc, sc = self._headline(name)
+        if not doc or "regular_fraction" not in doc:
+            return self.missing(f"The evidence of study {name}", f"Run `make {name}`, then `make docs-assets`.")
+        link = self._rel(self.study_asset(name, "json", sc))
+        return evidence_tables(doc) + f"\n*Scale **{sc}**: records of [{name}.json ({sc})]({link}).*\n"
+
+    def study_figure_wide(self, name: str) -> str:
+        """A further figure of a study (``<study>_<part>.png``) shown as hh:study-figure shows the main one (paper
+        scale at full width, quick folded); a marker of its own so that the main figure keeps the page's top."""
+        return self.study_figure(name)
+
+    def _scaled_docs(self, name: str, key: str):
+        """[(scale, doc)] of the study's committed JSON that hold ``key`` (dotted), paper scale first."""
+        out = []
+        for sc in ("paper", "quick"):
+            doc = self._numbers(name, sc)
+            if doc is not None and _dig(doc, key) not in (None, [], {}):
+                out.append((sc, doc))
+        return out
+
+    def study_table(self, arg: str) -> str:
+        """``<!-- hh:study-table name.key -->``: the records at ``key`` of the study's JSON as a table (columns
+        from :data:`STUDY_TABLES`; value ± error rounded to the error; a missing value "—"), the paper scale
+        first and the quick scale folded below."""
+        name, key = arg.split(".", 1)
+        docs = self._scaled_docs(name, key)
+        if not docs:
+            return self.missing(f"`{key}` of {name}.json", f"Run `make {name}`, then `make docs-assets`.")
+        out = []
+        for i, (sc, doc) in enumerate(docs):
+            link = self._rel(self.study_asset(name, "json", sc))
+            text = (spec_table(_dig(doc, key), STUDY_TABLES.get(arg)) +
+                    f"\n*Scale **{sc}**: `{key}` of [{name}.json ({sc})]({link}).*\n")
+            out.append(text if i == 0 else
+                       f'??? info "The same at the {sc} scale (click to open)"\n\n' + _indent(text) + "\n")
+        return "\n".join(out)
+
+    def study_statement(self, arg: str) -> str:
+        """``<!-- hh:study-statement name.key -->``: the ``statement`` string at ``key`` of the study's JSON, at
+        each committed scale (paper first)."""
+        name, key = arg.split(".", 1)
+        docs = self._scaled_docs(name, key)
+        if not docs:
+            return self.missing(f"`{key}` of {name}.json", f"Run `make {name}`, then `make docs-assets`.")
+        return "\n".join(f"- *{sc} scale*: {_dig(doc, key)['statement']}." for sc, doc in docs) + "\n"
+
     def study_module(self, name: str) -> str:
         mod = self.root / "studies" / name / "study.py"
         if not mod.exists():
@@ -401,6 +460,27 @@ class Renderer:
             return "*No paper-scale number differs from its quick-scale value by more than the quick-scale error.*\n"
         return "\n".join(out) + "\n"
 
+    def outcomes(self, _arg=None) -> str:
+        """The outcome names and what each means, from hhscatter.outcomes (the one declaration)."""
+        import hhscatter.outcomes as oc
+
+        doc = oc.__doc__ or ""
+        out = []
+        for name in oc.OUTCOMES:
+            m = re.search(rf"^\* ``{name}``: (.*?)(?=^\* ``|^\s*$)", doc, flags=re.M | re.S)
+            what = " ".join(m.group(1).split()) if m else ""
+            censor = " (censors the lifetime)" if name in oc.CENSORING_OUTCOMES else ""
+            out.append(f"- `{name}`: {what}{censor}")
+        return "\n".join(out) + "\n"
+
+    def study_names(self, _arg=None) -> str:
+        """The studies `make studies` builds, from the study folders, in the order it builds them."""
+        from hhscatter.studies.graph import studies
+
+        names = [s.name for s in studies(self.root / "studies")]
+        links = ", ".join(f"[{n}](studies/{n}.md)" for n in names)
+        return f"`make studies` builds {len(names)} studies, one per folder, each after the ones it needs: {links}.\n"
+
     def cli(self, _arg=None) -> str:
         from hhscatter.cli import build_parser
 
@@ -484,6 +564,96 @@ def claims_table(doc) -> str:
 
     for (claim, qty), per in sorted(rows.items(), key=claim_order):
         out.append(f"| {_cell(claim)} | {_cell(qty)} | " + " | ".join(cell(per.get(s)) for s in systems) + " |")
+    return "\n".join(out) + "\n"
+
+
+def _dig(doc, key: str):
+    """The value at the dotted ``key`` of a JSON document (None if absent)."""
+    cur = doc
+    for part in key.split("."):
+        if not isinstance(cur, dict) or part not in cur:
+            return None
+        cur = cur[part]
+    return cur
+
+
+#: columns (key, header) of the record tables that study pages ask for with ``hh:study-table``; a key with a
+#: sibling ``<key>_err`` is shown as value ± error rounded to the error
+STUDY_TABLES = {
+    "basins.entropy_by_box": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid (cells per side)"),
+                              ("box_side", "box side s"), ("box_cells", "box (cells)"), ("S_b", "S_b"),
+                              ("S_bb", "S_bb")),
+    "basins.point_table": (("E0", "E0"), ("gamma", "γ"), ("d", "d = 2 − α, one law"), ("fit_p", "its fit p"),
+                           ("d_coarse", "d(ε) coarse"), ("d_fine", "d(ε) finest resolved"),
+                           ("slope", "slope of d per decade"), ("slim", "slim fractal"),
+                           ("S_bb", "S_bb (headline box)"), ("box_cells", "box (cells)"),
+                           ("wada_all", "Wada, settled a basin"), ("wada_exits", "Wada, exits (settled masked)")),
+    "basins.entropy_exponent_by_grid": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid"),
+                                        ("alpha", "α from S_b ∝ s^α"), ("sides", "box sides s")),
+    "basins.cutoff_prediction": (("E0", "E0"), ("gamma", "γ"), ("tau2", "τ2"), ("eps_c", "measured ε_c"),
+                                 ("eps_c_interval", "measured 1σ interval"),
+                                 ("eps_c_predicted", "predicted ε_c (decision rate λ)"),
+                                 ("eps_c_predicted_kantz_grassberger", "predicted, λ = κ/α"),
+                                 ("eps_c_predicted_interval", "predicted interval (λ ± σ, μ ± σ, κ/α)"),
+                                 ("log10_ratio", "log10(measured/predicted)"), ("statement", "how far apart")),
+    "operator.mixed_phase_space": (("energy", "E"), ("probes", "KAM probes"), ("trapped_boxes", "trapped boxes"),
+                                   ("trapped_share_of_saddle_class", "their share of the saddle's class"),
+                                   ("kappa_without_trapped_boxes", "κ without them")),
+    "operator.cmeasure_distances": (("fig1_energy", "fig1 at E"), ("operator_energy", "operator at E"),
+                                    ("measure", "operator's measure"), ("n", "fig1 points"), ("box", "ε"),
+                                    ("hellinger_debiased", "debiased Hellinger"), ("hellinger_debiased_lo", "lo"),
+                                    ("hellinger_debiased_hi", "hi"), ("hellinger_noise", "noise")),
+    "operator.cmeasure_convergence": (("energy", "E"), ("box", "box side"), ("samples_per_box", "samples per box"),
+                                      ("kappa", "κ"), ("hellinger_debiased", "debiased Hellinger (ε = 0.1)"),
+                                      ("lo", "lo"), ("hi", "hi")),
+    "operator.dissipative.P_at": (("t", "t"), ("sim", "simulated", "sim_err"), ("operator", "operator (box × E)"),
+                                  ("reduced", "reduced, ρ(E) alone")),
+    "operator.cost": (("energy", "E"), ("pt_orbit_time_1pct", "P(t) route for 1 %"),
+                      ("op_orbit_time_1pct", "operator for 1 % (lower bound)"), ("pt_rel", "P(t): its rel. error"),
+                      ("op_rel", "operator: its rel. error"), ("pt_rel_at_op_cost", "P(t) at the operator's cost")),
+    "operator.kappa_ulam": (("energy", "E"), ("box", "finest box"), ("kappa", "κ_Ulam finest boxes", "err"),
+                            ("kappa_stat_err", "σ bootstrap"), ("discretisation_bias", "linear box bias"),
+                            ("fig2_kappa", "fig2 κ0", "fig2_err"), ("z_vs_fig2", "z vs κ0 (both errors)"),
+                            ("fig2_kappa_cm", "fig2 κ crossings", "fig2_kappa_cm_err"), ("kappa_map_per_return", "−ln ρ(P) per return"),
+                            ("mean_return_time", "⟨T⟩")),
+    "operator.kappa_convergence": (("energy", "E"), ("kappa_finest", "κ finest boxes"), ("kappa_inf", "κ∞", "err"),
+                                   ("stat_err", "σ stat (bootstrap)"), ("model_err", "σ model (M^−1/2 vs M^−1)"),
+                                   ("kappa0", "fig2 κ0"), ("residual_kappa0", "κ∞/κ0 − 1"), ("z_kappa0", "z vs κ0"),
+                                   ("kappa_cm", "fig2 κ crossings"), ("residual_kappa_cm", "κ∞/κ_cm − 1"),
+                                   ("z_kappa_cm", "z vs κ_cm"), ("note", "note")),
+}
+
+
+def spec_table(recs, spec=None) -> str:
+    """Markdown table of records with the columns ``spec`` ((key, header[, error key]); default every key): a key
+    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, None or NaN as "—"."""
+    import math
+
+    if spec is None:
+        cols = []
+        for r in recs:
+            cols.extend(k for k in r if k not in cols and not k.endswith("_err"))
+        spec = [(c, c) for c in cols]
+    spec = [(c[0], c[1], c[2] if len(c) > 2 else c[0] + "_err") for c in spec]
+    spec = [c for c in spec if any(r.get(c[0]) is not None for r in recs)]
+
+    def cell(r, k, ek):
+        v, e = r.get(k), r.get(ek)
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            return "—"
+        if k.startswith("z") and _is_num(v):  # a distance in σ
+            return f"{v:+.1f}"
+        if k.startswith("residual") and _is_num(v):  # a relative difference, in per cent
+            ok = _is_num(e) and math.isfinite(e) and e > 0
+            return (fmt_err(100 * v, 100 * e) if ok else f"{100 * v:+.2f}") + " %"
+        if _is_num(v) and _is_num(e) and math.isfinite(e) and e > 0:
+            return fmt_err(v, e)
+        if isinstance(v, list):
+            return "[" + ", ".join(fmt_num(x, 3) if _is_num(x) else str(x) for x in v) + "]"
+        return fmt_num(v) if _is_num(v) else str(v)
+
+    out = ["| " + " | ".join(_cell(h) for _, h, _ in spec) + " |", "|" + "---|" * len(spec)]
+    out.extend("| " + " | ".join(_cell(cell(r, k, ek)) for k, _, ek in spec) + " |" for r in recs)
     return "\n".join(out) + "\n"
 
 
@@ -647,6 +817,10 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
 
         about = {s.name: s.summary for s in studies(Path(config["config_file_path"]).resolve().parent / "studies")}
         markdown = figure_first(markdown, about.get(fig.group(1), ""))
+        # a study page gives its figure the width of the page: the table of contents (a few headings) goes
+        meta = getattr(page, "meta", None)
+        if isinstance(meta, dict):
+            meta["hide"] = [*meta.get("hide", []), "toc"]
     docs = Path(config["docs_dir"])
     root = Path(config["config_file_path"]).resolve().parent
     page_dir = (docs / page.file.src_uri).parent
@@ -662,3 +836,72 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
         return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 
     return _MARKER.sub(sub, markdown)
+
+
+def _pct(v, e=None) -> str:
+    if not _is_num(v):
+        return "—"
+    return fmt_err(100 * v, 100 * e) + " %" if _is_num(e) else f"{fmt_num(100 * v, 3)} %"
+
+
+def _ve_cell(d) -> str:
+    return fmt_err(d["value"], d["err"]) if d and _is_num(d.get("value")) and _is_num(d.get("err")) else (
+        fmt_num(d["value"]) if d and _is_num(d.get("value")) else "—")
+
+
+def evidence_tables(doc) -> str:
+    """Markdown tables of a generality JSON's evidence: regular fraction (systems × E/E_c per IC convention),
+    long-time escape (disk ICs), the validity map and the r_esc sensitivity."""
+    out = []
+    reg = doc["regular_fraction"]
+    ratios = sorted({r["e_ratio"] for r in reg})
+    out.append("**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ)\n")
+    out.append("| system | ICs | " + " | ".join(f"{r:g} E_c" for r in ratios) + " |")
+    out.append("|---|---|" + "---|" * len(ratios))
+    for (lab, ics) in dict.fromkeys((r["label"], r["ics"]) for r in reg):
+        cells = {r["e_ratio"]: _pct(r["fraction"], r["err"]) for r in reg if r["label"] == lab and r["ics"] == ics}
+        out.append(f"| {lab} | {ics} | " + " | ".join(cells.get(x, "—") for x in ratios) + " |")
+    P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
+    ts = sorted({r["t"] for r in doc.get("survival_long", [])})
+    out.append("\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
+               "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
+               "exponential from t0, p its χ² p-value)\n")
+    out.append("| system | E/E_c | " + " | ".join(f"P({t:g})" for t in ts)
+               + " | P∞ | κ∞ | regular share of the orbits inside at t_max | κ non-regular | p |")
+    out.append("|---|---|" + "---|" * (len(ts) + 5))
+    for f in doc["long_time"]:
+        if "disk" not in f["ics"]:
+            continue
+        ps = [P.get((f["label"], f["e_ratio"], t)) for t in ts]
+        out.append(f"| {f['label']} | {f['e_ratio']:g} | " + " | ".join(
+            fmt_err(x["P"], x["P_err"]) if x else "—" for x in ps) + " | "
+            + " | ".join([_ve_cell({"value": f.get("P_inf"), "err": f.get("P_inf_err")}),
+                          _ve_cell({"value": f.get("kappa_inf"), "err": f.get("kappa_inf_err")}),
+                          _pct(f.get("regular_fraction_of_censored")),
+                          _ve_cell({"value": f.get("kappa_nonregular"), "err": f.get("kappa_nonregular_err")}),
+                          fmt_num(f["p_nonregular"], 2) if _is_num(f.get("p_nonregular")) else "—"]) + " |")
+    vm = doc.get("validity_map", [])
+    if vm:
+        yn = {True: "yes", False: "no", None: "—"}
+        out.append("\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 defined with "
+                   "all orbits, the paper's convention) and claim 2's where tested, and whether the non-regular "
+                   "orbits decay as one exponential\n")
+        out.append("| system | E/E_c | regular fraction | κ0 defined (claim 1) | claim 2 | one exponential "
+                   "(non-regular) | plateau P∞ > 3σ |")
+        out.append("|---|---|---|---|---|---|---|")
+        for v in vm:
+            out.append(f"| {v['label']} | {v['e_ratio']:g} | {_pct(v['regular_fraction'], v['regular_err'])} | "
+                       f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | {yn[v['exponential']]} | "
+                       f"{yn[v['plateau']]} |")
+    rs = doc.get("resc", [])
+    if rs:
+        out.append("\n**r_esc sensitivity** (the same N and rules at each escape radius; windows of μ's fit)\n")
+        out.append("| system | r_esc | window | μ measured | μ predicted (c-measure) | μ own ⟨K⟩ | moment test "
+                   "(own − predicted) | 2⟨K⟩/E at E0 (measured) | at E0 interpolated (without E0) |")
+        out.append("|---|---|---|---|---|---|---|---|---|")
+        for r in rs:
+            out.append(f"| {r['label']} | {r['r_esc']:g}{' (default)' if r['default'] else ''} | "
+                       f"[{r['window'][0]:g}, {r['window'][1]:g}] | {_ve_cell(r['mu_measured'])} | "
+                       f"{_ve_cell(r['mu_predicted'])} | {_ve_cell(r['mu_own_K'])} | {_ve_cell(r['moment_test'])} | "
+                       f"{_ve_cell(r['kinetic_at_E0'])} | {fmt_num(r['kinetic_at_E0_interpolated_without_E0'])} |")
+    return "\n".join(out) + "\n"

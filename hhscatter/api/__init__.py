@@ -17,7 +17,7 @@ from an initial-condition table) is one ensemble per γ, with energy NaN.
 
 * :func:`survival` → :class:`SurvivalCurves`: Kaplan–Meier P(t) per point;
 * :func:`escape_rates` → :class:`EscapeRates`: κ ± error, τ0, the fit windows,
-  the MLE cross-check and τ* per point (paper Sec. II, Eq. (1)). κ is the
+  the MLE cross-check and τ* per point (paper Sec. II, Eq. (eqn:kappa_hyperbolic)). κ is the
   escape rate of the *conservative* system: for a dissipative point (γ > 0)
   P(t) is not exponential (paper Sec. III), so no κ is fitted there; its row
   has NaN and a note, and a warning names those points;

@@ -11,9 +11,18 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from hhscatter.api.plotting import _axes
-from hhscatter.api.points import _label, _PointRows, _same_point, _sorted_keys, _split_like, split_points
+from hhscatter.api.points import (
+    _key_columns,
+    _label,
+    _PointRows,
+    _same_point,
+    _sorted_keys,
+    _split_like,
+    split_points,
+)
 from hhscatter.api.rates import DISSIPATIVE_NOTE, EscapeRates, escape_rates
 from hhscatter.api.runs import run_scene
+from hhscatter.data.params import checked_value, same_run
 from hhscatter.data.read import read_lifetimes, read_sections
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
@@ -49,8 +58,8 @@ class CMeasureRates(_PointRows):
         return ax
 
 
-def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *, window: tuple[float, float],
-                          t_max: float, t_from: float | None = None, t_to: float | None = None,
+def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *,
+                          window: tuple[float, float] | None = None, t_max: float | None = None, t_from: float | None = None, t_to: float | None = None,
                           rec_efolds: float = 2.0, margin: float = 40.0, n_boot: int = 200,
                           seed: int = 0) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
@@ -71,10 +80,11 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     lifetimes, sections : DataFrame
         :func:`hhscatter.read_lifetimes` and :func:`hhscatter.read_sections` of one run (a scene or a grid;
         γ > 0 points get NaN and a note).
-    window : SectionWindow or dict
-        The section window the run recorded (``Scene.sections``).
-    t_max : float
-        The run's ``t_max`` (time units).
+    window : SectionWindow or dict, optional
+        The section window the run recorded (``Scene.sections``). Read from the data (the run's scene.json,
+        which the readers attach); a value passed here that contradicts it raises ValueError.
+    t_max : float, optional
+        The run's ``t_max`` (time units); read from the data like ``window``.
     t_from, t_to : float, optional
         The sampling window (time units). Default per point: t_from = max(window start, ⌈τ0 + rec_efolds/κ⌉)
         with τ0, κ from P(t) of the same point, t_to = t_record_end − ``margin``.
@@ -107,11 +117,16 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     True
     """
 
+    same_run(lifetimes, sections, what="the lifetimes and sections tables")
+    window = checked_value(lifetimes, "sections", _window_dict(window), what="the section window", name="window")
+    t_max = checked_value(lifetimes, "t_max", t_max, what="t_max")
+    if window is None or t_max is None:
+        raise ValueError("pass window= and t_max= of the run (the tables carry no record of their run)")
     window = _checked_cmeasure_window(window)
     t_max = float(t_max)
     t_record_end = min(float(window.get("t_to", math.inf)), t_max)
     lt, sec = lifetimes, sections
-    rates = escape_rates(lt) if any(g == 0 for (_, g), _ in split_points(lt)) else EscapeRates({}, {}, {})
+    rates = escape_rates(lt) if any(k[1] == 0 for k, _ in split_points(lt)) else EscapeRates({}, {}, {})
     keys = [k for k, _ in split_points(lt)]
     sec_by = _split_like(sec, keys, what="sections table")
     rows = {}
@@ -119,6 +134,11 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
         rows[key] = _cmeasure_point_row(key, df, sec_by.get(key, sec.iloc[:0]), rates, window, t_max, t_record_end,
                                         t_from, t_to, rec_efolds, margin, n_boot, seed)
     return CMeasureRates(rows)
+
+
+def _window_dict(window):
+    """A SectionWindow as the dict of its fields (None and dicts as given)."""
+    return dataclasses.asdict(window) if window is not None and dataclasses.is_dataclass(window) else window
 
 
 def _checked_cmeasure_window(window) -> dict:
@@ -144,7 +164,7 @@ def _cmeasure_point_row(key, df, sec, rates, window, t_max, t_record_end, t_from
         kappa_from_cmeasure,
     )
 
-    row = {"energy": key[0], "gamma": key[1], "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
+    row = {**_key_columns(key), "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
            "mu_exit": math.nan, "n_samples": 0, "n_exit": 0, "n_undetermined": 0, "t_from": math.nan,
            "t_to": math.nan, "t_record_end": t_record_end, "kappa_pt": math.nan, "kappa_pt_err": math.nan,
            "note": ""}

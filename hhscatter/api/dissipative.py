@@ -8,8 +8,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from hhscatter.api.plotting import _axes
-from hhscatter.api.points import _label, _PointRows, _same_point, _sorted_keys, _split_like, split_points
+from hhscatter.api.points import (
+    _key_columns,
+    _label,
+    _PointRows,
+    _same_point,
+    _sorted_keys,
+    _split_like,
+    split_points,
+)
 from hhscatter.api.rates import EscapeRates, escape_rates
+from hhscatter.data.params import plain_point
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -103,13 +112,18 @@ def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
             continue
         t2 = tau2_observed(df)
         iv = tau2_observed_interval(df) if t2 is not None else None
-        row = {"energy": key[0], "gamma": key[1], "n": len(df), "tau0": math.nan, "tau1": math.nan,
+        row = {**_key_columns(key), "n": len(df), "tau0": math.nan, "tau1": math.nan,
                "tau2": math.nan if t2 is None else t2, "tau2_lo": math.nan if iv is None else iv.lo,
                "tau2_hi": math.nan if iv is None else iv.hi, "note": ""}
         rows[key] = row
-        ref = [k for k in rates.results if _same_point(k, (key[0], 0.0))]
+        ref = [k for k in rates.results if _same_point(k[:2], (key[0], 0.0))]
+        ref = [k for k in ref if k[2:] == key[2:]] or ref  # the same run's partner first (a grid run)
         if not ref:
             row["note"] = "no conservative (γ = 0) point at this E0 with a κ fit: τ0 and τ1 need one"
+            continue
+        if len(ref) > 1:
+            row["note"] = (f"{len(ref)} conservative points at this E0 ({', '.join(_label(k) for k in ref)}): "
+                           "τ0 and τ1 need one; read the pair alone")
             continue
         r = rates.results[ref[0]]
         grid = np.asarray(t_grid, dtype=float) if t_grid is not None else np.linspace(
@@ -186,7 +200,10 @@ def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (
     window : (float, float)
         Fit window (time units).
     energy, gamma : float, optional
-        E0 and γ of a plain (non-grid) run, whose snapshots have no ``point_energy``/``point_gamma``.
+        E0 and γ of a plain (non-grid) run, whose snapshots have no ``point_energy``/``point_gamma``: read
+        from the data (the run's scene.json, which :func:`hhscatter.read_snapshots` attaches; else E0 from
+        the snapshots' energy at t = 0). A value passed here that contradicts the data raises ValueError
+        (:func:`hhscatter.data.params.plain_point`).
 
     Returns
     -------
@@ -209,6 +226,7 @@ def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (
     )
 
     curves, fits = {}, {}
+    energy, gamma = plain_point(snapshots, energy, gamma, what="snapshots table")
     for key, df in _split_like(snapshots, None, energy=energy, gamma=gamma, what="snapshots table").items():
         c = mean_energy(df)
         curves[key] = c

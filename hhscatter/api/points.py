@@ -38,8 +38,13 @@ def split_points(lifetimes):
     The ensembles of a lifetimes frame (module doc): by the ``energy`` and
     ``gamma`` columns when present; otherwise by clusters of ``e0`` (relative
     tolerance 1e-9; the key's energy is the cluster's median e0 to 12
-    significant digits) and ``gamma``. Raises ValueError if the frame is empty
-    or lacks ``t_end``/``outcome``.
+    significant digits) and ``gamma``. A frame of several runs
+    (:func:`hhscatter.read_lifetimes` of a list: a ``run`` column) is split per
+    run too, with keys ``(energy, gamma, run)``: one point per run and grid
+    point, unless the runs were pooled (``read_lifetimes(runs, pool=True)``).
+    Raises ValueError if the frame is empty, lacks ``t_end``/``outcome``, or
+    holds an orbit (``traj_id``) twice in one point (the same run concatenated
+    twice).
     """
     cols = set(lifetimes.columns)
     missing = {"t_end", "outcome"} - cols
@@ -47,6 +52,17 @@ def split_points(lifetimes):
         raise ValueError(f"lifetimes lacks column(s) {sorted(missing)}: pass a frame of hhscatter.read_lifetimes")
     if len(lifetimes) == 0:
         raise ValueError("lifetimes is empty: no orbits to analyse")
+    pooled = ((lifetimes.attrs.get("hhscatter") or {}).get("pooled") is not None)
+    if "run" in cols and not pooled:
+        out = [((*key, str(run)), df) for run, sub in lifetimes.groupby("run", observed=True, sort=False)
+               for key, df in _split_one(sub)]
+        return sorted(out, key=lambda kv: _sort_key(kv[0]))
+    return _split_one(lifetimes)
+
+
+def _split_one(lifetimes):
+    """split_points of the rows of one run (or of runs pooled on purpose); an orbit twice in a point refused."""
+    cols = set(lifetimes.columns)
     n = len(lifetimes)
     gamma = lifetimes["gamma"].to_numpy(dtype=float) if "gamma" in cols else np.zeros(n)
     if "energy" in cols:
@@ -64,24 +80,44 @@ def split_points(lifetimes):
     key_e = np.where(np.isnan(energy), -np.inf, energy)  # NaN sorts and compares as one value
     pairs = np.unique(np.column_stack([key_e, gamma]), axis=0)
     out = []
+    ids = ["run", "traj_id"] if "run" in cols else ["traj_id"]
     for e, g in pairs:
         mask = (key_e == e) & (gamma == g)
-        out.append(((math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]))
+        key, df = (math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]
+        if "traj_id" in cols and df.duplicated(subset=ids).any():
+            raise ValueError(f"lifetimes holds orbits twice at {_label(key)} (traj_id repeated): the same run "
+                             "concatenated twice, or several runs without a run column; read several runs with "
+                             "hhscatter.read_lifetimes([run1, run2, …]), which keeps them apart")
+        out.append((key, df))
     return out
 
 
+def _sort_key(k):
+    """Order of point keys: energy (NaN first), γ, then the run (as given)."""
+    return (float(np.nan_to_num(k[0], nan=-np.inf)), k[1], *(str(x) for x in k[2:]))
+
+
+def _key_columns(key) -> dict:
+    """The columns a point key gives a result row: energy, gamma (and run, for a frame of several runs)."""
+    return {"energy": key[0], "gamma": key[1], **({"run": key[2]} if len(key) > 2 else {})}
+
+
 def _label(key) -> str:
-    e, g = key
-    return f"E0={e:g}, γ={g:g}" if math.isfinite(e) else f"γ={g:g}"
+    e, g = key[0], key[1]
+    head = f"E0={e:g}, γ={g:g}" if math.isfinite(e) else f"γ={g:g}"
+    return f"{head} ({key[2]})" if len(key) > 2 else head
 
 
 def _sorted_keys(keys):
-    return sorted(keys, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1]))
+    return sorted(keys, key=_sort_key)
 
 
 def _same_point(a, b) -> bool:
-    """Two (energy, gamma) keys name the same point (energies to 1e-9 relative, NaN equal to NaN)."""
-    (ea, ga), (eb, gb) = a, b
+    """Two (energy, gamma[, run]) keys name the same point (energies to 1e-9 relative, NaN equal to NaN; the
+    runs equal when both keys name one)."""
+    if len(a) > 2 and len(b) > 2 and a[2] != b[2]:
+        return False
+    (ea, ga), (eb, gb) = a[:2], b[:2]
     same_e = (math.isnan(ea) and math.isnan(eb)) or (math.isfinite(ea) and math.isfinite(eb)
                                                      and abs(ea - eb) <= E0_RTOL * max(1.0, abs(ea)))
     return same_e and ga == gb

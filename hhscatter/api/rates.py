@@ -7,11 +7,9 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
 from hhscatter.api.plotting import plot_escape_rates, plot_survival
-from hhscatter.api.points import _label, split_points
+from hhscatter.api.points import _key_columns, _label, _sorted_keys, split_points
 from hhscatter.data.read import iter_survival_batches
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
@@ -54,7 +52,7 @@ class SurvivalCurves:
         """curves[(energy, gamma)] -> SurvivalCurve; ``curves[energy]`` if that energy has one point."""
         if key in self.curves:
             return self.curves[key]
-        hits = [k for k in self.curves if not isinstance(key, tuple) and k[0] == key]
+        hits = [k for k in self.curves if (k[0] == key if not isinstance(key, tuple) else k[:len(key)] == key)]
         if len(hits) == 1:
             return self.curves[hits[0]]
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
@@ -63,7 +61,7 @@ class SurvivalCurves:
         """The curves as one DataFrame: energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        parts = [pd.DataFrame({"energy": k[0], "gamma": k[1], "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
+        parts = [pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
                  for k, c in self.curves.items()]
         return pd.concat(parts, ignore_index=True)
 
@@ -133,7 +131,11 @@ class EscapeRates:
     n : dict
         (energy, gamma) → number of orbits N.
     notes : dict
-        (energy, gamma) → why a point has no κ (dissipative, too few orbits, …).
+        (energy, gamma) → why a point has no κ (dissipative, too few orbits, …), or why its κ is not the rate of
+        the population (a trapped plateau, a non-exponential decay).
+    status : dict
+        (energy, gamma) → :class:`~hhscatter.analysis.survival.long_time.RateStatus` of each fitted point:
+        'exponential', 'trapped' or 'non-exponential', with P∞ and κ∞ of the plateau-plus-exponential fit.
 
     Examples
     --------
@@ -148,6 +150,7 @@ class EscapeRates:
     results: dict
     n: dict
     notes: dict = field(default_factory=dict)
+    status: dict = field(default_factory=dict)
 
     def __getitem__(self, key):
         return self.results[key]
@@ -159,14 +162,15 @@ class EscapeRates:
         fits and statistics), kappa_stat, kappa_spread, tau0, t_stop, windows
         (the 4 (t_lo, t_hi) fit windows), kappa_mle, kappa_mle_err (maximum
         likelihood on [tau0, t_stop]), tau_star (NaN without power-law tail),
-        note (why κ is NaN, else empty).
+        status ('exponential', 'trapped', 'non-exponential'; empty where not fitted), p_inf, kappa_inf (the
+        plateau-plus-exponential fit from τ0), note (why κ is NaN or not the population's rate, else empty).
         """
         import pandas as pd  # deferred: pandas loads on first use
 
         rows = []
-        for key in sorted(self.n, key=lambda k: (np.nan_to_num(k[0], nan=-np.inf), k[1])):
+        for key in _sorted_keys(self.n):
             r = self.results.get(key)
-            row = {"energy": key[0], "gamma": key[1], "n": self.n[key]}
+            row = {**_key_columns(key), "n": self.n[key]}
             if r is None:
                 row.update(kappa=math.nan, kappa_err=math.nan, kappa_stat=math.nan, kappa_spread=math.nan,
                            tau0=math.nan, t_stop=math.nan, windows=None, kappa_mle=math.nan,
@@ -176,6 +180,9 @@ class EscapeRates:
                            kappa_spread=r.kappa_spread, tau0=r.tau0, t_stop=r.t_stop,
                            windows=[tuple(float(x) for x in w) for w in r.windows], kappa_mle=r.mle.kappa,
                            kappa_mle_err=r.mle.kappa_err, tau_star=r.tau_star)
+            st = self.status.get(key)
+            row.update(status=st.status if st else "", p_inf=st.p_inf if st else math.nan,
+                       kappa_inf=st.kappa_inf if st else math.nan)
             row["note"] = self.notes.get(key, "")
             rows.append(row)
         return pd.DataFrame(rows)
@@ -210,7 +217,10 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     -------
     EscapeRates
         ``.to_frame()`` one row per point (energy, gamma, n, kappa, kappa_err, tau0, windows, tau_star,
-        note), ``.plot(ax=)`` κ against E.
+        status, p_inf, kappa_inf, note), ``.plot(ax=)`` κ against E. A point whose orbits still inside at t_max
+        bias the window (status 'trapped') or whose decay is not one exponential ('non-exponential') says so in
+        ``status`` and ``note`` (:func:`~hhscatter.analysis.survival.long_time.rate_status`); its κ is then not
+        the population's escape rate.
 
     Examples
     --------
@@ -224,7 +234,9 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     from hhscatter.analysis.survival.escape_rate import escape_rate  # deferred: scipy loads on first use
     from hhscatter.analysis.survival.fits import observed_from_outcome  # deferred: scipy loads on first use
 
-    results, n, notes = {}, {}, {}
+    from hhscatter.analysis.survival.long_time import rate_status  # deferred: scipy loads on first use
+
+    results, n, notes, status = {}, {}, {}, {}
     for key, df in split_points(lifetimes):
         n[key] = len(df)
         if key[1] > 0:
@@ -232,9 +244,13 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
             continue
         observed = observed_from_outcome(df["outcome"].astype(object).to_numpy())
         try:
-            results[key] = escape_rate(df["t_end"].to_numpy(dtype=float), observed, t_grid, **kwargs)
+            results[key] = r = escape_rate(df["t_end"].to_numpy(dtype=float), observed, t_grid, **kwargs)
         except ValueError as exc:
             notes[key] = f"no fit: {exc}"
+            continue
+        status[key] = rate_status(df["t_end"].to_numpy(dtype=float), observed, r.tau0, r.t_stop)
+        if status[key].note:
+            notes[key] = status[key].note
     diss = [k for k, v in notes.items() if v == DISSIPATIVE_NOTE]
     if diss:
         warnings.warn(
@@ -242,7 +258,7 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
             f"point(s) {'; '.join(_label(k) for k in diss)}, whose P(t) is not exponential (paper Sec. III). "
             "Use hhscatter.survival for their P(t) and hhscatter.analysis.dissipative.transitions for τ1, τ2.",
             UserWarning, stacklevel=2)
-    return EscapeRates(results, n, notes)
+    return EscapeRates(results, n, notes, status)
 
 
 def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any = None, *,

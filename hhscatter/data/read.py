@@ -7,6 +7,11 @@ checksums verified. A missing table or part, a part outside the plan, of another
 :class:`~hhscatter.errors.IncompleteRunError` unless ``allow_partial=True``, which reads the finished chunks of
 every table alike and warns how much is missing. Runs of the legacy grid layout are read with the columns of
 the current one.
+
+A frame returned here carries what it was read from in ``DataFrame.attrs["hhscatter"]`` (:func:`run_identity`:
+the run's scene and hash), where the analysis functions read E0, γ, t_max … (:mod:`hhscatter.data.params`).
+:func:`read_lifetimes` of a list of runs keeps them apart (a ``run`` column: one point per run), refuses the
+same run or scene twice, and pools them only when asked (``pool=True``, checked).
 """
 from __future__ import annotations
 
@@ -16,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from hhscatter.data.params import FRAME_META
 from hhscatter.data.store import Store
 from hhscatter.errors import IncompleteRunError, RunIntegrityError
 from hhscatter.outcomes import CENSORING_OUTCOMES
@@ -264,7 +270,87 @@ def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = Fa
         df["outcome"] = df["outcome"].astype(str)
     if "exit_channel" in df.columns:
         df["exit_channel"] = df["exit_channel"].astype("Int8")
+    df.attrs[FRAME_META] = run_identity(run_dir)
     return df
+
+#: scene keys that do not change the physics of an ensemble: runs that differ only in these may be pooled
+POOLABLE_KEYS = ("seed", "n", "name", "batch_size", "chunk_size")
+
+
+def _decode_scene(d: dict) -> dict:
+    """A scene dict of scene.json with the JSON encoding of infinities ("inf", "-inf") undone."""
+    d = dict(d)
+    sec = d.get("sections")
+    if isinstance(sec, dict):
+        d["sections"] = {k: (float(v) if isinstance(v, str) and v.lstrip("-") == "inf" else v) for k, v in sec.items()}
+    return d
+
+
+def run_identity(run_dir) -> dict:
+    """run_identity(run_dir) -> {'run', 'scene_hash', 'scene', 'point_hashes', 'grid'}: what a run directory is.
+
+    From its ``scene.json`` (the scene or grid it was made from, with infinities decoded, its result hash and
+    the result hash of each grid point), else from the metadata of its first lifetimes part (a run written
+    before manifests). The readers leave this in ``DataFrame.attrs["hhscatter"]`` of what they return, so that
+    the analysis functions read E0, γ, t_max, the section window … from the data instead of trusting a
+    number typed again (:mod:`hhscatter.data.params`).
+    """
+    store = Store(run_dir)
+    if store.exists("scene.json"):
+        doc = json.loads(store.read_text("scene.json"))
+        points = [p["scene_hash"] for p in (doc.get("manifest") or {}).get("points", [])] or \
+            [p["scene_hash"] for p in doc.get("points", [])] or [doc.get("scene_hash")]
+        scene = doc.get("scene") or {}
+    else:
+        first = next((f for f in store.files("lifetimes") if f.endswith(".parquet")), None)
+        if first is None:
+            raise FileNotFoundError(f"no lifetimes table at {store.display('lifetimes')}")
+        meta = read_meta(store.path("lifetimes", first), filesystem=store.filesystem)
+        doc, scene = {"scene_hash": meta.get("scene_hash")}, meta.get("scene") or {}
+        points = [doc["scene_hash"]]
+    grid = any(isinstance(scene.get(k), list) for k in ("energy", "gamma"))
+    return {"run": str(run_dir), "scene_hash": doc.get("scene_hash"), "scene": _decode_scene(scene),
+            "point_hashes": [h for h in points if h], "grid": grid}
+
+
+def _distinct_runs(run_dirs) -> list[dict]:
+    """The identities of a list of runs, refused (ValueError) if one run, or one grid point, comes twice."""
+    ids, seen, where = [], {}, {}
+    for r in run_dirs:
+        root = Store(r).root
+        if root in where:
+            raise ValueError(f"run {str(r)!r} is given twice (as {where[root]!r} too): each orbit would count twice; "
+                             "give each run once")
+        where[root] = str(r)
+        ident = run_identity(r)
+        for h in ident["point_hashes"]:
+            if h in seen:
+                raise ValueError(f"runs {seen[h]!r} and {str(r)!r} hold the same scene (result hash {h[:12]}…): the "
+                                 "same orbits twice would count each orbit twice; give each run once")
+            seen[h] = str(r)
+        ids.append(ident)
+    return ids
+
+
+def _check_poolable(ids: list[dict]) -> None:
+    """Runs that may be pooled into one ensemble per point: the same scene apart from ``POOLABLE_KEYS``, and
+    distinct seeds (two runs of one seed share their first orbits). ValueError naming the key otherwise."""
+    ref = ids[0]
+    strip = lambda sc: {k: v for k, v in sc.items() if k not in POOLABLE_KEYS}  # noqa: E731
+    for other in ids[1:]:
+        a, b = strip(ref["scene"]), strip(other["scene"])
+        diff = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
+        if diff:
+            k = diff[0]
+            raise ValueError(f"pool=True: runs {ref['run']!r} and {other['run']!r} are not the same scene apart from "
+                             f"{'/'.join(POOLABLE_KEYS[:2])}: {k} is {a.get(k)!r} and {b.get(k)!r}"
+                             f"{f' (and {len(diff) - 1} more key(s))' if len(diff) > 1 else ''}; read them apart "
+                             "(pool=False) for one point per run")
+    seeds = [i["scene"].get("seed") for i in ids]
+    twice = sorted({s for s in seeds if seeds.count(s) > 1}, key=str)
+    if twice:
+        raise ValueError(f"pool=True: several runs have seed {twice[0]!r}; runs of one seed share their first orbits, "
+                         "so pooling them counts those orbits twice: pool runs of distinct seeds")
 
 
 def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, allow_partial: bool = False):
@@ -329,7 +415,7 @@ def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False)
 
 def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None = None,
                    filters: pyarrow.dataset.Expression | None = None, *, categorical: bool = False,
-                   allow_partial: bool = False) -> pandas.DataFrame:
+                   allow_partial: bool = False, pool: bool = False) -> pandas.DataFrame:
     """The lifetimes table of a run: one row per orbit.
 
     Columns: ``traj_id``, ``t_end`` (time of the orbit's end, time units), ``outcome`` ('escaped',
@@ -342,8 +428,11 @@ def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None =
     ----------
     run_dir : path or URL, or list of them
         A run directory written by :func:`hhscatter.simulate`. A list of runs gives their frames
-        concatenated (a plain run among grid runs gets its ``energy`` column from its orbits' ``e0``, so
-        that :func:`hhscatter.survival` and friends see one point per run and grid point).
+        concatenated and kept apart: a ``run`` column (categorical) names each row's run as given, so that
+        :func:`hhscatter.survival`, :func:`hhscatter.escape_rates` and friends see one point per run and
+        grid point even where two runs share E0 and γ (e.g. two escape radii); a plain run among grid runs
+        gets its ``energy`` column from its orbits' ``e0``. The same run twice (or two runs holding the
+        same scene: the same orbits) is refused.
     columns : list of str, optional
         Read only these columns (projection).
     filters : pyarrow.dataset.Expression, optional
@@ -353,12 +442,18 @@ def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None =
         ``outcome`` as a pandas categorical (1 byte per orbit, for 1e7 orbits and more) instead of str.
     allow_partial : bool
         Read the finished chunks of an unfinished run, with a warning saying how much is missing.
+    pool : bool
+        With a list of runs: pool them into one ensemble per point, an explicit choice that is checked
+        (the runs must be the same scene apart from ``seed``, ``n``, ``name``, ``batch_size`` and
+        ``chunk_size``, with distinct seeds); the ``run`` column is kept (``traj_id`` repeats across runs)
+        and ``DataFrame.attrs["hhscatter"]["pooled"]`` lists the runs pooled.
 
     Returns
     -------
     pandas.DataFrame
         ``exit_channel`` as nullable Int8. Runs in the layout of hhscatter ≤ 0.1.0 (``energy=…/gamma=…``
-        folders) come back with the same columns.
+        folders) come back with the same columns. ``attrs["hhscatter"]`` holds what the frame was read from
+        (:func:`run_identity`: the scene, its hash), where the analysis functions read E0, γ, … from.
 
     Raises
     ------
@@ -366,6 +461,9 @@ def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None =
         A table or planned part is missing, a part is damaged or not in the run's plan.
     IncompleteRunError
         Chunks are unfinished and ``allow_partial`` is False.
+    ValueError
+        A list holds the same run (or scene) twice; ``pool=True`` with runs that differ in a scene key
+        other than those above, or share a seed.
 
     Examples
     --------
@@ -378,20 +476,31 @@ def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None =
     (100, [])
     """
     if isinstance(run_dir, (list, tuple)):
-        return _concat_runs([_read(r, "lifetimes", columns, filters, categorical, allow_partial) for r in run_dir])
+        if not run_dir:
+            raise ValueError("no runs given")
+        ids = _distinct_runs(run_dir)
+        if pool:
+            _check_poolable(ids)
+        frames = [_read(r, "lifetimes", columns, filters, categorical, allow_partial) for r in run_dir]
+        return _concat_runs(frames, ids, pool)
+    if pool:
+        raise ValueError("pool=True needs a list of runs to pool")
     return _read(run_dir, "lifetimes", columns, filters, categorical, allow_partial)
 
 
-def _concat_runs(frames):
-    """One frame of several runs' lifetimes; plain runs get ``energy`` (their median e0, 12 digits) if any has it."""
+def _concat_runs(frames, ids, pool: bool = False):
+    """One frame of several runs' lifetimes with a ``run`` column naming each row's run; plain runs get
+    ``energy`` (their median e0, 12 digits) if any has it."""
     import pandas as pd  # deferred: pandas loads on first use
 
-    if not frames:
-        raise ValueError("no runs given")
     if any("energy" in f.columns for f in frames):
         frames = [f if "energy" in f.columns or "e0" not in f.columns or not len(f)
                   else f.assign(energy=float(f"{np.median(f['e0'].to_numpy(dtype=float)):.12g}")) for f in frames]
-    return pd.concat(frames, ignore_index=True)
+    names = [i["run"] for i in ids]
+    out = pd.concat([f.assign(run=name) for f, name in zip(frames, names)], ignore_index=True)
+    out["run"] = pd.Categorical(out["run"], categories=list(dict.fromkeys(names)))
+    out.attrs[FRAME_META] = {"runs": ids, "pooled": names if pool else None}
+    return out
 
 
 def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: bool = False) -> dict:

@@ -76,7 +76,7 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from hhscatter.outcomes import OUTCOMES
+from hhscatter.outcomes import OUTCOMES, TABLE_COLUMNS
 from hhscatter._version import __version__
 
 if TYPE_CHECKING:  # annotations only
@@ -96,27 +96,11 @@ def _schemas():
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
     f64 = pa.float64()
+    # the columns are declared once (hhscatter.outcomes.TABLE_COLUMNS); here their types (float64 unless named)
+    types = {"traj_id": pa.int64(), "outcome": pa.dictionary(pa.int8(), pa.string()), "exit_channel": pa.int8(),
+             "direction": pa.int8()}
     return {
-        "lifetimes": pa.schema(
-            [
-                ("traj_id", pa.int64()),
-                ("x0", f64),
-                ("y0", f64),
-                ("px0", f64),
-                ("py0", f64),
-                ("e0", f64),
-                ("gamma", f64),
-                ("outcome", pa.dictionary(pa.int8(), pa.string())),
-                ("t_end", f64),
-                ("exit_channel", pa.int8()),
-                ("e_end", f64),
-            ]
-        ),
-        "sections": pa.schema(
-            [("traj_id", pa.int64())] + [(c, f64) for c in ("t", "x", "y", "px", "py", "energy")]
-        ),
-        "snapshots": pa.schema([("traj_id", pa.int64()), ("t", f64), ("energy", f64)]),
-        "crossings": pa.schema([("traj_id", pa.int64()), ("t", f64), ("radius", f64), ("direction", pa.int8())]),
+        name: pa.schema([(c, types.get(c, f64)) for c in columns]) for name, columns in TABLE_COLUMNS.items()
     }
 
 

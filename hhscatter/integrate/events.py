@@ -65,11 +65,17 @@ from hhscatter.outcomes import (  # re-exported for the engine
 # value non-zero; it moves a crossing by 1e-300/|d(x px + y py)/dt|. (Random-direction momenta
 # (Scene.momentum = "random") start off the section: the first root is a real crossing, after T_INITIAL.)
 SECTION_OFFSET = 1e-300
-T_INITIAL = 1e-10  # section crossings before this orbit time are the initial point itself
+# Section crossings before T_INITIAL are the initial point itself. An orbit that starts on the section at an
+# inflection of r (r̈ = 0 as well as ṙ = 0) touches ṙ = 0 there with a near-triple root: in double (ṙ = 0 exactly)
+# its roots lie within ~1e-100 of t = 0, but the same initial numbers in long double carry ṙ ~ 1e-17, which the
+# cube root spreads to crossings up to ~1e-8 after the start (measured: 2e-9 to 2.5e-8). 1e-6 takes them all as
+# the initial point, so that the long-double reference driver and the engine agree on such orbits (the engine
+# redoes an orbit on it when heyoka's root finding fails: hhscatter.integrate.engine).
+T_INITIAL = 1e-6
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
 
-#: the outcome rules an event can trigger (each a handler of :class:`hhscatter.integrate.engine.LaneRules`)
+#: the outcome rules an event can trigger (each a handler of :class:`hhscatter.integrate.lanes.LaneRules`)
 RULES = ("escape", "closure", "far", "resc", "radius", "section", "clock")
 
 
@@ -80,7 +86,7 @@ class EventSpec:
     ``direction``: +1 (upward roots only), −1 (downward) or 0 (both);
     ``expression``: callable (Symbols) -> heyoka expression whose root is the event;
     ``rule``: the outcome rule its root triggers (one of :data:`RULES`; the handler
-    :meth:`hhscatter.integrate.engine.LaneRules.handler` binds); ``index``: the rule's argument (the radius
+    :meth:`hhscatter.integrate.lanes.LaneRules.handler` binds); ``index``: the rule's argument (the radius
     number of a follow radius), or None.
     """
 

@@ -32,6 +32,7 @@ __all__ = [
     "format_value_err",
     "markdown_to_html",
     "md_cell",
+    "scripts_to_html",
 ]
 
 
@@ -225,3 +226,34 @@ def markdown_to_html(text: str) -> str:
 
     return markdown.markdown(text, extensions=["tables", "fenced_code", "attr_list", "sane_lists"],
                              output_format="html")
+
+
+def scripts_to_html(text: str) -> str:
+    """scripts_to_html(text) -> ``x^{a}`` as ``x<sup>a</sup>`` and ``x_{a}`` as ``x<sub>a</sub>`` (braces matched,
+    nested ones converted too; anything else unchanged).
+
+    The package's docstrings and the pages write formulas as plain text that ``help()`` reads (``E0 e^{−μγt}``,
+    ``μ_c^{E1}``, ``Σ_{s∈i}``); the docs set them as superscripts and subscripts, never as raw braces.
+
+    Examples
+    --------
+    >>> scripts_to_html("E0 e^{−μγt}, ∫_{E_c}^{E0} and x^2")
+    'E0 e<sup>−μγt</sup>, ∫<sub>E_c</sub><sup>E0</sup> and x^2'
+    """
+    out, i = [], 0
+    while i < len(text):
+        if text[i] in "^_" and text.startswith("{", i + 1):
+            depth, j = 0, i + 1
+            while j < len(text):
+                depth += {"{": 1, "}": -1}.get(text[j], 0)
+                if depth == 0:
+                    break
+                j += 1
+            if depth == 0:
+                tag = "sup" if text[i] == "^" else "sub"
+                out.append(f"<{tag}>{scripts_to_html(text[i + 2:j])}</{tag}>")
+                i = j + 1
+                continue
+        out.append(text[i])
+        i += 1
+    return "".join(out)

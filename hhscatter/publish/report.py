@@ -17,6 +17,7 @@ import datetime as _dt
 import html
 import json
 import shutil
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,8 +29,10 @@ from hhscatter.publish.formatting import (
     markdown_to_html,
     md_cell,
 )
-from hhscatter.studies import studies_root
+from hhscatter.errors import StudyError
+from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary
+from hhscatter.studies.graph import GraphError, scales
 from hhscatter.studies.graph import studies as study_folders
 from hhscatter.studies.jsonio import write_json_atomic
 
@@ -47,7 +50,7 @@ class Section:
 
 def headline_numbers(numbers: dict, limit: int = 40) -> list[tuple[str, str]]:
     """headline_numbers(numbers) -> [(name, formatted)] of the scalar and value±err entries of a numbers JSON."""
-    skip = {"study", "scale", "paper_comparison", "config", "provenance", "raw_runs"}
+    skip = {"study", "scale", "paper_comparison", "config", "provenance", "raw_runs", "made_from", "sha256"}
     rows = []
 
     def walk(prefix, d, depth):
@@ -92,13 +95,29 @@ def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
     are read from ``studies/<name>/out/<scale>/`` when it made them on this
     machine, else from the committed copies in the docs (:func:`committed_assets`),
     so a report of the committed paper-scale results needs no simulation.
+
+    Every numbers JSON is verified before it is used (:meth:`hhscatter.studies.Study.verify_numbers`): one edited
+    after it was written, made from another study.toml, from other upstream numbers than those the report
+    shows beside it, or (in a study's out/ folder) from other raw runs than those there, raises
+    :class:`~hhscatter.studies.provenance.ProvenanceError` naming the file. An unknown ``scale`` raises
+    :class:`~hhscatter.errors.StudyError`.
     """
     root = Path(root) if root is not None else studies_root()
+    try:
+        known = scales(root)
+    except GraphError as exc:
+        raise StudyError(str(exc)) from None
+    if scale not in known:
+        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
     sections = []
     for info in study_folders(root):
         fig, nums, cost = _study_files(root, info.name, scale)
-        sec = Section(info.name, info.title, info.summary, fig,
-                      json.loads(nums.read_text()) if nums else None, info.paper)
+        doc = json.loads(nums.read_text()) if nums else None
+        if doc is not None:
+            study = load_study(info.name, scale, root=root)
+            study.verify_numbers(nums, doc, pick=lambda other: _study_files(root, other, scale)[1],
+                                 raw=nums.parent == root / info.name / "out" / scale)
+        sec = Section(info.name, info.title, info.summary, fig, doc, info.paper)
         sec.cost = json.loads(cost.read_text()) if cost else None
         sections.append(sec)
     return sections
@@ -320,9 +339,9 @@ def build_report(scale: str = "quick", out: Path | None = None, root: Path | Non
     """
     root = Path(root) if root is not None else studies_root()
     out = Path(out) if out is not None else root.parent / "reports" / scale
+    sections = collect(scale, root)  # verified before anything is written
     assets = out / "assets"
     assets.mkdir(parents=True, exist_ok=True)
-    sections = collect(scale, root)
 
     def copy_asset(path: Path, name: str) -> str:
         shutil.copyfile(path, assets / name)
@@ -346,7 +365,11 @@ def main(argv=None) -> int:
     p.add_argument("--scale", default="quick")
     p.add_argument("--out", help="output folder (default reports/<scale>)")
     a = p.parse_args(argv)
-    res = build_report(a.scale, a.out)
+    try:
+        res = build_report(a.scale, a.out)
+    except StudyError as exc:
+        print(f"report: error: {exc}", file=sys.stderr)
+        return exc.exit_code
     print(f"wrote {res['html']} and {res['markdown']} ({res['rows']} comparison rows)")
     if res["missing"]:
         print(f"missing outputs: {', '.join(res['missing'])}")

@@ -1,7 +1,7 @@
 """What a run plans and reports: chunks, tables, grid points, part-file paths, the manifest, the summary."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 from hhscatter.data.schema import part_name
@@ -30,11 +30,22 @@ class RunSummary:
     chunks_skipped: int = 0
     workers: int = 1
     backend: str = "local"
+    #: heyoka's event-detection failures (an event ignored in a step), per chunk that had any:
+    #: {'<partition>/<chunk>' ('<chunk>' for a single scene): {"failures": n, "orbits_redone": m}}; every orbit
+    #: they hit was redone on the reference driver
+    event_failures: dict = field(default_factory=dict)
 
     def add(self, other: RunSummary):
         for k in ("n", "escaped", "settled", "censored", "stopped", "n_sections", "n_snapshots", "compute_seconds"):
             setattr(self, k, getattr(self, k) + getattr(other, k))
+        self.event_failures.update(other.event_failures)
         self.chunks_done += 1
+
+    def event_failures_record(self) -> dict:
+        """The ``event_failures`` entry of the run's scene.json: total, orbits redone, counts per chunk."""
+        chunks = self.event_failures
+        return {"total": sum(c["failures"] for c in chunks.values()),
+                "orbits_redone": sum(c["orbits_redone"] for c in chunks.values()), "chunks": dict(sorted(chunks.items()))}
 
     def line(self) -> str:
         if self.n == 0 and self.chunks_skipped:
@@ -48,6 +59,9 @@ class RunSummary:
             f"{f', stopped {self.stopped}' if self.stopped else ''}"
             f" | wall {self.wall_seconds:.2f} s ({us:.2f} µs per orbit; {us_core:.2f} µs per orbit in the workers' chunks)"
             f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
+            + (f"\nheyoka event-detection failures: {self.event_failures_record()['total']} in "
+               f"{len(self.event_failures)} chunk(s); {self.event_failures_record()['orbits_redone']} orbit(s) redone "
+               "on the long-double reference driver (scene.json: event_failures)" if self.event_failures else "")
         )
 
 

@@ -35,7 +35,10 @@ and its orbit range); the readers of :mod:`hhscatter.data.schema` read exactly t
 planned parts whose chunk is finished, check each part's metadata against the
 plan and verify the page checksums, and refuse anything else. An unfinished
 chunk (no ``lifetimes`` part) makes the run incomplete: an error for readers
-unless they pass ``allow_partial=True``.
+unless they pass ``allow_partial=True``. When the run ends, ``scene.json`` also
+gets ``event_failures``: heyoka's event-detection failures per chunk (an event
+heyoka ignored in a step; :mod:`hhscatter.integrate.heyoka_log`) and the orbits
+redone because of them (zero counts included: the key says they were checked).
 
 One writer per run directory: ``simulate`` holds an exclusive ``flock`` on
 ``OUT/.hhscatter.lock`` (:meth:`hhscatter.data.store.Store.lock`) from its checks to
@@ -48,11 +51,13 @@ a :class:`RunError`.
 """
 from __future__ import annotations
 
+import json
 import multiprocessing as mp
 import os
 import queue as queue_mod
 import time
 import uuid
+from typing import NamedTuple
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing.managers import SyncManager
 
@@ -61,13 +66,24 @@ from hhscatter.data.store import Store
 from hhscatter.errors import ConfigError, RunError
 from hhscatter.run.dask_backend import check_scheduler, dask_client
 from hhscatter.run.output import prepare_output
-from hhscatter.run.plan import RunSummary, plan_chunks, points_of
+from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
 from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
 
+
+
+class ChunkTask(NamedTuple):
+    """One task of a run: the orbits start..stop−1 of one point's scene, chunk ``chunk`` of its plan."""
+
+    scene_json: str  # the point's scene (Scene.to_json), what the worker rebuilds it from
+    chunk: int
+    start: int
+    stop: int
+    partition: str  # the grid point's folder ('' for a single scene)
+    scene_hash: str  # the point's result hash, computed once per run
 
 
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
@@ -174,18 +190,39 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
         check_scheduler(scheduler, workers)
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
+    earlier = _earlier_event_failures(out) if resume else {}
     store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
     try:
-        return _simulate(run, store, points, table_ics, workers, resume, progress, scheduler)
+        summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier)
+        _record_event_failures(store, summary)
+        return summary
     finally:
         Store.unlock(lock)
 
 
-def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler) -> RunSummary:
+def _earlier_event_failures(out) -> dict:
+    """The per-chunk event-failure counts of the run in ``out`` (its scene.json), kept when it is resumed."""
+    try:
+        store = Store(out)
+        if not store.exists(SCENE_FILE):
+            return {}
+        return dict(json.loads(store.read_text(SCENE_FILE)).get("event_failures", {}).get("chunks", {}))
+    except (OSError, ValueError, AttributeError):
+        return {}
+
+
+def _record_event_failures(store, summary) -> None:
+    """Write the run's heyoka event-detection failures (per chunk, and the orbits redone) into its scene.json."""
+    doc = json.loads(store.read_text(SCENE_FILE))
+    doc["event_failures"] = summary.event_failures_record()
+    store.write_json(SCENE_FILE, doc)
+
+
+def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier=None) -> RunSummary:
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
-    summary = RunSummary()
+    summary = RunSummary(event_failures=dict(earlier or {}))
     n_total = sum(sc.n for sc, _, _ in points)
     n_chunks = sum(-(-sc.n // sc.chunk_size) for sc, _, _ in points)
     todo = []
@@ -196,20 +233,18 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
                 if chunk_complete(scene, store, chunk, start, stop, partition, want=h):
                     summary.chunks_skipped += 1
                     continue
-                todo.append((scene_json, chunk, start, stop, partition, h))
-        done_orbits = n_total - sum(t[3] - t[2] for t in todo)
+                todo.append(ChunkTask(scene_json, chunk, start, stop, partition, h))
+        done_orbits = n_total - sum(t.stop - t.start for t in todo)
         n_todo = len(todo)
-    else:  # planned lazily: one task tuple per chunk in flight, not per chunk of the run
-        todo = ((sj, chunk, start, stop, partition, h) for scene, partition, h in points
+    else:  # planned lazily: one task per chunk in flight, not per chunk of the run
+        todo = (ChunkTask(sj, chunk, start, stop, partition, h) for scene, partition, h in points
                 for sj in (scene.to_json(),) for chunk, start, stop in plan_chunks(scene))
         done_orbits, n_todo = 0, n_chunks
 
-    def args(task):
-        scene_json, c, s, e, partition, _ = task
-        if table_ics is None:
-            return (scene_json, c, s, e, out_url, None, None, partition)
-        states, ids = table_ics
-        return (scene_json, c, s, e, out_url, states[s:e], ids[s:e], partition)
+    def args(task: ChunkTask):
+        ics = (None, None) if table_ics is None else (table_ics[0][task.start:task.stop],
+                                                      table_ics[1][task.start:task.stop])
+        return (task.scene_json, task.chunk, task.start, task.stop, out_url, *ics, task.partition)
 
     t0 = time.perf_counter()
     bar = progress_bar(progress, n_total, done_orbits, run.name)
@@ -218,7 +253,7 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
 
     def on_done(task, result):
         summary.add(result)
-        bar.update(max(0, task[3] - task[2] - reported.pop((task[4], task[1]), 0)))
+        bar.update(max(0, task.stop - task.start - reported.pop((task.partition, task.chunk), 0)))
 
     def on_progress(key, k):
         reported[key] = reported.get(key, 0) + k
@@ -238,9 +273,9 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
             summary.workers = workers
             if workers == 1 or n_todo <= 1:
                 for task in todo:
-                    key = (task[4], task[1])
+                    key = (task.partition, task.chunk)
                     tell = (lambda k, key=key: on_progress(key, k)) if progress else None
-                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task[5]))
+                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task.scene_hash))
             else:
                 _run_pool(min(workers, n_todo), todo, args, on_done, on_progress if progress else None)
     except OSError as exc:
@@ -296,8 +331,8 @@ def _run_dask(client, todo, args, on_done, name):
     tag = uuid.uuid4().hex[:8]
 
     def submit(task):
-        key = f"hhscatter-{name}-{task[4].replace('/', ',') + '-' if task[4] else ''}{task[1]}-{tag}"
-        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task[5])
+        key = f"hhscatter-{name}-{task.partition.replace('/', ',') + '-' if task.partition else ''}{task.chunk}-{tag}"
+        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task.scene_hash)
 
     def wait_first(fs):
         alone_since = None

@@ -61,6 +61,9 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         "orbits": [start, stop],
         **provenance(),
     }
+    key = f"{partition}/{chunk}" if partition else str(chunk)
+    if res.event_failures:  # heyoka ignored an event in some step: counted, and the orbits hit were redone
+        meta["event_failures"] = {"count": res.event_failures, "redone": [int(k) for k in res.redone]}
     if scene.system is not None:  # which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
         meta["system"] = scene.model.provenance()
     rows = res.tables()
@@ -85,6 +88,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         n_sections=len(res.sections["t"]),
         n_snapshots=len(res.snapshots["t"]),
         compute_seconds=elapsed,
+        event_failures={key: {"failures": res.event_failures, "orbits_redone": len(res.redone)}}
+        if res.event_failures else {},
     )
 
 

@@ -168,5 +168,10 @@ def _run_one(study, mod, st, name, scale, workers, progress):
         import matplotlib  # deferred: matplotlib loads on first use
 
         matplotlib.use("Agg")
+        if not study.numbers_path.exists():
+            raise StudyError(f"{name} plot: {study.numbers_path} is missing; run `hhscatter study {name} analyze "
+                             f"--scale {scale}` first")
+        # the numbers drawn are the ones analyze wrote for this study.toml and these upstream numbers
+        study.verify_numbers(upstream=not dev_fallback_enabled())
         mod.plot(study)
         print(f"{name} plot: wrote {study.figure_path}", flush=True)

@@ -16,18 +16,14 @@ figure is stamped.  The default (and every make target) fails instead.
 from __future__ import annotations
 
 import math
-import os
 
 from hhscatter.errors import HHScatterError, StudyError
-from hhscatter.studies.study import load_study
+from hhscatter.studies.study import DEV_ENV, dev_fallback_enabled, load_study
 
-DEV_ENV = "HHSCATTER_DEV_FALLBACK"
+__all__ = ["DEV_ENV", "DEV_SOURCE", "UpstreamError", "any_fallback", "dev_fallback_enabled", "lookup", "numbers",
+           "published_table", "table", "value_or_fallback"]
+
 DEV_SOURCE = "paper fallback (DEVELOPMENT ONLY)"
-
-
-def dev_fallback_enabled() -> bool:
-    """dev_fallback_enabled() -> True if ``HHSCATTER_DEV_FALLBACK=1`` is set (development only)."""
-    return os.environ.get(DEV_ENV, "") == "1"
 
 
 class UpstreamError(StudyError, FileNotFoundError):

@@ -40,9 +40,17 @@ from hhscatter.studies.graph import (
 )
 from hhscatter.studies.graph import default_root as _graph_default_root
 from hhscatter.studies.jsonio import _jsonable, write_json_atomic
+from hhscatter.studies.provenance import made_from, sealed, verify_numbers
 
 STAGES = ("simulate", "analyze", "plot")
 DEFAULT_SCALE = "quick"
+DEV_ENV = "HHSCATTER_DEV_FALLBACK"
+
+
+def dev_fallback_enabled() -> bool:
+    """dev_fallback_enabled() -> True if ``HHSCATTER_DEV_FALLBACK=1`` is set (development only: a study may then
+    use the paper's value for a missing upstream number, :mod:`hhscatter.studies._upstream`)."""
+    return os.environ.get(DEV_ENV, "") == "1"
 
 
 def studies_root() -> Path:
@@ -265,20 +273,57 @@ class Study:
         return f"{head}{where}, r_esc {r_esc:g}" if r_esc is not None else f"{head}{where}"
 
     def write_numbers(self, numbers: dict) -> Path:
-        """Write the study's numbers JSON (with its comparisons, scale and provenance)."""
+        """Write the study's numbers JSON (with its comparisons, scale and provenance).
 
+        It records what it was made from (:mod:`hhscatter.studies.provenance`: the hash of this study's
+        configuration, of each upstream numbers JSON and the raw runs' scene hashes) and its own content hash.
+        """
+
+        ups = {name: doc for name, (_, doc) in self.upstream_numbers().items() if doc is not None}
         doc = {"study": self.name, "scale": self.scale, **numbers,
                "paper_comparison": list(self.comparisons), "config": self.config,
-               "raw_runs": dict(self.raw_runs), "provenance": provenance()}
-        write_json_atomic(self.numbers_path, doc)
+               "raw_runs": dict(self.raw_runs), "provenance": provenance(), "made_from": made_from(self, ups)}
+        write_json_atomic(self.numbers_path, sealed(_jsonable(doc)))
         return self.numbers_path
 
     def read_numbers(self, other: str | None = None) -> dict:
-        """read_numbers(other=None) -> numbers JSON of this study or of study ``other`` at the same scale."""
-        path = self.numbers_path if other is None else load_study(other, self.scale, root=self.root.parent).numbers_path
+        """read_numbers(other=None) -> numbers JSON of this study or of study ``other`` at the same scale, verified
+        (:meth:`verify_numbers`: not edited, not stale)."""
+        study = self if other is None else load_study(other, self.scale, root=self.root.parent)
+        path = study.numbers_path
         if not path.exists():
             raise FileNotFoundError(f"{path} is missing: run `make {other or self.name} SCALE={self.scale}` first")
-        return json.loads(path.read_text())
+        doc = json.loads(path.read_text())
+        study.verify_numbers(path, doc, upstream=not dev_fallback_enabled())
+        return doc
+
+    def upstream_numbers(self, pick=None) -> dict:
+        """upstream_numbers(pick=None) -> {name: (path, numbers JSON or None)} of every study this one needs.
+
+        ``pick(name) -> path`` chooses the file of an upstream study (default: its numbers JSON at this scale).
+        """
+        out = {}
+        for other in sorted(set(self.needs.values())):
+            path = pick(other) if pick is not None else \
+                load_study(other, self.scale, root=self.root.parent).numbers_path
+            out[other] = (path, json.loads(path.read_text()) if path is not None and path.exists() else None)
+        return out
+
+    def verify_numbers(self, path: Path | None = None, doc: dict | None = None, *, pick=None,
+                       upstream: bool = True, raw: bool = True) -> None:
+        """verify_numbers(path=None, doc=None, *, pick=None, upstream=True, raw=True) -> None, or ProvenanceError.
+
+        The study's numbers JSON (default: its own ``<name>.json``) checked against what it records
+        (:func:`hhscatter.studies.provenance.verify_numbers`): its content, this study's configuration now,
+        the upstream numbers JSON (``pick`` as for :meth:`upstream_numbers`; ``upstream=False`` skips them)
+        and, with ``raw``, its raw runs when they are here (``out/raw/done.json``). ProvenanceError: exit 2.
+        """
+        path = Path(path) if path is not None else self.numbers_path
+        doc = json.loads(path.read_text()) if doc is None else doc
+        ups = self.upstream_numbers(pick) if upstream else {}
+        verify_numbers(path, doc, config=_jsonable(self.config), scale=self.scale, upstream=ups,
+                       raw=self.out / "raw" if raw else None,
+                       remake=f"make it again with `make {self.name} SCALE={self.scale}`")
 
     def write_table(self, df, fname: str, **meta) -> Path:
         """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""

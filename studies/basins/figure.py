@@ -16,80 +16,124 @@ def _image(ax, labels, extent, cmap, norm):
 
 
 def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", local=None, scan=None):
-    """plot_basins(maps, zooms, entropy, uncertainty, numbers, path) -> None; writes basins.png.
+    """Write the study's figures: ``path`` (basins.png) and three siblings basins_<part>.png.
 
-    Rows 1–2: the basin maps of each (E0, γ) with a discrete legend; row 3:
-    the zoom of one boundary region at two magnifications (γ as listed);
-    row 4: (a) f(ε) on log–log axes with the fitted power laws, (b) S_b and
-    S_bb against γ with ln 2, (c) the uncertainty dimension d = 2 − α
-    against γ; row 5 (issue 25, when ``local`` and ``scan`` are given): the
-    local dimension d(ε) against ε for every γ at each E0, the measured and
-    predicted cut-off ε_c against γ, the Wada fraction of the exit basins
-    (settled masked) and of all basins against γ, and the γ = 0 energy scan
-    (S_b, S_bb, d = 2 − α and λ against E0, with fig2's break energy E_b).
+    basins.png: the basin map of each (E0, γ), three per row, with a discrete legend; basins_zoom.png: one
+    boundary region at two magnifications per γ listed; basins_measures.png: (a) f(ε) on log–log axes with the
+    fitted power laws, (b) S_b and S_bb against γ with ln 2, (c) d = 2 − α against γ, (d) S_b and S_bb at
+    fixed box sides on every grid (like for like across resolutions); basins_scale.png (when ``local`` and
+    ``scan`` are given): the local dimension d(ε) per E0, the measured against the predicted cut-off ε_c, the
+    Wada fraction, and the γ = 0 energy scan. Each panel is drawn 4 in wide or more, so that it stays
+    legible when the figure is shown at the page's content width.
     """
+    from pathlib import Path
+
     from matplotlib.colors import BoundaryNorm, ListedColormap
-    from matplotlib.patches import Patch
 
     plt = agg_pyplot()
+    path = Path(path)
     cmap = ListedColormap(COLORS).with_extremes(bad="white")
     norm = BoundaryNorm(np.arange(-0.5, 5.5), cmap.N)
     energies = sorted(maps.energy.unique())
     gammas = sorted(maps.gamma.unique())
     n = int(numbers["grid"])
-    ext = numbers["extent"]
-    zg = sorted(zooms.gamma.unique())
-    zf = sorted(zooms.factor.unique())
-    extra = local is not None and scan is not None
-    ncol = max(len(gammas), len(zg) * len(zf), 3, 6 if extra else 0)
-    nrow = len(energies) + 2 + int(extra)
-    fig = plt.figure(figsize=(3.0 * ncol, 3.0 * nrow), constrained_layout=True)
-    gs = fig.add_gridspec(nrow, ncol)
-    _map_rows(fig, gs, maps, energies, gammas, n, ext, cmap, norm)
-    _zoom_row(fig, gs, len(energies), zooms, zg, zf, numbers["zoom_centre"], cmap, norm)
+    tail = f"{' — ' + scale if scale else ''}"
+    pairs = [(E, g) for E in energies for g in gammas]
+    ncol = min(3, len(pairs))
+    nrow = -(-len(pairs) // ncol)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 4.0 * nrow + 0.6), constrained_layout=True,
+                            squeeze=False)
+    _map_panels(axs.ravel(), maps, pairs, n, numbers["extent"], cmap, norm)
+    _legend(fig)
+    fig.suptitle(f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ ({n}×{n} cells, "
+                 f"$r_{{esc}}=1.5$){tail}", fontsize=12)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    zg, zf = sorted(zooms.gamma.unique()), sorted(zooms.factor.unique())
+    fig, axs = plt.subplots(len(zg), len(zf), figsize=(4.6 * len(zf), 4.2 * len(zg) + 0.6),
+                            constrained_layout=True, squeeze=False)
+    _zoom_panels(axs, zooms, zg, zf, numbers["zoom_centre"], cmap, norm)
+    _legend(fig)
+    fig.suptitle(f"Zooms into one boundary region{tail}", fontsize=12)
+    fig.savefig(path.with_name(path.stem + "_zoom.png"), dpi=100)
+    plt.close(fig)
     per = numbers["per_point"]
-    last = nrow - 1 - int(extra)
-    _panel_uncertainty(fig.add_subplot(gs[last, 0]), uncertainty, per)
-    _panel_entropy(fig.add_subplot(gs[last, 1]), per, energies, gammas)
-    _panel_dimension(fig.add_subplot(gs[last, 2]), per, energies)
-    if extra:
-        _issue25_row(fig, gs, nrow - 1, ncol, energies, gammas, local, scan, numbers)
+    fig, axs = plt.subplots(2, 2, figsize=(11, 9), constrained_layout=True)
+    _panel_uncertainty(axs[0, 0], uncertainty, per)
+    _panel_entropy(axs[0, 1], per, energies, gammas)
+    _panel_dimension(axs[1, 0], per, energies)
+    _panel_entropy_by_box(axs[1, 1], numbers.get("entropy_by_box") or [])
+    fig.suptitle(f"Fractality measures{tail}", fontsize=12)
+    fig.savefig(path.with_name(path.stem + "_measures.png"), dpi=100)
+    plt.close(fig)
+    if local is not None and scan is not None:
+        fig, axs = plt.subplots(3, 2, figsize=(11, 13), constrained_layout=True)
+        _scale_panels(axs, energies, gammas, local, scan, numbers)
+        fig.suptitle(f"Scale-dependent dimension, cut-off, Wada and the γ = 0 energy scan{tail}", fontsize=12)
+        fig.savefig(path.with_name(path.stem + "_scale.png"), dpi=100)
+        plt.close(fig)
+
+
+def _legend(fig):
+    from matplotlib.patches import Patch
+
     fig.legend(handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)] +
                [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
-               loc="outside lower center", ncol=6, fontsize=9)
-    fig.suptitle(f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ "
-                 f"({n}×{n} cells, $r_{{esc}}=1.5$){' — ' + scale if scale else ''}", fontsize=11)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+               loc="outside lower center", ncol=6, fontsize=10)
 
 
-def _map_rows(fig, gs, maps, energies, gammas, n, ext, cmap, norm):
-    """Rows 1–2: the basin map of each (E0, γ), one row per E0."""
-    for i, E in enumerate(energies):
-        for j, g in enumerate(gammas):
-            ax = fig.add_subplot(gs[i, j])
-            lab = maps[(maps.energy == E) & (maps.gamma == g)].label.to_numpy().reshape(n, n)
-            _image(ax, lab, ext, cmap, norm)
-            ax.set_title(f"$E_0={E:g}$, $\\gamma={g:g}$", fontsize=10)
-            ax.set_aspect("equal")
-            ax.set_xlabel("$x$")
-            if j == 0:
-                ax.set_ylabel("$y$")
-
-
-def _zoom_row(fig, gs, row, zooms, zg, zf, centre, cmap, norm):
-    """Row 3: the zooms of one boundary region, per γ and magnification."""
-    cx, cy = centre
-    for j, (g, f) in enumerate((g, f) for g in zg for f in zf):
-        ax = fig.add_subplot(gs[row, j])
-        z = zooms[(zooms.gamma == g) & (zooms.factor == f)]
-        m = int(round(np.sqrt(len(z))))
-        e = [float(z[c].iloc[0]) for c in ("x0", "x1", "y0", "y1")]
-        _image(ax, z.label.to_numpy().reshape(m, m), e, cmap, norm)
-        ax.set_title(f"zoom ×{f:g} at ({cx:.3f}, {cy:.3f}), $\\gamma={g:g}$", fontsize=9)
+def _map_panels(axes, maps, pairs, n, ext, cmap, norm):
+    """The basin map of each (E0, γ) in ``pairs``, one panel each (spare panels hidden)."""
+    for ax, (E, g) in zip(axes, pairs):
+        lab = maps[(maps.energy == E) & (maps.gamma == g)].label.to_numpy().reshape(n, n)
+        _image(ax, lab, ext, cmap, norm)
+        ax.set_title(f"$E_0={E:g}$, $\\gamma={g:g}$", fontsize=11)
+        ax.set_aspect("equal")
         ax.set_xlabel("$x$")
-        ax.ticklabel_format(useOffset=False)
-        ax.tick_params(labelsize=7)
+        ax.set_ylabel("$y$")
+    for ax in axes[len(pairs):]:
+        ax.set_visible(False)
+
+
+def _zoom_panels(axs, zooms, zg, zf, centre, cmap, norm):
+    """The zooms of one boundary region: one row per γ, one column per magnification."""
+    cx, cy = centre
+    for i, g in enumerate(zg):
+        for j, f in enumerate(zf):
+            ax = axs[i, j]
+            z = zooms[(zooms.gamma == g) & (zooms.factor == f)]
+            m = int(round(np.sqrt(len(z))))
+            e = [float(z[c].iloc[0]) for c in ("x0", "x1", "y0", "y1")]
+            _image(ax, z.label.to_numpy().reshape(m, m), e, cmap, norm)
+            ax.set_title(f"×{f:g} at ({cx:.3f}, {cy:.3f}), $\\gamma={g:g}$", fontsize=10)
+            ax.set_xlabel("$x$")
+            ax.set_ylabel("$y$")
+            ax.ticklabel_format(useOffset=False)
+            ax.tick_params(labelsize=8)
+
+
+def _panel_entropy_by_box(ax, recs):
+    """S_b and S_bb at fixed box sides (position units) at γ = 0, one line per (E0, grid): like for like across
+    map resolutions."""
+    groups = {}
+    for r in recs:
+        if r["gamma"] == 0:
+            groups.setdefault((r["E0"], r["grid"], r.get("map", "map")), []).append(r)
+    for k, ((E, grid, which), rs) in enumerate(sorted(groups.items())):
+        rs = sorted(rs, key=lambda r: r["box_side"])
+        s = [r["box_side"] for r in rs]
+        c = f"C{k}"
+        ax.errorbar(s, [r["S_b"] for r in rs], yerr=[r["S_b_err"] for r in rs], fmt="o-", ms=4, color=c,
+                    label=f"$S_b$, $E_0={E:g}$, {grid}² ({which})")
+        ax.errorbar(s, [r["S_bb"] for r in rs], yerr=[r["S_bb_err"] for r in rs], fmt="s--", ms=4, color=c,
+                    mfc="none", label=f"$S_{{bb}}$, $E_0={E:g}$, {grid}²")
+    ax.axhline(np.log(2), color="k", lw=0.8, ls=":", label="ln 2")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("box side $s$ (position units)")
+    ax.set_ylabel("basin entropy at $\\gamma = 0$")
+    ax.set_title("(d) $S_b$, $S_{bb}$ at fixed box sides", fontsize=10)
+    ax.legend(fontsize=7)
 
 
 def _panel_uncertainty(ax, uncertainty, per):
@@ -141,24 +185,20 @@ def _panel_dimension(ax, per, energies):
     ax.legend(fontsize=7)
 
 
-def _issue25_row(fig, gs, row, ncol, energies, gammas, local, scan, numbers):
-    """Scale-dependent dimension, cut-off prediction, like-for-like Wada and the γ = 0 energy scan."""
+def _scale_panels(axs, energies, gammas, local, scan, numbers):
+    """Scale-dependent dimension per E0, cut-off prediction, like-for-like Wada and the γ = 0 energy scan."""
     import matplotlib.pyplot as plt
 
     cm = plt.get_cmap("viridis")
-    col = 0
-    for E in energies[:2]:
-        _panel_local_dimension(fig.add_subplot(gs[row, col]), E, gammas, local, cm)
-        col += 1
-    _panel_cutoff(fig.add_subplot(gs[row, col]), energies, numbers)
-    col += 1
-    _panel_wada(fig.add_subplot(gs[row, col]), energies, numbers["per_point"])
-    col += 1
+    for k, E in enumerate(energies[:2]):
+        _panel_local_dimension(axs[0, k], E, gammas, local, cm)
+    _panel_cutoff(axs[1, 0], energies, numbers)
+    _panel_wada(axs[1, 1], energies, numbers["per_point"])
     E_b = numbers["E_b"]["value"]
-    _panel_scan_entropy(fig.add_subplot(gs[row, col]), scan, E_b)
-    col += 1
-    if col < ncol:
-        _panel_scan_dimension(fig.add_subplot(gs[row, col]), scan, E_b)
+    _panel_scan_entropy(axs[2, 0], scan, E_b)
+    _panel_scan_dimension(axs[2, 1], scan, E_b)
+    if len(energies) < 2:
+        axs[0, 1].set_visible(False)
 
 
 def _panel_local_dimension(ax, E, gammas, local, cm):

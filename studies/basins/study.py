@@ -20,7 +20,7 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
    changes under a shift ε of x (fresh initial conditions at each ε, down to
    ε = 1e-9: exact event times and tol 1e-15 resolve it); d = 2 − α.
 3. **The paper's cut-off.** A broken power law against the single one for
-   f(ε) (:func:`~hhscatter.analysis.geometry.basins.uncertainty_cutoff`): ε_c(γ) or an
+   f(ε) (:func:`~hhscatter.analysis.geometry.uncertainty.uncertainty_cutoff`): ε_c(γ) or an
    upper bound; and the lifetimes of the orbits that decide the outcome at
    the smallest ε, against τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1, the
    late-time exponent of study fig3).
@@ -37,9 +37,8 @@ import pandas as pd
 
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 
-SETTLED_CODE, TRAPPED_CODE, OUTSIDE = 3, 4, -1
-CODES = (0, 1, 2, SETTLED_CODE, TRAPPED_CODE)
-CODE_NAMES = ("exit 0", "exit 1", "exit 2", "settled", "trapped")
+from hhscatter.analysis.geometry import basin_summary as bs
+from hhscatter.analysis.geometry.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
 
 
 class Params(StudyParams):
@@ -68,6 +67,7 @@ class Params(StudyParams):
     E_b_key: str = "kappa_fit.E_b"
     kappa_energy_key: str = "kappa_energy"
     mu_key: str = "mu"
+    box_sides: Numbers = (0.01, 0.02, 0.025, 0.05, 0.1, 0.2)  # S_b, S_bb also at these sides (position units)
 
 
 # -- keys and grids ----------------------------------------------------------------
@@ -115,18 +115,6 @@ def _eps(study):
     return eps
 
 
-def outcome_codes(lt: pd.DataFrame) -> np.ndarray:
-    """outcome_codes(lifetimes) -> int8 codes in traj_id order: exit channel, 3 settled, 4 trapped/stopped."""
-    lt = lt.sort_values("traj_id")
-    oc = lt["outcome"].astype(str).to_numpy()
-    ch = lt["exit_channel"].to_numpy(dtype=float, na_value=-1)
-    code = np.full(len(lt), TRAPPED_CODE, dtype=np.int8)
-    esc = oc == "escaped"
-    code[esc] = ch[esc].astype(np.int8)
-    code[oc == "settled"] = SETTLED_CODE
-    return code
-
-
 # -- simulate --------------------------------------------------------------------------
 def _run_table(study, key, states, gamma, workers, progress):
     """Run the initial conditions ``states`` (m, 4) through the engine (runner: resume, progress, Dask)."""
@@ -158,46 +146,12 @@ def _uncertainty_states(study, E, i, eps, n=None, seed_offset=0):
     return np.concatenate([ref[ok], moved[ok]])
 
 
-def zoom_centre(labels, extent, box=5, clearance=0):
-    """zoom_centre(labels, extent, box=5, clearance=0) -> (x, y): centre of the most mixed box (highest Gibbs
-    entropy; first in row-major order on ties), away from the map's edge and from forbidden cells.
-
-    ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
-    forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
-    cells around the centre is wholly allowed (the unconstrained choice sat at the edge of the
-    allowed region, where the zooms showed mostly forbidden cells).
-    """
-    from scipy import ndimage
-
-    from hhscatter.analysis.geometry.basins import basin_entropy
-
-    ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
-    nr, nc = labels.shape[0] // box, labels.shape[1] // box
-    blocks = labels[:nr * box, :nc * box].reshape(nr, box, nc, box).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
-    valid = (blocks != OUTSIDE).all(axis=-1)
-    grid = np.full((nr, nc), np.nan)
-    grid[valid] = ent.box_entropy
-    grid[[0, -1], :] = np.nan
-    grid[:, [0, -1]] = np.nan
-    if clearance > 0:
-        # distance of every cell to the nearest forbidden cell or to the map's edge (padded as forbidden)
-        dist = ndimage.distance_transform_edt(np.pad(labels != OUTSIDE, 1))[1:-1, 1:-1]
-        centres = dist[box // 2::box, box // 2::box][:nr, :nc]
-        grid[centres < clearance] = np.nan
-        if np.all(np.isnan(grid)):
-            raise ValueError(f"zoom_centre: no mixed box lies {clearance} cells inside the allowed region")
-    i, j = np.unravel_index(np.nanargmax(grid), grid.shape)
-    x0, x1, y0, y1 = extent
-    return (x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1],
-            y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0])
-
-
 def _zoom_centre(study, extent, n):
     """The zooms' centre: the most mixed box of the γ = 0 map at zoom_energy whose widest zoom window (the
     smallest factor) lies wholly in the allowed region."""
     Ez = study.params.zoom_energy
     clearance = math.ceil(math.sqrt(2.0) * n / (2.0 * min(study.params.zoom_factors)))
-    return zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
+    return bs.zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
 
 
 def _zoom_extent(extent, centre, factor):
@@ -243,30 +197,19 @@ def simulate(study, workers=None, progress=True):
 
 
 # -- analyze ---------------------------------------------------------------------------
-def _ve(v, e):
-    return {"value": float(v), "err": float(e)}
-
-
 def _uncertainty(study, E, g, eps, keys=None, times=None):
     """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
     the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ)."""
-    from hhscatter.analysis.geometry.basins import uncertainty_fraction
     from hhscatter.data.read import read_lifetimes
 
     rows = []
     keys = [unc_key(E, g, i) for i in range(len(eps))] if keys is None else keys
     for i, e in enumerate(eps):
         lt = read_lifetimes(study.raw(keys[i]), columns=["traj_id", "outcome", "exit_channel", "t_end"])
-        code = outcome_codes(lt)
-        m = len(code) // 2
-        uf = uncertainty_fraction(code[:m], code[m:])
-        t = lt.sort_values("traj_id")["t_end"].to_numpy()
-        changed = code[:m] != code[m:]
-        t_dec = np.minimum(t[:m], t[m:])[changed]  # until one of the pair leaves
+        row, t_dec = bs.uncertainty_row(outcome_codes(lt), lt.sort_values("traj_id")["t_end"].to_numpy(), E, g, e)
         if times is not None:
             times.append(t_dec)
-        rows.append({"energy": E, "gamma": g, "eps": e, "f": uf.f, "f_lo": uf.lo, "f_hi": uf.hi, "k": uf.k,
-                     "n": uf.n, "t_decide_median": float(np.median(t_dec)) if t_dec.size else math.nan})
+        rows.append(row)
     return pd.DataFrame(rows)
 
 
@@ -278,7 +221,7 @@ def analyze(study):
     ec = study.model.critical_energy
     boxes = list(study.params.boxes)
     hb = study.params.box_headline
-    maps, ent_rows, unc_tabs, per, loc_tabs = [], [], [], [], []
+    maps, ent_rows, unc_tabs, per, loc_tabs, by_box = [], [], [], [], [], []
     E_b, E_b_err = _upstream_value(study, "kappa", "E_b_key")
     mu, mu_err = _upstream_value(study, "mu", "mu_key")
     for E in study.params.energies:
@@ -288,28 +231,32 @@ def analyze(study):
             ent_rows.append(ent)
             unc_tabs.append(unc)
             loc_tabs.append(loc)
-            per.append(_point_numbers(E, g, hb, ec, ent, unc, loc, m))
+            per.append(bs.point_record(E, g, hb, ec, ent, unc, loc, m))
+            by_box.extend(_entropy_by_box(study, img, E, g, extent))
     study.write_table(pd.concat(maps, ignore_index=True), "basins_maps.parquet", grid=n, extent=list(extent))
     study.write_table(pd.concat(ent_rows, ignore_index=True), "basins_entropy.parquet")
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
     study.write_table(pd.concat(loc_tabs, ignore_index=True), "basins_local_exponent.parquet")
-    scan, scan_unc = _energy_scan(study, extent, boxes, hb, E_b)
-    scan = _kantz_grassberger(study, scan)
+    scan, scan_unc = _energy_scan(study, extent, boxes, hb, E_b, by_box)
+    scan = bs.kantz_grassberger(scan, _upstream_value(study, "kappa", "kappa_energy_key")[0])
     study.write_table(scan, "basins_energy_scan.parquet")
     study.write_table(scan_unc, "basins_energy_scan_uncertainty.parquet")
-    cut_pred = _cutoff_prediction(per, scan, mu, mu_err, ec)
-    trend = _energy_trend(scan, E_b)
+    cut_pred = bs.cutoff_records(per, scan, mu, mu_err, ec)
+    trend = bs.energy_trend(scan, E_b)
     zooms, centre = _zoom_maps(study, extent, n)
     study.write_table(zooms, "basins_zooms.parquet", grid=study.params.zoom_grid)
     _compare_with_paper(study, per, hb)
     study.write_numbers({
         "codes": dict(zip(CODE_NAMES, CODES)),
         "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
-        "zoom_centre": list(centre), "per_point": per,
+        "zoom_centre": list(centre), "per_point": per, "point_table": bs.point_table(per),
         "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
                                                            f"{study.params.E_b_key}"},
         "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
         "cutoff_prediction": cut_pred,
+        "cutoff_summary": bs.cutoff_summary(cut_pred),
+        "entropy_by_box": by_box,
+        "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
         "energy_scan": scan.to_dict(orient="records"),
         "energy_trend": trend,
         "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
@@ -321,14 +268,9 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
 
     Returns (labels image, entropy table, f(ε) table, local-exponent table, dict of the other measures).
     """
-    from hhscatter.analysis.geometry.basins import (
-        basin_entropy_table,
-        basin_fractions,
-        local_exponent,
-        slim_fractal,
-        wada_merging,
-    )
+    from hhscatter.analysis.geometry.basins import basin_entropy_table, basin_fractions, wada_merging
     from hhscatter.analysis.geometry.channels import channel_fractions
+    from hhscatter.analysis.geometry.uncertainty import local_exponent, slim_fractal
 
     img = basin_image(study, map_key(E, g), E, extent, n)
     fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
@@ -349,69 +291,10 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
               if len(exits) >= 3 else None)
     loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
     slim = slim_fractal(loc)
-    rate = _rate(eps, times) if g == 0 else None
-    ok, fit, cut = _uncertainty_fits(unc, study.params.fit_min_count)
+    rate = bs.rate_record(eps, times) if g == 0 else None
+    ok, fit, cut = bs.uncertainty_fits(unc, study.params.fit_min_count)
     return img, ent, unc, loc, {"fr": fr, "present": present, "wada": wada, "chans": chans, "exits": exits,
                                 "wada_x": wada_x, "slim": slim, "rate": rate, "ok": ok, "fit": fit, "cut": cut}
-
-
-def _uncertainty_fits(unc, min_count):
-    """The power law f(ε) ∝ ε^α and its cut-off, fitted over the resolved ε (≥ ``min_count`` changed pairs).
-
-    Returns (resolved mask, UncertaintyExponent or None below 3 resolved ε, UncertaintyCutoff or None below 5).
-    """
-    from hhscatter.analysis.geometry.basins import (
-        uncertainty_cutoff,
-        uncertainty_exponent,
-    )
-
-    ok = unc["k"] >= min_count
-    fit = cut = None
-    if ok.sum() >= 3:
-        rng = (float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max()))
-        fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"], eps_range=rng)
-        if ok.sum() >= 5:
-            cut = uncertainty_cutoff(unc["eps"], unc["f"], unc["n"], eps_range=rng)
-    return ok, fit, cut
-
-
-def _point_numbers(E, g, hb, ec, ent, unc, loc, m):
-    """The JSON record of one (E0, γ): the measures of :func:`_measure_point` (``m``) at the headline box."""
-    fr, wada, fit, cut = m["fr"], m["wada"], m["fit"], m["cut"]
-    head = ent.set_index("box").loc[hb] if hb in set(ent["box"]) else None
-    tau2 = math.log(E / ec) / g if g > 0 else math.inf
-    smallest = unc.loc[m["ok"]].tail(1)
-    return {
-        "energy": E, "gamma": g,
-        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in
-                      zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
-        "n_cells": int(fr.n),
-        "channel_symmetry_p": float(m["chans"].p_value),
-        "channel_shares_r_sym": [float(v) for v in m["chans"].frac],
-        "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
-        "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
-        "log2_fractal": bool(head.log2_fractal) if head is not None else None,
-        "box_headline": hb,
-        "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in m["present"]],
-                 "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
-                 "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
-        "wada_exits": _wada_dict(m["wada_x"], m["exits"]),
-        "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
-                    for r in loc.itertuples() if np.isfinite(r.d)],
-        "slim_fractal": m["slim"],
-        "lyapunov_decision": m["rate"],
-        "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
-        "d": _ve(fit.d, fit.d_err) if fit else None,
-        "alpha_fit_range": list(fit.eps_range) if fit else None,
-        "alpha_fit_p": float(fit.p_value) if fit else None,
-        "cutoff": ({"detected": bool(cut.detected), "eps_c": float(cut.eps_c),
-                    "eps_c_lo": float(cut.eps_c_lo), "eps_c_hi": float(cut.eps_c_hi),
-                    "delta_aic": float(cut.delta_aic)} if cut else None),
-        "tau2_mu1": tau2,
-        "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0])
-                                         if len(smallest) else None),
-        "smallest_resolved_eps": float(smallest["eps"].iloc[0]) if len(smallest) else None,
-    }
 
 
 def _zoom_maps(study, extent, n):
@@ -454,36 +337,24 @@ def _upstream_value(study, role, key_param):
 
     v, e = up.lookup(up.numbers(study, study.upstream(role)), getattr(study.params, key_param),
                      what=f"{study.upstream(role)}.json")
-    return float(v), float(e)
+    return (float(v), float(e)) if isinstance(v, (int, float)) else (v, e)
 
 
-def _wada_dict(w, basins):
-    if w is None:
-        return None
-    return {"verdict": bool(w.wada), "basins": [CODE_NAMES[c] for c in basins],
-            "W_at_r": float(w.wada_fraction[min(w.r_wada, len(w.wada_fraction) - 1)]), "r": int(w.r_wada),
-            "hausdorff_slope": float(w.hausdorff_slope)}
+def _entropy_by_box(study, img, E, g, extent, which="map"):
+    """S_b, S_bb at the fixed box sides [study].box_sides (position units) that are whole cells of ``img``."""
+    from hhscatter.analysis.geometry.basins import commensurate_sides, entropy_by_box
+
+    sides = commensurate_sides(study.params.box_sides, extent, img.shape[0], min_cells=2)
+    if not sides:
+        return []
+    t = entropy_by_box(img, extent, sides, outside=OUTSIDE)
+    return t.assign(E0=E, gamma=g, map=which).to_dict(orient="records")
 
 
-def _rate(eps, times):
-    """λ from the pairs' decision times (:func:`hhscatter.analysis.geometry.basins.decision_rate`), or None."""
-    from hhscatter.analysis.geometry.basins import decision_rate
-
-    try:
-        r = decision_rate(eps, times)
-    except ValueError:
-        return None
-    return {"value": r.lam, "err": r.lam_err, "t0": r.t0, "chi2": r.chi2, "dof": r.dof}
-
-
-def _energy_scan(study, extent, boxes, hb, E_b):
-    """γ = 0 energy scan: per E0, S_b, S_bb, the exits' Wada test, α and λ."""
-    from hhscatter.analysis.geometry.basins import (
-        basin_entropy_table,
-        basin_fractions,
-        uncertainty_exponent,
-        wada_merging,
-    )
+def _energy_scan(study, extent, boxes, hb, E_b, by_box):
+    """γ = 0 energy scan: per E0, S_b, S_bb, the exits' Wada test, α and λ; ``by_box`` receives the entropies
+    at fixed box sides of the scan maps at the study's energies (a second grid at the same E0)."""
+    from hhscatter.analysis.geometry.basins import basin_entropy_table, basin_fractions, wada_merging
 
     energies, eps = _scan(study)
     ns = study.params.scan_grid
@@ -498,12 +369,10 @@ def _energy_scan(study, extent, boxes, hb, E_b):
         times = []
         unc = _uncertainty(study, E, 0.0, eps, keys=[scan_unc_key(E, i) for i in range(len(eps))], times=times)
         uncs.append(unc)
-        ok = unc["k"] >= study.params.fit_min_count
-        fit = None
-        if ok.sum() >= 3:
-            fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"],
-                                       eps_range=(float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max())))
-        rate = _rate(eps, times)
+        _, fit, _ = bs.uncertainty_fits(unc, study.params.fit_min_count)
+        rate = bs.rate_record(eps, times)
+        if any(np.isclose(E, e) for e in study.params.energies):
+            by_box.extend(_entropy_by_box(study, img, E, 0.0, extent, which="scan"))
         h = ent.loc[hb] if hb in ent.index else ent.iloc[-1]
         rows.append({"energy": E, "above_E_b": bool(E > E_b), "S_b": float(h.S_b), "S_b_err": float(h.S_b_err),
                      "S_bb": float(h.S_bb), "S_bb_err": float(h.S_bb_err), "log2_fractal": bool(h.log2_fractal),
@@ -517,109 +386,6 @@ def _energy_scan(study, extent, boxes, hb, E_b):
             "W_exits", "alpha", "alpha_err", "alpha_p", "lam", "lam_err"]
     return (pd.DataFrame(rows, columns=cols),
             pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]))
-
-
-def _kantz_grassberger(study, scan):
-    """λ_KG = κ(E)/α(E) beside the decision rate: for a hyperbolic saddle the uncertainty exponent of the
-    section is α = κ/λ (Kantz & Grassberger, Physica D 17, 75 (1985)), κ the escape rate of study fig2
-    (its own runs, interpolated linearly in E; NaN outside its energies)."""
-    from hhscatter.studies import _upstream as up
-
-    rows, _ = up.lookup(up.numbers(study, study.upstream("kappa")), study.params.kappa_energy_key,
-                        what=f"{study.upstream('kappa')}.json")
-    k = pd.DataFrame(rows).sort_values("energy")
-    if scan.empty:
-        return scan.assign(kappa=[], lam_kg=[], lam_kg_err=[])
-    inside = (scan.energy >= k.energy.min()) & (scan.energy <= k.energy.max())
-    kap = np.where(inside, np.interp(scan.energy, k.energy, k.kappa), np.nan)
-    kap_err = np.where(inside, np.interp(scan.energy, k.energy, k.kappa_err), np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lam = kap / scan.alpha
-        err = np.abs(lam) * np.hypot(kap_err / kap, scan.alpha_err / scan.alpha)
-    return scan.assign(kappa=kap, lam_kg=lam, lam_kg_err=err)
-
-
-def _smooth_chi2(E, y, err):
-    """χ²/dof of a quadratic in E through (E, y ± err): ≈ 1 for a smooth curve, ≫ 1 when y fluctuates."""
-    ok = np.isfinite(y) & np.isfinite(err) & (err > 0)
-    E, y, err = np.asarray(E)[ok], np.asarray(y)[ok], np.asarray(err)[ok]
-    if E.size < 5:
-        return {"chi2_dof": math.nan, "n": int(E.size)}
-    c = np.polyfit(E, y, 2, w=1.0 / err)
-    chi2 = float(np.sum(((y - np.polyval(c, E)) / err) ** 2))
-    return {"chi2_dof": chi2 / (E.size - 3), "n": int(E.size)}
-
-
-def _energy_trend(scan, E_b, smooth_chi2=2.0):
-    """Nieto et al. 2020 (S_b fluctuates while KAM islands remain, smooth once hyperbolic) and Daza et al. 2016
-    (α rises with E) on the energy scan, each side of fig2's break energy E_b."""
-    if scan.empty:
-        return None
-    lo, hi = scan[~scan.above_E_b], scan[scan.above_E_b]
-    out = {"E_b": E_b}
-    for name, part in (("below_E_b", lo), ("above_E_b", hi)):
-        out[name] = {"S_b": _smooth_chi2(part.energy, part.S_b, part.S_b_err),
-                     "S_bb": _smooth_chi2(part.energy, part.S_bb, part.S_bb_err),
-                     "trapped_max": float(part.trapped.max()) if len(part) else math.nan,
-                     "wada_exits_all": bool(part.wada_exits.all()) if len(part) else None,
-                     "log2_all": bool(part.log2_fractal.all()) if len(part) else None}
-    # where the change happens: the lowest scan energy E* from which on S_b(E) is smooth (a quadratic with
-    # χ²/dof < smooth_chi2 on every energy ≥ E*, at least 5 of them), to be set beside E_b
-    for q in ("S_b", "S_bb"):
-        e_star = math.nan
-        for E in sorted(scan.energy)[::-1]:
-            part = scan[scan.energy >= E]
-            c = _smooth_chi2(part.energy, part[q], part[q + "_err"])
-            if c["n"] >= 5 and not c["chi2_dof"] < smooth_chi2:
-                break
-            if c["n"] >= 5:
-                e_star = float(E)
-        out[f"E_smooth_{q}"] = e_star
-    # the KAM islands' share (orbits alive at t_max at γ = 0): the lowest energy from which none remain
-    srt = scan.sort_values("energy")
-    trapped = srt.trapped.to_numpy() > 0
-    out["E_no_trapped"] = (float(srt.energy.iloc[np.flatnonzero(trapped).max() + 1])
-                           if trapped.any() and not trapped[-1] else
-                           (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
-    ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
-    if ok.sum() >= 3:
-        from hhscatter.analysis.geometry.basins import weighted_line
-
-        _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
-        out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
-    return out
-
-
-def _cutoff_prediction(per, scan, mu, mu_err, ec):
-    """Records {E0, gamma, eps_c, eps_c_err, eps_c_predicted, ...} of the measured and predicted cut-off."""
-    from hhscatter.analysis.geometry.basins import predicted_cutoff
-
-    lam_E = scan[np.isfinite(scan.lam)] if len(scan) else scan
-    out = []
-    for p in per:
-        if p["gamma"] <= 0 or lam_E is None or len(lam_E) == 0:
-            continue
-        E0, g = p["energy"], p["gamma"]
-        c = p["cutoff"]
-        pred = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam, ec)
-        lo = predicted_cutoff(E0, g, mu, lam_E.energy, lam_E.lam + lam_E.lam_err, ec)
-        hi = predicted_cutoff(E0, g, mu, lam_E.energy, np.maximum(lam_E.lam - lam_E.lam_err, 0), ec)
-        kg = scan[np.isfinite(scan.lam_kg)]
-        pred_kg = predicted_cutoff(E0, g, mu, kg.energy, kg.lam_kg, ec) if len(kg) else None
-        det = bool(c and c["detected"])
-        rec = {"E0": E0, "gamma": g,
-               "eps_c": c["eps_c"] if det else None,
-               "eps_c_err": 0.5 * (c["eps_c_hi"] - c["eps_c_lo"]) if det else None,
-               "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
-               "detected": det,
-               "eps_c_predicted": pred, "eps_c_predicted_interval": [lo, hi],
-               "eps_c_predicted_kantz_grassberger": pred_kg,
-               "tau2": math.log(E0 / ec) / (mu * g),
-               "smallest_resolved_eps": p["smallest_resolved_eps"]}
-        if det and pred > 0:
-            rec["log10_ratio"] = math.log10(c["eps_c"] / pred)
-        out.append(rec)
-    return out
 
 
 # -- plot -----------------------------------------------------------------------------------

@@ -171,3 +171,108 @@ def plot_generality(kappa, mu, curves, numbers, path):
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+# ---------------------------------------------------------------------------
+# the evidence: regular fraction, Poincaré sections, long-time decay (one figure each, legible at full width)
+# ---------------------------------------------------------------------------
+KIND_COLORS = {"regular": "#2166ac", "chaotic": "#d6604d", "none": "#999999", "escaped": "#bbbbbb"}
+
+
+def _name(label):
+    return {"henon_heiles": "Hénon–Heiles"}.get(label, label.replace("_", "–").title())
+
+
+def plot_regular(numbers, path):
+    """Regular fraction against E/E_c per system and IC convention (shadow indicator)."""
+    import pandas as pd
+
+    plt = agg_pyplot()
+    d = pd.DataFrame(numbers["regular_fraction"])
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    for (label, ics), g in d.groupby(["label", "ics"], sort=False):
+        disk = "disk" in ics
+        ax.errorbar(g["e_ratio"], g["fraction"], g["err"], fmt=("-" if disk else "--") + MARKERS.get(label, "o"),
+                    color=COLORS.get(label, "k"), mfc=None if disk else "none", ms=6, capsize=2, lw=1.2,
+                    label=f"{_name(label)}, {ics}")
+    ax.axhline(0.01, color="k", lw=0.8, ls=":")
+    ax.text(d["e_ratio"].max(), 0.012, "1 %", ha="right", va="bottom", fontsize=9)
+    ax.set_yscale("symlog", linthresh=0.01)
+    ax.set_ylim(-0.001, 1.05)
+    ax.set_xlabel(r"$E/E_c$")
+    ax.set_ylabel("regular fraction of all orbits")
+    r = d.iloc[0]
+    ax.set_title(f"Orbits on KAM tori (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "
+                 f"N = {int(r['n'])} per point)", fontsize=10)
+    ax.legend(fontsize=8, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def plot_sections(points, path):
+    """Poincaré sections (x, y of the crossings ṙ = 0, φ̇ > 0) per system and energy, regular vs chaotic orbits."""
+    plt = agg_pyplot()
+    labels = list(dict.fromkeys(points["system"]))
+    ratios = sorted(points["e_ratio"].unique())
+    fig, axs = plt.subplots(len(ratios), len(labels), figsize=(4.3 * len(labels), 4.3 * len(ratios)), squeeze=False)
+    for i, r in enumerate(ratios):
+        for j, label in enumerate(labels):
+            ax = axs[i, j]
+            d = points[(points["system"] == label) & (points["e_ratio"] == r)]
+            for kind in ("escaped", "none", "chaotic", "regular"):
+                k = d[d["kind"] == kind]
+                n = k["traj_id"].nunique()
+                ax.plot(k["x"], k["y"], ".", ms=1.2, mew=0, color=KIND_COLORS[kind], alpha=0.6 if kind != "regular" else 1,
+                        label=f"{kind} ({n} orbits)" if n else None, rasterized=True)
+            ax.set_aspect("equal")
+            ax.set_title(f"{_name(label)}, E = {r:g} E_c", fontsize=10)
+            ax.set_xlabel("x")
+            ax.set_ylabel("y")
+            leg = ax.legend(fontsize=7, loc="upper right", markerscale=20)
+            for h in leg.legend_handles:
+                h.set_alpha(1)
+    fig.suptitle("Section crossings (ṙ = 0, φ̇ > 0) coloured by the shadow indicator of their orbit", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def plot_decay(curves, numbers, path):
+    """P(t) to t_max of all orbits (solid) and of the non-regular orbits (dashed), and the plateau-plus-exponential
+    fit (dotted), per system at three energies."""
+    import pandas as pd
+
+    plt = agg_pyplot()
+    fits = pd.DataFrame(numbers["long_time"])
+    labels = list(dict.fromkeys(curves["label"]))
+    ratios = sorted(curves["e_ratio"].unique())
+    show = [r for r in (1.05, 1.2, 1.5, 1.9) if r in ratios] or ratios[:3]
+    fig, axs = plt.subplots(1, len(labels), figsize=(4.6 * len(labels), 4.6), squeeze=False, sharey=True)
+    cmap = plt.get_cmap("viridis")
+    for j, label in enumerate(labels):
+        ax = axs[0, j]
+        for k, r in enumerate(show):
+            col = cmap(k / max(len(show) - 1, 1))
+            d = curves[(curves["label"] == label) & (curves["e_ratio"] == r) & (curves["ics"] == "disk")]
+            for what, ls in (("all", "-"), ("non-regular", "--")):
+                c = d[(d["orbits"] == what) & (d["P"] > 0)]
+                ax.plot(c["t"], c["P"], ls, color=col, lw=1.3, label=f"E = {r:g} E_c" if what == "all" else None)
+            f = fits[(fits["label"] == label) & (fits["e_ratio"] == r) & fits["ics"].str.contains("disk")]
+            if len(f) and f["P_inf"].notna().iloc[0]:
+                f = f.iloc[0]
+                t = np.linspace(f["t0"], d["t"].max(), 100)
+                ax.plot(t, f["P_inf"] + (f["P_t0"] - f["P_inf"]) * np.exp(-f["kappa_inf"] * (t - f["t0"])), ":",
+                        color="k", lw=1)
+        ax.set_yscale("log")
+        ax.set_ylim(1e-4, 1.05)
+        ax.set_xlabel("t")
+        ax.set_title(_name(label), fontsize=10)
+        if j == 0:
+            ax.set_ylabel("P(t) (disk ICs, γ = 0)")
+        ax.legend(fontsize=8, loc="lower left")
+    fig.suptitle("Long-time escape: all orbits (solid), non-regular orbits (dashed), plateau + exponential fit "
+                 "(dotted)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)

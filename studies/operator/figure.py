@@ -131,3 +131,54 @@ def _panel_cost(f, cost):
     f.set_xticks(x, [f"E = {r['energy']:g}" for r in cost])
     f.set(ylabel="orbit-time for κ at 1 % (time units)", title="(f) cost of κ at 1 %")
     f.legend(fontsize=8)
+
+
+def plot_residuals(nums, grid, path):
+    """Write operator_residuals.png: (a) κ_Ulam/κ_ref − 1 against E, (b) the extrapolation of κ in samples per box.
+
+    (a) the extrapolated κ∞ against fig2's κ0 from P(t) and against fig2's κ from long-run crossings, the
+    error bar κ∞'s error and the shaded bar the reference's (both over κ_ref); the finest partition's κ as
+    crosses. (b) κ on the grid of box sides × samples per box against M^(−1/2), one colour per energy, one
+    marker per box side, with the fitted κ∞ + a·b + β·M^(−1/2) at b → 0 (dashed) ending at κ∞.
+    Inputs: operator.json's numbers and the derived table convergence_grid.parquet.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5))
+    recs = [r for r in nums.get("kappa_convergence", []) if r.get("kappa_inf") is not None]
+    for k, (ref, lab, dx) in enumerate((("kappa0", "κ0 from P(t)", -0.003), ("kappa_cm", "κ from crossings", 0.003))):
+        rs = [r for r in recs if r.get(ref) is not None]
+        if not rs:
+            continue
+        E = np.array([r["energy"] for r in rs]) + dx
+        res = np.array([r[f"residual_{ref}"] for r in rs])
+        own = np.array([r["err"] / abs(r[ref]) for r in rs])
+        refe = np.array([r[f"{ref}_err"] / r[ref] for r in rs])
+        a.bar(E, 2 * refe, bottom=res - refe, width=0.005, color=f"C{k}", alpha=0.25)
+        a.errorbar(E, res, own, fmt="o" if k == 0 else "D", color=f"C{k}", capsize=3,
+                   label=f"κ∞ vs fig2's {lab} (bar: ours; shade: fig2's)")
+        a.plot(E, [r[f"residual_finest_{ref}"] for r in rs], "x", color=f"C{k}", ms=7,
+               label=f"finest boxes, no extrapolation, vs {lab}")
+    a.axhline(0, color="k", lw=0.8)
+    a.set(xlabel="E", ylabel="κ_Ulam / κ_ref − 1", title="(a) residuals of Ulam's κ")
+    a.legend(fontsize=8)
+    if grid is not None and len(grid):
+        est = grid[grid["kind"] == "estimate"]
+        marks = {s: m for s, m in zip(sorted(est["box"].unique()), "os^")}
+        for i, (e, g) in enumerate(est.groupby("energy")):
+            rec = next((r for r in recs if np.isclose(r["energy"], e)), None)
+            for s, gs in g.groupby("box"):
+                gs = gs.sort_values("samples")
+                b.plot(gs["samples"] ** -0.5, gs["kappa"], marks.get(s, "o") + "-", color=f"C{i}", ms=4, lw=0.6)
+            if rec:
+                xs = np.linspace(0, (g["samples"] ** -0.5).max(), 20)
+                b.plot(xs, rec["kappa_inf"] + rec["coef_samples"] * xs, "--", color=f"C{i}", lw=0.8)
+                b.errorbar([0], [rec["kappa_inf"]], [rec["err"]], fmt="*", color=f"C{i}", ms=9, capsize=3,
+                           label=f"E = {e:g}: κ∞ = {rec['kappa_inf']:.4f}")
+        b.set_yscale("log")
+        b.set(xlabel="M^(−1/2) (M samples per box)", ylabel="κ (1/time)",
+              title="(b) κ on box sides (○ □ △: finest, ×2, ×4) × samples per box")
+        b.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -352,7 +352,7 @@ def test_10_dask_run_without_workers_fails_after_the_timeout(monkeypatch):
     monkeypatch.setattr(distributed, "wait", wait)
     monkeypatch.setattr(runner, "DASK_NO_WORKER_TIMEOUT", 0.2)
     client = NoWorkers()
-    task = ("{}", 0, 0, 10, "", "h")
+    task = runner.ChunkTask("{}", 0, 0, 10, "", "h")
     with pytest.raises(runner.RunError, match=r"the Dask cluster has had no workers for 0.2 s; stopped"):
         runner._run_dask(client, [task], lambda t: t, lambda *a: None, "x")
     assert client.cancelled == 1

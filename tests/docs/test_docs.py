@@ -310,7 +310,11 @@ def test_citation_and_licence_agree_with_pyproject():
     paper = cff["references"][0]
     assert paper["title"] == "Probabilistic description of dissipative chaotic scattering"
     assert [a["family-names"] for a in paper["authors"]] == ["Burton", "Dullin", "Altmann"]
-    assert "doi" not in paper  # none is known: the manuscript names none (add it when published)
+    assert "doi" not in paper  # none is known (add it when published)
+    assert {"type": "other", "value": "arXiv:2308.13555"}.items() <= paper["identifiers"][0].items()
+    assert paper["url"] == "https://arxiv.org/abs/2308.13555" and paper["year"] == 2023
+    for where in ("README.md", "docs/index.md"):  # the paper by its arXiv id wherever it is cited first
+        assert "arXiv:2308.13555" in (ROOT / where).read_text() and ".tex" not in (ROOT / where).read_text()
     assert (ROOT / "LICENSE").read_text().startswith("MIT License")
 
 
@@ -365,3 +369,36 @@ def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(
 def test_an_indented_marker_is_rendered_indented(tmp_path, hook):
     out, _ = _page(tmp_path, hook, '??? note "x"\n\n    <!-- hh:verdict-rule -->\n')
     assert "\n    !!! info" in out and "both uncertainties" in out
+
+
+def test_the_outcomes_and_the_study_list_come_from_the_code(tmp_path, hook):
+    import hhscatter.outcomes as oc
+    from hhscatter.studies.graph import studies
+
+    out = hook.Renderer(ROOT, DOCS, DOCS / "concepts").outcomes()
+    assert [line.split("`")[1] for line in out.splitlines()] == list(oc.OUTCOMES)
+    assert "- `stopped`: stopped early" in out and "(censors the lifetime)" in out
+    names = hook.Renderer(ROOT, DOCS, DOCS).study_names()
+    assert all(f"[{s.name}](studies/{s.name}.md)" in names for s in studies(ROOT / "studies"))
+    assert f"builds {len(studies(ROOT / 'studies'))} studies" in names
+
+
+def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook):
+    """hh:evidence-tables: the regular fraction as systems × E/E_c (per IC convention, in %), the long-time fits
+    and the r_esc rows, from the paper-scale JSON when committed."""
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    doc = {"study": "gx", "scale": "paper",
+           "regular_fraction": [{"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
+                                for r, f in ((1.05, 0.75), (1.5, 0.1))],
+           "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
+           "long_time": [{"label": "two", "e_ratio": 1.05, "ics": "disk/tangential", "P_inf": 0.751,
+                          "P_inf_err": 0.005, "kappa_inf": 0.00092, "kappa_inf_err": 0.00004}],
+           "resc": [{"label": "hh", "r_esc": 1.03, "default": False, "window": [0, 200],
+                     "mu_measured": {"value": 0.95, "err": 0.001}, "mu_predicted": {"value": 0.94, "err": 0.002},
+                     "mu_own_K": {"value": 0.951, "err": 0.001}, "moment_test": {"value": 0.011, "err": 0.002},
+                     "kinetic_at_E0": {"value": 1.018, "err": 0.002}, "kinetic_at_E0_interpolated_without_E0": 1.0}]}
+    (assets / "paper" / "gx.json").write_text(json.dumps(doc))
+    out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
+    assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out
+    assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out

@@ -1,14 +1,14 @@
 """The no-return rule of dissipative scenes: an escaped orbit stops at the system's no-return radius
 R(E) instead of r_far = max(10 r_s, 2 r_esc), with every table bitwise what the scene's own r_far gives
 (the rule's proof: hhscatter.model.henon_heiles.HenonHeiles.no_return_radius; the engine's use of it:
-hhscatter.integrate.engine._no_return). The references are the same scenes with an explicit r_far (10, the
+hhscatter.integrate.rerun._no_return). The references are the same scenes with an explicit r_far (10, the
 default's value, and 100: a ten times longer follow-up), which keep the old far event."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from hhscatter.integrate import engine
+from hhscatter.integrate import chunk, engine
 from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene, SectionWindow
@@ -43,8 +43,8 @@ def test_orbits_late_at_the_no_return_radius_are_rerun_to_r_far(monkeypatch):
     """Snapshots (epoch scheduler) and a short t_max: escapes close to t_max might not reach r_far by then,
     where the scene's rule censors them; those orbits run again with the scene's far event."""
     calls = []
-    merge = engine._merge_rerun
-    monkeypatch.setattr(engine, "_merge_rerun", lambda *a: calls.append(a[1].sum()) or merge(*a))
+    merge = chunk._merge_rerun
+    monkeypatch.setattr(chunk, "_merge_rerun", lambda *a: calls.append(a[1].sum()) or merge(*a))
     sc = Scene(energy=0.32, gamma=0.01, n=400, seed=72, r_esc=1.03, t_max=30.0,
                snapshots=tuple(np.arange(0.0, 30.01, 1.0)), sections=SectionWindow(t_from=3.0))
     ics = region_ics(sc, 0, sc.n)

@@ -5,6 +5,15 @@ import pytest
 
 from hhscatter.publish.formatting import format_value_err
 from hhscatter.publish.report import build_report
+from hhscatter.studies import load_study
+from hhscatter.studies.provenance import config_sha256, sealed
+
+
+def _sealed(root, name, doc, upstream=None):
+    """The numbers JSON as the analyze stage writes it: with what it was made from and its own content hash."""
+    config = load_study(name, "quick", root=root).config
+    return sealed({**doc, "config": config, "made_from": {"config_sha256": config_sha256(config),
+                                                          "upstream": upstream or {}, "raw_runs": {}}})
 
 
 def _fake_study(root, name, rows, with_figure=True, paper=None):
@@ -15,7 +24,7 @@ def _fake_study(root, name, rows, with_figure=True, paper=None):
                                   '[scene]\nn = 10\nenergy = 0.3\n')
     doc = {"study": name, "scale": "quick", "kappa": {"value": 0.153, "err": 0.004}, "n_points": 31000,
            "paper_comparison": rows, "provenance": {"heyoka": "7.13.2"}}
-    (d / "out" / "quick" / f"{name}.json").write_text(json.dumps(doc))
+    (d / "out" / "quick" / f"{name}.json").write_text(json.dumps(_sealed(root, name, doc)))
     if with_figure:
         import matplotlib
 
@@ -30,18 +39,18 @@ def _fake_study(root, name, rows, with_figure=True, paper=None):
 
 def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     root = tmp_path / "studies"
-    _fake_study(root, "fig2", [
+    _fake_study(root, "rep2", [
         {"quantity": "κ fit a", "ours": 13.1, "err": 0.4, "paper": 13.63, "unit": "", "verdict": "agrees within 2σ",
          "note": ""},
         {"quantity": "break energy", "ours": 0.31, "err": 0.01, "paper": 0.27, "unit": "", "verdict": "differs",
          "note": "continuous fit"},
     ])
-    _fake_study(root, "fig3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
+    _fake_study(root, "rep3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
                                 "verdict": "agrees within 2σ", "note": ""}], with_figure=False)
-    _fake_study(root, "resc", [{"quantity": "returns at r_esc=1.03", "ours": 0.011, "err": 0.0004, "paper": 0.0,
+    _fake_study(root, "rescx", [{"quantity": "returns at r_esc=1.03", "ours": 0.011, "err": 0.0004, "paper": 0.0,
                                 "verdict": "differs", "note": ""}], paper="")
-    _fake_study(root, "fig1", [], with_figure=False)
-    (root / "fig1" / "out" / "quick" / "fig1.json").unlink()  # a study folder that has not run yet
+    _fake_study(root, "rep1", [], with_figure=False)
+    (root / "rep1" / "out" / "quick" / "rep1.json").unlink()  # a study folder that has not run yet
     res = build_report("quick", out=tmp_path / "rep", root=root)
     page = res["html"].read_text()
     md = res["markdown"].read_text()
@@ -50,16 +59,17 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "break energy" in paper_part and "returns at r_esc" not in paper_part
     assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
     assert "3 numbers: 2 agree, 1 differ" in paper_part
+    assert "arXiv:2308.13555" in md.split("##")[0] and "both uncertainties" in md.split("##")[0]  # the header
     assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs (z = +3.6)</span>' in page  # the one rule: 0.04/√(0.01² + 0.005²)
-    assert page.count("data:image/png;base64,") == 2  # fig2 and resc; fig3 has numbers but no figure
-    assert set(res["missing"]) == {"fig1", "fig3"}  # the study folders of the root without figure or numbers
-    assert "### fig2 title (`make fig2`)" in md and "fig2 caption" in md  # titles and captions from [about]
-    assert md.index("### resc title") > md.index("## Beyond the paper\n")
-    assert "| fig2 | break energy | 0.310 ± 0.010 | 0.27 | differs (z = +3.6) | continuous fit |" in md
-    assert (tmp_path / "rep" / "assets" / "fig2.png").exists()
+    assert page.count("data:image/png;base64,") == 2  # rep2 and rescx; rep3 has numbers but no figure
+    assert set(res["missing"]) == {"rep1", "rep3"}  # the study folders of the root without figure or numbers
+    assert "### rep2 title (`make rep2`)" in md and "rep2 caption" in md  # titles and captions from [about]
+    assert md.index("### rescx title") > md.index("## Beyond the paper\n")
+    assert "| rep2 | break energy | 0.310 ± 0.010 | 0.27 | differs (z = +3.6) | continuous fit |" in md
+    assert (tmp_path / "rep" / "assets" / "rep2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
     assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [
-        "fig2", "fig2", "fig3", "resc"]
+        "rep2", "rep2", "rep3", "rescx"]
 
 
 @pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),

@@ -64,17 +64,22 @@ def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
     root = tmp_path / "studies"
     _summaries(root)
     assert "|ΔH|" in (root.parent / "benchmarks" / "out" / "stress" / "full" / "summary.md").read_text()
-    for name in ("fig2", "resc"):
+    from hhscatter.studies import load_study
+    from hhscatter.studies.provenance import config_sha256, sealed
+
+    for name in ("tab2", "tabx"):  # not the names of the repository's studies (whose Params would check these)
         d = root / name / "out" / "quick"
         d.mkdir(parents=True)
-        paper = "" if name == "resc" else "Fig. 2"
+        paper = "" if name == "tabx" else "Fig. 2"
         (root / name / "study.toml").write_text(f'[about]\ntitle = "{name}"\npaper = "{paper}"\nsummary = "s"\n'
                                                 '[scene]\nn = 1\n')
         rows = [{"quantity": "max |ΔH|/H | drift", "ours": 4.5e-10, "err": 1e-11, "paper": 0.0, "unit": "",
                  "verdict": "differs", "note": "a | b"},
                 {"quantity": "κ", "ours": "0.1 vs 0.2", "err": None, "paper": None, "verdict": None, "note": ""}]
-        (d / f"{name}.json").write_text(json.dumps({"kappa": {"value": 0.15, "err": 0.004}, "paper_comparison": rows,
-                                                    "note|bar": "x|y"}))
+        config = load_study(name, "quick", root=root).config
+        doc = {"kappa": {"value": 0.15, "err": 0.004}, "paper_comparison": rows, "note|bar": "x|y", "config": config,
+               "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}}
+        (d / f"{name}.json").write_text(json.dumps(sealed(doc)))
     res = build_report("quick", out=tmp_path / "rep", root=root)
     tables = assert_rows_match_headers(res["html"].read_text(), at_least=6)
     assert [6, 6] in tables and [6] * 4 in tables  # the comparison tables: study, quantity, ours, paper, verdict, note

@@ -20,6 +20,8 @@ import pandas as pd
 import pytest
 
 from hhscatter.analysis.geometry import basins as B
+from hhscatter.analysis.geometry import cutoff as C
+from hhscatter.analysis.geometry import uncertainty as U
 
 ROOTS3 = np.exp(2j * np.pi * np.arange(3) / 3)
 
@@ -70,19 +72,19 @@ def test_newton_z3_uncertainty_dimension_and_local_exponent():
     eps = np.logspace(-1, -7, 7)
     n = 20000
     k = uncertainty_counts(newton3, eps, n, seed=1)
-    fit = B.uncertainty_exponent(eps, k / n, n)
+    fit = U.uncertainty_exponent(eps, k / n, n)
     assert abs(fit.d - 1.42) < 3 * fit.d_err + 0.01, fit   # measured d = 1.435 ± 0.008
-    loc = B.local_exponent(eps, k, n)
+    loc = U.local_exponent(eps, k, n)
     ok = np.isfinite(loc.d)
     # one power law: every local dimension within 3σ of the published value, no slim fractal
     assert np.all(np.abs(loc.d[ok] - 1.42) < 3 * loc.d_err[ok] + 0.01), loc
-    assert not B.slim_fractal(loc)["slim"]
+    assert not U.slim_fractal(loc)["slim"]
 
 
 def test_newton_z2_smooth_boundary_has_alpha_one():
     eps = np.logspace(-1, -5, 5)
     n = 20000
-    fit = B.uncertainty_exponent(eps, uncertainty_counts(newton2, eps, n, seed=2) / n, n)
+    fit = U.uncertainty_exponent(eps, uncertainty_counts(newton2, eps, n, seed=2) / n, n)
     assert abs(fit.alpha - 1.0) < 3 * fit.alpha_err, fit
     assert B.basin_entropy(newton2(grid(200) + 0.02), 5).S_bb <= math.log(2) + 1e-12
 
@@ -119,9 +121,9 @@ def test_open_triadic_map_cantor_exponent_and_lyapunov_rate():
         ch = a != b
         k.append(int(ch.sum()))
         times.append(np.fmin(ta, tb)[ch])
-    fit = B.uncertainty_exponent(eps, np.array(k) / n, n)
+    fit = U.uncertainty_exponent(eps, np.array(k) / n, n)
     assert abs(fit.alpha - (1 - math.log(2) / math.log(3))) < 0.04, fit   # Cantor set: log-periodic wiggles
-    rate = B.decision_rate(eps, times)
+    rate = C.decision_rate(eps, times)
     assert abs(rate.lam / math.log(3) - 1) < 0.1, rate
 
 
@@ -134,7 +136,7 @@ def test_local_exponent_errors_cover_on_synthetic_binomial_data():
     hits = []
     for _ in range(400):
         k = rng.binomial(200000, f_true)
-        loc = B.local_exponent(eps, k, 200000)
+        loc = U.local_exponent(eps, k, 200000)
         hits.append(np.abs(loc.alpha.to_numpy() - a_true) <= loc.alpha_err.to_numpy())
     cover = np.mean(hits)
     assert 0.62 < cover < 0.74, cover
@@ -142,19 +144,19 @@ def test_local_exponent_errors_cover_on_synthetic_binomial_data():
 
 def test_slim_fractal_detects_a_falling_dimension():
     t = pd.DataFrame({"eps_mid": np.logspace(-1, -8, 8), "d": np.linspace(1.8, 1.1, 8), "d_err": 0.02})
-    s = B.slim_fractal(t)
+    s = U.slim_fractal(t)
     assert s["slim"] and s["slope"] > 0
-    assert not B.slim_fractal(t.assign(d=1.8))["slim"]
+    assert not U.slim_fractal(t.assign(d=1.8))["slim"]
 
 
 def test_predicted_cutoff_closed_form():
     # constant λ: ln(1/ε_c) = λ τ2 = λ ln(E0/E_c)/(μγ)
     lam, E0, ec, mu, g = 0.4, 0.3, 0.2, 0.9, 0.01
-    pred = B.predicted_cutoff(E0, g, mu, [0.25], [lam], ec)
+    pred = C.predicted_cutoff(E0, g, mu, [0.25], [lam], ec)
     assert math.log(1 / pred) == pytest.approx(lam * math.log(E0 / ec) / (mu * g), rel=1e-6)
     # λ ∝ E: ∫ λ/E dE = c (E0 − E_c)
-    pred = B.predicted_cutoff(E0, g, mu, [ec, E0], [2 * ec, 2 * E0], ec)
+    pred = C.predicted_cutoff(E0, g, mu, [ec, E0], [2 * ec, 2 * E0], ec)
     assert math.log(1 / pred) == pytest.approx(2 * (E0 - ec) / (mu * g), rel=1e-6)
-    assert B.predicted_cutoff(E0, 0.0, mu, [0.25], [lam], ec) == 0.0
+    assert C.predicted_cutoff(E0, 0.0, mu, [0.25], [lam], ec) == 0.0
     with pytest.raises(ValueError):
-        B.predicted_cutoff(0.1, g, mu, [0.25], [lam], ec)
+        C.predicted_cutoff(0.1, g, mu, [0.25], [lam], ec)

@@ -53,3 +53,15 @@ def test_basins_tiny_end_to_end(tiny_studies):
         assert 0 <= r["eps_c_predicted"] < 1
     scan = pd.read_parquet(out / "derived" / "basins_energy_scan.parquet")
     assert sorted(scan.energy) == [0.2, 0.3] and (scan.above_E_b == (scan.energy > nums["E_b"]["value"])).all()
+    # S_b, S_bb at fixed box sides: on every grid the study computes (the maps and the scan maps at the study's
+    # energies), each side a whole number of that grid's cells, the same side giving the same physical box
+    recs = nums["entropy_by_box"]
+    cfg = nums["config"]["study"]
+    scan_too = any(abs(e - E) < 1e-12 for e in cfg["scan_energies"] for E in cfg["energies"])
+    assert {(r["grid"], r["map"]) for r in recs} == {(n, "map")} | ({(cfg["scan_grid"], "scan")} if scan_too else set())
+    for r in recs:
+        assert r["box_cells"] >= 2 and abs(r["box_side"] - r["box_cells"] * 2.0 / r["grid"]) < 1e-12
+        assert 0 <= r["S_b"] <= r["S_bb"] + 1e-12 or r["S_bb"] != r["S_bb"]
+    assert {round(r["box_side"], 9) for r in recs if r["map"] == "map"} >= {0.083333333, 0.166666667}
+    summ = nums["cutoff_summary"]
+    assert summ["n_resolved"] == sum(1 for r in nums["cutoff_prediction"] if r["detected"])

@@ -1,4 +1,4 @@
-"""Tests of the basin-map measures (hhscatter.analysis.geometry.basins) on synthetic maps with known answers.
+"""Tests of the basin-map measures (hhscatter.analysis.geometry.basins, .uncertainty) on synthetic maps with known answers.
 
 Every random input is seeded.  Known answers: closed forms (straight
 boundaries), constructions whose exponent or Wada property is derived in the
@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from hhscatter.analysis.geometry import basins
+from hhscatter.analysis.geometry import basins, uncertainty
 from hhscatter.analysis.stats.intervals import wilson_interval
 
 LN2, LN3 = math.log(2.0), math.log(3.0)
@@ -268,11 +268,11 @@ def test_entropy_table_over_box_sizes():
 def test_uncertainty_fraction_counts_changed_outcomes():
     ref = np.array([0, 0, 1, 1, 2, 2, -1, 0])
     one = np.array([0, 1, 1, 1, 2, 0, 0, 0])
-    r = basins.uncertainty_fraction(ref, one)
+    r = uncertainty.uncertainty_fraction(ref, one)
     assert (r.k, r.n, r.n_excluded) == (2, 7, 1) and r.f == pytest.approx(2 / 7)
     # two perturbations each: uncertain if either differs; a perturbed outcome outside excludes the IC
     two = np.stack([one, np.array([0, 0, 2, 1, 2, 2, 0, -1])])
-    r = basins.uncertainty_fraction(ref, two)
+    r = uncertainty.uncertainty_fraction(ref, two)
     assert (r.k, r.n, r.n_excluded) == (3, 6, 2)
     p, lo, hi = wilson_interval(3, 6, 1.0)
     assert (r.f, r.lo, r.hi) == pytest.approx((p, lo, hi))
@@ -282,7 +282,7 @@ def test_exact_power_law_is_recovered():
     eps = np.logspace(-8, -2, 7)
     n = 10**12
     f = np.round(0.7 * eps**0.3 * n) / n
-    r = basins.uncertainty_exponent(eps, f, n)
+    r = uncertainty.uncertainty_exponent(eps, f, n)
     assert r.alpha == pytest.approx(0.3, abs=1e-6) and r.prefactor == pytest.approx(0.7, rel=1e-5)
     assert r.d == pytest.approx(1.7, abs=1e-6) and r.eps_range == (1e-8, 1e-2) and r.n_points == 7
 
@@ -310,8 +310,8 @@ def test_smooth_straight_boundary_has_alpha_one():
     for e in eps:
         x, y = rng.uniform(0, 1, N), rng.uniform(0, 1, N)
         per = np.stack([side(x + e, y), side(x - e, y), side(x, y + e), side(x, y - e)])
-        f.append(basins.uncertainty_fraction(side(x, y), per).f)
-    r = basins.uncertainty_exponent(eps, f, N)
+        f.append(uncertainty.uncertainty_fraction(side(x, y), per).f)
+    r = uncertainty.uncertainty_exponent(eps, f, N)
     assert r.alpha_err < 0.02
     assert abs(r.alpha - 1.0) < 3 * r.alpha_err, r
     assert abs(r.d - 1.0) < 3 * r.d_err
@@ -345,8 +345,8 @@ def test_cantor_boundary_has_the_uncertainty_exponent_of_its_dimension():
     for e in eps:
         x = rng.uniform(0, 1, N)
         per = np.stack([cantor_level(x - e, depth) % 2, cantor_level(x + e, depth) % 2])
-        f.append(basins.uncertainty_fraction(cantor_level(x, depth) % 2, per).f)
-    r = basins.uncertainty_exponent(eps, f, N, dim=1)
+        f.append(uncertainty.uncertainty_fraction(cantor_level(x, depth) % 2, per).f)
+    r = uncertainty.uncertainty_exponent(eps, f, N, dim=1)
     assert r.alpha_err < 0.004
     assert abs(r.alpha - CANTOR_ALPHA) < 3 * r.alpha_err, (r.alpha, r.alpha_err)
     assert abs(r.d - LN2 / LN3) < 3 * r.d_err
@@ -368,7 +368,7 @@ def test_uncertainty_exponent_errors_cover_the_truth_68_percent_of_the_time():
     R = 400
     cover, pvals = 0, []
     for _ in range(R):
-        r = basins.uncertainty_exponent(eps, rng.binomial(n, p) / n, n)
+        r = uncertainty.uncertainty_exponent(eps, rng.binomial(n, p) / n, n)
         cover += abs(r.alpha - alpha) <= r.alpha_err
         pvals.append(r.p_value)
     assert within_binomial(cover, R, 0.6827), cover / R
@@ -382,7 +382,7 @@ def test_eps_range_selects_the_fitted_points():
     p = np.minimum(0.2 * (eps / 1e-2) ** 0.5, 0.9)
     p[eps > 2e-2] = 0.9  # saturated: not a power law
     f = rng.binomial(n, p) / n
-    r = basins.uncertainty_exponent(eps, f, n, eps_range=(1e-6, 1.5e-2))
+    r = uncertainty.uncertainty_exponent(eps, f, n, eps_range=(1e-6, 1.5e-2))
     assert r.n_points == 9 and r.eps_range == (pytest.approx(1e-6), pytest.approx(1e-2))
     assert abs(r.alpha - 0.5) < 3 * r.alpha_err
     assert r.fitted.tolist() == [True] * 9 + [False] * 2
@@ -414,7 +414,7 @@ def test_cutoff_of_a_sharply_broken_power_law_is_found(beta):
     n = 20_000
     eps_c = 10**-3.83
     f = rng.binomial(n, _broken(EPS13, 0.4, eps_c)) / n
-    r = basins.uncertainty_cutoff(EPS13, f, n, beta=beta, z=3.0)
+    r = uncertainty.uncertainty_cutoff(EPS13, f, n, beta=beta, z=3.0)
     assert r.detected and r.delta_aic > 10
     assert r.eps_c_lo <= eps_c <= r.eps_c_hi and r.eps_c_hi / r.eps_c_lo < 2.0
     assert r.eps_c_lo < r.eps_c < r.eps_c_hi
@@ -436,7 +436,7 @@ def test_cutoff_intervals_cover_the_truth_68_percent_of_the_time():
     p = _broken(EPS13, 0.4, 1e-4)
     cover_c = cover_a = 0
     for _ in range(R):
-        r = basins.uncertainty_cutoff(EPS13, rng.binomial(n, p) / n, n, n_grid=60)
+        r = uncertainty.uncertainty_cutoff(EPS13, rng.binomial(n, p) / n, n, n_grid=60)
         assert r.detected
         cover_c += r.eps_c_lo <= 1e-4 <= r.eps_c_hi
         cover_a += abs(r.alpha - 0.4) <= r.alpha_err
@@ -458,7 +458,7 @@ def test_no_cutoff_gives_an_upper_bound_near_the_smallest_eps():
     p = _broken(EPS13, 0.4, 0.0)
     for _ in range(5):
         k = rng.binomial(n, p)
-        r = basins.uncertainty_cutoff(EPS13, k / n, n)
+        r = uncertainty.uncertainty_cutoff(EPS13, k / n, n)
         assert not r.detected and math.isnan(r.eps_c) and r.eps_c_lo == 0.0
         s = 0.6 * math.sqrt(k[0]) * math.log(r.eps_c_hi / EPS13[0])
         assert 0 < s <= 5, s
@@ -486,8 +486,8 @@ def test_truncated_cantor_boundary_shows_a_cutoff_at_its_finest_scale():
         def lab(v):
             return np.minimum(cantor_level(v, 20), m + 1) % 2
 
-        f.append(basins.uncertainty_fraction(lab(x), np.stack([lab(x - e), lab(x + e)])).f)
-    r = basins.uncertainty_cutoff(eps, f, N)
+        f.append(uncertainty.uncertainty_fraction(lab(x), np.stack([lab(x - e), lab(x + e)])).f)
+    r = uncertainty.uncertainty_cutoff(eps, f, N)
     assert r.detected
     assert 3.0 ** -(m + 1) <= r.eps_c <= 3.0**-m, r.eps_c
 
@@ -584,32 +584,32 @@ def test_bad_input_names_the_argument():
     with pytest.raises(ValueError, match="basins"):
         basins.basin_fractions(good, basins=[0, 0])
     with pytest.raises(ValueError, match="outcome_perturbed"):
-        basins.uncertainty_fraction(np.zeros(5, dtype=int), np.zeros(4, dtype=int))
+        uncertainty.uncertainty_fraction(np.zeros(5, dtype=int), np.zeros(4, dtype=int))
     with pytest.raises(ValueError, match="outcome_ref"):
-        basins.uncertainty_fraction(np.array([0.5, 1.0]), np.array([0, 1]))
+        uncertainty.uncertainty_fraction(np.array([0.5, 1.0]), np.array([0, 1]))
     eps, f = np.array([1e-3, 1e-2, 1e-1]), np.array([0.01, 0.05, 0.2])
     with pytest.raises(ValueError, match="eps"):
-        basins.uncertainty_exponent(-eps, f, 100)
+        uncertainty.uncertainty_exponent(-eps, f, 100)
     with pytest.raises(ValueError, match="eps and f"):
-        basins.uncertainty_exponent(eps[:2], f, 100)
+        uncertainty.uncertainty_exponent(eps[:2], f, 100)
     with pytest.raises(ValueError, match="f must"):
-        basins.uncertainty_exponent(eps, f + 1, 100)
+        uncertainty.uncertainty_exponent(eps, f + 1, 100)
     with pytest.raises(ValueError, match="n must"):
-        basins.uncertainty_exponent(eps, f, 0)
+        uncertainty.uncertainty_exponent(eps, f, 0)
     with pytest.raises(ValueError, match="f·n"):
-        basins.uncertainty_exponent(eps, f, 7)
+        uncertainty.uncertainty_exponent(eps, f, 7)
     with pytest.raises(ValueError, match="eps_range"):
-        basins.uncertainty_exponent(eps, f, 100, eps_range=(1e-1, 1e-3))
+        uncertainty.uncertainty_exponent(eps, f, 100, eps_range=(1e-1, 1e-3))
     with pytest.raises(ValueError, match="eps"):
-        basins.uncertainty_exponent(eps, f, 100, eps_range=(5e-3, 1.0))  # 2 points left
+        uncertainty.uncertainty_exponent(eps, f, 100, eps_range=(5e-3, 1.0))  # 2 points left
     with pytest.raises(ValueError, match="f = 1"):
-        basins.uncertainty_exponent(eps, np.array([0.01, 0.05, 1.0]), 100)
+        uncertainty.uncertainty_exponent(eps, np.array([0.01, 0.05, 1.0]), 100)
     with pytest.raises(ValueError, match="dim"):
-        basins.uncertainty_exponent(eps, f, 100, dim=0)
+        uncertainty.uncertainty_exponent(eps, f, 100, dim=0)
     with pytest.raises(ValueError, match="beta"):
-        basins.uncertainty_cutoff(eps, f, 100, beta=math.inf)
+        uncertainty.uncertainty_cutoff(eps, f, 100, beta=math.inf)
     with pytest.raises(ValueError, match="min_points"):
-        basins.uncertainty_cutoff(eps, f, 100, min_points=0)
+        uncertainty.uncertainty_cutoff(eps, f, 100, min_points=0)
     with pytest.raises(ValueError, match="basins"):
         basins.wada_merging(good)  # two basins only
     with pytest.raises(ValueError, match="r_wada"):

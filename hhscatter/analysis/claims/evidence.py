@@ -1,0 +1,158 @@
+"""Evidence behind the claims' readings: regular orbits counted, long-time escape resolved, where the claims hold.
+
+Pure pieces (frames in, records out) for a study that runs, per system and energy E = r·E_c, a conservative
+ensemble to t_max with the section recorded near its end and the shadow runs of the orbits still inside then
+(:mod:`hhscatter.analysis.geometry.regularity`):
+
+* :func:`regular_record` — the regular fraction of an ensemble: orbits the shadow indicator calls regular over all
+  orbits (those that escaped before the indicator's window are not regular), binomial error;
+* :func:`long_time_record` — P(t) at chosen times (Kaplan–Meier, Greenwood errors), the plateau-plus-exponential
+  fit of all orbits from t0 (P∞, κ∞: :func:`hhscatter.analysis.survival.long_time.fit_plateau_exponential`),
+  the single-exponential fit and the hazard of the non-regular orbits alone, and the fraction of the orbits still
+  inside at t_max that the indicator calls regular (the only ones called "trapped");
+* :func:`validity_map` — per (system, E/E_c): the regular fraction beside claim 1's verdict (κ0 defined under the
+  paper's convention), claim 2's where measured, and whether one exponential describes the non-regular orbits.
+
+Examples
+--------
+>>> import numpy as np, pandas as pd
+>>> lt = pd.DataFrame({"traj_id": np.arange(4), "t_end": [5.0, 50.0, 100.0, 100.0],
+...                    "outcome": ["escaped", "escaped", "censored", "censored"]})
+>>> ind = pd.DataFrame({"traj_id": [2, 3], "regular": [True, False], "kind": ["regular", "chaotic"]})
+>>> regular_record(lt, ind)["fraction"]
+0.25
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hhscatter.analysis.geometry.regularity import regular_fraction
+from hhscatter.analysis.survival.long_time import (
+    fit_plateau_exponential,
+    hazard_profile,
+    survival_at,
+)
+
+#: P-value below which one exponential is rejected for the non-regular orbits
+EXP_REJECT_P = 1e-3
+
+
+def _finite(x):
+    return None if x is None or not math.isfinite(float(x)) else float(x)
+
+
+def regular_record(lifetimes, indicator) -> dict:
+    """regular_record(lifetimes, indicator) -> {fraction, err, n, n_regular, n_chaotic, n_none, n_escaped_before}.
+
+    ``lifetimes``: the ensemble's traj_id, t_end, outcome; ``indicator``: :func:`shadow_indicator`'s frame for the
+    orbits still inside at the window's start (traj_id, regular, kind). Orbits without an indicator row left before
+    the window: not regular. ``n_none``: inside at the window's start but crossing the section in neither run
+    (their type undetermined; counted as not regular, and said).
+    """
+    n = len(lifetimes)
+    n_reg = int(indicator["regular"].sum())
+    f, e = regular_fraction(n, n_reg)
+    return {"fraction": f, "err": e, "n": n, "n_regular": n_reg,
+            "n_chaotic": int((indicator["kind"] == "chaotic").sum()), "n_none": int((indicator["kind"] == "none").sum()),
+            "n_escaped_before": int(n - len(indicator))}
+
+
+def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> tuple[list, dict]:
+    """long_time_record(lifetimes, regular_ids, times, t0, hazard_edges) -> (P rows, fit record).
+
+    P rows: {t, P, P_err} of all orbits at ``times`` (time units). Fit record: the plateau-plus-exponential fit from
+    ``t0`` of all orbits (p_inf, kappa_inf, errors, chi2, dof), the censored and regular fractions at t_max, and the
+    non-regular orbits alone (all minus ``regular_ids``): single exponential from t0 (kappa_nonregular, χ², p-value,
+    ``exponential`` True when p ≥ EXP_REJECT_P) and their hazard per bin of ``hazard_edges``.
+    """
+    from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
+
+    t = lifetimes["t_end"].to_numpy(float)
+    obs = (lifetimes["outcome"].astype(str) != "censored").to_numpy()
+    P, Pe = survival_at(t, obs, times)
+    rows = [{"t": float(a), "P": float(b), "P_err": float(c)} for a, b, c in zip(times, P, Pe)]
+    reg = lifetimes["traj_id"].isin(np.asarray(regular_ids)).to_numpy()
+    rec = {"t0": float(t0), "n": int(t.size), "censored_fraction": float((~obs).mean()),
+           "regular_fraction_of_censored": float(reg[~obs].mean()) if (~obs).any() else None}
+    try:
+        f = fit_plateau_exponential(t, obs, t0)
+        rec.update(P_inf=f.p_inf, P_inf_err=_finite(f.p_inf_err), kappa_inf=f.kappa, kappa_inf_err=_finite(f.kappa_err),
+                   chi2=f.chi2, dof=f.dof, P_t0=f.p_t0)
+    except ValueError as exc:
+        rec.update(P_inf=None, kappa_inf=None, reason=f"plateau fit: {exc}")
+    tn, on = t[~reg], obs[~reg]
+    try:
+        g = fit_plateau_exponential(tn, on, t0, plateau=False)
+        p = float(chi2_dist.sf(g.chi2, g.dof)) if g.dof > 0 else None
+        rec.update(kappa_nonregular=g.kappa, kappa_nonregular_err=g.kappa_err, chi2_nonregular=g.chi2,
+                   dof_nonregular=g.dof, p_nonregular=p, exponential=None if p is None else bool(p >= EXP_REJECT_P))
+    except ValueError as exc:
+        rec.update(kappa_nonregular=None, exponential=None, reason_nonregular=str(exc))
+    h = hazard_profile(tn, on, hazard_edges)
+    rec["hazard_nonregular"] = [{"t_lo": float(a), "t_hi": float(b), "hazard": _finite(c), "err": _finite(d),
+                                 "events": int(e)} for a, b, c, d, e in
+                                h[["t_lo", "t_hi", "hazard", "hazard_err", "events"]].itertuples(index=False)]
+    return rows, rec
+
+
+def decay_curves(lifetimes, regular_ids, grid):
+    """decay_curves(lifetimes, regular_ids, grid) -> DataFrame[orbits, t, P]: Kaplan–Meier P(t) on ``grid`` (time
+    units) of all orbits ('all') and of the orbits not in ``regular_ids`` ('non-regular')."""
+    import pandas as pd  # deferred: pandas loads on first use
+
+    t = lifetimes["t_end"].to_numpy(float)
+    obs = (lifetimes["outcome"].astype(str) != "censored").to_numpy()
+    nonreg = ~lifetimes["traj_id"].isin(np.asarray(regular_ids)).to_numpy()
+    out = []
+    for what, sel in (("all", np.ones(t.size, bool)), ("non-regular", nonreg)):
+        P = survival_at(t[sel], obs[sel], grid)[0] if sel.any() else np.full(len(grid), np.nan)
+        out.append(pd.DataFrame({"orbits": what, "t": np.asarray(grid, float), "P": P}))
+    return pd.concat(out, ignore_index=True)
+
+
+def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: str = "disk") -> list:
+    """validity_map(regular, fits, kappa, claims, ics='disk') -> one record per (system, e_ratio) of ``regular``.
+
+    Fields: regular_fraction (± err); kappa0_defined (claim 1: κ0 defined under the paper's convention, all orbits
+    with plateau windows, from the claims' ``kappa`` records at that E/E_c; None where that energy was not on the
+    claims' grid); claim2 (claim 2's verdict at that E/E_c, paper's convention, where tested); exponential (one
+    exponential describes the non-regular orbits from t0, from ``fits``); plateau (P∞ > 3σ, from ``fits``).
+    """
+    out = []
+    fit_at = {(f["system"], round(f["e_ratio"], 6)): f for f in fits if f.get("ics") == ics}
+    for r in (x for x in regular if x["ics"] == ics):
+        key = (r["system"], round(r["e_ratio"], 6))
+        k = [x for x in kappa if x.get("system") == r["label"] and x.get("convention") == "plateau"
+             and abs(x.get("ratio", -1) - r["e_ratio"]) < 1e-9]
+        c2 = [c for c in claims if c.get("claim") == "2" and c.get("system") == r["label"]
+              and f"E/E_c = {r['e_ratio']:g} (all orbits" in c.get("quantity", "")]
+        f = fit_at.get(key, {})
+        pinf, perr = f.get("P_inf"), f.get("P_inf_err")
+        out.append({"id": r.get("id"), "system": r["system"], "label": r["label"], "e_ratio": r["e_ratio"], "ics": ics,
+                    "regular_fraction": r["fraction"], "regular_err": r["err"],
+                    "kappa0_defined": bool(k[0]["defined"]) if k else None,
+                    "claim2": c2[0]["verdict"] if c2 else None,
+                    "exponential": f.get("exponential"),
+                    "plateau": None if pinf is None or perr is None else bool(pinf > 3 * perr)})
+    return out
+
+
+def first_below(regular: list, level: float = 0.01, *, ics: str = "disk") -> dict:
+    """first_below(regular, level=0.01, ics='disk') -> {system: {'from': E/E_c, 'text': …}}: the lowest E/E_c from
+    which every measured regular fraction lies below ``level`` ('from' None where the highest measured energy is
+    not below it: out of reach, and 'text' says up to where it was measured).
+
+    >>> first_below([{"system": "a", "ics": "disk", "e_ratio": r, "fraction": f}
+    ...              for r, f in [(1.1, 0.2), (1.5, 0.004), (2.0, 0.0)]])
+    {'a': {'from': 1.5, 'text': 'from 1.5 E_c on'}}
+    """
+    out = {}
+    for s in dict.fromkeys(r["system"] for r in regular):
+        rs = sorted((r["e_ratio"], r["fraction"]) for r in regular if r["system"] == s and r["ics"] == ics)
+        above = [e for e, f in rs if f >= level]
+        tail = [e for e, _ in rs if not above or e > max(above)]
+        out[s] = ({"from": tail[0], "text": f"from {tail[0]:g} E_c on"} if tail else
+                  {"from": None, "text": f"not reached up to {rs[-1][0]:g} E_c (the highest energy measured)"})
+    return out

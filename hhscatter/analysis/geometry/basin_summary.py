@@ -1,0 +1,422 @@
+"""The records a basin study publishes: outcome codes, one record per (E0, γ), the energy scan's trends.
+
+The measures themselves are in :mod:`hhscatter.analysis.geometry.basins` (fractions, entropies, Wada),
+:mod:`hhscatter.analysis.geometry.uncertainty` (f(ε), α, the cut-off) and
+:mod:`hhscatter.analysis.geometry.cutoff` (the decision rate λ and the predicted cut-off); this module turns
+their results into the JSON records of a basin study and computes the summaries that combine several of
+them. Pure functions: tables and result objects in, dicts and DataFrames out.
+
+Outcome codes of a basin map: 0 … n−1 the exit channel, :data:`SETTLED_CODE` settled (drag),
+:data:`TRAPPED_CODE` alive at t_max (or stopped), :data:`OUTSIDE` a forbidden cell (V ≥ E0).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.geometry.basins import basin_entropy
+from hhscatter.analysis.geometry.cutoff import cutoff_comparison, decision_rate
+from hhscatter.analysis.geometry.uncertainty import (
+    uncertainty_cutoff,
+    uncertainty_exponent,
+    uncertainty_fraction,
+    weighted_line,
+)
+
+__all__ = [
+    "CODES",
+    "CODE_NAMES",
+    "OUTSIDE",
+    "SETTLED_CODE",
+    "TRAPPED_CODE",
+    "cutoff_records",
+    "cutoff_summary",
+    "energy_trend",
+    "entropy_exponents",
+    "kantz_grassberger",
+    "outcome_codes",
+    "point_record",
+    "point_table",
+    "rate_record",
+    "smooth_chi2",
+    "uncertainty_fits",
+    "uncertainty_row",
+    "wada_record",
+    "zoom_centre",
+]
+
+SETTLED_CODE, TRAPPED_CODE, OUTSIDE = 3, 4, -1
+CODES = (0, 1, 2, SETTLED_CODE, TRAPPED_CODE)
+CODE_NAMES = ("exit 0", "exit 1", "exit 2", "settled", "trapped")
+
+
+def _ve(v, e):
+    return {"value": float(v), "err": float(e)}
+
+
+def outcome_codes(lt: pd.DataFrame) -> np.ndarray:
+    """Outcome code of each orbit of a lifetimes table, in traj_id order (int8).
+
+    ``lt`` has columns traj_id, outcome ("escaped", "settled", …) and exit_channel. Escaped orbits get
+    their channel, settled ones :data:`SETTLED_CODE`, the rest (alive at t_max, stopped)
+    :data:`TRAPPED_CODE`.
+
+    Examples
+    --------
+    >>> lt = pd.DataFrame({"traj_id": [1, 0, 2], "outcome": ["settled", "escaped", "censored"],
+    ...                    "exit_channel": [None, 2, None]})
+    >>> outcome_codes(lt).tolist()
+    [2, 3, 4]
+    """
+    lt = lt.sort_values("traj_id")
+    oc = lt["outcome"].astype(str).to_numpy()
+    ch = lt["exit_channel"].to_numpy(dtype=float, na_value=-1)
+    code = np.full(len(lt), TRAPPED_CODE, dtype=np.int8)
+    esc = oc == "escaped"
+    code[esc] = ch[esc].astype(np.int8)
+    code[oc == "settled"] = SETTLED_CODE
+    return code
+
+
+def zoom_centre(labels, extent, box=5, clearance=0):
+    """Centre (x, y) of the most mixed box of a basin map, away from its edge and from forbidden cells.
+
+    The most mixed box has the highest Gibbs entropy (first in row-major order on ties).
+    ``clearance`` (cells): only boxes whose centre lies at least this far (Euclidean, in cells) from every
+    forbidden cell and from the map's edge are eligible, so that a zoom window of half-width ``clearance``
+    cells around the centre is wholly allowed (an unconstrained choice sits at the edge of the allowed region, where
+    the zooms show mostly forbidden cells). ``extent`` = (x0, x1, y0, y1) in position units.
+
+    Examples
+    --------
+    >>> lab = np.zeros((20, 20), int); lab[:, 12:] = 1; lab[12:, 12:] = 2
+    >>> zoom_centre(lab, (0, 1, 0, 1))
+    (0.625, 0.625)
+    """
+    from scipy import ndimage  # deferred: scipy loads on first use
+
+    ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
+    nr, nc = labels.shape[0] // box, labels.shape[1] // box
+    blocks = labels[:nr * box, :nc * box].reshape(nr, box, nc, box).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
+    valid = (blocks != OUTSIDE).all(axis=-1)
+    grid = np.full((nr, nc), np.nan)
+    grid[valid] = ent.box_entropy
+    grid[[0, -1], :] = np.nan
+    grid[:, [0, -1]] = np.nan
+    if clearance > 0:
+        # distance of every cell to the nearest forbidden cell or to the map's edge (padded as forbidden)
+        dist = ndimage.distance_transform_edt(np.pad(labels != OUTSIDE, 1))[1:-1, 1:-1]
+        centres = dist[box // 2::box, box // 2::box][:nr, :nc]
+        grid[centres < clearance] = np.nan
+        if np.all(np.isnan(grid)):
+            raise ValueError(f"zoom_centre: no mixed box lies {clearance} cells inside the allowed region")
+    i, j = np.unravel_index(np.nanargmax(grid), grid.shape)
+    x0, x1, y0, y1 = extent
+    return (float(x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1]),
+            float(y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0]))
+
+
+def uncertainty_row(codes, t_end, energy, gamma, eps):
+    """One f(ε) row from the codes of m reference ICs followed by their m shifted copies.
+
+    Returns (row dict: energy, gamma, eps, f, f_lo, f_hi, k, n, t_decide_median; the decision times of the
+    pairs whose outcome differs, i.e. the time until the first orbit of the pair leaves).
+    """
+    codes, t_end = np.asarray(codes), np.asarray(t_end, dtype=float)
+    m = len(codes) // 2
+    uf = uncertainty_fraction(codes[:m], codes[m:])
+    changed = codes[:m] != codes[m:]
+    t_dec = np.minimum(t_end[:m], t_end[m:])[changed]
+    row = {"energy": energy, "gamma": gamma, "eps": eps, "f": uf.f, "f_lo": uf.lo, "f_hi": uf.hi, "k": uf.k,
+           "n": uf.n, "t_decide_median": float(np.median(t_dec)) if t_dec.size else math.nan}
+    return row, t_dec
+
+
+def uncertainty_fits(unc, min_count):
+    """The power law f(ε) ∝ ε^α and its cut-off, fitted over the resolved ε (≥ ``min_count`` changed pairs).
+
+    Returns (resolved mask, UncertaintyExponent or None below 3 resolved ε, UncertaintyCutoff or None
+    below 5).
+    """
+    ok = unc["k"] >= min_count
+    fit = cut = None
+    if ok.sum() >= 3:
+        rng = (float(unc.loc[ok, "eps"].min()), float(unc.loc[ok, "eps"].max()))
+        fit = uncertainty_exponent(unc["eps"], unc["f"], unc["n"], eps_range=rng)
+        if ok.sum() >= 5:
+            cut = uncertainty_cutoff(unc["eps"], unc["f"], unc["n"], eps_range=rng)
+    return ok, fit, cut
+
+
+def wada_record(w, basins):
+    """The JSON record of a :class:`~hhscatter.analysis.geometry.basins.WadaTest` (None → None)."""
+    if w is None:
+        return None
+    return {"verdict": bool(w.wada), "basins": [CODE_NAMES[c] for c in basins],
+            "W_at_r": float(w.wada_fraction[min(w.r_wada, len(w.wada_fraction) - 1)]), "r": int(w.r_wada),
+            "hausdorff_slope": float(w.hausdorff_slope)}
+
+
+def rate_record(eps, times):
+    """λ from the pairs' decision times (:func:`~hhscatter.analysis.geometry.cutoff.decision_rate`) as a
+    record {value, err, t0, chi2, dof}, or None when it cannot be measured."""
+    try:
+        r = decision_rate(eps, times)
+    except ValueError:
+        return None
+    return {"value": r.lam, "err": r.lam_err, "t0": r.t0, "chi2": r.chi2, "dof": r.dof}
+
+
+def point_record(E, g, hb, ec, ent, unc, loc, m):
+    """The JSON record of one (E0, γ) at the headline box ``hb`` (cells).
+
+    ``m`` holds the measures: fr (BasinFractions), present (codes in the Wada test), wada, chans (channel
+    fractions), exits, wada_x, slim, rate, ok, fit, cut (:func:`uncertainty_fits`); ``ent`` the entropy
+    table over box sides, ``unc`` the f(ε) table, ``loc`` the local exponents. τ2 = ln(E0/E_c)/γ is
+    Eq. (eq:tau2) with μ = 1 (∞ at γ = 0).
+    """
+    fr, wada, fit, cut = m["fr"], m["wada"], m["fit"], m["cut"]
+    head = ent.set_index("box").loc[hb] if hb in set(ent["box"]) else None
+    tau2 = math.log(E / ec) / g if g > 0 else math.inf
+    smallest = unc.loc[m["ok"]].tail(1)
+    return {
+        "energy": E, "gamma": g,
+        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in
+                      zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
+        "n_cells": int(fr.n),
+        "channel_symmetry_p": float(m["chans"].p_value),
+        "channel_shares_r_sym": [float(v) for v in m["chans"].frac],
+        "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
+        "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
+        "log2_fractal": bool(head.log2_fractal) if head is not None else None,
+        "box_headline": hb,
+        "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in m["present"]],
+                 "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
+                 "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
+        "wada_exits": wada_record(m["wada_x"], m["exits"]),
+        "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
+                    for r in loc.itertuples() if np.isfinite(r.d)],
+        "slim_fractal": m["slim"],
+        "lyapunov_decision": m["rate"],
+        "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
+        "d": _ve(fit.d, fit.d_err) if fit else None,
+        "alpha_fit_range": list(fit.eps_range) if fit else None,
+        "alpha_fit_p": float(fit.p_value) if fit else None,
+        "cutoff": ({"detected": bool(cut.detected), "eps_c": float(cut.eps_c),
+                    "eps_c_lo": float(cut.eps_c_lo), "eps_c_hi": float(cut.eps_c_hi),
+                    "delta_aic": float(cut.delta_aic)} if cut else None),
+        "tau2_mu1": tau2,
+        "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0])
+                                         if len(smallest) else None),
+        "smallest_resolved_eps": float(smallest["eps"].iloc[0]) if len(smallest) else None,
+    }
+
+
+def kantz_grassberger(scan: pd.DataFrame, kappa_rows) -> pd.DataFrame:
+    """``scan`` with columns kappa, lam_kg, lam_kg_err: λ_KG = κ(E)/α(E) beside the decision rate.
+
+    For a hyperbolic saddle the uncertainty exponent of the section is α = κ/λ (Kantz & Grassberger,
+    Physica D 17, 75 (1985)); ``kappa_rows`` are records {energy, kappa, kappa_err} of κ(E), interpolated
+    linearly in E (NaN outside their energies). ``scan`` has columns energy, alpha, alpha_err.
+    """
+    if scan.empty:
+        return scan.assign(kappa=[], lam_kg=[], lam_kg_err=[])
+    k = pd.DataFrame(kappa_rows).sort_values("energy")
+    inside = (scan.energy >= k.energy.min()) & (scan.energy <= k.energy.max())
+    kap = np.where(inside, np.interp(scan.energy, k.energy, k.kappa), np.nan)
+    kap_err = np.where(inside, np.interp(scan.energy, k.energy, k.kappa_err), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = kap / scan.alpha
+        err = np.abs(lam) * np.hypot(kap_err / kap, scan.alpha_err / scan.alpha)
+    return scan.assign(kappa=kap, lam_kg=lam, lam_kg_err=err)
+
+
+def smooth_chi2(E, y, err):
+    """χ²/dof of a quadratic in E through (E, y ± err): ≈ 1 for a smooth curve, ≫ 1 when y fluctuates.
+
+    Returns {chi2_dof, n}; chi2_dof is NaN below 5 usable points.
+
+    Examples
+    --------
+    >>> E = np.linspace(0, 1, 6)
+    >>> round(smooth_chi2(E, 1 + E ** 2, np.full(6, 0.1))["chi2_dof"], 12)
+    0.0
+    """
+    ok = np.isfinite(y) & np.isfinite(err) & (err > 0)
+    E, y, err = np.asarray(E)[ok], np.asarray(y)[ok], np.asarray(err)[ok]
+    if E.size < 5:
+        return {"chi2_dof": math.nan, "n": int(E.size)}
+    c = np.polyfit(E, y, 2, w=1.0 / err)
+    chi2 = float(np.sum(((y - np.polyval(c, E)) / err) ** 2))
+    return {"chi2_dof": chi2 / (E.size - 3), "n": int(E.size)}
+
+
+def energy_trend(scan, E_b, smooth_threshold=2.0):
+    """Nieto et al. 2020 (S_b fluctuates while KAM islands remain, smooth once hyperbolic) and Daza et al.
+    2016 (α rises with E) on the γ = 0 energy scan, each side of the break energy E_b of κ(E).
+
+    ``scan`` has columns energy, above_E_b, S_b(_err), S_bb(_err), trapped, wada_exits, log2_fractal,
+    alpha(_err). Returns None for an empty scan.
+    """
+    if scan.empty:
+        return None
+    lo, hi = scan[~scan.above_E_b], scan[scan.above_E_b]
+    out = {"E_b": E_b}
+    for name, part in (("below_E_b", lo), ("above_E_b", hi)):
+        out[name] = {"S_b": smooth_chi2(part.energy, part.S_b, part.S_b_err),
+                     "S_bb": smooth_chi2(part.energy, part.S_bb, part.S_bb_err),
+                     "trapped_max": float(part.trapped.max()) if len(part) else math.nan,
+                     "wada_exits_all": bool(part.wada_exits.all()) if len(part) else None,
+                     "log2_all": bool(part.log2_fractal.all()) if len(part) else None}
+    # where the change happens: the lowest scan energy E* from which on S_b(E) is smooth (a quadratic with
+    # χ²/dof < smooth_threshold on every energy ≥ E*, at least 5 of them), to be set beside E_b
+    for q in ("S_b", "S_bb"):
+        e_star = math.nan
+        for E in sorted(scan.energy)[::-1]:
+            part = scan[scan.energy >= E]
+            c = smooth_chi2(part.energy, part[q], part[q + "_err"])
+            if c["n"] >= 5 and not c["chi2_dof"] < smooth_threshold:
+                break
+            if c["n"] >= 5:
+                e_star = float(E)
+        out[f"E_smooth_{q}"] = e_star
+    # the KAM islands' share (orbits alive at t_max at γ = 0): the lowest energy from which none remain
+    srt = scan.sort_values("energy")
+    trapped = srt.trapped.to_numpy() > 0
+    out["E_no_trapped"] = (float(srt.energy.iloc[np.flatnonzero(trapped).max() + 1])
+                           if trapped.any() and not trapped[-1] else
+                           (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
+    ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
+    if ok.sum() >= 3:
+        _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
+        out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
+    return out
+
+
+def cutoff_records(per, scan, mu, mu_err, ec):
+    """Records of the measured and predicted cut-off ε_c, one per (E0, γ > 0) of ``per`` (point records).
+
+    The prediction (:func:`~hhscatter.analysis.geometry.cutoff.cutoff_comparison`) uses λ(E) of the γ = 0
+    ``scan`` (columns energy, lam, lam_err, lam_kg): the decision rate, with Kantz–Grassberger's κ/α as the
+    systematic in the predicted interval, and μ ± its error. Each record: E0, gamma, eps_c, eps_c_err,
+    eps_c_interval, detected, eps_c_predicted, eps_c_predicted_interval (statistical and systematic),
+    eps_c_predicted_kantz_grassberger, tau2, smallest_resolved_eps, log10_ratio (NaN when not detected),
+    factor, gap_decades, z, intervals_overlap, statement.
+    """
+    lam_E = scan[np.isfinite(scan.lam)] if len(scan) else scan
+    out = []
+    if len(lam_E) == 0:
+        return out
+    kg = lam_E["lam_kg"].to_numpy(dtype=float) if "lam_kg" in lam_E else None
+    for p in per:
+        if p["gamma"] <= 0:
+            continue
+        E0, g, c = p["energy"], p["gamma"], p["cutoff"]
+        det = bool(c and c["detected"])
+        cmp = cutoff_comparison(E0, g, ec, mu, mu_err, lam_E.energy, lam_E.lam, lam_E.lam_err, lam_alt=kg,
+                                measured=c["eps_c"] if det else None,
+                                measured_lo=c["eps_c_lo"] if c else None, measured_hi=c["eps_c_hi"] if c else None)
+        rec = {"E0": E0, "gamma": g,
+               "eps_c": c["eps_c"] if det else None,
+               "eps_c_err": 0.5 * (c["eps_c_hi"] - c["eps_c_lo"]) if det else None,
+               "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
+               "detected": det,
+               "eps_c_predicted": cmp.predicted,
+               "eps_c_predicted_interval": [cmp.predicted_lo, cmp.predicted_hi],
+               "eps_c_predicted_kantz_grassberger": cmp.predicted_alt if math.isfinite(cmp.predicted_alt) else None,
+               "tau2": math.log(E0 / ec) / (mu * g),
+               "smallest_resolved_eps": p["smallest_resolved_eps"],
+               "log10_ratio": cmp.log10_ratio if det else None,
+               "factor": cmp.factor if det else None,
+               "gap_decades": cmp.gap_decades,
+               "z": cmp.z if det else None,
+               "intervals_overlap": cmp.overlap,
+               "statement": cmp.statement}
+        out.append(rec)
+    return out
+
+
+def cutoff_summary(records) -> dict:
+    """How far prediction and measurement differ over the resolved cut-offs of :func:`cutoff_records`.
+
+    Returns {n_resolved, n_overlap, factor_min, factor_max, mean_log10_ratio, n_below, statement}
+    (factors and means over the detected cut-offs; NaN when none is).
+
+    Examples
+    --------
+    >>> cutoff_summary([{"detected": True, "log10_ratio": -0.3, "factor": 2.0, "intervals_overlap": False},
+    ...                 {"detected": False}])["n_resolved"]
+    1
+    """
+    det = [r for r in records if r.get("detected")]
+    if not det:
+        return {"n_resolved": 0, "n_overlap": 0, "factor_min": math.nan, "factor_max": math.nan,
+                "mean_log10_ratio": math.nan, "n_below": 0,
+                "statement": "no cut-off is resolved at these (E0, γ)"}
+    lr = np.array([r["log10_ratio"] for r in det])
+    fac = np.array([r["factor"] for r in det])
+    n_ov = sum(bool(r["intervals_overlap"]) for r in det)
+    n_below = int(np.count_nonzero(lr < 0))
+    words = (f"over the {len(det)} resolved cut-offs the prediction is off by a factor {fac.min():.2g} to "
+             f"{fac.max():.2g} (measured below it in {n_below} of {len(det)}; geometric mean factor "
+             f"{10 ** abs(lr.mean()):.2g}); the 1σ intervals, the predicted one with the λ(E) systematic, "
+             f"overlap in {n_ov} of {len(det)}")
+    return {"n_resolved": len(det), "n_overlap": int(n_ov), "factor_min": float(fac.min()),
+            "factor_max": float(fac.max()), "mean_log10_ratio": float(lr.mean()), "n_below": n_below,
+            "statement": words}
+
+
+def entropy_exponents(records, min_cells: int = 5) -> list:
+    """The exponent of S_b(s) ∝ s^α over the fixed box sides s, per map and grid.
+
+    ``records`` are rows of :func:`~hhscatter.analysis.geometry.basins.entropy_by_box` with E0, gamma and
+    map; for a fractal boundary the basin entropy grows as the box side to the power of the uncertainty
+    exponent (Daza et al., Sci. Rep. 6, 31416 (2016)), for a smooth one linearly. Weighted least squares of
+    ln S_b against ln s (errors σ(S_b)/S_b, widened by √(χ²/dof)) over the sides of at least ``min_cells`` cells
+    (a box of 2 cells cannot hold the mixing a fractal boundary puts in it); only groups with ≥ 3 such sides.
+    Returns records {E0, gamma, map, grid, alpha, alpha_err, sides}.
+
+    Examples
+    --------
+    >>> recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 2000, "box_side": s, "box_cells": int(s * 1000),
+    ...          "S_b": 0.5 * s ** 0.3, "S_b_err": 1e-3} for s in (0.01, 0.02, 0.05)]
+    >>> round(entropy_exponents(recs)[0]["alpha"], 6)
+    0.3
+    """
+    if not records:
+        return []
+    t = pd.DataFrame(records)
+    out = []
+    for (E0, g, which, grid), part in t.groupby(["E0", "gamma", "map", "grid"], sort=True):
+        part = part[(part.S_b > 0) & (part.S_b_err > 0) & (part.box_cells >= min_cells)].sort_values("box_side")
+        if len(part) < 3:
+            continue
+        _, slope, cov, _, _ = weighted_line(np.log(part.box_side), np.log(part.S_b), part.S_b_err / part.S_b)
+        out.append({"E0": float(E0), "gamma": float(g), "map": which, "grid": int(grid), "alpha": float(slope),
+                    "alpha_err": float(math.sqrt(cov[1, 1])), "sides": [float(v) for v in part.box_side]})
+    return out
+
+
+def point_table(per) -> list:
+    """One flat record per (E0, γ) of the point records ``per`` (:func:`point_record`), for a page's table:
+    E0, gamma, d (± d_err) of the one-law fit and its p, the local dimension at the coarsest and finest
+    resolved resolution, its slope per decade (± err) and the slim-fractal verdict, S_bb (± err) at the headline
+    box, and the Wada fraction with settled a basin and of the exits alone (settled masked)."""
+    out = []
+    for p in per:
+        s, w, wx = p.get("slim_fractal") or {}, p["wada"], p.get("wada_exits")
+        out.append({"E0": p["energy"], "gamma": p["gamma"],
+                    "d": p["d"]["value"] if p["d"] else None, "d_err": p["d"]["err"] if p["d"] else None,
+                    "fit_p": (p.get("alpha_fit_p") if p.get("alpha_fit_p") != 0 else "< 1e-300 (underflow)"),
+                    "d_coarse": s.get("d_coarse"), "d_coarse_err": s.get("d_coarse_err"),
+                    "d_fine": s.get("d_fine"), "d_fine_err": s.get("d_fine_err"),
+                    "slope": s.get("slope"), "slope_err": s.get("slope_err"),
+                    "slim": "yes" if s.get("slim") else "no",
+                    "S_bb": p["S_bb"]["value"] if p["S_bb"] else None, "S_bb_err": p["S_bb"]["err"] if p["S_bb"] else None,
+                    "box_cells": p.get("box_headline"),
+                    "wada_all": f"{'yes' if w['verdict'] else 'no'} (W = {w['W_at_r']:.3f})",
+                    "wada_exits": (f"{'yes' if wx['verdict'] else 'no'} (W = {wx['W_at_r']:.3f})" if wx else
+                                   "— (fewer than 3 exit basins)")})
+    return out

@@ -1,0 +1,210 @@
+"""The cut-off of fractal scaling under drag: the saddle's decision rate λ(E) and the predicted ε_c.
+
+The probabilistic description's one-line consequence for the fractal
+analysis of a dissipative scattering system: an orbit's energy decays as
+E(t) = E0 e^{−μγt}, scattering ends at τ2 = ln(E0/E_c)/(μγ), and two initial
+conditions ε apart can part only while they still follow the saddle, so the
+power law of f(ε) (:mod:`hhscatter.analysis.geometry.uncertainty`) must end
+at ε_c = e^{−Λ}, Λ = ∫_0^τ2 λ(E(t)) dt.
+
+* :func:`decision_rate` — λ from the decision times of pairs of initial
+  conditions with different outcomes, against ln(1/ε);
+* :func:`predicted_cutoff` — ε_c from λ(E), μ, γ, E0 and E_c;
+* :func:`cutoff_comparison` — measured against predicted ε_c, with the
+  systematic of λ(E) (two estimators) in the predicted interval, and a plain
+  statement of how far they differ.
+
+Pure functions (arrays in, numbers out). Units: ε in position units of the
+initial conditions; λ in 1/time; energies in the Hamiltonian's units.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.geometry.uncertainty import weighted_line
+
+__all__ = ["CutoffComparison", "DecisionRate", "cutoff_comparison", "decision_rate", "predicted_cutoff"]
+
+
+@dataclass(frozen=True)
+class DecisionRate:
+    """Result of :func:`decision_rate`: rate λ (1/time) with its error, offset t0 (time), per-ε table."""
+
+    lam: float
+    lam_err: float
+    t0: float
+    t0_err: float
+    chi2: float
+    dof: int
+    table: pd.DataFrame = field(repr=False)
+
+
+def decision_rate(eps, times) -> DecisionRate:
+    """decision_rate(eps, times) -> DecisionRate(lam, lam_err, t0, ...): the rate at which pairs decide.
+
+    Two initial conditions a distance ε apart separate as ε e^{λt} on a
+    chaotic saddle with Lyapunov exponent λ; their outcomes part when the
+    separation reaches O(1), at t ≈ t0 + ln(1/ε)/λ.  Given, for each ε, the
+    decision times of the pairs whose outcomes differ (``times``: a list of
+    arrays, e.g. the time until the first orbit of the pair leaves), this fits
+    mean t(ε) = t0 + ln(1/ε)/λ by weighted least squares with the standard
+    error of each mean (pairs independent, fresh per ε), and returns λ = 1 /
+    slope with the delta-method error.  ε with fewer than 3 times are left
+    out; at least 2 ε must remain.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> eps = [1e-2, 1e-4, 1e-6]
+    >>> ts = [5 + np.log(1 / e) / 0.5 + rng.normal(0, 1, 400) for e in eps]
+    >>> round(decision_rate(eps, ts).lam, 2)
+    0.5
+    """
+    eps = np.asarray(eps, dtype=float).ravel()
+    if len(times) != eps.size:
+        raise ValueError("times must hold one array per ε")
+    rows = []
+    for e, t in zip(eps, times):
+        t = np.asarray(t, dtype=float)
+        t = t[np.isfinite(t)]
+        if t.size >= 3 and e > 0:
+            rows.append({"eps": e, "x": math.log(1.0 / e), "t_mean": float(t.mean()),
+                         "t_sem": float(t.std(ddof=1) / math.sqrt(t.size)), "m": int(t.size)})
+    tab = pd.DataFrame(rows, columns=["eps", "x", "t_mean", "t_sem", "m"])
+    if len(tab) < 2 or tab["x"].nunique() < 2:
+        raise ValueError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
+    t0, slope, cov, chi2, dof = weighted_line(tab["x"], tab["t_mean"], np.maximum(tab["t_sem"], 1e-12))
+    s_err = float(math.sqrt(cov[1, 1]))
+    if not slope > 0:
+        raise ValueError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
+    return DecisionRate(lam=1.0 / slope, lam_err=s_err / slope ** 2, t0=t0,
+                        t0_err=float(math.sqrt(cov[0, 0])), chi2=chi2, dof=dof, table=tab)
+
+
+def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: float) -> float:
+    """predicted_cutoff(E0, γ, μ, energies, λ(energies), E_c) -> ε_c predicted by the probabilistic description.
+
+    The paper's description (Eqs. (eqn:energy_exp_decay), (eq:tau2)): the
+    energy of a surviving orbit decays as E(t) = E0 e^{−μγt} and scattering
+    ends at τ2 = ln(E0/E_c)/(μγ), when E(t) = E_c; meanwhile the orbit follows
+    the conservative saddle of energy E(t), where nearby orbits separate at
+    the rate λ(E).  Two initial conditions ε apart can reach different exits
+    only if they separate to O(1) before τ2, i.e. if
+    ln(1/ε) < Λ = ∫_0^{τ2} λ(E(t)) dt = (1/(μγ)) ∫_{E_c}^{E0} λ(E)/E dE.
+    Below ε_c = e^{−Λ} the outcome is decided by the settling alone and the
+    power law of f(ε) must end.  λ(E) is interpolated linearly in E between
+    the given ``energies`` (held constant beyond them); the integral uses
+    the trapezoidal rule on a fine grid.  γ = 0 gives ε_c = 0 (no cut-off).
+
+    Examples
+    --------
+    >>> round(math.log(1 / predicted_cutoff(0.3, 0.01, 1.0, [0.2, 0.3], [0.5, 0.5], 0.15)), 3)
+    34.657
+    """
+    E0, gamma, mu, e_c = float(E0), float(gamma), float(mu), float(e_c)
+    if not (E0 > e_c > 0 and gamma >= 0 and mu > 0):
+        raise ValueError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
+    if gamma == 0:
+        return 0.0
+    En = np.asarray(energies, dtype=float).ravel()
+    lam = np.asarray(lam, dtype=float).ravel()
+    ok = np.isfinite(En) & np.isfinite(lam)
+    if np.count_nonzero(ok) < 1:
+        raise ValueError("predicted_cutoff: no finite λ(E) given")
+    o = np.argsort(En[ok])
+    grid = np.linspace(e_c, E0, 2001)
+    val = np.interp(grid, En[ok][o], lam[ok][o]) / grid
+    big_lambda = float(np.sum(0.5 * (val[1:] + val[:-1]) * np.diff(grid))) / (mu * gamma)
+    return float(math.exp(-big_lambda))
+
+
+@dataclass(frozen=True)
+class CutoffComparison:
+    """Result of :func:`cutoff_comparison` (ε in position units; logs base 10).
+
+    predicted: ε_c from the decision rate λ(E) at μ; predicted_lo, predicted_hi: the envelope of the
+    predictions over λ ± 1σ, μ ± 1σ and the second estimator of λ (the systematic of λ(E));
+    predicted_alt: ε_c from the second estimator alone (NaN if not given); measured, measured_lo,
+    measured_hi: the measured ε_c and its interval (NaN when not detected; then measured_hi is the upper
+    bound); log10_ratio = log10(measured/predicted); factor = 10^|log10_ratio|; gap_decades: the distance
+    in decades between the two intervals (0 when they overlap); z: log10_ratio over the half-widths of
+    both intervals on the facing sides, combined in quadrature; overlap (bool); statement (plain words).
+    """
+
+    predicted: float
+    predicted_lo: float
+    predicted_hi: float
+    predicted_alt: float
+    measured: float
+    measured_lo: float
+    measured_hi: float
+    log10_ratio: float
+    factor: float
+    gap_decades: float
+    z: float
+    overlap: bool
+    statement: str = field(repr=False)
+
+
+def cutoff_comparison(E0, gamma, e_c, mu, mu_err, energies, lam, lam_err, *, lam_alt=None,
+                      measured=None, measured_lo=None, measured_hi=None) -> CutoffComparison:
+    """Measured against predicted cut-off ε_c, with the systematic of λ(E) in the predicted interval.
+
+    The prediction (:func:`predicted_cutoff`) uses the decision rate ``lam`` (± ``lam_err``, shifted
+    together at every energy: the errors of neighbouring energies share the method) and μ ± ``mu_err``;
+    ``lam_alt`` is a second estimator of the same λ(E) (e.g. Kantz–Grassberger's κ/α), whose prediction
+    is folded into the interval as the systematic: the predicted interval is the envelope of every
+    combination (λ ± σ, μ ± σ, and the alternative λ at μ ± σ).  ``measured`` is the detected ε_c with its
+    interval [``measured_lo``, ``measured_hi``] (None or NaN: not detected, ``measured_hi`` then the upper
+    bound).  Returns the ratio, the factor, the gap between the intervals in decades and a one-line
+    statement of how far they are apart.
+
+    Examples
+    --------
+    >>> c = cutoff_comparison(0.3, 0.02, 1 / 6, 0.94, 0.01, [0.2, 0.3], [0.5, 0.5], [0.01, 0.01],
+    ...                       measured=2e-5, measured_lo=1.9e-5, measured_hi=2.1e-5)
+    >>> c.overlap, round(c.log10_ratio, 2)
+    (False, 2.09)
+    """
+    E0, gamma, mu, mu_err = float(E0), float(gamma), float(mu), float(mu_err)
+    if not gamma > 0:
+        raise ValueError(f"cutoff_comparison: γ must be > 0 (no cut-off at γ = {gamma})")
+    En = np.asarray(energies, dtype=float)
+    lam, lam_err = np.asarray(lam, dtype=float), np.asarray(lam_err, dtype=float)
+    mus = [m for m in (mu - mu_err, mu, mu + mu_err) if m > 0] if math.isfinite(mu_err) else [mu]
+    pred = predicted_cutoff(E0, gamma, mu, En, lam, e_c)
+    cands = [predicted_cutoff(E0, gamma, m, En, np.maximum(lam + s * lam_err, 0.0), e_c)
+             for m in mus for s in (-1.0, 0.0, 1.0)]
+    alt = math.nan
+    if lam_alt is not None and np.any(np.isfinite(lam_alt)):
+        alt = predicted_cutoff(E0, gamma, mu, En, np.asarray(lam_alt, dtype=float), e_c)
+        cands += [predicted_cutoff(E0, gamma, m, En, np.asarray(lam_alt, dtype=float), e_c) for m in mus]
+    p_lo, p_hi = min(cands), max(cands)
+    det = measured is not None and math.isfinite(float(measured))
+    m = float(measured) if det else math.nan
+    m_lo = float(measured_lo) if det and measured_lo is not None else (0.0 if not det else m)
+    m_hi = float(measured_hi) if measured_hi is not None else m
+    lg = (lambda v: math.log10(v) if v > 0 else -math.inf)
+    if det and pred > 0:
+        r = math.log10(m / pred)
+        gap = max(0.0, lg(m_lo) - lg(p_hi), lg(p_lo) - lg(m_hi))
+        sm = (lg(m) - lg(m_lo)) if r > 0 else (lg(m_hi) - lg(m))
+        sp = (lg(p_hi) - lg(pred)) if r > 0 else (lg(pred) - lg(p_lo))
+        z = r / math.hypot(sm, sp) if math.hypot(sm, sp) > 0 else math.inf
+        side = "below" if r < 0 else "above"
+        words = (f"measured ε_c lies a factor {10 ** abs(r):.2g} {side} the prediction; "
+                 + ("the intervals overlap" if gap == 0 else
+                    f"the intervals are {gap:.2g} decades apart (z = {z:+.1f} with both widths)"))
+    else:
+        r, z = math.nan, math.nan
+        gap = max(0.0, lg(p_lo) - lg(m_hi))
+        words = (f"no cut-off resolved (ε_c < {m_hi:.2g}); predicted {pred:.2g}: "
+                 + ("consistent, below the smallest ε resolved" if pred < m_hi else
+                    "above that bound, its interval reaching below it" if gap == 0 else
+                    f"the predicted interval lies {gap:.2g} decades above that bound"))
+    return CutoffComparison(pred, p_lo, p_hi, alt, m, m_lo if det else math.nan, m_hi, r,
+                            10 ** abs(r) if math.isfinite(r) else math.nan, gap, z, bool(gap == 0), words)

@@ -1,0 +1,153 @@
+"""The chunk: ``run_chunk(scene, ics, traj_ids) -> ChunkResult``, one block of orbits on one batch integrator."""
+from __future__ import annotations
+
+import numpy as np
+
+from hhscatter.integrate import events, heyoka_log
+from hhscatter.integrate.batch import _batch_integrator
+from hhscatter.integrate.epochs import EPOCH_BATCH, _Epochs
+from hhscatter.integrate.events import ESCAPED
+from hhscatter.integrate.lanes import RERUN, _bind
+from hhscatter.integrate.rerun import _merge_rerun, _no_return, _orbits_with_failures, _own_far, _redo_on_reference
+from hhscatter.integrate.results import CROSSING_COLUMNS, SECTION_COLUMNS, ChunkResult, _empty_result, _rows_to_columns
+from hhscatter.integrate.stream import STREAM_BATCH, _SecondPhase, _Stream
+
+
+def scheduler(scene) -> str:
+    """scheduler(scene) -> 'epochs' for scenes with snapshots, else 'stream'."""
+    return "epochs" if scene.snapshots else "stream"
+
+
+def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+    """run_chunk(scene, ics, traj_ids, batch_size=None, count_steps=False, progress=None) -> ChunkResult.
+
+    ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
+    array (n,). Returns the table rows of this chunk, ordered by traj_id (and
+    time). ``batch_size`` (default: the scene's, else 8 lanes for the stream
+    scheduler and 8 for epochs) has no effect on the results. ``count_steps``:
+    fill ``ChunkResult.n_steps`` (the epoch scheduler otherwise skips reading
+    heyoka's per-lane results every epoch; the stream scheduler always counts).
+    ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
+    that many more orbits of the chunk have started, so long chunks show
+    progress.
+
+    heyoka's log is captured while the chunk runs (:mod:`hhscatter.integrate.heyoka_log`): an event whose root
+    finding failed in a step is ignored there by heyoka, so every such failure is counted
+    (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
+    on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
+    """
+    ics = np.ascontiguousarray(ics, dtype=float)
+    traj_ids = np.asarray(traj_ids, dtype=np.int64)
+    outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
+    inside = ~outside
+    kind = scheduler(scene)
+    far = _no_return(scene, ics[inside], kind)  # the integration's scene (maybe an earlier far event) and `late`
+    kw = dict(batch_size=batch_size, count_steps=count_steps)
+    with heyoka_log.capture() as log:
+        res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
+    failures, redone = log.event_failures, np.empty(0, np.int64)
+    if failures:
+        local = _orbits_with_failures(lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far,
+                                                             **kw), int(inside.sum()), failures)
+        res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
+        redone = traj_ids[inside][local]
+    if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
+        res = _with_escaped_at_start(scene, ics, traj_ids, outside, res)
+    res.event_failures, res.redone = failures, redone
+    return res
+
+
+def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+    """The chunk's orbits (all inside r_esc) on the batch engine; ``far``: :func:`_no_return`'s (scene, late),
+    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk."""
+    if not len(ics):
+        return _empty_result(traj_ids)
+    kind = scheduler(scene)
+    B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
+    phases = kind == "stream" and events.two_phase(scene)
+    orig, (scene, late) = scene, far
+    # first (or only) phase: without the section event when the window opens late
+    with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
+        config = dict(count_steps=count_steps, progress=progress, late=late)
+        if kind == "epochs":
+            lanes = _Epochs(scene, ta, layout, ics, **config)
+        else:  # the inlined handlers serve stream scenes with no section event in this integrator and no follow
+            inlined = scene.follow is None and (scene.sections is None or phases)
+            lanes = _Stream(scene, ta, layout, ics, inlined=inlined, migrate_at_open=phases, **config)
+        _bind(ta, specs, lanes, lanes.handlers)
+        try:
+            n_returns, n_steps, (s_ids, s_t, s_e) = lanes.run()
+        finally:
+            lanes.close()  # the integrator goes back to the cache: no view of it stays here
+    if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
+        with _batch_integrator(scene, B) as (ta2, specs2, _):
+            second = _SecondPhase(scene, ta2, layout, lanes, late=late)
+            _bind(ta2, specs2, second)
+            try:
+                r2, s2, _ = second.run()
+            finally:
+                second.close()
+        n_returns, n_steps = n_returns + r2, n_steps + s2
+    outcome = np.array(lanes.outcome, dtype=np.int8)
+    if (outcome == -1).any():
+        raise RuntimeError("internal error: some orbits of the chunk have no outcome")
+    res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps)
+    rerun = outcome == RERUN
+    if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
+        own = _own_far(orig)
+        res = _merge_rerun(res, rerun, traj_ids, _integrate(own, ics[rerun], traj_ids[rerun], (own, None),
+                                                            batch_size=batch_size, count_steps=count_steps))
+    return res
+
+
+def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_steps) -> ChunkResult:
+    """The chunk's rows from its lanes: lifetimes in orbit order, the other tables by orbit, then time."""
+    n, (s_ids, s_t, s_e) = len(ics), snaps
+    model = scene.model
+    end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
+    t_end = np.array(lanes.t_end, dtype=float)
+    channel = np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1)
+    lifetimes = {
+        "traj_id": traj_ids,
+        "x0": ics[:, 0].copy(),
+        "y0": ics[:, 1].copy(),
+        "px0": ics[:, 2].copy(),
+        "py0": ics[:, 3].copy(),
+        "e0": model.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3]),
+        "gamma": np.full(n, scene.gamma),
+        "outcome": outcome,
+        "t_end": t_end,
+        "exit_channel": channel.astype(np.int8),
+        "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
+    }
+    sections = _rows_to_columns(lanes.sec_rows, SECTION_COLUMNS, traj_ids)
+    crossings = _rows_to_columns(lanes.cross_rows, CROSSING_COLUMNS, traj_ids)
+    crossings["direction"] = crossings["direction"].astype(np.int8)
+    order = np.lexsort((s_t, s_ids))
+    snapshots = {"traj_id": traj_ids[s_ids[order]], "t": s_t[order], "energy": s_e[order]}
+    return ChunkResult(lifetimes, sections, snapshots, crossings, n_returns=n_returns, n_steps=int(n_steps))
+
+
+def _with_escaped_at_start(scene, ics, traj_ids, outside, res):
+    """The chunk's result from ``res`` (its orbits that start inside r_esc) and the orbits ``outside`` (a mask):
+    those start at r ≥ r_esc and are escaped at t = 0 (the authors' square ICs). Rows keep traj_id order."""
+    inside = ~outside
+    model = scene.model
+    x, y, px, py = ics.T
+    lt = {
+        "traj_id": traj_ids, "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
+        "e0": model.energy(x, y, px, py), "gamma": np.full(len(ics), scene.gamma),
+        "outcome": np.full(len(ics), ESCAPED, np.int8), "t_end": np.zeros(len(ics)),
+        "exit_channel": model.exit_channel(x, y).astype(np.int8), "e_end": model.energy(x, y, px, py),
+    }
+    if inside.any():
+        for col in ("outcome", "t_end", "exit_channel", "e_end"):
+            lt[col][inside] = res.lifetimes[col]
+    snaps = res.snapshots
+    if scene.snapshots and scene.snapshots[0] == 0.0:  # a snapshot at t = 0 ≤ t_end of the escaped ones
+        ids = np.concatenate([snaps["traj_id"], traj_ids[outside]])
+        t = np.concatenate([snaps["t"], np.zeros(int(outside.sum()))])
+        e = np.concatenate([snaps["energy"], lt["e0"][outside]])
+        order = np.lexsort((t, ids))
+        snaps = {"traj_id": ids[order], "t": t[order], "energy": e[order]}
+    return ChunkResult(lt, res.sections, snaps, res.crossings, n_returns=res.n_returns, n_steps=res.n_steps)

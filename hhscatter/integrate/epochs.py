@@ -1,0 +1,154 @@
+"""The epoch scheduler (scenes with energy snapshots): all lanes advance together; snapshots from ``propagate_grid``."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hhscatter.integrate.batch import _BatchRules, _check
+from hhscatter.integrate.events import CENSORED, SETTLED
+from hhscatter.integrate.lanes import CONTINUING, LIVE
+
+EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
+EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
+
+
+class _Epochs(_BatchRules):
+    """Epoch scheduler: all lanes advance together; snapshots from ``propagate_grid``."""
+
+    def __init__(self, scene, ta, layout, ics, **config):
+        super().__init__(scene, ta, layout, ics, **config)
+        self.handlers = {}  # the methods serve every rule
+        t_max = scene.t_max
+        # P divides t_max, so censoring falls on an epoch's end
+        self.n_epochs_max = max(1, math.ceil(t_max / EPOCH))
+        self.P = t_max / self.n_epochs_max
+        self.snaps = np.asarray(scene.snapshots or (), dtype=float)
+        self.s_last = float(self.snaps[-1]) if self.snaps.size else -math.inf
+        self.epoch = 0
+        self.start_epoch = [0] * self.B
+        self.zeros = np.zeros(self.B)
+
+    def elapsed(self, lane):
+        return ((self.epoch - self.start_epoch[lane]) * self.P + self.time_hi.item(lane)) + self.time_lo.item(lane)
+
+    def release(self, lane):
+        """Park the lane at the origin (a fixed point) until the epoch ends."""
+        self.commit_rows(lane)
+        self.orbit[lane] = -1
+        self.state[:, lane] = 0.0
+        if self.layout.clock is not None:
+            self.set_clock(lane, 1.0)
+        if self.layout.gate is not None:
+            self.set_gate(lane, 0.0)
+        return True
+
+    def _tables(self):
+        """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
+
+        Row k of ``grid_times`` holds the lane times of the snapshots s in [kP, (k+1)P)
+        (the last epoch before t_max also (k+1)P), padded with fillers (strictly
+        increasing, evaluated and discarded) to a common length; ``snap_times`` holds the
+        snapshot times, NaN at fillers. Row −1 (parked lanes) is all fillers.
+        Computed once per chunk, so an epoch's grid is a gather, not a loop.
+        """
+        P, S = self.P, self.snaps
+        K = self.n_epochs_max
+        rows = []
+        s_last = S[-1] if S.size else -math.inf
+        for k in range(K):
+            o = k * P
+            # a snapshot on an epoch boundary belongs to the later epoch's start, except the last
+            # snapshot (and t_max), which ends the earlier one: orbits that need nothing after
+            # them stop there
+            i0 = np.searchsorted(S, o, "right" if k and s_last <= o else "left")
+            i1 = np.searchsorted(S, o + P, "right" if k + 1 == K or s_last <= o + P else "left")
+            s = S[i0:i1]
+            rows.append((s - o, s))
+        m = max(int(((r[0] > 0) & (r[0] < P)).sum()) for r in rows)
+        n = m + 2
+        tau = np.empty((K + 1, n))
+        tt = np.full((K + 1, n), np.nan)
+        tau[:, 0], tau[:, -1] = 0.0, P
+        for k, (t, s) in enumerate(rows + [(np.empty(0), np.empty(0))]):
+            inner = (t > 0) & (t < P)
+            j = int(inner.sum())
+            tau[k, 1:1 + j] = t[inner]
+            tt[k, 1:1 + j] = s[inner]
+            a = t[inner][-1] if j else 0.0
+            tau[k, 1 + j:-1] = a + (P - a) * np.arange(1, m - j + 1) / (m - j + 1)
+            if len(t) and t[0] == 0.0:
+                tt[k, 0] = s[0]
+            if len(t) and t[-1] == P:
+                tt[k, -1] = s[-1]
+        self.grid_times, self.snap_times = tau, tt
+        self.has_snapshots = ~np.isnan(tt).all(axis=1)
+
+    def run(self):
+        B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
+        self._tables()
+        grid_times, has_snapshots = self.grid_times, self.has_snapshots
+        orbit, phase, start_epoch, st = self.orbit, self.phase, self.start_epoch, self.state
+        s_last = self.s_last
+        buf, rows = [], []
+        n_returns = n_steps = 0
+        lanes = range(B)
+        for lane in lanes:
+            self.load_next(lane)
+        while any(k >= 0 for k in orbit):
+            ta.set_time(self.zeros)
+            epoch = self.epoch
+            epoch_index = np.array([epoch - start_epoch[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
+            if has_snapshots[epoch_index].any():
+                ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
+                out = ta.propagate_grid(np.ascontiguousarray(grid_times[epoch_index].T))[1]
+                buf.append((out[:, :4, :], epoch_index, ids))
+                if len(buf) >= 256:
+                    rows.append(self._snapshot_rows(buf))
+                    buf = []
+            else:
+                ta.propagate_until(P)
+            n_returns += 1
+            if self.count_steps:
+                n_steps += _check(ta, self)
+            elif not np.isfinite(st).all():
+                _check(ta, self)
+            for lane in lanes:  # orbits that need nothing after this epoch end here
+                if orbit[lane] >= 0:
+                    k = epoch - start_epoch[lane] + 1  # epochs completed
+                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                        if phase[lane] == LIVE:
+                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                        self.release(lane)
+            self.epoch = epoch + 1
+            for lane in lanes:
+                if orbit[lane] < 0:
+                    self.load_next(lane)
+        if buf:
+            rows.append(self._snapshot_rows(buf))
+        ids = np.concatenate([r[0] for r in rows]) if rows else np.empty(0, np.int64)
+        t = np.concatenate([r[1] for r in rows]) if rows else np.empty(0)
+        e = np.concatenate([r[2] for r in rows]) if rows else np.empty(0)
+        # rows after an orbit's end belong to no table (settled orbits continued: all rows)
+        limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf,
+                         np.array(self.t_end))
+        keep = t <= limit[ids]
+        return n_returns, n_steps, (ids[keep], t[keep], e[keep])
+
+    def _snapshot_rows(self, buf):
+        """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows."""
+        out = np.stack([b[0] for b in buf])  # (epochs, n, 4, B)
+        epoch_index = np.stack([b[1] for b in buf])  # (epochs, B)
+        ids = np.stack([b[2] for b in buf])
+        tt = self.snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
+        ok = ~np.isnan(tt) & (ids >= 0)[:, None, :]
+        x, y, px, py = (out[:, :, i, :][ok] for i in range(4))
+        return (np.broadcast_to(ids[:, None, :], tt.shape)[ok], tt[ok], self.model.energy(x, y, px, py))
+
+    def load_next(self, lane):
+        k = self.next
+        if k >= self.n:
+            return
+        self.next = k + 1
+        self.start_epoch[lane] = self.epoch
+        self.load_orbit(lane, k)

@@ -1,0 +1,84 @@
+"""The censoring-aware plateau-plus-exponential fit against samples drawn from known laws."""
+import numpy as np
+import pytest
+
+from hhscatter.analysis.survival.long_time import fit_plateau_exponential, hazard_profile, survival_at
+
+
+def _sample(n, q, kappa, t_max, seed):
+    rng = np.random.default_rng(seed)
+    t = np.where(rng.random(n) < q, np.inf, rng.exponential(1 / kappa, n))
+    return np.minimum(t, t_max), t < t_max
+
+
+@pytest.mark.parametrize("q, kappa", [(0.3, 0.01), (0.75, 0.001), (0.05, 0.003)])
+def test_plateau_and_rate_recovered_within_errors(q, kappa):
+    t, obs = _sample(40000, q, kappa, 2000.0, 5)
+    f = fit_plateau_exponential(t, obs, 0.0)
+    assert abs(f.q - q) < 4 * f.q_err and abs(f.kappa - kappa) < 4 * f.kappa_err
+    assert f.chi2 / f.dof < 3
+
+
+def test_errors_match_the_spread_over_samples():
+    fits = [fit_plateau_exponential(*_sample(5000, 0.4, 0.004, 1000.0, s), 0.0) for s in range(30)]
+    k = np.array([f.kappa for f in fits])
+    err = np.median([f.kappa_err for f in fits])
+    assert 0.6 < k.std(ddof=1) / err < 1.6
+
+
+def test_a_single_exponential_on_a_plateau_is_rejected_by_its_chi2():
+    t, obs = _sample(20000, 0.3, 0.01, 800.0, 1)
+    single = fit_plateau_exponential(t, obs, 0.0, plateau=False)
+    both = fit_plateau_exponential(t, obs, 0.0)
+    assert single.chi2 / single.dof > 20 > both.chi2 / both.dof
+
+
+def test_rate_is_not_conditioned_on_escape_before_t_max():
+    # the escaping orbits alone look faster; the censoring-aware rate of the whole population does not
+    t, obs = _sample(40000, 0.0, 0.002, 400.0, 2)
+    f = fit_plateau_exponential(t, obs, 0.0, plateau=False)
+    assert abs(f.kappa - 0.002) < 4 * f.kappa_err
+    only_escaping = 1 / t[obs].mean()
+    assert only_escaping > 2.5 * 0.002
+
+
+def test_plateau_fraction_of_all_orbits_uses_survival_at_t0():
+    t, obs = _sample(20000, 0.5, 0.01, 1000.0, 4)
+    f = fit_plateau_exponential(t, obs, 100.0)
+    P100 = survival_at(t, obs, [100.0])[0][0]
+    assert f.p_t0 == pytest.approx(P100) and abs(f.p_inf - 0.5) < 4 * f.p_inf_err
+
+
+def test_hazard_profile_is_flat_for_an_exponential():
+    t, obs = _sample(50000, 0.0, 0.01, 300.0, 6)
+    h = hazard_profile(t, obs, [0.0, 100.0, 200.0, 300.0])
+    assert np.all(np.abs(h["hazard"] - 0.01) < 4 * h["hazard_err"])
+
+
+def test_too_few_orbits_refused():
+    with pytest.raises(ValueError, match="too few"):
+        fit_plateau_exponential([1.0, 2.0], [True, True], 0.0)
+
+
+def test_rate_status_flags_a_plateau_with_its_p_inf():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    t, obs = _sample(20000, 0.4, 0.005, 800.0, 8)
+    s = rate_status(t, obs, 50.0, 700.0)
+    assert s.status == "trapped" and "P∞" in s.note and abs(s.p_inf - 0.4) < 4 * s.p_inf_err
+
+
+def test_rate_status_flags_a_falling_hazard_as_non_exponential():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    rng = np.random.default_rng(9)
+    t = np.concatenate([rng.exponential(10.0, 10000), rng.exponential(100.0, 10000)])  # two rates: not one
+    s = rate_status(np.minimum(t, 3000.0), t < 3000.0, 5.0, 400.0)
+    assert s.status == "non-exponential" and s.note
+
+
+def test_rate_status_passes_one_exponential():
+    from hhscatter.analysis.survival.long_time import rate_status
+
+    t, obs = _sample(20000, 0.0, 0.05, 400.0, 10)
+    assert rate_status(t, obs, 5.0, 150.0).status == "exponential"

@@ -1,0 +1,135 @@
+"""Ulam's method from one-return samples (hhscatter.analysis.geometry.ulam) on synthetic input with known answers:
+the dissipative comparison's steps, κ's extrapolation in box side and samples per box, the residuals."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.analysis.geometry import transfer as tf
+from hhscatter.analysis.geometry import ulam
+
+
+def test_survival_agreement_on_constructed_curves():
+    """Operator P = P_sim·e^0.1 (|ln ratio| 0.1 everywhere), reduced P = P_sim·e^(−0.2 t/T); compared while
+    P_sim·N ≥ 30."""
+    dt, N = 0.5, 1000
+    grid = np.arange(0, 201) * dt  # up to t = 100
+    P_sim = np.exp(-0.05 * grid)  # P_sim·N ≥ 30 up to t = ln(1000/30)/0.05 = 70.1
+    P_op = P_sim * math.exp(0.1)
+    P_red = P_sim * np.exp(-0.2 * grid / 100)
+    out = ulam.survival_agreement(grid, dt, 20.0, P_sim, P_op, P_red, N)
+    t_until = 70.0  # the last grid time with P_sim·N ≥ 30
+    assert out["compared_until"] == t_until
+    assert out["lnP_rms_operator"] == pytest.approx(0.1, rel=1e-12)
+    assert out["lnP_max_operator"] == pytest.approx(0.1, rel=1e-12)
+    assert out["lnP_max_reduced"] == pytest.approx(0.2 * t_until / 100, rel=1e-12)
+    ok = grid <= t_until
+    assert out["lnP_rms_reduced"] == pytest.approx(np.sqrt(np.mean((0.2 * grid[ok] / 100) ** 2)), rel=1e-12)
+    # the fixed times within the grid, t* among them, with the binomial error of P_sim
+    assert [r["t"] for r in out["P_at"]] == [5.0, 10.0, 20.0, 25.0, 40.0, 60.0, 80.0, 100.0]
+    r = out["P_at"][2]
+    assert r["sim"] == pytest.approx(math.exp(-1.0), rel=1e-15)
+    assert r["sim_err"] == pytest.approx(math.sqrt(math.exp(-1) * (1 - math.exp(-1)) / N), rel=1e-12)
+    assert r["operator"] == pytest.approx(math.exp(-0.9), rel=1e-12)
+
+
+def test_survival_agreement_without_comparable_times_is_nan():
+    grid = np.arange(0, 11) * 1.0
+    P = np.full(11, 0.01)
+    out = ulam.survival_agreement(grid, 1.0, 5.0, P, P, P, 100)  # P·N = 1 < 30 everywhere
+    assert all(math.isnan(out[k]) for k in ("lnP_rms_operator", "lnP_max_reduced", "compared_until"))
+    assert [r["t"] for r in out["P_at"]] == [5.0, 10.0, 5.0]  # t* = 5 listed where given
+
+
+def test_t_star_energies_weighted_and_plain_moments():
+    pred = pd.DataFrame({"energy": [0.1, 0.2, 0.4], "w": [1.0, 2.0, 1.0]})
+    sim = pd.DataFrame({"energy": [0.1, 0.3]})
+    out = ulam.t_star_energies(pred, sim)
+    mean = (0.1 + 0.4 + 0.4) / 4  # weights 1/4, 2/4, 1/4
+    assert out["t_star_mean_energy"]["operator"] == pytest.approx(mean, rel=1e-14)
+    var = (0.1 - mean) ** 2 / 4 + 2 * (0.2 - mean) ** 2 / 4 + (0.4 - mean) ** 2 / 4
+    assert out["t_star_std_energy"]["operator"] == pytest.approx(math.sqrt(var), rel=1e-12)
+    sd = math.sqrt(0.02)  # sample std of (0.1, 0.3)
+    assert out["t_star_mean_energy"]["sim"] == pytest.approx(0.2, rel=1e-14)
+    assert out["t_star_mean_energy"]["sim_err"] == pytest.approx(sd / math.sqrt(2), rel=1e-12)
+    assert out["t_star_std_energy"]["sim"] == pytest.approx(sd, rel=1e-12)
+    assert out["t_star_points_sim"] == 2
+    # a single simulated point: no spread
+    assert math.isnan(ulam.t_star_energies(pred, sim.iloc[:1])["t_star_std_energy"]["sim"])
+
+
+def _grid(k_inf, a, beta, p, noise=0.0, seed=0):
+    """κ on 3 box sides × 3 sample subsets (M'·c² samples per merged box), exactly κ∞ + a·b + β·M^(−p) (+ noise)."""
+    rng = np.random.default_rng(seed)
+    rows = [{"box": 0.00625 * c, "samples": m * c * c} for c in (1, 2, 4) for m in (4, 16, 64)]
+    g = pd.DataFrame(rows)
+    g["kappa"] = k_inf + a * g.box + beta * g.samples ** (-p) + noise * rng.standard_normal(len(g))
+    return g
+
+
+def test_kappa_convergence_recovers_the_limit_of_its_model():
+    g = _grid(0.1972, 0.2, 0.03, 0.5)
+    c = ulam.kappa_convergence(g)
+    assert c["kappa_inf"] == pytest.approx(0.1972, abs=1e-12)
+    assert c["slope_box"] == pytest.approx(0.2, abs=1e-10) and c["coef_samples"] == pytest.approx(0.03, abs=1e-10)
+    # the other exponent does not describe these data: its limit differs, and that difference is the model error
+    assert c["model_err"] == pytest.approx(abs(c["kappa_inf_alt"] - 0.1972), rel=1e-12) and c["model_err"] > 1e-3
+    assert math.isnan(c["stat_err"]) and math.isnan(c["err"])  # no bootstrap grid: no statistical error
+
+
+def test_kappa_convergence_bootstrap_spread_is_the_statistical_error():
+    """Replicates = the exact grid + independent noise σ: the spread of their extrapolations is that of the
+    least-squares intercept, σ·√((XᵀX)⁻¹)₀₀ (an independent closed form)."""
+    g = _grid(0.1, 0.1, 0.02, 0.5)
+    sigma, n_rep = 1e-3, 400
+    reps = pd.concat([_grid(0.1, 0.1, 0.02, 0.5, noise=sigma, seed=r).assign(rep=r) for r in range(n_rep)])
+    c = ulam.kappa_convergence(g, reps)
+    X = np.column_stack([np.ones(len(g)), g.box, g.samples ** -0.5])
+    expect = sigma * math.sqrt(np.linalg.inv(X.T @ X)[0, 0])
+    assert c["stat_err"] == pytest.approx(expect, rel=0.1)  # 400 replicates: the std to ≈ 3.5 %
+    assert c["err"] == pytest.approx(math.hypot(c["stat_err"], c["model_err"]), rel=1e-12)
+
+
+def test_kappa_convergence_needs_two_box_sides_and_two_sample_counts():
+    g = _grid(0.1, 0.1, 0.02, 0.5)
+    with pytest.raises(ValueError, match="box sides"):
+        ulam.kappa_convergence(g[g.box == g.box.min()])
+    rec = ulam.convergence_record(0.3, g.head(3), None, 0.11, {"kappa0": (0.1, 0.001)})
+    assert rec["kappa_inf"] is None and "need" in rec["note"]
+
+
+def test_residuals_with_both_errors():
+    r = ulam.residuals(0.0994, 0.0006, 0.0972, 0.0002)
+    assert r["residual"] == pytest.approx(0.0994 / 0.0972 - 1, rel=1e-12)
+    assert r["z"] == pytest.approx(0.0022 / math.hypot(0.0006, 0.0002), rel=1e-12)
+    assert r["residual_err"] == pytest.approx(0.0994 / 0.0972 * math.hypot(0.0006 / 0.0994, 0.0002 / 0.0972),
+                                              rel=1e-12)
+
+
+def test_sample_transitions_merge_boxes_and_keep_the_first_ranks():
+    """Four finest boxes (2 × 2 of side 1 over [0, 2]²), two samples each: merged 2 × 2 they are one state; the
+    first rank alone keeps one sample per box; a censored sample is dropped; an image outside is an escape."""
+    tab = pd.DataFrame({"cell": [0, 0, 1, 1, 2, 2, 3, 3], "rank": [0, 1] * 4, "w": 1.0,
+                        "ret": [True, True, True, False, True, True, True, True],
+                        "T": [1.0, 2.0, 1.5, np.nan, 1.0, 1.0, 1.0, 1.0],
+                        "x1": [0.5, 1.5, 0.5, np.nan, 1.5, 1.5, 5.0, 0.5], "y1": [0.5, 0.5, 1.5, np.nan, 1.5, 0.5, 5.0, 0.5],
+                        "censored": [False] * 7 + [True]})
+    tr, ids, t = ulam.sample_transitions(tab, (0, 2, 0, 2), 1.0)
+    assert len(t) == 7 and tr.n_states == 4 and ids.tolist() == [0, 1, 2, 3]
+    assert tr.dst.tolist() == [0, 1, 2, -1, 3, 1, -1]  # (5, 5) lies outside: escape
+    one, _, _ = ulam.sample_transitions(tab, (0, 2, 0, 2), 1.0, c=2)
+    assert one.n_states == 1 and one.src.tolist() == [0] * 7
+    first, _, t1 = ulam.sample_transitions(tab, (0, 2, 0, 2), 1.0, m_max=1)
+    assert t1["rank"].tolist() == [0, 0, 0, 0]
+
+
+def test_saddle_kappa_of_a_uniform_leak():
+    """One box that returns with weight share q after time T, else escapes: ρ(M(κ)) = q e^{κT} = 1 → κ = −ln q / T."""
+    q, T = 0.75, 2.0
+    tr = tf.Transitions([0, 0, 0, 0], [0, 0, 0, -1], [T, T, T, 1.0], 1)
+    kap, kmap, info, keep, sub = ulam.saddle_kappa(tr)
+    assert kap == pytest.approx(-math.log(q) / T, rel=1e-10) and kmap == pytest.approx(-math.log(q), rel=1e-10)
+    assert info["saddle_states"] == 1 and info["closed_classes"] == 0
