@@ -23,8 +23,13 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP) ## create .venv and install hhscatter with its dev extra
 
-test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) chromium ## run the default test suite (creates .venv with the dev, bench and docs extras)
+test: $(STAMP) $(BENCH_STAMP) $(DOCS_STAMP) chromium ## run the default test suite, then `make lint` (creates .venv with the dev, bench and docs extras)
 	$(PY) -m pytest -q
+	@$(MAKE) --no-print-directory lint
+
+lint: $(DOCS_STAMP) ## ruff: lint and formatting of the whole tree (configuration in pyproject.toml [tool.ruff])
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 # the docs' browser tests (tests/docs/test_docs_browser.py) open the built site in Debian's Chromium, driven by the
 # playwright package of the docs extra (never `playwright install`: its browser downloads are not used). Installed
@@ -49,11 +54,11 @@ test-min: ## run the test suite against the lowest dependency versions pyproject
 	$(MIN_VENV)/bin/python -m pytest -q -p no:cacheprovider
 
 # -- demo: two real scenes end to end -----------------------------------------
-$(RUNS)/demo/conservative/.done: studies/demo/conservative.toml $(STAMP)
+$(RUNS)/demo/conservative/.done: examples/conservative.toml $(STAMP)
 	$(VENV)/bin/hhscatter simulate $< --out $(@D) --overwrite $(W)
 	@touch $@
 
-$(RUNS)/demo/dissipative/.done: studies/demo/dissipative.toml $(STAMP)
+$(RUNS)/demo/dissipative/.done: examples/dissipative.toml $(STAMP)
 	$(VENV)/bin/hhscatter simulate $< --out $(@D) --overwrite $(W)
 	@touch $@
 
@@ -98,8 +103,8 @@ FORCE:
 
 studies: $(STUDY_NAMES) ## all studies at SCALE (default quick), each after the studies it needs
 
-BENCH_SUMMARY := studies/bench/out/full/summary.md
-STRESS_SUMMARY := studies/stress/out/full/summary.md
+BENCH_SUMMARY := benchmarks/out/bench/full/summary.md
+STRESS_SUMMARY := benchmarks/out/stress/full/summary.md
 # The report reads, per study, studies/<name>/out/<SCALE>/{<name>.json,<name>.png,cost.json} where they exist, else
 # the committed copies in docs/studies/assets/<SCALE>/ (hhscatter/publish/report.py), and verifies each numbers
 # JSON against its study.toml and upstream numbers (so those are inputs too). A scale with committed results
@@ -107,7 +112,7 @@ STRESS_SUMMARY := studies/stress/out/full/summary.md
 # simulation; quick and any other declared scale (tiny) run the studies that are missing or out of date.
 COMMITTED := docs/studies/assets/$(SCALE)
 either = $(or $(wildcard $(1)),$(wildcard $(2)))
-BENCH_READ := $(foreach b,bench stress,$(call either,studies/$(b)/out/full/summary.md,docs/benchmarks/assets/$(b)/summary.md))
+BENCH_READ := $(foreach b,bench stress,$(call either,benchmarks/out/$(b)/full/summary.md,docs/benchmarks/assets/$(b)/summary.md))
 ifeq ($(filter $(SCALE),$(STUDY_SCALES)),)
 REPORT_INPUTS := report-unknown-scale
 else ifeq ($(SCALE),quick)
@@ -126,28 +131,28 @@ report-unknown-scale:
 
 report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown): quick runs what is missing; SCALE=paper reads the committed results
 
-bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → studies/engine/out/full/
-	$(PY) -m hhscatter.bench.engine $(ENGINE_ARGS)
+bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → benchmarks/out/engine/full/
+	$(PY) -m benchmarks.engine $(ENGINE_ARGS)
 
 bench-memory: $(STAMP) ## peak RSS of simulate + P(t) at E=0.27, N=1e5,1e6,1e7, 1 worker (1e7: ~5-10 CPU-min)
-	$(PY) -m hhscatter.bench.memory $(MEMORY_ARGS)
+	$(PY) -m benchmarks.memory $(MEMORY_ARGS)
 
 $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
 	@touch $@
 
-bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets → studies/{bench,engine}/out/
-	$(PY) -m hhscatter.bench $(BENCH_ARGS)
-	$(PY) -m hhscatter.bench.engine -n 30000 --repeat 2
+bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets → benchmarks/out/{bench,engine}/
+	$(PY) -m benchmarks $(BENCH_ARGS)
+	$(PY) -m benchmarks.engine -n 30000 --repeat 2
 
 # the report runs the benchmarks only when their summaries are missing or their code changed
-$(BENCH_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/bench/bench.toml | $(BENCH_STAMP)
-	$(PY) -m hhscatter.bench
-$(STRESS_SUMMARY): $(wildcard hhscatter/bench/*.py) studies/stress/stress.toml | $(BENCH_STAMP)
-	$(PY) -m hhscatter.bench.stress
+$(BENCH_SUMMARY): $(wildcard benchmarks/*.py) benchmarks/bench.toml | $(BENCH_STAMP)
+	$(PY) -m benchmarks
+$(STRESS_SUMMARY): $(wildcard benchmarks/*.py) benchmarks/stress.toml | $(BENCH_STAMP)
+	$(PY) -m benchmarks.stress
 
-stress: $(BENCH_STAMP) ## numerical stress tests (drift, threshold, grazing events, γ extremes, KS) → studies/stress/out/
-	$(PY) -m hhscatter.bench.stress $(STRESS_ARGS)
+stress: $(BENCH_STAMP) ## numerical stress tests (drift, threshold, grazing events, γ extremes, KS) → benchmarks/out/stress/
+	$(PY) -m benchmarks.stress $(STRESS_ARGS)
 
 clean-runs: ## delete simulation outputs under runs/
 	rm -rf $(RUNS)
@@ -173,5 +178,5 @@ docs-assets: ## copy the studies' figures/numbers/costs at SCALE (quick: with th
 
 .PHONY: docs docs-serve docs-assets tutorial
 
-.PHONY: help venv test chromium test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies \
+.PHONY: help venv test lint chromium test-min test-slow demo bench-engine bench-memory bench stress clean-runs report studies \
 	report-unknown-scale

@@ -8,9 +8,9 @@ costs ``cost.json`` (as ``<name>.cost.json``) to ``docs/studies/assets/``
 (quick scale) or ``docs/studies/assets/<scale>/`` (any other scale, e.g.
 ``paper``: the committed paper-scale results the docs and
 ``make report SCALE=paper`` read); for the benchmarks and stress tests, the markdown
-summaries, PNG figures and small CSV files of ``studies/bench/out/<s>/`` and
-``studies/stress/out/<s>/`` (``<s>`` = ``--bench-scale``, default ``full``,
-else ``quick``) to ``docs/benchmarks/assets/<bench|stress>/``.
+summaries, PNG figures and small CSV files of ``benchmarks/out/<bench|stress|engine>/<s>/``
+(``<s>`` = ``--bench-scale``, default ``full``, else ``quick``) to
+``docs/benchmarks/assets/<bench|stress|engine>/``.
 Outputs that do not exist yet are reported and skipped; an asset already in
 docs/ is then kept, and the page says which scale made it. The pages render
 these assets at build time (docs/_hooks/studies.py) and show a "not yet
@@ -82,7 +82,7 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
     if studies_only or scale != "quick":  # the benchmarks have scales of their own (full, quick)
         return pairs, missing
     for which in BENCHES:
-        base = ROOT / "studies" / which / "out"
+        base = ROOT / "benchmarks" / "out" / which
         out = _bench_dir(base, bench_scale)
         if out is None:
             missing.append(str(base.relative_to(ROOT)) + f"/{bench_scale or '<full|quick>'}/")
@@ -101,7 +101,7 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", default="quick", help="study scale whose outputs to copy (default: quick)")
-    ap.add_argument("--bench-scale", help="scale folder of studies/bench|stress/out to copy (default: full, else quick)")
+    ap.add_argument("--bench-scale", help="scale folder of benchmarks/out/<bench|stress|engine> to copy (default: full, else quick)")
     ap.add_argument("--check", action="store_true", help="copy nothing; exit 1 if an asset is stale")
     ap.add_argument("--studies-only", action="store_true", help="copy the studies' outputs, not the benchmarks'")
     a = ap.parse_args(argv)

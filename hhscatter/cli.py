@@ -188,13 +188,16 @@ def build_parser():
         "study",
         help="run one stage of a study (simulate → analyze → plot)",
         description="Run a stage of a study in studies/<name>/: 'simulate' writes raw Parquet runs, "
-        "'analyze' derived tables and <name>.json, 'plot' <name>.png; 'all' runs the three.",
+        "'analyze' derived tables and <name>.json, 'plot' <name>.png; 'all' runs the three. The studies folder is "
+        "studies/ of the repository the command runs in (the working directory or a parent), or --studies.",
         epilog=_studies_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2; listed below")
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
     st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    st.add_argument("--studies", metavar="DIR", help="the studies folder (default: $HHSCATTER_STUDIES, else studies/ "
+                    "of the repository the command runs in)")
     _progress_flags(st)
     return p
 
@@ -409,7 +412,8 @@ def cmd_survival(a):
 def cmd_study(a):
     from hhscatter.studies import run_stage  # deferred: `hhscatter --help` starts without the engine and tables
 
-    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a))
+    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a),
+              root=Path(a.studies) if a.studies else None)
     return 0
 
 

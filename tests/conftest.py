@@ -1,7 +1,6 @@
-from pathlib import Path
-
 import numpy as np
 import pytest
+from study_copy import REPO_STUDIES, copy_study_folder
 
 EPS = np.finfo(float).eps
 
@@ -21,21 +20,23 @@ def diss_scene():
                  sections=SectionWindow(t_from=5.0, t_to=40.0), snapshots=tuple(np.arange(0.0, 100.0, 10.0)))
 
 
+@pytest.fixture
+def copy_study():
+    """copy_study(name, root, edit=None) -> a copy of a study folder of the repository in the studies folder root."""
+    return copy_study_folder
+
+
 @pytest.fixture(scope="session")
 def tiny_studies(tmp_path_factory):
     """A studies root with every study of the repository built at scale 'tiny' from an empty out/,
     one after the other in the order of the declared graph (study.toml [needs]), as `make studies` does."""
-    import shutil
-
     from hhscatter.studies import run_stage
     from hhscatter.studies.graph import studies
 
-    repo = Path(__file__).resolve().parents[1] / "studies"
     root = tmp_path_factory.mktemp("studies")
-    order = [s.name for s in studies(repo)]
+    order = [s.name for s in studies(REPO_STUDIES)]
     for name in order:
-        (root / name).mkdir()
-        shutil.copy(repo / name / "study.toml", root / name / "study.toml")
+        copy_study_folder(name, root)
     for name in order:
         run_stage(name, "all", "tiny", workers=1, progress=False, root=root)
     return root

@@ -4,6 +4,7 @@ import json
 import subprocess
 import sys
 import types
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -165,8 +166,8 @@ def test_study_help_lists_the_studies_and_a_mistyped_name_is_answered(capsys, tm
     out = capsys.readouterr().out
     names = [s.name for s in studies()]
     assert "fig2" in names and all(f"\n  {n} " in out for n in names)
-    monkeypatch.chdir(tmp_path)
-    assert main(["study", "fgi2", "plot"]) == 2
+    monkeypatch.chdir(tmp_path)  # elsewhere, the studies folder named explicitly
+    assert main(["study", "fgi2", "plot", "--studies", str(Path(__file__).resolve().parents[1] / "studies")]) == 2
     assert "got 'fgi2' (did you mean 'fig2'?)" in capsys.readouterr().err
 
 

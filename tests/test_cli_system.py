@@ -82,7 +82,7 @@ def test_bad_declared_systems_exit_2_naming_the_problem(tmp_path, capsys, system
 
 
 def test_declared_potential_runs_end_to_end_from_a_scene_file(tmp_path, capsys):
-    """Done means: a scene file with [system] potential = … runs and names its system in the tables."""
+    """A scene file with [system] potential = … runs and names its system in the tables."""
     f = tmp_path / "scene.toml"
     f.write_text('[scene]\nenergy = 1.5\nn = 50\nt_max = 300\n[system]\n'
                  'potential = "0.5*(x**2 + y**2) - eps*x**2*y**2"\n[system.params]\neps = 0.25\n')

@@ -1,4 +1,4 @@
-"""Behaviour snapshot for refactors (issue "layers"): scene hashes, table contents and tiny-scale numbers.
+"""Behaviour snapshot for refactors: scene hashes, table contents and tiny-scale numbers.
 
 A refactor must leave every scene hash, every table byte and every study number unchanged. This tool
 records the three in one JSON file, so that the same command before and after a change shows what
@@ -104,6 +104,9 @@ def record_tables(hh: Path) -> dict:
 
 
 def record_scenes() -> dict:
+    import os
+
+    os.environ.setdefault("HHSCATTER_STUDIES", str(ROOT / "studies"))  # this checkout's studies, wherever it runs
     from hhscatter import studies as st
 
     out = {}

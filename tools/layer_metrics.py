@@ -1,4 +1,4 @@
-"""Layering metrics of the package (issue "layers"): import circles, function-level imports,
+"""Layering metrics of the package: import circles, function-level imports,
 casts of study parameters and long functions, measured from the source with :mod:`ast`.
 
 Run from the repository root::
@@ -211,7 +211,7 @@ LAYERS = {
     "studies": BASE | {"model", "scene", "integrate", "data", "run", "analysis", "api"},
     "publish": BASE | {"model", "scene", "data", "analysis", "api", "studies"},
 }
-TOP = {"", "__main__", "cli", "bench"}  # the package's door, the CLI and the benchmarks may import any layer
+TOP = {"", "__main__", "cli"}  # the package's door and the CLI may import any layer
 
 
 def layer_of(mod: str, package: str = "hhscatter") -> str:

@@ -49,7 +49,7 @@ class BasinMeasures:
     extent: tuple | None = None
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame, one row per (point, box side): energy, gamma, box, S_b, S_b_err, S_bb, S_bb_err,
+        """The measures as a DataFrame, one row per (point, box side): energy, gamma, box, S_b, S_b_err, S_bb, S_bb_err,
         a column ``share <basin>`` per basin, wada (verdict, or None)."""
         import pandas as pd  # deferred: pandas loads on first use
 
@@ -64,8 +64,7 @@ class BasinMeasures:
 
     def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None,
              **imshow_kwargs: Any) -> Axes:
-        """plot(ax=None, *, key=None, **imshow_kwargs) -> ax: the basin map of point ``key`` (default: the first),
-        one colour per basin, forbidden cells blank."""
+        """Draw the basin map of point ``key`` (default: the first), one colour per basin, forbidden cells blank."""
         from matplotlib.colors import ListedColormap  # deferred: matplotlib loads on first use
         from matplotlib.patches import Patch  # deferred: matplotlib loads on first use
 

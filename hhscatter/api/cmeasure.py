@@ -45,7 +45,7 @@ class CMeasureRates(_PointRows):
     """
 
     def plot(self, ax: Axes | None = None, **errorbar_kwargs: Any) -> Axes:
-        """plot(ax=None, **errorbar_kwargs) -> ax: κ from the c-measure and from P(t) against E0."""
+        """Draw κ from the c-measure and from P(t) against E0; returns the axes."""
         df = self.to_frame()
         ax = _axes(ax)
         kw = {"capsize": 3, **errorbar_kwargs}
@@ -251,7 +251,7 @@ class CMeasurePoints:
         raise KeyError(f"no point {key!r}; points: {list(self.points)}")
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame point_energy, point_gamma, traj_id, t, x, y, … (every selected crossing)."""
+        """Every selected crossing in one DataFrame: point_energy, point_gamma, traj_id, t, x, y, …"""
         import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([p.assign(point_energy=k[0], point_gamma=k[1]) for k, p in self.points.items()],
@@ -259,8 +259,7 @@ class CMeasurePoints:
 
     def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None, s: float = 0.5,
              **scatter_kwargs: Any) -> Axes:
-        """plot(ax=None, *, key=None, s=0.5, **scatter_kwargs) -> ax: the points in (x, y), one colour per point
-        (or only point ``key``)."""
+        """Draw the points in (x, y), one colour per grid point (or only point ``key``); returns the axes."""
         ax = _axes(ax)
         for k in ([key] if key is not None else _sorted_keys(self.points)):
             p = self[k]
@@ -341,14 +340,14 @@ class CMeasureDistances:
     scales: dict
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame energy, gamma, box, hellinger, tv, …_noise, …_excess, agreement_scale."""
+        """The distances as a DataFrame: energy, gamma, box, hellinger, tv, …_noise, …_excess, agreement_scale."""
         import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([self.tables[k].assign(energy=k[0], gamma=k[1], agreement_scale=self.scales[k])
                           for k in _sorted_keys(self.tables)], ignore_index=True)
 
     def plot(self, ax: Axes | None = None, *, kind: str = "hellinger", **plot_kwargs: Any) -> Axes:
-        """plot(ax=None, *, kind='hellinger') -> ax: distance and its split-half noise floor against the box side."""
+        """Draw the distance and its split-half noise floor against the box side; returns the axes."""
         ax = _axes(ax)
         for k in _sorted_keys(self.tables):
             d = self.tables[k]

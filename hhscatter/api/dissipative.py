@@ -39,7 +39,7 @@ class TransitionTimes(_PointRows):
     """
 
     def plot(self, ax: Axes | None = None, **plot_kwargs: Any) -> Axes:
-        """plot(ax=None, **plot_kwargs) -> ax: τ1 (circles) and τ2 (squares) against γ, log–log, one colour per E0."""
+        """Draw τ1 (circles) and τ2 (squares) against γ, log–log, one colour per E0; returns the axes."""
         df = self.to_frame()
         ax = _axes(ax)
         for e, d in df.groupby("energy", sort=True, dropna=False):
@@ -153,7 +153,7 @@ class EnergyDecay:
     fits: dict
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame, one row per point: energy, gamma, mu, mu_err, mu_free, mu_free_err, t_lo, t_hi."""
+        """μ per point as a DataFrame: energy, gamma, mu, mu_err, mu_free, mu_free_err, t_lo, t_hi."""
         import pandas as pd  # deferred: pandas loads on first use
 
         rows = [{"energy": k[0], "gamma": k[1], "mu": f.mu, "mu_err": f.mu_err, "mu_free": f.mu_free,
@@ -162,13 +162,13 @@ class EnergyDecay:
         return pd.DataFrame(rows)
 
     def curves_frame(self):
-        """curves_frame() -> DataFrame energy, gamma, t, n, mean_E, sem_E … (all ⟨E⟩(t) curves, tidy)."""
+        """Every ⟨E⟩(t) curve in one tidy DataFrame: energy, gamma, t, n, mean_E, sem_E …"""
         import pandas as pd  # deferred: pandas loads on first use
 
         return pd.concat([c.assign(energy=k[0], gamma=k[1]) for k, c in self.curves.items()], ignore_index=True)
 
     def plot(self, ax: Axes | None = None, **plot_kwargs: Any) -> Axes:
-        """plot(ax=None, **plot_kwargs) -> ax: ⟨E⟩(t) per point (log y) with the fitted E0·e^{−μγt} dashed."""
+        """Draw ⟨E⟩(t) per point (log y) with the fitted E0·e^{−μγt} dashed; returns the axes."""
         ax = _axes(ax)
         for key in _sorted_keys(self.curves):
             c, f = self.curves[key], self.fits.get(key)

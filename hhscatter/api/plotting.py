@@ -7,8 +7,7 @@ import numpy as np
 
 from hhscatter.api.points import _label
 
-if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
-    import pandas
+if TYPE_CHECKING:  # annotations only: matplotlib is imported when a function runs
     from matplotlib.axes import Axes
 
 

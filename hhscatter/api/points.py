@@ -33,7 +33,7 @@ def _clusters(values: np.ndarray) -> np.ndarray:
 
 
 def split_points(lifetimes):
-    """split_points(lifetimes) -> [((energy, gamma), sub-DataFrame)], sorted by energy then γ.
+    """The ensembles of a lifetimes frame: [((energy, gamma), sub-DataFrame)], sorted by energy then γ.
 
     The ensembles of a lifetimes frame (module doc): by the ``energy`` and
     ``gamma`` columns when present; otherwise by clusters of ``e0`` (relative
@@ -153,7 +153,7 @@ class _PointRows:
         return self.rows[key]
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame, one row per point (sorted by energy, then γ)."""
+        """The rows as a DataFrame, one per point (sorted by energy, then γ)."""
         import pandas as pd  # deferred: pandas loads on first use
 
         return pd.DataFrame([self.rows[k] for k in _sorted_keys(self.rows)])

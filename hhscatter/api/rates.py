@@ -58,7 +58,7 @@ class SurvivalCurves:
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
+        """The curves as one DataFrame: energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd  # deferred: pandas loads on first use
 
         parts = [pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
@@ -66,7 +66,7 @@ class SurvivalCurves:
         return pd.concat(parts, ignore_index=True)
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
-        """plot(ax=None, **kwargs) -> ax: :func:`plot_survival` of these curves."""
+        """Draw these curves with :func:`plot_survival`; returns the axes."""
         return plot_survival(self, ax=ax, **kwargs)
 
 
@@ -156,7 +156,7 @@ class EscapeRates:
         return self.results[key]
 
     def to_frame(self) -> pandas.DataFrame:
-        """to_frame() -> DataFrame, one row per point.
+        """The rates as a DataFrame, one row per point.
 
         Columns: energy, gamma, n, kappa, kappa_err (1σ: spread of the 4 window
         fits and statistics), kappa_stat, kappa_spread, tau0, t_stop, windows
@@ -188,7 +188,7 @@ class EscapeRates:
         return pd.DataFrame(rows)
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
-        """plot(ax=None, **kwargs) -> ax: :func:`plot_escape_rates` of these rates."""
+        """Draw these rates with :func:`plot_escape_rates`; returns the axes."""
         return plot_escape_rates(self, ax=ax, **kwargs)
 
 
@@ -263,7 +263,7 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
 
 def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any = None, *,
                     allow_partial: bool = False):
-    """stream_survival(run, t_grid, filters=None) -> SurvivalCurve(t, P, P_err) of a run's lifetimes at the grid times.
+    """P(t) of a run's lifetimes at the grid times, streamed from its table in bounded memory.
 
     P(t) = Pr(lifetime > t) (paper Eqs. (eqn:kappa_hyperbolic), (eqn:kappa_nonhyperbolic)) streamed over the run's
     lifetimes table in record batches (:func:`hhscatter.data.read.iter_survival_batches`) into

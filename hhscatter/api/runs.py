@@ -7,7 +7,7 @@ from hhscatter.data.store import Store
 
 
 def run_scene(run) -> dict:
-    """run_scene(run) -> the scene dict a run directory was written with (``scene.json``; infinities decoded).
+    """The scene a run directory was written with, as a dict (``scene.json``; infinities decoded).
 
     Raises ValueError if ``run`` holds no ``scene.json`` (not a run of :func:`hhscatter.simulate`).
     """

@@ -268,7 +268,7 @@ HAMILTON_ONLY = Layout(4, None, None, None, 0, 1.0)
 def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     """build_escape_only_batch(scene, batch_size, callback, tol=None) -> taylor_adaptive_batch: Hamilton's
     equations alone (x, y, px, py: no clock, no parameters) with the scene's conservative escape event, its
-    callback ``callback``: the minimal driver of ``make bench-engine`` (hhscatter.bench.engine.yardstick),
+    callback ``callback``: the minimal driver of ``make bench-engine`` (benchmarks/engine.py, yardstick),
     which censors with its own propagation bound. The event is the engine's declaration, so both integrate
     the same escape; ``scene`` must be conservative and without a follow."""
     import heyoka as hy  # deferred: heyoka loads on first use

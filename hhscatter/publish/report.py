@@ -2,7 +2,7 @@
 
 ``build_report(scale='quick', out=None)`` reads what the studies left on disk
 (``studies/<name>/out/<scale>/<name>.json`` and ``<name>.png``; the benchmark
-summary under ``studies/bench/out/``) and writes the report as Markdown
+summary under ``benchmarks/out/``) and writes the report as Markdown
 beside its PNG files and, from the same Markdown rendered by Python-Markdown,
 one self-contained HTML file (figures embedded as data URIs). It computes no
 physics: every number comes from a study's numbers JSON, so the report and
@@ -179,9 +179,9 @@ BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
 
 
 def _bench(root: Path, name: str = "bench"):
-    """_bench(root, name) -> (summary.md or None, [png]) of the full-scale benchmark/stress output (else the
-    copy committed in docs/benchmarks/assets/<name>/)."""
-    for out in (root / name / "out" / "full", root.parent / "docs" / "benchmarks" / "assets" / name):
+    """The summary.md (or None) and PNGs of the full-scale benchmark/stress output of the repository of the studies
+    folder ``root`` (``benchmarks/out/<name>/full/``), else of the copy committed in docs/benchmarks/assets/<name>/."""
+    for out in (root.parent / "benchmarks" / "out" / name / "full", root.parent / "docs" / "benchmarks" / "assets" / name):
         md = out / "summary.md"
         if md.exists():
             return md, sorted(out.glob("*.png"))

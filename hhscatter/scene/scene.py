@@ -68,7 +68,7 @@ UNUSED_RADIUS = 0.5
 #: the initial-condition regions of a scene (hhscatter.scene.ics)
 REGIONS = ("disk", "well", "square")
 #: the momentum conventions of region ICs (hhscatter.scene.ics): 'tangential' on the section ṙ = 0, φ̇ > 0 (the
-#: authors' goodICs; the default, and the only one of the first versions), 'random' uniform in direction on the circle
+#: authors' goodICs; the default), 'random' uniform in direction on the circle
 MOMENTA = ("tangential", "random")
 
 
@@ -545,9 +545,9 @@ class Scene:
             d["follow"] = {"radii": list(self.follow.radii)}
         if not self.continue_settled:
             del d["continue_settled"]
-        if self.momentum == "tangential":  # the only convention before; hashes of older scenes kept
+        if self.momentum == "tangential":  # the default: left out of the hash, so older scenes keep theirs
             del d["momentum"]
-        if self.system is None:  # Hénon–Heiles with linear drag, as before; hashes kept
+        if self.system is None:  # Hénon–Heiles with linear drag, the default: left out of the hash
             del d["system"]
         else:  # ω and λ are Hénon–Heiles' keys: a system carries its own parameters
             d["system"] = dict(self.system, params=dict(self.system["params"]))

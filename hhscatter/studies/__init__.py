@@ -5,8 +5,7 @@ A study is one folder ``studies/<name>/`` (adding a study is making a folder):
 ``study.toml``  its parameters, the one place they live, with ``[about]`` (what it
                 is) and ``[needs]`` (the studies whose published outputs it reads:
                 the one declared dependency graph, :mod:`hhscatter.studies.graph`);
-``study.py``    its three stages (the module ``hhscatter.studies.<name>.study``: the
-                study folders are subpackages of this package);
+``study.py``    its three stages (loaded from the folder by path, :func:`stage_module`);
 ``figure.py``   its figure code; ``page.md`` its page of the docs;
 ``out/<scale>/`` what it makes.
 
@@ -58,7 +57,6 @@ from hhscatter.studies.study import (
     load_conventions,
     load_study,
     missing_upstream,
-    outputs_root,
     simulate_inputs,
     stage_module,
     studies_root,
@@ -75,7 +73,6 @@ __all__ = [
     "load_conventions",
     "load_study",
     "missing_upstream",
-    "outputs_root",
     "run_stage",
     "simulate_inputs",
     "stage_module",
@@ -86,7 +83,7 @@ __all__ = [
 
 def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
               root: Path | None = None):
-    """run_stage(name, stage, scale='quick', workers=None) -> None; stage in simulate/analyze/plot/all."""
+    """Run one stage of a study (simulate, analyze, plot, or all three) at a scale, recording its cost."""
     if stage not in (*STAGES, "all"):
         raise StudyError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
     study = load_study(name, scale, root=root)
@@ -106,7 +103,7 @@ def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None
 
 
 def checked_raw_runs(study) -> dict:
-    """checked_raw_runs(study) -> {key: {scene_hash, orbits, complete}} of the raw runs analyze may read.
+    """The raw runs analyze may read, {key: {scene_hash, orbits, complete}}, each checked.
 
     StudyError (exit 2, before any analysis) if the simulate stage did not finish for the current
     study.toml (``raw/done.json`` missing, or made from another configuration), or if a raw run it made

@@ -22,6 +22,7 @@ any Python ≥ 3.11 before a virtual environment exists.
 """
 from __future__ import annotations
 
+import os
 import sys
 import tomllib
 from dataclasses import dataclass, field
@@ -58,9 +59,26 @@ class StudyInfo:
         return not self.paper
 
 
+#: names a studies folder explicitly (what ``hhscatter study --studies DIR`` sets)
+ROOT_ENV = "HHSCATTER_STUDIES"
+
+
 def default_root() -> Path:
-    """The repository's ``studies/`` folder (this file is hhscatter/studies/graph.py)."""
-    return Path(__file__).resolve().parents[2] / "studies"
+    """The studies folder a command works on: ``$HHSCATTER_STUDIES`` when set, else ``studies/`` of the repository
+    the command runs in (the working directory or its nearest parent with a ``studies/<name>/study.toml``).
+
+    Never the folder of the installed code: a second clone using the first clone's virtual environment reads its
+    own study files. GraphError when there is none.
+    """
+    env = os.environ.get(ROOT_ENV)
+    if env:
+        return Path(env)
+    cwd = Path.cwd()
+    for d in (cwd, *cwd.parents):
+        if any((d / "studies").glob("*/study.toml")):
+            return d / "studies"
+    raise GraphError(f"no studies folder in {cwd} or above it: run from a repository with studies/<name>/study.toml, "
+                     f"or name the folder (hhscatter study --studies DIR, or {ROOT_ENV}=DIR)")
 
 
 def _read_toml(path: Path) -> dict:

@@ -6,11 +6,12 @@
 from __future__ import annotations
 
 import copy
-import importlib
+import importlib.util
 import json
 import os
 import sys
 import tomllib
+import types
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,10 +25,10 @@ from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
 from hhscatter.scene.schema import (
     apply_convention,
-    typed_params,
-    typed_value,
     did_you_mean,
     merge_tables,
+    typed_params,
+    typed_value,
     validate_conventions_file,
     validate_study_file,
 )
@@ -54,30 +55,16 @@ def dev_fallback_enabled() -> bool:
 
 
 def studies_root() -> Path:
-    """studies_root() -> Path of the ``studies/`` folder (env ``HHSCATTER_STUDIES`` overrides)."""
-    env = os.environ.get("HHSCATTER_STUDIES")
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[2] / "studies"
-
-
-def outputs_root(root: Path) -> Path:
-    """outputs_root(root) -> the folder under which the studies of ``root`` write ``<name>/out/<scale>/``.
-
-    ``root`` itself, except for the repository's own ``studies/`` folder used from another directory than the
-    repository: then ``./studies`` of the current directory, so that ``hhscatter study …`` run elsewhere
-    (an installed package, a notebook's folder) never writes into the source tree. From the repository root,
-    as ``make`` runs it, the outputs are the study folders' own ``out/`` as before.
-    """
-    own = Path(__file__).resolve().parents[2] / "studies"
-    root = Path(root)
-    if root.resolve() == own and Path.cwd().resolve() != own.parent:
-        return Path.cwd() / "studies"
-    return root
+    """The studies folder commands work on: ``$HHSCATTER_STUDIES`` when set, else ``studies/`` of the repository the
+    command runs in (the working directory or its nearest parent holding one); StudyError when there is none."""
+    try:
+        return _graph_default_root()
+    except GraphError as exc:
+        raise StudyError(str(exc)) from None
 
 
 def study_names(root: Path | None = None) -> list[str]:
-    """study_names(root=None) -> names of the study folders (with a study.toml), each after the studies it needs."""
+    """The names of the study folders (with a study.toml), each after the studies it needs."""
 
     try:
         return [s.name for s in studies(root if root is not None else studies_root())]
@@ -150,8 +137,8 @@ class Study:
 
     @property
     def out(self) -> Path:
-        """``<studies>/<name>/out/<scale>``; see :func:`outputs_root` for a command run outside the repository."""
-        return outputs_root(self.root.parent) / self.name / "out" / self.scale
+        """``<studies>/<name>/out/<scale>``: a study writes into its own folder."""
+        return self.root / "out" / self.scale
 
     @property
     def raw_params(self) -> dict:
@@ -361,7 +348,7 @@ class Study:
 
 
 def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) -> Study:
-    """load_study(name, scale='quick', root=None) -> Study from ``<root>/<name>/study.toml``."""
+    """The study ``<root>/<name>/study.toml`` at a scale, its file checked strictly before any work."""
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
@@ -396,14 +383,12 @@ CONVENTIONS_FILE = "conventions.toml"
 
 
 def conventions_path(root: Path | None = None) -> Path:
-    """conventions_path(root=None) -> ``<root>/conventions.toml``, or the repository's when ``root`` has none."""
-    root = Path(root) if root is not None else studies_root()
-    own = root / CONVENTIONS_FILE
-    return own if own.exists() else _graph_default_root() / CONVENTIONS_FILE
+    """The shared scene conventions of a studies folder: ``<root>/conventions.toml``."""
+    return (Path(root) if root is not None else studies_root()) / CONVENTIONS_FILE
 
 
 def load_conventions(path: Path | None = None) -> dict:
-    """load_conventions(path=None) -> {name: {scene key: value}} of the conventions file, strictly checked."""
+    """The conventions file as {name: {scene key: value}}, strictly checked."""
 
     path = Path(path) if path is not None else conventions_path()
     try:
@@ -426,17 +411,13 @@ def _shown(path: Path) -> str:
 
 def _params_model(name: str, root: Path):
     """The ``Params`` model of the study's module (None: a study folder without code, or without Params)."""
-    try:
-        mod = stage_module(name, root)
-    except ModuleNotFoundError as exc:
-        if exc.name in (f"hhscatter.studies.{name}", f"hhscatter.studies.{name}.study"):
-            return None
-        raise
-    return getattr(mod, "Params", None)
+    if not (Path(root) / name / "study.py").is_file():
+        return None
+    return getattr(stage_module(name, root), "Params", None)
 
 
 def missing_upstream(study: Study) -> list[str]:
-    """missing_upstream(study) -> the declared upstream studies whose numbers JSON (same scale) is not there yet."""
+    """The declared upstream studies whose numbers JSON (same scale) is not there yet."""
     out = []
     for other in sorted(set(study.needs.values())):
         try:
@@ -461,35 +442,37 @@ def simulate_inputs(study, keys) -> dict:
                       "study": {k: study.param(k) for k in sorted(keys)}})
 
 
-# -- the study folders are subpackages of hhscatter.studies: studies/<name>/study.py is
-# hhscatter.studies.<name>.study (the repository's folders first, then those of HHSCATTER_STUDIES if set)
-_PACKAGE = sys.modules[__package__]  # the package being initialised (its __path__ exists before its __init__ runs)
-_OWN_MODULES = tuple(sorted(p.stem for p in Path(__file__).parent.glob("*.py")))  # the framework's own modules
-
-
-def _add_to_path(root: Path) -> None:
-    """Make the study folders of ``root`` importable as ``hhscatter.studies.<name>`` (after the repository's)."""
-    r = str(Path(root).resolve())
-    if r not in _PACKAGE.__path__:
-        _PACKAGE.__path__.append(r)
+# -- a study's code is loaded from its folder by path: studies/<name>/study.py becomes the module
+# hhscatter_study_<name>.study of a package whose path is that folder (so `from .figure import …` works); a folder
+# of the same name in another studies root gets a package of its own
+_LOADED: dict[Path, object] = {}  # study folder (resolved) -> its study module
 
 
 def stage_module(name: str, root: Path | None = None):
-    """stage_module(name, root=None) -> the module ``studies/<name>/study.py`` (``hhscatter.studies.<name>.study``).
+    """The module ``<root>/<name>/study.py`` (default root: :func:`studies_root`), loaded from that file.
 
-    A study folder is a namespace package inside ``hhscatter.studies`` (this
-    package's ``__path__`` holds the studies root), so its modules import each
-    other relatively (``from .figure import …``) and the library absolutely.
-    The repository's study folders come first; a folder that exists only in
-    ``root`` is found there.
+    The study folder is a package of its own (``hhscatter_study_<name>``), so its modules import each other
+    relatively (``from .figure import …``) and the library absolutely. Loaded once per folder.
     """
-
-    if name in _OWN_MODULES:
-        raise StudyError(f"a study cannot be named {name!r}: hhscatter.studies.{name} is part of the framework")
-    if root is not None:
-        _add_to_path(root)
-    return importlib.import_module(f"hhscatter.studies.{name}.study")
-
-
-_add_to_path(_graph_default_root())
-_add_to_path(studies_root())
+    folder = ((Path(root) if root is not None else studies_root()) / name).resolve()
+    if folder in _LOADED:
+        return _LOADED[folder]
+    path = folder / "study.py"
+    if not path.is_file():
+        raise StudyError(f"{_shown(path)} is missing: a study folder holds its study.toml and study.py")
+    pkg_name = f"hhscatter_study_{''.join(c if c.isalnum() else '_' for c in name)}"
+    if pkg_name in sys.modules:  # a study of that name from another folder is loaded already
+        pkg_name = f"{pkg_name}_{len(_LOADED)}"
+    pkg = types.ModuleType(pkg_name, f"the study folder {folder}")
+    pkg.__path__ = [str(folder)]
+    sys.modules[pkg_name] = pkg
+    spec = importlib.util.spec_from_file_location(f"{pkg_name}.study", path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod  # (dataclasses look their module up while the file executes)
+    try:
+        spec.loader.exec_module(mod)
+    except BaseException:
+        del sys.modules[spec.name], sys.modules[pkg_name]
+        raise
+    _LOADED[folder] = mod
+    return mod

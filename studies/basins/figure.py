@@ -138,7 +138,7 @@ def _panel_entropy_by_box(ax, recs):
 
 def _panel_uncertainty(ax, uncertainty, per):
     """Panel (a): f(ε) on log–log axes with the fitted power laws over their ε ranges."""
-    for k, ((E, g), u) in enumerate(uncertainty.groupby(["energy", "gamma"])):
+    for (E, g), u in uncertainty.groupby(["energy", "gamma"]):
         ok = u.k > 0
         err = np.vstack([u.f[ok] - u.f_lo[ok], u.f_hi[ok] - u.f[ok]])
         line = ax.errorbar(u.eps[ok], u.f[ok], yerr=err, fmt="o", ms=3, label=f"$E_0={E:g}, \\gamma={g:g}$")

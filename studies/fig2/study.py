@@ -1,47 +1,42 @@
 """Study fig2 — paper Fig. 2: P(t), κ0(E) with its piecewise law, and κ from the c-measure.
 
-Stages (``hhscatter study fig2 simulate|analyze|plot [--scale S]``); all
-parameters in ``studies/fig2/study.toml``.
+``simulate``: per grid energy a pilot fixes t_max (:func:`~hhscatter.analysis.survival.escape_rate.choose_t_max`),
+then the κ(E) run (``grid_E…``; the authors' square ICs too at ``square_energies``, ``sq_grid_E…``); the Fig. 2a
+runs (``pt_E…``, t_max = ``pt_t_max`` so that the sticky tail shows); the c-measure runs (``cm_E…``): every section
+crossing in the window :func:`~hhscatter.analysis.survival.summaries.cmeasure_windows` makes of the grid run's κ
+and τ0, orbits run to ``cm_t_max`` so that KAM-trapped ones are recognised. The choices go to
+``raw/fig2_choices.json``.
 
-``simulate(study, workers=None, progress=True)``
-    1. κ(E) grid: for every E in ``grid_energies`` a pilot (raw ``pilot_E0.175``,
-       ``pilot_n`` orbits, t_max = ``pilot_t_max``) fixes the main run's t_max
-       by :func:`hhscatter.analysis.survival.escape_rate.choose_t_max` (bounds the cost
-       of long-lived orbits near E_c and of KAM-trapped orbits), then the main
-       run (raw ``grid_E0.175``, ``grid_n`` orbits).
-    2. Fig. 2a: ``pt_n`` orbits at each of ``pt_energies`` (raw ``pt_E0.23``),
-       t_max = ``pt_t_max`` (5000, paper App. A) so that the sticky tail shows.
-    3. c-measure runs (raw ``cm_E0.30``): κ and τ0 of the grid run at that
-       energy give t_rec = ceil(τ0 + cm_rec_efolds/κ), a sample window
-       [t_rec, t_rec + cm_sample_efolds/κ] and the recording end t_rec +
-       cm_sample_efolds/κ + cm_margin; every section crossing (ṙ = 0, φ̇ > 0)
-       in [t_rec, recording end] is recorded (first_only = False); orbits run
-       to ``cm_t_max`` so that KAM-trapped ones can be recognised (censored).
-
-``analyze(study)``
-    Derived tables (``studies/fig2/out/<scale>/derived/``):
-    ``kappa_energy.parquet`` (one row per grid energy: κ, its error, the 4
-    window estimates, τ0, windows, MLE cross-check, t_max, censored count),
-    ``kappa_fit_curve.parquet`` (fitted laws on a grid of x = E − E_c),
-    ``survival_curves.parquet`` and ``pt_fit_lines.parquet`` (Fig. 2a),
-    ``kappa_cmeasure.parquet`` (κ from Eq. (eqn:kappa_cmeasure_truetime) vs
-    the P(t) κ); numbers in ``fig2.json`` with the paper comparison of a, b, c,
-    E_b, τ*.
-
-``plot(study)``
-    ``fig2.png`` via ``plot_fig2`` of the folder's ``figure.py``.
+``analyze``: κ(E) and its law (``kappa_energy``, ``kappa_fit_curve``), κ(E) under four conventions
+(``kappa_conventions``), Fig. 2a (``survival_curves``, ``pt_fit_lines``), κ from the c-measure
+(``kappa_cmeasure``, Eq. (eqn:kappa_cmeasure_truetime)); numbers in ``fig2.json`` with the paper comparison.
+``plot``: ``fig2.png`` (``figure.py``). Parameters: ``study.toml``.
 """
 from __future__ import annotations
 
 import json
 import math
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 
 from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.analysis.survival.summaries import (
+    cmeasure_windows,
+    kappa_cmeasure_entry,
+    kappa_cmeasure_shifts,
+    kappa_cmeasure_z,
+    kappa_law_curves,
+    kappa_law_summary,
+    rate_row,
+    rate_summary,
+    sticky_tail_summary,
+    survival_tables,
+    tau_star_estimate,
+)
 from hhscatter.run.plan import SCENE_FILE
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
@@ -84,22 +79,22 @@ LIFETIME_COLUMNS = ["traj_id", "e0", "gamma", "outcome", "t_end"]
 
 
 def grid_key(energy: float) -> str:
-    """grid_key(E) -> raw key of the κ(E) run, e.g. 'grid_E0.175'."""
+    """The raw key of the κ(E) run at E, e.g. 'grid_E0.175'."""
     return f"grid_E{energy:.3f}"
 
 
 def pt_key(energy: float) -> str:
-    """pt_key(E) -> raw key of a Fig. 2a run, e.g. 'pt_E0.23'."""
+    """The raw key of the Fig. 2a run at E, e.g. 'pt_E0.23'."""
     return f"pt_E{energy:.2f}"
 
 
 def sq_key(energy: float) -> str:
-    """sq_key(E) -> raw key of the square-IC κ(E) run, e.g. 'sq_grid_E0.175'."""
+    """The raw key of the square-IC κ(E) run at E, e.g. 'sq_grid_E0.175'."""
     return f"sq_{grid_key(energy)}"
 
 
 def grid_n(study, energy: float) -> int:
-    """grid_n(study, E) -> orbits of the κ(E) run at E: [study].grid_n_by_energy if given, else grid_n."""
+    """The orbits of the κ(E) run at E: [study].grid_n_by_energy if given, else grid_n."""
     per = study.params.grid_n_by_energy
     if per is None:
         return study.params.grid_n
@@ -110,31 +105,10 @@ def grid_n(study, energy: float) -> int:
 
 
 def cm_key(energy: float) -> str:
-    """cm_key(E) -> raw key of a c-measure section run, e.g. 'cm_E0.30'."""
+    """The raw key of the c-measure section run at E, e.g. 'cm_E0.30'."""
     return f"cm_E{energy:.2f}"
 
 
-def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds: float, margin: float,
-                     max_shift_efolds: float = 0.0):
-    """cmeasure_windows(κ, τ0, n_rec, n_sample, margin, max_shift=0) -> (t_rec, t_sample_end, t_record_end).
-
-    Times in time units.  t_rec = ceil(τ0 + n_rec/κ): the ensemble is in its
-    exponential regime and relaxed towards μ_c; sample crossings in
-    [t_rec, t_sample_end = t_rec + n_sample/κ]; recording continues to
-    t_record_end = t_sample_end + max_shift/κ + margin, so that the same
-    sample window started up to ``max_shift_efolds``/κ later (convergence
-    check) still sees every sampled crossing's next crossing or exit.
-    """
-    if not (math.isfinite(kappa) and kappa > 0):
-        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
-    t_rec = float(math.ceil(tau0 + rec_efolds / kappa))
-    t_sample_end = t_rec + sample_efolds / kappa
-    return t_rec, float(t_sample_end), float(t_sample_end + max_shift_efolds / kappa + margin)
-
-
-# ---------------------------------------------------------------------------
-# simulate
-# ---------------------------------------------------------------------------
 def _lifetimes(path):
     from hhscatter.data.read import read_lifetimes
 
@@ -146,13 +120,9 @@ def _t_max_choice(study, pilot_dir, n):
     from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
-    return choose_t_max(
-        t_end, obs, n,
-        min_survivors=study.params.min_survivors,
-        margin_efolds=study.params.margin_efolds,
-        t_min=study.params.t_max_min,
-        t_cap=study.params.t_max_cap,
-    )
+    p = study.params
+    return choose_t_max(t_end, obs, n, min_survivors=p.min_survivors, margin_efolds=p.margin_efolds,
+                        t_min=p.t_max_min, t_cap=p.t_max_cap)
 
 
 def _grid_rate(study, energy, lifetimes=None):
@@ -164,11 +134,10 @@ def _grid_rate(study, energy, lifetimes=None):
 
 
 def _cm_windows(study, energy):
-    r = _grid_rate(study, energy)
-    shifts = list(study.params.cm_start_shifts)
-    return r, cmeasure_windows(r.kappa, r.tau0, study.params.cm_rec_efolds,
-                               study.params.cm_sample_efolds, study.params.cm_margin,
-                               max(shifts))
+    """κ of the grid run at E and the c-measure window it gives (t_rec, t_sample_end, t_record_end)."""
+    r, p = _grid_rate(study, energy), study.params
+    return r, cmeasure_windows(r.kappa, r.tau0, p.cm_rec_efolds, p.cm_sample_efolds, p.cm_margin,
+                               max(p.cm_start_shifts))
 
 
 def _choices_path(study):
@@ -176,11 +145,8 @@ def _choices_path(study):
 
 
 def simulate(study, workers=None, progress=True):
-    """simulate(study, workers=None, progress=True) -> None; pilots, κ(E) grid, Fig. 2a and c-measure runs.
-
-    The t_max of every grid run and the c-measure windows actually used are
-    written to ``raw/fig2_choices.json``.
-    """
+    """Run the pilots, the κ(E) grid, Fig. 2a and the c-measure runs; the t_max and windows chosen go to
+    ``raw/fig2_choices.json``."""
     from dataclasses import asdict
 
     from hhscatter.studies import write_json_atomic
@@ -224,20 +190,8 @@ def simulate(study, workers=None, progress=True):
     write_json_atomic(_choices_path(study), choices)
 
 
-# ---------------------------------------------------------------------------
-# analyze
-# ---------------------------------------------------------------------------
 def _scene_of(path):
     return json.loads((path / SCENE_FILE).read_text())["scene"]
-
-
-def _ve(v, e):
-    return {"value": float(v), "err": float(e)}
-
-
-def _plot_grid(t_last, n_lin=4001, n_log=600):
-    """Times at which P(t) is tabulated for the figure: linear and logarithmic, up to t_last."""
-    return np.unique(np.concatenate([np.linspace(0.0, t_last, n_lin), np.geomspace(0.1, t_last, n_log)]))
 
 
 def _analyze_grid(study):
@@ -257,11 +211,7 @@ def _analyze_grid(study):
         runs[energy] = (lt, r)  # read and fitted once: the conventions and the c-measure use them again
         t_max = float(_scene_of(path)["t_max"])
         rows.append({
-            "energy": energy, "x": energy - E_C, "kappa": r.kappa, "kappa_err": r.kappa_err,
-            "kappa_spread": r.kappa_spread, "kappa_stat": r.kappa_stat,
-            **{f"kappa_w{i + 1}": f.kappa for i, f in enumerate(r.fits)},
-            **{f"window_w{i + 1}": f"{w[0]:.3f}-{w[1]:.3f}" for i, w in enumerate(r.windows)},
-            "tau0": r.tau0, "t_stop": r.t_stop, "kappa_mle": r.mle.kappa, "kappa_mle_err": r.mle.kappa_err,
+            "energy": energy, "x": energy - E_C, **rate_row(r),
             "n": len(lt), "t_max": t_max, "t_max_reason": tch["reason"],
             "kappa_pilot": tch["kappa_pilot"] if tch["kappa_pilot"] is not None else math.nan,
             "n_censored": int((lt["outcome"] == "censored").sum()),
@@ -281,40 +231,6 @@ def _analyze_grid(study):
     return df, fit, sep, runs
 
 
-def _fit_json(fit):
-    boot = fit.boot_err if fit.boot_err else (math.nan,) * 4
-    out = {}
-    for i, name in enumerate(("a", "b", "c", "E_b")):
-        cov_err = getattr(fit, f"{name}_err")
-        out[name] = {"value": float(getattr(fit, name)), "err": float(max(cov_err, boot[i])),
-                     "err_cov": float(cov_err), "err_boot": float(boot[i])}
-    out.update(continuous=fit.continuous, chi2=fit.chi2, dof=fit.dof,
-               chi2_per_dof=fit.chi2 / fit.dof if fit.dof > 0 else math.nan)
-    return out
-
-
-def _fit_curve_table(fit, sep, x_max, E_C):
-    import pandas as pd
-
-    x = np.linspace(0.0, x_max * 1.03, 400)
-    xb = fit.E_b - E_C
-    xs = sep.E_b - E_C
-    parts = []
-    for name, f, lo_hi in (("continuous", fit, xb), ("separate", sep, xs)):
-        nonlin = x <= lo_hi * 1.15
-        lin = x >= lo_hi * 0.85
-        parts.append(pd.DataFrame({"model": name, "regime": "nonlinear", "x": x[nonlin],
-                                   "kappa": f.a * x[nonlin] ** 2 + f.b * x[nonlin]}))
-        parts.append(pd.DataFrame({"model": name, "regime": "linear", "x": x[lin], "kappa": f.c * x[lin]}))
-    # the paper's two laws (Fig. 2b caption) for comparison
-    xp = PAPER["E_b"] - E_C
-    parts.append(pd.DataFrame({"model": "paper", "regime": "nonlinear", "x": x[x <= xp * 1.15],
-                               "kappa": PAPER["a"] * x[x <= xp * 1.15] ** 2 + PAPER["b"] * x[x <= xp * 1.15]}))
-    parts.append(pd.DataFrame({"model": "paper", "regime": "linear", "x": x[x >= xp * 0.85],
-                               "kappa": PAPER["c"] * x[x >= xp * 0.85]}))
-    return pd.concat(parts, ignore_index=True)
-
-
 def _analyze_pt(study):
     """Fig. 2a: P(t) per energy of pt_energies: fits, curves and fitted lines (derived tables), numbers, comparison."""
     import pandas as pd
@@ -323,18 +239,18 @@ def _analyze_pt(study):
     curves, lines, numbers = [], [], {}
     for energy in study.params.pt_energies:
         t_end, obs, t_max, r, tail = _pt_fits(study, pt_key(energy))
-        curve, line = _pt_curves(energy, t_end, obs, r)
+        curve, line = survival_tables(energy, t_end, obs, r)
         curves.append(curve)
         lines.append(line)
-        entry = _pt_entry(t_end, t_max, r, tail)
+        entry = rate_summary(t_end.size, t_max, r, tail.n_trapped)
         if tail.tail is not None:
-            line, more = _sticky_tail(energy, t_end, obs, t_max, tail)
+            line, more = sticky_tail_summary(energy, t_end, obs, t_max, tail)
             lines.append(line)
             entry.update(more)
         else:
             entry.update(tail_detected=False)
         numbers[pt_key(energy)] = entry
-        _compare_pt(study, energy, r, tail, E_C)
+        compare_pt(study, energy, r, tail, E_C)
     study.write_table(pd.concat(curves, ignore_index=True), "survival_curves.parquet",
                       description="Kaplan–Meier P(t) (all orbits) and P_esc(t) (orbits leaving before t_max), Fig. 2a")
     study.write_table(pd.concat(lines, ignore_index=True), "pt_fit_lines.parquet",
@@ -358,65 +274,7 @@ def _pt_fits(study, key: str):
     return t_end, obs, t_max, r, tail
 
 
-def _pt_curves(energy: float, t_end, obs, r):
-    """The curves of Fig. 2a: Kaplan–Meier P(t) of all orbits and of the escaping ones; the fitted exponential."""
-    import pandas as pd
-
-    from hhscatter.analysis.survival.fits import survival_curve
-
-    # P(t) of all orbits (Kaplan–Meier) and of the escaping ones, for the figure
-    t_last = float(np.max(t_end))
-    g = _plot_grid(t_last)
-    km = survival_curve(t_end, obs, g)
-    esc = survival_curve(t_end[obs], np.ones(int(obs.sum()), bool), g)
-    curve = pd.DataFrame({"energy": energy, "t": g, "P": km.P, "P_err": km.P_err,
-                          "P_esc": esc.P, "P_esc_err": esc.P_err})
-    f = r.fits[0]
-    te = np.linspace(0.0, r.t_stop * 1.25, 300)
-    return curve, pd.DataFrame({"energy": energy, "kind": "exponential", "t": te, "P": f.predict(te)})
-
-
-def _pt_entry(t_end, t_max, r, tail) -> dict:
-    """The numbers of one energy: κ (window fits and MLE), τ0, the windows, the trapped fraction."""
-    return {
-        "n": int(t_end.size), "t_max": t_max, "n_trapped": tail.n_trapped,
-        "trapped_fraction": tail.n_trapped / t_end.size,
-        "kappa": _ve(r.kappa, r.kappa_err), "kappa_windows": [fi.kappa for fi in r.fits],
-        "kappa_mle": _ve(r.mle.kappa, r.mle.kappa_err), "tau0": r.tau0, "t_stop": r.t_stop,
-        "windows": [list(w) for w in r.windows], "f0": r.fits[0].f0,
-        "t_floor": r.window_choice.t_floor,
-    }
-
-
-def _sticky_tail(energy: float, t_end, obs, t_max: float, tail):
-    """The sticky tail: its power-law line, its numbers (z, τ*, f*) and the bounds of z beyond it up to t_max."""
-    import pandas as pd
-
-    from hhscatter.analysis.survival.escape_rate import power_law_exponent_mle
-
-    tl = tail.tail
-    tp = np.geomspace(tl.window[0] * 0.6, tl.window[1] * 1.5, 200)
-    line = pd.DataFrame({"energy": energy, "kind": "power_law", "t": tp, "P": tl.predict(tp)})
-    entry = dict(
-        tail_detected=True, z=_ve(tl.z, tl.z_err), z_mle=_ve(tl.z_mle, tl.z_mle_err),
-        tail_window=list(tl.window), f_star=tl.f_star, tau_c=tl.window[0],
-        tau_star=tail.tau_star if math.isfinite(tail.tau_star) else None,
-        tau_star_definition="crossing of the fitted exponential and power law (crossover_time)"
-        if math.isfinite(tail.tau_star) else "the laws do not cross; use tau_c, the likelihood change point",
-        hazard_exponent=tl.hazard_exponent, delta_aic_split=tl.delta_aic_split,
-    )
-    # beyond the tail window, down to t_max: the last (sticky) escapes, below the tail's survivor floor
-    # the orbits still inside at t_max are either on KAM tori (never leave: remove them, z too high
-    # if some are merely sticky) or sticky (censored: keep them at risk, z too low): both bounds
-    lo = power_law_exponent_mle(t_end, obs, tl.window[1], t_max)
-    hi = power_law_exponent_mle(t_end[obs], np.ones(int(obs.sum()), bool), tl.window[1], t_max)
-    entry.update(late_tail={"t_window": [tl.window[1], t_max], "n_events": lo.n_events,
-                            "z_mle_trapped_censored": _ve(lo.kappa, lo.kappa_err),
-                            "z_mle_trapped_removed": _ve(hi.kappa, hi.kappa_err)})
-    return line, entry
-
-
-def _compare_pt(study, energy: float, r, tail, E_C: float) -> None:
+def compare_pt(study, energy: float, r, tail, E_C: float) -> None:
     """Compare with the paper: κ with its Fig. 2b law, τ* with its value, z (not in its text)."""
     paper_k = PAPER["a"] * (energy - E_C) ** 2 + PAPER["b"] * (energy - E_C) if energy < PAPER["E_b"] \
         else PAPER["c"] * (energy - E_C)
@@ -424,13 +282,7 @@ def _compare_pt(study, energy: float, r, tail, E_C: float) -> None:
                   note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)")
     if tail.tail is not None:
         tl = tail.tail
-        if math.isfinite(tail.tau_star):
-            # systematic error of τ*: distance between its two definitions (crossing, change point)
-            ts, ts_err = tail.tau_star, abs(tail.tau_star - tl.window[0])
-            note = "crossing of the exponential and power-law fits; err = |crossing − change point τ_c|"
-        else:
-            ts, ts_err = tl.window[0], None
-            note = "the fitted laws do not cross: τ* = τ_c, the likelihood change point of the hazard"
+        ts, ts_err, note = tau_star_estimate(tail)
         verdict = None if ts_err else ("agrees within 20 %" if abs(ts / PAPER["tau_star"] - 1) <= 0.2
                                        else "differs")
         study.compare(f"tau* (E0={energy:.2f})", ts, ts_err, PAPER["tau_star"], unit="time", note=note,
@@ -446,7 +298,9 @@ def _analyze_cmeasure(study, grid_runs):
     rows = []
     for energy in study.params.cm_energies:
         rows += _cmeasure_rows(study, energy, choices[cm_key(energy)], grid_runs, E_C)
-    df = _cmeasure_table(rows)
+    import pandas as pd
+
+    df = kappa_cmeasure_z(pd.DataFrame(rows))
     study.write_table(df, "kappa_cmeasure.parquet",
                       description="κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), vs κ from P(t)")
     df.to_csv(study.derived("kappa_cmeasure.csv"), index=False, float_format="%.6g")  # the same, for reading
@@ -455,10 +309,6 @@ def _analyze_cmeasure(study, grid_runs):
 
 def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> list:
     """κ from the c-measure of one energy's run per start shift (bootstrap over orbits), with κ from P(t)."""
-    from hhscatter.analysis.survival.cmeasure import (
-        cmeasure_sample_from_sections,
-        kappa_from_cmeasure,
-    )
     from hhscatter.analysis.survival.escape_rate import escape_rate
     from hhscatter.analysis.survival.fits import observed_from_outcome
     from hhscatter.data.read import read_lifetimes, read_sections
@@ -474,42 +324,12 @@ def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> lis
     sec = read_sections(study.raw(key), columns=["traj_id", "t"])
     own = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
                       min_survivors=study.params.min_survivors)
-    span = t_samp - t_rec
-    rows = []
-    for shift in study.params.cm_start_shifts:
-        t0 = t_rec + shift / ch["kappa"]
-        t1 = t0 + span
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
-                sec, lt, t0, t1, t_record_end=t_rec_end, drop_censored=True, with_orbits=True)
-        if T.size + n_exit == 0:
-            continue
-        # bootstrap over orbits (the independent unit), not over their correlated section crossings
-        k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=study.params.n_boot,
-                                rng=study.params.fit_seed)
-        rows.append({
-            "energy": energy, "x": energy - E_C, "shift_efolds": shift, "t_from": t0, "t_to": t1,
-            "t_record_end": t_rec_end, "n_samples": k.n_samples, "n_exit": k.n_exit, "n_undetermined": n_und,
-            "mu_exit": k.mu_exit, "T_mean": float(T.mean()) if T.size else math.nan,
-            "T_max": float(T.max()) if T.size else math.nan,
-            "kappa_cm": k.kappa, "kappa_cm_err": k.kappa_err, "kappa_cm_err_delta": k.kappa_err_delta,
-            "kappa_pt_grid": r.kappa, "kappa_pt_grid_err": r.kappa_err,
-            "kappa_pt_same_run": own.kappa, "kappa_pt_same_run_err": own.kappa_err,
-            "n_trapped_dropped": int((lt["outcome"] == "censored").sum()),
-        })
-    return rows
-
-
-def _cmeasure_table(rows: list):
-    """The c-measure table: its rows and the z-scores of κ_cm against κ from P(t) (grid run, same run)."""
-    import pandas as pd
-
-    df = pd.DataFrame(rows)
-    df["z_vs_grid"] = (df["kappa_cm"] - df["kappa_pt_grid"]) / np.hypot(df["kappa_cm_err"], df["kappa_pt_grid_err"])
-    df["z_vs_same_run"] = (df["kappa_cm"] - df["kappa_pt_same_run"]) / np.hypot(df["kappa_cm_err"],
-                                                                                df["kappa_pt_same_run_err"])
-    return df
+    rows = kappa_cmeasure_shifts(sec, lt, t_rec, t_samp - t_rec, study.params.cm_start_shifts, ch["kappa"],
+                                 t_rec_end, n_boot=study.params.n_boot, seed=study.params.fit_seed)
+    n_trapped = int((lt["outcome"] == "censored").sum())
+    return [{"energy": energy, "x": energy - E_C, **row, "kappa_pt_grid": r.kappa, "kappa_pt_grid_err": r.kappa_err,
+             "kappa_pt_same_run": own.kappa, "kappa_pt_same_run_err": own.kappa_err, "n_trapped_dropped": n_trapped}
+            for row in rows]
 
 
 def _cmeasure_numbers(study, df) -> dict:
@@ -522,18 +342,8 @@ def _cmeasure_numbers(study, df) -> dict:
                       unit="1/time", verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
                       note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
                            f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper")
-        numbers[cm_key(row["energy"])] = {
-            "energy": row["energy"], "t_window": [row["t_from"], row["t_to"]], "t_record_end": row["t_record_end"],
-            "n_samples": int(row["n_samples"]), "n_exit": int(row["n_exit"]),
-            "n_undetermined": int(row["n_undetermined"]), "mu_exit": row["mu_exit"],
-            "kappa_cm": _ve(row["kappa_cm"], row["kappa_cm_err"]),
-            "kappa_pt_grid": _ve(row["kappa_pt_grid"], row["kappa_pt_grid_err"]),
-            "kappa_pt_same_run": _ve(row["kappa_pt_same_run"], row["kappa_pt_same_run_err"]),
-            "z_vs_grid": row["z_vs_grid"], "z_vs_same_run": row["z_vs_same_run"],
-            "kappa_cm_later_starts": {f"+{s:g}/kappa": v for s, v in
-                                      df[(df["energy"] == row["energy"]) & (df["shift_efolds"] > 0)]
-                                      [["shift_efolds", "kappa_cm"]].itertuples(index=False)},
-        }
+        later = df[(df["energy"] == row["energy"]) & (df["shift_efolds"] > 0)]
+        numbers[cm_key(row["energy"])] = kappa_cmeasure_entry(row, later)
     return numbers
 
 
@@ -556,14 +366,13 @@ def _analyze_conventions(study, grid_runs):
     import pandas as pd
 
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
     from hhscatter.analysis.survival.kappa_conventions import (
-        escape_rate_p_levels,
+        convention_rows,
+        fit_laws,
         law_spread,
-        plateau_rate,
         stable_energies,
     )
-    from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
-    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 
     E_C = study.model.critical_energy
     p_hi, p_lo = study.params.p_levels
@@ -578,16 +387,8 @@ def _analyze_conventions(study, grid_runs):
             runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv))
         for region, (lt, res) in runs.items():
             t_end, obs = lifetimes_to_arrays(lt)
-            rates = {"plateau": plateau_rate(res, t_end, obs, max_bias=max_bias),
-                     "plevel": escape_rate_p_levels(t_end, obs, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)}
-            for rule, r in rates.items():
-                rows.append({"energy": energy, "x": energy - E_C, "convention": f"{region}_{rule}",
-                             "region": region, "windows": rule, "n": int(t_end.size),
-                             "n_escaped_at_start": int(((t_end == 0) & obs).sum()),
-                             "kappa": r.kappa, "kappa_err": r.kappa_err, "kappa_stat": r.kappa_stat,
-                             "kappa_spread": r.kappa_spread, "t_lo": r.t_lo, "t_hi": r.t_hi,
-                             "trapped_fraction": r.trapped_fraction, "bias_at_end": r.bias_at_end,
-                             "defined": bool(r.defined), "reason": r.reason})
+            rows += [{"energy": energy, "x": energy - E_C, "convention": f"{region}_{row['windows']}", "region": region,
+                      **row} for row in convention_rows(t_end, obs, res, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)]
     table = pd.DataFrame(rows)
     stab = stable_energies(table, rel_tol=study.params.stable_rel_tol)
     table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
@@ -595,20 +396,8 @@ def _analyze_conventions(study, grid_runs):
                       description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
                                   "defined = False where the trapped plateau makes κ ill-defined")
     stable = set(stab.loc[stab["stable"], "energy"])
-    fits, fit_info = {}, {}
-    seed, n_boot = study.params.fit_seed, study.params.n_boot
-    for name, *_ in CONVENTIONS:
-        d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(stable)]
-        fit_info[name] = {"energies": [float(e) for e in d["energy"]]}
-        if len(d) < 5:  # a, b and the break (c = a x_b + b) need points on both sides
-            fit_info[name]["fit"] = None
-            continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            f = fit_kappa_energy(d["energy"], d["kappa"], d["kappa_err"], E_C, continuous=True,
-                                 n_boot=n_boot, rng=seed)
-        fits[name] = f
-        fit_info[name]["fit"] = _fit_json(f)
+    fits, fit_info = fit_laws(table, [name for name, *_ in CONVENTIONS], stable, E_C, n_boot=study.params.n_boot,
+                              seed=study.params.fit_seed)
     law = law_spread(fits) if fits else {}
     numbers = {
         "conventions": {name: label for name, _, _, label in CONVENTIONS},
@@ -624,12 +413,13 @@ def _analyze_conventions(study, grid_runs):
 
 
 def analyze(study):
-    """analyze(study) -> None; derived tables and fig2.json (see the module docstring)."""
+    """Write the derived tables and fig2.json (see the module docstring)."""
     E_C = study.model.critical_energy
     grid_df, fit, sep, grid_runs = _analyze_grid(study)
-    study.write_table(_fit_curve_table(fit, sep, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
+    laws = {"continuous": fit, "separate": sep, "paper": SimpleNamespace(**PAPER)}
+    study.write_table(kappa_law_curves(laws, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
                       description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
-    fj, sj = _fit_json(fit), _fit_json(sep)
+    fj, sj = kappa_law_summary(fit), kappa_law_summary(sep)
     conv_table, _, conv = _analyze_conventions(study, grid_runs)
     units = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
     law = conv["law"]
@@ -691,7 +481,7 @@ def analyze(study):
 
 
 def plot(study):
-    """plot(study) -> None; draws fig2.png from the derived tables and fig2.json."""
+    """Draw fig2.png from the derived tables and fig2.json."""
     import pandas as pd
 
     from .figure import plot_fig2

@@ -70,6 +70,8 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.geometry import distance as dist
+
+from hhscatter.analysis.geometry import paired_distance as pdist
 from hhscatter.analysis.dissipative.decay import time_to_energy
 from hhscatter.scene.scene import MOMENTA
 from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
@@ -154,7 +156,7 @@ def _qualify_our_5b(rows) -> None:
     """Our Fig. 5b (our 5a filtered to the energy band) "differs" only where the authors' own 5b does too.
 
     The paper's claims about 5b are checked in its own construction (AUTHORS); a "differs" of ours that the
-    authors' construction does not reproduce is a difference of our convention only.
+    authors' construction does not reproduce is a difference of our convention only (the verdict rule).
     The authors' rows: 5b against the two references (:func:`_compare_refs_paired`) and 5b against 5a, like for
     like over grid placements (:func:`_compare_verdict`, construction 'cut_offsets').
     """
@@ -222,7 +224,7 @@ VERDICT_QUANTITY = "Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d
 REFS_QUANTITY = "Fig. {s} closer to μ_c^0.30 than to μ_c^0.35, paired Δ = d(μ_c^0.35) − d(μ_c^0.30)"
 
 VERDICT_ROWS = (
-    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction this page used first)", 1),
+    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction before issue 28)", 1),
     ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
     ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
     ("cut_offsets_random", "r < 1 on every set, averaged over grid offsets, momenta in random directions", None),
@@ -234,7 +236,7 @@ VERDICT_ROWS = (
 def _verdict_5b(study, cm_full, E1, ours):
     """The 5b − 5a verdict in every construction of VERDICT_ROWS: debiased Hellinger distances to
     μ_c^{E1} at box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every
-    set, the reference included (:func:`~hhscatter.analysis.geometry.distance.paired_hellinger_difference`). Sets of
+    set, the reference included (:func:`~hhscatter.analysis.geometry.paired_distance.paired_hellinger_difference`). Sets of
     one comparison are cut alike. Returns the JSON record, or None when the sets are too small (tiny scale)."""
     box = study.params.box_headline
     extent = tuple(study.params.extent)
@@ -253,7 +255,7 @@ def _verdict_5b(study, cm_full, E1, ours):
     for key, label, offs in VERDICT_ROWS:
         A, B, R = sets[key]
         try:
-            r = dist.paired_hellinger_difference(
+            r = pdist.paired_hellinger_difference(
                 dist.points(A), dist.points(B), dist.points(R), box, extent, units_a=A["traj_id"].to_numpy(),
                 units_b=B["traj_id"].to_numpy(), units_r=R["traj_id"].to_numpy(), offsets=offs or k,
                 n_boot=n_boot, level=level, seed=seed)
@@ -307,7 +309,7 @@ def _compare_verdict(study, verdict):
 
 def _interval_row(values, level):
     """{value, interval} of replicates: their mean and percentile interval."""
-    m, lo, hi = dist.percentile_interval(values, level)
+    m, lo, hi = pdist.percentile_interval(values, level)
     return {"value": m, "interval": [lo, hi]}
 
 
@@ -334,11 +336,11 @@ def _refs_paired(study, cm_full, sets_ours, E1, E2):
     for key, label, runs, refs in constructions:
         # one seed, one id space: 5a and 5b are the same orbits (ours: 5b ⊂ 5a; the authors': two runs of the same
         # ICs), and so are fig1's two references (the same positions at E1 and E2): each pair is drawn together
-        sets = {s: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "run") for s, df in runs.items()}
-        sets.update({r: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "cm") for r, df in refs.items()})
+        sets = {s: pdist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "run") for s, df in runs.items()}
+        sets.update({r: pdist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "cm") for r, df in refs.items()})
         pairs = [(s, r) for s in runs for r in ("E1", "E2")] + [("E2", "E1")]
         try:
-            curves = dist.paired_hellinger_replicates(sets, pairs, boxes, extent, offsets=p.verdict_offsets,
+            curves = pdist.paired_hellinger_replicates(sets, pairs, boxes, extent, offsets=p.verdict_offsets,
                                                       n_boot=p.verdict_boot, seed=p.seed)
         except ValueError as e:  # too few points (tiny scale)
             rows.append({"construction": key, "label": label, "note": str(e)})
@@ -399,12 +401,12 @@ def _panel_d_paired(study, sets, pg, dtab, E1, cm_E1):
     if len(gammas) < 2:
         return None
     # every γ's run starts from the same ICs (one seed): one draw of the orbits serves all γ (paired across t*)
-    units = {f"a{g:g}": dist.UnitSet(dist.points(sets[(g, "a")]), sets[(g, "a")]["traj_id"].to_numpy(), "run")
+    units = {f"a{g:g}": pdist.UnitSet(dist.points(sets[(g, "a")]), sets[(g, "a")]["traj_id"].to_numpy(), "run")
              for g in gammas}
-    units["E1"] = dist.UnitSet(dist.points(cm_E1), cm_E1["traj_id"].to_numpy(), "cm_E1")
+    units["E1"] = pdist.UnitSet(dist.points(cm_E1), cm_E1["traj_id"].to_numpy(), "cm_E1")
     pairs = [(f"a{g:g}", "E1") for g in gammas]
     try:
-        reps = dist.paired_hellinger_replicates(units, pairs, boxes, tuple(p.extent), offsets=p.verdict_offsets,
+        reps = pdist.paired_hellinger_replicates(units, pairs, boxes, tuple(p.extent), offsets=p.verdict_offsets,
                                                 n_boot=p.verdict_boot, seed=p.seed)
     except ValueError as e:  # too few points (tiny scale)
         return {"note": str(e)}
@@ -772,8 +774,7 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
                       "μ_c^{E1} better than μ_c^{E2}", verdict="agrees" if closer else "differs",
                       note="sliced Wasserstein W1 (units of x, y), bootstrap 1σ")
     # the debiased-Hellinger rows (5a/5b to μ_c^E1 vs μ_c^E2, 5b vs 5a, panel (d)) have paired intervals over
-    # orbits: _compare_refs_paired, _compare_verdict, _compare_panel_d (their split-spread forerunners
-    # are retired)
+    # orbits: _compare_refs_paired, _compare_verdict, _compare_panel_d
     return verdicts
 
 

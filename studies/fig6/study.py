@@ -26,7 +26,7 @@ analyze    inputs (the studies of ``[needs]``, their published outputs only):
            number of free parameters (K energy quantiles at t_ref = τ0,
            per-orbit μ_i from the snapshots, one shared trapped fraction φ).
            For fig4's γ values: the homogeneous fit and the model's τ1
-           (:func:`hhscatter.analysis.dissipative.survival_model.predict_tau1` against fig4's γ = 0
+           (:func:`hhscatter.analysis.dissipative.model_comparison.predict_tau1` against fig4's γ = 0
            curve), τ2 = ln(E0/E_c)/(μγ).  Writes derived tables and fig6.json.
 
            The paper's own constants beside ours (``[study] paper_*``: κ0(E) of
@@ -51,7 +51,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative import mixture
-from hhscatter.analysis.dissipative import survival_model as sm
+from hhscatter.analysis.dissipative import model_comparison as mc
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.analysis.survival.fits import survival_from_lifetimes
 from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
@@ -189,8 +189,8 @@ def _curve(lifetimes, dt):
     return c.t, c.P, c.P_err
 
 
-# the fitting rule, shared with study generality: hhscatter.analysis.dissipative.survival_model
-_fit_points = sm.survival_fit_points
+# the fitting rule, shared with study generality: hhscatter.analysis.dissipative.model_comparison
+_fit_points = mc.survival_fit_points
 
 
 def _fit_row(label, model, hazard, fit, extra):
@@ -206,9 +206,9 @@ def _fit_row(label, model, hazard, fit, extra):
     return row
 
 
-_best = sm.best_fit
-_plateau = sm.plateau_level
-_homogeneous_fits = sm.fit_homogeneous_hazards
+_best = mc.best_fit
+_plateau = mc.plateau_level
+_homogeneous_fits = mc.fit_homogeneous_hazards
 
 
 def _mixture_variants(study):
@@ -361,7 +361,7 @@ def _pair_rows(s: _Setup, t, cur, label, homog, homog_pc, mixes, extra):
         for name, f in models.items():
             fit_rows.append(_fit_row(label, name, h, f, extra))
             cur[f"{name}_{h}"] = f.predict(t)
-        cmp = sm.compare_fits(models).reset_index()
+        cmp = mc.compare_fits(models).reset_index()
         cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
     for h in s.hazards:
         cur[f"{PC}_{h}"] = homog_pc[h].predict(t)
@@ -457,7 +457,7 @@ def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
 # ---------------------------------------------------------------------------
 def _pc_row(ours, theirs, *, pair, E0, gamma, hazard, tau2_ours, tau2_pc) -> dict:
     """One (pair, hazard) row: the fit with the paper's constants beside ours on the same points."""
-    best = sm.better_fit({"ours": ours, PC: theirs})
+    best = mc.better_fit({"ours": ours, PC: theirs})
     row = {"pair": pair, "E0": E0, "gamma": gamma, "hazard": hazard, "n_points": theirs.n_points,
            "rms_log_residual": theirs.rms_log_residual, "rms_log_residual_ours": ours.rms_log_residual,
            "better": best if best is not None else "tie",
@@ -485,7 +485,7 @@ def _pc_taus(ours, theirs, fits_ours, fits_pc, hazards) -> pd.DataFrame:
             both = g in fits_ours and g in fits_pc
             row[f"rms_{h}"] = float(fits_pc[g][h].rms_log_residual) if both else None
             row[f"rms_{h}_ours"] = float(fits_ours[g][h].rms_log_residual) if both else None
-            best = sm.better_fit({"ours": fits_ours[g][h], PC: fits_pc[g][h]}) if both else None
+            best = mc.better_fit({"ours": fits_ours[g][h], PC: fits_pc[g][h]}) if both else None
             row[f"better_{h}"] = (best or "tie") if both else None
         rows.append(row)
     return pd.DataFrame(rows)
@@ -665,7 +665,7 @@ def _tau_rows(ref: _Fig4Ref, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_d
                     row[f"f_ne_{h}"] = float(fits[h].values["f_ne"])
                     row[f"rms_{h}"] = float(fits[h].rms_log_residual)
                     if ref.P_0 is not None:
-                        row[f"tau1_pred_{h}"] = sm.predict_tau1(fits[h], ref.P_0, alpha)
+                        row[f"tau1_pred_{h}"] = mc.predict_tau1(fits[h], ref.P_0, alpha)
         rows.append(row)
     return pd.DataFrame(rows), fits_by_gamma
 

@@ -228,7 +228,7 @@ def test_gen_studies_copies_what_exists_and_reports_the_rest(tmp_path, gen, monk
     (out / "fig3.png").write_bytes(b"png")
     (out / "fig3.json").write_text("{}")
     (out.parents[1] / "study.toml").write_text("[scene]\nn = 1\n")  # a study is a folder with a study.toml
-    bench = tmp_path / "studies" / "bench" / "out" / "full"
+    bench = tmp_path / "benchmarks" / "out" / "bench" / "full"
     bench.mkdir(parents=True)
     (bench / "summary.md").write_text("# s\n")
     (bench / "big.csv").write_bytes(b"x" * (gen.CSV_MAX_BYTES + 1))
@@ -327,8 +327,8 @@ def test_every_library_module_has_an_api_page():
     missing = []
     for p in (ROOT / "hhscatter").rglob("*.py"):
         parts = list(p.relative_to(ROOT).with_suffix("").parts)
-        if any(x.startswith("_") and x != "__init__" for x in parts) or parts[1:2] in (["bench"], ["cli"]):
-            continue  # private modules; the benchmarks and the CLI have their own pages (benchmarks, cli.md)
+        if any(x.startswith("_") and x != "__init__" for x in parts) or parts[1:2] == ["cli"]:
+            continue  # private modules; the CLI has its own page (cli.md)
         if parts[-1] == "__init__":
             parts = parts[:-1]
         if parts[:2] == ["hhscatter", "api"] and "hhscatter.api" in documented:

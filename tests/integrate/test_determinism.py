@@ -1,9 +1,9 @@
 """Determinism of the stream scheduler with many censored orbits: the same orbits give byte-identical tables
 whatever the chunk size and the batch size (README: "whatever workers/backend/chunk size").
 
-Found while tuning the chunk size: with a per-orbit propagation bound (lane start + t_max) the censored state depended on the
+A per-orbit propagation bound (lane start + t_max) would make the censored state depend on the
 lane's start time (the bound's rounding clamps the last step), and an orbit whose ending event fell in a step
-clamped by an earlier orbit's (stale) bound ended an ulp elsewhere (the event root is found on the clamped step).
+clamped by an earlier orbit's (stale) bound would end an ulp elsewhere (the event root is found on the clamped step).
 Short t_max: a tenth of the orbits are censored, and lanes refill often (many stale bounds). The reference is the
 same orbits run a batch at a time (each orbit alone in its lane from lane time 0), an independent schedule."""
 from __future__ import annotations

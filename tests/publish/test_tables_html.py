@@ -53,7 +53,7 @@ def test_parser_sees_a_broken_table():
 def _summaries(root: Path):
     """The committed benchmark and stress summaries (tables with |ΔH| cells, plain-text tables) as outputs."""
     for name in ("bench", "stress"):
-        out = root / name / "out" / "full"
+        out = root.parent / "benchmarks" / "out" / name / "full"
         out.mkdir(parents=True)
         shutil.copy(DOCS / "benchmarks" / "assets" / name / "summary.md", out / "summary.md")
 
@@ -63,7 +63,7 @@ def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
 
     root = tmp_path / "studies"
     _summaries(root)
-    assert "|ΔH|" in (root / "stress" / "out" / "full" / "summary.md").read_text()
+    assert "|ΔH|" in (root.parent / "benchmarks" / "out" / "stress" / "full" / "summary.md").read_text()
     from hhscatter.studies import load_study
     from hhscatter.studies.provenance import config_sha256, sealed
 

@@ -19,17 +19,16 @@ BASE = "f701897"  # the code before the strict configuration (and the study room
 
 
 def _files(root: Path) -> list[str]:
-    return sorted(str(p.relative_to(root)) for p in root.rglob("*"))
+    """The files below root (Python's bytecode caches of the study code aside)."""
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if "__pycache__" not in p.parts)
 
 
 def _study_root(tmp_path: Path, name: str, edit) -> Path:
-    """A studies root with the study's study.toml, changed by ``edit(text) -> text``."""
+    """A studies root with a copy of the study's folder, its study.toml changed by ``edit(text) -> text``."""
+    from study_copy import copy_study_folder
+
     root = tmp_path / "studies"
-    (root / name).mkdir(parents=True)
-    text = (ROOT / "studies" / name / "study.toml").read_text()
-    new = edit(text)
-    assert new != text, "the edit did not apply"
-    (root / name / "study.toml").write_text(new)
+    copy_study_folder(name, root, edit)
     return root
 
 
@@ -141,7 +140,8 @@ def test_a_refused_study_file_in_a_subprocess_prints_no_traceback(tmp_path):
                        cwd=tmp_path, env=env, capture_output=True, text=True)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.strip() == "hhscatter: error: studies/fig3/study.toml: [scene] energy must be a number, got '0.3'"
-    assert _files(root) == ["fig3", "fig3/study.toml"]
+    assert _files(root) == sorted(["conventions.toml", "fig3", *(f"fig3/{p.name}" for p in (ROOT / "studies" / "fig3").iterdir()
+                                                                 if p.is_file())])
 
 
 def test_every_study_declares_its_study_table():
@@ -193,7 +193,7 @@ def _scene_hashes(code_root: Path, cwd: Path, only=None, patch=None) -> dict:
     script = cwd / "hashes.py"
     script.write_text(_HASHES)
     env = {**os.environ, "PYTHONPATH": str(code_root)}
-    env.pop("HHSCATTER_STUDIES", None)
+    env["HHSCATTER_STUDIES"] = str(code_root / "studies")  # the study files of that code
     args = [",".join(only or []), *([json.dumps(patch)] if patch else [])]
     r = subprocess.run([sys.executable, str(script), *args], cwd=cwd, env=env, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr[-3000:]
@@ -265,9 +265,9 @@ def test_study_code_receives_typed_params():
     assert type(s.params.pilot_n) is int and type(s.params.pilot_t_max) is float
     assert s.params.pilot_t_max == s.param("pilot_t_max")  # the raw value, equal
     with pytest.raises(Exception, match="does not declare"):
-        s.params.no_such_key
+        _ = s.params.no_such_key
     s.params_read = set()
-    s.params.pilot_n
+    _ = s.params.pilot_n
     assert s.params_read == {"pilot_n"}
 
 

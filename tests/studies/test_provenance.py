@@ -54,6 +54,7 @@ def fig3_copy(tiny_studies, tmp_path):
     """fig3 at scale tiny as `make` leaves it (its raw runs, derived tables and numbers), in a root of its own."""
     root = tmp_path / "studies"
     shutil.copytree(tiny_studies / "fig3", root / "fig3")
+    shutil.copy(tiny_studies / "conventions.toml", root / "conventions.toml")  # a studies folder is self-contained
     return root
 
 

@@ -9,8 +9,7 @@ import pytest
 
 from hhscatter.studies import stage_module
 
-stage_module("resc")  # puts the study folders on hhscatter.studies' path
-fig = importlib.import_module("hhscatter.studies.resc.figure")
+fig = importlib.import_module(f"{stage_module('resc').__package__}.figure")  # the folder's figure module
 
 
 def test_logx_offsets_in_decades_of_r_minus_one():

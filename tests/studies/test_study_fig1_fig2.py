@@ -139,8 +139,10 @@ def test_lifetimes_to_arrays_accepts_rounding_in_e0_but_not_two_ensembles():
 
 
 def test_recording_rules_closed_form():
-    from hhscatter.studies.fig1.study import contour_levels, recording_time
-    from hhscatter.studies.fig2.study import cmeasure_windows
+    from hhscatter.studies import stage_module
+
+    contour_levels, recording_time = stage_module("fig1").contour_levels, stage_module("fig1").recording_time
+    cmeasure_windows = stage_module("fig2").cmeasure_windows
 
     assert recording_time(0.2, 3.4, 4.0) == 24.0  # ceil(3.4 + 20)
     t_rec, t_s, t_e = cmeasure_windows(0.25, 2.5, 2.0, 2.0, 40.0, 1.0)
@@ -263,7 +265,7 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
             assert km.P[0] > 0.5 >= km.P[1]
         assert row["n_escaped_at_start"] == int(((t_end == 0) & obs).sum()) > 0  # square corners beyond r_esc
     assert set(table["convention"]) == set(conv["conventions"])
-    for name, info in conv["fits"].items():
+    for info in conv["fits"].values():
         assert set(info["energies"]) <= set(conv["stable_energies"])
     undefined = table[~table["defined"]]
     assert (undefined["reason"].str.len() > 0).all()
@@ -294,7 +296,9 @@ def test_fig2_paper_n_per_energy_is_declared_per_grid_energy():
     """The paper scale's κ(E) runs: N per energy from grid_n_by_energy (same order as grid_energies); a list of
     the wrong length is refused by name."""
     from hhscatter.studies import load_study
-    from hhscatter.studies.fig2.study import grid_n
+    from hhscatter.studies import stage_module
+
+    grid_n = stage_module("fig2").grid_n
 
     paper = load_study("fig2", "paper")
     grid, per = paper.params.grid_energies, paper.params.grid_n_by_energy

@@ -156,7 +156,9 @@ def test_snapshot_grid_pieces():
     np.testing.assert_array_equal(g, [0, 0.5, 1, 1.5, 2, 3, 6, 9])
     with pytest.raises(ValueError, match="increasing"):
         snapshot_grid([[0, 2, 0.5], [1, 3, 1]])
-    from hhscatter.studies.fig4.study import raw_key
+    from hhscatter.studies import stage_module
+
+    raw_key = stage_module("fig4").raw_key
 
     assert [raw_key(g) for g in (0, 0.001, 0.01, 2e-2)] == ["gamma0", "gamma0.001", "gamma0.01", "gamma0.02"]
 
@@ -218,7 +220,9 @@ def _fixed_intercept_mu(t, mean_E, E0, gamma, window):
 def test_fig3_mu_verdict_rule():
     """The verdict of a μ row against the paper's "0.91": 2σ, then the paper's quoting precision; and our row's
     "differs" is kept only when no authors'-convention row agrees."""
-    from hhscatter.studies.fig3.study import mu_verdict, verdict_beside_authors
+    from hhscatter.studies import stage_module
+
+    mu_verdict, verdict_beside_authors = stage_module("fig3").mu_verdict, stage_module("fig3").verdict_beside_authors
 
     assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"           # |Δ| = 0.0005 ≤ 2σ
     assert mu_verdict(0.9139, 0.0005, 0.91, 0.005) == "agrees to the paper's quoted digits"  # prints as 0.91
@@ -318,7 +322,7 @@ def test_fig3_authors_rows_recompute_deterministically(tiny_root):
     assert after["mu"] == before["mu"]
 
 
-def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path):
+def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path, copy_study):
     """With [0, 100] declared the authors' window and the paper's μ set to our μ there, our [0, 200] row
     (farther than 2σ from it) must say that it differs in our convention only."""
     import shutil
@@ -326,7 +330,7 @@ def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path):
     from hhscatter.studies import run_stage
 
     src = tiny_root / "fig3"
-    dst = tmp_path / "fig3"
+    dst = copy_study("fig3", tmp_path)
     shutil.copytree(src / "out" / "tiny" / "raw", dst / "out" / "tiny" / "raw")
     nums = json.loads((src / "out" / "tiny" / "fig3.json").read_text())
     mu = {tuple(r["window"]): r for r in nums["authors_convention"]["mu"] if r["selection"] == "inside"}

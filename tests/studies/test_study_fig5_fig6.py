@@ -169,14 +169,14 @@ def test_fig5_tiny_end_to_end(tiny_studies):
     assert any(r["quantity"].startswith("t*") for r in nums["paper_comparison"])
 
 
-def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch):
+def test_fig5_fails_clearly_without_fig1(tiny_studies, tmp_path, monkeypatch, copy_study):
     from hhscatter.studies import run_stage
 
     monkeypatch.delenv(up.DEV_ENV, raising=False)
     for name in ("fig3", "fig5"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
-    (tmp_path / "fig1").mkdir()
-    shutil.copy(REPO / "studies" / "fig1" / "study.toml", tmp_path / "fig1" / "study.toml")
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
+    copy_study("fig1", tmp_path)
     with pytest.raises(up.UpstreamError, match="fig5 needs the published outputs of fig1 .*make fig5 SCALE=tiny"):
         run_stage("fig5", "analyze", "tiny", root=tmp_path)
 
@@ -244,7 +244,7 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
 
 
 def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
-    """Issue 28: 5a/5b against μ_c^0.30 and μ_c^0.35 and panel (d) carry paired intervals: Δ is the difference of
+    """5a/5b against μ_c^0.30 and μ_c^0.35 and panel (d) carry paired intervals: Δ is the difference of
     the two distances in every replicate, so its mean is the difference of the means; panel (d) has one curve per
     γ (ordered by t*) with its bands around the mean, and one step between consecutive t*."""
     from hhscatter.studies import load_study
@@ -268,7 +268,7 @@ def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
 
 
 def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_studies):
-    """Issue 28's sensitivity row: 5a/5b_authors_random are the authors' scenes but for momentum = 'random', and
+    """The sensitivity row: 5a/5b_authors_random are the authors' scenes but for momentum = 'random', and
     the verdict has its row, made like 'cut_offsets' from those runs, with its own convention."""
     from hhscatter.data.read import read_sections
     from hhscatter.studies import load_study
@@ -359,6 +359,7 @@ def test_fig6_changing_a_paper_constant_changes_only_its_rows(tiny_studies, tmp_
 
     for name in ("fig2", "fig3", "fig4", "fig6"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     before = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
     toml = tmp_path / "fig6" / "study.toml"
     text = toml.read_text()
@@ -390,6 +391,7 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
     for name in ("fig2", "fig3", "fig4", "fig6"):
         shutil.copytree(tiny_studies / name, tmp_path / name)
+    shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     k = _numbers(tmp_path, "fig2")["kappa_fit"]
     mine = {"paper_kappa_a": k["a"]["value"], "paper_kappa_b": k["b"]["value"], "paper_kappa_c": k["c"]["value"],
             "paper_kappa_Eb": k["E_b"]["value"], "paper_mu": _numbers(tmp_path, "fig3")["mu"]["value"]}
@@ -414,8 +416,10 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
 
 
 def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
-    """Issue 13's rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
-    from hhscatter.studies.fig5.study import REFS_QUANTITY, _qualify_our_5b
+    """The verdict rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
+    from hhscatter.studies import stage_module
+
+    REFS_QUANTITY, _qualify_our_5b = stage_module("fig5").REFS_QUANTITY, stage_module("fig5")._qualify_our_5b
 
     def rows(auth_verdict):
         return [

@@ -99,12 +99,12 @@ def test_ratios_outside_their_grid_are_refused_before_any_run(tmp_path, edit, ke
 
     from hhscatter.studies import run_stage
 
-    src = Path(__file__).resolve().parents[2] / "studies" / "generality" / "study.toml"
-    (tmp_path / "generality").mkdir()
-    text = src.read_text()
+    src = Path(__file__).resolve().parents[2] / "studies" / "generality"
+    shutil.copytree(src, tmp_path / "generality", ignore=shutil.ignore_patterns("out", "__pycache__"))
+    text = (src / "study.toml").read_text()
     assert edit[0] in text
     (tmp_path / "generality" / "study.toml").write_text(text.replace(*edit))
-    shutil.copy(src.parent.parent / "conventions.toml", tmp_path / "conventions.toml")
+    shutil.copy(src.parent / "conventions.toml", tmp_path / "conventions.toml")
     with pytest.raises(ValueError, match=key):
         run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
     assert not (tmp_path / "generality" / "out" / "tiny" / "raw").exists() or not any(

@@ -2,6 +2,7 @@
 the Makefile's rules, the build order, the report and the docs navigation."""
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -107,7 +108,7 @@ def test_report_and_docs_nav_list_the_study_folders():
 
 
 def _study_code(name: str) -> list[Path]:
-    """The Python files of one study: the modules of its folder (hhscatter.studies.<name>.*)."""
+    """The Python files of one study: the modules of its folder (the package hhscatter_study_<name>)."""
     return sorted((STUDIES / name).glob("*.py"))
 
 
@@ -138,9 +139,10 @@ def test_no_study_imports_another_or_reads_its_raw_runs():
         files = _study_code(name)
         assert files, f"studies/{name} has no modules"
         for path in files:
-            mods = _imported_modules(path, f"hhscatter.studies.{name}")
+            mods = _imported_modules(path, f"hhscatter_study_{name}")
             bad = {m for m in mods for o in others
-                   if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m) or m.endswith(f"studies.{o}")}
+                   if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m) or m.endswith(f"studies.{o}")
+                   or re.match(rf"(hhscatter_study_)?{o}(\.|$)", m)}
             assert not bad, f"{path.relative_to(ROOT)} imports another study: {sorted(bad)}"
             text = path.read_text()
             # other studies are reached through their published outputs only (_upstream.numbers / table)
@@ -190,17 +192,45 @@ def test_convention_label_says_the_studys_own_setup():
     assert load_study("fig2", "quick").convention_label.endswith("disk r < 0.5, r_esc 1.03")
 
 
-def test_a_study_run_from_another_directory_writes_there_not_into_the_source_tree(tmp_path, monkeypatch):
-    from hhscatter.studies import load_study
+def test_the_studies_folder_is_that_of_the_repository_the_command_runs_in(tmp_path, monkeypatch, copy_study):
+    """From a repository (or below it) its own studies/; elsewhere an error naming the way out; --studies or
+    HHSCATTER_STUDIES name one explicitly. Outputs go into the study's own folder."""
+    from hhscatter.errors import StudyError
+    from hhscatter.studies import load_study, studies_root
 
     monkeypatch.delenv("HHSCATTER_STUDIES", raising=False)
     monkeypatch.chdir(ROOT)
-    assert load_study("fig2").out == ROOT / "studies" / "fig2" / "out" / "quick"  # make's layout, unchanged
+    assert load_study("fig2").out == ROOT / "studies" / "fig2" / "out" / "quick"  # make's layout
+    monkeypatch.chdir(ROOT / "studies" / "fig2")
+    assert studies_root() == ROOT / "studies"
     monkeypatch.chdir(tmp_path)
-    study = load_study("fig2", "paper")
-    assert study.out == tmp_path / "studies" / "fig2" / "out" / "paper"
-    assert study.numbers_path.parent == study.out and study.raw("x").is_relative_to(tmp_path)
+    with pytest.raises(StudyError, match="no studies folder in .* --studies DIR"):
+        load_study("fig2")
     own = tmp_path / "mine"
-    (own / "fig2").mkdir(parents=True)
-    (own / "fig2" / "study.toml").write_text((ROOT / "studies" / "fig2" / "study.toml").read_text())
+    copy_study("fig2", own)
     assert load_study("fig2", root=own).out == own / "fig2" / "out" / "quick"  # a studies folder of one's own
+    monkeypatch.setenv("HHSCATTER_STUDIES", str(own))
+    assert studies_root() == own
+
+
+def test_a_second_clone_using_this_virtualenv_reads_its_own_study_files(tmp_path):
+    """This checkout's virtualenv imports this checkout's hhscatter (an editable install); a command run in another
+    clone must still read that clone's study.toml and study code, and write into that clone."""
+    clone = tmp_path / "clone"
+    shutil.copytree(STUDIES / "fig1", clone / "studies" / "fig1", ignore=shutil.ignore_patterns("out", "__pycache__"))
+    shutil.copy(STUDIES / "conventions.toml", clone / "studies" / "conventions.toml")
+    toml = clone / "studies" / "fig1" / "study.toml"
+    text = toml.read_text()
+    n = re.search(r"\[scale\.tiny\.scene\]\s*\nn = (\d+)", text)
+    assert n, "fig1 has a [scale.tiny.scene] n"
+    toml.write_text(text[:n.start(1)] + "123" + text[n.end(1):])
+    (clone / "studies" / "fig1" / "study.py").write_text(
+        (STUDIES / "fig1" / "study.py").read_text() + "\nCLONE_MARK = 1\n")
+    code = ("from hhscatter.studies import load_study, stage_module\n"
+            "s = load_study('fig1', 'tiny')\n"
+            "print(s.config['scene']['n'], s.out, stage_module('fig1').CLONE_MARK)\n")
+    env = {k: v for k, v in os.environ.items() if k != "HHSCATTER_STUDIES"}
+    r = subprocess.run([sys.executable, "-c", code], cwd=clone / "studies" / "fig1", env=env, capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.split() == ["123", str(clone / "studies" / "fig1" / "out" / "tiny"), "1"]

@@ -10,6 +10,7 @@ from hhscatter.analysis.claims.keys import cm_key, sec_key
 from hhscatter.analysis.claims.records import ve, z_verdict
 from hhscatter.analysis.dissipative.decay import time_to_energy
 from hhscatter.analysis.geometry import distance as dist
+from hhscatter.analysis.geometry import paired_distance as pdist
 from hhscatter.analysis.geometry.distance import first_crossings
 from hhscatter.analysis.survival.cmeasure import (
     cmeasure_sample_from_sections,
@@ -147,7 +148,7 @@ def claim5_distance(runs, claims, label, m, E0, mu, samples):
             continue
         sizes = f"{len(diss)} / {len(ref_s)} / {len(ref_0)} points (survivors / E(t*) / E0)"
         rec[kind] = r = {"n_ref_star": len(ref_s), "n_ref_E0": len(ref_0)}
-        sets = {n: dist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "orbits")
+        sets = {n: pdist.UnitSet(dist.points(df), df["traj_id"].to_numpy(), "orbits")
                 for n, df in (("diss", diss), ("star", ref_s), ("E0", ref_0))}
         allpts = np.concatenate([x.points for x in sets.values()])
         extent = (float(allpts[:, 0].min()), float(allpts[:, 0].max()), float(allpts[:, 1].min()),
@@ -155,14 +156,14 @@ def claim5_distance(runs, claims, label, m, E0, mu, samples):
         try:
             if min(len(diss), len(ref_s), len(ref_0)) < 4:
                 raise ValueError(sizes)
-            reps = dist.paired_hellinger_replicates(sets, [("diss", "star"), ("diss", "E0")], [rec["box"]], extent,
+            reps = pdist.paired_hellinger_replicates(sets, [("diss", "star"), ("diss", "E0")], [rec["box"]], extent,
                                                     offsets=p.c5_offsets, n_boot=p.c5_boot, seed=p.fit_seed)[:, :, 0]
         except ValueError as exc:  # too few points (tiny scale, or a KAM-dominated system)
             claims.add("5", q, label, None, None, f"undetermined: too few points ({exc})", sizes, 0.0)
             continue
-        d, lo, hi = dist.percentile_interval(reps[:, 1] - reps[:, 0], p.c5_level)
-        ds, ds_lo, ds_hi = dist.percentile_interval(reps[:, 0], p.c5_level)
-        d0, d0_lo, d0_hi = dist.percentile_interval(reps[:, 1], p.c5_level)
+        d, lo, hi = pdist.percentile_interval(reps[:, 1] - reps[:, 0], p.c5_level)
+        ds, ds_lo, ds_hi = pdist.percentile_interval(reps[:, 0], p.c5_level)
+        d0, d0_lo, d0_hi = pdist.percentile_interval(reps[:, 1], p.c5_level)
         r.update(delta={"value": d, "interval": [lo, hi]}, d_star={"value": ds, "interval": [ds_lo, ds_hi]},
                  d_E0={"value": d0, "interval": [d0_lo, d0_hi]}, extent=list(extent))
         lev = int(100 * p.c5_level)

@@ -13,7 +13,7 @@ from hhscatter.analysis.dissipative.effective_rate import (
     binned_hazard,
     observed_over_expected,
 )
-from hhscatter.analysis.dissipative.survival_model import (
+from hhscatter.analysis.dissipative.model_comparison import (
     fit_homogeneous_hazards,
     survival_fit_points,
 )

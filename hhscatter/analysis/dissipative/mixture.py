@@ -34,7 +34,7 @@ later t_ref the weights refer to the population at t_ref (an approximation).
 K = 1 with A = E0 reproduces the homogeneous model with a measured μ.
 
 The fit returns a :class:`~hhscatter.analysis.dissipative.survival_model.SurvivalFit` with the same goodness-of-fit
-measures as the homogeneous model (:func:`~hhscatter.analysis.dissipative.survival_model.compare_fits`).
+measures as the homogeneous model (:func:`~hhscatter.analysis.dissipative.model_comparison.compare_fits`).
 
 Units: time in model units, energies in model units, rates in 1/time.
 """
@@ -391,7 +391,7 @@ def fit_mixture_model(
     :func:`mixture_survival_model`) to P(t) ± P_err, with the same data
     selection (τ0 ≤ t ≤ t_max, P > P_min), residual ``space`` and
     goodness-of-fit measures as :func:`fit_survival_model`, so that the two
-    can be compared with :func:`compare_fits`.
+    can be compared with :func:`~hhscatter.analysis.dissipative.model_comparison.compare_fits`.
 
     ``components`` is a :class:`MixtureComponents` or the ``snapshots``
     DataFrame, from which the sub-ensembles are built by

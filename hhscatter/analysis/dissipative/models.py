@@ -20,14 +20,12 @@ from hhscatter.analysis.dissipative.mixture import (
     mixture_components_arrays,
     mixture_survival_model,
 )
+from hhscatter.analysis.dissipative.model_comparison import better_fit, compare_fits, predict_tau1
 from hhscatter.analysis.dissipative.survival_model import (
     HAZARDS,
     SurvivalFit,
     SurvivalModelParams,
-    better_fit,
-    compare_fits,
     fit_survival_model,
-    predict_tau1,
     settling_rate,
     survival_model,
 )

@@ -35,7 +35,7 @@ escape rate of the chaotic saddle is the root on the largest *open* class (:func
 
 Dissipative ensembles: states are (box, energy bin) and the return times are binned into lags of ``dt``
 (:func:`lag_kernels`); :func:`propagate` carries the crossing density n(t) forward return by return,
-:func:`survival` gives P(t) from it and the probability that the next event lies beyond a lag, and
+:func:`survival_from_crossings` gives P(t) from it and the probability that the next event lies beyond a lag, and
 :func:`first_crossing_after` the distribution of the first crossing after a time t* (paper Fig. 5).
 
 Eigenvalues: scipy.sparse.linalg.eigs (ARPACK) for the leading eigenpair of a sparse matrix, dense LAPACK
@@ -63,7 +63,7 @@ from scipy.sparse.linalg import eigs
 
 __all__ = ["DENSE_MAX", "ClassInfo", "Transitions", "bootstrap_kappa", "box_index", "capped_share", "communicating_classes", "first_crossing_after",
            "first_crossing_weights", "lag_kernels", "leading_left", "map_escape_rate", "propagate", "saddle_class", "saddle_measure", "section_flux_density",
-           "spectral_radius", "sprinkler_weights", "survival", "transfer_matrix", "true_time_kappa"]
+           "spectral_radius", "sprinkler_weights", "survival_from_crossings", "transfer_matrix", "true_time_kappa"]
 
 DENSE_MAX = 64  # below this many states the dense LAPACK eigensolver is used (ARPACK needs k < n − 1)
 
@@ -473,8 +473,8 @@ def propagate(n0, K: sp.csr_matrix, L: int, n_steps: int) -> np.ndarray:
     return out[: n_steps + 1]
 
 
-def survival(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
-    """survival(crossings, H) -> P(t_k), k = 0 … n_steps: the share of the ensemble not yet gone.
+def survival_from_crossings(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
+    """P(t_k), k = 0 … n_steps, of an ensemble propagated on the boxes: the share not yet gone.
 
     An orbit is alive at step k if its last crossing was at k' ≤ k and its next event lies beyond k − k':
     P(k) = Σ_{k' ≤ k} n(k') · H_{k − k'} (H beyond its last row: 0), one convolution per state

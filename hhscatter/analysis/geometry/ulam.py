@@ -432,7 +432,7 @@ def operator_survival(tr, t, n0, dt, steps, k_star, max_lag):
     cross = tf.propagate(n0, K, L, steps)
     wfc = tf.first_crossing_weights(cross, tr, dt, k_star)
     pred = pd.DataFrame({"x": t["x1"].to_numpy(), "y": t["y1"].to_numpy(), "energy": t["e1"].to_numpy(), "w": wfc})
-    return tf.survival(cross, H), pred[pred["w"] > 0].reset_index(drop=True)
+    return tf.survival_from_crossings(cross, H), pred[pred["w"] > 0].reset_index(drop=True)
 
 
 def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
@@ -505,7 +505,7 @@ def reduced_survival(tr, t, ids, n_cells, n_bins, dt, max_lag, steps):
     K2, H2, L2 = tf.lag_kernels(tr_red, t["t_end"].to_numpy(), dt, max_lag=max_lag)
     n0r = np.zeros(n_bins)
     n0r[-1] = 1.0
-    return tf.survival(tf.propagate(n0r, K2, L2, steps), H2), kappa_bins
+    return tf.survival_from_crossings(tf.propagate(n0r, K2, L2, steps), H2), kappa_bins
 
 
 def one_return_samples(df, lt, sec, what="run"):

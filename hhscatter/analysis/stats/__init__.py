@@ -1,1 +1,22 @@
-"""Statistics shared by the analyses: weighted least squares, binomial intervals, verdict wording."""
+"""Statistics shared by the analyses: weighted least squares, binomial intervals, verdict wording.
+
+Every public name of its modules is importable from here (loaded on first use).
+"""
+from hhscatter.analysis._exports import lazy_exports
+
+_EXPORTS = {
+    "wilson_interval": "intervals",
+    "LinearFit": "least_squares",
+    "least_squares_operator": "least_squares",
+    "weighted_least_squares": "least_squares",
+    "Verdict": "verdicts",
+    "half_unit": "verdicts",
+    "quoted_verdict": "verdicts",
+    "row_verdict": "verdicts",
+    "verdict": "verdicts",
+    "verdict_beside_authors": "verdicts",
+}
+
+__all__ = sorted(_EXPORTS)
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

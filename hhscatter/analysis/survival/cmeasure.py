@@ -233,7 +233,7 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
     n_exit = int(np.count_nonzero(leaves))
     n_und = int(leaves.size - n_exit)
     if n_und:
-        warnings.warn(f"{n_und} sample crossings have an undetermined fate and were dropped")
+        warnings.warn(f"{n_und} sample crossings have an undetermined fate and were dropped", stacklevel=2)
     if with_orbits:
         return (T.astype(float), n_exit, n_und, s["traj_id"].to_numpy()[ret],
                 last["traj_id"].to_numpy()[leaves])

@@ -391,7 +391,8 @@ def crossover_time(t, P, exp_fit, pow_fit) -> float:
     k = down[-1]
     tau = float(optimize.brentq(g, grid[k], grid[k + 1], xtol=1e-12 * grid[k + 1], rtol=1e-12))
     if tpos.size and not (tpos.min() <= tau <= tpos.max()):
-        warnings.warn(f"crossover time {tau:.4g} lies outside the data range [{tpos.min():.4g}, {tpos.max():.4g}]")
+        warnings.warn(f"crossover time {tau:.4g} lies outside the data range [{tpos.min():.4g}, {tpos.max():.4g}]",
+                      stacklevel=2)
     return tau
 
 

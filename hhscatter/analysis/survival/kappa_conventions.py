@@ -28,6 +28,7 @@ results out):
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +38,8 @@ from hhscatter.analysis.survival.fits import (
     mean_kappa_stat_err,
     survival_curve,
 )
+from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
+from hhscatter.analysis.survival.summaries import kappa_law_summary
 
 
 @dataclass(frozen=True)
@@ -192,3 +195,50 @@ def law_spread(fits: dict) -> dict:
                   "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
                   "per_convention": vals}
     return out
+
+
+def convention_rows(t_end, observed, result, *, p_hi: float = 0.5, p_lo: float = 1e-2,
+                    max_bias: float = 0.1) -> list[dict]:
+    """κ of one run under the two window rules, one row each: ``plateau`` (the windows of ``result``, the run's
+    :func:`~hhscatter.analysis.survival.escape_rate.escape_rate`) and ``plevel`` (windows fixed by the P levels
+    p_hi, p_lo); κ is ill-defined (``defined`` False, with its ``reason``) where the trapped fraction biases the slope
+    at the window end by more than ``max_bias``. Rows: windows, n, n_escaped_at_start, kappa (1/time), kappa_err,
+    kappa_stat, kappa_spread, t_lo, t_hi, trapped_fraction, bias_at_end, defined, reason.
+
+    Examples
+    --------
+    >>> from hhscatter.analysis.survival.escape_rate import escape_rate
+    >>> t = np.random.default_rng(2).exponential(5.0, 20000)
+    >>> obs = np.ones(t.size, bool)
+    >>> [r["windows"] for r in convention_rows(t, obs, escape_rate(t, obs, detect_tail=False))]
+    ['plateau', 'plevel']
+    """
+    t_end, observed = np.asarray(t_end, dtype=float), np.asarray(observed, dtype=bool)
+    rates = {"plateau": plateau_rate(result, t_end, observed, max_bias=max_bias),
+             "plevel": escape_rate_p_levels(t_end, observed, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)}
+    return [{"windows": rule, "n": int(t_end.size), "n_escaped_at_start": int(((t_end == 0) & observed).sum()),
+             "kappa": r.kappa, "kappa_err": r.kappa_err, "kappa_stat": r.kappa_stat, "kappa_spread": r.kappa_spread,
+             "t_lo": r.t_lo, "t_hi": r.t_hi, "trapped_fraction": r.trapped_fraction, "bias_at_end": r.bias_at_end,
+             "defined": bool(r.defined), "reason": r.reason} for rule, r in rates.items()]
+
+
+def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_points: int = 5):
+    """The κ(E) law (continuous at E_b, :func:`~hhscatter.analysis.survival.kappa_energy.fit_kappa_energy`) per
+    convention, on the rows of ``table`` (columns convention, energy, kappa, kappa_err, defined) where κ is defined
+    and the energy is among ``energies`` (the stable ones).
+
+    Returns (fits, info): fits {name: KappaEnergyFit} of the conventions with at least ``min_points`` energies (a,
+    b and the break need points on both sides); info {name: {"energies": [...], "fit": its numbers or None}}.
+    """
+    fits, info = {}, {}
+    for name in names:
+        d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(energies)]
+        info[name] = {"energies": [float(e) for e in d["energy"]], "fit": None}
+        if len(d) < min_points:
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fits[name] = fit_kappa_energy(d["energy"], d["kappa"], d["kappa_err"], E_c, continuous=True,
+                                          n_boot=n_boot, rng=seed)
+        info[name]["fit"] = kappa_law_summary(fits[name])
+    return fits, info

@@ -272,7 +272,7 @@ def _iterate_plateau(t, P, N, t_floor, w, kappa_ref, target, pilot, rel_tol, n_s
         inside = np.isfinite(s) & (np.abs(s - kappa_ref) <= tol)
         runs = _runs(c, inside, w)
         if not runs:
-            warnings.warn("no exponential plateau found; using the pilot range [t_a, t_b]")
+            warnings.warn("no exponential plateau found; using the pilot range [t_a, t_b]", stacklevel=2)
             tau0, t_stop = pilot
             break
         b, e = _overlapping_run(c, runs, target)

@@ -409,7 +409,7 @@ def test_distances_zero_for_identical_sets_and_symmetric():
 
 def test_histogram_distance_inequalities():
     rng = np.random.default_rng(1)
-    for i in range(30):
+    for _ in range(30):
         P = gaussian_blob(rng.integers(50, 2000), rng, sd=rng.uniform(0.05, 0.3))
         Q = gaussian_blob(rng.integers(50, 2000), rng, centre=rng.uniform(0.3, 0.7, 2), sd=rng.uniform(0.05, 0.3))
         box = rng.choice([0.02, 0.05, 0.1, 0.3])
@@ -458,7 +458,7 @@ def test_split_half_baseline_matches_hellinger_noise_floor():
     X = rng.uniform(0, 1, (20000, 2))
     for box in (0.1, 0.05):
         B = round(1 / box) ** 2
-        h2 = lambda A, C: distance.histogram_distance(A, C, box, UNIT) ** 2  # noqa: E731
+        h2 = lambda A, C, box=box: distance.histogram_distance(A, C, box, UNIT) ** 2  # noqa: E731
         r = distance.split_half_baseline(X, h2, 40, seed=1)
         assert r.mean == pytest.approx((B - 1) / 8 * (2 / 10000), rel=0.15)
         assert r.std > 0
@@ -594,7 +594,7 @@ def test_homogeneous_fit_steps_alone():
 def test_fit_homogeneous_hazards_by_the_figure_rule_recovers_the_model_it_sampled():
     """fig6's rule (coarse points, P(τ0) held, three starts, best χ²), now shared: a binomial sample of the model
     with known f_ne, L, b gives them back within 3σ for both hazards, and P(τ0) is read off the curve."""
-    from hhscatter.analysis.dissipative import survival_model as sm
+    from hhscatter.analysis.dissipative import model_comparison as mc
 
     for hazard, seed in (("paper", 11), ("integrated", 12)):
         t = np.arange(0.0, 301.0, 0.5)
@@ -602,12 +602,12 @@ def test_fit_homogeneous_hazards_by_the_figure_rule_recovers_the_model_it_sample
         P, P_err = binomial_sample(model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS, rng)
         P = np.where(t < TAU0, 1.0, P)  # the irregular regime is not modelled: any curve before τ0
         P_err = np.where(t < TAU0, 1e-3, P_err)
-        tf, Pf, sf = sm.survival_fit_points(t, P, P_err, TAU0, 2.0, N_ORBITS, 20)
+        tf, Pf, sf = mc.survival_fit_points(t, P, P_err, TAU0, 2.0, N_ORBITS, 20)
         assert np.all(np.diff(tf) >= 1.5) and tf[0] >= TAU0 and np.all(Pf * N_ORBITS >= 20)
         kw = {("kappa" if k == "kappa_of_E" else k): v for k, v in KW.items()}
-        fits = sm.fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, **kw, hazards=[hazard], fit_tau2=False,
+        fits = mc.fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, **kw, hazards=[hazard], fit_tau2=False,
                                              P_min=20 / N_ORBITS)
         f = fits[hazard]
-        assert f.values["P_tau0"] == pytest.approx(sm.plateau_level(t, P, TAU0))
+        assert f.values["P_tau0"] == pytest.approx(mc.plateau_level(t, P, TAU0))
         for name in ("f_ne", "L", "b"):
             assert abs(f.values[name] - TRUE[name]) < 3 * f.errors[name], (hazard, name, f.values[name])

@@ -1,4 +1,4 @@
-"""The engine benchmark's contenders (hhscatter/bench/engine.py) compute what they are compared on: the
+"""The engine benchmark's contenders (benchmarks/engine.py) compute what they are compared on: the
 minimal driver's escape and censoring times equal the engine's (an independent driver: its own integrator,
 bound-censored, single-length lane clock; with a short t_max its stale bounds once censored ~1 orbit in 500
 early), and the driver reads an IC table to the same orbits as it samples. Timings are not
@@ -12,7 +12,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from hhscatter.bench.engine import design_choices, yardstick
+from benchmarks.engine import design_choices, yardstick
 from hhscatter.integrate.engine import CENSORED, run_chunk
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene
@@ -36,7 +36,7 @@ def test_driver_reads_an_ic_table_to_the_orbits_it_samples(tmp_path):
     pq.write_table(pa.table({c: ics[:, i] for i, c in enumerate(("x", "y", "px", "py"))}), tmp_path / "ics.parquet")
     for args in ([], [str(tmp_path / "ics.parquet")]):
         out = tmp_path / f"t{len(args)}.parquet"
-        subprocess.run([sys.executable, "-m", "hhscatter.bench.engine", "--driver", str(n), "1", str(out), *args],
+        subprocess.run([sys.executable, "-m", "benchmarks.engine", "--driver", str(n), "1", str(out), *args],
                        check=True, capture_output=True)
     a, b = (pq.read_table(tmp_path / f"t{k}.parquet").column("t_end").to_numpy() for k in (0, 1))
     assert len(a) == n and np.array_equal(a, b)

@@ -1,6 +1,6 @@
-"""Numba kernels of the peer integrators (imported lazily by :mod:`hhscatter.bench.peers`).
+"""Numba kernels of the peer integrators (imported lazily by :mod:`benchmarks.peers`).
 
-This module imports numba at import time, so only :mod:`hhscatter.bench.peers`
+This module imports numba at import time, so only :mod:`benchmarks.peers`
 imports it, inside functions; the rest of the package never needs numba.
 
 Units and model: Hénon–Heiles with ω = λ = 1 (paper, Eq. (eqn:hh_ham)) and

@@ -1,4 +1,4 @@
-"""Configs of ``make bench`` / ``make stress``: ``studies/<name>/<name>.toml`` with ``[scale.<s>.*]`` overrides."""
+"""Configurations of ``make bench`` / ``make stress``: ``benchmarks/<name>.toml`` with ``[scale.<s>.*]`` overrides."""
 from __future__ import annotations
 
 import copy
@@ -9,10 +9,9 @@ from pathlib import Path
 SCALES = ("full", "tiny")
 
 
-def studies_root() -> Path:
-    """studies_root() -> Path of ``studies/`` (env ``HHSCATTER_STUDIES`` overrides, as the study framework)."""
-    env = os.environ.get("HHSCATTER_STUDIES")
-    return Path(env) if env else Path(__file__).resolve().parents[2] / "studies"
+def bench_root() -> Path:
+    """This folder, ``benchmarks/``: its ``<name>.toml`` configurations, its ``out/`` results."""
+    return Path(__file__).resolve().parent
 
 
 def _merge(base, over):
@@ -23,13 +22,13 @@ def _merge(base, over):
 
 
 def load_config(name: str, scale: str = "full", root=None) -> dict:
-    """load_config(name, scale='full', root=None) -> dict: ``studies/<name>/<name>.toml`` merged with its scale.
+    """The configuration ``<root>/<name>.toml`` (default root: ``benchmarks/``) merged with its scale's overrides.
 
     Raises ValueError naming ``scale`` for an unknown scale, FileNotFoundError for a missing file.
     """
     if scale not in SCALES:
         raise ValueError(f"scale must be one of {SCALES}, got {scale!r}")
-    path = Path(root or studies_root()) / name / f"{name}.toml"
+    path = Path(root or bench_root()) / f"{name}.toml"
     if not path.exists():
         raise FileNotFoundError(f"config not found: {path}")
     with open(path, "rb") as fh:
@@ -39,13 +38,13 @@ def load_config(name: str, scale: str = "full", root=None) -> dict:
         cfg = _merge(cfg, scales.get(scale, {}))
     cfg["_scale"] = scale
     # relative to the repository, so a summary reads the same on every machine
-    cfg["_path"] = f"studies/{name}/{name}.toml" if root is None else str(path)
+    cfg["_path"] = f"benchmarks/{name}.toml" if root is None else str(path)
     return cfg
 
 
 def out_dir(name: str, scale: str, root=None) -> Path:
-    """out_dir(name, scale, root=None) -> ``studies/<name>/out/<scale>/`` (created)."""
-    p = Path(root or studies_root()) / name / "out" / scale
+    """The results folder ``<root>/out/<name>/<scale>/`` (default root: ``benchmarks/``), created."""
+    p = Path(root or bench_root()) / "out" / name / scale
     p.mkdir(parents=True, exist_ok=True)
     return p
 

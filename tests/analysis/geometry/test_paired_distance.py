@@ -10,7 +10,7 @@ the marked units of A (as Fig. 5b is a subset of the orbits of 5a).
 import numpy as np
 import pytest
 
-from hhscatter.analysis.geometry.distance import (
+from hhscatter.analysis.geometry.paired_distance import (
     UnitSet, _offset_extents, paired_hellinger_difference, paired_hellinger_replicates, percentile_interval,
 )
 

@@ -1,4 +1,4 @@
-"""Peer integrators of ``make bench`` (hhscatter/bench/peers.py) against independent references.
+"""Peer integrators of ``make bench`` (benchmarks/peers.py) against independent references.
 
 References: closed-form properties of the composition (weights, symmetry),
 numerical convergence order against heyoka long double, and the long-double
@@ -9,15 +9,15 @@ import pytest
 
 numba = pytest.importorskip("numba")
 
-from hhscatter.bench import peers
-from hhscatter.bench.reference import reference_orbits
+from benchmarks import peers
+from benchmarks.reference import reference_orbits
 from hhscatter.integrate.engine import state_at
 from hhscatter.scene.scene import Scene
 
 
 @pytest.fixture(scope="module")
 def cons_ics():
-    from hhscatter.bench.workprecision import scene_ics
+    from benchmarks.workprecision import scene_ics
 
     return scene_ics(0.27, 0.0, 24, 99)
 
@@ -105,7 +105,7 @@ def test_dop853_tolerance_controls_error(cons_ics, cons_ref):
 
 def test_dissipative_peers_match_reference():
     """DOP853 (numba and SciPy) with the engine's dissipative rules: outcomes and escape/settle times vs long double."""
-    from hhscatter.bench.workprecision import scene_ics
+    from benchmarks.workprecision import scene_ics
 
     ics = scene_ics(0.3, 0.01, 10, 5)
     ref = reference_orbits(ics, gamma=0.01)
@@ -124,7 +124,7 @@ def test_section_mode_first_crossing(cons_ics):
     step (seen for DOP853 at tol 1e-13: crossings 0.044 apart); the engine's
     polynomial root isolation must not: it finds exactly the reference's crossing.
     """
-    from hhscatter.bench.workprecision import section_accuracy
+    from benchmarks.workprecision import section_accuracy
 
     ref = reference_orbits(cons_ics[:12], section=True)
     assert (ref["outcome"] == 3).sum() >= 3
@@ -161,19 +161,17 @@ def test_reference_long_double_vs_real128(cons_ics):
 
 
 def test_workprecision_tiny_end_to_end(tmp_path, monkeypatch):
-    """``python -m hhscatter.bench --scale tiny`` in a tmp studies root writes CSV, PNG and summary.md."""
+    """``python -m benchmarks --scale tiny`` with a tmp root writes CSV, PNG and summary.md."""
     import shutil
     from pathlib import Path
 
     import pandas as pd
 
-    from hhscatter.bench import workprecision
+    from benchmarks import workprecision
 
-    src = Path(__file__).resolve().parents[2] / "studies" / "bench" / "bench.toml"
-    (tmp_path / "bench").mkdir()
-    shutil.copy(src, tmp_path / "bench" / "bench.toml")
+    shutil.copy(Path(__file__).resolve().parents[2] / "benchmarks" / "bench.toml", tmp_path / "bench.toml")
     workprecision.main(["--scale", "tiny", "--root", str(tmp_path), "--no-throughput"])
-    out = tmp_path / "bench" / "out" / "tiny"
+    out = tmp_path / "out" / "bench" / "tiny"
     df = pd.read_csv(out / "workprecision.csv")
     assert {"conservative", "dissipative"} <= set(df.scene)
     assert (out / "workprecision.png").stat().st_size > 10_000

@@ -22,7 +22,7 @@ engine's escape rules (:mod:`hhscatter.integrate.engine`), and return the same a
   from SciPy's ``scipy.integrate._ivp.dop853_coefficients``, step control as
   SciPy's), compiled with numba, events by sign change between step ends and
   Newton on partial steps. The paper used Vern9 in Julia for the dissipative
-  runs; DOP853 is the compiled adaptive high-order RK offered by the issue.
+  runs; DOP853 is the compiled adaptive high-order Runge–Kutta method of the comparison.
 * :func:`scipy_dop853` — ``scipy.integrate.solve_ivp(method="DOP853")`` with
   terminal events (pure Python overhead; run on a subset).
 * :func:`engine` — hhscatter's batch Taylor engine (:func:`hhscatter.integrate.engine.run_chunk`).
@@ -89,7 +89,7 @@ def kahanli8_coefficients():
 
 def _kernels():
     try:
-        from hhscatter.bench import _kernels as k  # deferred: numba compiles the kernels on import (optional [bench] extra)
+        from benchmarks import _kernels as k  # deferred: numba compiles the kernels on import (optional [bench] extra)
     except ImportError as exc:  # numba missing
         raise ImportError(
             "the benchmark peers need numba: pip install -e '.[bench]' (or `make bench`)"

@@ -86,6 +86,24 @@ def test_true_time_root_equals_the_renewal_rate_with_random_times():
     assert np.mean(np.where(dst == 0, np.exp(k * T), 0.0)) == pytest.approx(1.0, abs=1e-10)
 
 
+@pytest.mark.parametrize("n, per_state", [(10, 3), (50, 3), (400, 2)])
+def test_communicating_classes_are_the_strongly_connected_components(n, per_state):
+    """Random transition graphs with cycles and self-loops (scipy 1.13.0 with numpy 2 never returned on such graphs,
+    hence the floor scipy >= 1.13.1): the classes against reachability computed independently (i ~ j iff each
+    reaches the other, transitive closure by repeated Boolean squaring)."""
+    rng = np.random.default_rng(n)
+    m = per_state * n
+    src, dst = rng.integers(0, n, m), np.where(rng.random(m) < 0.1, -1, rng.integers(0, n, m))
+    labels, classes = tf.communicating_classes(tf.Transitions(src, dst, np.ones(m), n))
+    reach = np.eye(n, dtype=bool)
+    reach[src[dst >= 0], dst[dst >= 0]] = True
+    for _ in range(int(np.ceil(np.log2(n))) + 1):
+        reach = reach | ((reach.astype(np.int64) @ reach.astype(np.int64)) > 0)
+    same = reach & reach.T
+    assert (same == (labels[:, None] == labels[None, :])).all()
+    assert sorted(c.label for c in classes) == list(range(labels.max() + 1))
+
+
 def test_closed_class_has_no_root_and_is_separated():
     # states 0, 1 leak into each other and out; state 2 maps to itself (an 'island'); 3 → 2 (transient)
     src = np.array([0, 0, 0, 1, 1, 2, 2, 3])
@@ -136,7 +154,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     K, H, L = tf.lag_kernels(tr, t_end, dt)
     assert L == 20
     n = tf.propagate([1.0], K, L, 100)
-    P = tf.survival(n, H)
+    P = tf.survival_from_crossings(n, H)
     k = np.arange(101)
     m, rem = k // 20, k % 20
     exact = np.where(rem < 10, q ** m, q ** (m + 1))
@@ -149,7 +167,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     # a lag cap of 15 steps brings the returns forward to t = 1.5: P then drops by q every 1.5 time units
     Kc, Hc, Lc = tf.lag_kernels(tr, t_end, dt, max_lag=15)
     assert Lc == 15 and tf.capped_share(tr, dt, 15) == 1.0 and tf.capped_share(tr, dt, 20) == 0.0
-    Pc = tf.survival(tf.propagate([1.0], Kc, Lc, 45), Hc)
+    Pc = tf.survival_from_crossings(tf.propagate([1.0], Kc, Lc, 45), Hc)
     assert Pc[44] == pytest.approx(q ** 3)
 
 
@@ -166,7 +184,7 @@ def test_first_crossing_weights_sum_to_the_state_distribution():
     by_dst = np.bincount(dst[dst >= 0], weights=w[dst >= 0], minlength=n_s)
     assert np.allclose(by_dst, tf.first_crossing_after(n, K, L, 77), rtol=1e-12, atol=1e-15)
     # survival by the FFT convolution equals the direct sum Σ_k' n(k')·H(k − k')
-    P = tf.survival(n, H)
+    P = tf.survival_from_crossings(n, H)
     direct = [sum(n[kp] @ H[k - kp] for kp in range(k + 1) if k - kp < H.shape[0]) for k in (0, 13, 60, 120)]
     assert np.allclose(P[[0, 13, 60, 120]], direct, atol=1e-12)
 

@@ -37,7 +37,7 @@ def _orbit_ensemble(rng, n_orbits, q, k, theta, per_orbit):
 
 def test_kappa_from_the_cmeasure_bootstrap_over_orbits_covers_the_truth():
     q, k, theta, per_orbit = 0.8, 3.0, 2.0, 4
-    truth = (1.0 - q ** (1.0 / k)) / theta  # the Lotka root (tests/analysis/test_survival.py checks the closed form)
+    truth = (1.0 - q ** (1.0 / k)) / theta  # the Lotka root (tests/analysis/survival/test_survival.py checks the closed form)
     rng = np.random.default_rng(1313)
     by_orbit, by_point = [], []
     for _ in range(200):

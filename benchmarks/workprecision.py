@@ -7,11 +7,11 @@ Two scenes, the same initial conditions for every method (disk ICs of
 * dissipative, E0 = 0.3, γ = 0.01 (paper Figs. 3–4): closure at E_c, escape
   time = last outward r_esc crossing.
 
-Methods (see :mod:`hhscatter.bench.peers`): the engine at several tolerances
+Methods (see :mod:`benchmarks.peers`): the engine at several tolerances
 and batch sizes; KahanLi8 (the paper's conservative integrator) at fixed dt
 with escape checked at step ends and root-found; DOP853 compiled with numba
 at several tolerances; SciPy's ``solve_ivp`` DOP853 on a subset.
-Reference: heyoka in long double (:mod:`hhscatter.bench.reference`), itself
+Reference: heyoka in long double (:mod:`benchmarks.reference`), itself
 checked against real128 on a subset.
 
 Timing: each method runs once on 8 orbits (JIT compilation), then
@@ -40,10 +40,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hhscatter.bench import peers
-from hhscatter.bench.config import load_config, machine_note, out_dir
-from hhscatter.bench.plots import plot_workprecision
-from hhscatter.bench.throughput import measure_throughput, throughput_markdown
+from benchmarks import peers
+from benchmarks.config import load_config, machine_note, out_dir
+from benchmarks.plots import plot_workprecision
+from benchmarks.throughput import measure_throughput, throughput_markdown
 
 SHORT_T = 20.0
 
@@ -120,7 +120,7 @@ def _key(ics, **kw):
 
 def cached_reference(ics, cache_dir, *, progress=False, **kw):
     """cached_reference(ics, cache_dir, **kw of reference_orbit) -> dict of arrays (cached as .npz by content hash)."""
-    from hhscatter.bench.reference import reference_orbits  # deferred: pydantic loads on first use
+    from benchmarks.reference import reference_orbits  # deferred: pydantic loads on first use
 
     path = cache_dir / f"ref_{_key(ics, **{k: str(v) for k, v in kw.items()})}.npz"
     if path.exists():
@@ -374,12 +374,12 @@ def summary_markdown(df, checks, ratios, pratios, note_start, note_end, seconds,
 
 
 def main(argv=None):
-    """``python -m hhscatter.bench [--scale full|tiny] [--root DIR] [--no-throughput]``: writes CSV, PNG, summary.md."""
+    """``python -m benchmarks [--scale full|tiny] [--root DIR] [--no-throughput]``: writes CSV, PNG, summary.md."""
 
 
     ap = argparse.ArgumentParser(description="hhscatter work–precision benchmark (make bench)")
     ap.add_argument("--scale", default="full", help="full (default) or tiny")
-    ap.add_argument("--root", default=None, help="studies root (default: the repository's studies/)")
+    ap.add_argument("--root", default=None, help="folder of bench.toml and out/ (default: benchmarks/)")
     ap.add_argument("--no-throughput", action="store_true")
     a = ap.parse_args(argv)
     cfg = load_config("bench", a.scale, a.root)

@@ -1,6 +1,6 @@
 """``make bench-engine``: the engine's targets as ratios measured side by side in one run.
 
-    python -m hhscatter.bench.engine [-n N] [--repeat R] [--out DIR]
+    python -m benchmarks.engine [-n N] [--repeat R] [--out DIR]
 
 One process, one core, the same initial conditions for every contender,
 best of ``--repeat`` timings each (the machine is shared: ratios, not
@@ -23,10 +23,10 @@ absolute times, are the result). Rows:
 * **whole process** — ``hhscatter simulate --energy 0.27 -n N --workers 1``
   (ICs sampled, Parquet parts written) against the minimal driver run as a
   whole process (the same ICs, the yardstick, one Parquet table of t_end;
-  ``python -m hhscatter.bench.engine --driver N SEED OUT``), the two run
+  ``python -m benchmarks.engine --driver N SEED OUT``), the two run
   alternately, best of each (target ≤ 1.2).
 
-Writes ``studies/engine/out/<full|quick>/engine.csv`` and ``engine_summary.md``
+Writes ``benchmarks/out/engine/<full|quick>/engine.csv`` and ``engine_summary.md``
 (``make docs-assets`` copies them to the benchmarks page). Not a
 test: numbers vary with the machine; the ratios are what is reported.
 """
@@ -43,7 +43,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hhscatter.bench import peers
+from benchmarks import peers
+from benchmarks.config import out_dir
 from hhscatter.integrate.engine import run_chunk
 from hhscatter.integrate.events import HAMILTON_ONLY, build_escape_only_batch, system
 from hhscatter.model import HenonHeiles
@@ -235,7 +236,7 @@ def _whole_rows(row, n, rep):
         pq.write_table(pa.table({c: ics[:, i] for i, c in enumerate(("x", "y", "px", "py"))}), table)
         sim = py + ["-m", "hhscatter", "simulate", "--workers", "1", "--out", f"{tmp}/sim", "--overwrite",
                     "--no-progress"]
-        drv = py + ["-m", "hhscatter.bench.engine", "--driver", str(n), "1", f"{tmp}/driver.parquet"]
+        drv = py + ["-m", "benchmarks.engine", "--driver", str(n), "1", f"{tmp}/driver.parquet"]
         variants = {
             "ICs sampled": {"simulate": sim + ["--energy", "0.27", "-n", str(n), "--seed", "1"], "driver": drv},
             "IC table": {"simulate": sim + ["--ics", table, "--gamma", "0"], "driver": drv + [table]},
@@ -261,8 +262,8 @@ def main(argv=None):
     ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--whole-n", type=int, default=1_000_000,
-                    help="orbits of the whole-process rows (default 1e6, the issue-27 target's N)")
-    ap.add_argument("--out", default=None, help="output folder (default studies/engine/out/full, "
+                    help="orbits of the whole-process rows (default 1e6, the whole-process target's N)")
+    ap.add_argument("--out", default=None, help="output folder (default benchmarks/out/engine/full, "
                     "or .../quick for N < 1e5)")
     a = ap.parse_args(argv)
     n, rep = a.n, a.repeat
@@ -410,8 +411,8 @@ def _design_rows(row):
 
 
 def _write_outputs(rows, out, n, rep):
-    """engine.csv and engine_summary.md in ``out`` (default studies/engine/out/full or quick)."""
-    out = Path(out or f"studies/engine/out/{'full' if n >= 100_000 else 'quick'}")
+    """engine.csv and engine_summary.md in ``out`` (default benchmarks/out/engine/full or quick)."""
+    out = Path(out) if out else out_dir("engine", "full" if n >= 100_000 else "quick")
     out.mkdir(parents=True, exist_ok=True)
     import pandas as pd  # deferred: pandas loads on first use
 

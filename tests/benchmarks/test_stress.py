@@ -1,4 +1,4 @@
-"""Stress cases of ``make stress`` (hhscatter/bench/stress.py) at small size.
+"""Stress cases of ``make stress`` (benchmarks/stress.py) at small size.
 
 Each case compares the engine with an independent reference (heyoka long
 double with exact event location, or the conservation law) and returns
@@ -8,7 +8,7 @@ that a failure names what broke.
 import numpy as np
 import pytest
 
-from hhscatter.bench import stress
+from benchmarks import stress
 
 
 def test_energy_drift_of_kam_trapped_orbits_small():
@@ -115,9 +115,9 @@ def test_first_section_crossing_inside_the_first_step():
     the engine lost before the section event got its 1e-300 offset (engine.py).
     Reference: heyoka long double, first crossing with φ̇ > 0.
     """
-    from hhscatter.bench import peers
-    from hhscatter.bench.reference import reference_orbits
-    from hhscatter.bench.workprecision import scene_ics
+    from benchmarks import peers
+    from benchmarks.reference import reference_orbits
+    from benchmarks.workprecision import scene_ics
 
     ics = scene_ics(0.27, 0.0, 425, 2026)[[23, 92, 120, 333, 352, 424]]
     ref = reference_orbits(ics, section=True, t_max=5.0)
@@ -143,15 +143,13 @@ def test_cmeasure_distance_small():
 
 
 def test_stress_tiny_end_to_end(tmp_path):
-    """``python -m hhscatter.bench.stress --scale tiny`` in a tmp studies root writes every case's CSV and summary.md."""
+    """``python -m benchmarks.stress --scale tiny`` with a tmp root writes every case's CSV and summary.md."""
     import shutil
     from pathlib import Path
 
-    src = Path(__file__).resolve().parents[2] / "studies" / "stress" / "stress.toml"
-    (tmp_path / "stress").mkdir()
-    shutil.copy(src, tmp_path / "stress" / "stress.toml")
+    shutil.copy(Path(__file__).resolve().parents[2] / "benchmarks" / "stress.toml", tmp_path / "stress.toml")
     rc = stress.main(["--scale", "tiny", "--root", str(tmp_path), "--only", "saddle_starts", "statistics"])
-    out = tmp_path / "stress" / "out" / "tiny"
+    out = tmp_path / "out" / "stress" / "tiny"
     assert rc == 0
     assert (out / "saddle_starts.csv").exists() and (out / "statistics.csv").exists()
     assert "| saddle_starts | ok |" in (out / "summary.md").read_text()

@@ -1,6 +1,6 @@
 """``make bench-memory``: peak memory of simulate + P(t) analysis as N grows.
 
-    python -m hhscatter.bench.memory [--n 1e5 1e6 1e7] [--energy 0.27] [--workers 1]
+    python -m benchmarks.memory [--n 1e5 1e6 1e7] [--energy 0.27] [--workers 1]
                                      [--chunk-size 10000] [--dir runs/bench-memory] [--keep]
 
 For each N, two fresh processes are measured by their peak resident set size
@@ -20,7 +20,7 @@ the fixed cost (Python, numpy, pyarrow, heyoka/LLVM and its JIT code).
 Simulation memory should not grow with N (O(chunk)); the Kaplan–Meier
 analysis grows by ~140 bytes per orbit (its arrays over all event times), the
 streamed one not at all. The slope per 1e6
-orbits is fitted and extrapolated. The issue's target: N = 1e7 under 2 GB.
+orbits is fitted and extrapolated. The target: N = 1e7 under 2 GB.
 At E = 0.27 one orbit costs ~20 µs on one core in the worst case (trapped
 orbits run to t_max), so N = 1e7 is minutes to hours depending on the machine.
 Not a test: numbers vary with the machine and its load.
@@ -84,7 +84,7 @@ def measure(stage: str, **kw) -> dict:
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m hhscatter.bench.memory", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="python -m benchmarks.memory", description=__doc__.splitlines()[0])
     p.add_argument("--n", nargs="+", type=float, default=[1e5, 1e6, 1e7], help="ensemble sizes")
     p.add_argument("--energy", type=float, default=0.27)
     p.add_argument("--workers", type=int, default=1)

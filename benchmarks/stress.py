@@ -5,9 +5,9 @@ Each case is a function that takes its size as arguments, runs the engine
 and an independent reference (heyoka long double, :mod:`.reference`), and
 returns a :class:`CaseResult` (table rows, a one-line finding, and ``ok``:
 whether the case's acceptance rule holds). ``tests/bench/test_stress.py`` calls the
-same functions at small size; ``python -m hhscatter.bench.stress`` runs them at
-the sizes of ``studies/stress/stress.toml`` and writes CSVs, a PNG and
-``summary.md`` under ``studies/stress/out/<scale>/``.
+same functions at small size; ``python -m benchmarks.stress`` runs them at
+the sizes of ``benchmarks/stress.toml`` and writes CSVs, a PNG and
+``summary.md`` under ``benchmarks/out/stress/<scale>/``.
 
 Cases:
   energy_drift        KAM-trapped orbits (E = 0.2) to t = 5000 and 5e4 per tolerance:
@@ -36,9 +36,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hhscatter.bench.config import load_config, machine_note, out_dir
-from hhscatter.bench.plots import plot_energy_drift
-from hhscatter.bench.reference import reference_orbits
+from benchmarks.config import load_config, machine_note, out_dir
+from benchmarks.plots import plot_energy_drift
+from benchmarks.reference import reference_orbits
 from hhscatter.data.read import read_lifetimes, read_sections, read_snapshots
 from hhscatter.integrate.engine import (
     CENSORED,
@@ -582,13 +582,13 @@ def _kw(d):
 
 
 def main(argv=None):
-    """``python -m hhscatter.bench.stress [--scale full|tiny] [--only CASE ...]``: writes CSVs, PNG, summary.md."""
+    """``python -m benchmarks.stress [--scale full|tiny] [--only CASE ...]``: writes CSVs, PNG, summary.md."""
     import pandas as pd  # deferred: pandas loads on first use
 
 
     ap = argparse.ArgumentParser(description="hhscatter numerical stress tests (make stress)")
     ap.add_argument("--scale", default="full")
-    ap.add_argument("--root", default=None)
+    ap.add_argument("--root", default=None, help="folder of stress.toml and out/ (default: benchmarks/)")
     ap.add_argument("--only", nargs="*", default=None, help=f"subset of {list(CASES)}")
     a = ap.parse_args(argv)
     cfg = load_config("stress", a.scale, a.root)
