@@ -103,7 +103,13 @@ def claim4(claims, label, taus: pd.DataFrame, mu_gamma):
                    "agrees within 15 %" if abs(ratio - 1) <= 0.15 else f"differs by {100 * (ratio - 1):+.0f} %",
                    f"τ2,obs = {r['tau2_obs']:.1f} (first settling, N = {int(r['n'])}: decreases with N; order-statistic "
                    f"interval [{r['tau2_obs_lo']:.1f}, {r['tau2_obs_hi']:.1f}]), ln(E0/E_c)/(μγ) = "
-                   f"{r['tau2_pred']:.1f} ± {r['tau2_pred_err']:.1f} with μ measured", 1.0)
+                   f"{r['tau2_pred']:.{_decimals(r['tau2_pred_err'])}f} ± {r['tau2_pred_err']:.{_decimals(r['tau2_pred_err'])}f} "
+                   "with μ measured", 1.0)
+
+
+def _decimals(err: float) -> int:
+    """Decimal places that show an error to two significant digits (never "± 0.0" for a small error)."""
+    return max(1, 1 - int(np.floor(np.log10(err)))) if np.isfinite(err) and err > 0 else 1
 
 
 def fit_claim6(runs, label, m, per, taus, E0, mu) -> dict:
