@@ -1,4 +1,5 @@
 """``python -m benchmarks``: the work–precision benchmark (see :mod:`benchmarks.workprecision`)."""
+
 from benchmarks.workprecision import main
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ Outcome codes follow :mod:`hhscatter.integrate.engine`: 0 escaped, 1 settled,
 2 censored; 3 = "section found" (section mode), −1 = inconsistent end (an
 orbit reached r_far without a recorded outward r_esc crossing).
 """
+
 from __future__ import annotations
 
 import math
@@ -54,6 +55,7 @@ def _gval(kind, s, gamma, c):
 
 
 # -- KahanLi8: symmetric composition of 17 Störmer–Verlet (KDK) steps ----------
+
 
 @njit(cache=True)
 def kl8_step(s, h, a, b, out):
@@ -176,6 +178,7 @@ def kl8_run(ics, dt, r_esc, t_max, rootfind, mode, a, b):
 
 
 # -- DOP853 (Hairer's coefficients as shipped by SciPy), step control as SciPy --
+
 
 @njit(cache=True)
 def _rhs(s, gamma, out):

@@ -1,4 +1,5 @@
 """Configurations of ``make bench`` / ``make stress``: ``benchmarks/<name>.toml`` with ``[scale.<s>.*]`` overrides."""
+
 from __future__ import annotations
 
 import copy

@@ -30,6 +30,7 @@ Writes ``benchmarks/out/engine/<full|quick>/engine.csv`` and ``engine_summary.md
 (``make docs-assets`` copies them to the benchmarks page). Not a
 test: numbers vary with the machine; the ratios are what is reported.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -234,8 +235,17 @@ def _whole_rows(row, n, rep):
         ics = region_ics(Scene(energy=0.27, n=n, seed=1), 0, n)
         table = f"{tmp}/ics.parquet"
         pq.write_table(pa.table({c: ics[:, i] for i, c in enumerate(("x", "y", "px", "py"))}), table)
-        sim = py + ["-m", "hhscatter", "simulate", "--workers", "1", "--out", f"{tmp}/sim", "--overwrite",
-                    "--no-progress"]
+        sim = py + [
+            "-m",
+            "hhscatter",
+            "simulate",
+            "--workers",
+            "1",
+            "--out",
+            f"{tmp}/sim",
+            "--overwrite",
+            "--no-progress",
+        ]
         drv = py + ["-m", "benchmarks.engine", "--driver", str(n), "1", f"{tmp}/driver.parquet"]
         variants = {
             "ICs sampled": {"simulate": sim + ["--energy", "0.27", "-n", str(n), "--seed", "1"], "driver": drv},
@@ -250,8 +260,13 @@ def _whole_rows(row, n, rep):
                     best[k] = min(best[k], time.perf_counter() - t0)
             row("whole process", f"{label}: minimal driver, s (one Parquet table)", best["driver"], "")
             row("whole process", f"{label}: hhscatter simulate --workers 1, s", best["simulate"], "")
-            row("whole process", f"{label}: simulate / minimal driver", best["simulate"] / best["driver"], "≤ 1.2",
-                f"E = 0.27, N = {n}, imports and JIT included")
+            row(
+                "whole process",
+                f"{label}: simulate / minimal driver",
+                best["simulate"] / best["driver"],
+                "≤ 1.2",
+                f"E = 0.27, N = {n}, imports and JIT included",
+            )
 
 
 def main(argv=None):
@@ -261,10 +276,15 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-n", type=int, default=100_000, help="orbits per measurement (default 1e5)")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--whole-n", type=int, default=1_000_000,
-                    help="orbits of the whole-process rows (default 1e6, the whole-process target's N)")
-    ap.add_argument("--out", default=None, help="output folder (default benchmarks/out/engine/full, "
-                    "or .../quick for N < 1e5)")
+    ap.add_argument(
+        "--whole-n",
+        type=int,
+        default=1_000_000,
+        help="orbits of the whole-process rows (default 1e6, the whole-process target's N)",
+    )
+    ap.add_argument(
+        "--out", default=None, help="output folder (default benchmarks/out/engine/full, or .../quick for N < 1e5)"
+    )
     a = ap.parse_args(argv)
     n, rep = a.n, a.repeat
     rows = []
@@ -289,6 +309,7 @@ def _bare_rows(row, n, rep):
     """The bare conservative scene against the yardstick driver (µs/orbit and their ratio)."""
     from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
+
     # -- bare conservative vs the yardstick ----------------------------------------------
     cons = Scene(energy=0.27, n=n, seed=1, r_esc=1.03)
     ics = region_ics(cons, 0, n)
@@ -317,19 +338,30 @@ def _system_rows(row, n, rep):
     same = np.mean(np.abs(rd.lifetimes["t_end"] - rb.lifetimes["t_end"]) <= 1e-9 * rb.lifetimes["t_end"])
     row("systems", "built-in Hénon–Heiles: ns/step", 1e9 * t_b / rb.n_steps, "")
     row("systems", "declared '0.5*(x**2 + y**2) + x**2*y - y**3/3': ns/step", 1e9 * t_d / rd.n_steps, "")
-    row("systems", "declared / built-in, per step", (t_d / rd.n_steps) / (t_b / rb.n_steps), "≤ 1.05",
-        f"same t_end (1e-9) on {100 * same:.1f} % of orbits")
+    row(
+        "systems",
+        "declared / built-in, per step",
+        (t_d / rd.n_steps) / (t_b / rb.n_steps),
+        "≤ 1.05",
+        f"same t_end (1e-9) on {100 * same:.1f} % of orbits",
+    )
     for spec in ({"name": "contopoulos"}, {"name": "n_exit", "params": {"n": 4}}, {"name": "barbanis"}):
         sc = Scene(energy=1.5 * system_from_spec(spec).critical_energy, n=min(m, 20_000), system=spec)
         t, r = _best(_engine(sc, region_ics(sc, 0, sc.n)), rep)
-        row("systems", f"{spec['name']} at 1.5 E_c: ns/step", 1e9 * t / r.n_steps, "",
-            f"{r.n_steps / sc.n:.1f} steps/orbit")
+        row(
+            "systems",
+            f"{spec['name']} at 1.5 E_c: ns/step",
+            1e9 * t / r.n_steps,
+            "",
+            f"{r.n_steps / sc.n:.1f} steps/orbit",
+        )
 
 
 def _dissipative_rows(row, n, rep):
     """Dissipative against conservative at E0 = 0.3 on the same ICs; returns that scene and its ICs."""
     from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
+
     # -- dissipative vs conservative at the same energy -----------------------------------
     c3 = Scene(energy=0.3, n=n, seed=2, r_esc=1.03)
     d3 = c3.replace(gamma=0.01)
@@ -339,8 +371,13 @@ def _dissipative_rows(row, n, rep):
     sc_, sd_ = rc.n_steps / n, rd.n_steps / n
     row("dissipative", "conservative E = 0.3: µs/orbit", 1e6 * t_c / n, "", f"{sc_:.1f} steps/orbit")
     row("dissipative", "dissipative E0 = 0.3, γ = 0.01: µs/orbit", 1e6 * t_d / n, "", f"{sd_:.1f} steps/orbit")
-    row("dissipative", "dissipative / conservative", t_d / t_c, "≤ 1.6",
-        f"per step: {(t_d / rd.n_steps) / (t_c / rc.n_steps):.2f}×")
+    row(
+        "dissipative",
+        "dissipative / conservative",
+        t_d / t_c,
+        "≤ 1.6",
+        f"per step: {(t_d / rd.n_steps) / (t_c / rc.n_steps):.2f}×",
+    )
     return c3, ics3
 
 
@@ -352,14 +389,20 @@ def _loose_tolerance_rows(row, n, rep, c3, ics3):
         sc = c3.replace(gamma=gamma, tol=1e-9, n=m)
         t_l, _ = _best(_engine(sc, ics3[:m]), rep)
         t_p, _ = _best(lambda g=gamma: peers.dop853(ics3[:m], 1e-7, gamma=g, r_esc=1.03), rep)
-        row("loose tol", f"{label}: numba DOP853 (1e-7) / engine (1e-9)", t_p / t_l, "≥ 2",
-            f"engine {1e6 * t_l / m:.2f}, DOP853 {1e6 * t_p / m:.2f} µs/orbit")
+        row(
+            "loose tol",
+            f"{label}: numba DOP853 (1e-7) / engine (1e-9)",
+            t_p / t_l,
+            "≥ 2",
+            f"engine {1e6 * t_l / m:.2f}, DOP853 {1e6 * t_p / m:.2f} µs/orbit",
+        )
 
 
 def _recording_rows(row, n, rep):
     """Snapshots and the first section crossing against the bare scene; returns the recording scene and ICs."""
     from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
     from hhscatter.scene.scene import Scene, SectionWindow  # deferred: pydantic loads on first use
+
     # -- recording scene ---------------------------------------------------------------------
     m = min(n, 20_000)
     bare = Scene(energy=0.3, gamma=0.01, n=m, seed=3, r_esc=1.03)
@@ -369,8 +412,13 @@ def _recording_rows(row, n, rep):
     t_r, rr = _best(_engine(rec, icr), rep)
     n_rows = len(rr.snapshots["t"]) + len(rr.sections["t"])
     row("recording", "bare µs/orbit", 1e6 * t_b / m, "", f"{rb.n_steps / m:.1f} steps/orbit")
-    row("recording", "recording µs/orbit", 1e6 * t_r / m, "",
-        f"{rr.n_steps / m:.1f} steps/orbit, {n_rows / m:.1f} rows/orbit")
+    row(
+        "recording",
+        "recording µs/orbit",
+        1e6 * t_r / m,
+        "",
+        f"{rr.n_steps / m:.1f} steps/orbit, {n_rows / m:.1f} rows/orbit",
+    )
     row("recording", "recording / bare", t_r / t_b, "≤ 2")
     row("recording", "marginal µs per recorded row", 1e6 * (t_r - t_b) / max(n_rows, 1), "≤ 2")
     only_snap = bare.replace(snapshots=RECORD_SNAPSHOTS)
@@ -392,22 +440,32 @@ def _profile_row(row, rec, icr):
     prof.disable()
     stats = pstats.Stats(prof).stats
     total = sum(v[2] for v in stats.values())
-    inside = sum(v[2] for k, v in stats.items() if k[2] in ("propagate_grid", "propagate_until")
-                 or "propagate_grid" in k[2] or "propagate_until" in k[2])
-    row("profile", "recording: share inside heyoka's compiled propagation", inside / total, "",
-        "self time of propagate_*; the rest is Python (callbacks, epochs, numpy)")
+    inside = sum(
+        v[2]
+        for k, v in stats.items()
+        if k[2] in ("propagate_grid", "propagate_until") or "propagate_grid" in k[2] or "propagate_until" in k[2]
+    )
+    row(
+        "profile",
+        "recording: share inside heyoka's compiled propagation",
+        inside / total,
+        "",
+        "self time of propagate_*; the rest is Python (callbacks, epochs, numpy)",
+    )
 
 
 def _design_rows(row):
     """ns per lane-step of the propagation modes behind the epoch scheduler."""
     # -- the design choices behind the epoch scheduler -------------------------------------
     dc = design_choices()
-    for kind, label in (("until", "propagate_until (no recording)"), ("grid2", "propagate_grid, 2 points/epoch"),
-                        ("grid17", "propagate_grid, 17 points/epoch (snapshots every 0.5)"),
-                        ("step callback", "Python step callback copying the Taylor coefficients"),
-                        ("c_output", "propagate_until with c_output=True")):
-        row("design", f"ns per lane-step: {label}", dc[kind], "",
-            f"{dc[kind] / dc['until']:.2f}× propagate_until")
+    for kind, label in (
+        ("until", "propagate_until (no recording)"),
+        ("grid2", "propagate_grid, 2 points/epoch"),
+        ("grid17", "propagate_grid, 17 points/epoch (snapshots every 0.5)"),
+        ("step callback", "Python step callback copying the Taylor coefficients"),
+        ("c_output", "propagate_until with c_output=True"),
+    ):
+        row("design", f"ns per lane-step: {label}", dc[kind], "", f"{dc[kind] / dc['until']:.2f}× propagate_until")
 
 
 def _write_outputs(rows, out, n, rep):
@@ -422,7 +480,8 @@ def _write_outputs(rows, out, n, rep):
     lines += [f"| {r.target} | {r.measure} | {r.value:.3g} | {r.goal} | {r.note} |" for r in df.itertuples()]
     (out / "engine_summary.md").write_text(
         f"Engine targets, N = {n} per measurement, 1 core, best of {rep}; every ratio is "
-        "measured side by side in one run.\n\n" + "\n".join(lines) + "\n")
+        "measured side by side in one run.\n\n" + "\n".join(lines) + "\n"
+    )
     print(f"wrote {out / 'engine.csv'} and {out / 'engine_summary.md'}")
 
 

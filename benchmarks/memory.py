@@ -25,6 +25,7 @@ At E = 0.27 one orbit costs ~20 µs on one core in the worst case (trapped
 orbits run to t_max), so N = 1e7 is minutes to hours depending on the machine.
 Not a test: numbers vary with the machine and its load.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -70,8 +71,7 @@ def measure(stage: str, **kw) -> dict:
     """measure(stage, **kw) -> {'peak_mb', 'wall_s', 'stdout'} of one fresh Python process."""
     code = _SNIPPETS[stage].format(**kw)
     t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     # read the pipes before reaping: wait4 gives this child's own peak RSS (and its reaped children's)
     out, err = proc.stdout.read(), proc.stderr.read()
     _, status, usage = os.wait4(proc.pid, 0)
@@ -79,8 +79,12 @@ def measure(stage: str, **kw) -> dict:
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"{stage} failed (exit {proc.returncode}):\n{err[-2000:]}")
-    return {"peak_mb": usage.ru_maxrss / 1024.0, "wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
-            "stdout": out.strip()}
+    return {
+        "peak_mb": usage.ru_maxrss / 1024.0,
+        "wall_s": wall,
+        "cpu_s": usage.ru_utime + usage.ru_stime,
+        "stdout": out.strip(),
+    }
 
 
 def main(argv=None):
@@ -98,8 +102,11 @@ def main(argv=None):
     rows = []
     b = measure("baseline", energy=a.energy)
     print(f"baseline (imports + JIT + 64 orbits): peak {b['peak_mb']:.0f} MB", flush=True)
-    print(f"{'N':>10} {'sim peak MB':>12} {'sim wall s':>10} {'sim CPU s':>10} {'µs/orbit/core':>14} "
-          f"{'P(t) peak MB':>13} {'P(t) wall s':>11} {'grid P(t) MB':>13}  κ (KM)  κ (grid)", flush=True)
+    print(
+        f"{'N':>10} {'sim peak MB':>12} {'sim wall s':>10} {'sim CPU s':>10} {'µs/orbit/core':>14} "
+        f"{'P(t) peak MB':>13} {'P(t) wall s':>11} {'grid P(t) MB':>13}  κ (KM)  κ (grid)",
+        flush=True,
+    )
     for n in (int(x) for x in a.n):
         out = base / f"E{a.energy}-N{n}"
         sim = measure("simulate", energy=a.energy, n=n, workers=a.workers, chunk=a.chunk, out=out)
@@ -107,22 +114,38 @@ def main(argv=None):
         fit = json.loads(ana["stdout"].splitlines()[-1])
         st = measure("streamed", out=out)
         fit_st = json.loads(st["stdout"].splitlines()[-1])
-        row = {"n": n, "sim_peak_mb": sim["peak_mb"], "sim_wall_s": sim["wall_s"], "sim_cpu_s": sim["cpu_s"],
-               "us_per_orbit_core": 1e6 * sim["cpu_s"] / n, "analysis_peak_mb": ana["peak_mb"],
-               "analysis_wall_s": ana["wall_s"], **fit, "streamed_peak_mb": st["peak_mb"],
-               "streamed_wall_s": st["wall_s"], "streamed_kappa": fit_st["kappa"],
-               "streamed_kappa_err": fit_st["kappa_err"]}
+        row = {
+            "n": n,
+            "sim_peak_mb": sim["peak_mb"],
+            "sim_wall_s": sim["wall_s"],
+            "sim_cpu_s": sim["cpu_s"],
+            "us_per_orbit_core": 1e6 * sim["cpu_s"] / n,
+            "analysis_peak_mb": ana["peak_mb"],
+            "analysis_wall_s": ana["wall_s"],
+            **fit,
+            "streamed_peak_mb": st["peak_mb"],
+            "streamed_wall_s": st["wall_s"],
+            "streamed_kappa": fit_st["kappa"],
+            "streamed_kappa_err": fit_st["kappa_err"],
+        }
         rows.append(row)
-        print(f"{n:>10} {row['sim_peak_mb']:>12.0f} {row['sim_wall_s']:>10.1f} {row['sim_cpu_s']:>10.1f} "
-              f"{row['us_per_orbit_core']:>14.1f} {row['analysis_peak_mb']:>13.0f} {row['analysis_wall_s']:>11.1f}"
-              f" {row['streamed_peak_mb']:>13.0f}  {fit['kappa']:.4f} ± {fit['kappa_err']:.4f}"
-              f"  {fit_st['kappa']:.4f} ± {fit_st['kappa_err']:.4f}", flush=True)
+        print(
+            f"{n:>10} {row['sim_peak_mb']:>12.0f} {row['sim_wall_s']:>10.1f} {row['sim_cpu_s']:>10.1f} "
+            f"{row['us_per_orbit_core']:>14.1f} {row['analysis_peak_mb']:>13.0f} {row['analysis_wall_s']:>11.1f}"
+            f" {row['streamed_peak_mb']:>13.0f}  {fit['kappa']:.4f} ± {fit['kappa_err']:.4f}"
+            f"  {fit_st['kappa']:.4f} ± {fit_st['kappa_err']:.4f}",
+            flush=True,
+        )
         if not a.keep:
             shutil.rmtree(out, ignore_errors=True)
-    doc = {"energy": a.energy, "workers": a.workers, "chunk_size": a.chunk, "baseline_peak_mb": b["peak_mb"],
-           "rows": rows}
+    doc = {
+        "energy": a.energy,
+        "workers": a.workers,
+        "chunk_size": a.chunk,
+        "baseline_peak_mb": b["peak_mb"],
+        "rows": rows,
+    }
     if len(rows) >= 2:
-
         ns = np.array([r["n"] for r in rows], float)
         for key in ("sim_peak_mb", "analysis_peak_mb", "streamed_peak_mb"):
             slope, icept = np.polyfit(ns / 1e6, [r[key] for r in rows], 1)

@@ -30,6 +30,7 @@ engine's escape rules (:mod:`hhscatter.integrate.engine`), and return the same a
 numba is a benchmark-only dependency (extra ``bench``); it is imported on
 first use only.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -91,9 +92,7 @@ def _kernels():
     try:
         from benchmarks import _kernels as k  # deferred: numba compiles the kernels on import (optional [bench] extra)
     except ImportError as exc:  # numba missing
-        raise ImportError(
-            "the benchmark peers need numba: pip install -e '.[bench]' (or `make bench`)"
-        ) from exc
+        raise ImportError("the benchmark peers need numba: pip install -e '.[bench]' (or `make bench`)") from exc
     return k
 
 
@@ -129,8 +128,13 @@ def _dop_tables():
     from scipy.integrate._ivp import dop853_coefficients as d  # deferred: scipy loads on first use
 
     A = np.ascontiguousarray(d.A[:12, :12])
-    return A, np.ascontiguousarray(d.B), np.ascontiguousarray(d.C[:12]), np.ascontiguousarray(d.E3), \
-        np.ascontiguousarray(d.E5)
+    return (
+        A,
+        np.ascontiguousarray(d.B),
+        np.ascontiguousarray(d.C[:12]),
+        np.ascontiguousarray(d.E3),
+        np.ascontiguousarray(d.E5),
+    )
 
 
 def dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0, section=False) -> PeerResult:
@@ -146,8 +150,23 @@ def dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0, section
     k = _kernels()
     mode = k.MODE_SECTION if section else (k.MODE_DISSIPATIVE if gamma > 0 else k.MODE_ESCAPE)
     A, B, C, E3, E5 = _dop_tables()
-    o, t, s, n, _ = k.dop853_run(_check_ics(ics), float(gamma), float(tol), float(tol), float(r_esc),
-                                 float(r_far), E_C, R_SADDLE, float(t_max), mode, A, B, C, E3, E5)
+    o, t, s, n, _ = k.dop853_run(
+        _check_ics(ics),
+        float(gamma),
+        float(tol),
+        float(tol),
+        float(r_esc),
+        float(r_far),
+        E_C,
+        R_SADDLE,
+        float(t_max),
+        mode,
+        A,
+        B,
+        C,
+        E3,
+        E5,
+    )
     return PeerResult(o, t, s, n)
 
 
@@ -181,7 +200,7 @@ def scipy_dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0) -
 
     def ev_close(t, s):
         x, y, px, py = s
-        return 0.5 * (px * px + py * py) + 0.5 * (x * x + y * y) + x * x * y - y ** 3 / 3.0 - E_C
+        return 0.5 * (px * px + py * py) + 0.5 * (x * x + y * y) + x * x * y - y**3 / 3.0 - E_C
 
     def ev_far(t, s):
         return s[0] * s[0] + s[1] * s[1] - r_far * r_far
@@ -201,8 +220,7 @@ def scipy_dop853(ics, tol, *, gamma=0.0, r_esc=1.03, r_far=10.0, t_max=5000.0) -
         ev_far.terminal, ev_far.direction = True, 1
         t0, s0, steps, last_out = 0.0, ic, 0, None
         while True:
-            sol = solve_ivp(f, (t0, t_max), s0, method="DOP853", rtol=tol, atol=tol,
-                            events=[ev_esc, ev_close, ev_far])
+            sol = solve_ivp(f, (t0, t_max), s0, method="DOP853", rtol=tol, atol=tol, events=[ev_esc, ev_close, ev_far])
             steps += sol.t.size - 1
             for te, ye in zip(sol.t_events[0], sol.y_events[0]):
                 last_out = (te, ye) if ye[0] * ye[2] + ye[1] * ye[3] > 0 else None
@@ -244,15 +262,24 @@ def engine(ics, tol, *, gamma=0.0, energy=None, r_esc=1.03, t_max=5000.0, batch_
     ics = _check_ics(ics)
     if energy is None:
         energy = float(HenonHeiles().energy(*ics[0]))
-    sc = Scene(energy=energy, n=len(ics), gamma=gamma, tol=tol, r_esc=r_esc, t_max=t_max, batch_size=batch_size,
-               sections=SectionWindow(first_only=True) if section else None)
+    sc = Scene(
+        energy=energy,
+        n=len(ics),
+        gamma=gamma,
+        tol=tol,
+        r_esc=r_esc,
+        t_max=t_max,
+        batch_size=batch_size,
+        sections=SectionWindow(first_only=True) if section else None,
+    )
     res = run_chunk(sc, ics, np.arange(len(ics)), batch_size=batch_size)
     lt = res.lifetimes
     st = np.full((len(ics), 4), np.nan)
     if not section:
         # run_chunk reports the end energy, not the end state
-        return PeerResult(lt["outcome"].copy(), lt["t_end"].copy(), None, np.zeros(len(ics), np.int64),
-                          e_end=lt["e_end"].copy())
+        return PeerResult(
+            lt["outcome"].copy(), lt["t_end"].copy(), None, np.zeros(len(ics), np.int64), e_end=lt["e_end"].copy()
+        )
     out = PeerResult(lt["outcome"].copy(), lt["t_end"].copy(), st, np.zeros(len(ics), np.int64))
     sec = res.sections
     idx = sec["traj_id"]

@@ -1,4 +1,5 @@
 """Plots of ``make bench`` / ``make stress``; they read the CSV tables and compute nothing."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -15,7 +16,6 @@ def plot_workprecision(csv_path, png_path):
     percentile of the relative escape-time error. Error bars: min–max µs/orbit.
     """
     import pandas as pd  # deferred: pandas loads on first use
-
 
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)
@@ -36,8 +36,17 @@ def plot_workprecision(csv_path, png_path):
                 x = g.us_per_orbit.to_numpy()
                 err = [x - g.us_min.to_numpy(), g.us_max.to_numpy() - x]
                 eng = bool(g.is_engine.iloc[0])
-                ax.errorbar(x, y, xerr=err, marker=markers[fams.index(f) % len(markers)], lw=2.2 if eng else 1.2,
-                            ms=6, capsize=2, label=f, color=colors[f])
+                ax.errorbar(
+                    x,
+                    y,
+                    xerr=err,
+                    marker=markers[fams.index(f) % len(markers)],
+                    lw=2.2 if eng else 1.2,
+                    ms=6,
+                    capsize=2,
+                    label=f,
+                    color=colors[f],
+                )
                 for xi, yi, s in zip(x, y, g.setting):
                     ax.annotate(s, (xi, yi), fontsize=6, xytext=(3, 3), textcoords="offset points")
             ax.set_xscale("log")
@@ -58,15 +67,19 @@ def plot_energy_drift(csv_path, png_path):
     """plot_energy_drift(csv, png) -> png path: max relative energy error vs t per tolerance (log–log)."""
     import pandas as pd  # deferred: pandas loads on first use
 
-
     plt = agg_pyplot()
     df = pd.read_csv(csv_path)
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for tol, g in df.groupby("tol"):
         g = g.sort_values("t")
         ax.plot(g.t, np.clip(g.max_rel_energy_err, _FLOOR, None), "o-", label=f"tol={tol:g} (max)")
-        ax.plot(g.t, np.clip(g.median_rel_energy_err, _FLOOR, None), "--", color=ax.lines[-1].get_color(),
-                label=f"tol={tol:g} (median)")
+        ax.plot(
+            g.t,
+            np.clip(g.median_rel_energy_err, _FLOOR, None),
+            "--",
+            color=ax.lines[-1].get_color(),
+            label=f"tol={tol:g} (median)",
+        )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("t")

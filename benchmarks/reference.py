@@ -15,6 +15,7 @@ the engine's scalar driver :func:`hhscatter.integrate.engine.simulate_orbit`:
 Results are plain float64 arrays (the rounding to double is far below the
 errors measured against them).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -32,8 +33,9 @@ from hhscatter.scene.scene import Scene, SectionWindow
 SECTION = STOPPED  # outcome of ``section=True``: stopped at the first section crossing
 
 
-def reference_orbit(ic, *, gamma=0.0, r_esc=1.03, t_max=5000.0, fp_type=np.longdouble, tol=None,
-                    section=False, model=None):
+def reference_orbit(
+    ic, *, gamma=0.0, r_esc=1.03, t_max=5000.0, fp_type=np.longdouble, tol=None, section=False, model=None
+):
     """reference_orbit(ic, gamma=0, r_esc=1.03, t_max=5000, fp_type=longdouble, tol=None, section=False)
     -> (outcome, t_end, state_end (4,), n_steps).
 
@@ -45,9 +47,16 @@ def reference_orbit(ic, *, gamma=0.0, r_esc=1.03, t_max=5000.0, fp_type=np.longd
     """
     model = model or HenonHeiles()
     # the scene's energy is only validated, never used: the initial condition sets the orbit's energy
-    scene = Scene(energy=2.0 * model.critical_energy, n=1, gamma=gamma, r_esc=r_esc, t_max=t_max,
-                  omega=model.omega, lam=model.lam,
-                  sections=SectionWindow(first_only=True, stop=True) if section else None)
+    scene = Scene(
+        energy=2.0 * model.critical_energy,
+        n=1,
+        gamma=gamma,
+        r_esc=r_esc,
+        t_max=t_max,
+        omega=model.omega,
+        lam=model.lam,
+        sections=SectionWindow(first_only=True, stop=True) if section else None,
+    )
     res = simulate_orbit(scene, ic, fp_type=fp_type, tol=tol)
     return int(res.outcome), float(res.t_end), _f(res.state_end), res.n_steps
 
@@ -60,8 +69,12 @@ def reference_orbits(ics, **kw):
     """reference_orbits(ics, **kw of reference_orbit) -> dict of arrays outcome, t_end, state_end, n_steps."""
     ics = np.asarray(ics, dtype=float)
     n = len(ics)
-    out = {"outcome": np.empty(n, np.int8), "t_end": np.empty(n), "state_end": np.empty((n, 4)),
-           "n_steps": np.empty(n, np.int64)}
+    out = {
+        "outcome": np.empty(n, np.int8),
+        "t_end": np.empty(n),
+        "state_end": np.empty((n, 4)),
+        "n_steps": np.empty(n, np.int64),
+    }
     for i, ic in enumerate(ics):
         o, t, s, k = reference_orbit(ic, **kw)
         out["outcome"][i], out["t_end"][i], out["state_end"][i], out["n_steps"][i] = o, t, s, k

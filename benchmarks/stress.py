@@ -25,6 +25,7 @@ Cases:
   cmeasure_distance   the fig5 section point set at tol 1e-12 vs 1e-15: sliced Wasserstein
                       distance against the split-half noise.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -73,13 +74,34 @@ def _energy(s):
     return MODEL.energy(s[..., 0], s[..., 1], s[..., 2], s[..., 3])
 
 
-def _run(ics, *, tol, energy=None, gamma=0.0, t_max=5000.0, r_esc=1.03, r_far=None, sections=None, snapshots=None,
-         batch_size=4):
+def _run(
+    ics,
+    *,
+    tol,
+    energy=None,
+    gamma=0.0,
+    t_max=5000.0,
+    r_esc=1.03,
+    r_far=None,
+    sections=None,
+    snapshots=None,
+    batch_size=4,
+):
     ics = np.ascontiguousarray(ics, dtype=float)
     if energy is None:
         energy = float(_energy(ics[0]))
-    sc = Scene(energy=max(energy, E_C + 1e-12), n=len(ics), gamma=gamma, tol=tol, t_max=t_max, r_esc=r_esc,
-               r_far=r_far, sections=sections, snapshots=snapshots, batch_size=batch_size)
+    sc = Scene(
+        energy=max(energy, E_C + 1e-12),
+        n=len(ics),
+        gamma=gamma,
+        tol=tol,
+        t_max=t_max,
+        r_esc=r_esc,
+        r_far=r_far,
+        sections=sections,
+        snapshots=snapshots,
+        batch_size=batch_size,
+    )
     return run_chunk(sc, ics, np.arange(len(ics)), batch_size=batch_size)
 
 
@@ -94,6 +116,7 @@ def backward(state, T):
 
 
 # -- long integrations ----------------------------------------------------------
+
 
 def kam_trapped_ics(energy=0.2, n_want=8, n_try=600, seed=4, t_sel=5000.0):
     """kam_trapped_ics(E, n_want, n_try, seed, t_sel) -> (n ≤ n_want, 4) ICs still inside at t_sel.
@@ -113,8 +136,17 @@ def _kam_trapped(energy, n_want, n_try, seed, t_sel):
     return ics[keep]
 
 
-def case_energy_drift(energy=0.2, n_orbits=8, tols=(1e-9, 1e-12, 1e-15), t_max=5000.0, n_times=12, seed=4,
-                      n_try=600, t_sel=5000.0, limit_1e15=1e-12):
+def case_energy_drift(
+    energy=0.2,
+    n_orbits=8,
+    tols=(1e-9, 1e-12, 1e-15),
+    t_max=5000.0,
+    n_times=12,
+    seed=4,
+    n_try=600,
+    t_sel=5000.0,
+    limit_1e15=1e-12,
+):
     """case_energy_drift(...) -> CaseResult: |H(t) − H(0)|/H(0) of KAM-trapped orbits at log-spaced t ≤ t_max.
 
     Energies before t_max are the engine's snapshots (dense output at the
@@ -144,25 +176,40 @@ def case_energy_drift(energy=0.2, n_orbits=8, tols=(1e-9, 1e-12, 1e-15), t_max=5
             m = ts == t
             if not m.any():
                 continue
-            rows.append({"tol": tol, "t": t, "n": int(m.sum()), "max_rel_energy_err": float(err[m].max()),
-                         "median_rel_energy_err": float(np.median(err[m])), "wall_s": wall})
+            rows.append(
+                {
+                    "tol": tol,
+                    "t": t,
+                    "n": int(m.sum()),
+                    "max_rel_energy_err": float(err[m].max()),
+                    "median_rel_energy_err": float(np.median(err[m])),
+                    "wall_s": wall,
+                }
+            )
         tt = np.array([r["t"] for r in rows if r["tol"] == tol])
         mx = np.array([r["max_rel_energy_err"] for r in rows if r["tol"] == tol])
         sel = (tt >= 10) & (mx > 0)
         slopes[tol] = float(np.polyfit(np.log(tt[sel]), np.log(mx[sel]), 1)[0]) if sel.sum() >= 2 else math.nan
     last = {r["tol"]: r for r in rows if r["t"] == t_max}
     ok = len(ics) > 0 and 1e-15 in last and last[1e-15]["max_rel_energy_err"] < limit_1e15
-    finding = (f"{len(ics)} KAM-trapped orbits (E={energy}, inside at t={t_sel:g}) to t={t_max:g}: max |ΔH|/H at "
-               "t_max = " + ", ".join(
-                   f"{last[t]['max_rel_energy_err']:.1e} (tol {t:g}, {last[t]['n']} orbits, growth ∝ t^{slopes[t]:.2f})"
-                   for t in tols if t in last))
+    finding = (
+        f"{len(ics)} KAM-trapped orbits (E={energy}, inside at t={t_sel:g}) to t={t_max:g}: max |ΔH|/H at "
+        "t_max = "
+        + ", ".join(
+            f"{last[t]['max_rel_energy_err']:.1e} (tol {t:g}, {last[t]['n']} orbits, growth ∝ t^{slopes[t]:.2f})"
+            for t in tols
+            if t in last
+        )
+    )
     return CaseResult("energy_drift", rows, finding, ok, {"slopes": slopes, "n_orbits": len(ics)})
 
 
 # -- near threshold ------------------------------------------------------------
 
-def case_near_threshold(deltas=(1e-2, 1e-3, 1e-4), n=200, t_max=5000.0, n_ref=20, t_ref=200.0, t_short=50.0,
-                        seed=4, tol=1e-15):
+
+def case_near_threshold(
+    deltas=(1e-2, 1e-3, 1e-4), n=200, t_max=5000.0, n_ref=20, t_ref=200.0, t_short=50.0, seed=4, tol=1e-15
+):
     """case_near_threshold(...) -> CaseResult for E = E_c + δ.
 
     Acceptance: outcomes are escaped or censored, t_end ∈ (0, t_max], energies
@@ -184,33 +231,53 @@ def case_near_threshold(deltas=(1e-2, 1e-3, 1e-4), n=200, t_max=5000.0, n_ref=20
         oc, te = lt["outcome"], lt["t_end"]
         esc = oc == ESCAPED
         e_err = np.abs(lt["e_end"][esc] - lt["e0"][esc]) / lt["e0"][esc]
-        valid = bool(np.isin(oc, (ESCAPED, CENSORED)).all() and np.isfinite(te).all() and (te > 0).all()
-                     and (te <= t_max).all() and np.isfinite(lt["e_end"]).all())
+        valid = bool(
+            np.isin(oc, (ESCAPED, CENSORED)).all()
+            and np.isfinite(te).all()
+            and (te > 0).all()
+            and (te <= t_max).all()
+            and np.isfinite(lt["e_end"]).all()
+        )
         ref = reference_orbits(ics[:n_ref], t_max=t_ref)
         sub = _run(ics[:n_ref], tol=tol, energy=E, t_max=t_ref).lifetimes
         short = (ref["outcome"] == ESCAPED) & (ref["t_end"] <= t_short)
         agree = (sub["outcome"] == ref["outcome"]) & (
-            (ref["outcome"] != ESCAPED) | (np.abs(sub["t_end"] - ref["t_end"]) <= 1e-6 * ref["t_end"]))
+            (ref["outcome"] != ESCAPED) | (np.abs(sub["t_end"] - ref["t_end"]) <= 1e-6 * ref["t_end"])
+        )
         # cost: steps per unit orbit time is bounded; a censored orbit is the most expensive one
         us = 1e6 * wall / n
-        row = {"delta": d, "energy": E, "n": n, "escaped": int(esc.sum()), "censored": int((oc == CENSORED).sum()),
-               "median_t_end": float(np.median(te)), "max_energy_err_at_escape": float(e_err.max()) if esc.any() else 0.0,
-               "valid": valid, "ref_n": n_ref, "ref_short_escapes": int(short.sum()),
-               "ref_agree_short": int(agree[short].sum()), "ref_agree_all_t_le_t_ref": int(agree.sum()),
-               "us_per_orbit": us, "steps_per_orbit": res.n_steps / n,
-               "steps_per_unit_time": res.n_steps / float(te.sum())}
+        row = {
+            "delta": d,
+            "energy": E,
+            "n": n,
+            "escaped": int(esc.sum()),
+            "censored": int((oc == CENSORED).sum()),
+            "median_t_end": float(np.median(te)),
+            "max_energy_err_at_escape": float(e_err.max()) if esc.any() else 0.0,
+            "valid": valid,
+            "ref_n": n_ref,
+            "ref_short_escapes": int(short.sum()),
+            "ref_agree_short": int(agree[short].sum()),
+            "ref_agree_all_t_le_t_ref": int(agree.sum()),
+            "us_per_orbit": us,
+            "steps_per_orbit": res.n_steps / n,
+            "steps_per_unit_time": res.n_steps / float(te.sum()),
+        }
         rows.append(row)
         ok &= valid and row["max_energy_err_at_escape"] < 1e-12 and bool(agree[short].all())
-    finding = "; ".join(f"δ={r['delta']:g}: {r['escaped']}/{r['n']} escaped, median t_end {r['median_t_end']:.0f}, "
-                        f"max |ΔH|/H at escape {r['max_energy_err_at_escape']:.1e}, short escapes matching ref "
-                        f"{r['ref_agree_short']}/{r['ref_short_escapes']}, outcome and t_end (1e-6) as the reference to "
-                        f"t={t_ref:g} for {r['ref_agree_all_t_le_t_ref']}/{r['ref_n']}, "
-                        f"{r['steps_per_unit_time']:.2f} steps per unit time"
-                        for r in rows)
+    finding = "; ".join(
+        f"δ={r['delta']:g}: {r['escaped']}/{r['n']} escaped, median t_end {r['median_t_end']:.0f}, "
+        f"max |ΔH|/H at escape {r['max_energy_err_at_escape']:.1e}, short escapes matching ref "
+        f"{r['ref_agree_short']}/{r['ref_short_escapes']}, outcome and t_end (1e-6) as the reference to "
+        f"t={t_ref:g} for {r['ref_agree_all_t_le_t_ref']}/{r['ref_n']}, "
+        f"{r['steps_per_unit_time']:.2f} steps per unit time"
+        for r in rows
+    )
     return CaseResult("near_threshold", rows, finding, ok)
 
 
 # -- grazing events ------------------------------------------------------------
+
 
 def _classify(t_eng, o_eng, t_ref, o_ref, rtol=1e-6):
     """(agree, missed, spurious) per orbit: missed = engine ends later than the reference (or not at all)."""
@@ -257,14 +324,23 @@ def case_saddle_starts(offsets=(0.0, 1e-8, 1e-4, 1e-2), n_dir=8, tols=(1e-9, 1e-
         agree, missed, spur = _classify(lt["t_end"], lt["outcome"], ref["t_end"], ref["outcome"])
         for off in offsets:
             m = offs == off
-            rows.append({"tol": tol, "offset": off, "n": int(m.sum()), "ref_escaped": int((ref["outcome"][m] == 0).sum()),
-                         "agree": int(agree[m].sum()), "missed": int(missed[m].sum()),
-                         "spurious": int(spur[m].sum())})
+            rows.append(
+                {
+                    "tol": tol,
+                    "offset": off,
+                    "n": int(m.sum()),
+                    "ref_escaped": int((ref["outcome"][m] == 0).sum()),
+                    "agree": int(agree[m].sum()),
+                    "missed": int(missed[m].sum()),
+                    "spurious": int(spur[m].sum()),
+                }
+            )
         if tol == min(tols):
             ok = not (missed.any() or spur.any())
     bad = {t: sum(r["missed"] + r["spurious"] for r in rows if r["tol"] == t) for t in tols}
     finding = f"{len(ics)} saddle starts: disagreements with the reference " + ", ".join(
-        f"{bad[t]} at tol {t:g}" for t in tols)
+        f"{bad[t]} at tol {t:g}" for t in tols
+    )
     return CaseResult("saddle_starts", rows, finding, ok)
 
 
@@ -288,8 +364,10 @@ def _tangent_points(energy=0.27, r_t=1.03, rdd=-0.02):
                 return rddot(axis + side * u)
 
             us = np.linspace(0.0, 0.5, 2001)
-            vals = [f(u) if 2 * (energy - (r_t**2 / 2 + r_t**3 * math.sin(3 * (axis + side * u)) / 3)) > 0
-                    else np.nan for u in us]
+            vals = [
+                f(u) if 2 * (energy - (r_t**2 / 2 + r_t**3 * math.sin(3 * (axis + side * u)) / 3)) > 0 else np.nan
+                for u in us
+            ]
             j = next((i for i in range(len(us) - 1) if vals[i] > 0 > vals[i + 1]), None)
             if j is None:
                 continue
@@ -303,9 +381,12 @@ def _tangent_points(energy=0.27, r_t=1.03, rdd=-0.02):
     return pts
 
 
-def case_tangent_resc(gaps=(1e-4, 1e-6, 1e-9, 1e-12, 1e-14, -1e-14, -1e-12, -1e-9, -1e-6, -1e-4),
-                      tols=(1e-9, 1e-12, 1e-15), T=0.3,
-                      r_esc=1.03):
+def case_tangent_resc(
+    gaps=(1e-4, 1e-6, 1e-9, 1e-12, 1e-14, -1e-14, -1e-12, -1e-9, -1e-6, -1e-4),
+    tols=(1e-9, 1e-12, 1e-15),
+    T=0.3,
+    r_esc=1.03,
+):
     """case_tangent_resc(...) -> CaseResult: orbits whose r(t) has a maximum r_esc − gap at t = T.
 
     gap > 0: the orbit touches r = r_esc − gap from inside (no escape there);
@@ -328,14 +409,25 @@ def case_tangent_resc(gaps=(1e-4, 1e-6, 1e-9, 1e-12, 1e-14, -1e-14, -1e-12, -1e-
         agree, missed, spur = _classify(lt["t_end"], lt["outcome"], ref["t_end"], ref["outcome"])
         for g in gaps:
             m = gs == g
-            rows.append({"tol": tol, "gap": g, "n": int(m.sum()), "ref_escaped": int((ref["outcome"][m] == 0).sum()),
-                         "agree": int(agree[m].sum()), "missed": int(missed[m].sum()), "spurious": int(spur[m].sum())})
+            rows.append(
+                {
+                    "tol": tol,
+                    "gap": g,
+                    "n": int(m.sum()),
+                    "ref_escaped": int((ref["outcome"][m] == 0).sum()),
+                    "agree": int(agree[m].sum()),
+                    "missed": int(missed[m].sum()),
+                    "spurious": int(spur[m].sum()),
+                }
+            )
         if tol == min(tols):
             big = np.abs(gs) >= 1e-9
             ok = not (missed[big].any() or spur[big].any())
     finding = "tangent to r_esc: " + "; ".join(
         f"tol {t:g}: missed {sum(r['missed'] for r in rows if r['tol'] == t)}, spurious "
-        f"{sum(r['spurious'] for r in rows if r['tol'] == t)} of {len(ics)}" for t in tols)
+        f"{sum(r['spurious'] for r in rows if r['tol'] == t)} of {len(ics)}"
+        for t in tols
+    )
     return CaseResult("tangent_resc", rows, finding, ok)
 
 
@@ -371,8 +463,13 @@ def reference_section_times(ic, t_max, r_esc=1.03):
     return np.array([float(r[0]) for r in res.sections])
 
 
-def case_section_skim(etas=(1e-2, 1e-5, 1e-8, 1e-11, 1e-13, -1e-13, -1e-11, -1e-8, -1e-5, -1e-2),
-                      tols=(1e-9, 1e-12, 1e-15), T=1.0, window=0.3, match=1e-7):
+def case_section_skim(
+    etas=(1e-2, 1e-5, 1e-8, 1e-11, 1e-13, -1e-13, -1e-11, -1e-8, -1e-5, -1e-2),
+    tols=(1e-9, 1e-12, 1e-15),
+    T=1.0,
+    window=0.3,
+    match=1e-7,
+):
     """case_section_skim(...) -> CaseResult: near double roots of x px + y py = 0 at t = T.
 
     At t = T the orbit has ṙ ≈ η and d(r ṙ)/dt ≈ η²: two crossings a time
@@ -404,22 +501,40 @@ def case_section_skim(etas=(1e-2, 1e-5, 1e-8, 1e-11, 1e-13, -1e-13, -1e-11, -1e-
             dup[i] = max(ne - nr, unmatched_eng, 0)
         for eta in etas:
             m = es == eta
-            rows.append({"tol": tol, "eta": eta, "n": int(m.sum()),
-                         "ref_crossings_near_T": int(sum((np.abs(ref[i] - T) <= window).sum() for i in np.flatnonzero(m))),
-                         "missed": int(missed[m].sum()), "duplicated": int(dup[m].sum())})
+            rows.append(
+                {
+                    "tol": tol,
+                    "eta": eta,
+                    "n": int(m.sum()),
+                    "ref_crossings_near_T": int(sum((np.abs(ref[i] - T) <= window).sum() for i in np.flatnonzero(m))),
+                    "missed": int(missed[m].sum()),
+                    "duplicated": int(dup[m].sum()),
+                }
+            )
         if tol == min(tols):
             big = np.abs(es) >= 1e-8
             ok = not (missed[big].any() or dup[big].any())
     finding = "skimming the section: " + "; ".join(
         f"tol {t:g}: missed {sum(r['missed'] for r in rows if r['tol'] == t)}, duplicated "
-        f"{sum(r['duplicated'] for r in rows if r['tol'] == t)} ({len(ics)} orbits)" for t in tols)
+        f"{sum(r['duplicated'] for r in rows if r['tol'] == t)} ({len(ics)} orbits)"
+        for t in tols
+    )
     return CaseResult("section_skim", rows, finding, ok)
 
 
 # -- dissipation extremes ------------------------------------------------------
 
-def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3, 1e8), r_far_gamma=1e-1,
-                              n_ref=20, t_max=5000.0, seed=6, tol=1e-15):
+
+def case_dissipation_extremes(
+    gammas=(1e-5, 1e-1, 1.0),
+    n=500,
+    r_fars=(None, 1e3, 1e8),
+    r_far_gamma=1e-1,
+    n_ref=20,
+    t_max=5000.0,
+    seed=6,
+    tol=1e-15,
+):
     """case_dissipation_extremes(...) -> CaseResult: runs through :func:`hhscatter.run.runner.simulate` and its Parquet tables.
 
     Acceptance: every float column of every table is finite; outcomes valid;
@@ -433,8 +548,18 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
     cases = [(g, None) for g in gammas] + [(r_far_gamma, rf) for rf in r_fars if rf is not None]
     rows, ok = [], True
     for g, rf in cases:
-        sc = Scene(energy=0.3, gamma=g, n=n, seed=seed, tol=tol, t_max=t_max, r_far=rf, chunk_size=max(n // 2, 1),
-                   sections=SectionWindow(t_from=1.0), snapshots=(0.0, 1.0, 10.0, 100.0))
+        sc = Scene(
+            energy=0.3,
+            gamma=g,
+            n=n,
+            seed=seed,
+            tol=tol,
+            t_max=t_max,
+            r_far=rf,
+            chunk_size=max(n // 2, 1),
+            sections=SectionWindow(t_from=1.0),
+            snapshots=(0.0, 1.0, 10.0, 100.0),
+        )
         err = None
         with tempfile.TemporaryDirectory() as d:
             t0 = time.perf_counter()
@@ -444,15 +569,16 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
                 err = f"{type(exc).__name__}: {exc}"
             wall = time.perf_counter() - t0
             if err is None:
-
                 lt = read_lifetimes(d)
                 tabs = {"lifetimes": lt, "sections": read_sections(d), "snapshots": read_snapshots(d)}
         if err is not None:
             rows.append({"gamma": g, "r_far": rf, "error": err})
             ok = False
             continue
-        nonfinite = {k: int(sum((~np.isfinite(v[c].to_numpy(dtype=float))).sum()
-                                for c in v.columns if v[c].dtype.kind == "f")) for k, v in tabs.items()}
+        nonfinite = {
+            k: int(sum((~np.isfinite(v[c].to_numpy(dtype=float))).sum() for c in v.columns if v[c].dtype.kind == "f"))
+            for k, v in tabs.items()
+        }
         oc = lt["outcome"].to_numpy()
         e0, ee = lt["e0"].to_numpy(), lt["e_end"].to_numpy()
         settled, esc = oc == "settled", oc == "escaped"
@@ -470,25 +596,49 @@ def case_dissipation_extremes(gammas=(1e-5, 1e-1, 1.0), n=500, r_fars=(None, 1e3
         same = o_eng == ref["outcome"]
         short = same & (ref["t_end"] <= 20) & (ref["outcome"] != CENSORED)
         t_ok = np.abs(t_eng[short] - ref["t_end"][short]) <= 1e-6 * ref["t_end"][short]
-        row = {"gamma": g, "r_far": rf if rf is not None else "default", "n": n, "escaped": int(esc.sum()),
-               "settled": int(settled.sum()), "censored": int((oc == "censored").sum()),
-               "nonfinite_values": sum(nonfinite.values()), "settled_energy_err": s_err,
-               "max_energy_rise_escaped": rise, "ref_outcome_agree": int(same.sum()), "ref_n": n_ref,
-               "ref_short_t_agree": int(t_ok.sum()), "ref_short": int(short.sum()), "wall_s": wall, "error": ""}
+        row = {
+            "gamma": g,
+            "r_far": rf if rf is not None else "default",
+            "n": n,
+            "escaped": int(esc.sum()),
+            "settled": int(settled.sum()),
+            "censored": int((oc == "censored").sum()),
+            "nonfinite_values": sum(nonfinite.values()),
+            "settled_energy_err": s_err,
+            "max_energy_rise_escaped": rise,
+            "ref_outcome_agree": int(same.sum()),
+            "ref_n": n_ref,
+            "ref_short_t_agree": int(t_ok.sum()),
+            "ref_short": int(short.sum()),
+            "wall_s": wall,
+            "error": "",
+        }
         rows.append(row)
-        ok &= (row["nonfinite_values"] == 0 and s_err < 1e-12 and not rise > 1e-12 and bool(t_ok.all())
-               and row["ref_outcome_agree"] >= n_ref - 1)
+        ok &= (
+            row["nonfinite_values"] == 0
+            and s_err < 1e-12
+            and not rise > 1e-12
+            and bool(t_ok.all())
+            and row["ref_outcome_agree"] >= n_ref - 1
+        )
     finding = "; ".join(
-        (f"γ={r['gamma']:g}, r_far={r['r_far']}: " + (r["error"] or
-         f"{r['escaped']} esc / {r['settled']} settled / {r['censored']} cens, non-finite {r['nonfinite_values']}, "
-         f"ref outcomes {r['ref_outcome_agree']}/{r['ref_n']}")) for r in rows)
+        (
+            f"γ={r['gamma']:g}, r_far={r['r_far']}: "
+            + (
+                r["error"]
+                or f"{r['escaped']} esc / {r['settled']} settled / {r['censored']} cens, non-finite {r['nonfinite_values']}, "
+                f"ref outcomes {r['ref_outcome_agree']}/{r['ref_n']}"
+            )
+        )
+        for r in rows
+    )
     return CaseResult("dissipation_extremes", rows, finding, ok)
 
 
 # -- statistical stability -----------------------------------------------------
 
-def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0), n_diss=5000,
-                    diss_gamma=0.01):
+
+def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0), n_diss=5000, diss_gamma=0.01):
     """case_statistics(...) -> CaseResult: P(t) at two tolerances on the same ICs.
 
     Conservative E = 0.27: two-sample KS test of the escape times, κ by
@@ -509,25 +659,36 @@ def case_statistics(n=20000, tols=(1e-12, 1e-15), seed=7, cons_window=(5.0, 30.0
         a, b = lts
         ks = ks_2samp(a["t_end"], b["t_end"], method="asymp")
         rel = np.abs(a["t_end"] - b["t_end"]) / b["t_end"]
-        row = {"scene": kind, "n": nn, "tol_a": tols[0], "tol_b": tols[1], "ks_stat": float(ks.statistic),
-               "ks_p": float(ks.pvalue), "outcome_differs": int((a["outcome"] != b["outcome"]).sum()),
-               "frac_t_differs_1e-6": float(np.mean(rel > 1e-6))}
+        row = {
+            "scene": kind,
+            "n": nn,
+            "tol_a": tols[0],
+            "tol_b": tols[1],
+            "ks_stat": float(ks.statistic),
+            "ks_p": float(ks.pvalue),
+            "outcome_differs": int((a["outcome"] != b["outcome"]).sum()),
+            "frac_t_differs_1e-6": float(np.mean(rel > 1e-6)),
+        }
         if g == 0:
             ka, kb = (escape_rate_mle(x["t_end"], x["outcome"] == ESCAPED, *cons_window) for x in lts)
-            row.update({"kappa_a": ka.kappa, "kappa_b": kb.kappa, "kappa_err": kb.kappa_err,
-                        "dkappa": ka.kappa - kb.kappa})
+            row.update(
+                {"kappa_a": ka.kappa, "kappa_b": kb.kappa, "kappa_err": kb.kappa_err, "dkappa": ka.kappa - kb.kappa}
+            )
             ok &= abs(row["dkappa"]) < kb.kappa_err
         ok &= row["ks_p"] > 0.01
         rows.append(row)
     c = rows[0]
-    finding = (f"tol 1e-12 vs 1e-15, same ICs: conservative KS p = {c['ks_p']:.3f}, κ = {c['kappa_a']:.5f} vs "
-               f"{c['kappa_b']:.5f} ± {c['kappa_err']:.5f}, {100 * c['frac_t_differs_1e-6']:.1f}% of t_end differ > 1e-6; "
-               f"dissipative KS p = {rows[1]['ks_p']:.3f}")
+    finding = (
+        f"tol 1e-12 vs 1e-15, same ICs: conservative KS p = {c['ks_p']:.3f}, κ = {c['kappa_a']:.5f} vs "
+        f"{c['kappa_b']:.5f} ± {c['kappa_err']:.5f}, {100 * c['frac_t_differs_1e-6']:.1f}% of t_end differ > 1e-6; "
+        f"dissipative KS p = {rows[1]['ks_p']:.3f}"
+    )
     return CaseResult("statistics", rows, finding, ok)
 
 
-def case_cmeasure_distance(n=100000, tols=(1e-12, 1e-15), energy=0.35, gamma=0.01, t_star=17.0, seed=8,
-                           n_proj=64, n_splits=4):
+def case_cmeasure_distance(
+    n=100000, tols=(1e-12, 1e-15), energy=0.35, gamma=0.01, t_star=17.0, seed=8, n_proj=64, n_splits=4
+):
     """case_cmeasure_distance(...) -> CaseResult: Fig. 5a point sets at two tolerances (same ICs).
 
     The dissipative ensemble of study fig5 (E2 = 0.35, γ = 0.01): position of
@@ -552,13 +713,22 @@ def case_cmeasure_distance(n=100000, tols=(1e-12, 1e-15), energy=0.35, gamma=0.0
     noise = []
     for _ in range(n_splits):
         perm = rng.permutation(len(P))
-        noise.append(sliced_wasserstein(P[perm[: len(P) // 2]], P[perm[len(P) // 2:]], n_proj=n_proj))
+        noise.append(sliced_wasserstein(P[perm[: len(P) // 2]], P[perm[len(P) // 2 :]], n_proj=n_proj))
     same_ids = len(np.intersect1d(ids[0], ids[1]))
-    row = {"n": n, "points_a": len(sets[0]), "points_b": len(sets[1]), "common_orbits": same_ids,
-           "sw_between_tols": d, "sw_split_half_noise": float(np.mean(noise)), "t_star": t_star}
+    row = {
+        "n": n,
+        "points_a": len(sets[0]),
+        "points_b": len(sets[1]),
+        "common_orbits": same_ids,
+        "sw_between_tols": d,
+        "sw_split_half_noise": float(np.mean(noise)),
+        "t_star": t_star,
+    }
     ok = len(P) >= 10 and d < row["sw_split_half_noise"]
-    finding = (f"Fig. 5a sets (E2={energy}, γ={gamma}, t*={t_star:g}): {len(sets[0])} vs {len(sets[1])} points, "
-               f"SW₁ between tol {tols[0]:g} and {tols[1]:g} = {d:.1e} vs split-half noise {np.mean(noise):.1e}")
+    finding = (
+        f"Fig. 5a sets (E2={energy}, γ={gamma}, t*={t_star:g}): {len(sets[0])} vs {len(sets[1])} points, "
+        f"SW₁ between tol {tols[0]:g} and {tols[1]:g} = {d:.1e} vs split-half noise {np.mean(noise):.1e}"
+    )
     return CaseResult("cmeasure_distance", [row], finding, ok)
 
 
@@ -585,7 +755,6 @@ def main(argv=None):
     """``python -m benchmarks.stress [--scale full|tiny] [--only CASE ...]``: writes CSVs, PNG, summary.md."""
     import pandas as pd  # deferred: pandas loads on first use
 
-
     ap = argparse.ArgumentParser(description="hhscatter numerical stress tests (make stress)")
     ap.add_argument("--scale", default="full")
     ap.add_argument("--root", default=None, help="folder of stress.toml and out/ (default: benchmarks/)")
@@ -610,19 +779,35 @@ def main(argv=None):
     drift = [n for n in ("energy_drift", "energy_drift_long") if (out / f"{n}.csv").exists()]
     for n in drift:
         plot_energy_drift(out / f"{n}.csv", out / f"{n}.png")
-    L = ["# Stress tests (`make stress`)", "",
-         f"Scale `{a.scale}`, config `{cfg['_path']}`. Machine shared with other jobs ({note0} at start; "
-         f"{machine_note()} at end); total {time.perf_counter() - t_all:.0f} s.", "",
-         "| case | verdict | seconds | finding |", "|---|---|---|---|"]
+    L = [
+        "# Stress tests (`make stress`)",
+        "",
+        f"Scale `{a.scale}`, config `{cfg['_path']}`. Machine shared with other jobs ({note0} at start; "
+        f"{machine_note()} at end); total {time.perf_counter() - t_all:.0f} s.",
+        "",
+        "| case | verdict | seconds | finding |",
+        "|---|---|---|---|",
+    ]
     for r in results:
         L.append(f"| {r.name} | {'ok' if r.ok else '**FAIL**'} | {r.extra['seconds']:.0f} | {r.finding} |")
-    L += ["", "Per-case tables: `<case>.csv` beside this file; energy drift plots: "
-          + ", ".join(f"`{n}.png`" for n in drift) + ".", ""]
+    L += [
+        "",
+        "Per-case tables: `<case>.csv` beside this file; energy drift plots: "
+        + ", ".join(f"`{n}.png`" for n in drift)
+        + ".",
+        "",
+    ]
     for r in results:
-        L += [f"## {r.name}", "", pd.DataFrame(r.rows).to_markdown(index=False) if _has_tabulate() else
-              pd.DataFrame(r.rows).to_string(index=False), ""]
+        L += [
+            f"## {r.name}",
+            "",
+            pd.DataFrame(r.rows).to_markdown(index=False)
+            if _has_tabulate()
+            else pd.DataFrame(r.rows).to_string(index=False),
+            "",
+        ]
     (out / "summary.md").write_text("\n".join(L))
-    print("\n".join(L[:8 + len(results)]))
+    print("\n".join(L[: 8 + len(results)]))
     print(f"wrote {out}/summary.md")
     return 0 if all(r.ok for r in results) else 1
 

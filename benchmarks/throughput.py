@@ -8,6 +8,7 @@ over the pool. Reported: wall µs/orbit (what the user waits), CPU µs/orbit/cor
 (sum of chunk times / N) and the wall time extrapolated to ``extrapolate_n``
 orbits (linear in N: orbits are independent).
 """
+
 from __future__ import annotations
 
 import json
@@ -60,8 +61,14 @@ def measure_one(scene, workers):
         wall = time.perf_counter() - t0
     cpu = sum(r[0] for r in res)
     oc = sum(r[1] for r in res)
-    return {"wall_s": wall, "us_wall": 1e6 * wall / n, "us_cpu_per_core": 1e6 * cpu / n,
-            "escaped": int(oc[0]), "settled": int(oc[1]), "censored": int(oc[2])}
+    return {
+        "wall_s": wall,
+        "us_wall": 1e6 * wall / n,
+        "us_cpu_per_core": 1e6 * cpu / n,
+        "escaped": int(oc[0]),
+        "settled": int(oc[1]),
+        "censored": int(oc[2]),
+    }
 
 
 def measure_throughput(cfg, *, progress=True):
@@ -73,35 +80,59 @@ def measure_throughput(cfg, *, progress=True):
 
     tp = cfg["throughput"]
     b = cfg["bench"]
-    scenes = [Scene(energy=E, n=tp["n"], seed=b["seed"], tol=tp["tol"], name=f"E={E:g}, γ=0")
-              for E in tp["energies"]]
-    scenes += [Scene(energy=tp["dissipative_energy"], gamma=g, n=tp["n"], seed=b["seed"], tol=tp["tol"],
-                     name=f"E0={tp['dissipative_energy']:g}, γ={g:g}") for g in tp["gammas"]]
+    scenes = [Scene(energy=E, n=tp["n"], seed=b["seed"], tol=tp["tol"], name=f"E={E:g}, γ=0") for E in tp["energies"]]
+    scenes += [
+        Scene(
+            energy=tp["dissipative_energy"],
+            gamma=g,
+            n=tp["n"],
+            seed=b["seed"],
+            tol=tp["tol"],
+            name=f"E0={tp['dissipative_energy']:g}, γ={g:g}",
+        )
+        for g in tp["gammas"]
+    ]
     allw = default_workers()
     rows = []
     for sc in scenes:
         for w in sorted({1, allw}):
             r = measure_one(sc, w)
-            r.update({"scene": sc.name, "workers": w, "n": sc.n,
-                      "extrapolated_wall_s": r["us_wall"] * 1e-6 * tp["extrapolate_n"]})
+            r.update(
+                {
+                    "scene": sc.name,
+                    "workers": w,
+                    "n": sc.n,
+                    "extrapolated_wall_s": r["us_wall"] * 1e-6 * tp["extrapolate_n"],
+                }
+            )
             rows.append(r)
             if progress:
-                print(f"  {sc.name:16s} workers={w}: {r['us_wall']:.1f} µs/orbit wall, "
-                      f"{r['us_cpu_per_core']:.1f} µs/orbit/core", flush=True)
+                print(
+                    f"  {sc.name:16s} workers={w}: {r['us_wall']:.1f} µs/orbit wall, "
+                    f"{r['us_cpu_per_core']:.1f} µs/orbit/core",
+                    flush=True,
+                )
     return pd.DataFrame(rows)
 
 
 def throughput_markdown(df, cfg):
     """throughput_markdown(df, cfg) -> markdown table of :func:`measure_throughput`'s rows."""
     n_ex = cfg["throughput"]["extrapolate_n"]
-    L = ["## Engine throughput", "",
-         f"tol = {cfg['throughput']['tol']:g}, disk ICs, t_max = 5000, N = {int(df.n.iloc[0])} per row; compile time "
-         "excluded (once per process). Wall µs/orbit on a shared machine: the all-worker rows are only as "
-         "parallel as the other jobs on the machine allowed.", "",
-         f"| scene | workers | wall µs/orbit | CPU µs/orbit/core | escaped / settled / censored | "
-         f"wall for N = {n_ex:.0e} |", "|---|---|---|---|---|---|"]
+    L = [
+        "## Engine throughput",
+        "",
+        f"tol = {cfg['throughput']['tol']:g}, disk ICs, t_max = 5000, N = {int(df.n.iloc[0])} per row; compile time "
+        "excluded (once per process). Wall µs/orbit on a shared machine: the all-worker rows are only as "
+        "parallel as the other jobs on the machine allowed.",
+        "",
+        f"| scene | workers | wall µs/orbit | CPU µs/orbit/core | escaped / settled / censored | "
+        f"wall for N = {n_ex:.0e} |",
+        "|---|---|---|---|---|---|",
+    ]
     for _, r in df.iterrows():
         h = r.extrapolated_wall_s / 3600
-        L.append(f"| {r.scene} | {r.workers} | {r.us_wall:.1f} | {r.us_cpu_per_core:.1f} | "
-                 f"{r.escaped} / {r.settled} / {r.censored} | {r.extrapolated_wall_s:.0f} s ({h:.2f} h) |")
+        L.append(
+            f"| {r.scene} | {r.workers} | {r.us_wall:.1f} | {r.us_cpu_per_core:.1f} | "
+            f"{r.escaped} / {r.settled} / {r.censored} | {r.extrapolated_wall_s:.0f} s ({h:.2f} h) |"
+        )
     return "\n".join(L)

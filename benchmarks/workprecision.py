@@ -30,6 +30,7 @@ Metrics per method and setting, against the reference:
   section_err_*  section scene (conservative): max-norm of the state error at
                  the first crossing of ṙ = 0, φ̇ > 0 (where both find one).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -77,32 +78,55 @@ def methods_for(kind, cfg) -> list[Method]:
     out = []
     for tol in sc["engine_tols"]:
         for B in sc["engine_batch"]:
-            out.append(Method(
-                f"hhscatter engine (batch {B})", f"tol={tol:g}",
-                lambda x, tol=tol, B=B: peers.engine(x, tol, gamma=g, energy=E, r_esc=r_esc, t_max=t_max,
-                                                     batch_size=B),
-                section=(lambda x, tol=tol, B=B: peers.engine(x, tol, energy=E, r_esc=r_esc, t_max=t_max,
-                                                              batch_size=B, section=True)) if g == 0 else None,
-                is_engine=True))
+            out.append(
+                Method(
+                    f"hhscatter engine (batch {B})",
+                    f"tol={tol:g}",
+                    lambda x, tol=tol, B=B: peers.engine(
+                        x, tol, gamma=g, energy=E, r_esc=r_esc, t_max=t_max, batch_size=B
+                    ),
+                    section=(
+                        lambda x, tol=tol, B=B: peers.engine(
+                            x, tol, energy=E, r_esc=r_esc, t_max=t_max, batch_size=B, section=True
+                        )
+                    )
+                    if g == 0
+                    else None,
+                    is_engine=True,
+                )
+            )
     if g == 0:
         for dt in sc["kl8_dt"]:
             for root in (False, True):
                 fam = "KahanLi8 (escape root-found)" if root else "KahanLi8 (escape at step ends)"
-                out.append(Method(
-                    fam, f"dt={dt:g}",
-                    lambda x, dt=dt, root=root: peers.kahanli8(x, dt, r_esc=r_esc, t_max=t_max, rootfind=root),
-                    section=lambda x, dt=dt: peers.kahanli8(x, dt, r_esc=r_esc, t_max=t_max, section=True)))
+                out.append(
+                    Method(
+                        fam,
+                        f"dt={dt:g}",
+                        lambda x, dt=dt, root=root: peers.kahanli8(x, dt, r_esc=r_esc, t_max=t_max, rootfind=root),
+                        section=lambda x, dt=dt: peers.kahanli8(x, dt, r_esc=r_esc, t_max=t_max, section=True),
+                    )
+                )
     for tol in sc["dop853_tols"]:
-        out.append(Method(
-            "DOP853 (numba)", f"tol={tol:g}",
-            lambda x, tol=tol: peers.dop853(x, tol, gamma=g, r_esc=r_esc, t_max=t_max),
-            section=(lambda x, tol=tol: peers.dop853(x, tol, r_esc=r_esc, t_max=t_max, section=True))
-            if g == 0 else None))
+        out.append(
+            Method(
+                "DOP853 (numba)",
+                f"tol={tol:g}",
+                lambda x, tol=tol: peers.dop853(x, tol, gamma=g, r_esc=r_esc, t_max=t_max),
+                section=(lambda x, tol=tol: peers.dop853(x, tol, r_esc=r_esc, t_max=t_max, section=True))
+                if g == 0
+                else None,
+            )
+        )
     for tol in sc["scipy_tols"]:
-        out.append(Method(
-            "SciPy solve_ivp DOP853", f"tol={tol:g}",
-            lambda x, tol=tol: peers.scipy_dop853(x, tol, gamma=g, r_esc=r_esc, t_max=t_max),
-            subset=sc["scipy_n"]))
+        out.append(
+            Method(
+                "SciPy solve_ivp DOP853",
+                f"tol={tol:g}",
+                lambda x, tol=tol: peers.scipy_dop853(x, tol, gamma=g, r_esc=r_esc, t_max=t_max),
+                subset=sc["scipy_n"],
+            )
+        )
     return out
 
 
@@ -143,11 +167,16 @@ def check_reference(ics, ref, cache_dir, **kw):
     n = len(ics)
     same = q["outcome"] == ref["outcome"][:n]
     rel = np.abs(ref["t_end"][:n] - q["t_end"]) / q["t_end"]
-    return {"n": n, "outcome_agree": float(same.mean()), "max_rel_t_diff": float(rel[same].max()) if same.any() else np.nan,
-            "max_state_diff": float(np.abs(ref["state_end"][:n] - q["state_end"]).max())}
+    return {
+        "n": n,
+        "outcome_agree": float(same.mean()),
+        "max_rel_t_diff": float(rel[same].max()) if same.any() else np.nan,
+        "max_state_diff": float(np.abs(ref["state_end"][:n] - q["state_end"]).max()),
+    }
 
 
 # -- metrics -----------------------------------------------------------------
+
 
 def _q(a, p):
     a = np.asarray(a, dtype=float)
@@ -198,11 +227,11 @@ def section_accuracy(res, ref):
     same_t = both & (np.abs(res.t_end - ref["t_end"]) <= 1e-6 * np.maximum(ref["t_end"], 1.0))
     err = np.abs(res.state_end[same_t] - ref["state_end"][same_t]).max(axis=1) if same_t.any() else np.empty(0)
     mismatch = ((res.outcome == 3) != (ref["outcome"] == 3)) | (both & ~same_t)
-    return {"section_err_median": _q(err, 50), "section_err_p99": _q(err, 99),
-            "section_mismatch": int(mismatch.sum())}
+    return {"section_err_median": _q(err, 50), "section_err_p99": _q(err, 99), "section_mismatch": int(mismatch.sum())}
 
 
 # -- the run -----------------------------------------------------------------
+
 
 def run(cfg, out, *, progress=True):
     """run(cfg, out, progress=True) -> (DataFrame of rows, dict of reference checks). Writes nothing."""
@@ -224,8 +253,9 @@ def run(cfg, out, *, progress=True):
         if g == 0:
             ns = sc["section_n"]
             sec_ref = cached_reference(ics[:ns], out, progress=progress, section=True, **kw)
-            checks["section"] = check_reference(ics[: min(ns, cfg["reference"]["real128_n"])], sec_ref, out,
-                                                section=True, **kw)
+            checks["section"] = check_reference(
+                ics[: min(ns, cfg["reference"]["real128_n"])], sec_ref, out, section=True, **kw
+            )
         ms = methods_for(kind, cfg)
         setup = {}
         for m in ms:  # JIT compilation (numba, heyoka) outside the timings
@@ -253,9 +283,16 @@ def run(cfg, out, *, progress=True):
         for m in ms:
             x = ics[: m.subset] if m.subset else ics
             us = np.array(times[id(m)])
-            row = {"scene": kind, "family": m.family, "setting": m.setting, "is_engine": m.is_engine,
-                   "us_per_orbit": float(np.median(us)), "us_min": float(us.min()), "us_max": float(us.max()),
-                   **accuracy(results[id(m)], ref, x, kind)}
+            row = {
+                "scene": kind,
+                "family": m.family,
+                "setting": m.setting,
+                "is_engine": m.is_engine,
+                "us_per_orbit": float(np.median(us)),
+                "us_min": float(us.min()),
+                "us_max": float(us.max()),
+                **accuracy(results[id(m)], ref, x, kind),
+            }
             if m.is_engine:
                 row["setup_ms"] = 1e3 * setup[id(m)]
                 row["us_per_orbit_no_setup"] = row["us_per_orbit"] - 1e6 * setup[id(m)] / len(x)
@@ -282,14 +319,33 @@ def speed_ratios(df, metric="rel_err_median"):
                 ok = p[p[metric] <= e[metric]]
                 if len(ok):
                     best = ok.loc[ok.us_per_orbit.idxmin()]
-                    out.append({"scene": scene, "engine": f"{e.family} {e.setting}", "engine_err": e[metric],
-                                "engine_us": e.us_per_orbit, "peer": fam, "peer_setting": best.setting,
-                                "peer_err": best[metric], "peer_us": best.us_per_orbit,
-                                "ratio": best.us_per_orbit / e.us_per_orbit})
+                    out.append(
+                        {
+                            "scene": scene,
+                            "engine": f"{e.family} {e.setting}",
+                            "engine_err": e[metric],
+                            "engine_us": e.us_per_orbit,
+                            "peer": fam,
+                            "peer_setting": best.setting,
+                            "peer_err": best[metric],
+                            "peer_us": best.us_per_orbit,
+                            "ratio": best.us_per_orbit / e.us_per_orbit,
+                        }
+                    )
                 else:
-                    out.append({"scene": scene, "engine": f"{e.family} {e.setting}", "engine_err": e[metric],
-                                "engine_us": e.us_per_orbit, "peer": fam, "peer_setting": "none as accurate",
-                                "peer_err": p[metric].min(), "peer_us": np.nan, "ratio": np.nan})
+                    out.append(
+                        {
+                            "scene": scene,
+                            "engine": f"{e.family} {e.setting}",
+                            "engine_err": e[metric],
+                            "engine_us": e.us_per_orbit,
+                            "peer": fam,
+                            "peer_setting": "none as accurate",
+                            "peer_err": p[metric].min(),
+                            "peer_us": np.nan,
+                            "ratio": np.nan,
+                        }
+                    )
     return pd.DataFrame(out)
 
 
@@ -304,9 +360,18 @@ def peer_ratios(df, metric="rel_err_median"):
             ok = eng[eng[metric] <= p[metric]]
             if len(ok):
                 e = ok.loc[ok.us_per_orbit.idxmin()]
-                out.append({"scene": scene, "peer": f"{p.family} {p.setting}", "peer_err": p[metric],
-                            "peer_us": p.us_per_orbit, "engine": f"{e.family} {e.setting}", "engine_err": e[metric],
-                            "engine_us": e.us_per_orbit, "ratio": p.us_per_orbit / e.us_per_orbit})
+                out.append(
+                    {
+                        "scene": scene,
+                        "peer": f"{p.family} {p.setting}",
+                        "peer_err": p[metric],
+                        "peer_us": p.us_per_orbit,
+                        "engine": f"{e.family} {e.setting}",
+                        "engine_err": e[metric],
+                        "engine_us": e.us_per_orbit,
+                        "ratio": p.us_per_orbit / e.us_per_orbit,
+                    }
+                )
     return pd.DataFrame(out)
 
 
@@ -320,62 +385,94 @@ def _fmt(v, f="{:.2e}"):
 
 def summary_markdown(df, checks, ratios, pratios, note_start, note_end, seconds, cfg, throughput=None):
     """summary_markdown(...) -> str: the tables of summary.md."""
-    L = ["# Work–precision benchmark (`make bench`)", "",
-         f"Scale `{cfg['_scale']}`, config `{cfg['_path']}`. Single-threaded; every method ran the same ICs "
-         f"(seed {cfg['bench']['seed']}), {cfg['bench']['repeats']} timing repeats interleaved in shuffled order.",
-         f"**Timings were taken on a shared, loaded machine** ({note_start} at start; {note_end} at end): "
-         "absolute µs/orbit are noisy, the ratios between methods (same repeats) are the meaningful numbers.",
-         f"Total wall time of the benchmark: {seconds:.0f} s.", "",
-         "Reference: heyoka scalar Taylor in long double at its default tolerance (ε ≈ 1.1e-19), checked against "
-         "real128:", ""]
+    L = [
+        "# Work–precision benchmark (`make bench`)",
+        "",
+        f"Scale `{cfg['_scale']}`, config `{cfg['_path']}`. Single-threaded; every method ran the same ICs "
+        f"(seed {cfg['bench']['seed']}), {cfg['bench']['repeats']} timing repeats interleaved in shuffled order.",
+        f"**Timings were taken on a shared, loaded machine** ({note_start} at start; {note_end} at end): "
+        "absolute µs/orbit are noisy, the ratios between methods (same repeats) are the meaningful numbers.",
+        f"Total wall time of the benchmark: {seconds:.0f} s.",
+        "",
+        "Reference: heyoka scalar Taylor in long double at its default tolerance (ε ≈ 1.1e-19), checked against "
+        "real128:",
+        "",
+    ]
     for k, c in checks.items():
-        L.append(f"- {k}: {c['n']} orbits, outcome agreement {c['outcome_agree']:.3f}, max |Δt|/t = "
-                 f"{_fmt(c['max_rel_t_diff'])}, max |Δstate| = {_fmt(c['max_state_diff'])}")
-    L += ["", "## Work–precision table", "",
-          "rel_err: |t_end − t_ref|/t_ref (mismatched outcome = inf); short: orbits with t_ref ≤ 20. "
-          "energy_err: conservative |H_end − H_0|/H_0 at the escape point; dissipative |H_end − H_ref,end|/E0 for "
-          "escaped orbits. section_err: max-norm state error at the first section crossing (matched crossings); "
-          "section mismatch: orbits where the method finds no or another first crossing than the reference "
-          "(of `section_n` orbits).", "",
-          "| scene | method | setting | N | µs/orbit (min–max) | mismatch | rel_err median | p99 | p99 short | "
-          "frac ≤1e-6 | energy_err median | p99 | section_err median | p99 | section mismatch |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        L.append(
+            f"- {k}: {c['n']} orbits, outcome agreement {c['outcome_agree']:.3f}, max |Δt|/t = "
+            f"{_fmt(c['max_rel_t_diff'])}, max |Δstate| = {_fmt(c['max_state_diff'])}"
+        )
+    L += [
+        "",
+        "## Work–precision table",
+        "",
+        "rel_err: |t_end − t_ref|/t_ref (mismatched outcome = inf); short: orbits with t_ref ≤ 20. "
+        "energy_err: conservative |H_end − H_0|/H_0 at the escape point; dissipative |H_end − H_ref,end|/E0 for "
+        "escaped orbits. section_err: max-norm state error at the first section crossing (matched crossings); "
+        "section mismatch: orbits where the method finds no or another first crossing than the reference "
+        "(of `section_n` orbits).",
+        "",
+        "| scene | method | setting | N | µs/orbit (min–max) | mismatch | rel_err median | p99 | p99 short | "
+        "frac ≤1e-6 | energy_err median | p99 | section_err median | p99 | section mismatch |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for _, r in df.iterrows():
-        L.append(f"| {r.scene} | {r.family} | {r.setting} | {r.n} | {r.us_per_orbit:.1f} ({r.us_min:.1f}–{r.us_max:.1f})"
-                 f" | {r.outcome_mismatch} | {_fmt(r.rel_err_median)} | {_fmt(r.rel_err_p99)} | "
-                 f"{_fmt(r.rel_err_p99_short)} | {_fmt(r.get('frac_within_1e-6'), '{:.3f}')} | "
-                 f"{_fmt(r.energy_err_median)} | {_fmt(r.energy_err_p99)} | {_fmt(r.get('section_err_median'))} | "
-                 f"{_fmt(r.get('section_err_p99'))} | {_fmt(r.get('section_mismatch'), '{:.0f}')} |")
+        L.append(
+            f"| {r.scene} | {r.family} | {r.setting} | {r.n} | {r.us_per_orbit:.1f} ({r.us_min:.1f}–{r.us_max:.1f})"
+            f" | {r.outcome_mismatch} | {_fmt(r.rel_err_median)} | {_fmt(r.rel_err_p99)} | "
+            f"{_fmt(r.rel_err_p99_short)} | {_fmt(r.get('frac_within_1e-6'), '{:.3f}')} | "
+            f"{_fmt(r.energy_err_median)} | {_fmt(r.energy_err_p99)} | {_fmt(r.get('section_err_median'))} | "
+            f"{_fmt(r.get('section_err_p99'))} | {_fmt(r.get('section_mismatch'), '{:.0f}')} |"
+        )
     eng = df[df.is_engine]
-    L += ["", "Engine: fixed cost per `run_chunk` call (integrator construction with heyoka's JIT cache warm; "
-          "paid once per chunk of 10,000 orbits in production runs) and µs/orbit with it removed:", "",
-          "| scene | engine | setup ms/call | µs/orbit measured | µs/orbit without setup |", "|---|---|---|---|---|"]
+    L += [
+        "",
+        "Engine: fixed cost per `run_chunk` call (integrator construction with heyoka's JIT cache warm; "
+        "paid once per chunk of 10,000 orbits in production runs) and µs/orbit with it removed:",
+        "",
+        "| scene | engine | setup ms/call | µs/orbit measured | µs/orbit without setup |",
+        "|---|---|---|---|---|",
+    ]
     for _, r in eng.iterrows():
-        L.append(f"| {r.scene} | {r.family} {r.setting} | {r.setup_ms:.1f} | {r.us_per_orbit:.1f} | "
-                 f"{r.us_per_orbit_no_setup:.1f} |")
-    L += ["", "## Speed of hhscatter against each peer at equal or better accuracy", "",
-          "For each engine setting: the fastest setting of each peer whose median relative escape-time error is "
-          "≤ the engine's; ratio = t_peer / t_engine (> 1: the engine is faster).", "",
-          "| scene | engine | engine err | engine µs | peer | peer setting | peer err | peer µs | ratio |",
-          "|---|---|---|---|---|---|---|---|---|"]
+        L.append(
+            f"| {r.scene} | {r.family} {r.setting} | {r.setup_ms:.1f} | {r.us_per_orbit:.1f} | "
+            f"{r.us_per_orbit_no_setup:.1f} |"
+        )
+    L += [
+        "",
+        "## Speed of hhscatter against each peer at equal or better accuracy",
+        "",
+        "For each engine setting: the fastest setting of each peer whose median relative escape-time error is "
+        "≤ the engine's; ratio = t_peer / t_engine (> 1: the engine is faster).",
+        "",
+        "| scene | engine | engine err | engine µs | peer | peer setting | peer err | peer µs | ratio |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for _, r in ratios.iterrows():
-        L.append(f"| {r.scene} | {r.engine} | {_fmt(r.engine_err)} | {r.engine_us:.1f} | {r.peer} | {r.peer_setting} |"
-                 f" {_fmt(r.peer_err)} | {_fmt(r.peer_us, '{:.1f}')} | {_fmt(r.ratio, '{:.2f}')} |")
-    L += ["", "For each peer setting: the fastest engine setting at equal or better median error; "
-          "ratio = t_peer / t_engine.", "",
-          "| scene | peer | peer err | peer µs | engine | engine err | engine µs | ratio |", "|---|---|---|---|---|---|---|---|"]
+        L.append(
+            f"| {r.scene} | {r.engine} | {_fmt(r.engine_err)} | {r.engine_us:.1f} | {r.peer} | {r.peer_setting} |"
+            f" {_fmt(r.peer_err)} | {_fmt(r.peer_us, '{:.1f}')} | {_fmt(r.ratio, '{:.2f}')} |"
+        )
+    L += [
+        "",
+        "For each peer setting: the fastest engine setting at equal or better median error; ratio = t_peer / t_engine.",
+        "",
+        "| scene | peer | peer err | peer µs | engine | engine err | engine µs | ratio |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for _, r in pratios.iterrows():
-        L.append(f"| {r.scene} | {r.peer} | {_fmt(r.peer_err)} | {r.peer_us:.1f} | {r.engine} | {_fmt(r.engine_err)} |"
-                 f" {r.engine_us:.1f} | {r.ratio:.2f} |")
+        L.append(
+            f"| {r.scene} | {r.peer} | {_fmt(r.peer_err)} | {r.peer_us:.1f} | {r.engine} | {_fmt(r.engine_err)} |"
+            f" {r.engine_us:.1f} | {r.ratio:.2f} |"
+        )
     if throughput is not None:
-
         L += ["", throughput_markdown(throughput, cfg)]
     return "\n".join(L) + "\n"
 
 
 def main(argv=None):
     """``python -m benchmarks [--scale full|tiny] [--root DIR] [--no-throughput]``: writes CSV, PNG, summary.md."""
-
 
     ap = argparse.ArgumentParser(description="hhscatter work–precision benchmark (make bench)")
     ap.add_argument("--scale", default="full", help="full (default) or tiny")

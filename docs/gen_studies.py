@@ -19,6 +19,7 @@ generated" note for anything missing, so `make docs` never needs the studies.
 ``--check`` copies nothing and exits 1 if an asset differs from its source
 (e.g. to see whether the committed docs are stale).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -39,6 +40,7 @@ def study_names(root: Path) -> list:
     graph = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
     spec.loader.exec_module(graph)
     return [s.name for s in graph.studies(root / "studies")]
+
 
 BENCHES = ("bench", "stress", "engine")
 CSV_MAX_BYTES = 200_000  # larger CSVs stay out of the repository's docs
@@ -71,8 +73,12 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
     for name in study_names(ROOT):
         out = ROOT / "studies" / name / "out" / scale
         extra = [(p, p.name) for p in sorted(out.glob(f"{name}_*.png"))]  # a study's further figures
-        for src, target in ((out / f"{name}.png", f"{name}.png"), (out / f"{name}.json", f"{name}.json"),
-                            (out / "cost.json", f"{name}.cost.json"), *extra):
+        for src, target in (
+            (out / f"{name}.png", f"{name}.png"),
+            (out / f"{name}.json", f"{name}.json"),
+            (out / "cost.json", f"{name}.cost.json"),
+            *extra,
+        ):
             if src.exists():
                 pairs.append((src, dst / target))
             elif src.name != "cost.json":
@@ -91,8 +97,10 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
         for src in sorted(out.iterdir()):
             if not src.is_file():
                 continue
-            if src.name.endswith("summary.md") or src.suffix == ".png" or (
-                src.suffix == ".csv" and src.stat().st_size <= CSV_MAX_BYTES
+            if (
+                src.name.endswith("summary.md")
+                or src.suffix == ".png"
+                or (src.suffix == ".csv" and src.stat().st_size <= CSV_MAX_BYTES)
             ):
                 pairs.append((src, dst_dir / src.name))
     return pairs, missing
@@ -101,7 +109,9 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", default="quick", help="study scale whose outputs to copy (default: quick)")
-    ap.add_argument("--bench-scale", help="scale folder of benchmarks/out/<bench|stress|engine> to copy (default: full, else quick)")
+    ap.add_argument(
+        "--bench-scale", help="scale folder of benchmarks/out/<bench|stress|engine> to copy (default: full, else quick)"
+    )
     ap.add_argument("--check", action="store_true", help="copy nothing; exit 1 if an asset is stale")
     ap.add_argument("--studies-only", action="store_true", help="copy the studies' outputs, not the benchmarks'")
     a = ap.parse_args(argv)

@@ -1,4 +1,5 @@
 """``python -m hhscatter`` = the ``hhscatter`` command."""
+
 import sys
 
 from hhscatter.cli import main

@@ -1,4 +1,5 @@
 """The installed distribution's version (``pyproject.toml`` is its only source), recorded in every table's metadata."""
+
 from importlib.metadata import PackageNotFoundError, version
 
 __all__ = ["__version__"]

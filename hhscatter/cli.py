@@ -4,6 +4,7 @@ Exit status: 0 on success, 2 on bad input (the message names the parameter and
 its allowed range; nothing has been computed; no traceback), 1 on other
 failures.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -50,12 +51,15 @@ class _Parser(argparse.ArgumentParser):
         return opts
 
     def error(self, message):
-        from hhscatter.scene.schema import did_you_mean  # deferred: `hhscatter --help` starts without the engine and tables
+        from hhscatter.scene.schema import (
+            did_you_mean,  # deferred: `hhscatter --help` starts without the engine and tables
+        )
 
         m = re_unrecognized.match(message)
         if m:
-            hints = [did_you_mean(a.split("=", 1)[0], self._all_options())
-                     for a in m.group(1).split() if a.startswith("-")]
+            hints = [
+                did_you_mean(a.split("=", 1)[0], self._all_options()) for a in m.group(1).split() if a.startswith("-")
+            ]
             message += "".join(h.replace(" (", "; ", 1).rstrip(")") for h in hints if h)
         m = re_choice.search(message)
         if m:
@@ -106,20 +110,33 @@ def _snapshots(s):
 
 def _system_flags(s) -> None:
     """--system, --param, --dissipation of ``simulate`` (hhscatter.model.spec)."""
-    sy = s.add_argument_group("system", "the system as data (default Hénon–Heiles, ω = λ = 1, linear drag); they "
-                              "override the scene file's [system]")
-    sy.add_argument("--system", metavar="NAME|EXPR", help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
-                    "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'")
-    sy.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", default=[],
-                    help="a parameter of the system (repeatable), e.g. --param eps=0.25")
+    sy = s.add_argument_group(
+        "system",
+        "the system as data (default Hénon–Heiles, ω = λ = 1, linear drag); they override the scene file's [system]",
+    )
+    sy.add_argument(
+        "--system",
+        metavar="NAME|EXPR",
+        help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
+        "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'",
+    )
+    sy.add_argument(
+        "--param",
+        action="append",
+        type=_param,
+        metavar="NAME=VALUE",
+        default=[],
+        help="a parameter of the system (repeatable), e.g. --param eps=0.25",
+    )
     sy.add_argument("--dissipation", choices=["linear", "quadratic"], help="drag law: −γp (linear, default) or −γ|p|p")
 
 
 def build_parser():
     from hhscatter import __version__  # deferred: `hhscatter --help` starts without the engine and tables
 
-    p = _Parser(prog="hhscatter", description=DESCRIPTION, epilog=EPILOG,
-                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _Parser(
+        prog="hhscatter", description=DESCRIPTION, epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("--version", action="version", version=f"hhscatter {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -129,57 +146,99 @@ def build_parser():
         description="Integrate an ensemble of orbits of a system (Hénon–Heiles by default; exact event times) and write "
         "the lifetimes (and, if asked, sections/snapshots) tables as Parquet datasets.",
     )
-    s.add_argument("scene", nargs="?", help="scene TOML file (flags below override its values); with --resume and "
-                   "no scene file, the scene is read from OUT/scene.json")
+    s.add_argument(
+        "scene",
+        nargs="?",
+        help="scene TOML file (flags below override its values); with --resume and "
+        "no scene file, the scene is read from OUT/scene.json",
+    )
     s.add_argument("--scale", help="named scale in the scene file, e.g. 'paper' (default: quick)")
-    s.add_argument("--energy", type=_floats,
-                   help="initial energy E0 (> the system's E_c: 1/6 for Hénon–Heiles with ω=λ=1); a list 0.25,0.3 "
-                        "makes a grid run")
+    s.add_argument(
+        "--energy",
+        type=_floats,
+        help="initial energy E0 (> the system's E_c: 1/6 for Hénon–Heiles with ω=λ=1); a list 0.25,0.3 "
+        "makes a grid run",
+    )
     s.add_argument("--gamma", type=_floats, help="drag γ ≥ 0 (0 = conservative); a list 0,0.01 makes a grid run")
     s.add_argument("-n", type=_int, help="number of orbits N > 0 (per grid point); 1e5 is accepted")
     s.add_argument("--seed", type=_int, help="seed ≥ 0 (with the orbit index it fixes every orbit)")
-    s.add_argument("--region", choices=["disk", "well", "square"],
-                   help="initial-condition region: disk (r < radius), well (the well's part of V < E_c: the saddle "
-                        "triangle of Hénon–Heiles), square (the authors' [-r_s, r_s]² with V < E; orbits starting at "
-                        "r ≥ r_esc are escaped at t = 0)")
-    s.add_argument("--radius", type=_float, help="disk radius (default: half the system's saddle distance r_s; 0.5 for "
-                   "Hénon–Heiles)")
-    s.add_argument("--r-esc", type=_float, dest="r_esc", help="escape radius (default: the system's; 1.5 for Hénon–Heiles, the paper used "
-                   "1.03, see study resc)")
+    s.add_argument(
+        "--region",
+        choices=["disk", "well", "square"],
+        help="initial-condition region: disk (r < radius), well (the well's part of V < E_c: the saddle "
+        "triangle of Hénon–Heiles), square (the authors' [-r_s, r_s]² with V < E; orbits starting at "
+        "r ≥ r_esc are escaped at t = 0)",
+    )
+    s.add_argument(
+        "--radius",
+        type=_float,
+        help="disk radius (default: half the system's saddle distance r_s; 0.5 for Hénon–Heiles)",
+    )
+    s.add_argument(
+        "--r-esc",
+        type=_float,
+        dest="r_esc",
+        help="escape radius (default: the system's; 1.5 for Hénon–Heiles, the paper used 1.03, see study resc)",
+    )
     _system_flags(s)
     s.add_argument("--t-max", type=_float, dest="t_max", help="maximum orbit time (default 5000)")
     s.add_argument("--tol", type=_float, help="integrator tolerance in [1e-18, 1e-6] (default 1e-15)")
     s.add_argument("--chunk-size", type=_int, dest="chunk_size", help="orbits per part file (default 10000)")
     s.add_argument("--batch-size", type=_int, dest="batch_size", help="SIMD lanes (default: heyoka's choice)")
-    sec = s.add_argument_group("sections", "record crossings of the section ṙ = 0, φ̇ > 0 (any of these flags "
-                                "turns it on; they override the scene file's [sections])")
+    sec = s.add_argument_group(
+        "sections",
+        "record crossings of the section ṙ = 0, φ̇ > 0 (any of these flags "
+        "turns it on; they override the scene file's [sections])",
+    )
     sec.add_argument("--sections", action="store_true", help="record every crossing (t > 0)")
-    sec.add_argument("--sections-t-from", type=_float, dest="sections_t_from", metavar="T",
-                     help="only crossings at orbit time ≥ T")
-    sec.add_argument("--sections-t-to", type=_float, dest="sections_t_to", metavar="T",
-                     help="only crossings at orbit time ≤ T")
-    sec.add_argument("--sections-e-min", type=_float, dest="sections_e_min", metavar="E",
-                     help="only crossings with energy ≥ E")
-    sec.add_argument("--sections-e-max", type=_float, dest="sections_e_max", metavar="E",
-                     help="only crossings with energy ≤ E")
-    sec.add_argument("--sections-first-only", action="store_true", dest="sections_first_only",
-                     help="only the first crossing in the window per orbit")
-    s.add_argument("--snapshots", type=_snapshots, metavar="START:STOP:STEP|T1,T2,…",
-                   help="record the energy of every live orbit at these orbit times (overrides [snapshots])")
+    sec.add_argument(
+        "--sections-t-from", type=_float, dest="sections_t_from", metavar="T", help="only crossings at orbit time ≥ T"
+    )
+    sec.add_argument(
+        "--sections-t-to", type=_float, dest="sections_t_to", metavar="T", help="only crossings at orbit time ≤ T"
+    )
+    sec.add_argument(
+        "--sections-e-min", type=_float, dest="sections_e_min", metavar="E", help="only crossings with energy ≥ E"
+    )
+    sec.add_argument(
+        "--sections-e-max", type=_float, dest="sections_e_max", metavar="E", help="only crossings with energy ≤ E"
+    )
+    sec.add_argument(
+        "--sections-first-only",
+        action="store_true",
+        dest="sections_first_only",
+        help="only the first crossing in the window per orbit",
+    )
+    s.add_argument(
+        "--snapshots",
+        type=_snapshots,
+        metavar="START:STOP:STEP|T1,T2,…",
+        help="record the energy of every live orbit at these orbit times (overrides [snapshots])",
+    )
     s.add_argument("--ics", help="Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]")
-    s.add_argument("--out", required=True, help="output directory (named explicitly: '.' for the working directory), or "
-                   "a URL pyarrow/fsspec can write (s3://…)")
+    s.add_argument(
+        "--out",
+        required=True,
+        help="output directory (named explicitly: '.' for the working directory), or "
+        "a URL pyarrow/fsspec can write (s3://…)",
+    )
     s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
-    s.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
-                   "or a scheduler address tcp://HOST:PORT (needs the 'dask' extra)")
+    s.add_argument(
+        "--scheduler",
+        help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
+        "or a scheduler address tcp://HOST:PORT (needs the 'dask' extra)",
+    )
     g = s.add_mutually_exclusive_group()
     g.add_argument("--overwrite", action="store_true", help="replace the tables in a non-empty --out")
     g.add_argument("--resume", action="store_true", help="keep verified finished chunks in --out, redo the rest")
     _progress_flags(s)
 
-    v = sub.add_parser("survival", help="plot P(t) of one or more runs to a PNG (one curve per grid point)",
-                       description="Plot the Kaplan–Meier survival probability P(t) of one or more runs; a grid "
-                       "run gives one curve per (E0, γ) point.")
+    v = sub.add_parser(
+        "survival",
+        help="plot P(t) of one or more runs to a PNG (one curve per grid point)",
+        description="Plot the Kaplan–Meier survival probability P(t) of one or more runs; a grid "
+        "run gives one curve per (E0, γ) point.",
+    )
     v.add_argument("runs", nargs="+", help="run directories (outputs of simulate)")
     v.add_argument("--png", required=True, help="output PNG path (its folder must exist)")
     v.add_argument("--labels", nargs="*", help="curve labels, one per curve in order (default: E0, γ and N)")
@@ -190,14 +249,18 @@ def build_parser():
         description="Run a stage of a study in studies/<name>/: 'simulate' writes raw Parquet runs, "
         "'analyze' derived tables and <name>.json, 'plot' <name>.png; 'all' runs the three. The studies folder is "
         "studies/ of the repository the command runs in (the working directory or a parent), or --studies.",
-        epilog=_studies_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=_studies_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2; listed below")
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
     st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
-    st.add_argument("--studies", metavar="DIR", help="the studies folder (default: $HHSCATTER_STUDIES, else studies/ "
-                    "of the repository the command runs in)")
+    st.add_argument(
+        "--studies",
+        metavar="DIR",
+        help="the studies folder (default: $HHSCATTER_STUDIES, else studies/ of the repository the command runs in)",
+    )
     _progress_flags(st)
     return p
 
@@ -230,10 +293,18 @@ def _studies_epilog() -> str:
 
 def _progress_flags(parser):
     g = parser.add_mutually_exclusive_group()
-    g.add_argument("--progress", action="store_true",
-                   help="show progress even when stderr is not a terminal (then as plain lines, no carriage returns)")
-    g.add_argument("--no-progress", "--quiet", action="store_true", dest="quiet",
-                   help="no progress (default when stderr is not a terminal)")
+    g.add_argument(
+        "--progress",
+        action="store_true",
+        help="show progress even when stderr is not a terminal (then as plain lines, no carriage returns)",
+    )
+    g.add_argument(
+        "--no-progress",
+        "--quiet",
+        action="store_true",
+        dest="quiet",
+        help="no progress (default when stderr is not a terminal)",
+    )
 
 
 def _progress(a):
@@ -263,18 +334,33 @@ def _resumed_scene(out):
 def _scene_from_args(a):
     """The Scene (or, when --energy/--gamma or the file give lists, the Grid) of the simulate flags."""
     from hhscatter.scene.grid import run_from_dict  # deferred: `hhscatter --help` starts without the engine and tables
-    from hhscatter.scene.schema import scene_dict_from_toml  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.scene.schema import (
+        scene_dict_from_toml,  # deferred: `hhscatter --help` starts without the engine and tables
+    )
 
     if a.ics is not None:
         given = [f"--{k}" for k in ("region", "radius") if getattr(a, k) is not None]
         if given:
-            raise UsageError(f"{' and '.join(given)} {'is' if len(given) == 1 else 'are'} for initial conditions "
-                             "sampled in a region; with --ics the table gives every initial state: drop "
-                             f"{' and '.join(given)}")
+            raise UsageError(
+                f"{' and '.join(given)} {'is' if len(given) == 1 else 'are'} for initial conditions "
+                "sampled in a region; with --ics the table gives every initial state: drop "
+                f"{' and '.join(given)}"
+            )
     flags = {
         k: getattr(a, k)
-        for k in ("energy", "gamma", "n", "seed", "region", "radius", "r_esc", "t_max", "tol", "chunk_size",
-                  "batch_size")
+        for k in (
+            "energy",
+            "gamma",
+            "n",
+            "seed",
+            "region",
+            "radius",
+            "r_esc",
+            "t_max",
+            "tol",
+            "chunk_size",
+            "batch_size",
+        )
     }
     for k, v in flags.items():
         for x in v if isinstance(v, list) else [v]:
@@ -293,8 +379,10 @@ def _scene_from_args(a):
         if a.ics is not None or d.get("ics") is not None:
             given = [k for k in ("region", "radius") if k in d]
             if given:
-                raise ConfigError(f"{a.scene}: [scene] {', '.join(given)} with ics: the IC table gives every initial "
-                                  f"state, {' and '.join(given)} would be ignored; remove {' and '.join(given)}")
+                raise ConfigError(
+                    f"{a.scene}: [scene] {', '.join(given)} with ics: the IC table gives every initial "
+                    f"state, {' and '.join(given)} would be ignored; remove {' and '.join(given)}"
+                )
     elif a.scale:
         raise ConfigError("--scale needs a scene file")
     elif a.resume and (old := _resumed_scene(a.out)) is not None:
@@ -333,8 +421,11 @@ def _system_from_args(a, base: dict | None) -> dict:
         twice = sorted({k for k in names if names.count(k) > 1})
         if twice:
             values = {k: [v for n, v in a.param if n == k] for k in twice}
-            raise UsageError("--param " + "; ".join(f"{k} given {len(v)} times ({', '.join(f'{x:g}' for x in v)})"
-                                                     for k, v in values.items()) + ": give each parameter once")
+            raise UsageError(
+                "--param "
+                + "; ".join(f"{k} given {len(v)} times ({', '.join(f'{x:g}' for x in v)})" for k, v in values.items())
+                + ": give each parameter once"
+            )
         spec["params"] = {**(spec.get("params") or {}), **dict(a.param)}
     if a.dissipation:
         spec["dissipation"] = a.dissipation
@@ -351,13 +442,20 @@ def _param(s: str) -> tuple[str, float]:
 
 
 def cmd_simulate(a):
-    from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.data.read import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)
-    summary = simulate(scene, a.out, workers=a.workers, overwrite=a.overwrite, resume=a.resume,
-                       progress=_progress(a), scheduler=a.scheduler)
+    summary = simulate(
+        scene,
+        a.out,
+        workers=a.workers,
+        overwrite=a.overwrite,
+        resume=a.resume,
+        progress=_progress(a),
+        scheduler=a.scheduler,
+    )
     print(summary.line())
     store = Store(a.out)
     print(run_report(store.root if store.local else store.url, describe_run(a.out)))
@@ -370,13 +468,17 @@ def run_report(out, info: dict) -> str:
     lines = [f"wrote {out}: {rows}"]
     for p in info["points"]:
         e = "E0 from the IC table" if p["energy"] is None else f"E0={p['energy']:g}"
-        lines.append(f"  {e}, γ={p['gamma']:g}: escaped {p['escaped']}, settled {p['settled']}, "
-                     f"censored {p['censored']}" + (f", stopped {p['stopped']}" if p.get("stopped") else ""))
+        lines.append(
+            f"  {e}, γ={p['gamma']:g}: escaped {p['escaped']}, settled {p['settled']}, "
+            f"censored {p['censored']}" + (f", stopped {p['stopped']}" if p.get("stopped") else "")
+        )
     return "\n".join(lines)
 
 
 def cmd_survival(a):
-    from matplotlib.figure import Figure  # no pyplot: no backend is chosen or changed  # deferred: `hhscatter --help` starts without the engine and tables
+    from matplotlib.figure import (
+        Figure,  # no pyplot: no backend is chosen or changed  # deferred: `hhscatter --help` starts without the engine and tables
+    )
 
     from hhscatter.api import (  # deferred: `hhscatter --help` starts without the engine and tables
         plot_survival,
@@ -398,8 +500,10 @@ def cmd_survival(a):
         curves.append(survival(df))
     n_curves = sum(len(c) for c in curves)
     if a.labels and len(a.labels) != n_curves:
-        raise UsageError(f"--labels: {len(a.labels)} label(s) for {n_curves} curve(s) "
-                         f"({', '.join(f'{r}: {len(c)}' for r, c in zip(a.runs, curves))})")
+        raise UsageError(
+            f"--labels: {len(a.labels)} label(s) for {n_curves} curve(s) "
+            f"({', '.join(f'{r}: {len(c)}' for r, c in zip(a.runs, curves))})"
+        )
     fig = Figure(figsize=(6, 4.2), constrained_layout=True)
     ax = plot_survival(curves, ax=fig.subplots(), labels=a.labels or None)
     ax.set_title("Survival probability")
@@ -412,14 +516,18 @@ def cmd_survival(a):
 def cmd_study(a):
     from hhscatter.studies import run_stage  # deferred: `hhscatter --help` starts without the engine and tables
 
-    run_stage(a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a),
-              root=Path(a.studies) if a.studies else None)
+    run_stage(
+        a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a), root=Path(a.studies) if a.studies else None
+    )
     return 0
 
 
 #: the text options of each command (argparse names): an empty or blank value is refused, never read as "not given"
-TEXT_OPTIONS = {"simulate": ("scene", "scale", "system", "ics", "out", "scheduler"),
-                "survival": ("runs", "png", "labels"), "study": ("name", "scale")}
+TEXT_OPTIONS = {
+    "simulate": ("scene", "scale", "system", "ics", "out", "scheduler"),
+    "survival": ("runs", "png", "labels"),
+    "study": ("name", "scale"),
+}
 
 
 def _check_text(a) -> None:
@@ -430,8 +538,10 @@ def _check_text(a) -> None:
         for v in value if isinstance(value, list) else [value]:
             if v is not None and not v.strip():
                 flag = key if key in ("scene", "runs", "name") else f"--{key.replace('_', '-')}"
-                raise UsageError(f"{flag} must not be empty, got {v!r}"
-                                 + (" (name the working directory as '.')" if key == "out" else ""))
+                raise UsageError(
+                    f"{flag} must not be empty, got {v!r}"
+                    + (" (name the working directory as '.')" if key == "out" else "")
+                )
 
 
 def main(argv=None):
@@ -449,7 +559,6 @@ def main(argv=None):
         print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
         return 130
     except BrokenPipeError:  # `hhscatter … | head -1`: the reader left; the run itself is complete
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return 141
 

@@ -27,6 +27,7 @@ ConfigError 2 n (number of orbits) must be an integer > 0, got 0
 >>> hhscatter.SceneError is ConfigError
 True
 """
+
 from __future__ import annotations
 
 __all__ = [

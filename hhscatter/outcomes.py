@@ -17,10 +17,19 @@ Examples
 >>> OUTCOMES[ESCAPED], CENSORING_OUTCOMES
 ('escaped', ('censored', 'stopped'))
 """
+
 from __future__ import annotations
 
-__all__ = ["CENSORED", "CENSORING_OUTCOMES", "ESCAPED", "LEAVING_OUTCOMES", "OUTCOMES", "SETTLED", "STOPPED",
-           "TABLE_COLUMNS"]
+__all__ = [
+    "CENSORED",
+    "CENSORING_OUTCOMES",
+    "ESCAPED",
+    "LEAVING_OUTCOMES",
+    "OUTCOMES",
+    "SETTLED",
+    "STOPPED",
+    "TABLE_COLUMNS",
+]
 
 #: outcome codes (int8 in the engine's arrays), indices into :data:`OUTCOMES`
 ESCAPED, SETTLED, CENSORED, STOPPED = 0, 1, 2, 3

@@ -16,8 +16,15 @@ def cons_scene():
 def diss_scene():
     from hhscatter.scene.scene import Scene, SectionWindow
 
-    return Scene(energy=0.3, gamma=0.01, n=300, seed=12, chunk_size=120,
-                 sections=SectionWindow(t_from=5.0, t_to=40.0), snapshots=tuple(np.arange(0.0, 100.0, 10.0)))
+    return Scene(
+        energy=0.3,
+        gamma=0.01,
+        n=300,
+        seed=12,
+        chunk_size=120,
+        sections=SectionWindow(t_from=5.0, t_to=40.0),
+        snapshots=tuple(np.arange(0.0, 100.0, 10.0)),
+    )
 
 
 @pytest.fixture

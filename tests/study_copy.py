@@ -1,4 +1,5 @@
 """Copies of the repository's study folders for tests that need a studies folder of their own."""
+
 from pathlib import Path
 
 REPO_STUDIES = Path(__file__).resolve().parents[1] / "studies"
@@ -10,8 +11,9 @@ def copy_study_folder(name: str, root: Path, edit=None, src: Path = REPO_STUDIES
     import shutil
 
     root.mkdir(parents=True, exist_ok=True)
-    shutil.copytree(src / name, root / name, ignore=shutil.ignore_patterns("out", "data", "__pycache__"),
-                    dirs_exist_ok=True)
+    shutil.copytree(
+        src / name, root / name, ignore=shutil.ignore_patterns("out", "data", "__pycache__"), dirs_exist_ok=True
+    )
     if not (root / "conventions.toml").exists():
         shutil.copy(src / "conventions.toml", root / "conventions.toml")
     if edit is not None:

@@ -1,5 +1,6 @@
 """The notebook API: hhscatter.survival / escape_rates / plot helpers on lifetimes DataFrames, and the
 "Analyze your own run" page, whose code is executed here exactly as printed."""
+
 import importlib.metadata
 import math
 import os
@@ -23,9 +24,15 @@ def _frame(points, n=20_000, seed=0, energy_column=True):
     parts = []
     for energy, gamma, kappa in points:
         t = rng.exponential(1 / kappa, n) + 2.0  # an irregular start would be here; pure delay is enough
-        df = pd.DataFrame({"traj_id": np.arange(n), "e0": energy * (1 + EPS * rng.integers(-4, 5, n)),
-                           "gamma": gamma, "outcome": np.where(t > 60, "censored", "escaped"),
-                           "t_end": np.minimum(t, 60.0)})
+        df = pd.DataFrame(
+            {
+                "traj_id": np.arange(n),
+                "e0": energy * (1 + EPS * rng.integers(-4, 5, n)),
+                "gamma": gamma,
+                "outcome": np.where(t > 60, "censored", "escaped"),
+                "t_end": np.minimum(t, 60.0),
+            }
+        )
         if energy_column:
             df["energy"] = energy
         parts.append(df)
@@ -52,7 +59,7 @@ def test_points_are_grouped_by_energy_never_by_e0():
     assert [k for k, _ in split_points(lt.drop(columns="energy"))] == keys
     # a run from an IC table (e0 varies continuously): one ensemble per γ, energy unknown
     ics = lt[lt.gamma == 0].drop(columns="energy").assign(e0=np.linspace(0.2, 0.4, 1000), traj_id=np.arange(1000))
-    (key, df), = split_points(ics)
+    ((key, df),) = split_points(ics)
     assert math.isnan(key[0]) and key[1] == 0.0 and len(df) == 1000
 
 
@@ -124,8 +131,14 @@ def test_plot_helpers_draw_on_the_given_axes_and_never_touch_the_backend(monkeyp
 def test_each_concept_has_one_top_level_function_with_a_frame_and_a_plot():
     from matplotlib.figure import Figure
 
-    for name in ("kappa_cmeasure", "transition_times", "energy_decay", "cmeasure_points", "cmeasure_distances",
-                 "basin_measures"):
+    for name in (
+        "kappa_cmeasure",
+        "transition_times",
+        "energy_decay",
+        "cmeasure_points",
+        "cmeasure_distances",
+        "basin_measures",
+    ):
         fn = getattr(hhscatter, name)
         assert name in hhscatter.__all__ and fn.__module__.startswith("hhscatter.api."), name
         doc = fn.__doc__
@@ -142,8 +155,15 @@ def _settling_frame():
     rng = np.random.default_rng(3)
     t0 = 5 + rng.exponential(5.0, 40_000)
     tg = np.where(t0 > 20, 20 + rng.exponential(40.0, t0.size), t0)
-    mk = lambda g, t, out: pd.DataFrame({"energy": 0.3, "gamma": g, "t_end": t, "outcome": out,  # noqa: E731
-                                         "traj_id": np.arange(t.size)})
+    mk = lambda g, t, out: pd.DataFrame(
+        {
+            "energy": 0.3,
+            "gamma": g,
+            "t_end": t,
+            "outcome": out,  # noqa: E731
+            "traj_id": np.arange(t.size),
+        }
+    )
     return pd.concat([mk(0.0, t0, "escaped"), mk(0.01, tg, np.where(tg > 30, "settled", "escaped"))])
 
 
@@ -162,8 +182,10 @@ def test_transition_times_against_closed_forms():
 
 def test_energy_decay_per_grid_point_and_plain_runs_need_e0_and_gamma():
     t = np.repeat(np.arange(0.0, 101.0, 5.0), 20)
-    rows = [pd.DataFrame({"traj_id": 0, "t": t, "energy": e0 * np.exp(-mu * g * t), "point_energy": e0,
-                          "point_gamma": g}) for e0, g, mu in ((0.3, 0.01, 0.9), (0.3, 0.02, 0.8), (0.4, 0.0, 0))]
+    rows = [
+        pd.DataFrame({"traj_id": 0, "t": t, "energy": e0 * np.exp(-mu * g * t), "point_energy": e0, "point_gamma": g})
+        for e0, g, mu in ((0.3, 0.01, 0.9), (0.3, 0.02, 0.8), (0.4, 0.0, 0))
+    ]
     res = hhscatter.energy_decay(pd.concat(rows), window=(0, 100))
     fr = res.to_frame()
     assert list(zip(fr.energy, fr.gamma)) == [(0.3, 0.01), (0.3, 0.02)]  # γ = 0: a curve, no μ
@@ -174,16 +196,25 @@ def test_energy_decay_per_grid_point_and_plain_runs_need_e0_and_gamma():
 
 
 def test_cmeasure_points_and_distances_per_point():
-    sec = pd.DataFrame({"traj_id": [1, 1, 1, 2, 2, 3], "t": [5.0, 25.0, 28.0, 22.0, 40.0, 50.0],
-                        "x": [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], "y": 0.0, "energy": [0.3, 0.3, 0.3, 0.29, 0.28, 0.2],
-                        "point_energy": 0.3, "point_gamma": 0.01})
+    sec = pd.DataFrame(
+        {
+            "traj_id": [1, 1, 1, 2, 2, 3],
+            "t": [5.0, 25.0, 28.0, 22.0, 40.0, 50.0],
+            "x": [0.0, 0.1, 0.2, 0.3, 0.4, 0.5],
+            "y": 0.0,
+            "energy": [0.3, 0.3, 0.3, 0.29, 0.28, 0.2],
+            "point_energy": 0.3,
+            "point_gamma": 0.01,
+        }
+    )
     every = hhscatter.cmeasure_points(sec, t_from=20.0, t_to=45.0)
     assert every[(0.3, 0.01)]["x"].tolist() == [0.1, 0.2, 0.3, 0.4]
     band = hhscatter.cmeasure_points(sec, t_from=20.0, first_only=True, e_min=0.25)
     assert band[(0.3, 0.01)]["x"].tolist() == [0.1, 0.3]  # orbit 3's first crossing is outside the band
     rng = np.random.default_rng(2)
     far = pd.DataFrame(rng.uniform(0, 1, (3000, 2)), columns=["x", "y"]).assign(
-        t=30.0, traj_id=np.arange(3000), point_energy=0.3, point_gamma=0.05)
+        t=30.0, traj_id=np.arange(3000), point_energy=0.3, point_gamma=0.05
+    )
     ref = pd.DataFrame(rng.uniform(-1, 1, (3000, 2)), columns=["x", "y"])
     d = hhscatter.cmeasure_distances(hhscatter.cmeasure_points(far, t_from=0.0), ref, boxes=[0.5], n_splits=4)
     row = d.to_frame().iloc[0]
@@ -193,9 +224,16 @@ def test_cmeasure_points_and_distances_per_point():
 
 def test_basin_measures_maps_outcomes_to_cells():
     shape, cell = (4, 4), np.array([1, 2, 5, 6, 9, 10])  # 6 allowed cells, the rest forbidden
-    lt = pd.DataFrame({"traj_id": [5, 4, 3, 2, 1, 0], "gamma": 0.01, "e0": 0.3, "t_end": 1.0,
-                       "outcome": ["escaped", "settled", "censored", "escaped", "escaped", "escaped"],
-                       "exit_channel": pd.array([2, None, None, 1, 0, 0], dtype="Int8")})
+    lt = pd.DataFrame(
+        {
+            "traj_id": [5, 4, 3, 2, 1, 0],
+            "gamma": 0.01,
+            "e0": 0.3,
+            "t_end": 1.0,
+            "outcome": ["escaped", "settled", "censored", "escaped", "escaped", "escaped"],
+            "exit_channel": pd.array([2, None, None, 1, 0, 0], dtype="Int8"),
+        }
+    )
     m = hhscatter.basin_measures(lt, cell, shape, boxes=[2], wada=False, extent=(-1, 1, -1, 1))
     lab = m.maps[(0.3, 0.01)]
     F = hhscatter.api
@@ -235,13 +273,18 @@ def test_analyse_your_own_run_page_runs_as_printed(tmp_path):
     assert len([ln for ln in code.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]) <= 12
     (tmp_path / "analyse.py").write_text(code)
     env = {**os.environ, "MPLBACKEND": "Agg"}  # the test's choice (headless); the page's code never sets one
-    proc = subprocess.run([sys.executable, "analyse.py"], cwd=tmp_path, env=env, capture_output=True, text=True,
-                          timeout=600)
+    proc = subprocess.run(
+        [sys.executable, "analyse.py"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
+    )
     assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
     assert "dissipative" in proc.stderr  # the UserWarning naming the γ > 0 points
     rows = [ln.split() for ln in proc.stdout.splitlines() if re.match(r"^\d+\s+0\.", ln)]
-    assert [(r[1], r[2], r[3]) for r in rows] == [("0.27", "0.00", "10000"), ("0.27", "0.01", "10000"),
-                                                   ("0.30", "0.00", "10000"), ("0.30", "0.01", "10000")], proc.stdout
+    assert [(r[1], r[2], r[3]) for r in rows] == [
+        ("0.27", "0.00", "10000"),
+        ("0.27", "0.01", "10000"),
+        ("0.30", "0.00", "10000"),
+        ("0.30", "0.01", "10000"),
+    ], proc.stdout
     kappa = {(r[1], r[2]): float(r[4]) for r in rows}
     assert math.isnan(kappa[("0.27", "0.01")]) and math.isnan(kappa[("0.30", "0.01")])
     # κ(E) grows with E (paper Fig. 2b): 0.27 → ~0.14, 0.30 → ~0.19
@@ -254,8 +297,9 @@ def test_kappa_cmeasure_agrees_with_kappa_from_pt_on_a_real_run(tmp_path):
     the section crossings in the late window, and the window fits of P(t). At 2·10⁵ orbits per energy they gave
     0.0956 ± 0.0014 / 0.185 ± 0.004 / 0.246 ± 0.005 against 0.0953 ± 0.0015 / 0.187 ± 0.002 / 0.246 ± 0.003 at
     E = 0.25 / 0.30 / 0.35 (the issue: 0.0974 / 0.181 / 0.235 against 0.0973 / 0.183 / 0.246)."""
-    scene = hhscatter.Scene(energy=0.3, n=40_000, seed=7, t_max=3000.0,
-                            sections=hhscatter.SectionWindow(t_from=10.0, t_to=160.0))
+    scene = hhscatter.Scene(
+        energy=0.3, n=40_000, seed=7, t_max=3000.0, sections=hhscatter.SectionWindow(t_from=10.0, t_to=160.0)
+    )
     hhscatter.simulate(scene, tmp_path / "run", overwrite=True, workers=1, progress=False)
     row = hhscatter.kappa_cmeasure(tmp_path / "run").to_frame().iloc[0]
     assert row.note == "" and row.n_undetermined == 0 and row.t_record_end == 160.0 and row.t_to == 120.0
@@ -269,8 +313,10 @@ def test_progress_goes_to_a_log_as_plain_lines_never_as_a_bar(tmp_path):
     import subprocess
     import sys
 
-    code = ("import hhscatter\nif __name__ == '__main__':\n"
-            "    hhscatter.simulate(hhscatter.Scene(energy=0.3, n=200, seed=1, t_max=50.0), 'run', workers=1)\n")
+    code = (
+        "import hhscatter\nif __name__ == '__main__':\n"
+        "    hhscatter.simulate(hhscatter.Scene(energy=0.3, n=200, seed=1, t_max=50.0), 'run', workers=1)\n"
+    )
     (tmp_path / "s.py").write_text(code)
     with open(tmp_path / "log.txt", "w") as log:
         subprocess.run([sys.executable, "s.py"], cwd=tmp_path, stderr=log, stdout=log, check=True, timeout=300)
@@ -282,23 +328,28 @@ def test_progress_goes_to_a_log_as_plain_lines_never_as_a_bar(tmp_path):
 def test_read_lifetimes_takes_a_list_of_runs(tmp_path):
     a = hhscatter.Scene(energy=0.27, n=300, seed=1, t_max=100.0)
     hhscatter.simulate(a, tmp_path / "a", workers=1, progress=False)
-    hhscatter.simulate(hhscatter.Grid(a, energies=[0.3], gammas=[0.0, 0.01]), tmp_path / "g", workers=1,
-                       progress=False)
+    hhscatter.simulate(hhscatter.Grid(a, energies=[0.3], gammas=[0.0, 0.01]), tmp_path / "g", workers=1, progress=False)
     both = hhscatter.read_lifetimes([tmp_path / "a", str(tmp_path / "g")])
     assert len(both) == 900 and list(both["run"].cat.categories) == [str(tmp_path / "a"), str(tmp_path / "g")]
     curves = hhscatter.survival(both)
-    assert sorted(curves.curves) == [(0.27, 0.0, str(tmp_path / "a")), (0.3, 0.0, str(tmp_path / "g")),
-                                     (0.3, 0.01, str(tmp_path / "g"))]
-    assert all(n == 300 for n in curves.n.values()) and curves[(0.3, 0.01)] is curves.curves[
-        (0.3, 0.01, str(tmp_path / "g"))]
+    assert sorted(curves.curves) == [
+        (0.27, 0.0, str(tmp_path / "a")),
+        (0.3, 0.0, str(tmp_path / "g")),
+        (0.3, 0.01, str(tmp_path / "g")),
+    ]
+    assert (
+        all(n == 300 for n in curves.n.values())
+        and curves[(0.3, 0.01)] is curves.curves[(0.3, 0.01, str(tmp_path / "g"))]
+    )
 
 
 def test_escape_rates_flags_a_trapped_population_instead_of_returning_its_plateau_silently():
     # 60 % of the orbits never leave (KAM tori), the rest at κ = 0.01: the window κ is the plateau's
     rng = np.random.default_rng(11)
     t = np.where(rng.random(20000) < 0.6, np.inf, rng.exponential(100.0, 20000))
-    lt = pd.DataFrame({"t_end": np.minimum(t, 800.0), "outcome": np.where(t < 800.0, "escaped", "censored"),
-                       "e0": 0.3, "gamma": 0.0})
+    lt = pd.DataFrame(
+        {"t_end": np.minimum(t, 800.0), "outcome": np.where(t < 800.0, "escaped", "censored"), "e0": 0.3, "gamma": 0.0}
+    )
     row = hhscatter.escape_rates(lt, detect_tail=False).to_frame().iloc[0]
     assert row.status == "trapped" and "plateau" in row.note
     assert abs(row.p_inf - 0.6) < 0.03 and abs(row.kappa_inf - 0.01) < 0.001

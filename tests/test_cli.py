@@ -1,5 +1,6 @@
 """The CLI as a new user meets it: python -m, --version, help, counts, --resume with only --out, section and
 snapshot flags, survival of grid runs, errors without tracebacks, the closing summary, progress in logs."""
+
 import json
 import subprocess
 import sys
@@ -43,9 +44,33 @@ def test_counts_refuse_non_integral_values(text, capsys):
 
 def test_resume_with_only_out_reads_the_scene_and_summary_tells(tmp_path, capsys):
     out = tmp_path / "g"
-    assert main(["simulate", "--energy", "0.27,0.3", "--gamma", "0,0.01", "-n", "2e2", "--chunk-size", "100",
-                 "--seed", "4", "--out", str(out), "--workers", "1", "--sections-t-from", "3",
-                 "--sections-first-only", "--snapshots", "0:4:2"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--energy",
+                "0.27,0.3",
+                "--gamma",
+                "0,0.01",
+                "-n",
+                "2e2",
+                "--chunk-size",
+                "100",
+                "--seed",
+                "4",
+                "--out",
+                str(out),
+                "--workers",
+                "1",
+                "--sections-t-from",
+                "3",
+                "--sections-first-only",
+                "--snapshots",
+                "0:4:2",
+            ]
+        )
+        == 0
+    )
     first = capsys.readouterr().out
     before = {p: p.read_bytes() for p in out.rglob("part-*.parquet")}
     assert len(before) == 3 * 8
@@ -54,8 +79,10 @@ def test_resume_with_only_out_reads_the_scene_and_summary_tells(tmp_path, capsys
     assert f"wrote {out.resolve()}: lifetimes 800 rows, sections {len(sec)} rows, snapshots {len(snap)} rows" in first
     for (e, g), d in lt.groupby(["energy", "gamma"]):
         oc = d["outcome"].value_counts()
-        line = (f"  E0={e:g}, γ={g:g}: escaped {oc.get('escaped', 0)}, settled {oc.get('settled', 0)}, "
-                f"censored {oc.get('censored', 0)}")
+        line = (
+            f"  E0={e:g}, γ={g:g}: escaped {oc.get('escaped', 0)}, settled {oc.get('settled', 0)}, "
+            f"censored {oc.get('censored', 0)}"
+        )
         assert line in first.splitlines(), line
     for p in list(before)[::5]:
         p.unlink()
@@ -76,11 +103,31 @@ def test_resume_without_scene_json_says_so(tmp_path, capsys):
 
 def test_section_and_snapshot_flags_override_the_scene_file(tmp_path):
     toml = tmp_path / "s.toml"
-    toml.write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 60\nseed = 2\n[sections]\nt_from = 1.0\n"
-                    "[snapshots]\ntimes = [0.0, 1.0]\n")
+    toml.write_text(
+        "[scene]\nenergy = 0.3\ngamma = 0.01\nn = 60\nseed = 2\n[sections]\nt_from = 1.0\n"
+        "[snapshots]\ntimes = [0.0, 1.0]\n"
+    )
     out = tmp_path / "o"
-    assert main(["simulate", str(toml), "--out", str(out), "--workers", "1", "--sections-t-to", "8",
-                 "--sections-e-max", "0.29", "--sections-first-only", "--snapshots", "0,2.5,5"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                str(toml),
+                "--out",
+                str(out),
+                "--workers",
+                "1",
+                "--sections-t-to",
+                "8",
+                "--sections-e-max",
+                "0.29",
+                "--sections-first-only",
+                "--snapshots",
+                "0,2.5,5",
+            ]
+        )
+        == 0
+    )
     scene = json.loads((out / "scene.json").read_text())["scene"]
     assert scene["sections"] == {"t_from": 1.0, "t_to": 8.0, "e_min": "-inf", "e_max": 0.29, "first_only": True}
     assert scene["snapshots"] == [0.0, 2.5, 5.0]
@@ -101,12 +148,15 @@ def test_survival_of_a_grid_run_draws_one_curve_per_point(tmp_path, capsys):
     assert "1 label(s) for 2 curve(s)" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("args,message", [
-    (["survival", "{tmp}/missing", "--png", "{tmp}/p.png"], "does not exist"),
-    (["survival", "{tmp}", "--png", "{tmp}/p.png"], "no lifetimes table"),
-    (["survival", "{tmp}", "--png", "{tmp}/no/such/dir/p.png"], "--png: folder"),
-    (["study", "fig6", "analyze", "--scale", "nosuchscale"], "scale"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["survival", "{tmp}/missing", "--png", "{tmp}/p.png"], "does not exist"),
+        (["survival", "{tmp}", "--png", "{tmp}/p.png"], "no lifetimes table"),
+        (["survival", "{tmp}", "--png", "{tmp}/no/such/dir/p.png"], "--png: folder"),
+        (["study", "fig6", "analyze", "--scale", "nosuchscale"], "scale"),
+    ],
+)
 def test_user_errors_exit_2_without_traceback(tmp_path, args, message):
     """A missing run, an empty folder, a --png folder that does not exist: message, status 2, no traceback."""
     r = _run(*[a.format(tmp=tmp_path) for a in args])
@@ -134,22 +184,33 @@ def test_study_stages_say_what_they_wrote(tmp_path, monkeypatch, capsys):
         study.write_numbers({"x": 1})
         study.derived("t.parquet").write_bytes(b"")
 
-    fake = types.SimpleNamespace(simulate=lambda study, workers=None, progress=True: None, analyze=analyze,
-                                 plot=lambda study: study.figure_path.write_bytes(np.zeros(4).tobytes()))
+    fake = types.SimpleNamespace(
+        simulate=lambda study, workers=None, progress=True: None,
+        analyze=analyze,
+        plot=lambda study: study.figure_path.write_bytes(np.zeros(4).tobytes()),
+    )
     monkeypatch.setattr(studies, "stage_module", lambda name, root=None: fake)
     studies.run_stage("fake", "all", "quick", root=tmp_path)
     out = capsys.readouterr().out.splitlines()
     where = tmp_path / "fake" / "out" / "quick"
-    assert out == [f"fake simulate: raw runs in {where / 'raw'}",
-                   f"fake analyze: wrote {where / 'fake.json'} and 1 derived table(s) in {where / 'derived'}",
-                   f"fake plot: wrote {where / 'fake.png'}"]
+    assert out == [
+        f"fake simulate: raw runs in {where / 'raw'}",
+        f"fake analyze: wrote {where / 'fake.json'} and 1 derived table(s) in {where / 'derived'}",
+        f"fake plot: wrote {where / 'fake.png'}",
+    ]
 
 
-@pytest.mark.parametrize("argv, hint", [
-    (["simulate", "--energy", "0.3", "--wokers", "2", "--out", "x"], "unrecognized arguments: --wokers; did you mean '--workers'?"),
-    (["study", "fig2", "analyse"], "did you mean 'analyze'?"),
-    (["simulat"], "did you mean 'simulate'?"),
-])
+@pytest.mark.parametrize(
+    "argv, hint",
+    [
+        (
+            ["simulate", "--energy", "0.3", "--wokers", "2", "--out", "x"],
+            "unrecognized arguments: --wokers; did you mean '--workers'?",
+        ),
+        (["study", "fig2", "analyse"], "did you mean 'analyze'?"),
+        (["simulat"], "did you mean 'simulate'?"),
+    ],
+)
 def test_a_mistyped_flag_or_choice_gets_a_suggestion(argv, hint, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exc:
@@ -187,9 +248,11 @@ def test_the_command_starts_without_loading_the_study_framework():
     import subprocess
     import sys
 
-    code = ("import sys, hhscatter.cli as c; c.build_parser(); "
-            "print(sorted(m for m in ('hhscatter.studies', 'hhscatter.run.runner', 'hhscatter.data.read', 'pydantic', "
-            "'pyarrow', 'heyoka') if m in sys.modules)); print('fig1' in c._studies_epilog())")
+    code = (
+        "import sys, hhscatter.cli as c; c.build_parser(); "
+        "print(sorted(m for m in ('hhscatter.studies', 'hhscatter.run.runner', 'hhscatter.data.read', 'pydantic', "
+        "'pyarrow', 'heyoka') if m in sys.modules)); print('fig1' in c._studies_epilog())"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
     assert out[0] == "[]" and out[1] == "True", out
 
@@ -197,20 +260,29 @@ def test_the_command_starts_without_loading_the_study_framework():
 SIM = ["simulate", "--energy", "0.3", "-n", "10", "--t-max", "20", "--workers", "1", "--quiet"]
 
 
-@pytest.mark.parametrize("args,message", [
-    (SIM + ["--system", "", "--out", "{tmp}/o"], "--system must not be empty, got ''"),
-    (["simulate", "--ics", "", "--out", "{tmp}/o"], "--ics must not be empty, got ''"),
-    (SIM + ["--out", ""], "--out must not be empty, got '' (name the working directory as '.')"),
-    (SIM + ["--scale", " ", "--out", "{tmp}/o"], "--scale must not be empty, got ' '"),
-    (SIM + ["--scheduler", "", "--out", "{tmp}/o"], "--scheduler must not be empty, got ''"),
-    (SIM + ["--system", "contopoulos", "--param", "eps=0.25", "--param", "eps=0.3", "--out", "{tmp}/o"],
-     "--param eps given 2 times (0.25, 0.3): give each parameter once"),
-    (["simulate", "--ics", "{tmp}/ics.csv", "--region", "square", "--out", "{tmp}/o"],
-     "--region is for initial conditions sampled in a region; with --ics the table gives every initial state"),
-    (["simulate", "--ics", "{tmp}/ics.csv", "--radius", "0.3", "--region", "disk", "--out", "{tmp}/o"],
-     "--region and --radius are for initial conditions sampled in a region"),
-    (SIM + ["--sections-e-min", "0.5", "--out", "{tmp}/o"], "sections.e_min = 0.5 is above E0 = 0.3"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (SIM + ["--system", "", "--out", "{tmp}/o"], "--system must not be empty, got ''"),
+        (["simulate", "--ics", "", "--out", "{tmp}/o"], "--ics must not be empty, got ''"),
+        (SIM + ["--out", ""], "--out must not be empty, got '' (name the working directory as '.')"),
+        (SIM + ["--scale", " ", "--out", "{tmp}/o"], "--scale must not be empty, got ' '"),
+        (SIM + ["--scheduler", "", "--out", "{tmp}/o"], "--scheduler must not be empty, got ''"),
+        (
+            SIM + ["--system", "contopoulos", "--param", "eps=0.25", "--param", "eps=0.3", "--out", "{tmp}/o"],
+            "--param eps given 2 times (0.25, 0.3): give each parameter once",
+        ),
+        (
+            ["simulate", "--ics", "{tmp}/ics.csv", "--region", "square", "--out", "{tmp}/o"],
+            "--region is for initial conditions sampled in a region; with --ics the table gives every initial state",
+        ),
+        (
+            ["simulate", "--ics", "{tmp}/ics.csv", "--radius", "0.3", "--region", "disk", "--out", "{tmp}/o"],
+            "--region and --radius are for initial conditions sampled in a region",
+        ),
+        (SIM + ["--sections-e-min", "0.5", "--out", "{tmp}/o"], "sections.e_min = 0.5 is above E0 = 0.3"),
+    ],
+)
 def test_empty_repeated_and_ignored_inputs_are_refused(tmp_path, monkeypatch, capsys, args, message):
     """An empty shell variable is not the default; a flag given twice or one that would be ignored is an error."""
     monkeypatch.chdir(tmp_path)

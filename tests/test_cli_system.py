@@ -1,4 +1,5 @@
 """The system flags of ``hhscatter simulate``: --system, --param, --dissipation."""
+
 import json
 
 import pyarrow.parquet as pq
@@ -33,20 +34,42 @@ def test_henon_heiles_by_name_writes_the_tables_of_the_default(tmp_path, capsys)
 
 def test_quadratic_drag_is_recorded_in_the_metadata(tmp_path, capsys):
     out = tmp_path / "q"
-    rc, _ = _cli(capsys, "simulate", "--energy", "0.3", "--gamma", "0.01", "-n", "20", "--workers", "1", "--quiet",
-                 "--dissipation", "quadratic", "--out", str(out))
+    rc, _ = _cli(
+        capsys,
+        "simulate",
+        "--energy",
+        "0.3",
+        "--gamma",
+        "0.01",
+        "-n",
+        "20",
+        "--workers",
+        "1",
+        "--quiet",
+        "--dissipation",
+        "quadratic",
+        "--out",
+        str(out),
+    )
     assert rc == 0
     m = _meta(out)
     assert m["scene"]["system"]["dissipation"] == "quadratic"
-    assert m["system"] == {"system": "henon_heiles", "potential": "0.5*omega**2*(x**2 + y**2) + lam*(x**2*y - y**3/3)",
-                           "params": {"omega": 1.0, "lam": 1.0}, "dissipation": "quadratic"}
+    assert m["system"] == {
+        "system": "henon_heiles",
+        "potential": "0.5*omega**2*(x**2 + y**2) + lam*(x**2*y - y**3/3)",
+        "params": {"omega": 1.0, "lam": 1.0},
+        "dissipation": "quadratic",
+    }
 
 
-@pytest.mark.parametrize("flags, message", [
-    (["--param", "eps"], "param: expected NAME=VALUE, got 'eps'"),
-    (["--param", "eps=big"], "argument --param: not a number: 'big'"),
-    (["--dissipation", "cubic"], "invalid choice: 'cubic'"),
-])
+@pytest.mark.parametrize(
+    "flags, message",
+    [
+        (["--param", "eps"], "param: expected NAME=VALUE, got 'eps'"),
+        (["--param", "eps=big"], "argument --param: not a number: 'big'"),
+        (["--dissipation", "cubic"], "invalid choice: 'cubic'"),
+    ],
+)
 def test_malformed_system_flags_exit_2(tmp_path, capsys, flags, message):
     out = tmp_path / "o"
     with pytest.raises(SystemExit) as exc:
@@ -58,21 +81,36 @@ def test_malformed_system_flags_exit_2(tmp_path, capsys, flags, message):
 
 def test_unknown_parameter_of_a_built_in_exits_2_before_any_work(tmp_path, capsys):
     out = tmp_path / "o"
-    rc, err = _cli(capsys, "simulate", "--energy", "0.3", "-n", "10", "--system", "henon_heiles", "--param", "mu=2",
-                   "--out", str(out))
+    rc, err = _cli(
+        capsys,
+        "simulate",
+        "--energy",
+        "0.3",
+        "-n",
+        "10",
+        "--system",
+        "henon_heiles",
+        "--param",
+        "mu=2",
+        "--out",
+        str(out),
+    )
     assert rc == 2 and "henon_heiles has parameters ['lam', 'omega'], got ['mu']" in err, err
     assert not out.exists()
 
 
-@pytest.mark.parametrize("system, params, energy, message", [
-    ("0.5*(x**2 + y**2) - eps*x**2*z", ["eps=0.25"], "1.5", "z"),                     # unknown symbol
-    ("0.5*(x**2 + y**2) - eps*foo(x)*y**2", ["eps=0.25"], "1.5", "foo"),              # unknown function
-    ("0.5*(x**2 + y**2) - eps*x**2*y**2", [], "1.5", "eps"),                          # missing parameter
-    ("0.5*(x**2 + y**2)", [], "1.5", "exit"),                                          # no exit
-    ("0.5*((x - 1)**2 + y**2) - 0.1*x**3", [], "1.5", "origin"),                       # well not at the origin
-    ("0.5*(x**2 + y**2) - eps*x**2*y**2", ["eps=0.25"], "0.5", "energy must be > E_c = 1"),  # E0 below E_c
-    ("__import__('os').system('echo hacked')", [], "1.5", "__import__"),               # never evaluated
-])
+@pytest.mark.parametrize(
+    "system, params, energy, message",
+    [
+        ("0.5*(x**2 + y**2) - eps*x**2*z", ["eps=0.25"], "1.5", "z"),  # unknown symbol
+        ("0.5*(x**2 + y**2) - eps*foo(x)*y**2", ["eps=0.25"], "1.5", "foo"),  # unknown function
+        ("0.5*(x**2 + y**2) - eps*x**2*y**2", [], "1.5", "eps"),  # missing parameter
+        ("0.5*(x**2 + y**2)", [], "1.5", "exit"),  # no exit
+        ("0.5*((x - 1)**2 + y**2) - 0.1*x**3", [], "1.5", "origin"),  # well not at the origin
+        ("0.5*(x**2 + y**2) - eps*x**2*y**2", ["eps=0.25"], "0.5", "energy must be > E_c = 1"),  # E0 below E_c
+        ("__import__('os').system('echo hacked')", [], "1.5", "__import__"),  # never evaluated
+    ],
+)
 def test_bad_declared_systems_exit_2_naming_the_problem(tmp_path, capsys, system, params, energy, message):
     out = tmp_path / "o"
     flags = [x for p in params for x in ("--param", p)]
@@ -84,8 +122,10 @@ def test_bad_declared_systems_exit_2_naming_the_problem(tmp_path, capsys, system
 def test_declared_potential_runs_end_to_end_from_a_scene_file(tmp_path, capsys):
     """A scene file with [system] potential = … runs and names its system in the tables."""
     f = tmp_path / "scene.toml"
-    f.write_text('[scene]\nenergy = 1.5\nn = 50\nt_max = 300\n[system]\n'
-                 'potential = "0.5*(x**2 + y**2) - eps*x**2*y**2"\n[system.params]\neps = 0.25\n')
+    f.write_text(
+        "[scene]\nenergy = 1.5\nn = 50\nt_max = 300\n[system]\n"
+        'potential = "0.5*(x**2 + y**2) - eps*x**2*y**2"\n[system.params]\neps = 0.25\n'
+    )
     out = tmp_path / "run"
     rc, _ = _cli(capsys, "simulate", str(f), "--workers", "1", "--quiet", "--out", str(out))
     assert rc == 0

@@ -1,4 +1,5 @@
 """Tables, runner and CLI: schema, metadata, determinism, resume, bad input."""
+
 import json
 import math
 
@@ -8,10 +9,10 @@ import pytest
 
 from hhscatter import read_lifetimes, read_sections, read_snapshots
 from hhscatter.cli import main
-from hhscatter.run.runner import simulate
-from hhscatter.errors import OutputError
-from hhscatter.scene.scene import Scene, SceneError, SectionWindow
 from hhscatter.data.read import read_meta
+from hhscatter.errors import OutputError
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SceneError, SectionWindow
 
 
 def _files(d):
@@ -20,8 +21,15 @@ def _files(d):
 
 @pytest.fixture(scope="module")
 def small_diss():
-    return Scene(energy=0.3, gamma=0.01, n=900, seed=5, chunk_size=300,
-                 sections=SectionWindow(t_from=10.0, first_only=True), snapshots=(0.0, 5.0, 10.0, 20.0))
+    return Scene(
+        energy=0.3,
+        gamma=0.01,
+        n=900,
+        seed=5,
+        chunk_size=300,
+        sections=SectionWindow(t_from=10.0, first_only=True),
+        snapshots=(0.0, 5.0, 10.0, 20.0),
+    )
 
 
 def test_one_and_two_workers_give_byte_identical_tables(tmp_path, small_diss):
@@ -74,8 +82,9 @@ def test_resume_skips_verified_chunks_and_redoes_damaged(tmp_path):
 
 def test_cli_simulate_and_survival(tmp_path, capsys):
     out = tmp_path / "cli"
-    rc = main(["simulate", "--energy", "0.27", "-n", "500", "--seed", "1", "--out", str(out), "--quiet",
-               "--workers", "1"])
+    rc = main(
+        ["simulate", "--energy", "0.27", "-n", "500", "--seed", "1", "--out", str(out), "--quiet", "--workers", "1"]
+    )
     assert rc == 0
     line = capsys.readouterr().out
     assert "500 orbits: escaped" in line and "µs per orbit" in line
@@ -91,8 +100,12 @@ def test_cli_ics_table(tmp_path):
     df = pd.DataFrame(ics, columns=["x", "y", "px", "py"])
     df["traj_id"] = np.arange(1000, 1050)
     df.to_csv(tmp_path / "ics.csv", index=False)
-    assert main(["simulate", "--ics", str(tmp_path / "ics.csv"), "--out", str(tmp_path / "o"), "--quiet",
-                 "--workers", "1"]) == 0
+    assert (
+        main(
+            ["simulate", "--ics", str(tmp_path / "ics.csv"), "--out", str(tmp_path / "o"), "--quiet", "--workers", "1"]
+        )
+        == 0
+    )
     lt = read_lifetimes(tmp_path / "o")
     assert list(lt["traj_id"]) == list(range(1000, 1050))
     assert np.allclose(lt["e0"], 0.3)
@@ -152,8 +165,10 @@ def test_scene_toml_and_scales(tmp_path):
     from hhscatter.scene.schema import load_scene
 
     p = tmp_path / "scene.toml"
-    p.write_text('[scene]\nenergy = 0.3\nn = 100\ngamma = 0.01\n[sections]\nt_from = 17.0\nfirst_only = true\n'
-                 '[snapshots]\nstart = 0\nstop = 10\nstep = 5\n[scale.paper]\nn = 10000000\n')
+    p.write_text(
+        "[scene]\nenergy = 0.3\nn = 100\ngamma = 0.01\n[sections]\nt_from = 17.0\nfirst_only = true\n"
+        "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n[scale.paper]\nn = 10000000\n"
+    )
     sc = load_scene(p)
     assert sc.n == 100 and sc.sections.t_from == 17.0 and sc.snapshots == (0.0, 5.0, 10.0)
     assert load_scene(p, scale="paper").n == 10_000_000

@@ -4,6 +4,7 @@ The import graph is read from the source with :mod:`ast` by tools/layer_metrics.
 function-level imports alike: a deferred import hides a circle from Python, not from the design); the layers
 and what each may import are ``LAYERS`` there (docs/api/index.md shows the same table).
 """
+
 import importlib.util
 from pathlib import Path
 
@@ -34,7 +35,11 @@ def test_every_module_is_in_a_declared_layer():
 
 
 def test_the_check_sees_an_upward_import():
-    graph = {"hhscatter.data.tables": {"hhscatter.analysis.survival.kaplan_meier"},
-             "hhscatter.analysis.survival.kaplan_meier": set(), "hhscatter.cli": {"hhscatter.publish.report"}}
+    graph = {
+        "hhscatter.data.tables": {"hhscatter.analysis.survival.kaplan_meier"},
+        "hhscatter.analysis.survival.kaplan_meier": set(),
+        "hhscatter.cli": {"hhscatter.publish.report"},
+    }
     assert lm.layer_violations(graph) == [
-        "hhscatter.data.tables -> hhscatter.analysis.survival.kaplan_meier (layer data may not import layer analysis)"]
+        "hhscatter.data.tables -> hhscatter.analysis.survival.kaplan_meier (layer data may not import layer analysis)"
+    ]

@@ -1,9 +1,10 @@
 """Closed forms of the model and the initial conditions."""
+
 import numpy as np
 import pytest
 
-from hhscatter.scene.ics import BLOCK, region_ics
 from hhscatter.model import HenonHeiles, equations, hamilton_equations
+from hhscatter.scene.ics import BLOCK, region_ics
 from hhscatter.scene.scene import Scene
 
 

@@ -9,6 +9,7 @@ module (what mkdocstrings shows with ``filters: ["!^_"]``). Counted per public f
 parameters (``self``/``cls`` excluded; a class's are its constructor's) and, for functions and public methods
 defined in the class body, the return annotation. Sections are a numpy title line followed by dashes.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -31,8 +32,11 @@ def doc_modules() -> list[str]:
 def public(module) -> list[tuple[str, object]]:
     names = getattr(module, "__all__", None)
     if names is None:
-        names = [n for n, o in vars(module).items() if not n.startswith("_")
-                 and getattr(o, "__module__", None) == module.__name__]
+        names = [
+            n
+            for n, o in vars(module).items()
+            if not n.startswith("_") and getattr(o, "__module__", None) == module.__name__
+        ]
     out = []
     for n in names:
         o = getattr(module, n)
@@ -96,13 +100,26 @@ def measure(objects, detail: bool) -> dict:
             n_param_sec += bool({"Parameters", "Attributes"} & s)
         if inspect.isfunction(obj):
             n_ret_sec += "Returns" in s
-        if detail and (untyped or no_ret or (ps and not {"Parameters", "Attributes"} & s)
-                       or (inspect.isfunction(obj) and "Returns" not in s)):
+        if detail and (
+            untyped
+            or no_ret
+            or (ps and not {"Parameters", "Attributes"} & s)
+            or (inspect.isfunction(obj) and "Returns" not in s)
+        ):
             print(f"  {qual}: untyped {untyped}{' no return type' if no_ret else ''}; sections {sorted(s)}")
     n_funcs = sum(1 for q, o, is_method in objects if not is_method and inspect.isfunction(o))
-    return dict(params=n_par, typed=n_typed, returns=n_ret, returns_typed=n_ret_typed, objects=n_fn,
-                with_params=n_fn_params, param_sections=n_param_sec, functions=n_funcs,
-                returns_sections=n_ret_sec, examples=n_ex)
+    return dict(
+        params=n_par,
+        typed=n_typed,
+        returns=n_ret,
+        returns_typed=n_ret_typed,
+        objects=n_fn,
+        with_params=n_fn_params,
+        param_sections=n_param_sec,
+        functions=n_funcs,
+        returns_sections=n_ret_sec,
+        examples=n_ex,
+    )
 
 
 def pct(a: int, b: int) -> str:
@@ -110,10 +127,12 @@ def pct(a: int, b: int) -> str:
 
 
 def report(label: str, m: dict) -> None:
-    print(f"{label}: parameter hints {m['typed']}/{m['params']} ({pct(m['typed'], m['params'])}), "
-          f"return hints {m['returns_typed']}/{m['returns']} ({pct(m['returns_typed'], m['returns'])}); "
-          f"of {m['objects']} public functions/classes: Parameters {m['param_sections']}/{m['with_params']}, "
-          f"Returns {m['returns_sections']}/{m['functions']} (functions), Examples {m['examples']}/{m['objects']}")
+    print(
+        f"{label}: parameter hints {m['typed']}/{m['params']} ({pct(m['typed'], m['params'])}), "
+        f"return hints {m['returns_typed']}/{m['returns']} ({pct(m['returns_typed'], m['returns'])}); "
+        f"of {m['objects']} public functions/classes: Parameters {m['param_sections']}/{m['with_params']}, "
+        f"Returns {m['returns_sections']}/{m['functions']} (functions), Examples {m['examples']}/{m['objects']}"
+    )
 
 
 def main(argv=None) -> int:

@@ -37,13 +37,26 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-VOLATILE = {"git_commit", "heyoka", "hhscatter", "numpy", "pyarrow", "python", "provenance", "created",
-            "written", "host", "cost", "wall_s", "cpu_s"}
+VOLATILE = {
+    "git_commit",
+    "heyoka",
+    "hhscatter",
+    "numpy",
+    "pyarrow",
+    "python",
+    "provenance",
+    "created",
+    "written",
+    "host",
+    "cost",
+    "wall_s",
+    "cpu_s",
+}
 SCALES = ("tiny", "quick", "paper")
 RUNS = {  # name -> CLI flags of `hhscatter simulate` (small: the set runs in well under a minute)
     "plain": "--energy 0.3 --gamma 0 -n 300 --seed 11 --chunk-size 100 --t-max 200",
     "drag_sections_snapshots": "--energy 0.3 --gamma 0.01 -n 300 --seed 12 --chunk-size 100 --t-max 200 "
-                               "--sections --snapshots 0:100:5",
+    "--sections --snapshots 0:100:5",
     "grid": "--energy 0.25,0.35 --gamma 0,0.02 -n 100 --seed 13 --chunk-size 50 --t-max 150 --sections",
     "square_resc": "--energy 0.35 --gamma 0.005 -n 200 --seed 14 --region square --r-esc 1.03 --t-max 150",
     "ics": "--gamma 0.01 --t-max 150 --sections --chunk-size 2",
@@ -54,8 +67,11 @@ ICS_CSV = "x,y,px,py\n0.1,0.05,0.6,0.1\n-0.2,0.1,0.1,-0.65\n0.0,-0.3,0.55,0.2\n0
 def _strip(obj):
     """obj without the volatile keys (versions, commit, timing), recursively."""
     if isinstance(obj, dict):  # an IC table's path lies in a temporary folder: keep its file name
-        return {k: Path(v).name if k == "ics" and isinstance(v, str) else _strip(v)
-                for k, v in obj.items() if k not in VOLATILE}
+        return {
+            k: Path(v).name if k == "ics" and isinstance(v, str) else _strip(v)
+            for k, v in obj.items()
+            if k not in VOLATILE
+        }
     if isinstance(obj, list):
         return [_strip(v) for v in obj]
     return obj
@@ -76,8 +92,11 @@ def part_digest(path: Path) -> dict:
     data = table.replace_schema_metadata(None)
     with pa.ipc.new_stream(sink, data.schema) as w:
         w.write_table(data)
-    return {"rows": table.num_rows, "data": _sha(sink.getvalue()),
-            "meta": _sha(json.dumps(meta, sort_keys=True).encode())}
+    return {
+        "rows": table.num_rows,
+        "data": _sha(sink.getvalue()),
+        "meta": _sha(json.dumps(meta, sort_keys=True).encode()),
+    }
 
 
 def record_tables(hh: Path) -> dict:
@@ -94,8 +113,11 @@ def record_tables(hh: Path) -> dict:
             if p.returncode:
                 out[name] = {"error": f"exit {p.returncode}: {p.stderr.strip()[-300:]}"}
                 continue
-            rec = {"scene.json": _sha(json.dumps(_strip(json.loads((run / "scene.json").read_text())),
-                                                 sort_keys=True).encode())}
+            rec = {
+                "scene.json": _sha(
+                    json.dumps(_strip(json.loads((run / "scene.json").read_text())), sort_keys=True).encode()
+                )
+            }
             for f in sorted(run.rglob("*.parquet")):
                 rec[str(f.relative_to(run))] = part_digest(f)
             out[name] = rec
@@ -133,8 +155,11 @@ def record_scenes() -> dict:
                     except BaseException as e:  # noqa: BLE001 - any stop is recorded and compared
                         stop = type(e).__name__
                 out[f"{name}@{scale}"] = {"hashes": study._recorded, "stopped_by": stop}
-                print(f"  scenes/{name}@{scale}: {len(study._recorded)} scene(s)"
-                      + (f", stopped by {stop}" if stop else ""), file=sys.stderr)
+                print(
+                    f"  scenes/{name}@{scale}: {len(study._recorded)} scene(s)"
+                    + (f", stopped by {stop}" if stop else ""),
+                    file=sys.stderr,
+                )
     finally:
         st.Study.run = real_run
     return out
@@ -183,8 +208,9 @@ def main(argv=None) -> int:
     r = sub.add_parser("record")
     r.add_argument("out", type=Path)
     r.add_argument("--numbers", action="store_true", help="also run `make studies SCALE=tiny` and record its JSONs")
-    r.add_argument("--numbers-only-existing", action="store_true",
-                   help="record the tiny JSONs already present (no make)")
+    r.add_argument(
+        "--numbers-only-existing", action="store_true", help="record the tiny JSONs already present (no make)"
+    )
     c = sub.add_parser("compare")
     c.add_argument("before", type=Path)
     c.add_argument("after", type=Path)
@@ -195,8 +221,10 @@ def main(argv=None) -> int:
             snap["numbers"] = record_numbers(make=a.numbers)
         a.out.write_text(json.dumps(snap, indent=1, sort_keys=True))
         n = sum(len(v.get("hashes", {})) for v in snap["scenes"].values())
-        print(f"wrote {a.out}: {n} scene hashes, {len(snap['tables'])} table runs, "
-              f"{sum(len(v) for v in snap.get('numbers', {}).values())} numbers")
+        print(
+            f"wrote {a.out}: {n} scene hashes, {len(snap['tables'])} table runs, "
+            f"{sum(len(v) for v in snap.get('numbers', {}).values())} numbers"
+        )
         return 0
     before, after = (json.loads(p.read_text()) for p in (a.before, a.after))
     diffs = compare(before, after)

@@ -14,6 +14,7 @@ Checks, over every HTML page (the text a reader sees: outside maths, code, scrip
 
 The tests (tests/docs/test_site_checks.py) run these over the site built in the suite.
 """
+
 from __future__ import annotations
 
 import re
@@ -26,8 +27,11 @@ RAW_TEX = re.compile(r"[\^_]\{|\\(?:[A-Za-z]{2,})\b|\\[{}]")
 #: names the floating-point value and is fine
 NAN = re.compile(r"(?<![\w.])(?:[+-]nan|nan)\b(?![\w-])")
 ZERO_ERR = re.compile(r"±\s*0\.0+(?![\d]*[1-9])")
-WORKFLOW = re.compile(r"\bissues?\s*#?\d+\b|#\d{1,3}\b(?=\s*\))|(?<![\w/])\.dev/|\b(?:at|since|from|in|before|after)"
-                      r"\s+(?:commit\s+)?`?[0-9a-f]{7,12}\b`?", re.I)
+WORKFLOW = re.compile(
+    r"\bissues?\s*#?\d+\b|#\d{1,3}\b(?=\s*\))|(?<![\w/])\.dev/|\b(?:at|since|from|in|before|after)"
+    r"\s+(?:commit\s+)?`?[0-9a-f]{7,12}\b`?",
+    re.I,
+)
 _HEX = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b")
 
 
@@ -58,8 +62,11 @@ def check(site: Path) -> dict[str, list[str]]:
     """{check: ["page: finding", …]} over every HTML page of ``site``."""
     site = Path(site)
     # 404.html is served from the site's root by a web server: its links are absolute on purpose
-    pages = sorted(p for p in site.rglob("*.html") if p.name != "404.html"
-                   and not {"assets", "javascripts"} & set(p.relative_to(site).parts[:-1]))
+    pages = sorted(
+        p
+        for p in site.rglob("*.html")
+        if p.name != "404.html" and not {"assets", "javascripts"} & set(p.relative_to(site).parts[:-1])
+    )
     ids_cache: dict[Path, set[str]] = {}
     out: dict[str, list[str]] = {k: [] for k in ("links", "raw_tex", "nan", "zero_err", "workflow")}
     for page in pages:
@@ -86,7 +93,7 @@ def check(site: Path) -> dict[str, list[str]]:
         text = reader_text(html)
         for key, rx in (("raw_tex", RAW_TEX), ("nan", NAN), ("zero_err", ZERO_ERR), ("workflow", WORKFLOW)):
             for m in rx.finditer(text):
-                ctx = " ".join(text[max(0, m.start() - 40):m.end() + 40].split())
+                ctx = " ".join(text[max(0, m.start() - 40) : m.end() + 40].split())
                 out[key].append(f"{rel}: …{ctx}…")
     return out
 
@@ -98,7 +105,7 @@ def main(argv=None) -> int:
     for key, items in res.items():
         print(f"{key:10s} {len(items)}")
     for key, items in res.items():
-        for line in items[:int(args[1]) if len(args) > 1 else 8]:
+        for line in items[: int(args[1]) if len(args) > 1 else 8]:
             print(f"  [{key}] {line}")
     return 1 if any(res.values()) else 0
 

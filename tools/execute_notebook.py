@@ -6,6 +6,7 @@ The notebook's runs (``runs/…`` relative paths) go to the temporary folder, wh
 Execution timestamps are dropped, so that re-running changes the file only where an output changed.
 ``--check`` executes without writing (what tests/docs/test_tutorial.py does). Exit 1 if a cell fails.
 """
+
 from __future__ import annotations
 
 import sys

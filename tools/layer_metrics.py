@@ -124,8 +124,12 @@ def is_param_cast(node: ast.AST) -> bool:
     if isinstance(arg, ast.GeneratorExp):
         gen = arg.generators[0]
         elt = arg.elt
-        return (_is_study_param(gen.iter) and isinstance(elt, ast.Call) and isinstance(elt.func, ast.Name)
-                and elt.func.id in {"float", "int"})
+        return (
+            _is_study_param(gen.iter)
+            and isinstance(elt, ast.Call)
+            and isinstance(elt.func, ast.Name)
+            and elt.func.id in {"float", "int"}
+        )
     return False
 
 
@@ -133,8 +137,12 @@ def _is_elementwise_cast(node: ast.AST) -> bool:
     """``[float(v) for v in study.params.x]`` or ``map(float, study.params.x)``."""
     if isinstance(node, ast.ListComp):
         elt, it = node.elt, node.generators[0].iter
-        return (_is_study_param(it) and isinstance(elt, ast.Call) and isinstance(elt.func, ast.Name)
-                and elt.func.id in {"float", "int"})
+        return (
+            _is_study_param(it)
+            and isinstance(elt, ast.Call)
+            and isinstance(elt.func, ast.Name)
+            and elt.func.id in {"float", "int"}
+        )
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "map" and len(node.args) == 2:
         f, it = node.args
         return isinstance(f, ast.Name) and f.id in {"float", "int"} and _is_study_param(it)
@@ -169,10 +177,14 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
                 for t in targets(node, mod, is_pkg, known):
                     if t != mod:  # an explicit import of a parent package is an edge too (a real circle if it
                         graph[mod].add(t)  # imports this module back)
-        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)]
+        casts += [
+            f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)
+        ]
     for f in extra:
         tree = ast.parse(f.read_text(), filename=str(f))
-        casts += [f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)]
+        casts += [
+            f"{f.relative_to(root)}:{n.lineno}" for n in ast.walk(tree) if is_param_cast(n) or _is_elementwise_cast(n)
+        ]
         for node in ast.walk(tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = node.end_lineno - node.lineno + 1
@@ -215,7 +227,7 @@ TOP = {"", "__main__", "cli"}  # the package's door and the CLI may import any l
 
 
 def layer_of(mod: str, package: str = "hhscatter") -> str:
-    rest = mod[len(package) + 1:] if mod.startswith(package + ".") else ""
+    rest = mod[len(package) + 1 :] if mod.startswith(package + ".") else ""
     return rest.split(".")[0]
 
 
@@ -246,9 +258,11 @@ def main(argv: list[str] | None = None) -> int:
     m = measure(args.root, args.package, extra)
     print(f"modules: {m['modules']}")
     print(f"import circles: {len(m['circles'])}")
-    print(f"function-level imports: {len(m['function_level_imports'])} "
-          f"({len(m['function_level_own_imports'])} of the package's own modules, "
-          f"{len(m['function_level_imports_without_reason'])} without a '# deferred: reason' comment)")
+    print(
+        f"function-level imports: {len(m['function_level_imports'])} "
+        f"({len(m['function_level_own_imports'])} of the package's own modules, "
+        f"{len(m['function_level_imports_without_reason'])} without a '# deferred: reason' comment)"
+    )
     print(f"casts of study parameters: {len(m['param_casts'])}")
     print(f"functions over {LONG} lines: {len(m['long_functions'])}")
     if args.package == "hhscatter":

@@ -5,6 +5,7 @@ and runs the test suite there, so the floors in pyproject.toml are tested
 rather than guessed. Usage: ``python tools/min_requirements.py [EXTRA ...]``
 (default extras: dev bench). Every requirement must have a ``>=`` floor.
 """
+
 from __future__ import annotations
 
 import re

@@ -8,6 +8,7 @@ number (:mod:`hhscatter.publish.numbers`, the mechanism of the docs pages: headl
 error, verdicts by the one rule). A GitHub reader sees plain Markdown; tests/docs/test_readme.py fails when
 the README is not what the template renders.
 """
+
 from __future__ import annotations
 
 import re
@@ -41,7 +42,7 @@ def main(argv=None) -> int:
     if i < 0 or j < 0:
         print(f"README.md has no {BEGIN!r} … {END!r} block", file=sys.stderr)
         return 2
-    new = readme[:i] + block + readme[j + len(END):]
+    new = readme[:i] + block + readme[j + len(END) :]
     if "--check" in argv:
         if new != readme:
             print("README.md is not current: run python tools/readme_results.py", file=sys.stderr)

@@ -19,6 +19,7 @@ an upstream's derived tables (not committed), and the content itself before stam
 repository's). From then on the report refuses a copy edited by hand or made stale. ``--check`` writes nothing
 and exits 1 if a copy lacks a valid record.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -52,7 +53,7 @@ def _sources(doc, upstream: str):
         if isinstance(x, dict):
             src = x.get("source")
             if isinstance(src, str) and src.startswith(f"{upstream}.json") and "value" in x:
-                key = src[len(upstream) + 5:].lstrip(": ").strip()
+                key = src[len(upstream) + 5 :].lstrip(": ").strip()
                 out.append((key, x.get("value"), x.get("err")))
             for v in x.values():
                 walk(v)
@@ -71,8 +72,11 @@ def _diff(a, b, err) -> float:
     if isinstance(a, dict) and isinstance(b, dict):
         return max([_diff(a[k], b[k], err) for k in a] or [0.0]) if a.keys() == b.keys() else math.inf
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        tol = TOL_ERR * err if isinstance(err, (int, float)) and err and math.isfinite(err) else \
-            TOL_REL * max(1.0, abs(a), abs(b))
+        tol = (
+            TOL_ERR * err
+            if isinstance(err, (int, float)) and err and math.isfinite(err)
+            else TOL_REL * max(1.0, abs(a), abs(b))
+        )
         return abs(a - b) / tol if tol else (0.0 if a == b else math.inf)
     return 0.0 if a == b else math.inf
 
@@ -94,21 +98,26 @@ def stamp(name: str, scale: str, stamped: dict) -> tuple[dict | None, str]:
             theirs, _ = lookup(udoc, key, what=f"{other}.json")
             d = _diff(value, theirs, err)
             if d > 1:
-                return None, (f"{path.relative_to(ROOT)}: its {other}.json:{key} = {value!r} is not the committed "
-                              f"{other}.json's {theirs!r}: stale, not stamped")
+                return None, (
+                    f"{path.relative_to(ROOT)}: its {other}.json:{key} = {value!r} is not the committed "
+                    f"{other}.json's {theirs!r}: stale, not stamped"
+                )
             checks.append(f"{other}.json:{key} equal to the committed {other}.json ({d:.2g} of the tolerance)")
         if not found:
-            checks.append(f"no value recorded as read from {other}.json: only its derived tables (not committed), "
-                          "not checked")
+            checks.append(
+                f"no value recorded as read from {other}.json: only its derived tables (not committed), not checked"
+            )
         upstream[other] = content_sha256(udoc)
     doc["made_from"] = {
         "config_sha256": config_sha256(study.config),
         "upstream": upstream,
         "raw_runs": {k: r.get("scene_hash") for k, r in sorted((doc.get("raw_runs") or {}).items())},
-        "stamped": {"note": "recorded after the fact from the committed copy (tools/stamp_assets.py): its config "
-                            "equals study.toml at this scale (checked); its raw runs are not in the repository "
-                            "(not checked); its content before this record is as committed",
-                    "checks": checks},
+        "stamped": {
+            "note": "recorded after the fact from the committed copy (tools/stamp_assets.py): its config "
+            "equals study.toml at this scale (checked); its raw runs are not in the repository "
+            "(not checked); its content before this record is as committed",
+            "checks": checks,
+        },
     }
     return sealed(doc), "; ".join(checks) or "no upstream"
 
@@ -129,7 +138,8 @@ def main(argv=None) -> int:
             if a.check:
                 try:
                     load_study(name, scale).verify_numbers(
-                        path, current, pick=lambda o, s=scale: assets_dir(s) / f"{o}.json", raw=False)
+                        path, current, pick=lambda o, s=scale: assets_dir(s) / f"{o}.json", raw=False
+                    )
                 except Exception as exc:  # noqa: BLE001 - reported, counted
                     print(f"{scale}/{name}: {exc}")
                     bad += 1

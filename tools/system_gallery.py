@@ -6,6 +6,7 @@ Each figure shows V's contours around the well, the level V = E_c (thick), the e
 dashed circle r = omega_radius) and the no-return radius at E = 1.5 E_c (dotted). The table's numbers come from
 the systems themselves; tests/docs/test_systems_page.py checks that the page still shows them.
 """
+
 from __future__ import annotations
 
 import sys
@@ -19,8 +20,12 @@ sys.path.insert(0, str(ROOT))
 from hhscatter.model.spec import system_from_spec  # noqa: E402
 
 #: the built-ins shown (n_exit with n = 4: n = 3 is Hénon–Heiles), the others at their default parameters
-GALLERY = ({"name": "henon_heiles"}, {"name": "n_exit", "params": {"n": 4}}, {"name": "contopoulos"},
-           {"name": "barbanis"})
+GALLERY = (
+    {"name": "henon_heiles"},
+    {"name": "n_exit", "params": {"n": 4}},
+    {"name": "contopoulos"},
+    {"name": "barbanis"},
+)
 
 
 def _num(v: float) -> str:
@@ -35,14 +40,25 @@ def table_rows():
         name = spec["name"]
         exits = "; ".join(f"({_num(e.x)}, {_num(e.y)})" for e in m.exits)
         params = ", ".join(f"{k} = {v:g}" for k, v in m.spec()["params"].items())
-        rows.append((name, params, m.critical_energy, len(m.exits), exits, m.omega_radius,
-                     m.no_return_radius(1.5 * m.critical_energy)))
+        rows.append(
+            (
+                name,
+                params,
+                m.critical_energy,
+                len(m.exits),
+                exits,
+                m.omega_radius,
+                m.no_return_radius(1.5 * m.critical_energy),
+            )
+        )
     return rows
 
 
 def markdown_table() -> str:
-    out = ["| system | parameters | E_c | exits | saddles (x, y) | Ω radius | R(1.5 E_c) |",
-           "|---|---|---|---|---|---|---|"]
+    out = [
+        "| system | parameters | E_c | exits | saddles (x, y) | Ω radius | R(1.5 E_c) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for name, params, ec, n, exits, om, nr in table_rows():
         out.append(f"| `{name}` | {params} | {ec:.6g} | {n} | {exits} | {om:.4g} | {nr:.4g} |")
     return "\n".join(out)

@@ -18,6 +18,7 @@ Markdown three things went wrong, and this extension rewrites them:
 The docstrings' numpy sections (Parameters, Returns, Examples) are parsed by
 griffe (``docstring_style: numpy`` in mkdocs.yml).
 """
+
 from __future__ import annotations
 
 import re
@@ -77,8 +78,7 @@ def escape_literal_stars(text: str) -> str:
             lines.append(line)
             continue
         state = [False]
-        lines.append("".join(p if i % 2 else _escape_stars_in(p, state)
-                             for i, p in enumerate(_CODE_SPAN.split(line))))
+        lines.append("".join(p if i % 2 else _escape_stars_in(p, state) for i, p in enumerate(_CODE_SPAN.split(line))))
     return "\n".join(lines)
 
 
@@ -144,7 +144,7 @@ def bullet_lists(text: str) -> str:
         if m and len(m.group(1)) < 4:
             if out and out[-1].strip() and not prev_bullet:
                 out.append("")
-            line = f"{m.group(1)}- {line[m.end():]}"
+            line = f"{m.group(1)}- {line[m.end() :]}"
             prev_bullet = True
         elif not line.strip() or not line.startswith(" "):
             prev_bullet = prev_bullet and line.startswith(" ")
@@ -185,9 +185,10 @@ def clean_docstring(text: str) -> str:
 
     Doctest blocks (``>>>`` lines and their output) are code and kept as they are.
     """
-    return "\n".join(block if doctest else
-                     field_lists(escape_literal_stars(scripts(bullet_lists(roles_to_code(block)))))
-                     for doctest, block in _prose_and_doctests(text))
+    return "\n".join(
+        block if doctest else field_lists(escape_literal_stars(scripts(bullet_lists(roles_to_code(block)))))
+        for doctest, block in _prose_and_doctests(text)
+    )
 
 
 class SphinxRolesToCode(griffe.Extension):

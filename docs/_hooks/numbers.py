@@ -9,6 +9,7 @@ docs/studies/adding.md). A reference that the JSON does not hold fails the
 build: a page never shows a stale number. References inside code (fences,
 inline code) are left as written, so pages can show the syntax itself.
 """
+
 from __future__ import annotations
 
 from pathlib import Path

@@ -18,6 +18,7 @@
 * **Footer.** ``on_config`` writes the commit (and date) the site was built
   from into the footer, so a page's numbers can be traced to their code.
 """
+
 from __future__ import annotations
 
 import datetime
@@ -37,16 +38,23 @@ _FIGREF = re.compile(r"\bfig:([\w-]+)")
 _PRE = re.compile(r"(<pre\b.*?</pre>|<code\b.*?</code>)", re.S)
 
 #: the paper's figures in order (labels from its LaTeX source)
-FIGURES = ("contour_two_manifolds", "kappa-E-dependence", "energy_decay", "survprob", "um_comparison",
-           "model_data_comparison")
+FIGURES = (
+    "contour_two_manifolds",
+    "kappa-E-dependence",
+    "energy_decay",
+    "survprob",
+    "um_comparison",
+    "model_data_comparison",
+)
 
 
 def mathjax_dir() -> Path:
     """The ``es5`` folder of the installed MathJax 3 copy (django-static-mathjax)."""
     spec = importlib.util.find_spec("mathjax")
     if spec is None or not spec.submodule_search_locations:
-        raise RuntimeError("the docs need MathJax from the 'docs' extra: pip install -e '.[docs]' "
-                           "(django-static-mathjax)")
+        raise RuntimeError(
+            "the docs need MathJax from the 'docs' extra: pip install -e '.[docs]' (django-static-mathjax)"
+        )
     es5 = Path(next(iter(spec.submodule_search_locations))) / "static" / "mathjax" / "es5"
     if not (es5 / "tex-chtml.js").is_file():
         raise RuntimeError(f"{es5}/tex-chtml.js is missing: reinstall django-static-mathjax")
@@ -61,6 +69,7 @@ def equation_numbers(docs_dir: Path) -> dict[str, str]:
 
 def link_labels(html: str, numbers: dict, prefix: str) -> str:
     """Equation labels → linked numbers, figure labels → 'Fig. N' (outside <pre> and <code>)."""
+
     def eq(m):
         label = m.group(1)
         if label not in numbers:
@@ -92,7 +101,7 @@ def scripts_outside_math(html: str) -> str:
         return html
     out, pos, stack = [], 0, []
     for m in _TAG.finditer(html):
-        text = html[pos:m.start()]
+        text = html[pos : m.start()]
         out.append(text if stack else scripts_to_html(text))
         closing, name, attrs = m.group(1), m.group(2).lower(), m.group(3)
         if not closing and name not in _VOID and not attrs.rstrip().endswith("/"):
@@ -110,13 +119,25 @@ def scripts_outside_math(html: str) -> str:
 
 def build_commit(root: Path) -> str:
     try:
-        out = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=root, capture_output=True,
-                             text=True, timeout=10, check=False)
+        out = subprocess.run(
+            ["git", "rev-parse", "--short=12", "HEAD"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=False,
+        )
         if out.returncode != 0:
             return "unknown commit"
         commit = out.stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
-                               capture_output=True, text=True, timeout=10, check=False)
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=False,
+        )
         return commit + ("-dirty" if dirty.stdout.strip() else "")
     except (OSError, subprocess.SubprocessError):
         return "unknown commit"

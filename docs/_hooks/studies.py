@@ -26,6 +26,7 @@ a visible "not yet generated" note instead of a broken link, so the strict
 build still passes; `make docs-assets` (docs/gen_studies.py) refreshes the
 assets from the studies' quick-scale outputs.
 """
+
 from __future__ import annotations
 
 import json
@@ -102,10 +103,12 @@ class Renderer:
             f'```toml title="studies/{name}/study.toml"\n{text}\n```\n'
         )
         conv = self.root / "studies" / "conventions.toml"
-        if conv.exists() and re.search(r'(?m)^convention\s*=', text):
-            out += ("\nIts `convention` lays these scene keys under its `[scene]`, from the one file that declares "
-                    "them for every figure study:\n\n"
-                    f'```toml title="studies/conventions.toml"\n{conv.read_text().rstrip()}\n```\n')
+        if conv.exists() and re.search(r"(?m)^convention\s*=", text):
+            out += (
+                "\nIts `convention` lays these scene keys under its `[scene]`, from the one file that declares "
+                "them for every figure study:\n\n"
+                f'```toml title="studies/conventions.toml"\n{conv.read_text().rstrip()}\n```\n'
+            )
         # folded: the configuration is there for who looks for it, not in the way of the figure (click to open)
         return f'??? abstract "Configuration: `studies/{name}/study.toml` (click to open)"\n\n' + _indent(out) + "\n"
 
@@ -122,15 +125,20 @@ class Renderer:
 
         def figure(path, scale, cmd):
             src = self._rel(path)
-            return (f'<figure class="hh-figure" markdown="span">\n[![{name}, {scale} scale]({src})]({src}){{ .hh-zoom }}\n'
-                    f"<figcaption>{scale.capitalize()} scale: <code>{cmd}</code> (click to zoom)</figcaption>\n</figure>\n")
+            return (
+                f'<figure class="hh-figure" markdown="span">\n[![{name}, {scale} scale]({src})]({src}){{ .hh-zoom }}\n'
+                f"<figcaption>{scale.capitalize()} scale: <code>{cmd}</code> (click to zoom)</figcaption>\n</figure>\n"
+            )
 
         if not paper.exists():
             return figure(png, "quick", f"make {name}")
         out = figure(paper, "paper", f"make {name} SCALE=paper")
         if png.exists():
-            out += ('\n??? note "The same figure at the quick scale (click to open)"\n\n'
-                    + _indent(figure(png, "quick", f"make {name}")) + "\n")
+            out += (
+                '\n??? note "The same figure at the quick scale (click to open)"\n\n'
+                + _indent(figure(png, "quick", f"make {name}"))
+                + "\n"
+            )
         return out
 
     def _numbers(self, name: str, scale: str = "quick"):
@@ -162,13 +170,17 @@ class Renderer:
         q = {r["quantity"]: r for r in quick_rows}
         order = [r["quantity"] for r in paper_rows] + [k for k in q if k not in {r["quantity"] for r in paper_rows}]
         p = {r["quantity"]: r for r in paper_rows}
-        out = ["| quantity | ours, quick | ours, paper scale | convention (ours) | paper | verdict (paper scale) |",
-               "|---|---|---|---|---|---|"]
+        out = [
+            "| quantity | ours, quick | ours, paper scale | convention (ours) | paper | verdict (paper scale) |",
+            "|---|---|---|---|---|---|",
+        ]
         for k in order:
             a, b = q.get(k), p.get(k)
             r = b or a
-            out.append(f"| {_cell(k)} | {_cell(ours(a))} | {_cell(ours(b))} | {_cell(r.get('convention') or '—')} | "
-                       f"{_cell(format_value(r.get('paper')))} | {_cell(row_verdict(b, 'paper') if b else '—')} |")
+            out.append(
+                f"| {_cell(k)} | {_cell(ours(a))} | {_cell(ours(b))} | {_cell(r.get('convention') or '—')} | "
+                f"{_cell(format_value(r.get('paper')))} | {_cell(row_verdict(b, 'paper') if b else '—')} |"
+            )
         return "\n".join(out) + "\n"
 
     def study_numbers(self, name: str) -> str:
@@ -184,8 +196,10 @@ class Renderer:
         quick = self._numbers(name, "quick")
         rows = doc.get("paper_comparison") or []
         if scale == "paper" and quick is not None:
-            out.append("Against the paper, at both scales (± is 1σ of our estimate; the verdict is the paper "
-                       "scale's, by the rule of the [studies index](index.md#the-papers-numbers-beside-ours)):\n")
+            out.append(
+                "Against the paper, at both scales (± is 1σ of our estimate; the verdict is the paper "
+                "scale's, by the rule of the [studies index](index.md#the-papers-numbers-beside-ours)):\n"
+            )
             out.append(self._both_scales(quick.get("paper_comparison") or [], rows))
         elif rows:
             out.append(f"Against the paper, {scale} scale (± is 1σ of our estimate):\n")
@@ -198,8 +212,11 @@ class Renderer:
         tables = [(k, v) for k, v in leaves if _is_record_list(v)]
         scalars = [(k, v) for k, v in leaves if (k, v) not in texts and (k, v) not in tables]
         if texts:
-            out.append('??? abstract "Rules and definitions the study states (click to open)"\n\n'
-                       + _indent("\n".join(f"`{k}`\n:   {v}\n" for k, v in texts)) + "\n")
+            out.append(
+                '??? abstract "Rules and definitions the study states (click to open)"\n\n'
+                + _indent("\n".join(f"`{k}`\n:   {v}\n" for k, v in texts))
+                + "\n"
+            )
         body = []
         for k, recs in tables:
             body.append(f"`{k}`:\n")
@@ -210,8 +227,9 @@ class Renderer:
             body.append("")
         if body:
             inner = "\n".join(body)
-            out.append(f'??? info "All numbers the study wrote, {scale} scale (click to open)"\n\n'
-                       + _indent(inner) + "\n")
+            out.append(
+                f'??? info "All numbers the study wrote, {scale} scale (click to open)"\n\n' + _indent(inner) + "\n"
+            )
         prov = doc.get("provenance") or {}
         bits = [f"scale **{doc.get('scale', scale)}**"]
         bits += [f"{k} {v}" for k, v in prov.items() if v and k != "git_commit"]
@@ -221,8 +239,10 @@ class Renderer:
         more = ""
         if scale == "paper" and quick is not None:
             more = f" The quick scale's: [{name}.json (quick)]({self._rel(self.study_asset(name, 'json'))})."
-        out.append(f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: "
-                   f"[{name}.json]({link}).{more}*\n")
+        out.append(
+            f"*Numbers made at {', '.join(bits)}. The full record, with the configuration: "
+            f"[{name}.json]({link}).{more}*\n"
+        )
         return "\n".join(out)
 
     def claims_table(self, name: str) -> str:
@@ -236,13 +256,18 @@ class Renderer:
         for i, (sc, doc) in enumerate(docs.items()):
             table = claims_table(doc)
             link = self._rel(self.study_asset(name, "json", sc))
-            caption = (f"*Scale **{sc}**: the records `claims` of [{name}.json ({sc})]({link}); a cell is "
-                       f"value ± 1σ: verdict (z = distance to the reference in σ).*\n")
+            caption = (
+                f"*Scale **{sc}**: the records `claims` of [{name}.json ({sc})]({link}); a cell is "
+                f"value ± 1σ: verdict (z = distance to the reference in σ).*\n"
+            )
             if i == 0:
                 out.append(table + "\n" + caption)
             else:
-                out.append(f'??? info "The same table at the {sc} scale (click to open)"\n\n'
-                           + _indent(table + "\n" + caption) + "\n")
+                out.append(
+                    f'??? info "The same table at the {sc} scale (click to open)"\n\n'
+                    + _indent(table + "\n" + caption)
+                    + "\n"
+                )
         return "\n".join(out)
 
     def _headline(self, name: str):
@@ -287,10 +312,13 @@ class Renderer:
         out = []
         for i, (sc, doc) in enumerate(docs):
             link = self._rel(self.study_asset(name, "json", sc))
-            text = (spec_table(_dig(doc, key), STUDY_TABLES.get(arg)) +
-                    f"\n*Scale **{sc}**: `{key}` of [{name}.json ({sc})]({link}).*\n")
-            out.append(text if i == 0 else
-                       f'??? info "The same at the {sc} scale (click to open)"\n\n' + _indent(text) + "\n")
+            text = (
+                spec_table(_dig(doc, key), STUDY_TABLES.get(arg))
+                + f"\n*Scale **{sc}**: `{key}` of [{name}.json ({sc})]({link}).*\n"
+            )
+            out.append(
+                text if i == 0 else f'??? info "The same at the {sc} scale (click to open)"\n\n' + _indent(text) + "\n"
+            )
         return "\n".join(out)
 
     def study_statement(self, arg: str) -> str:
@@ -320,8 +348,9 @@ class Renderer:
         out = ["| study | paper | what | needs |", "|---|---|---|---|"]
         for s in studies(self.root / "studies"):
             needs = ", ".join(f"[{u}]({u}.md)" for u in s.upstream)
-            out.append(f"| [{s.name}]({s.name}.md) | {_cell(s.paper or 'beyond the paper')} | {_cell(s.summary)} "
-                       f"| {needs} |")
+            out.append(
+                f"| [{s.name}]({s.name}.md) | {_cell(s.paper or 'beyond the paper')} | {_cell(s.summary)} | {needs} |"
+            )
         return "\n".join(out) + "\n"
 
     def comparison_all(self, _arg=None) -> str:
@@ -381,10 +410,14 @@ class Renderer:
         for r in rows:
             ok = goal_met(float(r["value"]), r["goal"])
             met += bool(ok)
-            out.append(f"| {_cell(r['target'])} | {_cell(r['measure'])} | {_cell(r['goal'])} | "
-                       f"{fmt_num(float(r['value']), 3)} | {'yes' if ok else '**no**' if ok is False else '?'} |")
-        head = (f"**{met} of {len(rows)} goals met** (`make bench-engine`, one core, best of three; the "
-                "[engine targets](#engine-targets) below give every measurement and its note):\n")
+            out.append(
+                f"| {_cell(r['target'])} | {_cell(r['measure'])} | {_cell(r['goal'])} | "
+                f"{fmt_num(float(r['value']), 3)} | {'yes' if ok else '**no**' if ok is False else '?'} |"
+            )
+        head = (
+            f"**{met} of {len(rows)} goals met** (`make bench-engine`, one core, best of three; the "
+            "[engine targets](#engine-targets) below give every measurement and its note):\n"
+        )
         return head + "\n" + "\n".join(out) + "\n"
 
     def _costs(self, scale: str) -> dict:
@@ -409,23 +442,33 @@ class Renderer:
         def agg(c):
             if not c:
                 return None
-            return {"cpu": c["cpu_s"] / 3600, "wall": c["wall_s"] / 3600, "orbits": c["orbits"], "rss": c["rss_mb"],
-                    "analysis": c["analysis_cpu_s"] / 3600}
+            return {
+                "cpu": c["cpu_s"] / 3600,
+                "wall": c["wall_s"] / 3600,
+                "orbits": c["orbits"],
+                "rss": c["rss_mb"],
+                "analysis": c["analysis_cpu_s"] / 3600,
+            }
 
         def f(x, fmt):
             return "—" if x is None else format(x, fmt)
 
-        out = ["| study | CPU h (quick → paper) | wall h (quick → paper) | orbits (quick → paper) | ratio of orbits | "
-               "ratio of CPU | analysis + plot CPU h (paper) | peak RSS MB (quick → paper) |", "|---|---|---|---|---|---|---|---|"]
+        out = [
+            "| study | CPU h (quick → paper) | wall h (quick → paper) | orbits (quick → paper) | ratio of orbits | "
+            "ratio of CPU | analysis + plot CPU h (paper) | peak RSS MB (quick → paper) |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
         tot = {"q": 0.0, "p": 0.0, "qw": 0.0, "pw": 0.0}
         for n in names:
             q, p = agg(quick.get(n)), agg(paper.get(n))
             ro = p["orbits"] / q["orbits"] if p and q and q["orbits"] else None
             rc = p["cpu"] / q["cpu"] if p and q and q["cpu"] else None
-            out.append(f"| [{n}]({n}.md) | {f(q and q['cpu'], '.3f')} → {f(p and p['cpu'], '.2f')} | "
-                       f"{f(q and q['wall'], '.3f')} → {f(p and p['wall'], '.2f')} | {f(q and q['orbits'], '.3g')} → "
-                       f"{f(p and p['orbits'], '.3g')} | {f(ro, '.0f')} | {f(rc, '.0f')} | {f(p and p['analysis'], '.3f')} | "
-                       f"{f(q and q['rss'], '.0f')} → {f(p and p['rss'], '.0f')} |")
+            out.append(
+                f"| [{n}]({n}.md) | {f(q and q['cpu'], '.3f')} → {f(p and p['cpu'], '.2f')} | "
+                f"{f(q and q['wall'], '.3f')} → {f(p and p['wall'], '.2f')} | {f(q and q['orbits'], '.3g')} → "
+                f"{f(p and p['orbits'], '.3g')} | {f(ro, '.0f')} | {f(rc, '.0f')} | {f(p and p['analysis'], '.3f')} | "
+                f"{f(q and q['rss'], '.0f')} → {f(p and p['rss'], '.0f')} |"
+            )
             tot["q"] += q["cpu"] if q else 0.0
             tot["p"] += p["cpu"] if p else 0.0
             tot["qw"] += q["wall"] if q else 0.0
@@ -454,8 +497,10 @@ class Renderer:
                 if not a["err"] or abs(r["ours"] - a["ours"]) <= a["err"]:
                     continue
                 n += 1
-                out.append(f"| [{st.name}]({st.name}.md) | {_cell(r['quantity'])} | {fmt_err(a['ours'], a['err'])} | "
-                           f"{fmt_err(r['ours'], r.get('err'))} | {(r['ours'] - a['ours']) / a['err']:+.1f} |")
+                out.append(
+                    f"| [{st.name}]({st.name}.md) | {_cell(r['quantity'])} | {fmt_err(a['ours'], a['err'])} | "
+                    f"{fmt_err(r['ours'], r.get('err'))} | {(r['ours'] - a['ours']) / a['err']:+.1f} |"
+                )
         if n == 0:
             return "*No paper-scale number differs from its quick-scale value by more than the quick-scale error.*\n"
         return "\n".join(out) + "\n"
@@ -523,8 +568,13 @@ def _is_record_list(v) -> bool:
         isinstance(v, list)
         and 1 <= len(v) <= 100
         and all(isinstance(x, dict) and "value" not in x for x in v)
-        and all(not isinstance(y, (dict, list)) or (isinstance(y, dict) and "value" in y)
-                or (isinstance(y, list) and len(y) <= 4) for x in v for y in x.values())
+        and all(
+            not isinstance(y, (dict, list))
+            or (isinstance(y, dict) and "value" in y)
+            or (isinstance(y, list) and len(y) <= 4)
+            for x in v
+            for y in x.values()
+        )
     )
 
 
@@ -541,8 +591,10 @@ def claims_table(doc) -> str:
 
     def head(label):
         info = (doc.get("systems") or {}).get(label) or {}
-        bits = [f"{info['n_exits']} exits" if info.get("n_exits") is not None else "",
-                f"E_c = {fmt_num(info['E_c'], 4)}" if _is_num(info.get("E_c")) else ""]
+        bits = [
+            f"{info['n_exits']} exits" if info.get("n_exits") is not None else "",
+            f"E_c = {fmt_num(info['E_c'], 4)}" if _is_num(info.get("E_c")) else "",
+        ]
         bits = [b for b in bits if b]
         return f"{label} ({', '.join(bits)})" if bits else str(label)
 
@@ -550,13 +602,16 @@ def claims_table(doc) -> str:
         if c is None:
             return "—"
         v, e = c.get("value"), c.get("err")
-        val = "n/a" if v is None else (fmt_err(v, e) if _is_num(e) else fmt_value(v) if not _is_num(v)
-                                       else fmt_num(v, 3))
+        val = (
+            "n/a" if v is None else (fmt_err(v, e) if _is_num(e) else fmt_value(v) if not _is_num(v) else fmt_num(v, 3))
+        )
         verdict = c.get("verdict")
         return _cell(f"{val}: {verdict}" if verdict else val)
 
-    out = ["| claim | quantity | " + " | ".join(_cell(head(s)) for s in systems) + " |",
-           "|---|---|" + "---|" * len(systems)]
+    out = [
+        "| claim | quantity | " + " | ".join(_cell(head(s)) for s in systems) + " |",
+        "|---|---|" + "---|" * len(systems),
+    ]
 
     def claim_order(item):  # by claim (numbers numerically), then in the order the records first appear
         claim = item[0][0]
@@ -580,47 +635,117 @@ def _dig(doc, key: str):
 #: columns (key, header) of the record tables that study pages ask for with ``hh:study-table``; a key with a
 #: sibling ``<key>_err`` is shown as value ± error rounded to the error
 STUDY_TABLES = {
-    "basins.entropy_by_box": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid (cells per side)"),
-                              ("box_side", "box side s"), ("box_cells", "box (cells)"), ("S_b", "S_b"),
-                              ("S_bb", "S_bb")),
-    "basins.point_table": (("E0", "E0"), ("gamma", "γ"), ("d", "d = 2 − α, one law"), ("fit_p", "its fit p"),
-                           ("d_coarse", "d(ε) coarse"), ("d_fine", "d(ε) finest resolved"),
-                           ("slope", "slope of d per decade"), ("slim", "slim fractal"),
-                           ("S_bb", "S_bb (headline box)"), ("box_cells", "box (cells)"),
-                           ("wada_all", "Wada, settled a basin"), ("wada_exits", "Wada, exits (settled masked)")),
-    "basins.entropy_exponent_by_grid": (("E0", "E0"), ("gamma", "γ"), ("map", "map"), ("grid", "grid"),
-                                        ("alpha", "α from S_b ∝ s^α"), ("sides", "box sides s")),
-    "basins.cutoff_prediction": (("E0", "E0"), ("gamma", "γ"), ("tau2", "τ2"), ("eps_c", "measured ε_c"),
-                                 ("eps_c_interval", "measured 1σ interval"),
-                                 ("eps_c_predicted", "predicted ε_c (decision rate λ)"),
-                                 ("eps_c_predicted_kantz_grassberger", "predicted, λ = κ/α"),
-                                 ("eps_c_predicted_interval", "predicted interval (λ ± σ, μ ± σ, κ/α)"),
-                                 ("log10_ratio", "log10(measured/predicted)"), ("statement", "how far apart")),
-    "operator.mixed_phase_space": (("energy", "E"), ("probes", "KAM probes"), ("trapped_boxes", "trapped boxes"),
-                                   ("trapped_share_of_saddle_class", "their share of the saddle's class"),
-                                   ("kappa_without_trapped_boxes", "κ without them")),
-    "operator.cmeasure_distances": (("fig1_energy", "fig1 at E"), ("operator_energy", "operator at E"),
-                                    ("measure", "operator's measure"), ("n", "fig1 points"), ("box", "ε"),
-                                    ("hellinger_debiased", "debiased Hellinger"), ("hellinger_debiased_lo", "lo"),
-                                    ("hellinger_debiased_hi", "hi"), ("hellinger_noise", "noise")),
-    "operator.cmeasure_convergence": (("energy", "E"), ("box", "box side"), ("samples_per_box", "samples per box"),
-                                      ("kappa", "κ"), ("hellinger_debiased", "debiased Hellinger (ε = 0.1)"),
-                                      ("lo", "lo"), ("hi", "hi")),
-    "operator.dissipative.P_at": (("t", "t"), ("sim", "simulated", "sim_err"), ("operator", "operator (box × E)"),
-                                  ("reduced", "reduced, ρ(E) alone")),
-    "operator.cost": (("energy", "E"), ("pt_orbit_time_1pct", "P(t) route for 1 %"),
-                      ("op_orbit_time_1pct", "operator for 1 % (lower bound)"), ("pt_rel", "P(t): its rel. error"),
-                      ("op_rel", "operator: its rel. error"), ("pt_rel_at_op_cost", "P(t) at the operator's cost")),
-    "operator.kappa_ulam": (("energy", "E"), ("box", "finest box"), ("kappa", "κ_Ulam finest boxes", "err"),
-                            ("kappa_stat_err", "σ bootstrap"), ("discretisation_bias", "linear box bias"),
-                            ("fig2_kappa", "fig2 κ0", "fig2_err"), ("z_vs_fig2", "z vs κ0 (both errors)"),
-                            ("fig2_kappa_cm", "fig2 κ crossings", "fig2_kappa_cm_err"), ("kappa_map_per_return", "−ln ρ(P) per return"),
-                            ("mean_return_time", "⟨T⟩")),
-    "operator.kappa_convergence": (("energy", "E"), ("kappa_finest", "κ finest boxes"), ("kappa_inf", "κ∞", "err"),
-                                   ("stat_err", "σ stat (bootstrap)"), ("model_err", "σ model (M^−1/2 vs M^−1)"),
-                                   ("kappa0", "fig2 κ0"), ("residual_kappa0", "κ∞/κ0 − 1"), ("z_kappa0", "z vs κ0"),
-                                   ("kappa_cm", "fig2 κ crossings"), ("residual_kappa_cm", "κ∞/κ_cm − 1"),
-                                   ("z_kappa_cm", "z vs κ_cm"), ("note", "note")),
+    "basins.entropy_by_box": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("map", "map"),
+        ("grid", "grid (cells per side)"),
+        ("box_side", "box side s"),
+        ("box_cells", "box (cells)"),
+        ("S_b", "S_b"),
+        ("S_bb", "S_bb"),
+    ),
+    "basins.point_table": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("d", "d = 2 − α, one law"),
+        ("fit_p", "its fit p"),
+        ("d_coarse", "d(ε) coarse"),
+        ("d_fine", "d(ε) finest resolved"),
+        ("slope", "slope of d per decade"),
+        ("slim", "slim fractal"),
+        ("S_bb", "S_bb (headline box)"),
+        ("box_cells", "box (cells)"),
+        ("wada_all", "Wada, settled a basin"),
+        ("wada_exits", "Wada, exits (settled masked)"),
+    ),
+    "basins.entropy_exponent_by_grid": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("map", "map"),
+        ("grid", "grid"),
+        ("alpha", "α from S_b ∝ s^α"),
+        ("sides", "box sides s"),
+    ),
+    "basins.cutoff_prediction": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("tau2", "τ2"),
+        ("eps_c", "measured ε_c"),
+        ("eps_c_interval", "measured 1σ interval"),
+        ("eps_c_predicted", "predicted ε_c (decision rate λ)"),
+        ("eps_c_predicted_kantz_grassberger", "predicted, λ = κ/α"),
+        ("eps_c_predicted_interval", "predicted interval (λ ± σ, μ ± σ, κ/α)"),
+        ("log10_ratio", "log10(measured/predicted)"),
+        ("statement", "how far apart"),
+    ),
+    "operator.mixed_phase_space": (
+        ("energy", "E"),
+        ("probes", "KAM probes"),
+        ("trapped_boxes", "trapped boxes"),
+        ("trapped_share_of_saddle_class", "their share of the saddle's class"),
+        ("kappa_without_trapped_boxes", "κ without them"),
+    ),
+    "operator.cmeasure_distances": (
+        ("fig1_energy", "fig1 at E"),
+        ("operator_energy", "operator at E"),
+        ("measure", "operator's measure"),
+        ("n", "fig1 points"),
+        ("box", "ε"),
+        ("hellinger_debiased", "debiased Hellinger"),
+        ("hellinger_debiased_lo", "lo"),
+        ("hellinger_debiased_hi", "hi"),
+        ("hellinger_noise", "noise"),
+    ),
+    "operator.cmeasure_convergence": (
+        ("energy", "E"),
+        ("box", "box side"),
+        ("samples_per_box", "samples per box"),
+        ("kappa", "κ"),
+        ("hellinger_debiased", "debiased Hellinger (ε = 0.1)"),
+        ("lo", "lo"),
+        ("hi", "hi"),
+    ),
+    "operator.dissipative.P_at": (
+        ("t", "t"),
+        ("sim", "simulated", "sim_err"),
+        ("operator", "operator (box × E)"),
+        ("reduced", "reduced, ρ(E) alone"),
+    ),
+    "operator.cost": (
+        ("energy", "E"),
+        ("pt_orbit_time_1pct", "P(t) route for 1 %"),
+        ("op_orbit_time_1pct", "operator for 1 % (lower bound)"),
+        ("pt_rel", "P(t): its rel. error"),
+        ("op_rel", "operator: its rel. error"),
+        ("pt_rel_at_op_cost", "P(t) at the operator's cost"),
+    ),
+    "operator.kappa_ulam": (
+        ("energy", "E"),
+        ("box", "finest box"),
+        ("kappa", "κ_Ulam finest boxes", "err"),
+        ("kappa_stat_err", "σ bootstrap"),
+        ("discretisation_bias", "linear box bias"),
+        ("fig2_kappa", "fig2 κ0", "fig2_err"),
+        ("z_vs_fig2", "z vs κ0 (both errors)"),
+        ("fig2_kappa_cm", "fig2 κ crossings", "fig2_kappa_cm_err"),
+        ("kappa_map_per_return", "−ln ρ(P) per return"),
+        ("mean_return_time", "⟨T⟩"),
+    ),
+    "operator.kappa_convergence": (
+        ("energy", "E"),
+        ("kappa_finest", "κ finest boxes"),
+        ("kappa_inf", "κ∞", "err"),
+        ("stat_err", "σ stat (bootstrap)"),
+        ("model_err", "σ model (M^−1/2 vs M^−1)"),
+        ("kappa0", "fig2 κ0"),
+        ("residual_kappa0", "κ∞/κ0 − 1"),
+        ("z_kappa0", "z vs κ0"),
+        ("kappa_cm", "fig2 κ crossings"),
+        ("residual_kappa_cm", "κ∞/κ_cm − 1"),
+        ("z_kappa_cm", "z vs κ_cm"),
+        ("note", "note"),
+    ),
 }
 
 
@@ -718,9 +843,7 @@ def cli_reference(parser) -> str:
             if a.option_strings:
                 flag = ", ".join(a.option_strings)
                 if a.nargs != 0:
-                    metavar = a.metavar or (
-                        "{" + ",".join(map(str, a.choices)) + "}" if a.choices else a.dest.upper()
-                    )
+                    metavar = a.metavar or ("{" + ",".join(map(str, a.choices)) + "}" if a.choices else a.dest.upper())
                     if a.nargs in ("*", "+"):
                         metavar += " …"
                     flag += f" {metavar}"
@@ -789,7 +912,7 @@ def figure_first(markdown: str, summary: str = "") -> str:
     cuts = [m.start() for m in _H2.finditer(markdown) if not any(a <= m.start() < b for a, b in fenced)]
     if not cuts:
         return markdown
-    head, parts = markdown[:cuts[0]], [markdown[a:b] for a, b in zip(cuts, [*cuts[1:], len(markdown)])]
+    head, parts = markdown[: cuts[0]], [markdown[a:b] for a, b in zip(cuts, [*cuts[1:], len(markdown)])]
     parts = [p if p.endswith("\n\n") else p.rstrip("\n") + "\n\n" for p in parts]
 
     def take(marker):
@@ -845,8 +968,11 @@ def _pct(v, e=None) -> str:
 
 
 def _ve_cell(d) -> str:
-    return fmt_err(d["value"], d["err"]) if d and _is_num(d.get("value")) and _is_num(d.get("err")) else (
-        fmt_num(d["value"]) if d and _is_num(d.get("value")) else "—")
+    return (
+        fmt_err(d["value"], d["err"])
+        if d and _is_num(d.get("value")) and _is_num(d.get("err"))
+        else (fmt_num(d["value"]) if d and _is_num(d.get("value")) else "—")
+    )
 
 
 def evidence_tables(doc) -> str:
@@ -858,50 +984,73 @@ def evidence_tables(doc) -> str:
     out.append("**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ)\n")
     out.append("| system | ICs | " + " | ".join(f"{r:g} E_c" for r in ratios) + " |")
     out.append("|---|---|" + "---|" * len(ratios))
-    for (lab, ics) in dict.fromkeys((r["label"], r["ics"]) for r in reg):
+    for lab, ics in dict.fromkeys((r["label"], r["ics"]) for r in reg):
         cells = {r["e_ratio"]: _pct(r["fraction"], r["err"]) for r in reg if r["label"] == lab and r["ics"] == ics}
         out.append(f"| {lab} | {ics} | " + " | ".join(cells.get(x, "—") for x in ratios) + " |")
     P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
     ts = sorted({r["t"] for r in doc.get("survival_long", [])})
-    out.append("\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
-               "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
-               "exponential from t0, p its χ² p-value)\n")
-    out.append("| system | E/E_c | " + " | ".join(f"P({t:g})" for t in ts)
-               + " | P∞ | κ∞ | regular share of the orbits inside at t_max | κ non-regular | p |")
+    out.append(
+        "\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
+        "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
+        "exponential from t0, p its χ² p-value)\n"
+    )
+    out.append(
+        "| system | E/E_c | "
+        + " | ".join(f"P({t:g})" for t in ts)
+        + " | P∞ | κ∞ | regular share of the orbits inside at t_max | κ non-regular | p |"
+    )
     out.append("|---|---|" + "---|" * (len(ts) + 5))
     for f in doc["long_time"]:
         if "disk" not in f["ics"]:
             continue
         ps = [P.get((f["label"], f["e_ratio"], t)) for t in ts]
-        out.append(f"| {f['label']} | {f['e_ratio']:g} | " + " | ".join(
-            fmt_err(x["P"], x["P_err"]) if x else "—" for x in ps) + " | "
-            + " | ".join([_ve_cell({"value": f.get("P_inf"), "err": f.get("P_inf_err")}),
-                          _ve_cell({"value": f.get("kappa_inf"), "err": f.get("kappa_inf_err")}),
-                          _pct(f.get("regular_fraction_of_censored")),
-                          _ve_cell({"value": f.get("kappa_nonregular"), "err": f.get("kappa_nonregular_err")}),
-                          fmt_num(f["p_nonregular"], 2) if _is_num(f.get("p_nonregular")) else "—"]) + " |")
+        out.append(
+            f"| {f['label']} | {f['e_ratio']:g} | "
+            + " | ".join(fmt_err(x["P"], x["P_err"]) if x else "—" for x in ps)
+            + " | "
+            + " | ".join(
+                [
+                    _ve_cell({"value": f.get("P_inf"), "err": f.get("P_inf_err")}),
+                    _ve_cell({"value": f.get("kappa_inf"), "err": f.get("kappa_inf_err")}),
+                    _pct(f.get("regular_fraction_of_censored")),
+                    _ve_cell({"value": f.get("kappa_nonregular"), "err": f.get("kappa_nonregular_err")}),
+                    fmt_num(f["p_nonregular"], 2) if _is_num(f.get("p_nonregular")) else "—",
+                ]
+            )
+            + " |"
+        )
     vm = doc.get("validity_map", [])
     if vm:
         yn = {True: "yes", False: "no", None: "—"}
-        out.append("\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 defined with "
-                   "all orbits, the paper's convention) and claim 2's where tested, and whether the non-regular "
-                   "orbits decay as one exponential\n")
-        out.append("| system | E/E_c | regular fraction | κ0 defined (claim 1) | claim 2 | one exponential "
-                   "(non-regular) | plateau P∞ > 3σ |")
+        out.append(
+            "\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 defined with "
+            "all orbits, the paper's convention) and claim 2's where tested, and whether the non-regular "
+            "orbits decay as one exponential\n"
+        )
+        out.append(
+            "| system | E/E_c | regular fraction | κ0 defined (claim 1) | claim 2 | one exponential "
+            "(non-regular) | plateau P∞ > 3σ |"
+        )
         out.append("|---|---|---|---|---|---|---|")
         for v in vm:
-            out.append(f"| {v['label']} | {v['e_ratio']:g} | {_pct(v['regular_fraction'], v['regular_err'])} | "
-                       f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | {yn[v['exponential']]} | "
-                       f"{yn[v['plateau']]} |")
+            out.append(
+                f"| {v['label']} | {v['e_ratio']:g} | {_pct(v['regular_fraction'], v['regular_err'])} | "
+                f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | {yn[v['exponential']]} | "
+                f"{yn[v['plateau']]} |"
+            )
     rs = doc.get("resc", [])
     if rs:
         out.append("\n**r_esc sensitivity** (the same N and rules at each escape radius; windows of μ's fit)\n")
-        out.append("| system | r_esc | window | μ measured | μ predicted (c-measure) | μ own ⟨K⟩ | moment test "
-                   "(own − predicted) | 2⟨K⟩/E at E0 (measured) | at E0 interpolated (without E0) |")
+        out.append(
+            "| system | r_esc | window | μ measured | μ predicted (c-measure) | μ own ⟨K⟩ | moment test "
+            "(own − predicted) | 2⟨K⟩/E at E0 (measured) | at E0 interpolated (without E0) |"
+        )
         out.append("|---|---|---|---|---|---|---|---|---|")
         for r in rs:
-            out.append(f"| {r['label']} | {r['r_esc']:g}{' (default)' if r['default'] else ''} | "
-                       f"[{r['window'][0]:g}, {r['window'][1]:g}] | {_ve_cell(r['mu_measured'])} | "
-                       f"{_ve_cell(r['mu_predicted'])} | {_ve_cell(r['mu_own_K'])} | {_ve_cell(r['moment_test'])} | "
-                       f"{_ve_cell(r['kinetic_at_E0'])} | {fmt_num(r['kinetic_at_E0_interpolated_without_E0'])} |")
+            out.append(
+                f"| {r['label']} | {r['r_esc']:g}{' (default)' if r['default'] else ''} | "
+                f"[{r['window'][0]:g}, {r['window'][1]:g}] | {_ve_cell(r['mu_measured'])} | "
+                f"{_ve_cell(r['mu_predicted'])} | {_ve_cell(r['mu_own_K'])} | {_ve_cell(r['moment_test'])} | "
+                f"{_ve_cell(r['kinetic_at_E0'])} | {fmt_num(r['kinetic_at_E0_interpolated_without_E0'])} |"
+            )
     return "\n".join(out) + "\n"

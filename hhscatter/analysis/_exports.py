@@ -1,5 +1,6 @@
 """Exports loaded on first use: the ``__getattr__`` and ``__dir__`` of a package whose public names live in its
 modules (``from hhscatter.analysis.survival import survival_curve`` imports only the module that defines it)."""
+
 import importlib
 import sys
 

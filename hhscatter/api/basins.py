@@ -1,4 +1,5 @@
 """Exit basins: the basin map of a grid of initial conditions per grid point, its shares, entropies and Wada test."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -57,13 +58,15 @@ class BasinMeasures:
         for k in _sorted_keys(self.maps):
             fr, w = self.fractions[k], self.wada.get(k)
             shares = {f"share {_basin_name(b)}": float(f) for b, f in zip(fr.basins, fr.frac)}
-            parts.append(self.entropy[k][["box", "S_b", "S_b_err", "S_bb", "S_bb_err"]].assign(
-                energy=k[0], gamma=k[1], **shares, wada=None if w is None else bool(w.wada)))
+            parts.append(
+                self.entropy[k][["box", "S_b", "S_b_err", "S_bb", "S_bb_err"]].assign(
+                    energy=k[0], gamma=k[1], **shares, wada=None if w is None else bool(w.wada)
+                )
+            )
         df = pd.concat(parts, ignore_index=True)
         return df[["energy", "gamma", *[c for c in df.columns if c not in ("energy", "gamma")]]]
 
-    def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None,
-             **imshow_kwargs: Any) -> Axes:
+    def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None, **imshow_kwargs: Any) -> Axes:
         """Draw the basin map of point ``key`` (default: the first), one colour per basin, forbidden cells blank."""
         from matplotlib.colors import ListedColormap  # deferred: matplotlib loads on first use
         from matplotlib.patches import Patch  # deferred: matplotlib loads on first use
@@ -73,25 +76,41 @@ class BasinMeasures:
         lab = self.maps[k]
         codes = sorted(int(c) for c in np.unique(lab) if c != OUTSIDE_BASIN)
         colours = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:brown", "tab:pink"]
-        palette = {c: ("0.55" if c == TRAPPED_BASIN else "orange" if c == SETTLED_BASIN else colours[i % 6])
-                   for i, c in enumerate(codes)}
+        palette = {
+            c: ("0.55" if c == TRAPPED_BASIN else "orange" if c == SETTLED_BASIN else colours[i % 6])
+            for i, c in enumerate(codes)
+        }
         index = np.full(lab.shape, np.nan)
         for i, c in enumerate(codes):
             index[lab == c] = i
-        ax.imshow(index, origin="lower", extent=self.extent, interpolation="nearest",
-                  cmap=ListedColormap([palette[c] for c in codes]), vmin=-0.5, vmax=len(codes) - 0.5,
-                  **imshow_kwargs)
-        ax.legend(handles=[Patch(color=palette[c], label=_basin_name(c)) for c in codes], loc="upper right",
-                  fontsize="small")
+        ax.imshow(
+            index,
+            origin="lower",
+            extent=self.extent,
+            interpolation="nearest",
+            cmap=ListedColormap([palette[c] for c in codes]),
+            vmin=-0.5,
+            vmax=len(codes) - 0.5,
+            **imshow_kwargs,
+        )
+        ax.legend(
+            handles=[Patch(color=palette[c], label=_basin_name(c)) for c in codes], loc="upper right", fontsize="small"
+        )
         ax.set_title(_label(k))
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         return ax
 
 
-def basin_measures(lifetimes: pandas.DataFrame, cell: ArrayLike, shape: tuple[int, int], *,
-                   boxes: tuple[int, ...] = (2, 5, 10), extent: tuple[float, float, float, float] | None = None,
-                   wada: bool = True) -> BasinMeasures:
+def basin_measures(
+    lifetimes: pandas.DataFrame,
+    cell: ArrayLike,
+    shape: tuple[int, int],
+    *,
+    boxes: tuple[int, ...] = (2, 5, 10),
+    extent: tuple[float, float, float, float] | None = None,
+    wada: bool = True,
+) -> BasinMeasures:
     """Exit-basin maps of a grid of initial conditions, per grid point, with their basin measures.
 
     Each cell of a (ny, nx) grid of initial conditions (e.g. :func:`hhscatter.scene.ics.section_grid`, which also gives

@@ -1,4 +1,5 @@
 """The c-measure: κ from the c-measure of a run's section crossings, its section points, their distances to a reference set."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -50,18 +51,34 @@ class CMeasureRates(_PointRows):
         ax = _axes(ax)
         kw = {"capsize": 3, **errorbar_kwargs}
         ax.errorbar(df["energy"], df["kappa_pt"], yerr=df["kappa_pt_err"], fmt="o", label="κ from P(t)", **kw)
-        ax.errorbar(df["energy"], df["kappa_cm"], yerr=df["kappa_cm_err"], fmt="D", mfc="none",
-                    label="κ from the c-measure", **kw)
+        ax.errorbar(
+            df["energy"],
+            df["kappa_cm"],
+            yerr=df["kappa_cm_err"],
+            fmt="D",
+            mfc="none",
+            label="κ from the c-measure",
+            **kw,
+        )
         ax.set_xlabel("E0")
         ax.set_ylabel("κ")
         ax.legend()
         return ax
 
 
-def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFrame, *,
-                          window: tuple[float, float] | None = None, t_max: float | None = None, t_from: float | None = None, t_to: float | None = None,
-                          rec_efolds: float = 2.0, margin: float = 40.0, n_boot: int = 200,
-                          seed: int = 0) -> CMeasureRates:
+def kappa_cmeasure_tables(
+    lifetimes: pandas.DataFrame,
+    sections: pandas.DataFrame,
+    *,
+    window: tuple[float, float] | None = None,
+    t_max: float | None = None,
+    t_from: float | None = None,
+    t_to: float | None = None,
+    rec_efolds: float = 2.0,
+    margin: float = 40.0,
+    n_boot: int = 200,
+    seed: int = 0,
+) -> CMeasureRates:
     """κ from the c-measure of the true-time map, per conservative grid point of a run, beside κ from P(t).
 
     Solves ∫_Ω e^{κT} dμ_c = 1 + μ_c(𝓔), Eq. (eqn:kappa_cmeasure_truetime), with every section crossing of
@@ -131,8 +148,21 @@ def kappa_cmeasure_tables(lifetimes: pandas.DataFrame, sections: pandas.DataFram
     sec_by = _split_like(sec, keys, what="sections table")
     rows = {}
     for key, df in split_points(lt):
-        rows[key] = _cmeasure_point_row(key, df, sec_by.get(key, sec.iloc[:0]), rates, window, t_max, t_record_end,
-                                        t_from, t_to, rec_efolds, margin, n_boot, seed)
+        rows[key] = _cmeasure_point_row(
+            key,
+            df,
+            sec_by.get(key, sec.iloc[:0]),
+            rates,
+            window,
+            t_max,
+            t_record_end,
+            t_from,
+            t_to,
+            rec_efolds,
+            margin,
+            n_boot,
+            seed,
+        )
     return CMeasureRates(rows)
 
 
@@ -146,17 +176,25 @@ def _checked_cmeasure_window(window) -> dict:
     if window is not None and dataclasses.is_dataclass(window):
         window = dataclasses.asdict(window)
     if not window:
-        raise ValueError("the run recorded no sections; simulate with sections=SectionWindow(t_from=…, t_to=…) "
-                         "(every crossing, no energy filter)")
-    if window.get("first_only") or math.isfinite(window.get("e_min", -math.inf)) or \
-            math.isfinite(window.get("e_max", math.inf)):
-        raise ValueError(f"the c-measure needs every section crossing; the run's window {window} filters them "
-                         "(first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)")
+        raise ValueError(
+            "the run recorded no sections; simulate with sections=SectionWindow(t_from=…, t_to=…) "
+            "(every crossing, no energy filter)"
+        )
+    if (
+        window.get("first_only")
+        or math.isfinite(window.get("e_min", -math.inf))
+        or math.isfinite(window.get("e_max", math.inf))
+    ):
+        raise ValueError(
+            f"the c-measure needs every section crossing; the run's window {window} filters them "
+            "(first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)"
+        )
     return window
 
 
-def _cmeasure_point_row(key, df, sec, rates, window, t_max, t_record_end, t_from, t_to, rec_efolds, margin,
-                        n_boot, seed) -> dict:
+def _cmeasure_point_row(
+    key, df, sec, rates, window, t_max, t_record_end, t_from, t_to, rec_efolds, margin, n_boot, seed
+) -> dict:
     """One grid point's row of :func:`kappa_cmeasure_tables`: its sampling window (time units) from τ0 and κ of
     P(t), the c-measure sample of its crossings in it, κ_cm ± err (1/time) beside κ from P(t), or a note."""
     from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
@@ -164,33 +202,57 @@ def _cmeasure_point_row(key, df, sec, rates, window, t_max, t_record_end, t_from
         kappa_from_cmeasure,
     )
 
-    row = {**_key_columns(key), "n": len(df), "kappa_cm": math.nan, "kappa_cm_err": math.nan,
-           "mu_exit": math.nan, "n_samples": 0, "n_exit": 0, "n_undetermined": 0, "t_from": math.nan,
-           "t_to": math.nan, "t_record_end": t_record_end, "kappa_pt": math.nan, "kappa_pt_err": math.nan,
-           "note": ""}
+    row = {
+        **_key_columns(key),
+        "n": len(df),
+        "kappa_cm": math.nan,
+        "kappa_cm_err": math.nan,
+        "mu_exit": math.nan,
+        "n_samples": 0,
+        "n_exit": 0,
+        "n_undetermined": 0,
+        "t_from": math.nan,
+        "t_to": math.nan,
+        "t_record_end": t_record_end,
+        "kappa_pt": math.nan,
+        "kappa_pt_err": math.nan,
+        "note": "",
+    }
     r = rates.results.get(key)
     if r is None:
         row["note"] = DISSIPATIVE_NOTE if key[1] > 0 else rates.notes.get(key, "no κ from P(t)")
         return row
     row.update(kappa_pt=r.kappa, kappa_pt_err=r.kappa_err)
-    t0 = float(t_from) if t_from is not None else max(float(window.get("t_from", 0.0)),
-                                                       math.ceil(r.tau0 + rec_efolds / r.kappa))
+    t0 = (
+        float(t_from)
+        if t_from is not None
+        else max(float(window.get("t_from", 0.0)), math.ceil(r.tau0 + rec_efolds / r.kappa))
+    )
     t1 = float(t_to) if t_to is not None else t_record_end - margin
     row.update(t_from=t0, t_to=t1)
     if not t1 > t0 or t0 < float(window.get("t_from", 0.0)) or t1 > t_record_end:
-        row["note"] = (f"sampling window [{t0:g}, {t1:g}] does not fit the recording [{window.get('t_from', 0)}, "
-                       f"{t_record_end:g}]: record sections until ≥ {t0 + margin + 2 / r.kappa:.0f}")
+        row["note"] = (
+            f"sampling window [{t0:g}, {t1:g}] does not fit the recording [{window.get('t_from', 0)}, "
+            f"{t_record_end:g}]: record sections until ≥ {t0 + margin + 2 / r.kappa:.0f}"
+        )
         return row
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the undetermined count is a column
         T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
-            sec, df, t0, t1, t_record_end=t_record_end, drop_censored=t_max > t_record_end, with_orbits=True)
+            sec, df, t0, t1, t_record_end=t_record_end, drop_censored=t_max > t_record_end, with_orbits=True
+        )
     if T.size + n_exit == 0:
         row["note"] = "no section crossing in the sampling window"
         return row
     k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot, rng=seed)
-    row.update(kappa_cm=k.kappa, kappa_cm_err=k.kappa_err, mu_exit=k.mu_exit, n_samples=k.n_samples,
-               n_exit=k.n_exit, n_undetermined=n_und)
+    row.update(
+        kappa_cm=k.kappa,
+        kappa_cm_err=k.kappa_err,
+        mu_exit=k.mu_exit,
+        n_samples=k.n_samples,
+        n_exit=k.n_exit,
+        n_undetermined=n_und,
+    )
     return row
 
 
@@ -224,10 +286,13 @@ def kappa_cmeasure(run: str | os.PathLike[str], **kwargs: Any) -> CMeasureRates:
     """
     scene = run_scene(run)
     if not scene.get("sections"):
-        raise ValueError(f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
-                         "t_to=…) (every crossing, no energy filter)")
-    return kappa_cmeasure_tables(read_lifetimes(run), read_sections(run), window=scene["sections"],
-                       t_max=float(scene["t_max"]), **kwargs)
+        raise ValueError(
+            f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
+            "t_to=…) (every crossing, no energy filter)"
+        )
+    return kappa_cmeasure_tables(
+        read_lifetimes(run), read_sections(run), window=scene["sections"], t_max=float(scene["t_max"]), **kwargs
+    )
 
 
 @dataclass(frozen=True)
@@ -254,14 +319,16 @@ class CMeasurePoints:
         """Every selected crossing in one DataFrame: point_energy, point_gamma, traj_id, t, x, y, …"""
         import pandas as pd  # deferred: pandas loads on first use
 
-        return pd.concat([p.assign(point_energy=k[0], point_gamma=k[1]) for k, p in self.points.items()],
-                         ignore_index=True)
+        return pd.concat(
+            [p.assign(point_energy=k[0], point_gamma=k[1]) for k, p in self.points.items()], ignore_index=True
+        )
 
-    def plot(self, ax: Axes | None = None, *, key: tuple[float, float] | None = None, s: float = 0.5,
-             **scatter_kwargs: Any) -> Axes:
+    def plot(
+        self, ax: Axes | None = None, *, key: tuple[float, float] | None = None, s: float = 0.5, **scatter_kwargs: Any
+    ) -> Axes:
         """Draw the points in (x, y), one colour per grid point (or only point ``key``); returns the axes."""
         ax = _axes(ax)
-        for k in ([key] if key is not None else _sorted_keys(self.points)):
+        for k in [key] if key is not None else _sorted_keys(self.points):
             p = self[k]
             ax.scatter(p["x"], p["y"], s=s, label=f"{_label(k)} ({len(p)})", **scatter_kwargs)
         ax.set_aspect("equal")
@@ -271,9 +338,16 @@ class CMeasurePoints:
         return ax
 
 
-def cmeasure_points(sections: pandas.DataFrame, *, t_from: float, t_to: float = math.inf, first_only: bool = False,
-                    e_min: float = -math.inf, e_max: float = math.inf,
-                    lifetimes: pandas.DataFrame | None = None) -> CMeasurePoints:
+def cmeasure_points(
+    sections: pandas.DataFrame,
+    *,
+    t_from: float,
+    t_to: float = math.inf,
+    first_only: bool = False,
+    e_min: float = -math.inf,
+    e_max: float = math.inf,
+    lifetimes: pandas.DataFrame | None = None,
+) -> CMeasurePoints:
     """Points of the c-measure on the section ṙ = 0, φ̇ > 0: the crossings of the survivors after ``t_from``.
 
     With ``first_only=False`` every crossing in [t_from, t_to] (the flux measure, paper Fig. 1b); with
@@ -343,8 +417,13 @@ class CMeasureDistances:
         """The distances as a DataFrame: energy, gamma, box, hellinger, tv, …_noise, …_excess, agreement_scale."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        return pd.concat([self.tables[k].assign(energy=k[0], gamma=k[1], agreement_scale=self.scales[k])
-                          for k in _sorted_keys(self.tables)], ignore_index=True)
+        return pd.concat(
+            [
+                self.tables[k].assign(energy=k[0], gamma=k[1], agreement_scale=self.scales[k])
+                for k in _sorted_keys(self.tables)
+            ],
+            ignore_index=True,
+        )
 
     def plot(self, ax: Axes | None = None, *, kind: str = "hellinger", **plot_kwargs: Any) -> Axes:
         """Draw the distance and its split-half noise floor against the box side; returns the axes."""
@@ -362,9 +441,15 @@ class CMeasureDistances:
         return ax
 
 
-def cmeasure_distances(points: CMeasurePoints, reference: pandas.DataFrame | np.ndarray,
-                       boxes: tuple[float, ...] = (0.4, 0.2, 0.1, 0.05), *, n_splits: int = 8, seed: int = 0,
-                       m: int | None = None) -> CMeasureDistances:
+def cmeasure_distances(
+    points: CMeasurePoints,
+    reference: pandas.DataFrame | np.ndarray,
+    boxes: tuple[float, ...] = (0.4, 0.2, 0.1, 0.05),
+    *,
+    n_splits: int = 8,
+    seed: int = 0,
+    m: int | None = None,
+) -> CMeasureDistances:
     """Hellinger and total-variation distances between each point's section points and a reference set, vs scale.
 
     Box histograms of the two sets over a common partition at each box side ε, the distance of the full sets,

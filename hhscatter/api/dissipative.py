@@ -1,4 +1,5 @@
 """Dissipative grid points: the transition times τ0, τ1, τ2 and the energy decay ⟨E⟩(t) with its μ."""
+
 from __future__ import annotations
 
 import math
@@ -54,8 +55,9 @@ class TransitionTimes(_PointRows):
         return ax
 
 
-def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
-                     t_grid: ArrayLike | None = None) -> TransitionTimes:
+def transition_times(
+    lifetimes: pandas.DataFrame, *, alpha: float = 2.0, t_grid: ArrayLike | None = None
+) -> TransitionTimes:
     """τ0, τ1 and τ2 of each dissipative grid point, against the conservative point of the same E0.
 
     * τ0: end of the irregular start of the conservative P_0(t) (:func:`escape_rates` of the γ = 0 point);
@@ -112,9 +114,16 @@ def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
             continue
         t2 = tau2_observed(df)
         iv = tau2_observed_interval(df) if t2 is not None else None
-        row = {**_key_columns(key), "n": len(df), "tau0": math.nan, "tau1": math.nan,
-               "tau2": math.nan if t2 is None else t2, "tau2_lo": math.nan if iv is None else iv.lo,
-               "tau2_hi": math.nan if iv is None else iv.hi, "note": ""}
+        row = {
+            **_key_columns(key),
+            "n": len(df),
+            "tau0": math.nan,
+            "tau1": math.nan,
+            "tau2": math.nan if t2 is None else t2,
+            "tau2_lo": math.nan if iv is None else iv.lo,
+            "tau2_hi": math.nan if iv is None else iv.hi,
+            "note": "",
+        }
         rows[key] = row
         ref = [k for k in rates.results if _same_point(k[:2], (key[0], 0.0))]
         ref = [k for k in ref if k[2:] == key[2:]] or ref  # the same run's partner first (a grid run)
@@ -122,14 +131,20 @@ def transition_times(lifetimes: pandas.DataFrame, *, alpha: float = 2.0,
             row["note"] = "no conservative (γ = 0) point at this E0 with a κ fit: τ0 and τ1 need one"
             continue
         if len(ref) > 1:
-            row["note"] = (f"{len(ref)} conservative points at this E0 ({', '.join(_label(k) for k in ref)}): "
-                           "τ0 and τ1 need one; read the pair alone")
+            row["note"] = (
+                f"{len(ref)} conservative points at this E0 ({', '.join(_label(k) for k in ref)}): "
+                "τ0 and τ1 need one; read the pair alone"
+            )
             continue
         r = rates.results[ref[0]]
-        grid = np.asarray(t_grid, dtype=float) if t_grid is not None else np.linspace(
-            0.0, float(max(df["t_end"].max(), points[ref[0]]["t_end"].max())), 4001)
-        t1 = tau1(grid, survival_from_lifetimes(df, grid).P, survival_from_lifetimes(points[ref[0]], grid).P,
-                  r.tau0, alpha)
+        grid = (
+            np.asarray(t_grid, dtype=float)
+            if t_grid is not None
+            else np.linspace(0.0, float(max(df["t_end"].max(), points[ref[0]]["t_end"].max())), 4001)
+        )
+        t1 = tau1(
+            grid, survival_from_lifetimes(df, grid).P, survival_from_lifetimes(points[ref[0]], grid).P, r.tau0, alpha
+        )
         row.update(tau0=r.tau0, tau1=math.nan if t1 is None else t1)
         if t1 is None:
             row["note"] = f"P_γ never reaches {alpha:g}·P_0 after τ0"
@@ -156,9 +171,19 @@ class EnergyDecay:
         """μ per point as a DataFrame: energy, gamma, mu, mu_err, mu_free, mu_free_err, t_lo, t_hi."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        rows = [{"energy": k[0], "gamma": k[1], "mu": f.mu, "mu_err": f.mu_err, "mu_free": f.mu_free,
-                 "mu_free_err": f.mu_free_err, "t_lo": f.window[0], "t_hi": f.window[1]}
-                for k, f in ((k, self.fits[k]) for k in _sorted_keys(self.fits))]
+        rows = [
+            {
+                "energy": k[0],
+                "gamma": k[1],
+                "mu": f.mu,
+                "mu_err": f.mu_err,
+                "mu_free": f.mu_free,
+                "mu_free_err": f.mu_free_err,
+                "t_lo": f.window[0],
+                "t_hi": f.window[1],
+            }
+            for k, f in ((k, self.fits[k]) for k in _sorted_keys(self.fits))
+        ]
         return pd.DataFrame(rows)
 
     def curves_frame(self):
@@ -175,8 +200,9 @@ class EnergyDecay:
             (line,) = ax.plot(c["t"], c["mean_E"], label=_label(key), **plot_kwargs)
             if f is not None and math.isfinite(f.mu):
                 t = c["t"].to_numpy()
-                ax.plot(t, key[0] * np.exp(-f.mu * key[1] * t), "--", color=line.get_color(), lw=1,
-                        label=f"μ = {f.mu:.3f}")
+                ax.plot(
+                    t, key[0] * np.exp(-f.mu * key[1] * t), "--", color=line.get_color(), lw=1, label=f"μ = {f.mu:.3f}"
+                )
         ax.set_yscale("log")
         ax.set_xlabel("t")
         ax.set_ylabel("⟨E⟩(t)")
@@ -184,8 +210,13 @@ class EnergyDecay:
         return ax
 
 
-def energy_decay(snapshots: pandas.DataFrame, *, window: tuple[float, float] = (0.0, 200.0),
-                 energy: float | None = None, gamma: float | None = None) -> EnergyDecay:
+def energy_decay(
+    snapshots: pandas.DataFrame,
+    *,
+    window: tuple[float, float] = (0.0, 200.0),
+    energy: float | None = None,
+    gamma: float | None = None,
+) -> EnergyDecay:
     """⟨E⟩(t) of the orbits still inside, and μ of E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)), per point.
 
     ⟨E⟩(t) is the mean energy over the orbits still inside Ω at each snapshot time (the paper's Fig. 3);

@@ -1,4 +1,5 @@
 """Plots of P(t) and κ on the caller's axes (default: a new pyplot figure), never touching the matplotlib backend."""
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
@@ -19,8 +20,15 @@ def _axes(ax):
     return plt.subplots(figsize=(6, 4.2), constrained_layout=True)[1]
 
 
-def plot_survival(curves: Any, ax: Axes | None = None, *, labels: list[str] | None = None, band: bool = True,
-                  logy: bool = True, **line_kwargs: Any) -> Axes:
+def plot_survival(
+    curves: Any,
+    ax: Axes | None = None,
+    *,
+    labels: list[str] | None = None,
+    band: bool = True,
+    logy: bool = True,
+    **line_kwargs: Any,
+) -> Axes:
     """Draw P(t) as steps, one line per curve, with a ±1σ band.
 
     Log-scale P by default (the final P = 0 step is not drawn). Does not change the matplotlib backend,
@@ -83,8 +91,7 @@ def plot_survival(curves: Any, ax: Axes | None = None, *, labels: list[str] | No
     return ax
 
 
-def plot_escape_rates(rates: Any, ax: Axes | None = None, *, x: str = "energy",
-                      **errorbar_kwargs: Any) -> Axes:
+def plot_escape_rates(rates: Any, ax: Axes | None = None, *, x: str = "energy", **errorbar_kwargs: Any) -> Axes:
     """Draw κ ± its error against the energy (or another column), one series per γ.
 
     Points without κ are skipped. Does not change the matplotlib backend.

@@ -7,6 +7,7 @@ or several plain runs concatenated) is split by clustering ``e0`` with a
 relative tolerance of 1e-9; a frame whose ``e0`` varies continuously (a run
 from an initial-condition table) is one ensemble per γ, with energy NaN.
 """
+
 from __future__ import annotations
 
 import math
@@ -52,10 +53,13 @@ def split_points(lifetimes):
         raise ValueError(f"lifetimes lacks column(s) {sorted(missing)}: pass a frame of hhscatter.read_lifetimes")
     if len(lifetimes) == 0:
         raise ValueError("lifetimes is empty: no orbits to analyse")
-    pooled = ((lifetimes.attrs.get("hhscatter") or {}).get("pooled") is not None)
+    pooled = (lifetimes.attrs.get("hhscatter") or {}).get("pooled") is not None
     if "run" in cols and not pooled:
-        out = [((*key, str(run)), df) for run, sub in lifetimes.groupby("run", observed=True, sort=False)
-               for key, df in _split_one(sub)]
+        out = [
+            ((*key, str(run)), df)
+            for run, sub in lifetimes.groupby("run", observed=True, sort=False)
+            for key, df in _split_one(sub)
+        ]
         return sorted(out, key=lambda kv: _sort_key(kv[0]))
     return _split_one(lifetimes)
 
@@ -85,9 +89,11 @@ def _split_one(lifetimes):
         mask = (key_e == e) & (gamma == g)
         key, df = (math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]
         if "traj_id" in cols and df.duplicated(subset=ids).any():
-            raise ValueError(f"lifetimes holds orbits twice at {_label(key)} (traj_id repeated): the same run "
-                             "concatenated twice, or several runs without a run column; read several runs with "
-                             "hhscatter.read_lifetimes([run1, run2, …]), which keeps them apart")
+            raise ValueError(
+                f"lifetimes holds orbits twice at {_label(key)} (traj_id repeated): the same run "
+                "concatenated twice, or several runs without a run column; read several runs with "
+                "hhscatter.read_lifetimes([run1, run2, …]), which keeps them apart"
+            )
         out.append((key, df))
     return out
 
@@ -118,8 +124,9 @@ def _same_point(a, b) -> bool:
     if len(a) > 2 and len(b) > 2 and a[2] != b[2]:
         return False
     (ea, ga), (eb, gb) = a[:2], b[:2]
-    same_e = (math.isnan(ea) and math.isnan(eb)) or (math.isfinite(ea) and math.isfinite(eb)
-                                                     and abs(ea - eb) <= E0_RTOL * max(1.0, abs(ea)))
+    same_e = (math.isnan(ea) and math.isnan(eb)) or (
+        math.isfinite(ea) and math.isfinite(eb) and abs(ea - eb) <= E0_RTOL * max(1.0, abs(ea))
+    )
     return same_e and ga == gb
 
 
@@ -139,8 +146,10 @@ def _split_like(table, keys, *, energy=None, gamma=None, what="table"):
         return {(math.nan if energy is None else float(energy), 0.0 if gamma is None else float(gamma)): table}
     if keys is not None and len(keys) == 1:
         return {keys[0]: table}
-    raise ValueError(f"the {what} has no point_energy/point_gamma columns (a plain run): pass energy= and gamma=, "
-                     "or the lifetimes of that one run")
+    raise ValueError(
+        f"the {what} has no point_energy/point_gamma columns (a plain run): pass energy= and gamma=, "
+        "or the lifetimes of that one run"
+    )
 
 
 @dataclass(frozen=True)

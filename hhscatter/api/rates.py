@@ -1,4 +1,5 @@
 """Survival and escape rates: Kaplan–Meier P(t) and κ per grid point, and P(t) streamed from a run directory."""
+
 from __future__ import annotations
 
 import math
@@ -52,7 +53,7 @@ class SurvivalCurves:
         """curves[(energy, gamma)] -> SurvivalCurve; ``curves[energy]`` if that energy has one point."""
         if key in self.curves:
             return self.curves[key]
-        hits = [k for k in self.curves if (k[0] == key if not isinstance(key, tuple) else k[:len(key)] == key)]
+        hits = [k for k in self.curves if (k[0] == key if not isinstance(key, tuple) else k[: len(key)] == key)]
         if len(hits) == 1:
             return self.curves[hits[0]]
         raise KeyError(f"no single point {key!r}; points: {list(self.curves)}")
@@ -61,8 +62,10 @@ class SurvivalCurves:
         """The curves as one DataFrame: energy, gamma, n, t, P, P_err (one row per curve step or grid time)."""
         import pandas as pd  # deferred: pandas loads on first use
 
-        parts = [pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
-                 for k, c in self.curves.items()]
+        parts = [
+            pd.DataFrame({**_key_columns(k), "n": self.n[k], "t": c.t, "P": c.P, "P_err": c.P_err})
+            for k, c in self.curves.items()
+        ]
         return pd.concat(parts, ignore_index=True)
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
@@ -172,17 +175,37 @@ class EscapeRates:
             r = self.results.get(key)
             row = {**_key_columns(key), "n": self.n[key]}
             if r is None:
-                row.update(kappa=math.nan, kappa_err=math.nan, kappa_stat=math.nan, kappa_spread=math.nan,
-                           tau0=math.nan, t_stop=math.nan, windows=None, kappa_mle=math.nan,
-                           kappa_mle_err=math.nan, tau_star=math.nan)
+                row.update(
+                    kappa=math.nan,
+                    kappa_err=math.nan,
+                    kappa_stat=math.nan,
+                    kappa_spread=math.nan,
+                    tau0=math.nan,
+                    t_stop=math.nan,
+                    windows=None,
+                    kappa_mle=math.nan,
+                    kappa_mle_err=math.nan,
+                    tau_star=math.nan,
+                )
             else:
-                row.update(kappa=r.kappa, kappa_err=r.kappa_err, kappa_stat=r.kappa_stat,
-                           kappa_spread=r.kappa_spread, tau0=r.tau0, t_stop=r.t_stop,
-                           windows=[tuple(float(x) for x in w) for w in r.windows], kappa_mle=r.mle.kappa,
-                           kappa_mle_err=r.mle.kappa_err, tau_star=r.tau_star)
+                row.update(
+                    kappa=r.kappa,
+                    kappa_err=r.kappa_err,
+                    kappa_stat=r.kappa_stat,
+                    kappa_spread=r.kappa_spread,
+                    tau0=r.tau0,
+                    t_stop=r.t_stop,
+                    windows=[tuple(float(x) for x in w) for w in r.windows],
+                    kappa_mle=r.mle.kappa,
+                    kappa_mle_err=r.mle.kappa_err,
+                    tau_star=r.tau_star,
+                )
             st = self.status.get(key)
-            row.update(status=st.status if st else "", p_inf=st.p_inf if st else math.nan,
-                       kappa_inf=st.kappa_inf if st else math.nan)
+            row.update(
+                status=st.status if st else "",
+                p_inf=st.p_inf if st else math.nan,
+                kappa_inf=st.kappa_inf if st else math.nan,
+            )
             row["note"] = self.notes.get(key, "")
             rows.append(row)
         return pd.DataFrame(rows)
@@ -233,7 +256,6 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     """
     from hhscatter.analysis.survival.escape_rate import escape_rate  # deferred: scipy loads on first use
     from hhscatter.analysis.survival.fits import observed_from_outcome  # deferred: scipy loads on first use
-
     from hhscatter.analysis.survival.long_time import rate_status  # deferred: scipy loads on first use
 
     results, n, notes, status = {}, {}, {}, {}
@@ -257,12 +279,15 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
             f"escape_rates: κ is the escape rate of the conservative system; not fitted for the dissipative "
             f"point(s) {'; '.join(_label(k) for k in diss)}, whose P(t) is not exponential (paper Sec. III). "
             "Use hhscatter.survival for their P(t) and hhscatter.analysis.dissipative.transitions for τ1, τ2.",
-            UserWarning, stacklevel=2)
+            UserWarning,
+            stacklevel=2,
+        )
     return EscapeRates(results, n, notes, status)
 
 
-def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any = None, *,
-                    allow_partial: bool = False):
+def stream_survival(
+    run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any = None, *, allow_partial: bool = False
+):
     """P(t) of a run's lifetimes at the grid times, streamed from its table in bounded memory.
 
     P(t) = Pr(lifetime > t) (paper Eqs. (eqn:kappa_hyperbolic), (eqn:kappa_nonhyperbolic)) streamed over the run's
@@ -297,6 +322,8 @@ def stream_survival(run: str | os.PathLike[str], t_grid: ArrayLike, filters: Any
     for t_end, observed in iter_survival_batches(run, filters, allow_partial=allow_partial):
         km.add(t_end, observed)
         if km.first_censoring < km.grid[-1]:
-            raise ValueError(f"an orbit was censored at t = {km.first_censoring:g} < max(t_grid) = "
-                             f"{km.grid[-1]:g}: use survival_curve (Kaplan–Meier) for this run")
+            raise ValueError(
+                f"an orbit was censored at t = {km.first_censoring:g} < max(t_grid) = "
+                f"{km.grid[-1]:g}: use survival_curve (Kaplan–Meier) for this run"
+            )
     return km.curve()

@@ -1,4 +1,5 @@
 """Run directories: the scene a run was written with."""
+
 from __future__ import annotations
 
 import json

@@ -20,14 +20,22 @@ Traceback (most recent call last):
 ...
 ValueError: gamma=0.02 contradicts the data: γ of runs/a is 0.01 (its scene.json); leave gamma out (it is read from the data)
 """
+
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-__all__ = ["FRAME_META", "checked_value", "frame_scene", "plain_point", "same_run", "same_value",
-           "snapshot_energy_at_start"]
+__all__ = [
+    "FRAME_META",
+    "checked_value",
+    "frame_scene",
+    "plain_point",
+    "same_run",
+    "same_value",
+    "snapshot_energy_at_start",
+]
 
 FRAME_META = "hhscatter"  # the key of DataFrame.attrs the readers fill (hhscatter.data.read.FRAME_META)
 RTOL = 1e-9  # a value typed again agrees with the data's to this relative tolerance (E0 of the orbits: last bits)
@@ -80,8 +88,10 @@ def checked_value(frame, key: str, value, *, what: str, name: str | None = None)
     if have is None or isinstance(have, list):
         return value
     if value is not None and not same_value(value, have):
-        raise ValueError(f"{name or key}={value!r} contradicts the data: {what} of {run} is {have!r} (its scene.json); "
-                         f"leave {name or key} out (it is read from the data)")
+        raise ValueError(
+            f"{name or key}={value!r} contradicts the data: {what} of {run} is {have!r} (its scene.json); "
+            f"leave {name or key} out (it is read from the data)"
+        )
     return have
 
 
@@ -114,8 +124,10 @@ def plain_point(frame, energy=None, gamma=None, *, what: str = "table") -> tuple
                 continue
             have = sorted(set(frame[col].to_numpy(dtype=float).tolist()))
             if not all(same_value(val, h) for h in have):
-                raise ValueError(f"{arg}={val!r} contradicts the data: the {what}'s rows are of the grid point(s) "
-                                 f"{col} = {', '.join(f'{h:g}' for h in have)}; leave {arg} out (the rows say it)")
+                raise ValueError(
+                    f"{arg}={val!r} contradicts the data: the {what}'s rows are of the grid point(s) "
+                    f"{col} = {', '.join(f'{h:g}' for h in have)}; leave {arg} out (the rows say it)"
+                )
         return energy, gamma
     scene, _ = frame_scene(frame)
     e = checked_value(frame, "energy", energy, what="E0", name="energy")
@@ -123,12 +135,16 @@ def plain_point(frame, energy=None, gamma=None, *, what: str = "table") -> tuple
     if scene is None or scene.get("energy") is None:
         start = snapshot_energy_at_start(frame)
         if start is not None and e is not None and not same_value(e, start):
-            raise ValueError(f"energy={e!r} contradicts the data: the {what}'s energy at t = 0 is {start:.12g} "
-                             "(every orbit's E0); leave energy out (it is read from the data)")
+            raise ValueError(
+                f"energy={e!r} contradicts the data: the {what}'s energy at t = 0 is {start:.12g} "
+                "(every orbit's E0); leave energy out (it is read from the data)"
+            )
         e = start if e is None else e
     if e is None or g is None:
-        raise ValueError(f"the {what} has no point_energy/point_gamma columns and no record of its run: pass "
-                         f"energy= and gamma= (missing: {', '.join(k for k, v in (('energy', e), ('gamma', g)) if v is None)})")
+        raise ValueError(
+            f"the {what} has no point_energy/point_gamma columns and no record of its run: pass "
+            f"energy= and gamma= (missing: {', '.join(k for k, v in (('energy', e), ('gamma', g)) if v is None)})"
+        )
     return e, g
 
 
@@ -138,5 +154,7 @@ def same_run(a, b, *, what: str) -> None:
     ma, mb = (getattr(x, "attrs", {}).get(FRAME_META) or {} for x in (a, b))
     ha, hb = ma.get("scene_hash"), mb.get("scene_hash")
     if ha and hb and ha != hb:
-        raise ValueError(f"{what} come from different runs: {ma.get('run')} (scene {ha[:12]}…) and {mb.get('run')} "
-                         f"(scene {hb[:12]}…); pass the tables of one run")
+        raise ValueError(
+            f"{what} come from different runs: {ma.get('run')} (scene {ha[:12]}…) and {mb.get('run')} "
+            f"(scene {hb[:12]}…); pass the tables of one run"
+        )

@@ -13,6 +13,7 @@ the run's scene and hash), where the analysis functions read E0, γ, t_max … (
 :func:`read_lifetimes` of a list of runs keeps them apart (a ``run`` column: one point per run), refuses the
 same run or scene twice, and pools them only when asked (``pool=True``, checked).
 """
+
 from __future__ import annotations
 
 import json
@@ -32,8 +33,8 @@ if TYPE_CHECKING:  # annotations only
 from hhscatter.data.schema import (
     META_KEY,
     POINT_COLUMNS,
-    RunPath,
     TABLES,
+    RunPath,
     legacy_point,
     part_name,
     schema_of,
@@ -91,9 +92,11 @@ def _without_manifest(store) -> RunIntegrityError:
         except (OSError, ValueError):
             pass
     said = f" (its parts say they belong to scene {hashes.pop()}…)" if hashes else ""
-    return RunIntegrityError(f"the run at {store.display()} has no scene.json, its manifest{said}: without it "
-                             "nobody can tell whether the run is complete; rerun the same `hhscatter simulate` "
-                             "with --resume (it verifies the parts and writes the manifest again) or --overwrite")
+    return RunIntegrityError(
+        f"the run at {store.display()} has no scene.json, its manifest{said}: without it "
+        "nobody can tell whether the run is complete; rerun the same `hhscatter simulate` "
+        "with --resume (it verifies the parts and writes the manifest again) or --overwrite"
+    )
 
 
 def run_status(run_dir) -> dict:
@@ -113,8 +116,14 @@ def run_status(run_dir) -> dict:
     man = doc.get("manifest")
     if man is None:
         n = len(store.files("lifetimes"))
-        return {"complete": n > 0, "chunks": n, "chunks_done": n, "orbits": None, "orbits_done": None,
-                "scene_hash": doc.get("scene_hash")}
+        return {
+            "complete": n > 0,
+            "chunks": n,
+            "chunks_done": n,
+            "orbits": None,
+            "orbits_done": None,
+            "scene_hash": doc.get("scene_hash"),
+        }
     have = set(store.files("lifetimes"))
     chunks = done = orbits = orbits_done = 0
     for p in man["points"]:
@@ -123,8 +132,14 @@ def run_status(run_dir) -> dict:
             chunks, orbits = chunks + 1, orbits + k
             if "/".join(x for x in (p["partition"], part_name(c)) if x) in have:
                 done, orbits_done = done + 1, orbits_done + k
-    return {"complete": done == chunks, "chunks": chunks, "chunks_done": done, "orbits": orbits,
-            "orbits_done": orbits_done, "scene_hash": doc.get("scene_hash")}
+    return {
+        "complete": done == chunks,
+        "chunks": chunks,
+        "chunks_done": done,
+        "orbits": orbits,
+        "orbits_done": orbits_done,
+        "scene_hash": doc.get("scene_hash"),
+    }
 
 
 def _planned_files(store, man: dict, name: str, allow_partial: bool):
@@ -132,11 +147,14 @@ def _planned_files(store, man: dict, name: str, allow_partial: bool):
     [(file relative to the table folder, point dict, chunk)]; RunIntegrityError on anything else."""
     run = store.display()
     if name not in man["tables"]:
-        raise FileNotFoundError(f"no {name} table: the run at {run} does not record it "
-                                f"(its tables: {', '.join(man['tables'])})")
+        raise FileNotFoundError(
+            f"no {name} table: the run at {run} does not record it (its tables: {', '.join(man['tables'])})"
+        )
     if not store.is_dir(name):
-        raise RunIntegrityError(f"the {name} table of the run at {run} is missing ({store.display(name)} "
-                                "does not exist); the run is damaged: simulate it again with --overwrite")
+        raise RunIntegrityError(
+            f"the {name} table of the run at {run} is missing ({store.display(name)} "
+            "does not exist); the run is damaged: simulate it again with --overwrite"
+        )
     present = {f for f in store.files(name) if not f.rsplit("/", 1)[-1].startswith(".")}
     finished = present if name == "lifetimes" else {f for f in store.files("lifetimes")}
     planned, missing_chunks, missing_orbits, chunks, orbits = [], 0, 0, 0, 0
@@ -151,27 +169,39 @@ def _planned_files(store, man: dict, name: str, allow_partial: bool):
                 missing_chunks, missing_orbits = missing_chunks + 1, missing_orbits + k
                 continue
             if rel not in present:
-                raise RunIntegrityError(f"{store.display(name + '/' + rel)} is missing, but its chunk is "
-                                        "finished; the run is damaged: simulate it again with --overwrite")
+                raise RunIntegrityError(
+                    f"{store.display(name + '/' + rel)} is missing, but its chunk is "
+                    "finished; the run is damaged: simulate it again with --overwrite"
+                )
             planned.append((rel, p, c))
     extra = sorted(present - expected)
     if extra:
-        raise RunIntegrityError(f"{len(extra)} file(s) in {store.display(name)} are not in the run's chunk plan "
-                                f"(first: {extra[0]}); remove them or simulate the run again with --overwrite")
+        raise RunIntegrityError(
+            f"{len(extra)} file(s) in {store.display(name)} are not in the run's chunk plan "
+            f"(first: {extra[0]}); remove them or simulate the run again with --overwrite"
+        )
     if missing_chunks:
-        what = (f"the run at {run} is incomplete: {missing_chunks} of {chunks} chunk(s) "
-                f"({missing_orbits} of {orbits} orbits) are not finished")
+        what = (
+            f"the run at {run} is incomplete: {missing_chunks} of {chunks} chunk(s) "
+            f"({missing_orbits} of {orbits} orbits) are not finished"
+        )
         if allow_partial and (pid := store.writer()) is not None:
             # its finished chunks change from one read to the next: two tables read apart would not match
-            raise IncompleteRunError(f"{what}, and it is being written now (pid {pid}): reading its finished chunks "
-                                     "(allow_partial=True) gives each table as of another moment; wait until the "
-                                     "writer ends (or stop it), then read")
+            raise IncompleteRunError(
+                f"{what}, and it is being written now (pid {pid}): reading its finished chunks "
+                "(allow_partial=True) gives each table as of another moment; wait until the "
+                "writer ends (or stop it), then read"
+            )
         if not allow_partial:
-            raise IncompleteRunError(f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
-                                     "the finished chunks with allow_partial=True")
+            raise IncompleteRunError(
+                f"{what}; finish it with `hhscatter simulate --out {run} --resume`, or read "
+                "the finished chunks with allow_partial=True"
+            )
 
-        warnings.warn(f"{what}; reading the {orbits - missing_orbits} orbits of the finished chunks "
-                      "(allow_partial=True)", stacklevel=4)
+        warnings.warn(
+            f"{what}; reading the {orbits - missing_orbits} orbits of the finished chunks (allow_partial=True)",
+            stacklevel=4,
+        )
     return planned
 
 
@@ -184,15 +214,23 @@ def _check_fragment(store, name, frag, point, chunk):
         raise RunIntegrityError(f"{where} is not an hhscatter table (no '{META_KEY.decode()}' metadata)")
     meta = json.loads(kv[META_KEY])
     if meta.get("scene_hash") != point["scene_hash"]:
-        raise RunIntegrityError(f"{where} was made by another scene (hash {str(meta.get('scene_hash'))[:12]}…, "
-                                f"this run {point['scene_hash'][:12]}…); simulate the run again with --overwrite")
+        raise RunIntegrityError(
+            f"{where} was made by another scene (hash {str(meta.get('scene_hash'))[:12]}…, "
+            f"this run {point['scene_hash'][:12]}…); simulate the run again with --overwrite"
+        )
     c, k = point["chunk_size"], chunk * point["chunk_size"]
     want = [k, min(k + c, point["n"])]
-    if meta.get("chunk") != chunk or meta.get("orbits") != want or meta.get("table") not in (None, name) \
-            or meta.get("rows") != md.num_rows:
-        raise RunIntegrityError(f"{where} does not hold chunk {chunk} (orbits {want}) of the {name} table "
-                                f"(its metadata: chunk {meta.get('chunk')}, orbits {meta.get('orbits')}, "
-                                f"rows {meta.get('rows')} of {md.num_rows})")
+    if (
+        meta.get("chunk") != chunk
+        or meta.get("orbits") != want
+        or meta.get("table") not in (None, name)
+        or meta.get("rows") != md.num_rows
+    ):
+        raise RunIntegrityError(
+            f"{where} does not hold chunk {chunk} (orbits {want}) of the {name} table "
+            f"(its metadata: chunk {meta.get('chunk')}, orbits {meta.get('orbits')}, "
+            f"rows {meta.get('rows')} of {md.num_rows})"
+        )
 
 
 def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: bool = False):
@@ -212,7 +250,6 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
     import pyarrow.dataset as ds  # deferred: pyarrow loads on first use
     import pyarrow.fs as pafs  # deferred: pyarrow loads on first use
 
-
     store = Store(run_dir)
     man = run_manifest(run_dir)
     checks = None
@@ -224,8 +261,11 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
         if not files:
             raise IncompleteRunError(f"no {name} table: no chunk of the run at {store.display()} is finished")
     elif not store.exists("scene.json"):
-        raise _without_manifest(store) if store.exists(name) or store.exists("lifetimes") else \
-            FileNotFoundError(f"no {name} table: {store.display()} holds no run (no scene.json)")
+        raise (
+            _without_manifest(store)
+            if store.exists(name) or store.exists("lifetimes")
+            else FileNotFoundError(f"no {name} table: {store.display()} holds no run (no scene.json)")
+        )
     else:
         rel = name if store.is_dir(name) or store.exists("scene.json") else ""
         if not store.exists(rel):
@@ -238,8 +278,9 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
     schema = schema_of(name, grid)
     paths = [store.path(rel, f) for f in files]
     # every data page's CRC (written by write_part) is verified as it is read
-    fmt = ds.ParquetFileFormat(default_fragment_scan_options=ds.ParquetFragmentScanOptions(
-        page_checksum_verification=True))
+    fmt = ds.ParquetFileFormat(
+        default_fragment_scan_options=ds.ParquetFragmentScanOptions(page_checksum_verification=True)
+    )
     fs = store.filesystem or pafs.LocalFileSystem()
     legacy = [legacy_point(f) for f in files]
     if any(p is not None for p in legacy):
@@ -261,6 +302,7 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
 
         def make(ps, es):
             return ds.dataset(ps, schema=schema, format=fmt, filesystem=store.filesystem)
+
     def checked(ps, es, which):
         try:
             dset = make(ps, es)
@@ -268,9 +310,11 @@ def _dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: boo
                 for frag, (point, chunk) in zip(dset.get_fragments(), which):
                     _check_fragment(store, name, frag, point, chunk)
         except pa.ArrowInvalid as exc:  # a file under a part's name that is no Parquet file
-            raise RunIntegrityError(f"a part of the {name} table of the run at {store.display()} is not a "
-                                    f"readable Parquet file ({exc}); the run is damaged: rerun it with --resume "
-                                    "(damaged chunks are redone) or --overwrite") from None
+            raise RunIntegrityError(
+                f"a part of the {name} table of the run at {store.display()} is not a "
+                f"readable Parquet file ({exc}); the run is damaged: rerun it with --resume "
+                "(damaged chunks are redone) or --overwrite"
+            ) from None
         return dset
 
     if one_by_one:
@@ -293,13 +337,19 @@ def _scan(dset, run_dir, name, scan):
             except (OSError, ValueError):
                 bad = path
                 break
-        raise RunIntegrityError(f"{bad} is damaged: a data page fails its checksum ({exc}); delete it and "
-                                f"rerun `hhscatter simulate --out {run_dir} --resume`") from None
+        raise RunIntegrityError(
+            f"{bad} is damaged: a data page fails its checksum ({exc}); delete it and "
+            f"rerun `hhscatter simulate --out {run_dir} --resume`"
+        ) from None
 
 
 def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False, allow_partial: bool = False):
-    table = _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
-                  lambda d: d.to_table(columns=columns, filter=filters))
+    table = _scan(
+        _dataset(run_dir, name, allow_partial=allow_partial),
+        run_dir,
+        name,
+        lambda d: d.to_table(columns=columns, filter=filters),
+    )
     df = table.to_pandas()
     if "outcome" in df.columns and not categorical:
         df["outcome"] = df["outcome"].astype(str)
@@ -307,6 +357,7 @@ def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = Fa
         df["exit_channel"] = df["exit_channel"].astype("Int8")
     df.attrs[FRAME_META] = run_identity(run_dir)
     return df
+
 
 #: scene keys that do not change the physics of an ensemble: runs that differ only in these may be pooled
 POOLABLE_KEYS = ("seed", "n", "name", "batch_size", "chunk_size")
@@ -333,8 +384,11 @@ def run_identity(run_dir) -> dict:
     store = Store(run_dir)
     if store.exists("scene.json"):
         doc = json.loads(store.read_text("scene.json"))
-        points = [p["scene_hash"] for p in (doc.get("manifest") or {}).get("points", [])] or \
-            [p["scene_hash"] for p in doc.get("points", [])] or [doc.get("scene_hash")]
+        points = (
+            [p["scene_hash"] for p in (doc.get("manifest") or {}).get("points", [])]
+            or [p["scene_hash"] for p in doc.get("points", [])]
+            or [doc.get("scene_hash")]
+        )
         scene = doc.get("scene") or {}
     else:
         first = next((f for f in store.files("lifetimes") if f.endswith(".parquet")), None)
@@ -344,8 +398,13 @@ def run_identity(run_dir) -> dict:
         doc, scene = {"scene_hash": meta.get("scene_hash")}, meta.get("scene") or {}
         points = [doc["scene_hash"]]
     grid = any(isinstance(scene.get(k), list) for k in ("energy", "gamma"))
-    return {"run": str(run_dir), "scene_hash": doc.get("scene_hash"), "scene": _decode_scene(scene),
-            "point_hashes": [h for h in points if h], "grid": grid}
+    return {
+        "run": str(run_dir),
+        "scene_hash": doc.get("scene_hash"),
+        "scene": _decode_scene(scene),
+        "point_hashes": [h for h in points if h],
+        "grid": grid,
+    }
 
 
 def _distinct_runs(run_dirs) -> list[dict]:
@@ -354,14 +413,18 @@ def _distinct_runs(run_dirs) -> list[dict]:
     for r in run_dirs:
         root = Store(r).root
         if root in where:
-            raise ValueError(f"run {str(r)!r} is given twice (as {where[root]!r} too): each orbit would count twice; "
-                             "give each run once")
+            raise ValueError(
+                f"run {str(r)!r} is given twice (as {where[root]!r} too): each orbit would count twice; "
+                "give each run once"
+            )
         where[root] = str(r)
         ident = run_identity(r)
         for h in ident["point_hashes"]:
             if h in seen:
-                raise ValueError(f"runs {seen[h]!r} and {str(r)!r} hold the same scene (result hash {h[:12]}…): the "
-                                 "same orbits twice would count each orbit twice; give each run once")
+                raise ValueError(
+                    f"runs {seen[h]!r} and {str(r)!r} hold the same scene (result hash {h[:12]}…): the "
+                    "same orbits twice would count each orbit twice; give each run once"
+                )
             seen[h] = str(r)
         ids.append(ident)
     return ids
@@ -377,15 +440,19 @@ def _check_poolable(ids: list[dict]) -> None:
         diff = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
         if diff:
             k = diff[0]
-            raise ValueError(f"pool=True: runs {ref['run']!r} and {other['run']!r} are not the same scene apart from "
-                             f"{'/'.join(POOLABLE_KEYS[:2])}: {k} is {a.get(k)!r} and {b.get(k)!r}"
-                             f"{f' (and {len(diff) - 1} more key(s))' if len(diff) > 1 else ''}; read them apart "
-                             "(pool=False) for one point per run")
+            raise ValueError(
+                f"pool=True: runs {ref['run']!r} and {other['run']!r} are not the same scene apart from "
+                f"{'/'.join(POOLABLE_KEYS[:2])}: {k} is {a.get(k)!r} and {b.get(k)!r}"
+                f"{f' (and {len(diff) - 1} more key(s))' if len(diff) > 1 else ''}; read them apart "
+                "(pool=False) for one point per run"
+            )
     seeds = [i["scene"].get("seed") for i in ids]
     twice = sorted({s for s in seeds if seeds.count(s) > 1}, key=str)
     if twice:
-        raise ValueError(f"pool=True: several runs have seed {twice[0]!r}; runs of one seed share their first orbits, "
-                         "so pooling them counts those orbits twice: pool runs of distinct seeds")
+        raise ValueError(
+            f"pool=True: several runs have seed {twice[0]!r}; runs of one seed share their first orbits, "
+            "so pooling them counts those orbits twice: pool runs of distinct seeds"
+        )
 
 
 def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, allow_partial: bool = False):
@@ -396,8 +463,12 @@ def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, 
     the run's planned, finished and verified parts (:func:`_dataset`); an incomplete run is an error unless
     ``allow_partial=True``.
     """
-    return _scan(_dataset(run_dir, name, allow_partial=allow_partial), run_dir, name,
-                 lambda d: d.to_table(columns=columns, filter=filters))
+    return _scan(
+        _dataset(run_dir, name, allow_partial=allow_partial),
+        run_dir,
+        name,
+        lambda d: d.to_table(columns=columns, filter=filters),
+    )
 
 
 def survival_arrays(run_dir, filters=None, *, allow_partial: bool = False):
@@ -409,13 +480,12 @@ def survival_arrays(run_dir, filters=None, *, allow_partial: bool = False):
     orbit). ``observed`` is False for censored orbits. Memory-bounded route for
     P(t) of 1e7+ orbits.
     """
-    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters,
-                       allow_partial=allow_partial)
+    table = read_arrow(run_dir, "lifetimes", columns=["t_end", "outcome"], filters=filters, allow_partial=allow_partial)
     t_end = table.column("t_end").to_numpy()
     observed = np.empty(len(t_end), dtype=bool)
     pos = 0
     for chunk in table.column("outcome").chunks:
-        observed[pos:pos + len(chunk)] = _observed(chunk)
+        observed[pos : pos + len(chunk)] = _observed(chunk)
         pos += len(chunk)
     return t_end, observed
 
@@ -434,8 +504,9 @@ def iter_survival_batches(run_dir, filters=None, *, allow_partial: bool = False)
     censored orbits. The input of a streaming Kaplan–Meier (:func:`hhscatter.api.stream_survival`).
     """
     for part in _dataset(run_dir, "lifetimes", one_by_one=True, allow_partial=allow_partial):
-        for batch in _scan(part, run_dir, "lifetimes", lambda d: d.to_table(
-                columns=["t_end", "outcome"], filter=filters).to_batches()):
+        for batch in _scan(
+            part, run_dir, "lifetimes", lambda d: d.to_table(columns=["t_end", "outcome"], filter=filters).to_batches()
+        ):
             yield batch.column(0).to_numpy(), _observed(batch.column(1))
 
 
@@ -448,9 +519,15 @@ def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False)
         yield _scan(part, run_dir, name, lambda d: d.to_table(columns=columns)).to_pandas()
 
 
-def read_lifetimes(run_dir: RunPath | list[RunPath], columns: list[str] | None = None,
-                   filters: pyarrow.dataset.Expression | None = None, *, categorical: bool = False,
-                   allow_partial: bool = False, pool: bool = False) -> pandas.DataFrame:
+def read_lifetimes(
+    run_dir: RunPath | list[RunPath],
+    columns: list[str] | None = None,
+    filters: pyarrow.dataset.Expression | None = None,
+    *,
+    categorical: bool = False,
+    allow_partial: bool = False,
+    pool: bool = False,
+) -> pandas.DataFrame:
     """The lifetimes table of a run: one row per orbit.
 
     Columns: ``traj_id``, ``t_end`` (time of the orbit's end, time units), ``outcome`` ('escaped',
@@ -529,8 +606,12 @@ def _concat_runs(frames, ids, pool: bool = False):
     import pandas as pd  # deferred: pandas loads on first use
 
     if any("energy" in f.columns for f in frames):
-        frames = [f if "energy" in f.columns or "e0" not in f.columns or not len(f)
-                  else f.assign(energy=float(f"{np.median(f['e0'].to_numpy(dtype=float)):.12g}")) for f in frames]
+        frames = [
+            f
+            if "energy" in f.columns or "e0" not in f.columns or not len(f)
+            else f.assign(energy=float(f"{np.median(f['e0'].to_numpy(dtype=float)):.12g}"))
+            for f in frames
+        ]
     names = [i["run"] for i in ids]
     out = pd.concat([f.assign(run=name) for f, name in zip(frames, names)], ignore_index=True)
     out["run"] = pd.Categorical(out["run"], categories=list(dict.fromkeys(names)))
@@ -568,9 +649,13 @@ def read_by_orbit(run_dir, columns, name: str = "lifetimes", *, allow_partial: b
     return out
 
 
-def read_sections(run_dir: RunPath, columns: list[str] | None = None,
-                  filters: pyarrow.dataset.Expression | None = None, *,
-                  allow_partial: bool = False) -> pandas.DataFrame:
+def read_sections(
+    run_dir: RunPath,
+    columns: list[str] | None = None,
+    filters: pyarrow.dataset.Expression | None = None,
+    *,
+    allow_partial: bool = False,
+) -> pandas.DataFrame:
     """The sections table of a run: one row per crossing of the section ṙ = 0, φ̇ > 0.
 
     Parameters
@@ -608,9 +693,13 @@ def read_sections(run_dir: RunPath, columns: list[str] | None = None,
     return _read(run_dir, "sections", columns, filters, allow_partial=allow_partial)
 
 
-def read_snapshots(run_dir: RunPath, columns: list[str] | None = None,
-                   filters: pyarrow.dataset.Expression | None = None, *,
-                   allow_partial: bool = False) -> pandas.DataFrame:
+def read_snapshots(
+    run_dir: RunPath,
+    columns: list[str] | None = None,
+    filters: pyarrow.dataset.Expression | None = None,
+    *,
+    allow_partial: bool = False,
+) -> pandas.DataFrame:
     """The snapshots table of a run: the energy of every orbit still alive at each snapshot time.
 
     Parameters
@@ -659,6 +748,7 @@ def _describe_parts(store, man):
     ``pyarrow.dataset`` and the pandas it imports cost ~0.5 s, which every ``simulate`` paid for its closing
     lines. None for a part that holds more than one grid point (then :func:`_dataset` counts)."""
     import types  # deferred: only this path needs it
+
     import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
     rows, points = {}, {}
@@ -669,8 +759,10 @@ def _describe_parts(store, man):
             try:
                 pf = pq.ParquetFile(path, page_checksum_verification=True)
             except (OSError, ValueError) as exc:  # (pyarrow's ArrowInvalid is a ValueError)
-                raise RunIntegrityError(f"{path} is not a readable Parquet file ({exc}); the run is damaged: rerun "
-                                        "it with --resume (damaged chunks are redone) or --overwrite") from None
+                raise RunIntegrityError(
+                    f"{path} is not a readable Parquet file ({exc}); the run is damaged: rerun "
+                    "it with --resume (damaged chunks are redone) or --overwrite"
+                ) from None
             _check_fragment(store, name, types.SimpleNamespace(metadata=pf.metadata, path=path), point, chunk)
             rows[name] += pf.metadata.num_rows
             if name != "lifetimes":
@@ -691,8 +783,13 @@ def _describe_parts(store, man):
             for o, c in zip(out.dictionary.to_pylist(), np.bincount(codes, minlength=len(out.dictionary))):
                 if c:
                     counts[o] += int(c)
-    return {"rows": rows,
-            "points": [{"energy": k[0], "gamma": k[1], **v} for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])]}
+    return {
+        "rows": rows,
+        "points": [
+            {"energy": k[0], "gamma": k[1], **v}
+            for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])
+        ],
+    }
 
 
 def describe_run(run_dir) -> dict:
@@ -725,10 +822,14 @@ def describe_run(run_dir) -> dict:
     points = {}
     for r in counts:
         key = tuple(r[k] for k in keys)
-        points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0, "stopped": 0})[r["outcome"]] = \
-            r["count_all"]
+        points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0, "stopped": 0})[r["outcome"]] = r["count_all"]
     if "energy" not in keys:  # a plain run: its one point is the scene's
         meta = read_meta(next(iter(dset.files)), filesystem=store.filesystem)["scene"]
         points = {(meta.get("energy"), meta.get("gamma")): c for c in points.values()}
-    return {"rows": rows,
-            "points": [{"energy": k[0], "gamma": k[1], **v} for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])]}
+    return {
+        "rows": rows,
+        "points": [
+            {"energy": k[0], "gamma": k[1], **v}
+            for k, v in sorted(points.items(), key=lambda kv: [(x is None, x or 0.0) for x in kv[0]])
+        ],
+    }

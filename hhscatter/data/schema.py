@@ -66,6 +66,7 @@ snapshots: traj_id int64, t energy float64 (with ``continue_settled``: also sett
 crossings: traj_id int64, t radius float64, direction int8 (+1 outward, −1 inward);
            follow scenes only: every crossing of the follow radii
 """
+
 from __future__ import annotations
 
 import functools
@@ -76,8 +77,8 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from hhscatter.outcomes import OUTCOMES, TABLE_COLUMNS
 from hhscatter._version import __version__
+from hhscatter.outcomes import OUTCOMES, TABLE_COLUMNS
 
 if TYPE_CHECKING:  # annotations only
     pass
@@ -97,11 +98,13 @@ def _schemas():
 
     f64 = pa.float64()
     # the columns are declared once (hhscatter.outcomes.TABLE_COLUMNS); here their types (float64 unless named)
-    types = {"traj_id": pa.int64(), "outcome": pa.dictionary(pa.int8(), pa.string()), "exit_channel": pa.int8(),
-             "direction": pa.int8()}
-    return {
-        name: pa.schema([(c, types.get(c, f64)) for c in columns]) for name, columns in TABLE_COLUMNS.items()
+    types = {
+        "traj_id": pa.int64(),
+        "outcome": pa.dictionary(pa.int8(), pa.string()),
+        "exit_channel": pa.int8(),
+        "direction": pa.int8(),
     }
+    return {name: pa.schema([(c, types.get(c, f64)) for c in columns]) for name, columns in TABLE_COLUMNS.items()}
 
 
 @functools.lru_cache(maxsize=1)
@@ -109,7 +112,6 @@ def provenance() -> dict:
     """Versions of the software that made a table, and the git commit if known."""
     import heyoka  # deferred: heyoka loads on first use
     import pyarrow  # deferred: pyarrow loads on first use
-
 
     commit = None
     try:
@@ -121,7 +123,11 @@ def provenance() -> dict:
             commit = out.stdout.strip()
             dirty = subprocess.run(
                 ["git", "status", "--porcelain", "--untracked-files=no"],
-                cwd=here, capture_output=True, text=True, timeout=5, check=False,
+                cwd=here,
+                capture_output=True,
+                text=True,
+                timeout=5,
+                check=False,
             )
             if dirty.returncode == 0 and dirty.stdout.strip():
                 commit += "-dirty"
@@ -146,8 +152,9 @@ def to_arrow(name: str, columns: dict):
         col = columns[field.name]
         if name == "lifetimes" and field.name == "outcome":
             codes = np.asarray(col, dtype=np.int8)
-            arrays.append(pa.DictionaryArray.from_buffers(field.type, len(codes), [None, pa.py_buffer(codes)],
-                                                          _outcome_names()))
+            arrays.append(
+                pa.DictionaryArray.from_buffers(field.type, len(codes), [None, pa.py_buffer(codes)], _outcome_names())
+            )
         elif name == "lifetimes" and field.name == "exit_channel":
             ch = np.asarray(col, dtype=np.int8)
             arrays.append(_arrow(ch, pa.int8(), mask=ch < 0))
@@ -217,8 +224,9 @@ def add_point_columns(name: str, table, scene):
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
     for col, key in POINT_COLUMNS[name]:
-        table = table.append_column(pa.field(col, pa.float64()),
-                                    pa.array(np.full(table.num_rows, float(getattr(scene, key)))))
+        table = table.append_column(
+            pa.field(col, pa.float64()), pa.array(np.full(table.num_rows, float(getattr(scene, key))))
+        )
     return table
 
 

@@ -18,6 +18,7 @@ readers use one set of operations:
 
 A ``Store`` pickles as its URL, so it travels to worker processes cheaply.
 """
+
 from __future__ import annotations
 
 import fcntl
@@ -68,8 +69,11 @@ class Store:
     # -- paths ---------------------------------------------------------------
     def path(self, *parts) -> str:
         """path(*parts) -> full path (local path or filesystem path) of root/parts."""
-        return posixpath.join(self.root, *[str(p) for p in parts if p]) if not self.local else \
-            os.path.join(self.root, *[str(p) for p in parts if p])
+        return (
+            posixpath.join(self.root, *[str(p) for p in parts if p])
+            if not self.local
+            else os.path.join(self.root, *[str(p) for p in parts if p])
+        )
 
     def display(self, rel: str = "") -> str:
         """A path as the user gave it (URL kept), for messages."""
@@ -216,7 +220,6 @@ class Store:
     def remove(self, rel: str):
         """Delete a file or a whole directory tree under root (missing: no-op)."""
         if self.local:
-
             p = self.path(rel)
             if os.path.isdir(p):
                 shutil.rmtree(p)
@@ -241,7 +244,7 @@ class Store:
         are there), this saves the directory fsync (5-8 ms per part measured, as much as writing it).
         """
         final = self.path(rel)
-        head, name = (os.path.split(final) if self.local else posixpath.split(final))
+        head, name = os.path.split(final) if self.local else posixpath.split(final)
         tmp = (os.path.join if self.local else posixpath.join)(head, f".{name}{TMP_MARK}{os.getpid()}")
         self.makedirs(os.path.dirname(rel) if self.local else posixpath.dirname(rel))
         try:
@@ -267,6 +270,7 @@ class Store:
 
     def write_text(self, rel: str, text: str) -> None:
         """Write a small text file atomically."""
+
         def write(target, fs):
             if fs is None:
                 with open(target, "w") as fh:

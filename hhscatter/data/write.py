@@ -1,11 +1,11 @@
 """Write part files: one Parquet file per chunk and table, atomically, with page checksums and the run's
 metadata (the layout and schemas: :mod:`hhscatter.data.schema`)."""
+
 from __future__ import annotations
 
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING
-
 
 from hhscatter.data.store import Store
 
@@ -27,7 +27,6 @@ def write_part(path, table, meta: dict, store=None, *, sync_dir: bool = True) ->
     """
     import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
-
     if store is None:
         path = Path(path)
         store, rel = Store(path.parent), path.name
@@ -37,8 +36,12 @@ def write_part(path, table, meta: dict, store=None, *, sync_dir: bool = True) ->
 
     def write(target, filesystem):
         # no per-file timestamps or writer-dependent fields: same rows, same bytes
-        opts = {"compression": "zstd", "write_statistics": True, "write_page_checksum": True,
-                "use_dictionary": dictionary_columns(table.schema)}
+        opts = {
+            "compression": "zstd",
+            "write_statistics": True,
+            "write_page_checksum": True,
+            "use_dictionary": dictionary_columns(table.schema),
+        }
         if filesystem is None:  # our own handle, closed even when the write fails (a full disk): a worker
             with open(target, "wb") as fh:  # that keeps the error must not keep the unlinked file open
                 pq.write_table(table, fh, **opts)
@@ -70,7 +73,6 @@ def write_parts_streamed(path, tables, meta: dict) -> int:
     """
     import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
 
-
     path = Path(path)
     store, rows = Store(path.parent), [0]
 
@@ -80,8 +82,14 @@ def write_parts_streamed(path, tables, meta: dict) -> int:
             for t in tables:
                 if writer is None:
                     schema = t.schema.with_metadata({META_KEY: json.dumps(meta, sort_keys=True).encode()})
-                    writer = pq.ParquetWriter(target, schema, filesystem=filesystem, compression="zstd",
-                                              write_statistics=True, write_page_checksum=True)
+                    writer = pq.ParquetWriter(
+                        target,
+                        schema,
+                        filesystem=filesystem,
+                        compression="zstd",
+                        write_statistics=True,
+                        write_page_checksum=True,
+                    )
                 writer.write_table(t.replace_schema_metadata(schema.metadata))
                 rows[0] += t.num_rows
         finally:

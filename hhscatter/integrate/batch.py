@@ -1,4 +1,5 @@
 """Lanes of one batch integrator: the per-process integrator cache and the part both schedulers share."""
+
 from __future__ import annotations
 
 import collections
@@ -135,7 +136,8 @@ def _check(ta, rules):
         if res[0] == hy.taylor_outcome.err_nf_state:
             raise FloatingPointError(
                 f"non-finite state in lane {lane}; this is a bug: escaping orbits must be stopped by the "
-                "engine's events")
+                "engine's events"
+            )
     return steps
 
 

@@ -1,4 +1,5 @@
 """The chunk: ``run_chunk(scene, ics, traj_ids) -> ChunkResult``, one block of orbits on one batch integrator."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -47,8 +48,11 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
     if failures:
-        local = _orbits_with_failures(lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far,
-                                                             **kw), int(inside.sum()), failures)
+        local = _orbits_with_failures(
+            lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
+            int(inside.sum()),
+            failures,
+        )
         res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
         redone = traj_ids[inside][local]
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
@@ -95,8 +99,12 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
     rerun = outcome == RERUN
     if rerun.any():  # decided at the no-return radius too close to t_max: the scene's own rule decides
         own = _own_far(orig)
-        res = _merge_rerun(res, rerun, traj_ids, _integrate(own, ics[rerun], traj_ids[rerun], (own, None),
-                                                            batch_size=batch_size, count_steps=count_steps))
+        res = _merge_rerun(
+            res,
+            rerun,
+            traj_ids,
+            _integrate(own, ics[rerun], traj_ids[rerun], (own, None), batch_size=batch_size, count_steps=count_steps),
+        )
     return res
 
 
@@ -135,10 +143,17 @@ def _with_escaped_at_start(scene, ics, traj_ids, outside, res):
     model = scene.model
     x, y, px, py = ics.T
     lt = {
-        "traj_id": traj_ids, "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
-        "e0": model.energy(x, y, px, py), "gamma": np.full(len(ics), scene.gamma),
-        "outcome": np.full(len(ics), ESCAPED, np.int8), "t_end": np.zeros(len(ics)),
-        "exit_channel": model.exit_channel(x, y).astype(np.int8), "e_end": model.energy(x, y, px, py),
+        "traj_id": traj_ids,
+        "x0": x.copy(),
+        "y0": y.copy(),
+        "px0": px.copy(),
+        "py0": py.copy(),
+        "e0": model.energy(x, y, px, py),
+        "gamma": np.full(len(ics), scene.gamma),
+        "outcome": np.full(len(ics), ESCAPED, np.int8),
+        "t_end": np.zeros(len(ics)),
+        "exit_channel": model.exit_channel(x, y).astype(np.int8),
+        "e_end": model.energy(x, y, px, py),
     }
     if inside.any():
         for col in ("outcome", "t_end", "exit_channel", "e_end"):

@@ -51,6 +51,7 @@ events with callbacks), so event states and times are the integrator's own.
 A process compiles a scene's integrator once and reuses it for its later
 chunks, reset to a new one's state (:func:`_batch_integrator`).
 """
+
 from __future__ import annotations
 
 # the engine's modules, by concern (hhscatter.integrate's docstring): this module gathers their public names
@@ -63,5 +64,17 @@ from hhscatter.integrate.reference import OrbitResult, simulate_orbit, state_at
 from hhscatter.integrate.rerun import _merge_rerun, _no_return  # noqa: F401
 from hhscatter.integrate.results import ChunkResult
 
-__all__ = ["LaneRules", "run_chunk", "simulate_orbit", "state_at", "scheduler", "ChunkResult", "OrbitResult", "OUTCOMES",
-           "ESCAPED", "SETTLED", "CENSORED", "STOPPED"]
+__all__ = [
+    "LaneRules",
+    "run_chunk",
+    "simulate_orbit",
+    "state_at",
+    "scheduler",
+    "ChunkResult",
+    "OrbitResult",
+    "OUTCOMES",
+    "ESCAPED",
+    "SETTLED",
+    "CENSORED",
+    "STOPPED",
+]

@@ -1,4 +1,5 @@
 """The epoch scheduler (scenes with energy snapshots): all lanes advance together; snapshots from ``propagate_grid``."""
+
 from __future__ import annotations
 
 import math
@@ -73,10 +74,10 @@ class _Epochs(_BatchRules):
         for k, (t, s) in enumerate(rows + [(np.empty(0), np.empty(0))]):
             inner = (t > 0) & (t < P)
             j = int(inner.sum())
-            tau[k, 1:1 + j] = t[inner]
-            tt[k, 1:1 + j] = s[inner]
+            tau[k, 1 : 1 + j] = t[inner]
+            tt[k, 1 : 1 + j] = s[inner]
             a = t[inner][-1] if j else 0.0
-            tau[k, 1 + j:-1] = a + (P - a) * np.arange(1, m - j + 1) / (m - j + 1)
+            tau[k, 1 + j : -1] = a + (P - a) * np.arange(1, m - j + 1) / (m - j + 1)
             if len(t) and t[0] == 0.0:
                 tt[k, 0] = s[0]
             if len(t) and t[-1] == P:
@@ -130,8 +131,7 @@ class _Epochs(_BatchRules):
         t = np.concatenate([r[1] for r in rows]) if rows else np.empty(0)
         e = np.concatenate([r[2] for r in rows]) if rows else np.empty(0)
         # rows after an orbit's end belong to no table (settled orbits continued: all rows)
-        limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf,
-                         np.array(self.t_end))
+        limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf, np.array(self.t_end))
         keep = t <= limit[ids]
         return n_returns, n_steps, (ids[keep], t[keep], e[keep])
 

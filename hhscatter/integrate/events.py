@@ -42,11 +42,12 @@ Outcome rules (the paper's, App. "Escape Condition"):
   ``stop = true`` is done); t_end is the stop time. Analyses treat it as
   censoring at t_end.
 """
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -205,14 +206,25 @@ def scene_events(scene) -> tuple:
         # one of them in batch mode (measured), so the r_esc radius is also the escape event
         ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "followed orbit far away"))
         for k, R in enumerate(follow_radii(scene)):
-            ev.append(EventSpec(f"radius{k}", 0, (lambda R2: lambda s: s.r2 - R2)(R * R),
-                                f"follow: crossing of r = {R:g}" + (" (outward: the escape)" if R == scene.r_esc
-                                                                   else ""), rule="radius", index=k))
+            ev.append(
+                EventSpec(
+                    f"radius{k}",
+                    0,
+                    (lambda R2: lambda s: s.r2 - R2)(R * R),
+                    f"follow: crossing of r = {R:g}" + (" (outward: the escape)" if R == scene.r_esc else ""),
+                    rule="radius",
+                    index=k,
+                )
+            )
     if scene.sections is not None:
-        ev.append(EventSpec(
-            "section", 0,
-            lambda s: s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate),
-            "section ṙ = 0 (gated)"))
+        ev.append(
+            EventSpec(
+                "section",
+                0,
+                lambda s: s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate),
+                "section ṙ = 0 (gated)",
+            )
+        )
     if clock_targets(scene):
         ev.append(EventSpec("clock", -1, lambda s: s.clock, "orbit-time schedule"))
     return tuple(ev)
@@ -252,12 +264,18 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
     specs = tuple(s for s in scene_events(scene) if s.name not in without)
     sym = Symbols(scene, lay)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
-    events = [hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction])
-              for s in specs]
+    events = [
+        hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction]) for s in specs
+    ]
     pars = batch_pars(scene, lay, batch_size, without)
     kw = {"pars": pars} if len(pars) else {}
-    ta = hy.taylor_adaptive_batch(system(scene, lay), np.zeros((lay.n_state, batch_size)),
-                                  tol=scene.tol if tol is None else tol, t_events=events, **kw)
+    ta = hy.taylor_adaptive_batch(
+        system(scene, lay),
+        np.zeros((lay.n_state, batch_size)),
+        tol=scene.tol if tol is None else tol,
+        t_events=events,
+        **kw,
+    )
     return ta, specs, lay
 
 
@@ -274,10 +292,12 @@ def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     import heyoka as hy  # deferred: heyoka loads on first use
 
     (esc,) = (e for e in scene_events(scene) if e.name == "escape")
-    ev = hy.t_event_batch(esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback,
-                          direction=hy.event_direction.positive)
-    return hy.taylor_adaptive_batch(system(scene, HAMILTON_ONLY), np.zeros((4, batch_size)),
-                                    tol=scene.tol if tol is None else tol, t_events=[ev])
+    ev = hy.t_event_batch(
+        esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback, direction=hy.event_direction.positive
+    )
+    return hy.taylor_adaptive_batch(
+        system(scene, HAMILTON_ONLY), np.zeros((4, batch_size)), tol=scene.tol if tol is None else tol, t_events=[ev]
+    )
 
 
 def batch_pars(scene, lay: Layout, batch_size: int, without=()) -> np.ndarray:
@@ -303,8 +323,13 @@ def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
     lay = layout(scene)
     specs = tuple(s for s in scene_events(scene) if s.name not in without)
     sym = Symbols(scene, lay)
-    key = (batch_size, float(scene.tol if tol is None else tol), lay, repr(system(scene, lay)),
-           tuple((s.name, s.rule, s.index, s.direction, repr(s.expression(sym))) for s in specs))
+    key = (
+        batch_size,
+        float(scene.tol if tol is None else tol),
+        lay,
+        repr(system(scene, lay)),
+        tuple((s.name, s.rule, s.index, s.direction, repr(s.expression(sym))) for s in specs),
+    )
     return key, specs, lay
 
 
@@ -322,8 +347,10 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
     sym = Symbols(scene, lay)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     cast = caster(fp_type)
-    events = [hy.t_event(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction],
-                         fp_type=fp_type) for s in specs]
+    events = [
+        hy.t_event(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction], fp_type=fp_type)
+        for s in specs
+    ]
     pars = [0.0] * lay.n_pars
     if lay.gamma is not None:
         pars[lay.gamma] = scene.gamma
@@ -331,8 +358,14 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
     if tol is not None or fp_type is float:
         t = scene.tol if tol is None else tol
         kw["tol"] = fp_type(t) if fp_type is not float else t
-    ta = hy.taylor_adaptive(system(scene, lay), cast([0.0] * lay.n_state), pars=cast(pars) if pars else [],
-                            t_events=events, fp_type=fp_type, **kw)
+    ta = hy.taylor_adaptive(
+        system(scene, lay),
+        cast([0.0] * lay.n_state),
+        pars=cast(pars) if pars else [],
+        t_events=events,
+        fp_type=fp_type,
+        **kw,
+    )
     return ta, specs, lay
 
 
@@ -346,6 +379,7 @@ def caster(fp_type):
 
 
 # -- outcome rules ---------------------------------------------------------------
+
 
 def closure_rule(r2: float, r_s: float, last_out) -> int | None:
     """closure_rule(r², r_s, last_out) -> SETTLED, ESCAPED or None (carry on).
@@ -366,11 +400,37 @@ def section_accepts(window, t: float, x: float, y: float, px: float, py: float, 
     φ̇ > 0 (x p_y − y p_x > 0), orbit time in [t_from, t_to] and after the
     initial point, energy in [e_min, e_max].
     """
-    return (x * py - y * px > 0 and t >= T_INITIAL and window.t_from <= t <= window.t_to
-            and window.e_min <= energy <= window.e_max)
+    return (
+        x * py - y * px > 0
+        and t >= T_INITIAL
+        and window.t_from <= t <= window.t_to
+        and window.e_min <= energy <= window.e_max
+    )
 
 
-__all__ = ["CENSORED", "ESCAPED", "OUTCOMES", "SETTLED", "STOPPED", "EventSpec", "HAMILTON_ONLY", "Layout", "RULES",
-           "batch_key", "batch_pars", "build_batch", "build_escape_only_batch", "build_scalar", "caster",
-           "clock_targets", "follow_radii", "closure_rule", "far_radius", "layout", "scene_events", "two_phase",
-           "section_accepts", "system"]
+__all__ = [
+    "CENSORED",
+    "ESCAPED",
+    "OUTCOMES",
+    "SETTLED",
+    "STOPPED",
+    "EventSpec",
+    "HAMILTON_ONLY",
+    "Layout",
+    "RULES",
+    "batch_key",
+    "batch_pars",
+    "build_batch",
+    "build_escape_only_batch",
+    "build_scalar",
+    "caster",
+    "clock_targets",
+    "follow_radii",
+    "closure_rule",
+    "far_radius",
+    "layout",
+    "scene_events",
+    "two_phase",
+    "section_accepts",
+    "system",
+]

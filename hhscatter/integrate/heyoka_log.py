@@ -19,6 +19,7 @@ not heyoka's
 >>> log.event_failures
 0
 """
+
 from __future__ import annotations
 
 import contextlib

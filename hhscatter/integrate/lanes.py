@@ -4,6 +4,7 @@
 :mod:`hhscatter.integrate.batch`, or the reference driver's one scalar orbit, :mod:`hhscatter.integrate.reference`)
 subclasses it and supplies the integrator access. Event callbacks (:class:`Callback`) are bound to its handlers.
 """
+
 from __future__ import annotations
 
 import abc
@@ -57,24 +58,30 @@ class LaneRules(abc.ABC):
     @abc.abstractmethod
     def elapsed(self, lane: int) -> float:
         """The orbit time of ``lane`` now (time units)."""
+
     @abc.abstractmethod
     def state4(self, lane: int) -> tuple:
         """(x, y, px, py) of ``lane`` now, as Python floats."""
+
     @abc.abstractmethod
     def set_gate(self, lane: int, g: float) -> None:
         """Open (1.0) or close (0.0) the section event of ``lane``."""
+
     @abc.abstractmethod
     def set_clock(self, lane: int, sigma: float) -> None:
         """Set the clock variable σ of ``lane`` (its root is the next clock target)."""
+
     @abc.abstractmethod
     def record(self, lane: int, outcome: int, t: float, state) -> None:
         """Record the orbit's outcome (a code of :mod:`hhscatter.outcomes`), its end time and end state."""
+
     @abc.abstractmethod
     def release(self, lane: int) -> bool:
         """The orbit of ``lane`` needs nothing more: load the next orbit, park the lane, or stop.
 
         Returns what the event callback returns (False stops the propagation).
         """
+
     #: None, or f(t, state) -> True when an orbit at the no-return far radius might not have reached the
     #: scene's r_far by t_max (run_chunk's no-return rule: the orbit is then rerun to r_far)
     late = None
@@ -83,8 +90,15 @@ class LaneRules(abc.ABC):
 
     def handler(self, spec):
         """handler(spec) -> the callable (lane, direction) -> continue? of the event ``spec``'s rule."""
-        rules = {"escape": self.on_escape, "closure": self.on_closure, "far": self.on_far, "resc": self.on_resc,
-                 "radius": self.on_radius, "section": self.on_section, "clock": self.on_clock}
+        rules = {
+            "escape": self.on_escape,
+            "closure": self.on_closure,
+            "far": self.on_far,
+            "resc": self.on_resc,
+            "radius": self.on_radius,
+            "section": self.on_section,
+            "clock": self.on_clock,
+        }
         h = rules[spec.rule]
         return functools.partial(h, spec.index) if spec.index is not None else h
 
@@ -225,8 +239,9 @@ class LaneRules(abc.ABC):
                 return self.release(lane)
             if targets[i][1] == "open":
                 if self.migrate_at_open:  # the window opens: the orbit goes on in the second phase
-                    self.migrants.append((self.orbit[lane], self.state4(lane), t, i + 1, self.last_out[lane],
-                                          self.phase[lane]))
+                    self.migrants.append(
+                        (self.orbit[lane], self.state4(lane), t, i + 1, self.last_out[lane], self.phase[lane])
+                    )
                     return self.release(lane)
                 if not self.sec_found[lane]:
                     self.set_gate(lane, 1.0)

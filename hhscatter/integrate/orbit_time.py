@@ -4,12 +4,13 @@ A stream lane's clock runs on across the orbits it carries; an orbit's time is t
 double-length times (hi, lo). TwoSum keeps it exact to ~2⁻¹⁰⁶ of the lane time, and a near-tie rounds to even,
 so orbit times do not depend on how orbits share lanes (:mod:`hhscatter.integrate.stream`).
 """
+
 from __future__ import annotations
 
 import math
 
 _ulp = math.ulp
-TIE_BAND = 2.0 ** -30  # an orbit time this close (in gaps) to a tie of its rounding is a tie (>> the 2^-106 residue)
+TIE_BAND = 2.0**-30  # an orbit time this close (in gaps) to a tie of its rounding is a tie (>> the 2^-106 residue)
 
 
 def _tie_to_even(r: float, rem: float) -> float:

@@ -1,5 +1,6 @@
 """The reference driver: one orbit at a time on heyoka's scalar integrator (any floating-point type), with the
 same events and rules as the engine."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -1,5 +1,6 @@
 """Orbits of a chunk integrated again: the no-return rule's late orbits (rerun to the scene's own far radius)
 and the orbits hit by a heyoka event-detection failure (found and redone on the reference driver)."""
+
 from __future__ import annotations
 
 import math
@@ -24,6 +25,7 @@ def _orbits_with_failures(integrate, n, failures) -> np.ndarray:
     integrated under capture, and the halves with failures split again (about 2n orbit integrations per failing
     orbit). A set whose failures no half reproduces is returned whole (every orbit of it is redone).
     """
+
     def count(idx):
         with heyoka_log.capture() as log:
             integrate(idx)
@@ -35,7 +37,7 @@ def _orbits_with_failures(integrate, n, failures) -> np.ndarray:
         if len(idx) == 1:
             found.append(idx)
             return
-        halves = (idx[: len(idx) // 2], idx[len(idx) // 2:])
+        halves = (idx[: len(idx) // 2], idx[len(idx) // 2 :])
         counts = [count(h) for h in halves]
         if not any(counts):  # not reproduced orbit by orbit: keep the whole set
             found.append(idx)
@@ -69,8 +71,9 @@ def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
             if not log.event_failures:
                 break
         else:
-            raise RuntimeError(f"orbit {traj_ids[j]}: heyoka's event detection failed in double, long double and "
-                               "real128")
+            raise RuntimeError(
+                f"orbit {traj_ids[j]}: heyoka's event detection failed in double, long double and real128"
+            )
         k = traj_ids[j]
         end = np.array([float(v) for v in o.state_end[:4]])
         rows["lifetimes"].append((j, o.outcome, float(o.t_end), end))
@@ -82,15 +85,24 @@ def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
     outcome = np.array([r[1] for r in rows["lifetimes"]], dtype=np.int8)
     x, y, px, py = ics[sel].T
     lifetimes = {
-        "traj_id": traj_ids[sel], "x0": x.copy(), "y0": y.copy(), "px0": px.copy(), "py0": py.copy(),
-        "e0": model.energy(x, y, px, py), "gamma": np.full(len(sel), scene.gamma), "outcome": outcome,
+        "traj_id": traj_ids[sel],
+        "x0": x.copy(),
+        "y0": y.copy(),
+        "px0": px.copy(),
+        "py0": py.copy(),
+        "e0": model.energy(x, y, px, py),
+        "gamma": np.full(len(sel), scene.gamma),
+        "outcome": outcome,
         "t_end": np.array([r[2] for r in rows["lifetimes"]], dtype=float),
         "exit_channel": np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1).astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
     snap = np.array(rows["snapshots"], dtype=float).reshape(-1, 6)
-    snapshots = {"traj_id": snap[:, 0].astype(np.int64), "t": snap[:, 1],
-                 "energy": model.energy(snap[:, 2], snap[:, 3], snap[:, 4], snap[:, 5])}
+    snapshots = {
+        "traj_id": snap[:, 0].astype(np.int64),
+        "t": snap[:, 1],
+        "energy": model.energy(snap[:, 2], snap[:, 3], snap[:, 4], snap[:, 5]),
+    }
     sec = np.array(rows["sections"], dtype=float).reshape(-1, len(SECTION_COLUMNS))
     sections = {c: sec[:, i] for i, c in enumerate(SECTION_COLUMNS)}
     cr = np.array(rows["crossings"], dtype=float).reshape(-1, len(CROSSING_COLUMNS))
@@ -172,5 +184,11 @@ def _merge_rerun(res, rerun, traj_ids, again):
         cols = {c: np.concatenate([a[c][keep], b[c].astype(a[c].dtype)]) for c in a}
         order = np.lexsort((cols["t"], local(cols["traj_id"])))
         tables[name] = {c: v[order] for c, v in cols.items()}
-    return ChunkResult(res.lifetimes, tables["sections"], tables["snapshots"], tables["crossings"],
-                       n_returns=res.n_returns + again.n_returns, n_steps=res.n_steps + again.n_steps)
+    return ChunkResult(
+        res.lifetimes,
+        tables["sections"],
+        tables["snapshots"],
+        tables["crossings"],
+        n_returns=res.n_returns + again.n_returns,
+        n_steps=res.n_steps + again.n_steps,
+    )

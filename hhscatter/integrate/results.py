@@ -1,4 +1,5 @@
 """A chunk's rows: :class:`ChunkResult` and the columns of its tables."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -25,16 +26,24 @@ class ChunkResult:
     redone: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))  # traj_ids redone on the reference
 
     def tables(self) -> dict:
-        return {"lifetimes": self.lifetimes, "sections": self.sections, "snapshots": self.snapshots,
-                "crossings": self.crossings}
+        return {
+            "lifetimes": self.lifetimes,
+            "sections": self.sections,
+            "snapshots": self.snapshots,
+            "crossings": self.crossings,
+        }
 
 
 def _empty_result(traj_ids) -> ChunkResult:
     """A chunk result without orbits."""
     crossings = _rows_to_columns([], CROSSING_COLUMNS, traj_ids)
     crossings["direction"] = crossings["direction"].astype(np.int8)
-    return ChunkResult({}, _rows_to_columns([], SECTION_COLUMNS, traj_ids),
-                       _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids), crossings)
+    return ChunkResult(
+        {},
+        _rows_to_columns([], SECTION_COLUMNS, traj_ids),
+        _rows_to_columns([], ("traj_id", "t", "energy"), traj_ids),
+        crossings,
+    )
 
 
 def _rows_to_columns(rows, columns, traj_ids):

@@ -1,4 +1,5 @@
 """The stream scheduler (scenes without snapshots): the next orbit is loaded in the callback that ends one."""
+
 from __future__ import annotations
 
 import numpy as np

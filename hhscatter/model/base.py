@@ -44,12 +44,14 @@ forms, or a declared one whose quantities are derived from its expression). The 
 | ``provenance()`` | what the tables' metadata records of the system | — |
 | ``hash_items()`` | what enters a scene's hash (None: the paper's default system, left out of the hash) | — |
 """
+
 from __future__ import annotations
 
 import abc
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -292,8 +294,12 @@ class System(abc.ABC):
 
     def provenance(self) -> dict[str, Any]:
         """What the tables' metadata records of the system: name, V as text, parameters, dissipation."""
-        return {"system": self.name, "potential": self.potential_text, "params": dict(self.params),
-                "dissipation": self.dissipation}
+        return {
+            "system": self.name,
+            "potential": self.potential_text,
+            "params": dict(self.params),
+            "dissipation": self.dissipation,
+        }
 
     def hash_items(self) -> dict[str, Any] | None:
         """What enters a scene's hash; None for the paper's system (Hénon–Heiles, linear drag)."""

@@ -12,11 +12,13 @@ byte for byte); the others are :class:`~hhscatter.model.declared.DeclaredSystem`
 whose E_c, exits and Ω are derived (and tested against the closed forms above). ``n_exit`` with n = 3 is
 Hénon–Heiles written as a declared potential.
 """
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from hhscatter.errors import ConfigError
 from hhscatter.model.base import DISSIPATIONS, System
@@ -179,8 +181,9 @@ def _positive(system: str, key: str, value: float) -> None:
 
 #: the built-in systems, name → :class:`Builtin`
 BUILTINS: dict[str, Builtin] = {
-    "henon_heiles": Builtin(henon_heiles, {"omega": (float, 1.0), "lam": (float, 1.0)},
-                            "ω²(x² + y²)/2 + λ(x²y − y³/3); E_c = ω⁶/(6λ²)"),
+    "henon_heiles": Builtin(
+        henon_heiles, {"omega": (float, 1.0), "lam": (float, 1.0)}, "ω²(x² + y²)/2 + λ(x²y − y³/3); E_c = ω⁶/(6λ²)"
+    ),
     "n_exit": Builtin(n_exit, {"n": (int, 3)}, "r²/2 + rⁿ sin(nθ)/n; E_c = (n − 2)/(2n)"),
     "contopoulos": Builtin(contopoulos, {"eps": (float, 0.25)}, "(x² + y²)/2 − εx²y²; E_c = 1/(4ε)"),
     "barbanis": Builtin(barbanis, {"eps": (float, 0.5)}, "(x² + y²)/2 − εxy²; E_c = 1/(8ε²)"),
@@ -197,8 +200,13 @@ def _typed(system: str, key: str, kind: type, value: Any) -> Any:
     return float(value)
 
 
-def make_system(name: str | None = None, potential: Any = None, params: Mapping[str, Any] | None = None,
-                dissipation: str = "linear", **overrides: Any) -> System:
+def make_system(
+    name: str | None = None,
+    potential: Any = None,
+    params: Mapping[str, Any] | None = None,
+    dissipation: str = "linear",
+    **overrides: Any,
+) -> System:
     """The system of a ``[system]`` table (or the CLI's ``--system``/``--param``, or the API): a built-in or declared.
 
     Parameters
@@ -237,28 +245,43 @@ def make_system(name: str | None = None, potential: Any = None, params: Mapping[
         raise ConfigError(f"system.dissipation must be one of {DISSIPATIONS}, got {dissipation!r}")
     unknown = sorted(set(overrides) - set(OVERRIDES))
     if unknown:
-        raise ConfigError(f"system: unknown key(s) {unknown} (allowed: name, potential, params, dissipation, "
-                          f"{', '.join(OVERRIDES)})")
+        raise ConfigError(
+            f"system: unknown key(s) {unknown} (allowed: name, potential, params, dissipation, {', '.join(OVERRIDES)})"
+        )
     if name is not None and potential is not None:
         raise ConfigError("system: give either `name` (a built-in) or `potential` (a declared potential), not both")
     if potential is not None:
         return DeclaredSystem(potential, params, dissipation, **overrides)
     name = "henon_heiles" if name is None else name
     if name not in BUILTINS:
-        raise ConfigError(f"system.name: unknown built-in {name!r} (built-ins: {', '.join(BUILTINS)}; or give "
-                          "`potential`)")
+        raise ConfigError(
+            f"system.name: unknown built-in {name!r} (built-ins: {', '.join(BUILTINS)}; or give `potential`)"
+        )
     if overrides:
-        raise ConfigError(f"system: {sorted(overrides)} cannot be given for the built-in {name!r} (its E_c, exits "
-                          "and Ω are closed forms or derived); declare the potential instead")
+        raise ConfigError(
+            f"system: {sorted(overrides)} cannot be given for the built-in {name!r} (its E_c, exits "
+            "and Ω are closed forms or derived); declare the potential instead"
+        )
     spec = BUILTINS[name]
     params = dict(params or {})
     bad = sorted(set(params) - set(spec.params))
     if bad:
-        raise ConfigError(f"system.params: unknown parameter(s) {bad} of {name!r} (its parameters: "
-                          f"{', '.join(spec.params) or 'none'})")
+        raise ConfigError(
+            f"system.params: unknown parameter(s) {bad} of {name!r} (its parameters: "
+            f"{', '.join(spec.params) or 'none'})"
+        )
     typed = {k: _typed(name, k, kind, params.get(k, default)) for k, (kind, default) in spec.params.items()}
     return spec.factory(dissipation=dissipation, **typed)
 
 
-__all__ = ["BUILTINS", "Builtin", "MAX_N_EXIT", "barbanis", "contopoulos", "henon_heiles", "make_system", "n_exit",
-           "n_exit_potential"]
+__all__ = [
+    "BUILTINS",
+    "Builtin",
+    "MAX_N_EXIT",
+    "barbanis",
+    "contopoulos",
+    "henon_heiles",
+    "make_system",
+    "n_exit",
+    "n_exit_potential",
+]

@@ -6,11 +6,13 @@ construction (:mod:`hhscatter.model.derive`; each can be given instead), R(E) on
 expressions of V and of the force −∇V are built by walking the sympy expressions (the force from the
 expanded gradient, so a declared Hénon–Heiles costs as many operations per Taylor step as the built-in).
 """
+
 from __future__ import annotations
 
 import json
 import math
-from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -69,9 +71,18 @@ class DeclaredSystem(System):
     0.625
     """
 
-    def __init__(self, potential: Any, params: Mapping[str, float] | None = None, dissipation: str = "linear", *,
-                 name: str = "declared", critical_energy: float | None = None, exits: Sequence | None = None,
-                 omega_radius: float | None = None, builtin_params: Mapping[str, float] | None = None):
+    def __init__(
+        self,
+        potential: Any,
+        params: Mapping[str, float] | None = None,
+        dissipation: str = "linear",
+        *,
+        name: str = "declared",
+        critical_energy: float | None = None,
+        exits: Sequence | None = None,
+        omega_radius: float | None = None,
+        builtin_params: Mapping[str, float] | None = None,
+    ):
         if dissipation not in DISSIPATIONS:
             raise ConfigError(f"dissipation must be one of {DISSIPATIONS}, got {dissipation!r}")
         values = check_params(params)
@@ -83,11 +94,21 @@ class DeclaredSystem(System):
         set_(self, "_text", potential.strip() if isinstance(potential, str) else str(expr))
         set_(self, "_expr", expr)
         set_(self, "_numeric", substitute(expr, values))
-        set_(self, "_overrides", {k: v for k, v in (("critical_energy", critical_energy), ("exits", exits),
-                                                     ("omega_radius", omega_radius)) if v is not None})
+        set_(
+            self,
+            "_overrides",
+            {
+                k: v
+                for k, v in (("critical_energy", critical_energy), ("exits", exits), ("omega_radius", omega_radius))
+                if v is not None
+            },
+        )
         set_(self, "_builtin_params", dict(builtin_params) if builtin_params is not None else None)
-        set_(self, "_derivation", derive(self._numeric, critical_energy=critical_energy, exits=exits,
-                                         omega_radius=omega_radius))
+        set_(
+            self,
+            "_derivation",
+            derive(self._numeric, critical_energy=critical_energy, exits=exits, omega_radius=omega_radius),
+        )
         set_(self, "_cache", {})
 
     # -- immutability, equality, pickling --------------------------------------------------------------------
@@ -108,16 +129,20 @@ class DeclaredSystem(System):
 
     def __repr__(self):
         extra = "".join(f", {k}={v!r}" for k, v in self._overrides.items())
-        return (f"DeclaredSystem({self._text!r}, {self._params!r}, {self.dissipation!r}, name={self._name!r}"
-                f"{extra})")
+        return f"DeclaredSystem({self._text!r}, {self._params!r}, {self.dissipation!r}, name={self._name!r}{extra})"
 
     def __reduce__(self):
         # rebuilt from its text with the derived quantities given: no second derivation in a worker
         d = self._derivation
-        state = {"critical_energy": d.critical_energy, "omega_radius": d.omega_radius,
-                 "exits": [(e.x, e.y, e.energy) for e in d.exits]}
-        return (_restore, (self._text, self._params, self.dissipation, self._name, self._overrides,
-                           self._builtin_params, state))
+        state = {
+            "critical_energy": d.critical_energy,
+            "omega_radius": d.omega_radius,
+            "exits": [(e.x, e.y, e.energy) for e in d.exits],
+        }
+        return (
+            _restore,
+            (self._text, self._params, self.dissipation, self._name, self._overrides, self._builtin_params, state),
+        )
 
     # -- identity ----------------------------------------------------------------------------------------------
     @property
@@ -239,8 +264,11 @@ class DeclaredSystem(System):
             out = {"potential": self._text, "params": dict(self._params)}
         out["dissipation"] = self.dissipation
         for k, v in self._overrides.items():
-            out[k] = [[float(c) for c in (e if not isinstance(e, Exit) else (e.x, e.y, e.energy))] for e in v] \
-                if k == "exits" else float(v)
+            out[k] = (
+                [[float(c) for c in (e if not isinstance(e, Exit) else (e.x, e.y, e.energy))] for e in v]
+                if k == "exits"
+                else float(v)
+            )
         return out
 
     def provenance(self) -> dict[str, Any]:
@@ -249,8 +277,11 @@ class DeclaredSystem(System):
         if self._builtin_params is not None:
             out["builtin_params"] = dict(self._builtin_params)
         for k, v in self._overrides.items():
-            out[k] = [list(map(float, e)) if not isinstance(e, Exit) else [e.x, e.y, e.energy] for e in v] \
-                if k == "exits" else float(v)
+            out[k] = (
+                [list(map(float, e)) if not isinstance(e, Exit) else [e.x, e.y, e.energy] for e in v]
+                if k == "exits"
+                else float(v)
+            )
         return out
 
     def hash_items(self) -> dict[str, Any]:
@@ -266,12 +297,21 @@ def _restore(text, params, dissipation, name, overrides, builtin_params, state):
     numeric = substitute(expr, values)
     land = Landscape(numeric)
     check_well(land, [])
-    derivation = Derivation((), _given_exits(land, state["exits"]), state["critical_energy"], state["omega_radius"],
-                            "given", 0.0)
-    for key, value in (("_name", name), ("_params", values), ("dissipation", dissipation), ("_text", text),
-                       ("_expr", expr), ("_numeric", numeric), ("_overrides", dict(overrides)),
-                       ("_builtin_params", builtin_params), ("_derivation", derivation),
-                       ("_cache", {"land": land})):
+    derivation = Derivation(
+        (), _given_exits(land, state["exits"]), state["critical_energy"], state["omega_radius"], "given", 0.0
+    )
+    for key, value in (
+        ("_name", name),
+        ("_params", values),
+        ("dissipation", dissipation),
+        ("_text", text),
+        ("_expr", expr),
+        ("_numeric", numeric),
+        ("_overrides", dict(overrides)),
+        ("_builtin_params", builtin_params),
+        ("_derivation", derivation),
+        ("_cache", {"land": land}),
+    ):
         object.__setattr__(self, key, value)
     return self
 

@@ -29,12 +29,14 @@ against the derivation wherever it can decide (a contradiction is refused, namin
 consistency where it cannot: given exits are critical points of V at their stated energy, E_c is the lowest exit's
 energy, Ω holds the well's part of {V < E_c} and meets no other part.
 """
+
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -215,8 +217,10 @@ class Landscape:
 
 # -- critical points ------------------------------------------------------------------------------
 def _curve_error(extra: str = "") -> ConfigError:
-    return ConfigError("the critical points of the potential form a curve (∇V = 0 is not a finite set of points"
-                       f"{extra}): the exits cannot be derived; give `critical_energy` and `exits` in [system]")
+    return ConfigError(
+        "the critical points of the potential form a curve (∇V = 0 is not a finite set of points"
+        f"{extra}): the exits cannot be derived; give `critical_energy` and `exits` in [system]"
+    )
 
 
 def _symbolic_candidates(land: Landscape) -> tuple[np.ndarray, np.ndarray]:
@@ -284,19 +288,26 @@ def check_well(land: Landscape, points: Sequence[CriticalPoint]) -> None:
     gx, gy = (float(g) for g in land.gradient(0.0, 0.0))
     scale = max(1.0, *(abs(float(h)) for h in land.hessian(0.0, 0.0)))
     if not (math.isfinite(v0) and math.isfinite(gx) and math.isfinite(gy)):
-        raise ConfigError(f"the potential is not finite at the origin (V(0, 0) = {v0}): the well's minimum must "
-                          "be at the origin with V = 0")
+        raise ConfigError(
+            f"the potential is not finite at the origin (V(0, 0) = {v0}): the well's minimum must "
+            "be at the origin with V = 0"
+        )
     if math.hypot(gx, gy) > 1e-12 * scale:
         minima = [p for p in points if p.kind == "minimum"]
         near = min(minima, key=lambda p: p.distance, default=None)
-        where = (f"found at ({near.x:.6g}, {near.y:.6g}) with V = {near.energy:.6g}" if near else
-                 f"∇V(0, 0) = ({gx:.3g}, {gy:.3g}) and no minimum was found")
+        where = (
+            f"found at ({near.x:.6g}, {near.y:.6g}) with V = {near.energy:.6g}"
+            if near
+            else f"∇V(0, 0) = ({gx:.3g}, {gy:.3g}) and no minimum was found"
+        )
         raise ConfigError(f"the well's minimum must be at the origin, {where}; shift the potential")
     cp = land.classify(0.0, 0.0)
     if cp.kind != "minimum":
-        raise ConfigError(f"the origin is a {cp.kind} critical point of the potential (Hessian eigenvalues "
-                          f"{cp.eigenvalues[0]:.3g}, {cp.eigenvalues[1]:.3g}), not a non-degenerate minimum: the "
-                          "well's minimum must be at the origin")
+        raise ConfigError(
+            f"the origin is a {cp.kind} critical point of the potential (Hessian eigenvalues "
+            f"{cp.eigenvalues[0]:.3g}, {cp.eigenvalues[1]:.3g}), not a non-degenerate minimum: the "
+            "well's minimum must be at the origin"
+        )
     if abs(v0) > 1e-14 * max([1.0] + [abs(p.energy) for p in points]):
         raise ConfigError(f"the well's minimum must have V = 0, but V(0, 0) = {v0!r}; subtract it from the potential")
 
@@ -334,8 +345,10 @@ def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> floa
             break
         r_max *= 4
     else:
-        raise ConfigError(f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
-                          f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits")
+        raise ConfigError(
+            f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
+            f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits"
+        )
     dr = r[1] - r[0]
     with np.errstate(all="ignore"):
         tau = X * gy - Y * gx  # ∂V/∂θ
@@ -389,8 +402,9 @@ def _polish(land: Landscape, x, y, energy: float, corner: bool, iterations: int 
 
 
 # -- exits -----------------------------------------------------------------------------------------------
-def _descend(land: Landscape, x0: float, y0: float, r_out: float,
-             minima: Sequence[CriticalPoint]) -> tuple[float, float, bool]:
+def _descend(
+    land: Landscape, x0: float, y0: float, r_out: float, minima: Sequence[CriticalPoint]
+) -> tuple[float, float, bool]:
     """Follow ẋ = −∇V/(1 + |∇V|) from (x0, y0): (end x, end y, True if it passed r_out).
 
     Stops beyond r_out, within 1e-6 (1 + |m|) of a known minimum m, where |∇V| falls below 1e-10, at t = 1e5 or
@@ -437,9 +451,11 @@ def _descend(land: Landscape, x0: float, y0: float, r_out: float,
     except _GiveUp as e:
         return float(e.args[0][0]), float(e.args[0][1]), False
     except _NotFinite as e:
-        raise ConfigError(f"the potential or its gradient is not finite at ({e.args[0][0]:.6g}, {e.args[0][1]:.6g}) "
-                          f"on the steepest descent from the saddle near ({x0:.6g}, {y0:.6g}): give a potential that "
-                          "is finite and real in the plane around the well and its exits") from None
+        raise ConfigError(
+            f"the potential or its gradient is not finite at ({e.args[0][0]:.6g}, {e.args[0][1]:.6g}) "
+            f"on the steepest descent from the saddle near ({x0:.6g}, {y0:.6g}): give a potential that "
+            "is finite and real in the plane around the well and its exits"
+        ) from None
     xe, ye = sol.y[:, -1]
     return float(xe), float(ye), bool(sol.t_events[0].size)
 
@@ -484,8 +500,9 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
         h = 1e-5 * s.distance
         if s.energy not in r_nr:
             value = no_return_radius(land, s.energy, scale)
-            r_nr.update({p.energy: value for p in saddles
-                         if abs(p.energy - s.energy) <= 1e-12 * max(1.0, abs(s.energy))})
+            r_nr.update(
+                {p.energy: value for p in saddles if abs(p.energy - s.energy) <= 1e-12 * max(1.0, abs(s.energy))}
+            )
         r_out = max(r_nr[s.energy], 1.5 * s.distance)
         pair = []
         for sign in (1, -1):
@@ -495,10 +512,12 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
                 continue
             hit = [i for i, m in enumerate(minima) if math.hypot(xe - m.x, ye - m.y) < 1e-4 * (1 + m.distance)]
             if not hit:
-                raise ConfigError(f"the steepest descent from the saddle at ({s.x:.6g}, {s.y:.6g}) (V = "
-                                  f"{s.energy:.6g}) ends at ({xe:.6g}, {ye:.6g}), neither a minimum nor infinity: "
-                                  "cannot tell whether orbits leave through it; give `critical_energy` and "
-                                  "`exits` in [system]")
+                raise ConfigError(
+                    f"the steepest descent from the saddle at ({s.x:.6g}, {s.y:.6g}) (V = "
+                    f"{s.energy:.6g}) ends at ({xe:.6g}, {ye:.6g}), neither a minimum nor infinity: "
+                    "cannot tell whether orbits leave through it; give `critical_energy` and "
+                    "`exits` in [system]"
+                )
             pair.append(("min", hit[0]))
         ends.append(pair)
     uf = _Union()
@@ -536,6 +555,7 @@ def find_exits(land: Landscape, points: Sequence[CriticalPoint], scale: float) -
 
 def _channel_order(exits):
     """Exits by ascending polar angle in [0, 2π) (then distance): channel k is exits[k]."""
+
     def angle(e):
         a = math.atan2(e.y, e.x) % (2 * math.pi)
         return 0.0 if a > 2 * math.pi - 1e-12 else a
@@ -544,8 +564,9 @@ def _channel_order(exits):
 
 
 # -- Ω ---------------------------------------------------------------------------------------------------
-def check_omega(land: Landscape, radius: float, critical_energy: float, exits: Sequence[Exit],
-                n: int = 601, eta: float = 1e-3) -> str | None:
+def check_omega(
+    land: Landscape, radius: float, critical_energy: float, exits: Sequence[Exit], n: int = 601, eta: float = 1e-3
+) -> str | None:
     """None if the disk r ≤ radius contains the well's part of {V < E_c} and meets no other part; else why not.
 
     Checked on an n × n grid over [−1.5 radius, 1.5 radius]² at the level E_c (1 − eta) (so that the parts
@@ -567,14 +588,13 @@ def check_omega(land: Landscape, radius: float, critical_energy: float, exits: S
     if well[0, :].any() or well[-1, :].any() or well[:, 0].any() or well[:, -1].any():
         return f"the well's part of V < E_c reaches beyond r = {L:.4g}"
     if r[well].max() > radius + 2 * h:
-        return (f"the well's part of V < E_c reaches r = {r[well].max():.4g} > {radius:.4g}")
+        return f"the well's part of V < E_c reaches r = {r[well].max():.4g} > {radius:.4g}"
     other = inside & ~well & (r < radius - 2 * h)
     for e in exits:
         other &= np.hypot(X - e.x, Y - e.y) > 0.05 * radius
     if other.any():
         k = np.argmax(other)
-        return (f"the disk r ≤ {radius:.4g} meets another part of V < E_c, e.g. at "
-                f"({X.flat[k]:.4g}, {Y.flat[k]:.4g})")
+        return f"the disk r ≤ {radius:.4g} meets another part of V < E_c, e.g. at ({X.flat[k]:.4g}, {Y.flat[k]:.4g})"
     return None
 
 
@@ -604,10 +624,13 @@ def _given_exits(land: Landscape, exits) -> tuple[Exit, ...]:
         gx, gy = (float(g) for g in land.gradient(vals[0], vals[1]))
         hess = max((abs(float(h)) for h in land.hessian(vals[0], vals[1])), default=0.0)
         r = math.hypot(vals[0], vals[1])
-        if not (math.isfinite(v) and math.isfinite(gx) and math.isfinite(gy)) or \
-                math.hypot(gx, gy) > GIVEN_TOL * (1.0 + hess * r + abs(v)):
-            raise ConfigError(f"exits[{k}] = {e!r} is not a critical point of V (|∇V| = {math.hypot(gx, gy):.3g}, "
-                              f"V = {v:.10g} there): an exit is a saddle orbits leave through, where ∇V = 0")
+        if not (math.isfinite(v) and math.isfinite(gx) and math.isfinite(gy)) or math.hypot(gx, gy) > GIVEN_TOL * (
+            1.0 + hess * r + abs(v)
+        ):
+            raise ConfigError(
+                f"exits[{k}] = {e!r} is not a critical point of V (|∇V| = {math.hypot(gx, gy):.3g}, "
+                f"V = {v:.10g} there): an exit is a saddle orbits leave through, where ∇V = 0"
+            )
         if abs(v - energy) > GIVEN_TOL * max(1.0, abs(v)):
             raise ConfigError(f"exits[{k}] = {e!r}: its energy {energy!r} is not V there, {v!r}")
         out.append(Exit(vals[0], vals[1], energy))
@@ -625,23 +648,30 @@ def _derived_exits(land: Landscape) -> tuple[tuple[CriticalPoint, ...], str, tup
     bad = [p for p in points if p.kind == "degenerate" and p.energy <= top]
     if bad:
         p = bad[0]
-        raise ConfigError(f"degenerate critical point at ({p.x:.6g}, {p.y:.6g}) with V = {p.energy:.6g} "
-                          f"(Hessian eigenvalues {p.eigenvalues[0]:.3g}, {p.eigenvalues[1]:.3g}): cannot tell "
-                          "whether orbits from the well leave through it; give `critical_energy` and `exits` "
-                          "in [system]")
+        raise ConfigError(
+            f"degenerate critical point at ({p.x:.6g}, {p.y:.6g}) with V = {p.energy:.6g} "
+            f"(Hessian eigenvalues {p.eigenvalues[0]:.3g}, {p.eigenvalues[1]:.3g}): cannot tell "
+            "whether orbits from the well leave through it; give `critical_energy` and `exits` "
+            "in [system]"
+        )
     if not found:
         listed = ", ".join(f"{p.kind} at ({p.x:.4g}, {p.y:.4g}) V = {p.energy:.4g}" for p in points) or "none"
-        raise ConfigError(f"no exit: the potential has no saddle through which orbits from the well reach "
-                          f"infinity (critical points: {listed}); an escape over an asymptotic threshold, with no "
-                          "saddle, has no exit to give")
+        raise ConfigError(
+            f"no exit: the potential has no saddle through which orbits from the well reach "
+            f"infinity (critical points: {listed}); an escape over an asymptotic threshold, with no "
+            "saddle, has no exit to give"
+        )
     return points, method, found
 
 
 def _same_exits(a: Sequence[Exit], b: Sequence[Exit]) -> bool:
     """The same saddles (positions and energies within GIVEN_TOL), whatever the order."""
+
     def close(e, f):
-        return (math.hypot(e.x - f.x, e.y - f.y) <= GIVEN_TOL * (1 + e.distance) * 100
-                and abs(e.energy - f.energy) <= GIVEN_TOL * max(1.0, abs(f.energy)))
+        return math.hypot(e.x - f.x, e.y - f.y) <= GIVEN_TOL * (1 + e.distance) * 100 and abs(
+            e.energy - f.energy
+        ) <= GIVEN_TOL * max(1.0, abs(f.energy))
+
     return len(a) == len(b) and all(any(close(e, f) for f in b) for e in a)
 
 
@@ -649,8 +679,9 @@ def _show_exits(exits: Sequence[Exit]) -> str:
     return "[" + ", ".join(f"[{e.x:.6g}, {e.y:.6g}, {e.energy:.6g}]" for e in exits) + "]"
 
 
-def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None = None,
-           omega_radius: float | None = None) -> Derivation:
+def derive(
+    expr, *, critical_energy: float | None = None, exits: Sequence | None = None, omega_radius: float | None = None
+) -> Derivation:
     """Derive the critical points, exits, E_c and Ω of a potential (module docstring), with overrides.
 
     Parameters
@@ -695,8 +726,10 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
         except ConfigError:
             derived = None
         if derived is not None and not _same_exits(found, derived):
-            raise ConfigError(f"exits {_show_exits(found)} contradict the derivation, which finds the exits "
-                              f"{_show_exits(derived)}; leave `exits` out of [system] (it is derived) or correct it")
+            raise ConfigError(
+                f"exits {_show_exits(found)} contradict the derivation, which finds the exits "
+                f"{_show_exits(derived)}; leave `exits` out of [system] (it is derived) or correct it"
+            )
     else:
         points, method, found = _derived_exits(land)
     lowest = min(e.energy for e in found)
@@ -705,15 +738,18 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
         raise ConfigError(f"critical_energy must be a finite number > 0, got {ec!r}")
     if abs(ec - lowest) > GIVEN_TOL * max(1.0, abs(lowest)):
         source = "given" if exits is not None else "derived"
-        raise ConfigError(f"critical_energy = {ec!r} contradicts the exits: E_c is the lowest exit's energy, "
-                          f"{lowest!r} (exits {source}); leave `critical_energy` out of [system] or correct it")
+        raise ConfigError(
+            f"critical_energy = {ec!r} contradicts the exits: E_c is the lowest exit's energy, "
+            f"{lowest!r} (exits {source}); leave `critical_energy` out of [system] or correct it"
+        )
     at_ec = [e for e in found if e.energy <= ec * (1 + 1e-12)] or list(found)
     if omega_radius is None:
         omega = max(e.distance for e in at_ec)
         why = check_omega(land, omega, ec, found)
         if why:
-            raise ConfigError(f"Ω cannot be derived as a disk about the origin ({why}); give `omega_radius` in "
-                              "[system]")
+            raise ConfigError(
+                f"Ω cannot be derived as a disk about the origin ({why}); give `omega_radius` in [system]"
+            )
     else:
         omega = float(omega_radius)
         if not (math.isfinite(omega) and omega > 0):
@@ -722,10 +758,25 @@ def derive(expr, *, critical_energy: float | None = None, exits: Sequence | None
         if why:
             guess = max(e.distance for e in at_ec)
             derived_omega = "" if check_omega(land, guess, ec, found) else f"; the derivation finds {guess:.10g}"
-            raise ConfigError(f"omega_radius = {omega!r} is not a radius of Ω, which must hold the well's part of "
-                              f"{{V < E_c}} and meet no other part: {why}{derived_omega}")
+            raise ConfigError(
+                f"omega_radius = {omega!r} is not a radius of Ω, which must hold the well's part of "
+                f"{{V < E_c}} and meet no other part: {why}{derived_omega}"
+            )
     return Derivation(points, found, ec, omega, method, time.perf_counter() - t0)
 
 
-__all__ = ["CriticalPoint", "DEGENERATE", "Derivation", "Landscape", "MAX_DESCENT_STEPS", "NO_RETURN_MARGIN",
-           "SEARCH_RADIUS", "check_omega", "check_well", "critical_points", "derive", "find_exits", "no_return_radius"]
+__all__ = [
+    "CriticalPoint",
+    "DEGENERATE",
+    "Derivation",
+    "Landscape",
+    "MAX_DESCENT_STEPS",
+    "NO_RETURN_MARGIN",
+    "SEARCH_RADIUS",
+    "check_omega",
+    "check_well",
+    "critical_points",
+    "derive",
+    "find_exits",
+    "no_return_radius",
+]

@@ -8,11 +8,13 @@ All quantities are in the model's natural units (unit mass; time t, energy E).
 Numeric helpers work on numpy arrays; the heyoka expressions are built lazily
 by :func:`equations` so that importing this module does not import heyoka.
 """
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 

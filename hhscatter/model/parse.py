@@ -20,20 +20,36 @@ derivation (:mod:`hhscatter.model.derive`) works on exact polynomials.
 
 sympy is imported on first use (it takes ~0.3 s to import).
 """
+
 from __future__ import annotations
 
 import ast
 import keyword
 import math
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from hhscatter.errors import ConfigError
 
 #: the functions a potential may call: name → number of arguments (all integrated by heyoka)
 FUNCTIONS = {
-    "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1, "atan2": 2,
-    "sinh": 1, "cosh": 1, "tanh": 1, "asinh": 1, "acosh": 1, "atanh": 1,
-    "exp": 1, "log": 1, "sqrt": 1, "erf": 1,
+    "sin": 1,
+    "cos": 1,
+    "tan": 1,
+    "asin": 1,
+    "acos": 1,
+    "atan": 1,
+    "atan2": 2,
+    "sinh": 1,
+    "cosh": 1,
+    "tanh": 1,
+    "asinh": 1,
+    "acosh": 1,
+    "atanh": 1,
+    "exp": 1,
+    "log": 1,
+    "sqrt": 1,
+    "erf": 1,
 }
 #: the names a potential may use besides its parameters
 VARIABLES = ("x", "y")
@@ -97,8 +113,10 @@ def check_params(params: Mapping[str, Any] | None) -> dict[str, float]:
         if not isinstance(name, str) or not name.isidentifier() or keyword.iskeyword(name) or name.startswith("_"):
             raise ConfigError(f"system parameter name {name!r} is not a plain identifier")
         if name in VARIABLES or name in CONSTANTS or name in FUNCTIONS:
-            raise ConfigError(f"system parameter name {name!r} is reserved (the variables x, y, the constant pi "
-                              f"and the functions {', '.join(FUNCTIONS)})")
+            raise ConfigError(
+                f"system parameter name {name!r} is reserved (the variables x, y, the constant pi "
+                f"and the functions {', '.join(FUNCTIONS)})"
+            )
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"system parameter {name!r} must be a number, got {value!r}")
         if not math.isfinite(value):
@@ -138,9 +156,11 @@ class _Walker:
             return sp.Integer(node.value) if isinstance(node.value, int) else _rational(node.value)
         if isinstance(node, ast.Name):
             if node.id not in self.names:
-                raise ConfigError(f"potential: unknown symbol {node.id!r} (allowed: x, y, pi and the parameters "
-                                  f"{sorted(set(self.names) - {'x', 'y', 'pi'}) or 'none declared'}; "
-                                  "declare a parameter in [system.params])")
+                raise ConfigError(
+                    f"potential: unknown symbol {node.id!r} (allowed: x, y, pi and the parameters "
+                    f"{sorted(set(self.names) - {'x', 'y', 'pi'}) or 'none declared'}; "
+                    "declare a parameter in [system.params])"
+                )
             return self.names[node.id]
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
             v = self(node.operand)
@@ -160,8 +180,10 @@ class _Walker:
             if b.is_number and (not b.is_real or abs(float(b)) > MAX_EXPONENT):
                 raise ConfigError(f"potential: the exponent {b} is out of range (|exponent| ≤ {MAX_EXPONENT})")
             if a.is_number and b.is_number and _log2_abs(a) * abs(float(b)) > MAX_CONSTANT_BITS:
-                raise ConfigError(f"potential: the constant {ast.unparse(node)[:60]!r} is out of range (beyond a "
-                                  f"double's ≈ 1.8e308 or below its smallest normal number)")
+                raise ConfigError(
+                    f"potential: the constant {ast.unparse(node)[:60]!r} is out of range (beyond a "
+                    f"double's ≈ 1.8e308 or below its smallest normal number)"
+                )
             return a**b
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitXor):
             raise ConfigError("potential: '^' is not a power in Python syntax; write x**2, not x^2")
@@ -176,9 +198,11 @@ class _Walker:
             if len(node.args) != FUNCTIONS[name]:
                 raise ConfigError(f"potential: {name}() takes {FUNCTIONS[name]} argument(s), got {len(node.args)}")
             return self.functions[name](*(self(a) for a in node.args))
-        raise ConfigError(f"potential: {type(node).__name__} is not allowed in a potential "
-                          f"({ast.unparse(node)[:60]!r}); use numbers, x, y, parameters, + - * / ** and "
-                          f"the functions {', '.join(FUNCTIONS)}")
+        raise ConfigError(
+            f"potential: {type(node).__name__} is not allowed in a potential "
+            f"({ast.unparse(node)[:60]!r}); use numbers, x, y, parameters, + - * / ** and "
+            f"the functions {', '.join(FUNCTIONS)}"
+        )
 
 
 def _log2_abs(v) -> float:
@@ -245,20 +269,26 @@ def _check_sympy(expr, names: set[str]):
     for node in sp.preorder_traversal(expr):
         if isinstance(node, sp.Symbol):
             if node.name not in {"x", "y", *names}:
-                raise ConfigError(f"potential: unknown symbol {node.name!r} (allowed: x, y and the parameters "
-                                  f"{sorted(names) or 'none declared'})")
+                raise ConfigError(
+                    f"potential: unknown symbol {node.name!r} (allowed: x, y and the parameters "
+                    f"{sorted(names) or 'none declared'})"
+                )
         elif isinstance(node, sp.Number):
             if not node.is_finite or not node.is_real:
                 raise ConfigError(f"potential: the constant {node} is not a finite real number")
             if _log2_abs(node) > MAX_CONSTANT_BITS:
-                raise ConfigError(f"potential: the constant {str(node)[:40]} is out of range (beyond a double's "
-                                  "≈ 1.8e308 or below its smallest normal number)")
+                raise ConfigError(
+                    f"potential: the constant {str(node)[:40]} is out of range (beyond a double's "
+                    "≈ 1.8e308 or below its smallest normal number)"
+                )
         elif isinstance(node, (sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow)):  # NumberSymbol: pi, E
             if isinstance(node, sp.Pow) and node.exp.is_number and abs(float(node.exp)) > MAX_EXPONENT:
                 raise ConfigError(f"potential: the exponent {node.exp} is out of range (|exponent| ≤ {MAX_EXPONENT})")
         elif not isinstance(node, allowed_functions):
-            raise ConfigError(f"potential: {type(node).__name__} ({str(node)[:60]!r}) is not allowed "
-                              f"(allowed functions: {', '.join(FUNCTIONS)})")
+            raise ConfigError(
+                f"potential: {type(node).__name__} ({str(node)[:60]!r}) is not allowed "
+                f"(allowed functions: {', '.join(FUNCTIONS)})"
+            )
     real = {s: sp.Symbol(s.name, real=True) for s in expr.free_symbols}
     return expr.xreplace(real)
 
@@ -313,8 +343,10 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
         free = used - called - set(VARIABLES) - set(CONSTANTS)
         missing = sorted(free - names)
         if missing and values:  # parameters declared, but not these: a missing value, not a stray name
-            raise ConfigError(f"potential: parameter(s) {missing} have no value; give them in [system.params] "
-                              f"(given: {sorted(names)})")
+            raise ConfigError(
+                f"potential: parameter(s) {missing} have no value; give them in [system.params] "
+                f"(given: {sorted(names)})"
+            )
         try:
             expr = _Walker(names)(tree)
         except RecursionError:
@@ -339,13 +371,17 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
         raise ConfigError(f"potential: parameter(s) {missing} have no value; give them in [system.params]")
     unused = sorted(names - used_names)
     if unused:
-        raise ConfigError(f"system parameter(s) {unused} are not used in the potential {str(expr)!r} "
-                          "(misspelt? remove them or use them)")
+        raise ConfigError(
+            f"system parameter(s) {unused} are not used in the potential {str(expr)!r} "
+            "(misspelt? remove them or use them)"
+        )
     if not ({s.name for s in expr.free_symbols} & set(VARIABLES)):
         raise ConfigError(f"potential: {str(expr)!r} depends on neither x nor y")
     if (d := degree_bound(expr)) > MAX_DEGREE:
-        raise ConfigError(f"potential: its degree is up to {d}, more than {MAX_DEGREE} (the derivation's cost grows "
-                          "steeply with the degree)")
+        raise ConfigError(
+            f"potential: its degree is up to {d}, more than {MAX_DEGREE} (the derivation's cost grows "
+            "steeply with the degree)"
+        )
     return expr
 
 
@@ -451,5 +487,19 @@ def _ordered(args):
     return sorted(args, key=sp.default_sort_key)
 
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_CONSTANT_BITS", "MAX_DEGREE", "MAX_DEPTH", "MAX_EXPONENT", "MAX_NODES", "VARIABLES", "check_params", "parse_potential", "substitute",
-           "symbols", "to_heyoka", "degree_bound"]
+__all__ = [
+    "CONSTANTS",
+    "FUNCTIONS",
+    "MAX_CONSTANT_BITS",
+    "MAX_DEGREE",
+    "MAX_DEPTH",
+    "MAX_EXPONENT",
+    "MAX_NODES",
+    "VARIABLES",
+    "check_params",
+    "parse_potential",
+    "substitute",
+    "symbols",
+    "to_heyoka",
+    "degree_bound",
+]

@@ -18,6 +18,7 @@ Examples
 >>> round(system_from_spec({"name": "henon_heiles"}).critical_energy, 12)
 0.166666666667
 """
+
 from __future__ import annotations
 
 import functools
@@ -38,7 +39,7 @@ SYSTEM_KEYS = {
     "critical_energy": "override: E_c, when the derivation cannot decide it",
     "omega_radius": "override: the radius of Ω (the closure rule's well), when the derivation cannot decide it",
     "exits": "override: the exits' saddles as [[x, y], ...] or [[x, y, energy], ...], when the derivation cannot "
-             "decide them",
+    "decide them",
 }
 OVERRIDES = ("critical_energy", "omega_radius", "exits")
 
@@ -58,8 +59,10 @@ def canonical_spec(spec: dict[str, Any] | System) -> dict[str, Any]:
         raise ConfigError(f"unknown [system] keys: {unknown}; allowed: {sorted(SYSTEM_KEYS)}")
     has_name, has_pot = spec.get("name") is not None, spec.get("potential") is not None
     if has_name == has_pot:
-        raise ConfigError("[system] needs exactly one of 'name' (a built-in) or 'potential' (an expression in x, y)"
-                          + (", not both" if has_name else ""))
+        raise ConfigError(
+            "[system] needs exactly one of 'name' (a built-in) or 'potential' (an expression in x, y)"
+            + (", not both" if has_name else "")
+        )
     out: dict[str, Any] = {}
     key = "name" if has_name else "potential"
     if not isinstance(spec[key], str) or not spec[key].strip():
@@ -79,10 +82,16 @@ def canonical_spec(spec: dict[str, Any] | System) -> dict[str, Any]:
     out["dissipation"] = diss
     if spec.get("exits") is not None:
         ex = spec["exits"]
-        ok = isinstance(ex, (list, tuple)) and ex and all(
-            isinstance(e, (list, tuple)) and len(e) in (2, 3) and all(
-                not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(float(v)) for v in e)
-            for e in ex)
+        ok = (
+            isinstance(ex, (list, tuple))
+            and ex
+            and all(
+                isinstance(e, (list, tuple))
+                and len(e) in (2, 3)
+                and all(not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(float(v)) for v in e)
+                for e in ex
+            )
+        )
         if not ok:
             raise ConfigError(f"system.exits must be a list of [x, y] or [x, y, energy] (finite numbers), got {ex!r}")
         out["exits"] = [[float(v) for v in e] for e in ex]

@@ -16,6 +16,7 @@ and the figures.
   embedded in another: headings demoted, plain-text tables fenced, bars escaped;
 * :func:`markdown_to_html` — Python-Markdown with the extensions the report needs.
 """
+
 from __future__ import annotations
 
 import math
@@ -97,8 +98,10 @@ def format_value(v, *, html: bool = False) -> str:
         if v.get("value") is None:
             return "—"
         if _is_num(v.get("lo")) and _is_num(v.get("hi")):
-            return (f"{format_number(v['value'], html=html)} [{format_number(v['lo'], html=html)}, "
-                    f"{format_number(v['hi'], html=html)}]")
+            return (
+                f"{format_number(v['value'], html=html)} [{format_number(v['lo'], html=html)}, "
+                f"{format_number(v['hi'], html=html)}]"
+            )
         return format_value_err(v.get("value"), v.get("err"))
     if isinstance(v, (list, tuple)):
         if len(v) <= 8 and all(_is_num(x) or isinstance(x, str) or x is None for x in v):
@@ -143,11 +146,16 @@ def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None, 
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         v = row_verdict(r, r.get("scale", scale))
-        cells = [r.get("study", "")] * study + [
-            quantity(r) if quantity else md_cell(r.get("quantity", "")),
-            md_cell(ours_cell(r))] + [md_cell(r.get("convention") or "—")] * conv + [
-            md_cell(format_value(r.get("paper"))),
-            verdict(v) if verdict else md_cell(v), md_cell(r.get("note") or "")]
+        cells = (
+            [r.get("study", "")] * study
+            + [quantity(r) if quantity else md_cell(r.get("quantity", "")), md_cell(ours_cell(r))]
+            + [md_cell(r.get("convention") or "—")] * conv
+            + [
+                md_cell(format_value(r.get("paper"))),
+                verdict(v) if verdict else md_cell(v),
+                md_cell(r.get("note") or ""),
+            ]
+        )
         out.append("| " + " | ".join(str(c) for c in cells) + " |")
     if not rows:
         out.append("| " + " | ".join(["—"] * study + ["no study outputs found", "", "", "", ""] + [""] * conv) + " |")
@@ -224,8 +232,9 @@ def markdown_to_html(text: str) -> str:
     """markdown_to_html(text) -> HTML by Python-Markdown (tables, fenced code, attribute lists, raw HTML kept)."""
     import markdown  # deferred: markdown loads on first use
 
-    return markdown.markdown(text, extensions=["tables", "fenced_code", "attr_list", "sane_lists"],
-                             output_format="html")
+    return markdown.markdown(
+        text, extensions=["tables", "fenced_code", "attr_list", "sane_lists"], output_format="html"
+    )
 
 
 def scripts_to_html(text: str) -> str:
@@ -251,7 +260,7 @@ def scripts_to_html(text: str) -> str:
                 j += 1
             if depth == 0:
                 tag = "sup" if text[i] == "^" else "sub"
-                out.append(f"<{tag}>{scripts_to_html(text[i + 2:j])}</{tag}>")
+                out.append(f"<{tag}>{scripts_to_html(text[i + 2 : j])}</{tag}>")
                 i = j + 1
                 continue
         out.append(text[i])

@@ -39,12 +39,13 @@ syntax on these pages), so a reference may stand inside ``$…$`` maths too.
 types by hand that are neither references nor declared conventions
 (``<!-- conventions: … -->``); the docs tests fail on any.
 """
+
 from __future__ import annotations
 
 import json
-import tomllib
 import math
 import re
+import tomllib
 from functools import lru_cache
 from pathlib import Path
 
@@ -64,8 +65,10 @@ __all__ = [
 
 #: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine); the bar may
 #: be written ``\|`` where the source is a Markdown table that other tools read as it is
-REF = re.compile(r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|\\]|\[[^\]]*\])+?)"
-                 r"\s*(?:\\?\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]")
+REF = re.compile(
+    r"\[\[\s*(?P<study>[\w-]+)(?:@(?P<scale>[\w-]+))?\s*:\s*(?P<path>(?:[^\]\[|\\]|\[[^\]]*\])+?)"
+    r"\s*(?:\\?\|\s*(?P<fmt>[^\]]+?)\s*)?\]\]"
+)
 
 
 class NumberRefError(ValueError):
@@ -97,8 +100,10 @@ def load_numbers(root: Path, study: str, scale: str | None = None) -> tuple[dict
     scale = scale or headline_scale(root, study)
     path = assets_dir(root, scale) / f"{study}.json"
     if not path.is_file():
-        raise NumberRefError(f"no committed numbers for study {study!r} at scale {scale!r} ({path.name} "
-                             f"missing from docs/studies/assets{'' if scale == 'quick' else '/' + scale})")
+        raise NumberRefError(
+            f"no committed numbers for study {study!r} at scale {scale!r} ({path.name} "
+            f"missing from docs/studies/assets{'' if scale == 'quick' else '/' + scale})"
+        )
     return _load(str(path), path.stat().st_mtime), scale
 
 
@@ -171,8 +176,7 @@ def resolve(doc, path: str):
                 if not all(eq for _, eq, _ in conds):
                     raise NumberRefError(f"selector {p}: write [index], [field=value] or [field=value,field=value]")
                 conds = [(f.strip(), w.strip()) for f, _, w in conds]
-                hits = [r for r in node if isinstance(r, dict)
-                        and all(f in r and _same(r[f], w) for f, w in conds)]
+                hits = [r for r in node if isinstance(r, dict) and all(f in r and _same(r[f], w) for f, w in conds)]
                 if len(hits) != 1:
                     raise NumberRefError(f"{'.'.join(seen)}{p}: {len(hits)} records match (need exactly one)")
                 node = hits[0]
@@ -298,8 +302,9 @@ def _interval(leaf, fmt: str) -> str:
     elif isinstance(leaf, (list, tuple)) and len(leaf) == 2:
         value, iv = leaf
     else:
-        raise NumberRefError(f"no interval here ({leaf!r:.60}): write path.to.x with a sibling x_interval, "
-                             "or a {value, interval} leaf")
+        raise NumberRefError(
+            f"no interval here ({leaf!r:.60}): write path.to.x with a sibling x_interval, or a {{value, interval}} leaf"
+        )
     nums = [value, *(iv or [])] if isinstance(iv, (list, tuple)) and len(iv) == 2 else None
     if nums is None or not all(_is_num(x) and math.isfinite(x) for x in nums):
         raise NumberRefError(f"no number or no interval here (value {value!r}, interval {iv!r})")
@@ -364,9 +369,11 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
     spans = _protected(out)
     for m in re.finditer(r"\[\[\s*[\w-]+(?:@[\w-]+)?\s*:", out):
         if not any(a <= m.start() < b for a, b in spans):
-            line = out[m.start():out.find("\n", m.start())][:80]
-            errors.append(f"{line}: not a reference the syntax reads ([[study[@scale]:path[|format]]]; a selector "
-                          "value may not hold brackets)")
+            line = out[m.start() : out.find("\n", m.start())][:80]
+            errors.append(
+                f"{line}: not a reference the syntax reads ([[study[@scale]:path[|format]]]; a selector "
+                "value may not hold brackets)"
+            )
     if errors:
         raise NumberRefError(f"{where or 'text'}: " + "; ".join(errors))
     return out
@@ -374,13 +381,17 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
 
 # -- numbers typed by hand --------------------------------------------------------------------------------------
 _CONVENTIONS = re.compile(r"<!--\s*conventions:(.*?)-->", re.S)
-_NUMBER = re.compile(r"(?<![\w.\-/−])[-−+]?(?:\d+(?:[.,]\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?:[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)?"
-                     r"(?![\w.]*\w)")
+_NUMBER = re.compile(
+    r"(?<![\w.\-/−])[-−+]?(?:\d+(?:[.,]\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?:[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)?"
+    r"(?![\w.]*\w)"
+)
 #: references to the paper's and the site's own parts ("Fig. 2", "Eq. (3)", "Eqs. (14)–(16)", "Table 1",
 #: "panel 2"), the paper's arXiv id and years (2023): numbers that name things, not results
-_NAMING = re.compile(r"(?:\b(?:Figs?|Eqs?|Sec|Secs|Table|Tables|Ref|App)\.?\s*\(?\d+[a-z]?\)?"
-                     r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|(?<![\d.])(?:19|20)\d\d(?![\d.,]\d|[²³])|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
-                     re.M)
+_NAMING = re.compile(
+    r"(?:\b(?:Figs?|Eqs?|Sec|Secs|Table|Tables|Ref|App)\.?\s*\(?\d+[a-z]?\)?"
+    r"(?:\s*(?:[–,-]|and|to)\s*\(?\d+[a-z]?\)?)*|arXiv:\d+\.\d+|(?<![\d.])(?:19|20)\d\d(?![\d.,]\d|[²³])|\(\d+\)(?=\s*[,.;:)–]|\s*$))",
+    re.M,
+)
 _LINK_TARGET = re.compile(r"\]\([^)]*\)|\]\[[^\]]*\]|\{[#.][^}]*\}|</?[a-zA-Z][^>]*>|\(eqn?:[\w-]+\)|fig:[\w-]+")
 #: small integers name counts, panels and exponents ("4 windows", "(2)", "t^2"): never a measured result here
 SMALL_INT = 12
@@ -408,7 +419,7 @@ def _as_float(tok: str):
     t = tok.replace("−", "-").replace(",", ".")
     sup = re.search(r"[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+$", t)
     if sup:
-        base, power = t[:sup.start()], sup.group(0).translate(str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-"))
+        base, power = t[: sup.start()], sup.group(0).translate(str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-"))
         # 10⁶ is a power of ten; 512² a grid of 512 × 512 (the number typed is 512)
         t = f"1e{power}" if base.endswith("10") and base.rstrip("×") in ("10", "1×10") else base
     try:
@@ -475,8 +486,9 @@ def stray_numbers(text: str, allowed: set[float] = frozenset()) -> list[tuple[in
         v = abs(v)
         if v == int(v) and v <= SMALL_INT and not re.search(r"[.,eE]", tok.lstrip("+-−")):
             continue
-        if _matches(v, allowed) or (tok.endswith(tuple("⁰¹²³⁴⁵⁶⁷⁸⁹")) and _matches(v, {10.0 ** k for k in
-                                                                                       range(-20, 21)})):
+        if _matches(v, allowed) or (
+            tok.endswith(tuple("⁰¹²³⁴⁵⁶⁷⁸⁹")) and _matches(v, {10.0**k for k in range(-20, 21)})
+        ):
             continue
         out.append((body.count("\n", 0, m.start()) + 1, tok))
     return out

@@ -9,6 +9,7 @@ physics: every number comes from a study's numbers JSON, so the report and
 the study outputs cannot disagree. Numbers and the paper-vs-ours tables are
 formatted by :mod:`hhscatter.publish.formatting`, as in the docs.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hhscatter.analysis.stats.verdicts import RULE, row_verdict
+from hhscatter.errors import StudyError
 from hhscatter.publish.formatting import (
     comparison_table,
     embed_markdown,
@@ -29,7 +31,6 @@ from hhscatter.publish.formatting import (
     markdown_to_html,
     md_cell,
 )
-from hhscatter.errors import StudyError
 from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary
 from hhscatter.studies.graph import GraphError, scales
@@ -81,8 +82,11 @@ def _study_files(root: Path, name: str, scale: str):
     out = root / name / "out" / scale
     assets = committed_assets(root, scale)
     pick = []
-    for here, there in ((out / f"{name}.png", assets / f"{name}.png"), (out / f"{name}.json", assets / f"{name}.json"),
-                        (out / "cost.json", assets / f"{name}.cost.json")):
+    for here, there in (
+        (out / f"{name}.png", assets / f"{name}.png"),
+        (out / f"{name}.json", assets / f"{name}.json"),
+        (out / "cost.json", assets / f"{name}.cost.json"),
+    ):
         pick.append(here if here.exists() else there if there.exists() else None)
     return tuple(pick)
 
@@ -115,8 +119,12 @@ def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
         doc = json.loads(nums.read_text()) if nums else None
         if doc is not None:
             study = load_study(info.name, scale, root=root)
-            study.verify_numbers(nums, doc, pick=lambda other: _study_files(root, other, scale)[1],
-                                 raw=nums.parent == root / info.name / "out" / scale)
+            study.verify_numbers(
+                nums,
+                doc,
+                pick=lambda other: _study_files(root, other, scale)[1],
+                raw=nums.parent == root / info.name / "out" / scale,
+            )
         sec = Section(info.name, info.title, info.summary, fig, doc, info.paper)
         sec.cost = json.loads(cost.read_text()) if cost else None
         sections.append(sec)
@@ -169,19 +177,26 @@ def commits_line(sections) -> str:
             by.setdefault(str(c), []).append(s.key)
     if not by:
         return ""
-    parts = [f"`{c.split('-')[0][:12]}`{' (uncommitted changes)' if c.endswith('-dirty') else ''}: "
-             f"{', '.join(names)}" for c, names in sorted(by.items(), key=lambda kv: -len(kv[1]))]
+    parts = [
+        f"`{c.split('-')[0][:12]}`{' (uncommitted changes)' if c.endswith('-dirty') else ''}: {', '.join(names)}"
+        for c, names in sorted(by.items(), key=lambda kv: -len(kv[1]))
+    ]
     return "Numbers made at commit " + "; ".join(parts) + "."
 
 
-BENCH_PARTS = (("bench", "Work–precision and throughput (`make bench`)"),
-               ("stress", "Numerical stress tests (`make stress`)"))
+BENCH_PARTS = (
+    ("bench", "Work–precision and throughput (`make bench`)"),
+    ("stress", "Numerical stress tests (`make stress`)"),
+)
 
 
 def _bench(root: Path, name: str = "bench"):
     """The summary.md (or None) and PNGs of the full-scale benchmark/stress output of the repository of the studies
     folder ``root`` (``benchmarks/out/<name>/full/``), else of the copy committed in docs/benchmarks/assets/<name>/."""
-    for out in (root.parent / "benchmarks" / "out" / name / "full", root.parent / "docs" / "benchmarks" / "assets" / name):
+    for out in (
+        root.parent / "benchmarks" / "out" / name / "full",
+        root.parent / "docs" / "benchmarks" / "assets" / name,
+    ):
         md = out / "summary.md"
         if md.exists():
             return md, sorted(out.glob("*.png"))
@@ -191,8 +206,11 @@ def _bench(root: Path, name: str = "bench"):
 def raw_runs_line(runs: dict) -> str:
     """raw_runs_line({key: {scene_hash, orbits, complete}}) -> one line naming the raw runs a study's numbers
     were made from, their completeness and scene hashes (checked by the analyze stage)."""
-    parts = [f"`{k}` ({r.get('orbits') or '?'} orbits, {'complete' if r.get('complete') else 'INCOMPLETE'}, "
-             f"scene {str(r.get('scene_hash'))[:10]}…)" for k, r in sorted(runs.items())]
+    parts = [
+        f"`{k}` ({r.get('orbits') or '?'} orbits, {'complete' if r.get('complete') else 'INCOMPLETE'}, "
+        f"scene {str(r.get('scene_hash'))[:10]}…)"
+        for k, r in sorted(runs.items())
+    ]
     return f"*Made from {len(runs)} raw run(s):* " + "; ".join(parts) + "."
 
 
@@ -203,22 +221,36 @@ def cost_rows(sections) -> list[dict]:
         if not s.cost:
             continue
         c = summary(s.cost)
-        rows.append({"study": s.key, "wall_h": c["wall_s"] / 3600, "cpu_h": c["cpu_s"] / 3600,
-                     "simulate_cpu_h": c["simulate_cpu_s"] / 3600, "orbits": c["orbits"], "rss_mb": c["rss_mb"]})
+        rows.append(
+            {
+                "study": s.key,
+                "wall_h": c["wall_s"] / 3600,
+                "cpu_h": c["cpu_s"] / 3600,
+                "simulate_cpu_h": c["simulate_cpu_s"] / 3600,
+                "orbits": c["orbits"],
+                "rss_mb": c["rss_mb"],
+            }
+        )
     return rows
 
 
 def cost_table(rows) -> str:
     """cost_table(rows of :func:`cost_rows`) -> Markdown table with a total row."""
-    out = ["| study | wall (h) | CPU (h) | of which simulate (h) | orbits integrated | peak RSS per process (MB) |",
-           "|---|---|---|---|---|---|"]
+    out = [
+        "| study | wall (h) | CPU (h) | of which simulate (h) | orbits integrated | peak RSS per process (MB) |",
+        "|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        out.append(f"| {r['study']} | {r['wall_h']:.2f} | {r['cpu_h']:.2f} | {r['simulate_cpu_h']:.2f} | "
-                   f"{r['orbits']:.3g} | {r['rss_mb']:.0f} |")
+        out.append(
+            f"| {r['study']} | {r['wall_h']:.2f} | {r['cpu_h']:.2f} | {r['simulate_cpu_h']:.2f} | "
+            f"{r['orbits']:.3g} | {r['rss_mb']:.0f} |"
+        )
     if rows:
-        out.append(f"| **total** | **{sum(r['wall_h'] for r in rows):.2f}** | **{sum(r['cpu_h'] for r in rows):.2f}** |"
-                   f" {sum(r['simulate_cpu_h'] for r in rows):.2f} | {sum(r['orbits'] for r in rows):.3g} | "
-                   f"{max(r['rss_mb'] for r in rows):.0f} |")
+        out.append(
+            f"| **total** | **{sum(r['wall_h'] for r in rows):.2f}** | **{sum(r['cpu_h'] for r in rows):.2f}** |"
+            f" {sum(r['simulate_cpu_h'] for r in rows):.2f} | {sum(r['orbits'] for r in rows):.3g} | "
+            f"{max(r['rss_mb'] for r in rows):.0f} |"
+        )
     return "\n".join(out) + "\n"
 
 
@@ -246,6 +278,7 @@ def _count_line(rows):
 def _rows_table(rows, html_verdicts: bool) -> str:
     """The paper-vs-ours rows of several studies (:func:`hhscatter.publish.formatting.comparison_table`); in the HTML
     flavour the verdicts are coloured spans."""
+
     def verdict(v):
         cls = _verdict_class(v)
         return f'<span class="{cls}">{html.escape(v)}</span>' if html_verdicts and cls else md_cell(v)
@@ -262,29 +295,47 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
     """
     paper_rows, beyond_rows = split_rows(comparison_rows(sections), sections)
     prov = _provenance(sections)
-    lines = [f"# hhscatter reproduction report ({scale} scale)", "",
-             "Reproduction of L. Burton, H. Dullin, E. G. Altmann, *Probabilistic description of dissipative "
-             "chaotic scattering*, arXiv:2308.13555 (2023) (Hénon–Heiles with linear "
-             "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
-             "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: "
-             f"{RULE} The paper's numbers are in the authors' "
-             "convention; the column *convention (ours)* says how each of ours was made (\"authors'\" marks a row "
-             "made in the authors' own convention). \"Differs\" is kept for differences that survive the authors' "
-             "convention; one that does not reads \"differs in our convention only\" and is not counted as a "
-             "difference.", "",
-             f"Generated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}; "
-             f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str) and k != 'git_commit')}. "
-             f"{commits_line(sections)}", "",
-             "## The paper's numbers beside ours", "", _count_line(paper_rows), "",
-             _rows_table(paper_rows, html_verdicts), "",
-             "## Beyond the paper: checks and numbers the paper does not state", "", _count_line(beyond_rows), "",
-             _rows_table(beyond_rows, html_verdicts)]
+    lines = [
+        f"# hhscatter reproduction report ({scale} scale)",
+        "",
+        "Reproduction of L. Burton, H. Dullin, E. G. Altmann, *Probabilistic description of dissipative "
+        "chaotic scattering*, arXiv:2308.13555 (2023) (Hénon–Heiles with linear "
+        "drag), with exact event times from heyoka's Taylor integrator. Every number below is read from the "
+        "studies' numbers JSON files; see `make help` for the targets that made them. Verdicts: "
+        f"{RULE} The paper's numbers are in the authors' "
+        'convention; the column *convention (ours)* says how each of ours was made ("authors\'" marks a row '
+        "made in the authors' own convention). \"Differs\" is kept for differences that survive the authors' "
+        'convention; one that does not reads "differs in our convention only" and is not counted as a '
+        "difference.",
+        "",
+        f"Generated {_dt.datetime.now(_dt.UTC):%Y-%m-%d %H:%M UTC}; "
+        f"versions: {', '.join(f'{k} {v}' for k, v in prov.items() if isinstance(v, str) and k != 'git_commit')}. "
+        f"{commits_line(sections)}",
+        "",
+        "## The paper's numbers beside ours",
+        "",
+        _count_line(paper_rows),
+        "",
+        _rows_table(paper_rows, html_verdicts),
+        "",
+        "## Beyond the paper: checks and numbers the paper does not state",
+        "",
+        _count_line(beyond_rows),
+        "",
+        _rows_table(beyond_rows, html_verdicts),
+    ]
     costs = cost_rows(sections)
     if costs:
-        lines += ["", f"## What it cost ({scale} scale)", "",
-                  "Measured by the study stages (`studies/<name>/out/<scale>/cost.json`): wall and CPU time of "
-                  "simulate + analyze + plot (CPU includes the worker processes), orbits integrated, and the peak "
-                  "resident memory of one process.", "", cost_table(costs)]
+        lines += [
+            "",
+            f"## What it cost ({scale} scale)",
+            "",
+            "Measured by the study stages (`studies/<name>/out/<scale>/cost.json`): wall and CPU time of "
+            "simulate + analyze + plot (CPU includes the worker processes), orbits integrated, and the peak "
+            "resident memory of one process.",
+            "",
+            cost_table(costs),
+        ]
     for group, of_paper in (("Figures of the paper", True), ("Beyond the paper", False)):
         lines += ["", f"## {group}", ""]
         for s in (s for s in sections if bool(s.paper) == of_paper):
@@ -325,10 +376,13 @@ pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 def render_html(sections, scale, root) -> str:
     """render_html(sections, scale, root) -> one self-contained HTML page: the report's Markdown (figures as
     data URIs) rendered by Python-Markdown."""
-    body = markdown_to_html(render_markdown(sections, scale, root, lambda path, name: _img_uri(path),
-                                            html_verdicts=True))
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
-            f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n")
+    body = markdown_to_html(
+        render_markdown(sections, scale, root, lambda path, name: _img_uri(path), html_verdicts=True)
+    )
+    return (
+        f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
+        f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n"
+    )
 
 
 def build_report(scale: str = "quick", out: Path | None = None, root: Path | None = None) -> dict:

@@ -14,6 +14,7 @@ chunk, so the client's bandwidth and memory do not grow with N.
 
 Install the optional extra: ``pip install 'hhscatter[dask]'``.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -44,8 +45,10 @@ def check_scheduler(scheduler: str, workers: int | None) -> None:
         return
     scheme = scheduler.split("://", 1)[0] if "://" in scheduler else None
     if scheme not in SCHEMES:
-        raise ConfigError(f"scheduler must be 'local' or an address like tcp://host:8786 (protocols: "
-                         f"{', '.join(SCHEMES)}), got {scheduler!r}")
+        raise ConfigError(
+            f"scheduler must be 'local' or an address like tcp://host:8786 (protocols: "
+            f"{', '.join(SCHEMES)}), got {scheduler!r}"
+        )
     if workers is not None:
         raise ConfigError("workers: the number of workers is the cluster's when --scheduler is an address")
 
@@ -67,8 +70,13 @@ def dask_client(scheduler: str, workers: int | None = None):
     )
 
     if scheduler == "local":
-        cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.ERROR)
+        cluster = LocalCluster(
+            n_workers=workers or default_workers(),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.ERROR,
+        )
         try:
             with Client(cluster) as client:
                 yield client

@@ -1,18 +1,17 @@
 """The output location of a run, checked and prepared before any work: empty, overwritten or resumed (the same
 scene, no part outside the plan), locked for one writer."""
+
 from __future__ import annotations
 
 import json
 import os
 import shutil
 
-
-from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
 from hhscatter.data.schema import TABLES
+from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
 from hhscatter.errors import ConfigError, OutputError
-from hhscatter.scene.grid import Grid
 from hhscatter.run.plan import SCENE_FILE, manifest_of, part_rel, points_of, tables_of
-
+from hhscatter.scene.grid import Grid
 
 
 def _diff(old: dict, new: dict) -> str:
@@ -22,8 +21,12 @@ def _diff(old: dict, new: dict) -> str:
 
 def _extra_parts(store, manifest) -> list[str]:
     """Part files under the table folders that the manifest does not plan (duplicates, junk, other runs)."""
-    planned = {part_rel(name, p["partition"], c) for name in manifest["tables"] for p in manifest["points"]
-               for c in range(-(-p["n"] // p["chunk_size"]))}
+    planned = {
+        part_rel(name, p["partition"], c)
+        for name in manifest["tables"]
+        for p in manifest["points"]
+        for c in range(-(-p["n"] // p["chunk_size"]))
+    }
     extra = []
     for name in TABLES:
         for f in store.files(name):
@@ -62,8 +65,7 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
         try:
             lock = store.lock()
         except LockedError as exc:
-            raise OutputError(f"out: {exc}; one writer per run directory: wait for it or use another --out") \
-                from None
+            raise OutputError(f"out: {exc}; one writer per run directory: wait for it or use another --out") from None
         except OSError as exc:
             raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
         # ours to remove on failure only if it was not there and still holds nothing but our lock
@@ -87,11 +89,11 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
         try:
             store.write_json(SCENE_FILE, doc)
         except OSError as exc:
-            raise OutputError(f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); "
-                             "nothing was computed") from None
+            raise OutputError(
+                f"out: cannot write {store.display(SCENE_FILE)} ({exc.strerror or exc}); nothing was computed"
+            ) from None
     except BaseException:
         if lock is not None and created:  # never a directory another writer made or holds
-
             shutil.rmtree(store.root, ignore_errors=True)
         elif lock is not None and not had_note:  # a refused folder keeps nothing of ours, not even the pid note
             try:
@@ -146,24 +148,39 @@ def _remove_run(store, entries) -> None:
     without manifest) is refused before anything is removed: OutputError naming the first foreign entry."""
     where = store.display()
     if not store.exists(SCENE_FILE):
-        raise OutputError(f"--overwrite: {where} holds no hhscatter run (no {SCENE_FILE}: its manifest) but "
-                          f"{len(entries)} entr{'y' if len(entries) == 1 else 'ies'} (first: {entries[0]}); "
-                          "--overwrite removes only what a run's manifest lists: empty it yourself or use another --out")
+        raise OutputError(
+            f"--overwrite: {where} holds no hhscatter run (no {SCENE_FILE}: its manifest) but "
+            f"{len(entries)} entr{'y' if len(entries) == 1 else 'ies'} (first: {entries[0]}); "
+            "--overwrite removes only what a run's manifest lists: empty it yourself or use another --out"
+        )
     try:
         man = json.loads(store.read_text(SCENE_FILE))["manifest"]
-        planned = {part_rel(name, p["partition"], c) for name in man["tables"] for p in man["points"]
-                   for c in range(-(-int(p["n"]) // int(p["chunk_size"])))}
+        planned = {
+            part_rel(name, p["partition"], c)
+            for name in man["tables"]
+            for p in man["points"]
+            for c in range(-(-int(p["n"]) // int(p["chunk_size"])))
+        }
     except (ValueError, KeyError, TypeError) as exc:
-        raise OutputError(f"--overwrite: {store.display(SCENE_FILE)} holds no readable run manifest ({exc!r}); "
-                          "--overwrite removes only what a run's manifest lists: empty the folder yourself or use "
-                          "another --out") from None
+        raise OutputError(
+            f"--overwrite: {store.display(SCENE_FILE)} holds no readable run manifest ({exc!r}); "
+            "--overwrite removes only what a run's manifest lists: empty the folder yourself or use "
+            "another --out"
+        ) from None
     foreign = [e for e in entries if e not in (*TABLES, SCENE_FILE) and not _ours(e)]
-    foreign += [f"{t}/{f}" for t in TABLES if store.is_dir(t) for f in store.files(t)
-                if f"{t}/{f}" not in planned and not _ours(f"{t}/{f}")]
+    foreign += [
+        f"{t}/{f}"
+        for t in TABLES
+        if store.is_dir(t)
+        for f in store.files(t)
+        if f"{t}/{f}" not in planned and not _ours(f"{t}/{f}")
+    ]
     if foreign:
-        raise OutputError(f"--overwrite: {where} holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} its "
-                          f"run's manifest does not list (first: {store.display(foreign[0])}); hhscatter removes "
-                          "only what it wrote: move them away, or use another --out. Nothing was removed")
+        raise OutputError(
+            f"--overwrite: {where} holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} its "
+            f"run's manifest does not list (first: {store.display(foreign[0])}); hhscatter removes "
+            "only what it wrote: move them away, or use another --out. Nothing was removed"
+        )
     for t in TABLES:
         for f in store.files(t):
             store.remove(f"{t}/{f}")

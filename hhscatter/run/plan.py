@@ -1,14 +1,12 @@
 """What a run plans and reports: chunks, tables, grid points, part-file paths, the manifest, the summary."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-
 from hhscatter.data.schema import part_name
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.scene import Scene
-
-
 
 SCENE_FILE = "scene.json"
 
@@ -44,8 +42,11 @@ class RunSummary:
     def event_failures_record(self) -> dict:
         """The ``event_failures`` entry of the run's scene.json: total, orbits redone, counts per chunk."""
         chunks = self.event_failures
-        return {"total": sum(c["failures"] for c in chunks.values()),
-                "orbits_redone": sum(c["orbits_redone"] for c in chunks.values()), "chunks": dict(sorted(chunks.items()))}
+        return {
+            "total": sum(c["failures"] for c in chunks.values()),
+            "orbits_redone": sum(c["orbits_redone"] for c in chunks.values()),
+            "chunks": dict(sorted(chunks.items())),
+        }
 
     def line(self) -> str:
         if self.n == 0 and self.chunks_skipped:
@@ -59,9 +60,13 @@ class RunSummary:
             f"{f', stopped {self.stopped}' if self.stopped else ''}"
             f" | wall {self.wall_seconds:.2f} s ({us:.2f} µs per orbit; {us_core:.2f} µs per orbit in the workers' chunks)"
             f" ({self.workers} worker{'s' if self.workers != 1 else ''}{where}{skipped})"
-            + (f"\nheyoka event-detection failures: {self.event_failures_record()['total']} in "
-               f"{len(self.event_failures)} chunk(s); {self.event_failures_record()['orbits_redone']} orbit(s) redone "
-               "on the long-double reference driver (scene.json: event_failures)" if self.event_failures else "")
+            + (
+                f"\nheyoka event-detection failures: {self.event_failures_record()['total']} in "
+                f"{len(self.event_failures)} chunk(s); {self.event_failures_record()['orbits_redone']} orbit(s) redone "
+                "on the long-double reference driver (scene.json: event_failures)"
+                if self.event_failures
+                else ""
+            )
         )
 
 
@@ -110,6 +115,10 @@ def manifest_of(points, tables) -> dict:
     complete run has are exactly part_rel(table, partition, chunk) for chunk < ceil(n/chunk_size), each
     carrying ``scene_hash`` and its orbit range in its metadata (:func:`hhscatter.data.read.run_parts`).
     """
-    return {"tables": list(tables),
-            "points": [{"partition": part, "scene_hash": h, "n": int(sc.n), "chunk_size": int(sc.chunk_size)}
-                       for sc, part, h in points]}
+    return {
+        "tables": list(tables),
+        "points": [
+            {"partition": part, "scene_hash": h, "n": int(sc.n), "chunk_size": int(sc.chunk_size)}
+            for sc, part, h in points
+        ],
+    }

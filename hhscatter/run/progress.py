@@ -1,12 +1,10 @@
 """Progress of a long run: a tqdm bar in a terminal or notebook, plain lines otherwise, nothing when asked."""
+
 from __future__ import annotations
 
 import importlib.util
 import sys
 import time
-
-
-
 
 
 class PlainProgress:
@@ -22,8 +20,12 @@ class PlainProgress:
         now = time.perf_counter()
         if now - self.last >= self.every or self.n >= self.total:
             self.last = now
-            print(f"{self.desc}: {self.n}/{self.total} orbits ({100 * self.n / max(self.total, 1):.0f} %), "
-                  f"{now - self.t0:.0f} s", file=self.file, flush=True)
+            print(
+                f"{self.desc}: {self.n}/{self.total} orbits ({100 * self.n / max(self.total, 1):.0f} %), "
+                f"{now - self.t0:.0f} s",
+                file=self.file,
+                flush=True,
+            )
 
     def close(self):
         pass
@@ -42,7 +44,9 @@ def progress_bar(progress, total, initial, desc):
         return _Silent()
 
     if sys.stderr.isatty() or importlib.util.find_spec("ipywidgets") is None:
-        from tqdm.std import tqdm  # text bar (tqdm.auto would warn in a kernel without ipywidgets)  # deferred: tqdm loads on first use
+        from tqdm.std import (
+            tqdm,  # text bar (tqdm.auto would warn in a kernel without ipywidgets)  # deferred: tqdm loads on first use
+        )
     else:
         from tqdm.auto import tqdm  # deferred: tqdm loads on first use
 

@@ -49,6 +49,7 @@ the process that started them (:func:`die_with_parent`); a Dask run whose
 cluster has had no worker for :data:`DASK_NO_WORKER_TIMEOUT` seconds fails with
 a :class:`RunError`.
 """
+
 from __future__ import annotations
 
 import json
@@ -57,10 +58,9 @@ import os
 import queue as queue_mod
 import time
 import uuid
-from typing import NamedTuple
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing.managers import SyncManager
-
+from typing import NamedTuple
 
 from hhscatter.data.store import Store
 from hhscatter.errors import ConfigError, RunError
@@ -72,7 +72,6 @@ from hhscatter.run.worker import chunk_complete, default_workers, die_with_paren
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
-
 
 
 class ChunkTask(NamedTuple):
@@ -117,9 +116,16 @@ def _drain(submit, wait_first, tasks, window, on_done, cancel):
         raise
 
 
-def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | None = None,
-             overwrite: bool = False, resume: bool = False, progress: bool | str = True,
-             scheduler: str | None = None) -> RunSummary:
+def simulate(
+    run: Scene | Grid,
+    out: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    overwrite: bool = False,
+    resume: bool = False,
+    progress: bool | str = True,
+    scheduler: str | None = None,
+) -> RunSummary:
     """Integrate an ensemble and write its tables (lifetimes, and sections/snapshots if asked) as Parquet.
 
     Every orbit runs to its end by exact events: escape at r = r_esc (then followed to r_far for the
@@ -176,14 +182,14 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ConfigError(f"workers must be an integer ≥ 1, got {workers!r}")
     if workers is not None and workers > WORKERS_MAX:
-        raise ConfigError(f"workers must be ≤ {WORKERS_MAX}, got {workers} (one process each, with its own compiled "
-                          "integrator)")
+        raise ConfigError(
+            f"workers must be ≤ {WORKERS_MAX}, got {workers} (one process each, with its own compiled integrator)"
+        )
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
         raise ConfigError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
     points = points_of(run)
     table_ics = None
     if points[0][0].ics is not None:
-
         scene = points[0][0]
         table_ics = read_ics_table(scene.ics)
         if len(table_ics[0]) != scene.n:
@@ -191,7 +197,6 @@ def simulate(run: Scene | Grid, out: str | os.PathLike[str], *, workers: int | N
         for sc, _ in points:
             check_ics(sc, table_ics[0])
     if scheduler is not None:
-
         check_scheduler(scheduler, workers)
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
@@ -242,13 +247,20 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
         done_orbits = n_total - sum(t.stop - t.start for t in todo)
         n_todo = len(todo)
     else:  # planned lazily: one task per chunk in flight, not per chunk of the run
-        todo = (ChunkTask(sj, chunk, start, stop, partition, h) for scene, partition, h in points
-                for sj in (scene.to_json(),) for chunk, start, stop in plan_chunks(scene))
+        todo = (
+            ChunkTask(sj, chunk, start, stop, partition, h)
+            for scene, partition, h in points
+            for sj in (scene.to_json(),)
+            for chunk, start, stop in plan_chunks(scene)
+        )
         done_orbits, n_todo = 0, n_chunks
 
     def args(task: ChunkTask):
-        ics = (None, None) if table_ics is None else (table_ics[0][task.start:task.stop],
-                                                      table_ics[1][task.start:task.stop])
+        ics = (
+            (None, None)
+            if table_ics is None
+            else (table_ics[0][task.start : task.stop], table_ics[1][task.start : task.stop])
+        )
         return (task.scene_json, task.chunk, task.start, task.stop, out_url, *ics, task.partition)
 
     t0 = time.perf_counter()
@@ -268,7 +280,6 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
         if not n_todo:
             summary.workers = 0
         elif scheduler is not None:
-
             with dask_client(scheduler, workers) as client:
                 summary.workers = sum(client.nthreads().values())
                 summary.backend = f"dask {scheduler}" if scheduler != "local" else "dask LocalCluster"
@@ -296,8 +307,9 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
 
 def _run_pool(workers, todo, args, on_done, on_progress=None):
     ctx = mp.get_context("spawn")  # no fork of a process holding LLVM/JIT state
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=die_with_parent,
-                               initargs=(os.getpid(),))
+    pool = ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=die_with_parent, initargs=(os.getpid(),)
+    )
     manager = None
     if on_progress is not None:
         manager = SyncManager(ctx=ctx)
@@ -320,9 +332,14 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
                 return done
 
     try:
-        _drain(lambda t: pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5]),
-               wait_first, todo, 2 * workers, on_done,
-               lambda fs: [f.cancel() for f in fs])
+        _drain(
+            lambda t: pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5]),
+            wait_first,
+            todo,
+            2 * workers,
+            on_done,
+            lambda fs: [f.cancel() for f in fs],
+        )
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
         if manager is not None:
@@ -353,6 +370,7 @@ def _run_dask(client, todo, args, on_done, name):
             elif time.monotonic() - alone_since > DASK_NO_WORKER_TIMEOUT:
                 raise RunError(
                     f"the Dask cluster has had no workers for {DASK_NO_WORKER_TIMEOUT:g} s; stopped. Finished "
-                    "part files are intact: start workers and rerun with --resume")
+                    "part files are intact: start workers and rerun with --resume"
+                )
 
     _drain(submit, wait_first, todo, window, on_done, lambda fs: client.cancel(fs))

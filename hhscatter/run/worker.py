@@ -1,5 +1,6 @@
 """The worker side of a run: integrate one (point, chunk) and write its part files; check a finished chunk;
 workers that die with the process that started them."""
+
 from __future__ import annotations
 
 import hashlib
@@ -12,16 +13,15 @@ import time
 
 import numpy as np
 
-from hhscatter.data.store import Store
-from hhscatter.data.schema import add_point_columns, provenance, to_arrow
 from hhscatter.data.read import read_meta, verify_part
+from hhscatter.data.schema import add_point_columns, provenance, to_arrow
+from hhscatter.data.store import Store
 from hhscatter.data.write import write_part
 from hhscatter.errors import RunIntegrityError
 from hhscatter.integrate.engine import run_chunk
+from hhscatter.run.plan import RunSummary, _decode, part_rel, tables_of
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene, scene_from_dict
-from hhscatter.run.plan import RunSummary, _decode, part_rel, tables_of
-
 
 
 def _chunk_ics(scene, start, stop, table_ics):
@@ -32,8 +32,18 @@ def _chunk_ics(scene, start, stop, table_ics):
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
 
 
-def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=None, ids=None, partition="",
-                  progress=None, scene_hash=None):
+def run_one_chunk(
+    scene_json: str,
+    chunk: int,
+    start: int,
+    stop: int,
+    out,
+    ics=None,
+    ids=None,
+    partition="",
+    progress=None,
+    scene_hash=None,
+):
     """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None,
     scene_hash=None) -> RunSummary.
 
@@ -90,7 +100,8 @@ def run_one_chunk(scene_json: str, chunk: int, start: int, stop: int, out, ics=N
         n_snapshots=len(res.snapshots["t"]),
         compute_seconds=elapsed,
         event_failures={key: {"failures": res.event_failures, "orbits_redone": len(res.redone)}}
-        if res.event_failures else {},
+        if res.event_failures
+        else {},
     )
 
 

@@ -36,6 +36,7 @@ The sweep thus compares paired ensembles, which removes the ensemble-to-
 ensemble noise from differences between points. Give points different seeds
 by running them as separate scenes if independent ensembles are wanted.
 """
+
 from __future__ import annotations
 
 import hashlib

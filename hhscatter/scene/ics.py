@@ -17,6 +17,7 @@ angles θ. Orbit i is therefore fixed by (seed, i) alone, whatever the chunk
 size or the number of workers, and its position is the same in both
 conventions.
 """
+
 from __future__ import annotations
 
 import math
@@ -127,8 +128,10 @@ def read_ics_table(path) -> tuple[np.ndarray, np.ndarray]:
     names = list(table.column_names)
     twice = sorted({c for c in names if names.count(c) > 1 and c in ("x", "y", "px", "py", "traj_id")})
     if twice:
-        raise ConfigError(f"ics: table {path} has column(s) {twice} more than once: which one holds the initial "
-                          "states is ambiguous; keep one of each")
+        raise ConfigError(
+            f"ics: table {path} has column(s) {twice} more than once: which one holds the initial "
+            "states is ambiguous; keep one of each"
+        )
     missing = [c for c in ("x", "y", "px", "py") if c not in table.column_names]
     if missing:
         raise ConfigError(f"ics: table {path} lacks column(s) {missing}; required: x, y, px, py")
@@ -170,7 +173,7 @@ def _column(table, name, kind) -> np.ndarray:
         out = np.frombuffer(arr.buffers()[1], dtype=np.float64, count=len(arr), offset=arr.offset * 8).copy()
         if arr.null_count:  # (nulls as NaN: refused as non-finite by the caller)
             valid = np.unpackbits(np.frombuffer(arr.buffers()[0], np.uint8), bitorder="little")
-            out[valid[arr.offset:arr.offset + len(arr)] == 0] = math.nan
+            out[valid[arr.offset : arr.offset + len(arr)] == 0] = math.nan
         return out
     if not pa.types.is_integer(t) or col.null_count:
         raise TypeError(f"column {name} of type {t} with {col.null_count} null(s)")
@@ -195,16 +198,20 @@ def check_ics(scene: Scene, states: np.ndarray) -> None:
     far = r > R_ESC_MAX * m.saddle_radius
     if far.any():
         i = int(np.argmax(far))
-        raise ConfigError(f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
-                         f"r = {r[i]:.3g}); energy conservation fails that far out")
+        raise ConfigError(
+            f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
+            f"r = {r[i]:.3g}); energy conservation fails that far out"
+        )
     with np.errstate(over="ignore", invalid="ignore"):
         e = m.energy(x, y, px, py)
     high = ~(e <= E0_MAX * m.critical_energy)
     if high.any():
         i = int(np.argmax(high))
-        raise ConfigError(f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
-                         f"{E0_MAX * m.critical_energy:.6g} (first: row {i}, E = {e[i]:.3g}; momenta too large: "
-                         "every orbit leaves at once, p² overflows near 1e308)")
+        raise ConfigError(
+            f"ics: {int(high.sum())} row(s) have an energy above {E0_MAX:g} E_c = "
+            f"{E0_MAX * m.critical_energy:.6g} (first: row {i}, E = {e[i]:.3g}; momenta too large: "
+            "every orbit leaves at once, p² overflows near 1e308)"
+        )
     if scene.gamma > 0:
         low = (e <= m.critical_energy) & (r < scene.r_esc)
         if low.any():
@@ -212,7 +219,8 @@ def check_ics(scene: Scene, states: np.ndarray) -> None:
             raise ConfigError(
                 f"ics: {int(low.sum())} row(s) start below E_c = {m.critical_energy:.10g} inside r_esc with drag "
                 f"γ = {scene.gamma:g} (first: row {i}, E = {e[i]:.6g}): such an orbit can never escape and never "
-                "crosses E_c from above, so it has no outcome; drop these rows (they are trapped from t = 0)")
+                "crosses E_c from above, so it has no outcome; drop these rows (they are trapped from t = 0)"
+            )
 
 
 def section_grid(model, energy: float, extent, shape):

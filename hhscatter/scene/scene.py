@@ -5,6 +5,7 @@ optionally ``[sections]``, ``[snapshots]`` and ``[scale.<name>]`` overrides)
 or built from CLI flags. Every bad value is refused before any work with a
 ``ConfigError`` naming the parameter and its allowed range.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -82,15 +83,18 @@ class SnapshotGrid(tuple):
     """
 
     def __new__(cls, start, stop, step):
-        start, stop, step = (_finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop),
-                                                                       ("step", step)))
+        start, stop, step = (
+            _finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop), ("step", step))
+        )
         if not step > 0:
             raise ConfigError(f"snapshots.step must be > 0, got {step}")
         count = math.floor((stop - start) / step + 0.5) + 1
         if count > SNAPSHOTS_MAX:
-            raise ConfigError(f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
-                             f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
-                             "in memory): use a larger step")
+            raise ConfigError(
+                f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
+                f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
+                "in memory): use a larger step"
+            )
         self = super().__new__(cls, (float(t) for t in np.arange(start, stop + 0.5 * step, step)))
         self.definition = {"start": start, "stop": stop, "step": step}
         return self
@@ -176,8 +180,10 @@ class SectionWindow:
         if not self.e_max > self.e_min:
             raise ConfigError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
         if self.stop and not (self.first_only or math.isfinite(self.t_to)):
-            raise ConfigError("sections.stop needs first_only = true or a finite t_to "
-                             "(otherwise the window never closes and the orbit is always needed)")
+            raise ConfigError(
+                "sections.stop needs first_only = true or a finite t_to "
+                "(otherwise the window never closes and the orbit is always needed)"
+            )
 
 
 @dataclass(frozen=True)
@@ -339,8 +345,10 @@ class Scene:
             except ValueError as exc:
                 raise ConfigError(str(exc)) from None
         if (self.omega, self.lam) != (1.0, 1.0):
-            raise ConfigError("omega and lam are Hénon–Heiles' scene keys: with a system give them in its params "
-                              "(system.params.omega, system.params.lam)")
+            raise ConfigError(
+                "omega and lam are Hénon–Heiles' scene keys: with a system give them in its params "
+                "(system.params.omega, system.params.lam)"
+            )
         model, spec = resolve(self.system)
         if isinstance(model, HenonHeiles) and model.hash_items() is None:
             object.__setattr__(self, "omega", model.omega)
@@ -374,18 +382,24 @@ class Scene:
         if gamma < 0:
             raise ConfigError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
         if gamma > GAMMA_MAX * m.frequency:
-            raise ConfigError(f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.frequency:g}, got {gamma:g} (beyond, "
-                             "the motion is overdamped: orbits settle within a fraction of a period)")
+            raise ConfigError(
+                f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.frequency:g}, got {gamma:g} (beyond, "
+                "the motion is overdamped: orbits settle within a fraction of a period)"
+            )
         if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
             raise ConfigError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")
         if self.n > N_MAX:
-            raise ConfigError(f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
-                             "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds")
+            raise ConfigError(
+                f"n must be ≤ {N_MAX:.0e} per run, got {self.n:.3g} (its lifetimes table alone would "
+                "need ≈ 90 bytes per orbit in memory when read): split it into runs with other seeds"
+            )
         if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
             raise ConfigError(f"seed must be an integer ≥ 0, got {self.seed!r}")
         if self.seed > SEED_MAX:
-            raise ConfigError(f"seed must be ≤ 2**63 − 1 = {SEED_MAX}, got {self.seed} (it is stored and read back as a "
-                              "64-bit integer)")
+            raise ConfigError(
+                f"seed must be ≤ 2**63 − 1 = {SEED_MAX}, got {self.seed} (it is stored and read back as a "
+                "64-bit integer)"
+            )
         tol = _finite("tol", self.tol)
         if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
             raise ConfigError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
@@ -393,8 +407,10 @@ class Scene:
         if t_max <= 0:
             raise ConfigError(f"t_max must be > 0, got {t_max}")
         if t_max > T_MAX_MAX / m.frequency:
-            raise ConfigError(f"t_max must be ≤ {T_MAX_MAX:g}/ω = {T_MAX_MAX / m.frequency:g}, got {t_max:g} (every orbit "
-                              "still inside at t_max is integrated all the way, at a cost ∝ t_max)")
+            raise ConfigError(
+                f"t_max must be ≤ {T_MAX_MAX:g}/ω = {T_MAX_MAX / m.frequency:g}, got {t_max:g} (every orbit "
+                "still inside at t_max is integrated all the way, at a cost ∝ t_max)"
+            )
         return gamma, t_max
 
     def _check_radii(self):
@@ -407,14 +423,18 @@ class Scene:
                 f"(outside the Lyapunov orbits), got {r_esc}"
             )
         if r_esc > R_ESC_MAX * m.saddle_radius:
-            raise ConfigError(f"r_esc must be ≤ {R_ESC_MAX:g} r_s = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
-                             "(energy conservation: far out |V| ≫ E and the energy error grows like tol·|V|/E)")
+            raise ConfigError(
+                f"r_esc must be ≤ {R_ESC_MAX:g} r_s = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
+                "(energy conservation: far out |V| ≫ E and the energy error grows like tol·|V|/E)"
+            )
         if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
             raise ConfigError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
         if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
-            raise ConfigError(f"r_far must be ≤ {R_FAR_MAX:g} r_s = {R_FAR_MAX * m.saddle_radius:g}, got "
-                             f"{self.r_far:g} (the range checked by the stress study; V heads for float64 "
-                             "overflow beyond)")
+            raise ConfigError(
+                f"r_far must be ≤ {R_FAR_MAX:g} r_s = {R_FAR_MAX * m.saddle_radius:g}, got "
+                f"{self.r_far:g} (the range checked by the stress study; V heads for float64 "
+                "overflow beyond)"
+            )
         if self.region not in REGIONS:
             raise ConfigError(f"region must be one of {REGIONS}, got {self.region!r}")
         # where orbits move: inside r_esc, escaped ones followed to r_far (drag, follow), square ICs in [−r_s, r_s]²
@@ -425,31 +445,42 @@ class Scene:
             what, reach = "the square region", math.sqrt(2.0) * m.saddle_radius
         bad = m.nonfinite_point(reach)
         if bad is not None:
-            raise ConfigError(f"system.potential: V or its gradient is not finite at ({bad[0]:.6g}, {bad[1]:.6g}), "
-                              f"inside r ≤ {reach:g} ({what}) where orbits move; give a potential that is finite "
-                              f"and real there, or a smaller {what}")
+            raise ConfigError(
+                f"system.potential: V or its gradient is not finite at ({bad[0]:.6g}, {bad[1]:.6g}), "
+                f"inside r ≤ {reach:g} ({what}) where orbits move; give a potential that is finite "
+                f"and real there, or a smaller {what}"
+            )
         if not isinstance(self.momentum, str) or self.momentum not in MOMENTA:
             raise ConfigError(f"momentum must be one of {MOMENTA}, got {self.momentum!r}")
         radius = _finite("radius", self.radius)
         if radius <= 0:
             raise ConfigError(f"radius must be > 0, got {radius}")
         if radius > r_esc:
-            raise ConfigError(f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
-                             "escaped already, and the sampler would reject almost every draw: V < E only "
-                             "holds near the well)")
+            raise ConfigError(
+                f"radius must be ≤ r_esc = {r_esc:g}, got {radius:g} (a disk point beyond r_esc has "
+                "escaped already, and the sampler would reject almost every draw: V < E only "
+                "holds near the well)"
+            )
         return r_esc
 
     def _check_chunks(self):
         """chunk_size (and the number of part files it makes) and batch_size."""
-        if not isinstance(self.chunk_size, (int, np.integer)) or isinstance(self.chunk_size, bool) \
-                or self.chunk_size <= 0:
+        if (
+            not isinstance(self.chunk_size, (int, np.integer))
+            or isinstance(self.chunk_size, bool)
+            or self.chunk_size <= 0
+        ):
             raise ConfigError(f"chunk_size must be an integer > 0, got {self.chunk_size!r}")
         if self.chunk_size > CHUNK_SIZE_MAX:
-            raise ConfigError(f"chunk_size must be ≤ {CHUNK_SIZE_MAX:.0e}, got {self.chunk_size:.3g} (a chunk's rows are "
-                              "held in memory until its part files are written)")
+            raise ConfigError(
+                f"chunk_size must be ≤ {CHUNK_SIZE_MAX:.0e}, got {self.chunk_size:.3g} (a chunk's rows are "
+                "held in memory until its part files are written)"
+            )
         if -(-self.n // self.chunk_size) > CHUNKS_MAX:
-            raise ConfigError(f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
-                             f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size")
+            raise ConfigError(
+                f"chunk_size {self.chunk_size} gives {-(-self.n // self.chunk_size)} chunks for "
+                f"n = {self.n}, more than {CHUNKS_MAX} part files per table: use a larger chunk_size"
+            )
         if self.batch_size is not None and (
             not isinstance(self.batch_size, (int, np.integer)) or not 1 <= self.batch_size <= 64
         ):
@@ -469,9 +500,11 @@ class Scene:
                     f"(no point of the region is accessible), got {energy}"
                 )
             if energy > E0_MAX * m.critical_energy:
-                raise ConfigError(f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
-                                 f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
-                                 "near 1e308)")
+                raise ConfigError(
+                    f"energy must be ≤ {E0_MAX:g} E_c = {E0_MAX * m.critical_energy:.6g}, got "
+                    f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
+                    "near 1e308)"
+                )
             if energy <= m.critical_energy:
                 what = "dissipative" if gamma > 0 else "conservative escape"
                 raise ConfigError(
@@ -482,17 +515,22 @@ class Scene:
                 raise ConfigError(
                     f"energy must exceed E_c = {m.critical_energy!r} by more than {EC_MARGIN:g} E_c, got {energy!r} "
                     f"(E0 − E_c = {energy - m.critical_energy:.3g}): a sampled initial energy |p|²/2 + V equals E0 "
-                    "only up to rounding, and an orbit that starts at or below E_c has settled before it starts")
+                    "only up to rounding, and an orbit that starts at or below E_c has settled before it starts"
+                )
             if isinstance(self.sections, SectionWindow) and self.sections.e_min > energy:
-                raise ConfigError(f"sections.e_min = {self.sections.e_min:g} is above E0 = {energy:g}: the energy "
-                                  "never rises above E0, so no crossing would be recorded")
+                raise ConfigError(
+                    f"sections.e_min = {self.sections.e_min:g} is above E0 = {energy:g}: the energy "
+                    "never rises above E0, so no crossing would be recorded"
+                )
         elif not isinstance(self.ics, (str, Path)) or not str(self.ics).strip():
             raise ConfigError(f"ics must be the path of a Parquet/CSV table, got {self.ics!r}")
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
         elif self.momentum != "tangential":
-            raise ConfigError(f"momentum = {self.momentum!r} is an option of region ICs and must not be given with "
-                             "ics: each orbit's momentum comes from its table row")
+            raise ConfigError(
+                f"momentum = {self.momentum!r} is an option of region ICs and must not be given with "
+                "ics: each orbit's momentum comes from its table row"
+            )
 
     def _check_recording(self, gamma, t_max, r_esc):
         """sections, snapshots (normalised to a sorted tuple), follow and continue_settled."""
@@ -501,10 +539,13 @@ class Scene:
             raise ConfigError("sections must be a SectionWindow or None")
         if self.snapshots is not None:
             if not isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOTS_MAX:
-                raise ConfigError(f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
-                                 "orbit writes one row per time; a chunk holds them in memory)")
-            snaps = self.snapshots if isinstance(self.snapshots, SnapshotGrid) else \
-                tuple(float(s) for s in self.snapshots)
+                raise ConfigError(
+                    f"snapshots: {len(self.snapshots)} times, more than {SNAPSHOTS_MAX} (every live "
+                    "orbit writes one row per time; a chunk holds them in memory)"
+                )
+            snaps = (
+                self.snapshots if isinstance(self.snapshots, SnapshotGrid) else tuple(float(s) for s in self.snapshots)
+            )
             if not snaps:
                 raise ConfigError("snapshots must be a non-empty list of times or omitted")
             if not all(math.isfinite(s) and 0 <= s <= t_max for s in snaps):
@@ -517,16 +558,20 @@ class Scene:
             if not isinstance(self.follow, Follow):
                 raise ConfigError("follow must be a Follow or None")
             if gamma > 0:
-                raise ConfigError("follow is for conservative scenes (gamma = 0): dissipative escapes "
-                                 "are already final (the orbit is followed to E_c or r_far)")
+                raise ConfigError(
+                    "follow is for conservative scenes (gamma = 0): dissipative escapes "
+                    "are already final (the orbit is followed to E_c or r_far)"
+                )
             rf = self.r_far if self.r_far is not None else max(10.0 * m.saddle_radius, 2.0 * r_esc)
             if max(self.follow.radii) >= rf:
                 raise ConfigError(f"follow.radii must all be < r_far = {rf:g}, got {max(self.follow.radii):g}")
         if not isinstance(self.continue_settled, bool):
             raise ConfigError(f"continue_settled must be true or false, got {self.continue_settled!r}")
         if self.continue_settled and not (gamma > 0 and self.snapshots):
-            raise ConfigError("continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
-                             "it records settled orbits' energies after settling")
+            raise ConfigError(
+                "continue_settled needs a dissipative scene (gamma > 0) with snapshots: "
+                "it records settled orbits' energies after settling"
+            )
 
     # -- identity -----------------------------------------------------------
     def to_dict(self) -> dict:

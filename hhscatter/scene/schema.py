@@ -20,14 +20,15 @@ A study declares its ``[study]`` table as a :class:`StudyParams` subclass
 named ``Params`` in its ``study.py``; its fields are the keys, with defaults
 for the optional ones.
 """
+
 from __future__ import annotations
 
 import copy
 import dataclasses
+import difflib
 import os
 import tomllib
-import difflib
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -67,8 +68,6 @@ __all__ = [
     "validate_scene_file",
     "validate_study_file",
 ]
-
-
 
 
 # -- strict leaf types ------------------------------------------------------------------------------
@@ -117,17 +116,25 @@ Text = _strict("a string (in quotes)", lambda v: isinstance(v, str), str)
 #: a list of numbers; in Python a list of floats
 Numbers = _strict("a list of numbers", _is_nums, _floats)
 #: a list of integers
-Integers = _strict("a list of integers",
-                   lambda v: isinstance(v, list) and all(isinstance(x, int) and not isinstance(x, bool) for x in v),
-                   lambda v: [int(x) for x in v])
+Integers = _strict(
+    "a list of integers",
+    lambda v: isinstance(v, list) and all(isinstance(x, int) and not isinstance(x, bool) for x in v),
+    lambda v: [int(x) for x in v],
+)
 #: a list of strings
 Texts = _strict("a list of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v), list)
 #: a list of lists of numbers (e.g. windows [[t_lo, t_hi], …]); in Python a list of lists of floats
-NumberLists = _strict("a list of lists of numbers", lambda v: isinstance(v, list) and all(_is_nums(x) for x in v),
-                      lambda v: [_floats(x) for x in v])
+NumberLists = _strict(
+    "a list of lists of numbers",
+    lambda v: isinstance(v, list) and all(_is_nums(x) for x in v),
+    lambda v: [_floats(x) for x in v],
+)
 #: a number, or a list of numbers (a grid axis of a scene file); in Python a float or a list of floats
-NumberOrNumbers = _strict("a number or a list of numbers", lambda v: _is_num(v) or (_is_nums(v) and len(v) > 0),
-                          lambda v: _floats(v) if isinstance(v, list) else float(v))
+NumberOrNumbers = _strict(
+    "a number or a list of numbers",
+    lambda v: _is_num(v) or (_is_nums(v) and len(v) > 0),
+    lambda v: _floats(v) if isinstance(v, list) else float(v),
+)
 
 
 def _number_or_keep(v):
@@ -147,14 +154,18 @@ def _show(v) -> str:
 
 def OneOf(*values) -> Any:
     """OneOf('a', 'b') -> a leaf type that accepts exactly these values."""
-    return _strict("one of " + ", ".join(_show(v) for v in values), lambda v: any(v == x and type(v) is type(x)
-                                                                               for x in values))  # kept as is
+    return _strict(
+        "one of " + ", ".join(_show(v) for v in values), lambda v: any(v == x and type(v) is type(x) for x in values)
+    )  # kept as is
 
 
 def NumberOr(*values) -> Any:
     """NumberOr('tau0') -> a number, or one of these values."""
-    return _strict("a number or one of " + ", ".join(_show(v) for v in values),
-                   lambda v: _is_num(v) or any(v == x and type(v) is type(x) for x in values), _number_or_keep)
+    return _strict(
+        "a number or one of " + ", ".join(_show(v) for v in values),
+        lambda v: _is_num(v) or any(v == x and type(v) is type(x) for x in values),
+        _number_or_keep,
+    )
 
 
 class _Table(BaseModel):
@@ -163,8 +174,16 @@ class _Table(BaseModel):
 
 # -- the tables of a scene: derived from the dataclasses (one declaration of every field) -----------
 #: the leaf type of a file value, by the dataclass annotation of its field
-_LEAF_OF = {"float": Number, "float | None": Number, "int": Integer, "int | None": Integer, "bool": Bool,
-            "str": Text, "str | None": Text, "tuple": Numbers}
+_LEAF_OF = {
+    "float": Number,
+    "float | None": Number,
+    "int": Integer,
+    "int | None": Integer,
+    "bool": Bool,
+    "str": Text,
+    "str | None": Text,
+    "tuple": Numbers,
+}
 
 
 def table_of(cls, name: str, doc: str, *, leaves: dict | None = None, exclude=(), required=()) -> type[BaseModel]:
@@ -183,20 +202,35 @@ def table_of(cls, name: str, doc: str, *, leaves: dict | None = None, exclude=()
             continue
         leaf = leaves.get(f.name) or _LEAF_OF.get(str(f.type))
         if leaf is None:
-            raise TypeError(f"{cls.__name__}.{f.name}: no file type for annotation {f.type!r} (add it to _LEAF_OF "
-                            "or pass leaves=)")
+            raise TypeError(
+                f"{cls.__name__}.{f.name}: no file type for annotation {f.type!r} (add it to _LEAF_OF or pass leaves=)"
+            )
         fields[f.name] = (leaf, ... if f.name in required else None)
     return create_model(name, __base__=_Table, __doc__=doc, **fields)
 
 
-SectionsTable = table_of(SectionWindow, "SectionsTable",
-                         "``[sections]``: which crossings of the section to record (SectionWindow's fields).")
-FollowTable = table_of(Follow, "FollowTable", "``[follow]``: escaped orbits followed to r_far (conservative "
-                       "scenes), crossings of these radii recorded (Follow's fields).", required=("radii",))
-SceneTable = table_of(Scene, "SceneTable", "``[scene]`` of a scene file: the Scene fields (energy and gamma may be "
-                      "lists: a grid).", exclude=("sections", "snapshots", "follow", "system"),
-                      leaves={"energy": NumberOrNumbers, "gamma": NumberOrNumbers, "region": OneOf(*REGIONS),
-                              "momentum": OneOf(*MOMENTA)})
+SectionsTable = table_of(
+    SectionWindow, "SectionsTable", "``[sections]``: which crossings of the section to record (SectionWindow's fields)."
+)
+FollowTable = table_of(
+    Follow,
+    "FollowTable",
+    "``[follow]``: escaped orbits followed to r_far (conservative "
+    "scenes), crossings of these radii recorded (Follow's fields).",
+    required=("radii",),
+)
+SceneTable = table_of(
+    Scene,
+    "SceneTable",
+    "``[scene]`` of a scene file: the Scene fields (energy and gamma may be lists: a grid).",
+    exclude=("sections", "snapshots", "follow", "system"),
+    leaves={
+        "energy": NumberOrNumbers,
+        "gamma": NumberOrNumbers,
+        "region": OneOf(*REGIONS),
+        "momentum": OneOf(*MOMENTA),
+    },
+)
 
 
 class SnapshotsTable(_Table):
@@ -217,9 +251,13 @@ class SnapshotsTable(_Table):
         return self
 
 
-StudySceneTable = table_of(Scene, "StudySceneTable", "``[scene]`` of a study.toml: one scene's fields (no grid: "
-                           "a study makes its runs itself).", exclude=("sections", "snapshots", "follow", "system"),
-                           leaves={"region": OneOf(*REGIONS), "momentum": OneOf(*MOMENTA)})
+StudySceneTable = table_of(
+    Scene,
+    "StudySceneTable",
+    "``[scene]`` of a study.toml: one scene's fields (no grid: a study makes its runs itself).",
+    exclude=("sections", "snapshots", "follow", "system"),
+    leaves={"region": OneOf(*REGIONS), "momentum": OneOf(*MOMENTA)},
+)
 
 
 class SystemTable(_Table):
@@ -286,40 +324,55 @@ def typed_value(model: type[BaseModel], name: str, raw: dict) -> Any:
     return conv(v) if conv is not None and v is not None else v
 
 
-_SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable,
-                 "system": SystemTable}
+_SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable, "system": SystemTable}
 
 
 def _scene_file_model():
-    fields = {"scene": (SceneTable, ...), **{k: (m, None) for k, m in _SCENE_TABLES.items()},
-              "scale": (dict[str, SceneTable], None)}
+    fields = {
+        "scene": (SceneTable, ...),
+        **{k: (m, None) for k, m in _SCENE_TABLES.items()},
+        "scale": (dict[str, SceneTable], None),
+    }
     return create_model("SceneFile", __base__=_Table, **fields)
 
 
 SceneFile = _scene_file_model()
 
 
-@lru_cache(maxsize=None)
+@cache
 def _partial(model: type[BaseModel]) -> type[BaseModel]:
     """The model with every field optional (an override table: a scale's [study])."""
-    fields = {name: (Annotated[(f.annotation, *f.metadata)] if f.metadata else f.annotation, None)
-              for name, f in model.model_fields.items()}
+    fields = {
+        name: (Annotated[(f.annotation, *f.metadata)] if f.metadata else f.annotation, None)
+        for name, f in model.model_fields.items()
+    }
     return create_model(f"{model.__name__}Override", __base__=_Table, **fields)
 
 
-@lru_cache(maxsize=None)
+@cache
 def study_file_model(params: type[BaseModel] | None):
     """The model of a study.toml whose [study] table is ``params`` (None: any keys, unchecked)."""
     study = params if params is not None else dict[str, Any]
     override = _partial(params) if params is not None else dict[str, Any]
     tables = {k: (m, None) for k, m in _SCENE_TABLES.items()}
-    scale = create_model("StudyScale", __base__=_Table, scene=(StudySceneTable, None),
-                         **{k: (_partial(m) if m is not FollowTable else m, None) for k, m in _SCENE_TABLES.items()},
-                         study=(override, None))
-    return create_model("StudyFile", __base__=_Table, convention=(Text, None),
-                        about=(AboutTable, None), needs=(dict[str, Text], None),
-                        scene=(StudySceneTable, ...), **tables, study=(study, None if params is None else ...),
-                        scale=(dict[str, scale], None))
+    scale = create_model(
+        "StudyScale",
+        __base__=_Table,
+        scene=(StudySceneTable, None),
+        **{k: (_partial(m) if m is not FollowTable else m, None) for k, m in _SCENE_TABLES.items()},
+        study=(override, None),
+    )
+    return create_model(
+        "StudyFile",
+        __base__=_Table,
+        convention=(Text, None),
+        about=(AboutTable, None),
+        needs=(dict[str, Text], None),
+        scene=(StudySceneTable, ...),
+        **tables,
+        study=(study, None if params is None else ...),
+        scale=(dict[str, scale], None),
+    )
 
 
 # -- messages ------------------------------------------------------------------------------------
@@ -383,13 +436,17 @@ def _message(model, err: dict) -> str:
         if not table and len(key) == 1:
             tables = [k for k in allowed if _is_table(_child(node, k))]
             if isinstance(err.get("input"), dict) or not set(allowed) - set(tables):
-                return (f"unknown table [{key[0]}]{did_you_mean(key[0], tables)}; allowed tables: "
-                        + ", ".join(f"[{k}]" for k in sorted(tables)))
-            return (f"unknown key {key[0]!r}{did_you_mean(key[0], set(allowed) - set(tables))} before the first "
-                    "table; allowed keys there: "
-                    + ", ".join(sorted(set(allowed) - set(tables))))
-        return (f"{where} unknown key {_key_path(key)!r}{did_you_mean(key[-1], allowed)}; "
-                f"allowed keys: {', '.join(sorted(allowed))}").strip()
+                return f"unknown table [{key[0]}]{did_you_mean(key[0], tables)}; allowed tables: " + ", ".join(
+                    f"[{k}]" for k in sorted(tables)
+                )
+            return (
+                f"unknown key {key[0]!r}{did_you_mean(key[0], set(allowed) - set(tables))} before the first "
+                "table; allowed keys there: " + ", ".join(sorted(set(allowed) - set(tables)))
+            )
+        return (
+            f"{where} unknown key {_key_path(key)!r}{did_you_mean(key[-1], allowed)}; "
+            f"allowed keys: {', '.join(sorted(allowed))}"
+        ).strip()
     if kind == "missing":
         return f"{where} needs {_key_path(key)!r}" if key else f"needs a {where} table"
     if kind in ("model_type", "dict_type"):
@@ -451,8 +508,7 @@ def validate_study_file(doc: dict, source: str, params: type[BaseModel] | None =
 def validate_conventions_file(doc: dict, source: str) -> None:
     """validate_conventions_file(doc, source) -> None or ConfigError: each table ``[<name>]`` of the conventions
     file holds ``[scene]`` keys of a study (strictly typed, no other key)."""
-    model = create_model("ConventionsFile", __base__=_Table,
-                         **{str(k): (StudySceneTable, None) for k in doc})
+    model = create_model("ConventionsFile", __base__=_Table, **{str(k): (StudySceneTable, None) for k in doc})
     _validate(model, doc, str(source))
 
 
@@ -469,15 +525,20 @@ def apply_convention(doc: dict, conventions: dict, source: str, conventions_sour
     if name is None:
         return copy.deepcopy(doc)
     if name not in conventions:
-        raise ConfigError(f"{source}: unknown convention {name!r}; conventions in {conventions_source}: "
-                          + ", ".join(repr(k) for k in sorted(conventions)))
+        raise ConfigError(
+            f"{source}: unknown convention {name!r}; conventions in {conventions_source}: "
+            + ", ".join(repr(k) for k in sorted(conventions))
+        )
     given = dict(conventions[name])
     clashes = [f"[scene] {k}" for k in doc.get("scene", {}) if k in given]
     for s, over in (doc.get("scale") or {}).items():
         clashes += [f"[scale.{s}.scene] {k}" for k in (over.get("scene") or {}) if k in given]
     if clashes:
-        raise ConfigError("\n".join(f"{source}: {c} is set by convention {name!r} ({conventions_source}); "
-                                     f"remove it here" for c in clashes))
+        raise ConfigError(
+            "\n".join(
+                f"{source}: {c} is set by convention {name!r} ({conventions_source}); remove it here" for c in clashes
+            )
+        )
     out = copy.deepcopy(doc)
     out["scene"] = {**copy.deepcopy(given), **out.get("scene", {})}
     return out
@@ -555,5 +616,7 @@ def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrid
     d = scene_dict_from_toml(path, scale, **overrides)
     for k in ("energy", "gamma"):
         if isinstance(d.get(k), (list, tuple)):
-            raise ConfigError(f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run")
+            raise ConfigError(
+                f"{k} is a list in {path}: that is a grid run; load it with hhscatter.scene.grid.load_run"
+            )
     return scene_from_dict(d)

@@ -38,6 +38,7 @@ The numbers JSON follows one convention so the report can tabulate it: a value
 with an uncertainty is ``{"value": v, "err": e}``, and the list
 ``"paper_comparison"`` holds rows ``{quantity, ours, err, paper, verdict, note}``.
 """
+
 from __future__ import annotations
 
 import json
@@ -81,8 +82,10 @@ __all__ = [
     "write_json_atomic",
 ]
 
-def run_stage(name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True,
-              root: Path | None = None):
+
+def run_stage(
+    name: str, stage: str, scale: str = DEFAULT_SCALE, *, workers=None, progress=True, root: Path | None = None
+):
     """Run one stage of a study (simulate, analyze, plot, or all three) at a scale, recording its cost."""
     if stage not in (*STAGES, "all"):
         raise StudyError(f"stage must be one of {[*STAGES, 'all']}, got {stage!r}")
@@ -115,27 +118,35 @@ def checked_raw_runs(study) -> dict:
     again = f"run `hhscatter study {study.name} simulate --scale {study.scale}` first"
     if not done.exists():
         if raw.is_dir() and any((p / "scene.json").exists() for p in raw.iterdir() if p.is_dir()):
-            raise StudyError(f"{study.name} analyze: the simulate stage has not finished ({done} is missing); "
-                             f"{again}")
+            raise StudyError(f"{study.name} analyze: the simulate stage has not finished ({done} is missing); {again}")
         return {}
     rec = json.loads(done.read_text())
     was = rec.get("inputs") or {}
     now = simulate_inputs(study, (was.get("study") or {}).keys())
     changed = [f"[{t}]" for t in SCENE_TABLES if (was.get("tables") or {}).get(t) != now["tables"][t]]
-    changed += [f"[study] {k} ({v!r} → {now['study'][k]!r})" for k, v in (was.get("study") or {}).items()
-                if v != now["study"][k]]
+    changed += [
+        f"[study] {k} ({v!r} → {now['study'][k]!r})"
+        for k, v in (was.get("study") or {}).items()
+        if v != now["study"][k]
+    ]
     if "inputs" not in rec or changed:
-        raise StudyError(f"{study.name} analyze: the raw runs in {raw} were made from another study.toml "
-                         f"({', '.join(changed) or 'no record of its inputs'} changed since simulate); {again}")
+        raise StudyError(
+            f"{study.name} analyze: the raw runs in {raw} were made from another study.toml "
+            f"({', '.join(changed) or 'no record of its inputs'} changed since simulate); {again}"
+        )
     runs = {}
     for key, want in rec.get("runs", {}).items():
         st = run_status(raw / key)
         if st["scene_hash"] != want["scene_hash"]:
-            raise StudyError(f"{study.name} analyze: raw run {raw / key} holds another scene than simulate made "
-                             f"(hash {str(st['scene_hash'])[:12]}…, expected {want['scene_hash'][:12]}…); {again}")
+            raise StudyError(
+                f"{study.name} analyze: raw run {raw / key} holds another scene than simulate made "
+                f"(hash {str(st['scene_hash'])[:12]}…, expected {want['scene_hash'][:12]}…); {again}"
+            )
         if not st["complete"]:
-            raise StudyError(f"{study.name} analyze: raw run {raw / key} is incomplete ({st['chunks_done']} of "
-                             f"{st['chunks']} chunks finished); {again}")
+            raise StudyError(
+                f"{study.name} analyze: raw run {raw / key} is incomplete ({st['chunks_done']} of "
+                f"{st['chunks']} chunks finished); {again}"
+            )
         runs[key] = {"scene_hash": want["scene_hash"], "orbits": st["orbits"], "complete": True}
     return runs
 
@@ -149,16 +160,17 @@ def _run_one(study, mod, st, name, scale, workers, progress):
             mod.simulate(study, workers=workers, progress=progress)
         finally:
             read, study.params_read = study.params_read, None
-        write_json_atomic(done, {"study": name, "scale": scale, "inputs": simulate_inputs(study, read),
-                                 "runs": study.raw_runs})
+        write_json_atomic(
+            done, {"study": name, "scale": scale, "inputs": simulate_inputs(study, read), "runs": study.raw_runs}
+        )
         print(f"{name} simulate: raw runs in {study.out / 'raw'}", flush=True)
     elif st == "analyze":
-
         missing = [] if dev_fallback_enabled() else missing_upstream(study)
         if missing:
             raise UpstreamError(
                 f"{name} needs the published outputs of {', '.join(missing)} (declared in [needs] of "
-                f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first")
+                f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first"
+            )
         study.raw_runs = checked_raw_runs(study)
         mod.analyze(study)
         derived = study.out / "derived"
@@ -169,8 +181,10 @@ def _run_one(study, mod, st, name, scale, workers, progress):
 
         matplotlib.use("Agg")
         if not study.numbers_path.exists():
-            raise StudyError(f"{name} plot: {study.numbers_path} is missing; run `hhscatter study {name} analyze "
-                             f"--scale {scale}` first")
+            raise StudyError(
+                f"{name} plot: {study.numbers_path} is missing; run `hhscatter study {name} analyze "
+                f"--scale {scale}` first"
+            )
         # the numbers drawn are the ones analyze wrote for this study.toml and these upstream numbers
         study.verify_numbers(upstream=not dev_fallback_enabled())
         mod.plot(study)

@@ -13,6 +13,7 @@ use the paper's value *only* if the environment variable
 source ``"paper fallback (DEVELOPMENT ONLY)"`` in the numbers JSON and the
 figure is stamped.  The default (and every make target) fails instead.
 """
+
 from __future__ import annotations
 
 import math
@@ -20,8 +21,18 @@ import math
 from hhscatter.errors import HHScatterError, StudyError
 from hhscatter.studies.study import DEV_ENV, dev_fallback_enabled, load_study
 
-__all__ = ["DEV_ENV", "DEV_SOURCE", "UpstreamError", "any_fallback", "dev_fallback_enabled", "lookup", "numbers",
-           "published_table", "table", "value_or_fallback"]
+__all__ = [
+    "DEV_ENV",
+    "DEV_SOURCE",
+    "UpstreamError",
+    "any_fallback",
+    "dev_fallback_enabled",
+    "lookup",
+    "numbers",
+    "published_table",
+    "table",
+    "value_or_fallback",
+]
 
 DEV_SOURCE = "paper fallback (DEVELOPMENT ONLY)"
 
@@ -52,7 +63,12 @@ def lookup(doc: dict, path: str, *, what: str = "numbers JSON"):
             if isinstance(cur, dict) and part in cur:
                 cur = cur[part]
                 break
-            if j == i + 1 and isinstance(cur, list) and part.lstrip("-").isdigit() and -len(cur) <= int(part) < len(cur):
+            if (
+                j == i + 1
+                and isinstance(cur, list)
+                and part.lstrip("-").isdigit()
+                and -len(cur) <= int(part) < len(cur)
+            ):
                 cur = cur[int(part)]
                 break
         else:
@@ -97,7 +113,6 @@ def table(study, other: str, name: str, filters=None, columns=None):
     """
     import pandas as pd  # deferred: pandas loads on first use
 
-
     try:
         o = load_study(other, study.scale, root=study.root.parent)
     except StudyError as exc:
@@ -105,8 +120,10 @@ def table(study, other: str, name: str, filters=None, columns=None):
     path = o.out / "derived" / name
     if not path.exists():
         have = sorted(p.name for p in path.parent.glob("*")) if path.parent.is_dir() else []
-        raise UpstreamError(f"{study.name} needs {path}, a derived table of study {other!r} (present: {have}); "
-                            f"run `make {study.name} SCALE={study.scale}`, which builds {other} first")
+        raise UpstreamError(
+            f"{study.name} needs {path}, a derived table of study {other!r} (present: {have}); "
+            f"run `make {study.name} SCALE={study.scale}`, which builds {other} first"
+        )
     return pd.read_parquet(path, filters=filters, columns=columns)
 
 

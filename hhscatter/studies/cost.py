@@ -19,6 +19,7 @@ up; analyze and plot start over, so their last invocation replaces the earlier);
 stages. The numbers are measurements of a
 shared machine: wall time depends on the load, CPU time much less.
 """
+
 from __future__ import annotations
 
 import json
@@ -28,7 +29,7 @@ import sys
 import time
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 from hhscatter.studies.jsonio import write_json_atomic
@@ -62,8 +63,7 @@ def _cpu(who) -> float:
 @contextmanager
 def meter(stage: str, workers=None):
     """meter(stage, workers=None) -> context manager yielding a StageCost filled at exit (also on error)."""
-    cost = StageCost(stage=stage, workers=workers,
-                     started=datetime.now(timezone.utc).isoformat(timespec="seconds"))
+    cost = StageCost(stage=stage, workers=workers, started=datetime.now(UTC).isoformat(timespec="seconds"))
     t0 = time.perf_counter()
     c0 = _cpu(resource.RUSAGE_SELF) + _cpu(resource.RUSAGE_CHILDREN)
     try:

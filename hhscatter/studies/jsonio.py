@@ -1,4 +1,5 @@
 """The numbers JSON of a study, written atomically: non-finite floats as null/"inf", numpy scalars as Python."""
+
 from __future__ import annotations
 
 import json

@@ -32,6 +32,7 @@ Traceback (most recent call last):
 ...
 hhscatter.studies.provenance.ProvenanceError: fig3.json was edited after it was written: its content hash is ...
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -53,8 +54,9 @@ class ProvenanceError(StudyError):
 
 
 def _canonical(obj) -> bytes:
-    return json.dumps(_jsonable(obj), sort_keys=True, separators=(",", ":"), ensure_ascii=False,
-                      allow_nan=False).encode()
+    return json.dumps(
+        _jsonable(obj), sort_keys=True, separators=(",", ":"), ensure_ascii=False, allow_nan=False
+    ).encode()
 
 
 def content_sha256(doc: dict) -> str:
@@ -69,9 +71,11 @@ def config_sha256(config: dict) -> str:
 
 def made_from(study, upstream_docs: dict) -> dict:
     """made_from(study, {name: numbers JSON}) -> the ``made_from`` record of a numbers JSON being written."""
-    return {"config_sha256": config_sha256(study.config),
-            "upstream": {name: content_sha256(doc) for name, doc in sorted(upstream_docs.items())},
-            "raw_runs": {k: r.get("scene_hash") for k, r in sorted(study.raw_runs.items())}}
+    return {
+        "config_sha256": config_sha256(study.config),
+        "upstream": {name: content_sha256(doc) for name, doc in sorted(upstream_docs.items())},
+        "raw_runs": {k: r.get("scene_hash") for k, r in sorted(study.raw_runs.items())},
+    }
 
 
 def sealed(doc: dict) -> dict:
@@ -81,8 +85,9 @@ def sealed(doc: dict) -> dict:
     return out
 
 
-def verify_numbers(path: Path, doc: dict, *, config: dict, scale: str, upstream: dict, raw: Path | None = None,
-                   remake: str = "") -> None:
+def verify_numbers(
+    path: Path, doc: dict, *, config: dict, scale: str, upstream: dict, raw: Path | None = None, remake: str = ""
+) -> None:
     """verify_numbers(path, doc, *, config, scale, upstream, raw=None, remake='') -> None, or ProvenanceError.
 
     ``doc`` is the numbers JSON read from ``path``; ``config`` the study's configuration now (``Study.config``);
@@ -92,31 +97,42 @@ def verify_numbers(path: Path, doc: dict, *, config: dict, scale: str, upstream:
     """
     again = f"; {remake}" if remake else ""
     if doc.get(SELF_KEY) is None or not isinstance(doc.get(MADE_FROM), dict):
-        raise ProvenanceError(f"{path} carries no record of what it was made from (no '{SELF_KEY}'/'{MADE_FROM}': "
-                              f"written before such records, or by hand){again}")
+        raise ProvenanceError(
+            f"{path} carries no record of what it was made from (no '{SELF_KEY}'/'{MADE_FROM}': "
+            f"written before such records, or by hand){again}"
+        )
     have = content_sha256(doc)
     if have != doc[SELF_KEY]:
-        raise ProvenanceError(f"{path} was edited after it was written: its content hash is {have[:12]}…, the hash "
-                              f"it was written with {str(doc[SELF_KEY])[:12]}…{again}")
+        raise ProvenanceError(
+            f"{path} was edited after it was written: its content hash is {have[:12]}…, the hash "
+            f"it was written with {str(doc[SELF_KEY])[:12]}…{again}"
+        )
     rec = doc[MADE_FROM]
     if rec.get("config_sha256") != config_sha256(config):
-        raise ProvenanceError(f"{path} is stale: the study's configuration at scale {scale} (its study.toml, with "
-                              f"its convention) changed since these numbers were made{again}")
+        raise ProvenanceError(
+            f"{path} is stale: the study's configuration at scale {scale} (its study.toml, with "
+            f"its convention) changed since these numbers were made{again}"
+        )
     for name, (upath, udoc) in sorted(upstream.items()):
         want = (rec.get("upstream") or {}).get(name)
         if want is None:
             raise ProvenanceError(f"{path} records no hash of the numbers of study {name!r} it needs{again}")
         if udoc is None:
-            raise ProvenanceError(f"{path} was made from the numbers of study {name!r}, which are missing here "
-                                  f"({upath}){again}")
+            raise ProvenanceError(
+                f"{path} was made from the numbers of study {name!r}, which are missing here ({upath}){again}"
+            )
         if content_sha256(udoc) != want:
-            raise ProvenanceError(f"{path} is stale: it was made from another {upath.name} than {upath} (content "
-                                  f"hash {content_sha256(udoc)[:12]}…, made from {want[:12]}…){again}")
+            raise ProvenanceError(
+                f"{path} is stale: it was made from another {upath.name} than {upath} (content "
+                f"hash {content_sha256(udoc)[:12]}…, made from {want[:12]}…){again}"
+            )
     done = Path(raw) / "done.json" if raw is not None else None
     if done is not None and done.exists():
         runs = {k: r.get("scene_hash") for k, r in (json.loads(done.read_text()).get("runs") or {}).items()}
         made = rec.get("raw_runs") or {}
         changed = sorted(k for k in made if runs.get(k) != made[k])
         if changed:
-            raise ProvenanceError(f"{path} is stale: raw run {raw / changed[0]} now holds another scene than the one "
-                                  f"these numbers were made from ({len(changed)} run(s) changed){again}")
+            raise ProvenanceError(
+                f"{path} is stale: raw run {raw / changed[0]} now holds another scene than the one "
+                f"these numbers were made from ({len(changed)} run(s) changed){again}"
+            )

@@ -3,6 +3,7 @@
 :class:`Study` is what a study's stages receive; :func:`load_study` makes it. The stage runner is
 :func:`hhscatter.studies.run_stage`.
 """
+
 from __future__ import annotations
 
 import copy
@@ -117,8 +118,8 @@ class Study:
     root: Path
     comparisons: list = field(default_factory=list)
     info: StudyInfo | None = None
-    orbits_run: int = 0       # orbits integrated by this process's run() calls (the cost record)
-    chunks_resumed: int = 0   # chunks found complete and kept by run()
+    orbits_run: int = 0  # orbits integrated by this process's run() calls (the cost record)
+    chunks_resumed: int = 0  # chunks found complete and kept by run()
     params_model: type | None = None  # the study's Params (hhscatter.scene.schema.StudyParams) of its [study] table
     raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
     params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
@@ -131,8 +132,9 @@ class Study:
     def upstream(self, role: str) -> str:
         """upstream(role) -> the study declared for ``role`` in ``[needs]``; a missing role is an error."""
         if role not in self.needs:
-            raise StudyError(f"{self.root / 'study.toml'}: [needs] must name the study for {role!r} "
-                             f"(has {sorted(self.needs)})")
+            raise StudyError(
+                f"{self.root / 'study.toml'}: [needs] must name the study for {role!r} (has {sorted(self.needs)})"
+            )
         return self.needs[role]
 
     @property
@@ -151,7 +153,9 @@ class Study:
         declares) converted to the declared type (Number → float, Integer → int, Numbers → list of floats, …;
         :func:`hhscatter.scene.schema.typed_params`). A key ``Params`` does not declare is a :class:`StudyError`;
         keys read while the simulate stage runs are recorded (``raw/done.json``)."""
-        return ParamsView(self, self.params_model, self.raw_params)  # each read converts the current value (lists: copies)
+        return ParamsView(
+            self, self.params_model, self.raw_params
+        )  # each read converts the current value (lists: copies)
 
     def param(self, key, default=None):
         """param(key) -> value of ``[study].key`` as written in study.toml, else the default its ``Params`` declares.
@@ -236,8 +240,19 @@ class Study:
             print(f"  {self.name}/{key}: {summary.line()}", flush=True)
         return out
 
-    def compare(self, quantity: str, ours, err=None, paper=None, *, unit: str = "", note: str = "",
-                verdict: str | None = None, convention: str | None = None, authors: bool = False) -> dict:
+    def compare(
+        self,
+        quantity: str,
+        ours,
+        err=None,
+        paper=None,
+        *,
+        unit: str = "",
+        note: str = "",
+        verdict: str | None = None,
+        convention: str | None = None,
+        authors: bool = False,
+    ) -> dict:
         """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
 
         One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test. ``convention`` says how
@@ -253,8 +268,17 @@ class Study:
         conv = convention if convention is not None else self.convention_label
         if authors and not conv.startswith("authors"):
             conv = f"authors': {conv}"
-        row = {"quantity": quantity, "ours": ours, "err": err, "paper": paper, "unit": unit,
-               "verdict": verdict, "note": note, "convention": conv, "authors": bool(authors)}
+        row = {
+            "quantity": quantity,
+            "ours": ours,
+            "err": err,
+            "paper": paper,
+            "unit": unit,
+            "verdict": verdict,
+            "note": note,
+            "convention": conv,
+            "authors": bool(authors),
+        }
         self.comparisons.append(row)
         return row
 
@@ -281,9 +305,16 @@ class Study:
         """
 
         ups = {name: doc for name, (_, doc) in self.upstream_numbers().items() if doc is not None}
-        doc = {"study": self.name, "scale": self.scale, **numbers,
-               "paper_comparison": list(self.comparisons), "config": self.config,
-               "raw_runs": dict(self.raw_runs), "provenance": provenance(), "made_from": made_from(self, ups)}
+        doc = {
+            "study": self.name,
+            "scale": self.scale,
+            **numbers,
+            "paper_comparison": list(self.comparisons),
+            "config": self.config,
+            "raw_runs": dict(self.raw_runs),
+            "provenance": provenance(),
+            "made_from": made_from(self, ups),
+        }
         write_json_atomic(self.numbers_path, sealed(_jsonable(doc)))
         return self.numbers_path
 
@@ -305,13 +336,15 @@ class Study:
         """
         out = {}
         for other in sorted(set(self.needs.values())):
-            path = pick(other) if pick is not None else \
-                load_study(other, self.scale, root=self.root.parent).numbers_path
+            path = (
+                pick(other) if pick is not None else load_study(other, self.scale, root=self.root.parent).numbers_path
+            )
             out[other] = (path, json.loads(path.read_text()) if path is not None and path.exists() else None)
         return out
 
-    def verify_numbers(self, path: Path | None = None, doc: dict | None = None, *, pick=None,
-                       upstream: bool = True, raw: bool = True) -> None:
+    def verify_numbers(
+        self, path: Path | None = None, doc: dict | None = None, *, pick=None, upstream: bool = True, raw: bool = True
+    ) -> None:
         """verify_numbers(path=None, doc=None, *, pick=None, upstream=True, raw=True) -> None, or ProvenanceError.
 
         The study's numbers JSON (default: its own ``<name>.json``) checked against what it records
@@ -322,14 +355,19 @@ class Study:
         path = Path(path) if path is not None else self.numbers_path
         doc = json.loads(path.read_text()) if doc is None else doc
         ups = self.upstream_numbers(pick) if upstream else {}
-        verify_numbers(path, doc, config=_jsonable(self.config), scale=self.scale, upstream=ups,
-                       raw=self.out / "raw" if raw else None,
-                       remake=f"make it again with `make {self.name} SCALE={self.scale}`")
+        verify_numbers(
+            path,
+            doc,
+            config=_jsonable(self.config),
+            scale=self.scale,
+            upstream=ups,
+            raw=self.out / "raw" if raw else None,
+            remake=f"make it again with `make {self.name} SCALE={self.scale}`",
+        )
 
     def write_table(self, df, fname: str, **meta) -> Path:
         """Write a derived pandas table as Parquet with the study config and provenance in its metadata."""
         import pyarrow as pa  # deferred: pyarrow loads on first use
-
 
         table = pa.Table.from_pandas(df, preserve_index=False)
         doc = {"study": self.name, "scale": self.scale, "config": self.config, **meta, "versions": provenance()}
@@ -352,7 +390,6 @@ def load_study(name: str, scale: str = DEFAULT_SCALE, root: Path | None = None) 
     root = Path(root) if root is not None else studies_root()
     path = root / name / "study.toml"
     if not path.exists():
-
         known = sorted(p.parent.name for p in root.glob("*/study.toml"))
         raise StudyError(f"study must be one of {known}, got {name!r}{did_you_mean(name, known)}")
     try:
@@ -438,8 +475,9 @@ def simulate_inputs(study, keys) -> dict:
     """simulate_inputs(study, keys) -> what the simulate stage made its runs from: the scene tables of
     study.toml (this scale) and the values of the ``[study]`` keys it read (``keys``). Analysis-only keys
     (a paper constant, a fit window) are not in it: changing them needs no new simulation."""
-    return _jsonable({"tables": {t: study.config.get(t) for t in SCENE_TABLES},
-                      "study": {k: study.param(k) for k in sorted(keys)}})
+    return _jsonable(
+        {"tables": {t: study.config.get(t) for t in SCENE_TABLES}, "study": {k: study.param(k) for k in sorted(keys)}}
+    )
 
 
 # -- a study's code is loaded from its folder by path: studies/<name>/study.py becomes the module

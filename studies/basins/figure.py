@@ -1,4 +1,5 @@
 """Figure of the study ``basins`` (draws the derived tables; computes nothing)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -41,17 +42,19 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     pairs = [(E, g) for E in energies for g in gammas]
     ncol = min(3, len(pairs))
     nrow = -(-len(pairs) // ncol)
-    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 4.0 * nrow + 0.6), constrained_layout=True,
-                            squeeze=False)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 4.0 * nrow + 0.6), constrained_layout=True, squeeze=False)
     _map_panels(axs.ravel(), maps, pairs, n, numbers["extent"], cmap, norm)
     _legend(fig)
-    fig.suptitle(f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ ({n}×{n} cells, "
-                 f"$r_{{esc}}=1.5$){tail}", fontsize=12)
+    fig.suptitle(
+        f"Exit basins on the section $\\dot r = 0$, $\\dot\\varphi > 0$ ({n}×{n} cells, $r_{{esc}}=1.5$){tail}",
+        fontsize=12,
+    )
     fig.savefig(path, dpi=100)
     plt.close(fig)
     zg, zf = sorted(zooms.gamma.unique()), sorted(zooms.factor.unique())
-    fig, axs = plt.subplots(len(zg), len(zf), figsize=(4.6 * len(zf), 4.2 * len(zg) + 0.6),
-                            constrained_layout=True, squeeze=False)
+    fig, axs = plt.subplots(
+        len(zg), len(zf), figsize=(4.6 * len(zf), 4.2 * len(zg) + 0.6), constrained_layout=True, squeeze=False
+    )
     _zoom_panels(axs, zooms, zg, zf, numbers["zoom_centre"], cmap, norm)
     _legend(fig)
     fig.suptitle(f"Zooms into one boundary region{tail}", fontsize=12)
@@ -77,9 +80,13 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
 def _legend(fig):
     from matplotlib.patches import Patch
 
-    fig.legend(handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)] +
-               [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
-               loc="outside lower center", ncol=6, fontsize=10)
+    fig.legend(
+        handles=[Patch(color=c, label=nm) for c, nm in zip(COLORS, NAMES)]
+        + [Patch(facecolor="white", edgecolor="0.6", label="forbidden ($V \\geq E_0$)")],
+        loc="outside lower center",
+        ncol=6,
+        fontsize=10,
+    )
 
 
 def _map_panels(axes, maps, pairs, n, ext, cmap, norm):
@@ -91,7 +98,7 @@ def _map_panels(axes, maps, pairs, n, ext, cmap, norm):
         ax.set_aspect("equal")
         ax.set_xlabel("$x$")
         ax.set_ylabel("$y$")
-    for ax in axes[len(pairs):]:
+    for ax in axes[len(pairs) :]:
         ax.set_visible(False)
 
 
@@ -123,10 +130,25 @@ def _panel_entropy_by_box(ax, recs):
         rs = sorted(rs, key=lambda r: r["box_side"])
         s = [r["box_side"] for r in rs]
         c = f"C{k}"
-        ax.errorbar(s, [r["S_b"] for r in rs], yerr=[r["S_b_err"] for r in rs], fmt="o-", ms=4, color=c,
-                    label=f"$S_b$, $E_0={E:g}$, {grid}² ({which})")
-        ax.errorbar(s, [r["S_bb"] for r in rs], yerr=[r["S_bb_err"] for r in rs], fmt="s--", ms=4, color=c,
-                    mfc="none", label=f"$S_{{bb}}$, $E_0={E:g}$, {grid}²")
+        ax.errorbar(
+            s,
+            [r["S_b"] for r in rs],
+            yerr=[r["S_b_err"] for r in rs],
+            fmt="o-",
+            ms=4,
+            color=c,
+            label=f"$S_b$, $E_0={E:g}$, {grid}² ({which})",
+        )
+        ax.errorbar(
+            s,
+            [r["S_bb"] for r in rs],
+            yerr=[r["S_bb_err"] for r in rs],
+            fmt="s--",
+            ms=4,
+            color=c,
+            mfc="none",
+            label=f"$S_{{bb}}$, $E_0={E:g}$, {grid}²",
+        )
     ax.axhline(np.log(2), color="k", lw=0.8, ls=":", label="ln 2")
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -176,8 +198,14 @@ def _panel_dimension(ax, per, energies):
     """Panel (c): the uncertainty dimension d = 2 − α against γ."""
     for E in energies:
         rows = [q for q in per if q["energy"] == E and q["d"]]
-        ax.errorbar([max(q["gamma"], 1e-4) for q in rows], [q["d"]["value"] for q in rows],
-                    yerr=[q["d"]["err"] for q in rows], fmt="o-", capsize=2, label=f"$E_0={E:g}$")
+        ax.errorbar(
+            [max(q["gamma"], 1e-4) for q in rows],
+            [q["d"]["value"] for q in rows],
+            yerr=[q["d"]["err"] for q in rows],
+            fmt="o-",
+            capsize=2,
+            label=f"$E_0={E:g}$",
+        )
     ax.axhline(1.0, color="k", lw=0.8, ls=":", label="smooth boundary (d = 1)")
     ax.set_xscale("log")
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
@@ -205,8 +233,17 @@ def _panel_local_dimension(ax, E, gammas, local, cm):
     """The local dimension d(ε) = 2 − α(ε) against ε at one E0, one line per γ (points with σ < 0.3)."""
     for i, g in enumerate(gammas):
         t = local[(local.energy == E) & (local.gamma == g) & np.isfinite(local.d) & (local.d_err < 0.3)]
-        ax.errorbar(t.eps_mid, t.d, yerr=t.d_err, fmt="o-", ms=3, lw=0.8, capsize=2,
-                    color=cm(i / max(len(gammas) - 1, 1)), label=f"$\\gamma={g:g}$")
+        ax.errorbar(
+            t.eps_mid,
+            t.d,
+            yerr=t.d_err,
+            fmt="o-",
+            ms=3,
+            lw=0.8,
+            capsize=2,
+            color=cm(i / max(len(gammas) - 1, 1)),
+            label=f"$\\gamma={g:g}$",
+        )
     ax.axhline(1.0, color="k", lw=0.8, ls=":")
     ax.set_xscale("log")
     ax.set_ylim(0.8, 2.05)
@@ -232,8 +269,14 @@ def _panel_cutoff(ax, energies, numbers):
         for r in recs:
             if r["detected"]:
                 lo_m, hi_m = r["eps_c_interval"]
-                ax.errorbar([r["gamma"]], [r["eps_c"]], yerr=[[r["eps_c"] - lo_m], [hi_m - r["eps_c"]]],
-                            fmt="o", color=c, capsize=2)
+                ax.errorbar(
+                    [r["gamma"]],
+                    [r["eps_c"]],
+                    yerr=[[r["eps_c"] - lo_m], [hi_m - r["eps_c"]]],
+                    fmt="o",
+                    color=c,
+                    capsize=2,
+                )
             elif r["eps_c_interval"]:
                 ax.plot([r["gamma"]], [r["eps_c_interval"][1]], "v", color=c, mfc="none")
     ax.set_xscale("log")
@@ -249,10 +292,21 @@ def _panel_wada(ax, energies, per):
     for k, E in enumerate(energies):
         rows = [q for q in per if q["energy"] == E]
         gx = [max(q["gamma"], 1e-4) for q in rows]
-        ax.plot(gx, [q["wada"]["W_at_r"] for q in rows], "s--", color=f"C{k}", mfc="none",
-                label=f"all basins (settled a basin), $E_0={E:g}$")
-        ax.plot(gx, [q["wada_exits"]["W_at_r"] if q["wada_exits"] else np.nan for q in rows], "o-",
-                color=f"C{k}", label=f"exit basins (settled masked), $E_0={E:g}$")
+        ax.plot(
+            gx,
+            [q["wada"]["W_at_r"] for q in rows],
+            "s--",
+            color=f"C{k}",
+            mfc="none",
+            label=f"all basins (settled a basin), $E_0={E:g}$",
+        )
+        ax.plot(
+            gx,
+            [q["wada_exits"]["W_at_r"] if q["wada_exits"] else np.nan for q in rows],
+            "o-",
+            color=f"C{k}",
+            label=f"exit basins (settled masked), $E_0={E:g}$",
+        )
     ax.axhline(0.99, color="k", lw=0.8, ls=":", label="Wada threshold")
     ax.set_xscale("log")
     ax.set_xlabel("$\\gamma$ ($\\gamma=0$ drawn at $10^{-4}$)")
@@ -273,16 +327,23 @@ def _panel_scan_entropy(ax, scan, E_b):
 
 def _panel_scan_dimension(ax, scan, E_b):
     """The γ = 0 energy scan: d = 2 − α and the decision rate λ (and κ/α when present) against E0."""
-    ax.errorbar(scan.energy, 2 - scan.alpha, yerr=scan.alpha_err, fmt="o-", ms=3, color="C2",
-                label="$d = 2 - \\alpha$")
+    ax.errorbar(scan.energy, 2 - scan.alpha, yerr=scan.alpha_err, fmt="o-", ms=3, color="C2", label="$d = 2 - \\alpha$")
     ax.set_ylabel("uncertainty dimension $d$", color="C2")
     ax.axvline(E_b, color="0.4", lw=0.8, ls="--")
     ax.set_xlabel("$E_0$ ($\\gamma = 0$)")
     ax2 = ax.twinx()
-    ax2.errorbar(scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3",
-                 label="$\\lambda$, decision rate")
+    ax2.errorbar(
+        scan.energy, scan.lam, yerr=scan.lam_err, fmt="s--", ms=3, color="C3", label="$\\lambda$, decision rate"
+    )
     if "lam_kg" in scan:
-        ax2.errorbar(scan.energy, scan.lam_kg, yerr=scan.lam_kg_err, fmt="^:", ms=3, color="C1",
-                     label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)")
+        ax2.errorbar(
+            scan.energy,
+            scan.lam_kg,
+            yerr=scan.lam_kg_err,
+            fmt="^:",
+            ms=3,
+            color="C1",
+            label="$\\kappa/\\alpha$ (Kantz–Grassberger, $\\kappa$ of fig2)",
+        )
     ax2.legend(fontsize=6, loc="lower right")
     ax2.set_ylabel("decision rate $\\lambda$ (1/time)", color="C3")

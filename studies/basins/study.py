@@ -28,6 +28,7 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
 Outcome codes: 0, 1, 2 exit channel (the 120° sector of the escape point);
 3 settled; 4 trapped (alive at t_max); −1 forbidden cell (V ≥ E0).
 """
+
 from __future__ import annotations
 
 import math
@@ -35,10 +36,9 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
-
 from hhscatter.analysis.geometry import basin_summary as bs
 from hhscatter.analysis.geometry.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
@@ -186,14 +186,22 @@ def simulate(study, workers=None, progress=True):
     for g in study.params.zoom_gammas:
         for f in study.params.zoom_factors:
             ext = _zoom_extent(extent, centre, f)
-            _run_table(study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, study.params.zoom_grid)[3],
-                       g, workers, progress)
+            _run_table(
+                study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, study.params.zoom_grid)[3], g, workers, progress
+            )
     scan_E, scan_eps = _scan(study)
     ns = study.params.scan_grid
     for E in scan_E:
         _run_table(study, scan_map_key(E), _map_states(study, E, extent, ns)[3], 0.0, workers, progress)
         for i, e in enumerate(scan_eps):
-            _run_table(study, scan_unc_key(E, i), _uncertainty_states(study, E, i, e, study.params.scan_n_uncertainty, seed_offset=50), 0.0, workers, progress)
+            _run_table(
+                study,
+                scan_unc_key(E, i),
+                _uncertainty_states(study, E, i, e, study.params.scan_n_uncertainty, seed_offset=50),
+                0.0,
+                workers,
+                progress,
+            )
 
 
 # -- analyze ---------------------------------------------------------------------------
@@ -246,21 +254,26 @@ def analyze(study):
     zooms, centre = _zoom_maps(study, extent, n)
     study.write_table(zooms, "basins_zooms.parquet", grid=study.params.zoom_grid)
     _compare_with_paper(study, per, hb)
-    study.write_numbers({
-        "codes": dict(zip(CODE_NAMES, CODES)),
-        "grid": n, "extent": list(extent), "eps": [float(e) for e in eps],
-        "zoom_centre": list(centre), "per_point": per, "point_table": bs.point_table(per),
-        "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json "
-                                                           f"{study.params.E_b_key}"},
-        "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
-        "cutoff_prediction": cut_pred,
-        "cutoff_summary": bs.cutoff_summary(cut_pred),
-        "entropy_by_box": by_box,
-        "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
-        "energy_scan": scan.to_dict(orient="records"),
-        "energy_trend": trend,
-        "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
-    })
+    study.write_numbers(
+        {
+            "codes": dict(zip(CODE_NAMES, CODES)),
+            "grid": n,
+            "extent": list(extent),
+            "eps": [float(e) for e in eps],
+            "zoom_centre": list(centre),
+            "per_point": per,
+            "point_table": bs.point_table(per),
+            "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json {study.params.E_b_key}"},
+            "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
+            "cutoff_prediction": cut_pred,
+            "cutoff_summary": bs.cutoff_summary(cut_pred),
+            "entropy_by_box": by_box,
+            "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
+            "energy_scan": scan.to_dict(orient="records"),
+            "energy_trend": trend,
+            "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
+        }
+    )
 
 
 def _measure_point(study, E, g, eps, extent, n, boxes):
@@ -287,14 +300,30 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
     # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
     # settled (and trapped) cells masked as outside
     exits = [c for c in present if c in (0, 1, 2)]
-    wada_x = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
-              if len(exits) >= 3 else None)
+    wada_x = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r) if len(exits) >= 3 else None
     loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
     slim = slim_fractal(loc)
     rate = bs.rate_record(eps, times) if g == 0 else None
     ok, fit, cut = bs.uncertainty_fits(unc, study.params.fit_min_count)
-    return img, ent, unc, loc, {"fr": fr, "present": present, "wada": wada, "chans": chans, "exits": exits,
-                                "wada_x": wada_x, "slim": slim, "rate": rate, "ok": ok, "fit": fit, "cut": cut}
+    return (
+        img,
+        ent,
+        unc,
+        loc,
+        {
+            "fr": fr,
+            "present": present,
+            "wada": wada,
+            "chans": chans,
+            "exits": exits,
+            "wada_x": wada_x,
+            "slim": slim,
+            "rate": rate,
+            "ok": ok,
+            "fit": fit,
+            "cut": cut,
+        },
+    )
 
 
 def _zoom_maps(study, extent, n):
@@ -306,8 +335,19 @@ def _zoom_maps(study, extent, n):
         for f in study.params.zoom_factors:
             ext = _zoom_extent(extent, centre, f)
             img = basin_image(study, zoom_key(Ez, g, f), Ez, ext, study.params.zoom_grid)
-            zooms.append(pd.DataFrame({"gamma": g, "factor": f, "x0": ext[0], "x1": ext[1], "y0": ext[2],
-                                       "y1": ext[3], "label": img.ravel()}))
+            zooms.append(
+                pd.DataFrame(
+                    {
+                        "gamma": g,
+                        "factor": f,
+                        "x0": ext[0],
+                        "x1": ext[1],
+                        "y0": ext[2],
+                        "y1": ext[3],
+                        "label": img.ravel(),
+                    }
+                )
+            )
     return pd.concat(zooms, ignore_index=True), centre
 
 
@@ -316,27 +356,43 @@ def _compare_with_paper(study, per, hb):
     for p in per:
         tag = f"E0={p['energy']:g}, γ={p['gamma']:g}"
         if p["alpha"]:
-            study.compare(f"uncertainty exponent α ({tag})", p["alpha"]["value"], p["alpha"]["err"],
-                          note=f"f(ε) ∝ ε^α on ε ∈ [{p['alpha_fit_range'][0]:.0e}, {p['alpha_fit_range'][1]:.0e}];"
-                               f" d = 2 − α = {p['d']['value']:.3f}")
+            study.compare(
+                f"uncertainty exponent α ({tag})",
+                p["alpha"]["value"],
+                p["alpha"]["err"],
+                note=f"f(ε) ∝ ε^α on ε ∈ [{p['alpha_fit_range'][0]:.0e}, {p['alpha_fit_range'][1]:.0e}];"
+                f" d = 2 − α = {p['d']['value']:.3f}",
+            )
         if p["S_bb"]:
-            study.compare(f"boundary basin entropy S_bb ({tag}, box {hb})", p["S_bb"]["value"], p["S_bb"]["err"],
-                          note="S_bb > ln 2 is sufficient for a fractal boundary: "
-                               + ("yes" if p["log2_fractal"] else "not shown"))
+            study.compare(
+                f"boundary basin entropy S_bb ({tag}, box {hb})",
+                p["S_bb"]["value"],
+                p["S_bb"]["err"],
+                note="S_bb > ln 2 is sufficient for a fractal boundary: "
+                + ("yes" if p["log2_fractal"] else "not shown"),
+            )
         if p["cutoff"] is not None and p["gamma"] > 0:
             c = p["cutoff"]
-            study.compare(f"cut-off ε_c of the power law f(ε) ({tag})",
-                          c["eps_c"] if c["detected"] else None, None,
-                          note=(f"detected, 1σ [{c['eps_c_lo']:.2g}, {c['eps_c_hi']:.2g}]" if c["detected"] else
-                                f"none seen: ε_c < {c['eps_c_hi']:.2g}") + " (paper: expected for γ > 0)")
+            study.compare(
+                f"cut-off ε_c of the power law f(ε) ({tag})",
+                c["eps_c"] if c["detected"] else None,
+                None,
+                note=(
+                    f"detected, 1σ [{c['eps_c_lo']:.2g}, {c['eps_c_hi']:.2g}]"
+                    if c["detected"]
+                    else f"none seen: ε_c < {c['eps_c_hi']:.2g}"
+                )
+                + " (paper: expected for γ > 0)",
+            )
 
 
 def _upstream_value(study, role, key_param):
     """(value, err) of a number in the JSON of the study [needs].role, at the dotted path [study].key_param."""
     from hhscatter.studies import _upstream as up
 
-    v, e = up.lookup(up.numbers(study, study.upstream(role)), getattr(study.params, key_param),
-                     what=f"{study.upstream(role)}.json")
+    v, e = up.lookup(
+        up.numbers(study, study.upstream(role)), getattr(study.params, key_param), what=f"{study.upstream(role)}.json"
+    )
     return (float(v), float(e)) if isinstance(v, (int, float)) else (v, e)
 
 
@@ -364,8 +420,7 @@ def _energy_scan(study, extent, boxes, hb, E_b, by_box):
         fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
         ent = basin_entropy_table(img, [b for b in boxes if b <= ns // 4], outside=OUTSIDE).set_index("box")
         exits = [c for c in (0, 1, 2) if fr.frac[c] >= study.params.wada_min_share]
-        w = (wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r)
-             if len(exits) >= 3 else None)
+        w = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r) if len(exits) >= 3 else None
         times = []
         unc = _uncertainty(study, E, 0.0, eps, keys=[scan_unc_key(E, i) for i in range(len(eps))], times=times)
         uncs.append(unc)
@@ -374,18 +429,46 @@ def _energy_scan(study, extent, boxes, hb, E_b, by_box):
         if any(np.isclose(E, e) for e in study.params.energies):
             by_box.extend(_entropy_by_box(study, img, E, 0.0, extent, which="scan"))
         h = ent.loc[hb] if hb in ent.index else ent.iloc[-1]
-        rows.append({"energy": E, "above_E_b": bool(E > E_b), "S_b": float(h.S_b), "S_b_err": float(h.S_b_err),
-                     "S_bb": float(h.S_bb), "S_bb_err": float(h.S_bb_err), "log2_fractal": bool(h.log2_fractal),
-                     "trapped": float(fr.frac[TRAPPED_CODE]),
-                     "wada_exits": bool(w.wada) if w else False,
-                     "W_exits": float(w.wada_fraction[w.r_wada]) if w else math.nan,
-                     "alpha": fit.alpha if fit else math.nan, "alpha_err": fit.alpha_err if fit else math.nan,
-                     "alpha_p": fit.p_value if fit else math.nan,
-                     "lam": rate["value"] if rate else math.nan, "lam_err": rate["err"] if rate else math.nan})
-    cols = ["energy", "above_E_b", "S_b", "S_b_err", "S_bb", "S_bb_err", "log2_fractal", "trapped", "wada_exits",
-            "W_exits", "alpha", "alpha_err", "alpha_p", "lam", "lam_err"]
-    return (pd.DataFrame(rows, columns=cols),
-            pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]))
+        rows.append(
+            {
+                "energy": E,
+                "above_E_b": bool(E > E_b),
+                "S_b": float(h.S_b),
+                "S_b_err": float(h.S_b_err),
+                "S_bb": float(h.S_bb),
+                "S_bb_err": float(h.S_bb_err),
+                "log2_fractal": bool(h.log2_fractal),
+                "trapped": float(fr.frac[TRAPPED_CODE]),
+                "wada_exits": bool(w.wada) if w else False,
+                "W_exits": float(w.wada_fraction[w.r_wada]) if w else math.nan,
+                "alpha": fit.alpha if fit else math.nan,
+                "alpha_err": fit.alpha_err if fit else math.nan,
+                "alpha_p": fit.p_value if fit else math.nan,
+                "lam": rate["value"] if rate else math.nan,
+                "lam_err": rate["err"] if rate else math.nan,
+            }
+        )
+    cols = [
+        "energy",
+        "above_E_b",
+        "S_b",
+        "S_b_err",
+        "S_bb",
+        "S_bb_err",
+        "log2_fractal",
+        "trapped",
+        "wada_exits",
+        "W_exits",
+        "alpha",
+        "alpha_err",
+        "alpha_p",
+        "lam",
+        "lam_err",
+    ]
+    return (
+        pd.DataFrame(rows, columns=cols),
+        pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]),
+    )
 
 
 # -- plot -----------------------------------------------------------------------------------
@@ -393,10 +476,14 @@ def plot(study):
     """plot(study) -> None: basins.png from the derived tables."""
     from .figure import plot_basins
 
-    plot_basins(pd.read_parquet(study.derived("basins_maps.parquet")),
-                pd.read_parquet(study.derived("basins_zooms.parquet")),
-                pd.read_parquet(study.derived("basins_entropy.parquet")),
-                pd.read_parquet(study.derived("basins_uncertainty.parquet")),
-                study.read_numbers(), study.figure_path, scale=study.scale,
-                local=pd.read_parquet(study.derived("basins_local_exponent.parquet")),
-                scan=pd.read_parquet(study.derived("basins_energy_scan.parquet")))
+    plot_basins(
+        pd.read_parquet(study.derived("basins_maps.parquet")),
+        pd.read_parquet(study.derived("basins_zooms.parquet")),
+        pd.read_parquet(study.derived("basins_entropy.parquet")),
+        pd.read_parquet(study.derived("basins_uncertainty.parquet")),
+        study.read_numbers(),
+        study.figure_path,
+        scale=study.scale,
+        local=pd.read_parquet(study.derived("basins_local_exponent.parquet")),
+        scan=pd.read_parquet(study.derived("basins_energy_scan.parquet")),
+    )

@@ -1,4 +1,5 @@
 """Fig. 1 of the paper: potential contours (a) and the c-measure support (b). Draws only."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -38,16 +39,21 @@ def plot_fig1(grid, points, numbers, path):
     norm = plt.Normalize(0.0, 0.5)
     colours = [cmap(norm(e)) for e in levels]
     others = ~np.isclose(levels, E_c, rtol=0, atol=1e-12)
-    ax.contour(xs, ys, V, levels=levels[others], colors=[c for c, o in zip(colours, others) if o],
-               linewidths=0.9)
+    ax.contour(xs, ys, V, levels=levels[others], colors=[c for c, o in zip(colours, others) if o], linewidths=0.9)
     ax.contour(xs, ys, V, levels=[E_c], colors="tab:blue", linewidths=2.2)
     ax.plot(saddles[:, 0], saddles[:, 1], "o", color="tab:green", ms=7, mec="k", mew=0.6, zorder=5)
     sm = plt.cm.ScalarMappable(cmap=cmap, norm=norm)
     cb = fig.colorbar(sm, ax=ax, shrink=0.8, pad=0.02)
     cb.set_label("energy $E$ of the contour $V(x,y)=E$")
-    ax.legend(handles=[Line2D([], [], color="tab:blue", lw=2.2, label=r"$E = E_c = 1/6$"),
-                       Line2D([], [], ls="", marker="o", color="tab:green", mec="k", label="saddle points")],
-              loc="upper right", fontsize=9, framealpha=0.9)
+    ax.legend(
+        handles=[
+            Line2D([], [], color="tab:blue", lw=2.2, label=r"$E = E_c = 1/6$"),
+            Line2D([], [], ls="", marker="o", color="tab:green", mec="k", label="saddle points"),
+        ],
+        loc="upper right",
+        fontsize=9,
+        framealpha=0.9,
+    )
     ax.set_title(f"(a) potential contours, {levels.size} energies in (0, 0.5)", loc="left", fontsize=11)
 
     ax = axes[1]
@@ -58,11 +64,29 @@ def plot_fig1(grid, points, numbers, path):
         info = energies[key]
         sel = np.isclose(points["energy"].to_numpy(), info["energy"])
         colour = POINT_COLOURS.get(key, None)
-        ax.scatter(points["x"].to_numpy()[sel], points["y"].to_numpy()[sel], s=0.8, lw=0, color=colour,
-                   alpha=0.8, rasterized=True)
-        handles.append(Line2D([], [], ls="", marker="o", ms=5, color=colour,
-                              label=(f"$E = {info['energy']:.2f}$: {info['n_points']} points, "
-                                     f"$t_{{rec}} = {info['t_rec']:g}$ ($\\kappa t_{{rec}} = {info['t_rec_times_kappa']:.1f}$)")))
+        ax.scatter(
+            points["x"].to_numpy()[sel],
+            points["y"].to_numpy()[sel],
+            s=0.8,
+            lw=0,
+            color=colour,
+            alpha=0.8,
+            rasterized=True,
+        )
+        handles.append(
+            Line2D(
+                [],
+                [],
+                ls="",
+                marker="o",
+                ms=5,
+                color=colour,
+                label=(
+                    f"$E = {info['energy']:.2f}$: {info['n_points']} points, "
+                    f"$t_{{rec}} = {info['t_rec']:g}$ ($\\kappa t_{{rec}} = {info['t_rec_times_kappa']:.1f}$)"
+                ),
+            )
+        )
     ax.plot(saddles[:, 0], saddles[:, 1], "o", color="tab:green", ms=5, mec="k", mew=0.5, zorder=5)
     ax.legend(handles=handles, loc="lower center", fontsize=8.5, framealpha=0.9)
     ax.set_title(r"(b) support of $\mu_c$ (sprinkler: first crossing after $t_{rec}$)", loc="left", fontsize=11)

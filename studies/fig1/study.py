@@ -33,6 +33,7 @@ raw runs ``raw/E0.30`` and ``raw/E0.35``; all rows have t ≥ t_rec by
 construction (first_only). ``fig1.json`` names the table (``tables``) and
 gives t_rec per energy (``cmeasure_sample``).
 """
+
 from __future__ import annotations
 
 import json
@@ -40,21 +41,21 @@ import math
 
 import numpy as np
 
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 from hhscatter.run.plan import SCENE_FILE
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
     """``[study]`` of studies/fig1/study.toml."""
 
-    energies: Numbers            # E of the main runs (c-measure samples)
-    pilot_n: Integer             # orbits of the pilot runs (κ, τ0 → t_rec)
+    energies: Numbers  # E of the main runs (c-measure samples)
+    pilot_n: Integer  # orbits of the pilot runs (κ, τ0 → t_rec)
     pilot_seed: Integer
     pilot_t_max: Number
-    rec_efolds: Number           # t_rec = ceil(τ0 + rec_efolds/κ)
-    t_after: Number              # main runs: t_max = t_rec + t_after
-    n_contours: Integer          # Fig. 1a contour levels k/(n+1)·0.5
-    grid_half_width: Number      # potential grid [-h, h]²
+    rec_efolds: Number  # t_rec = ceil(τ0 + rec_efolds/κ)
+    t_after: Number  # main runs: t_max = t_rec + t_after
+    n_contours: Integer  # Fig. 1a contour levels k/(n+1)·0.5
+    grid_half_width: Number  # potential grid [-h, h]²
     grid_points: Integer
 
 
@@ -118,16 +119,23 @@ def simulate(study, workers=None, progress=True):
 
     choices = {}
     for energy in study.params.energies:
-        pdir = study.run(f"pilot_{energy_key(energy)}", _pilot_scene(study, energy), workers=workers,
-                         progress=progress)
+        pdir = study.run(f"pilot_{energy_key(energy)}", _pilot_scene(study, energy), workers=workers, progress=progress)
         r = _pilot_rate(pdir)
         t_rec = recording_time(r.kappa, r.tau0, study.params.rec_efolds)
-        print(f"  fig1 E={energy}: pilot κ = {r.kappa:.4f} ± {r.kappa_err:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}",
-              flush=True)
+        print(
+            f"  fig1 E={energy}: pilot κ = {r.kappa:.4f} ± {r.kappa_err:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}",
+            flush=True,
+        )
         study.run(energy_key(energy), _main_scene(study, energy, t_rec), workers=workers, progress=progress)
-        choices[energy_key(energy)] = {"energy": float(energy), "t_rec": t_rec, "kappa": r.kappa,
-                                       "kappa_err": r.kappa_err, "tau0": r.tau0, "t_stop": r.t_stop,
-                                       "n_pilot": int(r.n_total)}
+        choices[energy_key(energy)] = {
+            "energy": float(energy),
+            "t_rec": t_rec,
+            "kappa": r.kappa,
+            "kappa_err": r.kappa_err,
+            "tau0": r.tau0,
+            "t_stop": r.t_stop,
+            "n_pilot": int(r.n_total),
+        }
     write_json_atomic(_choices_path(study), choices)
 
 
@@ -146,9 +154,12 @@ def analyze(study):
         key = energy_key(energy)
         per_energy[key], pts = _energy_run(study, energy, key, choices[key])
         points.append(pts)
-    study.write_table(pd.concat(points, ignore_index=True), CMEASURE_TABLE,
-                      description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec; "
-                                  "energy = the run's E, e_cross = the orbit's energy at the crossing")
+    study.write_table(
+        pd.concat(points, ignore_index=True),
+        CMEASURE_TABLE,
+        description="sprinkler c-measure sample: first section crossing (ṙ=0, φ̇>0) at t ≥ t_rec; "
+        "energy = the run's E, e_cross = the orbit's energy at the crossing",
+    )
     _write_potential_grid(study)
     study.write_numbers(_numbers(study, per_energy))
 
@@ -161,8 +172,10 @@ def _energy_run(study, energy: float, key: str, ch: dict):
     t_rec = float(ch["t_rec"])
     scene = json.loads((study.raw(key) / SCENE_FILE).read_text())["scene"]
     if abs(float(scene["sections"]["t_from"]) - t_rec) > 1e-9:
-        raise RuntimeError(f"{key}: raw run's t_rec = {scene['sections']['t_from']} is not the recorded "
-                           f"choice {t_rec}; re-run the simulate stage")
+        raise RuntimeError(
+            f"{key}: raw run's t_rec = {scene['sections']['t_from']} is not the recorded "
+            f"choice {t_rec}; re-run the simulate stage"
+        )
     # the rule with the current analysis code (differs only if escape_rate changed since simulate)
     r = _pilot_rate(study.raw(f"pilot_{key}"))
     t_rec_now = recording_time(r.kappa, r.tau0, study.params.rec_efolds)
@@ -194,9 +207,14 @@ def _energy_run(study, energy: float, key: str, ch: dict):
     pts.insert(0, "energy", energy)
     pts["e_cross"] = sec["energy"].to_numpy()  # the orbit's energy at the crossing (E up to rounding)
     # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
-    study.compare(f"kappa(E={energy:.2f}) used for t_rec", ch["kappa"], ch["kappa_err"],
-                  1.41 * (energy - study.model.critical_energy), unit="1/time",
-                  note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b")
+    study.compare(
+        f"kappa(E={energy:.2f}) used for t_rec",
+        ch["kappa"],
+        ch["kappa_err"],
+        1.41 * (energy - study.model.critical_energy),
+        unit="1/time",
+        note="pilot fit vs the paper's linear law κ = 1.41 (E − E_c) of Fig. 2b",
+    )
     return entry, pts
 
 
@@ -208,8 +226,11 @@ def _write_potential_grid(study) -> None:
     m = study.params.grid_points
     g = np.linspace(-h, h, m)
     X, Y = np.meshgrid(g, g)
-    study.write_table(pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": study.model.potential(X, Y).ravel()}),
-                      "potential_grid.parquet", description=f"V(x, y) on a {m}×{m} grid, Eq. (eqn:hh_potential)")
+    study.write_table(
+        pd.DataFrame({"x": X.ravel(), "y": Y.ravel(), "V": study.model.potential(X, Y).ravel()}),
+        "potential_grid.parquet",
+        description=f"V(x, y) on a {m}×{m} grid, Eq. (eqn:hh_potential)",
+    )
 
 
 def _numbers(study, per_energy: dict) -> dict:
@@ -217,14 +238,14 @@ def _numbers(study, per_energy: dict) -> dict:
     model = study.model  # E_c and the saddles of the scene's potential (ω, λ)
     return {
         "sprinkler_rule": "t_rec = ceil(tau0 + rec_efolds/kappa), kappa and tau0 from the pilot run's Kaplan-Meier "
-                          "P(t) (escape_rate: mean of 4 window fits); main run records the first section crossing "
-                          "at t >= t_rec (SectionWindow first_only=True), t_max = t_rec + t_after",
+        "P(t) (escape_rate: mean of 4 window fits); main run records the first section crossing "
+        "at t >= t_rec (SectionWindow first_only=True), t_max = t_rec + t_after",
         "rec_efolds": study.params.rec_efolds,
         "energies": per_energy,
         "tables": {"cmeasure_points": CMEASURE_TABLE, "potential_grid": "potential_grid.parquet"},
         "cmeasure_sample": {
             "how": f"the rows of derived/{CMEASURE_TABLE} with energy = E (published for other studies), i.e. every "
-                   "row of the 'sections' table of raw run raw/E0.30 (raw/E0.35); all rows have t >= t_rec",
+            "row of the 'sections' table of raw run raw/E0.30 (raw/E0.35); all rows have t >= t_rec",
             "raw_keys": {k: v["raw_run"] for k, v in per_energy.items()},
             "t_rec": {k: v["t_rec"] for k, v in per_energy.items()},
             "n_points": {k: v["n_points"] for k, v in per_energy.items()},

@@ -1,10 +1,11 @@
 """Fig. 2 of the paper: P(t) at two energies (a) and κ0(E) (b). Draws only."""
+
 from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.formatting import format_value_err
 from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
 
 PT_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
 
@@ -39,8 +40,13 @@ def _panel_a(ax, curves, lines, numbers):
         keep = c["P"].to_numpy() > 0
         t, P, err = c["t"].to_numpy()[keep], c["P"].to_numpy()[keep], c["P_err"].to_numpy()[keep]
         kap = info["kappa"]
-        ax.plot(t, P, color=colour, lw=1.5,
-                label=rf"$E_0 = {E:.2f}$ ($N = {_sci(info['n'])}$): $\kappa = {_fmt_err(kap['value'], kap['err'])}$")
+        ax.plot(
+            t,
+            P,
+            color=colour,
+            lw=1.5,
+            label=rf"$E_0 = {E:.2f}$ ($N = {_sci(info['n'])}$): $\kappa = {_fmt_err(kap['value'], kap['err'])}$",
+        )
         ax.fill_between(t, np.clip(P - err, P * 0.05, None), P + err, color=colour, alpha=0.25, lw=0)
         ln = lines[np.isclose(lines["energy"], E)]
         ex = ln[ln["kind"] == "exponential"]
@@ -49,20 +55,39 @@ def _panel_a(ax, curves, lines, numbers):
         if info.get("tail_detected"):
             Pe = c["P_esc"].to_numpy()
             ke = Pe > 0
-            ax.plot(c["t"].to_numpy()[ke], Pe[ke], color=colour, lw=0.9, ls=(0, (4, 2)),
-                    label=rf"$E_0 = {E:.2f}$, escaping orbits only ($P_{{esc}}$)")
+            ax.plot(
+                c["t"].to_numpy()[ke],
+                Pe[ke],
+                color=colour,
+                lw=0.9,
+                ls=(0, (4, 2)),
+                label=rf"$E_0 = {E:.2f}$, escaping orbits only ($P_{{esc}}$)",
+            )
             pl = ln[ln["kind"] == "power_law"]
             win = info["tail_window"]
             on = (pl["t"] >= 0.85 * win[0]) & (pl["t"] <= 1.15 * win[1])
             ax.plot(pl["t"][on], pl["P"][on], ":", color="k", lw=1.8)
             z = info["z"]
-            ax.annotate(rf"$t^{{-z}},\ z = {_fmt_err(z['value'], z['err'])}$",
-                        (pl["t"][on].iloc[len(pl["t"][on]) // 2], pl["P"][on].iloc[len(pl["t"][on]) // 2]),
-                        xytext=(10, 4), textcoords="offset points", color=colour, fontsize=9)
+            ax.annotate(
+                rf"$t^{{-z}},\ z = {_fmt_err(z['value'], z['err'])}$",
+                (pl["t"][on].iloc[len(pl["t"][on]) // 2], pl["P"][on].iloc[len(pl["t"][on]) // 2]),
+                xytext=(10, 4),
+                textcoords="offset points",
+                color=colour,
+                fontsize=9,
+            )
             ts = info["tau_star"] if info.get("tau_star") is not None else info["tau_c"]
             ax.axvline(ts, color=colour, lw=0.9, ls="-.", alpha=0.8)
-            ax.annotate(rf"$\tau^\star \approx {ts:.0f}$", (ts, 0.3), xycoords=("data", "axes fraction"),
-                        xytext=(4, 0), textcoords="offset points", color=colour, fontsize=9, rotation=90)
+            ax.annotate(
+                rf"$\tau^\star \approx {ts:.0f}$",
+                (ts, 0.3),
+                xycoords=("data", "axes fraction"),
+                xytext=(4, 0),
+                textcoords="offset points",
+                color=colour,
+                fontsize=9,
+                rotation=90,
+            )
             # inset: log–log view of the escaping orbits' tail
             if inset is None:
                 inset = ax.inset_axes([0.62, 0.50, 0.35, 0.36])
@@ -74,14 +99,23 @@ def _panel_a(ax, curves, lines, numbers):
             lt = info.get("late_tail")
             if lt:
                 zr = lt["z_mle_trapped_removed"]
-                inset.text(0.03, 0.04, f"$t > {lt['t_window'][0]:.0f}$: {lt['n_events']} escapes,\n"
-                           rf"$z_{{MLE}} = {_fmt_err(zr['value'], zr['err'])}$", transform=inset.transAxes,
-                           fontsize=7, va="bottom")
+                inset.text(
+                    0.03,
+                    0.04,
+                    f"$t > {lt['t_window'][0]:.0f}$: {lt['n_events']} escapes,\n"
+                    rf"$z_{{MLE}} = {_fmt_err(zr['value'], zr['err'])}$",
+                    transform=inset.transAxes,
+                    fontsize=7,
+                    va="bottom",
+                )
             inset.set_xlabel("$t$", fontsize=8, labelpad=1)
             inset.set_ylabel(r"$P_{esc}(t)$", fontsize=8, labelpad=1)
             inset.tick_params(labelsize=7)
-            inset.set_title(f"$E_0={E:.2f}$: escaping orbits (solid), all (dashed;\n"
-                            f"KAM-trapped fraction {info['trapped_fraction']:.1e})", fontsize=7)
+            inset.set_title(
+                f"$E_0={E:.2f}$: escaping orbits (solid), all (dashed;\n"
+                f"KAM-trapped fraction {info['trapped_fraction']:.1e})",
+                fontsize=7,
+            )
     ax.set_yscale("log")
     ax.set_xlim(0, t_right)
     ymin = min(float(np.nanmin(curves["P"][curves["P"] > 0])), 1e-3)
@@ -89,35 +123,71 @@ def _panel_a(ax, curves, lines, numbers):
     ax.set_xlabel("time $t$")
     ax.set_ylabel("survival probability $P(t)$")
     ax.legend(loc="lower left", fontsize=8.5)
-    ax.set_title(r"(a) $P(t)$, Hamiltonian ($\gamma = 0$); dashed: $f_0 e^{-\kappa t}$, dotted: $f_{*}\, t^{-z}$",
-                 loc="left", fontsize=10)
+    ax.set_title(
+        r"(a) $P(t)$, Hamiltonian ($\gamma = 0$); dashed: $f_0 e^{-\kappa t}$, dotted: $f_{*}\, t^{-z}$",
+        loc="left",
+        fontsize=10,
+    )
     ax.grid(True, which="major", alpha=0.3)
 
 
 def _panel_b(ax, kappa_e, fit_curve, cm, numbers):
     fit = numbers["kappa_fit"]
-    ax.errorbar(kappa_e["x"], kappa_e["kappa"], yerr=kappa_e["kappa_err"], fmt="o", ms=4, color="tab:blue",
-                ecolor="tab:blue", capsize=2, label=r"$\kappa_0$ from $P(t)$: mean of 4 window fits (bar: spread $\oplus$ stat.)", zorder=4)
+    ax.errorbar(
+        kappa_e["x"],
+        kappa_e["kappa"],
+        yerr=kappa_e["kappa_err"],
+        fmt="o",
+        ms=4,
+        color="tab:blue",
+        ecolor="tab:blue",
+        capsize=2,
+        label=r"$\kappa_0$ from $P(t)$: mean of 4 window fits (bar: spread $\oplus$ stat.)",
+        zorder=4,
+    )
     main = cm[cm["shift_efolds"] == 0.0]
     if len(main):
-        ax.errorbar(main["x"], main["kappa_cm"], yerr=main["kappa_cm_err"], fmt="D", ms=6, mfc="none",
-                    mec="tab:red", ecolor="tab:red", capsize=2, zorder=5,
-                    label=r"$\kappa$ from the c-measure, $\int e^{\kappa T} d\mu_c = 1 + \mu_c(\mathcal{E})$")
+        ax.errorbar(
+            main["x"],
+            main["kappa_cm"],
+            yerr=main["kappa_cm_err"],
+            fmt="D",
+            ms=6,
+            mfc="none",
+            mec="tab:red",
+            ecolor="tab:red",
+            capsize=2,
+            zorder=5,
+            label=r"$\kappa$ from the c-measure, $\int e^{\kappa T} d\mu_c = 1 + \mu_c(\mathcal{E})$",
+        )
     styles = {"nonlinear": ("tab:green", "--"), "linear": ("tab:orange", "--")}
     for regime, (colour, ls) in styles.items():
         f = fit_curve[(fit_curve["model"] == "continuous") & (fit_curve["regime"] == regime)]
         if regime == "nonlinear":
-            lab = (rf"$a x^2 + b x$: $a = {_fmt_err(fit['a']['value'], fit['a']['err'])}$, "
-                   rf"$b = {_fmt_err(fit['b']['value'], fit['b']['err'])}$")
+            lab = (
+                rf"$a x^2 + b x$: $a = {_fmt_err(fit['a']['value'], fit['a']['err'])}$, "
+                rf"$b = {_fmt_err(fit['b']['value'], fit['b']['err'])}$"
+            )
         else:
             lab = rf"$c x$: $c = {_fmt_err(fit['c']['value'], fit['c']['err'])}$"
         ax.plot(f["x"], f["kappa"], ls, color=colour, lw=1.6, label=lab)
         p = fit_curve[(fit_curve["model"] == "paper") & (fit_curve["regime"] == regime)]
-        ax.plot(p["x"], p["kappa"], ":", color="0.45", lw=1.0,
-                label=_paper_law_label(numbers["paper"]) if regime == "linear" else None)
+        ax.plot(
+            p["x"],
+            p["kappa"],
+            ":",
+            color="0.45",
+            lw=1.0,
+            label=_paper_law_label(numbers["paper"]) if regime == "linear" else None,
+        )
     xb = fit["E_b"]["value"] - numbers["E_c"]
-    ax.axvline(xb, color="tab:purple", ls="-.", lw=1.2,
-               label=rf"break $E_b = {_fmt_err(fit['E_b']['value'], fit['E_b']['err'])}$")
+    ax.axvline(
+        xb,
+        color="tab:purple",
+        ls="-.",
+        lw=1.2,
+        label=rf"break $E_b = {_fmt_err(fit['E_b']['value'], fit['E_b']['err'])}$",
+    )
     ax.set_xlabel(r"$E_0 - E_c$")
     ax.set_ylabel(r"escape rate $\kappa_0$ (1/time)")
     ax.set_xlim(0, None)
@@ -144,8 +214,18 @@ def _panel_c(ax, conv_table, numbers):
         m, colour, dx = CONVENTION_STYLE[name]
         d = near[near["convention"] == name]
         ok = d[d["defined"]]
-        ax.errorbar(ok["x"] + dx, ok["kappa"], yerr=ok["kappa_err"], fmt=m, ms=4.5, color=colour, capsize=2,
-                    mfc="none" if "plevel" in name else colour, label=label, zorder=4)
+        ax.errorbar(
+            ok["x"] + dx,
+            ok["kappa"],
+            yerr=ok["kappa_err"],
+            fmt=m,
+            ms=4.5,
+            color=colour,
+            capsize=2,
+            mfc="none" if "plevel" in name else colour,
+            label=label,
+            zorder=4,
+        )
         bad = d[~d["defined"]]
         if len(bad):
             ax.plot(bad["x"] + dx, np.zeros(len(bad)), "x", color=colour, ms=8, mew=2, clip_on=False, zorder=5)
@@ -159,14 +239,26 @@ def _panel_c(ax, conv_table, numbers):
         a, b, c = law["a"]["value"], law["b"]["value"], law["c"]["value"]
         xb = law["E_b"]["value"] - numbers["E_c"]
         lo, hi = xs[xs <= xb], xs[xs >= xb]
-        ax.plot(lo, a * lo**2 + b * lo, "-", color="k", lw=1.2,
-                label=rf"law across conventions: $a = {_fmt_err(a, law['a']['err'])}$, "
-                      rf"$b = {_fmt_err(b, law['b']['err'])}$, $c = {_fmt_err(c, law['c']['err'])}$")
+        ax.plot(
+            lo,
+            a * lo**2 + b * lo,
+            "-",
+            color="k",
+            lw=1.2,
+            label=rf"law across conventions: $a = {_fmt_err(a, law['a']['err'])}$, "
+            rf"$b = {_fmt_err(b, law['b']['err'])}$, $c = {_fmt_err(c, law['c']['err'])}$",
+        )
         ax.plot(hi, c * hi, "-", color="k", lw=1.2)
     pp = numbers["paper"]  # the paper's law (Fig. 2b caption), as the study recorded it
     xp = pp["E_b"] - numbers["E_c"]
-    ax.plot(xs[xs <= xp], pp["a"] * xs[xs <= xp]**2 + pp["b"] * xs[xs <= xp], ":", color="0.45", lw=1.0,
-            label=_paper_law_label(pp))
+    ax.plot(
+        xs[xs <= xp],
+        pp["a"] * xs[xs <= xp] ** 2 + pp["b"] * xs[xs <= xp],
+        ":",
+        color="0.45",
+        lw=1.0,
+        label=_paper_law_label(pp),
+    )
     ax.plot(xs[xs >= xp], pp["c"] * xs[xs >= xp], ":", color="0.45", lw=1.0)
     ax.plot([], [], "x", color="0.3", ms=7, mew=2, label="κ ill-defined (trapped plateau): excluded")
     ax.fill_between([], [], color="0.85", label=f"unstable across conventions (> {conv['stable_rel_tol']:.0%})")
@@ -175,8 +267,12 @@ def _panel_c(ax, conv_table, numbers):
     ax.set_xlabel(r"$E_0 - E_c$")
     ax.set_ylabel(r"$\kappa_0$ (1/time)")
     ax.legend(loc="upper left", fontsize=7.5)
-    ax.set_title(r"(c) $\kappa_0$ near $E_c$: IC region (disk, authors' square) $\times$ windows "
-                 rf"(plateau, $P = {conv['p_levels'][0]:g} \to {conv['p_levels'][1]:g}$)", loc="left", fontsize=10)
+    ax.set_title(
+        r"(c) $\kappa_0$ near $E_c$: IC region (disk, authors' square) $\times$ windows "
+        rf"(plateau, $P = {conv['p_levels'][0]:g} \to {conv['p_levels'][1]:g}$)",
+        loc="left",
+        fontsize=10,
+    )
     ax.grid(True, alpha=0.3)
 
 

@@ -12,6 +12,7 @@ and τ0, orbits run to ``cm_t_max`` so that KAM-trapped ones are recognised. The
 (``kappa_cmeasure``, Eq. (eqn:kappa_cmeasure_truetime)); numbers in ``fig2.json`` with the paper comparison.
 ``plot``: ``fig2.png`` (``figure.py``). Parameters: ``study.toml``.
 """
+
 from __future__ import annotations
 
 import json
@@ -68,10 +69,10 @@ class Params(StudyParams):
     fit_seed: Integer
     # -- κ(E) near E_c under several conventions (the authors' square ICs, windows fixed by P levels) --
     grid_n_by_energy: Integers = None  # orbits per grid energy (same order as grid_energies); None: grid_n for all
-    square_energies: Numbers = []      # grid energies also run with the authors' square ICs (raw sq_grid_E…)
-    p_levels: Numbers = [0.5, 0.01]    # [p_hi, p_lo] of the P-level windows
-    max_plateau_bias: Number = 0.1     # κ ill-defined when the trapped fraction is > this share of P at the window end
-    stable_rel_tol: Number = 0.1       # κ(E) stable: (max − min)/mean over the defined conventions ≤ this
+    square_energies: Numbers = []  # grid energies also run with the authors' square ICs (raw sq_grid_E…)
+    p_levels: Numbers = [0.5, 0.01]  # [p_hi, p_lo] of the P-level windows
+    max_plateau_bias: Number = 0.1  # κ ill-defined when the trapped fraction is > this share of P at the window end
+    stable_rel_tol: Number = 0.1  # κ(E) stable: (max − min)/mean over the defined conventions ≤ this
 
 
 PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
@@ -121,8 +122,15 @@ def _t_max_choice(study, pilot_dir, n):
 
     t_end, obs = lifetimes_to_arrays(_lifetimes(pilot_dir))
     p = study.params
-    return choose_t_max(t_end, obs, n, min_survivors=p.min_survivors, margin_efolds=p.margin_efolds,
-                        t_min=p.t_max_min, t_cap=p.t_max_cap)
+    return choose_t_max(
+        t_end,
+        obs,
+        n,
+        min_survivors=p.min_survivors,
+        margin_efolds=p.margin_efolds,
+        t_min=p.t_max_min,
+        t_cap=p.t_max_cap,
+    )
 
 
 def _grid_rate(study, energy, lifetimes=None):
@@ -136,8 +144,9 @@ def _grid_rate(study, energy, lifetimes=None):
 def _cm_windows(study, energy):
     """κ of the grid run at E and the c-measure window it gives (t_rec, t_sample_end, t_record_end)."""
     r, p = _grid_rate(study, energy), study.params
-    return r, cmeasure_windows(r.kappa, r.tau0, p.cm_rec_efolds, p.cm_sample_efolds, p.cm_margin,
-                               max(p.cm_start_shifts))
+    return r, cmeasure_windows(
+        r.kappa, r.tau0, p.cm_rec_efolds, p.cm_sample_efolds, p.cm_margin, max(p.cm_start_shifts)
+    )
 
 
 def _choices_path(study):
@@ -158,10 +167,17 @@ def simulate(study, workers=None, progress=True):
         raise ValueError(f"[study].square_energies must be among grid_energies; {off} are not")
     missing = [e for e in study.params.cm_energies if not np.isclose(grid, e).any()]
     if missing:
-        raise ValueError(f"[study].cm_energies must be among grid_energies (t_rec comes from their κ); {missing} are not")
+        raise ValueError(
+            f"[study].cm_energies must be among grid_energies (t_rec comes from their κ); {missing} are not"
+        )
     for energy in grid:
-        pilot = study.scene(f"pilot_E{energy:.3f}", energy=energy, n=study.params.pilot_n,
-                            seed=study.params.pilot_seed, t_max=study.params.pilot_t_max)
+        pilot = study.scene(
+            f"pilot_E{energy:.3f}",
+            energy=energy,
+            n=study.params.pilot_n,
+            seed=study.params.pilot_seed,
+            t_max=study.params.pilot_t_max,
+        )
         pdir = study.run(f"pilot_E{energy:.3f}", pilot, workers=workers, progress=progress)
         n = grid_n(study, energy)
         choice = _t_max_choice(study, pdir, n)
@@ -173,19 +189,34 @@ def simulate(study, workers=None, progress=True):
             sq = study.scene(sq_key(energy), energy=energy, n=n, t_max=choice.t_max, region="square")
             study.run(sq_key(energy), sq, workers=workers, progress=progress)
     for energy, n in zip(study.params.pt_energies, study.params.pt_n):
-        scene = study.scene(pt_key(energy), energy=float(energy), n=int(n), seed=study.params.pt_seed,
-                            t_max=study.params.pt_t_max)
+        scene = study.scene(
+            pt_key(energy), energy=float(energy), n=int(n), seed=study.params.pt_seed, t_max=study.params.pt_t_max
+        )
         study.run(pt_key(energy), scene, workers=workers, progress=progress)
     for energy in study.params.cm_energies:
         energy = float(energy)
         r, (t_rec, t_samp, t_rec_end) = _cm_windows(study, energy)
-        choices["cmeasure"][cm_key(energy)] = {"energy": energy, "kappa": r.kappa, "tau0": r.tau0, "t_rec": t_rec,
-                                               "t_sample_end": t_samp, "t_record_end": t_rec_end}
-        print(f"  fig2 c-measure E={energy}: κ = {r.kappa:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}, "
-              f"recording to {t_rec_end:.2f}", flush=True)
-        scene = study.scene(cm_key(energy), energy=energy, n=study.params.cm_n,
-                            seed=study.params.cm_seed, t_max=study.params.cm_t_max,
-                            sections={"t_from": t_rec, "t_to": t_rec_end, "first_only": False})
+        choices["cmeasure"][cm_key(energy)] = {
+            "energy": energy,
+            "kappa": r.kappa,
+            "tau0": r.tau0,
+            "t_rec": t_rec,
+            "t_sample_end": t_samp,
+            "t_record_end": t_rec_end,
+        }
+        print(
+            f"  fig2 c-measure E={energy}: κ = {r.kappa:.4f}, τ0 = {r.tau0:.2f} → t_rec = {t_rec:g}, "
+            f"recording to {t_rec_end:.2f}",
+            flush=True,
+        )
+        scene = study.scene(
+            cm_key(energy),
+            energy=energy,
+            n=study.params.cm_n,
+            seed=study.params.cm_seed,
+            t_max=study.params.cm_t_max,
+            sections={"t_from": t_rec, "t_to": t_rec_end, "first_only": False},
+        )
         study.run(cm_key(energy), scene, workers=workers, progress=progress)
     write_json_atomic(_choices_path(study), choices)
 
@@ -210,24 +241,33 @@ def _analyze_grid(study):
         r = _grid_rate(study, energy, lt)
         runs[energy] = (lt, r)  # read and fitted once: the conventions and the c-measure use them again
         t_max = float(_scene_of(path)["t_max"])
-        rows.append({
-            "energy": energy, "x": energy - E_C, **rate_row(r),
-            "n": len(lt), "t_max": t_max, "t_max_reason": tch["reason"],
-            "kappa_pilot": tch["kappa_pilot"] if tch["kappa_pilot"] is not None else math.nan,
-            "n_censored": int((lt["outcome"] == "censored").sum()),
-            "window_reaches_t_max": bool(r.t_stop >= t_max - r.window_choice.width),
-        })
+        rows.append(
+            {
+                "energy": energy,
+                "x": energy - E_C,
+                **rate_row(r),
+                "n": len(lt),
+                "t_max": t_max,
+                "t_max_reason": tch["reason"],
+                "kappa_pilot": tch["kappa_pilot"] if tch["kappa_pilot"] is not None else math.nan,
+                "n_censored": int((lt["outcome"] == "censored").sum()),
+                "window_reaches_t_max": bool(r.t_stop >= t_max - r.window_choice.width),
+            }
+        )
     df = pd.DataFrame(rows)
-    study.write_table(df, "kappa_energy.parquet",
-                      description="κ0(E): mean of 4 least-squares fits of log P(t) (escape_rate), Fig. 2b")
+    study.write_table(
+        df, "kappa_energy.parquet", description="κ0(E): mean of 4 least-squares fits of log P(t) (escape_rate), Fig. 2b"
+    )
     seed = study.params.fit_seed
     n_boot = study.params.n_boot
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fit = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=True,
-                               n_boot=n_boot, rng=seed)
-        sep = fit_kappa_energy(df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=False,
-                               n_boot=n_boot, rng=seed)
+        fit = fit_kappa_energy(
+            df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=True, n_boot=n_boot, rng=seed
+        )
+        sep = fit_kappa_energy(
+            df["energy"], df["kappa"], df["kappa_err"], E_C, continuous=False, n_boot=n_boot, rng=seed
+        )
     return df, fit, sep, runs
 
 
@@ -251,10 +291,16 @@ def _analyze_pt(study):
             entry.update(tail_detected=False)
         numbers[pt_key(energy)] = entry
         compare_pt(study, energy, r, tail, E_C)
-    study.write_table(pd.concat(curves, ignore_index=True), "survival_curves.parquet",
-                      description="Kaplan–Meier P(t) (all orbits) and P_esc(t) (orbits leaving before t_max), Fig. 2a")
-    study.write_table(pd.concat(lines, ignore_index=True), "pt_fit_lines.parquet",
-                      description="fitted exponential f0 e^{-κt} and power law f* t^{-z} of Fig. 2a")
+    study.write_table(
+        pd.concat(curves, ignore_index=True),
+        "survival_curves.parquet",
+        description="Kaplan–Meier P(t) (all orbits) and P_esc(t) (orbits leaving before t_max), Fig. 2a",
+    )
+    study.write_table(
+        pd.concat(lines, ignore_index=True),
+        "pt_fit_lines.parquet",
+        description="fitted exponential f0 e^{-κt} and power law f* t^{-z} of Fig. 2a",
+    )
     return numbers
 
 
@@ -276,19 +322,31 @@ def _pt_fits(study, key: str):
 
 def compare_pt(study, energy: float, r, tail, E_C: float) -> None:
     """Compare with the paper: κ with its Fig. 2b law, τ* with its value, z (not in its text)."""
-    paper_k = PAPER["a"] * (energy - E_C) ** 2 + PAPER["b"] * (energy - E_C) if energy < PAPER["E_b"] \
+    paper_k = (
+        PAPER["a"] * (energy - E_C) ** 2 + PAPER["b"] * (energy - E_C)
+        if energy < PAPER["E_b"]
         else PAPER["c"] * (energy - E_C)
-    study.compare(f"kappa(E0={energy:.2f}) [Fig. 2a]", r.kappa, r.kappa_err, paper_k, unit="1/time",
-                  note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)")
+    )
+    study.compare(
+        f"kappa(E0={energy:.2f}) [Fig. 2a]",
+        r.kappa,
+        r.kappa_err,
+        paper_k,
+        unit="1/time",
+        note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)",
+    )
     if tail.tail is not None:
         tl = tail.tail
         ts, ts_err, note = tau_star_estimate(tail)
-        verdict = None if ts_err else ("agrees within 20 %" if abs(ts / PAPER["tau_star"] - 1) <= 0.2
-                                       else "differs")
-        study.compare(f"tau* (E0={energy:.2f})", ts, ts_err, PAPER["tau_star"], unit="time", note=note,
-                      verdict=verdict)
-        study.compare(f"z (E0={energy:.2f})", tl.z, tl.z_err, None, note="power-law exponent of the sticky "
-                      "tail (the paper annotates it in Fig. 2a; no number in the text)")
+        verdict = None if ts_err else ("agrees within 20 %" if abs(ts / PAPER["tau_star"] - 1) <= 0.2 else "differs")
+        study.compare(f"tau* (E0={energy:.2f})", ts, ts_err, PAPER["tau_star"], unit="time", note=note, verdict=verdict)
+        study.compare(
+            f"z (E0={energy:.2f})",
+            tl.z,
+            tl.z_err,
+            None,
+            note="power-law exponent of the sticky tail (the paper annotates it in Fig. 2a; no number in the text)",
+        )
 
 
 def _analyze_cmeasure(study, grid_runs):
@@ -301,8 +359,11 @@ def _analyze_cmeasure(study, grid_runs):
     import pandas as pd
 
     df = kappa_cmeasure_z(pd.DataFrame(rows))
-    study.write_table(df, "kappa_cmeasure.parquet",
-                      description="κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), vs κ from P(t)")
+    study.write_table(
+        df,
+        "kappa_cmeasure.parquet",
+        description="κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), vs κ from P(t)",
+    )
     df.to_csv(study.derived("kappa_cmeasure.csv"), index=False, float_format="%.6g")  # the same, for reading
     return _cmeasure_numbers(study, df)
 
@@ -317,19 +378,44 @@ def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> lis
     t_rec, t_samp, t_rec_end = ch["t_rec"], ch["t_sample_end"], ch["t_record_end"]
     win = _scene_of(study.raw(key))["sections"]
     if abs(float(win["t_from"]) - t_rec) > 1e-9 or abs(float(win["t_to"]) - t_rec_end) > 1e-6:
-        raise RuntimeError(f"{key}: raw run's section window {win} is not the recorded choice "
-                           f"[{t_rec}, {t_rec_end}]; re-run the simulate stage")
+        raise RuntimeError(
+            f"{key}: raw run's section window {win} is not the recorded choice "
+            f"[{t_rec}, {t_rec_end}]; re-run the simulate stage"
+        )
     r = grid_runs[min(grid_runs, key=lambda e: abs(e - energy))][1]  # the Fig. 2b κ at this energy (a grid E)
     lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "t_end"], categorical=True)
     sec = read_sections(study.raw(key), columns=["traj_id", "t"])
-    own = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
-                      min_survivors=study.params.min_survivors)
-    rows = kappa_cmeasure_shifts(sec, lt, t_rec, t_samp - t_rec, study.params.cm_start_shifts, ch["kappa"],
-                                 t_rec_end, n_boot=study.params.n_boot, seed=study.params.fit_seed)
+    own = escape_rate(
+        lt["t_end"].to_numpy(),
+        observed_from_outcome(lt["outcome"]),
+        detect_tail=False,
+        min_survivors=study.params.min_survivors,
+    )
+    rows = kappa_cmeasure_shifts(
+        sec,
+        lt,
+        t_rec,
+        t_samp - t_rec,
+        study.params.cm_start_shifts,
+        ch["kappa"],
+        t_rec_end,
+        n_boot=study.params.n_boot,
+        seed=study.params.fit_seed,
+    )
     n_trapped = int((lt["outcome"] == "censored").sum())
-    return [{"energy": energy, "x": energy - E_C, **row, "kappa_pt_grid": r.kappa, "kappa_pt_grid_err": r.kappa_err,
-             "kappa_pt_same_run": own.kappa, "kappa_pt_same_run_err": own.kappa_err, "n_trapped_dropped": n_trapped}
-            for row in rows]
+    return [
+        {
+            "energy": energy,
+            "x": energy - E_C,
+            **row,
+            "kappa_pt_grid": r.kappa,
+            "kappa_pt_grid_err": r.kappa_err,
+            "kappa_pt_same_run": own.kappa,
+            "kappa_pt_same_run_err": own.kappa_err,
+            "n_trapped_dropped": n_trapped,
+        }
+        for row in rows
+    ]
 
 
 def _cmeasure_numbers(study, df) -> dict:
@@ -338,10 +424,16 @@ def _cmeasure_numbers(study, df) -> dict:
     numbers = {}
     for _, row in main.iterrows():
         z = row["z_vs_grid"]
-        study.compare(f"κ from the c-measure (E={row['energy']:.2f})", row["kappa_cm"], row["kappa_cm_err"], None,
-                      unit="1/time", verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
-                      note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
-                           f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper")
+        study.compare(
+            f"κ from the c-measure (E={row['energy']:.2f})",
+            row["kappa_cm"],
+            row["kappa_cm_err"],
+            None,
+            unit="1/time",
+            verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
+            note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
+            f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
+        )
         later = df[(df["energy"] == row["energy"]) & (df["shift_efolds"] > 0)]
         numbers[cm_key(row["energy"])] = kappa_cmeasure_entry(row, later)
     return numbers
@@ -387,27 +479,43 @@ def _analyze_conventions(study, grid_runs):
             runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv))
         for region, (lt, res) in runs.items():
             t_end, obs = lifetimes_to_arrays(lt)
-            rows += [{"energy": energy, "x": energy - E_C, "convention": f"{region}_{row['windows']}", "region": region,
-                      **row} for row in convention_rows(t_end, obs, res, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)]
+            rows += [
+                {
+                    "energy": energy,
+                    "x": energy - E_C,
+                    "convention": f"{region}_{row['windows']}",
+                    "region": region,
+                    **row,
+                }
+                for row in convention_rows(t_end, obs, res, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)
+            ]
     table = pd.DataFrame(rows)
     stab = stable_energies(table, rel_tol=study.params.stable_rel_tol)
     table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
-    study.write_table(table, "kappa_conventions.parquet",
-                      description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
-                                  "defined = False where the trapped plateau makes κ ill-defined")
+    study.write_table(
+        table,
+        "kappa_conventions.parquet",
+        description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
+        "defined = False where the trapped plateau makes κ ill-defined",
+    )
     stable = set(stab.loc[stab["stable"], "energy"])
-    fits, fit_info = fit_laws(table, [name for name, *_ in CONVENTIONS], stable, E_C, n_boot=study.params.n_boot,
-                              seed=study.params.fit_seed)
+    fits, fit_info = fit_laws(
+        table, [name for name, *_ in CONVENTIONS], stable, E_C, n_boot=study.params.n_boot, seed=study.params.fit_seed
+    )
     law = law_spread(fits) if fits else {}
     numbers = {
         "conventions": {name: label for name, _, _, label in CONVENTIONS},
-        "p_levels": [p_hi, p_lo], "max_plateau_bias": max_bias,
+        "p_levels": [p_hi, p_lo],
+        "max_plateau_bias": max_bias,
         "stable_rel_tol": study.params.stable_rel_tol,
         "stable_energies": sorted(float(e) for e in stable),
         "unstable_energies": sorted(float(e) for e in stab.loc[~stab["stable"], "energy"]),
-        "ill_defined": [{"energy": r.energy, "convention": r.convention, "reason": r.reason}
-                        for r in table[~table["defined"]].itertuples()],
-        "fits": fit_info, "law": law,
+        "ill_defined": [
+            {"energy": r.energy, "convention": r.convention, "reason": r.reason}
+            for r in table[~table["defined"]].itertuples()
+        ],
+        "fits": fit_info,
+        "law": law,
     }
     return table, stab, numbers
 
@@ -417,8 +525,11 @@ def analyze(study):
     E_C = study.model.critical_energy
     grid_df, fit, sep, grid_runs = _analyze_grid(study)
     laws = {"continuous": fit, "separate": sep, "paper": SimpleNamespace(**PAPER)}
-    study.write_table(kappa_law_curves(laws, float(grid_df["x"].max()), E_C), "kappa_fit_curve.parquet",
-                      description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's")
+    study.write_table(
+        kappa_law_curves(laws, float(grid_df["x"].max()), E_C),
+        "kappa_fit_curve.parquet",
+        description="fitted κ(E) laws of Fig. 2b on a grid of x = E − E_c, and the paper's",
+    )
     fj, sj = kappa_law_summary(fit), kappa_law_summary(sep)
     conv_table, _, conv = _analyze_conventions(study, grid_runs)
     units = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
@@ -431,53 +542,77 @@ def analyze(study):
             across = quoted_verdict(law[name]["value"], law[name]["err"], PAPER[name], half_unit(PAPER[name]))
             if across != "differs":
                 verdict = f"differs in this convention only; across conventions: {across}"
-        study.compare(f"{name} (κ(E) law, continuous fit)", fj[name]["value"], fj[name]["err"], PAPER[name],
-                      unit=units[name], verdict=verdict,
-                      note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
-                           "err = max(covariance, bootstrap); all grid energies")
+        study.compare(
+            f"{name} (κ(E) law, continuous fit)",
+            fj[name]["value"],
+            fj[name]["err"],
+            PAPER[name],
+            unit=units[name],
+            verdict=verdict,
+            note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
+            "err = max(covariance, bootstrap); all grid energies",
+        )
     for name in ("a", "b", "c", "E_b"):
         if name not in law:
             continue
         L = law[name]
-        study.compare(f"{name} (κ(E) law across conventions)", L["value"], L["err"], PAPER[name], unit=units[name],
-                      verdict=quoted_verdict(L["value"], L["err"], PAPER[name], half_unit(PAPER[name])),
-                      convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
-                      authors=True,
-                      note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
-                           + ", ".join(f"{k} {v:.4g}" for k, v in L["per_convention"].items()))
+        study.compare(
+            f"{name} (κ(E) law across conventions)",
+            L["value"],
+            L["err"],
+            PAPER[name],
+            unit=units[name],
+            verdict=quoted_verdict(L["value"], L["err"], PAPER[name], half_unit(PAPER[name])),
+            convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
+            authors=True,
+            note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
+            + ", ".join(f"{k} {v:.4g}" for k, v in L["per_convention"].items()),
+        )
     ill = conv_table[~conv_table["defined"]]
-    study.compare("κ(E) points ill-defined by the trapped plateau", len(ill), None, None,
-                  convention="all 4 conventions",
-                  note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
-                  verdict="excluded from the law, not returned as κ ≈ 0")
+    study.compare(
+        "κ(E) points ill-defined by the trapped plateau",
+        len(ill),
+        None,
+        None,
+        convention="all 4 conventions",
+        note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
+        verdict="excluded from the law, not returned as κ ≈ 0",
+    )
     for name in ("a", "b", "c", "E_b"):
-        study.compare(f"{name} (κ(E) law, separate fits)", sj[name]["value"], sj[name]["err"], PAPER[name],
-                      verdict=quoted_verdict(sj[name]["value"], sj[name]["err"], PAPER[name], half_unit(PAPER[name])),
-                      note="the two laws fitted independently on either side of the best partition (as the paper)")
+        study.compare(
+            f"{name} (κ(E) law, separate fits)",
+            sj[name]["value"],
+            sj[name]["err"],
+            PAPER[name],
+            verdict=quoted_verdict(sj[name]["value"], sj[name]["err"], PAPER[name], half_unit(PAPER[name])),
+            note="the two laws fitted independently on either side of the best partition (as the paper)",
+        )
     pt = _analyze_pt(study)
     cm = _analyze_cmeasure(study, grid_runs)
-    study.write_numbers({
-        "rules": {
-            "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "
-                     "covering most e-folds, floor of min_survivors survivors); kappa = mean of the 4 weighted "
-                     "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
-            "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
-                     " clipped to [t_max_min, t_max_cap]",
-            "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
-                    "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
-            "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
-                        "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
-                        "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
-        },
-        "E_c": E_C,
-        "kappa_fit": fj,
-        "kappa_fit_separate": sj,
-        "paper": PAPER,
-        "kappa_energy": grid_df.to_dict(orient="records"),
-        "kappa_conventions": conv,
-        "Pt": pt,
-        "cmeasure": cm,
-    })
+    study.write_numbers(
+        {
+            "rules": {
+                "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "
+                "covering most e-folds, floor of min_survivors survivors); kappa = mean of the 4 weighted "
+                "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
+                "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
+                " clipped to [t_max_min, t_max_cap]",
+                "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
+                "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
+                "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
+                "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
+                "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
+            },
+            "E_c": E_C,
+            "kappa_fit": fj,
+            "kappa_fit_separate": sj,
+            "paper": PAPER,
+            "kappa_energy": grid_df.to_dict(orient="records"),
+            "kappa_conventions": conv,
+            "Pt": pt,
+            "cmeasure": cm,
+        }
+    )
 
 
 def plot(study):
@@ -495,6 +630,7 @@ def plot(study):
         pd.read_parquet(d / "kappa_cmeasure.parquet"),
         study.read_numbers(),
         study.figure_path,
-        conv_table=pd.read_parquet(d / "kappa_conventions.parquet") if (d / "kappa_conventions.parquet").exists()
+        conv_table=pd.read_parquet(d / "kappa_conventions.parquet")
+        if (d / "kappa_conventions.parquet").exists()
         else None,
     )

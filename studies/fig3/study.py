@@ -42,6 +42,7 @@ Stages: ``simulate`` (one engine run with snapshots on the grid, settled
 orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
 ``fig3_mu_windows``, ``fig3_histograms`` and fig3.json), ``plot`` (fig3.png).
 """
+
 from __future__ import annotations
 
 import json
@@ -59,18 +60,18 @@ from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyP
 class Params(StudyParams):
     """``[study]`` of studies/fig3/study.toml."""
 
-    snapshot_grid: NumberLists   # pieces [start, stop, step]
-    fit_window: Numbers          # [t_lo, t_hi] of the paper's μ fit
-    alt_window: Numbers          # [t_lo, t_hi] of the second μ fit (beside the paper's window)
-    authors_selection: Text      # "inside" or "above": the authors' reading of "inside Ω at t"
-    authors_window: Numbers      # fit_window or alt_window: the authors' fit window
-    paper_mu_half_unit: Number   # half a unit of the last digit of the paper's μ (quoting precision)
-    ribbon_t: Number             # time of the ribbon rows (3 SD vs 3 SEM)
+    snapshot_grid: NumberLists  # pieces [start, stop, step]
+    fit_window: Numbers  # [t_lo, t_hi] of the paper's μ fit
+    alt_window: Numbers  # [t_lo, t_hi] of the second μ fit (beside the paper's window)
+    authors_selection: Text  # "inside" or "above": the authors' reading of "inside Ω at t"
+    authors_window: Numbers  # fit_window or alt_window: the authors' fit window
+    paper_mu_half_unit: Number  # half a unit of the last digit of the paper's μ (quoting precision)
+    ribbon_t: Number  # time of the ribbon rows (3 SD vs 3 SEM)
     later_windows: NumberLists
-    sliding_window: Numbers      # [width, stride]
+    sliding_window: Numbers  # [width, stride]
     hist_times: Numbers
     hist_bins: Integer
-    plot_t_max: Number = None    # time axis of the figure (None: the whole grid)
+    plot_t_max: Number = None  # time axis of the figure (None: the whole grid)
     n_boot: Integer
     n_boot_orbits: Integer
     boot_seed: Integer
@@ -111,8 +112,9 @@ def analyze(study):
     window = tuple(study.params.fit_window)
     fit = _paper_fit(me, E0, gamma, window)
     alt = tuple(study.params.alt_window)
-    windows, kinds = _fit_windows(window, [tuple(w) for w in study.params.later_windows],
-                                 study.params.sliding_window, alt, float(me["t"].max()))
+    windows, kinds = _fit_windows(
+        window, [tuple(w) for w in study.params.later_windows], study.params.sliding_window, alt, float(me["t"].max())
+    )
     tab = _mu_table(me, E0, gamma, windows, kinds)
     boot, boot_up, scale = _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt)
     _add_bootstrap_errors(tab, me, boot, scale, len(windows), study.params.n_boot)
@@ -188,14 +190,16 @@ def _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt):
     n_boot = study.params.n_boot
     k = min(study.params.n_boot_orbits, n_orbits)
     rows = _snapshot_rows(study, key, ds.field("traj_id") < k)
-    boot, scale = bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot=n_boot,
-                                            seed=study.params.boot_seed)
+    boot, scale = bootstrap_mu_first_orbits(
+        rows, n_orbits, k, E0, gamma, windows, n_boot=n_boot, seed=study.params.boot_seed
+    )
     # the same bootstrap for the average over orbits with E > E_c only: E decreases monotonically, so these
     # are the rows before settling (the continued rows are all below E_c). Every orbit keeps its row at
     # t = 0 (E = E0 > E_c), so the orbits, their order and, with the same seed, their Poisson
     # multiplicities are those of the replicates above: the two curves are resampled together.
-    boot_up, _ = bootstrap_mu_first_orbits(rows[rows["energy"] > E_C], n_orbits, k, E0, gamma, [window, alt],
-                                           n_boot=n_boot, seed=study.params.boot_seed)
+    boot_up, _ = bootstrap_mu_first_orbits(
+        rows[rows["energy"] > E_C], n_orbits, k, E0, gamma, [window, alt], n_boot=n_boot, seed=study.params.boot_seed
+    )
     return boot, boot_up, scale
 
 
@@ -235,21 +239,29 @@ def _histogram_rows(h, edges) -> pd.DataFrame:
     for k in range(len(h.t)):
         tot = h.counts[k].sum()
         for b in range(len(edges) - 1):
-            hrows.append({"t_requested": h.t_requested[k], "t": h.t[k], "e_lo": edges[b], "e_hi": edges[b + 1],
-                          "count": int(h.counts[k, b]),
-                          "density_log10E": h.counts[k, b] / (tot * dlog[b]) if tot else np.nan,
-                          "n_inside": int(h.n_alive[k]), "mean_E": h.mean_E[k]})
+            hrows.append(
+                {
+                    "t_requested": h.t_requested[k],
+                    "t": h.t[k],
+                    "e_lo": edges[b],
+                    "e_hi": edges[b + 1],
+                    "count": int(h.counts[k, b]),
+                    "density_log10E": h.counts[k, b] / (tot * dlog[b]) if tot else np.nan,
+                    "n_inside": int(h.n_alive[k]),
+                    "mean_E": h.mean_E[k],
+                }
+            )
     return pd.DataFrame(hrows)
 
 
 class _Results(NamedTuple):
     """The numbers that the comparison with the paper and fig3.json share."""
 
-    p: pd.Series          # the paper window's row of fig3_mu_windows
+    p: pd.Series  # the paper window's row of fig3_mu_windows
     later_tab: pd.DataFrame
-    last: pd.Series       # the last later window
+    last: pd.Series  # the last later window
     n_settled: int
-    over: float           # mean log(fit/⟨E⟩) at the end of the fit window
+    over: float  # mean log(fit/⟨E⟩) at the end of the fit window
     tau2_pred: float
     tau2_pred_err: float
     authors: dict
@@ -282,23 +294,58 @@ def _compare_with_paper(study, res: _Results, window, E0, gamma, E_C) -> None:
     """Compare with the paper: μ per convention, the ribbons, μ → 1, the fit's overshoot, τ2."""
     p, last, paper_mu = res.p, res.last, study.params.paper_mu
     for r in res.authors["mu"]:
-        study.compare(r["quantity"], r["value"], r["err"], paper_mu, verdict=r["verdict"],
-                      convention=r["convention"], authors=r["authors"], note=r["note"])
+        study.compare(
+            r["quantity"],
+            r["value"],
+            r["err"],
+            paper_mu,
+            verdict=r["verdict"],
+            convention=r["convention"],
+            authors=r["authors"],
+            note=r["note"],
+        )
     for r in res.ribbon["rows"]:
-        study.compare(r["quantity"], r["value"], None, None, unit="energy", convention=r["convention"],
-                      authors=r["authors"], note=r["note"])
-    study.compare("μ free intercept on [0, 200]", float(p["mu_free"]), float(p["mu_free_err"]), None,
-                  note="log⟨E⟩ = a − μγt; not in the paper")
-    study.compare(f"local μ on [{last['t_lo']:g}, {last['t_hi']:g}] (μ → 1 claim)", float(last["mu_free"]),
-                  float(last["mu_free_err"]), 1.0,
-                  verdict="approaches 1" if abs(last["mu_free"] - 1) < abs(p["mu"] - 1) else "does not approach 1",
-                  note=f"⟨E⟩ ≈ {last['mean_E_mid']:.2g} there; free-intercept slope of log⟨E⟩ on the window")
-    study.compare("fit overestimates ⟨E⟩ at the end of [0, 200]", res.over, None, "yes (qualitative)",
-                  verdict="agrees" if res.over > 0 else "differs",
-                  note=f"mean log(fit/⟨E⟩) over t ∈ [{0.75 * window[1]:g}, {window[1]:g}]")
-    study.compare("τ2 = ln(E0/E_c)/(μγ) at γ = 0.01", res.tau2_pred, res.tau2_pred_err,
-                  float(np.log(E0 / E_C) / (paper_mu * gamma)), unit="time",
-                  note="paper value computed from its μ = 0.91 with Eq. (eq:tau2)")
+        study.compare(
+            r["quantity"],
+            r["value"],
+            None,
+            None,
+            unit="energy",
+            convention=r["convention"],
+            authors=r["authors"],
+            note=r["note"],
+        )
+    study.compare(
+        "μ free intercept on [0, 200]",
+        float(p["mu_free"]),
+        float(p["mu_free_err"]),
+        None,
+        note="log⟨E⟩ = a − μγt; not in the paper",
+    )
+    study.compare(
+        f"local μ on [{last['t_lo']:g}, {last['t_hi']:g}] (μ → 1 claim)",
+        float(last["mu_free"]),
+        float(last["mu_free_err"]),
+        1.0,
+        verdict="approaches 1" if abs(last["mu_free"] - 1) < abs(p["mu"] - 1) else "does not approach 1",
+        note=f"⟨E⟩ ≈ {last['mean_E_mid']:.2g} there; free-intercept slope of log⟨E⟩ on the window",
+    )
+    study.compare(
+        "fit overestimates ⟨E⟩ at the end of [0, 200]",
+        res.over,
+        None,
+        "yes (qualitative)",
+        verdict="agrees" if res.over > 0 else "differs",
+        note=f"mean log(fit/⟨E⟩) over t ∈ [{0.75 * window[1]:g}, {window[1]:g}]",
+    )
+    study.compare(
+        "τ2 = ln(E0/E_c)/(μγ) at γ = 0.01",
+        res.tau2_pred,
+        res.tau2_pred_err,
+        float(np.log(E0 / E_C) / (paper_mu * gamma)),
+        unit="time",
+        note="paper value computed from its μ = 0.91 with Eq. (eq:tau2)",
+    )
 
 
 def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbits) -> dict:
@@ -310,8 +357,10 @@ def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbit
         "n_orbits": n_orbits,
         "n_settled": n_settled,
         "f_settled": n_settled / n_orbits,
-        "definition": ("⟨E⟩(t): mean energy over orbits not escaped by t; settled orbits (E reached E_c inside Ω) "
-                       "continued past settling by re-integration; ribbon ±3 standard errors of the mean"),
+        "definition": (
+            "⟨E⟩(t): mean energy over orbits not escaped by t; settled orbits (E reached E_c inside Ω) "
+            "continued past settling by re-integration; ribbon ±3 standard errors of the mean"
+        ),
         "raw_keys": {"engine": key},
         "continuation": {k: v for k, v in cont.items() if k != "key"},
         "fit_window": list(window),
@@ -321,8 +370,13 @@ def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbit
         "E0_free": float(np.exp(fit.log_E0_free)),
         "rms_log_residual": fit.rms_log_residual,
         "mu_later_windows": [
-            {"t_lo": r.t_lo, "t_hi": r.t_hi, "mu": {"value": r.mu, "err": r.mu_err},
-             "mu_local": {"value": r.mu_free, "err": r.mu_free_err}, "mean_E_mid": r.mean_E_mid}
+            {
+                "t_lo": r.t_lo,
+                "t_hi": r.t_hi,
+                "mu": {"value": r.mu, "err": r.mu_err},
+                "mu_local": {"value": r.mu_free, "err": r.mu_free_err},
+                "mean_E_mid": r.mean_E_mid,
+            }
             for r in res.later_tab.itertuples()
         ],
         "tau2_predicted": {"value": res.tau2_pred, "err": res.tau2_pred_err},
@@ -365,8 +419,9 @@ def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -
     if a_sel not in SELECTIONS:
         raise ValueError(f"[study] authors_selection must be one of {sorted(SELECTIONS)}, got {a_sel!r}")
     if a_win not in (window, alt):
-        raise ValueError(f"[study] authors_window must be fit_window {list(window)} or alt_window {list(alt)}, "
-                         f"got {list(a_win)}")
+        raise ValueError(
+            f"[study] authors_window must be fit_window {list(window)} or alt_window {list(alt)}, got {list(a_win)}"
+        )
     column = {"inside": "mean_E", "above": "mean_E_above"}
     t = me["t"].to_numpy()
     t_end_above = float(t[me["n_above"].to_numpy() > 0].max())
@@ -378,31 +433,58 @@ def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -
             t_last = float(t[used].max())
             is_ours = sel == "inside" and w == window
             is_authors = sel == a_sel and w == a_win
-            who = "authors' and ours" if is_ours and is_authors else (
-                "authors'" if is_authors else ("ours" if is_ours else "alternative"))
-            ends = (f" (its points end at t = {t_last:g}: no orbit is above E_c later)"
-                    if t_last < w[1] else "")
+            who = (
+                "authors' and ours"
+                if is_ours and is_authors
+                else ("authors'" if is_authors else ("ours" if is_ours else "alternative"))
+            )
+            ends = f" (its points end at t = {t_last:g}: no orbit is above E_c later)" if t_last < w[1] else ""
             label = f"{sel}, fit {_window_text(w)}"
             err = boot_err[(sel, w)]
-            out.append({
-                "selection": sel, "window": list(w), "label": label,
-                "quantity": (f"μ on {_window_text(w)} (log fit, E(0)=E0)" if is_ours else
-                             f"μ on {_window_text(w)}, {WHO[sel]}"),
-                "value": f.mu, "err": err, "fit_err": f.mu_err, "n_points": f.n_points, "t_last": t_last,
-                "ours": is_ours, "authors": is_authors,
-                "convention": (f"{who}: {SELECTIONS[sel]}; unweighted log fit on {_window_text(w)}{ends}; "
-                               f"{study.convention_label}"),
-                "verdict": mu_verdict(f.mu, err, paper_mu, half),
-                "note": (f"bootstrap (orbits) error; fit misfit error {f.mu_err:.2g}; N = {n_orbits}; "
-                         f"{abs(f.mu - paper_mu) / err:.1f}σ from {paper_mu:g}"),
-            })
+            out.append(
+                {
+                    "selection": sel,
+                    "window": list(w),
+                    "label": label,
+                    "quantity": (
+                        f"μ on {_window_text(w)} (log fit, E(0)=E0)"
+                        if is_ours
+                        else f"μ on {_window_text(w)}, {WHO[sel]}"
+                    ),
+                    "value": f.mu,
+                    "err": err,
+                    "fit_err": f.mu_err,
+                    "n_points": f.n_points,
+                    "t_last": t_last,
+                    "ours": is_ours,
+                    "authors": is_authors,
+                    "convention": (
+                        f"{who}: {SELECTIONS[sel]}; unweighted log fit on {_window_text(w)}{ends}; "
+                        f"{study.convention_label}"
+                    ),
+                    "verdict": mu_verdict(f.mu, err, paper_mu, half),
+                    "note": (
+                        f"bootstrap (orbits) error; fit misfit error {f.mu_err:.2g}; N = {n_orbits}; "
+                        f"{abs(f.mu - paper_mu) / err:.1f}σ from {paper_mu:g}"
+                    ),
+                }
+            )
     ours = next(r for r in out if r["ours"])
     ours["verdict"] = verdict_beside_authors(ours["verdict"], [r for r in out if r["authors"] and not r["ours"]])
-    return {"authors_selection": a_sel, "authors_window": list(a_win), "selections": SELECTIONS,
-            "reading": ("the paper's Fig. 3: μ = 0.91 on [0, 200] of ⟨E⟩ 'over an ensemble of trajectories "
-                        "inside Ω at time t'; selection and window flagged authors=True: [study] "
-                        "authors_selection, authors_window"),
-            "paper_mu": paper_mu, "paper_mu_half_unit": half, "t_end_above": t_end_above, "mu": out}
+    return {
+        "authors_selection": a_sel,
+        "authors_window": list(a_win),
+        "selections": SELECTIONS,
+        "reading": (
+            "the paper's Fig. 3: μ = 0.91 on [0, 200] of ⟨E⟩ 'over an ensemble of trajectories "
+            "inside Ω at time t'; selection and window flagged authors=True: [study] "
+            "authors_selection, authors_window"
+        ),
+        "paper_mu": paper_mu,
+        "paper_mu_half_unit": half,
+        "t_end_above": t_end_above,
+        "mu": out,
+    }
 
 
 def _ribbons(study, me) -> dict:
@@ -419,17 +501,32 @@ def _ribbons(study, me) -> dict:
     n = int(r["n"])
     tr = f"t = {float(r['t']):g}"
     rows = [
-        {"quantity": f"ribbon half-width at {tr}: 3 standard deviations of E", "value": float(3 * r["std_E"]),
-         "authors": True, "convention": "authors': ± 3 standard deviations of the energies of the orbits inside Ω "
-                                        "(the ensemble's spread; Fig. 3 caption)",
-         "note": f"{3 * r['std_E'] / r['mean_E']:.2%} of ⟨E⟩ = {r['mean_E']:.4g}; n = {n} orbits"},
-        {"quantity": f"ribbon half-width at {tr}: 3 standard errors of ⟨E⟩", "value": float(3 * r["sem_E"]),
-         "authors": False, "convention": "ours: ± 3 standard errors of the mean ⟨E⟩ (= 3 SD/√n)",
-         "note": f"{3 * r['sem_E'] / r['mean_E']:.3%} of ⟨E⟩; SD/SEM = {r['std_E'] / r['sem_E']:.4g} = √n"},
+        {
+            "quantity": f"ribbon half-width at {tr}: 3 standard deviations of E",
+            "value": float(3 * r["std_E"]),
+            "authors": True,
+            "convention": "authors': ± 3 standard deviations of the energies of the orbits inside Ω "
+            "(the ensemble's spread; Fig. 3 caption)",
+            "note": f"{3 * r['std_E'] / r['mean_E']:.2%} of ⟨E⟩ = {r['mean_E']:.4g}; n = {n} orbits",
+        },
+        {
+            "quantity": f"ribbon half-width at {tr}: 3 standard errors of ⟨E⟩",
+            "value": float(3 * r["sem_E"]),
+            "authors": False,
+            "convention": "ours: ± 3 standard errors of the mean ⟨E⟩ (= 3 SD/√n)",
+            "note": f"{3 * r['sem_E'] / r['mean_E']:.3%} of ⟨E⟩; SD/SEM = {r['std_E'] / r['sem_E']:.4g} = √n",
+        },
     ]
-    return {"t": float(r["t"]), "n": n, "mean_E": float(r["mean_E"]), "half_width_3sd": float(3 * r["std_E"]),
-            "half_width_3sem": float(3 * r["sem_E"]), "max_rel_half_width_3sd": rel_sd,
-            "max_rel_half_width_3sem": rel_sem, "rows": rows}
+    return {
+        "t": float(r["t"]),
+        "n": n,
+        "mean_E": float(r["mean_E"]),
+        "half_width_3sd": float(3 * r["std_E"]),
+        "half_width_3sem": float(3 * r["sem_E"]),
+        "max_rel_half_width_3sd": rel_sd,
+        "max_rel_half_width_3sem": rel_sem,
+        "rows": rows,
+    }
 
 
 def _nearest(grid, times):

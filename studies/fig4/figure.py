@@ -1,14 +1,14 @@
 """Fig 4 (paper fig:survprob): P(t) for several γ at E0 = 0.3 with τ0, τ1, τ2 marked for one γ,
 and the ratio P_γ/P_0 that defines τ1.  Plot functions draw what they are given and compute nothing."""
+
 from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.formatting import format_value_err
 from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.formatting import format_value_err
 
-FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294",
-                0.02: "#d62728"}
+FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294", 0.02: "#d62728"}
 
 
 def _colors(gammas):
@@ -67,12 +67,18 @@ def plot_fig4(surv, ratio, taus, numbers, path, *, mark_gamma=0.01):
             pv = np.interp(tv, c["t"], c["P"])
             ax.axvline(tv, color=mc, lw=0.7, ls=":", zorder=1)
             ax.plot(tv, pv, m, ms=7, mfc=col[mark_gamma] if mc == "k" else mc, mec="k", zorder=6)
-            ax.annotate(f"${lab}$", (tv, pv), xytext=off, textcoords="offset points", fontsize=9, color=mc,
-                        zorder=7)
+            ax.annotate(f"${lab}$", (tv, pv), xytext=off, textcoords="offset points", fontsize=9, color=mc, zorder=7)
             lines.append(f"${lab} = {_pm(tv, te)}$")
-        ax.text(0.985, 0.985, rf"$\gamma={mark_gamma:g}$:" + "\n" + "\n".join(lines), transform=ax.transAxes,
-                ha="right", va="top", fontsize=8.5,
-                bbox={"boxstyle": "round,pad=0.3", "fc": "white", "ec": col[mark_gamma], "alpha": 0.9})
+        ax.text(
+            0.985,
+            0.985,
+            rf"$\gamma={mark_gamma:g}$:" + "\n" + "\n".join(lines),
+            transform=ax.transAxes,
+            ha="right",
+            va="top",
+            fontsize=8.5,
+            bbox={"boxstyle": "round,pad=0.3", "fc": "white", "ec": col[mark_gamma], "alpha": 0.9},
+        )
     ax.set_xscale("log")
     ax.set_yscale("log")
     n = numbers["n_orbits_per_curve"]
@@ -92,8 +98,18 @@ def plot_fig4(surv, ratio, taus, numbers, path, *, mark_gamma=0.01):
         rr = taus[taus["gamma"] == g].iloc[0]
         if np.isfinite(rr["tau1"]):
             filled = bool(rr["tau1_resolved"])
-            bx.errorbar(rr["tau1"], numbers["alpha"], xerr=rr["tau1_err"] if np.isfinite(rr["tau1_err"]) else None,
-                        fmt="o", ms=6, color=col[g], mfc=col[g] if filled else "white", mec="k", capsize=2, zorder=5)
+            bx.errorbar(
+                rr["tau1"],
+                numbers["alpha"],
+                xerr=rr["tau1_err"] if np.isfinite(rr["tau1_err"]) else None,
+                fmt="o",
+                ms=6,
+                color=col[g],
+                mfc=col[g] if filled else "white",
+                mec="k",
+                capsize=2,
+                zorder=5,
+            )
     bx.axhline(numbers["alpha"], color="k", lw=0.9, ls="--", label=rf"$\alpha={numbers['alpha']:g}$")
     bx.set_yscale("log")
     bx.set_xlabel(r"$t$")

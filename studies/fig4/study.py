@@ -42,6 +42,7 @@ its settled orbits, continued past E_c.  Published for other studies (fig6
 reads them, never the raw runs): ``fig4.json`` and the derived tables, among
 them ``fig4_lifetimes.parquet`` (γ, t_end, outcome of every orbit).
 """
+
 from __future__ import annotations
 
 import json
@@ -57,7 +58,7 @@ from hhscatter.studies import _upstream as up
 class Params(StudyParams):
     """``[study]`` of studies/fig4/study.toml."""
 
-    gammas: Numbers              # increasing, with 0 (the conservative reference)
+    gammas: Numbers  # increasing, with 0 (the conservative reference)
     mark_gamma: Number
     alpha: Number
     tau_grid_step: Number
@@ -121,8 +122,8 @@ def analyze(study):
     (:func:`_tau_table`), the figure's tables (:func:`_figure_tables`), the
     paper comparison (:func:`_compare`) and the numbers (:func:`_numbers`).
     """
-    from hhscatter.analysis.survival.fits import observed_from_outcome
     from hhscatter.analysis.dissipative.transitions import bootstrap_transition_times, survival_on_grid
+    from hhscatter.analysis.survival.fits import observed_from_outcome
 
     gs, mg = _gammas(study)
     E0 = float(study.config["scene"]["energy"])
@@ -145,8 +146,13 @@ def analyze(study):
     K = min(study.params.n_boot_orbits, N)
     boot = bootstrap_transition_times(
         # slice before converting: a view of a converted 1e7 object array would keep all of it alive (690 MB per γ)
-        {g: (lts[g]["t_end"].iloc[:K].to_numpy(), lts[g]["outcome"].iloc[:K].to_numpy()) for g in gs}, 0.0, grid,
-        tau0=_tau0_rule, alpha=alpha, n_boot=nb, seed=study.params.boot_seed + 1,
+        {g: (lts[g]["t_end"].iloc[:K].to_numpy(), lts[g]["outcome"].iloc[:K].to_numpy()) for g in gs},
+        0.0,
+        grid,
+        tau0=_tau0_rule,
+        alpha=alpha,
+        n_boot=nb,
+        seed=study.params.boot_seed + 1,
     )
     bscale = float(np.sqrt(K / N))
     taus = _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha)
@@ -158,14 +164,21 @@ def analyze(study):
     study.write_table(ratio, "fig4_ratio.parquet", **meta)
     # published for the studies that build on fig4 (fig6): every orbit's lifetime per γ, orbit order
     # one row group per γ, written one after the other (6 × 1e7 rows at paper scale: never concatenated)
-    study.write_table_streamed((_lifetimes_arrow(g, lts[g]) for g in gs), LIFETIMES_TABLE, **meta,
-                               description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
-                                           "the same initial conditions for every γ; one row group per γ")
+    study.write_table_streamed(
+        (_lifetimes_arrow(g, lts[g]) for g in gs),
+        LIFETIMES_TABLE,
+        **meta,
+        description="lifetimes (t_end, outcome) of every orbit per γ, rows in traj_id order; "
+        "the same initial conditions for every γ; one row group per γ",
+    )
 
     tau0_err = float(boot["tau0"].std(ddof=1)) * bscale
     exponents = _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err)
-    study.write_numbers(_numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0,
-                                 tau0_err, exponents, nb, K))
+    study.write_numbers(
+        _numbers(
+            study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents, nb, K
+        )
+    )
 
 
 def _lifetimes_arrow(g, lt):
@@ -173,8 +186,13 @@ def _lifetimes_arrow(g, lt):
     import pyarrow as pa
 
     n = len(lt)
-    return pa.table({"gamma": pa.array(np.full(n, float(g))), "t_end": pa.array(lt["t_end"].to_numpy()),
-                     "outcome": pa.array(lt["outcome"]).cast(pa.dictionary(pa.int8(), pa.string()))})
+    return pa.table(
+        {
+            "gamma": pa.array(np.full(n, float(g))),
+            "t_end": pa.array(lt["t_end"].to_numpy()),
+            "outcome": pa.array(lt["outcome"]).cast(pa.dictionary(pa.int8(), pa.string())),
+        }
+    )
 
 
 def _read_lifetimes(study, gs):
@@ -208,22 +226,29 @@ def _own_mu(study, mg, E0, N):
     from hhscatter.analysis.dissipative.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
     from hhscatter.data.read import iter_parts, read_snapshots
 
-    ime = inside_mean_energy(iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]),
-                             study.model.critical_energy)
+    ime = inside_mean_energy(
+        iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]), study.model.critical_energy
+    )
     me, cont = ime.inside, {"rows_below_ec": ime.rows_below_ec}
     win = tuple(study.params.mu_window)
     mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
     k_mu = min(study.params.n_boot_orbits, N)
     rows_mu = read_snapshots(study.raw(raw_key(mg)), filters=ds.field("traj_id") < k_mu)
-    bm, mu_scale = bootstrap_mu_first_orbits(rows_mu, N, k_mu, E0, mg, [win], n_boot=study.params.n_boot,
-                                             seed=study.params.boot_seed)
+    bm, mu_scale = bootstrap_mu_first_orbits(
+        rows_mu, N, k_mu, E0, mg, [win], n_boot=study.params.n_boot, seed=study.params.boot_seed
+    )
     return mu, float(bm["mu"].std(ddof=1)) * mu_scale, cont, win
 
 
 def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha) -> pd.DataFrame:
     """One row per γ: outcome fractions, τ0, τ1 (Eq. (eqn:tau1)), τ2 observed (+ settling-time quantiles) and
     predicted (Eq. (eq:tau2)), each with its bootstrap error (σ over replicates × bscale)."""
-    from hhscatter.analysis.dissipative.transitions import settle_time_quantiles, tau1, tau2_observed_interval, tau2_predicted
+    from hhscatter.analysis.dissipative.transitions import (
+        settle_time_quantiles,
+        tau1,
+        tau2_observed_interval,
+        tau2_predicted,
+    )
 
     E_C = study.model.critical_energy
     paper_mu = study.params.paper_mu
@@ -247,23 +272,35 @@ def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha
             v = v[np.isfinite(v)]
             return float(np.std(v, ddof=1)) * bscale if v.size > 1 else np.nan
 
-        rows.append({
-            "gamma": g, "key": raw_key(g), "n": N,
-            "f_escaped": float(np.mean(oc == "escaped")), "f_settled": float(np.mean(oc == "settled")),
-            "f_censored": float(np.mean(oc == "censored")),
-            "tau0": tau0, "tau0_err": sd("tau0") if g > 0 else float(boot["tau0"].std(ddof=1)) * bscale,
-            "tau1": np.nan if t1 is None else t1, "tau1_err": sd("tau1"),
-            "tau1_boot_defined": float(np.isfinite(b["tau1"]).mean()) if b is not None else np.nan,
-            "n0_at_tau1": n0, "tau1_resolved": bool(np.isfinite(n0) and n0 >= min_ref),
-            "tau2_obs": np.nan if t2 is None else t2.value,
-            "tau2_obs_err": np.nan if t2 is None else (t2.hi - t2.lo) / 2 if np.isfinite(t2.hi) else np.nan,
-            "tau2_obs_lo": np.nan if t2 is None else t2.lo, "tau2_obs_hi": np.nan if t2 is None else t2.hi,
-            "tau2_obs_coverage": np.nan if t2 is None else t2.coverage,
-            "t_settle_q01": np.nan if q is None else float(q[0]), "t_settle_q01_err": sd("t_settle_q0.01"),
-            "t_settle_q50": np.nan if q is None else float(q[1]), "t_settle_q50_err": sd("t_settle_q0.5"),
-            "tau2_pred": pred, "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
-            "tau2_pred_paper_mu": pred_p,
-        })
+        rows.append(
+            {
+                "gamma": g,
+                "key": raw_key(g),
+                "n": N,
+                "f_escaped": float(np.mean(oc == "escaped")),
+                "f_settled": float(np.mean(oc == "settled")),
+                "f_censored": float(np.mean(oc == "censored")),
+                "tau0": tau0,
+                "tau0_err": sd("tau0") if g > 0 else float(boot["tau0"].std(ddof=1)) * bscale,
+                "tau1": np.nan if t1 is None else t1,
+                "tau1_err": sd("tau1"),
+                "tau1_boot_defined": float(np.isfinite(b["tau1"]).mean()) if b is not None else np.nan,
+                "n0_at_tau1": n0,
+                "tau1_resolved": bool(np.isfinite(n0) and n0 >= min_ref),
+                "tau2_obs": np.nan if t2 is None else t2.value,
+                "tau2_obs_err": np.nan if t2 is None else (t2.hi - t2.lo) / 2 if np.isfinite(t2.hi) else np.nan,
+                "tau2_obs_lo": np.nan if t2 is None else t2.lo,
+                "tau2_obs_hi": np.nan if t2 is None else t2.hi,
+                "tau2_obs_coverage": np.nan if t2 is None else t2.coverage,
+                "t_settle_q01": np.nan if q is None else float(q[0]),
+                "t_settle_q01_err": sd("t_settle_q0.01"),
+                "t_settle_q50": np.nan if q is None else float(q[1]),
+                "t_settle_q50_err": sd("t_settle_q0.5"),
+                "tau2_pred": pred,
+                "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
+                "tau2_pred_paper_mu": pred_p,
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -284,8 +321,7 @@ def _figure_tables(lts, grid, P, dt, t_last, N):
         with np.errstate(divide="ignore", invalid="ignore"):
             r = P[g][keep] / P[0.0][keep]
         ok = np.rint(P[0.0][keep] * N) >= 1  # at least one reference orbit left (a count: rounding-proof)
-        ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok],
-                                   "n0": (P[0.0][keep] * N)[ok]}))
+        ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok], "n0": (P[0.0][keep] * N)[ok]}))
     return surv, pd.concat(ratio, ignore_index=True)
 
 
@@ -305,37 +341,80 @@ def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -
     p50, p50_err = power_law_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
     res = d[d["tau1_resolved"]]
     p1, p1_err = power_law_exponent(res["gamma"], res["tau1"], res["tau1_err"])
-    study.compare(f"μ used for τ2 (own γ={mg:g} run, [{win[0]:g}, {win[1]:g}])", mu, mu_err, paper_mu,
-                  note="same definition as study fig3")
+    study.compare(
+        f"μ used for τ2 (own γ={mg:g} run, [{win[0]:g}, {win[1]:g}])",
+        mu,
+        mu_err,
+        paper_mu,
+        note="same definition as study fig3",
+    )
     if mu_fig3 is not None:
-        study.compare("μ: fig4's own vs fig3", mu, mu_err, mu_fig3.get("value"),
-                      note="consistency check between studies (same seed; grids differ)")
+        study.compare(
+            "μ: fig4's own vs fig3",
+            mu,
+            mu_err,
+            mu_fig3.get("value"),
+            note="consistency check between studies (same seed; grids differ)",
+        )
     r01 = taus[taus["gamma"] == 0.01]
     if len(r01):
         r = r01.iloc[0]
-        study.compare("τ2 predicted at γ = 0.01", r["tau2_pred"], r["tau2_pred_err"],
-                      float(tau2_predicted(E0, E_C, paper_mu, 0.01)), unit="time",
-                      note="paper value from its μ = 0.91 via Eq. (eq:tau2)")
-        study.compare("τ2 observed (first settling) at γ = 0.01", r["tau2_obs"], r["tau2_obs_err"], None,
-                      unit="time", note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
-                                        f"{round(r['f_settled'] * N)} settlers, decreases with N; err: half-width "
-                                        f"of the order-statistic interval [{r['tau2_obs_lo']:.4g}, "
-                                        f"{r['tau2_obs_hi']:.4g}] of the quantile t_1/N")
-    study.compare("τ1 increases as γ decreases", mono1, None, True,
-                  verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
-                  note="paper: 'both τ1 and τ2 increase with decreasing γ'")
+        study.compare(
+            "τ2 predicted at γ = 0.01",
+            r["tau2_pred"],
+            r["tau2_pred_err"],
+            float(tau2_predicted(E0, E_C, paper_mu, 0.01)),
+            unit="time",
+            note="paper value from its μ = 0.91 via Eq. (eq:tau2)",
+        )
+        study.compare(
+            "τ2 observed (first settling) at γ = 0.01",
+            r["tau2_obs"],
+            r["tau2_obs_err"],
+            None,
+            unit="time",
+            note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
+            f"{round(r['f_settled'] * N)} settlers, decreases with N; err: half-width "
+            f"of the order-statistic interval [{r['tau2_obs_lo']:.4g}, "
+            f"{r['tau2_obs_hi']:.4g}] of the quantile t_1/N",
+        )
+    study.compare(
+        "τ1 increases as γ decreases",
+        mono1,
+        None,
+        True,
+        verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
+        note="paper: 'both τ1 and τ2 increase with decreasing γ'",
+    )
     if p1 is not None:
-        study.compare("p1 in τ1 ∝ γ^−p1", p1, p1_err, None,
-                      note="not in the paper; a linear κ0(E) with E = E0 e^{−μγt} gives P_γ/P_0 ≈ "
-                           "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2")
+        study.compare(
+            "p1 in τ1 ∝ γ^−p1",
+            p1,
+            p1_err,
+            None,
+            note="not in the paper; a linear κ0(E) with E = E0 e^{−μγt} gives P_γ/P_0 ≈ "
+            "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2",
+        )
     if p_exp is not None:
-        study.compare("p in τ2,obs ∝ γ^−p", p_exp, p_err, 1.0,
-                      note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); unweighted log-log fit over γ with settlers")
+        study.compare(
+            "p in τ2,obs ∝ γ^−p",
+            p_exp,
+            p_err,
+            1.0,
+            note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); unweighted log-log fit over γ with settlers",
+        )
     if p50 is not None:
-        study.compare("p in median settling time ∝ γ^−p", p50, p50_err, 1.0,
-                      note="N-independent companion of τ2,obs (same fit)")
-    study.compare("τ0 (data-driven, on P_0)", tau0, tau0_err, None, unit="time",
-                  note="paper: τ0 effectively independent of γ; no value given")
+        study.compare(
+            "p in median settling time ∝ γ^−p", p50, p50_err, 1.0, note="N-independent companion of τ2,obs (same fit)"
+        )
+    study.compare(
+        "τ0 (data-driven, on P_0)",
+        tau0,
+        tau0_err,
+        None,
+        unit="time",
+        note="paper: τ0 effectively independent of γ; no value given",
+    )
     return {"tau2": (p_exp, p_err), "settle_median": (p50, p50_err), "tau1": (p1, p1_err)}
 
 
@@ -347,9 +426,11 @@ def _vu(v, e):
     return {"value": _fin(v), "err": _fin(e)}
 
 
-def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents,
-             nb, K) -> dict:
+def _numbers(
+    study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents, nb, K
+) -> dict:
     """The content of fig4.json (definitions stated with the numbers)."""
+
     def exponent(name):
         p, e = exponents[name]
         return None if p is None else {"value": p, "err": e}
@@ -361,12 +442,16 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
         "alpha": alpha,
         "raw_keys": {f"{g:g}": raw_key(g) for g in gs},
         "tables": {"lifetimes": LIFETIMES_TABLE, "tau": "fig4_tau.parquet", "survival": "fig4_survival.parquet"},
-        "raw_key_naming": ("raw runs are studies/fig4/out/<scale>/raw/gamma<γ formatted with %g>: gamma0 (conservative "
-                           "reference), gamma0.001, gamma0.002, gamma0.005, gamma0.01, gamma0.02; every run has the "
-                           "same initial conditions (seed, n); raw/gamma<mu_gamma> also holds the energies of that "
-                           "run's settled orbits after settling (snapshots schema)"),
-        "tau0_rule": ("τ0 = choose_windows(P_0).tau0: first time after which the local escape rate of the conservative "
-                      "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.survival.escape_rate)"),
+        "raw_key_naming": (
+            "raw runs are studies/fig4/out/<scale>/raw/gamma<γ formatted with %g>: gamma0 (conservative "
+            "reference), gamma0.001, gamma0.002, gamma0.005, gamma0.01, gamma0.02; every run has the "
+            "same initial conditions (seed, n); raw/gamma<mu_gamma> also holds the energies of that "
+            "run's settled orbits after settling (snapshots schema)"
+        ),
+        "tau0_rule": (
+            "τ0 = choose_windows(P_0).tau0: first time after which the local escape rate of the conservative "
+            "curve stays within max(10 %, 3σ) of its plateau (hhscatter.analysis.survival.escape_rate)"
+        ),
         "tau1_definition": f"first t ≥ τ0 with P_γ(t) = α P_0(t), α = {alpha:g} (Eq. eqn:tau1), grid step {dt:g}",
         "tau2_obs_definition": "min settling time (first E = E_c inside Ω); depends on N",
         "tau2_pred_definition": f"ln(E0/E_c)/(μγ) with μ from this study's γ = {mg:g} run on [{win[0]:g}, {win[1]:g}]",
@@ -379,12 +464,20 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
         "tau0": _vu(tau0, tau0_err),
         "taus": [
             {
-                "gamma": r.gamma, "key": r.key,
-                "f_escaped": r.f_escaped, "f_settled": r.f_settled, "f_censored": r.f_censored,
-                "tau1": _vu(r.tau1, r.tau1_err), "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
+                "gamma": r.gamma,
+                "key": r.key,
+                "f_escaped": r.f_escaped,
+                "f_settled": r.f_settled,
+                "f_censored": r.f_censored,
+                "tau1": _vu(r.tau1, r.tau1_err),
+                "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
                 "tau1_resolved": r.tau1_resolved,
-                "tau2_obs": {**_vu(r.tau2_obs, r.tau2_obs_err), "lo": _fin(r.tau2_obs_lo), "hi": _fin(r.tau2_obs_hi),
-                             "coverage": _fin(r.tau2_obs_coverage)},
+                "tau2_obs": {
+                    **_vu(r.tau2_obs, r.tau2_obs_err),
+                    "lo": _fin(r.tau2_obs_lo),
+                    "hi": _fin(r.tau2_obs_hi),
+                    "coverage": _fin(r.tau2_obs_coverage),
+                },
                 "t_settle_q01": _vu(r.t_settle_q01, r.t_settle_q01_err),
                 "t_settle_q50": _vu(r.t_settle_q50, r.t_settle_q50_err),
                 "tau2_pred": _vu(r.tau2_pred, r.tau2_pred_err),
@@ -397,10 +490,12 @@ def _numbers(study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, co
         "tau1_gamma_exponent": exponent("tau1"),
         "n_boot": nb,
         "n_boot_orbits": K,
-        "errors": ("paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
-                   "scaled by sqrt(n_boot_orbits/N); τ2,obs (a minimum): the distribution-free order-statistic "
-                   "interval [lo, hi] of the quantile t_1/N it estimates (exact coverage given), err its half-width; "
-                   "its γ exponent from an unweighted fit"),
+        "errors": (
+            "paired bootstrap over orbits (Poisson multiplicities) on the first n_boot_orbits orbits, "
+            "scaled by sqrt(n_boot_orbits/N); τ2,obs (a minimum): the distribution-free order-statistic "
+            "interval [lo, hi] of the quantile t_1/N it estimates (exact coverage given), err its half-width; "
+            "its γ exponent from an unweighted fit"
+        ),
     }
 
 

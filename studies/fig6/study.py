@@ -42,6 +42,7 @@ Errors: the fit errors treat the points of one Kaplan–Meier curve as
 independent (``absolute_sigma``); the points are positively correlated, so
 χ²/dof and the parameter errors are indicative (coarse grid ``fit_dt``).
 """
+
 from __future__ import annotations
 
 import math
@@ -52,9 +53,9 @@ import pandas as pd
 
 from hhscatter.analysis.dissipative import mixture
 from hhscatter.analysis.dissipative import model_comparison as mc
-from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-from hhscatter.analysis.survival.fits import survival_from_lifetimes
 from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
+from hhscatter.analysis.survival.fits import survival_from_lifetimes
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.scene.schema import (
     Bool,
     Integer,
@@ -82,7 +83,7 @@ class Mixture(StudyParams):
 class Params(StudyParams):
     """``[study]`` of studies/fig6/study.toml."""
 
-    pairs: NumberLists           # [[E0, γ], ...]
+    pairs: NumberLists  # [[E0, γ], ...]
     dt: Number
     fit_dt: Number
     min_count: Number
@@ -94,11 +95,11 @@ class Params(StudyParams):
     mixture_max_orbits: Integer = None  # the mixture model uses the snapshots of orbits traj_id < this (None: all)
     mixture_plotted: Text = None
     alpha: Number
-    paper_kappa_a: Number        # the paper's κ0(E) law (Fig. 2b caption): a x² + b x below E_b, c x above,
-    paper_kappa_b: Number        #   x = E − E_c; a in 1/(time·energy²), b and c in 1/(time·energy), E_b an energy
+    paper_kappa_a: Number  # the paper's κ0(E) law (Fig. 2b caption): a x² + b x below E_b, c x above,
+    paper_kappa_b: Number  #   x = E − E_c; a in 1/(time·energy²), b and c in 1/(time·energy), E_b an energy
     paper_kappa_c: Number
     paper_kappa_Eb: Number
-    paper_mu: Number             # the paper's energy-decay exponent (Sec. III.A, Fig. 3), dimensionless
+    paper_mu: Number  # the paper's energy-decay exponent (Sec. III.A, Fig. 3), dimensionless
     kappa_a_key: Text
     kappa_b_key: Text
     kappa_c_key: Text
@@ -133,8 +134,7 @@ def _pairs(study):
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None) -> None; one run per (E0, γ) pair with energy snapshots."""
     for E0, g in _pairs(study):
-        study.run(pair_key(E0, g), study.scene(pair_key(E0, g), energy=E0, gamma=g), workers=workers,
-                  progress=progress)
+        study.run(pair_key(E0, g), study.scene(pair_key(E0, g), energy=E0, gamma=g), workers=workers, progress=progress)
 
 
 # ---------------------------------------------------------------------------
@@ -148,15 +148,24 @@ def paper_constants(study) -> dict:
     and μ (Eq. (eqn:energy_exp_decay), dimensionless; Sec. III.A, Fig. 3 =
     fig:energy_decay).  Read from study.toml, never written in the code.
     """
-    return {"a": study.params.paper_kappa_a, "b": study.params.paper_kappa_b,
-            "c": study.params.paper_kappa_c, "E_b": study.params.paper_kappa_Eb,
-            "mu": study.params.paper_mu}
+    return {
+        "a": study.params.paper_kappa_a,
+        "b": study.params.paper_kappa_b,
+        "c": study.params.paper_kappa_c,
+        "E_b": study.params.paper_kappa_Eb,
+        "mu": study.params.paper_mu,
+    }
 
 
 def kappa_law(const: dict, E_c: float) -> PiecewiseKappa:
     """kappa_law({a, b, c, E_b, ...}, E_c) -> the piecewise κ0(E) of paper Fig. 2b with these coefficients."""
-    return PiecewiseKappa(a2=float(const["a"]), a1=float(const["b"]), slope=float(const["c"]),
-                          E_switch=float(const["E_b"]), E_c=float(E_c))
+    return PiecewiseKappa(
+        a2=float(const["a"]),
+        a1=float(const["b"]),
+        slope=float(const["c"]),
+        E_switch=float(const["E_b"]),
+        E_c=float(E_c),
+    )
 
 
 def _constants_label(const: dict, hazard: str, ours: bool) -> str:
@@ -195,10 +204,20 @@ _fit_points = mc.survival_fit_points
 
 def _fit_row(label, model, hazard, fit, extra):
     v, e = fit.values, fit.errors
-    row = {"pair": label, "model": model, "hazard": hazard,
-           "n_points": fit.n_points, "n_free": len(fit.free), "chi2": fit.chi2, "dof": fit.dof,
-           "chi2_red": fit.chi2_red, "rms_log_residual": fit.rms_log_residual, "aic": fit.aic,
-           "success": fit.success, **extra}
+    row = {
+        "pair": label,
+        "model": model,
+        "hazard": hazard,
+        "n_points": fit.n_points,
+        "n_free": len(fit.free),
+        "chi2": fit.chi2,
+        "dof": fit.dof,
+        "chi2_red": fit.chi2_red,
+        "rms_log_residual": fit.rms_log_residual,
+        "aic": fit.aic,
+        "success": fit.success,
+        **extra,
+    }
     for k in ("f_ne", "f_e", "L", "b", "tau2", "phi", "P_tau0"):
         if k in v and np.ndim(v[k]) == 0:
             row[k] = float(v[k])
@@ -237,9 +256,26 @@ def _mixture_fits(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, mode, P
             alt[f"f_ne_{k}"] = max(min(left, cap), 1e-9)
             left -= min(left, cap)
     starts = [None, {**alt, "L": 1.0, "b": 1.0}, {**alt, "L": 3.0, "b": 0.3}]
-    return {h: _best(lambda p0, h=h: mixture.fit_mixture_model(
-        tf, Pf, sf, comps, kappa_of_E=kappa, tau0=tau0, E_c=E_c, P_tau0=P_tau0, fne_mode=mode, hazard=h,
-        P_min=P_min, p0=p0), starts) for h in hazards}
+    return {
+        h: _best(
+            lambda p0, h=h: mixture.fit_mixture_model(
+                tf,
+                Pf,
+                sf,
+                comps,
+                kappa_of_E=kappa,
+                tau0=tau0,
+                E_c=E_c,
+                P_tau0=P_tau0,
+                fne_mode=mode,
+                hazard=h,
+                P_min=P_min,
+                p0=p0,
+            ),
+            starts,
+        )
+        for h in hazards
+    }
 
 
 def analyze(study):
@@ -284,10 +320,10 @@ class _Setup(NamedTuple):
     mu_err: float
     tau0: float
     E_c: float
-    pc: dict                  # the paper's constants (paper_constants)
+    pc: dict  # the paper's constants (paper_constants)
     kappa_pc: PiecewiseKappa  # κ0(E) with the paper's constants
     hazards: list
-    mixtures: list            # [study] mixtures, checked
+    mixtures: list  # [study] mixtures, checked
 
 
 def _setup(study) -> _Setup:
@@ -311,16 +347,50 @@ def _fit_pair(study, s: _Setup, E0: float, g: float):
     t, P, P_err = _curve(lt, study.params.dt)
     tf, Pf, sf = _fit_points(t, P, P_err, s.tau0, study.params.fit_dt, n, min_count)
     P_min = min_count / n * 0.999
-    homog = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=s.kappa, E0=E0, mu=s.mu, gamma=g, tau0=s.tau0,
-                              E_c=s.E_c, hazards=s.hazards, fit_tau2=study.params.fit_tau2, P_min=P_min)
+    homog = _homogeneous_fits(
+        t,
+        P,
+        P_err,
+        tf,
+        Pf,
+        sf,
+        kappa=s.kappa,
+        E0=E0,
+        mu=s.mu,
+        gamma=g,
+        tau0=s.tau0,
+        E_c=s.E_c,
+        hazards=s.hazards,
+        fit_tau2=study.params.fit_tau2,
+        P_min=P_min,
+    )
     # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
     # so the two RMS log residuals compare the constants alone
-    homog_pc = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=s.kappa_pc, E0=E0, mu=s.pc["mu"], gamma=g,
-                                 tau0=s.tau0, E_c=s.E_c, hazards=s.hazards, fit_tau2=study.params.fit_tau2,
-                                 P_min=P_min)
+    homog_pc = _homogeneous_fits(
+        t,
+        P,
+        P_err,
+        tf,
+        Pf,
+        sf,
+        kappa=s.kappa_pc,
+        E0=E0,
+        mu=s.pc["mu"],
+        gamma=g,
+        tau0=s.tau0,
+        E_c=s.E_c,
+        hazards=s.hazards,
+        fit_tau2=study.params.fit_tau2,
+        P_min=P_min,
+    )
     comp_rows, mixes = _mixture_pair(study, s, raw, label, E0, g, (t, P, tf, Pf, sf), P_min)
-    extra = {"E0": E0, "gamma": g, "N": n, "tau2_eq": tau2_predicted(E0, s.E_c, s.mu, g),
-             "tau2_observed": tau2_observed(lt)}
+    extra = {
+        "E0": E0,
+        "gamma": g,
+        "N": n,
+        "tau2_eq": tau2_predicted(E0, s.E_c, s.mu, g),
+        "tau2_observed": tau2_observed(lt),
+    }
     cur = pd.DataFrame({"t": t, "P": P, "P_err": P_err})
     fit_rows, cmp_rows, pc_rows = _pair_rows(s, t, cur, label, homog, homog_pc, mixes, extra)
     return cur.assign(pair=label, E0=E0, gamma=g, N=n), (fit_rows, comp_rows, cmp_rows, pc_rows)
@@ -344,11 +414,24 @@ def _mixture_pair(study, s: _Setup, raw, label, E0, g, points, P_min):
     comp_rows, mixes = [], {}
     for var in s.mixtures:
         t_ref = s.tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
-        comps = mixture.mixture_components(snaps, gamma=g, t_ref=t_ref, n_components=study.params.n_components,
-                                           by=var["by"], fit_window=(s.tau0, w_hi))
+        comps = mixture.mixture_components(
+            snaps, gamma=g, t_ref=t_ref, n_components=study.params.n_components, by=var["by"], fit_window=(s.tau0, w_hi)
+        )
         comp_rows.append(comps.to_frame(s.E_c).assign(pair=label, E0=E0, gamma=g, model=var["name"]))
-        mixes[var["name"]] = _mixture_fits(t, P, tf, Pf, sf, comps, kappa=s.kappa, tau0=s.tau0, E_c=s.E_c,
-                                           hazards=s.hazards, mode=var["fne_mode"], P_min=P_min)
+        mixes[var["name"]] = _mixture_fits(
+            t,
+            P,
+            tf,
+            Pf,
+            sf,
+            comps,
+            kappa=s.kappa,
+            tau0=s.tau0,
+            E_c=s.E_c,
+            hazards=s.hazards,
+            mode=var["fne_mode"],
+            P_min=P_min,
+        )
     return comp_rows, mixes
 
 
@@ -365,9 +448,18 @@ def _pair_rows(s: _Setup, t, cur, label, homog, homog_pc, mixes, extra):
         cmp_rows.append(cmp.assign(pair=label, E0=E0, gamma=g, hazard=h))
     for h in s.hazards:
         cur[f"{PC}_{h}"] = homog_pc[h].predict(t)
-        pc_rows.append(_pc_row(homog[h], homog_pc[h], pair=label, E0=E0, gamma=g, hazard=h,
-                               tau2_ours=tau2_predicted(E0, s.E_c, s.mu, g),
-                               tau2_pc=tau2_predicted(E0, s.E_c, s.pc["mu"], g)))
+        pc_rows.append(
+            _pc_row(
+                homog[h],
+                homog_pc[h],
+                pair=label,
+                E0=E0,
+                gamma=g,
+                hazard=h,
+                tau2_ours=tau2_predicted(E0, s.E_c, s.mu, g),
+                tau2_pc=tau2_predicted(E0, s.E_c, s.pc["mu"], g),
+            )
+        )
     return fit_rows, cmp_rows, pc_rows
 
 
@@ -375,8 +467,15 @@ def _tau_predictions(study, s: _Setup):
     """τ1, τ2 vs γ at fig4's E0: the model fitted to fig4's P(t), with our constants and with the paper's."""
     dt = study.params.dt
     ref = _fig4_reference(study, s.inputs, dt)
-    tau_kw = {"tau0": s.tau0, "E_c": s.E_c, "hazards": s.hazards, "dt": dt, "fit_dt": study.params.fit_dt,
-              "min_count": study.params.min_count, "alpha": study.params.alpha}
+    tau_kw = {
+        "tau0": s.tau0,
+        "E_c": s.E_c,
+        "hazards": s.hazards,
+        "dt": dt,
+        "fit_dt": study.params.fit_dt,
+        "min_count": study.params.min_count,
+        "alpha": study.params.alpha,
+    }
     taus, tau_fits = _tau_rows(ref, kappa=s.kappa, mu=s.mu, mu_err=s.mu_err, **tau_kw)
     taus_pc, tau_fits_pc = _tau_rows(ref, kappa=s.kappa_pc, mu=s.pc["mu"], mu_err=math.nan, **tau_kw)
     pct = _pc_taus(taus, taus_pc, tau_fits, tau_fits_pc, s.hazards)
@@ -391,10 +490,15 @@ def _compare_with_paper(study, s: _Setup, fits, cmps, taus, pcf, pct) -> None:
     study.compare("μ used (from fig3)", s.mu, s.mu_err, s.pc["mu"], note=s.inputs["mu"]["source"])
     for r in fits.itertuples():
         if r.model == "homogeneous":
-            study.compare(f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual", r.rms_log_residual, None,
-                          None, verdict=None, convention=f"{_constants_label(ours_const, r.hazard, ours=True)}; "
-                                                         f"{study.convention_label}",
-                          note=f"χ²/dof = {r.chi2_red:.3g} ({r.n_points} points); paper: 'satisfying agreement'")
+            study.compare(
+                f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual",
+                r.rms_log_residual,
+                None,
+                None,
+                verdict=None,
+                convention=f"{_constants_label(ours_const, r.hazard, ours=True)}; {study.convention_label}",
+                note=f"χ²/dof = {r.chi2_red:.3g} ({r.n_points} points); paper: 'satisfying agreement'",
+            )
     _compare_mixtures(study, s, cmps)
     _compare_taus(study, taus, s.hazards)
     _compare_paper_constants(study, s.pc, s.tau0, pcf, pct, s.hazards)
@@ -409,14 +513,23 @@ def _compare_mixtures(study, s: _Setup, cmps) -> None:
             name, mode = var["name"], var["fne_mode"]
             better = int((c[name] < c["homogeneous"]).sum())
             better_aic = int((a[name] < a["homogeneous"]).sum())
-            study.compare(f"{name} vs homogeneous ({h} hazard): pairs with smaller rms log residual (AIC)",
-                          f"{better} ({better_aic}) of {len(c)}", None, "improved agreement expected (future work)",
-                          verdict="agrees" if better > len(c) / 2 else "differs",
-                          note=(f"components by {var['by']} at t_ref = {var['t_ref']}; same data selection; "
-                                + ("same number of free parameters (one trapped fraction φ)"
-                                if mode == "shared" else "K trapped fractions f_ne,k: K − 1 more parameters")
-                                + "; rms " + ", ".join(f"{p}: {c.loc[p, 'homogeneous']:.3f} → {c.loc[p, name]:.3f}"
-                                                       for p in c.index)))
+            study.compare(
+                f"{name} vs homogeneous ({h} hazard): pairs with smaller rms log residual (AIC)",
+                f"{better} ({better_aic}) of {len(c)}",
+                None,
+                "improved agreement expected (future work)",
+                verdict="agrees" if better > len(c) / 2 else "differs",
+                note=(
+                    f"components by {var['by']} at t_ref = {var['t_ref']}; same data selection; "
+                    + (
+                        "same number of free parameters (one trapped fraction φ)"
+                        if mode == "shared"
+                        else "K trapped fractions f_ne,k: K − 1 more parameters"
+                    )
+                    + "; rms "
+                    + ", ".join(f"{p}: {c.loc[p, 'homogeneous']:.3f} → {c.loc[p, name]:.3f}" for p in c.index)
+                ),
+            )
 
 
 def _compare_taus(study, taus, hazards) -> None:
@@ -424,15 +537,25 @@ def _compare_taus(study, taus, hazards) -> None:
     for r in taus.itertuples():
         if r.tau2_observed is not None and np.isfinite(r.tau2_observed):
             rel = (r.tau2_observed - r.tau2_predicted) / r.tau2_predicted
-            study.compare(f"τ2(γ={r.gamma:g}) observed vs Eq. (eq:tau2)", r.tau2_observed, None,
-                          None, verdict=f"{100 * rel:+.0f}% from predicted {r.tau2_predicted:.1f}",
-                          note="observed: first settling time (fig4); paper: τ2 ∝ 1/γ, predicted by Eq. (eq:tau2)")
+            study.compare(
+                f"τ2(γ={r.gamma:g}) observed vs Eq. (eq:tau2)",
+                r.tau2_observed,
+                None,
+                None,
+                verdict=f"{100 * rel:+.0f}% from predicted {r.tau2_predicted:.1f}",
+                note="observed: first settling time (fig4); paper: τ2 ∝ 1/γ, predicted by Eq. (eq:tau2)",
+            )
         for h in hazards:
             pred = getattr(r, f"tau1_pred_{h}")
             if r.tau1_observed is not None and np.isfinite(r.tau1_observed) and pred is not None and np.isfinite(pred):
-                study.compare(f"τ1(γ={r.gamma:g}) observed vs model ({h})", r.tau1_observed, None, None,
-                              verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
-                              note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)")
+                study.compare(
+                    f"τ1(γ={r.gamma:g}) observed vs model ({h})",
+                    r.tau1_observed,
+                    None,
+                    None,
+                    verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
+                    note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)",
+                )
 
 
 def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
@@ -458,11 +581,23 @@ def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
 def _pc_row(ours, theirs, *, pair, E0, gamma, hazard, tau2_ours, tau2_pc) -> dict:
     """One (pair, hazard) row: the fit with the paper's constants beside ours on the same points."""
     best = mc.better_fit({"ours": ours, PC: theirs})
-    row = {"pair": pair, "E0": E0, "gamma": gamma, "hazard": hazard, "n_points": theirs.n_points,
-           "rms_log_residual": theirs.rms_log_residual, "rms_log_residual_ours": ours.rms_log_residual,
-           "better": best if best is not None else "tie",
-           "chi2_red": theirs.chi2_red, "chi2_red_ours": ours.chi2_red, "aic": theirs.aic, "aic_ours": ours.aic,
-           "tau2_predicted": tau2_pc, "tau2_predicted_ours": tau2_ours, "success": theirs.success}
+    row = {
+        "pair": pair,
+        "E0": E0,
+        "gamma": gamma,
+        "hazard": hazard,
+        "n_points": theirs.n_points,
+        "rms_log_residual": theirs.rms_log_residual,
+        "rms_log_residual_ours": ours.rms_log_residual,
+        "better": best if best is not None else "tie",
+        "chi2_red": theirs.chi2_red,
+        "chi2_red_ours": ours.chi2_red,
+        "aic": theirs.aic,
+        "aic_ours": ours.aic,
+        "tau2_predicted": tau2_pc,
+        "tau2_predicted_ours": tau2_ours,
+        "success": theirs.success,
+    }
     for k in ("f_ne", "f_e", "L", "b"):
         row[k] = float(theirs.values[k])
         row[f"{k}_err"] = float(theirs.errors.get(k, math.nan))
@@ -477,8 +612,13 @@ def _pc_taus(ours, theirs, fits_ours, fits_pc, hazards) -> pd.DataFrame:
     rows = []
     for o, p in zip(ours.to_dict("records"), theirs.to_dict("records")):
         g = o["gamma"]
-        row = {"gamma": g, "tau1_observed": o["tau1_observed"], "tau2_observed": o["tau2_observed"],
-               "tau2_predicted": p["tau2_predicted"], "tau2_predicted_ours": o["tau2_predicted"]}
+        row = {
+            "gamma": g,
+            "tau1_observed": o["tau1_observed"],
+            "tau2_observed": o["tau2_observed"],
+            "tau2_predicted": p["tau2_predicted"],
+            "tau2_predicted_ours": o["tau2_predicted"],
+        }
         for h in hazards:
             row[f"tau1_pred_{h}"] = p[f"tau1_pred_{h}"]
             row[f"tau1_pred_{h}_ours"] = o[f"tau1_pred_{h}"]
@@ -509,13 +649,20 @@ def _compare_paper_constants(study, pc, tau0, pcf, pct, hazards):
     and which constants fit better; per hazard the count; per γ of fig4 the τ2 and τ1 they predict."""
     setup = study.convention_label
     for r in pcf.itertuples():
-        study.compare(f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual, paper's constants",
-                      r.rms_log_residual, None, None,
-                      verdict=_better_text(r.better, r.rms_log_residual_ours, r.rms_log_residual),
-                      convention=f"{_constants_label(pc, r.hazard, ours=False)}; {setup}", authors=True,
-                      note=(f"same {r.n_points} points, free f_ne, L, b and τ0 = {tau0:g} (ours, fig4: the paper "
-                            f"gives none) as the row with our constants; χ²/dof = {r.chi2_red:.3g} "
-                            f"(ours {r.chi2_red_ours:.3g})"))
+        study.compare(
+            f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual, paper's constants",
+            r.rms_log_residual,
+            None,
+            None,
+            verdict=_better_text(r.better, r.rms_log_residual_ours, r.rms_log_residual),
+            convention=f"{_constants_label(pc, r.hazard, ours=False)}; {setup}",
+            authors=True,
+            note=(
+                f"same {r.n_points} points, free f_ne, L, b and τ0 = {tau0:g} (ours, fig4: the paper "
+                f"gives none) as the row with our constants; χ²/dof = {r.chi2_red:.3g} "
+                f"(ours {r.chi2_red_ours:.3g})"
+            ),
+        )
     for h in hazards:
         sub = pcf[pcf["hazard"] == h]
         n_pc, n_ours = int((sub["better"] == PC).sum()), int((sub["better"] == "ours").sum())
@@ -524,54 +671,88 @@ def _compare_paper_constants(study, pc, tau0, pcf, pct, hazards):
         else:
             who = "the paper's" if n_pc > n_ours else "our"
             verdict = f"{who} constants fit better on {max(n_pc, n_ours)} of {len(sub)} pairs"
-        study.compare(f"Fig. 6a ({h} hazard): pairs the paper's constants fit better than ours",
-                      f"{n_pc} of {len(sub)}", None, None, verdict=verdict,
-                      convention=f"{_constants_label(pc, h, ours=False)}; {setup}", authors=True,
-                      note="smaller rms log residual on the same points; rms ours → paper's: " + ", ".join(
-                          f"{q.pair}: {q.rms_log_residual_ours:.3f} → {q.rms_log_residual:.3f}"
-                          for q in sub.itertuples()))
+        study.compare(
+            f"Fig. 6a ({h} hazard): pairs the paper's constants fit better than ours",
+            f"{n_pc} of {len(sub)}",
+            None,
+            None,
+            verdict=verdict,
+            convention=f"{_constants_label(pc, h, ours=False)}; {setup}",
+            authors=True,
+            note="smaller rms log residual on the same points; rms ours → paper's: "
+            + ", ".join(
+                f"{q.pair}: {q.rms_log_residual_ours:.3f} → {q.rms_log_residual:.3f}" for q in sub.itertuples()
+            ),
+        )
     for r in pct.itertuples():
         g = r.gamma
         if r.tau2_observed is not None and np.isfinite(r.tau2_observed):
-            closer = ("paper's μ" if abs(r.tau2_observed - r.tau2_predicted) < abs(r.tau2_observed
-                                                                                    - r.tau2_predicted_ours)
-                      else "our μ")
-            study.compare(f"τ2(γ={g:g}) Eq. (eq:tau2) with the paper's μ vs observed", r.tau2_predicted, None, None,
-                          verdict=(f"observed {r.tau2_observed:.1f} is {_pct(r.tau2_observed, r.tau2_predicted)} "
-                                   f"from it ({_pct(r.tau2_observed, r.tau2_predicted_ours)} from "
-                                   f"{r.tau2_predicted_ours:.1f} with our μ): {closer} closer"),
-                          convention=f"paper's μ = {pc['mu']:g}; {setup}", authors=True,
-                          note="observed: first settling time (fig4); τ2 = ln(E0/E_c)/(μγ)")
+            closer = (
+                "paper's μ"
+                if abs(r.tau2_observed - r.tau2_predicted) < abs(r.tau2_observed - r.tau2_predicted_ours)
+                else "our μ"
+            )
+            study.compare(
+                f"τ2(γ={g:g}) Eq. (eq:tau2) with the paper's μ vs observed",
+                r.tau2_predicted,
+                None,
+                None,
+                verdict=(
+                    f"observed {r.tau2_observed:.1f} is {_pct(r.tau2_observed, r.tau2_predicted)} "
+                    f"from it ({_pct(r.tau2_observed, r.tau2_predicted_ours)} from "
+                    f"{r.tau2_predicted_ours:.1f} with our μ): {closer} closer"
+                ),
+                convention=f"paper's μ = {pc['mu']:g}; {setup}",
+                authors=True,
+                note="observed: first settling time (fig4); τ2 = ln(E0/E_c)/(μγ)",
+            )
         for h in hazards:
             pred, pred_o = getattr(r, f"tau1_pred_{h}"), getattr(r, f"tau1_pred_{h}_ours")
             obs = r.tau1_observed
             if not all(v is not None and np.isfinite(v) for v in (pred, pred_o, obs)):
                 continue
             closer = "paper's constants" if abs(pred - obs) < abs(pred_o - obs) else "our constants"
-            study.compare(f"τ1(γ={g:g}) model with the paper's constants ({h}) vs observed", pred, None, None,
-                          verdict=(f"{_pct(pred, obs)} from observed {obs:.1f}; our constants {pred_o:.1f} "
-                                   f"({_pct(pred_o, obs)}): {closer} closer"),
-                          convention=f"{_constants_label(pc, h, ours=False)}; {setup}", authors=True,
-                          note=(f"Eq. (eqn:surv_prob_model) fitted to fig4's P(t) with the paper's κ0 and μ, solved "
-                                f"for P = α P_0 (Eq. (eqn:tau1), α = 2); rms log residual {getattr(r, f'rms_{h}'):.3f} "
-                                f"(ours {getattr(r, f'rms_{h}_ours'):.3f})"))
+            study.compare(
+                f"τ1(γ={g:g}) model with the paper's constants ({h}) vs observed",
+                pred,
+                None,
+                None,
+                verdict=(
+                    f"{_pct(pred, obs)} from observed {obs:.1f}; our constants {pred_o:.1f} "
+                    f"({_pct(pred_o, obs)}): {closer} closer"
+                ),
+                convention=f"{_constants_label(pc, h, ours=False)}; {setup}",
+                authors=True,
+                note=(
+                    f"Eq. (eqn:surv_prob_model) fitted to fig4's P(t) with the paper's κ0 and μ, solved "
+                    f"for P = α P_0 (Eq. (eqn:tau1), α = 2); rms log residual {getattr(r, f'rms_{h}'):.3f} "
+                    f"(ours {getattr(r, f'rms_{h}_ours'):.3f})"
+                ),
+            )
 
 
 def _pc_numbers(pc, E_c, tau0, pcf, pct, hazards) -> dict:
     """The ``paper_constants`` key of fig6.json: the constants; ``fits``, one row per pair and hazard (the fit with
     them beside ours: RMS log residuals, which is smaller, τ2 of Eq. (eq:tau2) with both μ); ``tau_vs_gamma``, per
     γ of fig4 the τ1, τ2 they predict beside ours and the observed ones."""
-    return {"constants": {**pc, "E_c": E_c,
-                          "source": "study.toml [study] paper_kappa_a, paper_kappa_b, paper_kappa_c, paper_kappa_Eb, "
-                                    "paper_mu (paper: Fig. 2b caption; Sec. III.A, Fig. 3)"},
-            "tau0": tau0,
-            "method": ("the homogeneous model, Eq. (eqn:surv_prob_model), in hazard forms "
-                       f"{', '.join(hazards)}, with κ0(E) and μ held at these values; free f_ne, L, b "
-                       "(f_e = P(τ0) − f_ne) fitted on the same points as with our constants; τ0 ours (fig4): "
-                       "the paper gives none; 'better': the smaller rms log residual (columns '_ours': our "
-                       "constants)"),
-            "fits": pcf.to_dict(orient="records"),
-            "tau_vs_gamma": pct.to_dict(orient="records")}
+    return {
+        "constants": {
+            **pc,
+            "E_c": E_c,
+            "source": "study.toml [study] paper_kappa_a, paper_kappa_b, paper_kappa_c, paper_kappa_Eb, "
+            "paper_mu (paper: Fig. 2b caption; Sec. III.A, Fig. 3)",
+        },
+        "tau0": tau0,
+        "method": (
+            "the homogeneous model, Eq. (eqn:surv_prob_model), in hazard forms "
+            f"{', '.join(hazards)}, with κ0(E) and μ held at these values; free f_ne, L, b "
+            "(f_e = P(τ0) − f_ne) fitted on the same points as with our constants; τ0 ours (fig4): "
+            "the paper gives none; 'better': the smaller rms log residual (columns '_ours': our "
+            "constants)"
+        ),
+        "fits": pcf.to_dict(orient="records"),
+        "tau_vs_gamma": pct.to_dict(orient="records"),
+    }
 
 
 # ---------------------------------------------------------------------------
@@ -601,11 +782,18 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
         gcol, t1, t2 = (getattr(study.params, k) for k in ("tau_gamma_field", "tau1_field", "tau2_field"))
         missing = {gcol, t1, t2} - set(obs.columns)
         if missing:
-            raise up.UpstreamError(f"{other}.json:{study.params.tau_table_key} rows lack {sorted(missing)}; "
-                                   f"have {sorted(obs.columns)}")
-        obs = pd.DataFrame({"gamma": obs[gcol].astype(float),
-                            "tau1_observed": [_val(v)[0] for v in obs[t1]], "tau1_err": [_val(v)[1] for v in obs[t1]],
-                            "tau2_observed": [_val(v)[0] for v in obs[t2]], "tau2_err": [_val(v)[1] for v in obs[t2]]})
+            raise up.UpstreamError(
+                f"{other}.json:{study.params.tau_table_key} rows lack {sorted(missing)}; have {sorted(obs.columns)}"
+            )
+        obs = pd.DataFrame(
+            {
+                "gamma": obs[gcol].astype(float),
+                "tau1_observed": [_val(v)[0] for v in obs[t1]],
+                "tau1_err": [_val(v)[1] for v in obs[t1]],
+                "tau2_observed": [_val(v)[0] for v in obs[t2]],
+                "tau2_err": [_val(v)[1] for v in obs[t2]],
+            }
+        )
         inputs["tau_table"] = {"source": f"{other}.json:{study.params.tau_table_key}"}
         # P(t) of the τ study's runs from its published lifetimes table (never its raw runs)
         tname = doc.get("tables", {}).get("lifetimes")
@@ -630,10 +818,20 @@ def _fig4_reference(study, inputs, dt) -> _Fig4Ref:
             raise
         # development only: observed τ2 from this study's own E0 = 0.3 runs, no τ1 (no γ = 0 run)
         inputs["tau_table"] = {"source": up.DEV_SOURCE + ": own E0 runs, τ1 not available"}
-        lifetimes = {g: read_lifetimes(study.raw(pair_key(e, g)), columns=["t_end", "outcome"], categorical=True)
-                     for e, g in _pairs(study) if abs(e - E0) < 1e-12}
-        obs = pd.DataFrame({"gamma": sorted(lifetimes), "tau1_observed": None, "tau1_err": None, "tau2_err": None,
-                            "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)]})
+        lifetimes = {
+            g: read_lifetimes(study.raw(pair_key(e, g)), columns=["t_end", "outcome"], categorical=True)
+            for e, g in _pairs(study)
+            if abs(e - E0) < 1e-12
+        }
+        obs = pd.DataFrame(
+            {
+                "gamma": sorted(lifetimes),
+                "tau1_observed": None,
+                "tau1_err": None,
+                "tau2_err": None,
+                "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)],
+            }
+        )
         P_0 = None
     return _Fig4Ref(obs, lifetimes, P_0, E0)
 
@@ -645,10 +843,15 @@ def _tau_rows(ref: _Fig4Ref, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_d
     for r in ref.obs[ref.obs["gamma"] > 0].sort_values("gamma").itertuples():
         g = float(r.gamma)
         tau2_pred = tau2_predicted(ref.E0, E_c, mu, g)
-        row = {"gamma": g, "tau1_observed": _num(r.tau1_observed), "tau1_observed_err": _num(r.tau1_err),
-               "tau2_observed": _num(r.tau2_observed), "tau2_observed_err": _num(r.tau2_err),
-               "tau2_predicted": tau2_pred,
-               "tau2_predicted_err": tau2_pred * mu_err / mu if math.isfinite(mu_err) else math.nan}
+        row = {
+            "gamma": g,
+            "tau1_observed": _num(r.tau1_observed),
+            "tau1_observed_err": _num(r.tau1_err),
+            "tau2_observed": _num(r.tau2_observed),
+            "tau2_observed_err": _num(r.tau2_err),
+            "tau2_predicted": tau2_pred,
+            "tau2_predicted_err": tau2_pred * mu_err / mu if math.isfinite(mu_err) else math.nan,
+        }
         lt = ref.lifetimes.get(g)
         for h in hazards:
             row[f"tau1_pred_{h}"] = None
@@ -657,9 +860,23 @@ def _tau_rows(ref: _Fig4Ref, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_d
             t, P, P_err = _curve(lt, dt)
             tf, Pf, sf = _fit_points(t, P, P_err, tau0, fit_dt, len(lt), min_count)
             if tf.size >= 5:
-                fits = _homogeneous_fits(t, P, P_err, tf, Pf, sf, kappa=kappa, E0=ref.E0, mu=mu, gamma=g, tau0=tau0,
-                                         E_c=E_c, hazards=hazards, fit_tau2=False,
-                                         P_min=min_count / len(lt) * 0.999)
+                fits = _homogeneous_fits(
+                    t,
+                    P,
+                    P_err,
+                    tf,
+                    Pf,
+                    sf,
+                    kappa=kappa,
+                    E0=ref.E0,
+                    mu=mu,
+                    gamma=g,
+                    tau0=tau0,
+                    E_c=E_c,
+                    hazards=hazards,
+                    fit_tau2=False,
+                    P_min=min_count / len(lt) * 0.999,
+                )
                 fits_by_gamma[g] = fits
                 for h in hazards:
                     row[f"f_ne_{h}"] = float(fits[h].values["f_ne"])
@@ -672,13 +889,21 @@ def _tau_rows(ref: _Fig4Ref, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_d
 
 def _tau2_curve(taus, E0, E_c, mu, mu_err, mu_pc) -> pd.DataFrame:
     """Eq. (eq:tau2) on a fine γ grid: with our μ (and its ±1σ band) and with the paper's μ."""
-    gg = np.geomspace(min(taus["gamma"].min(), 1e-3) * 0.8, max(taus["gamma"].max(), 0.02) * 1.25, 200) \
-        if len(taus) else np.geomspace(1e-3, 0.03, 200)
+    gg = (
+        np.geomspace(min(taus["gamma"].min(), 1e-3) * 0.8, max(taus["gamma"].max(), 0.02) * 1.25, 200)
+        if len(taus)
+        else np.geomspace(1e-3, 0.03, 200)
+    )
     t2 = tau2_predicted(E0, E_c, mu, gg)
-    return pd.DataFrame({"gamma": gg, "tau2_predicted": t2,
-                         "tau2_lo": t2 / (1 + mu_err / mu) if math.isfinite(mu_err) else t2,
-                         "tau2_hi": t2 / (1 - mu_err / mu) if math.isfinite(mu_err) else t2,
-                         f"tau2_predicted_{PC}": tau2_predicted(E0, E_c, mu_pc, gg)})
+    return pd.DataFrame(
+        {
+            "gamma": gg,
+            "tau2_predicted": t2,
+            "tau2_lo": t2 / (1 + mu_err / mu) if math.isfinite(mu_err) else t2,
+            "tau2_hi": t2 / (1 - mu_err / mu) if math.isfinite(mu_err) else t2,
+            f"tau2_predicted_{PC}": tau2_predicted(E0, E_c, mu_pc, gg),
+        }
+    )
 
 
 def _val(v):
@@ -704,6 +929,14 @@ def plot(study):
 
     nums = study.read_numbers()
     read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()
-    plot_fig6(read("curves.parquet"), read("fits.parquet"), read("tau_vs_gamma.parquet"),
-              read("tau2_curve.parquet"), read("compare_fits.parquet"), nums, study.figure_path,
-              pc_fits=read(f"{PC}_fits.parquet"), pc_taus=read(f"{PC}_taus.parquet"))
+    plot_fig6(
+        read("curves.parquet"),
+        read("fits.parquet"),
+        read("tau_vs_gamma.parquet"),
+        read("tau2_curve.parquet"),
+        read("compare_fits.parquet"),
+        nums,
+        study.figure_path,
+        pc_fits=read(f"{PC}_fits.parquet"),
+        pc_taus=read(f"{PC}_taus.parquet"),
+    )

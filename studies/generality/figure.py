@@ -1,5 +1,6 @@
 """Figure of study ``generality`` (draws the derived tables and generality.json; computes nothing but the laws'
 curves from their fitted parameters)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -19,8 +20,16 @@ def _panel_kappa(ax, kappa, numbers):
         col, mk = COLORS.get(name, "k"), MARKERS.get(name, "o")
         d = kappa[(kappa["system"] == name) & (kappa["convention"] == "plateau")]
         ok = d["defined"].astype(bool)
-        ax.errorbar(d.loc[ok, "eps"], d.loc[ok, "kappa"], d.loc[ok, "kappa_err"], fmt=mk, color=col, ms=5,
-                    capsize=2, label=_label(name, info))
+        ax.errorbar(
+            d.loc[ok, "eps"],
+            d.loc[ok, "kappa"],
+            d.loc[ok, "kappa_err"],
+            fmt=mk,
+            color=col,
+            ms=5,
+            capsize=2,
+            label=_label(name, info),
+        )
         ax.plot(d.loc[~ok, "eps"], d.loc[~ok, "kappa"], "x", color=col, ms=7)  # trapped plateau: ill-defined
         e = kappa[(kappa["system"] == name) & (kappa["convention"] == "escaping") & kappa["defined"]]
         ax.plot(e["eps"], e["kappa"], mk, mfc="none", color=col, ms=8, alpha=0.7)
@@ -30,15 +39,24 @@ def _panel_kappa(ax, kappa, numbers):
         if law:
             a, b, c, eb = (law[k]["value"] for k in ("a", "b", "c", "eps_b"))
             x = np.geomspace(max(float(d["eps"].min()) / 1.3, 1e-3), float(d["eps"].max()) * 1.2, 200)
-            ax.plot(x, np.where(x < eb, a * x * x + b * x, c * x), "-" if conv == "plateau" else "--", color=col,
-                    lw=1, alpha=0.8)
+            ax.plot(
+                x,
+                np.where(x < eb, a * x * x + b * x, c * x),
+                "-" if conv == "plateau" else "--",
+                color=col,
+                lw=1,
+                alpha=0.8,
+            )
             ax.axvline(eb, color=col, ls=":", lw=0.8)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(r"$\epsilon = (E - E_c)/E_c$")
     ax.set_ylabel(r"$\kappa_0$ (1/time; well frequency 1)")
-    ax.set_title("(a) κ0: filled all orbits, × ill-defined (trapped plateau),\nopen escaping orbits only; "
-                 "lines: law aε²+bε | cε, dotted: break", fontsize=9)
+    ax.set_title(
+        "(a) κ0: filled all orbits, × ill-defined (trapped plateau),\nopen escaping orbits only; "
+        "lines: law aε²+bε | cε, dotted: break",
+        fontsize=9,
+    )
     ax.legend(fontsize=7, loc="lower right")
 
 
@@ -66,9 +84,18 @@ def _panel_mu(ax, numbers, paper_mu):
             if m["value"] is None or p["value"] is None:
                 continue
             w = bw["window"]
-            ax.errorbar(p["value"], m["value"], xerr=p["err"], yerr=m["err"], fmt=MARKERS.get(name, "o"),
-                        color=COLORS.get(name, "k"), ms=6, capsize=3, mfc=None if wname == "paper" else "none",
-                        label=f"{name}, t ∈ [{w[0]:g}, {w[1]:g}]")
+            ax.errorbar(
+                p["value"],
+                m["value"],
+                xerr=p["err"],
+                yerr=m["err"],
+                fmt=MARKERS.get(name, "o"),
+                color=COLORS.get(name, "k"),
+                ms=6,
+                capsize=3,
+                mfc=None if wname == "paper" else "none",
+                label=f"{name}, t ∈ [{w[0]:g}, {w[1]:g}]",
+            )
             lo, hi = min(lo, m["value"] - 0.03, p["value"] - 0.03), max(hi, m["value"] + 0.03, p["value"] + 0.03)
     ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
     ax.axhline(paper_mu, color="0.5", ls=":", lw=0.8)
@@ -77,8 +104,11 @@ def _panel_mu(ax, numbers, paper_mu):
     ax.set_ylim(lo, hi)
     ax.set_xlabel("μ predicted (conservative ⟨K⟩)")
     ax.set_ylabel("μ measured (⟨E⟩(t) fit)")
-    ax.set_title("(c) μ measured vs predicted (c-measure above E_c, microcanonical well below)\n"
-                 "filled: fig3's window [0, 200]; open: ⟨E⟩ > E_c window", fontsize=9)
+    ax.set_title(
+        "(c) μ measured vs predicted (c-measure above E_c, microcanonical well below)\n"
+        "filled: fig3's window [0, 200]; open: ⟨E⟩ > E_c window",
+        fontsize=9,
+    )
     ax.legend(fontsize=7)
 
 
@@ -88,8 +118,14 @@ def _panel_curves(ax, curves, numbers, gamma):
         d = curves[(curves["system"] == name) & (curves["t"] > 0)]
         for kind, ls in (("measured", "-"), ("predicted", "--")):
             k = d[d["kind"] == kind]
-            ax.plot(k["t"], -np.log(k["mean_E_over_E0"]) / (gamma * k["t"]), ls, color=col, lw=1.4 if ls == "-" else 1,
-                    label=f"{name} {kind}")
+            ax.plot(
+                k["t"],
+                -np.log(k["mean_E_over_E0"]) / (gamma * k["t"]),
+                ls,
+                color=col,
+                lw=1.4 if ls == "-" else 1,
+                label=f"{name} {kind}",
+            )
     ax.set_xlabel("t")
     ax.set_ylabel(r"$-\ln(\langle E\rangle/E_0)/(\gamma t)$")
     ax.set_title(f"(d) running μ of ⟨E⟩(t), γ = {gamma:g}: measured (solid), predicted path (dashed)", fontsize=9)
@@ -106,10 +142,25 @@ def _panel_kappa_cm(ax, numbers):
             if r["kappa_cm"] is None or r["kappa_escaping"] is None:
                 continue
             filled = r["kappa_plateau"] is not None and r.get("ratio_minus_1_plateau") is not None
-            ax.errorbar(r["kappa_escaping"], r["kappa_cm"], xerr=r["kappa_escaping_err"], yerr=r["kappa_cm_err"],
-                        fmt=mk, color=col, mfc=None if filled else "none", ms=6, capsize=2)
-            ax.annotate(f"{r['ratio']:g}", (r["kappa_escaping"], r["kappa_cm"]), fontsize=6, color=col,
-                        xytext=(4, -8), textcoords="offset points")
+            ax.errorbar(
+                r["kappa_escaping"],
+                r["kappa_cm"],
+                xerr=r["kappa_escaping_err"],
+                yerr=r["kappa_cm_err"],
+                fmt=mk,
+                color=col,
+                mfc=None if filled else "none",
+                ms=6,
+                capsize=2,
+            )
+            ax.annotate(
+                f"{r['ratio']:g}",
+                (r["kappa_escaping"], r["kappa_cm"]),
+                fontsize=6,
+                color=col,
+                xytext=(4, -8),
+                textcoords="offset points",
+            )
             lo, hi = min(lo, r["kappa_escaping"], r["kappa_cm"]), max(hi, r["kappa_escaping"], r["kappa_cm"])
         ax.plot([], [], mk, color=col, label=name)
     if hi > 0:
@@ -118,8 +169,11 @@ def _panel_kappa_cm(ax, numbers):
     ax.set_yscale("log")
     ax.set_xlabel(r"$\kappa_0$ from P(t) (escaping orbits, claim-1 run)")
     ax.set_ylabel(r"$\kappa$ from the c-measure, $\int e^{\kappa T} d\mu_c = 1 + \mu_c(\mathcal{E})$")
-    ax.set_title("(e) claim 2: κ from the c-measure vs κ0 (labels E/E_c);\nfilled: the paper's all-orbit κ0 defined "
-                 "too, open: ill-defined (trapped plateau)", fontsize=9)
+    ax.set_title(
+        "(e) claim 2: κ from the c-measure vs κ0 (labels E/E_c);\nfilled: the paper's all-orbit κ0 defined "
+        "too, open: ill-defined (trapped plateau)",
+        fontsize=9,
+    )
     ax.legend(fontsize=7)
 
 
@@ -139,20 +193,39 @@ def _panel_distance(ax, numbers):
                 dl = r["delta"]
                 text.append(f"{name}: Δ = {dl['value']:+.2f} [{dl['interval'][0]:+.2f}, {dl['interval'][1]:+.2f}]")
             x, y = r["d_E0"], r["d_star"]
-            ax.errorbar(x["value"], y["value"], xerr=[[x["value"] - x["interval"][0]], [x["interval"][1] - x["value"]]],
-                        yerr=[[y["value"] - y["interval"][0]], [y["interval"][1] - y["value"]]], fmt=mk, color=col,
-                        mfc=None if filled else "none", ms=6, capsize=2,
-                        label=f"{name}, {'μ_c (trapped dropped)' if filled else 'all survivors'}")
+            ax.errorbar(
+                x["value"],
+                y["value"],
+                xerr=[[x["value"] - x["interval"][0]], [x["interval"][1] - x["value"]]],
+                yerr=[[y["value"] - y["interval"][0]], [y["interval"][1] - y["value"]]],
+                fmt=mk,
+                color=col,
+                mfc=None if filled else "none",
+                ms=6,
+                capsize=2,
+                label=f"{name}, {'μ_c (trapped dropped)' if filled else 'all survivors'}",
+            )
             top = max(top, x["interval"][1], y["interval"][1])
     ax.plot([0, top * 1.1], [0, top * 1.1], "k-", lw=0.8)
-    ax.text(0.03, 0.80, "paired Δ = d(μ_c^E0) − d(μ_c^E(t*)), μ_c:\n" + "\n".join(text), transform=ax.transAxes,
-            ha="left", va="top", fontsize=7, bbox={"fc": "white", "ec": "0.8"})
+    ax.text(
+        0.03,
+        0.80,
+        "paired Δ = d(μ_c^E0) − d(μ_c^E(t*)), μ_c:\n" + "\n".join(text),
+        transform=ax.transAxes,
+        ha="left",
+        va="top",
+        fontsize=7,
+        bbox={"fc": "white", "ec": "0.8"},
+    )
     ax.set_xlim(0, top * 1.1)
     ax.set_ylim(0, top * 1.1)
     ax.set_xlabel(r"d(survivors at t*, $\mu_c^{E_0}$)")
     ax.set_ylabel(r"d(survivors at t*, $\mu_c^{E(t^*)}$)")
-    ax.set_title("(f) claim 5, Fig. 5's test: debiased Hellinger distances (95 % paired intervals);\n"
-                 "below the diagonal: closer to the c-measure at E(t*)", fontsize=9)
+    ax.set_title(
+        "(f) claim 5, Fig. 5's test: debiased Hellinger distances (95 % paired intervals);\n"
+        "below the diagonal: closer to the c-measure at E(t*)",
+        fontsize=9,
+    )
     ax.legend(fontsize=6)
 
 
@@ -166,8 +239,9 @@ def plot_generality(kappa, mu, curves, numbers, path):
     _panel_curves(axs[1, 1], curves, numbers, numbers["config"]["study"]["mu_gamma"])
     _panel_kappa_cm(axs[2, 0], numbers)
     _panel_distance(axs[2, 1], numbers)
-    fig.suptitle(f"generality ({numbers['scale']} scale): the paper's claims on three systems at the same E/E_c",
-                 fontsize=10)
+    fig.suptitle(
+        f"generality ({numbers['scale']} scale): the paper's claims on three systems at the same E/E_c", fontsize=10
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
@@ -192,9 +266,18 @@ def plot_regular(numbers, path):
     fig, ax = plt.subplots(figsize=(8, 4.8))
     for (label, ics), g in d.groupby(["label", "ics"], sort=False):
         disk = "disk" in ics
-        ax.errorbar(g["e_ratio"], g["fraction"], g["err"], fmt=("-" if disk else "--") + MARKERS.get(label, "o"),
-                    color=COLORS.get(label, "k"), mfc=None if disk else "none", ms=6, capsize=2, lw=1.2,
-                    label=f"{_name(label)}, {ics}")
+        ax.errorbar(
+            g["e_ratio"],
+            g["fraction"],
+            g["err"],
+            fmt=("-" if disk else "--") + MARKERS.get(label, "o"),
+            color=COLORS.get(label, "k"),
+            mfc=None if disk else "none",
+            ms=6,
+            capsize=2,
+            lw=1.2,
+            label=f"{_name(label)}, {ics}",
+        )
     ax.axhline(0.01, color="k", lw=0.8, ls=":")
     ax.text(d["e_ratio"].max(), 0.012, "1 %", ha="right", va="bottom", fontsize=9)
     ax.set_yscale("symlog", linthresh=0.01)
@@ -202,8 +285,11 @@ def plot_regular(numbers, path):
     ax.set_xlabel(r"$E/E_c$")
     ax.set_ylabel("regular fraction of all orbits")
     r = d.iloc[0]
-    ax.set_title(f"Orbits on KAM tori (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "
-                 f"N = {int(r['n'])} per point)", fontsize=10)
+    ax.set_title(
+        f"Orbits on KAM tori (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "
+        f"N = {int(r['n'])} per point)",
+        fontsize=10,
+    )
     ax.legend(fontsize=8, ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=150)
@@ -223,8 +309,17 @@ def plot_sections(points, path):
             for kind in ("escaped", "none", "chaotic", "regular"):
                 k = d[d["kind"] == kind]
                 n = k["traj_id"].nunique()
-                ax.plot(k["x"], k["y"], ".", ms=1.2, mew=0, color=KIND_COLORS[kind], alpha=0.6 if kind != "regular" else 1,
-                        label=f"{kind} ({n} orbits)" if n else None, rasterized=True)
+                ax.plot(
+                    k["x"],
+                    k["y"],
+                    ".",
+                    ms=1.2,
+                    mew=0,
+                    color=KIND_COLORS[kind],
+                    alpha=0.6 if kind != "regular" else 1,
+                    label=f"{kind} ({n} orbits)" if n else None,
+                    rasterized=True,
+                )
             ax.set_aspect("equal")
             ax.set_title(f"{_name(label)}, E = {r:g} E_c", fontsize=10)
             ax.set_xlabel("x")
@@ -262,8 +357,13 @@ def plot_decay(curves, numbers, path):
             if len(f) and f["P_inf"].notna().iloc[0]:
                 f = f.iloc[0]
                 t = np.linspace(f["t0"], d["t"].max(), 100)
-                ax.plot(t, f["P_inf"] + (f["P_t0"] - f["P_inf"]) * np.exp(-f["kappa_inf"] * (t - f["t0"])), ":",
-                        color="k", lw=1)
+                ax.plot(
+                    t,
+                    f["P_inf"] + (f["P_t0"] - f["P_inf"]) * np.exp(-f["kappa_inf"] * (t - f["t0"])),
+                    ":",
+                    color="k",
+                    lw=1,
+                )
         ax.set_yscale("log")
         ax.set_ylim(1e-4, 1.05)
         ax.set_xlabel("t")
@@ -271,8 +371,10 @@ def plot_decay(curves, numbers, path):
         if j == 0:
             ax.set_ylabel("P(t) (disk ICs, γ = 0)")
         ax.legend(fontsize=8, loc="lower left")
-    fig.suptitle("Long-time escape: all orbits (solid), non-regular orbits (dashed), plateau + exponential fit "
-                 "(dotted)", fontsize=10)
+    fig.suptitle(
+        "Long-time escape: all orbits (solid), non-regular orbits (dashed), plateau + exponential fit (dotted)",
+        fontsize=10,
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)

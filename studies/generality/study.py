@@ -19,6 +19,7 @@ into the generality.json already in the output folder.
 ``plot`` — ``generality.png`` (the claims) and ``generality_regular.png``, ``generality_sections.png``,
 ``generality_decay.png`` (the evidence), figure.py.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -62,7 +63,7 @@ class Params(StudyParams):
 
     systems: list[SystemEntry]
     radius_frac: Number
-    alt_region: OneOf(*REGIONS) = None     # a second IC convention for κ0(E): the same grid with these ICs
+    alt_region: OneOf(*REGIONS) = None  # a second IC convention for κ0(E): the same grid with these ICs
     alt_momentum: OneOf(*MOMENTA) = "random"
     ratios: Numbers
     grid_n: Integer
@@ -90,8 +91,8 @@ class Params(StudyParams):
     alpha: Number
     tau_grid_step: Number
     paper_mu: Number
-    hazard_bin: Number = 5.0      # claim 7: width of the time bins of the escape hazard (time units)
-    sm_dt: Number = 0.5           # claim 6 (fig6 rule)
+    hazard_bin: Number = 5.0  # claim 7: width of the time bins of the escape hazard (time units)
+    sm_dt: Number = 0.5  # claim 6 (fig6 rule)
     sm_fit_dt: Number = 2.0
     sm_min_count: Number = 20.0
     # claim 2 (κ from the c-measure) and claim 5 (Fig. 5's distance): conservative runs recording every section
@@ -100,22 +101,22 @@ class Params(StudyParams):
     cm_n: Integer = 5000
     cm_t_to: Number = 400.0
     cm_t_max: Number = 800.0
-    cm_rec_efolds: Number = 2.0   # sampling from t_rec = ⌈τ0 + cm_rec_efolds/κ⌉ (escaping orbits' P(t) of the run)
-    cm_margin: Number = 40.0      # … to cm_t_to − cm_margin
-    c5_ratio: Number = 1.5        # E(t*)/E_c of claim 5 (one of cm_ratios, below e0_ratio)
-    c5_mu_range: Numbers = [0.6, 1.3]   # sections of the dissipative run recorded for t* of any μ in this range
+    cm_rec_efolds: Number = 2.0  # sampling from t_rec = ⌈τ0 + cm_rec_efolds/κ⌉ (escaping orbits' P(t) of the run)
+    cm_margin: Number = 40.0  # … to cm_t_to − cm_margin
+    c5_ratio: Number = 1.5  # E(t*)/E_c of claim 5 (one of cm_ratios, below e0_ratio)
+    c5_mu_range: Numbers = [0.6, 1.3]  # sections of the dissipative run recorded for t* of any μ in this range
     c5_pad: Number = 25.0
-    c5_box_frac: Number = 0.25    # box side of the Hellinger distance, in units of the saddle distance r_s
+    c5_box_frac: Number = 0.25  # box side of the Hellinger distance, in units of the saddle distance r_s
     c5_offsets: Integer = 2
     c5_boot: Integer = 100
     c5_level: Number = 0.95
     # the evidence behind the claims' readings (rules in study.toml): which parts a scale runs
     parts: list[OneOf("claims", "evidence")] = ["claims", "evidence"]
     ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.9, 2.6, 3.5, 5.0]
-    ev_ics: list[OneOf(*REGIONS)] = ["disk", "well"]   # disk: radius_frac·r_s, tangential; others: alt_momentum
+    ev_ics: list[OneOf(*REGIONS)] = ["disk", "well"]  # disk: radius_frac·r_s, tangential; others: alt_momentum
     ev_n: Integer = 2000
     ev_t_max: Number = 2000.0
-    ev_window: Number = 100.0     # the indicator compares first crossings after ev_t_max − ev_window
+    ev_window: Number = 100.0  # the indicator compares first crossings after ev_t_max − ev_window
     ev_delta: Number = 1e-9
     ev_g_max: Number = 1e4
     ev_times: Numbers = [100.0, 200.0, 400.0, 800.0, 2000.0]
@@ -124,7 +125,7 @@ class Params(StudyParams):
     ps_ratios: Numbers = [1.05, 1.5]
     ps_n: Integer = 150
     ps_t_max: Number = 1000.0
-    resc_values: Numbers = [1.03]   # r_esc sensitivity: these beside the default, for systems where they are valid
+    resc_values: Numbers = [1.03]  # r_esc sensitivity: these beside the default, for systems where they are valid
     resc_ratios: Numbers = [1.2, 1.5, 1.8, 1.9, 2.6]
     resc_n: Integer = 2000
     resc_probe_n: Integer = 1000
@@ -164,7 +165,9 @@ def _check(study):
     if not np.isclose(p.resc_ratios, p.e0_ratio).any():
         raise ValueError(f"[study].resc_ratios must contain e0_ratio = {p.e0_ratio:g} (2⟨K⟩/E measured at E0)")
     if not study.params.cm_t_max > study.params.cm_t_to:
-        raise ValueError("[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max are dropped as KAM-trapped)")
+        raise ValueError(
+            "[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max are dropped as KAM-trapped)"
+        )
 
 
 # ---------------------------------------------------------------------------
@@ -191,25 +194,56 @@ def simulate(study, workers=None, progress=True):
         if p.alt_region is not None:  # the same grid with other ICs: is a trapped plateau the ICs' doing?
             for r in p.ratios:
                 key = alt_key(label, r, p.alt_region)
-                sc = study.scene(key, system=spec, energy=r * ec, n=p.grid_n, region=p.alt_region,
-                                 momentum=p.alt_momentum)
+                sc = study.scene(
+                    key, system=spec, energy=r * ec, n=p.grid_n, region=p.alt_region, momentum=p.alt_momentum
+                )
                 study.run(key, sc, workers=workers, progress=progress)
         for r in p.probe_ratios:
-            sc = study.scene(probe_key(label, r), system=spec, energy=r * ec, n=p.probe_n, radius=radius,
-                             gamma=p.probe_gamma, t_max=p.probe_t_max, snapshots=probe_times)
+            sc = study.scene(
+                probe_key(label, r),
+                system=spec,
+                energy=r * ec,
+                n=p.probe_n,
+                radius=radius,
+                gamma=p.probe_gamma,
+                t_max=p.probe_t_max,
+                snapshots=probe_times,
+            )
             study.run(probe_key(label, r), sc, workers=workers, progress=progress)
         for g in p.gammas:
             extra = {"snapshots": grid, "continue_settled": True} if g == p.mu_gamma else {}
-            sc = study.scene(diss_key(label, g), system=spec, energy=p.e0_ratio * ec, n=p.diss_n, radius=radius,
-                             gamma=g, t_max=p.diss_t_max, **extra)
+            sc = study.scene(
+                diss_key(label, g),
+                system=spec,
+                energy=p.e0_ratio * ec,
+                n=p.diss_n,
+                radius=radius,
+                gamma=g,
+                t_max=p.diss_t_max,
+                **extra,
+            )
             study.run(diss_key(label, g), sc, workers=workers, progress=progress)
         for r in cm_ratios(p):  # claims 2 and 5: every section crossing in [0, cm_t_to], conservative
-            sc = study.scene(cm_key(label, r), system=spec, energy=r * ec, n=p.cm_n, radius=radius,
-                             t_max=p.cm_t_max, sections={"t_from": 0.0, "t_to": p.cm_t_to})
+            sc = study.scene(
+                cm_key(label, r),
+                system=spec,
+                energy=r * ec,
+                n=p.cm_n,
+                radius=radius,
+                t_max=p.cm_t_max,
+                sections={"t_from": 0.0, "t_to": p.cm_t_to},
+            )
             study.run(cm_key(label, r), sc, workers=workers, progress=progress)
         t_lo, t_hi = c5_window(p, ec)  # claim 5: the dissipative survivors' crossings around t*; stop after
-        sc = study.scene(sec_key(label, p.mu_gamma), system=spec, energy=p.e0_ratio * ec, n=p.diss_n, radius=radius,
-                         gamma=p.mu_gamma, sections={"t_from": t_lo, "t_to": t_hi, "stop": True})
+        sc = study.scene(
+            sec_key(label, p.mu_gamma),
+            system=spec,
+            energy=p.e0_ratio * ec,
+            n=p.diss_n,
+            radius=radius,
+            gamma=p.mu_gamma,
+            sections={"t_from": t_lo, "t_to": t_hi, "stop": True},
+        )
         study.run(sec_key(label, p.mu_gamma), sc, workers=workers, progress=progress)
 
 
@@ -237,16 +271,20 @@ class _Runs:
 
         from hhscatter.data.read import read_sections
 
-        return read_sections(self.study.raw(key), columns=["traj_id", "t", "x", "y", "energy"],
-                             filters=pads.field("t") >= t_from)
+        return read_sections(
+            self.study.raw(key), columns=["traj_id", "t", "x", "y", "energy"], filters=pads.field("t") >= t_from
+        )
 
     def snapshots(self, key, *, t_from=None, t_to=None, max_id=None):
         import pyarrow.dataset as pads
 
         from hhscatter.data.read import read_snapshots
 
-        f = pads.field("traj_id") < max_id if max_id is not None else (
-            (pads.field("t") >= t_from) & (pads.field("t") <= t_to))
+        f = (
+            pads.field("traj_id") < max_id
+            if max_id is not None
+            else ((pads.field("t") >= t_from) & (pads.field("t") <= t_to))
+        )
         return read_snapshots(self.study.raw(key), columns=["traj_id", "t", "energy"], filters=f)
 
     def snapshot_parts(self, key):
@@ -314,30 +352,55 @@ def _analyze_claims(study) -> dict:
         if hz is not None:
             hazards.append(hz)
         systems[label] = {
-            "spec": spec, "E_c": ec, "n_exits": len(m.exits), "saddle_radius": m.saddle_radius,
-            "ic_radius": p.radius_frac * m.saddle_radius, "r_esc_at_E0": float(m.default_escape_radius(E0)),
-            "E0": E0, "kappa_law": per, **mu_numbers, "taus": taus.drop(columns=["system"]).to_dict(orient="records"),
-            "kappa_cmeasure": cm_rows, "cmeasure_distance": c5,
+            "spec": spec,
+            "E_c": ec,
+            "n_exits": len(m.exits),
+            "saddle_radius": m.saddle_radius,
+            "ic_radius": p.radius_frac * m.saddle_radius,
+            "r_esc_at_E0": float(m.default_escape_radius(E0)),
+            "E0": E0,
+            "kappa_law": per,
+            **mu_numbers,
+            "taus": taus.drop(columns=["system"]).to_dict(orient="records"),
+            "kappa_cmeasure": cm_rows,
+            "cmeasure_distance": c5,
         }
     hh = next((label for label, spec, _ in _systems(study) if spec["name"] == "henon_heiles"), None)
     for label, rec in dissipative.claim6(claims, sm6, hh, p).items():
         systems[label]["survival_model"] = rec
     ktab = pd.DataFrame(kappa_rows)
     for df, name, what in (
-            (ktab, "kappa", "κ0(E) per system, E/E_c and window convention"),
-            (pd.DataFrame(mu_rows), "mu_conservative", "2⟨K⟩/E of the conservative system: c-measure (probe drag) "
-                                                       "and microcanonical well"),
-            (pd.concat(curves, ignore_index=True), "energy_curves", "⟨E⟩(t)/E0 measured and the predicted path "
-                                                                    "dE/dt = −γ μ(E) E"),
-            (pd.concat(tau_tables, ignore_index=True), "taus", "τ0, τ1, τ2 per γ"),
-            (pd.DataFrame(kcm_rows), "kappa_cmeasure", "claim 2: κ from the c-measure, Eq. (eqn:kappa_cmeasure_"
-                                                       "truetime), beside κ0"),
-            (pd.concat(hazards, ignore_index=True) if hazards else None, "hazard",
-             "claim 7: escape hazard of the smallest γ per time bin, κ0 at E0 e^(−μγt)")):
+        (ktab, "kappa", "κ0(E) per system, E/E_c and window convention"),
+        (
+            pd.DataFrame(mu_rows),
+            "mu_conservative",
+            "2⟨K⟩/E of the conservative system: c-measure (probe drag) and microcanonical well",
+        ),
+        (
+            pd.concat(curves, ignore_index=True),
+            "energy_curves",
+            "⟨E⟩(t)/E0 measured and the predicted path dE/dt = −γ μ(E) E",
+        ),
+        (pd.concat(tau_tables, ignore_index=True), "taus", "τ0, τ1, τ2 per γ"),
+        (
+            pd.DataFrame(kcm_rows),
+            "kappa_cmeasure",
+            "claim 2: κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), beside κ0",
+        ),
+        (
+            pd.concat(hazards, ignore_index=True) if hazards else None,
+            "hazard",
+            "claim 7: escape hazard of the smallest γ per time bin, κ0 at E0 e^(−μγt)",
+        ),
+    ):
         if df is not None:
             study.write_table(df, f"{name}.parquet", description=what)
-    return {"rules": RULES, "systems": systems, "claims": claims.rows,
-            "kappa": ktab.replace({np.nan: None}).to_dict(orient="records")}
+    return {
+        "rules": RULES,
+        "systems": systems,
+        "claims": claims.rows,
+        "kappa": ktab.replace({np.nan: None}).to_dict(orient="records"),
+    }
 
 
 # ---------------------------------------------------------------------------
@@ -366,8 +429,15 @@ def _run_pair(study, key, spec, m, t_from, workers, progress, **kw):
     path = study.derived(f"{key}_shadow_ics.parquet")
     cols = {"traj_id": alive["traj_id"].to_numpy(), **dict(zip(("x", "y", "px", "py"), states.T)), "d0": d0}
     pq.write_table(pa.table(cols), path)
-    sh = study.scene(key + "_shadow", system=spec, ics=str(path), n=len(alive), t_max=sc.t_max, r_esc=sc.r_esc,
-                     sections=kw["sections"])
+    sh = study.scene(
+        key + "_shadow",
+        system=spec,
+        ics=str(path),
+        n=len(alive),
+        t_max=sc.t_max,
+        r_esc=sc.r_esc,
+        sections=kw["sections"],
+    )
     study.run(key + "_shadow", sh, workers=workers, progress=progress)
 
 
@@ -379,17 +449,40 @@ def _simulate_evidence(study, workers, progress):
         for label, spec, m in sysl:
             ec, radius = m.critical_energy, p.radius_frac * m.saddle_radius
             for r in p.ev_ratios:
-                _run_pair(study, ev_key(label, ics, r), spec, m, t_from, workers, progress, energy=r * ec, n=p.ev_n,
-                          t_max=p.ev_t_max, sections={"t_from": t_from, "t_to": p.ev_t_max}, **_ics_kw(p, ics, radius))
+                _run_pair(
+                    study,
+                    ev_key(label, ics, r),
+                    spec,
+                    m,
+                    t_from,
+                    workers,
+                    progress,
+                    energy=r * ec,
+                    n=p.ev_n,
+                    t_max=p.ev_t_max,
+                    sections={"t_from": t_from, "t_to": p.ev_t_max},
+                    **_ics_kw(p, ics, radius),
+                )
         if ics != p.ev_ics[0]:
             continue
         for label, spec, m in sysl:
             _simulate_resc(study, label, spec, m, workers, progress)
         for label, spec, m in sysl:
             for r in p.ps_ratios:
-                _run_pair(study, ps_key(label, r), spec, m, p.ps_t_max - p.ev_window, workers, progress,
-                          energy=r * m.critical_energy, n=p.ps_n, t_max=p.ps_t_max,
-                          sections={"t_from": 0.0, "t_to": p.ps_t_max}, radius=p.radius_frac * m.saddle_radius)
+                _run_pair(
+                    study,
+                    ps_key(label, r),
+                    spec,
+                    m,
+                    p.ps_t_max - p.ev_window,
+                    workers,
+                    progress,
+                    energy=r * m.critical_energy,
+                    n=p.ps_n,
+                    t_max=p.ps_t_max,
+                    sections={"t_from": 0.0, "t_to": p.ps_t_max},
+                    radius=p.radius_frac * m.saddle_radius,
+                )
 
 
 def _simulate_resc(study, label, spec, m, workers, progress):
@@ -403,16 +496,38 @@ def _simulate_resc(study, label, spec, m, workers, progress):
     for R in values if len(values) > 1 else ():
         for r in p.resc_ratios:
             key = resc_key(label, R, f"r{r:.3f}")
-            study.run(key, study.scene(key, system=spec, energy=r * ec, n=p.resc_n, radius=radius, r_esc=R),
-                      workers=workers, progress=progress)
+            study.run(
+                key,
+                study.scene(key, system=spec, energy=r * ec, n=p.resc_n, radius=radius, r_esc=R),
+                workers=workers,
+                progress=progress,
+            )
             key = resc_key(label, R, f"probe_r{r:.3f}")
-            sc = study.scene(key, system=spec, energy=r * ec, n=p.resc_probe_n, radius=radius, r_esc=R,
-                             gamma=p.probe_gamma, t_max=p.probe_t_max, snapshots=probe_times)
+            sc = study.scene(
+                key,
+                system=spec,
+                energy=r * ec,
+                n=p.resc_probe_n,
+                radius=radius,
+                r_esc=R,
+                gamma=p.probe_gamma,
+                t_max=p.probe_t_max,
+                snapshots=probe_times,
+            )
             study.run(key, sc, workers=workers, progress=progress)
         key = resc_key(label, R, f"g{p.mu_gamma:g}")
-        sc = study.scene(key, system=spec, energy=p.e0_ratio * ec, n=p.resc_diss_n, radius=radius, r_esc=R,
-                         gamma=p.mu_gamma, t_max=p.diss_t_max, snapshots=tuple(snapshot_grid(p.snapshot_grid)),
-                         continue_settled=True)
+        sc = study.scene(
+            key,
+            system=spec,
+            energy=p.e0_ratio * ec,
+            n=p.resc_diss_n,
+            radius=radius,
+            r_esc=R,
+            gamma=p.mu_gamma,
+            t_max=p.diss_t_max,
+            snapshots=tuple(snapshot_grid(p.snapshot_grid)),
+            continue_settled=True,
+        )
         study.run(key, sc, workers=workers, progress=progress)
 
 
@@ -430,8 +545,14 @@ def _indicator(study, key, t_from):
         return lt, pd.DataFrame({"traj_id": [], "regular": [], "kind": []})
     ics = pq.read_table(shp).to_pandas()
     flt = pads.field("t") >= t_from
-    ind = shadow_indicator(read_sections(study.raw(key), filters=flt), read_sections(study.raw(key + "_shadow"),
-                           filters=flt), ics["traj_id"], ics["d0"], t_from, g_max=study.params.ev_g_max)
+    ind = shadow_indicator(
+        read_sections(study.raw(key), filters=flt),
+        read_sections(study.raw(key + "_shadow"), filters=flt),
+        ics["traj_id"],
+        ics["d0"],
+        t_from,
+        g_max=study.params.ev_g_max,
+    )
     return lt, ind
 
 
@@ -451,37 +572,63 @@ def _analyze_evidence(study, numbers: dict) -> dict:
     reg, surv, fits, points, curves = [], [], [], [], []
     t_from = p.ev_t_max - p.ev_window
     grid = np.linspace(0.0, p.ev_t_max, 401)
-    for label, spec, m in _systems(study):
+    for label, spec, _m in _systems(study):
         head = {"system": spec["name"], "label": label}
         for ics in p.ev_ics:
             for r in p.ev_ratios:
                 lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
                 name = "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"
                 at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": name}
-                reg.append({**at, **regular_record(lt, ind), "indicator": INDICATOR, "t_from": t_from,
-                            "g_max": p.ev_g_max, "delta": p.ev_delta})
-                rows, fit = long_time_record(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times,
-                                             p.ev_fit_t0, p.ev_hazard_edges)
+                reg.append(
+                    {
+                        **at,
+                        **regular_record(lt, ind),
+                        "indicator": INDICATOR,
+                        "t_from": t_from,
+                        "g_max": p.ev_g_max,
+                        "delta": p.ev_delta,
+                    }
+                )
+                rows, fit = long_time_record(
+                    lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times, p.ev_fit_t0, p.ev_hazard_edges
+                )
                 surv += [{**at, **row, "id": f"{at['id']}-t{row['t']:g}"} for row in rows] if ics == "disk" else []
                 fits.append({**at, **fit})
-                curves.append(decay_curves(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], grid).assign(
-                    label=label, e_ratio=r, ics=ics))
+                curves.append(
+                    decay_curves(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], grid).assign(
+                        label=label, e_ratio=r, ics=ics
+                    )
+                )
         for r in p.ps_ratios:
             lt, ind = _indicator(study, ps_key(label, r), p.ps_t_max - p.ev_window)
             sec = read_sections(study.raw(ps_key(label, r)), columns=["traj_id", "t", "x", "y", "px", "py"])
             kind = sec["traj_id"].map(ind.set_index("traj_id")["kind"]).fillna("escaped")
             points.append(sec.assign(system=label, e_ratio=r, kind=kind.astype(str)))
     if points:
-        study.write_table(pd.concat(points, ignore_index=True), "sections_regular.parquet",
-                          description="section crossings of the Poincaré runs with each orbit's indicator verdict")
-    study.write_table(pd.concat(curves, ignore_index=True), "survival_long.parquet",
-                      description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits")
-    study.write_table(pd.DataFrame(fits).drop(columns=["hazard_nonregular"]), "long_time.parquet",
-                      description="plateau-plus-exponential fits and the non-regular decay per system, E/E_c, ICs")
+        study.write_table(
+            pd.concat(points, ignore_index=True),
+            "sections_regular.parquet",
+            description="section crossings of the Poincaré runs with each orbit's indicator verdict",
+        )
+    study.write_table(
+        pd.concat(curves, ignore_index=True),
+        "survival_long.parquet",
+        description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits",
+    )
+    study.write_table(
+        pd.DataFrame(fits).drop(columns=["hazard_nonregular"]),
+        "long_time.parquet",
+        description="plateau-plus-exponential fits and the non-regular decay per system, E/E_c, ICs",
+    )
     vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics="disk/tangential")
-    return {"regular_fraction": reg, "survival_long": surv, "long_time": fits, "validity_map": vmap,
-            "regular_below_1pc": first_below(reg, 0.01, ics="disk/tangential"),
-            "resc": resc_rows(_Runs(study), _systems(study))}
+    return {
+        "regular_fraction": reg,
+        "survival_long": surv,
+        "long_time": fits,
+        "validity_map": vmap,
+        "regular_below_1pc": first_below(reg, 0.01, ics="disk/tangential"),
+        "resc": resc_rows(_Runs(study), _systems(study)),
+    }
 
 
 def plot(study):
@@ -490,8 +637,13 @@ def plot(study):
 
     d, numbers, parts = study.out / "derived", study.read_numbers(), study.params.parts
     if "claims" in parts:
-        plot_generality(pd.read_parquet(d / "kappa.parquet"), pd.read_parquet(d / "mu_conservative.parquet"),
-                        pd.read_parquet(d / "energy_curves.parquet"), numbers, study.figure_path)
+        plot_generality(
+            pd.read_parquet(d / "kappa.parquet"),
+            pd.read_parquet(d / "mu_conservative.parquet"),
+            pd.read_parquet(d / "energy_curves.parquet"),
+            numbers,
+            study.figure_path,
+        )
     if "evidence" in parts:
         stem = study.figure_path.with_suffix("")
         plot_regular(numbers, f"{stem}_regular.png")

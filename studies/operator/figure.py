@@ -1,5 +1,6 @@
 """Figure of study operator: κ(E) by Ulam's method against fig2, convergence, μ_c, the dissipative P(t), the
 energies at t* and the cost comparison (drawn from operator.json and the derived tables; nothing computed)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -39,16 +40,39 @@ def _panel_kappa(a, nums, recs, E):
     cm = [(r["energy"], r["fig2_kappa_cm"], r["fig2_kappa_cm_err"]) for r in recs if r.get("fig2_kappa_cm") is not None]
     if cm:
         ec, kc, sc = map(np.array, zip(*cm))
-        a.errorbar(ec + 0.004, kc, sc, fmt="D", color="C0", mfc="none", ms=6, capsize=3,
-                   label="fig2: κ from long-run crossings (true-time rel.)")
-    a.errorbar(E, [r["kappa"] for r in recs], [r["err"] for r in recs], fmt="o", color="C3", capsize=3,
-               label=f"Ulam, box {recs[0]['box']:g} (err: stat ⊕ bias)")
+        a.errorbar(
+            ec + 0.004,
+            kc,
+            sc,
+            fmt="D",
+            color="C0",
+            mfc="none",
+            ms=6,
+            capsize=3,
+            label="fig2: κ from long-run crossings (true-time rel.)",
+        )
+    a.errorbar(
+        E,
+        [r["kappa"] for r in recs],
+        [r["err"] for r in recs],
+        fmt="o",
+        color="C3",
+        capsize=3,
+        label=f"Ulam, box {recs[0]['box']:g} (err: stat ⊕ bias)",
+    )
     a.plot(E, [r["kappa_extrapolated"] for r in recs], "x", color="C3", label="Ulam, linear box → 0")
     for m in nums.get("mixed_phase_space", []):
         rec = m.get("record")
         if rec:
-            a.errorbar([rec["energy"]], [rec["kappa"]], [rec["err"]], fmt="o", color="0.6", capsize=3,
-                       label=f"Ulam at E = {rec['energy']:g} (mixed)")
+            a.errorbar(
+                [rec["energy"]],
+                [rec["kappa"]],
+                [rec["err"]],
+                fmt="o",
+                color="0.6",
+                capsize=3,
+                label=f"Ulam at E = {rec['energy']:g} (mixed)",
+            )
             if rec.get("fig2_kappa") is not None:
                 a.errorbar([rec["energy"]], [rec["fig2_kappa"]], [rec["fig2_err"]], fmt="s", color="0.6", mfc="none")
     a.set(xlabel="E", ylabel="κ (1/time)", title="(a) escape rate: ρ(M(κ)) = 1 against P(t)")
@@ -65,12 +89,21 @@ def _panel_convergence(b, conv, recs):
             continue
         b.plot(g["box"], g["kappa"] / ref, "o-", color=f"C{i}", ms=4, label=f"E = {e:g}")
         cs = conv[(conv["vary"] == "samples") & np.isclose(conv["energy"], e)]
-        b.plot(cs["box"] * (1 + 0.12 * np.log2(cs["samples"] / cs["samples"].max())), cs["kappa"] / ref, "^",
-               color=f"C{i}", ms=4, mfc="none")
+        b.plot(
+            cs["box"] * (1 + 0.12 * np.log2(cs["samples"] / cs["samples"].max())),
+            cs["kappa"] / ref,
+            "^",
+            color=f"C{i}",
+            ms=4,
+            mfc="none",
+        )
     b.axhline(1, color="k", lw=0.8)
     b.set_xscale("log")
-    b.set(xlabel="box side (M per finest box: triangles, left = fewer)", ylabel="κ_Ulam / κ0(fig2)",
-          title="(b) discretisation bias: κ vs box side")
+    b.set(
+        xlabel="box side (M per finest box: triangles, left = fewer)",
+        ylabel="κ_Ulam / κ0(fig2)",
+        title="(b) discretisation bias: κ vs box side",
+    )
     b.legend(fontsize=7, ncol=2)
 
 
@@ -85,8 +118,11 @@ def _panel_cmeasure(c, nums, ulam_pts, fig1_pts):
             f = fig1_pts[np.isclose(fig1_pts["energy"], e0)]
             c.plot(f["x"], f["y"], ".", color="C3", ms=1.2, alpha=0.6, label=f"fig1 sprinkler points ({len(f)})")
             c.legend(fontsize=8, loc="lower left", markerscale=6)
-        d = [r for r in nums["cmeasure_distances"] if np.isclose(r["fig1_energy"], e0)
-             and np.isclose(r["operator_energy"], e0) and r["measure"] == "sprinkler"]
+        d = [
+            r
+            for r in nums["cmeasure_distances"]
+            if np.isclose(r["fig1_energy"], e0) and np.isclose(r["operator_energy"], e0) and r["measure"] == "sprinkler"
+        ]
         t = f"(c) μ_c at E = {e0:g}: operator (grey) vs fig1"
         if d:
             t += f"\ndebiased H(ε={d[0]['box']:g}) = {d[0]['hellinger_debiased']:.3f}"
@@ -98,7 +134,9 @@ def _panel_survival(dd, dn, surv):
     """(d) the dissipative P(t): simulated, operator on (box × E bin) and reduced operator on ρ(E)."""
     dd.semilogy(surv["t"], surv["sim"], "k-", lw=1.6, label=f"simulated (N = {dn['sim_orbits']})")
     dd.semilogy(surv["t"], surv["operator"], "--", color="C3", lw=1.4, label="operator on (box × E bin)")
-    dd.semilogy(surv["t"], np.maximum(surv["reduced"], 1e-12), ":", color="C0", lw=1.6, label="reduced operator on ρ(E)")
+    dd.semilogy(
+        surv["t"], np.maximum(surv["reduced"], 1e-12), ":", color="C0", lw=1.6, label="reduced operator on ρ(E)"
+    )
     dd.axvline(dn["t_star"], color="0.5", lw=0.8)
     lo = max(1.0 / dn["sim_orbits"], 1e-6)
     dd.set_ylim(lo / 3, 1.2)
@@ -112,13 +150,24 @@ def _panel_t_star_energy(e, dn, pts):
     """(e) energies of the survivors' first crossing after t*: operator (weighted) against the simulation."""
     op, sim = pts[pts["set"] == "operator"], pts[pts["set"] == "sim"]
     bins = np.linspace(min(op["energy"].min(), sim["energy"].min() if len(sim) else 1), dn["energy"], 40)
-    e.hist(op["energy"], bins=bins, weights=op["w"] / op["w"].sum(), histtype="step", color="C3", lw=1.5,
-           label="operator")
+    e.hist(
+        op["energy"], bins=bins, weights=op["w"] / op["w"].sum(), histtype="step", color="C3", lw=1.5, label="operator"
+    )
     if len(sim):
-        e.hist(sim["energy"], bins=bins, weights=np.full(len(sim), 1.0 / len(sim)), histtype="step", color="k",
-               lw=1.5, label=f"simulated ({len(sim)} orbits)")
-    e.set(xlabel="E at the first crossing after t*", ylabel="share",
-          title=f"(e) survivors at t* = {dn['t_star']:g}: energy")
+        e.hist(
+            sim["energy"],
+            bins=bins,
+            weights=np.full(len(sim), 1.0 / len(sim)),
+            histtype="step",
+            color="k",
+            lw=1.5,
+            label=f"simulated ({len(sim)} orbits)",
+        )
+    e.set(
+        xlabel="E at the first crossing after t*",
+        ylabel="share",
+        title=f"(e) survivors at t* = {dn['t_star']:g}: energy",
+    )
     e.legend(fontsize=8)
 
 
@@ -155,10 +204,23 @@ def plot_residuals(nums, grid, path):
         own = np.array([r["err"] / abs(r[ref]) for r in rs])
         refe = np.array([r[f"{ref}_err"] / r[ref] for r in rs])
         a.bar(E, 2 * refe, bottom=res - refe, width=0.005, color=f"C{k}", alpha=0.25)
-        a.errorbar(E, res, own, fmt="o" if k == 0 else "D", color=f"C{k}", capsize=3,
-                   label=f"κ∞ vs fig2's {lab} (bar: ours; shade: fig2's)")
-        a.plot(E, [r[f"residual_finest_{ref}"] for r in rs], "x", color=f"C{k}", ms=7,
-               label=f"finest boxes, no extrapolation, vs {lab}")
+        a.errorbar(
+            E,
+            res,
+            own,
+            fmt="o" if k == 0 else "D",
+            color=f"C{k}",
+            capsize=3,
+            label=f"κ∞ vs fig2's {lab} (bar: ours; shade: fig2's)",
+        )
+        a.plot(
+            E,
+            [r[f"residual_finest_{ref}"] for r in rs],
+            "x",
+            color=f"C{k}",
+            ms=7,
+            label=f"finest boxes, no extrapolation, vs {lab}",
+        )
     a.axhline(0, color="k", lw=0.8)
     a.set(xlabel="E", ylabel="κ_Ulam / κ_ref − 1", title="(a) residuals of Ulam's κ")
     a.legend(fontsize=8)
@@ -173,11 +235,22 @@ def plot_residuals(nums, grid, path):
             if rec:
                 xs = np.linspace(0, (g["samples"] ** -0.5).max(), 20)
                 b.plot(xs, rec["kappa_inf"] + rec["coef_samples"] * xs, "--", color=f"C{i}", lw=0.8)
-                b.errorbar([0], [rec["kappa_inf"]], [rec["err"]], fmt="*", color=f"C{i}", ms=9, capsize=3,
-                           label=f"E = {e:g}: κ∞ = {rec['kappa_inf']:.4f}")
+                b.errorbar(
+                    [0],
+                    [rec["kappa_inf"]],
+                    [rec["err"]],
+                    fmt="*",
+                    color=f"C{i}",
+                    ms=9,
+                    capsize=3,
+                    label=f"E = {e:g}: κ∞ = {rec['kappa_inf']:.4f}",
+                )
         b.set_yscale("log")
-        b.set(xlabel="M^(−1/2) (M samples per box)", ylabel="κ (1/time)",
-              title="(b) κ on box sides (○ □ △: finest, ×2, ×4) × samples per box")
+        b.set(
+            xlabel="M^(−1/2) (M samples per box)",
+            ylabel="κ (1/time)",
+            title="(b) κ on box sides (○ □ △: finest, ×2, ×4) × samples per box",
+        )
         b.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -15,6 +15,7 @@ a one-return section scene, ``sections.first_only`` and ``stop``); the analysis 
    first crossing after t* against an ensemble simulated here; then the operator on ρ(E) alone.
 4. **Cost**: orbit-time of each route for κ at 1 %.
 """
+
 from __future__ import annotations
 
 import math
@@ -112,8 +113,15 @@ def _write_ics(study, key, df):
     """The initial-condition table of run ``key`` from the points of ``df``: (path, number of orbits)."""
     path = study.raw(key + "_ics.parquet")
     path.parent.mkdir(parents=True, exist_ok=True)
-    ics = pd.DataFrame({"traj_id": np.arange(len(df), dtype=np.int64), "x": df["x"].to_numpy(),
-                        "y": df["y"].to_numpy(), "px": df["px"].to_numpy(), "py": df["py"].to_numpy()})
+    ics = pd.DataFrame(
+        {
+            "traj_id": np.arange(len(df), dtype=np.int64),
+            "x": df["x"].to_numpy(),
+            "y": df["y"].to_numpy(),
+            "px": df["px"].to_numpy(),
+            "py": df["py"].to_numpy(),
+        }
+    )
     # rewritten only when different: the scene's hash includes the file's, and resume relies on it
     if not path.exists() or not pd.read_parquet(path).equals(ics):
         ics.to_parquet(path, index=False)
@@ -162,9 +170,14 @@ def _probe_scene(study, E, df):
 
 def _sim_scene(study):
     E0, g = study.params.diss_energy, study.params.diss_gamma
-    return study.scene(SIM_KEY, energy=E0, n=study.params.sim_n, gamma=g,
-                       t_max=study.params.t_horizon,
-                       sections={"t_from": study.params.t_star, "first_only": True})
+    return study.scene(
+        SIM_KEY,
+        energy=E0,
+        n=study.params.sim_n,
+        gamma=g,
+        t_max=study.params.t_horizon,
+        sections={"t_from": study.params.t_star, "first_only": True},
+    )
 
 
 def _cost_scene(study, E):
@@ -221,28 +234,63 @@ def _ulam_energy(study, E):
     for c in study.params.coarsen:
         tr, _, _ = transitions(tab, study, c=int(c))
         kap, kmap, info, _, _ = ulam.saddle_kappa(tr)
-        rows.append({"energy": E, "box": box * int(c), "samples": int(k * k * c * c), "kappa": kap,
-                     "kappa_map": kmap, "vary": "box", **info})
+        rows.append(
+            {
+                "energy": E,
+                "box": box * int(c),
+                "samples": int(k * k * c * c),
+                "kappa": kap,
+                "kappa_map": kmap,
+                "vary": "box",
+                **info,
+            }
+        )
     for m in study.params.sample_subsets:
         tr, _, _ = transitions(tab, study, m_max=int(m))
         kap, kmap, info, _, _ = ulam.saddle_kappa(tr)
-        rows.append({"energy": E, "box": box, "samples": int(m), "kappa": kap, "kappa_map": kmap,
-                     "vary": "samples", **info})
-    grid, boot_grid = ulam.convergence_grid(tab, _extent(study), box, list(study.params.coarsen)[:3],
-                                            study.params.sample_subsets, k * k, study.params.n_boot_grid,
-                                            [study.params.seed, int(round(E * 1e6)), 17])
+        rows.append(
+            {"energy": E, "box": box, "samples": int(m), "kappa": kap, "kappa_map": kmap, "vary": "samples", **info}
+        )
+    grid, boot_grid = ulam.convergence_grid(
+        tab,
+        _extent(study),
+        box,
+        list(study.params.coarsen)[:3],
+        study.params.sample_subsets,
+        k * k,
+        study.params.n_boot_grid,
+        [study.params.seed, int(round(E * 1e6)), 17],
+    )
     tr, ids, t = transitions(tab, study)
     boot = tf.bootstrap_kappa(tr, study.params.n_boot, rng=study.params.seed + int(E * 1000))
     kap, kmap, info, keep, sub = ulam.saddle_kappa(tr)
     full_classes = tf.communicating_classes(tr)[1]
     ok = ~tab["censored"]
-    cost = {"orbit_time": float(tab["t_end"].sum()),
-            "orbits": int(len(tab)), "censored": int((~ok).sum()),
-            "mean_return_time": float(np.average(tab.loc[tab["ret"], "T"], weights=tab.loc[tab["ret"], "w"]))}
+    cost = {
+        "orbit_time": float(tab["t_end"].sum()),
+        "orbits": int(len(tab)),
+        "censored": int((~ok).sum()),
+        "mean_return_time": float(np.average(tab.loc[tab["ret"], "T"], weights=tab.loc[tab["ret"], "w"])),
+    }
     islands = _islands(study, E, df, tr, ids, keep, sub)
-    return {"tab": tab, "t": t, "rows": rows, "boot": boot, "kappa": kap, "kappa_map": kmap, "info": info,
-            "keep": keep, "ids": ids, "sub": sub, "tr": tr, "cost": cost, "islands": islands, "grid": grid,
-            "boot_grid": boot_grid, "largest_classes": [dict(c.__dict__) for c in full_classes[:3]]}
+    return {
+        "tab": tab,
+        "t": t,
+        "rows": rows,
+        "boot": boot,
+        "kappa": kap,
+        "kappa_map": kmap,
+        "info": info,
+        "keep": keep,
+        "ids": ids,
+        "sub": sub,
+        "tr": tr,
+        "cost": cost,
+        "islands": islands,
+        "grid": grid,
+        "boot_grid": boot_grid,
+        "largest_classes": [dict(c.__dict__) for c in full_classes[:3]],
+    }
 
 
 def _islands(study, E, df, tr, ids, keep, sub):
@@ -272,11 +320,19 @@ def _cmeasure_distances(study, results, inputs):
             kinds = ("sprinkler", "flux", "map") if np.isclose(ref_E, E) else ("sprinkler",)
             for kind in kinds:
                 P = ulam.measure_points(results[ref_E], kind, len(Q), rng)
-                tab, j = ulam.hellinger_by_box(P, Q, boxes, _extent(study), study.params.n_splits,
-                                               study.params.seed, head)
+                tab, j = ulam.hellinger_by_box(
+                    P, Q, boxes, _extent(study), study.params.n_splits, study.params.seed, head
+                )
                 tabs.append(tab.assign(fig1_energy=E, operator_energy=ref_E, kind=kind))
-                rows.append({"fig1_energy": E, "operator_energy": ref_E, "measure": kind, "n": int(len(Q)),
-                             **ulam.hellinger_row(tab, j)})
+                rows.append(
+                    {
+                        "fig1_energy": E,
+                        "operator_energy": ref_E,
+                        "measure": kind,
+                        "n": int(len(Q)),
+                        **ulam.hellinger_row(tab, j),
+                    }
+                )
     conv = _cmeasure_convergence(study, results, cm, boxes, head)
     return rows, (pd.concat(tabs, ignore_index=True) if tabs else pd.DataFrame()), conv
 
@@ -288,9 +344,18 @@ def _cmeasure_convergence(study, results, cm, boxes, head):
     if E not in results:
         return []
     Q = cm[np.isclose(cm["energy"], E, rtol=0, atol=1e-9)][["x", "y"]].to_numpy()
-    rows = ulam.eigenvector_convergence(results[E]["tab"], _extent(study), study.params.box,
-                                        list(study.params.coarsen)[:3], study.params.sample_subsets, Q, boxes,
-                                        study.params.n_splits, study.params.seed, head)
+    rows = ulam.eigenvector_convergence(
+        results[E]["tab"],
+        _extent(study),
+        study.params.box,
+        list(study.params.coarsen)[:3],
+        study.params.sample_subsets,
+        Q,
+        boxes,
+        study.params.n_splits,
+        study.params.seed,
+        head,
+    )
     return [{"energy": E, **r} for r in rows]
 
 
@@ -299,8 +364,10 @@ def _initial_density(study, ids, n_cells, top_bin):
     """The initial ensemble (uniform in the scene's disk at E0, on the section) on the operator's states."""
     sc = _sim_scene(study)
     if sc.region != "disk":
-        raise ValueError(f"operator: the dissipative comparison needs region 'disk' (its initial density is the "
-                         f"disk's), got {sc.region!r}")
+        raise ValueError(
+            f"operator: the dissipative comparison needs region 'disk' (its initial density is the "
+            f"disk's), got {sc.region!r}"
+        )
     return ulam.disk_density(float(sc.radius), _extent(study), study.params.diss_box, ids, n_cells, top_bin)
 
 
@@ -311,29 +378,44 @@ def _dissipative(study, inputs):
     edges = _diss_bins(study)
     dt = study.params.dt
     op = _operator_survival(study, edges)
-    P_red, kappa_bins = ulam.reduced_survival(op["tr"], op["t"], op["ids"], op["n_cells"], len(edges) - 1, dt,
-                                              op["max_lag"], op["steps"])
+    P_red, kappa_bins = ulam.reduced_survival(
+        op["tr"], op["t"], op["ids"], op["n_cells"], len(edges) - 1, dt, op["max_lag"], op["steps"]
+    )
     sim = _simulated_survival(study, op["grid"])
     P_sim, P_op, N, grid, pred = sim["P"], op["P"], sim["N"], op["grid"], op["pred"]
     agreement = ulam.survival_agreement(grid, dt, study.params.t_star, P_sim, P_op, P_red, N)
     dtab, j = _t_star_distance(study, pred, sim["pts"])
     numbers = {
-        "energy": study.params.diss_energy, "gamma": study.params.diss_gamma,
-        "t_star": study.params.t_star, "dt": dt, "energy_bins": edges.tolist(),
-        "states": int(op["tr"].n_states), "samples": int(len(op["tab"])), "initial_mass_lost": op["lost"],
-        "returns_capped_share": tf.capped_share(op["tr"], dt, op["max_lag"]), "max_return_time": op["max_lag"] * dt,
-        "operator_orbit_time": float(op["tab"]["t_end"].sum()), "sim_orbits": int(N),
+        "energy": study.params.diss_energy,
+        "gamma": study.params.diss_gamma,
+        "t_star": study.params.t_star,
+        "dt": dt,
+        "energy_bins": edges.tolist(),
+        "states": int(op["tr"].n_states),
+        "samples": int(len(op["tab"])),
+        "initial_mass_lost": op["lost"],
+        "returns_capped_share": tf.capped_share(op["tr"], dt, op["max_lag"]),
+        "max_return_time": op["max_lag"] * dt,
+        "operator_orbit_time": float(op["tab"]["t_end"].sum()),
+        "sim_orbits": int(N),
         "sim_orbit_time": float(sim["lt"]["t_end"].sum()),
         **agreement,
         **ulam.t_star_energies(pred, sim["pts"]),
-        "t_star_hellinger_debiased": {"box": float(dtab["box"].iloc[j]), "value": float(dtab.hellinger_debiased.iloc[j]),
-                                      "lo": float(dtab.lo.iloc[j]), "hi": float(dtab.hi.iloc[j]),
-                                      "noise": float(dtab["hellinger_noise"].iloc[j])},
-        "kappa_bins": [{"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(kappa_bins)],
+        "t_star_hellinger_debiased": {
+            "box": float(dtab["box"].iloc[j]),
+            "value": float(dtab.hellinger_debiased.iloc[j]),
+            "lo": float(dtab.lo.iloc[j]),
+            "hi": float(dtab.hi.iloc[j]),
+            "noise": float(dtab["hellinger_noise"].iloc[j]),
+        },
+        "kappa_bins": [
+            {"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(kappa_bins)
+        ],
     }
     curves = pd.DataFrame({"t": grid, "sim": P_sim, "operator": P_op, "reduced": P_red})
-    pts = pd.concat([pred.assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")],
-                    ignore_index=True)
+    pts = pd.concat(
+        [pred.assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")], ignore_index=True
+    )
     return numbers, curves, pts, dtab
 
 
@@ -353,8 +435,19 @@ def _operator_survival(study, edges):
     max_lag = int(round(study.params.max_return_time / dt))
     P_op, pred = ulam.operator_survival(tr, t, n0, dt, steps, k_star, max_lag)
     grid = np.arange(steps + 1) * dt
-    return {"tab": tab, "tr": tr, "ids": ids, "t": t, "n_cells": n_cells, "lost": lost, "max_lag": max_lag,
-            "steps": steps, "P": P_op, "grid": grid, "pred": pred}
+    return {
+        "tab": tab,
+        "tr": tr,
+        "ids": ids,
+        "t": t,
+        "n_cells": n_cells,
+        "lost": lost,
+        "max_lag": max_lag,
+        "steps": steps,
+        "P": P_op,
+        "grid": grid,
+        "pred": pred,
+    }
 
 
 def _simulated_survival(study, grid):
@@ -379,9 +472,15 @@ def _t_star_distance(study, pred, sim_pts):
 
     rng = np.random.default_rng(study.params.seed + 9)
     draw = pred.iloc[rng.choice(len(pred), size=max(len(sim_pts), 4), p=pred["w"] / pred["w"].sum())]
-    return ulam.hellinger_by_box(draw[["x", "y"]].to_numpy(), dist.points(sim_pts), list(study.params.cm_boxes),
-                                 _extent(study), study.params.n_splits, study.params.seed,
-                                 study.params.cm_box_headline)
+    return ulam.hellinger_by_box(
+        draw[["x", "y"]].to_numpy(),
+        dist.points(sim_pts),
+        list(study.params.cm_boxes),
+        _extent(study),
+        study.params.n_splits,
+        study.params.seed,
+        study.params.cm_box_headline,
+    )
 
 
 # -- cost: orbit-time for κ at 1 % -----------------------------------------------------------------
@@ -394,8 +493,9 @@ def _cost(study, records, kappa0):
     rows = []
     for E in list(study.params.cost_energies):
         lt = read_lifetimes(study.raw(cost_key(E)), columns=["outcome", "t_end"])
-        r = escape_rate(lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False,
-                        min_survivors=100.0)
+        r = escape_rate(
+            lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False, min_survivors=100.0
+        )
         pt = {"kappa": r.kappa, "kappa_err": r.kappa_err, "orbits": len(lt), "orbit_time": float(lt["t_end"].sum())}
         rec = next((x for x in records if np.isclose(x["energy"], E)), None)
         rows.append(ulam.cost_row(E, pt, rec, kappa0, study.params.target_rel))
@@ -409,11 +509,16 @@ def _fig2_kappa(study, inputs):
     ke = doc.get("kappa_energy")
     if not ke:
         raise up.UpstreamError(f"{other}.json has no list 'kappa_energy'")
-    inputs["kappa0"] = {"source": f"{other}.json: kappa_energy (P(t) route, paper setup) and cmeasure (the "
-                                  "true-time relation on long-run section crossings)"}
+    inputs["kappa0"] = {
+        "source": f"{other}.json: kappa_energy (P(t) route, paper setup) and cmeasure (the "
+        "true-time relation on long-run section crossings)"
+    }
     k0 = {float(r["energy"]): (float(r["kappa"]), float(r["kappa_err"])) for r in ke}
-    kcm = {float(v["energy"]): (float(v["kappa_cm"]["value"]), float(v["kappa_cm"]["err"]))
-           for v in doc.get("cmeasure", {}).values() if "kappa_cm" in v}
+    kcm = {
+        float(v["energy"]): (float(v["kappa_cm"]["value"]), float(v["kappa_cm"]["err"]))
+        for v in doc.get("cmeasure", {}).values()
+        if "kappa_cm" in v
+    }
     return k0, kcm
 
 
@@ -428,8 +533,14 @@ def kappa_part(study, inputs):
         res = out["results"][E] = _ulam_energy(study, E)
         k0, kc = kappa0.get(E), kappa_cm.get(E)
         rec = ulam.kappa_record(E, res, study.params.samples, study.params.box)
-        rec.update({"fig2_kappa": k0[0] if k0 else None, "fig2_err": k0[1] if k0 else None,
-                    "fig2_kappa_cm": kc[0] if kc else None, "fig2_kappa_cm_err": kc[1] if kc else None})
+        rec.update(
+            {
+                "fig2_kappa": k0[0] if k0 else None,
+                "fig2_err": k0[1] if k0 else None,
+                "fig2_kappa_cm": kc[0] if kc else None,
+                "fig2_kappa_cm_err": kc[1] if kc else None,
+            }
+        )
         if k0:
             rec["z_vs_fig2"] = (rec["kappa"] - k0[0]) / math.hypot(rec["err"], k0[1])
         out["rows"].extend(res["rows"])
@@ -437,18 +548,25 @@ def kappa_part(study, inputs):
         out["mixed"].append({"energy": E, **isl, "largest_classes": res["largest_classes"]})
         if any(np.isclose(E, e) for e in study.params.energies):
             out["records"].append(rec)
-            out["convergence"].append(ulam.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"],
-                                                              {"kappa0": k0, "kappa_cm": kc}))
-            out["grids"] += [res["grid"].assign(energy=E, kind="estimate"),
-                             res["boot_grid"].assign(energy=E, kind="bootstrap")]
+            out["convergence"].append(
+                ulam.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], {"kappa0": k0, "kappa_cm": kc})
+            )
+            out["grids"] += [
+                res["grid"].assign(energy=E, kind="estimate"),
+                res["boot_grid"].assign(energy=E, kind="bootstrap"),
+            ]
         else:
             out["mixed"][-1]["record"] = {**rec, "note": "mixed phase space (below the κ grid)"}
     for r in out["convergence"]:
         if r.get("kappa0") is not None and r.get("kappa_inf") is not None:
-            row = study.compare(f"κ_Ulam({r['energy']:g}) extrapolated vs fig2's κ0", r["kappa_inf"], r["err"],
-                                r["kappa0"], verdict=verdict(r["kappa_inf"], r["err"], r["kappa0"], r["kappa0_err"]).text(),
-                                note=f"fig2 ± {r['kappa0_err']:.2g}; finest boxes {study.params.box:g}: "
-                                     f"κ = {r['kappa_finest']:.4g}")
+            row = study.compare(
+                f"κ_Ulam({r['energy']:g}) extrapolated vs fig2's κ0",
+                r["kappa_inf"],
+                r["err"],
+                r["kappa0"],
+                verdict=verdict(r["kappa_inf"], r["err"], r["kappa0"], r["kappa0_err"]).text(),
+                note=f"fig2 ± {r['kappa0_err']:.2g}; finest boxes {study.params.box:g}: κ = {r['kappa_finest']:.4g}",
+            )
             row["paper_err"] = r["kappa0_err"]  # the reference's own error: the rule takes both
     return out
 
@@ -467,15 +585,29 @@ def analyze(study):
         study.write_table(cm_tab, "cmeasure_distances.parquet")
     for name, tab in (("survival", curves), ("t_star_points", pts), ("t_star_distances", dtab)):
         study.write_table(tab, f"{name}.parquet")
-    img = [pd.DataFrame(ulam.measure_points(results[E], "sprinkler", 200000, np.random.default_rng(3)), columns=["x", "y"])
-           .assign(energy=E) for E in study.params.cm_energies if E in results]
+    img = [
+        pd.DataFrame(
+            ulam.measure_points(results[E], "sprinkler", 200000, np.random.default_rng(3)), columns=["x", "y"]
+        ).assign(energy=E)
+        for E in study.params.cm_energies
+        if E in results
+    ]
     if img:
         study.write_table(pd.concat(img, ignore_index=True), "ulam_measure_points.parquet")
-    study.write_numbers({"inputs": inputs, "kappa_ulam": k["records"], "kappa_convergence": k["convergence"],
-                         "kappa_convergence_summary": ulam.convergence_summary(k["convergence"]),
-                         "mixed_phase_space": k["mixed"], "cmeasure_distances": cm_rows, "cmeasure_convergence": cm_conv,
-                         "dissipative": diss, "cost": _cost(study, k["records"], k["kappa0"]),
-                         "tables": {"convergence": "convergence.parquet", "survival": "survival.parquet"}})
+    study.write_numbers(
+        {
+            "inputs": inputs,
+            "kappa_ulam": k["records"],
+            "kappa_convergence": k["convergence"],
+            "kappa_convergence_summary": ulam.convergence_summary(k["convergence"]),
+            "mixed_phase_space": k["mixed"],
+            "cmeasure_distances": cm_rows,
+            "cmeasure_convergence": cm_conv,
+            "dissipative": diss,
+            "cost": _cost(study, k["records"], k["kappa0"]),
+            "tables": {"convergence": "convergence.parquet", "survival": "survival.parquet"},
+        }
+    )
 
 
 def plot(study):
@@ -491,9 +623,18 @@ def plot(study):
         fig1_pts, _ = up.published_table(study, study.upstream("cmeasure"), "cmeasure_points")
     except up.UpstreamError:  # the figure then shows the operator's measure alone
         pass
-    plot_operator(study.read_numbers(), read("convergence.parquet"), read("survival.parquet"),
-                  read("t_star_points.parquet"), read("ulam_measure_points.parquet") if cm_pts.exists() else None,
-                  fig1_pts, study.figure_path)
+    plot_operator(
+        study.read_numbers(),
+        read("convergence.parquet"),
+        read("survival.parquet"),
+        read("t_star_points.parquet"),
+        read("ulam_measure_points.parquet") if cm_pts.exists() else None,
+        fig1_pts,
+        study.figure_path,
+    )
     grid = study.out / "derived" / "convergence_grid.parquet"
-    plot_residuals(study.read_numbers(), read(grid.name) if grid.exists() else None,
-                   study.figure_path.with_name("operator_residuals.png"))
+    plot_residuals(
+        study.read_numbers(),
+        read(grid.name) if grid.exists() else None,
+        study.figure_path.with_name("operator_residuals.png"),
+    )

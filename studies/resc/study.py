@@ -34,6 +34,7 @@ Outputs (``studies/resc/out/<scale>/``): derived/kappa.parquet,
 derived/returns.parquet, derived/channels.parquet, derived/lyapunov.parquet,
 resc.json, resc.png.
 """
+
 from __future__ import annotations
 
 import math
@@ -86,8 +87,14 @@ def _follow_scene(study, E):
 
     r_ref = study.params.r_ref
     base = study.scene(_key(E, r_ref), energy=E, r_esc=r_ref)
-    return study.scene(_follow_key(E), energy=E, r_esc=r_ref, n=min(study.params.n_follow, base.n),
-                       r_far=study.params.r_far, follow=Follow(_follow_radii(study)))
+    return study.scene(
+        _follow_key(E),
+        energy=E,
+        r_esc=r_ref,
+        n=min(study.params.n_follow, base.n),
+        r_far=study.params.r_far,
+        follow=Follow(_follow_radii(study)),
+    )
 
 
 def simulate(study, workers=None, progress=True):
@@ -243,8 +250,8 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
     """(row of kappa.parquet, PairedShift) of cell (E, r): κ by the MLE on the common window, its shift from
     r_ref (paired log-survival-ratio slope; on the follow runs too), the paper's LSQ κ, delays and flight
     times."""
-    from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
     from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+    from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
 
     t_ref, obs_ref = arrs[r_ref]
     n_tot = t_ref.size
@@ -256,8 +263,7 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
         k_lsq = k_lsq_err = tau0 = t_stop = math.nan
     ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
     mle = escape_rate_mle(t_alt, obs_alt, *win)
-    rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win,
-                               n_groups=study.params.n_groups)
+    rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win, n_groups=study.params.n_groups)
     # delay of P(t) at the window start: log(P_alt/P_ref)(t_lo)/κ_ref (the flight time, plus the
     # premature escapes of r_ref accumulated up to t_lo)
     tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
@@ -273,21 +279,39 @@ def _kappa_row(study, E, r, r_ref, arrs, own, win, rs, ends):
         tf_ref = np.where(np.isfinite(s_ref["t_esc"]), s_ref["t_esc"], ends.t_end.to_numpy())
         tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], ends.t_end.to_numpy())
         try:
-            rf = survival_ratio_slope(tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]),
-                                      win, n_groups=study.params.n_groups)
+            rf = survival_ratio_slope(
+                tf_ref,
+                np.isfinite(s_ref["t_esc"]),
+                tf_alt,
+                np.isfinite(s["t_esc"]),
+                win,
+                n_groups=study.params.n_groups,
+            )
             fol = rf.shift, rf.shift_err
         except ValueError:
             pass
     row = {
-        "energy": E, "r_esc": r, "n": n_tot, "n_escaped": int(obs_alt.sum()),
-        "kappa": ps.kappa_alt, "kappa_err": ps.kappa_alt_err, "n_events": mle.n_events,
-        "t_start": win[0], "t_stop": win[1],
+        "energy": E,
+        "r_esc": r,
+        "n": n_tot,
+        "n_escaped": int(obs_alt.sum()),
+        "kappa": ps.kappa_alt,
+        "kappa_err": ps.kappa_alt_err,
+        "n_events": mle.n_events,
+        "t_start": win[0],
+        "t_stop": win[1],
         "kappa_shift": rsl.shift if r != r_ref else 0.0,
         "kappa_shift_err": rsl.shift_err if r != r_ref else 0.0,
-        "kappa_shift_follow": fol[0], "kappa_shift_follow_err": fol[1],
-        "mle_shift": ps.shift, "mle_shift_err": ps.shift_err,
-        "mle_shift_err_unpaired": ps.shift_err_unpaired, "mle_correlation": ps.correlation,
-        "kappa_lsq": k_lsq, "kappa_lsq_err": k_lsq_err, "tau0_own": tau0, "t_stop_own": t_stop,
+        "kappa_shift_follow": fol[0],
+        "kappa_shift_follow_err": fol[1],
+        "mle_shift": ps.shift,
+        "mle_shift_err": ps.shift_err,
+        "mle_shift_err_unpaired": ps.shift_err_unpaired,
+        "mle_correlation": ps.correlation,
+        "kappa_lsq": k_lsq,
+        "kappa_lsq_err": k_lsq_err,
+        "tau0_own": tau0,
+        "t_stop_own": t_stop,
         "time_shift": tshift,
         "flight_mean": float(flight.mean()) if flight.size else math.nan,
         "flight_err": float(flight.std(ddof=1) / math.sqrt(flight.size)) if flight.size > 1 else math.nan,
@@ -317,17 +341,32 @@ def _returns_row(study, E, r, s, recrossed, win, ps, lyapE, ends) -> dict:
     n_fast = int(np.count_nonzero(stay <= fast))
     pf, flo, fhi = wilson_interval(n_fast, n_ret, z) if n_ret else (math.nan,) * 3
     return {
-        "energy": E, "r_esc": r, "n_followed": nf, "n_escaped": n_esc, "n_returned": n_ret,
-        "frac": float(p), "lo": float(lo), "hi": float(hi),
+        "energy": E,
+        "r_esc": r,
+        "n_followed": nf,
+        "n_escaped": n_esc,
+        "n_returned": n_ret,
+        "frac": float(p),
+        "lo": float(lo),
+        "hi": float(hi),
         "upper95": float(wilson_interval(n_ret, n_esc, 1.96)[2]),
         "n_recrossed": int(recrossed.sum()),
-        "t_late": win[0], "n_escaped_late": n_late, "n_returned_late": n_ret_late,
-        "frac_late": float(pl), "lo_late": float(lol), "hi_late": float(hil),
-        "n_reescaped": n_re, "stay_median": float(np.nanmedian(stay)) if n_re else math.nan,
+        "t_late": win[0],
+        "n_escaped_late": n_late,
+        "n_returned_late": n_ret_late,
+        "frac_late": float(pl),
+        "lo_late": float(lol),
+        "hi_late": float(hil),
+        "n_reescaped": n_re,
+        "stay_median": float(np.nanmedian(stay)) if n_re else math.nan,
         "stay_mean": float(np.nanmean(stay)) if n_re else math.nan,
-        "kappa_ref": ps.kappa_ref, "n_fast": n_fast, "frac_fast": float(pf), "frac_fast_lo": float(flo),
+        "kappa_ref": ps.kappa_ref,
+        "n_fast": n_fast,
+        "frac_fast": float(pf),
+        "frac_fast_lo": float(flo),
         "frac_fast_hi": float(fhi),
-        "lyap_r_min": lyapE.r_min, "lyap_r_max": lyapE.r_max,
+        "lyap_r_min": lyapE.r_min,
+        "lyap_r_max": lyapE.r_max,
         "energy_error_max": float(ends.energy_error.max()),
         "n_censored_follow": int((ends.outcome == "censored").sum()),
     }
@@ -344,10 +383,21 @@ def _channel_rows(study, E, r, ch, t_alt, win) -> list:
     for subset, m in (("all", np.ones(n_tot, bool)), ("early", t_alt <= win[0]), ("late", t_alt > win[0])):
         cf = channel_fractions(ch[m], 3, z)
         for k in range(3):
-            rows.append({"energy": E, "r_esc": r, "subset": subset, "channel": k,
-                         "count": int(cf.counts[k]), "n": cf.n, "frac": float(cf.frac[k]),
-                         "lo": float(cf.lo[k]), "hi": float(cf.hi[k]), "chi2": cf.chi2,
-                         "p_value": cf.p_value})
+            rows.append(
+                {
+                    "energy": E,
+                    "r_esc": r,
+                    "subset": subset,
+                    "channel": k,
+                    "count": int(cf.counts[k]),
+                    "n": cf.n,
+                    "frac": float(cf.frac[k]),
+                    "lo": float(cf.lo[k]),
+                    "hi": float(cf.hi[k]),
+                    "chi2": cf.chi2,
+                    "p_value": cf.p_value,
+                }
+            )
     return rows
 
 
@@ -356,8 +406,15 @@ def _numbers_and_comparison(study, energies, radii, r_ref, kap, ret, chan, lyap)
     r_esc recommended."""
     r_in = study.params.r_in
     fast = study.params.reesc_fast
-    numbers = {"energies": energies, "r_esc": radii, "r_ref": r_ref, "kappa": {}, "returns": {},
-               "channels": {}, "lyapunov": {}}
+    numbers = {
+        "energies": energies,
+        "r_esc": radii,
+        "r_ref": r_ref,
+        "kappa": {},
+        "returns": {},
+        "channels": {},
+        "lyapunov": {},
+    }
     for row in kap.itertuples():
         key = f"E={row.energy:.2f}"
         numbers["kappa"].setdefault(key, {})[f"r_esc={row.r_esc:g}"] = {
@@ -372,41 +429,57 @@ def _numbers_and_comparison(study, energies, radii, r_ref, kap, ret, chan, lyap)
             "mean_t_end_difference": {"value": row.dt_end_mean, "err": row.dt_end_err},
         }
         if row.r_esc != r_ref:
-            study.compare(f"κ(E={row.energy:.2f}, r_esc={row.r_esc:g}) − κ(r_esc={r_ref:g})", row.kappa_shift,
-                          row.kappa_shift_err, 0.0, unit="1/time",
-                          note="paper App. 'Escape Condition': any r_esc slightly above 1 gives the same "
-                               "observations (paired slope of log P(t) ratio on a common window)")
+            study.compare(
+                f"κ(E={row.energy:.2f}, r_esc={row.r_esc:g}) − κ(r_esc={r_ref:g})",
+                row.kappa_shift,
+                row.kappa_shift_err,
+                0.0,
+                unit="1/time",
+                note="paper App. 'Escape Condition': any r_esc slightly above 1 gives the same "
+                "observations (paired slope of log P(t) ratio on a common window)",
+            )
     for row in ret.itertuples():
         numbers["returns"].setdefault(f"E={row.energy:.2f}", {})[f"r_esc={row.r_esc:g}"] = {
-            "n_escaped": row.n_escaped, "n_returned": row.n_returned,
+            "n_escaped": row.n_escaped,
+            "n_returned": row.n_returned,
             "n_back_inside_r_esc": row.n_recrossed,
             "fraction": {"value": row.frac, "lo": row.lo, "hi": row.hi, "upper95": row.upper95},
-            "returned_then_reescaped": row.n_reescaped, "stay_median": row.stay_median,
-            "stay_mean": row.stay_mean, "one_over_kappa_ref": 1.0 / row.kappa_ref,
-            "fraction_reescaping_within_reesc_fast": {"value": row.frac_fast, "lo": row.frac_fast_lo,
-                                                      "hi": row.frac_fast_hi},
+            "returned_then_reescaped": row.n_reescaped,
+            "stay_median": row.stay_median,
+            "stay_mean": row.stay_mean,
+            "one_over_kappa_ref": 1.0 / row.kappa_ref,
+            "fraction_reescaping_within_reesc_fast": {
+                "value": row.frac_fast,
+                "lo": row.frac_fast_lo,
+                "hi": row.frac_fast_hi,
+            },
             # the same for a typical survivor of the exponential regime: 1 − e^{−κ t_fast}
             "typical_survivor_fraction_within_reesc_fast": 1.0 - math.exp(-row.kappa_ref * fast),
             "reesc_fast": fast,
-            "fraction_late": {"value": row.frac_late, "lo": row.lo_late, "hi": row.hi_late,
-                              "t_late": row.t_late},
+            "fraction_late": {"value": row.frac_late, "lo": row.lo_late, "hi": row.hi_late, "t_late": row.t_late},
         }
-        study.compare(f"fraction returning inside r<{r_in:g} after crossing r_esc={row.r_esc:g} (E={row.energy:.2f})",
-                      row.frac, 0.5 * (row.hi - row.lo), 0.0,
-                      note="paper: crossing r_esc slightly above 1 means the orbit has left Ω for good; "
-                           "err = half the Wilson ±1σ interval")
+        study.compare(
+            f"fraction returning inside r<{r_in:g} after crossing r_esc={row.r_esc:g} (E={row.energy:.2f})",
+            row.frac,
+            0.5 * (row.hi - row.lo),
+            0.0,
+            note="paper: crossing r_esc slightly above 1 means the orbit has left Ω for good; "
+            "err = half the Wilson ±1σ interval",
+        )
     for row in chan.itertuples():
-        numbers["channels"].setdefault(f"E={row.energy:.2f}", {}).setdefault(f"r_esc={row.r_esc:g}", {}) \
-            .setdefault(row.subset, {"n": row.n, "chi2_p_value": row.p_value})[f"channel {row.channel}"] = {
-                "value": row.frac, "lo": row.lo, "hi": row.hi}
+        numbers["channels"].setdefault(f"E={row.energy:.2f}", {}).setdefault(f"r_esc={row.r_esc:g}", {}).setdefault(
+            row.subset, {"n": row.n, "chi2_p_value": row.p_value}
+        )[f"channel {row.channel}"] = {"value": row.frac, "lo": row.lo, "hi": row.hi}
     for row in chan[(chan.subset == "all") & (chan.r_esc == r_ref)].itertuples():
-        study.compare(f"escape fraction through channel {row.channel} (E={row.energy:.2f}, r_esc={r_ref:g})",
-                      row.frac, 0.5 * (row.hi - row.lo), 1.0 / 3.0,
-                      note="three-fold symmetry of V and of the disk ICs (rotation by 120° maps the IC "
-                           "ensemble onto itself)")
+        study.compare(
+            f"escape fraction through channel {row.channel} (E={row.energy:.2f}, r_esc={r_ref:g})",
+            row.frac,
+            0.5 * (row.hi - row.lo),
+            1.0 / 3.0,
+            note="three-fold symmetry of V and of the disk ICs (rotation by 120° maps the IC ensemble onto itself)",
+        )
     for row in lyap.itertuples():
-        numbers["lyapunov"][f"E={row.energy:.2f}"] = {"r_min": row.r_min, "r_max": row.r_max,
-                                                      "period": row.period}
+        numbers["lyapunov"][f"E={row.energy:.2f}"] = {"r_min": row.r_min, "r_max": row.r_max, "period": row.period}
     numbers["default_r_esc"] = _recommend(kap, ret, lyap, r_ref)
     return numbers
 
@@ -424,7 +497,7 @@ def _recommend(kap, ret, lyap, r_ref):
         "lyapunov_r_max_at_max_energy": float(lyap.r_max.max()),
         "lyapunov_energy_max": float(lyap.energy.max()),
         "rule": "smallest tested r_esc with zero measured returns at every energy; it must exceed the radial "
-                "extent r_max of the Lyapunov orbit (the exact boundary of Ω) at the highest energy used",
+        "extent r_max of the Lyapunov orbit (the exact boundary of Ω) at the highest energy used",
     }
 
 

@@ -1,6 +1,7 @@
 """The records of a basin study (hhscatter.analysis.geometry.basin_summary), S_b at fixed box sides
 (hhscatter.analysis.geometry.basins.entropy_by_box) and the cut-off comparison
 (hhscatter.analysis.geometry.cutoff.cutoff_comparison) on synthetic input with known answers."""
+
 from __future__ import annotations
 
 import math
@@ -62,11 +63,23 @@ def test_point_numbers_tau2_and_smallest_resolved_eps():
     class Chans:
         p_value, frac = 0.5, [1 / 3] * 3
 
-    ent = pd.DataFrame({"box": [5], "S_b": [0.3], "S_b_err": [0.01], "S_bb": [0.8], "S_bb_err": [0.02],
-                        "log2_fractal": [True]})
+    ent = pd.DataFrame(
+        {"box": [5], "S_b": [0.3], "S_b_err": [0.01], "S_bb": [0.8], "S_bb_err": [0.02], "log2_fractal": [True]}
+    )
     loc = pd.DataFrame({"eps_mid": [1e-3, 1e-4], "d": [1.5, math.nan], "d_err": [0.1, math.nan]})
-    m = {"fr": Frac, "present": [0], "wada": Wada, "chans": Chans, "exits": [0], "wada_x": None, "slim": None,
-         "rate": None, "ok": ok, "fit": fit, "cut": cut}
+    m = {
+        "fr": Frac,
+        "present": [0],
+        "wada": Wada,
+        "chans": Chans,
+        "exits": [0],
+        "wada_x": None,
+        "slim": None,
+        "rate": None,
+        "ok": ok,
+        "fit": fit,
+        "cut": cut,
+    }
     ec = 1 / 6
     p = bs.point_record(0.3, 0.01, 5, ec, ent, unc, loc, m)
     assert p["tau2_mu1"] == pytest.approx(math.log(0.3 / ec) / 0.01, rel=1e-15)
@@ -120,11 +133,33 @@ def test_entropy_by_box_refuses_sides_that_are_not_whole_cells():
 
 
 def test_entropy_exponents_recover_a_power_law_and_skip_short_groups():
-    recs = [{"E0": 0.25, "gamma": 0.0, "map": "map", "grid": 400, "box_side": s, "box_cells": int(round(s * 200)),
-             "S_b": 0.7 * s ** 0.24, "S_b_err": 1e-4} for s in (0.01, 0.025, 0.05, 0.1, 0.2)]
+    recs = [
+        {
+            "E0": 0.25,
+            "gamma": 0.0,
+            "map": "map",
+            "grid": 400,
+            "box_side": s,
+            "box_cells": int(round(s * 200)),
+            "S_b": 0.7 * s**0.24,
+            "S_b_err": 1e-4,
+        }
+        for s in (0.01, 0.025, 0.05, 0.1, 0.2)
+    ]
     recs[0]["S_b"] = 0.01  # a 2-cell box: below min_cells, left out
-    recs += [{"E0": 0.25, "gamma": 0.0, "map": "scan", "grid": 200, "box_side": s, "box_cells": int(round(s * 100)),
-              "S_b": s, "S_b_err": 1e-4} for s in (0.02, 0.05, 0.1)]  # 2, 5, 10 cells: two sides left
+    recs += [
+        {
+            "E0": 0.25,
+            "gamma": 0.0,
+            "map": "scan",
+            "grid": 200,
+            "box_side": s,
+            "box_cells": int(round(s * 100)),
+            "S_b": s,
+            "S_b_err": 1e-4,
+        }
+        for s in (0.02, 0.05, 0.1)
+    ]  # 2, 5, 10 cells: two sides left
     out = bs.entropy_exponents(recs)
     assert len(out) == 1 and out[0]["grid"] == 400
     assert out[0]["alpha"] == pytest.approx(0.24, abs=1e-12)
@@ -139,14 +174,26 @@ def test_cutoff_comparison_against_the_closed_form():
     E0, g, ec, mu, smu, lam, sl, alt = 0.3, 0.01, 0.15, 1.0, 0.005, 0.5, 0.002, 0.4
     L = lambda l, m: math.exp(-l * math.log(E0 / ec) / (m * g))
     pred = L(lam, mu)
-    meas = pred * 10 ** -0.5
-    c = cutoff_comparison(E0, g, ec, mu, smu, [0.2, 0.3], [lam] * 2, [sl] * 2, lam_alt=[alt] * 2,
-                          measured=meas, measured_lo=meas * 0.9, measured_hi=meas * 1.1)
+    meas = pred * 10**-0.5
+    c = cutoff_comparison(
+        E0,
+        g,
+        ec,
+        mu,
+        smu,
+        [0.2, 0.3],
+        [lam] * 2,
+        [sl] * 2,
+        lam_alt=[alt] * 2,
+        measured=meas,
+        measured_lo=meas * 0.9,
+        measured_hi=meas * 1.1,
+    )
     assert c.predicted == pytest.approx(pred, rel=1e-6)
     assert c.predicted_alt == pytest.approx(L(alt, mu), rel=1e-6)
     assert c.predicted_lo == pytest.approx(L(lam + sl, mu - smu), rel=1e-6)
     assert c.predicted_hi == pytest.approx(L(alt, mu + smu), rel=1e-6)
-    assert c.log10_ratio == pytest.approx(-0.5, abs=1e-6) and c.factor == pytest.approx(10 ** 0.5, rel=1e-6)
+    assert c.log10_ratio == pytest.approx(-0.5, abs=1e-6) and c.factor == pytest.approx(10**0.5, rel=1e-6)
     # measured below: the gap is from the measured interval's top to the predicted interval's bottom
     gap = math.log10(c.predicted_lo) - math.log10(meas * 1.1)
     assert gap > 0 and c.gap_decades == pytest.approx(gap, rel=1e-6) and not c.overlap
@@ -165,13 +212,24 @@ def test_cutoff_comparison_without_a_detected_cutoff_checks_the_bound():
 
 
 def test_cutoff_records_and_summary():
-    per = [{"energy": 0.3, "gamma": 0.0, "cutoff": None, "smallest_resolved_eps": 1e-10},
-           {"energy": 0.3, "gamma": 0.01, "smallest_resolved_eps": 1e-10,
-            "cutoff": {"detected": True, "eps_c": 1e-3, "eps_c_lo": 0.9e-3, "eps_c_hi": 1.1e-3}},
-           {"energy": 0.3, "gamma": 0.02, "smallest_resolved_eps": 1e-10,
-            "cutoff": {"detected": False, "eps_c": math.nan, "eps_c_lo": 0.0, "eps_c_hi": 1e-9}}]
-    scan = pd.DataFrame({"energy": [0.2, 0.3], "lam": [0.5, 0.5], "lam_err": [0.0, 0.0],
-                         "lam_kg": [math.nan, math.nan]})
+    per = [
+        {"energy": 0.3, "gamma": 0.0, "cutoff": None, "smallest_resolved_eps": 1e-10},
+        {
+            "energy": 0.3,
+            "gamma": 0.01,
+            "smallest_resolved_eps": 1e-10,
+            "cutoff": {"detected": True, "eps_c": 1e-3, "eps_c_lo": 0.9e-3, "eps_c_hi": 1.1e-3},
+        },
+        {
+            "energy": 0.3,
+            "gamma": 0.02,
+            "smallest_resolved_eps": 1e-10,
+            "cutoff": {"detected": False, "eps_c": math.nan, "eps_c_lo": 0.0, "eps_c_hi": 1e-9},
+        },
+    ]
+    scan = pd.DataFrame(
+        {"energy": [0.2, 0.3], "lam": [0.5, 0.5], "lam_err": [0.0, 0.0], "lam_kg": [math.nan, math.nan]}
+    )
     recs = bs.cutoff_records(per, scan, 1.0, 0.0, 0.15)
     assert [(r["E0"], r["gamma"], r["detected"]) for r in recs] == [(0.3, 0.01, True), (0.3, 0.02, False)]
     pred = math.exp(-0.5 * math.log(2) / 0.01)

@@ -1,4 +1,5 @@
 """Each analysis subpackage exports the public names of its modules, each the object its module defines."""
+
 import importlib
 
 import pytest

@@ -1,5 +1,6 @@
 """Ulam's method from one-return samples (hhscatter.analysis.geometry.ulam) on synthetic input with known answers:
 the dissipative comparison's steps, κ's extrapolation in box side and samples per box, the residuals."""
+
 from __future__ import annotations
 
 import math
@@ -87,7 +88,7 @@ def test_kappa_convergence_bootstrap_spread_is_the_statistical_error():
     sigma, n_rep = 1e-3, 400
     reps = pd.concat([_grid(0.1, 0.1, 0.02, 0.5, noise=sigma, seed=r).assign(rep=r) for r in range(n_rep)])
     c = ulam.kappa_convergence(g, reps)
-    X = np.column_stack([np.ones(len(g)), g.box, g.samples ** -0.5])
+    X = np.column_stack([np.ones(len(g)), g.box, g.samples**-0.5])
     expect = sigma * math.sqrt(np.linalg.inv(X.T @ X)[0, 0])
     assert c["stat_err"] == pytest.approx(expect, rel=0.1)  # 400 replicates: the std to ≈ 3.5 %
     assert c["err"] == pytest.approx(math.hypot(c["stat_err"], c["model_err"]), rel=1e-12)
@@ -105,18 +106,24 @@ def test_residuals_with_both_errors():
     r = ulam.residuals(0.0994, 0.0006, 0.0972, 0.0002)
     assert r["residual"] == pytest.approx(0.0994 / 0.0972 - 1, rel=1e-12)
     assert r["z"] == pytest.approx(0.0022 / math.hypot(0.0006, 0.0002), rel=1e-12)
-    assert r["residual_err"] == pytest.approx(0.0994 / 0.0972 * math.hypot(0.0006 / 0.0994, 0.0002 / 0.0972),
-                                              rel=1e-12)
+    assert r["residual_err"] == pytest.approx(0.0994 / 0.0972 * math.hypot(0.0006 / 0.0994, 0.0002 / 0.0972), rel=1e-12)
 
 
 def test_sample_transitions_merge_boxes_and_keep_the_first_ranks():
     """Four finest boxes (2 × 2 of side 1 over [0, 2]²), two samples each: merged 2 × 2 they are one state; the
     first rank alone keeps one sample per box; a censored sample is dropped; an image outside is an escape."""
-    tab = pd.DataFrame({"cell": [0, 0, 1, 1, 2, 2, 3, 3], "rank": [0, 1] * 4, "w": 1.0,
-                        "ret": [True, True, True, False, True, True, True, True],
-                        "T": [1.0, 2.0, 1.5, np.nan, 1.0, 1.0, 1.0, 1.0],
-                        "x1": [0.5, 1.5, 0.5, np.nan, 1.5, 1.5, 5.0, 0.5], "y1": [0.5, 0.5, 1.5, np.nan, 1.5, 0.5, 5.0, 0.5],
-                        "censored": [False] * 7 + [True]})
+    tab = pd.DataFrame(
+        {
+            "cell": [0, 0, 1, 1, 2, 2, 3, 3],
+            "rank": [0, 1] * 4,
+            "w": 1.0,
+            "ret": [True, True, True, False, True, True, True, True],
+            "T": [1.0, 2.0, 1.5, np.nan, 1.0, 1.0, 1.0, 1.0],
+            "x1": [0.5, 1.5, 0.5, np.nan, 1.5, 1.5, 5.0, 0.5],
+            "y1": [0.5, 0.5, 1.5, np.nan, 1.5, 0.5, 5.0, 0.5],
+            "censored": [False] * 7 + [True],
+        }
+    )
     tr, ids, t = ulam.sample_transitions(tab, (0, 2, 0, 2), 1.0)
     assert len(t) == 7 and tr.n_states == 4 and ids.tolist() == [0, 1, 2, 3]
     assert tr.dst.tolist() == [0, 1, 2, -1, 3, 1, -1]  # (5, 5) lies outside: escape

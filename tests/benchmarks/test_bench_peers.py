@@ -4,6 +4,7 @@ References: closed-form properties of the composition (weights, symmetry),
 numerical convergence order against heyoka long double, and the long-double
 reference orbits (exact Taylor event location) for the event handling.
 """
+
 import numpy as np
 import pytest
 
@@ -56,8 +57,7 @@ def test_kahanli8_converges_with_order_8():
     saved = peers.KAHANLI8_GAMMA
     try:
         peers.KAHANLI8_GAMMA = tuple(bad)
-        errs_bad = np.array([np.abs(peers.kahanli8_propagate(s0, dt, int(round(T / dt))) - exact).max()
-                             for dt in dts])
+        errs_bad = np.array([np.abs(peers.kahanli8_propagate(s0, dt, int(round(T / dt))) - exact).max() for dt in dts])
     finally:
         peers.KAHANLI8_GAMMA = saved
     assert np.polyfit(np.log(dts), np.log(errs_bad), 1)[0] < 3

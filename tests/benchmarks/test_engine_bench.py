@@ -3,6 +3,7 @@ minimal driver's escape and censoring times equal the engine's (an independent d
 bound-censored, single-length lane clock; with a short t_max its stale bounds once censored ~1 orbit in 500
 early), and the driver reads an IC table to the same orbits as it samples. Timings are not
 tested (speed claims live in `make bench-engine`)."""
+
 from __future__ import annotations
 
 import subprocess
@@ -36,8 +37,11 @@ def test_driver_reads_an_ic_table_to_the_orbits_it_samples(tmp_path):
     pq.write_table(pa.table({c: ics[:, i] for i, c in enumerate(("x", "y", "px", "py"))}), tmp_path / "ics.parquet")
     for args in ([], [str(tmp_path / "ics.parquet")]):
         out = tmp_path / f"t{len(args)}.parquet"
-        subprocess.run([sys.executable, "-m", "benchmarks.engine", "--driver", str(n), "1", str(out), *args],
-                       check=True, capture_output=True)
+        subprocess.run(
+            [sys.executable, "-m", "benchmarks.engine", "--driver", str(n), "1", str(out), *args],
+            check=True,
+            capture_output=True,
+        )
     a, b = (pq.read_table(tmp_path / f"t{k}.parquet").column("t_end").to_numpy() for k in (0, 1))
     assert len(a) == n and np.array_equal(a, b)
 

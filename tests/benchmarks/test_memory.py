@@ -1,4 +1,5 @@
 """Memory: simulation O(chunk) whatever N; P(t) inputs read with column projection (~9 bytes/orbit)."""
+
 import os
 import subprocess
 import sys
@@ -23,6 +24,7 @@ def test_client_keeps_a_bounded_window_of_tasks():
         return i * i
 
     with ThreadPoolExecutor(4) as ex:
+
         def submit(task):
             with lock:
                 live[0] += 1
@@ -36,8 +38,9 @@ def test_client_keeps_a_bounded_window_of_tasks():
                 live[0] -= 1
             got[task] = result
 
-        _drain(submit, lambda fs: wait(fs, return_when=FIRST_COMPLETED).done, range(1, 301), 6, on_done,
-               lambda fs: None)
+        _drain(
+            submit, lambda fs: wait(fs, return_when=FIRST_COMPLETED).done, range(1, 301), 6, on_done, lambda fs: None
+        )
     assert got == {i: i * i for i in range(1, 301)} and peak[0] <= 6
 
 
@@ -50,9 +53,14 @@ def test_a_failing_task_stops_submission_and_cancels_the_rest():
         return i
 
     with ThreadPoolExecutor(1) as ex, pytest.raises(OSError, match="No space"):
-        _drain(lambda t: submitted.append(t) or ex.submit(work, t),
-               lambda fs: wait(fs, return_when=FIRST_COMPLETED).done, range(100), 4, lambda t, r: None,
-               lambda fs: cancelled.extend(fs))
+        _drain(
+            lambda t: submitted.append(t) or ex.submit(work, t),
+            lambda fs: wait(fs, return_when=FIRST_COMPLETED).done,
+            range(100),
+            4,
+            lambda t, r: None,
+            lambda fs: cancelled.extend(fs),
+        )
     assert len(submitted) < 10 and cancelled
 
 
@@ -131,19 +139,29 @@ def test_survival_inputs_are_read_with_column_projection(tmp_path):
         outcome = np.where(t > t_max, 2, 0).astype(np.int8)
         t = np.minimum(t, t_max)
         cols = {c: rng.random(n_part) for c in ("x0", "y0", "px0", "py0", "e0", "gamma", "e_end")}
-        cols.update(traj_id=np.arange(k * n_part, (k + 1) * n_part), outcome=outcome, t_end=t,
-                    exit_channel=np.where(outcome == 0, k % 3, -1))
+        cols.update(
+            traj_id=np.arange(k * n_part, (k + 1) * n_part),
+            outcome=outcome,
+            t_end=t,
+            exit_channel=np.where(outcome == 0, k % 3, -1),
+        )
         write_part(tmp_path / "lifetimes" / part_name(k), to_arrow("lifetimes", cols), {"rows": n_part})
     (tmp_path / "scene.json").write_text("{}")  # a run written before manifests: read by listing its parts
     res = {}
     for mode in ("lean", "full", "grid"):
-        out = subprocess.run([sys.executable, "-c", _READ, str(tmp_path), mode, str(tmp_path / "warm")],
-                             capture_output=True, text=True, check=True).stdout.split()
+        out = subprocess.run(
+            [sys.executable, "-c", _READ, str(tmp_path), mode, str(tmp_path / "warm")],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()
         res[mode] = (int(out[0]) / 1024, int(out[1]), int(out[2]), float(out[3]))
     n = n_part * parts
     lean, full, grid = res["lean"], res["full"], res["grid"]
-    print(f"extra peak RSS for {n} orbits: survival_arrays {lean[0]:.0f} MB, read_lifetimes {full[0]:.0f} MB, "
-          f"survival_on_grid {grid[0]:.0f} MB")
+    print(
+        f"extra peak RSS for {n} orbits: survival_arrays {lean[0]:.0f} MB, read_lifetimes {full[0]:.0f} MB, "
+        f"survival_on_grid {grid[0]:.0f} MB"
+    )
     # streaming P(t) on a grid: the Kaplan–Meier value, in memory independent of N (one part at a time;
     # `make bench-memory` shows it flat from 1e5 to 1e7 orbits)
     assert grid[3] == pytest.approx(full[3], abs=1e-12) and grid[0] < 40  # 12-18 MB: one part + reader pools
@@ -172,8 +190,9 @@ def test_survival_on_grid_equals_kaplan_meier(tmp_path):
         t = np.minimum(t, 50.0)
         t[:50] = np.round(t[:50])  # ties with the grid times
         cols = {c: rng.random(n) for c in ("x0", "y0", "px0", "py0", "e0", "gamma", "e_end")}
-        cols.update(traj_id=np.arange(k * n, (k + 1) * n), outcome=outcome, t_end=t,
-                    exit_channel=np.where(outcome == 0, 0, -1))
+        cols.update(
+            traj_id=np.arange(k * n, (k + 1) * n), outcome=outcome, t_end=t, exit_channel=np.where(outcome == 0, 0, -1)
+        )
         write_part(tmp_path / "lifetimes" / part_name(k), to_arrow("lifetimes", cols), {"rows": n})
         t_all.append(t)
         obs_all.append(outcome != 2)

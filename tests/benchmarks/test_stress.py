@@ -5,6 +5,7 @@ double with exact event location, or the conservation law) and returns
 ``ok`` by its own acceptance rule; the asserts here restate the rule's core so
 that a failure names what broke.
 """
+
 import numpy as np
 import pytest
 

@@ -4,6 +4,7 @@ Nothing wrong is read or published silently: every case ends in a clear refusal 
 or in a correct result (byte-identical to an undisturbed run). Processes are started by the tests and
 killed by their own PIDs only.
 """
+
 import errno
 import hashlib
 import json
@@ -22,13 +23,20 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.run.runner import simulate
-from hhscatter.errors import IncompleteRunError, OutputError, RunIntegrityError, StudyError
-from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 from hhscatter.data.read import read_lifetimes, read_sections, read_snapshots
+from hhscatter.errors import IncompleteRunError, OutputError, RunIntegrityError, StudyError
+from hhscatter.run.runner import simulate
+from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 
-SCENE = {"energy": 0.3, "gamma": 0.01, "n": 400, "seed": 11, "chunk_size": 100, "sections": SectionWindow(),
-         "snapshots": (0.0, 5.0, 50.0)}
+SCENE = {
+    "energy": 0.3,
+    "gamma": 0.01,
+    "n": 400,
+    "seed": 11,
+    "chunk_size": 100,
+    "sections": SectionWindow(),
+    "snapshots": (0.0, 5.0, 50.0),
+}
 
 
 def _hh(*args):
@@ -79,8 +87,11 @@ def test_2_damaged_data_page_is_refused_and_named(run):
     for k in range(3):
         b[cc.data_page_offset + cc.total_compressed_size // 2 + k] ^= 0xFF
     p.write_bytes(b)
-    with pytest.raises(RunIntegrityError, match=r"sections/part-000001.parquet is damaged: a data page fails its "
-                                                r"checksum"):
+    with pytest.raises(
+        RunIntegrityError,
+        match=r"sections/part-000001.parquet is damaged: a data page fails its "
+        r"checksum",
+    ):
         read_sections(run)
 
 
@@ -99,12 +110,17 @@ def test_3_parts_outside_the_plan_are_refused(run, tmp_path, capsys, what):
     if what == "foreign":
         with pytest.raises(RunIntegrityError, match=r"part-000001.parquet was made by another scene"):
             read_lifetimes(run)
-        with pytest.raises(RunIntegrityError, match=r"cannot resume: .*part-000001.parquet was made by a different scene"):
+        with pytest.raises(
+            RunIntegrityError, match=r"cannot resume: .*part-000001.parquet was made by a different scene"
+        ):
             simulate(Scene(**SCENE), run, workers=1, progress=False, resume=True)
         return
     extra = "part-000099.parquet" if what == "duplicate" else "part-junk.parquet"
-    with pytest.raises(RunIntegrityError, match=rf"1 file\(s\) in .*lifetimes are not in the run's chunk plan "
-                                                rf"\(first: {extra}\)"):
+    with pytest.raises(
+        RunIntegrityError,
+        match=rf"1 file\(s\) in .*lifetimes are not in the run's chunk plan "
+        rf"\(first: {extra}\)",
+    ):
         read_lifetimes(run)
     rc, err = _cli(capsys, "simulate", "--out", str(run), "--resume", "--workers", "1", "--quiet")
     assert rc == 2 and f"1 part file(s) are not in this run's chunk plan (first: {run}/lifetimes/{extra})" in err
@@ -113,15 +129,42 @@ def test_3_parts_outside_the_plan_are_refused(run, tmp_path, capsys, what):
 # 4 -- one writer per directory; --overwrite removes the old run completely
 def test_4_second_writer_is_refused_while_the_first_runs(tmp_path, capsys):
     out = tmp_path / "run"
-    proc = subprocess.Popen(_hh("simulate", "--energy", "0.27", "-n", "20000", "--chunk-size", "200", "--workers",
-                                "1", "--quiet", "--out", str(out)), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        _hh(
+            "simulate",
+            "--energy",
+            "0.27",
+            "-n",
+            "20000",
+            "--chunk-size",
+            "200",
+            "--workers",
+            "1",
+            "--quiet",
+            "--out",
+            str(out),
+        ),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         deadline = time.monotonic() + 120
         while not (out / "scene.json").exists() and time.monotonic() < deadline:
             time.sleep(0.01)
-        rc, err = _cli(capsys, "simulate", "--energy", "0.27", "-n", "100", "--out", str(out), "--overwrite",
-                       "--quiet", "--workers", "1")
+        rc, err = _cli(
+            capsys,
+            "simulate",
+            "--energy",
+            "0.27",
+            "-n",
+            "100",
+            "--out",
+            str(out),
+            "--overwrite",
+            "--quiet",
+            "--workers",
+            "1",
+        )
         assert rc == 2 and f"is being written by another process (pid {proc.pid})" in err
         assert "one writer per run directory" in err
     finally:
@@ -171,9 +214,24 @@ def test_5_pool_workers_die_with_their_parent(tmp_path, sig):
     import psutil
 
     out = tmp_path / "run"
-    proc = subprocess.Popen(_hh("simulate", "--energy", "0.27", "-n", "40000", "--chunk-size", "500", "--workers",
-                                "2", "--quiet", "--out", str(out)), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        _hh(
+            "simulate",
+            "--energy",
+            "0.27",
+            "-n",
+            "40000",
+            "--chunk-size",
+            "500",
+            "--workers",
+            "2",
+            "--quiet",
+            "--out",
+            str(out),
+        ),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     kids = []
     try:
         deadline = time.monotonic() + 120
@@ -207,10 +265,15 @@ def test_6_analyze_refuses_stale_or_incomplete_raw_runs(tmp_path, base_run):
     raw.mkdir(parents=True)
     shutil.copytree(base_run, raw / "E0.30")
     h = Scene(**SCENE).result_hash()
-    done = {"study": "toy", "scale": "tiny", "inputs": {"tables": {"scene": {"energy": 0.3}, "sections": None,
-                                                                   "snapshots": None, "follow": None},
-                                                        "study": {"x": 1}},  # simulate read [study] x only
-            "runs": {"E0.30": {"scene_hash": h, "orbits": 400, "complete": True}}}
+    done = {
+        "study": "toy",
+        "scale": "tiny",
+        "inputs": {
+            "tables": {"scene": {"energy": 0.3}, "sections": None, "snapshots": None, "follow": None},
+            "study": {"x": 1},
+        },  # simulate read [study] x only
+        "runs": {"E0.30": {"scene_hash": h, "orbits": 400, "complete": True}},
+    }
     (raw / "done.json").write_text(json.dumps(done))
     assert checked_raw_runs(study) == {"E0.30": {"scene_hash": h, "orbits": 400, "complete": True}}
     study.config = {**config, "study": {"x": 1, "paper_mu": 0.8}}  # an analysis-only key: no new simulation
@@ -251,8 +314,11 @@ def test_6_simulate_stage_invalidates_its_done_record_first(tmp_path, monkeypatc
 # 7 -- partial runs: an error by default, a warning and consistent tables on request
 def test_7_partial_run_is_an_error_unless_asked_for(run):
     (run / "lifetimes" / "part-000002.parquet").unlink()  # chunk 2 unfinished (lifetimes is written last)
-    with pytest.raises(IncompleteRunError, match=r"incomplete: 1 of 4 chunk\(s\) \(100 of 400 orbits\) are not "
-                                                 r"finished; finish it with `hhscatter simulate --out .* --resume`"):
+    with pytest.raises(
+        IncompleteRunError,
+        match=r"incomplete: 1 of 4 chunk\(s\) \(100 of 400 orbits\) are not "
+        r"finished; finish it with `hhscatter simulate --out .* --resume`",
+    ):
         read_lifetimes(run)
     with pytest.raises(IncompleteRunError):
         read_sections(run)
@@ -269,30 +335,43 @@ def test_7_partial_run_is_an_error_unless_asked_for(run):
 def test_8_ics_below_ec_with_drag_are_refused(tmp_path, capsys):
     ics = tmp_path / "b.csv"
     ics.write_text("x,y,px,py\n0.05,0.02,0.05,0.05\n")
-    rc, err = _cli(capsys, "simulate", "--ics", str(ics), "--gamma", "0.01", "--t-max", "200", "--out",
-                   str(tmp_path / "d8"), "--quiet")
+    rc, err = _cli(
+        capsys,
+        "simulate",
+        "--ics",
+        str(ics),
+        "--gamma",
+        "0.01",
+        "--t-max",
+        "200",
+        "--out",
+        str(tmp_path / "d8"),
+        "--quiet",
+    )
     assert rc == 2 and "1 row(s) start below E_c = 0.1666666667 inside r_esc with drag γ = 0.01 (first: row 0" in err
     assert not (tmp_path / "d8").exists()
 
 
 # 9 -- bounds with reasons, before any work, nothing written
-@pytest.mark.parametrize("flags,message", [
-    (["--r-esc", "1e50"], "r_esc must be ≤ 100 r_s = 100, got 1e+50 (energy conservation"),
-    (["--radius", "1e300"], "radius must be ≤ r_esc = 1.5, got 1e+300"),
-    (["--energy", "1e300"], "energy must be ≤ 1000 E_c = 166.667, got 1e+300"),
-    (["--gamma", "1e300"], "gamma must be ≤ 10 ω = 10, got 1e+300 (beyond, the motion is overdamped"),
-    (["--snapshots", "0:5000:1e-6"], "snapshots: 0:5000:1e-06 gives 5000000001 times, more than 100000"),
-    (["-n", "1e12"], "n must be ≤ 1e+09 per run, got 1e+12"),
-    (["-n", "1e8", "--chunk-size", "10"], "gives 10000000 chunks for n = 100000000, more than 100000 part files"),
-    (["--t-max", "1e300"], "t_max must be ≤ 1e+07/ω = 1e+07, got 1e+300 (every orbit still inside at t_max"),
-    (["--seed", "1e30"], "seed must be ≤ 2**63 − 1 = 9223372036854775807, got 1000000000000000019884624838656"),
-    (["--chunk-size", "1e12"], "chunk_size must be ≤ 1e+07, got 1e+12 (a chunk's rows are held in memory"),
-    (["--workers", "1e6"], "workers must be ≤ 1024, got 1000000 (one process each"),
-])
+@pytest.mark.parametrize(
+    "flags,message",
+    [
+        (["--r-esc", "1e50"], "r_esc must be ≤ 100 r_s = 100, got 1e+50 (energy conservation"),
+        (["--radius", "1e300"], "radius must be ≤ r_esc = 1.5, got 1e+300"),
+        (["--energy", "1e300"], "energy must be ≤ 1000 E_c = 166.667, got 1e+300"),
+        (["--gamma", "1e300"], "gamma must be ≤ 10 ω = 10, got 1e+300 (beyond, the motion is overdamped"),
+        (["--snapshots", "0:5000:1e-6"], "snapshots: 0:5000:1e-06 gives 5000000001 times, more than 100000"),
+        (["-n", "1e12"], "n must be ≤ 1e+09 per run, got 1e+12"),
+        (["-n", "1e8", "--chunk-size", "10"], "gives 10000000 chunks for n = 100000000, more than 100000 part files"),
+        (["--t-max", "1e300"], "t_max must be ≤ 1e+07/ω = 1e+07, got 1e+300 (every orbit still inside at t_max"),
+        (["--seed", "1e30"], "seed must be ≤ 2**63 − 1 = 9223372036854775807, got 1000000000000000019884624838656"),
+        (["--chunk-size", "1e12"], "chunk_size must be ≤ 1e+07, got 1e+12 (a chunk's rows are held in memory"),
+        (["--workers", "1e6"], "workers must be ≤ 1024, got 1000000 (one process each"),
+    ],
+)
 def test_9_out_of_bounds_is_refused_before_any_work(tmp_path, capsys, flags, message):
     args = {"--energy": "0.3", "-n": "100", "--t-max": "5000", **dict(zip(flags[::2], flags[1::2]))}
-    rc, err = _cli(capsys, "simulate", *[x for kv in args.items() for x in kv],
-                   "--out", str(tmp_path / "o"), "--quiet")
+    rc, err = _cli(capsys, "simulate", *[x for kv in args.items() for x in kv], "--out", str(tmp_path / "o"), "--quiet")
     assert rc == 2 and message in err, err
     assert not (tmp_path / "o").exists()
 
@@ -320,8 +399,19 @@ def test_10_enospc_on_scene_json_is_clear_and_leaves_nothing(tmp_path, capsys, m
 
 def test_10_bad_scheduler_is_refused(tmp_path, capsys):
     pytest.importorskip("distributed")
-    rc, err = _cli(capsys, "simulate", "--energy", "0.3", "-n", "10", "--out", str(tmp_path / "o"), "--quiet",
-                   "--scheduler", "foo://bar")
+    rc, err = _cli(
+        capsys,
+        "simulate",
+        "--energy",
+        "0.3",
+        "-n",
+        "10",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+        "--scheduler",
+        "foo://bar",
+    )
     assert rc == 2 and "scheduler must be 'local' or an address like tcp://host:8786" in err
     assert not (tmp_path / "o").exists()
 
@@ -329,8 +419,12 @@ def test_10_bad_scheduler_is_refused(tmp_path, capsys):
 def test_10_broken_pipe_is_quiet(tmp_path):
     import shlex
 
-    cmd = shlex.join(_hh("simulate", "--energy", "0.3", "-n", "20", "--workers", "1", "--quiet", "--out",
-                         str(tmp_path / "o"))) + " | head -c 1"
+    cmd = (
+        shlex.join(
+            _hh("simulate", "--energy", "0.3", "-n", "20", "--workers", "1", "--quiet", "--out", str(tmp_path / "o"))
+        )
+        + " | head -c 1"
+    )
     r = subprocess.run(cmd, shell=True, capture_output=True, text=True, timeout=300, check=False)
     assert "Traceback" not in r.stderr and "BrokenPipe" not in r.stderr, r.stderr
     assert len(read_lifetimes(tmp_path / "o")) == 20
@@ -365,20 +459,35 @@ def test_10_dask_run_without_workers_fails_after_the_timeout(monkeypatch):
 
 # 11 -- a long snapshot grid is stored as its definition
 def test_11_snapshot_grid_metadata_stays_small(tmp_path):
-    d = {"energy": 0.3, "gamma": 0.01, "n": 50, "seed": 11, "chunk_size": 10, "t_max": 50.0,
-         "snapshots": {"start": 0.0, "stop": 50.0, "step": 0.001}}
+    d = {
+        "energy": 0.3,
+        "gamma": 0.01,
+        "n": 50,
+        "seed": 11,
+        "chunk_size": 10,
+        "t_max": 50.0,
+        "snapshots": {"start": 0.0, "stop": 50.0, "step": 0.001},
+    }
     scene = scene_from_dict(d)
     assert len(scene.snapshots) == 50001 and scene.snapshots[-1] == 50.0
     simulate(scene, tmp_path / "o", workers=1, progress=False)
     assert (tmp_path / "o" / "scene.json").stat().st_size < 3000
     meta = pq.read_schema(tmp_path / "o" / "snapshots" / "part-000000.parquet").metadata[b"hhscatter"]
-    assert len(meta) < 3000 and json.loads(meta)["scene"]["snapshots"] == {"start": 0.0, "stop": 50.0,
-                                                                           "step": 0.001}
+    assert len(meta) < 3000 and json.loads(meta)["scene"]["snapshots"] == {"start": 0.0, "stop": 50.0, "step": 0.001}
     snaps = read_snapshots(tmp_path / "o")
     assert set(snaps.t) <= set(np.arange(0.0, 50.0005, 0.001))
     # a short grid (every study's) keeps its list, and its scene hash: the value computed on main (fb21563)
-    short = scene_from_dict({"energy": 0.3, "gamma": 0.01, "n": 500, "seed": 11, "chunk_size": 100,
-                             "snapshots": {"start": 0.0, "stop": 100.0, "step": 5.0}, "sections": {}})
+    short = scene_from_dict(
+        {
+            "energy": 0.3,
+            "gamma": 0.01,
+            "n": 500,
+            "seed": 11,
+            "chunk_size": 100,
+            "snapshots": {"start": 0.0, "stop": 100.0, "step": 5.0},
+            "sections": {},
+        }
+    )
     assert short.result_hash() == "1f6f2e0588e5210dc6b82997b9e53c9e409348268eb953294aa8bf563c7a835b"
 
 
@@ -394,8 +503,9 @@ def test_12_ic_table_is_hashed_once_per_run(tmp_path, monkeypatch):
     scene_mod._file_sha256.cache_clear()
     reads = []
     real = scene_mod._file_sha256.__wrapped__
-    monkeypatch.setattr(scene_mod, "_file_sha256",
-                        scene_mod.functools.lru_cache(maxsize=64)(lambda *a: reads.append(a) or real(*a)))
+    monkeypatch.setattr(
+        scene_mod, "_file_sha256", scene_mod.functools.lru_cache(maxsize=64)(lambda *a: reads.append(a) or real(*a))
+    )
     s = Scene(energy=None, n=60, ics=str(ics), chunk_size=5)
     simulate(s, tmp_path / "o", workers=1, progress=False)
     assert len(reads) == 1  # 12 chunks, one hash
@@ -423,8 +533,11 @@ def test_13_a_run_without_its_manifest_is_refused(run, capsys):
 # 14 -- a file that is no Parquet file under a planned part's name: a named error, no traceback
 def test_14_junk_under_a_part_name_is_refused(run, capsys):
     (run / "lifetimes" / "part-000001.parquet").write_text("junk")
-    with pytest.raises(RunIntegrityError, match=r"a part of the lifetimes table of the run at .*run is not a readable "
-                                                r"Parquet file .*part-000001.parquet.*rerun it with --resume"):
+    with pytest.raises(
+        RunIntegrityError,
+        match=r"a part of the lifetimes table of the run at .*run is not a readable "
+        r"Parquet file .*part-000001.parquet.*rerun it with --resume",
+    ):
         read_lifetimes(run)
     rc, err = _cli(capsys, "survival", str(run), "--png", str(run.parent / "p.png"))
     assert rc == 2 and "is not a readable Parquet file" in err
@@ -437,8 +550,11 @@ def test_15_partial_reads_of_a_run_being_written_are_refused(run):
     (run / "lifetimes" / "part-000003.parquet").unlink()  # its last chunk not finished yet
     held = Store(run).lock()  # a writer at work
     try:
-        with pytest.raises(IncompleteRunError, match=r"is incomplete: 1 of 4 chunk\(s\) .*and it is being written "
-                                                     r"now \(pid \d+\).*wait until the writer ends"):
+        with pytest.raises(
+            IncompleteRunError,
+            match=r"is incomplete: 1 of 4 chunk\(s\) .*and it is being written "
+            r"now \(pid \d+\).*wait until the writer ends",
+        ):
             read_lifetimes(run, allow_partial=True)
     finally:
         Store.unlock(held)
@@ -455,7 +571,11 @@ def test_16_a_long_list_of_snapshot_times_stays_out_of_the_footers(tmp_path):
     scene = Scene(energy=0.3, gamma=0.01, n=20, seed=1, chunk_size=10, t_max=50.0, snapshots=times)
     simulate(scene, tmp_path / "o", workers=1, progress=False)
     meta = json.loads(pq.read_schema(tmp_path / "o" / "lifetimes" / "part-000000.parquet").metadata[b"hhscatter"])
-    assert meta["scene"]["snapshots"] == {"count": 2000, "first": 0.01, "last": 20.0,
-                                          "sha256": hashlib.sha256(json.dumps(times).encode()).hexdigest()}
+    assert meta["scene"]["snapshots"] == {
+        "count": 2000,
+        "first": 0.01,
+        "last": 20.0,
+        "sha256": hashlib.sha256(json.dumps(times).encode()).hexdigest(),
+    }
     assert json.loads((tmp_path / "o" / "scene.json").read_text())["scene"]["snapshots"] == times  # kept once
     assert set(read_snapshots(tmp_path / "o").t) <= set(times)

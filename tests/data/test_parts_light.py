@@ -1,6 +1,7 @@
 """The lighter paths of writing and describing a run give what the general ones give: ``to_arrow``
 builds its arrays from the numpy buffers (the same Arrow data as ``pa.array``, byte for byte in Arrow IPC),
 ``describe_run`` counts a manifest run from its part files (the same dict as the ``pyarrow.dataset`` scan)."""
+
 from __future__ import annotations
 
 import io
@@ -38,10 +39,14 @@ def _to_arrow_with_pa_array(name, columns):  # the reference: pa.array on every 
     return pa.Table.from_arrays(arrays, schema=schema._schemas()[name])
 
 
-@pytest.mark.parametrize("kw", [
-    {"gamma": 0.01, "t_max": 30.0, "snapshots": (0.0, 1.0, 5.0), "sections": SectionWindow()},
-    {"gamma": 0.0, "follow": Follow((1.2,))},
-], ids=["censored+sections+snapshots", "follow crossings"])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"gamma": 0.01, "t_max": 30.0, "snapshots": (0.0, 1.0, 5.0), "sections": SectionWindow()},
+        {"gamma": 0.0, "follow": Follow((1.2,))},
+    ],
+    ids=["censored+sections+snapshots", "follow crossings"],
+)
 def test_to_arrow_equals_pa_array_in_arrow_ipc_bytes(kw, tmp_path):
     sc = Scene(energy=0.3, n=200, seed=5, r_esc=1.03, **kw)
     res = run_chunk(sc, region_ics(sc, 0, sc.n), np.arange(sc.n))
@@ -55,11 +60,18 @@ def test_to_arrow_equals_pa_array_in_arrow_ipc_bytes(kw, tmp_path):
         assert (res.lifetimes["exit_channel"] < 0).any()  # the masked (null) channel is exercised
 
 
-@pytest.mark.parametrize("args", [
-    {"run": Scene(energy=0.3, gamma=0.02, n=120, seed=3, chunk_size=50, t_max=100.0, sections=SectionWindow())},
-    {"run": hhscatter.Grid(Scene(energy=0.3, n=60, seed=4, chunk_size=25, t_max=100.0),
-                           energies=(0.25, 0.35), gammas=(0.0, 0.02))},
-], ids=["plain", "grid"])
+@pytest.mark.parametrize(
+    "args",
+    [
+        {"run": Scene(energy=0.3, gamma=0.02, n=120, seed=3, chunk_size=50, t_max=100.0, sections=SectionWindow())},
+        {
+            "run": hhscatter.Grid(
+                Scene(energy=0.3, n=60, seed=4, chunk_size=25, t_max=100.0), energies=(0.25, 0.35), gammas=(0.0, 0.02)
+            )
+        },
+    ],
+    ids=["plain", "grid"],
+)
 def test_describe_run_from_parts_equals_the_dataset_scan(args, tmp_path, monkeypatch):
     hhscatter.simulate(args["run"], tmp_path, workers=1, progress=False, overwrite=True)
     light = read.describe_run(tmp_path)

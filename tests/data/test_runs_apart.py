@@ -1,6 +1,7 @@
 """Several runs read together stay apart (one point per run), the same run twice is refused, pooling is an
 explicit and checked choice, and the physical parameters of an analysis come from the data, never a number
 typed again that contradicts it."""
+
 import math
 
 import pandas as pd
@@ -13,10 +14,15 @@ from hhscatter.api import kappa_cmeasure_tables
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     d = tmp_path_factory.mktemp("runs")
-    base = hhscatter.Scene(energy=0.3, n=300, seed=1, t_max=120.0, sections=hhscatter.SectionWindow(t_from=5.0, t_to=60.0))
-    for key, scene in (("r15", base), ("r103", base.replace(r_esc=1.03)), ("seed2", base.replace(seed=2)),
-                       ("decay", hhscatter.Scene(energy=0.3, gamma=0.01, n=60, seed=3, t_max=60.0,
-                                                 snapshots=[0.0, 10.0, 20.0, 30.0]))):
+    base = hhscatter.Scene(
+        energy=0.3, n=300, seed=1, t_max=120.0, sections=hhscatter.SectionWindow(t_from=5.0, t_to=60.0)
+    )
+    for key, scene in (
+        ("r15", base),
+        ("r103", base.replace(r_esc=1.03)),
+        ("seed2", base.replace(seed=2)),
+        ("decay", hhscatter.Scene(energy=0.3, gamma=0.01, n=60, seed=3, t_max=60.0, snapshots=[0.0, 10.0, 20.0, 30.0])),
+    ):
         hhscatter.simulate(scene, d / key, workers=1, progress=False)
     return d
 
@@ -58,7 +64,7 @@ def test_pooling_is_explicit_and_checks_the_runs_are_one_scene(runs):
         hhscatter.read_lifetimes([runs / "r15", runs / "r103"], pool=True)
     pooled = hhscatter.read_lifetimes([runs / "r15", runs / "seed2"], pool=True)
     assert pooled.attrs["hhscatter"]["pooled"] == [str(runs / "r15"), str(runs / "seed2")]
-    (key, df), = hhscatter.api.split_points(pooled)
+    ((key, df),) = hhscatter.api.split_points(pooled)
     assert key == (0.3, 0.0) and len(df) == 600
     with pytest.raises(ValueError, match="needs a list"):
         hhscatter.read_lifetimes(runs / "r15", pool=True)

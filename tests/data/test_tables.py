@@ -1,4 +1,5 @@
 """Grid datasets open identically in hhscatter, pandas, pyarrow, DuckDB and polars; old-layout runs still read and resume."""
+
 import json
 import shutil
 
@@ -9,11 +10,11 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter import read_lifetimes, read_sections, read_snapshots
-from hhscatter.scene.grid import Grid
-from hhscatter.run.runner import simulate
-from hhscatter.scene.scene import Scene, SectionWindow
 from hhscatter.data.read import read_meta, survival_arrays
 from hhscatter.data.write import write_part
+from hhscatter.run.runner import simulate
+from hhscatter.scene.grid import Grid
+from hhscatter.scene.scene import Scene, SectionWindow
 
 KEYS = ["energy", "gamma", "traj_id"]
 COLS = ["traj_id", "energy", "gamma", "e0", "x0", "outcome", "t_end", "e_end"]
@@ -21,8 +22,15 @@ COLS = ["traj_id", "energy", "gamma", "e0", "x0", "outcome", "t_end", "e_end"]
 
 @pytest.fixture(scope="module")
 def grid():
-    base = Scene(energy=0.25, n=60, seed=23, chunk_size=30, name="five",
-                 sections=SectionWindow(t_from=1.0, first_only=True), snapshots=(0.0, 2.0, 4.0))
+    base = Scene(
+        energy=0.25,
+        n=60,
+        seed=23,
+        chunk_size=30,
+        name="five",
+        sections=SectionWindow(t_from=1.0, first_only=True),
+        snapshots=(0.0, 2.0, 4.0),
+    )
     return Grid(base, (0.25, 0.3), (0.0, 0.01))
 
 
@@ -51,15 +59,18 @@ def test_five_readers_give_the_same_frame(run):
         "pandas": pd.read_parquet(run / "lifetimes"),
         "pyarrow": ds.dataset(run / "lifetimes", format="parquet", partitioning="hive").to_table().to_pandas(),
         "duckdb": duckdb.sql(
-            f"select * from read_parquet('{run}/lifetimes/**/*.parquet', hive_partitioning=true)").df(),
+            f"select * from read_parquet('{run}/lifetimes/**/*.parquet', hive_partitioning=true)"
+        ).df(),
         "polars": pl.scan_parquet(run / "lifetimes", hive_partitioning=True).collect().to_pandas(),
     }
     for name, df in frames.items():
         assert set(df.columns) == set(read_lifetimes(run).columns), name  # no extra key columns
         pd.testing.assert_frame_equal(_same_frame(df), ours, obj=name)
     # a numeric filter on the point columns works in SQL (the old layout gave VARCHAR keys)
-    n = duckdb.sql(f"select count(*) from read_parquet('{run}/lifetimes/**/*.parquet', hive_partitioning=true) "
-                   "where gamma > 0.001 and energy = 0.3").fetchall()[0][0]
+    n = duckdb.sql(
+        f"select count(*) from read_parquet('{run}/lifetimes/**/*.parquet', hive_partitioning=true) "
+        "where gamma > 0.001 and energy = 0.3"
+    ).fetchall()[0][0]
     assert n == 60
 
 
@@ -81,8 +92,11 @@ def test_sections_and_snapshots_keep_their_energy_and_name_their_point(run):
 def _to_old_layout(run, dest):
     """Rewrite a grid run as hhscatter 0.1.0 wrote it: hive folders energy=…/gamma=…, no point columns."""
     shutil.copytree(run, dest)
-    extra = {"lifetimes": ["energy"], "sections": ["point_energy", "point_gamma"],
-             "snapshots": ["point_energy", "point_gamma"]}
+    extra = {
+        "lifetimes": ["energy"],
+        "sections": ["point_energy", "point_gamma"],
+        "snapshots": ["point_energy", "point_gamma"],
+    }
     for f in sorted(dest.rglob("part-*.parquet")):
         name = f.relative_to(dest).parts[0]
         meta = read_meta(f)
@@ -129,6 +143,7 @@ def test_old_layout_reads_like_the_new_one(run, old_run):
 def test_old_layout_run_resumes_in_its_own_layout(grid, old_run, tmp_path):
     out = tmp_path / "old"
     shutil.copytree(old_run, out)
+
     def tables():
         return {p.relative_to(out).as_posix(): (pq.read_table(p), read_meta(p)) for p in out.rglob("part-*.parquet")}
 
@@ -141,8 +156,9 @@ def test_old_layout_run_resumes_in_its_own_layout(grid, old_run, tmp_path):
     assert after.keys() == before.keys()  # redone in the old folders ...
     for k, (table, meta) in after.items():  # ... without point columns, same rows and metadata
         assert table.equals(before[k][0]) and meta == before[k][1], k
-    assert [p["partition"] for p in json.loads((out / "scene.json").read_text())["points"]][1] == \
-        "energy=0.25/gamma=0.01"
+    assert [p["partition"] for p in json.loads((out / "scene.json").read_text())["points"]][
+        1
+    ] == "energy=0.25/gamma=0.01"
 
 
 def test_read_lifetimes_categorical_is_the_same_table_at_one_byte_per_outcome(run):

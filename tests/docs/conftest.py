@@ -1,5 +1,6 @@
 """The built site, once per test session: ``mkdocs build --strict`` into a temporary folder (the browser tests and
 the site checks read it)."""
+
 from __future__ import annotations
 
 import os

@@ -11,8 +11,9 @@ import pytest
 
 import hhscatter
 
-PUBLIC = [n for n in hhscatter.__all__
-          if inspect.isfunction(getattr(hhscatter, n)) or inspect.isclass(getattr(hhscatter, n))]
+PUBLIC = [
+    n for n in hhscatter.__all__ if inspect.isfunction(getattr(hhscatter, n)) or inspect.isclass(getattr(hhscatter, n))
+]
 
 
 def sections(doc: str) -> dict[str, str]:
@@ -77,9 +78,13 @@ def test_public_object_is_fully_typed(name):
         assert inspect.signature(obj).return_annotation is not inspect.Signature.empty, f"{name}: no return type"
 
 
-METHODS = [f"{n}.{m}" for n in PUBLIC if inspect.isclass(getattr(hhscatter, n))
-           for m, v in vars(getattr(hhscatter, n)).items()
-           if not m.startswith("_") and inspect.isfunction(v)]
+METHODS = [
+    f"{n}.{m}"
+    for n in PUBLIC
+    if inspect.isclass(getattr(hhscatter, n))
+    for m, v in vars(getattr(hhscatter, n)).items()
+    if not m.startswith("_") and inspect.isfunction(v)
+]
 
 
 def test_public_classes_have_public_methods():
@@ -90,7 +95,10 @@ def test_public_classes_have_public_methods():
 def test_public_method_is_fully_typed(name):
     cls, meth = name.split(".")
     sig = inspect.signature(getattr(getattr(hhscatter, cls), meth))
-    untyped = [p.name for p in sig.parameters.values()
-               if p.name not in ("self", "cls") and p.annotation is inspect.Parameter.empty]
+    untyped = [
+        p.name
+        for p in sig.parameters.values()
+        if p.name not in ("self", "cls") and p.annotation is inspect.Parameter.empty
+    ]
     assert not untyped, f"{name}: parameters without a type hint: {untyped}"
     assert sig.return_annotation is not inspect.Signature.empty, f"{name}: no return type"

@@ -3,6 +3,7 @@ the asset copier (docs/gen_studies.py) and the consistency of mkdocs.yml with
 the pages and modules. The site build itself (`make docs`, mkdocs --strict)
 runs in CI; these tests need no docs extra and take well under a second.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -130,13 +131,24 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assets.mkdir(parents=True)
     (assets / "fig2.png").write_bytes(b"\x89PNG")
     doc = {
-        "study": "fig2", "scale": "quick",
+        "study": "fig2",
+        "scale": "quick",
         "a": {"value": 13.1, "err": 0.52},
         "tau0_rule": "τ0 is where the local slope settles within 10 % of its plateau (documented rule)",
         "per_gamma": [{"gamma": 0.01, "tau1": {"value": 17.2, "err": 1.0}}, {"gamma": 0.02, "tau1": None}],
-        "paper_comparison": [{"quantity": "a", "ours": 13.1, "err": 0.52, "paper": 13.63, "unit": "",
-                              "verdict": "agrees within 2σ", "note": ""}],
-        "config": {}, "provenance": {"hhscatter": "0.1.0", "git_commit": "0123456789abcdef"},
+        "paper_comparison": [
+            {
+                "quantity": "a",
+                "ours": 13.1,
+                "err": 0.52,
+                "paper": 13.63,
+                "unit": "",
+                "verdict": "agrees within 2σ",
+                "note": "",
+            }
+        ],
+        "config": {},
+        "provenance": {"hhscatter": "0.1.0", "git_commit": "0123456789abcdef"},
     }
     (assets / "fig2.json").write_text(json.dumps(doc))
     md = "<!-- hh:study-params fig2 -->\n<!-- hh:study-figure fig2 -->\n<!-- hh:study-numbers fig2 -->\n"
@@ -157,16 +169,32 @@ def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
     (assets / "paper").mkdir(parents=True)
 
     def doc(scale, kappa):
-        return {"study": "gx", "scale": scale, "provenance": {"git_commit": "abcdef0123456789"},
-                "systems": {"hh": {"n_exits": 3, "E_c": 1 / 6}, "two": {"n_exits": 2, "E_c": 0.5}},
-                "claims": [
-                    {"claim": "1", "quantity": "κ0", "system": "hh", "value": kappa, "err": 0.0123,
-                     "verdict": "agrees (z = +0.1)"},
-                    {"claim": "1", "quantity": "κ0", "system": "two", "value": None, "err": None,
-                     "verdict": "undetermined: 97% trapped"},
-                    {"claim": "3", "quantity": "μ", "system": "two", "value": 0.98, "err": None, "verdict": "measured"},
-                    {"claim": "2", "quantity": "κ_cm", "system": "hh", "value": 0.1, "err": None, "verdict": "ok"},
-                ]}
+        return {
+            "study": "gx",
+            "scale": scale,
+            "provenance": {"git_commit": "abcdef0123456789"},
+            "systems": {"hh": {"n_exits": 3, "E_c": 1 / 6}, "two": {"n_exits": 2, "E_c": 0.5}},
+            "claims": [
+                {
+                    "claim": "1",
+                    "quantity": "κ0",
+                    "system": "hh",
+                    "value": kappa,
+                    "err": 0.0123,
+                    "verdict": "agrees (z = +0.1)",
+                },
+                {
+                    "claim": "1",
+                    "quantity": "κ0",
+                    "system": "two",
+                    "value": None,
+                    "err": None,
+                    "verdict": "undetermined: 97% trapped",
+                },
+                {"claim": "3", "quantity": "μ", "system": "two", "value": 0.98, "err": None, "verdict": "measured"},
+                {"claim": "2", "quantity": "κ_cm", "system": "hh", "value": 0.1, "err": None, "verdict": "ok"},
+            ],
+        }
 
     (assets / "gx.json").write_text(json.dumps(doc("quick", 0.3)))
     out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
@@ -283,13 +311,25 @@ def test_nav_pages_and_api_modules_exist():
 
 
 def test_study_pages_put_the_figure_first_and_fold_the_configuration(hook):
-    page = ("# Fig 9\n\nintro line\n\n## What it computes\n\nprose\n\n```text\n## not a heading\n```\n\n"
-            "## Parameters\n\n<!-- hh:study-params fig9 -->\n\n## Figure\n\n<!-- hh:study-figure fig9 -->\n\n"
-            "## Numbers\n\n<!-- hh:study-numbers fig9 -->\n\n## Implementation\n\n<!-- hh:study-module fig9 -->\n")
+    page = (
+        "# Fig 9\n\nintro line\n\n## What it computes\n\nprose\n\n```text\n## not a heading\n```\n\n"
+        "## Parameters\n\n<!-- hh:study-params fig9 -->\n\n## Figure\n\n<!-- hh:study-figure fig9 -->\n\n"
+        "## Numbers\n\n<!-- hh:study-numbers fig9 -->\n\n## Implementation\n\n<!-- hh:study-module fig9 -->\n"
+    )
     out = hook.figure_first(page, "what fig 9 shows")
-    order = [out.index(s) for s in ("intro line", "**What it shows:** what fig 9 shows.", "## Figure",
-                                    "## What it computes", "## not a heading", "## Numbers", "## Parameters",
-                                    "## Implementation")]
+    order = [
+        out.index(s)
+        for s in (
+            "intro line",
+            "**What it shows:** what fig 9 shows.",
+            "## Figure",
+            "## What it computes",
+            "## not a heading",
+            "## Numbers",
+            "## Parameters",
+            "## Implementation",
+        )
+    ]
     assert order == sorted(order), out
     assert sorted(out.split("\n")) == sorted((page + "\n**What it shows:** what fig 9 shows.\n\n").split("\n"))
     assert hook.figure_first("# no sections\n") == "# no sections\n"
@@ -338,8 +378,16 @@ def test_every_library_module_has_an_api_page():
     assert not missing, f"modules without an API page (docs/api/...md with '::: module'): {missing}"
 
 
-@pytest.mark.parametrize("value, goal, want", [(1.32, "≤ 1 (0.8)", False), (0.9, "≤ 1 (0.8)", True),
-                                               (1.04, "≥ 2", False), (2.0, "≥ 2", True), (3.0, "fast", None)])
+@pytest.mark.parametrize(
+    "value, goal, want",
+    [
+        (1.32, "≤ 1 (0.8)", False),
+        (0.9, "≤ 1 (0.8)", True),
+        (1.04, "≥ 2", False),
+        (2.0, "≥ 2", True),
+        (3.0, "fast", None),
+    ],
+)
 def test_a_benchmark_goal_is_read_from_its_text(hook, value, goal, want):
     assert hook.goal_met(value, goal) is want
 
@@ -347,11 +395,16 @@ def test_a_benchmark_goal_is_read_from_its_text(hook, value, goal, want):
 def test_benchmarks_page_opens_with_goals_and_a_count(tmp_path, hook):
     eng = tmp_path / "docs" / "benchmarks" / "assets" / "engine"
     eng.mkdir(parents=True)
-    (eng / "engine.csv").write_text("target,measure,value,goal,note\nbare,engine µs/orbit,10.0,,\n"
-                                    "bare,engine / yardstick,1.32,≤ 1 (0.8),\nrec,marginal,1.9,≤ 2,\n")
+    (eng / "engine.csv").write_text(
+        "target,measure,value,goal,note\nbare,engine µs/orbit,10.0,,\n"
+        "bare,engine / yardstick,1.32,≤ 1 (0.8),\nrec,marginal,1.9,≤ 2,\n"
+    )
     out, _ = _page(tmp_path, hook, "<!-- hh:bench-goals -->\n")
     assert "**1 of 2 goals met**" in out
-    assert "| bare | engine / yardstick | ≤ 1 (0.8) | 1.32 | **no** |" in out and "| rec | marginal | ≤ 2 | 1.9 | yes |" in out
+    assert (
+        "| bare | engine / yardstick | ≤ 1 (0.8) | 1.32 | **no** |" in out
+        and "| rec | marginal | ≤ 2 | 1.9 | yes |" in out
+    )
 
 
 def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(tmp_path, hook):
@@ -388,16 +441,40 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     and the r_esc rows, from the paper-scale JSON when committed."""
     assets = tmp_path / "docs" / "studies" / "assets"
     (assets / "paper").mkdir(parents=True)
-    doc = {"study": "gx", "scale": "paper",
-           "regular_fraction": [{"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
-                                for r, f in ((1.05, 0.75), (1.5, 0.1))],
-           "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
-           "long_time": [{"label": "two", "e_ratio": 1.05, "ics": "disk/tangential", "P_inf": 0.751,
-                          "P_inf_err": 0.005, "kappa_inf": 0.00092, "kappa_inf_err": 0.00004}],
-           "resc": [{"label": "hh", "r_esc": 1.03, "default": False, "window": [0, 200],
-                     "mu_measured": {"value": 0.95, "err": 0.001}, "mu_predicted": {"value": 0.94, "err": 0.002},
-                     "mu_own_K": {"value": 0.951, "err": 0.001}, "moment_test": {"value": 0.011, "err": 0.002},
-                     "kinetic_at_E0": {"value": 1.018, "err": 0.002}, "kinetic_at_E0_interpolated_without_E0": 1.0}]}
+    doc = {
+        "study": "gx",
+        "scale": "paper",
+        "regular_fraction": [
+            {"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
+            for r, f in ((1.05, 0.75), (1.5, 0.1))
+        ],
+        "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
+        "long_time": [
+            {
+                "label": "two",
+                "e_ratio": 1.05,
+                "ics": "disk/tangential",
+                "P_inf": 0.751,
+                "P_inf_err": 0.005,
+                "kappa_inf": 0.00092,
+                "kappa_inf_err": 0.00004,
+            }
+        ],
+        "resc": [
+            {
+                "label": "hh",
+                "r_esc": 1.03,
+                "default": False,
+                "window": [0, 200],
+                "mu_measured": {"value": 0.95, "err": 0.001},
+                "mu_predicted": {"value": 0.94, "err": 0.002},
+                "mu_own_K": {"value": 0.951, "err": 0.001},
+                "moment_test": {"value": 0.011, "err": 0.002},
+                "kinetic_at_E0": {"value": 1.018, "err": 0.002},
+                "kinetic_at_E0_interpolated_without_E0": 1.0,
+            }
+        ],
+    }
     (assets / "paper" / "gx.json").write_text(json.dumps(doc))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
     assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out

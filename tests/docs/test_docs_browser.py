@@ -15,6 +15,7 @@ What is checked, on every page of the site:
 * no JavaScript error on any page;
 * the search box, typed into on ``index.html`` opened from disk, lists results (Material's ``offline`` plugin).
 """
+
 from __future__ import annotations
 
 import io
@@ -28,8 +29,16 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = os.environ.get("HHSCATTER_CHROMIUM", "/usr/bin/chromium")
 #: Chromium flags for a sandboxless container without network: no first-run UI, no background downloads
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 INK = 110  # a pixel darker than this (0-255 grey) is ink: text is near black, the page white
 MIN_INK_PIXELS = 3
 
@@ -37,8 +46,10 @@ MIN_INK_PIXELS = 3
 def _need_browser():
     sync_api = pytest.importorskip("playwright.sync_api", reason="no playwright: pip install -e '.[docs]'")
     if not (os.path.isfile(CHROMIUM) and os.access(CHROMIUM, os.X_OK)):
-        pytest.skip(f"no Chromium at {CHROMIUM}: `make chromium` installs Debian's package (needs root and apt); "
-                    "the browser tests of the docs did not run")
+        pytest.skip(
+            f"no Chromium at {CHROMIUM}: `make chromium` installs Debian's package (needs root and apt); "
+            "the browser tests of the docs did not run"
+        )
     return sync_api
 
 
@@ -52,8 +63,9 @@ def browser(tmp_path_factory):
     sync_api = _need_browser()
     user_data = tmp_path_factory.mktemp("chromium-profile")
     with sync_api.sync_playwright() as p:
-        ctx = p.chromium.launch_persistent_context(str(user_data), executable_path=CHROMIUM, args=FLAGS,
-                                                   headless=True, viewport={"width": 1400, "height": 900})
+        ctx = p.chromium.launch_persistent_context(
+            str(user_data), executable_path=CHROMIUM, args=FLAGS, headless=True, viewport={"width": 1400, "height": 900}
+        )
         try:
             yield ctx
         finally:
@@ -83,8 +95,10 @@ def _pages(site: Path):
 def test_ink_detector_sees_text_and_not_a_blank(browser, tmp_path):
     """The dark-pixel check itself: ink in a rendered word, none in an empty box of the same size."""
     html = tmp_path / "probe.html"
-    html.write_text('<body style="background:#fff"><span id="a" style="font-size:20px">κ = 0.18</span>'
-                    '<span id="b" style="display:inline-block;width:80px;height:20px"></span></body>')
+    html.write_text(
+        '<body style="background:#fff"><span id="a" style="font-size:20px">κ = 0.18</span>'
+        '<span id="b" style="display:inline-block;width:80px;height:20px"></span></body>'
+    )
     page, _ = _open(browser, html)
     assert _ink(page.locator("#a").screenshot()) >= MIN_INK_PIXELS
     assert _ink(page.locator("#b").screenshot()) == 0
@@ -124,8 +138,7 @@ def test_every_figure_on_every_page_loads(site, browser):
         if "<img" not in path.read_text(errors="replace"):
             continue
         page, errors = _open(browser, path)
-        sizes = page.evaluate("Array.from(document.images, i => [i.getAttribute('src'), i.complete, "
-                              "i.naturalWidth])")
+        sizes = page.evaluate("Array.from(document.images, i => [i.getAttribute('src'), i.complete, i.naturalWidth])")
         rel = path.relative_to(site).as_posix()
         broken += [f"{rel}: {src}" for src, complete, width in sizes if not (complete and width > 0)]
         broken += [f"{rel}: JavaScript error {e}" for e in errors]
@@ -164,9 +177,12 @@ def test_the_site_loads_nothing_from_the_network(site):
     import re
 
     remote = re.compile(r"""<(?:script|img|link)\b[^>]*\b(?:src|href)=["'](?:https?:)?//""", re.IGNORECASE)
-    hits = [f"{p.relative_to(site)}: {m.group(0)[:120]}" for p in _pages(site)
-            for m in remote.finditer(p.read_text(errors="replace"))
-            if "rel=\"canonical\"" not in m.group(0)]
+    hits = [
+        f"{p.relative_to(site)}: {m.group(0)[:120]}"
+        for p in _pages(site)
+        for m in remote.finditer(p.read_text(errors="replace"))
+        if 'rel="canonical"' not in m.group(0)
+    ]
     assert not hits, "\n".join(hits[:20])
 
 
@@ -176,8 +192,10 @@ def test_api_pages_show_no_literal_bullet_stars(site):
 
     hidden = re.compile(r"<script\b.*?</script>|<pre\b.*?</pre>|<code\b.*?</code>", re.DOTALL)
     star = re.compile(r"(?:<p>|<br ?/?>|\n)\s*\\?\*\s+\S[^<\n]{0,50}")
-    hits = {p.relative_to(site).as_posix(): star.findall(hidden.sub("", p.read_text(errors="replace")))[:2]
-            for p in _pages(site)}
+    hits = {
+        p.relative_to(site).as_posix(): star.findall(hidden.sub("", p.read_text(errors="replace")))[:2]
+        for p in _pages(site)
+    }
     hits = {k: v for k, v in hits.items() if v}
     assert not hits, hits
     api_page = (site / "api" / "api" / "rates.html").read_text()  # the notebook API: escape_rates and friends
@@ -192,8 +210,11 @@ def test_api_pages_show_no_literal_rst_tables(site):
 
     hidden = re.compile(r"<script\b.*?</script>|<pre\b.*?</pre>|<code\b.*?</code>", re.DOTALL)
     rule = re.compile(r"={8,}")
-    hits = {p.relative_to(site).as_posix(): rule.findall(hidden.sub("", p.read_text(errors="replace")))[:1]
-            for p in _pages(site) if p.relative_to(site).parts[0] == "api"}
+    hits = {
+        p.relative_to(site).as_posix(): rule.findall(hidden.sub("", p.read_text(errors="replace")))[:1]
+        for p in _pages(site)
+        if p.relative_to(site).parts[0] == "api"
+    }
     hits = {k: v for k, v in hits.items() if v}
     assert not hits, hits
     assert "<table" in (site / "api" / "errors.html").read_text()  # the error family's table
@@ -205,8 +226,12 @@ def test_api_examples_show_their_code_as_written(site):
     import re
 
     code = re.compile(r"<code\b[^>]*>(.*?)</code>", re.DOTALL)
-    hits = [f"{p.relative_to(site).as_posix()}: {line.strip()[:100]}" for p in _pages(site) if "/api/" in p.as_posix()
-            for block in code.findall(p.read_text(errors="replace"))
-            for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()
-            if ">>>" in line and "\\*" in line]
+    hits = [
+        f"{p.relative_to(site).as_posix()}: {line.strip()[:100]}"
+        for p in _pages(site)
+        if "/api/" in p.as_posix()
+        for block in code.findall(p.read_text(errors="replace"))
+        for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()
+        if ">>>" in line and "\\*" in line
+    ]
     assert not hits, "\n".join(hits[:20])

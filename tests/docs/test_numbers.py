@@ -7,6 +7,7 @@
 * no study page (and no page that reports results) types a number that is neither a reference, a
   parameter of the study, the paper's value, a small count nor a declared convention.
 """
+
 from __future__ import annotations
 
 import json
@@ -22,8 +23,10 @@ STUDIES = sorted(p.parent.name for p in (ROOT / "studies").glob("*/page.md"))
 DOC = {
     "kappa_fit": {"c": {"value": 1.4348590349, "err": 0.0170463952}, "chi2": 68.87144818141033, "dof": 17},
     "E0.30": {"mu": {"value": 0.0123456, "err": 0.00031}},
-    "rows": [{"energy": 0.25, "kappa": 0.0912, "verdict": "agrees"},
-             {"energy": 0.27, "kappa": 0.14516, "verdict": "differs"}],
+    "rows": [
+        {"energy": 0.25, "kappa": 0.0912, "verdict": "agrees"},
+        {"energy": 0.27, "kappa": 0.14516, "verdict": "differs"},
+    ],
     "frac": {"value": 0.0623, "err": 0.0012},
     "big": 1234567,
     "tiny": 2.5e-9,
@@ -32,37 +35,43 @@ DOC = {
 }
 
 
-@pytest.mark.parametrize("path, fmt, want", [
-    ("kappa_fit.c", None, "1.435 ± 0.017"),            # two digits of an error that starts with 1; value alike
-    ("kappa_fit.c", "value", "1.435"),
-    ("kappa_fit.c", "err", "0.017"),
-    ("kappa_fit.chi2", None, "68.87"),                  # no error: 4 significant digits
-    ("kappa_fit.chi2", ".1f", "68.9"),
-    ("kappa_fit.dof", None, "17"),
-    ("E0.30.mu", None, "0.0123 ± 0.0003"),              # a key holding a dot is found as it is
-    ("rows[energy=0.27].kappa", ".3f", "0.145"),        # a record chosen by a field, numbers compared as numbers
-    ("rows[energy=0.270].verdict", None, "differs"),
-    ("rows[0].energy", None, "0.25"),
-    ("rows[-1].verdict", None, "differs"),
-    ("frac", "pct", "6.23 ± 0.12 %"),
-    ("big", "int", "1\u2009234\u2009567"),
-    ("tiny", None, "2.500×10⁻⁹"),
-    ("tiny", "sci", "2.50×10⁻⁹"),
-    ("interval", None, "0.339 [0.3285, 0.3497]"),
-])
+@pytest.mark.parametrize(
+    "path, fmt, want",
+    [
+        ("kappa_fit.c", None, "1.435 ± 0.017"),  # two digits of an error that starts with 1; value alike
+        ("kappa_fit.c", "value", "1.435"),
+        ("kappa_fit.c", "err", "0.017"),
+        ("kappa_fit.chi2", None, "68.87"),  # no error: 4 significant digits
+        ("kappa_fit.chi2", ".1f", "68.9"),
+        ("kappa_fit.dof", None, "17"),
+        ("E0.30.mu", None, "0.0123 ± 0.0003"),  # a key holding a dot is found as it is
+        ("rows[energy=0.27].kappa", ".3f", "0.145"),  # a record chosen by a field, numbers compared as numbers
+        ("rows[energy=0.270].verdict", None, "differs"),
+        ("rows[0].energy", None, "0.25"),
+        ("rows[-1].verdict", None, "differs"),
+        ("frac", "pct", "6.23 ± 0.12 %"),
+        ("big", "int", "1\u2009234\u2009567"),
+        ("tiny", None, "2.500×10⁻⁹"),
+        ("tiny", "sci", "2.50×10⁻⁹"),
+        ("interval", None, "0.339 [0.3285, 0.3497]"),
+    ],
+)
 def test_a_reference_resolves_and_formats_as_documented(path, fmt, want):
     assert nb.format_leaf(nb.resolve(DOC, path), fmt) == want
 
 
-@pytest.mark.parametrize("path, fmt, says", [
-    ("kappa_fit.d", None, "no key 'd'"),
-    ("rows[energy=0.3].kappa", None, "0 records match"),
-    ("rows[7]", None, "out of range"),
-    ("kappa_fit", None, "name one of them"),
-    ("missing", None, "no number"),                      # NaN is an error, never "nan" on a page
-    ("kappa_fit.dof", "err", "no uncertainty"),
-    ("kappa_fit.chi2", "q", "bad format"),
-])
+@pytest.mark.parametrize(
+    "path, fmt, says",
+    [
+        ("kappa_fit.d", None, "no key 'd'"),
+        ("rows[energy=0.3].kappa", None, "0 records match"),
+        ("rows[7]", None, "out of range"),
+        ("kappa_fit", None, "name one of them"),
+        ("missing", None, "no number"),  # NaN is an error, never "nan" on a page
+        ("kappa_fit.dof", "err", "no uncertainty"),
+        ("kappa_fit.chi2", "q", "bad format"),
+    ],
+)
 def test_what_the_json_does_not_hold_is_an_error(path, fmt, says):
     with pytest.raises(nb.NumberRefError, match=says):
         nb.format_leaf(nb.resolve(DOC, path), fmt)
@@ -129,11 +138,19 @@ def test_every_reference_on_every_page_resolves_against_the_committed_json():
 #: strict: a page that passes must leave this set (the test then fails to say so).
 NOT_YET: set[str] = set()
 RESULT_PAGES = [f"studies/{s}/page.md" for s in STUDIES] + [
-    "docs/index.md", "docs/studies/index.md", "docs/studies/paper-scale.md"]  # README.md: tests/docs/test_readme.py
+    "docs/index.md",
+    "docs/studies/index.md",
+    "docs/studies/paper-scale.md",
+]  # README.md: tests/docs/test_readme.py
 
 
-@pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="not yet moved"))
-                                  if p in NOT_YET else p for p in RESULT_PAGES])
+@pytest.mark.parametrize(
+    "page",
+    [
+        pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="not yet moved")) if p in NOT_YET else p
+        for p in RESULT_PAGES
+    ],
+)
 def test_a_page_types_no_result_number(page):
     parts = Path(page).parts
     if parts[0] == "studies":
@@ -141,9 +158,11 @@ def test_a_page_types_no_result_number(page):
     else:  # pages over all studies: any study's parameters and the paper's values
         allowed = set().union(*(nb.study_conventions(ROOT, s) for s in STUDIES))
     stray = nb.stray_numbers((ROOT / page).read_text(), allowed)
-    assert not stray, (f"{page} types numbers by hand (line, number): {stray}. Render a result with "
-                       "[[study:path]]; declare a convention as <!-- conventions: value (reason) -->; "
-                       "see docs/studies/adding.md")
+    assert not stray, (
+        f"{page} types numbers by hand (line, number): {stray}. Render a result with "
+        "[[study:path]]; declare a convention as <!-- conventions: value (reason) -->; "
+        "see docs/studies/adding.md"
+    )
 
 
 def test_a_reference_the_syntax_cannot_read_is_an_error_not_left_as_text(tmp_path):

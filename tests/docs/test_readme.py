@@ -1,5 +1,6 @@
 """The README tells the truth: its results block is what the committed JSON renders, its code runs as printed,
 and the rest of its prose types no number it does not declare."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -55,12 +56,13 @@ def test_the_readme_python_and_sql_run_as_printed(tmp_path):
     )
     statements = [q.strip() for q in re.sub(r"(?m)^--.*$", "", "\n".join(sql)).split(";") if q.strip()]
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    made = subprocess.run([sys.executable, "-c", setup], cwd=tmp_path, env=env, capture_output=True, text=True,
-                          timeout=300, check=False)
+    made = subprocess.run(
+        [sys.executable, "-c", setup], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300, check=False
+    )
     assert made.returncode == 0, made.stderr[-3000:]
-    code = ("\n".join(py) + "\nimport duckdb\n"
-            + "".join(f"print(duckdb.sql({q!r}).fetchall())\n" for q in statements))
-    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
-                          timeout=300, check=False)
+    code = "\n".join(py) + "\nimport duckdb\n" + "".join(f"print(duckdb.sql({q!r}).fetchall())\n" for q in statements)
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300, check=False
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "escaped" in proc.stdout

@@ -1,6 +1,7 @@
 """What a reader of the built site must never meet (tools/check_site.py): a broken link or anchor (non-ASCII
 anchors included), LaTeX outside maths, "nan" as a value, an uncertainty printed as "± 0.000", the project's
 workflow history (issue numbers, the planning folder, commit hashes cited as history)."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -44,8 +45,9 @@ def test_the_checker_sees_what_it_should(tmp_path):
     (tmp_path / "a.html").write_text(
         '<html><body><article><h2 id="κ-law">κ</h2><a href="#κ-law">ok</a> <a href="#%CE%BA-law">ok</a>'
         '<a href="b.html#nowhere">x</a><a href="c.html">x</a><img src="d.png">'
-        "<p>E0 e^{−μγt} and <span class=\"arithmatex\">\\(e^{x}\\)</span> <code>a^{b}</code>; +nan; 0.5 ± 0.000;"
-        " see issue 28 and .dev/x.py; as made at commit 0ecf473; NaN names the value</p></article></body></html>")
+        '<p>E0 e^{−μγt} and <span class="arithmatex">\\(e^{x}\\)</span> <code>a^{b}</code>; +nan; 0.5 ± 0.000;'
+        " see issue 28 and .dev/x.py; as made at commit 0ecf473; NaN names the value</p></article></body></html>"
+    )
     (tmp_path / "b.html").write_text('<html><body><h1 id="here">b</h1></body></html>')
     res = mod.check(tmp_path)
     assert len(res["links"]) == 3 and all("a.html" in f for f in res["links"])

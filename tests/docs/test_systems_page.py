@@ -1,4 +1,5 @@
 """The Systems page shows the built-ins' numbers as the systems derive them today (tools/system_gallery.py)."""
+
 import importlib.util
 from pathlib import Path
 

@@ -1,6 +1,7 @@
 """docs/tutorial.ipynb runs from a clean folder (nbclient, a real Jupyter kernel, ~20 s), and the outputs
 committed with it (shown on the docs page) are those of its current code: every code cell has outputs and no
 error, and the numbers it prints agree with a fresh run within their errors."""
+
 from __future__ import annotations
 
 import importlib.util

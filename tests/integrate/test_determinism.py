@@ -6,6 +6,7 @@ lane's start time (the bound's rounding clamps the last step), and an orbit whos
 clamped by an earlier orbit's (stale) bound would end an ulp elsewhere (the event root is found on the clamped step).
 Short t_max: a tenth of the orbits are censored, and lanes refill often (many stale bounds). The reference is the
 same orbits run a batch at a time (each orbit alone in its lane from lane time 0), an independent schedule."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -17,8 +18,10 @@ from hhscatter.scene.scene import Scene, SectionWindow
 
 
 def _split(scene, ics, ids, size, batch_size=None):
-    parts = [run_chunk(scene, ics[a:a + size], ids[a:a + size], batch_size=batch_size).tables()
-             for a in range(0, len(ics), size)]
+    parts = [
+        run_chunk(scene, ics[a : a + size], ids[a : a + size], batch_size=batch_size).tables()
+        for a in range(0, len(ics), size)
+    ]
     return {name: {c: np.concatenate([p[name][c] for p in parts]) for c in cols} for name, cols in parts[0].items()}
 
 
@@ -30,16 +33,20 @@ def _assert_bitwise(a, b, what):
             assert v.tobytes() == w.tobytes(), (what, name, col, int((v != w).sum()))
 
 
-@pytest.mark.parametrize("kw", [
-    {"gamma": 0.01, "energy": 0.3},  # the no-return rule (linear drag, default r_far)
-    {"gamma": 0.01, "energy": 0.3, "r_far": 10.0},  # the scene's own far event
-    {"gamma": 0.0, "energy": 0.3},  # conservative: escapes in steps clamped by stale bounds moved an ulp
-    {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow(), "r_far": 10.0},  # generic handlers, section rows
-    # orbit 556's escape time is exactly halfway between two doubles (the exact sum of its steps): the lane's
-    # double-length time carries ~1e-30 of error that depends on the lane's start and decided the rounding
-    # (t_end differed by 1 ulp with chunks of 300) until near-ties rounded to even (engine._tie_to_even)
-    {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow()},
-], ids=["no-return", "own-r_far", "conservative", "sections", "sections-no-return-tie"])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"gamma": 0.01, "energy": 0.3},  # the no-return rule (linear drag, default r_far)
+        {"gamma": 0.01, "energy": 0.3, "r_far": 10.0},  # the scene's own far event
+        {"gamma": 0.0, "energy": 0.3},  # conservative: escapes in steps clamped by stale bounds moved an ulp
+        {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow(), "r_far": 10.0},  # generic handlers, section rows
+        # orbit 556's escape time is exactly halfway between two doubles (the exact sum of its steps): the lane's
+        # double-length time carries ~1e-30 of error that depends on the lane's start and decided the rounding
+        # (t_end differed by 1 ulp with chunks of 300) until near-ties rounded to even (engine._tie_to_even)
+        {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow()},
+    ],
+    ids=["no-return", "own-r_far", "conservative", "sections", "sections-no-return-tie"],
+)
 def test_censoring_scenes_do_not_depend_on_chunk_or_batch_size(kw):
     sc = Scene(n=2000, seed=5, r_esc=1.03, t_max=20.0, **kw)
     ics = region_ics(sc, 0, sc.n)

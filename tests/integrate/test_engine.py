@@ -1,12 +1,13 @@
 """Accuracy of the batch engine against invariants and an independent
 high-precision reference (heyoka's scalar integrator in real128/long double)."""
+
 import heyoka as hy
 import numpy as np
 import pytest
 
 from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk, simulate_orbit, state_at
-from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.model import HenonHeiles, equations
+from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.scene.scene import Scene, SectionWindow
 
 EPS = np.finfo(float).eps
@@ -81,8 +82,7 @@ def test_settling_energy_matches_work_integral():
     px, py = sys[2][0], sys[3][0]
     w = hy.make_vars("w")
     for k in settled[:4]:
-        ta = hy.taylor_adaptive(sys + [(w, hy.par[0] * (px**2 + py**2))], list(ics[k]) + [0.0],
-                                pars=[0.02], tol=1e-15)
+        ta = hy.taylor_adaptive(sys + [(w, hy.par[0] * (px**2 + py**2))], list(ics[k]) + [0.0], pars=[0.02], tol=1e-15)
         ta.propagate_until(lt["t_end"][k])
         assert abs(m.energy(*ics[k]) - ta.state[4] - m.critical_energy) <= 1e-12
         assert abs(lt["e_end"][k] - m.critical_energy) <= 1e-13
@@ -93,7 +93,7 @@ def test_settling_energy_matches_work_integral():
 def test_escape_times_against_high_precision_reference(cons_scene, fp_type):
     ics, res = _run(cons_scene, n=40)
     t = res.lifetimes["t_end"]
-    short = np.flatnonzero(t < 12)[:8 if fp_type is np.longdouble else 3]
+    short = np.flatnonzero(t < 12)[: 8 if fp_type is np.longdouble else 3]
     assert len(short) >= 3
     for k in short:
         ref = simulate_orbit(cons_scene, ics[k], fp_type=fp_type)
@@ -147,7 +147,7 @@ def test_results_do_not_depend_on_lanes_or_chunking(cons_scene):
         other = run_chunk(cons_scene, ics, ids, batch_size=b).lifetimes
         for col in ("t_end", "e_end", "outcome", "exit_channel"):
             assert np.array_equal(base[col], other[col]), (b, col)
-    split = [run_chunk(cons_scene, ics[a:a + 37], ids[a:a + 37]).lifetimes for a in range(0, 120, 37)]
+    split = [run_chunk(cons_scene, ics[a : a + 37], ids[a : a + 37]).lifetimes for a in range(0, 120, 37)]
     assert np.array_equal(base["t_end"], np.concatenate([s["t_end"] for s in split]))
 
 
@@ -214,8 +214,15 @@ def test_reused_integrator_gives_the_rows_of_a_new_one(kind):
     from hhscatter.integrate import engine
 
     if kind == "dissipative_recording":
-        a = Scene(energy=0.3, gamma=0.01, n=40, seed=3, snapshots=[0.0, 0.5, 3.0, 7.5],
-                  sections=SectionWindow(t_from=0.0), t_max=40.0)
+        a = Scene(
+            energy=0.3,
+            gamma=0.01,
+            n=40,
+            seed=3,
+            snapshots=[0.0, 0.5, 3.0, 7.5],
+            sections=SectionWindow(t_from=0.0),
+            t_max=40.0,
+        )
         b = a.replace(gamma=0.05, t_max=13.0)  # other γ and bound, same compiled system
     else:
         a = Scene(energy=0.27, n=40, seed=3, sections=SectionWindow(t_from=4.0, first_only=True))

@@ -1,4 +1,5 @@
 """The engine's declared contracts: lane rules as an abstract base, handlers bound by each event's rule."""
+
 import numpy as np
 import pytest
 
@@ -16,11 +17,14 @@ def test_a_scheduler_must_supply_the_integrator_access():
     assert {"elapsed", "state4", "set_gate", "set_clock", "record", "release"} == engine.LaneRules.__abstractmethods__
 
 
-@pytest.mark.parametrize("scene", [
-    Scene(energy=0.3, n=4, gamma=0.01, sections=SectionWindow(t_from=1.0, t_to=5.0)),
-    Scene(energy=0.3, n=4, follow=Follow(radii=(1.2, 2.0))),
-    Scene(energy=0.3, n=4),
-])
+@pytest.mark.parametrize(
+    "scene",
+    [
+        Scene(energy=0.3, n=4, gamma=0.01, sections=SectionWindow(t_from=1.0, t_to=5.0)),
+        Scene(energy=0.3, n=4, follow=Follow(radii=(1.2, 2.0))),
+        Scene(energy=0.3, n=4),
+    ],
+)
 def test_every_event_of_a_scene_has_the_handler_of_its_rule(scene):
     specs = events.scene_events(scene)
     assert specs and all(s.rule in events.RULES for s in specs)

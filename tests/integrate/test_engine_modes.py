@@ -1,6 +1,7 @@
 """Every mode of the one engine, built from the one event declaration (hhscatter.integrate.events):
 against the scalar long-double reference driver (same events and rules, independent precision),
 for invariance under chunking and lanes, and for what each scene option promises."""
+
 from __future__ import annotations
 
 import re
@@ -9,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hhscatter.integrate import events
 from hhscatter.analysis.survival.fits import observed_from_outcome
+from hhscatter.integrate import events
 from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, STOPPED, run_chunk, scheduler, simulate_orbit
-from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.model import HenonHeiles
+from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.scene.scene import Follow, Scene, SceneError, SectionWindow
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -28,20 +29,24 @@ def _run(scene, n=None, ics=None, **kw):
 
 # -- the declaration ------------------------------------------------------------
 
+
 def test_only_the_events_module_constructs_heyoka_events():
     pat = re.compile(r"\b(t_event|nt_event|t_event_batch|nt_event_batch)\(")
     users = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "hhscatter").rglob("*.py") if pat.search(p.read_text()))
     assert users == ["hhscatter/integrate/events.py"]
 
 
-@pytest.mark.parametrize("kw, names", [
-    ({}, ["escape", "clock"]),  # stream scenes censor with the clock (orbit time: test_determinism)
-    ({"gamma": 0.01}, ["closure", "far", "resc", "clock"]),
-    ({"gamma": 0.01, "snapshots": (1.0, 2.0)}, ["closure", "far", "resc"]),  # epochs censor at an epoch's end
-    ({"sections": SectionWindow()}, ["escape", "section", "clock"]),
-    ({"sections": SectionWindow(t_from=3.0, t_to=9.0)}, ["escape", "section", "clock"]),
-    ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2", "clock"]),
-])
+@pytest.mark.parametrize(
+    "kw, names",
+    [
+        ({}, ["escape", "clock"]),  # stream scenes censor with the clock (orbit time: test_determinism)
+        ({"gamma": 0.01}, ["closure", "far", "resc", "clock"]),
+        ({"gamma": 0.01, "snapshots": (1.0, 2.0)}, ["closure", "far", "resc"]),  # epochs censor at an epoch's end
+        ({"sections": SectionWindow()}, ["escape", "section", "clock"]),
+        ({"sections": SectionWindow(t_from=3.0, t_to=9.0)}, ["escape", "section", "clock"]),
+        ({"follow": Follow((1.0, 2.0))}, ["far", "radius0", "radius1", "radius2", "clock"]),
+    ],
+)
 def test_scene_events_compile_only_what_the_scene_needs(kw, names):
     # (a stream scene whose window opens late compiles the section event only into the
     # orbits' second phase: events.two_phase, tested bitwise and against the reference below)
@@ -76,6 +81,7 @@ def test_new_options_leave_existing_scene_hashes_unchanged():
 
 
 # -- against the scalar reference (long double) ------------------------------------
+
 
 def _agree_short(scene, ics, res, t_short=12.0, rtol=1e-9, n_min=20):
     """Outcomes and t_end of short-lived orbits against the long-double scalar driver."""
@@ -120,8 +126,11 @@ def test_sections_with_every_window_kind_against_reference():
         assert len(mine) == len(theirs), k
         np.testing.assert_allclose(mine, theirs, rtol=1e-9)
     # first_only: at most one row per orbit, and the first of the full window's rows
-    first = run_chunk(sc.replace(sections=SectionWindow(t_from=2.0, t_to=14.0, e_min=0.29, e_max=0.31,
-                                                        first_only=True)), ics, np.arange(len(ics))).sections
+    first = run_chunk(
+        sc.replace(sections=SectionWindow(t_from=2.0, t_to=14.0, e_min=0.29, e_max=0.31, first_only=True)),
+        ics,
+        np.arange(len(ics)),
+    ).sections
     assert not np.any(np.diff(first["traj_id"]) == 0)
     for k, t in zip(first["traj_id"][:30], first["t"][:30]):
         assert abs(t - sec["t"][sec["traj_id"] == k][0]) <= 1e-9 * t
@@ -172,8 +181,7 @@ def test_continue_settled_against_reference():
 
 
 def test_stopped_orbits_are_censoring():
-    sc = Scene(energy=0.35, n=300, seed=36, r_esc=1.03,
-               sections=SectionWindow(t_from=4.0, first_only=True, stop=True))
+    sc = Scene(energy=0.35, n=300, seed=36, r_esc=1.03, sections=SectionWindow(t_from=4.0, first_only=True, stop=True))
     ics, res = _run(sc)
     lt, sec = res.lifetimes, res.sections
     stopped = lt["outcome"] == STOPPED
@@ -191,8 +199,9 @@ def test_stopped_orbits_are_censoring():
 
 
 def test_section_window_stop_at_t_to():
-    sc = Scene(energy=0.3, gamma=0.01, n=200, seed=37, r_esc=1.03,
-               sections=SectionWindow(t_from=3.0, t_to=9.0, stop=True))
+    sc = Scene(
+        energy=0.3, gamma=0.01, n=200, seed=37, r_esc=1.03, sections=SectionWindow(t_from=3.0, t_to=9.0, stop=True)
+    )
     _, res = _run(sc)
     lt = res.lifetimes
     st = lt["outcome"] == STOPPED
@@ -204,20 +213,29 @@ def test_section_window_stop_at_t_to():
 
 # -- invariance -----------------------------------------------------------------------
 
-@pytest.mark.parametrize("kw", [
-    {"gamma": 0.005, "energy": 0.32},
-    {"gamma": 0.01, "energy": 0.3, "snapshots": tuple(np.arange(0.0, 40.01, 0.5)),
-     "sections": SectionWindow(t_from=5.0, first_only=True)},
-    {"gamma": 0.0, "energy": 0.3, "follow": Follow((1.0, 2.0))},
-    {"gamma": 0.01, "energy": 0.35, "sections": SectionWindow(t_from=6.0, t_to=30.0)},
-], ids=["dissipative", "epochs+sections", "follow", "two-phase sections"])
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"gamma": 0.005, "energy": 0.32},
+        {
+            "gamma": 0.01,
+            "energy": 0.3,
+            "snapshots": tuple(np.arange(0.0, 40.01, 0.5)),
+            "sections": SectionWindow(t_from=5.0, first_only=True),
+        },
+        {"gamma": 0.0, "energy": 0.3, "follow": Follow((1.0, 2.0))},
+        {"gamma": 0.01, "energy": 0.35, "sections": SectionWindow(t_from=6.0, t_to=30.0)},
+    ],
+    ids=["dissipative", "epochs+sections", "follow", "two-phase sections"],
+)
 def test_tables_do_not_depend_on_chunking_or_lanes(kw):
     """Bitwise, for γ > 0 too: event roots end heyoka's step, so times come from the orbit's own clock."""
     sc = Scene(n=240, seed=38, r_esc=1.03, **kw)
     ics = region_ics(sc, 0, sc.n)
     ids = np.arange(sc.n)
     base = run_chunk(sc, ics, ids, batch_size=4).tables()
-    split = [run_chunk(sc, ics[a:a + 70], ids[a:a + 70], batch_size=8).tables() for a in range(0, sc.n, 70)]
+    split = [run_chunk(sc, ics[a : a + 70], ids[a : a + 70], batch_size=8).tables() for a in range(0, sc.n, 70)]
     for name, cols in base.items():
         for col, v in cols.items():
             other = np.concatenate([s[name][col] for s in split])
@@ -239,6 +257,7 @@ def test_follow_and_conservative_lifetimes_agree_on_outcomes():
 
 
 # -- progress from inside a chunk ------------------------------------------------------
+
 
 @pytest.mark.parametrize("kw", [{}, {"gamma": 0.01, "snapshots": (0.0, 5.0, 10.0)}], ids=["stream", "epochs"])
 def test_progress_is_reported_from_inside_a_chunk(kw):
@@ -275,6 +294,7 @@ def test_runner_progress_moves_within_chunks_and_totals_exactly(tmp_path, monkey
 
 # -- the authors' square initial conditions ----------------------------------------------
 
+
 def test_square_region_is_uniform_in_the_allowed_square_and_on_the_energy_shell():
     from scipy import stats
 
@@ -299,8 +319,15 @@ def test_square_region_is_uniform_in_the_allowed_square_and_on_the_energy_shell(
 
 @pytest.mark.parametrize("gamma", [0.0, 0.01])
 def test_orbits_starting_beyond_r_esc_are_escaped_at_t0(gamma):
-    sc = Scene(energy=0.3, gamma=gamma, n=3000, seed=43, region="square", r_esc=1.03,
-               snapshots=(0.0, 1.0, 2.0) if gamma else None)
+    sc = Scene(
+        energy=0.3,
+        gamma=gamma,
+        n=3000,
+        seed=43,
+        region="square",
+        r_esc=1.03,
+        snapshots=(0.0, 1.0, 2.0) if gamma else None,
+    )
     ics = region_ics(sc, 0, sc.n)
     out = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= 1.03**2
     assert out.sum() > 20

@@ -4,6 +4,7 @@ heyoka ignores an event in a step when its polynomial root finding fails (it onl
 on the section ṙ = 0 at an inflection of r (r̈ = 0 there too) give the section event a near-triple root at
 t = 0, which makes the root finding fail for many of them: the provocation used here.
 """
+
 import json
 
 import heyoka as hy
@@ -71,7 +72,7 @@ def test_failures_counted_and_each_orbit_redone_on_the_reference():
     alone = []
     for j in range(len(ics)):
         with heyoka_log.capture() as log:
-            run_chunk(SCENE, ics[j:j + 1], ids[j:j + 1])
+            run_chunk(SCENE, ics[j : j + 1], ids[j : j + 1])
         alone.append(log.event_failures)
     alone = np.array(alone)
     assert res.event_failures == alone.sum() > 0
@@ -90,11 +91,12 @@ def test_run_manifest_and_summary_count_the_failures(tmp_path):
     ics = inflection_ics(12)
     table = tmp_path / "ics.csv"
     table.write_text("x,y,px,py\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in ics) + "\n")
-    sc = Scene(energy=None, n=12, t_max=400.0, ics=str(table), chunk_size=6,
-               sections=SectionWindow(first_only=True, stop=True))
+    sc = Scene(
+        energy=None, n=12, t_max=400.0, ics=str(table), chunk_size=6, sections=SectionWindow(first_only=True, stop=True)
+    )
     summary = simulate(sc, tmp_path / "run", workers=1, progress=False)
     doc = json.loads((tmp_path / "run" / "scene.json").read_text())["event_failures"]
-    expected = [run_chunk(sc, ics[s:s + 6], np.arange(s, s + 6)).event_failures for s in (0, 6)]
+    expected = [run_chunk(sc, ics[s : s + 6], np.arange(s, s + 6)).event_failures for s in (0, 6)]
     assert doc["total"] == sum(expected) > 0
     assert {k: v["failures"] for k, v in doc["chunks"].items()} == {str(c): n for c, n in enumerate(expected) if n}
     assert "heyoka event-detection failures" in summary.line()

@@ -7,13 +7,14 @@ the engine's escape is the last outward crossing, decided later). The
 density is estimated from the escape times in [0, τ] by a weighted linear fit of the binned density (its
 intercept at t = 0, with its standard error < 4 % of the rate), and must agree within 3σ (seed fixed).
 """
+
 import numpy as np
 import pytest
 
 from hhscatter.analysis.geometry.flux import initial_escape_rate
 from hhscatter.integrate.engine import ESCAPED, run_chunk
-from hhscatter.scene.ics import region_ics
 from hhscatter.model.spec import system_from_spec
+from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene
 
 N = 150_000
@@ -26,8 +27,9 @@ SYSTEMS = [
     pytest.param({"name": "n_exit", "params": {"n": 4}}, 1.5, 1.2, id="n_exit4"),
     pytest.param({"name": "contopoulos", "params": {"eps": 0.25}}, 1.5, 1.1, id="contopoulos"),
     pytest.param({"name": "barbanis"}, 1.5, 1.2, id="barbanis"),
-    pytest.param({"potential": "0.5*x**2 + 0.8*y**2 - eps*x**2*y**2 + 0.1*x*y", "params": {"eps": 0.3}}, 1.4, 1.15,
-                 id="declared"),
+    pytest.param(
+        {"potential": "0.5*x**2 + 0.8*y**2 - eps*x**2*y**2 + 0.1*x*y", "params": {"eps": 0.3}}, 1.4, 1.15, id="declared"
+    ),
 ]
 
 
@@ -48,8 +50,9 @@ def _intercept(t_esc, n):
 def test_initial_escape_rate_is_flux_over_shell_volume(system, ratio, r_ratio):
     m = system_from_spec(system or {"name": "henon_heiles"})
     energy, R = ratio * m.critical_energy, r_ratio * m.saddle_radius
-    scene = Scene(energy=energy, n=N, region="disk", radius=R, r_esc=R, momentum="random",
-                  t_max=TAU, seed=7, system=system)
+    scene = Scene(
+        energy=energy, n=N, region="disk", radius=R, r_esc=R, momentum="random", t_max=TAU, seed=7, system=system
+    )
     ics = region_ics(scene, 0, N)
     res = run_chunk(scene, ics, np.arange(N))
     lt = res.lifetimes

@@ -3,6 +3,7 @@ R(E) instead of r_far = max(10 r_s, 2 r_esc), with every table bitwise what the 
 (the rule's proof: hhscatter.model.henon_heiles.HenonHeiles.no_return_radius; the engine's use of it:
 hhscatter.integrate.rerun._no_return). The references are the same scenes with an explicit r_far (10, the
 default's value, and 100: a ten times longer follow-up), which keep the old far event."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -45,8 +46,16 @@ def test_orbits_late_at_the_no_return_radius_are_rerun_to_r_far(monkeypatch):
     calls = []
     merge = chunk._merge_rerun
     monkeypatch.setattr(chunk, "_merge_rerun", lambda *a: calls.append(a[1].sum()) or merge(*a))
-    sc = Scene(energy=0.32, gamma=0.01, n=400, seed=72, r_esc=1.03, t_max=30.0,
-               snapshots=tuple(np.arange(0.0, 30.01, 1.0)), sections=SectionWindow(t_from=3.0))
+    sc = Scene(
+        energy=0.32,
+        gamma=0.01,
+        n=400,
+        seed=72,
+        r_esc=1.03,
+        t_max=30.0,
+        snapshots=tuple(np.arange(0.0, 30.01, 1.0)),
+        sections=SectionWindow(t_from=3.0),
+    )
     ics = region_ics(sc, 0, sc.n)
     _, t_fast = _tables(sc, ics)
     assert calls and calls[0] > 0

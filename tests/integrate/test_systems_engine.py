@@ -1,11 +1,12 @@
 """The engine on every built-in system and a declared expression: energy conservation, escape times
 against a long-double reference, the closure at E = E_c inside Ω, and the exit fractions of symmetric systems."""
+
 import numpy as np
 import pytest
 from scipy import stats
 
-from hhscatter.model.spec import system_from_spec
 from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, run_chunk, simulate_orbit
+from hhscatter.model.spec import system_from_spec
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene
 
@@ -15,8 +16,9 @@ SYSTEMS = [
     pytest.param({"name": "n_exit", "params": {"n": 4}}, 4, True, id="n_exit4"),
     pytest.param({"name": "contopoulos", "params": {"eps": 0.25}}, 4, True, id="contopoulos"),
     pytest.param({"name": "barbanis"}, 2, True, id="barbanis"),
-    pytest.param({"potential": "0.5*(x**2 + y**2) - eps*x**2*y**2", "params": {"eps": 0.5}}, 4, True,
-                 id="declared-contopoulos"),
+    pytest.param(
+        {"potential": "0.5*(x**2 + y**2) - eps*x**2*y**2", "params": {"eps": 0.5}}, 4, True, id="declared-contopoulos"
+    ),
 ]
 
 

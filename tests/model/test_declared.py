@@ -1,5 +1,6 @@
 """DeclaredSystem in heyoka: the same trajectories and cost as the built-in, energy conserved; immutable, picklable;
 make_system's errors name the key."""
+
 import math
 import pickle
 
@@ -35,8 +36,10 @@ def test_declared_hh_costs_no_more_per_step_than_the_builtin(hh3):
         sizes = [len(_ta(m, [0.1, 0.2, 0.3, 0.1], gamma).decomposition) for m in (HenonHeiles(), hh3)]
         assert sizes[1] <= sizes[0], sizes  # 15 vs 17 (conservative), 19 vs 21 (linear drag)
     quad = DeclaredSystem(HenonHeiles().potential_text, {"omega": 1.0, "lam": 1.0}, "quadratic")
-    sizes = [len(hy.taylor_adaptive(m.equations(hy.par[0]), [0.1, 0.2, 0.3, 0.1], pars=[0.01]).decomposition)
-             for m in (HenonHeiles(dissipation="quadratic"), quad)]
+    sizes = [
+        len(hy.taylor_adaptive(m.equations(hy.par[0]), [0.1, 0.2, 0.3, 0.1], pars=[0.01]).decomposition)
+        for m in (HenonHeiles(dissipation="quadratic"), quad)
+    ]
     assert sizes[1] <= sizes[0] + 2, sizes
 
 
@@ -119,8 +122,12 @@ def test_immutable_equal_hashable_and_picklable(conto):
 
 
 def test_provenance_records_the_system(hh3, conto):
-    assert conto.provenance() == {"system": "contopoulos", "potential": "0.5*(x**2 + y**2) - eps*x**2*y**2",
-                                  "params": {"eps": 0.25}, "dissipation": "linear"}
+    assert conto.provenance() == {
+        "system": "contopoulos",
+        "potential": "0.5*(x**2 + y**2) - eps*x**2*y**2",
+        "params": {"eps": 0.25},
+        "dissipation": "linear",
+    }
     assert conto.hash_items() == conto.provenance()
     assert hh3.provenance()["builtin_params"] == {"n": 3} and hh3.provenance()["params"] == {}
     d = DeclaredSystem("0.5*(x**2 + y**2) + x**2*y - y**3/3")
@@ -148,20 +155,23 @@ def test_make_system_builtins_and_defaults():
     assert s.name == "n_exit" and len(s.exits) == 4
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"name": "henon_heils"}, "unknown built-in 'henon_heils' .*henon_heiles, n_exit, contopoulos, barbanis"),
-    ({"name": "contopoulos", "params": {"epsilon": 0.2}}, r"unknown parameter\(s\) \['epsilon'\] of 'contopoulos'"),
-    ({"name": "contopoulos", "params": {"eps": -1}}, "eps must be a finite number > 0"),
-    ({"name": "n_exit", "params": {"n": 2}}, "n must be an integer from 3 to 8"),
-    ({"name": "n_exit", "params": {"n": 3.5}}, "'n' must be an integer"),
-    ({"name": "henon_heiles", "params": {"omega": 0}}, "henon_heiles: omega must be a finite number > 0"),
-    ({"name": "contopoulos", "potential": "x**2 + y**2"}, "either `name`.*or `potential`"),
-    ({"potential": "x**2/2 + y**2/2 - x**3", "dissipation": "cubic"}, "dissipation must be one of"),
-    ({"name": "contopoulos", "critical_energy": 1.0}, "cannot be given for the built-in"),
-    ({"potential": "x**2/2 + y**2/2 - x**3", "omega": 1.0}, r"unknown key\(s\) \['omega'\]"),
-    ({"potential": "x**2/2 + y**2/2 - a*x**3"}, r"unknown symbol 'a'.*declare a parameter in \[system.params\]"),
-    ({"potential": "x**2/2 + y**2/2 - a*x**3", "params": {"b": 1}}, r"\['a'\] have no value"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"name": "henon_heils"}, "unknown built-in 'henon_heils' .*henon_heiles, n_exit, contopoulos, barbanis"),
+        ({"name": "contopoulos", "params": {"epsilon": 0.2}}, r"unknown parameter\(s\) \['epsilon'\] of 'contopoulos'"),
+        ({"name": "contopoulos", "params": {"eps": -1}}, "eps must be a finite number > 0"),
+        ({"name": "n_exit", "params": {"n": 2}}, "n must be an integer from 3 to 8"),
+        ({"name": "n_exit", "params": {"n": 3.5}}, "'n' must be an integer"),
+        ({"name": "henon_heiles", "params": {"omega": 0}}, "henon_heiles: omega must be a finite number > 0"),
+        ({"name": "contopoulos", "potential": "x**2 + y**2"}, "either `name`.*or `potential`"),
+        ({"potential": "x**2/2 + y**2/2 - x**3", "dissipation": "cubic"}, "dissipation must be one of"),
+        ({"name": "contopoulos", "critical_energy": 1.0}, "cannot be given for the built-in"),
+        ({"potential": "x**2/2 + y**2/2 - x**3", "omega": 1.0}, r"unknown key\(s\) \['omega'\]"),
+        ({"potential": "x**2/2 + y**2/2 - a*x**3"}, r"unknown symbol 'a'.*declare a parameter in \[system.params\]"),
+        ({"potential": "x**2/2 + y**2/2 - a*x**3", "params": {"b": 1}}, r"\['a'\] have no value"),
+    ],
+)
 def test_make_system_errors_name_the_key(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         make_system(**kwargs)
@@ -184,8 +194,14 @@ def test_escape_radius_lies_beyond_every_bounded_orbit(conto):
         assert 0.5 * R < r_max <= R, (E, r_max, R)
 
 
-@pytest.mark.parametrize("text", ["0.5*(x**2 + y**2) - 0.25*x**2*y**2", "atan(0.5*(x**2 + y**2) + x**2*y - y**3/3)",
-                                  "0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cos(y)"])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "0.5*(x**2 + y**2) - 0.25*x**2*y**2",
+        "atan(0.5*(x**2 + y**2) + x**2*y - y**3/3)",
+        "0.5*(x**2 + y**2) + sqrt(2)*(x**2*y - y**3/3) + 0.01*erf(x**2)*cos(y)",
+    ],
+)
 def test_heyoka_expressions_match_numpy_and_differentiation(text):
     import heyoka as hy
 

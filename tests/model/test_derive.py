@@ -1,4 +1,5 @@
 """Derived E_c, exits, Ω and R(E) against closed forms, and the pitfalls each a clear error (or a right answer)."""
+
 import math
 
 import numpy as np
@@ -54,8 +55,9 @@ def test_declared_hh_equals_the_builtin():
     assert np.allclose(d.potential(*pts), hh.potential(*pts), rtol=0, atol=1e-15 * 10)  # |V| ≤ ~10 here
     assert np.max(np.abs(d.potential(*pts) - hh.potential(*pts)) / np.maximum(1, np.abs(hh.potential(*pts)))) < 1e-15
     assert d.critical_energy == pytest.approx(hh.critical_energy, rel=1e-15)
-    assert np.allclose([(e.x, e.y, e.energy) for e in d.exits], [(e.x, e.y, e.energy) for e in hh.exits],
-                       rtol=0, atol=1e-15)
+    assert np.allclose(
+        [(e.x, e.y, e.energy) for e in d.exits], [(e.x, e.y, e.energy) for e in hh.exits], rtol=0, atol=1e-15
+    )
     assert d.saddle_radius == pytest.approx(hh.saddle_radius, rel=1e-15)
     assert d.omega_radius == pytest.approx(hh.omega_radius, rel=1e-15)
     for x, y in pts.T[:50]:  # channels: the same exit nearest in angle
@@ -73,13 +75,16 @@ def test_no_return_radius_reproduces_the_hh_closed_form(omega, lam):
         assert got >= want and got == pytest.approx(want, rel=1e-8), (E, got, want)
 
 
-@pytest.mark.parametrize("name, params, closed", [
-    # V = r²/2 + r^k g(θ) homogeneous: V_r = 0 and V = E meet at r² = 2kE/(k − 2) (k = 3: HH's √(6E))
-    ("n_exit", {"n": 4}, lambda E: math.sqrt(8 * E / 2)),
-    ("n_exit", {"n": 5}, lambda E: math.sqrt(10 * E / 3)),
-    ("contopoulos", {"eps": 0.25}, lambda E: 2 * math.sqrt(E)),
-    ("barbanis", {"eps": 0.5}, lambda E: math.sqrt(6 * E)),
-])
+@pytest.mark.parametrize(
+    "name, params, closed",
+    [
+        # V = r²/2 + r^k g(θ) homogeneous: V_r = 0 and V = E meet at r² = 2kE/(k − 2) (k = 3: HH's √(6E))
+        ("n_exit", {"n": 4}, lambda E: math.sqrt(8 * E / 2)),
+        ("n_exit", {"n": 5}, lambda E: math.sqrt(10 * E / 3)),
+        ("contopoulos", {"eps": 0.25}, lambda E: 2 * math.sqrt(E)),
+        ("barbanis", {"eps": 0.5}, lambda E: math.sqrt(6 * E)),
+    ],
+)
 def test_no_return_radius_closed_forms_of_the_builtins(name, params, closed):
     s = make_system(name, params=params)
     for f in (1.0, 1.5, 3.0):
@@ -129,16 +134,19 @@ def test_saddle_that_does_not_lead_out():
     assert bool(s.inside_well(0.0, 1.0))  # the second well is part of the well below E_c
 
 
-@pytest.mark.parametrize("text, match", [
-    # a whole circle of maxima (the ring) at r = 1: the critical points form a curve
-    ("0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2", "form a curve.*`critical_energy` and `exits`"),
-    # an inflection x(1−x)²: a degenerate critical point at (1, 0)
-    ("x**2/2 - 2*x**3/3 + x**4/4 + y**2/2", r"degenerate critical point at \(1, 0\)"),
-    ("0.5*(x**2 + y**2) + x**4", "no exit"),
-    ("0.5*((x - 1)**2 + y**2)", r"minimum must be at the origin, found at \(1, 0\)"),
-    ("0.5*(x**2 + y**2) + 1 - x**3", "V = 0, but V\\(0, 0\\) = 1"),
-    ("x**2 - y**2 + x**3", "origin is a saddle"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        # a whole circle of maxima (the ring) at r = 1: the critical points form a curve
+        ("0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2", "form a curve.*`critical_energy` and `exits`"),
+        # an inflection x(1−x)²: a degenerate critical point at (1, 0)
+        ("x**2/2 - 2*x**3/3 + x**4/4 + y**2/2", r"degenerate critical point at \(1, 0\)"),
+        ("0.5*(x**2 + y**2) + x**4", "no exit"),
+        ("0.5*((x - 1)**2 + y**2)", r"minimum must be at the origin, found at \(1, 0\)"),
+        ("0.5*(x**2 + y**2) + 1 - x**3", "V = 0, but V\\(0, 0\\) = 1"),
+        ("x**2 - y**2 + x**3", "origin is a saddle"),
+    ],
+)
 def test_pitfalls_are_clear_errors(text, match):
     with pytest.raises(ConfigError, match=match):
         DeclaredSystem(text)
@@ -172,8 +180,12 @@ def test_irrational_coefficients_go_the_numeric_way(lam_text, lam):
 
 def test_overrides_replace_the_derivation():
     # the ring: nothing derivable, everything given
-    s = DeclaredSystem("0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2", critical_energy=0.25,
-                       exits=[[1, 0], [0, 1], [-1, 0], [0, -1]], omega_radius=1.0)
+    s = DeclaredSystem(
+        "0.5*(x**2 + y**2) - 0.25*(x**2 + y**2)**2",
+        critical_energy=0.25,
+        exits=[[1, 0], [0, 1], [-1, 0], [0, -1]],
+        omega_radius=1.0,
+    )
     assert s.critical_energy == 0.25 and s.omega_radius == 1.0 and s.derivation.method == "given"
     assert [e.energy for e in s.exits] == [0.25] * 4
     assert s.provenance()["critical_energy"] == 0.25
@@ -186,8 +198,11 @@ def test_overrides_replace_the_derivation():
 def test_a_critical_energy_the_derived_exits_contradict_is_refused():
     # exits at 1/384 (r = 1/8) and at 1/6 (r = 1): E_c is the lower one; forcing it up to the far exit's energy
     # contradicts the derivation and is refused, naming both values
-    with pytest.raises(ConfigError, match=r"critical_energy = 0.16666666666666666 contradicts the exits: E_c is the "
-                                          r"lowest exit's energy, 0.0026041666666666\d* \(exits derived\)"):
+    with pytest.raises(
+        ConfigError,
+        match=r"critical_energy = 0.16666666666666666 contradicts the exits: E_c is the "
+        r"lowest exit's energy, 0.0026041666666666\d* \(exits derived\)",
+    ):
         DeclaredSystem("0.5*(x**2 + y**2) - x**3/3 - 8*y**3/3", critical_energy=1 / 6)
 
 

@@ -1,5 +1,6 @@
 """The safe parser of declared potentials: only numbers, x, y, pi, declared parameters, arithmetic and heyoka's
 functions; never eval of user text."""
+
 import pytest
 
 from hhscatter.errors import ConfigError
@@ -27,28 +28,31 @@ def test_every_whitelisted_function_parses_and_converts_to_heyoka():
         assert name in str(to_heyoka(e, hx, hy_)) or name == "sqrt"  # sqrt may print as a power
 
 
-@pytest.mark.parametrize("text, match", [
-    ("__import__('os')", "unknown function '__import__'"),
-    ("x.__class__", "Attribute is not allowed"),
-    ("(lambda: 1)()", "only plain function calls"),
-    ("lambda x: x", "Lambda is not allowed"),
-    ("[x for x in (1,)]", "ListComp is not allowed"),
-    ("x[0]", "Subscript is not allowed"),
-    ("open('f')", "unknown function 'open'"),
-    ("x**2 + z", "unknown symbol 'z'"),
-    ("x^2", r"'\^' is not a power"),
-    ("x if y else 0", "IfExp is not allowed"),
-    ("x == y", "Compare is not allowed"),
-    ("'text'", "not a real number"),
-    ("True*x", "not a real number"),
-    ("x**10**10", "exponent .* out of range"),
-    ("sin(x, y)", r"sin\(\) takes 1 argument"),
-    ("exp(x=1)", "positional arguments only"),
-    ("x +", "is not a Python expression"),
-    ("x/0", "division by zero"),
-    ("3", "depends on neither x nor y"),
-    ("sqrt(x**2) + y**2", r"Abs \('Abs\(x\)'\) is not allowed"),  # sympy's rewrite of sqrt(x**2), caught too
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("__import__('os')", "unknown function '__import__'"),
+        ("x.__class__", "Attribute is not allowed"),
+        ("(lambda: 1)()", "only plain function calls"),
+        ("lambda x: x", "Lambda is not allowed"),
+        ("[x for x in (1,)]", "ListComp is not allowed"),
+        ("x[0]", "Subscript is not allowed"),
+        ("open('f')", "unknown function 'open'"),
+        ("x**2 + z", "unknown symbol 'z'"),
+        ("x^2", r"'\^' is not a power"),
+        ("x if y else 0", "IfExp is not allowed"),
+        ("x == y", "Compare is not allowed"),
+        ("'text'", "not a real number"),
+        ("True*x", "not a real number"),
+        ("x**10**10", "exponent .* out of range"),
+        ("sin(x, y)", r"sin\(\) takes 1 argument"),
+        ("exp(x=1)", "positional arguments only"),
+        ("x +", "is not a Python expression"),
+        ("x/0", "division by zero"),
+        ("3", "depends on neither x nor y"),
+        ("sqrt(x**2) + y**2", r"Abs \('Abs\(x\)'\) is not allowed"),  # sympy's rewrite of sqrt(x**2), caught too
+    ],
+)
 def test_refuses_anything_outside_the_whitelist(text, match):
     with pytest.raises(ConfigError, match=match):
         parse_potential(text)

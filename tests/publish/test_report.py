@@ -1,4 +1,5 @@
 """The reproduction report tabulates exactly what the studies wrote, and says what is missing."""
+
 import json
 
 import pytest
@@ -12,18 +13,31 @@ from hhscatter.studies.provenance import config_sha256, sealed
 def _sealed(root, name, doc, upstream=None):
     """The numbers JSON as the analyze stage writes it: with what it was made from and its own content hash."""
     config = load_study(name, "quick", root=root).config
-    return sealed({**doc, "config": config, "made_from": {"config_sha256": config_sha256(config),
-                                                          "upstream": upstream or {}, "raw_runs": {}}})
+    return sealed(
+        {
+            **doc,
+            "config": config,
+            "made_from": {"config_sha256": config_sha256(config), "upstream": upstream or {}, "raw_runs": {}},
+        }
+    )
 
 
 def _fake_study(root, name, rows, with_figure=True, paper=None):
     d = root / name
     (d / "out" / "quick").mkdir(parents=True)
     paper = f"Fig. {name[-1]}" if paper is None else paper
-    (d / "study.toml").write_text(f'[about]\ntitle = "{name} title"\npaper = "{paper}"\nsummary = "{name} caption"\n'
-                                  '[scene]\nn = 10\nenergy = 0.3\n')
-    doc = {"study": name, "scale": "quick", "kappa": {"value": 0.153, "err": 0.004}, "n_points": 31000,
-           "paper_comparison": rows, "provenance": {"heyoka": "7.13.2"}}
+    (d / "study.toml").write_text(
+        f'[about]\ntitle = "{name} title"\npaper = "{paper}"\nsummary = "{name} caption"\n'
+        "[scene]\nn = 10\nenergy = 0.3\n"
+    )
+    doc = {
+        "study": name,
+        "scale": "quick",
+        "kappa": {"value": 0.153, "err": 0.004},
+        "n_points": 31000,
+        "paper_comparison": rows,
+        "provenance": {"heyoka": "7.13.2"},
+    }
     (d / "out" / "quick" / f"{name}.json").write_text(json.dumps(_sealed(root, name, doc)))
     if with_figure:
         import matplotlib
@@ -39,16 +53,60 @@ def _fake_study(root, name, rows, with_figure=True, paper=None):
 
 def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     root = tmp_path / "studies"
-    _fake_study(root, "rep2", [
-        {"quantity": "κ fit a", "ours": 13.1, "err": 0.4, "paper": 13.63, "unit": "", "verdict": "agrees within 2σ",
-         "note": ""},
-        {"quantity": "break energy", "ours": 0.31, "err": 0.01, "paper": 0.27, "unit": "", "verdict": "differs",
-         "note": "continuous fit"},
-    ])
-    _fake_study(root, "rep3", [{"quantity": "μ on [0,200]", "ours": 0.905, "err": 0.003, "paper": 0.91,
-                                "verdict": "agrees within 2σ", "note": ""}], with_figure=False)
-    _fake_study(root, "rescx", [{"quantity": "returns at r_esc=1.03", "ours": 0.011, "err": 0.0004, "paper": 0.0,
-                                "verdict": "differs", "note": ""}], paper="")
+    _fake_study(
+        root,
+        "rep2",
+        [
+            {
+                "quantity": "κ fit a",
+                "ours": 13.1,
+                "err": 0.4,
+                "paper": 13.63,
+                "unit": "",
+                "verdict": "agrees within 2σ",
+                "note": "",
+            },
+            {
+                "quantity": "break energy",
+                "ours": 0.31,
+                "err": 0.01,
+                "paper": 0.27,
+                "unit": "",
+                "verdict": "differs",
+                "note": "continuous fit",
+            },
+        ],
+    )
+    _fake_study(
+        root,
+        "rep3",
+        [
+            {
+                "quantity": "μ on [0,200]",
+                "ours": 0.905,
+                "err": 0.003,
+                "paper": 0.91,
+                "verdict": "agrees within 2σ",
+                "note": "",
+            }
+        ],
+        with_figure=False,
+    )
+    _fake_study(
+        root,
+        "rescx",
+        [
+            {
+                "quantity": "returns at r_esc=1.03",
+                "ours": 0.011,
+                "err": 0.0004,
+                "paper": 0.0,
+                "verdict": "differs",
+                "note": "",
+            }
+        ],
+        paper="",
+    )
     _fake_study(root, "rep1", [], with_figure=False)
     (root / "rep1" / "out" / "quick" / "rep1.json").unlink()  # a study folder that has not run yet
     res = build_report("quick", out=tmp_path / "rep", root=root)
@@ -60,7 +118,9 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert "returns at r_esc" in beyond_part.split("## Figures of the paper")[0]
     assert "3 numbers: 2 agree, 1 differ" in paper_part
     assert "arXiv:2308.13555" in md.split("##")[0] and "both uncertainties" in md.split("##")[0]  # the header
-    assert "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs (z = +3.6)</span>' in page  # the one rule: 0.04/√(0.01² + 0.005²)
+    assert (
+        "13.1 ± 0.4" in page and "13.63" in page and '<span class="bad">differs (z = +3.6)</span>' in page
+    )  # the one rule: 0.04/√(0.01² + 0.005²)
     assert page.count("data:image/png;base64,") == 2  # rep2 and rescx; rep3 has numbers but no figure
     assert set(res["missing"]) == {"rep1", "rep3"}  # the study folders of the root without figure or numbers
     assert "### rep2 title (`make rep2`)" in md and "rep2 caption" in md  # titles and captions from [about]
@@ -69,11 +129,25 @@ def test_report_tables_rows_embeds_figures_and_lists_missing(tmp_path):
     assert (tmp_path / "rep" / "assets" / "rep2.png").exists()
     assert "kappa | 0.153 ± 0.004" in md and "n_points | 31000" in md
     assert [r["study"] for r in json.loads((tmp_path / "rep" / "comparison.json").read_text())] == [
-        "rep2", "rep2", "rep3", "rescx"]
+        "rep2",
+        "rep2",
+        "rep3",
+        "rescx",
+    ]
 
 
-@pytest.mark.parametrize("v,err,want", [(0.9123, 0.0031, "0.912 ± 0.003"), (0.31, 0.012, "0.310 ± 0.012"), (13.63, None, "13.63"),
-                                        (2.5e-14, 1e-15, "2.5e-14 ± 1.0e-15"), (0.0, 8.3e-6, "0 ± 8.3e-06"), (-9.2e-4, 5.2e-4, "-0.0009 ± 0.0005"), (152.0, 7.0, "152 ± 7")])
+@pytest.mark.parametrize(
+    "v,err,want",
+    [
+        (0.9123, 0.0031, "0.912 ± 0.003"),
+        (0.31, 0.012, "0.310 ± 0.012"),
+        (13.63, None, "13.63"),
+        (2.5e-14, 1e-15, "2.5e-14 ± 1.0e-15"),
+        (0.0, 8.3e-6, "0 ± 8.3e-06"),
+        (-9.2e-4, 5.2e-4, "-0.0009 ± 0.0005"),
+        (152.0, 7.0, "152 ± 7"),
+    ],
+)
 def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
     assert format_value_err(v, err) == want
 
@@ -81,9 +155,12 @@ def test_number_formatting_rounds_to_the_uncertainty(v, err, want):
 def test_a_difference_only_in_our_convention_is_not_counted_as_one():
     from hhscatter.publish.report import verdict_counts
 
-    rows = [{"verdict": "differs"}, {"verdict": "differs in our convention only; agrees under the authors' ([0, 100])"},
-            {"verdict": "differs in this convention only; within the spread across conventions"},
-            {"verdict": "agrees within 2σ"}]
+    rows = [
+        {"verdict": "differs"},
+        {"verdict": "differs in our convention only; agrees under the authors' ([0, 100])"},
+        {"verdict": "differs in this convention only; within the spread across conventions"},
+        {"verdict": "agrees within 2σ"},
+    ]
     c = verdict_counts(rows)
     assert (c["bad"], c["meh"], c["ok"]) == (1, 2, 1)
 
@@ -91,8 +168,10 @@ def test_a_difference_only_in_our_convention_is_not_counted_as_one():
 def test_report_header_names_each_studys_commit_and_says_dirty_in_words():
     from hhscatter.publish.report import Section, commits_line
 
-    secs = [Section(k, k, "", None, {"provenance": {"git_commit": c}}) for k, c in
-            (("fig1", "a" * 40 + "-dirty"), ("fig2", "b" * 40), ("fig3", "b" * 40), ("fig4", None))]
+    secs = [
+        Section(k, k, "", None, {"provenance": {"git_commit": c}})
+        for k, c in (("fig1", "a" * 40 + "-dirty"), ("fig2", "b" * 40), ("fig3", "b" * 40), ("fig4", None))
+    ]
     line = commits_line(secs)
     assert line == f"Numbers made at commit `{'b' * 12}`: fig2, fig3; `{'a' * 12}` (uncommitted changes): fig1."
     assert "-dirty" not in line and commits_line([]) == ""

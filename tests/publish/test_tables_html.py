@@ -1,5 +1,6 @@
 """Report and docs tables are rendered by a real Markdown library (Python-Markdown): every row of every table
 in the generated HTML has as many cells as its header, also with |ΔH| in a cell (the benchmark summaries)."""
+
 from __future__ import annotations
 
 import json
@@ -46,8 +47,7 @@ def assert_rows_match_headers(page: str, at_least: int = 1) -> list:
 
 def test_parser_sees_a_broken_table():
     with pytest.raises(AssertionError, match="header has 2 cells"):
-        assert_rows_match_headers("<table><tr><th>a</th><th>b</th></tr><tr><td>1</td><td>2</td><td>3</td></tr>"
-                                  "</table>")
+        assert_rows_match_headers("<table><tr><th>a</th><th>b</th></tr><tr><td>1</td><td>2</td><td>3</td></tr></table>")
 
 
 def _summaries(root: Path):
@@ -71,14 +71,29 @@ def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
         d = root / name / "out" / "quick"
         d.mkdir(parents=True)
         paper = "" if name == "tabx" else "Fig. 2"
-        (root / name / "study.toml").write_text(f'[about]\ntitle = "{name}"\npaper = "{paper}"\nsummary = "s"\n'
-                                                '[scene]\nn = 1\n')
-        rows = [{"quantity": "max |ΔH|/H | drift", "ours": 4.5e-10, "err": 1e-11, "paper": 0.0, "unit": "",
-                 "verdict": "differs", "note": "a | b"},
-                {"quantity": "κ", "ours": "0.1 vs 0.2", "err": None, "paper": None, "verdict": None, "note": ""}]
+        (root / name / "study.toml").write_text(
+            f'[about]\ntitle = "{name}"\npaper = "{paper}"\nsummary = "s"\n[scene]\nn = 1\n'
+        )
+        rows = [
+            {
+                "quantity": "max |ΔH|/H | drift",
+                "ours": 4.5e-10,
+                "err": 1e-11,
+                "paper": 0.0,
+                "unit": "",
+                "verdict": "differs",
+                "note": "a | b",
+            },
+            {"quantity": "κ", "ours": "0.1 vs 0.2", "err": None, "paper": None, "verdict": None, "note": ""},
+        ]
         config = load_study(name, "quick", root=root).config
-        doc = {"kappa": {"value": 0.15, "err": 0.004}, "paper_comparison": rows, "note|bar": "x|y", "config": config,
-               "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}}
+        doc = {
+            "kappa": {"value": 0.15, "err": 0.004},
+            "paper_comparison": rows,
+            "note|bar": "x|y",
+            "config": config,
+            "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}},
+        }
         (d / f"{name}.json").write_text(json.dumps(sealed(doc)))
     res = build_report("quick", out=tmp_path / "rep", root=root)
     tables = assert_rows_match_headers(res["html"].read_text(), at_least=6)
@@ -95,11 +110,24 @@ def test_docs_pages_tables_have_as_many_cells_as_their_headers(tmp_path):
     from test_docs import _load
 
     hook = _load(DOCS / "_hooks" / "studies.py", "hh_docs_hook_tables")
-    extensions = ["admonition", "attr_list", "def_list", "footnotes", "md_in_html", "tables",
-                  "pymdownx.details", "pymdownx.superfences"]
+    extensions = [
+        "admonition",
+        "attr_list",
+        "def_list",
+        "footnotes",
+        "md_in_html",
+        "tables",
+        "pymdownx.details",
+        "pymdownx.superfences",
+    ]
     pages = {f"studies/{p.parent.name}.md": p for p in sorted((ROOT / "studies").glob("*/page.md"))}
-    pages.update({"studies/index.md": DOCS / "studies" / "index.md",
-                  "benchmarks/index.md": DOCS / "benchmarks" / "index.md", "cli.md": DOCS / "cli.md"})
+    pages.update(
+        {
+            "studies/index.md": DOCS / "studies" / "index.md",
+            "benchmarks/index.md": DOCS / "benchmarks" / "index.md",
+            "cli.md": DOCS / "cli.md",
+        }
+    )
 
     class File:
         pass

@@ -1,9 +1,10 @@
 """Dask backend: the same bytes as the local pool, on a real LocalCluster (separate worker processes)."""
+
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.run.runner import simulate
 from hhscatter.errors import OutputError, SetupError
+from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, SectionWindow
 
 distributed = pytest.importorskip("distributed")
@@ -20,8 +21,9 @@ def cluster():
 
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as c:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+    ) as c:
         yield c
 
 
@@ -29,8 +31,15 @@ def cluster():
 def scene():
     # all three tables, 3 chunks; section and snapshot times depend on chunk_size in the last
     # bits (absolute lane times), so every backend must use the same chunk_size: it is part of the scene
-    return Scene(energy=0.3, gamma=0.01, n=450, seed=21, chunk_size=150,
-                 sections=SectionWindow(t_from=5.0, first_only=True), snapshots=(0.0, 5.0, 20.0))
+    return Scene(
+        energy=0.3,
+        gamma=0.01,
+        n=450,
+        seed=21,
+        chunk_size=150,
+        sections=SectionWindow(t_from=5.0, first_only=True),
+        snapshots=(0.0, 5.0, 20.0),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -79,8 +88,20 @@ def test_dask_cluster_equals_local_pool_byte_for_byte(tmp_path, scene, reference
 
 def test_cli_scheduler_local_grid(tmp_path, capsys):
     """`--scheduler local` starts its own LocalCluster; a grid run gives the pool's bytes."""
-    args = ["simulate", "--energy", "0.25,0.3", "--gamma", "0.005,0.01", "-n", "120", "--chunk-size", "60",
-            "--seed", "4", "--quiet"]
+    args = [
+        "simulate",
+        "--energy",
+        "0.25,0.3",
+        "--gamma",
+        "0.005,0.01",
+        "-n",
+        "120",
+        "--chunk-size",
+        "60",
+        "--seed",
+        "4",
+        "--quiet",
+    ]
     assert main([*args, "--out", str(tmp_path / "g"), "--workers", "1"]) == 0
     capsys.readouterr()
     # same out name (it is the scene name, stored in the metadata) in another folder
@@ -91,10 +112,13 @@ def test_cli_scheduler_local_grid(tmp_path, capsys):
     assert len(a) == 8 and a == b
 
 
-@pytest.mark.parametrize("args,message", [
-    (["--scheduler", "nowhere"], "scheduler must be 'local' or an address"),
-    (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "2"], "workers: the number of workers is the cluster's"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["--scheduler", "nowhere"], "scheduler must be 'local' or an address"),
+        (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "2"], "workers: the number of workers is the cluster's"),
+    ],
+)
 def test_bad_scheduler_fails_before_work(tmp_path, capsys, args, message):
     out = tmp_path / "never"
     assert main(["simulate", "--energy", "0.3", "-n", "10", "--out", str(out), "--quiet", *args]) == 2
@@ -128,8 +152,11 @@ def test_fsspec_url_output_resume_and_read(tmp_path, scene, reference):
     try:
         simulate(scene, url, workers=1, progress=False)
         fs = fsspec.filesystem("memory")
-        got = {p.split("/run/", 1)[1]: fs.cat(p) for p in fs.find("/hhscatter-test/run")
-               if p.rsplit("/", 1)[-1].startswith("part-")}
+        got = {
+            p.split("/run/", 1)[1]: fs.cat(p)
+            for p in fs.find("/hhscatter-test/run")
+            if p.rsplit("/", 1)[-1].startswith("part-")
+        }
         assert got == reference
         fs.rm("/hhscatter-test/run/lifetimes/part-000001.parquet")
         s = simulate(scene, url, workers=1, resume=True, progress=False)

@@ -4,6 +4,7 @@ write lock survives the deletion of its file.
 Each case used to lose data or let two writers mix their parts; each is now refused before anything is removed
 or written.
 """
+
 import json
 import os
 
@@ -32,9 +33,12 @@ def run(tmp_path):
 def test_overwrite_refuses_a_file_the_run_did_not_write_and_removes_nothing(run):
     (run / "lifetimes" / "thesis.tex").write_text("months of work")
     before = _files(run)
-    with pytest.raises(OutputError, match=r"--overwrite: .*run holds 1 entry its run's manifest does not list \(first: "
-                                          r".*lifetimes/thesis.tex\); hhscatter removes only what it wrote.*Nothing "
-                                          "was removed"):
+    with pytest.raises(
+        OutputError,
+        match=r"--overwrite: .*run holds 1 entry its run's manifest does not list \(first: "
+        r".*lifetimes/thesis.tex\); hhscatter removes only what it wrote.*Nothing "
+        "was removed",
+    ):
         simulate(SCENE.replace(seed=3), run, workers=1, progress=False, overwrite=True)
     assert _files(run) == before
 
@@ -43,8 +47,11 @@ def test_overwrite_refuses_a_folder_that_holds_no_run(tmp_path):
     out = tmp_path / "notes"
     out.mkdir()
     (out / "notes.txt").write_text("x")
-    with pytest.raises(OutputError, match=r"--overwrite: .*notes holds no hhscatter run \(no scene.json: its manifest\) "
-                                          r"but 1 entry \(first: notes.txt\)"):
+    with pytest.raises(
+        OutputError,
+        match=r"--overwrite: .*notes holds no hhscatter run \(no scene.json: its manifest\) "
+        r"but 1 entry \(first: notes.txt\)",
+    ):
         simulate(SCENE, out, workers=1, progress=False, overwrite=True)
     assert _files(out) == ["notes.txt"]
 
@@ -63,8 +70,11 @@ def test_overwrite_removes_exactly_the_manifests_files(tmp_path):
 @pytest.mark.parametrize("out", ["", "   "])
 def test_out_must_name_a_directory(tmp_path, out, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(ConfigError, match=r"out must name a directory \(or a URL\), got '\s*'; the working directory "
-                                          "is '.'"):
+    with pytest.raises(
+        ConfigError,
+        match=r"out must name a directory \(or a URL\), got '\s*'; the working directory "
+        "is '.'",
+    ):
         simulate(SCENE, out, workers=1, progress=False)
     assert os.listdir(tmp_path) == []
 

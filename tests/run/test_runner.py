@@ -1,4 +1,5 @@
 """Crash safety and resume: kill -9, damaged parts, full disk, refused resumes."""
+
 import errno
 import os
 import shutil
@@ -11,12 +12,11 @@ from pathlib import Path
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.errors import RunError
+from hhscatter.data.read import verify_part
+from hhscatter.errors import OutputError, RunError
 from hhscatter.run.runner import simulate
-from hhscatter.errors import OutputError
 from hhscatter.scene.scene import Scene, SectionWindow
 from hhscatter.scene.schema import load_scene
-from hhscatter.data.read import verify_part
 
 TOML = """[scene]
 energy = 0.3
@@ -57,8 +57,12 @@ def test_kill_9_then_resume_equals_uninterrupted_run(tmp_path):
 
     out = tmp_path / "run"
     # a pool of 2 processes in its own session: kill -9 the whole group as soon as the first chunk exists
-    proc = subprocess.Popen(_hh("simulate", str(toml), "--out", str(out), "--workers", "2", "--quiet"),
-                            start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        _hh("simulate", str(toml), "--out", str(out), "--workers", "2", "--quiet"),
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     first = out / "lifetimes" / "part-000000.parquet"
     deadline = time.monotonic() + 120
     while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
@@ -73,8 +77,13 @@ def test_kill_9_then_resume_equals_uninterrupted_run(tmp_path):
     for p in out.rglob("part-*.parquet"):
         verify_part(p)
 
-    r = subprocess.run(_hh("simulate", str(toml), "--out", str(out), "--workers", "2", "--quiet", "--resume"),
-                       capture_output=True, text=True, timeout=300, check=False)
+    r = subprocess.run(
+        _hh("simulate", str(toml), "--out", str(out), "--workers", "2", "--quiet", "--resume"),
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert r.returncode == 0, r.stderr
     assert "chunk(s) resumed" in r.stdout
     assert _files(out) == reference
@@ -82,8 +91,9 @@ def test_kill_9_then_resume_equals_uninterrupted_run(tmp_path):
 
 
 def test_damaged_parts_and_temporaries_are_redone(tmp_path):
-    sc = Scene(energy=0.3, gamma=0.01, n=600, seed=3, chunk_size=150,
-               sections=SectionWindow(t_from=5.0), snapshots=(0.0, 10.0))
+    sc = Scene(
+        energy=0.3, gamma=0.01, n=600, seed=3, chunk_size=150, sections=SectionWindow(t_from=5.0), snapshots=(0.0, 10.0)
+    )
     out = tmp_path / "r"
     simulate(sc, out, workers=1, progress=False)
     before = _files(out)
@@ -111,8 +121,23 @@ def test_resume_of_another_scene_is_refused_and_names_the_difference(tmp_path, c
     before = _files(out)
     with pytest.raises(OutputError, match=r"different scene \(seed: 3 → 4\)"):
         simulate(sc.replace(seed=4), out, workers=1, resume=True, progress=False)
-    rc = main(["simulate", "--energy", "0.27", "-n", "200", "--seed", "3", "--chunk-size", "50", "--out", str(out),
-               "--resume", "--quiet"])
+    rc = main(
+        [
+            "simulate",
+            "--energy",
+            "0.27",
+            "-n",
+            "200",
+            "--seed",
+            "3",
+            "--chunk-size",
+            "50",
+            "--out",
+            str(out),
+            "--resume",
+            "--quiet",
+        ]
+    )
     assert rc == 2 and "chunk_size: 100 → 50" in capsys.readouterr().err
     assert _files(out) == before
 
@@ -150,8 +175,9 @@ def test_write_failure_is_clear_and_keeps_finished_parts(tmp_path, monkeypatch, 
 
 
 def _can_mount_tmpfs(where):
-    r = subprocess.run(["unshare", "-rm", "sh", "-c", f"mount -t tmpfs -o size=64k tmpfs {where}"],
-                       capture_output=True, check=False)
+    r = subprocess.run(
+        ["unshare", "-rm", "sh", "-c", f"mount -t tmpfs -o size=64k tmpfs {where}"], capture_output=True, check=False
+    )
     return r.returncode == 0
 
 
@@ -169,8 +195,7 @@ def test_real_full_disk_on_a_tiny_tmpfs(tmp_path):
         f"{sys.executable} -c 'import sys; from hhscatter.cli import main; sys.exit(main())' simulate "
         f"{' '.join(sc_args)} --out {mnt}/run; echo rc=$?; cp -a {mnt}/run {keep}"
     )
-    r = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True, text=True, timeout=300,
-                       check=False)
+    r = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True, text=True, timeout=300, check=False)
     assert "rc=1" in r.stdout, r.stdout + r.stderr
     assert "No space left on device" in r.stderr and "--resume" in r.stderr and "Traceback" not in r.stderr
     kept = _files(keep)

@@ -1,17 +1,18 @@
 """Grid runs: lists of energies/γ → one job, one folder per point (no hive keys), paired ICs, resume."""
+
 import numpy as np
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 import pytest
 
 from hhscatter.cli import main
-from hhscatter.scene.grid import Grid, load_run
+from hhscatter.data.read import read_lifetimes, read_meta, read_sections
+from hhscatter.errors import OutputError
 from hhscatter.model import HenonHeiles
 from hhscatter.run.runner import simulate
-from hhscatter.errors import OutputError
+from hhscatter.scene.grid import Grid, load_run
 from hhscatter.scene.scene import Scene, SceneError
 from hhscatter.scene.schema import load_scene
-from hhscatter.data.read import read_lifetimes, read_meta, read_sections
 
 ENERGIES, GAMMAS = (0.25, 0.3), (0.0, 0.01)
 
@@ -20,8 +21,9 @@ ENERGIES, GAMMAS = (0.25, 0.3), (0.0, 0.01)
 def grid():
     from hhscatter.scene.scene import SectionWindow
 
-    base = Scene(energy=0.25, n=160, seed=17, chunk_size=80, sections=SectionWindow(t_from=2.0, first_only=True),
-                 name="sweep")
+    base = Scene(
+        energy=0.25, n=160, seed=17, chunk_size=80, sections=SectionWindow(t_from=2.0, first_only=True), name="sweep"
+    )
     return Grid(base, ENERGIES, GAMMAS)
 
 
@@ -46,13 +48,16 @@ def test_toml_lists_make_a_grid_and_scalars_a_scene(tmp_path):
     assert isinstance(load_run(p), Scene)
 
 
-@pytest.mark.parametrize("energies,gammas,message", [
-    ([0.3, 0.3], [0.0], "energy lists a value twice"),
-    ([0.3, 0.1], [0.0], "energy must be > E_c"),
-    ([0.3], [0.0, -0.01], "gamma must be ≥ 0"),
-    ([0.3, float("nan")], [0.0], "energy must be finite"),
-    ([], [0.0], "non-empty list"),
-])
+@pytest.mark.parametrize(
+    "energies,gammas,message",
+    [
+        ([0.3, 0.3], [0.0], "energy lists a value twice"),
+        ([0.3, 0.1], [0.0], "energy must be > E_c"),
+        ([0.3], [0.0, -0.01], "gamma must be ≥ 0"),
+        ([0.3, float("nan")], [0.0], "energy must be finite"),
+        ([], [0.0], "non-empty list"),
+    ],
+)
 def test_bad_grids_name_the_parameter(energies, gammas, message):
     with pytest.raises(SceneError, match=message):
         Grid(Scene(energy=0.3, n=10), energies, gammas)
@@ -77,10 +82,12 @@ def test_layout_metadata_and_partition_columns(grid, grid_run):
     assert (lt["e0"] != lt["energy"]).any()
     # plain pyarrow reads the same dataset, the point columns from the files
     t = ds.dataset(grid_run / "lifetimes", format="parquet", partitioning="hive").to_table(
-        filter=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01), columns=["traj_id", "t_end"])
+        filter=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01), columns=["traj_id", "t_end"]
+    )
     assert t.num_rows == 160
-    one = read_lifetimes(grid_run, columns=["traj_id", "t_end"],
-                         filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01))
+    one = read_lifetimes(
+        grid_run, columns=["traj_id", "t_end"], filters=(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)
+    )
     assert one.sort_values("traj_id")["t_end"].tolist() == t.sort_by("traj_id").column("t_end").to_pylist()
     sec = read_sections(grid_run)
     assert {"point_energy", "point_gamma"} <= set(sec.columns) and (sec["t"] >= 2.0).all()
@@ -135,8 +142,9 @@ def test_grid_resume_and_refusal(tmp_path, grid, grid_run):
 
 def test_cli_grid_lists(tmp_path, capsys):
     out = tmp_path / "c"
-    rc = main(["simulate", "--energy", "0.27,0.3", "-n", "50", "--seed", "2", "--out", str(out), "--workers", "1",
-               "--quiet"])
+    rc = main(
+        ["simulate", "--energy", "0.27,0.3", "-n", "50", "--seed", "2", "--out", str(out), "--workers", "1", "--quiet"]
+    )
     assert rc == 0 and "100 orbits" in capsys.readouterr().out
     lt = read_lifetimes(out)
     assert sorted(set(lt["energy"])) == [0.27, 0.3] and set(lt["gamma"]) == {0.0}

@@ -1,9 +1,10 @@
 """Initial conditions on a section grid and their perturbed copies (basin maps, uncertainty algorithm)."""
+
 import numpy as np
 import pytest
 
-from hhscatter.scene.ics import perturbed_on_section, section_grid
 from hhscatter.model import HenonHeiles
+from hhscatter.scene.ics import perturbed_on_section, section_grid
 
 M = HenonHeiles()
 

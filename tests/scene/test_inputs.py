@@ -3,6 +3,7 @@
 Each case a hostile input that used to run with exit 0 (wrong or endless numbers); each now a ConfigError naming
 the key and the reason, or (−0, the IC radius) the right scene.
 """
+
 import json
 
 import pytest
@@ -14,13 +15,19 @@ from hhscatter.scene.scene import Scene, SectionWindow, scene_from_dict
 HH = "x**2/2 + y**2/2 + x**2*y - y**3/3"
 
 
-@pytest.mark.parametrize("changes,message", [
-    ({"t_max": 1e300}, r"t_max must be ≤ 1e\+07/ω = 1e\+07, got 1e\+300 \(every orbit still inside at t_max is "
-                       r"integrated all the way"),
-    ({"seed": 10**30}, r"seed must be ≤ 2\*\*63 − 1 = 9223372036854775807, got 10{30}"),
-    ({"chunk_size": 10**12}, r"chunk_size must be ≤ 1e\+07, got 1e\+12 \(a chunk's rows are held in memory"),
-    ({"seed": True}, r"seed must be an integer ≥ 0, got True"),
-])
+@pytest.mark.parametrize(
+    "changes,message",
+    [
+        (
+            {"t_max": 1e300},
+            r"t_max must be ≤ 1e\+07/ω = 1e\+07, got 1e\+300 \(every orbit still inside at t_max is "
+            r"integrated all the way",
+        ),
+        ({"seed": 10**30}, r"seed must be ≤ 2\*\*63 − 1 = 9223372036854775807, got 10{30}"),
+        ({"chunk_size": 10**12}, r"chunk_size must be ≤ 1e\+07, got 1e\+12 \(a chunk's rows are held in memory"),
+        ({"seed": True}, r"seed must be an integer ≥ 0, got True"),
+    ],
+)
 def test_every_number_is_bounded(changes, message):
     with pytest.raises(ConfigError, match=message):
         Scene(energy=0.3, n=10, **changes)
@@ -55,8 +62,11 @@ def test_a_declared_systems_scene_carries_no_henon_heiles_keys_and_keeps_its_has
 
 
 def test_a_section_window_above_e0_is_refused():
-    with pytest.raises(ConfigError, match=r"sections.e_min = 0.5 is above E0 = 0.3: the energy never rises above E0, "
-                                          "so no crossing would be recorded"):
+    with pytest.raises(
+        ConfigError,
+        match=r"sections.e_min = 0.5 is above E0 = 0.3: the energy never rises above E0, "
+        "so no crossing would be recorded",
+    ):
         Scene(energy=0.3, n=10, sections=SectionWindow(e_min=0.5))
 
 
@@ -64,8 +74,11 @@ def test_an_energy_within_rounding_of_ec_is_refused():
     ec = 1 / 6
     one_ulp = 0.16666666666666669
     assert one_ulp > ec
-    with pytest.raises(ConfigError, match=r"energy must exceed E_c = 0.16666666666666666 by more than 1e-09 E_c, got "
-                                          r"0.16666666666666669 \(E0 − E_c = 2.78e-17\)"):
+    with pytest.raises(
+        ConfigError,
+        match=r"energy must exceed E_c = 0.16666666666666666 by more than 1e-09 E_c, got "
+        r"0.16666666666666669 \(E0 − E_c = 2.78e-17\)",
+    ):
         Scene(energy=one_ulp, n=50, gamma=0.01)
     assert Scene(energy=ec * (1 + 1e-6), n=50, gamma=0.01).energy > ec
 

@@ -1,4 +1,5 @@
 """The momentum convention of region ICs: 'tangential' (default, unchanged) and 'random' directions."""
+
 from __future__ import annotations
 
 import os
@@ -88,8 +89,10 @@ for region in ("disk", "well", "square"):
 
 
 def test_default_scenes_give_the_ics_and_hashes_of_main_before_the_option(tmp_path):
-    if shutil.which("git") is None or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT,
-                                                     capture_output=True).returncode != 0:
+    if (
+        shutil.which("git") is None
+        or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT, capture_output=True).returncode != 0
+    ):
         pytest.skip(f"needs the git history with {BASE}")
     old = tmp_path / "old"
     old.mkdir()
@@ -137,8 +140,9 @@ def test_bad_momentum_is_refused_with_the_key_and_the_allowed_values(tmp_path):
 def test_cli_refuses_a_bad_momentum_in_a_scene_file_with_exit_2(tmp_path):
     hh = Path(sys.executable).parent / "hhscatter"
     (tmp_path / "a.toml").write_text('[scene]\nenergy = 0.3\nn = 10\nmomentum = "radial"\n')
-    r = subprocess.run([str(hh), "simulate", str(tmp_path / "a.toml"), "--out", str(tmp_path / "run")],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [str(hh), "simulate", str(tmp_path / "a.toml"), "--out", str(tmp_path / "run")], capture_output=True, text=True
+    )
     assert r.returncode == 2 and "momentum" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "run").exists()
 
@@ -164,8 +168,7 @@ def _first_crossings_reference(ic, gamma, t_end):
 def test_sections_are_recorded_for_random_momenta_as_by_an_independent_integrator():
     from hhscatter.integrate.engine import run_chunk
 
-    sc = Scene(energy=0.3, n=40, gamma=0.01, seed=9, momentum="random", t_max=12.0,
-               sections=SectionWindow(t_to=12.0))
+    sc = Scene(energy=0.3, n=40, gamma=0.01, seed=9, momentum="random", t_max=12.0, sections=SectionWindow(t_to=12.0))
     ics = region_ics(sc, 0, sc.n)
     res = run_chunk(sc, ics, np.arange(sc.n))
     sec = res.sections

@@ -1,5 +1,6 @@
 """Strict configuration (hhscatter.scene.schema): every bad table, key or value type of a study.toml or scene file
 exits with status 2 and one exact message before any work, and the checks change no scene's result_hash."""
+
 from __future__ import annotations
 
 import json
@@ -45,34 +46,58 @@ def _run_study(root: Path, name: str, capsys, monkeypatch, tmp_path) -> tuple[in
 
 BAD_STUDY_FILES = [
     # (study, edit of its study.toml, exact message after "hhscatter: error: studies/<study>/study.toml: ")
-    ("fig1", lambda t: t + '\n[sections]\nfirst_only = "no"\n',
-     "[sections] first_only must be true or false, got 'no'"),
-    ("fig3", lambda t: t.replace("seed = 2026 ", "seed = true ", 1),
-     "[scene] seed must be an integer, got true"),
-    ("fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1),
-     "[scene] energy must be a number, got '0.3'"),
-    ("fig6", lambda t: t.replace("[snapshots]", "[snapshot]", 1),
-     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
-     "[snapshots], [study], [system]"),
-    ("fig3", lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
-     "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot' (did you mean 'n_boot'?); allowed keys: alt_window, "
-     "authors_selection, authors_window, boot_seed, fit_window, hist_bins, hist_times, later_windows, n_boot, "
-     "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid"),
-    ("fig3", lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
-     "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
-     "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol"),
-    ("fig6", lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
-     "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'"),
-    ("resc", lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
-     "[scale.tiny.study] n_follow must be an integer, got '300'"),
-    ("fig5", lambda t: t.replace('summary = ', 'summry = ', 1),
-     "[about] unknown key 'summry' (did you mean 'summary'?); allowed keys: paper, setup, summary, title"),
-    ("fig4", lambda t: t.replace("\nmu_gamma = 0.01", "\n", 1),
-     "[study] needs 'mu_gamma'"),
-    ("fig5", lambda t: t.replace('sensitivity_momentum = "random"', 'sensitivity_momentum = "radial"', 1),
-     "[study] sensitivity_momentum must be one of 'random', got 'radial'"),
-    ("fig5", lambda t: t.replace("seed = 505", 'seed = 505\nmomentum = "radial"', 1),
-     "[scene] momentum must be one of 'tangential', 'random', got 'radial'"),
+    (
+        "fig1",
+        lambda t: t + '\n[sections]\nfirst_only = "no"\n',
+        "[sections] first_only must be true or false, got 'no'",
+    ),
+    ("fig3", lambda t: t.replace("seed = 2026 ", "seed = true ", 1), "[scene] seed must be an integer, got true"),
+    ("fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1), "[scene] energy must be a number, got '0.3'"),
+    (
+        "fig6",
+        lambda t: t.replace("[snapshots]", "[snapshot]", 1),
+        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
+        "[snapshots], [study], [system]",
+    ),
+    (
+        "fig3",
+        lambda t: t.replace("n_boot = 100 ", "n_bot = 100 ", 1),
+        "[study] needs 'n_boot'\nstudies/fig3/study.toml: [study] unknown key 'n_bot' (did you mean 'n_boot'?); allowed keys: alt_window, "
+        "authors_selection, authors_window, boot_seed, fit_window, hist_bins, hist_times, later_windows, n_boot, "
+        "n_boot_orbits, paper_mu, paper_mu_half_unit, plot_t_max, ribbon_t, sliding_window, snapshot_grid",
+    ),
+    (
+        "fig3",
+        lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
+        "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
+        "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol",
+    ),
+    (
+        "fig6",
+        lambda t: t.replace('by = "rate"', 'by = "speed"', 1),
+        "[study] mixtures[2].by must be one of 'energy', 'rate', got 'speed'",
+    ),
+    (
+        "resc",
+        lambda t: t.replace("n_follow = 300", 'n_follow = "300"', 1),
+        "[scale.tiny.study] n_follow must be an integer, got '300'",
+    ),
+    (
+        "fig5",
+        lambda t: t.replace("summary = ", "summry = ", 1),
+        "[about] unknown key 'summry' (did you mean 'summary'?); allowed keys: paper, setup, summary, title",
+    ),
+    ("fig4", lambda t: t.replace("\nmu_gamma = 0.01", "\n", 1), "[study] needs 'mu_gamma'"),
+    (
+        "fig5",
+        lambda t: t.replace('sensitivity_momentum = "random"', 'sensitivity_momentum = "radial"', 1),
+        "[study] sensitivity_momentum must be one of 'random', got 'radial'",
+    ),
+    (
+        "fig5",
+        lambda t: t.replace("seed = 505", 'seed = 505\nmomentum = "radial"', 1),
+        "[scene] momentum must be one of 'tangential', 'random', got 'radial'",
+    ),
 ]
 
 
@@ -85,27 +110,40 @@ def test_bad_study_file_exits_2_with_its_exact_message(name, edit, message, tmp_
 
 
 def test_every_problem_of_a_file_is_named_once(tmp_path, capsys, monkeypatch):
-    root = _study_root(tmp_path, "fig3", lambda t: t.replace("seed = 2026 ", "seed = true ", 1)
-                       .replace("tol = 1e-15", "tol = 1e-15\nt_mx = 3", 1))
+    root = _study_root(
+        tmp_path,
+        "fig3",
+        lambda t: t.replace("seed = 2026 ", "seed = true ", 1).replace("tol = 1e-15", "tol = 1e-15\nt_mx = 3", 1),
+    )
     rc, err = _run_study(root, "fig3", capsys, monkeypatch, tmp_path)
     assert rc == 2
     lines = err.splitlines()
     assert len(lines) == 2
     assert lines[0] == "hhscatter: error: studies/fig3/study.toml: [scene] seed must be an integer, got true"
-    assert lines[1].startswith("studies/fig3/study.toml: [scene] unknown key 't_mx' (did you mean 't_max'?); allowed keys: batch_size")
+    assert lines[1].startswith(
+        "studies/fig3/study.toml: [scene] unknown key 't_mx' (did you mean 't_max'?); allowed keys: batch_size"
+    )
 
 
 BAD_SCENE_FILES = [
-    ("[scene]\nenergy = 0.3\nn = 40\n[sections]\nfirst_only = \"no\"\n",
-     "[sections] first_only must be true or false, got 'no'"),
+    (
+        '[scene]\nenergy = 0.3\nn = 40\n[sections]\nfirst_only = "no"\n',
+        "[sections] first_only must be true or false, got 'no'",
+    ),
     ("[scene]\nenergy = 0.3\nn = 40\nseed = true\n", "[scene] seed must be an integer, got true"),
-    ("[scene]\nenergy = \"0.3\"\nn = 40\n", "[scene] energy must be a number or a list of numbers, got '0.3'"),
-    ("[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
-     "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots], [system]"),
-    ("[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",
-     "[snapshots] needs 'times' or all of start, stop and step"),
-    ("[scene]\nenergy = [0.3, 0.35]\nn = 40\ngamma = [0, true]\n",
-     "[scene] gamma must be a number or a list of numbers, got [0, true]"),
+    ('[scene]\nenergy = "0.3"\nn = 40\n', "[scene] energy must be a number or a list of numbers, got '0.3'"),
+    (
+        "[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
+        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots], [system]",
+    ),
+    (
+        "[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",
+        "[snapshots] needs 'times' or all of start, stop and step",
+    ),
+    (
+        "[scene]\nenergy = [0.3, 0.35]\nn = 40\ngamma = [0, true]\n",
+        "[scene] gamma must be a number or a list of numbers, got [0, true]",
+    ),
     ("[scene]\nenergy = 0.3\nn = 40\n[scale.paper]\nn = 1e7\n", "[scale.paper] n must be an integer, got 10000000.0"),
 ]
 
@@ -136,12 +174,18 @@ def test_text_for_a_number_is_refused_by_the_scene_itself():
 def test_a_refused_study_file_in_a_subprocess_prints_no_traceback(tmp_path):
     root = _study_root(tmp_path, "fig3", lambda t: t.replace("energy = 0.3 ", 'energy = "0.3" ', 1))
     env = {**os.environ, "HHSCATTER_STUDIES": str(root)}
-    r = subprocess.run([sys.executable, "-m", "hhscatter", "study", "fig3", "simulate", "--scale", "tiny"],
-                       cwd=tmp_path, env=env, capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "hhscatter", "study", "fig3", "simulate", "--scale", "tiny"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.strip() == "hhscatter: error: studies/fig3/study.toml: [scene] energy must be a number, got '0.3'"
-    assert _files(root) == sorted(["conventions.toml", "fig3", *(f"fig3/{p.name}" for p in (ROOT / "studies" / "fig3").iterdir()
-                                                                 if p.is_file())])
+    assert _files(root) == sorted(
+        ["conventions.toml", "fig3", *(f"fig3/{p.name}" for p in (ROOT / "studies" / "fig3").iterdir() if p.is_file())]
+    )
 
 
 def test_every_study_declares_its_study_table():
@@ -206,21 +250,27 @@ CONVENTION_CHANGED = {"fig5": {"r_esc": 1.03}, "fig6": {"r_esc": 1.03}}
 
 
 def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_checks(tmp_path):
-    if shutil.which("git") is None or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT,
-                                                     capture_output=True).returncode != 0:
+    if (
+        shutil.which("git") is None
+        or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT, capture_output=True).returncode != 0
+    ):
         pytest.skip(f"needs the git history with {BASE}")
     old = tmp_path / "old"
     old.mkdir()
-    archive = subprocess.run(["git", "archive", BASE, "hhscatter", "studies"], cwd=ROOT, capture_output=True,
-                             check=True).stdout
+    archive = subprocess.run(
+        ["git", "archive", BASE, "hhscatter", "studies"], cwd=ROOT, capture_output=True, check=True
+    ).stdout
     subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
     before = _scene_hashes(old, old)
     # the studies that existed then (a study added since, e.g. basins, has no earlier hash to keep)
     then = sorted({k.split("/")[0] for k in before})
     after = _scene_hashes(ROOT, tmp_path, only=then)
     # every old scene is still made; the only new ones are the runs added since, by name
-    added = {f"fig5/{scale}/{key}" for scale in ("quick", "tiny", "paper")
-             for key in ("5a_authors", "5b_authors", "5a_authors_random", "5b_authors_random")}
+    added = {
+        f"fig5/{scale}/{key}"
+        for scale in ("quick", "tiny", "paper")
+        for key in ("5a_authors", "5b_authors", "5a_authors_random", "5b_authors_random")
+    }
     assert set(before) <= set(after) and set(after) - set(before) == added
     after = {k: after[k] for k in before}
     # changed on purpose for the paper scale: fig1's pilot keeps its quick-scale size (it fixes t_rec).
@@ -234,8 +284,9 @@ def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_chec
     moved = {k.split("/")[0] for k in CONVENTION_CHANGED}
     assert {"fig1", "fig2", "fig3", "fig4", "resc"} <= set(then) and moved <= set(then)
     # every other study keeps every scene
-    assert {k: v for k, v in after.items() if k.split("/")[0] not in moved} == \
-        {k: v for k, v in before.items() if k.split("/")[0] not in moved}
+    assert {k: v for k, v in after.items() if k.split("/")[0] not in moved} == {
+        k: v for k, v in before.items() if k.split("/")[0] not in moved
+    }
     # fig5 and fig6: every scene changed, and by r_esc only (the old code with r_esc = 1.03 gives the new hashes)
     changed = {k for k in before if k.split("/")[0] in moved}
     assert changed and all(after[k] != before[k] for k in changed)
@@ -247,12 +298,14 @@ def test_the_engine_options_are_accepted_in_files(tmp_path):
     """sections.stop, [follow] radii and continue_settled pass the strict checks (and build their scenes)."""
     from hhscatter.scene.schema import load_scene
 
-    (tmp_path / "a.toml").write_text("[scene]\nenergy = 0.3\ngamma = 0.01\nn = 10\ncontinue_settled = true\n"
-                                     "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n"
-                                     "[sections]\nt_from = 2.0\nfirst_only = true\nstop = true\n")
+    (tmp_path / "a.toml").write_text(
+        "[scene]\nenergy = 0.3\ngamma = 0.01\nn = 10\ncontinue_settled = true\n"
+        "[snapshots]\nstart = 0\nstop = 10\nstep = 5\n"
+        "[sections]\nt_from = 2.0\nfirst_only = true\nstop = true\n"
+    )
     s = load_scene(tmp_path / "a.toml")
     assert s.continue_settled and s.sections.stop and s.snapshots == (0.0, 5.0, 10.0)
-    (tmp_path / "b.toml").write_text("[scene]\nenergy = 0.3\nn = 10\nregion = \"square\"\n[follow]\nradii = [1.0, 2.0]\n")
+    (tmp_path / "b.toml").write_text('[scene]\nenergy = 0.3\nn = 10\nregion = "square"\n[follow]\nradii = [1.0, 2.0]\n')
     assert load_scene(tmp_path / "b.toml").follow.radii == (1.0, 2.0)
 
 

@@ -1,4 +1,5 @@
 """A scene's system as data: the [system] table, its canonical form, the hash, the drag law."""
+
 import json
 import math
 
@@ -33,15 +34,18 @@ def test_quadratic_drag_is_another_scene_and_round_trips():
     assert again.result_hash() == quad.result_hash() and again.system == quad.system
 
 
-@pytest.mark.parametrize("spec, message", [
-    ({"name": "henon_heiles", "potential": "x**2"}, "exactly one of 'name'"),
-    ({}, "exactly one of 'name'"),
-    ({"name": "henon_heiles", "colour": 1}, "unknown [system] keys: ['colour']"),
-    ({"name": "henon_heiles", "dissipation": "cubic"}, "system.dissipation must be one of"),
-    ({"name": "henon_heiles", "params": {"lam": "one"}}, "system.params.lam must be a finite number"),
-    ({"name": "henon_heiles", "params": {"mu": 1.0}}, "henon_heiles has parameters ['lam', 'omega'], got ['mu']"),
-    ({"name": "henon_heiles", "params": {"lam": -1.0}}, "lam must be a finite number > 0"),
-])
+@pytest.mark.parametrize(
+    "spec, message",
+    [
+        ({"name": "henon_heiles", "potential": "x**2"}, "exactly one of 'name'"),
+        ({}, "exactly one of 'name'"),
+        ({"name": "henon_heiles", "colour": 1}, "unknown [system] keys: ['colour']"),
+        ({"name": "henon_heiles", "dissipation": "cubic"}, "system.dissipation must be one of"),
+        ({"name": "henon_heiles", "params": {"lam": "one"}}, "system.params.lam must be a finite number"),
+        ({"name": "henon_heiles", "params": {"mu": 1.0}}, "henon_heiles has parameters ['lam', 'omega'], got ['mu']"),
+        ({"name": "henon_heiles", "params": {"lam": -1.0}}, "lam must be a finite number > 0"),
+    ],
+)
 def test_bad_system_specs_name_the_key(spec, message):
     with pytest.raises(ConfigError, match=None) as exc:
         Scene(energy=0.3, n=10, system=spec)
@@ -55,8 +59,10 @@ def test_omega_and_lam_with_a_system_are_refused():
 
 def test_scene_file_system_table(tmp_path):
     f = tmp_path / "scene.toml"
-    f.write_text('[scene]\nenergy = 0.3\nn = 10\ngamma = 0.01\n[system]\nname = "henon_heiles"\n'
-                 'dissipation = "quadratic"\n[system.params]\nlam = 1.0\n')
+    f.write_text(
+        '[scene]\nenergy = 0.3\nn = 10\ngamma = 0.01\n[system]\nname = "henon_heiles"\n'
+        'dissipation = "quadratic"\n[system.params]\nlam = 1.0\n'
+    )
     s = load_scene(f)
     assert s.system["dissipation"] == "quadratic" and s.model.lam == 1.0
     f.write_text('[scene]\nenergy = 0.3\nn = 10\n[system]\nname = "henon_heiles"\ndrag = "linear"\n')
@@ -69,7 +75,10 @@ def test_scene_file_system_table(tmp_path):
 
 def test_canonical_spec_writes_every_parameter_as_a_float():
     assert canonical_spec({"potential": " x**2 + y**2 ", "params": {"b": 2, "a": 1}}) == {
-        "potential": "x**2 + y**2", "params": {"a": 1.0, "b": 2.0}, "dissipation": "linear"}
+        "potential": "x**2 + y**2",
+        "params": {"a": 1.0, "b": 2.0},
+        "dissipation": "linear",
+    }
 
 
 def test_default_escape_radius_comes_from_the_system():
@@ -109,8 +118,11 @@ def test_drag_laws_against_an_independent_integrator(dissipation):
 
 
 def test_exits_and_critical_energy_can_be_given_and_are_checked():
-    spec = {"potential": "0.5*(x**2 + y**2) - eps*x**2*y**2", "params": {"eps": 0.25},
-            "exits": [[2**0.5, 2**0.5], [-(2**0.5), 2**0.5], [-(2**0.5), -(2**0.5)], [2**0.5, -(2**0.5)]]}
+    spec = {
+        "potential": "0.5*(x**2 + y**2) - eps*x**2*y**2",
+        "params": {"eps": 0.25},
+        "exits": [[2**0.5, 2**0.5], [-(2**0.5), 2**0.5], [-(2**0.5), -(2**0.5)], [2**0.5, -(2**0.5)]],
+    }
     s = Scene(energy=1.5, n=10, system=spec)
     assert len(s.model.exits) == 4 and s.model.critical_energy == pytest.approx(1.0, rel=1e-12)
     assert s.system["exits"][0] == [2**0.5, 2**0.5]

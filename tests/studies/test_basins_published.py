@@ -11,6 +11,7 @@
   D = ln 2/ln 3, so α = 1 − ln 2/ln 3 = 0.369, and nearby points separate at
   the rate λ = ln 3 per step (the decision time grows as ln(1/ε)/ln 3).
 """
+
 from __future__ import annotations
 
 import math
@@ -30,14 +31,14 @@ def newton3(z, iterations=40):
     """Index of the root of z³ = 1 that Newton's method reaches from z."""
     z = np.asarray(z, dtype=complex)
     for _ in range(iterations):
-        z = z - (z ** 3 - 1) / (3 * z ** 2)
+        z = z - (z**3 - 1) / (3 * z**2)
     return np.argmin(np.abs(z[..., None] - ROOTS3), axis=-1)
 
 
 def newton2(z, iterations=40):
     z = np.asarray(z, dtype=complex)
     for _ in range(iterations):
-        z = z - (z ** 2 - 1) / (2 * z)
+        z = z - (z**2 - 1) / (2 * z)
     return (z.real > 0).astype(int)
 
 
@@ -63,7 +64,7 @@ def uncertainty_counts(outcome, eps, n, seed):
 
 def test_newton_z3_box_counting_dimension_is_published_value(newton_map):
     bc = B.box_counting_dimension(newton_map, (8, 16, 32, 64))
-    assert abs(bc.D - 1.42) < 0.06, bc            # measured 1.39 ± 0.03 on 512²
+    assert abs(bc.D - 1.42) < 0.06, bc  # measured 1.39 ± 0.03 on 512²
     # the straight boundary of z² = 1 has dimension 1
     assert abs(B.box_counting_dimension(newton2(grid(128) + 2 / 128), (2, 4, 8, 16)).D - 1.0) < 0.02
 
@@ -73,7 +74,7 @@ def test_newton_z3_uncertainty_dimension_and_local_exponent():
     n = 20000
     k = uncertainty_counts(newton3, eps, n, seed=1)
     fit = U.uncertainty_exponent(eps, k / n, n)
-    assert abs(fit.d - 1.42) < 3 * fit.d_err + 0.01, fit   # measured d = 1.435 ± 0.008
+    assert abs(fit.d - 1.42) < 3 * fit.d_err + 0.01, fit  # measured d = 1.435 ± 0.008
     loc = U.local_exponent(eps, k, n)
     ok = np.isfinite(loc.d)
     # one power law: every local dimension within 3σ of the published value, no slim fractal
@@ -92,7 +93,7 @@ def test_newton_z2_smooth_boundary_has_alpha_one():
 def test_newton_z3_is_wada_with_sbb_above_log2(newton_map):
     assert B.wada_merging(newton_map).wada
     ent = B.basin_entropy(newton_map, 5)
-    assert ent.log2_fractal and ent.S_bb > math.log(2), ent      # measured 0.715 ± 0.009 (box 5, 512²)
+    assert ent.log2_fractal and ent.S_bb > math.log(2), ent  # measured 0.715 ± 0.009 (box 5, 512²)
 
 
 def triadic(x, iterations=45):
@@ -122,7 +123,7 @@ def test_open_triadic_map_cantor_exponent_and_lyapunov_rate():
         k.append(int(ch.sum()))
         times.append(np.fmin(ta, tb)[ch])
     fit = U.uncertainty_exponent(eps, np.array(k) / n, n)
-    assert abs(fit.alpha - (1 - math.log(2) / math.log(3))) < 0.04, fit   # Cantor set: log-periodic wiggles
+    assert abs(fit.alpha - (1 - math.log(2) / math.log(3))) < 0.04, fit  # Cantor set: log-periodic wiggles
     rate = C.decision_rate(eps, times)
     assert abs(rate.lam / math.log(3) - 1) < 0.1, rate
 
@@ -131,7 +132,7 @@ def test_local_exponent_errors_cover_on_synthetic_binomial_data():
     """1σ intervals of α(ε) cover the true local exponent in ≈ 68 % of replicates."""
     rng = np.random.default_rng(4)
     eps = np.array([1e-2, 1e-3, 1e-4, 1e-5])
-    f_true = np.array([0.05, 0.02, 0.004, 0.0005])          # a bending law: α(ε) 0.40, 0.70, 0.90
+    f_true = np.array([0.05, 0.02, 0.004, 0.0005])  # a bending law: α(ε) 0.40, 0.70, 0.90
     a_true = np.log(f_true[1:] / f_true[:-1]) / np.log(eps[1:] / eps[:-1])
     hits = []
     for _ in range(400):

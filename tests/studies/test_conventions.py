@@ -1,4 +1,5 @@
 """The shared conventions (studies/conventions.toml): declared once, inherited by the figure studies, strictly checked."""
+
 from __future__ import annotations
 
 import re
@@ -64,16 +65,26 @@ def test_a_study_file_with_a_convention_is_the_merged_scene():
 
 REFUSED = [
     # (edit of fig3's study.toml, what the message must say)
-    (lambda t: t.replace('convention = "paper"', 'convention = "papr"', 1),
-     "studies/fig3/study.toml: unknown convention 'papr'; conventions in "),
-    (lambda t: t.replace('convention = "paper"', 'conventon = "paper"', 1),
-     "studies/fig3/study.toml: unknown key 'conventon' (did you mean 'convention'?) before the first table; allowed keys there: convention"),
-    (lambda t: t.replace('convention = "paper"', 'convention = 1', 1),
-     "studies/fig3/study.toml: convention must be a string (in quotes), got 1"),
-    (lambda t: t.replace("seed = 2026 ", "r_esc = 1.5\nseed = 2026 ", 1),
-     "studies/fig3/study.toml: [scene] r_esc is set by convention 'paper' ("),
-    (lambda t: t.replace("[scale.tiny.scene]\n", "[scale.tiny.scene]\nradius = 0.4\n", 1),
-     "studies/fig3/study.toml: [scale.tiny.scene] radius is set by convention 'paper' ("),
+    (
+        lambda t: t.replace('convention = "paper"', 'convention = "papr"', 1),
+        "studies/fig3/study.toml: unknown convention 'papr'; conventions in ",
+    ),
+    (
+        lambda t: t.replace('convention = "paper"', 'conventon = "paper"', 1),
+        "studies/fig3/study.toml: unknown key 'conventon' (did you mean 'convention'?) before the first table; allowed keys there: convention",
+    ),
+    (
+        lambda t: t.replace('convention = "paper"', "convention = 1", 1),
+        "studies/fig3/study.toml: convention must be a string (in quotes), got 1",
+    ),
+    (
+        lambda t: t.replace("seed = 2026 ", "r_esc = 1.5\nseed = 2026 ", 1),
+        "studies/fig3/study.toml: [scene] r_esc is set by convention 'paper' (",
+    ),
+    (
+        lambda t: t.replace("[scale.tiny.scene]\n", "[scale.tiny.scene]\nradius = 0.4\n", 1),
+        "studies/fig3/study.toml: [scale.tiny.scene] radius is set by convention 'paper' (",
+    ),
 ]
 
 
@@ -85,12 +96,18 @@ def test_a_bad_convention_exits_2_naming_it(edit, message, tmp_path, capsys, mon
     assert err.startswith("hhscatter: error: " + message), err
 
 
-@pytest.mark.parametrize("text, message", [
-    ('[paper]\nregion = "disk"\nradius = 0.5\nr_ecs = 1.03\n', "[paper] unknown key 'r_ecs' (did you mean 'r_esc'?); allowed keys: "),
-    ('[paper]\nr_esc = "1.03"\n', "[paper] r_esc must be a number, got '1.03'"),
-    ('[paper]\nregion = "disc"\n', "[paper] region must be one of "),
-    ('paper = 1.03\n', "[paper] must be a table, got 1.03"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            '[paper]\nregion = "disk"\nradius = 0.5\nr_ecs = 1.03\n',
+            "[paper] unknown key 'r_ecs' (did you mean 'r_esc'?); allowed keys: ",
+        ),
+        ('[paper]\nr_esc = "1.03"\n', "[paper] r_esc must be a number, got '1.03'"),
+        ('[paper]\nregion = "disc"\n', "[paper] region must be one of "),
+        ("paper = 1.03\n", "[paper] must be a table, got 1.03"),
+    ],
+)
 def test_a_bad_conventions_file_exits_2_naming_the_key(text, message, tmp_path, capsys, monkeypatch):
     root = _study_root(tmp_path, "fig3", lambda t: t + "\n")
     (root / "conventions.toml").write_text(text)

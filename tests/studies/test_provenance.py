@@ -1,6 +1,7 @@
 """A study's numbers JSON records what it was made from and its own hash; the plot stage, a downstream analyze
 and the report refuse numbers that were edited or are stale (naming the file), and `make report` tracks what the
 report reads at every scale."""
+
 import json
 import shutil
 import subprocess
@@ -9,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from hhscatter.errors import StudyError
-from hhscatter.publish.report import build_report, main as report_main
+from hhscatter.publish.report import build_report
+from hhscatter.publish.report import main as report_main
 from hhscatter.studies import run_stage
 from hhscatter.studies.provenance import ProvenanceError, config_sha256, content_sha256, sealed, verify_numbers
 
@@ -18,8 +20,15 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _doc(**extra):
     config = {"scene": {"energy": 0.3}, "study": {"fit_window": [0.0, 200.0]}}
-    return sealed({"study": "x", "mu": {"value": 0.9287, "err": 0.001}, "config": config,
-                   "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}, **extra}), config
+    return sealed(
+        {
+            "study": "x",
+            "mu": {"value": 0.9287, "err": 0.001},
+            "config": config,
+            "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}},
+            **extra,
+        }
+    ), config
 
 
 def test_a_sealed_document_verifies_and_any_change_of_a_value_is_seen(tmp_path):
@@ -30,8 +39,13 @@ def test_a_sealed_document_verifies_and_any_change_of_a_value_is_seen(tmp_path):
     with pytest.raises(ProvenanceError, match=r"x.json was edited after it was written"):
         verify_numbers(tmp_path / "x.json", edited, config=config, scale="quick", upstream={})
     with pytest.raises(ProvenanceError, match=r"x.json is stale: the study's configuration at scale quick"):
-        verify_numbers(tmp_path / "x.json", doc, config={**config, "study": {"fit_window": [0.0, 100.0]}},
-                       scale="quick", upstream={})
+        verify_numbers(
+            tmp_path / "x.json",
+            doc,
+            config={**config, "study": {"fit_window": [0.0, 100.0]}},
+            scale="quick",
+            upstream={},
+        )
     bare = {k: v for k, v in doc.items() if k not in ("sha256", "made_from")}
     with pytest.raises(ProvenanceError, match="carries no record of what it was made from"):
         verify_numbers(tmp_path / "x.json", bare, config=config, scale="quick", upstream={})
@@ -40,13 +54,24 @@ def test_a_sealed_document_verifies_and_any_change_of_a_value_is_seen(tmp_path):
 def test_numbers_made_from_another_upstream_json_are_stale(tmp_path):
     up, _ = _doc()
     config = {"scene": {}}
-    down = sealed({"config": config, "made_from": {"config_sha256": config_sha256(config),
-                                                   "upstream": {"up": content_sha256(up)}, "raw_runs": {}}})
-    verify_numbers(tmp_path / "down.json", down, config=config, scale="quick", upstream={"up": (tmp_path / "up.json", up)})
+    down = sealed(
+        {
+            "config": config,
+            "made_from": {
+                "config_sha256": config_sha256(config),
+                "upstream": {"up": content_sha256(up)},
+                "raw_runs": {},
+            },
+        }
+    )
+    verify_numbers(
+        tmp_path / "down.json", down, config=config, scale="quick", upstream={"up": (tmp_path / "up.json", up)}
+    )
     newer = sealed({**up, "mu": {"value": 0.93, "err": 0.001}})  # up analyzed again since
     with pytest.raises(ProvenanceError, match=r"down.json is stale: it was made from another up.json"):
-        verify_numbers(tmp_path / "down.json", down, config=config, scale="quick",
-                       upstream={"up": (tmp_path / "up.json", newer)})
+        verify_numbers(
+            tmp_path / "down.json", down, config=config, scale="quick", upstream={"up": (tmp_path / "up.json", newer)}
+        )
 
 
 @pytest.fixture
@@ -118,14 +143,15 @@ def test_a_committed_result_made_from_another_upstream_copy_is_refused(tmp_path)
     doc = json.loads((assets / "fig3.json").read_text())
     doc["mu"]["value"] = 0.9100
     (assets / "fig3.json").write_text(json.dumps(sealed(doc), indent=2))  # fig3 made again, its readers not
-    with pytest.raises(ProvenanceError, match=r"(fig5|fig6|basins|fig4).json is stale: it was made from another fig3.json"):
+    with pytest.raises(
+        ProvenanceError, match=r"(fig5|fig6|basins|fig4).json is stale: it was made from another fig3.json"
+    ):
         build_report("paper", out=tmp_path / "rep", root=root)
 
 
 def _make_n(*args):
     """What `make report` would run from scratch (-B: as if nothing were made; -n: nothing is run)."""
-    return subprocess.run(["make", "-n", "-B", "report", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120)
+    return subprocess.run(["make", "-n", "-B", "report", *args], cwd=ROOT, capture_output=True, text=True, timeout=120)
 
 
 def test_make_report_runs_the_studies_of_a_scale_without_committed_results_and_refuses_an_unknown_one():
@@ -134,8 +160,7 @@ def test_make_report_runs_the_studies_of_a_scale_without_committed_results_and_r
     tiny = _make_n("SCALE=tiny")  # the report reads studies/*/out/tiny: it makes them
     assert "hhscatter study fig3 plot --scale tiny" in tiny.stdout, tiny.stdout + tiny.stderr
     assert "hhscatter.publish.report --scale tiny" in tiny.stdout
-    bad = subprocess.run(["make", "report", "SCALE=nonexistent"], cwd=ROOT, capture_output=True, text=True,
-                         timeout=120)
+    bad = subprocess.run(["make", "report", "SCALE=nonexistent"], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "SCALE=nonexistent is not a scale of the studies" in bad.stderr
     paper = _make_n("SCALE=paper")
     assert "hhscatter study" not in paper.stdout  # the committed results: no simulation

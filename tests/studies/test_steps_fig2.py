@@ -1,5 +1,6 @@
 """Study fig2's comparison of κ and τ* with the paper (its law of Fig. 2b per regime, the two definitions of τ*) on
 synthetic input with a known answer."""
+
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -29,10 +30,10 @@ def test_compare_pt_uses_the_paper_law_of_each_regime_and_no_tail_rows_without_a
     st = _Recorder()
     E_C = 1.0 / 6.0
     no_tail = SimpleNamespace(tail=None)
-    mod.compare_pt(st, 0.25, _fit_result(), no_tail, E_C)   # below E_b = 0.27: a x² + b x
-    mod.compare_pt(st, 0.30, _fit_result(), no_tail, E_C)   # above: c x
+    mod.compare_pt(st, 0.25, _fit_result(), no_tail, E_C)  # below E_b = 0.27: a x² + b x
+    mod.compare_pt(st, 0.30, _fit_result(), no_tail, E_C)  # above: c x
     x1, x2 = 0.25 - E_C, 0.30 - E_C
-    assert [r["paper"] for r in st.rows] == pytest.approx([13.63 * x1 ** 2 + 0.03 * x1, 1.41 * x2])
+    assert [r["paper"] for r in st.rows] == pytest.approx([13.63 * x1**2 + 0.03 * x1, 1.41 * x2])
     assert [r["quantity"] for r in st.rows] == ["kappa(E0=0.25) [Fig. 2a]", "kappa(E0=0.30) [Fig. 2a]"]
 
 

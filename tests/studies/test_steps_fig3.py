@@ -1,5 +1,6 @@
 """Steps of study fig3's analysis (the window chooser, the paper's fit, the bootstrap errors, the histogram rows)
 on synthetic input with a known answer."""
+
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -14,11 +15,20 @@ mod = stage_module("fig3")
 
 
 def test_fit_windows_paper_later_sliding_alt_in_order():
-    windows, kinds = mod._fit_windows((0.0, 200.0), [(200.0, 400.0), (400.0, 600.0)], [100.0, 50.0],
-                                      (0.0, 100.0), 260.0)
+    windows, kinds = mod._fit_windows(
+        (0.0, 200.0), [(200.0, 400.0), (400.0, 600.0)], [100.0, 50.0], (0.0, 100.0), 260.0
+    )
     # sliding windows start at 0, 50, 100, 150 (the last one, [150, 250], still ends by t_last = 260)
-    assert windows == [(0.0, 200.0), (200.0, 400.0), (400.0, 600.0), (0.0, 100.0), (50.0, 150.0),
-                       (100.0, 200.0), (150.0, 250.0), (0.0, 100.0)]
+    assert windows == [
+        (0.0, 200.0),
+        (200.0, 400.0),
+        (400.0, 600.0),
+        (0.0, 100.0),
+        (50.0, 150.0),
+        (100.0, 200.0),
+        (150.0, 250.0),
+        (0.0, 100.0),
+    ]
     assert kinds == ["paper", "later", "later"] + ["sliding"] * 4 + ["alt"]
 
 
@@ -68,8 +78,13 @@ def test_bootstrap_errors_are_the_replicates_std_times_scale_per_window():
 def test_histogram_rows_density_integrates_to_one_in_log10_E():
     edges = np.array([0.01, 0.1, 1.0, 100.0])  # Δlog10 E = 1, 1, 2
     counts = np.array([[2, 6, 2], [0, 0, 0]])
-    h = SimpleNamespace(t_requested=np.array([10.0, 20.0]), t=np.array([10.5, 19.5]), counts=counts,
-                        n_alive=np.array([10, 0]), mean_E=np.array([0.5, np.nan]))
+    h = SimpleNamespace(
+        t_requested=np.array([10.0, 20.0]),
+        t=np.array([10.5, 19.5]),
+        counts=counts,
+        n_alive=np.array([10, 0]),
+        mean_E=np.array([0.5, np.nan]),
+    )
     rows = mod._histogram_rows(h, edges)
     assert len(rows) == 6
     first = rows[rows["t"] == 10.5]

@@ -1,5 +1,6 @@
 """Steps of study fig6's comparison with the paper (τ1/τ2 observed vs predicted, the mixture against the homogeneous
 model) on synthetic tables with a known answer."""
+
 from __future__ import annotations
 
 import math
@@ -23,9 +24,16 @@ class _Recorder:
 
 
 def test_compare_taus_relative_differences_and_skips_what_was_not_observed():
-    taus = pd.DataFrame({"gamma": [0.01, 0.02], "tau2_observed": [110.0, math.nan], "tau2_predicted": [100.0, 50.0],
-                         "tau1_observed": [50.0, 40.0], "tau1_pred_paper": [60.0, 30.0],
-                         "tau1_pred_integrated": [math.nan, 42.0]})
+    taus = pd.DataFrame(
+        {
+            "gamma": [0.01, 0.02],
+            "tau2_observed": [110.0, math.nan],
+            "tau2_predicted": [100.0, 50.0],
+            "tau1_observed": [50.0, 40.0],
+            "tau1_pred_paper": [60.0, 30.0],
+            "tau1_pred_integrated": [math.nan, 42.0],
+        }
+    )
     st = _Recorder()
     mod._compare_taus(st, taus, ["paper", "integrated"])
     got = [(r["quantity"], r["ours"], r["verdict"]) for r in st.rows]
@@ -43,17 +51,21 @@ def _cmps(rms, aic, hazard):
     rows = []
     for pair in rms:
         for k, model in enumerate(("homogeneous", "mixture_tau0")):
-            rows.append({"pair": pair, "model": model, "hazard": hazard, "rms_log_residual": rms[pair][k],
-                         "aic": aic[pair][k]})
+            rows.append(
+                {"pair": pair, "model": model, "hazard": hazard, "rms_log_residual": rms[pair][k], "aic": aic[pair][k]}
+            )
     return rows
 
 
 def test_compare_mixtures_counts_pairs_where_the_mixture_fits_better():
     cmps = pd.DataFrame(
         _cmps({"A": (0.2, 0.1), "B": (0.1, 0.3)}, {"A": (5.0, 7.0), "B": (5.0, 4.0)}, "paper")
-        + _cmps({"A": (0.2, 0.1), "B": (0.3, 0.25)}, {"A": (5.0, 4.0), "B": (5.0, 6.0)}, "integrated"))
-    s = SimpleNamespace(hazards=["paper", "integrated"],
-                        mixtures=[{"name": "mixture_tau0", "by": "energy", "t_ref": "tau0", "fne_mode": "shared"}])
+        + _cmps({"A": (0.2, 0.1), "B": (0.3, 0.25)}, {"A": (5.0, 4.0), "B": (5.0, 6.0)}, "integrated")
+    )
+    s = SimpleNamespace(
+        hazards=["paper", "integrated"],
+        mixtures=[{"name": "mixture_tau0", "by": "energy", "t_ref": "tau0", "fne_mode": "shared"}],
+    )
     st = _Recorder()
     mod._compare_mixtures(st, s, cmps)
     assert [(r["ours"], r["verdict"]) for r in st.rows] == [("1 (1) of 2", "differs"), ("2 (1) of 2", "agrees")]

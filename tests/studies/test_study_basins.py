@@ -1,4 +1,5 @@
 """End-to-end test of the study ``basins`` at SCALE=tiny (built in graph order by conftest's tiny_studies)."""
+
 from __future__ import annotations
 
 import json
@@ -46,8 +47,9 @@ def test_basins_tiny_end_to_end(tiny_studies):
         if p["gamma"] == 0:
             assert p["wada_exits"] is None or p["wada_exits"]["basins"] == ["exit 0", "exit 1", "exit 2"]
     recs = nums["cutoff_prediction"]
-    assert {(r["E0"], r["gamma"]) for r in recs} == {(p["energy"], p["gamma"]) for p in nums["per_point"]
-                                                      if p["gamma"] > 0}
+    assert {(r["E0"], r["gamma"]) for r in recs} == {
+        (p["energy"], p["gamma"]) for p in nums["per_point"] if p["gamma"] > 0
+    }
     for r in recs:
         assert {"E0", "gamma", "eps_c", "eps_c_err", "eps_c_predicted"} <= set(r)
         assert 0 <= r["eps_c_predicted"] < 1

@@ -1,4 +1,5 @@
 """The cost record of a study stage (hhscatter.studies.cost): CPU of children counted, invocations added."""
+
 import json
 import multiprocessing as mp
 
@@ -34,8 +35,14 @@ def test_record_adds_resumed_invocations_and_a_fresh_run_replaces_them(tmp_path)
     record(tmp_path, StageCost("analyze", wall_s=4, cpu_s=4))
     record(tmp_path, StageCost("analyze", wall_s=3, cpu_s=3))  # analyze starts over: the last one counts
     t = totals(json.loads((tmp_path / "cost.json").read_text()))
-    assert t["simulate"] == {"wall_s": 15, "cpu_s": 27, "orbits": 150, "rss_self_mb": 250,
-                             "rss_children_mb": 300, "invocations": 2}
+    assert t["simulate"] == {
+        "wall_s": 15,
+        "cpu_s": 27,
+        "orbits": 150,
+        "rss_self_mb": 250,
+        "rss_children_mb": 300,
+        "invocations": 2,
+    }
     assert t["analyze"]["invocations"] == 1 and t["analyze"]["cpu_s"] == 3
     record(tmp_path, StageCost("simulate", wall_s=1, cpu_s=2, orbits=7))  # a fresh run: nothing resumed
     t = totals(json.loads((tmp_path / "cost.json").read_text()))
@@ -51,8 +58,10 @@ def test_streamed_table_is_one_file_with_a_row_group_per_part(tmp_path):
     from hhscatter.data.write import write_parts_streamed
 
     dic = pa.dictionary(pa.int8(), pa.string())
-    parts = [pa.table({"g": pa.array([0.0, 0.0]), "o": pa.array(["escaped", "censored"]).cast(dic)}),
-             pa.table({"g": pa.array([1.0]), "o": pa.array(["settled"]).cast(dic)})]
+    parts = [
+        pa.table({"g": pa.array([0.0, 0.0]), "o": pa.array(["escaped", "censored"]).cast(dic)}),
+        pa.table({"g": pa.array([1.0]), "o": pa.array(["settled"]).cast(dic)}),
+    ]
     path = tmp_path / "t.parquet"
     assert write_parts_streamed(path, iter(parts), {"study": "x"}) == 3
     f = pq.ParquetFile(path)

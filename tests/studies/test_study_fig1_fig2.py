@@ -6,6 +6,7 @@ temporary studies root and check the outputs against physics that the code
 does not impose (κ from two independent estimators, energy conservation on
 the section, the sign and size of κ).
 """
+
 import json
 import math
 import warnings
@@ -115,13 +116,13 @@ def test_escaping_tail_finds_no_tail_in_a_pure_exponential():
 # ---------------------------------------------------------------------------
 def test_cmeasure_sample_drops_censored_orbits():
     sections = pd.DataFrame({"traj_id": [1, 1, 1, 2, 2, 2, 3], "t": [10.0, 16.0, 23.0, 11.0, 14.0, 17.0, 12.0]})
-    lifetimes = pd.DataFrame({"traj_id": [1, 2, 3], "outcome": ["escaped", "censored", "escaped"],
-                              "t_end": [25.0, 5000.0, 13.0]})
+    lifetimes = pd.DataFrame(
+        {"traj_id": [1, 2, 3], "outcome": ["escaped", "censored", "escaped"], "t_end": [25.0, 5000.0, 13.0]}
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         T_all, ne_all, nu_all = cmeasure_sample_from_sections(sections, lifetimes, 10.0, 20.0, t_record_end=40.0)
-    T, ne, nu = cmeasure_sample_from_sections(sections, lifetimes, 10.0, 20.0, t_record_end=40.0,
-                                              drop_censored=True)
+    T, ne, nu = cmeasure_sample_from_sections(sections, lifetimes, 10.0, 20.0, t_record_end=40.0, drop_censored=True)
     np.testing.assert_allclose(np.sort(T), [6.0, 7.0])
     assert (ne, nu) == (1, 0)
     # without dropping, orbit 2's crossings at 11 and 14 return (3, 3) and its last one (17) is undetermined
@@ -130,8 +131,14 @@ def test_cmeasure_sample_drops_censored_orbits():
 
 
 def test_lifetimes_to_arrays_accepts_rounding_in_e0_but_not_two_ensembles():
-    base = pd.DataFrame({"t_end": [1.0, 2.0, 3.0], "outcome": ["escaped", "censored", "escaped"],
-                         "e0": 0.3 + np.array([0.0, 5.5e-17, -5.5e-17]), "gamma": 0.0})
+    base = pd.DataFrame(
+        {
+            "t_end": [1.0, 2.0, 3.0],
+            "outcome": ["escaped", "censored", "escaped"],
+            "e0": 0.3 + np.array([0.0, 5.5e-17, -5.5e-17]),
+            "gamma": 0.0,
+        }
+    )
     _, obs = lifetimes_to_arrays(base)
     np.testing.assert_array_equal(obs, [True, False, True])
     with pytest.raises(ValueError, match="e0"):
@@ -173,8 +180,8 @@ def _finite_numbers(obj):
 
 
 def test_fig1_tiny_end_to_end(tiny_root):
-    from hhscatter.studies import load_study
     from hhscatter.data.read import read_sections
+    from hhscatter.studies import load_study
 
     study = load_study("fig1", "tiny", root=tiny_root)
     assert study.figure_path.stat().st_size > 20_000
@@ -244,8 +251,8 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
     the P-level windows sit at the P levels of the run's own Kaplan–Meier curve, the law rows use only stable
     energies, and the analysis gives the same numbers twice."""
     from hhscatter.analysis.survival.fits import lifetimes_to_arrays, survival_curve
-    from hhscatter.studies import load_study, run_stage
     from hhscatter.data.read import read_lifetimes
+    from hhscatter.studies import load_study, run_stage
 
     study = load_study("fig2", "tiny", root=tiny_root)
     doc = json.loads(study.numbers_path.read_text())
@@ -255,8 +262,9 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
         disk = json.loads((study.raw(f"grid_E{e:.3f}") / "scene.json").read_text())["scene"]
         sq = json.loads((study.raw(f"sq_grid_E{e:.3f}") / "scene.json").read_text())["scene"]
         assert sq["region"] == "square" and disk["region"] == "disk"
-        assert {k: v for k, v in sq.items() if k not in ("region", "name")} == \
-            {k: v for k, v in disk.items() if k not in ("region", "name")}
+        assert {k: v for k, v in sq.items() if k not in ("region", "name")} == {
+            k: v for k, v in disk.items() if k not in ("region", "name")
+        }
         # P-level window: starts where the square run's own KM curve first falls to 0.5
         t_end, obs = lifetimes_to_arrays(read_lifetimes(study.raw(f"sq_grid_E{e:.3f}")))
         row = table[(table["energy"] == e) & (table["convention"] == "square_plevel")].iloc[0]
@@ -295,8 +303,7 @@ def test_power_law_exponent_mle_recovers_pareto_exponent():
 def test_fig2_paper_n_per_energy_is_declared_per_grid_energy():
     """The paper scale's κ(E) runs: N per energy from grid_n_by_energy (same order as grid_energies); a list of
     the wrong length is refused by name."""
-    from hhscatter.studies import load_study
-    from hhscatter.studies import stage_module
+    from hhscatter.studies import load_study, stage_module
 
     grid_n = stage_module("fig2").grid_n
 

@@ -1,5 +1,6 @@
 """Studies fig3 (energy decay, μ) and fig4 (P(t) vs γ, τ0/τ1/τ2): analysis additions on synthetic data
 with known answers, and tiny end-to-end runs checked against direct counts from the raw tables."""
+
 from __future__ import annotations
 
 import json
@@ -10,12 +11,12 @@ import pandas as pd
 import pytest
 
 from hhscatter.analysis.dissipative.decay import bootstrap_mu
-from hhscatter.analysis.survival.fits import survival_curve
 from hhscatter.analysis.dissipative.transitions import (
     bootstrap_transition_times,
     settle_time_quantiles,
     survival_on_grid,
 )
+from hhscatter.analysis.survival.fits import survival_curve
 
 ROOT = Path(__file__).resolve().parents[2]
 E_C = 1.0 / 6.0
@@ -93,8 +94,9 @@ def test_survival_on_grid_matches_kaplan_meier_and_weights():
     cidx = rng.choice(n, 300, replace=False)
     t_end[cidx] = rng.choice(grid[1:], 300)
     observed[cidx] = False
-    np.testing.assert_allclose(survival_on_grid(t_end, observed, grid), survival_curve(t_end, observed, grid).P,
-                               rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        survival_on_grid(t_end, observed, grid), survival_curve(t_end, observed, grid).P, rtol=1e-12, atol=1e-15
+    )
     # integer weights = replicated orbits; without censoring P is the weighted fraction with t_end > t
     w = rng.integers(0, 4, n).astype(float)
     obs = np.ones(n, bool)
@@ -224,15 +226,19 @@ def test_fig3_mu_verdict_rule():
 
     mu_verdict, verdict_beside_authors = stage_module("fig3").mu_verdict, stage_module("fig3").verdict_beside_authors
 
-    assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"           # |Δ| = 0.0005 ≤ 2σ
+    assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"  # |Δ| = 0.0005 ≤ 2σ
     assert mu_verdict(0.9139, 0.0005, 0.91, 0.005) == "agrees to the paper's quoted digits"  # prints as 0.91
-    assert mu_verdict(0.9139, 0.0005, 0.91, 0.0) == "differs"                       # 7.8σ, no rounding allowed
-    assert mu_verdict(0.9393, 0.0004, 0.91, 0.005) == "differs"                     # 0.029 ≫ 2σ + 0.005
-    assert mu_verdict(0.93, 0.0101, 0.91, 0.0) == "agrees within 2σ"                # |Δ| = 0.02 ≤ 0.0202
-    rows = [{"label": "inside, fit [0, 100]", "verdict": "agrees within 2σ"},
-            {"label": "above, fit [0, 200]", "verdict": "differs"}]
-    assert verdict_beside_authors("differs", rows) == \
-        "differs in our convention only; agrees under the authors' (inside, fit [0, 100])"
+    assert mu_verdict(0.9139, 0.0005, 0.91, 0.0) == "differs"  # 7.8σ, no rounding allowed
+    assert mu_verdict(0.9393, 0.0004, 0.91, 0.005) == "differs"  # 0.029 ≫ 2σ + 0.005
+    assert mu_verdict(0.93, 0.0101, 0.91, 0.0) == "agrees within 2σ"  # |Δ| = 0.02 ≤ 0.0202
+    rows = [
+        {"label": "inside, fit [0, 100]", "verdict": "agrees within 2σ"},
+        {"label": "above, fit [0, 200]", "verdict": "differs"},
+    ]
+    assert (
+        verdict_beside_authors("differs", rows)
+        == "differs in our convention only; agrees under the authors' (inside, fit [0, 100])"
+    )
     assert verdict_beside_authors("differs", rows[1:]) == "differs"  # the difference survives their convention
     assert verdict_beside_authors("differs", []) == "differs"
     assert verdict_beside_authors("agrees within 2σ", rows) == "agrees within 2σ"
@@ -252,8 +258,10 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
     snap = read_snapshots(raw).merge(lt[["traj_id", "t_end", "outcome"]], on="traj_id")
     continued = (snap["outcome"] == "settled") & (snap["t"] > snap["t_end"])
     assert continued.sum() > 100  # the selections differ on this run (18 settled orbits at scale tiny)
-    direct = {"inside": snap.groupby("t")["energy"].agg(["size", "mean"]),
-              "above": snap[~continued].groupby("t")["energy"].agg(["size", "mean"])}
+    direct = {
+        "inside": snap.groupby("t")["energy"].agg(["size", "mean"]),
+        "above": snap[~continued].groupby("t")["energy"].agg(["size", "mean"]),
+    }
     me = pd.read_parquet(out / "derived" / "fig3_mean_energy.parquet").set_index("t")
     up = direct["above"].reindex(me.index)
     np.testing.assert_array_equal(me["n_above"], up["size"].fillna(0).astype(int))
@@ -266,18 +274,24 @@ def test_fig3_authors_rows_against_the_raw_snapshots(tiny_root):
     assert len(auth["mu"]) == 4 and sum(r["ours"] for r in auth["mu"]) == 1
     for r in auth["mu"]:
         d = direct[r["selection"]]
-        assert r["value"] == pytest.approx(_fixed_intercept_mu(d.index, d["mean"], E0, gamma, r["window"]),
-                                           rel=1e-10)
+        assert r["value"] == pytest.approx(_fixed_intercept_mu(d.index, d["mean"], E0, gamma, r["window"]), rel=1e-10)
         assert 0 < r["err"] < 0.05  # bootstrap over orbits
         dev = abs(r["value"] - paper)
-        rule = ("agrees within 2σ" if dev <= 2 * r["err"] else
-                "agrees to the paper's quoted digits" if dev <= 2 * r["err"] + auth["paper_mu_half_unit"] else
-                "differs")
+        rule = (
+            "agrees within 2σ"
+            if dev <= 2 * r["err"]
+            else "agrees to the paper's quoted digits"
+            if dev <= 2 * r["err"] + auth["paper_mu_half_unit"]
+            else "differs"
+        )
         assert r["verdict"].startswith(rule)
         c = rows[r["quantity"]]
         assert (c["ours"], c["err"], c["paper"], c["verdict"]) == (r["value"], r["err"], paper, r["verdict"])
-        assert c["authors"] == r["authors"] == (r["selection"] == auth["authors_selection"]
-                                                and r["window"] == auth["authors_window"])
+        assert (
+            c["authors"]
+            == r["authors"]
+            == (r["selection"] == auth["authors_selection"] and r["window"] == auth["authors_window"])
+        )
         assert c["convention"].startswith("authors'") == c["authors"]
     ours = next(r for r in auth["mu"] if r["ours"])
     assert (ours["value"], ours["err"]) == (nums["mu"]["value"], nums["mu"]["err"])  # key mu unchanged
@@ -306,8 +320,12 @@ def test_fig3_ribbons_sd_and_sem(tiny_root):
     rows = {r["quantity"]: r for r in nums["paper_comparison"]}
     r_sd = next(r for q, r in rows.items() if q.startswith("ribbon") and "standard deviations" in q)
     r_sem = next(r for q, r in rows.items() if q.startswith("ribbon") and "standard errors" in q)
-    assert (r_sd["ours"], r_sd["authors"], r_sem["ours"], r_sem["authors"]) == \
-        (rib["half_width_3sd"], True, rib["half_width_3sem"], False)
+    assert (r_sd["ours"], r_sd["authors"], r_sem["ours"], r_sem["authors"]) == (
+        rib["half_width_3sd"],
+        True,
+        rib["half_width_3sem"],
+        False,
+    )
 
 
 def test_fig3_authors_rows_recompute_deterministically(tiny_root):
@@ -337,9 +355,11 @@ def test_fig3_our_verdict_names_an_agreeing_authors_row(tiny_root, tmp_path, cop
     m200, m100 = mu[(0.0, 200.0)], mu[(0.0, 100.0)]
     assert abs(m200["value"] - m100["value"]) > 2 * m200["err"]  # the premise: the windows disagree at tiny
     toml = (src / "study.toml").read_text()
-    for old, new in (("authors_window = [0.0, 200.0]", "authors_window = [0.0, 100.0]"),
-                     ("paper_mu = 0.91", f"paper_mu = {m100['value']!r}"),
-                     ("paper_mu_half_unit = 0.005", "paper_mu_half_unit = 0.0")):
+    for old, new in (
+        ("authors_window = [0.0, 200.0]", "authors_window = [0.0, 100.0]"),
+        ("paper_mu = 0.91", f"paper_mu = {m100['value']!r}"),
+        ("paper_mu_half_unit = 0.005", "paper_mu_half_unit = 0.0"),
+    ):
         assert old in toml
         toml = toml.replace(old, new)
     (dst / "study.toml").write_text(toml)

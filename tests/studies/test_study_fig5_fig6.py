@@ -6,6 +6,7 @@ studies root, with the upstream inputs made here: real tiny simulations in
 the layout of studies fig1/fig4 and minimal numbers JSONs carrying the
 paper's values (μ = 0.91, κ0 fit 13.63/0.03/1.41/0.27) as stated inputs.
 """
+
 from __future__ import annotations
 
 import json
@@ -17,8 +18,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.dissipative.models import time_to_energy
+from hhscatter.analysis.geometry import distance as dist
 from hhscatter.model import HenonHeiles
 
 E_C = HenonHeiles().critical_energy  # the paper's system's E_c
@@ -47,13 +48,15 @@ def test_time_to_energy_inverts_the_exponential_law():
 
 
 def test_first_crossings_picks_first_after_t_from_then_filters_energy():
-    sec = pd.DataFrame({
-        "traj_id": [1, 1, 1, 2, 2, 3, 4],
-        "t": [5.0, 17.5, 19.0, 16.0, 18.0, 30.0, 10.0],
-        "x": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7],
-        "y": 0.0,
-        "energy": [0.33, 0.31, 0.299, 0.30, 0.30, 0.28, 0.32],
-    })
+    sec = pd.DataFrame(
+        {
+            "traj_id": [1, 1, 1, 2, 2, 3, 4],
+            "t": [5.0, 17.5, 19.0, 16.0, 18.0, 30.0, 10.0],
+            "x": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7],
+            "y": 0.0,
+            "energy": [0.33, 0.31, 0.299, 0.30, 0.30, 0.28, 0.32],
+        }
+    )
     out = dist.first_crossings(sec.sample(frac=1.0, random_state=3), 17.0)  # order must not matter
     assert out["traj_id"].tolist() == [1, 2, 3]  # orbit 4 has no crossing after t*
     assert out["t"].tolist() == [17.5, 18.0, 30.0]
@@ -78,8 +81,9 @@ def test_distance_vs_scale_common_sample_size():
     for tab, m in ((small, 100), (full, 500)):
         assert tab["hellinger_noise"].iloc[0] == pytest.approx(math.sqrt(16 / 8 * 2 / m), rel=0.2)
         # same distribution: the cross distance sits on the noise floor
-        z = (tab["hellinger_pq"] - tab["hellinger_noise"]) / np.hypot(tab["hellinger_pq_std"],
-                                                                      tab["hellinger_noise_std"])
+        z = (tab["hellinger_pq"] - tab["hellinger_noise"]) / np.hypot(
+            tab["hellinger_pq_std"], tab["hellinger_noise_std"]
+        )
         assert (np.abs(z) < 3).all()
     assert (small["hellinger_noise"] > full["hellinger_noise"]).all()
     with pytest.raises(ValueError, match="m must be in"):
@@ -109,16 +113,20 @@ def test_debiased_hellinger_recovers_exact_distance_of_shifted_uniforms():
         assert dist.agreement_scale_debiased(tab, delta=0.28) == 0.2  # 0.242 ≤ δ < 0.316
         assert dist.agreement_scale_debiased(tab, delta=0.2) is None
     # identical distributions: the corrected distance is compatible with 0 at every scale
-    same = dist.distance_vs_scale(P, rng.random((n, 2)), [0.2, 0.1, 0.05], ext, kinds=("hellinger",),
-                                  n_splits=6, seed=3)
+    same = dist.distance_vs_scale(
+        P, rng.random((n, 2)), [0.2, 0.1, 0.05], ext, kinds=("hellinger",), n_splits=6, seed=3
+    )
     d, lo, hi = dist.debiased_distance(same)
     assert (lo == 0).all() and (d < 0.05).all()
     assert dist.agreement_scale_debiased(same, delta=0.05) == 0.05
 
 
 def test_upstream_lookup_dotted_keys_and_errors():
-    doc = {"energies": {"E0.30": {"t_rec": 24.0}}, "mu": {"value": 0.93, "err": 0.01},
-           "taus": [{"gamma": 0.01, "tau1": {"value": 17.0, "err": 1.0}}]}
+    doc = {
+        "energies": {"E0.30": {"t_rec": 24.0}},
+        "mu": {"value": 0.93, "err": 0.01},
+        "taus": [{"gamma": 0.01, "tau1": {"value": 17.0, "err": 1.0}}],
+    }
     assert up.lookup(doc, "energies.E0.30.t_rec")[0] == 24.0
     assert up.lookup(doc, "mu") == (0.93, 0.01)
     assert up.lookup(doc, "taus.0.tau1") == (17.0, 1.0)
@@ -216,15 +224,17 @@ def test_fig6_tiny_end_to_end(tiny_studies):
 def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministically(tiny_studies):
     """The authors' Fig. 5 convention: square ICs (goodICs) at E2, their windows, r < 1 — built from runs
     whose scenes say so, and the same numbers when the analysis runs again."""
-    from hhscatter.studies import load_study, run_stage
     from hhscatter.data.read import read_sections
+    from hhscatter.studies import load_study, run_stage
 
     study = load_study("fig5", "tiny", root=tiny_studies)
     nums = json.loads(study.numbers_path.read_text())
     auth = nums["authors_convention"]
     g = nums["gamma_main"]
-    for key, check in (("5a_authors", lambda s: (s["t"] > 17.0) & (s["t"] < 30.0)),
-                       ("5b_authors", lambda s: (s["energy"] >= 0.295) & (s["energy"] <= 0.305))):
+    for key, check in (
+        ("5a_authors", lambda s: (s["t"] > 17.0) & (s["t"] < 30.0)),
+        ("5b_authors", lambda s: (s["energy"] >= 0.295) & (s["energy"] <= 0.305)),
+    ):
         scene = json.loads((study.raw(key) / "scene.json").read_text())["scene"]
         assert scene["region"] == "square" and scene["gamma"] == g and scene["sections"]["first_only"]
         sec = read_sections(study.raw(key))
@@ -232,11 +242,15 @@ def test_fig5_authors_convention_rows_are_their_sets_and_recompute_deterministic
         assert auth["n_points"][key] == int((np.hypot(sec["x"], sec["y"]) < 1).sum())
     rows = {r["quantity"]: r for r in nums["paper_comparison"]}
     # the authors' rows are paired: 5a and 5b against both references, one row each, like for like
-    paired = [q for q, r in rows.items() if r["authors"] and q.startswith(("Fig. 5a closer", "Fig. 5b closer"))
-              and "than to μ_c^0.35, paired" in q]
+    paired = [
+        q
+        for q, r in rows.items()
+        if r["authors"] and q.startswith(("Fig. 5a closer", "Fig. 5b closer")) and "than to μ_c^0.35, paired" in q
+    ]
     refs = {r["set"]: r for r in nums["refs_paired"]["rows"] if r["construction"] == "authors" and "set" in r}
-    assert len(paired) == len(refs) and all(r["n_set"] == min(auth["n_points"][f"{s}_authors"], study.params.n_cap)
-                                            for s, r in refs.items())
+    assert len(paired) == len(refs) and all(
+        r["n_set"] == min(auth["n_points"][f"{s}_authors"], study.params.n_cap) for s, r in refs.items()
+    )
     assert not any("both in the authors' convention" in q for q in rows)  # the split-spread row is retired
     run_stage("fig5", "analyze", "tiny", root=tiny_studies)
     again = json.loads(study.numbers_path.read_text())["authors_convention"]
@@ -263,7 +277,9 @@ def test_fig5_paired_records_of_the_references_and_panel_d(tiny_studies):
     ts = [c["t_star"] for c in pdl["curves"]]
     assert ts == sorted(ts) and len(pdl["steps"]) == len(ts) - 1
     for c in pdl["curves"]:
-        assert len(c["d"]) == len(pdl["boxes"]) and all(lo <= d <= hi for lo, d, hi in zip(c["d_lo"], c["d"], c["d_hi"]))
+        assert len(c["d"]) == len(pdl["boxes"]) and all(
+            lo <= d <= hi for lo, d, hi in zip(c["d_lo"], c["d"], c["d_hi"])
+        )
     assert 0.0 <= pdl["eps_shrink_share"] <= 1.0
 
 
@@ -308,9 +324,17 @@ def test_fig6_paper_constant_kappa_law_is_the_fig2b_caption():
         kappa = mod.kappa_law(pc, study.model.critical_energy)
         E = np.array([0.1, 1 / 6, 0.2, 0.25, 0.2699, 0.27, 0.3, 0.35, 0.4])
         x = E - 1 / 6
-        by_hand = [0.0, 0.0,
-                   13.63 * x[2] ** 2 + 0.03 * x[2], 13.63 * x[3] ** 2 + 0.03 * x[3], 13.63 * x[4] ** 2 + 0.03 * x[4],
-                   1.41 * x[5], 1.41 * x[6], 1.41 * x[7], 1.41 * x[8]]
+        by_hand = [
+            0.0,
+            0.0,
+            13.63 * x[2] ** 2 + 0.03 * x[2],
+            13.63 * x[3] ** 2 + 0.03 * x[3],
+            13.63 * x[4] ** 2 + 0.03 * x[4],
+            1.41 * x[5],
+            1.41 * x[6],
+            1.41 * x[7],
+            1.41 * x[8],
+        ]
         np.testing.assert_allclose(kappa(E), by_hand, rtol=1e-12, atol=1e-15)
         # e.g. κ0(0.3) = 1.41 · 2/15 = 0.188 and κ0(0.25) = 13.63/144 + 0.0025
         assert float(kappa(0.3)) == pytest.approx(0.188, rel=1e-12)
@@ -328,8 +352,13 @@ def test_fig6_paper_constant_rows_recompute_deterministically(tiny_studies):
     study = load_study("fig6", "tiny", root=tiny_studies)
     nums = json.loads(study.numbers_path.read_text())
     pc, rows = _fig6_pc(nums)
-    assert {k: pc["constants"][k] for k in ("a", "b", "c", "E_b", "mu")} == \
-        {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "mu": 0.91}
+    assert {k: pc["constants"][k] for k in ("a", "b", "c", "E_b", "mu")} == {
+        "a": 13.63,
+        "b": 0.03,
+        "c": 1.41,
+        "E_b": 0.27,
+        "mu": 0.91,
+    }
     ours = pd.DataFrame(nums["fits"])
     ours = ours[ours["model"] == "homogeneous"].set_index(["pair", "hazard"])
     assert sorted((v["pair"], v["hazard"]) for v in pc["fits"]) == sorted(ours.index)  # every pair and hazard
@@ -339,12 +368,19 @@ def test_fig6_paper_constant_rows_recompute_deterministically(tiny_studies):
         mine = ours.loc[(v["pair"], v["hazard"])]
         # same fitted points as our constants' fit, and "better" is the smaller of the two residuals
         assert v["n_points"] == mine["n_points"] and v["rms_log_residual_ours"] == mine["rms_log_residual"]
-        want = ("ours" if v["rms_log_residual_ours"] < v["rms_log_residual"] else
-                "paper_constants" if v["rms_log_residual"] < v["rms_log_residual_ours"] else "tie")
+        want = (
+            "ours"
+            if v["rms_log_residual_ours"] < v["rms_log_residual"]
+            else "paper_constants"
+            if v["rms_log_residual"] < v["rms_log_residual_ours"]
+            else "tie"
+        )
         assert v["better"] == want
-    assert rows and all(r["convention"].startswith("authors': paper's constants (a, b, c, E_b, μ) = "
-                                                   "(13.63, 0.03, 1.41, 0.27, 0.91)")
-                        or r["convention"].startswith("authors': paper's μ = 0.91") for r in rows)
+    assert rows and all(
+        r["convention"].startswith("authors': paper's constants (a, b, c, E_b, μ) = (13.63, 0.03, 1.41, 0.27, 0.91)")
+        or r["convention"].startswith("authors': paper's μ = 0.91")
+        for r in rows
+    )
     assert not any(str(r["verdict"]).startswith("differ") for r in rows)
     # the curves of panel (a): one per hazard with the paper's constants, beside ours
     curves = pd.read_parquet(study.out / "derived" / "curves.parquet")
@@ -364,8 +400,11 @@ def test_fig6_changing_a_paper_constant_changes_only_its_rows(tiny_studies, tmp_
     toml = tmp_path / "fig6" / "study.toml"
     text = toml.read_text()
     assert text.count("paper_mu = 0.91\n") == 1 and text.count("paper_kappa_a = 13.63\n") == 1
-    toml.write_text(text.replace("paper_mu = 0.91\n", "paper_mu = 0.8\n")
-                    .replace("paper_kappa_a = 13.63\n", "paper_kappa_a = 20.0\n"))
+    toml.write_text(
+        text.replace("paper_mu = 0.91\n", "paper_mu = 0.8\n").replace(
+            "paper_kappa_a = 13.63\n", "paper_kappa_a = 20.0\n"
+        )
+    )
     run_stage("fig6", "analyze", "tiny", root=tmp_path)
     after = json.loads(load_study("fig6", "tiny", root=tmp_path).numbers_path.read_text())
     pc0, rows0 = _fig6_pc(before)
@@ -393,12 +432,22 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
         shutil.copytree(tiny_studies / name, tmp_path / name)
     shutil.copy(tiny_studies / "conventions.toml", tmp_path / "conventions.toml")  # a studies folder is self-contained
     k = _numbers(tmp_path, "fig2")["kappa_fit"]
-    mine = {"paper_kappa_a": k["a"]["value"], "paper_kappa_b": k["b"]["value"], "paper_kappa_c": k["c"]["value"],
-            "paper_kappa_Eb": k["E_b"]["value"], "paper_mu": _numbers(tmp_path, "fig3")["mu"]["value"]}
+    mine = {
+        "paper_kappa_a": k["a"]["value"],
+        "paper_kappa_b": k["b"]["value"],
+        "paper_kappa_c": k["c"]["value"],
+        "paper_kappa_Eb": k["E_b"]["value"],
+        "paper_mu": _numbers(tmp_path, "fig3")["mu"]["value"],
+    }
     toml = tmp_path / "fig6" / "study.toml"
     text = toml.read_text()
-    for key, paper in (("paper_kappa_a", "13.63"), ("paper_kappa_b", "0.03"), ("paper_kappa_c", "1.41"),
-                       ("paper_kappa_Eb", "0.27"), ("paper_mu", "0.91")):
+    for key, paper in (
+        ("paper_kappa_a", "13.63"),
+        ("paper_kappa_b", "0.03"),
+        ("paper_kappa_c", "1.41"),
+        ("paper_kappa_Eb", "0.27"),
+        ("paper_mu", "0.91"),
+    ):
         assert text.count(f"\n{key} = {paper}\n") == 1, key
         text = text.replace(f"\n{key} = {paper}\n", f"\n{key} = {mine[key]!r}\n")
     toml.write_text(text)
@@ -425,8 +474,11 @@ def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
         return [
             {"quantity": "Fig. 5b: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
             {"quantity": "Fig. 5a: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {"quantity": REFS_QUANTITY.format(s="5b") + ": the authors' 5a and 5b runs, r < 1 on every set",
-             "verdict": auth_verdict, "authors": True},
+            {
+                "quantity": REFS_QUANTITY.format(s="5b") + ": the authors' 5a and 5b runs, r < 1 on every set",
+                "verdict": auth_verdict,
+                "authors": True,
+            },
         ]
 
     agreeing = rows("agrees")

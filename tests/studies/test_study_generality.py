@@ -1,5 +1,6 @@
 """Study generality: the tiny end-to-end run, its JSON's structure, and its numbers against
 independent recomputations from the raw tables (numpy/pandas only) and exact identities."""
+
 from __future__ import annotations
 
 import itertools
@@ -33,8 +34,12 @@ def test_generality_tiny_end_to_end_writes_claims_for_every_system(tiny):
     ratios = {round(s["E0"] / s["E_c"], 12) for s in doc["systems"].values()}
     assert ratios == {doc["config"]["study"]["e0_ratio"]}
     # κ0 under every convention: all orbits (plateau, P-level windows), the escaping orbits, the alternative ICs
-    assert {r["convention"] for r in doc["kappa"]} == {"plateau", "plevel", "escaping",
-                                                      doc["config"]["study"]["alt_region"]}
+    assert {r["convention"] for r in doc["kappa"]} == {
+        "plateau",
+        "plevel",
+        "escaping",
+        doc["config"]["study"]["alt_region"],
+    }
     for c in claims:  # a verdict is a statement, a value a number or None (never NaN in the JSON)
         assert isinstance(c["verdict"], str) and c["verdict"]
         assert c["value"] is None or math.isfinite(c["value"])
@@ -90,8 +95,13 @@ def test_mu_below_threshold_is_the_microcanonical_well_value_and_tends_to_one_at
         assert all(a[1] > b[1] for a, b in itertools.pairwise(w)), name
 
 
-@pytest.mark.parametrize("edit, key", [(("probe_ratios = [1.6]", "probe_ratios = [1.7]"), "probe_ratios"),
-                                       (("c5_ratio = 1.6", "c5_ratio = 1.3"), "c5_ratio")])
+@pytest.mark.parametrize(
+    "edit, key",
+    [
+        (("probe_ratios = [1.6]", "probe_ratios = [1.7]"), "probe_ratios"),
+        (("c5_ratio = 1.6", "c5_ratio = 1.3"), "c5_ratio"),
+    ],
+)
 def test_ratios_outside_their_grid_are_refused_before_any_run(tmp_path, edit, key):
     """probe_ratios must lie on the κ0 grid, c5_ratio among cm_ratios: refused, naming the key, nothing run."""
     import shutil
@@ -108,15 +118,17 @@ def test_ratios_outside_their_grid_are_refused_before_any_run(tmp_path, edit, ke
     with pytest.raises(ValueError, match=key):
         run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
     assert not (tmp_path / "generality" / "out" / "tiny" / "raw").exists() or not any(
-        (tmp_path / "generality" / "out" / "tiny" / "raw").iterdir())
+        (tmp_path / "generality" / "out" / "tiny" / "raw").iterdir()
+    )
 
 
 def _raw(out, key, table, columns):
     import pyarrow.parquet as pq
 
     d = out / "raw" / key / table
-    return pd.concat([pq.read_table(p, columns=columns).to_pandas() for p in sorted(d.glob("*.parquet"))],
-                     ignore_index=True)
+    return pd.concat(
+        [pq.read_table(p, columns=columns).to_pandas() for p in sorted(d.glob("*.parquet"))], ignore_index=True
+    )
 
 
 def test_kappa_cmeasure_solves_the_true_time_relation_on_the_raw_crossings(tiny):
@@ -152,10 +164,16 @@ def test_kappa_cmeasure_solves_the_true_time_relation_on_the_raw_crossings(tiny)
                 mid = 0.5 * (lo + hi)
                 lo, hi = (mid, hi) if np.exp(mid * T).sum() < M else (lo, mid)
             assert row["kappa_cm"] == pytest.approx(lo, rel=1e-8), (name, row["ratio"])
-            k0 = [k for k in doc["kappa"] if k["system"] == name and k["convention"] == "escaping"
-                  and k["ratio"] == row["ratio"]][0]
-            rec = [c for c in doc["claims"] if c["system"] == name and c["claim"] == "2"
-                   and f"= {row['ratio']:g} (escaping" in c["quantity"]][0]
+            k0 = [
+                k
+                for k in doc["kappa"]
+                if k["system"] == name and k["convention"] == "escaping" and k["ratio"] == row["ratio"]
+            ][0]
+            rec = [
+                c
+                for c in doc["claims"]
+                if c["system"] == name and c["claim"] == "2" and f"= {row['ratio']:g} (escaping" in c["quantity"]
+            ][0]
             if k0["defined"]:
                 assert rec["value"] == pytest.approx(row["kappa_cm"] / k0["kappa"] - 1, rel=1e-12)
             checked += 1
@@ -172,13 +190,17 @@ def test_claim5_distance_counts_and_verdicts_follow_the_raw_sections_and_the_int
     for name, s in doc["systems"].items():
         c5 = s["cmeasure_distance"]
         mu = s["mu_measured"]["value"]
-        assert c5["t_star"] == pytest.approx(math.log(st["e0_ratio"] / st["c5_ratio"]) / (mu * st["mu_gamma"]),
-                                             rel=1e-12)
+        assert c5["t_star"] == pytest.approx(
+            math.log(st["e0_ratio"] / st["c5_ratio"]) / (mu * st["mu_gamma"]), rel=1e-12
+        )
         if "n_diss" in c5:
             sec = _raw(out, f"{name}_sec_g{st['mu_gamma']:g}", "sections", ["traj_id", "t"])
             assert c5["n_diss"] == sec.loc[sec["t"] >= c5["t_star"], "traj_id"].nunique()
-        recs = [c for c in doc["claims"] if c["system"] == name and c["claim"] == "5"
-                and c["quantity"].startswith("Fig. 5's distance")]
+        recs = [
+            c
+            for c in doc["claims"]
+            if c["system"] == name and c["claim"] == "5" and c["quantity"].startswith("Fig. 5's distance")
+        ]
         assert len(recs) == 2, name
         for kind, rec in zip(("c-measure", "all"), recs):
             if rec["value"] is None:

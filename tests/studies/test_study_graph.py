@@ -1,5 +1,6 @@
 """The studies' one declared dependency graph (study.toml [about], [needs]) and what is derived from it:
 the Makefile's rules, the build order, the report and the docs navigation."""
+
 from __future__ import annotations
 
 import os
@@ -68,8 +69,13 @@ def _repo(tmp_path: Path) -> Path:
 
 def _dry_run(work: Path, target: str) -> list[str]:
     """`make -n -B <target> SCALE=tiny` in ``work``: the study stage commands, in order."""
-    r = subprocess.run(["make", "-n", "-B", target, "SCALE=tiny", f"PYTHON={sys.executable}"], cwd=work,
-                       capture_output=True, text=True, check=True)
+    r = subprocess.run(
+        ["make", "-n", "-B", target, "SCALE=tiny", f"PYTHON={sys.executable}"],
+        cwd=work,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return re.findall(r"hhscatter study (\w+) (simulate|analyze|plot) --scale tiny", r.stdout)
 
 
@@ -89,8 +95,9 @@ def test_a_new_study_folder_gets_make_rules_without_editing_the_makefile(tmp_pat
     _study(work / "studies", "figx", {"c": "fig1"})
     steps = _dry_run(work, "figx")
     assert ("fig1", "analyze") in steps and steps[-1] == ("figx", "plot")
-    help_text = subprocess.run(["make", "help", f"PYTHON={sys.executable}"], cwd=work,
-                               capture_output=True, text=True, check=True).stdout
+    help_text = subprocess.run(
+        ["make", "help", f"PYTHON={sys.executable}"], cwd=work, capture_output=True, text=True, check=True
+    ).stdout
     assert "figx" in help_text and "what figx does (needs fig1)" in help_text
 
 
@@ -140,9 +147,14 @@ def test_no_study_imports_another_or_reads_its_raw_runs():
         assert files, f"studies/{name} has no modules"
         for path in files:
             mods = _imported_modules(path, f"hhscatter_study_{name}")
-            bad = {m for m in mods for o in others
-                   if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m) or m.endswith(f"studies.{o}")
-                   or re.match(rf"(hhscatter_study_)?{o}(\.|$)", m)}
+            bad = {
+                m
+                for m in mods
+                for o in others
+                if re.search(rf"(^|\.)(studies|plotting)\.{o}(\.|$)", m)
+                or m.endswith(f"studies.{o}")
+                or re.match(rf"(hhscatter_study_)?{o}(\.|$)", m)
+            }
             assert not bad, f"{path.relative_to(ROOT)} imports another study: {sorted(bad)}"
             text = path.read_text()
             # other studies are reached through their published outputs only (_upstream.numbers / table)
@@ -169,10 +181,29 @@ def test_the_analysis_layer_is_pure():
     """No heyoka, no engine or runner, no file I/O under hhscatter/analysis: arrays or DataFrames in, results out."""
     import ast
 
-    banned_modules = ("heyoka", "pyarrow", "hhscatter.integrate.engine", "hhscatter.run.runner", "hhscatter.data.read", "hhscatter.data.write", "hhscatter.data.schema",
-                      "hhscatter.data.store", "hhscatter.studies")
-    banned_calls = {"open", "read_text", "write_text", "read_bytes", "write_bytes", "read_parquet", "to_parquet",
-                    "to_csv", "read_csv", "savefig"}
+    banned_modules = (
+        "heyoka",
+        "pyarrow",
+        "hhscatter.integrate.engine",
+        "hhscatter.run.runner",
+        "hhscatter.data.read",
+        "hhscatter.data.write",
+        "hhscatter.data.schema",
+        "hhscatter.data.store",
+        "hhscatter.studies",
+    )
+    banned_calls = {
+        "open",
+        "read_text",
+        "write_text",
+        "read_bytes",
+        "write_bytes",
+        "read_parquet",
+        "to_parquet",
+        "to_csv",
+        "read_csv",
+        "savefig",
+    }
     for path in sorted((ROOT / "hhscatter" / "analysis").glob("*.py")):
         mods = _imported_modules(path, "hhscatter.analysis")
         bad = {m for m in mods for b in banned_modules if m == b or m.startswith(b + ".")}
@@ -223,14 +254,18 @@ def test_a_second_clone_using_this_virtualenv_reads_its_own_study_files(tmp_path
     text = toml.read_text()
     n = re.search(r"\[scale\.tiny\.scene\]\s*\nn = (\d+)", text)
     assert n, "fig1 has a [scale.tiny.scene] n"
-    toml.write_text(text[:n.start(1)] + "123" + text[n.end(1):])
+    toml.write_text(text[: n.start(1)] + "123" + text[n.end(1) :])
     (clone / "studies" / "fig1" / "study.py").write_text(
-        (STUDIES / "fig1" / "study.py").read_text() + "\nCLONE_MARK = 1\n")
-    code = ("from hhscatter.studies import load_study, stage_module\n"
-            "s = load_study('fig1', 'tiny')\n"
-            "print(s.config['scene']['n'], s.out, stage_module('fig1').CLONE_MARK)\n")
+        (STUDIES / "fig1" / "study.py").read_text() + "\nCLONE_MARK = 1\n"
+    )
+    code = (
+        "from hhscatter.studies import load_study, stage_module\n"
+        "s = load_study('fig1', 'tiny')\n"
+        "print(s.config['scene']['n'], s.out, stage_module('fig1').CLONE_MARK)\n"
+    )
     env = {k: v for k, v in os.environ.items() if k != "HHSCATTER_STUDIES"}
-    r = subprocess.run([sys.executable, "-c", code], cwd=clone / "studies" / "fig1", env=env, capture_output=True,
-                       text=True)
+    r = subprocess.run(
+        [sys.executable, "-c", code], cwd=clone / "studies" / "fig1", env=env, capture_output=True, text=True
+    )
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout.split() == ["123", str(clone / "studies" / "fig1" / "out" / "tiny"), "1"]

@@ -1,4 +1,5 @@
 """End-to-end test of the study ``operator`` at SCALE=tiny (built in graph order by conftest's tiny_studies)."""
+
 from __future__ import annotations
 
 import json
@@ -30,7 +31,7 @@ def test_operator_tiny_kappa_convergence(tiny_studies):
         if r["kappa_inf"] is None:
             continue
         # κ∞ is the intercept of the least-squares fit κ = κ∞ + a·b + β·M^(−1/2), recomputed here
-        X = np.column_stack([np.ones(len(g)), g.box, g.samples ** -0.5])
+        X = np.column_stack([np.ones(len(g)), g.box, g.samples**-0.5])
         assert math.isclose(np.linalg.lstsq(X, g.kappa.to_numpy(), rcond=None)[0][0], r["kappa_inf"], rel_tol=1e-9)
         if r["energy"] in k0:
             assert math.isclose(r["residual_kappa0"], r["kappa_inf"] / k0[r["energy"]] - 1, rel_tol=1e-12)

@@ -5,6 +5,7 @@ interval), 1-D quadratures of motion along a symmetry axis of the potential,
 the linearisation at the saddle, invariants (energy, periodicity), synthetic
 samples with known rates, and the engine's own escape times.
 """
+
 from __future__ import annotations
 
 import math
@@ -14,10 +15,8 @@ import pytest
 from scipy import integrate, optimize
 
 from hhscatter.analysis.geometry.channels import channel_fractions, lyapunov_orbit, return_statistics
-
-from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
-
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
 from hhscatter.integrate.events import CENSORED, ESCAPED
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.scene import SceneError
@@ -68,10 +67,19 @@ def test_return_statistics_known_sequences():
     # orbit 0: straight out; orbit 1: out past 1.03, back inside r < 1, out again;
     # orbit 2: no crossing at all; orbit 3: dips to r > 1 and back before escaping (not a return)
     rows = [
-        (0, 1.0, 1.0, +1), (0, 2.0, 1.03, +1), (0, 3.0, 2.0, +1),
-        (1, 1.0, 1.03, +1), (1, 2.0, 1.03, -1), (1, 2.5, 1.0, -1), (1, 5.0, 1.0, +1), (1, 6.0, 1.03, +1),
+        (0, 1.0, 1.0, +1),
+        (0, 2.0, 1.03, +1),
+        (0, 3.0, 2.0, +1),
+        (1, 1.0, 1.03, +1),
+        (1, 2.0, 1.03, -1),
+        (1, 2.5, 1.0, -1),
+        (1, 5.0, 1.0, +1),
+        (1, 6.0, 1.03, +1),
         (1, 7.0, 2.0, +1),
-        (3, 1.0, 1.0, +1), (3, 1.5, 1.0, -1), (3, 4.0, 1.0, +1), (3, 4.5, 1.03, +1),
+        (3, 1.0, 1.0, +1),
+        (3, 1.5, 1.0, -1),
+        (3, 4.0, 1.0, +1),
+        (3, 4.5, 1.03, +1),
     ]
     o, t, r, d = (np.array(c) for c in zip(*rows))
     s = return_statistics(o, t, r, d, 4, 1.03)
@@ -96,8 +104,9 @@ def _v_axis(y):
 
 def _time_between(E, a, b):
     """Time to move monotonically from y = a to y = b on the axis at energy E (no turning point inside)."""
-    return integrate.quad(lambda y: 1.0 / math.sqrt(2.0 * (E - _v_axis(y))), min(a, b), max(a, b),
-                          epsabs=1e-14, epsrel=1e-13, limit=200)[0]
+    return integrate.quad(
+        lambda y: 1.0 / math.sqrt(2.0 * (E - _v_axis(y))), min(a, b), max(a, b), epsabs=1e-14, epsrel=1e-13, limit=200
+    )[0]
 
 
 def _time_to_turning(E, a, yt):

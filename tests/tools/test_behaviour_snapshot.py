@@ -8,21 +8,30 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 spec = importlib.util.spec_from_file_location(
-    "behaviour_snapshot", Path(__file__).resolve().parents[2] / "tools" / "behaviour_snapshot.py")
+    "behaviour_snapshot", Path(__file__).resolve().parents[2] / "tools" / "behaviour_snapshot.py"
+)
 bs = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(bs)
 
 
 def _part(path, values, version):
-    meta = {"hhscatter": json.dumps({"hhscatter": version, "git_commit": version * 3, "rows": len(values),
-                                     "scene": {"ics": f"/tmp/{version}/ics.csv", "seed": 1}})}
+    meta = {
+        "hhscatter": json.dumps(
+            {
+                "hhscatter": version,
+                "git_commit": version * 3,
+                "rows": len(values),
+                "scene": {"ics": f"/tmp/{version}/ics.csv", "seed": 1},
+            }
+        )
+    }
     pq.write_table(pa.table({"t": values}).replace_schema_metadata(meta), path)
     return bs.part_digest(path)
 
 
 def test_part_digest_sees_data_and_ignores_versions_and_temporary_paths(tmp_path):
     a = _part(tmp_path / "a.parquet", [1.0, 2.0], "0.1")
-    b = _part(tmp_path / "b.parquet", [1.0, 2.0], "0.2")          # other version, commit, tmp folder
+    b = _part(tmp_path / "b.parquet", [1.0, 2.0], "0.2")  # other version, commit, tmp folder
     c = _part(tmp_path / "c.parquet", [1.0, 2.0 + 2**-51], "0.1")  # one ulp-scale change in the data
     assert a == b
     assert a["data"] != c["data"] and a["meta"] == c["meta"]
@@ -33,8 +42,11 @@ def test_compare_lists_every_change_and_nothing_else():
     same = json.loads(json.dumps(before))
     after = {"scenes": {"fig1@tiny": {"hashes": {"E0.30": "ab"}, "stopped_by": None}}, "numbers": {"y": 1.0}}
     assert bs.compare(before, same) == []
-    assert bs.compare(before, after) == ["/numbers/x: only in before", "/numbers/y: only in after",
-                                         "/scenes/fig1@tiny/hashes/E0.30: 'aa' -> 'ab'"]
+    assert bs.compare(before, after) == [
+        "/numbers/x: only in before",
+        "/numbers/y: only in after",
+        "/scenes/fig1@tiny/hashes/E0.30: 'aa' -> 'ab'",
+    ]
 
 
 def test_numeric_leaves_skip_provenance_and_cost():

@@ -4,7 +4,8 @@ import importlib.util
 from pathlib import Path
 
 spec = importlib.util.spec_from_file_location(
-    "layer_metrics", Path(__file__).resolve().parents[2] / "tools" / "layer_metrics.py")
+    "layer_metrics", Path(__file__).resolve().parents[2] / "tools" / "layer_metrics.py"
+)
 lm = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(lm)
 
@@ -27,7 +28,7 @@ def _pkg(tmp_path: Path) -> Path:
 def test_metrics_on_a_known_package(tmp_path):
     m = lm.measure(_pkg(tmp_path), "pkg", [])
     assert sorted(m["circles"]) == [["pkg.a", "pkg.b"], ["pkg.c", "pkg.sub.d"]]
-    assert len(m["function_level_imports"]) == 2        # `from .a import f` and `import json`
+    assert len(m["function_level_imports"]) == 2  # `from .a import f` and `import json`
     assert len(m["function_level_own_imports"]) == 1
     assert len(m["param_casts"]) == 1
     assert [n for n, _ in m["long_functions"]] == [87]
@@ -46,13 +47,14 @@ def test_casts_of_study_parameters_are_told_from_other_casts(tmp_path):
     (p / "__init__.py").write_text("")
     (p / "s.py").write_text(
         "def f(study, row):\n"
-        "    a = float(study.param('x'))\n"             # a cast: counted
-        "    b = int(study.params.n)\n"                 # counted
+        "    a = float(study.param('x'))\n"  # a cast: counted
+        "    b = int(study.params.n)\n"  # counted
         "    c = [float(v) for v in study.params.e]\n"  # element-wise: counted
         "    d = tuple(float(v) for v in study.params.w)\n"  # counted
-        "    e = list(map(float, study.params.e))\n"    # counted
-        "    g = float(row['mu'])\n"                    # a DataFrame row: not a study parameter
-        "    h = study.params.e\n"                      # typed, no cast
-        "    return a, b, c, d, e, g, h\n")
+        "    e = list(map(float, study.params.e))\n"  # counted
+        "    g = float(row['mu'])\n"  # a DataFrame row: not a study parameter
+        "    h = study.params.e\n"  # typed, no cast
+        "    return a, b, c, d, e, g, h\n"
+    )
     m = lm.measure(tmp_path, "pkg", [])
     assert sorted(int(w.rsplit(":", 1)[1]) for w in m["param_casts"]) == [2, 3, 4, 5, 6]

@@ -22,6 +22,7 @@ Examples
 >>> regular_record(lt, ind)["fraction"]
 0.25
 """
+
 from __future__ import annotations
 
 import math
@@ -54,9 +55,15 @@ def regular_record(lifetimes, indicator) -> dict:
     n = len(lifetimes)
     n_reg = int(indicator["regular"].sum())
     f, e = regular_fraction(n, n_reg)
-    return {"fraction": f, "err": e, "n": n, "n_regular": n_reg,
-            "n_chaotic": int((indicator["kind"] == "chaotic").sum()), "n_none": int((indicator["kind"] == "none").sum()),
-            "n_escaped_before": int(n - len(indicator))}
+    return {
+        "fraction": f,
+        "err": e,
+        "n": n,
+        "n_regular": n_reg,
+        "n_chaotic": int((indicator["kind"] == "chaotic").sum()),
+        "n_none": int((indicator["kind"] == "none").sum()),
+        "n_escaped_before": int(n - len(indicator)),
+    }
 
 
 def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> tuple[list, dict]:
@@ -74,26 +81,44 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     P, Pe = survival_at(t, obs, times)
     rows = [{"t": float(a), "P": float(b), "P_err": float(c)} for a, b, c in zip(times, P, Pe)]
     reg = lifetimes["traj_id"].isin(np.asarray(regular_ids)).to_numpy()
-    rec = {"t0": float(t0), "n": int(t.size), "censored_fraction": float((~obs).mean()),
-           "regular_fraction_of_censored": float(reg[~obs].mean()) if (~obs).any() else None}
+    rec = {
+        "t0": float(t0),
+        "n": int(t.size),
+        "censored_fraction": float((~obs).mean()),
+        "regular_fraction_of_censored": float(reg[~obs].mean()) if (~obs).any() else None,
+    }
     try:
         f = fit_plateau_exponential(t, obs, t0)
-        rec.update(P_inf=f.p_inf, P_inf_err=_finite(f.p_inf_err), kappa_inf=f.kappa, kappa_inf_err=_finite(f.kappa_err),
-                   chi2=f.chi2, dof=f.dof, P_t0=f.p_t0)
+        rec.update(
+            P_inf=f.p_inf,
+            P_inf_err=_finite(f.p_inf_err),
+            kappa_inf=f.kappa,
+            kappa_inf_err=_finite(f.kappa_err),
+            chi2=f.chi2,
+            dof=f.dof,
+            P_t0=f.p_t0,
+        )
     except ValueError as exc:
         rec.update(P_inf=None, kappa_inf=None, reason=f"plateau fit: {exc}")
     tn, on = t[~reg], obs[~reg]
     try:
         g = fit_plateau_exponential(tn, on, t0, plateau=False)
         p = float(chi2_dist.sf(g.chi2, g.dof)) if g.dof > 0 else None
-        rec.update(kappa_nonregular=g.kappa, kappa_nonregular_err=g.kappa_err, chi2_nonregular=g.chi2,
-                   dof_nonregular=g.dof, p_nonregular=p, exponential=None if p is None else bool(p >= EXP_REJECT_P))
+        rec.update(
+            kappa_nonregular=g.kappa,
+            kappa_nonregular_err=g.kappa_err,
+            chi2_nonregular=g.chi2,
+            dof_nonregular=g.dof,
+            p_nonregular=p,
+            exponential=None if p is None else bool(p >= EXP_REJECT_P),
+        )
     except ValueError as exc:
         rec.update(kappa_nonregular=None, exponential=None, reason_nonregular=str(exc))
     h = hazard_profile(tn, on, hazard_edges)
-    rec["hazard_nonregular"] = [{"t_lo": float(a), "t_hi": float(b), "hazard": _finite(c), "err": _finite(d),
-                                 "events": int(e)} for a, b, c, d, e in
-                                h[["t_lo", "t_hi", "hazard", "hazard_err", "events"]].itertuples(index=False)]
+    rec["hazard_nonregular"] = [
+        {"t_lo": float(a), "t_hi": float(b), "hazard": _finite(c), "err": _finite(d), "events": int(e)}
+        for a, b, c, d, e in h[["t_lo", "t_hi", "hazard", "hazard_err", "events"]].itertuples(index=False)
+    ]
     return rows, rec
 
 
@@ -124,18 +149,37 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
     fit_at = {(f["system"], round(f["e_ratio"], 6)): f for f in fits if f.get("ics") == ics}
     for r in (x for x in regular if x["ics"] == ics):
         key = (r["system"], round(r["e_ratio"], 6))
-        k = [x for x in kappa if x.get("system") == r["label"] and x.get("convention") == "plateau"
-             and abs(x.get("ratio", -1) - r["e_ratio"]) < 1e-9]
-        c2 = [c for c in claims if c.get("claim") == "2" and c.get("system") == r["label"]
-              and f"E/E_c = {r['e_ratio']:g} (all orbits" in c.get("quantity", "")]
+        k = [
+            x
+            for x in kappa
+            if x.get("system") == r["label"]
+            and x.get("convention") == "plateau"
+            and abs(x.get("ratio", -1) - r["e_ratio"]) < 1e-9
+        ]
+        c2 = [
+            c
+            for c in claims
+            if c.get("claim") == "2"
+            and c.get("system") == r["label"]
+            and f"E/E_c = {r['e_ratio']:g} (all orbits" in c.get("quantity", "")
+        ]
         f = fit_at.get(key, {})
         pinf, perr = f.get("P_inf"), f.get("P_inf_err")
-        out.append({"id": r.get("id"), "system": r["system"], "label": r["label"], "e_ratio": r["e_ratio"], "ics": ics,
-                    "regular_fraction": r["fraction"], "regular_err": r["err"],
-                    "kappa0_defined": bool(k[0]["defined"]) if k else None,
-                    "claim2": c2[0]["verdict"] if c2 else None,
-                    "exponential": f.get("exponential"),
-                    "plateau": None if pinf is None or perr is None else bool(pinf > 3 * perr)})
+        out.append(
+            {
+                "id": r.get("id"),
+                "system": r["system"],
+                "label": r["label"],
+                "e_ratio": r["e_ratio"],
+                "ics": ics,
+                "regular_fraction": r["fraction"],
+                "regular_err": r["err"],
+                "kappa0_defined": bool(k[0]["defined"]) if k else None,
+                "claim2": c2[0]["verdict"] if c2 else None,
+                "exponential": f.get("exponential"),
+                "plateau": None if pinf is None or perr is None else bool(pinf > 3 * perr),
+            }
+        )
     return out
 
 
@@ -153,6 +197,9 @@ def first_below(regular: list, level: float = 0.01, *, ics: str = "disk") -> dic
         rs = sorted((r["e_ratio"], r["fraction"]) for r in regular if r["system"] == s and r["ics"] == ics)
         above = [e for e, f in rs if f >= level]
         tail = [e for e, _ in rs if not above or e > max(above)]
-        out[s] = ({"from": tail[0], "text": f"from {tail[0]:g} E_c on"} if tail else
-                  {"from": None, "text": f"not reached up to {rs[-1][0]:g} E_c (the highest energy measured)"})
+        out[s] = (
+            {"from": tail[0], "text": f"from {tail[0]:g} E_c on"}
+            if tail
+            else {"from": None, "text": f"not reached up to {rs[-1][0]:g} E_c (the highest energy measured)"}
+        )
     return out

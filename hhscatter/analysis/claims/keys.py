@@ -1,4 +1,5 @@
 """Names of the raw runs of the claims (one per system, energy, drag and kind), and the energies of the section runs."""
+
 from __future__ import annotations
 
 

@@ -1,4 +1,5 @@
 """Claims 3 and 5 (moment): μ measured from ⟨E⟩(t), μ predicted from the conservative 2⟨K⟩/E, the survivors' own ⟨K⟩."""
+
 from __future__ import annotations
 
 import math
@@ -30,12 +31,14 @@ def mu_conservative(runs, label, m, fits, keys=None):
     keys = keys or {r: probe_key(label, r) for r in p.probe_ratios}
     for r, key in keys.items():
         # κ, τ0 of the escaping orbits of the κ0(E) run at r: defined even where a trapped plateau is not
-        res = fits.get(("escaping", min((k[1] for k in fits if isinstance(k, tuple)), key=lambda x: abs(x - r),
-                                        default=math.nan)))
+        res = fits.get(
+            ("escaping", min((k[1] for k in fits if isinstance(k, tuple)), key=lambda x: abs(x - r), default=math.nan))
+        )
         t0, t1, relaxed = probe_window(res, p)
         if t0 is None:
-            rows.append({"system": label, "ratio": r, "kind": "c-measure", "mu": math.nan, "mu_err": math.nan,
-                         "relaxed": False})
+            rows.append(
+                {"system": label, "ratio": r, "kind": "c-measure", "mu": math.nan, "mu_err": math.nan, "relaxed": False}
+            )
             continue
         lt = runs.lifetimes(key)
         # only the rows the average uses (kinetic_fraction_from_energies keeps t_from ≤ t ≤ t_to): the same
@@ -43,11 +46,23 @@ def mu_conservative(runs, label, m, fits, keys=None):
         sn = runs.snapshots(key, t_from=t0, t_to=t1)
         escaping = lt.loc[lt["outcome"] != "censored", "traj_id"].to_numpy()
         for kind, keep in (("c-measure", escaping), ("all survivors", None)):
-            k = kinetic_fraction_from_energies(sn["traj_id"], sn["t"], sn["energy"], p.probe_gamma, t0, t1,
-                                               keep=keep, n_boot=p.n_boot, rng=p.fit_seed)
-            rows.append({"system": label, "ratio": r, "kind": kind, "mu": k.value, "mu_err": k.err,
-                         "t_from": t0, "t_to": t1, "relaxed": relaxed, "n_orbits": k.n_orbits,
-                         "n_intervals": k.n_intervals})
+            k = kinetic_fraction_from_energies(
+                sn["traj_id"], sn["t"], sn["energy"], p.probe_gamma, t0, t1, keep=keep, n_boot=p.n_boot, rng=p.fit_seed
+            )
+            rows.append(
+                {
+                    "system": label,
+                    "ratio": r,
+                    "kind": kind,
+                    "mu": k.value,
+                    "mu_err": k.err,
+                    "t_from": t0,
+                    "t_to": t1,
+                    "relaxed": relaxed,
+                    "n_orbits": k.n_orbits,
+                    "n_intervals": k.n_intervals,
+                }
+            )
     for r in p.mc_ratios:
         v = microcanonical_kinetic_fraction(m.potential, r * m.critical_energy, 2.5 * m.saddle_radius)
         rows.append({"system": label, "ratio": r, "kind": "microcanonical well", "mu": v, "mu_err": 0.0})
@@ -90,8 +105,9 @@ def mu_measured(runs, label, m, E0, key=None, n=None):
     wins = mu_windows(runs)
     k = min(p.n_boot_orbits, n)
     rows = runs.snapshots(key, max_id=k)
-    b, scale = bootstrap_mu_first_orbits(rows, n, k, E0, p.mu_gamma, list(wins.values()),
-                                         n_boot=p.n_boot, seed=p.fit_seed)
+    b, scale = bootstrap_mu_first_orbits(
+        rows, n, k, E0, p.mu_gamma, list(wins.values()), n_boot=p.n_boot, seed=p.fit_seed
+    )
     out = {}
     for name, w in wins.items():
         mu = fit_energy_decay(ime.inside["t"], ime.inside["mean_E"], E0, p.mu_gamma, w).mu
@@ -113,8 +129,9 @@ def mu_own(rows, E0, gamma, wins, groups: int = 10):
     (traj_id mod groups: σ = sd/√groups), orbits being the independent unit."""
     full, path = own_path_mu(rows, E0, gamma, wins)
     parts = [own_path_mu(rows[rows["traj_id"] % groups == k], E0, gamma, wins)[0] for k in range(groups)]
-    return {name: (v, float(np.std([q[name] for q in parts], ddof=1) / math.sqrt(groups)))
-            for name, v in full.items()}, path
+    return {
+        name: (v, float(np.std([q[name] for q in parts], ddof=1) / math.sqrt(groups))) for name, v in full.items()
+    }, path
 
 
 def mu_windows(runs) -> dict:
@@ -140,24 +157,48 @@ def mu_predicted(runs, mdf, ec, E0):
 
 
 def claim3(claims, label, meas, pred, wins, mu_c0, paper_mu, is_hh, relaxed):
-    how = ("dE/dt = −γ μ(E) E with μ(E) = 2⟨K⟩/E of the conservative flow ({}) above E_c and of the microcanonical "
-           "well below, fitted like the measured ⟨E⟩(t)" + ("" if relaxed else
-                                                          "; probe window not relaxed at some energy (clipped)"))
+    how = (
+        "dE/dt = −γ μ(E) E with μ(E) = 2⟨K⟩/E of the conservative flow ({}) above E_c and of the microcanonical "
+        "well below, fitted like the measured ⟨E⟩(t)"
+        + ("" if relaxed else "; probe window not relaxed at some energy (clipped)")
+    )
     for wname, w in wins.items():
         where = f"on [{w[0]:g}, {w[1]:g}]" + (" (fig3's window)" if wname == "paper" else " (⟨E⟩ > E_c)")
         mu_m, mu_m_err = meas[wname]
-        claims.add("3", f"μ measured {where}", label, mu_m, mu_m_err,
-                   z_verdict(mu_m, mu_m_err, paper_mu, "agrees with the paper's 0.91", "differs from the paper's 0.91")
-                   if is_hh and wname == "paper" else "measured",
-                   "⟨E⟩(t) of the orbits not escaped, fixed-intercept log fit (fig3's); bootstrap over orbits; this "
-                   "study's setup (r_esc the system's default)", paper_mu if is_hh and wname == "paper" else None)
+        claims.add(
+            "3",
+            f"μ measured {where}",
+            label,
+            mu_m,
+            mu_m_err,
+            z_verdict(mu_m, mu_m_err, paper_mu, "agrees with the paper's 0.91", "differs from the paper's 0.91")
+            if is_hh and wname == "paper"
+            else "measured",
+            "⟨E⟩(t) of the orbits not escaped, fixed-intercept log fit (fig3's); bootstrap over orbits; this "
+            "study's setup (r_esc the system's default)",
+            paper_mu if is_hh and wname == "paper" else None,
+        )
         for kind, name in (("c-measure", "c-measure: trapped orbits dropped"), ("all survivors", "all survivors")):
             v, e = pred[kind, wname]
-            claims.add("3", f"μ predicted {where}, {kind}", label, v, e,
-                       z_verdict(v, e, mu_m, "agrees with μ measured", "differs from μ measured", mu_m_err),
-                       how.format(name), mu_m)
-    claims.add("3", "2⟨K⟩/E of the c-measure at E0", label, mu_c0, None, "for reference (instantaneous μ at E0)",
-               "interpolated between probe energies")
+            claims.add(
+                "3",
+                f"μ predicted {where}, {kind}",
+                label,
+                v,
+                e,
+                z_verdict(v, e, mu_m, "agrees with μ measured", "differs from μ measured", mu_m_err),
+                how.format(name),
+                mu_m,
+            )
+    claims.add(
+        "3",
+        "2⟨K⟩/E of the c-measure at E0",
+        label,
+        mu_c0,
+        None,
+        "for reference (instantaneous μ at E0)",
+        "interpolated between probe energies",
+    )
 
 
 def claim5_moment(claims, label, meas, own, pred, wins):
@@ -166,18 +207,42 @@ def claim5_moment(claims, label, meas, own, pred, wins):
         where = f"on [{w[0]:g}, {w[1]:g}]"
         v, e = own[wname]
         m, me = meas[wname]
-        claims.add("5", f"moment test: μ of the survivors' own ⟨K⟩ {where} (no selection)", label, v, e,
-                   z_verdict(m, me, v, "selection by escape/settling negligible",
-                              f"selection by escape/settling shifts μ by {m - v:+.3f}", e),
-                   "2⟨K⟩/⟨E⟩ of the dissipative survivors from their energy loss (ΔE = −2γ∫K dt), path fitted "
-                   "like ⟨E⟩(t), on the orbits traj_id < n_boot_orbits; σ from 10 groups of them; reference: μ measured", m)
+        claims.add(
+            "5",
+            f"moment test: μ of the survivors' own ⟨K⟩ {where} (no selection)",
+            label,
+            v,
+            e,
+            z_verdict(
+                m,
+                me,
+                v,
+                "selection by escape/settling negligible",
+                f"selection by escape/settling shifts μ by {m - v:+.3f}",
+                e,
+            ),
+            "2⟨K⟩/⟨E⟩ of the dissipative survivors from their energy loss (ΔE = −2γ∫K dt), path fitted "
+            "like ⟨E⟩(t), on the orbits traj_id < n_boot_orbits; σ from 10 groups of them; reference: μ measured",
+            m,
+        )
         pv, pe = pred["c-measure", wname]
-        claims.add("5", f"moment test: survivors' ⟨K⟩ against the conservative c-measure's {where}", label, v - pv,
-                   math.hypot(e, pe),
-                   z_verdict(v - pv, math.hypot(e, pe), 0.0, "survivors carry the c-measure's ⟨K⟩",
-                              "survivors' ⟨K⟩ differs from the c-measure's"),
-                   "value: μ(own ⟨K⟩) − μ predicted (c-measure above E_c, microcanonical well below): a moment test "
-                   "of claim 5 (not the distance of Fig. 5)", 0.0)
+        claims.add(
+            "5",
+            f"moment test: survivors' ⟨K⟩ against the conservative c-measure's {where}",
+            label,
+            v - pv,
+            math.hypot(e, pe),
+            z_verdict(
+                v - pv,
+                math.hypot(e, pe),
+                0.0,
+                "survivors carry the c-measure's ⟨K⟩",
+                "survivors' ⟨K⟩ differs from the c-measure's",
+            ),
+            "value: μ(own ⟨K⟩) − μ predicted (c-measure above E_c, microcanonical well below): a moment test "
+            "of claim 5 (not the distance of Fig. 5)",
+            0.0,
+        )
 
 
 def analyze_mu(runs, claims, label, spec, m, E0, fits):
@@ -193,17 +258,30 @@ def analyze_mu(runs, claims, label, spec, m, E0, fits):
     wins = mu_windows(runs)
     claim3(claims, label, meas, pred, wins, mu_c0, p.paper_mu, spec["name"] == "henon_heiles", relaxed)
     claim5_moment(claims, label, meas, own, pred, wins)
-    curves = [pd.DataFrame({"system": label, "t": t, "mean_E_over_E0": e / E0, "kind": kind}) for t, e, kind in (
-        (inside["t"], inside["mean_E"], "measured"), (grid, path, "predicted"),
-        (own_path[0], own_path[1], "survivors' own ⟨K⟩"))]
+    curves = [
+        pd.DataFrame({"system": label, "t": t, "mean_E_over_E0": e / E0, "kind": kind})
+        for t, e, kind in (
+            (inside["t"], inside["mean_E"], "measured"),
+            (grid, path, "predicted"),
+            (own_path[0], own_path[1], "survivors' own ⟨K⟩"),
+        )
+    ]
     numbers = {
-        "mu_measured": ve(*meas["paper"]), "mu_predicted": ve(*pred["c-measure", "paper"]),
-        "mu_by_window": {name: {"window": list(w), "measured": ve(*meas[name]),
-                                "predicted_c_measure": ve(*pred["c-measure", name]),
-                                "predicted_all_survivors": ve(*pred["all survivors", name]),
-                                "survivors_own_K": ve(*own[name])} for name, w in wins.items()},
+        "mu_measured": ve(*meas["paper"]),
+        "mu_predicted": ve(*pred["c-measure", "paper"]),
+        "mu_by_window": {
+            name: {
+                "window": list(w),
+                "measured": ve(*meas[name]),
+                "predicted_c_measure": ve(*pred["c-measure", name]),
+                "predicted_all_survivors": ve(*pred["all survivors", name]),
+                "survivors_own_K": ve(*own[name]),
+            }
+            for name, w in wins.items()
+        },
         "mu_c_at_E0": mu_c0,
-        "mu_conservative": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                             for k, v in r.items()} for r in mrows],
+        "mu_conservative": [
+            {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()} for r in mrows
+        ],
     }
     return mrows, curves, meas["paper"], numbers

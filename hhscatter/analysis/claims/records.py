@@ -1,4 +1,5 @@
 """Claim records and verdicts: ``{claim, quantity, system, value, err, reference, verdict, note}``."""
+
 from __future__ import annotations
 
 import math
@@ -52,12 +53,21 @@ class Claims:
     def add(self, claim, quantity, system, value, err, verdict, note="", reference=None) -> None:
         """Append one record {claim, quantity, system, value, err, reference, verdict, note}."""
         k = sum(r["claim"] == claim and r["system"] == system for r in self.rows)
-        rec = {"id": f"{system}-{claim}-{k}", "claim": claim, "quantity": quantity, "system": system,
-               **ve(value, err), "reference": reference, "verdict": verdict, "note": note}
+        rec = {
+            "id": f"{system}-{claim}-{k}",
+            "claim": claim,
+            "quantity": quantity,
+            "system": system,
+            **ve(value, err),
+            "reference": reference,
+            "verdict": verdict,
+            "note": note,
+        }
         self.rows.append(rec)
         if self.compare is not None:
-            self.compare(f"[{claim}] {quantity} — {system}", rec["value"], rec["err"], reference, verdict=verdict,
-                         note=note)
+            self.compare(
+                f"[{claim}] {quantity} — {system}", rec["value"], rec["err"], reference, verdict=verdict, note=note
+            )
 
 
 def with_ids(rows: list) -> list:
@@ -95,17 +105,17 @@ RULES = {
     "kappa": "escape_rate (plateau windows) and P-level windows, trapped-plateau check; law in ε = E/E_c − 1",
     "mu_measured": "fig3's: <E>(t) of orbits not escaped, settled continued; fixed-intercept log fit",
     "mu_predicted": "2<K>/E of the conservative flow (probe drag, c-measure) above E_c, microcanonical "
-                    "well below; path dE/dt = -gamma mu(E) E fitted like the measured curve",
+    "well below; path dE/dt = -gamma mu(E) E fitted like the measured curve",
     "taus": "fig4's: tau0 choose_windows(P_0), tau1 P_g = alpha P_0, tau2 first settling, Eq. (eq:tau2)",
     "kappa_cmeasure": "claim 2: every section crossing of a conservative run (KAM-trapped orbits dropped) on "
-                      "[ceil(tau0 + cm_rec_efolds/kappa), cm_t_to - cm_margin], Eq. (eqn:kappa_cmeasure_"
-                      "truetime), bootstrap over orbits; against kappa0 of the claim-1 run at that E/E_c",
+    "[ceil(tau0 + cm_rec_efolds/kappa), cm_t_to - cm_margin], Eq. (eqn:kappa_cmeasure_"
+    "truetime), bootstrap over orbits; against kappa0 of the claim-1 run at that E/E_c",
     "cmeasure_distance": "claim 5: first crossing after t* of the dissipative survivors vs the sprinkler "
-                         "points of mu_c at E(t*) and E0; paired debiased Hellinger, half-samples of orbits",
+    "points of mu_c at E(t*) and E0; paired debiased Hellinger, half-samples of orbits",
     "regular_fraction": "shadow FTLE: each orbit and a shadow d0 = ev_delta away on its energy shell, compared at "
-                        "their first section crossing after ev_t_max - ev_window; regular when the separation grew "
-                        "less than ev_g_max; orbits that left before: not regular",
+    "their first section crossing after ev_t_max - ev_window; regular when the separation grew "
+    "less than ev_g_max; orbits that left before: not regular",
     "survival_long": "Kaplan-Meier P(t) (Greenwood errors) of the ev runs to ev_t_max, disk ICs, gamma = 0",
     "long_time": "P(t|t0) = q + (1-q) exp(-kappa (t-t0)) by maximum likelihood on the lifetimes, censored orbits "
-                 "as censored (no conditioning on escape before t_max); the non-regular orbits alone with q = 0",
+    "as censored (no conditioning on escape before t_max); the non-regular orbits alone with q = 0",
 }

@@ -1,5 +1,6 @@
 """r_esc sensitivity of claims 3 and 5: μ measured, μ predicted, the survivors' own-⟨K⟩ μ and 2⟨K⟩/E at E0 itself,
 per escape radius, with the same N and rules for each (the default radius and ``resc_values``)."""
+
 from __future__ import annotations
 
 import math
@@ -44,26 +45,39 @@ def resc_rows(runs, systems) -> list:
                 try:
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore")
-                        fits["escaping", r] = escape_rate_from_lifetimes(lt[lt["outcome"] != "censored"],
-                                                                         detect_tail=False,
-                                                                         min_survivors=p.min_survivors)
+                        fits["escaping", r] = escape_rate_from_lifetimes(
+                            lt[lt["outcome"] != "censored"], detect_tail=False, min_survivors=p.min_survivors
+                        )
                 except (ValueError, RuntimeError):
                     pass
             keys = {r: resc_key(label, R, f"probe_r{r:.3f}") for r in p.resc_ratios}
             mdf = pd.DataFrame(mu_conservative(runs, label, m, fits, keys=keys))
-            meas, _, (own, _) = mu_measured(runs, label, m, E0, key=resc_key(label, R, f"g{p.mu_gamma:g}"),
-                                             n=p.resc_diss_n)
+            meas, _, (own, _) = mu_measured(
+                runs, label, m, E0, key=resc_key(label, R, f"g{p.mu_gamma:g}"), n=p.resc_diss_n
+            )
             pred, _, _ = mu_predicted(runs, mdf, ec, E0)
             c = mdf[(mdf["kind"] == "c-measure") & np.isclose(mdf["ratio"], p.e0_ratio)]
             r_esc = float(m.default_escape_radius(E0)) if R is None else float(R)
             for wname, w in mu_windows(runs).items():
                 (v, e), (pv, pe) = own[wname], pred["c-measure", wname]
-                out.append({"id": f"{label}-r{r_esc:g}-{wname}", "system": spec["name"], "label": label,
-                            "r_esc": r_esc, "default": R is None,
-                            "window": list(w), "mu_measured": ve(*meas[wname]), "mu_predicted": ve(pv, pe),
-                            "mu_own_K": ve(v, e), "moment_test": ve(v - pv, math.hypot(e, pe)),
-                            "kinetic_at_E0": ve(*(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))),
-                            "kinetic_at_E0_interpolated_without_E0": float(mu_of_E(
-                                mdf[~np.isclose(mdf["ratio"], p.e0_ratio)], ec)(E0)),
-                            "n_diss": p.resc_diss_n, "n_probe": p.resc_probe_n})
+                out.append(
+                    {
+                        "id": f"{label}-r{r_esc:g}-{wname}",
+                        "system": spec["name"],
+                        "label": label,
+                        "r_esc": r_esc,
+                        "default": R is None,
+                        "window": list(w),
+                        "mu_measured": ve(*meas[wname]),
+                        "mu_predicted": ve(pv, pe),
+                        "mu_own_K": ve(v, e),
+                        "moment_test": ve(v - pv, math.hypot(e, pe)),
+                        "kinetic_at_E0": ve(*(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))),
+                        "kinetic_at_E0_interpolated_without_E0": float(
+                            mu_of_E(mdf[~np.isclose(mdf["ratio"], p.e0_ratio)], ec)(E0)
+                        ),
+                        "n_diss": p.resc_diss_n,
+                        "n_probe": p.resc_probe_n,
+                    }
+                )
     return out

@@ -32,6 +32,7 @@ Functions here are pure (no file I/O, no plotting):
 Units: the model's natural units (unit mass); t in time units, E in energy
 units, γ in 1/time; μ is dimensionless.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -191,8 +192,17 @@ def pool_mean_energy(tables) -> pd.DataFrame:
     with np.errstate(invalid="ignore", divide="ignore"):
         std = np.where(n > 1, np.sqrt(m2 / np.maximum(n - 1, 1)), np.nan)
         sem = std / np.sqrt(n)
-    return pd.DataFrame({"t": n_s.index.to_numpy(dtype=float), "n": n.astype(np.int64), "mean_E": mean,
-                         "std_E": std, "sem_E": sem, "lo_3sigma": mean - 3 * std, "hi_3sigma": mean + 3 * std})
+    return pd.DataFrame(
+        {
+            "t": n_s.index.to_numpy(dtype=float),
+            "n": n.astype(np.int64),
+            "mean_E": mean,
+            "std_E": std,
+            "sem_E": sem,
+            "lo_3sigma": mean - 3 * std,
+            "hi_3sigma": mean + 3 * std,
+        }
+    )
 
 
 @dataclass(frozen=True)
@@ -382,9 +392,7 @@ def fit_energy_decay_table(
         with np.errstate(divide="ignore", invalid="ignore"):
             weights = (table["mean_E"].to_numpy() / table["sem_E"].to_numpy()) ** 2
         weights = np.where(np.isfinite(weights), weights, 0.0)
-    return fit_energy_decay(
-        table["t"].to_numpy(), table["mean_E"].to_numpy(), E0, gamma, window, weights
-    )
+    return fit_energy_decay(table["t"].to_numpy(), table["mean_E"].to_numpy(), E0, gamma, window, weights)
 
 
 def mu_by_window(
@@ -553,8 +561,9 @@ def bootstrap_mu(
     return pd.DataFrame(rows, columns=["replicate", "t_lo", "t_hi", "mu", "mu_free"])
 
 
-def bootstrap_mu_first_orbits(rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, windows, *,
-                              n_boot: int = 200, seed: int = 0):
+def bootstrap_mu_first_orbits(
+    rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, windows, *, n_boot: int = 200, seed: int = 0
+):
     """bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, windows, n_boot, seed) -> (replicates, scale).
 
     :func:`bootstrap_mu` on the snapshot rows (traj_id, t, energy) of the

@@ -11,6 +11,7 @@ Eq. (eqn:surv_prob_model), integrates. Pure functions (no I/O):
 
 Units: t in time units, hazard and κ in 1/time.
 """
+
 from __future__ import annotations
 
 import math
@@ -57,8 +58,17 @@ def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
     with np.errstate(invalid="ignore", divide="ignore"):
         h = np.where(exposure > 0, events / exposure, np.nan)
         err = np.where(exposure > 0, np.sqrt(events) / exposure, np.nan)
-    return pd.DataFrame({"t_lo": lo, "t_hi": hi, "t_mid": 0.5 * (lo + hi), "events": events, "exposure": exposure,
-                         "hazard": h, "hazard_err": err})
+    return pd.DataFrame(
+        {
+            "t_lo": lo,
+            "t_hi": hi,
+            "t_mid": 0.5 * (lo + hi),
+            "events": events,
+            "exposure": exposure,
+            "hazard": h,
+            "hazard_err": err,
+        }
+    )
 
 
 def observed_over_expected(bins: pd.DataFrame, rate) -> tuple[float, float, float]:

@@ -24,6 +24,7 @@ for a homogeneous V ∝ r^k, by the virial theorem). Pure functions (no I/O):
 
 Units: energies in energy units, t in time units, γ in 1/time; μ dimensionless.
 """
+
 from __future__ import annotations
 
 import math
@@ -31,8 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["KineticFraction", "decay_path", "kinetic_fraction_by_time", "kinetic_fraction_from_energies",
-           "microcanonical_kinetic_fraction"]
+__all__ = [
+    "KineticFraction",
+    "decay_path",
+    "kinetic_fraction_by_time",
+    "kinetic_fraction_from_energies",
+    "microcanonical_kinetic_fraction",
+]
 
 
 @dataclass(frozen=True)
@@ -57,8 +63,9 @@ def _checked_rows(traj_id, t, energy, gamma):
     return ids, t, e
 
 
-def kinetic_fraction_from_energies(traj_id, t, energy, gamma_probe: float, t_from: float, t_to: float, *,
-                                   keep=None, n_boot: int = 200, rng=None) -> KineticFraction:
+def kinetic_fraction_from_energies(
+    traj_id, t, energy, gamma_probe: float, t_from: float, t_to: float, *, keep=None, n_boot: int = 200, rng=None
+) -> KineticFraction:
     """kinetic_fraction_from_energies(traj_id, t, energy, γ_p, t_from, t_to, *, keep=None) -> KineticFraction.
 
     Snapshot rows (``traj_id``, ``t``, ``energy``) of a run with the probe drag ``gamma_probe`` (1/time). Every
@@ -194,8 +201,15 @@ def decay_path(t, E0: float, gamma: float, mu_of_E) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     if t.size == 0 or np.any(np.diff(t) < 0) or t[0] < 0:
         raise ValueError("t must be non-empty, ≥ 0 and increasing")
-    sol = solve_ivp(lambda _, y: [-gamma * float(mu_of_E(np.exp(y[0])))], (0.0, float(t[-1]) or 1.0),
-                    [math.log(E0)], t_eval=t, method="DOP853", rtol=1e-10, atol=1e-12)
+    sol = solve_ivp(
+        lambda _, y: [-gamma * float(mu_of_E(np.exp(y[0])))],
+        (0.0, float(t[-1]) or 1.0),
+        [math.log(E0)],
+        t_eval=t,
+        method="DOP853",
+        rtol=1e-10,
+        atol=1e-12,
+    )
     if not sol.success:
         raise RuntimeError(f"decay_path: {sol.message}")
     return np.exp(sol.y[0])

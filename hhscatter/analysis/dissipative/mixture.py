@@ -38,10 +38,11 @@ measures as the homogeneous model (:func:`~hhscatter.analysis.dissipative.model_
 
 Units: time in model units, energies in model units, rates in 1/time.
 """
+
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -419,15 +420,15 @@ def fit_mixture_model(
     names, free = _mixture_parameters(c.K, fne_mode, fixed)
     tau2_k = c.tau2(E_c)
     guess, b_starts = _mixture_start(tf, Pf, tau2_k, c.weights, P_tau0, p0)
-    prob = _MixtureProblem(tf, Pf, sf, kappa_of_E, c, tau0, E_c, hazard, space, fne_mode, free, fixed, guess,
-                           b_starts)
+    prob = _MixtureProblem(tf, Pf, sf, kappa_of_E, c, tau0, E_c, hazard, space, fne_mode, free, fixed, guess, b_starts)
     sol, res = prob.solve(prob.starts(), P_tau0)
     theta = sol.x if sol is not None else np.array([])
     model = prob.model(theta, P_tau0)
     r = res(theta)
     # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
-    st = _fit_stats(sol, model(tf), tf, Pf, r, len(free), absolute_sigma, P_tau0_err,
-                    lambda dP: prob.solve([sol.x], P_tau0 + dP)[0])
+    st = _fit_stats(
+        sol, model(tf), tf, Pf, r, len(free), absolute_sigma, P_tau0_err, lambda dP: prob.solve([sol.x], P_tau0 + dP)[0]
+    )
     values, errors = _mixture_values_errors(prob, theta, names, st, P_tau0, P_tau0_err, tau2_k)
     return _survival_fit(model, values, errors, free, st, tf, r, sol, space)
 
@@ -505,6 +506,7 @@ class _MixtureProblem:
 
     def bounds(self, P0):
         """(lo, hi) of θ: 0 ≤ f_ne_k ≤ w_k P(τ0), 0 ≤ phi ≤ 1, L ∈ [1e-9, 1e3], b ∈ [1e-6, 1e3]."""
+
         def bound(n):
             if n == "phi":
                 return (0.0, 1.0)
@@ -531,8 +533,9 @@ class _MixtureProblem:
     def model(self, theta, P0) -> MixtureModelParams:
         """The mixture model P(t) of θ."""
         v, fk = self.unpack(theta, P0)
-        return MixtureModelParams(self.kappa_of_E, self.components, self.tau0, fk, P0, v["L"], v["b"], self.E_c,
-                                  self.hazard)
+        return MixtureModelParams(
+            self.kappa_of_E, self.components, self.tau0, fk, P0, v["L"], v["b"], self.E_c, self.hazard
+        )
 
     def starts(self) -> list:
         """Starting θ, one per start of b."""

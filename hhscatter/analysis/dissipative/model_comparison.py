@@ -4,6 +4,7 @@ systems). The models and their fits are :mod:`hhscatter.analysis.dissipative.sur
 
 Units: time in model units, rates in 1/time.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -146,8 +147,10 @@ def better_fit(fits: dict) -> str | None:
     t_ref = np.asarray(items[0][1].t_fit)
     for name, f in items[1:]:
         if not np.array_equal(np.asarray(f.t_fit), t_ref):
-            raise ValueError(f"fit {name!r} was made on other points than {items[0][0]!r}; "
-                             "compare fits on the same data selection only")
+            raise ValueError(
+                f"fit {name!r} was made on other points than {items[0][0]!r}; "
+                "compare fits on the same data selection only"
+            )
     rms = np.array([f.rms_log_residual for _, f in items], dtype=float)
     if not np.isfinite(rms).all():
         raise ValueError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
@@ -185,8 +188,13 @@ def best_fit(fit_fn: Callable, starts):
     The χ² surface has local minima (the settling branch can be traded for a lower trapped fraction);
     starts whose fit raises RuntimeError or ValueError are skipped; none left is a RuntimeError.
     """
-    return _best_of(fit_fn, starts, lambda f: f.chi2, (RuntimeError, ValueError),
-                    "survival-model fit failed from every starting point")
+    return _best_of(
+        fit_fn,
+        starts,
+        lambda f: f.chi2,
+        (RuntimeError, ValueError),
+        "survival-model fit failed from every starting point",
+    )
 
 
 def plateau_level(t, P, t_q: float) -> float:
@@ -210,7 +218,23 @@ def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, ta
     starts = [None, {"f_ne": fne, "L": 1.0, "b": 1.0}, {"f_ne": fne, "L": 3.0, "b": 0.3}]
     fits = {}
     for h in hazards:
-        fits[h] = best_fit(lambda p0, h=h: fit_survival_model(
-            tf, Pf, sf, kappa_of_E=kappa, E0=E0, mu=mu, gamma=gamma, tau0=tau0, E_c=E_c, hazard=h,
-            fit_tau2=fit_tau2, P_min=P_min, P_tau0=P_tau0, p0=p0), starts)
+        fits[h] = best_fit(
+            lambda p0, h=h: fit_survival_model(
+                tf,
+                Pf,
+                sf,
+                kappa_of_E=kappa,
+                E0=E0,
+                mu=mu,
+                gamma=gamma,
+                tau0=tau0,
+                E_c=E_c,
+                hazard=h,
+                fit_tau2=fit_tau2,
+                P_min=P_min,
+                P_tau0=P_tau0,
+                p0=p0,
+            ),
+            starts,
+        )
     return fits

@@ -9,6 +9,7 @@
 
 This module only gathers their names (``from hhscatter.analysis.dissipative import models``).
 """
+
 from __future__ import annotations
 
 from hhscatter.analysis.dissipative.decay import energy_path, time_to_energy

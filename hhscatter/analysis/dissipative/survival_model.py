@@ -34,6 +34,7 @@ predicts and the figure studies' fitting rule are in :mod:`hhscatter.analysis.di
 
 Units: time in model units, energies in model units, rates in 1/time.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -283,6 +284,7 @@ def _best_of(fit_fn, starts, cost, errors, message):
 
 def _lsq(res, starts, lo, hi):
     """Best least_squares solution over several starting points."""
+
     def solve(x0):
         x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
         return optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
@@ -425,8 +427,25 @@ def fit_survival_model(
     tau2_eq, fit_tau2 = _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2)
     free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
     fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
-    prob = HomogeneousProblem(tf, Pf, sf, kappa_of_E, E0, mu, gamma, tau0, E_c, hazard, space, free, fixed,
-                              {"f_ne": fne0, "f_e": fe0, "L": L0}, b_starts, constrain_total, P_tau0)
+    prob = HomogeneousProblem(
+        tf,
+        Pf,
+        sf,
+        kappa_of_E,
+        E0,
+        mu,
+        gamma,
+        tau0,
+        E_c,
+        hazard,
+        space,
+        free,
+        fixed,
+        {"f_ne": fne0, "f_e": fe0, "L": L0},
+        b_starts,
+        constrain_total,
+        P_tau0,
+    )
     tau2_fit, tau2_err, sol, res = _fit_settling_time(prob, tau2_eq, fit_tau2, absolute_sigma)
     return _homogeneous_result(prob, sol, res, tau2_fit, tau2_err, fit_tau2, P_tau0_err, absolute_sigma)
 
@@ -481,8 +500,9 @@ def _fit_settling_time(prob: HomogeneousProblem, tau2_eq, fit_tau2, absolute_sig
     return tau2_fit, tau2_err, sol, res
 
 
-def _homogeneous_result(prob: HomogeneousProblem, sol, res, tau2_fit, tau2_err, fit_tau2, P_tau0_err,
-                        absolute_sigma) -> SurvivalFit:
+def _homogeneous_result(
+    prob: HomogeneousProblem, sol, res, tau2_fit, tau2_err, fit_tau2, P_tau0_err, absolute_sigma
+) -> SurvivalFit:
     """The SurvivalFit of a solution: goodness of fit, errors with P(τ0)'s error propagated through the constraint."""
     free, tf, P_tau0 = prob.free, prob.tf, prob.P_tau0
     k = len(free) + (1 if fit_tau2 else 0)
@@ -492,8 +512,7 @@ def _homogeneous_result(prob: HomogeneousProblem, sol, res, tau2_fit, tau2_err, 
     curve_vals = model(tf)
     r = res(theta)
     # propagate the error of the measured P(τ0) through the constraint
-    refit = ((lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0])
-             if prob.derive_fe else None)
+    refit = (lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0]) if prob.derive_fe else None
     st = _fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
     errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
     errors["tau2"] = tau2_err
@@ -560,10 +579,16 @@ class HomogeneousProblem:
     def bounds(self, P0=None):
         """(lo, hi) of θ: 0 ≤ f_ne ≤ P(τ0) (or 1), 0 ≤ f_e ≤ 1, L ∈ [1e-9, 1e3], b ∈ [1e-6, 1e3]."""
         P0 = self.P_tau0 if P0 is None else P0
-        bounds = {"f_ne": (0.0, P0 if self.constrain_total else 1.0), "f_e": (0.0, 1.0), "L": (1e-9, 1e3),
-                  "b": (1e-6, 1e3)}
-        return (np.array([bounds[n][0] for n in self.free], dtype=float),
-                np.array([bounds[n][1] for n in self.free], dtype=float))
+        bounds = {
+            "f_ne": (0.0, P0 if self.constrain_total else 1.0),
+            "f_e": (0.0, 1.0),
+            "L": (1e-9, 1e3),
+            "b": (1e-6, 1e3),
+        }
+        return (
+            np.array([bounds[n][0] for n in self.free], dtype=float),
+            np.array([bounds[n][1] for n in self.free], dtype=float),
+        )
 
     def values(self, theta, tau2, P0=None) -> dict:
         """All parameters from θ: the starts, overridden by ``fixed``, then θ; f_e derived; τ2 set."""
@@ -576,8 +601,20 @@ class HomogeneousProblem:
         return v
 
     def model(self, v: dict) -> SurvivalModelParams:
-        return SurvivalModelParams(self.kappa_of_E, self.E0, self.mu, self.gamma, self.tau0, v["tau2"], v["f_ne"],
-                                   v["f_e"], v["L"], v["b"], self.E_c, self.hazard)
+        return SurvivalModelParams(
+            self.kappa_of_E,
+            self.E0,
+            self.mu,
+            self.gamma,
+            self.tau0,
+            v["tau2"],
+            v["f_ne"],
+            v["f_e"],
+            v["L"],
+            v["b"],
+            self.E_c,
+            self.hazard,
+        )
 
     def starts(self, prev=None, warm_only: bool = False) -> list:
         """Starting θ: a previous solution (warm start) first, then one per start of b."""
@@ -631,13 +668,21 @@ class HomogeneousProblem:
         def chi2_at(tv):
             return self.fit_at(float(tv), warm)[1]
 
-        lo, hi = profile_interval(chi2_at, tau2_best, c2min, grid[0], grid[-1], delta=scale,
-                                  step=fine[1] - fine[0])
+        lo, hi = profile_interval(chi2_at, tau2_best, c2min, grid[0], grid[-1], delta=scale, step=fine[1] - fine[0])
         return tau2_best, float((hi - lo) / 2), sol, c2min, res
 
 
-def profile_interval(chi2_of, best: float, chi2_min: float, lo_edge: float, hi_edge: float, *, delta: float = 1.0,
-                     step: float | None = None, xtol: float = 1e-9) -> tuple[float, float]:
+def profile_interval(
+    chi2_of,
+    best: float,
+    chi2_min: float,
+    lo_edge: float,
+    hi_edge: float,
+    *,
+    delta: float = 1.0,
+    step: float | None = None,
+    xtol: float = 1e-9,
+) -> tuple[float, float]:
     """profile_interval(chi2_of, best, chi2_min, lo_edge, hi_edge, *, delta=1, step=None) -> (lo, hi): the ends of
     the region χ²(x) ≤ χ²_min + Δ of a profile χ²(x) around its minimum ``best``, by root-finding on each side.
 

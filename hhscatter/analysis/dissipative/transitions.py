@@ -18,6 +18,7 @@ survival curves themselves come from :mod:`hhscatter.analysis.survival.fits`;
 
 Units: model time units for all times; energies in model units.
 """
+
 from __future__ import annotations
 
 import math
@@ -53,6 +54,7 @@ __all__ = [
 # τ1
 # ---------------------------------------------------------------------------
 
+
 def outcome_is(outcome, value: str) -> np.ndarray:
     """outcome_is(outcome, value) -> bool array: outcome == value, without a Python string per orbit.
 
@@ -64,6 +66,7 @@ def outcome_is(outcome, value: str) -> np.ndarray:
     if isinstance(outcome, (pd.Series, pd.Categorical, pd.Index)):
         return np.array(outcome == value, dtype=bool).ravel()  # a writable copy (callers combine masks in place)
     return np.asarray(outcome).ravel() == value
+
 
 def _log_ratio(P_gamma, P_0, alpha):
     """D = ln P_γ − ln(α P_0), with +inf where P_0 = 0 < P_γ and NaN where both vanish."""
@@ -246,15 +249,15 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
         return 0.0 if j == 0 else (float(x[j - 1]) if j <= x.size else math.inf)
 
     k = max(1, math.ceil(n * p - 1e-12))
-    return OrderStatisticInterval(p=float(p), value=order(k), lo=order(r), hi=order(s), r=r, s=s, coverage=cov,
-                                  n=n, n_settled=int(x.size))
+    return OrderStatisticInterval(
+        p=float(p), value=order(k), lo=order(r), hi=order(s), r=r, s=s, coverage=cov, n=n, n_settled=int(x.size)
+    )
 
 
 def tau2_observed_interval(lifetimes: pd.DataFrame, level: float = 0.6826894921370859) -> OrderStatisticInterval:
     """tau2_observed_interval(lifetimes) -> :func:`settle_quantile_interval` at p = 1/N: the observed τ2 (first
     settling time) and the order-statistic interval of the quantile it estimates."""
-    return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"],
-                                    1.0 / len(lifetimes), level)
+    return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"], 1.0 / len(lifetimes), level)
 
 
 def tau2_predicted(E0, E_c, mu, gamma):

@@ -9,6 +9,7 @@ them. Pure functions: tables and result objects in, dicts and DataFrames out.
 Outcome codes of a basin map: 0 … n−1 the exit channel, :data:`SETTLED_CODE` settled (drag),
 :data:`TRAPPED_CODE` alive at t_max (or stopped), :data:`OUTSIDE` a forbidden cell (V ≥ E0).
 """
+
 from __future__ import annotations
 
 import math
@@ -99,7 +100,7 @@ def zoom_centre(labels, extent, box=5, clearance=0):
 
     ent = basin_entropy(labels, box, outside=OUTSIDE)  # box_entropy: the wholly valid boxes, row-major
     nr, nc = labels.shape[0] // box, labels.shape[1] // box
-    blocks = labels[:nr * box, :nc * box].reshape(nr, box, nc, box).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
+    blocks = labels[: nr * box, : nc * box].reshape(nr, box, nc, box).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
     valid = (blocks != OUTSIDE).all(axis=-1)
     grid = np.full((nr, nc), np.nan)
     grid[valid] = ent.box_entropy
@@ -108,14 +109,16 @@ def zoom_centre(labels, extent, box=5, clearance=0):
     if clearance > 0:
         # distance of every cell to the nearest forbidden cell or to the map's edge (padded as forbidden)
         dist = ndimage.distance_transform_edt(np.pad(labels != OUTSIDE, 1))[1:-1, 1:-1]
-        centres = dist[box // 2::box, box // 2::box][:nr, :nc]
+        centres = dist[box // 2 :: box, box // 2 :: box][:nr, :nc]
         grid[centres < clearance] = np.nan
         if np.all(np.isnan(grid)):
             raise ValueError(f"zoom_centre: no mixed box lies {clearance} cells inside the allowed region")
     i, j = np.unravel_index(np.nanargmax(grid), grid.shape)
     x0, x1, y0, y1 = extent
-    return (float(x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1]),
-            float(y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0]))
+    return (
+        float(x0 + (j + 0.5) * box * (x1 - x0) / labels.shape[1]),
+        float(y0 + (i + 0.5) * box * (y1 - y0) / labels.shape[0]),
+    )
 
 
 def uncertainty_row(codes, t_end, energy, gamma, eps):
@@ -129,8 +132,17 @@ def uncertainty_row(codes, t_end, energy, gamma, eps):
     uf = uncertainty_fraction(codes[:m], codes[m:])
     changed = codes[:m] != codes[m:]
     t_dec = np.minimum(t_end[:m], t_end[m:])[changed]
-    row = {"energy": energy, "gamma": gamma, "eps": eps, "f": uf.f, "f_lo": uf.lo, "f_hi": uf.hi, "k": uf.k,
-           "n": uf.n, "t_decide_median": float(np.median(t_dec)) if t_dec.size else math.nan}
+    row = {
+        "energy": energy,
+        "gamma": gamma,
+        "eps": eps,
+        "f": uf.f,
+        "f_lo": uf.lo,
+        "f_hi": uf.hi,
+        "k": uf.k,
+        "n": uf.n,
+        "t_decide_median": float(np.median(t_dec)) if t_dec.size else math.nan,
+    }
     return row, t_dec
 
 
@@ -154,9 +166,13 @@ def wada_record(w, basins):
     """The JSON record of a :class:`~hhscatter.analysis.geometry.basins.WadaTest` (None → None)."""
     if w is None:
         return None
-    return {"verdict": bool(w.wada), "basins": [CODE_NAMES[c] for c in basins],
-            "W_at_r": float(w.wada_fraction[min(w.r_wada, len(w.wada_fraction) - 1)]), "r": int(w.r_wada),
-            "hausdorff_slope": float(w.hausdorff_slope)}
+    return {
+        "verdict": bool(w.wada),
+        "basins": [CODE_NAMES[c] for c in basins],
+        "W_at_r": float(w.wada_fraction[min(w.r_wada, len(w.wada_fraction) - 1)]),
+        "r": int(w.r_wada),
+        "hausdorff_slope": float(w.hausdorff_slope),
+    }
 
 
 def rate_record(eps, times):
@@ -182,9 +198,9 @@ def point_record(E, g, hb, ec, ent, unc, loc, m):
     tau2 = math.log(E / ec) / g if g > 0 else math.inf
     smallest = unc.loc[m["ok"]].tail(1)
     return {
-        "energy": E, "gamma": g,
-        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in
-                      zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
+        "energy": E,
+        "gamma": g,
+        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
         "n_cells": int(fr.n),
         "channel_symmetry_p": float(m["chans"].p_value),
         "channel_shares_r_sym": [float(v) for v in m["chans"].frac],
@@ -192,24 +208,38 @@ def point_record(E, g, hb, ec, ent, unc, loc, m):
         "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
         "log2_fractal": bool(head.log2_fractal) if head is not None else None,
         "box_headline": hb,
-        "wada": {"verdict": bool(wada.wada), "basins": [CODE_NAMES[c] for c in m["present"]],
-                 "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
-                 "r": int(wada.r_wada), "hausdorff_slope": float(wada.hausdorff_slope)},
+        "wada": {
+            "verdict": bool(wada.wada),
+            "basins": [CODE_NAMES[c] for c in m["present"]],
+            "W_at_r": float(wada.wada_fraction[min(wada.r_wada, len(wada.wada_fraction) - 1)]),
+            "r": int(wada.r_wada),
+            "hausdorff_slope": float(wada.hausdorff_slope),
+        },
         "wada_exits": wada_record(m["wada_x"], m["exits"]),
-        "local_d": [{"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
-                    for r in loc.itertuples() if np.isfinite(r.d)],
+        "local_d": [
+            {"eps_mid": float(r.eps_mid), "d": float(r.d), "d_err": float(r.d_err)}
+            for r in loc.itertuples()
+            if np.isfinite(r.d)
+        ],
         "slim_fractal": m["slim"],
         "lyapunov_decision": m["rate"],
         "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
         "d": _ve(fit.d, fit.d_err) if fit else None,
         "alpha_fit_range": list(fit.eps_range) if fit else None,
         "alpha_fit_p": float(fit.p_value) if fit else None,
-        "cutoff": ({"detected": bool(cut.detected), "eps_c": float(cut.eps_c),
-                    "eps_c_lo": float(cut.eps_c_lo), "eps_c_hi": float(cut.eps_c_hi),
-                    "delta_aic": float(cut.delta_aic)} if cut else None),
+        "cutoff": (
+            {
+                "detected": bool(cut.detected),
+                "eps_c": float(cut.eps_c),
+                "eps_c_lo": float(cut.eps_c_lo),
+                "eps_c_hi": float(cut.eps_c_hi),
+                "delta_aic": float(cut.delta_aic),
+            }
+            if cut
+            else None
+        ),
         "tau2_mu1": tau2,
-        "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0])
-                                         if len(smallest) else None),
+        "t_decide_median_smallest_eps": (float(smallest["t_decide_median"].iloc[0]) if len(smallest) else None),
         "smallest_resolved_eps": float(smallest["eps"].iloc[0]) if len(smallest) else None,
     }
 
@@ -265,11 +295,13 @@ def energy_trend(scan, E_b, smooth_threshold=2.0):
     lo, hi = scan[~scan.above_E_b], scan[scan.above_E_b]
     out = {"E_b": E_b}
     for name, part in (("below_E_b", lo), ("above_E_b", hi)):
-        out[name] = {"S_b": smooth_chi2(part.energy, part.S_b, part.S_b_err),
-                     "S_bb": smooth_chi2(part.energy, part.S_bb, part.S_bb_err),
-                     "trapped_max": float(part.trapped.max()) if len(part) else math.nan,
-                     "wada_exits_all": bool(part.wada_exits.all()) if len(part) else None,
-                     "log2_all": bool(part.log2_fractal.all()) if len(part) else None}
+        out[name] = {
+            "S_b": smooth_chi2(part.energy, part.S_b, part.S_b_err),
+            "S_bb": smooth_chi2(part.energy, part.S_bb, part.S_bb_err),
+            "trapped_max": float(part.trapped.max()) if len(part) else math.nan,
+            "wada_exits_all": bool(part.wada_exits.all()) if len(part) else None,
+            "log2_all": bool(part.log2_fractal.all()) if len(part) else None,
+        }
     # where the change happens: the lowest scan energy E* from which on S_b(E) is smooth (a quadratic with
     # χ²/dof < smooth_threshold on every energy ≥ E*, at least 5 of them), to be set beside E_b
     for q in ("S_b", "S_bb"):
@@ -285,9 +317,11 @@ def energy_trend(scan, E_b, smooth_threshold=2.0):
     # the KAM islands' share (orbits alive at t_max at γ = 0): the lowest energy from which none remain
     srt = scan.sort_values("energy")
     trapped = srt.trapped.to_numpy() > 0
-    out["E_no_trapped"] = (float(srt.energy.iloc[np.flatnonzero(trapped).max() + 1])
-                           if trapped.any() and not trapped[-1] else
-                           (float(srt.energy.iloc[0]) if not trapped.any() else math.nan))
+    out["E_no_trapped"] = (
+        float(srt.energy.iloc[np.flatnonzero(trapped).max() + 1])
+        if trapped.any() and not trapped[-1]
+        else (float(srt.energy.iloc[0]) if not trapped.any() else math.nan)
+    )
     ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
     if ok.sum() >= 3:
         _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
@@ -315,25 +349,39 @@ def cutoff_records(per, scan, mu, mu_err, ec):
             continue
         E0, g, c = p["energy"], p["gamma"], p["cutoff"]
         det = bool(c and c["detected"])
-        cmp = cutoff_comparison(E0, g, ec, mu, mu_err, lam_E.energy, lam_E.lam, lam_E.lam_err, lam_alt=kg,
-                                measured=c["eps_c"] if det else None,
-                                measured_lo=c["eps_c_lo"] if c else None, measured_hi=c["eps_c_hi"] if c else None)
-        rec = {"E0": E0, "gamma": g,
-               "eps_c": c["eps_c"] if det else None,
-               "eps_c_err": 0.5 * (c["eps_c_hi"] - c["eps_c_lo"]) if det else None,
-               "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
-               "detected": det,
-               "eps_c_predicted": cmp.predicted,
-               "eps_c_predicted_interval": [cmp.predicted_lo, cmp.predicted_hi],
-               "eps_c_predicted_kantz_grassberger": cmp.predicted_alt if math.isfinite(cmp.predicted_alt) else None,
-               "tau2": math.log(E0 / ec) / (mu * g),
-               "smallest_resolved_eps": p["smallest_resolved_eps"],
-               "log10_ratio": cmp.log10_ratio if det else None,
-               "factor": cmp.factor if det else None,
-               "gap_decades": cmp.gap_decades,
-               "z": cmp.z if det else None,
-               "intervals_overlap": cmp.overlap,
-               "statement": cmp.statement}
+        cmp = cutoff_comparison(
+            E0,
+            g,
+            ec,
+            mu,
+            mu_err,
+            lam_E.energy,
+            lam_E.lam,
+            lam_E.lam_err,
+            lam_alt=kg,
+            measured=c["eps_c"] if det else None,
+            measured_lo=c["eps_c_lo"] if c else None,
+            measured_hi=c["eps_c_hi"] if c else None,
+        )
+        rec = {
+            "E0": E0,
+            "gamma": g,
+            "eps_c": c["eps_c"] if det else None,
+            "eps_c_err": 0.5 * (c["eps_c_hi"] - c["eps_c_lo"]) if det else None,
+            "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None,
+            "detected": det,
+            "eps_c_predicted": cmp.predicted,
+            "eps_c_predicted_interval": [cmp.predicted_lo, cmp.predicted_hi],
+            "eps_c_predicted_kantz_grassberger": cmp.predicted_alt if math.isfinite(cmp.predicted_alt) else None,
+            "tau2": math.log(E0 / ec) / (mu * g),
+            "smallest_resolved_eps": p["smallest_resolved_eps"],
+            "log10_ratio": cmp.log10_ratio if det else None,
+            "factor": cmp.factor if det else None,
+            "gap_decades": cmp.gap_decades,
+            "z": cmp.z if det else None,
+            "intervals_overlap": cmp.overlap,
+            "statement": cmp.statement,
+        }
         out.append(rec)
     return out
 
@@ -352,20 +400,34 @@ def cutoff_summary(records) -> dict:
     """
     det = [r for r in records if r.get("detected")]
     if not det:
-        return {"n_resolved": 0, "n_overlap": 0, "factor_min": math.nan, "factor_max": math.nan,
-                "mean_log10_ratio": math.nan, "n_below": 0,
-                "statement": "no cut-off is resolved at these (E0, γ)"}
+        return {
+            "n_resolved": 0,
+            "n_overlap": 0,
+            "factor_min": math.nan,
+            "factor_max": math.nan,
+            "mean_log10_ratio": math.nan,
+            "n_below": 0,
+            "statement": "no cut-off is resolved at these (E0, γ)",
+        }
     lr = np.array([r["log10_ratio"] for r in det])
     fac = np.array([r["factor"] for r in det])
     n_ov = sum(bool(r["intervals_overlap"]) for r in det)
     n_below = int(np.count_nonzero(lr < 0))
-    words = (f"over the {len(det)} resolved cut-offs the prediction is off by a factor {fac.min():.2g} to "
-             f"{fac.max():.2g} (measured below it in {n_below} of {len(det)}; geometric mean factor "
-             f"{10 ** abs(lr.mean()):.2g}); the 1σ intervals, the predicted one with the λ(E) systematic, "
-             f"overlap in {n_ov} of {len(det)}")
-    return {"n_resolved": len(det), "n_overlap": int(n_ov), "factor_min": float(fac.min()),
-            "factor_max": float(fac.max()), "mean_log10_ratio": float(lr.mean()), "n_below": n_below,
-            "statement": words}
+    words = (
+        f"over the {len(det)} resolved cut-offs the prediction is off by a factor {fac.min():.2g} to "
+        f"{fac.max():.2g} (measured below it in {n_below} of {len(det)}; geometric mean factor "
+        f"{10 ** abs(lr.mean()):.2g}); the 1σ intervals, the predicted one with the λ(E) systematic, "
+        f"overlap in {n_ov} of {len(det)}"
+    )
+    return {
+        "n_resolved": len(det),
+        "n_overlap": int(n_ov),
+        "factor_min": float(fac.min()),
+        "factor_max": float(fac.max()),
+        "mean_log10_ratio": float(lr.mean()),
+        "n_below": n_below,
+        "statement": words,
+    }
 
 
 def entropy_exponents(records, min_cells: int = 5) -> list:
@@ -394,8 +456,17 @@ def entropy_exponents(records, min_cells: int = 5) -> list:
         if len(part) < 3:
             continue
         _, slope, cov, _, _ = weighted_line(np.log(part.box_side), np.log(part.S_b), part.S_b_err / part.S_b)
-        out.append({"E0": float(E0), "gamma": float(g), "map": which, "grid": int(grid), "alpha": float(slope),
-                    "alpha_err": float(math.sqrt(cov[1, 1])), "sides": [float(v) for v in part.box_side]})
+        out.append(
+            {
+                "E0": float(E0),
+                "gamma": float(g),
+                "map": which,
+                "grid": int(grid),
+                "alpha": float(slope),
+                "alpha_err": float(math.sqrt(cov[1, 1])),
+                "sides": [float(v) for v in part.box_side],
+            }
+        )
     return out
 
 
@@ -407,16 +478,29 @@ def point_table(per) -> list:
     out = []
     for p in per:
         s, w, wx = p.get("slim_fractal") or {}, p["wada"], p.get("wada_exits")
-        out.append({"E0": p["energy"], "gamma": p["gamma"],
-                    "d": p["d"]["value"] if p["d"] else None, "d_err": p["d"]["err"] if p["d"] else None,
-                    "fit_p": (p.get("alpha_fit_p") if p.get("alpha_fit_p") != 0 else "< 1e-300 (underflow)"),
-                    "d_coarse": s.get("d_coarse"), "d_coarse_err": s.get("d_coarse_err"),
-                    "d_fine": s.get("d_fine"), "d_fine_err": s.get("d_fine_err"),
-                    "slope": s.get("slope"), "slope_err": s.get("slope_err"),
-                    "slim": "yes" if s.get("slim") else "no",
-                    "S_bb": p["S_bb"]["value"] if p["S_bb"] else None, "S_bb_err": p["S_bb"]["err"] if p["S_bb"] else None,
-                    "box_cells": p.get("box_headline"),
-                    "wada_all": f"{'yes' if w['verdict'] else 'no'} (W = {w['W_at_r']:.3f})",
-                    "wada_exits": (f"{'yes' if wx['verdict'] else 'no'} (W = {wx['W_at_r']:.3f})" if wx else
-                                   "— (fewer than 3 exit basins)")})
+        out.append(
+            {
+                "E0": p["energy"],
+                "gamma": p["gamma"],
+                "d": p["d"]["value"] if p["d"] else None,
+                "d_err": p["d"]["err"] if p["d"] else None,
+                "fit_p": (p.get("alpha_fit_p") if p.get("alpha_fit_p") != 0 else "< 1e-300 (underflow)"),
+                "d_coarse": s.get("d_coarse"),
+                "d_coarse_err": s.get("d_coarse_err"),
+                "d_fine": s.get("d_fine"),
+                "d_fine_err": s.get("d_fine_err"),
+                "slope": s.get("slope"),
+                "slope_err": s.get("slope_err"),
+                "slim": "yes" if s.get("slim") else "no",
+                "S_bb": p["S_bb"]["value"] if p["S_bb"] else None,
+                "S_bb_err": p["S_bb"]["err"] if p["S_bb"] else None,
+                "box_cells": p.get("box_headline"),
+                "wada_all": f"{'yes' if w['verdict'] else 'no'} (W = {w['W_at_r']:.3f})",
+                "wada_exits": (
+                    f"{'yes' if wx['verdict'] else 'no'} (W = {wx['W_at_r']:.3f})"
+                    if wx
+                    else "— (fewer than 3 exit basins)"
+                ),
+            }
+        )
     return out

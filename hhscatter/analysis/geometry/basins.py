@@ -83,6 +83,7 @@ are treated as outside.
 Units: box sizes, distances and r in grid cells (box sides in position units
 in :func:`entropy_by_box`); entropies in nats.
 """
+
 from __future__ import annotations
 
 import math
@@ -216,8 +217,9 @@ def basin_entropy(labels, box: int, *, outside: int = -1, min_valid: float = 1.0
     code = np.full(blocks.shape, keys.size, dtype=np.int64)  # keys.size marks outside
     code[valid] = inv.ravel()
     nk = keys.size + 1
-    counts = np.bincount((np.arange(blocks.shape[0])[:, None] * nk + code).ravel(),
-                         minlength=blocks.shape[0] * nk).reshape(blocks.shape[0], nk)[:, : keys.size]
+    counts = np.bincount(
+        (np.arange(blocks.shape[0])[:, None] * nk + code).ravel(), minlength=blocks.shape[0] * nk
+    ).reshape(blocks.shape[0], nk)[:, : keys.size]
     nvalid = counts.sum(axis=1)
     keep = (nvalid > 0) & (nvalid >= float(min_valid) * box * box - 1e-9)
     counts, nvalid = counts[keep], nvalid[keep]
@@ -245,8 +247,9 @@ def basin_entropy(labels, box: int, *, outside: int = -1, min_valid: float = 1.0
     return BasinEntropy(box, N, Nb, n_basins, S_b, S_b_err, S_bb, S_bb_err, fractal, z, S)
 
 
-def basin_entropy_table(labels, boxes=(2, 3, 4, 5, 8, 10, 16), *, outside: int = -1,
-                        min_valid: float = 1.0) -> pd.DataFrame:
+def basin_entropy_table(
+    labels, boxes=(2, 3, 4, 5, 8, 10, 16), *, outside: int = -1, min_valid: float = 1.0
+) -> pd.DataFrame:
     """basin_entropy_table(labels, boxes=(2, 3, 4, 5, 8, 10, 16), *, outside=-1, min_valid=1.0) -> DataFrame.
 
     :func:`basin_entropy` at each box side in ``boxes`` (those larger than the
@@ -258,8 +261,7 @@ def basin_entropy_table(labels, boxes=(2, 3, 4, 5, 8, 10, 16), *, outside: int =
     """
     lab = _int_labels(labels, "labels", ndim=2)
     sizes = [_positive_int(b, "boxes") for b in np.atleast_1d(boxes)]
-    cols = ("box", "n_boxes", "n_boundary", "n_basins", "S_b", "S_b_err", "S_bb", "S_bb_err", "log2_fractal",
-            "log2_z")
+    cols = ("box", "n_boxes", "n_boundary", "n_basins", "S_b", "S_b_err", "S_bb", "S_bb_err", "log2_fractal", "log2_z")
     rows = []
     for b in sizes:
         if b > min(lab.shape):
@@ -267,9 +269,20 @@ def basin_entropy_table(labels, boxes=(2, 3, 4, 5, 8, 10, 16), *, outside: int =
         try:
             r = basin_entropy(lab, b, outside=outside, min_valid=min_valid)
         except _NoBoxes:  # every box of this side has too many outside cells: a row of NaN
-            rows.append({"box": b, "n_boxes": 0, "n_boundary": 0, "n_basins": 0, "S_b": math.nan,
-                         "S_b_err": math.nan, "S_bb": math.nan, "S_bb_err": math.nan, "log2_fractal": False,
-                         "log2_z": math.nan})
+            rows.append(
+                {
+                    "box": b,
+                    "n_boxes": 0,
+                    "n_boundary": 0,
+                    "n_basins": 0,
+                    "S_b": math.nan,
+                    "S_b_err": math.nan,
+                    "S_bb": math.nan,
+                    "S_bb_err": math.nan,
+                    "log2_fractal": False,
+                    "log2_z": math.nan,
+                }
+            )
             continue
         rows.append({k: getattr(r, k) for k in cols})
     if not rows:
@@ -336,8 +349,9 @@ def _boundary_distances(lab, keys, outside_code):
     return bnd, np.array(dist).reshape(len(keys), -1)
 
 
-def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_wada: int = 3, tol: float = 0.01,
-                 steps=(1, 2, 4)) -> WadaTest:
+def wada_merging(
+    labels, *, basins=None, outside: int = -1, r_max: int = 10, r_wada: int = 3, tol: float = 0.01, steps=(1, 2, 4)
+) -> WadaTest:
     """wada_merging(labels, *, basins=None, outside=-1, r_max=10, r_wada=3, tol=0.01, steps=(1, 2, 4)) -> WadaTest(wada, r, wada_fraction, ...).
 
     The merging method of Daza, Wagemakers and Sanjuán (2018) on the 2-D
@@ -376,14 +390,22 @@ def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_w
         if nb == 0:
             if s == 1:
                 raise ValueError("labels: the map has no boundary between the basins tested")
-            rows.append({"step": s, "shape": sub.shape, "n_boundary": 0, "wada_fraction": math.nan,
-                         "hausdorff": math.nan})
+            rows.append(
+                {"step": s, "shape": sub.shape, "n_boundary": 0, "wada_fraction": math.nan, "hausdorff": math.nan}
+            )
             continue
         dmax = dist.max(axis=0)
         W = np.array([np.mean(dmax <= ri) for ri in r])
         haus = dist.max(axis=1)
-        rows.append({"step": s, "shape": sub.shape, "n_boundary": nb, "wada_fraction": float(W[r_wada]),
-                     "hausdorff": float(haus.max())})
+        rows.append(
+            {
+                "step": s,
+                "shape": sub.shape,
+                "n_boundary": nb,
+                "wada_fraction": float(W[r_wada]),
+                "hausdorff": float(haus.max()),
+            }
+        )
         if s == 1:
             covered = np.array([[np.mean(d <= ri) for ri in r] for d in dist])
             full = (W, covered, haus, nb)
@@ -392,8 +414,11 @@ def wada_merging(labels, *, basins=None, outside: int = -1, r_max: int = 10, r_w
     wada = bool(W[r_wada] >= 1.0 - float(tol))
     h = table["hausdorff"].to_numpy(dtype=float)
     ok = np.isfinite(h) & (h > 0)
-    slope = (float(np.polyfit(-np.log(table["step"].to_numpy(float)[ok]), np.log(h[ok]), 1)[0])
-             if np.count_nonzero(ok) >= 2 else math.nan)
+    slope = (
+        float(np.polyfit(-np.log(table["step"].to_numpy(float)[ok]), np.log(h[ok]), 1)[0])
+        if np.count_nonzero(ok) >= 2
+        else math.nan
+    )
     return WadaTest(wada, keys, r, W, covered, haus, nb, r_wada, float(tol), slope, table)
 
 
@@ -433,7 +458,7 @@ def box_counting_dimension(labels, sizes=(2, 4, 8, 16, 32), *, outside: int = -1
         nr, nc = lab.shape[0] // b, lab.shape[1] // b
         if nr == 0 or nc == 0:
             raise ValueError(f"sizes: box {b} exceeds the map {lab.shape}")
-        blk = lab[:nr * b, :nc * b].reshape(nr, b, nc, b).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
+        blk = lab[: nr * b, : nc * b].reshape(nr, b, nc, b).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
         valid = (blk != outside).all(axis=-1)
         mixed = blk.min(axis=-1) != blk.max(axis=-1)
         counts.append(int(np.count_nonzero(valid & mixed)))
@@ -504,8 +529,19 @@ def entropy_by_box(labels, extent, sides, *, outside: int = -1, min_valid: float
         if not (abs(c - round(c)) <= 1e-9 * max(1.0, c) and round(c) >= 1):
             raise ValueError(f"sides: {s:g} is {c:.4g} cells of the {n}² map, not a whole number")
         r = basin_entropy(lab, int(round(c)), outside=outside, min_valid=min_valid)
-        rows.append({"grid": n, "box_side": float(s), "box_cells": int(round(c)), "n_boxes": r.n_boxes,
-                     "n_boundary": r.n_boundary, "S_b": r.S_b, "S_b_err": r.S_b_err, "S_bb": r.S_bb,
-                     "S_bb_err": r.S_bb_err})
-    return pd.DataFrame(rows, columns=["grid", "box_side", "box_cells", "n_boxes", "n_boundary", "S_b", "S_b_err",
-                                       "S_bb", "S_bb_err"])
+        rows.append(
+            {
+                "grid": n,
+                "box_side": float(s),
+                "box_cells": int(round(c)),
+                "n_boxes": r.n_boxes,
+                "n_boundary": r.n_boundary,
+                "S_b": r.S_b,
+                "S_b_err": r.S_b_err,
+                "S_bb": r.S_bb,
+                "S_bb_err": r.S_bb_err,
+            }
+        )
+    return pd.DataFrame(
+        rows, columns=["grid", "box_side", "box_cells", "n_boxes", "n_boundary", "S_b", "S_b_err", "S_bb", "S_bb_err"]
+    )

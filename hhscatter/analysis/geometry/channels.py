@@ -22,6 +22,7 @@ The paired κ shifts between two criteria are in :mod:`hhscatter.analysis.surviv
 Units: model units (unit mass; ω = λ = 1 gives saddle distance 1, E_c = 1/6);
 times in time units, κ in 1/time.
 """
+
 from __future__ import annotations
 
 import math
@@ -126,8 +127,9 @@ def _wall_x(model, energy, y):
         return np.sqrt(num / den)
 
 
-def lyapunov_orbit(energy: float, model: HenonHeiles | None = None, *, rtol: float = 1e-12,
-                   n_samples: int = 400) -> LyapunovOrbit:
+def lyapunov_orbit(
+    energy: float, model: HenonHeiles | None = None, *, rtol: float = 1e-12, n_samples: int = 400
+) -> LyapunovOrbit:
     """lyapunov_orbit(energy, model=None) -> LyapunovOrbit(r_min, r_max, period, ...).
 
     The Lyapunov orbit of exit channel 0 at energy E > E_c: the unstable
@@ -162,8 +164,16 @@ def lyapunov_orbit(energy: float, model: HenonHeiles | None = None, *, rtol: flo
 
     def shoot(yb, dense=False):
         xb = float(_wall_x(model, E, yb))
-        sol = integrate.solve_ivp(rhs, t_span, [xb, yb, 0.0, 0.0], method="DOP853", events=axis_hit,
-                                  rtol=rtol, atol=rtol * 1e-2, dense_output=dense)
+        sol = integrate.solve_ivp(
+            rhs,
+            t_span,
+            [xb, yb, 0.0, 0.0],
+            method="DOP853",
+            events=axis_hit,
+            rtol=rtol,
+            atol=rtol * 1e-2,
+            dense_output=dense,
+        )
         if not sol.t_events[0].size:
             return (math.nan, sol) if dense else math.nan
         return (sol.y_events[0][0][3], sol) if dense else sol.y_events[0][0][3]
@@ -180,13 +190,23 @@ def lyapunov_orbit(energy: float, model: HenonHeiles | None = None, *, rtol: flo
     quarter = float(sol.t_events[0][0])
     # the brake orbit goes brake point → axis → mirror brake point and back: period = 4 quarters
     xb = float(_wall_x(model, E, yb))
-    full = integrate.solve_ivp(rhs, (0.0, 4 * quarter), [xb, yb, 0.0, 0.0], method="DOP853", rtol=rtol,
-                               atol=rtol * 1e-2, dense_output=True)
+    full = integrate.solve_ivp(
+        rhs, (0.0, 4 * quarter), [xb, yb, 0.0, 0.0], method="DOP853", rtol=rtol, atol=rtol * 1e-2, dense_output=True
+    )
     t = np.linspace(0.0, 4 * quarter, int(n_samples) + 1)
     states = full.sol(t).T
     r = np.hypot(states[:, 0], states[:, 1])
-    return LyapunovOrbit(energy=E, x_b=xb, y_b=float(yb), y_axis=float(sol.y_events[0][0][1]),
-                         r_min=float(r.min()), r_max=float(r.max()), period=4 * quarter, t=t, states=states)
+    return LyapunovOrbit(
+        energy=E,
+        x_b=xb,
+        y_b=float(yb),
+        y_axis=float(sol.y_events[0][0][1]),
+        r_min=float(r.min()),
+        r_max=float(r.max()),
+        period=4 * quarter,
+        t=t,
+        states=states,
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -236,5 +256,3 @@ def return_statistics(orbit, t, radius, direction, n_orbits: int, r_esc: float, 
     o, tt = first_per_orbit(again)
     t_re[o] = tt
     return {"t_esc": t_esc, "returned": np.isfinite(t_ret), "t_return": t_ret, "t_reesc": t_re}
-
-

@@ -17,6 +17,7 @@ at ε_c = e^{−Λ}, Λ = ∫_0^τ2 λ(E(t)) dt.
 Pure functions (arrays in, numbers out). Units: ε in position units of the
 initial conditions; λ in 1/time; energies in the Hamiltonian's units.
 """
+
 from __future__ import annotations
 
 import math
@@ -72,8 +73,15 @@ def decision_rate(eps, times) -> DecisionRate:
         t = np.asarray(t, dtype=float)
         t = t[np.isfinite(t)]
         if t.size >= 3 and e > 0:
-            rows.append({"eps": e, "x": math.log(1.0 / e), "t_mean": float(t.mean()),
-                         "t_sem": float(t.std(ddof=1) / math.sqrt(t.size)), "m": int(t.size)})
+            rows.append(
+                {
+                    "eps": e,
+                    "x": math.log(1.0 / e),
+                    "t_mean": float(t.mean()),
+                    "t_sem": float(t.std(ddof=1) / math.sqrt(t.size)),
+                    "m": int(t.size),
+                }
+            )
     tab = pd.DataFrame(rows, columns=["eps", "x", "t_mean", "t_sem", "m"])
     if len(tab) < 2 or tab["x"].nunique() < 2:
         raise ValueError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
@@ -81,8 +89,15 @@ def decision_rate(eps, times) -> DecisionRate:
     s_err = float(math.sqrt(cov[1, 1]))
     if not slope > 0:
         raise ValueError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
-    return DecisionRate(lam=1.0 / slope, lam_err=s_err / slope ** 2, t0=t0,
-                        t0_err=float(math.sqrt(cov[0, 0])), chi2=chi2, dof=dof, table=tab)
+    return DecisionRate(
+        lam=1.0 / slope,
+        lam_err=s_err / slope**2,
+        t0=t0,
+        t0_err=float(math.sqrt(cov[0, 0])),
+        chi2=chi2,
+        dof=dof,
+        table=tab,
+    )
 
 
 def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: float) -> float:
@@ -150,8 +165,21 @@ class CutoffComparison:
     statement: str = field(repr=False)
 
 
-def cutoff_comparison(E0, gamma, e_c, mu, mu_err, energies, lam, lam_err, *, lam_alt=None,
-                      measured=None, measured_lo=None, measured_hi=None) -> CutoffComparison:
+def cutoff_comparison(
+    E0,
+    gamma,
+    e_c,
+    mu,
+    mu_err,
+    energies,
+    lam,
+    lam_err,
+    *,
+    lam_alt=None,
+    measured=None,
+    measured_lo=None,
+    measured_hi=None,
+) -> CutoffComparison:
     """Measured against predicted cut-off ε_c, with the systematic of λ(E) in the predicted interval.
 
     The prediction (:func:`predicted_cutoff`) uses the decision rate ``lam`` (± ``lam_err``, shifted
@@ -177,8 +205,11 @@ def cutoff_comparison(E0, gamma, e_c, mu, mu_err, energies, lam, lam_err, *, lam
     lam, lam_err = np.asarray(lam, dtype=float), np.asarray(lam_err, dtype=float)
     mus = [m for m in (mu - mu_err, mu, mu + mu_err) if m > 0] if math.isfinite(mu_err) else [mu]
     pred = predicted_cutoff(E0, gamma, mu, En, lam, e_c)
-    cands = [predicted_cutoff(E0, gamma, m, En, np.maximum(lam + s * lam_err, 0.0), e_c)
-             for m in mus for s in (-1.0, 0.0, 1.0)]
+    cands = [
+        predicted_cutoff(E0, gamma, m, En, np.maximum(lam + s * lam_err, 0.0), e_c)
+        for m in mus
+        for s in (-1.0, 0.0, 1.0)
+    ]
     alt = math.nan
     if lam_alt is not None and np.any(np.isfinite(lam_alt)):
         alt = predicted_cutoff(E0, gamma, mu, En, np.asarray(lam_alt, dtype=float), e_c)
@@ -188,7 +219,7 @@ def cutoff_comparison(E0, gamma, e_c, mu, mu_err, energies, lam, lam_err, *, lam
     m = float(measured) if det else math.nan
     m_lo = float(measured_lo) if det and measured_lo is not None else (0.0 if not det else m)
     m_hi = float(measured_hi) if measured_hi is not None else m
-    lg = (lambda v: math.log10(v) if v > 0 else -math.inf)
+    lg = lambda v: math.log10(v) if v > 0 else -math.inf
     if det and pred > 0:
         r = math.log10(m / pred)
         gap = max(0.0, lg(m_lo) - lg(p_hi), lg(p_lo) - lg(m_hi))
@@ -196,15 +227,33 @@ def cutoff_comparison(E0, gamma, e_c, mu, mu_err, energies, lam, lam_err, *, lam
         sp = (lg(p_hi) - lg(pred)) if r > 0 else (lg(pred) - lg(p_lo))
         z = r / math.hypot(sm, sp) if math.hypot(sm, sp) > 0 else math.inf
         side = "below" if r < 0 else "above"
-        words = (f"measured ε_c lies a factor {10 ** abs(r):.2g} {side} the prediction; "
-                 + ("the intervals overlap" if gap == 0 else
-                    f"the intervals are {gap:.2g} decades apart (z = {z:+.1f} with both widths)"))
+        words = f"measured ε_c lies a factor {10 ** abs(r):.2g} {side} the prediction; " + (
+            "the intervals overlap"
+            if gap == 0
+            else f"the intervals are {gap:.2g} decades apart (z = {z:+.1f} with both widths)"
+        )
     else:
         r, z = math.nan, math.nan
         gap = max(0.0, lg(p_lo) - lg(m_hi))
-        words = (f"no cut-off resolved (ε_c < {m_hi:.2g}); predicted {pred:.2g}: "
-                 + ("consistent, below the smallest ε resolved" if pred < m_hi else
-                    "above that bound, its interval reaching below it" if gap == 0 else
-                    f"the predicted interval lies {gap:.2g} decades above that bound"))
-    return CutoffComparison(pred, p_lo, p_hi, alt, m, m_lo if det else math.nan, m_hi, r,
-                            10 ** abs(r) if math.isfinite(r) else math.nan, gap, z, bool(gap == 0), words)
+        words = f"no cut-off resolved (ε_c < {m_hi:.2g}); predicted {pred:.2g}: " + (
+            "consistent, below the smallest ε resolved"
+            if pred < m_hi
+            else "above that bound, its interval reaching below it"
+            if gap == 0
+            else f"the predicted interval lies {gap:.2g} decades above that bound"
+        )
+    return CutoffComparison(
+        pred,
+        p_lo,
+        p_hi,
+        alt,
+        m,
+        m_lo if det else math.nan,
+        m_hi,
+        r,
+        10 ** abs(r) if math.isfinite(r) else math.nan,
+        gap,
+        z,
+        bool(gap == 0),
+        words,
+    )

@@ -68,9 +68,11 @@ difference becomes detectable at coarser ε.
 Inputs are arrays of shape (n, 2) with columns (x, y) (any 2-D coordinates).
 Outputs: dimensionless for TV/H, length units for SW.
 """
+
 from __future__ import annotations
 
-from typing import Callable, NamedTuple
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -110,8 +112,9 @@ def points(df: pd.DataFrame, columns=("x", "y")) -> np.ndarray:
     return np.column_stack([df[c].to_numpy(dtype=float) for c in columns])
 
 
-def first_crossings(sections: pd.DataFrame, t_from: float, *, e_min: float = -np.inf,
-                    e_max: float = np.inf) -> pd.DataFrame:
+def first_crossings(
+    sections: pd.DataFrame, t_from: float, *, e_min: float = -np.inf, e_max: float = np.inf
+) -> pd.DataFrame:
     """first_crossings(sections, t_from, *, e_min=-inf, e_max=inf) -> DataFrame, one row per orbit.
 
     For each ``traj_id`` of the engine's ``sections`` table (columns traj_id,
@@ -184,7 +187,7 @@ def box_histograms(P, Q, box: float, extent=None, weights_P=None, weights_Q=None
     wp = np.ones(P.shape[0]) if weights_P is None else np.asarray(weights_P, dtype=float)
     wq = np.ones(Q.shape[0]) if weights_Q is None else np.asarray(weights_Q, dtype=float)
     p = np.bincount(inv[: P.shape[0]], weights=wp, minlength=uniq.size)
-    q = np.bincount(inv[P.shape[0]:], weights=wq, minlength=uniq.size)
+    q = np.bincount(inv[P.shape[0] :], weights=wq, minlength=uniq.size)
     return p / p.sum(), q / q.sum()
 
 
@@ -376,8 +379,7 @@ def debiased_distance(table: pd.DataFrame, kind: str = "hellinger"):
     return (np.sqrt(np.maximum(d2, 0.0)), np.sqrt(np.maximum(d2 - s2, 0.0)), np.sqrt(np.maximum(d2 + s2, 0.0)))
 
 
-def agreement_scale_debiased(table: pd.DataFrame, delta: float = 0.1, kind: str = "hellinger",
-                             noise_max: float = 0.5):
+def agreement_scale_debiased(table: pd.DataFrame, delta: float = 0.1, kind: str = "hellinger", noise_max: float = 0.5):
     """agreement_scale_debiased(table, delta=0.1, kind="hellinger", noise_max=0.5) -> float or None.
 
     Like :func:`agreement_scale`, but with a tolerance instead of a
@@ -485,8 +487,10 @@ def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> 
     if int(n_boot) < 1:
         raise ValueError(f"n_boot must be >= 1, got {n_boot!r}")
     rng = np.random.default_rng(seed)
-    draws = [fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
-             for _ in range(int(n_boot))]
+    draws = [
+        fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
+        for _ in range(int(n_boot))
+    ]
     return _mean_std(draws)
 
 
@@ -525,9 +529,7 @@ def split_half_noise(P, Q, fn: Callable, m: int | None = None, n_splits: int = 8
     return _mean_std(vals)
 
 
-def split_half_baseline(
-    P, fn: Callable, n_splits: int = 20, seed: int = 0, size: int | None = None
-) -> BootstrapResult:
+def split_half_baseline(P, fn: Callable, n_splits: int = 20, seed: int = 0, size: int | None = None) -> BootstrapResult:
     """split_half_baseline(P, fn, n_splits=20, seed=0, size=None) -> BootstrapResult(mean, std).
 
     Finite-sample noise floor of the distance ``fn``: mean and std (ddof = 1)

@@ -26,6 +26,7 @@ The harmonic well V = r²/2 at E = 1 inside R = 1: Φ = 2π·2√(2 − 1) = 4π
 >>> round(r.rate, 4), round(2 / 3.141592653589793, 4)
 (0.6366, 0.6366)
 """
+
 from __future__ import annotations
 
 import math

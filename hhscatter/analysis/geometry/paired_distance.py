@@ -5,6 +5,7 @@ generality). The distances themselves are :mod:`hhscatter.analysis.geometry.dist
 
 Units: positions in the section's units; Hellinger distances are dimensionless.
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -30,18 +31,18 @@ class UnitSet(NamedTuple):
     (e.g. the orbit's ``traj_id``) and its group: sets of one group share one id space (one run, e.g. 5a and
     5b, or a set and its subset) and are half-sampled together; different groups independently."""
 
-    points: np.ndarray   # (n, 2) points (x, y)
-    units: np.ndarray    # (n,) unit of each point
-    group: str           # the run whose units the set shares
+    points: np.ndarray  # (n, 2) points (x, y)
+    units: np.ndarray  # (n,) unit of each point
+    group: str  # the run whose units the set shares
 
 
 class PairedDifference(NamedTuple):
     """Result of :func:`paired_hellinger_difference` (Hellinger distances, dimensionless)."""
 
-    d_a: float          # debiased, offset-averaged H(A, R): mean over half-sample replicates
-    d_b: float          # the same for B
-    delta: float        # d_b − d_a (mean over replicates)
-    lo: float           # percentile interval of Δ over the replicates (level ``level``)
+    d_a: float  # debiased, offset-averaged H(A, R): mean over half-sample replicates
+    d_b: float  # the same for B
+    delta: float  # d_b − d_a (mean over replicates)
+    lo: float  # percentile interval of Δ over the replicates (level ``level``)
     hi: float
     d_a_interval: tuple  # percentile intervals of d_a and d_b
     d_b_interval: tuple
@@ -95,7 +96,14 @@ def percentile_interval(values, level: float = 0.95):
 
 
 def paired_hellinger_replicates(
-    sets, pairs, boxes, extent, *, offsets: int = 2, n_boot: int = 100, seed: int = 0,
+    sets,
+    pairs,
+    boxes,
+    extent,
+    *,
+    offsets: int = 2,
+    n_boot: int = 100,
+    seed: int = 0,
 ) -> np.ndarray:
     """Debiased Hellinger distances of several pairs of sets, on common half-samples of every set's units.
 
@@ -159,8 +167,11 @@ def paired_hellinger_replicates(
         noise = {n: [np.array([_h2_counts(h, c) for h, c in row]) for row in counts[n]] for n in used}
         for i, (x, ref) in enumerate(pairs):
             for j in range(len(boxes)):
-                h2 = (np.array([_h2_counts(hx, hr) for (hx, _), (hr, _) in zip(counts[x][j], counts[ref][j])])
-                      - 0.5 * noise[x][j] - 0.5 * noise[ref][j])
+                h2 = (
+                    np.array([_h2_counts(hx, hr) for (hx, _), (hr, _) in zip(counts[x][j], counts[ref][j])])
+                    - 0.5 * noise[x][j]
+                    - 0.5 * noise[ref][j]
+                )
                 out[r, i, j] = np.sqrt(max(h2.mean(), 0.0))
     return out
 
@@ -202,8 +213,19 @@ def _half_counts(name, s, halves, cells, totals):
 
 
 def paired_hellinger_difference(
-    A, B, R, box: float, extent, *, units_a, units_b, units_r, offsets: int = 2, n_boot: int = 100,
-    level: float = 0.95, seed: int = 0,
+    A,
+    B,
+    R,
+    box: float,
+    extent,
+    *,
+    units_a,
+    units_b,
+    units_r,
+    offsets: int = 2,
+    n_boot: int = 100,
+    level: float = 0.95,
+    seed: int = 0,
 ) -> PairedDifference:
     """Δ = H(B, R) − H(A, R) with a paired interval that resamples the independent unit of every set.
 
@@ -258,13 +280,21 @@ def paired_hellinger_difference(
     if not 0 < level < 1:
         raise ValueError(f"level must be in (0, 1), got {level!r}")
     sets = {"A": UnitSet(A, units_a, "run"), "B": UnitSet(B, units_b, "run"), "R": UnitSet(R, units_r, "ref")}
-    reps = paired_hellinger_replicates(sets, [("A", "R"), ("B", "R")], [box], extent, offsets=offsets,
-                                       n_boot=n_boot, seed=seed)[:, :, 0]
+    reps = paired_hellinger_replicates(
+        sets, [("A", "R"), ("B", "R")], [box], extent, offsets=offsets, n_boot=n_boot, seed=seed
+    )[:, :, 0]
     da, db = reps[:, 0], reps[:, 1]
     d, lo, hi = percentile_interval(db - da, level)
     extents = _offset_extents(extent, float(box), int(offsets))
     full = np.sqrt(_h2(B, R, box, extents)) - np.sqrt(_h2(A, R, box, extents))
     return PairedDifference(
-        d_a=float(da.mean()), d_b=float(db.mean()), delta=d, lo=lo, hi=hi,
-        d_a_interval=percentile_interval(da, level)[1:], d_b_interval=percentile_interval(db, level)[1:],
-        offset_spread=float(full.std(ddof=1)) if full.size > 1 else 0.0, n_boot=int(n_boot))
+        d_a=float(da.mean()),
+        d_b=float(db.mean()),
+        delta=d,
+        lo=lo,
+        hi=hi,
+        d_a_interval=percentile_interval(da, level)[1:],
+        d_b_interval=percentile_interval(db, level)[1:],
+        offset_spread=float(full.std(ddof=1)) if full.size > 1 else 0.0,
+        n_boot=int(n_boot),
+    )

@@ -31,6 +31,7 @@ Examples
 >>> ind["regular"].tolist()
 [True, False]
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -84,8 +85,9 @@ def shadow_ics(states, potential, delta: float = SHADOW_DELTA) -> tuple[np.ndarr
     return out, np.linalg.norm(out - s, axis=1)
 
 
-def shadow_indicator(base_sections: pd.DataFrame, shadow_sections: pd.DataFrame, traj_ids, d0, t_from: float, *,
-                     g_max: float = G_MAX) -> pd.DataFrame:
+def shadow_indicator(
+    base_sections: pd.DataFrame, shadow_sections: pd.DataFrame, traj_ids, d0, t_from: float, *, g_max: float = G_MAX
+) -> pd.DataFrame:
     """shadow_indicator(base_sections, shadow_sections, traj_ids, d0, t_from, g_max=1e4) -> DataFrame per orbit.
 
     For each orbit of ``traj_ids`` (shadows share the base's traj_id), its first section crossing at t ≥ ``t_from``

@@ -49,6 +49,7 @@ Example
 >>> bool(round(true_time_kappa(tr), 6) == round(-np.log(0.25) / 3.0, 6))
 True
 """
+
 from __future__ import annotations
 
 import math
@@ -61,9 +62,29 @@ from scipy import optimize
 from scipy.sparse import csgraph
 from scipy.sparse.linalg import eigs
 
-__all__ = ["DENSE_MAX", "ClassInfo", "Transitions", "bootstrap_kappa", "box_index", "capped_share", "communicating_classes", "first_crossing_after",
-           "first_crossing_weights", "lag_kernels", "leading_left", "map_escape_rate", "propagate", "saddle_class", "saddle_measure", "section_flux_density",
-           "spectral_radius", "sprinkler_weights", "survival_from_crossings", "transfer_matrix", "true_time_kappa"]
+__all__ = [
+    "DENSE_MAX",
+    "ClassInfo",
+    "Transitions",
+    "bootstrap_kappa",
+    "box_index",
+    "capped_share",
+    "communicating_classes",
+    "first_crossing_after",
+    "first_crossing_weights",
+    "lag_kernels",
+    "leading_left",
+    "map_escape_rate",
+    "propagate",
+    "saddle_class",
+    "saddle_measure",
+    "section_flux_density",
+    "spectral_radius",
+    "sprinkler_weights",
+    "survival_from_crossings",
+    "transfer_matrix",
+    "true_time_kappa",
+]
 
 DENSE_MAX = 64  # below this many states the dense LAPACK eigensolver is used (ARPACK needs k < n − 1)
 
@@ -90,8 +111,9 @@ class Transitions:
         w = np.ones(src.size) if self.w is None else np.asarray(self.w, dtype=float).ravel()
         n = int(self.n_states)
         if not (src.size == dst.size == T.size == w.size):
-            raise ValueError(f"src, dst, T, w must have one entry per sample, got sizes "
-                             f"{src.size}, {dst.size}, {T.size}, {w.size}")
+            raise ValueError(
+                f"src, dst, T, w must have one entry per sample, got sizes {src.size}, {dst.size}, {T.size}, {w.size}"
+            )
         if src.size and (src.min() < 0 or src.max() >= n):
             raise ValueError(f"src must lie in [0, n_states = {n})")
         if dst.size and dst.max() >= n:
@@ -119,7 +141,7 @@ class Transitions:
         with np.errstate(invalid="ignore", divide="ignore"):
             return esc / self.row_weight
 
-    def subset(self, keep) -> "Transitions":
+    def subset(self, keep) -> Transitions:
         """subset(keep) -> Transitions on the states where ``keep`` (bool, n_states) holds, renumbered;
         samples from dropped states are removed, samples *into* dropped states become escapes."""
         keep = np.asarray(keep, dtype=bool)
@@ -167,16 +189,24 @@ def _arpack_leading(A, tol: float, *, vector: bool):
     n = A.shape[0]
     # start from the uniform vector: it overlaps every non-negative Perron vector, and fixes ARPACK's
     # otherwise random start, so that the result does not depend on earlier calls in the process
-    kw = dict(k=1, which="LR", tol=tol, maxiter=max(2000, 20 * n), return_eigenvectors=vector,
-              v0=np.full(n, 1.0 / math.sqrt(n)))
+    kw = dict(
+        k=1,
+        which="LR",
+        tol=tol,
+        maxiter=max(2000, 20 * n),
+        return_eigenvectors=vector,
+        v0=np.full(n, 1.0 / math.sqrt(n)),
+    )
     try:
         out = eigs(At, **kw)
     except sp.linalg.ArpackNoConvergence:
         try:
             out = eigs(At, ncv=min(n - 1, 64), **kw)
         except sp.linalg.ArpackNoConvergence as e:
-            raise ValueError(f"ARPACK found no Perron root of this {n}-state matrix (largest real part, "
-                             "64 Lanczos vectors): its spectrum is too close to a circle") from e
+            raise ValueError(
+                f"ARPACK found no Perron root of this {n}-state matrix (largest real part, "
+                "64 Lanczos vectors): its spectrum is too close to a circle"
+            ) from e
     if vector:
         vals, vecs = out
         return vals[0], vecs[:, 0]
@@ -211,8 +241,10 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     v = (v * np.exp(-1j * np.angle(v[j]))).real
     v = np.where(np.abs(v) < 1e-14 * np.abs(v).max(), 0.0, v)
     if v.min() < -1e-8 * v.max():
-        raise ValueError("leading eigenvector has both signs: A is reducible with several Perron roots; "
-                         "restrict it to one communicating class (communicating_classes)")
+        raise ValueError(
+            "leading eigenvector has both signs: A is reducible with several Perron roots; "
+            "restrict it to one communicating class (communicating_classes)"
+        )
     v = np.clip(v, 0.0, None)
     return float(lam.real), v / v.sum()
 
@@ -240,13 +272,16 @@ def true_time_kappa(tr: Transitions, *, xtol: float = 1e-13) -> float:
     of states (ρ(P) = 1, e.g. a KAM island) has no root: restrict ``tr`` to the saddle's class first
     (:func:`saddle_class`); ValueError otherwise.
     """
+
     def h(k):
         return math.log(spectral_radius(transfer_matrix(tr, k)))
 
     h0 = h(0.0)
     if not h0 < -1e-12:
-        raise ValueError(f"ρ(P) = {math.exp(h0):.12g} ≥ 1: no escape, no root κ > 0 (closed states: "
-                         "remove them with communicating_classes / saddle_class)")
+        raise ValueError(
+            f"ρ(P) = {math.exp(h0):.12g} ≥ 1: no escape, no root κ > 0 (closed states: "
+            "remove them with communicating_classes / saddle_class)"
+        )
     ret = tr.dst >= 0
     t_mean = float(np.average(tr.T[ret], weights=tr.w[ret])) if ret.any() else 1.0
     hi = -h0 / max(t_mean, 1e-300)
@@ -306,9 +341,17 @@ def communicating_classes(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]
     esc = np.bincount(lab_s[~ret], weights=tr.w[~ret], minlength=nl)
     out = np.bincount(lab_s[ret & ~same], weights=tr.w[ret & ~same], minlength=nl)
     size = np.bincount(labels, minlength=nl)
-    infos = [ClassInfo(int(c), int(size[c]), float(W[c]), bool(W[c] > 0 and esc[c] == 0 and out[c] == 0),
-                       float(esc[c] / W[c]) if W[c] > 0 else math.nan, float(out[c] / W[c]) if W[c] > 0 else math.nan)
-             for c in range(nl)]
+    infos = [
+        ClassInfo(
+            int(c),
+            int(size[c]),
+            float(W[c]),
+            bool(W[c] > 0 and esc[c] == 0 and out[c] == 0),
+            float(esc[c] / W[c]) if W[c] > 0 else math.nan,
+            float(out[c] / W[c]) if W[c] > 0 else math.nan,
+        )
+        for c in range(nl)
+    ]
     infos.sort(key=lambda c: (-c.weight, c.label))
     return labels, infos
 

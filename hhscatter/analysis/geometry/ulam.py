@@ -19,6 +19,7 @@ and turns their results into the records of an operator study:
 Pure functions (tables and arrays in, records out). Units: box sides in position units, times in the
 Hamiltonian's time unit, κ in 1/time.
 """
+
 from __future__ import annotations
 
 import math
@@ -110,7 +111,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
     ids, inv = np.unique(np.concatenate([src, dst[dst >= 0]]), return_inverse=True)
     s_new = inv[: src.size]
     d_new = np.full(dst.size, -1)
-    d_new[dst >= 0] = inv[src.size:]
+    d_new[dst >= 0] = inv[src.size :]
     return tf.Transitions(s_new, d_new, np.where(ret, t["T"], 1.0), ids.size, t["w"].to_numpy()), ids, t
 
 
@@ -121,9 +122,14 @@ def saddle_kappa(tr):
     kappa = tf.true_time_kappa(sub)
     closed = [c for c in classes if c.closed]
     W = sum(c.weight for c in classes)
-    info = {"states": int(tr.n_states), "saddle_states": int(keep.sum()), "classes": len(classes),
-            "closed_classes": len(closed), "closed_states": int(sum(c.size for c in closed)),
-            "closed_weight_share": float(sum(c.weight for c in closed) / W) if W > 0 else 0.0}
+    info = {
+        "states": int(tr.n_states),
+        "saddle_states": int(keep.sum()),
+        "classes": len(classes),
+        "closed_classes": len(closed),
+        "closed_states": int(sum(c.size for c in closed)),
+        "closed_weight_share": float(sum(c.weight for c in closed) / W) if W > 0 else 0.0,
+    }
     return kappa, tf.map_escape_rate(sub), info, keep, sub
 
 
@@ -136,16 +142,30 @@ def kappa_record(E, res, samples, box):
     """
     rows = pd.DataFrame([r for r in res["rows"] if r["vary"] == "box"]).sort_values("box")
     fit = rows.head(3)
-    slope, k_inf = np.polyfit(fit["box"].to_numpy(), fit["kappa"].to_numpy(), 1) if len(fit) >= 2 else (0.0, res["kappa"])
+    slope, k_inf = (
+        np.polyfit(fit["box"].to_numpy(), fit["kappa"].to_numpy(), 1) if len(fit) >= 2 else (0.0, res["kappa"])
+    )
     boot = res["boot"]
     stat = float(np.std(boot, ddof=1)) if boot.size > 1 else math.nan
     bias = float(k_inf - res["kappa"])
-    return {"energy": E, "kappa": res["kappa"], "err": float(math.hypot(stat, bias)), "boxes": int(res["sub"].n_states),
-            "samples": samples, "box": box, "kappa_stat_err": stat,
-            "discretisation_bias": bias, "kappa_extrapolated": float(k_inf), "bias_slope": float(slope),
-            "kappa_map_per_return": res["kappa_map"], "mean_return_time": res["cost"]["mean_return_time"],
-            "orbit_time": res["cost"]["orbit_time"], "orbits": res["cost"]["orbits"],
-            "censored": res["cost"]["censored"], **{f"class_{k}": v for k, v in res["info"].items()}}
+    return {
+        "energy": E,
+        "kappa": res["kappa"],
+        "err": float(math.hypot(stat, bias)),
+        "boxes": int(res["sub"].n_states),
+        "samples": samples,
+        "box": box,
+        "kappa_stat_err": stat,
+        "discretisation_bias": bias,
+        "kappa_extrapolated": float(k_inf),
+        "bias_slope": float(slope),
+        "kappa_map_per_return": res["kappa_map"],
+        "mean_return_time": res["cost"]["mean_return_time"],
+        "orbit_time": res["cost"]["orbit_time"],
+        "orbits": res["cost"]["orbits"],
+        "censored": res["cost"]["censored"],
+        **{f"class_{k}": v for k, v in res["info"].items()},
+    }
 
 
 def _fit_convergence(b, M, k, p):
@@ -154,11 +174,12 @@ def _fit_convergence(b, M, k, p):
     coef, *_ = np.linalg.lstsq(X, k, rcond=None)
     res = k - X @ coef
     dof = max(len(k) - 3, 1)
-    return float(coef[0]), float(math.sqrt(np.sum(res ** 2) / dof)), X, coef
+    return float(coef[0]), float(math.sqrt(np.sum(res**2) / dof)), X, coef
 
 
-def kappa_convergence(grid: pd.DataFrame, boot_grid: pd.DataFrame | None = None, *, p_main: float = 0.5,
-                      p_alt: float = 1.0) -> dict:
+def kappa_convergence(
+    grid: pd.DataFrame, boot_grid: pd.DataFrame | None = None, *, p_main: float = 0.5, p_alt: float = 1.0
+) -> dict:
     """κ of Ulam's method extrapolated to infinitely many samples per box and to box side 0.
 
     ``grid`` holds κ of one energy on a grid of partitions: columns box (side, position units), samples
@@ -201,9 +222,19 @@ def kappa_convergence(grid: pd.DataFrame, boot_grid: pd.DataFrame | None = None,
             stat = float(np.std(reps, ddof=1))
     model = abs(k_alt - k_inf)
     err = math.hypot(stat, model) if math.isfinite(stat) else math.nan
-    return {"kappa_inf": k_inf, "stat_err": stat, "model_err": model, "err": err, "kappa_inf_alt": k_alt,
-            "slope_box": float(coef[1]), "coef_samples": float(coef[2]), "p": p_main, "p_alt": p_alt,
-            "residual_rms": rms, "n_points": int(len(g))}
+    return {
+        "kappa_inf": k_inf,
+        "stat_err": stat,
+        "model_err": model,
+        "err": err,
+        "kappa_inf_alt": k_alt,
+        "slope_box": float(coef[1]),
+        "coef_samples": float(coef[2]),
+        "p": p_main,
+        "p_alt": p_alt,
+        "residual_rms": rms,
+        "n_points": int(len(g)),
+    }
 
 
 def residuals(value, err, ref, ref_err) -> dict:
@@ -234,16 +265,26 @@ def leading_modes(sub, trapped_sub, k: int = 4):
         vals, vecs = scipy.linalg.eig(P.toarray().T)
     else:
         # a fixed start (ARPACK's own is random): the same eigenvalues in every run, not ≤ 1e-11 apart
-        vals, vecs = eigs(P.T.tocsr(), k=min(k, sub.n_states - 2), which="LM", tol=1e-10,
-                          v0=np.full(sub.n_states, 1.0 / np.sqrt(sub.n_states)))
+        vals, vecs = eigs(
+            P.T.tocsr(),
+            k=min(k, sub.n_states - 2),
+            which="LM",
+            tol=1e-10,
+            v0=np.full(sub.n_states, 1.0 / np.sqrt(sub.n_states)),
+        )
     # by modulus, a conjugate pair (equal moduli up to rounding) with the positive argument first
     order = np.lexsort((-np.angle(vals), -np.round(np.abs(vals), 10)))
     modes = []
     for j in order[:k]:
         v = np.abs(vecs[:, j])
         v = v / v.sum()
-        modes.append({"eigenvalue": float(abs(vals[j])), "eigenvalue_arg": float(np.angle(vals[j])),
-                      "mass_on_trapped_boxes": float(v[trapped_sub].sum())})
+        modes.append(
+            {
+                "eigenvalue": float(abs(vals[j])),
+                "eigenvalue_arg": float(np.angle(vals[j])),
+                "mass_on_trapped_boxes": float(v[trapped_sub].sum()),
+            }
+        )
     return modes
 
 
@@ -288,7 +329,7 @@ def reduced_operator(tr, ids, n_cells, n_bins):
         dst_box = np.where(tr.dst[sel] >= 0, box_of[np.maximum(tr.dst[sel], 0)], -1)
         u, inv = np.unique(np.concatenate([src_box, dst_box[dst_box >= 0]]), return_inverse=True)
         d = np.full(dst_box.size, -1)
-        d[dst_box >= 0] = inv[src_box.size:]
+        d[dst_box >= 0] = inv[src_box.size :]
         tra = tf.Transitions(inv[: src_box.size], d, tr.T[sel], u.size, tr.w[sel])
         try:
             keep, _ = tf.saddle_class(tra)
@@ -327,8 +368,16 @@ def survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
     at = [a for a in at if a <= grid[-1]]
     ix = [int(round(a / dt)) for a in at]
     return {
-        "P_at": [{"t": a, "sim": float(P_sim[i]), "sim_err": float(sig[i]), "operator": float(P_op[i]),
-                  "reduced": float(P_red[i])} for a, i in zip(at, ix)],
+        "P_at": [
+            {
+                "t": a,
+                "sim": float(P_sim[i]),
+                "sim_err": float(sig[i]),
+                "operator": float(P_op[i]),
+                "reduced": float(P_red[i]),
+            }
+            for a, i in zip(at, ix)
+        ],
         "lnP_rms_operator": float(np.sqrt(np.mean(lr[ok] ** 2))) if ok.any() else math.nan,
         "lnP_rms_reduced": float(np.sqrt(np.mean(lr2[ok] ** 2))) if ok.any() else math.nan,
         "lnP_max_operator": float(np.max(np.abs(lr[ok]))) if ok.any() else math.nan,
@@ -344,9 +393,15 @@ def t_star_energies(pred, sim_pts):
     sE_pred = float(np.sqrt(np.sum(wE * (pred["energy"] - mE_pred) ** 2)))
     return {
         "t_star_points_sim": int(len(sim_pts)),
-        "t_star_mean_energy": {"operator": mE_pred, "sim": float(sim_pts["energy"].mean()) if len(sim_pts) else math.nan,
-                               "sim_err": float(sim_pts["energy"].std() / math.sqrt(max(len(sim_pts), 1)))},
-        "t_star_std_energy": {"operator": sE_pred, "sim": float(sim_pts["energy"].std()) if len(sim_pts) > 1 else math.nan},
+        "t_star_mean_energy": {
+            "operator": mE_pred,
+            "sim": float(sim_pts["energy"].mean()) if len(sim_pts) else math.nan,
+            "sim_err": float(sim_pts["energy"].std() / math.sqrt(max(len(sim_pts), 1))),
+        },
+        "t_star_std_energy": {
+            "operator": sE_pred,
+            "sim": float(sim_pts["energy"].std()) if len(sim_pts) > 1 else math.nan,
+        },
     }
 
 
@@ -361,9 +416,17 @@ def cost_row(E, pt, rec, kappa0, target):
     rel = float(pt["kappa_err"] / pt["kappa"])
     ot = float(pt["orbit_time"])
     k0 = kappa0.get(E, (math.nan, math.nan))
-    row = {"energy": E, "pt_kappa": float(pt["kappa"]), "pt_err": float(pt["kappa_err"]), "pt_rel": rel,
-           "pt_orbits": int(pt["orbits"]), "pt_orbit_time": ot, "pt_orbit_time_1pct": ot * (rel / target) ** 2,
-           "fig2_kappa": k0[0], "fig2_err": k0[1]}
+    row = {
+        "energy": E,
+        "pt_kappa": float(pt["kappa"]),
+        "pt_err": float(pt["kappa_err"]),
+        "pt_rel": rel,
+        "pt_orbits": int(pt["orbits"]),
+        "pt_orbit_time": ot,
+        "pt_orbit_time_1pct": ot * (rel / target) ** 2,
+        "fig2_kappa": k0[0],
+        "fig2_err": k0[1],
+    }
     if rec is not None:
         k = rec["kappa"]
         st_rel = rec["kappa_stat_err"] / k
@@ -371,10 +434,18 @@ def cost_row(E, pt, rec, kappa0, target):
         share = target / math.sqrt(2)  # half of the budget (in quadrature) to each part
         f_bias = max(1.0, (b_rel / share) ** 2)
         f_stat = max(1.0, (st_rel / share) ** 2)
-        row.update({"op_kappa": k, "op_err": rec["err"], "op_rel": rec["err"] / k, "op_stat_rel": st_rel,
-                    "op_bias_rel": b_rel, "op_orbit_time": rec["orbit_time"],
-                    "op_orbit_time_1pct": rec["orbit_time"] * max(f_bias, f_stat),
-                    "pt_rel_at_op_cost": rel * math.sqrt(ot / rec["orbit_time"])})
+        row.update(
+            {
+                "op_kappa": k,
+                "op_err": rec["err"],
+                "op_rel": rec["err"] / k,
+                "op_stat_rel": st_rel,
+                "op_bias_rel": b_rel,
+                "op_orbit_time": rec["orbit_time"],
+                "op_orbit_time_1pct": rec["orbit_time"] * max(f_bias, f_stat),
+                "pt_rel_at_op_cost": rel * math.sqrt(ot / rec["orbit_time"]),
+            }
+        )
     return row
 
 
@@ -394,8 +465,15 @@ def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
         if ref is None or c["err"] is None or not math.isfinite(c["err"]):
             continue
         r = residuals(c["kappa_inf"], c["err"], ref[0], ref[1])
-        rec.update({f"{name}": ref[0], f"{name}_err": ref[1], f"residual_{name}": r["residual"],
-                    f"residual_{name}_err": r["residual_err"], f"z_{name}": r["z"]})
+        rec.update(
+            {
+                f"{name}": ref[0],
+                f"{name}_err": ref[1],
+                f"residual_{name}": r["residual"],
+                f"residual_{name}_err": r["residual_err"],
+                f"z_{name}": r["z"],
+            }
+        )
         rf = residuals(kappa_finest, 0.0, ref[0], ref[1])  # the finest partition's offset, for the page
         rec[f"residual_finest_{name}"] = rf["residual"]
     return rec
@@ -446,10 +524,8 @@ def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
     NaN where a replicate leaves no open class).
     """
     parts = [(int(c), int(m)) for c in coarsen for m in subsets]
-    trs = {(c, m): sample_transitions(tab, extent, box, c=c, m_max=None if m == samples else m)[0]
-           for c, m in parts}
-    grid = pd.DataFrame([{"box": box * c, "samples": m * c * c, "kappa": saddle_kappa(trs[c, m])[0]}
-                         for c, m in parts])
+    trs = {(c, m): sample_transitions(tab, extent, box, c=c, m_max=None if m == samples else m)[0] for c, m in parts}
+    grid = pd.DataFrame([{"box": box * c, "samples": m * c * c, "kappa": saddle_kappa(trs[c, m])[0]} for c, m in parts])
     gen = np.random.default_rng(rng)
     rank = tab["rank"].to_numpy()[~tab["censored"].to_numpy()]  # the samples sample_transitions keeps, in order
     reps = []
@@ -524,8 +600,11 @@ def one_return_samples(df, lt, sec, what="run"):
     idx = sec["traj_id"].to_numpy()
     out.loc[idx, "ret"] = True
     out.loc[idx, "T"] = sec["t"].to_numpy()
-    out.loc[idx, "x1"], out.loc[idx, "y1"], out.loc[idx, "e1"] = (sec["x"].to_numpy(), sec["y"].to_numpy(),
-                                                                  sec["energy"].to_numpy())
+    out.loc[idx, "x1"], out.loc[idx, "y1"], out.loc[idx, "e1"] = (
+        sec["x"].to_numpy(),
+        sec["y"].to_numpy(),
+        sec["energy"].to_numpy(),
+    )
     if not np.all(oc[idx] == "stopped"):
         raise ValueError(f"{what}: a sample with a section crossing did not stop there")
     return out
@@ -543,19 +622,32 @@ def eigenvector_convergence(tab, extent, box, coarsen, subsets, Q, boxes, n_spli
             res = {"sub": sub, "t": t, "keep": keep, "tr": tr, "kappa": kap}
             P = measure_points(res, "sprinkler", len(Q), np.random.default_rng(seed + 6))
             d, j = hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head)
-            out.append({"box": box * c, "samples_per_box": m * c * c, "kappa": kap, "eps": float(d["box"].iloc[j]),
-                        "hellinger_debiased": float(d.hellinger_debiased.iloc[j]), "lo": float(d.lo.iloc[j]),
-                        "hi": float(d.hi.iloc[j])})
+            out.append(
+                {
+                    "box": box * c,
+                    "samples_per_box": m * c * c,
+                    "kappa": kap,
+                    "eps": float(d["box"].iloc[j]),
+                    "hellinger_debiased": float(d.hellinger_debiased.iloc[j]),
+                    "lo": float(d.lo.iloc[j]),
+                    "hi": float(d.hi.iloc[j]),
+                }
+            )
     return out
 
 
 def hellinger_row(tab, j):
     """The record of a :func:`hellinger_by_box` table at its row ``j``: box, hellinger_debiased (lo, hi),
     hellinger_pq, hellinger_noise and the debiased agreement scale at 0.1."""
-    return {"box": float(tab["box"].iloc[j]), "hellinger_debiased": float(tab.hellinger_debiased.iloc[j]),
-            "hellinger_debiased_lo": float(tab.lo.iloc[j]), "hellinger_debiased_hi": float(tab.hi.iloc[j]),
-            "hellinger_pq": float(tab["hellinger_pq"].iloc[j]), "hellinger_noise": float(tab["hellinger_noise"].iloc[j]),
-            "agreement_scale_debiased": dist.agreement_scale_debiased(tab, 0.1, "hellinger")}
+    return {
+        "box": float(tab["box"].iloc[j]),
+        "hellinger_debiased": float(tab.hellinger_debiased.iloc[j]),
+        "hellinger_debiased_lo": float(tab.lo.iloc[j]),
+        "hellinger_debiased_hi": float(tab.hi.iloc[j]),
+        "hellinger_pq": float(tab["hellinger_pq"].iloc[j]),
+        "hellinger_noise": float(tab["hellinger_noise"].iloc[j]),
+        "agreement_scale_debiased": dist.agreement_scale_debiased(tab, 0.1, "hellinger"),
+    }
 
 
 def islands_record(trapped_cells, tr, ids, keep, sub):
@@ -564,9 +656,11 @@ def islands_record(trapped_cells, tr, ids, keep, sub):
     class, the leading modes' mass on them (:func:`leading_modes`) and κ without them."""
     trapped = np.isin(ids, trapped_cells)
     trapped_sub = trapped[keep]
-    out = {"trapped_boxes": int(np.size(trapped_cells)),
-           "trapped_share_of_saddle_class": float(trapped_sub.mean()) if trapped_sub.size else 0.0,
-           "modes_P": leading_modes(sub, trapped_sub)}
+    out = {
+        "trapped_boxes": int(np.size(trapped_cells)),
+        "trapped_share_of_saddle_class": float(trapped_sub.mean()) if trapped_sub.size else 0.0,
+        "modes_P": leading_modes(sub, trapped_sub),
+    }
     if np.size(trapped_cells):
         try:
             out["kappa_without_trapped_boxes"] = saddle_kappa(tr.subset(~trapped))[0]
@@ -595,9 +689,15 @@ def convergence_summary(records, *, z_agree: float = 2.0) -> dict:
             continue
         agree = [r["energy"] for r in rs if abs(r[f"z_{ref}"]) <= z_agree]
         res = np.array([r[f"residual_{ref}"] for r in rs])
-        out[ref] = {"energies": [r["energy"] for r in rs], "agree": agree, "max_abs_residual": float(np.max(np.abs(res))),
-                    "mean_residual": float(res.mean())}
-        words.append(f"against {label}, κ∞ agrees within {z_agree:g}σ (both errors) at {len(agree)} of {len(rs)} "
-                     f"energies; |κ∞/κ_ref − 1| ≤ {100 * np.max(np.abs(res)):.2g} %, mean {100 * res.mean():+.2g} %")
+        out[ref] = {
+            "energies": [r["energy"] for r in rs],
+            "agree": agree,
+            "max_abs_residual": float(np.max(np.abs(res))),
+            "mean_residual": float(res.mean()),
+        }
+        words.append(
+            f"against {label}, κ∞ agrees within {z_agree:g}σ (both errors) at {len(agree)} of {len(rs)} "
+            f"energies; |κ∞/κ_ref − 1| ≤ {100 * np.max(np.abs(res)):.2g} %, mean {100 * res.mean():+.2g} %"
+        )
     out["statement"] = "; ".join(words) if words else "no reference to compare with"
     return out

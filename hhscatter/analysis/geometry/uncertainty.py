@@ -60,6 +60,7 @@ gives an interval that is too narrow.
 
 Units: ε in the units of the initial conditions (the caller's coordinates).
 """
+
 from __future__ import annotations
 
 import math
@@ -107,8 +108,6 @@ def _positive_int(v, name: str, minimum: int = 1) -> int:
     if isinstance(v, bool) or not float(v).is_integer() or int(v) < minimum:
         raise ValueError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
     return int(v)
-
-
 
 
 # ---------------------------------------------------------------------------
@@ -299,11 +298,23 @@ def uncertainty_exponent(eps, f, n, *, eps_range=None, dim: float = 2.0) -> Unce
     chi2, dof, pv = _pearson(k[use], n[use], p, 2)
     alpha, a_err = float(b[1]), float(math.sqrt(cov[1, 1]))
     return UncertaintyExponent(
-        alpha=alpha, alpha_err=a_err, dim=float(dim), d=float(dim) - alpha, d_err=a_err,
+        alpha=alpha,
+        alpha_err=a_err,
+        dim=float(dim),
+        d=float(dim) - alpha,
+        d_err=a_err,
         prefactor=float(math.exp(b[0] - b[1] * xm)),
         prefactor_rel_err=float(math.sqrt(cov[0, 0] + xm * xm * cov[1, 1] - 2 * xm * cov[0, 1])),
-        eps_range=(float(eps[use].min()), float(eps[use].max())), n_points=int(np.count_nonzero(use)),
-        chi2=chi2, dof=dof, p_value=pv, eps=eps, f=f, n=n, fitted=use)
+        eps_range=(float(eps[use].min()), float(eps[use].max())),
+        n_points=int(np.count_nonzero(use)),
+        chi2=chi2,
+        dof=dof,
+        p_value=pv,
+        eps=eps,
+        f=f,
+        n=n,
+        fitted=use,
+    )
 
 
 @dataclass(frozen=True)
@@ -354,8 +365,18 @@ def _broken_fit(x, k, n, xc, beta):
     return B, C, ll
 
 
-def uncertainty_cutoff(eps, f, n, *, beta: float | None = 1.0, eps_range=None, z: float = 1.0,
-                       min_points: int = 3, n_grid: int = 120, dim: float = 2.0) -> UncertaintyCutoff:
+def uncertainty_cutoff(
+    eps,
+    f,
+    n,
+    *,
+    beta: float | None = 1.0,
+    eps_range=None,
+    z: float = 1.0,
+    min_points: int = 3,
+    n_grid: int = 120,
+    dim: float = 2.0,
+) -> UncertaintyCutoff:
     """uncertainty_cutoff(eps, f, n, *, beta=1.0, eps_range=None, z=1.0, min_points=3) -> UncertaintyCutoff(detected, eps_c, eps_c_lo, eps_c_hi, ...).
 
     Looks for a scale ε_c below which f(ε) departs from the power law: the
@@ -389,8 +410,9 @@ def uncertainty_cutoff(eps, f, n, *, beta: float | None = 1.0, eps_range=None, z
     if np.any(candidate):
         i = int(np.argmax(np.where(candidate, prof, -np.inf)))
         lo_b, hi_b = grid[max(i - 1, 0)], grid[min(i + 1, n_grid - 1)]
-        opt = optimize.minimize_scalar(lambda v: -prof2(v), bounds=(lo_b, hi_b), method="bounded",
-                                       options={"xatol": 1e-6})
+        opt = optimize.minimize_scalar(
+            lambda v: -prof2(v), bounds=(lo_b, hi_b), method="bounded", options={"xatol": 1e-6}
+        )
         xc_best, top_best = (float(opt.x), -float(opt.fun)) if -opt.fun > prof[i] else (float(grid[i]), float(prof[i]))
     n_below = int(np.count_nonzero(x < xc_best - 1e-12))
     lr = float(max(top_best - 2.0 * ll0, 0.0))
@@ -413,8 +435,23 @@ def uncertainty_cutoff(eps, f, n, *, beta: float | None = 1.0, eps_range=None, z
         alpha, a_err = single.alpha, single.alpha_err
         bt, bt_err = (beta, 0.0) if beta is not None else (math.nan, math.nan)
         n_below = 0
-    return UncertaintyCutoff(detected, eps_c, lo, hi, alpha, a_err, bt, bt_err, beta is not None, lr, delta_aic,
-                             n_below, single, np.exp(grid), prof)
+    return UncertaintyCutoff(
+        detected,
+        eps_c,
+        lo,
+        hi,
+        alpha,
+        a_err,
+        bt,
+        bt_err,
+        beta is not None,
+        lr,
+        delta_aic,
+        n_below,
+        single,
+        np.exp(grid),
+        prof,
+    )
 
 
 def _crossing(prof2, grid, prof, level, i, side):
@@ -453,8 +490,6 @@ def _broken_cov(x, k, n, xc, beta):
     return b, out
 
 
-
-
 def weighted_line(x, y, err):
     """weighted_line(x, y, err) -> (intercept, slope, cov (2, 2), chi2, dof): weighted least-squares line.
 
@@ -468,7 +503,7 @@ def weighted_line(x, y, err):
     (2.0, 1)
     """
     x, y, err = (np.asarray(v, dtype=float).ravel() for v in (x, y, err))
-    w = 1.0 / err ** 2
+    w = 1.0 / err**2
     X = np.column_stack([np.ones_like(x), x])
     cov = np.linalg.inv(X.T @ (w[:, None] * X))
     b = cov @ (X.T @ (w * y))
@@ -518,12 +553,21 @@ def local_exponent(eps, k, n) -> pd.DataFrame:
     with np.errstate(divide="ignore", invalid="ignore"):
         lx = np.log(eps[1:] / eps[:-1])
         alpha = np.log(f[1:] / f[:-1]) / lx
-        var = ((1 - f[:-1]) / k[:-1] + (1 - f[1:]) / k[1:]) / lx ** 2
+        var = ((1 - f[:-1]) / k[:-1] + (1 - f[1:]) / k[1:]) / lx**2
     bad = (k[:-1] == 0) | (k[1:] == 0)
     alpha[bad] = np.nan
     err = np.sqrt(np.where(bad, np.nan, var))
-    return pd.DataFrame({"eps_lo": eps[1:], "eps_hi": eps[:-1], "eps_mid": np.sqrt(eps[1:] * eps[:-1]),
-                         "alpha": alpha, "alpha_err": err, "d": 2.0 - alpha, "d_err": err})
+    return pd.DataFrame(
+        {
+            "eps_lo": eps[1:],
+            "eps_hi": eps[:-1],
+            "eps_mid": np.sqrt(eps[1:] * eps[:-1]),
+            "alpha": alpha,
+            "alpha_err": err,
+            "d": 2.0 - alpha,
+            "d_err": err,
+        }
+    )
 
 
 def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
@@ -544,17 +588,31 @@ def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
     False
     """
     t = local[np.isfinite(local["d"]) & np.isfinite(local["d_err"]) & (local["d_err"] > 0)]
-    out = {"slope": math.nan, "slope_err": math.nan, "d_coarse": math.nan, "d_coarse_err": math.nan,
-           "d_fine": math.nan, "d_fine_err": math.nan, "slim": False, "fractal_coarse": False,
-           "n_points": len(t)}
+    out = {
+        "slope": math.nan,
+        "slope_err": math.nan,
+        "d_coarse": math.nan,
+        "d_coarse_err": math.nan,
+        "d_fine": math.nan,
+        "d_fine_err": math.nan,
+        "slim": False,
+        "fractal_coarse": False,
+        "n_points": len(t),
+    }
     if len(t) < 2:
         return out
     t = t.sort_values("eps_mid", ascending=False)
     y = t["d"].to_numpy()
     _, slope, cov, _, _ = weighted_line(np.log10(t["eps_mid"].to_numpy()), y, t["d_err"].to_numpy())
     se = math.sqrt(cov[1, 1])
-    out.update(slope=slope, slope_err=se, d_coarse=float(y[0]), d_coarse_err=float(t["d_err"].iloc[0]),
-               d_fine=float(y[-1]), d_fine_err=float(t["d_err"].iloc[-1]))
+    out.update(
+        slope=slope,
+        slope_err=se,
+        d_coarse=float(y[0]),
+        d_coarse_err=float(t["d_err"].iloc[0]),
+        d_fine=float(y[-1]),
+        d_fine_err=float(t["d_err"].iloc[-1]),
+    )
     out["fractal_coarse"] = bool(y[0] - 1.0 > z * out["d_coarse_err"])
     out["slim"] = bool(out["fractal_coarse"] and slope > z * se)
     return out

@@ -2,6 +2,7 @@
 
 Every public name of its modules is importable from here (loaded on first use).
 """
+
 from hhscatter.analysis._exports import lazy_exports
 
 _EXPORTS = {

@@ -1,4 +1,5 @@
 """Binomial fractions with Wilson score intervals (model-free; used by the exit-channel and basin measures)."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -19,6 +19,7 @@ The parameter covariance has three readings (``errors``):
 * ``"inflated"`` — F⁻¹ max(1, χ²/dof): absolute errors, enlarged when the
   points scatter more than their error bars.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -8,6 +8,7 @@
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
   survives the authors' convention.
 """
+
 from __future__ import annotations
 
 import math
@@ -15,12 +16,14 @@ from dataclasses import dataclass
 from decimal import Decimal
 
 #: the verdict rule, stated once (the docs' studies index and the report print this text)
-RULE = ("**agrees** when |ours − reference| ≤ 2σ, σ = √(σ_ours² + σ_ref²): both uncertainties, ours (1σ, "
-        "resampled over orbits) and the reference's (another study's 1σ, or, for a number the paper prints "
-        "without an error, half a unit of its last printed digit, so '≈ 17' stands for [16.5, 17.5); a reference 0 or 1 — a "
-        "predicted shift, exponent or limit — is exact); **differs** otherwise; z = (ours − reference)/σ. "
-        "A cell without a number or without our uncertainty says so instead of a verdict; the tiny scale "
-        "(a smoke test of a few hundred orbits) gives no verdicts.")
+RULE = (
+    "**agrees** when |ours − reference| ≤ 2σ, σ = √(σ_ours² + σ_ref²): both uncertainties, ours (1σ, "
+    "resampled over orbits) and the reference's (another study's 1σ, or, for a number the paper prints "
+    "without an error, half a unit of its last printed digit, so '≈ 17' stands for [16.5, 17.5); a reference 0 or 1 — a "
+    "predicted shift, exponent or limit — is exact); **differs** otherwise; z = (ours − reference)/σ. "
+    "A cell without a number or without our uncertainty says so instead of a verdict; the tiny scale "
+    "(a smoke test of a few hundred orbits) gives no verdicts."
+)
 #: scales whose outputs are smoke tests: their rows carry no verdict
 SMOKE_SCALES = ("tiny",)
 
@@ -93,8 +96,12 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
         return "no verdict (tiny scale: a smoke test)"
     ours, paper = row.get("ours"), row.get("paper")
     stored = str(row.get("verdict") or "")
-    numeric = (isinstance(ours, (int, float)) and not isinstance(ours, bool)
-               and isinstance(paper, (int, float)) and not isinstance(paper, bool))
+    numeric = (
+        isinstance(ours, (int, float))
+        and not isinstance(ours, bool)
+        and isinstance(paper, (int, float))
+        and not isinstance(paper, bool)
+    )
     if not numeric:
         if isinstance(ours, float) and not math.isfinite(ours):
             return "undetermined: no value of ours (not measurable here)"

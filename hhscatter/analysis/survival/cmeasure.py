@@ -7,6 +7,7 @@ sample from the engine's ``sections`` and ``lifetimes`` tables (as
 DataFrames: no I/O here). Beyond the paper: an estimator of κ independent of
 P(t) (study fig2).
 """
+
 from __future__ import annotations
 
 import math
@@ -61,8 +62,9 @@ def _solve_renewal(T, M, w=None):
     return float(optimize.brentq(h, 0.0, hi, xtol=1e-14, rtol=1e-12))
 
 
-def kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, n_boot: int = 200,
-                        rng=None) -> CMeasureKappa:
+def kappa_from_cmeasure(
+    return_times, n_exit, *, orbits=None, exit_orbits=None, n_boot: int = 200, rng=None
+) -> CMeasureKappa:
     """kappa_from_cmeasure(return_times, n_exit, *, orbits=None, exit_orbits=None, n_boot=200, rng=None) -> CMeasureKappa.
 
     Escape rate κ (1/time) from section data via the true-time-map relation
@@ -176,10 +178,12 @@ def _orbit_bootstrap(T, n_exit, orbits, exit_orbits, n_boot, gen) -> np.ndarray:
     orbits = np.asarray([] if orbits is None else orbits).ravel()
     exit_orbits = np.asarray([] if exit_orbits is None else exit_orbits).ravel()
     if orbits.size != T.size or exit_orbits.size != n_exit:
-        raise ValueError(f"orbits must give the orbit of each of the {T.size} return times and exit_orbits of "
-                         f"each of the {n_exit} exits, got {orbits.size} and {exit_orbits.size}")
+        raise ValueError(
+            f"orbits must give the orbit of each of the {T.size} return times and exit_orbits of "
+            f"each of the {n_exit} exits, got {orbits.size} and {exit_orbits.size}"
+        )
     ids, inv = np.unique(np.concatenate([orbits, exit_orbits]), return_inverse=True)
-    of_T = inv[:T.size]
+    of_T = inv[: T.size]
     points = np.bincount(inv, minlength=ids.size)  # sample points (returns and exits) per orbit
     boot = np.empty(n_boot)
     for i in range(n_boot):
@@ -188,8 +192,9 @@ def _orbit_bootstrap(T, n_exit, orbits, exit_orbits, n_boot, gen) -> np.ndarray:
     return boot
 
 
-def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=math.inf,
-                                  drop_censored: bool = False, with_orbits: bool = False):
+def cmeasure_sample_from_sections(
+    sections, lifetimes, t_from, t_to, *, t_record_end=math.inf, drop_censored: bool = False, with_orbits: bool = False
+):
     """cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record_end=inf, drop_censored=False, with_orbits=False) -> (return_times, n_exit, n_undetermined[, orbits, exit_orbits]).
 
     Builds the input of :func:`kappa_from_cmeasure` from the engine's tables
@@ -235,6 +240,5 @@ def cmeasure_sample_from_sections(sections, lifetimes, t_from, t_to, *, t_record
     if n_und:
         warnings.warn(f"{n_und} sample crossings have an undetermined fate and were dropped", stacklevel=2)
     if with_orbits:
-        return (T.astype(float), n_exit, n_und, s["traj_id"].to_numpy()[ret],
-                last["traj_id"].to_numpy()[leaves])
+        return (T.astype(float), n_exit, n_und, s["traj_id"].to_numpy()[ret], last["traj_id"].to_numpy()[leaves])
     return T.astype(float), n_exit, n_und

@@ -20,6 +20,7 @@
 Pure functions (no I/O, no plotting).  Times in the model's natural time units,
 κ in 1/time, energies in the system's energy units (E_c from the system: ``scene.model.critical_energy``).
 """
+
 from __future__ import annotations
 
 import math
@@ -66,7 +67,6 @@ __all__ = [
     "kappa_from_cmeasure",
     "power_law_exponent_mle",
 ]
-
 
 
 # ---------------------------------------------------------------------------
@@ -258,8 +258,10 @@ def escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=Fals
     ValueError, or with ``allow_dissipative=True`` is fitted with a UserWarning.
     """
     if "gamma" in lifetimes.columns and len(lifetimes) and float(lifetimes["gamma"].max()) > 0:
-        msg = (f"escape_rate_from_lifetimes: this ensemble is dissipative (gamma = {float(lifetimes['gamma'].max()):g}"
-               " > 0); κ is the conservative escape rate and its exponential fit does not describe P(t) with drag")
+        msg = (
+            f"escape_rate_from_lifetimes: this ensemble is dissipative (gamma = {float(lifetimes['gamma'].max()):g}"
+            " > 0); κ is the conservative escape rate and its exponential fit does not describe P(t) with drag"
+        )
         if not allow_dissipative:
             raise ValueError(msg + " (pass allow_dissipative=True to fit it anyway)")
         warnings.warn(msg, UserWarning, stacklevel=2)

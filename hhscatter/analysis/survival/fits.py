@@ -39,6 +39,7 @@ under the independent-increment covariance Cov(log P_i, log P_j) = V(min(t_i,t_j
 (``kappa_err`` / ``z_err``); the naive diagonal-weight error, which ignores the
 correlations and is far too small on a fine grid, is kept as ``*_err_naive``.
 """
+
 from __future__ import annotations
 
 import math
@@ -211,7 +212,9 @@ def _prepare(t, P, P_err, window, log_t):
     if P_err is not None:
         sig = P_err[m][order] / PP
     if tt.size < 3:
-        raise ValueError(f"fewer than 3 usable points (P > 0{', P_err > 0' if P_err is not None else ''}) in window {window}")
+        raise ValueError(
+            f"fewer than 3 usable points (P > 0{', P_err > 0' if P_err is not None else ''}) in window {window}"
+        )
     return tt, PP, sig, (lo, hi)
 
 
@@ -391,8 +394,9 @@ def crossover_time(t, P, exp_fit, pow_fit) -> float:
     k = down[-1]
     tau = float(optimize.brentq(g, grid[k], grid[k + 1], xtol=1e-12 * grid[k + 1], rtol=1e-12))
     if tpos.size and not (tpos.min() <= tau <= tpos.max()):
-        warnings.warn(f"crossover time {tau:.4g} lies outside the data range [{tpos.min():.4g}, {tpos.max():.4g}]",
-                      stacklevel=2)
+        warnings.warn(
+            f"crossover time {tau:.4g} lies outside the data range [{tpos.min():.4g}, {tpos.max():.4g}]", stacklevel=2
+        )
     return tau
 
 
@@ -518,9 +522,16 @@ def detect_power_law_tail(
         return None
     tau_c, D_tail, z_mle = _refined_change_point(tf, Pf, N, tau0, t_floor, edges, bins, jb)
     fit = fit_power_law_tail(t, P, (tau_c, t_floor), P_err)
-    return PowerLawFit(**{**fit.__dict__, "z_mle": float(z_mle), "z_mle_err": float(z_mle / math.sqrt(D_tail)),
-                          "hazard_exponent": beta_hat, "delta_aic_split": float(d_aic_split),
-                          "delta_aic_tail": float(d_aic_tail)})
+    return PowerLawFit(
+        **{
+            **fit.__dict__,
+            "z_mle": float(z_mle),
+            "z_mle_err": float(z_mle / math.sqrt(D_tail)),
+            "hazard_exponent": beta_hat,
+            "delta_aic_split": float(d_aic_split),
+            "delta_aic_tail": float(d_aic_tail),
+        }
+    )
 
 
 # the steps of detect_power_law_tail (its docstring's rule, step by step)
@@ -634,7 +645,7 @@ def _hazard_exponent(bins: _HazardBins, edges, jb):
     Exact bin integrals of t^{−β}, β by profile likelihood in [−3, 5]: 1 for a power law, 0 for an exponential.
     """
     dk, nk = bins.d[jb:], bins.n[jb:]
-    lo, hi = edges[jb:-1], edges[jb + 1:]
+    lo, hi = edges[jb:-1], edges[jb + 1 :]
 
     def neg_ll(beta):
         if abs(1.0 - beta) < 1e-8:

@@ -27,6 +27,7 @@ t_k. The inputs differ only in what the t_k are:
 Without censoring before t, P(t) is the (weighted) fraction #{t_end > t}/N
 and Greenwood's error the binomial √(P(1−P)/N).
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -216,7 +217,7 @@ class KaplanMeierGrid:
         self.n_total = 0.0
         self.first_censoring = np.inf
 
-    def add(self, t_end, observed, weights=None) -> "KaplanMeierGrid":
+    def add(self, t_end, observed, weights=None) -> KaplanMeierGrid:
         t_end, observed, weights = _check(t_end, observed, weights)
         w = np.ones(t_end.size) if weights is None else weights
         j = np.searchsorted(self.grid, t_end, side="left")  # g[j-1] < t_end <= g[j]

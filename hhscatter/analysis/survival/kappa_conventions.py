@@ -25,6 +25,7 @@ results out):
 * :func:`law_spread` — the parameters of the κ(E) law fitted per convention
   and their spread, the systematic uncertainty of "the κ(E) law".
 """
+
 from __future__ import annotations
 
 import math
@@ -102,8 +103,14 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     """
     bias = f_trapped / P_end if P_end > 0 else math.inf
     if bias > max_bias:
-        return False, bias, (f"plateau: orbits still inside at t_max (KAM-trapped or sticky) are {f_trapped:.2%}, "
-                             f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined")
+        return (
+            False,
+            bias,
+            (
+                f"plateau: orbits still inside at t_max (KAM-trapped or sticky) are {f_trapped:.2%}, "
+                f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined"
+            ),
+        )
     return True, bias, ""
 
 
@@ -115,8 +122,9 @@ def _windows_rate(t, P, E, windows):
     return float(ks.mean()), spread, stat
 
 
-def escape_rate_p_levels(t_end, observed, *, p_hi: float = 0.5, p_lo: float = 1e-2, max_bias: float = 0.1,
-                         n_grid: int = 20001) -> ConventionRate:
+def escape_rate_p_levels(
+    t_end, observed, *, p_hi: float = 0.5, p_lo: float = 1e-2, max_bias: float = 0.1, n_grid: int = 20001
+) -> ConventionRate:
     """escape_rate_p_levels(t_end, observed, *, p_hi=0.5, p_lo=1e-2, max_bias=0.1) -> ConventionRate.
 
     κ (1/time) of Eq. (eqn:kappa_hyperbolic) on windows fixed by P levels
@@ -133,12 +141,23 @@ def escape_rate_p_levels(t_end, observed, *, p_hi: float = 0.5, p_lo: float = 1e
     t, P, E = curve.t[ok], curve.P[ok], curve.P_err[ok]
     wins = p_level_windows(t, P, p_hi, p_lo)
     if wins is None:
-        return ConventionRate(math.nan, math.nan, math.nan, math.nan, math.nan, math.nan, f_inf, math.inf, False,
-                              f"P(t) never falls to {p_lo:g} (trapped fraction {f_inf:.2%})")
+        return ConventionRate(
+            math.nan,
+            math.nan,
+            math.nan,
+            math.nan,
+            math.nan,
+            math.nan,
+            f_inf,
+            math.inf,
+            False,
+            f"P(t) never falls to {p_lo:g} (trapped fraction {f_inf:.2%})",
+        )
     defined, bias, reason = plateau_check(float(np.interp(wins[0][1], t, P)), f_inf, max_bias)
     kappa, spread, stat = _windows_rate(t, P, E, wins)
-    return ConventionRate(kappa, float(math.hypot(spread, stat)), stat, spread, wins[0][0], wins[0][1], f_inf, bias,
-                          defined, reason)
+    return ConventionRate(
+        kappa, float(math.hypot(spread, stat)), stat, spread, wins[0][0], wins[0][1], f_inf, bias, defined, reason
+    )
 
 
 def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> ConventionRate:
@@ -150,8 +169,18 @@ def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> Conventio
     f_inf = trapped_fraction(t_end, observed)
     P_end = float(np.interp(result.t_stop, result.curve.t, result.curve.P))
     defined, bias, reason = plateau_check(P_end, f_inf, max_bias)
-    return ConventionRate(result.kappa, result.kappa_err, result.kappa_stat, result.kappa_spread, result.tau0,
-                          result.t_stop, f_inf, bias, defined, reason)
+    return ConventionRate(
+        result.kappa,
+        result.kappa_err,
+        result.kappa_stat,
+        result.kappa_spread,
+        result.tau0,
+        result.t_stop,
+        f_inf,
+        bias,
+        defined,
+        reason,
+    )
 
 
 def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
@@ -168,8 +197,14 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
     for energy, g in table.groupby("energy", sort=True):
         k = g.loc[g["defined"].astype(bool), "kappa"].to_numpy(float)
         rel = float((k.max() - k.min()) / k.mean()) if k.size >= 1 and k.mean() > 0 else math.nan
-        rows.append({"energy": float(energy), "n_defined": int(k.size), "rel_range": rel,
-                     "stable": bool(k.size >= min_defined and rel <= rel_tol)})
+        rows.append(
+            {
+                "energy": float(energy),
+                "n_defined": int(k.size),
+                "rel_range": rel,
+                "stable": bool(k.size >= min_defined and rel <= rel_tol),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -191,14 +226,19 @@ def law_spread(fits: dict) -> dict:
         v = np.array(list(vals.values()))
         spread = float((v.max() - v.min()) / 2) if v.size else math.nan
         stat = float(np.nanmax(errs)) if errs and np.isfinite(errs).any() else math.nan
-        out[p] = {"value": float(v.mean()) if v.size else math.nan, "err_stat": stat, "spread": spread,
-                  "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
-                  "per_convention": vals}
+        out[p] = {
+            "value": float(v.mean()) if v.size else math.nan,
+            "err_stat": stat,
+            "spread": spread,
+            "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
+            "per_convention": vals,
+        }
     return out
 
 
-def convention_rows(t_end, observed, result, *, p_hi: float = 0.5, p_lo: float = 1e-2,
-                    max_bias: float = 0.1) -> list[dict]:
+def convention_rows(
+    t_end, observed, result, *, p_hi: float = 0.5, p_lo: float = 1e-2, max_bias: float = 0.1
+) -> list[dict]:
     """κ of one run under the two window rules, one row each: ``plateau`` (the windows of ``result``, the run's
     :func:`~hhscatter.analysis.survival.escape_rate.escape_rate`) and ``plevel`` (windows fixed by the P levels
     p_hi, p_lo); κ is ill-defined (``defined`` False, with its ``reason``) where the trapped fraction biases the slope
@@ -214,12 +254,28 @@ def convention_rows(t_end, observed, result, *, p_hi: float = 0.5, p_lo: float =
     ['plateau', 'plevel']
     """
     t_end, observed = np.asarray(t_end, dtype=float), np.asarray(observed, dtype=bool)
-    rates = {"plateau": plateau_rate(result, t_end, observed, max_bias=max_bias),
-             "plevel": escape_rate_p_levels(t_end, observed, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)}
-    return [{"windows": rule, "n": int(t_end.size), "n_escaped_at_start": int(((t_end == 0) & observed).sum()),
-             "kappa": r.kappa, "kappa_err": r.kappa_err, "kappa_stat": r.kappa_stat, "kappa_spread": r.kappa_spread,
-             "t_lo": r.t_lo, "t_hi": r.t_hi, "trapped_fraction": r.trapped_fraction, "bias_at_end": r.bias_at_end,
-             "defined": bool(r.defined), "reason": r.reason} for rule, r in rates.items()]
+    rates = {
+        "plateau": plateau_rate(result, t_end, observed, max_bias=max_bias),
+        "plevel": escape_rate_p_levels(t_end, observed, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias),
+    }
+    return [
+        {
+            "windows": rule,
+            "n": int(t_end.size),
+            "n_escaped_at_start": int(((t_end == 0) & observed).sum()),
+            "kappa": r.kappa,
+            "kappa_err": r.kappa_err,
+            "kappa_stat": r.kappa_stat,
+            "kappa_spread": r.kappa_spread,
+            "t_lo": r.t_lo,
+            "t_hi": r.t_hi,
+            "trapped_fraction": r.trapped_fraction,
+            "bias_at_end": r.bias_at_end,
+            "defined": bool(r.defined),
+            "reason": r.reason,
+        }
+        for rule, r in rates.items()
+    ]
 
 
 def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_points: int = 5):
@@ -238,7 +294,8 @@ def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_
             continue
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            fits[name] = fit_kappa_energy(d["energy"], d["kappa"], d["kappa_err"], E_c, continuous=True,
-                                          n_boot=n_boot, rng=seed)
+            fits[name] = fit_kappa_energy(
+                d["energy"], d["kappa"], d["kappa_err"], E_c, continuous=True, n_boot=n_boot, rng=seed
+            )
         info[name]["fit"] = kappa_law_summary(fits[name])
     return fits, info

@@ -6,6 +6,7 @@ as two separate laws on either side of the best partition (as the paper),
 with covariance and bootstrap errors. E_c comes from the system
 (``scene.model.critical_energy``, :class:`hhscatter.model.System`); no default. Pure functions.
 """
+
 from __future__ import annotations
 
 import warnings

@@ -5,6 +5,7 @@ E_switch and slope·ΔE above (ΔE = E − E_c, zero below E_c); the coefficient
 are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` (study
 fig2) or are the paper's (:data:`PAPER_KAPPA`). E_c comes from the model.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -14,7 +15,6 @@ import numpy as np
 from hhscatter.model import HenonHeiles
 
 __all__ = ["PAPER_KAPPA", "PiecewiseKappa"]
-
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ Examples
 >>> bool(abs(f.p_inf - 0.3) < 4 * f.p_inf_err and abs(f.kappa - 0.01) < 4 * f.kappa_err)
 True
 """
+
 from __future__ import annotations
 
 import math
@@ -143,9 +144,13 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
         f = lambda v: _negloglik(1 / (1 + math.exp(-v[0])), math.exp(v[1]), s, esc)  # noqa: E731
         q_start = min(max(1 - esc.mean(), 1e-3), 1 - 1e-3)
         starts = [(math.log(q_start / (1 - q_start)), math.log(k_start * m)) for m in (1.0, 3.0, 10.0)]
-        best = min((minimize(f, x0, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-10,
-                                                                     "maxiter": 4000}) for x0 in starts),
-                   key=lambda r: r.fun)
+        best = min(
+            (
+                minimize(f, x0, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 4000})
+                for x0 in starts
+            ),
+            key=lambda r: r.fun,
+        )
         q, kappa = 1 / (1 + math.exp(-best.x[0])), math.exp(best.x[1])
         if q < 1e-6:  # the plateau at its boundary: no plateau; the single exponential, q = 0 without an error
             f0 = fit_plateau_exponential(t, obs, t0, plateau=False, n_bins=n_bins)
@@ -165,9 +170,19 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
         n_par = 1
     chi2, dof = _pearson(s, esc, q, kappa, n_bins, n_par)
     p_t0 = _km_at(t, obs, t0)
-    return PlateauFit(t0=float(t0), n_at_risk=n, p_t0=p_t0, q=float(q), q_err=float(q_err),
-                      p_inf=float(q * p_t0), p_inf_err=float(q_err * p_t0),
-                      kappa=float(kappa), kappa_err=float(k_err), chi2=chi2, dof=dof)
+    return PlateauFit(
+        t0=float(t0),
+        n_at_risk=n,
+        p_t0=p_t0,
+        q=float(q),
+        q_err=float(q_err),
+        p_inf=float(q * p_t0),
+        p_inf_err=float(q_err * p_t0),
+        kappa=float(kappa),
+        kappa_err=float(k_err),
+        chi2=chi2,
+        dof=dof,
+    )
 
 
 def _km_at(t, obs, t0) -> float:
@@ -254,8 +269,9 @@ class RateStatus:
     note: str
 
 
-def rate_status(t_end, observed, tau0: float, t_stop: float, *, max_bias: float = 0.1,
-                p_reject: float = 1e-3) -> RateStatus:
+def rate_status(
+    t_end, observed, tau0: float, t_stop: float, *, max_bias: float = 0.1, p_reject: float = 1e-3
+) -> RateStatus:
     """rate_status(t_end, observed, tau0, t_stop, max_bias=0.1, p_reject=1e-3) -> RateStatus.
 
     Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' when
@@ -297,13 +313,17 @@ def rate_status(t_end, observed, tau0: float, t_stop: float, *, max_bias: float 
         p = nan
     if not defined:
         status = "trapped"
-        note = (f"not a rate of the whole population: {f_inf:.1%} of the orbits are still inside at t_max, "
-                f"{bias:.0%} of P at the window end; the window's κ is the plateau's. Plateau-plus-exponential "
-                f"from τ0: P∞ = {plat[0]:.3g} ± {plat[1]:.2g}, κ∞ = {plat[2]:.3g} ± {plat[3]:.2g} (escaping part)")
+        note = (
+            f"not a rate of the whole population: {f_inf:.1%} of the orbits are still inside at t_max, "
+            f"{bias:.0%} of P at the window end; the window's κ is the plateau's. Plateau-plus-exponential "
+            f"from τ0: P∞ = {plat[0]:.3g} ± {plat[1]:.2g}, κ∞ = {plat[2]:.3g} ± {plat[3]:.2g} (escaping part)"
+        )
     elif math.isfinite(p) and p < p_reject:
         status = "non-exponential"
-        note = (f"P(t) is not one exponential from τ0 = {tau0:.3g} (censoring-aware fit rejected, p = {p:.1e}); "
-                "κ is an average over a hazard that changes with time")
+        note = (
+            f"P(t) is not one exponential from τ0 = {tau0:.3g} (censoring-aware fit rejected, p = {p:.1e}); "
+            "κ is an average over a hazard that changes with time"
+        )
     else:
         status, note = "exponential", ""
     return RateStatus(status, f_inf, *plat, p, note)

@@ -9,6 +9,7 @@
 
 Units: times in time units, κ in 1/time.
 """
+
 from __future__ import annotations
 
 import math
@@ -88,8 +89,9 @@ def paired_mle_shift(t_ref, observed_ref, t_alt, observed_alt, t_start: float, t
     v0, v1 = float(np.sum(u0 * u0)), float(np.sum(u1 * u1))
     vd = float(np.sum((u1 - u0) ** 2))
     corr = float(np.sum(u0 * u1) / math.sqrt(v0 * v1)) if v0 > 0 and v1 > 0 else math.nan
-    return PairedShift(float(k0), math.sqrt(v0), float(k1), math.sqrt(v1), float(k1 - k0), math.sqrt(vd),
-                       math.sqrt(v0 + v1), corr)
+    return PairedShift(
+        float(k0), math.sqrt(v0), float(k1), math.sqrt(v1), float(k1 - k0), math.sqrt(vd), math.sqrt(v0 + v1), corr
+    )
 
 
 @dataclass(frozen=True)
@@ -119,8 +121,9 @@ def _log_ratio_fit(t_ref, obs_ref, t_alt, obs_alt, grid):
     return -float(slope), float(icpt)
 
 
-def survival_ratio_slope(t_ref, observed_ref, t_alt, observed_alt, window, *, n_groups: int = 16,
-                         n_grid: int = 400) -> RatioSlope:
+def survival_ratio_slope(
+    t_ref, observed_ref, t_alt, observed_alt, window, *, n_groups: int = 16, n_grid: int = 400
+) -> RatioSlope:
     """survival_ratio_slope(t_ref, observed_ref, t_alt, observed_alt, window, *, n_groups=16) -> RatioSlope.
 
     Difference of escape rates κ_alt − κ_ref of two escape criteria applied
@@ -154,8 +157,12 @@ def survival_ratio_slope(t_ref, observed_ref, t_alt, observed_alt, window, *, n_
     grid = np.linspace(lo, hi, int(n_grid))
     shift, offset = _log_ratio_fit(t_ref, observed_ref, t_alt, observed_alt, grid)
     g = np.arange(t_ref.size) % n_groups
-    gs = np.array([_log_ratio_fit(t_ref[g == i], observed_ref[g == i], t_alt[g == i], observed_alt[g == i],
-                                  grid)[0] for i in range(n_groups)])
+    gs = np.array(
+        [
+            _log_ratio_fit(t_ref[g == i], observed_ref[g == i], t_alt[g == i], observed_alt[g == i], grid)[0]
+            for i in range(n_groups)
+        ]
+    )
     gs_ok = gs[np.isfinite(gs)]
     err = float(np.std(gs_ok, ddof=1) / math.sqrt(gs_ok.size)) if gs_ok.size > 1 else math.nan
     return RatioSlope(shift, err, offset, (lo, hi), gs)

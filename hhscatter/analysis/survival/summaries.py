@@ -5,6 +5,7 @@ of its sampling window.
 A value with an uncertainty is ``{"value": v, "err": e}`` (:func:`value_err`), the convention of every numbers
 JSON. Units: time in model units, rates in 1/time, energies in model units.
 """
+
 from __future__ import annotations
 
 import math
@@ -83,8 +84,9 @@ def survival_tables(energy: float, t_end, observed, rate) -> tuple[pd.DataFrame,
     g = plot_grid(float(np.max(t_end)))
     km = survival_curve(t_end, observed, g)
     esc = survival_curve(t_end[observed], np.ones(int(observed.sum()), bool), g)
-    curve = pd.DataFrame({"energy": energy, "t": g, "P": km.P, "P_err": km.P_err, "P_esc": esc.P,
-                          "P_esc_err": esc.P_err})
+    curve = pd.DataFrame(
+        {"energy": energy, "t": g, "P": km.P, "P_err": km.P_err, "P_esc": esc.P, "P_esc_err": esc.P_err}
+    )
     te = np.linspace(0.0, rate.t_stop * 1.25, 300)
     return curve, pd.DataFrame({"energy": energy, "kind": "exponential", "t": te, "P": rate.fits[0].predict(te)})
 
@@ -96,10 +98,18 @@ def rate_summary(n: int, t_max: float, rate, n_trapped: int) -> dict:
     :func:`~hhscatter.analysis.survival.escape_rate.escape_rate` result.
     """
     return {
-        "n": int(n), "t_max": t_max, "n_trapped": n_trapped, "trapped_fraction": n_trapped / n,
-        "kappa": value_err(rate.kappa, rate.kappa_err), "kappa_windows": [fi.kappa for fi in rate.fits],
-        "kappa_mle": value_err(rate.mle.kappa, rate.mle.kappa_err), "tau0": rate.tau0, "t_stop": rate.t_stop,
-        "windows": [list(w) for w in rate.windows], "f0": rate.fits[0].f0, "t_floor": rate.window_choice.t_floor,
+        "n": int(n),
+        "t_max": t_max,
+        "n_trapped": n_trapped,
+        "trapped_fraction": n_trapped / n,
+        "kappa": value_err(rate.kappa, rate.kappa_err),
+        "kappa_windows": [fi.kappa for fi in rate.fits],
+        "kappa_mle": value_err(rate.mle.kappa, rate.mle.kappa_err),
+        "tau0": rate.tau0,
+        "t_stop": rate.t_stop,
+        "windows": [list(w) for w in rate.windows],
+        "f0": rate.fits[0].f0,
+        "t_floor": rate.window_choice.t_floor,
     }
 
 
@@ -118,19 +128,30 @@ def sticky_tail_summary(energy: float, t_end, observed, t_max: float, tail) -> t
     line = pd.DataFrame({"energy": energy, "kind": "power_law", "t": tp, "P": tl.predict(tp)})
     crossing = math.isfinite(tail.tau_star)
     entry = dict(
-        tail_detected=True, z=value_err(tl.z, tl.z_err), z_mle=value_err(tl.z_mle, tl.z_mle_err),
-        tail_window=list(tl.window), f_star=tl.f_star, tau_c=tl.window[0],
+        tail_detected=True,
+        z=value_err(tl.z, tl.z_err),
+        z_mle=value_err(tl.z_mle, tl.z_mle_err),
+        tail_window=list(tl.window),
+        f_star=tl.f_star,
+        tau_c=tl.window[0],
         tau_star=tail.tau_star if crossing else None,
-        tau_star_definition="crossing of the fitted exponential and power law (crossover_time)" if crossing
+        tau_star_definition="crossing of the fitted exponential and power law (crossover_time)"
+        if crossing
         else "the laws do not cross; use tau_c, the likelihood change point",
-        hazard_exponent=tl.hazard_exponent, delta_aic_split=tl.delta_aic_split,
+        hazard_exponent=tl.hazard_exponent,
+        delta_aic_split=tl.delta_aic_split,
     )
     t_end, observed = np.asarray(t_end, dtype=float), np.asarray(observed, dtype=bool)
     lo = power_law_exponent_mle(t_end, observed, tl.window[1], t_max)
     hi = power_law_exponent_mle(t_end[observed], np.ones(int(observed.sum()), bool), tl.window[1], t_max)
-    entry.update(late_tail={"t_window": [tl.window[1], t_max], "n_events": lo.n_events,
-                            "z_mle_trapped_censored": value_err(lo.kappa, lo.kappa_err),
-                            "z_mle_trapped_removed": value_err(hi.kappa, hi.kappa_err)})
+    entry.update(
+        late_tail={
+            "t_window": [tl.window[1], t_max],
+            "n_events": lo.n_events,
+            "z_mle_trapped_censored": value_err(lo.kappa, lo.kappa_err),
+            "z_mle_trapped_removed": value_err(hi.kappa, hi.kappa_err),
+        }
+    )
     return line, entry
 
 
@@ -141,10 +162,18 @@ def kappa_law_summary(fit) -> dict:
     out = {}
     for i, name in enumerate(("a", "b", "c", "E_b")):
         cov_err = getattr(fit, f"{name}_err")
-        out[name] = {"value": float(getattr(fit, name)), "err": float(max(cov_err, boot[i])),
-                     "err_cov": float(cov_err), "err_boot": float(boot[i])}
-    out.update(continuous=fit.continuous, chi2=fit.chi2, dof=fit.dof,
-               chi2_per_dof=fit.chi2 / fit.dof if fit.dof > 0 else math.nan)
+        out[name] = {
+            "value": float(getattr(fit, name)),
+            "err": float(max(cov_err, boot[i])),
+            "err_cov": float(cov_err),
+            "err_boot": float(boot[i]),
+        }
+    out.update(
+        continuous=fit.continuous,
+        chi2=fit.chi2,
+        dof=fit.dof,
+        chi2_per_dof=fit.chi2 / fit.dof if fit.dof > 0 else math.nan,
+    )
     return out
 
 
@@ -159,14 +188,18 @@ def kappa_law_curves(fits: dict, x_max: float, E_c: float) -> pd.DataFrame:
     for name, f in fits.items():
         xb = f.E_b - E_c
         nonlin, lin = x <= xb * 1.15, x >= xb * 0.85
-        parts.append(pd.DataFrame({"model": name, "regime": "nonlinear", "x": x[nonlin],
-                                   "kappa": f.a * x[nonlin] ** 2 + f.b * x[nonlin]}))
+        parts.append(
+            pd.DataFrame(
+                {"model": name, "regime": "nonlinear", "x": x[nonlin], "kappa": f.a * x[nonlin] ** 2 + f.b * x[nonlin]}
+            )
+        )
         parts.append(pd.DataFrame({"model": name, "regime": "linear", "x": x[lin], "kappa": f.c * x[lin]}))
     return pd.concat(parts, ignore_index=True)
 
 
-def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds: float, margin: float,
-                     max_shift_efolds: float = 0.0) -> tuple[float, float, float]:
+def cmeasure_windows(
+    kappa: float, tau0: float, rec_efolds: float, sample_efolds: float, margin: float, max_shift_efolds: float = 0.0
+) -> tuple[float, float, float]:
     """The sampling window of κ from the c-measure, (t_rec, t_sample_end, t_record_end) in time units.
 
     t_rec = ceil(τ0 + n_rec/κ): the ensemble is in its exponential regime and relaxed towards μ_c; crossings are
@@ -186,8 +219,9 @@ def cmeasure_windows(kappa: float, tau0: float, rec_efolds: float, sample_efolds
     return t_rec, float(t_sample_end), float(t_sample_end + max_shift_efolds / kappa + margin)
 
 
-def kappa_cmeasure_shifts(sections, lifetimes, t_rec: float, span: float, shifts, kappa: float,
-                          t_record_end: float, *, n_boot: int, seed: int) -> list[dict]:
+def kappa_cmeasure_shifts(
+    sections, lifetimes, t_rec: float, span: float, shifts, kappa: float, t_record_end: float, *, n_boot: int, seed: int
+) -> list[dict]:
     """κ from the c-measure (Eq. (eqn:kappa_cmeasure_truetime)) of one run's section crossings, one row per start of
     the sampling window [t_rec + shift/κ, + span] (shift in e-folds of ``kappa``), bootstrapped over orbits (the
     independent unit, not their correlated crossings); orbits censored at t_max (KAM-trapped) dropped.
@@ -207,14 +241,28 @@ def kappa_cmeasure_shifts(sections, lifetimes, t_rec: float, span: float, shifts
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the undetermined count is a column
             T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
-                sections, lifetimes, t0, t1, t_record_end=t_record_end, drop_censored=True, with_orbits=True)
+                sections, lifetimes, t0, t1, t_record_end=t_record_end, drop_censored=True, with_orbits=True
+            )
         if T.size + n_exit == 0:
             continue
         k = kappa_from_cmeasure(T, n_exit, orbits=orb, exit_orbits=exit_orb, n_boot=n_boot, rng=seed)
-        rows.append({"shift_efolds": shift, "t_from": t0, "t_to": t1, "t_record_end": t_record_end,
-                     "n_samples": k.n_samples, "n_exit": k.n_exit, "n_undetermined": n_und, "mu_exit": k.mu_exit,
-                     "T_mean": float(T.mean()) if T.size else math.nan, "T_max": float(T.max()) if T.size else math.nan,
-                     "kappa_cm": k.kappa, "kappa_cm_err": k.kappa_err, "kappa_cm_err_delta": k.kappa_err_delta})
+        rows.append(
+            {
+                "shift_efolds": shift,
+                "t_from": t0,
+                "t_to": t1,
+                "t_record_end": t_record_end,
+                "n_samples": k.n_samples,
+                "n_exit": k.n_exit,
+                "n_undetermined": n_und,
+                "mu_exit": k.mu_exit,
+                "T_mean": float(T.mean()) if T.size else math.nan,
+                "T_max": float(T.max()) if T.size else math.nan,
+                "kappa_cm": k.kappa,
+                "kappa_cm_err": k.kappa_err,
+                "kappa_cm_err_delta": k.kappa_err_delta,
+            }
+        )
     return rows
 
 
@@ -231,8 +279,9 @@ def kappa_cmeasure_z(table: pd.DataFrame, references=("grid", "same_run")) -> pd
     """
     out = table.copy()
     for ref in references:
-        out[f"z_vs_{ref}"] = (out["kappa_cm"] - out[f"kappa_pt_{ref}"]) / np.hypot(out["kappa_cm_err"],
-                                                                                  out[f"kappa_pt_{ref}_err"])
+        out[f"z_vs_{ref}"] = (out["kappa_cm"] - out[f"kappa_pt_{ref}"]) / np.hypot(
+            out["kappa_cm_err"], out[f"kappa_pt_{ref}_err"]
+        )
     return out
 
 
@@ -244,25 +293,39 @@ def kappa_cmeasure_entry(row, later: pd.DataFrame) -> dict:
     :func:`kappa_cmeasure_z`; ``later``: the rows of the same energy with shift_efolds > 0.
     """
     return {
-        "energy": row["energy"], "t_window": [row["t_from"], row["t_to"]], "t_record_end": row["t_record_end"],
-        "n_samples": int(row["n_samples"]), "n_exit": int(row["n_exit"]),
-        "n_undetermined": int(row["n_undetermined"]), "mu_exit": row["mu_exit"],
+        "energy": row["energy"],
+        "t_window": [row["t_from"], row["t_to"]],
+        "t_record_end": row["t_record_end"],
+        "n_samples": int(row["n_samples"]),
+        "n_exit": int(row["n_exit"]),
+        "n_undetermined": int(row["n_undetermined"]),
+        "mu_exit": row["mu_exit"],
         "kappa_cm": value_err(row["kappa_cm"], row["kappa_cm_err"]),
         "kappa_pt_grid": value_err(row["kappa_pt_grid"], row["kappa_pt_grid_err"]),
         "kappa_pt_same_run": value_err(row["kappa_pt_same_run"], row["kappa_pt_same_run_err"]),
-        "z_vs_grid": row["z_vs_grid"], "z_vs_same_run": row["z_vs_same_run"],
-        "kappa_cm_later_starts": {f"+{s:g}/kappa": v for s, v in
-                                  later[["shift_efolds", "kappa_cm"]].itertuples(index=False)},
+        "z_vs_grid": row["z_vs_grid"],
+        "z_vs_same_run": row["z_vs_same_run"],
+        "kappa_cm_later_starts": {
+            f"+{s:g}/kappa": v for s, v in later[["shift_efolds", "kappa_cm"]].itertuples(index=False)
+        },
     }
 
 
 def rate_row(rate) -> dict:
     """One row of a κ(E) table: κ (1/time) with its error and parts, the four window estimates and windows, τ0,
     t_stop and the MLE cross-check, from an :func:`~hhscatter.analysis.survival.escape_rate.escape_rate` result."""
-    return {"kappa": rate.kappa, "kappa_err": rate.kappa_err, "kappa_spread": rate.kappa_spread,
-            "kappa_stat": rate.kappa_stat, **{f"kappa_w{i + 1}": f.kappa for i, f in enumerate(rate.fits)},
-            **{f"window_w{i + 1}": f"{w[0]:.3f}-{w[1]:.3f}" for i, w in enumerate(rate.windows)},
-            "tau0": rate.tau0, "t_stop": rate.t_stop, "kappa_mle": rate.mle.kappa, "kappa_mle_err": rate.mle.kappa_err}
+    return {
+        "kappa": rate.kappa,
+        "kappa_err": rate.kappa_err,
+        "kappa_spread": rate.kappa_spread,
+        "kappa_stat": rate.kappa_stat,
+        **{f"kappa_w{i + 1}": f.kappa for i, f in enumerate(rate.fits)},
+        **{f"window_w{i + 1}": f"{w[0]:.3f}-{w[1]:.3f}" for i, w in enumerate(rate.windows)},
+        "tau0": rate.tau0,
+        "t_stop": rate.t_stop,
+        "kappa_mle": rate.mle.kappa,
+        "kappa_mle_err": rate.mle.kappa_err,
+    }
 
 
 def tau_star_estimate(tail) -> tuple[float, float | None, str]:
@@ -271,6 +334,9 @@ def tau_star_estimate(tail) -> tuple[float, float | None, str]:
     not cross, τ* = τ_c without an error."""
     tl = tail.tail
     if math.isfinite(tail.tau_star):
-        return (tail.tau_star, abs(tail.tau_star - tl.window[0]),
-                "crossing of the exponential and power-law fits; err = |crossing − change point τ_c|")
+        return (
+            tail.tau_star,
+            abs(tail.tau_star - tl.window[0]),
+            "crossing of the exponential and power-law fits; err = |crossing − change point τ_c|",
+        )
     return tl.window[0], None, "the fitted laws do not cross: τ* = τ_c, the likelihood change point of the hazard"

@@ -6,6 +6,7 @@ local escape rate stays on its plateau) and the 4 windows of the exponential
 regime that :func:`hhscatter.analysis.survival.escape_rate.escape_rate` fits. Pure
 functions; times in time units, rates in 1/time.
 """
+
 from __future__ import annotations
 
 import math
@@ -185,8 +186,18 @@ def choose_windows(
     tau0, t_stop, kappa_ref, w, (c, s, se), converged = _iterate_plateau(
         t, P, N, t_floor, w, kappa_ref, target, (t_a, t_b), rel_tol, n_sigma, min_width, w_max, max_iter
     )
-    return WindowChoice(tau0=tau0, t_stop=t_stop, windows=_fitting_windows(tau0, t_stop), kappa_ref=kappa_ref,
-                        width=w, t_floor=float(t_floor), converged=converged, slope_t=c, slope=s, slope_err=se)
+    return WindowChoice(
+        tau0=tau0,
+        t_stop=t_stop,
+        windows=_fitting_windows(tau0, t_stop),
+        kappa_ref=kappa_ref,
+        width=w,
+        t_floor=float(t_floor),
+        converged=converged,
+        slope_t=c,
+        slope=s,
+        slope_err=se,
+    )
 
 
 # the steps of choose_windows (its docstring's rule, step by step)

@@ -1,5 +1,6 @@
 """The claims' analysis (hhscatter.analysis.claims): a reason per κ convention, claim 6 independent of the order of
 the systems, the evidence records."""
+
 from types import SimpleNamespace
 
 import numpy as np
@@ -27,8 +28,7 @@ def _lt(t, censored=()):
 
 def test_each_kappa_convention_carries_its_own_reason():
     # too few orbits for the window rule, in all orbits and in the escaping ones: each row says its own failure
-    p = SimpleNamespace(ratios=[1.5], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01],
-                        alt_region="well")
+    p = SimpleNamespace(ratios=[1.5], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01], alt_region="well")
     t = np.random.default_rng(1).exponential(10.0, 30)
     runs = _Runs(p, {"s_r1.500": _lt(t), "s_well_r1.500": _lt(t)})
     rows = {r["convention"]: r for r in kappa_rows(runs, "s", system_from_spec({"name": "henon_heiles"}))[0]}
@@ -43,9 +43,17 @@ def _fit(rms):
 
 def test_claim6_verdicts_do_not_depend_on_the_order_of_the_systems():
     curve = SimpleNamespace(t=np.arange(10.0), P=np.ones(10))
-    res = {lab: {"conv": "plateau", "tau0": 1.0, "curve": curve, "reason": "", "law": True,
-                 "fits": {"paper": _fit(rms), "integrated": _fit(rms)}}
-           for lab, rms in (("hh", 1.0), ("co", 2.0), ("ba", 1.2))}
+    res = {
+        lab: {
+            "conv": "plateau",
+            "tau0": 1.0,
+            "curve": curve,
+            "reason": "",
+            "law": True,
+            "fits": {"paper": _fit(rms), "integrated": _fit(rms)},
+        }
+        for lab, rms in (("hh", 1.0), ("co", 2.0), ("ba", 1.2))
+    }
     p = SimpleNamespace(mu_gamma=0.01, sm_fit_dt=2.0, sm_min_count=20.0)
     verdicts = []
     for order in (["hh", "co", "ba"], ["co", "ba", "hh"]):
@@ -70,15 +78,29 @@ def test_long_time_record_separates_regular_orbits_from_the_decay():
 
 
 def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
-    reg = [{"system": "barbanis", "label": "b", "e_ratio": 1.5, "ics": "disk/tangential", "fraction": 0.1,
-            "err": 0.01}]
-    fits = [{"system": "barbanis", "e_ratio": 1.5, "ics": "disk/tangential", "P_inf": 0.1, "P_inf_err": 0.01,
-             "exponential": False}]
+    reg = [{"system": "barbanis", "label": "b", "e_ratio": 1.5, "ics": "disk/tangential", "fraction": 0.1, "err": 0.01}]
+    fits = [
+        {
+            "system": "barbanis",
+            "e_ratio": 1.5,
+            "ics": "disk/tangential",
+            "P_inf": 0.1,
+            "P_inf_err": 0.01,
+            "exponential": False,
+        }
+    ]
     kappa = [{"system": "b", "ratio": 1.5, "convention": "plateau", "defined": False}]
-    claims = [{"claim": "2", "system": "b", "quantity": "κ_cm/κ0 − 1 at E/E_c = 1.5 (all orbits, plateau windows)",
-               "verdict": "undetermined"}]
+    claims = [
+        {
+            "claim": "2",
+            "system": "b",
+            "quantity": "κ_cm/κ0 − 1 at E/E_c = 1.5 (all orbits, plateau windows)",
+            "verdict": "undetermined",
+        }
+    ]
     (v,) = validity_map(reg, fits, kappa, claims, ics="disk/tangential")
     assert (v["kappa0_defined"], v["claim2"], v["exponential"], v["plateau"]) == (False, "undetermined", False, True)
     assert first_below(reg + [{**reg[0], "e_ratio": 2.0, "fraction": 0.0}], ics="disk/tangential") == {
-        "barbanis": {"from": 2.0, "text": "from 2 E_c on"}}
+        "barbanis": {"from": 2.0, "text": "from 2 E_c on"}
+    }
     assert first_below(reg, ics="disk/tangential")["barbanis"]["from"] is None

@@ -1,4 +1,5 @@
 """Direct tests of the steps of fit_energy_decay: the window chooser and the two fits (synthetic, known answers)."""
+
 import math
 
 import numpy as np
@@ -42,8 +43,9 @@ def test_fixed_intercept_recovers_exact_slope_and_nan_without_points():
     mu, err, rms = decay._fit_fixed_intercept(t, y, np.ones_like(t), E0, GAMMA, "scaled")
     assert mu == pytest.approx(0.8, rel=1e-12) and err < 1e-10 and rms < 1e-12
     # only t = 0: the slope is not determined
-    assert all(math.isnan(v) for v in decay._fit_fixed_intercept(np.zeros(1), np.zeros(1), np.ones(1), E0, GAMMA,
-                                                                 "scaled"))
+    assert all(
+        math.isnan(v) for v in decay._fit_fixed_intercept(np.zeros(1), np.zeros(1), np.ones(1), E0, GAMMA, "scaled")
+    )
 
 
 def test_free_intercept_recovers_slope_and_intercept_and_nan_with_one_time():

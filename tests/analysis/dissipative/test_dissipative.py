@@ -3,6 +3,7 @@
 All inputs are synthetic with known answers (closed forms or generating
 parameters); every random input is seeded.
 """
+
 import math
 
 import numpy as np
@@ -256,8 +257,9 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
     """Data made with one (κ0, μ); the same model fitted with those and with other constants (our quick-scale
     fig2/fig3 values): the generating constants have the smaller RMS log residual, whatever the dict order."""
     t = np.arange(0.0, 301.0)
-    P, P_err = binomial_sample(model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS,
-                               np.random.default_rng(21))
+    P, P_err = binomial_sample(
+        model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS, np.random.default_rng(21)
+    )
     other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709, E_c=model.PAPER_KAPPA.E_c)
     common = {"P_min": 20 / N_ORBITS, "hazard": hazard}
     right = model.fit_survival_model(t, P, P_err, **KW, **common)
@@ -275,8 +277,9 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
 
 
 def test_predict_tau1_solves_eq_tau1():
-    params = model.SurvivalModelParams(model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2,
-                                       model.PAPER_KAPPA.E_c)
+    params = model.SurvivalModelParams(
+        model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2, model.PAPER_KAPPA.E_c
+    )
     k0 = float(model.PAPER_KAPPA(E0))
 
     def P0(t):  # conservative curve at E0: P(τ0) e^{−κ0(E0)(t − τ0)}
@@ -341,13 +344,23 @@ def test_mixture_components_recover_sub_ensembles(two_population_snapshots, by):
 
 def test_mixture_with_one_component_is_the_homogeneous_model():
     one = np.ones(1)
-    c = model.MixtureComponents(TAU0, "energy", np.array([0.0, 1.0]), one, one, E0 * one, E0 * one, MU * one,
-                                0 * one, (0.0, 1.0), GAMMA)
+    c = model.MixtureComponents(
+        TAU0, "energy", np.array([0.0, 1.0]), one, one, E0 * one, E0 * one, MU * one, 0 * one, (0.0, 1.0), GAMMA
+    )
     t = np.arange(0.0, 200.0, 0.5)
     for hz in ("paper", "integrated"):
         Pm = model.mixture_survival_model(
-            t, kappa_of_E=model.PAPER_KAPPA, components=c, tau0=TAU0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2, hazard=hz,
-            E_c=EC)
+            t,
+            kappa_of_E=model.PAPER_KAPPA,
+            components=c,
+            tau0=TAU0,
+            f_ne=0.1,
+            P_tau0=0.5,
+            L=0.1,
+            b=0.2,
+            hazard=hz,
+            E_c=EC,
+        )
         np.testing.assert_allclose(Pm, model.survival_model(t, **KW, **TRUE, hazard=hz), equal_nan=True)
 
 
@@ -358,14 +371,24 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     rng = np.random.default_rng(21)
     f_ne_true = np.array([0.03, 0.12])  # slow (μ = 0.6), fast (μ = 1.3)
     P_true = model.mixture_survival_model(
-        t, kappa_of_E=model.PAPER_KAPPA, components=true_components(), tau0=TAU0,
-        f_ne=f_ne_true, P_tau0=0.5, L=0.1, b=0.2, hazard=hazard, E_c=EC,
+        t,
+        kappa_of_E=model.PAPER_KAPPA,
+        components=true_components(),
+        tau0=TAU0,
+        f_ne=f_ne_true,
+        P_tau0=0.5,
+        L=0.1,
+        b=0.2,
+        hazard=hazard,
+        E_c=EC,
     )
     P, P_err = binomial_sample(P_true, N_ORBITS, rng)
     # homogeneous model with the paper's procedure: μ from ⟨E⟩ on [0, 200]
     m = decay.mean_energy(snaps)
     mu_h = decay.fit_energy_decay(m["t"], m["mean_E"], E0, GAMMA, (0, 200)).mu
-    common = dict(kappa_of_E=model.PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard, E_c=model.PAPER_KAPPA.E_c)
+    common = dict(
+        kappa_of_E=model.PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard, E_c=model.PAPER_KAPPA.E_c
+    )
     homog = model.fit_survival_model(t, P, P_err, E0=E0, mu=mu_h, gamma=GAMMA, **common)
     mix = model.fit_mixture_model(t, P, P_err, snaps, gamma=GAMMA, n_components=2, by="rate", **common)
     table = model.compare_fits({"homogeneous": homog, "mixture": mix})
@@ -516,16 +539,22 @@ def test_box_distances_bootstrap_of_several_distances_and_two_set_noise_floor():
     assert d[1, 0] == distance.histogram_distance(P, Q, 0.1, UNIT, "hellinger")
     assert d[0, 1] == distance.histogram_distance(P, Q, 0.25, UNIT, "tv")
     # several distances of the same resamples: each part as if bootstrapped alone with the same seed
-    both = distance.bootstrap_distance(P, Q, lambda A, B: (distance.box_distances(A, B, boxes, UNIT),
-                                                          distance.sliced_wasserstein(A, B, 16, 1)), 7, seed=4)
+    both = distance.bootstrap_distance(
+        P,
+        Q,
+        lambda A, B: (distance.box_distances(A, B, boxes, UNIT), distance.sliced_wasserstein(A, B, 16, 1)),
+        7,
+        seed=4,
+    )
     alone = distance.bootstrap_distance(P, Q, lambda A, B: distance.sliced_wasserstein(A, B, 16, 1), 7, seed=4)
     assert both.mean[1] == alone.mean and both.std[1] == alone.std
     assert both.std[0].shape == (2, 2) and (both.std[0] > 0).all()
     # the two-set noise floor is distance_vs_scale's, split for split
     tab = distance.distance_vs_scale(P, Q, boxes, UNIT, kinds=("hellinger",), n_splits=5, seed=9, m=250)
     for j, box in enumerate(sorted(boxes, reverse=True)):
-        nz = distance.split_half_noise(P, Q, lambda A, B, box=box: distance.histogram_distance(A, B, box, UNIT),
-                                       m=250, n_splits=5, seed=9)
+        nz = distance.split_half_noise(
+            P, Q, lambda A, B, box=box: distance.histogram_distance(A, B, box, UNIT), m=250, n_splits=5, seed=9
+        )
         assert nz.mean == pytest.approx(tab["hellinger_noise"].iloc[j], rel=1e-12)
         assert nz.std == pytest.approx(tab["hellinger_noise_std"].iloc[j], rel=1e-12)
     with pytest.raises(ValueError, match="m must be in"):
@@ -534,8 +563,9 @@ def test_box_distances_bootstrap_of_several_distances_and_two_set_noise_floor():
 
 def test_inside_mean_energy_pools_parts_and_splits_at_ec():
     rng = np.random.default_rng(3)
-    rows = pd.DataFrame({"traj_id": np.repeat(np.arange(60), 5), "t": np.tile(np.arange(5.0), 60),
-                         "energy": rng.uniform(0.1, 0.3, 300)})
+    rows = pd.DataFrame(
+        {"traj_id": np.repeat(np.arange(60), 5), "t": np.tile(np.arange(5.0), 60), "energy": rng.uniform(0.1, 0.3, 300)}
+    )
     parts = [rows.iloc[:120], rows.iloc[120:]]
     r = decay.inside_mean_energy(parts, EC)
     whole = decay.mean_energy(rows)
@@ -550,8 +580,13 @@ def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
     t = np.arange(0.0, 100.0, 5.0)
     n = 400
     mu_i = rng.normal(MU, 0.05, n)
-    rows = pd.DataFrame({"traj_id": np.repeat(np.arange(n), t.size), "t": np.tile(t, n),
-                         "energy": (E0 * np.exp(-np.outer(mu_i, GAMMA * t))).ravel()})
+    rows = pd.DataFrame(
+        {
+            "traj_id": np.repeat(np.arange(n), t.size),
+            "t": np.tile(t, n),
+            "energy": (E0 * np.exp(-np.outer(mu_i, GAMMA * t))).ravel(),
+        }
+    )
     boot, scale = decay.bootstrap_mu_first_orbits(rows, n, 100, E0, GAMMA, [(0.0, 95.0)], n_boot=5, seed=2)
     sub = rows[rows["traj_id"] < 100]
     direct = decay.bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, GAMMA, [(0.0, 95.0)], n_boot=5, seed=2)
@@ -576,9 +611,25 @@ def test_homogeneous_fit_steps_alone():
     assert 0 < fne0 <= 0.9 * P_tau0 and fe0 == pytest.approx(P_tau0 - fne0) and L0 > 0
     assert b_starts == (0.02, 0.1, 0.5)
     assert homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
-    prob = HomogeneousProblem(tf, Pf, sf, KW["kappa_of_E"], KW["E0"], KW["mu"], KW["gamma"], KW["tau0"], EC,
-                              "paper", "log", ("f_ne", "L", "b"), {}, {"f_ne": fne0, "f_e": fe0, "L": L0},
-                              b_starts, True, P_tau0)
+    prob = HomogeneousProblem(
+        tf,
+        Pf,
+        sf,
+        KW["kappa_of_E"],
+        KW["E0"],
+        KW["mu"],
+        KW["gamma"],
+        KW["tau0"],
+        EC,
+        "paper",
+        "log",
+        ("f_ne", "L", "b"),
+        {},
+        {"f_ne": fne0, "f_e": fe0, "L": L0},
+        b_starts,
+        True,
+        P_tau0,
+    )
     lo, hi = prob.bounds()
     assert hi[0] == P_tau0 and lo[1] == 1e-9 and hi[2] == 1e3
     v = prob.values([0.2, 0.3, 0.4], tau2)
@@ -605,8 +656,9 @@ def test_fit_homogeneous_hazards_by_the_figure_rule_recovers_the_model_it_sample
         tf, Pf, sf = mc.survival_fit_points(t, P, P_err, TAU0, 2.0, N_ORBITS, 20)
         assert np.all(np.diff(tf) >= 1.5) and tf[0] >= TAU0 and np.all(Pf * N_ORBITS >= 20)
         kw = {("kappa" if k == "kappa_of_E" else k): v for k, v in KW.items()}
-        fits = mc.fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, **kw, hazards=[hazard], fit_tau2=False,
-                                             P_min=20 / N_ORBITS)
+        fits = mc.fit_homogeneous_hazards(
+            t, P, P_err, tf, Pf, sf, **kw, hazards=[hazard], fit_tau2=False, P_min=20 / N_ORBITS
+        )
         f = fits[hazard]
         assert f.values["P_tau0"] == pytest.approx(mc.plateau_level(t, P, TAU0))
         for name in ("f_ne", "L", "b"):

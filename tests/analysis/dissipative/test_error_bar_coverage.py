@@ -1,5 +1,6 @@
 """Coverage of the error bars: on synthetic ensembles with a known answer, about 68 % of the
 1σ intervals must cover the truth, within the exact binomial band at 3σ over ≥ 200 replicates."""
+
 from __future__ import annotations
 
 import math
@@ -10,7 +11,7 @@ from scipy import optimize, stats
 from hhscatter.analysis.survival.cmeasure import kappa_from_cmeasure
 
 ONE_SIGMA = math.erf(1 / math.sqrt(2))  # 0.6827: the chance that a 1σ interval covers the truth
-P_3SIGMA = 2 * stats.norm.sf(3.0)       # 0.0027
+P_3SIGMA = 2 * stats.norm.sf(3.0)  # 0.0027
 
 
 def _covers_as_1sigma(hits) -> bool:
@@ -20,9 +21,9 @@ def _covers_as_1sigma(hits) -> bool:
 
 
 def test_the_binomial_band_refuses_a_wrong_coverage():
-    assert _covers_as_1sigma([True] * 137 + [False] * 63)        # 68.5 %
-    assert not _covers_as_1sigma([True] * 100 + [False] * 100)   # 50 %
-    assert not _covers_as_1sigma([True] * 180 + [False] * 20)    # 90 %
+    assert _covers_as_1sigma([True] * 137 + [False] * 63)  # 68.5 %
+    assert not _covers_as_1sigma([True] * 100 + [False] * 100)  # 50 %
+    assert not _covers_as_1sigma([True] * 180 + [False] * 20)  # 90 %
 
 
 # -- κ from the c-measure: bootstrap over orbits ------------------------------------------------------------
@@ -37,7 +38,9 @@ def _orbit_ensemble(rng, n_orbits, q, k, theta, per_orbit):
 
 def test_kappa_from_the_cmeasure_bootstrap_over_orbits_covers_the_truth():
     q, k, theta, per_orbit = 0.8, 3.0, 2.0, 4
-    truth = (1.0 - q ** (1.0 / k)) / theta  # the Lotka root (tests/analysis/survival/test_survival.py checks the closed form)
+    truth = (
+        1.0 - q ** (1.0 / k)
+    ) / theta  # the Lotka root (tests/analysis/survival/test_survival.py checks the closed form)
     rng = np.random.default_rng(1313)
     by_orbit, by_point = [], []
     for _ in range(200):
@@ -93,7 +96,7 @@ def test_the_order_statistic_interval_of_tau2_covers_the_quantile(rank):
     print(f"τ2 order-statistic interval, rank {rank}: stated {cov:.3f}, measured {np.mean(hits):.3f}")
     assert ONE_SIGMA <= cov < ONE_SIGMA + 0.08
     assert stats.binomtest(int(np.sum(hits)), len(hits), cov).pvalue > P_3SIGMA  # its exact coverage
-    assert _covers_as_1sigma(hits)                                               # and about 68 %
+    assert _covers_as_1sigma(hits)  # and about 68 %
 
 
 def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
@@ -101,11 +104,12 @@ def test_the_first_settling_time_and_its_interval_on_a_tiny_ensemble():
 
     from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_observed_interval
 
-    lt = pd.DataFrame({"t_end": [5.0, 3.0, 9.0, 1.0, 7.0], "outcome": ["settled", "settled", "escaped", "escaped",
-                                                                        "censored"]})
+    lt = pd.DataFrame(
+        {"t_end": [5.0, 3.0, 9.0, 1.0, 7.0], "outcome": ["settled", "settled", "escaped", "escaped", "censored"]}
+    )
     iv = tau2_observed_interval(lt)
     assert iv.value == tau2_observed(lt) == 3.0 and (iv.r, iv.s) == (0, 2) and (iv.lo, iv.hi) == (0.0, 5.0)
-    assert iv.n_settled == 2 and iv.coverage == pytest.approx(0.8 ** 5 + 5 * 0.2 * 0.8 ** 4)
+    assert iv.n_settled == 2 and iv.coverage == pytest.approx(0.8**5 + 5 * 0.2 * 0.8**4)
 
 
 # -- τ2 from the survival model: the Δχ² = 1 ends of its profile by root-finding ---------------------------------
@@ -126,15 +130,17 @@ def test_the_profile_interval_by_root_finding_covers_the_truth():
             return float(np.sum((y - a * f) ** 2)) / sigma**2
 
         grid = np.linspace(0.5, 20.0, 25)  # a coarse scan, as fit_tau2 does; then the ends by root-finding
-        best = float(optimize.minimize_scalar(chi2, bounds=(0.5, 20.0), method="bounded",
-                                              options={"xatol": 1e-10}).x)
+        best = float(optimize.minimize_scalar(chi2, bounds=(0.5, 20.0), method="bounded", options={"xatol": 1e-10}).x)
         lo, hi = profile_interval(chi2, best, chi2(best), 0.5, 20.0, step=grid[1] - grid[0])
-        assert chi2(lo) == pytest.approx(chi2(best) + 1, abs=1e-6) and chi2(hi) == pytest.approx(chi2(best) + 1,
-                                                                                                abs=1e-6)
+        assert chi2(lo) == pytest.approx(chi2(best) + 1, abs=1e-6) and chi2(hi) == pytest.approx(
+            chi2(best) + 1, abs=1e-6
+        )
         hits.append(lo <= tau <= hi)
         widths.append((hi - lo) / 2)
-    print(f"τ profile interval 1σ coverage: {np.mean(hits):.3f} (mean half-width {np.mean(widths):.3f}, "
-          f"grid step {grid[1] - grid[0]:.3f})")
+    print(
+        f"τ profile interval 1σ coverage: {np.mean(hits):.3f} (mean half-width {np.mean(widths):.3f}, "
+        f"grid step {grid[1] - grid[0]:.3f})"
+    )
     assert _covers_as_1sigma(hits)
     # the interval is not bounded by the scan's step: the old cap would have been ±1 grid step
     assert np.mean(widths) < grid[1] - grid[0]

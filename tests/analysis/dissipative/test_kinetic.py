@@ -1,4 +1,5 @@
 """μ predicted from the mean kinetic energy (hhscatter.analysis.dissipative.kinetic): closed forms."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -39,8 +40,9 @@ def test_kinetic_fraction_recovers_known_kinetic_energies_and_weights_by_time():
         if span > 0:
             num += 2 * K / E0 * span
             den += span
-    r = kinetic_fraction_from_energies(np.concatenate(ids), np.concatenate(ts), np.concatenate(es), g, 5.0, 30.0,
-                                       n_boot=100, rng=2)
+    r = kinetic_fraction_from_energies(
+        np.concatenate(ids), np.concatenate(ts), np.concatenate(es), g, 5.0, 30.0, n_boot=100, rng=2
+    )
     assert r.value == pytest.approx(num / den, rel=2e-4)  # E_k vs E0 in the denominator: O(γ K t/E)
     assert 0 < r.err < 0.05
 
@@ -62,8 +64,7 @@ def test_kinetic_fraction_bootstrap_error_matches_the_scatter_of_independent_ens
 
 def test_decay_path_is_the_exponential_law_for_constant_mu_and_slower_for_smaller_mu_at_low_energy():
     t = np.linspace(0, 200, 101)
-    np.testing.assert_allclose(decay_path(t, 0.3, 0.01, lambda E: 0.93 + 0 * E), 0.3 * np.exp(-0.0093 * t),
-                               rtol=1e-8)
+    np.testing.assert_allclose(decay_path(t, 0.3, 0.01, lambda E: 0.93 + 0 * E), 0.3 * np.exp(-0.0093 * t), rtol=1e-8)
     slow = decay_path(t, 0.3, 0.01, lambda E: np.where(E < 0.2, 0.5, 0.93))
     assert np.all(slow >= 0.3 * np.exp(-0.0093 * t) * (1 - 1e-9)) and slow[-1] > 1.2 * 0.3 * np.exp(-1.86)
 

@@ -5,6 +5,7 @@ boundaries), constructions whose exponent or Wada property is derived in the
 test's docstring (middle-thirds Cantor boundaries, Newton's method for
 z³ = 1), and generating parameters (Bernoulli outcomes with p = c ε^α).
 """
+
 import itertools
 import math
 
@@ -57,7 +58,7 @@ def cantor_stripes(n_cols, n_rows, mod):
 
 def newton_basins(n, iterations=40):
     """Basins of the three roots of z³ = 1 under Newton's method on [−1.5, 1.5]², labels 0/1/2."""
-    y, x = np.mgrid[-1.5:1.5:n * 1j, -1.5:1.5:n * 1j]
+    y, x = np.mgrid[-1.5 : 1.5 : n * 1j, -1.5 : 1.5 : n * 1j]
     z = x + 1j * y
     with np.errstate(all="ignore"):
         for _ in range(iterations):
@@ -70,7 +71,7 @@ def newton_basins(n, iterations=40):
 
 def three_sectors(n):
     """Three 120° sectors meeting at the centre of an n × n map: a boundary made of three rays."""
-    y, x = np.mgrid[-1:1:n * 1j, -1:1:n * 1j]
+    y, x = np.mgrid[-1 : 1 : n * 1j, -1 : 1 : n * 1j]
     a = np.mod(np.arctan2(y, x), 2 * np.pi)
     return np.minimum((a // (2 * np.pi / 3)).astype(int), 2)
 
@@ -127,7 +128,7 @@ def test_entropy_of_a_vertical_boundary_matches_the_closed_form(box):
     L = M * box
     for k in range(1, box):
         lab = np.zeros((L, L), dtype=int)
-        lab[:, 5 * box + k:] = 1
+        lab[:, 5 * box + k :] = 1
         r = basins.basin_entropy(lab, box)
         assert r.n_boxes == M * M and r.n_boundary == M and r.n_basins == 2
         assert r.S_bb == pytest.approx(h2(k / box), rel=1e-12)
@@ -135,11 +136,11 @@ def test_entropy_of_a_vertical_boundary_matches_the_closed_form(box):
         assert r.S_bb_err == pytest.approx(0.0, abs=1e-12)  # every boundary box has the same entropy
         assert not r.log2_fractal
     lab = np.zeros((L, L), dtype=int)
-    lab[:, 5 * box + box // 2:] = 1
+    lab[:, 5 * box + box // 2 :] = 1
     if box % 2 == 0:
         assert basins.basin_entropy(lab, box).S_bb == pytest.approx(LN2, rel=1e-12)
     lab = np.zeros((L, L), dtype=int)
-    lab[:, 5 * box:] = 1
+    lab[:, 5 * box :] = 1
     r = basins.basin_entropy(lab, box)
     assert r.S_b == 0.0 and r.n_boundary == 0 and math.isnan(r.S_bb) and not r.log2_fractal
 
@@ -170,8 +171,8 @@ def test_entropy_ignores_cells_outside_the_allowed_region():
     box, M = 4, 10
     L = box * M
     lab = np.zeros((L, L), dtype=int)
-    lab[:, 3 * box + 2:] = 1
-    lab[L // 2 + 2:, :] = -1  # rows from 22 on: the box row 5 (rows 20–23) is half outside
+    lab[:, 3 * box + 2 :] = 1
+    lab[L // 2 + 2 :, :] = -1  # rows from 22 on: the box row 5 (rows 20–23) is half outside
     r = basins.basin_entropy(lab, box)
     assert r.n_boxes == 5 * M and r.n_boundary == 5
     assert r.S_bb == pytest.approx(LN2) and r.S_b == pytest.approx(5 * LN2 / (5 * M))

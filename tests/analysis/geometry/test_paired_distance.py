@@ -11,7 +11,11 @@ import numpy as np
 import pytest
 
 from hhscatter.analysis.geometry.paired_distance import (
-    UnitSet, _offset_extents, paired_hellinger_difference, paired_hellinger_replicates, percentile_interval,
+    UnitSet,
+    _offset_extents,
+    paired_hellinger_difference,
+    paired_hellinger_replicates,
+    percentile_interval,
 )
 
 EXTENT = (0.0, 1.0, 0.0, 1.0)
@@ -40,8 +44,10 @@ def true_distances(mark, box, offsets):
     exts = _offset_extents(EXTENT, box, offsets)
 
     def d(mix):
-        h2 = [0.5 * np.sum((np.sqrt(cell_probs(mix, box, e)) - np.sqrt(cell_probs([(1.0, WIDE)], box, e))) ** 2)
-              for e in exts]
+        h2 = [
+            0.5 * np.sum((np.sqrt(cell_probs(mix, box, e)) - np.sqrt(cell_probs([(1.0, WIDE)], box, e))) ** 2)
+            for e in exts
+        ]
         return float(np.sqrt(np.mean(h2)))
 
     return d(a), d(b), d(b) - d(a)
@@ -63,8 +69,9 @@ def coverage(mark, n_exp, seed, box=0.25, offsets=2, n_boot=100):
     hits, est = 0, []
     for e in range(n_exp):
         A, ua, B, ub, R, ur = draw(rng, mark)
-        r = paired_hellinger_difference(A, B, R, box, EXTENT, units_a=ua, units_b=ub, units_r=ur,
-                                        offsets=offsets, n_boot=n_boot, seed=e)
+        r = paired_hellinger_difference(
+            A, B, R, box, EXTENT, units_a=ua, units_b=ub, units_r=ur, offsets=offsets, n_boot=n_boot, seed=e
+        )
         hits += r.lo <= truth <= r.hi
         est.append(r.delta)
     return hits / n_exp, truth, np.array(est)
@@ -74,7 +81,7 @@ def test_closed_form_reference_is_right():
     """The exact cell probabilities sum to one, and a set equal to the reference is at distance 0."""
     for e in _offset_extents(EXTENT, 0.25, 2):
         assert cell_probs([(0.7, WIDE), (0.3, CORNER)], 0.25, e).sum() == pytest.approx(1.0, abs=1e-12)
-    d_a, d_b, delta = true_distances((1.0, 0.0), 0.25, 2)   # B = the wide component only = the reference
+    d_a, d_b, delta = true_distances((1.0, 0.0), 0.25, 2)  # B = the wide component only = the reference
     assert d_b == pytest.approx(0.0, abs=1e-12) and delta == pytest.approx(-d_a)
 
 
@@ -82,7 +89,7 @@ def test_closed_form_reference_is_right():
 def test_paired_interval_covers_the_true_difference(mark, seed):
     """95 % intervals on 25 synthetic data sets: B closer than A (Δ = −0.112), and B a random subset (Δ = 0)."""
     cov, truth, est = coverage(mark, 25, seed)
-    assert cov >= 0.8, (cov, truth)                          # 0.95 expected; ≤ 19 of 25 has p < 0.01
+    assert cov >= 0.8, (cov, truth)  # 0.95 expected; ≤ 19 of 25 has p < 0.01
     assert abs(est.mean() - truth) < 3 * est.std(ddof=1) / np.sqrt(est.size) + 0.01
 
 
@@ -100,9 +107,15 @@ def test_the_unit_is_resampled_not_the_point():
     A, ua, B, ub, R, ur = draw(np.random.default_rng(5), (0.5, 0.1))
     kw = dict(box=0.25, extent=EXTENT, n_boot=60, seed=3)
     one = paired_hellinger_difference(A, B, R, units_a=ua, units_b=ub, units_r=ur, **kw)
-    three = paired_hellinger_difference(np.repeat(A, 3, axis=0), np.repeat(B, 3, axis=0), np.repeat(R, 3, axis=0),
-                                        units_a=np.repeat(ua, 3), units_b=np.repeat(ub, 3), units_r=np.repeat(ur, 3),
-                                        **kw)
+    three = paired_hellinger_difference(
+        np.repeat(A, 3, axis=0),
+        np.repeat(B, 3, axis=0),
+        np.repeat(R, 3, axis=0),
+        units_a=np.repeat(ua, 3),
+        units_b=np.repeat(ub, 3),
+        units_r=np.repeat(ur, 3),
+        **kw,
+    )
     assert three.lo == pytest.approx(one.lo, abs=1e-12) and three.hi == pytest.approx(one.hi, abs=1e-12)
     assert three.delta == pytest.approx(one.delta, abs=1e-12)
 
@@ -126,8 +139,10 @@ def mixture(w_corner):
 
 def true_distance(mix_x, mix_r, box, offsets):
     """Offset-averaged Hellinger distance of two mixtures' exact cell probabilities (closed form)."""
-    h2 = [0.5 * np.sum((np.sqrt(cell_probs(mix_x, box, e)) - np.sqrt(cell_probs(mix_r, box, e))) ** 2)
-          for e in _offset_extents(EXTENT, box, offsets)]
+    h2 = [
+        0.5 * np.sum((np.sqrt(cell_probs(mix_x, box, e)) - np.sqrt(cell_probs(mix_r, box, e))) ** 2)
+        for e in _offset_extents(EXTENT, box, offsets)
+    ]
     return float(np.sqrt(np.mean(h2)))
 
 
@@ -179,7 +194,7 @@ def test_multi_set_paired_interval_covers_the_true_difference(case, seed):
     """95 % intervals of paired differences on 20 synthetic data sets with closed-form distances."""
     weights, pairs, diff = CASES[case]
     cov, truth, est = multi_coverage(weights, pairs, diff, 20, seed)
-    assert cov >= 0.8, (cov, truth)                          # 0.95 expected; ≤ 15 of 20 has p < 0.003
+    assert cov >= 0.8, (cov, truth)  # 0.95 expected; ≤ 15 of 20 has p < 0.003
     assert abs(est.mean() - truth) < 3 * est.std(ddof=1) / np.sqrt(est.size) + 0.01
 
 
@@ -198,8 +213,9 @@ def test_replicates_pair_the_shared_set_and_reproduce_the_two_set_difference():
     A, ua, B, ub, R, ur = draw(np.random.default_rng(7), (0.5, 0.1))
     r = paired_hellinger_difference(A, B, R, 0.25, EXTENT, units_a=ua, units_b=ub, units_r=ur, n_boot=30, seed=2)
     sets = {"A": UnitSet(A, ua, "run"), "B": UnitSet(B, ub, "run"), "R": UnitSet(R, ur, "ref")}
-    reps = paired_hellinger_replicates(sets, [("A", "R"), ("B", "R"), ("R", "R")], [0.25, 0.5], EXTENT,
-                                       n_boot=30, seed=2)
+    reps = paired_hellinger_replicates(
+        sets, [("A", "R"), ("B", "R"), ("R", "R")], [0.25, 0.5], EXTENT, n_boot=30, seed=2
+    )
     assert reps.shape == (30, 3, 2)
     assert r.delta == pytest.approx((reps[:, 1, 0] - reps[:, 0, 0]).mean(), abs=1e-12)
     assert np.all(reps[:, 2] == 0.0)

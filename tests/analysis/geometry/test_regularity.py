@@ -4,6 +4,7 @@ Reference: scipy's DOP853 on Hénon–Heiles' equations and their variational eq
 package's system code), the tangent vector renormalised every 50 time units; its finite-time Lyapunov exponent
 over [0, T] is ~1e-4 on a torus and 0.04–0.07 in the chaotic sea at E = 1/8 (bounded: nothing escapes).
 """
+
 import numpy as np
 import pandas as pd
 import pytest

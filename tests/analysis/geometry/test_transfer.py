@@ -1,6 +1,7 @@
 """Transfer operators (hhscatter.analysis.geometry.transfer) on exact cases: open maps with closed-form escape rates and
 conditionally invariant densities, the true-time root of a two-state chain, the time-binned propagation of a
 renewal process, and the Perron-vector conventions."""
+
 import math
 
 import numpy as np
@@ -157,7 +158,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     P = tf.survival_from_crossings(n, H)
     k = np.arange(101)
     m, rem = k // 20, k % 20
-    exact = np.where(rem < 10, q ** m, q ** (m + 1))
+    exact = np.where(rem < 10, q**m, q ** (m + 1))
     assert np.allclose(P, exact, atol=1e-12)
     # first crossing at or after t* = 2.5 (step 25): the crossing at t = 4 of the q² that are still there
     fc = tf.first_crossing_after(n, K, L, 25)
@@ -168,7 +169,7 @@ def test_renewal_survival_and_first_crossing_after_t_star():
     Kc, Hc, Lc = tf.lag_kernels(tr, t_end, dt, max_lag=15)
     assert Lc == 15 and tf.capped_share(tr, dt, 15) == 1.0 and tf.capped_share(tr, dt, 20) == 0.0
     Pc = tf.survival_from_crossings(tf.propagate([1.0], Kc, Lc, 45), Hc)
-    assert Pc[44] == pytest.approx(q ** 3)
+    assert Pc[44] == pytest.approx(q**3)
 
 
 def test_first_crossing_weights_sum_to_the_state_distribution():
@@ -269,7 +270,7 @@ def test_long_cycle_has_its_perron_root_and_vector():
     C = sp.csr_matrix((np.full(n, 0.9), (np.arange(n), (np.arange(n) + 1) % n)), shape=(n, n))
     d = np.exp(np.random.default_rng(0).normal(size=n))
     A = (sp.diags(1.0 / d) @ C @ sp.diags(d)).tocsr()
-    assert A.shape[0] > tf.DENSE_MAX            # the ARPACK path
+    assert A.shape[0] > tf.DENSE_MAX  # the ARPACK path
     assert tf.spectral_radius(A) == pytest.approx(0.9, abs=1e-10)
     lam, v = tf.leading_left(A)
     assert lam == pytest.approx(0.9, abs=1e-10)
@@ -278,6 +279,7 @@ def test_long_cycle_has_its_perron_root_and_vector():
 
 def test_arpack_stall_is_a_clear_error_not_a_wrong_root(monkeypatch):
     """If ARPACK stalls twice (a spectrum too close to a circle), the caller gets a ValueError saying so."""
+
     def stall(*a, **k):
         raise sp.linalg.ArpackNoConvergence("stalled", np.empty(0), np.empty((0, 0)))
 
@@ -299,10 +301,10 @@ def test_three_block_cycle_matches_lapack():
     A = np.zeros((n, n))
     for b in range(3):
         c = (b + 1) % 3
-        A[b * m:(b + 1) * m, c * m:(c + 1) * m] = rng.random((m, m)) * (rng.random((m, m)) < 0.05)
+        A[b * m : (b + 1) * m, c * m : (c + 1) * m] = rng.random((m, m)) * (rng.random((m, m)) < 0.05)
     vals, left = scipy.linalg.eig(A.T)
     top = np.abs(vals) > np.abs(vals).max() * (1 - 1e-9)
-    assert top.sum() == 3                        # the ambiguity is really there
+    assert top.sum() == 3  # the ambiguity is really there
     j = int(np.argmax(vals.real))
     ref = np.abs(left[:, j].real) / np.abs(left[:, j].real).sum()
     S = sp.csr_matrix(A)

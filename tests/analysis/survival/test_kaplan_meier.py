@@ -1,5 +1,6 @@
 """The one Kaplan–Meier estimator (hhscatter.analysis.survival.kaplan_meier) against library implementations,
 with weights and streamed, and the other reference checks of the analysis (Wilson intervals)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -137,7 +138,7 @@ def test_power_law_exponent_without_errors_takes_its_error_from_the_scatter():
     from hhscatter.analysis.dissipative.transitions import power_law_exponent
 
     g = np.array([0.005, 0.01, 0.02, 0.04])
-    tau = 0.5 / g ** 1.05 * np.array([1.01, 0.98, 1.02, 0.99])
+    tau = 0.5 / g**1.05 * np.array([1.01, 0.98, 1.02, 0.99])
     p, err = power_law_exponent(g, tau, np.full(g.size, np.nan))
     (c, slope), cov = curve_fit(lambda x, c, s: c + s * x, np.log(g), np.log(tau))  # unweighted, scaled
     assert p == pytest.approx(-slope, rel=1e-8)  # curve_fit iterates to its xtol = 1.5e-8

@@ -1,4 +1,5 @@
 """κ(E) under several conventions (hhscatter.analysis.survival.kappa_conventions), on synthetic lifetimes with a known κ."""
+
 import math
 from types import SimpleNamespace
 
@@ -35,7 +36,9 @@ def test_p_level_windows_of_an_exponential_are_at_its_levels():
     assert w[0][0] == pytest.approx(math.log(2) / kappa, abs=2e-3)
     assert w[0][1] == pytest.approx(math.log(100) / kappa, abs=2e-3)
     L = w[0][1] - w[0][0]
-    assert w[1] == pytest.approx((w[0][0], w[0][0] + L / 2)) and w[3] == pytest.approx((w[0][0] + L / 4, w[0][0] + 3 * L / 4))
+    assert w[1] == pytest.approx((w[0][0], w[0][0] + L / 2)) and w[3] == pytest.approx(
+        (w[0][0] + L / 4, w[0][0] + 3 * L / 4)
+    )
     assert p_level_windows(t, 0.05 + 0.95 * np.exp(-kappa * t), 0.5, 0.01) is None  # a plateau above p_lo
     with pytest.raises(ValueError, match="p_lo"):
         p_level_windows(t, np.exp(-t), 0.01, 0.5)
@@ -67,8 +70,10 @@ def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
     assert pr.defined == (0.065 / P_end <= 0.1)
     assert pr.bias_at_end == pytest.approx(trapped_fraction(t, obs) / P_end)
     t0, obs0 = _lifetimes(kappa, 20000, seed=3)
-    assert escape_rate_p_levels(t0, obs0).defined and plateau_rate(escape_rate(t0, obs0, detect_tail=False),
-                                                                     t0, obs0).defined
+    assert (
+        escape_rate_p_levels(t0, obs0).defined
+        and plateau_rate(escape_rate(t0, obs0, detect_tail=False), t0, obs0).defined
+    )
 
 
 def test_plateau_check_threshold():
@@ -79,9 +84,11 @@ def test_plateau_check_threshold():
 
 def test_stable_energies_need_agreement_of_the_defined_conventions():
     rows = []
-    for e, ks, defined in ((0.2, [0.020, 0.021, 0.030, 0.0], [1, 1, 1, 0]),   # 40 % range: unstable
-                           (0.3, [0.200, 0.205, 0.198, 0.0], [1, 1, 1, 0]),   # 3.5 %: stable (undefined one ignored)
-                           (0.4, [0.3, 0.0, 0.0, 0.0], [1, 0, 0, 0])):        # one convention only: unstable
+    for e, ks, defined in (
+        (0.2, [0.020, 0.021, 0.030, 0.0], [1, 1, 1, 0]),  # 40 % range: unstable
+        (0.3, [0.200, 0.205, 0.198, 0.0], [1, 1, 1, 0]),  # 3.5 %: stable (undefined one ignored)
+        (0.4, [0.3, 0.0, 0.0, 0.0], [1, 0, 0, 0]),
+    ):  # one convention only: unstable
         rows += [{"energy": e, "kappa": k, "defined": bool(d)} for k, d in zip(ks, defined)]
     s = stable_energies(pd.DataFrame(rows), rel_tol=0.1).set_index("energy")
     assert list(s["stable"]) == [False, True, False]

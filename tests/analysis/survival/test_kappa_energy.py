@@ -1,4 +1,5 @@
 """hhscatter.analysis.survival.kappa_energy: the steps of fit_kappa_energy on κ(E) points of a known piecewise law."""
+
 import numpy as np
 import pytest
 
@@ -12,7 +13,7 @@ from hhscatter.analysis.survival.kappa_energy import (
 )
 
 E_C = 1.0 / 6.0
-A, B, E_B = 13.63, 0.03, 0.27          # the paper's law; continuous: c = a x_b + b
+A, B, E_B = 13.63, 0.03, 0.27  # the paper's law; continuous: c = a x_b + b
 C = A * (E_B - E_C) + B
 E = np.linspace(0.18, 0.50, 33)
 
@@ -55,7 +56,7 @@ def test_continuous_covariance_is_the_gauss_newton_inverse():
     """Against a finite-difference Jacobian of κ(x) = b x + a x min(x, x_b), and c = a x_b + b by the delta method."""
     x = E - E_C
     w = np.full(x.size, 1.0 / 0.003**2)
-    xb = 0.2745 - E_C                                   # between two energies: the model is smooth in x_b there
+    xb = 0.2745 - E_C  # between two energies: the model is smooth in x_b there
     cov, dof = _continuous_covariance(x, w, A, xb, 0.0, True)
 
     def model(p):
@@ -63,10 +64,11 @@ def test_continuous_covariance_is_the_gauss_newton_inverse():
         return b * x + a * x * np.minimum(x, xb_)
 
     p, h = np.array([A, B, xb]), np.array([1e-6, 1e-8, 1e-7])
-    J = np.column_stack([(model(p + h[i] * np.eye(3)[i]) - model(p - h[i] * np.eye(3)[i])) / (2 * h[i])
-                         for i in range(3)])
+    J = np.column_stack(
+        [(model(p + h[i] * np.eye(3)[i]) - model(p - h[i] * np.eye(3)[i])) / (2 * h[i]) for i in range(3)]
+    )
     cov3 = np.linalg.inv((J.T * w) @ J)
-    g_c = np.array([xb, 1.0, A])                      # ∂c/∂(a, b, x_b)
+    g_c = np.array([xb, 1.0, A])  # ∂c/∂(a, b, x_b)
     assert dof == x.size - 3
     np.testing.assert_allclose(np.diag(cov)[[0, 1, 3]], np.diag(cov3), rtol=1e-4)
     assert cov[2, 2] == pytest.approx(g_c @ cov3 @ g_c, rel=1e-4)
@@ -82,7 +84,7 @@ def test_discontinuous_covariance_blocks():
     expected[:2, :2], expected[2, 2], expected[3, 3] = F1, 0.25, 0.01
     assert dof == 16
     np.testing.assert_array_equal(cov, expected)
-    scaled, _ = _discontinuous_covariance(F1, F2, 0.01, 32.0, 20, False)   # χ²/dof = 2 scales the fits, not E_b
+    scaled, _ = _discontinuous_covariance(F1, F2, 0.01, 32.0, 20, False)  # χ²/dof = 2 scales the fits, not E_b
     np.testing.assert_array_equal(np.diag(scaled), [8.0, 18.0, 0.5, 0.01])
 
 

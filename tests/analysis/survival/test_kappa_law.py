@@ -1,4 +1,5 @@
 """hhscatter.analysis.survival.kappa_law: the piecewise law κ0(E) of Fig. 2b at energies with a hand-computed answer."""
+
 import math
 
 import numpy as np
@@ -21,12 +22,16 @@ def test_paper_law_at_known_energies():
     """κ0 = 13.63 ΔE² + 0.03 ΔE below E = 0.27, 1.41 ΔE from there on, 0 at and below E_c (ΔE = E − 1/6)."""
     E = np.array([0.0, 0.1, 1 / 6, 0.2, 0.25, 0.27, 0.3, 0.5])
     d = E - 1.0 / 6.0
-    expected = [0.0, 0.0, 0.0,
-                13.63 * (1 / 30) ** 2 + 0.03 / 30,        # E = 0.2: ΔE = 1/30
-                13.63 * (1 / 12) ** 2 + 0.03 / 12,        # E = 0.25: ΔE = 1/12
-                1.41 * d[5],                              # E_switch belongs to the linear branch
-                1.41 * (0.3 - 1 / 6),
-                1.41 / 3]
+    expected = [
+        0.0,
+        0.0,
+        0.0,
+        13.63 * (1 / 30) ** 2 + 0.03 / 30,  # E = 0.2: ΔE = 1/30
+        13.63 * (1 / 12) ** 2 + 0.03 / 12,  # E = 0.25: ΔE = 1/12
+        1.41 * d[5],  # E_switch belongs to the linear branch
+        1.41 * (0.3 - 1 / 6),
+        1.41 / 3,
+    ]
     np.testing.assert_allclose(PAPER_KAPPA(E), expected, rtol=1e-12, atol=0)
 
 
@@ -45,7 +50,7 @@ def test_other_coefficients_and_shapes():
     assert float(law(0.2)) == 0.0
     grid = np.linspace(0.2, 0.6, 12).reshape(3, 4)
     assert law(grid).shape == (3, 4) and np.ndim(law(0.3)) == 0
-    assert np.all(np.diff(law(np.linspace(0.25, 0.39, 50))) > 0)     # increasing on the quadratic branch
+    assert np.all(np.diff(law(np.linspace(0.25, 0.39, 50))) > 0)  # increasing on the quadratic branch
 
 
 def test_fitted_law_reproduces_a_continuous_piecewise_kappa():

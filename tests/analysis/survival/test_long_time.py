@@ -1,4 +1,5 @@
 """The censoring-aware plateau-plus-exponential fit against samples drawn from known laws."""
+
 import numpy as np
 import pytest
 

@@ -1,5 +1,6 @@
 """Escape-rate results as numbers and plot tables (hhscatter.analysis.survival.summaries) on synthetic input with a
 known answer."""
+
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -43,13 +44,27 @@ def test_survival_tables_kaplan_meier_of_all_orbits_and_of_the_escaping_ones():
 
 
 def test_kappa_cmeasure_z_scores_against_both_kappas_from_pt():
-    rows = [{"kappa_cm": 1.0, "kappa_cm_err": 0.3, "kappa_pt_grid": 1.5, "kappa_pt_grid_err": 0.4,
-             "kappa_pt_same_run": 0.0, "kappa_pt_same_run_err": 0.4},
-            {"kappa_cm": 2.0, "kappa_cm_err": 0.05, "kappa_pt_grid": 2.0, "kappa_pt_grid_err": 0.12,
-             "kappa_pt_same_run": 2.13, "kappa_pt_same_run_err": 0.12}]
+    rows = [
+        {
+            "kappa_cm": 1.0,
+            "kappa_cm_err": 0.3,
+            "kappa_pt_grid": 1.5,
+            "kappa_pt_grid_err": 0.4,
+            "kappa_pt_same_run": 0.0,
+            "kappa_pt_same_run_err": 0.4,
+        },
+        {
+            "kappa_cm": 2.0,
+            "kappa_cm_err": 0.05,
+            "kappa_pt_grid": 2.0,
+            "kappa_pt_grid_err": 0.12,
+            "kappa_pt_same_run": 2.13,
+            "kappa_pt_same_run_err": 0.12,
+        },
+    ]
     df = kappa_cmeasure_z(pd.DataFrame(rows))
-    np.testing.assert_allclose(df["z_vs_grid"], [-1.0, 0.0])         # (1 − 1.5)/hypot(0.3, 0.4) = −0.5/0.5
-    np.testing.assert_allclose(df["z_vs_same_run"], [2.0, -1.0])     # 1/0.5; −0.13/0.13
+    np.testing.assert_allclose(df["z_vs_grid"], [-1.0, 0.0])  # (1 − 1.5)/hypot(0.3, 0.4) = −0.5/0.5
+    np.testing.assert_allclose(df["z_vs_same_run"], [2.0, -1.0])  # 1/0.5; −0.13/0.13
     assert len(df) == 2 and isinstance(df, pd.DataFrame)
 
 
@@ -71,5 +86,5 @@ def test_kappa_law_curves_follow_each_law_on_its_side_of_the_break():
     t = kappa_law_curves({"L": law}, x_max=0.4, E_c=0.1)
     nl, li = t[t.regime == "nonlinear"], t[t.regime == "linear"]
     assert nl.x.max() <= 0.2 * 1.15 and li.x.min() >= 0.2 * 0.85
-    np.testing.assert_allclose(nl.kappa, 10.0 * nl.x ** 2 + 0.1 * nl.x)
+    np.testing.assert_allclose(nl.kappa, 10.0 * nl.x**2 + 0.1 * nl.x)
     np.testing.assert_allclose(li.kappa, 1.5 * li.x)

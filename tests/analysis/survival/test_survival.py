@@ -4,6 +4,7 @@ Every statistical test uses a fixed seed and compares with an independent
 closed-form truth (the survival function the sample was drawn from, the
 Lotka root of a renewal process, the parameters of a synthetic κ(E) law).
 """
+
 import math
 import warnings
 

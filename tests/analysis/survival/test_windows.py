@@ -1,4 +1,5 @@
 """hhscatter.analysis.survival.windows: the steps of choose_windows on survival curves with a known rate."""
+
 import math
 
 import numpy as np
@@ -41,8 +42,8 @@ def test_pilot_rate_of_an_exact_exponential():
     P = exact(T)
     t_a, t_b, k = _pilot_rate(T, P, N, t_floor_of(P), 100.0, 0.1, 2.0)
     assert k == pytest.approx(KAPPA, rel=1e-10)
-    assert t_a == pytest.approx(math.log(10) / KAPPA, abs=0.011)          # first grid time with P ≤ 0.1
-    assert t_b == pytest.approx(math.log(1000) / KAPPA, abs=0.011)        # first with P ≤ max(floor, 10^{−3})
+    assert t_a == pytest.approx(math.log(10) / KAPPA, abs=0.011)  # first grid time with P ≤ 0.1
+    assert t_b == pytest.approx(math.log(1000) / KAPPA, abs=0.011)  # first with P ≤ max(floor, 10^{−3})
 
 
 def test_plateau_level_skips_the_fast_start():
@@ -59,8 +60,8 @@ def test_overlapping_run_prefers_overlap_then_length_then_earlier():
     c = np.arange(20.0)
     runs = [(0, 3), (5, 9), (12, 14), (16, 18)]
     assert _overlapping_run(c, runs, (6.0, 8.0)) == (5, 9)
-    assert _overlapping_run(c, runs, (8.5, 13.0)) == (12, 14)          # overlap 1.0 vs 0.5
-    assert _overlapping_run(c, runs, (30.0, 40.0)) == (5, 9)           # no overlap: the longest
+    assert _overlapping_run(c, runs, (8.5, 13.0)) == (12, 14)  # overlap 1.0 vs 0.5
+    assert _overlapping_run(c, runs, (30.0, 40.0)) == (5, 9)  # no overlap: the longest
     assert _overlapping_run(c, [(0, 2), (4, 6)], (30.0, 40.0)) == (0, 2)  # equal length: the earlier
 
 
@@ -76,7 +77,8 @@ def test_iteration_converges_to_the_rate_from_a_nearby_level():
     tf = t_floor_of(P)
     w = _smoothing_width(0.16, 2 * math.pi, 1e9)
     tau0, t_stop, k, w_end, (c, s, se), converged = _iterate_plateau(
-        T, P, N, tf, w, 0.16, (0.0, tf), (0.0, tf), 0.1, 3.0, 2 * math.pi, 1e9, 20)
+        T, P, N, tf, w, 0.16, (0.0, tf), (0.0, tf), 0.1, 3.0, 2 * math.pi, 1e9, 20
+    )
     assert converged and tau0 == 0.0 and t_stop == tf
     assert k == pytest.approx(KAPPA, rel=2e-3) and w_end == pytest.approx(1 / k)
     assert c.shape == s.shape == se.shape
