@@ -476,9 +476,8 @@ def run_report(out, info: dict) -> str:
 
 
 def cmd_survival(a):
-    from matplotlib.figure import (
-        Figure,  # no pyplot: no backend is chosen or changed  # deferred: `hhscatter --help` starts without the engine and tables
-    )
+    # no pyplot: no backend is chosen or changed
+    from matplotlib.figure import Figure  # deferred: `hhscatter --help` starts without the engine and tables
 
     from hhscatter.api import (  # deferred: `hhscatter --help` starts without the engine and tables
         plot_survival,

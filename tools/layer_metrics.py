@@ -169,7 +169,8 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
                     if isinstance(sub, (ast.Import, ast.ImportFrom)):
                         where = f"{f.relative_to(root)}:{sub.lineno}"
                         deferred.append(where)
-                        if "# deferred" not in lines[sub.lineno - 1]:
+                        # the reason on any line of the statement (a formatter may wrap it into parentheses)
+                        if not any("# deferred" in ln for ln in lines[sub.lineno - 1 : sub.end_lineno]):
                             unexplained.append(where)
                         if targets(sub, mod, is_pkg, known):
                             deferred_own.append(where)

@@ -44,9 +44,8 @@ def progress_bar(progress, total, initial, desc):
         return _Silent()
 
     if sys.stderr.isatty() or importlib.util.find_spec("ipywidgets") is None:
-        from tqdm.std import (
-            tqdm,  # text bar (tqdm.auto would warn in a kernel without ipywidgets)  # deferred: tqdm loads on first use
-        )
+        # a text bar (tqdm.auto would warn in a kernel without ipywidgets)
+        from tqdm.std import tqdm  # deferred: tqdm loads on first use
     else:
         from tqdm.auto import tqdm  # deferred: tqdm loads on first use
 
