@@ -20,8 +20,8 @@ reproduction report -- and raises :class:`ProvenanceError` (exit status 2) namin
 Raw runs are checked where they are (a study's own out/ folder); the committed copies of the results in
 docs/studies/assets/ have none, and are checked for everything else.
 
-Example
--------
+Examples
+--------
 >>> config = {"study": {"fit_window": [0.0, 200.0]}}
 >>> doc = sealed({"mu": {"value": 0.9287, "err": 0.001}, "config": config,
 ...               "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}})
