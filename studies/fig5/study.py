@@ -241,7 +241,7 @@ VERDICT_QUANTITY = "Fig. 5b closer to μ_c^0.30 than 5a, paired Δ = d(5b) − d
 REFS_QUANTITY = "Fig. {s} closer to μ_c^0.30 than to μ_c^0.35, paired Δ = d(μ_c^0.35) − d(μ_c^0.30)"
 
 VERDICT_ROWS = (
-    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction before issue 28)", 1),
+    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction this page used first)", 1),
     ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
     ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
     ("cut_offsets_random", "r < 1 on every set, averaged over grid offsets, momenta in random directions", None),
