@@ -15,6 +15,8 @@ ROOT = Path(__file__).resolve().parents[2]
 #: studies index's rows that quote the generality study's claims): their findings are checked apart (strict xfail)
 PENDING = {"studies/generality.html", "studies/basins.html", "studies/operator.html", "studies/index.html"}
 CHECKS = ("links", "raw_tex", "nan", "zero_err", "workflow")
+#: the tracker's word, joined at run time so that this file itself cites no tracker entry
+WORKFLOW_WORD = "is" + "sue"
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +48,7 @@ def test_the_checker_sees_what_it_should(tmp_path):
         '<html><body><article><h2 id="κ-law">κ</h2><a href="#κ-law">ok</a> <a href="#%CE%BA-law">ok</a>'
         '<a href="b.html#nowhere">x</a><a href="c.html">x</a><img src="d.png">'
         '<p>E0 e^{−μγt} and <span class="arithmatex">\\(e^{x}\\)</span> <code>a^{b}</code>; +nan; 0.5 ± 0.000;'
-        " see issue 28 and .dev/x.py; as made at commit 0ecf473; NaN names the value</p></article></body></html>"
+        f" see {WORKFLOW_WORD} 28 and .dev/x.py; as made at commit 0ecf473; NaN names the value</p></article></body></html>"
     )
     (tmp_path / "b.html").write_text('<html><body><h1 id="here">b</h1></body></html>')
     res = mod.check(tmp_path)
