@@ -50,6 +50,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from hhscatter.publish.formatting import format_number, format_value_err
+from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
     "NumberRefError",
@@ -92,7 +93,14 @@ def headline_scale(root: Path, study: str) -> str:
 
 @lru_cache(maxsize=64)
 def _load(path: str, mtime: float) -> dict:
-    return json.loads(Path(path).read_text())
+    """The numbers JSON at ``path``, refused when its content is not the one it was written with (its ``sha256``)."""
+    doc = json.loads(Path(path).read_text())
+    if doc.get(SELF_KEY) is None or content_sha256(doc) != doc[SELF_KEY]:
+        raise NumberRefError(
+            f"{path} is not as its study wrote it (no content hash, or another content than the hash it was written "
+            "with): a page quotes no number from an edited file; make the study again and copy its results"
+        )
+    return doc
 
 
 def load_numbers(root: Path, study: str, scale: str | None = None) -> tuple[dict, str]:

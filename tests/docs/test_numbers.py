@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from hhscatter.publish import numbers as nb
+from hhscatter.studies.provenance import sealed
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDIES = sorted(p.parent.name for p in (ROOT / "studies").glob("*/page.md"))
@@ -81,10 +82,24 @@ def _repo(tmp_path, quick=None, paper=None):
     assets = tmp_path / "docs" / "studies" / "assets"
     (assets / "paper").mkdir(parents=True)
     if quick is not None:
-        (assets / "s.json").write_text(json.dumps(quick))
+        (assets / "s.json").write_text(json.dumps(sealed(quick)))
     if paper is not None:
-        (assets / "paper" / "s.json").write_text(json.dumps(paper))
+        (assets / "paper" / "s.json").write_text(json.dumps(sealed(paper)))
     return tmp_path
+
+
+def test_a_number_from_an_edited_or_unsealed_json_is_refused(tmp_path):
+    root = _repo(tmp_path, quick={"x": 1.5})
+    assert nb.render_refs("[[s:x]]", root) == "1.5"
+    path = root / "docs/studies/assets/s.json"
+    doc = json.loads(path.read_text())
+    doc["x"] = 1.6  # edited by hand
+    path.write_text(json.dumps(doc, indent=1))
+    with pytest.raises(nb.NumberRefError, match="not as its study wrote it"):
+        nb.render_refs("[[s:x]]", root)
+    path.write_text(json.dumps({"x": 1.6}))  # never sealed
+    with pytest.raises(nb.NumberRefError, match="no content hash"):
+        nb.render_refs("[[s:x]]", root)
 
 
 def test_the_headline_is_the_paper_scale_where_committed(tmp_path):
