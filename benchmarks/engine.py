@@ -47,7 +47,8 @@ import numpy as np
 from benchmarks import peers
 from benchmarks.config import out_dir
 from hhscatter.integrate.engine import run_chunk
-from hhscatter.integrate.events import HAMILTON_ONLY, build_escape_only_batch, system
+from hhscatter.integrate.events import HAMILTON_ONLY, system
+from hhscatter.integrate.integrators import build_escape_only_batch
 from hhscatter.model import HenonHeiles
 
 RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))

@@ -9,7 +9,7 @@ import threading
 
 import numpy as np
 
-from hhscatter.integrate import events
+from hhscatter.integrate import integrators
 from hhscatter.integrate.lanes import CONTINUING, LaneRules, _Callback, _unbind
 
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
@@ -24,24 +24,24 @@ _FREE_KEYS = 4  # distinct compiled systems kept per process (a grid of r_esc va
 def _batch_integrator(scene, batch_size, without=()):
     """_batch_integrator(scene, batch_size, without=()) -> context manager yielding (ta, specs, layout).
 
-    One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.events.batch_key`),
+    One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.integrators.batch_key`),
     reused across chunks instead of a new ``taylor_adaptive_batch`` per chunk (measured: ~6 ms and a
     JIT lookup each). A reused integrator is reset to what a new one is: time 0 (both parts of the
     double-length clock), state 0, the scene's parameters (γ; gates closed), no event cooldowns;
     heyoka's step depends on nothing else, so results are bit-identical (tested). An integrator in
     use is out of the cache; the handlers are unbound on return.
     """
-    key, specs, lay = events.batch_key(scene, batch_size, without=without)
+    key, specs, lay = integrators.batch_key(scene, batch_size, without=without)
     with _FREE_LOCK:
         free = _FREE.get(key)
         ta = free.pop() if free else None
     if ta is None:
-        ta, specs, lay = events.build_batch(scene, batch_size, _Callback, without=without)
+        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without)
     else:
         zeros = np.zeros(batch_size)
         ta.set_dtime(zeros, zeros)
         ta.state[:] = 0.0
-        pars = events.batch_pars(scene, lay, batch_size, without)
+        pars = integrators.batch_pars(scene, lay, batch_size, without)
         if len(pars):
             ta.pars[:] = pars
         ta.reset_cooldowns()

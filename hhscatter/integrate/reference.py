@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hhscatter.integrate import events
-from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED, caster
+from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
+from hhscatter.integrate.integrators import build_scalar, caster
 from hhscatter.integrate.lanes import CONTINUING, LIVE, LaneRules, _bind, _Callback, _unbind
 
 
@@ -74,7 +75,7 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
         snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []
         return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
-    ta, specs, layout = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
+    ta, specs, layout = build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
     rules = _Scalar(scene, ta, layout, fp_type)
     _bind(ta, specs, rules)
     cast = caster(fp_type)

@@ -15,6 +15,7 @@ from hhscatter import simulate
 from hhscatter.integrate import heyoka_log
 from hhscatter.integrate.engine import run_chunk, simulate_orbit
 from hhscatter.model import HenonHeiles
+from hhscatter.outcomes import STOPPED
 from hhscatter.scene.ics import section_velocities
 from hhscatter.scene.scene import Scene, SectionWindow
 
@@ -106,3 +107,41 @@ def test_a_run_without_failures_records_zero(tmp_path):
     simulate(Scene(energy=0.3, n=20, seed=1, t_max=100.0), tmp_path / "run", workers=1, progress=False)
     doc = json.loads((tmp_path / "run" / "scene.json").read_text())["event_failures"]
     assert doc == {"total": 0, "orbits_redone": 0, "chunks": {}}
+
+
+def dense_first_crossing(ic, t_stop=3.0, n_grid=6000):
+    """The first ṙ = 0 crossing with φ̇ > 0 after t = 1e-3 of the conservative orbit from ``ic``, found without
+    heyoka's events: heyoka's dense output (no events) sampled on a grid, x p_x + y p_y's sign changes refined
+    by SciPy's brentq on the same dense output. None if there is none before ``t_stop``."""
+    m = HenonHeiles()
+    (x, y, px, py), _, _ = m.expressions()
+    ta = hy.taylor_adaptive(m.equations(None), list(ic), tol=1e-16)
+    co = ta.propagate_until(t_stop, c_output=True)[4]
+
+    def f(t):
+        s = co(t)
+        return s[0] * s[2] + s[1] * s[3]
+
+    ts = np.linspace(1e-3, t_stop, n_grid)
+    fs = np.array([f(t) for t in ts])
+    for i in np.flatnonzero(fs[:-1] * fs[1:] < 0):
+        t = brentq(f, ts[i], ts[i + 1], xtol=1e-15)
+        s = co(t)
+        if s[0] * s[3] - s[1] * s[2] > 0:
+            return t
+    return None
+
+
+def test_no_section_crossing_lost_after_a_start_at_an_inflection():
+    """Orbits started on the section at an inflection of r: heyoka finds a spurious root right after the start
+    (the initial point, not recorded) with the section function's derivative ~0 there. Its deduced cooldown then
+    swallowed the first true crossing, and often every later one, without a log line: the orbit ran on to t_max
+    with no section point. Each orbit's first section point is checked against a search without events."""
+    ics = inflection_ics(12)
+    res = run_chunk(SCENE, ics, np.arange(len(ics)))
+    for j, ic in enumerate(ics):
+        t = dense_first_crossing(ic)
+        assert t is not None
+        assert res.lifetimes["outcome"][j] == STOPPED, j
+        (row,) = np.flatnonzero(res.sections["traj_id"] == j)
+        assert abs(res.sections["t"][row] - t) < 1e-9, j
