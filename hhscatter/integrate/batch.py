@@ -59,15 +59,32 @@ def _batch_integrator(scene, batch_size, without=()):
 class _BatchRules(LaneRules):
     """Lanes of one batch integrator: the part shared by both schedulers."""
 
-    def __init__(self, scene, ta, layout, ics, *, count_steps=False, progress=None, late=None, migrate_at_open=False):
+    def __init__(
+        self,
+        scene,
+        ta,
+        layout,
+        ics,
+        *,
+        count_steps=False,
+        progress=None,
+        late=None,
+        migrate_at_open=False,
+        open_late=None,
+    ):
         """``count_steps``: the epoch loop reads every lane's result (``ChunkResult.n_steps``); ``progress``: f(k)
         after every PROGRESS_EVERY orbits loaded; ``late``: the no-return rule's test (:attr:`LaneRules.late`);
-        ``migrate_at_open``: the first phase of a two-phase scene (orbits handed on when the window opens)."""
+        ``migrate_at_open``: the first phase of a two-phase scene (orbits handed on when the window opens);
+        ``open_late``: None, or a bool per orbit: its section window opens at T_INITIAL (the scene has a clock)."""
         self.ta = ta
         self.B = ta.batch_size
         self.setup(scene, layout, self.B)
         self.late = late
         self.migrate_at_open = migrate_at_open
+        if open_late is not None:
+            if layout.clock is None:
+                raise RuntimeError("internal error: an orbit's window opens late in a scene without a clock")
+            self.open_late = open_late.tolist()
         self.state = ta.state  # live views into the integrator
         self.cols = [self.state[:4, lane] for lane in range(self.B)]  # (x, y, px, py) of each lane
         self.pars = ta.pars if layout.n_pars else None

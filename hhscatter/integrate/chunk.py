@@ -36,6 +36,9 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     finding failed in a step is ignored there by heyoka, so every such failure is counted
     (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
     on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
+    An orbit that starts on the section near an inflection of r has its section window opened at T_INITIAL
+    by the clock (:func:`hhscatter.integrate.events.opens_late`), or, in a scene without a clock, is redone
+    on the reference driver too.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
@@ -47,18 +50,36 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     with heyoka_log.capture() as log:
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
+    local = _unclocked_late(scene, ics[inside])
     if failures:
-        local = _orbits_with_failures(
+        found = _orbits_with_failures(
             lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
             int(inside.sum()),
             failures,
         )
+        local = np.union1d(local, found)
+    if len(local):
         res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
         redone = traj_ids[inside][local]
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
         res = _with_escaped_at_start(scene, ics, traj_ids, outside, res)
     res.event_failures, res.redone = failures, redone
     return res
+
+
+def _opens_late(scene, ics):
+    """events.opens_late where the scene has the clock that opens those windows at T_INITIAL, else None."""
+    return events.opens_late(scene, ics) if events.layout(scene).clock is not None else None
+
+
+def _unclocked_late(scene, ics) -> np.ndarray:
+    """Local indices of the orbits whose window should open late (events.opens_late) in a scene without a clock
+    (snapshots, a window open from 0 to the end): they are redone on the reference driver (its section cooldown
+    is fixed: events.SECTION_COOLDOWN)."""
+    if events.layout(scene).clock is not None:
+        return np.empty(0, np.int64)
+    late = events.opens_late(scene, ics)
+    return np.flatnonzero(late) if late is not None else np.empty(0, np.int64)
 
 
 def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
@@ -72,7 +93,7 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
     orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
-        config = dict(count_steps=count_steps, progress=progress, late=late)
+        config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
         if kind == "epochs":
             lanes = _Epochs(scene, ta, layout, ics, **config)
         else:  # the inlined handlers serve stream scenes with no section event in this integrator and no follow

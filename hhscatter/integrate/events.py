@@ -49,6 +49,8 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from hhscatter.outcomes import (  # re-exported for the engine
     CENSORED,
     ESCAPED,
@@ -71,11 +73,15 @@ SECTION_OFFSET = 1e-300
 # the initial point, so that the long-double reference driver and the engine agree on such orbits (the engine
 # redoes an orbit on it when heyoka's root finding fails: hhscatter.integrate.engine).
 T_INITIAL = 1e-6
-# heyoka ignores an event's roots for a cooldown after each of its roots (so that a step starting on a root does
-# not find it again); by default it deduces the cooldown from the event's derivative at the root, which near an
-# initial point at an inflection of r is ~0: the cooldown after the initial point then reached beyond the first
-# true crossing (and often beyond t_max), which was lost without a word. The section's cooldown is fixed: two
-# ṙ = 0 roots closer than this are one crossing.
+# An orbit that starts on the section puts a root of the section event at its start (x p_x + y p_y = 0 there; the
+# offset moves it to ~1e-300/ḟ(0), ḟ = d(x p_x + y p_y)/dt). Where ḟ(0) is small (r̈ ≈ 0 as well: the start is near
+# an inflection of r) that root is nearly double, and heyoka (a) fails to isolate it now and then (the event
+# is then ignored in the step; logged) and (b) deduces from ḟ ≈ 0 a cooldown after it that swallowed the first true
+# crossing, often every later one, without a word. Such orbits (|ḟ(0)| ≤ OPEN_LATE_SLOPE |p|²) therefore start
+# with their section event off: the clock opens it at T_INITIAL (opens_late; hhscatter.integrate.lanes).
+OPEN_LATE_SLOPE = 1e-3
+# The scalar reference driver fixes its section cooldown instead of heyoka's deduced one (it has no per-orbit
+# clock for the above in every scene): two ṙ = 0 roots closer than this are one crossing there.
 SECTION_COOLDOWN = 1e-9
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
@@ -92,8 +98,8 @@ class EventSpec:
     ``expression``: callable (Symbols) -> heyoka expression whose root is the event;
     ``rule``: the outcome rule its root triggers (one of :data:`RULES`; the handler
     :meth:`hhscatter.integrate.lanes.LaneRules.handler` binds); ``index``: the rule's argument (the radius
-    number of a follow radius), or None; ``cooldown``: heyoka's cooldown after each root (time units; −1:
-    heyoka deduces it from the event's derivative at the root).
+    number of a follow radius), or None; ``cooldown``: the scalar reference driver's cooldown after each root
+    (time units; −1: heyoka deduces it from the event's derivative at the root, as the batch engine always does).
     """
 
     name: str
@@ -278,6 +284,24 @@ def closure_rule(r2: float, r_s: float, last_out) -> int | None:
     return ESCAPED if last_out is not None else None
 
 
+def opens_late(scene, ics):
+    """opens_late(scene, ics) -> bool array (n,), or None: the orbits whose section window opens at T_INITIAL.
+
+    Those of a scene whose window is open from the start that start on the section (x p_x + y p_y = 0 to
+    rounding) with |ḟ(0)| = |p|² + x F_x + y F_y| ≤ OPEN_LATE_SLOPE |p|² (F = −∇V, the system's force): near
+    an inflection of r, where the section event's root at the start is nearly double. None if there is none.
+    """
+    w = scene.sections
+    if w is None or w.t_from > 0 or not len(ics):
+        return None
+    x, y, px, py = np.asarray(ics, dtype=float).T
+    on = np.abs(x * px + y * py) <= 4 * np.finfo(float).eps * (np.abs(x * px) + np.abs(y * py))
+    fx, fy = scene.model.force(x, y)
+    p2 = px * px + py * py
+    late = on & (np.abs(p2 + x * fx + y * fy) <= OPEN_LATE_SLOPE * p2)
+    return late if late.any() else None
+
+
 def section_accepts(window, t: float, x: float, y: float, px: float, py: float, energy: float) -> bool:
     """section_accepts(window, t, x, y, px, py, E) -> bool: is this ṙ = 0 root a recorded section point?
 
@@ -306,6 +330,7 @@ __all__ = [
     "follow_radii",
     "closure_rule",
     "far_radius",
+    "opens_late",
     "layout",
     "scene_events",
     "two_phase",

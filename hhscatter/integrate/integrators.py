@@ -23,8 +23,7 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
     sym = Symbols(scene, lay)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     events = [
-        hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction], cooldown=s.cooldown)
-        for s in specs
+        hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction]) for s in specs
     ]
     pars = batch_pars(scene, lay, batch_size, without)
     kw = {"pars": pars} if len(pars) else {}
@@ -83,7 +82,7 @@ def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
         float(scene.tol if tol is None else tol),
         lay,
         repr(system(scene, lay)),
-        tuple((s.name, s.rule, s.index, s.direction, s.cooldown, repr(s.expression(sym))) for s in specs),
+        tuple((s.name, s.rule, s.index, s.direction, repr(s.expression(sym))) for s in specs),
     )
     return key, specs, lay
 
