@@ -2,7 +2,7 @@
 
 ``scene_events(scene) -> tuple[EventSpec, ...]`` is the one place where the
 events of a scene are declared: each is plain data (name, direction, the
-expression whose root is the event, its cooldown, what it is for). Every driver builds its
+expression whose root is the event, what it is for). Every driver builds its
 heyoka events from it through :mod:`hhscatter.integrate.integrators`: the batch engine
 (:mod:`hhscatter.integrate.engine`), the scalar reference driver
 (:func:`hhscatter.integrate.engine.simulate_orbit`, which the benchmarks and stress tests use in long
@@ -80,8 +80,10 @@ T_INITIAL = 1e-6
 # crossing, often every later one, without a word. Such orbits (|ḟ(0)| ≤ OPEN_LATE_SLOPE |p|²) therefore start
 # with their section event off: the clock opens it at T_INITIAL (opens_late; hhscatter.integrate.lanes).
 OPEN_LATE_SLOPE = 1e-3
-# The scalar reference driver fixes its section cooldown instead of heyoka's deduced one (it has no per-orbit
-# clock for the above in every scene): two ṙ = 0 roots closer than this are one crossing there.
+# Where the scene has no clock (snapshots, a window open to the end), such an orbit is redone on the reference
+# driver with this fixed section cooldown instead of heyoka's deduced one (two ṙ = 0 roots closer than this are
+# one crossing there). Everywhere else heyoka's deduced cooldowns stay: a fixed one trades merged grazing
+# crossings for duplicated roots (docs: concepts/events).
 SECTION_COOLDOWN = 1e-9
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
@@ -92,14 +94,13 @@ RULES = ("escape", "closure", "far", "resc", "radius", "section", "clock")
 
 @dataclass(frozen=True)
 class EventSpec:
-    """EventSpec(name, direction, expression, role, rule=name, index=None, cooldown=-1): one event of a scene, as data.
+    """EventSpec(name, direction, expression, role, rule=name, index=None): one event of a scene, as data.
 
     ``direction``: +1 (upward roots only), −1 (downward) or 0 (both);
     ``expression``: callable (Symbols) -> heyoka expression whose root is the event;
     ``rule``: the outcome rule its root triggers (one of :data:`RULES`; the handler
     :meth:`hhscatter.integrate.lanes.LaneRules.handler` binds); ``index``: the rule's argument (the radius
-    number of a follow radius), or None; ``cooldown``: the scalar reference driver's cooldown after each root
-    (time units; −1: heyoka deduces it from the event's derivative at the root, as the batch engine always does).
+    number of a follow radius), or None.
     """
 
     name: str
@@ -108,7 +109,6 @@ class EventSpec:
     role: str
     rule: str = ""
     index: int | None = None
-    cooldown: float = -1.0
 
     def __post_init__(self):
         if not self.rule:
@@ -235,7 +235,6 @@ def scene_events(scene) -> tuple:
                 0,
                 lambda s: s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate),
                 "section ṙ = 0 (gated)",
-                cooldown=SECTION_COOLDOWN,
             )
         )
     if clock_targets(scene):

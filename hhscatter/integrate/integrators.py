@@ -87,12 +87,14 @@ def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
     return key, specs, lay
 
 
-def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
-    """build_scalar(scene, make_callback, fp_type=float, tol=None) -> (taylor_adaptive, specs, layout).
+def build_scalar(scene, make_callback, *, fp_type=float, tol=None, section_cooldown=-1.0):
+    """build_scalar(scene, make_callback, fp_type=float, tol=None, section_cooldown=-1) -> (taylor_adaptive, specs,
+    layout).
 
     The same events on heyoka's scalar integrator, in ``fp_type`` (float,
     numpy.longdouble or heyoka.real128). ``tol`` defaults to the scene's for
-    float and to the type's epsilon otherwise.
+    float and to the type's epsilon otherwise. ``section_cooldown``: the section event's cooldown after a root
+    (time units; −1: heyoka's, deduced from the event's derivative at the root, as for every other event).
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
@@ -106,7 +108,7 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
             s.expression(sym),
             callback=make_callback(s),
             direction=dirs[s.direction],
-            cooldown=fp_type(s.cooldown),
+            cooldown=fp_type(section_cooldown if s.rule == "section" else -1.0),
             fp_type=fp_type,
         )
         for s in specs
