@@ -645,6 +645,16 @@ STUDY_TABLES = {
         ("S_b", "S_b"),
         ("S_bb", "S_bb"),
     ),
+    "basins.entropy_by_box_at": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("box_side", "box side s"),
+        ("map", "map"),
+        ("grid", "grid (cells per side)"),
+        ("box_cells", "box (cells)"),
+        ("S_b", "S_b"),
+        ("S_bb", "S_bb"),
+    ),
     "basins.point_table": (
         ("E0", "E0"),
         ("gamma", "γ"),

@@ -268,6 +268,7 @@ def analyze(study):
             "cutoff_prediction": cut_pred,
             "cutoff_summary": bs.cutoff_summary(cut_pred),
             "entropy_by_box": by_box,
+            "entropy_by_box_at": bs.entropy_by_box_at(by_box),
             "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
             "energy_scan": scan.to_dict(orient="records"),
             "energy_trend": trend,

@@ -11,6 +11,7 @@ _EXPORTS = {
     "cutoff_records": "basin_summary",
     "cutoff_summary": "basin_summary",
     "energy_trend": "basin_summary",
+    "entropy_by_box_at": "basin_summary",
     "entropy_exponents": "basin_summary",
     "kantz_grassberger": "basin_summary",
     "outcome_codes": "basin_summary",
