@@ -754,8 +754,8 @@ STUDY_TABLES = {
         ("kappa_cm", "fig2 κ crossings"),
         ("residual_kappa_cm", "κ∞/κ_cm − 1"),
         ("verdict_kappa_cm", "vs κ_cm (both errors)"),
-        ("cut_nu_on_cut", "c-measure on cut boxes"),
-        ("cut_weight_on_cut", "flux weight on cut boxes"),
+        ("cut_nu", "c-measure on cut boxes"),
+        ("cut_weight", "flux weight on cut boxes"),
         ("note", "note"),
     ),
 }

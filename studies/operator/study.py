@@ -401,7 +401,7 @@ def kappa_part(study, inputs):
             out["records"].append(rec)
             refs = {"kappa0": k0, "kappa_cm": kc}
             conv = uc.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], refs, verdicts=not_smoke)
-            out["convergence"].append({**conv, **{f"cut_{k}": v for k, v in res["cut_boxes"].items()}})
+            out["convergence"].append({**conv, **res["cut_boxes"]})
             out["grids"] += [
                 res["grid"].assign(energy=E, kind="estimate"),
                 res["boot_grid"].assign(energy=E, kind="bootstrap"),

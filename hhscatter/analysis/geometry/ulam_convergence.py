@@ -342,10 +342,10 @@ def measure_on_cut_boxes(res, samples: int) -> dict:
 
     A finest box holding fewer than ``samples`` points is cut by the section's boundary (V = E or r = r_esc):
     there the flux weight |ṗ_r|/v grows as 1/v and a box's row of M(κ) rests on few heavy points. Returns
-    {cut_share: share of the saddle class's boxes that are cut, nu_on_cut: share of the c-measure ν (left
-    Perron vector of M(κ) at the root) on them, weight_on_cut: share of the samples' flux weight on them,
-    top_weight_share_cut: mean share of a cut box's flux weight carried by its heaviest sample, the same for
-    the full boxes (top_weight_share_full)}.
+    {cut_share: share of the saddle class's boxes that are cut, cut_nu: share of the c-measure ν (left
+    Perron vector of M(κ) at the root) on them, cut_weight: share of the samples' flux weight on them,
+    cut_top_weight: mean share of a cut box's flux weight carried by its heaviest sample, full_top_weight: the
+    same for the full boxes}.
 
     Examples
     --------
@@ -357,7 +357,7 @@ def measure_on_cut_boxes(res, samples: int) -> dict:
     ...     "T": 2.0, "t_end": 2.0, "x1": -0.75 + 0.5 * (nxt % 4), "y1": -0.75 + 0.5 * (nxt // 4), "e1": 0.3})
     >>> tab = tab[(tab.cell > 0) | (tab["rank"] < 4)]
     >>> r = measure_on_cut_boxes(energy_results(tab, (-1, 1, -1, 1), 0.5, [1], [16], 16, 2, 2, 1, 0.3), 16)
-    >>> r["cut_share"], round(r["nu_on_cut"], 6), r["top_weight_share_cut"], r["top_weight_share_full"]
+    >>> r["cut_share"], round(r["cut_nu"], 6), r["cut_top_weight"], r["full_top_weight"]
     (0.0625, 0.0625, 0.25, 0.0625)
     """
     tab, keep, ids = res["tab"], np.asarray(res["keep"], dtype=bool), np.asarray(res["ids"])
@@ -371,10 +371,10 @@ def measure_on_cut_boxes(res, samples: int) -> dict:
     share = top["top"] / top["tot"]
     return {
         "cut_share": float(cut[keep].mean()) if keep.any() else math.nan,
-        "nu_on_cut": float(nu[cut].sum() / nu.sum()) if nu.sum() > 0 else math.nan,
-        "weight_on_cut": float(w[on_cut].sum() / w.sum()),
-        "top_weight_share_cut": float(share[top["c"]].mean()) if top["c"].any() else math.nan,
-        "top_weight_share_full": float(share[~top["c"]].mean()) if (~top["c"]).any() else math.nan,
+        "cut_nu": float(nu[cut].sum() / nu.sum()) if nu.sum() > 0 else math.nan,
+        "cut_weight": float(w[on_cut].sum() / w.sum()),
+        "cut_top_weight": float(share[top["c"]].mean()) if top["c"].any() else math.nan,
+        "full_top_weight": float(share[~top["c"]].mean()) if (~top["c"]).any() else math.nan,
     }
 
 

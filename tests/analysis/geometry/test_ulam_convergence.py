@@ -111,9 +111,9 @@ def test_measure_on_cut_boxes_counts_the_boxes_and_the_heaviest_sample():
     res = uc.energy_results(tab, (-1, 1, -1, 1), 0.5, [1], [16], 16, 2, 2, 1, 0.3)
     r = uc.measure_on_cut_boxes(res, 16)
     assert r["cut_share"] == pytest.approx(1 / 16)
-    assert r["weight_on_cut"] == pytest.approx(12 / (12 + 15 * 16))
-    assert r["top_weight_share_cut"] == pytest.approx(9 / 12) and r["top_weight_share_full"] == pytest.approx(1 / 16)
-    assert 0 < r["nu_on_cut"] < 1
+    assert r["cut_weight"] == pytest.approx(12 / (12 + 15 * 16))
+    assert r["cut_top_weight"] == pytest.approx(9 / 12) and r["full_top_weight"] == pytest.approx(1 / 16)
+    assert 0 < r["cut_nu"] < 1
 
 
 def test_kappa_references_read_both_routes_and_name_a_missing_list():
