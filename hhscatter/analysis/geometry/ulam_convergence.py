@@ -108,7 +108,9 @@ def kappa_convergence(
     finite-variance ratio estimator's bias): κ∞ is the first fit, its model error the difference of the two.
 
     ``boot_grid`` (optional) holds bootstrap replicates on the same grid (columns rep, box, samples, kappa):
-    each replicate is extrapolated with the same design and their spread is the statistical error of κ∞.
+    each replicate is extrapolated with the same design (on the partitions where it has a κ: a replicate's
+    Poisson weights can leave a partition with few samples per box without an open class) and their spread is
+    the statistical error of κ∞.
 
     Returns {kappa_inf, stat_err, model_err, err (the two in quadrature), kappa_inf_alt, slope_box,
     coef_samples, p, p_alt, residual_rms, n_points}.
@@ -132,8 +134,9 @@ def kappa_convergence(
         reps = []
         for _, part in boot_grid.groupby("rep"):
             pt = part.set_index(["box", "samples"]).reindex(list(zip(b, M)))["kappa"].to_numpy(dtype=float)
-            if np.all(np.isfinite(pt)):
-                reps.append(np.linalg.lstsq(X, pt, rcond=None)[0][0])
+            ok = np.isfinite(pt)  # a replicate that leaves a partition without an open class: fit the rest
+            if ok.sum() >= 4 and np.unique(b[ok]).size >= 2 and np.unique(M[ok]).size >= 2:
+                reps.append(np.linalg.lstsq(X[ok], pt[ok], rcond=None)[0][0])
         if len(reps) > 1:
             stat = float(np.std(reps, ddof=1))
     model = abs(k_alt - k_inf)

@@ -124,3 +124,17 @@ def test_kappa_references_read_both_routes_and_name_a_missing_list():
     assert uc.kappa_references(doc) == ({0.25: (0.097, 0.002)}, {0.25: (0.0972, 0.0002)})
     with pytest.raises(KeyError, match="kappa_energy"):
         uc.kappa_references({"cmeasure": {}})
+
+
+def test_kappa_convergence_fits_a_replicate_on_the_partitions_where_it_has_a_kappa():
+    """A replicate without κ at one partition (no open class left) is extrapolated on the other eight: with
+    exact model data its intercept is still κ∞, so three such replicates and one complete give no spread."""
+    g = _grid(0.33, 0.2, 0.03, 0.5)
+    reps = []
+    for r in range(4):
+        part = g.assign(rep=r)
+        if r < 3:
+            part.loc[(part.box == part.box.min()) & (part.samples == 4), "kappa"] = np.nan
+        reps.append(part)
+    c = uc.kappa_convergence(g, pd.concat(reps))
+    assert c["stat_err"] == pytest.approx(0.0, abs=1e-12) and math.isfinite(c["err"])
