@@ -211,7 +211,7 @@ def plot_residuals(nums, grid, path):
     """
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 6.2))
     recs = [r for r in nums.get("kappa_convergence", []) if r.get("kappa_inf") is not None]
     for k, (ref, lab, dx) in enumerate((("kappa0", "κ0 from P(t)", -0.003), ("kappa_cm", "κ from crossings", 0.003))):
         rs = [r for r in recs if r.get(ref) is not None]
@@ -241,7 +241,7 @@ def plot_residuals(nums, grid, path):
         )
     a.axhline(0, color="k", lw=0.8)
     a.set(xlabel="E", ylabel="κ_Ulam / κ_ref − 1", title="(a) residuals of Ulam's κ")
-    a.legend(fontsize=9)
+    a.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     if grid is not None and len(grid):
         est = grid[grid["kind"] == "estimate"]
         marks = {s: m for s, m in zip(sorted(est["box"].unique()), "os^")}
