@@ -11,6 +11,7 @@ _EXPORTS = {
     "ThermalRate": "kramers",
     "hessian": "kramers",
     "kramers_langer": "kramers",
+    "reactivation_survival": "reactivation",
     "thermal_rate": "kramers",
 }
 
