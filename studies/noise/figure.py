@@ -66,7 +66,7 @@ def _panel_no_drag(ax, nd):
     ax.set_xlabel("t")
     ax.set_ylabel("P(t)")
     ax.set_title(r"(d) noise without drag", fontsize=10)
-    ax.legend(fontsize=6.5, loc="lower left", ncol=2)
+    ax.legend(fontsize=6.5, loc="upper right", ncol=2)
 
 
 def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
