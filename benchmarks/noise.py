@@ -4,7 +4,9 @@ Time per unit of orbit time (µs of wall time per orbit per time unit, one proce
 
 * ``conservative``: Hénon–Heiles at E0 = 0.3 without noise (the stream scheduler);
 * ``noise``: the same orbits with a noise strength σ = 0.01 and no drag (the noise scheduler, default kick);
-* ``heat bath``: γ = 1, T = ΔE/6 from the well (long orbits: ≈ 2400 time units each);
+* ``heat bath``: γ = 1, T = ΔE/6 from the well (long orbits: ≈ 2400 time units each), with the noise
+  scheduler's default batch and (``heat bath, B lanes``, to t = 300) with B = 8 and 16 lanes: the Python per
+  kick shared by the batch;
 * ``numpy OBABO``: the independent vectorised integrator (:mod:`hhscatter.integrate.noise_reference`) on the
   heat-bath case, at the step where its weak error on ⟨V⟩ is as small as the engine's.
 
@@ -28,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from hhscatter.integrate.chunk import run_chunk
+from hhscatter.integrate.noise import NOISE_BATCH
 from hhscatter.integrate.noise_reference import obabo_escape_times
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.ics import region_ics
@@ -38,12 +41,12 @@ BIAS = 0.005  # the weak error (relative bias of ⟨V⟩) at which the numpy ref
 DELTA_E = 1.0 / 6.0
 
 
-def _engine(scene, n):
+def _engine(scene, n, batch_size=None):
     """µs per unit of orbit time of the engine on ``n`` orbits of ``scene`` (integrator compiled beforehand)."""
     ics = region_ics(scene, 0, n)
-    run_chunk(scene, ics[:8], np.arange(8))  # compile
+    run_chunk(scene, ics[:8], np.arange(8), batch_size=batch_size)  # compile
     t = time.perf_counter()
-    lt = run_chunk(scene, ics, np.arange(n)).lifetimes
+    lt = run_chunk(scene, ics, np.arange(n), batch_size=batch_size).lifetimes
     dt = time.perf_counter() - t
     return 1e6 * dt / float(lt["t_end"].sum())
 
@@ -99,6 +102,9 @@ def main(argv=None):
     T6 = DELTA_E / 6
     bath = Scene(energy=0.05, n=a.n // 10, gamma=1.0, seed=1, t_max=2000.0, noise=Noise(temperature=T6))
     rows["heat bath"] = _engine(bath, a.n // 10)
+    short = bath.replace(t_max=300.0)
+    for b in (8, 16, NOISE_BATCH):
+        rows[f"heat bath, {b} lanes"] = _engine(short, 128, batch_size=b)
     # the numpy reference's weak error: its leading order checked at h = 0.2, its cost at bias BIAS
     T10 = DELTA_E / 10
     bias = {0.2: _obabo_mean_v(model, T10, 0.2) / _boltzmann_mean_v(model, T10) - 1}
@@ -115,6 +121,8 @@ def main(argv=None):
             "noise / conservative": rows["noise"] / rows["conservative"],
             "heat bath / conservative": rows["heat bath"] / rows["conservative"],
             "heat bath / numpy OBABO at equal weak error": rows["heat bath"] / rows["numpy OBABO"],
+            f"heat bath, 8 lanes / {NOISE_BATCH} lanes": rows["heat bath, 8 lanes"]
+            / rows[f"heat bath, {NOISE_BATCH} lanes"],
         },
         "numpy_obabo_bias_of_mean_V": {str(h): b for h, b in bias.items()},
         "numpy_obabo_step_at_equal_weak_error": h_eq,
