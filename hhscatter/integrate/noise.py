@@ -18,7 +18,7 @@ place of the Verlet B-A-B):
 Both parts leave the Boltzmann density e^{−H/T} invariant exactly (Φ_H conserves H and phase volume, O
 the Maxwell distribution of p), so the stationary measure has no splitting error at any h (up to the
 integrator's tolerance); the dynamics has a weak error O(h²) (Strang splitting of the generator; the
-escape rate's, measured by the ``noise`` study, is stated in :class:`hhscatter.scene.scene.Noise`).
+escape rate's, measured, is stated in :class:`hhscatter.scene.scene.Noise`).
 
 Scheduling is that of the epoch scheduler (:mod:`hhscatter.integrate.epochs`) with the kick interval as
 the epoch: all lanes propagate to h together (one ``propagate_until`` call), then one numpy kick acts on

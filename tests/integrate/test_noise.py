@@ -139,3 +139,12 @@ def test_escape_rate_against_kramers_langer_at_a_low_barrier():
     ratio = rate.rate / kramers_langer(sc.model, 1.0, T).rate
     assert rate.n_events > 500
     assert abs(ratio - 1) < 0.15, (ratio, rate.rate_err / rate.rate)
+
+
+def test_the_scalar_reference_driver_refuses_a_noise_scene():
+    """It would integrate the flow without the kicks: refused, not run."""
+    from hhscatter.integrate.engine import simulate_orbit
+
+    sc = Scene(energy=0.1, n=1, gamma=1.0, noise=Noise(temperature=0.05))
+    with pytest.raises(ValueError, match="no reference driver"):
+        simulate_orbit(sc, [0.1, 0.0, 0.0, 0.1])
