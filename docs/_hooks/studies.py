@@ -139,7 +139,11 @@ class Renderer:
             if not panels:
                 return whole
             out = "".join(
-                one(p, f"{name}, panel ({p.stem[-1]}), {scale} scale", f"({p.stem[-1]}) {scale} scale: <code>{cmd}</code>")
+                one(
+                    p,
+                    f"{name}, panel ({p.stem[-1]}), {scale} scale",
+                    f"({p.stem[-1]}) {scale} scale: <code>{cmd}</code>",
+                )
                 for p in panels
             )
             return out + '\n??? note "The panels in one image (click to open)"\n\n' + _indent(whole) + "\n"
