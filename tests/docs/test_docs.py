@@ -164,6 +164,21 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assert "](assets/fig2.json)" in out
 
 
+def test_a_figure_with_panels_shows_each_at_full_width_the_composite_folded(tmp_path, hook):
+    (tmp_path / "studies" / "fig5").mkdir(parents=True)
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    for f in ("fig5.png", "fig5_panel_a.png", "fig5_panel_b.png"):
+        (assets / "paper" / f).write_bytes(b"\x89PNG")
+    (assets / "fig5.png").write_bytes(b"\x89PNG")  # the quick scale: no panels, the composite
+    out, _ = _page(tmp_path, hook, "<!-- hh:study-figure fig5 -->\n")
+    head, folded = out.split("??? note", 1)
+    assert head.count('class="hh-figure"') == 2 and "](assets/paper/fig5_panel_a.png){ .hh-zoom }" in head
+    assert "(a) paper scale" in head and "(b) paper scale" in head and "assets/paper/fig5.png" not in head
+    assert '"The panels in one image (click to open)"' in folded and "](assets/paper/fig5.png){ .hh-zoom }" in folded
+    assert "](assets/fig5.png){ .hh-zoom }" in folded  # the quick scale below, folded too
+
+
 def test_generated_tables_refuse_an_edited_numbers_json(tmp_path, hook):
     """The generated tables read a study's JSON as the number references do: one whose content no longer matches
     the hash it was written with (a number edited by hand), or one never sealed, fails the build."""
