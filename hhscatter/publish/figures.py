@@ -8,6 +8,8 @@ your own axes in a notebook use :func:`hhscatter.plot_survival` and
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 def agg_pyplot():
     """agg_pyplot() -> matplotlib.pyplot with the file-writing Agg backend selected."""
@@ -39,8 +41,6 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     ['fig9_panel_a.png', 'fig9_panel_b.png']
     >>> plt.close(fig)
     """
-    from pathlib import Path
-
     from matplotlib.transforms import Bbox  # deferred: matplotlib loads on first use
 
     path = Path(path)
