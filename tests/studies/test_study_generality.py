@@ -6,11 +6,15 @@ from __future__ import annotations
 import itertools
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from hhscatter.analysis.stats.verdicts import NO_VERDICT
+
+ROOT = Path(__file__).resolve().parents[2]
 SYSTEMS = {"henon_heiles", "contopoulos", "barbanis"}
 
 
@@ -196,6 +200,31 @@ def test_claim5_distance_counts_and_verdicts_follow_the_raw_sections_and_the_int
         if "n_diss" in c5:
             sec = _raw(out, f"{name}_sec_g{st['mu_gamma']:g}", "sections", ["traj_id", "t"])
             assert c5["n_diss"] == sec.loc[sec["t"] >= c5["t_star"], "traj_id"].nunique()
+        recs = [
+            c
+            for c in doc["claims"]
+            if c["system"] == name and c["claim"] == "5" and c["quantity"].startswith("Fig. 5's distance")
+        ]
+        assert len(recs) == 2, name
+        for kind, rec in zip(("c-measure", "all"), recs):
+            assert rec["verdict"] == NO_VERDICT  # a smoke test: values, no verdict (the rule: committed JSON below)
+            if rec["value"] is None:
+                continue
+            lo, hi = c5[kind]["delta"]["interval"]
+            assert lo <= rec["value"] <= hi
+            checked += 1
+    assert checked >= 1
+
+
+@pytest.mark.parametrize("scale", ["quick", "paper"])
+def test_claim5_committed_verdicts_state_the_sign_of_the_paired_interval(scale):
+    """Claim 5 in the committed JSON (quick, paper): the verdict states the sign of the paired interval exactly
+    (closer to μ_c^E(t*) iff its lower end > 0, to μ_c^E0 iff its upper end < 0), "undetermined" without a value."""
+    assets = ROOT / "docs" / "studies" / "assets"
+    doc = json.loads(((assets if scale == "quick" else assets / scale) / "generality.json").read_text())
+    checked = 0
+    for name, s in doc["systems"].items():
+        c5 = s["cmeasure_distance"]
         recs = [
             c
             for c in doc["claims"]
