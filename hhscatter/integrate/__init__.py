@@ -4,7 +4,8 @@ One module per concern (in the manner of SciPy's ``integrate/_ivp``):
 
 | module | concern |
 |---|---|
-| `events` | the events and outcome rules of a scene, as data; builds heyoka's integrators |
+| `events` | the events and outcome rules of a scene, as data |
+| `integrators` | heyoka's batch and scalar integrators built from those events (the only heyoka events) |
 | `lanes` | the lane-rules contract: `LaneRules`, the rules as event handlers per lane, their callbacks |
 | `batch` | lanes of one batch integrator, and the per-process cache of compiled integrators |
 | `stream` | the stream scheduler (no snapshots): an orbit's end loads the next in its callback |

@@ -39,8 +39,10 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     finding failed in a step is ignored there by heyoka, so every such failure is counted
     (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
     on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
-    A noise scene's orbits have no reference driver (their kicks live in the noise scheduler): their
-    failures are counted, not redone.
+    An orbit that starts on the section near an inflection of r has its section window opened at T_INITIAL
+    by the clock (:func:`hhscatter.integrate.events.opens_late`), or, in a scene without a clock, is redone
+    on the reference driver too. A noise scene's orbits have no reference driver (their kicks live in the
+    noise scheduler): their failures are counted, not redone.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
@@ -53,18 +55,36 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     with heyoka_log.capture() as log:
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
+    local = _unclocked_late(scene, ics[inside]) if kind != "noise" else np.empty(0, np.int64)
     if failures and kind != "noise":
-        local = _orbits_with_failures(
+        found = _orbits_with_failures(
             lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
             int(inside.sum()),
             failures,
         )
+        local = np.union1d(local, found)
+    if len(local):
         res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
         redone = traj_ids[inside][local]
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
         res = _with_escaped_at_start(scene, ics, traj_ids, outside, res)
     res.event_failures, res.redone = failures, redone
     return res
+
+
+def _opens_late(scene, ics):
+    """events.opens_late where the scene has the clock that opens those windows at T_INITIAL, else None."""
+    return events.opens_late(scene, ics) if events.layout(scene).clock is not None else None
+
+
+def _unclocked_late(scene, ics) -> np.ndarray:
+    """Local indices of the orbits whose window should open late (events.opens_late) in a scene without a clock
+    (snapshots, a window open from 0 to the end): they are redone on the reference driver (its section cooldown
+    is fixed: events.SECTION_COOLDOWN)."""
+    if events.layout(scene).clock is not None:
+        return np.empty(0, np.int64)
+    late = events.opens_late(scene, ics)
+    return np.flatnonzero(late) if late is not None else np.empty(0, np.int64)
 
 
 def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
@@ -78,7 +98,7 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
     orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
-        config = dict(count_steps=count_steps, progress=progress, late=late)
+        config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
         if kind == "noise":
             lanes = _Noisy(scene, ta, layout, ics, traj_ids, **config)
         elif kind == "epochs":
