@@ -986,12 +986,10 @@ def _compare(study, pg, stab, g_main, mu, mu_err, inputs) -> dict:
 # ---------------------------------------------------------------------------
 def plot(study):
     """plot(study) -> None; Fig. 5 from the derived tables and fig5.json."""
-    import pyarrow.parquet as pq
-
     from .figure import plot_fig5
 
     nums = study.read_numbers()
-    read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()
+    read = lambda f: pd.read_parquet(study.derived(f))
     plot_fig5(
         read("points.parquet"),
         read("cmeasure_points.parquet"),
