@@ -463,29 +463,3 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
     curves = pd.read_parquet(tmp_path / "fig6" / "out" / "tiny" / "derived" / "curves.parquet")
     for h in ("paper", "integrated"):
         np.testing.assert_array_equal(curves[f"paper_constants_{h}"], curves[f"homogeneous_{h}"])
-
-
-def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
-    """The verdict rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
-    from hhscatter.studies import stage_module
-
-    REFS_QUANTITY, _qualify_our_5b = stage_module("fig5").REFS_QUANTITY, stage_module("fig5")._qualify_our_5b
-
-    def rows(auth_verdict):
-        return [
-            {"quantity": "Fig. 5b: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {"quantity": "Fig. 5a: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {
-                "quantity": REFS_QUANTITY.format(s="5b") + ": the authors' 5a and 5b runs, r < 1 on every set",
-                "verdict": auth_verdict,
-                "authors": True,
-            },
-        ]
-
-    agreeing = rows("agrees")
-    _qualify_our_5b(agreeing)
-    assert agreeing[0]["verdict"].startswith("differs in our convention only")
-    assert agreeing[1]["verdict"] == "differs"  # 5a is not 5b
-    differing = rows("differs")
-    _qualify_our_5b(differing)
-    assert differing[0]["verdict"] == "differs"
