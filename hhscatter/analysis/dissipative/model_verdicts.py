@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.model_tables import PAPER_CONSTANTS
+from hhscatter.analysis.stats.verdicts import comparison_row
 
 __all__ = [
     "better_text",
@@ -70,11 +71,11 @@ def homogeneous_comparisons(fits: pd.DataFrame, const: dict, setup: str) -> list
     'Fig. 6a A: homogeneous (paper) rms log residual'
     """
     return [
-        dict(
-            quantity=f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual",
-            ours=r.rms_log_residual,
-            err=None,
-            paper=None,
+        comparison_row(
+            f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual",
+            r.rms_log_residual,
+            None,
+            None,
             verdict=None,
             convention=f"{constants_label(const, r.hazard, ours=True)}; {setup}",
             note=f"χ²/dof = {r.chi2_red:.3g} ({r.n_points} points); paper: 'satisfying agreement'",
@@ -108,11 +109,11 @@ def mixture_comparisons(cmps: pd.DataFrame, hazards, mixtures) -> list:
             better = int((c[name] < c["homogeneous"]).sum())
             better_aic = int((a[name] < a["homogeneous"]).sum())
             rows.append(
-                dict(
-                    quantity=f"{name} vs homogeneous ({h} hazard): pairs with smaller rms log residual (AIC)",
-                    ours=f"{better} ({better_aic}) of {len(c)}",
-                    err=None,
-                    paper="improved agreement expected (future work)",
+                comparison_row(
+                    f"{name} vs homogeneous ({h} hazard): pairs with smaller rms log residual (AIC)",
+                    f"{better} ({better_aic}) of {len(c)}",
+                    None,
+                    "improved agreement expected (future work)",
                     verdict="agrees" if better > len(c) / 2 else "differs",
                     note=(
                         f"components by {var['by']} at t_ref = {var['t_ref']}; same data selection; "
@@ -147,11 +148,11 @@ def tau_comparisons(taus: pd.DataFrame, hazards) -> list:
         if r.tau2_observed is not None and np.isfinite(r.tau2_observed):
             rel = (r.tau2_observed - r.tau2_predicted) / r.tau2_predicted
             rows.append(
-                dict(
-                    quantity=f"τ2(γ={r.gamma:g}) observed vs Eq. (eq:tau2)",
-                    ours=r.tau2_observed,
-                    err=None,
-                    paper=None,
+                comparison_row(
+                    f"τ2(γ={r.gamma:g}) observed vs Eq. (eq:tau2)",
+                    r.tau2_observed,
+                    None,
+                    None,
                     verdict=f"{100 * rel:+.0f}% from predicted {r.tau2_predicted:.1f}",
                     note="observed: first settling time (fig4); paper: τ2 ∝ 1/γ, predicted by Eq. (eq:tau2)",
                 )
@@ -160,11 +161,11 @@ def tau_comparisons(taus: pd.DataFrame, hazards) -> list:
             pred = getattr(r, f"tau1_pred_{h}")
             if r.tau1_observed is not None and np.isfinite(r.tau1_observed) and pred is not None and np.isfinite(pred):
                 rows.append(
-                    dict(
-                        quantity=f"τ1(γ={r.gamma:g}) observed vs model ({h})",
-                        ours=r.tau1_observed,
-                        err=None,
-                        paper=None,
+                    comparison_row(
+                        f"τ1(γ={r.gamma:g}) observed vs model ({h})",
+                        r.tau1_observed,
+                        None,
+                        None,
                         verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
                         note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)",
                     )
@@ -193,11 +194,11 @@ def constants_comparisons(pc: dict, tau0: float, pcf: pd.DataFrame, pct: pd.Data
     rows = []
     for r in pcf.itertuples():
         rows.append(
-            dict(
-                quantity=f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual, paper's constants",
-                ours=r.rms_log_residual,
-                err=None,
-                paper=None,
+            comparison_row(
+                f"Fig. 6a {r.pair}: homogeneous ({r.hazard}) rms log residual, paper's constants",
+                r.rms_log_residual,
+                None,
+                None,
                 verdict=better_text(r.better, r.rms_log_residual_ours, r.rms_log_residual),
                 convention=f"{constants_label(pc, r.hazard, ours=False)}; {setup}",
                 authors=True,
@@ -217,11 +218,11 @@ def constants_comparisons(pc: dict, tau0: float, pcf: pd.DataFrame, pct: pd.Data
             who = "the paper's" if n_pc > n_ours else "our"
             verdict = f"{who} constants fit better on {max(n_pc, n_ours)} of {len(sub)} pairs"
         rows.append(
-            dict(
-                quantity=f"Fig. 6a ({h} hazard): pairs the paper's constants fit better than ours",
-                ours=f"{n_pc} of {len(sub)}",
-                err=None,
-                paper=None,
+            comparison_row(
+                f"Fig. 6a ({h} hazard): pairs the paper's constants fit better than ours",
+                f"{n_pc} of {len(sub)}",
+                None,
+                None,
                 verdict=verdict,
                 convention=f"{constants_label(pc, h, ours=False)}; {setup}",
                 authors=True,
@@ -240,11 +241,11 @@ def constants_comparisons(pc: dict, tau0: float, pcf: pd.DataFrame, pct: pd.Data
                 else "our μ"
             )
             rows.append(
-                dict(
-                    quantity=f"τ2(γ={g:g}) Eq. (eq:tau2) with the paper's μ vs observed",
-                    ours=r.tau2_predicted,
-                    err=None,
-                    paper=None,
+                comparison_row(
+                    f"τ2(γ={g:g}) Eq. (eq:tau2) with the paper's μ vs observed",
+                    r.tau2_predicted,
+                    None,
+                    None,
                     verdict=(
                         f"observed {r.tau2_observed:.1f} is {_pct(r.tau2_observed, r.tau2_predicted)} "
                         f"from it ({_pct(r.tau2_observed, r.tau2_predicted_ours)} from "
@@ -262,11 +263,11 @@ def constants_comparisons(pc: dict, tau0: float, pcf: pd.DataFrame, pct: pd.Data
                 continue
             closer = "paper's constants" if abs(pred - obs) < abs(pred_o - obs) else "our constants"
             rows.append(
-                dict(
-                    quantity=f"τ1(γ={g:g}) model with the paper's constants ({h}) vs observed",
-                    ours=pred,
-                    err=None,
-                    paper=None,
+                comparison_row(
+                    f"τ1(γ={g:g}) model with the paper's constants ({h}) vs observed",
+                    pred,
+                    None,
+                    None,
                     verdict=(
                         f"{_pct(pred, obs)} from observed {obs:.1f}; our constants {pred_o:.1f} "
                         f"({_pct(pred_o, obs)}): {closer} closer"

@@ -24,6 +24,7 @@ from hhscatter.analysis.dissipative.transitions import (
     tau2_observed_interval,
     tau2_predicted,
 )
+from hhscatter.analysis.stats.verdicts import comparison_row
 from hhscatter.analysis.survival.fits import survival_from_lifetimes
 
 __all__ = ["log_time_grid", "survival_ratio_tables", "transition_comparisons", "transition_table"]
@@ -258,21 +259,21 @@ def transition_comparisons(
     p1, p1_err = power_law_exponent(res["gamma"], res["tau1"], res["tau1_err"])
     win = mu_window
     rows = [
-        dict(
-            quantity=f"μ used for τ2 (own γ={mu_gamma:g} run, [{win[0]:g}, {win[1]:g}])",
-            ours=mu,
-            err=mu_err,
-            paper=paper_mu,
+        comparison_row(
+            f"μ used for τ2 (own γ={mu_gamma:g} run, [{win[0]:g}, {win[1]:g}])",
+            mu,
+            mu_err,
+            paper_mu,
             note="same definition as study fig3",
         )
     ]
     if mu_other is not None:
         rows.append(
-            dict(
-                quantity="μ: fig4's own vs fig3",
-                ours=mu,
-                err=mu_err,
-                paper=mu_other.get("value"),
+            comparison_row(
+                "μ: fig4's own vs fig3",
+                mu,
+                mu_err,
+                mu_other.get("value"),
                 note="consistency check between studies (same seed; grids differ)",
             )
         )
@@ -280,21 +281,21 @@ def transition_comparisons(
     if len(r01):
         r = r01.iloc[0]
         rows.append(
-            dict(
-                quantity="τ2 predicted at γ = 0.01",
-                ours=r["tau2_pred"],
-                err=r["tau2_pred_err"],
-                paper=float(tau2_predicted(E0, E_c, paper_mu, 0.01)),
+            comparison_row(
+                "τ2 predicted at γ = 0.01",
+                r["tau2_pred"],
+                r["tau2_pred_err"],
+                float(tau2_predicted(E0, E_c, paper_mu, 0.01)),
                 unit="time",
                 note="paper value from its μ = 0.91 via Eq. (eq:tau2)",
             )
         )
         rows.append(
-            dict(
-                quantity="τ2 observed (first settling) at γ = 0.01",
-                ours=r["tau2_obs"],
-                err=r["tau2_obs_err"],
-                paper=None,
+            comparison_row(
+                "τ2 observed (first settling) at γ = 0.01",
+                r["tau2_obs"],
+                r["tau2_obs_err"],
+                None,
                 unit="time",
                 note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
                 f"{round(r['f_settled'] * N)} settlers, decreases with N; err: half-width "
@@ -303,52 +304,52 @@ def transition_comparisons(
             )
         )
     rows.append(
-        dict(
-            quantity="τ1 increases as γ decreases",
-            ours=mono1,
-            err=None,
-            paper=True,
+        comparison_row(
+            "τ1 increases as γ decreases",
+            mono1,
+            None,
+            True,
             verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
             note="paper: 'both τ1 and τ2 increase with decreasing γ'",
         )
     )
     if p1 is not None:
         rows.append(
-            dict(
-                quantity="p1 in τ1 ∝ γ^−p1",
-                ours=p1,
-                err=p1_err,
-                paper=None,
+            comparison_row(
+                "p1 in τ1 ∝ γ^−p1",
+                p1,
+                p1_err,
+                None,
                 note="not in the paper; a linear κ0(E) with E = E0 e^{−μγt} gives P_γ/P_0 ≈ "
                 "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2",
             )
         )
     if p_exp is not None:
         rows.append(
-            dict(
-                quantity="p in τ2,obs ∝ γ^−p",
-                ours=p_exp,
-                err=p_err,
-                paper=1.0,
+            comparison_row(
+                "p in τ2,obs ∝ γ^−p",
+                p_exp,
+                p_err,
+                1.0,
                 note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); unweighted log-log fit over γ with settlers",
             )
         )
     if p50 is not None:
         rows.append(
-            dict(
-                quantity="p in median settling time ∝ γ^−p",
-                ours=p50,
-                err=p50_err,
-                paper=1.0,
+            comparison_row(
+                "p in median settling time ∝ γ^−p",
+                p50,
+                p50_err,
+                1.0,
                 note="N-independent companion of τ2,obs (same fit)",
             )
         )
     rows.append(
-        dict(
-            quantity="τ0 (data-driven, on P_0)",
-            ours=tau0,
-            err=tau0_err,
-            paper=None,
+        comparison_row(
+            "τ0 (data-driven, on P_0)",
+            tau0,
+            tau0_err,
+            None,
             unit="time",
             note="paper: τ0 effectively independent of γ; no value given",
         )

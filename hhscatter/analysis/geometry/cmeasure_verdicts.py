@@ -14,6 +14,8 @@ import math
 
 import pandas as pd
 
+from hhscatter.analysis.stats.verdicts import comparison_row
+
 __all__ = [
     "REFS_QUANTITY",
     "VERDICT_QUANTITY",
@@ -77,28 +79,28 @@ def closer_comparisons(pg: pd.DataFrame, stab: pd.DataFrame, g_main: float, *, m
     frac_a = float(main["n_a_all"]) / float(main["N"])
     paper_frac = paper["fraction"]
     rows = [
-        dict(
-            quantity="t* (E2=0.35 → E1=0.30, γ=0.01)",
-            ours=float(main["t_star"]),
-            err=float(main["t_star_err"]),
-            paper=paper["t_star"],
+        comparison_row(
+            "t* (E2=0.35 → E1=0.30, γ=0.01)",
+            float(main["t_star"]),
+            float(main["t_star_err"]),
+            paper["t_star"],
             note=f"t* = ln(E2/E1)/(μγ) with μ = {mu:.4g} ± {mu_err:.2g} from {mu_source}; "
             "paper gives t* ≈ 17 (its μ = 0.91 gives 16.94)",
         ),
-        dict(
-            quantity="fraction of N plotted in Fig. 5a",
-            ours=frac_a,
-            err=math.sqrt(frac_a * (1 - frac_a) / float(main["N"])),
-            paper=paper_frac,
+        comparison_row(
+            "fraction of N plotted in Fig. 5a",
+            frac_a,
+            math.sqrt(frac_a * (1 - frac_a) / float(main["N"])),
+            paper_frac,
             verdict="differs" if abs(frac_a - 3e-3) > 0.5 * 3e-3 else "comparable",
             note="paper: ≈3e4 of N = 1e7 plotted; the fraction depends on the initial ensemble "
             "(ours: uniform disk r < 0.5, tangential velocities), so only the order matters",
         ),
-        dict(
-            quantity="⟨E⟩ of the Fig. 5a crossings",
-            ours=float(main["mean_E_a"]),
-            err=float(main["std_E_a"]) / math.sqrt(max(float(main["n_a"]), 1.0)),
-            paper=E1,
+        comparison_row(
+            "⟨E⟩ of the Fig. 5a crossings",
+            float(main["mean_E_a"]),
+            float(main["std_E_a"]) / math.sqrt(max(float(main["n_a"]), 1.0)),
+            E1,
             note=f"spread (std) {float(main['std_E_a']):.4f}; the paper's premise is ⟨E⟩ ≈ E1 at t*",
         ),
     ]
@@ -110,11 +112,11 @@ def closer_comparisons(pg: pd.DataFrame, stab: pd.DataFrame, g_main: float, *, m
         closer = r1["sw1"] + 2 * math.hypot(r1["sw1_err"], r2["sw1_err"]) < r2["sw1"]
         closer_by_set[s] = bool(closer)
         rows.append(
-            dict(
-                quantity=f"Fig. 5{s}: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)",
-                ours=f"{r1['sw1']:.4f}±{r1['sw1_err']:.4f} vs {r2['sw1']:.4f}±{r2['sw1_err']:.4f}",
-                err=None,
-                paper="μ_c^{E1} better than μ_c^{E2}",
+            comparison_row(
+                f"Fig. 5{s}: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)",
+                f"{r1['sw1']:.4f}±{r1['sw1_err']:.4f} vs {r2['sw1']:.4f}±{r2['sw1_err']:.4f}",
+                None,
+                "μ_c^{E1} better than μ_c^{E2}",
                 verdict="agrees" if closer else "differs",
                 note="sliced Wasserstein W1 (units of x, y), bootstrap 1σ",
             )
@@ -149,11 +151,11 @@ def difference_comparisons(record: dict, conventions: dict, like_for_like: str =
         if r["construction"] == "ours" and v == "differs" and like is not None and verdict_of(like) != "differs":
             v = f"differs in our convention only; in the authors' construction, like for like: {verdict_of(like)}"
         out.append(
-            dict(
-                quantity=VERDICT_QUANTITY.format(label=r["label"]),
-                ours=f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]",
-                err=None,
-                paper="Δ < 0 (the energy filter tightens the agreement)",
+            comparison_row(
+                VERDICT_QUANTITY.format(label=r["label"]),
+                f"{r['delta']:+.3f} [{lo:+.3f}, {hi:+.3f}]",
+                None,
+                "Δ < 0 (the energy filter tightens the agreement)",
                 verdict=v,
                 authors=r["construction"] != "ours",
                 convention=conventions[r["construction"]],
@@ -190,11 +192,11 @@ def reference_comparisons(record: dict, authors_convention: str) -> list:
         d, (lo, hi) = r["delta"]["value"], r["delta"]["interval"]
         ours = r["construction"] == "ours"
         out.append(
-            dict(
-                quantity=REFS_QUANTITY.format(s=r["set"]) + f": {r['label']}",
-                ours=f"{d:+.3f} [{lo:+.3f}, {hi:+.3f}]",
-                err=None,
-                paper="Δ > 0 (closer to μ_c^{E1})",
+            comparison_row(
+                REFS_QUANTITY.format(s=r["set"]) + f": {r['label']}",
+                f"{d:+.3f} [{lo:+.3f}, {hi:+.3f}]",
+                None,
+                "Δ > 0 (closer to μ_c^{E1})",
                 verdict=interval_verdict(lo, hi, sign=+1),
                 authors=not ours,
                 convention=None if ours else authors_convention,
@@ -234,28 +236,28 @@ def scale_comparisons(record) -> list:
     any_up = any(s["interval"][0] > 0 for s in steps)
     jh = record["boxes"].index(record["box_headline"])
     return [
-        dict(
-            quantity=f"agreement scale ε*_δ of Fig. 5a vs μ_c^0.30 shrinks with relaxation time t* (debiased H ≤ δ = "
+        comparison_row(
+            f"agreement scale ε*_δ of Fig. 5a vs μ_c^0.30 shrinks with relaxation time t* (debiased H ≤ δ = "
             f"{record['delta']:g}, paired half-samples)",
-            ours="; ".join(
+            "; ".join(
                 f"t*={c['t_star']:.1f}: {fmt(c['eps_delta'])} [{fmt(c['eps_delta_interval'][0])}, "
                 f"{fmt(c['eps_delta_interval'][1])}]"
                 for c in cur
             ),
-            err=None,
-            paper="finite scale, smaller for longer relaxation",
+            None,
+            "finite scale, smaller for longer relaxation",
             verdict="agrees" if share >= record["level"] else "not shown",
             note=f"ε*_δ of the mean curve with its {level} % interval over {record['n_boot']} paired half-samples "
             f"(orbits of every γ's run and of the reference); it shrinks in {share:.0%} of them",
         ),
-        dict(
-            quantity=f"debiased Hellinger(ε={record['box_headline']:g}) of Fig. 5a to μ_c^0.30 decreases with t* "
+        comparison_row(
+            f"debiased Hellinger(ε={record['box_headline']:g}) of Fig. 5a to μ_c^0.30 decreases with t* "
             "(paired differences between consecutive t*)",
-            ours=", ".join(f"t*={c['t_star']:.1f}: {c['d'][jh]:.3f}" for c in cur)
+            ", ".join(f"t*={c['t_star']:.1f}: {c['d'][jh]:.3f}" for c in cur)
             + "; steps "
             + ", ".join(f"{s['value']:+.3f} [{s['interval'][0]:+.3f}, {s['interval'][1]:+.3f}]" for s in steps),
-            err=None,
-            paper="convergence to μ_c^{E(t)} with relaxation time",
+            None,
+            "convergence to μ_c^{E(t)} with relaxation time",
             verdict="agrees" if all_down else ("differs" if any_up else "not shown"),
             note=f"{level} % intervals of d(t*_(i+1)) − d(t*_i) from {record['n_boot']} paired half-samples; "
             f"{record['offsets']} grid placements",
