@@ -259,9 +259,10 @@ def _verdict_5b(study, cm_full, E1, ours):
 
 
 def _refs_paired(study, cm_full, sets_ours, E1, E2):
-    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired (:func:`~hhscatter.analysis.geometry.cmeasure_comparison.
-    paired_reference_distances`), in two constructions, each cut alike: ours (γ = gamma_main, no cut) and the
-    authors' (their two runs, r < r_cut on every set). Returns the JSON record; the curves are panel (c)."""
+    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired
+    (:func:`~hhscatter.analysis.geometry.cmeasure_comparison.paired_reference_distances`), in two constructions,
+    each cut alike: ours (γ = gamma_main, no cut) and the authors' (their two runs, r < r_cut on every set).
+    Returns the JSON record; the curves are panel (c)."""
     s = cc.ComparisonSettings.from_params(study.params)
     auth = _authors_sets(study)
     cut = {k: cc.cap_rows(cc.within_radius(v, s.r_cut), s.n_cap, s.seed) for k, v in cm_full.items()}
