@@ -9,13 +9,16 @@ from hhscatter.integrate.batch import _batch_integrator
 from hhscatter.integrate.epochs import EPOCH_BATCH, _Epochs
 from hhscatter.integrate.events import ESCAPED
 from hhscatter.integrate.lanes import RERUN, _bind
+from hhscatter.integrate.noise import NOISE_BATCH, _Noisy
 from hhscatter.integrate.rerun import _merge_rerun, _no_return, _orbits_with_failures, _own_far, _redo_on_reference
 from hhscatter.integrate.results import CROSSING_COLUMNS, SECTION_COLUMNS, ChunkResult, _empty_result, _rows_to_columns
 from hhscatter.integrate.stream import STREAM_BATCH, _SecondPhase, _Stream
 
 
 def scheduler(scene) -> str:
-    """scheduler(scene) -> 'epochs' for scenes with snapshots, else 'stream'."""
+    """scheduler(scene) -> 'noise' for scenes with noise, 'epochs' for scenes with snapshots, else 'stream'."""
+    if scene.noise is not None:
+        return "noise"
     return "epochs" if scene.snapshots else "stream"
 
 
@@ -36,18 +39,21 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     finding failed in a step is ignored there by heyoka, so every such failure is counted
     (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
     on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
+    A noise scene's orbits have no reference driver (their kicks live in the noise scheduler): their
+    failures are counted, not redone.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
     outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
     inside = ~outside
     kind = scheduler(scene)
-    far = _no_return(scene, ics[inside], kind)  # the integration's scene (maybe an earlier far event) and `late`
+    # the integration's scene (maybe an earlier far event) and `late`
+    far = (scene, None) if kind == "noise" else _no_return(scene, ics[inside], kind)
     kw = dict(batch_size=batch_size, count_steps=count_steps)
     with heyoka_log.capture() as log:
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
-    if failures:
+    if failures and kind != "noise":
         local = _orbits_with_failures(
             lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
             int(inside.sum()),
@@ -67,13 +73,15 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
     if not len(ics):
         return _empty_result(traj_ids)
     kind = scheduler(scene)
-    B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
+    B = int(batch_size or scene.batch_size or {"epochs": EPOCH_BATCH, "noise": NOISE_BATCH}.get(kind, STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
     orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
         config = dict(count_steps=count_steps, progress=progress, late=late)
-        if kind == "epochs":
+        if kind == "noise":
+            lanes = _Noisy(scene, ta, layout, ics, traj_ids, **config)
+        elif kind == "epochs":
             lanes = _Epochs(scene, ta, layout, ics, **config)
         else:  # the inlined handlers serve stream scenes with no section event in this integrator and no follow
             inlined = scene.follow is None and (scene.sections is None or phases)

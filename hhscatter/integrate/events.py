@@ -41,6 +41,9 @@ Outcome rules (the paper's, App. "Escape Condition"):
 * ``stopped``: nothing more was needed from the orbit (a section window with
   ``stop = true`` is done); t_end is the stop time. Analyses treat it as
   censoring at t_end.
+* noise (:mod:`hhscatter.integrate.noise`): the flow between kicks is Hamiltonian (the drag is in the
+  Ornstein–Uhlenbeck step), with the conservative rule: ``escaped`` at the first outward r_esc crossing;
+  E = E_c is no event (a heat bath lifts a settled orbit again); ``censored`` at t_max.
 """
 
 from __future__ import annotations
@@ -158,7 +161,7 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if w is not None and math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    if not scene.snapshots:
+    if not scene.snapshots and scene.noise is None:  # a noise scene censors at its last kick
         out.append((float(scene.t_max), "censor"))
     return tuple(sorted(out))
 
@@ -174,7 +177,7 @@ def layout(scene) -> Layout:
     clock = 4 if targets else None
     n_pars = 0
     gamma = gate = None
-    if scene.gamma > 0:
+    if scene.gamma > 0 and scene.noise is None:  # with noise the drag is the Ornstein–Uhlenbeck step's
         gamma, n_pars = n_pars, n_pars + 1
     if scene.sections is not None:
         gate, n_pars = n_pars, n_pars + 1
@@ -195,7 +198,7 @@ def scene_events(scene) -> tuple:
     rf2 = far_radius(scene) ** 2
     ec = scene.model.critical_energy
     ev = []
-    if scene.gamma > 0:
+    if scene.gamma > 0 and scene.noise is None:
         ev.append(EventSpec("closure", -1, lambda s: s.H - ec, "dissipative: E = E_c, settled or escaped"))
         ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "escaped orbit far away"))
         ev.append(EventSpec("resc", 0, lambda s: s.r2 - r_esc2, "last outward r_esc crossing"))

@@ -67,9 +67,12 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     high-precision reference (tolerance then defaults to that type's
     epsilon). Snapshots at ``scene.snapshots`` come from stopping at each
     time (so its steps differ from the engine's, as a reference's should).
+    A scene with noise has no such driver (its kicks live in the noise scheduler): ValueError.
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
+    if scene.noise is not None:
+        raise ValueError("simulate_orbit integrates the deterministic flow: a scene with noise has no reference driver")
     ic = np.asarray(ic, dtype=float)
     if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
         snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []

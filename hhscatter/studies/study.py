@@ -191,9 +191,9 @@ class Study:
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
-        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
+        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides."""
         d = dict(self.config.get("scene", {}))
-        for extra in ("sections", "snapshots", "system"):
+        for extra in ("sections", "snapshots", "noise", "system"):
             if extra in self.config:
                 d[extra] = copy.deepcopy(self.config[extra])
         d.update(overrides)
@@ -468,7 +468,7 @@ def missing_upstream(study: Study) -> list[str]:
 
 
 #: the study.toml tables every raw run's scene is made from (Study.scene, Study.model)
-SCENE_TABLES = ("scene", "sections", "snapshots", "follow", "system")
+SCENE_TABLES = ("scene", "sections", "snapshots", "follow", "noise", "system")
 
 
 def simulate_inputs(study, keys) -> dict:
