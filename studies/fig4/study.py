@@ -45,12 +45,15 @@ them ``fig4_lifetimes.parquet`` (γ, t_end, outcome of every orbit).
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.analysis.dissipative.transition_tables import (
+    survival_ratio_tables,
+    transition_comparisons,
+    transition_table,
+)
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
 
@@ -109,18 +112,14 @@ def _tau0_rule(grid, P0, n):
     return choose_windows(grid, P0, n_total=n).tau0
 
 
-def _plot_grid(t_last):
-    """Log-spaced grid for drawing P(t): 0.2 … t_last."""
-    return np.unique(np.round(np.geomspace(0.2, max(t_last, 1.0), 1500), 6))
-
-
 def analyze(study):
     """analyze(study) -> None: P(t) per γ, τ0/τ1/τ2 (+ bootstrap), μ, derived tables and fig4.json.
 
     Steps: the paired lifetimes (:func:`_read_lifetimes`), P(t) on the τ grid and
     τ0, the study's own μ (:func:`_own_mu`), the paired bootstrap, the τ table
-    (:func:`_tau_table`), the figure's tables (:func:`_figure_tables`), the
-    paper comparison (:func:`_compare`) and the numbers (:func:`_numbers`).
+    (:func:`~hhscatter.analysis.dissipative.transition_tables.transition_table`), the figure's tables, the
+    paper comparison (:func:`~hhscatter.analysis.dissipative.transition_tables.transition_comparisons`) and
+    the numbers (:func:`_numbers`).
     """
     from hhscatter.analysis.dissipative.transitions import bootstrap_transition_times, survival_on_grid
     from hhscatter.analysis.survival.fits import observed_from_outcome
@@ -155,8 +154,23 @@ def analyze(study):
         seed=study.params.boot_seed + 1,
     )
     bscale = float(np.sqrt(K / N))
-    taus = _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha)
-    surv, ratio = _figure_tables(lts, grid, P, dt, t_last, N)
+    taus = transition_table(
+        lts,
+        grid,
+        P,
+        tau0,
+        boot,
+        bscale,
+        E0=E0,
+        E_c=study.model.critical_energy,
+        mu=mu,
+        mu_err=mu_err,
+        paper_mu=study.params.paper_mu,
+        alpha=alpha,
+        min_ref_orbits=study.params.min_ref_orbits,
+        key=raw_key,
+    )
+    surv, ratio = survival_ratio_tables(lts, grid, P, dt, t_last, key=raw_key)
 
     meta = {"E0": E0, "alpha": alpha, "tau0_rule": "choose_windows on P_0"}
     study.write_table(taus, "fig4_tau.parquet", **meta)
@@ -173,7 +187,22 @@ def analyze(study):
     )
 
     tau0_err = float(boot["tau0"].std(ddof=1)) * bscale
-    exponents = _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err)
+    rows, exponents = transition_comparisons(
+        taus,
+        N=N,
+        E0=E0,
+        E_c=study.model.critical_energy,
+        mu_gamma=mg,
+        mu_window=win,
+        mu=mu,
+        mu_err=mu_err,
+        mu_other=mu_fig3,
+        tau0=tau0,
+        tau0_err=tau0_err,
+        paper_mu=study.params.paper_mu,
+    )
+    for row in rows:
+        study.compare(**row)
     study.write_numbers(
         _numbers(
             study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents, nb, K
@@ -238,184 +267,6 @@ def _own_mu(study, mg, E0, N):
         rows_mu, N, k_mu, E0, mg, [win], n_boot=study.params.n_boot, seed=study.params.boot_seed
     )
     return mu, float(bm["mu"].std(ddof=1)) * mu_scale, cont, win
-
-
-def _tau_table(study, lts, grid, P, tau0, boot, bscale, N, E0, mu, mu_err, alpha) -> pd.DataFrame:
-    """One row per γ: outcome fractions, τ0, τ1 (Eq. (eqn:tau1)), τ2 observed (+ settling-time quantiles) and
-    predicted (Eq. (eq:tau2)), each with its bootstrap error (σ over replicates × bscale)."""
-    from hhscatter.analysis.dissipative.transitions import (
-        settle_time_quantiles,
-        tau1,
-        tau2_observed_interval,
-        tau2_predicted,
-    )
-
-    E_C = study.model.critical_energy
-    paper_mu = study.params.paper_mu
-    min_ref = study.params.min_ref_orbits
-    rows = []
-    for g, lt in lts.items():
-        oc = lt["outcome"]  # categorical: compared on its codes
-        b = boot[boot["label"] == g] if g > 0 else None
-        t1 = tau1(grid, P[g], P[0.0], tau0, alpha) if g > 0 else None
-        n0 = float(N * np.interp(t1, grid, P[0.0])) if t1 is not None else np.nan
-        t2 = tau2_observed_interval(lt) if g > 0 else None  # first settling time, order-statistic interval
-        t2 = None if t2 is None or t2.n_settled == 0 else t2
-        q = settle_time_quantiles(lt["t_end"].to_numpy(), oc, (0.01, 0.5)) if g > 0 else None
-        pred = float(tau2_predicted(E0, E_C, mu, g)) if g > 0 else np.inf
-        pred_p = float(tau2_predicted(E0, E_C, paper_mu, g)) if g > 0 else np.inf
-
-        def sd(col, b=b):
-            if b is None:
-                return np.nan
-            v = b[col].to_numpy(float)
-            v = v[np.isfinite(v)]
-            return float(np.std(v, ddof=1)) * bscale if v.size > 1 else np.nan
-
-        rows.append(
-            {
-                "gamma": g,
-                "key": raw_key(g),
-                "n": N,
-                "f_escaped": float(np.mean(oc == "escaped")),
-                "f_settled": float(np.mean(oc == "settled")),
-                "f_censored": float(np.mean(oc == "censored")),
-                "tau0": tau0,
-                "tau0_err": sd("tau0") if g > 0 else float(boot["tau0"].std(ddof=1)) * bscale,
-                "tau1": np.nan if t1 is None else t1,
-                "tau1_err": sd("tau1"),
-                "tau1_boot_defined": float(np.isfinite(b["tau1"]).mean()) if b is not None else np.nan,
-                "n0_at_tau1": n0,
-                "tau1_resolved": bool(np.isfinite(n0) and n0 >= min_ref),
-                "tau2_obs": np.nan if t2 is None else t2.value,
-                "tau2_obs_err": np.nan if t2 is None else (t2.hi - t2.lo) / 2 if np.isfinite(t2.hi) else np.nan,
-                "tau2_obs_lo": np.nan if t2 is None else t2.lo,
-                "tau2_obs_hi": np.nan if t2 is None else t2.hi,
-                "tau2_obs_coverage": np.nan if t2 is None else t2.coverage,
-                "t_settle_q01": np.nan if q is None else float(q[0]),
-                "t_settle_q01_err": sd("t_settle_q0.01"),
-                "t_settle_q50": np.nan if q is None else float(q[1]),
-                "t_settle_q50_err": sd("t_settle_q0.5"),
-                "tau2_pred": pred,
-                "tau2_pred_err": pred * mu_err / mu if g > 0 else np.nan,
-                "tau2_pred_paper_mu": pred_p,
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def _figure_tables(lts, grid, P, dt, t_last, N):
-    """(P(t) per γ, exact Kaplan–Meier at log-spaced times; P_γ/P_0 on the τ grid while reference orbits remain)."""
-    from hhscatter.analysis.survival.fits import survival_from_lifetimes
-
-    gs = list(lts)
-    pg = _plot_grid(t_last)
-    surv = []
-    for g in gs:
-        c = survival_from_lifetimes(lts[g][["t_end", "outcome"]], pg)
-        surv.append(pd.DataFrame({"gamma": g, "key": raw_key(g), "t": c.t, "P": c.P, "P_err": c.P_err}))
-    surv = pd.concat(surv, ignore_index=True)
-    keep = (grid > 0) & (np.arange(grid.size) % max(1, round(0.5 / dt)) == 0)
-    ratio = []
-    for g in gs[1:]:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = P[g][keep] / P[0.0][keep]
-        ok = np.rint(P[0.0][keep] * N) >= 1  # at least one reference orbit left (a count: rounding-proof)
-        ratio.append(pd.DataFrame({"gamma": g, "t": grid[keep][ok], "ratio": r[ok], "n0": (P[0.0][keep] * N)[ok]}))
-    return surv, pd.concat(ratio, ignore_index=True)
-
-
-def _compare(study, taus, N, E0, mg, win, mu, mu_err, mu_fig3, tau0, tau0_err) -> dict:
-    """The paper comparison (the paper gives τ's only in figures; its statements are checked); returns the
-    fitted exponents {name: (p, σ_p)} of τ ∝ γ^−p."""
-    from hhscatter.analysis.dissipative.transitions import power_law_exponent, tau2_predicted
-
-    E_C = study.model.critical_energy
-    paper_mu = study.params.paper_mu
-    d = taus[taus["gamma"] > 0]
-    t1v = d["tau1"].to_numpy()
-    ok1 = np.isfinite(t1v)
-    mono1 = bool(np.all(np.diff(t1v[ok1]) <= 0)) if ok1.sum() > 1 else None
-    # unweighted: the first settling time is a minimum, its interval no Gaussian error to weight by
-    p_exp, p_err = power_law_exponent(d["gamma"], d["tau2_obs"], np.full(len(d), np.nan))
-    p50, p50_err = power_law_exponent(d["gamma"], d["t_settle_q50"], d["t_settle_q50_err"])
-    res = d[d["tau1_resolved"]]
-    p1, p1_err = power_law_exponent(res["gamma"], res["tau1"], res["tau1_err"])
-    study.compare(
-        f"μ used for τ2 (own γ={mg:g} run, [{win[0]:g}, {win[1]:g}])",
-        mu,
-        mu_err,
-        paper_mu,
-        note="same definition as study fig3",
-    )
-    if mu_fig3 is not None:
-        study.compare(
-            "μ: fig4's own vs fig3",
-            mu,
-            mu_err,
-            mu_fig3.get("value"),
-            note="consistency check between studies (same seed; grids differ)",
-        )
-    r01 = taus[taus["gamma"] == 0.01]
-    if len(r01):
-        r = r01.iloc[0]
-        study.compare(
-            "τ2 predicted at γ = 0.01",
-            r["tau2_pred"],
-            r["tau2_pred_err"],
-            float(tau2_predicted(E0, E_C, paper_mu, 0.01)),
-            unit="time",
-            note="paper value from its μ = 0.91 via Eq. (eq:tau2)",
-        )
-        study.compare(
-            "τ2 observed (first settling) at γ = 0.01",
-            r["tau2_obs"],
-            r["tau2_obs_err"],
-            None,
-            unit="time",
-            note=f"N = {N}; the paper (N = 1e7) marks it only in Fig. 4; min over "
-            f"{round(r['f_settled'] * N)} settlers, decreases with N; err: half-width "
-            f"of the order-statistic interval [{r['tau2_obs_lo']:.4g}, "
-            f"{r['tau2_obs_hi']:.4g}] of the quantile t_1/N",
-        )
-    study.compare(
-        "τ1 increases as γ decreases",
-        mono1,
-        None,
-        True,
-        verdict=None if mono1 is None else ("agrees" if mono1 else "differs"),
-        note="paper: 'both τ1 and τ2 increase with decreasing γ'",
-    )
-    if p1 is not None:
-        study.compare(
-            "p1 in τ1 ∝ γ^−p1",
-            p1,
-            p1_err,
-            None,
-            note="not in the paper; a linear κ0(E) with E = E0 e^{−μγt} gives P_γ/P_0 ≈ "
-            "exp(κ0' E0 μ γ t²/2), i.e. p1 = 1/2",
-        )
-    if p_exp is not None:
-        study.compare(
-            "p in τ2,obs ∝ γ^−p",
-            p_exp,
-            p_err,
-            1.0,
-            note="paper: τ2 ∝ 1/γ (Eq. (eq:tau2)); unweighted log-log fit over γ with settlers",
-        )
-    if p50 is not None:
-        study.compare(
-            "p in median settling time ∝ γ^−p", p50, p50_err, 1.0, note="N-independent companion of τ2,obs (same fit)"
-        )
-    study.compare(
-        "τ0 (data-driven, on P_0)",
-        tau0,
-        tau0_err,
-        None,
-        unit="time",
-        note="paper: τ0 effectively independent of γ; no value given",
-    )
-    return {"tau2": (p_exp, p_err), "settle_median": (p50, p50_err), "tau1": (p1, p1_err)}
 
 
 def _fin(v):
@@ -506,5 +357,5 @@ def plot(study):
     surv = pd.read_parquet(study.derived("fig4_survival.parquet"))
     ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))
     taus = pd.read_parquet(study.derived("fig4_tau.parquet"))
-    numbers = json.loads(study.numbers_path.read_text())
+    numbers = study.read_numbers()
     plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=study.params.mark_gamma)

@@ -315,6 +315,7 @@ def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_stu
 def test_fig6_paper_constant_kappa_law_is_the_fig2b_caption():
     """κ0(E) built from study.toml's paper_* keys against the caption of the paper's Fig. 2b, by hand:
     13.63 x² + 0.03 x below E = 0.27 and 1.41 x from there on, x = E − 1/6; no escape at or below E_c."""
+    from hhscatter.analysis.dissipative.model_tables import kappa_from_constants
     from hhscatter.studies import load_study, stage_module
 
     mod = stage_module("fig6")
@@ -322,7 +323,7 @@ def test_fig6_paper_constant_kappa_law_is_the_fig2b_caption():
         study = load_study("fig6", scale)
         pc = mod.paper_constants(study)
         assert pc["mu"] == 0.91
-        kappa = mod.kappa_law(pc, study.model.critical_energy)
+        kappa = kappa_from_constants(pc, study.model.critical_energy)
         E = np.array([0.1, 1 / 6, 0.2, 0.25, 0.2699, 0.27, 0.3, 0.35, 0.4])
         x = E - 1 / 6
         by_hand = [
@@ -463,29 +464,3 @@ def test_fig6_paper_constants_set_to_ours_reproduce_our_fit(tiny_studies, tmp_pa
     curves = pd.read_parquet(tmp_path / "fig6" / "out" / "tiny" / "derived" / "curves.parquet")
     for h in ("paper", "integrated"):
         np.testing.assert_array_equal(curves[f"paper_constants_{h}"], curves[f"homogeneous_{h}"])
-
-
-def test_fig5_our_5b_differs_only_if_the_authors_5b_does():
-    """The verdict rule: our 5b (5a filtered to the band) 'differs' is qualified when the authors' own 5b agrees."""
-    from hhscatter.studies import stage_module
-
-    REFS_QUANTITY, _qualify_our_5b = stage_module("fig5").REFS_QUANTITY, stage_module("fig5")._qualify_our_5b
-
-    def rows(auth_verdict):
-        return [
-            {"quantity": "Fig. 5b: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {"quantity": "Fig. 5a: SW1(diss, μ_c^0.30) < SW1(diss, μ_c^0.35)", "verdict": "differs"},
-            {
-                "quantity": REFS_QUANTITY.format(s="5b") + ": the authors' 5a and 5b runs, r < 1 on every set",
-                "verdict": auth_verdict,
-                "authors": True,
-            },
-        ]
-
-    agreeing = rows("agrees")
-    _qualify_our_5b(agreeing)
-    assert agreeing[0]["verdict"].startswith("differs in our convention only")
-    assert agreeing[1]["verdict"] == "differs"  # 5a is not 5b
-    differing = rows("differs")
-    _qualify_our_5b(differing)
-    assert differing[0]["verdict"] == "differs"

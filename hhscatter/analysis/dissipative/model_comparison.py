@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
+from hhscatter.analysis.dissipative.mixture import fit_mixture_model
 from hhscatter.analysis.dissipative.survival_model import _best_of, fit_survival_model
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 
@@ -21,6 +22,7 @@ __all__ = [
     "better_fit",
     "compare_fits",
     "fit_homogeneous_hazards",
+    "fit_mixture_hazards",
     "plateau_level",
     "predict_tau1",
     "survival_fit_points",
@@ -238,3 +240,67 @@ def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, ta
             starts,
         )
     return fits
+
+
+def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, mode, P_min):
+    """{hazard: MixtureFit}: the mixture model of sub-ensembles fitted by the rule of study fig6.
+
+    ``t, P``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fractions are read from it);
+    ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`); ``comps`` the sub-ensembles
+    (:func:`~hhscatter.analysis.dissipative.mixture.mixture_components`); ``kappa`` κ0(E) (1/time); ``mode``
+    "shared" (one trapped fraction φ of P(τ0)) or "free" (one f_ne,k per sub-ensemble). P(τ0) is held; three
+    starts (data-driven, and the trapped fraction P at τ0 + 0.85 (τ2,min − τ0) — shared, or handed to the
+    low-energy sub-ensembles first, which reach E_c first — with (L, b) = (1, 1) and (3, 0.3)), the best χ²
+    kept (:func:`best_fit`). Eq. (eqn:surv_prob_model) per sub-ensemble, τ2,k of Eq. (eq:tau2) with its own
+    μ_k. Units: t in time units, E in energy units.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from hhscatter.analysis.dissipative.mixture import mixture_components
+    >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+    >>> rng = np.random.default_rng(1)
+    >>> tt = np.arange(0.0, 101.0, 2.0)
+    >>> E = 0.3 * np.exp(-0.9 * 0.01 * tt)[None, :] * rng.uniform(0.95, 1.05, (40, 1))
+    >>> snaps = pd.DataFrame({"traj_id": np.repeat(np.arange(40), tt.size), "t": np.tile(tt, 40),
+    ...                       "energy": E.ravel()})
+    >>> comps = mixture_components(snaps, gamma=0.01, t_ref=5.0, n_components=2, fit_window=(5.0, 100.0))
+    >>> t = np.arange(0.0, 200.0, 0.5); P = 0.2 + 0.8 * np.exp(-0.15 * t)
+    >>> tf, Pf, sf = survival_fit_points(t, P, 0.01 * P, 5.0, 2.0, 10**5, 20)
+    >>> fits = fit_mixture_hazards(t, P, tf, Pf, sf, comps, kappa=PiecewiseKappa(E_c=1 / 6), tau0=5.0,
+    ...                            E_c=1 / 6, hazards=["paper"], mode="shared", P_min=1e-4)
+    >>> sorted(fits), bool(np.isfinite(fits["paper"].chi2))
+    (['paper'], True)
+    """
+    P_tau0 = plateau_level(t, P, tau0)
+    t2 = float(np.min(comps.tau2(E_c)))
+    fne = min(plateau_level(t, P, tau0 + 0.85 * max(t2 - tau0, 0.0)), 0.95 * P_tau0)
+    if mode == "shared":
+        alt = {"phi": fne / P_tau0}
+    else:  # trapped orbits first assigned to the low-energy sub-ensembles (they reach E_c first)
+        alt, left = {}, fne
+        for k in np.argsort(comps.E_ref):
+            cap = 0.99 * comps.weights[k] * P_tau0
+            alt[f"f_ne_{k}"] = max(min(left, cap), 1e-9)
+            left -= min(left, cap)
+    starts = [None, {**alt, "L": 1.0, "b": 1.0}, {**alt, "L": 3.0, "b": 0.3}]
+    return {
+        h: best_fit(
+            lambda p0, h=h: fit_mixture_model(
+                tf,
+                Pf,
+                sf,
+                comps,
+                kappa_of_E=kappa,
+                tau0=tau0,
+                E_c=E_c,
+                P_tau0=P_tau0,
+                fne_mode=mode,
+                hazard=h,
+                P_min=P_min,
+                p0=p0,
+            ),
+            starts,
+        )
+        for h in hazards
+    }

@@ -11,6 +11,7 @@ _EXPORTS = {
     "least_squares_operator": "least_squares",
     "weighted_least_squares": "least_squares",
     "Verdict": "verdicts",
+    "comparison_row": "verdicts",
     "half_unit": "verdicts",
     "quoted_verdict": "verdicts",
     "row_verdict": "verdicts",

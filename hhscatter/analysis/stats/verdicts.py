@@ -6,7 +6,8 @@
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
 * :func:`half_unit` — half a unit of the last digit of a printed number;
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
-  survives the authors' convention.
+  survives the authors' convention;
+* :func:`comparison_row` — one row of a study's paper comparison, as the analysis functions return them.
 """
 
 from __future__ import annotations
@@ -184,3 +185,18 @@ def verdict_beside_authors(verdict: str, authors_rows) -> str:
     if not agree:
         return verdict
     return f"differs in our convention only; agrees under the authors' ({'; '.join(agree)})"
+
+
+def comparison_row(quantity: str, ours, err=None, paper=None, **fields) -> dict:
+    """One row of a study's paper comparison: the keyword arguments of ``Study.compare``.
+
+    ``quantity`` names what is compared, ``ours`` is our number (or text) with its 1σ ``err``, ``paper`` the
+    paper's number (or statement); ``fields`` the rest (``verdict``, ``note``, ``unit``, ``convention``,
+    ``authors``). Analysis functions return such rows; the study records them in order.
+
+    Examples
+    --------
+    >>> comparison_row("τ0", 5.2, 0.3, None, unit="time")
+    {'quantity': 'τ0', 'ours': 5.2, 'err': 0.3, 'paper': None, 'unit': 'time'}
+    """
+    return {"quantity": quantity, "ours": ours, "err": err, "paper": paper, **fields}
