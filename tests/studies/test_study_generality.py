@@ -212,3 +212,42 @@ def test_claim5_distance_counts_and_verdicts_follow_the_raw_sections_and_the_int
             assert rec["verdict"].startswith("closer to μ_c^E0") == (hi < 0)
             checked += 1
     assert checked >= 1
+
+
+def test_claims_do_not_depend_on_the_order_of_the_systems(tiny, tmp_path):
+    """The claims analysed again on the same raw runs with [study] systems in the reverse order: every record
+    (verdict, value, error, reference, note) the same, claim 6 still judged against Hénon–Heiles (last in that
+    order)."""
+    import shutil
+    from pathlib import Path
+
+    from hhscatter.studies import run_stage
+
+    out, doc = tiny
+    src = Path(__file__).resolve().parents[2] / "studies" / "generality"
+    shutil.copytree(src, tmp_path / "generality", ignore=shutil.ignore_patterns("out", "__pycache__"))
+    shutil.copy(src.parent / "conventions.toml", tmp_path / "conventions.toml")
+    text = (src / "study.toml").read_text()
+    block = text[text.index("systems = [") : text.index("]\n", text.index("systems = [")) + 2]
+    entries = [line for line in block.splitlines()[1:-1]]
+    assert len(entries) == 3 and "henon_heiles" in entries[0]
+    reversed_block = "\n".join(["systems = [", *entries[::-1], "]"]) + "\n"
+    text = text.replace(block, reversed_block).replace(
+        "[scale.tiny.study]\n", '[scale.tiny.study]\nparts = ["claims"]\n'
+    )
+    (tmp_path / "generality" / "study.toml").write_text(text)
+    dst = tmp_path / "generality" / "out" / "tiny"
+    shutil.copytree(out / "raw", dst / "raw")
+    (dst / "derived").mkdir()
+    # the same scenes under the new order: simulate finds every run complete and only records the configuration
+    run_stage("generality", "simulate", "tiny", workers=1, progress=False, root=tmp_path)
+    run_stage("generality", "analyze", "tiny", root=tmp_path)
+    again = json.loads((dst / "generality.json").read_text())
+    assert [c["system"] for c in again["claims"]][0] == "barbanis"  # the order did change
+    key = lambda c: (c["system"], c["quantity"], c["id"])  # noqa: E731
+    fields = ("verdict", "value", "err", "reference", "note")
+    before = {key(c): [c[f] for f in fields] for c in doc["claims"]}
+    after = {key(c): [c[f] for f in fields] for c in again["claims"]}
+    assert after == before
+    six = [c["verdict"] for c in again["claims"] if c["claim"] == "6" and c["system"] != "henon_heiles"]
+    assert six and all("Hénon–Heiles" in v for v in six)
