@@ -12,7 +12,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import hhscatter
-from hhscatter.data import read, schema
+from hhscatter.data import schema, verify
 from hhscatter.data.write import dictionary_columns
 from hhscatter.integrate.engine import run_chunk
 from hhscatter.scene.ics import region_ics
@@ -74,7 +74,7 @@ def test_to_arrow_equals_pa_array_in_arrow_ipc_bytes(kw, tmp_path):
 )
 def test_describe_run_from_parts_equals_the_dataset_scan(args, tmp_path, monkeypatch):
     hhscatter.simulate(args["run"], tmp_path, workers=1, progress=False, overwrite=True)
-    light = read.describe_run(tmp_path)
-    monkeypatch.setattr(read, "_describe_parts", lambda *a: None)
-    assert light == read.describe_run(tmp_path)
+    light = verify.describe_run(tmp_path)
+    monkeypatch.setattr(verify, "_describe_parts", lambda *a: None)
+    assert light == verify.describe_run(tmp_path)
     assert sum(p["escaped"] + p["settled"] + p["censored"] for p in light["points"]) == light["rows"]["lifetimes"]
