@@ -58,7 +58,7 @@ _EXPORTS = {
     "SurvivalModelParams": "survival_model",
     "fit_survival_model": "survival_model",
     "homogeneous_start": "survival_model",
-    "profile_interval": "survival_model",
+    "profile_interval": "curve_fit",
     "settling_rate": "survival_model",
     "OrderStatisticInterval": "transitions",
     "bootstrap_transition_times": "transitions",
