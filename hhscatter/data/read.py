@@ -159,7 +159,7 @@ def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, 
 
     The memory-lean reader: only ``columns`` are read (column projection in
     the Parquet reader), no pandas conversion. ``run_dir`` may be a URL. Every reader here reads exactly
-    the run's planned, finished and verified parts (:func:`_dataset`); an incomplete run is an error unless
+    the run's planned, finished and verified parts (:func:`~hhscatter.data.verify.verified_dataset`); an incomplete run is an error unless
     ``allow_partial=True``.
     """
     return scan_checked(

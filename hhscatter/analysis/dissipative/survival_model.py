@@ -543,7 +543,7 @@ class HomogeneousProblem:
     def fit_tau2(self, absolute_sigma: bool = True):
         """τ2 fitted by profiling χ²: a coarse scan over [τ0, t_last], then a fine one around its minimum; the
         error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``), its two ends
-        found by root-finding on the profile (:func:`profile_interval`), not bounded by the scan's steps.
+        found by root-finding on the profile (:func:`~hhscatter.analysis.dissipative.curve_fit.profile_interval`), not bounded by the scan's steps.
         Returns (τ2, σ_τ2, solution, χ², residual function)."""
         grid = np.linspace(self.tau0 + 1e-9, float(self.tf[-1]), 25)
         prof, _ = self.profile(grid)
