@@ -368,7 +368,9 @@ def _describe_parts(store, man):
                 key = (meta.get("energy"), meta.get("gamma"))
             out = t.column("outcome").combine_chunks()
             ix = out.indices  # (Arrow's to_numpy imports pandas too: the codes straight from their buffer)
-            codes = np.frombuffer(ix.buffers()[1], dtype=np.int8, count=len(ix), offset=ix.offset)
+            # int8 as written; pyarrow before 17 reads a dictionary column's indices back as int32
+            width = np.dtype(f"int{ix.type.bit_width}")
+            codes = np.frombuffer(ix.buffers()[1], dtype=width, count=len(ix), offset=ix.offset * width.itemsize)
             counts = points.setdefault(key, {"escaped": 0, "settled": 0, "censored": 0, "stopped": 0})
             for o, c in zip(out.dictionary.to_pylist(), np.bincount(codes, minlength=len(out.dictionary))):
                 if c:

@@ -55,7 +55,12 @@ def test_to_arrow_equals_pa_array_in_arrow_ipc_bytes(kw, tmp_path):
         assert _ipc(ours) == _ipc(ref), name
         path = tmp_path / f"{name}.parquet"  # and the Parquet written with our encodings reads back the same
         pq.write_table(ours, path, use_dictionary=dictionary_columns(ours.schema), compression="zstd")
-        assert pq.read_table(path).equals(ref), name
+        back = pq.read_table(path)
+        assert back.cast(ref.schema).equals(ref), name
+        # the types too, but for the width of a dictionary's indices: int8 as written, kept by pyarrow ≥ 17 and
+        # read back as int32 by older ones
+        for b, r in zip(back.schema, ref.schema):
+            assert b.type == r.type or (pa.types.is_dictionary(r.type) and b.type.value_type == r.type.value_type)
     if sc.gamma > 0:
         assert (res.lifetimes["exit_channel"] < 0).any()  # the masked (null) channel is exercised
 
