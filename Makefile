@@ -141,9 +141,10 @@ $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
 	@touch $@
 
-bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets → benchmarks/out/{bench,engine}/
+bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets + the cost of noise → benchmarks/out/{bench,engine,noise}/
 	$(PY) -m benchmarks $(BENCH_ARGS)
 	$(PY) -m benchmarks.engine -n 30000 --repeat 2
+	$(PY) -m benchmarks.noise
 
 # the report runs the benchmarks only when their summaries are missing or their code changed
 $(BENCH_SUMMARY): $(wildcard benchmarks/*.py) benchmarks/bench.toml | $(BENCH_STAMP)

@@ -35,6 +35,7 @@ from hhscatter._version import __version__ as __version__  # re-exported
 _EXPORTS = {
     "Scene": "scene.scene",
     "SectionWindow": "scene.scene",
+    "Noise": "scene.scene",
     "SceneError": "errors",
     "HHScatterError": "errors",
     "ConfigError": "errors",

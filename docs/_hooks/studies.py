@@ -123,12 +123,30 @@ class Renderer:
                 f"Run `make {name}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
 
-        def figure(path, scale, cmd):
+        def one(path, alt, caption):
             src = self._rel(path)
             return (
-                f'<figure class="hh-figure" markdown="span">\n[![{name}, {scale} scale]({src})]({src}){{ .hh-zoom }}\n'
-                f"<figcaption>{scale.capitalize()} scale: <code>{cmd}</code> (click to zoom)</figcaption>\n</figure>\n"
+                f'<figure class="hh-figure" markdown="span">\n[![{alt}]({src})]({src}){{ .hh-zoom }}\n'
+                f"<figcaption>{caption} (click to zoom)</figcaption>\n</figure>\n"
             )
+
+        def figure(path, scale, cmd):
+            """The figure at one scale; a multi-panel figure whose plot stage wrote its panels one by one
+            (``<name>_panel_<letter>.png``, hhscatter.publish.figures.save_panels) panel by panel, each at the full
+            width of the text, the composite folded below them."""
+            whole = one(path, f"{name}, {scale} scale", f"{scale.capitalize()} scale: <code>{cmd}</code>")
+            panels = sorted(path.parent.glob(f"{path.stem}_panel_*.png"))
+            if not panels:
+                return whole
+            out = "".join(
+                one(
+                    p,
+                    f"{name}, panel ({p.stem[-1]}), {scale} scale",
+                    f"({p.stem[-1]}) {scale} scale: <code>{cmd}</code>",
+                )
+                for p in panels
+            )
+            return out + '\n??? note "The panels in one image (click to open)"\n\n' + _indent(whole) + "\n"
 
         if not paper.exists():
             return figure(png, "quick", f"make {name}")
@@ -142,10 +160,15 @@ class Renderer:
         return out
 
     def _numbers(self, name: str, scale: str = "quick"):
+        """The committed numbers JSON of study ``name`` at ``scale`` (None if not committed), verified as the
+        ``[[study:path]]`` references are: an edited or unsealed file is refused
+        (:func:`hhscatter.publish.numbers.read_numbers_file`)."""
+        from hhscatter.publish.numbers import read_numbers_file
+
         path = self.study_asset(name, "json", scale)
         if not path.exists():
             return None
-        return json.loads(path.read_text())
+        return read_numbers_file(path)
 
     def _headline(self, name: str):
         """(numbers JSON, scale) at the headline scale: paper where committed, else quick (None, None if neither)."""
@@ -645,6 +668,16 @@ STUDY_TABLES = {
         ("S_b", "S_b"),
         ("S_bb", "S_bb"),
     ),
+    "basins.entropy_by_box_at": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("box_side", "box side s"),
+        ("map", "map"),
+        ("grid", "grid (cells per side)"),
+        ("box_cells", "box (cells)"),
+        ("S_b", "S_b"),
+        ("S_bb", "S_bb"),
+    ),
     "basins.point_table": (
         ("E0", "E0"),
         ("gamma", "γ"),
@@ -740,10 +773,12 @@ STUDY_TABLES = {
         ("model_err", "σ model (M^−1/2 vs M^−1)"),
         ("kappa0", "fig2 κ0"),
         ("residual_kappa0", "κ∞/κ0 − 1"),
-        ("z_kappa0", "z vs κ0"),
+        ("verdict_kappa0", "vs κ0 (both errors)"),
         ("kappa_cm", "fig2 κ crossings"),
         ("residual_kappa_cm", "κ∞/κ_cm − 1"),
-        ("z_kappa_cm", "z vs κ_cm"),
+        ("verdict_kappa_cm", "vs κ_cm (both errors)"),
+        ("cut_nu", "c-measure on cut boxes"),
+        ("cut_weight", "flux weight on cut boxes"),
         ("note", "note"),
     ),
 }
@@ -948,13 +983,19 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
     root = Path(config["config_file_path"]).resolve().parent
     page_dir = (docs / page.file.src_uri).parent
     r = Renderer(root, docs, page_dir)
+    from hhscatter.publish.numbers import NumberRefError
 
     def sub(m):
         indent, kind, arg = m.group(1), m.group(2), m.group(3)
         fn = getattr(r, kind.replace("-", "_"), None)
         if fn is None:
             raise ValueError(f"{page.file.src_uri}: unknown docs marker hh:{kind}")
-        out = fn(arg)
+        try:
+            out = fn(arg)
+        except NumberRefError as e:
+            from mkdocs.exceptions import PluginError
+
+            raise PluginError(f"{page.file.src_uri}: hh:{kind}: {e}") from None
         # a marker inside an admonition (indented) gets its content indented alike
         return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 

@@ -4,11 +4,14 @@ One module per concern (in the manner of SciPy's ``integrate/_ivp``):
 
 | module | concern |
 |---|---|
-| `events` | the events and outcome rules of a scene, as data; builds heyoka's integrators |
+| `events` | the events and outcome rules of a scene, as data |
+| `integrators` | heyoka's batch and scalar integrators built from those events (the only heyoka events) |
 | `lanes` | the lane-rules contract: `LaneRules`, the rules as event handlers per lane, their callbacks |
 | `batch` | lanes of one batch integrator, and the per-process cache of compiled integrators |
 | `stream` | the stream scheduler (no snapshots): an orbit's end loads the next in its callback |
 | `epochs` | the epoch scheduler (snapshots): all lanes advance together, `propagate_grid` |
+| `noise` | the noise scheduler (scenes with `[noise]`): epochs of one kick interval, vectorised Ornstein–Uhlenbeck kicks |
+| `noise_reference` | an independent numpy Langevin integrator (OBABO), the noise scheduler's reference |
 | `orbit_time` | an orbit's time on a stream lane (TwoSum, near-ties to even) |
 | `chunk` | `run_chunk`: one block of orbits, its schedulers, phases and results |
 | `rerun` | orbits integrated again: the no-return rule's late ones, those an event-detection failure hit |

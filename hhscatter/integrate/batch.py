@@ -9,7 +9,7 @@ import threading
 
 import numpy as np
 
-from hhscatter.integrate import events
+from hhscatter.integrate import integrators
 from hhscatter.integrate.lanes import CONTINUING, LaneRules, _Callback, _unbind
 
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
@@ -24,24 +24,24 @@ _FREE_KEYS = 4  # distinct compiled systems kept per process (a grid of r_esc va
 def _batch_integrator(scene, batch_size, without=()):
     """_batch_integrator(scene, batch_size, without=()) -> context manager yielding (ta, specs, layout).
 
-    One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.events.batch_key`),
+    One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.integrators.batch_key`),
     reused across chunks instead of a new ``taylor_adaptive_batch`` per chunk (measured: ~6 ms and a
     JIT lookup each). A reused integrator is reset to what a new one is: time 0 (both parts of the
     double-length clock), state 0, the scene's parameters (γ; gates closed), no event cooldowns;
     heyoka's step depends on nothing else, so results are bit-identical (tested). An integrator in
     use is out of the cache; the handlers are unbound on return.
     """
-    key, specs, lay = events.batch_key(scene, batch_size, without=without)
+    key, specs, lay = integrators.batch_key(scene, batch_size, without=without)
     with _FREE_LOCK:
         free = _FREE.get(key)
         ta = free.pop() if free else None
     if ta is None:
-        ta, specs, lay = events.build_batch(scene, batch_size, _Callback, without=without)
+        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without)
     else:
         zeros = np.zeros(batch_size)
         ta.set_dtime(zeros, zeros)
         ta.state[:] = 0.0
-        pars = events.batch_pars(scene, lay, batch_size, without)
+        pars = integrators.batch_pars(scene, lay, batch_size, without)
         if len(pars):
             ta.pars[:] = pars
         ta.reset_cooldowns()
@@ -59,15 +59,32 @@ def _batch_integrator(scene, batch_size, without=()):
 class _BatchRules(LaneRules):
     """Lanes of one batch integrator: the part shared by both schedulers."""
 
-    def __init__(self, scene, ta, layout, ics, *, count_steps=False, progress=None, late=None, migrate_at_open=False):
+    def __init__(
+        self,
+        scene,
+        ta,
+        layout,
+        ics,
+        *,
+        count_steps=False,
+        progress=None,
+        late=None,
+        migrate_at_open=False,
+        open_late=None,
+    ):
         """``count_steps``: the epoch loop reads every lane's result (``ChunkResult.n_steps``); ``progress``: f(k)
         after every PROGRESS_EVERY orbits loaded; ``late``: the no-return rule's test (:attr:`LaneRules.late`);
-        ``migrate_at_open``: the first phase of a two-phase scene (orbits handed on when the window opens)."""
+        ``migrate_at_open``: the first phase of a two-phase scene (orbits handed on when the window opens);
+        ``open_late``: None, or a bool per orbit: its section window opens at T_INITIAL (the scene has a clock)."""
         self.ta = ta
         self.B = ta.batch_size
         self.setup(scene, layout, self.B)
         self.late = late
         self.migrate_at_open = migrate_at_open
+        if open_late is not None:
+            if layout.clock is None:
+                raise RuntimeError("internal error: an orbit's window opens late in a scene without a clock")
+            self.open_late = open_late.tolist()
         self.state = ta.state  # live views into the integrator
         self.cols = [self.state[:4, lane] for lane in range(self.B)]  # (x, y, px, py) of each lane
         self.pars = ta.pars if layout.n_pars else None

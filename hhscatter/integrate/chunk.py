@@ -9,13 +9,16 @@ from hhscatter.integrate.batch import _batch_integrator
 from hhscatter.integrate.epochs import EPOCH_BATCH, _Epochs
 from hhscatter.integrate.events import ESCAPED
 from hhscatter.integrate.lanes import RERUN, _bind
+from hhscatter.integrate.noise import NOISE_BATCH, _Noisy
 from hhscatter.integrate.rerun import _merge_rerun, _no_return, _orbits_with_failures, _own_far, _redo_on_reference
 from hhscatter.integrate.results import CROSSING_COLUMNS, SECTION_COLUMNS, ChunkResult, _empty_result, _rows_to_columns
 from hhscatter.integrate.stream import STREAM_BATCH, _SecondPhase, _Stream
 
 
 def scheduler(scene) -> str:
-    """scheduler(scene) -> 'epochs' for scenes with snapshots, else 'stream'."""
+    """scheduler(scene) -> 'noise' for scenes with noise, 'epochs' for scenes with snapshots, else 'stream'."""
+    if scene.noise is not None:
+        return "noise"
     return "epochs" if scene.snapshots else "stream"
 
 
@@ -36,23 +39,31 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     finding failed in a step is ignored there by heyoka, so every such failure is counted
     (``ChunkResult.event_failures``), the orbits it hit are found (:func:`_orbits_with_failures`) and redone
     on the long-double reference driver (:func:`_redo_on_reference`; ``ChunkResult.redone`` their traj_ids).
+    An orbit that starts on the section near an inflection of r has its section window opened at T_INITIAL
+    by the clock (:func:`hhscatter.integrate.events.opens_late`), or, in a scene without a clock, is redone
+    on the reference driver too. A noise scene's orbits have no reference driver (their kicks live in the
+    noise scheduler): their failures are counted, not redone.
     """
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
     outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
     inside = ~outside
     kind = scheduler(scene)
-    far = _no_return(scene, ics[inside], kind)  # the integration's scene (maybe an earlier far event) and `late`
+    # the integration's scene (maybe an earlier far event) and `late`
+    far = (scene, None) if kind == "noise" else _no_return(scene, ics[inside], kind)
     kw = dict(batch_size=batch_size, count_steps=count_steps)
     with heyoka_log.capture() as log:
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
-    if failures:
-        local = _orbits_with_failures(
+    local = _unclocked_late(scene, ics[inside]) if kind != "noise" else np.empty(0, np.int64)
+    if failures and kind != "noise":
+        found = _orbits_with_failures(
             lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
             int(inside.sum()),
             failures,
         )
+        local = np.union1d(local, found)
+    if len(local):
         res = _redo_on_reference(scene, res, ics[inside], traj_ids[inside], local)
         redone = traj_ids[inside][local]
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
@@ -61,19 +72,36 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     return res
 
 
+def _opens_late(scene, ics):
+    """events.opens_late where the scene has the clock that opens those windows at T_INITIAL, else None."""
+    return events.opens_late(scene, ics) if events.layout(scene).clock is not None else None
+
+
+def _unclocked_late(scene, ics) -> np.ndarray:
+    """Local indices of the orbits whose window should open late (events.opens_late) in a scene without a clock
+    (snapshots, a window open from 0 to the end): they are redone on the reference driver (its section cooldown
+    is fixed: events.SECTION_COOLDOWN)."""
+    if events.layout(scene).clock is not None:
+        return np.empty(0, np.int64)
+    late = events.opens_late(scene, ics)
+    return np.flatnonzero(late) if late is not None else np.empty(0, np.int64)
+
+
 def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
     """The chunk's orbits (all inside r_esc) on the batch engine; ``far``: :func:`_no_return`'s (scene, late),
     fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk."""
     if not len(ics):
         return _empty_result(traj_ids)
     kind = scheduler(scene)
-    B = int(batch_size or scene.batch_size or (EPOCH_BATCH if kind == "epochs" else STREAM_BATCH))
+    B = int(batch_size or scene.batch_size or {"epochs": EPOCH_BATCH, "noise": NOISE_BATCH}.get(kind, STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
     orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
     with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
-        config = dict(count_steps=count_steps, progress=progress, late=late)
-        if kind == "epochs":
+        config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
+        if kind == "noise":
+            lanes = _Noisy(scene, ta, layout, ics, traj_ids, **config)
+        elif kind == "epochs":
             lanes = _Epochs(scene, ta, layout, ics, **config)
         else:  # the inlined handlers serve stream scenes with no section event in this integrator and no follow
             inlined = scene.follow is None and (scene.sections is None or phases)

@@ -3,10 +3,10 @@
 ``scene_events(scene) -> tuple[EventSpec, ...]`` is the one place where the
 events of a scene are declared: each is plain data (name, direction, the
 expression whose root is the event, what it is for). Every driver builds its
-heyoka events from it: the batch engine (:mod:`hhscatter.integrate.engine`), the
-scalar reference driver (:func:`hhscatter.integrate.engine.simulate_orbit`, which the
-benchmarks and stress tests use in long double or real128) and every
-continuation. No other module constructs a heyoka event.
+heyoka events from it through :mod:`hhscatter.integrate.integrators`: the batch engine
+(:mod:`hhscatter.integrate.engine`), the scalar reference driver
+(:func:`hhscatter.integrate.engine.simulate_orbit`, which the benchmarks and stress tests use in long
+double or real128) and every continuation. No other module constructs a heyoka event.
 
 All events are heyoka *terminal* events with a callback: heyoka then ends the
 step exactly at the root, so the state and the orbit time of every recorded
@@ -41,6 +41,9 @@ Outcome rules (the paper's, App. "Escape Condition"):
 * ``stopped``: nothing more was needed from the orbit (a section window with
   ``stop = true`` is done); t_end is the stop time. Analyses treat it as
   censoring at t_end.
+* noise (:mod:`hhscatter.integrate.noise`): the flow between kicks is Hamiltonian (the drag is in the
+  Ornstein–Uhlenbeck step), with the conservative rule: ``escaped`` at the first outward r_esc crossing;
+  E = E_c is no event (a heat bath lifts a settled orbit again); ``censored`` at t_max.
 """
 
 from __future__ import annotations
@@ -73,6 +76,18 @@ SECTION_OFFSET = 1e-300
 # the initial point, so that the long-double reference driver and the engine agree on such orbits (the engine
 # redoes an orbit on it when heyoka's root finding fails: hhscatter.integrate.engine).
 T_INITIAL = 1e-6
+# An orbit that starts on the section puts a root of the section event at its start (x p_x + y p_y = 0 there; the
+# offset moves it to ~1e-300/ḟ(0), ḟ = d(x p_x + y p_y)/dt). Where ḟ(0) is small (r̈ ≈ 0 as well: the start is near
+# an inflection of r) that root is nearly double, and heyoka (a) fails to isolate it now and then (the event
+# is then ignored in the step; logged) and (b) deduces from ḟ ≈ 0 a cooldown after it that swallowed the first true
+# crossing, often every later one, without a word. Such orbits (|ḟ(0)| ≤ OPEN_LATE_SLOPE |p|²) therefore start
+# with their section event off: the clock opens it at T_INITIAL (opens_late; hhscatter.integrate.lanes).
+OPEN_LATE_SLOPE = 1e-3
+# Where the scene has no clock (snapshots, a window open to the end), such an orbit is redone on the reference
+# driver with this fixed section cooldown instead of heyoka's deduced one (two ṙ = 0 roots closer than this are
+# one crossing there). Everywhere else heyoka's deduced cooldowns stay: a fixed one trades merged grazing
+# crossings for duplicated roots (docs: concepts/events).
+SECTION_COOLDOWN = 1e-9
 CLOCK_MARGIN = 1e-9  # the clock opens a window this much early and closes it this much late
 
 
@@ -158,7 +173,7 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if w is not None and math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    if not scene.snapshots:
+    if not scene.snapshots and scene.noise is None:  # a noise scene censors at its last kick
         out.append((float(scene.t_max), "censor"))
     return tuple(sorted(out))
 
@@ -174,7 +189,7 @@ def layout(scene) -> Layout:
     clock = 4 if targets else None
     n_pars = 0
     gamma = gate = None
-    if scene.gamma > 0:
+    if scene.gamma > 0 and scene.noise is None:  # with noise the drag is the Ornstein–Uhlenbeck step's
         gamma, n_pars = n_pars, n_pars + 1
     if scene.sections is not None:
         gate, n_pars = n_pars, n_pars + 1
@@ -195,7 +210,7 @@ def scene_events(scene) -> tuple:
     rf2 = far_radius(scene) ** 2
     ec = scene.model.critical_energy
     ev = []
-    if scene.gamma > 0:
+    if scene.gamma > 0 and scene.noise is None:
         ev.append(EventSpec("closure", -1, lambda s: s.H - ec, "dissipative: E = E_c, settled or escaped"))
         ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "escaped orbit far away"))
         ev.append(EventSpec("resc", 0, lambda s: s.r2 - r_esc2, "last outward r_esc crossing"))
@@ -240,6 +255,10 @@ def system(scene, lay: Layout):
     return sys
 
 
+#: the layout of Hamilton's equations alone (x, y, px, py: no clock, no parameters)
+HAMILTON_ONLY = Layout(4, None, None, None, 0, 1.0)
+
+
 def two_phase(scene) -> bool:
     """two_phase(scene) -> True if the section event is compiled only into an orbit's second phase.
 
@@ -249,133 +268,6 @@ def two_phase(scene) -> bool:
     switch the event off per lane instead (all lanes share one grid there).
     """
     return scene.sections is not None and scene.sections.t_from > 0 and not scene.snapshots
-
-
-def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
-    """build_batch(scene, batch_size, make_callback, without=()) -> (taylor_adaptive_batch, specs, layout).
-
-    ``make_callback(spec)`` returns the callback object of one event (heyoka
-    deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
-    ``without``: names of events left out (an orbit phase that does not need them).
-    """
-    import heyoka as hy  # deferred: heyoka loads on first use
-
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
-    sym = Symbols(scene, lay)
-    dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
-    events = [
-        hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction]) for s in specs
-    ]
-    pars = batch_pars(scene, lay, batch_size, without)
-    kw = {"pars": pars} if len(pars) else {}
-    ta = hy.taylor_adaptive_batch(
-        system(scene, lay),
-        np.zeros((lay.n_state, batch_size)),
-        tol=scene.tol if tol is None else tol,
-        t_events=events,
-        **kw,
-    )
-    return ta, specs, lay
-
-
-#: the layout of Hamilton's equations alone (x, y, px, py: no clock, no parameters)
-HAMILTON_ONLY = Layout(4, None, None, None, 0, 1.0)
-
-
-def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
-    """build_escape_only_batch(scene, batch_size, callback, tol=None) -> taylor_adaptive_batch: Hamilton's
-    equations alone (x, y, px, py: no clock, no parameters) with the scene's conservative escape event, its
-    callback ``callback``: the minimal driver of ``make bench-engine`` (benchmarks/engine.py, yardstick),
-    which censors with its own propagation bound. The event is the engine's declaration, so both integrate
-    the same escape; ``scene`` must be conservative and without a follow."""
-    import heyoka as hy  # deferred: heyoka loads on first use
-
-    (esc,) = (e for e in scene_events(scene) if e.name == "escape")
-    ev = hy.t_event_batch(
-        esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback, direction=hy.event_direction.positive
-    )
-    return hy.taylor_adaptive_batch(
-        system(scene, HAMILTON_ONLY), np.zeros((4, batch_size)), tol=scene.tol if tol is None else tol, t_events=[ev]
-    )
-
-
-def batch_pars(scene, lay: Layout, batch_size: int, without=()) -> np.ndarray:
-    """batch_pars(scene, layout, batch_size, without=()) -> (n_pars, batch_size): the runtime parameters a
-    batch integrator starts with (γ in every lane, the section gate closed)."""
-    # the gate is the last parameter: without the section event heyoka's system has none
-    n_pars = lay.n_pars - (1 if lay.gate is not None and "section" in without else 0)
-    pars = np.zeros((n_pars, batch_size))
-    if lay.gamma is not None:
-        pars[lay.gamma] = scene.gamma
-    return pars
-
-
-def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
-    """batch_key(scene, batch_size, tol=None, without=()) -> (key, specs, layout).
-
-    ``key`` (hashable) holds everything :func:`build_batch` compiles: the system and the event
-    expressions as heyoka prints them (constants to 17 digits, which round-trip), the events'
-    directions and rules, the tolerance, the layout and the batch size. Two calls with equal keys
-    give interchangeable integrators: what differs between them (γ, the section gate) is a runtime
-    parameter, set per chunk (:func:`batch_pars`). Costs ~0.1 ms, no compilation.
-    """
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
-    sym = Symbols(scene, lay)
-    key = (
-        batch_size,
-        float(scene.tol if tol is None else tol),
-        lay,
-        repr(system(scene, lay)),
-        tuple((s.name, s.rule, s.index, s.direction, repr(s.expression(sym))) for s in specs),
-    )
-    return key, specs, lay
-
-
-def build_scalar(scene, make_callback, *, fp_type=float, tol=None):
-    """build_scalar(scene, make_callback, fp_type=float, tol=None) -> (taylor_adaptive, specs, layout).
-
-    The same events on heyoka's scalar integrator, in ``fp_type`` (float,
-    numpy.longdouble or heyoka.real128). ``tol`` defaults to the scene's for
-    float and to the type's epsilon otherwise.
-    """
-    import heyoka as hy  # deferred: heyoka loads on first use
-
-    lay = layout(scene)
-    specs = scene_events(scene)
-    sym = Symbols(scene, lay)
-    dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
-    cast = caster(fp_type)
-    events = [
-        hy.t_event(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction], fp_type=fp_type)
-        for s in specs
-    ]
-    pars = [0.0] * lay.n_pars
-    if lay.gamma is not None:
-        pars[lay.gamma] = scene.gamma
-    kw = {}
-    if tol is not None or fp_type is float:
-        t = scene.tol if tol is None else tol
-        kw["tol"] = fp_type(t) if fp_type is not float else t
-    ta = hy.taylor_adaptive(
-        system(scene, lay),
-        cast([0.0] * lay.n_state),
-        pars=cast(pars) if pars else [],
-        t_events=events,
-        fp_type=fp_type,
-        **kw,
-    )
-    return ta, specs, lay
-
-
-def caster(fp_type):
-    """caster(fp_type) -> function turning a list/array of floats into what heyoka's constructor takes."""
-    if fp_type is float:
-        return lambda v: np.asarray(v, dtype=float)
-    if fp_type is np.longdouble:
-        return lambda v: np.asarray(v, dtype=np.longdouble)
-    return lambda v: [fp_type(float(a)) for a in np.asarray(v, dtype=float)]
 
 
 # -- outcome rules ---------------------------------------------------------------
@@ -392,6 +284,24 @@ def closure_rule(r2: float, r_s: float, last_out) -> int | None:
     if r2 <= r_s * r_s:
         return SETTLED
     return ESCAPED if last_out is not None else None
+
+
+def opens_late(scene, ics):
+    """opens_late(scene, ics) -> bool array (n,), or None: the orbits whose section window opens at T_INITIAL.
+
+    Those of a scene whose window is open from the start that start on the section (x p_x + y p_y = 0 to
+    rounding) with |ḟ(0)| = |p|² + x F_x + y F_y| ≤ OPEN_LATE_SLOPE |p|² (F = −∇V, the system's force): near
+    an inflection of r, where the section event's root at the start is nearly double. None if there is none.
+    """
+    w = scene.sections
+    if w is None or w.t_from > 0 or not len(ics):
+        return None
+    x, y, px, py = np.asarray(ics, dtype=float).T
+    on = np.abs(x * px + y * py) <= 4 * np.finfo(float).eps * (np.abs(x * px) + np.abs(y * py))
+    fx, fy = scene.model.force(x, y)
+    p2 = px * px + py * py
+    late = on & (np.abs(p2 + x * fx + y * fy) <= OPEN_LATE_SLOPE * p2)
+    return late if late.any() else None
 
 
 def section_accepts(window, t: float, x: float, y: float, px: float, py: float, energy: float) -> bool:
@@ -418,16 +328,11 @@ __all__ = [
     "HAMILTON_ONLY",
     "Layout",
     "RULES",
-    "batch_key",
-    "batch_pars",
-    "build_batch",
-    "build_escape_only_batch",
-    "build_scalar",
-    "caster",
     "clock_targets",
     "follow_radii",
     "closure_rule",
     "far_radius",
+    "opens_late",
     "layout",
     "scene_events",
     "two_phase",

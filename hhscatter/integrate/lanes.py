@@ -124,6 +124,8 @@ class LaneRules(abc.ABC):
         self.pending_cross = [[] for _ in range(n_lanes)]
         self.sec_rows, self.cross_rows = [], []
         self.migrants = []
+        #: None, or per orbit of the chunk: its section window opens at T_INITIAL (events.opens_late)
+        self.open_late = None
 
     def start_orbit(self, lane, k):
         """Per-orbit rule state at load; sets the section gate and the clock."""
@@ -138,6 +140,10 @@ class LaneRules(abc.ABC):
             self.set_gate(lane, 1.0 if self.win.t_from <= 0 else 0.0)
         if self.targets:
             self.set_clock(lane, self.targets[0][0] / self.clock_scale)
+        if self.open_late is not None and self.open_late[k]:  # the clock opens the window at T_INITIAL
+            self.set_gate(lane, 0.0)
+            self.clock_i[lane] = -1
+            self.set_clock(lane, events.T_INITIAL / self.clock_scale)
 
     def end_censored(self, lane):
         """Alive at t_max: censored there (t_end = t_max exactly, the state where the orbit is)."""
@@ -229,6 +235,9 @@ class LaneRules(abc.ABC):
             return True
         t = self.elapsed(lane)
         i = self.clock_i[lane]
+        if i < 0:  # T_INITIAL of an orbit whose window opens late (events.opens_late)
+            i = 0
+            self.set_gate(lane, 1.0)
         targets = self.targets
         # the root of σ lands within rounding (~ulp(1)·G) of its target, on either side
         while i < len(targets) and targets[i][0] <= t + 1e-12 * self.clock_scale:

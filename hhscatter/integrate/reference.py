@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hhscatter.integrate import events
-from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED, caster
+from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
+from hhscatter.integrate.integrators import build_scalar, caster
 from hhscatter.integrate.lanes import CONTINUING, LIVE, LaneRules, _bind, _Callback, _unbind
 
 
@@ -67,15 +68,25 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     high-precision reference (tolerance then defaults to that type's
     epsilon). Snapshots at ``scene.snapshots`` come from stopping at each
     time (so its steps differ from the engine's, as a reference's should).
+    A scene with noise has no such driver (its kicks live in the noise scheduler): ValueError.
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
+    if scene.noise is not None:
+        raise ValueError("simulate_orbit integrates the deterministic flow: a scene with noise has no reference driver")
     ic = np.asarray(ic, dtype=float)
     if ic[0] ** 2 + ic[1] ** 2 >= scene.r_esc**2:  # starts beyond r_esc: escaped at t = 0
         snaps = [(0.0, ic.copy())] if scene.snapshots and scene.snapshots[0] == 0.0 else []
         return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
-    ta, specs, layout = events.build_scalar(scene, _Callback, fp_type=fp_type, tol=tol)
+    # a start on the section near an inflection of r (events.opens_late): the window opens at T_INITIAL on the
+    # clock, as in the engine; a scene without a clock fixes the section's cooldown instead
+    late = events.opens_late(scene, ic[None]) is not None
+    clocked = events.layout(scene).clock is not None
+    cooldown = events.SECTION_COOLDOWN if late and not clocked else -1.0
+    ta, specs, layout = build_scalar(scene, _Callback, fp_type=fp_type, tol=tol, section_cooldown=cooldown)
     rules = _Scalar(scene, ta, layout, fp_type)
+    if late and clocked:
+        rules.open_late = [True]
     _bind(ta, specs, rules)
     cast = caster(fp_type)
     st = np.zeros(layout.n_state)

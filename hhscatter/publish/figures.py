@@ -8,6 +8,8 @@ your own axes in a notebook use :func:`hhscatter.plot_survival` and
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 def agg_pyplot():
     """agg_pyplot() -> matplotlib.pyplot with the file-writing Agg backend selected."""
@@ -17,3 +19,53 @@ def agg_pyplot():
     import matplotlib.pyplot as plt  # deferred: matplotlib loads on first use
 
     return plt
+
+
+def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
+    """save_panels(fig, path, groups=None, dpi=None) -> the paths of one PNG per panel of a drawn multi-panel figure.
+
+    A page shows each at the full width of its text, where a composite of four or six panels would print its
+    labels at a few pixels. Panel ``i`` goes to ``<stem>_panel_<letter>.png`` beside ``path`` (``a``, ``b``, …
+    in the order of ``groups``), cropped from ``fig`` as drawn (same data and fonts; give the composite's ``dpi``): the
+    tight box of the group's axes, their titles, labels and legends, ``pad`` inches around. ``groups`` is a list
+    of lists of axes drawn on together (a panel and its colour bar); default: every visible axes of ``fig``
+    except colour bars, one each, with each colour bar joined to the panel it sits beside.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> plt = agg_pyplot()
+    >>> fig, axs = plt.subplots(1, 2, figsize=(8, 3))
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> [p.name for p in save_panels(fig, d / "fig9.png")]
+    ['fig9_panel_a.png', 'fig9_panel_b.png']
+    >>> plt.close(fig)
+    """
+    from matplotlib.transforms import Bbox  # deferred: matplotlib loads on first use
+
+    path = Path(path)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    if groups is None:
+        axes = [ax for ax in fig.axes if ax.get_visible()]
+        bars = [ax for ax in axes if hasattr(ax, "_colorbar")]
+        groups = [[ax] for ax in axes if ax not in bars]
+
+        def centre(ax):
+            b = ax.get_position()
+            return (b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2
+
+        for bar in bars:  # a colour bar belongs to the nearest panel
+            cx, cy = centre(bar)
+            near = min(groups, key=lambda g: (centre(g[0])[0] - cx) ** 2 + (centre(g[0])[1] - cy) ** 2)
+            near.append(bar)
+    for old in path.parent.glob(f"{path.stem}_panel_*.png"):  # panels of an earlier layout
+        old.unlink()
+    out = []
+    inches = fig.dpi_scale_trans.inverted()
+    for i, group in enumerate(groups):
+        box = Bbox.union([ax.get_tightbbox(renderer) for ax in group]).transformed(inches).padded(pad)
+        p = path.with_name(f"{path.stem}_panel_{chr(ord('a') + i)}.png")
+        fig.savefig(p, bbox_inches=box, dpi=dpi or "figure")
+        out.append(p)
+    return out

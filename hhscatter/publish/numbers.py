@@ -42,6 +42,7 @@ types by hand that are neither references nor declared conventions
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import re
@@ -59,6 +60,7 @@ __all__ = [
     "format_ref",
     "headline_scale",
     "prose",
+    "read_numbers_file",
     "render_refs",
     "resolve",
     "stray_numbers",
@@ -91,16 +93,32 @@ def headline_scale(root: Path, study: str) -> str:
     return "paper" if (assets_dir(root, "paper") / f"{study}.json").is_file() else "quick"
 
 
+def _load(path: str) -> dict:
+    """The numbers JSON at ``path``, refused when its content is not the one it was written with (its ``sha256``).
+
+    Parsed once per content (the cache is keyed by the file's bytes, so a file rewritten within the clock's
+    resolution is read again)."""
+    return _parse(path, Path(path).read_bytes())
+
+
 @lru_cache(maxsize=64)
-def _load(path: str, mtime: float) -> dict:
-    """The numbers JSON at ``path``, refused when its content is not the one it was written with (its ``sha256``)."""
-    doc = json.loads(Path(path).read_text())
+def _parse(path: str, raw: bytes) -> dict:
+    doc = json.loads(raw)
     if doc.get(SELF_KEY) is None or content_sha256(doc) != doc[SELF_KEY]:
         raise NumberRefError(
             f"{path} is not as its study wrote it (no content hash, or another content than the hash it was written "
             "with): a page quotes no number from an edited file; make the study again and copy its results"
         )
     return doc
+
+
+def read_numbers_file(path: Path) -> dict:
+    """read_numbers_file(path) -> a committed numbers JSON, verified against its content hash.
+
+    Every reader that puts a study's numbers on a page goes through here (the ``[[study:path]]`` references
+    and the docs hooks' generated tables alike); raises :class:`NumberRefError` for an edited or unsealed file.
+    """
+    return copy.deepcopy(_load(str(path)))
 
 
 def load_numbers(root: Path, study: str, scale: str | None = None) -> tuple[dict, str]:
@@ -112,7 +130,7 @@ def load_numbers(root: Path, study: str, scale: str | None = None) -> tuple[dict
             f"no committed numbers for study {study!r} at scale {scale!r} ({path.name} "
             f"missing from docs/studies/assets{'' if scale == 'quick' else '/' + scale})"
         )
-    return _load(str(path), path.stat().st_mtime), scale
+    return _load(str(path)), scale
 
 
 _SEG = re.compile(r"\[([^\]]*)\]")
@@ -526,5 +544,5 @@ def study_conventions(root: Path, study: str) -> set[float]:
     for scale in ("quick", "paper"):
         path = assets_dir(root, scale) / f"{study}.json"
         if path.is_file():
-            out |= _paper_values(_load(str(path), path.stat().st_mtime))
+            out |= _paper_values(_load(str(path)))
     return {abs(v) for v in out}

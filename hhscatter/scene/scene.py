@@ -22,6 +22,7 @@ import numpy as np
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import resolve
+from hhscatter.scene.noise import KICK_FRACTION, KICK_MAX_FRACTION, Noise
 from hhscatter.scene.recording import (
     SNAPSHOT_LIST_MAX,
     SNAPSHOTS_MAX,
@@ -142,6 +143,10 @@ class Scene:
         on the section ṙ = 0, φ̇ > 0 (the authors' ``goodICs``); 'random' uniform on the circle, drawn per
         orbit from the seed (not on the section: its first recorded crossing is its first ṙ = 0 root with
         φ̇ > 0 at t > 0). The same for every region; not with ``ics`` (the table fixes the momenta).
+    noise : Noise, optional
+        Random forces on the momenta (:class:`Noise`): a heat bath of temperature T with drag, a noise of
+        strength σ without. Such a scene records lifetimes only; escape is the first outward r_esc crossing
+        (settling below E_c is not an outcome: the noise lifts the orbit again), censoring at t_max.
     name : str
         A label for progress lines and the tables' metadata.
 
@@ -182,6 +187,7 @@ class Scene:
     follow: Follow | None = None
     continue_settled: bool = False
     momentum: str = "tangential"
+    noise: Noise | None = None
     system: dict | None = field(default=None, hash=False)
     name: str = "scene"
     _model: System = field(default=None, init=False, repr=False, compare=False)
@@ -231,6 +237,30 @@ class Scene:
     def dissipative(self) -> bool:
         return self.gamma > 0
 
+    @property
+    def noise_strength(self) -> float:
+        """σ of dp = … + σ dW (momentum/√time): √(2γT) for a heat bath, the given σ without drag, 0 without noise."""
+        if self.noise is None:
+            return 0.0
+        if self.noise.temperature is not None:
+            return math.sqrt(2.0 * self.gamma * self.noise.temperature)
+        return self.noise.sigma
+
+    @property
+    def kick_interval(self) -> float | None:
+        """The noise's kick interval h (time units): the given one or KICK_FRACTION · min(1/ω, 1/γ); None without
+        noise. (The engine uses t_max/⌈t_max/h⌉ ≤ h.)"""
+        if self.noise is None:
+            return None
+        if self.noise.kick is not None:
+            return self.noise.kick
+        return KICK_FRACTION * self._shortest_time()
+
+    def _shortest_time(self) -> float:
+        """min(1/ω, 1/γ) (time units): the time scale a kick interval must resolve."""
+        rate = max(self.model.frequency, self.gamma)
+        return 1.0 / rate
+
     # -- validation ---------------------------------------------------------
     def _validate(self):
         """Every field in range, checked in this order (the first bad one is the error); snapshots normalised."""
@@ -239,6 +269,46 @@ class Scene:
         self._check_chunks()
         self._check_energy(gamma)
         self._check_recording(gamma, t_max, r_esc)
+        self._check_noise(gamma)
+
+    def _check_noise(self, gamma):
+        """noise: a heat bath needs linear drag, a noise strength none; the kick interval's bound; a noise scene
+        records lifetimes only."""
+        if self.noise is None:
+            return
+        if not isinstance(self.noise, Noise):
+            raise ConfigError("noise must be a Noise or None")
+        if self.noise.temperature is not None:
+            if not gamma > 0:
+                raise ConfigError(
+                    "noise.temperature is a heat bath: it needs drag gamma > 0 (without drag give noise.sigma)"
+                )
+            if self.model.dissipation != "linear":
+                raise ConfigError(
+                    f"noise.temperature needs the linear drag law (the heat bath's fluctuation–dissipation pair), "
+                    f"got system.dissipation = {self.model.dissipation!r}"
+                )
+        elif gamma > 0:
+            raise ConfigError(
+                f"noise.sigma is noise without drag (gamma = 0), got gamma = {gamma:g}: with drag give "
+                "noise.temperature (a heat bath)"
+            )
+        h_max = KICK_MAX_FRACTION * self._shortest_time()
+        if self.noise.kick is not None and self.noise.kick > h_max:
+            raise ConfigError(
+                f"noise.kick must be ≤ {KICK_MAX_FRACTION:g} min(1/ω, 1/γ) = {h_max:g}, got {self.noise.kick:g} "
+                "(the splitting would resolve neither the oscillation nor the drag)"
+            )
+        for name, given in (
+            ("sections", self.sections is not None),
+            ("snapshots", bool(self.snapshots)),
+            ("follow", self.follow is not None),
+            ("continue_settled", self.continue_settled),
+        ):
+            if given:
+                raise ConfigError(f"{name} is not available with noise: a noise scene records lifetimes only")
+        if self.r_far is not None:
+            raise ConfigError("r_far is not read with noise: the escape is the first outward r_esc crossing")
 
     def _check_dynamics(self):
         """γ, n, seed, tol and t_max; returns (γ, t_max)."""
@@ -370,13 +440,13 @@ class Scene:
                     f"{energy:g} (far above the saddles every orbit leaves at once; p² overflows "
                     "near 1e308)"
                 )
-            if energy <= m.critical_energy:
+            if energy <= m.critical_energy and self.noise is None:  # noise lifts an orbit over the saddles
                 what = "dissipative" if gamma > 0 else "conservative escape"
                 raise ConfigError(
                     f"energy must be > E_c = {m.critical_energy:.10g} in a {what} scene "
                     f"(no escape is possible below it), got {energy}"
                 )
-            if energy - m.critical_energy <= EC_MARGIN * m.critical_energy:
+            if self.noise is None and energy - m.critical_energy <= EC_MARGIN * m.critical_energy:
                 raise ConfigError(
                     f"energy must exceed E_c = {m.critical_energy!r} by more than {EC_MARGIN:g} E_c, got {energy!r} "
                     f"(E0 − E_c = {energy - m.critical_energy:.3g}): a sampled initial energy |p|²/2 + V equals E0 "
@@ -455,6 +525,10 @@ class Scene:
             d["follow"] = {"radii": list(self.follow.radii)}
         if not self.continue_settled:
             del d["continue_settled"]
+        if self.noise is None:  # no noise, the default: left out of the hash, so older scenes keep theirs
+            del d["noise"]
+        else:
+            d["noise"] = {k: v for k, v in dataclasses.asdict(self.noise).items() if v is not None}
         if self.momentum == "tangential":  # the default: left out of the hash, so older scenes keep theirs
             del d["momentum"]
         if self.system is None:  # Hénon–Heiles with linear drag, the default: left out of the hash
@@ -547,6 +621,16 @@ def scene_from_dict(d: dict) -> Scene:
         if unknown:
             raise ConfigError(f"unknown follow keys: {sorted(unknown)}; allowed: ['radii']")
         d["follow"] = Follow(**fol)
+    noise = d.pop("noise", None)
+    if isinstance(noise, Noise):
+        d["noise"] = noise
+    elif noise is not None:
+        if not isinstance(noise, dict):
+            raise ConfigError("noise must be a table with temperature or sigma (and kick)")
+        unknown = set(noise) - {f.name for f in dataclasses.fields(Noise)}
+        if unknown:
+            raise ConfigError(f"unknown noise keys: {sorted(unknown)}; allowed: ['kick', 'sigma', 'temperature']")
+        d["noise"] = Noise(**noise)
     snaps = d.pop("snapshots", None)
     if isinstance(snaps, dict):
         unknown = set(snaps) - {"times", "start", "stop", "step"}

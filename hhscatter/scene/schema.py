@@ -43,7 +43,7 @@ from pydantic import (
 
 from hhscatter.errors import ConfigError
 from hhscatter.model import DISSIPATIONS
-from hhscatter.scene.scene import MOMENTA, REGIONS, Follow, Scene, SectionWindow, scene_from_dict
+from hhscatter.scene.scene import MOMENTA, REGIONS, Follow, Noise, Scene, SectionWindow, scene_from_dict
 
 __all__ = [
     "load_scene",
@@ -219,11 +219,17 @@ FollowTable = table_of(
     "scenes), crossings of these radii recorded (Follow's fields).",
     required=("radii",),
 )
+NoiseTable = table_of(
+    Noise,
+    "NoiseTable",
+    "``[noise]``: random forces on the momenta: a heat bath (temperature, with drag) or a noise strength "
+    "(sigma, without drag), and the kick interval (Noise's fields).",
+)
 SceneTable = table_of(
     Scene,
     "SceneTable",
     "``[scene]`` of a scene file: the Scene fields (energy and gamma may be lists: a grid).",
-    exclude=("sections", "snapshots", "follow", "system"),
+    exclude=("sections", "snapshots", "follow", "noise", "system"),
     leaves={
         "energy": NumberOrNumbers,
         "gamma": NumberOrNumbers,
@@ -255,7 +261,7 @@ StudySceneTable = table_of(
     Scene,
     "StudySceneTable",
     "``[scene]`` of a study.toml: one scene's fields (no grid: a study makes its runs itself).",
-    exclude=("sections", "snapshots", "follow", "system"),
+    exclude=("sections", "snapshots", "follow", "noise", "system"),
     leaves={"region": OneOf(*REGIONS), "momentum": OneOf(*MOMENTA)},
 )
 
@@ -324,7 +330,13 @@ def typed_value(model: type[BaseModel], name: str, raw: dict) -> Any:
     return conv(v) if conv is not None and v is not None else v
 
 
-_SCENE_TABLES = {"sections": SectionsTable, "snapshots": SnapshotsTable, "follow": FollowTable, "system": SystemTable}
+_SCENE_TABLES = {
+    "sections": SectionsTable,
+    "snapshots": SnapshotsTable,
+    "follow": FollowTable,
+    "noise": NoiseTable,
+    "system": SystemTable,
+}
 
 
 def _scene_file_model():
@@ -567,7 +579,7 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
         d["sections"] = doc["sections"]
     if "snapshots" in doc:
         d["snapshots"] = doc["snapshots"]
-    for table in ("follow", "system"):
+    for table in ("follow", "noise", "system"):
         if table in doc:
             d[table] = doc[table]
     if scale is not None and scale != "quick":
@@ -583,7 +595,7 @@ def load_scene(path: str | os.PathLike[str], scale: str | None = None, **overrid
     """A Scene from a TOML file.
 
     Layout: ``[scene]`` (Scene fields), optional ``[sections]`` (SectionWindow fields), ``[snapshots]``
-    (``times = [...]`` or ``start/stop/step``) and ``[scale.<name>]`` tables whose keys override
+    (``times = [...]`` or ``start/stop/step``), ``[noise]`` (Noise fields) and ``[scale.<name>]`` tables whose keys override
     ``[scene]`` when ``scale`` is given. A file whose ``energy`` or ``gamma`` is a list is a grid: load it
     with :func:`hhscatter.load_run`.
 

@@ -16,6 +16,7 @@ import types
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from hhscatter.analysis.stats.verdicts import NO_VERDICT, SMOKE_SCALES, without_verdicts
 from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
@@ -191,9 +192,9 @@ class Study:
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
-        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``) and overrides."""
+        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides."""
         d = dict(self.config.get("scene", {}))
-        for extra in ("sections", "snapshots", "system"):
+        for extra in ("sections", "snapshots", "noise", "system"):
             if extra in self.config:
                 d[extra] = copy.deepcopy(self.config[extra])
         d.update(overrides)
@@ -258,9 +259,12 @@ class Study:
         One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test. ``convention`` says how
         *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
         row computed in the authors' own convention (their IC region, window or selection rule), so that a
-        "differs" can be checked against it. The paper's number is always in the authors' convention.
+        "differs" can be checked against it. The paper's number is always in the authors' convention. At a smoke
+        scale (tiny) the row states no verdict (:data:`~hhscatter.analysis.stats.verdicts.NO_VERDICT`).
         """
-        if verdict is None and paper is not None and ours is not None and err is not None:
+        if self.scale in SMOKE_SCALES:
+            verdict = NO_VERDICT
+        elif verdict is None and paper is not None and ours is not None and err is not None:
             try:
                 verdict = "agrees within 2σ" if abs(float(ours) - float(paper)) <= 2 * float(err) else "differs"
             except (TypeError, ValueError):
@@ -300,7 +304,8 @@ class Study:
     def write_numbers(self, numbers: dict) -> Path:
         """Write the study's numbers JSON (with its comparisons, scale and provenance).
 
-        It records what it was made from (:mod:`hhscatter.studies.provenance`: the hash of this study's
+        At a smoke scale (tiny) it states no verdict anywhere: every ``"verdict"`` reads
+        :data:`~hhscatter.analysis.stats.verdicts.NO_VERDICT` (values and errors stay). It records what it was made from (:mod:`hhscatter.studies.provenance`: the hash of this study's
         configuration, of each upstream numbers JSON and the raw runs' scene hashes) and its own content hash.
         """
 
@@ -308,8 +313,8 @@ class Study:
         doc = {
             "study": self.name,
             "scale": self.scale,
-            **numbers,
-            "paper_comparison": list(self.comparisons),
+            **without_verdicts(numbers, self.scale),
+            "paper_comparison": without_verdicts(list(self.comparisons), self.scale),
             "config": self.config,
             "raw_runs": dict(self.raw_runs),
             "provenance": provenance(),
@@ -468,7 +473,7 @@ def missing_upstream(study: Study) -> list[str]:
 
 
 #: the study.toml tables every raw run's scene is made from (Study.scene, Study.model)
-SCENE_TABLES = ("scene", "sections", "snapshots", "follow", "system")
+SCENE_TABLES = ("scene", "sections", "snapshots", "follow", "noise", "system")
 
 
 def simulate_inputs(study, keys) -> dict:

@@ -38,7 +38,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import basin_summary as bs
 from hhscatter.analysis.geometry.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 
 
 class Params(StudyParams):
@@ -68,6 +68,9 @@ class Params(StudyParams):
     kappa_energy_key: str = "kappa_energy"
     mu_key: str = "mu"
     box_sides: Numbers = (0.01, 0.02, 0.025, 0.05, 0.1, 0.2)  # S_b, S_bb also at these sides (position units)
+    # the map read also on every k-th cell (k = grid/subgrid odd: the coarse grid's cell centres are cells of the
+    # fine grid, the same orbits), its entropies at the same sides: resolution alone, like for like
+    box_subgrids: Integers = (400,)
 
 
 # -- keys and grids ----------------------------------------------------------------
@@ -241,6 +244,7 @@ def analyze(study):
             loc_tabs.append(loc)
             per.append(bs.point_record(E, g, hb, ec, ent, unc, loc, m))
             by_box.extend(_entropy_by_box(study, img, E, g, extent))
+            by_box.extend(_entropy_by_subgrid(study, img, E, g, extent))
     study.write_table(pd.concat(maps, ignore_index=True), "basins_maps.parquet", grid=n, extent=list(extent))
     study.write_table(pd.concat(ent_rows, ignore_index=True), "basins_entropy.parquet")
     study.write_table(pd.concat(unc_tabs, ignore_index=True), "basins_uncertainty.parquet")
@@ -268,6 +272,7 @@ def analyze(study):
             "cutoff_prediction": cut_pred,
             "cutoff_summary": bs.cutoff_summary(cut_pred),
             "entropy_by_box": by_box,
+            "entropy_by_box_at": bs.entropy_by_box_at(by_box),
             "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
             "energy_scan": scan.to_dict(orient="records"),
             "energy_trend": trend,
@@ -405,6 +410,18 @@ def _entropy_by_box(study, img, E, g, extent, which="map"):
         return []
     t = entropy_by_box(img, extent, sides, outside=OUTSIDE)
     return t.assign(E0=E, gamma=g, map=which).to_dict(orient="records")
+
+
+def _entropy_by_subgrid(study, img, E, g, extent):
+    """S_b, S_bb at the fixed box sides of the map read on every k-th cell, for each of [study].box_subgrids
+    with k = grid/subgrid a whole odd number > 1 (the subgrid's cell centres are cells of the map: the same
+    orbits on a coarser grid, map "every k-th cell")."""
+    rows = []
+    for sub in study.params.box_subgrids:
+        k, r = divmod(img.shape[0], int(sub))
+        if k > 1 and r == 0 and k % 2 == 1:
+            rows += _entropy_by_box(study, img[k // 2 :: k, k // 2 :: k], E, g, extent, which=f"every {k}th cell")
+    return rows
 
 
 def _energy_scan(study, extent, boxes, hb, E_b, by_box):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 # paper's colours: E = 0.35 orange, E = 0.30 black
 POINT_COLOURS = {"E0.35": "tab:orange", "E0.30": "black"}
@@ -97,4 +97,5 @@ def plot_fig1(grid, points, numbers, path):
         ax.set_xlabel("$x$")
         ax.set_ylabel("$y$")
     fig.savefig(path, dpi=180)
+    save_panels(fig, path, dpi=180)  # each panel legible at a page's full width
     plt.close(fig)

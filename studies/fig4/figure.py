@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 from hhscatter.publish.formatting import format_value_err
 
 FIXED_COLORS = {0.0: "#1f77b4", 0.001: "#2ca02c", 0.002: "#bcbd22", 0.005: "#ff7f0e", 0.01: "#7b3294", 0.02: "#d62728"}
@@ -122,4 +122,5 @@ def plot_fig4(surv, ratio, taus, numbers, path, *, mark_gamma=0.01):
     ax.text(0.01, 0.99, "(a)", transform=ax.transAxes, va="top", fontsize=10, fontweight="bold")
     bx.text(0.97, 0.03, "(b)", transform=bx.transAxes, ha="right", fontsize=10, fontweight="bold")
     fig.savefig(path, dpi=200)
+    save_panels(fig, path, dpi=200)  # each panel legible at a page's full width
     plt.close(fig)

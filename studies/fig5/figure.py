@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 from hhscatter.publish.formatting import format_value_err
 
 RED = "#c0392b"
@@ -118,6 +118,7 @@ def plot_fig5(points, cmeasure, dist_tab, summary, nums, path):
     if nums.get("dev_fallback"):
         fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
     fig.savefig(path, dpi=160)
+    save_panels(fig, path, dpi=160)  # each panel legible at a page's full width
     plt.close(fig)
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"]
 LS = {"paper": (0, (5, 2)), "integrated": (0, (1.5, 1.5))}
@@ -105,6 +105,7 @@ def plot_fig6(curves, fits, taus, tau2_curve, cmps, nums, path, pc_fits=None, pc
     if nums.get("dev_fallback"):
         fig.suptitle("DEVELOPMENT FALLBACK INPUTS — not a result", color="red")
     fig.savefig(path, dpi=150)
+    save_panels(fig, path, dpi=150)  # each panel legible at a page's full width
     plt.close(fig)
 
 

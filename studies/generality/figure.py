@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 COLORS = {"henon_heiles": "#2166ac", "contopoulos": "#b2182b", "barbanis": "#1b7837"}
 MARKERS = {"henon_heiles": "o", "contopoulos": "s", "barbanis": "^"}
@@ -244,6 +244,7 @@ def plot_generality(kappa, mu, curves, numbers, path):
     )
     fig.tight_layout()
     fig.savefig(path, dpi=150)
+    save_panels(fig, path, dpi=150)  # each panel legible at a page's full width
     plt.close(fig)
 
 
@@ -377,4 +378,5 @@ def plot_decay(curves, numbers, path):
     )
     fig.tight_layout()
     fig.savefig(path, dpi=150)
+    save_panels(fig, path, dpi=150)  # each panel legible at a page's full width
     plt.close(fig)

@@ -7,27 +7,45 @@ import numpy as np
 
 
 def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
-    """plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path) -> None; writes operator.png.
+    """plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path) -> None; writes operator.png and siblings.
 
-    Panels: (a) κ(E) by Ulam's method against fig2's; (b) its convergence in box side and samples; (c) the
-    operator's c-measure μ_c against fig1's sprinkler points; (d) the dissipative P(t): simulated, operator
-    and reduced operator; (e) the energies of the first crossing after t*; (f) the orbit-time cost of κ at 1 %.
+    Two panels at most per file, so that each stays legible at the page's content width: ``path``
+    (operator.png): (a) κ(E) by Ulam's method against fig2's, (b) its convergence in box side and samples;
+    operator_cmeasure.png (when fig1's points are given): the operator's c-measure μ_c against fig1's sprinkler
+    points; operator_dissipative.png: (a) the dissipative P(t), simulated, operator and reduced operator, (b)
+    the energies of the first crossing after t*; operator_cost.png: the orbit-time cost of κ at 1 %.
     Inputs: operator.json's numbers and the study's derived tables (pandas DataFrames).
     """
+    from pathlib import Path
+
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(2, 3, figsize=(15, 9.2))
+    path = Path(path)
+    fig, ax = plt.subplots(1, 2, figsize=(12, 5.2))
     recs = nums["kappa_ulam"]
     E = np.array([r["energy"] for r in recs])
-    _panel_kappa(ax[0, 0], nums, recs, E)
-    _panel_convergence(ax[0, 1], conv, recs)
-    _panel_cmeasure(ax[0, 2], nums, ulam_pts, fig1_pts)
+    _panel_kappa(ax[0], nums, recs, E)
+    _panel_convergence(ax[1], conv, recs)
+    _save(fig, path)
+    if fig1_pts is not None and ulam_pts is not None:
+        fig, c = plt.subplots(figsize=(7, 6.6))
+        _panel_cmeasure(c, nums, ulam_pts, fig1_pts)
+        _save(fig, path.with_name(path.stem + "_cmeasure.png"))
     dn = nums["dissipative"]
-    _panel_survival(ax[1, 0], dn, surv)
-    _panel_t_star_energy(ax[1, 1], dn, pts)
-    _panel_cost(ax[1, 2], nums["cost"])
+    fig, ax = plt.subplots(1, 2, figsize=(12, 5.2))
+    _panel_survival(ax[0], dn, surv)
+    _panel_t_star_energy(ax[1], dn, pts)
+    _save(fig, path.with_name(path.stem + "_dissipative.png"))
+    fig, f = plt.subplots(figsize=(7, 5))
+    _panel_cost(f, nums["cost"])
+    _save(fig, path.with_name(path.stem + "_cost.png"))
+
+
+def _save(fig, path):
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(path, dpi=120)
     plt.close(fig)
 
 
@@ -75,8 +93,8 @@ def _panel_kappa(a, nums, recs, E):
             )
             if rec.get("fig2_kappa") is not None:
                 a.errorbar([rec["energy"]], [rec["fig2_kappa"]], [rec["fig2_err"]], fmt="s", color="0.6", mfc="none")
-    a.set(xlabel="E", ylabel="κ (1/time)", title="(a) escape rate: ρ(M(κ)) = 1 against P(t)")
-    a.legend(fontsize=8)
+    a.set(xlabel="E", ylabel="κ (1/time)", title="(a) escape rate: root of ρ(M(κ)) = 1 against P(t)")
+    a.legend(fontsize=9)
 
 
 def _panel_convergence(b, conv, recs):
@@ -104,7 +122,7 @@ def _panel_convergence(b, conv, recs):
         ylabel="κ_Ulam / κ0(fig2)",
         title="(b) discretisation bias: κ vs box side",
     )
-    b.legend(fontsize=7, ncol=2)
+    b.legend(fontsize=9, ncol=2)
 
 
 def _panel_cmeasure(c, nums, ulam_pts, fig1_pts):
@@ -123,7 +141,7 @@ def _panel_cmeasure(c, nums, ulam_pts, fig1_pts):
             for r in nums["cmeasure_distances"]
             if np.isclose(r["fig1_energy"], e0) and np.isclose(r["operator_energy"], e0) and r["measure"] == "sprinkler"
         ]
-        t = f"(c) μ_c at E = {e0:g}: operator (grey) vs fig1"
+        t = f"μ_c at E = {e0:g}: operator (grey) vs fig1"
         if d:
             t += f"\ndebiased H(ε={d[0]['box']:g}) = {d[0]['hellinger_debiased']:.3f}"
         c.set(xlabel="x", ylabel="y", title=t)
@@ -142,7 +160,7 @@ def _panel_survival(dd, dn, surv):
     dd.set_ylim(lo / 3, 1.2)
     t_hi = dn.get("compared_until") or surv["t"].max()
     dd.set_xlim(0, min(float(surv["t"].max()), 1.5 * float(t_hi)))
-    dd.set(xlabel="t", ylabel="P(t)", title=f"(d) dissipative: E0 = {dn['energy']:g}, γ = {dn['gamma']:g}")
+    dd.set(xlabel="t", ylabel="P(t)", title=f"(a) dissipative P(t): E0 = {dn['energy']:g}, γ = {dn['gamma']:g}")
     dd.legend(fontsize=8)
 
 
@@ -166,7 +184,7 @@ def _panel_t_star_energy(e, dn, pts):
     e.set(
         xlabel="E at the first crossing after t*",
         ylabel="share",
-        title=f"(e) survivors at t* = {dn['t_star']:g}: energy",
+        title=f"(b) survivors at t* = {dn['t_star']:g}: energy",
     )
     e.legend(fontsize=8)
 
@@ -178,7 +196,7 @@ def _panel_cost(f, cost):
     f.bar(x + 0.2, [r.get("op_orbit_time_1pct", np.nan) for r in cost], 0.4, color="C3", label="Ulam operator")
     f.set_yscale("log")
     f.set_xticks(x, [f"E = {r['energy']:g}" for r in cost])
-    f.set(ylabel="orbit-time for κ at 1 % (time units)", title="(f) cost of κ at 1 %")
+    f.set(ylabel="orbit-time for κ at 1 % (time units)", title="cost of κ at 1 %")
     f.legend(fontsize=8)
 
 
@@ -193,7 +211,7 @@ def plot_residuals(nums, grid, path):
     """
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 6.2))
     recs = [r for r in nums.get("kappa_convergence", []) if r.get("kappa_inf") is not None]
     for k, (ref, lab, dx) in enumerate((("kappa0", "κ0 from P(t)", -0.003), ("kappa_cm", "κ from crossings", 0.003))):
         rs = [r for r in recs if r.get(ref) is not None]
@@ -223,7 +241,7 @@ def plot_residuals(nums, grid, path):
         )
     a.axhline(0, color="k", lw=0.8)
     a.set(xlabel="E", ylabel="κ_Ulam / κ_ref − 1", title="(a) residuals of Ulam's κ")
-    a.legend(fontsize=8)
+    a.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     if grid is not None and len(grid):
         est = grid[grid["kind"] == "estimate"]
         marks = {s: m for s, m in zip(sorted(est["box"].unique()), "os^")}
@@ -251,7 +269,7 @@ def plot_residuals(nums, grid, path):
             ylabel="κ (1/time)",
             title="(b) κ on box sides (○ □ △: finest, ×2, ×4) × samples per box",
         )
-        b.legend(fontsize=8)
+        b.legend(fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -23,8 +23,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.geometry import ulam
+from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
 
@@ -224,73 +224,17 @@ def transitions(tab, study, c=1, m_max=None, ebins=None):
 
 
 def _ulam_energy(study, E):
-    """Every number of one energy: κ at every box side and sample count, on the grid of the three finest sides
-    × the sample subsets (with bootstrap replicates there, for the extrapolation), classes, cost."""
-    k = _k(study.params.samples, "samples")
-    box = study.params.box
-    df = _samples(study, E, box, k, 0)
+    """Every number of one energy (:func:`~hhscatter.analysis.geometry.ulam_convergence.energy_results`), the
+    KAM islands and where the c-measure lives against the partition."""
+    p = study.params
+    df = _samples(study, E, p.box, _k(p.samples, "samples"), 0)
     tab = one_return_table(study, ulam_key(E), df)
-    rows = []
-    for c in study.params.coarsen:
-        tr, _, _ = transitions(tab, study, c=int(c))
-        kap, kmap, info, _, _ = ulam.saddle_kappa(tr)
-        rows.append(
-            {
-                "energy": E,
-                "box": box * int(c),
-                "samples": int(k * k * c * c),
-                "kappa": kap,
-                "kappa_map": kmap,
-                "vary": "box",
-                **info,
-            }
-        )
-    for m in study.params.sample_subsets:
-        tr, _, _ = transitions(tab, study, m_max=int(m))
-        kap, kmap, info, _, _ = ulam.saddle_kappa(tr)
-        rows.append(
-            {"energy": E, "box": box, "samples": int(m), "kappa": kap, "kappa_map": kmap, "vary": "samples", **info}
-        )
-    grid, boot_grid = ulam.convergence_grid(
-        tab,
-        _extent(study),
-        box,
-        list(study.params.coarsen)[:3],
-        study.params.sample_subsets,
-        k * k,
-        study.params.n_boot_grid,
-        [study.params.seed, int(round(E * 1e6)), 17],
+    res = uc.energy_results(
+        tab, _extent(study), p.box, p.coarsen, p.sample_subsets, p.samples, p.n_boot, p.n_boot_grid, p.seed, E
     )
-    tr, ids, t = transitions(tab, study)
-    boot = tf.bootstrap_kappa(tr, study.params.n_boot, rng=study.params.seed + int(E * 1000))
-    kap, kmap, info, keep, sub = ulam.saddle_kappa(tr)
-    full_classes = tf.communicating_classes(tr)[1]
-    ok = ~tab["censored"]
-    cost = {
-        "orbit_time": float(tab["t_end"].sum()),
-        "orbits": int(len(tab)),
-        "censored": int((~ok).sum()),
-        "mean_return_time": float(np.average(tab.loc[tab["ret"], "T"], weights=tab.loc[tab["ret"], "w"])),
-    }
-    islands = _islands(study, E, df, tr, ids, keep, sub)
-    return {
-        "tab": tab,
-        "t": t,
-        "rows": rows,
-        "boot": boot,
-        "kappa": kap,
-        "kappa_map": kmap,
-        "info": info,
-        "keep": keep,
-        "ids": ids,
-        "sub": sub,
-        "tr": tr,
-        "cost": cost,
-        "islands": islands,
-        "grid": grid,
-        "boot_grid": boot_grid,
-        "largest_classes": [dict(c.__dict__) for c in full_classes[:3]],
-    }
+    res["islands"] = _islands(study, E, df, res["tr"], res["ids"], res["keep"], res["sub"])
+    res["cut_boxes"] = uc.measure_on_cut_boxes(res, p.samples)
+    return res
 
 
 def _islands(study, E, df, tr, ids, keep, sub):
@@ -360,94 +304,35 @@ def _cmeasure_convergence(study, results, cm, boxes, head):
 
 
 # -- the dissipative operator ----------------------------------------------------------------------
-def _initial_density(study, ids, n_cells, top_bin):
-    """The initial ensemble (uniform in the scene's disk at E0, on the section) on the operator's states."""
-    sc = _sim_scene(study)
+def _dissipative(study, inputs):
+    """The dissipative comparison at (diss_energy, diss_gamma): P(t) of the operator on (box × E bin)
+    (:func:`~hhscatter.analysis.geometry.ulam.dissipative_operator`), of the reduced operator on ρ(E) and of
+    the simulated ensemble; the first crossing after t*. Returns (numbers, P(t) curves, t* points, distances)."""
+    p, sc, edges = study.params, _sim_scene(study), _diss_bins(study)
     if sc.region != "disk":
         raise ValueError(
-            f"operator: the dissipative comparison needs region 'disk' (its initial density is the "
-            f"disk's), got {sc.region!r}"
+            f"operator: the dissipative comparison needs region 'disk' (its initial density is the disk's), got {sc.region!r}"
         )
-    return ulam.disk_density(float(sc.radius), _extent(study), study.params.diss_box, ids, n_cells, top_bin)
-
-
-def _dissipative(study, inputs):
-    """The dissipative comparison at (diss_energy, diss_gamma): P(t) of the operator on (box × E bin), of the
-    reduced operator on ρ(E) and of the simulated ensemble; the energies and points of the first crossing after
-    t*. Returns (numbers, P(t) curves, t* points, t* distances)."""
-    edges = _diss_bins(study)
-    dt = study.params.dt
-    op = _operator_survival(study, edges)
-    P_red, kappa_bins = ulam.reduced_survival(
-        op["tr"], op["t"], op["ids"], op["n_cells"], len(edges) - 1, dt, op["max_lag"], op["steps"]
-    )
+    tab = one_return_table(study, DISS_KEY, _diss_samples(study))
+    op = ulam.dissipative_operator(
+        tab, _extent(study), p.diss_box, edges, dt=p.dt, t_horizon=p.t_horizon, t_star=p.t_star,
+        max_return_time=p.max_return_time, radius=float(sc.radius),
+    )  # fmt: skip
     sim = _simulated_survival(study, op["grid"])
-    P_sim, P_op, N, grid, pred = sim["P"], op["P"], sim["N"], op["grid"], op["pred"]
-    agreement = ulam.survival_agreement(grid, dt, study.params.t_star, P_sim, P_op, P_red, N)
-    dtab, j = _t_star_distance(study, pred, sim["pts"])
-    numbers = {
-        "energy": study.params.diss_energy,
-        "gamma": study.params.diss_gamma,
-        "t_star": study.params.t_star,
-        "dt": dt,
-        "energy_bins": edges.tolist(),
-        "states": int(op["tr"].n_states),
-        "samples": int(len(op["tab"])),
-        "initial_mass_lost": op["lost"],
-        "returns_capped_share": tf.capped_share(op["tr"], dt, op["max_lag"]),
-        "max_return_time": op["max_lag"] * dt,
-        "operator_orbit_time": float(op["tab"]["t_end"].sum()),
-        "sim_orbits": int(N),
-        "sim_orbit_time": float(sim["lt"]["t_end"].sum()),
-        **agreement,
-        **ulam.t_star_energies(pred, sim["pts"]),
-        "t_star_hellinger_debiased": {
-            "box": float(dtab["box"].iloc[j]),
-            "value": float(dtab.hellinger_debiased.iloc[j]),
-            "lo": float(dtab.lo.iloc[j]),
-            "hi": float(dtab.hi.iloc[j]),
-            "noise": float(dtab["hellinger_noise"].iloc[j]),
-        },
-        "kappa_bins": [
-            {"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(kappa_bins)
-        ],
-    }
-    curves = pd.DataFrame({"t": grid, "sim": P_sim, "operator": P_op, "reduced": P_red})
+    dtab, j = ulam.t_star_distance(
+        op["pred"], sim["xy"], list(p.cm_boxes), _extent(study), p.n_splits, p.seed, p.cm_box_headline
+    )
+    t_sim = float(sim["lt"]["t_end"].sum())
+    numbers = ulam.dissipative_record(
+        op, edges, sim["P"], sim["N"], sim["pts"], t_sim, dtab, j, energy=p.diss_energy, gamma=p.diss_gamma,
+        dt=p.dt, t_star=p.t_star,
+    )  # fmt: skip
+    curves = pd.DataFrame({"t": op["grid"], "sim": sim["P"], "operator": op["P"], "reduced": op["P_reduced"]})
     pts = pd.concat(
-        [pred.assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")], ignore_index=True
+        [op["pred"].assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")],
+        ignore_index=True,
     )
     return numbers, curves, pts, dtab
-
-
-def _operator_survival(study, edges):
-    """The operator on (box × E bin) from the one-return samples: P(t) from the disk's initial density, and the
-    weighted image points of the first crossing after t*."""
-    n_bins = len(edges) - 1
-    dt = study.params.dt
-    steps = int(round(study.params.t_horizon / dt))
-    k_star = int(round(study.params.t_star / dt))
-    df = _diss_samples(study)
-    tab = one_return_table(study, DISS_KEY, df)
-    tr, ids, t = transitions(tab, study, ebins=edges)
-    nx, _ = ulam.grid_shape(_extent(study), study.params.diss_box)
-    n_cells = nx * nx
-    n0, lost = _initial_density(study, ids, n_cells, n_bins - 1)
-    max_lag = int(round(study.params.max_return_time / dt))
-    P_op, pred = ulam.operator_survival(tr, t, n0, dt, steps, k_star, max_lag)
-    grid = np.arange(steps + 1) * dt
-    return {
-        "tab": tab,
-        "tr": tr,
-        "ids": ids,
-        "t": t,
-        "n_cells": n_cells,
-        "lost": lost,
-        "max_lag": max_lag,
-        "steps": steps,
-        "P": P_op,
-        "grid": grid,
-        "pred": pred,
-    }
 
 
 def _simulated_survival(study, grid):
@@ -462,25 +347,7 @@ def _simulated_survival(study, grid):
     P_sim = ulam.empirical_survival(lt["t_end"].to_numpy(), leaving, grid)
     sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
     sim_pts = dist.first_crossings(sec, study.params.t_star)
-    return {"lt": lt, "P": P_sim, "pts": sim_pts, "N": len(lt)}
-
-
-def _t_star_distance(study, pred, sim_pts):
-    """Debiased Hellinger distance over box sizes between the operator's t* points (drawn by weight, seeded)
-    and the simulated ones: (table, index of the headline box)."""
-    from hhscatter.analysis.geometry import distance as dist
-
-    rng = np.random.default_rng(study.params.seed + 9)
-    draw = pred.iloc[rng.choice(len(pred), size=max(len(sim_pts), 4), p=pred["w"] / pred["w"].sum())]
-    return ulam.hellinger_by_box(
-        draw[["x", "y"]].to_numpy(),
-        dist.points(sim_pts),
-        list(study.params.cm_boxes),
-        _extent(study),
-        study.params.n_splits,
-        study.params.seed,
-        study.params.cm_box_headline,
-    )
+    return {"lt": lt, "P": P_sim, "pts": sim_pts, "xy": dist.points(sim_pts), "N": len(lt)}
 
 
 # -- cost: orbit-time for κ at 1 % -----------------------------------------------------------------
@@ -505,52 +372,36 @@ def _cost(study, records, kappa0):
 # -- analyze ---------------------------------------------------------------------------------------
 def _fig2_kappa(study, inputs):
     other = study.upstream("kappa")
-    doc = up.numbers(study, other)
-    ke = doc.get("kappa_energy")
-    if not ke:
-        raise up.UpstreamError(f"{other}.json has no list 'kappa_energy'")
     inputs["kappa0"] = {
         "source": f"{other}.json: kappa_energy (P(t) route, paper setup) and cmeasure (the "
         "true-time relation on long-run section crossings)"
     }
-    k0 = {float(r["energy"]): (float(r["kappa"]), float(r["kappa_err"])) for r in ke}
-    kcm = {
-        float(v["energy"]): (float(v["kappa_cm"]["value"]), float(v["kappa_cm"]["err"]))
-        for v in doc.get("cmeasure", {}).values()
-        if "kappa_cm" in v
-    }
-    return k0, kcm
+    try:
+        return uc.kappa_references(up.numbers(study, other))
+    except KeyError:
+        raise up.UpstreamError(f"{other}.json has no list 'kappa_energy'") from None
 
 
 def kappa_part(study, inputs):
     """κ at every Ulam energy: {results per E, records (kappa_ulam), convergence (kappa_convergence), mixed
     (mixed phase space), rows (κ per partition), grids (the extrapolation grids and their replicates), kappa0}."""
-    from hhscatter.analysis.stats.verdicts import verdict
+    from hhscatter.analysis.stats.verdicts import SMOKE_SCALES, verdict
 
     kappa0, kappa_cm = _fig2_kappa(study, inputs)
+    not_smoke = study.scale not in SMOKE_SCALES  # a smoke-test scale states no verdicts
     out = {"results": {}, "records": [], "convergence": [], "mixed": [], "rows": [], "grids": [], "kappa0": kappa0}
     for E in _ulam_energies(study):
         res = out["results"][E] = _ulam_energy(study, E)
         k0, kc = kappa0.get(E), kappa_cm.get(E)
-        rec = ulam.kappa_record(E, res, study.params.samples, study.params.box)
-        rec.update(
-            {
-                "fig2_kappa": k0[0] if k0 else None,
-                "fig2_err": k0[1] if k0 else None,
-                "fig2_kappa_cm": kc[0] if kc else None,
-                "fig2_kappa_cm_err": kc[1] if kc else None,
-            }
-        )
-        if k0:
-            rec["z_vs_fig2"] = (rec["kappa"] - k0[0]) / math.hypot(rec["err"], k0[1])
+        rec = uc.kappa_record(E, res, study.params.samples, study.params.box, k0, kc)
         out["rows"].extend(res["rows"])
         isl = res["islands"]
         out["mixed"].append({"energy": E, **isl, "largest_classes": res["largest_classes"]})
         if any(np.isclose(E, e) for e in study.params.energies):
             out["records"].append(rec)
-            out["convergence"].append(
-                ulam.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], {"kappa0": k0, "kappa_cm": kc})
-            )
+            refs = {"kappa0": k0, "kappa_cm": kc}
+            conv = uc.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], refs, verdicts=not_smoke)
+            out["convergence"].append({**conv, **res["cut_boxes"]})
             out["grids"] += [
                 res["grid"].assign(energy=E, kind="estimate"),
                 res["boot_grid"].assign(energy=E, kind="bootstrap"),
@@ -599,7 +450,7 @@ def analyze(study):
             "inputs": inputs,
             "kappa_ulam": k["records"],
             "kappa_convergence": k["convergence"],
-            "kappa_convergence_summary": ulam.convergence_summary(k["convergence"]),
+            "kappa_convergence_summary": uc.convergence_summary(k["convergence"]),
             "mixed_phase_space": k["mixed"],
             "cmeasure_distances": cm_rows,
             "cmeasure_convergence": cm_conv,

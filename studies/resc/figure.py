@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
@@ -270,4 +270,5 @@ def plot_resc(kappa, returns, channels, lyapunov, path, *, r_ref=1.03, scale="")
     _panel_channels(d, channels, energies, col, r_ref)
     fig.suptitle(f"Escape criterion r > r_esc, conservative Hénon–Heiles (disk ICs; scale '{scale}')", fontsize=11)
     fig.savefig(path, dpi=150)
+    save_panels(fig, path, dpi=150)  # each panel legible at a page's full width
     plt.close(fig)

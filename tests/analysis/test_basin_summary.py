@@ -238,3 +238,23 @@ def test_cutoff_records_and_summary():
     summ = bs.cutoff_summary(recs)
     assert summ["n_resolved"] == 1 and summ["n_below"] == 0 and summ["n_overlap"] == 0
     assert summ["factor_min"] == pytest.approx(1e-3 / pred, rel=1e-6)
+
+
+def test_entropy_by_box_at_keeps_the_asked_sides_of_every_grid():
+    """The same physical box on both grids, and nothing else: sides matched to 1e-9, not to the cell count."""
+    from hhscatter.analysis.geometry.basin_summary import entropy_by_box_at
+
+    recs = [
+        {"E0": E, "gamma": 0.0, "map": m, "grid": n, "box_side": s, "box_cells": round(s * n / 2), "S_b": 0.1}
+        for E in (0.30, 0.25)
+        for m, n in (("map", 2000), ("scan", 400))
+        for s in (0.01, 0.025, 0.05 + 1e-12, 0.1)
+    ]
+    got = entropy_by_box_at(recs)
+    assert [(r["E0"], r["grid"], r["box_cells"]) for r in got[:4]] == [
+        (0.25, 400, 5),
+        (0.25, 2000, 25),
+        (0.25, 400, 10),
+        (0.25, 2000, 50),
+    ]
+    assert len(got) == 8 and entropy_by_box_at(recs, sides=(0.2,)) == []

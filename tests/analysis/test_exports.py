@@ -5,7 +5,7 @@ import importlib
 import pytest
 
 
-@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims"])
+@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims", "noise"])
 def test_subpackage_exports_its_modules_public_names(sub):
     pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
     assert pkg.__all__ and set(pkg.__all__) <= set(dir(pkg))
@@ -23,7 +23,7 @@ def test_a_name_is_exported_from_the_module_that_defines_it():
     assert survival._EXPORTS["survival_curve"] == "kaplan_meier" and geometry._EXPORTS["UnitSet"] == "paired_distance"
 
 
-@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims"])
+@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims", "noise"])
 def test_every_name_a_module_declares_in_all_exists(sub):
     import pkgutil
 

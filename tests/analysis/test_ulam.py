@@ -62,53 +62,6 @@ def test_t_star_energies_weighted_and_plain_moments():
     assert math.isnan(ulam.t_star_energies(pred, sim.iloc[:1])["t_star_std_energy"]["sim"])
 
 
-def _grid(k_inf, a, beta, p, noise=0.0, seed=0):
-    """κ on 3 box sides × 3 sample subsets (M'·c² samples per merged box), exactly κ∞ + a·b + β·M^(−p) (+ noise)."""
-    rng = np.random.default_rng(seed)
-    rows = [{"box": 0.00625 * c, "samples": m * c * c} for c in (1, 2, 4) for m in (4, 16, 64)]
-    g = pd.DataFrame(rows)
-    g["kappa"] = k_inf + a * g.box + beta * g.samples ** (-p) + noise * rng.standard_normal(len(g))
-    return g
-
-
-def test_kappa_convergence_recovers_the_limit_of_its_model():
-    g = _grid(0.1972, 0.2, 0.03, 0.5)
-    c = ulam.kappa_convergence(g)
-    assert c["kappa_inf"] == pytest.approx(0.1972, abs=1e-12)
-    assert c["slope_box"] == pytest.approx(0.2, abs=1e-10) and c["coef_samples"] == pytest.approx(0.03, abs=1e-10)
-    # the other exponent does not describe these data: its limit differs, and that difference is the model error
-    assert c["model_err"] == pytest.approx(abs(c["kappa_inf_alt"] - 0.1972), rel=1e-12) and c["model_err"] > 1e-3
-    assert math.isnan(c["stat_err"]) and math.isnan(c["err"])  # no bootstrap grid: no statistical error
-
-
-def test_kappa_convergence_bootstrap_spread_is_the_statistical_error():
-    """Replicates = the exact grid + independent noise σ: the spread of their extrapolations is that of the
-    least-squares intercept, σ·√((XᵀX)⁻¹)₀₀ (an independent closed form)."""
-    g = _grid(0.1, 0.1, 0.02, 0.5)
-    sigma, n_rep = 1e-3, 400
-    reps = pd.concat([_grid(0.1, 0.1, 0.02, 0.5, noise=sigma, seed=r).assign(rep=r) for r in range(n_rep)])
-    c = ulam.kappa_convergence(g, reps)
-    X = np.column_stack([np.ones(len(g)), g.box, g.samples**-0.5])
-    expect = sigma * math.sqrt(np.linalg.inv(X.T @ X)[0, 0])
-    assert c["stat_err"] == pytest.approx(expect, rel=0.1)  # 400 replicates: the std to ≈ 3.5 %
-    assert c["err"] == pytest.approx(math.hypot(c["stat_err"], c["model_err"]), rel=1e-12)
-
-
-def test_kappa_convergence_needs_two_box_sides_and_two_sample_counts():
-    g = _grid(0.1, 0.1, 0.02, 0.5)
-    with pytest.raises(ValueError, match="box sides"):
-        ulam.kappa_convergence(g[g.box == g.box.min()])
-    rec = ulam.convergence_record(0.3, g.head(3), None, 0.11, {"kappa0": (0.1, 0.001)})
-    assert rec["kappa_inf"] is None and "need" in rec["note"]
-
-
-def test_residuals_with_both_errors():
-    r = ulam.residuals(0.0994, 0.0006, 0.0972, 0.0002)
-    assert r["residual"] == pytest.approx(0.0994 / 0.0972 - 1, rel=1e-12)
-    assert r["z"] == pytest.approx(0.0022 / math.hypot(0.0006, 0.0002), rel=1e-12)
-    assert r["residual_err"] == pytest.approx(0.0994 / 0.0972 * math.hypot(0.0006 / 0.0994, 0.0002 / 0.0972), rel=1e-12)
-
-
 def test_sample_transitions_merge_boxes_and_keep_the_first_ranks():
     """Four finest boxes (2 × 2 of side 1 over [0, 2]²), two samples each: merged 2 × 2 they are one state; the
     first rank alone keeps one sample per box; a censored sample is dropped; an image outside is an escape."""

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from hhscatter.studies.provenance import sealed
+
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
@@ -150,7 +152,7 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
         "config": {},
         "provenance": {"hhscatter": "0.1.0", "git_commit": "0123456789abcdef"},
     }
-    (assets / "fig2.json").write_text(json.dumps(doc))
+    (assets / "fig2.json").write_text(json.dumps(sealed(doc)))
     md = "<!-- hh:study-params fig2 -->\n<!-- hh:study-figure fig2 -->\n<!-- hh:study-numbers fig2 -->\n"
     out, _ = _page(tmp_path, hook, md)
     assert "n = 10  # orbits" in out
@@ -160,6 +162,46 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assert "| `gamma` | `tau1` |" in out and "| 0.01 | 17.2 ± 1.0 |" in out
     assert "scale **quick**" in out and "commit `0123456789ab`" in out
     assert "](assets/fig2.json)" in out
+
+
+def test_a_figure_with_panels_shows_each_at_full_width_the_composite_folded(tmp_path, hook):
+    (tmp_path / "studies" / "fig5").mkdir(parents=True)
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    for f in ("fig5.png", "fig5_panel_a.png", "fig5_panel_b.png"):
+        (assets / "paper" / f).write_bytes(b"\x89PNG")
+    (assets / "fig5.png").write_bytes(b"\x89PNG")  # the quick scale: no panels, the composite
+    out, _ = _page(tmp_path, hook, "<!-- hh:study-figure fig5 -->\n")
+    head, folded = out.split("??? note", 1)
+    assert head.count('class="hh-figure"') == 2 and "](assets/paper/fig5_panel_a.png){ .hh-zoom }" in head
+    assert "(a) paper scale" in head and "(b) paper scale" in head and "assets/paper/fig5.png" not in head
+    assert '"The panels in one image (click to open)"' in folded and "](assets/paper/fig5.png){ .hh-zoom }" in folded
+    assert "](assets/fig5.png){ .hh-zoom }" in folded  # the quick scale below, folded too
+
+
+def test_generated_tables_refuse_an_edited_numbers_json(tmp_path, hook):
+    """The generated tables read a study's JSON as the number references do: one whose content no longer matches
+    the hash it was written with (a number edited by hand), or one never sealed, fails the build."""
+    from mkdocs.exceptions import PluginError
+
+    (tmp_path / "studies" / "fig2").mkdir(parents=True)
+    (tmp_path / "studies" / "fig2" / "study.toml").write_text("[scene]\nn = 10\n")
+    assets = tmp_path / "docs" / "studies" / "assets"
+    assets.mkdir(parents=True)
+    row = {"quantity": "a", "ours": 13.1, "err": 0.52, "paper": 13.63, "verdict": None, "note": ""}
+    doc = sealed({"study": "fig2", "scale": "quick", "a": 13.1, "paper_comparison": [row], "config": {}})
+    out, _ = _page(tmp_path, hook, "<!-- hh:study-numbers fig2 -->\n")
+    assert "13.1 ± 0.5" not in out  # nothing written yet: a note, not a table
+    (assets / "fig2.json").write_text(json.dumps(doc))
+    assert "| a | 13.1 ± 0.5 | 13.63 |" in _page(tmp_path, hook, "<!-- hh:study-numbers fig2 -->\n")[0]
+    edited = json.loads((assets / "fig2.json").read_text())
+    edited["paper_comparison"][0]["ours"] = 13.5
+    (assets / "fig2.json").write_text(json.dumps(edited))
+    with pytest.raises(PluginError, match="not as its study wrote it"):
+        _page(tmp_path, hook, "<!-- hh:study-numbers fig2 -->\n")
+    (assets / "fig2.json").write_text(json.dumps({k: v for k, v in doc.items() if k != "sha256"}))
+    with pytest.raises(PluginError, match="not as its study wrote it"):
+        _page(tmp_path, hook, "<!-- hh:study-numbers fig2 -->\n")
 
 
 def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
@@ -196,14 +238,14 @@ def test_claims_table_is_claims_by_systems_paper_scale_first(tmp_path, hook):
             ],
         }
 
-    (assets / "gx.json").write_text(json.dumps(doc("quick", 0.3)))
+    (assets / "gx.json").write_text(json.dumps(sealed(doc("quick", 0.3))))
     out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
     assert "| claim | quantity | hh (3 exits, E_c = 0.1667) | two (2 exits, E_c = 0.5) |" in out
     assert "| 1 | κ0 | 0.300 ± 0.012: agrees (z = +0.1) | n/a: undetermined: 97% trapped |" in out
     assert "| 3 | μ | — | 0.98: measured |" in out
     assert out.index("| 1 | κ0 |") < out.index("| 2 | κ_cm |") < out.index("| 3 | μ |")  # by claim
     assert "Scale **quick**" in out and "???" not in out
-    (assets / "paper" / "gx.json").write_text(json.dumps(doc("paper", 0.25)))
+    (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc("paper", 0.25))))
     out, _ = _page(tmp_path, hook, "<!-- hh:claims-table gx -->\n")
     first, folded = out.split("???", 1)
     assert "0.250 ± 0.012" in first and "Scale **paper**" in first and "0.300" not in first
@@ -475,7 +517,7 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
             }
         ],
     }
-    (assets / "paper" / "gx.json").write_text(json.dumps(doc))
+    (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
     assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out

@@ -42,6 +42,25 @@ def test_outside_its_generated_block_the_readme_types_no_undeclared_number():
     assert nb.stray_numbers(rest, allowed) == []
 
 
+def test_the_target_table_s_cpu_minutes_are_the_committed_cost_records():
+    """Each study row of the README's target table states the CPU minutes of its committed quick-scale cost record
+    (hhscatter.studies.cost.summary), to the table's one decimal; the `make studies` row their sum."""
+    import json
+
+    from hhscatter.studies.cost import summary
+
+    rows = re.findall(r"^\| `make (\w+)` \|[^\n]*\| ([0-9.]+) \|$", README.read_text(), flags=re.M)
+    studies = {p.parent.name for p in (ROOT / "studies").glob("*/study.toml")}
+    total = [float(v) for name, v in rows if name == "studies"]
+    rows = [(name, float(v)) for name, v in rows if name in studies]
+    assert {name for name, _ in rows} == studies  # a row per study folder
+    assets = ROOT / "docs" / "studies" / "assets"
+    minutes = {name: summary(json.loads((assets / f"{name}.cost.json").read_text()))["cpu_s"] / 60 for name in studies}
+    for name, stated in rows:
+        assert stated == round(minutes[name], 1), f"make {name}: README says {stated}, the record {minutes[name]:.2f}"
+    assert total == [round(sum(minutes.values()), 1)]  # make studies: all of them
+
+
 def test_the_readme_python_and_sql_run_as_printed(tmp_path):
     """The README's Python and DuckDB snippets, verbatim, on the demo runs' layout (a 400-orbit conservative and a
     300-orbit dissipative scene written where the snippets look: runs/demo/…)."""

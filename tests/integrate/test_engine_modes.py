@@ -30,10 +30,10 @@ def _run(scene, n=None, ics=None, **kw):
 # -- the declaration ------------------------------------------------------------
 
 
-def test_only_the_events_module_constructs_heyoka_events():
+def test_only_the_integrators_module_constructs_heyoka_events():
     pat = re.compile(r"\b(t_event|nt_event|t_event_batch|nt_event_batch)\(")
     users = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "hhscatter").rglob("*.py") if pat.search(p.read_text()))
-    assert users == ["hhscatter/integrate/events.py"]
+    assert users == ["hhscatter/integrate/integrators.py"]
 
 
 @pytest.mark.parametrize(

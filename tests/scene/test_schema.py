@@ -56,7 +56,7 @@ BAD_STUDY_FILES = [
     (
         "fig6",
         lambda t: t.replace("[snapshots]", "[snapshot]", 1),
-        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [scale], [scene], [sections], "
+        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [about], [follow], [needs], [noise], [scale], [scene], [sections], "
         "[snapshots], [study], [system]",
     ),
     (
@@ -134,7 +134,7 @@ BAD_SCENE_FILES = [
     ('[scene]\nenergy = "0.3"\nn = 40\n', "[scene] energy must be a number or a list of numbers, got '0.3'"),
     (
         "[scene]\nenergy = 0.3\nn = 40\n[snapshot]\nstart = 0\n",
-        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [scale], [scene], [sections], [snapshots], [system]",
+        "unknown table [snapshot] (did you mean 'snapshots'?); allowed tables: [follow], [noise], [scale], [scene], [sections], [snapshots], [system]",
     ),
     (
         "[scene]\nenergy = 0.3\nn = 40\n[snapshots]\nstart = 0\nstop = 10\n",

@@ -67,3 +67,28 @@ def test_basins_tiny_end_to_end(tiny_studies):
     assert {round(r["box_side"], 9) for r in recs if r["map"] == "map"} >= {0.083333333, 0.166666667}
     summ = nums["cutoff_summary"]
     assert summ["n_resolved"] == sum(1 for r in nums["cutoff_prediction"] if r["detected"])
+
+
+def test_subgrid_cells_are_cells_of_the_map_and_their_entropies_are_the_subsampled_maps():
+    """Every k-th cell from k // 2 (k odd) has the centre of the coarse grid's cell: (j + ½)·h·k = (k·j + k//2 + ½)·h.
+    The entropies at the fixed sides are those of that subsampled image; an even k (no common centres) and a
+    subgrid that does not divide the map give nothing."""
+    from types import SimpleNamespace
+
+    from hhscatter.analysis.geometry.basins import entropy_by_box
+    from hhscatter.studies.study import stage_module
+
+    mod = stage_module("basins")
+    n, k, ext = 60, 5, (-1.0, 1.0, -1.0, 1.0)
+    fine = (np.arange(n) + 0.5) * 2.0 / n - 1.0
+    coarse = (np.arange(n // k) + 0.5) * 2.0 / (n // k) - 1.0
+    assert np.allclose(fine[k // 2 :: k], coarse)
+    X, Y = np.meshgrid(fine, fine)
+    img = np.where(np.sin(7 * X) * np.cos(5 * Y) > 0, 0, 1).astype(np.int8)
+    img[X**2 + Y**2 > 0.95] = -1
+    study = SimpleNamespace(params=SimpleNamespace(box_sides=[1 / 3, 2 / 3], box_subgrids=[12, 15, 7]))
+    rows = mod._entropy_by_subgrid(study, img, 0.25, 0.0, ext)
+    want = entropy_by_box(img[2::5, 2::5], ext, [1 / 3, 2 / 3], outside=-1)
+    assert [r["map"] for r in rows] == ["every 5th cell"] * 2  # 15: k = 4 is even; 7 does not divide 60
+    assert [r["grid"] for r in rows] == [12, 12]
+    assert np.allclose([r["S_b"] for r in rows], want["S_b"]) and np.allclose([r["S_bb"] for r in rows], want["S_bb"])

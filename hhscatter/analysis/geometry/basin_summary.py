@@ -27,6 +27,7 @@ from hhscatter.analysis.geometry.uncertainty import (
 )
 
 __all__ = [
+    "entropy_by_box_at",
     "CODES",
     "CODE_NAMES",
     "OUTSIDE",
@@ -468,6 +469,22 @@ def entropy_exponents(records, min_cells: int = 5) -> list:
             }
         )
     return out
+
+
+def entropy_by_box_at(records, sides=(0.025, 0.05)) -> list:
+    """The rows of :func:`~hhscatter.analysis.geometry.basins.entropy_by_box` (with E0, gamma, map) at the box
+    ``sides`` (position units, matched to 1e-9), sorted by E0, γ, side and grid: the like-for-like table of the
+    page (the same physical box on every grid).
+
+    Examples
+    --------
+    >>> recs = [{"E0": 0.25, "gamma": 0.0, "map": m, "grid": n, "box_side": s, "S_b": 0.4}
+    ...         for m, n in (("map", 2000), ("scan", 400)) for s in (0.01, 0.025, 0.05)]
+    >>> [(r["grid"], r["box_side"]) for r in entropy_by_box_at(recs)]
+    [(400, 0.025), (2000, 0.025), (400, 0.05), (2000, 0.05)]
+    """
+    keep = [r for r in records if any(abs(r["box_side"] - s) < 1e-9 for s in sides)]
+    return sorted(keep, key=lambda r: (r["E0"], r["gamma"], r["box_side"], r["grid"]))
 
 
 def point_table(per) -> list:

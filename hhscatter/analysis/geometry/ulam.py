@@ -7,10 +7,8 @@ and turns their results into the records of an operator study:
 
 * :func:`sample_transitions` — the samples on boxes merged c × c, optionally the first M' per box, optionally
   on (box × energy bin) states;
-* :func:`saddle_kappa`, :func:`kappa_record` — κ on the chaotic saddle's class and its record;
-* :func:`kappa_convergence` — κ extrapolated to infinitely many samples per box and to box side 0, with the
-  statistical and model errors (see its notes);
-* :func:`residuals` — κ_Ulam/κ_ref − 1 with both errors and the one verdict;
+* :func:`saddle_kappa` — κ on the chaotic saddle's class (its records, convergence and extrapolation:
+  :mod:`hhscatter.analysis.geometry.ulam_convergence`);
 * :func:`leading_modes`, :func:`measure_points`, :func:`reduced_operator` — spectra, c-measure samples and the
   operator on ρ(E) alone;
 * :func:`empirical_survival`, :func:`survival_agreement`, :func:`t_star_energies`, :func:`cost_row` — the
@@ -31,10 +29,10 @@ from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import transfer as tf
 
 __all__ = [
+    "t_star_distance",
+    "dissipative_record",
+    "dissipative_operator",
     "coarse_index",
-    "convergence_grid",
-    "convergence_record",
-    "convergence_summary",
     "cost_row",
     "disk_density",
     "eigenvector_convergence",
@@ -43,14 +41,11 @@ __all__ = [
     "hellinger_by_box",
     "hellinger_row",
     "islands_record",
-    "kappa_convergence",
-    "kappa_record",
     "leading_modes",
     "measure_points",
     "one_return_samples",
     "operator_survival",
     "reduced_operator",
-    "residuals",
     "reduced_survival",
     "saddle_kappa",
     "stratified_section_points",
@@ -131,127 +126,6 @@ def saddle_kappa(tr):
         "closed_weight_share": float(sum(c.weight for c in closed) / W) if W > 0 else 0.0,
     }
     return kappa, tf.map_escape_rate(sub), info, keep, sub
-
-
-def kappa_record(E, res, samples, box):
-    """The record of κ at one energy from the results ``res`` of the finest partition.
-
-    ``res`` holds rows (κ per box side, ``vary`` = "box"), boot (bootstrap replicates), kappa, kappa_map,
-    info, sub, cost. κ on the finest boxes; the linear discretisation bias from a straight line κ(b) through
-    the three finest box sides (κ at b → 0); err = √(σ_boot² + bias²).
-    """
-    rows = pd.DataFrame([r for r in res["rows"] if r["vary"] == "box"]).sort_values("box")
-    fit = rows.head(3)
-    slope, k_inf = (
-        np.polyfit(fit["box"].to_numpy(), fit["kappa"].to_numpy(), 1) if len(fit) >= 2 else (0.0, res["kappa"])
-    )
-    boot = res["boot"]
-    stat = float(np.std(boot, ddof=1)) if boot.size > 1 else math.nan
-    bias = float(k_inf - res["kappa"])
-    return {
-        "energy": E,
-        "kappa": res["kappa"],
-        "err": float(math.hypot(stat, bias)),
-        "boxes": int(res["sub"].n_states),
-        "samples": samples,
-        "box": box,
-        "kappa_stat_err": stat,
-        "discretisation_bias": bias,
-        "kappa_extrapolated": float(k_inf),
-        "bias_slope": float(slope),
-        "kappa_map_per_return": res["kappa_map"],
-        "mean_return_time": res["cost"]["mean_return_time"],
-        "orbit_time": res["cost"]["orbit_time"],
-        "orbits": res["cost"]["orbits"],
-        "censored": res["cost"]["censored"],
-        **{f"class_{k}": v for k, v in res["info"].items()},
-    }
-
-
-def _fit_convergence(b, M, k, p):
-    """Least squares of κ = κ∞ + a·b + β·M^(−p): (κ∞, residual rms, design matrix, coefficients)."""
-    X = np.column_stack([np.ones_like(b), b, M ** (-p)])
-    coef, *_ = np.linalg.lstsq(X, k, rcond=None)
-    res = k - X @ coef
-    dof = max(len(k) - 3, 1)
-    return float(coef[0]), float(math.sqrt(np.sum(res**2) / dof)), X, coef
-
-
-def kappa_convergence(
-    grid: pd.DataFrame, boot_grid: pd.DataFrame | None = None, *, p_main: float = 0.5, p_alt: float = 1.0
-) -> dict:
-    """κ of Ulam's method extrapolated to infinitely many samples per box and to box side 0.
-
-    ``grid`` holds κ of one energy on a grid of partitions: columns box (side, position units), samples
-    (sample points per box, M) and kappa. Two effects move κ, and both are seen in the study: the box side b
-    (coarse boxes smear the hole's edges: κ(b) = κ∞ + a·b to first order) and the samples per box M (the
-    flux weights |ṗ_r|/v are heavy-tailed — 1/v at V = E — and the Perron root of a matrix estimated from M
-    samples per row is biased, falling as M grows). The model κ(b, M) = κ∞ + a·b + β·M^(−p) is fitted by
-    least squares with p = ``p_main`` (½, the decay of the bias of a ratio estimator with heavy-tailed
-    weights that the study's grids show) and, as the model systematic, with p = ``p_alt`` (1, the decay of a
-    finite-variance ratio estimator's bias): κ∞ is the first fit, its model error the difference of the two.
-
-    ``boot_grid`` (optional) holds bootstrap replicates on the same grid (columns rep, box, samples, kappa):
-    each replicate is extrapolated with the same design and their spread is the statistical error of κ∞.
-
-    Returns {kappa_inf, stat_err, model_err, err (the two in quadrature), kappa_inf_alt, slope_box,
-    coef_samples, p, p_alt, residual_rms, n_points}.
-
-    Examples
-    --------
-    >>> b, M = np.meshgrid([0.01, 0.02, 0.04], [4.0, 16.0, 64.0])
-    >>> g = pd.DataFrame({"box": b.ravel(), "samples": M.ravel() * (b.ravel() / 0.01) ** 2})
-    >>> g["kappa"] = 0.2 + 0.3 * g.box + 0.05 / np.sqrt(g.samples)
-    >>> round(kappa_convergence(g)["kappa_inf"], 10)
-    0.2
-    """
-    g = grid.dropna(subset=["kappa"])
-    if len(g) < 4 or g["box"].nunique() < 2 or g["samples"].nunique() < 2:
-        raise ValueError("kappa_convergence: need ≥ 4 partitions with ≥ 2 box sides and ≥ 2 sample counts")
-    b, M, k = (g[c].to_numpy(dtype=float) for c in ("box", "samples", "kappa"))
-    k_inf, rms, X, coef = _fit_convergence(b, M, k, p_main)
-    k_alt, _, _, _ = _fit_convergence(b, M, k, p_alt)
-    stat = math.nan
-    if boot_grid is not None and len(boot_grid):
-        reps = []
-        for _, part in boot_grid.groupby("rep"):
-            pt = part.set_index(["box", "samples"]).reindex(list(zip(b, M)))["kappa"].to_numpy(dtype=float)
-            if np.all(np.isfinite(pt)):
-                reps.append(np.linalg.lstsq(X, pt, rcond=None)[0][0])
-        if len(reps) > 1:
-            stat = float(np.std(reps, ddof=1))
-    model = abs(k_alt - k_inf)
-    err = math.hypot(stat, model) if math.isfinite(stat) else math.nan
-    return {
-        "kappa_inf": k_inf,
-        "stat_err": stat,
-        "model_err": model,
-        "err": err,
-        "kappa_inf_alt": k_alt,
-        "slope_box": float(coef[1]),
-        "coef_samples": float(coef[2]),
-        "p": p_main,
-        "p_alt": p_alt,
-        "residual_rms": rms,
-        "n_points": int(len(g)),
-    }
-
-
-def residuals(value, err, ref, ref_err) -> dict:
-    """κ/κ_ref − 1 with both errors, and z = (κ − κ_ref)/√(σ² + σ_ref²).
-
-    Examples
-    --------
-    >>> r = residuals(0.102, 0.003, 0.1, 0.004)
-    >>> round(r["residual"], 6), round(r["residual_err"], 6), round(r["z"], 6)
-    (0.02, 0.050642, 0.4)
-    """
-    value, err, ref, ref_err = (float(v) for v in (value, err, ref, ref_err))
-    res = value / ref - 1.0
-    # the ratio's error from both: σ_r/r in quadrature, r = κ/κ_ref
-    res_err = (value / ref) * math.hypot(err / value, ref_err / ref)
-    sig = math.hypot(err, ref_err)
-    return {"residual": res, "residual_err": res_err, "z": (value - ref) / sig if sig > 0 else math.inf}
 
 
 def leading_modes(sub, trapped_sub, k: int = 4):
@@ -449,36 +323,6 @@ def cost_row(E, pt, rec, kappa0, target):
     return row
 
 
-def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
-    """The record of κ's convergence at energy E: :func:`kappa_convergence` of ``grid`` (with ``boot_grid``)
-    and, for each reference in ``refs`` ({name: (κ_ref, err) or None}), :func:`residuals` of κ∞ against it
-    (keys residual_<name>, residual_<name>_err, z_<name>). A grid too small for the fit gives kappa_inf None
-    and the reason in ``note``."""
-    rec = {"energy": float(E), "kappa_finest": float(kappa_finest)}
-    try:
-        c = kappa_convergence(grid, boot_grid)
-    except ValueError as exc:
-        rec.update(kappa_inf=None, err=None, note=str(exc))
-        return rec
-    rec.update(c)
-    for name, ref in refs.items():
-        if ref is None or c["err"] is None or not math.isfinite(c["err"]):
-            continue
-        r = residuals(c["kappa_inf"], c["err"], ref[0], ref[1])
-        rec.update(
-            {
-                f"{name}": ref[0],
-                f"{name}_err": ref[1],
-                f"residual_{name}": r["residual"],
-                f"residual_{name}_err": r["residual_err"],
-                f"z_{name}": r["z"],
-            }
-        )
-        rf = residuals(kappa_finest, 0.0, ref[0], ref[1])  # the finest partition's offset, for the page
-        rec[f"residual_finest_{name}"] = rf["residual"]
-    return rec
-
-
 def hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head):
     """Debiased Hellinger distance between point sets P and Q over box sizes
     (:func:`~hhscatter.analysis.geometry.distance.distance_vs_scale`): (table with hellinger_debiased, lo, hi;
@@ -511,35 +355,6 @@ def operator_survival(tr, t, n0, dt, steps, k_star, max_lag):
     wfc = tf.first_crossing_weights(cross, tr, dt, k_star)
     pred = pd.DataFrame({"x": t["x1"].to_numpy(), "y": t["y1"].to_numpy(), "energy": t["e1"].to_numpy(), "w": wfc})
     return tf.survival_from_crossings(cross, H), pred[pred["w"] > 0].reset_index(drop=True)
-
-
-def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
-    """κ of one energy on the grid of box sides × sample counts, and its Poisson-bootstrap replicates.
-
-    The partitions: the finest boxes (side ``box``) merged c × c for c in ``coarsen`` × the first M' ranks of
-    each finest box for M' in ``subsets`` (``samples`` = all of them); M'·c² samples per merged box. Each of the
-    ``n_boot`` replicates multiplies every sample's weight by one Poisson(1) count, the same at every
-    partition, so that a replicate's grid can be extrapolated like the estimate's
-    (:func:`kappa_convergence`). Returns (grid: box, samples, kappa; replicates: rep, box, samples, kappa —
-    NaN where a replicate leaves no open class).
-    """
-    parts = [(int(c), int(m)) for c in coarsen for m in subsets]
-    trs = {(c, m): sample_transitions(tab, extent, box, c=c, m_max=None if m == samples else m)[0] for c, m in parts}
-    grid = pd.DataFrame([{"box": box * c, "samples": m * c * c, "kappa": saddle_kappa(trs[c, m])[0]} for c, m in parts])
-    gen = np.random.default_rng(rng)
-    rank = tab["rank"].to_numpy()[~tab["censored"].to_numpy()]  # the samples sample_transitions keeps, in order
-    reps = []
-    for r in range(int(n_boot)):
-        pois = gen.poisson(1.0, rank.size)
-        for c, m in parts:
-            tr = trs[c, m]
-            rep = tf.Transitions(tr.src, tr.dst, tr.T, tr.n_states, tr.w * (pois if m == samples else pois[rank < m]))
-            try:
-                kap = saddle_kappa(rep)[0]
-            except ValueError:
-                kap = math.nan
-            reps.append({"rep": r, "box": box * c, "samples": m * c * c, "kappa": kap})
-    return grid, pd.DataFrame(reps, columns=["rep", "box", "samples", "kappa"])
 
 
 def stratified_section_points(model, energy, extent, box, k, r_esc, rng, *, e_width=0.0) -> pd.DataFrame:
@@ -669,35 +484,81 @@ def islands_record(trapped_cells, tr, ids, keep, sub):
     return out
 
 
-def convergence_summary(records, *, z_agree: float = 2.0) -> dict:
-    """How the extrapolated κ∞ of :func:`convergence_record` compares with the references, in words and numbers.
+def dissipative_operator(tab, extent, box, edges, *, dt, t_horizon, t_star, max_return_time, radius) -> dict:
+    """The operator on (box × energy bin) from the one-return samples ``tab`` of a run with drag.
 
-    For each reference (kappa0, kappa_cm): the energies where |z| ≤ ``z_agree`` (both errors), the largest
-    |κ∞/κ_ref − 1| and the mean residual; ``statement`` says it in one sentence per reference.
-
-    Examples
-    --------
-    >>> recs = [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]
-    >>> convergence_summary(recs)["kappa0"]["agree"]
-    [0.3]
+    States: boxes of side ``box`` × the energy bins ``edges`` (``tab`` has a column ``ebin``). The initial
+    density is uniform in the disk r < ``radius`` in the top bin (:func:`disk_density`); it is carried
+    forward in steps ``dt`` up to ``t_horizon`` (returns longer than ``max_return_time`` arrive then):
+    P(t) of the full operator and of the operator on ρ(E) alone (:func:`reduced_survival`), and the weighted
+    image points of the first crossing after ``t_star`` (:func:`operator_survival`). Returns {tab, tr, ids,
+    t, n_cells, lost (share of the disk on no state), max_lag, steps, grid (times), P, P_reduced,
+    kappa_bins, pred}.
     """
-    out, words = {}, []
-    names = {"kappa0": "fig2's κ0 from P(t)", "kappa_cm": "fig2's κ from long-run crossings"}
-    for ref, label in names.items():
-        rs = [r for r in records if r.get("kappa_inf") is not None and r.get(f"z_{ref}") is not None]
-        if not rs:
-            continue
-        agree = [r["energy"] for r in rs if abs(r[f"z_{ref}"]) <= z_agree]
-        res = np.array([r[f"residual_{ref}"] for r in rs])
-        out[ref] = {
-            "energies": [r["energy"] for r in rs],
-            "agree": agree,
-            "max_abs_residual": float(np.max(np.abs(res))),
-            "mean_residual": float(res.mean()),
-        }
-        words.append(
-            f"against {label}, κ∞ agrees within {z_agree:g}σ (both errors) at {len(agree)} of {len(rs)} "
-            f"energies; |κ∞/κ_ref − 1| ≤ {100 * np.max(np.abs(res)):.2g} %, mean {100 * res.mean():+.2g} %"
-        )
-    out["statement"] = "; ".join(words) if words else "no reference to compare with"
-    return out
+    n_bins = len(edges) - 1
+    steps, k_star, max_lag = (int(round(v / dt)) for v in (t_horizon, t_star, max_return_time))
+    tr, ids, t = sample_transitions(tab, extent, box, ebins=edges)
+    nx, _ = grid_shape(extent, box)
+    n_cells = nx * nx
+    n0, lost = disk_density(radius, extent, box, ids, n_cells, n_bins - 1)
+    P_op, pred = operator_survival(tr, t, n0, dt, steps, k_star, max_lag)
+    P_red, kappa_bins = reduced_survival(tr, t, ids, n_cells, n_bins, dt, max_lag, steps)
+    return {
+        "tab": tab,
+        "tr": tr,
+        "ids": ids,
+        "t": t,
+        "n_cells": n_cells,
+        "lost": lost,
+        "max_lag": max_lag,
+        "steps": steps,
+        "grid": np.arange(steps + 1) * dt,
+        "P": P_op,
+        "P_reduced": P_red,
+        "kappa_bins": kappa_bins,
+        "pred": pred,
+    }
+
+
+def t_star_distance(pred, sim_points, boxes, extent, n_splits, seed, head):
+    """Debiased Hellinger distance over box sizes (:func:`hellinger_by_box`) between the operator's points of
+    the first crossing after t* (``pred``: x, y, w; drawn by weight, as many as ``sim_points``, seeded by
+    seed + 9) and the simulated ones (an (n, 2) array): (table, index of the box nearest ``head``)."""
+    rng = np.random.default_rng(seed + 9)
+    draw = pred.iloc[rng.choice(len(pred), size=max(len(sim_points), 4), p=pred["w"] / pred["w"].sum())]
+    return hellinger_by_box(draw[["x", "y"]].to_numpy(), sim_points, boxes, extent, n_splits, seed, head)
+
+
+def dissipative_record(op, edges, P_sim, N, sim_pts, sim_orbit_time, dtab, j, *, energy, gamma, dt, t_star) -> dict:
+    """The numbers of the dissipative comparison: the operator ``op`` (:func:`dissipative_operator`) on the
+    energy bins ``edges`` against the simulated ensemble of ``N`` orbits (P_sim on op's grid, its first
+    crossings after t* ``sim_pts`` with x, y, energy, its orbit-time): :func:`survival_agreement`,
+    :func:`t_star_energies` and the t* distance table ``dtab`` at row ``j`` (:func:`t_star_distance`), with
+    (energy, gamma) of the ensemble, the step ``dt`` and ``t_star``."""
+    return {
+        "energy": energy,
+        "gamma": gamma,
+        "t_star": t_star,
+        "dt": dt,
+        "energy_bins": [float(e) for e in edges],
+        "states": int(op["tr"].n_states),
+        "samples": int(len(op["tab"])),
+        "initial_mass_lost": op["lost"],
+        "returns_capped_share": tf.capped_share(op["tr"], dt, op["max_lag"]),
+        "max_return_time": op["max_lag"] * dt,
+        "operator_orbit_time": float(op["tab"]["t_end"].sum()),
+        "sim_orbits": int(N),
+        "sim_orbit_time": float(sim_orbit_time),
+        **survival_agreement(op["grid"], dt, t_star, P_sim, op["P"], op["P_reduced"], N),
+        **t_star_energies(op["pred"], sim_pts),
+        "t_star_hellinger_debiased": {
+            "box": float(dtab["box"].iloc[j]),
+            "value": float(dtab.hellinger_debiased.iloc[j]),
+            "lo": float(dtab.lo.iloc[j]),
+            "hi": float(dtab.hi.iloc[j]),
+            "noise": float(dtab["hellinger_noise"].iloc[j]),
+        },
+        "kappa_bins": [
+            {"energy": float(0.5 * (edges[a] + edges[a + 1])), "kappa": kb} for a, kb in enumerate(op["kappa_bins"])
+        ],
+    }

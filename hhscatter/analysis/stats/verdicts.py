@@ -26,6 +26,8 @@ RULE = (
 )
 #: scales whose outputs are smoke tests: their rows carry no verdict
 SMOKE_SCALES = ("tiny",)
+#: what a smoke-scale output states in place of a verdict
+NO_VERDICT = "no verdict (tiny scale: a smoke test)"
 
 
 @dataclass(frozen=True)
@@ -93,7 +95,7 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     'no verdict (tiny scale: a smoke test)'
     """
     if scale in SMOKE_SCALES:
-        return "no verdict (tiny scale: a smoke test)"
+        return NO_VERDICT
     ours, paper = row.get("ours"), row.get("paper")
     stored = str(row.get("verdict") or "")
     numeric = (
@@ -113,6 +115,33 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     if v.word == "differs" and stored.startswith("differs") and ";" in stored:
         return f"{v.text()}; {stored.split(';', 1)[1].strip()}"
     return v.text()
+
+
+def without_verdicts(doc, scale: str | None):
+    """without_verdicts(doc, scale) -> ``doc`` with every ``"verdict"`` value stated as :data:`NO_VERDICT` at a
+    smoke scale (:data:`SMOKE_SCALES`); ``doc`` itself (unchanged) at any other scale.
+
+    The values, errors and references stay: a smoke test shows that the pipeline runs and what it
+    measured, not whether a few hundred orbits agree with the paper.
+
+    Examples
+    --------
+    >>> without_verdicts({"rows": [{"ours": 1.0, "verdict": "agrees (z = +0.3)"}]}, "tiny")
+    {'rows': [{'ours': 1.0, 'verdict': 'no verdict (tiny scale: a smoke test)'}]}
+    >>> without_verdicts({"verdict": "differs"}, "quick")
+    {'verdict': 'differs'}
+    """
+    if scale not in SMOKE_SCALES:
+        return doc
+
+    def strip(o):
+        if isinstance(o, dict):
+            return {k: NO_VERDICT if k == "verdict" else strip(v) for k, v in o.items()}
+        if isinstance(o, list):
+            return [strip(v) for v in o]
+        return o
+
+    return strip(doc)
 
 
 def half_unit(printed: float) -> float:

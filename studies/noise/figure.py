@@ -1,0 +1,83 @@
+"""Figure of the noise study (draws the derived tables and noise.json; computes nothing)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hhscatter.publish.figures import agg_pyplot
+
+COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
+
+
+def _panel_arrhenius(ax, k):
+    """(a) rate against ΔE/T at one γ: measured and Kramers–Langer (log scale), ratio in an inset."""
+    ax.errorbar(k.barrier_over_T, k.rate, k.rate_err, fmt="o", color=COLORS[1], ms=4, capsize=2, label="measured")
+    b = np.linspace(k.barrier_over_T.min() - 0.3, k.barrier_over_T.max() + 0.3, 50)
+    # Kramers–Langer ∝ e^{−ΔE/T}: its prefactor from the records (the same at every T for fixed γ)
+    pref = float((k.kramers_langer * np.exp(k.barrier_over_T)).iloc[0])
+    ax.plot(b, pref * np.exp(-b), "-", color="k", lw=1, label="Kramers–Langer")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"barrier $\Delta E/T$")
+    ax.set_ylabel(r"escape rate $k$")
+    ax.set_title(rf"(a) heat bath, $\gamma$ = {k.gamma.iloc[0]:g}", fontsize=10)
+    ax.legend(fontsize=8, loc="lower left")
+    ins = ax.inset_axes([0.58, 0.62, 0.38, 0.33])
+    ins.errorbar(k.barrier_over_T, k.ratio, k.ratio_err, fmt="o", color=COLORS[1], ms=3, capsize=2)
+    ins.axhline(1.0, color="k", lw=0.8)
+    ins.set_ylabel(r"$k/k_{KL}$", fontsize=7)
+    ins.tick_params(labelsize=7)
+
+
+def _panel_turnover(ax, t):
+    """(b) rate against γ at fixed T: measured and Kramers–Langer (the spatial-diffusion branch)."""
+    t = t.sort_values("gamma")
+    ax.errorbar(t.gamma, t.rate, t.rate_err, fmt="o", color=COLORS[2], ms=4, capsize=2, label="measured")
+    ax.plot(t.gamma, t.kramers_langer, "-", color="k", lw=1, label="Kramers–Langer")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"drag $\gamma$")
+    ax.set_ylabel(r"escape rate $k$")
+    ax.set_title(rf"(b) turnover, $\Delta E/T$ = {t.barrier_over_T.iloc[0]:.3g}", fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
+
+
+def _panel_reactivation(ax, r, num):
+    """(c) the paper's P(t) with drag, without and with temperature, and the re-activation extension."""
+    ax.plot(r.t, r.P_0, "-", color="0.5", lw=1.2, label="T = 0: $P(t)$ (settled leave)")
+    ax.plot(r.t, r.P_0_settled_inside, "--", color="0.5", lw=1, label="T = 0: settled counted inside")
+    ax.plot(r.t, r.P_T, "-", color=COLORS[0], lw=1.5, label=f"T = {num['temperature']:.3g}")
+    ax.plot(r.t, r.model, ":", color="k", lw=1.5, label="re-activation at the thermal rate")
+    ax.set_yscale("log")
+    ax.set_ylim(max(1e-3, float(np.nanmin(r.P_T[r.P_T > 0])) / 2), 1.05)
+    ax.set_xlabel("t")
+    ax.set_ylabel("P(t)")
+    ax.set_title(rf"(c) $E_0$ = {num['energy']:g}, $\gamma$ = {num['gamma']:g}", fontsize=10)
+    ax.legend(fontsize=7, loc="lower left")
+
+
+def _panel_no_drag(ax, nd):
+    """(d) P(t) without drag for each noise strength σ (σ = 0: the conservative κ0)."""
+    styles = ("-", "--")
+    for i, (E, g) in enumerate(nd.groupby("energy")):
+        for j, (s, h) in enumerate(g.groupby("sigma")):
+            lab = f"E = {E:.2f}, σ = {s:g}"
+            ax.plot(h.t, h.P, styles[i % 2], color=COLORS[j % len(COLORS)], lw=1.2, label=lab)
+    ax.set_yscale("log")
+    ax.set_xlabel("t")
+    ax.set_ylabel("P(t)")
+    ax.set_title(r"(d) noise without drag", fontsize=10)
+    ax.legend(fontsize=6.5, loc="upper right", ncol=2)
+
+
+def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
+    """plot_noise(...) -> None: the study's four panels in ``path``."""
+    plt = agg_pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(10, 8))
+    _panel_arrhenius(axes[0, 0], rates[rates.set == "kramers"].sort_values("barrier_over_T"))
+    _panel_turnover(axes[0, 1], rates[rates.set == "turnover"])
+    _panel_reactivation(axes[1, 0], reactivation, numbers["reactivation"])
+    _panel_no_drag(axes[1, 1], no_drag)
+    fig.suptitle(f"Hénon–Heiles in a heat bath and with noise ({scale} scale)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)

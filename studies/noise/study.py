@@ -1,0 +1,305 @@
+"""Study noise — thermal and noisy scattering in Hénon–Heiles (beyond the paper).
+
+Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
+
+``simulate(study, workers=None, progress=True)``
+    Engine runs with a scene ``[noise]`` (:class:`hhscatter.scene.scene.Noise`; the noise scheduler of
+    :mod:`hhscatter.integrate.noise`), orbits uniform in the disk r < radius, r_esc = 1.5:
+
+    * ``kramers_b<b>``: γ = gamma_kramers, T = ΔE/b for each barrier b of ``barriers``, orbits started in the
+      well at E0 = well_energy < E_c, t_max from ``kramers_t_max``;
+    * ``turnover_g<γ>``: T = ΔE/turnover_barrier for each γ of ``turnover_gammas``;
+    * ``react_T0`` and ``react_T``: the paper's dissipative ensemble (E0 = react_energy, γ = react_gamma) without
+      and with the heat bath T = ΔE/react_barrier; ``react_well``: the thermal rate at that (γ, T) from the well;
+    * ``nodrag_E<E>_s<σ>``: γ = 0, noise strength σ (σ = 0: the conservative κ0) at each E0 of nodrag_energies.
+
+``analyze(study)``
+    Rates by the constant-hazard MLE on [t_relax, t_max] (:func:`hhscatter.analysis.noise.thermal_rate`,
+    left-truncated and right-censored) against Kramers–Langer (:func:`hhscatter.analysis.noise.kramers_langer`,
+    saddles and Hessians from the system); P(t) of the heat-bath ensemble against the drag-only one extended
+    by re-activation (:func:`hhscatter.analysis.noise.reactivation_survival`); the no-drag rates on
+    ``nodrag_window`` against κ0. Writes ``noise.json`` (keys ``kramers``, ``turnover``, ``reactivation``,
+    ``no_drag``) and the derived tables ``rates.parquet``, ``survival.parquet``.
+
+``plot(study)``
+    ``noise.png`` via ``plot_noise`` of the folder's ``figure.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/noise/study.toml."""
+
+    well_energy: Number  # E0 of the orbits started in the well
+    t_relax: Number  # rate window [t_relax, t_max]
+    gamma_kramers: Number
+    barriers: Numbers  # ΔE/T
+    kramers_t_max: Numbers
+    turnover_barrier: Number
+    turnover_gammas: Numbers
+    turnover_t_max: Numbers
+    turnover_n: Integer
+    react_energy: Number
+    react_gamma: Number
+    react_barrier: Number
+    react_n: Integer
+    react_t_max: Number
+    react_tail_start: Number  # start of the tail window of P_T(t)
+    nodrag_energies: Numbers
+    nodrag_sigmas: Numbers
+    nodrag_n: Integer
+    nodrag_t_max: Number
+    nodrag_window: Numbers
+
+
+def _barrier(study) -> float:
+    """ΔE = E_c − V(min) of the system (energy units): the lowest saddle above the well's minimum."""
+    m = study.model
+    return m.critical_energy - float(m.potential(np.array(0.0), np.array(0.0)))
+
+
+def _pairs(study, a, b):
+    p = study.params
+    xs, ys = getattr(p, a), getattr(p, b)
+    if len(xs) != len(ys):
+        raise ValueError(f"[study] {a} and {b} must have the same length, got {len(xs)} and {len(ys)}")
+    return list(zip(xs, ys))
+
+
+def _runs(study):
+    """{key: scene} of every raw run (module docstring)."""
+    p, dE = study.params, _barrier(study)
+    runs = {}
+    for b, t_max in _pairs(study, "barriers", "kramers_t_max"):
+        runs[f"kramers_b{b:g}"] = dict(
+            energy=p.well_energy, gamma=p.gamma_kramers, t_max=t_max, noise={"temperature": dE / b}
+        )
+    for g, t_max in _pairs(study, "turnover_gammas", "turnover_t_max"):
+        runs[f"turnover_g{g:g}"] = dict(
+            energy=p.well_energy,
+            gamma=g,
+            t_max=t_max,
+            n=p.turnover_n,
+            noise={"temperature": dE / p.turnover_barrier},
+        )
+    react = dict(energy=p.react_energy, gamma=p.react_gamma, t_max=p.react_t_max, n=p.react_n)
+    runs["react_T0"] = react
+    runs["react_T"] = dict(react, noise={"temperature": dE / p.react_barrier})
+    runs["react_well"] = dict(react, energy=p.well_energy, noise={"temperature": dE / p.react_barrier})
+    for E in p.nodrag_energies:
+        for s in p.nodrag_sigmas:
+            runs[f"nodrag_E{E:.2f}_s{s:g}"] = dict(
+                energy=E, gamma=0.0, t_max=p.nodrag_t_max, n=p.nodrag_n, noise={"sigma": s} if s > 0 else None
+            )
+    return {k: study.scene(k, **kw) for k, kw in runs.items()}
+
+
+def simulate(study, workers=None, progress=True):
+    """simulate(study, workers=None, progress=True) -> None: every raw run of :func:`_runs`."""
+    for key, scene in _runs(study).items():
+        study.run(key, scene, workers=workers, progress=progress)
+
+
+# -- analyze ----------------------------------------------------------------
+def _lifetimes(study, key):
+    """(t_end, escaped, settled) arrays of raw run ``key``, in orbit order."""
+    from hhscatter.data.read import read_by_orbit
+
+    c = read_by_orbit(study.raw(key), ["outcome", "t_end"])
+    o = np.asarray(c["outcome"].astype(str))
+    return c["t_end"], o == "escaped", o == "settled"
+
+
+def _rate_row(study, key, scene, t_start):
+    from hhscatter.analysis.noise import kramers_langer, thermal_rate
+
+    t_end, escaped, _ = _lifetimes(study, key)
+    r = thermal_rate(t_end, escaped, t_start, scene.t_max)
+    T = scene.noise.temperature
+    kl = kramers_langer(scene.model, scene.gamma, T)
+    return {
+        "gamma": scene.gamma,
+        "temperature": T,
+        "barrier_over_T": kl.barrier_over_T,
+        "rate": r.rate,
+        "rate_err": r.rate_err,
+        "kramers_langer": kl.rate,
+        "ratio": r.rate / kl.rate,
+        "ratio_err": r.rate_err / kl.rate,
+        "n_events": r.n_events,
+        "n": scene.n,
+        "window": [t_start, scene.t_max],
+        "rate_first_half": r.halves[0][0],
+        "rate_second_half": r.halves[1][0],
+    }
+
+
+def _reactivation(study, runs):
+    """P(t) with and without the heat bath, the extension's prediction, and their numbers."""
+    from hhscatter.analysis.noise import reactivation_survival, thermal_rate
+    from hhscatter.analysis.survival.kaplan_meier import survival_curve
+
+    p = study.params
+    t0, esc0, set0 = _lifetimes(study, "react_T0")
+    tT, escT, _ = _lifetimes(study, "react_T")
+    tw, escw, _ = _lifetimes(study, "react_well")
+    sc = runs["react_T"]
+    k_well = thermal_rate(tw, escw, p.t_relax, sc.t_max)
+    cens0 = ~(esc0 | set0)
+    t_hi = min(sc.t_max, float(t0[cens0].min()) if cens0.any() else sc.t_max)
+    grid = np.linspace(0.0, t_hi, 401)
+    P_T = survival_curve(tT, escT, grid)
+    P_0 = survival_curve(t0, esc0 | set0, grid)  # drag only: leaving = escaped or settled
+    # drag only, settled orbits counted inside for ever: 1 − (escapes up to t)/N (t ≤ the earliest censoring)
+    settled_alive = 1.0 - np.searchsorted(np.sort(t0[esc0]), grid, side="right") / len(t0)
+    model = reactivation_survival(grid, t0, esc0, set0, k_well.rate)
+    # the tail of P_T: the MLE rate on [react_tail_start, t_max], after the drag-only orbits have settled (their
+    # 99 % settling time is recorded beside it) and relaxed
+    t_settled = float(np.quantile(t0[set0], 0.99)) if set0.any() else 0.0
+    if p.react_tail_start < t_settled:
+        raise ValueError(f"[study] react_tail_start = {p.react_tail_start:g} is before the T = 0 orbits have settled")
+    tail = thermal_rate(tT, escT, p.react_tail_start, sc.t_max)
+    dev = np.abs(P_T.P - model)
+    ok = np.isfinite(dev)
+    i = int(np.nanargmax(np.where(ok, dev, -1)))
+    table = pd.DataFrame(
+        {
+            "t": grid,
+            "P_T": P_T.P,
+            "P_T_err": P_T.P_err,
+            "P_0": P_0.P,
+            "P_0_settled_inside": settled_alive,
+            "model": model,
+        }
+    )
+    numbers = {
+        "energy": p.react_energy,
+        "gamma": sc.gamma,
+        "temperature": sc.noise.temperature,
+        "barrier_over_T": p.react_barrier,
+        "n": sc.n,
+        "settled_fraction_T0": float(set0.mean()),
+        "escaped_fraction_T0": float(esc0.mean()),
+        "t_settled_99": t_settled,
+        "tail_window": [p.react_tail_start, sc.t_max],
+        "tail_rate": {"value": tail.rate, "err": tail.rate_err},
+        "thermal_rate": {"value": k_well.rate, "err": k_well.rate_err},
+        "tail_over_thermal": {
+            "value": tail.rate / k_well.rate,
+            "err": tail.rate / k_well.rate * math.hypot(tail.rate_err / tail.rate, k_well.rate_err / k_well.rate),
+        },
+        "model_max_deviation": float(dev[i]),
+        "model_max_deviation_at": float(grid[i]),
+        "model_max_deviation_sigma": float(dev[i] / P_T.P_err[i]) if P_T.P_err[i] > 0 else math.inf,
+    }
+    return numbers, table
+
+
+def _no_drag(study, runs):
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+
+    p = study.params
+    lo, hi = p.nodrag_window
+    rows = []
+    for E in p.nodrag_energies:
+        base = None
+        for s in p.nodrag_sigmas:
+            t_end, esc, _ = _lifetimes(study, f"nodrag_E{E:.2f}_s{s:g}")
+            m = escape_rate_mle(t_end, esc, lo, hi)
+            if s == 0:
+                base = m
+            row = {"energy": E, "sigma": s, "kappa": m.kappa, "kappa_err": m.kappa_err, "n_events": m.n_events}
+            if base is not None:
+                r = m.kappa / base.kappa
+                row["kappa_over_kappa0"] = r
+                row["kappa_over_kappa0_err"] = r * math.hypot(m.kappa_err / m.kappa, base.kappa_err / base.kappa)
+                # energy gained by diffusion over the window: ⟨E⟩ grows by σ² t (two degrees of freedom)
+                row["energy_gain_at_window_end"] = s * s * hi
+            rows.append(row)
+    return rows
+
+
+def _survival_tables(study, runs):
+    """P(t) of every no-drag run on a common grid (the figure's panel)."""
+    from hhscatter.analysis.survival.kaplan_meier import survival_curve
+
+    p = study.params
+    grid = np.linspace(0.0, p.nodrag_t_max, 301)
+    frames = []
+    for E in p.nodrag_energies:
+        for s in p.nodrag_sigmas:
+            t_end, esc, _ = _lifetimes(study, f"nodrag_E{E:.2f}_s{s:g}")
+            c = survival_curve(t_end, esc, grid)
+            frames.append(pd.DataFrame({"energy": E, "sigma": s, "t": grid, "P": c.P, "P_err": c.P_err}))
+    return pd.concat(frames, ignore_index=True)
+
+
+def analyze(study):
+    """analyze(study) -> None: rates against Kramers–Langer, the heat-bath P(t), the no-drag rates; noise.json."""
+    p = study.params
+    runs = _runs(study)
+    kramers = [
+        _rate_row(study, f"kramers_b{b:g}", runs[f"kramers_b{b:g}"], p.t_relax)
+        for b, _ in _pairs(study, "barriers", "kramers_t_max")
+    ]
+    turnover = [
+        _rate_row(study, f"turnover_g{g:g}", runs[f"turnover_g{g:g}"], p.t_relax)
+        for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max")
+    ]
+    react, react_table = _reactivation(study, runs)
+    no_drag = _no_drag(study, runs)
+    rates = pd.DataFrame([{"set": "kramers", **r} for r in kramers] + [{"set": "turnover", **r} for r in turnover])
+    rates["window"] = rates["window"].map(lambda w: float(w[1]))
+    study.write_table(rates.rename(columns={"window": "t_max"}), "rates.parquet")
+    study.write_table(react_table, "reactivation.parquet")
+    study.write_table(_survival_tables(study, runs), "no_drag.parquet")
+    study.write_table(pd.DataFrame(no_drag), "no_drag_rates.parquet")
+    hi = kramers[-1]
+    study.compare(
+        f"escape rate / Kramers–Langer at ΔE/T = {hi['barrier_over_T']:.3g}, γ = {hi['gamma']:g}",
+        hi["ratio"],
+        hi["ratio_err"],
+        1.0,
+        note="Kramers–Langer is the large-barrier limit; the ratio should tend to 1 as ΔE/T grows",
+        convention="disk r < 0.5 at E0 = well_energy, rate window [t_relax, t_max], r_esc 1.5",
+    )
+    study.write_numbers(
+        {
+            "kramers": kramers,
+            "turnover": turnover,
+            "reactivation": react,
+            "no_drag": no_drag,
+            "conventions": {
+                "r_esc": runs["react_T"].r_esc,
+                "ic_region": "disk r < 0.5",
+                "rate": "constant-hazard MLE on [t_relax, t_max], left-truncated, right-censored",
+                "t_relax": p.t_relax,
+                "nodrag_window": list(p.nodrag_window),
+                "kick": "0.1 min(1/ω, 1/γ) (the scene default)",
+            },
+        }
+    )
+
+
+# -- plot -------------------------------------------------------------------
+def plot(study):
+    """plot(study) -> None: noise.png from the derived tables and noise.json."""
+    from .figure import plot_noise
+
+    d = study.out / "derived"
+    plot_noise(
+        rates=pd.read_parquet(d / "rates.parquet"),
+        reactivation=pd.read_parquet(d / "reactivation.parquet"),
+        no_drag=pd.read_parquet(d / "no_drag.parquet"),
+        numbers=study.read_numbers(),
+        path=study.figure_path,
+        scale=study.scale,
+    )

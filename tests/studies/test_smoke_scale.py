@@ -1,0 +1,38 @@
+"""The tiny scale is a smoke test of a few hundred orbits: its outputs state values and no verdict."""
+
+from __future__ import annotations
+
+import json
+import re
+
+from hhscatter.analysis.stats.verdicts import NO_VERDICT
+
+#: what a verdict reads like, wherever it would sit in a JSON (a row's verdict, a claim's, a note)
+VERDICT_WORDS = re.compile(r"^(agrees|differs|consistent with|closer to|same as|not shown|comparable|Wada)\b")
+
+
+def _verdicts(obj, path=""):
+    """(path, value) of every "verdict" key and every string that reads as a verdict, outside the configuration."""
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            if k in ("config", "provenance", "made_from"):
+                continue
+            if k == "verdict":
+                yield f"{path}.{k}", v
+            else:
+                yield from _verdicts(v, f"{path}.{k}")
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            yield from _verdicts(v, f"{path}[{i}]")
+    elif isinstance(obj, str) and VERDICT_WORDS.match(obj):
+        yield path, obj
+
+
+def test_every_tiny_json_states_no_verdict(tiny_studies):
+    docs = sorted(tiny_studies.glob("*/out/tiny/*.json"))
+    docs = [p for p in docs if p.name == f"{p.parent.parent.parent.name}.json"]  # each study's numbers
+    assert len(docs) >= 10
+    found = {p.name: list(_verdicts(json.loads(p.read_text()))) for p in docs}
+    assert sum(len(v) for v in found.values()) > 50  # the rows are there, each with its verdict cell
+    wrong = [(name, path, v) for name, got in found.items() for path, v in got if v != NO_VERDICT]
+    assert not wrong, wrong[:10]
