@@ -442,8 +442,8 @@ def _param(s: str) -> tuple[str, float]:
 
 
 def cmd_simulate(a):
-    from hhscatter.data.read import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
+    from hhscatter.data.verify import describe_run  # deferred: `hhscatter --help` starts without the engine and tables
     from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)

@@ -34,7 +34,7 @@ Runs written before this layout (hhscatter ≤ 0.1.0 grid runs, hive folders
 still read by the functions here, which give them the same columns as the new
 layout; ``--resume`` continues such a run in its own layout.
 
-Reading is verified (:func:`_dataset`): a run read by these functions is read
+Reading is verified (:func:`~hhscatter.data.verify.verified_dataset`): a run read by these functions is read
 as exactly the part files its manifest (``scene.json``) plans and that are
 finished, each checked against the plan (scene hash, chunk, orbit range, row
 count) with its data pages' checksums verified. A missing table or part, a part
@@ -50,7 +50,7 @@ JSON document with the full scene, its result hash, the chunk index and
 orbit range, the row count, and the versions of hhscatter, heyoka, numpy and
 pyarrow plus the git commit when available: a table alone says how it was
 made. Files are written to a temporary name and renamed when complete, with
-Parquet page checksums (see :func:`verify_part`).
+Parquet page checksums (see :func:`~hhscatter.data.verify.verify_part`).
 
 Schemas
 -------
@@ -196,7 +196,7 @@ def part_name(chunk: int) -> str:
     return f"part-{chunk:06d}.parquet"
 
 
-#: folder keys of grid runs written by hhscatter ≤ 0.1.0 (``energy=…/gamma=…``), read by :func:`_dataset`
+#: folder keys of grid runs written by hhscatter ≤ 0.1.0 (``energy=…/gamma=…``), read by :func:`~hhscatter.data.verify.verified_dataset`
 LEGACY_PARTITION_KEYS = ("energy", "gamma")
 
 

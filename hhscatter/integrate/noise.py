@@ -1,6 +1,6 @@
 """The noise scheduler: Langevin dynamics by splitting, heyoka's exact-event flow between vectorised kicks.
 
-A scene with ``[noise]`` (:class:`hhscatter.scene.scene.Noise`) integrates
+A scene with ``[noise]`` (:class:`hhscatter.scene.noise.Noise`) integrates
 
     dq = p dt,   dp = −∇V dt − γ p dt + σ dW,     σ = √(2γT) (heat bath) or the given σ (γ = 0),
 
@@ -18,7 +18,7 @@ place of the Verlet B-A-B):
 Both parts leave the Boltzmann density e^{−H/T} invariant exactly (Φ_H conserves H and phase volume, O
 the Maxwell distribution of p), so the stationary measure has no splitting error at any h (up to the
 integrator's tolerance); the dynamics has a weak error O(h²) (Strang splitting of the generator; the
-escape rate's, measured, is stated in :class:`hhscatter.scene.scene.Noise`).
+escape rate's, measured, is stated in :class:`hhscatter.scene.noise.Noise`).
 
 Scheduling is that of the epoch scheduler (:mod:`hhscatter.integrate.epochs`) with the kick interval as
 the epoch: all lanes propagate to h together (one ``propagate_until`` call), then one numpy kick acts on

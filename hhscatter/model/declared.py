@@ -18,13 +18,14 @@ import numpy as np
 
 from hhscatter.errors import ConfigError
 from hhscatter.model.base import DISSIPATIONS, Exit, System
-from hhscatter.model.derive import Derivation, Landscape, _given_exits, check_well, derive, no_return_radius
+from hhscatter.model.derive import Derivation, _given_exits, derive
+from hhscatter.model.landscape import Landscape, check_well, no_return_radius
 from hhscatter.model.parse import check_params, parse_potential, substitute, symbols, to_heyoka
 
 if TYPE_CHECKING:  # annotations only
     from numpy.typing import ArrayLike
 
-    from hhscatter.model.derive import CriticalPoint
+    from hhscatter.model.landscape import CriticalPoint
 
 #: the keys that override a derived quantity (a scene file's [system] table may give them)
 OVERRIDES = ("critical_energy", "exits", "omega_radius")
@@ -203,7 +204,7 @@ class DeclaredSystem(System):
         return self._cache[key]
 
     def no_return_radius(self, energy: float) -> float:
-        """R(E) ≥ the nearest saddle's distance, from :func:`hhscatter.model.derive.no_return_radius` (cached)."""
+        """R(E) ≥ the nearest saddle's distance, from :func:`hhscatter.model.landscape.no_return_radius` (cached)."""
         energy = float(energy)
         key = ("nrr", energy)
         if key not in self._cache:

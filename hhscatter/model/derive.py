@@ -20,9 +20,10 @@ Given V(x, y) as a sympy expression in x and y (parameters substituted, :func:`h
    energies are all kept, each with its own energy; E_c is the lowest;
 5. **Ω**: the disk r ≤ the largest distance of the exits opening at E_c, checked on a grid to contain the
    well's part of {V < E_c} and to meet no other part;
-6. **R(E)** (:func:`no_return_radius`): the smallest R beyond which −∂V/∂r > 0 at every point with V ≤ E,
+6. **R(E)** (:func:`~hhscatter.model.landscape.no_return_radius`): the smallest R beyond which −∂V/∂r > 0 at every point with V ≤ E,
    from a polar grid refined by constrained optimisation (for Hénon–Heiles it reproduces √(6E)/ω).
 
+Steps 1–3 and 6 (V as numbers, the critical points, the well, R(E)) are :mod:`hhscatter.model.landscape`.
 Every step that cannot decide raises a :class:`~hhscatter.errors.ConfigError` naming the ``[system]`` key
 that overrides it (``critical_energy``, ``exits``, ``omega_radius``). A value given for one of them is checked
 against the derivation wherever it can decide (a contradiction is refused, naming both values), and for
@@ -42,52 +43,22 @@ import numpy as np
 
 from hhscatter.errors import ConfigError
 from hhscatter.model.base import Exit
-from hhscatter.model.parse import symbols
+from hhscatter.model.landscape import (  # noqa: F401 - the landscape's public names are importable from here too
+    DEGENERATE,
+    NO_RETURN_MARGIN,
+    SEARCH_RADIUS,
+    CriticalPoint,
+    Landscape,
+    check_well,
+    critical_points,
+    no_return_radius,
+)
 
-#: radius of the numeric critical-point search (non-polynomial potentials), in the potential's length units
-SEARCH_RADIUS = 100.0
-#: a Hessian eigenvalue below this fraction of the largest |eigenvalue| makes a critical point degenerate
-DEGENERATE = 1e-8
 #: steps after which a steepest-descent path that has neither reached a minimum nor R(E) is given up
 MAX_DESCENT_STEPS = 20_000
-#: relative margin added to R(E) beyond the refined grid estimate
-NO_RETURN_MARGIN = 1e-9
 #: relative tolerance of a given override against what it is checked with (∇V = 0 at a given exit, its energy V
 #: there, a given E_c against the lowest exit's energy, a given exit against a derived one)
 GIVEN_TOL = 1e-8
-
-
-@dataclass(frozen=True)
-class CriticalPoint:
-    """A critical point of V (∇V = 0).
-
-    Parameters
-    ----------
-    x, y : float
-        Position (length).
-    energy : float
-        V there (energy).
-    kind : {'minimum', 'saddle', 'maximum', 'degenerate'}
-        From the Hessian's eigenvalues.
-    eigenvalues : tuple of float
-        The Hessian's eigenvalues, ascending (energy/length²).
-
-    Examples
-    --------
-    >>> CriticalPoint(0.0, 1.0, 1 / 6, "saddle", (-1.0, 3.0)).distance
-    1.0
-    """
-
-    x: float
-    y: float
-    energy: float
-    kind: str
-    eigenvalues: tuple[float, float]
-
-    @property
-    def distance(self) -> float:
-        """Distance from the origin (length)."""
-        return math.hypot(self.x, self.y)
 
 
 @dataclass(frozen=True)
@@ -125,283 +96,6 @@ class Derivation:
     seconds: float = field(compare=False)
 
 
-class Landscape:
-    """Numeric V, ∇V and the Hessian of a sympy potential in x, y (numpy, lambdified from the expression).
-
-    Parameters
-    ----------
-    expr : sympy.Expr
-        V in the symbols x and y of :func:`hhscatter.model.parse.symbols` (no other free symbols).
-
-    Examples
-    --------
-    >>> from hhscatter.model.parse import parse_potential
-    >>> land = Landscape(parse_potential("x**2/2 + y**2/2 + x**2*y - y**3/3"))
-    >>> float(land.v(0.0, 1.0)), land.polynomial
-    (0.16666666666666669, True)
-    """
-
-    def __init__(self, expr):
-        import sympy as sp  # deferred: sympy takes ~0.3 s to import
-
-        x, y = symbols()
-        self.expr, self.x, self.y = expr, x, y
-        self.grad = (sp.diff(expr, x), sp.diff(expr, y))
-        self.hess = (sp.diff(self.grad[0], x), sp.diff(self.grad[0], y), sp.diff(self.grad[1], y))
-        # symbolic critical points for polynomials with rational coefficients (pi, sqrt(2)... go the numeric way)
-        self.polynomial = bool(expr.is_polynomial(x, y)) and sp.Poly(expr, x, y).domain in (sp.ZZ, sp.QQ)
-        # numpy arrays; scipy.special for what numpy lacks (erf)
-        funcs = [sp.lambdify((x, y), e, ["scipy", "numpy"]) for e in (expr, *self.grad, *self.hess)]
-        self._v, self._gx, self._gy, self._hxx, self._hxy, self._hyy = funcs
-        #: (V_x, V_y) at one point in plain floats (the descent paths' right-hand side)
-        self.scalar_gradient = sp.lambdify((x, y), self.grad, "math")
-
-    @staticmethod
-    def _arr(f, x, y) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        y = np.asarray(y, dtype=float)
-        with np.errstate(all="ignore"):
-            return np.asarray(f(x, y), dtype=float) + np.zeros(np.broadcast(x, y).shape)
-
-    def v(self, x, y) -> np.ndarray:
-        """V(x, y) (energy)."""
-        return self._arr(self._v, x, y)
-
-    def gradient(self, x, y) -> tuple[np.ndarray, np.ndarray]:
-        """(V_x, V_y) (energy/length)."""
-        return self._arr(self._gx, x, y), self._arr(self._gy, x, y)
-
-    def hessian(self, x, y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(V_xx, V_xy, V_yy) (energy/length²)."""
-        return self._arr(self._hxx, x, y), self._arr(self._hxy, x, y), self._arr(self._hyy, x, y)
-
-    def radial(self, x, y) -> np.ndarray:
-        """r ∂V/∂r = x V_x + y V_y (energy): ≥ 0 where the radial force is not outward."""
-        gx, gy = self.gradient(x, y)
-        return np.asarray(x) * gx + np.asarray(y) * gy
-
-    def newton(self, x, y, iterations: int = 60, max_step: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
-        """Damped Newton iterations on ∇V = 0 for arrays of starts (steps capped at max_step·max(r, 0.1))."""
-        x = np.array(x, dtype=float, copy=True)
-        y = np.array(y, dtype=float, copy=True)
-        for _ in range(iterations):
-            gx, gy = self.gradient(x, y)
-            a, b, c = self.hessian(x, y)
-            with np.errstate(all="ignore"):
-                det = a * c - b * b
-                dx = -(c * gx - b * gy) / det
-                dy = -(a * gy - b * gx) / det
-                step = np.hypot(dx, dy)
-                cap = max_step * np.maximum(np.hypot(x, y), 0.1)
-                f = np.where(step > cap, cap / step, 1.0)
-            ok = np.isfinite(dx) & np.isfinite(dy) & np.isfinite(f)
-            x = np.where(ok, x + np.where(ok, f * dx, 0.0), x)
-            y = np.where(ok, y + np.where(ok, f * dy, 0.0), y)
-        return x, y
-
-    def classify(self, x: float, y: float) -> CriticalPoint:
-        """The critical point at (x, y) with its energy, Hessian eigenvalues and kind."""
-        a, b, c = (float(h) for h in self.hessian(x, y))
-        lo, hi = np.linalg.eigvalsh(np.array([[a, b], [b, c]]))
-        big = max(abs(lo), abs(hi))
-        if big == 0 or min(abs(lo), abs(hi)) < DEGENERATE * big:
-            kind = "degenerate"
-        elif lo > 0:
-            kind = "minimum"
-        elif hi < 0:
-            kind = "maximum"
-        else:
-            kind = "saddle"
-        return CriticalPoint(float(x), float(y), float(self.v(x, y)), kind, (float(lo), float(hi)))
-
-
-# -- critical points ------------------------------------------------------------------------------
-def _curve_error(extra: str = "") -> ConfigError:
-    return ConfigError(
-        "the critical points of the potential form a curve (∇V = 0 is not a finite set of points"
-        f"{extra}): the exits cannot be derived; give `critical_energy` and `exits` in [system]"
-    )
-
-
-def _symbolic_candidates(land: Landscape) -> tuple[np.ndarray, np.ndarray]:
-    """Every real solution of ∇V = 0 of a polynomial V: the real roots of the two lex eliminants, paired."""
-    import sympy as sp  # deferred: sympy takes ~0.3 s to import
-
-    x, y = land.x, land.y
-    grad = [sp.expand(g) for g in land.grad]
-    roots = {}
-    for gens, var in (((x, y), y), ((y, x), x)):
-        G = sp.groebner(grad, *gens, order="lex")
-        if not G.is_zero_dimensional:
-            raise _curve_error()
-        uni = [g for g in G.exprs if g.free_symbols <= {var}]
-        if not uni:
-            raise _curve_error()
-        poly = sp.Poly(uni[-1], var)
-        roots[var] = sorted({float(r.evalf(30)) for r in poly.real_roots()}) if poly.degree() > 0 else []
-    xs, ys = np.meshgrid(np.array(roots[x]), np.array(roots[y]))
-    return xs.ravel(), ys.ravel()
-
-
-def _numeric_candidates(land: Landscape) -> tuple[np.ndarray, np.ndarray]:
-    """Damped-Newton limits from a polar grid of starts out to SEARCH_RADIUS."""
-    r = np.geomspace(0.02, SEARCH_RADIUS, 48)
-    th = np.linspace(0, 2 * np.pi, 40, endpoint=False) + 0.0123
-    R, T = np.meshgrid(r, th)
-    x0 = np.concatenate([[0.0], (R * np.cos(T)).ravel()])
-    y0 = np.concatenate([[0.0], (R * np.sin(T)).ravel()])
-    return land.newton(x0, y0, iterations=100)
-
-
-def critical_points(land: Landscape) -> tuple[tuple[CriticalPoint, ...], str]:
-    """critical_points(land) -> (points sorted by energy, "symbolic" or "numeric").
-
-    Raises ConfigError when the critical points form a curve (a polynomial's Gröbner basis is not
-    zero-dimensional).
-    """
-    if land.polynomial:
-        xs, ys, method = *_symbolic_candidates(land), "symbolic"
-    else:
-        xs, ys, method = *_numeric_candidates(land), "numeric"
-    xs, ys = land.newton(xs, ys, iterations=30, max_step=1e9)
-    gx, gy = land.gradient(xs, ys)
-    a, b, c = land.hessian(xs, ys)
-    scale = 1.0 + np.abs(a) + np.abs(b) + np.abs(c)
-    ok = np.isfinite(gx) & np.isfinite(gy) & (np.hypot(gx, gy) < 1e-9 * scale * (1 + np.hypot(xs, ys)))
-    ok &= np.isfinite(land.v(xs, ys)) & np.isfinite(scale)  # (not where V itself is undefined: log, sqrt)
-    if method == "numeric":
-        ok &= np.hypot(xs, ys) <= SEARCH_RADIUS
-    pts: list[tuple[float, float]] = []
-    for px, py in zip(xs[ok], ys[ok]):
-        px = 0.0 if abs(px) < 1e-14 else float(px)
-        py = 0.0 if abs(py) < 1e-14 else float(py)
-        if all(math.hypot(px - qx, py - qy) > 1e-7 * (1 + math.hypot(px, py)) for qx, qy in pts):
-            pts.append((px, py))
-    out = sorted((land.classify(px, py) for px, py in pts), key=lambda p: (p.energy, p.distance))
-    return tuple(out), method
-
-
-# -- the well ----------------------------------------------------------------------------------------
-def check_well(land: Landscape, points: Sequence[CriticalPoint]) -> None:
-    """The well's minimum must be a non-degenerate minimum at the origin with V(0, 0) = 0 (ConfigError)."""
-    v0 = float(land.v(0.0, 0.0))
-    gx, gy = (float(g) for g in land.gradient(0.0, 0.0))
-    scale = max(1.0, *(abs(float(h)) for h in land.hessian(0.0, 0.0)))
-    if not (math.isfinite(v0) and math.isfinite(gx) and math.isfinite(gy)):
-        raise ConfigError(
-            f"the potential is not finite at the origin (V(0, 0) = {v0}): the well's minimum must "
-            "be at the origin with V = 0"
-        )
-    if math.hypot(gx, gy) > 1e-12 * scale:
-        minima = [p for p in points if p.kind == "minimum"]
-        near = min(minima, key=lambda p: p.distance, default=None)
-        where = (
-            f"found at ({near.x:.6g}, {near.y:.6g}) with V = {near.energy:.6g}"
-            if near
-            else f"∇V(0, 0) = ({gx:.3g}, {gy:.3g}) and no minimum was found"
-        )
-        raise ConfigError(f"the well's minimum must be at the origin, {where}; shift the potential")
-    cp = land.classify(0.0, 0.0)
-    if cp.kind != "minimum":
-        raise ConfigError(
-            f"the origin is a {cp.kind} critical point of the potential (Hessian eigenvalues "
-            f"{cp.eigenvalues[0]:.3g}, {cp.eigenvalues[1]:.3g}), not a non-degenerate minimum: the "
-            "well's minimum must be at the origin"
-        )
-    if abs(v0) > 1e-14 * max([1.0] + [abs(p.energy) for p in points]):
-        raise ConfigError(f"the well's minimum must have V = 0, but V(0, 0) = {v0!r}; subtract it from the potential")
-
-
-# -- the no-return radius --------------------------------------------------------------------------------
-def no_return_radius(land: Landscape, energy: float, scale: float = 1.0) -> float:
-    """R(E): the smallest R with −∂V/∂r > 0 at every point r ≥ R where V ≤ E (length).
-
-    The "bad" set S = {V ≤ E, ρ ≥ 0} with ρ = x V_x + y V_y = r ∂V/∂r is scanned on a polar grid (720 angles ×
-    1000 radii) out to r_max = 50·scale (×4 up to three times while S reaches 90 % of r_max). S's farthest point
-    is where its boundary is farthest out: a corner (V = E and ρ = 0) or a point of the level curve V = E
-    tangent to the circle (V = E and ∂V/∂θ = 0). Grid cells across which both functions of either pair change
-    sign are polished by Newton's method; R is the farthest polished point in S, or, if a grid point of S lies
-    beyond every one (a case neither pair describes), that grid point plus one radial step. A relative margin of
-    :data:`NO_RETURN_MARGIN` is added. 0 when S is empty.
-
-    Raises ConfigError when S reaches beyond 3200·scale: no no-return radius (the potential does not push
-    outward far out, e.g. it is bounded there).
-    """
-    r_max = 50.0 * scale
-    th = np.linspace(0, 2 * np.pi, 720, endpoint=False)
-    for _ in range(4):
-        r = np.linspace(0, r_max, 1001)[1:]
-        R, T = np.meshgrid(r, th)
-        X, Y = R * np.cos(T), R * np.sin(T)
-        f = land.v(X, Y) - energy
-        gx, gy = land.gradient(X, Y)
-        with np.errstate(all="ignore"):  # overflow far out: inf/nan compare False, as they should
-            rho = X * gx + Y * gy
-        bad = (f <= 0) & (rho >= 0)
-        if not bad.any():
-            return 0.0
-        rb = float(R[bad].max())
-        if rb < 0.9 * r_max:
-            break
-        r_max *= 4
-    else:
-        raise ConfigError(
-            f"no no-return radius at E = {energy:.6g}: points with V ≤ E where the radial force "
-            f"is not outward reach r = {r_max:.3g}; the potential must fall off outward in its exits"
-        )
-    dr = r[1] - r[0]
-    with np.errstate(all="ignore"):
-        tau = X * gy - Y * gx  # ∂V/∂θ
-
-    def changes(F):  # cells (θ_i..θ_i+1, r_j..r_j+1) across which F changes sign (θ wraps round)
-        c = np.stack([F[:, :-1], F[:, 1:], np.roll(F, -1, 0)[:, :-1], np.roll(F, -1, 0)[:, 1:]])
-        return (c.min(axis=0) <= 0) & (c.max(axis=0) >= 0)
-
-    best = 0.0
-    fc = changes(f)
-    for second in (rho, tau):
-        cells = fc & changes(second)
-        cells &= R[:, :-1] >= rb - 3 * dr  # only cells near the far end of S matter
-        if not cells.any():
-            continue
-        x0, y0 = (X[:, :-1][cells] + X[:, 1:][cells]) / 2, (Y[:, :-1][cells] + Y[:, 1:][cells]) / 2
-        x, y = _polish(land, x0, y0, energy, second is rho)
-        f1 = land.v(x, y) - energy
-        r1 = land.radial(x, y)
-        ok = (np.abs(f1) <= 1e-10 * max(1.0, abs(energy))) & (r1 >= -1e-10 * max(1.0, abs(energy)))
-        ok &= np.hypot(x - x0, y - y0) < 4 * dr
-        if ok.any():
-            best = max(best, float(np.hypot(x, y)[ok].max()))
-    if rb > best:
-        best = rb + dr  # S reaches beyond every polished point: the grid's resolution bound
-    return best * (1 + NO_RETURN_MARGIN)
-
-
-def _polish(land: Landscape, x, y, energy: float, corner: bool, iterations: int = 40):
-    """Newton's method on (V − E, ρ) (corner) or (V − E, ∂V/∂θ) (tangent point), vectorised over starts."""
-    x = np.array(x, dtype=float, copy=True)
-    y = np.array(y, dtype=float, copy=True)
-    for _ in range(iterations):
-        gx, gy = land.gradient(x, y)
-        a, b, c = land.hessian(x, y)
-        f1 = land.v(x, y) - energy
-        if corner:
-            f2 = x * gx + y * gy
-            j21, j22 = gx + x * a + y * b, gy + x * b + y * c
-        else:
-            f2 = x * gy - y * gx
-            j21, j22 = gy + x * b - y * a, -gx + x * c - y * b
-        with np.errstate(all="ignore"):
-            det = gx * j22 - gy * j21
-            dx = -(j22 * f1 - gy * f2) / det
-            dy = -(gx * f2 - j21 * f1) / det
-        ok = np.isfinite(dx) & np.isfinite(dy)
-        x = np.where(ok, x + np.where(ok, dx, 0.0), x)
-        y = np.where(ok, y + np.where(ok, dy, 0.0), y)
-    return x, y
-
-
-# -- exits -----------------------------------------------------------------------------------------------
 def _descend(
     land: Landscape, x0: float, y0: float, r_out: float, minima: Sequence[CriticalPoint]
 ) -> tuple[float, float, bool]:

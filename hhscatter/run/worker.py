@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
-from hhscatter.data.read import read_meta, verify_part
 from hhscatter.data.schema import add_point_columns, provenance, to_arrow
 from hhscatter.data.store import Store
+from hhscatter.data.verify import read_meta, verify_part
 from hhscatter.data.write import write_part
 from hhscatter.errors import RunIntegrityError
 from hhscatter.integrate.engine import run_chunk

@@ -22,6 +22,16 @@ import numpy as np
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import resolve
+from hhscatter.scene.noise import KICK_FRACTION, KICK_MAX_FRACTION, Noise
+from hhscatter.scene.recording import (
+    SNAPSHOT_LIST_MAX,
+    SNAPSHOTS_MAX,
+    Follow,
+    SectionWindow,
+    SnapshotGrid,
+    finite_number,
+    plus_zero,
+)
 
 TOL_RANGE = (1e-18, 1e-6)
 
@@ -42,9 +52,6 @@ GAMMA_MAX = 10.0
 N_MAX = 10**9
 #: at most CHUNKS_MAX part files per table and run point (file-system limits, one task per chunk)
 CHUNKS_MAX = 100_000
-#: at most SNAPSHOTS_MAX snapshot times: every live orbit writes one row per time (24 B), a chunk's
-#: snapshot rows are held in memory until written
-SNAPSHOTS_MAX = 100_000
 #: t_max ≤ T_MAX_MAX / ω: every orbit still inside at t_max (a trapped or censored one) is integrated all the way,
 #: at a cost ∝ t_max; 2000 times the paper's 5000, where no window of the analyses reaches, and a value such as
 #: 1e300 would never end
@@ -58,9 +65,6 @@ CHUNK_SIZE_MAX = 10**7
 #: up to a few units of rounding (≈ 1e-16 relative), and an orbit whose computed energy is ≤ E_c has settled
 #: before it starts (the IC-table check refuses such rows, :func:`hhscatter.scene.ics.check_ics`)
 EC_MARGIN = 1e-9
-#: a start/stop/step snapshot grid longer than this is stored (scene.json, part metadata, hash) as its
-#: definition, not as every time (shorter grids are stored as their times, as before: same hashes)
-SNAPSHOT_LIST_MAX = 1000
 
 
 #: the radius field of a scene whose region is not the disk and that gives none: no region but the disk reads it,
@@ -71,219 +75,6 @@ REGIONS = ("disk", "well", "square")
 #: the momentum conventions of region ICs (hhscatter.scene.ics): 'tangential' on the section ṙ = 0, φ̇ > 0 (the
 #: authors' goodICs; the default), 'random' uniform in direction on the circle
 MOMENTA = ("tangential", "random")
-
-
-class SnapshotGrid(tuple):
-    """SnapshotGrid(start, stop, step) -> the times start, start + step, … ≤ stop (both ends included).
-
-    A tuple of the times (what the engine uses) that remembers its definition, so that a long grid is
-    stored as ``{"start", "stop", "step"}`` (see :data:`SNAPSHOT_LIST_MAX`). The count is checked against
-    :data:`SNAPSHOTS_MAX` before any time is made. Example: ``SnapshotGrid(0, 10, 2.5)`` is
-    (0.0, 2.5, 5.0, 7.5, 10.0).
-    """
-
-    def __new__(cls, start, stop, step):
-        start, stop, step = (
-            _finite(f"snapshots.{k}", v) for k, v in (("start", start), ("stop", stop), ("step", step))
-        )
-        if not step > 0:
-            raise ConfigError(f"snapshots.step must be > 0, got {step}")
-        count = math.floor((stop - start) / step + 0.5) + 1
-        if count > SNAPSHOTS_MAX:
-            raise ConfigError(
-                f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
-                f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
-                "in memory): use a larger step"
-            )
-        self = super().__new__(cls, (float(t) for t in np.arange(start, stop + 0.5 * step, step)))
-        self.definition = {"start": start, "stop": stop, "step": step}
-        return self
-
-    def __reduce__(self):
-        d = self.definition
-        return (SnapshotGrid, (d["start"], d["stop"], d["step"]))
-
-
-def _plus_zero(v):
-    """v with a float −0.0 written as 0.0 (−0 is the same value: it must not make another scene or read "γ=-0")."""
-    return 0.0 if isinstance(v, float) and v == 0.0 else v
-
-
-def _finite(name, value):
-    # a number, never text or a boolean ("0.3" would pass float() and fail deep inside the engine)
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise ConfigError(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ConfigError(f"{name} must be finite, got {value!r}")
-    return v
-
-
-@dataclass(frozen=True)
-class SectionWindow:
-    """Which crossings of the section ṙ = 0, φ̇ > 0 a scene records (paper, App. "Initial Conditions").
-
-    Those at orbit times t_from ≤ t ≤ t_to whose energy lies in [e_min, e_max]; with ``first_only`` only the
-    first such crossing of each orbit. The initial point itself (t = 0) is never recorded.
-
-    Parameters
-    ----------
-    t_from, t_to : float
-        Orbit-time window (time units), 0 ≤ t_from < t_to ≤ ∞.
-    e_min, e_max : float
-        Energy window of the crossing (units of the potential); with drag, a band around a target energy.
-    first_only : bool
-        Only the first crossing in the window, per orbit.
-    stop : bool
-        With ``first_only``: end the orbit at that crossing (one-return runs, e.g. Ulam's method).
-
-    Raises
-    ------
-    ConfigError
-        A value that is not a number, or an empty window.
-
-    Examples
-    --------
-    The first crossing after t* = 17 (paper Fig. 5a), and the first crossing in an energy band (Fig. 5b):
-
-    >>> import hhscatter
-    >>> a = hhscatter.SectionWindow(t_from=17.0, first_only=True)
-    >>> b = hhscatter.SectionWindow(e_min=0.295, e_max=0.305, first_only=True)
-    >>> a.t_to, b.e_max
-    (inf, 0.305)
-    """
-
-    t_from: float = 0.0
-    t_to: float = math.inf
-    e_min: float = -math.inf
-    e_max: float = math.inf
-    first_only: bool = False
-    stop: bool = False
-
-    def __post_init__(self):
-        for name in ("t_from", "t_to", "e_min", "e_max"):
-            object.__setattr__(self, name, _plus_zero(getattr(self, name)))
-        for name in ("first_only", "stop"):
-            if not isinstance(getattr(self, name), bool):
-                raise ConfigError(f"sections.{name} must be true or false, got {getattr(self, name)!r}")
-        for name in ("t_from", "t_to", "e_min", "e_max"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float)) or math.isnan(v):
-                raise ConfigError(f"sections.{name} must be a number, got {v!r}")
-        if self.t_from < 0 or math.isinf(self.t_from):
-            raise ConfigError(f"sections.t_from must be finite and ≥ 0, got {self.t_from}")
-        if not self.t_to > self.t_from:
-            raise ConfigError(f"sections.t_to must be > t_from = {self.t_from}, got {self.t_to}")
-        if not self.e_max > self.e_min:
-            raise ConfigError(f"sections.e_max must be > e_min = {self.e_min}, got {self.e_max}")
-        if self.stop and not (self.first_only or math.isfinite(self.t_to)):
-            raise ConfigError(
-                "sections.stop needs first_only = true or a finite t_to "
-                "(otherwise the window never closes and the orbit is always needed)"
-            )
-
-
-#: the default kick interval of noise scenes, as a fraction of the shortest time scale min(1/ω, 1/γ)
-#: (:class:`Noise`; the measured weak error at this interval is stated there)
-KICK_FRACTION = 0.1
-#: a kick interval above KICK_MAX_FRACTION · min(1/ω, 1/γ) is refused: the splitting resolves neither the
-#: oscillation nor the drag any more (the escape rate's weak error grows like h²)
-KICK_MAX_FRACTION = 0.5
-
-
-@dataclass(frozen=True)
-class Noise:
-    """Noise(temperature=None, sigma=None, kick=None): random forces on the momenta of a scene, as data.
-
-    With drag (γ > 0) the noise is a heat bath at ``temperature`` T (energy units, k_B = 1), the
-    fluctuation–dissipation pair of the linear drag:
-
-        dq = p dt,   dp = −∇V dt − γ p dt + √(2γT) dW;
-
-    without drag (γ = 0) it is a noise of ``strength`` σ alone (energy diffuses, nothing settles):
-
-        dq = p dt,   dp = −∇V dt + σ dW,
-
-    with W a two-dimensional Wiener process (one per orbit). Exactly one of ``temperature`` (γ > 0) and
-    ``sigma`` (γ = 0) is given.
-
-    Integration (:mod:`hhscatter.integrate.noise`): Strang splitting O(h/2) · Φ_H(h) · O(h/2) with Φ_H the
-    Hamiltonian flow on heyoka's Taylor integrator (events at their exact roots: positions are continuous, so
-    no crossing of r_esc is missed between kicks) and O the exact Ornstein–Uhlenbeck step on the momenta,
-    p ← e^{−γδ} p + √(T(1 − e^{−2γδ})) ξ (σ√δ ξ without drag), δ = h/2. Both parts preserve the Boltzmann
-    density e^{−H/T} exactly, so the invariant measure carries no splitting error at any h; dynamical
-    quantities (escape rates) carry a weak error O(h²). Measured on Hénon–Heiles (γ = 1, ΔE/T = 3, 1000
-    orbits): the escape rate at h = 0.3 differs from that at the default h = 0.1 by −0.6 % ± 5 %
-    (statistical), so with the h² scaling the weak error of the rate at h = 0.1 is below about 1 %.
-
-    Parameters
-    ----------
-    temperature : float, optional
-        Heat-bath temperature T > 0 (energy units); needs γ > 0 and the linear drag law.
-    sigma : float, optional
-        Noise strength σ > 0 (momentum / √time); needs γ = 0.
-    kick : float, optional
-        Kick interval h (time units), 0 < h ≤ KICK_MAX_FRACTION · min(1/ω, 1/γ); default KICK_FRACTION ·
-        min(1/ω, 1/γ). The engine uses h' = t_max / ⌈t_max/h⌉ ≤ h, so t_max falls on a kick.
-
-    Raises
-    ------
-    ConfigError
-        Neither or both of temperature and sigma, a value ≤ 0 or not finite (naming the key).
-
-    Examples
-    --------
-    >>> import hhscatter
-    >>> s = hhscatter.Scene(energy=0.1, n=10, gamma=1.0, noise=hhscatter.Noise(temperature=1 / 36))
-    >>> round(s.noise.temperature, 6), s.noise_strength == (2 * 1.0 / 36) ** 0.5, s.kick_interval
-    (0.027778, True, 0.1)
-    """
-
-    temperature: float | None = None
-    sigma: float | None = None
-    kick: float | None = None
-
-    def __post_init__(self):
-        for name in ("temperature", "sigma", "kick"):
-            v = getattr(self, name)
-            if v is not None:
-                v = _finite(f"noise.{name}", v)
-                if not v > 0:
-                    raise ConfigError(f"noise.{name} must be > 0, got {v:g}")
-                object.__setattr__(self, name, v)
-        if (self.temperature is None) == (self.sigma is None):
-            raise ConfigError(
-                "noise needs exactly one of temperature (a heat bath, with drag gamma > 0) and sigma "
-                "(a noise strength, without drag)"
-            )
-
-
-@dataclass(frozen=True)
-class Follow:
-    """Follow(radii) -> keep integrating escaped orbits (conservative scenes).
-
-    After its escape (the outward r_esc crossing, which stays the orbit's
-    t_end) the orbit is followed until it reaches r_far or t_max, and every
-    crossing of a circle r = R for R in ``radii`` and of r_esc (both directions,
-    from t = 0) goes to the ``crossings`` table: the check that an 'escaped' orbit does
-    not come back (study ``resc``).
-    """
-
-    radii: tuple = ()
-
-    def __post_init__(self):
-        try:
-            radii = tuple(float(r) for r in self.radii)
-        except (TypeError, ValueError):
-            raise ConfigError(f"follow.radii must be a list of numbers, got {self.radii!r}") from None
-        if not radii or not all(math.isfinite(r) and r > 0 for r in radii):
-            raise ConfigError(f"follow.radii must be a non-empty list of finite radii > 0, got {self.radii!r}")
-        if any(b <= a for a, b in zip(radii, radii[1:])):
-            raise ConfigError("follow.radii must be strictly increasing")
-        object.__setattr__(self, "radii", radii)
 
 
 @dataclass(frozen=True)
@@ -407,12 +198,12 @@ class Scene:
             if isinstance(v, (float, np.floating)) and math.isfinite(v) and v == int(v):
                 object.__setattr__(self, name, int(v))
         object.__setattr__(self, "_model", self._make_model())
-        object.__setattr__(self, "gamma", _plus_zero(self.gamma))
+        object.__setattr__(self, "gamma", plus_zero(self.gamma))
         if self.radius is None:  # the disk's is the system's; the other regions have none (see UNUSED_RADIUS)
             radius = self._model.default_ic_radius() if self.region == "disk" else UNUSED_RADIUS
             object.__setattr__(self, "radius", float(radius))
         if self.r_esc is None:
-            e = None if self.energy is None or isinstance(self.energy, bool) else _finite("energy", self.energy)
+            e = None if self.energy is None or isinstance(self.energy, bool) else finite_number("energy", self.energy)
             object.__setattr__(self, "r_esc", float(self._model.default_escape_radius(e)))
         self._validate()
 
@@ -421,7 +212,7 @@ class Scene:
         drag becomes ω and λ, so that it has the hash of the same scene written without a [system] table)."""
         if self.system is None:
             try:
-                return HenonHeiles(_finite("omega", self.omega), _finite("lam", self.lam))
+                return HenonHeiles(finite_number("omega", self.omega), finite_number("lam", self.lam))
             except ValueError as exc:
                 raise ConfigError(str(exc)) from None
         if (self.omega, self.lam) != (1.0, 1.0):
@@ -522,7 +313,7 @@ class Scene:
     def _check_dynamics(self):
         """γ, n, seed, tol and t_max; returns (γ, t_max)."""
         m = self.model
-        gamma = _finite("gamma", self.gamma)
+        gamma = finite_number("gamma", self.gamma)
         if gamma < 0:
             raise ConfigError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
         if gamma > GAMMA_MAX * m.frequency:
@@ -544,10 +335,10 @@ class Scene:
                 f"seed must be ≤ 2**63 − 1 = {SEED_MAX}, got {self.seed} (it is stored and read back as a "
                 "64-bit integer)"
             )
-        tol = _finite("tol", self.tol)
+        tol = finite_number("tol", self.tol)
         if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
             raise ConfigError(f"tol must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], got {tol:g}")
-        t_max = _finite("t_max", self.t_max)
+        t_max = finite_number("t_max", self.t_max)
         if t_max <= 0:
             raise ConfigError(f"t_max must be > 0, got {t_max}")
         if t_max > T_MAX_MAX / m.frequency:
@@ -560,7 +351,7 @@ class Scene:
     def _check_radii(self):
         """r_esc, r_far, the IC region and its radius; returns r_esc."""
         m = self.model
-        r_esc = _finite("r_esc", self.r_esc)
+        r_esc = finite_number("r_esc", self.r_esc)
         if r_esc <= m.saddle_radius:
             raise ConfigError(
                 f"r_esc must be > the saddle distance r_s = {m.saddle_radius:g} "
@@ -571,7 +362,7 @@ class Scene:
                 f"r_esc must be ≤ {R_ESC_MAX:g} r_s = {R_ESC_MAX * m.saddle_radius:g}, got {r_esc:g} "
                 "(energy conservation: far out |V| ≫ E and the energy error grows like tol·|V|/E)"
             )
-        if self.r_far is not None and _finite("r_far", self.r_far) <= r_esc:
+        if self.r_far is not None and finite_number("r_far", self.r_far) <= r_esc:
             raise ConfigError(f"r_far must be > r_esc = {r_esc}, got {self.r_far}")
         if self.r_far is not None and self.r_far > R_FAR_MAX * m.saddle_radius:
             raise ConfigError(
@@ -596,7 +387,7 @@ class Scene:
             )
         if not isinstance(self.momentum, str) or self.momentum not in MOMENTA:
             raise ConfigError(f"momentum must be one of {MOMENTA}, got {self.momentum!r}")
-        radius = _finite("radius", self.radius)
+        radius = finite_number("radius", self.radius)
         if radius <= 0:
             raise ConfigError(f"radius must be > 0, got {radius}")
         if radius > r_esc:
@@ -636,7 +427,7 @@ class Scene:
         if self.ics is None:
             if self.energy is None:
                 raise ConfigError("energy is required unless initial conditions come from a table (ics)")
-            energy = _finite("energy", self.energy)
+            energy = finite_number("energy", self.energy)
             # the region's minimum of V is V(0, 0) = 0 (the origin is in every region)
             if energy <= 0:
                 raise ConfigError(

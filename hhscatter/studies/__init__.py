@@ -44,7 +44,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from hhscatter.data.read import run_status
+from hhscatter.data.verify import run_status
 from hhscatter.errors import StudyError
 from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
 from hhscatter.studies.cost import meter, record

@@ -22,11 +22,18 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+from hhscatter.analysis.survival.paper_fig2 import (
+    FIG2_CONVENTIONS,
+    FIG2_RULES,
+    PAPER_FIG2,
+    cmeasure_comparisons,
+    cmeasure_table_rows,
+    convention_numbers,
+    law_comparisons,
+    pt_comparisons,
+)
 from hhscatter.analysis.survival.summaries import (
     cmeasure_windows,
-    kappa_cmeasure_entry,
-    kappa_cmeasure_shifts,
     kappa_cmeasure_z,
     kappa_law_curves,
     kappa_law_summary,
@@ -34,7 +41,6 @@ from hhscatter.analysis.survival.summaries import (
     rate_summary,
     sticky_tail_summary,
     survival_tables,
-    tau_star_estimate,
 )
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
@@ -75,7 +81,6 @@ class Params(StudyParams):
     stable_rel_tol: Number = 0.1  # κ(E) stable: (max − min)/mean over the defined conventions ≤ this
 
 
-PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
 LIFETIME_COLUMNS = ["traj_id", "e0", "gamma", "outcome", "t_end"]
 
 
@@ -290,7 +295,7 @@ def _analyze_pt(study):
         else:
             entry.update(tail_detected=False)
         numbers[pt_key(energy)] = entry
-        compare_pt(study, energy, r, tail, E_C)
+        _record(study, pt_comparisons(energy, r, tail, E_C))
     study.write_table(
         pd.concat(curves, ignore_index=True),
         "survival_curves.parquet",
@@ -320,35 +325,6 @@ def _pt_fits(study, key: str):
     return t_end, obs, t_max, r, tail
 
 
-def compare_pt(study, energy: float, r, tail, E_C: float) -> None:
-    """Compare with the paper: κ with its Fig. 2b law, τ* with its value, z (not in its text)."""
-    paper_k = (
-        PAPER["a"] * (energy - E_C) ** 2 + PAPER["b"] * (energy - E_C)
-        if energy < PAPER["E_b"]
-        else PAPER["c"] * (energy - E_C)
-    )
-    study.compare(
-        f"kappa(E0={energy:.2f}) [Fig. 2a]",
-        r.kappa,
-        r.kappa_err,
-        paper_k,
-        unit="1/time",
-        note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)",
-    )
-    if tail.tail is not None:
-        tl = tail.tail
-        ts, ts_err, note = tau_star_estimate(tail)
-        verdict = None if ts_err else ("agrees within 20 %" if abs(ts / PAPER["tau_star"] - 1) <= 0.2 else "differs")
-        study.compare(f"tau* (E0={energy:.2f})", ts, ts_err, PAPER["tau_star"], unit="time", note=note, verdict=verdict)
-        study.compare(
-            f"z (E0={energy:.2f})",
-            tl.z,
-            tl.z_err,
-            None,
-            note="power-law exponent of the sticky tail (the paper annotates it in Fig. 2a; no number in the text)",
-        )
-
-
 def _analyze_cmeasure(study, grid_runs):
     """κ from the c-measure per energy of cm_energies and start shift, beside κ from P(t): table, comparison."""
     E_C = study.model.critical_energy
@@ -365,13 +341,13 @@ def _analyze_cmeasure(study, grid_runs):
         description="κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), vs κ from P(t)",
     )
     df.to_csv(study.derived("kappa_cmeasure.csv"), index=False, float_format="%.6g")  # the same, for reading
-    return _cmeasure_numbers(study, df)
+    rows, entries = cmeasure_comparisons(df)
+    _record(study, rows)
+    return {cm_key(energy): entry for energy, entry in entries.items()}
 
 
 def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> list:
     """κ from the c-measure of one energy's run per start shift (bootstrap over orbits), with κ from P(t)."""
-    from hhscatter.analysis.survival.escape_rate import escape_rate
-    from hhscatter.analysis.survival.fits import observed_from_outcome
     from hhscatter.data.read import read_lifetimes, read_sections
 
     key = cm_key(energy)
@@ -385,70 +361,30 @@ def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> lis
     r = grid_runs[min(grid_runs, key=lambda e: abs(e - energy))][1]  # the Fig. 2b κ at this energy (a grid E)
     lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "t_end"], categorical=True)
     sec = read_sections(study.raw(key), columns=["traj_id", "t"])
-    own = escape_rate(
-        lt["t_end"].to_numpy(),
-        observed_from_outcome(lt["outcome"]),
-        detect_tail=False,
-        min_survivors=study.params.min_survivors,
-    )
-    rows = kappa_cmeasure_shifts(
+    p = study.params
+    return cmeasure_table_rows(
         sec,
         lt,
-        t_rec,
-        t_samp - t_rec,
-        study.params.cm_start_shifts,
+        (t_rec, t_samp, t_rec_end),
+        p.cm_start_shifts,
         ch["kappa"],
-        t_rec_end,
-        n_boot=study.params.n_boot,
-        seed=study.params.fit_seed,
+        r,
+        energy=energy,
+        E_c=E_C,
+        min_survivors=p.min_survivors,
+        n_boot=p.n_boot,
+        seed=p.fit_seed,
     )
-    n_trapped = int((lt["outcome"] == "censored").sum())
-    return [
-        {
-            "energy": energy,
-            "x": energy - E_C,
-            **row,
-            "kappa_pt_grid": r.kappa,
-            "kappa_pt_grid_err": r.kappa_err,
-            "kappa_pt_same_run": own.kappa,
-            "kappa_pt_same_run_err": own.kappa_err,
-            "n_trapped_dropped": n_trapped,
-        }
-        for row in rows
-    ]
 
 
-def _cmeasure_numbers(study, df) -> dict:
-    """Compare κ_cm with κ from P(t) at the unshifted windows; the numbers per energy (later starts beside)."""
-    main = df[df["shift_efolds"] == 0.0]
-    numbers = {}
-    for _, row in main.iterrows():
-        z = row["z_vs_grid"]
-        study.compare(
-            f"κ from the c-measure (E={row['energy']:.2f})",
-            row["kappa_cm"],
-            row["kappa_cm_err"],
-            None,
-            unit="1/time",
-            verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
-            note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
-            f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
-        )
-        later = df[(df["energy"] == row["energy"]) & (df["shift_efolds"] > 0)]
-        numbers[cm_key(row["energy"])] = kappa_cmeasure_entry(row, later)
-    return numbers
-
-
-CONVENTIONS = (  # (name, IC region, window rule, label)
-    ("disk_plateau", "disk", "plateau", "paper setup (disk r < 0.5), our plateau windows"),
-    ("disk_plevel", "disk", "plevel", "paper setup (disk r < 0.5), P-level windows"),
-    ("square_plateau", "square", "plateau", "authors' square ICs (goodICs), our plateau windows"),
-    ("square_plevel", "square", "plevel", "authors' square ICs (goodICs), P-level windows"),
-)
+def _record(study, rows) -> None:
+    """Record comparison rows (the keyword arguments of ``study.compare``)."""
+    for row in rows:
+        study.compare(**row)
 
 
 def _analyze_conventions(study, grid_runs):
-    """κ(E) under the 4 conventions of CONVENTIONS, the stable energies and the law per convention.
+    """κ(E) under the 4 conventions of FIG2_CONVENTIONS, the stable energies and the law per convention.
 
     Returns (table, stability, numbers). Conventions: IC region (disk, the
     authors' square) × window rule (our data-driven plateau, windows fixed by
@@ -466,31 +402,29 @@ def _analyze_conventions(study, grid_runs):
         stable_energies,
     )
 
-    E_C = study.model.critical_energy
-    p_hi, p_lo = study.params.p_levels
-    max_bias = study.params.max_plateau_bias
-    min_surv = study.params.min_survivors
-    squares = list(study.params.square_energies)
+    E_C, p = study.model.critical_energy, study.params
     rows = []
-    for energy in study.params.grid_energies:
+    for energy in p.grid_energies:
         runs = {"disk": grid_runs[energy]}  # the Fig. 2b run, already read and fitted
-        if any(np.isclose(energy, e) for e in squares):
+        if any(np.isclose(energy, e) for e in p.square_energies):
             lt = _lifetimes(study.raw(sq_key(energy)))
-            runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_surv))
+            runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=p.min_survivors))
         for region, (lt, res) in runs.items():
             t_end, obs = lifetimes_to_arrays(lt)
-            rows += [
-                {
-                    "energy": energy,
-                    "x": energy - E_C,
-                    "convention": f"{region}_{row['windows']}",
-                    "region": region,
-                    **row,
-                }
-                for row in convention_rows(t_end, obs, res, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias)
-            ]
+            for row in convention_rows(
+                t_end, obs, res, p_hi=p.p_levels[0], p_lo=p.p_levels[1], max_bias=p.max_plateau_bias
+            ):
+                rows.append(
+                    {
+                        "energy": energy,
+                        "x": energy - E_C,
+                        "convention": f"{region}_{row['windows']}",
+                        "region": region,
+                        **row,
+                    }
+                )
     table = pd.DataFrame(rows)
-    stab = stable_energies(table, rel_tol=study.params.stable_rel_tol)
+    stab = stable_energies(table, rel_tol=p.stable_rel_tol)
     table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
     study.write_table(
         table,
@@ -499,24 +433,12 @@ def _analyze_conventions(study, grid_runs):
         "defined = False where the trapped plateau makes κ ill-defined",
     )
     stable = set(stab.loc[stab["stable"], "energy"])
-    fits, fit_info = fit_laws(
-        table, [name for name, *_ in CONVENTIONS], stable, E_C, n_boot=study.params.n_boot, seed=study.params.fit_seed
-    )
+    names = [name for name, *_ in FIG2_CONVENTIONS]
+    fits, fit_info = fit_laws(table, names, stable, E_C, n_boot=p.n_boot, seed=p.fit_seed)
     law = law_spread(fits) if fits else {}
-    numbers = {
-        "conventions": {name: label for name, _, _, label in CONVENTIONS},
-        "p_levels": [p_hi, p_lo],
-        "max_plateau_bias": max_bias,
-        "stable_rel_tol": study.params.stable_rel_tol,
-        "stable_energies": sorted(float(e) for e in stable),
-        "unstable_energies": sorted(float(e) for e in stab.loc[~stab["stable"], "energy"]),
-        "ill_defined": [
-            {"energy": r.energy, "convention": r.convention, "reason": r.reason}
-            for r in table[~table["defined"]].itertuples()
-        ],
-        "fits": fit_info,
-        "law": law,
-    }
+    numbers = convention_numbers(
+        table, stab, fit_info, law, p_levels=p.p_levels, max_bias=p.max_plateau_bias, rel_tol=p.stable_rel_tol
+    )
     return table, stab, numbers
 
 
@@ -524,7 +446,7 @@ def analyze(study):
     """Write the derived tables and fig2.json (see the module docstring)."""
     E_C = study.model.critical_energy
     grid_df, fit, sep, grid_runs = _analyze_grid(study)
-    laws = {"continuous": fit, "separate": sep, "paper": SimpleNamespace(**PAPER)}
+    laws = {"continuous": fit, "separate": sep, "paper": SimpleNamespace(**PAPER_FIG2)}
     study.write_table(
         kappa_law_curves(laws, float(grid_df["x"].max()), E_C),
         "kappa_fit_curve.parquet",
@@ -532,81 +454,17 @@ def analyze(study):
     )
     fj, sj = kappa_law_summary(fit), kappa_law_summary(sep)
     conv_table, _, conv = _analyze_conventions(study, grid_runs)
-    units = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
-    law = conv["law"]
-    for name in ("a", "b", "c", "E_b"):
-        # "differs" only if it survives the spread of the law across conventions (the authors' square ICs among them)
-        # 2σ, then the paper's printed precision (it gives no errors: 0.27 stands for [0.265, 0.275))
-        verdict = quoted_verdict(fj[name]["value"], fj[name]["err"], PAPER[name], half_unit(PAPER[name]))
-        if verdict == "differs" and name in law:
-            across = quoted_verdict(law[name]["value"], law[name]["err"], PAPER[name], half_unit(PAPER[name]))
-            if across != "differs":
-                verdict = f"differs in this convention only; across conventions: {across}"
-        study.compare(
-            f"{name} (κ(E) law, continuous fit)",
-            fj[name]["value"],
-            fj[name]["err"],
-            PAPER[name],
-            unit=units[name],
-            verdict=verdict,
-            note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
-            "err = max(covariance, bootstrap); all grid energies",
-        )
-    for name in ("a", "b", "c", "E_b"):
-        if name not in law:
-            continue
-        L = law[name]
-        study.compare(
-            f"{name} (κ(E) law across conventions)",
-            L["value"],
-            L["err"],
-            PAPER[name],
-            unit=units[name],
-            verdict=quoted_verdict(L["value"], L["err"], PAPER[name], half_unit(PAPER[name])),
-            convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
-            authors=True,
-            note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
-            + ", ".join(f"{k} {v:.4g}" for k, v in L["per_convention"].items()),
-        )
     ill = conv_table[~conv_table["defined"]]
-    study.compare(
-        "κ(E) points ill-defined by the trapped plateau",
-        len(ill),
-        None,
-        None,
-        convention="all 4 conventions",
-        note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
-        verdict="excluded from the law, not returned as κ ≈ 0",
-    )
-    for name in ("a", "b", "c", "E_b"):
-        study.compare(
-            f"{name} (κ(E) law, separate fits)",
-            sj[name]["value"],
-            sj[name]["err"],
-            PAPER[name],
-            verdict=quoted_verdict(sj[name]["value"], sj[name]["err"], PAPER[name], half_unit(PAPER[name])),
-            note="the two laws fitted independently on either side of the best partition (as the paper)",
-        )
+    _record(study, law_comparisons(fj, sj, conv["law"], ill))
     pt = _analyze_pt(study)
     cm = _analyze_cmeasure(study, grid_runs)
     study.write_numbers(
         {
-            "rules": {
-                "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "
-                "covering most e-folds, floor of min_survivors survivors); kappa = mean of the 4 weighted "
-                "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
-                "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
-                " clipped to [t_max_min, t_max_cap]",
-                "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
-                "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
-                "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
-                "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
-                "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
-            },
+            "rules": FIG2_RULES,
             "E_c": E_C,
             "kappa_fit": fj,
             "kappa_fit_separate": sj,
-            "paper": PAPER,
+            "paper": PAPER_FIG2,
             "kappa_energy": grid_df.to_dict(orient="records"),
             "kappa_conventions": conv,
             "Pt": pt,

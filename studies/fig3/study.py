@@ -35,8 +35,8 @@ authors' reading (default: the paper's own words, every orbit inside Ω on
 [0, 200]); rows in it carry ``authors=True``.  Verdicts: agreement within 2σ
 of the bootstrap error, or within 2σ plus half a unit of the last digit the
 paper quotes (0.91 stands for [0.905, 0.915]); our row's "differs" names an
-authors'-convention row that agrees, if there is one (:func:`mu_verdict`,
-:func:`verdict_beside_authors`).
+authors'-convention row that agrees, if there is one
+(:func:`~hhscatter.analysis.dissipative.paper_fig3.authors_convention`).
 
 Stages: ``simulate`` (one engine run with snapshots on the grid, settled
 orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
@@ -52,8 +52,16 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
-from hhscatter.analysis.stats.verdicts import quoted_verdict as mu_verdict
-from hhscatter.analysis.stats.verdicts import verdict_beside_authors
+from hhscatter.analysis.dissipative.paper_fig3 import (
+    add_bootstrap_errors,
+    authors_convention,
+    fit_windows,
+    histogram_rows,
+    mu_table,
+    nearest_times,
+    paper_fit,
+    ribbons,
+)
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
 
 
@@ -110,14 +118,14 @@ def analyze(study):
     n_orbits = len(lt)
 
     window = tuple(study.params.fit_window)
-    fit = _paper_fit(me, E0, gamma, window)
+    fit = paper_fit(me, E0, gamma, window)
     alt = tuple(study.params.alt_window)
-    windows, kinds = _fit_windows(
+    windows, kinds = fit_windows(
         window, [tuple(w) for w in study.params.later_windows], study.params.sliding_window, alt, float(me["t"].max())
     )
-    tab = _mu_table(me, E0, gamma, windows, kinds)
+    tab = mu_table(me, E0, gamma, windows, kinds)
     boot, boot_up, scale = _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt)
-    _add_bootstrap_errors(tab, me, boot, scale, len(windows), study.params.n_boot)
+    add_bootstrap_errors(tab, me, boot, scale, len(windows), study.params.n_boot)
     hist, h = _histograms(study, key, me, E0)
 
     meta = {"E0": E0, "gamma": gamma, "definition": "mean over orbits not escaped at t (settled orbits continued)"}
@@ -147,40 +155,6 @@ def _mean_energy(study, key: str, E_C: float):
     return me, cont, lt
 
 
-def _paper_fit(me, E0: float, gamma: float, window):
-    """The paper's fit: log⟨E⟩ by E0 e^{−μγt} on the fit window (column fit_E added to ``me``)."""
-    from hhscatter.analysis.dissipative.decay import fit_energy_decay
-
-    fit = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, window)
-    me["fit_E"] = E0 * np.exp(-fit.mu * gamma * me["t"])
-    return fit
-
-
-def _fit_windows(window, later, sliding_window, alt, t_last: float):
-    """The window chooser: the fit windows of μ and their kinds (paper, later, sliding, alt), times in model units.
-
-    The sliding windows ``[lo, lo + width]`` start at 0, stride, 2·stride, ... while they end by ``t_last``
-    (``sliding_window`` = [width, stride]).
-
-    >>> _fit_windows((0, 200), [(200, 400)], [100.0, 50.0], (0, 100), 250.0)[1]
-    ['paper', 'later', 'sliding', 'sliding', 'sliding', 'sliding', 'alt']
-    """
-    width, stride = sliding_window
-    sliding = [(lo, lo + width) for lo in np.arange(0.0, t_last - width + 1e-9, stride)]
-    windows = [window] + later + sliding + [alt]
-    kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding) + ["alt"]
-    return windows, kinds
-
-
-def _mu_table(me, E0: float, gamma: float, windows, kinds) -> pd.DataFrame:
-    """The fits: μ (E(0) = E0) and μ_free (free intercept) of log⟨E⟩ on every window, with their fit errors."""
-    from hhscatter.analysis.dissipative.decay import mu_by_window
-
-    tab = mu_by_window(me["t"], me["mean_E"], E0, gamma, windows)
-    tab["kind"] = kinds
-    return tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
-
-
 def _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt):
     """The bootstrap over orbits of μ on every window (inside Ω), and on the fit and alt windows above E_c."""
     import pyarrow.dataset as ds
@@ -203,17 +177,6 @@ def _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt):
     return boot, boot_up, scale
 
 
-def _add_bootstrap_errors(tab, me, boot, scale, n_windows, n_boot) -> None:
-    """Bootstrap errors of μ, μ_free per window (replicates' std × scale), window centres and ⟨E⟩ there."""
-    boot["w"] = np.tile(np.arange(n_windows), n_boot)
-    err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
-    tab["mu_err"] = err["mu"].to_numpy() * scale
-    tab["mu_free_err"] = err["mu_free"].to_numpy() * scale
-    tab["t_mid"] = 0.5 * (tab["t_lo"] + tab["t_hi"])
-    # ⟨E⟩ at the window centre: where on the energy axis the local exponent is measured
-    tab["mean_E_mid"] = np.interp(tab["t_mid"], me["t"], me["mean_E"])
-
-
 def _histograms(study, key, me, E0: float):
     """The inset: histograms of log10 E at the marked times (geometric bins from the lowest energy to E0)."""
     import pyarrow.dataset as ds
@@ -221,37 +184,11 @@ def _histograms(study, key, me, E0: float):
     from hhscatter.analysis.dissipative.decay import energy_histograms
 
     hist_times = list(study.params.hist_times)
-    at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(_nearest(me["t"].to_numpy(), hist_times))))
+    at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(nearest_times(me["t"].to_numpy(), hist_times))))
     lo = max(float(at["energy"].min()), 1e-12)
     edges = np.geomspace(lo * 0.98, E0 * 1.001, study.params.hist_bins + 1)
     h = energy_histograms(at, hist_times, bins=edges)
-    return _histogram_rows(h, edges), h
-
-
-def _histogram_rows(h, edges) -> pd.DataFrame:
-    """The histograms as rows (t, bin edges, count, density in log10 E: Σ density · Δlog10 E = 1 per time).
-
-    ``h``: an :func:`~hhscatter.analysis.dissipative.decay.energy_histograms` result (t_requested, t, counts
-    (times × bins), n_alive, mean_E); ``edges``: the energy bin edges (model units).
-    """
-    dlog = np.diff(np.log10(edges))
-    hrows = []
-    for k in range(len(h.t)):
-        tot = h.counts[k].sum()
-        for b in range(len(edges) - 1):
-            hrows.append(
-                {
-                    "t_requested": h.t_requested[k],
-                    "t": h.t[k],
-                    "e_lo": edges[b],
-                    "e_hi": edges[b + 1],
-                    "count": int(h.counts[k, b]),
-                    "density_log10E": h.counts[k, b] / (tot * dlog[b]) if tot else np.nan,
-                    "n_inside": int(h.n_alive[k]),
-                    "mean_E": h.mean_E[k],
-                }
-            )
-    return pd.DataFrame(hrows)
+    return histogram_rows(h, edges), h
 
 
 class _Results(NamedTuple):
@@ -285,8 +222,22 @@ def _results(study, me, tab, lt, boot_up, scale, window, alt, E0, gamma, E_C, n_
     boot_err = {("inside", window): float(p["mu_err"]), ("inside", alt): float(alt_row["mu_err"])}
     err_up = boot_up.assign(w=np.tile(np.arange(2), n_boot)).groupby("w")["mu"].std(ddof=1).to_numpy() * scale
     boot_err.update({("above", window): float(err_up[0]), ("above", alt): float(err_up[1])})
-    authors = _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits)
-    ribbon = _ribbons(study, me)
+    sp = study.params
+    authors = authors_convention(
+        me,
+        boot_err,
+        window,
+        alt,
+        E0,
+        gamma,
+        n_orbits,
+        paper_mu=sp.paper_mu,
+        half_unit=sp.paper_mu_half_unit,
+        selection=sp.authors_selection,
+        authors_window=sp.authors_window,
+        setup=study.convention_label,
+    )
+    ribbon = ribbons(me, sp.ribbon_t, sp.plot_t_max)
     return _Results(p, later_tab, last, n_settled, over, tau2_pred, tau2_pred_err, authors, ribbon)
 
 
@@ -386,153 +337,6 @@ def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbit
         "paper_mu": study.params.paper_mu,
         "authors_convention": {**res.authors, "ribbon": {k: v for k, v in res.ribbon.items() if k != "rows"}},
     }
-
-
-SELECTIONS = {  # which orbits ⟨E⟩(t) averages over; the keys of [study] authors_selection
-    "inside": "every orbit not escaped by t (settled ones continued below E_c)",
-    "above": "orbits with E > E_c only (an orbit leaves at settling, as for P(t))",
-}
-
-
-WHO = {"inside": "every orbit inside Ω", "above": "orbits with E > E_c only"}  # short, for row names
-
-
-def _window_text(w) -> str:
-    return f"[{w[0]:g}, {w[1]:g}]"
-
-
-def _authors_convention(study, me, boot_err, window, alt, E0, gamma, n_orbits) -> dict:
-    """μ of Eq. (eqn:energy_exp_decay) in each selection × window, flagged and judged (key authors_convention).
-
-    ``me``: the fig3_mean_energy table (columns t, mean_E, mean_E_above, n_above); ``boot_err``: {(selection,
-    window): 1σ bootstrap error}.  Selection "inside" averages every orbit not escaped by t, "above" only
-    the orbits with E > E_c (its curve ends when the last orbit settles: its fit uses the points up to then,
-    whatever the window says).  Each fit is the unweighted log fit with E(0) = E0 (:func:`fit_energy_decay`).
-    The row in (fit_window, "inside") is ours, the one that fig3.json ``mu`` holds.
-    """
-    from hhscatter.analysis.dissipative.decay import fit_energy_decay
-
-    paper_mu = study.params.paper_mu
-    half = study.params.paper_mu_half_unit
-    a_sel = study.params.authors_selection
-    a_win = tuple(study.params.authors_window)
-    if a_sel not in SELECTIONS:
-        raise ValueError(f"[study] authors_selection must be one of {sorted(SELECTIONS)}, got {a_sel!r}")
-    if a_win not in (window, alt):
-        raise ValueError(
-            f"[study] authors_window must be fit_window {list(window)} or alt_window {list(alt)}, got {list(a_win)}"
-        )
-    column = {"inside": "mean_E", "above": "mean_E_above"}
-    t = me["t"].to_numpy()
-    t_end_above = float(t[me["n_above"].to_numpy() > 0].max())
-    out = []
-    for sel in ("inside", "above"):
-        for w in (window, alt):
-            f = fit_energy_decay(t, me[column[sel]].to_numpy(), E0, gamma, w)
-            used = (t >= w[0]) & (t <= w[1]) & np.isfinite(me[column[sel]].to_numpy())
-            t_last = float(t[used].max())
-            is_ours = sel == "inside" and w == window
-            is_authors = sel == a_sel and w == a_win
-            who = (
-                "authors' and ours"
-                if is_ours and is_authors
-                else ("authors'" if is_authors else ("ours" if is_ours else "alternative"))
-            )
-            ends = f" (its points end at t = {t_last:g}: no orbit is above E_c later)" if t_last < w[1] else ""
-            label = f"{sel}, fit {_window_text(w)}"
-            err = boot_err[(sel, w)]
-            out.append(
-                {
-                    "selection": sel,
-                    "window": list(w),
-                    "label": label,
-                    "quantity": (
-                        f"μ on {_window_text(w)} (log fit, E(0)=E0)"
-                        if is_ours
-                        else f"μ on {_window_text(w)}, {WHO[sel]}"
-                    ),
-                    "value": f.mu,
-                    "err": err,
-                    "fit_err": f.mu_err,
-                    "n_points": f.n_points,
-                    "t_last": t_last,
-                    "ours": is_ours,
-                    "authors": is_authors,
-                    "convention": (
-                        f"{who}: {SELECTIONS[sel]}; unweighted log fit on {_window_text(w)}{ends}; "
-                        f"{study.convention_label}"
-                    ),
-                    "verdict": mu_verdict(f.mu, err, paper_mu, half),
-                    "note": (
-                        f"bootstrap (orbits) error; fit misfit error {f.mu_err:.2g}; N = {n_orbits}; "
-                        f"{abs(f.mu - paper_mu) / err:.1f}σ from {paper_mu:g}"
-                    ),
-                }
-            )
-    ours = next(r for r in out if r["ours"])
-    ours["verdict"] = verdict_beside_authors(ours["verdict"], [r for r in out if r["authors"] and not r["ours"]])
-    return {
-        "authors_selection": a_sel,
-        "authors_window": list(a_win),
-        "selections": SELECTIONS,
-        "reading": (
-            "the paper's Fig. 3: μ = 0.91 on [0, 200] of ⟨E⟩ 'over an ensemble of trajectories "
-            "inside Ω at time t'; selection and window flagged authors=True: [study] "
-            "authors_selection, authors_window"
-        ),
-        "paper_mu": paper_mu,
-        "paper_mu_half_unit": half,
-        "t_end_above": t_end_above,
-        "mu": out,
-    }
-
-
-def _ribbons(study, me) -> dict:
-    """The two ribbons of Fig. 3 at [study] ribbon_t: ± 3 SD of the energies (the caption's "3 standard
-    deviations", the ensemble's spread) and ± 3 SEM (ours, = 3 SD/√n: how well ⟨E⟩ is known); energies in
-    model units.  Also the largest half-width relative to ⟨E⟩ of each over the figure's time axis."""
-    t = me["t"].to_numpy()
-    i = int(np.argmin(np.abs(t - study.params.ribbon_t)))
-    r = me.iloc[i]
-    t_max = study.params.plot_t_max
-    vis = t <= (t[-1] if t_max is None else float(t_max))
-    rel_sd = float((3 * me["std_E"] / me["mean_E"])[vis].max())
-    rel_sem = float((3 * me["sem_E"] / me["mean_E"])[vis].max())
-    n = int(r["n"])
-    tr = f"t = {float(r['t']):g}"
-    rows = [
-        {
-            "quantity": f"ribbon half-width at {tr}: 3 standard deviations of E",
-            "value": float(3 * r["std_E"]),
-            "authors": True,
-            "convention": "authors': ± 3 standard deviations of the energies of the orbits inside Ω "
-            "(the ensemble's spread; Fig. 3 caption)",
-            "note": f"{3 * r['std_E'] / r['mean_E']:.2%} of ⟨E⟩ = {r['mean_E']:.4g}; n = {n} orbits",
-        },
-        {
-            "quantity": f"ribbon half-width at {tr}: 3 standard errors of ⟨E⟩",
-            "value": float(3 * r["sem_E"]),
-            "authors": False,
-            "convention": "ours: ± 3 standard errors of the mean ⟨E⟩ (= 3 SD/√n)",
-            "note": f"{3 * r['sem_E'] / r['mean_E']:.3%} of ⟨E⟩; SD/SEM = {r['std_E'] / r['sem_E']:.4g} = √n",
-        },
-    ]
-    return {
-        "t": float(r["t"]),
-        "n": n,
-        "mean_E": float(r["mean_E"]),
-        "half_width_3sd": float(3 * r["std_E"]),
-        "half_width_3sem": float(3 * r["sem_E"]),
-        "max_rel_half_width_3sd": rel_sd,
-        "max_rel_half_width_3sem": rel_sem,
-        "rows": rows,
-    }
-
-
-def _nearest(grid, times):
-    idx = np.clip(np.searchsorted(grid, times), 1, len(grid) - 1)
-    left, right = grid[idx - 1], grid[idx]
-    return np.where(np.abs(np.asarray(times) - left) <= np.abs(right - np.asarray(times)), left, right)
 
 
 def plot(study):

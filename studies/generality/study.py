@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.claims.chain import analyze_claims, analyze_evidence, check_params
 from hhscatter.analysis.claims.keys import (
     alt_key,
     cm_key,
@@ -37,7 +38,7 @@ from hhscatter.analysis.claims.keys import (
     resc_key,
     sec_key,
 )
-from hhscatter.analysis.claims.resc import resc_rows, resc_values
+from hhscatter.analysis.claims.resc import resc_values
 from hhscatter.scene.scene import MOMENTA, REGIONS
 from hhscatter.scene.schema import (
     Integer,
@@ -143,33 +144,6 @@ def _systems(study):
     return out
 
 
-def _check(study):
-    ratios, probes = list(study.params.ratios), list(study.params.probe_ratios)
-    off = [r for r in probes if not np.isclose(ratios, r).any()]
-    if off:
-        raise ValueError(f"[study].probe_ratios must be among ratios (their κ, τ0 set the window); {off} are not")
-    gs = list(study.params.gammas)
-    if 0.0 not in gs or study.params.mu_gamma not in gs or sorted(gs) != gs:
-        raise ValueError(f"[study].gammas must be increasing, contain 0 and mu_gamma; got {gs}")
-    if any(r <= 1 for r in ratios) or any(r >= 1 for r in study.params.mc_ratios):
-        raise ValueError("[study].ratios must be > 1 (above E_c) and mc_ratios < 1 (below)")
-    off = [r for r in study.params.cm_ratios if not np.isclose(ratios, r).any()]
-    if off:
-        raise ValueError(f"[study].cm_ratios must be among ratios (claim 2 compares with their κ0); {off} are not")
-    c5 = study.params.c5_ratio
-    if not np.isclose(study.params.cm_ratios, c5).any() or not 1 < c5 < study.params.e0_ratio:
-        raise ValueError(f"[study].c5_ratio = {c5} must be one of cm_ratios and between 1 and e0_ratio")
-    p = study.params
-    if max(p.ev_times) > p.ev_t_max or not 0 < p.ev_window < min(p.ev_t_max, p.ps_t_max):
-        raise ValueError("[study].ev_times must be ≤ ev_t_max and ev_window inside (0, min(ev_t_max, ps_t_max))")
-    if not np.isclose(p.resc_ratios, p.e0_ratio).any():
-        raise ValueError(f"[study].resc_ratios must contain e0_ratio = {p.e0_ratio:g} (2⟨K⟩/E measured at E0)")
-    if not study.params.cm_t_max > study.params.cm_t_to:
-        raise ValueError(
-            "[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max are dropped as KAM-trapped)"
-        )
-
-
 # ---------------------------------------------------------------------------
 # simulate
 # ---------------------------------------------------------------------------
@@ -178,7 +152,7 @@ def simulate(study, workers=None, progress=True):
     from hhscatter.analysis.claims.cmeasure import c5_window
     from hhscatter.analysis.dissipative.decay import snapshot_grid
 
-    _check(study)
+    check_params(study.params)
     p = study.params
     if "evidence" in p.parts:
         _simulate_evidence(study, workers, progress)
@@ -266,14 +240,21 @@ class _Runs:
     def lifetimes(self, key):
         return _lifetimes(self.study.raw(key))
 
-    def sections(self, key, t_from):
+    def sections(self, key, t_from=None, columns=("traj_id", "t", "x", "y", "energy")):
+        """The section crossings of run ``key`` at t ≥ t_from (all without t_from), these columns (None: all)."""
         import pyarrow.dataset as pads
 
         from hhscatter.data.read import read_sections
 
-        return read_sections(
-            self.study.raw(key), columns=["traj_id", "t", "x", "y", "energy"], filters=pads.field("t") >= t_from
-        )
+        flt = None if t_from is None else pads.field("t") >= t_from
+        return read_sections(self.study.raw(key), columns=None if columns is None else list(columns), filters=flt)
+
+    def shadow_ics(self, key):
+        """The ICs of the shadow run of ``key`` (traj_id, x, y, px, py, d0); None where no orbit was left."""
+        import pyarrow.parquet as pq
+
+        path = self.study.derived(f"{key}_shadow_ics.parquet")
+        return pq.read_table(path).to_pandas() if path.exists() else None
 
     def snapshots(self, key, *, t_from=None, t_to=None, max_id=None):
         import pyarrow.dataset as pads
@@ -302,14 +283,17 @@ def analyze(study):
     from hhscatter.data.schema import provenance
     from hhscatter.studies.jsonio import write_json_atomic
 
-    _check(study)
-    p = study.params
+    check_params(study.params)
+    p, runs, systems = study.params, _Runs(study), _systems(study)
     if "claims" in p.parts:
-        numbers = _analyze_claims(study)
+        compare = lambda *a, **k: study.compare(*a, **k, convention=study.convention_label)  # noqa: E731
+        numbers, tables = analyze_claims(runs, systems, compare)
+        _write_tables(study, tables)
     else:
         numbers = study.read_numbers() if study.numbers_path.exists() else {}
     if "evidence" in p.parts:
-        ev = _analyze_evidence(study, numbers)
+        ev, tables = analyze_evidence(runs, systems, numbers)
+        _write_tables(study, tables)
         if "claims" not in p.parts and numbers:  # merge: the claims' record kept, with its scale and provenance
             rec = {"scale": study.scale, "config": study.config, "provenance": provenance()}
             numbers.update(ev, claims=with_ids(numbers.get("claims", [])), evidence_record=rec)
@@ -319,88 +303,10 @@ def analyze(study):
     study.write_numbers(numbers)
 
 
-def _analyze_claims(study) -> dict:
-    """Claims 1–7 per system (:mod:`hhscatter.analysis.claims`): the derived tables and the claims' part of
-    generality.json (returned). Claim 6's verdicts are given once every system is fitted (against Hénon–Heiles
-    wherever it stands in [study] systems)."""
-    from hhscatter.analysis.claims import cmeasure, dissipative, kappa, mu
-    from hhscatter.analysis.claims.records import RULES, Claims
-
-    p, runs = study.params, _Runs(study)
-    claims = Claims(lambda *a, **k: study.compare(*a, **k, convention=study.convention_label))
-    kappa_rows, mu_rows, tau_tables, curves, hazards, systems, sm6, kcm_rows = [], [], [], [], [], {}, {}, []
-    for label, spec, m in _systems(study):
-        ec = m.critical_energy
-        E0 = p.e0_ratio * ec
-        rows, fits = kappa.kappa_rows(runs, label, m)
-        kappa_rows += rows
-        table = pd.DataFrame(rows)
-        per = kappa.fit_law(runs, table)
-        kappa.claim1(claims, label, per, table)
-        mrows, cur, (mu_m, mu_m_err), mu_numbers = mu.analyze_mu(runs, claims, label, spec, m, E0, fits)
-        mu_rows += mrows
-        curves += cur
-        taus = dissipative.taus(runs, label, m, E0, mu_m, mu_m_err)
-        tau_tables.append(taus)
-        dissipative.claim4(claims, label, taus, p.mu_gamma)
-        sm6[label] = dissipative.fit_claim6(runs, label, m, per, taus, E0, mu_m)
-        samples = {r: cmeasure.cm_sample(runs, label, r) for r in cm_ratios(p)}
-        cm_rows = cmeasure.claim2(runs, claims, label, table, samples)
-        kcm_rows += [{"system": label, **{k: v for k, v in r.items() if not isinstance(v, dict)}} for r in cm_rows]
-        c5 = cmeasure.claim5_distance(runs, claims, label, m, E0, mu_m, samples)
-        hz = dissipative.claim7(runs, claims, label, m, table, taus, E0, mu_m)
-        if hz is not None:
-            hazards.append(hz)
-        systems[label] = {
-            "spec": spec,
-            "E_c": ec,
-            "n_exits": len(m.exits),
-            "saddle_radius": m.saddle_radius,
-            "ic_radius": p.radius_frac * m.saddle_radius,
-            "r_esc_at_E0": float(m.default_escape_radius(E0)),
-            "E0": E0,
-            "kappa_law": per,
-            **mu_numbers,
-            "taus": taus.drop(columns=["system"]).to_dict(orient="records"),
-            "kappa_cmeasure": cm_rows,
-            "cmeasure_distance": c5,
-        }
-    hh = next((label for label, spec, _ in _systems(study) if spec["name"] == "henon_heiles"), None)
-    for label, rec in dissipative.claim6(claims, sm6, hh, p).items():
-        systems[label]["survival_model"] = rec
-    ktab = pd.DataFrame(kappa_rows)
-    for df, name, what in (
-        (ktab, "kappa", "κ0(E) per system, E/E_c and window convention"),
-        (
-            pd.DataFrame(mu_rows),
-            "mu_conservative",
-            "2⟨K⟩/E of the conservative system: c-measure (probe drag) and microcanonical well",
-        ),
-        (
-            pd.concat(curves, ignore_index=True),
-            "energy_curves",
-            "⟨E⟩(t)/E0 measured and the predicted path dE/dt = −γ μ(E) E",
-        ),
-        (pd.concat(tau_tables, ignore_index=True), "taus", "τ0, τ1, τ2 per γ"),
-        (
-            pd.DataFrame(kcm_rows),
-            "kappa_cmeasure",
-            "claim 2: κ from the c-measure, Eq. (eqn:kappa_cmeasure_truetime), beside κ0",
-        ),
-        (
-            pd.concat(hazards, ignore_index=True) if hazards else None,
-            "hazard",
-            "claim 7: escape hazard of the smallest γ per time bin, κ0 at E0 e^(−μγt)",
-        ),
-    ):
-        if df is not None:
-            study.write_table(df, f"{name}.parquet", description=what)
-    return {
-        "rules": RULES,
-        "systems": systems,
-        "claims": claims.rows,
-        "kappa": ktab.replace({np.nan: None}).to_dict(orient="records"),
-    }
+def _write_tables(study, tables: dict) -> None:
+    """Write the derived tables {name: (DataFrame, description)} as <name>.parquet."""
+    for name, (df, what) in tables.items():
+        study.write_table(df, f"{name}.parquet", description=what)
 
 
 # ---------------------------------------------------------------------------
@@ -529,106 +435,6 @@ def _simulate_resc(study, label, spec, m, workers, progress):
             continue_settled=True,
         )
         study.run(key, sc, workers=workers, progress=progress)
-
-
-def _indicator(study, key, t_from):
-    """(lifetimes, shadow indicator frame) of the pair ``key`` / ``key_shadow``."""
-    import pyarrow.dataset as pads
-    import pyarrow.parquet as pq
-
-    from hhscatter.analysis.geometry.regularity import shadow_indicator
-    from hhscatter.data.read import read_sections
-
-    lt = _lifetimes(study.raw(key))
-    shp = study.derived(f"{key}_shadow_ics.parquet")
-    if not shp.exists():
-        return lt, pd.DataFrame({"traj_id": [], "regular": [], "kind": []})
-    ics = pq.read_table(shp).to_pandas()
-    flt = pads.field("t") >= t_from
-    ind = shadow_indicator(
-        read_sections(study.raw(key), filters=flt),
-        read_sections(study.raw(key + "_shadow"), filters=flt),
-        ics["traj_id"],
-        ics["d0"],
-        t_from,
-        g_max=study.params.ev_g_max,
-    )
-    return lt, ind
-
-
-def _analyze_evidence(study, numbers: dict) -> dict:
-    """The evidence keys of generality.json: regular_fraction, survival_long, long_time, validity_map, resc."""
-    from hhscatter.analysis.claims.evidence import (
-        decay_curves,
-        first_below,
-        long_time_record,
-        regular_record,
-        validity_map,
-    )
-    from hhscatter.analysis.geometry.regularity import INDICATOR
-    from hhscatter.data.read import read_sections
-
-    p = study.params
-    reg, surv, fits, points, curves = [], [], [], [], []
-    t_from = p.ev_t_max - p.ev_window
-    grid = np.linspace(0.0, p.ev_t_max, 401)
-    for label, spec, _m in _systems(study):
-        head = {"system": spec["name"], "label": label}
-        for ics in p.ev_ics:
-            for r in p.ev_ratios:
-                lt, ind = _indicator(study, ev_key(label, ics, r), t_from)
-                name = "disk/tangential" if ics == "disk" else f"{ics}/{p.alt_momentum}"
-                at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": name}
-                reg.append(
-                    {
-                        **at,
-                        **regular_record(lt, ind),
-                        "indicator": INDICATOR,
-                        "t_from": t_from,
-                        "g_max": p.ev_g_max,
-                        "delta": p.ev_delta,
-                    }
-                )
-                rows, fit = long_time_record(
-                    lt, ind.loc[ind["regular"].astype(bool), "traj_id"], p.ev_times, p.ev_fit_t0, p.ev_hazard_edges
-                )
-                surv += [{**at, **row, "id": f"{at['id']}-t{row['t']:g}"} for row in rows] if ics == "disk" else []
-                fits.append({**at, **fit})
-                curves.append(
-                    decay_curves(lt, ind.loc[ind["regular"].astype(bool), "traj_id"], grid).assign(
-                        label=label, e_ratio=r, ics=ics
-                    )
-                )
-        for r in p.ps_ratios:
-            lt, ind = _indicator(study, ps_key(label, r), p.ps_t_max - p.ev_window)
-            sec = read_sections(study.raw(ps_key(label, r)), columns=["traj_id", "t", "x", "y", "px", "py"])
-            kind = sec["traj_id"].map(ind.set_index("traj_id")["kind"]).fillna("escaped")
-            points.append(sec.assign(system=label, e_ratio=r, kind=kind.astype(str)))
-    if points:
-        study.write_table(
-            pd.concat(points, ignore_index=True),
-            "sections_regular.parquet",
-            description="section crossings of the Poincaré runs with each orbit's indicator verdict",
-        )
-    study.write_table(
-        pd.concat(curves, ignore_index=True),
-        "survival_long.parquet",
-        description="Kaplan–Meier P(t) to ev_t_max of all and of the non-regular orbits",
-    )
-    study.write_table(
-        pd.DataFrame(fits).drop(columns=["hazard_nonregular"]),
-        "long_time.parquet",
-        description="plateau-plus-exponential fits and the non-regular decay per system, E/E_c, ICs",
-    )
-    vmap = validity_map(reg, fits, numbers.get("kappa", []), numbers.get("claims", []), ics="disk/tangential")
-    return {
-        "regular_fraction": reg,
-        "survival_long": surv,
-        "long_time": fits,
-        "validity_map": vmap,
-        "regular_below_1pc": first_below(reg, 0.01, ics="disk/tangential"),
-        "resc": resc_rows(_Runs(study), _systems(study)),
-    }
 
 
 def plot(study):

@@ -223,9 +223,8 @@ def _fixed_intercept_mu(t, mean_E, E0, gamma, window):
 def test_fig3_mu_verdict_rule():
     """The verdict of a μ row against the paper's "0.91": 2σ, then the paper's quoting precision; and our row's
     "differs" is kept only when no authors'-convention row agrees."""
-    from hhscatter.studies import stage_module
-
-    mu_verdict, verdict_beside_authors = stage_module("fig3").mu_verdict, stage_module("fig3").verdict_beside_authors
+    from hhscatter.analysis.stats.verdicts import quoted_verdict as mu_verdict
+    from hhscatter.analysis.stats.verdicts import verdict_beside_authors
 
     assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"  # |Δ| = 0.0005 ≤ 2σ
     assert mu_verdict(0.9139, 0.0005, 0.91, 0.005) == "agrees to the paper's quoted digits"  # prints as 0.91

@@ -241,3 +241,67 @@ def test_claim5_committed_verdicts_state_the_sign_of_the_paired_interval(scale):
             assert rec["verdict"].startswith("closer to μ_c^E0") == (hi < 0)
             checked += 1
     assert checked >= 1
+
+
+class _TinyRuns:
+    """The raw runs of the tiny build as the claims' analysis reads them (hhscatter.analysis.claims.chain)."""
+
+    def __init__(self, out, params):
+        self.raw, self.params = out / "raw", params
+
+    def lifetimes(self, key):
+        from hhscatter.data.read import read_lifetimes
+
+        return read_lifetimes(self.raw / key, columns=["traj_id", "outcome", "t_end"], categorical=True)
+
+    def sections(self, key, t_from=None, columns=("traj_id", "t", "x", "y", "energy")):
+        import pyarrow.dataset as pads
+
+        from hhscatter.data.read import read_sections
+
+        flt = None if t_from is None else pads.field("t") >= t_from
+        return read_sections(self.raw / key, columns=None if columns is None else list(columns), filters=flt)
+
+    def snapshots(self, key, *, t_from=None, t_to=None, max_id=None):
+        import pyarrow.dataset as pads
+
+        from hhscatter.data.read import read_snapshots
+
+        t = pads.field("t")
+        f = pads.field("traj_id") < max_id if max_id is not None else ((t >= t_from) & (t <= t_to))
+        return read_snapshots(self.raw / key, columns=["traj_id", "t", "energy"], filters=f)
+
+    def snapshot_parts(self, key):
+        from hhscatter.data.read import iter_parts
+
+        return iter_parts(self.raw / key, "snapshots", ["t", "energy"])
+
+
+def test_claims_do_not_depend_on_the_order_of_the_systems(tiny):
+    """The claims analysed on the tiny runs with the systems in the study's order and in the reverse order: every
+    record (verdict, value, error, reference, note) the same, claim 6 judged against Hénon–Heiles (last in the
+    reverse order). The library's verdicts are compared: the tiny JSON states none."""
+    from hhscatter.analysis.claims.chain import analyze_claims
+    from hhscatter.model.spec import system_from_spec
+    from hhscatter.studies import load_study
+
+    out, doc = tiny
+    params = load_study("generality", "tiny").params
+    systems = []
+    for e in params.systems:
+        spec = {"name": e["name"], "params": dict(e.get("params") or {})}
+        systems.append((e["label"], spec, system_from_spec(spec)))
+    assert systems[0][0] == "henon_heiles"
+    runs = _TinyRuns(out, params)
+    key = lambda c: (c["system"], c["quantity"], c["id"])  # noqa: E731
+    fields = ("verdict", "value", "err", "reference", "note")
+    recs = []
+    for order in (systems, systems[::-1]):
+        numbers, _ = analyze_claims(runs, order)
+        recs.append({key(c): [c[f] for f in fields] for c in numbers["claims"]})
+    assert recs[0] == recs[1]
+    assert {k[:2]: v[1] for k, v in recs[0].items()} == {
+        (c["system"], c["quantity"]): c["value"] for c in doc["claims"]
+    }
+    six = [v[0] for k, v in recs[1].items() if k[0] != "henon_heiles" and k[2].endswith(("-6-0", "-6-1"))]
+    assert six and all("Hénon–Heiles" in v for v in six)

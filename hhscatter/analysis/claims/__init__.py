@@ -6,6 +6,9 @@ Every public name of its modules is importable from here (loaded on first use).
 from hhscatter.analysis._exports import lazy_exports
 
 _EXPORTS = {
+    "analyze_claims": "chain",
+    "analyze_evidence": "chain",
+    "check_params": "chain",
     "c5_window": "cmeasure",
     "claim2": "cmeasure",
     "claim5_distance": "cmeasure",
@@ -24,6 +27,7 @@ _EXPORTS = {
     "exponents": "kappa",
     "fit_law": "kappa",
     "kappa_rows": "kappa",
+    "rate_or_reason": "kappa",
     "window_rate": "kappa",
     "alt_key": "keys",
     "cm_key": "keys",

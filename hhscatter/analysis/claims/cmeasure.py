@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 
+from hhscatter.analysis.claims.kappa import rate_or_reason
 from hhscatter.analysis.claims.keys import cm_key, sec_key
 from hhscatter.analysis.claims.records import ve, z_verdict
 from hhscatter.analysis.dissipative.decay import time_to_energy
@@ -17,7 +18,6 @@ from hhscatter.analysis.survival.cmeasure import (
     cmeasure_sample_from_sections,
     kappa_from_cmeasure,
 )
-from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
 
 def c5_window(p, ec):
@@ -53,12 +53,9 @@ def cm_sample(runs, label, r):
         "reason": "",
     }
     esc = lt[lt["outcome"] != "censored"]
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            res = escape_rate_from_lifetimes(esc, detect_tail=False, min_survivors=p.min_survivors)
-    except (ValueError, RuntimeError) as exc:
-        out["reason"] = f"no κ, τ0 from the escaping orbits' P(t) for t_rec: {exc}"
+    res, why = rate_or_reason(esc, p.min_survivors)
+    if res is None:
+        out["reason"] = f"no κ, τ0 from the escaping orbits' P(t) for t_rec: {why}"
         return out
     t_rec = float(math.ceil(res.tau0 + p.cm_rec_efolds / res.kappa))
     t_to = p.cm_t_to - p.cm_margin

@@ -22,20 +22,36 @@ CONVENTIONS = ("plateau", "plevel", "escaping")
 HH_PAPER_BREAK = (0.27 - 1 / 6) / (1 / 6)  # the paper's E_b ≈ 0.27 for Hénon–Heiles, as (E_b − E_c)/E_c
 
 
-def window_rate(lifetimes, p, failure: str):
-    """window_rate(lifetimes, p, failure) -> (ConventionRate | None, EscapeRateResult | None, reason).
+def rate_or_reason(lifetimes, min_survivors: float):
+    """κ of a lifetimes table by :func:`escape_rate_from_lifetimes` (data-driven plateau windows, no tail search):
+    (EscapeRateResult, "") or, where the window rule fails (too few escapes), (None, the rule's message).
 
-    κ of :func:`escape_rate_from_lifetimes` (data-driven plateau windows) with the trapped-plateau check
-    (``p.max_plateau_bias``); where the window rule fails (too few escapes), None and ``failure`` followed by the
-    rule's message: the reason of this convention alone.
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> lt = pd.DataFrame({"t_end": np.arange(1.0, 11.0), "outcome": ["escaped"] * 10})
+    >>> res, reason = rate_or_reason(lt, 50.0)
+    >>> res is None and reason != ""
+    True
     """
-    t_end, obs = lifetimes_to_arrays(lifetimes)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = escape_rate_from_lifetimes(lifetimes, detect_tail=False, min_survivors=p.min_survivors)
+            return escape_rate_from_lifetimes(lifetimes, detect_tail=False, min_survivors=min_survivors), ""
     except (ValueError, RuntimeError) as exc:  # too few escapes for the window rule: said, not hidden
-        return None, None, f"{failure}: {exc}"
+        return None, str(exc)
+
+
+def window_rate(lifetimes, p, failure: str):
+    """window_rate(lifetimes, p, failure) -> (ConventionRate | None, EscapeRateResult | None, reason).
+
+    κ of :func:`rate_or_reason` with the trapped-plateau check (``p.max_plateau_bias``); where the window rule
+    fails, None and ``failure`` followed by the rule's message: the reason of this convention alone.
+    """
+    t_end, obs = lifetimes_to_arrays(lifetimes)
+    res, why = rate_or_reason(lifetimes, p.min_survivors)
+    if res is None:
+        return None, None, f"{failure}: {why}"
     return plateau_rate(res, t_end, obs, max_bias=p.max_plateau_bias), res, ""
 
 

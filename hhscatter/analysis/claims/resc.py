@@ -4,11 +4,11 @@ per escape radius, with the same N and rules for each (the default radius and ``
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.claims.kappa import rate_or_reason
 from hhscatter.analysis.claims.keys import resc_key
 from hhscatter.analysis.claims.mu import (
     mu_conservative,
@@ -18,7 +18,6 @@ from hhscatter.analysis.claims.mu import (
     mu_windows,
 )
 from hhscatter.analysis.claims.records import ve
-from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
 
 def resc_values(p, m) -> list:
@@ -42,14 +41,9 @@ def resc_rows(runs, systems) -> list:
             fits = {}
             for r in p.resc_ratios:
                 lt = runs.lifetimes(resc_key(label, R, f"r{r:.3f}"))
-                try:
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")
-                        fits["escaping", r] = escape_rate_from_lifetimes(
-                            lt[lt["outcome"] != "censored"], detect_tail=False, min_survivors=p.min_survivors
-                        )
-                except (ValueError, RuntimeError):
-                    pass
+                res, _ = rate_or_reason(lt[lt["outcome"] != "censored"], p.min_survivors)
+                if res is not None:  # too few escapes: no κ, τ0 for the probe window at this energy
+                    fits["escaping", r] = res
             keys = {r: resc_key(label, R, f"probe_r{r:.3f}") for r in p.resc_ratios}
             mdf = pd.DataFrame(mu_conservative(runs, label, m, fits, keys=keys))
             meas, _, (own, _) = mu_measured(

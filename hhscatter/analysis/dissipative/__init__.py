@@ -6,6 +6,15 @@ Every public name of its modules is importable from here (loaded on first use); 
 from hhscatter.analysis._exports import lazy_exports
 
 _EXPORTS = {
+    "FIG3_SELECTIONS": "paper_fig3",
+    "add_bootstrap_errors": "paper_fig3",
+    "authors_convention": "paper_fig3",
+    "fit_windows": "paper_fig3",
+    "histogram_rows": "paper_fig3",
+    "mu_table": "paper_fig3",
+    "nearest_times": "paper_fig3",
+    "paper_fit": "paper_fig3",
+    "ribbons": "paper_fig3",
     "EnergyDecayFit": "decay",
     "EnergyHistograms": "decay",
     "InsideMeanEnergy": "decay",
@@ -69,7 +78,7 @@ _EXPORTS = {
     "SurvivalModelParams": "survival_model",
     "fit_survival_model": "survival_model",
     "homogeneous_start": "survival_model",
-    "profile_interval": "survival_model",
+    "profile_interval": "curve_fit",
     "settling_rate": "survival_model",
     "log_time_grid": "transition_tables",
     "survival_ratio_tables": "transition_tables",

@@ -47,14 +47,12 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.dissipative.curve_fit import fit_stats, lsq, residual_fn
 from hhscatter.analysis.dissipative.survival_model import (
     HAZARDS,
     SurvivalFit,
     _component,
     _fit_data,
-    _fit_stats,
-    _lsq,
-    _residual_fn,
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
@@ -426,7 +424,7 @@ def fit_mixture_model(
     model = prob.model(theta, P_tau0)
     r = res(theta)
     # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
-    st = _fit_stats(
+    st = fit_stats(
         sol, model(tf), tf, Pf, r, len(free), absolute_sigma, P_tau0_err, lambda dP: prob.solve([sol.x], P_tau0 + dP)[0]
     )
     values, errors = _mixture_values_errors(prob, theta, names, st, P_tau0, P_tau0_err, tau2_k)
@@ -547,8 +545,8 @@ class _MixtureProblem:
 
     def solve(self, starts, P0):
         """(best solution over ``starts``, or None without free parameters; residual function)."""
-        res = _residual_fn(lambda th: self.model(th, P0)(self.tf), self.Pf, self.sf, self.space)
-        return (_lsq(res, starts, *self.bounds(P0)) if self.free else None), res
+        res = residual_fn(lambda th: self.model(th, P0)(self.tf), self.Pf, self.sf, self.space)
+        return (lsq(res, starts, *self.bounds(P0)) if self.free else None), res
 
 
 def _mixture_values_errors(prob: _MixtureProblem, theta, names, st, P_tau0, P_tau0_err, tau2_k):

@@ -13,8 +13,9 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
+from hhscatter.analysis.dissipative.curve_fit import best_of
 from hhscatter.analysis.dissipative.mixture import fit_mixture_model
-from hhscatter.analysis.dissipative.survival_model import _best_of, fit_survival_model
+from hhscatter.analysis.dissipative.survival_model import fit_survival_model
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 
 __all__ = [
@@ -190,7 +191,7 @@ def best_fit(fit_fn: Callable, starts):
     The χ² surface has local minima (the settling branch can be traded for a lower trapped fraction);
     starts whose fit raises RuntimeError or ValueError are skipped; none left is a RuntimeError.
     """
-    return _best_of(
+    return best_of(
         fit_fn,
         starts,
         lambda f: f.chi2,

@@ -41,8 +41,17 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, special
+from scipy import special
 
+from hhscatter.analysis.dissipative.curve_fit import (
+    FitStats,
+    fit_stats,
+    lsq,
+    p_at,
+    profile_interval,  # noqa: F401 - importable from here too
+    residual_fn,
+    select_points,
+)
 from hhscatter.analysis.dissipative.decay import energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 
@@ -218,129 +227,12 @@ class SurvivalFit:
 
 
 # ---------------------------------------------------------------------------
-# generic weighted least squares
-# ---------------------------------------------------------------------------
-def _select(t, P, P_err, tau0, t_max, P_min):
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
-    P_err = np.asarray(P_err, dtype=float).ravel()
-    if not (t.shape == P.shape == P_err.shape):
-        raise ValueError("t, P and P_err must have the same length")
-    sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
-    if t_max is not None:
-        sel &= t <= t_max
-    return t[sel], P[sel], P_err[sel]
-
-
-def _p_at(t, P, P_err, t0):
-    """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
-    t = np.asarray(t, dtype=float)
-    P = np.asarray(P, dtype=float)
-    E = np.asarray(P_err, dtype=float)
-    ok = np.isfinite(P) & (P > 0)
-    t, P, E = t[ok], P[ok], E[ok]
-    if t.size == 0 or t0 < t[0] or t0 > t[-1]:
-        raise ValueError("cannot interpolate P at tau0 from the data; pass P_tau0")
-    return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
-
-
-def _residual_fn(curve, P, sig, space):
-    if space == "log":
-        y, s = np.log(P), sig / P
-
-        def res(theta):
-            m = curve(theta)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                lm = np.log(np.where(m > 0, m, 1e-300))
-            lm = np.where(np.isfinite(lm), lm, -700.0)
-            return (lm - y) / s
-
-    elif space == "linear":
-
-        def res(theta):
-            m = curve(theta)
-            return (np.where(np.isfinite(m), m, 0.0) - P) / sig
-
-    else:
-        raise ValueError(f"space must be 'log' or 'linear', got {space!r}")
-    return res
-
-
-def _best_of(fit_fn, starts, cost, errors, message):
-    """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
-    none left is a RuntimeError(``message``)."""
-    best = None
-    for x0 in starts:
-        try:
-            r = fit_fn(x0)
-        except errors:
-            continue
-        if best is None or cost(r) < cost(best):
-            best = r
-    if best is None:
-        raise RuntimeError(message)
-    return best
-
-
-def _lsq(res, starts, lo, hi):
-    """Best least_squares solution over several starting points."""
-
-    def solve(x0):
-        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
-        return optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
-
-    return _best_of(solve, starts, lambda r: r.cost, ValueError, "survival fit failed for all starting points")
-
-
-def _covariance(J, chi2_red, absolute_sigma):
-    cov = np.linalg.pinv(J.T @ J)
-    if not absolute_sigma:
-        cov = cov * chi2_red
-    return cov
-
-
-def _goodness(curve_vals, t, P, res_norm, k):
-    n = t.size
-    chi2 = float(np.sum(res_norm**2))
-    dof = n - k
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lr = np.log(curve_vals) - np.log(P)
-    lr = lr[np.isfinite(lr)]
-    rms = float(np.sqrt(np.mean(lr**2))) if lr.size else float("nan")
-    return chi2, dof, (chi2 / dof if dof > 0 else float("nan")), rms, chi2 + 2 * k
-
-
-# ---------------------------------------------------------------------------
 # homogeneous fit
 # ---------------------------------------------------------------------------
 _HOMOG = ("f_ne", "f_e", "L", "b", "tau2")
 
 
-@dataclass(frozen=True)
-class _FitStats:
-    """Post-fit statistics shared by the homogeneous and the mixture fit."""
-
-    chi2: float
-    dof: int
-    chi2_red: float
-    rms: float
-    aic: float
-    cov_fit: np.ndarray  # covariance of the free parameters from the fit alone
-    sens: np.ndarray  # ∂θ/∂P(τ0) from a re-fit at P(τ0) + σ_P(τ0)
-    cov: np.ndarray  # cov_fit plus the propagated error of the measured P(τ0)
-
-
-def _fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> _FitStats:
-    """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
-    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, t, P, r, k)
-    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
-    sens = np.zeros(0 if sol is None else sol.x.size)
-    if refit is not None and P_tau0_err > 0 and sol is not None:
-        sens = (refit(P_tau0_err).x - sol.x) / P_tau0_err
-    return _FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
-
-
-def _survival_fit(model, values, errors, free, st: _FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
+def _survival_fit(model, values, errors, free, st: FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
     return SurvivalFit(
         params=model,
         values=values,
@@ -469,10 +361,10 @@ def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
     """
     t_all = np.asarray(t, dtype=float)
     if P_tau0 is None:
-        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
+        P_tau0, P_tau0_err = p_at(t_all, P, P_err, tau0)
     else:
         P_tau0_err = 0.0
-    tf, Pf, sf = _select(t, P, P_err, tau0, t_max, P_min)
+    tf, Pf, sf = select_points(t, P, P_err, tau0, t_max, P_min)
     if tf.size < 3:
         raise ValueError("fewer than 3 data points selected")
     return P_tau0, P_tau0_err, tf, Pf, sf
@@ -513,7 +405,7 @@ def _homogeneous_result(
     r = res(theta)
     # propagate the error of the measured P(τ0) through the constraint
     refit = (lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0]) if prob.derive_fe else None
-    st = _fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    st = fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
     errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
     errors["tau2"] = tau2_err
     values = dict(v)
@@ -631,11 +523,11 @@ class HomogeneousProblem:
     def fit_at(self, tau2, prev=None, warm_only: bool = False, P0=None):
         """(solution or None, χ², residual function) of the fit with τ2 held at ``tau2``."""
         curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)
-        res = _residual_fn(curve, self.Pf, self.sf, self.space)
+        res = residual_fn(curve, self.Pf, self.sf, self.space)
         if not self.free:
             r = res(np.array([]))
             return None, float(np.sum(r**2)), res
-        sol = _lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
+        sol = lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
         return sol, float(2 * sol.cost), res
 
     def profile(self, taus):
@@ -651,7 +543,7 @@ class HomogeneousProblem:
     def fit_tau2(self, absolute_sigma: bool = True):
         """τ2 fitted by profiling χ²: a coarse scan over [τ0, t_last], then a fine one around its minimum; the
         error is the half-width of the Δχ² = 1 region (scaled by χ²/dof unless ``absolute_sigma``), its two ends
-        found by root-finding on the profile (:func:`profile_interval`), not bounded by the scan's steps.
+        found by root-finding on the profile (:func:`~hhscatter.analysis.dissipative.curve_fit.profile_interval`), not bounded by the scan's steps.
         Returns (τ2, σ_τ2, solution, χ², residual function)."""
         grid = np.linspace(self.tau0 + 1e-9, float(self.tf[-1]), 25)
         prof, _ = self.profile(grid)
@@ -670,47 +562,6 @@ class HomogeneousProblem:
 
         lo, hi = profile_interval(chi2_at, tau2_best, c2min, grid[0], grid[-1], delta=scale, step=fine[1] - fine[0])
         return tau2_best, float((hi - lo) / 2), sol, c2min, res
-
-
-def profile_interval(
-    chi2_of,
-    best: float,
-    chi2_min: float,
-    lo_edge: float,
-    hi_edge: float,
-    *,
-    delta: float = 1.0,
-    step: float | None = None,
-    xtol: float = 1e-9,
-) -> tuple[float, float]:
-    """profile_interval(chi2_of, best, chi2_min, lo_edge, hi_edge, *, delta=1, step=None) -> (lo, hi): the ends of
-    the region χ²(x) ≤ χ²_min + Δ of a profile χ²(x) around its minimum ``best``, by root-finding on each side.
-
-    From ``best`` each side steps outward (``step``, default 1 % of the range,
-    doubling) until the profile exceeds χ²_min + Δ, then
-    :func:`scipy.optimize.brentq` finds the crossing. A side whose profile does
-    not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
-    the allowed range on that side: the data do not bound it).
-    """
-    target = float(chi2_min) + float(delta)
-
-    def g(x):
-        return float(chi2_of(x)) - target
-
-    step = float(step) if step else 0.01 * (hi_edge - lo_edge)
-    ends = []
-    for sign, edge in ((-1.0, lo_edge), (1.0, hi_edge)):
-        inner, h, end = float(best), step, None
-        while end is None:
-            outer = float(best) + sign * h
-            if sign * (outer - edge) >= 0:
-                end = edge if g(edge) <= 0 else float(optimize.brentq(g, *sorted((inner, edge)), xtol=xtol))
-            elif g(outer) > 0:
-                end = float(optimize.brentq(g, *sorted((inner, outer)), xtol=xtol))
-            else:
-                inner, h = outer, 2 * h
-        ends.append(end)
-    return ends[0], ends[1]
 
 
 def _homogeneous_errors(free, st, derive_fe: bool, P_tau0_err: float) -> dict:

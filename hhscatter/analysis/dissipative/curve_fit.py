@@ -1,0 +1,191 @@
+"""The weighted least squares the survival-model fits share (:mod:`~hhscatter.analysis.dissipative.survival_model`,
+:mod:`~hhscatter.analysis.dissipative.mixture`, :mod:`~hhscatter.analysis.dissipative.model_comparison`): the data
+points a fit uses, residuals in log or linear space, the best of several starts, the covariance, the goodness of fit
+(χ², dof, χ²/dof, RMS of log residuals, AIC), the sensitivity to the measured P(τ0), and profile-likelihood
+intervals. P is a survival probability (dimensionless), t in time units.
+
+Examples
+--------
+>>> t = np.array([0.0, 1.0, 2.0, 3.0])
+>>> select_points(t, np.exp(-t), np.full(4, 0.01), 1.0, None, 0.1)[0].tolist()
+[1.0, 2.0]
+>>> lo, hi = profile_interval(lambda x: (x - 2.0) ** 2, 2.0, 0.0, 0.0, 10.0)
+>>> round(lo, 6), round(hi, 6)
+(1.0, 3.0)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize
+
+__all__ = [
+    "FitStats",
+    "best_of",
+    "covariance",
+    "fit_stats",
+    "goodness",
+    "lsq",
+    "p_at",
+    "profile_interval",
+    "residual_fn",
+    "select_points",
+]
+
+
+# ---------------------------------------------------------------------------
+def select_points(t, P, P_err, tau0, t_max, P_min):
+    t = np.asarray(t, dtype=float).ravel()
+    P = np.asarray(P, dtype=float).ravel()
+    P_err = np.asarray(P_err, dtype=float).ravel()
+    if not (t.shape == P.shape == P_err.shape):
+        raise ValueError("t, P and P_err must have the same length")
+    sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
+    if t_max is not None:
+        sel &= t <= t_max
+    return t[sel], P[sel], P_err[sel]
+
+
+def p_at(t, P, P_err, t0):
+    """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
+    t = np.asarray(t, dtype=float)
+    P = np.asarray(P, dtype=float)
+    E = np.asarray(P_err, dtype=float)
+    ok = np.isfinite(P) & (P > 0)
+    t, P, E = t[ok], P[ok], E[ok]
+    if t.size == 0 or t0 < t[0] or t0 > t[-1]:
+        raise ValueError("cannot interpolate P at tau0 from the data; pass P_tau0")
+    return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
+
+
+def residual_fn(curve, P, sig, space):
+    if space == "log":
+        y, s = np.log(P), sig / P
+
+        def res(theta):
+            m = curve(theta)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                lm = np.log(np.where(m > 0, m, 1e-300))
+            lm = np.where(np.isfinite(lm), lm, -700.0)
+            return (lm - y) / s
+
+    elif space == "linear":
+
+        def res(theta):
+            m = curve(theta)
+            return (np.where(np.isfinite(m), m, 0.0) - P) / sig
+
+    else:
+        raise ValueError(f"space must be 'log' or 'linear', got {space!r}")
+    return res
+
+
+def best_of(fit_fn, starts, cost, errors, message):
+    """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
+    none left is a RuntimeError(``message``)."""
+    best = None
+    for x0 in starts:
+        try:
+            r = fit_fn(x0)
+        except errors:
+            continue
+        if best is None or cost(r) < cost(best):
+            best = r
+    if best is None:
+        raise RuntimeError(message)
+    return best
+
+
+def lsq(res, starts, lo, hi):
+    """Best least_squares solution over several starting points."""
+
+    def solve(x0):
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
+        return optimize.least_squares(res, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=2000)
+
+    return best_of(solve, starts, lambda r: r.cost, ValueError, "survival fit failed for all starting points")
+
+
+def covariance(J, chi2_red, absolute_sigma):
+    cov = np.linalg.pinv(J.T @ J)
+    if not absolute_sigma:
+        cov = cov * chi2_red
+    return cov
+
+
+def goodness(curve_vals, t, P, res_norm, k):
+    n = t.size
+    chi2 = float(np.sum(res_norm**2))
+    dof = n - k
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lr = np.log(curve_vals) - np.log(P)
+    lr = lr[np.isfinite(lr)]
+    rms = float(np.sqrt(np.mean(lr**2))) if lr.size else float("nan")
+    return chi2, dof, (chi2 / dof if dof > 0 else float("nan")), rms, chi2 + 2 * k
+
+
+@dataclass(frozen=True)
+class FitStats:
+    """Post-fit statistics shared by the homogeneous and the mixture fit."""
+
+    chi2: float
+    dof: int
+    chi2_red: float
+    rms: float
+    aic: float
+    cov_fit: np.ndarray  # covariance of the free parameters from the fit alone
+    sens: np.ndarray  # ∂θ/∂P(τ0) from a re-fit at P(τ0) + σ_P(τ0)
+    cov: np.ndarray  # cov_fit plus the propagated error of the measured P(τ0)
+
+
+def fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> FitStats:
+    """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
+    chi2, dof, chi2_red, rms, aic = goodness(curve_vals, t, P, r, k)
+    cov_fit = covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    sens = np.zeros(0 if sol is None else sol.x.size)
+    if refit is not None and P_tau0_err > 0 and sol is not None:
+        sens = (refit(P_tau0_err).x - sol.x) / P_tau0_err
+    return FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
+
+
+def profile_interval(
+    chi2_of,
+    best: float,
+    chi2_min: float,
+    lo_edge: float,
+    hi_edge: float,
+    *,
+    delta: float = 1.0,
+    step: float | None = None,
+    xtol: float = 1e-9,
+) -> tuple[float, float]:
+    """profile_interval(chi2_of, best, chi2_min, lo_edge, hi_edge, *, delta=1, step=None) -> (lo, hi): the ends of
+    the region χ²(x) ≤ χ²_min + Δ of a profile χ²(x) around its minimum ``best``, by root-finding on each side.
+
+    From ``best`` each side steps outward (``step``, default 1 % of the range,
+    doubling) until the profile exceeds χ²_min + Δ, then
+    :func:`scipy.optimize.brentq` finds the crossing. A side whose profile does
+    not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
+    the allowed range on that side: the data do not bound it).
+    """
+    target = float(chi2_min) + float(delta)
+
+    def g(x):
+        return float(chi2_of(x)) - target
+
+    step = float(step) if step else 0.01 * (hi_edge - lo_edge)
+    ends = []
+    for sign, edge in ((-1.0, lo_edge), (1.0, hi_edge)):
+        inner, h, end = float(best), step, None
+        while end is None:
+            outer = float(best) + sign * h
+            if sign * (outer - edge) >= 0:
+                end = edge if g(edge) <= 0 else float(optimize.brentq(g, *sorted((inner, edge)), xtol=xtol))
+            elif g(outer) > 0:
+                end = float(optimize.brentq(g, *sorted((inner, outer)), xtol=xtol))
+            else:
+                inner, h = outer, 2 * h
+        ends.append(end)
+    return ends[0], ends[1]

@@ -1,0 +1,338 @@
+"""The paper's Fig. 3 (fig:energy_decay) in tables: the μ of Eq. (eqn:energy_exp_decay) on the paper's window and
+on others, its bootstrap errors, the inset's energy histograms, μ in the authors' conventions beside ours and the
+ribbons of the figure.
+
+The inputs are the ⟨E⟩(t) table of a dissipative run (columns t, n, mean_E, std_E, sem_E and, for the authors'
+selections, mean_E_above and n_above: :func:`~hhscatter.analysis.dissipative.decay.inside_mean_energy`) and the
+results of :mod:`~hhscatter.analysis.dissipative.decay`; nothing here reads a file. Units: t in time units, E in
+energy units, γ in 1/time; μ is dimensionless.
+
+Examples
+--------
+>>> import pandas as pd
+>>> t = np.arange(0.0, 401.0, 2.0)
+>>> me = pd.DataFrame({"t": t, "mean_E": 0.3 * np.exp(-0.9 * 0.01 * t)})
+>>> windows, kinds = fit_windows((0.0, 200.0), [(200.0, 400.0)], [200.0, 200.0], (0.0, 100.0), 400.0)
+>>> tab = mu_table(me, 0.3, 0.01, windows, kinds)
+>>> list(tab["kind"]), [round(m, 6) for m in tab["mu"]]
+(['paper', 'later', 'sliding', 'sliding', 'alt'], [0.9, 0.9, 0.9, 0.9, 0.9])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.dissipative.decay import fit_energy_decay, mu_by_window
+from hhscatter.analysis.stats.verdicts import quoted_verdict, verdict_beside_authors
+
+__all__ = [
+    "FIG3_SELECTIONS",
+    "add_bootstrap_errors",
+    "authors_convention",
+    "fit_windows",
+    "histogram_rows",
+    "mu_table",
+    "nearest_times",
+    "paper_fit",
+    "ribbons",
+]
+
+#: which orbits ⟨E⟩(t) averages over (the keys of a study's ``authors_selection``)
+FIG3_SELECTIONS = {
+    "inside": "every orbit not escaped by t (settled ones continued below E_c)",
+    "above": "orbits with E > E_c only (an orbit leaves at settling, as for P(t))",
+}
+
+_WHO = {"inside": "every orbit inside Ω", "above": "orbits with E > E_c only"}  # short, for row names
+
+
+def _window_text(w) -> str:
+    return f"[{w[0]:g}, {w[1]:g}]"
+
+
+def paper_fit(me: pd.DataFrame, E0: float, gamma: float, window):
+    """The paper's fit of Fig. 3: log⟨E⟩ by E0 e^{−μγt}, Eq. (eqn:energy_exp_decay), on ``window``.
+
+    Adds the column ``fit_E`` (the fitted curve on every t of ``me``) and returns the
+    :func:`~hhscatter.analysis.dissipative.decay.fit_energy_decay` result.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> me = pd.DataFrame({"t": [0.0, 100.0, 200.0], "mean_E": 0.3 * np.exp(-0.91 * 0.01 * np.array([0, 100, 200]))})
+    >>> round(paper_fit(me, 0.3, 0.01, (0.0, 200.0)).mu, 10), "fit_E" in me
+    (0.91, True)
+    """
+    fit = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, window)
+    me["fit_E"] = E0 * np.exp(-fit.mu * gamma * me["t"])
+    return fit
+
+
+def fit_windows(window, later, sliding_window, alt, t_last: float):
+    """The fit windows of μ and their kinds (paper, later, sliding, alt), times in time units.
+
+    The sliding windows ``[lo, lo + width]`` start at 0, stride, 2·stride, ... while they end by ``t_last``
+    (``sliding_window`` = [width, stride]).
+
+    Examples
+    --------
+    >>> fit_windows((0, 200), [(200, 400)], [100.0, 50.0], (0, 100), 250.0)[1]
+    ['paper', 'later', 'sliding', 'sliding', 'sliding', 'sliding', 'alt']
+    """
+    width, stride = sliding_window
+    sliding = [(lo, lo + width) for lo in np.arange(0.0, t_last - width + 1e-9, stride)]
+    windows = [window] + later + sliding + [alt]
+    kinds = ["paper"] + ["later"] * len(later) + ["sliding"] * len(sliding) + ["alt"]
+    return windows, kinds
+
+
+def mu_table(me: pd.DataFrame, E0: float, gamma: float, windows, kinds) -> pd.DataFrame:
+    """μ (E(0) = E0) and μ_free (free intercept) of log⟨E⟩ on every window, with their fit errors (mu_fit_err,
+    mu_free_fit_err) and the window's kind (see the module's example)."""
+    tab = mu_by_window(me["t"], me["mean_E"], E0, gamma, windows)
+    tab["kind"] = kinds
+    return tab.rename(columns={"mu_err": "mu_fit_err", "mu_free_err": "mu_free_fit_err"})
+
+
+def add_bootstrap_errors(tab: pd.DataFrame, me: pd.DataFrame, boot: pd.DataFrame, scale, n_windows, n_boot) -> None:
+    """Add to ``tab`` the bootstrap errors of μ and μ_free per window, the window centres and ⟨E⟩ there.
+
+    ``boot``: the replicates of :func:`~hhscatter.analysis.dissipative.decay.bootstrap_mu_first_orbits`, one row per
+    (replicate, window), replicate-major; the error is the replicates' standard deviation × ``scale`` (√(K/N): the
+    bootstrap ran on K of N orbits). ``mean_E_mid``: ⟨E⟩ interpolated linearly at the window centre ``t_mid``,
+    where on the energy axis the local exponent is measured.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> tab = pd.DataFrame({"t_lo": [0.0], "t_hi": [200.0]})
+    >>> boot = pd.DataFrame({"mu": [0.9, 1.1], "mu_free": [0.9, 1.1]})
+    >>> add_bootstrap_errors(tab, pd.DataFrame({"t": [0.0, 200.0], "mean_E": [0.3, 0.1]}), boot, 1.0, 1, 2)
+    >>> round(float(tab["mu_err"][0]), 4), round(float(tab["mean_E_mid"][0]), 6)
+    (0.1414, 0.2)
+    """
+    boot["w"] = np.tile(np.arange(n_windows), n_boot)
+    err = boot.groupby("w")[["mu", "mu_free"]].std(ddof=1)
+    tab["mu_err"] = err["mu"].to_numpy() * scale
+    tab["mu_free_err"] = err["mu_free"].to_numpy() * scale
+    tab["t_mid"] = 0.5 * (tab["t_lo"] + tab["t_hi"])
+    tab["mean_E_mid"] = np.interp(tab["t_mid"], me["t"], me["mean_E"])
+
+
+def nearest_times(grid, times) -> np.ndarray:
+    """The times of the increasing ``grid`` nearest to each of ``times`` (the earlier one on a tie).
+
+    Examples
+    --------
+    >>> nearest_times(np.array([0.0, 2.0, 4.0]), [1.0, 2.9, 10.0]).tolist()
+    [0.0, 2.0, 4.0]
+    """
+    idx = np.clip(np.searchsorted(grid, times), 1, len(grid) - 1)
+    left, right = grid[idx - 1], grid[idx]
+    return np.where(np.abs(np.asarray(times) - left) <= np.abs(right - np.asarray(times)), left, right)
+
+
+def histogram_rows(h, edges) -> pd.DataFrame:
+    """The inset's histograms as rows: t, bin edges, count and the density in log10 E (Σ density · Δlog10 E = 1 per
+    time; NaN where no orbit is inside).
+
+    ``h``: an :func:`~hhscatter.analysis.dissipative.decay.energy_histograms` result (t_requested, t, counts
+    (times × bins), n_alive, mean_E); ``edges``: the energy bin edges (energy units).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> h = NS(t_requested=[10.0], t=[10.0], counts=np.array([[1, 3]]), n_alive=[4], mean_E=[0.2])
+    >>> histogram_rows(h, np.array([0.01, 0.1, 1.0]))["density_log10E"].tolist()
+    [0.25, 0.75]
+    """
+    dlog = np.diff(np.log10(edges))
+    hrows = []
+    for k in range(len(h.t)):
+        tot = h.counts[k].sum()
+        for b in range(len(edges) - 1):
+            hrows.append(
+                {
+                    "t_requested": h.t_requested[k],
+                    "t": h.t[k],
+                    "e_lo": edges[b],
+                    "e_hi": edges[b + 1],
+                    "count": int(h.counts[k, b]),
+                    "density_log10E": h.counts[k, b] / (tot * dlog[b]) if tot else np.nan,
+                    "n_inside": int(h.n_alive[k]),
+                    "mean_E": h.mean_E[k],
+                }
+            )
+    return pd.DataFrame(hrows)
+
+
+def authors_convention(
+    me: pd.DataFrame,
+    boot_err: dict,
+    window,
+    alt,
+    E0: float,
+    gamma: float,
+    n_orbits: int,
+    *,
+    paper_mu: float,
+    half_unit: float,
+    selection: str,
+    authors_window,
+    setup: str,
+) -> dict:
+    """μ of Eq. (eqn:energy_exp_decay) in each selection × window, flagged and judged against the paper's.
+
+    Parameters
+    ----------
+    me : DataFrame
+        ⟨E⟩(t) (columns t, mean_E, mean_E_above, n_above). Selection "inside" averages every orbit not escaped by t,
+        "above" only the orbits with E > E_c (its curve ends when the last orbit settles: its fit uses the points up
+        to then, whatever the window says).
+    boot_err : dict
+        {(selection, window): 1σ bootstrap error of μ}.
+    window, alt : (float, float)
+        Our fit window and the alternative one (time units).
+    E0, gamma : float
+        Initial energy and drag coefficient; ``n_orbits`` the ensemble's size (for the note).
+    paper_mu, half_unit : float
+        The paper's μ and half a unit of its last printed digit.
+    selection, authors_window
+        The authors' reading: one of :data:`FIG3_SELECTIONS` and ``window`` or ``alt``.
+    setup : str
+        Our setup in words (the study's convention label), appended to every row's convention.
+
+    Returns
+    -------
+    dict
+        The reading and a row per (selection, window) under ``"mu"``: value, bootstrap err, fit_err, n_points,
+        t_last, ours, authors, convention, verdict (:func:`~hhscatter.analysis.stats.verdicts.quoted_verdict`;
+        ours names an authors' row that agrees, :func:`~hhscatter.analysis.stats.verdicts.verdict_beside_authors`),
+        note. Each fit is the unweighted log fit with E(0) = E0; the row in (window, "inside") is ours.
+
+    Raises
+    ------
+    ValueError
+        An unknown selection, or an authors' window that is neither ``window`` nor ``alt``.
+    """
+    a_win = tuple(authors_window)
+    if selection not in FIG3_SELECTIONS:
+        raise ValueError(f"[study] authors_selection must be one of {sorted(FIG3_SELECTIONS)}, got {selection!r}")
+    if a_win not in (window, alt):
+        raise ValueError(
+            f"[study] authors_window must be fit_window {list(window)} or alt_window {list(alt)}, got {list(a_win)}"
+        )
+    column = {"inside": "mean_E", "above": "mean_E_above"}
+    t = me["t"].to_numpy()
+    t_end_above = float(t[me["n_above"].to_numpy() > 0].max())
+    out = []
+    for sel in ("inside", "above"):
+        for w in (window, alt):
+            f = fit_energy_decay(t, me[column[sel]].to_numpy(), E0, gamma, w)
+            used = (t >= w[0]) & (t <= w[1]) & np.isfinite(me[column[sel]].to_numpy())
+            t_last = float(t[used].max())
+            is_ours = sel == "inside" and w == window
+            is_authors = sel == selection and w == a_win
+            who = (
+                "authors' and ours"
+                if is_ours and is_authors
+                else ("authors'" if is_authors else ("ours" if is_ours else "alternative"))
+            )
+            ends = f" (its points end at t = {t_last:g}: no orbit is above E_c later)" if t_last < w[1] else ""
+            err = boot_err[(sel, w)]
+            out.append(
+                {
+                    "selection": sel,
+                    "window": list(w),
+                    "label": f"{sel}, fit {_window_text(w)}",
+                    "quantity": (
+                        f"μ on {_window_text(w)} (log fit, E(0)=E0)"
+                        if is_ours
+                        else f"μ on {_window_text(w)}, {_WHO[sel]}"
+                    ),
+                    "value": f.mu,
+                    "err": err,
+                    "fit_err": f.mu_err,
+                    "n_points": f.n_points,
+                    "t_last": t_last,
+                    "ours": is_ours,
+                    "authors": is_authors,
+                    "convention": (
+                        f"{who}: {FIG3_SELECTIONS[sel]}; unweighted log fit on {_window_text(w)}{ends}; {setup}"
+                    ),
+                    "verdict": quoted_verdict(f.mu, err, paper_mu, half_unit),
+                    "note": (
+                        f"bootstrap (orbits) error; fit misfit error {f.mu_err:.2g}; N = {n_orbits}; "
+                        f"{abs(f.mu - paper_mu) / err:.1f}σ from {paper_mu:g}"
+                    ),
+                }
+            )
+    ours = next(r for r in out if r["ours"])
+    ours["verdict"] = verdict_beside_authors(ours["verdict"], [r for r in out if r["authors"] and not r["ours"]])
+    return {
+        "authors_selection": selection,
+        "authors_window": list(a_win),
+        "selections": FIG3_SELECTIONS,
+        "reading": (
+            "the paper's Fig. 3: μ = 0.91 on [0, 200] of ⟨E⟩ 'over an ensemble of trajectories "
+            "inside Ω at time t'; selection and window flagged authors=True: [study] "
+            "authors_selection, authors_window"
+        ),
+        "paper_mu": paper_mu,
+        "paper_mu_half_unit": half_unit,
+        "t_end_above": t_end_above,
+        "mu": out,
+    }
+
+
+def ribbons(me: pd.DataFrame, ribbon_t: float, t_max: float | None = None) -> dict:
+    """The two ribbons of Fig. 3 at the grid time nearest ``ribbon_t``: ± 3 SD of the energies (the caption's "3
+    standard deviations", the ensemble's spread) and ± 3 SEM (ours, = 3 SD/√n: how well ⟨E⟩ is known), in energy
+    units, with a comparison row for each; also the largest half-width relative to ⟨E⟩ of each up to ``t_max``
+    (the figure's time axis; None: the whole grid).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> me = pd.DataFrame({"t": [0.0, 10.0], "n": [100, 100], "mean_E": [0.3, 0.2], "std_E": [0.1, 0.1],
+    ...                    "sem_E": [0.01, 0.01]})
+    >>> r = ribbons(me, 9.0)
+    >>> r["t"], round(r["half_width_3sd"], 6), round(r["max_rel_half_width_3sem"], 6)
+    (10.0, 0.3, 0.15)
+    """
+    t = me["t"].to_numpy()
+    i = int(np.argmin(np.abs(t - ribbon_t)))
+    r = me.iloc[i]
+    vis = t <= (t[-1] if t_max is None else float(t_max))
+    rel_sd = float((3 * me["std_E"] / me["mean_E"])[vis].max())
+    rel_sem = float((3 * me["sem_E"] / me["mean_E"])[vis].max())
+    n = int(r["n"])
+    tr = f"t = {float(r['t']):g}"
+    rows = [
+        {
+            "quantity": f"ribbon half-width at {tr}: 3 standard deviations of E",
+            "value": float(3 * r["std_E"]),
+            "authors": True,
+            "convention": "authors': ± 3 standard deviations of the energies of the orbits inside Ω "
+            "(the ensemble's spread; Fig. 3 caption)",
+            "note": f"{3 * r['std_E'] / r['mean_E']:.2%} of ⟨E⟩ = {r['mean_E']:.4g}; n = {n} orbits",
+        },
+        {
+            "quantity": f"ribbon half-width at {tr}: 3 standard errors of ⟨E⟩",
+            "value": float(3 * r["sem_E"]),
+            "authors": False,
+            "convention": "ours: ± 3 standard errors of the mean ⟨E⟩ (= 3 SD/√n)",
+            "note": f"{3 * r['sem_E'] / r['mean_E']:.3%} of ⟨E⟩; SD/SEM = {r['std_E'] / r['sem_E']:.4g} = √n",
+        },
+    ]
+    return {
+        "t": float(r["t"]),
+        "n": n,
+        "mean_E": float(r["mean_E"]),
+        "half_width_3sd": float(3 * r["std_E"]),
+        "half_width_3sem": float(3 * r["sem_E"]),
+        "max_rel_half_width_3sd": rel_sd,
+        "max_rel_half_width_3sem": rel_sem,
+        "rows": rows,
+    }

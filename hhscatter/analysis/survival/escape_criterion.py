@@ -1,0 +1,431 @@
+"""Is the escape criterion r > r_esc sound? (paper App. "Escape Condition"): κ under several r_esc on the same
+orbits, the returns after an escape, the exit channels, and the default r_esc these measurements recommend.
+
+The paper deems a conservative orbit escaped at its first outward crossing of r_esc "slightly larger than 1" and
+states that all values tried gave the same observations. Per energy the runs at every r_esc hold the same orbits
+(paired); one common window serves the paired estimators (:func:`common_window`); per r_esc a κ row
+(:func:`kappa_row`: the constant-hazard MLE on the window, the shift from r_ref by the slope of the paired
+log-survival ratio, the paper's mean of 4 least-squares fits with the cell's own windows, delays and flight times),
+a returns row (:func:`returns_row`, from runs followed past their escape) and the exit channels
+(:func:`channel_rows`); then the numbers and the comparison rows (:func:`criterion_numbers`).
+
+Units: time in time units, κ in 1/time, radii in length units, energies in energy units.
+
+Examples
+--------
+>>> rng = np.random.default_rng(0)
+>>> t = rng.exponential(10.0, 4000)
+>>> arrs = {1.5: (t, np.ones(t.size, bool)), 2.0: (t + 0.5, np.ones(t.size, bool))}
+>>> grid, own, win = common_window(arrs, [1.5, 2.0], 1.5, 0.1)
+>>> row, shift = kappa_row(0.3, 2.0, 1.5, arrs, own, win, n_groups=8)
+>>> abs(row["kappa_shift"]) < 3 * row["kappa_shift_err"]  # a constant delay leaves κ unchanged
+True
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.analysis.survival.escape_rate import escape_rate, escape_rate_mle
+from hhscatter.analysis.survival.fits import survival_curve
+from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
+
+__all__ = [
+    "channel_rows",
+    "common_window",
+    "criterion_numbers",
+    "kappa_row",
+    "lyapunov_table",
+    "recommend_r_esc",
+    "returns_row",
+]
+
+
+def common_window(arrs: dict, radii, r_ref: float, p_start: float):
+    """The window rule of one energy: (grid, {r: EscapeRateResult or None}, window).
+
+    (a) The paper's rule (mean of 4 least-squares fits) with each cell's own windows; None where it fails.
+    (b) One common window for the paired estimators: the median of the cells' own windows (robust to one cell's
+    plateau search picking an outlying τ0), started no earlier than where the reference P(t) has fallen to
+    ``p_start``: a prompt-escape transient inside the window (hazard peak at t ≈ 5, ringing for a few periods)
+    would be shifted in or out by the flight time and masquerade as a κ shift.
+
+    Parameters
+    ----------
+    arrs : dict
+        {r_esc: (t_end, observed)} of the runs at one energy, the same orbits in the same order.
+    radii : sequence of float
+        The r_esc values; ``r_ref`` the reference among them.
+    p_start : float
+        The reference P(t) at which the window may start at the earliest.
+
+    Returns
+    -------
+    (ndarray, dict, (float, float))
+        The P(t) grid (20001 times up to the reference run's quantile 1 − 10/N), the cells' own results and the
+        common window (t_lo, t_hi).
+    """
+    t_ref, _ = arrs[r_ref]
+    n_tot = t_ref.size
+    t_hi = float(np.quantile(t_ref, 1 - 10 / n_tot)) if n_tot > 20 else float(t_ref.max())
+    grid = np.linspace(0.0, t_hi, 20001)
+    curves = {r: survival_curve(*arrs[r], grid) for r in radii}
+    own = {}
+    for r in radii:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                own[r] = escape_rate(*arrs[r], grid, detect_tail=False)
+        except ValueError:
+            own[r] = None
+    below = np.flatnonzero(curves[r_ref].P <= p_start)
+    t_p = float(grid[below[0]]) if below.size else 0.0
+    tau0s = [own[r].tau0 for r in radii if own[r] is not None]
+    stops = [own[r].t_stop for r in radii if own[r] is not None]
+    win = (max(t_p, float(np.median(tau0s)) if tau0s else 0.0), float(np.median(stops)) if stops else t_hi)
+    if not win[1] > win[0]:
+        win = (t_p, t_hi)
+    return grid, own, win
+
+
+def _mean_err(x):
+    return (
+        float(x.mean()) if x.size else math.nan,
+        float(x.std(ddof=1) / math.sqrt(x.size)) if x.size > 1 else math.nan,
+    )
+
+
+def _follow_shift(s_ref, s, t_end, win, n_groups):
+    """The κ shift of the paired ratio slope on the follow runs: both criteria on one and the same trajectory (no
+    divergence of the paired runs), a smaller sample; (NaN, NaN) where the slope cannot be fitted."""
+    tf_ref = np.where(np.isfinite(s_ref["t_esc"]), s_ref["t_esc"], t_end)
+    tf_alt = np.where(np.isfinite(s["t_esc"]), s["t_esc"], t_end)
+    try:
+        rf = survival_ratio_slope(
+            tf_ref, np.isfinite(s_ref["t_esc"]), tf_alt, np.isfinite(s["t_esc"]), win, n_groups=n_groups
+        )
+    except ValueError:
+        return math.nan, math.nan
+    return rf.shift, rf.shift_err
+
+
+def kappa_row(E, r, r_ref, arrs, own, win, returns=None, follow_t_end=None, *, n_groups: int = 16):
+    """(row of the κ table, PairedShift) of cell (E, r).
+
+    κ by the constant-hazard MLE on the common window ``win``; its shift from r_ref by the slope of the paired
+    log-survival ratio (:func:`~hhscatter.analysis.survival.paired.survival_ratio_slope`, the main estimator; the
+    MLE difference beside it); the paper's κ (mean of 4 least-squares fits, Fig. 2b caption) with the cell's own
+    windows (``own`` of :func:`common_window`); the delay of P(t) at the window start, log(P_r/P_ref)(t_lo)/κ_ref;
+    the mean difference of t_end of the orbits escaping under both. With ``returns`` ({r: return statistics of
+    :func:`~hhscatter.analysis.geometry.channels.return_statistics`}) and ``follow_t_end`` (the follow runs'
+    t_end): the flight time from r_ref to r on identical trajectories and the shift on them.
+    """
+    t_ref, obs_ref = arrs[r_ref]
+    t_alt, obs_alt = arrs[r]
+    res = own[r]
+    if res is not None:
+        k_lsq, k_lsq_err, tau0, t_stop = res.kappa, res.kappa_err, res.tau0, res.t_stop
+    else:
+        k_lsq = k_lsq_err = tau0 = t_stop = math.nan
+    ps = paired_mle_shift(t_ref, obs_ref, t_alt, obs_alt, *win)
+    mle = escape_rate_mle(t_alt, obs_alt, *win)
+    rsl = survival_ratio_slope(t_ref, obs_ref, t_alt, obs_alt, win, n_groups=n_groups)
+    # delay of P(t) at the window start (the flight time, plus the premature escapes of r_ref up to t_lo)
+    tshift = rsl.offset / ps.kappa_ref if r != r_ref else 0.0
+    both = obs_alt & obs_ref
+    flight, fol = np.array([]), (math.nan, math.nan)
+    if returns is not None:
+        s_ref, s = returns[r_ref], returns[r]
+        ok = np.isfinite(s["t_esc"]) & np.isfinite(s_ref["t_esc"])
+        flight = s["t_esc"][ok] - s_ref["t_esc"][ok]
+        if r != r_ref:
+            fol = _follow_shift(s_ref, s, follow_t_end, win, n_groups)
+    f_mean, f_err = _mean_err(flight)
+    dt_mean, dt_err = _mean_err(t_alt[both] - t_ref[both])
+    row = {
+        "energy": E,
+        "r_esc": r,
+        "n": t_ref.size,
+        "n_escaped": int(obs_alt.sum()),
+        "kappa": ps.kappa_alt,
+        "kappa_err": ps.kappa_alt_err,
+        "n_events": mle.n_events,
+        "t_start": win[0],
+        "t_stop": win[1],
+        "kappa_shift": rsl.shift if r != r_ref else 0.0,
+        "kappa_shift_err": rsl.shift_err if r != r_ref else 0.0,
+        "kappa_shift_follow": fol[0],
+        "kappa_shift_follow_err": fol[1],
+        "mle_shift": ps.shift,
+        "mle_shift_err": ps.shift_err,
+        "mle_shift_err_unpaired": ps.shift_err_unpaired,
+        "mle_correlation": ps.correlation,
+        "kappa_lsq": k_lsq,
+        "kappa_lsq_err": k_lsq_err,
+        "tau0_own": tau0,
+        "t_stop_own": t_stop,
+        "time_shift": tshift,
+        "flight_mean": f_mean,
+        "flight_err": f_err,
+        "flight_median": float(np.median(flight)) if flight.size else math.nan,
+        "dt_end_mean": dt_mean,
+        "dt_end_err": dt_err,
+    }
+    return row, ps
+
+
+def returns_row(E, r, s, recrossed, win, kappa_ref, lyapunov, follow, *, z: float = 1.0, fast: float = 10.0) -> dict:
+    """Row of the returns table of cell (E, r): the fraction of escapes that come back inside r_in (all, and after
+    the window start) with Wilson intervals at ``z`` σ (and the 95 % upper bound), how long the returned orbits stay
+    and the fraction of them escaping again within ``fast``, the Lyapunov orbit's extent.
+
+    ``s``: :func:`~hhscatter.analysis.geometry.channels.return_statistics` back inside r_in; ``recrossed``: the
+    orbits back inside r itself; ``kappa_ref``: κ of r_ref on the window; ``lyapunov``: a row with r_min, r_max;
+    ``follow``: the follow runs' lifetimes (outcome, energy_error).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> s = {"t_esc": np.array([5.0, 20.0, np.nan]), "returned": np.array([True, False, False]),
+    ...      "t_return": np.array([6.0, np.nan, np.nan]), "t_reesc": np.array([9.0, np.nan, np.nan])}
+    >>> follow = pd.DataFrame({"outcome": ["escaped", "escaped", "censored"], "energy_error": [0.0, 1e-12, 0.0]})
+    >>> row = returns_row(0.3, 1.5, s, np.array([True, False, False]), (10.0, 50.0), 0.1, NS(r_min=1.1, r_max=1.3),
+    ...                   follow)
+    >>> row["n_escaped"], row["n_returned"], row["n_escaped_late"], row["stay_median"], row["n_fast"]
+    (2, 1, 1, 3.0, 1)
+    """
+    nf = len(follow)
+    esc = np.isfinite(s["t_esc"])
+    late = esc & (s["t_esc"] > win[0])
+    n_esc, n_ret = int(esc.sum()), int(s["returned"].sum())
+    n_late, n_ret_late = int(late.sum()), int((s["returned"] & late).sum())
+    p, lo, hi = wilson_interval(n_ret, n_esc, z)
+    pl, lol, hil = wilson_interval(n_ret_late, n_late, z) if n_late else (math.nan,) * 3
+    stay = s["t_reesc"][s["returned"]] - s["t_return"][s["returned"]]
+    n_re = int(np.isfinite(stay).sum())
+    n_fast = int(np.count_nonzero(stay <= fast))
+    pf, flo, fhi = wilson_interval(n_fast, n_ret, z) if n_ret else (math.nan,) * 3
+    return {
+        "energy": E,
+        "r_esc": r,
+        "n_followed": nf,
+        "n_escaped": n_esc,
+        "n_returned": n_ret,
+        "frac": float(p),
+        "lo": float(lo),
+        "hi": float(hi),
+        "upper95": float(wilson_interval(n_ret, n_esc, 1.96)[2]),
+        "n_recrossed": int(recrossed.sum()),
+        "t_late": win[0],
+        "n_escaped_late": n_late,
+        "n_returned_late": n_ret_late,
+        "frac_late": float(pl),
+        "lo_late": float(lol),
+        "hi_late": float(hil),
+        "n_reescaped": n_re,
+        "stay_median": float(np.nanmedian(stay)) if n_re else math.nan,
+        "stay_mean": float(np.nanmean(stay)) if n_re else math.nan,
+        "kappa_ref": kappa_ref,
+        "n_fast": n_fast,
+        "frac_fast": float(pf),
+        "frac_fast_lo": float(flo),
+        "frac_fast_hi": float(fhi),
+        "lyap_r_min": lyapunov.r_min,
+        "lyap_r_max": lyapunov.r_max,
+        "energy_error_max": float(follow.energy_error.max()),
+        "n_censored_follow": int((follow.outcome == "censored").sum()),
+    }
+
+
+def channel_rows(E, r, channel, t_end, win, *, z: float = 1.0, n_channels: int = 3) -> list[dict]:
+    """Rows of the channels table of cell (E, r): the escape fraction per exit channel with Wilson intervals and the
+    χ² test of equal shares, for all escapes and for those before ("early") and after ("late") the window start.
+
+    ``channel``: the exit channel per orbit (−1: not escaped); ``t_end``: the orbits' end times.
+
+    Examples
+    --------
+    >>> rows = channel_rows(0.3, 1.5, np.array([0, 1, 2, 0, -1]), np.array([1.0, 2.0, 30.0, 40.0, 50.0]), (10.0, 60.0))
+    >>> [(r["subset"], r["count"]) for r in rows if r["channel"] == 0]
+    [('all', 2), ('early', 1), ('late', 1)]
+    """
+    from hhscatter.analysis.geometry.channels import channel_fractions  # deferred: scipy loads on first use
+
+    n_tot = t_end.size
+    rows = []
+    for subset, m in (("all", np.ones(n_tot, bool)), ("early", t_end <= win[0]), ("late", t_end > win[0])):
+        cf = channel_fractions(channel[m], n_channels, z)
+        for k in range(n_channels):
+            rows.append(
+                {
+                    "energy": E,
+                    "r_esc": r,
+                    "subset": subset,
+                    "channel": k,
+                    "count": int(cf.counts[k]),
+                    "n": cf.n,
+                    "frac": float(cf.frac[k]),
+                    "lo": float(cf.lo[k]),
+                    "hi": float(cf.hi[k]),
+                    "chi2": cf.chi2,
+                    "p_value": cf.p_value,
+                }
+            )
+    return rows
+
+
+def lyapunov_table(energies) -> pd.DataFrame:
+    """The Lyapunov orbit of the exits (the exact boundary of Ω) at every energy: radial extent r_min, r_max, y on
+    the axis and period (:func:`~hhscatter.analysis.geometry.channels.lyapunov_orbit`), energies sorted, once each.
+    """
+    from hhscatter.analysis.geometry.channels import lyapunov_orbit  # deferred: scipy loads on first use
+
+    rows = []
+    for E in sorted(set(energies)):
+        L = lyapunov_orbit(E)
+        rows.append({"energy": E, "r_min": L.r_min, "r_max": L.r_max, "y_axis": L.y_axis, "period": L.period})
+    return pd.DataFrame(rows)
+
+
+def recommend_r_esc(returns: pd.DataFrame, lyapunov: pd.DataFrame, r_ref: float) -> dict:
+    """The default r_esc the measurements recommend: the smallest tested radius beyond every Lyapunov orbit of the
+    energies considered (the exact no-return boundary of Ω) with no measured return at any energy; the largest
+    tested one if none qualifies.
+
+    Examples
+    --------
+    >>> ret = pd.DataFrame({"r_esc": [1.03, 1.03, 1.5, 1.5], "n_returned": [3, 0, 0, 0]})
+    >>> recommend_r_esc(ret, pd.DataFrame({"energy": [0.3], "r_max": [1.2]}), 1.03)["recommended"]
+    1.5
+    """
+    radii = sorted(returns.r_esc.unique())
+    r_lyap = float(lyapunov.r_max.max())
+    ok = [r for r in radii if r > r_lyap and returns[returns.r_esc == r].n_returned.sum() == 0]
+    choice = ok[0] if ok else radii[-1]
+    return {
+        "recommended": float(choice),
+        "current": float(r_ref),
+        "lyapunov_r_max_at_max_energy": float(lyapunov.r_max.max()),
+        "lyapunov_energy_max": float(lyapunov.energy.max()),
+        "rule": "smallest tested r_esc with zero measured returns at every energy; it must exceed the radial "
+        "extent r_max of the Lyapunov orbit (the exact boundary of Ω) at the highest energy used",
+    }
+
+
+def _kappa_numbers(kap, r_ref):
+    numbers, rows = {}, []
+    for row in kap.itertuples():
+        numbers.setdefault(f"E={row.energy:.2f}", {})[f"r_esc={row.r_esc:g}"] = {
+            "kappa": {"value": row.kappa, "err": row.kappa_err},
+            "shift_vs_ref": {"value": row.kappa_shift, "err": row.kappa_shift_err},
+            "mle_difference_vs_ref": {"value": row.mle_shift, "err": row.mle_shift_err},
+            "shift_vs_ref_follow_runs": {"value": row.kappa_shift_follow, "err": row.kappa_shift_follow_err},
+            "kappa_lsq": {"value": row.kappa_lsq, "err": row.kappa_lsq_err},
+            "window": [row.t_start, row.t_stop],
+            "delay_of_P": row.time_shift,
+            "flight_time_from_ref": {"value": row.flight_mean, "err": row.flight_err},
+            "mean_t_end_difference": {"value": row.dt_end_mean, "err": row.dt_end_err},
+        }
+        if row.r_esc != r_ref:
+            rows.append(
+                {
+                    "quantity": f"κ(E={row.energy:.2f}, r_esc={row.r_esc:g}) − κ(r_esc={r_ref:g})",
+                    "ours": row.kappa_shift,
+                    "err": row.kappa_shift_err,
+                    "paper": 0.0,
+                    "unit": "1/time",
+                    "note": "paper App. 'Escape Condition': any r_esc slightly above 1 gives the same "
+                    "observations (paired slope of log P(t) ratio on a common window)",
+                }
+            )
+    return numbers, rows
+
+
+def _returns_numbers(ret, r_in, fast):
+    numbers, rows = {}, []
+    for row in ret.itertuples():
+        numbers.setdefault(f"E={row.energy:.2f}", {})[f"r_esc={row.r_esc:g}"] = {
+            "n_escaped": row.n_escaped,
+            "n_returned": row.n_returned,
+            "n_back_inside_r_esc": row.n_recrossed,
+            "fraction": {"value": row.frac, "lo": row.lo, "hi": row.hi, "upper95": row.upper95},
+            "returned_then_reescaped": row.n_reescaped,
+            "stay_median": row.stay_median,
+            "stay_mean": row.stay_mean,
+            "one_over_kappa_ref": 1.0 / row.kappa_ref,
+            "fraction_reescaping_within_reesc_fast": {
+                "value": row.frac_fast,
+                "lo": row.frac_fast_lo,
+                "hi": row.frac_fast_hi,
+            },
+            # the same for a typical survivor of the exponential regime: 1 − e^{−κ t_fast}
+            "typical_survivor_fraction_within_reesc_fast": 1.0 - math.exp(-row.kappa_ref * fast),
+            "reesc_fast": fast,
+            "fraction_late": {"value": row.frac_late, "lo": row.lo_late, "hi": row.hi_late, "t_late": row.t_late},
+        }
+        rows.append(
+            {
+                "quantity": f"fraction returning inside r<{r_in:g} after crossing r_esc={row.r_esc:g} "
+                f"(E={row.energy:.2f})",
+                "ours": row.frac,
+                "err": 0.5 * (row.hi - row.lo),
+                "paper": 0.0,
+                "note": "paper: crossing r_esc slightly above 1 means the orbit has left Ω for good; "
+                "err = half the Wilson ±1σ interval",
+            }
+        )
+    return numbers, rows
+
+
+def criterion_numbers(energies, radii, r_ref, kap, ret, chan, lyap, *, r_in: float, fast: float):
+    """The numbers of the escape-criterion study and its comparison rows (the keyword arguments of a study's
+    ``compare``): κ shifts against 0, the fraction of returns against 0, the channel fractions against 1/3 (the
+    three-fold symmetry of V and of the disk ICs), and the recommended default r_esc (:func:`recommend_r_esc`).
+
+    ``kap``, ``ret``, ``chan``, ``lyap``: the tables of :func:`kappa_row`, :func:`returns_row`, :func:`channel_rows`
+    and :func:`lyapunov_table`; ``r_in``: the radius a return must reach; ``fast``: the re-escape time of the fast
+    fraction.
+
+    Returns
+    -------
+    (dict, list of dict)
+        The numbers (energies, r_esc, r_ref, kappa, returns, channels, lyapunov, default_r_esc) and the rows.
+    """
+    kappa, rows = _kappa_numbers(kap, r_ref)
+    returns, ret_rows = _returns_numbers(ret, r_in, fast)
+    rows += ret_rows
+    channels = {}
+    for row in chan.itertuples():
+        channels.setdefault(f"E={row.energy:.2f}", {}).setdefault(f"r_esc={row.r_esc:g}", {}).setdefault(
+            row.subset, {"n": row.n, "chi2_p_value": row.p_value}
+        )[f"channel {row.channel}"] = {"value": row.frac, "lo": row.lo, "hi": row.hi}
+    for row in chan[(chan.subset == "all") & (chan.r_esc == r_ref)].itertuples():
+        rows.append(
+            {
+                "quantity": f"escape fraction through channel {row.channel} (E={row.energy:.2f}, r_esc={r_ref:g})",
+                "ours": row.frac,
+                "err": 0.5 * (row.hi - row.lo),
+                "paper": 1.0 / 3.0,
+                "note": "three-fold symmetry of V and of the disk ICs (rotation by 120° maps the IC ensemble onto "
+                "itself)",
+            }
+        )
+    numbers = {
+        "energies": energies,
+        "r_esc": radii,
+        "r_ref": r_ref,
+        "kappa": kappa,
+        "returns": returns,
+        "channels": channels,
+        "lyapunov": {
+            f"E={row.energy:.2f}": {"r_min": row.r_min, "r_max": row.r_max, "period": row.period}
+            for row in lyap.itertuples()
+        },
+        "default_r_esc": recommend_r_esc(ret, lyap, r_ref),
+    }
+    return numbers, rows
