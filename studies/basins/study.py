@@ -157,12 +157,6 @@ def _zoom_centre(study, extent, n):
     return bs.zoom_centre(basin_image(study, map_key(Ez, 0.0), Ez, extent, n), extent, clearance=clearance)
 
 
-def _zoom_extent(extent, centre, factor):
-    x0, x1, y0, y1 = extent
-    hx, hy = (x1 - x0) / (2 * factor), (y1 - y0) / (2 * factor)
-    return (centre[0] - hx, centre[0] + hx, centre[1] - hy, centre[1] + hy)
-
-
 def basin_image(study, key, E, extent, n):
     """basin_image(study, key, E, extent, n) -> (n, n) int8 outcome codes (−1 forbidden) of a map run."""
     from hhscatter.data.read import read_lifetimes
@@ -188,7 +182,7 @@ def simulate(study, workers=None, progress=True):
     centre = _zoom_centre(study, extent, n)
     for g in study.params.zoom_gammas:
         for f in study.params.zoom_factors:
-            ext = _zoom_extent(extent, centre, f)
+            ext = bs.zoom_extent(extent, centre, f)
             _run_table(
                 study, zoom_key(Ez, g, f), _map_states(study, Ez, ext, study.params.zoom_grid)[3], g, workers, progress
             )
@@ -338,7 +332,7 @@ def _zoom_maps(study, extent, n):
     centre = _zoom_centre(study, extent, n)
     for g in study.params.zoom_gammas:
         for f in study.params.zoom_factors:
-            ext = _zoom_extent(extent, centre, f)
+            ext = bs.zoom_extent(extent, centre, f)
             img = basin_image(study, zoom_key(Ez, g, f), Ez, ext, study.params.zoom_grid)
             zooms.append(
                 pd.DataFrame(
@@ -413,14 +407,12 @@ def _entropy_by_box(study, img, E, g, extent, which="map"):
 
 
 def _entropy_by_subgrid(study, img, E, g, extent):
-    """S_b, S_bb at the fixed box sides of the map read on every k-th cell, for each of [study].box_subgrids
-    with k = grid/subgrid a whole odd number > 1 (the subgrid's cell centres are cells of the map: the same
-    orbits on a coarser grid, map "every k-th cell")."""
+    """S_b, S_bb at the fixed box sides of the map read on every k-th cell ([study].box_subgrids)."""
+    from hhscatter.analysis.geometry.basins import every_kth_cell
+
     rows = []
-    for sub in study.params.box_subgrids:
-        k, r = divmod(img.shape[0], int(sub))
-        if k > 1 and r == 0 and k % 2 == 1:
-            rows += _entropy_by_box(study, img[k // 2 :: k, k // 2 :: k], E, g, extent, which=f"every {k}th cell")
+    for k, sub in every_kth_cell(img, study.params.box_subgrids):
+        rows += _entropy_by_box(study, sub, E, g, extent, which=f"every {k}th cell")
     return rows
 
 

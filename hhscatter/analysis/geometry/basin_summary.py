@@ -47,6 +47,7 @@ __all__ = [
     "uncertainty_row",
     "wada_record",
     "zoom_centre",
+    "zoom_extent",
 ]
 
 SETTLED_CODE, TRAPPED_CODE, OUTSIDE = 3, 4, -1
@@ -80,6 +81,20 @@ def outcome_codes(lt: pd.DataFrame) -> np.ndarray:
     code[esc] = ch[esc].astype(np.int8)
     code[oc == "settled"] = SETTLED_CODE
     return code
+
+
+def zoom_extent(extent, centre, factor):
+    """The window (x0, x1, y0, y1) of a zoom by ``factor`` into the map over ``extent`` around ``centre`` (x, y):
+    the same aspect, sides divided by ``factor`` (position units).
+
+    Examples
+    --------
+    >>> zoom_extent((-1, 1, -1, 1), (0.5, 0.0), 10)
+    (0.4, 0.6, -0.1, 0.1)
+    """
+    x0, x1, y0, y1 = extent
+    hx, hy = (x1 - x0) / (2 * factor), (y1 - y0) / (2 * factor)
+    return (centre[0] - hx, centre[0] + hx, centre[1] - hy, centre[1] + hy)
 
 
 def zoom_centre(labels, extent, box=5, clearance=0):

@@ -107,6 +107,7 @@ __all__ = [
     "box_counting_dimension",
     "commensurate_sides",
     "entropy_by_box",
+    "every_kth_cell",
     "wada_merging",
 ]
 
@@ -545,3 +546,27 @@ def entropy_by_box(labels, extent, sides, *, outside: int = -1, min_valid: float
     return pd.DataFrame(
         rows, columns=["grid", "box_side", "box_cells", "n_boxes", "n_boundary", "S_b", "S_b_err", "S_bb", "S_bb_err"]
     )
+
+
+def every_kth_cell(labels, subgrids) -> list:
+    """every_kth_cell(labels, subgrids) -> [(k, sub-map)]: an n × n map read on every k-th cell, k = n / m for each
+    m in ``subgrids`` that divides n with k odd and > 1.
+
+    The sub-map's cell centres are cells of the map (its cell k//2, k//2 + k, …), so it holds the same orbits as an
+    independent m × m map of the same extent: a coarser grid of the same data, to compare entropies of different
+    resolutions at a fixed physical box side (:func:`entropy_by_box`) without a second simulation.  Grids that do
+    not qualify (m not dividing n, k even or 1) are left out.
+
+    Examples
+    --------
+    >>> lab = np.arange(36).reshape(6, 6)
+    >>> [(k, sub.tolist()) for k, sub in every_kth_cell(lab, [2, 4, 6])]
+    [(3, [[7, 10], [25, 28]])]
+    """
+    lab = np.asarray(labels)
+    out = []
+    for m in subgrids:
+        k, r = divmod(lab.shape[0], int(m))
+        if k > 1 and r == 0 and k % 2 == 1:
+            out.append((k, lab[k // 2 :: k, k // 2 :: k]))
+    return out

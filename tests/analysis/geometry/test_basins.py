@@ -621,3 +621,25 @@ def test_bad_input_names_the_argument():
         basins.wada_merging(three_sectors(20), tol=1.0)
     with pytest.raises(ValueError, match="labels"):  # three basins kept apart by outside cells: no boundary
         basins.wada_merging(np.tile([0, -1, 1, -1, 2], (5, 1)))
+
+
+def test_every_kth_cell_holds_the_cells_of_the_coarser_grid():
+    """The sub-map read on every k-th cell has the coarser grid's cell centres (x_j = x0 + (j + ½)·Δ_m), so an
+    m × m map of the same extent and the sub-map hold the same orbits; grids with even or unit k are left out."""
+    n, x0, x1 = 2000, -1.0, 1.0
+    centres = x0 + (np.arange(n) + 0.5) * (x1 - x0) / n
+    lab = np.broadcast_to(centres, (n, n))  # each cell labelled by its own x
+    got = basins.every_kth_cell(lab, [400, 500, 1000, 2000, 333])
+    assert [k for k, _ in got] == [5]  # 2000/500 = 4 and 2000/1000 = 2 are even, 2000/2000 = 1, 333 does not divide
+    k, sub = got[0]
+    want = x0 + (np.arange(400) + 0.5) * (x1 - x0) / 400
+    assert sub.shape == (400, 400)
+    np.testing.assert_allclose(sub[0], want, rtol=0, atol=1e-12)
+
+
+def test_zoom_extent_keeps_the_centre_and_divides_the_sides():
+    from hhscatter.analysis.geometry.basin_summary import zoom_extent
+
+    x0, x1, y0, y1 = zoom_extent((-1.0, 1.0, -0.5, 0.5), (0.2, -0.1), 4)
+    assert (x1 - x0, y1 - y0) == pytest.approx((0.5, 0.25))
+    assert ((x0 + x1) / 2, (y0 + y1) / 2) == pytest.approx((0.2, -0.1))
