@@ -24,7 +24,6 @@ from __future__ import annotations
 import datetime
 import importlib.util
 import re
-import subprocess
 from pathlib import Path
 
 MATHJAX_DEST = "javascripts/mathjax"
@@ -118,29 +117,9 @@ def scripts_outside_math(html: str) -> str:
 
 
 def build_commit(root: Path) -> str:
-    try:
-        out = subprocess.run(
-            ["git", "rev-parse", "--short=12", "HEAD"],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=10,
-            check=False,
-        )
-        if out.returncode != 0:
-            return "unknown commit"
-        commit = out.stdout.strip()
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no"],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=10,
-            check=False,
-        )
-        return commit + ("-dirty" if dirty.stdout.strip() else "")
-    except (OSError, subprocess.SubprocessError):
-        return "unknown commit"
+    from hhscatter.data.schema import git_commit  # deferred: the package loads when the site is built
+
+    return git_commit(root, length=12, timeout=10) or "unknown commit"
 
 
 # -- MkDocs entry points ---------------------------------------------------------

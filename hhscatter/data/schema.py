@@ -107,32 +107,37 @@ def _schemas():
     return {name: pa.schema([(c, types.get(c, f64)) for c in columns]) for name, columns in TABLE_COLUMNS.items()}
 
 
+def git_commit(where: Path, *, length: int | None = None, timeout: float = 5) -> str | None:
+    """The commit checked out in the git work tree holding ``where`` (``length`` hex digits, all when None), with
+    "-dirty" when tracked files differ from it; None when there is no git or no work tree.
+
+    Examples
+    --------
+    >>> c = git_commit(Path("."))
+    >>> c is None or len(c.removesuffix("-dirty")) >= 7
+    True
+    """
+
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=where, capture_output=True, text=True, timeout=timeout, check=False)
+
+    try:
+        out = git("rev-parse", f"--short={length}" if length else "HEAD", *(["HEAD"] if length else []))
+        if out.returncode != 0:
+            return None
+        dirty = git("status", "--porcelain", "--untracked-files=no")
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() + ("-dirty" if dirty.returncode == 0 and dirty.stdout.strip() else "")
+
+
 @functools.lru_cache(maxsize=1)
 def provenance() -> dict:
     """Versions of the software that made a table, and the git commit if known."""
     import heyoka  # deferred: heyoka loads on first use
     import pyarrow  # deferred: pyarrow loads on first use
 
-    commit = None
-    try:
-        here = Path(__file__).resolve().parent
-        out = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=here, capture_output=True, text=True, timeout=5, check=False
-        )
-        if out.returncode == 0:
-            commit = out.stdout.strip()
-            dirty = subprocess.run(
-                ["git", "status", "--porcelain", "--untracked-files=no"],
-                cwd=here,
-                capture_output=True,
-                text=True,
-                timeout=5,
-                check=False,
-            )
-            if dirty.returncode == 0 and dirty.stdout.strip():
-                commit += "-dirty"
-    except (OSError, subprocess.SubprocessError):
-        pass
+    commit = git_commit(Path(__file__).resolve().parent)
     return {
         "hhscatter": __version__,
         "heyoka": heyoka.__version__,
