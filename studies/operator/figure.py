@@ -241,7 +241,7 @@ def plot_residuals(nums, grid, path):
         )
     a.axhline(0, color="k", lw=0.8)
     a.set(xlabel="E", ylabel="κ_Ulam / κ_ref − 1", title="(a) residuals of Ulam's κ")
-    a.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+    a.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1)
     if grid is not None and len(grid):
         est = grid[grid["kind"] == "estimate"]
         marks = {s: m for s, m in zip(sorted(est["box"].unique()), "os^")}
@@ -267,7 +267,7 @@ def plot_residuals(nums, grid, path):
         b.set(
             xlabel="M^(−1/2) (M samples per box)",
             ylabel="κ (1/time)",
-            title="(b) κ on box sides (○ □ △: finest, ×2, ×4) × samples per box",
+            title="(b) κ on box sides (○ □ △: finest, ×2, ×4)\n× samples per box",
         )
         b.legend(fontsize=9)
     fig.tight_layout()
