@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.api.plotting import _axes
 from hhscatter.api.points import (
     _key_columns,
@@ -236,8 +237,7 @@ def _cmeasure_point_row(
             f"{t_record_end:g}]: record sections until ≥ {t0 + margin + 2 / r.kappa:.0f}"
         )
         return row
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the undetermined count is a column
+    with counted("api.cmeasure"):
         T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
             sec, df, t0, t1, t_record_end=t_record_end, drop_censored=t_max > t_record_end, with_orbits=True
         )

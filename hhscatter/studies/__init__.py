@@ -44,6 +44,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from hhscatter.analysis.stats.library_warnings import reset_warning_counts, warning_counts
 from hhscatter.data.verify import run_status
 from hhscatter.errors import StudyError
 from hhscatter.studies._upstream import UpstreamError, dev_fallback_enabled
@@ -172,10 +173,19 @@ def _run_one(study, mod, st, name, scale, workers, progress):
                 f"{study.root / 'study.toml'}); run `make {name} SCALE={scale}`, which builds them first"
             )
         study.raw_runs = checked_raw_runs(study)
+        reset_warning_counts()  # the numbers JSON records the library warnings of this analysis alone
         mod.analyze(study)
         derived = study.out / "derived"
         extra = f" and {len(list(derived.iterdir()))} derived table(s) in {derived}" if derived.is_dir() else ""
         print(f"{name} analyze: wrote {study.numbers_path}{extra}", flush=True)
+        counts = warning_counts()
+        if counts:
+            total = sum(r["count"] for r in counts)
+            print(
+                f"{name} analyze: {total} library warning(s) counted, not shown, in {len(counts)} kind(s) "
+                f"(key library_warnings of {study.numbers_path.name})",
+                flush=True,
+            )
     else:
         import matplotlib  # deferred: matplotlib loads on first use
 

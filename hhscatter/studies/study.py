@@ -16,6 +16,7 @@ import types
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from hhscatter.analysis.stats.library_warnings import warning_counts
 from hhscatter.analysis.stats.verdicts import NO_VERDICT, SMOKE_SCALES, without_verdicts
 from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
@@ -317,6 +318,8 @@ class Study:
             "paper_comparison": without_verdicts(list(self.comparisons), self.scale),
             "config": self.config,
             "raw_runs": dict(self.raw_runs),
+            # warnings of numpy/scipy in the analysis, counted instead of shown (hhscatter.analysis.stats.counted)
+            "library_warnings": warning_counts(),
             "provenance": provenance(),
             "made_from": made_from(self, ups),
         }

@@ -44,8 +44,12 @@ def plot_operator(nums, conv, surv, pts, ulam_pts, fig1_pts, path):
 def _save(fig, path):
     import matplotlib.pyplot as plt
 
+    from hhscatter.publish.figures import save_panels
+
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+    if len(fig.axes) > 1:
+        save_panels(fig, path, dpi=120)  # each panel legible at a page's full width
     plt.close(fig)
 
 
@@ -211,6 +215,8 @@ def plot_residuals(nums, grid, path):
     """
     import matplotlib.pyplot as plt
 
+    from hhscatter.publish.figures import save_panels
+
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 6.2))
     recs = [r for r in nums.get("kappa_convergence", []) if r.get("kappa_inf") is not None]
     for k, (ref, lab, dx) in enumerate((("kappa0", "κ0 from P(t)", -0.003), ("kappa_cm", "κ from crossings", 0.003))):
@@ -272,4 +278,5 @@ def plot_residuals(nums, grid, path):
         b.legend(fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
+    save_panels(fig, path, dpi=110)  # each panel legible at a page's full width
     plt.close(fig)

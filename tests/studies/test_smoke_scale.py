@@ -36,3 +36,16 @@ def test_every_tiny_json_states_no_verdict(tiny_studies):
     assert sum(len(v) for v in found.values()) > 50  # the rows are there, each with its verdict cell
     wrong = [(name, path, v) for name, got in found.items() for path, v in got if v != NO_VERDICT]
     assert not wrong, wrong[:10]
+
+
+def test_every_tiny_json_records_its_library_warnings(tiny_studies):
+    """Each study's analyze stage writes the numpy/scipy warnings it counted (a list, possibly empty) into its JSON."""
+    docs = [
+        p for p in sorted(tiny_studies.glob("*/out/tiny/*.json")) if p.name == f"{p.parent.parent.parent.name}.json"
+    ]
+    assert len(docs) >= 10
+    for p in docs:
+        recs = json.loads(p.read_text())["library_warnings"]
+        assert isinstance(recs, list), p.name
+        for r in recs:
+            assert set(r) == {"where", "category", "message", "count"} and r["count"] >= 1, (p.name, r)

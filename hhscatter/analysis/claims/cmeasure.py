@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
@@ -14,6 +13,7 @@ from hhscatter.analysis.dissipative.decay import time_to_energy
 from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import paired_distance as pdist
 from hhscatter.analysis.geometry.distance import first_crossings
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.cmeasure import (
     cmeasure_sample_from_sections,
     kappa_from_cmeasure,
@@ -77,8 +77,7 @@ def cm_sample(runs, label, r):
             f"κ = {res.kappa:.3g}): no sampling window"
         )
         return out
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the undetermined count is reported
+    with counted("claims.cmeasure.sample"):
         T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
             sec, lt, t_rec, t_to, t_record_end=p.cm_t_to, drop_censored=True, with_orbits=True
         )

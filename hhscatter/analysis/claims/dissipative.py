@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pandas as pd
@@ -27,6 +26,7 @@ from hhscatter.analysis.dissipative.transitions import (
     tau2_observed_interval,
     tau2_predicted,
 )
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.fits import (
     observed_from_outcome,
     survival_from_lifetimes,
@@ -198,8 +198,7 @@ def fit_claim6(runs, label, m, per, taus, E0, mu) -> dict:
             raise ValueError(
                 f"τ0 = {tau0:.0f} (on P_0) ≥ τ2 = {tau2:.0f} by Eq. (eq:tau2): the model has no escape regime"
             )
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with counted("claims.dissipative.fit_homogeneous_hazards"):
             fits = fit_homogeneous_hazards(
                 c.t,
                 c.P,

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
-import warnings
 
 from hhscatter.analysis.claims.keys import alt_key, grid_key
 from hhscatter.analysis.claims.records import across, ve, z_verdict
 from hhscatter.analysis.dissipative.transitions import power_law_exponent
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 from hhscatter.analysis.survival.kappa_conventions import (
@@ -35,8 +35,7 @@ def rate_or_reason(lifetimes, min_survivors: float):
     True
     """
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with counted("claims.kappa.rate_or_reason"):
             return escape_rate_from_lifetimes(lifetimes, detect_tail=False, min_survivors=min_survivors), ""
     except (ValueError, RuntimeError) as exc:  # too few escapes for the window rule: said, not hidden
         return None, str(exc)
@@ -138,8 +137,7 @@ def fit_law(runs, table):
         if len(d) < 5:  # a, b and the break need points on both sides
             per[conv] = None
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with counted("claims.kappa.fit_kappa_energy"):
             f = fit_kappa_energy(
                 d["ratio"],
                 d["kappa"],

@@ -1,4 +1,5 @@
-"""Statistics shared by the analyses: weighted least squares, binomial intervals, verdict wording.
+"""Statistics shared by the analyses: weighted least squares, binomial intervals, verdict wording, the libraries'
+warnings counted.
 
 Every public name of its modules is importable from here (loaded on first use).
 """
@@ -7,6 +8,9 @@ from hhscatter.analysis._exports import lazy_exports
 
 _EXPORTS = {
     "wilson_interval": "intervals",
+    "counted": "library_warnings",
+    "reset_warning_counts": "library_warnings",
+    "warning_counts": "library_warnings",
     "LinearFit": "least_squares",
     "least_squares_operator": "least_squares",
     "weighted_least_squares": "least_squares",

@@ -25,12 +25,12 @@ True
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.escape_rate import escape_rate, escape_rate_mle
 from hhscatter.analysis.survival.fits import survival_curve
 from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
@@ -78,8 +78,7 @@ def common_window(arrs: dict, radii, r_ref: float, p_start: float):
     own = {}
     for r in radii:
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
+            with counted("survival.escape_criterion.escape_rate"):
                 own[r] = escape_rate(*arrs[r], grid, detect_tail=False)
         except ValueError:
             own[r] = None

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.cmeasure import (
     CMeasureKappa,
     cmeasure_sample_from_sections,
@@ -418,7 +419,6 @@ def escaping_tail(
     tail = detect_power_law_tail(t, P, tau0, E, n_total=t_esc.size, **kw)
     tau_star = math.nan
     if tail is not None and exp_fit is not None:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with counted("survival.escape_rate.crossover_time"):
             tau_star = crossover_time(t, P, exp_fit, tail)
     return EscapingTail(tail, float(tau_star), int(t_esc.size), int(t_end.size - t_esc.size), curve)

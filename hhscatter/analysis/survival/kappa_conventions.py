@@ -29,11 +29,11 @@ results out):
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.survival.fits import (
     fit_exponential,
     mean_kappa_stat_err,
@@ -292,8 +292,7 @@ def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_
         info[name] = {"energies": [float(e) for e in d["energy"]], "fit": None}
         if len(d) < min_points:
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with counted("survival.kappa_conventions.fit"):
             fits[name] = fit_kappa_energy(
                 d["energy"], d["kappa"], d["kappa_err"], E_c, continuous=True, n_boot=n_boot, rng=seed
             )

@@ -9,13 +9,13 @@ with covariance and bootstrap errors. E_c comes from the system
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import optimize
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.library_warnings import counted
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy"]
 
@@ -244,8 +244,7 @@ def _bootstrap_replicates(x, y, w, continuous, n_grid, n_boot, rng):
     for i in range(int(n_boot)):
         idx = gen.integers(0, n, n)
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
+            with counted("survival.kappa_energy.bootstrap"):
                 if continuous:
                     r = _fit_continuous(x[idx], y[idx], w[idx], max(n_grid // 4, 50))
                     boot[i] = r[:4]

@@ -9,10 +9,11 @@ JSON. Units: time in model units, rates in 1/time, energies in model units.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pandas as pd
+
+from hhscatter.analysis.stats.library_warnings import counted
 
 __all__ = [
     "cmeasure_windows",
@@ -238,8 +239,7 @@ def kappa_cmeasure_shifts(
     for shift in shifts:
         t0 = t_rec + shift / kappa
         t1 = t0 + span
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the undetermined count is a column
+        with counted("survival.summaries"):
             T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
                 sections, lifetimes, t0, t1, t_record_end=t_record_end, drop_censored=True, with_orbits=True
             )

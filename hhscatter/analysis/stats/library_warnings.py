@@ -1,0 +1,55 @@
+"""Warnings of the libraries an analysis calls (numpy, scipy), captured and counted instead of printed or dropped.
+
+A fit run a thousand times in a bootstrap may warn on a few replicates (an overflow in ``exp``, a covariance that
+cannot be estimated); the analysis already handles those replicates (a NaN, a failed fit it counts), so the warning
+is not shown, but it is not lost either: :func:`counted` records each warning raised in its block under the name of
+the place that called it, and :func:`warning_counts` returns the tally. A study's analyze stage writes the tally into
+its numbers JSON (key ``library_warnings``) and prints its total.
+
+Examples
+--------
+>>> import warnings
+>>> reset_warning_counts()
+>>> with counted("example.fit"):
+...     warnings.warn("covariance could not be estimated", RuntimeWarning)
+...     warnings.warn("covariance could not be estimated", RuntimeWarning)
+>>> warning_counts()
+[{'where': 'example.fit', 'category': 'RuntimeWarning', 'message': 'covariance could not be estimated', 'count': 2}]
+>>> reset_warning_counts()
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections import Counter
+from contextlib import contextmanager
+
+_COUNTS: Counter = Counter()
+_MESSAGE_CHARS = 200  # a message is kept to its first line, at most this many characters
+
+
+@contextmanager
+def counted(where: str):
+    """counted(where) -> context manager: warnings raised in the block are recorded under ``where`` (the place in
+    the analysis, e.g. ``"survival.kappa_energy.bootstrap"``), not shown; the count of each (category, message)
+    goes to the process's tally (:func:`warning_counts`). Errors pass through unchanged."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")  # every occurrence, not the first per place: they are counted
+        try:
+            yield
+        finally:
+            for w in caught:
+                msg = str(w.message).strip().splitlines()[0][:_MESSAGE_CHARS] if str(w.message).strip() else ""
+                _COUNTS[(where, w.category.__name__, msg)] += 1
+
+
+def warning_counts() -> list[dict]:
+    """warning_counts() -> [{where, category, message, count}], one record per distinct warning counted by
+    :func:`counted` since the last :func:`reset_warning_counts`, sorted by place, then by count (largest first)."""
+    recs = [{"where": w, "category": c, "message": m, "count": int(n)} for (w, c, m), n in _COUNTS.items()]
+    return sorted(recs, key=lambda r: (r["where"], -r["count"], r["category"], r["message"]))
+
+
+def reset_warning_counts() -> None:
+    """reset_warning_counts() -> None: empty the tally (a study's analyze stage does so before it starts)."""
+    _COUNTS.clear()
