@@ -72,12 +72,10 @@ def plan(scale: str, bench_scale=None, studies_only: bool = False):
     dst = assets_dir(scale)
     for name in study_names(ROOT):
         out = ROOT / "studies" / name / "out" / scale
-        extra = [(p, p.name) for p in sorted(out.glob(f"{name}_*.png"))]  # a study's further figures
         for src, target in (
             (out / f"{name}.png", f"{name}.png"),
             (out / f"{name}.json", f"{name}.json"),
             (out / "cost.json", f"{name}.cost.json"),
-            *extra,
         ):
             if src.exists():
                 pairs.append((src, dst / target))
@@ -122,6 +120,14 @@ def main(argv=None) -> int:
         for s, d in stale:
             print(f"stale: {d.relative_to(ROOT)} (source {s.relative_to(ROOT)})")
         return 1 if stale else 0
+    # panels of an earlier layout: a study whose figure is copied keeps only the panels its plot stage wrote now
+    copied = {d for _, d in pairs}
+    for d in copied:
+        if d.suffix == ".png" and "_panel_" not in d.stem:
+            for old in d.parent.glob(f"{d.stem}_panel_*.png"):
+                if old not in copied:
+                    old.unlink()
+                    print(f"removed {old.relative_to(ROOT)} (its study's plot stage no longer writes it)")
     for s, d in stale:
         d.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(s, d)

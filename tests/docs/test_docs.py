@@ -327,6 +327,30 @@ def test_gen_studies_puts_another_scale_in_its_own_folder_with_the_costs(tmp_pat
     assert not any(p.is_file() for p in (tmp_path / "docs" / "studies" / "assets").iterdir())
 
 
+def test_gen_studies_copies_the_panels_once_and_drops_those_of_an_earlier_layout(tmp_path, gen, monkeypatch):
+    monkeypatch.setattr(gen, "ROOT", tmp_path)
+    monkeypatch.setattr(gen, "DOCS", tmp_path / "docs")
+    out = tmp_path / "studies" / "fig5" / "out" / "paper"
+    out.mkdir(parents=True)
+    for name in ("fig5.png", "fig5_panel_a.png", "fig5_panel_b.png", "fig5.json"):
+        (out / name).write_text(name)
+    (out.parents[1] / "study.toml").write_text("[scene]\nn = 1\n")
+    paper = tmp_path / "docs" / "studies" / "assets" / "paper"
+    paper.mkdir(parents=True)
+    (paper / "fig5_panel_c.png").write_text("a panel the plot stage no longer writes")
+    (paper / "fig6_panel_a.png").write_text("another study's panel: kept")
+    pairs, _ = gen.plan("paper")
+    assert len(pairs) == len(set(pairs)) == 4  # each file once
+    assert gen.main(["--scale", "paper"]) == 0
+    assert sorted(p.name for p in paper.iterdir()) == [
+        "fig5.json",
+        "fig5.png",
+        "fig5_panel_a.png",
+        "fig5_panel_b.png",
+        "fig6_panel_a.png",
+    ]
+
+
 # -- mkdocs.yml against the pages and the package -------------------------------------
 def test_nav_pages_and_api_modules_exist():
     yaml = pytest.importorskip("yaml")
