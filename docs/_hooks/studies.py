@@ -117,10 +117,20 @@ class Renderer:
         zooms it (docs/javascripts/zoom.js); the quick-scale figure folded below it."""
         png = self.study_asset(name, "png")
         paper = self.study_asset(name, "png", "paper")
+        # the study that draws it: a further figure <study>_<part>.png belongs to the study folder <study>
+        parts = name.split("_")
+        study = next(
+            (
+                "_".join(parts[:i])
+                for i in range(len(parts), 0, -1)
+                if (self.root / "studies" / "_".join(parts[:i])).is_dir()
+            ),
+            name,
+        )
         if not png.exists() and not paper.exists():
             return self.missing(
                 f"The figure `{name}.png`",
-                f"Run `make {name}` and then `make docs-assets` to copy the quick-scale figure here.",
+                f"Run `make {study}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
 
         def one(path, alt, caption):
@@ -149,12 +159,12 @@ class Renderer:
             return out + '\n??? note "The panels in one image (click to open)"\n\n' + _indent(whole) + "\n"
 
         if not paper.exists():
-            return figure(png, "quick", f"make {name}")
-        out = figure(paper, "paper", f"make {name} SCALE=paper")
+            return figure(png, "quick", f"make {study}")
+        out = figure(paper, "paper", f"make {study} SCALE=paper")
         if png.exists():
             out += (
                 '\n??? note "The same figure at the quick scale (click to open)"\n\n'
-                + _indent(figure(png, "quick", f"make {name}"))
+                + _indent(figure(png, "quick", f"make {study}"))
                 + "\n"
             )
         return out

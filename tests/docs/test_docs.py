@@ -485,6 +485,18 @@ def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(
     assert "(assets/fig2.png){ .hh-zoom }" in folded and "quick scale" in folded
 
 
+def test_a_further_figure_names_the_make_target_of_its_study(tmp_path, hook):
+    """`<study>_<part>.png` is drawn by study <study>: its caption's command is `make <study>`, which exists."""
+    (tmp_path / "studies" / "operator").mkdir(parents=True)
+    assets = tmp_path / "docs" / "studies" / "assets"
+    (assets / "paper").mkdir(parents=True)
+    (assets / "paper" / "operator_dissipative.png").write_bytes(b"\x89PNG")
+    (assets / "operator_dissipative.png").write_bytes(b"\x89PNG")
+    out, _ = _page(tmp_path, hook, "<!-- hh:study-figure operator_dissipative -->\n")
+    assert "<code>make operator SCALE=paper</code>" in out and "<code>make operator</code>" in out
+    assert "make operator_dissipative" not in out
+
+
 def test_an_indented_marker_is_rendered_indented(tmp_path, hook):
     out, _ = _page(tmp_path, hook, '??? note "x"\n\n    <!-- hh:verdict-rule -->\n')
     assert "\n    !!! info" in out and "both uncertainties" in out
