@@ -24,9 +24,9 @@ def test_each_warning_counted_under_its_place_and_not_shown():
         with counted("a.fit"):
             for _ in range(3):
                 np.exp(np.array([1000.0]))  # numpy's overflow RuntimeWarning, three times
-            warnings.warn("first line\nsecond line", UserWarning)
+            warnings.warn("first line\nsecond line", UserWarning, stacklevel=2)
         with counted("b.sample"):
-            warnings.warn("first line\nsecond line", UserWarning)
+            warnings.warn("first line\nsecond line", UserWarning, stacklevel=2)
     assert outside == []  # nothing reached the caller
     got = {(r["where"], r["category"], r["message"]): r["count"] for r in warning_counts()}
     assert got == {
@@ -39,7 +39,7 @@ def test_each_warning_counted_under_its_place_and_not_shown():
 def test_an_error_passes_through_and_the_warnings_before_it_are_kept():
     with pytest.raises(ValueError, match="bad fit"):
         with counted("c.fit"):
-            warnings.warn("before the error", RuntimeWarning)
+            warnings.warn("before the error", RuntimeWarning, stacklevel=2)
             raise ValueError("bad fit")
     assert warning_counts() == [
         {"where": "c.fit", "category": "RuntimeWarning", "message": "before the error", "count": 1}
@@ -51,7 +51,7 @@ def test_a_claims_rate_counts_what_its_fit_warns(monkeypatch):
     from hhscatter.analysis.claims import kappa
 
     def warns(*a, **k):
-        warnings.warn("Covariance of the parameters could not be estimated", RuntimeWarning)
+        warnings.warn("Covariance of the parameters could not be estimated", RuntimeWarning, stacklevel=2)
         raise ValueError("too few escapes")
 
     monkeypatch.setattr(kappa, "escape_rate_from_lifetimes", warns)
