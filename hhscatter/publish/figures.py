@@ -27,7 +27,8 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     A page shows each at the full width of its text, where a composite of four or six panels would print its
     labels at a few pixels. Panel ``i`` goes to ``<stem>_panel_<letter>.png`` beside ``path`` (``a``, ``b``, …
     in the order of ``groups``), cropped from ``fig`` as drawn (same data and fonts; give the composite's ``dpi``): the
-    tight box of the group's axes, their titles, labels and legends, ``pad`` inches around. ``groups`` is a list
+    tight box of the group's axes, their titles, labels and legends, ``pad`` inches around, the other panels hidden
+    (a neighbour's label that reaches into the box is not drawn). ``groups`` is a list
     of lists of axes drawn on together (a panel and its colour bar); default: every visible axes of ``fig``
     except colour bars, one each, with each colour bar joined to the panel it sits beside.
 
@@ -63,9 +64,16 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
         old.unlink()
     out = []
     inches = fig.dpi_scale_trans.inverted()
-    for i, group in enumerate(groups):
-        box = Bbox.union([ax.get_tightbbox(renderer) for ax in group]).transformed(inches).padded(pad)
-        p = path.with_name(f"{path.stem}_panel_{chr(ord('a') + i)}.png")
-        fig.savefig(p, bbox_inches=box, dpi=dpi or "figure")
-        out.append(p)
+    boxes = [Bbox.union([ax.get_tightbbox(renderer) for ax in g]).transformed(inches).padded(pad) for g in groups]
+    shown = {ax: ax.get_visible() for ax in fig.axes}
+    try:
+        for i, (group, box) in enumerate(zip(groups, boxes)):
+            for ax in fig.axes:  # the other panels hidden: no neighbour's label reaches into the crop
+                ax.set_visible(shown[ax] and ax in group)
+            p = path.with_name(f"{path.stem}_panel_{chr(ord('a') + i)}.png")
+            fig.savefig(p, bbox_inches=box, dpi=dpi or "figure")
+            out.append(p)
+    finally:
+        for ax, vis in shown.items():
+            ax.set_visible(vis)
     return out
