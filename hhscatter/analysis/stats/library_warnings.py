@@ -39,8 +39,8 @@ def counted(where: str):
             yield
         finally:
             for w in caught:
-                msg = str(w.message).strip().splitlines()[0][:_MESSAGE_CHARS] if str(w.message).strip() else ""
-                _COUNTS[(where, w.category.__name__, msg)] += 1
+                text = str(w.message).strip()
+                _COUNTS[(where, w.category.__name__, text.splitlines()[0][:_MESSAGE_CHARS] if text else "")] += 1
 
 
 def warning_counts() -> list[dict]:
