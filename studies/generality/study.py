@@ -277,12 +277,8 @@ class _Runs:
 def analyze(study):
     """analyze(study) -> None: claims 1–7 per system (5 as Fig. 5's distance and as a moment) and the evidence
     (regular fraction, long-time escape, validity map, r_esc), per ``[study] parts``; derived tables and
-    generality.json. Evidence alone is merged into the generality.json already in the output folder (its claims
-    kept; its evidence keys replaced), so the evidence can be added to a record whose claim runs are elsewhere."""
-    from hhscatter.analysis.claims.records import with_ids
-    from hhscatter.data.schema import provenance
-    from hhscatter.studies.jsonio import write_json_atomic
-
+    generality.json. A scale that runs one part publishes that part alone (sealed, made from its own runs): the
+    validity map of an evidence-only record has no claims' verdicts beside its regular fractions."""
     check_params(study.params)
     p, runs, systems = study.params, _Runs(study), _systems(study)
     if "claims" in p.parts:
@@ -290,15 +286,10 @@ def analyze(study):
         numbers, tables = analyze_claims(runs, systems, compare)
         _write_tables(study, tables)
     else:
-        numbers = study.read_numbers() if study.numbers_path.exists() else {}
+        numbers = {}
     if "evidence" in p.parts:
         ev, tables = analyze_evidence(runs, systems, numbers)
         _write_tables(study, tables)
-        if "claims" not in p.parts and numbers:  # merge: the claims' record kept, with its scale and provenance
-            rec = {"scale": study.scale, "config": study.config, "provenance": provenance()}
-            numbers.update(ev, claims=with_ids(numbers.get("claims", [])), evidence_record=rec)
-            write_json_atomic(study.numbers_path, numbers)
-            return
         numbers.update(ev)
     study.write_numbers(numbers)
 

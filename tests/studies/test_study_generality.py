@@ -305,3 +305,34 @@ def test_claims_do_not_depend_on_the_order_of_the_systems(tiny):
     }
     six = [v[0] for k, v in recs[1].items() if k[0] != "henon_heiles" and k[2].endswith(("-6-0", "-6-1"))]
     assert six and all("Hénon–Heiles" in v for v in six)
+
+
+def test_a_scale_running_the_evidence_alone_publishes_it_sealed_without_claims(tiny, tmp_path, copy_study):
+    """`[study] parts = ["evidence"]`: simulate and analyze write a sealed generality.json of the evidence alone (no
+    claims taken from a record already in the folder), verified like every published JSON; its evidence is the full
+    tiny build's (same seeds)."""
+    from hhscatter.publish.numbers import read_numbers_file
+    from hhscatter.studies import run_stage
+
+    out, full = tiny
+    copy_study(
+        "generality",
+        tmp_path,
+        edit=lambda t: t.replace("[scale.tiny.study]\n", '[scale.tiny.study]\nparts = ["evidence"]\n', 1),
+    )
+    dst = tmp_path / "generality" / "out" / "tiny"
+    dst.mkdir(parents=True)
+    dst.joinpath("generality.json").write_text(json.dumps(full))  # a record with claims in the way: not merged
+    for stage in ("simulate", "analyze"):
+        run_stage("generality", stage, "tiny", workers=1, progress=False, root=tmp_path)
+    import re
+
+    # the claims' runs: κ0 <label>_r<r>, <label>_well_r<r>, c-measure <label>_cm_r<r>, dissipative <label>_g<γ>, …
+    claim_runs = re.compile(rf"^({'|'.join(SYSTEMS)})_(r\d|well_r|cm_r|probe_r|g\d|sec_g)")
+    names = [p.name for p in (dst / "raw").iterdir()]
+    assert any(n.startswith("henon_heiles_ev_disk") for n in names)
+    assert not [n for n in names if claim_runs.match(n)]
+    doc = read_numbers_file(dst / "generality.json")  # raises for an unsealed or edited file
+    assert "claims" not in doc and "evidence_record" not in doc
+    assert doc["regular_fraction"] == full["regular_fraction"]
+    assert doc["survival_long"] == full["survival_long"]

@@ -104,3 +104,44 @@ def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
         "barbanis": {"from": 2.0, "text": "from 2 E_c on"}
     }
     assert first_below(reg, ics="disk/tangential")["barbanis"]["from"] is None
+
+
+def _taus(obs, lo, hi, pred, pred_err):
+    return pd.DataFrame(
+        {
+            "gamma": [0.005, 0.01],
+            "n": [1000, 1000],
+            "tau0": [8.0, 8.0],
+            "tau0_err": [0.4, 0.4],
+            "tau1": [np.nan, np.nan],
+            "tau1_err": [np.nan, np.nan],
+            "tau2_obs": [np.nan, obs],
+            "tau2_obs_lo": [np.nan, lo],
+            "tau2_obs_hi": [np.nan, hi],
+            "p0_trapped": [0.0, 0.0],
+            "t_settle_q50": [200.0, 100.0],
+            "t_settle_q50_err": [2.0, 1.0],
+            "tau2_pred": [125.0, pred],
+            "tau2_pred_err": [0.02, pred_err],
+        }
+    )
+
+
+def test_claim4_tau2_ratio_is_judged_by_the_one_rule_with_both_errors():
+    """τ2,obs / τ2,pred carries an error (half-width of the order-statistic interval, and the prediction's) and the
+    one verdict rule: a first settling time at 0.93 of the prediction with its interval [0, τ2,obs] agrees (|z| ≈
+    0.2); the same ratio with a tight interval differs. No fixed tolerance."""
+    from hhscatter.analysis.claims.dissipative import claim4
+
+    def rec(*args):
+        c = Claims()
+        claim4(c, "s", _taus(*args), 0.01)
+        return next(r for r in c.rows if r["quantity"].startswith("τ2 observed"))
+
+    wide = rec(58.0, 0.0, 58.0, 62.5, 0.01)
+    assert abs(wide["err"] - 0.928 * 0.5) < 1e-3
+    assert wide["verdict"] == "agrees (z = -0.2)"
+    tight = rec(58.0, 57.5, 58.5, 62.5, 0.01)
+    assert abs(tight["err"] - 0.928 * 0.5 / 58.0) < 1e-5
+    assert tight["verdict"].startswith("differs (z = -")
+    assert "within 15 %" not in wide["verdict"] + tight["verdict"]
