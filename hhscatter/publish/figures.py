@@ -21,6 +21,10 @@ def agg_pyplot():
     return plt
 
 
+def _same_box(a, b) -> bool:
+    return all(abs(x - y) < 1e-9 for x, y in zip(a, b))
+
+
 def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     """save_panels(fig, path, groups=None, dpi=None) -> the paths of one PNG per panel of a drawn multi-panel figure.
 
@@ -30,7 +34,8 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     tight box of the group's axes, their titles, labels and legends, ``pad`` inches around, the other panels hidden
     (a neighbour's label that reaches into the box is not drawn). ``groups`` is a list
     of lists of axes drawn on together (a panel and its colour bar); default: every visible axes of ``fig``
-    except colour bars, one each, with each colour bar joined to the panel it sits beside.
+    except colour bars, one each, with each colour bar joined to the panel it sits beside and a twin axes
+    (``ax.twinx()``: the same box) to the panel it twins; inset axes travel with their parent.
 
     Examples
     --------
@@ -38,6 +43,9 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     >>> plt = agg_pyplot()
     >>> fig, axs = plt.subplots(1, 2, figsize=(8, 3))
     >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> [p.name for p in save_panels(fig, d / "fig9.png")]
+    ['fig9_panel_a.png', 'fig9_panel_b.png']
+    >>> _ = axs[1].twinx()   # a second y axis on panel (b): still two panels
     >>> [p.name for p in save_panels(fig, d / "fig9.png")]
     ['fig9_panel_a.png', 'fig9_panel_b.png']
     >>> plt.close(fig)
@@ -50,7 +58,16 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     if groups is None:
         axes = [ax for ax in fig.axes if ax.get_visible()]
         bars = [ax for ax in axes if hasattr(ax, "_colorbar")]
-        groups = [[ax] for ax in axes if ax not in bars]
+        groups = []
+        for ax in axes:
+            if ax in bars:
+                continue
+            box = ax.get_position().bounds
+            twin = next((g for g in groups if _same_box(g[0].get_position().bounds, box)), None)
+            if twin is not None:  # a twinx/twiny axes: one panel with the axes it shares its box with
+                twin.append(ax)
+            else:
+                groups.append([ax])
 
         def centre(ax):
             b = ax.get_position()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 #: colour per outcome code 0, 1, 2 (exit channels), 3 (settled), 4 (trapped); forbidden cells white
 COLORS = ("#d7301f", "#2171b5", "#238b45", "#fdb863", "#3f3f3f")
@@ -68,12 +68,14 @@ def plot_basins(maps, zooms, entropy, uncertainty, numbers, path, *, scale="", l
     _panel_entropy_by_box(axs[1, 1], numbers.get("entropy_by_box") or [])
     fig.suptitle(f"Fractality measures{tail}", fontsize=12)
     fig.savefig(path.with_name(path.stem + "_measures.png"), dpi=100)
+    save_panels(fig, path.with_name(path.stem + "_measures.png"), dpi=180)  # each at a page's full width
     plt.close(fig)
     if local is not None and scan is not None:
         fig, axs = plt.subplots(3, 2, figsize=(11, 13), constrained_layout=True)
         _scale_panels(axs, energies, gammas, local, scan, numbers)
         fig.suptitle(f"Scale-dependent dimension, cut-off, Wada and the γ = 0 energy scan{tail}", fontsize=12)
         fig.savefig(path.with_name(path.stem + "_scale.png"), dpi=100)
+        save_panels(fig, path.with_name(path.stem + "_scale.png"), dpi=180)  # the twin-axes panel stays one
         plt.close(fig)
 
 

@@ -331,6 +331,7 @@ def plot_sections(points, path):
     fig.suptitle("Section crossings (ṙ = 0, φ̇ > 0) coloured by the shadow indicator of their orbit", fontsize=11)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
+    save_panels(fig, path, dpi=200)  # each section at a page's full width (≈ 900 px), its legend legible
     plt.close(fig)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.publish.figures import agg_pyplot
+from hhscatter.publish.figures import agg_pyplot, save_panels
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
@@ -80,4 +80,5 @@ def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
     fig.suptitle(f"Hénon–Heiles in a heat bath and with noise ({scale} scale)", fontsize=11)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
+    save_panels(fig, path, dpi=200)  # each panel legible at a page's full width (the inset travels with (a))
     plt.close(fig)

@@ -49,3 +49,35 @@ def test_every_tiny_json_records_its_library_warnings(tiny_studies):
         assert isinstance(recs, list), p.name
         for r in recs:
             assert set(r) == {"where", "category", "message", "count"} and r["count"] >= 1, (p.name, r)
+
+
+#: the multi-panel figures the pages show, each written panel by panel too (hhscatter.publish.figures.save_panels)
+MULTI_PANEL = {
+    "fig1": "fig1",
+    "fig4": "fig4",
+    "fig5": "fig5",
+    "fig6": "fig6",
+    "resc": "resc",
+    "noise": "noise",
+    "operator": "operator",
+    "generality": "generality",
+    "generality_decay": "generality",
+    "generality_sections": "generality",
+    "basins_measures": "basins",
+    "basins_scale": "basins",
+}
+
+
+def test_every_multi_panel_figure_is_written_panel_by_panel(tiny_studies):
+    """Each multi-panel figure of the tiny build has ≥ 2 panels beside it, each between 600 and 1400 px wide: shown
+    at a page's full content width (≈ 1000 px) its labels print at about their drawn size, not at a third of it."""
+    from matplotlib.image import imread
+
+    for fig, study in MULTI_PANEL.items():
+        out = tiny_studies / study / "out" / "tiny"
+        assert (out / f"{fig}.png").exists(), fig
+        panels = sorted(out.glob(f"{fig}_panel_*.png"))
+        assert len(panels) >= 2, fig
+        for p in panels:
+            w = imread(p).shape[1]
+            assert 600 <= w <= 1400, (p.name, w)
