@@ -83,6 +83,8 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     inches = fig.dpi_scale_trans.inverted()
     boxes = [Bbox.union([ax.get_tightbbox(renderer) for ax in g]).transformed(inches).padded(pad) for g in groups]
     shown = {ax: ax.get_visible() for ax in fig.axes}
+    engine = fig.get_layout_engine()
+    fig.set_layout_engine("none")  # the layout as drawn: a layout engine would reflow around the hidden panels
     try:
         for i, (group, box) in enumerate(zip(groups, boxes)):
             for ax in fig.axes:  # the other panels hidden: no neighbour's label reaches into the crop
@@ -93,4 +95,5 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     finally:
         for ax, vis in shown.items():
             ax.set_visible(vis)
+        fig.set_layout_engine(engine)
     return out
