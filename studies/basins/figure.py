@@ -161,22 +161,33 @@ def _panel_entropy_by_box(ax, recs):
 
 
 def _panel_uncertainty(ax, uncertainty, per):
-    """Panel (a): f(ε) on log–log axes with the fitted power laws over their ε ranges."""
+    """Panel (a): f(ε) on log–log axes with the fitted power laws over their ε ranges; a colour per γ (viridis), a
+    marker and line style per E0 (no colour repeats however many points)."""
+    from matplotlib import colormaps
+
+    gs = sorted(uncertainty.gamma.unique())
+    es = sorted(uncertainty.energy.unique())
+    cmap = colormaps["viridis"]
     for (E, g), u in uncertainty.groupby(["energy", "gamma"]):
         ok = u.k > 0
         err = np.vstack([u.f[ok] - u.f_lo[ok], u.f_hi[ok] - u.f[ok]])
-        line = ax.errorbar(u.eps[ok], u.f[ok], yerr=err, fmt="o", ms=3, label=f"$E_0={E:g}, \\gamma={g:g}$")
+        colour = cmap(0.9 * gs.index(g) / max(1, len(gs) - 1))
+        marker = "osD^v"[es.index(E) % 5]
+        line = ax.errorbar(
+            u.eps[ok], u.f[ok], yerr=err, fmt=marker, ms=3.5, color=colour, label=f"$E_0={E:g}, \\gamma={g:g}$"
+        )
         p = next(q for q in per if q["energy"] == E and q["gamma"] == g)
         if p["alpha"]:
             lo, hi = p["alpha_fit_range"]
             xs = np.geomspace(lo, hi, 20)
             f_hi = float(u.f[u.eps == u.eps[(u.eps >= lo)].min()].iloc[0])
-            ax.plot(xs, f_hi * (xs / xs[0]) ** p["alpha"]["value"], "-", color=line[0].get_color(), lw=0.8)
+            ls = ("-", "--", ":", "-.")[es.index(E) % 4]
+            ax.plot(xs, f_hi * (xs / xs[0]) ** p["alpha"]["value"], ls, color=line[0].get_color(), lw=0.9)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("perturbation $\\varepsilon$")
     ax.set_ylabel("uncertain fraction $f(\\varepsilon)$")
-    ax.legend(fontsize=6, ncol=1)
+    ax.legend(fontsize=6.5, ncol=2)
 
 
 def _panel_entropy(ax, per, energies, gammas):
