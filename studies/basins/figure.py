@@ -187,7 +187,7 @@ def _panel_uncertainty(ax, uncertainty, per):
     ax.set_yscale("log")
     ax.set_xlabel("perturbation $\\varepsilon$")
     ax.set_ylabel("uncertain fraction $f(\\varepsilon)$")
-    ax.legend(fontsize=6.5, ncol=2)
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.14))  # below: the data fill the box
 
 
 def _panel_entropy(ax, per, energies, gammas):
