@@ -163,7 +163,7 @@ def claim4(claims, label, taus: pd.DataFrame, mu_gamma):
 def tau2_ratio(obs, lo, hi, pred, pred_err) -> tuple[float, float]:
     """tau2_ratio(τ2,obs, its interval lo, hi, τ2 by Eq. (eq:tau2), its 1σ) -> (ratio, 1σ): τ2,obs/τ2,pred with the
     half-width of the order-statistic interval as the observed value's error (fig4's convention) and both errors
-    propagated; (nan, nan) without a finite observed value or interval.
+    propagated; both NaN without a finite observed value or interval.
 
     Examples
     --------
