@@ -89,7 +89,7 @@ class _Epochs(_BatchRules):
         B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
         self._tables()
         grid_times, has_snapshots = self.grid_times, self.has_snapshots
-        orbit, phase, start_epoch, st = self.orbit, self.phase, self.start_epoch, self.state
+        orbit, phase, start_epoch = self.orbit, self.phase, self.start_epoch
         s_last = self.s_last
         buf, rows = [], []
         n_returns = n_steps = 0
@@ -110,21 +110,12 @@ class _Epochs(_BatchRules):
             else:
                 ta.propagate_until(P)
             n_returns += 1
-            if self.count_steps:
-                n_steps += _check(ta, self)
-            elif not np.isfinite(st).all():
-                _check(ta, self)
-            for lane in lanes:  # orbits that need nothing after this epoch end here
-                if orbit[lane] >= 0:
-                    k = epoch - start_epoch[lane] + 1  # epochs completed
-                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
-                        if phase[lane] == LIVE:
-                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
-                        self.release(lane)
-            self.epoch = epoch + 1
-            for lane in lanes:
-                if orbit[lane] < 0:
-                    self.load_next(lane)
+            n_steps += self._checked()
+            # orbits that need nothing after this epoch end here (k: epochs completed)
+            self._end_epoch(
+                [lane for lane in lanes if orbit[lane] >= 0],
+                lambda lane, k: k >= K or (phase[lane] == CONTINUING and k * P >= s_last),
+            )
         if buf:
             rows.append(self._snapshot_rows(buf))
         ids = np.concatenate([r[0] for r in rows]) if rows else np.empty(0, np.int64)
@@ -134,6 +125,30 @@ class _Epochs(_BatchRules):
         limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf, np.array(self.t_end))
         keep = t <= limit[ids]
         return n_returns, n_steps, (ids[keep], t[keep], e[keep])
+
+    def _checked(self) -> int:
+        """After a propagation: the steps taken (when counted), the integrator's state checked (always when counted,
+        else when a lane is not finite)."""
+        if self.count_steps:
+            return _check(self.ta, self)
+        if not np.isfinite(self.state).all():
+            _check(self.ta, self)
+        return 0
+
+    def _end_epoch(self, lanes, done) -> None:
+        """Close the epoch: each lane of ``lanes`` whose orbit is done after it (``done(lane, k)``, k its epochs
+        completed) is recorded as censored at t_max if still live, and released; the next epoch begins with the free
+        lanes refilled."""
+        epoch, start_epoch, phase = self.epoch, self.start_epoch, self.phase
+        for lane in lanes:
+            if done(lane, epoch - start_epoch[lane] + 1):
+                if phase[lane] == LIVE:
+                    self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                self.release(lane)
+        self.epoch = epoch + 1
+        for lane in range(self.B):
+            if self.orbit[lane] < 0:
+                self.load_next(lane)
 
     def _snapshot_rows(self, buf):
         """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows."""

@@ -40,10 +40,7 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate.batch import _check
 from hhscatter.integrate.epochs import _Epochs
-from hhscatter.integrate.events import CENSORED
-from hhscatter.integrate.lanes import LIVE
 
 #: spawn key that marks the noise streams (initial conditions use keys of length one: (block,))
 NOISE_STREAM = 0x4E4F495345  # "NOISE"
@@ -128,7 +125,7 @@ class _Noisy(_Epochs):
 
     def run(self):
         B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
-        orbit, phase, start_epoch, st = self.orbit, self.phase, self.start_epoch, self.state
+        orbit, st = self.orbit, self.state
         c, s = self.c, self.s
         p = st[2:4]  # view (2, B) of the momenta
         n_returns = n_steps = 0
@@ -144,23 +141,11 @@ class _Noisy(_Epochs):
             p[:, live] = c * p[:, live] + s * xi[live, :2].T
             ta.propagate_until(P)
             n_returns += 1
-            if self.count_steps:
-                n_steps += _check(ta, self)
-            elif not np.isfinite(st).all():
-                _check(ta, self)
+            n_steps += self._checked()
             still = np.array(orbit) >= 0  # an orbit that escaped in the epoch is parked: no kick
             p[:, still] = c * p[:, still] + s * xi[still, 2:].T
             self.kicks[live] += 1
-            epoch = self.epoch
-            for lane in np.flatnonzero(still).tolist():
-                if epoch - start_epoch[lane] + 1 >= K:  # t_max: censored after its last kick
-                    if phase[lane] == LIVE:
-                        self.record(lane, CENSORED, self.scene.t_max, self.state4(lane))
-                    self.release(lane)
-            self.epoch = epoch + 1
-            for lane in lanes:
-                if orbit[lane] < 0:
-                    self.load_next(lane)
+            self._end_epoch(np.flatnonzero(still).tolist(), lambda lane, k: k >= K)  # t_max: after its last kick
         self.n_kicks = n_returns
         e = np.empty(0)
         return n_returns, n_steps, (np.empty(0, np.int64), e, e)
