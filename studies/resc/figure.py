@@ -237,11 +237,11 @@ def _panel_channels(d, channels, energies, col, r_ref):
     d.set_xticklabels([r"channel 0 ($\varphi=\pi/2$)", r"1 ($7\pi/6$)", r"2 ($11\pi/6$)"])
     d.set_ylabel("fraction of escapes")
     d.set_title(r"(d) exit channels at $r_{esc}$" + f" = {r_ref:g}", fontsize=10)
-    d.legend(fontsize=6, ncol=2, loc="lower center")
+    d.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.13))  # below: off the data and ticks
     lo = float(ch.lo.min())
     hi = float(ch.hi.max())
-    pad = max(hi - lo, 0.01)
-    d.set_ylim(lo - 0.9 * pad, hi + 0.15 * pad)
+    pad = max(hi - lo, 0.002)
+    d.set_ylim(lo - 0.2 * pad, hi + 0.2 * pad)
     d.grid(alpha=0.3, axis="y")
 
 
@@ -270,5 +270,5 @@ def plot_resc(kappa, returns, channels, lyapunov, path, *, r_ref=1.03, scale="")
     _panel_channels(d, channels, energies, col, r_ref)
     fig.suptitle(f"Escape criterion r > r_esc, conservative Hénon–Heiles (disk ICs; scale '{scale}')", fontsize=11)
     fig.savefig(path, dpi=150)
-    save_panels(fig, path, dpi=150)  # each panel legible at a page's full width
+    save_panels(fig, path, dpi=200)  # each panel legible at a page's full width (≈ 1000 px)
     plt.close(fig)
