@@ -100,7 +100,8 @@ def test_recommend_r_esc_is_the_smallest_radius_beyond_the_lyapunov_orbit_withou
     assert recommend_r_esc(ret.assign(n_returned=1), lyap, 1.03)["recommended"] == 2.0  # none qualifies: the largest
 
 
-def test_criterion_numbers_compare_shifts_returns_and_channels():
+def _kappa_and_returns():
+    """κ and return tables at E = 0.3, r_esc = 1.5 (the reference) and 2.0, as kappa_row and returns_row give them."""
     kap = pd.DataFrame(
         {
             "energy": [0.3, 0.3],
@@ -130,6 +131,11 @@ def test_criterion_numbers_compare_shifts_returns_and_channels():
         | {c: [0, 0] for c in ("n_escaped", "n_recrossed", "n_reescaped", "stay_median", "stay_mean")}
         | {c: [0.0, 0.0] for c in ("frac_fast", "frac_fast_lo", "frac_fast_hi")}
     )
+    return kap, ret
+
+
+def test_criterion_numbers_compare_shifts_returns_and_channels():
+    kap, ret = _kappa_and_returns()
     chan = pd.DataFrame(channel_rows(0.3, 1.5, np.array([0, 1, 2]), np.array([1.0, 2.0, 3.0]), (10.0, 20.0)))
     lyap = pd.DataFrame({"energy": [0.3], "r_min": [1.0], "r_max": [1.2], "period": [6.0]})
     numbers, rows = criterion_numbers([0.3], [1.5, 2.0], 1.5, kap, ret, chan, lyap, r_in=1.0, fast=10.0)
@@ -147,3 +153,21 @@ def test_criterion_numbers_compare_shifts_returns_and_channels():
         1 - math.exp(-1.0)
     )
     assert numbers["channels"]["E=0.30"]["r_esc=1.5"]["all"]["channel 0"]["value"] == pytest.approx(1 / 3)
+
+
+def test_channel_rows_state_the_family_chi2_and_the_chance_count():
+    """Each channel row's note gives the χ² p-value of its energy's three fractions (scipy's chisquare of the counts,
+    computed here independently) and how many of the rows a 2σ rule flags by chance under exact symmetry
+    (3 rows × erfc(√2) ≈ 0.14)."""
+    from scipy import stats
+
+    counts = np.array([300, 360, 340])
+    ch = np.repeat([0, 1, 2], counts)
+    chan = pd.DataFrame(channel_rows(0.3, 1.5, ch, np.linspace(1.0, 50.0, ch.size), (10.0, 20.0)))
+    kap, ret = _kappa_and_returns()
+    lyap = pd.DataFrame({"energy": [0.3], "r_min": [1.0], "r_max": [1.2], "period": [6.0]})
+    _, rows = criterion_numbers([0.3], [1.5, 2.0], 1.5, kap, ret, chan, lyap, r_in=1.0, fast=10.0)
+    notes = [r["note"] for r in rows if r["quantity"].startswith("escape fraction")]
+    p = stats.chisquare(counts).pvalue
+    assert len(notes) == 3
+    assert all(f"χ² p = {p:.2g}" in n and "0.1 of these 3 rows lie beyond 2σ by chance" in n for n in notes)
