@@ -117,16 +117,13 @@ class Renderer:
         zooms it (docs/javascripts/zoom.js); the quick-scale figure folded below it."""
         png = self.study_asset(name, "png")
         paper = self.study_asset(name, "png", "paper")
-        # the study that draws it: a further figure <study>_<part>.png belongs to the study folder <study>
+        from hhscatter.studies.graph import studies
+
+        # the study that draws it: a further figure <study>_<part>.png belongs to the study <study> (a folder with
+        # a study.toml, as the graph and docs/gen_studies.py define a study)
+        names = {s.name for s in studies(self.root / "studies")}
         parts = name.split("_")
-        study = next(
-            (
-                "_".join(parts[:i])
-                for i in range(len(parts), 0, -1)
-                if (self.root / "studies" / "_".join(parts[:i])).is_dir()
-            ),
-            name,
-        )
+        study = next(("_".join(parts[:i]) for i in range(len(parts), 0, -1) if "_".join(parts[:i]) in names), name)
         if not png.exists() and not paper.exists():
             return self.missing(
                 f"The figure `{name}.png`",

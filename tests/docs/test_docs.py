@@ -488,6 +488,7 @@ def test_study_figure_is_the_paper_scale_at_full_width_and_the_quick_one_folded(
 def test_a_further_figure_names_the_make_target_of_its_study(tmp_path, hook):
     """`<study>_<part>.png` is drawn by study <study>: its caption's command is `make <study>`, which exists."""
     (tmp_path / "studies" / "operator").mkdir(parents=True)
+    (tmp_path / "studies" / "operator" / "study.toml").write_text('[about]\ntitle = "Transfer operators"\n')
     assets = tmp_path / "docs" / "studies" / "assets"
     (assets / "paper").mkdir(parents=True)
     (assets / "paper" / "operator_dissipative.png").write_bytes(b"\x89PNG")
