@@ -149,18 +149,41 @@ def test_a_committed_result_made_from_another_upstream_copy_is_refused(tmp_path)
         build_report("paper", out=tmp_path / "rep", root=root)
 
 
-def _make_n(*args):
+def _clean_checkout(tmp_path):
+    """The repository as a fresh clone has it: the files git tracks or would track, from the working tree (ignored
+    ones, such as a working copy's studies/*/out/, runs or .venv, are left out: make would remake them)."""
+    if not (ROOT / ".git").exists():
+        return ROOT  # not a git working tree: nothing was made here beyond the sources
+    listed = subprocess.run(
+        ["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        check=True,
+    ).stdout.split(b"\0")
+    dest = tmp_path / "clone"
+    for name in filter(None, (f.decode() for f in listed)):
+        src = ROOT / name
+        if src.is_file():
+            (dest / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / name)
+    return dest
+
+
+def _make_n(where, *args):
     """What `make report` would run from scratch (-B: as if nothing were made; -n: nothing is run)."""
-    return subprocess.run(["make", "-n", "-B", "report", *args], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    return subprocess.run(["make", "-n", "-B", "report", *args], cwd=where, capture_output=True, text=True, timeout=120)
 
 
-def test_make_report_runs_the_studies_of_a_scale_without_committed_results_and_refuses_an_unknown_one():
+def test_make_report_runs_the_studies_of_a_scale_without_committed_results_and_refuses_an_unknown_one(tmp_path):
     if shutil.which("make") is None:
         pytest.fail("make is not installed")
-    tiny = _make_n("SCALE=tiny")  # the report reads studies/*/out/tiny: it makes them
+    where = _clean_checkout(tmp_path)
+    tiny = _make_n(where, "SCALE=tiny")  # the report reads studies/*/out/tiny: it makes them
     assert "hhscatter study fig3 plot --scale tiny" in tiny.stdout, tiny.stdout + tiny.stderr
     assert "hhscatter.publish.report --scale tiny" in tiny.stdout
-    bad = subprocess.run(["make", "report", "SCALE=nonexistent"], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    bad = subprocess.run(
+        ["make", "report", "SCALE=nonexistent"], cwd=where, capture_output=True, text=True, timeout=120
+    )
     assert bad.returncode == 2 and "SCALE=nonexistent is not a scale of the studies" in bad.stderr
-    paper = _make_n("SCALE=paper")
+    paper = _make_n(where, "SCALE=paper")
     assert "hhscatter study" not in paper.stdout  # the committed results: no simulation
