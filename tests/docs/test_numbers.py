@@ -192,3 +192,24 @@ def test_a_row_verdict_follows_the_one_rule(tmp_path):
     # selector values may hold commas and parentheses; 0.025/√(0.017² + 0.005²) = 1.41
     assert nb.render_refs("[[s@quick:rows[quantity=c (law, fit)]|verdict]]", root) == "agrees (z = +1.4)"
     assert nb.render_refs("[[s:rows[0]|verdict]]", root) == "no verdict (tiny scale: a smoke test)"
+
+
+def test_every_committed_verdict_is_written_one_way():
+    """Every "verdict" of the committed JSON writes a negative z with "−" (as Verdict.text does), never "z = -"."""
+    ascii_minus = []
+
+    def walk(o, where):
+        if isinstance(o, dict):
+            for k, v in o.items():
+                if k == "verdict" and isinstance(v, str) and "z = -" in v:
+                    ascii_minus.append(f"{where}: {v}")
+                walk(v, where)
+        elif isinstance(o, list):
+            for v in o:
+                walk(v, where)
+
+    found = sorted((ROOT / "docs" / "studies" / "assets").rglob("*.json"))
+    assert len(found) >= 11
+    for f in found:
+        walk(json.loads(f.read_text()), f.relative_to(ROOT).as_posix())
+    assert not ascii_minus, "\n".join(ascii_minus)

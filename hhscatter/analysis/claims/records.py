@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from hhscatter.analysis.stats.verdicts import Verdict, verdict
+
 
 def ve(v, e=None) -> dict:
     """ve(v, e=None) -> {'value': v, 'err': e}, non-finite numbers as None (JSON).
@@ -20,19 +22,25 @@ def ve(v, e=None) -> dict:
 
 
 def z_verdict(value, err, ref, label_ok, label_bad, ref_err=0.0) -> str:
-    """z_verdict(value, err, ref, label_ok, label_bad, ref_err=0) -> '<label> (z = …)': |z| ≤ 2 is ``label_ok``,
-    z = (value − ref)/√(err² + ref_err²); 'undetermined' without a value or a finite error.
+    """z_verdict(value, err, ref, label_ok, label_bad, ref_err=0) -> '<label> (z = …)' by the one rule
+    (:data:`hhscatter.analysis.stats.verdicts.RULE`): |z| ≤ 2 is ``label_ok``, z = (value − ref)/√(err² + ref_err²),
+    written as every verdict is (:meth:`~hhscatter.analysis.stats.verdicts.Verdict.text`, minus sign "−"); without a
+    value, a reference or our error, "undetermined: <why>".
 
     Examples
     --------
     >>> z_verdict(1.1, 0.1, 1.0, "agrees", "differs")
     'agrees (z = +1.0)'
+    >>> z_verdict(0.5, 0.1, 1.0, "τ2 ∝ 1/γ", "not ∝ 1/γ")
+    'not ∝ 1/γ (z = −5.0)'
+    >>> z_verdict(0.5, None, 1.0, "agrees", "differs")
+    'undetermined: no uncertainty of ours'
     """
-    if value is None or ref is None or err is None or not math.isfinite(err):
-        return "undetermined"
-    s = math.hypot(err, ref_err or 0.0)
-    z = (value - ref) / s if s > 0 else math.inf
-    return f"{label_ok} (z = {z:+.1f})" if abs(z) <= 2 else f"{label_bad} (z = {z:+.1f})"
+    v = verdict(value, err, ref, ref_err or 0.0)
+    if v.word not in ("agrees", "differs"):
+        return v.text()
+    label = label_ok if v.word == "agrees" else label_bad
+    return Verdict(label, v.z, v.why).text() if v.z is not None else f"{label} ({v.why})" if v.why else label
 
 
 class Claims:

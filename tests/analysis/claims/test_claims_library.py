@@ -140,8 +140,32 @@ def test_claim4_tau2_ratio_is_judged_by_the_one_rule_with_both_errors():
 
     wide = rec(58.0, 0.0, 58.0, 62.5, 0.01)
     assert abs(wide["err"] - 0.928 * 0.5) < 1e-3
-    assert wide["verdict"] == "agrees (z = -0.2)"
+    assert wide["verdict"] == "agrees (z = −0.2)"
     tight = rec(58.0, 57.5, 58.5, 62.5, 0.01)
     assert abs(tight["err"] - 0.928 * 0.5 / 58.0) < 1e-5
-    assert tight["verdict"].startswith("differs (z = -")
+    assert tight["verdict"].startswith("differs (z = −")
     assert "within 15 %" not in wide["verdict"] + tight["verdict"]
+
+
+def test_a_claim_verdict_is_the_one_rule_written_as_every_verdict():
+    """z_verdict applies the rule of every table (|z| ≤ 2, both errors) and writes z as Verdict.text does ("−"),
+    checked against z computed here; without our error it says why, as every undetermined cell does."""
+    import math
+
+    from hhscatter.analysis.claims.records import z_verdict
+
+    for value, err, ref, ref_err in [
+        (1.1, 0.1, 1.0, 0.0),
+        (0.5, 0.1, 1.0, 0.0),
+        (0.996, 0.1, 1.0, 0.0),
+        (1.0, 0.02, 1.05, 0.01),
+        (0.9, 0.03, 1.0, 0.04),
+        (1.3, 0.1, 1.0, 0.1),
+    ]:
+        z = (value - ref) / math.hypot(err, ref_err)
+        word = "ok" if abs(z) <= 2 else "bad"
+        sign = "−" if z < 0 else "+"
+        assert z_verdict(value, err, ref, "ok", "bad", ref_err) == f"{word} (z = {sign}{abs(z):.1f})"
+    assert z_verdict(0.5, None, 1.0, "ok", "bad") == "undetermined: no uncertainty of ours"
+    assert z_verdict(None, 0.1, 1.0, "ok", "bad").startswith("undetermined: no value of ours")
+    assert z_verdict(1.0, 0.0, 1.0, "ok", "bad") == "ok"
