@@ -123,6 +123,16 @@ def test_henon_heiles_exits_are_rotations_of_exit_0():
     assert abs(L0.x_axis) < 1e-12 and 1.0 < L0.y_axis < L0.y_b
 
 
+def test_henon_heiles_orbits_scale_with_omega_and_lambda():
+    # V(x; ω, λ) = (ω⁶/λ²) V(λx/ω²; 1, 1): lengths scale by ω²/λ, energies by ω⁶/λ², times by 1/ω
+    omega, lam, E1 = 1.3, 0.7, 0.27
+    ell, eps = omega**2 / lam, omega**6 / lam**2
+    L1 = lyapunov_orbit(E1, HenonHeiles())
+    L = lyapunov_orbit(E1 * eps, HenonHeiles(omega, lam), exit=2)
+    assert L.period == pytest.approx(L1.period / omega, rel=1e-10)
+    assert (L.r_min, L.r_max) == (pytest.approx(L1.r_min * ell, rel=1e-8), pytest.approx(L1.r_max * ell, rel=1e-8))
+
+
 @pytest.mark.parametrize(
     "E, r_min, r_max, period",
     [
