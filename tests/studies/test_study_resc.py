@@ -2,8 +2,8 @@
 
 References are independent of the code under test: closed forms (Wilson
 interval), 1-D quadratures of motion along a symmetry axis of the potential,
-the linearisation at the saddle, invariants (energy, periodicity), synthetic
-samples with known rates, and the engine's own escape times.
+synthetic samples with known rates, and the engine's own escape times. The
+Lyapunov orbits are tested in tests/analysis/geometry/test_channels.py.
 """
 
 from __future__ import annotations
@@ -14,14 +14,11 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from hhscatter.analysis.geometry.channels import channel_fractions, lyapunov_orbit, return_statistics
+from hhscatter.analysis.geometry.channels import channel_fractions, return_statistics
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
 from hhscatter.integrate.events import CENSORED, ESCAPED
-from hhscatter.model import HenonHeiles
 from hhscatter.scene.scene import SceneError
-
-E_C = 1.0 / 6.0
 
 
 # ---------------------------------------------------------------------------
@@ -208,33 +205,6 @@ def test_follow_matches_the_scalar_reference_and_plain_escape_times():
         assert len(mine) == len(theirs), k
         np.testing.assert_allclose(mine, theirs, rtol=1e-9, atol=1e-10)
         assert float(ref.t_end) == pytest.approx(lt["t_end"][k], rel=1e-9)
-
-
-# ---------------------------------------------------------------------------
-# Lyapunov orbit
-# ---------------------------------------------------------------------------
-def test_lyapunov_orbit_small_amplitude_limit():
-    # near E_c the orbit is the tangential oscillation at the saddle: V ≈ E_c + (3/2) x² − u²/2,
-    # period 2π/√3 and amplitude √(2(E − E_c)/3)
-    dE = 1e-5
-    L = lyapunov_orbit(E_C + dE)
-    assert L.period == pytest.approx(2 * math.pi / math.sqrt(3), rel=1e-4)
-    assert L.x_b == pytest.approx(math.sqrt(2 * dE / 3), rel=1e-2)
-    assert abs(L.r_max - 1) < 1e-4 and abs(L.r_min - 1) < 1e-4
-
-
-def test_lyapunov_orbit_invariants():
-    m = HenonHeiles()
-    for E in (0.25, 0.35):
-        L = lyapunov_orbit(E)
-        x, y, px, py = L.states.T
-        np.testing.assert_allclose(m.energy(x, y, px, py), E, atol=1e-10)
-        np.testing.assert_allclose(L.states[-1], L.states[0], atol=1e-7)  # periodic
-        assert L.states[0, 2] == 0 and L.states[0, 3] == 0  # brake point
-        assert np.max(np.abs(x)) == pytest.approx(L.x_b, rel=1e-6)  # symmetric in x
-        assert 1.0 < L.r_min < L.r_max
-    with pytest.raises(ValueError, match="E_c"):
-        lyapunov_orbit(0.1)
 
 
 # ---------------------------------------------------------------------------

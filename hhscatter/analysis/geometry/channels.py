@@ -7,8 +7,10 @@ The exact criterion is the outward crossing of the Lyapunov orbit that
 straddles each exit channel (paper Sec. II, "Scattering dynamics"); this
 module measures how well r_esc approximates it:
 
-* :func:`lyapunov_orbit` — the Lyapunov (brake) orbit of exit channel 0 at
-  energy E: its radial extent r_min … r_max and period;
+* :func:`lyapunov_orbit` — the Lyapunov (brake) orbit of an exit at energy E
+  above its saddle, for any system (:mod:`hhscatter.model`: the saddle and V
+  come from the system object): its brake points, radial extent r_min … r_max
+  and period;
 * :func:`return_statistics` — from the crossings of a set of radii recorded
   by the engine's ``follow`` scenes (table ``crossings``): for a given r_esc, the
   first escape time, whether the orbit comes back inside r < r_in, when, and
@@ -19,8 +21,8 @@ module measures how well r_esc approximates it:
 
 The paired κ shifts between two criteria are in :mod:`hhscatter.analysis.survival.paired`.
 
-Units: model units (unit mass; ω = λ = 1 gives saddle distance 1, E_c = 1/6);
-times in time units, κ in 1/time.
+Units: the system's (unit mass; Hénon–Heiles with ω = λ = 1 has saddle
+distance 1, E_c = 1/6); times in time units, κ in 1/time.
 """
 
 from __future__ import annotations
@@ -31,8 +33,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import integrate, optimize, stats
 
+from hhscatter.analysis.noise.kramers import hessian
 from hhscatter.analysis.stats.intervals import wilson_interval
-from hhscatter.model import HenonHeiles
+from hhscatter.model import HenonHeiles, System
 
 __all__ = [
     "ChannelFractions",
@@ -41,6 +44,8 @@ __all__ = [
     "lyapunov_orbit",
     "return_statistics",
 ]
+
+_EPS = float(np.finfo(float).eps)
 
 
 # ---------------------------------------------------------------------------
@@ -90,16 +95,35 @@ def channel_fractions(channel, n_channels: int = 3, z: float = 1.0) -> ChannelFr
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class LyapunovOrbit:
-    """Result of :func:`lyapunov_orbit` (channel 0, the saddle on the +y axis).
+    """Result of :func:`lyapunov_orbit`: the Lyapunov orbit of one exit at one energy.
 
-    energy, brake point (x_b, y_b) on V = E (one end of the orbit; the other is
-    (−x_b, y_b)), y_axis (where it crosses x = 0), r_min and r_max (its radial
-    extent), period; t, states: one period sampled (for plots and checks).
+    Parameters
+    ----------
+    energy : float
+        E (energy).
+    exit : int
+        The exit's channel index (``system.exits[exit]``).
+    x_b, y_b : float
+        The brake point where the orbit starts at rest on V = E (length): the end on the side +v of the
+        channel's axis (v: the saddle's stable direction, the channel's outward direction turned by −90°).
+    x_axis, y_axis : float
+        Where the orbit crosses the channel's axis (the line through the saddle along its unstable
+        direction) from the +v side, half way between the brake points (length).
+    r_min, r_max : float
+        The orbit's radial extent from the well's minimum over the samples ``states`` (length).
+    period : float
+        The period, twice the time between the brake points (time).
+    t : numpy.ndarray
+        ``n_samples + 1`` times over one period from 0 to ``period`` (time).
+    states : numpy.ndarray
+        (x, y, p_x, p_y) at ``t``, shape (n_samples + 1, 4); ``states[0]`` is (x_b, y_b, 0, 0).
     """
 
     energy: float
+    exit: int
     x_b: float
     y_b: float
+    x_axis: float
     y_axis: float
     r_min: float
     r_max: float
@@ -108,105 +132,190 @@ class LyapunovOrbit:
     states: np.ndarray = field(repr=False)
 
 
-def _hh_rhs(model):
-    w2, lam = model.omega**2, model.lam
+def _checked_energy(energy: float, system: System, k: int) -> float:
+    """E as a float, after the checks of :func:`lyapunov_orbit`'s arguments (ValueError naming the value)."""
+    exits = system.exits
+    if not exits:
+        raise ValueError(f"the system {system.name!r} has no exit (no saddle of V): it has no Lyapunov orbit")
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(exits):
+        raise ValueError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {k!r}")
+    E, e_s = float(energy), exits[k].energy
+    if not (math.isfinite(E) and E > e_s):
+        raise ValueError(
+            f"energy must be > the saddle energy E_s = {e_s:.6g} of exit {k} (E_c = "
+            f"{system.critical_energy:.6g}), got {energy!r}"
+        )
+    return E
 
-    def rhs(t, s):
-        x, y, px, py = s
-        return [px, py, -w2 * x - 2 * lam * x * y, -w2 * y - lam * (x * x - y * y)]
 
-    return rhs
+class _Shooting:
+    """The brake-orbit shooting of :func:`lyapunov_orbit` for exit k of a system (validated there).
 
+    The saddle's frame: u the unit unstable direction pointing away from the well's minimum, v = u turned by
+    −90° (the stable direction), ω_v = √(the positive Hessian eigenvalue) (1/time).
+    """
 
-def _wall_x(model, energy, y):
-    """x > 0 with V(x, y) = E on the channel-0 wall (NaN where none)."""
-    w2, lam = model.omega**2, model.lam
-    num = energy - 0.5 * w2 * y * y + lam * y**3 / 3.0
-    den = 0.5 * w2 + lam * y
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.sqrt(num / den)
+    def __init__(self, system: System, k: int, rtol: float):
+        e = system.exits[k]
+        self.k = int(k)
+        self.saddle, self.e_s = np.array([e.x, e.y]), e.energy
+        eig, vec = np.linalg.eigh(hessian(system, e.x, e.y))
+        if not eig[0] < 0 < eig[1]:
+            raise ValueError(f"exit {k} at ({e.x:.6g}, {e.y:.6g}) is not a saddle of V: Hessian eigenvalues {eig}")
+        self.u = vec[:, 0] if vec[:, 0] @ self.saddle >= 0 else -vec[:, 0]
+        self.v = np.array([self.u[1], -self.u[0]])
+        self.omega_v = math.sqrt(eig[1])
+        self.pot, self.force = system.potential, system.force
+        self.tol = {"method": "DOP853", "rtol": rtol, "atol": rtol * 1e-2}
+
+    def rhs(self, t, s):
+        fx, fy = self.force(s[0], s[1])
+        return [s[2], s[3], float(fx), float(fy)]
+
+    def axis(self, t, s):
+        """Signed distance (along v) from the channel's axis, the line through the saddle along u."""
+        return (s[0] - self.saddle[0]) * self.v[0] + (s[1] - self.saddle[1]) * self.v[1]
+
+    def brake_point(self, c: float, e: float) -> np.ndarray | None:
+        """The point of V = e on the +v side at c along u from the saddle (None where there is none)."""
+        base = self.saddle + c * self.u
+        g = lambda s: float(self.pot(*(base + s * self.v))) - e
+        lo, hi = 0.0, math.sqrt(2 * (e - self.e_s)) / self.omega_v  # the linear guess A first
+        if not g(lo) < 0:
+            return None
+        for _ in range(60):
+            if g(hi) > 0:
+                return base + optimize.brentq(g, lo, hi, xtol=_EPS * hi, rtol=4 * _EPS) * self.v
+            lo, hi = hi, 1.5 * hi
+        return None
+
+    def momentum_at(self, z, e: float) -> np.ndarray:
+        """(p_x, p_y) at time T = z[1] from rest at the brake point of energy e at c = z[0] along u."""
+        c, half = z
+        b = self.brake_point(c, e)
+        if b is None:
+            return np.ones(2)
+        if half == 0:
+            return np.zeros(2)
+        return integrate.solve_ivp(self.rhs, (0.0, half), [b[0], b[1], 0.0, 0.0], **self.tol).y[2:, -1]
+
+    def solve(self, e: float, guess) -> tuple[float, float] | None:
+        """(c, T) of the brake orbit of energy e from ``guess``; None if it is not found near the guess."""
+        sol = optimize.root(self.momentum_at, guess, args=(e,), method="hybr", options={"xtol": 1e-13})
+        c, half = sol.x
+        ok = np.all(np.isfinite(sol.fun)) and np.max(np.abs(sol.fun)) <= 1e-8 * math.sqrt(2 * (e - self.e_s))
+        return (float(c), float(half)) if ok and 0.5 < half / guess[1] < 1.5 else None
+
+    def family(self, energy: float) -> tuple[float, float]:
+        """(c, T) at E = energy: from the linear guess, else continued in energy from the saddle."""
+        start = (0.0, math.pi / self.omega_v)
+        z = self.solve(energy, start)
+        if z is not None:
+            return z
+        z, f, step = start, 0.0, 1.0 / 16  # continuation: f is the fraction of E − E_s reached
+        while f < 1.0:
+            f_next = min(1.0, f + step)
+            z_next = self.solve(self.e_s + f_next * (energy - self.e_s), z)
+            if z_next is None:
+                step /= 2
+                if step < 1.0 / 4096:
+                    e_end = self.e_s + f * (energy - self.e_s)
+                    raise RuntimeError(f"no Lyapunov orbit found at E = {energy} (the family is lost near {e_end:.6g})")
+                continue
+            z, f = z_next, f_next
+        return z
+
+    def orbit(self, energy: float, n_samples: int) -> LyapunovOrbit:
+        """The Lyapunov orbit at E = energy, one period sampled at n_samples + 1 times."""
+        c, half = self.family(energy)
+        xb, yb = self.brake_point(c, energy)
+        period = 2 * half
+        full = integrate.solve_ivp(
+            self.rhs, (0.0, period), [xb, yb, 0.0, 0.0], events=self.axis, dense_output=True, **self.tol
+        )
+        if full.t_events[0].size != 2:
+            raise RuntimeError(
+                f"the brake orbit found at E = {energy} crosses the axis of exit {self.k} {full.t_events[0].size} "
+                "times per period, not twice: it is not the Lyapunov orbit"
+            )
+        t = np.linspace(0.0, period, int(n_samples) + 1)
+        states = full.sol(t).T
+        r = np.hypot(states[:, 0], states[:, 1])
+        x_axis, y_axis = full.y_events[0][0][:2]
+        return LyapunovOrbit(
+            energy=energy,
+            exit=self.k,
+            x_b=float(xb),
+            y_b=float(yb),
+            x_axis=float(x_axis),
+            y_axis=float(y_axis),
+            r_min=float(r.min()),
+            r_max=float(r.max()),
+            period=period,
+            t=t,
+            states=states,
+        )
 
 
 def lyapunov_orbit(
-    energy: float, model: HenonHeiles | None = None, *, rtol: float = 1e-12, n_samples: int = 400
+    energy: float, system: System | None = None, *, exit: int = 0, rtol: float = 1e-12, n_samples: int = 400
 ) -> LyapunovOrbit:
-    """lyapunov_orbit(energy, model=None) -> LyapunovOrbit(r_min, r_max, period, ...).
+    """lyapunov_orbit(energy, system=None, *, exit=0) -> LyapunovOrbit(r_min, r_max, period, ...).
 
-    The Lyapunov orbit of exit channel 0 at energy E > E_c: the unstable
-    periodic orbit that oscillates across the channel near the saddle
-    (0, ω²/λ) and bounds the scattering region Ω (paper Sec. II, "Scattering
-    dynamics"; an orbit crossing it outward never returns).  It is a brake
-    orbit, symmetric under x → −x: released from rest on the wall V = E at
-    (x_b, y_b), it crosses x = 0 with p_y = 0.  y_b is found
-    by shooting (brentq on p_y at the first x = 0 crossing), the root nearest
-    the saddle.  By the three-fold symmetry the other channels' orbits are its
-    rotations by ±120°.  Integration: scipy DOP853 with relative tolerance
-    ``rtol``.
+    The Lyapunov orbit of an exit at energy E above its saddle's energy E_s: the unstable periodic orbit that
+    oscillates across the exit channel through the saddle; the exits' Lyapunov orbits bound the scattering
+    region Ω (paper Sec. II, "Scattering dynamics": an orbit that crosses one outward never returns). Any
+    two-degree-of-freedom system: the saddle, E_s and V come from the system object.
 
-    As E → E_c the orbit shrinks to the saddle and its period tends to
-    2π/(√3 ω), the tangential frequency there (V_xx = 3ω² at the saddle).
+    Method: at the saddle V's Hessian has one negative eigenvalue (direction u, along the channel) and one
+    positive one, ω_v² (direction v, across it); near E_s the orbit is saddle + A v cos(ω_v t), ω_v² A²/2 =
+    E − E_s. The orbit is a brake orbit, at rest on V = E at both ends. From rest at the point of V = E at
+    c along u and s > 0 along v from the saddle (s solved on V = E from s = A), the unknowns (c, T) solve
+    p(T) = 0 (:func:`scipy.optimize.root` from c = 0, T = π/ω_v; failing that, continued in energy from E_s:
+    the root kept is the family grown from the saddle); the period is 2T. Integration: scipy's DOP853,
+    relative tolerance ``rtol``, absolute ``rtol``/100.
+
+    Parameters
+    ----------
+    energy : float
+        E > E_s of the exit (energy).
+    system : System, optional
+        The system (:mod:`hhscatter.model`); the paper's Hénon–Heiles (ω = λ = 1) if None. The second
+        positional argument (formerly ``model``).
+    exit : int
+        The exit's channel index, 0 ≤ exit < len(system.exits).
+    rtol : float
+        Relative tolerance of the integration.
+    n_samples : int
+        One period is sampled at n_samples + 1 equally spaced times (``t``, ``states``, r_min, r_max).
+
+    Returns
+    -------
+    LyapunovOrbit
+
+    Raises
+    ------
+    ValueError
+        Before any integration: E not finite or ≤ E_s, an exit index out of range, a system without exits,
+        an exit that is not a saddle of V.
+    RuntimeError
+        No Lyapunov orbit found at E.
+
+    Notes
+    -----
+    As E → E_s the orbit shrinks to the saddle and its period tends to 2π/ω_v (2π/(√3 ω) at Hénon–Heiles'
+    saddles). Units: the system's (unit mass): lengths, energies, times.
+
+    Examples
+    --------
+    >>> from hhscatter.model import make_system
+    >>> L = lyapunov_orbit(0.6, make_system("barbanis"), exit=1)  # E_s = 0.5, 2π/ω_v = 4.4429
+    >>> round(L.period, 4), L.states[0, 2:].tolist()
+    (4.4408, [0.0, 0.0])
     """
-    model = model or HenonHeiles()
-    if not isinstance(model, HenonHeiles):
-        raise TypeError(f"lyapunov_orbit uses Hénon–Heiles' channel-0 symmetry (x → −x); got the system {model.name!r}")
-    E = float(energy)
-    if not E > model.critical_energy:
-        raise ValueError(f"energy must be > E_c = {model.critical_energy:.6g}, got {energy}")
-    rs = model.saddle_radius
-    rhs = _hh_rhs(model)
-
-    def axis_hit(t, s):
-        return s[0]
-
-    axis_hit.terminal = True
-    axis_hit.direction = -1
-    t_span = (0.0, 20.0 * 2 * math.pi / model.omega)
-
-    def shoot(yb, dense=False):
-        xb = float(_wall_x(model, E, yb))
-        sol = integrate.solve_ivp(
-            rhs,
-            t_span,
-            [xb, yb, 0.0, 0.0],
-            method="DOP853",
-            events=axis_hit,
-            rtol=rtol,
-            atol=rtol * 1e-2,
-            dense_output=dense,
-        )
-        if not sol.t_events[0].size:
-            return (math.nan, sol) if dense else math.nan
-        return (sol.y_events[0][0][3], sol) if dense else sol.y_events[0][0][3]
-
-    grid = rs * np.linspace(0.9, 1.3, 161)
-    vals = np.array([shoot(y) for y in grid])
-    ok = np.isfinite(vals[:-1]) & np.isfinite(vals[1:]) & (np.sign(vals[:-1]) != np.sign(vals[1:]))
-    idx = np.flatnonzero(ok)
-    if idx.size == 0:
-        raise RuntimeError(f"no Lyapunov orbit found at E = {E}")
-    i = idx[np.argmin(np.abs(grid[idx] - rs))]
-    yb = optimize.brentq(shoot, grid[i], grid[i + 1], xtol=1e-15 * rs, rtol=4 * np.finfo(float).eps)
-    _, sol = shoot(yb, dense=True)
-    quarter = float(sol.t_events[0][0])
-    # the brake orbit goes brake point → axis → mirror brake point and back: period = 4 quarters
-    xb = float(_wall_x(model, E, yb))
-    full = integrate.solve_ivp(
-        rhs, (0.0, 4 * quarter), [xb, yb, 0.0, 0.0], method="DOP853", rtol=rtol, atol=rtol * 1e-2, dense_output=True
-    )
-    t = np.linspace(0.0, 4 * quarter, int(n_samples) + 1)
-    states = full.sol(t).T
-    r = np.hypot(states[:, 0], states[:, 1])
-    return LyapunovOrbit(
-        energy=E,
-        x_b=xb,
-        y_b=float(yb),
-        y_axis=float(sol.y_events[0][0][1]),
-        r_min=float(r.min()),
-        r_max=float(r.max()),
-        period=4 * quarter,
-        t=t,
-        states=states,
-    )
+    system = HenonHeiles() if system is None else system
+    E = _checked_energy(energy, system, exit)
+    return _Shooting(system, exit, rtol).orbit(E, n_samples)
 
 
 # ---------------------------------------------------------------------------
