@@ -74,7 +74,9 @@ demo: $(RUNS)/demo/survival.png ## run two small real scenes (1e5 orbits each), 
 # hhscatter/studies/graph.py turns them into the rules below (build/studies.mk), nothing lists them here.
 SCALE ?= quick
 HH := $(VENV)/bin/hhscatter
-ANALYSIS_SRC := $(wildcard hhscatter/analysis/*.py hhscatter/studies/*.py)
+# the library code an analysis or a plot runs, subpackages included (an edit there makes the outputs out of date)
+ANALYSIS_SRC := $(shell find hhscatter/analysis hhscatter/data hhscatter/model hhscatter/scene hhscatter/studies -name '*.py')
+PLOT_SRC := $(shell find hhscatter/publish -name '*.py')
 so = studies/$(1)/out/$(SCALE)
 study_code = $(wildcard studies/$(1)/*.py)
 CONVENTIONS := $(wildcard studies/conventions.toml)  # scene keys the figure studies share (convention = "paper")
@@ -85,7 +87,7 @@ $(call so,$(1))/raw/done.json: studies/$(1)/study.toml $(CONVENTIONS) $(call stu
 	$(HH) study $(1) simulate --scale $(SCALE) $(W)
 $(call so,$(1))/$(1).json: $(call so,$(1))/raw/done.json $(ANALYSIS_SRC) $(call study_code,$(1)) $(foreach u,$(2),$(call so,$(u))/$(u).json)
 	$(HH) study $(1) analyze --scale $(SCALE)
-$(call so,$(1))/$(1).png: $(call so,$(1))/$(1).json $(call study_code,$(1)) $(wildcard hhscatter/plotting/*.py)
+$(call so,$(1))/$(1).png: $(call so,$(1))/$(1).json $(call study_code,$(1)) $(PLOT_SRC)
 	$(HH) study $(1) plot --scale $(SCALE)
 endef
 

@@ -140,7 +140,7 @@ def analyze(study):
     if r_ref not in radii:
         raise ValueError(f"[study] r_ref = {r_ref} must be one of r_esc = {radii}")
     p = study.params
-    lyap = lyapunov_table([*p.lyapunov_energies, *energies])
+    lyap = lyapunov_table([*p.lyapunov_energies, *energies], study.model)
     lyap_at = {row.energy: row for row in lyap.itertuples()}
 
     k_rows, ret_rows, ch_rows = [], [], []

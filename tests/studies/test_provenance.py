@@ -187,3 +187,34 @@ def test_make_report_runs_the_studies_of_a_scale_without_committed_results_and_r
     assert bad.returncode == 2 and "SCALE=nonexistent is not a scale of the studies" in bad.stderr
     paper = _make_n(where, "SCALE=paper")
     assert "hhscatter study" not in paper.stdout  # the committed results: no simulation
+
+
+def test_an_edit_anywhere_in_the_library_an_analysis_runs_remakes_the_study(tmp_path):
+    """make's rules list the analysis code of every subpackage (hhscatter/analysis/geometry/… too) and the plotting
+    code: with a study's outputs up to date, editing one of them reruns its analysis or its plot, nothing else."""
+    if shutil.which("make") is None:
+        pytest.fail("make is not installed")
+    import os
+    import time
+
+    where = _clean_checkout(tmp_path)
+    made = [where / ".venv" / ".installed-stamp"] + [
+        where / "studies" / "resc" / "out" / "tiny" / f for f in ("raw/done.json", "resc.json", "resc.png")
+    ]
+    later = time.time() + 60
+    for i, f in enumerate(made):  # each output newer than every source and than the one before it
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_text("{}")
+        os.utime(f, (later + i, later + i))
+    target = "studies/resc/out/tiny/resc.png"
+
+    def dry(*what_if):
+        cmd = ["make", "-n", "SCALE=tiny", *(a for w in what_if for a in ("-W", w)), target]
+        return subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=120).stdout
+
+    assert "hhscatter study" not in dry()  # up to date
+    for edited in ("hhscatter/analysis/geometry/channels.py", "hhscatter/analysis/survival/escape_criterion.py"):
+        out = dry(edited)
+        assert "study resc analyze --scale tiny" in out and "simulate" not in out, (edited, out)
+    out = dry("hhscatter/publish/figures.py")
+    assert "study resc plot --scale tiny" in out and "analyze" not in out, out

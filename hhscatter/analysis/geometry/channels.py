@@ -110,7 +110,8 @@ class LyapunovOrbit:
         Where the orbit crosses the channel's axis (the line through the saddle along its unstable
         direction) from the +v side, half way between the brake points (length).
     r_min, r_max : float
-        The orbit's radial extent from the well's minimum over the samples ``states`` (length).
+        The orbit's radial extent, r = √(x² + y²) (the radius r_esc is compared with), over the samples
+        ``states`` (length).
     period : float
         The period, twice the time between the brake points (time).
     t : numpy.ndarray

@@ -278,16 +278,36 @@ def channel_rows(E, r, channel, t_end, win, *, z: float = 1.0, n_channels: int =
     return rows
 
 
-def lyapunov_table(energies) -> pd.DataFrame:
-    """The Lyapunov orbit of the exits (the exact boundary of Ω) at every energy: radial extent r_min, r_max, y on
-    the axis and period (:func:`~hhscatter.analysis.geometry.channels.lyapunov_orbit`), energies sorted, once each.
+def lyapunov_table(energies, system) -> pd.DataFrame:
+    """lyapunov_table(energies, system) -> one row per energy (sorted, once each) over all exits of ``system``.
+
+    The exits' Lyapunov orbits are the exact boundary of Ω (paper Sec. II, "Scattering dynamics";
+    :func:`~hhscatter.analysis.geometry.channels.lyapunov_orbit`); the row gives their radial extent together:
+    ``r_min`` the smallest and ``r_max`` the largest r = √(x² + y²) on any of them (length), ``period`` the
+    longest of their periods (time; under Hénon–Heiles' three-fold symmetry all three are equal) and
+    ``n_exits``. Energies at or below an exit's saddle energy are refused by ``lyapunov_orbit`` (ValueError).
+
+    Examples
+    --------
+    >>> from hhscatter.model import HenonHeiles
+    >>> t = lyapunov_table([0.3, 0.2, 0.3], HenonHeiles())
+    >>> t.energy.tolist(), t.n_exits.tolist(), round(float(t.r_max.iloc[1]), 4)
+    ([0.2, 0.3], [3, 3], 1.0858)
     """
     from hhscatter.analysis.geometry.channels import lyapunov_orbit  # deferred: scipy loads on first use
 
     rows = []
     for E in sorted(set(energies)):
-        L = lyapunov_orbit(E)
-        rows.append({"energy": E, "r_min": L.r_min, "r_max": L.r_max, "y_axis": L.y_axis, "period": L.period})
+        orbits = [lyapunov_orbit(E, system, exit=k) for k in range(len(system.exits))]
+        rows.append(
+            {
+                "energy": E,
+                "r_min": min(L.r_min for L in orbits),
+                "r_max": max(L.r_max for L in orbits),
+                "period": max(L.period for L in orbits),
+                "n_exits": len(orbits),
+            }
+        )
     return pd.DataFrame(rows)
 
 

@@ -171,3 +171,25 @@ def test_channel_rows_state_the_family_chi2_and_the_chance_count():
     p = stats.chisquare(counts).pvalue
     assert len(notes) == 3
     assert all(f"χ² p = {p:.2g}" in n and "0.1 of these 3 rows lie beyond 2σ by chance" in n for n in notes)
+
+
+def test_the_lyapunov_table_spans_every_exit_of_the_system_it_is_given():
+    """lyapunov_table reads the exits from the system (no Hénon–Heiles default): the row of a Hénon–Heiles with its
+    symmetry broken (+ 0.03 x³: three saddles at three energies) covers each exit's Lyapunov orbit; Hénon–Heiles'
+    three exits give exit 0's extent (three-fold symmetry)."""
+    from hhscatter.analysis.geometry.channels import lyapunov_orbit
+    from hhscatter.analysis.survival.escape_criterion import lyapunov_table
+    from hhscatter.model import HenonHeiles
+    from hhscatter.model.spec import system_from_spec
+
+    bar = system_from_spec({"potential": "x**2/2 + y**2/2 + x**2*y - y**3/3 + 0.03*x**3"})
+    E = max(e.energy for e in bar.exits) + 0.05
+    (row,) = lyapunov_table([E], bar).itertuples()
+    each = [lyapunov_orbit(E, bar, exit=k) for k in range(len(bar.exits))]
+    assert row.n_exits == len(bar.exits) == 3
+    assert row.r_max == max(L.r_max for L in each) and row.r_min == min(L.r_min for L in each)
+    assert len({round(L.r_max, 6) for L in each}) > 1  # the exits differ: exit 0 alone would not do
+    hh = HenonHeiles()
+    (row,) = lyapunov_table([0.25], hh).itertuples()
+    L0 = lyapunov_orbit(0.25, hh)
+    assert row.n_exits == 3 and abs(row.r_max - L0.r_max) < 1e-9 and abs(row.period - L0.period) < 1e-9
