@@ -14,6 +14,7 @@ from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import paired_distance as pdist
 from hhscatter.analysis.geometry.distance import first_crossings
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.analysis.survival.cmeasure import (
     cmeasure_sample_from_sections,
     kappa_from_cmeasure,
@@ -138,7 +139,14 @@ def claim2(runs, claims, label, table, samples):
             e = math.hypot(s["kappa_cm_err"] / k0["kappa"], s["kappa_cm"] * k0["kappa_err"] / k0["kappa"] ** 2)
             row[f"ratio_minus_1_{conv}"] = ve(v, e)
             claims.add(
-                "2", q, label, v, e, z_verdict(v, e, 0.0, "κ_cm = κ0", f"κ_cm ≠ κ0 ({100 * v:+.0f} %)"), note, 0.0
+                "2",
+                q,
+                label,
+                v,
+                e,
+                z_verdict(v, e, 0.0, "κ_cm = κ0", f"κ_cm ≠ κ0 ({signed(100 * v, '+.0f')} %)"),
+                note,
+                0.0,
             )
         rows.append(row)
     return rows
@@ -241,11 +249,11 @@ def claim5_distance(runs, claims, label, m, E0, mu, samples):
         )
         lev = int(100 * p.c5_level)
         verdict = (
-            f"closer to μ_c^E(t*) ({lev} % interval [{lo:+.3f}, {hi:+.3f}] excludes 0)"
+            f"closer to μ_c^E(t*) ({lev} % interval [{signed(lo, '+.3f')}, {signed(hi, '+.3f')}] excludes 0)"
             if lo > 0
-            else f"closer to μ_c^E0 ({lev} % interval [{lo:+.3f}, {hi:+.3f}])"
+            else f"closer to μ_c^E0 ({lev} % interval [{signed(lo, '+.3f')}, {signed(hi, '+.3f')}])"
             if hi < 0
-            else f"no significant difference ({lev} % interval [{lo:+.3f}, {hi:+.3f}] contains 0)"
+            else f"no significant difference ({lev} % interval [{signed(lo, '+.3f')}, {signed(hi, '+.3f')}] contains 0)"
         )
         claims.add(
             "5",

@@ -27,6 +27,7 @@ from hhscatter.analysis.dissipative.transitions import (
     tau2_predicted,
 )
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.analysis.survival.fits import (
     observed_from_outcome,
     survival_from_lifetimes,
@@ -344,7 +345,7 @@ def claim7(runs, claims, label, m, table, taus, E0, mu):
         label,
         r,
         e,
-        z_verdict(r, e, 1.0, "κγ(t) = κ0(E(t))", f"κγ differs from κ0(E(t)) by {100 * (r - 1):+.0f} %"),
+        z_verdict(r, e, 1.0, "κγ(t) = κ0(E(t))", f"κγ differs from κ0(E(t)) by {signed(100 * (r - 1), '+.0f')} %"),
         f"bins of {p.hazard_bin:g} from τ0 = {tau0:.1f} while E(t) = E0 e^(−μγt) ≥ the lowest defined κ0 "
         f"energy; κ0 interpolated (log) between the {conv} points; {expected:.0f} escapes expected",
         1.0,

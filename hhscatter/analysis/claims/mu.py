@@ -21,6 +21,7 @@ from hhscatter.analysis.dissipative.kinetic import (
     kinetic_fraction_from_energies,
     microcanonical_kinetic_fraction,
 )
+from hhscatter.analysis.stats.verdicts import signed
 
 
 def mu_conservative(runs, label, m, fits, keys=None):
@@ -218,7 +219,7 @@ def claim5_moment(claims, label, meas, own, pred, wins):
                 me,
                 v,
                 "selection by escape/settling negligible",
-                f"selection by escape/settling shifts μ by {m - v:+.3f}",
+                f"selection by escape/settling shifts μ by {signed(m - v, '+.3f')}",
                 e,
             ),
             "2⟨K⟩/⟨E⟩ of the dissipative survivors from their energy loss (ΔE = −2γ∫K dt), path fitted "

@@ -4,6 +4,7 @@
   |ours − reference| ≤ 2σ with σ = √(σ_ours² + σ_ref²), both uncertainties; :func:`row_verdict` applies it
   to a paper-vs-ours row and says why when it cannot (never a "not a number"), and gives no verdict at the tiny scale;
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
+* :func:`signed` — a signed number as verdicts print it ("−");
 * :func:`half_unit` — half a unit of the last digit of a printed number;
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
   survives the authors' convention;
@@ -43,8 +44,19 @@ class Verdict:
     def text(self) -> str:
         """The cell: "agrees (z = +1.3)", "differs (z = −4.2)", "undetermined: no uncertainty of ours"."""
         if self.z is not None:
-            return f"{self.word} (z = {self.z:+.1f})".replace("-", "−")
+            return f"{self.word} (z = {signed(self.z)})"
         return f"{self.word}: {self.why}" if self.why else self.word
+
+
+def signed(x: float, spec: str = "+.1f") -> str:
+    """signed(x, spec="+.1f") -> x formatted with ``spec`` and a minus sign "−" (U+2212), as verdicts print numbers.
+
+    Examples
+    --------
+    >>> signed(-4.21), signed(1.25, "+.0f"), signed(-0.0071, "+.3f")
+    ('−4.2', '+1', '−0.007')
+    """
+    return format(x, spec).replace("-", "−")
 
 
 def _finite(x) -> bool:

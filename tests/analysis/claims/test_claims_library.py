@@ -169,3 +169,5 @@ def test_a_claim_verdict_is_the_one_rule_written_as_every_verdict():
     assert z_verdict(0.5, None, 1.0, "ok", "bad") == "undetermined: no uncertainty of ours"
     assert z_verdict(None, 0.1, 1.0, "ok", "bad").startswith("undetermined: no value of ours")
     assert z_verdict(1.0, 0.0, 1.0, "ok", "bad") == "ok"
+    # the sign of z is written "−"; a label's own hyphens stay as written
+    assert z_verdict(0.7, 0.1, 1.0, "the c-measure's", "not the c-measure's") == "not the c-measure's (z = −3.0)"
