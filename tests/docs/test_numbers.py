@@ -195,13 +195,17 @@ def test_a_row_verdict_follows_the_one_rule(tmp_path):
 
 
 def test_every_committed_verdict_is_written_one_way():
-    """Every "verdict" of the committed JSON writes a negative z with "−" (as Verdict.text does), never "z = -"."""
+    """Every "verdict" of the committed JSON writes a negative number (z, a shift, an interval's end) with "−" (as
+    Verdict.text does), never an ASCII "-" (a hyphen in a word, "c-measure", stays)."""
+    import re
+
+    minus = re.compile(r"(?<![\w.])-\d")
     ascii_minus = []
 
     def walk(o, where):
         if isinstance(o, dict):
             for k, v in o.items():
-                if k == "verdict" and isinstance(v, str) and "z = -" in v:
+                if k == "verdict" and isinstance(v, str) and minus.search(v):
                     ascii_minus.append(f"{where}: {v}")
                 walk(v, where)
         elif isinstance(o, list):

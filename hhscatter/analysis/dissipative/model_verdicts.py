@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.model_tables import PAPER_CONSTANTS
-from hhscatter.analysis.stats.verdicts import comparison_row
+from hhscatter.analysis.stats.verdicts import comparison_row, signed
 
 __all__ = [
     "better_text",
@@ -54,7 +54,7 @@ def better_text(best, rms_ours: float, rms_pc: float) -> str:
 
 
 def _pct(x, ref):
-    return f"{100 * (x - ref) / ref:+.0f}%"
+    return f"{signed(100 * (x - ref) / ref, '+.0f')}%"
 
 
 def homogeneous_comparisons(fits: pd.DataFrame, const: dict, setup: str) -> list:
@@ -153,7 +153,7 @@ def tau_comparisons(taus: pd.DataFrame, hazards) -> list:
                     r.tau2_observed,
                     None,
                     None,
-                    verdict=f"{100 * rel:+.0f}% from predicted {r.tau2_predicted:.1f}",
+                    verdict=f"{signed(100 * rel, '+.0f')}% from predicted {r.tau2_predicted:.1f}",
                     note="observed: first settling time (fig4); paper: τ2 ∝ 1/γ, predicted by Eq. (eq:tau2)",
                 )
             )
@@ -166,7 +166,7 @@ def tau_comparisons(taus: pd.DataFrame, hazards) -> list:
                         r.tau1_observed,
                         None,
                         None,
-                        verdict=f"model {pred:.1f} ({100 * (pred - r.tau1_observed) / r.tau1_observed:+.0f}%)",
+                        verdict=f"model {pred:.1f} ({signed(100 * (pred - r.tau1_observed) / r.tau1_observed, '+.0f')}%)",
                         note="observed from fig4 (Eq. (eqn:tau1), α = 2); model: fitted Eq. (eqn:surv_prob_model)",
                     )
                 )

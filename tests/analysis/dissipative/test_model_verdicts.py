@@ -30,7 +30,7 @@ def test_compare_taus_relative_differences_and_skips_what_was_not_observed():
         ("τ2(γ=0.01) observed vs Eq. (eq:tau2)", 110.0, "+10% from predicted 100.0"),
         ("τ1(γ=0.01) observed vs model (paper)", 50.0, "model 60.0 (+20%)"),
         # no τ1 of the integrated hazard at γ = 0.01, no τ2 observed at γ = 0.02
-        ("τ1(γ=0.02) observed vs model (paper)", 40.0, "model 30.0 (-25%)"),
+        ("τ1(γ=0.02) observed vs model (paper)", 40.0, "model 30.0 (−25%)"),
         ("τ1(γ=0.02) observed vs model (integrated)", 40.0, "model 42.0 (+5%)"),
     ]
 
@@ -95,6 +95,6 @@ def test_constants_comparisons_count_the_pairs_and_say_which_constants_predict_c
     # one pair each: neither set of constants fits better on more pairs
     assert verdicts[3] == "neither: the paper's constants fit better on 1, ours on 1 of 3 pairs"
     # τ2: |100 − 90| < |100 − 120| (the paper's μ closer); τ1: |40 − 50| = 10 > |55 − 50| = 5 (ours closer)
-    assert verdicts[4] == "observed 100.0 is +11% from it (-17% from 120.0 with our μ): paper's μ closer"
-    assert verdicts[5] == "-20% from observed 50.0; our constants 55.0 (+10%): our constants closer"
+    assert verdicts[4] == "observed 100.0 is +11% from it (−17% from 120.0 with our μ): paper's μ closer"
+    assert verdicts[5] == "−20% from observed 50.0; our constants 55.0 (+10%): our constants closer"
     assert rows[4]["convention"] == "paper's μ = 0.91; paper setup: disk r < 0.5"
