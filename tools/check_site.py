@@ -10,7 +10,10 @@ Checks, over every HTML page (the text a reader sees: outside maths, code, scrip
 * ``nan``     — "nan" / "NaN" as a value;
 * ``zero_err`` — "± 0.000", "± 0.0": an uncertainty printed with more digits than it has;
 * ``workflow`` — the project's own workflow history: issue numbers, the planning folder ``.dev``,
-  commit hashes cited as history.
+  commit hashes cited as history;
+* ``minus``   — a negative number written with the hyphen "-" in place of the minus sign "−" (as the verdicts and
+  the rendered numbers write it), on the pages of results and concepts (the API reference and the tutorial, whose
+  text quotes Python, are not checked).
 
 The tests (tests/docs/test_site_checks.py) run these over the site built in the suite.
 """
@@ -32,6 +35,10 @@ WORKFLOW = re.compile(
     r"\s+(?:commit\s+)?`?[0-9a-f]{7,12}\b`?",
     re.I,
 )
+#: a hyphen used as the sign of a number: "-0.26", "(z = -1.1)", "[-0.015, …]", "10^-10"; not "x-1", "grid[-1]"
+MINUS = re.compile(r"(?<![\w.\-/\[])-(?=\.?\d)|(?<=\[)-(?=\d+(?:\.\d+)?,)")
+#: pages whose text quotes code (Python indices, shell flags): the minus check leaves them
+NOT_PROSE = ("api/", "tutorial.html")
 _HEX = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b")
 
 
@@ -68,7 +75,7 @@ def check(site: Path) -> dict[str, list[str]]:
         if p.name != "404.html" and not {"assets", "javascripts"} & set(p.relative_to(site).parts[:-1])
     )
     ids_cache: dict[Path, set[str]] = {}
-    out: dict[str, list[str]] = {k: [] for k in ("links", "raw_tex", "nan", "zero_err", "workflow")}
+    out: dict[str, list[str]] = {k: [] for k in ("links", "raw_tex", "nan", "zero_err", "workflow", "minus")}
     for page in pages:
         rel = page.relative_to(site).as_posix()
         html = page.read_text(errors="replace")
@@ -91,7 +98,10 @@ def check(site: Path) -> dict[str, list[str]]:
                     if unquote(parts.fragment) not in ids_cache[target]:
                         out["links"].append(f"{rel}: {url} (no anchor #{unquote(parts.fragment)})")
         text = reader_text(html)
-        for key, rx in (("raw_tex", RAW_TEX), ("nan", NAN), ("zero_err", ZERO_ERR), ("workflow", WORKFLOW)):
+        checks = [("raw_tex", RAW_TEX), ("nan", NAN), ("zero_err", ZERO_ERR), ("workflow", WORKFLOW)]
+        if not rel.startswith(NOT_PROSE):
+            checks.append(("minus", MINUS))
+        for key, rx in checks:
             for m in rx.finditer(text):
                 ctx = " ".join(text[max(0, m.start() - 40) : m.end() + 40].split())
                 out[key].append(f"{rel}: …{ctx}…")

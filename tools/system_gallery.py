@@ -60,6 +60,7 @@ def markdown_table() -> str:
         "|---|---|---|---|---|---|---|",
     ]
     for name, params, ec, n, exits, om, nr in table_rows():
+        exits = exits.replace("-", "−")  # the minus sign, as every number the site prints
         out.append(f"| `{name}` | {params} | {ec:.6g} | {n} | {exits} | {om:.4g} | {nr:.4g} |")
     return "\n".join(out)
 

@@ -1009,10 +1009,31 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
             from mkdocs.exceptions import PluginError
 
             raise PluginError(f"{page.file.src_uri}: hh:{kind}: {e}") from None
+        out = typographic_minus(out)
         # a marker inside an admonition (indented) gets its content indented alike
         return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 
     return _MARKER.sub(sub, markdown)
+
+
+#: what typographic_minus leaves as written: code spans, maths, HTML tags (their attributes)
+_VERBATIM = re.compile(r"`[^`\n]*`|\$\$.*?\$\$|\$[^$\n]*\$|\\\(.*?\\\)|<[^>\n]*>", re.S)
+#: a hyphen as the sign of a number: after a space, an opening bracket, "=", ":", ";", "(" or ">"; not "x-1", "E0-E_c"
+_SIGN = re.compile(r"(?<![\w.\-/])-(?=\.?\d)")
+
+
+def typographic_minus(text: str) -> str:
+    """The generated text with a negative number's hyphen written as the minus sign "−" (as the verdicts and the
+    rendered numbers write it); code spans, maths and HTML tags are left as written.
+
+    >>> typographic_minus("| -0.26 ± 0.19 | (z = -1.1) | `grid[-1]` | x-1 | 10<sup>-10</sup> |")
+    '| −0.26 ± 0.19 | (z = −1.1) | `grid[-1]` | x-1 | 10<sup>−10</sup> |'
+    """
+    out, last = [], 0
+    for m in _VERBATIM.finditer(text):
+        out += [_SIGN.sub("−", text[last : m.start()]), m.group(0)]
+        last = m.end()
+    return "".join(out) + _SIGN.sub("−", text[last:])
 
 
 def _pct(v, e=None) -> str:
