@@ -69,6 +69,13 @@ def _cell(s) -> str:
     return md_cell(s)
 
 
+def typographic_minus(text: str) -> str:
+    """A negative number's hyphen written "−" (hhscatter.publish.formatting.typographic_minus)."""
+    from hhscatter.publish.formatting import typographic_minus as minus
+
+    return minus(text)
+
+
 # -- renderers -----------------------------------------------------------------
 class Renderer:
     """Render the markers of one page; ``root`` is the repository, ``docs`` the docs folder."""
@@ -1014,26 +1021,6 @@ def on_page_markdown(markdown, page, config, files, **kwargs):
         return "\n".join(indent + line if line.strip() else "" for line in out.splitlines()) if indent else out
 
     return _MARKER.sub(sub, markdown)
-
-
-#: what typographic_minus leaves as written: code spans, maths, HTML tags (their attributes)
-_VERBATIM = re.compile(r"`[^`\n]*`|\$\$.*?\$\$|\$[^$\n]*\$|\\\(.*?\\\)|<[^>\n]*>", re.S)
-#: a hyphen as the sign of a number: after a space, an opening bracket, "=", ":", ";", "(" or ">"; not "x-1", "E0-E_c"
-_SIGN = re.compile(r"(?<![\w.\-/])-(?=\.?\d)")
-
-
-def typographic_minus(text: str) -> str:
-    """The generated text with a negative number's hyphen written as the minus sign "−" (as the verdicts and the
-    rendered numbers write it); code spans, maths and HTML tags are left as written.
-
-    >>> typographic_minus("| -0.26 ± 0.19 | (z = -1.1) | `grid[-1]` | x-1 | 10<sup>-10</sup> |")
-    '| −0.26 ± 0.19 | (z = −1.1) | `grid[-1]` | x-1 | 10<sup>−10</sup> |'
-    """
-    out, last = [], 0
-    for m in _VERBATIM.finditer(text):
-        out += [_SIGN.sub("−", text[last : m.start()]), m.group(0)]
-        last = m.end()
-    return "".join(out) + _SIGN.sub("−", text[last:])
 
 
 def _pct(v, e=None) -> str:

@@ -30,6 +30,7 @@ from hhscatter.publish.formatting import (
     format_value,
     markdown_to_html,
     md_cell,
+    typographic_minus,
 )
 from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary
@@ -350,6 +351,7 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
                 lines += ["| number | value |", "|---|---|"]
                 lines += [f"| {md_cell(k)} | {md_cell(v)} |" for k, v in headline_numbers(s.numbers)]
                 lines.append("")
+    lines = [typographic_minus("\n".join(lines))]  # the studies' part: a negative number written "−"
     for name, title in BENCH_PARTS:
         md, pngs = _bench(root, name)
         lines += [f"## {title}", ""]

@@ -175,3 +175,15 @@ def test_report_header_names_each_studys_commit_and_says_dirty_in_words():
     line = commits_line(secs)
     assert line == f"Numbers made at commit `{'b' * 12}`: fig2, fig3; `{'a' * 12}` (uncommitted changes): fig1."
     assert "-dirty" not in line and commits_line([]) == ""
+
+
+def test_the_report_writes_a_negative_number_with_the_minus_sign(tmp_path):
+    """A negative number of a study (value, error interval, z) is written "−" in report.md and report.html, as on
+    the docs site; the study's own words keep their hyphens."""
+    root = tmp_path / "studies"
+    row = {"quantity": "κ shift (c-measure)", "ours": -0.0131, "err": 0.0004, "paper": 0.0, "verdict": "", "note": ""}
+    _fake_study(root, "rep4", [row])
+    res = build_report("quick", out=tmp_path / "rep", root=root)
+    md, page = res["markdown"].read_text(), res["html"].read_text()
+    assert "| rep4 | κ shift (c-measure) | −0.0131 ± 0.0004 | 0 | differs (z = −32.8) |" in md, md
+    assert "−0.0131 ± 0.0004" in page and "-0.0131" not in md + page
