@@ -50,7 +50,7 @@ import tomllib
 from functools import lru_cache
 from pathlib import Path
 
-from hhscatter.publish.formatting import format_number, format_value_err
+from hhscatter.publish.formatting import format_number, format_value_err, typographic_minus
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
@@ -254,11 +254,12 @@ def _digits(err: float) -> int:
 
 
 def format_leaf(leaf, fmt: str | None = None) -> str:
-    """format_leaf(JSON leaf, format) -> its text; a negative number with the minus sign "−" (see _format_leaf)."""
+    """format_leaf(JSON leaf, format) -> its text (see _format_leaf); a negative number with the minus sign "−"
+    (:func:`hhscatter.publish.formatting.typographic_minus`, as the docs tables and the report write it)."""
     out = _format_leaf(leaf, fmt)
     if isinstance(leaf, str) or (isinstance(leaf, dict) and isinstance(leaf.get("value"), str)):
         return out
-    return re.sub(r"(^|[\s(\[])-(?=\d)", r"\1−", out)
+    return typographic_minus(out)
 
 
 def _format_leaf(leaf, fmt: str | None = None) -> str:
