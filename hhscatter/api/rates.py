@@ -138,7 +138,7 @@ class EscapeRates:
         the population (a trapped plateau, a non-exponential decay).
     status : dict
         (energy, gamma) → :class:`~hhscatter.analysis.survival.long_time.RateStatus` of each fitted point:
-        'exponential', 'trapped' or 'non-exponential', with P∞ and κ∞ of the plateau-plus-exponential fit.
+        'exponential', 'trapped', 'non-exponential' or 'empty' (no orbit left after τ0), with P∞ and κ∞ of the plateau-plus-exponential fit.
 
     Examples
     --------
@@ -165,7 +165,7 @@ class EscapeRates:
         fits and statistics), kappa_stat, kappa_spread, tau0, t_stop, windows
         (the 4 (t_lo, t_hi) fit windows), kappa_mle, kappa_mle_err (maximum
         likelihood on [tau0, t_stop]), tau_star (NaN without power-law tail),
-        status ('exponential', 'trapped', 'non-exponential'; empty where not fitted), p_inf, kappa_inf (the
+        status ('exponential', 'trapped', 'non-exponential', 'empty'; "" where not fitted), p_inf, kappa_inf (the
         plateau-plus-exponential fit from τ0), note (why κ is NaN or not the population's rate, else empty).
         """
         import pandas as pd  # deferred: pandas loads on first use

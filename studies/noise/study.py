@@ -139,6 +139,8 @@ def _rate_row(study, key, scene, t_start):
         "window": [t_start, scene.t_max],
         "rate_first_half": r.halves[0][0],
         "rate_second_half": r.halves[1][0],
+        # a window without an escape: no rate (NaN), its one-sided 95 % upper bound and the ratio's
+        **({"rate_upper95": r.upper95, "ratio_upper95": r.upper95 / kl.rate} if r.is_bound else {}),
     }
 
 

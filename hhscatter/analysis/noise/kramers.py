@@ -134,7 +134,11 @@ def kramers_langer(model, gamma: float, temperature: float) -> KramersLanger:
 class ThermalRate:
     """A measured long-time escape rate: ``rate`` ± ``rate_err`` (1/time) on [t_start, t_stop], from
     ``n_events`` escapes over ``exposure`` (orbit·time); ``halves``: the rates on the window's two halves (a
-    constant hazard gives equal ones within their errors), each (rate, err)."""
+    constant hazard gives equal ones within their errors), each (rate, err).
+
+    A window without an escape holds no rate: ``rate`` and ``rate_err`` are NaN, ``is_bound`` is True and
+    ``upper95`` (1/time) is the one-sided 95 % upper bound −ln(0.05)/exposure
+    (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_mle`); compare it as a bound, never as a value."""
 
     rate: float
     rate_err: float
@@ -143,6 +147,12 @@ class ThermalRate:
     t_start: float
     t_stop: float
     halves: tuple
+    upper95: float = math.nan
+
+    @property
+    def is_bound(self) -> bool:
+        """True when the window holds no escape: ``upper95`` bounds the rate, ``rate`` is NaN."""
+        return self.n_events == 0
 
 
 def thermal_rate(t_end, escaped, t_start: float, t_stop: float) -> ThermalRate:
@@ -160,6 +170,12 @@ def thermal_rate(t_end, escaped, t_start: float, t_stop: float) -> ThermalRate:
     >>> r = thermal_rate(np.minimum(t, 300.0), t < 300.0, 50.0, 300.0)
     >>> abs(r.rate - 0.01) < 3 * r.rate_err, r.n_events > 5000
     (True, True)
+
+    No escape in the window: a bound, not a rate of 0:
+
+    >>> b = thermal_rate(np.full(1000, 300.0), np.zeros(1000, bool), 50.0, 300.0)
+    >>> b.is_bound, b.rate, round(b.upper95 * 1000 * 250.0, 4)     # −ln 0.05 over 2.5e5 orbit·time
+    (True, nan, 2.9957)
     """
     t_end = np.asarray(t_end, dtype=float)
     escaped = np.asarray(escaped, dtype=bool)
@@ -169,4 +185,6 @@ def thermal_rate(t_end, escaped, t_start: float, t_stop: float) -> ThermalRate:
         (m.kappa, m.kappa_err)
         for m in (escape_rate_mle(t_end, escaped, a, b) for a, b in ((t_start, mid), (mid, t_stop)))
     )
-    return ThermalRate(whole.kappa, whole.kappa_err, whole.n_events, whole.exposure, t_start, t_stop, halves)
+    return ThermalRate(
+        whole.kappa, whole.kappa_err, whole.n_events, whole.exposure, t_start, t_stop, halves, whole.upper95
+    )

@@ -79,6 +79,10 @@ class MLERate:
 
     kappa, kappa_err (1/time; err = κ/√events), n_events, exposure (orbit·time),
     n_at_risk (orbits alive at t_start), t_start, t_stop.
+
+    A window without an escape measures no rate: ``kappa`` and ``kappa_err`` are NaN and ``upper95`` is the
+    one-sided 95 % upper bound −ln(0.05)/exposure ≈ 3.0/exposure (1/time; infinite without exposure);
+    ``is_bound`` is True. With escapes, ``upper95`` is NaN.
     """
 
     kappa: float
@@ -88,6 +92,12 @@ class MLERate:
     n_at_risk: int
     t_start: float
     t_stop: float
+    upper95: float = math.nan
+
+    @property
+    def is_bound(self) -> bool:
+        """True when the window holds no escape: the result is the upper bound ``upper95``, not a rate."""
+        return self.n_events == 0
 
 
 def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
@@ -104,6 +114,16 @@ def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
     with standard error κ̂/√D (Fisher information D/κ²).  Unlike least
     squares on the cumulative P(t) it uses independent information only, so
     its error is the statistical benchmark.  O(N).
+
+    Without an escape in the window (D = 0) there is no rate, only the one-sided 95 % upper bound
+    κ < −ln(0.05)/X (the rate at which no event in the exposure X has probability 5 %): ``kappa`` is NaN and
+    ``upper95`` holds the bound (:class:`MLERate`).
+
+    Examples
+    --------
+    >>> m = escape_rate_mle([5.0, 7.0, 30.0], [True, True, False], 10.0, 20.0)   # one orbit at risk, no escape
+    >>> m.is_bound, m.kappa, round(m.upper95, 4), m.exposure
+    (True, nan, 0.2996, 10.0)
     """
     t_end = np.asarray(t_end, dtype=float).ravel()
     observed = np.asarray(observed).ravel()
@@ -114,9 +134,15 @@ def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
     at_risk = t_end > t_start
     exposure = float(np.sum(np.minimum(t_end[at_risk], t_stop) - t_start))
     D = int(np.count_nonzero(observed & at_risk & (t_end <= t_stop)))
-    kappa = D / exposure if exposure > 0 else math.nan
-    err = kappa / math.sqrt(D) if D > 0 else math.nan
-    return MLERate(kappa, err, D, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop))
+    if D == 0:  # no escape: no rate, the one-sided 95 % upper bound from the exposure
+        upper = -math.log(0.05) / exposure if exposure > 0 else math.inf
+        return MLERate(
+            math.nan, math.nan, 0, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop), upper
+        )
+    kappa = D / exposure
+    return MLERate(
+        kappa, kappa / math.sqrt(D), D, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop)
+    )
 
 
 def power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate:

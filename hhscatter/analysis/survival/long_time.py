@@ -54,7 +54,8 @@ class PlateauFit:
         Fraction of all orbits still inside at t0 (Kaplan–Meier).
     q, q_err : float
         Fraction of the orbits inside at t0 that never escape, and its 1σ error (q = 0 with ``plateau=False``;
-        q = 0 with a NaN error where the fitted plateau lies at its boundary 0).
+        q = 0 with a NaN error where the fitted plateau lies at its boundary 0, as when no orbit after t0 is
+        censored: the likelihood then falls with q and its maximum is q = 0).
     p_inf, p_inf_err : float
         P∞ = q·P(t0): the plateau as a fraction of all orbits.
     kappa, kappa_err : float
@@ -138,10 +139,15 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
         raise ValueError(f"too few orbits inside at t0 = {t0:g} ({n}) or escapes after it ({int(obs[risk].sum())})")
     s, esc = t[risk] - t0, obs[risk]
     from scipy.optimize import minimize  # deferred: scipy loads on first use
+    from scipy.special import expit  # deferred: scipy loads on first use
 
     k_start = esc.sum() / max(s.sum(), 1e-300)
+    if plateau and esc.all():  # nothing censored: the likelihood falls with q, its maximum is q = 0 exactly
+        f0 = fit_plateau_exponential(t, obs, t0, plateau=False, n_bins=n_bins)
+        return PlateauFit(**{**f0.__dict__, "q_err": math.nan, "p_inf_err": math.nan})
     if plateau:
-        f = lambda v: _negloglik(1 / (1 + math.exp(-v[0])), math.exp(v[1]), s, esc)  # noqa: E731
+        # q by its logit and κ by its logarithm, both mapped without overflow wherever the simplex wanders
+        f = lambda v: _negloglik(float(expit(v[0])), math.exp(min(v[1], 700.0)), s, esc)  # noqa: E731
         q_start = min(max(1 - esc.mean(), 1e-3), 1 - 1e-3)
         starts = [(math.log(q_start / (1 - q_start)), math.log(k_start * m)) for m in (1.0, 3.0, 10.0)]
         best = min(
@@ -151,7 +157,7 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
             ),
             key=lambda r: r.fun,
         )
-        q, kappa = 1 / (1 + math.exp(-best.x[0])), math.exp(best.x[1])
+        q, kappa = float(expit(best.x[0])), math.exp(min(best.x[1], 700.0))
         if q < 1e-6:  # the plateau at its boundary: no plateau; the single exponential, q = 0 without an error
             f0 = fit_plateau_exponential(t, obs, t0, plateau=False, n_bins=n_bins)
             return PlateauFit(**{**f0.__dict__, "q_err": math.nan, "p_inf_err": math.nan})
@@ -217,7 +223,7 @@ def survival_at(t_end, observed, times) -> tuple[np.ndarray, np.ndarray]:
     """survival_at(t_end, observed, times) -> (P, P_err): Kaplan–Meier P(t) and its Greenwood error at ``times``.
 
     >>> P, e = survival_at([1.0, 2.0, 3.0, 4.0], [True, True, False, False], [1.5, 3.5])
-    >>> P.tolist()
+    >>> P.round(12).tolist()
     [0.75, 0.5]
     """
     from hhscatter.analysis.survival.kaplan_meier import survival_curve  # deferred: kept off import time
@@ -248,7 +254,8 @@ class RateStatus:
     status : str
         'exponential' (one exponential from τ0 on, with the orbits still inside at t_max a negligible share),
         'trapped' (orbits still inside at t_max are more than ``max_bias`` of P at the window end: the window
-        measures the plateau), or 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``).
+        measures the plateau), 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``), or
+        'empty' (no orbit was still inside after τ0: every one left before the window, which holds no rate).
     trapped_fraction : float
         Orbits still inside at the end (censored), of all.
     p_inf, p_inf_err, kappa_inf, kappa_inf_err : float
@@ -277,7 +284,8 @@ def rate_status(
     Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' when
     the orbits still inside at t_max are more than ``max_bias`` of P(t_stop)
     (:func:`hhscatter.analysis.survival.kappa_conventions.plateau_check`), 'non-exponential' when one exponential
-    from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), else 'exponential'. With a plateau,
+    from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), 'empty' when no orbit was still
+    inside after τ0, else 'exponential'. With no orbit still inside at the end there is no plateau. With a plateau,
     the note gives P∞ and κ∞ of the plateau-plus-exponential fit.
 
     Examples
@@ -290,6 +298,8 @@ def rate_status(
     >>> t = rng.exponential(10.0, 5000)
     >>> rate_status(np.minimum(t, 800.0), t < 800.0, 1.0, 60.0).status
     'exponential'
+    >>> rate_status(t, np.ones(t.size, bool), 1e6, 2e6).status     # every orbit left before τ0
+    'empty'
     """
     from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
 
@@ -297,10 +307,23 @@ def rate_status(
 
     t = np.asarray(t_end, dtype=float).ravel()
     obs = np.asarray(observed, dtype=bool).ravel()
-    f_inf = float((~obs).mean()) if obs.size else math.nan
-    P_end = _km_at(t, obs, t_stop)
-    defined, bias, _ = plateau_check(P_end, f_inf, max_bias)
     nan = math.nan
+    f_inf = float((~obs).mean()) if obs.size else math.nan
+    if not (t > tau0).any():  # the whole population left before the window: nothing to call trapped or a rate
+        return RateStatus(
+            "empty",
+            f_inf,
+            nan,
+            nan,
+            nan,
+            nan,
+            nan,
+            f"no orbit is inside after τ0 = {tau0:.3g} (all {t.size} ended by then): the window holds no escape "
+            "and no rate",
+        )
+    P_end = _km_at(t, obs, t_stop)
+    # no orbit still inside at the end: no plateau, whatever P at the window end (0 of 0 is no bias)
+    defined, bias, _ = plateau_check(P_end, f_inf, max_bias) if f_inf > 0 else (True, 0.0, "")
     try:
         pf = fit_plateau_exponential(t, obs, tau0)
         plat = (pf.p_inf, pf.p_inf_err, pf.kappa, pf.kappa_err)

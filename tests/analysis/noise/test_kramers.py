@@ -74,3 +74,17 @@ def test_reactivation_survival_against_the_process_it_assumes():
     np.testing.assert_allclose(model, empirical, atol=4 * math.sqrt(0.25 / n))
     with pytest.raises(ValueError, match="beyond the earliest censoring"):
         reactivation_survival([50.0], [10.0, 40.0], [True, False], [False, False], k)
+
+
+def test_a_window_without_escapes_is_an_upper_bound_not_a_rate_of_zero():
+    """No escape in [50, 300] among 1000 orbits still inside: the rate is NaN, the bound −ln(0.05)/exposure."""
+    t_end = np.concatenate([np.full(1000, 400.0), [10.0, 20.0]])
+    escaped = np.concatenate([np.zeros(1000, bool), [True, True]])
+    r = thermal_rate(t_end, escaped, 50.0, 300.0)
+    assert r.is_bound and r.n_events == 0 and math.isnan(r.rate) and math.isnan(r.rate_err)
+    assert r.exposure == 1000 * 250.0
+    assert r.upper95 == pytest.approx(-math.log(0.05) / 250000.0, rel=1e-12)
+    assert all(math.isnan(k) for k, _ in r.halves)
+    with_escapes = thermal_rate(np.array([60.0, 400.0]), np.array([True, False]), 50.0, 300.0)
+    assert not with_escapes.is_bound and math.isnan(with_escapes.upper95)
+    assert with_escapes.rate == pytest.approx(1 / 260.0)

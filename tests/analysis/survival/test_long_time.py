@@ -1,9 +1,11 @@
 """The censoring-aware plateau-plus-exponential fit against samples drawn from known laws."""
 
+import math
+
 import numpy as np
 import pytest
 
-from hhscatter.analysis.survival.long_time import fit_plateau_exponential, hazard_profile, survival_at
+from hhscatter.analysis.survival.long_time import fit_plateau_exponential, hazard_profile, rate_status, survival_at
 
 
 def _sample(n, q, kappa, t_max, seed):
@@ -83,3 +85,34 @@ def test_rate_status_passes_one_exponential():
 
     t, obs = _sample(20000, 0.0, 0.05, 400.0, 10)
     assert rate_status(t, obs, 5.0, 150.0).status == "exponential"
+
+
+def test_nothing_censored_gives_the_single_exponential_without_overflow():
+    """With every orbit escaped the likelihood falls with q: the MLE is q = 0, κ = escapes / exposure. This
+    sample once sent the simplex to a logit beyond exp's range (OverflowError)."""
+    t = np.random.default_rng(17).exponential(5.0, 100)
+    f = fit_plateau_exponential(t, np.ones(t.size, bool), 10.0)
+    s = t[t > 10.0] - 10.0
+    assert f.q == 0.0 and f.p_inf == 0.0 and math.isnan(f.q_err)
+    assert f.kappa == pytest.approx(s.size / s.sum(), rel=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_rate_status_of_uncensored_exponentials_is_exponential(seed):
+    t = np.random.default_rng(seed).exponential(5.0, 600)
+    st = rate_status(t, np.ones(t.size, bool), 1.0, 15.0)
+    assert st.status == "exponential" and st.trapped_fraction == 0.0 and st.note == ""
+    assert st.p_inf == 0.0 and math.isfinite(st.kappa_inf)
+
+
+def test_rate_status_of_a_population_gone_before_tau0_is_empty_not_trapped():
+    t = np.random.default_rng(0).exponential(1.0, 500)
+    st = rate_status(t, np.ones(t.size, bool), 100.0, 200.0)
+    assert st.status == "empty" and "inf" not in st.note and "no orbit is inside after τ0" in st.note
+
+
+def test_rate_status_with_every_orbit_gone_before_the_window_end_has_no_plateau():
+    """All escaped between τ0 and t_stop: P(t_stop) = 0 and nothing trapped is no bias (was 'trapped', inf %)."""
+    t = np.random.default_rng(4).exponential(5.0, 2000)
+    st = rate_status(t, np.ones(t.size, bool), 1.0, 10 * t.max())
+    assert st.status == "exponential" and "inf" not in st.note
