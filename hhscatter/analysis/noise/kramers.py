@@ -5,8 +5,8 @@ Borkovec, Rev. Mod. Phys. 62, 251 (1990), Eq. (4.49)) for unit mass and the line
 
     k = Σ_saddles (λ₊/2π) √(det H_min / |det H_s|) e^{−ΔE_s/T},    λ₊ = −γ/2 + √(γ²/4 + ω_b²),
 
-with H_min, H_s the Hessians of V at the well's minimum and at saddle s, ω_b² = −(the negative eigenvalue
-of H_s) and ΔE_s = V(s) − V(min). Everything comes from the system object: its exits are the saddles, its
+with H_min, H_s the Hessians of V at the well's minimum and at saddle s (exact, from the potential's
+expression: :func:`hessian`), ω_b² = −(the negative eigenvalue of H_s) and ΔE_s = V(s) − V(min). Everything comes from the system object: its exits are the saddles, its
 potential gives the Hessians (:func:`hessian`), the minimum is the origin (the System contract). The formula
 is the leading term of an expansion in T/ΔE: the measured rate's ratio to it tends to 1 as the barrier grows.
 
@@ -26,27 +26,54 @@ from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 
 __all__ = ["KramersLanger", "SaddleTerm", "ThermalRate", "hessian", "kramers_langer", "thermal_rate"]
 
-#: central-difference step of :func:`hessian` (length): relative error ≈ step² · V''''/V'' ≈ 1e-8 for smooth V
+#: relative central-difference step of :func:`hessian` for a potential given as a function only: the step is
+#: this times the point's length scale max(|x|, |y|, the saddles' distance), so a rescaled system keeps the same
+#: relative error (about step² times the ratio of the fourth to the second derivative: 1e-8 for smooth V)
 HESSIAN_STEP = 1e-4
 
+_LANDSCAPES: dict = {}
 
-def hessian(model, x: float, y: float, step: float = HESSIAN_STEP) -> np.ndarray:
+
+def _landscape(model):
+    """The exact derivatives of ``model``'s potential (its text and parameters), built once per potential."""
+    from hhscatter.model.landscape import Landscape  # deferred: sympy loads on first use
+    from hhscatter.model.parse import parse_potential, substitute  # deferred: sympy loads on first use
+
+    params = dict(model.params)
+    key = (model.potential_text, tuple(sorted(params.items())))
+    if key not in _LANDSCAPES:
+        _LANDSCAPES[key] = Landscape(substitute(parse_potential(model.potential_text, params), params))
+    return _LANDSCAPES[key]
+
+
+def hessian(model, x: float, y: float, step: float | None = None) -> np.ndarray:
     """hessian(model, x, y) -> (2, 2) Hessian of the system's potential V at (x, y) (energy/length²).
 
-    Central differences of ``model.potential`` with step ``step`` (error O(step²)).
+    Exact: the second derivatives of the system's potential expression (``model.potential_text`` with
+    ``model.params``, :class:`hhscatter.model.landscape.Landscape`), so the result is right at every scale of
+    the system (a Hénon–Heiles with λ = 1e-5 has its saddles at distance 10⁵). An object with only a
+    ``potential`` function, or an explicit ``step``, gets central differences with the step ``step`` (default
+    :data:`HESSIAN_STEP`) times the point's length scale max(|x|, |y|, the saddles' distance).
 
     Examples
     --------
     >>> from hhscatter.model import HenonHeiles
-    >>> np.round(hessian(HenonHeiles(), 0.0, 1.0), 6)     # the saddle (0, 1): V_xx = 1 + 2y, V_yy = 1 − 2y
+    >>> hessian(HenonHeiles(), 0.0, 1.0)     # the saddle (0, 1): V_xx = 1 + 2y, V_yy = 1 − 2y
+    array([[ 3.,  0.],
+           [ 0., -1.]])
+    >>> hessian(HenonHeiles(lam=1e-5), 0.0, 1e5)      # the same saddle of a system 10⁵ times larger
     array([[ 3.,  0.],
            [ 0., -1.]])
     """
+    if step is None and hasattr(model, "potential_text") and hasattr(model, "params"):
+        a, b, c = (float(v) for v in _landscape(model).hessian(float(x), float(y)))
+        return np.array([[a, b], [b, c]])
 
     def v(a, b):
         return float(model.potential(np.array(a, dtype=float), np.array(b, dtype=float)))
 
-    h = step
+    scale = max(abs(x), abs(y), float(getattr(model, "saddle_radius", 1.0)))
+    h = (HESSIAN_STEP if step is None else step) * scale
     vxx = (v(x + h, y) - 2 * v(x, y) + v(x - h, y)) / h**2
     vyy = (v(x, y + h) - 2 * v(x, y) + v(x, y - h)) / h**2
     vxy = (v(x + h, y + h) - v(x + h, y - h) - v(x - h, y + h) + v(x - h, y - h)) / (4 * h * h)

@@ -88,3 +88,44 @@ def test_a_window_without_escapes_is_an_upper_bound_not_a_rate_of_zero():
     with_escapes = thermal_rate(np.array([60.0, 400.0]), np.array([True, False]), 50.0, 300.0)
     assert not with_escapes.is_bound and math.isnan(with_escapes.upper95)
     assert with_escapes.rate == pytest.approx(1 / 260.0)
+
+
+@pytest.mark.parametrize("lam", [1.0, 1e-4, 1e-5])
+def test_kramers_langer_of_a_rescaled_henon_heiles_is_scale_invariant(lam):
+    """λ rescales lengths by 1/λ and energies by 1/λ²; at ΔE/T = 6 the rate is the λ = 1 closed form
+    3 (λ₊/2π)(1/√3) e^{−6} (a fixed difference step was 6 % high at λ = 1e-4, no saddle at λ = 1e-5)."""
+    m = HenonHeiles(1.0, lam)
+    kl = kramers_langer(m, 1.0, m.critical_energy / 6)
+    assert kl.rate == pytest.approx(3 * (math.sqrt(5) - 1) / 2 / (2 * math.pi) / math.sqrt(3) * math.exp(-6), rel=1e-9)
+    np.testing.assert_allclose(hessian(m, 0.0, 1 / lam), [[3.0, 0.0], [0.0, -1.0]], rtol=1e-12, atol=1e-12)
+    c, s = math.cos(math.radians(210)), math.sin(math.radians(210))  # the saddle at angle 210°
+    np.testing.assert_allclose(
+        hessian(m, c / lam, s / lam), [[1 + 2 * s, 2 * c], [2 * c, 1 - 2 * s]], rtol=1e-12, atol=1e-12
+    )
+
+
+@pytest.mark.parametrize("eps", [0.5, 1e-4])
+def test_kramers_langer_of_barbanis_against_its_closed_form(eps):
+    """V = (x² + y²)/2 − εxy²: saddles (1/(2ε), ±1/(√2 ε)) with Hessian [[1, ∓√2], [∓√2, 0]] (eigenvalues 2, −1,
+    det −2), minimum Hessian I, barrier 1/(8ε²): k = 2 (λ₊/2π) √(1/2) e^{−ΔE/T}, λ₊ = −γ/2 + √(γ²/4 + 1)."""
+    from hhscatter.model.builtins import barbanis
+
+    m = barbanis(eps)
+    gamma, T = 0.3, 1 / (8 * eps**2) / 5
+    kl = kramers_langer(m, gamma, T)
+    lam_plus = -gamma / 2 + math.sqrt(gamma**2 / 4 + 1)
+    assert kl.rate == pytest.approx(2 * lam_plus / (2 * math.pi) * math.sqrt(0.5) * math.exp(-5.0), rel=1e-9)
+    np.testing.assert_allclose(
+        hessian(m, 1 / (2 * eps), 1 / (math.sqrt(2) * eps)), [[1.0, -math.sqrt(2)], [-math.sqrt(2), 0.0]], atol=1e-9
+    )
+
+
+def test_difference_hessian_of_a_function_scales_its_step_with_the_point():
+    """A potential given as a function only: the step follows the length scale (a quartic far out)."""
+
+    class Quartic:
+        def potential(self, x, y):
+            return 1e-20 * x**4 + y * y
+
+    # V_xx = 12e-20 x² = 12 at x = 1e10; a fixed step of 1e-4 there is lost in rounding
+    np.testing.assert_allclose(hessian(Quartic(), 1e10, 0.0), [[12.0, 0.0], [0.0, 2.0]], rtol=1e-6, atol=1e-6)
