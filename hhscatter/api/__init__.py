@@ -37,7 +37,9 @@ One module per concept, every public name importable from ``hhscatter.api``:
 * ``dissipative`` — transition times and energy decay (:func:`transition_times`, :func:`energy_decay`);
 * ``basins`` — exit-basin maps and their measures (:func:`basin_measures`);
 * ``plotting`` — :func:`plot_survival`, :func:`plot_escape_rates`;
-* ``runs`` — what a run directory holds (:func:`run_scene`).
+* ``runs`` — what a run directory holds (:func:`run_scene`);
+* ``checks`` — the argument checks every function above makes before any work (a wrong table, run, number or
+  result is refused with a :class:`~hhscatter.errors.ConfigError` naming the argument).
 """
 
 from hhscatter.api.basins import OUTSIDE_BASIN as OUTSIDE_BASIN  # the basin codes (module constants, not in __all__)

@@ -7,8 +7,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.api import checks
 from hhscatter.api.plotting import _axes
 from hhscatter.api.points import _label, _sorted_keys, split_points
+from hhscatter.errors import ConfigError
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -159,14 +161,29 @@ def basin_measures(
         wada_merging,
     )
 
-    cell = np.asarray(cell, dtype=np.int64).ravel()
-    ny, nx = (int(v) for v in shape)
+    checks.frame(lifetimes, "lifetimes", needs=("traj_id", "outcome", "exit_channel", "t_end"))
+    try:
+        cell = np.asarray(cell).ravel()
+        ok = cell.size > 0 and np.issubdtype(cell.dtype, np.integer)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ConfigError(f"cell must be a non-empty array of integer cell indices, got {checks.describe(cell)}")
+    cell = cell.astype(np.int64)
+    if not (isinstance(shape, (tuple, list)) and len(shape) == 2):
+        raise ConfigError(f"shape must be (ny, nx), got {checks.describe(shape)}")
+    ny, nx = (checks.number(v, f"shape[{i}]", lo=1, integer=True) for i, v in enumerate(shape))
+    if cell.min() < 0 or cell.max() >= ny * nx:
+        raise ConfigError(
+            f"cell holds indices outside the {ny}×{nx} grid (0 … {ny * nx - 1}): {cell.min()} … {cell.max()}"
+        )
+    boxes = [checks.number(b, "boxes[]", lo=1, integer=True) for b in np.atleast_1d(boxes).tolist()]
     maps, fracs, ent, wd = {}, {}, {}, {}
     for key, df in split_points(lifetimes):
         df = df.sort_values("traj_id")
         ids = df["traj_id"].to_numpy(dtype=np.int64)
         if ids.size and (ids.min() < 0 or ids.max() >= cell.size):
-            raise ValueError(f"traj_id {ids.max()} has no cell: cell holds {cell.size} initial conditions")
+            raise ConfigError(f"traj_id {ids.max()} has no cell: cell holds {cell.size} initial conditions")
         oc = df["outcome"].astype(str).to_numpy()
         code = np.full(ids.size, TRAPPED_BASIN, dtype=np.int64)
         esc = oc == "escaped"

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.api import checks
 from hhscatter.api.plotting import _axes
 from hhscatter.api.points import (
     _key_columns,
@@ -26,6 +27,10 @@ from hhscatter.api.rates import DISSIPATIVE_NOTE, EscapeRates, escape_rates
 from hhscatter.api.runs import run_scene
 from hhscatter.data.params import checked_value, same_run
 from hhscatter.data.read import read_lifetimes, read_sections
+from hhscatter.errors import ConfigError
+
+#: the columns of a sections table the c-measure reads
+SECTION_COLUMNS = ("traj_id", "t")
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -135,6 +140,17 @@ def kappa_cmeasure_tables(
     True
     """
 
+    checks.frame(lifetimes, "lifetimes", needs=("t_end", "outcome"))
+    checks.frame(
+        sections, "sections", needs=SECTION_COLUMNS, what="a sections table", reader="hhscatter.read_sections(run)"
+    )
+    for name, v, lo in (("rec_efolds", rec_efolds, 0.0), ("margin", margin, 0.0)):
+        checks.number(v, name, lo=lo)
+    checks.number(n_boot, "n_boot", lo=0, integer=True)
+    checks.number(seed, "seed", lo=0, integer=True)
+    for name, v in (("t_from", t_from), ("t_to", t_to), ("t_max", t_max)):
+        if v is not None:
+            checks.number(v, name, lo=0.0)
     same_run(lifetimes, sections, what="the lifetimes and sections tables")
     window = checked_value(lifetimes, "sections", _window_dict(window), what="the section window", name="window")
     t_max = checked_value(lifetimes, "t_max", t_max, what="t_max")
@@ -284,9 +300,16 @@ def kappa_cmeasure(run: str | os.PathLike[str], **kwargs: Any) -> CMeasureRates:
     >>> hhscatter.kappa_cmeasure(run).to_frame()[["energy", "t_record_end", "note"]].values.tolist()
     [[0.3, 70.0, '']]
     """
+    checks.run_dir(run)
+    unknown = sorted(set(kwargs) - {"t_from", "t_to", "rec_efolds", "margin", "n_boot", "seed"})
+    if unknown:
+        raise ConfigError(
+            f"kappa_cmeasure has no option {unknown[0]!r}; its options: t_from, t_to, rec_efolds, margin, n_boot, "
+            "seed (window and t_max are read from the run)"
+        )
     scene = run_scene(run)
     if not scene.get("sections"):
-        raise ValueError(
+        raise ConfigError(
             f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
             "t_to=…) (every crossing, no energy filter)"
         )
@@ -384,6 +407,17 @@ def cmeasure_points(
     """
     from hhscatter.analysis.geometry.distance import first_crossings  # deferred: pandas, pyarrow load on first use
 
+    checks.frame(
+        sections,
+        "sections",
+        needs=("t", "x", "y", "traj_id"),
+        what="a sections table",
+        reader="hhscatter.read_sections(run)",
+    )
+    t_from = checks.number(t_from, "t_from", lo=0.0)
+    t_to = checks.number(t_to, "t_to", lo=t_from, finite=False)
+    e_min = checks.number(e_min, "e_min", finite=False)
+    e_max = checks.number(e_max, "e_max", lo=e_min, finite=False)
     keys = [k for k, _ in split_points(lifetimes)] if lifetimes is not None else None
     out = {}
     for key, df in _split_like(sections, keys, what="sections table").items():
@@ -494,7 +528,26 @@ def cmeasure_distances(
     )
     from hhscatter.analysis.geometry.distance import points as xy  # deferred: pandas, pyarrow load on first use
 
-    Q = xy(reference) if hasattr(reference, "columns") else np.asarray(reference, dtype=float)
+    checks.result(points, "points", (CMeasurePoints,), "hhscatter.cmeasure_points")
+    if hasattr(reference, "columns"):
+        checks.frame(reference, "reference", needs=("x", "y"), what="section points", reader="cmeasure_points")
+        Q = xy(reference)
+    else:
+        try:
+            Q = np.asarray(reference, dtype=float)
+        except (TypeError, ValueError):
+            Q = np.empty((0, 0))
+        if Q.ndim != 2 or Q.shape[1] != 2 or not len(Q) or not np.isfinite(Q).all():
+            raise ConfigError(
+                f"reference must be a DataFrame (x, y) or a finite (n, 2) array, got {checks.describe(reference)}"
+            )
+    boxes = [checks.number(b, "boxes[]", lo=0.0, lo_open=True) for b in np.atleast_1d(boxes).tolist()]
+    if not boxes:
+        raise ConfigError("boxes must hold at least one box side")
+    n_splits = checks.number(n_splits, "n_splits", lo=0, integer=True)
+    seed = checks.number(seed, "seed", lo=0, integer=True)
+    if m is not None:
+        m = checks.number(m, "m", lo=1, integer=True)
     tables, scales, few = {}, {}, []
     if m is None and n_splits > 0:  # one sample size for every point, so their noise floors compare
         sizes = [min(len(df), len(Q)) // 2 for df in points.points.values() if len(df) >= 4]

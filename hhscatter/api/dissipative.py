@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.api import checks
 from hhscatter.api.plotting import _axes
 from hhscatter.api.points import (
     _key_columns,
@@ -19,7 +20,8 @@ from hhscatter.api.points import (
     split_points,
 )
 from hhscatter.api.rates import EscapeRates, escape_rates
-from hhscatter.data.params import plain_point
+from hhscatter.data.params import FRAME_META, plain_point
+from hhscatter.errors import ConfigError
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -31,7 +33,8 @@ if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a
 class TransitionTimes(_PointRows):
     """Result of :func:`transition_times`: τ0, τ1, τ2 per dissipative grid point.
 
-    ``.to_frame()`` columns: energy, gamma, n, tau0, tau1, tau2, tau2_lo, tau2_hi, note (one row per γ > 0).
+    ``.to_frame()`` columns: energy, gamma, n, tau0, tau1, tau2, tau2_lo, tau2_hi, partner (the conservative
+    point τ0 and τ1 come from, "" without one), note (one row per γ > 0).
 
     Attributes
     ----------
@@ -80,8 +83,19 @@ def transition_times(
     Returns
     -------
     TransitionTimes
-        ``.to_frame()`` one row per γ > 0 point; ``.plot(ax=)`` τ1 and τ2 against γ. A point without a
-        conservative partner, or whose τ1 is never reached, gets NaN and a note.
+        ``.to_frame()`` one row per γ > 0 point, with the ``partner`` it was compared with; ``.plot(ax=)`` τ1 and
+        τ2 against γ. A point without a conservative partner, or whose τ1 is never reached, gets NaN and a note.
+
+    The partner is the γ = 0 point of the same E0 in the same run; in a frame of several runs
+    (:func:`hhscatter.read_lifetimes` of a list) another run's γ = 0 point is a partner only if its scene has the
+    same system, initial conditions (region, radius, table, seed), escape rule (r_esc, r_far) and noise
+    (:data:`hhscatter.api.checks.PAIRING_KEYS`); the note names a refused one and how it differs.
+
+    Raises
+    ------
+    ConfigError
+        ``lifetimes`` is not a lifetimes table, holds no γ > 0 point, ``alpha`` ≤ 1 or ``t_grid`` is not a grid
+        of times.
 
     Examples
     --------
@@ -95,8 +109,8 @@ def transition_times(
     >>> tg = np.where(t0 > 20, 20 + rng.exponential(40.0, 20000), t0)   # from t = 20 on, escape slows down
     >>> lt = pd.concat([point(0.0, t0).assign(outcome="escaped"), point(0.01, tg)])
     >>> row = hhscatter.transition_times(lt).to_frame().iloc[0]
-    >>> bool(20 < row.tau1 < 40), bool(row.tau2 > 30)
-    (True, True)
+    >>> bool(20 < row.tau1 < 40), bool(row.tau2 > 30), row.partner
+    (True, True, 'E0=0.3, γ=0')
     """
     from hhscatter.analysis.dissipative.transitions import (  # deferred: pandas, pyarrow, scipy load on first use
         tau1,
@@ -105,9 +119,18 @@ def transition_times(
     )
     from hhscatter.analysis.survival.fits import survival_from_lifetimes  # deferred: scipy loads on first use
 
+    checks.frame(lifetimes, "lifetimes", needs=("t_end", "outcome"))
+    alpha = checks.number(alpha, "alpha", lo=1.0, lo_open=True)
+    t_grid = checks.time_grid(t_grid)
     points = dict(split_points(lifetimes))
+    if not any(k[1] > 0 for k in points):
+        raise ConfigError(
+            "transition_times needs dissipative (γ > 0) points beside their γ = 0 partners; the lifetimes hold "
+            f"only γ = 0 ({', '.join(_label(k) for k in _sorted_keys(points))}): read a run with drag as well"
+        )
     conservative = lifetimes[lifetimes["gamma"] == 0] if "gamma" in lifetimes.columns else lifetimes
     rates = escape_rates(conservative) if len(conservative) else EscapeRates({}, {}, {})
+    scenes = _run_scenes(lifetimes)
     rows = {}
     for key, df in points.items():
         if key[1] == 0:
@@ -122,13 +145,25 @@ def transition_times(
             "tau2": math.nan if t2 is None else t2,
             "tau2_lo": math.nan if iv is None else iv.lo,
             "tau2_hi": math.nan if iv is None else iv.hi,
+            "partner": "",
             "note": "",
         }
         rows[key] = row
-        ref = [k for k in rates.results if _same_point(k[:2], (key[0], 0.0))]
-        ref = [k for k in ref if k[2:] == key[2:]] or ref  # the same run's partner first (a grid run)
+        same_e = [k for k in rates.n if _same_point(k[:2], (key[0], 0.0))]
+        ref = [k for k in same_e if k[2:] == key[2:]]  # the same run's partner (a grid run, or one table)
+        refused = []
+        if not ref:  # another run's γ = 0 point: only of the same system, initial conditions and escape rule
+            for k in same_e:
+                diff = checks.scene_differences(scenes.get(_run_of(key)), scenes.get(_run_of(k)))
+                (refused if diff else ref).append((k, diff) if diff else k)
         if not ref:
-            row["note"] = "no conservative (γ = 0) point at this E0 with a κ fit: τ0 and τ1 need one"
+            row["note"] = "no conservative (γ = 0) point at this E0 with a κ fit: τ0 and τ1 need one" + (
+                "; not paired with "
+                + "; ".join(f"{_label(k)}, which differs in {', '.join(d)}" for k, d in refused)
+                + " (pairing needs the same system, initial conditions, escape rule and noise)"
+                if refused
+                else ""
+            )
             continue
         if len(ref) > 1:
             row["note"] = (
@@ -136,9 +171,13 @@ def transition_times(
                 "τ0 and τ1 need one; read the pair alone"
             )
             continue
-        r = rates.results[ref[0]]
+        row["partner"] = _label(ref[0])
+        r = rates.results.get(ref[0])
+        if r is None:
+            row["note"] = f"the conservative partner {_label(ref[0])} has no κ fit ({rates.notes.get(ref[0], '')})"
+            continue
         grid = (
-            np.asarray(t_grid, dtype=float)
+            t_grid
             if t_grid is not None
             else np.linspace(0.0, float(max(df["t_end"].max(), points[ref[0]]["t_end"].max())), 4001)
         )
@@ -149,6 +188,19 @@ def transition_times(
         if t1 is None:
             row["note"] = f"P_γ never reaches {alpha:g}·P_0 after τ0"
     return TransitionTimes(rows)
+
+
+def _run_of(key):
+    """The run a point key names (a frame of several runs), else None (one run)."""
+    return key[2] if len(key) > 2 else None
+
+
+def _run_scenes(lifetimes) -> dict:
+    """{run name (None for a frame of one run): its scene dict} from what the readers attached to the frame."""
+    meta = getattr(lifetimes, "attrs", {}).get(FRAME_META) or {}
+    if "scene" in meta:
+        return {None: meta["scene"]}
+    return {str(r.get("run")): r.get("scene") for r in meta.get("runs") or []}
 
 
 @dataclass(frozen=True)
@@ -256,6 +308,18 @@ def energy_decay(
         mean_energy,
     )
 
+    checks.frame(
+        snapshots,
+        "snapshots",
+        needs=("traj_id", "t", "energy"),
+        what="a snapshots table",
+        reader="hhscatter.read_snapshots(run)",
+    )
+    window = checks.window(window)
+    if energy is not None:
+        energy = checks.number(energy, "energy")
+    if gamma is not None:
+        gamma = checks.number(gamma, "gamma", lo=0.0)
     curves, fits = {}, {}
     energy, gamma = plain_point(snapshots, energy, gamma, what="snapshots table")
     for key, df in _split_like(snapshots, None, energy=energy, gamma=gamma, what="snapshots table").items():

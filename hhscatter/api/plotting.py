@@ -6,7 +6,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.api import checks
 from hhscatter.api.points import _label
+from hhscatter.errors import ConfigError
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported when a function runs
     from matplotlib.axes import Axes
@@ -62,6 +64,14 @@ def plot_survival(
     >>> ax.get_ylabel()
     'P(t)'
     """
+    for c in curves if isinstance(curves, list) else [curves]:
+        if not (isinstance(getattr(c, "curves", None), dict) or all(hasattr(c, a) for a in ("t", "P", "P_err"))):
+            raise ConfigError(
+                "curves must be a SurvivalCurves (what hhscatter.survival returns), a SurvivalCurve (t, P, P_err) "
+                f"or a list of them, got {checks.describe(c)}"
+            )
+    if isinstance(curves, list) and not curves:
+        raise ConfigError("curves is an empty list: nothing to draw")
     items = []
     for c in curves if isinstance(curves, list) else [curves]:
         if isinstance(getattr(c, "curves", None), dict):  # a SurvivalCurves: one line per grid point
@@ -70,7 +80,7 @@ def plot_survival(
             items.append((None, c))
     if labels is not None:
         if len(labels) != len(items):
-            raise ValueError(f"{len(labels)} labels for {len(items)} curves")
+            raise ConfigError(f"{len(labels)} labels for {len(items)} curves")
         items = [(lab, c) for lab, (_, c) in zip(labels, items)]
     ax = _axes(ax)
     for label, c in items:
@@ -119,7 +129,14 @@ def plot_escape_rates(rates: Any, ax: Axes | None = None, *, x: str = "energy", 
     >>> hhscatter.plot_escape_rates(rates).get_xlabel()
     'E0'
     """
-    df = rates if hasattr(rates, "columns") else rates.to_frame()  # a DataFrame, or an EscapeRates
+    if isinstance(getattr(rates, "results", None), dict) and hasattr(rates, "to_frame"):  # an EscapeRates
+        df = rates.to_frame()
+    else:
+        df = checks.frame(
+            rates, "rates", needs=("gamma", "kappa", "kappa_err"), what="escape rates", reader="hhscatter.escape_rates"
+        )
+    if x not in df.columns:
+        raise ConfigError(f"x = {x!r} is not a column of the rates; columns: {', '.join(map(str, df.columns))}")
     df = df[np.isfinite(df["kappa"].to_numpy(dtype=float))]
     ax = _axes(ax)
     kw = {"fmt": "o-", "capsize": 3, **errorbar_kwargs}

@@ -16,6 +16,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from hhscatter.api import checks
+from hhscatter.errors import ConfigError
+from hhscatter.outcomes import OUTCOMES
+
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
 
@@ -43,16 +47,15 @@ def split_points(lifetimes):
     (:func:`hhscatter.read_lifetimes` of a list: a ``run`` column) is split per
     run too, with keys ``(energy, gamma, run)``: one point per run and grid
     point, unless the runs were pooled (``read_lifetimes(runs, pool=True)``).
-    Raises ValueError if the frame is empty, lacks ``t_end``/``outcome``, or
-    holds an orbit (``traj_id``) twice in one point (the same run concatenated
-    twice).
+    Raises ConfigError (a ValueError) if ``lifetimes`` is not a DataFrame, is
+    empty, lacks ``t_end``/``outcome``, has a ``t_end``, ``energy``, ``e0`` or
+    ``gamma`` that is not a number (NaN, negative times or γ), an ``outcome``
+    that is not one of the table's, or holds an orbit (``traj_id``) twice in one
+    point (the same run concatenated twice).
     """
+    checks.frame(lifetimes, "lifetimes", needs=("t_end", "outcome"))
+    _check_columns(lifetimes)
     cols = set(lifetimes.columns)
-    missing = {"t_end", "outcome"} - cols
-    if missing:
-        raise ValueError(f"lifetimes lacks column(s) {sorted(missing)}: pass a frame of hhscatter.read_lifetimes")
-    if len(lifetimes) == 0:
-        raise ValueError("lifetimes is empty: no orbits to analyse")
     pooled = (lifetimes.attrs.get("hhscatter") or {}).get("pooled") is not None
     if "run" in cols and not pooled:
         out = [
@@ -62,6 +65,35 @@ def split_points(lifetimes):
         ]
         return sorted(out, key=lambda kv: _sort_key(kv[0]))
     return _split_one(lifetimes)
+
+
+def _check_columns(lifetimes) -> None:
+    """The values a split and the estimators rely on: t_end finite and ≥ 0, γ finite and ≥ 0, energies finite
+    (NaN allowed: a point without a nominal E0), outcomes of the table's vocabulary."""
+    import pandas as pd  # deferred: pandas loads on first use
+
+    def numeric(col, *, nonneg: bool, nan_ok: bool = False):
+        if col not in lifetimes.columns:
+            return
+        v = pd.to_numeric(lifetimes[col], errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(v) & ~(np.isnan(v) & nan_ok & lifetimes[col].isna().to_numpy())
+        if nonneg:
+            bad |= v < 0
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ConfigError(
+                f"lifetimes column {col} must hold finite numbers{' ≥ 0' if nonneg else ''}; row {i} has "
+                f"{lifetimes[col].iloc[i]!r} ({int(bad.sum())} such row(s))"
+            )
+
+    numeric("t_end", nonneg=True)
+    numeric("gamma", nonneg=True)
+    numeric("energy", nonneg=False, nan_ok=True)
+    numeric("e0", nonneg=False)
+    outcome = lifetimes["outcome"].astype(object)
+    unknown = sorted({str(o) for o in pd.unique(outcome)} - set(OUTCOMES), key=str)
+    if unknown:
+        raise ConfigError(f"lifetimes column outcome holds {unknown[:3]}: an outcome is one of {', '.join(OUTCOMES)}")
 
 
 def _split_one(lifetimes):
@@ -89,7 +121,7 @@ def _split_one(lifetimes):
         mask = (key_e == e) & (gamma == g)
         key, df = (math.nan if e == -np.inf else float(e), float(g)), lifetimes[mask]
         if "traj_id" in cols and df.duplicated(subset=ids).any():
-            raise ValueError(
+            raise ConfigError(
                 f"lifetimes holds orbits twice at {_label(key)} (traj_id repeated): the same run "
                 "concatenated twice, or several runs without a run column; read several runs with "
                 "hhscatter.read_lifetimes([run1, run2, …]), which keeps them apart"
@@ -146,7 +178,7 @@ def _split_like(table, keys, *, energy=None, gamma=None, what="table"):
         return {(math.nan if energy is None else float(energy), 0.0 if gamma is None else float(gamma)): table}
     if keys is not None and len(keys) == 1:
         return {keys[0]: table}
-    raise ValueError(
+    raise ConfigError(
         f"the {what} has no point_energy/point_gamma columns (a plain run): pass energy= and gamma=, "
         "or the lifetimes of that one run"
     )

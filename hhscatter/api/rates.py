@@ -9,9 +9,11 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
+from hhscatter.api import checks
 from hhscatter.api.plotting import plot_escape_rates, plot_survival
 from hhscatter.api.points import _key_columns, _label, _sorted_keys, split_points
 from hhscatter.data.read import iter_survival_batches
+from hhscatter.errors import ConfigError
 
 if TYPE_CHECKING:  # annotations only: pandas and matplotlib are imported when a function runs
     import pandas
@@ -111,6 +113,7 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
         survival_curve,
     )
 
+    t_grid = checks.time_grid(t_grid)
     curves, n = {}, {}
     for key, df in split_points(lifetimes):
         observed = observed_from_outcome(df["outcome"].astype(object).to_numpy())
@@ -120,6 +123,34 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
 
 
 DISSIPATIVE_NOTE = "dissipative (γ > 0): P(t) is not exponential, no κ fitted"
+
+
+def _check_rate_options(kwargs: dict) -> None:
+    """The options :func:`escape_rates` passes on: names of :func:`~hhscatter.analysis.survival.escape_rate.escape_rate`
+    and of the window choice, each of its default's kind (a flag a bool, a number a finite number ≥ 0)."""
+    import inspect  # deferred: only for the option check
+
+    from hhscatter.analysis.survival.escape_rate import escape_rate  # deferred: scipy loads on first use
+    from hhscatter.analysis.survival.windows import choose_windows  # deferred: scipy loads on first use
+
+    known = {
+        p.name: p.default
+        for f in (escape_rate, choose_windows)
+        for p in inspect.signature(f).parameters.values()
+        if p.kind is p.KEYWORD_ONLY and p.name != "n_total"
+    }
+    for k, v in kwargs.items():
+        if k not in known:
+            raise ConfigError(f"escape_rates has no option {k!r}; its options: {', '.join(sorted(known))}")
+        d = known[k]
+        if isinstance(d, bool) and not isinstance(v, bool):
+            raise ConfigError(f"{k} must be True or False, got {checks.describe(v)}")
+        if isinstance(d, int) and not isinstance(d, bool):
+            checks.number(v, k, lo=1, integer=True)
+        elif isinstance(d, float):
+            checks.number(v, k, lo=0.0)
+        elif k == "tail_kwargs" and v is not None and not isinstance(v, dict):
+            raise ConfigError(f"tail_kwargs must be a dict of options, got {checks.describe(v)}")
 
 
 @dataclass(frozen=True)
@@ -258,6 +289,8 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     from hhscatter.analysis.survival.fits import observed_from_outcome  # deferred: scipy loads on first use
     from hhscatter.analysis.survival.long_time import rate_status  # deferred: scipy loads on first use
 
+    t_grid = checks.time_grid(t_grid)
+    _check_rate_options(kwargs)
     results, n, notes, status = {}, {}, {}, {}
     for key, df in split_points(lifetimes):
         n[key] = len(df)
@@ -318,7 +351,8 @@ def stream_survival(
         If some orbit was censored before max(t_grid) (use :func:`hhscatter.survival` then).
     """
 
-    km = KaplanMeierGrid(t_grid)
+    checks.run_dir(run)
+    km = KaplanMeierGrid(checks.time_grid(t_grid))
     for t_end, observed in iter_survival_batches(run, filters, allow_partial=allow_partial):
         km.add(t_end, observed)
         if km.first_censoring < km.grid[-1]:

@@ -17,6 +17,8 @@ same run or scene twice, and pools them only when asked (``pool=True``, checked)
 from __future__ import annotations
 
 import json
+import re
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +34,7 @@ from hhscatter.data.verify import (  # noqa: F401 - the verification's public na
     verified_dataset,
     verify_part,
 )
+from hhscatter.errors import ConfigError
 from hhscatter.outcomes import CENSORING_OUTCOMES
 
 if TYPE_CHECKING:  # annotations only
@@ -42,12 +45,89 @@ from hhscatter.data.schema import (
 )
 
 
+def _public_fields(dset) -> list[str]:
+    """The columns a user may read or filter on: the table's fields (the storage's own are left out)."""
+    return [f for f in dset.schema.names if not f.startswith("_")]
+
+
+def _expression(filters):
+    """``filters`` as a pyarrow expression: an expression as given, or the pandas/pyarrow list form
+    ``[("energy", "==", 0.3), …]`` (a conjunction; a list of such lists, a disjunction); ConfigError otherwise."""
+    import pyarrow.compute as pc  # deferred: pyarrow loads on first use
+
+    if filters is None or isinstance(filters, pc.Expression):
+        return filters
+    if isinstance(filters, (list, tuple)) and filters:
+        import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
+
+        try:
+            return pq.filters_to_expression(list(filters))
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(
+                f"filters {filters!r} is not a list of (column, op, value) triples (or a list of such lists): {exc}"
+            ) from None
+    raise ConfigError(
+        "filters must be a pyarrow expression, e.g. pyarrow.dataset.field('energy') == 0.3, or the list form "
+        f"[('energy', '==', 0.3)], got {type(filters).__name__} {str(filters)[:60]!r}"
+    )
+
+
+def _scan(dset, run_dir, name: str, columns, filters, scan):
+    """``scan(dset, columns, expression)`` of a verified dataset, with the columns and the filter's fields checked
+    against the table's (ConfigError naming the unknown one and the table's columns) and damaged pages reported
+    (:func:`~hhscatter.data.verify.scan_checked`)."""
+    import pyarrow as pa  # deferred: pyarrow loads on first use
+
+    fields = _public_fields(dset)
+    if columns is not None:
+        if isinstance(columns, str) or not all(isinstance(c, str) for c in columns):
+            raise ConfigError(f"columns must be a list of column names, got {columns!r}")
+        unknown = [c for c in columns if c not in dset.schema.names]
+        if unknown:
+            raise ConfigError(
+                f"columns {unknown} are not in the {name} table of {run_dir}; its columns: {', '.join(fields)}"
+            )
+        columns = list(columns)
+    expr = _expression(filters)
+    try:
+        return scan_checked(dset, run_dir, name, lambda d: scan(d, columns, expr))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError) as exc:
+        text = str(exc)
+        m = re.search(r"FieldRef\.Name\(([^)]*)\)", text)
+        what = (
+            f"the field {m.group(1)!r}, which is not a column"
+            if m
+            else f"what it cannot compare ({text.splitlines()[0]})"
+        )
+        raise ConfigError(
+            f"filters {expr} names {what} of the {name} table of {run_dir}; its columns: {', '.join(fields)}"
+        ) from None
+
+
+def _nothing_matched(df, run_dir, name: str, filters) -> None:
+    """Say so when a filter kept no row: a warning naming the filter and the run's grid values (a value that is
+    not a grid point matches nothing), and ``attrs['hhscatter']['nothing_matched']``."""
+    if filters is None or len(df):
+        return
+    scene = df.attrs.get(FRAME_META, {}).get("scene") or {}
+    grid = "; ".join(
+        f"{k} = {', '.join(f'{v:g}' for v in np.atleast_1d(scene[k]))}" for k in ("energy", "gamma") if k in scene
+    )
+    msg = f"nothing matched filters {_expression(filters)} in the {name} table of {run_dir}" + (
+        f" (its points: {grid})" if grid else ""
+    )
+    df.attrs[FRAME_META] = {**df.attrs.get(FRAME_META, {}), "nothing_matched": msg}
+    warnings.warn(msg, UserWarning, stacklevel=3)
+
+
 def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = False, allow_partial: bool = False):
-    table = scan_checked(
+    table = _scan(
         verified_dataset(run_dir, name, allow_partial=allow_partial),
         run_dir,
         name,
-        lambda d: d.to_table(columns=columns, filter=filters),
+        columns,
+        filters,
+        lambda d, c, f: d.to_table(columns=c, filter=f),
     )
     df = table.to_pandas()
     if "outcome" in df.columns and not categorical:
@@ -55,6 +135,7 @@ def _read(run_dir, name: str, columns=None, filters=None, categorical: bool = Fa
     if "exit_channel" in df.columns:
         df["exit_channel"] = df["exit_channel"].astype("Int8")
     df.attrs[FRAME_META] = run_identity(run_dir)
+    _nothing_matched(df, run_dir, name, filters)
     return df
 
 
@@ -162,11 +243,13 @@ def read_arrow(run_dir, name: str = "lifetimes", columns=None, filters=None, *, 
     the run's planned, finished and verified parts (:func:`~hhscatter.data.verify.verified_dataset`); an incomplete run is an error unless
     ``allow_partial=True``.
     """
-    return scan_checked(
+    return _scan(
         verified_dataset(run_dir, name, allow_partial=allow_partial),
         run_dir,
         name,
-        lambda d: d.to_table(columns=columns, filter=filters),
+        columns,
+        filters,
+        lambda d, c, f: d.to_table(columns=c, filter=f),
     )
 
 
@@ -203,8 +286,13 @@ def iter_survival_batches(run_dir, filters=None, *, allow_partial: bool = False)
     censored orbits. The input of a streaming Kaplan–Meier (:func:`hhscatter.api.stream_survival`).
     """
     for part in verified_dataset(run_dir, "lifetimes", one_by_one=True, allow_partial=allow_partial):
-        for batch in scan_checked(
-            part, run_dir, "lifetimes", lambda d: d.to_table(columns=["t_end", "outcome"], filter=filters).to_batches()
+        for batch in _scan(
+            part,
+            run_dir,
+            "lifetimes",
+            ["t_end", "outcome"],
+            filters,
+            lambda d, c, f: d.to_table(columns=c, filter=f).to_batches(),
         ):
             yield batch.column(0).to_numpy(), _observed(batch.column(1))
 
@@ -246,9 +334,11 @@ def read_lifetimes(
         same scene: the same orbits) is refused.
     columns : list of str, optional
         Read only these columns (projection).
-    filters : pyarrow.dataset.Expression, optional
+    filters : pyarrow.dataset.Expression or list, optional
         Row filter, e.g. ``(ds.field("energy") == 0.3) & (ds.field("gamma") == 0.01)`` to read one grid
-        point.
+        point, or the same in the pandas list form ``[("energy", "==", 0.3), ("gamma", "==", 0.01)]``. A filter
+        that keeps no row (a value that is not a grid point) gives an empty frame with a ``UserWarning`` naming
+        the filter and the run's grid values (also in ``attrs["hhscatter"]["nothing_matched"]``).
     categorical : bool
         ``outcome`` as a pandas categorical (1 byte per orbit, for 1e7 orbits and more) instead of str.
     allow_partial : bool
@@ -275,6 +365,9 @@ def read_lifetimes(
     ValueError
         A list holds the same run (or scene) twice; ``pool=True`` with runs that differ in a scene key
         other than those above, or share a seed.
+    ConfigError
+        ``columns`` or a field of ``filters`` that is not a column of the table (the message lists its
+        columns), ``filters`` neither an expression nor the list form.
 
     Examples
     --------
