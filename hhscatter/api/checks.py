@@ -30,7 +30,17 @@ import numpy as np
 
 from hhscatter.errors import ConfigError
 
-__all__ = ["describe", "frame", "number", "result", "run_dir", "scene_differences", "time_grid", "window"]
+__all__ = [
+    "describe",
+    "frame",
+    "number",
+    "numeric_columns",
+    "result",
+    "run_dir",
+    "scene_differences",
+    "time_grid",
+    "window",
+]
 
 
 def describe(obj) -> str:
@@ -77,6 +87,44 @@ def frame(obj, name: str, *, needs: Iterable[str] = (), what: str = "a lifetimes
     if len(obj) == 0:
         raise ConfigError(f"{name} is empty: no rows to analyse ({what}: {reader})")
     return obj
+
+
+def numeric_columns(df, name: str, *, nonneg=(), finite=(), nan_ok=()) -> None:
+    """Refuse a table whose columns (those present of the lists) hold what is not a number: ``nonneg`` finite and
+    ≥ 0, ``finite`` finite, ``nan_ok`` finite or missing (NaN). The message names the column, a bad row and
+    how many there are.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> numeric_columns(pd.DataFrame({"t_end": [1.0, -2.0]}), "lifetimes", nonneg=["t_end"])
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: lifetimes column t_end must hold finite numbers ≥ 0; row 1 has -2.0 (1 such row(s))
+    """
+    import pandas as pd  # deferred: pandas loads on first use
+
+    for cols, positive, allow_nan in ((nonneg, True, False), (finite, False, False), (nan_ok, False, True)):
+        for col in cols:
+            if col not in df.columns:
+                continue
+            raw = df[col]
+            try:
+                v = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+            except (TypeError, ValueError):
+                v = np.full(len(raw), np.nan)
+            bad = ~np.isfinite(v)
+            if allow_nan:
+                bad &= ~(np.isnan(v) & raw.isna().to_numpy())
+            if positive:
+                bad |= v < 0
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                val = raw.iloc[i]
+                raise ConfigError(
+                    f"{name} column {col} must hold finite numbers{' ≥ 0' if positive else ''}; row {i} has "
+                    f"{repr(val) if isinstance(val, str) else val} ({int(bad.sum())} such row(s))"
+                )
 
 
 def number(

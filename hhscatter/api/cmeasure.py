@@ -26,7 +26,7 @@ from hhscatter.api.points import (
 from hhscatter.api.rates import DISSIPATIVE_NOTE, EscapeRates, escape_rates
 from hhscatter.api.runs import run_scene
 from hhscatter.data.params import checked_value, same_run
-from hhscatter.data.read import read_lifetimes, read_sections
+from hhscatter.data.read import read_lifetimes
 from hhscatter.errors import ConfigError
 
 #: the columns of a sections table the c-measure reads
@@ -155,7 +155,7 @@ def kappa_cmeasure_tables(
     window = checked_value(lifetimes, "sections", _window_dict(window), what="the section window", name="window")
     t_max = checked_value(lifetimes, "t_max", t_max, what="t_max")
     if window is None or t_max is None:
-        raise ValueError("pass window= and t_max= of the run (the tables carry no record of their run)")
+        raise ConfigError("pass window= and t_max= of the run (the tables carry no record of their run)")
     window = _checked_cmeasure_window(window)
     t_max = float(t_max)
     t_record_end = min(float(window.get("t_to", math.inf)), t_max)
@@ -163,12 +163,28 @@ def kappa_cmeasure_tables(
     rates = escape_rates(lt) if any(k[1] == 0 for k, _ in split_points(lt)) else EscapeRates({}, {}, {})
     keys = [k for k, _ in split_points(lt)]
     sec_by = _split_like(sec, keys, what="sections table")
+    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
+        cmeasure_sample_from_sections,
+    )
+
     rows = {}
     for key, df in split_points(lt):
+
+        def sample(t0, t1, key=key, df=df):
+            return cmeasure_sample_from_sections(
+                sec_by.get(key, sec.iloc[:0]),
+                df,
+                t0,
+                t1,
+                t_record_end=t_record_end,
+                drop_censored=t_max > t_record_end,
+                with_orbits=True,
+            )
+
         rows[key] = _cmeasure_point_row(
             key,
             df,
-            sec_by.get(key, sec.iloc[:0]),
+            sample,
             rates,
             window,
             t_max,
@@ -193,7 +209,7 @@ def _checked_cmeasure_window(window) -> dict:
     if window is not None and dataclasses.is_dataclass(window):
         window = dataclasses.asdict(window)
     if not window:
-        raise ValueError(
+        raise ConfigError(
             "the run recorded no sections; simulate with sections=SectionWindow(t_from=…, t_to=…) "
             "(every crossing, no energy filter)"
         )
@@ -202,22 +218,35 @@ def _checked_cmeasure_window(window) -> dict:
         or math.isfinite(window.get("e_min", -math.inf))
         or math.isfinite(window.get("e_max", math.inf))
     ):
-        raise ValueError(
+        raise ConfigError(
             f"the c-measure needs every section crossing; the run's window {window} filters them "
             "(first_only or e_min/e_max): record with a plain SectionWindow(t_from, t_to)"
         )
     return window
 
 
+def _sampling_window(key, rates, window, t_record_end, t_from, t_to, rec_efolds, margin):
+    """(t0, t1) of a point's c-measure sample (time units), or None without a κ from P(t)."""
+    r = rates.results.get(key)
+    if r is None:
+        return None
+    t0 = (
+        float(t_from)
+        if t_from is not None
+        else max(float(window.get("t_from", 0.0)), math.ceil(r.tau0 + rec_efolds / r.kappa))
+    )
+    t1 = float(t_to) if t_to is not None else t_record_end - margin
+    return t0, t1
+
+
 def _cmeasure_point_row(
-    key, df, sec, rates, window, t_max, t_record_end, t_from, t_to, rec_efolds, margin, n_boot, seed
+    key, df, sample, rates, window, t_max, t_record_end, t_from, t_to, rec_efolds, margin, n_boot, seed
 ) -> dict:
     """One grid point's row of :func:`kappa_cmeasure_tables`: its sampling window (time units) from τ0 and κ of
-    P(t), the c-measure sample of its crossings in it, κ_cm ± err (1/time) beside κ from P(t), or a note."""
-    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
-        cmeasure_sample_from_sections,
-        kappa_from_cmeasure,
-    )
+    P(t), the c-measure sample of its crossings in it (``sample(t0, t1)`` → the return times, exits, undetermined
+    count and their orbits, :func:`~hhscatter.analysis.survival.cmeasure.cmeasure_sample_from_sections`),
+    κ_cm ± err (1/time) beside κ from P(t), or a note."""
+    from hhscatter.analysis.survival.cmeasure import kappa_from_cmeasure  # deferred: scipy loads on first use
 
     row = {
         **_key_columns(key),
@@ -240,12 +269,7 @@ def _cmeasure_point_row(
         row["note"] = DISSIPATIVE_NOTE if key[1] > 0 else rates.notes.get(key, "no κ from P(t)")
         return row
     row.update(kappa_pt=r.kappa, kappa_pt_err=r.kappa_err)
-    t0 = (
-        float(t_from)
-        if t_from is not None
-        else max(float(window.get("t_from", 0.0)), math.ceil(r.tau0 + rec_efolds / r.kappa))
-    )
-    t1 = float(t_to) if t_to is not None else t_record_end - margin
+    t0, t1 = _sampling_window(key, rates, window, t_record_end, t_from, t_to, rec_efolds, margin)
     row.update(t_from=t0, t_to=t1)
     if not t1 > t0 or t0 < float(window.get("t_from", 0.0)) or t1 > t_record_end:
         row["note"] = (
@@ -254,9 +278,7 @@ def _cmeasure_point_row(
         )
         return row
     with counted("api.cmeasure"):
-        T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
-            sec, df, t0, t1, t_record_end=t_record_end, drop_censored=t_max > t_record_end, with_orbits=True
-        )
+        T, n_exit, n_und, orb, exit_orb = sample(t0, t1)
     if T.size + n_exit == 0:
         row["note"] = "no section crossing in the sampling window"
         return row
@@ -313,9 +335,88 @@ def kappa_cmeasure(run: str | os.PathLike[str], **kwargs: Any) -> CMeasureRates:
             f"{run}: the run recorded no sections; simulate with sections=SectionWindow(t_from=…, "
             "t_to=…) (every crossing, no energy filter)"
         )
-    return kappa_cmeasure_tables(
-        read_lifetimes(run), read_sections(run), window=scene["sections"], t_max=float(scene["t_max"]), **kwargs
+    opts = {"t_from": None, "t_to": None, "rec_efolds": 2.0, "margin": 40.0, "n_boot": 200, "seed": 0, **kwargs}
+    for name in ("rec_efolds", "margin"):
+        checks.number(opts[name], name, lo=0.0)
+    checks.number(opts["n_boot"], "n_boot", lo=0, integer=True)
+    checks.number(opts["seed"], "seed", lo=0, integer=True)
+    for name in ("t_from", "t_to"):
+        if opts[name] is not None:
+            checks.number(opts[name], name, lo=0.0)
+    window = _checked_cmeasure_window(scene["sections"])
+    t_max = float(scene["t_max"])
+    t_record_end = min(float(window.get("t_to", math.inf)), t_max)
+    grid = any(isinstance(scene.get(k), list) for k in ("energy", "gamma"))
+    # the lifetimes: the columns a point, κ from P(t) and the sample's fates need, outcome as categories
+    lt = read_lifetimes(
+        run, columns=["traj_id", "t_end", "outcome", "gamma", "energy" if grid else "e0"], categorical=True
     )
+    points = split_points(lt)
+    keys = [k for k, _ in points]
+    conservative = [k for k in keys if k[1] == 0]
+    rates = escape_rates(lt[lt["gamma"] == 0]) if conservative else EscapeRates({}, {}, {})
+    args = (t_record_end, opts["t_from"], opts["t_to"], opts["rec_efolds"], opts["margin"])
+    windows = {k: w for k in keys if (w := _sampling_window(k, rates, window, *args)) is not None}
+    samples = _streamed_samples(run, dict(points), windows, keys, grid, t_record_end, t_max > t_record_end)
+    rows = {}
+    for key, df in points:
+        rows[key] = _cmeasure_point_row(
+            key,
+            df,
+            lambda t0, t1, key=key: samples[key],
+            rates,
+            window,
+            t_max,
+            t_record_end,
+            opts["t_from"],
+            opts["t_to"],
+            opts["rec_efolds"],
+            opts["margin"],
+            opts["n_boot"],
+            opts["seed"],
+        )
+    return CMeasureRates(rows)
+
+
+def _streamed_samples(run, lifetimes: dict, windows: dict, keys, grid: bool, t_record_end, drop_censored) -> dict:
+    """{key: the c-measure sample of the point's crossings in its window} from the run's sections table read part
+    by part (only ``traj_id``, ``t`` and the point columns of the crossings at t ≥ the earliest window start):
+    memory is one part's late crossings plus the samples, whatever N. Parts are orbit ranges, so each part's
+    sample is exact; concatenated and put in orbit order it is the sample of the whole table."""
+    import pyarrow.dataset as ds  # deferred: pyarrow loads on first use
+
+    from hhscatter.analysis.survival.cmeasure import (  # deferred: scipy loads on first use
+        cmeasure_sample_from_sections,
+    )
+    from hhscatter.data.read import iter_part_frames  # deferred: pyarrow loads on first use
+
+    fits = {k: w for k, w in windows.items() if w[1] > w[0]}
+    acc = {k: ([], 0, 0, [], []) for k in fits}
+    if fits:
+        columns = ["traj_id", "t", *(("point_energy", "point_gamma") if grid else ())]
+        start = min(w[0] for w in fits.values())
+        for part in iter_part_frames(run, "sections", columns, ds.field("t") >= start):
+            if not len(part):
+                continue
+            for key, sec in _split_like(part, keys, what="sections table").items():
+                if key not in fits or not len(sec):
+                    continue
+                lt = lifetimes[key]
+                lt = lt[lt["traj_id"].isin(sec["traj_id"].unique())]
+                T, n_exit, n_und, orb, exit_orb = cmeasure_sample_from_sections(
+                    sec, lt, *fits[key], t_record_end=t_record_end, drop_censored=drop_censored, with_orbits=True
+                )
+                Ts, ne, nu, orbs, exits = acc[key]
+                acc[key] = (Ts + [(orb, T)], ne + n_exit, nu + n_und, orbs, exits + [exit_orb])
+    out = {}
+    for key, (Ts, n_exit, n_und, _, exits) in acc.items():
+        orb = np.concatenate([o for o, _ in Ts]) if Ts else np.empty(0, np.int64)
+        T = np.concatenate([t for _, t in Ts]) if Ts else np.empty(0)
+        order = np.argsort(orb, kind="stable")  # the whole table's order: by orbit, then time
+        exit_orb = np.sort(np.concatenate(exits)) if exits else np.empty(0, np.int64)
+        out[key] = (T[order], n_exit, n_und, orb[order], exit_orb)
+    empty = (np.empty(0), 0, 0, np.empty(0, np.int64), np.empty(0, np.int64))
+    return {k: out.get(k, empty) for k in windows}
 
 
 @dataclass(frozen=True)

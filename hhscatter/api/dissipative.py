@@ -315,6 +315,7 @@ def energy_decay(
         what="a snapshots table",
         reader="hhscatter.read_snapshots(run)",
     )
+    checks.numeric_columns(snapshots, "snapshots", nonneg=("t",), finite=("energy",))
     window = checks.window(window)
     if energy is not None:
         energy = checks.number(energy, "energy")

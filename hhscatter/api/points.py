@@ -72,24 +72,7 @@ def _check_columns(lifetimes) -> None:
     (NaN allowed: a point without a nominal E0), outcomes of the table's vocabulary."""
     import pandas as pd  # deferred: pandas loads on first use
 
-    def numeric(col, *, nonneg: bool, nan_ok: bool = False):
-        if col not in lifetimes.columns:
-            return
-        v = pd.to_numeric(lifetimes[col], errors="coerce").to_numpy(dtype=float)
-        bad = ~np.isfinite(v) & ~(np.isnan(v) & nan_ok & lifetimes[col].isna().to_numpy())
-        if nonneg:
-            bad |= v < 0
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            raise ConfigError(
-                f"lifetimes column {col} must hold finite numbers{' ≥ 0' if nonneg else ''}; row {i} has "
-                f"{lifetimes[col].iloc[i]!r} ({int(bad.sum())} such row(s))"
-            )
-
-    numeric("t_end", nonneg=True)
-    numeric("gamma", nonneg=True)
-    numeric("energy", nonneg=False, nan_ok=True)
-    numeric("e0", nonneg=False)
+    checks.numeric_columns(lifetimes, "lifetimes", nonneg=("t_end", "gamma"), finite=("e0",), nan_ok=("energy",))
     outcome = lifetimes["outcome"].astype(object)
     unknown = sorted({str(o) for o in pd.unique(outcome)} - set(OUTCOMES), key=str)
     if unknown:

@@ -356,7 +356,7 @@ def stream_survival(
     for t_end, observed in iter_survival_batches(run, filters, allow_partial=allow_partial):
         km.add(t_end, observed)
         if km.first_censoring < km.grid[-1]:
-            raise ValueError(
+            raise ConfigError(
                 f"an orbit was censored at t = {km.first_censoring:g} < max(t_grid) = "
                 f"{km.grid[-1]:g}: use survival_curve (Kaplan–Meier) for this run"
             )

@@ -297,6 +297,26 @@ def iter_survival_batches(run_dir, filters=None, *, allow_partial: bool = False)
             yield batch.column(0).to_numpy(), _observed(batch.column(1))
 
 
+def iter_part_frames(run_dir, name: str, columns=None, filters=None, *, allow_partial: bool = False):
+    """iter_part_frames(run_dir, name, columns=None, filters=None) -> pandas.DataFrame per part file, in file order.
+
+    The rows of table ``name`` that pass ``filters`` (pushed down to the Parquet reader), ``columns`` only, one
+    part file at a time: memory is one part's selected rows, whatever N. Columns and filters are checked as in
+    :func:`read_lifetimes`. Parts are orbit ranges, so every orbit's rows come in one frame.
+
+    Examples
+    --------
+    >>> import tempfile, hhscatter
+    >>> run = tempfile.mkdtemp()
+    >>> _ = hhscatter.simulate(hhscatter.Scene(energy=0.3, n=50, chunk_size=20, t_max=5.0), run,
+    ...                        overwrite=True, workers=1, progress=False)
+    >>> [len(df) for df in iter_part_frames(run, "lifetimes", ["traj_id"])]
+    [20, 20, 10]
+    """
+    for part in verified_dataset(run_dir, name, one_by_one=True, allow_partial=allow_partial):
+        yield _scan(part, run_dir, name, columns, filters, lambda d, c, f: d.to_table(columns=c, filter=f)).to_pandas()
+
+
 def iter_parts(run_dir, name: str, columns=None, *, allow_partial: bool = False):
     """iter_parts(run_dir, name, columns=None) -> pandas.DataFrame per part file of table ``name``, in file order.
 

@@ -161,3 +161,23 @@ def test_transition_times_pair_runs_of_the_same_scene_and_say_with_what():
 def test_transition_times_of_a_conservative_run_only_is_refused():
     with pytest.raises(ConfigError, match=r"needs dissipative \(γ > 0\) points.*only γ = 0 \(E0=0\.3, γ=0\)"):
         hhscatter.transition_times(_lifetimes())
+
+
+# -- kappa_cmeasure streams its run ------------------------------------------------------------------------------
+@pytest.mark.parametrize("grid", [False, True])
+def test_kappa_cmeasure_streamed_part_by_part_equals_the_whole_tables(tmp_path, grid):
+    """kappa_cmeasure(run) reads the sections part by part (several parts here): every number equals the
+    in-memory route over the whole tables."""
+    scene = hhscatter.Scene(
+        energy=0.3, n=400, seed=3, t_max=400.0, chunk_size=90, sections=hhscatter.SectionWindow(t_from=10.0, t_to=80.0)
+    )
+    what = hhscatter.Grid(scene, energies=(0.25, 0.3), gammas=(0.0,)) if grid else scene
+    hhscatter.simulate(what, tmp_path, overwrite=True, workers=1, progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        streamed = hhscatter.kappa_cmeasure(tmp_path, n_boot=50).to_frame()
+        whole = hhscatter.api.kappa_cmeasure_tables(
+            hhscatter.read_lifetimes(tmp_path), hhscatter.read_sections(tmp_path), n_boot=50
+        ).to_frame()
+    assert len(streamed) == (2 if grid else 1) and (streamed["n_samples"] > 0).all()
+    pd.testing.assert_frame_equal(streamed, whole)
