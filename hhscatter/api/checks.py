@@ -9,10 +9,10 @@ Examples
 --------
 >>> import hhscatter
 >>> try:
-...     hhscatter.survival("run")
+...     hhscatter.escape_rates(42)
 ... except hhscatter.ConfigError as e:
 ...     print(e)
-lifetimes must be a pandas DataFrame (a lifetimes table: hhscatter.read_lifetimes(run)), got str 'run'
+lifetimes must be a pandas DataFrame (a lifetimes table: hhscatter.read_lifetimes(run)), got int 42
 >>> number(0.5, "alpha", lo=1.0)
 Traceback (most recent call last):
 ...
@@ -240,8 +240,11 @@ def run_dir(run, name: str = "run"):
 
     if not isinstance(run, (str, os.PathLike)):
         raise ConfigError(f"{name} must be the path of a run directory (str or Path), got {describe(run)}")
-    store = Store(run)
-    if not store.exists("scene.json"):
+    try:
+        is_run = Store(run).exists("scene.json")
+    except (OSError, ValueError):  # a path the file system cannot even look at (a null byte, an unknown protocol)
+        is_run = False
+    if not is_run:
         raise ConfigError(
             f"{name} = {str(run)!r}: not a run directory (no scene.json): give a directory written by hhscatter.simulate"
         )

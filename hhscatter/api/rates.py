@@ -85,9 +85,10 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
 
     Parameters
     ----------
-    lifetimes : DataFrame
+    lifetimes : DataFrame, or str or Path of a run directory
         :func:`hhscatter.read_lifetimes` of a run (columns ``t_end``, ``outcome``, ``gamma`` and
-        ``energy`` or ``e0``), or any frame with those columns.
+        ``energy`` or ``e0``), or any frame with those columns; or the run directory itself, of which only
+        those columns are read (outcome as categories: about 25 bytes per orbit).
     t_grid : array_like of float, optional
         Times (time units) at which P is given. Default: a step at every distinct event time.
 
@@ -114,6 +115,8 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
     )
 
     t_grid = checks.time_grid(t_grid)
+    if isinstance(lifetimes, (str, os.PathLike)):
+        lifetimes = _point_columns(lifetimes)
     curves, n = {}, {}
     for key, df in split_points(lifetimes):
         observed = observed_from_outcome(df["outcome"].astype(object).to_numpy())
@@ -123,6 +126,18 @@ def survival(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None) -> Su
 
 
 DISSIPATIVE_NOTE = "dissipative (γ > 0): P(t) is not exponential, no κ fitted"
+
+
+def _point_columns(run):
+    """The lifetimes of run directory ``run`` with only what P(t) and κ need (t_end, outcome as categories, γ and
+    the point's energy): about 25 bytes per orbit instead of the whole table."""
+    from hhscatter.api.runs import run_scene  # deferred: pydantic loads on first use
+    from hhscatter.data.read import read_lifetimes  # deferred: pyarrow loads on first use
+
+    checks.run_dir(run, "lifetimes")
+    scene = run_scene(run)
+    grid = any(isinstance(scene.get(k), list) for k in ("energy", "gamma"))
+    return read_lifetimes(run, columns=["t_end", "outcome", "gamma", "energy" if grid else "e0"], categorical=True)
 
 
 def _check_rate_options(kwargs: dict) -> None:
@@ -259,8 +274,9 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
 
     Parameters
     ----------
-    lifetimes : DataFrame
-        :func:`hhscatter.read_lifetimes` of a run, or any frame with its columns (see :func:`survival`).
+    lifetimes : DataFrame, or str or Path of a run directory
+        :func:`hhscatter.read_lifetimes` of a run, or any frame with its columns, or the run directory (only the
+        columns κ needs are read; see :func:`survival`).
     t_grid : array_like of float, optional
         Times (time units) of the P(t) that is fitted. Default: every distinct event time.
     **kwargs
@@ -291,6 +307,8 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
 
     t_grid = checks.time_grid(t_grid)
     _check_rate_options(kwargs)
+    if isinstance(lifetimes, (str, os.PathLike)):
+        lifetimes = _point_columns(lifetimes)
     results, n, notes, status = {}, {}, {}, {}
     for key, df in split_points(lifetimes):
         n[key] = len(df)

@@ -33,7 +33,7 @@ def grid_run(tmp_path_factory):
 @pytest.mark.parametrize(
     "call, words",
     [
-        (lambda: hhscatter.survival("run"), ["lifetimes must be a pandas DataFrame", "str 'run'"]),
+        (lambda: hhscatter.survival("run"), ["lifetimes = 'run': not a run directory (no scene.json)"]),
         (lambda: hhscatter.escape_rates(42), ["lifetimes must be a pandas DataFrame", "int 42"]),
         (lambda: hhscatter.survival(_lifetimes().iloc[:0]), ["lifetimes is empty"]),
         (lambda: hhscatter.survival(_lifetimes().drop(columns="outcome")), ["lacks the column(s) ['outcome']"]),
@@ -64,9 +64,21 @@ def test_wrong_arguments_are_refused_naming_them(call, words):
 
 
 def test_kappa_cmeasure_and_run_scene_refuse_a_folder_that_is_not_a_run(tmp_path):
-    for call in (hhscatter.kappa_cmeasure, hhscatter.api.run_scene):
-        with pytest.raises(ConfigError, match="not a run directory"):
-            call(tmp_path)
+    for call in (hhscatter.kappa_cmeasure, hhscatter.api.run_scene, hhscatter.survival):
+        for path in (tmp_path, "no\x00such"):
+            with pytest.raises(ConfigError, match="not a run directory"):
+                call(path)
+
+
+def test_survival_and_escape_rates_of_a_run_directory_read_only_what_they_need(grid_run):
+    """A run directory in place of its table: the same curves and rates as from the whole table."""
+    whole = hhscatter.read_lifetimes(grid_run)
+    a, b = hhscatter.survival(grid_run).to_frame(), hhscatter.survival(whole).to_frame()
+    pd.testing.assert_frame_equal(a, b)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ra, rb = hhscatter.escape_rates(grid_run).to_frame(), hhscatter.escape_rates(whole).to_frame()
+    pd.testing.assert_frame_equal(ra, rb)
 
 
 # -- reads ------------------------------------------------------------------------------------------------------
