@@ -209,8 +209,8 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
 # first package component below hhscatter (``hhscatter.scene.grid`` -> ``scene``); inside ``analysis`` it is the
 # subpackage (``hhscatter.analysis.survival.fits`` -> ``analysis.survival``), so that the estimators are layered
 # too: stats -> survival -> {dissipative, noise} -> geometry. ``errors`` and ``outcomes`` are the bottom.
-BASE = {"errors", "outcomes", "_version"}  # what every layer shares: the error family, the outcome names,
-# the version
+BASE = {"errors", "outcomes", "_version", "_exports"}  # what every layer shares: the error family, the outcome names,
+# the version, the lazy exports of a package
 ANALYSIS_ORDER = {  # the subpackages of analysis and the subpackages each may import (besides itself)
     "stats": set(),
     "survival": {"stats"},
@@ -218,11 +218,12 @@ ANALYSIS_ORDER = {  # the subpackages of analysis and the subpackages each may i
     "noise": {"stats", "survival"},
     "geometry": {"stats", "survival", "noise"},
 }
-ANALYSIS = {"analysis"} | {f"analysis.{sub}" for sub in ANALYSIS_ORDER}  # the door and lazy exports + subpackages
+ANALYSIS = {"analysis"} | {f"analysis.{sub}" for sub in ANALYSIS_ORDER}  # the package door and its subpackages
 LAYERS = {
     "errors": set(),
     "outcomes": set(),
     "_version": set(),
+    "_exports": set(),
     "model": BASE,
     "scene": BASE | {"model"},
     "integrate": BASE | {"model", "scene"},

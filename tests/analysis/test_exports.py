@@ -40,7 +40,7 @@ def test_every_name_a_module_declares_in_all_exists(name):
 
 def test_the_export_map_is_generated_from_what_the_modules_define(tmp_path):
     """A new public function is exported by defining it; private names, imports and module names are not."""
-    from hhscatter.analysis._exports import module_exports
+    from hhscatter._exports import module_exports
 
     (tmp_path / "rates.py").write_text("import math\nfrom os import path\nK = 1\n_P = 2\ndef rate(): ...\n")
     (tmp_path / "fits.py").write_text("def fit(): ...\ndef rates(): ...\nclass Fit: ...\n")

@@ -3,7 +3,7 @@
 Every public name of its modules is importable from here (loaded on first use); the functions named like their module (survival_model.survival_model) from their module.
 """
 
-from hhscatter.analysis._exports import lazy_exports
+from hhscatter._exports import lazy_exports
 
 _EXPORTS, __getattr__, __dir__ = lazy_exports(__name__)
 __all__ = sorted(_EXPORTS)
