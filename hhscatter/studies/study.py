@@ -224,9 +224,18 @@ class Study:
 
         A finished run of the same scene is kept (chunks verified), an
         interrupted one resumed; a run of a different scene (the study file
-        changed) is replaced.
+        changed) is replaced. A key this study has already run with another scene is a
+        :class:`~hhscatter.errors.StudyError` before any work (two runs would share one folder:
+        make keys with :func:`hhscatter.studies.keys.number_key`).
         """
 
+        made = self.raw_runs.get(key)
+        if made is not None and made.get("scene_hash") != scene.result_hash():
+            raise StudyError(
+                f"study {self.name}: run key {key!r} was already used for another scene in this stage; two runs "
+                "cannot share a key (a key formatted from a number can collide: make it with "
+                "hhscatter.studies.keys.number_key)"
+            )
         out = self.raw(key)
         resume, overwrite = False, False
         sj = out / SCENE_FILE
