@@ -13,6 +13,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -128,7 +129,9 @@ class Scene:
     batch_size : int, optional
         SIMD lanes (default: heyoka's recommended size); no effect on results.
     ics : str, optional
-        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id].
+        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]; a relative path is
+        made absolute against the working directory (a scene file's own ``ics`` against the file's folder,
+        :func:`~hhscatter.scene.schema.load_scene`), so that ``scene.json`` names one file.
     sections : SectionWindow, optional
         Which crossings of the section ṙ = 0, φ̇ > 0 to record (default: no sections table).
     snapshots : tuple of float, optional
@@ -459,6 +462,8 @@ class Scene:
                 )
         elif not isinstance(self.ics, (str, Path)) or not str(self.ics).strip():
             raise ConfigError(f"ics must be the path of a Parquet/CSV table, got {self.ics!r}")
+        elif not os.path.isabs(self.ics):  # one meaning wherever the scene is read again (scene.json, --resume)
+            object.__setattr__(self, "ics", os.path.abspath(self.ics))
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
         elif self.momentum != "tangential":

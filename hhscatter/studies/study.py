@@ -193,11 +193,15 @@ class Study:
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
-        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides."""
+        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides.
+
+        A relative ``ics`` path of study.toml is relative to the study's folder."""
         d = dict(self.config.get("scene", {}))
         for extra in ("sections", "snapshots", "noise", "system"):
             if extra in self.config:
                 d[extra] = copy.deepcopy(self.config[extra])
+        if isinstance(d.get("ics"), str) and d["ics"].strip() and not os.path.isabs(d["ics"]):
+            d["ics"] = os.path.abspath(self.root / d["ics"])  # study.toml's paths are relative to its folder
         d.update(overrides)
         d = {k: v for k, v in d.items() if v is not None or k in ("sections", "snapshots")}
         d["name"] = f"{self.name}/{key}"
