@@ -2,7 +2,8 @@
 
 Exit status: 0 on success, 2 on bad input (the message names the parameter and
 its allowed range; nothing has been computed; no traceback), 1 on other
-failures.
+failures, 130 when interrupted by SIGINT (Ctrl-C) and 143 by SIGTERM: one line
+says what was kept and how to continue, without a traceback.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import importlib.util
 import math
 import os
 import re
+import signal
 import sys
 from pathlib import Path
 
@@ -543,23 +545,116 @@ def _check_text(a) -> None:
                 )
 
 
-def main(argv=None):
-    a = build_parser().parse_args(argv)
+#: the exit status of a command ended by a signal: 128 + the signal's number (the shells' convention)
+SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM arrived: raised where the command is, so that its cleanup runs (a run's lock is
+    released, a run that wrote no chunk is removed) before the command ends with one line and 128 + the signal."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+_received: list[int] = []  # the signals received by this command, in order
+
+
+def _on_signal(signum, frame):
+    _received.append(signum)
+    if len(_received) == 1:  # once: a second Ctrl-C must not break the cleanup of the first
+        raise Interrupted(signum)
+    if len(_received) >= 3:  # a third: the cleanup is not wanted, end now
+        os._exit(SIGNAL_EXIT.get(signum, 128 + int(signum)))
+
+
+def _catch_signals() -> dict:
+    """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread (a no-op elsewhere); returns the handlers
+    they had, for :func:`_restore_signals`."""
+    _received.clear()
+    before = {}
     try:
+        for sig in SIGNAL_EXIT:
+            before[sig] = signal.signal(sig, _on_signal)
+    except ValueError:  # not the main thread: signals stay as they are
+        pass
+    return before
+
+
+def _restore_signals(before: dict) -> None:
+    for sig, handler in before.items():
+        signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+
+
+def _interrupted_advice(a) -> str:
+    """What an interrupted command kept and how to continue it: one clause for the closing line."""
+    if a is None:
+        return "nothing was done"
+    if a.command == "simulate":
+        from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
+
+        try:
+            kept = Store(a.out).exists("scene.json")
+        except (OSError, ValueError):
+            kept = False
+        if kept:
+            return f"the finished chunks in {a.out} are kept: run the command again with --resume to continue"
+        return f"no chunk had finished and nothing is left in {a.out}: run the command again"
+    if a.command == "study":
+        again = f"hhscatter study {a.name} {a.stage} --scale {a.scale}"
+        if a.stage in ("simulate", "all"):
+            return f"finished runs and chunks are kept: run `{again}` again to continue"
+        return f"the {a.stage} stage did not finish and replaced none of its outputs: run `{again}` again"
+    return "nothing was written"
+
+
+def main(argv=None):
+    before = _catch_signals()
+    try:
+        return _main(argv)
+    finally:
+        _restore_signals(before)
+
+
+def _main(argv):
+    a = None
+    try:
+        a = build_parser().parse_args(argv)
         _check_text(a)
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
     except HHScatterError as exc:  # bad input (2, before any work), or a run that could not complete (1)
+        if _received:
+            return _interrupted(a)
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except FileNotFoundError as exc:  # a run or file that is not there
+        if _received:
+            return _interrupted(a)
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
-        return 130
     except BrokenPipeError:  # `hhscatter … | head -1`: the reader left; the run itself is complete
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return 141
+    except KeyboardInterrupt:
+        if not _received:
+            _received.append(signal.SIGINT)
+        return _interrupted(a)
+    except BaseException:
+        if _received:  # whatever the signal broke on its way out (a half-made import, a pool): the signal is the news
+            return _interrupted(a)
+        raise
+
+
+def _interrupted(a) -> int:
+    """Print the one closing line of an interrupted command; its exit status (130 SIGINT, 143 SIGTERM)."""
+    signum = _received[0]
+    try:
+        advice = _interrupted_advice(a)
+    except Exception:  # noqa: BLE001 - the closing line must come out whatever the state
+        advice = "see the output folder"
+    print(f"hhscatter: interrupted by {signal.Signals(signum).name}; {advice}", file=sys.stderr)
+    return SIGNAL_EXIT.get(signum, 128 + int(signum))
 
 
 if __name__ == "__main__":

@@ -45,7 +45,10 @@ One writer per run directory: ``simulate`` holds an exclusive ``flock`` on
 its end; the kernel releases it however the process ends. ``overwrite=True``
 removes the old run (its tables, scene.json, temporaries) under that lock
 before anything is written. Pool workers (and the progress manager) die with
-the process that started them (:func:`die_with_parent`); a Dask run whose
+the process that started them (:func:`die_with_parent`). A new run (not ``resume``) that fails or is interrupted
+before its first chunk is written leaves nothing behind (:func:`~hhscatter.run.output.discard_failed_start`:
+its ``scene.json`` and lock note, and the folder if the run made it), so the same command can simply be run
+again; once a chunk is written, the run is kept for ``--resume``. A Dask run whose
 cluster has had no worker for :data:`DASK_NO_WORKER_TIMEOUT` seconds fails with
 a :class:`RunError`.
 """
@@ -65,7 +68,7 @@ from typing import NamedTuple
 from hhscatter.data.store import Store
 from hhscatter.errors import ConfigError, RunError
 from hhscatter.run.dask_backend import check_scheduler, dask_client
-from hhscatter.run.output import prepare_output
+from hhscatter.run.output import discard_failed_start, prepare_output
 from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
 from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
@@ -201,11 +204,16 @@ def simulate(
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
     earlier = _earlier_event_failures(out) if resume else {}
+    created = not Store(out).exists()
     store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
     try:
         summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier)
         _record_event_failures(store, summary)
         return summary
+    except BaseException:
+        if not resume:  # a start that failed before any chunk finished leaves nothing behind
+            discard_failed_start(store, remove_root=created)
+        raise
     finally:
         Store.unlock(lock)
 
@@ -340,10 +348,26 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
             on_done,
             lambda fs: [f.cancel() for f in fs],
         )
+    except BaseException:  # an error or an interrupt: the chunks in flight are not waited for (their parts are
+        _stop_workers(pool)  # temporaries until complete; --resume removes them and redoes those chunks)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
         if manager is not None:
             manager.shutdown()
+
+
+def _stop_workers(pool) -> None:
+    """Terminate the pool's worker processes now (ProcessPoolExecutor.terminate_workers where it exists)."""
+    stop = getattr(pool, "terminate_workers", None)
+    if stop is not None:
+        stop()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            proc.terminate()
+        except (OSError, ValueError):  # gone already
+            pass
 
 
 def _run_dask(client, todo, args, on_done, name):
