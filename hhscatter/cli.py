@@ -224,7 +224,11 @@ def build_parser():
         help="output directory (named explicitly: '.' for the working directory), or "
         "a URL pyarrow/fsspec can write (s3://…)",
     )
-    s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    s.add_argument(
+        "--workers",
+        type=_int,
+        help="worker processes (default: all cores; more than the cores this process may use runs that many)",
+    )
     s.add_argument(
         "--scheduler",
         help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
@@ -242,7 +246,7 @@ def build_parser():
         "run gives one curve per (E0, γ) point.",
     )
     v.add_argument("runs", nargs="+", help="run directories (outputs of simulate)")
-    v.add_argument("--png", required=True, help="output PNG path (its folder must exist)")
+    v.add_argument("--png", required=True, help="output PNG path, ending in .png (its folder must exist)")
     v.add_argument("--labels", nargs="*", help="curve labels, one per curve in order (default: E0, γ and N)")
 
     st = sub.add_parser(
@@ -257,7 +261,11 @@ def build_parser():
     st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2; listed below")
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
-    st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    st.add_argument(
+        "--workers",
+        type=_int,
+        help="worker processes (default: all cores; more than the cores this process may use runs that many)",
+    )
     st.add_argument(
         "--studies",
         metavar="DIR",
@@ -449,6 +457,8 @@ def cmd_simulate(a):
     from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)
+    if a.scheduler is None or a.scheduler == "local":
+        _note_workers(a.workers)
     summary = simulate(
         scene,
         a.out,
@@ -462,6 +472,20 @@ def cmd_simulate(a):
     store = Store(a.out)
     print(run_report(store.root if store.local else store.url, describe_run(a.out)))
     return 0
+
+
+def _note_workers(workers) -> None:
+    """One line on stderr when --workers asks for more processes than the CPUs this process may use: that many
+    run (more would only compete for them, each with its own compiled integrator)."""
+    from hhscatter.run.worker import default_workers  # deferred: `hhscatter --help` starts without the engine
+
+    cpus = default_workers()
+    if workers is not None and workers > cpus:
+        print(
+            f"hhscatter: --workers {workers} is more than the {cpus} CPU(s) this process may use: "
+            f"{cpus} worker process(es) run",
+            file=sys.stderr,
+        )
 
 
 def run_report(out, info: dict) -> str:
@@ -488,6 +512,8 @@ def cmd_survival(a):
     from hhscatter.data.read import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
 
     png = Path(a.png)
+    if png.suffix.lower() != ".png":
+        raise UsageError(f"--png must name a .png file, got {a.png!r}")
     if not png.parent.is_dir():
         raise UsageError(f"--png: folder {png.parent} does not exist")
     curves = []
@@ -517,6 +543,7 @@ def cmd_survival(a):
 def cmd_study(a):
     from hhscatter.studies import run_stage  # deferred: `hhscatter --help` starts without the engine and tables
 
+    _note_workers(a.workers)
     run_stage(
         a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a), root=Path(a.studies) if a.studies else None
     )

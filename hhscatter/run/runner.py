@@ -143,7 +143,8 @@ def simulate(
         Output directory (created), or a URL pyarrow/fsspec can write (``s3://…``); see
         :mod:`hhscatter.data.schema` for the layout.
     workers : int, optional
-        Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes).
+        Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes); at most
+        the CPUs this process may use (its affinity mask): a larger number runs that many (the CLI says so).
     overwrite : bool
         Replace the tables of a non-empty ``out`` (the old run is removed first, under the run's lock).
     resume : bool
@@ -190,6 +191,8 @@ def simulate(
         )
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
         raise ConfigError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
+    if workers is not None and scheduler in (None, "local"):  # processes beyond the CPUs only compete for them
+        workers = min(workers, default_workers())
     points = points_of(run)
     table_ics = None
     if points[0][0].ics is not None:
