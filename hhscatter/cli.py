@@ -589,6 +589,9 @@ _received: list[int] = []  # the signals received by this command, in order
 
 
 def _on_signal(signum, frame):
+    runner = sys.modules.get("hhscatter.run.runner")
+    if runner is not None and runner.defer_signal(signum):  # a worker process is being started: raised at its end
+        return
     _received.append(signum)
     if len(_received) == 1:  # once: a second Ctrl-C must not break the cleanup of the first
         raise Interrupted(signum)

@@ -19,6 +19,7 @@ SIM = ["simulate", "--energy", "0.3", "-n", "10", "--t-max", "5"]
     [
         (["--snapshots", "0:1e300:1e-300"], "snapshots: 0:1e+300:1e-300 gives inf times, more than 100000"),
         (["--snapshots", "0:5:1e-300"], "snapshots: 0:5:1e-300 gives 5e+300 times"),
+        (["--snapshots", "0:5:1e-6"], "snapshots: 0:5:1e-06 gives 5000001 times"),
         (["--system", "henon_heiles", "--param", "lam=1e-300"], "lam = 1e-300 give E_c = ω⁶/(6λ²) = inf, outside"),
         (["--param", "lam=1e-300"], "lam = 1e-300 give E_c = ω⁶/(6λ²) = inf, outside"),
         (["--system", "henon_heiles", "--param", "omega=1e-30"], "give E_c = ω⁶/(6λ²) = 1.67e-181, outside"),

@@ -107,7 +107,7 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
 
 def _check_and_clear(run, store, points, *, overwrite, resume):
     """The emptiness / same-scene checks of prepare_output, under the lock; --overwrite clears the old run.
-    --resume needs the run's manifest: a folder holding anything else but no scene.json is refused."""
+    --resume continues a run: without scene.json, a folder holding anything but a run's table folders is refused."""
     entries = [e for e in store.listdir() if e != LOCK_FILE]
     if not entries:
         return
@@ -118,8 +118,8 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
         raise OutputError(
             f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
         )
-    if not store.exists(SCENE_FILE):
-        theirs = [e for e in entries if not _ours(e)]
+    if not store.exists(SCENE_FILE):  # a run whose manifest is gone is verified part by part; anything else is not ours
+        theirs = [e for e in entries if e not in TABLES and not _ours(e)]
         if theirs:
             raise OutputError(
                 f"cannot resume into {store.display()}: it holds no hhscatter run (no {SCENE_FILE}: its manifest) "

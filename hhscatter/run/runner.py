@@ -55,10 +55,12 @@ a :class:`RunError`.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import multiprocessing as mp
 import os
 import queue as queue_mod
+import signal
 import time
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -324,7 +326,8 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
     manager = None
     if on_progress is not None:
         manager = SyncManager(ctx=ctx)
-        manager.start(initializer=die_with_parent, initargs=(os.getpid(),))
+        with _signals_held():
+            manager.start(initializer=die_with_parent, initargs=(os.getpid(),))
     q = manager.Queue() if manager is not None else None
 
     def relay():
@@ -342,9 +345,13 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
             if done:
                 return done
 
+    def submit(t):
+        with _signals_held():  # (the pool starts its worker processes in submit)
+            return pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5])
+
     try:
         _drain(
-            lambda t: pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5]),
+            submit,
             wait_first,
             todo,
             2 * workers,
@@ -358,6 +365,34 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
         pool.shutdown(wait=True, cancel_futures=True)
         if manager is not None:
             manager.shutdown()
+
+
+_HELD = {"depth": 0, "pending": []}  # sections that start a worker process, and the signals that came meanwhile
+
+
+def defer_signal(signum: int) -> bool:
+    """defer_signal(signum) -> True while a worker process is being started: the signal is kept and raised again
+    when the start is complete (:func:`_signals_held`). For a signal handler that stops the run (the CLI's): a
+    start cut halfway leaves the new process reading a half-written pipe, an EOFError traceback on stderr."""
+    if _HELD["depth"]:
+        _HELD["pending"].append(signum)
+        return True
+    return False
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """The section in which the main thread starts a worker process; signals deferred meanwhile
+    (:func:`defer_signal`) are raised again at its end."""
+    _HELD["depth"] += 1
+    try:
+        yield
+    finally:
+        _HELD["depth"] -= 1
+        if not _HELD["depth"] and _HELD["pending"]:
+            signum = _HELD["pending"][0]
+            _HELD["pending"].clear()
+            signal.raise_signal(signum)
 
 
 def _stop_workers(pool) -> None:

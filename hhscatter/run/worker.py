@@ -167,8 +167,9 @@ def die_with_parent(parent_pid: int) -> None:
     Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)``, which the kernel applies however the parent ends
     (SIGTERM, SIGINT, kill -9), so no worker keeps computing and writing parts for a run that is gone.
     Elsewhere: a daemon thread that polls the parent every second. The pool's and the progress
-    manager's initializer.
+    manager's initializer. It also ignores SIGINT (the parent answers Ctrl-C and stops its workers).
     """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform.startswith("linux"):
         import ctypes  # deferred: Linux-only (prctl), imported where it is used
 

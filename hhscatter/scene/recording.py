@@ -55,10 +55,11 @@ class SnapshotGrid(tuple):
         if not step > 0:
             raise ConfigError(f"snapshots.step must be > 0, got {step}")
         span = (stop - start) / step  # inf when the span overflows (0:1e300:1e-300)
-        count = math.floor(span + 0.5) + 1 if span <= SNAPSHOTS_MAX else math.inf
+        count = math.floor(span + 0.5) + 1 if span < 1e15 else math.inf
         if count > SNAPSHOTS_MAX:
+            shown = count if count < math.inf else f"{span + 1:.3g}"
             raise ConfigError(
-                f"snapshots: {start:g}:{stop:g}:{step:g} gives {span + 1:.3g} times, more than "
+                f"snapshots: {start:g}:{stop:g}:{step:g} gives {shown} times, more than "
                 f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
                 "in memory): use a larger step"
             )
