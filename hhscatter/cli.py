@@ -2,7 +2,8 @@
 
 Exit status: 0 on success, 2 on bad input (the message names the parameter and
 its allowed range; nothing has been computed; no traceback), 1 on other
-failures.
+failures, 130 when interrupted by SIGINT (Ctrl-C) and 143 by SIGTERM: one line
+says what was kept and how to continue, without a traceback.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import importlib.util
 import math
 import os
 import re
+import signal
 import sys
 from pathlib import Path
 
@@ -222,7 +224,11 @@ def build_parser():
         help="output directory (named explicitly: '.' for the working directory), or "
         "a URL pyarrow/fsspec can write (s3://…)",
     )
-    s.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    s.add_argument(
+        "--workers",
+        type=_int,
+        help="worker processes (default: all cores; more than the cores this process may use runs that many)",
+    )
     s.add_argument(
         "--scheduler",
         help="run the chunks on Dask: 'local' (a LocalCluster of --workers processes) "
@@ -240,7 +246,7 @@ def build_parser():
         "run gives one curve per (E0, γ) point.",
     )
     v.add_argument("runs", nargs="+", help="run directories (outputs of simulate)")
-    v.add_argument("--png", required=True, help="output PNG path (its folder must exist)")
+    v.add_argument("--png", required=True, help="output PNG path, ending in .png (its folder must exist)")
     v.add_argument("--labels", nargs="*", help="curve labels, one per curve in order (default: E0, γ and N)")
 
     st = sub.add_parser(
@@ -255,7 +261,11 @@ def build_parser():
     st.add_argument("name", help="study name (a folder of studies/ with a study.toml), e.g. fig2; listed below")
     st.add_argument("stage", choices=["simulate", "analyze", "plot", "all"])
     st.add_argument("--scale", default="quick", help="'quick' (default), 'paper', or another scale in study.toml")
-    st.add_argument("--workers", type=_int, help="worker processes (default: all cores)")
+    st.add_argument(
+        "--workers",
+        type=_int,
+        help="worker processes (default: all cores; more than the cores this process may use runs that many)",
+    )
     st.add_argument(
         "--studies",
         metavar="DIR",
@@ -447,6 +457,8 @@ def cmd_simulate(a):
     from hhscatter.run.runner import simulate  # deferred: `hhscatter --help` starts without the engine and tables
 
     scene = _scene_from_args(a)
+    if a.scheduler is None or a.scheduler == "local":
+        _note_workers(a.workers)
     summary = simulate(
         scene,
         a.out,
@@ -460,6 +472,20 @@ def cmd_simulate(a):
     store = Store(a.out)
     print(run_report(store.root if store.local else store.url, describe_run(a.out)))
     return 0
+
+
+def _note_workers(workers) -> None:
+    """One line on stderr when --workers asks for more processes than the CPUs this process may use: that many
+    run (more would only compete for them, each with its own compiled integrator)."""
+    from hhscatter.run.worker import default_workers  # deferred: `hhscatter --help` starts without the engine
+
+    cpus = default_workers()
+    if workers is not None and workers > cpus:
+        print(
+            f"hhscatter: --workers {workers} is more than the {cpus} CPU(s) this process may use: "
+            f"{cpus} worker process(es) run",
+            file=sys.stderr,
+        )
 
 
 def run_report(out, info: dict) -> str:
@@ -486,6 +512,8 @@ def cmd_survival(a):
     from hhscatter.data.read import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
 
     png = Path(a.png)
+    if png.suffix.lower() != ".png":
+        raise UsageError(f"--png must name a .png file, got {a.png!r}")
     if not png.parent.is_dir():
         raise UsageError(f"--png: folder {png.parent} does not exist")
     curves = []
@@ -515,6 +543,7 @@ def cmd_survival(a):
 def cmd_study(a):
     from hhscatter.studies import run_stage  # deferred: `hhscatter --help` starts without the engine and tables
 
+    _note_workers(a.workers)
     run_stage(
         a.name, a.stage, a.scale, workers=a.workers, progress=_progress(a), root=Path(a.studies) if a.studies else None
     )
@@ -543,23 +572,119 @@ def _check_text(a) -> None:
                 )
 
 
-def main(argv=None):
-    a = build_parser().parse_args(argv)
+#: the exit status of a command ended by a signal: 128 + the signal's number (the shells' convention)
+SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM arrived: raised where the command is, so that its cleanup runs (a run's lock is
+    released, a run that wrote no chunk is removed) before the command ends with one line and 128 + the signal."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+_received: list[int] = []  # the signals received by this command, in order
+
+
+def _on_signal(signum, frame):
+    runner = sys.modules.get("hhscatter.run.runner")
+    if runner is not None and runner.defer_signal(signum):  # a worker process is being started: raised at its end
+        return
+    _received.append(signum)
+    if len(_received) == 1:  # once: a second Ctrl-C must not break the cleanup of the first
+        raise Interrupted(signum)
+    if len(_received) >= 3:  # a third: the cleanup is not wanted, end now
+        os._exit(SIGNAL_EXIT.get(signum, 128 + int(signum)))
+
+
+def _catch_signals() -> dict:
+    """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread (a no-op elsewhere); returns the handlers
+    they had, for :func:`_restore_signals`."""
+    _received.clear()
+    before = {}
     try:
+        for sig in SIGNAL_EXIT:
+            before[sig] = signal.signal(sig, _on_signal)
+    except ValueError:  # not the main thread: signals stay as they are
+        pass
+    return before
+
+
+def _restore_signals(before: dict) -> None:
+    for sig, handler in before.items():
+        signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+
+
+def _interrupted_advice(a) -> str:
+    """What an interrupted command kept and how to continue it: one clause for the closing line."""
+    if a is None:
+        return "nothing was done"
+    if a.command == "simulate":
+        from hhscatter.data.store import Store  # deferred: `hhscatter --help` starts without the engine and tables
+
+        try:
+            kept = Store(a.out).exists("scene.json")
+        except (OSError, ValueError):
+            kept = False
+        if kept:
+            return f"the finished chunks in {a.out} are kept: run the command again with --resume to continue"
+        return f"no chunk had finished and nothing is left in {a.out}: run the command again"
+    if a.command == "study":
+        again = f"hhscatter study {a.name} {a.stage} --scale {a.scale}"
+        if a.stage in ("simulate", "all"):
+            return f"finished runs and chunks are kept: run `{again}` again to continue"
+        return f"the {a.stage} stage did not finish and replaced none of its outputs: run `{again}` again"
+    return "nothing was written"
+
+
+def main(argv=None):
+    before = _catch_signals()
+    try:
+        return _main(argv)
+    finally:
+        _restore_signals(before)
+
+
+def _main(argv):
+    a = None
+    try:
+        a = build_parser().parse_args(argv)
         _check_text(a)
         return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
     except HHScatterError as exc:  # bad input (2, before any work), or a run that could not complete (1)
+        if _received:
+            return _interrupted(a)
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except FileNotFoundError as exc:  # a run or file that is not there
+        if _received:
+            return _interrupted(a)
         print(f"hhscatter: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("hhscatter: interrupted; rerun with --resume to continue", file=sys.stderr)
-        return 130
     except BrokenPipeError:  # `hhscatter … | head -1`: the reader left; the run itself is complete
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return 141
+    except KeyboardInterrupt:
+        if not _received:
+            _received.append(signal.SIGINT)
+        return _interrupted(a)
+    except BaseException:
+        if _received:  # whatever the signal broke on its way out (a half-made import, a pool): the signal is the news
+            return _interrupted(a)
+        raise
+
+
+def _interrupted(a) -> int:
+    """Print the one closing line of an interrupted command; its exit status (130 SIGINT, 143 SIGTERM)."""
+    signum = _received[0]
+    try:
+        advice = _interrupted_advice(a)
+    except Exception:  # noqa: BLE001 - the closing line must come out whatever the state
+        advice = "see the output folder"
+    print(f"hhscatter: interrupted by {signal.Signals(signum).name}; {advice}", file=sys.stderr)
+    return SIGNAL_EXIT.get(signum, 128 + int(signum))
 
 
 if __name__ == "__main__":

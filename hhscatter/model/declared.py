@@ -31,6 +31,11 @@ if TYPE_CHECKING:  # annotations only
 OVERRIDES = ("critical_energy", "exits", "omega_radius")
 
 
+#: a denominator D of V vanishes where √(|D| / max|D|) ≤ POLE_TOL (|D| ≤ 1e-14 of its largest value in the disk):
+#: a pole there, or a force so large that the integrator would stop (DeclaredSystem.nonfinite_point)
+POLE_TOL = 1e-7
+
+
 class DeclaredSystem(System):
     """A system given by its potential V(x, y) and drag law; E_c, exits, Ω and R(E) derived (module docstring).
 
@@ -200,8 +205,49 @@ class DeclaredSystem(System):
             return None
         key = ("nonfinite", float(radius))
         if key not in self._cache:
-            self._cache[key] = super().nonfinite_point(radius)
+            self._cache[key] = super().nonfinite_point(radius) or self._pole(float(radius))
         return self._cache[key]
+
+    def _pole(self, radius: float) -> tuple[float, float] | None:
+        """A zero of a denominator of V in the disk r ≤ radius (a pole the grid of :meth:`nonfinite_point` can step
+        over: 1/((x − a)² + (y − b)²) is finite at every grid point), or None.
+
+        Each denominator of V (sympy's ``together``/``fraction``, and of every subexpression) is sampled on a
+        polar grid; a sign change between neighbours, or a local minimum of |D| that reaches 0 (|D| ≤ POLE_TOL² of
+        its largest value on the grid, by least squares on √|D| from the grid's smallest values), is a zero."""
+        import sympy as sp  # deferred: sympy takes ~0.3 s to import
+        from scipy.optimize import least_squares  # deferred: scipy loads on first use
+
+        x, y = symbols()
+        dens = {sp.fraction(sp.together(e))[1] for e in sp.preorder_traversal(self._numeric) if e.free_symbols}
+        dens = [d for d in dens if d.free_symbols]
+        r = np.linspace(0.0, radius, 201)
+        th = np.linspace(0.0, 2 * np.pi, 361)
+        R, T = np.meshgrid(r, th)
+        X, Y = R * np.cos(T), R * np.sin(T)
+        for den in dens:
+            f = sp.lambdify((x, y), den, "numpy")
+            with np.errstate(all="ignore"):
+                D = np.broadcast_to(np.asarray(f(X, Y), dtype=float), X.shape)
+            if not np.isfinite(D).all():
+                continue  # not a real number there: the grid check of nonfinite_point answers for it
+            scale = float(np.max(np.abs(D))) or 1.0
+            sign = np.sign(D)
+            for flips, (di, dj) in ((sign[:, 1:] * sign[:, :-1] <= 0, (0, 1)), (sign[1:] * sign[:-1] <= 0, (1, 0))):
+                if flips.any():  # a zero between two neighbours (along r, or along θ)
+                    i, j = np.argwhere(flips)[0]
+                    return float(X[i + di, j + dj]), float(Y[i + di, j + dj])
+
+            def root(z, f=f, scale=scale):  # √|D|: a double zero (a sum of squares) becomes a simple one
+                return [math.sqrt(abs(float(f(z[0], z[1]))) / scale)]
+
+            for k in np.argsort(np.abs(D), axis=None)[:8]:
+                start = np.array([X.flat[k], Y.flat[k]])
+                with np.errstate(all="ignore"):
+                    sol = least_squares(root, start, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+                if np.hypot(*sol.x) <= radius and abs(sol.fun[0]) <= POLE_TOL:
+                    return float(sol.x[0]), float(sol.x[1])
+        return None
 
     def no_return_radius(self, energy: float) -> float:
         """R(E) ≥ the nearest saddle's distance, from :func:`hhscatter.model.landscape.no_return_radius` (cached)."""

@@ -18,10 +18,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from hhscatter.errors import ConfigError
 from hhscatter.model.base import DISSIPATIONS, Exit, System
 
 if TYPE_CHECKING:  # annotations only
     from numpy.typing import ArrayLike
+
+#: E_c = ω⁶/(6λ²) and the saddle distance ω²/λ must lie in [SCALE_MIN, SCALE_MAX]: far outside, squares of
+#: momenta and positions leave the floating-point range (the dynamics is scale-invariant, so nothing is lost)
+SCALE_MIN, SCALE_MAX = 1e-100, 1e100
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,17 @@ class HenonHeiles(System):
                 raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
         if self.dissipation not in DISSIPATIONS:
             raise ValueError(f"dissipation must be one of {DISSIPATIONS}, got {self.dissipation!r}")
+        try:  # E_c = ω⁶/(6λ²) and the saddle distance ω²/λ must be ordinary numbers (not 0, inf or subnormal)
+            scales = {"E_c = ω⁶/(6λ²)": self.omega**6 / (6.0 * self.lam**2), "ω²/λ": self.omega**2 / self.lam}
+        except (OverflowError, ZeroDivisionError):
+            scales = {"E_c = ω⁶/(6λ²)": math.inf}
+        for what, v in scales.items():
+            if not SCALE_MIN <= v <= SCALE_MAX:
+                raise ConfigError(
+                    f"omega = {self.omega!r}, lam = {self.lam!r} give {what} = {v:.3g}, outside "
+                    f"[{SCALE_MIN:g}, {SCALE_MAX:g}]: the dynamics does not depend on the scale (lengths in ω²/λ, "
+                    "energies in E_c), so use ω and λ nearer 1"
+                )
 
     # -- identity (the System contract) -------------------------------------
     @property

@@ -12,7 +12,11 @@ energies in the potential's units.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import signal
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -38,6 +42,12 @@ SEARCH_RADIUS = 100.0
 DEGENERATE = 1e-8
 #: relative margin added to R(E) beyond the refined grid estimate
 NO_RETURN_MARGIN = 1e-9
+#: seconds the symbolic search for critical points (lex Gröbner bases of ∇V) may take before the derivation is
+#: refused (a dense polynomial with many-digit coefficients can take hours); ``HHSCATTER_DERIVE_SECONDS`` sets
+#: another. Enforced in the main thread of the process that first builds the system (a run's workers rebuild it
+#: from a scene already accepted, without a budget).
+SYMBOLIC_BUDGET_SECONDS = 30.0
+BUDGET_ENV = "HHSCATTER_DERIVE_SECONDS"
 
 
 @dataclass(frozen=True)
@@ -171,8 +181,85 @@ def _curve_error(extra: str = "") -> ConfigError:
     )
 
 
+class _OverBudget(Exception):
+    """The symbolic work ran past its budget (raised by the timer's signal inside sympy)."""
+
+
+_unbounded = threading.local()
+
+
+@contextlib.contextmanager
+def unbounded_derivation():
+    """Within this block the symbolic derivation has no time budget: for a process that rebuilds a system another
+    process accepted (a run's worker), where a slower machine must not refuse it."""
+    before = getattr(_unbounded, "on", False)
+    _unbounded.on = True
+    try:
+        yield
+    finally:
+        _unbounded.on = before
+
+
+def symbolic_budget() -> float | None:
+    """The seconds the symbolic search may take here: :data:`SYMBOLIC_BUDGET_SECONDS` or ``$HHSCATTER_DERIVE_SECONDS``
+    (ConfigError unless a number > 0); None inside :func:`unbounded_derivation`."""
+    if getattr(_unbounded, "on", False):
+        return None
+    text = os.environ.get(BUDGET_ENV, "").strip()
+    if not text:
+        return SYMBOLIC_BUDGET_SECONDS
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ConfigError(f"{BUDGET_ENV} must be a number of seconds > 0, got {text!r}")
+    return value
+
+
+@contextlib.contextmanager
+def _time_budget(seconds: float | None):
+    """Raise _OverBudget in this block after ``seconds`` (a real-time timer; only in the main thread, and only
+    when no other timer is running: elsewhere the block runs unbounded)."""
+    usable = (
+        seconds is not None
+        and hasattr(signal, "setitimer")
+        and threading.current_thread() is threading.main_thread()
+        and signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    )
+    if not usable:
+        yield
+        return
+
+    def on_alarm(signum, frame):
+        raise _OverBudget()
+
+    before = signal.signal(signal.SIGALRM, on_alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, before)
+
+
 def _symbolic_candidates(land: Landscape) -> tuple[np.ndarray, np.ndarray]:
-    """Every real solution of ∇V = 0 of a polynomial V: the real roots of the two lex eliminants, paired."""
+    """Every real solution of ∇V = 0 of a polynomial V: the real roots of the two lex eliminants, paired; a
+    ConfigError when the Gröbner bases take longer than :func:`symbolic_budget`."""
+    budget = symbolic_budget()
+    try:
+        with _time_budget(budget):
+            return _symbolic_roots(land)
+    except _OverBudget:
+        raise ConfigError(
+            f"the critical points of the potential were not derived within {budget:g} s (the symbolic "
+            f"elimination of ∇V = 0 grows fast with the degree, the number of terms and the digits of the "
+            f"coefficients; {BUDGET_ENV} sets another budget): give `critical_energy` and `exits` in [system], "
+            "or a potential with fewer terms or shorter coefficients"
+        ) from None
+
+
+def _symbolic_roots(land: Landscape) -> tuple[np.ndarray, np.ndarray]:
     import sympy as sp  # deferred: sympy takes ~0.3 s to import
 
     x, y = land.x, land.y

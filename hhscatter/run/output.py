@@ -106,7 +106,8 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
 
 
 def _check_and_clear(run, store, points, *, overwrite, resume):
-    """The emptiness / same-scene checks of prepare_output, under the lock; --overwrite clears the old run."""
+    """The emptiness / same-scene checks of prepare_output, under the lock; --overwrite clears the old run.
+    --resume continues a run: without scene.json, a folder holding anything but a run's table folders is refused."""
     entries = [e for e in store.listdir() if e != LOCK_FILE]
     if not entries:
         return
@@ -117,7 +118,15 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
         raise OutputError(
             f"out: {store.display()} is not empty; pass --overwrite to replace it or --resume to continue it"
         )
-    if store.exists(SCENE_FILE):
+    if not store.exists(SCENE_FILE):  # a run whose manifest is gone is verified part by part; anything else is not ours
+        theirs = [e for e in entries if e not in TABLES and not _ours(e)]
+        if theirs:
+            raise OutputError(
+                f"cannot resume into {store.display()}: it holds no hhscatter run (no {SCENE_FILE}: its manifest) "
+                f"but {len(theirs)} entr{'y' if len(theirs) == 1 else 'ies'} (first: {theirs[0]}); --resume "
+                "continues a run: use another --out, or empty it yourself"
+            )
+    else:
         old = json.loads(store.read_text(SCENE_FILE))
         if old.get("scene_hash") != run.result_hash():
             what = _diff(old.get("scene", {}), json.loads(run.to_json()))
@@ -208,3 +217,22 @@ def resumed_points(store, points):
     if points and len(points[0]) == 3:
         return [(scene, old.get(h) or part, h) for scene, part, h in points]
     return [(scene, old.get(scene.result_hash()) or part) for scene, part in points]
+
+
+def discard_failed_start(store, *, remove_root: bool) -> bool:
+    """discard_failed_start(store, remove_root) -> True if the run at ``store`` was removed: a new run that ended
+    (an error, an interrupt) before any part file was written keeps nothing (its scene.json, lock note, write
+    probe, temporaries and empty table folders; the folder itself when ``remove_root``, i.e. the run made it).
+    A run with a written part is kept, for ``--resume``."""
+    try:
+        for name in TABLES:
+            if any(not _ours(f"{name}/{f}") for f in store.files(name)):
+                return False
+        for e in store.listdir():
+            if e in TABLES or e == SCENE_FILE or _ours(e):
+                store.remove(e)
+        if remove_root and not store.listdir():
+            store.remove("")
+    except OSError:
+        return False
+    return True

@@ -45,17 +45,22 @@ One writer per run directory: ``simulate`` holds an exclusive ``flock`` on
 its end; the kernel releases it however the process ends. ``overwrite=True``
 removes the old run (its tables, scene.json, temporaries) under that lock
 before anything is written. Pool workers (and the progress manager) die with
-the process that started them (:func:`die_with_parent`); a Dask run whose
+the process that started them (:func:`die_with_parent`). A new run (not ``resume``) that fails or is interrupted
+before its first chunk is written leaves nothing behind (:func:`~hhscatter.run.output.discard_failed_start`:
+its ``scene.json`` and lock note, and the folder if the run made it), so the same command can simply be run
+again; once a chunk is written, the run is kept for ``--resume``. A Dask run whose
 cluster has had no worker for :data:`DASK_NO_WORKER_TIMEOUT` seconds fails with
 a :class:`RunError`.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import multiprocessing as mp
 import os
 import queue as queue_mod
+import signal
 import time
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -65,7 +70,7 @@ from typing import NamedTuple
 from hhscatter.data.store import Store
 from hhscatter.errors import ConfigError, RunError
 from hhscatter.run.dask_backend import check_scheduler, dask_client
-from hhscatter.run.output import prepare_output
+from hhscatter.run.output import discard_failed_start, prepare_output
 from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
 from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
@@ -140,7 +145,8 @@ def simulate(
         Output directory (created), or a URL pyarrow/fsspec can write (``s3://…``); see
         :mod:`hhscatter.data.schema` for the layout.
     workers : int, optional
-        Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes).
+        Processes (default: all cores; with ``scheduler='local'``, the LocalCluster's worker processes); at most
+        the CPUs this process may use (its affinity mask): a larger number runs that many (the CLI says so).
     overwrite : bool
         Replace the tables of a non-empty ``out`` (the old run is removed first, under the run's lock).
     resume : bool
@@ -187,6 +193,8 @@ def simulate(
         )
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler):
         raise ConfigError(f"scheduler must be 'local' or a Dask scheduler address, got {scheduler!r}")
+    if workers is not None and scheduler in (None, "local"):  # processes beyond the CPUs only compete for them
+        workers = min(workers, default_workers())
     points = points_of(run)
     table_ics = None
     if points[0][0].ics is not None:
@@ -201,11 +209,16 @@ def simulate(
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
     earlier = _earlier_event_failures(out) if resume else {}
+    created = not Store(out).exists()
     store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
     try:
         summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier)
         _record_event_failures(store, summary)
         return summary
+    except BaseException:
+        if not resume:  # a start that failed before any chunk finished leaves nothing behind
+            discard_failed_start(store, remove_root=created)
+        raise
     finally:
         Store.unlock(lock)
 
@@ -313,7 +326,8 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
     manager = None
     if on_progress is not None:
         manager = SyncManager(ctx=ctx)
-        manager.start(initializer=die_with_parent, initargs=(os.getpid(),))
+        with _signals_held():
+            manager.start(initializer=die_with_parent, initargs=(os.getpid(),))
     q = manager.Queue() if manager is not None else None
 
     def relay():
@@ -331,19 +345,67 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
             if done:
                 return done
 
+    def submit(t):
+        with _signals_held():  # (the pool starts its worker processes in submit)
+            return pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5])
+
     try:
         _drain(
-            lambda t: pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5]),
+            submit,
             wait_first,
             todo,
             2 * workers,
             on_done,
             lambda fs: [f.cancel() for f in fs],
         )
+    except BaseException:  # an error or an interrupt: the chunks in flight are not waited for (their parts are
+        _stop_workers(pool)  # temporaries until complete; --resume removes them and redoes those chunks)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
         if manager is not None:
             manager.shutdown()
+
+
+_HELD = {"depth": 0, "pending": []}  # sections that start a worker process, and the signals that came meanwhile
+
+
+def defer_signal(signum: int) -> bool:
+    """defer_signal(signum) -> True while a worker process is being started: the signal is kept and raised again
+    when the start is complete (:func:`_signals_held`). For a signal handler that stops the run (the CLI's): a
+    start cut halfway leaves the new process reading a half-written pipe, an EOFError traceback on stderr."""
+    if _HELD["depth"]:
+        _HELD["pending"].append(signum)
+        return True
+    return False
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """The section in which the main thread starts a worker process; signals deferred meanwhile
+    (:func:`defer_signal`) are raised again at its end."""
+    _HELD["depth"] += 1
+    try:
+        yield
+    finally:
+        _HELD["depth"] -= 1
+        if not _HELD["depth"] and _HELD["pending"]:
+            signum = _HELD["pending"][0]
+            _HELD["pending"].clear()
+            signal.raise_signal(signum)
+
+
+def _stop_workers(pool) -> None:
+    """Terminate the pool's worker processes now (ProcessPoolExecutor.terminate_workers where it exists)."""
+    stop = getattr(pool, "terminate_workers", None)
+    if stop is not None:
+        stop()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            proc.terminate()
+        except (OSError, ValueError):  # gone already
+            pass
 
 
 def _run_dask(client, todo, args, on_done, name):

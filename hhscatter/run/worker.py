@@ -19,6 +19,7 @@ from hhscatter.data.verify import read_meta, verify_part
 from hhscatter.data.write import write_part
 from hhscatter.errors import RunIntegrityError
 from hhscatter.integrate.engine import run_chunk
+from hhscatter.model.landscape import unbounded_derivation
 from hhscatter.run.plan import RunSummary, _decode, part_rel, tables_of
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Scene, scene_from_dict
@@ -55,7 +56,8 @@ def run_one_chunk(
     the client computed it once per run (default: computed here, which re-reads an IC table).
     """
 
-    scene = scene_from_dict(_decode(json.loads(scene_json)))
+    with unbounded_derivation():  # the client accepted this scene: its system is rebuilt here whatever it takes
+        scene = scene_from_dict(_decode(json.loads(scene_json)))
     store = Store(out)
     if ics is None:
         ics, ids = _chunk_ics(scene, start, stop, None)
@@ -165,8 +167,9 @@ def die_with_parent(parent_pid: int) -> None:
     Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)``, which the kernel applies however the parent ends
     (SIGTERM, SIGINT, kill -9), so no worker keeps computing and writing parts for a run that is gone.
     Elsewhere: a daemon thread that polls the parent every second. The pool's and the progress
-    manager's initializer.
+    manager's initializer. It also ignores SIGINT (the parent answers Ctrl-C and stops its workers).
     """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform.startswith("linux"):
         import ctypes  # deferred: Linux-only (prctl), imported where it is used
 

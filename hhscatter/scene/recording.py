@@ -54,10 +54,12 @@ class SnapshotGrid(tuple):
         )
         if not step > 0:
             raise ConfigError(f"snapshots.step must be > 0, got {step}")
-        count = math.floor((stop - start) / step + 0.5) + 1
+        span = (stop - start) / step  # inf when the span overflows (0:1e300:1e-300)
+        count = math.floor(span + 0.5) + 1 if span < 1e15 else math.inf
         if count > SNAPSHOTS_MAX:
+            shown = count if count < math.inf else f"{span + 1:.3g}"
             raise ConfigError(
-                f"snapshots: {start:g}:{stop:g}:{step:g} gives {count} times, more than "
+                f"snapshots: {start:g}:{stop:g}:{step:g} gives {shown} times, more than "
                 f"{SNAPSHOTS_MAX} (every live orbit writes one row per time; a chunk holds them "
                 "in memory): use a larger step"
             )

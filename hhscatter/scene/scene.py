@@ -13,6 +13,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,7 +23,7 @@ import numpy as np
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import resolve
-from hhscatter.scene.noise import KICK_FRACTION, KICK_MAX_FRACTION, Noise
+from hhscatter.scene.noise import KICK_FRACTION, KICK_MAX_FRACTION, KICK_SECONDS, KICKS_PER_ORBIT_MAX, Noise
 from hhscatter.scene.recording import (
     SNAPSHOT_LIST_MAX,
     SNAPSHOTS_MAX,
@@ -128,7 +129,9 @@ class Scene:
     batch_size : int, optional
         SIMD lanes (default: heyoka's recommended size); no effect on results.
     ics : str, optional
-        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id].
+        Path of a Parquet/CSV table of initial states with columns x, y, px, py [, traj_id]; a relative path is
+        made absolute against the working directory (a scene file's own ``ics`` against the file's folder,
+        :func:`~hhscatter.scene.schema.load_scene`), so that ``scene.json`` names one file.
     sections : SectionWindow, optional
         Which crossings of the section ṙ = 0, φ̇ > 0 to record (default: no sections table).
     snapshots : tuple of float, optional
@@ -269,9 +272,9 @@ class Scene:
         self._check_chunks()
         self._check_energy(gamma)
         self._check_recording(gamma, t_max, r_esc)
-        self._check_noise(gamma)
+        self._check_noise(gamma, t_max)
 
-    def _check_noise(self, gamma):
+    def _check_noise(self, gamma, t_max):
         """noise: a heat bath needs linear drag, a noise strength none; the kick interval's bound; a noise scene
         records lifetimes only."""
         if self.noise is None:
@@ -298,6 +301,16 @@ class Scene:
             raise ConfigError(
                 f"noise.kick must be ≤ {KICK_MAX_FRACTION:g} min(1/ω, 1/γ) = {h_max:g}, got {self.noise.kick:g} "
                 "(the splitting would resolve neither the oscillation nor the drag)"
+            )
+        kicks = t_max / self.kick_interval  # (inf for a kick of 1e-300)
+        if kicks > KICKS_PER_ORBIT_MAX:
+            what = "noise.kick" if self.noise.kick is not None else "t_max"
+            cost = self.n * kicks * KICK_SECONDS / 3600.0
+            h = "noise.kick" if self.noise.kick is not None else f"the kick interval {KICK_FRACTION:g} min(1/ω, 1/γ)"
+            raise ConfigError(
+                f"{what}: t_max / {h} = {t_max:g} / {self.kick_interval:.3g} = {kicks:.3g} kicks per orbit, "
+                f"more than {KICKS_PER_ORBIT_MAX:.0e} (the {self.n} orbits would take ≈ {cost:.3g} CPU-hours at "
+                f"≈ {KICK_SECONDS * 1e6:g} µs a kick): give a larger noise.kick or a shorter t_max"
             )
         for name, given in (
             ("sections", self.sections is not None),
@@ -457,8 +470,21 @@ class Scene:
                     f"sections.e_min = {self.sections.e_min:g} is above E0 = {energy:g}: the energy "
                     "never rises above E0, so no crossing would be recorded"
                 )
+            if isinstance(self.sections, SectionWindow) and self.noise is None:  # (noise records no sections)
+                if gamma == 0 and self.sections.e_max < energy:
+                    raise ConfigError(
+                        f"sections.e_max = {self.sections.e_max:g} is below E0 = {energy:g}: without drag the "
+                        "energy stays E0, so no crossing would be recorded"
+                    )
+                if gamma > 0 and self.sections.e_max < m.critical_energy and not self.continue_settled:
+                    raise ConfigError(
+                        f"sections.e_max = {self.sections.e_max:g} is below E_c = {m.critical_energy:.10g}: an "
+                        "orbit settles (and ends) when its energy falls to E_c, so no crossing would be recorded"
+                    )
         elif not isinstance(self.ics, (str, Path)) or not str(self.ics).strip():
             raise ConfigError(f"ics must be the path of a Parquet/CSV table, got {self.ics!r}")
+        elif not os.path.isabs(self.ics):  # one meaning wherever the scene is read again (scene.json, --resume)
+            object.__setattr__(self, "ics", os.path.abspath(self.ics))
         elif self.energy is not None:
             raise ConfigError("energy must not be given with ics: each orbit's energy comes from its table row")
         elif self.momentum != "tangential":
@@ -472,6 +498,11 @@ class Scene:
         m = self.model
         if self.sections is not None and not isinstance(self.sections, SectionWindow):
             raise ConfigError("sections must be a SectionWindow or None")
+        if self.sections is not None and self.sections.t_from >= t_max:
+            raise ConfigError(
+                f"sections.t_from = {self.sections.t_from:g} is not before t_max = {t_max:g}: every orbit ends by "
+                "t_max, so no crossing would be recorded"
+            )
         if self.snapshots is not None:
             if not isinstance(self.snapshots, SnapshotGrid) and len(self.snapshots) > SNAPSHOTS_MAX:
                 raise ConfigError(

@@ -561,7 +561,8 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
     """scene_dict_from_toml(path, scale=None, **overrides) -> the raw scene dict of a TOML file.
 
     What :func:`load_scene` validates; values may still be lists (a grid, see
-    :mod:`hhscatter.scene.grid`).
+    :mod:`hhscatter.scene.grid`). A relative ``ics`` path in the file is relative to the file's folder (made
+    absolute here); one given in ``overrides`` is taken as given.
     """
     path = Path(path)
     try:
@@ -587,6 +588,8 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
         if scale not in scales:
             raise ConfigError(f"scale must be one of {['quick', *scales]}, got {scale!r}")
         d.update(scales[scale])
+    if isinstance(d.get("ics"), str) and d["ics"].strip() and not os.path.isabs(d["ics"]):
+        d["ics"] = os.path.abspath(path.parent / d["ics"])  # the file's own paths are relative to its folder
     d.update({k: v for k, v in overrides.items() if v is not None})
     return d
 

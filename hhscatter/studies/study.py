@@ -193,11 +193,15 @@ class Study:
         return HenonHeiles(sc.get("omega", 1.0), sc.get("lam", 1.0))
 
     def scene(self, key: str, **overrides) -> Scene:
-        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides."""
+        """scene(key, **overrides) -> Scene from ``[scene]`` (+ ``[sections]``, ``[snapshots]``, ``[noise]``) and overrides.
+
+        A relative ``ics`` path of study.toml is relative to the study's folder."""
         d = dict(self.config.get("scene", {}))
         for extra in ("sections", "snapshots", "noise", "system"):
             if extra in self.config:
                 d[extra] = copy.deepcopy(self.config[extra])
+        if isinstance(d.get("ics"), str) and d["ics"].strip() and not os.path.isabs(d["ics"]):
+            d["ics"] = os.path.abspath(self.root / d["ics"])  # study.toml's paths are relative to its folder
         d.update(overrides)
         d = {k: v for k, v in d.items() if v is not None or k in ("sections", "snapshots")}
         d["name"] = f"{self.name}/{key}"
@@ -224,9 +228,18 @@ class Study:
 
         A finished run of the same scene is kept (chunks verified), an
         interrupted one resumed; a run of a different scene (the study file
-        changed) is replaced.
+        changed) is replaced. A key this study has already run with another scene is a
+        :class:`~hhscatter.errors.StudyError` before any work (two runs would share one folder:
+        make keys with :func:`hhscatter.studies.keys.number_key`).
         """
 
+        made = self.raw_runs.get(key)
+        if made is not None and made.get("scene_hash") != scene.result_hash():
+            raise StudyError(
+                f"study {self.name}: run key {key!r} was already used for another scene in this stage; two runs "
+                "cannot share a key (a key formatted from a number can collide: make it with "
+                "hhscatter.studies.keys.number_key)"
+            )
         out = self.raw(key)
         resume, overwrite = False, False
         sj = out / SCENE_FILE

@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.studies.keys import RunKeys, number_key
 
 
 class Params(StudyParams):
@@ -74,16 +75,28 @@ def _pairs(study, a, b):
     return list(zip(xs, ys))
 
 
+def _kramers_key(b) -> str:
+    return f"kramers_b{number_key(b, 'g')}"
+
+
+def _turnover_key(g) -> str:
+    return f"turnover_g{number_key(g, 'g')}"
+
+
+def _nodrag_key(E, s) -> str:
+    return f"nodrag_E{number_key(E, '.2f')}_s{number_key(s, 'g')}"
+
+
 def _runs(study):
-    """{key: scene} of every raw run (module docstring)."""
+    """{key: scene} of every raw run (module docstring); each key names one run (:class:`RunKeys`)."""
     p, dE = study.params, _barrier(study)
-    runs = {}
+    runs = RunKeys()
     for b, t_max in _pairs(study, "barriers", "kramers_t_max"):
-        runs[f"kramers_b{b:g}"] = dict(
+        runs[_kramers_key(b)] = dict(
             energy=p.well_energy, gamma=p.gamma_kramers, t_max=t_max, noise={"temperature": dE / b}
         )
     for g, t_max in _pairs(study, "turnover_gammas", "turnover_t_max"):
-        runs[f"turnover_g{g:g}"] = dict(
+        runs[_turnover_key(g)] = dict(
             energy=p.well_energy,
             gamma=g,
             t_max=t_max,
@@ -96,7 +109,7 @@ def _runs(study):
     runs["react_well"] = dict(react, energy=p.well_energy, noise={"temperature": dE / p.react_barrier})
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
-            runs[f"nodrag_E{E:.2f}_s{s:g}"] = dict(
+            runs[_nodrag_key(E, s)] = dict(
                 energy=E, gamma=0.0, t_max=p.nodrag_t_max, n=p.nodrag_n, noise={"sigma": s} if s > 0 else None
             )
     return {k: study.scene(k, **kw) for k, kw in runs.items()}
@@ -214,7 +227,7 @@ def _no_drag(study, runs):
     for E in p.nodrag_energies:
         base = None
         for s in p.nodrag_sigmas:
-            t_end, esc, _ = _lifetimes(study, f"nodrag_E{E:.2f}_s{s:g}")
+            t_end, esc, _ = _lifetimes(study, _nodrag_key(E, s))
             m = escape_rate_mle(t_end, esc, lo, hi)
             if s == 0:
                 base = m
@@ -238,7 +251,7 @@ def _survival_tables(study, runs):
     frames = []
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
-            t_end, esc, _ = _lifetimes(study, f"nodrag_E{E:.2f}_s{s:g}")
+            t_end, esc, _ = _lifetimes(study, _nodrag_key(E, s))
             c = survival_curve(t_end, esc, grid)
             frames.append(pd.DataFrame({"energy": E, "sigma": s, "t": grid, "P": c.P, "P_err": c.P_err}))
     return pd.concat(frames, ignore_index=True)
@@ -249,11 +262,11 @@ def analyze(study):
     p = study.params
     runs = _runs(study)
     kramers = [
-        _rate_row(study, f"kramers_b{b:g}", runs[f"kramers_b{b:g}"], p.t_relax)
+        _rate_row(study, _kramers_key(b), runs[_kramers_key(b)], p.t_relax)
         for b, _ in _pairs(study, "barriers", "kramers_t_max")
     ]
     turnover = [
-        _rate_row(study, f"turnover_g{g:g}", runs[f"turnover_g{g:g}"], p.t_relax)
+        _rate_row(study, _turnover_key(g), runs[_turnover_key(g)], p.t_relax)
         for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max")
     ]
     react, react_table = _reactivation(study, runs)
