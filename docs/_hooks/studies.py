@@ -403,8 +403,14 @@ class Renderer:
                 continue
             scales.setdefault(scale, []).append(name)
             for r in doc.get("paper_comparison") or []:
-                out.append({**r, "scale": scale, "quantity": f"[{name}]({name}.md): {r.get('quantity', '')}"})
-        text = comparison_table(out) if out else "*No study has written paper-vs-ours rows yet.*\n"
+                out.append({**r, "scale": scale, "study": name})
+        from hhscatter.publish.formatting import comparison_table as table
+        from hhscatter.publish.formatting import md_cell
+
+        def linked(r):  # the row keeps its own quantity (its verdict is the row's); the cell links the study
+            return md_cell(f"[{r['study']}]({r['study']}.md): {r.get('quantity', '')}")
+
+        text = table(out, quantity=linked) if out else "*No study has written paper-vs-ours rows yet.*\n"
         said = "; ".join(f"{sc} scale: " + ", ".join(f"[{n}]({n}.md)" for n in names) for sc, names in scales.items())
         text += f"\n*Scale of each study's rows — {said}.*\n" if said else ""
         if missing:
@@ -618,7 +624,10 @@ def _is_record_list(v) -> bool:
 
 def claims_table(doc) -> str:
     """Markdown table claims × systems of a numbers JSON with a ``claims`` list and a ``systems`` dict
-    ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear."""
+    ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear; each
+    verdict by the one rule (:func:`hhscatter.analysis.stats.verdicts.claim_verdict`)."""
+    from hhscatter.analysis.stats.verdicts import claim_verdict
+
     systems = list((doc.get("systems") or {}).keys())
     for c in doc["claims"]:
         if c.get("system") not in systems:
@@ -643,7 +652,7 @@ def claims_table(doc) -> str:
         val = (
             "n/a" if v is None else (fmt_err(v, e) if _is_num(e) else fmt_value(v) if not _is_num(v) else fmt_num(v, 3))
         )
-        verdict = c.get("verdict")
+        verdict = claim_verdict(c, doc.get("scale")) if c.get("verdict") else None  # the rule of every table
         return _cell(f"{val}: {verdict}" if verdict else val)
 
     out = [

@@ -8,7 +8,7 @@ study's committed numbers JSON when the page is built::
     quick scale: [[fig2@quick:kappa_fit.c]]           → the quick-scale JSON
     [[fig2:kappa_fit.c|value]], [[fig2:kappa_fit.c|err]]
     [[fig2:kappa_energy[energy=0.27].kappa|.4f]]      → a record of a list, chosen by a field
-    [[fig5:paper_comparison[quantity=d_rel].verdict]] → text leaves as they are
+    [[fig5:paper_comparison[quantity=d_rel].verdict]] → a row's verdict, by the one rule
 
 The reference is ``[[study[@scale]:path[|format]]]``:
 
@@ -362,18 +362,31 @@ def _protected(text: str) -> list[tuple[int, int]]:
 def format_ref(doc, path: str, fmt: str | None = None) -> str:
     """The text of one reference: :func:`resolve` then :func:`format_leaf`; with ``ci`` a number whose interval
     is its sibling ``<key>_interval`` (``rows[…].delta`` beside ``rows[…].delta_interval``) is written with it."""
+    scale = doc.get("scale") if isinstance(doc, dict) else None
+    stripped = path.strip()
+    if stripped.endswith(".verdict") and not fmt:  # a row's or a claim's verdict: by the one rule, not as stored
+        parent = resolve(doc, stripped[: -len(".verdict")])
+        if isinstance(parent, dict) and ("ours" in parent or "reference" in parent):
+            return _rule_verdict(parent, scale)
     leaf = resolve(doc, path)
     if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
-        from hhscatter.analysis.stats.verdicts import row_verdict  # deferred: only this format needs it
-
-        if not isinstance(leaf, dict) or "ours" not in leaf:
-            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours')")
-        return row_verdict(leaf, doc.get("scale") if isinstance(doc, dict) else None)
+        if not isinstance(leaf, dict) or not ("ours" in leaf or "reference" in leaf):
+            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours') or a claim record")
+        return _rule_verdict(leaf, scale)
     if (fmt or "").strip() == "pm" and _is_num(leaf):  # a number beside its error <key>_err
         return format_leaf({"value": leaf, "err": resolve(doc, path.strip() + "_err")})
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)
+
+
+def _rule_verdict(row: dict, scale) -> str:
+    """The verdict of a paper-vs-ours row or a claim record by the one rule
+    (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, :func:`~hhscatter.analysis.stats.verdicts.claim_verdict`),
+    its minus signs typographic."""
+    from hhscatter.analysis.stats.verdicts import claim_verdict, row_verdict  # deferred: only verdicts need it
+
+    return row_verdict(row, scale) if "ours" in row else claim_verdict(row, scale)
 
 
 def render_refs(text: str, root: Path, *, where: str = "") -> str:

@@ -22,7 +22,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from hhscatter.analysis.stats.verdicts import RULE, row_verdict
+from hhscatter.analysis.stats.verdicts import RULE, row_verdict, verdict_class
 from hhscatter.errors import StudyError
 from hhscatter.publish.formatting import (
     comparison_table,
@@ -140,18 +140,7 @@ def comparison_rows(sections) -> list[dict]:
     return rows
 
 
-def _verdict_class(v):
-    if not v:
-        return ""
-    v = v.lower()
-    if v.startswith("agree") or v.startswith("consistent") or v.startswith("reproduced"):
-        return "ok"
-    if v.startswith("differs in") and "only" in v:
-        # a difference that does not survive the authors' convention: not counted as one
-        return "meh"
-    if v.startswith("differ") or v.startswith("not"):
-        return "bad"
-    return "meh"
+_verdict_class = verdict_class  # agrees / differs / neither, by |z| when the verdict has one
 
 
 def _img_uri(path: Path) -> str:
@@ -282,7 +271,9 @@ def _rows_table(rows, html_verdicts: bool) -> str:
 
     def verdict(v):
         cls = _verdict_class(v)
-        return f'<span class="{cls}">{html.escape(v)}</span>' if html_verdicts and cls else md_cell(v)
+        if html_verdicts and cls:  # a bar of the verdict ("|z| ≤ 2") escaped, as md_cell does: one cell
+            return f'<span class="{cls}">{md_cell(html.escape(v))}</span>'
+        return md_cell(v)
 
     return comparison_table(rows, study=True, verdict=verdict)
 

@@ -15,12 +15,17 @@ _EXPORTS = {
     "least_squares_operator": "least_squares",
     "weighted_least_squares": "least_squares",
     "Verdict": "verdicts",
+    "REFERENCE_KINDS": "verdicts",
+    "claim_verdict": "verdicts",
     "comparison_row": "verdicts",
+    "reference_err": "verdicts",
+    "reference_kind": "verdicts",
     "half_unit": "verdicts",
     "quoted_verdict": "verdicts",
     "row_verdict": "verdicts",
     "verdict": "verdicts",
     "verdict_beside_authors": "verdicts",
+    "verdict_class": "verdicts",
 }
 
 __all__ = sorted(_EXPORTS)
