@@ -9,6 +9,7 @@ study's committed numbers JSON when the page is built::
     [[fig2:kappa_fit.c|value]], [[fig2:kappa_fit.c|err]]
     [[fig2:kappa_energy[energy=0.27].kappa|.4f]]      → a record of a list, chosen by a field
     [[fig5:paper_comparison[quantity=d_rel].verdict]] → a row's verdict, by the one rule
+    [[reading:fig5.premise]]                         → a generated reading (hhscatter.publish.readings)
 
 The reference is ``[[study[@scale]:path[|format]]]``:
 
@@ -389,6 +390,17 @@ def _rule_verdict(row: dict, scale) -> str:
     return row_verdict(row, scale) if "ours" in row else claim_verdict(row, scale)
 
 
+def _reading(root: Path, name: str) -> str:
+    """The sentence of reading ``name`` (:func:`hhscatter.publish.readings.reading`); NumberRefError when unknown or
+    when the numbers it reads are missing."""
+    from hhscatter.publish.readings import reading  # deferred: readings imports this module
+
+    try:
+        return reading(root, name.strip())
+    except (KeyError, StopIteration, TypeError, ValueError) as e:
+        raise NumberRefError(f"reading {name!r}: {e}") from None
+
+
 def render_refs(text: str, root: Path, *, where: str = "") -> str:
     """Every ``[[study:path]]`` of ``text`` (outside code) replaced by its number; NumberRefError names them all."""
     spans = _protected(text)
@@ -398,6 +410,8 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
         if any(a <= m.start() < b for a, b in spans):
             return m.group(0)
         try:
+            if m.group("study") == "reading":  # a generated reading (hhscatter.publish.readings)
+                return _reading(root, m.group("path"))
             doc, _ = load_numbers(root, m.group("study"), m.group("scale"))
             return format_ref(doc, m.group("path"), m.group("fmt"))
         except NumberRefError as e:
