@@ -38,7 +38,8 @@ syntax on these pages), so a reference may stand inside ``$…$`` maths too.
 
 :func:`stray_numbers` is the other half: it lists the numbers a page's prose
 types by hand that are neither references nor declared conventions
-(``<!-- conventions: … -->``); the docs tests fail on any.
+(``<!-- conventions: … -->``); the docs tests fail on any. :func:`typed_readings` does the same for readings (agrees, within a factor, holds,
+never, …), which a page names as ``[[reading:name]]`` (:mod:`hhscatter.publish.readings`).
 """
 
 from __future__ import annotations
@@ -65,6 +66,7 @@ __all__ = [
     "render_refs",
     "resolve",
     "stray_numbers",
+    "typed_readings",
 ]
 
 #: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine); the bar may
@@ -391,12 +393,12 @@ def _rule_verdict(row: dict, scale) -> str:
 
 
 def _reading(root: Path, name: str) -> str:
-    """The sentence of reading ``name`` (:func:`hhscatter.publish.readings.reading`); NumberRefError when unknown or
-    when the numbers it reads are missing."""
-    from hhscatter.publish.readings import reading  # deferred: readings imports this module
+    """The sentence of reading ``name`` (:func:`hhscatter.publish.readings.reading`) from the committed numbers under
+    ``root``; NumberRefError when unknown or when the numbers it reads are missing."""
+    from hhscatter.publish.readings import reading  # deferred: only pages with readings need it (numpy, scipy)
 
     try:
-        return reading(root, name.strip())
+        return reading(lambda study, scale: load_numbers(root, study, scale)[0], name.strip())
     except (KeyError, StopIteration, TypeError, ValueError) as e:
         raise NumberRefError(f"reading {name!r}: {e}") from None
 
@@ -574,3 +576,39 @@ def study_conventions(root: Path, study: str) -> set[float]:
         if path.is_file():
             out |= _paper_values(_load(str(path)))
     return {abs(v) for v in out}
+
+
+# -- readings typed by hand (hhscatter.publish.readings writes them) ---------------------------------------------------------------------------------------
+#: the words of a comparative or qualitative reading of results
+READING_WORDS = re.compile(
+    r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
+    r"best|worst|consistent(?:ly)? with)\b",
+    re.I,
+)
+_PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)
+_QUOTE = re.compile(r"\"[^\"]*\"|“[^”]*”")
+
+
+def typed_readings(text: str) -> list[tuple[int, str]]:
+    """typed_readings(page Markdown) -> [(line, phrase)] of the reading words its prose types by hand.
+
+    Not counted: ``[[…]]`` references (numbers and readings), code, HTML comments, quotes of the paper ("…"), and
+    the phrases a page declares as explanation or definition in a ``<!-- prose: "phrase"; "phrase" -->`` comment.
+
+    Examples
+    --------
+    >>> typed_readings('The ratio approaches 1. The paper says "μ approaches 1". [[reading:noise.kramers]]')
+    [(1, 'approaches')]
+    >>> typed_readings('<!-- prose: "never leave" -->\\nOrbits in the well can never leave.')
+    []
+    """
+    declared = [p.strip() for m in _PROSE.finditer(text) for p in re.findall(r"\"([^\"]+)\"", m.group(1))]
+    body = prose(text)
+    chars = list(body)
+    for rx in [_QUOTE] + [re.compile(re.escape(p)) for p in declared]:
+        for m in rx.finditer("".join(chars)):
+            for i in range(*m.span()):
+                if chars[i] != "\n":
+                    chars[i] = " "
+    body = "".join(chars)
+    return [(body.count("\n", 0, m.start()) + 1, m.group(0)) for m in READING_WORDS.finditer(body)]

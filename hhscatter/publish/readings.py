@@ -8,9 +8,8 @@ the distance's interval). Where the data do not support a reading, the sentence 
 
 The building blocks are pure functions of numbers (:func:`trend`, :func:`trend_words`, :func:`factor_words`,
 :func:`closer_words`, :func:`pass_fail_words`); :data:`READINGS` maps each name a page may use to the function that
-writes it from the studies' numbers. :func:`typed_readings` lists the reading words a page types by hand (outside
-references, code, comments, quotes of the paper and the definitions the page declares with
-``<!-- prose: … -->``); the docs tests fail on any, as they fail on a typed number.
+writes it from the studies' numbers. :func:`hhscatter.publish.numbers.typed_readings` lists the reading words a page
+types by hand; the docs tests fail on any, as they fail on a typed number.
 """
 
 from __future__ import annotations
@@ -18,7 +17,6 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
@@ -34,7 +32,6 @@ __all__ = [
     "reading",
     "trend",
     "trend_words",
-    "typed_readings",
 ]
 
 #: the p-value below which a goodness-of-fit test rejects
@@ -467,50 +464,17 @@ READINGS: dict[str, Callable[[Loader], str]] = {
 }
 
 
-def reading(root: Path, name: str) -> str:
-    """reading(repository root, name) -> the sentence of :data:`READINGS` ``name`` from the committed numbers (the
-    headline scale of each study); KeyError for a name it does not know."""
-    from hhscatter.publish.numbers import load_numbers  # deferred: numbers imports this module
-
-    if name not in READINGS:
-        raise KeyError(f"no reading {name!r} (known: {', '.join(sorted(READINGS))})")
-    text = READINGS[name](lambda study, scale: load_numbers(root, study, scale)[0])
-    return typographic_minus(text)  # a negative number with the minus sign, as every rendered number
-
-
-# -- readings typed by hand ---------------------------------------------------------------------------------------
-#: the words of a comparative or qualitative reading of results
-READING_WORDS = re.compile(
-    r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
-    r"best|worst|consistent(?:ly)? with)\b",
-    re.I,
-)
-_PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)
-_QUOTE = re.compile(r"\"[^\"]*\"|“[^”]*”")
-
-
-def typed_readings(text: str) -> list[tuple[int, str]]:
-    """typed_readings(page Markdown) -> [(line, phrase)] of the reading words its prose types by hand.
-
-    Not counted: ``[[…]]`` references (numbers and readings), code, HTML comments, quotes of the paper ("…"), and
-    the phrases a page declares as explanation or definition in a ``<!-- prose: "phrase"; "phrase" -->`` comment.
+def reading(get: Loader, name: str) -> str:
+    """reading(loader, name) -> the sentence of :data:`READINGS` ``name``, its negative numbers with the minus sign;
+    ``get(study, scale)`` returns a study's numbers JSON (``scale=None``: the headline scale). KeyError for a name it
+    does not know. Pages name readings as ``[[reading:name]]`` (:func:`hhscatter.publish.numbers.render_refs`).
 
     Examples
     --------
-    >>> typed_readings('The ratio approaches 1. The paper says "μ approaches 1". [[reading:noise.kramers]]')
-    [(1, 'approaches')]
-    >>> typed_readings('<!-- prose: "never leave" -->\\nOrbits in the well can never leave.')
-    []
+    >>> docs = {"noise": {"kramers": [{"barrier_over_T": x, "ratio": 0.9, "ratio_err": 0.01} for x in (3, 4, 5)]}}
+    >>> reading(lambda study, scale: docs[study], "noise.kramers")[:58]
+    'the ratio lies below 1 by more than 2σ at ΔE/T = 3, 4, 5; '
     """
-    from hhscatter.publish.numbers import prose  # deferred: numbers imports this module
-
-    declared = [p.strip() for m in _PROSE.finditer(text) for p in re.findall(r"\"([^\"]+)\"", m.group(1))]
-    body = prose(text)
-    chars = list(body)
-    for rx in [_QUOTE] + [re.compile(re.escape(p)) for p in declared]:
-        for m in rx.finditer("".join(chars)):
-            for i in range(*m.span()):
-                if chars[i] != "\n":
-                    chars[i] = " "
-    body = "".join(chars)
-    return [(body.count("\n", 0, m.start()) + 1, m.group(0)) for m in READING_WORDS.finditer(body)]
+    if name not in READINGS:
+        raise KeyError(f"no reading {name!r} (known: {', '.join(sorted(READINGS))})")
+    return typographic_minus(READINGS[name](get))  # a negative number with the minus sign, as every rendered number
