@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from hhscatter.publish.numbers import load_numbers, render_refs
+from hhscatter.publish.numbers import load_numbers, render_refs, typed_readings
 from hhscatter.publish.readings import (
     READINGS,
     closer_words,
@@ -17,7 +17,6 @@ from hhscatter.publish.readings import (
     pass_fail_words,
     trend,
     trend_words,
-    typed_readings,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -121,3 +120,25 @@ def test_the_resc_page_names_the_tools_own_default():
     assert "[[resc:default_r_esc.recommended]]; that is the tool's own default" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
+
+
+def _beyond_the_paper():
+    import tomllib
+
+    for page in PAGES:
+        about = tomllib.loads((page.parent / "study.toml").read_text())["about"]
+        if not about.get("paper"):
+            yield page
+
+
+@pytest.mark.parametrize("page", list(_beyond_the_paper()), ids=lambda p: p.parent.name)
+def test_a_page_beyond_the_paper_states_its_limits(page):
+    """A section "## Limits" that names the scale of its numbers (from the JSON), N and what the study does not
+    show."""
+    text = page.read_text()
+    assert "\n## Limits\n" in text, page.parent.name
+    section = text.split("\n## Limits\n", 1)[1].split("\n## ", 1)[0]
+    name = page.parent.name
+    assert f"[[{name}:scale]]" in section or f"[[{name}@" in section, "the scale, from the JSON"
+    assert "|int]]" in section, "N, from the JSON"
+    assert "does not show" in section
