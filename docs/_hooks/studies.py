@@ -417,6 +417,15 @@ class Renderer:
             text += "\n*Not yet generated: " + ", ".join(f"[{m}]({m}.md)" for m in missing) + ".*\n"
         return text
 
+    def headline_results(self, _arg=None) -> str:
+        """The README's results (tools/readme_results.md), its numbers and verdicts rendered from the committed JSON
+        as the README's are: the docs home opens with them."""
+        from hhscatter.publish.numbers import render_refs
+
+        text = (self.root / "tools" / "readme_results.md").read_text()
+        text = re.sub(r"\A<!--.*?-->\n", "", text, flags=re.S)  # the template's own note
+        return render_refs(text, self.root, where="tools/readme_results.md")
+
     def verdict_rule(self, _arg=None) -> str:
         """The one verdict rule, as the code states it (hhscatter.analysis.stats.verdicts.RULE)."""
         from hhscatter.analysis.stats.verdicts import RULE

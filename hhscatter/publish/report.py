@@ -17,6 +17,7 @@ import base64
 import datetime as _dt
 import html
 import json
+import os
 import shutil
 import sys
 from dataclasses import dataclass
@@ -33,7 +34,7 @@ from hhscatter.publish.formatting import (
     typographic_minus,
 )
 from hhscatter.studies import load_study, studies_root
-from hhscatter.studies.cost import summary
+from hhscatter.studies.cost import summary, totals
 from hhscatter.studies.graph import GraphError, scales
 from hhscatter.studies.graph import studies as study_folders
 from hhscatter.studies.jsonio import write_json_atomic
@@ -406,12 +407,78 @@ def build_report(scale: str = "quick", out: Path | None = None, root: Path | Non
     return {"html": out / "report.html", "markdown": out / "report.md", "missing": missing, "rows": len(rows)}
 
 
+def plan_line(scale: str = "quick", root: Path | None = None, cores: int | None = None) -> str:
+    """plan_line(scale, root=None, cores=None) -> what ``make report`` at ``scale`` will run before it writes, and
+    roughly how long.
+
+    As the Makefile decides: a scale with committed results (other than quick) runs no study; otherwise every
+    study without its figure in ``studies/<name>/out/<scale>/`` is run. The time is the CPU time of the committed cost records of that scale
+    (``docs/studies/assets[/<scale>]/<study>.cost.json``) over the cores; a study without a record is named. The
+    benchmarks whose summaries are missing run too (not timed). An unknown ``scale`` raises
+    :class:`~hhscatter.errors.StudyError`.
+    """
+    root = Path(root) if root is not None else studies_root()
+    try:
+        known = scales(root)
+    except GraphError as exc:
+        raise StudyError(str(exc)) from None
+    if scale not in known:
+        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
+    cores = cores or os.cpu_count() or 1
+    head = f"make report (SCALE={scale})"
+    committed = scale != "quick" and any(committed_assets(root, scale).glob("*.json"))
+    if committed:
+        absent = [i.name for i in study_folders(root) if None in _study_files(root, i.name, scale)[:2]]
+        return (
+            f"{head}: reads the committed {scale}-scale results and runs no study"
+            + (f" (no outputs for {', '.join(absent)}: the report lists them as missing)" if absent else "")
+            + "; then the benchmarks whose summaries are missing, then writes."
+        )
+    missing, cpu, unknown = [], 0.0, []
+    for info in study_folders(root):
+        if (root / info.name / "out" / scale / f"{info.name}.png").is_file():
+            continue
+        missing.append(info.name)
+        rec = committed_assets(root, scale) / f"{info.name}.cost.json"
+        if rec.is_file():
+            cpu += sum(t["cpu_s"] for t in totals(json.loads(rec.read_text())).values())
+        else:
+            unknown.append(info.name)
+    if not missing:
+        return (
+            f"{head}: every study's outputs are there; it runs the benchmarks whose summaries are missing, then writes."
+        )
+    timed = []
+    if len(unknown) < len(missing):
+        timed.append(
+            f"about {max(1, round(cpu / 60.0 / cores))} min on {cores} core{'s' * (cores > 1)} by the committed cost records"
+        )
+    if unknown:
+        timed.append(f"no cost record for {', '.join(unknown)} (its time is not known here)")
+    n = len(missing)
+    out = f"{head}: runs {n} stud{'y' if n == 1 else 'ies'} first ({', '.join(missing)}): {'; '.join(timed)}; "
+    out += "then the benchmarks whose summaries are missing, then writes."
+    if scale == "quick":
+        out += " SCALE=paper reads the committed paper-scale results instead."
+    return out
+
+
 def main(argv=None) -> int:
 
     p = argparse.ArgumentParser(prog="python -m hhscatter.publish.report", description=__doc__.splitlines()[0])
     p.add_argument("--scale", default="quick")
     p.add_argument("--out", help="output folder (default reports/<scale>)")
+    p.add_argument(
+        "--plan", action="store_true", help="say what the report will run and roughly how long; write nothing"
+    )
     a = p.parse_args(argv)
+    if a.plan:
+        try:
+            print(plan_line(a.scale))
+        except StudyError as exc:
+            print(f"report: error: {exc}", file=sys.stderr)
+            return exc.exit_code
+        return 0
     try:
         res = build_report(a.scale, a.out)
     except StudyError as exc:
