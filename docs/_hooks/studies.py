@@ -137,17 +137,17 @@ class Renderer:
                 f"Run `make {study}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
 
-        def one(path, alt, caption):
+        def one(path, alt, caption, cls="hh-figure"):
             src = self._rel(path)
             return (
-                f'<figure class="hh-figure" markdown="span">\n[![{alt}]({src})]({src}){{ .hh-zoom }}\n'
+                f'<figure class="{cls}" markdown="span">\n[![{alt}]({src})]({src}){{ .hh-zoom }}\n'
                 f"<figcaption>{caption} (click to zoom)</figcaption>\n</figure>\n"
             )
 
         def figure(path, scale, cmd):
             """The figure at one scale; a multi-panel figure whose plot stage wrote its panels one by one
-            (``<name>_panel_<letter>.png``, hhscatter.publish.figures.save_panels) panel by panel, each at the full
-            width of the text, the composite folded below them."""
+            (``<name>_panel_<letter>.png``, hhscatter.publish.figures.save_panels) panel by panel, each at its natural
+            width (at most the text's: a panel is never upscaled), the composite folded below them."""
             whole = one(path, f"{name}, {scale} scale", f"{scale.capitalize()} scale: <code>{cmd}</code>")
             panels = sorted(path.parent.glob(f"{path.stem}_panel_*.png"))
             if not panels:
@@ -157,6 +157,7 @@ class Renderer:
                     p,
                     f"{name}, panel ({p.stem[-1]}), {scale} scale",
                     f"({p.stem[-1]}) {scale} scale: <code>{cmd}</code>",
+                    "hh-figure hh-panel",  # at its natural width (never upscaled), at most the text's
                 )
                 for p in panels
             )

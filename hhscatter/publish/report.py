@@ -18,6 +18,7 @@ import datetime as _dt
 import html
 import json
 import os
+import re
 import shutil
 import sys
 from dataclasses import dataclass
@@ -31,6 +32,7 @@ from hhscatter.publish.formatting import (
     format_value,
     markdown_to_html,
     md_cell,
+    scripts_to_html,
     typographic_minus,
 )
 from hhscatter.studies import load_study, studies_root
@@ -367,12 +369,66 @@ pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 """
 
 
+_EQ_HEADING = re.compile(r"^###\s+\(([A-Z]?\d+)\).*\{#([\w-]+)\}\s*$", re.M)
+_EQ_REF = re.compile(r"\((eqn?:[\w-]+)\)")
+_CODE_HTML = re.compile(r"(<pre\b.*?</pre>|<code\b.*?</code>)", re.S)
+
+
+def equation_numbers(root: Path) -> dict[str, str]:
+    """equation_numbers(studies root) -> {'eqn:surv_prob_model': '18', …}: the paper's equation labels and their
+    numbers, from the ``### (N) … {#eqn-…}`` headings of the repository's docs/equations.md (empty without it), as
+    the docs site numbers them.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> equation_numbers(Path("/nonexistent/studies"))
+    {}
+    """
+    path = Path(root).parent / "docs" / "equations.md"
+    if not path.is_file():
+        return {}
+    return {anchor.replace("-", ":", 1): num for num, anchor in _EQ_HEADING.findall(path.read_text())}
+
+
+def number_equations(html_text: str, numbers: dict) -> str:
+    """number_equations(html, {label: number}) -> the equation labels "(eqn:…)" written as the site writes them,
+    "(18)", outside code; a label without a number stays as written.
+
+    Examples
+    --------
+    >>> number_equations("Eq. (eqn:surv_prob_model), <code>(eqn:x)</code>", {"eqn:surv_prob_model": "18"})
+    'Eq. (18), <code>(eqn:x)</code>'
+    """
+    parts = _CODE_HTML.split(html_text)
+    for i in range(0, len(parts), 2):  # even indices: outside code
+        parts[i] = _EQ_REF.sub(lambda m: f"({numbers[m.group(1)]})" if m.group(1) in numbers else m.group(0), parts[i])
+    return "".join(parts)
+
+
+def scripts_outside_code(html_text: str) -> str:
+    """scripts_outside_code(html) -> ``e^{−μγt}`` as ``e<sup>−μγt</sup>`` and ``μ_c^{E1}`` alike outside code, as the
+    docs site sets them (:func:`hhscatter.publish.formatting.scripts_to_html`).
+
+    Examples
+    --------
+    >>> scripts_outside_code("E0 e^{−μγt} <code>x^{2}</code>")
+    'E0 e<sup>−μγt</sup> <code>x^{2}</code>'
+    """
+    parts = _CODE_HTML.split(html_text)
+    for i in range(0, len(parts), 2):
+        parts[i] = scripts_to_html(parts[i])
+    return "".join(parts)
+
+
 def render_html(sections, scale, root) -> str:
     """render_html(sections, scale, root) -> one self-contained HTML page: the report's Markdown (figures as
-    data URIs) rendered by Python-Markdown."""
+    data URIs) rendered by Python-Markdown; the paper's equation labels numbered and ``^{…}``/``_{…}`` set as
+    superscripts and subscripts, as on the docs site."""
     body = markdown_to_html(
         render_markdown(sections, scale, root, lambda path, name: _img_uri(path), html_verdicts=True)
     )
+    body = scripts_outside_code(number_equations(body, equation_numbers(root)))
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
         f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n"

@@ -208,3 +208,23 @@ def test_make_report_says_what_it_will_run_and_how_long(tmp_path):
     assert "rep6" not in line
     with pytest.raises(StudyError, match="scale must be one of"):
         plan_line("bogus", root=root)
+
+
+def test_the_report_html_numbers_equations_as_the_site(tmp_path):
+    """The report's HTML writes the paper's equation labels as the docs site does, "(18)", from docs/equations.md,
+    and a formula's ^{…} as a superscript."""
+    root = tmp_path / "studies"
+    row = {
+        "quantity": "f_ne",
+        "ours": 0.2,
+        "err": 0.01,
+        "paper": None,
+        "verdict": "",
+        "note": "Eq. (eqn:surv_prob_model), E0 e^{−μγt}",
+    }
+    _fake_study(root, "rep7", [row])
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "equations.md").write_text("### (18) Survival model {#eqn-surv_prob_model}\n")
+    page = build_report("quick", out=tmp_path / "rep", root=root)["html"].read_text()
+    assert "Eq. (18)" in page and "eqn:surv_prob_model" not in page
+    assert "E0 e<sup>−μγt</sup>" in page and "^{" not in page
