@@ -397,8 +397,8 @@ def number_equations(html_text: str, numbers: dict) -> str:
 
     Examples
     --------
-    >>> number_equations("Eq. (eqn:surv_prob_model), <code>(eqn:x)</code>", {"eqn:surv_prob_model": "18"})
-    'Eq. (18), <code>(eqn:x)</code>'
+    >>> number_equations("Eq. (eqn:surv_prob_model), <code>(eqn:surv_prob_model)</code>", {"eqn:surv_prob_model": "18"})
+    'Eq. (18), <code>(eqn:surv_prob_model)</code>'
     """
     parts = _CODE_HTML.split(html_text)
     for i in range(0, len(parts), 2):  # even indices: outside code
