@@ -75,7 +75,7 @@ demo: $(RUNS)/demo/survival.png ## run two small real scenes (1e5 orbits each), 
 SCALE ?= quick
 HH := $(VENV)/bin/hhscatter
 # the library code an analysis or a plot runs, subpackages included (an edit there makes the outputs out of date)
-ANALYSIS_SRC := $(shell find hhscatter/analysis hhscatter/data hhscatter/model hhscatter/scene hhscatter/studies -name '*.py')
+ANALYSIS_SRC := $(shell find hhscatter/analysis hhscatter/reproduction hhscatter/data hhscatter/model hhscatter/scene hhscatter/studies -name '*.py')
 PLOT_SRC := $(shell find hhscatter/publish -name '*.py')
 so = studies/$(1)/out/$(SCALE)
 study_code = $(wildcard studies/$(1)/*.py)

@@ -41,5 +41,27 @@ def test_the_check_sees_an_upward_import():
         "hhscatter.cli": {"hhscatter.publish.report"},
     }
     assert lm.layer_violations(graph) == [
-        "hhscatter.data.tables -> hhscatter.analysis.survival.kaplan_meier (layer data may not import layer analysis)"
+        "hhscatter.data.tables -> hhscatter.analysis.survival.kaplan_meier (layer data may not import layer analysis.survival)"
     ]
+
+
+def test_the_check_sees_an_upward_import_between_analysis_subpackages():
+    graph = {
+        "hhscatter.analysis.survival.long_time": {"hhscatter.analysis.dissipative.decay"},
+        "hhscatter.analysis.dissipative.decay": {"hhscatter.analysis.survival.kaplan_meier"},
+        "hhscatter.analysis.survival.kaplan_meier": {"hhscatter.analysis.stats.intervals"},
+        "hhscatter.analysis.geometry.channels": {"hhscatter.reproduction.fig2"},
+        "hhscatter.analysis.stats.intervals": set(),
+    }
+    assert lm.layer_violations(graph) == [
+        "hhscatter.analysis.geometry.channels -> hhscatter.reproduction.fig2 "
+        "(layer analysis.geometry may not import layer reproduction)",
+        "hhscatter.analysis.survival.long_time -> hhscatter.analysis.dissipative.decay "
+        "(layer analysis.survival may not import layer analysis.dissipative)",
+    ]
+
+
+def test_analysis_subpackages_are_layers_of_their_own():
+    assert lm.layer_of("hhscatter.analysis.geometry.basins") == "analysis.geometry"
+    assert lm.layer_of("hhscatter.analysis") == "analysis" and lm.layer_of("hhscatter._exports") == "_exports"
+    assert lm.layer_of("hhscatter.reproduction.claims.kappa") == "reproduction"

@@ -206,30 +206,48 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
 
 
 # The layers of hhscatter, bottom up, and the layers each may import (besides itself). A module's layer is its
-# first package component below hhscatter (``hhscatter.scene.grid`` -> ``scene``); ``errors`` and ``outcomes``
-# are the bottom.
-BASE = {"errors", "outcomes", "_version"}  # what every layer shares: the error family, the outcome names,
-# the version
+# first package component below hhscatter (``hhscatter.scene.grid`` -> ``scene``); inside ``analysis`` it is the
+# subpackage (``hhscatter.analysis.survival.fits`` -> ``analysis.survival``), so that the estimators are layered
+# too: stats -> survival -> {dissipative, noise} -> geometry. ``errors`` and ``outcomes`` are the bottom.
+BASE = {"errors", "outcomes", "_version", "_exports"}  # what every layer shares: the error family, the outcome names,
+# the version, the lazy exports of a package
+ANALYSIS_ORDER = {  # the subpackages of analysis and the subpackages each may import (besides itself)
+    "stats": set(),
+    "survival": {"stats"},
+    "dissipative": {"stats", "survival"},
+    "noise": {"stats", "survival"},
+    "geometry": {"stats", "survival", "noise"},
+}
+ANALYSIS = {"analysis"} | {f"analysis.{sub}" for sub in ANALYSIS_ORDER}  # the package door and its subpackages
 LAYERS = {
     "errors": set(),
     "outcomes": set(),
     "_version": set(),
+    "_exports": set(),
     "model": BASE,
     "scene": BASE | {"model"},
     "integrate": BASE | {"model", "scene"},
     "data": BASE | {"model", "scene"},
     "run": BASE | {"model", "scene", "integrate", "data"},
     "analysis": BASE | {"model"},
-    "api": BASE | {"model", "scene", "data", "run", "analysis"},
-    "studies": BASE | {"model", "scene", "integrate", "data", "run", "analysis", "api"},
-    "publish": BASE | {"model", "scene", "data", "analysis", "api", "studies"},
+    **{
+        f"analysis.{sub}": BASE | {"model", "analysis"} | {f"analysis.{d}" for d in below}
+        for sub, below in ANALYSIS_ORDER.items()
+    },
+    "reproduction": BASE | {"model"} | ANALYSIS,
+    "api": BASE | {"model", "scene", "data", "run"} | ANALYSIS,
+    "studies": BASE | {"model", "scene", "integrate", "data", "run", "api", "reproduction"} | ANALYSIS,
+    "publish": BASE | {"model", "scene", "data", "api", "studies", "reproduction"} | ANALYSIS,
 }
 TOP = {"", "__main__", "cli"}  # the package's door and the CLI may import any layer
 
 
 def layer_of(mod: str, package: str = "hhscatter") -> str:
-    rest = mod[len(package) + 1 :] if mod.startswith(package + ".") else ""
-    return rest.split(".")[0]
+    """The layer of module ``mod``: its first component below ``package``, the subpackage inside analysis."""
+    parts = (mod[len(package) + 1 :] if mod.startswith(package + ".") else "").split(".")
+    if parts[0] == "analysis" and len(parts) > 1 and parts[1] in ANALYSIS_ORDER:
+        return f"analysis.{parts[1]}"
+    return parts[0]
 
 
 def layer_violations(graph: dict[str, set[str]], package: str = "hhscatter") -> list[str]:

@@ -36,8 +36,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.geometry import basin_summary as bs
-from hhscatter.analysis.geometry.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
+from hhscatter.reproduction import basin_summary as bs
+from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 
 

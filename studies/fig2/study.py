@@ -3,7 +3,7 @@
 ``simulate``: per grid energy a pilot fixes t_max (:func:`~hhscatter.analysis.survival.escape_rate.choose_t_max`),
 then the κ(E) run (``grid_E…``; the authors' square ICs too at ``square_energies``, ``sq_grid_E…``); the Fig. 2a
 runs (``pt_E…``, t_max = ``pt_t_max`` so that the sticky tail shows); the c-measure runs (``cm_E…``): every section
-crossing in the window :func:`~hhscatter.analysis.survival.summaries.cmeasure_windows` makes of the grid run's κ
+crossing in the window :func:`~hhscatter.reproduction.escape_summaries.cmeasure_windows` makes of the grid run's κ
 and τ0, orbits run to ``cm_t_max`` so that KAM-trapped ones are recognised. The choices go to
 ``raw/fig2_choices.json``.
 
@@ -22,7 +22,17 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from hhscatter.analysis.survival.paper_fig2 import (
+from hhscatter.analysis.survival.kappa_energy import kappa_law_summary
+from hhscatter.reproduction.escape_summaries import (
+    cmeasure_windows,
+    kappa_cmeasure_z,
+    kappa_law_curves,
+    rate_row,
+    rate_summary,
+    sticky_tail_summary,
+    survival_tables,
+)
+from hhscatter.reproduction.fig2 import (
     FIG2_CONVENTIONS,
     FIG2_RULES,
     PAPER_FIG2,
@@ -31,16 +41,6 @@ from hhscatter.analysis.survival.paper_fig2 import (
     convention_numbers,
     law_comparisons,
     pt_comparisons,
-)
-from hhscatter.analysis.survival.summaries import (
-    cmeasure_windows,
-    kappa_cmeasure_z,
-    kappa_law_curves,
-    kappa_law_summary,
-    rate_row,
-    rate_summary,
-    sticky_tail_summary,
-    survival_tables,
 )
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams

@@ -36,7 +36,7 @@ authors' reading (default: the paper's own words, every orbit inside Ω on
 of the bootstrap error, or within 2σ plus half a unit of the last digit the
 paper quotes (0.91 stands for [0.905, 0.915]); our row's "differs" names an
 authors'-convention row that agrees, if there is one
-(:func:`~hhscatter.analysis.dissipative.paper_fig3.authors_convention`).
+(:func:`~hhscatter.reproduction.fig3.authors_convention`).
 
 Stages: ``simulate`` (one engine run with snapshots on the grid, settled
 orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
@@ -52,7 +52,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
-from hhscatter.analysis.dissipative.paper_fig3 import (
+from hhscatter.reproduction.fig3 import (
     add_bootstrap_errors,
     authors_convention,
     fit_windows,

@@ -49,7 +49,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
-from hhscatter.analysis.dissipative.transition_tables import (
+from hhscatter.reproduction.transition_tables import (
     survival_ratio_tables,
     transition_comparisons,
     transition_table,
@@ -117,8 +117,8 @@ def analyze(study):
 
     Steps: the paired lifetimes (:func:`_read_lifetimes`), P(t) on the τ grid and
     τ0, the study's own μ (:func:`_own_mu`), the paired bootstrap, the τ table
-    (:func:`~hhscatter.analysis.dissipative.transition_tables.transition_table`), the figure's tables, the
-    paper comparison (:func:`~hhscatter.analysis.dissipative.transition_tables.transition_comparisons`) and
+    (:func:`~hhscatter.reproduction.transition_tables.transition_table`), the figure's tables, the
+    paper comparison (:func:`~hhscatter.reproduction.transition_tables.transition_comparisons`) and
     the numbers (:func:`_numbers`).
     """
     from hhscatter.analysis.dissipative.transitions import bootstrap_transition_times, survival_on_grid

@@ -71,9 +71,9 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import time_to_energy
-from hhscatter.analysis.geometry import cmeasure_comparison as cc
-from hhscatter.analysis.geometry import cmeasure_verdicts as cv
 from hhscatter.analysis.geometry import distance as dist
+from hhscatter.reproduction import cmeasure_comparison as cc
+from hhscatter.reproduction import cmeasure_verdicts as cv
 from hhscatter.scene.scene import MOMENTA
 from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
 from hhscatter.studies import _upstream as up
@@ -223,7 +223,7 @@ VERDICT_ROWS = (
 def _verdict_5b(study, cm_full, E1, ours):
     """The 5b − 5a verdict in every construction of VERDICT_ROWS: debiased Hellinger distances to μ_c^{E1} at
     box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every set, the
-    reference included (:func:`~hhscatter.analysis.geometry.cmeasure_comparison.paired_differences`). Sets of one
+    reference included (:func:`~hhscatter.reproduction.cmeasure_comparison.paired_differences`). Sets of one
     comparison are cut alike. Returns the JSON record (rows with a note where the sets are too small)."""
     s = cc.ComparisonSettings.from_params(study.params)
     ref_all = cc.cap_rows(cm_full, s.n_cap, s.seed)
@@ -260,7 +260,7 @@ def _verdict_5b(study, cm_full, E1, ours):
 
 def _refs_paired(study, cm_full, sets_ours, E1, E2):
     """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired
-    (:func:`~hhscatter.analysis.geometry.cmeasure_comparison.paired_reference_distances`), in two constructions,
+    (:func:`~hhscatter.reproduction.cmeasure_comparison.paired_reference_distances`), in two constructions,
     each cut alike: ours (γ = gamma_main, no cut) and the authors' (their two runs, r < r_cut on every set).
     Returns the JSON record; the curves are panel (c)."""
     s = cc.ComparisonSettings.from_params(study.params)
@@ -357,8 +357,8 @@ def analyze(study):
 
     Steps: μ from the study [needs].mu (:func:`_mu`), the c-measure samples (:func:`_cmeasure_points`), the
     Fig. 5a/b point sets per γ (:func:`_point_sets`), the distances at one common split-half sample size
-    (:mod:`hhscatter.analysis.geometry.cmeasure_comparison`), the paired verdicts and the paper comparison
-    (:mod:`hhscatter.analysis.geometry.cmeasure_verdicts`).
+    (:mod:`hhscatter.reproduction.cmeasure_comparison`), the paired verdicts and the paper comparison
+    (:mod:`hhscatter.reproduction.cmeasure_verdicts`).
     """
     inputs = {}
     E2 = float(study.config["scene"]["energy"])
@@ -446,7 +446,7 @@ def _mu(study, inputs):
 def _point_sets(study, gammas, E1, E2, mu, mu_err):
     """({(γ, 'a'|'b'): points}, per-γ DataFrame, point tables): the first crossing after t* of each surviving
     orbit (Fig. 5a) and those in the energy band (Fig. 5b), capped at n_cap points
-    (:func:`~hhscatter.analysis.geometry.cmeasure_comparison.crossing_sets`)."""
+    (:func:`~hhscatter.reproduction.cmeasure_comparison.crossing_sets`)."""
     import pyarrow.dataset as pads
 
     from hhscatter.data.read import read_lifetimes, read_sections

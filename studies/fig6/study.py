@@ -52,10 +52,10 @@ import pandas as pd
 
 from hhscatter.analysis.dissipative import mixture
 from hhscatter.analysis.dissipative import model_comparison as mc
-from hhscatter.analysis.dissipative import model_tables as mt
-from hhscatter.analysis.dissipative import model_verdicts as mv
 from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.reproduction import model_tables as mt
+from hhscatter.reproduction import model_verdicts as mv
 from hhscatter.scene.schema import (
     Bool,
     Integer,

@@ -4,7 +4,7 @@ The paper concludes with "a generally-applicable model for the study of dissipat
 Hénon–Heiles only. This study runs the same chain, the system a parameter of every stage (``[study] systems``), at
 energies placed alike relative to each threshold (E = r·E_c), ICs alike (disk r < radius_frac·r_s, tangential
 momenta), linear drag. Rules in the header of ``studies/generality/study.toml``; the science in
-:mod:`hhscatter.analysis.claims` (this module runs and reads, the library analyses).
+:mod:`hhscatter.reproduction.claims` (this module runs and reads, the library analyses).
 
 ``simulate`` — ``[study] parts``: "claims": per system the κ0(E) runs ``<label>_r<r>``, the probe runs
 ``<label>_probe_r<r>``, the dissipative runs ``<label>_g<γ>`` at E0, the section runs ``<label>_cm_r<r>`` and
@@ -25,8 +25,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.claims.chain import analyze_claims, analyze_evidence, check_params
-from hhscatter.analysis.claims.keys import (
+from hhscatter.reproduction.claims.chain import analyze_claims, analyze_evidence, check_params
+from hhscatter.reproduction.claims.keys import (
     alt_key,
     cm_key,
     cm_ratios,
@@ -38,7 +38,7 @@ from hhscatter.analysis.claims.keys import (
     resc_key,
     sec_key,
 )
-from hhscatter.analysis.claims.resc import resc_values
+from hhscatter.reproduction.claims.resc import resc_values
 from hhscatter.scene.scene import MOMENTA, REGIONS
 from hhscatter.scene.schema import (
     Integer,
@@ -149,8 +149,8 @@ def _systems(study):
 # ---------------------------------------------------------------------------
 def simulate(study, workers=None, progress=True):
     """simulate(study, workers=None, progress=True) -> None: per system the κ0(E), probe and dissipative runs."""
-    from hhscatter.analysis.claims.cmeasure import c5_window
     from hhscatter.analysis.dissipative.decay import snapshot_grid
+    from hhscatter.reproduction.claims.cmeasure import c5_window
 
     check_params(study.params)
     p = study.params
@@ -231,7 +231,7 @@ def _lifetimes(path):
 
 
 class _Runs:
-    """The study's raw runs as the claims' analysis reads them (:mod:`hhscatter.analysis.claims`): params and the
+    """The study's raw runs as the claims' analysis reads them (:mod:`hhscatter.reproduction.claims`): params and the
     tables of a run key, read with only the rows the analysis uses (pushed-down filters)."""
 
     def __init__(self, study):

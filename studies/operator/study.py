@@ -25,6 +25,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
+from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
 
@@ -377,7 +378,7 @@ def _fig2_kappa(study, inputs):
         "true-time relation on long-run section crossings)"
     }
     try:
-        return uc.kappa_references(up.numbers(study, other))
+        return kappa_references(up.numbers(study, other))
     except KeyError:
         raise up.UpstreamError(f"{other}.json has no list 'kappa_energy'") from None
 

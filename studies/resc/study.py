@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.survival.escape_criterion import (
+from hhscatter.reproduction.escape_criterion import (
     channel_rows,
     common_window,
     criterion_numbers,
@@ -133,7 +133,7 @@ def analyze(study):
 
     Steps per energy: the paired runs (:func:`_paired_runs`), the common κ window, the follow runs' returns
     (:func:`_follow_returns`), then per r_esc the κ row, the returns row and the exit channels; then the numbers
-    and the comparison (:mod:`hhscatter.analysis.survival.escape_criterion`).
+    and the comparison (:mod:`hhscatter.reproduction.escape_criterion`).
     """
     energies, radii = _grid(study)
     r_ref = study.params.r_ref

@@ -4,10 +4,14 @@ import importlib
 
 import pytest
 
+PACKAGES = [f"hhscatter.analysis.{sub}" for sub in ("stats", "survival", "dissipative", "geometry", "noise")] + [
+    "hhscatter.reproduction.claims"
+]
 
-@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims", "noise"])
-def test_subpackage_exports_its_modules_public_names(sub):
-    pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
+
+@pytest.mark.parametrize("name", PACKAGES)
+def test_subpackage_exports_its_modules_public_names(name):
+    pkg = importlib.import_module(name)
     assert pkg.__all__ and set(pkg.__all__) <= set(dir(pkg))
     for name in pkg.__all__:
         obj = getattr(pkg, name)
@@ -23,12 +27,32 @@ def test_a_name_is_exported_from_the_module_that_defines_it():
     assert survival._EXPORTS["survival_curve"] == "kaplan_meier" and geometry._EXPORTS["UnitSet"] == "paired_distance"
 
 
-@pytest.mark.parametrize("sub", ["stats", "survival", "dissipative", "geometry", "claims", "noise"])
-def test_every_name_a_module_declares_in_all_exists(sub):
+@pytest.mark.parametrize("name", PACKAGES)
+def test_every_name_a_module_declares_in_all_exists(name):
     import pkgutil
 
-    pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
+    pkg = importlib.import_module(name)
     for info in pkgutil.iter_modules(pkg.__path__):
         mod = importlib.import_module(f"{pkg.__name__}.{info.name}")
         missing = [n for n in getattr(mod, "__all__", []) if not hasattr(mod, n)]
         assert not missing, (mod.__name__, missing)
+
+
+def test_the_export_map_is_generated_from_what_the_modules_define(tmp_path):
+    """A new public function is exported by defining it; private names, imports and module names are not."""
+    from hhscatter._exports import module_exports
+
+    (tmp_path / "rates.py").write_text("import math\nfrom os import path\nK = 1\n_P = 2\ndef rate(): ...\n")
+    (tmp_path / "fits.py").write_text("def fit(): ...\ndef rates(): ...\nclass Fit: ...\n")
+    (tmp_path / "_private.py").write_text("def hidden(): ...\n")
+    assert module_exports(tmp_path) == {"Fit": "fits", "K": "rates", "fit": "fits", "rate": "rates"}
+    (tmp_path / "more.py").write_text("def rate(): ...\n")
+    with pytest.raises(ValueError, match="'rate' is defined by two modules"):
+        module_exports(tmp_path)
+
+
+def test_every_public_function_of_a_module_is_exported():
+    from hhscatter.analysis import survival
+
+    assert survival._EXPORTS["kappa_law_summary"] == "kappa_energy"
+    assert survival._EXPORTS["binned_hazard"] == "effective_rate"

@@ -48,7 +48,7 @@ def test_an_error_passes_through_and_the_warnings_before_it_are_kept():
 
 def test_a_claims_rate_counts_what_its_fit_warns(monkeypatch):
     """The claims' escape rate used to silence its fit's warnings; now they reach the tally under its name."""
-    from hhscatter.analysis.claims import kappa
+    from hhscatter.reproduction.claims import kappa
 
     def warns(*a, **k):
         warnings.warn("Covariance of the parameters could not be estimated", RuntimeWarning, stacklevel=2)

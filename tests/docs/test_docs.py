@@ -427,7 +427,7 @@ def test_citation_and_licence_agree_with_pyproject():
 def test_every_library_module_has_an_api_page():
     """A study page may link any analysis function; mkdocs --strict fails on a module without a page (seen:
     two new modules linked from a study page), so every module of the layers has one."""
-    documented = set()
+    documented = set(_load(DOCS / "_hooks" / "api_pages.py", "hh_api_pages").api_pages().values())
     for md in DOCS.rglob("*.md"):
         documented |= set(re.findall(r"^::: ([\w.]+)", md.read_text(), flags=re.M))
     missing = []
@@ -442,6 +442,57 @@ def test_every_library_module_has_an_api_page():
         if len(parts) > 1 and ".".join(parts) not in documented and ".".join(parts) != "hhscatter.analysis":
             missing.append(".".join(parts))
     assert not missing, f"modules without an API page (docs/api/...md with '::: module'): {missing}"
+
+
+def test_api_pages_and_their_navigation_are_generated_from_the_package(tmp_path):
+    """A new module gets a page and a navigation line without a file under docs/; the layers keep their order."""
+    gen = _load(DOCS / "_hooks" / "api_pages.py", "hh_api_pages")
+    pkg = tmp_path / "pkg"
+    for rel in (
+        "__init__.py",
+        "cli.py",
+        "errors.py",
+        "_private.py",
+        "analysis/__init__.py",
+        "analysis/survival/__init__.py",
+        "analysis/survival/rates.py",
+        "analysis/stats/__init__.py",
+        "analysis/stats/intervals.py",
+        "analysis/_exports.py",
+        "model/__init__.py",
+        "model/base.py",
+    ):
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text("")
+    pages = gen.api_pages(tmp_path, "pkg")
+    assert pages == {
+        "api/errors.md": "pkg.errors",
+        "api/analysis/index.md": "pkg.analysis",
+        "api/analysis/stats/index.md": "pkg.analysis.stats",
+        "api/analysis/stats/intervals.md": "pkg.analysis.stats.intervals",
+        "api/analysis/survival/index.md": "pkg.analysis.survival",
+        "api/analysis/survival/rates.md": "pkg.analysis.survival.rates",
+        "api/model/index.md": "pkg.model",
+        "api/model/base.md": "pkg.model.base",
+    }
+    order = ["errors", "model", "analysis", "analysis.stats", "analysis.survival"]
+    assert gen.api_nav(pages, order, "pkg") == [
+        "api/index.md",
+        {"pkg.errors": "api/errors.md"},
+        {"pkg.model": ["api/model/index.md", {"base": "api/model/base.md"}]},
+        {
+            "pkg.analysis": [
+                "api/analysis/index.md",
+                {"stats": ["api/analysis/stats/index.md", {"intervals": "api/analysis/stats/intervals.md"}]},
+                {"survival": ["api/analysis/survival/index.md", {"rates": "api/analysis/survival/rates.md"}]},
+            ]
+        },
+    ]
+    assert (
+        gen.page_text("api/model/base.md", "pkg.model.base")
+        == "::: pkg.model.base\n    options:\n      heading_level: 1\n"
+    )
+    assert "members: false" in gen.page_text("api/model/index.md", "pkg.model")
 
 
 @pytest.mark.parametrize(

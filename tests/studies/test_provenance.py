@@ -213,7 +213,7 @@ def test_an_edit_anywhere_in_the_library_an_analysis_runs_remakes_the_study(tmp_
         return subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=120).stdout
 
     assert "hhscatter study" not in dry()  # up to date
-    for edited in ("hhscatter/analysis/geometry/channels.py", "hhscatter/analysis/survival/escape_criterion.py"):
+    for edited in ("hhscatter/analysis/geometry/channels.py", "hhscatter/reproduction/escape_criterion.py"):
         out = dry(edited)
         assert "study resc analyze --scale tiny" in out and "simulate" not in out, (edited, out)
     out = dry("hhscatter/publish/figures.py")

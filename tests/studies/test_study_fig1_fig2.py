@@ -149,7 +149,7 @@ def test_recording_rules_closed_form():
     from hhscatter.studies import stage_module
 
     contour_levels, recording_time = stage_module("fig1").contour_levels, stage_module("fig1").recording_time
-    from hhscatter.analysis.survival.summaries import cmeasure_windows
+    from hhscatter.reproduction.escape_summaries import cmeasure_windows
 
     assert recording_time(0.2, 3.4, 4.0) == 24.0  # ceil(3.4 + 20)
     t_rec, t_s, t_e = cmeasure_windows(0.25, 2.5, 2.0, 2.0, 40.0, 1.0)

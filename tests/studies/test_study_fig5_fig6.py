@@ -315,7 +315,7 @@ def test_fig5_sensitivity_runs_are_the_authors_runs_with_random_momenta(tiny_stu
 def test_fig6_paper_constant_kappa_law_is_the_fig2b_caption():
     """κ0(E) built from study.toml's paper_* keys against the caption of the paper's Fig. 2b, by hand:
     13.63 x² + 0.03 x below E = 0.27 and 1.41 x from there on, x = E − 1/6; no escape at or below E_c."""
-    from hhscatter.analysis.dissipative.model_tables import kappa_from_constants
+    from hhscatter.reproduction.model_tables import kappa_from_constants
     from hhscatter.studies import load_study, stage_module
 
     mod = stage_module("fig6")

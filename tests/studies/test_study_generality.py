@@ -244,7 +244,7 @@ def test_claim5_committed_verdicts_state_the_sign_of_the_paired_interval(scale):
 
 
 class _TinyRuns:
-    """The raw runs of the tiny build as the claims' analysis reads them (hhscatter.analysis.claims.chain)."""
+    """The raw runs of the tiny build as the claims' analysis reads them (hhscatter.reproduction.claims.chain)."""
 
     def __init__(self, out, params):
         self.raw, self.params = out / "raw", params
@@ -281,8 +281,8 @@ def test_claims_do_not_depend_on_the_order_of_the_systems(tiny):
     """The claims analysed on the tiny runs with the systems in the study's order and in the reverse order: every
     record (verdict, value, error, reference, note) the same, claim 6 judged against Hénon–Heiles (last in the
     reverse order). The library's verdicts are compared: the tiny JSON states none."""
-    from hhscatter.analysis.claims.chain import analyze_claims
     from hhscatter.model.spec import system_from_spec
+    from hhscatter.reproduction.claims.chain import analyze_claims
     from hhscatter.studies import load_study
 
     out, doc = tiny

@@ -1,4 +1,6 @@
-"""Energy decay of the dissipative ensemble (paper Sec. III.A.1, Fig. 3 = fig:energy_decay).
+"""Energy decay of a dissipative ensemble: E(t), the decay exponent μ, energy histograms.
+
+Reference: Sec. III.A.1 and fig:energy_decay of arXiv:2308.13555.
 
 With linear drag the energy of every orbit decays as dE/dt = −γ v², Eq.
 (eqn:energy_diffeq).  Approximating the potential, on average along an orbit,

@@ -1,5 +1,6 @@
-"""Mixture model (the paper's proposed extension, end of Sec. III.B.3)
--------------------------------------------------------------------
+"""Mixture survival model: sub-ensembles of a dissipative ensemble, each with its own energy decay.
+
+Reference: the extension proposed at the end of Sec. III.B.3 of arXiv:2308.13555:
 "An improved agreement would be obtained by avoiding the approximation of
 homogeneous energy decay ... a mixture model for P(t) involving multiple
 sub-ensembles, each with their own energy decay exponent μ."  Design:

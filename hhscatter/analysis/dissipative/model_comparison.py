@@ -1,6 +1,5 @@
 """What fitted survival models of dissipative scattering give: the τ1 they predict (Eq. (eqn:tau1)), their
-comparison side by side, and the fitting rule of the figure studies (fig6; study generality applies it to other
-systems). The models and their fits are :mod:`hhscatter.analysis.dissipative.survival_model`.
+comparison side by side, and the fitting rule that fits them to a measured P(t) (any system). The models and their fits are :mod:`hhscatter.analysis.dissipative.survival_model`.
 
 Units: time in model units, rates in 1/time.
 """
@@ -162,7 +161,7 @@ def better_fit(fits: dict) -> str | None:
 
 
 # ---------------------------------------------------------------------------
-# the fitting rule of the figure studies (fig6; study generality applies it to other systems)
+# the fitting rule: which points of a measured P(t) are fitted, and the fits on them
 # ---------------------------------------------------------------------------
 def survival_fit_points(t, P, P_err, tau0: float, fit_dt: float, n: int, min_count: float):
     """survival_fit_points(t, P, P_err, τ0, fit_dt, n, min_count) -> (t, P, P_err) of the fitted points.
@@ -208,7 +207,8 @@ def plateau_level(t, P, t_q: float) -> float:
 
 def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, tau0, E_c, hazards, fit_tau2, P_min):
     """fit_homogeneous_hazards(curve, fitted points, *, κ0(E), E0, μ, γ, τ0, E_c, hazards, fit_tau2, P_min)
-    -> {hazard: SurvivalFit}: the homogeneous model, Eq. (eqn:surv_prob_model), fitted by the rule of study fig6.
+    -> {hazard: SurvivalFit}: the homogeneous model, Eq. (eqn:surv_prob_model), fitted on the points of
+    :func:`survival_fit_points`.
 
     ``t, P, P_err``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fraction are read from it);
     ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`). P(τ0) is held; three starts (data-driven,
@@ -244,7 +244,8 @@ def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, ta
 
 
 def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, mode, P_min):
-    """{hazard: MixtureFit}: the mixture model of sub-ensembles fitted by the rule of study fig6.
+    """{hazard: MixtureFit}: the mixture model of sub-ensembles fitted on the points of
+    :func:`survival_fit_points`.
 
     ``t, P``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fractions are read from it);
     ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`); ``comps`` the sub-ensembles

@@ -1,4 +1,4 @@
-"""The survival models of dissipative scattering (paper Sec. III.B.3, Eq. (eqn:surv_prob_model)), by concept:
+"""The survival models of dissipative scattering, Eq. (eqn:surv_prob_model), by concept:
 
 * :mod:`hhscatter.analysis.survival.kappa_law` — κ0(E), the conservative escape-rate law (Fig. 2b);
 * :mod:`hhscatter.analysis.dissipative.decay` — the energy path E(t) = E0 e^{−μγt} and its inverse t*;

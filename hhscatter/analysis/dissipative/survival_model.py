@@ -1,4 +1,4 @@
-"""The homogeneous survival model of dissipative scattering (paper Sec. III.B.3, Eq. (eqn:surv_prob_model)), its fit
+"""The homogeneous survival model of dissipative scattering, Eq. (eqn:surv_prob_model), its fit
 and the τ1 it predicts; the sub-ensemble version is :mod:`hhscatter.analysis.dissipative.mixture`.
 
 Homogeneous model (the paper's)

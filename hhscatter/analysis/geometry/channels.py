@@ -1,4 +1,6 @@
-"""Checks of the conservative escape criterion r > r_esc (paper, App. "Escape Condition").
+"""Exit channels of an open system: channel fractions, Lyapunov orbits, returns after an escape (r > r_esc).
+
+Reference: App. "Escape Condition" of arXiv:2308.13555.
 
 The paper deems an orbit escaped when r = √(x² + y²) first exceeds a radius
 r_esc "slightly larger than 1" (the saddle distance), and states that

@@ -1,4 +1,6 @@
-"""Distances between point sets on the surface of section (paper Sec. III.B.2, Fig. 5 = fig:um_comparison).
+"""Distances between point sets on the surface of section.
+
+Reference: Sec. III.B.2 and fig:um_comparison of arXiv:2308.13555.
 
 The paper compares, by eye, the section crossings (x, y) of dissipative orbits
 alive at t* with the conservative c-measure μ_c^{E1}, and claims that "the

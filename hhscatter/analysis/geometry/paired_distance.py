@@ -1,7 +1,6 @@
 """Paired differences of distances between point sets on the section, resampling the independent unit (orbits):
 is set B farther from a reference than set A, with an interval that accounts for the points of one orbit being
-correlated and for sets that share orbits (paper Fig. 5; the 5b − 5a verdict of study fig5, claim 5 of study
-generality). The distances themselves are :mod:`hhscatter.analysis.geometry.distance`.
+correlated and for sets that share orbits. The distances themselves are :mod:`hhscatter.analysis.geometry.distance`.
 
 Units: positions in the section's units; Hellinger distances are dimensionless.
 """

@@ -11,7 +11,6 @@ Built on :mod:`hhscatter.analysis.geometry.ulam` (the samples as transitions, κ
   errors against each reference, per energy and in one sentence;
 * :func:`measure_on_cut_boxes` — where the c-measure lives against the partition: its share on the boxes cut
   by the section's boundary (V = E or r = r_esc), where the flux weights |ṗ_r|/v are heavy-tailed;
-* :func:`kappa_references` — fig2's κ0(E) and κ from crossings, from its numbers JSON.
 
 Units: box sides in position units, times in the Hamiltonian's time unit, κ in 1/time.
 """
@@ -34,7 +33,6 @@ __all__ = [
     "energy_results",
     "kappa_convergence",
     "kappa_record",
-    "kappa_references",
     "measure_on_cut_boxes",
     "residuals",
 ]
@@ -379,27 +377,3 @@ def measure_on_cut_boxes(res, samples: int) -> dict:
         "cut_top_weight": float(share[top["c"]].mean()) if top["c"].any() else math.nan,
         "full_top_weight": float(share[~top["c"]].mean()) if (~top["c"]).any() else math.nan,
     }
-
-
-def kappa_references(doc: dict) -> tuple[dict, dict]:
-    """fig2's references from its numbers JSON ``doc``: ({E: (κ0, err)} of ``kappa_energy``, the P(t) route;
-    {E: (κ, err)} of ``cmeasure.*.kappa_cm``, the true-time relation on long-run section crossings).
-    KeyError if ``kappa_energy`` is missing.
-
-    Examples
-    --------
-    >>> doc = {"kappa_energy": [{"energy": 0.3, "kappa": 0.2, "kappa_err": 0.01}],
-    ...        "cmeasure": {"a": {"energy": 0.3, "kappa_cm": {"value": 0.19, "err": 0.001}}}}
-    >>> kappa_references(doc)
-    ({0.3: (0.2, 0.01)}, {0.3: (0.19, 0.001)})
-    """
-    ke = doc.get("kappa_energy")
-    if not ke:
-        raise KeyError("kappa_energy")
-    k0 = {float(r["energy"]): (float(r["kappa"]), float(r["kappa_err"])) for r in ke}
-    kcm = {
-        float(v["energy"]): (float(v["kappa_cm"]["value"]), float(v["kappa_cm"]["err"]))
-        for v in (doc.get("cmeasure") or {}).values()
-        if isinstance(v, dict) and "kappa_cm" in v
-    }
-    return k0, kcm

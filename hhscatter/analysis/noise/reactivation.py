@@ -1,4 +1,4 @@
-"""The paper's P(t) in a heat bath: the drag-only survival extended by the thermal re-escape of settled orbits.
+"""P(t) in a heat bath: the drag-only survival model extended by the thermal re-escape of settled orbits.
 
 Without noise (T = 0) an orbit of the dissipative ensemble either escapes during the transient (at t_i) or
 settles in the well (at τ_j, its energy crossing E_c inside Ω) and stays there for ever: P_0(t) → f_s, the

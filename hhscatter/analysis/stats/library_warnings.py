@@ -51,5 +51,5 @@ def warning_counts() -> list[dict]:
 
 
 def reset_warning_counts() -> None:
-    """reset_warning_counts() -> None: empty the tally (a study's analyze stage does so before it starts)."""
+    """reset_warning_counts() -> None: empty the tally (before an analysis whose warnings are to be counted alone)."""
     _COUNTS.clear()

@@ -39,8 +39,7 @@ from hhscatter.analysis.survival.fits import (
     mean_kappa_stat_err,
     survival_curve,
 )
-from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
-from hhscatter.analysis.survival.summaries import kappa_law_summary
+from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy, kappa_law_summary
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The escape-rate law κ0(E) of Fig. 2b: κ = a x² + b x below the break energy E_b, c x above, x = E − E_c.
+"""The piecewise escape-rate law κ0(E): κ = a x² + b x below the break energy E_b, c x above, x = E − E_c.
 
 :func:`fit_kappa_energy` fits the piecewise law to κ(E) points with their
 errors, continuous at E_b (the break estimated by profiling χ² over E_b) or
@@ -9,6 +9,7 @@ with covariance and bootstrap errors. E_c comes from the system
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,7 +18,7 @@ from scipy import optimize
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
 
-__all__ = ["KappaEnergyFit", "fit_kappa_energy"]
+__all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 
 
 # ---------------------------------------------------------------------------
@@ -254,3 +255,46 @@ def _bootstrap_replicates(x, y, w, continuous, n_grid, n_boot, rng):
         except (ValueError, np.linalg.LinAlgError):
             continue
     return boot
+
+
+def kappa_law_summary(fit) -> dict:
+    """A fitted κ(E) law (:func:`fit_kappa_energy`) as numbers: a, b, c, E_b each with err = max(covariance,
+    bootstrap) and both errors, and the fit's χ², dof, χ²/dof.
+
+    Parameters
+    ----------
+    fit : KappaEnergyFit
+        Or any object with a, b, c, E_b (a, b in 1/(time·energy²) and 1/(time·energy), c in 1/(time·energy),
+        E_b in energy units), their ``*_err``, ``boot_err`` (same order, or empty), ``continuous``, ``chi2``, ``dof``.
+
+    Returns
+    -------
+    dict
+        {"a"|"b"|"c"|"E_b": {"value", "err", "err_cov", "err_boot"}, "continuous", "chi2", "dof", "chi2_per_dof"}.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> fit = NS(a=1.0, b=0.5, c=0.2, E_b=0.3, a_err=0.1, b_err=0.05, c_err=0.02, E_b_err=0.01,
+    ...          boot_err=(0.2, 0.01, 0.01, 0.02), continuous=True, chi2=4.0, dof=2)
+    >>> s = kappa_law_summary(fit)
+    >>> s["a"]["err"], s["E_b"]["err"], s["chi2_per_dof"]
+    (0.2, 0.02, 2.0)
+    """
+    boot = fit.boot_err if fit.boot_err else (math.nan,) * 4
+    out = {}
+    for i, name in enumerate(("a", "b", "c", "E_b")):
+        cov_err = getattr(fit, f"{name}_err")
+        out[name] = {
+            "value": float(getattr(fit, name)),
+            "err": float(max(cov_err, boot[i])),
+            "err_cov": float(cov_err),
+            "err_boot": float(boot[i]),
+        }
+    out.update(
+        continuous=fit.continuous,
+        chi2=fit.chi2,
+        dof=fit.dof,
+        chi2_per_dof=fit.chi2 / fit.dof if fit.dof > 0 else math.nan,
+    )
+    return out

@@ -1,4 +1,4 @@
-"""The conservative escape-rate law κ0(E) as a callable (paper Fig. 2b), the input of the survival models.
+"""The conservative escape-rate law κ0(E) as a callable, the input of the survival models.
 
 :class:`PiecewiseKappa` holds the piecewise law κ0 = a2 ΔE² + a1 ΔE below
 E_switch and slope·ΔE above (ΔE = E − E_c, zero below E_c); the coefficients

@@ -19,7 +19,7 @@ one t_max (the runs here: γ = 0). With ``plateau=False``, q = 0 (a single expon
 
 :func:`survival_at` gives Kaplan–Meier P(t) and its Greenwood error at chosen times, :func:`hazard_profile` the
 censoring-aware hazard per time bin (escapes over orbit-time at risk,
-:func:`hhscatter.analysis.dissipative.effective_rate.binned_hazard`).
+:func:`hhscatter.analysis.survival.effective_rate.binned_hazard`).
 
 Examples
 --------
@@ -234,7 +234,7 @@ def hazard_profile(t_end, escaped, edges):
     >>> h["events"].tolist()
     [2.0, 0.0]
     """
-    from hhscatter.analysis.dissipative.effective_rate import binned_hazard  # deferred: pandas loads on first use
+    from hhscatter.analysis.survival.effective_rate import binned_hazard  # deferred: pandas loads on first use
 
     return binned_hazard(np.asarray(t_end, float), np.asarray(escaped, bool), np.asarray(edges, float))
 

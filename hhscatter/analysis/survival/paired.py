@@ -1,4 +1,4 @@
-"""κ shifts between two escape criteria measured on the same orbits (paired), paper App. "Escape Condition".
+"""κ shifts between two escape criteria measured on the same orbits (paired).
 
 * :func:`paired_mle_shift` — difference of two constant-hazard MLE escape
   rates (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_mle`) measured on

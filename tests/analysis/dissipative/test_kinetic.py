@@ -98,7 +98,7 @@ def test_binned_hazard_recovers_a_known_exponential_rate_and_observed_over_expec
     """Exponential escapes at rate 0.2 with competing settling at rate 0.1: the escape hazard is 0.2 in every bin
     (the competing exit only removes exposure); O/E against the true rate is 1 within its Poisson error in ≥ 90 %
     of independent ensembles (nominal 95 %)."""
-    from hhscatter.analysis.dissipative.effective_rate import (
+    from hhscatter.analysis.survival.effective_rate import (
         binned_hazard,
         observed_over_expected,
     )

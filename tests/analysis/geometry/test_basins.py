@@ -638,7 +638,7 @@ def test_every_kth_cell_holds_the_cells_of_the_coarser_grid():
 
 
 def test_zoom_extent_keeps_the_centre_and_divides_the_sides():
-    from hhscatter.analysis.geometry.basin_summary import zoom_extent
+    from hhscatter.reproduction.basin_summary import zoom_extent
 
     x0, x1, y0, y1 = zoom_extent((-1.0, 1.0, -0.5, 0.5), (0.2, -0.1), 4)
     assert (x1 - x0, y1 - y0) == pytest.approx((0.5, 0.25))

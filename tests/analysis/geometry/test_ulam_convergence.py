@@ -116,16 +116,6 @@ def test_measure_on_cut_boxes_counts_the_boxes_and_the_heaviest_sample():
     assert 0 < r["cut_nu"] < 1
 
 
-def test_kappa_references_read_both_routes_and_name_a_missing_list():
-    doc = {
-        "kappa_energy": [{"energy": 0.25, "kappa": 0.097, "kappa_err": 0.002}],
-        "cmeasure": {"E0.25": {"energy": 0.25, "kappa_cm": {"value": 0.0972, "err": 0.0002}}, "note": "text"},
-    }
-    assert uc.kappa_references(doc) == ({0.25: (0.097, 0.002)}, {0.25: (0.0972, 0.0002)})
-    with pytest.raises(KeyError, match="kappa_energy"):
-        uc.kappa_references({"cmeasure": {}})
-
-
 def test_kappa_convergence_fits_a_replicate_on_the_partitions_where_it_has_a_kappa():
     """A replicate without κ at one partition (no open class left) is extrapolated on the other eight: with
     exact model data its intercept is still κ∞, so three such replicates and one complete give no spread."""

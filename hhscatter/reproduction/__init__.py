@@ -1,0 +1,14 @@
+"""What reproduces the paper: the numbers, tables and comparisons a figure, a study or a claim assembles.
+
+Above :mod:`hhscatter.analysis` (whose general estimators these modules call) and below the studies and the
+report; imports ``model`` and ``analysis`` only.
+
+* ``fig2`` — the paper's Fig. 2 values and ours beside them (κ of P(t), τ*, the κ(E) law, κ from the c-measure);
+* ``escape_summaries`` — escape-rate results as numbers and plot tables (P(t), κ, the sticky tail, the κ(E) law);
+* ``escape_criterion`` — κ under several r_esc on the same orbits, returns, exit channels, the recommended r_esc;
+* ``fig3`` — μ on the paper's and other windows, the inset's histograms, μ in the authors' conventions;
+* ``transition_tables``, ``model_tables``, ``model_verdicts`` — τ1, τ2 and the survival models' tables and verdicts;
+* ``basin_summary`` — the records of a basin study: outcome codes, per-point records, trends, cut-off records;
+* ``cmeasure_comparison``, ``cmeasure_verdicts`` — section points against the conservative c-measure (Fig. 5);
+* ``claims`` — the paper's claims tested on a system, and the evidence behind their readings.
+"""

@@ -1,0 +1,355 @@
+"""The paper's Fig. 2 in numbers and our numbers set beside them: κ of P(t) and its sticky tail (Fig. 2a), the κ(E)
+law (Fig. 2b) under one and under several conventions, and κ from the c-measure (Eq. (eqn:kappa_cmeasure_truetime),
+not in the paper).
+
+Each ``*_comparisons`` function returns comparison rows: dicts with the keyword arguments of a study's
+``compare`` (quantity, ours, err, paper and unit, verdict, convention, authors, note), so that the rule of each
+verdict lives here and the study only records the rows. Units: time in model units, κ in 1/time, energies in model
+units; x = E − E_c.
+
+Examples
+--------
+>>> round(paper_law_kappa(0.30, 1 / 6), 4)  # above E_b = 0.27: c x
+0.188
+>>> from types import SimpleNamespace as NS
+>>> [r["quantity"] for r in pt_comparisons(0.25, NS(kappa=0.2, kappa_err=0.01), NS(tail=None), 1 / 6)]
+['kappa(E0=0.25) [Fig. 2a]']
+"""
+
+from __future__ import annotations
+
+from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+from hhscatter.analysis.survival.kappa_conventions import LAW_PARAMETERS
+from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
+
+__all__ = [
+    "FIG2_CONVENTIONS",
+    "LAW_UNITS",
+    "PAPER_FIG2",
+    "FIG2_RULES",
+    "cmeasure_comparisons",
+    "cmeasure_table_rows",
+    "convention_numbers",
+    "law_comparisons",
+    "paper_law_kappa",
+    "pt_comparisons",
+]
+
+#: the paper's Fig. 2 values: the κ(E) law κ = a x² + b x (E < E_b), c x (E ≥ E_b), x = E − E_c, and τ*
+PAPER_FIG2 = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
+
+#: the units of the law's parameters
+LAW_UNITS = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}
+
+#: the conventions of κ(E) (name, IC region, window rule, label): the paper's disk or the authors' square ICs ×
+#: our plateau windows or windows fixed by P levels
+FIG2_CONVENTIONS = (
+    ("disk_plateau", "disk", "plateau", "paper setup (disk r < 0.5), our plateau windows"),
+    ("disk_plevel", "disk", "plevel", "paper setup (disk r < 0.5), P-level windows"),
+    ("square_plateau", "square", "plateau", "authors' square ICs (goodICs), our plateau windows"),
+    ("square_plevel", "square", "plevel", "authors' square ICs (goodICs), P-level windows"),
+)
+
+#: the rules of Fig. 2's numbers, as its numbers JSON states them
+FIG2_RULES = {
+    "kappa": "escape_rate: Kaplan-Meier P(t); tau0 and 4 windows by choose_windows (local-slope plateau "
+    "covering most e-folds, floor of min_survivors survivors); kappa = mean of the 4 weighted "
+    "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
+    "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
+    " clipped to [t_max_min, t_max_cap]",
+    "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
+    "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
+    "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
+    "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
+    "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
+}
+
+
+def _row(quantity, ours, err=None, paper=None, **kw) -> dict:
+    return {"quantity": quantity, "ours": ours, "err": err, "paper": paper, **kw}
+
+
+def paper_law_kappa(energy: float, E_c: float, paper: dict = PAPER_FIG2) -> float:
+    """κ (1/time) at ``energy`` of the paper's fitted law of Fig. 2b: a x² + b x below E_b, c x above, x = E − E_c.
+
+    Examples
+    --------
+    >>> x = 0.25 - 1 / 6
+    >>> paper_law_kappa(0.25, 1 / 6) == 13.63 * x**2 + 0.03 * x
+    True
+    """
+    return (
+        paper["a"] * (energy - E_c) ** 2 + paper["b"] * (energy - E_c)
+        if energy < paper["E_b"]
+        else paper["c"] * (energy - E_c)
+    )
+
+
+def pt_comparisons(energy: float, rate, tail, E_c: float, paper: dict = PAPER_FIG2) -> list[dict]:
+    """Fig. 2a at one energy against the paper: κ with its Fig. 2b law, τ* with its 100 and z (not in its text).
+
+    Parameters
+    ----------
+    energy : float
+        E0 of the P(t) run (energy units).
+    rate
+        Its :func:`~hhscatter.analysis.survival.escape_rate.escape_rate` result (``kappa``, ``kappa_err``).
+    tail
+        Its :func:`~hhscatter.analysis.survival.escape_rate.escaping_tail` result; no τ* or z row without a tail.
+    E_c : float
+        The critical energy.
+
+    Returns
+    -------
+    list of dict
+        Comparison rows. τ*'s error is the distance of its two definitions (:func:`tau_star_estimate`); its verdict
+        agreement within 20 % where that error is undefined.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> rows = pt_comparisons(0.30, NS(kappa=0.19, kappa_err=0.01), NS(tail=None), 1 / 6)
+    >>> round(rows[0]["paper"], 4), rows[0]["unit"]
+    (0.188, '1/time')
+    """
+    rows = [
+        _row(
+            f"kappa(E0={energy:.2f}) [Fig. 2a]",
+            rate.kappa,
+            rate.kappa_err,
+            paper_law_kappa(energy, E_c, paper),
+            unit="1/time",
+            note="paper value from its fitted law of Fig. 2b (annotations of Fig. 2a not in the text)",
+        )
+    ]
+    if tail.tail is None:
+        return rows
+    tl = tail.tail
+    ts, ts_err, note = tau_star_estimate(tail)
+    ref = paper["tau_star"]
+    verdict = None if ts_err else ("agrees within 20 %" if abs(ts / ref - 1) <= 0.2 else "differs")
+    rows.append(_row(f"tau* (E0={energy:.2f})", ts, ts_err, ref, unit="time", note=note, verdict=verdict))
+    rows.append(
+        _row(
+            f"z (E0={energy:.2f})",
+            tl.z,
+            tl.z_err,
+            None,
+            note="power-law exponent of the sticky tail (the paper annotates it in Fig. 2a; no number in the text)",
+        )
+    )
+    return rows
+
+
+def law_comparisons(continuous: dict, separate: dict, across: dict, ill, paper: dict = PAPER_FIG2) -> list[dict]:
+    """The κ(E) law of Fig. 2b against the paper's a, b, c, E_b: the continuous fit, the law across conventions, the
+    points left out as ill-defined, the separate fits.
+
+    Parameters
+    ----------
+    continuous, separate : dict
+        :func:`~hhscatter.analysis.survival.kappa_energy.kappa_law_summary` of the law continuous at E_b and of the
+        two laws fitted independently ({name: {"value", "err"}}).
+    across : dict
+        :func:`~hhscatter.analysis.survival.kappa_conventions.law_spread` over the conventions (may be empty).
+    ill : DataFrame
+        The (energy, convention) rows where κ is ill-defined (the trapped plateau).
+
+    Returns
+    -------
+    list of dict
+        Comparison rows. A "differs" of the continuous fit stands only if it survives the spread across conventions
+        (2σ, then the paper's printed precision: 0.27 stands for [0.265, 0.275)).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> fit = {k: {"value": v, "err": 0.01} for k, v in PAPER_FIG2.items()}
+    >>> rows = law_comparisons(fit, fit, {}, pd.DataFrame({"energy": [], "convention": []}))
+    >>> len(rows), rows[0]["verdict"]
+    (9, 'agrees within 2σ')
+    """
+
+    def quoted(name, d):
+        return quoted_verdict(d[name]["value"], d[name]["err"], paper[name], half_unit(paper[name]))
+
+    rows = []
+    for name in LAW_PARAMETERS:
+        verdict = quoted(name, continuous)
+        if verdict == "differs" and name in across:
+            other = quoted(name, across)
+            if other != "differs":
+                verdict = f"differs in this convention only; across conventions: {other}"
+        rows.append(
+            _row(
+                f"{name} (κ(E) law, continuous fit)",
+                continuous[name]["value"],
+                continuous[name]["err"],
+                paper[name],
+                unit=LAW_UNITS[name],
+                verdict=verdict,
+                note="κ = a x² + b x below E_b, c x above, x = E − E_c, continuous at E_b; "
+                "err = max(covariance, bootstrap); all grid energies",
+            )
+        )
+    for name in (n for n in LAW_PARAMETERS if n in across):
+        L = across[name]
+        rows.append(
+            _row(
+                f"{name} (κ(E) law across conventions)",
+                L["value"],
+                L["err"],
+                paper[name],
+                unit=LAW_UNITS[name],
+                verdict=quoted(name, across),
+                convention="mean over disk/square ICs × plateau/P-level windows, stable energies only",
+                authors=True,
+                note=f"err = √(stat² + spread²), spread (half range across conventions) {L['spread']:.3g}; "
+                + ", ".join(f"{k} {v:.4g}" for k, v in L["per_convention"].items()),
+            )
+        )
+    rows.append(
+        _row(
+            "κ(E) points ill-defined by the trapped plateau",
+            len(ill),
+            convention="all 4 conventions",
+            note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
+            verdict="excluded from the law, not returned as κ ≈ 0",
+        )
+    )
+    for name in LAW_PARAMETERS:
+        rows.append(
+            _row(
+                f"{name} (κ(E) law, separate fits)",
+                separate[name]["value"],
+                separate[name]["err"],
+                paper[name],
+                verdict=quoted(name, separate),
+                note="the two laws fitted independently on either side of the best partition (as the paper)",
+            )
+        )
+    return rows
+
+
+def cmeasure_table_rows(
+    sections, lifetimes, window, shifts, kappa: float, reference, *, energy, E_c, min_survivors, n_boot, seed
+) -> list[dict]:
+    """κ from the c-measure of one energy's section run, one row per start shift, beside κ from P(t): of the Fig. 2b
+    run at that energy (``reference``) and of the section run itself.
+
+    Parameters
+    ----------
+    sections, lifetimes : DataFrame
+        The section run's crossings (traj_id, t) and lifetimes (traj_id, outcome, t_end).
+    window : (float, float, float)
+        (t_rec, t_sample_end, t_record_end) of :func:`~hhscatter.reproduction.escape_summaries.cmeasure_windows`.
+    shifts : sequence of float
+        Later starts of the window, in e-folds of ``kappa`` (0: the window itself).
+    kappa : float
+        κ (1/time) that set the window; ``reference``: the escape-rate result of the Fig. 2b run.
+    energy, E_c : float
+        The run's energy and the critical energy; min_survivors the window rule's survivor floor.
+
+    Returns
+    -------
+    list of dict
+        The rows of :func:`~hhscatter.reproduction.escape_summaries.kappa_cmeasure_shifts` with energy, x = E − E_c,
+        kappa_pt_grid(_err), kappa_pt_same_run(_err) and n_trapped_dropped (orbits censored at t_max).
+    """
+    from hhscatter.analysis.survival.escape_rate import escape_rate  # deferred: scipy loads on first use
+    from hhscatter.analysis.survival.fits import observed_from_outcome  # deferred: as above
+
+    t_rec, t_samp, t_rec_end = window
+    own = escape_rate(
+        lifetimes["t_end"].to_numpy(),
+        observed_from_outcome(lifetimes["outcome"]),
+        detect_tail=False,
+        min_survivors=min_survivors,
+    )
+    rows = kappa_cmeasure_shifts(
+        sections, lifetimes, t_rec, t_samp - t_rec, shifts, kappa, t_rec_end, n_boot=n_boot, seed=seed
+    )
+    n_trapped = int((lifetimes["outcome"] == "censored").sum())
+    return [
+        {
+            "energy": energy,
+            "x": energy - E_c,
+            **row,
+            "kappa_pt_grid": reference.kappa,
+            "kappa_pt_grid_err": reference.kappa_err,
+            "kappa_pt_same_run": own.kappa,
+            "kappa_pt_same_run_err": own.kappa_err,
+            "n_trapped_dropped": n_trapped,
+        }
+        for row in rows
+    ]
+
+
+def cmeasure_comparisons(table) -> tuple[list[dict], dict]:
+    """κ from the c-measure at the unshifted window of each energy against κ from P(t) of Fig. 2b (not in the paper).
+
+    Parameters
+    ----------
+    table : DataFrame
+        The rows of :func:`~hhscatter.reproduction.escape_summaries.kappa_cmeasure_shifts` completed with the P(t)
+        references and :func:`~hhscatter.reproduction.escape_summaries.kappa_cmeasure_z` (columns energy,
+        shift_efolds, kappa_cm, kappa_cm_err, kappa_pt_grid, kappa_pt_grid_err, z_vs_grid, ...).
+
+    Returns
+    -------
+    (rows, entries)
+        Comparison rows (consistent where |z| ≤ 2) and {energy: numbers entry} with the later starts beside
+        (:func:`~hhscatter.reproduction.escape_summaries.kappa_cmeasure_entry`).
+    """
+    rows, entries = [], {}
+    for _, row in table[table["shift_efolds"] == 0.0].iterrows():
+        z = row["z_vs_grid"]
+        rows.append(
+            _row(
+                f"κ from the c-measure (E={row['energy']:.2f})",
+                row["kappa_cm"],
+                row["kappa_cm_err"],
+                None,
+                unit="1/time",
+                verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
+                note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
+                f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
+            )
+        )
+        later = table[(table["energy"] == row["energy"]) & (table["shift_efolds"] > 0)]
+        entries[row["energy"]] = kappa_cmeasure_entry(row, later)
+    return rows, entries
+
+
+def convention_numbers(table, stability, fit_info: dict, law: dict, *, p_levels, max_bias, rel_tol) -> dict:
+    """The numbers of κ(E) under the :data:`FIG2_CONVENTIONS`: the rules, the stable and unstable energies, the points
+    ill-defined by the trapped plateau (with their reasons), the law per convention and across them.
+
+    ``table``: one row per (energy, convention) with defined and reason; ``stability``:
+    :func:`~hhscatter.analysis.survival.kappa_conventions.stable_energies`; ``fit_info`` and ``law``: the second
+    result of :func:`~hhscatter.analysis.survival.kappa_conventions.fit_laws` and its
+    :func:`~hhscatter.analysis.survival.kappa_conventions.law_spread`.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> t = pd.DataFrame({"energy": [0.2], "convention": ["disk_plateau"], "defined": [False], "reason": ["plateau"]})
+    >>> s = pd.DataFrame({"energy": [0.2], "stable": [False]})
+    >>> convention_numbers(t, s, {}, {}, p_levels=[0.5, 0.01], max_bias=0.1, rel_tol=0.1)["ill_defined"]
+    [{'energy': 0.2, 'convention': 'disk_plateau', 'reason': 'plateau'}]
+    """
+    stable = stability.loc[stability["stable"], "energy"]
+    return {
+        "conventions": {name: label for name, _, _, label in FIG2_CONVENTIONS},
+        "p_levels": list(p_levels),
+        "max_plateau_bias": max_bias,
+        "stable_rel_tol": rel_tol,
+        "stable_energies": sorted(float(e) for e in set(stable)),
+        "unstable_energies": sorted(float(e) for e in stability.loc[~stability["stable"], "energy"]),
+        "ill_defined": [
+            {"energy": r.energy, "convention": r.convention, "reason": r.reason}
+            for r in table[~table["defined"]].itertuples()
+        ],
+        "fits": fit_info,
+        "law": law,
+    }

@@ -1,0 +1,173 @@
+"""The claims' analysis (hhscatter.reproduction.claims): a reason per κ convention, claim 6 independent of the order of
+the systems, the evidence records."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+
+from hhscatter.model.spec import system_from_spec
+from hhscatter.reproduction.claims.dissipative import claim6
+from hhscatter.reproduction.claims.evidence import first_below, long_time_record, validity_map
+from hhscatter.reproduction.claims.kappa import kappa_rows
+from hhscatter.reproduction.claims.records import Claims
+
+
+class _Runs:
+    def __init__(self, params, tables):
+        self.params, self.tables = params, tables
+
+    def lifetimes(self, key):
+        return self.tables[key]
+
+
+def _lt(t, censored=()):
+    out = np.where(np.isin(np.arange(len(t)), censored), "censored", "escaped")
+    return pd.DataFrame({"traj_id": np.arange(len(t)), "t_end": t, "outcome": pd.Categorical(out)})
+
+
+def test_each_kappa_convention_carries_its_own_reason():
+    # too few orbits for the window rule, in all orbits and in the escaping ones: each row says its own failure
+    p = SimpleNamespace(ratios=[1.5], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01], alt_region="well")
+    t = np.random.default_rng(1).exponential(10.0, 30)
+    runs = _Runs(p, {"s_r1.500": _lt(t), "s_well_r1.500": _lt(t)})
+    rows = {r["convention"]: r for r in kappa_rows(runs, "s", system_from_spec({"name": "henon_heiles"}))[0]}
+    assert rows["plateau"]["reason"].startswith("window rule failed: ")
+    assert rows["escaping"]["reason"].startswith("window rule failed on the escaping orbits: ")
+    assert rows["well"]["reason"].startswith("window rule failed with well ICs: ")
+
+
+def _fit(rms):
+    return SimpleNamespace(rms_log_residual=rms, chi2_red=1.0, n_points=10, values={}, predict=lambda t: t)
+
+
+def test_claim6_verdicts_do_not_depend_on_the_order_of_the_systems():
+    curve = SimpleNamespace(t=np.arange(10.0), P=np.ones(10))
+    res = {
+        lab: {
+            "conv": "plateau",
+            "tau0": 1.0,
+            "curve": curve,
+            "reason": "",
+            "law": True,
+            "fits": {"paper": _fit(rms), "integrated": _fit(rms)},
+        }
+        for lab, rms in (("hh", 1.0), ("co", 2.0), ("ba", 1.2))
+    }
+    p = SimpleNamespace(mu_gamma=0.01, sm_fit_dt=2.0, sm_min_count=20.0)
+    verdicts = []
+    for order in (["hh", "co", "ba"], ["co", "ba", "hh"]):
+        c = Claims()
+        claim6(c, {k: res[k] for k in order}, "hh", p)
+        verdicts.append({(r["system"], r["quantity"]): r["verdict"] for r in c.rows})
+    assert verdicts[0] == verdicts[1]
+    assert verdicts[1][("co", "survival model (paper hazard) at γ = 0.01: rms log residual")].startswith("worse")
+    assert verdicts[1][("hh", "survival model (paper hazard) at γ = 0.01: rms log residual")].startswith("reference")
+
+
+def test_long_time_record_separates_regular_orbits_from_the_decay():
+    rng = np.random.default_rng(4)
+    n = 20000
+    reg = rng.random(n) < 0.3  # regular: never leave
+    t = np.where(reg, 2000.0, np.minimum(rng.exponential(1 / 0.004, n), 2000.0))
+    lt = _lt(t, censored=np.flatnonzero(t >= 2000.0))
+    rows, rec = long_time_record(lt, np.flatnonzero(reg), [100.0, 2000.0], 100.0, [100.0, 1000.0, 2000.0])
+    assert rows[1]["P"] > 0.3 and abs(rec["P_inf"] - 0.3) < 4 * rec["P_inf_err"]
+    assert abs(rec["kappa_nonregular"] - 0.004) < 4 * rec["kappa_nonregular_err"] and rec["exponential"]
+    assert rec["regular_fraction_of_censored"] > 0.9
+
+
+def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
+    reg = [{"system": "barbanis", "label": "b", "e_ratio": 1.5, "ics": "disk/tangential", "fraction": 0.1, "err": 0.01}]
+    fits = [
+        {
+            "system": "barbanis",
+            "e_ratio": 1.5,
+            "ics": "disk/tangential",
+            "P_inf": 0.1,
+            "P_inf_err": 0.01,
+            "exponential": False,
+        }
+    ]
+    kappa = [{"system": "b", "ratio": 1.5, "convention": "plateau", "defined": False}]
+    claims = [
+        {
+            "claim": "2",
+            "system": "b",
+            "quantity": "κ_cm/κ0 − 1 at E/E_c = 1.5 (all orbits, plateau windows)",
+            "verdict": "undetermined",
+        }
+    ]
+    (v,) = validity_map(reg, fits, kappa, claims, ics="disk/tangential")
+    assert (v["kappa0_defined"], v["claim2"], v["exponential"], v["plateau"]) == (False, "undetermined", False, True)
+    assert first_below(reg + [{**reg[0], "e_ratio": 2.0, "fraction": 0.0}], ics="disk/tangential") == {
+        "barbanis": {"from": 2.0, "text": "from 2 E_c on"}
+    }
+    assert first_below(reg, ics="disk/tangential")["barbanis"]["from"] is None
+
+
+def _taus(obs, lo, hi, pred, pred_err):
+    return pd.DataFrame(
+        {
+            "gamma": [0.005, 0.01],
+            "n": [1000, 1000],
+            "tau0": [8.0, 8.0],
+            "tau0_err": [0.4, 0.4],
+            "tau1": [np.nan, np.nan],
+            "tau1_err": [np.nan, np.nan],
+            "tau2_obs": [np.nan, obs],
+            "tau2_obs_lo": [np.nan, lo],
+            "tau2_obs_hi": [np.nan, hi],
+            "p0_trapped": [0.0, 0.0],
+            "t_settle_q50": [200.0, 100.0],
+            "t_settle_q50_err": [2.0, 1.0],
+            "tau2_pred": [125.0, pred],
+            "tau2_pred_err": [0.02, pred_err],
+        }
+    )
+
+
+def test_claim4_tau2_ratio_is_judged_by_the_one_rule_with_both_errors():
+    """τ2,obs / τ2,pred carries an error (half-width of the order-statistic interval, and the prediction's) and the
+    one verdict rule: a first settling time at 0.93 of the prediction with its interval [0, τ2,obs] agrees (|z| ≈
+    0.2); the same ratio with a tight interval differs. No fixed tolerance."""
+    from hhscatter.reproduction.claims.dissipative import claim4
+
+    def rec(*args):
+        c = Claims()
+        claim4(c, "s", _taus(*args), 0.01)
+        return next(r for r in c.rows if r["quantity"].startswith("τ2 observed"))
+
+    wide = rec(58.0, 0.0, 58.0, 62.5, 0.01)
+    assert abs(wide["err"] - 0.928 * 0.5) < 1e-3
+    assert wide["verdict"] == "agrees (z = −0.2)"
+    tight = rec(58.0, 57.5, 58.5, 62.5, 0.01)
+    assert abs(tight["err"] - 0.928 * 0.5 / 58.0) < 1e-5
+    assert tight["verdict"].startswith("differs (z = −")
+    assert "within 15 %" not in wide["verdict"] + tight["verdict"]
+
+
+def test_a_claim_verdict_is_the_one_rule_written_as_every_verdict():
+    """z_verdict applies the rule of every table (|z| ≤ 2, both errors) and writes z as Verdict.text does ("−"),
+    checked against z computed here; without our error it says why, as every undetermined cell does."""
+    import math
+
+    from hhscatter.reproduction.claims.records import z_verdict
+
+    for value, err, ref, ref_err in [
+        (1.1, 0.1, 1.0, 0.0),
+        (0.5, 0.1, 1.0, 0.0),
+        (0.996, 0.1, 1.0, 0.0),
+        (1.0, 0.02, 1.05, 0.01),
+        (0.9, 0.03, 1.0, 0.04),
+        (1.3, 0.1, 1.0, 0.1),
+    ]:
+        z = (value - ref) / math.hypot(err, ref_err)
+        word = "ok" if abs(z) <= 2 else "bad"
+        sign = "−" if z < 0 else "+"
+        assert z_verdict(value, err, ref, "ok", "bad", ref_err) == f"{word} (z = {sign}{abs(z):.1f})"
+    assert z_verdict(0.5, None, 1.0, "ok", "bad") == "undetermined: no uncertainty of ours"
+    assert z_verdict(None, 0.1, 1.0, "ok", "bad").startswith("undetermined: no value of ours")
+    assert z_verdict(1.0, 0.0, 1.0, "ok", "bad") == "ok"
+    # the sign of z is written "−"; a label's own hyphens stay as written
+    assert z_verdict(0.7, 0.1, 1.0, "the c-measure's", "not the c-measure's") == "not the c-measure's (z = −3.0)"

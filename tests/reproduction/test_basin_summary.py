@@ -1,0 +1,260 @@
+"""The records of a basin study (hhscatter.reproduction.basin_summary), S_b at fixed box sides
+(hhscatter.analysis.geometry.basins.entropy_by_box) and the cut-off comparison
+(hhscatter.analysis.geometry.cutoff.cutoff_comparison) on synthetic input with known answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hhscatter.analysis.geometry.basins import commensurate_sides, entropy_by_box
+from hhscatter.analysis.geometry.cutoff import cutoff_comparison
+from hhscatter.reproduction import basin_summary as bs
+
+ALPHA, C, N = 0.4, 0.5, 200_000
+
+
+def _unc(eps, k_override=None):
+    """An f(ε) table of the exact power law f = C ε^α with counts k = round(f n) (``k_override``: {index: k})."""
+    eps = np.asarray(eps, dtype=float)
+    k = np.round(C * eps**ALPHA * N).astype(int)
+    for i, v in (k_override or {}).items():
+        k[i] = v
+    return pd.DataFrame({"eps": eps, "f": k / N, "k": k, "n": N})
+
+
+def test_uncertainty_fits_choose_the_resolved_window():
+    # ε decreasing, as in the study; the two smallest ε are unresolved (k < 10) and far off the power law:
+    # the window must leave them out
+    eps = np.geomspace(1e-2, 1e-9, 8)
+    unc = _unc(eps, {6: 9, 7: 3})
+    ok, fit, cut = bs.uncertainty_fits(unc, 10)
+    np.testing.assert_array_equal(ok.to_numpy(), [True] * 6 + [False, False])
+    assert fit.eps_range == (eps[5], eps[0])
+    assert fit.n_points == 6
+    assert fit.alpha == pytest.approx(ALPHA, abs=5e-3)  # rounding of the counts only
+    assert cut is not None and not cut.detected  # a single power law: no cut-off
+
+
+def test_uncertainty_fits_need_three_points_for_alpha_and_five_for_the_cutoff():
+    eps = np.geomspace(1e-2, 1e-6, 6)
+    for n_ok, has_fit, has_cut in [(2, False, False), (3, True, False), (4, True, False), (5, True, True)]:
+        unc = _unc(eps, {i: 0 for i in range(n_ok, len(eps))})
+        ok, fit, cut = bs.uncertainty_fits(unc, 10)
+        assert int(ok.sum()) == n_ok
+        assert (fit is not None, cut is not None) == (has_fit, has_cut), n_ok
+
+
+def test_point_numbers_tau2_and_smallest_resolved_eps():
+    """τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1; ∞ at γ = 0) and the smallest resolved ε's decision time."""
+    eps = np.geomspace(1e-2, 1e-6, 6)  # decreasing, as in the study
+    unc = _unc(eps, {5: 0}).assign(t_decide_median=np.arange(6.0) + 10)
+    ok, fit, cut = bs.uncertainty_fits(unc, 10)
+
+    class Frac:
+        frac, lo, hi, n = [1.0, 0, 0, 0, 0], [0.9, 0, 0, 0, 0], [1.0, 0, 0, 0, 0], 100
+
+    class Wada:
+        wada, wada_fraction, r_wada, hausdorff_slope = False, np.array([0.1, 0.2]), 5, 1.0
+
+    class Chans:
+        p_value, frac = 0.5, [1 / 3] * 3
+
+    ent = pd.DataFrame(
+        {"box": [5], "S_b": [0.3], "S_b_err": [0.01], "S_bb": [0.8], "S_bb_err": [0.02], "log2_fractal": [True]}
+    )
+    loc = pd.DataFrame({"eps_mid": [1e-3, 1e-4], "d": [1.5, math.nan], "d_err": [0.1, math.nan]})
+    m = {
+        "fr": Frac,
+        "present": [0],
+        "wada": Wada,
+        "chans": Chans,
+        "exits": [0],
+        "wada_x": None,
+        "slim": None,
+        "rate": None,
+        "ok": ok,
+        "fit": fit,
+        "cut": cut,
+    }
+    ec = 1 / 6
+    p = bs.point_record(0.3, 0.01, 5, ec, ent, unc, loc, m)
+    assert p["tau2_mu1"] == pytest.approx(math.log(0.3 / ec) / 0.01, rel=1e-15)
+    assert bs.point_record(0.3, 0.0, 5, ec, ent, unc, loc, m)["tau2_mu1"] == math.inf
+    # the smallest resolved ε is the fifth row (the sixth has k = 0); its decision time comes along
+    assert p["smallest_resolved_eps"] == eps[4] and p["t_decide_median_smallest_eps"] == 14.0
+    assert p["S_bb"] == {"value": 0.8, "err": 0.02} and p["log2_fractal"] is True
+    assert p["wada"]["W_at_r"] == 0.2  # r_wada beyond the table: its last entry
+    assert p["local_d"] == [{"eps_mid": 1e-3, "d": 1.5, "d_err": 0.1}]  # NaN rows dropped
+    # a headline box not in the table: no entropies
+    assert bs.point_record(0.3, 0.01, 7, ec, ent, unc, loc, m)["S_b"] is None
+
+
+# ---------------------------------------------------------------------------
+# S_b and S_bb at fixed physical box sides
+# ---------------------------------------------------------------------------
+def _straight(n, x_b=0.05):
+    """An n × n map of [−1, 1]² with label 0 left of x = x_b and 1 right of it (cell centres)."""
+    c = -1 + (np.arange(n) + 0.5) * 2.0 / n
+    return np.broadcast_to((c >= x_b).astype(int), (n, n)).copy()
+
+
+def test_entropy_by_box_of_a_straight_boundary_matches_the_closed_form():
+    """x = 0.05 splits the box column [0, 0.1) in half (S = ln 2) and [0, 0.2) at 1/4 (S = h(1/4)); one column of
+    boundary boxes out of 1/side columns."""
+    t = entropy_by_box(_straight(40), (-1, 1, -1, 1), [0.1, 0.2])
+    h = lambda p: -p * math.log(p) - (1 - p) * math.log(1 - p)
+    assert t.box_cells.tolist() == [2, 4] and t.grid.tolist() == [40, 40]
+    assert t.n_boundary.tolist() == [20, 10]
+    assert t.S_bb.tolist() == pytest.approx([math.log(2), h(0.25)], rel=1e-12)
+    assert t.S_b.tolist() == pytest.approx([math.log(2) / 20, h(0.25) / 10], rel=1e-12)
+
+
+def test_entropy_by_box_compares_grids_like_for_like():
+    """The same straight boundary on a 40² and an 80² map: at the same side (0.1: 2 and 4 cells) the same S_b;
+    at the same number of cells (2: sides 0.1 and 0.05) not (x = 0.05 is a box edge at side 0.05)."""
+    a = entropy_by_box(_straight(40), (-1, 1, -1, 1), [0.1]).iloc[0]
+    b = entropy_by_box(_straight(80), (-1, 1, -1, 1), [0.1, 0.05])
+    assert b.box_cells.tolist() == [4, 2]
+    assert b.S_b.iloc[0] == pytest.approx(a.S_b, rel=1e-12)
+    assert a.S_b == pytest.approx(math.log(2) / 20, rel=1e-12) and b.S_b.iloc[1] == 0.0
+
+
+def test_entropy_by_box_refuses_sides_that_are_not_whole_cells():
+    assert commensurate_sides([0.01, 0.025, 0.05, 0.1], (-1, 1, -1, 1), 200) == [0.05, 0.1]
+    assert commensurate_sides([0.01, 0.025], (-1, 1, -1, 1), 2000) == [0.01, 0.025]
+    with pytest.raises(ValueError, match="0.025"):
+        entropy_by_box(_straight(200), (-1, 1, -1, 1), [0.025])
+    with pytest.raises(ValueError, match="square"):
+        entropy_by_box(_straight(40), (-1, 1, -1, 2), [0.1])
+
+
+def test_entropy_exponents_recover_a_power_law_and_skip_short_groups():
+    recs = [
+        {
+            "E0": 0.25,
+            "gamma": 0.0,
+            "map": "map",
+            "grid": 400,
+            "box_side": s,
+            "box_cells": int(round(s * 200)),
+            "S_b": 0.7 * s**0.24,
+            "S_b_err": 1e-4,
+        }
+        for s in (0.01, 0.025, 0.05, 0.1, 0.2)
+    ]
+    recs[0]["S_b"] = 0.01  # a 2-cell box: below min_cells, left out
+    recs += [
+        {
+            "E0": 0.25,
+            "gamma": 0.0,
+            "map": "scan",
+            "grid": 200,
+            "box_side": s,
+            "box_cells": int(round(s * 100)),
+            "S_b": s,
+            "S_b_err": 1e-4,
+        }
+        for s in (0.02, 0.05, 0.1)
+    ]  # 2, 5, 10 cells: two sides left
+    out = bs.entropy_exponents(recs)
+    assert len(out) == 1 and out[0]["grid"] == 400
+    assert out[0]["alpha"] == pytest.approx(0.24, abs=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# the cut-off: measured against predicted
+# ---------------------------------------------------------------------------
+def test_cutoff_comparison_against_the_closed_form():
+    """λ constant on [E_c, E0]: ln(1/ε_c) = λ ln(E0/E_c)/(μγ); the predicted interval is the envelope of λ ± σ,
+    μ ± σ and the second estimator (λ_alt) of λ."""
+    E0, g, ec, mu, smu, lam, sl, alt = 0.3, 0.01, 0.15, 1.0, 0.005, 0.5, 0.002, 0.4
+    L = lambda l, m: math.exp(-l * math.log(E0 / ec) / (m * g))
+    pred = L(lam, mu)
+    meas = pred * 10**-0.5
+    c = cutoff_comparison(
+        E0,
+        g,
+        ec,
+        mu,
+        smu,
+        [0.2, 0.3],
+        [lam] * 2,
+        [sl] * 2,
+        lam_alt=[alt] * 2,
+        measured=meas,
+        measured_lo=meas * 0.9,
+        measured_hi=meas * 1.1,
+    )
+    assert c.predicted == pytest.approx(pred, rel=1e-6)
+    assert c.predicted_alt == pytest.approx(L(alt, mu), rel=1e-6)
+    assert c.predicted_lo == pytest.approx(L(lam + sl, mu - smu), rel=1e-6)
+    assert c.predicted_hi == pytest.approx(L(alt, mu + smu), rel=1e-6)
+    assert c.log10_ratio == pytest.approx(-0.5, abs=1e-6) and c.factor == pytest.approx(10**0.5, rel=1e-6)
+    # measured below: the gap is from the measured interval's top to the predicted interval's bottom
+    gap = math.log10(c.predicted_lo) - math.log10(meas * 1.1)
+    assert gap > 0 and c.gap_decades == pytest.approx(gap, rel=1e-6) and not c.overlap
+    assert "factor 3.2 below" in c.statement
+
+
+def test_cutoff_comparison_without_a_detected_cutoff_checks_the_bound():
+    args = (0.3, 0.01, 0.15, 1.0, 0.0, [0.2, 0.3], [0.5, 0.5], [0.0, 0.0])
+    pred = math.exp(-0.5 * math.log(2) / 0.01)
+    ok = cutoff_comparison(*args, measured=None, measured_hi=pred * 10)
+    assert math.isnan(ok.log10_ratio) and ok.overlap and "consistent" in ok.statement
+    far = cutoff_comparison(*args, measured=None, measured_hi=pred / 100)
+    assert far.gap_decades == pytest.approx(2.0, abs=1e-6) and not far.overlap
+    with pytest.raises(ValueError, match="γ"):
+        cutoff_comparison(0.3, 0.0, *args[2:])
+
+
+def test_cutoff_records_and_summary():
+    per = [
+        {"energy": 0.3, "gamma": 0.0, "cutoff": None, "smallest_resolved_eps": 1e-10},
+        {
+            "energy": 0.3,
+            "gamma": 0.01,
+            "smallest_resolved_eps": 1e-10,
+            "cutoff": {"detected": True, "eps_c": 1e-3, "eps_c_lo": 0.9e-3, "eps_c_hi": 1.1e-3},
+        },
+        {
+            "energy": 0.3,
+            "gamma": 0.02,
+            "smallest_resolved_eps": 1e-10,
+            "cutoff": {"detected": False, "eps_c": math.nan, "eps_c_lo": 0.0, "eps_c_hi": 1e-9},
+        },
+    ]
+    scan = pd.DataFrame(
+        {"energy": [0.2, 0.3], "lam": [0.5, 0.5], "lam_err": [0.0, 0.0], "lam_kg": [math.nan, math.nan]}
+    )
+    recs = bs.cutoff_records(per, scan, 1.0, 0.0, 0.15)
+    assert [(r["E0"], r["gamma"], r["detected"]) for r in recs] == [(0.3, 0.01, True), (0.3, 0.02, False)]
+    pred = math.exp(-0.5 * math.log(2) / 0.01)
+    assert recs[0]["log10_ratio"] == pytest.approx(math.log10(1e-3 / pred), rel=1e-6)
+    assert recs[1]["log10_ratio"] is None and recs[1]["eps_c_predicted_kantz_grassberger"] is None
+    summ = bs.cutoff_summary(recs)
+    assert summ["n_resolved"] == 1 and summ["n_below"] == 0 and summ["n_overlap"] == 0
+    assert summ["factor_min"] == pytest.approx(1e-3 / pred, rel=1e-6)
+
+
+def test_entropy_by_box_at_keeps_the_asked_sides_of_every_grid():
+    """The same physical box on both grids, and nothing else: sides matched to 1e-9, not to the cell count."""
+    from hhscatter.reproduction.basin_summary import entropy_by_box_at
+
+    recs = [
+        {"E0": E, "gamma": 0.0, "map": m, "grid": n, "box_side": s, "box_cells": round(s * n / 2), "S_b": 0.1}
+        for E in (0.30, 0.25)
+        for m, n in (("map", 2000), ("scan", 400))
+        for s in (0.01, 0.025, 0.05 + 1e-12, 0.1)
+    ]
+    got = entropy_by_box_at(recs)
+    assert [(r["E0"], r["grid"], r["box_cells"]) for r in got[:4]] == [
+        (0.25, 400, 5),
+        (0.25, 2000, 25),
+        (0.25, 400, 10),
+        (0.25, 2000, 50),
+    ]
+    assert len(got) == 8 and entropy_by_box_at(recs, sides=(0.2,)) == []
