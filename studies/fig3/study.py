@@ -52,6 +52,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.reproduction.fig3 import (
     add_bootstrap_errors,
     authors_convention,
@@ -62,7 +63,6 @@ from hhscatter.reproduction.fig3 import (
     paper_fit,
     ribbons,
 )
-from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
 
 
