@@ -445,6 +445,54 @@ def _operator_convergence(get: Loader) -> str:
     return "; ".join(out)
 
 
+def _noise_turnover(get: Loader) -> str:
+    rows = sorted(get("noise", None)["turnover"], key=lambda r: r["gamma"])
+
+    def z1(r):
+        return verdict(r["ratio"], r["ratio_err"], 1.0)
+
+    below = [f"{r['gamma']:g}" for r in rows if z1(r).word == "differs" and r["ratio"] < 1]
+    near = [f"{r['gamma']:g}" for r in rows if z1(r).word == "agrees"]
+    steps = []
+    for a, b in zip(rows, rows[1:]):
+        v = verdict(b["ratio"], b["ratio_err"], a["ratio"], a["ratio_err"])
+        steps.append((f"{a['gamma']:g} → {b['gamma']:g}", v))
+    up = [s for s, v in steps if v.word == "differs" and v.z > 0]
+    down = [s for s, v in steps if v.word == "differs" and v.z < 0]
+    flat = [s for s, v in steps if v.word != "differs"]
+    parts = [f"below 1 by more than 2σ at γ = {', '.join(below)}" if below else "below 1 by 2σ nowhere"]
+    if near:
+        parts.append(f"within 2σ of 1 at γ = {', '.join(near)}")
+    trend_bits = []
+    if up:
+        trend_bits.append(f"rises by more than 2σ at {len(up)} of the {len(steps)} steps in γ ({'; '.join(up)})")
+    if down:
+        trend_bits.append(f"falls by more than 2σ at {'; '.join(down)}")
+    if flat:
+        trend_bits.append(f"shows no resolved change at {'; '.join(flat)}")
+    low = rows[0]
+    return (
+        f"the ratio lies {' and '.join(parts)}; from step to step it "
+        + ", ".join(trend_bits)
+        + f"; at γ = {low['gamma']:g} the rate is {_ve(low['ratio'], low['ratio_err'])} of Kramers–Langer's"
+    )
+
+
+def _noise_no_drag(get: Loader) -> str:
+    rows = [r for r in get("noise", None)["no_drag"] if r["sigma"] > 0]
+    out = []
+    for s in sorted({r["sigma"] for r in rows}):
+        cells = []
+        for r in sorted((r for r in rows if r["sigma"] == s), key=lambda r: r["energy"]):
+            v = verdict(r["kappa_over_kappa0"], r["kappa_over_kappa0_err"], 1.0)
+            word = (
+                "below κ0" if v.word == "differs" and v.z < 0 else "above κ0" if v.word == "differs" else "κ0 within 2σ"
+            )
+            cells.append(f"{word} at E0 = {r['energy']:g} (z = {signed(v.z)})")
+        out.append(f"σ = {s:g}: " + ", ".join(cells))
+    return "the rate over the window is " + "; ".join(out)
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -453,6 +501,8 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.one_exponential": _generality_one_exponential,
     "generality.hh_1_05": _generality_hh_1_05,
     "noise.kramers": _noise_kramers,
+    "noise.turnover": _noise_turnover,
+    "noise.no_drag": _noise_no_drag,
     "b_relation": _b_relation,
     "fig5.tightening": _fig5_tightening,
     "fig5.shrink": _fig5_shrink,

@@ -142,3 +142,24 @@ def test_a_page_beyond_the_paper_states_its_limits(page):
     assert f"[[{name}:scale]]" in section or f"[[{name}@" in section, "the scale, from the JSON"
     assert "|int]]" in section, "N, from the JSON"
     assert "does not show" in section
+
+
+def test_the_turnover_reading_follows_each_step_and_its_errors():
+    rows = [{"gamma": g, "ratio": r, "ratio_err": 0.01} for g, r in ((0.03, 0.3), (0.1, 0.6), (0.3, 0.61), (1, 1.0))]
+    text = READINGS["noise.turnover"](_loader({"noise": {"turnover": rows}}))
+    assert "below 1 by more than 2σ at γ = 0.03, 0.1, 0.3 and within 2σ of 1 at γ = 1" in text
+    assert "rises by more than 2σ at 2 of the 3 steps in γ (0.03 → 0.1; 0.3 → 1)" in text
+    assert "no resolved change at 0.1 → 0.3" in text
+
+
+def test_the_no_drag_reading_says_below_only_beyond_two_sigma():
+    rows = [
+        {"energy": 0.3, "sigma": 0.0, "kappa_over_kappa0": 1.0, "kappa_over_kappa0_err": 0.05},
+        {"energy": 0.3, "sigma": 0.01, "kappa_over_kappa0": 0.95, "kappa_over_kappa0_err": 0.05},
+        {"energy": 0.3, "sigma": 0.02, "kappa_over_kappa0": 0.70, "kappa_over_kappa0_err": 0.05},
+    ]
+    text = READINGS["noise.no_drag"](_loader({"noise": {"no_drag": rows}}))
+    assert text == (
+        "the rate over the window is σ = 0.01: κ0 within 2σ at E0 = 0.3 (z = −1.0); "
+        "σ = 0.02: below κ0 at E0 = 0.3 (z = −6.0)"
+    )
