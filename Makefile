@@ -133,6 +133,13 @@ report-unknown-scale:
 
 report: reports/$(SCALE)/report.html ## reproduction report (HTML + Markdown): quick runs what is missing; SCALE=paper reads the committed results
 
+# `make report` says what it will run and roughly how long (the committed cost records) before anything starts
+ifneq ($(filter report,$(MAKECMDGOALS)),)
+ifneq ($(filter $(SCALE),$(STUDY_SCALES)),)
+$(info $(shell $(PY) -m hhscatter.publish.report --plan --scale $(SCALE)))
+endif
+endif
+
 bench-engine: $(BENCH_STAMP) ## engine targets as ratios in one run (yardstick, DOP853, recording) → benchmarks/out/engine/full/
 	$(PY) -m benchmarks.engine $(ENGINE_ARGS)
 

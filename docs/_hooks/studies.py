@@ -137,17 +137,17 @@ class Renderer:
                 f"Run `make {study}` and then `make docs-assets` to copy the quick-scale figure here.",
             )
 
-        def one(path, alt, caption):
+        def one(path, alt, caption, cls="hh-figure"):
             src = self._rel(path)
             return (
-                f'<figure class="hh-figure" markdown="span">\n[![{alt}]({src})]({src}){{ .hh-zoom }}\n'
+                f'<figure class="{cls}" markdown="span">\n[![{alt}]({src})]({src}){{ .hh-zoom }}\n'
                 f"<figcaption>{caption} (click to zoom)</figcaption>\n</figure>\n"
             )
 
         def figure(path, scale, cmd):
             """The figure at one scale; a multi-panel figure whose plot stage wrote its panels one by one
-            (``<name>_panel_<letter>.png``, hhscatter.publish.figures.save_panels) panel by panel, each at the full
-            width of the text, the composite folded below them."""
+            (``<name>_panel_<letter>.png``, hhscatter.publish.figures.save_panels) panel by panel, each at its natural
+            width (at most the text's: a panel is never upscaled), the composite folded below them."""
             whole = one(path, f"{name}, {scale} scale", f"{scale.capitalize()} scale: <code>{cmd}</code>")
             panels = sorted(path.parent.glob(f"{path.stem}_panel_*.png"))
             if not panels:
@@ -157,6 +157,7 @@ class Renderer:
                     p,
                     f"{name}, panel ({p.stem[-1]}), {scale} scale",
                     f"({p.stem[-1]}) {scale} scale: <code>{cmd}</code>",
+                    "hh-figure hh-panel",  # at its natural width (never upscaled), at most the text's
                 )
                 for p in panels
             )
@@ -403,13 +404,28 @@ class Renderer:
                 continue
             scales.setdefault(scale, []).append(name)
             for r in doc.get("paper_comparison") or []:
-                out.append({**r, "scale": scale, "quantity": f"[{name}]({name}.md): {r.get('quantity', '')}"})
-        text = comparison_table(out) if out else "*No study has written paper-vs-ours rows yet.*\n"
+                out.append({**r, "scale": scale, "study": name})
+        from hhscatter.publish.formatting import comparison_table as table
+        from hhscatter.publish.formatting import md_cell
+
+        def linked(r):  # the row keeps its own quantity (its verdict is the row's); the cell links the study
+            return md_cell(f"[{r['study']}]({r['study']}.md): {r.get('quantity', '')}")
+
+        text = table(out, quantity=linked) if out else "*No study has written paper-vs-ours rows yet.*\n"
         said = "; ".join(f"{sc} scale: " + ", ".join(f"[{n}]({n}.md)" for n in names) for sc, names in scales.items())
         text += f"\n*Scale of each study's rows — {said}.*\n" if said else ""
         if missing:
             text += "\n*Not yet generated: " + ", ".join(f"[{m}]({m}.md)" for m in missing) + ".*\n"
         return text
+
+    def headline_results(self, _arg=None) -> str:
+        """The README's results (tools/readme_results.md), its numbers and verdicts rendered from the committed JSON
+        as the README's are: the docs home opens with them."""
+        from hhscatter.publish.numbers import render_refs
+
+        text = (self.root / "tools" / "readme_results.md").read_text()
+        text = re.sub(r"\A<!--.*?-->\n", "", text, flags=re.S)  # the template's own note
+        return render_refs(text, self.root, where="tools/readme_results.md")
 
     def verdict_rule(self, _arg=None) -> str:
         """The one verdict rule, as the code states it (hhscatter.analysis.stats.verdicts.RULE)."""
@@ -618,7 +634,10 @@ def _is_record_list(v) -> bool:
 
 def claims_table(doc) -> str:
     """Markdown table claims × systems of a numbers JSON with a ``claims`` list and a ``systems`` dict
-    ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear."""
+    ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear; each
+    verdict by the one rule (:func:`hhscatter.analysis.stats.verdicts.claim_verdict`)."""
+    from hhscatter.analysis.stats.verdicts import claim_verdict
+
     systems = list((doc.get("systems") or {}).keys())
     for c in doc["claims"]:
         if c.get("system") not in systems:
@@ -643,7 +662,7 @@ def claims_table(doc) -> str:
         val = (
             "n/a" if v is None else (fmt_err(v, e) if _is_num(e) else fmt_value(v) if not _is_num(v) else fmt_num(v, 3))
         )
-        verdict = c.get("verdict")
+        verdict = claim_verdict(c, doc.get("scale")) if c.get("verdict") else None  # the rule of every table
         return _cell(f"{val}: {verdict}" if verdict else val)
 
     out = [

@@ -1,1 +1,2 @@
-"""Publish: number formatting (``formatting``), the studies report (``report``) and the figure backend (``figures``)."""
+"""Publish: number formatting (``formatting``), numbers and readings in prose from the committed JSON (``numbers``,
+``readings``), the studies report (``report``) and the figure backend (``figures``)."""

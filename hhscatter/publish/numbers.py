@@ -8,7 +8,8 @@ study's committed numbers JSON when the page is built::
     quick scale: [[fig2@quick:kappa_fit.c]]           → the quick-scale JSON
     [[fig2:kappa_fit.c|value]], [[fig2:kappa_fit.c|err]]
     [[fig2:kappa_energy[energy=0.27].kappa|.4f]]      → a record of a list, chosen by a field
-    [[fig5:paper_comparison[quantity=d_rel].verdict]] → text leaves as they are
+    [[fig5:paper_comparison[quantity=d_rel].verdict]] → a row's verdict, by the one rule
+    [[reading:fig5.premise]]                         → a generated reading (hhscatter.publish.readings)
 
 The reference is ``[[study[@scale]:path[|format]]]``:
 
@@ -37,7 +38,8 @@ syntax on these pages), so a reference may stand inside ``$…$`` maths too.
 
 :func:`stray_numbers` is the other half: it lists the numbers a page's prose
 types by hand that are neither references nor declared conventions
-(``<!-- conventions: … -->``); the docs tests fail on any.
+(``<!-- conventions: … -->``); the docs tests fail on any. :func:`typed_readings` does the same for readings (agrees, within a factor, holds,
+never, …), which a page names as ``[[reading:name]]`` (:mod:`hhscatter.publish.readings`).
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ __all__ = [
     "render_refs",
     "resolve",
     "stray_numbers",
+    "typed_readings",
 ]
 
 #: ``[[study[@scale]:path[|format]]]``; ``]]`` closes it (a ``[…]`` selector inside the path is fine); the bar may
@@ -362,18 +365,42 @@ def _protected(text: str) -> list[tuple[int, int]]:
 def format_ref(doc, path: str, fmt: str | None = None) -> str:
     """The text of one reference: :func:`resolve` then :func:`format_leaf`; with ``ci`` a number whose interval
     is its sibling ``<key>_interval`` (``rows[…].delta`` beside ``rows[…].delta_interval``) is written with it."""
+    scale = doc.get("scale") if isinstance(doc, dict) else None
+    stripped = path.strip()
+    if stripped.endswith(".verdict") and not fmt:  # a row's or a claim's verdict: by the one rule, not as stored
+        parent = resolve(doc, stripped[: -len(".verdict")])
+        if isinstance(parent, dict) and ("ours" in parent or "reference" in parent):
+            return _rule_verdict(parent, scale)
     leaf = resolve(doc, path)
     if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
-        from hhscatter.analysis.stats.verdicts import row_verdict  # deferred: only this format needs it
-
-        if not isinstance(leaf, dict) or "ours" not in leaf:
-            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours')")
-        return row_verdict(leaf, doc.get("scale") if isinstance(doc, dict) else None)
+        if not isinstance(leaf, dict) or not ("ours" in leaf or "reference" in leaf):
+            raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours') or a claim record")
+        return _rule_verdict(leaf, scale)
     if (fmt or "").strip() == "pm" and _is_num(leaf):  # a number beside its error <key>_err
         return format_leaf({"value": leaf, "err": resolve(doc, path.strip() + "_err")})
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)
+
+
+def _rule_verdict(row: dict, scale) -> str:
+    """The verdict of a paper-vs-ours row or a claim record by the one rule
+    (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, :func:`~hhscatter.analysis.stats.verdicts.claim_verdict`),
+    its minus signs typographic."""
+    from hhscatter.analysis.stats.verdicts import claim_verdict, row_verdict  # deferred: only verdicts need it
+
+    return row_verdict(row, scale) if "ours" in row else claim_verdict(row, scale)
+
+
+def _reading(root: Path, name: str) -> str:
+    """The sentence of reading ``name`` (:func:`hhscatter.publish.readings.reading`) from the committed numbers under
+    ``root``; NumberRefError when unknown or when the numbers it reads are missing."""
+    from hhscatter.publish.readings import reading  # deferred: only pages with readings need it (numpy, scipy)
+
+    try:
+        return reading(lambda study, scale: load_numbers(root, study, scale)[0], name.strip())
+    except (KeyError, StopIteration, TypeError, ValueError) as e:
+        raise NumberRefError(f"reading {name!r}: {e}") from None
 
 
 def render_refs(text: str, root: Path, *, where: str = "") -> str:
@@ -385,6 +412,8 @@ def render_refs(text: str, root: Path, *, where: str = "") -> str:
         if any(a <= m.start() < b for a, b in spans):
             return m.group(0)
         try:
+            if m.group("study") == "reading":  # a generated reading (hhscatter.publish.readings)
+                return _reading(root, m.group("path"))
             doc, _ = load_numbers(root, m.group("study"), m.group("scale"))
             return format_ref(doc, m.group("path"), m.group("fmt"))
         except NumberRefError as e:
@@ -547,3 +576,39 @@ def study_conventions(root: Path, study: str) -> set[float]:
         if path.is_file():
             out |= _paper_values(_load(str(path)))
     return {abs(v) for v in out}
+
+
+# -- readings typed by hand (hhscatter.publish.readings writes them) ---------------------------------------------------------------------------------------
+#: the words of a comparative or qualitative reading of results
+READING_WORDS = re.compile(
+    r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
+    r"best|worst|consistent(?:ly)? with)\b",
+    re.I,
+)
+_PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)
+_QUOTE = re.compile(r"\"[^\"]*\"|“[^”]*”")
+
+
+def typed_readings(text: str) -> list[tuple[int, str]]:
+    """typed_readings(page Markdown) -> [(line, phrase)] of the reading words its prose types by hand.
+
+    Not counted: ``[[…]]`` references (numbers and readings), code, HTML comments, quotes of the paper ("…"), and
+    the phrases a page declares as explanation or definition in a ``<!-- prose: "phrase"; "phrase" -->`` comment.
+
+    Examples
+    --------
+    >>> typed_readings('The ratio approaches 1. The paper says "μ approaches 1". [[reading:noise.kramers]]')
+    [(1, 'approaches')]
+    >>> typed_readings('<!-- prose: "never leave" -->\\nOrbits in the well can never leave.')
+    []
+    """
+    declared = [p.strip() for m in _PROSE.finditer(text) for p in re.findall(r"\"([^\"]+)\"", m.group(1))]
+    body = prose(text)
+    chars = list(body)
+    for rx in [_QUOTE] + [re.compile(re.escape(p)) for p in declared]:
+        for m in rx.finditer("".join(chars)):
+            for i in range(*m.span()):
+                if chars[i] != "\n":
+                    chars[i] = " "
+    body = "".join(chars)
+    return [(body.count("\n", 0, m.start()) + 1, m.group(0)) for m in READING_WORDS.finditer(body)]

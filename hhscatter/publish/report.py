@@ -17,12 +17,14 @@ import base64
 import datetime as _dt
 import html
 import json
+import os
+import re
 import shutil
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from hhscatter.analysis.stats.verdicts import RULE, row_verdict
+from hhscatter.analysis.stats.verdicts import RULE, row_verdict, verdict_class
 from hhscatter.errors import StudyError
 from hhscatter.publish.formatting import (
     comparison_table,
@@ -30,10 +32,11 @@ from hhscatter.publish.formatting import (
     format_value,
     markdown_to_html,
     md_cell,
+    scripts_to_html,
     typographic_minus,
 )
 from hhscatter.studies import load_study, studies_root
-from hhscatter.studies.cost import summary
+from hhscatter.studies.cost import summary, totals
 from hhscatter.studies.graph import GraphError, scales
 from hhscatter.studies.graph import studies as study_folders
 from hhscatter.studies.jsonio import write_json_atomic
@@ -140,18 +143,7 @@ def comparison_rows(sections) -> list[dict]:
     return rows
 
 
-def _verdict_class(v):
-    if not v:
-        return ""
-    v = v.lower()
-    if v.startswith("agree") or v.startswith("consistent") or v.startswith("reproduced"):
-        return "ok"
-    if v.startswith("differs in") and "only" in v:
-        # a difference that does not survive the authors' convention: not counted as one
-        return "meh"
-    if v.startswith("differ") or v.startswith("not"):
-        return "bad"
-    return "meh"
+_verdict_class = verdict_class  # agrees / differs / neither, by |z| when the verdict has one
 
 
 def _img_uri(path: Path) -> str:
@@ -282,7 +274,9 @@ def _rows_table(rows, html_verdicts: bool) -> str:
 
     def verdict(v):
         cls = _verdict_class(v)
-        return f'<span class="{cls}">{html.escape(v)}</span>' if html_verdicts and cls else md_cell(v)
+        if html_verdicts and cls:  # a bar of the verdict ("|z| ≤ 2") escaped, as md_cell does: one cell
+            return f'<span class="{cls}">{md_cell(html.escape(v))}</span>'
+        return md_cell(v)
 
     return comparison_table(rows, study=True, verdict=verdict)
 
@@ -375,12 +369,66 @@ pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 """
 
 
+_EQ_HEADING = re.compile(r"^###\s+\(([A-Z]?\d+)\).*\{#([\w-]+)\}\s*$", re.M)
+_EQ_REF = re.compile(r"\((eqn?:[\w-]+)\)")
+_CODE_HTML = re.compile(r"(<pre\b.*?</pre>|<code\b.*?</code>)", re.S)
+
+
+def equation_numbers(root: Path) -> dict[str, str]:
+    """equation_numbers(studies root) -> {'eqn:surv_prob_model': '18', …}: the paper's equation labels and their
+    numbers, from the ``### (N) … {#eqn-…}`` headings of the repository's docs/equations.md (empty without it), as
+    the docs site numbers them.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> equation_numbers(Path("/nonexistent/studies"))
+    {}
+    """
+    path = Path(root).parent / "docs" / "equations.md"
+    if not path.is_file():
+        return {}
+    return {anchor.replace("-", ":", 1): num for num, anchor in _EQ_HEADING.findall(path.read_text())}
+
+
+def number_equations(html_text: str, numbers: dict) -> str:
+    """number_equations(html, {label: number}) -> the equation labels "(eqn:…)" written as the site writes them,
+    "(18)", outside code; a label without a number stays as written.
+
+    Examples
+    --------
+    >>> number_equations("Eq. (eqn:surv_prob_model), <code>(eqn:surv_prob_model)</code>", {"eqn:surv_prob_model": "18"})
+    'Eq. (18), <code>(eqn:surv_prob_model)</code>'
+    """
+    parts = _CODE_HTML.split(html_text)
+    for i in range(0, len(parts), 2):  # even indices: outside code
+        parts[i] = _EQ_REF.sub(lambda m: f"({numbers[m.group(1)]})" if m.group(1) in numbers else m.group(0), parts[i])
+    return "".join(parts)
+
+
+def scripts_outside_code(html_text: str) -> str:
+    """scripts_outside_code(html) -> ``e^{−μγt}`` as ``e<sup>−μγt</sup>`` and ``μ_c^{E1}`` alike outside code, as the
+    docs site sets them (:func:`hhscatter.publish.formatting.scripts_to_html`).
+
+    Examples
+    --------
+    >>> scripts_outside_code("E0 e^{−μγt} <code>x^{2}</code>")
+    'E0 e<sup>−μγt</sup> <code>x^{2}</code>'
+    """
+    parts = _CODE_HTML.split(html_text)
+    for i in range(0, len(parts), 2):
+        parts[i] = scripts_to_html(parts[i])
+    return "".join(parts)
+
+
 def render_html(sections, scale, root) -> str:
     """render_html(sections, scale, root) -> one self-contained HTML page: the report's Markdown (figures as
-    data URIs) rendered by Python-Markdown."""
+    data URIs) rendered by Python-Markdown; the paper's equation labels numbered and ``^{…}``/``_{…}`` set as
+    superscripts and subscripts, as on the docs site."""
     body = markdown_to_html(
         render_markdown(sections, scale, root, lambda path, name: _img_uri(path), html_verdicts=True)
     )
+    body = scripts_outside_code(number_equations(body, equation_numbers(root)))
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><title>hhscatter reproduction report "
         f"({html.escape(scale)})</title><style>{_CSS}</style></head><body>\n{body}\n</body></html>\n"
@@ -415,12 +463,78 @@ def build_report(scale: str = "quick", out: Path | None = None, root: Path | Non
     return {"html": out / "report.html", "markdown": out / "report.md", "missing": missing, "rows": len(rows)}
 
 
+def plan_line(scale: str = "quick", root: Path | None = None, cores: int | None = None) -> str:
+    """plan_line(scale, root=None, cores=None) -> what ``make report`` at ``scale`` will run before it writes, and
+    roughly how long.
+
+    As the Makefile decides: a scale with committed results (other than quick) runs no study; otherwise every
+    study without its figure in ``studies/<name>/out/<scale>/`` is run. The time is the CPU time of the committed cost records of that scale
+    (``docs/studies/assets[/<scale>]/<study>.cost.json``) over the cores; a study without a record is named. The
+    benchmarks whose summaries are missing run too (not timed). An unknown ``scale`` raises
+    :class:`~hhscatter.errors.StudyError`.
+    """
+    root = Path(root) if root is not None else studies_root()
+    try:
+        known = scales(root)
+    except GraphError as exc:
+        raise StudyError(str(exc)) from None
+    if scale not in known:
+        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
+    cores = cores or os.cpu_count() or 1
+    head = f"make report (SCALE={scale})"
+    committed = scale != "quick" and any(committed_assets(root, scale).glob("*.json"))
+    if committed:
+        absent = [i.name for i in study_folders(root) if None in _study_files(root, i.name, scale)[:2]]
+        return (
+            f"{head}: reads the committed {scale}-scale results and runs no study"
+            + (f" (no outputs for {', '.join(absent)}: the report lists them as missing)" if absent else "")
+            + "; then the benchmarks whose summaries are missing, then writes."
+        )
+    missing, cpu, unknown = [], 0.0, []
+    for info in study_folders(root):
+        if (root / info.name / "out" / scale / f"{info.name}.png").is_file():
+            continue
+        missing.append(info.name)
+        rec = committed_assets(root, scale) / f"{info.name}.cost.json"
+        if rec.is_file():
+            cpu += sum(t["cpu_s"] for t in totals(json.loads(rec.read_text())).values())
+        else:
+            unknown.append(info.name)
+    if not missing:
+        return (
+            f"{head}: every study's outputs are there; it runs the benchmarks whose summaries are missing, then writes."
+        )
+    timed = []
+    if len(unknown) < len(missing):
+        timed.append(
+            f"about {max(1, round(cpu / 60.0 / cores))} min on {cores} core{'s' * (cores > 1)} by the committed cost records"
+        )
+    if unknown:
+        timed.append(f"no cost record for {', '.join(unknown)} (its time is not known here)")
+    n = len(missing)
+    out = f"{head}: runs {n} stud{'y' if n == 1 else 'ies'} first ({', '.join(missing)}): {'; '.join(timed)}; "
+    out += "then the benchmarks whose summaries are missing, then writes."
+    if scale == "quick":
+        out += " SCALE=paper reads the committed paper-scale results instead."
+    return out
+
+
 def main(argv=None) -> int:
 
     p = argparse.ArgumentParser(prog="python -m hhscatter.publish.report", description=__doc__.splitlines()[0])
     p.add_argument("--scale", default="quick")
     p.add_argument("--out", help="output folder (default reports/<scale>)")
+    p.add_argument(
+        "--plan", action="store_true", help="say what the report will run and roughly how long; write nothing"
+    )
     a = p.parse_args(argv)
+    if a.plan:
+        try:
+            print(plan_line(a.scale))
+        except StudyError as exc:
+            print(f"report: error: {exc}", file=sys.stderr)
+            return exc.exit_code
+        return 0
     try:
         res = build_report(a.scale, a.out)
     except StudyError as exc:

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from hhscatter.analysis.stats.library_warnings import warning_counts
-from hhscatter.analysis.stats.verdicts import NO_VERDICT, SMOKE_SCALES, without_verdicts
+from hhscatter.analysis.stats.verdicts import NO_VERDICT, REFERENCE_KINDS, SMOKE_SCALES, row_verdict, without_verdicts
 from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
@@ -267,10 +267,18 @@ class Study:
         verdict: str | None = None,
         convention: str | None = None,
         authors: bool = False,
+        reference: str | None = None,
+        paper_err: float | None = None,
+        why: str = "",
     ) -> dict:
         """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
 
-        One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test. ``convention`` says how
+        One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test; the tables and pages
+        judge the row by the one rule (:func:`~hhscatter.analysis.stats.verdicts.row_verdict`). ``reference``
+        names the kind of ``paper`` (:data:`~hhscatter.analysis.stats.verdicts.REFERENCE_KINDS`: "printed" by
+        the paper, "propagated" from printed numbers with its 1σ ``paper_err``, "exact" theory, "other": not the
+        same quantity, with ``why``); without it the rule infers it
+        (:func:`~hhscatter.analysis.stats.verdicts.reference_kind`). ``convention`` says how
         *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
         row computed in the authors' own convention (their IC region, window or selection rule), so that a
         "differs" can be checked against it. The paper's number is always in the authors' convention. At a smoke
@@ -286,6 +294,10 @@ class Study:
         conv = convention if convention is not None else self.convention_label
         if authors and not conv.startswith("authors"):
             conv = f"authors': {conv}"
+        if reference is not None and reference not in REFERENCE_KINDS:
+            raise StudyError(f"compare({quantity!r}): reference must be one of {', '.join(REFERENCE_KINDS)}")
+        if reference == "propagated" and paper_err is None:
+            raise StudyError(f"compare({quantity!r}): a propagated reference needs its 1σ paper_err")
         row = {
             "quantity": quantity,
             "ours": ours,
@@ -297,6 +309,14 @@ class Study:
             "convention": conv,
             "authors": bool(authors),
         }
+        if reference is not None:
+            row["reference_kind"] = reference
+        if paper_err is not None:
+            row["paper_err"] = float(paper_err)
+        if why:
+            row["why"] = why
+        if reference is not None and self.scale not in SMOKE_SCALES:
+            row["verdict"] = row_verdict(row, self.scale)
         self.comparisons.append(row)
         return row
 

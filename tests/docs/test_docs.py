@@ -164,7 +164,7 @@ def test_present_assets_render_figure_numbers_and_params(tmp_path, hook):
     assert "](assets/fig2.json)" in out
 
 
-def test_a_figure_with_panels_shows_each_at_full_width_the_composite_folded(tmp_path, hook):
+def test_a_figure_with_panels_shows_each_at_its_natural_width_the_composite_folded(tmp_path, hook):
     (tmp_path / "studies" / "fig5").mkdir(parents=True)
     assets = tmp_path / "docs" / "studies" / "assets"
     (assets / "paper").mkdir(parents=True)
@@ -173,7 +173,7 @@ def test_a_figure_with_panels_shows_each_at_full_width_the_composite_folded(tmp_
     (assets / "fig5.png").write_bytes(b"\x89PNG")  # the quick scale: no panels, the composite
     out, _ = _page(tmp_path, hook, "<!-- hh:study-figure fig5 -->\n")
     head, folded = out.split("??? note", 1)
-    assert head.count('class="hh-figure"') == 2 and "](assets/paper/fig5_panel_a.png){ .hh-zoom }" in head
+    assert head.count('class="hh-figure hh-panel"') == 2 and "](assets/paper/fig5_panel_a.png){ .hh-zoom }" in head
     assert "(a) paper scale" in head and "(b) paper scale" in head and "assets/paper/fig5.png" not in head
     assert '"The panels in one image (click to open)"' in folded and "](assets/paper/fig5.png){ .hh-zoom }" in folded
     assert "](assets/fig5.png){ .hh-zoom }" in folded  # the quick scale below, folded too

@@ -187,3 +187,44 @@ def test_the_report_writes_a_negative_number_with_the_minus_sign(tmp_path):
     md, page = res["markdown"].read_text(), res["html"].read_text()
     assert "| rep4 | κ shift (c-measure) | −0.0131 ± 0.0004 | 0 | differs (z = −32.8) |" in md, md
     assert "−0.0131 ± 0.0004" in page and "-0.0131" not in md + page
+
+
+def test_make_report_says_what_it_will_run_and_how_long(tmp_path):
+    """Before any work: the studies without their figure at the quick scale, and their CPU time from the committed
+    cost records over the cores; a study with its figure is not named; an unknown scale is refused."""
+    from hhscatter.errors import StudyError
+    from hhscatter.publish.report import plan_line
+
+    root = tmp_path / "studies"
+    _fake_study(root, "rep5", [], with_figure=False)
+    _fake_study(root, "rep6", [], with_figure=True)
+    assets = tmp_path / "docs" / "studies" / "assets"
+    assets.mkdir(parents=True)
+    run = {"wall_s": 1.0, "cpu_s": 600.0, "rss_self_mb": 1.0, "rss_children_mb": 1.0}
+    (assets / "rep5.cost.json").write_text(json.dumps({"simulate": [run, run], "analyze": [{**run, "cpu_s": 120.0}]}))
+    line = plan_line("quick", root=root, cores=2)
+    # (600 + 600 + 120) CPU s over 2 cores = 11 min
+    assert line.startswith("make report (SCALE=quick): runs 1 study first (rep5): about 11 min on 2 cores"), line
+    assert "rep6" not in line
+    with pytest.raises(StudyError, match="scale must be one of"):
+        plan_line("bogus", root=root)
+
+
+def test_the_report_html_numbers_equations_as_the_site(tmp_path):
+    """The report's HTML writes the paper's equation labels as the docs site does, "(18)", from docs/equations.md,
+    and a formula's ^{…} as a superscript."""
+    root = tmp_path / "studies"
+    row = {
+        "quantity": "f_ne",
+        "ours": 0.2,
+        "err": 0.01,
+        "paper": None,
+        "verdict": "",
+        "note": "Eq. (eqn:surv_prob_model), E0 e^{−μγt}",
+    }
+    _fake_study(root, "rep7", [row])
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "equations.md").write_text("### (18) Survival model {#eqn-surv_prob_model}\n")
+    page = build_report("quick", out=tmp_path / "rep", root=root)["html"].read_text()
+    assert "Eq. (18)" in page and "eqn:surv_prob_model" not in page
+    assert "E0 e<sup>−μγt</sup>" in page and "^{" not in page

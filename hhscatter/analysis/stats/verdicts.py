@@ -3,6 +3,10 @@
 * :data:`RULE` and :func:`verdict` — **the one rule** every table and every page applies: "agrees" when
   |ours − reference| ≤ 2σ with σ = √(σ_ours² + σ_ref²), both uncertainties; :func:`row_verdict` applies it
   to a paper-vs-ours row and says why when it cannot (never a "not a number"), and gives no verdict at the tiny scale;
+* :data:`REFERENCE_KINDS`, :func:`reference_kind`, :func:`reference_err` — the reference's own uncertainty kind
+  (printed, propagated, exact, or not the same quantity);
+* :func:`claim_verdict` — a claim record's verdict, by :func:`row_verdict`; :func:`verdict_class` — agrees,
+  differs or neither, from a verdict's text;
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
 * :func:`signed` — a signed number as verdicts print it ("−");
 * :func:`half_unit` — half a unit of the last digit of a printed number;
@@ -14,17 +18,29 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from decimal import Decimal
+
+#: the kinds of reference a number of ours is compared with, each with the uncertainty it carries
+REFERENCE_KINDS = {
+    "printed": "a number the paper prints without an error: half a unit of its last printed digit "
+    "('≈ 17' stands for [16.5, 17.5))",
+    "propagated": "a number derived from printed ones (a τ2 computed from the paper's μ carries μ's uncertainty) "
+    "or another measurement of ours: its own 1σ",
+    "exact": "a value of theory (an exponent 2, a limit 1, a predicted shift 0): no uncertainty",
+    "other": "not the same quantity: shown side by side, no verdict, with why",
+}
 
 #: the verdict rule, stated once (the docs' studies index and the report print this text)
 RULE = (
     "**agrees** when |ours − reference| ≤ 2σ, σ = √(σ_ours² + σ_ref²): both uncertainties, ours (1σ, "
-    "resampled over orbits) and the reference's (another study's 1σ, or, for a number the paper prints "
-    "without an error, half a unit of its last printed digit, so '≈ 17' stands for [16.5, 17.5); a reference 0 or 1 — a "
-    "predicted shift, exponent or limit — is exact); **differs** otherwise; z = (ours − reference)/σ. "
-    "A cell without a number or without our uncertainty says so instead of a verdict; the tiny scale "
-    "(a smoke test of a few hundred orbits) gives no verdicts."
+    "resampled over orbits) and the reference's own kind: **printed** by the paper (half a unit of its last "
+    "printed digit, so '≈ 17' stands for [16.5, 17.5)), **propagated** (derived from printed numbers, or "
+    "another measurement: its 1σ), **exact** (theory: an exponent 2, a limit 1, a predicted shift 0); "
+    "**differs** otherwise; z = (ours − reference)/σ. A reference that is **not the same quantity** is shown "
+    "side by side with why, and no verdict. A cell without a number or without our uncertainty says so "
+    "instead of a verdict; the tiny scale (a smoke test of a few hundred orbits) gives no verdicts."
 )
 #: scales whose outputs are smoke tests: their rows carry no verdict
 SMOKE_SCALES = ("tiny",)
@@ -90,13 +106,71 @@ def verdict(value, err, ref, ref_err=0.0) -> Verdict:
     return Verdict("agrees" if abs(z) <= 2 else "differs", z)
 
 
-def row_verdict(row: dict, scale: str | None = None) -> str:
-    """row_verdict(paper-vs-ours row, scale) -> the text of its verdict cell by :data:`RULE`.
+_CLAIM = re.compile(r"^\[\w+\] ")
 
-    A row with numbers (``ours``, ``err``, ``paper``; ``paper_err`` when the
-    reference has one, else half a unit of the paper's last printed digit)
-    gets the rule's verdict; a qualitative row (text, or no reference) keeps
-    the verdict its study wrote, or "—"; at a smoke scale (tiny) no verdict.
+
+def reference_kind(row: dict) -> str:
+    """reference_kind(paper-vs-ours row) -> the kind of its reference, one of :data:`REFERENCE_KINDS` (or
+    "recorded").
+
+    The row's ``reference_kind`` when it states one; else, for rows written before rows stated it:
+    "propagated" when it records ``paper_err``; "recorded" for a claim record (quantity "[n] …"), whose verdict
+    the claims library made by this rule against the reference it names (theory exact, another measurement
+    with its 1σ) unless that verdict names the paper's printed number ("printed"); "exact" for a reference 0
+    or 1 (a predicted shift, a limit); else "printed".
+
+    Examples
+    --------
+    >>> reference_kind({"ours": 1.46, "err": 0.12, "paper": 2.0, "reference_kind": "exact"})
+    'exact'
+    >>> reference_kind({"ours": 0.2705, "err": 0.001, "paper": 0.27}), reference_kind({"ours": 0.1, "paper": 0})
+    ('printed', 'exact')
+    """
+    kind = row.get("reference_kind")
+    if kind:
+        if kind not in REFERENCE_KINDS:
+            raise ValueError(f"reference_kind {kind!r}: expected one of {', '.join(REFERENCE_KINDS)}")
+        return kind
+    if _finite(row.get("paper_err")):
+        return "propagated"
+    if _CLAIM.match(str(row.get("quantity", ""))) and row.get("verdict"):
+        return "printed" if "the paper's" in str(row["verdict"]) else "recorded"
+    paper = row.get("paper")
+    if _finite(paper) and paper in (0, 1):
+        return "exact"
+    return "printed"
+
+
+def reference_err(row: dict, kind: str | None = None) -> float | None:
+    """reference_err(row, kind=None) -> the 1σ of the row's reference by its kind: half a unit of the last printed
+    digit (printed), ``paper_err`` (propagated; None when not recorded), 0 (exact).
+
+    Examples
+    --------
+    >>> reference_err({"paper": 17.0}), reference_err({"paper": 2.0, "reference_kind": "exact"})
+    (0.5, 0.0)
+    """
+    kind = kind or reference_kind(row)
+    paper = row.get("paper")
+    if kind == "printed":
+        return half_unit(paper) if _finite(paper) else None
+    if kind == "propagated":
+        e = row.get("paper_err")
+        return float(e) if _finite(e) else None
+    return 0.0
+
+
+def row_verdict(row: dict, scale: str | None = None) -> str:
+    """row_verdict(paper-vs-ours row, scale) -> the text of its verdict cell by :data:`RULE`: **the one function**
+    every table, claim, report row and sentence takes its verdict from.
+
+    A row with numbers (``ours``, ``err``, ``paper``) is judged against its
+    reference with the uncertainty of the reference's kind
+    (:func:`reference_kind`: printed, propagated, exact); a reference of
+    another quantity ("other") is side by side, no verdict, with the row's
+    ``why``; a claim record keeps the verdict the claims library made by this
+    rule ("recorded"); a qualitative row (text, or no reference) keeps the
+    verdict its study wrote, or "—"; at a smoke scale (tiny) no verdict.
     A "differs" that the study qualified (e.g. "differs in our convention
     only; agrees under the authors' …") keeps its qualification.
 
@@ -104,6 +178,10 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     --------
     >>> row_verdict({"ours": 0.2705, "err": 0.001, "paper": 0.27})
     'agrees (z = +0.1)'
+    >>> row_verdict({"ours": 1.46, "err": 0.12, "paper": 2.0, "reference_kind": "exact"})
+    'differs (z = −4.5)'
+    >>> row_verdict({"ours": 1.46, "err": 0.12, "paper": 2.0, "reference_kind": "other", "why": "another window"})
+    'not the same quantity: another window'
     >>> row_verdict({"ours": 0.2705, "err": 0.001, "paper": 0.27}, "tiny")
     'no verdict (tiny scale: a smoke test)'
     """
@@ -121,13 +199,71 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
         if isinstance(ours, float) and not math.isfinite(ours):
             return "undetermined: no value of ours (not measurable here)"
         return stored or "—"
-    ref_err = row.get("paper_err")
-    if not _finite(ref_err):  # the paper's printed number: half a unit of its last digit; 0 and 1 are exact
-        ref_err = half_unit(paper) if _finite(paper) and paper not in (0, 1) else 0.0
+    kind = reference_kind(row)
+    if kind == "other":
+        return f"not the same quantity: {row.get('why') or 'see the note'}"
+    if kind == "recorded":
+        return stored
+    ref_err = reference_err(row, kind)
+    if ref_err is None:
+        return "undetermined: the reference's propagated uncertainty is not recorded"
     v = verdict(ours, row.get("err"), paper, ref_err)
     if v.word == "differs" and stored.startswith("differs") and ";" in stored:
         return f"{v.text()}; {stored.split(';', 1)[1].strip()}"
     return v.text()
+
+
+def claim_verdict(rec: dict, scale: str | None = None) -> str:
+    """claim_verdict(claim record, scale) -> its verdict by :func:`row_verdict`, as the record's row of the
+    paper-vs-ours table ('[claim] quantity — system') gets it: one number, one verdict.
+
+    Examples
+    --------
+    >>> claim_verdict({"claim": "1", "quantity": "κ0", "system": "hh", "value": 0.2, "err": 0.01, "reference": 0.27,
+    ...                "verdict": "differs from the paper's 0.27 (z = −7.0)"})
+    'differs (z = −6.3)'
+    """
+    row = {
+        "quantity": f"[{rec.get('claim')}] {rec.get('quantity')} — {rec.get('system')}",
+        "ours": rec.get("value"),
+        "err": rec.get("err"),
+        "paper": rec.get("reference"),
+        "verdict": rec.get("verdict"),
+        **{k: rec[k] for k in ("reference_kind", "paper_err", "why") if k in rec},
+    }
+    return row_verdict(row, scale)
+
+
+_Z = re.compile(r"\(z = ([−+-]?\d+(?:\.\d+)?)\)")
+
+
+def verdict_class(text: str) -> str:
+    """verdict_class(verdict text) -> "ok" (agrees), "bad" (differs) or "meh" (qualified, qualitative, not
+    comparable, no verdict): a verdict with a z by |z| ≤ 2 whatever its words ("not quadratic (z = −4.5)" is
+    "bad"), a difference in our convention only "meh".
+
+    Examples
+    --------
+    >>> [verdict_class(v) for v in ("not quadratic (z = −4.5)", "quadratic onset (b = 0) (z = +1.2)",
+    ...  "not the same quantity: another window", "differs in our convention only; agrees under the authors' (x)")]
+    ['bad', 'ok', 'meh', 'meh']
+    """
+    v = str(text or "").strip()
+    low = v.lower()
+    if not v:
+        return ""
+    if low.startswith("differs in") and "only" in low:
+        return "meh"
+    m = _Z.search(v)
+    if m:
+        return "ok" if abs(float(m.group(1).replace("−", "-"))) <= 2 else "bad"
+    if low.startswith(("not the same", "not applicable", "no verdict", "undetermined")):
+        return "meh"
+    if low.startswith(("agree", "consistent", "reproduced")):
+        return "ok"
+    if low.startswith(("differ", "not")):
+        return "bad"
+    return "meh"
 
 
 def without_verdicts(doc, scale: str | None):

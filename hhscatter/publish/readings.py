@@ -1,0 +1,530 @@
+"""Readings in prose, generated from the committed study JSON like the numbers: the words around the numbers.
+
+A comparative or qualitative statement on a results page (agrees, approaches, monotone, within a factor, holds,
+never, always, the best or worst case) is not typed: the page names a reading, ``[[reading:name]]``, and the docs
+build replaces it with the sentence a function writes after testing its condition with the uncertainties (a
+trend by a weighted fit and its σ, "within a factor" from the intervals, "holds" from the verdicts, "closer" from
+the distance's interval). Where the data do not support a reading, the sentence says what is measured, no more.
+
+The building blocks are pure functions of numbers (:func:`trend`, :func:`trend_words`, :func:`factor_words`,
+:func:`closer_words`, :func:`pass_fail_words`); :data:`READINGS` maps each name a page may use to the function that
+writes it from the studies' numbers. :func:`hhscatter.publish.numbers.typed_readings` lists the reading words a page
+types by hand; the docs tests fail on any, as they fail on a typed number.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+
+import numpy as np
+
+from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.verdicts import claim_verdict, signed, verdict, verdict_class
+from hhscatter.publish.formatting import format_value_err, typographic_minus
+
+__all__ = [
+    "READINGS",
+    "closer_words",
+    "factor_words",
+    "pass_fail_words",
+    "reading",
+    "trend",
+    "trend_words",
+]
+
+#: the p-value below which a goodness-of-fit test rejects
+P_LEVEL = 0.05
+#: a difference or slope is "resolved" when it lies this many σ from zero (the verdict rule's 2σ)
+Z_RESOLVED = 2.0
+
+
+def _ve(value, err) -> str:
+    return typographic_minus(format_value_err(float(value), float(err)))
+
+
+def _int(n) -> str:
+    """A count with thin-space thousands (as the rendered numbers write them)."""
+    return f"{int(n):,}".replace(",", "\u2009")
+
+
+def trend(x, y, err) -> dict:
+    """trend(x, y, 1σ of y) -> {slope, err, z, chi2, dof}: the weighted straight-line fit y = a + s·x (weights 1/σ²).
+
+    Examples
+    --------
+    >>> t = trend([3, 4, 5, 6], [0.874, 0.932, 0.909, 0.972], [0.030, 0.030, 0.030, 0.031])
+    >>> round(t["slope"], 4), round(t["err"], 4), round(t["z"], 1)
+    (0.0269, 0.0136, 2.0)
+    """
+    x, y, e = (np.asarray(v, dtype=float) for v in (x, y, err))
+    if x.size < 3:
+        raise ValueError(f"a trend needs at least 3 points, got {x.size}")
+    fit = weighted_least_squares(np.column_stack([np.ones_like(x), x]), y, 1.0 / e**2)
+    s, se = float(fit.coef[1]), float(math.sqrt(fit.cov[1, 1]))
+    return {"slope": s, "err": se, "z": s / se, "chi2": fit.chi2, "dof": fit.dof}
+
+
+def trend_words(t: dict, y_name: str, x_name: str, unit: str = "") -> str:
+    """trend_words(trend, what, against what) -> "rises with X (slope s ± σ per unit, z = …)" when |z| > 2, "falls
+    …" likewise, else "shows no trend resolved at 2σ (slope …)".
+
+    Examples
+    --------
+    >>> trend_words({"slope": 0.0286, "err": 0.0135, "z": 2.12}, "the ratio", "ΔE/T")
+    'the ratio rises with ΔE/T (weighted slope 0.029 ± 0.013, z = +2.1)'
+    >>> trend_words({"slope": 0.01, "err": 0.02, "z": 0.5}, "the ratio", "ΔE/T")
+    'the ratio shows no trend in ΔE/T resolved at 2σ (weighted slope 0.010 ± 0.020, z = +0.5)'
+    """
+    per = f" per {unit}" if unit else ""
+    fit = f"weighted slope {_ve(t['slope'], t['err'])}{per}, z = {signed(t['z'])}"
+    if abs(t["z"]) > Z_RESOLVED:
+        return f"{y_name} {'rises' if t['slope'] > 0 else 'falls'} with {x_name} ({fit})"
+    return f"{y_name} shows no trend in {x_name} resolved at 2σ ({fit})"
+
+
+def factor_words(factor_min: float, factor_max: float, n_overlap: int, n: int, what: str = "the prediction") -> str:
+    """factor_words(smallest factor, largest factor, intervals overlapping, cases) -> how far apart two sets of
+    numbers are, from their ratios and their intervals: "within a factor F" only when every ratio is within it.
+
+    Examples
+    --------
+    >>> factor_words(1.08, 6.63, 1, 5)
+    'the prediction is off by a factor 1.1 to 6.6 over the 5 cases; their 1σ intervals overlap in 1 of 5'
+    >>> factor_words(1.02, 1.4, 5, 5)
+    'the prediction is within a factor 1.4 in all 5 cases, and their 1σ intervals overlap in every one'
+    """
+    if n_overlap == n and factor_max <= 2:
+        return (
+            f"{what} is within a factor {factor_max:.2g} in all {n} cases, and their 1σ intervals overlap in every one"
+        )
+    return (
+        f"{what} is off by a factor {factor_min:.2g} to {factor_max:.2g} over the {n} cases; their 1σ intervals "
+        f"overlap in {n_overlap} of {n}"
+    )
+
+
+def closer_words(d_a, e_a, d_b, e_b, a: str, b: str, distance: str) -> str:
+    """closer_words(d to a, 1σ, d to b, 1σ, a, b, distance) -> which reference is closer by this distance, by the
+    verdict rule (|Δd| > 2σ, both errors): "closer to a by SW1 (… vs …, z = …)" or "as close to a as to b".
+
+    Examples
+    --------
+    >>> closer_words(0.0288, 0.0015, 0.0206, 0.0010, "μ_c^0.30", "μ_c^0.35", "SW1")
+    'closer to μ_c^0.35 by SW1 (0.0288 ± 0.0015 to μ_c^0.30 vs 0.0206 ± 0.0010, z = +4.5)'
+    """
+    v = verdict(d_a, e_a, d_b, e_b)
+    pair = f"{_ve(d_a, e_a)} to {a} vs {_ve(d_b, e_b)}"
+    if v.z is None or v.word == "agrees":
+        return f"as close to {a} as to {b} by {distance} ({pair}{'' if v.z is None else f', z = {signed(v.z)}'})"
+    return f"closer to {a if v.z < 0 else b} by {distance} ({pair}, z = {signed(v.z)})"
+
+
+def pass_fail_words(cells: list[tuple[str, bool | None]], holds: str, fails: str) -> str:
+    """pass_fail_words([(cell, passed: True / False / None)], holds, fails) -> "fails at …; holds at …; not tested
+    at …": never an "always" or a "never" unless every cell was tested and says so.
+
+    Examples
+    --------
+    >>> pass_fail_words([("1.05", False), ("1.9", True), ("2.6", None)], "one exponential", "not one exponential")
+    'not one exponential at 1.05; one exponential at 1.9; not tested at 2.6'
+    >>> pass_fail_words([("a", False), ("b", False)], "holds", "fails")
+    'fails at every tested cell (a, b)'
+    """
+    groups: dict = {False: [], True: [], None: []}
+    for cell, ok in cells:
+        groups[ok].append(cell)
+    if groups[False] and not groups[True] and not groups[None]:
+        return f"{fails} at every tested cell ({', '.join(groups[False])})"
+    if groups[True] and not groups[False] and not groups[None]:
+        return f"{holds} at every tested cell ({', '.join(groups[True])})"
+    out = []
+    if groups[False]:
+        out.append(f"{fails} at {', '.join(groups[False])}")
+    if groups[True]:
+        out.append(f"{holds} at {', '.join(groups[True])}")
+    if groups[None]:
+        out.append(f"not tested at {', '.join(groups[None])}")
+    return "; ".join(out)
+
+
+# -- the named readings -----------------------------------------------------------------------------------------
+Loader = Callable[[str, str | None], dict]
+
+
+def _basins_cutoff(get: Loader) -> str:
+    s = get("basins", None)["cutoff_summary"]
+    words = factor_words(s["factor_min"], s["factor_max"], s["n_overlap"], s["n_resolved"])
+    return f"{words} (the measured cut-off lies below the prediction in {s['n_below']} of {s['n_resolved']})"
+
+
+def _fig5_premise(get: Loader) -> str:
+    d = get("fig5", None)
+    g = d["gamma_main"]
+    rows = {(r["set"], r["ref"]): r for r in d["distances"] if r["gamma"] == g}
+    paired = {r["set"]: r for r in d["refs_paired"]["rows"] if r["construction"] == "ours"}
+    parts, closer = [], {}
+    for s in ("a", "b"):
+        p = paired[f"5{s}"]["delta"]
+        lo, hi = p["interval"]
+        by_h = "μ_c^0.30" if lo > 0 else "μ_c^0.35" if hi < 0 else None
+        hel = (
+            f"closer to {by_h} by the debiased Hellinger distance (Δ = d(μ_c^0.35) − d(μ_c^0.30) = "
+            f"{signed(p['value'], '+.3f')}, 95 % [{signed(lo, '+.3f')}, {signed(hi, '+.3f')}])"
+            if by_h
+            else "as close to either by the debiased Hellinger distance (its 95 % interval of Δ holds 0)"
+        )
+        r1, r2 = rows[s, "E1"], rows[s, "E2"]
+        sw = closer_words(r1["sw1"], r1["sw1_err"], r2["sw1"], r2["sw1_err"], "μ_c^0.30", "μ_c^0.35", "SW1")
+        by_s = "μ_c^0.30" if "closer to μ_c^0.30" in sw else "μ_c^0.35" if "closer to μ_c^0.35" in sw else None
+        closer[s] = {by_h, by_s}
+        parts.append(f"5{s} lies {hel} and {sw}")
+    same = [s for s in ("a", "b") if closer[s] == {"μ_c^0.30"}]
+    if len(same) == 2:
+        tail = "the paper's premise for Fig. 5 (the points are distributed like μ_c^0.30) holds for both sets by both distances"
+    elif same:
+        other = "b" if same == ["a"] else "a"
+        tail = (
+            f"the paper's premise for Fig. 5 (the points are distributed like μ_c^0.30) holds for 5{same[0]} by both "
+            f"distances; for 5{other} it depends on the distance"
+        )
+    else:
+        tail = "the paper's premise for Fig. 5 (the points are distributed like μ_c^0.30) depends on the distance"
+    return f"At γ = {g:g}, " + "; ".join(parts) + f": {tail}"
+
+
+def _generality_b_onset(get: Loader) -> str:
+    d = get("generality", None)
+    rec = next(c for c in d["claims"] if c["id"] == "henon_heiles-1-5")
+    v = claim_verdict(rec, d.get("scale"))
+    cls = verdict_class(v)
+    z = re.search(r"\(z = [^)]*\)", v)
+    if cls == "ok":
+        return f"consistent with a quadratic onset, b = 0 {z.group(0) if z else ''}".strip()
+    if cls == "bad":
+        return f"a linear onset, b resolved from 0 {z.group(0) if z else ''}".strip()
+    return f"not judged against b = 0 ({v})"
+
+
+def _b_relation(get: Loader) -> str:
+    f2, g = get("fig2", None), get("generality", None)
+    e_c = float(f2["E_c"])
+    b = f2["kappa_fit"]["b"]
+    rec = next(c for c in g["claims"] if c["id"] == "henon_heiles-1-5")
+    b_red, e_red = b["value"] * e_c, b["err"] * e_c
+    v = verdict(rec["value"], rec["err"], b_red, e_red)
+    f2_n = f2["config"]["study"]["grid_n"]
+    f2_e = f2["config"]["study"]["grid_energies"]
+    g_st = g["config"]["study"]
+    ratio = rec["err"] / e_red
+    z_f2, z_g = b["value"] / b["err"], rec["value"] / rec["err"]
+    agree = "agree" if v.word == "agrees" else "differ"
+    return (
+        (
+            f"fig2's linear term b = {_ve(b['value'], b['err'])} is fitted to κ (1/time) against E − E_c on "
+            f"{len(f2_e)} energies from {min(f2_e):g} to {max(f2_e):g} (r_esc {f2['config']['scene']['r_esc']:g}, "
+            f"{_int(f2_n)} orbits each, t_max up to {f2['config']['scene']['t_max']:g}); in generality's reduced units "
+            f"(κ in well frequencies, which for Hénon–Heiles (ω = 1) is 1/time, against ε = E/E_c − 1) it is "
+            f"b·E_c = {_ve(b_red, e_red)}. Generality's b = {_ve(rec['value'], rec['err'])} is the mean over its "
+            f"window and IC conventions on {len(g_st['ratios'])} energies from {min(g_st['ratios']):g} to "
+            f"{max(g_st['ratios']):g} E_c (r_esc the system's default, {_int(g_st['grid_n'])} orbits each, t_max "
+            f"{g['config']['scene']['t_max']:g}), its error widened by their spread. The two {agree} "
+            f"(z = {signed(v.z)}); generality's error is {ratio:.0f} times fig2's, so fig2 resolves b from 0 "
+            f"({abs(z_f2):.0f}σ) and generality does not ({abs(z_g):.1f}σ)"
+        )
+        .replace(",", "\u2009")
+        .replace("\u2009 ", ", ")
+    )
+
+
+def _generality_one_exponential(get: Loader) -> str:
+    d = get("generality", None)
+    out = []
+    for label in d.get("systems") or {}:
+        cells = [
+            (f"{f['e_ratio']:g}", None if f.get("p_nonregular") is None else f["p_nonregular"] >= P_LEVEL)
+            for f in d["long_time"]
+            if f["label"] == label and "disk" in f["ics"]
+        ]
+        out.append(f"{label}: " + pass_fail_words(cells, f"p ≥ {P_LEVEL:g}", f"p < {P_LEVEL:g}"))
+    return (
+        "The χ² test of one exponential from t0 on the non-regular orbits gives, by E/E_c, "
+        + "; ".join(out)
+        + ". What it measures is the fit of one exponential, not its cause: its last cell, the orbits still inside "
+        "at t_max, can have an expected count far below 5, where a handful of orbits drives χ²"
+    )
+
+
+def constancy_words(values, errs, what: str) -> str:
+    """constancy_words(values, 1σ, what) -> whether numbers are one constant within their errors: the weighted mean,
+    χ² about it and its p-value; "constant within its errors" only when p ≥ 0.05.
+
+    Examples
+    --------
+    >>> constancy_words([0.00309, 0.00333, 0.00319], [6.9e-5, 6.5e-5, 7.1e-5], "the hazard")
+    'the hazard is not one constant within its errors (weighted mean 0.00321 ± 0.00004, χ² = 6.5 for 2 dof, p = 0.039)'
+    """
+    from scipy.stats import chi2 as chi2_dist  # deferred: scipy is loaded on first use
+
+    v, e = np.asarray(values, dtype=float), np.asarray(errs, dtype=float)
+    w = 1.0 / e**2
+    mean, mean_err = float(np.sum(w * v) / np.sum(w)), float(1.0 / math.sqrt(np.sum(w)))
+    chi2, dof = float(np.sum(w * (v - mean) ** 2)), v.size - 1
+    pv = float(chi2_dist.sf(chi2, dof)) if dof > 0 else float("nan")
+    head = f"{what} is constant within its errors" if pv >= P_LEVEL else f"{what} is not one constant within its errors"
+    return f"{head} (weighted mean {_ve(mean, mean_err)}, χ² = {chi2:.1f} for {dof} dof, p = {pv:.2g})"
+
+
+def _generality_hh_1_05(get: Loader) -> str:
+    d = get("generality", None)
+    k = next(
+        r for r in d["kappa"] if r["system"] == "henon_heiles" and r["ratio"] == 1.05 and r["convention"] == "plateau"
+    )
+    vm = next(v for v in d["validity_map"] if v["id"] == "henon_heiles-1.05-disk")
+    lt = next(f for f in d["long_time"] if f["id"] == "henon_heiles-1.05-disk")
+    t_max = d["config"]["scene"]["t_max"]
+    bins = lt["hazard_nonregular"]
+    before = [b for b in bins if b["t_hi"] <= t_max]
+    after = [b for b in bins if b["t_lo"] >= t_max]
+    state = "defined" if k["defined"] else "ill-defined"
+    out = (
+        f"κ0 is {state} under the plateau rule at t_max = {t_max:g}: with κ ≈ {k['kappa']:.2g} the run covers "
+        f"κ·t_max = {k['kappa'] * t_max:.1f} e-folds, and {100 * k['trapped_fraction']:.1f} % of its orbits are still "
+        f"inside at t_max (the rule: {k['reason'] or 'met'}). Its regular fraction is "
+        f"{100 * vm['regular_fraction']:.2g} %: the orbits left inside are chaotic by the indicator. In the long run "
+        f"({_int(lt['n'])} orbits to t = {max(b['t_hi'] for b in bins):g}) "
+        + constancy_words(
+            [b["hazard"] for b in before],
+            [b["err"] for b in before],
+            f"the non-regular orbits' hazard from t = {before[0]['t_lo']:g} to {t_max:g}",
+        )
+    )
+    if after:
+        mean = np.average([b["hazard"] for b in before], weights=[1 / b["err"] ** 2 for b in before])
+        zs = ", ".join(
+            f"[{b['t_lo']:g}, {b['t_hi']:g}]: {_ve(b['hazard'], b['err'])} (z = {signed((b['hazard'] - mean) / b['err'])})"
+            for b in after
+        )
+        out += f"; after t_max it is {zs} against that mean"
+    return out
+
+
+def _noise_kramers(get: Loader) -> str:
+    d = get("noise", None)
+    rows = sorted(d["kramers"], key=lambda r: r["barrier_over_T"])
+    x = [r["barrier_over_T"] for r in rows]
+    y = [r["ratio"] for r in rows]
+    e = [r["ratio_err"] for r in rows]
+    below = [r for r in rows if verdict(r["ratio"], r["ratio_err"], 1.0).word == "differs" and r["ratio"] < 1]
+    within = [r for r in rows if verdict(r["ratio"], r["ratio_err"], 1.0).word == "agrees"]
+    t = trend(x, y, e)
+    where = ", ".join(f"{r['barrier_over_T']:g}" for r in below)
+    near = ", ".join(f"{r['barrier_over_T']:g}" for r in within)
+    head = f"the ratio lies below 1 by more than 2σ at ΔE/T = {where}" if below else "no ratio lies below 1 by 2σ"
+    head += f" and within 2σ of 1 at {near}" if near else ""
+    return f"{head}; {trend_words(t, 'it', 'ΔE/T')}"
+
+
+def _fig5_tightening(get: Loader) -> str:
+    d = get("fig5", None)
+    rows = [r for r in d["verdict_5b"]["rows"] if r["construction"] != "old"]  # like for like: every set cut alike
+    below = [r for r in rows if r["delta_interval"][1] < 0]
+    above = [r for r in rows if r["delta_interval"][0] > 0]
+    zero = len(rows) - len(below) - len(above)
+    big = max(abs(r["delta"]) for r in rows)
+    return (
+        f"of the {len(rows)} like-for-like constructions, the tightening the paper reports (Δ < 0, its 95 % "
+        f"interval below 0) is seen in {len(below)}, the opposite (interval above 0) in {len(above)}, and the "
+        f"interval holds 0 in {zero}; |Δ| ≤ {big:.3f} in all of them"
+    )
+
+
+def _fig5_shrink(get: Loader) -> str:
+    pd_ = get("fig5", None)["panel_d"]
+    steps = pd_["steps"]
+    down = [st for st in steps if st["interval"][1] < 0]
+    share = pd_["eps_shrink_share"]
+    level = pd_["level"]
+    every = len(down) == len(steps)
+    head = (
+        f"d at the headline box falls at {'every one' if every else f'{len(down)}'} of the {len(steps)} steps "
+        f"of t* (95 % intervals below 0), and ε*_δ shrinks with t* in {100 * share:.0f} % of the half-samples"
+    )
+    if every and share >= level:
+        return head + ": the paper's statement is borne out within these intervals"
+    return head + f": below the {100 * level:.0f} % level, so the statement is not established here"
+
+
+def _operator_residuals(get: Loader) -> str:
+    rows = [r for r in get("operator", None)["kappa_convergence"] if r.get("residual_kappa0_err") is not None]
+    within = [r for r in rows if abs(r["residual_kappa0"]) <= Z_RESOLVED * r["residual_kappa0_err"]]
+    errs = [100 * r["residual_kappa0_err"] for r in within]
+    return (
+        f"the residuals κ∞/κ0 − 1 lie within 2σ of zero at {len(within)} of {len(rows)} energies, with 1σ errors "
+        f"of {min(errs):.0f} to {max(errs):.0f} % there"
+    )
+
+
+def _generality_validity(get: Loader) -> str:
+    d = get("generality", None)
+    cells = [v for v in d["validity_map"] if v["kappa0_defined"] is not None]
+
+    def name(v):
+        return f"{v['label']} {v['e_ratio']:g}"
+
+    low = [v for v in cells if v["regular_fraction"] < 0.01]
+    low_ill = [name(v) for v in low if not v["kappa0_defined"]]
+    high_def = [name(v) for v in cells if v["regular_fraction"] >= 0.01 and v["kappa0_defined"]]
+    n_high = sum(v["regular_fraction"] >= 0.01 for v in cells)
+    out = (
+        f"of the {len(cells)} cells of the map with a κ0 verdict, {len(low)} have a regular fraction below 1 %; "
+        f"κ0 is defined at {len(low) - len(low_ill)} of them"
+        + (f" and ill-defined at {', '.join(low_ill)}" if low_ill else "")
+        + f". Of the {n_high} cells at or above 1 %, κ0 is defined at {len(high_def)}"
+        + (f" ({', '.join(high_def)})" if high_def else "")
+    )
+    both: dict[str, list[str]] = {}
+    for v in low:
+        if v["kappa0_defined"]:
+            both.setdefault(v["label"], []).append(f"{v['e_ratio']:g}")
+    where = "; ".join(f"{k} at {', '.join(x)} E_c" for k, x in both.items())
+    return out + f". Both conditions are met for {where}" if where else out
+
+
+def _generality_resc_rule(get: Loader) -> str:
+    from hhscatter.model.spec import system_from_spec  # deferred: the model is loaded for this reading only
+
+    d = get("generality", None)
+    ratios = sorted({v["e_ratio"] for v in d["validity_map"]} | set(d["config"]["study"]["ratios"]))
+    out = []
+    for label, info in (d.get("systems") or {}).items():
+        m = system_from_spec(info["spec"])
+        e_c = m.critical_energy
+        r = [m.default_escape_radius(x * e_c) for x in ratios]
+        if max(r) - min(r) < 1e-12:
+            out.append(f"{label} {r[0]:.3g} at every energy")
+        else:
+            k = next(i for i, y in enumerate(r) if y > r[0] + 1e-12)
+            out.append(
+                f"{label} {r[0]:.3g} up to {ratios[k - 1]:g} E_c, then growing ({r[k]:.3g} at {ratios[k]:g} E_c, "
+                f"{r[-1]:.3g} at {ratios[-1]:g} E_c)"
+            )
+    return "the escape radius is each system's default (`default_escape_radius` of its model, by energy): " + "; ".join(
+        out
+    )
+
+
+def _generality_claims_by_system(get: Loader) -> str:
+    d = get("generality", None)
+    out = []
+    for label in d.get("systems") or {}:
+        n = {"ok": 0, "bad": 0, "meh": 0}
+        for c in d["claims"]:
+            if c["system"] == label:
+                cls = verdict_class(claim_verdict(c, d.get("scale")))
+                n[cls if cls in n else "meh"] += 1
+        out.append(f"{label} {n['ok']} agree, {n['bad']} differ, {n['meh']} qualitative or without a verdict")
+    return "of the claims' records, by the verdicts' classes: " + "; ".join(out)
+
+
+def _operator_convergence(get: Loader) -> str:
+    rows = get("operator", None)["kappa_convergence"]
+    out = []
+    for key, what in (
+        ("verdict_kappa0", "fig2's κ0 from P(t)"),
+        ("verdict_kappa_cm", "fig2's κ from long-run crossings"),
+    ):
+        cells = [(f"{r['energy']:g}", verdict_class(r[key]) == "ok") for r in rows if r.get(key)]
+        ok = [c for c, passed in cells if passed]
+        miss = [c for c, passed in cells if not passed]
+        out.append(
+            f"κ∞ agrees with {what} within 2σ (both errors) at {len(ok)} of {len(cells)} energies"
+            + (f" (not at E = {', '.join(miss)})" if miss else "")
+        )
+    return "; ".join(out)
+
+
+def _noise_turnover(get: Loader) -> str:
+    rows = sorted(get("noise", None)["turnover"], key=lambda r: r["gamma"])
+
+    def z1(r):
+        return verdict(r["ratio"], r["ratio_err"], 1.0)
+
+    below = [f"{r['gamma']:g}" for r in rows if z1(r).word == "differs" and r["ratio"] < 1]
+    near = [f"{r['gamma']:g}" for r in rows if z1(r).word == "agrees"]
+    steps = []
+    for a, b in zip(rows, rows[1:]):
+        v = verdict(b["ratio"], b["ratio_err"], a["ratio"], a["ratio_err"])
+        steps.append((f"{a['gamma']:g} → {b['gamma']:g}", v))
+    up = [s for s, v in steps if v.word == "differs" and v.z > 0]
+    down = [s for s, v in steps if v.word == "differs" and v.z < 0]
+    flat = [s for s, v in steps if v.word != "differs"]
+    parts = [f"below 1 by more than 2σ at γ = {', '.join(below)}" if below else "below 1 by 2σ nowhere"]
+    if near:
+        parts.append(f"within 2σ of 1 at γ = {', '.join(near)}")
+    trend_bits = []
+    if up:
+        trend_bits.append(f"rises by more than 2σ at {len(up)} of the {len(steps)} steps in γ ({'; '.join(up)})")
+    if down:
+        trend_bits.append(f"falls by more than 2σ at {'; '.join(down)}")
+    if flat:
+        trend_bits.append(f"shows no resolved change at {'; '.join(flat)}")
+    low = rows[0]
+    return (
+        f"the ratio lies {' and '.join(parts)}; from step to step it "
+        + ", ".join(trend_bits)
+        + f"; at γ = {low['gamma']:g} the rate is {_ve(low['ratio'], low['ratio_err'])} of Kramers–Langer's"
+    )
+
+
+def _noise_no_drag(get: Loader) -> str:
+    rows = [r for r in get("noise", None)["no_drag"] if r["sigma"] > 0]
+    out = []
+    for s in sorted({r["sigma"] for r in rows}):
+        cells = []
+        for r in sorted((r for r in rows if r["sigma"] == s), key=lambda r: r["energy"]):
+            v = verdict(r["kappa_over_kappa0"], r["kappa_over_kappa0_err"], 1.0)
+            word = (
+                "below κ0" if v.word == "differs" and v.z < 0 else "above κ0" if v.word == "differs" else "κ0 within 2σ"
+            )
+            cells.append(f"{word} at E0 = {r['energy']:g} (z = {signed(v.z)})")
+        out.append(f"σ = {s:g}: " + ", ".join(cells))
+    return "the rate over the window is " + "; ".join(out)
+
+
+#: the readings a page may name: ``[[reading:<name>]]``
+READINGS: dict[str, Callable[[Loader], str]] = {
+    "basins.cutoff": _basins_cutoff,
+    "fig5.premise": _fig5_premise,
+    "generality.b_onset": _generality_b_onset,
+    "generality.one_exponential": _generality_one_exponential,
+    "generality.hh_1_05": _generality_hh_1_05,
+    "noise.kramers": _noise_kramers,
+    "noise.turnover": _noise_turnover,
+    "noise.no_drag": _noise_no_drag,
+    "b_relation": _b_relation,
+    "fig5.tightening": _fig5_tightening,
+    "fig5.shrink": _fig5_shrink,
+    "operator.residuals": _operator_residuals,
+    "operator.convergence": _operator_convergence,
+    "generality.validity": _generality_validity,
+    "generality.resc_rule": _generality_resc_rule,
+    "generality.claims_by_system": _generality_claims_by_system,
+}
+
+
+def reading(get: Loader, name: str) -> str:
+    """reading(loader, name) -> the sentence of :data:`READINGS` ``name``, its negative numbers with the minus sign;
+    ``get(study, scale)`` returns a study's numbers JSON (``scale=None``: the headline scale). KeyError for a name it
+    does not know. Pages name readings as ``[[reading:name]]`` (:func:`hhscatter.publish.numbers.render_refs`).
+
+    Examples
+    --------
+    >>> docs = {"noise": {"kramers": [{"barrier_over_T": x, "ratio": 0.9, "ratio_err": 0.01} for x in (3, 4, 5)]}}
+    >>> reading(lambda study, scale: docs[study], "noise.kramers")[:58]
+    'the ratio lies below 1 by more than 2σ at ΔE/T = 3, 4, 5; '
+    """
+    if name not in READINGS:
+        raise KeyError(f"no reading {name!r} (known: {', '.join(sorted(READINGS))})")
+    return typographic_minus(READINGS[name](get))  # a negative number with the minus sign, as every rendered number

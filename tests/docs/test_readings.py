@@ -1,0 +1,165 @@
+"""Readings are generated like numbers: no study page types a comparative or qualitative reading by hand, every
+``[[reading:…]]`` renders from the committed JSON, and each reading's words follow its numbers and their
+uncertainties (the inputs here are built by hand, so the expected words are known without the code)."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from hhscatter.publish.numbers import load_numbers, render_refs, typed_readings
+from hhscatter.publish.readings import (
+    READINGS,
+    closer_words,
+    factor_words,
+    pass_fail_words,
+    trend,
+    trend_words,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+PAGES = sorted((ROOT / "studies").glob("*/page.md"))
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.parent.name)
+def test_no_study_page_types_a_reading(page):
+    found = typed_readings(page.read_text())
+    assert not found, f"{page.parent.name}: readings typed by hand (write [[reading:…]]): {found}"
+
+
+def test_the_scan_finds_the_readings_that_were_typed():
+    """The sentences these pages typed before their readings were generated are found."""
+    typed = [
+        "predicts the cut-off of their scaling to\nwithin a factor of a few, with no free parameter.",
+        "Both point sets lie far closer to μ_c^0.30: the paper's premise for\nFig. 5 holds without qualification.",
+        "The non-regular orbits of Contopoulos and Barbanis never decay as one exponential below 2.6 E_c.",
+        "the ratio approaches 1 from below as the barrier grows",
+        "b = 0.08 ± 0.07, consistent with a quadratic onset",
+    ]
+    assert all(typed_readings(t) for t in typed)
+    assert typed_readings('the paper says "μ approaches 1"') == []
+
+
+@pytest.mark.parametrize("name", sorted(READINGS))
+def test_every_reading_renders_from_the_committed_numbers(name):
+    text = render_refs(f"[[reading:{name}]]", ROOT)
+    assert text and "[[" not in text and "nan" not in text.lower()
+
+
+def test_every_reading_a_page_names_exists():
+    for page in PAGES:
+        render_refs(page.read_text(), ROOT, where=page.parent.name)  # NumberRefError on an unknown reading
+
+
+def test_trend_words_follow_the_fit_and_its_sigma():
+    rising = trend([1, 2, 3, 4], [0.80, 0.85, 0.90, 0.95], [0.01] * 4)  # slope 0.05, σ = 0.01/√5
+    assert rising["slope"] == pytest.approx(0.05) and rising["err"] == pytest.approx(0.01 / 5**0.5)
+    assert trend_words(rising, "the ratio", "ΔE/T").startswith("the ratio rises with ΔE/T")
+    flat = trend([1, 2, 3, 4], [0.90, 0.93, 0.89, 0.92], [0.03] * 4)
+    assert "no trend in ΔE/T resolved at 2σ" in trend_words(flat, "the ratio", "ΔE/T")
+
+
+def test_a_factor_is_never_called_few_when_intervals_do_not_overlap():
+    assert "off by a factor 1.1 to 6.6" in factor_words(1.08, 6.6, 1, 5)
+    assert "overlap in 1 of 5" in factor_words(1.08, 6.6, 1, 5)
+    assert factor_words(1.02, 1.3, 4, 4).startswith("the prediction is within a factor 1.3 in all 4 cases")
+
+
+def test_closer_follows_the_two_distances_and_their_errors():
+    assert closer_words(0.10, 0.01, 0.50, 0.01, "A", "B", "d").startswith("closer to A by d")
+    assert closer_words(0.50, 0.01, 0.10, 0.01, "A", "B", "d").startswith("closer to B by d")
+    assert closer_words(0.10, 0.02, 0.12, 0.02, "A", "B", "d").startswith("as close to A as to B")
+
+
+def test_never_and_always_only_when_every_cell_says_so():
+    assert pass_fail_words([("1", False), ("2", False)], "one", "not one") == "not one at every tested cell (1, 2)"
+    mixed = pass_fail_words([("1", False), ("2", True), ("3", None)], "one", "not one")
+    assert mixed == "not one at 1; one at 2; not tested at 3"
+
+
+def _loader(docs):
+    return lambda study, scale: docs[study]
+
+
+def test_the_fig5_premise_follows_both_distances():
+    """With SW1 closer to μ_c^0.30 for both sets, the premise holds by both distances; with 5b's SW1 reversed (the
+    committed numbers), it depends on the distance for 5b."""
+    doc = copy.deepcopy(load_numbers(ROOT, "fig5")[0])
+    g = doc["gamma_main"]
+    for r in doc["distances"]:
+        if r["gamma"] == g:
+            r["sw1"], r["sw1_err"] = (0.01, 0.001) if r["ref"] == "E1" else (0.05, 0.001)
+    text = READINGS["fig5.premise"](_loader({"fig5": doc}))
+    assert text.endswith("holds for both sets by both distances")
+    committed = READINGS["fig5.premise"](_loader({"fig5": load_numbers(ROOT, "fig5")[0]}))
+    assert "for 5b it depends on the distance" in committed and "closer to μ_c^0.35 by SW1" in committed
+
+
+def test_the_noise_reading_says_below_one_only_beyond_two_sigma():
+    doc = {"kramers": [{"barrier_over_T": x, "ratio": 1.0 - 0.1 / x, "ratio_err": 0.001} for x in (3, 4, 5, 6)]}
+    text = READINGS["noise.kramers"](_loader({"noise": doc}))
+    assert text.startswith("the ratio lies below 1 by more than 2σ at ΔE/T = 3, 4, 5, 6") and "it rises with" in text
+    doc = {"kramers": [{"barrier_over_T": x, "ratio": 1.0, "ratio_err": 0.05} for x in (3, 4, 5, 6)]}
+    text = READINGS["noise.kramers"](_loader({"noise": doc}))
+    assert text.startswith("no ratio lies below 1 by 2σ and within 2σ of 1 at 3, 4, 5, 6")
+
+
+def test_the_resc_page_names_the_tools_own_default():
+    """The page says the rule's pick is the tool's default for Hénon–Heiles: it is, at every energy of the study,
+    and the page no longer calls the reference radius the default."""
+    from hhscatter.model import HenonHeiles
+
+    doc, _ = load_numbers(ROOT, "resc")
+    pick, ref = doc["default_r_esc"]["recommended"], doc["default_r_esc"]["current"]
+    assert pick != ref
+    for e in doc["energies"]:
+        assert HenonHeiles().default_escape_radius(e) == pytest.approx(pick)
+    page = (ROOT / "studies" / "resc" / "page.md").read_text()
+    assert "[[resc:default_r_esc.recommended]]; that is the tool's own default" in page
+    rendered = render_refs(page, ROOT)
+    assert f"the default r_esc = {ref:g}" not in rendered
+
+
+def _beyond_the_paper():
+    import tomllib
+
+    for page in PAGES:
+        about = tomllib.loads((page.parent / "study.toml").read_text())["about"]
+        if not about.get("paper"):
+            yield page
+
+
+@pytest.mark.parametrize("page", list(_beyond_the_paper()), ids=lambda p: p.parent.name)
+def test_a_page_beyond_the_paper_states_its_limits(page):
+    """A section "## Limits" that names the scale of its numbers (from the JSON), N and what the study does not
+    show."""
+    text = page.read_text()
+    assert "\n## Limits\n" in text, page.parent.name
+    section = text.split("\n## Limits\n", 1)[1].split("\n## ", 1)[0]
+    name = page.parent.name
+    assert f"[[{name}:scale]]" in section or f"[[{name}@" in section, "the scale, from the JSON"
+    assert "|int]]" in section, "N, from the JSON"
+    assert "does not show" in section
+
+
+def test_the_turnover_reading_follows_each_step_and_its_errors():
+    rows = [{"gamma": g, "ratio": r, "ratio_err": 0.01} for g, r in ((0.03, 0.3), (0.1, 0.6), (0.3, 0.61), (1, 1.0))]
+    text = READINGS["noise.turnover"](_loader({"noise": {"turnover": rows}}))
+    assert "below 1 by more than 2σ at γ = 0.03, 0.1, 0.3 and within 2σ of 1 at γ = 1" in text
+    assert "rises by more than 2σ at 2 of the 3 steps in γ (0.03 → 0.1; 0.3 → 1)" in text
+    assert "no resolved change at 0.1 → 0.3" in text
+
+
+def test_the_no_drag_reading_says_below_only_beyond_two_sigma():
+    rows = [
+        {"energy": 0.3, "sigma": 0.0, "kappa_over_kappa0": 1.0, "kappa_over_kappa0_err": 0.05},
+        {"energy": 0.3, "sigma": 0.01, "kappa_over_kappa0": 0.95, "kappa_over_kappa0_err": 0.05},
+        {"energy": 0.3, "sigma": 0.02, "kappa_over_kappa0": 0.70, "kappa_over_kappa0_err": 0.05},
+    ]
+    text = READINGS["noise.no_drag"](_loader({"noise": {"no_drag": rows}}))
+    assert text == (
+        "the rate over the window is σ = 0.01: κ0 within 2σ at E0 = 0.3 (z = −1.0); "
+        "σ = 0.02: below κ0 at E0 = 0.3 (z = −6.0)"
+    )
