@@ -21,8 +21,9 @@ _FREE_KEYS = 4  # distinct compiled systems kept per process (a grid of r_esc va
 
 
 @contextlib.contextmanager
-def _batch_integrator(scene, batch_size, without=()):
-    """_batch_integrator(scene, batch_size, without=()) -> context manager yielding (ta, specs, layout).
+def _batch_integrator(scene, batch_size, without=(), products=False):
+    """_batch_integrator(scene, batch_size, without=(), products=False) -> context manager yielding (ta, specs,
+    layout).
 
     One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.integrators.batch_key`),
     reused across chunks instead of a new ``taylor_adaptive_batch`` per chunk (measured: ~6 ms and a
@@ -31,12 +32,12 @@ def _batch_integrator(scene, batch_size, without=()):
     heyoka's step depends on nothing else, so results are bit-identical (tested). An integrator in
     use is out of the cache; the handlers are unbound on return.
     """
-    key, specs, lay = integrators.batch_key(scene, batch_size, without=without)
+    key, specs, lay = integrators.batch_key(scene, batch_size, without=without, products=products)
     with _FREE_LOCK:
         free = _FREE.get(key)
         ta = free.pop() if free else None
     if ta is None:
-        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without)
+        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without, products=products)
     else:
         zeros = np.zeros(batch_size)
         ta.set_dtime(zeros, zeros)

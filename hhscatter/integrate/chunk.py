@@ -87,17 +87,34 @@ def _unclocked_late(scene, ics) -> np.ndarray:
     return np.flatnonzero(late) if late is not None else np.empty(0, np.int64)
 
 
-def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+def _integrate(
+    scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None, products=None
+) -> ChunkResult:
     """The chunk's orbits (all inside r_esc) on the batch engine; ``far``: :func:`_no_return`'s (scene, late),
-    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk."""
+    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk.
+
+    ``products``: the events' H with its powers written as products (True) or as the system gives it (False);
+    None: the system's, and the orbits that start where a power of H has a zero base
+    (:func:`hhscatter.integrate.events.zero_power_start`: heyoka would skip their closure event in the first step)
+    are integrated again in products, their rows replacing the first ones."""
     if not len(ics):
         return _empty_result(traj_ids)
+    kw = dict(batch_size=batch_size, count_steps=count_steps)
+    if products is None:
+        res = _integrate(scene, ics, traj_ids, far, progress=progress, products=False, **kw)
+        zero = events.zero_power_start(scene, ics)
+        if zero is not None:
+            res = _merge_rerun(
+                res, zero, traj_ids, _integrate(scene, ics[zero], traj_ids[zero], far, products=True, **kw)
+            )
+        return res
     kind = scheduler(scene)
     B = int(batch_size or scene.batch_size or {"epochs": EPOCH_BATCH, "noise": NOISE_BATCH}.get(kind, STREAM_BATCH))
     phases = kind == "stream" and events.two_phase(scene)
     orig, (scene, late) = scene, far
     # first (or only) phase: without the section event when the window opens late
-    with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
+    without = ("section",) if phases else ()
+    with _batch_integrator(scene, B, without=without, products=products) as (ta, specs, layout):
         config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
         if kind == "noise":
             lanes = _Noisy(scene, ta, layout, ics, traj_ids, **config)
@@ -112,7 +129,7 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
         finally:
             lanes.close()  # the integrator goes back to the cache: no view of it stays here
     if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
-        with _batch_integrator(scene, B) as (ta2, specs2, _):
+        with _batch_integrator(scene, B, products=products) as (ta2, specs2, _):
             second = _SecondPhase(scene, ta2, layout, lanes, late=late)
             _bind(ta2, specs2, second)
             try:
@@ -131,7 +148,7 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
             res,
             rerun,
             traj_ids,
-            _integrate(own, ics[rerun], traj_ids[rerun], (own, None), batch_size=batch_size, count_steps=count_steps),
+            _integrate(own, ics[rerun], traj_ids[rerun], (own, None), products=products, **kw),
         )
     return res
 

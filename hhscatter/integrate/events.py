@@ -138,16 +138,103 @@ class Layout:
 
 
 class Symbols:
-    """The heyoka expressions events are written in (built lazily: no heyoka at import)."""
+    """The heyoka expressions events are written in (built lazily: no heyoka at import).
 
-    def __init__(self, scene, layout: Layout):
+    ``products``: V and H with their natural powers ≥ 3 written as products (:func:`_powers_as_products`), for the
+    orbits that start where such a power's base is 0 (:func:`zero_power_start`)."""
+
+    def __init__(self, scene, layout: Layout, products: bool = False):
         import heyoka as hy  # deferred: heyoka loads on first use
 
         (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions()
+        if products:
+            self.V, self.H = _powers_as_products(self.V), _powers_as_products(self.H)
         self.r2 = self.x**2 + self.y**2
         self.clock = hy.make_vars("sigma") if layout.clock is not None else None
         self.gate = hy.par[layout.gate] if layout.gate is not None else None
         self.gamma = hy.par[layout.gamma] if layout.gamma is not None else None
+
+
+_PRODUCTS = {}  # repr of an expression -> (its rewrite or None, the bases of its natural powers ≥ 3 as numpy functions)
+
+
+def _powers_as_products(expr):
+    """The heyoka expression ``expr`` with every power of a natural exponent n ≥ 3 written as a product of n
+    factors (squares stay: heyoka's square has no such defect); ``expr`` itself if it has none.
+
+    heyoka's Taylor recurrence of uⁿ divides by u at the start of the step: an event whose expression holds
+    y**3 (Hénon–Heiles' H) has non-finite Taylor coefficients in a step that starts at y = 0 exactly (an
+    initial condition on an axis), and heyoka then skips the event in that step without a word. The closure
+    event (E = E_c) of such an orbit, crossed in its first step, was missed and the orbit ran on to t_max.
+
+    >>> import heyoka as hy
+    >>> x, y = hy.make_vars("x", "y")
+    >>> print(_powers_as_products(x**2 * y - y**3 / 3.0))
+    ((y * x**2.0000000000000000) - (0.33333333333333331 * (y * y * y)))
+    >>> e = x**2 + y**2
+    >>> _powers_as_products(e) is e
+    True
+    """
+    rewritten = _rewrite_powers(expr)[0]
+    return rewritten if rewritten is not None else expr
+
+
+def _rewrite_powers(expr):
+    """(:func:`_powers_as_products`' rewrite or None when ``expr`` has no natural power ≥ 3, the bases of those
+    powers as numpy functions of (x, y, px, py)); cached by the expression's text."""
+    key = repr(expr)
+    if key not in _PRODUCTS:
+        _PRODUCTS[key] = _rewrite_powers_uncached(expr)
+    return _PRODUCTS[key]
+
+
+def _rewrite_powers_uncached(expr):
+    import heyoka as hy  # deferred: heyoka loads on first use
+    import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+    found = []
+
+    def walk(e):
+        if e.is_Pow and e.exp.is_Integer and int(e.exp) >= 3:
+            found.append(e)
+            b = walk(e.base)
+            return sp.Mul(*([b] * int(e.exp)), evaluate=False)
+        if e.args:
+            return e.func(*[walk(a) for a in e.args], evaluate=False)
+        return e
+
+    rewritten = walk(hy.to_sympy(expr))
+    if not found:
+        return None, ()
+    names = sp.symbols("x y px py")
+    bases = tuple(sp.lambdify(names, b, "numpy") for b in {f.base for f in found})
+    return hy.from_sympy(rewritten), bases
+
+
+def zero_power_start(scene, ics) -> np.ndarray | None:
+    """zero_power_start(scene, ics) -> bool array (n,), or None: the orbits of a dissipative scene that start where
+    the base of a natural power ≥ 3 in H is 0 exactly (y = 0 for Hénon–Heiles' y³).
+
+    heyoka skips the closure event (E = E_c) in such an orbit's first step (:func:`_powers_as_products`): these
+    orbits are integrated with H written in products (``Symbols(products=True)``). None if there is none, or the
+    scene has no closure event.
+
+    >>> import numpy as np
+    >>> from hhscatter.scene.scene import Scene
+    >>> s = Scene(energy=0.17, n=2, gamma=0.01)
+    >>> zero_power_start(s, np.array([[0.05, 0.0, 0.0, 0.58], [0.05, 0.01, 0.0, 0.58]])).tolist()
+    [True, False]
+    """
+    if not (scene.gamma > 0 and scene.noise is None) or not len(ics):
+        return None
+    bases = _rewrite_powers(scene.model.expressions()[2])[1]
+    if not bases:
+        return None
+    x, y, px, py = np.asarray(ics, dtype=float).T
+    zero = np.zeros(len(x), dtype=bool)
+    for base in bases:
+        zero |= np.broadcast_to(base(x, y, px, py), zero.shape) == 0
+    return zero if zero.any() else None
 
 
 def far_radius(scene) -> float:
@@ -337,5 +424,6 @@ __all__ = [
     "scene_events",
     "two_phase",
     "section_accepts",
+    "zero_power_start",
     "system",
 ]

@@ -83,7 +83,10 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     late = events.opens_late(scene, ic[None]) is not None
     clocked = events.layout(scene).clock is not None
     cooldown = events.SECTION_COOLDOWN if late and not clocked else -1.0
-    ta, specs, layout = build_scalar(scene, _Callback, fp_type=fp_type, tol=tol, section_cooldown=cooldown)
+    products = events.zero_power_start(scene, np.asarray(ic, dtype=float)[None, :4]) is not None  # (as the engine)
+    ta, specs, layout = build_scalar(
+        scene, _Callback, fp_type=fp_type, tol=tol, section_cooldown=cooldown, products=products
+    )
     rules = _Scalar(scene, ta, layout, fp_type)
     if late and clocked:
         rules.open_late = [True]
