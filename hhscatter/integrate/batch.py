@@ -11,6 +11,7 @@ import numpy as np
 
 from hhscatter.integrate import integrators
 from hhscatter.integrate.lanes import CONTINUING, LaneRules, _Callback, _unbind
+from hhscatter.integrate.orbit_time import _orbit_times
 
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 
@@ -91,18 +92,39 @@ class _BatchRules(LaneRules):
         self.pars = ta.pars if layout.n_pars else None
         self.gate_live = layout.gate is not None and layout.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
-        self.ics = ics.tolist()
+        self.ics = np.ascontiguousarray(ics, dtype=float)
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
-        # Python lists (an element write costs a fifth of numpy's), arrays once per chunk
         self.count_steps = count_steps
         self.progress = progress
         self.ticks = 0
-        self.outcome = [-1] * self.n
-        self.t_end = [math.nan] * self.n
-        # state at t_end; energies and exit channels are computed from it once per chunk
-        self.end_state = [None] * self.n
+        self._records(self.n)
+
+    #: the per-orbit arrays an orbit's end is written into (a second phase shares its first phase's)
+    RECORDS = ("outcome", "t_end", "end_state", "lane_timed", "end_hi", "end_lo", "start_hi_of", "start_lo_of")
+
+    def _records(self, n):
+        """Preallocate what the chunk's orbits end with: ``outcome`` (int8, −1 until known), the end state
+        ``end_state`` (n, 4), and the orbit time either as a number (``t_end``, by :meth:`record`) or, where
+        ``lane_timed``, as the lane time at the end and at the orbit's start, double-length (``end_hi``,
+        ``end_lo``, ``start_hi_of``, ``start_lo_of``: the stream's ends, whose times :meth:`orbit_times` computes
+        once per chunk). No Python object is kept per orbit."""
+        self.outcome = np.full(n, -1, dtype=np.int8)
+        self.t_end = np.full(n, math.nan)
+        self.end_state = np.zeros((n, 4))
+        self.lane_timed = np.zeros(n, dtype=np.uint8)
+        self.end_hi, self.end_lo = np.zeros(n), np.zeros(n)
+        self.start_hi_of, self.start_lo_of = np.zeros(n), np.zeros(n)
+
+    def orbit_times(self) -> np.ndarray:
+        """The orbit time at each orbit's end (time units), once per chunk: :meth:`record`'s, or, for the
+        orbits ended by lane time, (end) − (start) of the double-length lane times (:func:`_orbit_times`)."""
+        t = self.t_end.copy()
+        m = self.lane_timed.astype(bool)
+        if m.any():
+            t[m] = _orbit_times(self.end_hi[m], self.end_lo[m], self.start_hi_of[m], self.start_lo_of[m])
+        return t
 
     def state4(self, lane):
         return tuple(self.cols[lane].tolist())
@@ -118,6 +140,7 @@ class _BatchRules(LaneRules):
         k = self.orbit[lane]
         self.outcome[k] = outcome
         self.t_end[k] = t
+        self.lane_timed[k] = 0
         self.end_state[k] = state
 
     def tick(self):

@@ -137,7 +137,7 @@ def _integrate(
             finally:
                 second.close()
         n_returns, n_steps = n_returns + r2, n_steps + s2
-    outcome = np.array(lanes.outcome, dtype=np.int8)
+    outcome = lanes.outcome
     if (outcome == -1).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
     res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps)
@@ -157,8 +157,8 @@ def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_step
     """The chunk's rows from its lanes: lifetimes in orbit order, the other tables by orbit, then time."""
     n, (s_ids, s_t, s_e) = len(ics), snaps
     model = scene.model
-    end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
-    t_end = np.array(lanes.t_end, dtype=float)
+    end = lanes.end_state
+    t_end = lanes.orbit_times()
     channel = np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1)
     lifetimes = {
         "traj_id": traj_ids,

@@ -133,7 +133,7 @@ def _no_return(scene, ics, kind):
     the same at either radius, and no recorded row lies after t_end.
 
     The one thing r_far still decides: an orbit that has not reached r_far by t_max is censored there.
-    ``late(t, state)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
+    ``late(t, x, y, px, py)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
     scene's own far event (exactly as before: tables byte-identical for the same scene hash). A censored orbit
     never reached R, so its steps are the same under either far event (the clock censors it in orbit time, a
     stream lane's history does not enter). The bound: beyond
@@ -154,8 +154,7 @@ def _no_return(scene, ics, kind):
         return scene, None
     gamma, t_max = float(scene.gamma), float(scene.t_max)
 
-    def late(t, state):
-        x, y, px, py = state
+    def late(t, x, y, px, py):
         r = math.sqrt(x * x + y * y)
         pr = (x * px + y * py) / r
         a = gamma * (r_far - r)
