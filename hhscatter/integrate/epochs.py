@@ -6,19 +6,29 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate.batch import _BatchRules, _check
+from hhscatter.integrate.batch import _check
 from hhscatter.integrate.events import CENSORED, SETTLED
 from hhscatter.integrate.lanes import CONTINUING, LIVE
+from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 
 
-class _Epochs(_BatchRules):
+@register
+class _Epochs(Scheduler):
     """Epoch scheduler: all lanes advance together; snapshots from ``propagate_grid``."""
 
-    def __init__(self, scene, ta, layout, ics, **config):
-        super().__init__(scene, ta, layout, ics, **config)
+    name = "epochs"
+    priority = 20
+    batch_size = EPOCH_BATCH
+
+    @classmethod
+    def applies(cls, plan) -> bool:
+        return bool(plan.snapshots)
+
+    def __init__(self, scene, ta, layout, ics, traj_ids=None, **config):
+        super().__init__(scene, ta, layout, ics, traj_ids, **config)
         self.handlers = {}  # the methods serve every rule
         t_max = scene.t_max
         # P divides t_max, so censoring falls on an epoch's end

@@ -212,7 +212,7 @@ def _rewrite_powers_uncached(expr):
 
 
 def zero_power_start(scene, ics) -> np.ndarray | None:
-    """zero_power_start(scene, ics) -> bool array (n,), or None: the orbits of a dissipative scene that start where
+    """zero_power_start(plan, ics) -> bool array (n,), or None: the orbits of a dissipative scene that start where
     the base of a natural power ≥ 3 in H is 0 exactly (y = 0 for Hénon–Heiles' y³).
 
     heyoka skips the closure event (E = E_c) in such an orbit's first step (:func:`_powers_as_products`): these
@@ -220,14 +220,15 @@ def zero_power_start(scene, ics) -> np.ndarray | None:
     scene has no closure event.
 
     >>> import numpy as np
+    >>> from hhscatter.integrate.plan import plan_of
     >>> from hhscatter.scene.scene import Scene
-    >>> s = Scene(energy=0.17, n=2, gamma=0.01)
+    >>> s = plan_of(Scene(energy=0.17, n=2, gamma=0.01))
     >>> zero_power_start(s, np.array([[0.05, 0.0, 0.0, 0.58], [0.05, 0.01, 0.0, 0.58]])).tolist()
     [True, False]
     """
     if not (scene.gamma > 0 and scene.noise is None) or not len(ics):
         return None
-    bases = _rewrite_powers(scene.model.expressions()[2])[1]
+    bases = scene.cached("power bases", lambda: _rewrite_powers(scene.model.expressions()[2])[1])
     if not bases:
         return None
     x, y, px, py = np.asarray(ics, dtype=float).T
@@ -244,15 +245,16 @@ def far_radius(scene) -> float:
     return max(10.0 * scene.model.saddle_radius, 2.0 * scene.r_esc)
 
 
-def clock_targets(scene) -> tuple:
-    """clock_targets(scene) -> ((orbit time, action), ...): when the clock acts, in order.
+def clock_targets(scene, censor: bool) -> tuple:
+    """clock_targets(plan, censor) -> ((orbit time, action), ...): when the clock acts, in order.
 
     Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
     that opens late could miss a crossing) and 'close' it (at t_to +
-    CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
-    without snapshots (the stream scheduler) also 'censor' with it at t_max:
-    in orbit time, so a censored orbit's end state does not depend on the
-    orbits before it in its lane (a propagation bound's rounding did).
+    CLOCK_MARGIN); the section rule itself checks the exact window. With
+    ``censor`` (a scheduler that censors by the clock: the stream) it also
+    'censors' at t_max: in orbit time, so a censored orbit's end state does not
+    depend on the orbits before it in its lane (a propagation bound's rounding
+    did).
     """
     w = scene.sections
     out = []
@@ -260,7 +262,7 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if w is not None and math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    if not scene.snapshots and scene.noise is None:  # a noise scene censors at its last kick
+    if censor:
         out.append((float(scene.t_max), "censor"))
     return tuple(sorted(out))
 
@@ -271,8 +273,8 @@ def follow_radii(scene) -> tuple:
 
 
 def layout(scene) -> Layout:
-    """layout(scene) -> Layout: state and parameter slots the scene's events need."""
-    targets = clock_targets(scene)
+    """layout(plan) -> Layout: state and parameter slots the plan's events need (from its ``clock_targets``)."""
+    targets = scene.clock_targets
     clock = 4 if targets else None
     n_pars = 0
     gamma = gate = None
@@ -285,7 +287,8 @@ def layout(scene) -> Layout:
 
 
 def scene_events(scene) -> tuple:
-    """scene_events(scene) -> tuple[EventSpec, ...]: the events a scene needs, in callback order.
+    """scene_events(plan) -> tuple[EventSpec, ...]: the events a plan needs, in callback order (from its
+    ``far_radius``, ``follow_radii`` and ``clock_targets``).
 
     Only what the scene needs is compiled: the section event only for scenes
     with a section window (and switched off per lane outside it), the clock
@@ -294,7 +297,7 @@ def scene_events(scene) -> tuple:
     follow scenes.
     """
     r_esc2 = scene.r_esc**2
-    rf2 = far_radius(scene) ** 2
+    rf2 = scene.far_radius**2
     ec = scene.model.critical_energy
     ev = []
     if scene.gamma > 0 and scene.noise is None:
@@ -307,7 +310,7 @@ def scene_events(scene) -> tuple:
         # each root is declared once: two terminal events with the same root in one lane lose
         # one of them in batch mode (measured), so the r_esc radius is also the escape event
         ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "followed orbit far away"))
-        for k, R in enumerate(follow_radii(scene)):
+        for k, R in enumerate(scene.follow_radii):
             ev.append(
                 EventSpec(
                     f"radius{k}",
@@ -327,7 +330,7 @@ def scene_events(scene) -> tuple:
                 "section ṙ = 0 (gated)",
             )
         )
-    if clock_targets(scene):
+    if scene.clock_targets:
         ev.append(EventSpec("clock", -1, lambda s: s.clock, "orbit-time schedule"))
     return tuple(ev)
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.integrate.events import HAMILTON_ONLY, Layout, Symbols, layout, scene_events, system
+from hhscatter.integrate.events import HAMILTON_ONLY, Layout, Symbols, system
 
 
 def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=(), products=False):
@@ -20,8 +20,8 @@ def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=(), 
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
+    lay = scene.layout
+    specs = tuple(s for s in scene.events if s.name not in without)
     sym = Symbols(scene, lay, products)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     events = [
@@ -47,7 +47,7 @@ def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     the same escape; ``scene`` must be conservative and without a follow."""
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    (esc,) = (e for e in scene_events(scene) if e.name == "escape")
+    (esc,) = (e for e in scene.events if e.name == "escape")
     ev = hy.t_event_batch(
         esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback, direction=hy.event_direction.positive
     )
@@ -76,8 +76,14 @@ def batch_key(scene, batch_size: int, *, tol=None, without=(), products=False) -
     give interchangeable integrators: what differs between them (γ, the section gate) is a runtime
     parameter, set per chunk (:func:`batch_pars`). Costs ~0.1 ms, no compilation.
     """
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
+    return scene.cached(
+        ("batch key", batch_size, tol, without, products), lambda: _key(scene, batch_size, tol, without, products)
+    )
+
+
+def _key(scene, batch_size, tol, without, products):
+    lay = scene.layout
+    specs = tuple(s for s in scene.events if s.name not in without)
     sym = Symbols(scene, lay, products)
     key = (
         batch_size,
@@ -101,8 +107,8 @@ def build_scalar(scene, make_callback, *, fp_type=float, tol=None, section_coold
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = layout(scene)
-    specs = scene_events(scene)
+    lay = scene.layout
+    specs = scene.events
     sym = Symbols(scene, lay, products)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     cast = caster(fp_type)

@@ -125,10 +125,10 @@ class LaneRules(abc.ABC):
         self.layout = layout
         self.win = scene.sections
         self.follow = scene.follow is not None
-        self.radii = events.follow_radii(scene) if self.follow else ()
+        self.radii = scene.follow_radii
         self.r_esc = float(scene.r_esc)
         self.continue_settled = bool(scene.continue_settled)
-        self.targets = events.clock_targets(scene)
+        self.targets = scene.clock_targets
         self.clock_scale = layout.clock_scale
         self.orbit = [-1] * n_lanes
         self.phase = [LIVE] * n_lanes

@@ -4,22 +4,60 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.integrate.batch import _BatchRules, _check, _no_snapshots
+from hhscatter.integrate.batch import _batch_integrator, _check, _no_snapshots
 from hhscatter.integrate.events import ESCAPED, SETTLED
-from hhscatter.integrate.lanes import LIVE, RERUN
+from hhscatter.integrate.lanes import LIVE, RERUN, _bind
 from hhscatter.integrate.orbit_time import _orbit_time
+from hhscatter.integrate.schedulers import Scheduler, register
 
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
 
-class _Stream(_BatchRules):
+@register
+class _Stream(Scheduler):
     """Stream scheduler: the next orbit is loaded in the callback that ends one."""
 
-    def __init__(self, scene, ta, layout, ics, *, inlined=False, **config):
+    name = "stream"
+    priority = 90  # the scheduler of every scene no other claims
+    batch_size = STREAM_BATCH
+    clock_censors = True
+
+    @classmethod
+    def applies(cls, plan) -> bool:
+        return True
+
+    @classmethod
+    def integrate(cls, plan, batch_size, ics, traj_ids, *, products=False, **config):
+        """The chunk in one phase, or two (:attr:`hhscatter.integrate.plan.Plan.two_phase`: a window that opens
+        late): the first without the section event, the orbits alive at t_from handed on to a second integrator
+        that has it (:class:`_SecondPhase`)."""
+        phases = plan.two_phase
+        # the inlined handlers serve scenes with no section event in this integrator and no follow
+        inlined = plan.follow is None and (plan.sections is None or phases)
+        without = ("section",) if phases else ()
+        with _batch_integrator(plan, batch_size, without=without, products=products) as (ta, specs, layout):
+            lanes = cls(plan, ta, layout, ics, traj_ids, inlined=inlined, migrate_at_open=phases, **config)
+            _bind(ta, specs, lanes, lanes.handlers)
+            try:
+                n_returns, n_steps, snaps = lanes.run()
+            finally:
+                lanes.close()  # the integrator goes back to the cache: no view of it stays here
+        if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
+            with _batch_integrator(plan, batch_size, products=products) as (ta2, specs2, _):
+                second = _SecondPhase(plan, ta2, layout, lanes, late=config.get("late"))
+                _bind(ta2, specs2, second)
+                try:
+                    r2, s2, _ = second.run()
+                finally:
+                    second.close()
+            n_returns, n_steps = n_returns + r2, n_steps + s2
+        return lanes, n_returns, n_steps, snaps
+
+    def __init__(self, plan, ta, layout, ics, traj_ids=None, *, inlined=False, **config):
         """``inlined``: serve the hot rules by the lean closures of :meth:`_inlined_handlers` (plain scenes: no
-        section event in this integrator, no follow); ``config``: :class:`_BatchRules`'s."""
-        super().__init__(scene, ta, layout, ics, **config)
+        section event in this integrator, no follow); ``config``: :class:`Scheduler`'s."""
+        super().__init__(plan, ta, layout, ics, traj_ids, **config)
         # the lane time at which the lane's orbit started (double-length)
         self.start_hi, self.start_lo = np.zeros(self.B), np.zeros(self.B)
         # the lane's orbit's last outward r_esc crossing (dissipative scenes, inlined rules): whether there is

@@ -6,6 +6,7 @@ from scipy.integrate import solve_ivp
 
 from hhscatter.integrate.engine import SETTLED, run_chunk, simulate_orbit
 from hhscatter.integrate.events import zero_power_start
+from hhscatter.integrate.plan import plan_of
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.ics import section_velocities
 from hhscatter.scene.scene import Scene
@@ -58,5 +59,5 @@ def test_orbit_whose_energy_crosses_critical_energy_in_its_first_step_settles(xy
 def test_zero_power_start_marks_starts_on_the_base_of_a_cube():
     """Hénon–Heiles' H holds y³ (x² is a square): the orbits that start at y = 0 exactly, in drag scenes only."""
     ics = np.array([[0.05, 0.0, 0.0, 0.58], [0.0, 0.05, 0.58, 0.0], [0.05, 1e-300, 0.0, 0.58]])
-    assert zero_power_start(Scene(energy=0.17, n=3, gamma=GAMMA), ics).tolist() == [True, False, False]
-    assert zero_power_start(Scene(energy=0.17, n=3), ics) is None
+    assert zero_power_start(plan_of(Scene(energy=0.17, n=3, gamma=GAMMA)), ics).tolist() == [True, False, False]
+    assert zero_power_start(plan_of(Scene(energy=0.17, n=3)), ics) is None
