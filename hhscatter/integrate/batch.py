@@ -93,6 +93,14 @@ class _BatchRules(LaneRules):
         self.gate_live = layout.gate is not None and layout.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
         self.ics = np.ascontiguousarray(ics, dtype=float)
+        if not (self.state.flags.c_contiguous and (self.pars is None or self.pars.flags.c_contiguous)):
+            raise RuntimeError("internal error: the integrator's state or parameters are not one contiguous block")
+        # flat memoryviews (one element written at a time, no numpy scalar or index tuple per write):
+        # state variable i of a lane at i * B + lane, initial condition k at 4k .. 4k + 3
+        self._s, self._ic = memoryview(self.state.reshape(-1)), memoryview(self.ics.reshape(-1))
+        self._p = memoryview(self.pars.reshape(-1)) if self.gate_live else None
+        self._gate_at = layout.gate * self.B if self.gate_live else 0
+        self._clock_at = layout.clock * self.B if layout.clock is not None else 0
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
@@ -131,10 +139,10 @@ class _BatchRules(LaneRules):
 
     def set_gate(self, lane, g):
         if self.gate_live:  # (a first phase has no section event, hence no gate)
-            self.pars[self.layout.gate, lane] = g
+            self._p[self._gate_at + lane] = g
 
     def set_clock(self, lane, sigma):
-        self.state[self.layout.clock, lane] = sigma
+        self._s[self._clock_at + lane] = sigma
 
     def record(self, lane, outcome, t, state):
         k = self.orbit[lane]
@@ -153,12 +161,17 @@ class _BatchRules(LaneRules):
     def close(self):
         """Drop every view of the integrator (it goes back to the cache) and every closure over these lanes."""
         self.ta = self.state = self.cols = self.pars = self.time_hi = self.time_lo = None
+        self._s = self._ic = self._p = None
 
     def load_orbit(self, lane, k):
         """Initial condition k into ``lane`` (state, rules, cooldowns)."""
         if self.progress is not None:
             self.tick()
-        self.state[:4, lane] = self.ics[k]
+        s, ic, B, j = self._s, self._ic, self.B, 4 * k
+        s[lane] = ic[j]
+        s[B + lane] = ic[j + 1]
+        s[2 * B + lane] = ic[j + 2]
+        s[3 * B + lane] = ic[j + 3]
         self.start_orbit(lane, k)
         self.ta.reset_cooldowns(lane)
 

@@ -153,8 +153,10 @@ class LaneRules(abc.ABC):
         self.last_out[lane] = None
         self.sec_found[lane] = False
         self.clock_i[lane] = 0
-        self.pending_sec[lane] = []
-        self.pending_cross[lane] = []
+        if self.pending_sec[lane]:  # (empty but after an orbit that left rows uncommitted)
+            self.pending_sec[lane] = []
+        if self.pending_cross[lane]:
+            self.pending_cross[lane] = []
         if self.win is not None:
             self.set_gate(lane, 1.0 if self.win.t_from <= 0 else 0.0)
         if self.targets:
