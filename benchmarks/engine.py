@@ -6,6 +6,12 @@ One process, one core, the same initial conditions for every contender,
 best of ``--repeat`` timings each (the machine is shared: ratios, not
 absolute times, are the result). Rows:
 
+* **alternated** — CPU time in one process, the contenders run in turn in every
+  round (``--repeat`` rounds; a ratio is the median of the rounds' ratios):
+  the minimal driver (below), ``run_chunk`` bare on the same ICs (E = 0.27,
+  target ≤ 1.05), and on the dissipative scene (E0 = 0.3, γ = 0.01) bare,
+  recording (target ≤ 1.5), first section only, and a noise scene;
+  ``--only alternated`` runs these rows alone;
 * **yardstick** — a minimal refill-in-callback driver (heyoka batch, one
   escape event whose callback records the time and loads the next initial
   condition, the t_max bound, nothing else), at heyoka's recommended batch
@@ -51,6 +57,7 @@ from benchmarks.config import out_dir
 from hhscatter.integrate.engine import run_chunk
 from hhscatter.integrate.events import HAMILTON_ONLY, system
 from hhscatter.integrate.integrators import build_escape_only_batch
+from hhscatter.integrate.plan import plan_of
 from hhscatter.model import HenonHeiles
 
 RECORD_SNAPSHOTS = tuple(float(t) for t in np.arange(0.0, 200.0 + 1e-9, 0.5))
@@ -80,7 +87,7 @@ def yardstick(ics, *, r_esc=1.03, t_max=5000.0, tol=1e-15, batch_size=None):
         def __call__(self, ta, d, lane):
             return state["on_escape"](lane)
 
-    ta = build_escape_only_batch(sc, B, Cb(), tol=tol)  # x, y, px, py and the escape event alone
+    ta = build_escape_only_batch(plan_of(sc), B, Cb(), tol=tol)  # x, y, px, py and the escape event alone
     ics_l = np.ascontiguousarray(ics, dtype=float).tolist()
     n = len(ics_l)
     t_end = np.full(n, t_max)
@@ -309,9 +316,10 @@ def main(argv=None):
     )
     ap.add_argument(
         "--only",
-        choices=("whole", "recording"),
+        choices=("whole", "recording", "alternated"),
         default=None,
-        help="only the whole-process rows, or only the recording rows (and the bare row they are read with)",
+        help="only the whole-process rows, the recording rows (and the bare row they are read with), or the "
+        "in-process rows alternated in CPU time",
     )
     a = ap.parse_args(argv)
     n, rep = a.n, a.repeat
@@ -328,6 +336,10 @@ def main(argv=None):
     if a.only == "recording":
         _recording_rows(row, n, rep)
         return _write_outputs(rows, a.out, n, rep)
+    if a.only == "alternated":
+        _alternated_rows(row, n, rep)
+        return _write_outputs(rows, a.out, n, rep)
+    _alternated_rows(row, n, rep)
     _bare_rows(row, n, rep)
     c3, ics3 = _dissipative_rows(row, n, rep)
     _loose_tolerance_rows(row, n, rep, c3, ics3)
@@ -337,6 +349,63 @@ def main(argv=None):
     _system_rows(row, n, rep)
     _whole_rows(row, a.whole_n, rep)
     _write_outputs(rows, a.out, n, rep)
+
+
+def _alternated_rows(row, n, rep):
+    """The engine's in-process rows in CPU time, alternated: each round runs every contender once, in turn
+    (minimal driver, ``run_chunk`` bare, the dissipative bare scene, recording, first section only, noise), so a
+    change of the machine's load falls on all of them alike; a ratio is the median over the rounds of the ratio
+    within a round. The driver and the bare engine integrate the same conservative ICs (E = 0.27, r_esc 1.03);
+    recording and first section are read against the dissipative bare scene on the same ICs (E0 = 0.3, γ = 0.01)."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.noise import Noise  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene, SectionWindow  # deferred: pydantic loads on first use
+
+    cons = Scene(energy=0.27, n=n, seed=1, r_esc=1.03)
+    ics = region_ics(cons, 0, n)
+    m = min(n, 20_000)
+    diss = Scene(energy=0.3, gamma=0.01, n=m, seed=3, r_esc=1.03)
+    icr = region_ics(diss, 0, m)
+    rec = diss.replace(snapshots=RECORD_SNAPSHOTS, sections=SectionWindow(t_from=17.0, first_only=True))
+    sec = diss.replace(sections=SectionWindow(t_from=17.0, first_only=True))
+    k = min(n, 2_000)
+    noisy = Scene(energy=0.3, n=k, seed=4, r_esc=1.03, t_max=200.0, noise=Noise(sigma=0.01))
+    icn = region_ics(noisy, 0, k)
+    contenders = {
+        "driver": (lambda: yardstick(ics), n),
+        "bare": (_engine(cons, ics), n),
+        "dissipative bare": (_engine(diss, icr), m),
+        "recording": (_engine(rec, icr), m),
+        "first section": (_engine(sec, icr), m),
+        "noise": (_engine(noisy, icn), k),
+    }
+    for fn, _ in contenders.values():
+        fn()  # JIT compilation and caches outside the measurement
+    cpu = {name: [] for name in contenders}
+    for _ in range(rep):
+        for name, (fn, _) in contenders.items():
+            t0 = time.process_time()
+            fn()
+            cpu[name].append(time.process_time() - t0)
+    cpu = {name: np.array(v) for name, v in cpu.items()}
+
+    def ratio(a, b):
+        r = (cpu[a] / contenders[a][1]) / (cpu[b] / contenders[b][1])
+        return float(np.median(r)), f"median of {rep} rounds ({r.min():.2f}-{r.max():.2f})"
+
+    for name, (_, count) in contenders.items():
+        row("alternated", f"{name}: CPU µs/orbit (median)", 1e6 * float(np.median(cpu[name])) / count, "")
+    row(
+        "alternated",
+        "run_chunk bare / minimal driver, CPU",
+        *ratio("bare", "driver")[:1],
+        "≤ 1.05",
+        ratio("bare", "driver")[1] + f"; E = 0.27, N = {n}",
+    )
+    for name, goal in (("recording", "≤ 1.5"), ("first section", ""), ("noise", "")):
+        base = "dissipative bare" if name != "noise" else "driver"
+        v, note = ratio(name, base)
+        row("alternated", f"{name} / {base}, CPU per orbit", v, goal, note)
 
 
 def _bare_rows(row, n, rep):

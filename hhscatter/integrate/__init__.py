@@ -4,6 +4,8 @@ One module per concern (in the manner of SciPy's ``integrate/_ivp``):
 
 | module | concern |
 |---|---|
+| `plan` | a scene's `Plan`: what the engine reads from it, frozen once, and what it derives (scheduler, layout, events) |
+| `schedulers` | the scheduler contract (`Scheduler`) and registry (`SCHEDULERS`, `register`) |
 | `events` | the events and outcome rules of a scene, as data |
 | `integrators` | heyoka's batch and scalar integrators built from those events (the only heyoka events) |
 | `lanes` | the lane-rules contract: `LaneRules`, the rules as event handlers per lane, their callbacks |
@@ -13,7 +15,7 @@ One module per concern (in the manner of SciPy's ``integrate/_ivp``):
 | `noise` | the noise scheduler (scenes with `[noise]`): epochs of one kick interval, vectorised Ornstein–Uhlenbeck kicks |
 | `noise_reference` | an independent numpy Langevin integrator (OBABO), the noise scheduler's reference |
 | `orbit_time` | an orbit's time on a stream lane (TwoSum, near-ties to even) |
-| `chunk` | `run_chunk`: one block of orbits, its schedulers, phases and results |
+| `chunk` | `run_chunk`: one block of orbits on its plan's scheduler, its reruns and results |
 | `rerun` | orbits integrated again: the no-return rule's late ones, those an event-detection failure hit |
 | `results` | a chunk's rows (`ChunkResult`) |
 | `reference` | the reference driver: one orbit on heyoka's scalar integrator, any precision |
@@ -32,5 +34,6 @@ The life of an orbit in a lane, in one vocabulary (the method names of the modul
 * **release** — the orbit needs nothing more: commit its rows, then load the next orbit or park (``release``);
 * **park** — no orbit is left for the lane: it holds still (the stream) or sits at the origin (the epochs).
 
-Depends on :mod:`hhscatter.scene` and :mod:`hhscatter.model`.
+The engine reads a scene only through its plan (:func:`hhscatter.integrate.plan.plan_of`); it imports neither
+:mod:`hhscatter.scene` nor :mod:`hhscatter.model` (the plan holds the system object).
 """

@@ -11,6 +11,7 @@ import numpy as np
 
 from hhscatter.integrate import integrators
 from hhscatter.integrate.lanes import CONTINUING, LaneRules, _Callback, _unbind
+from hhscatter.integrate.orbit_time import _orbit_times
 
 PROGRESS_EVERY = 1024  # orbits between progress reports from inside a chunk
 
@@ -21,8 +22,9 @@ _FREE_KEYS = 4  # distinct compiled systems kept per process (a grid of r_esc va
 
 
 @contextlib.contextmanager
-def _batch_integrator(scene, batch_size, without=()):
-    """_batch_integrator(scene, batch_size, without=()) -> context manager yielding (ta, specs, layout).
+def _batch_integrator(scene, batch_size, without=(), products=False):
+    """_batch_integrator(scene, batch_size, without=(), products=False) -> context manager yielding (ta, specs,
+    layout).
 
     One compiled batch integrator per worker process and scene (:func:`hhscatter.integrate.integrators.batch_key`),
     reused across chunks instead of a new ``taylor_adaptive_batch`` per chunk (measured: ~6 ms and a
@@ -31,12 +33,12 @@ def _batch_integrator(scene, batch_size, without=()):
     heyoka's step depends on nothing else, so results are bit-identical (tested). An integrator in
     use is out of the cache; the handlers are unbound on return.
     """
-    key, specs, lay = integrators.batch_key(scene, batch_size, without=without)
+    key, specs, lay = integrators.batch_key(scene, batch_size, without=without, products=products)
     with _FREE_LOCK:
         free = _FREE.get(key)
         ta = free.pop() if free else None
     if ta is None:
-        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without)
+        ta, specs, lay = integrators.build_batch(scene, batch_size, _Callback, without=without, products=products)
     else:
         zeros = np.zeros(batch_size)
         ta.set_dtime(zeros, zeros)
@@ -90,33 +92,63 @@ class _BatchRules(LaneRules):
         self.pars = ta.pars if layout.n_pars else None
         self.gate_live = layout.gate is not None and layout.gate < len(ta.pars)
         self.time_hi, self.time_lo = ta.dtime
-        self.ics = ics.tolist()
+        self.ics = np.ascontiguousarray(ics, dtype=float)
+        if not (self.state.flags.c_contiguous and (self.pars is None or self.pars.flags.c_contiguous)):
+            raise RuntimeError("internal error: the integrator's state or parameters are not one contiguous block")
+        # flat memoryviews (one element written at a time, no numpy scalar or index tuple per write):
+        # state variable i of a lane at i * B + lane, initial condition k at 4k .. 4k + 3
+        self._s, self._ic = memoryview(self.state.reshape(-1)), memoryview(self.ics.reshape(-1))
+        self._p = memoryview(self.pars.reshape(-1)) if self.gate_live else None
+        self._gate_at = layout.gate * self.B if self.gate_live else 0
+        self._clock_at = layout.clock * self.B if layout.clock is not None else 0
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
-        # Python lists (an element write costs a fifth of numpy's), arrays once per chunk
         self.count_steps = count_steps
         self.progress = progress
         self.ticks = 0
-        self.outcome = [-1] * self.n
-        self.t_end = [math.nan] * self.n
-        # state at t_end; energies and exit channels are computed from it once per chunk
-        self.end_state = [None] * self.n
+        self._records(self.n)
+
+    #: the per-orbit arrays an orbit's end is written into (a second phase shares its first phase's)
+    RECORDS = ("outcome", "t_end", "end_state", "lane_timed", "end_hi", "end_lo", "start_hi_of", "start_lo_of")
+
+    def _records(self, n):
+        """Preallocate what the chunk's orbits end with: ``outcome`` (int8, −1 until known), the end state
+        ``end_state`` (n, 4), and the orbit time either as a number (``t_end``, by :meth:`record`) or, where
+        ``lane_timed``, as the lane time at the end and at the orbit's start, double-length (``end_hi``,
+        ``end_lo``, ``start_hi_of``, ``start_lo_of``: the stream's ends, whose times :meth:`orbit_times` computes
+        once per chunk). No Python object is kept per orbit."""
+        self.outcome = np.full(n, -1, dtype=np.int8)
+        self.t_end = np.full(n, math.nan)
+        self.end_state = np.zeros((n, 4))
+        self.lane_timed = np.zeros(n, dtype=np.uint8)
+        self.end_hi, self.end_lo = np.zeros(n), np.zeros(n)
+        self.start_hi_of, self.start_lo_of = np.zeros(n), np.zeros(n)
+
+    def orbit_times(self) -> np.ndarray:
+        """The orbit time at each orbit's end (time units), once per chunk: :meth:`record`'s, or, for the
+        orbits ended by lane time, (end) − (start) of the double-length lane times (:func:`_orbit_times`)."""
+        t = self.t_end.copy()
+        m = self.lane_timed.astype(bool)
+        if m.any():
+            t[m] = _orbit_times(self.end_hi[m], self.end_lo[m], self.start_hi_of[m], self.start_lo_of[m])
+        return t
 
     def state4(self, lane):
         return tuple(self.cols[lane].tolist())
 
     def set_gate(self, lane, g):
         if self.gate_live:  # (a first phase has no section event, hence no gate)
-            self.pars[self.layout.gate, lane] = g
+            self._p[self._gate_at + lane] = g
 
     def set_clock(self, lane, sigma):
-        self.state[self.layout.clock, lane] = sigma
+        self._s[self._clock_at + lane] = sigma
 
     def record(self, lane, outcome, t, state):
         k = self.orbit[lane]
         self.outcome[k] = outcome
         self.t_end[k] = t
+        self.lane_timed[k] = 0
         self.end_state[k] = state
 
     def tick(self):
@@ -129,12 +161,17 @@ class _BatchRules(LaneRules):
     def close(self):
         """Drop every view of the integrator (it goes back to the cache) and every closure over these lanes."""
         self.ta = self.state = self.cols = self.pars = self.time_hi = self.time_lo = None
+        self._s = self._ic = self._p = None
 
     def load_orbit(self, lane, k):
         """Initial condition k into ``lane`` (state, rules, cooldowns)."""
         if self.progress is not None:
             self.tick()
-        self.state[:4, lane] = self.ics[k]
+        s, ic, B, j = self._s, self._ic, self.B, 4 * k
+        s[lane] = ic[j]
+        s[B + lane] = ic[j + 1]
+        s[2 * B + lane] = ic[j + 2]
+        s[3 * B + lane] = ic[j + 3]
         self.start_orbit(lane, k)
         self.ta.reset_cooldowns(lane)
 

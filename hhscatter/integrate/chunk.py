@@ -5,27 +5,25 @@ from __future__ import annotations
 import numpy as np
 
 from hhscatter.integrate import events, heyoka_log
-from hhscatter.integrate.batch import _batch_integrator
-from hhscatter.integrate.epochs import EPOCH_BATCH, _Epochs
 from hhscatter.integrate.events import ESCAPED
-from hhscatter.integrate.lanes import RERUN, _bind
-from hhscatter.integrate.noise import NOISE_BATCH, _Noisy
+from hhscatter.integrate.lanes import RERUN
+from hhscatter.integrate.plan import plan_of
 from hhscatter.integrate.rerun import _merge_rerun, _no_return, _orbits_with_failures, _own_far, _redo_on_reference
 from hhscatter.integrate.results import CROSSING_COLUMNS, SECTION_COLUMNS, ChunkResult, _empty_result, _rows_to_columns
-from hhscatter.integrate.stream import STREAM_BATCH, _SecondPhase, _Stream
 
 
 def scheduler(scene) -> str:
-    """scheduler(scene) -> 'noise' for scenes with noise, 'epochs' for scenes with snapshots, else 'stream'."""
-    if scene.noise is not None:
-        return "noise"
-    return "epochs" if scene.snapshots else "stream"
+    """scheduler(scene) -> the name of the scheduler that integrates the scene (a registered one,
+    :mod:`hhscatter.integrate.schedulers`): 'noise' for scenes with noise, 'epochs' for scenes with snapshots,
+    else 'stream'."""
+    return plan_of(scene).scheduler
 
 
 def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
     """run_chunk(scene, ics, traj_ids, batch_size=None, count_steps=False, progress=None) -> ChunkResult.
 
-    ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
+    ``scene``: the scene's :class:`hhscatter.integrate.plan.Plan` (a run builds it once), or a scene (its plan
+    is built here). ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
     array (n,). Returns the table rows of this chunk, ordered by traj_id (and
     time). ``batch_size`` (default: the scene's, else 8 lanes for the stream
     scheduler and 8 for epochs) has no effect on the results. ``count_steps``:
@@ -42,21 +40,23 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     An orbit that starts on the section near an inflection of r has its section window opened at T_INITIAL
     by the clock (:func:`hhscatter.integrate.events.opens_late`), or, in a scene without a clock, is redone
     on the reference driver too. A noise scene's orbits have no reference driver (their kicks live in the
-    noise scheduler): their failures are counted, not redone.
+    noise scheduler, not :attr:`hhscatter.integrate.schedulers.Scheduler.deterministic`): their failures are
+    counted, not redone.
     """
+    scene = plan_of(scene)
     ics = np.ascontiguousarray(ics, dtype=float)
     traj_ids = np.asarray(traj_ids, dtype=np.int64)
     outside = ics[:, 0] ** 2 + ics[:, 1] ** 2 >= scene.r_esc**2
     inside = ~outside
-    kind = scheduler(scene)
-    # the integration's scene (maybe an earlier far event) and `late`
-    far = (scene, None) if kind == "noise" else _no_return(scene, ics[inside], kind)
+    deterministic = scene.kind.deterministic
+    # the integration's plan (maybe an earlier far event) and `late`
+    far = _no_return(scene, ics[inside]) if deterministic else (scene, None)
     kw = dict(batch_size=batch_size, count_steps=count_steps)
     with heyoka_log.capture() as log:
         res = _integrate(scene, ics[inside], traj_ids[inside], far, progress=progress, **kw)
     failures, redone = log.event_failures, np.empty(0, np.int64)
-    local = _unclocked_late(scene, ics[inside]) if kind != "noise" else np.empty(0, np.int64)
-    if failures and kind != "noise":
+    local = _unclocked_late(scene, ics[inside]) if deterministic else np.empty(0, np.int64)
+    if failures and deterministic:
         found = _orbits_with_failures(
             lambda idx: _integrate(scene, ics[inside][idx], traj_ids[inside][idx], far, **kw),
             int(inside.sum()),
@@ -74,53 +74,46 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
 
 def _opens_late(scene, ics):
     """events.opens_late where the scene has the clock that opens those windows at T_INITIAL, else None."""
-    return events.opens_late(scene, ics) if events.layout(scene).clock is not None else None
+    return events.opens_late(scene, ics) if scene.layout.clock is not None else None
 
 
 def _unclocked_late(scene, ics) -> np.ndarray:
     """Local indices of the orbits whose window should open late (events.opens_late) in a scene without a clock
     (snapshots, a window open from 0 to the end): they are redone on the reference driver (its section cooldown
     is fixed: events.SECTION_COOLDOWN)."""
-    if events.layout(scene).clock is not None:
+    if scene.layout.clock is not None:
         return np.empty(0, np.int64)
     late = events.opens_late(scene, ics)
     return np.flatnonzero(late) if late is not None else np.empty(0, np.int64)
 
 
-def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None) -> ChunkResult:
+def _integrate(
+    scene, ics, traj_ids, far, *, batch_size=None, count_steps=False, progress=None, products=None
+) -> ChunkResult:
     """The chunk's orbits (all inside r_esc) on the batch engine; ``far``: :func:`_no_return`'s (scene, late),
-    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk."""
+    fixed by the caller so that any subset of the chunk is integrated exactly as in the chunk.
+
+    ``products``: the events' H with its powers written as products (True) or as the system gives it (False);
+    None: the system's, and the orbits that start where a power of H has a zero base
+    (:func:`hhscatter.integrate.events.zero_power_start`: heyoka would skip their closure event in the first step)
+    are integrated again in products, their rows replacing the first ones."""
     if not len(ics):
         return _empty_result(traj_ids)
-    kind = scheduler(scene)
-    B = int(batch_size or scene.batch_size or {"epochs": EPOCH_BATCH, "noise": NOISE_BATCH}.get(kind, STREAM_BATCH))
-    phases = kind == "stream" and events.two_phase(scene)
+    kw = dict(batch_size=batch_size, count_steps=count_steps)
+    if products is None:
+        res = _integrate(scene, ics, traj_ids, far, progress=progress, products=False, **kw)
+        zero = events.zero_power_start(scene, ics)
+        if zero is not None:
+            res = _merge_rerun(
+                res, zero, traj_ids, _integrate(scene, ics[zero], traj_ids[zero], far, products=True, **kw)
+            )
+        return res
+    kind = scene.kind
+    B = int(batch_size or scene.batch_size or kind.batch_size)
     orig, (scene, late) = scene, far
-    # first (or only) phase: without the section event when the window opens late
-    with _batch_integrator(scene, B, without=("section",) if phases else ()) as (ta, specs, layout):
-        config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
-        if kind == "noise":
-            lanes = _Noisy(scene, ta, layout, ics, traj_ids, **config)
-        elif kind == "epochs":
-            lanes = _Epochs(scene, ta, layout, ics, **config)
-        else:  # the inlined handlers serve stream scenes with no section event in this integrator and no follow
-            inlined = scene.follow is None and (scene.sections is None or phases)
-            lanes = _Stream(scene, ta, layout, ics, inlined=inlined, migrate_at_open=phases, **config)
-        _bind(ta, specs, lanes, lanes.handlers)
-        try:
-            n_returns, n_steps, (s_ids, s_t, s_e) = lanes.run()
-        finally:
-            lanes.close()  # the integrator goes back to the cache: no view of it stays here
-    if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
-        with _batch_integrator(scene, B) as (ta2, specs2, _):
-            second = _SecondPhase(scene, ta2, layout, lanes, late=late)
-            _bind(ta2, specs2, second)
-            try:
-                r2, s2, _ = second.run()
-            finally:
-                second.close()
-        n_returns, n_steps = n_returns + r2, n_steps + s2
-    outcome = np.array(lanes.outcome, dtype=np.int8)
+    config = dict(count_steps=count_steps, progress=progress, late=late, open_late=_opens_late(scene, ics))
+    lanes, n_returns, n_steps, (s_ids, s_t, s_e) = kind.integrate(scene, B, ics, traj_ids, products=products, **config)
+    outcome = lanes.outcome
     if (outcome == -1).any():
         raise RuntimeError("internal error: some orbits of the chunk have no outcome")
     res = _chunk_result(scene, lanes, ics, traj_ids, outcome, (s_ids, s_t, s_e), n_returns, n_steps)
@@ -131,7 +124,7 @@ def _integrate(scene, ics, traj_ids, far, *, batch_size=None, count_steps=False,
             res,
             rerun,
             traj_ids,
-            _integrate(own, ics[rerun], traj_ids[rerun], (own, None), batch_size=batch_size, count_steps=count_steps),
+            _integrate(own, ics[rerun], traj_ids[rerun], (own, None), products=products, **kw),
         )
     return res
 
@@ -140,8 +133,8 @@ def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_step
     """The chunk's rows from its lanes: lifetimes in orbit order, the other tables by orbit, then time."""
     n, (s_ids, s_t, s_e) = len(ics), snaps
     model = scene.model
-    end = np.array(lanes.end_state, dtype=float).reshape(n, 4)
-    t_end = np.array(lanes.t_end, dtype=float)
+    end = lanes.end_state
+    t_end = lanes.orbit_times()
     channel = np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1)
     lifetimes = {
         "traj_id": traj_ids,

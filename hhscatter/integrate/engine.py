@@ -6,8 +6,12 @@ same rules (:class:`LaneRules`) drive the scalar reference driver
 :func:`simulate_orbit` (long double, real128) used by the tests, the
 benchmarks and the stress cases.
 
-Two lane schedulers, chosen by the scene
-----------------------------------------
+Lane schedulers, chosen by the scene's plan
+-------------------------------------------
+A scene is integrated through its plan (:mod:`hhscatter.integrate.plan`), which names a registered scheduler
+(:mod:`hhscatter.integrate.schedulers`; the docs page "Adding a scheduler"). The stream and the epochs are
+below; the noise scheduler (:mod:`hhscatter.integrate.noise`) runs epochs of one kick interval.
+
 *Stream* (scenes without snapshots). heyoka's batch ``propagate_until``
 returns for all lanes when one lane stops, and a return costs more than a
 short orbit, so an orbit's end never stops the propagation: its event
@@ -55,16 +59,22 @@ chunks, reset to a new one's state (:func:`_batch_integrator`).
 from __future__ import annotations
 
 # the engine's modules, by concern (hhscatter.integrate's docstring): this module gathers their public names
-from hhscatter.integrate.batch import _FREE, PROGRESS_EVERY  # noqa: F401
+from hhscatter.integrate.batch import PROGRESS_EVERY
 from hhscatter.integrate.chunk import run_chunk, scheduler
 from hhscatter.integrate.events import CENSORED, ESCAPED, OUTCOMES, SETTLED, STOPPED
 from hhscatter.integrate.lanes import LaneRules
-from hhscatter.integrate.orbit_time import _tie_to_even  # noqa: F401
+from hhscatter.integrate.plan import Plan, plan_of
 from hhscatter.integrate.reference import OrbitResult, simulate_orbit, state_at
-from hhscatter.integrate.rerun import _merge_rerun, _no_return  # noqa: F401
 from hhscatter.integrate.results import ChunkResult
+from hhscatter.integrate.schedulers import SCHEDULERS, Scheduler, register
 
 __all__ = [
+    "PROGRESS_EVERY",
+    "Plan",
+    "plan_of",
+    "SCHEDULERS",
+    "Scheduler",
+    "register",
     "LaneRules",
     "run_chunk",
     "simulate_orbit",

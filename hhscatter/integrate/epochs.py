@@ -6,20 +6,34 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate.batch import _BatchRules, _check
-from hhscatter.integrate.events import CENSORED, SETTLED
-from hhscatter.integrate.lanes import CONTINUING, LIVE
+from hhscatter.integrate.batch import _check
+from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
+from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN
+from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
 EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
 
 
-class _Epochs(_BatchRules):
+@register
+class _Epochs(Scheduler):
     """Epoch scheduler: all lanes advance together; snapshots from ``propagate_grid``."""
 
-    def __init__(self, scene, ta, layout, ics, **config):
-        super().__init__(scene, ta, layout, ics, **config)
-        self.handlers = {}  # the methods serve every rule
+    name = "epochs"
+    priority = 20
+    batch_size = EPOCH_BATCH
+
+    @classmethod
+    def applies(cls, plan) -> bool:
+        return bool(plan.snapshots)
+
+    def __init__(self, scene, ta, layout, ics, traj_ids=None, **config):
+        super().__init__(scene, ta, layout, ics, traj_ids, **config)
+        self._handlers = None
+        # the lane's orbit's last outward r_esc crossing (dissipative scenes, inlined rules): whether there is
+        # one, its orbit time, its state (x, y, px, py of lane j at 4j..4j+3)
+        self.has_out = np.zeros(self.B, dtype=np.uint8)
+        self.out_t, self.out_state = np.zeros(self.B), np.zeros(4 * self.B)
         t_max = scene.t_max
         # P divides t_max, so censoring falls on an epoch's end
         self.n_epochs_max = max(1, math.ceil(t_max / EPOCH))
@@ -35,14 +49,122 @@ class _Epochs(_BatchRules):
 
     def release(self, lane):
         """Park the lane at the origin (a fixed point) until the epoch ends."""
-        self.commit_rows(lane)
+        if self.pending_sec[lane] or self.pending_cross[lane]:
+            self.commit_rows(lane)
         self.orbit[lane] = -1
-        self.state[:, lane] = 0.0
+        s, B = self._s, self.B
+        for i in range(self.layout.n_state):
+            s[i * B + lane] = 0.0
         if self.layout.clock is not None:
             self.set_clock(lane, 1.0)
         if self.layout.gate is not None:
             self.set_gate(lane, 0.0)
         return True
+
+    @property
+    def handlers(self):
+        """{rule: callable (ta, direction, lane)}: the lean handlers of the escape, closure, far and r_esc rules
+        (scenes without follow; the methods serve the section and clock rules), built on first use (a subclass
+        sets its epoch length P after this class's construction)."""
+        if self._handlers is None:
+            self._handlers = self._inlined_handlers() if not self.follow else {}
+        return self._handlers
+
+    def _inlined_handlers(self):
+        """The rules of :class:`hhscatter.integrate.lanes.LaneRules` for escape, closure, far and r_esc, written
+        out with heyoka's callback signature: the lane's orbit time, state and the chunk's records read and
+        written through flat memoryviews, the last outward r_esc crossing kept in per-lane arrays; no Python
+        container per orbit end or per crossing (as the stream's, :mod:`hhscatter.integrate.stream`)."""
+        B, P = self.B, self.P
+        orbit, phase, start_epoch = self.orbit, self.phase, self.start_epoch
+        s = memoryview(self.state.reshape(-1))  # s[i * B + lane]
+        hi, lo = memoryview(self.time_hi), memoryview(self.time_lo)
+        out, tend, timed = memoryview(self.outcome), memoryview(self.t_end), memoryview(self.lane_timed)
+        end = memoryview(self.end_state.reshape(-1))  # end[4k + i]
+        has, ot, ost = memoryview(self.has_out), memoryview(self.out_t), memoryview(self.out_state)
+        b1, b2, b3 = B, 2 * B, 3 * B
+        r_s2 = self.r_s * self.r_s
+        cont, late, release = self.continue_settled, self.late, self.release
+        escaped, settled, rerun, live, continuing = ESCAPED, SETTLED, RERUN, LIVE, CONTINUING
+        lanes = self
+
+        def now(lane):  # elapsed(lane)
+            return ((lanes.epoch - start_epoch[lane]) * P + hi[lane]) + lo[lane]
+
+        def here(lane, code):  # record(lane, code, elapsed(lane), state4(lane))
+            k = orbit[lane]
+            out[k] = code
+            tend[k] = now(lane)
+            timed[k] = 0
+            j = 4 * k
+            end[j] = s[lane]
+            end[j + 1] = s[b1 + lane]
+            end[j + 2] = s[b2 + lane]
+            end[j + 3] = s[b3 + lane]
+
+        def at_out(lane, code):  # record(lane, code, *last_out)
+            k = orbit[lane]
+            out[k] = code
+            tend[k] = ot[lane]
+            timed[k] = 0
+            j, q = 4 * k, 4 * lane
+            end[j] = ost[q]
+            end[j + 1] = ost[q + 1]
+            end[j + 2] = ost[q + 2]
+            end[j + 3] = ost[q + 3]
+
+        def on_escape(ta, d, lane):
+            if orbit[lane] < 0 or phase[lane] != live:
+                return True
+            here(lane, escaped)
+            return release(lane)
+
+        def on_resc(ta, d, lane):
+            if orbit[lane] >= 0 and phase[lane] == live:
+                if d > 0:
+                    has[lane] = 1
+                    ot[lane] = now(lane)
+                    q = 4 * lane
+                    ost[q] = s[lane]
+                    ost[q + 1] = s[b1 + lane]
+                    ost[q + 2] = s[b2 + lane]
+                    ost[q + 3] = s[b3 + lane]
+                else:
+                    has[lane] = 0
+            return True
+
+        def on_closure(ta, d, lane):
+            if orbit[lane] < 0 or phase[lane] != live:
+                return True
+            x, y = s[lane], s[b1 + lane]
+            if x * x + y * y <= r_s2:  # events.closure_rule, inlined
+                here(lane, settled)
+                if cont:
+                    phase[lane] = continuing
+                    return True
+                return release(lane)
+            if has[lane]:
+                at_out(lane, escaped)
+                return release(lane)
+            return True
+
+        def on_far(ta, d, lane):
+            if orbit[lane] < 0:
+                return True
+            if phase[lane] == live:
+                if not has[lane]:  # unreachable: r_far > r_esc; kept as a guard
+                    raise RuntimeError("orbit reached r_far without crossing r_esc")
+                if late is not None and late(now(lane), s[lane], s[b1 + lane], s[b2 + lane], s[b3 + lane]):
+                    at_out(lane, rerun)
+                else:
+                    at_out(lane, escaped)
+            return release(lane)  # (a followed orbit is gone)
+
+        return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
+
+    def close(self):
+        super().close()
+        self._handlers = {}  # the closures refer back to the lanes: free them now
 
     def _tables(self):
         """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
@@ -166,4 +288,5 @@ class _Epochs(_BatchRules):
             return
         self.next = k + 1
         self.start_epoch[lane] = self.epoch
+        self.has_out[lane] = 0
         self.load_orbit(lane, k)

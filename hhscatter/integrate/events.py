@@ -138,16 +138,104 @@ class Layout:
 
 
 class Symbols:
-    """The heyoka expressions events are written in (built lazily: no heyoka at import)."""
+    """The heyoka expressions events are written in (built lazily: no heyoka at import).
 
-    def __init__(self, scene, layout: Layout):
+    ``products``: V and H with their natural powers ≥ 3 written as products (:func:`_powers_as_products`), for the
+    orbits that start where such a power's base is 0 (:func:`zero_power_start`)."""
+
+    def __init__(self, scene, layout: Layout, products: bool = False):
         import heyoka as hy  # deferred: heyoka loads on first use
 
         (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions()
+        if products:
+            self.V, self.H = _powers_as_products(self.V), _powers_as_products(self.H)
         self.r2 = self.x**2 + self.y**2
         self.clock = hy.make_vars("sigma") if layout.clock is not None else None
         self.gate = hy.par[layout.gate] if layout.gate is not None else None
         self.gamma = hy.par[layout.gamma] if layout.gamma is not None else None
+
+
+_PRODUCTS = {}  # repr of an expression -> (its rewrite or None, the bases of its natural powers ≥ 3 as numpy functions)
+
+
+def _powers_as_products(expr):
+    """The heyoka expression ``expr`` with every power of a natural exponent n ≥ 3 written as a product of n
+    factors (squares stay: heyoka's square has no such defect); ``expr`` itself if it has none.
+
+    heyoka's Taylor recurrence of uⁿ divides by u at the start of the step: an event whose expression holds
+    y**3 (Hénon–Heiles' H) has non-finite Taylor coefficients in a step that starts at y = 0 exactly (an
+    initial condition on an axis), and heyoka then skips the event in that step without a word. The closure
+    event (E = E_c) of such an orbit, crossed in its first step, was missed and the orbit ran on to t_max.
+
+    >>> import heyoka as hy
+    >>> x, y = hy.make_vars("x", "y")
+    >>> print(_powers_as_products(x**2 * y - y**3 / 3.0))
+    ((y * x**2.0000000000000000) - (0.33333333333333331 * (y * y * y)))
+    >>> e = x**2 + y**2
+    >>> _powers_as_products(e) is e
+    True
+    """
+    rewritten = _rewrite_powers(expr)[0]
+    return rewritten if rewritten is not None else expr
+
+
+def _rewrite_powers(expr):
+    """(:func:`_powers_as_products`' rewrite or None when ``expr`` has no natural power ≥ 3, the bases of those
+    powers as numpy functions of (x, y, px, py)); cached by the expression's text."""
+    key = repr(expr)
+    if key not in _PRODUCTS:
+        _PRODUCTS[key] = _rewrite_powers_uncached(expr)
+    return _PRODUCTS[key]
+
+
+def _rewrite_powers_uncached(expr):
+    import heyoka as hy  # deferred: heyoka loads on first use
+    import sympy as sp  # deferred: sympy takes ~0.3 s to import
+
+    found = []
+
+    def walk(e):
+        if e.is_Pow and e.exp.is_Integer and int(e.exp) >= 3:
+            found.append(e)
+            b = walk(e.base)
+            return sp.Mul(*([b] * int(e.exp)), evaluate=False)
+        if e.args:
+            return e.func(*[walk(a) for a in e.args], evaluate=False)
+        return e
+
+    rewritten = walk(hy.to_sympy(expr))
+    if not found:
+        return None, ()
+    names = sp.symbols("x y px py")
+    bases = tuple(sp.lambdify(names, b, "numpy") for b in {f.base for f in found})
+    return hy.from_sympy(rewritten), bases
+
+
+def zero_power_start(scene, ics) -> np.ndarray | None:
+    """zero_power_start(plan, ics) -> bool array (n,), or None: the orbits of a dissipative scene that start where
+    the base of a natural power ≥ 3 in H is 0 exactly (y = 0 for Hénon–Heiles' y³).
+
+    heyoka skips the closure event (E = E_c) in such an orbit's first step (:func:`_powers_as_products`): these
+    orbits are integrated with H written in products (``Symbols(products=True)``). None if there is none, or the
+    scene has no closure event.
+
+    >>> import numpy as np
+    >>> from hhscatter.integrate.plan import plan_of
+    >>> from hhscatter.scene.scene import Scene
+    >>> s = plan_of(Scene(energy=0.17, n=2, gamma=0.01))
+    >>> zero_power_start(s, np.array([[0.05, 0.0, 0.0, 0.58], [0.05, 0.01, 0.0, 0.58]])).tolist()
+    [True, False]
+    """
+    if not (scene.gamma > 0 and scene.noise is None) or not len(ics):
+        return None
+    bases = scene.cached("power bases", lambda: _rewrite_powers(scene.model.expressions()[2])[1])
+    if not bases:
+        return None
+    x, y, px, py = np.asarray(ics, dtype=float).T
+    zero = np.zeros(len(x), dtype=bool)
+    for base in bases:
+        zero |= np.broadcast_to(base(x, y, px, py), zero.shape) == 0
+    return zero if zero.any() else None
 
 
 def far_radius(scene) -> float:
@@ -157,15 +245,16 @@ def far_radius(scene) -> float:
     return max(10.0 * scene.model.saddle_radius, 2.0 * scene.r_esc)
 
 
-def clock_targets(scene) -> tuple:
-    """clock_targets(scene) -> ((orbit time, action), ...): when the clock acts, in order.
+def clock_targets(scene, censor: bool) -> tuple:
+    """clock_targets(plan, censor) -> ((orbit time, action), ...): when the clock acts, in order.
 
     Actions: 'open' the section window (at t_from − CLOCK_MARGIN, a window
     that opens late could miss a crossing) and 'close' it (at t_to +
-    CLOCK_MARGIN); the section rule itself checks the exact window. Scenes
-    without snapshots (the stream scheduler) also 'censor' with it at t_max:
-    in orbit time, so a censored orbit's end state does not depend on the
-    orbits before it in its lane (a propagation bound's rounding did).
+    CLOCK_MARGIN); the section rule itself checks the exact window. With
+    ``censor`` (a scheduler that censors by the clock: the stream) it also
+    'censors' at t_max: in orbit time, so a censored orbit's end state does not
+    depend on the orbits before it in its lane (a propagation bound's rounding
+    did).
     """
     w = scene.sections
     out = []
@@ -173,7 +262,7 @@ def clock_targets(scene) -> tuple:
         out.append((max(float(w.t_from) - CLOCK_MARGIN, 0.0), "open"))
     if w is not None and math.isfinite(w.t_to):
         out.append((float(w.t_to) + CLOCK_MARGIN, "close"))
-    if not scene.snapshots and scene.noise is None:  # a noise scene censors at its last kick
+    if censor:
         out.append((float(scene.t_max), "censor"))
     return tuple(sorted(out))
 
@@ -184,8 +273,8 @@ def follow_radii(scene) -> tuple:
 
 
 def layout(scene) -> Layout:
-    """layout(scene) -> Layout: state and parameter slots the scene's events need."""
-    targets = clock_targets(scene)
+    """layout(plan) -> Layout: state and parameter slots the plan's events need (from its ``clock_targets``)."""
+    targets = scene.clock_targets
     clock = 4 if targets else None
     n_pars = 0
     gamma = gate = None
@@ -198,7 +287,8 @@ def layout(scene) -> Layout:
 
 
 def scene_events(scene) -> tuple:
-    """scene_events(scene) -> tuple[EventSpec, ...]: the events a scene needs, in callback order.
+    """scene_events(plan) -> tuple[EventSpec, ...]: the events a plan needs, in callback order (from its
+    ``far_radius``, ``follow_radii`` and ``clock_targets``).
 
     Only what the scene needs is compiled: the section event only for scenes
     with a section window (and switched off per lane outside it), the clock
@@ -207,7 +297,7 @@ def scene_events(scene) -> tuple:
     follow scenes.
     """
     r_esc2 = scene.r_esc**2
-    rf2 = far_radius(scene) ** 2
+    rf2 = scene.far_radius**2
     ec = scene.model.critical_energy
     ev = []
     if scene.gamma > 0 and scene.noise is None:
@@ -220,7 +310,7 @@ def scene_events(scene) -> tuple:
         # each root is declared once: two terminal events with the same root in one lane lose
         # one of them in batch mode (measured), so the r_esc radius is also the escape event
         ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "followed orbit far away"))
-        for k, R in enumerate(follow_radii(scene)):
+        for k, R in enumerate(scene.follow_radii):
             ev.append(
                 EventSpec(
                     f"radius{k}",
@@ -240,7 +330,7 @@ def scene_events(scene) -> tuple:
                 "section ṙ = 0 (gated)",
             )
         )
-    if clock_targets(scene):
+    if scene.clock_targets:
         ev.append(EventSpec("clock", -1, lambda s: s.clock, "orbit-time schedule"))
     return tuple(ev)
 
@@ -337,5 +427,6 @@ __all__ = [
     "scene_events",
     "two_phase",
     "section_accepts",
+    "zero_power_start",
     "system",
 ]

@@ -6,21 +6,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.integrate.events import HAMILTON_ONLY, Layout, Symbols, layout, scene_events, system
+from hhscatter.integrate.events import HAMILTON_ONLY, Layout, Symbols, system
 
 
-def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=()):
-    """build_batch(scene, batch_size, make_callback, without=()) -> (taylor_adaptive_batch, specs, layout).
+def build_batch(scene, batch_size: int, make_callback, *, tol=None, without=(), products=False):
+    """build_batch(scene, batch_size, make_callback, without=(), products=False) -> (taylor_adaptive_batch, specs,
+    layout).
 
     ``make_callback(spec)`` returns the callback object of one event (heyoka
     deep-copies it; bind handlers afterwards through ``ta.t_events[i].callback``).
-    ``without``: names of events left out (an orbit phase that does not need them).
+    ``without``: names of events left out (an orbit phase that does not need them); ``products``: the events'
+    H with its powers as products (:class:`hhscatter.integrate.events.Symbols`).
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
-    sym = Symbols(scene, lay)
+    lay = scene.layout
+    specs = tuple(s for s in scene.events if s.name not in without)
+    sym = Symbols(scene, lay, products)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     events = [
         hy.t_event_batch(s.expression(sym), callback=make_callback(s), direction=dirs[s.direction]) for s in specs
@@ -45,7 +47,7 @@ def build_escape_only_batch(scene, batch_size: int, callback, *, tol=None):
     the same escape; ``scene`` must be conservative and without a follow."""
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    (esc,) = (e for e in scene_events(scene) if e.name == "escape")
+    (esc,) = (e for e in scene.events if e.name == "escape")
     ev = hy.t_event_batch(
         esc.expression(Symbols(scene, HAMILTON_ONLY)), callback=callback, direction=hy.event_direction.positive
     )
@@ -65,8 +67,8 @@ def batch_pars(scene, lay: Layout, batch_size: int, without=()) -> np.ndarray:
     return pars
 
 
-def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
-    """batch_key(scene, batch_size, tol=None, without=()) -> (key, specs, layout).
+def batch_key(scene, batch_size: int, *, tol=None, without=(), products=False) -> tuple:
+    """batch_key(scene, batch_size, tol=None, without=(), products=False) -> (key, specs, layout).
 
     ``key`` (hashable) holds everything :func:`build_batch` compiles: the system and the event
     expressions as heyoka prints them (constants to 17 digits, which round-trip), the events'
@@ -74,9 +76,15 @@ def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
     give interchangeable integrators: what differs between them (γ, the section gate) is a runtime
     parameter, set per chunk (:func:`batch_pars`). Costs ~0.1 ms, no compilation.
     """
-    lay = layout(scene)
-    specs = tuple(s for s in scene_events(scene) if s.name not in without)
-    sym = Symbols(scene, lay)
+    return scene.cached(
+        ("batch key", batch_size, tol, without, products), lambda: _key(scene, batch_size, tol, without, products)
+    )
+
+
+def _key(scene, batch_size, tol, without, products):
+    lay = scene.layout
+    specs = tuple(s for s in scene.events if s.name not in without)
+    sym = Symbols(scene, lay, products)
     key = (
         batch_size,
         float(scene.tol if tol is None else tol),
@@ -87,20 +95,21 @@ def batch_key(scene, batch_size: int, *, tol=None, without=()) -> tuple:
     return key, specs, lay
 
 
-def build_scalar(scene, make_callback, *, fp_type=float, tol=None, section_cooldown=-1.0):
-    """build_scalar(scene, make_callback, fp_type=float, tol=None, section_cooldown=-1) -> (taylor_adaptive, specs,
-    layout).
+def build_scalar(scene, make_callback, *, fp_type=float, tol=None, section_cooldown=-1.0, products=False):
+    """build_scalar(scene, make_callback, fp_type=float, tol=None, section_cooldown=-1, products=False) ->
+    (taylor_adaptive, specs, layout).
 
     The same events on heyoka's scalar integrator, in ``fp_type`` (float,
     numpy.longdouble or heyoka.real128). ``tol`` defaults to the scene's for
     float and to the type's epsilon otherwise. ``section_cooldown``: the section event's cooldown after a root
     (time units; −1: heyoka's, deduced from the event's derivative at the root, as for every other event).
+    ``products``: the events' H with its powers as products (:class:`hhscatter.integrate.events.Symbols`).
     """
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    lay = layout(scene)
-    specs = scene_events(scene)
-    sym = Symbols(scene, lay)
+    lay = scene.layout
+    specs = scene.events
+    sym = Symbols(scene, lay, products)
     dirs = {+1: hy.event_direction.positive, -1: hy.event_direction.negative, 0: hy.event_direction.any}
     cast = caster(fp_type)
     events = [

@@ -18,9 +18,18 @@ RERUN = -2  # outcome code inside a chunk: decided at the no-return radius too c
 
 
 class _Callback:
-    """An event's callback; heyoka deep-copies it, so its handler is bound afterwards."""
+    """An event's callback; heyoka deep-copies it, so its handler is bound afterwards (:func:`_bind`).
+
+    Each callback is an instance of a class of its own, so that a handler with heyoka's signature
+    (ta, direction, lane) can be bound as the class's ``__call__``: heyoka then calls it with no Python frame in
+    between (the engine's hot handlers, :meth:`hhscatter.integrate.stream._Stream._inlined_handlers`)."""
 
     __slots__ = ("handler",)
+
+    def __new__(cls, spec=None):
+        if cls is _Callback:
+            cls = type("_EventCallback", (_Callback,), {"__slots__": ()})
+        return object.__new__(cls)
 
     def __init__(self, spec=None):
         self.handler = None
@@ -30,19 +39,25 @@ class _Callback:
 
 
 def _bind(ta, specs, rules, inlined=None):
-    """Bind each event's callback to the handler of its rule (``inlined``: {rule: closure} that replace some)."""
+    """Bind each event's callback to the handler of its rule: ``rules.handler(spec)``, a callable (lane,
+    direction), or, for the rules in ``inlined`` ({rule: callable (ta, direction, lane)}), that callable as the
+    callback itself."""
     for spec, ev in zip(specs, ta.t_events):
+        cb = ev.callback
         if inlined and spec.rule in inlined:
-            ev.callback.handler = inlined[spec.rule]
+            type(cb).__call__ = staticmethod(inlined[spec.rule])
         else:
-            ev.callback.handler = rules.handler(spec)
+            cb.handler = rules.handler(spec)
 
 
 def _unbind(ta):
     """Break the cycle integrator → callbacks → rules → integrator (heyoka's objects are
     invisible to Python's cycle collector: without this every chunk's integrator stayed alive)."""
     for ev in ta.t_events:
-        ev.callback.handler = None
+        cb = ev.callback
+        cb.handler = None
+        if type(cb) is not _Callback and "__call__" in type(cb).__dict__:
+            del type(cb).__call__
 
 
 class LaneRules(abc.ABC):
@@ -110,10 +125,10 @@ class LaneRules(abc.ABC):
         self.layout = layout
         self.win = scene.sections
         self.follow = scene.follow is not None
-        self.radii = events.follow_radii(scene) if self.follow else ()
+        self.radii = scene.follow_radii
         self.r_esc = float(scene.r_esc)
         self.continue_settled = bool(scene.continue_settled)
-        self.targets = events.clock_targets(scene)
+        self.targets = scene.clock_targets
         self.clock_scale = layout.clock_scale
         self.orbit = [-1] * n_lanes
         self.phase = [LIVE] * n_lanes
@@ -127,6 +142,10 @@ class LaneRules(abc.ABC):
         #: None, or per orbit of the chunk: its section window opens at T_INITIAL (events.opens_late)
         self.open_late = None
 
+    def last_out_of(self, lane):
+        """The last outward r_esc crossing of the orbit in ``lane``: (orbit time, state), or None."""
+        return self.last_out[lane]
+
     def start_orbit(self, lane, k):
         """Per-orbit rule state at load; sets the section gate and the clock."""
         self.orbit[lane] = k
@@ -134,8 +153,10 @@ class LaneRules(abc.ABC):
         self.last_out[lane] = None
         self.sec_found[lane] = False
         self.clock_i[lane] = 0
-        self.pending_sec[lane] = []
-        self.pending_cross[lane] = []
+        if self.pending_sec[lane]:  # (empty but after an orbit that left rows uncommitted)
+            self.pending_sec[lane] = []
+        if self.pending_cross[lane]:
+            self.pending_cross[lane] = []
         if self.win is not None:
             self.set_gate(lane, 1.0 if self.win.t_from <= 0 else 0.0)
         if self.targets:
@@ -193,7 +214,7 @@ class LaneRules(abc.ABC):
         if self.phase[lane] == LIVE:
             if self.last_out[lane] is None:  # unreachable: r_far > r_esc; kept as a guard
                 raise RuntimeError("orbit reached r_far without crossing r_esc")
-            if self.late is not None and self.late(self.elapsed(lane), self.state4(lane)):
+            if self.late is not None and self.late(self.elapsed(lane), *self.state4(lane)):
                 return self.end(lane, RERUN, *self.last_out[lane])
             return self.end(lane, ESCAPED, *self.last_out[lane])
         return self.release(lane)  # a followed orbit is gone
@@ -249,7 +270,7 @@ class LaneRules(abc.ABC):
             if targets[i][1] == "open":
                 if self.migrate_at_open:  # the window opens: the orbit goes on in the second phase
                     self.migrants.append(
-                        (self.orbit[lane], self.state4(lane), t, i + 1, self.last_out[lane], self.phase[lane])
+                        (self.orbit[lane], self.state4(lane), t, i + 1, self.last_out_of(lane), self.phase[lane])
                     )
                     return self.release(lane)
                 if not self.sec_found[lane]:

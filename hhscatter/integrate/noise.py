@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from hhscatter.integrate.epochs import _Epochs
+from hhscatter.integrate.schedulers import register
 
 #: spawn key that marks the noise streams (initial conditions use keys of length one: (block,))
 NOISE_STREAM = 0x4E4F495345  # "NOISE"
@@ -97,11 +98,21 @@ def orbit_stream(seed: int, traj_id: int) -> np.random.Generator:
     )
 
 
+@register
 class _Noisy(_Epochs):
     """The noise scheduler: epochs of one kick interval, a vectorised Ornstein–Uhlenbeck kick around each."""
 
+    name = "noise"
+    priority = 10
+    batch_size = NOISE_BATCH
+    deterministic = False  # the kicks live here: no reference driver, no no-return rule
+
+    @classmethod
+    def applies(cls, plan) -> bool:
+        return plan.noise is not None
+
     def __init__(self, scene, ta, layout, ics, traj_ids, **config):
-        super().__init__(scene, ta, layout, ics, **config)
+        super().__init__(scene, ta, layout, ics, traj_ids, **config)
         self.P = kick_interval(scene)
         self.n_epochs_max = max(1, round(scene.t_max / self.P))
         self.c, self.s = ou_coefficients(float(scene.gamma), float(scene.noise_strength), 0.5 * self.P)

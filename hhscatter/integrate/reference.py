@@ -11,6 +11,7 @@ from hhscatter.integrate import events
 from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
 from hhscatter.integrate.integrators import build_scalar, caster
 from hhscatter.integrate.lanes import CONTINUING, LIVE, LaneRules, _bind, _Callback, _unbind
+from hhscatter.integrate.plan import plan_of
 
 
 @dataclass
@@ -80,10 +81,14 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
         return OrbitResult(ESCAPED, 0.0, ic.copy(), [], snaps, [], 0)
     # a start on the section near an inflection of r (events.opens_late): the window opens at T_INITIAL on the
     # clock, as in the engine; a scene without a clock fixes the section's cooldown instead
+    scene = plan_of(scene)
     late = events.opens_late(scene, ic[None]) is not None
-    clocked = events.layout(scene).clock is not None
+    clocked = scene.layout.clock is not None
     cooldown = events.SECTION_COOLDOWN if late and not clocked else -1.0
-    ta, specs, layout = build_scalar(scene, _Callback, fp_type=fp_type, tol=tol, section_cooldown=cooldown)
+    products = events.zero_power_start(scene, np.asarray(ic, dtype=float)[None, :4]) is not None  # (as the engine)
+    ta, specs, layout = build_scalar(
+        scene, _Callback, fp_type=fp_type, tol=tol, section_cooldown=cooldown, products=products
+    )
     rules = _Scalar(scene, ta, layout, fp_type)
     if late and clocked:
         rules.open_late = [True]

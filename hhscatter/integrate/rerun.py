@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate import events, heyoka_log
+from hhscatter.integrate import heyoka_log
 from hhscatter.integrate.events import ESCAPED
 from hhscatter.integrate.reference import simulate_orbit
 from hhscatter.integrate.results import CROSSING_COLUMNS, SECTION_COLUMNS, ChunkResult
@@ -118,11 +118,11 @@ def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
 
 def _own_far(scene):
     """The scene with its own far radius written out: integrated under the scene's rule, not the no-return one."""
-    return scene.replace(r_far=events.far_radius(scene))
+    return scene.replace(r_far=scene.far_radius)
 
 
-def _no_return(scene, ics, kind):
-    """_no_return(scene, ics, kind) -> (scene to integrate, late): the no-return rule of dissipative scenes.
+def _no_return(scene, ics):
+    """_no_return(plan, ics) -> (plan to integrate, late): the no-return rule of dissipative scenes.
 
     An escaped dissipative orbit is decided at its last outward r_esc crossing (t_end, its state); the scene
     follows it on to r_far = max(10 r_s, 2 r_esc) only to know that no crossing comes after. The system's
@@ -133,7 +133,7 @@ def _no_return(scene, ics, kind):
     the same at either radius, and no recorded row lies after t_end.
 
     The one thing r_far still decides: an orbit that has not reached r_far by t_max is censored there.
-    ``late(t, state)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
+    ``late(t, x, y, px, py)`` tells at the no-return radius whether that can happen; such an orbit is rerun with the
     scene's own far event (exactly as before: tables byte-identical for the same scene hash). A censored orbit
     never reached R, so its steps are the same under either far event (the clock censors it in orbit time, a
     stream lane's history does not enter). The bound: beyond
@@ -145,7 +145,7 @@ def _no_return(scene, ics, kind):
     m = scene.model
     if scene.gamma <= 0 or scene.r_far is not None or m.dissipation != "linear" or not len(ics):
         return scene, None
-    r_far = events.far_radius(scene)
+    r_far = scene.far_radius
     e0 = float(np.max(m.energy(ics[:, 0], ics[:, 1], ics[:, 2], ics[:, 3])))
     grid = NO_RETURN_GRID * m.saddle_radius
     R = max(m.no_return_radius(e0 + 1e-12 * abs(e0)) * (1.0 + 1e-9), float(scene.r_esc) * (1.0 + FAR_BEYOND_RESC))
@@ -154,8 +154,7 @@ def _no_return(scene, ics, kind):
         return scene, None
     gamma, t_max = float(scene.gamma), float(scene.t_max)
 
-    def late(t, state):
-        x, y, px, py = state
+    def late(t, x, y, px, py):
         r = math.sqrt(x * x + y * y)
         pr = (x * px + y * py) / r
         a = gamma * (r_far - r)

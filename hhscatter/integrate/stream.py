@@ -4,29 +4,72 @@ from __future__ import annotations
 
 import numpy as np
 
-from hhscatter.integrate.batch import _BatchRules, _check, _no_snapshots
+from hhscatter.integrate.batch import _batch_integrator, _check, _no_snapshots
 from hhscatter.integrate.events import ESCAPED, SETTLED
-from hhscatter.integrate.lanes import LIVE, RERUN
+from hhscatter.integrate.lanes import LIVE, RERUN, _bind
 from hhscatter.integrate.orbit_time import _orbit_time
+from hhscatter.integrate.schedulers import Scheduler, register
 
 STREAM_BATCH = 8  # lanes of the stream scheduler (measured: 14 % less per lane-step than 4)
 _NO_BOUND = 1e15  # propagation bound of lanes whose orbits the clock ends at t_max (never reached)
 
 
-class _Stream(_BatchRules):
+@register
+class _Stream(Scheduler):
     """Stream scheduler: the next orbit is loaded in the callback that ends one."""
 
-    def __init__(self, scene, ta, layout, ics, *, inlined=False, **config):
+    name = "stream"
+    priority = 90  # the scheduler of every scene no other claims
+    batch_size = STREAM_BATCH
+    clock_censors = True
+
+    @classmethod
+    def applies(cls, plan) -> bool:
+        return True
+
+    @classmethod
+    def integrate(cls, plan, batch_size, ics, traj_ids, *, products=False, **config):
+        """The chunk in one phase, or two (:attr:`hhscatter.integrate.plan.Plan.two_phase`: a window that opens
+        late): the first without the section event, the orbits alive at t_from handed on to a second integrator
+        that has it (:class:`_SecondPhase`)."""
+        phases = plan.two_phase
+        # the inlined handlers serve scenes with no section event in this integrator and no follow
+        inlined = plan.follow is None and (plan.sections is None or phases)
+        without = ("section",) if phases else ()
+        with _batch_integrator(plan, batch_size, without=without, products=products) as (ta, specs, layout):
+            lanes = cls(plan, ta, layout, ics, traj_ids, inlined=inlined, migrate_at_open=phases, **config)
+            _bind(ta, specs, lanes, lanes.handlers)
+            try:
+                n_returns, n_steps, snaps = lanes.run()
+            finally:
+                lanes.close()  # the integrator goes back to the cache: no view of it stays here
+        if phases and lanes.migrants:  # second phase: the orbits alive at t_from, with the section event
+            with _batch_integrator(plan, batch_size, products=products) as (ta2, specs2, _):
+                second = _SecondPhase(plan, ta2, layout, lanes, late=config.get("late"))
+                _bind(ta2, specs2, second)
+                try:
+                    r2, s2, _ = second.run()
+                finally:
+                    second.close()
+            n_returns, n_steps = n_returns + r2, n_steps + s2
+        return lanes, n_returns, n_steps, snaps
+
+    def __init__(self, plan, ta, layout, ics, traj_ids=None, *, inlined=False, **config):
         """``inlined``: serve the hot rules by the lean closures of :meth:`_inlined_handlers` (plain scenes: no
-        section event in this integrator, no follow); ``config``: :class:`_BatchRules`'s."""
-        super().__init__(scene, ta, layout, ics, **config)
-        self.start_hi = [0.0] * self.B
-        self.start_lo = [0.0] * self.B
+        section event in this integrator, no follow); ``config``: :class:`Scheduler`'s."""
+        super().__init__(plan, ta, layout, ics, traj_ids, **config)
+        # the lane time at which the lane's orbit started (double-length)
+        self.start_hi, self.start_lo = np.zeros(self.B), np.zeros(self.B)
+        # the lane's orbit's last outward r_esc crossing (dissipative scenes, inlined rules): whether there is
+        # one (``has_out``), its lane time (double-length) and its state (x, y, px, py of lane j at 4j..4j+3)
+        self.has_out = np.zeros(self.B, dtype=np.uint8)
+        self.out_hi, self.out_lo, self.out_state = np.zeros(self.B), np.zeros(self.B), np.zeros(4 * self.B)
         # bound of the running propagate_until call: none for live lanes (the clock censors at t_max)
         self.bound = np.zeros(self.B)
         if not any(a == "censor" for _, a in self.targets):
             raise RuntimeError("internal error: a stream scene without the clock's censor target")
         self.t_off = [0.0] * self.B  # orbit time at which the lane's orbit entered this integrator
+        self.inlined = inlined
         #: {rule: handler} that replace the methods' (empty: the methods serve every rule), and the loader of the
         #: next orbit that goes with them
         self.handlers, self.loader = self._inlined_handlers() if inlined else ({}, self.load_next)
@@ -35,117 +78,193 @@ class _Stream(_BatchRules):
         """Lean closures for the hot handlers of plain scenes (no section event, no follow): ({rule: handler},
         the loader of the next orbit they share).
 
-        The same rules as the methods of :class:`LaneRules`, with the per-orbit
-        Python cut to a few list operations (measured: the generic chain of
-        method calls cost ~3 µs per orbit, more than half the integration of a
-        conservative orbit at E = 0.27).
+        The same rules as the methods of :class:`LaneRules`, with heyoka's callback signature (ta, direction,
+        lane): each is its event's callback itself (:func:`hhscatter.integrate.lanes._bind`). Per orbit end no Python container is made: the
+        integrator's state and lane times, the initial conditions and the chunk's records are read and written
+        through flat memoryviews (one float at a time), an orbit's end is kept as lane times (orbit times are
+        computed once per chunk, :meth:`orbit_times`), and the last outward r_esc crossing of a dissipative
+        orbit as a lane time and a state in per-lane arrays. (Measured: lists, tuples, ``.item`` and
+        ``tolist`` per orbit, and the garbage collections the containers set off, were most of the engine's
+        cost above a minimal driver.)
         """
-        elapsed, end_at, end_here, load_next, cols = self._inlined_orbit_steps()
-        orbit, last_out = self.orbit, self.last_out
-        r_s2 = self.r_s * self.r_s
-
-        def on_escape(lane, d):
-            if orbit[lane] < 0:
-                return True
-            return end_here(lane, ESCAPED)
-
-        def on_resc(lane, d):
-            if orbit[lane] >= 0:
-                last_out[lane] = (elapsed(lane), cols[lane].tolist()) if d > 0 else None
-            return True
-
-        def on_closure(lane, d):
-            if orbit[lane] < 0:
-                return True
-            x, y, _, _ = cols[lane].tolist()
-            if x * x + y * y <= r_s2:  # events.closure_rule, inlined
-                return end_here(lane, SETTLED)
-            out = last_out[lane]
-            return end_at(lane, ESCAPED, *out) if out is not None else True
-
-        late = self.late
-
-        def on_far(lane, d):
-            if orbit[lane] < 0:
-                return True
-            out = last_out[lane]
-            if out is None:  # unreachable: r_far > r_esc; kept as a guard
-                raise RuntimeError("orbit reached r_far without crossing r_esc")
-            if late is not None and late(elapsed(lane), cols[lane].tolist()):
-                return end_at(lane, RERUN, *out)
-            return end_at(lane, ESCAPED, *out)
-
-        return {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}, load_next
-
-    def _inlined_orbit_steps(self):
-        """The closures the inlined handlers share: a lane's orbit time, the end of an orbit at a given time and
-        state (record, load the next), the end of an orbit where the lane is now, the loading of the next orbit
-        (returns what a callback returns); state captured once, as lists, Python floats and per-lane views.
-        Per orbit end (measured): the lane time is read once (an orbit that ends where the lane is
-        ends at the time the next starts), the state through ``cols[lane]`` (a third of ``state[:4, lane]``)."""
-        orbit, last_out = self.orbit, self.last_out
-        hi, lo, starts_hi, starts_lo = self.time_hi, self.time_lo, self.start_hi, self.start_lo
-        st, ics, ta, cols = self.state, self.ics, self.ta, self.cols
-        outcomes, t_ends, end_states = self.outcome, self.t_end, self.end_state
-        n = self.n
-        progress = self.progress
-        reset = ta.reset_cooldowns
+        B = self.B
+        orbit = self.orbit
+        s = memoryview(self.state.reshape(-1))  # s[i * B + lane]: state variable i of the lane
+        hi, lo = memoryview(self.time_hi), memoryview(self.time_lo)
+        sh, sl = memoryview(self.start_hi), memoryview(self.start_lo)
+        has, ohi, olo, ost = (memoryview(a) for a in (self.has_out, self.out_hi, self.out_lo, self.out_state))
+        out, ehi, elo, shk, slk, timed = (
+            memoryview(a)
+            for a in (self.outcome, self.end_hi, self.end_lo, self.start_hi_of, self.start_lo_of, self.lane_timed)
+        )
+        end = memoryview(self.end_state.reshape(-1))  # end[4k + i]
+        ics = memoryview(self.ics.reshape(-1))  # ics[4k + i]
+        b1, b2, b3 = B, 2 * B, 3 * B
+        n, progress, reset = self.n, self.progress, self.ta.reset_cooldowns
         # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
         clock, phase, clock_i = self.layout.clock, self.phase, self.clock_i
+        sc = clock * B if clock is not None else 0
         sigma0 = self.targets[0][0] / self.clock_scale
-
-        hi_, lo_ = hi.item, lo.item  # Python floats: numpy scalar arithmetic costs ~5× more
+        r_s2 = self.r_s * self.r_s
+        late = self.late
         orbit_time = _orbit_time
-
-        def elapsed(lane):
-            return orbit_time(hi_(lane), lo_(lane), starts_hi[lane], starts_lo[lane])
-
-        counter = [self.next]
+        nxt = self.next
+        escaped, settled, rerun = ESCAPED, SETTLED, RERUN
 
         def load_next_at(lane, h, el):
-            """Load the next orbit into ``lane``, whose time is (h, el) now."""
-            k = counter[0]
+            """Load the next orbit into ``lane``, whose time is (h, el) now; park the lane if none is left."""
+            nonlocal nxt
+            k = nxt
             if k >= n:
                 orbit[lane] = -1
                 self.next = n
                 return False
-            counter[0] = k + 1
+            nxt = k + 1
             orbit[lane] = k
-            last_out[lane] = None
+            has[lane] = 0
             if progress is not None:
                 self.tick()
-            c = cols[lane]
-            c[0], c[1], c[2], c[3] = ics[k]  # four scalar writes: half the cost of converting the list
+            j = 4 * k
+            s[lane] = ics[j]
+            s[b1 + lane] = ics[j + 1]
+            s[b2 + lane] = ics[j + 2]
+            s[b3 + lane] = ics[j + 3]
             if clock is not None:
-                st[clock, lane] = sigma0
+                s[sc + lane] = sigma0
                 clock_i[lane] = 0
                 phase[lane] = LIVE
-            starts_hi[lane] = h
-            starts_lo[lane] = el
+            sh[lane] = h
+            sl[lane] = el
             reset(lane)
             return True
 
         def load_next(lane):
-            return load_next_at(lane, hi_(lane), lo_(lane))
+            return load_next_at(lane, hi[lane], lo[lane])
 
-        def end_at(lane, outcome, t, state):
+        def end_here(lane, code):
+            """The orbit of ``lane`` ends where the lane is now (its time and state)."""
             k = orbit[lane]
-            outcomes[k], t_ends[k], end_states[k] = outcome, t, state
+            a, el = hi[lane], lo[lane]
+            out[k] = code
+            timed[k] = 1
+            ehi[k] = a
+            elo[k] = el
+            shk[k] = sh[lane]
+            slk[k] = sl[lane]
+            j = 4 * k
+            end[j] = s[lane]
+            end[j + 1] = s[b1 + lane]
+            end[j + 2] = s[b2 + lane]
+            end[j + 3] = s[b3 + lane]
+            return load_next_at(lane, a, el)  # the next orbit starts at the time this one ends
+
+        def end_out(lane, code):
+            """The orbit of ``lane`` ends at its last outward r_esc crossing."""
+            k = orbit[lane]
+            out[k] = code
+            timed[k] = 1
+            ehi[k] = ohi[lane]
+            elo[k] = olo[lane]
+            shk[k] = sh[lane]
+            slk[k] = sl[lane]
+            j, q = 4 * k, 4 * lane
+            end[j] = ost[q]
+            end[j + 1] = ost[q + 1]
+            end[j + 2] = ost[q + 2]
+            end[j + 3] = ost[q + 3]
             return load_next(lane)
 
-        def end_here(lane, outcome):
+        def on_escape(ta, d, lane):
+            # end_here(lane, ESCAPED) and load_next_at written out: the hottest path (conservative scenes)
+            nonlocal nxt
             k = orbit[lane]
-            a, el = hi_(lane), lo_(lane)
-            outcomes[k] = outcome
-            t_ends[k] = orbit_time(a, el, starts_hi[lane], starts_lo[lane])  # elapsed(lane), lane time read once
-            end_states[k] = cols[lane].tolist()
-            return load_next_at(lane, a, el)
+            if k < 0:
+                return True
+            a, el = hi[lane], lo[lane]
+            out[k] = escaped
+            timed[k] = 1
+            ehi[k] = a
+            elo[k] = el
+            shk[k] = sh[lane]
+            slk[k] = sl[lane]
+            j = 4 * k
+            end[j] = s[lane]
+            end[j + 1] = s[b1 + lane]
+            end[j + 2] = s[b2 + lane]
+            end[j + 3] = s[b3 + lane]
+            k = nxt
+            if k >= n:
+                orbit[lane] = -1
+                self.next = n
+                return False
+            nxt = k + 1
+            orbit[lane] = k
+            if progress is not None:
+                self.tick()
+            j = 4 * k
+            s[lane] = ics[j]
+            s[b1 + lane] = ics[j + 1]
+            s[b2 + lane] = ics[j + 2]
+            s[b3 + lane] = ics[j + 3]
+            if clock is not None:
+                s[sc + lane] = sigma0
+                clock_i[lane] = 0
+                phase[lane] = LIVE
+            sh[lane] = a
+            sl[lane] = el
+            reset(lane)
+            return True
 
-        return elapsed, end_at, end_here, load_next, cols
+        def on_resc(ta, d, lane):
+            if orbit[lane] >= 0:
+                if d > 0:
+                    has[lane] = 1
+                    ohi[lane] = hi[lane]
+                    olo[lane] = lo[lane]
+                    q = 4 * lane
+                    ost[q] = s[lane]
+                    ost[q + 1] = s[b1 + lane]
+                    ost[q + 2] = s[b2 + lane]
+                    ost[q + 3] = s[b3 + lane]
+                else:
+                    has[lane] = 0
+            return True
+
+        def on_closure(ta, d, lane):
+            if orbit[lane] < 0:
+                return True
+            x, y = s[lane], s[b1 + lane]
+            if x * x + y * y <= r_s2:  # events.closure_rule, inlined
+                return end_here(lane, settled)
+            return end_out(lane, escaped) if has[lane] else True
+
+        def on_far(ta, d, lane):
+            if orbit[lane] < 0:
+                return True
+            if not has[lane]:  # unreachable: r_far > r_esc; kept as a guard
+                raise RuntimeError("orbit reached r_far without crossing r_esc")
+            if late is not None:
+                t = orbit_time(hi[lane], lo[lane], sh[lane], sl[lane])
+                if late(t, s[lane], s[b1 + lane], s[b2 + lane], s[b3 + lane]):
+                    return end_out(lane, rerun)
+            return end_out(lane, escaped)
+
+        handlers = {"escape": on_escape, "resc": on_resc, "closure": on_closure, "far": on_far}
+        return handlers, load_next
+
+    def last_out_of(self, lane):
+        if not self.inlined:
+            return self.last_out[lane]
+        if not self.has_out[lane]:
+            return None
+        t = _orbit_time(*(float(a[lane]) for a in (self.out_hi, self.out_lo, self.start_hi, self.start_lo)))
+        return t, tuple(self.out_state[4 * lane : 4 * lane + 4].tolist())
 
     def elapsed(self, lane):
         """Orbit time of ``lane`` now: the double nearest (hi + lo) − (hi0 + lo0), via TwoSum."""
-        r = _orbit_time(self.time_hi.item(lane), self.time_lo.item(lane), self.start_hi[lane], self.start_lo[lane])
+        r = _orbit_time(
+            self.time_hi.item(lane), self.time_lo.item(lane), self.start_hi.item(lane), self.start_lo.item(lane)
+        )
         # + the orbit time at which it entered this integrator (0 but in a second phase)
         return r + self.t_off[lane]
 
@@ -163,7 +282,7 @@ class _Stream(_BatchRules):
             return False
         self.next = k + 1
         self.load_orbit(lane, k)
-        self.start_hi[lane], self.start_lo[lane] = self.time_hi.item(lane), self.time_lo.item(lane)
+        self.start_hi[lane], self.start_lo[lane] = self.time_hi[lane], self.time_lo[lane]
         return True
 
     def release(self, lane):
@@ -200,7 +319,7 @@ class _SecondPhase(_Stream):
         self.migrants_in = first.migrants
         # (no progress: the first phase reported these orbits already)
         super().__init__(scene, ta, layout, np.zeros((len(first.migrants), 4)), late=late)
-        for name in ("outcome", "t_end", "end_state", "sec_rows", "cross_rows"):
+        for name in (*self.RECORDS, "sec_rows", "cross_rows"):
             setattr(self, name, getattr(first, name))
 
     def load_orbit(self, lane, j):

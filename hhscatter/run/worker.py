@@ -3,6 +3,7 @@ workers that die with the process that started them."""
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -19,6 +20,7 @@ from hhscatter.data.verify import read_meta, verify_part
 from hhscatter.data.write import write_part
 from hhscatter.errors import RunIntegrityError
 from hhscatter.integrate.engine import run_chunk
+from hhscatter.integrate.plan import plan_of
 from hhscatter.model.landscape import unbounded_derivation
 from hhscatter.run.plan import RunSummary, _decode, part_rel, tables_of
 from hhscatter.scene.ics import region_ics
@@ -31,6 +33,15 @@ def _chunk_ics(scene, start, stop, table_ics):
         return states[start:stop], ids[start:stop]
 
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
+
+
+@functools.lru_cache(maxsize=8)
+def _scene_and_plan(scene_json: str):
+    """(scene, its engine plan) of a point's scene JSON: built once per worker process and scene, then handed to
+    every chunk of it (the plan is what the engine reads: :mod:`hhscatter.integrate.plan`)."""
+    with unbounded_derivation():  # the client accepted this scene: its system is rebuilt here whatever it takes
+        scene = scene_from_dict(_decode(json.loads(scene_json)))
+    return scene, plan_of(scene)
 
 
 def run_one_chunk(
@@ -56,8 +67,7 @@ def run_one_chunk(
     the client computed it once per run (default: computed here, which re-reads an IC table).
     """
 
-    with unbounded_derivation():  # the client accepted this scene: its system is rebuilt here whatever it takes
-        scene = scene_from_dict(_decode(json.loads(scene_json)))
+    scene, plan = _scene_and_plan(scene_json)
     store = Store(out)
     if ics is None:
         ics, ids = _chunk_ics(scene, start, stop, None)
@@ -65,7 +75,7 @@ def run_one_chunk(
         queue, key = progress, (partition, chunk)
         progress = lambda k: queue.put((key, k))  # noqa: E731 - a queue proxy of the parent's Manager
     t0 = time.perf_counter()
-    res = run_chunk(scene, ics, ids, progress=progress)
+    res = run_chunk(plan, ics, ids, progress=progress)
     elapsed = time.perf_counter() - t0
     meta = {
         "scene": footer_scene(json.loads(scene_json)),

@@ -42,7 +42,7 @@ def _assert_bitwise(a, b, what):
         {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow(), "r_far": 10.0},  # generic handlers, section rows
         # orbit 556's escape time is exactly halfway between two doubles (the exact sum of its steps): the lane's
         # double-length time carries ~1e-30 of error that depends on the lane's start and decided the rounding
-        # (t_end differed by 1 ulp with chunks of 300) until near-ties rounded to even (engine._tie_to_even)
+        # (t_end differed by 1 ulp with chunks of 300) until near-ties rounded to even (orbit_time._tie_to_even)
         {"gamma": 0.01, "energy": 0.3, "sections": SectionWindow()},
     ],
     ids=["no-return", "own-r_far", "conservative", "sections", "sections-no-return-tie"],

@@ -200,9 +200,9 @@ def test_dissipation_extremes_write_finite_rows(gamma):
 
 def _fresh_chunk(scene, ics, ids):
     """run_chunk on newly built integrators (the per-process cache emptied first)."""
-    from hhscatter.integrate import engine
+    from hhscatter.integrate import batch  # deferred: only this helper empties the cache
 
-    engine._FREE.clear()
+    batch._FREE.clear()
     return run_chunk(scene, ics, ids)
 
 

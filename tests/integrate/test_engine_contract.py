@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from hhscatter.integrate import engine, events
+from hhscatter.integrate.plan import plan_of
 from hhscatter.scene.scene import Follow, Scene, SectionWindow
 
 
@@ -26,7 +27,7 @@ def test_a_scheduler_must_supply_the_integrator_access():
     ],
 )
 def test_every_event_of_a_scene_has_the_handler_of_its_rule(scene):
-    specs = events.scene_events(scene)
+    specs = plan_of(scene).events
     assert specs and all(s.rule in events.RULES for s in specs)
 
     class Probe(engine.LaneRules):

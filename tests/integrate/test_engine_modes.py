@@ -13,6 +13,7 @@ import pytest
 from hhscatter.analysis.survival.fits import observed_from_outcome
 from hhscatter.integrate import events
 from hhscatter.integrate.engine import CENSORED, ESCAPED, SETTLED, STOPPED, run_chunk, scheduler, simulate_orbit
+from hhscatter.integrate.plan import plan_of
 from hhscatter.model import HenonHeiles
 from hhscatter.scene.ics import region_ics, section_velocities
 from hhscatter.scene.scene import Follow, Scene, SceneError, SectionWindow
@@ -50,9 +51,9 @@ def test_only_the_integrators_module_constructs_heyoka_events():
 def test_scene_events_compile_only_what_the_scene_needs(kw, names):
     # (a stream scene whose window opens late compiles the section event only into the
     # orbits' second phase: events.two_phase, tested bitwise and against the reference below)
-    sc = Scene(energy=0.3, n=1, r_esc=1.5, **kw)
-    assert [e.name for e in events.scene_events(sc)] == names
-    lay = events.layout(sc)
+    sc = plan_of(Scene(energy=0.3, n=1, r_esc=1.5, **kw))
+    assert [e.name for e in sc.events] == names
+    lay = sc.layout
     assert (lay.clock is not None) == ("clock" in names)
     assert (lay.gate is not None) == ("section" in names)
 

@@ -15,6 +15,7 @@ from hhscatter.integrate.engine import CENSORED, ESCAPED, run_chunk
 from hhscatter.integrate.lanes import _bind
 from hhscatter.integrate.noise import _Noisy, orbit_stream
 from hhscatter.integrate.noise_reference import obabo_escape_times
+from hhscatter.integrate.plan import plan_of
 from hhscatter.scene.ics import region_ics
 from hhscatter.scene.scene import Noise, Scene
 
@@ -74,8 +75,9 @@ def test_an_orbits_kicks_depend_on_seed_and_traj_id_only():
 
 def _end_states(scene, ics):
     """Every orbit's outcome and end state (x, y, px, py), from the scheduler's lanes."""
-    with _batch_integrator(scene, 64) as (ta, specs, layout):
-        lanes = _Noisy(scene, ta, layout, ics, np.arange(len(ics)))
+    plan = plan_of(scene)
+    with _batch_integrator(plan, 64) as (ta, specs, layout):
+        lanes = _Noisy(plan, ta, layout, ics, np.arange(len(ics)))
         _bind(ta, specs, lanes, lanes.handlers)
         try:
             lanes.run()
