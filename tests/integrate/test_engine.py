@@ -211,7 +211,7 @@ def test_reused_integrator_gives_the_rows_of_a_new_one(kind):
     """Bitwise: a chunk on an integrator that a chunk of another scene with the same compiled system
     (another γ, other orbits, orbits ended mid-flight) left behind gives the rows of a new integrator:
     the reset restores time, state, parameters and cooldowns."""
-    from hhscatter.integrate import engine
+    from hhscatter.integrate import batch
 
     if kind == "dissipative_recording":
         a = Scene(
@@ -230,7 +230,7 @@ def test_reused_integrator_gives_the_rows_of_a_new_one(kind):
     ids = np.arange(40)
     runs = [(a, region_ics(a, 0, 40)), (b, region_ics(b, 0, 40)[::-1])]
     want = [_fresh_chunk(sc, ics, ids).tables() for sc, ics in runs]
-    assert engine._FREE, "the chunk returned no integrator to the cache"
+    assert batch._FREE, "the chunk returned no integrator to the cache"
     for (sc, ics), w in zip(runs + runs, want + want):  # each on the integrators the other left
         got = run_chunk(sc, ics, ids).tables()
         for table, cols in w.items():
