@@ -185,6 +185,10 @@ def simulate(
     >>> summary.n, summary.escaped + summary.settled + summary.censored
     (200, 200)
     """
+    if not isinstance(run, (Scene, Grid)):
+        raise ConfigError(
+            f"run must be a Scene or a Grid (hhscatter.Scene(...), hhscatter.load_run(file)), got {type(run).__name__}"
+        )
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ConfigError(f"workers must be an integer ≥ 1, got {workers!r}")
     if workers is not None and workers > WORKERS_MAX:

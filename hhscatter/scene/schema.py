@@ -565,6 +565,10 @@ def scene_dict_from_toml(path, scale: str | None = None, **overrides) -> dict:
     absolute here); one given in ``overrides`` is taken as given.
     """
     path = Path(path)
+    if path.is_dir():
+        raise ConfigError(
+            f"{path} is a folder: give a scene TOML file (a run directory is read with hhscatter.read_lifetimes and the other readers)"
+        )
     try:
         doc = tomllib.loads(path.read_text())
     except FileNotFoundError:

@@ -193,3 +193,18 @@ def test_kappa_cmeasure_streamed_part_by_part_equals_the_whole_tables(tmp_path, 
         ).to_frame()
     assert len(streamed) == (2 if grid else 1) and (streamed["n_samples"] > 0).all()
     pd.testing.assert_frame_equal(streamed, whole)
+
+
+def test_load_run_of_a_folder_names_what_it_takes(tmp_path):
+    with pytest.raises(ConfigError, match="is a folder: give a scene TOML file"):
+        hhscatter.load_run(tmp_path)
+    with pytest.raises(ConfigError, match="is a folder"):
+        hhscatter.load_scene(tmp_path)
+
+
+@pytest.mark.parametrize("run", [{"energy": 0.3, "n": 10}, "scene.toml", None])
+def test_simulate_refuses_what_is_not_a_scene_or_grid_before_any_work(tmp_path, run):
+    out = tmp_path / "out"
+    with pytest.raises(ConfigError, match="run must be a Scene or a Grid"):
+        hhscatter.simulate(run, out, workers=1, progress=False)
+    assert not out.exists()  # nothing written
