@@ -39,6 +39,7 @@ import pandas as pd
 from hhscatter.reproduction import basin_summary as bs
 from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 
 
 class Params(StudyParams):
@@ -481,18 +482,15 @@ def _energy_scan(study, extent, boxes, hb, E_b, by_box):
 
 
 # -- plot -----------------------------------------------------------------------------------
-def plot(study):
-    """plot(study) -> None: basins.png from the derived tables."""
-    from .figure import plot_basins
-
-    plot_basins(
-        pd.read_parquet(study.derived("basins_maps.parquet")),
-        pd.read_parquet(study.derived("basins_zooms.parquet")),
-        pd.read_parquet(study.derived("basins_entropy.parquet")),
-        pd.read_parquet(study.derived("basins_uncertainty.parquet")),
-        study.read_numbers(),
-        study.figure_path,
-        scale=study.scale,
-        local=pd.read_parquet(study.derived("basins_local_exponent.parquet")),
-        scan=pd.read_parquet(study.derived("basins_energy_scan.parquet")),
-    )
+plot = figure_stage(
+    "plot_basins",
+    "basins_maps",
+    "basins_zooms",
+    "basins_entropy",
+    "basins_uncertainty",
+    NUMBERS,
+    PATH,
+    scale=SCALE,
+    local="basins_local_exponent",
+    scan="basins_energy_scan",
+)

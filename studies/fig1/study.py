@@ -43,6 +43,7 @@ import numpy as np
 
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
 class Params(StudyParams):
@@ -256,13 +257,4 @@ def _numbers(study, per_energy: dict) -> dict:
     }
 
 
-def plot(study):
-    """plot(study) -> None; draws fig1.png from the derived tables and fig1.json."""
-    import pandas as pd
-
-    from .figure import plot_fig1
-
-    numbers = study.read_numbers()
-    grid = pd.read_parquet(study.out / "derived" / "potential_grid.parquet")
-    pts = pd.read_parquet(study.out / "derived" / CMEASURE_TABLE)
-    plot_fig1(grid, pts, numbers, study.figure_path)
+plot = figure_stage("plot_fig1", "potential_grid", CMEASURE_TABLE, NUMBERS, PATH)

@@ -45,7 +45,6 @@ orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
 
 from __future__ import annotations
 
-import json
 from typing import NamedTuple
 
 import numpy as np
@@ -63,6 +62,7 @@ from hhscatter.reproduction.fig3 import (
     ribbons,
 )
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
 class Params(StudyParams):
@@ -339,12 +339,6 @@ def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbit
     }
 
 
-def plot(study):
-    """plot(study) -> None: fig3.png from the derived tables and fig3.json."""
-    from .figure import plot_fig3
-
-    me = pd.read_parquet(study.derived("fig3_mean_energy.parquet"))
-    tab = pd.read_parquet(study.derived("fig3_mu_windows.parquet"))
-    hist = pd.read_parquet(study.derived("fig3_histograms.parquet"))
-    numbers = json.loads(study.numbers_path.read_text())
-    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.params.plot_t_max)
+plot = figure_stage(
+    "plot_fig3", "fig3_mean_energy", "fig3_mu_windows", "fig3_histograms", NUMBERS, PATH, t_max=Param("plot_t_max")
+)

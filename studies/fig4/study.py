@@ -56,6 +56,7 @@ from hhscatter.reproduction.transition_tables import (
 )
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
 class Params(StudyParams):
@@ -350,12 +351,6 @@ def _numbers(
     }
 
 
-def plot(study):
-    """plot(study) -> None: fig4.png from the derived tables and fig4.json."""
-    from .figure import plot_fig4
-
-    surv = pd.read_parquet(study.derived("fig4_survival.parquet"))
-    ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))
-    taus = pd.read_parquet(study.derived("fig4_tau.parquet"))
-    numbers = study.read_numbers()
-    plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=study.params.mark_gamma)
+plot = figure_stage(
+    "plot_fig4", "fig4_survival", "fig4_ratio", "fig4_tau", NUMBERS, PATH, mark_gamma=Param("mark_gamma")
+)

@@ -28,6 +28,7 @@ from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Sibling, Table, Upstream, figure_stage, figures
 
 
 class Params(StudyParams):
@@ -462,31 +463,16 @@ def analyze(study):
     )
 
 
-def plot(study):
-    """plot(study) -> None: the figure from operator.json and the derived tables."""
-    import pyarrow.parquet as pq
-
-    from .figure import plot_operator, plot_residuals
-
-    read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()
-    cm_pts = study.out / "derived" / "ulam_measure_points.parquet"
-    fig1_pts = None
-    try:
-        fig1_pts, _ = up.published_table(study, study.upstream("cmeasure"), "cmeasure_points")
-    except up.UpstreamError:  # the figure then shows the operator's measure alone
-        pass
-    plot_operator(
-        study.read_numbers(),
-        read("convergence.parquet"),
-        read("survival.parquet"),
-        read("t_star_points.parquet"),
-        read("ulam_measure_points.parquet") if cm_pts.exists() else None,
-        fig1_pts,
-        study.figure_path,
-    )
-    grid = study.out / "derived" / "convergence_grid.parquet"
-    plot_residuals(
-        study.read_numbers(),
-        read(grid.name) if grid.exists() else None,
-        study.figure_path.with_name("operator_residuals.png"),
-    )
+plot = figures(
+    figure_stage(
+        "plot_operator",
+        NUMBERS,
+        "convergence",
+        "survival",
+        "t_star_points",
+        Table("ulam_measure_points", optional=True),
+        Upstream("cmeasure", "cmeasure_points"),  # absent: the figure shows the operator's measure alone
+        PATH,
+    ),
+    figure_stage("plot_residuals", NUMBERS, Table("convergence_grid", optional=True), Sibling("_residuals")),
+)
