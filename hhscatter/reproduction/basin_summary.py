@@ -17,9 +17,12 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.geometry.basins import basin_entropy
+from hhscatter.analysis.geometry.basins import basin_entropy, basin_entropy_table, basin_fractions, wada_merging
+from hhscatter.analysis.geometry.channels import channel_fractions
 from hhscatter.analysis.geometry.cutoff import cutoff_comparison, decision_rate
 from hhscatter.analysis.geometry.uncertainty import (
+    local_exponent,
+    slim_fractal,
     uncertainty_cutoff,
     uncertainty_exponent,
     uncertainty_fraction,
@@ -37,11 +40,14 @@ __all__ = [
     "cutoff_summary",
     "energy_trend",
     "entropy_exponents",
+    "SCAN_COLUMNS",
     "kantz_grassberger",
+    "map_measures",
     "outcome_codes",
     "point_record",
     "point_table",
     "rate_record",
+    "scan_row",
     "smooth_chi2",
     "uncertainty_fits",
     "uncertainty_row",
@@ -536,3 +542,140 @@ def point_table(per) -> list:
             }
         )
     return out
+
+
+def map_measures(
+    img,
+    r,
+    unc: pd.DataFrame,
+    eps,
+    times,
+    E: float,
+    g: float,
+    boxes,
+    *,
+    wada_min_share: float,
+    wada_r: int,
+    symmetry_radius: float,
+    fit_min_count: int,
+):
+    """map_measures(img, r, unc, eps, times, E, g, boxes, ...) -> (entropy table, local-exponent table, measures).
+
+    The measures of one basin map (labels :data:`CODES`, :data:`OUTSIDE` for forbidden cells) at (E0, γ) =
+    (``E``, ``g``): the basins' fractions, the basin entropy per box size ``boxes`` (cells), the Wada test of the
+    basins holding at least ``wada_min_share`` of the allowed cells and of the exits alone (three exits present;
+    ``wada_r`` cells), the exits' shares on the cells with ``r`` < ``symmetry_radius`` (``r``: each cell's distance
+    from the origin, position units; the potential is three-fold symmetric, a square map is not), the local
+    uncertainty exponent and the slim-fractal test of the f(ε) table ``unc``, its power-law and cut-off fits
+    (:func:`uncertainty_fits`) and, at γ = 0, the decision rate of the pairs' decision ``times`` per ε
+    (:func:`rate_record`).
+
+    Returns the entropy table and the local-exponent table (with columns energy, gamma) and a dict: fr, present,
+    wada, chans, exits, wada_x, slim, rate, ok, fit, cut.
+
+    Examples
+    --------
+    >>> img = np.repeat(np.array([[0, 1, 2, 3]]), 4, axis=0)
+    >>> eps = np.geomspace(1e-2, 1e-5, 6)
+    >>> unc = pd.DataFrame({"eps": eps, "k": np.round(1e5 * 0.5 * eps**0.4).astype(int), "n": 100_000})
+    >>> unc["f"] = unc["k"] / unc["n"]
+    >>> ent, loc, m = map_measures(img, np.zeros((4, 4)), unc, eps, None, 0.3, 0.01, [2], wada_min_share=0.1,
+    ...                           wada_r=1, symmetry_radius=1.0, fit_min_count=10)
+    >>> [float(f) for f in m["fr"].frac[:4]], m["present"], m["exits"], round(m["fit"].alpha, 2), m["rate"]
+    ([0.25, 0.25, 0.25, 0.25], [0, 1, 2, 3], [0, 1, 2], 0.4, None)
+    """
+    fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
+    ent = basin_entropy_table(img, boxes, outside=OUTSIDE).assign(energy=E, gamma=g)
+    present = [c for c, share in zip(CODES, fr.frac) if share >= wada_min_share]
+    wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=wada_r)
+    chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < symmetry_radius)])
+    # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
+    # settled (and trapped) cells masked as outside
+    exits = [c for c in present if c in (0, 1, 2)]
+    wada_x = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=wada_r) if len(exits) >= 3 else None
+    loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
+    slim = slim_fractal(loc)
+    rate = rate_record(eps, times) if g == 0 else None
+    ok, fit, cut = uncertainty_fits(unc, fit_min_count)
+    measures = {
+        "fr": fr,
+        "present": present,
+        "wada": wada,
+        "chans": chans,
+        "exits": exits,
+        "wada_x": wada_x,
+        "slim": slim,
+        "rate": rate,
+        "ok": ok,
+        "fit": fit,
+        "cut": cut,
+    }
+    return ent, loc, measures
+
+
+#: the columns of a basin study's energy scan table (one row per E0 of :func:`scan_row`)
+SCAN_COLUMNS = [
+    "energy",
+    "above_E_b",
+    "S_b",
+    "S_b_err",
+    "S_bb",
+    "S_bb_err",
+    "log2_fractal",
+    "trapped",
+    "wada_exits",
+    "W_exits",
+    "alpha",
+    "alpha_err",
+    "alpha_p",
+    "lam",
+    "lam_err",
+]
+
+
+def scan_row(
+    img, unc: pd.DataFrame, eps, times, E: float, E_b: float, boxes, hb, *, wada_min_share, wada_r, fit_min_count
+):
+    """scan_row(img, unc, eps, times, E, E_b, boxes, hb, ...) -> one row of the γ = 0 energy scan (:data:`SCAN_COLUMNS`).
+
+    At E0 = ``E``: the basin entropies S_b, S_bb (with errors, bits) at the box size ``hb`` (cells; the largest
+    of ``boxes`` when ``hb`` is not one of them), whether the map is above E_b, the trapped share, the Wada test of
+    the exits holding at least ``wada_min_share`` of the allowed cells (three present; ``wada_r`` cells), the
+    uncertainty exponent α of the f(ε) table ``unc`` (:func:`uncertainty_fits`) and the decision rate λ
+    (1/time) of the decision ``times`` per ε (:func:`rate_record`). NaN where a measure is undefined.
+
+    Examples
+    --------
+    >>> img = np.repeat(np.array([[0, 1, 2, 4]]), 4, axis=0)
+    >>> eps = np.geomspace(1e-2, 1e-5, 6)
+    >>> unc = pd.DataFrame({"eps": eps, "k": np.round(1e5 * 0.5 * eps**0.4).astype(int), "n": 100_000})
+    >>> unc["f"] = unc["k"] / unc["n"]
+    >>> row = scan_row(img, unc, eps, [np.array([1.0, 2.0])] * 6, 0.2, 0.25, [2], 2, wada_min_share=0.1,
+    ...                wada_r=1, fit_min_count=10)
+    >>> row["above_E_b"], row["trapped"], round(row["alpha"], 2), list(row) == SCAN_COLUMNS
+    (False, 0.25, 0.4, True)
+    """
+    fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
+    ent = basin_entropy_table(img, boxes, outside=OUTSIDE).set_index("box")
+    exits = [c for c in (0, 1, 2) if fr.frac[c] >= wada_min_share]
+    w = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=wada_r) if len(exits) >= 3 else None
+    _, fit, _ = uncertainty_fits(unc, fit_min_count)
+    rate = rate_record(eps, times)
+    h = ent.loc[hb] if hb in ent.index else ent.iloc[-1]
+    return {
+        "energy": E,
+        "above_E_b": bool(E > E_b),
+        "S_b": float(h.S_b),
+        "S_b_err": float(h.S_b_err),
+        "S_bb": float(h.S_bb),
+        "S_bb_err": float(h.S_bb_err),
+        "log2_fractal": bool(h.log2_fractal),
+        "trapped": float(fr.frac[TRAPPED_CODE]),
+        "wada_exits": bool(w.wada) if w else False,
+        "W_exits": float(w.wada_fraction[w.r_wada]) if w else math.nan,
+        "alpha": fit.alpha if fit else math.nan,
+        "alpha_err": fit.alpha_err if fit else math.nan,
+        "alpha_p": fit.p_value if fit else math.nan,
+        "lam": rate["value"] if rate else math.nan,
+        "lam_err": rate["err"] if rate else math.nan,
+    }

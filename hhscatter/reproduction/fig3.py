@@ -20,14 +20,20 @@ Examples
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import fit_energy_decay, mu_by_window
+from hhscatter.analysis.dissipative.transitions import tau2_predicted
 from hhscatter.analysis.stats.verdicts import quoted_verdict, verdict_beside_authors
 
 __all__ = [
     "FIG3_SELECTIONS",
+    "DecayResults",
+    "decay_results",
+    "fit_overshoot",
     "add_bootstrap_errors",
     "authors_convention",
     "fit_windows",
@@ -336,3 +342,125 @@ def ribbons(me: pd.DataFrame, ribbon_t: float, t_max: float | None = None) -> di
         "max_rel_half_width_3sem": rel_sem,
         "rows": rows,
     }
+
+
+def fit_overshoot(me: pd.DataFrame, window, from_fraction: float = 0.75) -> float:
+    """fit_overshoot(me, window, from_fraction=0.75) -> mean of ln(fit_E / mean_E) over the last quarter of the window.
+
+    How far the fitted law E0 e^{−μγt} lies above the measured ⟨E⟩ near the end of the fit window (the long-lived
+    orbits decay faster than the fit): the mean, over the grid times ``from_fraction`` · t_hi ≤ t ≤ t_hi, of the
+    natural log of the ratio of the columns ``fit_E`` and ``mean_E`` (energy units; the result is dimensionless).
+
+    Examples
+    --------
+    >>> me = pd.DataFrame({"t": [0.0, 100.0, 150.0, 200.0], "mean_E": [0.3, 0.1, 0.05, 0.02]})
+    >>> me["fit_E"] = me["mean_E"] * np.exp([0.0, 0.0, 0.1, 0.3])
+    >>> round(fit_overshoot(me, (0.0, 200.0)), 12)
+    0.2
+    """
+    resid = np.log(me["fit_E"] / me["mean_E"])
+    late = (me["t"] >= from_fraction * window[1]) & (me["t"] <= window[1])
+    return float(resid[late].mean())
+
+
+class DecayResults(NamedTuple):
+    """The numbers that Fig. 3's comparison with the paper and its numbers JSON share (:func:`decay_results`)."""
+
+    p: pd.Series  # the paper window's row of the μ table
+    later_tab: pd.DataFrame  # the rows of the later windows
+    last: pd.Series  # the last later window
+    n_settled: int  # orbits settled (trapped for ever) in the run
+    over: float  # fit_overshoot at the end of the fit window
+    tau2_pred: float  # τ2 of Eq. (eq:tau2) from the paper window's μ, time units
+    tau2_pred_err: float
+    authors: dict  # authors_convention
+    ribbon: dict  # ribbons
+
+
+def decay_results(
+    me: pd.DataFrame,
+    tab: pd.DataFrame,
+    outcome,
+    boot_up: pd.DataFrame,
+    scale: float,
+    window,
+    alt,
+    E0: float,
+    gamma: float,
+    E_c: float,
+    n_orbits: int,
+    *,
+    n_boot: int,
+    paper_mu: float,
+    half_unit: float,
+    selection: str,
+    authors_window,
+    setup: str,
+    ribbon_t: float,
+    t_max: float | None = None,
+) -> DecayResults:
+    """Fig. 3's numbers: τ2 predicted from μ, the fit's overshoot, μ in the authors' conventions, the ribbons.
+
+    Parameters
+    ----------
+    me : DataFrame
+        ⟨E⟩(t) with the paper fit (columns t, n, mean_E, std_E, sem_E, fit_E, mean_E_above, n_above).
+    tab : DataFrame
+        The μ table (:func:`mu_table` with :func:`add_bootstrap_errors`): its first row is the paper window's,
+        then the rows of kind "later" and one of kind "alt".
+    outcome : array-like of str
+        The outcome of every orbit of the run (counts the settled ones).
+    boot_up, scale : DataFrame, float
+        The bootstrap replicates of μ of the average over orbits above E_c on ``window`` and ``alt``, in that
+        order per replicate (``n_boot`` of each), and their scale √(k/N).
+    window, alt : (float, float)
+        Our fit window and the alternative one (time units).
+    E0, gamma, E_c, n_orbits
+        Initial energy, drag coefficient (1/time), critical energy (energy units), ensemble size.
+    n_boot, paper_mu, half_unit, selection, authors_window, setup
+        As for :func:`authors_convention` (``n_boot``: the replicates per window).
+    ribbon_t, t_max : float
+        As for :func:`ribbons`.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 201.0, 10.0)
+    >>> mean_E = 0.3 * np.exp(-0.9 * 0.01 * t)
+    >>> me = pd.DataFrame({"t": t, "n": 100, "mean_E": mean_E, "std_E": 0.01, "sem_E": 0.001, "fit_E": mean_E,
+    ...                    "mean_E_above": mean_E, "n_above": 100})
+    >>> tab = pd.DataFrame({"kind": ["paper", "later", "alt"], "mu": [0.9, 0.9, 0.9], "mu_err": [0.01, 0.02, 0.03]})
+    >>> boot_up = pd.DataFrame({"mu": [0.89, 0.88, 0.91, 0.92]})
+    >>> r = decay_results(me, tab, ["settled", "escaped"], boot_up, 1.0, (0.0, 200.0), (0.0, 100.0), 0.3, 0.01,
+    ...                   1 / 6, 2, n_boot=2, paper_mu=0.91, half_unit=0.005, selection="inside",
+    ...                   authors_window=(0.0, 200.0), setup="disk", ribbon_t=100.0)
+    >>> round(r.tau2_pred, 4), r.n_settled, round(r.over, 12)
+    (65.3096, 1, 0.0)
+    """
+    p = tab.iloc[0]
+    later_tab = tab[tab["kind"] == "later"]
+    last = later_tab.iloc[-1]
+    n_settled = int((np.asarray(outcome) == "settled").sum())
+    over = fit_overshoot(me, window)
+    tau2_pred = float(tau2_predicted(E0, E_c, p["mu"], gamma))
+    tau2_pred_err = float(tau2_pred * p["mu_err"] / p["mu"])
+
+    alt_row = tab[tab["kind"] == "alt"].iloc[0]
+    boot_err = {("inside", window): float(p["mu_err"]), ("inside", alt): float(alt_row["mu_err"])}
+    err_up = boot_up.assign(w=np.tile(np.arange(2), n_boot)).groupby("w")["mu"].std(ddof=1).to_numpy() * scale
+    boot_err.update({("above", window): float(err_up[0]), ("above", alt): float(err_up[1])})
+    authors = authors_convention(
+        me,
+        boot_err,
+        window,
+        alt,
+        E0,
+        gamma,
+        n_orbits,
+        paper_mu=paper_mu,
+        half_unit=half_unit,
+        selection=selection,
+        authors_window=authors_window,
+        setup=setup,
+    )
+    ribbon = ribbons(me, ribbon_t, t_max)
+    return DecayResults(p, later_tab, last, n_settled, over, tau2_pred, tau2_pred_err, authors, ribbon)

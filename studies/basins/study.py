@@ -37,8 +37,9 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.reproduction import basin_summary as bs
-from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, TRAPPED_CODE, outcome_codes
+from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, outcome_codes
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 
 
 class Params(StudyParams):
@@ -276,53 +277,30 @@ def analyze(study):
 
 
 def _measure_point(study, E, g, eps, extent, n, boxes):
-    """Measures of one (E0, γ) map: fractions, entropies, Wada tests, exit symmetry and f(ε) with its fits.
+    """One (E0, γ) map and its measures (:func:`~hhscatter.reproduction.basin_summary.map_measures`).
 
     Returns (labels image, entropy table, f(ε) table, local-exponent table, dict of the other measures).
     """
-    from hhscatter.analysis.geometry.basins import basin_entropy_table, basin_fractions, wada_merging
-    from hhscatter.analysis.geometry.channels import channel_fractions
-    from hhscatter.analysis.geometry.uncertainty import local_exponent, slim_fractal
-
     img = basin_image(study, map_key(E, g), E, extent, n)
-    fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
-    ent = basin_entropy_table(img, boxes, outside=OUTSIDE).assign(energy=E, gamma=g)
-    present = [c for c, share in zip(CODES, fr.frac) if share >= study.params.wada_min_share]
-    wada = wada_merging(img, basins=present, outside=OUTSIDE, r_wada=study.params.wada_r)
-    # the potential is three-fold symmetric, the square [−1, 1]² is not: test the exits' shares on
-    # a rotation-invariant part of the map, the allowed cells with r < symmetry_radius
     gx, gy = _map_states(study, E, extent, n)[:2]
-    r = np.hypot(*np.meshgrid(gx, gy))
-    chans = channel_fractions(img[(img >= 0) & (img <= 2) & (r < study.params.symmetry_radius)])
     times = []
     unc = _uncertainty(study, E, g, eps, times=times)
-    # like-for-like with the literature (Seoane, Aguirre, Sanjuán & Lai 2006): the exit basins alone,
-    # settled (and trapped) cells masked as outside
-    exits = [c for c in present if c in (0, 1, 2)]
-    wada_x = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r) if len(exits) >= 3 else None
-    loc = local_exponent(unc["eps"], unc["k"], unc["n"]).assign(energy=E, gamma=g)
-    slim = slim_fractal(loc)
-    rate = bs.rate_record(eps, times) if g == 0 else None
-    ok, fit, cut = bs.uncertainty_fits(unc, study.params.fit_min_count)
-    return (
+    p = study.params
+    ent, loc, m = bs.map_measures(
         img,
-        ent,
+        np.hypot(*np.meshgrid(gx, gy)),
         unc,
-        loc,
-        {
-            "fr": fr,
-            "present": present,
-            "wada": wada,
-            "chans": chans,
-            "exits": exits,
-            "wada_x": wada_x,
-            "slim": slim,
-            "rate": rate,
-            "ok": ok,
-            "fit": fit,
-            "cut": cut,
-        },
+        eps,
+        times,
+        E,
+        g,
+        boxes,
+        wada_min_share=p.wada_min_share,
+        wada_r=p.wada_r,
+        symmetry_radius=p.symmetry_radius,
+        fit_min_count=p.fit_min_count,
     )
+    return img, ent, unc, loc, m
 
 
 def _zoom_maps(study, extent, n):
@@ -417,82 +395,52 @@ def _entropy_by_subgrid(study, img, E, g, extent):
 
 
 def _energy_scan(study, extent, boxes, hb, E_b, by_box):
-    """γ = 0 energy scan: per E0, S_b, S_bb, the exits' Wada test, α and λ; ``by_box`` receives the entropies
-    at fixed box sides of the scan maps at the study's energies (a second grid at the same E0)."""
-    from hhscatter.analysis.geometry.basins import basin_entropy_table, basin_fractions, wada_merging
-
+    """γ = 0 energy scan: per E0 a row of :func:`~hhscatter.reproduction.basin_summary.scan_row`; ``by_box``
+    receives the entropies at fixed box sides of the scan maps at the study's energies (a second grid at the
+    same E0)."""
     energies, eps = _scan(study)
     ns = study.params.scan_grid
+    p = study.params
     rows, uncs = [], []
     for E in energies:
         img = basin_image(study, scan_map_key(E), E, extent, ns)
-        fr = basin_fractions(img, basins=list(CODES), outside=OUTSIDE)
-        ent = basin_entropy_table(img, [b for b in boxes if b <= ns // 4], outside=OUTSIDE).set_index("box")
-        exits = [c for c in (0, 1, 2) if fr.frac[c] >= study.params.wada_min_share]
-        w = wada_merging(img, basins=exits, outside=OUTSIDE, r_wada=study.params.wada_r) if len(exits) >= 3 else None
         times = []
         unc = _uncertainty(study, E, 0.0, eps, keys=[scan_unc_key(E, i) for i in range(len(eps))], times=times)
         uncs.append(unc)
-        _, fit, _ = bs.uncertainty_fits(unc, study.params.fit_min_count)
-        rate = bs.rate_record(eps, times)
         if any(np.isclose(E, e) for e in study.params.energies):
             by_box.extend(_entropy_by_box(study, img, E, 0.0, extent, which="scan"))
-        h = ent.loc[hb] if hb in ent.index else ent.iloc[-1]
+        scan_boxes = [b for b in boxes if b <= ns // 4]
         rows.append(
-            {
-                "energy": E,
-                "above_E_b": bool(E > E_b),
-                "S_b": float(h.S_b),
-                "S_b_err": float(h.S_b_err),
-                "S_bb": float(h.S_bb),
-                "S_bb_err": float(h.S_bb_err),
-                "log2_fractal": bool(h.log2_fractal),
-                "trapped": float(fr.frac[TRAPPED_CODE]),
-                "wada_exits": bool(w.wada) if w else False,
-                "W_exits": float(w.wada_fraction[w.r_wada]) if w else math.nan,
-                "alpha": fit.alpha if fit else math.nan,
-                "alpha_err": fit.alpha_err if fit else math.nan,
-                "alpha_p": fit.p_value if fit else math.nan,
-                "lam": rate["value"] if rate else math.nan,
-                "lam_err": rate["err"] if rate else math.nan,
-            }
+            bs.scan_row(
+                img,
+                unc,
+                eps,
+                times,
+                E,
+                E_b,
+                scan_boxes,
+                hb,
+                wada_min_share=p.wada_min_share,
+                wada_r=p.wada_r,
+                fit_min_count=p.fit_min_count,
+            )
         )
-    cols = [
-        "energy",
-        "above_E_b",
-        "S_b",
-        "S_b_err",
-        "S_bb",
-        "S_bb_err",
-        "log2_fractal",
-        "trapped",
-        "wada_exits",
-        "W_exits",
-        "alpha",
-        "alpha_err",
-        "alpha_p",
-        "lam",
-        "lam_err",
-    ]
     return (
-        pd.DataFrame(rows, columns=cols),
+        pd.DataFrame(rows, columns=bs.SCAN_COLUMNS),
         pd.concat(uncs, ignore_index=True) if uncs else pd.DataFrame(columns=["energy", "eps", "f", "k", "n"]),
     )
 
 
 # -- plot -----------------------------------------------------------------------------------
-def plot(study):
-    """plot(study) -> None: basins.png from the derived tables."""
-    from .figure import plot_basins
-
-    plot_basins(
-        pd.read_parquet(study.derived("basins_maps.parquet")),
-        pd.read_parquet(study.derived("basins_zooms.parquet")),
-        pd.read_parquet(study.derived("basins_entropy.parquet")),
-        pd.read_parquet(study.derived("basins_uncertainty.parquet")),
-        study.read_numbers(),
-        study.figure_path,
-        scale=study.scale,
-        local=pd.read_parquet(study.derived("basins_local_exponent.parquet")),
-        scan=pd.read_parquet(study.derived("basins_energy_scan.parquet")),
-    )
+plot = figure_stage(
+    "plot_basins",
+    "basins_maps",
+    "basins_zooms",
+    "basins_entropy",
+    "basins_uncertainty",
+    NUMBERS,
+    PATH,
+    scale=SCALE,
+    local="basins_local_exponent",
+    scan="basins_energy_scan",
+)

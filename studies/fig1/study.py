@@ -42,8 +42,10 @@ import math
 import numpy as np
 
 from hhscatter.analysis.stats.verdicts import half_unit
+from hhscatter.reproduction.fig1 import energy_record
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
 class Params(StudyParams):
@@ -167,7 +169,6 @@ def analyze(study):
 
 def _energy_run(study, energy: float, key: str, ch: dict):
     """One energy's main run: checked against the recorded choice, its numbers and c-measure points; κ compared."""
-    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
     from hhscatter.data.read import read_lifetimes, read_sections
 
     t_rec = float(ch["t_rec"])
@@ -184,29 +185,7 @@ def _energy_run(study, energy: float, key: str, ch: dict):
     sec = read_sections(study.raw(key))
     if (sec["t"] < t_rec).any() or sec["traj_id"].duplicated().any():
         raise RuntimeError(f"{key}: sections must hold one crossing per orbit at t ≥ t_rec")
-    alive = int(np.count_nonzero(lt["t_end"].to_numpy() > t_rec))
-    own = escape_rate_from_lifetimes(lt, detect_tail=False)
-    e_dev = float(np.max(np.abs(sec["energy"].to_numpy() - energy))) if len(sec) else 0.0
-    entry = {
-        "energy": energy,
-        "t_rec": t_rec,
-        "t_max": float(scene["t_max"]),
-        "kappa_used": {"value": ch["kappa"], "err": ch["kappa_err"]},
-        "tau0_used": ch["tau0"],
-        "fit_window_pilot": [ch["tau0"], ch["t_stop"]],
-        "t_rec_times_kappa": t_rec * ch["kappa"],
-        "t_rec_rule_with_current_code": t_rec_now,
-        "n_pilot": int(ch["n_pilot"]),
-        "n_orbits": len(lt),
-        "n_survivors_at_t_rec": alive,
-        "n_points": len(sec),
-        "kappa_main_run": {"value": own.kappa, "err": own.kappa_err},
-        "max_energy_deviation": e_dev,
-        "raw_run": f"raw/{key}",
-    }
-    pts = sec[["traj_id", "t", "x", "y", "px", "py"]].copy()
-    pts.insert(0, "energy", energy)
-    pts["e_cross"] = sec["energy"].to_numpy()  # the orbit's energy at the crossing (E up to rounding)
+    entry, pts = energy_record(energy, ch, scene["t_max"], lt, sec, t_rec_now, f"raw/{key}")
     # paper Fig. 2b linear law κ = 1.41 (E − E_c), for orientation only
     study.compare(
         f"kappa(E={energy:.2f}) used for t_rec",
@@ -260,13 +239,4 @@ def _numbers(study, per_energy: dict) -> dict:
     }
 
 
-def plot(study):
-    """plot(study) -> None; draws fig1.png from the derived tables and fig1.json."""
-    import pandas as pd
-
-    from .figure import plot_fig1
-
-    numbers = study.read_numbers()
-    grid = pd.read_parquet(study.out / "derived" / "potential_grid.parquet")
-    pts = pd.read_parquet(study.out / "derived" / CMEASURE_TABLE)
-    plot_fig1(grid, pts, numbers, study.figure_path)
+plot = figure_stage("plot_fig1", "potential_grid", CMEASURE_TABLE, NUMBERS, PATH)

@@ -44,6 +44,7 @@ from hhscatter.reproduction.fig2 import (
 )
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Table, figure_stage
 
 
 class Params(StudyParams):
@@ -473,22 +474,14 @@ def analyze(study):
     )
 
 
-def plot(study):
-    """Draw fig2.png from the derived tables and fig2.json."""
-    import pandas as pd
-
-    from .figure import plot_fig2
-
-    d = study.out / "derived"
-    plot_fig2(
-        pd.read_parquet(d / "survival_curves.parquet"),
-        pd.read_parquet(d / "pt_fit_lines.parquet"),
-        pd.read_parquet(d / "kappa_energy.parquet"),
-        pd.read_parquet(d / "kappa_fit_curve.parquet"),
-        pd.read_parquet(d / "kappa_cmeasure.parquet"),
-        study.read_numbers(),
-        study.figure_path,
-        conv_table=pd.read_parquet(d / "kappa_conventions.parquet")
-        if (d / "kappa_conventions.parquet").exists()
-        else None,
-    )
+plot = figure_stage(
+    "plot_fig2",
+    "survival_curves",
+    "pt_fit_lines",
+    "kappa_energy",
+    "kappa_fit_curve",
+    "kappa_cmeasure",
+    NUMBERS,
+    PATH,
+    conv_table=Table("kappa_conventions", optional=True),
+)

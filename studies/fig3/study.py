@@ -45,25 +45,23 @@ orbits continued), ``analyze`` (derived tables ``fig3_mean_energy``,
 
 from __future__ import annotations
 
-import json
-from typing import NamedTuple
-
 import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
 from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.reproduction.fig3 import (
+    DecayResults,
     add_bootstrap_errors,
-    authors_convention,
+    decay_results,
     fit_windows,
     histogram_rows,
     mu_table,
     nearest_times,
     paper_fit,
-    ribbons,
 )
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
 class Params(StudyParams):
@@ -134,7 +132,28 @@ def analyze(study):
     study.write_table(tab, "fig3_mu_windows.parquet", **meta)
     study.write_table(hist, "fig3_histograms.parquet", **meta)
 
-    res = _results(study, me, tab, lt, boot_up, scale, window, alt, E0, gamma, E_C, n_orbits)
+    sp = study.params
+    res = decay_results(
+        me,
+        tab,
+        lt["outcome"],
+        boot_up,
+        scale,
+        window,
+        alt,
+        E0,
+        gamma,
+        E_C,
+        n_orbits,
+        n_boot=sp.n_boot,
+        paper_mu=sp.paper_mu,
+        half_unit=sp.paper_mu_half_unit,
+        selection=sp.authors_selection,
+        authors_window=sp.authors_window,
+        setup=study.convention_label,
+        ribbon_t=sp.ribbon_t,
+        t_max=sp.plot_t_max,
+    )
     _compare_with_paper(study, res, window, E0, gamma, E_C)
     study.write_numbers(_numbers(study, res, fit, h, cont, key, window, E0, gamma, n_orbits))
 
@@ -192,57 +211,7 @@ def _histograms(study, key, me, E0: float):
     return histogram_rows(h, edges), h
 
 
-class _Results(NamedTuple):
-    """The numbers that the comparison with the paper and fig3.json share."""
-
-    p: pd.Series  # the paper window's row of fig3_mu_windows
-    later_tab: pd.DataFrame
-    last: pd.Series  # the last later window
-    n_settled: int
-    over: float  # mean log(fit/⟨E⟩) at the end of the fit window
-    tau2_pred: float
-    tau2_pred_err: float
-    authors: dict
-    ribbon: dict
-
-
-def _results(study, me, tab, lt, boot_up, scale, window, alt, E0, gamma, E_C, n_orbits) -> _Results:
-    """Assemble the numbers: τ2 predicted, the fit's overshoot at the window's end, the authors' conventions."""
-    p = tab.iloc[0]
-    later_tab = tab[tab["kind"] == "later"]
-    last = later_tab.iloc[-1]
-    n_settled = int((lt["outcome"] == "settled").sum())
-    resid = np.log(me["fit_E"] / me["mean_E"])
-    late = (me["t"] >= 0.75 * window[1]) & (me["t"] <= window[1])
-    over = float(resid[late].mean())
-    tau2_pred = float(np.log(E0 / E_C) / (p["mu"] * gamma))
-    tau2_pred_err = float(tau2_pred * p["mu_err"] / p["mu"])
-
-    n_boot = study.params.n_boot
-    alt_row = tab[tab["kind"] == "alt"].iloc[0]
-    boot_err = {("inside", window): float(p["mu_err"]), ("inside", alt): float(alt_row["mu_err"])}
-    err_up = boot_up.assign(w=np.tile(np.arange(2), n_boot)).groupby("w")["mu"].std(ddof=1).to_numpy() * scale
-    boot_err.update({("above", window): float(err_up[0]), ("above", alt): float(err_up[1])})
-    sp = study.params
-    authors = authors_convention(
-        me,
-        boot_err,
-        window,
-        alt,
-        E0,
-        gamma,
-        n_orbits,
-        paper_mu=sp.paper_mu,
-        half_unit=sp.paper_mu_half_unit,
-        selection=sp.authors_selection,
-        authors_window=sp.authors_window,
-        setup=study.convention_label,
-    )
-    ribbon = ribbons(me, sp.ribbon_t, sp.plot_t_max)
-    return _Results(p, later_tab, last, n_settled, over, tau2_pred, tau2_pred_err, authors, ribbon)
-
-
-def _compare_with_paper(study, res: _Results, window, E0, gamma, E_C) -> None:
+def _compare_with_paper(study, res: DecayResults, window, E0, gamma, E_C) -> None:
     """Compare with the paper: μ per convention, the ribbons, μ → 1, the fit's overshoot, τ2."""
     p, last, paper_mu = res.p, res.last, study.params.paper_mu
     for r in res.authors["mu"]:
@@ -303,7 +272,7 @@ def _compare_with_paper(study, res: _Results, window, E0, gamma, E_C) -> None:
     )
 
 
-def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbits) -> dict:
+def _numbers(study, res: DecayResults, fit, h, cont, key, window, E0, gamma, n_orbits) -> dict:
     """fig3.json: the fitted μ (bootstrap and fit errors), later windows, τ2, the authors' conventions."""
     p, n_settled = res.p, res.n_settled
     return {
@@ -343,12 +312,6 @@ def _numbers(study, res: _Results, fit, h, cont, key, window, E0, gamma, n_orbit
     }
 
 
-def plot(study):
-    """plot(study) -> None: fig3.png from the derived tables and fig3.json."""
-    from .figure import plot_fig3
-
-    me = pd.read_parquet(study.derived("fig3_mean_energy.parquet"))
-    tab = pd.read_parquet(study.derived("fig3_mu_windows.parquet"))
-    hist = pd.read_parquet(study.derived("fig3_histograms.parquet"))
-    numbers = json.loads(study.numbers_path.read_text())
-    plot_fig3(me, tab, hist, numbers, study.figure_path, t_max=study.params.plot_t_max)
+plot = figure_stage(
+    "plot_fig3", "fig3_mean_energy", "fig3_mu_windows", "fig3_histograms", NUMBERS, PATH, t_max=Param("plot_t_max")
+)

@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.analysis.dissipative.decay import decay_exponent, snapshot_grid
 from hhscatter.reproduction.transition_tables import (
     survival_ratio_tables,
     transition_comparisons,
@@ -56,6 +56,7 @@ from hhscatter.reproduction.transition_tables import (
 )
 from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
 class Params(StudyParams):
@@ -248,25 +249,26 @@ def _read_lifetimes(study, gs):
 
 
 def _own_mu(study, mg, E0, N):
-    """(μ, σ_μ, continuation counts, window): μ from this study's own γ = mu_gamma run, fig3's definition
-    (⟨E⟩ over orbits not escaped, settled ones continued; log fit on mu_window), bootstrap error."""
+    """(μ, σ_μ, continuation counts, window) of this study's own γ = mu_gamma run, fig3's definition
+    (:func:`~hhscatter.analysis.dissipative.decay.decay_exponent`)."""
     import pyarrow.dataset as ds
 
-    from hhscatter.analysis.dissipative.decay import bootstrap_mu_first_orbits, fit_energy_decay, inside_mean_energy
     from hhscatter.data.read import iter_parts, read_snapshots
 
-    ime = inside_mean_energy(
-        iter_parts(study.raw(raw_key(mg)), "snapshots", ["t", "energy"]), study.model.critical_energy
+    run, k = study.raw(raw_key(mg)), min(study.params.n_boot_orbits, N)
+    d = decay_exponent(
+        iter_parts(run, "snapshots", ["t", "energy"]),
+        read_snapshots(run, filters=ds.field("traj_id") < k),
+        N,
+        k,
+        E0,
+        mg,
+        study.model.critical_energy,
+        study.params.mu_window,
+        n_boot=study.params.n_boot,
+        seed=study.params.boot_seed,
     )
-    me, cont = ime.inside, {"rows_below_ec": ime.rows_below_ec}
-    win = tuple(study.params.mu_window)
-    mu = fit_energy_decay(me["t"], me["mean_E"], E0, mg, win).mu
-    k_mu = min(study.params.n_boot_orbits, N)
-    rows_mu = read_snapshots(study.raw(raw_key(mg)), filters=ds.field("traj_id") < k_mu)
-    bm, mu_scale = bootstrap_mu_first_orbits(
-        rows_mu, N, k_mu, E0, mg, [win], n_boot=study.params.n_boot, seed=study.params.boot_seed
-    )
-    return mu, float(bm["mu"].std(ddof=1)) * mu_scale, cont, win
+    return d.mu, d.mu_err, {"rows_below_ec": d.rows_below_ec}, d.window
 
 
 def _fin(v):
@@ -350,12 +352,6 @@ def _numbers(
     }
 
 
-def plot(study):
-    """plot(study) -> None: fig4.png from the derived tables and fig4.json."""
-    from .figure import plot_fig4
-
-    surv = pd.read_parquet(study.derived("fig4_survival.parquet"))
-    ratio = pd.read_parquet(study.derived("fig4_ratio.parquet"))
-    taus = pd.read_parquet(study.derived("fig4_tau.parquet"))
-    numbers = study.read_numbers()
-    plot_fig4(surv, ratio, taus, numbers, study.figure_path, mark_gamma=study.params.mark_gamma)
+plot = figure_stage(
+    "plot_fig4", "fig4_survival", "fig4_ratio", "fig4_tau", NUMBERS, PATH, mark_gamma=Param("mark_gamma")
+)

@@ -77,6 +77,7 @@ from hhscatter.reproduction import cmeasure_verdicts as cv
 from hhscatter.scene.scene import MOMENTA
 from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
 class Params(StudyParams):
@@ -478,17 +479,4 @@ def _point_sets(study, gammas, E1, E2, mu, mu_err):
 # ---------------------------------------------------------------------------
 # plot
 # ---------------------------------------------------------------------------
-def plot(study):
-    """plot(study) -> None; Fig. 5 from the derived tables and fig5.json."""
-    from .figure import plot_fig5
-
-    nums = study.read_numbers()
-    read = lambda f: pd.read_parquet(study.derived(f))
-    plot_fig5(
-        read("points.parquet"),
-        read("cmeasure_points.parquet"),
-        read("distance_vs_scale.parquet"),
-        read("distance_summary.parquet"),
-        nums,
-        study.figure_path,
-    )
+plot = figure_stage("plot_fig5", "points", "cmeasure_points", "distance_vs_scale", "distance_summary", NUMBERS, PATH)

@@ -69,6 +69,7 @@ from hhscatter.scene.schema import (
     Texts,
 )
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
 class Mixture(StudyParams):
@@ -441,20 +442,15 @@ def _fig4_reference(study, inputs, dt) -> mt.TauReference:
     return mt.TauReference(obs, lifetimes, P_0, E0)
 
 
-def plot(study):
-    """plot(study) -> None; Fig. 6 from the derived tables and fig6.json."""
-    from .figure import plot_fig6
-
-    nums = study.read_numbers()
-    read = lambda f: pd.read_parquet(study.derived(f))
-    plot_fig6(
-        read("curves.parquet"),
-        read("fits.parquet"),
-        read("tau_vs_gamma.parquet"),
-        read("tau2_curve.parquet"),
-        read("compare_fits.parquet"),
-        nums,
-        study.figure_path,
-        pc_fits=read(f"{PC}_fits.parquet"),
-        pc_taus=read(f"{PC}_taus.parquet"),
-    )
+plot = figure_stage(
+    "plot_fig6",
+    "curves",
+    "fits",
+    "tau_vs_gamma",
+    "tau2_curve",
+    "compare_fits",
+    NUMBERS,
+    PATH,
+    pc_fits=f"{PC}_fits",
+    pc_taus=f"{PC}_taus",
+)

@@ -23,7 +23,6 @@ into the generality.json already in the output folder.
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from hhscatter.reproduction.claims.chain import analyze_claims, analyze_evidence, check_params
 from hhscatter.reproduction.claims.keys import (
@@ -49,6 +48,7 @@ from hhscatter.scene.schema import (
     StudyParams,
     Text,
 )
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Sibling, Table, figure_stage, figures
 
 
 class SystemEntry(StudyParams):
@@ -428,22 +428,13 @@ def _simulate_resc(study, label, spec, m, workers, progress):
         study.run(key, sc, workers=workers, progress=progress)
 
 
-def plot(study):
-    """plot(study) -> None: generality.png (claims) and the evidence figures, from the derived tables and the JSON."""
-    from .figure import plot_decay, plot_generality, plot_regular, plot_sections
-
-    d, numbers, parts = study.out / "derived", study.read_numbers(), study.params.parts
-    if "claims" in parts:
-        plot_generality(
-            pd.read_parquet(d / "kappa.parquet"),
-            pd.read_parquet(d / "mu_conservative.parquet"),
-            pd.read_parquet(d / "energy_curves.parquet"),
-            numbers,
-            study.figure_path,
-        )
-    if "evidence" in parts:
-        stem = study.figure_path.with_suffix("")
-        plot_regular(numbers, f"{stem}_regular.png")
-        if (d / "sections_regular.parquet").exists():
-            plot_sections(pd.read_parquet(d / "sections_regular.parquet"), f"{stem}_sections.png")
-        plot_decay(pd.read_parquet(d / "survival_long.parquet"), numbers, f"{stem}_decay.png")
+plot = figures(
+    figure_stage(
+        "plot_generality", "kappa", "mu_conservative", "energy_curves", NUMBERS, PATH, when=("parts", "claims")
+    ),
+    figure_stage("plot_regular", NUMBERS, Sibling("_regular"), when=("parts", "evidence")),
+    figure_stage(
+        "plot_sections", Table("sections_regular", skip=True), Sibling("_sections"), when=("parts", "evidence")
+    ),
+    figure_stage("plot_decay", "survival_long", NUMBERS, Sibling("_decay"), when=("parts", "evidence")),
+)

@@ -26,8 +26,10 @@ import pandas as pd
 from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
+from hhscatter.reproduction.operator_cmeasure import measure_distances
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.plot_stage import NUMBERS, PATH, Sibling, Table, Upstream, figure_stage, figures
 
 
 class Params(StudyParams):
@@ -251,35 +253,21 @@ def _islands(study, E, df, tr, ids, keep, sub):
 
 # -- μ_c against fig1's sprinkler points -----------------------------------------------------------
 def _cmeasure_distances(study, results, inputs):
-    """μ_c: the operator's measures against fig1's sprinkler points, per energy and kind of measure."""
+    """μ_c: the operator's measures against fig1's sprinkler points, per energy and kind of measure
+    (:func:`~hhscatter.reproduction.operator_cmeasure.measure_distances`)."""
     other = study.upstream("cmeasure")
     cm, name = up.published_table(study, other, "cmeasure_points")
     boxes = list(study.params.cm_boxes)
     head = study.params.cm_box_headline
     rng = np.random.default_rng(study.params.seed + 5)
-    rows, tabs = [], []
-    for E in list(study.params.cm_energies):
-        Q = cm[np.isclose(cm["energy"], E, rtol=0, atol=1e-9)][["x", "y"]].to_numpy()
-        inputs[f"cmeasure_E{E:.2f}"] = {"source": f"{other}: derived/{name}", "n_points": int(len(Q))}
-        for ref_E in [e for e in results if any(np.isclose(e, c) for c in study.params.cm_energies)]:
-            kinds = ("sprinkler", "flux", "map") if np.isclose(ref_E, E) else ("sprinkler",)
-            for kind in kinds:
-                P = ulam.measure_points(results[ref_E], kind, len(Q), rng)
-                tab, j = ulam.hellinger_by_box(
-                    P, Q, boxes, _extent(study), study.params.n_splits, study.params.seed, head
-                )
-                tabs.append(tab.assign(fig1_energy=E, operator_energy=ref_E, kind=kind))
-                rows.append(
-                    {
-                        "fig1_energy": E,
-                        "operator_energy": ref_E,
-                        "measure": kind,
-                        "n": int(len(Q)),
-                        **ulam.hellinger_row(tab, j),
-                    }
-                )
+    p = study.params
+    rows, tab, counts = measure_distances(
+        results, cm, list(p.cm_energies), boxes, _extent(study), p.n_splits, p.seed, head, rng
+    )
+    for E, n in counts.items():
+        inputs[f"cmeasure_E{E:.2f}"] = {"source": f"{other}: derived/{name}", "n_points": n}
     conv = _cmeasure_convergence(study, results, cm, boxes, head)
-    return rows, (pd.concat(tabs, ignore_index=True) if tabs else pd.DataFrame()), conv
+    return rows, tab, conv
 
 
 def _cmeasure_convergence(study, results, cm, boxes, head):
@@ -462,31 +450,16 @@ def analyze(study):
     )
 
 
-def plot(study):
-    """plot(study) -> None: the figure from operator.json and the derived tables."""
-    import pyarrow.parquet as pq
-
-    from .figure import plot_operator, plot_residuals
-
-    read = lambda f: pq.read_table(study.out / "derived" / f).to_pandas()
-    cm_pts = study.out / "derived" / "ulam_measure_points.parquet"
-    fig1_pts = None
-    try:
-        fig1_pts, _ = up.published_table(study, study.upstream("cmeasure"), "cmeasure_points")
-    except up.UpstreamError:  # the figure then shows the operator's measure alone
-        pass
-    plot_operator(
-        study.read_numbers(),
-        read("convergence.parquet"),
-        read("survival.parquet"),
-        read("t_star_points.parquet"),
-        read("ulam_measure_points.parquet") if cm_pts.exists() else None,
-        fig1_pts,
-        study.figure_path,
-    )
-    grid = study.out / "derived" / "convergence_grid.parquet"
-    plot_residuals(
-        study.read_numbers(),
-        read(grid.name) if grid.exists() else None,
-        study.figure_path.with_name("operator_residuals.png"),
-    )
+plot = figures(
+    figure_stage(
+        "plot_operator",
+        NUMBERS,
+        "convergence",
+        "survival",
+        "t_star_points",
+        Table("ulam_measure_points", optional=True),
+        Upstream("cmeasure", "cmeasure_points"),  # absent: the figure shows the operator's measure alone
+        PATH,
+    ),
+    figure_stage("plot_residuals", NUMBERS, Table("convergence_grid", optional=True), Sibling("_residuals")),
+)

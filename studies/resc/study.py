@@ -49,6 +49,7 @@ from hhscatter.reproduction.escape_criterion import (
     returns_row,
 )
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.studies.plot_stage import PATH, SCALE, Param, figure_stage
 
 
 class Params(StudyParams):
@@ -204,17 +205,13 @@ def _follow_returns(study, E, radii):
 
 
 # -- plot -------------------------------------------------------------------
-def plot(study):
-    """plot(study) -> None: resc.png from the derived tables."""
-    from .figure import plot_resc
-
-    d = study.out / "derived"
-    plot_resc(
-        kappa=pd.read_parquet(d / "kappa.parquet"),
-        returns=pd.read_parquet(d / "returns.parquet"),
-        channels=pd.read_parquet(d / "channels.parquet"),
-        lyapunov=pd.read_parquet(d / "lyapunov.parquet"),
-        path=study.figure_path,
-        r_ref=study.params.r_ref,
-        scale=study.scale,
-    )
+plot = figure_stage(
+    "plot_resc",
+    kappa="kappa",
+    returns="returns",
+    channels="channels",
+    lyapunov="lyapunov",
+    path=PATH,
+    r_ref=Param("r_ref"),
+    scale=SCALE,
+)

@@ -258,3 +258,57 @@ def test_entropy_by_box_at_keeps_the_asked_sides_of_every_grid():
         (0.25, 2000, 50),
     ]
     assert len(got) == 8 and entropy_by_box_at(recs, sides=(0.2,)) == []
+
+
+def _stripes():
+    """Four vertical stripes: exits 0, 1, 2 two cells wide each, settled one cell, and a forbidden column."""
+    return np.repeat(np.array([[0, 0, 1, 1, 2, 2, bs.SETTLED_CODE, bs.OUTSIDE]]), 8, axis=0)
+
+
+def _measures(img, g, times=None, **kw):
+    eps = np.geomspace(1e-2, 1e-6, 6)
+    args = {"wada_min_share": 0.1, "wada_r": 1, "symmetry_radius": 1.0, "fit_min_count": 10, **kw}
+    return bs.map_measures(img, np.zeros(img.shape), _unc(eps), eps, times, 0.3, g, [2, 4], **args)
+
+
+def test_map_measures_of_straight_stripes():
+    ent, loc, m = _measures(_stripes(), 0.01)
+    # 56 allowed cells: 16 per exit, 8 settled, no trapped cell
+    np.testing.assert_allclose(m["fr"].frac, [16 / 56, 16 / 56, 16 / 56, 8 / 56, 0.0])
+    assert m["present"] == [0, 1, 2, bs.SETTLED_CODE] and m["exits"] == [0, 1, 2]
+    assert not m["wada"].wada and not m["wada_x"].wada  # straight boundaries: no point touches three basins
+    np.testing.assert_allclose(m["chans"].frac, [1 / 3, 1 / 3, 1 / 3])
+    assert m["fit"].alpha == pytest.approx(ALPHA, abs=5e-3) and m["rate"] is None  # λ at γ = 0 only
+    assert list(ent["box"]) == [2, 4] and set(ent["energy"]) == {0.3} and set(ent["gamma"]) == {0.01}
+    assert set(loc["gamma"]) == {0.01}
+
+
+def test_map_measures_keep_the_exits_wada_test_for_three_exits_and_the_symmetry_disk():
+    img = _stripes()
+    img[:, 4:6] = bs.SETTLED_CODE  # exit 2 gone: two exits left
+    _, _, m = _measures(img, 0.01)
+    assert m["exits"] == [0, 1] and m["wada_x"] is None
+    r = np.tile(
+        np.arange(8.0), (8, 1)
+    )  # the distance grows to the right: the disk r < 3 holds exit 0 and one exit-1 column
+    _, _, m = bs.map_measures(
+        _stripes(), r, _unc(np.geomspace(1e-2, 1e-6, 6)), np.geomspace(1e-2, 1e-6, 6), None, 0.3, 0.01, [2],
+        wada_min_share=0.1, wada_r=1, symmetry_radius=3.0, fit_min_count=10,
+    )  # fmt: skip
+    assert list(m["chans"].counts) == [16, 8, 0]
+
+
+def test_scan_row_reads_the_headline_box_and_the_trapped_share():
+    img = _stripes()
+    img[:, 6] = bs.TRAPPED_CODE
+    eps = np.geomspace(1e-2, 1e-6, 6)
+    kw = {"wada_min_share": 0.1, "wada_r": 1, "fit_min_count": 10}
+    row = bs.scan_row(img, _unc(eps), eps, [np.array([1.0, 2.0])] * 6, 0.2, 0.19, [2, 4], 2, **kw)
+    assert list(row) == bs.SCAN_COLUMNS
+    assert row["above_E_b"] and row["trapped"] == pytest.approx(8 / 56) and not row["wada_exits"]
+    assert row["alpha"] == pytest.approx(ALPHA, abs=5e-3)
+    # 2 × 2 boxes on stripes two cells wide: one basin per box, no boundary box (S_bb undefined)
+    assert row["S_b"] == 0.0 and math.isnan(row["S_bb"])
+    # a headline box that is not on the list: the largest (4 × 4 boxes straddle two stripes: S_b > 0)
+    wide = bs.scan_row(img, _unc(eps), eps, [np.array([1.0])] * 6, 0.2, 0.3, [2, 4], 3, **kw)
+    assert not wide["above_E_b"] and wide["S_b"] > 0

@@ -152,3 +152,62 @@ def test_authors_convention_judges_each_selection_and_window_and_names_the_agree
         _authors(me, err, authors_window=(0.0, 50.0))
     with pytest.raises(ValueError, match="authors_selection"):
         _authors(me, err, selection="below")
+
+
+def test_fit_overshoot_is_the_mean_log_ratio_over_the_last_quarter_of_the_window():
+    t = np.arange(0.0, 301.0, 10.0)
+    me = pd.DataFrame({"t": t, "mean_E": 0.3 * np.exp(-0.01 * t)})
+    me["fit_E"] = me["mean_E"] * np.exp(np.where(t >= 150.0, 0.02 * (t - 140.0), 0.0))
+    # window [0, 200]: t = 150 … 200, log ratios 0.2, 0.4, …, 1.2; t > 200 left out
+    assert mod.fit_overshoot(me, (0.0, 200.0)) == pytest.approx(np.mean([0.2, 0.4, 0.6, 0.8, 1.0, 1.2]))
+
+
+def test_decay_results_predict_tau2_count_settled_orbits_and_take_the_above_errors_per_window():
+    t = np.arange(0.0, 201.0, 10.0)
+    mean_E = 0.3 * np.exp(-0.9 * 0.01 * t)
+    me = pd.DataFrame(
+        {
+            "t": t,
+            "n": 100,
+            "mean_E": mean_E,
+            "std_E": 0.01,
+            "sem_E": 0.001,
+            "fit_E": mean_E,
+            "mean_E_above": mean_E,
+            "n_above": 100,
+        }
+    )
+    tab = pd.DataFrame(
+        {"kind": ["paper", "later", "later", "alt"], "mu": [0.9, 0.95, 0.97, 0.9], "mu_err": [0.02, 0.1, 0.2, 0.03]}
+    )
+    # replicates: window, alt, window, alt, window, alt
+    boot_up = pd.DataFrame({"mu": [0.90, 0.80, 0.92, 0.84, 0.94, 0.88]})
+    r = mod.decay_results(
+        me,
+        tab,
+        ["settled", "escaped", "settled", "censored"],
+        boot_up,
+        0.5,
+        (0.0, 200.0),
+        (0.0, 100.0),
+        0.3,
+        0.01,
+        1 / 6,
+        4,
+        n_boot=3,
+        paper_mu=0.91,
+        half_unit=0.005,
+        selection="inside",
+        authors_window=(0.0, 200.0),
+        setup="disk",
+        ribbon_t=100.0,
+    )
+    tau2 = np.log(0.3 * 6) / (0.9 * 0.01)
+    assert r.tau2_pred == pytest.approx(tau2) and r.tau2_pred_err == pytest.approx(tau2 * 0.02 / 0.9)
+    assert r.n_settled == 2 and r.over == pytest.approx(0.0, abs=1e-12)
+    assert list(r.later_tab["mu"]) == [0.95, 0.97] and r.last["mu"] == 0.97 and r.p["kind"] == "paper"
+    errs = {(row["selection"], tuple(row["window"])): row["err"] for row in r.authors["mu"]}
+    assert errs["inside", (0.0, 200.0)] == 0.02 and errs["inside", (0.0, 100.0)] == 0.03
+    assert errs["above", (0.0, 200.0)] == pytest.approx(0.02 * 0.5)  # std of 0.90, 0.92, 0.94 times the scale
+    assert errs["above", (0.0, 100.0)] == pytest.approx(0.04 * 0.5)  # std of 0.80, 0.84, 0.88
+    assert r.ribbon["t"] == 100.0

@@ -29,6 +29,7 @@ Functions here are pure (no file I/O, no plotting):
 * :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
 * :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits),
   :func:`bootstrap_mu_first_orbits` on the first K orbits with errors scaled to N;
+* :func:`decay_exponent` — μ of ⟨E⟩(t) over every orbit not escaped, with its bootstrap error, in one call;
 * :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
 
 Units: the model's natural units (unit mass); t in time units, E in energy
@@ -45,11 +46,13 @@ import pandas as pd
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 
 __all__ = [
+    "DecayExponent",
     "EnergyDecayFit",
     "EnergyHistograms",
     "InsideMeanEnergy",
     "bootstrap_mu",
     "bootstrap_mu_first_orbits",
+    "decay_exponent",
     "energy_path",
     "energy_histograms",
     "energy_histograms_arrays",
@@ -579,3 +582,41 @@ def bootstrap_mu_first_orbits(
     sub = rows[rows["traj_id"] < k]
     boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
     return boot, float(np.sqrt(k / n_orbits))
+
+
+@dataclass(frozen=True)
+class DecayExponent:
+    """Result of :func:`decay_exponent`: μ (dimensionless), its bootstrap error, the snapshot rows at or below E_c
+    and the fit window (time units)."""
+
+    mu: float
+    mu_err: float
+    rows_below_ec: int
+    window: tuple
+
+
+def decay_exponent(
+    parts, rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, e_c: float, window, *, n_boot=200, seed=0
+) -> DecayExponent:
+    """decay_exponent(parts, rows, n_orbits, k, E0, gamma, e_c, window, n_boot=200, seed=0) -> DecayExponent.
+
+    The exponent μ of E(t) = E0 e^{−μγt}, Eq. (eqn:energy_exp_decay), fitted (log fit, intercept log E0,
+    :func:`fit_energy_decay`) on ``window`` to ⟨E⟩(t) over every orbit not escaped by t
+    (:func:`inside_mean_energy` of ``parts``, the snapshot tables with columns t, energy), and its statistical
+    error: the bootstrap over the orbits traj_id < k of ``rows`` (columns traj_id, t, energy) scaled to the
+    ``n_orbits`` orbits (:func:`bootstrap_mu_first_orbits`). E0 and ``e_c`` in energy units, ``gamma`` in 1/time.
+
+    Examples
+    --------
+    >>> t = np.repeat(np.arange(0.0, 101.0, 10.0), 3)
+    >>> rows = pd.DataFrame({"traj_id": np.tile([0, 1, 2], 11), "t": t, "energy": 0.3 * np.exp(-0.8 * 0.01 * t)})
+    >>> d = decay_exponent([rows], rows, 3, 3, 0.3, 0.01, 0.15, (0.0, 100.0), n_boot=20, seed=1)
+    >>> round(d.mu, 9), round(d.mu_err, 9), d.rows_below_ec
+    (0.8, 0.0, 6)
+    """
+    ime = inside_mean_energy(parts, e_c)
+    me = ime.inside
+    win = tuple(window)
+    mu = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, win).mu
+    boot, scale = bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, [win], n_boot=n_boot, seed=seed)
+    return DecayExponent(mu, float(boot["mu"].std(ddof=1)) * scale, ime.rows_below_ec, win)
