@@ -118,8 +118,15 @@ def format_value(v, *, html: bool = False) -> str:
 
 
 def md_cell(s) -> str:
-    """Text for one cell of a Markdown table: bars escaped, on one line."""
-    return str(s).replace("|", "\\|").replace("\n", " ")
+    """Text for one cell of a Markdown table: bars and stars escaped (a formula's t* stays a star, never emphasis),
+    on one line.
+
+    Examples
+    --------
+    >>> print(md_cell("d(μ_c^E(t*)), E(t*) = 1.5 E_c | x"))
+    d(μ_c^E(t\\*)), E(t\\*) = 1.5 E_c \\| x
+    """
+    return str(s).replace("|", "\\|").replace("*", "\\*").replace("\n", " ")
 
 
 def ours_cell(row) -> str:

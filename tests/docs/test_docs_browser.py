@@ -133,15 +133,15 @@ def test_every_equation_on_every_page_shows_ink(site, browser):
 
 
 def test_no_panel_is_shown_wider_than_it_is(site, browser):
-    """At 1280 px a figure's panel is shown at its natural width or narrower, never upscaled (the study pages)."""
+    """At 1280 px a study figure or a panel of one is shown at its natural width or narrower, never upscaled."""
     checked, upscaled = 0, []
     for path in sorted((Path(site) / "studies").glob("*.html")):
-        if "hh-panel" not in path.read_text(errors="replace"):
+        if "hh-figure" not in path.read_text(errors="replace"):
             continue
         page, _ = _open(browser, path)
         page.set_viewport_size({"width": 1280, "height": 900})
         sizes = page.evaluate(
-            "Array.from(document.querySelectorAll('figure.hh-panel img'), "
+            "Array.from(document.querySelectorAll('figure.hh-figure img'), "
             "i => [i.getAttribute('src'), i.naturalWidth, i.getBoundingClientRect().width])"
         )
         upscaled += [f"{path.name}: {src} {shown:.0f} px > {nat} px" for src, nat, shown in sizes if shown > nat + 1]

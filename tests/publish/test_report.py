@@ -228,3 +228,11 @@ def test_the_report_html_numbers_equations_as_the_site(tmp_path):
     page = build_report("quick", out=tmp_path / "rep", root=root)["html"].read_text()
     assert "Eq. (18)" in page and "eqn:surv_prob_model" not in page
     assert "E0 e<sup>−μγt</sup>" in page and "^{" not in page
+
+
+def test_a_star_of_a_formula_in_a_table_cell_stays_a_star():
+    """Markdown never eats the * of t* in a generated cell (the claims table's "d(μ_c^E(t*)), E(t*) = …")."""
+    from hhscatter.publish.formatting import markdown_to_html, md_cell
+
+    page = markdown_to_html("| q |\n|---|\n| " + md_cell("d(μ_c^E(t*)), E(t*) = 1.5 E_c") + " |\n")
+    assert "E(t*)) , E(t*)".replace(" ,", ",") in page and "<em>" not in page
