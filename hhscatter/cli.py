@@ -509,6 +509,7 @@ def cmd_survival(a):
         plot_survival,
         survival,
     )
+    from hhscatter.data.read import read_lifetimes  # deferred: `hhscatter --help` starts without the engine and tables
 
     png = Path(a.png)
     if png.suffix.lower() != ".png":
@@ -519,10 +520,11 @@ def cmd_survival(a):
     for run in a.runs:
         if not Path(run).is_dir() and "://" not in run:
             raise UsageError(f"run {run!r} does not exist (give a directory written by hhscatter simulate)")
-        try:  # the run directory itself: survival reads only the columns it needs, part by part
-            curves.append(survival(run))
+        try:
+            df = read_lifetimes(run)
         except FileNotFoundError as exc:
             raise UsageError(f"run {run!r}: {exc}") from None
+        curves.append(survival(df))
     n_curves = sum(len(c) for c in curves)
     if a.labels and len(a.labels) != n_curves:
         raise UsageError(

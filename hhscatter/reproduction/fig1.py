@@ -1,4 +1,4 @@
-"""The paper's Fig. 1 (fig:potential_cmeasure) in tables: the record of one energy's c-measure run and its points.
+"""The paper's Fig. 1 (fig:contour_two_manifolds) in tables: the record of one energy's c-measure run and its points.
 
 A c-measure run at energy E is a conservative ensemble whose orbits still inside at the recording time t_rec
 record their first crossing of the section ṙ = 0, φ̇ > 0 (the sprinkler construction); t_rec = ⌈τ0 + n/κ⌉ comes
