@@ -520,11 +520,11 @@ def cmd_survival(a):
     for run in a.runs:
         if not Path(run).is_dir() and "://" not in run:
             raise UsageError(f"run {run!r} does not exist (give a directory written by hhscatter simulate)")
-        try:
-            df = read_lifetimes(run)
+        try:  # the run checked as every reader checks it, on one small column; then read as survival needs it
+            read_lifetimes(run, columns=["outcome"], categorical=True)
         except FileNotFoundError as exc:
             raise UsageError(f"run {run!r}: {exc}") from None
-        curves.append(survival(df))
+        curves.append(survival(run))  # part by part, only the columns P(t) needs
     n_curves = sum(len(c) for c in curves)
     if a.labels and len(a.labels) != n_curves:
         raise UsageError(

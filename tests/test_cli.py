@@ -148,6 +148,27 @@ def test_survival_of_a_grid_run_draws_one_curve_per_point(tmp_path, capsys):
     assert "1 label(s) for 2 curve(s)" in capsys.readouterr().err
 
 
+def test_survival_reads_no_whole_table(tmp_path, capsys, monkeypatch):
+    """The command checks the run on one column and hands the run directory to survival (read part by part, the
+    columns P(t) needs): no reader is asked for every column of the lifetimes table."""
+    import hhscatter.data.read as read
+
+    out = tmp_path / "r"
+    assert main(["simulate", "--energy", "0.3", "-n", "100", "--out", str(out), "--workers", "1"]) == 0
+    asked = []
+    real = read.read_lifetimes
+
+    def spy(run, *args, **kwargs):
+        asked.append(kwargs.get("columns"))
+        return real(run, *args, **kwargs)
+
+    monkeypatch.setattr(read, "read_lifetimes", spy)
+    capsys.readouterr()
+    assert main(["survival", str(out), "--png", str(tmp_path / "p.png")]) == 0
+    assert "(1 curve)" in capsys.readouterr().out
+    assert asked and None not in asked, asked
+
+
 @pytest.mark.parametrize(
     "args,message",
     [
