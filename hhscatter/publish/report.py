@@ -95,6 +95,19 @@ def _study_files(root: Path, name: str, scale: str):
     return tuple(pick)
 
 
+def _checked_root(root: Path | None, scale: str) -> Path:
+    """The studies folder (``root``, default the repository's), once ``scale`` is one its study.toml files declare
+    (else :class:`~hhscatter.errors.StudyError`)."""
+    root = Path(root) if root is not None else studies_root()
+    try:
+        known = scales(root)
+    except GraphError as exc:
+        raise StudyError(str(exc)) from None
+    if scale not in known:
+        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
+    return root
+
+
 def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
     """collect(scale, root=None) -> [Section], one per study folder of ``root`` (in dependency order).
 
@@ -110,13 +123,7 @@ def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
     :class:`~hhscatter.studies.provenance.ProvenanceError` naming the file. An unknown ``scale`` raises
     :class:`~hhscatter.errors.StudyError`.
     """
-    root = Path(root) if root is not None else studies_root()
-    try:
-        known = scales(root)
-    except GraphError as exc:
-        raise StudyError(str(exc)) from None
-    if scale not in known:
-        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
+    root = _checked_root(root, scale)
     sections = []
     for info in study_folders(root):
         fig, nums, cost = _study_files(root, info.name, scale)
@@ -473,13 +480,7 @@ def plan_line(scale: str = "quick", root: Path | None = None, cores: int | None 
     benchmarks whose summaries are missing run too (not timed). An unknown ``scale`` raises
     :class:`~hhscatter.errors.StudyError`.
     """
-    root = Path(root) if root is not None else studies_root()
-    try:
-        known = scales(root)
-    except GraphError as exc:
-        raise StudyError(str(exc)) from None
-    if scale not in known:
-        raise StudyError(f"scale must be one of {known} (the scales the study.toml files declare), got {scale!r}")
+    root = _checked_root(root, scale)
     cores = cores or os.cpu_count() or 1
     head = f"make report (SCALE={scale})"
     committed = scale != "quick" and any(committed_assets(root, scale).glob("*.json"))
