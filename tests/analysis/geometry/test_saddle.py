@@ -1,0 +1,299 @@
+"""The saddle's estimators against open baker maps, whose κ, λ̄, d₀ and d₁ are known in closed form.
+
+The open baker map (Lai and Tél, *Transient Chaos*, 2011, sec. 2.1 and 6.2; Ott, *Chaos in Dynamical Systems*,
+2nd ed., sec. 5.2) acts on the unit square; y is the unstable coordinate, x the stable one:
+
+    y ≤ a₁:        (x, y) → (c₁ x,            y/a₁)
+    y ≥ 1 − a₂:    (x, y) → (1 − c₂ + c₂ x,   (y − 1 + a₂)/a₂)
+
+and a point with a₁ < y < 1 − a₂ escapes (a₁ + a₂ < 1, c₁ + c₂ ≤ 1). Its saddle is the product of two Cantor
+sets, C_x (unstable manifold) × C_y (stable manifold). Closed forms, with S = a₁ + a₂:
+
+* Escape rate: a uniform density keeps the fraction S per step, so P(n) = Sⁿ and κ = −ln S.
+* The natural measure: conditioned on survival each step lands in strip i with probability q_i = a_i/S,
+  independently of the others (the map is a Bernoulli shift), so the mean Lyapunov exponent is
+  λ̄ = −Σ q_i ln a_i and every finite stretch Λ over T steps is a sum of T independent terms.
+* Partial dimensions: along y the measure gives weight q_i to pieces shrunk by a_i, along x to pieces shrunk by
+  c_i, so the information dimensions are d₁ᵘ = Σ q_i ln q_i / Σ q_i ln a_i (= 1 − κ/λ̄: the Kantz–Grassberger
+  relation holds exactly) and d₁ˢ = Σ q_i ln q_i / Σ q_i ln c_i; the capacity dimensions solve a₁^d + a₂^d = 1
+  and c₁^d + c₂^d = 1 (Moran's equation). The saddle's dimension in the plane is the sum of the two.
+
+With c_i = a_i the map is area-preserving, as the section map of a two-degree-of-freedom Hamiltonian flow:
+d₁ˢ = d₁ᵘ, and the saddle's information dimension in the plane is 2d₁ᵘ. With a = (0.45, 0.45) every measure is
+uniform (d₀ = d₁); with a = (0.7, 0.1), c = (0.5, 0.2) it is not, and d₁ < d₀ in both directions.
+
+The saddle is sampled by the sprinkler method in numpy here: uniform initial conditions are iterated, each
+orbit's escape step is its lifetime t_end, and the states of the long-lived orbits go to the estimators as a
+lifetimes table and a states table, as a run's would.
+"""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.optimize import brentq
+
+from hhscatter.analysis.geometry.saddle import (
+    capacity_dimension,
+    dimension_from_uncertainty,
+    information_dimension,
+    kantz_grassberger,
+    lyapunov_convergence,
+    mean_lyapunov,
+    saddle_points,
+    window_dependence,
+)
+from hhscatter.analysis.geometry.uncertainty import uncertainty_fraction
+from hhscatter.errors import ConfigError
+
+UNIFORM = {"a": (0.45, 0.45), "c": (0.45, 0.45)}
+TWO_SCALE = {"a": (0.7, 0.1), "c": (0.5, 0.2)}
+
+
+def closed_forms(a, c):
+    """κ, λ̄, d₁ᵘ, d₁ˢ, d₀ᵘ, d₀ˢ of the open baker map with strips a and contractions c (module notes)."""
+    a, c = np.asarray(a), np.asarray(c)
+    S = a.sum()
+    q = a / S
+    kappa = -math.log(S)
+    lam = float(-(q * np.log(a)).sum())
+    H = float((q * np.log(q)).sum())
+    d1u, d1s = H / float((q * np.log(a)).sum()), H / float((q * np.log(c)).sum())
+    d0u = brentq(lambda d: a[0] ** d + a[1] ** d - 1, 1e-6, 1.0)
+    d0s = brentq(lambda d: c[0] ** d + c[1] ** d - 1, 1e-6, 1.0)
+    return {"kappa": kappa, "lam": lam, "d1u": d1u, "d1s": d1s, "d0u": d0u, "d0s": d0s}
+
+
+def _step(x, y, a, c):
+    low, up = y <= a[0], y >= 1 - a[1]
+    nx = np.where(low, c[0] * x, 1 - c[1] + c[1] * x)
+    ny = np.where(low, y / a[0], (y - 1 + a[1]) / a[1])
+    return nx, ny, np.where(low, -math.log(a[0]), -math.log(a[1])), low | up
+
+
+def sprinkle(a, c, n0, t_min, seed, n_max=None):
+    """(lifetimes, states) of n0 uniform initial conditions: t_end = escape step (censored at n_max); states
+    (x, y and the step's log-stretch ``lam``, that of the step from t − 1 to t) of the orbits with t_end ≥ t_min."""
+    n_max = n_max or int(3 * t_min)
+    rng = np.random.default_rng(seed)
+    x0, y0 = rng.random(n0), rng.random(n0)
+    t_end = np.full(n0, float(n_max))
+    alive, y = np.arange(n0), y0.copy()
+    for k in range(1, n_max + 1):  # the escape step depends on y only
+        _, y, _, ok = _step(np.zeros(y.size), y, a, c)
+        t_end[alive[~ok]] = k
+        alive, y = alive[ok], y[ok]
+    long = np.flatnonzero(t_end >= t_min)
+    x, y, rows = x0[long], y0[long], []
+    for k in range(1, n_max):
+        x, y, lam, _ = _step(x, y, a, c)
+        m = k < t_end[long]
+        if not m.any():
+            break
+        rows.append(pd.DataFrame({"traj_id": long[m], "t": float(k), "x": x[m], "y": y[m], "lam": lam[m]}))
+    outcome = np.where(t_end < n_max, "escaped", "censored")
+    return pd.DataFrame({"traj_id": np.arange(n0), "t_end": t_end, "outcome": outcome}), pd.concat(rows)
+
+
+def kappa_from_lifetimes(life, n_from, n_to):
+    """κ = −ln q̂ of P(n) = Sⁿ between steps n_from and n_to: q̂ = survivors/at risk (geometric maximum likelihood),
+    its 1σ by the delta method."""
+    t = life["t_end"].to_numpy()
+    at_risk = sum(np.count_nonzero(t > n) for n in range(n_from, n_to))
+    survive = sum(np.count_nonzero(t > n + 1) for n in range(n_from, n_to))
+    q = survive / at_risk
+    return -math.log(q), math.sqrt((1 - q) / (q * at_risk))
+
+
+def lyapunov_inputs(points):
+    """Per-orbit (Λ, T) over the sprinkler window: the sum of the window's step log-stretches and their number."""
+    g = points.groupby("traj_id")["lam"]
+    return g.sum().to_numpy(), g.size().to_numpy().astype(float)
+
+
+@pytest.fixture(scope="module")
+def uniform():
+    life, states = sprinkle(**UNIFORM, n0=1_600_000, t_min=40, seed=1)
+    sp = saddle_points(life, states, t_min=40, window=(0.4, 0.6), columns=["x", "y", "lam"])
+    return life, states, sp, closed_forms(**UNIFORM)
+
+
+@pytest.fixture(scope="module")
+def uniform_section_d1(uniform):
+    sp = uniform[2]
+    return information_dimension(sp.points[["x", "y"]], groups=sp.points["traj_id"].to_numpy(), n_boot=10)
+
+
+@pytest.fixture(scope="module")
+def two_scale():
+    life, states = sprinkle(**TWO_SCALE, n0=4_000_000, t_min=40, seed=2)
+    sp = saddle_points(life, states, t_min=40, window=(0.4, 0.6), columns=["x", "y", "lam"])
+    return life, states, sp, closed_forms(**TWO_SCALE)
+
+
+def test_closed_forms_obey_kantz_grassberger_and_moran():
+    for m in (UNIFORM, TWO_SCALE):
+        ref = closed_forms(**m)
+        assert ref["d1u"] == pytest.approx(1 - ref["kappa"] / ref["lam"], rel=1e-12)
+    u = closed_forms(**UNIFORM)
+    assert u["d0u"] == pytest.approx(math.log(2) / math.log(1 / 0.45), rel=1e-9) == pytest.approx(u["d1u"])
+
+
+def test_saddle_points_keep_the_mid_window_of_orbits_that_left_late():
+    life = pd.DataFrame({"traj_id": [0, 1, 2, 3], "t_end": [40.0, 8.0, 100.0, 200.0],
+                         "outcome": ["escaped", "escaped", "settled", "censored"]})  # fmt: skip
+    st = pd.DataFrame({"traj_id": [0, 0, 0, 1, 2, 2, 3], "t": [5.0, 20.0, 35.0, 4.0, 30.0, 80.0, 100.0],
+                       "x": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]})  # fmt: skip
+    sp = saddle_points(life, st, t_min=30.0, window=(0.25, 0.75))
+    assert sp.points[["traj_id", "t", "x"]].values.tolist() == [[0, 20.0, 0.2], [2, 30.0, 0.5]]
+    assert (sp.n_long, sp.n_orbits, sp.n_points, sp.n_beyond_record) == (2, 2, 2, 0)
+    # orbit 2's window ends at 75 > 60: not fully recorded, dropped
+    sp = saddle_points(life, st, t_min=30.0, t_record_end=60.0)
+    assert sp.points["traj_id"].tolist() == [0] and sp.n_beyond_record == 1
+
+
+@pytest.mark.parametrize(
+    "call, names",
+    [
+        (lambda li, st: saddle_points(li, st, t_min=0.0), "t_min"),
+        (lambda li, st: saddle_points(li, st, t_min=5.0, window=(0.6, 0.4)), "window"),
+        (lambda li, st: saddle_points(li.drop(columns="t_end"), st, t_min=5.0), "lifetimes"),
+        (lambda li, st: saddle_points(li, st, t_min=5.0, columns=["z"]), "states"),
+        (lambda li, st: information_dimension(np.zeros((10, 2))), "points"),
+        (lambda li, st: information_dimension(np.random.default_rng(0).random((50, 2))), "min_occupancy"),
+        (lambda li, st: information_dimension(np.ones((3, 2)) * [[1], [2], [3]], groups=[0, 1]), "groups"),
+        (lambda li, st: mean_lyapunov([1.0, 2.0], [1.0, 0.0]), "duration"),
+        (lambda li, st: mean_lyapunov([1.0, 2.0], [1.0]), "log_stretch"),
+        (lambda li, st: kantz_grassberger(0.1, 0.01, -1.0, 0.1, 0.5, 0.1), "lyapunov"),
+        (lambda li, st: kantz_grassberger(0.1, -0.01, 1.0, 0.1, 0.5, 0.1), "kappa_err"),
+        (lambda li, st: kantz_grassberger(0.1, 0.01, 1.0, 0.1, 0.5, 0.1, dimension="full"), "dimension"),
+    ],
+)
+def test_bad_input_is_refused_naming_the_argument(call, names):
+    life = pd.DataFrame({"traj_id": [0], "t_end": [10.0]})
+    st = pd.DataFrame({"traj_id": [0], "t": [5.0], "x": [0.0]})
+    with pytest.raises(ConfigError, match=names):
+        call(life, st)
+
+
+def test_uniform_baker_dimensions_match_the_closed_forms(uniform, uniform_section_d1):
+    _, _, sp, ref = uniform
+    P, orbits = sp.points, sp.points["traj_id"].to_numpy()
+    assert sp.n_orbits > 5000
+    checks = [
+        (uniform_section_d1, 2 * ref["d1u"]),  # the saddle in the plane: 2d₁ᵘ
+        (information_dimension(P["y"], groups=orbits, n_boot=10), ref["d1u"]),  # partial, unstable direction
+        (capacity_dimension(P["y"], groups=orbits, n_boot=10), ref["d0u"]),
+    ]
+    for d, truth in checks:
+        assert abs(d.value - truth) <= 2 * d.err, (d, truth)
+        assert d.err < 0.04 * truth  # a check, not a wide interval
+        assert d.eps_range[0] < d.eps_range[1] / 10  # at least a decade fitted
+
+
+def test_two_scale_baker_information_dimension_is_below_the_capacity_dimension(two_scale):
+    _, _, sp, ref = two_scale
+    P, orbits = sp.points, sp.points["traj_id"].to_numpy()
+    assert ref["d0s"] - ref["d1s"] > 0.15 and ref["d0u"] - ref["d1u"] > 0.04
+    d1s = information_dimension(P["x"], groups=orbits, n_boot=20)
+    d1u = information_dimension(P["y"], groups=orbits, n_boot=20)
+    for d, truth in ((d1s, ref["d1s"]), (d1u, ref["d1u"])):
+        assert abs(d.value - truth) <= 2 * d.err, (d, truth)
+    # d₀ along the unstable direction from the uncertainty exponent of the exit side on lines x = const
+    d0u = dimension_from_uncertainty(*baker_uncertainty(TWO_SCALE["a"], seed=3))
+    assert abs(d0u.value - ref["d0u"]) <= 2 * d0u.err, (d0u, ref["d0u"])
+    # told apart: the measured d₀ excludes d₁ along y, the measured d₁ excludes d₀ along x
+    assert d0u.value - ref["d1u"] > 3 * d0u.err
+    assert ref["d0s"] - d1s.value > 3 * d1s.err
+
+
+def baker_uncertainty(a, seed, n=20_000, n_max=80):
+    """(eps, f, n) of the uncertainty algorithm on the baker's y lines: the outcome of y is the half of the gap
+    (a₁, 1 − a₂) through which it escapes (0 lower, 1 upper; −1 still inside after n_max steps)."""
+    rng, eps = np.random.default_rng(seed), np.geomspace(1e-7, 1e-3, 9)
+    mid = 0.5 * (a[0] + 1 - a[1])
+
+    def outcome(y):
+        out, idx = np.full(y.size, -1), np.arange(y.size)
+        for _ in range(n_max):
+            gap = (y > a[0]) & (y < 1 - a[1])
+            out[idx[gap]] = (y[gap] > mid).astype(int)
+            idx, y = idx[~gap], y[~gap]
+            y = np.where(y <= a[0], y / a[0], (y - 1 + a[1]) / a[1])
+        return out
+
+    k, used = [], []
+    for e in eps:
+        y = e + (1 - 2 * e) * rng.random(n)
+        r = uncertainty_fraction(outcome(y), np.stack([outcome(y - e), outcome(y + e)]))
+        k.append(r.k)
+        used.append(r.n)
+    return eps, np.array(k) / np.array(used), np.array(used)
+
+
+def test_uniform_baker_lyapunov_exponent(uniform):
+    _, _, sp, ref = uniform
+    L, T = lyapunov_inputs(sp.points)
+    lam = mean_lyapunov(L, T)
+    assert abs(lam.value - ref["lam"]) <= 2 * lam.err and lam.err < 0.01 * ref["lam"]
+    # a step's stretch is ln(1/0.45) whatever the strip: every FTLE is λ̄ exactly
+    assert lam.ftle_std == pytest.approx(0.0, abs=1e-12)
+
+
+def test_two_scale_lyapunov_exponent_has_no_drift_in_the_window(two_scale):
+    _, _, sp, ref = two_scale
+    L, T = lyapunov_inputs(sp.points)
+    lam = mean_lyapunov(L, T)
+    assert abs(lam.value - ref["lam"]) <= 2 * lam.err and lam.err < 0.03 * ref["lam"]
+    # the windows scale with each orbit's lifetime: no 1/T drift in a Bernoulli shift
+    conv = lyapunov_convergence(L, T)
+    assert conv.converged and abs(conv.extrapolated - ref["lam"]) <= 2 * conv.extrapolated_err
+
+
+def test_two_scale_lyapunov_interval_covers_the_closed_form_over_seeds():
+    ref = closed_forms(**TWO_SCALE)
+    covered, spreads = 0, []
+    for seed in range(40):
+        life, states = sprinkle(**TWO_SCALE, n0=40_000, t_min=16, seed=100 + seed)
+        sp = saddle_points(life, states, t_min=16, window=(0.25, 0.75), columns=["lam"])
+        lam = mean_lyapunov(*lyapunov_inputs(sp.points), n_boot=300, seed=seed)
+        covered += abs(lam.value - ref["lam"]) <= lam.err
+        spreads.append(lam.ftle_std)
+    # 1σ intervals cover in 68.3 % of cases: 27.3 of 40, binomial σ 2.9
+    assert 19 <= covered <= 35, covered
+    # the two strips stretch differently: the FTLEs spread (their distribution is returned)
+    assert min(spreads) > 0.1
+
+
+def test_lyapunov_convergence_finds_a_transient_offset():
+    rng = np.random.default_rng(5)
+    T = rng.uniform(10, 200, 4000)
+    L = 0.5 * T + rng.normal(0, np.sqrt(T) * 0.3) - 3.0  # an alignment transient costs 3 in Λ
+    conv = lyapunov_convergence(L, T)
+    assert not conv.converged and conv.slope < 0
+    assert abs(conv.extrapolated - 0.5) <= 2 * conv.extrapolated_err
+    assert abs(conv.slope + 3.0) <= 2 * conv.slope_err
+
+
+def test_window_dependence_flags_points_off_the_saddle(two_scale):
+    life, states, _, _ = two_scale
+    d1 = lambda sp: information_dimension(sp.points["y"], groups=sp.points["traj_id"].to_numpy(), n_boot=10)  # noqa: E731
+    tab = window_dependence(life, states, d1, t_mins=[30], windows=[(0.0, 1.0), (0.3, 0.7), (0.4, 0.6)])
+    # the whole lifetime includes the orbits' uniform start (d → 1 along y); around the mid-time it does not
+    assert tab["agrees"].tolist() == [False, True, True]
+    assert tab["value"].iloc[0] > tab["value"].iloc[2]
+
+
+def test_kantz_grassberger_holds_on_the_area_preserving_baker(uniform, uniform_section_d1):
+    life, _, sp, ref = uniform
+    kappa, kappa_err = kappa_from_lifetimes(life, 5, 60)
+    assert abs(kappa - ref["kappa"]) <= 3 * kappa_err  # the input's sanity: P(n) = Sⁿ
+    lam = mean_lyapunov(*lyapunov_inputs(sp.points))
+    d1 = uniform_section_d1
+    kg = kantz_grassberger(kappa, kappa_err, lam.value, lam.err, d1.value, d1.err, dimension="section")
+    assert kg.verdict.startswith("agrees"), kg
+    assert kg.d1 == pytest.approx(d1.value / 2) and abs(kg.z) <= 2
+    # and it fails where it should: a dimension of the whole lifetime's states is not the saddle's
+    wrong = kantz_grassberger(kappa, kappa_err, lam.value, lam.err, 1.0, 0.005, dimension="partial")
+    assert wrong.verdict.startswith("differs")
