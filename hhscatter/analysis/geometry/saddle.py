@@ -653,7 +653,8 @@ def lyapunov_convergence(
 
     λ̄ against the duration T of the stretches: the orbits are split into ``n_bins`` bins of T (quantiles of
     ``duration``), λ̄ and its bootstrap error computed in each by :func:`mean_lyapunov`, and λ̄(T) = λ∞ + b/T fitted
-    by weighted least squares. A finite-time exponent carries a transient of the tangent vector's alignment (a
+    by weighted least squares (each bin's error floored at 10⁻⁹ of its λ̄, the rounding of identical exponents).
+    A finite-time exponent carries a transient of the tangent vector's alignment (a
     constant offset of Λ, so b ≠ 0); ``converged`` says that no such drift is resolved (|b| ≤ 2σ_b), else λ∞ is
     the estimate. The durations must differ between orbits (e.g. windows proportional to each orbit's lifetime).
 
@@ -682,8 +683,9 @@ def lyapunov_convergence(
     if len(tab) < 3:
         raise ConfigError("duration: fewer than 3 bins of T with 2 orbits or more")
     x, y = 1.0 / tab["T"].to_numpy(), tab["value"].to_numpy()
-    e = tab["err"].to_numpy()
-    wts = 1.0 / np.where(e > 0, e, np.min(e[e > 0]) if np.any(e > 0) else 1.0) ** 2
+    # a floor of 1e-9 relative: identical finite-time exponents (a uniformly hyperbolic map) leave errors of rounding
+    e = np.maximum(tab["err"].to_numpy(), 1e-9 * np.abs(y) + 1e-300)
+    wts = 1.0 / e**2
     X = np.column_stack([np.ones_like(x), x])
     cov = np.linalg.inv(X.T @ (X * wts[:, None]))
     beta = cov @ (X.T @ (wts * y))

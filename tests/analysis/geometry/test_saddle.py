@@ -237,8 +237,10 @@ def test_uniform_baker_lyapunov_exponent(uniform):
     L, T = lyapunov_inputs(sp.points)
     lam = mean_lyapunov(L, T)
     assert abs(lam.value - ref["lam"]) <= 2 * lam.err and lam.err < 0.01 * ref["lam"]
-    # a step's stretch is ln(1/0.45) whatever the strip: every FTLE is λ̄ exactly
+    # a step's stretch is ln(1/0.45) whatever the strip: every FTLE is λ̄ exactly, and nothing drifts with T
     assert lam.ftle_std == pytest.approx(0.0, abs=1e-12)
+    conv = lyapunov_convergence(L, T)
+    assert conv.converged and conv.extrapolated == pytest.approx(ref["lam"], rel=1e-12)
 
 
 def test_two_scale_lyapunov_exponent_has_no_drift_in_the_window(two_scale):
