@@ -559,12 +559,13 @@ def dimension_from_uncertainty(eps, f, n, *, eps_range=None) -> SaddleDimension:
 class LyapunovMean:
     """Result of :func:`mean_lyapunov` (1/time).
 
-    value = ΣΛ_i/ΣT_i (λ̄), err (bootstrap over orbits, 1σ), n_orbits, ftle (Λ_i/T_i per orbit), ftle_std (their
+    value = ΣΛ_i/ΣT_i (λ̄), err (bootstrap over orbits, 1σ), method, n_orbits, ftle (Λ_i/T_i per orbit), ftle_std (their
     spread), ftle_quantiles ({q: value} at 5, 25, 50, 75 and 95 %), boot (bootstrap replicates of λ̄).
     """
 
     value: float
     err: float
+    method: str
     n_orbits: int
     ftle_std: float
     ftle_quantiles: dict
@@ -621,6 +622,7 @@ def mean_lyapunov(log_stretch, duration, *, n_boot: int = 1000, seed: int = 0) -
     return LyapunovMean(
         value=value,
         err=err,
+        method=f"ΣΛ/ΣT over {n} orbits, error by {n_boot} bootstrap replicates over orbits",
         n_orbits=int(n),
         ftle_std=float(np.std(ftle, ddof=1)) if n >= 2 else math.nan,
         ftle_quantiles={k: float(v) for k, v in zip(q, np.quantile(ftle, q))},
