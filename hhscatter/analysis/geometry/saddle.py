@@ -119,7 +119,10 @@ def _window(window) -> tuple[float, float]:
 
 
 def _finite_array(a, name: str, ndim: int) -> np.ndarray:
-    a = np.asarray(a, dtype=float)
+    try:
+        a = np.asarray(a, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
     if ndim == 2 and a.ndim == 1:
         a = a[:, None]
     if a.ndim != ndim:
@@ -245,7 +248,8 @@ def window_dependence(
     ``t_mins`` × ``windows``; the reference row is the last of both (list the longest t_min and the narrowest
     window last: the points closest to the saddle). Each row: t_min, lo, hi, n_orbits, n_points, value, err and
     z = (value − reference)/√(err² + err_ref²) (0 for the reference; the samples overlap, so |z| ≤ 2 is a loose
-    test), and ``agrees`` (|z| ≤ 2). An estimate that drifts with t_min or the window says the points are not yet
+    test), ``agrees`` (|z| ≤ 2) and ``note`` (why a row has no value: the estimator refused its points, e.g. too
+    few for its rule; such a row does not agree). An estimate that drifts with t_min or the window says the points are not yet
     on the saddle (t_min too short) or that the window reaches the manifolds (too wide).
 
     Examples
@@ -268,10 +272,14 @@ def window_dependence(
     for tm in t_mins:
         for w in windows:
             sp = saddle_points(lifetimes, states, t_min=tm, window=w, columns=columns, t_record_end=t_record_end)
-            out = estimator(sp) if sp.n_points else (math.nan, math.nan)
+            note = ""
+            try:
+                out = estimator(sp) if sp.n_points else (math.nan, math.nan)
+            except ConfigError as exc:  # e.g. too few points for the estimator's rule: the row says so
+                out, note = (math.nan, math.nan), str(exc)
             v, e = (out.value, out.err) if hasattr(out, "value") else out
             rows.append({"t_min": tm, "lo": w[0], "hi": w[1], "n_orbits": sp.n_orbits, "n_points": sp.n_points,
-                         "value": float(v), "err": float(e)})  # fmt: skip
+                         "value": float(v), "err": float(e), "note": note})  # fmt: skip
     df = pd.DataFrame(rows)
     ref = df.iloc[-1]
     sig = np.sqrt(df["err"] ** 2 + float(ref["err"]) ** 2)

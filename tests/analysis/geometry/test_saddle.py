@@ -165,6 +165,7 @@ def test_saddle_points_keep_the_mid_window_of_orbits_that_left_late():
         (lambda li, st: information_dimension(np.ones((3, 2)) * [[1], [2], [3]], groups=[0, 1]), "groups"),
         (lambda li, st: mean_lyapunov([1.0, 2.0], [1.0, 0.0]), "duration"),
         (lambda li, st: mean_lyapunov([1.0, 2.0], [1.0]), "log_stretch"),
+        (lambda li, st: mean_lyapunov(["a", "b"], [1.0, 1.0]), "log_stretch"),
         (lambda li, st: kantz_grassberger(0.1, 0.01, -1.0, 0.1, 0.5, 0.1), "lyapunov"),
         (lambda li, st: kantz_grassberger(0.1, -0.01, 1.0, 0.1, 0.5, 0.1), "kappa_err"),
         (lambda li, st: kantz_grassberger(0.1, 0.01, 1.0, 0.1, 0.5, 0.1, dimension="full"), "dimension"),
@@ -285,6 +286,9 @@ def test_window_dependence_flags_points_off_the_saddle(two_scale):
     # the whole lifetime includes the orbits' uniform start (d → 1 along y); around the mid-time it does not
     assert tab["agrees"].tolist() == [False, True, True]
     assert tab["value"].iloc[0] > tab["value"].iloc[2]
+    # a selection too small for the estimator's rule is a row that says why, not an error
+    few = window_dependence(life, states, d1, t_mins=[60, 40], windows=[(0.4, 0.6)])
+    assert np.isnan(few["value"].iloc[0]) and "min_occupancy" in few["note"].iloc[0] and not few["agrees"].iloc[0]
 
 
 def test_kantz_grassberger_holds_on_the_area_preserving_baker(uniform, uniform_section_d1):
