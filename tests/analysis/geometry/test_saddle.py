@@ -307,3 +307,14 @@ def test_kantz_grassberger_holds_on_the_area_preserving_baker(uniform, uniform_s
     # and it fails where it should: a dimension of the whole lifetime's states is not the saddle's
     wrong = kantz_grassberger(kappa, kappa_err, lam.value, lam.err, 1.0, 0.005, dimension="partial")
     assert wrong.verdict.startswith("differs")
+
+
+def test_kantz_grassberger_holds_with_a_non_uniform_measure(two_scale):
+    life, _, sp, ref = two_scale
+    kappa, kappa_err = kappa_from_lifetimes(life, 5, 40)
+    assert abs(kappa - ref["kappa"]) <= 3 * kappa_err  # the input's sanity: P(n) = Sⁿ
+    lam = mean_lyapunov(*lyapunov_inputs(sp.points))
+    d1u = information_dimension(sp.points["y"], groups=sp.points["traj_id"].to_numpy(), n_boot=20)
+    kg = kantz_grassberger(kappa, kappa_err, lam.value, lam.err, d1u.value, d1u.err)
+    assert kg.verdict.startswith("agrees") and abs(kg.d1_implied - ref["d1u"]) <= 2 * kg.d1_implied_err, kg
+    assert kg.predicted_err < 0.1 * kappa  # a check, not a wide interval
