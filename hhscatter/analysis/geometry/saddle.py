@@ -60,6 +60,7 @@ import pandas as pd
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent
 from hhscatter.analysis.stats.verdicts import row_verdict
 from hhscatter.errors import ConfigError
+from hhscatter.outcomes import LEAVING_OUTCOMES
 
 __all__ = [
     "KantzGrassberger",
@@ -76,8 +77,6 @@ __all__ = [
     "saddle_points",
     "window_dependence",
 ]
-
-LEAVING = ("escaped", "settled")  # outcomes with a known lifetime (an orbit still inside has no mid-time yet)
 
 
 # ---------------------------------------------------------------------------
@@ -211,7 +210,7 @@ def saddle_points(
         raise ConfigError(f"t_record_end must be a time > 0 (inf: recorded to the end), got {t_record_end!r}")
     life = lifetimes
     if "outcome" in life.columns:
-        life = life[life["outcome"].astype(object).isin(LEAVING)]
+        life = life[life["outcome"].astype(object).isin(LEAVING_OUTCOMES)]
     long = life.loc[life["t_end"].to_numpy() >= t_min, ["traj_id", "t_end"]]
     beyond = long["t_end"].to_numpy() * hi > t_record_end
     n_long = len(long)
