@@ -82,7 +82,7 @@ from hhscatter.scene.scene import Scene
 class ChunkTask(NamedTuple):
     """One task of a run: the orbits start..stop−1 of one point's scene, chunk ``chunk`` of its plan."""
 
-    scene_json: str  # the point's scene (Scene.to_json), what the worker rebuilds it from
+    scene_json: str  # the point's scene (Scene.to_json), as its parts' metadata records it
     chunk: int
     start: int
     stop: int
