@@ -7,8 +7,8 @@ heyoka's batch ``propagate_grid`` costs 1.5× ``propagate_until`` per lane-step 
 1.9× with the 17 of snapshots every 0.5 (it writes the Taylor coefficients at every step and walks the grid lane
 by lane), and lanes parked until the epoch ends leave 28 % of the batch's lane-steps idle (1.44 lane-steps per
 step the same orbits take on the stream). Starting an orbit as soon as its lane is free would need a return per
-orbit end and per-lane grids: at most that 28 % of the compiled part is to be won, against one more
-``propagate_grid`` call per orbit.
+orbit end and per-lane grids: at most those 28 % of the compiled part, ≈ 12 µs per orbit here, are to be won,
+and one more ``propagate_grid`` call per orbit costs more (≈ 25 µs beyond its steps, measured with 8 lanes).
 """
 
 from __future__ import annotations
