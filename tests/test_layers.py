@@ -65,3 +65,21 @@ def test_analysis_subpackages_are_layers_of_their_own():
     assert lm.layer_of("hhscatter.analysis.geometry.basins") == "analysis.geometry"
     assert lm.layer_of("hhscatter.analysis") == "analysis" and lm.layer_of("hhscatter._exports") == "_exports"
     assert lm.layer_of("hhscatter.reproduction.claims.kappa") == "reproduction"
+
+
+def test_the_engine_imports_neither_scene_nor_model():
+    """The engine reads a scene only through its plan (hhscatter.integrate.plan), which carries the system."""
+    engine = {m: deps for m, deps in M["graph"].items() if lm.layer_of(m) == "integrate"}
+    assert engine and not lm.LAYERS["integrate"] & {"scene", "model"}
+    assert [(m, d) for m, deps in engine.items() for d in deps if lm.layer_of(d) in ("scene", "model")] == []
+
+
+def test_heyoka_is_imported_only_by_the_engine():
+    assert lm.confined_violations(M["external"]) == []
+    importers = {lm.layer_of(m) for m, deps in M["external"].items() if "heyoka" in deps}
+    assert importers == {"integrate"}
+
+
+def test_the_check_sees_heyoka_imported_outside_the_engine():
+    external = {"hhscatter.model.base": {"numpy", "heyoka"}, "hhscatter.integrate.batch": {"heyoka"}}
+    assert lm.confined_violations(external) == ["hhscatter.model.base -> heyoka (only integrate may import it)"]

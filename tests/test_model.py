@@ -32,8 +32,8 @@ def test_simplified_rhs_equals_hamilton_equations():
     import heyoka as hy
 
     for m in (HenonHeiles(), HenonHeiles(1.3, 0.7)):
-        a = hy.cfunc([rhs for _, rhs in equations(m)], vars=hy.make_vars("x", "y", "px", "py"))
-        b = hy.cfunc([rhs for _, rhs in hamilton_equations(m)], vars=hy.make_vars("x", "y", "px", "py"))
+        a = hy.cfunc([rhs for _, rhs in equations(m, hy)], vars=hy.make_vars("x", "y", "px", "py"))
+        b = hy.cfunc([rhs for _, rhs in hamilton_equations(m, hy)], vars=hy.make_vars("x", "y", "px", "py"))
         pts = np.random.default_rng(0).uniform(-1.5, 1.5, (4, 200))
         assert np.allclose(a(pts), b(pts), rtol=4 * np.finfo(float).eps, atol=8 * np.finfo(float).eps)
 

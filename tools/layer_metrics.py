@@ -154,6 +154,7 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
     mods = {module_name(f, root): f for f in files}
     known = set(mods)
     graph: dict[str, set[str]] = {m: set() for m in mods}
+    external: dict[str, set[str]] = {m: set() for m in mods}  # module -> the outside packages it imports
     deferred, deferred_own, casts, long_funcs, unexplained = [], [], [], [], []
     for mod, f in mods.items():
         text = f.read_text()
@@ -174,6 +175,10 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
                             unexplained.append(where)
                         if targets(sub, mod, is_pkg, known):
                             deferred_own.append(where)
+            if isinstance(node, ast.Import):
+                external[mod] |= {a.name.split(".")[0] for a in node.names} - {package}
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                external[mod] |= {node.module.split(".")[0]} - {package}
             if isinstance(node, (ast.Import, ast.ImportFrom)):
                 for t in targets(node, mod, is_pkg, known):
                     if t != mod:  # an explicit import of a parent package is an edge too (a real circle if it
@@ -202,6 +207,7 @@ def measure(root: Path, package: str, extra: list[Path]) -> dict:
         "param_casts": casts,
         "long_functions": sorted(set(long_funcs), reverse=True),
         "graph": graph,
+        "external": external,
     }
 
 
@@ -226,7 +232,7 @@ LAYERS = {
     "_exports": set(),
     "model": BASE,
     "scene": BASE | {"model"},
-    "integrate": BASE | {"model", "scene"},
+    "integrate": BASE,  # the engine reads a scene only through its plan, which carries the system: no scene, no model
     "data": BASE | {"model", "scene"},
     "run": BASE | {"model", "scene", "integrate", "data"},
     "analysis": BASE | {"model"},
@@ -240,6 +246,9 @@ LAYERS = {
     "publish": BASE | {"model", "scene", "data", "api", "studies", "reproduction"} | ANALYSIS,
 }
 TOP = {"", "__main__", "cli"}  # the package's door and the CLI may import any layer
+# outside packages only some layers may import: heyoka only the engine (the model builds its expressions with the
+# heyoka module the engine hands it; the data layer reads heyoka's version from its distribution)
+CONFINED = {"heyoka": {"integrate"}}
 
 
 def layer_of(mod: str, package: str = "hhscatter") -> str:
@@ -267,6 +276,17 @@ def layer_violations(graph: dict[str, set[str]], package: str = "hhscatter") -> 
     return out
 
 
+def confined_violations(external: dict[str, set[str]], package: str = "hhscatter") -> list[str]:
+    """confined_violations(measure(...)["external"]) -> "module -> heyoka (only integrate may import it)" for every
+    import of a package of CONFINED outside the layers that may import it."""
+    return [
+        f"{mod} -> {dep} (only {', '.join(sorted(CONFINED[dep]))} may import it)"
+        for mod, deps in sorted(external.items())
+        for dep in sorted(deps & set(CONFINED))
+        if layer_of(mod, package) not in CONFINED[dep]
+    ]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--root", type=Path, default=Path("."))
@@ -286,6 +306,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"functions over {LONG} lines: {len(m['long_functions'])}")
     if args.package == "hhscatter":
         print(f"imports against the layers: {len(layer_violations(m['graph']))}")
+        print(f"imports of confined packages outside their layers: {len(confined_violations(m['external']))}")
     if args.details:
         for c in m["circles"]:
             print("circle:", " -> ".join(c))

@@ -70,6 +70,7 @@ crossings: traj_id int64, t radius float64, direction int8 (+1 outward, −1 inw
 from __future__ import annotations
 
 import functools
+import importlib.metadata
 import os
 import subprocess
 from pathlib import Path
@@ -134,13 +135,12 @@ def git_commit(where: Path, *, length: int | None = None, timeout: float = 5) ->
 @functools.lru_cache(maxsize=1)
 def provenance() -> dict:
     """Versions of the software that made a table, and the git commit if known."""
-    import heyoka  # deferred: heyoka loads on first use
     import pyarrow  # deferred: pyarrow loads on first use
 
     commit = git_commit(Path(__file__).resolve().parent)
     return {
         "hhscatter": __version__,
-        "heyoka": heyoka.__version__,
+        "heyoka": importlib.metadata.version("heyoka"),  # the installed distribution's: heyoka is the engine's
         "numpy": np.__version__,
         "pyarrow": pyarrow.__version__,
         "git_commit": commit,

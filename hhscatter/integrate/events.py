@@ -51,6 +51,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -146,7 +147,7 @@ class Symbols:
     def __init__(self, scene, layout: Layout, products: bool = False):
         import heyoka as hy  # deferred: heyoka loads on first use
 
-        (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions()
+        (self.x, self.y, self.px, self.py), self.V, self.H = scene.model.expressions(hy)
         if products:
             self.V, self.H = _powers_as_products(self.V), _powers_as_products(self.H)
         self.r2 = self.x**2 + self.y**2
@@ -228,7 +229,7 @@ def zero_power_start(scene, ics) -> np.ndarray | None:
     """
     if not (scene.gamma > 0 and scene.noise is None) or not len(ics):
         return None
-    bases = scene.cached("power bases", lambda: _rewrite_powers(scene.model.expressions()[2])[1])
+    bases = scene.cached("power bases", lambda: _rewrite_powers(_hamiltonian(scene.model))[1])
     if not bases:
         return None
     x, y, px, py = np.asarray(ics, dtype=float).T
@@ -236,6 +237,13 @@ def zero_power_start(scene, ics) -> np.ndarray | None:
     for base in bases:
         zero |= np.broadcast_to(base(x, y, px, py), zero.shape) == 0
     return zero if zero.any() else None
+
+
+def _hamiltonian(model):
+    """H of ``model`` as a heyoka expression."""
+    import heyoka as hy  # deferred: heyoka loads on first use
+
+    return model.expressions(hy)[2]
 
 
 def far_radius(scene) -> float:
@@ -301,45 +309,62 @@ def scene_events(scene) -> tuple:
     ec = scene.model.critical_energy
     ev = []
     if scene.gamma > 0 and scene.noise is None:
-        ev.append(EventSpec("closure", -1, lambda s: s.H - ec, "dissipative: E = E_c, settled or escaped"))
-        ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "escaped orbit far away"))
-        ev.append(EventSpec("resc", 0, lambda s: s.r2 - r_esc2, "last outward r_esc crossing"))
+        ev.append(EventSpec("closure", -1, partial(_energy_minus, ec), "dissipative: E = E_c, settled or escaped"))
+        ev.append(EventSpec("far", +1, partial(_far, rf2), "escaped orbit far away"))
+        ev.append(EventSpec("resc", 0, partial(_radius, r_esc2), "last outward r_esc crossing"))
     elif scene.follow is None:
-        ev.append(EventSpec("escape", +1, lambda s: s.r2 - r_esc2, "conservative escape"))
+        ev.append(EventSpec("escape", +1, partial(_radius, r_esc2), "conservative escape"))
     else:
         # each root is declared once: two terminal events with the same root in one lane lose
         # one of them in batch mode (measured), so the r_esc radius is also the escape event
-        ev.append(EventSpec("far", +1, lambda s: s.r2 / rf2 - 1.0, "followed orbit far away"))
+        ev.append(EventSpec("far", +1, partial(_far, rf2), "followed orbit far away"))
         for k, R in enumerate(scene.follow_radii):
             ev.append(
                 EventSpec(
                     f"radius{k}",
                     0,
-                    (lambda R2: lambda s: s.r2 - R2)(R * R),
+                    partial(_radius, R * R),
                     f"follow: crossing of r = {R:g}" + (" (outward: the escape)" if R == scene.r_esc else ""),
                     rule="radius",
                     index=k,
                 )
             )
     if scene.sections is not None:
-        ev.append(
-            EventSpec(
-                "section",
-                0,
-                lambda s: s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate),
-                "section ṙ = 0 (gated)",
-            )
-        )
+        ev.append(EventSpec("section", 0, _gated_section, "section ṙ = 0 (gated)"))
     if scene.clock_targets:
-        ev.append(EventSpec("clock", -1, lambda s: s.clock, "orbit-time schedule"))
+        ev.append(EventSpec("clock", -1, _clock, "orbit-time schedule"))
     return tuple(ev)
+
+
+# the events' expressions: module-level functions (bound with functools.partial), so that a plan pickles and
+# is handed to worker processes as it is
+
+
+def _energy_minus(ec, s):
+    return s.H - ec
+
+
+def _far(rf2, s):
+    return s.r2 / rf2 - 1.0
+
+
+def _radius(R2, s):
+    return s.r2 - R2
+
+
+def _gated_section(s):
+    return s.gate * (s.x * s.px + s.y * s.py - SECTION_OFFSET) + (1.0 - s.gate)
+
+
+def _clock(s):
+    return s.clock
 
 
 def system(scene, lay: Layout):
     """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock)."""
     import heyoka as hy  # deferred: heyoka loads on first use
 
-    sys = scene.model.equations(hy.par[lay.gamma] if lay.gamma is not None else None)
+    sys = scene.model.equations(hy, hy.par[lay.gamma] if lay.gamma is not None else None)
     if lay.clock is not None:
         sys.append((hy.make_vars("sigma"), hy.expression(-1.0 / lay.clock_scale)))
     return sys

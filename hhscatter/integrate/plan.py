@@ -3,9 +3,14 @@
 :func:`plan_of` reads a scene's values once (the system, times, radii, what it records, its noise) and derives
 the rest once: the scheduler (:mod:`hhscatter.integrate.schedulers`), the clock's targets, the state and
 parameter layout, the events, the far radius, whether the section event waits for a second phase. Every engine
-function takes the plan; nothing in the engine reads a scene or recomputes what the plan holds. A run builds
-the plan of each of its scenes once per worker process (:mod:`hhscatter.run.worker`) and hands it to every
-chunk.
+function takes the plan; nothing in the engine reads a scene or recomputes what the plan holds, and the engine
+imports neither :mod:`hhscatter.scene` nor :mod:`hhscatter.model`: the plan carries the system object, whose
+expression builders the engine calls with the heyoka module (heyoka is imported only by the engine).
+
+A run builds the plan of each of its scenes once, where it accepts the scene (:func:`hhscatter.run.runner.simulate`),
+and pickles it with the scene (:func:`hhscatter.run.worker.pack_point`): every chunk, in this process, a pool's
+worker process or on a Dask worker, gets those bytes and unpickles the plan as it is (its derived values included:
+nothing is derived again; each process unpickles a point's plan once).
 """
 
 from __future__ import annotations
@@ -103,6 +108,11 @@ class Plan:
     def kind(self) -> type:
         """The scheduler class (:data:`hhscatter.integrate.schedulers.SCHEDULERS`)."""
         return SCHEDULERS[self.scheduler]
+
+    def __getstate__(self):
+        """A plan pickles as what it holds, derived values included, without its memo (``cached``): a run
+        pickles each scene's plan once and every worker process unpickles it as it is."""
+        return {**self.__dict__, "_cache": {}}
 
     def replace(self, **values) -> Plan:
         """replace(**values) -> the plan with these values changed, everything derived again."""

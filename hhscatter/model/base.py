@@ -29,8 +29,8 @@ forms, or a declared one whose quantities are derived from its expression). The 
 | ``saddle_radius`` | distance of the nearest exit saddle from the minimum: the length scale of bounds and IC regions | length |
 | ``omega_radius`` | Ω = {r ≤ omega_radius}: the closure rule's well (contains the well part of V ≤ E_c, meets no other part) | length |
 | ``potential(x, y)`` | V on numpy arrays | energy |
-| ``expressions()`` | ``((x, y, px, py), V, H)`` as heyoka expressions | — |
-| ``equations(gamma_par)`` | the heyoka ODE system, with the drag when ``gamma_par`` is given | — |
+| ``expressions(hy)`` | ``((x, y, px, py), V, H)`` as heyoka expressions (``hy``: the heyoka module the engine hands in) | — |
+| ``equations(hy, gamma_par)`` | the heyoka ODE system, with the drag when ``gamma_par`` is given | — |
 | ``no_return_radius(E)`` | R such that an orbit of energy ≤ E at r ≥ R moving outward (ṙ > 0) never returns | length |
 | ``inside_well(x, y)`` | in the well's part of {V < E_c} (the ``well`` IC region) | — |
 | ``exit_channel(x, y)`` | index of the exit nearest in angle | — |
@@ -142,8 +142,9 @@ class System(abc.ABC):
         """V(x, y) on numpy arrays (energy)."""
 
     @abc.abstractmethod
-    def potential_expression(self, x: Any, y: Any) -> Any:
-        """V as a heyoka expression of the heyoka variables ``x``, ``y``."""
+    def potential_expression(self, x: Any, y: Any, hy: Any) -> Any:
+        """V as a heyoka expression of the heyoka variables ``x``, ``y``; ``hy``: the heyoka module (the engine
+        hands it in: the model builds expressions, it does not import heyoka)."""
 
     @abc.abstractmethod
     def no_return_radius(self, energy: float) -> float:
@@ -249,32 +250,30 @@ class System(abc.ABC):
             ok &= self.potential(s * x, s * y) < ec
         return ok
 
-    def expressions(self) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
-        """(state_vars, V, H) as heyoka expressions; state order x, y, px, py."""
-        import heyoka as hy  # deferred: heyoka loads on first use
-
+    # The expression builders below take the heyoka module as ``hy``: heyoka is imported only by the engine
+    # (hhscatter.integrate), which hands it in; the model says what the expressions are, in heyoka's vocabulary.
+    def expressions(self, hy: Any) -> tuple[tuple[Any, Any, Any, Any], Any, Any]:
+        """expressions(hy) -> (state_vars, V, H) as heyoka expressions; state order x, y, px, py; ``hy``: the
+        heyoka module."""
         x, y, px, py = hy.make_vars("x", "y", "px", "py")
-        V = self.potential_expression(x, y)
+        V = self.potential_expression(x, y, hy)
         return (x, y, px, py), V, 0.5 * (px**2 + py**2) + V
 
-    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
-        """(F_x, F_y) = −∇V as heyoka expressions (a built-in may give simplified forms)."""
-        import heyoka as hy  # deferred: heyoka loads on first use
-
-        V = self.potential_expression(x, y)
+    def force_expressions(self, x: Any, y: Any, hy: Any) -> tuple[Any, Any]:
+        """(F_x, F_y) = −∇V as heyoka expressions (a built-in may give simplified forms); ``hy``: the heyoka
+        module."""
+        V = self.potential_expression(x, y, hy)
         return -hy.diff(V, x), -hy.diff(V, y)
 
-    def equations(self, gamma_par: Any = None) -> list:
-        """equations(gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
+    def equations(self, hy: Any, gamma_par: Any = None) -> list:
+        """equations(hy, gamma_par=None) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
 
         Hamilton's equations of H, Eq. (eqn:hh_ham) for Hénon–Heiles, plus the drag of :attr:`dissipation`
         when ``gamma_par`` (a heyoka expression for γ, e.g. ``hy.par[0]``) is given; None builds the
-        conservative system without drag terms.
+        conservative system without drag terms. ``hy``: the heyoka module.
         """
-        import heyoka as hy  # deferred: heyoka loads on first use
-
         x, y, px, py = hy.make_vars("x", "y", "px", "py")
-        fx, fy = self.force_expressions(x, y)
+        fx, fy = self.force_expressions(x, y, hy)
         if gamma_par is not None:
             if self.dissipation == "linear":
                 fx, fy = fx - gamma_par * px, fy - gamma_par * py

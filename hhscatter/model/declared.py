@@ -263,16 +263,16 @@ class DeclaredSystem(System):
         """V(x, y) on numpy arrays (energy)."""
         return self._landscape.v(x, y)
 
-    def potential_expression(self, x: Any, y: Any) -> Any:
+    def potential_expression(self, x: Any, y: Any, hy: Any) -> Any:
         """V as a heyoka expression of x, y (walked from the sympy expression, parameters as constants)."""
-        return to_heyoka(self._numeric, x, y)
+        return to_heyoka(self._numeric, x, y, hy)
 
-    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
+    def force_expressions(self, x: Any, y: Any, hy: Any) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V from the expanded sympy gradient (no redundant products per Taylor step)."""
         import sympy as sp  # deferred: sympy takes ~0.3 s to import
 
         land = self._landscape
-        return tuple(to_heyoka(sp.expand(-g), x, y) for g in land.grad)
+        return tuple(to_heyoka(sp.expand(-g), x, y, hy) for g in land.grad)
 
     def scalar_energy(self) -> Callable[[float, float, float, float], float]:
         """A plain-float H(x, y, px, py) (V lambdified with the math module from the sympy expression)."""

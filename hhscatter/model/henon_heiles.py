@@ -5,8 +5,8 @@
     ṗ       = −∇V − γ p            (dissipative system, γ ≥ 0)
 
 All quantities are in the model's natural units (unit mass; time t, energy E).
-Numeric helpers work on numpy arrays; the heyoka expressions are built lazily
-by :func:`equations` so that importing this module does not import heyoka.
+Numeric helpers work on numpy arrays; the heyoka expressions are built by :func:`equations` with the heyoka
+module it is handed (the engine's): the model never imports heyoka.
 """
 
 from __future__ import annotations
@@ -173,8 +173,8 @@ class HenonHeiles(System):
         py = np.asarray(py, dtype=float)
         return 0.5 * (px * px + py * py) + self.potential(x, y)
 
-    def potential_expression(self, x: Any, y: Any) -> Any:
-        """V as a heyoka expression of the variables x, y (the same arithmetic as :meth:`expressions`)."""
+    def potential_expression(self, x: Any, y: Any, hy: Any = None) -> Any:
+        """V as a heyoka expression of the variables x, y (arithmetic only: ``hy`` is not needed)."""
         return 0.5 * self.omega**2 * (x**2 + y**2) + self.lam * (x**2 * y - y**3 / 3.0)
 
     def inside_well(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
@@ -209,14 +209,15 @@ class HenonHeiles(System):
         return inside
 
     # -- heyoka (expressions() and equations() come from System) ---------
-    def force_expressions(self, x: Any, y: Any) -> tuple[Any, Any]:
+    def force_expressions(self, x: Any, y: Any, hy: Any = None) -> tuple[Any, Any]:
         """(F_x, F_y) = −∇V simplified (−ω²x − 2λxy, −ω²y − λ(x² − y²)): no redundant products per Taylor step."""
         w2, lam = self.omega**2, self.lam
         return -(w2 * x) - (2.0 * lam) * (x * y), -(w2 * y) - lam * (x**2 - y**2)
 
 
-def equations(model: System, gamma_par=None):
-    """equations(model, gamma_par) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)].
+def equations(model: System, hy, gamma_par=None):
+    """equations(model, hy, gamma_par=None) -> heyoka system [(x, ẋ), (y, ẏ), (px, ṗx), (py, ṗy)]; ``hy``: the
+    heyoka module.
 
     Hamilton's equations of H, paper Eq. (eqn:hh_ham), plus the drag −γp of the
     dissipative system when ``gamma_par`` (a heyoka expression for γ, e.g.
@@ -228,16 +229,15 @@ def equations(model: System, gamma_par=None):
     products such as ``0.5*(2*px)`` that would cost operations on every
     Taylor step; ``tests/test_model.py`` checks both agree.
     """
-    return model.equations(gamma_par)
+    return model.equations(hy, gamma_par)
 
 
-def hamilton_equations(model: System):
-    """hamilton_equations(model) -> [(x, ∂H/∂px), ..., (py, −∂H/∂y)] straight from ``hy.diff``.
+def hamilton_equations(model: System, hy):
+    """hamilton_equations(model, hy) -> [(x, ∂H/∂px), ..., (py, −∂H/∂y)] straight from ``hy.diff`` (``hy``: the
+    heyoka module).
 
     Hamilton's equations of H, Eq. (eqn:hh_ham), derived symbolically: the
     reference against which the hand-simplified :func:`equations` is tested.
     """
-    import heyoka as hy  # deferred: heyoka loads on first use
-
-    (x, y, px, py), _, H = model.expressions()
+    (x, y, px, py), _, H = model.expressions(hy)
     return [(x, hy.diff(H, px)), (y, hy.diff(H, py)), (px, -hy.diff(H, x)), (py, -hy.diff(H, y))]

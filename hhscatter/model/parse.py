@@ -26,6 +26,7 @@ from __future__ import annotations
 import ast
 import keyword
 import math
+import sys
 from collections.abc import Mapping
 from typing import Any
 
@@ -356,8 +357,8 @@ def parse_potential(source: Any, params: Mapping[str, Any] | None = None):
     else:
         mod = type(source).__module__ or ""
         if mod.startswith("heyoka"):
-            import heyoka as hy  # deferred: heyoka loads on first use
-
+            # a heyoka expression was given, so heyoka is loaded: its module is taken from it, not imported here
+            hy = sys.modules[mod.partition(".")[0]]
             try:
                 source = hy.to_sympy(source)
             except (TypeError, ValueError) as e:
@@ -409,7 +410,7 @@ def substitute(expr, params: Mapping[str, float]):
     return expr.xreplace(subs)
 
 
-def to_heyoka(expr, x, y):
+def to_heyoka(expr, x, y, hy):
     """The heyoka expression of a sympy expression in x, y (parameters already substituted), built by walking it.
 
     Rationals become double constants; integer powers stay integer powers (heyoka expands squares and small
@@ -421,6 +422,8 @@ def to_heyoka(expr, x, y):
         A potential or force in x and y only (:func:`substitute`).
     x, y : heyoka.expression
         The heyoka variables.
+    hy : module
+        The heyoka module (the engine hands it in: the model does not import heyoka).
 
     Returns
     -------
@@ -431,10 +434,9 @@ def to_heyoka(expr, x, y):
     >>> import heyoka as hy
     >>> hx, hy_ = hy.make_vars("x", "y")
     >>> e = substitute(parse_potential("0.5*x**2 - eps*x*y", {"eps": 2}), {"eps": 2})
-    >>> print(to_heyoka(e, hx, hy_))
+    >>> print(to_heyoka(e, hx, hy_, hy))
     ((0.50000000000000000 * x**2.0000000000000000) - (2.0000000000000000 * (x * y)))
     """
-    import heyoka as hy  # deferred: heyoka loads on first use
     import sympy as sp  # deferred: sympy takes ~0.3 s to import
 
     funcs = {getattr(sp, n): getattr(hy, n) for n in FUNCTIONS}

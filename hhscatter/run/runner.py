@@ -73,7 +73,7 @@ from hhscatter.run.dask_backend import check_scheduler, dask_client
 from hhscatter.run.output import discard_failed_start, prepare_output
 from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
-from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, run_one_chunk
+from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, pack_point, run_one_chunk
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
@@ -82,12 +82,13 @@ from hhscatter.scene.scene import Scene
 class ChunkTask(NamedTuple):
     """One task of a run: the orbits start..stop−1 of one point's scene, chunk ``chunk`` of its plan."""
 
-    scene_json: str  # the point's scene (Scene.to_json), what the worker rebuilds it from
+    scene_json: str  # the point's scene (Scene.to_json), as its parts' metadata records it
     chunk: int
     start: int
     stop: int
     partition: str  # the grid point's folder ('' for a single scene)
     scene_hash: str  # the point's result hash, computed once per run
+    plan: bytes | None = None  # the point's scene and engine plan, pickled once per run (worker.pack_point)
 
 
 #: seconds a Dask run waits with no worker in the cluster before it fails (hhscatter.run.runner._run_dask)
@@ -212,11 +213,14 @@ def simulate(
         check_scheduler(scheduler, workers)
     # every point's result hash once per run (an IC table is read and hashed here, not per chunk)
     points = [(sc, part, sc.result_hash()) for sc, part in points]
+    # every point's engine plan once per run, here where its scene is accepted: pickled with the scene and
+    # handed to every chunk (worker processes and Dask unpickle it; nothing is rebuilt there)
+    packed = {part: pack_point(sc) for sc, part, _ in points}
     earlier = _earlier_event_failures(out) if resume else {}
     created = not Store(out).exists()
     store, lock, points = prepare_output(run, out, overwrite=overwrite, resume=resume, points=points)
     try:
-        summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier)
+        summary = _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier, packed)
         _record_event_failures(store, summary)
         return summary
     except BaseException:
@@ -245,11 +249,14 @@ def _record_event_failures(store, summary) -> None:
     store.write_json(SCENE_FILE, doc)
 
 
-def _simulate(run, store, points, table_ics, workers, resume, progress, scheduler, earlier=None) -> RunSummary:
+def _simulate(
+    run, store, points, table_ics, workers, resume, progress, scheduler, earlier=None, packed=None
+) -> RunSummary:
     # workers get an absolute path (their working directory may differ) or the URL
     out_url = store.root if store.local else store.url
 
     summary = RunSummary(event_failures=dict(earlier or {}))
+    packed = packed or {}
     n_total = sum(sc.n for sc, _, _ in points)
     n_chunks = sum(-(-sc.n // sc.chunk_size) for sc, _, _ in points)
     todo = []
@@ -260,12 +267,12 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
                 if chunk_complete(scene, store, chunk, start, stop, partition, want=h):
                     summary.chunks_skipped += 1
                     continue
-                todo.append(ChunkTask(scene_json, chunk, start, stop, partition, h))
+                todo.append(ChunkTask(scene_json, chunk, start, stop, partition, h, packed.get(partition)))
         done_orbits = n_total - sum(t.stop - t.start for t in todo)
         n_todo = len(todo)
     else:  # planned lazily: one task per chunk in flight, not per chunk of the run
         todo = (
-            ChunkTask(sj, chunk, start, stop, partition, h)
+            ChunkTask(sj, chunk, start, stop, partition, h, packed.get(partition))
             for scene, partition, h in points
             for sj in (scene.to_json(),)
             for chunk, start, stop in plan_chunks(scene)
@@ -308,7 +315,7 @@ def _simulate(run, store, points, table_ics, workers, resume, progress, schedule
                 for task in todo:
                     key = (task.partition, task.chunk)
                     tell = (lambda k, key=key: on_progress(key, k)) if progress else None
-                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task.scene_hash))
+                    on_done(task, run_one_chunk(*args(task), progress=tell, scene_hash=task.scene_hash, plan=task.plan))
             else:
                 _run_pool(min(workers, n_todo), todo, args, on_done, on_progress if progress else None)
     except OSError as exc:
@@ -351,7 +358,7 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
 
     def submit(t):
         with _signals_held():  # (the pool starts its worker processes in submit)
-            return pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t[5])
+            return pool.submit(run_one_chunk, *args(t), progress=q, scene_hash=t.scene_hash, plan=t.plan)
 
     try:
         _drain(
@@ -420,7 +427,9 @@ def _run_dask(client, todo, args, on_done, name):
 
     def submit(task):
         key = f"hhscatter-{name}-{task.partition.replace('/', ',') + '-' if task.partition else ''}{task.chunk}-{tag}"
-        return client.submit(run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task.scene_hash)
+        return client.submit(
+            run_one_chunk, *args(task), key=key, pure=False, retries=0, scene_hash=task.scene_hash, plan=task.plan
+        )
 
     def wait_first(fs):
         alone_since = None

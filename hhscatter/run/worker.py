@@ -7,6 +7,7 @@ import functools
 import hashlib
 import json
 import os
+import pickle
 import signal
 import sys
 import threading
@@ -35,10 +36,25 @@ def _chunk_ics(scene, start, stop, table_ics):
     return region_ics(scene, start, stop), np.arange(start, stop, dtype=np.int64)
 
 
+def pack_point(scene: Scene) -> bytes:
+    """pack_point(scene) -> bytes: the scene and its engine plan (:func:`hhscatter.integrate.plan.plan_of`), built
+    once and pickled together, as a run hands them to every chunk of the point (its worker processes and Dask's
+    unpickle them as they are: no scene is rebuilt and no system derived again there).
+
+    Example: ``pickle.loads(pack_point(Scene(energy=0.2, n=10)))[1].scheduler`` is ``'stream'``.
+    """
+    return pickle.dumps((scene, plan_of(scene)), protocol=pickle.HIGHEST_PROTOCOL)
+
+
+@functools.lru_cache(maxsize=8)
+def _unpack_point(packed: bytes):
+    """(scene, plan) of :func:`pack_point`'s bytes: unpickled once per worker process and point."""
+    return pickle.loads(packed)
+
+
 @functools.lru_cache(maxsize=8)
 def _scene_and_plan(scene_json: str):
-    """(scene, its engine plan) of a point's scene JSON: built once per worker process and scene, then handed to
-    every chunk of it (the plan is what the engine reads: :mod:`hhscatter.integrate.plan`)."""
+    """(scene, its engine plan) of a point's scene JSON, for a caller that hands no :func:`pack_point` bytes."""
     with unbounded_derivation():  # the client accepted this scene: its system is rebuilt here whatever it takes
         scene = scene_from_dict(_decode(json.loads(scene_json)))
     return scene, plan_of(scene)
@@ -55,19 +71,22 @@ def run_one_chunk(
     partition="",
     progress=None,
     scene_hash=None,
+    plan=None,
 ):
     """run_one_chunk(scene_json, chunk, start, stop, out, ics=None, ids=None, partition='', progress=None,
-    scene_hash=None) -> RunSummary.
+    scene_hash=None, plan=None) -> RunSummary.
 
     Worker entry (local pool or Dask): integrate orbits start..stop−1 of the
     scene, write the chunk's part files under ``out`` (path or URL) and
     return the chunk's counts. An OSError while writing is re-raised naming
     the file. ``progress``: a callable f(k), or a queue that gets (chunk, k)
     (another process's), told as orbits of the chunk start. ``scene_hash``: the scene's result hash as
-    the client computed it once per run (default: computed here, which re-reads an IC table).
+    the client computed it once per run (default: computed here, which re-reads an IC table). ``plan``: the
+    point's :func:`pack_point` bytes, made once per run (default: the scene rebuilt from ``scene_json`` and its
+    plan built here, once per process).
     """
 
-    scene, plan = _scene_and_plan(scene_json)
+    scene, plan = _unpack_point(plan) if plan is not None else _scene_and_plan(scene_json)
     store = Store(out)
     if ics is None:
         ics, ids = _chunk_ics(scene, start, stop, None)

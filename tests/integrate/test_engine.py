@@ -54,7 +54,7 @@ def test_dissipative_energy_balance():
     """E(t) + γ∫|p|² dt − E0 = 0 along orbits (work integral carried as a 5th state), ≤ 1e-12."""
     m = HenonHeiles()
     gamma = 0.01
-    sys = equations(m, hy.par[0])
+    sys = equations(m, hy, hy.par[0])
     x, y, px, py = (v for v, _ in sys)
     w = hy.make_vars("w")
     sys5 = sys + [(w, hy.par[0] * (px**2 + py**2))]
@@ -78,7 +78,7 @@ def test_settling_energy_matches_work_integral():
     lt = res.lifetimes
     settled = np.flatnonzero(lt["outcome"] == SETTLED)
     assert len(settled) >= 2
-    sys = equations(m, hy.par[0])
+    sys = equations(m, hy, hy.par[0])
     px, py = sys[2][0], sys[3][0]
     w = hy.make_vars("w")
     for k in settled[:4]:

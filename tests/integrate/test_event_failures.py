@@ -123,8 +123,8 @@ def dense_first_crossing(ic, t_stop=3.0, n_grid=6000):
     heyoka's events: heyoka's dense output (no events) sampled on a grid, x p_x + y p_y's sign changes refined
     by SciPy's brentq on the same dense output. None if there is none before ``t_stop``."""
     m = HenonHeiles()
-    (x, y, px, py), _, _ = m.expressions()
-    ta = hy.taylor_adaptive(m.equations(None), list(ic), tol=1e-16)
+    (x, y, px, py), _, _ = m.expressions(hy)
+    ta = hy.taylor_adaptive(m.equations(hy, None), list(ic), tol=1e-16)
     co = ta.propagate_until(t_stop, c_output=True)[4]
 
     def f(t):

@@ -26,7 +26,7 @@ def _ta(system, state, gamma=None, tol=1e-15, events=()):
 
     g = None if gamma is None else hy.par[0]
     kw = {"pars": [gamma]} if gamma is not None else {}
-    return hy.taylor_adaptive(system.equations(g), state, tol=tol, t_events=list(events), **kw)
+    return hy.taylor_adaptive(system.equations(hy, g), state, tol=tol, t_events=list(events), **kw)
 
 
 def test_declared_hh_costs_no_more_per_step_than_the_builtin(hh3):
@@ -37,7 +37,7 @@ def test_declared_hh_costs_no_more_per_step_than_the_builtin(hh3):
         assert sizes[1] <= sizes[0], sizes  # 15 vs 17 (conservative), 19 vs 21 (linear drag)
     quad = DeclaredSystem(HenonHeiles().potential_text, {"omega": 1.0, "lam": 1.0}, "quadratic")
     sizes = [
-        len(hy.taylor_adaptive(m.equations(hy.par[0]), [0.1, 0.2, 0.3, 0.1], pars=[0.01]).decomposition)
+        len(hy.taylor_adaptive(m.equations(hy, hy.par[0]), [0.1, 0.2, 0.3, 0.1], pars=[0.01]).decomposition)
         for m in (HenonHeiles(dissipation="quadratic"), quad)
     ]
     assert sizes[1] <= sizes[0] + 2, sizes
@@ -207,8 +207,8 @@ def test_heyoka_expressions_match_numpy_and_differentiation(text):
 
     s = DeclaredSystem(text)
     x, y = hy.make_vars("x", "y")
-    V = s.potential_expression(x, y)
-    fx, fy = s.force_expressions(x, y)
+    V = s.potential_expression(x, y, hy)
+    fx, fy = s.force_expressions(x, y, hy)
     pts = np.random.default_rng(3).uniform(-1.2, 1.2, (2, 300))
     v = hy.cfunc([V], vars=[x, y])(pts)[0]
     assert np.allclose(v, s.potential(*pts), rtol=1e-14, atol=1e-15)

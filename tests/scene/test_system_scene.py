@@ -102,7 +102,7 @@ def test_drag_laws_against_an_independent_integrator(dissipation):
 
     gamma = 0.05
     hh = HenonHeiles(dissipation=dissipation)
-    ta = hy.taylor_adaptive(hh.equations(hy.par[0]), [0.1, 0.2, 0.3, -0.2], pars=[gamma], tol=1e-15)
+    ta = hy.taylor_adaptive(hh.equations(hy, hy.par[0]), [0.1, 0.2, 0.3, -0.2], pars=[gamma], tol=1e-15)
     ta.propagate_until(10.0)
 
     def rhs(t, s):
