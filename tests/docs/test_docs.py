@@ -575,10 +575,17 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
         "study": "gx",
         "scale": "paper",
         "regular_fraction": [
-            {"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
+            {"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01, "syst": 0.05}
             for r, f in ((1.05, 0.75), (1.5, 0.1))
+        ]
+        + [
+            {"label": "two", "ics": "disk/tangential", "e_ratio": 2.0, "fraction": 0.0, "err": None}
+            | {"fraction_upper": 0.0015, "fraction_cl": 0.95, "syst": 0.0}
         ],
-        "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
+        "survival_long": [
+            {"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004},
+            {"label": "two", "e_ratio": 1.05, "t": 2000.0, "P": 0.0, "P_err": None, "P_upper": 3e-4, "P_cl": 0.95},
+        ],
         "long_time": [
             {
                 "label": "two",
@@ -607,7 +614,8 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     }
     (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
-    assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out
+    assert "| two | disk/tangential | 75.0 ± 1.0 ± 5.0 % | 10.0 ± 1.0 ± 5.0 % | < 0.15 % (95 %) |" in out
+    assert "| 0.800 ± 0.004 | < 3.0e-4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
 
 

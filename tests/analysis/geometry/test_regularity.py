@@ -86,3 +86,19 @@ def test_regular_fraction_error_is_binomial_and_never_zero():
     f, e = regular_fraction(10000, 2500)
     assert f == 0.25 and abs(e - np.sqrt(0.25 * 0.75 / 1e4)) < 1e-6
     assert regular_fraction(10000, 0)[1] > 1e-5
+
+
+def test_threshold_systematic_is_the_largest_shift_over_the_thresholds():
+    from hhscatter.analysis.geometry.regularity import threshold_systematic
+
+    growth = np.array([5.0, 2e3, 2e3, 3e4, 3e4, 3e4, 1e9, np.inf, np.nan])
+    r = threshold_systematic(100, growth)
+    # below 1e3: 1, below 1e4: 3, below 1e5: 6 of 100
+    assert r["by_threshold"] == {1e3: 0.01, 1e4: 0.03, 1e5: 0.06}
+    assert (
+        r["value"] == 0.03
+        and r["syst"] == pytest.approx(0.03)
+        and r["stat"] == pytest.approx((0.03 * 0.97 / 100 + 1 / 4e4) ** 0.5 / 1.01)  # Wilson 1σ half-width
+    )
+    with pytest.raises(ValueError, match="n_orbits"):
+        threshold_systematic(3, growth)
