@@ -825,7 +825,8 @@ STUDY_TABLES = {
 
 def spec_table(recs, spec=None) -> str:
     """Markdown table of records with the columns ``spec`` ((key, header[, error key]); default every key): a key
-    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, None or NaN as "—"."""
+    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, a key with a sibling
+    ``<key>_upper`` (a count of 0) as its one-sided bound, None or NaN as "—"."""
     import math
 
     if spec is None:
@@ -840,6 +841,10 @@ def spec_table(recs, spec=None) -> str:
         v, e = r.get(k), r.get(ek)
         if v is None or (isinstance(v, float) and math.isnan(v)):
             return "—"
+        if _is_num(r.get(k + "_upper")) or _is_num(r.get(k + "_lower")):  # a count of 0 (or all): its bound
+            from hhscatter.publish.formatting import format_bound
+
+            return format_bound(r.get(k + "_upper"), r.get(k + "_lower"), r.get(k + "_cl", 0.95))
         if k.startswith("z") and _is_num(v):  # a distance in σ
             return f"{v:+.1f}"
         if k.startswith("residual") and _is_num(v):  # a relative difference, in per cent

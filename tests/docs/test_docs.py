@@ -630,3 +630,10 @@ def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
         "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
+
+
+def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
+    """A record with a sibling <key>_upper (a count of 0) shows its one-sided bound, never "0 ± 0"."""
+    recs = [{"t": 80.0, "sim": 0.25, "sim_err": 0.01}, {"t": 100.0, "sim": 0.0, "sim_err": None, "sim_upper": 3e-4}]
+    out = hook.spec_table(recs, (("t", "t"), ("sim", "simulated")))
+    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out
