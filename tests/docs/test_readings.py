@@ -118,6 +118,8 @@ def test_the_resc_page_names_the_tools_own_default():
         assert HenonHeiles().default_escape_radius(e) == pytest.approx(pick)
     page = (ROOT / "studies" / "resc" / "page.md").read_text()
     assert "[[resc:default_r_esc.recommended]]; that is the tool's own default" in page
+    # the reference radius is read as what it is (the study's r_ref), not as a "current default"
+    assert "default_r_esc.current" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
 
