@@ -1053,10 +1053,14 @@ def _pct(v, e=None) -> str:
     return fmt_err(100 * v, 100 * e) + " %" if _is_num(e) else f"{fmt_num(100 * v, 3)} %"
 
 
-def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None) -> str:
-    """A fraction as value ± stat (± syst), or, at a count of 0, its one-sided bound "< b (95 %)"."""
+def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None, n=None) -> str:
+    """A fraction as value ± stat (± syst), or, at a count of 0, its one-sided bound "< b (95 %)" (a record written
+    before bounds were recorded: from its number of orbits ``n``, by the same estimator)."""
+    from hhscatter.analysis.stats.intervals import fraction_with_bound
     from hhscatter.publish.formatting import format_bound
 
+    if not _is_num(upper) and v == 0 and _is_num(n) and n > 0:
+        upper = fraction_with_bound(0, int(n), cl=cl).upper
     if _is_num(upper):
         return format_bound(upper, cl=cl, pct=pct)
     if pct:
@@ -1097,6 +1101,7 @@ def evidence_tables(doc) -> str:
                 r.get("fraction_cl", 0.95),
                 pct=True,
                 syst=r.get("syst"),
+                n=r.get("n"),
             )
             for r in reg
             if r["label"] == lab and r["ics"] == ics
@@ -1122,7 +1127,10 @@ def evidence_tables(doc) -> str:
         ps = [P.get((f["label"], f["e_ratio"], t)) for t in ts]
         out.append(
             f"| {f['label']} | {f['e_ratio']:g} | "
-            + " | ".join(_bounded(x["P"], x["P_err"], x.get("P_upper"), x.get("P_cl", 0.95)) if x else "—" for x in ps)
+            + " | ".join(
+                _bounded(x["P"], x["P_err"], x.get("P_upper"), x.get("P_cl", 0.95), n=f.get("n")) if x else "—"
+                for x in ps
+            )
             + " | "
             + " | ".join(
                 [
@@ -1138,6 +1146,7 @@ def evidence_tables(doc) -> str:
             + " |"
         )
     vm = doc.get("validity_map", [])
+    n_of = {r.get("id"): r.get("n") for r in reg}
     if vm:
         yn = {True: "yes", False: "no", None: "—"}
         out.append(
@@ -1153,7 +1162,7 @@ def evidence_tables(doc) -> str:
         for v in vm:
             out.append(
                 f"| {v['label']} | {v['e_ratio']:g} | "
-                f"{_bounded(v['regular_fraction'], v['regular_err'], v.get('regular_fraction_upper'), pct=True)} | "
+                f"{_bounded(v['regular_fraction'], v['regular_err'], v.get('regular_fraction_upper'), pct=True, n=n_of.get(v.get('id')))} | "
                 f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | "
                 f"{yn[v['exponential']] if v['exponential'] is not None else v.get('exponential_verdict') or '—'} | "
                 f"{yn[v['plateau']]} |"

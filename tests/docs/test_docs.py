@@ -619,6 +619,26 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
 
 
+def test_evidence_tables_write_zero_counts_of_records_without_bounds_from_their_orbit_count(tmp_path, hook):
+    """Records written before bounds were recorded (a P of 0 with error 0, a regular fraction of 0 with a Wilson
+    error): the table gives the one-sided 95 % bound from the record's number of orbits, 1 − 0.05^(1/n)."""
+    doc = {
+        "regular_fraction": [
+            {"id": "two-2-disk", "label": "two", "ics": "disk/tangential", "e_ratio": 2.0, "fraction": 0.0}
+            | {"err": 0.00025, "n": 2000}
+        ],
+        "survival_long": [{"label": "two", "e_ratio": 2.0, "t": 800.0, "P": 0.0, "P_err": 0.0}],
+        "long_time": [{"label": "two", "e_ratio": 2.0, "ics": "disk/tangential", "n": 2000}],
+        "validity_map": [
+            {"id": "two-2-disk", "label": "two", "e_ratio": 2.0, "regular_fraction": 0.0, "regular_err": 0.00025}
+            | {"kappa0_defined": True, "claim2": None, "exponential": None, "plateau": None}
+        ],
+    }
+    out = hook.evidence_tables(doc)
+    assert "0 ± 0" not in out and "0.0 ± 0.0" not in out
+    assert out.count("< 0.15 % (95 %)") == 2 and "| < 1.5e-3 (95 %) |" not in out and "| < 0.0015 (95 %) |" in out
+
+
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
     """The hook's output writes a number's sign "−" (as the verdicts and the [[…]] numbers do); code spans, maths,
     HTML attributes, ranges and e-notation stay as written."""

@@ -14,7 +14,9 @@ e^{λt} until it saturates at the size of the chaotic sea (≈ 0.1–1, i.e. G �
 called regular when G < ``g_max`` (default 10⁴: ln G = 9.2, so a chaotic orbit with λ > 9.2/t is told apart;
 λ ≳ 0.005 at t = 1900). An orbit whose shadow leaves (escapes) while it stays, or the reverse, is chaotic. The
 threshold is validated against orbits whose type an independent integration (scipy, variational equations,
-renormalised tangent vector) fixes: tests/analysis/geometry/test_regularity.py.
+renormalised tangent vector) fixes, among them orbits at island edges whose growth lies between a torus' and the
+saturated sea's: tests/analysis/geometry/test_regularity.py. :func:`threshold_systematic` gives the systematic of
+the threshold choice (the fraction's largest shift with the threshold a decade either side).
 
 Conventions: the separation is Euclidean in (x, y, p_x, p_y) (length and momentum units alike: ω = 1); the
 shadow differs by +d0 in x with both momenta scaled by one factor that keeps H(x, y, p_x, p_y) = E (−d0 where
