@@ -825,7 +825,8 @@ STUDY_TABLES = {
 
 def spec_table(recs, spec=None) -> str:
     """Markdown table of records with the columns ``spec`` ((key, header[, error key]); default every key): a key
-    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, None or NaN as "—"."""
+    with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, a key with a sibling
+    ``<key>_upper`` (a count of 0) as its one-sided bound, None or NaN as "—"."""
     import math
 
     if spec is None:
@@ -840,6 +841,10 @@ def spec_table(recs, spec=None) -> str:
         v, e = r.get(k), r.get(ek)
         if v is None or (isinstance(v, float) and math.isnan(v)):
             return "—"
+        if _is_num(r.get(k + "_upper")) or _is_num(r.get(k + "_lower")):  # a count of 0 (or all): its bound
+            from hhscatter.publish.formatting import format_bound
+
+            return format_bound(r.get(k + "_upper"), r.get(k + "_lower"), r.get(k + "_cl", 0.95))
         if k.startswith("z") and _is_num(v):  # a distance in σ
             return f"{v:+.1f}"
         if k.startswith("residual") and _is_num(v):  # a relative difference, in per cent
@@ -1048,6 +1053,24 @@ def _pct(v, e=None) -> str:
     return fmt_err(100 * v, 100 * e) + " %" if _is_num(e) else f"{fmt_num(100 * v, 3)} %"
 
 
+def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None, n=None) -> str:
+    """A fraction as value ± stat (± syst), or, at a count of 0, its one-sided bound "< b (95 %)" (a record written
+    before bounds were recorded: from its number of orbits ``n``, by the same estimator)."""
+    from hhscatter.analysis.stats.intervals import fraction_with_bound
+    from hhscatter.publish.formatting import format_bound
+
+    if not _is_num(upper) and v == 0 and _is_num(n) and n > 0:
+        upper = fraction_with_bound(0, int(n), cl=cl).upper
+    if _is_num(upper):
+        return format_bound(upper, cl=cl, pct=pct)
+    if pct:
+        out = _pct(v, e)
+        if _is_num(syst) and syst > 0 and _is_num(e) and e > 0:
+            out = out[: -len(" %")] + f" ± {fmt_err(100 * syst, 100 * e).split(' ± ')[0]} %"  # stat's decimals
+        return out
+    return _ve_cell({"value": v, "err": e})
+
+
 def _ve_cell(d) -> str:
     return (
         fmt_err(d["value"], d["err"])
@@ -1062,18 +1085,35 @@ def evidence_tables(doc) -> str:
     out = []
     reg = doc["regular_fraction"]
     ratios = sorted({r["e_ratio"] for r in reg})
-    out.append("**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ)\n")
+    out.append(
+        "**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ ± the "
+        "systematic of the threshold, the largest shift with the threshold a decade either side; where no orbit "
+        "is regular, the one-sided 95 % upper bound)\n"
+    )
     out.append("| system | ICs | " + " | ".join(f"{r:g} E_c" for r in ratios) + " |")
     out.append("|---|---|" + "---|" * len(ratios))
     for lab, ics in dict.fromkeys((r["label"], r["ics"]) for r in reg):
-        cells = {r["e_ratio"]: _pct(r["fraction"], r["err"]) for r in reg if r["label"] == lab and r["ics"] == ics}
+        cells = {
+            r["e_ratio"]: _bounded(
+                r["fraction"],
+                r["err"],
+                r.get("fraction_upper"),
+                r.get("fraction_cl", 0.95),
+                pct=True,
+                syst=r.get("syst"),
+                n=r.get("n"),
+            )
+            for r in reg
+            if r["label"] == lab and r["ics"] == ics
+        }
         out.append(f"| {lab} | {ics} | " + " | ".join(cells.get(x, "—") for x in ratios) + " |")
     P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
     ts = sorted({r["t"] for r in doc.get("survival_long", [])})
     out.append(
         "\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
         "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
-        "exponential from t0, p its χ² p-value)\n"
+        "exponential from t0, p its χ² p-value over cells pooled to ≥ 5 expected orbits; a P of 0 as its "
+        "one-sided 95 % upper bound)\n"
     )
     out.append(
         "| system | E/E_c | "
@@ -1087,20 +1127,26 @@ def evidence_tables(doc) -> str:
         ps = [P.get((f["label"], f["e_ratio"], t)) for t in ts]
         out.append(
             f"| {f['label']} | {f['e_ratio']:g} | "
-            + " | ".join(fmt_err(x["P"], x["P_err"]) if x else "—" for x in ps)
+            + " | ".join(
+                _bounded(x["P"], x["P_err"], x.get("P_upper"), x.get("P_cl", 0.95), n=f.get("n")) if x else "—"
+                for x in ps
+            )
             + " | "
             + " | ".join(
                 [
-                    _ve_cell({"value": f.get("P_inf"), "err": f.get("P_inf_err")}),
+                    _bounded(f.get("P_inf"), f.get("P_inf_err"), f.get("P_inf_upper"), f.get("P_inf_cl", 0.95)),
                     _ve_cell({"value": f.get("kappa_inf"), "err": f.get("kappa_inf_err")}),
                     _pct(f.get("regular_fraction_of_censored")),
                     _ve_cell({"value": f.get("kappa_nonregular"), "err": f.get("kappa_nonregular_err")}),
-                    fmt_num(f["p_nonregular"], 2) if _is_num(f.get("p_nonregular")) else "—",
+                    fmt_num(f["p_nonregular"], 2)
+                    if _is_num(f.get("p_nonregular"))
+                    else (f.get("exponential_verdict") or "—"),
                 ]
             )
             + " |"
         )
     vm = doc.get("validity_map", [])
+    n_of = {r.get("id"): r.get("n") for r in reg}
     if vm:
         yn = {True: "yes", False: "no", None: "—"}
         out.append(
@@ -1115,8 +1161,10 @@ def evidence_tables(doc) -> str:
         out.append("|---|---|---|---|---|---|---|")
         for v in vm:
             out.append(
-                f"| {v['label']} | {v['e_ratio']:g} | {_pct(v['regular_fraction'], v['regular_err'])} | "
-                f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | {yn[v['exponential']]} | "
+                f"| {v['label']} | {v['e_ratio']:g} | "
+                f"{_bounded(v['regular_fraction'], v['regular_err'], v.get('regular_fraction_upper'), pct=True, n=n_of.get(v.get('id')))} | "
+                f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | "
+                f"{yn[v['exponential']] if v['exponential'] is not None else v.get('exponential_verdict') or '—'} | "
                 f"{yn[v['plateau']]} |"
             )
     rs = doc.get("resc", [])

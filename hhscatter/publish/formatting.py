@@ -92,6 +92,27 @@ def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
     return f"{v:.{digits}f}{sep}{err:.{digits}f}"
 
 
+def format_bound(upper=None, lower=None, cl: float = 0.95, *, pct: bool = False) -> str:
+    """format_bound(upper=None, lower=None, cl=0.95, pct=False) -> a one-sided bound as pages write it: a count
+    of 0 as "< bound (95 %)", a count of all as "> bound (95 %)" (2 significant digits; ``pct``: in per cent).
+
+    >>> format_bound(2.995e-4), format_bound(2.995e-4, pct=True), format_bound(lower=0.9985, cl=0.9)
+    ('< 3.0e-4 (95 %)', '< 0.030 % (95 %)', '> 0.9985 (90 %)')
+    """
+    if (upper is None) == (lower is None):
+        raise ValueError("give one bound: upper (a count of 0) or lower (a count of all)")
+    b, sign = (upper, "<") if upper is not None else (lower, ">")
+    level = f"({100 * cl:g} %)"
+    if sign == ">" and b > 0.9:  # 2 significant digits of the distance to 1
+        return f"{sign} {b:.{1 - math.floor(math.log10(1 - b))}f} {level}"
+    v = 100 * b if pct else b
+    if not pct and v < 1e-3:
+        m, e = f"{v:.1e}".split("e")
+        return f"{sign} {m}e{int(e)} {level}"
+    text = f"{v:.{max(0, 1 - math.floor(math.log10(v)))}f}"
+    return f"{sign} {text}{' %' if pct else ''} {level}"
+
+
 def format_value(v, *, html: bool = False) -> str:
     """format_value(v) -> text of one numbers-JSON leaf: {value, err} → v ± err, {value, lo, hi} → v [lo, hi],
     short lists element by element, longer lists and tables by their size."""

@@ -52,7 +52,7 @@ import tomllib
 from functools import lru_cache
 from pathlib import Path
 
-from hhscatter.publish.formatting import format_number, format_value_err, typographic_minus
+from hhscatter.publish.formatting import format_bound, format_number, format_value_err, typographic_minus
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
@@ -372,6 +372,11 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
         if isinstance(parent, dict) and ("ours" in parent or "reference" in parent):
             return _rule_verdict(parent, scale)
     leaf = resolve(doc, path)
+    bound = _bound_of(doc, stripped, leaf)
+    f = (fmt or "").strip()
+    if bound is not None and (f in ("", "pct", "value") or f.startswith(".")):
+        # a count of 0 (or of all): its one-sided bound, never "0 ± 0"
+        return format_bound(**bound, pct=(fmt or "").strip() == "pct")
     if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
         if not isinstance(leaf, dict) or not ("ours" in leaf or "reference" in leaf):
             raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours') or a claim record")
@@ -381,6 +386,32 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)
+
+
+def _bound_of(doc, path: str, leaf) -> dict | None:
+    """The one-sided bound of a number recorded at a count of 0 or of all: {upper | lower, cl} from its siblings
+    ``<key>_upper`` / ``<key>_lower`` and ``<key>_cl`` (:meth:`hhscatter.analysis.stats.intervals.BoundedFraction.record`),
+    or from the keys ``upper`` / ``lower`` of a ``{value, upper, cl}`` leaf; None when it has none.
+
+    >>> _bound_of({"r": {"P": 0.0, "P_upper": 3e-4, "P_cl": 0.95}}, "r.P", 0.0)
+    {'cl': 0.95, 'upper': 0.0003}
+    """
+    if isinstance(leaf, dict):
+        found = {k: leaf[k] for k in ("upper", "lower") if _is_num(leaf.get(k))}
+        return {**found, "cl": leaf.get("cl", 0.95)} if len(found) == 1 else None
+    if not _is_num(leaf):
+        return None
+    found = {}
+    for k in ("upper", "lower", "cl"):
+        try:
+            v = resolve(doc, f"{path}_{k}")
+        except NumberRefError:
+            continue
+        if _is_num(v):
+            found[k] = v
+    if ("upper" in found) == ("lower" in found):
+        return None
+    return {"cl": 0.95, **found}
 
 
 def _rule_verdict(row: dict, scale) -> str:

@@ -121,9 +121,9 @@ def closer_words(d_a, e_a, d_b, e_b, a: str, b: str, distance: str) -> str:
     return f"closer to {a if v.z < 0 else b} by {distance} ({pair}, z = {signed(v.z)})"
 
 
-def pass_fail_words(cells: list[tuple[str, bool | None]], holds: str, fails: str) -> str:
-    """pass_fail_words([(cell, passed: True / False / None)], holds, fails) -> "fails at …; holds at …; not tested
-    at …": never an "always" or a "never" unless every cell was tested and says so.
+def pass_fail_words(cells: list[tuple[str, bool | None]], holds: str, fails: str, untested: str = "not tested") -> str:
+    """pass_fail_words([(cell, passed: True / False / None)], holds, fails, untested='not tested') -> "fails at …;
+    holds at …; not tested at …": never an "always" or a "never" unless every cell was tested and says so.
 
     Examples
     --------
@@ -145,7 +145,7 @@ def pass_fail_words(cells: list[tuple[str, bool | None]], holds: str, fails: str
     if groups[True]:
         out.append(f"{holds} at {', '.join(groups[True])}")
     if groups[None]:
-        out.append(f"not tested at {', '.join(groups[None])}")
+        out.append(f"{untested} at {', '.join(groups[None])}")
     return "; ".join(out)
 
 
@@ -240,6 +240,7 @@ def _b_relation(get: Loader) -> str:
 
 def _generality_one_exponential(get: Loader) -> str:
     d = get("generality", None)
+    pooled = any("exponential_verdict" in f for f in d["long_time"])  # cells pooled to expected counts ≥ 5
     out = []
     for label in d.get("systems") or {}:
         cells = [
@@ -247,12 +248,21 @@ def _generality_one_exponential(get: Loader) -> str:
             for f in d["long_time"]
             if f["label"] == label and "disk" in f["ics"]
         ]
-        out.append(f"{label}: " + pass_fail_words(cells, f"p ≥ {P_LEVEL:g}", f"p < {P_LEVEL:g}"))
+        untested = "too few orbits for the test" if pooled else "not tested"
+        out.append(f"{label}: " + pass_fail_words(cells, f"p ≥ {P_LEVEL:g}", f"p < {P_LEVEL:g}", untested))
+    caveat = (
+        "Its cells are pooled until each expects at least 5 orbits (the orbits still inside at t_max join the last "
+        "escape cell where they expect fewer), so no handful of orbits in a nearly empty cell decides it; where no "
+        "degree of freedom is left it gives no verdict"
+        if pooled
+        else "What it measures is the fit of one exponential, not its cause: its last cell, the orbits still inside "
+        "at t_max, can have an expected count far below 5, where a handful of orbits drives χ²"
+    )
     return (
         "The χ² test of one exponential from t0 on the non-regular orbits gives, by E/E_c, "
         + "; ".join(out)
-        + ". What it measures is the fit of one exponential, not its cause: its last cell, the orbits still inside "
-        "at t_max, can have an expected count far below 5, where a handful of orbits drives χ²"
+        + ". "
+        + caveat
     )
 
 

@@ -6,9 +6,10 @@ import numpy as np
 
 from hhscatter.publish.figures import agg_pyplot, save_panels
 
-#: colour per outcome code 0, 1, 2 (exit channels), 3 (settled), 4 (trapped); forbidden cells white
+#: colour per outcome code 0, 1, 2 (exit channels), 3 (settled), 4 (censored: still inside at t_max); forbidden
+#: cells white
 COLORS = ("#d7301f", "#2171b5", "#238b45", "#fdb863", "#3f3f3f")
-NAMES = ("exit 0", "exit 1", "exit 2", "settled", "trapped")
+NAMES = ("exit 0", "exit 1", "exit 2", "settled", "censored")
 
 
 def _image(ax, labels, extent, cmap, norm):

@@ -30,7 +30,7 @@ def _panel_kappa(ax, kappa, numbers):
             capsize=2,
             label=_label(name, info),
         )
-        ax.plot(d.loc[~ok, "eps"], d.loc[~ok, "kappa"], "x", color=col, ms=7)  # trapped plateau: ill-defined
+        ax.plot(d.loc[~ok, "eps"], d.loc[~ok, "kappa"], "x", color=col, ms=7)  # plateau of censored orbits: ill-defined
         e = kappa[(kappa["system"] == name) & (kappa["convention"] == "escaping") & kappa["defined"]]
         ax.plot(e["eps"], e["kappa"], mk, mfc="none", color=col, ms=8, alpha=0.7)
         laws = info["kappa_law"]
@@ -53,7 +53,7 @@ def _panel_kappa(ax, kappa, numbers):
     ax.set_xlabel(r"$\epsilon = (E - E_c)/E_c$")
     ax.set_ylabel(r"$\kappa_0$ (1/time; well frequency 1)")
     ax.set_title(
-        "(a) κ0: filled all orbits, × ill-defined (trapped plateau),\nopen escaping orbits only; "
+        "(a) κ0: filled all orbits, × ill-defined (plateau of censored orbits),\nopen escaping orbits only; "
         "lines: law aε²+bε | cε, dotted: break",
         fontsize=9,
     )
@@ -171,7 +171,7 @@ def _panel_kappa_cm(ax, numbers):
     ax.set_ylabel(r"$\kappa$ from the c-measure, $\int e^{\kappa T} d\mu_c = 1 + \mu_c(\mathcal{E})$")
     ax.set_title(
         "(e) claim 2: κ from the c-measure vs κ0 (labels E/E_c);\nfilled: the paper's all-orbit κ0 defined "
-        "too, open: ill-defined (trapped plateau)",
+        "too, open: ill-defined (plateau of censored orbits)",
         fontsize=9,
     )
     ax.legend(fontsize=7)
@@ -203,7 +203,7 @@ def _panel_distance(ax, numbers):
                 mfc=None if filled else "none",
                 ms=6,
                 capsize=2,
-                label=f"{name}, {'μ_c (trapped dropped)' if filled else 'all survivors'}",
+                label=f"{name}, {'μ_c (censored dropped)' if filled else 'all survivors'}",
             )
             top = max(top, x["interval"][1], y["interval"][1])
     ax.plot([0, top * 1.1], [0, top * 1.1], "k-", lw=0.8)
@@ -259,18 +259,24 @@ def _name(label):
 
 
 def plot_regular(numbers, path):
-    """Regular fraction against E/E_c per system and IC convention (shadow indicator)."""
+    """Regular fraction against E/E_c per system and IC convention (shadow indicator); a count of 0 with its
+    one-sided 95 % upper bound as the bar above it."""
     import pandas as pd
 
     plt = agg_pyplot()
     d = pd.DataFrame(numbers["regular_fraction"])
     fig, ax = plt.subplots(figsize=(8, 4.8))
+    if "fraction_upper" not in d:
+        d["fraction_upper"] = np.nan
+    err = pd.to_numeric(d["err"], errors="coerce")
+    # a count of 0: no error, its one-sided 95 % upper bound drawn as the bar above 0
+    d = d.assign(lo=err.fillna(0.0), hi=err.fillna(pd.to_numeric(d["fraction_upper"], errors="coerce")).fillna(0.0))
     for (label, ics), g in d.groupby(["label", "ics"], sort=False):
         disk = "disk" in ics
         ax.errorbar(
             g["e_ratio"],
             g["fraction"],
-            g["err"],
+            [g["lo"].to_numpy(), g["hi"].to_numpy()],
             fmt=("-" if disk else "--") + MARKERS.get(label, "o"),
             color=COLORS.get(label, "k"),
             mfc=None if disk else "none",
@@ -284,7 +290,7 @@ def plot_regular(numbers, path):
     ax.set_yscale("symlog", linthresh=0.01)
     ax.set_ylim(-0.001, 1.05)
     ax.set_xlabel(r"$E/E_c$")
-    ax.set_ylabel("regular fraction of all orbits")
+    ax.set_ylabel("regular fraction of all orbits\n(bars: 1σ; at 0: 95 % upper bound)")
     r = d.iloc[0]
     ax.set_title(
         f"Orbits on KAM tori (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "

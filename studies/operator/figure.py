@@ -54,7 +54,8 @@ def _save(fig, path):
 
 
 def _panel_kappa(a, nums, recs, E):
-    """(a) κ(E): Ulam's κ (and its box → 0 extrapolation) against fig2's κ0 and long-run κ."""
+    """(a) κ(E): Ulam's κ∞ (the headline: extrapolated in box side and samples per box) and its finest-box values
+    against fig2's κ0 and long-run κ."""
     f2 = [(r["energy"], r["fig2_kappa"], r["fig2_err"]) for r in recs if r.get("fig2_kappa") is not None]
     if f2:
         e2, k2, s2 = map(np.array, zip(*f2))
@@ -79,10 +80,18 @@ def _panel_kappa(a, nums, recs, E):
         [r["err"] for r in recs],
         fmt="o",
         color="C3",
-        capsize=3,
-        label=f"Ulam, box {recs[0]['box']:g} (err: stat ⊕ bias)",
+        mfc="none",
+        ms=5,
+        capsize=2,
+        alpha=0.6,
+        label=f"Ulam, finest box {recs[0]['box']:g} (biased; err: stat ⊕ bias)",
     )
-    a.plot(E, [r["kappa_extrapolated"] for r in recs], "x", color="C3", label="Ulam, linear box → 0")
+    inf = [(r["energy"], r["kappa_inf"], r["err"]) for r in nums.get("kappa_convergence", []) if r.get("kappa_inf")]
+    if inf:
+        ei, ki, si = map(np.array, zip(*inf))
+        a.errorbar(
+            ei - 0.004, ki, si, fmt="o", color="C3", ms=7, capsize=3, label="Ulam κ∞: box → 0, samples → ∞ (headline)"
+        )
     for m in nums.get("mixed_phase_space", []):
         rec = m.get("record")
         if rec:

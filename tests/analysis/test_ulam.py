@@ -45,6 +45,15 @@ def test_survival_agreement_without_comparable_times_is_nan():
     assert [r["t"] for r in out["P_at"]] == [5.0, 10.0, 5.0]  # t* = 5 listed where given
 
 
+def test_survival_agreement_writes_a_simulated_zero_as_its_one_sided_bound():
+    grid = np.arange(0, 201) * 0.5
+    P_sim = np.where(grid < 90, np.exp(-0.05 * grid), 0.0)  # no orbit of 1000 left from t = 90 on
+    out = ulam.survival_agreement(grid, 0.5, 20.0, P_sim, P_sim, P_sim, 1000)
+    last = out["P_at"][-1]
+    assert last["t"] == 100.0 and last["sim"] == 0 and last["sim_err"] is None
+    assert last["sim_upper"] == pytest.approx(1 - 0.05 ** (1 / 1000), abs=1e-6) and last["sim_cl"] == 0.95
+
+
 def test_t_star_energies_weighted_and_plain_moments():
     pred = pd.DataFrame({"energy": [0.1, 0.2, 0.4], "w": [1.0, 2.0, 1.0]})
     sim = pd.DataFrame({"energy": [0.1, 0.3]})

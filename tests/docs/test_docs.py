@@ -575,10 +575,17 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
         "study": "gx",
         "scale": "paper",
         "regular_fraction": [
-            {"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01}
+            {"label": "two", "ics": "disk/tangential", "e_ratio": r, "fraction": f, "err": 0.01, "syst": 0.05}
             for r, f in ((1.05, 0.75), (1.5, 0.1))
+        ]
+        + [
+            {"label": "two", "ics": "disk/tangential", "e_ratio": 2.0, "fraction": 0.0, "err": None}
+            | {"fraction_upper": 0.0015, "fraction_cl": 0.95, "syst": 0.0}
         ],
-        "survival_long": [{"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004}],
+        "survival_long": [
+            {"label": "two", "e_ratio": 1.05, "t": 800.0, "P": 0.8, "P_err": 0.004},
+            {"label": "two", "e_ratio": 1.05, "t": 2000.0, "P": 0.0, "P_err": None, "P_upper": 3e-4, "P_cl": 0.95},
+        ],
         "long_time": [
             {
                 "label": "two",
@@ -607,8 +614,29 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     }
     (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
-    assert "| two | disk/tangential | 75.0 ± 1.0 % | 10.0 ± 1.0 % |" in out
+    assert "| two | disk/tangential | 75.0 ± 1.0 ± 5.0 % | 10.0 ± 1.0 ± 5.0 % | < 0.15 % (95 %) |" in out
+    assert "| 0.800 ± 0.004 | < 3.0e-4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
+
+
+def test_evidence_tables_write_zero_counts_of_records_without_bounds_from_their_orbit_count(tmp_path, hook):
+    """Records written before bounds were recorded (a P of 0 with error 0, a regular fraction of 0 with a Wilson
+    error): the table gives the one-sided 95 % bound from the record's number of orbits, 1 − 0.05^(1/n)."""
+    doc = {
+        "regular_fraction": [
+            {"id": "two-2-disk", "label": "two", "ics": "disk/tangential", "e_ratio": 2.0, "fraction": 0.0}
+            | {"err": 0.00025, "n": 2000}
+        ],
+        "survival_long": [{"label": "two", "e_ratio": 2.0, "t": 800.0, "P": 0.0, "P_err": 0.0}],
+        "long_time": [{"label": "two", "e_ratio": 2.0, "ics": "disk/tangential", "n": 2000}],
+        "validity_map": [
+            {"id": "two-2-disk", "label": "two", "e_ratio": 2.0, "regular_fraction": 0.0, "regular_err": 0.00025}
+            | {"kappa0_defined": True, "claim2": None, "exponential": None, "plateau": None}
+        ],
+    }
+    out = hook.evidence_tables(doc)
+    assert "0 ± 0" not in out and "0.0 ± 0.0" not in out
+    assert out.count("< 0.15 % (95 %)") == 2 and "| < 1.5e-3 (95 %) |" not in out and "| < 0.0015 (95 %) |" in out
 
 
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
@@ -622,3 +650,10 @@ def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
         "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
+
+
+def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
+    """A record with a sibling <key>_upper (a count of 0) shows its one-sided bound, never "0 ± 0"."""
+    recs = [{"t": 80.0, "sim": 0.25, "sim_err": 0.01}, {"t": 100.0, "sim": 0.0, "sim_err": None, "sim_upper": 3e-4}]
+    out = hook.spec_table(recs, (("t", "t"), ("sim", "simulated")))
+    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out

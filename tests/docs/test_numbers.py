@@ -217,3 +217,13 @@ def test_every_committed_verdict_is_written_one_way():
     for f in found:
         walk(json.loads(f.read_text()), f.relative_to(ROOT).as_posix())
     assert not ascii_minus, "\n".join(ascii_minus)
+
+
+def test_a_count_of_zero_is_written_as_its_one_sided_bound_never_zero_plus_minus_zero():
+    from hhscatter.analysis.stats.intervals import fraction_with_bound
+
+    doc = {"rows": [{"id": "a", **fraction_with_bound(0, 10000).record("P")}, {"id": "b", "P": 0.25, "P_err": 0.01}]}
+    assert nb.format_ref(doc, "rows[id=a].P", ".4f") == "< 3.0e-4 (95 %)"
+    assert nb.format_ref(doc, "rows[id=a].P", "pct") == "< 0.030 % (95 %)"
+    assert nb.format_ref(doc, "rows[id=a].P") == "< 3.0e-4 (95 %)"
+    assert nb.format_ref(doc, "rows[id=b].P", ".2f") == "0.25"  # a nonzero count keeps its number

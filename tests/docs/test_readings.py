@@ -118,6 +118,8 @@ def test_the_resc_page_names_the_tools_own_default():
         assert HenonHeiles().default_escape_radius(e) == pytest.approx(pick)
     page = (ROOT / "studies" / "resc" / "page.md").read_text()
     assert "[[resc:default_r_esc.recommended]]; that is the tool's own default" in page
+    # the reference radius is read as what it is (the study's r_ref), not as a "current default"
+    assert "default_r_esc.current" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
 
@@ -163,3 +165,17 @@ def test_the_no_drag_reading_says_below_only_beyond_two_sigma():
         "the rate over the window is σ = 0.01: κ0 within 2σ at E0 = 0.3 (z = −1.0); "
         "σ = 0.02: below κ0 at E0 = 0.3 (z = −6.0)"
     )
+
+
+def test_the_one_exponential_reading_says_too_few_orbits_where_the_pooled_test_has_no_verdict():
+    """Records of the pooled test (with ``exponential_verdict``): a cell without a p-value is "too few orbits", and
+    the caveat about nearly empty cells is replaced by the pooling rule; older records keep the caveat."""
+    rows = [
+        {"label": "a", "ics": "disk/tangential", "e_ratio": 1.05, "p_nonregular": 0.4},
+        {"label": "a", "ics": "disk/tangential", "e_ratio": 1.5, "p_nonregular": None},
+    ]
+    new = [r | {"exponential_verdict": "too few orbits" if r["p_nonregular"] is None else "yes"} for r in rows]
+    text = READINGS["generality.one_exponential"](_loader({"generality": {"systems": {"a": {}}, "long_time": new}}))
+    assert "too few orbits for the test at 1.5" in text and "pooled until each expects at least 5 orbits" in text
+    old = READINGS["generality.one_exponential"](_loader({"generality": {"systems": {"a": {}}, "long_time": rows}}))
+    assert "not tested at 1.5" in old and "a handful of orbits drives χ²" in old

@@ -27,6 +27,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import transfer as tf
+from hhscatter.analysis.stats.intervals import fraction_with_bound
 
 __all__ = [
     "t_star_distance",
@@ -232,7 +233,9 @@ def empirical_survival(t_end, leaving, grid):
 
 def survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
     """P(t) of operator and reduced operator against the simulation: values at fixed times and the rms/max
-    |ln(P/P_sim)| where P_sim·N ≥ 30 (also the time up to which that holds)."""
+    |ln(P/P_sim)| where P_sim·N ≥ 30 (also the time up to which that holds). A simulated P of 0 (no orbit of N
+    left) is written with its one-sided 95 % upper bound ``sim_upper`` and no error
+    (:func:`~hhscatter.analysis.stats.intervals.fraction_with_bound`)."""
     ok = P_sim * N >= 30
     lr = np.log(np.where(ok, P_op, 1.0) / np.where(ok, P_sim, 1.0))
     lr2 = np.log(np.where(ok, np.maximum(P_red, 1e-300), 1.0) / np.where(ok, P_sim, 1.0))
@@ -245,8 +248,11 @@ def survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
         "P_at": [
             {
                 "t": a,
-                "sim": float(P_sim[i]),
-                "sim_err": float(sig[i]),
+                **(
+                    fraction_with_bound(round(P_sim[i] * N), N).record("sim")  # none left: its 95 % bound, not 0 ± 0
+                    if P_sim[i] * N < 0.5
+                    else {"sim": float(P_sim[i]), "sim_err": float(sig[i])}
+                ),
                 "operator": float(P_op[i]),
                 "reduced": float(P_red[i]),
             }

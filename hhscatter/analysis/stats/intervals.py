@@ -1,10 +1,14 @@
-"""Binomial fractions with Wilson score intervals (model-free; used by the exit-channel and basin measures)."""
+"""Binomial fractions: Wilson score intervals (model-free; used by the exit-channel and basin measures) and a
+fraction reported with its error, or, at a count of 0 or of all, with its one-sided bound (never "0 ± 0")."""
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["wilson_interval"]
+__all__ = ["BoundedFraction", "fraction_with_bound", "wilson_interval"]
 
 
 def wilson_interval(k, n, z: float = 1.0):
@@ -28,3 +32,84 @@ def wilson_interval(k, n, z: float = 1.0):
         c = (p + z * z / (2 * n)) / d
         h = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
     return p, c - h, c + h
+
+
+@dataclass(frozen=True)
+class BoundedFraction:
+    """Result of :func:`fraction_with_bound`: a fraction k/n with its 1σ error, or its one-sided bound at k = 0 or
+    k = n.
+
+    Attributes
+    ----------
+    k, n : int
+        The count and the number of trials.
+    value : float
+        k/n.
+    err : float or None
+        The 1σ error (binomial √(f(1 − f)/n), at least the Wilson 1σ half-width) for 0 < k < n; None at k = 0 or
+        k = n, where the fraction is reported by its bound instead.
+    upper, lower : float or None
+        The one-sided bound at confidence ``cl``: ``upper`` at k = 0, ``lower`` at k = n (None otherwise).
+    cl : float
+        The confidence level of the bound.
+    """
+
+    k: int
+    n: int
+    value: float
+    err: float | None
+    upper: float | None
+    lower: float | None
+    cl: float
+
+    def record(self, prefix: str = "") -> dict:
+        """The JSON fields ``{prefix}value``-style: ``{"value", "err"}`` plus ``"upper"``/``"lower"`` and ``"cl"``
+        where the count is 0 or n (with a ``prefix`` the keys are ``prefix``, ``prefix_err``, ``prefix_upper``…).
+
+        >>> fraction_with_bound(0, 1000).record("P")
+        {'P': 0.0, 'P_err': None, 'P_upper': 0.002991, 'P_cl': 0.95}
+        """
+        key = (lambda s: f"{prefix}_{s}") if prefix else (lambda s: s)
+        out = {prefix or "value": self.value, key("err"): self.err}
+        if self.upper is not None:
+            out[key("upper")] = round(self.upper, 6)
+        if self.lower is not None:
+            out[key("lower")] = round(self.lower, 6)
+        if self.upper is not None or self.lower is not None:
+            out[key("cl")] = self.cl
+        return out
+
+
+def fraction_with_bound(k: int, n: int, *, cl: float = 0.95) -> BoundedFraction:
+    """fraction_with_bound(k, n, cl=0.95) -> BoundedFraction: the fraction k/n of n trials, with its 1σ error for
+    0 < k < n and its exact one-sided bound at confidence ``cl`` at k = 0 (upper: 1 − (1 − cl)^(1/n), the
+    Clopper–Pearson bound, ≈ 3/n at 95 %) or k = n (lower: (1 − cl)^(1/n)); a count of 0 is never "0 ± 0".
+
+    The error for 0 < k < n is the binomial √(f(1 − f)/n), at least the Wilson 1σ half-width (which stays
+    nonzero near 0 and 1).
+
+    Examples
+    --------
+    >>> f = fraction_with_bound(0, 10000)
+    >>> f.value, f.err, round(f.upper, 7)        # 1 − 0.05^(1/10000)
+    (0.0, None, 0.0002995)
+    >>> f = fraction_with_bound(250, 1000)
+    >>> round(f.err, 5), f.upper                 # √(0.25 · 0.75 / 1000)
+    (0.01369, None)
+    >>> round(fraction_with_bound(20, 20).lower, 4)
+    0.8609
+    """
+    k, n = int(k), int(n)
+    if n <= 0:
+        raise ValueError(f"n must be a positive number of trials, got {n}")
+    if not 0 <= k <= n:
+        raise ValueError(f"k must lie in [0, n] = [0, {n}], got {k}")
+    if not 0 < cl < 1:
+        raise ValueError(f"cl must lie in (0, 1), got {cl}")
+    f = k / n
+    if k == 0:
+        return BoundedFraction(k, n, 0.0, None, -math.expm1(math.log1p(-cl) / n), None, cl)
+    if k == n:
+        return BoundedFraction(k, n, 1.0, None, None, math.exp(math.log1p(-cl) / n), cl)
+    wilson = math.sqrt(f * (1 - f) / n + 1 / (4 * n * n)) / (1 + 1 / n)
+    return BoundedFraction(k, n, f, max(math.sqrt(f * (1 - f) / n), wilson), None, None, cl)

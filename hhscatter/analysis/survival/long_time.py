@@ -12,10 +12,15 @@ q the fraction of them that never escapes (P∞ = q·P(t0) of all orbits) and κ
 contributes the density (1 − q) κ e^{−κ(t − t0)}, an orbit still inside at its censoring time c the survival
 P(c | t0). Censored orbits enter the likelihood as what they are, so the rate is not conditioned on escaping
 before t_max (the bias of fitting only the escaping orbits, whose hazard rises towards t_max). Errors from the
-inverse of the observed information (numerical Hessian of the log-likelihood at the optimum); the goodness of fit
-is Pearson's χ² of the escapes in ``n_bins`` time bins of equal expected counts plus the orbits still inside,
-against the fitted model (dof = cells − 1 − number of fitted parameters), valid when every orbit is censored at
-one t_max (the runs here: γ = 0). With ``plateau=False``, q = 0 (a single exponential from t0).
+inverse of the observed information (numerical Hessian of the log-likelihood at the optimum); P∞ = q·P(t0)
+carries both errors, q's and the binomial (Greenwood) error of P(t0): σ(P∞)² = (P(t0) σ_q)² + (q σ_P(t0))² (q is
+fitted on the orbits inside at t0, given their number, so the two are independent). The goodness of fit is
+Pearson's χ² of the escapes in ``n_bins`` time bins of equal expected counts plus the orbits still inside,
+against the fitted model, with adjacent cells pooled until each expects at least 5 orbits (the tail cell joins
+its neighbour: :func:`hhscatter.analysis.stats.goodness.pooled_pearson`) and dof = pooled cells − 1 − number of
+fitted parameters; with no degree of freedom left the test says "too few orbits" (``too_few``, p NaN). Valid
+when every orbit is censored at one t_max (the runs here: γ = 0). With ``plateau=False``, q = 0 (a single
+exponential from t0).
 
 :func:`survival_at` gives Kaplan–Meier P(t) and its Greenwood error at chosen times, :func:`hazard_profile` the
 censoring-aware hazard per time bin (escapes over orbit-time at risk,
@@ -56,17 +61,25 @@ class PlateauFit:
         Fraction of the orbits inside at t0 that never escape, and its 1σ error (q = 0 with ``plateau=False``;
         q = 0 with a NaN error where the fitted plateau lies at its boundary 0, as when no orbit after t0 is
         censored: the likelihood then falls with q and its maximum is q = 0).
+    p_t0_err : float
+        The Greenwood (binomial, without censoring before t0) 1σ error of ``p_t0``.
     p_inf, p_inf_err : float
-        P∞ = q·P(t0): the plateau as a fraction of all orbits.
+        P∞ = q·P(t0): the plateau as a fraction of all orbits, its error from q's and P(t0)'s.
     kappa, kappa_err : float
         κ∞ (1/time) of the escaping part, and its 1σ error.
     chi2, dof : float, int
-        Pearson χ² of the binned escapes and the orbits still inside against the model, and its degrees of freedom.
+        Pearson χ² of the binned escapes and the orbits still inside against the model (cells pooled to expected
+        counts ≥ 5), and its degrees of freedom after pooling; χ² NaN when ``too_few``.
+    p_value : float
+        P(χ²_dof ≥ chi2); NaN when ``too_few``.
+    too_few : bool
+        True when the pooled cells leave no degree of freedom: too few orbits for a goodness-of-fit verdict.
     """
 
     t0: float
     n_at_risk: int
     p_t0: float
+    p_t0_err: float
     q: float
     q_err: float
     p_inf: float
@@ -75,6 +88,8 @@ class PlateauFit:
     kappa_err: float
     chi2: float
     dof: int
+    p_value: float
+    too_few: bool
 
     @property
     def chi2_red(self) -> float:
@@ -174,20 +189,24 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
         q, kappa = 0.0, float(k_start)  # the exponential's MLE: escapes over orbit-time at risk
         q_err, k_err = 0.0, kappa / math.sqrt(esc.sum())
         n_par = 1
-    chi2, dof = _pearson(s, esc, q, kappa, n_bins, n_par)
-    p_t0 = _km_at(t, obs, t0)
+    g = _pearson(s, esc, q, kappa, n_bins, n_par)
+    P0, P0_err = survival_at(t, obs, [t0])
+    p_t0, p_t0_err = float(P0[0]), float(P0_err[0])
     return PlateauFit(
         t0=float(t0),
         n_at_risk=n,
         p_t0=p_t0,
+        p_t0_err=p_t0_err,
         q=float(q),
         q_err=float(q_err),
         p_inf=float(q * p_t0),
-        p_inf_err=float(q_err * p_t0),
+        p_inf_err=float(math.hypot(q_err * p_t0, q * p_t0_err)),
         kappa=float(kappa),
         kappa_err=float(k_err),
-        chi2=chi2,
-        dof=dof,
+        chi2=g.chi2,
+        dof=g.dof,
+        p_value=g.p_value,
+        too_few=g.too_few,
     )
 
 
@@ -199,13 +218,16 @@ def _km_at(t, obs, t0) -> float:
 
 def _pearson(s, esc, q, kappa, n_bins, n_par):
     """Pearson χ² of the escapes in n_bins bins (edges at the fitted model's quantiles of the escape time, up to the
-    earliest censoring) and the orbits still inside there, against q + (1 − q) e^{−κs}."""
+    earliest censoring) and the orbits still inside there, against q + (1 − q) e^{−κs}, cells pooled to expected
+    counts ≥ 5 (:func:`~hhscatter.analysis.stats.goodness.pooled_pearson`)."""
+    from hhscatter.analysis.stats.goodness import PooledPearson, pooled_pearson  # deferred: scipy on first use
+
     n = s.size
     c = float(s[~esc].min()) if (~esc).any() else float(s.max())
     S = lambda x: q + (1 - q) * np.exp(-kappa * x)  # noqa: E731
     p_esc = 1 - S(c)
     if p_esc <= 0:
-        return math.nan, 0
+        return PooledPearson(math.nan, 0, math.nan, 0, True)
     levels = 1 - np.linspace(0, p_esc, n_bins + 1)[1:-1]  # S at the inner edges
     inner = -np.log((levels - q) / (1 - q)) / kappa
     edges = np.concatenate([[0.0], inner, [c]])
@@ -214,9 +236,7 @@ def _pearson(s, esc, q, kappa, n_bins, n_par):
     inside_obs, inside_exp = float((s > c).sum() + (~esc & (s <= c)).sum()), n * S(c)
     o = np.append(obs_counts, inside_obs)
     e = np.append(exp_counts, inside_exp)
-    keep = e > 0
-    chi2 = float((((o - e) ** 2)[keep] / e[keep]).sum())
-    return chi2, int(keep.sum() - 1 - n_par)
+    return pooled_pearson(o, e, n_fitted=n_par)
 
 
 def survival_at(t_end, observed, times) -> tuple[np.ndarray, np.ndarray]:
@@ -301,8 +321,6 @@ def rate_status(
     >>> rate_status(t, np.ones(t.size, bool), 1e6, 2e6).status     # every orbit left before τ0
     'empty'
     """
-    from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
-
     from hhscatter.analysis.survival.kappa_conventions import plateau_check  # deferred: kept off import time
 
     t = np.asarray(t_end, dtype=float).ravel()
@@ -330,8 +348,7 @@ def rate_status(
     except ValueError:
         plat = (nan, nan, nan, nan)
     try:
-        single = fit_plateau_exponential(t, obs, tau0, plateau=False)
-        p = float(chi2_dist.sf(single.chi2, single.dof)) if single.dof > 0 else nan
+        p = fit_plateau_exponential(t, obs, tau0, plateau=False).p_value
     except ValueError:
         p = nan
     if not defined:

@@ -200,7 +200,7 @@ def _ensemble_evidence(runs, label, head, ics, r, t_from, grid):
     at = {"id": f"{label}-{r:g}-{ics}", **head, "e_ratio": r, "ics": name}
     reg = {
         **at,
-        **evidence.regular_record(lt, ind),
+        **evidence.regular_record(lt, ind, p.ev_g_max),
         "indicator": INDICATOR,
         "t_from": t_from,
         "g_max": p.ev_g_max,

@@ -21,6 +21,8 @@ Examples
 >>> ind = pd.DataFrame({"traj_id": [2, 3], "regular": [True, False], "kind": ["regular", "chaotic"]})
 >>> regular_record(lt, ind)["fraction"]
 0.25
+>>> regular_record(lt, ind.assign(regular=False))["fraction_upper"]     # none regular of 4: a bound, not 0 ± 0
+0.527129
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ import math
 
 import numpy as np
 
-from hhscatter.analysis.geometry.regularity import regular_fraction
+from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
+from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
     hazard_profile,
@@ -38,26 +41,37 @@ from hhscatter.analysis.survival.long_time import (
 
 #: P-value below which one exponential is rejected for the non-regular orbits
 EXP_REJECT_P = 1e-3
+#: the verdict of a goodness-of-fit test with no degree of freedom left after pooling (or too few orbits to fit)
+TOO_FEW = "too few orbits"
 
 
 def _finite(x):
     return None if x is None or not math.isfinite(float(x)) else float(x)
 
 
-def regular_record(lifetimes, indicator) -> dict:
-    """regular_record(lifetimes, indicator) -> {fraction, err, n, n_regular, n_chaotic, n_none, n_escaped_before}.
+def regular_record(lifetimes, indicator, g_max: float = G_MAX) -> dict:
+    """regular_record(lifetimes, indicator, g_max=1e4) -> {fraction, err, fraction_upper, fraction_cl, syst,
+    by_threshold, n, n_regular, n_chaotic, n_none, n_escaped_before}.
 
     ``lifetimes``: the ensemble's traj_id, t_end, outcome; ``indicator``: :func:`shadow_indicator`'s frame for the
-    orbits still inside at the window's start (traj_id, regular, kind). Orbits without an indicator row left before
-    the window: not regular. ``n_none``: inside at the window's start but crossing the section in neither run
-    (their type undetermined; counted as not regular, and said).
+    orbits still inside at the window's start (traj_id, regular, kind, growth) at threshold ``g_max``. Orbits
+    without an indicator row left before the window: not regular. ``n_none``: inside at the window's start but
+    crossing the section in neither run (their type undetermined; counted as not regular, and said). The fraction
+    by :func:`~hhscatter.analysis.stats.intervals.fraction_with_bound` (no error but a one-sided 95 % bound
+    ``fraction_upper`` at a count of 0); ``syst`` the shift under a threshold a decade either side
+    (:func:`~hhscatter.analysis.geometry.regularity.threshold_systematic`; ``by_threshold`` the fractions).
     """
     n = len(lifetimes)
     n_reg = int(indicator["regular"].sum())
-    f, e = regular_fraction(n, n_reg)
+    b = fraction_with_bound(n_reg, n)
+    growth = indicator["growth"] if "growth" in indicator else indicator["regular"].map({True: 0.0, False: np.inf})
+    ts = threshold_systematic(n, growth.to_numpy(float), g_max)
     return {
-        "fraction": f,
-        "err": e,
+        "fraction": b.value,
+        "err": b.err,
+        **{f"fraction_{k}": v for k, v in b.record().items() if k in ("upper", "lower", "cl")},
+        "syst": ts["syst"],
+        "by_threshold": [{"g_max": g, "fraction": f} for g, f in ts["by_threshold"].items()],
         "n": n,
         "n_regular": n_reg,
         "n_chaotic": int((indicator["kind"] == "chaotic").sum()),
@@ -71,15 +85,16 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
 
     P rows: {t, P, P_err} of all orbits at ``times`` (time units). Fit record: the plateau-plus-exponential fit from
     ``t0`` of all orbits (p_inf, kappa_inf, errors, chi2, dof), the censored and regular fractions at t_max, and the
-    non-regular orbits alone (all minus ``regular_ids``): single exponential from t0 (kappa_nonregular, χ², p-value,
-    ``exponential`` True when p ≥ EXP_REJECT_P) and their hazard per bin of ``hazard_edges``.
+    non-regular orbits alone (all minus ``regular_ids``): single exponential from t0 (kappa_nonregular, χ² of cells
+    pooled to expected counts ≥ 5, p-value, ``exponential`` True when p ≥ EXP_REJECT_P, ``exponential_verdict``
+    'yes', 'no' or 'too few orbits' when no degree of freedom is left) and their hazard per bin of
+    ``hazard_edges``. A P of 0 carries its one-sided 95 % bound ``P_upper`` instead of an error; so does a P∞ of 0
+    with no orbit inside at t_max (``P_inf_upper``).
     """
-    from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
-
     t = lifetimes["t_end"].to_numpy(float)
     obs = (lifetimes["outcome"].astype(str) != "censored").to_numpy()
     P, Pe = survival_at(t, obs, times)
-    rows = [{"t": float(a), "P": float(b), "P_err": float(c)} for a, b, c in zip(times, P, Pe)]
+    rows = [_p_row(float(a), float(b), float(c), t, obs) for a, b, c in zip(times, P, Pe)]
     reg = lifetimes["traj_id"].isin(np.asarray(regular_ids)).to_numpy()
     rec = {
         "t0": float(t0),
@@ -89,6 +104,9 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     }
     try:
         f = fit_plateau_exponential(t, obs, t0)
+        if f.p_inf == 0 and obs.all():  # no plateau fitted and none inside at t_max: P∞ below the 0-of-N bound
+            zero = fraction_with_bound(0, t.size).record("P_inf")
+            rec.update({k: v for k, v in zero.items() if k in ("P_inf_upper", "P_inf_cl")})
         rec.update(
             P_inf=f.p_inf,
             P_inf_err=_finite(f.p_inf_err),
@@ -103,23 +121,36 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     tn, on = t[~reg], obs[~reg]
     try:
         g = fit_plateau_exponential(tn, on, t0, plateau=False)
-        p = float(chi2_dist.sf(g.chi2, g.dof)) if g.dof > 0 else None
+        p = None if g.too_few else float(g.p_value)
         rec.update(
             kappa_nonregular=g.kappa,
             kappa_nonregular_err=g.kappa_err,
-            chi2_nonregular=g.chi2,
+            chi2_nonregular=_finite(g.chi2),
             dof_nonregular=g.dof,
             p_nonregular=p,
             exponential=None if p is None else bool(p >= EXP_REJECT_P),
+            exponential_verdict=TOO_FEW if p is None else ("yes" if p >= EXP_REJECT_P else "no"),
         )
     except ValueError as exc:
-        rec.update(kappa_nonregular=None, exponential=None, reason_nonregular=str(exc))
+        rec.update(kappa_nonregular=None, exponential=None, exponential_verdict=TOO_FEW, reason_nonregular=str(exc))
     h = hazard_profile(tn, on, hazard_edges)
     rec["hazard_nonregular"] = [
         {"t_lo": float(a), "t_hi": float(b), "hazard": _finite(c), "err": _finite(d), "events": int(e)}
         for a, b, c, d, e in h[["t_lo", "t_hi", "hazard", "hazard_err", "events"]].itertuples(index=False)
     ]
     return rows, rec
+
+
+def _p_row(t: float, P: float, P_err: float, t_end, observed) -> dict:
+    """{t, P, P_err} of one time; where no orbit is left (P = 0) or none has left (P = 1), P's one-sided 95 % bound
+    from the orbits not censored before t (:func:`~hhscatter.analysis.stats.intervals.fraction_with_bound`:
+    P = k/n exactly when no orbit is censored before t, as in runs censored at t_max only) and no error."""
+    if P_err > 0 or P not in (0.0, 1.0):
+        return {"t": t, "P": P, "P_err": P_err}
+    n = int(((t_end >= t) | observed).sum())
+    if n == 0:
+        return {"t": t, "P": P, "P_err": None}
+    return {"t": t, **fraction_with_bound(0 if P == 0 else n, n).record("P")}
 
 
 def decay_curves(lifetimes, regular_ids, grid):
@@ -143,7 +174,8 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
     Fields: regular_fraction (± err); kappa0_defined (claim 1: κ0 defined under the paper's convention, all orbits
     with plateau windows, from the claims' ``kappa`` records at that E/E_c; None where that energy was not on the
     claims' grid); claim2 (claim 2's verdict at that E/E_c, paper's convention, where tested); exponential (one
-    exponential describes the non-regular orbits from t0, from ``fits``); plateau (P∞ > 3σ, from ``fits``).
+    exponential describes the non-regular orbits from t0, from ``fits``; None with ``exponential_verdict`` 'too
+    few orbits' where the test has no degree of freedom); plateau (P∞ > 3σ, from ``fits``).
     """
     out = []
     fit_at = {(f["system"], round(f["e_ratio"], 6)): f for f in fits if f.get("ics") == ics}
@@ -174,9 +206,12 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
                 "ics": ics,
                 "regular_fraction": r["fraction"],
                 "regular_err": r["err"],
+                **({"regular_fraction_upper": r["fraction_upper"]} if r.get("fraction_upper") is not None else {}),
+                "regular_syst": r.get("syst"),
                 "kappa0_defined": bool(k[0]["defined"]) if k else None,
                 "claim2": c2[0]["verdict"] if c2 else None,
                 "exponential": f.get("exponential"),
+                "exponential_verdict": f.get("exponential_verdict"),
                 "plateau": None if pinf is None or perr is None else bool(pinf > 3 * perr),
             }
         )

@@ -86,3 +86,48 @@ def test_regular_fraction_error_is_binomial_and_never_zero():
     f, e = regular_fraction(10000, 2500)
     assert f == 0.25 and abs(e - np.sqrt(0.25 * 0.75 / 1e4)) < 1e-6
     assert regular_fraction(10000, 0)[1] > 1e-5
+
+
+def test_threshold_systematic_is_the_largest_shift_over_the_thresholds():
+    from hhscatter.analysis.geometry.regularity import threshold_systematic
+
+    growth = np.array([5.0, 2e3, 2e3, 3e4, 3e4, 3e4, 1e9, np.inf, np.nan])
+    r = threshold_systematic(100, growth)
+    # below 1e3: 1, below 1e4: 3, below 1e5: 6 of 100
+    assert r["by_threshold"] == {1e3: 0.01, 1e4: 0.03, 1e5: 0.06}
+    assert (
+        r["value"] == 0.03
+        and r["syst"] == pytest.approx(0.03)
+        and r["stat"] == pytest.approx((0.03 * 0.97 / 100 + 1 / 4e4) ** 0.5 / 1.01)  # Wilson 1σ half-width
+    )
+    with pytest.raises(ValueError, match="n_orbits"):
+        threshold_systematic(3, growth)
+
+
+#: section ICs (x = 0, p_y = 0, y below) at E = 1/8 at the edges of three islands: the band where the indicator's
+#: growth lies between a torus' (~1) and the saturated chaotic sea's (~1e8), sticky orbits among them
+BAND_YS = (-0.4155, -0.4145, -0.2745, -0.2735, -0.1265, -0.1255, -0.1155, -0.1145, -0.1135)
+
+
+@pytest.mark.slow
+def test_threshold_agrees_with_a_long_reference_on_orbits_spanning_the_ambiguous_band():
+    """Labels from an independent integration 1.5 times longer than the indicator's (scipy, variational equations,
+    T = 3000): regular where λ_T < 0.003 (a growth below ~10⁴ over T: shear), chaotic where λ_T > 0.005 (above
+    ~3·10⁶), undecided between. The indicator at t ≥ 1900 (as the generality study runs it) agrees with every
+    decided label at its threshold and at a decade either side (the thresholds of the systematic)."""
+    T, t_from, T_ref = 2000.0, 1900.0, 3000.0
+    ics = _section_ics(np.array(BAND_YS))
+    ref = np.array([_ftle_reference(z, T_ref) for z in ics])
+    label = np.where(ref < 0.003, "regular", np.where(ref > 0.005, "chaotic", "undecided"))
+    decided = label != "undecided"
+    assert decided.sum() >= 8 and (label == "regular").sum() >= 3 and (label == "chaotic").sum() >= 3
+    sc = Scene(energy=0.2, n=len(ics), t_max=T, sections=SectionWindow(t_from=t_from, t_to=T))
+    sh, d0 = shadow_ics(ics, _V)
+    base = pd.DataFrame(run_chunk(sc, ics, np.arange(len(ics))).sections)
+    shadow = pd.DataFrame(run_chunk(sc, sh, np.arange(len(ics))).sections)
+    ind = shadow_indicator(base, shadow, np.arange(len(ics)), d0, t_from)
+    g = ind["growth"].to_numpy()
+    assert ((g > 10) & (g < 1e7)).sum() >= 3  # the set spans the band between tori and the saturated sea
+    for g_max in (G_MAX / 10, G_MAX, G_MAX * 10):
+        called = np.where(g < g_max, "regular", "chaotic")
+        assert (called[decided] == label[decided]).all(), (g_max, list(zip(BAND_YS, ref, g)))

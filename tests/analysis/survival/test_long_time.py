@@ -116,3 +116,45 @@ def test_rate_status_with_every_orbit_gone_before_the_window_end_has_no_plateau(
     t = np.random.default_rng(4).exponential(5.0, 2000)
     st = rate_status(t, np.ones(t.size, bool), 1.0, 10 * t.max())
     assert st.status == "exponential" and "inf" not in st.note
+
+
+def test_one_orbit_left_in_a_tail_cell_expecting_1e_5_does_not_decide_the_fit():
+    # an exponential sample with one orbit still inside at t_max, where one exponential expects ~1e-5 of them
+    rng = np.random.default_rng(21)
+    kappa, t_max, n = 0.024, 800.0, 2000
+    t = np.append(rng.exponential(1 / kappa, n - 1), np.inf)
+    obs = t < t_max
+    f = fit_plateau_exponential(np.minimum(t, t_max), obs, 0.0, plateau=False)
+    expected_inside = n * math.exp(-f.kappa * t_max)
+    assert 1e-7 < expected_inside < 1e-3 and (~obs).sum() == 1  # unpooled, that cell alone adds ~1/expected
+    assert not f.too_few and f.chi2 < 30 and f.p_value > 1e-3
+
+
+def test_p_values_of_one_exponential_are_uniform_over_seeds():
+    # 200 exponential samples whose tail cell expects < 5 orbits: rejections at 5 % within binomial bounds
+    p = []
+    for seed in range(200):
+        t, obs = _sample(300, 0.0, 0.06, 100.0, 1000 + seed)
+        f = fit_plateau_exponential(t, obs, 0.0, plateau=False)
+        assert not f.too_few and f.dof >= 5
+        p.append(f.p_value)
+    p = np.array(p)
+    assert 2 <= int((p < 0.05).sum()) <= 20  # 10 expected, binomial 1σ 3.1
+    assert 0.38 < float((p < 0.5).mean()) < 0.62
+
+
+def test_a_handful_of_orbits_gives_too_few_not_a_verdict():
+    t, obs = _sample(12, 0.0, 0.05, 400.0, 3)
+    f = fit_plateau_exponential(t, obs, 0.0, plateau=False)
+    assert f.too_few and math.isnan(f.p_value) and f.dof < 1
+
+
+def test_p_inf_error_carries_the_binomial_error_of_p_t0():
+    # 8 % of 2000 orbits never leave, the others leave fast (κ = 0.05) so P∞ is close to a binomial count:
+    # σ ≈ √(0.08 · 0.92 / 2000) = 0.0061, where q's error alone times P(t0) gives ≈ 0.0017
+    binom = math.sqrt(0.08 * 0.92 / 2000)
+    fits = [fit_plateau_exponential(*_sample(2000, 0.08, 0.05, 1000.0, 300 + s), 100.0) for s in range(100)]
+    p_inf = np.array([f.p_inf for f in fits])
+    err = float(np.median([f.p_inf_err for f in fits]))
+    assert err == pytest.approx(binom, rel=0.1)
+    assert 0.8 < p_inf.std(ddof=1) / err < 1.25  # the Monte Carlo spread over 100 samples

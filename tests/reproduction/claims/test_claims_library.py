@@ -5,10 +5,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from hhscatter.model.spec import system_from_spec
 from hhscatter.reproduction.claims.dissipative import claim6
-from hhscatter.reproduction.claims.evidence import first_below, long_time_record, validity_map
+from hhscatter.reproduction.claims.evidence import first_below, long_time_record, regular_record, validity_map
 from hhscatter.reproduction.claims.kappa import kappa_rows
 from hhscatter.reproduction.claims.records import Claims
 
@@ -75,6 +76,31 @@ def test_long_time_record_separates_regular_orbits_from_the_decay():
     assert rows[1]["P"] > 0.3 and abs(rec["P_inf"] - 0.3) < 4 * rec["P_inf_err"]
     assert abs(rec["kappa_nonregular"] - 0.004) < 4 * rec["kappa_nonregular_err"] and rec["exponential"]
     assert rec["regular_fraction_of_censored"] > 0.9
+
+
+def test_long_time_record_gives_a_bound_where_no_orbit_is_left_and_says_too_few():
+    rng = np.random.default_rng(8)
+    t = rng.exponential(20.0, 2000)  # every orbit gone long before t = 2000, none censored
+    lt = _lt(t, censored=[])
+    rows, rec = long_time_record(lt, [], [100.0, 2000.0], 1.0, [1.0, 1000.0, 2000.0])
+    assert rows[1]["P"] == 0 and rows[1]["P_err"] is None
+    assert rows[1]["P_upper"] == pytest.approx(1 - 0.05 ** (1 / 2000), abs=1e-6) and rows[1]["P_cl"] == 0.95
+    assert rec["P_inf"] == 0 and rec["P_inf_upper"] == pytest.approx(1 - 0.05 ** (1 / 2000), abs=1e-6)
+    # a handful of non-regular orbits after t0: neither "one exponential" nor "not one": too few orbits
+    few = _lt(np.concatenate([rng.exponential(5.0, 1988), 100.0 + rng.exponential(50.0, 12)]), censored=[])
+    _, rec = long_time_record(few, [], [100.0], 100.0, [100.0, 1000.0])
+    assert rec["exponential"] is None and rec["exponential_verdict"] == "too few orbits"
+
+
+def test_regular_record_carries_the_threshold_systematic_and_a_bound_at_zero():
+    lt = _lt(np.full(1000, 2000.0), censored=np.arange(1000))
+    ind = pd.DataFrame({"traj_id": np.arange(6), "growth": [10.0, 5e3, 2e4, 5e4, 1e9, np.inf]})
+    ind = ind.assign(regular=ind["growth"] < 1e4, kind=np.where(ind["growth"] < 1e4, "regular", "chaotic"))
+    r = regular_record(lt, ind)
+    assert r["fraction"] == 0.002 and r["syst"] == pytest.approx(0.002)  # 1 below 1e3, 4 below 1e5
+    assert "fraction_upper" not in r and r["err"] > 0
+    r0 = regular_record(lt, ind.assign(regular=False, growth=np.inf))
+    assert r0["fraction"] == 0 and r0["err"] is None and r0["fraction_upper"] == pytest.approx(0.002991, abs=1e-6)
 
 
 def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
