@@ -32,6 +32,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
 from hhscatter.studies.keys import RunKeys, number_key
 
@@ -205,12 +206,9 @@ def _reactivation(study, runs):
         "escaped_fraction_T0": float(esc0.mean()),
         "t_settled_99": t_settled,
         "tail_window": [p.react_tail_start, sc.t_max],
-        "tail_rate": {"value": tail.rate, "err": tail.rate_err},
-        "thermal_rate": {"value": k_well.rate, "err": k_well.rate_err},
-        "tail_over_thermal": {
-            "value": tail.rate / k_well.rate,
-            "err": tail.rate / k_well.rate * math.hypot(tail.rate_err / tail.rate, k_well.rate_err / k_well.rate),
-        },
+        "tail_rate": Measured(tail.rate, tail.rate_err).to_dict(),
+        "thermal_rate": Measured(k_well.rate, k_well.rate_err).to_dict(),
+        "tail_over_thermal": (Measured(tail.rate, tail.rate_err) / Measured(k_well.rate, k_well.rate_err)).to_dict(),
         "model_max_deviation": float(dev[i]),
         "model_max_deviation_at": float(grid[i]),
         "model_max_deviation_sigma": float(dev[i] / P_T.P_err[i]) if P_T.P_err[i] > 0 else math.inf,
@@ -233,9 +231,8 @@ def _no_drag(study, runs):
                 base = m
             row = {"energy": E, "sigma": s, "kappa": m.kappa, "kappa_err": m.kappa_err, "n_events": m.n_events}
             if base is not None:
-                r = m.kappa / base.kappa
-                row["kappa_over_kappa0"] = r
-                row["kappa_over_kappa0_err"] = r * math.hypot(m.kappa_err / m.kappa, base.kappa_err / base.kappa)
+                r = Measured(m.kappa, m.kappa_err) / Measured(base.kappa, base.kappa_err)
+                row["kappa_over_kappa0"], row["kappa_over_kappa0_err"] = r.value, r.err
                 # energy gained by diffusion over the window: ⟨E⟩ grows by σ² t (two degrees of freedom)
                 row["energy_gain_at_window_end"] = s * s * hi
             rows.append(row)

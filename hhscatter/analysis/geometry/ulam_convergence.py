@@ -24,6 +24,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.geometry.ulam import saddle_kappa, sample_transitions
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
 
 __all__ = [
@@ -165,8 +166,7 @@ def residuals(value, err, ref, ref_err) -> dict:
     """
     value, err, ref, ref_err = (float(v) for v in (value, err, ref, ref_err))
     res = value / ref - 1.0
-    # the ratio's error from both: σ_r/r in quadrature, r = κ/κ_ref
-    res_err = (value / ref) * math.hypot(err / value, ref_err / ref)
+    res_err = (Measured(value, err) / Measured(ref, ref_err)).err  # the error of r = κ/κ_ref
     sig = math.hypot(err, ref_err)
     return {"residual": res, "residual_err": res_err, "z": (value - ref) / sig if sig > 0 else math.inf}
 

@@ -74,7 +74,7 @@ class Measured:
 
     @classmethod
     def of(cls, value, err, method: str = "", n: int | None = None) -> Measured:
-        """Measured with value and err as Python floats (``None`` err: nan), e.g. from numpy scalars.
+        """Measured with value and err as Python floats (``None``: nan, not measured), e.g. from numpy scalars.
 
         Examples
         --------
@@ -82,7 +82,7 @@ class Measured:
         >>> Measured.of(np.float64(2.0), None)
         Measured(value=2.0, err=nan, method='', n=None)
         """
-        return cls(float(value), math.nan if err is None else float(err), method, n)
+        return cls(math.nan if value is None else float(value), math.nan if err is None else float(err), method, n)
 
     @property
     def rel_err(self) -> float:

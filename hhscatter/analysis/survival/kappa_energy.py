@@ -17,6 +17,7 @@ from scipy import optimize
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 
@@ -286,8 +287,7 @@ def kappa_law_summary(fit) -> dict:
     for i, name in enumerate(("a", "b", "c", "E_b")):
         cov_err = getattr(fit, f"{name}_err")
         out[name] = {
-            "value": float(getattr(fit, name)),
-            "err": float(max(cov_err, boot[i])),
+            **Measured.of(getattr(fit, name), max(cov_err, boot[i])).to_dict(),
             "err_cov": float(cov_err),
             "err_boot": float(boot[i]),
         }
