@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-__all__ = ["Measured"]
+__all__ = ["Measured", "WithErrors"]
 
 
 def _as_measured(x) -> Measured:
@@ -188,3 +189,34 @@ class Measured:
     __mul__ = product
     __sub__ = difference
     __add__ = sum
+
+
+class WithErrors:
+    """Mixin of an estimator's result whose estimates are fields ``x`` with their 1σ ``x_err``:
+    ``result.measured("x")`` is the :class:`Measured` of ``x`` (the result's method, its number of units).
+
+    A result class sets ``method`` (what made its estimates) and ``n_field`` (the field counting the independent
+    units behind them, or None).
+
+    Examples
+    --------
+    >>> @dataclass(frozen=True)
+    ... class Rate(WithErrors):
+    ...     method: ClassVar[str] = "MLE"
+    ...     n_field: ClassVar[str] = "n_events"
+    ...     kappa: float
+    ...     kappa_err: float
+    ...     n_events: int
+    >>> Rate(0.2, 0.01, 400).measured("kappa")
+    Measured(value=0.2, err=0.01, method='MLE', n=400)
+    """
+
+    method: ClassVar[str] = ""
+    n_field: ClassVar[str | None] = None
+
+    def measured(self, name: str) -> Measured:
+        """The :class:`Measured` of the estimate ``name`` (a field with a ``<name>_err`` field beside it)."""
+        if not hasattr(self, f"{name}_err"):
+            raise AttributeError(f"{type(self).__name__} has no estimate {name!r} with an error {name}_err")
+        n = getattr(self, self.n_field) if self.n_field else None
+        return Measured(getattr(self, name), getattr(self, f"{name}_err"), self.method or type(self).__name__, n)

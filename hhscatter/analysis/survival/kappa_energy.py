@@ -17,7 +17,7 @@ from scipy import optimize
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
-from hhscatter.analysis.stats.measured import Measured
+from hhscatter.analysis.stats.measured import Measured, WithErrors
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 
@@ -26,7 +26,7 @@ __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 # κ(E): piecewise law of Fig. 2b
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class KappaEnergyFit:
+class KappaEnergyFit(WithErrors):
     """Result of :func:`fit_kappa_energy`; with x = E − E_c,
 
         κ = a x² + b x   for E < E_b   (non-linear regime),
@@ -38,6 +38,8 @@ class KappaEnergyFit:
     (``boot_err``, same order; ``boot`` holds the replicates).  ``continuous``
     tells which model was fitted (then c = a x_b + b).  ``chi2``/``dof`` of the best fit.
     """
+
+    method = "weighted least squares of κ(E)"
 
     a: float
     b: float

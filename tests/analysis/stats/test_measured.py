@@ -92,3 +92,23 @@ def test_propagation_agrees_with_a_monte_carlo_sample(op):
 
 def test_z_is_the_distance_in_combined_sigma():
     assert Measured(1.3, 0.3).z(1.0, 0.4) == pytest.approx(0.3 / 0.5)
+
+
+def test_an_estimator_result_gives_its_estimates_as_measured():
+    """The MLE escape rate of exponential lifetimes, all escaped inside the window: κ = n / Σt, σ = κ/√n."""
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+
+    t = np.random.default_rng(3).exponential(10.0, 400)
+    m = escape_rate_mle(t, np.ones(t.size, bool), 0.0, float(t.max()) + 1.0).measured("kappa")
+    kappa = 400 / t.sum()
+    assert m.value == pytest.approx(kappa, rel=1e-12)
+    assert m.err == pytest.approx(kappa / math.sqrt(400), rel=1e-12)
+    assert (m.n, m.method) == (400, "maximum likelihood (events / exposure)")
+
+
+def test_a_result_without_that_estimate_is_refused():
+    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+
+    t = np.array([1.0, 2.0, 3.0])
+    with pytest.raises(AttributeError, match="n_events"):
+        escape_rate_mle(t, np.ones(3, bool), 0.0, 5.0).measured("n_events")
