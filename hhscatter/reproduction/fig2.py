@@ -18,9 +18,10 @@ Examples
 
 from __future__ import annotations
 
-from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.analysis.survival.kappa_conventions import LAW_PARAMETERS
 from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
+from hhscatter.reproduction.verdicts import quoted_verdict
 
 __all__ = [
     "FIG2_CONVENTIONS",

@@ -374,7 +374,8 @@ def _fig2_kappa(study, inputs):
 def kappa_part(study, inputs):
     """κ at every Ulam energy: {results per E, records (kappa_ulam), convergence (kappa_convergence), mixed
     (mixed phase space), rows (κ per partition), grids (the extrapolation grids and their replicates), kappa0}."""
-    from hhscatter.analysis.stats.verdicts import SMOKE_SCALES, verdict
+    from hhscatter.analysis.stats.verdicts import verdict
+    from hhscatter.reproduction.verdicts import SMOKE_SCALES
 
     kappa0, kappa_cm = _fig2_kappa(study, inputs)
     not_smoke = study.scale not in SMOKE_SCALES  # a smoke-test scale states no verdicts

@@ -13,7 +13,7 @@ from hhscatter.reproduction.model_tables import number_or_none
 
 def z_verdict(value, err, ref, label_ok, label_bad, ref_err=0.0) -> str:
     """z_verdict(value, err, ref, label_ok, label_bad, ref_err=0) -> '<label> (z = …)' by the one rule
-    (:data:`hhscatter.analysis.stats.verdicts.RULE`): |z| ≤ 2 is ``label_ok``, z = (value − ref)/√(err² + ref_err²),
+    (:data:`hhscatter.reproduction.verdicts.RULE`): |z| ≤ 2 is ``label_ok``, z = (value − ref)/√(err² + ref_err²),
     written as every verdict is (:meth:`~hhscatter.analysis.stats.verdicts.Verdict.text`, minus sign "−"); without a
     value, a reference or our error, "undetermined: <why>".
 
