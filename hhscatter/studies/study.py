@@ -122,7 +122,7 @@ class Study:
     info: StudyInfo | None = None
     orbits_run: int = 0  # orbits integrated by this process's run() calls (the cost record)
     chunks_resumed: int = 0  # chunks found complete and kept by run()
-    params_model: type | None = None  # the study's Params (hhscatter.scene.schema.StudyParams) of its [study] table
+    params_model: type | None = None  # the study's Params (hhscatter.studies.params.StudyParams) of its [study] table
     raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
     params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
 

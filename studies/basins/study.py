@@ -39,7 +39,8 @@ import pandas as pd
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction import basin_summary as bs
 from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, outcome_codes
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 
 

@@ -61,7 +61,8 @@ from hhscatter.reproduction.fig3 import (
     nearest_times,
     paper_fit,
 )
-from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, Text
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 

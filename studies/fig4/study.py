@@ -55,8 +55,9 @@ from hhscatter.reproduction.transition_tables import (
     transition_comparisons,
     transition_table,
 )
-from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 

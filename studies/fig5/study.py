@@ -76,8 +76,9 @@ from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction import cmeasure_comparison as cc
 from hhscatter.reproduction import cmeasure_verdicts as cv
 from hhscatter.scene.scene import MOMENTA
-from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
+from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, Text
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 

@@ -57,19 +57,9 @@ from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.reproduction import model_tables as mt
 from hhscatter.reproduction import model_verdicts as mv
-from hhscatter.scene.schema import (
-    Bool,
-    Integer,
-    Number,
-    NumberLists,
-    NumberOr,
-    Numbers,
-    OneOf,
-    StudyParams,
-    Text,
-    Texts,
-)
+from hhscatter.scene.schema import Bool, Integer, Number, NumberLists, NumberOr, Numbers, OneOf, Text, Texts
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 

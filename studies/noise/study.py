@@ -30,8 +30,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers
 from hhscatter.studies.keys import RunKeys, number_key
+from hhscatter.studies.params import StudyParams
 
 
 class Params(StudyParams):

@@ -142,7 +142,7 @@ def survival_model(
                       f_ne + f_e exp(−∫_{τ0}^t κ_γ ds)      [hazard="integrated"]
         t > τ2        f_ne exp(−g(t)(t − τ2)),  g = L/(1 + e^{−b(t−τ2)})²
 
-    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. :data:`~hhscatter.analysis.survival.kappa_law.PAPER_KAPPA`);
+    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. a :class:`~hhscatter.analysis.survival.kappa_law.PiecewiseKappa`);
     ``tau2=None`` uses Eq. (eq:tau2), ln(E0/E_c)/(μγ).  See the module
     docstring for why the literal ("paper") escape factor is non-monotone.
     Returns an array shaped like ``t`` (float if ``t`` is scalar).

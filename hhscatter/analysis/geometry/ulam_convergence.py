@@ -171,12 +171,12 @@ def residuals(value, err, ref, ref_err) -> dict:
     return {"residual": res, "residual_err": res_err, "z": (value - ref) / sig if sig > 0 else math.inf}
 
 
-def convergence_record(E, grid, boot_grid, kappa_finest, refs, *, verdicts: bool = True) -> dict:
+def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
     """The record of κ's convergence at energy E: :func:`kappa_convergence` of ``grid`` (with ``boot_grid``)
     and, for each reference in ``refs`` ({name: (κ_ref, err) or None}), :func:`residuals` of κ∞ against it
     (keys residual_<name>, residual_<name>_err, z_<name> and verdict_<name>, the one verdict rule of
-    :func:`hhscatter.analysis.stats.verdicts.verdict`; none with ``verdicts`` False, for a smoke-test scale). A grid too small for the fit gives kappa_inf None
-    and the reason in ``note``."""
+    :func:`hhscatter.analysis.stats.verdicts.verdict`). A grid too small for the fit gives kappa_inf None and the
+    reason in ``note``."""
     rec = {"energy": float(E), "kappa_finest": float(kappa_finest)}
     try:
         c = kappa_convergence(grid, boot_grid)
@@ -197,8 +197,7 @@ def convergence_record(E, grid, boot_grid, kappa_finest, refs, *, verdicts: bool
                 f"z_{name}": r["z"],
             }
         )
-        if verdicts:
-            rec[f"verdict_{name}"] = verdict(c["kappa_inf"], c["err"], ref[0], ref[1]).text()
+        rec[f"verdict_{name}"] = verdict(c["kappa_inf"], c["err"], ref[0], ref[1]).text()
         rf = residuals(kappa_finest, 0.0, ref[0], ref[1])  # the finest partition's offset, for the page
         rec[f"residual_finest_{name}"] = rf["residual"]
     return rec

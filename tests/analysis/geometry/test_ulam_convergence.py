@@ -96,10 +96,8 @@ def test_energy_results_give_the_closed_form_rate_at_every_partition():
     assert res["cost"]["orbits"] == 256 and res["cost"]["orbit_time"] == pytest.approx(512.0)
     rec = uc.convergence_record(0.3, res["grid"], res["boot_grid"], res["kappa"], {"kappa0": (exact, 0.001)})
     assert rec["kappa_inf"] == pytest.approx(exact, rel=1e-9) and rec["verdict_kappa0"].startswith("agrees")
-    quiet = uc.convergence_record(
-        0.3, res["grid"], res["boot_grid"], res["kappa"], {"kappa0": (0.5, 0.001)}, verdicts=False
-    )
-    assert "verdict_kappa0" not in quiet and quiet["residual_kappa0"] < 0  # no verdict at a smoke-test scale
+    far = uc.convergence_record(0.3, res["grid"], res["boot_grid"], res["kappa"], {"kappa0": (0.5, 0.001)})
+    assert far["verdict_kappa0"].startswith(("agrees (z = −", "differs (z = −")) and far["residual_kappa0"] < 0
 
 
 def test_measure_on_cut_boxes_counts_the_boxes_and_the_heaviest_sample():
