@@ -362,7 +362,8 @@ def _decay_window(t, mean_E, E0, gamma, window, weights):
 
 
 def _fit_fixed_intercept(t, y, w, E0, gamma, errors):
-    """The paper's fit, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a usable point."""
+    """The fit with the intercept fixed at log E0, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a
+    usable point (the fit of arXiv:2308.13555)."""
     nan = float("nan")
     if t.size >= 1 and np.sum(w * t * t) > 0:
         fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)

@@ -1,4 +1,5 @@
-"""Escape rate κ of the conservative Hénon–Heiles system (paper Sec. II, Fig. 2).
+"""Escape rate κ of an open conservative system from its orbits' lifetimes: window fits of log P(t), the MLE,
+the escaping tail (Sec. II of arXiv:2308.13555).
 
 * :func:`~hhscatter.analysis.survival.windows.choose_windows` (module ``windows``) — data-driven τ0 and the 4
   fitting windows of the exponential regime of Eq. (eqn:kappa_hyperbolic);

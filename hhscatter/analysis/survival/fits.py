@@ -1,6 +1,6 @@
-"""Survival probability P(t) and its exponential / power-law regimes (paper Sec. II).
+"""Survival probability P(t) and its exponential / power-law regimes.
 
-The paper describes the survival probability of an ensemble started in the
+Sec. II of arXiv:2308.13555 (the paper) describes the survival probability of an ensemble started in the
 scattering region Ω as
 
 * Eq. (eqn:kappa_hyperbolic), hyperbolic saddles:
