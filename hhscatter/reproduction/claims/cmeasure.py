@@ -140,8 +140,9 @@ def claim2(runs, claims, label, table, samples):
                     0.0,
                 )
                 continue
-            m = Measured(s["kappa_cm"], s["kappa_cm_err"]) / Measured(k0["kappa"], k0["kappa_err"]) - 1.0
-            v, e = m.value, m.err
+            v = s["kappa_cm"] / k0["kappa"] - 1
+            # the absolute form of the ratio's error (Measured.ratio's relative form differs in the last digit)
+            e = math.hypot(s["kappa_cm_err"] / k0["kappa"], s["kappa_cm"] * k0["kappa_err"] / k0["kappa"] ** 2)
             row[f"ratio_minus_1_{conv}"] = Measured.of(v, e).to_dict()
             claims.add(
                 "2",

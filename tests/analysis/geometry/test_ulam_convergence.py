@@ -59,6 +59,13 @@ def test_residuals_with_both_errors():
     assert r["residual_err"] == pytest.approx(0.0994 / 0.0972 * math.hypot(0.0006 / 0.0994, 0.0002 / 0.0972), rel=1e-12)
 
 
+def test_the_residual_error_of_a_negative_estimate_is_positive():
+    """An extrapolated κ∞ below zero (a small grid): r = κ/κ_ref = −0.5, σ_r = |r| √((σ/κ)² + (σ_ref/κ_ref)²)."""
+    r = uc.residuals(-0.05, 0.01, 0.1, 0.001)
+    assert r["residual"] == pytest.approx(-1.5, rel=1e-12)
+    assert r["residual_err"] == pytest.approx(0.5 * math.hypot(0.01 / 0.05, 0.001 / 0.1), rel=1e-12)
+
+
 def _boxes(leak_every=4, self_every=4, cut_box=None, kept=4, w=None):
     """16 boxes of side 0.5 over [−1, 1]², 16 samples each: rank % leak_every == 0 escapes, rank % self_every == 1
     returns into its own box, the others into the next box (T = 2). ``cut_box`` keeps only its first ``kept``
