@@ -22,14 +22,14 @@ def _as_measured(x) -> Measured:
 
 @dataclass(frozen=True)
 class Measured:
-    """Measured(value, err=nan, method="", n=None): a value with its 1σ uncertainty (same unit as the value).
+    """Measured(value, err=NaN, method="", n=None): a value with its 1σ uncertainty (same unit as the value).
 
     Parameters
     ----------
     value : float
         The estimate (any unit; the error has the same unit).
     err : float
-        Its 1σ standard error (nan: not known, ``None`` in JSON).
+        Its 1σ standard error (NaN: not known, ``None`` in JSON).
     method : str
         What made it (e.g. "MLE", "bootstrap", "ratio"); not written by :meth:`to_dict`.
     n : int or None
@@ -63,7 +63,7 @@ class Measured:
 
     @classmethod
     def from_dict(cls, d, method: str = "", n: int | None = None) -> Measured:
-        """The :class:`Measured` of a numbers-JSON leaf ``{"value": v, "err": e}`` (a missing or null err is nan).
+        """The :class:`Measured` of a numbers-JSON leaf ``{"value": v, "err": e}`` (a missing or null err is NaN).
 
         Examples
         --------
@@ -75,7 +75,7 @@ class Measured:
 
     @classmethod
     def of(cls, value, err, method: str = "", n: int | None = None) -> Measured:
-        """Measured with value and err as Python floats (``None``: nan, not measured), e.g. from numpy scalars.
+        """Measured with value and err as Python floats (``None``: NaN, not measured), e.g. from numpy scalars.
 
         Examples
         --------
@@ -87,7 +87,7 @@ class Measured:
 
     @property
     def rel_err(self) -> float:
-        """err / |value| (nan for a zero value).
+        """err / |value| (NaN for a zero value).
 
         Examples
         --------
