@@ -30,7 +30,8 @@ x = 1
 
 STUDY_PY = """import time
 
-from hhscatter.scene.schema import Integer, StudyParams
+from hhscatter.scene.schema import Integer
+from hhscatter.studies.params import StudyParams
 
 
 class Params(StudyParams):

@@ -199,8 +199,8 @@ class Renderer:
 
     def _both_scales(self, quick_rows, paper_rows) -> str:
         """The paper-vs-ours rows at both scales in one table, matched by quantity."""
-        from hhscatter.analysis.stats.verdicts import row_verdict
         from hhscatter.publish.formatting import format_value, ours_cell
+        from hhscatter.reproduction.verdicts import row_verdict
 
         def ours(r):
             return "—" if r is None else ours_cell(r)
@@ -428,8 +428,8 @@ class Renderer:
         return render_refs(text, self.root, where="tools/readme_results.md")
 
     def verdict_rule(self, _arg=None) -> str:
-        """The one verdict rule, as the code states it (hhscatter.analysis.stats.verdicts.RULE)."""
-        from hhscatter.analysis.stats.verdicts import RULE
+        """The one verdict rule, as the code states it (hhscatter.reproduction.verdicts.RULE)."""
+        from hhscatter.reproduction.verdicts import RULE
 
         return f'!!! info "The verdict rule (every table and page)"\n    {RULE}\n'
 
@@ -635,8 +635,8 @@ def _is_record_list(v) -> bool:
 def claims_table(doc) -> str:
     """Markdown table claims × systems of a numbers JSON with a ``claims`` list and a ``systems`` dict
     ({label: {n_exits, E_c, ...}}); rows by claim, within a claim in the order the records first appear; each
-    verdict by the one rule (:func:`hhscatter.analysis.stats.verdicts.claim_verdict`)."""
-    from hhscatter.analysis.stats.verdicts import claim_verdict
+    verdict by the one rule (:func:`hhscatter.reproduction.verdicts.claim_verdict`)."""
+    from hhscatter.reproduction.verdicts import claim_verdict
 
     systems = list((doc.get("systems") or {}).keys())
     for c in doc["claims"]:

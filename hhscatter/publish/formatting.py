@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import re
 
-from hhscatter.analysis.stats.verdicts import row_verdict
+from hhscatter.reproduction.verdicts import row_verdict
 
 __all__ = [
     "comparison_table",
@@ -166,7 +166,7 @@ def comparison_table(rows, *, study: bool = False, quantity=None, verdict=None, 
     link, or a coloured span in HTML). Columns: quantity, ours, convention
     (how our number was made, when a row says), paper, verdict, note. The
     verdict cell is the one rule's
-    (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, both
+    (:func:`hhscatter.reproduction.verdicts.row_verdict`, both
     uncertainties; none at the tiny ``scale``), whatever rule the row was
     written with.
     """

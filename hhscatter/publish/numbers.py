@@ -27,7 +27,7 @@ The reference is ``[[study[@scale]:path[|format]]]``:
   [lo, hi] of an interval (a ``{value, interval}`` leaf, or a number beside
   its ``<key>_interval``), decimals from its half-width, ``+``: signed;
   ``pm``: a number ± its sibling ``<key>_err``; ``pct``: ×100 with ``%``; ``verdict``: the verdict of a paper-vs-ours row by
-  the one rule (:func:`hhscatter.analysis.stats.verdicts.row_verdict`);
+  the one rule (:func:`hhscatter.reproduction.verdicts.row_verdict`);
   ``abs``: the magnitude; ``int``: rounded, thousands separated by a thin
   space; ``sci``: a×10ᵇ; a Python format spec (``.3f``, ``.2g``, ``+.2f``).
 
@@ -416,9 +416,9 @@ def _bound_of(doc, path: str, leaf) -> dict | None:
 
 def _rule_verdict(row: dict, scale) -> str:
     """The verdict of a paper-vs-ours row or a claim record by the one rule
-    (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, :func:`~hhscatter.analysis.stats.verdicts.claim_verdict`),
+    (:func:`hhscatter.reproduction.verdicts.row_verdict`, :func:`~hhscatter.reproduction.verdicts.claim_verdict`),
     its minus signs typographic."""
-    from hhscatter.analysis.stats.verdicts import claim_verdict, row_verdict  # deferred: only verdicts need it
+    from hhscatter.reproduction.verdicts import claim_verdict, row_verdict  # deferred: only verdicts need it
 
     return row_verdict(row, scale) if "ours" in row else claim_verdict(row, scale)
 

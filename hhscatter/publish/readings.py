@@ -21,8 +21,9 @@ from collections.abc import Callable
 import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
-from hhscatter.analysis.stats.verdicts import claim_verdict, signed, verdict, verdict_class
+from hhscatter.analysis.stats.verdicts import signed, verdict, verdict_class
 from hhscatter.publish.formatting import format_value_err, typographic_minus
+from hhscatter.reproduction.verdicts import claim_verdict
 
 __all__ = [
     "READINGS",

@@ -24,7 +24,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from hhscatter.analysis.stats.verdicts import RULE, row_verdict, verdict_class
+from hhscatter.analysis.stats.verdicts import verdict_class
 from hhscatter.errors import StudyError
 from hhscatter.publish.formatting import (
     comparison_table,
@@ -35,6 +35,7 @@ from hhscatter.publish.formatting import (
     scripts_to_html,
     typographic_minus,
 )
+from hhscatter.reproduction.verdicts import RULE, row_verdict
 from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary, totals
 from hhscatter.studies.graph import GraphError, scales

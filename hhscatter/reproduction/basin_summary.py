@@ -28,6 +28,7 @@ from hhscatter.analysis.geometry.uncertainty import (
     uncertainty_fraction,
     weighted_line,
 )
+from hhscatter.analysis.stats.measured import Measured
 
 __all__ = [
     "entropy_by_box_at",
@@ -59,10 +60,6 @@ __all__ = [
 SETTLED_CODE, TRAPPED_CODE, OUTSIDE = 3, 4, -1
 CODES = (0, 1, 2, SETTLED_CODE, TRAPPED_CODE)
 CODE_NAMES = ("exit 0", "exit 1", "exit 2", "settled", "trapped")
-
-
-def _ve(v, e):
-    return {"value": float(v), "err": float(e)}
 
 
 def outcome_codes(lt: pd.DataFrame) -> np.ndarray:
@@ -204,7 +201,7 @@ def rate_record(eps, times):
         r = decision_rate(eps, times)
     except ValueError:
         return None
-    return {"value": r.lam, "err": r.lam_err, "t0": r.t0, "chi2": r.chi2, "dof": r.dof}
+    return {**Measured(r.lam, r.lam_err).to_dict(), "t0": r.t0, "chi2": r.chi2, "dof": r.dof}
 
 
 def point_record(E, g, hb, ec, ent, unc, loc, m):
@@ -222,12 +219,15 @@ def point_record(E, g, hb, ec, ent, unc, loc, m):
     return {
         "energy": E,
         "gamma": g,
-        "fractions": {name: _ve(f, 0.5 * (hi - lo)) for name, f, lo, hi in zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)},
+        "fractions": {
+            name: Measured.of(f, 0.5 * (hi - lo)).to_dict()
+            for name, f, lo, hi in zip(CODE_NAMES, fr.frac, fr.lo, fr.hi)
+        },
         "n_cells": int(fr.n),
         "channel_symmetry_p": float(m["chans"].p_value),
         "channel_shares_r_sym": [float(v) for v in m["chans"].frac],
-        "S_b": _ve(head.S_b, head.S_b_err) if head is not None else None,
-        "S_bb": _ve(head.S_bb, head.S_bb_err) if head is not None else None,
+        "S_b": Measured.of(head.S_b, head.S_b_err).to_dict() if head is not None else None,
+        "S_bb": Measured.of(head.S_bb, head.S_bb_err).to_dict() if head is not None else None,
         "log2_fractal": bool(head.log2_fractal) if head is not None else None,
         "box_headline": hb,
         "wada": {
@@ -245,8 +245,8 @@ def point_record(E, g, hb, ec, ent, unc, loc, m):
         ],
         "slim_fractal": m["slim"],
         "lyapunov_decision": m["rate"],
-        "alpha": _ve(fit.alpha, fit.alpha_err) if fit else None,
-        "d": _ve(fit.d, fit.d_err) if fit else None,
+        "alpha": Measured.of(fit.alpha, fit.alpha_err).to_dict() if fit else None,
+        "d": Measured.of(fit.d, fit.d_err).to_dict() if fit else None,
         "alpha_fit_range": list(fit.eps_range) if fit else None,
         "alpha_fit_p": float(fit.p_value) if fit else None,
         "cutoff": (
@@ -347,7 +347,7 @@ def energy_trend(scan, E_b, smooth_threshold=2.0):
     ok = np.isfinite(scan.alpha) & (scan.alpha_err > 0)
     if ok.sum() >= 3:
         _, slope, cov, _, _ = weighted_line(scan.energy[ok], scan.alpha[ok], scan.alpha_err[ok])
-        out["alpha_slope"] = {"value": slope, "err": float(math.sqrt(cov[1, 1]))}
+        out["alpha_slope"] = Measured(slope, float(math.sqrt(cov[1, 1]))).to_dict()
     return out
 
 

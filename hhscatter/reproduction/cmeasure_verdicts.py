@@ -14,7 +14,7 @@ import math
 
 import pandas as pd
 
-from hhscatter.analysis.stats.verdicts import comparison_row
+from hhscatter.reproduction.verdicts import comparison_row
 
 __all__ = [
     "REFS_QUANTITY",

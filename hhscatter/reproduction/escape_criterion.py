@@ -31,6 +31,7 @@ import pandas as pd
 
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import escape_rate, escape_rate_mle
 from hhscatter.analysis.survival.fits import survival_curve
 from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
@@ -340,15 +341,15 @@ def _kappa_numbers(kap, r_ref):
     numbers, rows = {}, []
     for row in kap.itertuples():
         numbers.setdefault(f"E={row.energy:.2f}", {})[f"r_esc={row.r_esc:g}"] = {
-            "kappa": {"value": row.kappa, "err": row.kappa_err},
-            "shift_vs_ref": {"value": row.kappa_shift, "err": row.kappa_shift_err},
-            "mle_difference_vs_ref": {"value": row.mle_shift, "err": row.mle_shift_err},
-            "shift_vs_ref_follow_runs": {"value": row.kappa_shift_follow, "err": row.kappa_shift_follow_err},
-            "kappa_lsq": {"value": row.kappa_lsq, "err": row.kappa_lsq_err},
+            "kappa": Measured(row.kappa, row.kappa_err).to_dict(),
+            "shift_vs_ref": Measured(row.kappa_shift, row.kappa_shift_err).to_dict(),
+            "mle_difference_vs_ref": Measured(row.mle_shift, row.mle_shift_err).to_dict(),
+            "shift_vs_ref_follow_runs": Measured(row.kappa_shift_follow, row.kappa_shift_follow_err).to_dict(),
+            "kappa_lsq": Measured(row.kappa_lsq, row.kappa_lsq_err).to_dict(),
             "window": [row.t_start, row.t_stop],
             "delay_of_P": row.time_shift,
-            "flight_time_from_ref": {"value": row.flight_mean, "err": row.flight_err},
-            "mean_t_end_difference": {"value": row.dt_end_mean, "err": row.dt_end_err},
+            "flight_time_from_ref": Measured(row.flight_mean, row.flight_err).to_dict(),
+            "mean_t_end_difference": Measured(row.dt_end_mean, row.dt_end_err).to_dict(),
         }
         if row.r_esc != r_ref:
             rows.append(

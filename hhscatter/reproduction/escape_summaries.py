@@ -2,7 +2,7 @@
 Fig. 2a), of the κ(E) law (Fig. 2b), and of κ from the c-measure (Eq. (eqn:kappa_cmeasure_truetime)) per start
 of its sampling window.
 
-A value with an uncertainty is ``{"value": v, "err": e}`` (:func:`value_err`), the convention of every numbers
+A value with an uncertainty is written ``{"value": v, "err": e}`` (:meth:`~hhscatter.analysis.stats.measured.Measured.to_dict`), the convention of every numbers
 JSON. Units: time in model units, rates in 1/time, energies in model units.
 """
 
@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 
 __all__ = [
     "cmeasure_windows",
@@ -24,19 +25,7 @@ __all__ = [
     "rate_summary",
     "sticky_tail_summary",
     "survival_tables",
-    "value_err",
 ]
-
-
-def value_err(value, err) -> dict:
-    """A value with its uncertainty as the numbers JSON writes it, ``{"value": v, "err": e}`` (floats).
-
-    Examples
-    --------
-    >>> value_err(0.25, 0.01)
-    {'value': 0.25, 'err': 0.01}
-    """
-    return {"value": float(value), "err": float(err)}
 
 
 def plot_grid(t_last: float, n_lin: int = 4001, n_log: int = 600) -> np.ndarray:
@@ -102,9 +91,9 @@ def rate_summary(n: int, t_max: float, rate, n_trapped: int) -> dict:
         "t_max": t_max,
         "n_trapped": n_trapped,
         "trapped_fraction": n_trapped / n,
-        "kappa": value_err(rate.kappa, rate.kappa_err),
+        "kappa": rate.measured("kappa").to_dict(),
         "kappa_windows": [fi.kappa for fi in rate.fits],
-        "kappa_mle": value_err(rate.mle.kappa, rate.mle.kappa_err),
+        "kappa_mle": rate.mle.measured("kappa").to_dict(),
         "tau0": rate.tau0,
         "t_stop": rate.t_stop,
         "windows": [list(w) for w in rate.windows],
@@ -129,8 +118,8 @@ def sticky_tail_summary(energy: float, t_end, observed, t_max: float, tail) -> t
     crossing = math.isfinite(tail.tau_star)
     entry = dict(
         tail_detected=True,
-        z=value_err(tl.z, tl.z_err),
-        z_mle=value_err(tl.z_mle, tl.z_mle_err),
+        z=Measured.of(tl.z, tl.z_err).to_dict(),
+        z_mle=Measured.of(tl.z_mle, tl.z_mle_err).to_dict(),
         tail_window=list(tl.window),
         f_star=tl.f_star,
         tau_c=tl.window[0],
@@ -148,8 +137,8 @@ def sticky_tail_summary(energy: float, t_end, observed, t_max: float, tail) -> t
         late_tail={
             "t_window": [tl.window[1], t_max],
             "n_events": lo.n_events,
-            "z_mle_trapped_censored": value_err(lo.kappa, lo.kappa_err),
-            "z_mle_trapped_removed": value_err(hi.kappa, hi.kappa_err),
+            "z_mle_trapped_censored": Measured.of(lo.kappa, lo.kappa_err).to_dict(),
+            "z_mle_trapped_removed": Measured.of(hi.kappa, hi.kappa_err).to_dict(),
         }
     )
     return line, entry
@@ -277,9 +266,9 @@ def kappa_cmeasure_entry(row, later: pd.DataFrame) -> dict:
         "n_exit": int(row["n_exit"]),
         "n_undetermined": int(row["n_undetermined"]),
         "mu_exit": row["mu_exit"],
-        "kappa_cm": value_err(row["kappa_cm"], row["kappa_cm_err"]),
-        "kappa_pt_grid": value_err(row["kappa_pt_grid"], row["kappa_pt_grid_err"]),
-        "kappa_pt_same_run": value_err(row["kappa_pt_same_run"], row["kappa_pt_same_run_err"]),
+        "kappa_cm": Measured.of(row["kappa_cm"], row["kappa_cm_err"]).to_dict(),
+        "kappa_pt_grid": Measured.of(row["kappa_pt_grid"], row["kappa_pt_grid_err"]).to_dict(),
+        "kappa_pt_same_run": Measured.of(row["kappa_pt_same_run"], row["kappa_pt_same_run_err"]).to_dict(),
         "z_vs_grid": row["z_vs_grid"],
         "z_vs_same_run": row["z_vs_same_run"],
         "kappa_cm_later_starts": {

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 
 __all__ = ["POINT_COLUMNS", "energy_record"]
@@ -77,7 +78,7 @@ def energy_record(
         "energy": energy,
         "t_rec": t_rec,
         "t_max": float(t_max),
-        "kappa_used": {"value": choice["kappa"], "err": choice["kappa_err"]},
+        "kappa_used": Measured(choice["kappa"], choice["kappa_err"]).to_dict(),
         "tau0_used": choice["tau0"],
         "fit_window_pilot": [choice["tau0"], choice["t_stop"]],
         "t_rec_times_kappa": t_rec * choice["kappa"],
@@ -86,7 +87,7 @@ def energy_record(
         "n_orbits": len(lifetimes),
         "n_survivors_at_t_rec": alive,
         "n_points": len(sections),
-        "kappa_main_run": {"value": own.kappa, "err": own.kappa_err},
+        "kappa_main_run": Measured(own.kappa, own.kappa_err).to_dict(),
         "max_energy_deviation": e_dev,
         "raw_run": raw_run,
     }

@@ -18,14 +18,18 @@ Examples
 
 from __future__ import annotations
 
-from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.analysis.survival.kappa_conventions import LAW_PARAMETERS
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.model import HenonHeiles
 from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
+from hhscatter.reproduction.verdicts import quoted_verdict
 
 __all__ = [
     "FIG2_CONVENTIONS",
     "LAW_UNITS",
     "PAPER_FIG2",
+    "PAPER_KAPPA",
     "FIG2_RULES",
     "cmeasure_comparisons",
     "cmeasure_table_rows",
@@ -37,6 +41,15 @@ __all__ = [
 
 #: the paper's Fig. 2 values: the κ(E) law κ = a x² + b x (E < E_b), c x (E ≥ E_b), x = E − E_c, and τ*
 PAPER_FIG2 = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "tau_star": 100.0}
+
+PAPER_KAPPA = PiecewiseKappa(
+    E_c=HenonHeiles().critical_energy,
+    a2=PAPER_FIG2["a"],
+    a1=PAPER_FIG2["b"],
+    slope=PAPER_FIG2["c"],
+    E_switch=PAPER_FIG2["E_b"],
+)
+"""κ0(E) with the paper's fitted coefficients (Fig. 2b), for the paper's system (Hénon–Heiles, ω = λ = 1)."""
 
 #: the units of the law's parameters
 LAW_UNITS = {"a": "1/(time·energy²)", "b": "1/(time·energy)", "c": "1/(time·energy)", "E_b": "energy"}

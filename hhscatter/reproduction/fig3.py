@@ -27,7 +27,7 @@ import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import fit_energy_decay, mu_by_window
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
-from hhscatter.analysis.stats.verdicts import quoted_verdict, verdict_beside_authors
+from hhscatter.reproduction.verdicts import quoted_verdict, verdict_beside_authors
 
 __all__ = [
     "FIG3_SELECTIONS",
@@ -213,8 +213,8 @@ def authors_convention(
     -------
     dict
         The reading and a row per (selection, window) under ``"mu"``: value, bootstrap err, fit_err, n_points,
-        t_last, ours, authors, convention, verdict (:func:`~hhscatter.analysis.stats.verdicts.quoted_verdict`;
-        ours names an authors' row that agrees, :func:`~hhscatter.analysis.stats.verdicts.verdict_beside_authors`),
+        t_last, ours, authors, convention, verdict (:func:`~hhscatter.reproduction.verdicts.quoted_verdict`;
+        ours names an authors' row that agrees, :func:`~hhscatter.reproduction.verdicts.verdict_beside_authors`),
         note. Each fit is the unweighted log fit with E(0) = E0; the row in (window, "inside") is ours.
 
     Raises

@@ -12,8 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.stats.verdicts import comparison_row, signed
+from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.reproduction.model_tables import PAPER_CONSTANTS
+from hhscatter.reproduction.verdicts import comparison_row
 
 __all__ = [
     "better_text",

@@ -24,8 +24,8 @@ from hhscatter.analysis.dissipative.transitions import (
     tau2_observed_interval,
     tau2_predicted,
 )
-from hhscatter.analysis.stats.verdicts import comparison_row
 from hhscatter.analysis.survival.fits import survival_from_lifetimes
+from hhscatter.reproduction.verdicts import comparison_row
 
 __all__ = ["log_time_grid", "survival_ratio_tables", "transition_comparisons", "transition_table"]
 

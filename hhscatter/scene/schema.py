@@ -16,9 +16,8 @@ problem::
     studies/fig3/study.toml: unknown table [snapshot]; allowed tables: [about], [follow], …
     studies/fig3/study.toml: [study] unknown key 'n_bot'; allowed keys: boot_seed, fit_window, …
 
-A study declares its ``[study]`` table as a :class:`StudyParams` subclass
-named ``Params`` in its ``study.py``; its fields are the keys, with defaults
-for the optional ones.
+A ``[study]`` table is checked against a model of its keys (a study's ``Params``, a pydantic model of the leaf
+types below); its fields are the keys, with defaults for the optional ones.
 """
 
 from __future__ import annotations
@@ -60,7 +59,6 @@ __all__ = [
     "NumberOrNumbers",
     "Numbers",
     "OneOf",
-    "StudyParams",
     "Text",
     "Texts",
     "apply_convention",
@@ -288,16 +286,6 @@ class AboutTable(_Table):
     setup: Text = None  # the study's own setup in a few words, when its ICs are not the [scene]'s region
 
 
-class StudyParams(_Table):
-    """Base of a study's ``Params``: the keys of its ``[study]`` table, strictly typed; no other key is allowed.
-
-    A study declares ``class Params(StudyParams)`` with one field per key (leaf types :data:`Number`,
-    :data:`Integer`, :data:`Numbers`, …, a default where the key is optional); study.toml is checked against it
-    when the study is loaded, and the study's code reads ``study.params.<key>``, converted by
-    :func:`typed_params` (Number → float, Integer → int, Numbers → list of floats, …).
-    """
-
-
 def typed_params(model: type[BaseModel], raw: dict) -> BaseModel:
     """typed_params(Params, raw) -> a ``Params`` instance: each key of ``raw`` (a checked ``[study]`` table), or the
     field's default, converted to the Python type its leaf type declares. ``raw`` must have passed the file check
@@ -305,8 +293,9 @@ def typed_params(model: type[BaseModel], raw: dict) -> BaseModel:
 
     Examples
     --------
-    >>> from hhscatter.scene.schema import Integer, Numbers, StudyParams, typed_params
-    >>> class Params(StudyParams):
+    >>> from pydantic import BaseModel
+    >>> from hhscatter.scene.schema import Integer, Numbers, typed_params
+    >>> class Params(BaseModel):
     ...     energies: Numbers
     ...     n: Integer = 10
     >>> p = typed_params(Params, {"energies": [0.3, 1]})

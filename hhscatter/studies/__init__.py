@@ -35,7 +35,8 @@ The stages make runs as separate targets:
     [scale.paper.study]  # 'tiny' the scale of the end-to-end tests
 
 The numbers JSON follows one convention so the report can tabulate it: a value
-with an uncertainty is ``{"value": v, "err": e}``, and the list
+with an uncertainty is a :class:`~hhscatter.analysis.stats.measured.Measured`, written ``{"value": v, "err": e}``,
+and the list
 ``"paper_comparison"`` holds rows ``{quantity, ours, err, paper, verdict, note}``.
 """
 

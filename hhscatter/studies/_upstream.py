@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import HHScatterError, StudyError
 from hhscatter.studies.study import DEV_ENV, dev_fallback_enabled, load_study
 
@@ -137,13 +138,13 @@ def value_or_fallback(study, other: str, path: str, paper_value, inputs: dict, n
     """
     try:
         v, e = lookup(numbers(study, other), path, what=f"{other}.json")
-        inputs[name] = {"value": v, "err": e, "source": f"{other}.json:{path}"}
+        inputs[name] = {**Measured(v, e).to_dict(), "source": f"{other}.json:{path}"}
         return v, e
     except UpstreamError as exc:
         if not dev_fallback_enabled():
             raise
         print(f"  WARNING {study.name}: {exc}\n  using the paper's {name} = {paper_value} ({DEV_SOURCE})", flush=True)
-        inputs[name] = {"value": paper_value, "err": math.nan, "source": DEV_SOURCE}
+        inputs[name] = {**Measured(paper_value, math.nan).to_dict(), "source": DEV_SOURCE}
         return paper_value, math.nan
 
 

@@ -1,4 +1,5 @@
-"""The numbers JSON of a study, written atomically: non-finite floats as null/"inf", numpy scalars as Python."""
+"""The numbers JSON of a study, written atomically: non-finite floats as null/"inf", numpy scalars as Python, a
+:class:`~hhscatter.analysis.stats.measured.Measured` as its ``.to_dict()``."""
 
 from __future__ import annotations
 
@@ -7,10 +8,14 @@ import math
 import os
 from pathlib import Path
 
+from hhscatter.analysis.stats.measured import Measured
+
 __all__ = ["write_json_atomic"]
 
 
 def _jsonable(v):
+    if isinstance(v, Measured):
+        return _jsonable(v.to_dict())
     if isinstance(v, float) and not math.isfinite(v):
         return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
     if isinstance(v, dict):

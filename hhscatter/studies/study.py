@@ -17,12 +17,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from hhscatter.analysis.stats.library_warnings import warning_counts
-from hhscatter.analysis.stats.verdicts import NO_VERDICT, REFERENCE_KINDS, SMOKE_SCALES, row_verdict, without_verdicts
 from hhscatter.data.schema import provenance
 from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import system_from_spec
+from hhscatter.reproduction.verdicts import NO_VERDICT, REFERENCE_KINDS, SMOKE_SCALES, row_verdict, without_verdicts
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
@@ -122,7 +122,7 @@ class Study:
     info: StudyInfo | None = None
     orbits_run: int = 0  # orbits integrated by this process's run() calls (the cost record)
     chunks_resumed: int = 0  # chunks found complete and kept by run()
-    params_model: type | None = None  # the study's Params (hhscatter.scene.schema.StudyParams) of its [study] table
+    params_model: type | None = None  # the study's Params (hhscatter.studies.params.StudyParams) of its [study] table
     raw_runs: dict = field(default_factory=dict)  # key -> {scene_hash, orbits, complete}: the runs made/read
     params_read: set | None = None  # [study] keys read while this is a set (the simulate stage records them)
 
@@ -274,15 +274,15 @@ class Study:
         """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
 
         One row of the paper-vs-ours table. ``verdict`` defaults to an |Δ| ≤ 2σ test; the tables and pages
-        judge the row by the one rule (:func:`~hhscatter.analysis.stats.verdicts.row_verdict`). ``reference``
-        names the kind of ``paper`` (:data:`~hhscatter.analysis.stats.verdicts.REFERENCE_KINDS`: "printed" by
+        judge the row by the one rule (:func:`~hhscatter.reproduction.verdicts.row_verdict`). ``reference``
+        names the kind of ``paper`` (:data:`~hhscatter.reproduction.verdicts.REFERENCE_KINDS`: "printed" by
         the paper, "propagated" from printed numbers with its 1σ ``paper_err``, "exact" theory, "other": not the
         same quantity, with ``why``); without it the rule infers it
-        (:func:`~hhscatter.analysis.stats.verdicts.reference_kind`). ``convention`` says how
+        (:func:`~hhscatter.reproduction.verdicts.reference_kind`). ``convention`` says how
         *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
         row computed in the authors' own convention (their IC region, window or selection rule), so that a
         "differs" can be checked against it. The paper's number is always in the authors' convention. At a smoke
-        scale (tiny) the row states no verdict (:data:`~hhscatter.analysis.stats.verdicts.NO_VERDICT`).
+        scale (tiny) the row states no verdict (:data:`~hhscatter.reproduction.verdicts.NO_VERDICT`).
         """
         if self.scale in SMOKE_SCALES:
             verdict = NO_VERDICT
@@ -339,7 +339,7 @@ class Study:
         """Write the study's numbers JSON (with its comparisons, scale and provenance).
 
         At a smoke scale (tiny) it states no verdict anywhere: every ``"verdict"`` reads
-        :data:`~hhscatter.analysis.stats.verdicts.NO_VERDICT` (values and errors stay). It records what it was made from (:mod:`hhscatter.studies.provenance`: the hash of this study's
+        :data:`~hhscatter.reproduction.verdicts.NO_VERDICT` (values and errors stay). It records what it was made from (:mod:`hhscatter.studies.provenance`: the hash of this study's
         configuration, of each upstream numbers JSON and the raw runs' scene hashes) and its own content hash.
         """
 

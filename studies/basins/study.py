@@ -36,9 +36,11 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction import basin_summary as bs
 from hhscatter.reproduction.basin_summary import CODE_NAMES, CODES, OUTSIDE, outcome_codes
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 
 
@@ -262,8 +264,11 @@ def analyze(study):
             "zoom_centre": list(centre),
             "per_point": per,
             "point_table": bs.point_table(per),
-            "E_b": {"value": E_b, "err": E_b_err, "source": f"{study.upstream('kappa')}.json {study.params.E_b_key}"},
-            "mu": {"value": mu, "err": mu_err, "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
+            "E_b": {
+                **Measured(E_b, E_b_err).to_dict(),
+                "source": f"{study.upstream('kappa')}.json {study.params.E_b_key}",
+            },
+            "mu": {**Measured(mu, mu_err).to_dict(), "source": f"{study.upstream('mu')}.json {study.params.mu_key}"},
             "cutoff_prediction": cut_pred,
             "cutoff_summary": bs.cutoff_summary(cut_pred),
             "entropy_by_box": by_box,

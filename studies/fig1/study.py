@@ -44,7 +44,8 @@ import numpy as np
 from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.reproduction.fig1 import energy_record
 from hhscatter.run.plan import SCENE_FILE
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 

@@ -43,7 +43,8 @@ from hhscatter.reproduction.fig2 import (
     pt_comparisons,
 )
 from hhscatter.run.plan import SCENE_FILE
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Table, figure_stage
 
 

@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import snapshot_grid
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.reproduction.fig3 import (
     DecayResults,
@@ -60,7 +61,8 @@ from hhscatter.reproduction.fig3 import (
     nearest_times,
     paper_fit,
 )
-from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams, Text
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, Text
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
@@ -288,22 +290,22 @@ def _numbers(study, res: DecayResults, fit, h, cont, key, window, E0, gamma, n_o
         "raw_keys": {"engine": key},
         "continuation": {k: v for k, v in cont.items() if k != "key"},
         "fit_window": list(window),
-        "mu": {"value": float(p["mu"]), "err": float(p["mu_err"])},
+        "mu": Measured.of(p["mu"], p["mu_err"]).to_dict(),
         "mu_fit_err": float(p["mu_fit_err"]),
-        "mu_free": {"value": float(p["mu_free"]), "err": float(p["mu_free_err"])},
+        "mu_free": Measured.of(p["mu_free"], p["mu_free_err"]).to_dict(),
         "E0_free": float(np.exp(fit.log_E0_free)),
         "rms_log_residual": fit.rms_log_residual,
         "mu_later_windows": [
             {
                 "t_lo": r.t_lo,
                 "t_hi": r.t_hi,
-                "mu": {"value": r.mu, "err": r.mu_err},
-                "mu_local": {"value": r.mu_free, "err": r.mu_free_err},
+                "mu": Measured(r.mu, r.mu_err).to_dict(),
+                "mu_local": Measured(r.mu_free, r.mu_free_err).to_dict(),
                 "mean_E_mid": r.mean_E_mid,
             }
             for r in res.later_tab.itertuples()
         ],
-        "tau2_predicted": {"value": res.tau2_pred, "err": res.tau2_pred_err},
+        "tau2_predicted": Measured(res.tau2_pred, res.tau2_pred_err).to_dict(),
         "hist_times": [float(v) for v in h.t],
         "n_boot": study.params.n_boot,
         "n_boot_orbits": min(study.params.n_boot_orbits, n_orbits),

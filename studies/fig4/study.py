@@ -49,13 +49,15 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import decay_exponent, snapshot_grid
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction.transition_tables import (
     survival_ratio_tables,
     transition_comparisons,
     transition_table,
 )
-from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Param, figure_stage
 
 
@@ -275,10 +277,6 @@ def _fin(v):
     return None if not np.isfinite(v) else float(v)
 
 
-def _vu(v, e):
-    return {"value": _fin(v), "err": _fin(e)}
-
-
 def _numbers(
     study, taus, gs, N, E0, alpha, dt, mg, win, mu, mu_err, mu_fig3, cont, tau0, tau0_err, exponents, nb, K
 ) -> dict:
@@ -286,7 +284,7 @@ def _numbers(
 
     def exponent(name):
         p, e = exponents[name]
-        return None if p is None else {"value": p, "err": e}
+        return None if p is None else Measured(p, e).to_dict()
 
     return {
         "E0": E0,
@@ -308,13 +306,13 @@ def _numbers(
         "tau1_definition": f"first t ≥ τ0 with P_γ(t) = α P_0(t), α = {alpha:g} (Eq. eqn:tau1), grid step {dt:g}",
         "tau2_obs_definition": "min settling time (first E = E_c inside Ω); depends on N",
         "tau2_pred_definition": f"ln(E0/E_c)/(μγ) with μ from this study's γ = {mg:g} run on [{win[0]:g}, {win[1]:g}]",
-        "mu": {"value": float(mu), "err": mu_err},
+        "mu": Measured(float(mu), mu_err).to_dict(),
         "mu_gamma": mg,
         "mu_window": list(win),
         "mu_fig3": mu_fig3,
         "paper_mu": study.params.paper_mu,
         "continuation": {k: v for k, v in cont.items() if k != "key"},
-        "tau0": _vu(tau0, tau0_err),
+        "tau0": Measured(_fin(tau0), _fin(tau0_err)).to_dict(),
         "taus": [
             {
                 "gamma": r.gamma,
@@ -322,18 +320,18 @@ def _numbers(
                 "f_escaped": r.f_escaped,
                 "f_settled": r.f_settled,
                 "f_censored": r.f_censored,
-                "tau1": _vu(r.tau1, r.tau1_err),
+                "tau1": Measured(_fin(r.tau1), _fin(r.tau1_err)).to_dict(),
                 "n0_at_tau1": None if not np.isfinite(r.n0_at_tau1) else r.n0_at_tau1,
                 "tau1_resolved": r.tau1_resolved,
                 "tau2_obs": {
-                    **_vu(r.tau2_obs, r.tau2_obs_err),
+                    **Measured(_fin(r.tau2_obs), _fin(r.tau2_obs_err)).to_dict(),
                     "lo": _fin(r.tau2_obs_lo),
                     "hi": _fin(r.tau2_obs_hi),
                     "coverage": _fin(r.tau2_obs_coverage),
                 },
-                "t_settle_q01": _vu(r.t_settle_q01, r.t_settle_q01_err),
-                "t_settle_q50": _vu(r.t_settle_q50, r.t_settle_q50_err),
-                "tau2_pred": _vu(r.tau2_pred, r.tau2_pred_err),
+                "t_settle_q01": Measured(_fin(r.t_settle_q01), _fin(r.t_settle_q01_err)).to_dict(),
+                "t_settle_q50": Measured(_fin(r.t_settle_q50), _fin(r.t_settle_q50_err)).to_dict(),
+                "tau2_pred": Measured(_fin(r.tau2_pred), _fin(r.tau2_pred_err)).to_dict(),
                 "tau2_pred_paper_mu": None if not np.isfinite(r.tau2_pred_paper_mu) else r.tau2_pred_paper_mu,
             }
             for r in taus.itertuples()

@@ -72,11 +72,13 @@ import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import time_to_energy
 from hhscatter.analysis.geometry import distance as dist
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction import cmeasure_comparison as cc
 from hhscatter.reproduction import cmeasure_verdicts as cv
 from hhscatter.scene.scene import MOMENTA
-from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, StudyParams, Text
+from hhscatter.scene.schema import Integer, Number, Numbers, OneOf, Text
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
@@ -411,12 +413,12 @@ def analyze(study):
         {
             "inputs": inputs,
             "dev_fallback": up.any_fallback(inputs),
-            "mu": {"value": mu, "err": mu_err},
+            "mu": Measured(mu, mu_err).to_dict(),
             "E1": E1,
             "E2": E2,
             "band": list(study.params.band),
             "gamma_main": g_main,
-            "t_star": {gamma_key(r.gamma): {"value": r.t_star, "err": r.t_star_err} for r in pg.itertuples()},
+            "t_star": {gamma_key(r.gamma): Measured(r.t_star, r.t_star_err).to_dict() for r in pg.itertuples()},
             "per_gamma": pg.to_dict(orient="records"),
             "m_common": m_common,
             "delta": delta,

@@ -53,22 +53,13 @@ import pandas as pd
 from hhscatter.analysis.dissipative import mixture
 from hhscatter.analysis.dissipative import model_comparison as mc
 from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.reproduction import model_tables as mt
 from hhscatter.reproduction import model_verdicts as mv
-from hhscatter.scene.schema import (
-    Bool,
-    Integer,
-    Number,
-    NumberLists,
-    NumberOr,
-    Numbers,
-    OneOf,
-    StudyParams,
-    Text,
-    Texts,
-)
+from hhscatter.scene.schema import Bool, Integer, Number, NumberLists, NumberOr, Numbers, OneOf, Text, Texts
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
 
 
@@ -360,7 +351,7 @@ def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
         "inputs": s.inputs,
         "dev_fallback": up.any_fallback(s.inputs),
         "kappa0": {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "E_c": s.E_c},
-        "mu": {"value": s.mu, "err": s.mu_err},
+        "mu": Measured(s.mu, s.mu_err).to_dict(),
         "tau0": s.tau0,
         "fits": fits.to_dict(orient="records"),
         "compare_fits": cmps.to_dict(orient="records"),

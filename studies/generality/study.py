@@ -39,15 +39,8 @@ from hhscatter.reproduction.claims.keys import (
 )
 from hhscatter.reproduction.claims.resc import resc_values
 from hhscatter.scene.scene import MOMENTA, REGIONS
-from hhscatter.scene.schema import (
-    Integer,
-    Number,
-    NumberLists,
-    Numbers,
-    OneOf,
-    StudyParams,
-    Text,
-)
+from hhscatter.scene.schema import Integer, Number, NumberLists, Numbers, OneOf, Text
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Sibling, Table, figure_stage, figures
 
 

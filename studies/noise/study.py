@@ -27,13 +27,12 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers
 from hhscatter.studies.keys import RunKeys, number_key
+from hhscatter.studies.params import StudyParams
 
 
 class Params(StudyParams):
@@ -159,8 +158,7 @@ def _rate_row(study, key, scene, t_start):
 
 def _reactivation(study, runs):
     """P(t) with and without the heat bath, the extension's prediction, and their numbers."""
-    from hhscatter.analysis.noise import reactivation_survival, thermal_rate
-    from hhscatter.analysis.survival.kaplan_meier import survival_curve
+    from hhscatter.analysis.noise import reactivation_check, thermal_rate
 
     p = study.params
     t0, esc0, set0 = _lifetimes(study, "react_T0")
@@ -168,74 +166,45 @@ def _reactivation(study, runs):
     tw, escw, _ = _lifetimes(study, "react_well")
     sc = runs["react_T"]
     k_well = thermal_rate(tw, escw, p.t_relax, sc.t_max)
-    cens0 = ~(esc0 | set0)
-    t_hi = min(sc.t_max, float(t0[cens0].min()) if cens0.any() else sc.t_max)
-    grid = np.linspace(0.0, t_hi, 401)
-    P_T = survival_curve(tT, escT, grid)
-    P_0 = survival_curve(t0, esc0 | set0, grid)  # drag only: leaving = escaped or settled
-    # drag only, settled orbits counted inside for ever: 1 − (escapes up to t)/N (t ≤ the earliest censoring)
-    settled_alive = 1.0 - np.searchsorted(np.sort(t0[esc0]), grid, side="right") / len(t0)
-    model = reactivation_survival(grid, t0, esc0, set0, k_well.rate)
-    # the tail of P_T: the MLE rate on [react_tail_start, t_max], after the drag-only orbits have settled (their
-    # 99 % settling time is recorded beside it) and relaxed
-    t_settled = float(np.quantile(t0[set0], 0.99)) if set0.any() else 0.0
-    if p.react_tail_start < t_settled:
-        raise ValueError(f"[study] react_tail_start = {p.react_tail_start:g} is before the T = 0 orbits have settled")
-    tail = thermal_rate(tT, escT, p.react_tail_start, sc.t_max)
-    dev = np.abs(P_T.P - model)
-    ok = np.isfinite(dev)
-    i = int(np.nanargmax(np.where(ok, dev, -1)))
-    table = pd.DataFrame(
-        {
-            "t": grid,
-            "P_T": P_T.P,
-            "P_T_err": P_T.P_err,
-            "P_0": P_0.P,
-            "P_0_settled_inside": settled_alive,
-            "model": model,
-        }
-    )
+    try:
+        c = reactivation_check(t0, esc0, set0, tT, escT, k_well.rate, sc.t_max, p.react_tail_start)
+    except ValueError as e:
+        raise ValueError(f"[study] react_tail_start: {e}") from None
     numbers = {
         "energy": p.react_energy,
         "gamma": sc.gamma,
         "temperature": sc.noise.temperature,
         "barrier_over_T": p.react_barrier,
         "n": sc.n,
-        "settled_fraction_T0": float(set0.mean()),
-        "escaped_fraction_T0": float(esc0.mean()),
-        "t_settled_99": t_settled,
+        "settled_fraction_T0": c.settled_fraction,
+        "escaped_fraction_T0": c.escaped_fraction,
+        "t_settled_99": c.t_settled_99,
         "tail_window": [p.react_tail_start, sc.t_max],
-        "tail_rate": {"value": tail.rate, "err": tail.rate_err},
-        "thermal_rate": {"value": k_well.rate, "err": k_well.rate_err},
-        "tail_over_thermal": {
-            "value": tail.rate / k_well.rate,
-            "err": tail.rate / k_well.rate * math.hypot(tail.rate_err / tail.rate, k_well.rate_err / k_well.rate),
-        },
-        "model_max_deviation": float(dev[i]),
-        "model_max_deviation_at": float(grid[i]),
-        "model_max_deviation_sigma": float(dev[i] / P_T.P_err[i]) if P_T.P_err[i] > 0 else math.inf,
+        "tail_rate": c.tail.measured("rate").to_dict(),
+        "thermal_rate": k_well.measured("rate").to_dict(),
+        "tail_over_thermal": (c.tail.measured("rate") / k_well.measured("rate")).to_dict(),
+        "model_max_deviation": c.max_deviation,
+        "model_max_deviation_at": c.max_deviation_at,
+        "model_max_deviation_sigma": c.max_deviation_sigma,
     }
-    return numbers, table
+    return numbers, c.table
 
 
 def _no_drag(study, runs):
-    from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+    from hhscatter.analysis.survival.relative_rates import relative_rates
 
     p = study.params
     lo, hi = p.nodrag_window
+    sigmas = list(p.nodrag_sigmas)
+    ref = sigmas.index(0) if 0 in sigmas else None
     rows = []
     for E in p.nodrag_energies:
-        base = None
-        for s in p.nodrag_sigmas:
-            t_end, esc, _ = _lifetimes(study, _nodrag_key(E, s))
-            m = escape_rate_mle(t_end, esc, lo, hi)
-            if s == 0:
-                base = m
+        samples = [_lifetimes(study, _nodrag_key(E, s))[:2] for s in sigmas]
+        for s, rr in zip(sigmas, relative_rates(samples, lo, hi, ref)):
+            m = rr.rate
             row = {"energy": E, "sigma": s, "kappa": m.kappa, "kappa_err": m.kappa_err, "n_events": m.n_events}
-            if base is not None:
-                r = m.kappa / base.kappa
-                row["kappa_over_kappa0"] = r
-                row["kappa_over_kappa0_err"] = r * math.hypot(m.kappa_err / m.kappa, base.kappa_err / base.kappa)
+            if rr.ratio is not None:
+                row["kappa_over_kappa0"], row["kappa_over_kappa0_err"] = rr.ratio.value, rr.ratio.err
                 # energy gained by diffusion over the window: ⟨E⟩ grows by σ² t (two degrees of freedom)
                 row["energy_gain_at_window_end"] = s * s * hi
             rows.append(row)

@@ -27,8 +27,9 @@ from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.reproduction.operator_cmeasure import measure_distances
-from hhscatter.scene.schema import Integer, Integers, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Integers, Number, Numbers
 from hhscatter.studies import _upstream as up
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, Sibling, Table, Upstream, figure_stage, figures
 
 
@@ -374,7 +375,8 @@ def _fig2_kappa(study, inputs):
 def kappa_part(study, inputs):
     """κ at every Ulam energy: {results per E, records (kappa_ulam), convergence (kappa_convergence), mixed
     (mixed phase space), rows (κ per partition), grids (the extrapolation grids and their replicates), kappa0}."""
-    from hhscatter.analysis.stats.verdicts import SMOKE_SCALES, verdict
+    from hhscatter.analysis.stats.verdicts import verdict
+    from hhscatter.reproduction.verdicts import SMOKE_SCALES
 
     kappa0, kappa_cm = _fig2_kappa(study, inputs)
     not_smoke = study.scale not in SMOKE_SCALES  # a smoke-test scale states no verdicts
@@ -389,7 +391,9 @@ def kappa_part(study, inputs):
         if any(np.isclose(E, e) for e in study.params.energies):
             out["records"].append(rec)
             refs = {"kappa0": k0, "kappa_cm": kc}
-            conv = uc.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], refs, verdicts=not_smoke)
+            conv = uc.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], refs)
+            if not not_smoke:  # a smoke-test scale states no verdict
+                conv = {k: v for k, v in conv.items() if not k.startswith("verdict_")}
             out["convergence"].append({**conv, **res["cut_boxes"]})
             out["grids"] += [
                 res["grid"].assign(energy=E, kind="estimate"),

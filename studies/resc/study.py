@@ -48,7 +48,8 @@ from hhscatter.reproduction.escape_criterion import (
     lyapunov_table,
     returns_row,
 )
-from hhscatter.scene.schema import Integer, Number, Numbers, StudyParams
+from hhscatter.scene.schema import Integer, Number, Numbers
+from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import PATH, SCALE, Param, figure_stage
 
 

@@ -1,6 +1,6 @@
 """One number, one verdict: every verdict the built site and the reproduction report show, read back from their
 HTML, is the same wherever the same number of the same row appears (the claims table, the study's numbers table, the
-studies index, the report), and it is the one rule's (hhscatter.analysis.stats.verdicts.row_verdict)."""
+studies index, the report), and it is the one rule's (hhscatter.reproduction.verdicts.row_verdict)."""
 
 from __future__ import annotations
 

@@ -189,8 +189,8 @@ def test_a_refused_study_file_in_a_subprocess_prints_no_traceback(tmp_path):
 
 
 def test_every_study_declares_its_study_table():
-    from hhscatter.scene.schema import StudyParams
     from hhscatter.studies import load_study, study_names
+    from hhscatter.studies.params import StudyParams
 
     for name in study_names():
         s = load_study(name, "tiny")
@@ -325,16 +325,8 @@ def test_study_code_receives_typed_params():
 
 
 def test_typed_params_converts_each_leaf_type():
-    from hhscatter.scene.schema import (
-        Integer,
-        Integers,
-        NumberLists,
-        NumberOr,
-        Numbers,
-        StudyParams,
-        Text,
-        typed_params,
-    )
+    from hhscatter.scene.schema import Integer, Integers, NumberLists, NumberOr, Numbers, Text, typed_params
+    from hhscatter.studies.params import StudyParams
 
     class Params(StudyParams):
         a: Integer

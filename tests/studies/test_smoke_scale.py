@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import re
 
-from hhscatter.analysis.stats.verdicts import NO_VERDICT
+from hhscatter.reproduction.verdicts import NO_VERDICT
 
 #: what a verdict reads like, wherever it would sit in a JSON (a row's verdict, a claim's, a note)
 VERDICT_WORDS = re.compile(r"^(agrees|differs|consistent with|closer to|same as|not shown|comparable|Wada)\b")

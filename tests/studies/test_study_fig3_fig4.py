@@ -16,8 +16,8 @@ from hhscatter.analysis.dissipative.transitions import (
     settle_time_quantiles,
     survival_on_grid,
 )
-from hhscatter.analysis.stats.verdicts import NO_VERDICT
 from hhscatter.analysis.survival.fits import survival_curve
+from hhscatter.reproduction.verdicts import NO_VERDICT
 
 ROOT = Path(__file__).resolve().parents[2]
 E_C = 1.0 / 6.0
@@ -223,8 +223,8 @@ def _fixed_intercept_mu(t, mean_E, E0, gamma, window):
 def test_fig3_mu_verdict_rule():
     """The verdict of a μ row against the paper's "0.91": 2σ, then the paper's quoting precision; and our row's
     "differs" is kept only when no authors'-convention row agrees."""
-    from hhscatter.analysis.stats.verdicts import quoted_verdict as mu_verdict
-    from hhscatter.analysis.stats.verdicts import verdict_beside_authors
+    from hhscatter.reproduction.verdicts import quoted_verdict as mu_verdict
+    from hhscatter.reproduction.verdicts import verdict_beside_authors
 
     assert mu_verdict(0.9105, 0.0004, 0.91, 0.005) == "agrees within 2σ"  # |Δ| = 0.0005 ≤ 2σ
     assert mu_verdict(0.9139, 0.0005, 0.91, 0.005) == "agrees to the paper's quoted digits"  # prints as 0.91
@@ -336,7 +336,7 @@ def test_fig3_authors_rows_recompute_deterministically(tiny_root):
 def test_fig3_committed_mu_verdicts_follow_the_rule(scale):
     """The committed μ rows (quick, paper) carry the verdict of the rule from their own numbers: 2σ, then the
     paper's printed digits; our row's "differs" is qualified only when an authors'-convention row agrees."""
-    from hhscatter.analysis.stats.verdicts import quoted_verdict, verdict_beside_authors
+    from hhscatter.reproduction.verdicts import quoted_verdict, verdict_beside_authors
 
     assets = ROOT / "docs" / "studies" / "assets"
     nums = json.loads(((assets if scale == "quick" else assets / scale) / "fig3.json").read_text())

@@ -20,8 +20,8 @@ import pytest
 
 from hhscatter.analysis.dissipative.models import time_to_energy
 from hhscatter.analysis.geometry import distance as dist
-from hhscatter.analysis.stats.verdicts import NO_VERDICT
 from hhscatter.model import HenonHeiles
+from hhscatter.reproduction.verdicts import NO_VERDICT
 
 E_C = HenonHeiles().critical_energy  # the paper's system's E_c
 from hhscatter.analysis.dissipative.transitions import tau2_predicted

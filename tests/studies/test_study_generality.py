@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.stats.verdicts import NO_VERDICT
+from hhscatter.reproduction.verdicts import NO_VERDICT
 
 ROOT = Path(__file__).resolve().parents[2]
 SYSTEMS = {"henon_heiles", "contopoulos", "barbanis"}

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.stats.verdicts import NO_VERDICT, verdict
+from hhscatter.analysis.stats.verdicts import verdict
+from hhscatter.reproduction.verdicts import NO_VERDICT
 
 ROOT = Path(__file__).resolve().parents[2]
 

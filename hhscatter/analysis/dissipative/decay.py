@@ -44,6 +44,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.measured import WithErrors
 
 __all__ = [
     "DecayExponent",
@@ -248,7 +249,7 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
 # fitting μ
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class EnergyDecayFit:
+class EnergyDecayFit(WithErrors):
     """Result of :func:`fit_energy_decay` (all μ dimensionless).
 
     Fixed intercept, the paper's Eq. (eqn:energy_exp_decay) with E(0) = E0:
@@ -259,6 +260,9 @@ class EnergyDecayFit:
     ``window`` is the (t_lo, t_hi) used, ``n_points`` the number of grid times
     in it.  Errors are 1σ (NaN when not determinable, e.g. too few points).
     """
+
+    method = "least squares of log ⟨E⟩"
+    n_field = "n_points"
 
     mu: float
     mu_err: float
@@ -358,7 +362,8 @@ def _decay_window(t, mean_E, E0, gamma, window, weights):
 
 
 def _fit_fixed_intercept(t, y, w, E0, gamma, errors):
-    """The paper's fit, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a usable point."""
+    """The fit with the intercept fixed at log E0, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a
+    usable point (the fit of arXiv:2308.13555)."""
     nan = float("nan")
     if t.size >= 1 and np.sum(w * t * t) > 0:
         fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
@@ -585,9 +590,11 @@ def bootstrap_mu_first_orbits(
 
 
 @dataclass(frozen=True)
-class DecayExponent:
+class DecayExponent(WithErrors):
     """Result of :func:`decay_exponent`: μ (dimensionless), its bootstrap error, the snapshot rows at or below E_c
     and the fit window (time units)."""
+
+    method = "least squares of log ⟨E⟩, bootstrap over orbits"
 
     mu: float
     mu_err: float

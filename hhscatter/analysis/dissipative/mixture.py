@@ -301,7 +301,7 @@ def mixture_survival_model(
     hazard: str = "paper",
     tau2=None,
 ):
-    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c, hazard="paper") -> P(t).
+    """mixture_survival_model(t, *, kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c, hazard) -> P(t).
 
     Mixture generalisation of Eq. (eqn:surv_prob_model):
     P(t) = Σ_k P_k(t), each sub-ensemble k following the homogeneous model

@@ -30,11 +30,10 @@ from hhscatter.analysis.dissipative.survival_model import (
     settling_rate,
     survival_model,
 )
-from hhscatter.analysis.survival.kappa_law import PAPER_KAPPA, PiecewiseKappa
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 
 __all__ = [
     "HAZARDS",
-    "PAPER_KAPPA",
     "MixtureComponents",
     "MixtureModelParams",
     "PiecewiseKappa",

@@ -82,7 +82,7 @@ def settling_rate(t, tau2: float, L: float, b: float):
 
 
 def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
-    """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0) ("paper") or ∫_{τ0}^t κ0(E(s))ds ("integrated")."""
+    """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0), or ∫_{τ0}^t κ0(E(s))ds with hazard "integrated"."""
     t = np.asarray(t, dtype=float)
     if hazard == "paper":
         return np.asarray(kappa_of_E(energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
@@ -132,7 +132,7 @@ def survival_model(
     E_c: float,
     hazard: str = "paper",
 ):
-    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard="paper") -> P(t).
+    """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard) -> P(t).
 
     The paper's survival model, Eq. (eqn:surv_prob_model), with
     κ_γ(t) = κ0(E(t)) and E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)):
@@ -142,7 +142,7 @@ def survival_model(
                       f_ne + f_e exp(−∫_{τ0}^t κ_γ ds)      [hazard="integrated"]
         t > τ2        f_ne exp(−g(t)(t − τ2)),  g = L/(1 + e^{−b(t−τ2)})²
 
-    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. :data:`~hhscatter.analysis.survival.kappa_law.PAPER_KAPPA`);
+    ``kappa_of_E`` is κ0(E) (vectorised callable, e.g. a :class:`~hhscatter.analysis.survival.kappa_law.PiecewiseKappa`);
     ``tau2=None`` uses Eq. (eq:tau2), ln(E0/E_c)/(μγ).  See the module
     docstring for why the literal ("paper") escape factor is non-monotone.
     Returns an array shaped like ``t`` (float if ``t`` is scalar).

@@ -1,4 +1,6 @@
-"""Transition times τ1, τ2 (paper Sec. III.A.2, III.B.1, Fig. 6b = fig:model_data_comparison).
+"""Transition times τ1, τ2 of a dissipative ensemble: the start of enhanced trapping and the end of the escapes.
+
+Sections III.A.2, III.B.1 and the model-data comparison of arXiv:2308.13555 define them:
 
 * τ0 — end of the irregular, ensemble-dependent initial decay; independent of
   γ, an input here.

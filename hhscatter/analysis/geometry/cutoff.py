@@ -27,13 +27,16 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.geometry.uncertainty import weighted_line
+from hhscatter.analysis.stats.measured import WithErrors
 
 __all__ = ["CutoffComparison", "DecisionRate", "cutoff_comparison", "decision_rate", "predicted_cutoff"]
 
 
 @dataclass(frozen=True)
-class DecisionRate:
+class DecisionRate(WithErrors):
     """Result of :func:`decision_rate`: rate λ (1/time) with its error, offset t0 (time), per-ε table."""
+
+    method = "least squares of the decision times"
 
     lam: float
     lam_err: float

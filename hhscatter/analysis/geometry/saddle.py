@@ -20,7 +20,7 @@ Functions here are pure (arrays and DataFrames in, frozen results out; no file I
 * :func:`mean_lyapunov` — λ̄ and the distribution of finite-time Lyapunov exponents from per-orbit accumulated
   log-stretching factors Λ_i over durations T_i; :func:`lyapunov_convergence` — λ̄ against T.
 * :func:`kantz_grassberger` — κ against λ̄(1 − d₁), both with errors, and the verdict of the project's one rule
-  (:func:`hhscatter.analysis.stats.verdicts.row_verdict`, reference kind "propagated": the right-hand side is
+  (:func:`hhscatter.analysis.stats.verdicts.verdict`, the 2σ comparison with both errors: the right-hand side is
   another measurement with its own 1σ).
 
 Box counting
@@ -58,7 +58,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent
-from hhscatter.analysis.stats.verdicts import row_verdict
+from hhscatter.analysis.stats.verdicts import verdict
 from hhscatter.errors import ConfigError
 from hhscatter.outcomes import LEAVING_OUTCOMES
 
@@ -746,8 +746,8 @@ def kantz_grassberger(
     points in a surface of section of a two-degree-of-freedom Hamiltonian flow (an area-preserving return map, whose
     saddle has equal partial dimensions along both directions) and uses d₁/2. The prediction's error is propagated
     from λ̄'s and d₁'s, taken as independent: σ² = (1 − d₁)² σ_λ² + λ̄² σ_d². The verdict is the project's one rule
-    (:func:`~hhscatter.analysis.stats.verdicts.row_verdict`) with the prediction as a reference of kind
-    "propagated" (another measurement, its own 1σ): agrees when |κ − λ̄(1 − d₁)| ≤ 2σ with both errors.
+    (:func:`~hhscatter.analysis.stats.verdicts.verdict`) with the prediction as a reference carrying its own
+    propagated 1σ (another measurement): agrees when |κ − λ̄(1 − d₁)| ≤ 2σ with both errors.
 
     Examples
     --------
@@ -776,7 +776,6 @@ def kantz_grassberger(
     spred = math.hypot((1.0 - d) * sl, lam * sd)
     sig = math.hypot(sk, spred)
     z = (k - pred) / sig if sig > 0 else (0.0 if k == pred else math.copysign(math.inf, k - pred))
-    row = {"ours": k, "err": sk, "paper": pred, "paper_err": spred, "reference_kind": "propagated"}
     return KantzGrassberger(
         kappa=k,
         kappa_err=sk,
@@ -787,5 +786,5 @@ def kantz_grassberger(
         d1_implied=1.0 - k / lam,
         d1_implied_err=math.hypot(sk / lam, k * sl / lam**2),
         z=float(z),
-        verdict=row_verdict(row),
+        verdict=verdict(k, sk, pred, spred).text(),
     )

@@ -24,6 +24,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.geometry.ulam import saddle_kappa, sample_transitions
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
 
 __all__ = [
@@ -165,18 +166,17 @@ def residuals(value, err, ref, ref_err) -> dict:
     """
     value, err, ref, ref_err = (float(v) for v in (value, err, ref, ref_err))
     res = value / ref - 1.0
-    # the ratio's error from both: σ_r/r in quadrature, r = κ/κ_ref
-    res_err = (value / ref) * math.hypot(err / value, ref_err / ref)
+    res_err = (Measured(value, err) / Measured(ref, ref_err)).err  # the error of r = κ/κ_ref
     sig = math.hypot(err, ref_err)
     return {"residual": res, "residual_err": res_err, "z": (value - ref) / sig if sig > 0 else math.inf}
 
 
-def convergence_record(E, grid, boot_grid, kappa_finest, refs, *, verdicts: bool = True) -> dict:
+def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
     """The record of κ's convergence at energy E: :func:`kappa_convergence` of ``grid`` (with ``boot_grid``)
     and, for each reference in ``refs`` ({name: (κ_ref, err) or None}), :func:`residuals` of κ∞ against it
     (keys residual_<name>, residual_<name>_err, z_<name> and verdict_<name>, the one verdict rule of
-    :func:`hhscatter.analysis.stats.verdicts.verdict`; none with ``verdicts`` False, for a smoke-test scale). A grid too small for the fit gives kappa_inf None
-    and the reason in ``note``."""
+    :func:`hhscatter.analysis.stats.verdicts.verdict`). A grid too small for the fit gives kappa_inf None and the
+    reason in ``note``."""
     rec = {"energy": float(E), "kappa_finest": float(kappa_finest)}
     try:
         c = kappa_convergence(grid, boot_grid)
@@ -197,8 +197,7 @@ def convergence_record(E, grid, boot_grid, kappa_finest, refs, *, verdicts: bool
                 f"z_{name}": r["z"],
             }
         )
-        if verdicts:
-            rec[f"verdict_{name}"] = verdict(c["kappa_inf"], c["err"], ref[0], ref[1]).text()
+        rec[f"verdict_{name}"] = verdict(c["kappa_inf"], c["err"], ref[0], ref[1]).text()
         rf = residuals(kappa_finest, 0.0, ref[0], ref[1])  # the finest partition's offset, for the page
         rec[f"residual_finest_{name}"] = rf["residual"]
     return rec

@@ -71,6 +71,7 @@ import pandas as pd
 from scipy import optimize, stats
 
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.analysis.stats.measured import WithErrors
 
 __all__ = [
     "UncertaintyCutoff",
@@ -205,7 +206,7 @@ def _loglin_binomial(X, k, n, offset):
 
 
 @dataclass(frozen=True)
-class UncertaintyExponent:
+class UncertaintyExponent(WithErrors):
     """Result of :func:`uncertainty_exponent`.
 
     alpha, alpha_err (uncertainty exponent, 1σ), dim (D of the space of
@@ -214,6 +215,9 @@ class UncertaintyExponent:
     largest ε fitted), n_points, chi2 (Pearson), dof, p_value; eps, f, n and
     fitted (mask of the points used) for plots.
     """
+
+    method = "least squares of log f(ε)"
+    n_field = "n_points"
 
     alpha: float
     alpha_err: float
@@ -318,7 +322,7 @@ def uncertainty_exponent(eps, f, n, *, eps_range=None, dim: float = 2.0) -> Unce
 
 
 @dataclass(frozen=True)
-class UncertaintyCutoff:
+class UncertaintyCutoff(WithErrors):
     """Result of :func:`uncertainty_cutoff`.
 
     detected (bool), eps_c (best break; NaN when not detected), eps_c_lo,
@@ -330,6 +334,8 @@ class UncertaintyCutoff:
     (the :class:`UncertaintyExponent` fit of the same points); profile_eps and
     profile_2ll (2ℓ(x_c), for plots).
     """
+
+    method = "least squares of log f(ε) with a cutoff"
 
     detected: bool
     eps_c: float

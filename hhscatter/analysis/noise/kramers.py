@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 
 __all__ = ["KramersLanger", "SaddleTerm", "ThermalRate", "hessian", "kramers_langer", "thermal_rate"]
@@ -158,7 +159,7 @@ def kramers_langer(model, gamma: float, temperature: float) -> KramersLanger:
 
 
 @dataclass(frozen=True)
-class ThermalRate:
+class ThermalRate(WithErrors):
     """A measured long-time escape rate: ``rate`` ± ``rate_err`` (1/time) on [t_start, t_stop], from
     ``n_events`` escapes over ``exposure`` (orbit·time); ``halves``: the rates on the window's two halves (a
     constant hazard gives equal ones within their errors), each (rate, err).
@@ -166,6 +167,9 @@ class ThermalRate:
     A window without an escape holds no rate: ``rate`` and ``rate_err`` are NaN, ``is_bound`` is True and
     ``upper95`` (1/time) is the one-sided 95 % upper bound −ln(0.05)/exposure
     (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_mle`); compare it as a bound, never as a value."""
+
+    method = "maximum likelihood (events / exposure)"
+    n_field = "n_events"
 
     rate: float
     rate_err: float

@@ -14,9 +14,16 @@ P_T(t) ≈ f_s e^{−k (t − τ̄)}. Comparing it with the measured P_T(t) test
 
 from __future__ import annotations
 
-import numpy as np
+import math
+from dataclasses import dataclass
 
-__all__ = ["reactivation_survival"]
+import numpy as np
+import pandas as pd
+
+from hhscatter.analysis.noise.kramers import ThermalRate, thermal_rate
+from hhscatter.analysis.survival.kaplan_meier import survival_curve
+
+__all__ = ["ReactivationCheck", "reactivation_check", "reactivation_survival"]
 
 
 def reactivation_survival(t, t_end, escaped, settled, rate: float) -> np.ndarray:
@@ -57,3 +64,107 @@ def reactivation_survival(t, t_end, escaped, settled, rate: float) -> np.ndarray
     react = np.exp(-rate * wait).sum(axis=1)
     alive_cens = (t_end[censored][None, :] > t[:, None]).sum(axis=1)
     return (alive_esc + react + alive_cens) / n
+
+
+@dataclass(frozen=True)
+class ReactivationCheck:
+    """Result of :func:`reactivation_check` (times in time units, rates in 1/time).
+
+    table               t, P_T, P_T_err (Kaplan–Meier of the heat-bath ensemble), P_0 (drag only, leaving =
+                        escaped or settled), P_0_settled_inside (drag only, settled orbits inside for ever:
+                        1 − escapes up to t / N), model (:func:`reactivation_survival` with the thermal rate)
+    settled_fraction, escaped_fraction   of the drag-only ensemble
+    t_settled_99        99 % quantile of the drag-only settling times (0 without a settled orbit)
+    tail                the constant-hazard MLE of P_T on [tail_start, t_max] (:func:`thermal_rate`)
+    max_deviation, max_deviation_at, max_deviation_sigma
+                        max |P_T − model| over the grid, where, and in units of P_T's error there (inf: no error)
+    """
+
+    table: pd.DataFrame
+    settled_fraction: float
+    escaped_fraction: float
+    t_settled_99: float
+    tail: ThermalRate
+    max_deviation: float
+    max_deviation_at: float
+    max_deviation_sigma: float
+
+
+def reactivation_check(
+    t_end0, escaped0, settled0, t_end, escaped, rate: float, t_max: float, tail_start: float, n_grid: int = 401
+) -> ReactivationCheck:
+    """reactivation_check(drag-only t_end0, escaped0, settled0, heat-bath t_end, escaped, thermal rate, t_max,
+    tail_start) -> :class:`ReactivationCheck`: the measured P_T(t) of the heat-bath ensemble against the
+    re-activation extension of the drag-only one (:func:`reactivation_survival`), and the rate of its tail.
+
+    Parameters
+    ----------
+    t_end0, escaped0, settled0 : arrays (N0,)
+        The drag-only ensemble: end times (time units), escaped and settled masks (neither: censored).
+    t_end, escaped : arrays (N,)
+        The heat-bath ensemble: end times and escaped mask.
+    rate : float
+        The thermal escape rate of a settled orbit (1/time), measured apart (e.g. :func:`thermal_rate` of orbits
+        started in the well).
+    t_max : float
+        The heat-bath runs' end time; the grid of ``n_grid`` times runs from 0 to it, or to the earliest
+        censoring of the drag-only ensemble if sooner.
+    tail_start : float
+        Start of the window [tail_start, t_max] of the tail's rate; it must not precede the drag-only orbits'
+        99 % settling time (``ValueError``).
+
+    Examples
+    --------
+    Orbits that settle at τ ~ U(0, 10) and then leave at rate k = 0.05 in the bath: the model holds, the tail's
+    rate is k.
+
+    >>> rng = np.random.default_rng(0)
+    >>> tau = rng.uniform(0, 10, 4000)
+    >>> t_bath = tau + rng.exponential(20.0, tau.size)
+    >>> c = reactivation_check(tau, np.zeros(tau.size, bool), np.ones(tau.size, bool),
+    ...                        np.minimum(t_bath, 200.0), t_bath < 200.0, 0.05, 200.0, 20.0)
+    >>> c.settled_fraction, bool(c.max_deviation < 0.03), bool(abs(c.tail.rate - 0.05) < 3 * c.tail.rate_err)
+    (1.0, True, True)
+    """
+    t0, esc0, set0 = (np.asarray(a) for a in (t_end0, escaped0, settled0))
+    t0, esc0, set0 = t0.astype(float), esc0.astype(bool), set0.astype(bool)
+    tT, escT = np.asarray(t_end, dtype=float), np.asarray(escaped, dtype=bool)
+    cens0 = ~(esc0 | set0)
+    t_hi = min(t_max, float(t0[cens0].min()) if cens0.any() else t_max)
+    grid = np.linspace(0.0, t_hi, n_grid)
+    P_T = survival_curve(tT, escT, grid)
+    P_0 = survival_curve(t0, esc0 | set0, grid)  # drag only: leaving = escaped or settled
+    # drag only, settled orbits counted inside for ever: 1 − (escapes up to t)/N (t ≤ the earliest censoring)
+    settled_alive = 1.0 - np.searchsorted(np.sort(t0[esc0]), grid, side="right") / len(t0)
+    model = reactivation_survival(grid, t0, esc0, set0, rate)
+    # the tail of P_T: the MLE rate on [tail_start, t_max], after the drag-only orbits have settled (their
+    # 99 % settling time is recorded beside it) and relaxed
+    t_settled = float(np.quantile(t0[set0], 0.99)) if set0.any() else 0.0
+    if tail_start < t_settled:
+        raise ValueError(
+            f"tail_start = {tail_start:g} is before the drag-only orbits have settled (99 % by t = {t_settled:g})"
+        )
+    tail = thermal_rate(tT, escT, tail_start, t_max)
+    dev = np.abs(P_T.P - model)
+    ok = np.isfinite(dev)
+    i = int(np.nanargmax(np.where(ok, dev, -1)))
+    table = pd.DataFrame(
+        {
+            "t": grid,
+            "P_T": P_T.P,
+            "P_T_err": P_T.P_err,
+            "P_0": P_0.P,
+            "P_0_settled_inside": settled_alive,
+            "model": model,
+        }
+    )
+    return ReactivationCheck(
+        table=table,
+        settled_fraction=float(set0.mean()),
+        escaped_fraction=float(esc0.mean()),
+        t_settled_99=t_settled,
+        tail=tail,
+        max_deviation=float(dev[i]),
+        max_deviation_at=float(grid[i]),
+        max_deviation_sigma=float(dev[i] / P_T.P_err[i]) if P_T.P_err[i] > 0 else math.inf,
+    )

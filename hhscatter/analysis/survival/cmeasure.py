@@ -18,6 +18,8 @@ import numpy as np
 from scipy import optimize
 from scipy.special import logsumexp
 
+from hhscatter.analysis.stats.measured import WithErrors
+
 __all__ = ["CMeasureKappa", "cmeasure_sample_from_sections", "kappa_from_cmeasure"]
 
 
@@ -25,13 +27,16 @@ __all__ = ["CMeasureKappa", "cmeasure_sample_from_sections", "kappa_from_cmeasur
 # κ from the c-measure of the true-time map
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class CMeasureKappa:
+class CMeasureKappa(WithErrors):
     """Result of :func:`kappa_from_cmeasure` (κ in 1/time).
 
     kappa, kappa_err (bootstrap std), kappa_err_delta (delta method),
     mu_exit = n_exit/M (the c-measure of the exit set, μ_c(𝓔)), n_samples M,
     n_exit, boot (bootstrap replicates of κ).
     """
+
+    method = "c-measure"
+    n_field = "n_samples"
 
     kappa: float
     kappa_err: float

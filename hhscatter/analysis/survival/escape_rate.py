@@ -1,4 +1,5 @@
-"""Escape rate κ of the conservative Hénon–Heiles system (paper Sec. II, Fig. 2).
+"""Escape rate κ of an open conservative system from its orbits' lifetimes: window fits of log P(t), the MLE,
+the escaping tail (Sec. II of arXiv:2308.13555).
 
 * :func:`~hhscatter.analysis.survival.windows.choose_windows` (module ``windows``) — data-driven τ0 and the 4
   fitting windows of the exponential regime of Eq. (eqn:kappa_hyperbolic);
@@ -30,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.cmeasure import (
     CMeasureKappa,
     cmeasure_sample_from_sections,
@@ -74,7 +76,7 @@ __all__ = [
 # escape rate
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class MLERate:
+class MLERate(WithErrors):
     """Result of :func:`escape_rate_mle`: κ = events / exposure on [t_start, t_stop].
 
     kappa, kappa_err (1/time; err = κ/√events), n_events, exposure (orbit·time),
@@ -84,6 +86,9 @@ class MLERate:
     one-sided 95 % upper bound −ln(0.05)/exposure ≈ 3.0/exposure (1/time; infinite without exposure);
     ``is_bound`` is True. With escapes, ``upper95`` is NaN.
     """
+
+    method = "maximum likelihood (events / exposure)"
+    n_field = "n_events"
 
     kappa: float
     kappa_err: float
@@ -165,7 +170,7 @@ def power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate:
 
 
 @dataclass(frozen=True)
-class EscapeRateResult:
+class EscapeRateResult(WithErrors):
     """Result of :func:`escape_rate` (κ in 1/time, times in time units).
 
     kappa           mean of the 4 window fits (Fig. 2b caption)
@@ -182,6 +187,8 @@ class EscapeRateResult:
     curve           the :class:`SurvivalCurve` on the analysis grid
     n_total         N
     """
+
+    method = "least-squares fits of log P over plateau windows"
 
     kappa: float
     kappa_err: float

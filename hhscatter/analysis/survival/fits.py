@@ -1,6 +1,6 @@
-"""Survival probability P(t) and its exponential / power-law regimes (paper Sec. II).
+"""Survival probability P(t) and its exponential / power-law regimes.
 
-The paper describes the survival probability of an ensemble started in the
+Sec. II of arXiv:2308.13555 (the paper) describes the survival probability of an ensemble started in the
 scattering region Ω as
 
 * Eq. (eqn:kappa_hyperbolic), hyperbolic saddles:
@@ -55,6 +55,7 @@ from hhscatter.analysis.stats.least_squares import (
     least_squares_operator,
     weighted_least_squares,
 )
+from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.kaplan_meier import SurvivalCurve, survival_curve
 from hhscatter.outcomes import CENSORED, CENSORING_OUTCOMES, LEAVING_OUTCOMES, OUTCOMES
 
@@ -247,7 +248,7 @@ def mean_kappa_stat_err(t, P, P_err, windows) -> float:
 
 
 @dataclass(frozen=True)
-class ExponentialFit:
+class ExponentialFit(WithErrors):
     """Result of :func:`fit_exponential`: log P = log f0 − κ t on ``window``.
 
     kappa, kappa_err      escape rate κ and its 1σ error (1/time); the error
@@ -259,6 +260,9 @@ class ExponentialFit:
     n_points              grid points used; rms_log_residual  rms of log-P residuals
     weighted              True if weighted by 1/σ²(log P)
     """
+
+    method = "least squares of log P"
+    n_field = "n_points"
 
     kappa: float
     kappa_err: float
@@ -306,7 +310,7 @@ def fit_exponential(t, P, window, P_err=None) -> ExponentialFit:
 
 
 @dataclass(frozen=True)
-class PowerLawFit:
+class PowerLawFit(WithErrors):
     """Result of :func:`fit_power_law_tail`: log P = log f* − z log t on ``window``.
 
     z, z_err              power-law exponent of Eq. (eqn:kappa_nonhyperbolic) and
@@ -321,6 +325,9 @@ class PowerLawFit:
     delta_aic_split       AIC gain of "exponential then power law" over one exponential on [τ0, end]
     delta_aic_tail        AIC gain of a power law over an exponential on the tail window
     """
+
+    method = "least squares of log P against log t"
+    n_field = "n_points"
 
     z: float
     z_err: float

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.fits import (
     fit_exponential,
     mean_kappa_stat_err,
@@ -43,8 +44,10 @@ from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy, kappa_law
 
 
 @dataclass(frozen=True)
-class ConventionRate:
+class ConventionRate(WithErrors):
     """κ of one convention at one energy (1/time); ``defined`` False with a ``reason`` when ill-defined."""
+
+    method = "plateau windows of one convention"
 
     kappa: float
     kappa_err: float

@@ -17,6 +17,7 @@ from scipy import optimize
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured, WithErrors
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 
@@ -25,7 +26,7 @@ __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 # κ(E): piecewise law of Fig. 2b
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class KappaEnergyFit:
+class KappaEnergyFit(WithErrors):
     """Result of :func:`fit_kappa_energy`; with x = E − E_c,
 
         κ = a x² + b x   for E < E_b   (non-linear regime),
@@ -37,6 +38,8 @@ class KappaEnergyFit:
     (``boot_err``, same order; ``boot`` holds the replicates).  ``continuous``
     tells which model was fitted (then c = a x_b + b).  ``chi2``/``dof`` of the best fit.
     """
+
+    method = "weighted least squares of κ(E)"
 
     a: float
     b: float
@@ -286,8 +289,7 @@ def kappa_law_summary(fit) -> dict:
     for i, name in enumerate(("a", "b", "c", "E_b")):
         cov_err = getattr(fit, f"{name}_err")
         out[name] = {
-            "value": float(getattr(fit, name)),
-            "err": float(max(cov_err, boot[i])),
+            **Measured.of(getattr(fit, name), max(cov_err, boot[i])).to_dict(),
             "err_cov": float(cov_err),
             "err_boot": float(boot[i]),
         }

@@ -2,8 +2,8 @@
 
 :class:`PiecewiseKappa` holds the piecewise law κ0 = a2 ΔE² + a1 ΔE below
 E_switch and slope·ΔE above (ΔE = E − E_c, zero below E_c); the coefficients
-are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` (study
-fig2) or are the paper's (:data:`PAPER_KAPPA`). E_c comes from the model.
+are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` or given. E_c comes from
+the model.
 """
 
 from __future__ import annotations
@@ -12,16 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hhscatter.model import HenonHeiles
-
-__all__ = ["PAPER_KAPPA", "PiecewiseKappa"]
+__all__ = ["PiecewiseKappa"]
 
 
 @dataclass(frozen=True)
 class PiecewiseKappa:
     """PiecewiseKappa(E_c, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27) -> callable κ0(E).
 
-    Conservative escape rate as a function of energy (paper Fig. 2b), with
+    Conservative escape rate as a function of energy, with
     ΔE = E − E_c:
 
         κ0 = a2 ΔE² + a1 ΔE   for E_c < E < E_switch   (non-hyperbolic regime)
@@ -29,7 +27,7 @@ class PiecewiseKappa:
         κ0 = 0                for E ≤ E_c              (no escape)
 
     E_c is the system's (``scene.model.critical_energy``; no default: it comes from the system). Defaults of
-    the coefficients are the paper's fits for Hénon–Heiles (:data:`PAPER_KAPPA`).  Calling it on an array returns an array
+    the coefficients are the fits of arXiv:2308.13555 for Hénon–Heiles.  Calling it on an array returns an array
     (rates in 1/time).  Note the two branches do not join exactly at
     E_switch (0.1486 vs 0.1457 with the defaults).
     """
@@ -45,7 +43,3 @@ class PiecewiseKappa:
         d = E - self.E_c
         k = np.where(E < self.E_switch, self.a2 * d * d + self.a1 * d, self.slope * d)
         return np.where(d > 0, k, 0.0)
-
-
-PAPER_KAPPA = PiecewiseKappa(E_c=HenonHeiles().critical_energy)
-"""κ0(E) with the paper's fitted coefficients (Fig. 2b), for the paper's system (Hénon–Heiles, ω = λ = 1)."""

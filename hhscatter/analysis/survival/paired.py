@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.kaplan_meier import survival_curve
 
 __all__ = ["PairedShift", "RatioSlope", "paired_mle_shift", "survival_ratio_slope"]
@@ -27,7 +28,7 @@ __all__ = ["PairedShift", "RatioSlope", "paired_mle_shift", "survival_ratio_slop
 # κ shifts between escape criteria
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class PairedShift:
+class PairedShift(WithErrors):
     """Result of :func:`paired_mle_shift` (1/time).
 
     kappa_ref, kappa_ref_err, kappa_alt, kappa_alt_err (each MLE with its own
@@ -35,6 +36,8 @@ class PairedShift:
     shift_err_unpaired (√(σ_ref² + σ_alt²), as if the samples were
     independent), correlation of the two estimates.
     """
+
+    method = "paired maximum likelihood"
 
     kappa_ref: float
     kappa_ref_err: float
@@ -95,13 +98,15 @@ def paired_mle_shift(t_ref, observed_ref, t_alt, observed_alt, t_start: float, t
 
 
 @dataclass(frozen=True)
-class RatioSlope:
+class RatioSlope(WithErrors):
     """Result of :func:`survival_ratio_slope` (κ in 1/time, times in time units).
 
     shift = κ_alt − κ_ref (minus the slope of log(P_alt/P_ref)), shift_err
     (from ``n_groups`` disjoint groups of orbits), offset = fitted
     log(P_alt/P_ref) at the window start, window, group_shifts.
     """
+
+    method = "slope of log P_alt/P_ref"
 
     shift: float
     shift_err: float

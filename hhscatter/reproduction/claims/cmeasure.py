@@ -11,6 +11,7 @@ from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import paired_distance as pdist
 from hhscatter.analysis.geometry.distance import first_crossings
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.analysis.survival.cmeasure import (
     cmeasure_sample_from_sections,
@@ -18,7 +19,8 @@ from hhscatter.analysis.survival.cmeasure import (
 )
 from hhscatter.reproduction.claims.kappa import rate_or_reason
 from hhscatter.reproduction.claims.keys import cm_key, sec_key
-from hhscatter.reproduction.claims.records import ve, z_verdict
+from hhscatter.reproduction.claims.records import z_verdict
+from hhscatter.reproduction.model_tables import number_or_none
 
 
 def c5_window(p, ec):
@@ -105,7 +107,10 @@ def claim2(runs, claims, label, table, samples):
             ("escaping", "escaping orbits only, as the c-measure"),
         ):
             k0 = table[(table["convention"] == conv) & np.isclose(table["ratio"], r)].iloc[0]
-            row[f"kappa_{conv}"], row[f"kappa_{conv}_err"] = ve(k0["kappa"])["value"], ve(k0["kappa_err"])["value"]
+            row[f"kappa_{conv}"], row[f"kappa_{conv}_err"] = (
+                number_or_none(k0["kappa"]),
+                number_or_none(k0["kappa_err"]),
+            )
             q = f"κ_cm/κ0 − 1 at E/E_c = {r:g} ({what})"
             cm = (
                 f"κ_cm = {s['kappa_cm']:.4g} ± {s['kappa_cm_err']:.2g}"
@@ -136,8 +141,9 @@ def claim2(runs, claims, label, table, samples):
                 )
                 continue
             v = s["kappa_cm"] / k0["kappa"] - 1
+            # the absolute form of the ratio's error (Measured.ratio's relative form differs in the last digit)
             e = math.hypot(s["kappa_cm_err"] / k0["kappa"], s["kappa_cm"] * k0["kappa_err"] / k0["kappa"] ** 2)
-            row[f"ratio_minus_1_{conv}"] = ve(v, e)
+            row[f"ratio_minus_1_{conv}"] = Measured.of(v, e).to_dict()
             claims.add(
                 "2",
                 q,

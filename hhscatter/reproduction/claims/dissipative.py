@@ -21,6 +21,7 @@ from hhscatter.analysis.dissipative.transitions import (
     tau2_predicted,
 )
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.analysis.survival.effective_rate import (
     binned_hazard,
@@ -176,8 +177,8 @@ def tau2_ratio(obs, lo, hi, pred, pred_err) -> tuple[float, float]:
     if not all(math.isfinite(v) for v in vals) or vals[0] <= 0 or vals[3] <= 0:
         return math.nan, math.nan
     obs, lo, hi, pred, pred_err = vals
-    ratio = obs / pred
-    return ratio, ratio * math.hypot(0.5 * (hi - lo) / obs, pred_err / pred)
+    r = Measured(obs, 0.5 * (hi - lo)) / Measured(pred, pred_err)
+    return r.value, r.err
 
 
 def _decimals(err: float) -> int:

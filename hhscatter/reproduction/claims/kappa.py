@@ -6,6 +6,7 @@ import math
 
 from hhscatter.analysis.dissipative.transitions import power_law_exponent
 from hhscatter.analysis.stats.library_warnings import counted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 from hhscatter.analysis.survival.kappa_conventions import (
@@ -14,7 +15,7 @@ from hhscatter.analysis.survival.kappa_conventions import (
 )
 from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
 from hhscatter.reproduction.claims.keys import alt_key, grid_key
-from hhscatter.reproduction.claims.records import across, ve, z_verdict
+from hhscatter.reproduction.claims.records import across, z_verdict
 
 CONVENTIONS = ("plateau", "plevel", "escaping")
 
@@ -152,14 +153,14 @@ def fit_law(runs, table):
         err = lambda v, e, b: float(max(e, b)) if b is not None and math.isfinite(b) else float(e)
         be = f.boot_err if f.boot_err else (math.nan,) * 4
         per[conv] = {
-            "a": ve(f.a, err(f.a, f.a_err, be[0])),
-            "b": ve(f.b, err(f.b, f.b_err, be[1])),
-            "c": ve(f.c, err(f.c, f.c_err, be[2])),
-            "eps_b": ve(eps_b, err(eps_b, f.E_b_err, be[3])),
+            "a": Measured.of(f.a, err(f.a, f.a_err, be[0])).to_dict(),
+            "b": Measured.of(f.b, err(f.b, f.b_err, be[1])).to_dict(),
+            "c": Measured.of(f.c, err(f.c, f.c_err, be[2])).to_dict(),
+            "eps_b": Measured.of(eps_b, err(eps_b, f.E_b_err, be[3])).to_dict(),
             "chi2": f.chi2,
             "dof": f.dof,
-            "beta_low": None if lo is None else ve(*lo),
-            "beta_high": None if hi is None else ve(*hi),
+            "beta_low": None if lo is None else Measured.of(*lo).to_dict(),
+            "beta_high": None if hi is None else Measured.of(*hi).to_dict(),
             "n_points": len(d),
         }
     return per

@@ -19,9 +19,10 @@ from hhscatter.analysis.dissipative.kinetic import (
     kinetic_fraction_from_energies,
     microcanonical_kinetic_fraction,
 )
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.reproduction.claims.keys import diss_key, probe_key
-from hhscatter.reproduction.claims.records import ve, z_verdict
+from hhscatter.reproduction.claims.records import z_verdict
 
 
 def mu_conservative(runs, label, m, fits, keys=None):
@@ -268,15 +269,15 @@ def analyze_mu(runs, claims, label, spec, m, E0, fits):
         )
     ]
     numbers = {
-        "mu_measured": ve(*meas["paper"]),
-        "mu_predicted": ve(*pred["c-measure", "paper"]),
+        "mu_measured": Measured.of(*meas["paper"]).to_dict(),
+        "mu_predicted": Measured.of(*pred["c-measure", "paper"]).to_dict(),
         "mu_by_window": {
             name: {
                 "window": list(w),
-                "measured": ve(*meas[name]),
-                "predicted_c_measure": ve(*pred["c-measure", name]),
-                "predicted_all_survivors": ve(*pred["all survivors", name]),
-                "survivors_own_K": ve(*own[name]),
+                "measured": Measured.of(*meas[name]).to_dict(),
+                "predicted_c_measure": Measured.of(*pred["c-measure", name]).to_dict(),
+                "predicted_all_survivors": Measured.of(*pred["all survivors", name]).to_dict(),
+                "survivors_own_K": Measured.of(*own[name]).to_dict(),
             }
             for name, w in wins.items()
         },

@@ -6,24 +6,14 @@ import math
 
 import numpy as np
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import Verdict, verdict
-
-
-def ve(v, e=None) -> dict:
-    """ve(v, e=None) -> {'value': v, 'err': e}, non-finite numbers as None (JSON).
-
-    Examples
-    --------
-    >>> ve(1.5, float("nan"))
-    {'value': 1.5, 'err': None}
-    """
-    f = lambda x: None if x is None or not math.isfinite(float(x)) else float(x)  # noqa: E731
-    return {"value": f(v), "err": f(e)}
+from hhscatter.reproduction.model_tables import number_or_none
 
 
 def z_verdict(value, err, ref, label_ok, label_bad, ref_err=0.0) -> str:
     """z_verdict(value, err, ref, label_ok, label_bad, ref_err=0) -> '<label> (z = …)' by the one rule
-    (:data:`hhscatter.analysis.stats.verdicts.RULE`): |z| ≤ 2 is ``label_ok``, z = (value − ref)/√(err² + ref_err²),
+    (:data:`hhscatter.reproduction.verdicts.RULE`): |z| ≤ 2 is ``label_ok``, z = (value − ref)/√(err² + ref_err²),
     written as every verdict is (:meth:`~hhscatter.analysis.stats.verdicts.Verdict.text`, minus sign "−"); without a
     value, a reference or our error, "undetermined: <why>".
 
@@ -66,7 +56,7 @@ class Claims:
             "claim": claim,
             "quantity": quantity,
             "system": system,
-            **ve(value, err),
+            **{k: number_or_none(x) for k, x in Measured.of(value, err).to_dict().items()},
             "reference": reference,
             "verdict": verdict,
             "note": note,

@@ -3,11 +3,10 @@ per escape radius, with the same N and rules for each (the default radius and ``
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction.claims.kappa import rate_or_reason
 from hhscatter.reproduction.claims.keys import resc_key
 from hhscatter.reproduction.claims.mu import (
@@ -17,7 +16,6 @@ from hhscatter.reproduction.claims.mu import (
     mu_predicted,
     mu_windows,
 )
-from hhscatter.reproduction.claims.records import ve
 
 
 def resc_values(p, m) -> list:
@@ -62,11 +60,13 @@ def resc_rows(runs, systems) -> list:
                         "r_esc": r_esc,
                         "default": R is None,
                         "window": list(w),
-                        "mu_measured": ve(*meas[wname]),
-                        "mu_predicted": ve(pv, pe),
-                        "mu_own_K": ve(v, e),
-                        "moment_test": ve(v - pv, math.hypot(e, pe)),
-                        "kinetic_at_E0": ve(*(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))),
+                        "mu_measured": Measured.of(*meas[wname]).to_dict(),
+                        "mu_predicted": Measured.of(pv, pe).to_dict(),
+                        "mu_own_K": Measured.of(v, e).to_dict(),
+                        "moment_test": (Measured.of(v, e) - Measured.of(pv, pe)).to_dict(),
+                        "kinetic_at_E0": Measured.of(
+                            *(c[["mu", "mu_err"]].iloc[0] if len(c) else (None, None))
+                        ).to_dict(),
                         "kinetic_at_E0_interpolated_without_E0": float(
                             mu_of_E(mdf[~np.isclose(mdf["ratio"], p.e0_ratio)], ec)(E0)
                         ),

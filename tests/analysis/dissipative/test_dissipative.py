@@ -14,6 +14,7 @@ from scipy import stats
 from hhscatter.analysis.dissipative import decay, transitions
 from hhscatter.analysis.dissipative import models as model
 from hhscatter.analysis.geometry import distance
+from hhscatter.reproduction.fig2 import PAPER_KAPPA
 
 E0, GAMMA, MU, TAU0, EC = 0.3, 0.01, 0.91, 5.0, 1.0 / 6.0
 N_ORBITS = 100_000
@@ -170,12 +171,12 @@ def test_tau1_from_lifetime_tables():
 # ---------------------------------------------------------------------------
 # homogeneous survival model
 # ---------------------------------------------------------------------------
-KW = dict(kappa_of_E=model.PAPER_KAPPA, E0=E0, mu=MU, gamma=GAMMA, tau0=TAU0, E_c=model.PAPER_KAPPA.E_c)
+KW = dict(kappa_of_E=PAPER_KAPPA, E0=E0, mu=MU, gamma=GAMMA, tau0=TAU0, E_c=PAPER_KAPPA.E_c)
 TRUE = dict(f_ne=0.1, f_e=0.4, L=0.1, b=0.2)
 
 
 def test_paper_kappa_fit():
-    k = model.PAPER_KAPPA
+    k = PAPER_KAPPA
     np.testing.assert_allclose(k([0.1, EC, 0.2, 0.3]), [0, 0, 13.63 / 900 + 0.001, 1.41 * (0.3 - EC)])
 
 
@@ -186,7 +187,7 @@ def test_survival_model_branches():
     assert np.isnan(P[:2]).all()
     assert P[2] == pytest.approx(0.5)
     E30 = E0 * math.exp(-MU * GAMMA * 30)
-    assert P[3] == pytest.approx(0.1 + 0.4 * math.exp(-model.PAPER_KAPPA(E30) * 25))
+    assert P[3] == pytest.approx(0.1 + 0.4 * math.exp(-PAPER_KAPPA(E30) * 25))
     for i in (5, 6):
         g = 0.1 / (1 + math.exp(-0.2 * (t[i] - tau2))) ** 2
         assert P[i] == pytest.approx(0.1 * math.exp(-g * (t[i] - tau2)))
@@ -202,7 +203,7 @@ def test_integrated_hazard_closed_forms():
     for hz in ("paper", "integrated"):
         P = model.survival_model(t, **const, **TRUE, tau2=100.0, hazard=hz)
         np.testing.assert_allclose(P, 0.1 + 0.4 * np.exp(-0.07 * (t - TAU0)), rtol=1e-9)
-    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41, E_c=model.PAPER_KAPPA.E_c)  # κ = 1.41 (E − E_c)
+    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41, E_c=PAPER_KAPPA.E_c)  # κ = 1.41 (E − E_c)
     beta = MU * GAMMA
     K = 1.41 * (E0 * (np.exp(-beta * TAU0) - np.exp(-beta * t)) / beta - EC * (t - TAU0))
     P = model.survival_model(t, **dict(KW, kappa_of_E=lin), **TRUE, hazard="integrated")
@@ -260,7 +261,7 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
     P, P_err = binomial_sample(
         model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS, np.random.default_rng(21)
     )
-    other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709, E_c=model.PAPER_KAPPA.E_c)
+    other = model.PiecewiseKappa(a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709, E_c=PAPER_KAPPA.E_c)
     common = {"P_min": 20 / N_ORBITS, "hazard": hazard}
     right = model.fit_survival_model(t, P, P_err, **KW, **common)
     wrong = model.fit_survival_model(t, P, P_err, **dict(KW, kappa_of_E=other, mu=0.939), **common)
@@ -277,10 +278,8 @@ def test_better_fit_names_the_constants_that_made_the_data(hazard):
 
 
 def test_predict_tau1_solves_eq_tau1():
-    params = model.SurvivalModelParams(
-        model.PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2, model.PAPER_KAPPA.E_c
-    )
-    k0 = float(model.PAPER_KAPPA(E0))
+    params = model.SurvivalModelParams(PAPER_KAPPA, E0, MU, GAMMA, TAU0, 64.59, 0.1, 0.4, 0.1, 0.2, PAPER_KAPPA.E_c)
+    k0 = float(PAPER_KAPPA(E0))
 
     def P0(t):  # conservative curve at E0: P(τ0) e^{−κ0(E0)(t − τ0)}
         return 0.5 * np.exp(-k0 * (np.asarray(t) - TAU0))
@@ -351,7 +350,7 @@ def test_mixture_with_one_component_is_the_homogeneous_model():
     for hz in ("paper", "integrated"):
         Pm = model.mixture_survival_model(
             t,
-            kappa_of_E=model.PAPER_KAPPA,
+            kappa_of_E=PAPER_KAPPA,
             components=c,
             tau0=TAU0,
             f_ne=0.1,
@@ -372,7 +371,7 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     f_ne_true = np.array([0.03, 0.12])  # slow (μ = 0.6), fast (μ = 1.3)
     P_true = model.mixture_survival_model(
         t,
-        kappa_of_E=model.PAPER_KAPPA,
+        kappa_of_E=PAPER_KAPPA,
         components=true_components(),
         tau0=TAU0,
         f_ne=f_ne_true,
@@ -386,9 +385,7 @@ def test_mixture_fits_two_population_data_better(two_population_snapshots, hazar
     # homogeneous model with the paper's procedure: μ from ⟨E⟩ on [0, 200]
     m = decay.mean_energy(snaps)
     mu_h = decay.fit_energy_decay(m["t"], m["mean_E"], E0, GAMMA, (0, 200)).mu
-    common = dict(
-        kappa_of_E=model.PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard, E_c=model.PAPER_KAPPA.E_c
-    )
+    common = dict(kappa_of_E=PAPER_KAPPA, tau0=TAU0, P_min=20 / N_ORBITS, hazard=hazard, E_c=PAPER_KAPPA.E_c)
     homog = model.fit_survival_model(t, P, P_err, E0=E0, mu=mu_h, gamma=GAMMA, **common)
     mix = model.fit_mixture_model(t, P, P_err, snaps, gamma=GAMMA, n_components=2, by="rate", **common)
     table = model.compare_fits({"homogeneous": homog, "mixture": mix})

@@ -20,7 +20,7 @@ from hhscatter.analysis.dissipative.mixture import (
     mixture_survival_model,
 )
 from hhscatter.analysis.dissipative.survival_model import survival_model
-from hhscatter.analysis.survival.kappa_law import PAPER_KAPPA
+from hhscatter.reproduction.fig2 import PAPER_KAPPA
 
 E0, GAMMA, TAU0 = 0.3, 0.01, 5.0
 MU = np.array([0.6, 1.3])

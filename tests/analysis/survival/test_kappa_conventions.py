@@ -107,7 +107,8 @@ def test_law_spread_is_half_the_range_across_conventions():
 
 
 def test_quoted_verdict_uses_the_papers_printed_precision():
-    from hhscatter.analysis.stats.verdicts import half_unit, quoted_verdict
+    from hhscatter.analysis.stats.verdicts import half_unit
+    from hhscatter.reproduction.verdicts import quoted_verdict
 
     assert half_unit(0.27) == pytest.approx(0.005) and half_unit(13.63) == pytest.approx(0.005)
     assert half_unit(100.0) == 0.5 and half_unit(1.0) == 0.5

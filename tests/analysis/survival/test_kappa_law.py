@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy
-from hhscatter.analysis.survival.kappa_law import PAPER_KAPPA, PiecewiseKappa
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.model import HenonHeiles
+from hhscatter.reproduction.fig2 import PAPER_KAPPA
 
 E_C = HenonHeiles().critical_energy  # E_c comes from the system
 

@@ -8,13 +8,8 @@ import math
 
 import pytest
 
-from hhscatter.analysis.stats.verdicts import (
-    REFERENCE_KINDS,
-    claim_verdict,
-    reference_kind,
-    row_verdict,
-    verdict_class,
-)
+from hhscatter.analysis.stats.verdicts import verdict_class
+from hhscatter.reproduction.verdicts import REFERENCE_KINDS, claim_verdict, reference_kind, row_verdict
 
 
 def _z(ours, err, ref, ref_err):
@@ -96,7 +91,7 @@ def test_a_study_row_records_its_reference_kind_and_the_rules_verdict():
     from hhscatter.errors import StudyError
     from hhscatter.studies.study import load_study
 
-    study = load_study("fig3", "quick", root=Path(__file__).resolve().parents[3] / "studies")
+    study = load_study("fig3", "quick", root=Path(__file__).resolve().parents[2] / "studies")
     row = study.compare("β", 1.46, 0.12, 2.0, reference="exact")
     assert row["reference_kind"] == "exact" and row["verdict"] == "differs (z = −4.5)"
     row = study.compare("τ2", 64.0, 0.3, 64.6, reference="propagated", paper_err=0.36)
