@@ -14,7 +14,7 @@ each with its CPU time per unit of orbit time (µs of one core per orbit per tim
 alternating rounds in one process so that the machine's load hits all alike) and the rate's relative bias
 against a reference (BAOAB at the finest step with the most orbits) with its σ (both rates' statistical errors
 combined). Cost at equal accuracy: each method's cheapest case whose bias, widened by 2σ, is within ±1 %
-(``cheapest_within``), relative to the BAOAB's. Results: ``benchmarks/out/noise/rate.json`` and ``rate.md``.
+(``cheapest_within``), relative to the BAOAB's. Results: ``benchmarks/out/noise/rate.json`` and ``rate_summary.md``.
 """
 
 from __future__ import annotations
@@ -188,7 +188,7 @@ def main(argv=None):
         )
     lines += ["", f"Cheapest case within ±{ACCURACY:.0%} (bias + 2σ), cost relative to the {ref}'s:", ""]
     lines += [f"- {m}: {best[m]}, {ratios.get(m, float('nan')):.3g}×" for m in best]
-    (OUT / "rate.md").write_text("\n".join(lines) + "\n")
+    (OUT / "rate_summary.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

@@ -330,7 +330,8 @@ class _NoisySymplectic(Scheduler):
         if progress is not None and len(ics):
             progress(len(ics))
         e = np.empty(0)
-        return _Ends(outcome, t_end, state), 1, int(n_kicks * len(ics)), (np.empty(0, np.int64), e, e)
+        steps = int(np.ceil(t_end / P - 1e-9).sum())  # the symplectic steps taken (one per kick)
+        return _Ends(outcome, t_end, state), 1, steps, (np.empty(0, np.int64), e, e)
 
 
 __all__ = ["YOSHIDA4", "philox4x32", "scene_key", "symplectic_escapes"]
