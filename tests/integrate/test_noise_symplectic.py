@@ -198,3 +198,23 @@ def test_the_flow_key_selects_the_scheduler_and_is_checked():
         Noise(temperature=1 / 12, flow="rk4")
     d = _scene().to_dict()
     assert scene_from_dict(d) == _scene()
+
+
+def test_a_graze_between_two_step_ends_is_an_escape():
+    """An orbit on the y axis (where Hénon–Heiles keeps it) whose turning point y = 0.301 lies in the middle of a
+    step of h = 0.5: both step ends are inside r_esc = 0.3, the path is not; the escape is found at the crossing
+    of SciPy's DOP853 (tolerance 1e-13) to the interpolant's accuracy."""
+    model, r_esc, h = HenonHeiles(), 0.3, 0.5
+
+    def rhs(t, s):
+        fx, fy = model.force(s[0], s[1])
+        return [s[2], s[3], fx, fy]
+
+    turn = np.array([0.0, 0.301, 0.0, 0.0])
+    start = solve_ivp(rhs, (0.0, -0.5 * h), turn, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    end = solve_ivp(rhs, (0.0, 0.5 * h), turn, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    assert math.hypot(*start[:2]) < r_esc and math.hypot(*end[:2]) < r_esc
+    t_ref, _ = _dop853_escape(model, start, r_esc)
+    o, t, st = symplectic_escapes(model, start[None, :], [0], seed=1, gamma=0.0, sigma=0.0, h=h, n_kicks=1, r_esc=r_esc)
+    assert o[0] == ESCAPED and abs(t[0] - t_ref) < 1e-3, (t[0], t_ref)
+    assert math.hypot(st[0, 0], st[0, 1]) == pytest.approx(r_esc, abs=1e-12)
