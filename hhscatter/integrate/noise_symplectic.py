@@ -21,12 +21,17 @@ at t_max = K h), O(h) in between.
 Random numbers: counter-based. A scene with seed s has the key of
 ``SeedSequence(s, spawn_key=(NOISE_STREAM, 0, 1))`` (two 32-bit words, :func:`scene_key`); kicks 2m and 2m + 1
 of orbit ``traj_id`` use Philox4x32-10 (Salmon et al., SC'11) of the counter (m, 0, traj_id mod 2³²,
-traj_id div 2³²) under that key: four 32-bit words, four normals by Box–Muller (two per kick). An orbit's kicks depend on (seed, traj_id, k) alone: tables are the same, byte for byte,
-whatever the workers, chunks or batch size. (Other numbers than the Taylor flow's: the two flows give
+traj_id div 2³²) under that key: four 32-bit words, four normals by Box–Muller (two per kick). An orbit's
+kicks depend on (seed, traj_id, k) alone: tables are the same, byte for byte, whatever the workers, chunks or
+batch size. (Other numbers than the Taylor flow's: the two flows give
 statistically, not path by path, equal tables.)
 
-Weak error: the splitting's O(h²) as in the Taylor flow, plus the step's O(h⁴) error of the Hamiltonian flow;
-the escape rate's bias against a fine reference is measured in ``make bench`` (``benchmarks/noise_rate.py``).
+Weak error: the splitting's O(h²) as in the Taylor flow, plus the step's O(h⁴) error of the Hamiltonian flow
+(the invariant measure is no longer exact). The escape rate's bias against a fine reference, measured in
+``make bench`` (``benchmarks/noise_rate.py``, Hénon–Heiles at γ = 1, ΔE/T = 3), is +0.3 % ± 0.4 % at the default
+kick h = 0.1, +1.1 % ± 0.4 % at h = 0.25 and +3.8 % ± 0.4 % at h = 0.5 (the Taylor flow's: +1.5 % ± 0.4 % at
+h = 0.5); the cost per unit of orbit time at h = 0.1 is ≈ 1.1 µs, about that of a compiled BAOAB at dt = 0.1
+(its bias there −0.0 % ± 0.4 %), against ≈ 28 µs for the Taylor flow.
 """
 
 from __future__ import annotations

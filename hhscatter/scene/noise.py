@@ -17,7 +17,7 @@ __all__ = ["FLOWS", "KICKS_PER_ORBIT_MAX", "KICK_FRACTION", "KICK_MAX_FRACTION",
 #: the Hamiltonian flows between the kicks (the first is the default)
 FLOWS = ("taylor", "symplectic")
 #: the default kick interval of noise scenes, as a fraction of the shortest time scale min(1/ω, 1/γ)
-#: (:class:`Noise`; the measured weak error at this interval is stated there)
+#: (:class:`Noise`; the escape rate's measured bias at this interval, ≤ 1 % with either flow, is stated there)
 KICK_FRACTION = 0.1
 #: a kick interval above KICK_MAX_FRACTION · min(1/ω, 1/γ) is refused: the splitting resolves neither the
 #: oscillation nor the drag any more (the escape rate's weak error grows like h²)
@@ -51,9 +51,11 @@ class Noise:
     no crossing of r_esc is missed between kicks) and O the exact Ornstein–Uhlenbeck step on the momenta,
     p ← e^{−γδ} p + √(T(1 − e^{−2γδ})) ξ (σ√δ ξ without drag), δ = h/2. Both parts preserve the Boltzmann
     density e^{−H/T} exactly, so the invariant measure carries no splitting error at any h; dynamical
-    quantities (escape rates) carry a weak error O(h²). Measured on Hénon–Heiles (γ = 1, ΔE/T = 3, 1000
-    orbits): the escape rate at h = 0.3 differs from that at the default h = 0.1 by −0.6 % ± 5 %
-    (statistical), so with the h² scaling the weak error of the rate at h = 0.1 is below about 1 %.
+    quantities (escape rates) carry a weak error O(h²). Measured (``make bench``, ``benchmarks/noise_rate.py``:
+    Hénon–Heiles, γ = 1, ΔE/T = 3, the rate on [20, 150] against a compiled BAOAB at dt = 0.02 with 240 000
+    orbits): the rate's bias is +1.5 % ± 0.4 % at h = 0.5, +0.8 % ± 0.7 % at h = 0.2 and −1.6 % ± 1.5 % at
+    the default h = 0.1 (the h² law from h = 0.5 gives ≈ +0.1 % there); with ``flow = "symplectic"`` +3.8 % ±
+    0.4 % at h = 0.5, +1.1 % ± 0.4 % at h = 0.25 and +0.3 % ± 0.4 % at the default h = 0.1 (≈ 15 h² %).
 
     Parameters
     ----------
@@ -70,7 +72,7 @@ class Noise:
         at the scene's tolerance, events at their exact roots (:mod:`hhscatter.integrate.noise`);
         ``"symplectic"`` one compiled fourth-order symplectic step per kick with the escape at the exact root of
         its Hermite interpolant and counter-based random streams (:mod:`hhscatter.integrate.noise_symplectic`),
-        an order of magnitude cheaper (``make bench``). The two give statistically equal, not identical, tables.
+        ≈ 25× cheaper at the default kick (``make bench``). The two give statistically equal, not identical, tables.
 
     Raises
     ------

@@ -128,7 +128,11 @@ def _runs(study):
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
             runs[_nodrag_key(E, s)] = dict(
-                energy=E, gamma=0.0, t_max=p.nodrag_t_max, n=p.nodrag_n, noise={"sigma": s, "flow": p.flow} if s > 0 else None
+                energy=E,
+                gamma=0.0,
+                t_max=p.nodrag_t_max,
+                n=p.nodrag_n,
+                noise={"sigma": s, "flow": p.flow} if s > 0 else None,
             )
     scenes = {k: study.scene(k, **kw) for k, kw in runs.items()}
     for k, sc in scenes.items():
