@@ -55,7 +55,8 @@ class Noise:
     Hénon–Heiles, γ = 1, ΔE/T = 3, the rate on [20, 150] against a compiled BAOAB at dt = 0.02 with 240 000
     orbits): the rate's bias is +1.5 % ± 0.4 % at h = 0.5, +0.8 % ± 0.7 % at h = 0.2 and −1.6 % ± 1.5 % at
     the default h = 0.1 (the h² law from h = 0.5 gives ≈ +0.1 % there); with ``flow = "symplectic"`` +3.8 % ±
-    0.4 % at h = 0.5, +1.1 % ± 0.4 % at h = 0.25 and +0.3 % ± 0.4 % at the default h = 0.1 (≈ 15 h² %).
+    0.4 % at h = 0.5, +1.1 % ± 0.4 % at h = 0.25, +0.6 % ± 0.4 % at h = 0.2 and +0.3 % ± 0.4 % at the default
+    h = 0.1 (≈ 15 h² %).
 
     Parameters
     ----------
