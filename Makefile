@@ -150,10 +150,11 @@ $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
 	@touch $@
 
-bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets + the cost of noise → benchmarks/out/{bench,engine,noise}/
+bench: $(BENCH_STAMP) ## work–precision vs KahanLi8/DOP853/SciPy + throughput + engine targets + the cost of noise and the escape rate's work–precision with noise → benchmarks/out/{bench,engine,noise}/
 	$(PY) -m benchmarks $(BENCH_ARGS)
 	$(PY) -m benchmarks.engine -n 30000 --repeat 2
 	$(PY) -m benchmarks.noise
+	$(PY) -m benchmarks.noise_rate
 
 # the report runs the benchmarks only when their summaries are missing or their code changed
 $(BENCH_SUMMARY): $(wildcard benchmarks/*.py) benchmarks/bench.toml | $(BENCH_STAMP)

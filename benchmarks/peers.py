@@ -299,3 +299,12 @@ __all__ = [
     "kahanli8_propagate",
     "scipy_dop853",
 ]
+
+
+def baoab(ics, dt, *, gamma, temperature, r_esc=1.5, t_max=150.0, seed=1):
+    """Langevin escape times of Hénon–Heiles by a compiled BAOAB at step ``dt`` (time units): drag γ (1/time),
+    heat bath T (energy units); escapes resolved to ``dt``. Returns (t_end, escaped) arrays."""
+    k = _kernels()
+    return k.baoab_run(
+        _check_ics(ics), float(gamma), float(temperature), float(dt), float(r_esc), float(t_max), int(seed)
+    )

@@ -42,7 +42,7 @@ def study_names(root: Path) -> list:
     return [s.name for s in graph.studies(root / "studies")]
 
 
-BENCHES = ("bench", "stress", "engine")
+BENCHES = ("bench", "stress", "engine", "noise")
 CSV_MAX_BYTES = 200_000  # larger CSVs stay out of the repository's docs
 JSON_WARN_BYTES = 500_000
 

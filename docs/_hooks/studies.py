@@ -34,6 +34,8 @@ import re
 from pathlib import Path
 
 _MARKER = re.compile(r"^([ \t]*)<!--\s*hh:([a-z-]+)(?:\s+([\w.-]+))?\s*-->[ \t]*$", re.M)
+#: the make target that writes a benchmark's summaries, where it is not the benchmark's name
+_BENCH_TARGETS = {"engine": "bench-engine", "noise": "bench"}
 _SKIP_KEYS = {"study", "scale", "paper_comparison", "config", "provenance", "made_from", "sha256"}
 
 
@@ -440,7 +442,7 @@ class Renderer:
         if not summaries:
             return self.missing(
                 f"The {which} summary",
-                f"Run `make {'bench-engine' if which == 'engine' else which}` and then `make docs-assets` "
+                f"Run `make {_BENCH_TARGETS.get(which, which)}` and then `make docs-assets` "
                 f"to copy `studies/{which}/out/` here.",
             )
         text = "\n\n".join(_embed_markdown(s.read_text(), assets, self._rel) for s in summaries)

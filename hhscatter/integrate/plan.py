@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 # the built-in schedulers register themselves on import
-from hhscatter.integrate import epochs, events, noise, stream  # noqa: F401
+from hhscatter.integrate import epochs, events, noise, noise_symplectic, stream  # noqa: F401
 from hhscatter.integrate.events import Layout
 from hhscatter.integrate.schedulers import SCHEDULERS, select
 

@@ -146,6 +146,23 @@ class System(abc.ABC):
         """V as a heyoka expression of the heyoka variables ``x``, ``y``; ``hy``: the heyoka module (the engine
         hands it in: the model builds expressions, it does not import heyoka)."""
 
+    def force_source(self) -> tuple[str, str]:
+        """(F_x, F_y) = −∇V as Python source in x, y (``math`` functions), derived from :attr:`potential_text` and
+        :attr:`params`: the force as code for a compiled integrator (the noise scheduler's symplectic flow).
+
+        Examples
+        --------
+        Hénon–Heiles, V = (x² + y²)/2 + x²y − y³/3: F = (−x − 2xy, −y − x² + y²), (−0.42, −0.25) at (0.3, 0.2):
+
+        >>> from hhscatter.model import HenonHeiles
+        >>> fx, fy = HenonHeiles().force_source()
+        >>> [round(eval(f, {"x": 0.3, "y": 0.2}), 12) for f in (fx, fy)]
+        [-0.42, -0.25]
+        """
+        from hhscatter.model.parse import force_source  # deferred: parse imports sympy lazily, base stays light
+
+        return force_source(self.potential_text, tuple(sorted(self.params.items())))
+
     @abc.abstractmethod
     def no_return_radius(self, energy: float) -> float:
         """R(E): an orbit of energy ≤ E at r ≥ R with ṙ > 0 never comes back (length).

@@ -11,11 +11,13 @@ from dataclasses import dataclass
 from hhscatter.errors import ConfigError
 from hhscatter.scene.recording import finite_number
 
-__all__ = ["KICKS_PER_ORBIT_MAX", "KICK_FRACTION", "KICK_MAX_FRACTION", "KICK_SECONDS", "Noise"]
+__all__ = ["FLOWS", "KICKS_PER_ORBIT_MAX", "KICK_FRACTION", "KICK_MAX_FRACTION", "KICK_SECONDS", "Noise"]
 
 
+#: the Hamiltonian flows between the kicks (the first is the default)
+FLOWS = ("taylor", "symplectic")
 #: the default kick interval of noise scenes, as a fraction of the shortest time scale min(1/ω, 1/γ)
-#: (:class:`Noise`; the measured weak error at this interval is stated there)
+#: (:class:`Noise`; the escape rate's measured bias at this interval, ≤ 1 % with either flow, is stated there)
 KICK_FRACTION = 0.1
 #: a kick interval above KICK_MAX_FRACTION · min(1/ω, 1/γ) is refused: the splitting resolves neither the
 #: oscillation nor the drag any more (the escape rate's weak error grows like h²)
@@ -30,7 +32,7 @@ KICK_SECONDS = 5e-6
 
 @dataclass(frozen=True)
 class Noise:
-    """Noise(temperature=None, sigma=None, kick=None): random forces on the momenta of a scene, as data.
+    """Noise(temperature=None, sigma=None, kick=None, flow=None): random forces on the momenta of a scene, as data.
 
     With drag (γ > 0) the noise is a heat bath at ``temperature`` T (energy units, k_B = 1), the
     fluctuation–dissipation pair of the linear drag:
@@ -49,9 +51,12 @@ class Noise:
     no crossing of r_esc is missed between kicks) and O the exact Ornstein–Uhlenbeck step on the momenta,
     p ← e^{−γδ} p + √(T(1 − e^{−2γδ})) ξ (σ√δ ξ without drag), δ = h/2. Both parts preserve the Boltzmann
     density e^{−H/T} exactly, so the invariant measure carries no splitting error at any h; dynamical
-    quantities (escape rates) carry a weak error O(h²). Measured on Hénon–Heiles (γ = 1, ΔE/T = 3, 1000
-    orbits): the escape rate at h = 0.3 differs from that at the default h = 0.1 by −0.6 % ± 5 %
-    (statistical), so with the h² scaling the weak error of the rate at h = 0.1 is below about 1 %.
+    quantities (escape rates) carry a weak error O(h²). Measured (``make bench``, ``benchmarks/noise_rate.py``:
+    Hénon–Heiles, γ = 1, ΔE/T = 3, the rate on [20, 150] against a compiled BAOAB at dt = 0.02 with 240 000
+    orbits): the rate's bias is +1.5 % ± 0.4 % at h = 0.5, +0.8 % ± 0.7 % at h = 0.2 and −1.6 % ± 1.5 % at
+    the default h = 0.1 (the h² law from h = 0.5 gives ≈ +0.1 % there); with ``flow = "symplectic"`` +3.8 % ±
+    0.4 % at h = 0.5, +1.1 % ± 0.4 % at h = 0.25, +0.6 % ± 0.4 % at h = 0.2 and +0.3 % ± 0.4 % at the default
+    h = 0.1 (≈ 15 h² %).
 
     Parameters
     ----------
@@ -63,11 +68,17 @@ class Noise:
         Kick interval h (time units), 0 < h ≤ KICK_MAX_FRACTION · min(1/ω, 1/γ); default KICK_FRACTION ·
         min(1/ω, 1/γ). The engine uses h' = t_max / ⌈t_max/h⌉ ≤ h, so t_max falls on a kick. A scene refuses
         more than KICKS_PER_ORBIT_MAX kicks per orbit (⌈t_max/h⌉), saying what they would cost.
+    flow : {"taylor", "symplectic"}, optional
+        The Hamiltonian flow between the kicks: ``"taylor"`` (the default, also None) heyoka's Taylor integrator
+        at the scene's tolerance, events at their exact roots (:mod:`hhscatter.integrate.noise`);
+        ``"symplectic"`` one compiled fourth-order symplectic step per kick with the escape at the exact root of
+        its Hermite interpolant and counter-based random streams (:mod:`hhscatter.integrate.noise_symplectic`),
+        ≈ 25× cheaper at the default kick (``make bench``). The two give statistically equal, not identical, tables.
 
     Raises
     ------
     ConfigError
-        Neither or both of temperature and sigma, a value ≤ 0 or not finite (naming the key).
+        Neither or both of temperature and sigma, a value ≤ 0 or not finite, an unknown flow (naming the key).
 
     Examples
     --------
@@ -80,8 +91,14 @@ class Noise:
     temperature: float | None = None
     sigma: float | None = None
     kick: float | None = None
+    flow: str | None = None
 
     def __post_init__(self):
+        if self.flow is not None:
+            if self.flow not in FLOWS:
+                raise ConfigError(f"noise.flow must be one of {list(FLOWS)}, got {self.flow!r}")
+            if self.flow == FLOWS[0]:  # the default, spelled out: the same scene (and scene hash) as without it
+                object.__setattr__(self, "flow", None)
         for name in ("temperature", "sigma", "kick"):
             v = getattr(self, name)
             if v is not None:

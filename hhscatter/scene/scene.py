@@ -660,7 +660,9 @@ def scene_from_dict(d: dict) -> Scene:
             raise ConfigError("noise must be a table with temperature or sigma (and kick)")
         unknown = set(noise) - {f.name for f in dataclasses.fields(Noise)}
         if unknown:
-            raise ConfigError(f"unknown noise keys: {sorted(unknown)}; allowed: ['kick', 'sigma', 'temperature']")
+            raise ConfigError(
+                f"unknown noise keys: {sorted(unknown)}; allowed: ['flow', 'kick', 'sigma', 'temperature']"
+            )
         d["noise"] = Noise(**noise)
     snaps = d.pop("snapshots", None)
     if isinstance(snaps, dict):

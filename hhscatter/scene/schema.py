@@ -221,7 +221,7 @@ NoiseTable = table_of(
     Noise,
     "NoiseTable",
     "``[noise]``: random forces on the momenta: a heat bath (temperature, with drag) or a noise strength "
-    "(sigma, without drag), and the kick interval (Noise's fields).",
+    "(sigma, without drag), the kick interval and the flow between the kicks (Noise's fields).",
 )
 SceneTable = table_of(
     Scene,

@@ -14,8 +14,9 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     * ``nodrag_E<E>_s<σ>``: γ = 0, noise strength σ (σ = 0: the conservative κ0) at each E0 of nodrag_energies.
 
 ``analyze(study)``
-    Rates by the constant-hazard MLE on [t_relax, t_max] (:func:`hhscatter.analysis.noise.thermal_rate`,
-    left-truncated and right-censored) against Kramers–Langer (:func:`hhscatter.analysis.noise.kramers_langer`,
+    Rates by the constant-hazard MLE on [t_relax + relax_widths/γ, t_max] (after relaxation;
+    :func:`hhscatter.analysis.noise.thermal_rate`, left-truncated and right-censored; the window's two halves
+    compared: ``halves_z``, ``constant_in_window``) against Kramers–Langer (:func:`hhscatter.analysis.noise.kramers_langer`,
     saddles and Hessians from the system); P(t) of the heat-bath ensemble against the drag-only one extended
     by re-activation (:func:`hhscatter.analysis.noise.reactivation_survival`); the no-drag rates on
     ``nodrag_window`` against κ0. Writes ``noise.json`` (keys ``kramers``, ``turnover``, ``reactivation``,
@@ -27,10 +28,13 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
 
 from __future__ import annotations
 
+import math
+import zlib
+
 import numpy as np
 import pandas as pd
 
-from hhscatter.scene.schema import Integer, Number, Numbers
+from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.keys import RunKeys, number_key
 from hhscatter.studies.params import StudyParams
 
@@ -39,7 +43,10 @@ class Params(StudyParams):
     """``[study]`` of studies/noise/study.toml."""
 
     well_energy: Number  # E0 of the orbits started in the well
-    t_relax: Number  # rate window [t_relax, t_max]
+    t_relax: Number  # the rate window opens at t_relax + relax_widths/γ
+    relax_widths: Number  # relaxation times 1/γ waited before the rate window opens
+    constancy_z: Number  # the two halves of a rate window agree when |k₂ − k₁| < constancy_z σ
+    flow: Text  # the noise flow between kicks: "taylor" or "symplectic" (hhscatter.scene.noise.Noise)
     gamma_kramers: Number
     barriers: Numbers  # ΔE/T
     kramers_t_max: Numbers
@@ -86,13 +93,25 @@ def _nodrag_key(E, s) -> str:
     return f"nodrag_E{number_key(E, '.2f')}_s{number_key(s, 'g')}"
 
 
+def _record_seed(seed: int, key: str) -> int:
+    """The seed of the rate record ``key``: derived from the study's seed and the key, so that no two records share
+    initial conditions or noise streams."""
+    return int(np.random.SeedSequence([int(seed), zlib.crc32(key.encode())]).generate_state(1)[0])
+
+
+def _window_start(p, gamma: float) -> float:
+    """The rate window's start (time units): t_relax + relax_widths/γ, after the start's relaxation."""
+    return p.t_relax + p.relax_widths / gamma
+
+
 def _runs(study):
-    """{key: scene} of every raw run (module docstring); each key names one run (:class:`RunKeys`)."""
+    """{key: scene} of every raw run (module docstring); each key names one run (:class:`RunKeys`). The Kramers
+    and turnover records each have their own seed (:func:`_record_seed`)."""
     p, dE = study.params, _barrier(study)
     runs = RunKeys()
     for b, t_max in _pairs(study, "barriers", "kramers_t_max"):
         runs[_kramers_key(b)] = dict(
-            energy=p.well_energy, gamma=p.gamma_kramers, t_max=t_max, noise={"temperature": dE / b}
+            energy=p.well_energy, gamma=p.gamma_kramers, t_max=t_max, noise={"temperature": dE / b, "flow": p.flow}
         )
     for g, t_max in _pairs(study, "turnover_gammas", "turnover_t_max"):
         runs[_turnover_key(g)] = dict(
@@ -100,18 +119,27 @@ def _runs(study):
             gamma=g,
             t_max=t_max,
             n=p.turnover_n,
-            noise={"temperature": dE / p.turnover_barrier},
+            noise={"temperature": dE / p.turnover_barrier, "flow": p.flow},
         )
     react = dict(energy=p.react_energy, gamma=p.react_gamma, t_max=p.react_t_max, n=p.react_n)
     runs["react_T0"] = react
-    runs["react_T"] = dict(react, noise={"temperature": dE / p.react_barrier})
-    runs["react_well"] = dict(react, energy=p.well_energy, noise={"temperature": dE / p.react_barrier})
+    bath = {"temperature": dE / p.react_barrier, "flow": p.flow}
+    runs["react_T"] = dict(react, noise=bath)
+    runs["react_well"] = dict(react, energy=p.well_energy, noise=bath)
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
             runs[_nodrag_key(E, s)] = dict(
-                energy=E, gamma=0.0, t_max=p.nodrag_t_max, n=p.nodrag_n, noise={"sigma": s} if s > 0 else None
+                energy=E,
+                gamma=0.0,
+                t_max=p.nodrag_t_max,
+                n=p.nodrag_n,
+                noise={"sigma": s, "flow": p.flow} if s > 0 else None,
             )
-    return {k: study.scene(k, **kw) for k, kw in runs.items()}
+    scenes = {k: study.scene(k, **kw) for k, kw in runs.items()}
+    for k, sc in scenes.items():
+        if k.startswith(("kramers_", "turnover_")):
+            scenes[k] = sc.replace(seed=_record_seed(sc.seed, k))
+    return scenes
 
 
 def simulate(study, workers=None, progress=True):
@@ -130,11 +158,15 @@ def _lifetimes(study, key):
     return c["t_end"], o == "escaped", o == "settled"
 
 
-def _rate_row(study, key, scene, t_start):
+def _rate_row(study, key, scene):
     from hhscatter.analysis.noise import kramers_langer, thermal_rate
 
+    p = study.params
+    t_start = _window_start(p, scene.gamma)
     t_end, escaped, _ = _lifetimes(study, key)
     r = thermal_rate(t_end, escaped, t_start, scene.t_max)
+    (k1, e1), (k2, e2) = r.halves
+    z = (k2 - k1) / math.hypot(e1, e2) if e1 > 0 and e2 > 0 else math.nan
     T = scene.noise.temperature
     kl = kramers_langer(scene.model, scene.gamma, T)
     return {
@@ -151,6 +183,12 @@ def _rate_row(study, key, scene, t_start):
         "window": [t_start, scene.t_max],
         "rate_first_half": r.halves[0][0],
         "rate_second_half": r.halves[1][0],
+        "rate_first_half_err": e1,
+        "rate_second_half_err": e2,
+        # the rate is constant inside the window: the halves' difference in standard errors
+        "halves_z": z,
+        "constant_in_window": bool(abs(z) < p.constancy_z),
+        "seed": scene.seed,
         # a window without an escape: no rate (NaN), its one-sided 95 % upper bound and the ratio's
         **({"rate_upper95": r.upper95, "ratio_upper95": r.upper95 / kl.rate} if r.is_bound else {}),
     }
@@ -165,7 +203,7 @@ def _reactivation(study, runs):
     tT, escT, _ = _lifetimes(study, "react_T")
     tw, escw, _ = _lifetimes(study, "react_well")
     sc = runs["react_T"]
-    k_well = thermal_rate(tw, escw, p.t_relax, sc.t_max)
+    k_well = thermal_rate(tw, escw, _window_start(p, sc.gamma), sc.t_max)
     try:
         c = reactivation_check(t0, esc0, set0, tT, escT, k_well.rate, sc.t_max, p.react_tail_start)
     except ValueError as e:
@@ -231,11 +269,10 @@ def analyze(study):
     p = study.params
     runs = _runs(study)
     kramers = [
-        _rate_row(study, _kramers_key(b), runs[_kramers_key(b)], p.t_relax)
-        for b, _ in _pairs(study, "barriers", "kramers_t_max")
+        _rate_row(study, _kramers_key(b), runs[_kramers_key(b)]) for b, _ in _pairs(study, "barriers", "kramers_t_max")
     ]
     turnover = [
-        _rate_row(study, _turnover_key(g), runs[_turnover_key(g)], p.t_relax)
+        _rate_row(study, _turnover_key(g), runs[_turnover_key(g)])
         for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max")
     ]
     react, react_table = _reactivation(study, runs)
@@ -253,7 +290,7 @@ def analyze(study):
         hi["ratio_err"],
         1.0,
         note="Kramers–Langer is the large-barrier limit; the ratio should tend to 1 as ΔE/T grows",
-        convention="disk r < 0.5 at E0 = well_energy, rate window [t_relax, t_max], r_esc 1.5",
+        convention="disk r < 0.5 at E0 = well_energy, rate window [t_relax + relax_widths/γ, t_max], r_esc 1.5",
     )
     study.write_numbers(
         {
@@ -264,10 +301,16 @@ def analyze(study):
             "conventions": {
                 "r_esc": runs["react_T"].r_esc,
                 "ic_region": "disk r < 0.5",
-                "rate": "constant-hazard MLE on [t_relax, t_max], left-truncated, right-censored",
+                "rate": "constant-hazard MLE on [t_relax + relax_widths/γ, t_max], left-truncated, right-censored",
                 "t_relax": p.t_relax,
+                "relax_widths": p.relax_widths,
+                "window_rule": f"t ≥ {p.t_relax:g} + {p.relax_widths:g}/γ; constant when the halves agree within "
+                f"{p.constancy_z:g}σ",
+                "all_constant_in_window": all(r["constant_in_window"] for r in kramers + turnover),
+                "seeds": "one per Kramers and turnover record, derived from the study's seed and the record's key",
                 "nodrag_window": list(p.nodrag_window),
                 "kick": "0.1 min(1/ω, 1/γ) (the scene default)",
+                "flow": p.flow,
             },
         }
     )

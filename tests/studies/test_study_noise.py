@@ -1,0 +1,34 @@
+"""The noise study's rate records: each has its own initial conditions and noise streams, and its window opens after
+the start has relaxed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hhscatter.scene.ics import region_ics
+from hhscatter.studies import load_study, stage_module
+
+
+@pytest.fixture(scope="module")
+def runs():
+    study = load_study("noise", "quick")
+    return study, stage_module("noise")._runs(study)
+
+
+def test_rate_records_share_no_orbits(runs):
+    _, scenes = runs
+    rated = {k: sc for k, sc in scenes.items() if k.startswith(("kramers_", "turnover_"))}
+    assert len({sc.seed for sc in rated.values()}) == len(rated)
+    # the turnover point γ = 1 is the Kramers point ΔE/T = 3 in all but its seed: other initial states
+    kramers, turnover = scenes["kramers_b3"], scenes["turnover_g1"]
+    assert (kramers.gamma, kramers.noise, kramers.energy) == (turnover.gamma, turnover.noise, turnover.energy)
+    a, b = region_ics(kramers, 0, 50), region_ics(turnover, 0, 50)
+    assert not np.isin(a, b).any()
+
+
+def test_rate_windows_open_after_relaxation(runs):
+    study, _ = runs
+    p, mod = study.params, stage_module("noise")
+    assert mod._window_start(p, 0.03) == pytest.approx(p.t_relax + p.relax_widths / 0.03)
+    assert mod._window_start(p, 0.03) > 3 / 0.03 and mod._window_start(p, 1.0) > p.t_relax
