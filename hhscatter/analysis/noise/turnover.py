@@ -26,9 +26,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate
+from scipy import integrate, optimize
 
-__all__ = ["TurnoverRate", "depopulation_factor", "energy_loss_parameter", "turnover_rate"]
+__all__ = ["TurnoverRate", "barrier_action", "depopulation_factor", "energy_loss_parameter", "turnover_rate"]
 
 
 def _log_upsilon(delta: float) -> float:
@@ -78,6 +78,48 @@ def energy_loss_parameter(gamma: float, action: float, temperature: float) -> fl
         if not (math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be finite and > 0, got {v!r}")
     return round(gamma * action / temperature, 15)
+
+
+def barrier_action(model, exit: int = 0) -> float:
+    """barrier_action(model, exit=0) -> S (energy·time): the action ∮ p·dq of the orbit at the saddle's energy
+    E_s that leaves the saddle of ``model.exits[exit]`` along the line to the well's minimum (the origin),
+    turns on V = E_s across the well and comes back: S = 2 ∫ √(2 (E_s − V)) ds along that line (unit mass).
+
+    It is the orbit whose energy loss per period, γ S, sets δ = γ S/T (:func:`energy_loss_parameter`). The
+    orbit stays on the line when the line is invariant (the force along it is parallel to it: the symmetry
+    axes of Hénon–Heiles); otherwise S is the one-dimensional estimate along it.
+
+    Examples
+    --------
+    Hénon–Heiles along x = 0: E_s − V = (1 − y)² (y + 1/2)/3, from y = −1/2 to the saddle y = 1: S = 6/5.
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> round(barrier_action(HenonHeiles()), 10)
+    1.2
+    """
+    exits = model.exits
+    if isinstance(exit, bool) or not isinstance(exit, (int, np.integer)) or not 0 <= exit < len(exits):
+        raise ValueError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {exit!r}")
+    e = exits[exit]
+    xs, ys, e_s = float(e.x), float(e.y), float(e.energy)
+    r_s = math.hypot(xs, ys)
+    ux, uy = xs / r_s, ys / r_s
+
+    def gap(s):  # E_s − V at s along the line (s = r_s: the saddle, s = 0: the minimum)
+        return e_s - float(model.potential(np.array(s * ux), np.array(s * uy)))
+
+    if not gap(0.0) > 0:
+        raise ValueError("the origin is not below the saddle's energy: the system has no well there")
+    lo = -r_s
+    while gap(lo) > 0:  # the far turning point on V = E_s, across the well
+        lo *= 2
+        if lo < -1e6 * r_s:
+            raise ValueError(f"V stays below E_s along the line through exit {exit} and the minimum: no turning point")
+    s_turn = optimize.brentq(gap, lo, 0.0, xtol=1e-15 * r_s, rtol=1e-15)
+    f = lambda s: math.sqrt(2.0 * max(gap(s), 0.0))
+    val = integrate.quad(f, s_turn, 0.0, epsabs=0, epsrel=1e-12, limit=200)[0]
+    val += integrate.quad(f, 0.0, r_s, epsabs=0, epsrel=1e-12, limit=200)[0]
+    return 2.0 * val
 
 
 @dataclass(frozen=True)

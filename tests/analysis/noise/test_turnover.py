@@ -9,7 +9,13 @@ import mpmath
 import numpy as np
 import pytest
 
-from hhscatter.analysis.noise import depopulation_factor, energy_loss_parameter, kramers_langer, turnover_rate
+from hhscatter.analysis.noise import (
+    barrier_action,
+    depopulation_factor,
+    energy_loss_parameter,
+    kramers_langer,
+    turnover_rate,
+)
 from hhscatter.model import HenonHeiles
 
 
@@ -76,3 +82,14 @@ def test_turnover_rate_takes_one_action_per_saddle():
     assert mixed.upsilon[2] > mixed.upsilon[0] and mixed.rate > one.rate
     with pytest.raises(ValueError):
         turnover_rate(kl, [0.7, 0.7])
+
+
+@pytest.mark.parametrize("omega, lam", [(1.0, 1.0), (1.3, 0.7)])
+def test_barrier_action_of_henon_heiles_against_its_closed_form(omega, lam):
+    """Along x = 0, V = ω² y²/2 − λ y³/3: with y = (ω²/λ) z, E_s − V = (ω⁶/λ²)(1 − z)²(z + 1/2)/3 and
+    S = 2 ∫ √(2(E_s − V)) dy = (ω⁵/λ²) · 2√(2/3) ∫_{−1/2}^{1} (1 − z)√(z + 1/2) dz = (6/5) ω⁵/λ²."""
+    m = HenonHeiles(omega, lam)
+    for k in range(3):  # the three saddles are images of each other under the 120° rotation
+        assert barrier_action(m, k) == pytest.approx(1.2 * omega**5 / lam**2, rel=1e-9)
+    with pytest.raises(ValueError, match="exit must be a channel index"):
+        barrier_action(m, 3)
