@@ -489,6 +489,43 @@ def _noise_turnover(get: Loader) -> str:
     )
 
 
+def _noise_turnover_theory(get: Loader) -> str:
+    d = get("noise", None)
+    rows = sorted((r for r in d["turnover"] if "ratio_mm" in r), key=lambda r: r["gamma"])
+    if not rows:
+        return "the turnover theory's ratios are not in this scale's numbers"
+    rng = d["conventions"].get("theory_range", "its range")
+    inside = [r for r in rows if r["theory_assumptions_hold"]]
+    outside = [r for r in rows if not r["theory_assumptions_hold"]]
+
+    def cells(rs):
+        groups = {"within 2σ of 1": [], "below 1 by more than 2σ": [], "above 1 by more than 2σ": []}
+        for r in rs:
+            v = verdict(r["ratio_mm"], r["ratio_mm_err"], 1.0)
+            key = (
+                "within 2σ of 1"
+                if v.word != "differs"
+                else "below 1 by more than 2σ"
+                if v.z < 0
+                else "above 1 by more than 2σ"
+            )
+            groups[key].append(f"{r['gamma']:g}")
+        return "; ".join(f"{k} at γ = {', '.join(g)}" for k, g in groups.items() if g)
+
+    out = []
+    if inside:
+        dev = max(abs(r["ratio_mm"] - 1) for r in inside)
+        gammas = ", ".join(f"{r['gamma']:g}" for r in inside)
+        out.append(
+            f"where {rng} (γ = {gammas}) the rate over Υ(δ) k_KL is {cells(inside)}, |ratio − 1| at most {dev:.1%}"
+        )
+    else:
+        out.append(f"no turnover point lies where {rng}")
+    if outside:
+        out.append(f"outside that range {cells(outside)}")
+    return "; ".join(out)
+
+
 def _noise_no_drag(get: Loader) -> str:
     rows = [r for r in get("noise", None)["no_drag"] if r["sigma"] > 0]
     out = []
@@ -513,6 +550,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.hh_1_05": _generality_hh_1_05,
     "noise.kramers": _noise_kramers,
     "noise.turnover": _noise_turnover,
+    "noise.turnover_theory": _noise_turnover_theory,
     "noise.no_drag": _noise_no_drag,
     "b_relation": _b_relation,
     "fig5.tightening": _fig5_tightening,

@@ -29,10 +29,15 @@ def _panel_arrhenius(ax, k):
 
 
 def _panel_turnover(ax, t):
-    """(b) rate against γ at fixed T: measured and Kramers–Langer (the spatial-diffusion branch)."""
+    """(b) rate against γ at fixed T: measured, Kramers–Langer (the spatial-diffusion branch) and, where the
+    records carry them, Mel'nikov–Meshkov and the energy-diffusion limit."""
     t = t.sort_values("gamma")
     ax.errorbar(t.gamma, t.rate, t.rate_err, fmt="o", color=COLORS[2], ms=4, capsize=2, label="measured")
     ax.plot(t.gamma, t.kramers_langer, "-", color="k", lw=1, label="Kramers–Langer")
+    if "melnikov_meshkov" in t:  # the turnover theory at the measured γ and its energy-diffusion limit
+        ax.plot(t.gamma, t.melnikov_meshkov, "-", color=COLORS[3], lw=1.2, label=r"Mel'nikov–Meshkov $\Upsilon k_{KL}$")
+        ax.plot(t.gamma, t.energy_diffusion, ":", color="0.4", lw=1, label=r"energy diffusion $\delta k_{TST}$")
+        ax.set_ylim(0.5 * float(t.rate.min()), 2 * float(t.kramers_langer.max()))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(r"drag $\gamma$")

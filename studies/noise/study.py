@@ -19,8 +19,11 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     compared: ``halves_z``, ``constant_in_window``) against Kramers–Langer (:func:`hhscatter.analysis.noise.kramers_langer`,
     saddles and Hessians from the system); P(t) of the heat-bath ensemble against the drag-only one extended
     by re-activation (:func:`hhscatter.analysis.noise.reactivation_survival`); the no-drag rates on
-    ``nodrag_window`` against κ0. Writes ``noise.json`` (keys ``kramers``, ``turnover``, ``reactivation``,
-    ``no_drag``) and the derived tables ``rates.parquet``, ``survival.parquet``.
+    ``nodrag_window`` against κ0; each turnover rate against the Mel'nikov–Meshkov/Pollak–Grabert–Hänggi rate
+    Υ(δ) k_KL (:func:`hhscatter.analysis.noise.turnover_rate`, δ = γS/T with S the action of the orbit at the
+    saddle's energy through the well, :func:`hhscatter.analysis.noise.barrier_action`) and both Kramers limits,
+    the theory's range stated as γ/ω_b ≤ THEORY_GAMMA_MAX. Writes ``noise.json`` (keys ``kramers``,
+    ``turnover``, ``reactivation``, ``no_drag``) and the derived tables ``rates.parquet``, ``survival.parquet``.
 
 ``plot(study)``
     ``noise.png`` via ``plot_noise`` of the folder's ``figure.py``.
@@ -37,6 +40,10 @@ import pandas as pd
 from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.keys import RunKeys, number_key
 from hhscatter.studies.params import StudyParams
+
+#: the turnover theory (Mel'nikov–Meshkov/PGH) assumes an underdamped barrier crossing: its ratios are read where
+#: γ/ω_b ≤ this (ω_b the saddles' unstable frequency)
+THEORY_GAMMA_MAX = 0.3
 
 
 class Params(StudyParams):
@@ -194,6 +201,28 @@ def _rate_row(study, key, scene):
     }
 
 
+def _turnover_theory(study, row, scene) -> dict:
+    """The turnover record ``row`` against Mel'nikov–Meshkov/PGH and both Kramers limits (module docstring)."""
+    from hhscatter.analysis.noise import barrier_action, kramers_langer, turnover_rate
+
+    m = scene.model
+    kl = kramers_langer(m, scene.gamma, row["temperature"])
+    tr = turnover_rate(kl, [barrier_action(m, k) for k in range(len(m.exits))])
+    out = {
+        "action": barrier_action(m, 0),
+        "delta": tr.delta[0],
+        "upsilon": tr.upsilon[0],
+        "melnikov_meshkov": tr.rate,
+        "energy_diffusion": tr.energy_diffusion,
+        "gamma_over_omega_b": tr.gamma_over_omega_b,
+        "theory_assumptions_hold": bool(tr.gamma_over_omega_b <= THEORY_GAMMA_MAX),
+    }
+    for name, k in (("mm", tr.rate), ("ed", tr.energy_diffusion)):
+        out[f"ratio_{name}"] = row["rate"] / k
+        out[f"ratio_{name}_err"] = row["rate_err"] / k
+    return out
+
+
 def _reactivation(study, runs):
     """P(t) with and without the heat bath, the extension's prediction, and their numbers."""
     from hhscatter.analysis.noise import reactivation_check, thermal_rate
@@ -271,10 +300,10 @@ def analyze(study):
     kramers = [
         _rate_row(study, _kramers_key(b), runs[_kramers_key(b)]) for b, _ in _pairs(study, "barriers", "kramers_t_max")
     ]
-    turnover = [
-        _rate_row(study, _turnover_key(g), runs[_turnover_key(g)])
-        for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max")
-    ]
+    turnover = []
+    for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max"):
+        row = _rate_row(study, _turnover_key(g), runs[_turnover_key(g)])
+        turnover.append({**row, **_turnover_theory(study, row, runs[_turnover_key(g)])})
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
     rates = pd.DataFrame([{"set": "kramers", **r} for r in kramers] + [{"set": "turnover", **r} for r in turnover])
@@ -311,6 +340,9 @@ def analyze(study):
                 "nodrag_window": list(p.nodrag_window),
                 "kick": "0.1 min(1/ω, 1/γ) (the scene default)",
                 "flow": p.flow,
+                "turnover_theory": "Mel'nikov–Meshkov/PGH k = Υ(δ) k_KL, δ = γS/T, S the action of the orbit at "
+                "the saddle's energy through the well; energy diffusion k_ED = δ k_TST",
+                "theory_range": f"γ/ω_b ≤ {THEORY_GAMMA_MAX:g}",
             },
         }
     )

@@ -179,3 +179,21 @@ def test_the_one_exponential_reading_says_too_few_orbits_where_the_pooled_test_h
     assert "too few orbits for the test at 1.5" in text and "pooled until each expects at least 5 orbits" in text
     old = READINGS["generality.one_exponential"](_loader({"generality": {"systems": {"a": {}}, "long_time": rows}}))
     assert "not tested at 1.5" in old and "a handful of orbits drives χ²" in old
+
+
+def test_the_turnover_theory_reading_follows_the_ratios_and_the_range():
+    def row(g, ratio, err, holds):
+        return {"gamma": g, "ratio_mm": ratio, "ratio_mm_err": err, "theory_assumptions_hold": holds}
+
+    doc = {
+        "turnover": [row(0.01, 0.97, 0.02, True), row(0.1, 0.80, 0.02, True), row(1.0, 1.30, 0.02, False)],
+        "conventions": {"theory_range": "γ/ω_b ≤ 0.3"},
+    }
+    text = READINGS["noise.turnover_theory"](lambda study, scale: doc)
+    assert text == (
+        "where γ/ω_b ≤ 0.3 (γ = 0.01, 0.1) the rate over Υ(δ) k_KL is within 2σ of 1 at γ = 0.01; below 1 by more "
+        "than 2σ at γ = 0.1, |ratio − 1| at most 20.0%; outside that range above 1 by more than 2σ at γ = 1"
+    )
+    assert "not in this scale's numbers" in READINGS["noise.turnover_theory"](
+        lambda study, scale: {"turnover": [{"gamma": 1.0}], "conventions": {}}
+    )
