@@ -32,6 +32,7 @@ import math
 import numpy as np
 
 from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
+from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
@@ -41,8 +42,6 @@ from hhscatter.analysis.survival.long_time import (
 
 #: P-value below which one exponential is rejected for the non-regular orbits
 EXP_REJECT_P = 1e-3
-#: the verdict of a goodness-of-fit test with no degree of freedom left after pooling (or too few orbits to fit)
-TOO_FEW = "too few orbits"
 
 
 def _finite(x):

@@ -168,3 +168,26 @@ def test_a_hazard_bin_without_escape_gives_its_poisson_upper_bound_not_zero_plus
     assert math.isnan(empty["hazard_err"])  # no "± 0"
     assert empty["hazard_upper"] == pytest.approx(2.995732 / 50.0, rel=1e-6)  # P(0 events | κ·50) = 0.05
     assert math.isnan(h.iloc[0]["hazard_upper"]) and h.iloc[0]["hazard_err"] > 0
+
+
+@pytest.mark.parametrize("n", [6, 12])
+def test_rate_status_with_too_few_orbits_says_so_by_the_pooled_chi2_rule(n):
+    """A handful of exponential lifetimes: one exponential is neither accepted nor rejected (was 'exponential')."""
+    from hhscatter.analysis.stats.goodness import TOO_FEW
+
+    t = np.random.default_rng(n).exponential(10.0, n)
+    obs = np.ones(n, bool)
+    if n >= 10:  # fitted: the pooled χ²'s rule, with n orbits in cells of ≥ 5 expected no degree of freedom left
+        assert fit_plateau_exponential(t, obs, 0.0, plateau=False).too_few
+    else:  # too few to fit one exponential at all
+        with pytest.raises(ValueError, match="too few"):
+            fit_plateau_exponential(t, obs, 0.0, plateau=False)
+    st = rate_status(t, obs, 0.0, 20.0)
+    assert st.status == TOO_FEW == "too few orbits" and math.isnan(st.p_value) and TOO_FEW in st.note
+
+
+def test_rate_status_gives_a_verdict_once_the_pooled_chi2_has_a_degree_of_freedom():
+    t = np.random.default_rng(5).exponential(10.0, 200)
+    obs = np.ones(t.size, bool)
+    assert not fit_plateau_exponential(t, obs, 0.0, plateau=False).too_few
+    assert rate_status(t, obs, 0.0, 20.0).status == "exponential"
