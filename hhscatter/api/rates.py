@@ -184,7 +184,8 @@ class EscapeRates:
         the population (a trapped plateau, a non-exponential decay).
     status : dict
         (energy, gamma) → :class:`~hhscatter.analysis.survival.long_time.RateStatus` of each fitted point:
-        'exponential', 'trapped', 'non-exponential' or 'empty' (no orbit left after τ0), with P∞ and κ∞ of the plateau-plus-exponential fit.
+        'exponential', 'trapped', 'non-exponential', 'too few orbits' (no verdict on one exponential) or 'empty'
+        (no orbit left after τ0), with P∞ and κ∞ of the plateau-plus-exponential fit.
 
     Examples
     --------
@@ -211,7 +212,7 @@ class EscapeRates:
         fits and statistics), kappa_stat, kappa_spread, tau0, t_stop, windows
         (the 4 (t_lo, t_hi) fit windows), kappa_mle, kappa_mle_err (maximum
         likelihood on [tau0, t_stop]), tau_star (NaN without power-law tail),
-        status ('exponential', 'trapped', 'non-exponential', 'empty'; "" where not fitted), p_inf, kappa_inf (the
+        status ('exponential', 'trapped', 'non-exponential', 'too few orbits', 'empty'; "" where not fitted), p_inf, kappa_inf (the
         plateau-plus-exponential fit from τ0), note (why κ is NaN or not the population's rate, else empty).
         """
         import pandas as pd  # deferred: pandas loads on first use
@@ -288,7 +289,8 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     EscapeRates
         ``.to_frame()`` one row per point (energy, gamma, n, kappa, kappa_err, tau0, windows, tau_star,
         status, p_inf, kappa_inf, note), ``.plot(ax=)`` κ against E. A point whose orbits still inside at t_max
-        bias the window (status 'trapped') or whose decay is not one exponential ('non-exponential') says so in
+        bias the window (status 'trapped'), whose decay is not one exponential ('non-exponential') or has too
+        few orbits to tell ('too few orbits') says so in
         ``status`` and ``note`` (:func:`~hhscatter.analysis.survival.long_time.rate_status`); its κ is then not
         the population's escape rate.
 

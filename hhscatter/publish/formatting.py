@@ -76,15 +76,19 @@ def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
     One significant digit of ``err``, two when it starts with 1 or 2 (e.g.
     0.912 ± 0.003, 0.310 ± 0.012, 152 ± 7); v to the same decimal place.
     Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15).
-    Without a usable error (None, NaN, < 0) the value alone; an error of 0 is
-    written "± 0". ``sep``: e.g. ``r" \\pm "`` inside the LaTeX labels of figures.
+    Without a usable error (None, NaN, < 0) the value alone; so with an error of
+    exactly 0 (a number exact by construction, as a reference against itself,
+    or a count of 0 recorded without its bound), never "± 0": a count of 0 with
+    its bound is written by :func:`format_bound`. ``sep``: e.g. ``r" \\pm "``
+    inside the LaTeX labels of figures.
+
+    >>> format_value_err(0.0, 0.0), format_value_err(0.5, 0.0), format_value_err(0.912, 0.003)
+    ('0', '0.5', '0.912 ± 0.003')
     """
     if not _is_num(v) or (isinstance(v, float) and not math.isfinite(v)):
         return format_number(v)
-    if not _is_num(err) or not math.isfinite(err) or err < 0:
+    if not _is_num(err) or not math.isfinite(err) or err <= 0:  # no error to write (never "± 0")
         return format_number(v)
-    if err == 0:
-        return f"{format_number(v)}{sep}0"
     exp10 = int(math.floor(math.log10(err)))
     digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
     if abs(v) >= 1e4 or digits > 5:

@@ -22,7 +22,7 @@ import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.verdicts import signed, verdict, verdict_class
-from hhscatter.publish.formatting import format_value_err, typographic_minus
+from hhscatter.publish.formatting import format_bound, format_value_err, typographic_minus
 from hhscatter.reproduction.verdicts import claim_verdict
 
 __all__ = [
@@ -43,6 +43,13 @@ Z_RESOLVED = 2.0
 
 def _ve(value, err) -> str:
     return typographic_minus(format_value_err(float(value), float(err)))
+
+
+def _hazard_text(b: dict) -> str:
+    """A hazard bin as pages write it: its value ± error, or, with no escape in the bin, its one-sided bound."""
+    if b.get("hazard_upper") is not None:
+        return typographic_minus(format_bound(b["hazard_upper"], cl=b.get("hazard_cl", 0.95)))
+    return _ve(b["hazard"], b["err"])
 
 
 def _int(n) -> str:
@@ -296,8 +303,9 @@ def _generality_hh_1_05(get: Loader) -> str:
     lt = next(f for f in d["long_time"] if f["id"] == "henon_heiles-1.05-disk")
     t_max = d["config"]["scene"]["t_max"]
     bins = lt["hazard_nonregular"]
-    before = [b for b in bins if b["t_hi"] <= t_max]
-    after = [b for b in bins if b["t_lo"] >= t_max]
+    before = [b for b in bins if b["t_hi"] <= t_max and b["err"] is not None]
+    empty = [b for b in bins if b["t_hi"] <= t_max and b.get("hazard_upper") is not None]
+    after = [b for b in bins if b["t_lo"] >= t_max and (b["err"] is not None or b.get("hazard_upper") is not None)]
     state = "defined" if k["defined"] else "ill-defined"
     out = (
         f"κ0 is {state} under the plateau rule at t_max = {t_max:g}: with κ ≈ {k['kappa']:.2g} the run covers "
@@ -311,10 +319,13 @@ def _generality_hh_1_05(get: Loader) -> str:
             f"the non-regular orbits' hazard from t = {before[0]['t_lo']:g} to {t_max:g}",
         )
     )
+    if empty:
+        out += " (no escape in " + ", ".join(f"[{b['t_lo']:g}, {b['t_hi']:g}]: {_hazard_text(b)}" for b in empty) + ")"
     if after:
         mean = np.average([b["hazard"] for b in before], weights=[1 / b["err"] ** 2 for b in before])
         zs = ", ".join(
-            f"[{b['t_lo']:g}, {b['t_hi']:g}]: {_ve(b['hazard'], b['err'])} (z = {signed((b['hazard'] - mean) / b['err'])})"
+            f"[{b['t_lo']:g}, {b['t_hi']:g}]: {_hazard_text(b)}"
+            + (f" (z = {signed((b['hazard'] - mean) / b['err'])})" if b["err"] is not None else "")
             for b in after
         )
         out += f"; after t_max it is {zs} against that mean"

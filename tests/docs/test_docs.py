@@ -48,7 +48,8 @@ def gen():
         (-0.00017021, 0.00106, "-0.0002 ± 0.0011"),
         (250.0, 31.0, "250 ± 31"),
         (0.5, None, "0.5"),
-        (0.5, 0.0, "0.5 ± 0"),
+        (0.5, 0.0, "0.5"),  # an error of exactly 0 is not written: never "± 0"
+        (0.0, 0.0, "0"),
     ],
 )
 def test_fmt_err(hook, v, err, want):
@@ -657,3 +658,32 @@ def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
     recs = [{"t": 80.0, "sim": 0.25, "sim_err": 0.01}, {"t": 100.0, "sim": 0.0, "sim_err": None, "sim_upper": 3e-4}]
     out = hook.spec_table(recs, (("t", "t"), ("sim", "simulated")))
     assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out
+
+
+def _studies_with_numbers():
+    return sorted(p.stem for p in (DOCS / "studies" / "assets").glob("*.json") if not p.stem.endswith(".cost"))
+
+
+@pytest.mark.parametrize("name", _studies_with_numbers())
+def test_no_built_number_reads_plus_minus_zero(hook, name):
+    """Every number a study page shows from the committed JSON (its references, its tables, all the numbers the
+    study wrote, at both scales) and the report's headline numbers: a count of 0 is a bound, an exact number has
+    no error written; never "± 0"."""
+    from hhscatter.publish.numbers import load_numbers, render_refs
+    from hhscatter.publish.report import headline_numbers
+
+    r = hook.Renderer(ROOT, DOCS, DOCS / "studies")
+    page = ROOT / "studies" / name / "page.md"
+    text = [r.study_numbers(name)]
+    if page.exists():
+        src = page.read_text()
+        text.append(render_refs(src, ROOT, where=name))
+        text += [r.study_table(arg) for arg in re.findall(r"<!-- hh:study-table (\S+) -->", src)]
+    for scale in ("quick", "paper"):
+        try:
+            doc = load_numbers(ROOT, name, scale)[0]
+        except Exception:  # this study has no committed JSON at this scale
+            continue
+        text += [f"{k}: {v}" for k, v in headline_numbers(doc, limit=10**6)]
+    zero = [m.group(0) for t in text for m in re.finditer(r".{0,40}± 0(?![.,\d]).{0,10}", t)]
+    assert not zero, zero[:5]

@@ -5,6 +5,7 @@ uncertainties (the inputs here are built by hand, so the expected words are know
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import pytest
@@ -197,3 +198,46 @@ def test_the_turnover_theory_reading_follows_the_ratios_and_the_range():
     assert "not in this scale's numbers" in READINGS["noise.turnover_theory"](
         lambda study, scale: {"turnover": [{"gamma": 1.0}], "conventions": {}}
     )
+
+
+def _prose(text: str) -> str:
+    """A page's words without its code (fenced and inline) and its number references."""
+    text = re.sub(r"```.*?```", " ", text, flags=re.S)
+    text = re.sub(r"\[\[.*?\]\]", " ", text, flags=re.S)
+    return re.sub(r"`[^`\n]*`", " ", text)
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.parent.name)
+def test_study_pages_name_survivors_by_the_glossary(page):
+    """Survivors are regular, chaotic but confined or censored (the glossary); "trapped" meant each of them on some
+    page, so the prose does not use it."""
+    words = _prose(page.read_text())
+    assert not re.search(r"\btrapped\b", words, flags=re.I), page.parent.name
+    glossary = (ROOT / "docs" / "equations.md").read_text()
+    for term in ("| regular |", "| chaotic but confined |", "| censored |"):
+        assert glossary.count(term) == 1, term  # one meaning each
+
+
+def test_the_hh_1_05_reading_writes_a_hazard_bin_without_escape_as_its_bound():
+    def b(lo, hi, h, e, n, **kw):
+        return {"t_lo": lo, "t_hi": hi, "hazard": h, "err": e, "events": n, **kw}
+
+    bins = [
+        b(100.0, 200.0, 0.003, 0.0003, 100),
+        b(200.0, 400.0, 0.003, 0.0003, 100),
+        b(400.0, 800.0, 0.0, None, 0, hazard_upper=3.0e-4, hazard_cl=0.95),
+        b(800.0, 1400.0, 0.0, None, 0, hazard_upper=2.0e-4, hazard_cl=0.95),
+    ]
+    doc = {
+        "kappa": [
+            {"system": "henon_heiles", "ratio": 1.05, "convention": "plateau", "defined": False, "kappa": 0.003}
+            | {"trapped_fraction": 0.1, "reason": "plateau"}
+        ],
+        "validity_map": [{"id": "henon_heiles-1.05-disk", "regular_fraction": 0.0}],
+        "long_time": [{"id": "henon_heiles-1.05-disk", "n": 1000, "hazard_nonregular": bins}],
+        "config": {"scene": {"t_max": 800.0}},
+    }
+    text = READINGS["generality.hh_1_05"](_loader({"generality": doc}))
+    assert "no escape in [400, 800]: < 3.0e-4 (95 %)" in text
+    assert "[800, 1400]: < 2.0e-4 (95 %)" in text and "± 0 " not in text and "nan" not in text
+    assert "is constant within its errors (weighted mean 0.00300 ± 0.00021" in text

@@ -25,6 +25,8 @@ import numpy as np
 
 #: the smallest expected count of a pooled cell
 MIN_EXPECTED = 5.0
+#: the verdict of a goodness-of-fit test left without a degree of freedom by the pooling (``PooledPearson.too_few``)
+TOO_FEW = "too few orbits"
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,6 @@
 """Binomial fractions: Wilson score intervals (model-free; used by the exit-channel and basin measures) and a
-fraction reported with its error, or, at a count of 0 or of all, with its one-sided bound (never "0 ± 0")."""
+fraction reported with its error, or, at a count of 0 or of all, with its one-sided bound (never "0 ± 0"); a Poisson
+rate with no event in its exposure by its one-sided bound (:func:`rate_upper_bound`)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BoundedFraction", "fraction_with_bound", "wilson_interval"]
+__all__ = ["BoundedFraction", "fraction_with_bound", "rate_upper_bound", "wilson_interval"]
 
 
 def wilson_interval(k, n, z: float = 1.0):
@@ -113,3 +114,28 @@ def fraction_with_bound(k: int, n: int, *, cl: float = 0.95) -> BoundedFraction:
         return BoundedFraction(k, n, 1.0, None, None, math.exp(math.log1p(-cl) / n), cl)
     wilson = math.sqrt(f * (1 - f) / n + 1 / (4 * n * n)) / (1 + 1 / n)
     return BoundedFraction(k, n, f, max(math.sqrt(f * (1 - f) / n), wilson), None, None, cl)
+
+
+def rate_upper_bound(exposure, cl: float = 0.95):
+    """rate_upper_bound(exposure, cl=0.95) -> the one-sided upper bound (1/time) at confidence ``cl`` of a Poisson
+    rate with no event in ``exposure`` (orbit-time at risk, time units): −ln(1 − cl)/exposure, the rate at which
+    no event has probability 1 − cl (≈ 3/exposure at 95 %); inf at zero exposure. Works on arrays.
+
+    A rate estimated as events/exposure with its Poisson error √events/exposure is "0 ± 0" at 0 events; this bound
+    is what such a bin reports instead.
+
+    Examples
+    --------
+    >>> round(rate_upper_bound(1000.0), 6)            # −ln(0.05)/1000
+    0.002996
+    >>> rate_upper_bound([100.0, 0.0]).round(4).tolist()
+    [0.03, inf]
+    """
+    if not 0 < cl < 1:
+        raise ValueError(f"cl must lie in (0, 1), got {cl}")
+    x = np.asarray(exposure, dtype=float)
+    if np.any(x < 0):
+        raise ValueError("exposure must be ≥ 0")
+    with np.errstate(divide="ignore"):
+        out = np.where(x > 0, -math.log1p(-cl) / np.where(x > 0, x, 1.0), np.inf)
+    return float(out) if out.ndim == 0 else out

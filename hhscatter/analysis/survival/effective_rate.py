@@ -5,7 +5,8 @@ energy, κγ(t) = κ0(E(t)), E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay))
 Eq. (eqn:surv_prob_model), integrates. Pure functions (no I/O):
 
 * :func:`binned_hazard` — the escape hazard in time bins: escapes in the bin over the time the orbits spent
-  at risk in it (orbits leave the risk set when they escape, settle or are censored), with its Poisson error;
+  at risk in it (orbits leave the risk set when they escape, settle or are censored), with its Poisson error, or,
+  in a bin with no escape, its one-sided 95 % upper bound (never "0 ± 0");
 * :func:`observed_over_expected` — Σ escapes / Σ κ0(E(t)) · exposure over the bins: 1 when the hazard is
   κ0(E(t)), with the Poisson error of the observed count.
 
@@ -19,23 +20,31 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.intervals import rate_upper_bound
+
 __all__ = ["binned_hazard", "observed_over_expected"]
 
 
 def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
-    """binned_hazard(t_end, escaped, edges) -> DataFrame[t_lo, t_hi, t_mid, events, exposure, hazard, hazard_err].
+    """binned_hazard(t_end, escaped, edges) -> DataFrame[t_lo, t_hi, t_mid, events, exposure, hazard, hazard_err,
+    hazard_upper].
 
     ``t_end``: each orbit's end time (escape, settling or censoring); ``escaped``: True where it ended by escape.
     Per bin [t_lo, t_hi): events = escapes in it, exposure = Σ_i |[t_lo, t_hi) ∩ [0, t_end_i)| (orbit-time at
-    risk), hazard = events/exposure (the maximum-likelihood constant rate of the bin), hazard_err =
-    √events/exposure.
+    risk), hazard = events/exposure (1/time: the maximum-likelihood constant rate of the bin), hazard_err =
+    √events/exposure. A bin with orbits at risk but no escape has hazard 0, no error (NaN) and its one-sided 95 %
+    upper bound hazard_upper = −ln(0.05)/exposure (escapes ~ Poisson in the exposure:
+    :func:`~hhscatter.analysis.stats.intervals.rate_upper_bound`); hazard_upper is NaN elsewhere. A bin with no
+    orbit at risk has NaN throughout.
 
     Examples
     --------
     >>> import numpy as np
-    >>> d = binned_hazard(np.array([1.0, 3.0, 5.0]), np.array([True, True, False]), [0.0, 2.0, 4.0])
+    >>> d = binned_hazard(np.array([1.0, 3.0, 5.0]), np.array([True, True, False]), [0.0, 2.0, 4.0, 6.0])
     >>> d[["events", "exposure"]].to_numpy().tolist()
-    [[1.0, 5.0], [1.0, 3.0]]
+    [[1.0, 5.0], [1.0, 3.0], [0.0, 1.0]]
+    >>> d["hazard_upper"].round(3).tolist()    # no escape in [4, 6): hazard < −ln(0.05)/1
+    [nan, nan, 2.996]
     """
     t = np.asarray(t_end, dtype=float).ravel()
     e = np.asarray(escaped, dtype=bool).ravel()
@@ -57,7 +66,8 @@ def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
     events = np.histogram(t[e], bins=edges)[0].astype(float)
     with np.errstate(invalid="ignore", divide="ignore"):
         h = np.where(exposure > 0, events / exposure, np.nan)
-        err = np.where(exposure > 0, np.sqrt(events) / exposure, np.nan)
+        err = np.where((exposure > 0) & (events > 0), np.sqrt(events) / exposure, np.nan)
+    upper = np.where((exposure > 0) & (events == 0), rate_upper_bound(exposure), np.nan)
     return pd.DataFrame(
         {
             "t_lo": lo,
@@ -67,6 +77,7 @@ def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
             "exposure": exposure,
             "hazard": h,
             "hazard_err": err,
+            "hazard_upper": upper,
         }
     )
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hhscatter.analysis.stats.intervals import rate_upper_bound
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.cmeasure import (
@@ -140,7 +141,7 @@ def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
     exposure = float(np.sum(np.minimum(t_end[at_risk], t_stop) - t_start))
     D = int(np.count_nonzero(observed & at_risk & (t_end <= t_stop)))
     if D == 0:  # no escape: no rate, the one-sided 95 % upper bound from the exposure
-        upper = -math.log(0.05) / exposure if exposure > 0 else math.inf
+        upper = rate_upper_bound(exposure)
         return MLERate(
             math.nan, math.nan, 0, exposure, int(np.count_nonzero(at_risk)), float(t_start), float(t_stop), upper
         )

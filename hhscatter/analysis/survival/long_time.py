@@ -44,6 +44,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats.goodness import TOO_FEW
+
 
 @dataclass(frozen=True)
 class PlateauFit:
@@ -274,7 +276,9 @@ class RateStatus:
     status : str
         'exponential' (one exponential from τ0 on, with the orbits still inside at t_max a negligible share),
         'trapped' (orbits still inside at t_max are more than ``max_bias`` of P at the window end: the window
-        measures the plateau), 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``), or
+        measures the plateau), 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``),
+        'too few orbits' (one exponential from τ0 can be neither accepted nor rejected: the pooled χ² has no
+        degree of freedom, :data:`hhscatter.analysis.stats.goodness.TOO_FEW`, or too few orbits to fit it), or
         'empty' (no orbit was still inside after τ0: every one left before the window, which holds no rate).
     trapped_fraction : float
         Orbits still inside at the end (censored), of all.
@@ -304,8 +308,10 @@ def rate_status(
     Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' when
     the orbits still inside at t_max are more than ``max_bias`` of P(t_stop)
     (:func:`hhscatter.analysis.survival.kappa_conventions.plateau_check`), 'non-exponential' when one exponential
-    from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), 'empty' when no orbit was still
-    inside after τ0, else 'exponential'. With no orbit still inside at the end there is no plateau. With a plateau,
+    from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), 'too few orbits' when that test has
+    no verdict (by the pooled χ²'s own rule, :func:`~hhscatter.analysis.stats.goodness.pooled_pearson`: no degree
+    of freedom left once every cell expects 5 orbits; or too few orbits after τ0 to fit), 'empty' when no orbit
+    was still inside after τ0, else 'exponential'. With no orbit still inside at the end there is no plateau. With a plateau,
     the note gives P∞ and κ∞ of the plateau-plus-exponential fit.
 
     Examples
@@ -320,6 +326,8 @@ def rate_status(
     'exponential'
     >>> rate_status(t, np.ones(t.size, bool), 1e6, 2e6).status     # every orbit left before τ0
     'empty'
+    >>> rate_status(t[:8], np.ones(8, bool), 0.5, 20.0).status     # 8 orbits: no verdict either way
+    'too few orbits'
     """
     from hhscatter.analysis.survival.kappa_conventions import plateau_check  # deferred: kept off import time
 
@@ -348,9 +356,10 @@ def rate_status(
     except ValueError:
         plat = (nan, nan, nan, nan)
     try:
-        p = fit_plateau_exponential(t, obs, tau0, plateau=False).p_value
-    except ValueError:
-        p = nan
+        one = fit_plateau_exponential(t, obs, tau0, plateau=False)
+        p, too_few, why = one.p_value, one.too_few, f"the pooled χ² has {one.dof} degrees of freedom"
+    except ValueError as exc:  # too few orbits after τ0 to fit one exponential at all
+        p, too_few, why = nan, True, str(exc)
     if not defined:
         status = "trapped"
         note = (
@@ -363,6 +372,12 @@ def rate_status(
         note = (
             f"P(t) is not one exponential from τ0 = {tau0:.3g} (censoring-aware fit rejected, p = {p:.1e}); "
             "κ is an average over a hazard that changes with time"
+        )
+    elif too_few:
+        status = TOO_FEW
+        note = (
+            f"{TOO_FEW} to say whether P(t) is one exponential from τ0 = {tau0:.3g} ({why}); κ is not shown to be "
+            "the population's rate"
         )
     else:
         status, note = "exponential", ""

@@ -32,6 +32,7 @@ import math
 import numpy as np
 
 from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
+from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
@@ -41,8 +42,6 @@ from hhscatter.analysis.survival.long_time import (
 
 #: P-value below which one exponential is rejected for the non-regular orbits
 EXP_REJECT_P = 1e-3
-#: the verdict of a goodness-of-fit test with no degree of freedom left after pooling (or too few orbits to fit)
-TOO_FEW = "too few orbits"
 
 
 def _finite(x):
@@ -88,7 +87,8 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     non-regular orbits alone (all minus ``regular_ids``): single exponential from t0 (kappa_nonregular, χ² of cells
     pooled to expected counts ≥ 5, p-value, ``exponential`` True when p ≥ EXP_REJECT_P, ``exponential_verdict``
     'yes', 'no' or 'too few orbits' when no degree of freedom is left) and their hazard per bin of
-    ``hazard_edges``. A P of 0 carries its one-sided 95 % bound ``P_upper`` instead of an error; so does a P∞ of 0
+    ``hazard_edges`` (a bin with no escape: hazard 0 with its one-sided 95 % bound ``hazard_upper``, no error). A P
+    of 0 carries its one-sided 95 % bound ``P_upper`` instead of an error; so does a P∞ of 0
     with no orbit inside at t_max (``P_inf_upper``).
     """
     t = lifetimes["t_end"].to_numpy(float)
@@ -134,11 +134,27 @@ def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> 
     except ValueError as exc:
         rec.update(kappa_nonregular=None, exponential=None, exponential_verdict=TOO_FEW, reason_nonregular=str(exc))
     h = hazard_profile(tn, on, hazard_edges)
-    rec["hazard_nonregular"] = [
-        {"t_lo": float(a), "t_hi": float(b), "hazard": _finite(c), "err": _finite(d), "events": int(e)}
-        for a, b, c, d, e in h[["t_lo", "t_hi", "hazard", "hazard_err", "events"]].itertuples(index=False)
-    ]
+    rec["hazard_nonregular"] = [_hazard_bin(*row) for row in h[list(HAZARD_COLUMNS)].itertuples(index=False)]
     return rows, rec
+
+
+#: the columns of :func:`~hhscatter.analysis.survival.long_time.hazard_profile` a hazard bin record is made from
+HAZARD_COLUMNS = ("t_lo", "t_hi", "hazard", "hazard_err", "events", "hazard_upper")
+
+
+def _hazard_bin(t_lo, t_hi, hazard, err, events, upper) -> dict:
+    """{t_lo, t_hi, hazard, err, events} of one hazard bin; a bin with orbits at risk and no escape gets no error
+    but its one-sided 95 % upper bound ``hazard_upper`` (and ``hazard_cl``), never "0 ± 0"."""
+    out = {
+        "t_lo": float(t_lo),
+        "t_hi": float(t_hi),
+        "hazard": _finite(hazard),
+        "err": _finite(err),
+        "events": int(events),
+    }
+    if _finite(upper) is not None:
+        out.update(hazard_upper=float(upper), hazard_cl=0.95)
+    return out
 
 
 def _p_row(t: float, P: float, P_err: float, t_end, observed) -> dict:

@@ -158,3 +158,36 @@ def test_p_inf_error_carries_the_binomial_error_of_p_t0():
     err = float(np.median([f.p_inf_err for f in fits]))
     assert err == pytest.approx(binom, rel=0.1)
     assert 0.8 < p_inf.std(ddof=1) / err < 1.25  # the Monte Carlo spread over 100 samples
+
+
+def test_a_hazard_bin_without_escape_gives_its_poisson_upper_bound_not_zero_plus_minus_zero():
+    # orbits end at 10, 20 (escapes) and 100 (censored): [50, 100) has one orbit at risk for 50 time units, no escape
+    h = hazard_profile([10.0, 20.0, 100.0], [True, True, False], [0.0, 50.0, 100.0])
+    empty = h.iloc[1]
+    assert empty["events"] == 0 and empty["exposure"] == 50.0 and empty["hazard"] == 0.0
+    assert math.isnan(empty["hazard_err"])  # no "± 0"
+    assert empty["hazard_upper"] == pytest.approx(2.995732 / 50.0, rel=1e-6)  # P(0 events | κ·50) = 0.05
+    assert math.isnan(h.iloc[0]["hazard_upper"]) and h.iloc[0]["hazard_err"] > 0
+
+
+@pytest.mark.parametrize("n", [6, 12])
+def test_rate_status_with_too_few_orbits_says_so_by_the_pooled_chi2_rule(n):
+    """A handful of exponential lifetimes: one exponential is neither accepted nor rejected (was 'exponential')."""
+    from hhscatter.analysis.stats.goodness import TOO_FEW
+
+    t = np.random.default_rng(n).exponential(10.0, n)
+    obs = np.ones(n, bool)
+    if n >= 10:  # fitted: the pooled χ²'s rule, with n orbits in cells of ≥ 5 expected no degree of freedom left
+        assert fit_plateau_exponential(t, obs, 0.0, plateau=False).too_few
+    else:  # too few to fit one exponential at all
+        with pytest.raises(ValueError, match="too few"):
+            fit_plateau_exponential(t, obs, 0.0, plateau=False)
+    st = rate_status(t, obs, 0.0, 20.0)
+    assert st.status == TOO_FEW == "too few orbits" and math.isnan(st.p_value) and TOO_FEW in st.note
+
+
+def test_rate_status_gives_a_verdict_once_the_pooled_chi2_has_a_degree_of_freedom():
+    t = np.random.default_rng(5).exponential(10.0, 200)
+    obs = np.ones(t.size, bool)
+    assert not fit_plateau_exponential(t, obs, 0.0, plateau=False).too_few
+    assert rate_status(t, obs, 0.0, 20.0).status == "exponential"

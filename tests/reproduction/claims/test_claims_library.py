@@ -1,6 +1,7 @@
 """The claims' analysis (hhscatter.reproduction.claims): a reason per κ convention, claim 6 independent of the order of
 the systems, the evidence records."""
 
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -90,6 +91,17 @@ def test_long_time_record_gives_a_bound_where_no_orbit_is_left_and_says_too_few(
     few = _lt(np.concatenate([rng.exponential(5.0, 1988), 100.0 + rng.exponential(50.0, 12)]), censored=[])
     _, rec = long_time_record(few, [], [100.0], 100.0, [100.0, 1000.0])
     assert rec["exponential"] is None and rec["exponential_verdict"] == "too few orbits"
+
+
+def test_long_time_record_gives_a_hazard_bin_without_escape_its_bound():
+    rng = np.random.default_rng(3)
+    t = np.concatenate([rng.uniform(100.0, 1000.0, 200), np.full(50, 2000.0)])  # no escape after t = 1000
+    lt = _lt(t, censored=np.flatnonzero(t >= 2000.0))
+    _, rec = long_time_record(lt, [], [100.0], 100.0, [100.0, 1000.0, 2000.0])
+    full, empty = rec["hazard_nonregular"]
+    assert full["events"] == 200 and full["err"] > 0 and "hazard_upper" not in full
+    assert empty["events"] == 0 and empty["hazard"] == 0.0 and empty["err"] is None
+    assert empty["hazard_upper"] == pytest.approx(-math.log(0.05) / (50 * 1000.0)) and empty["hazard_cl"] == 0.95
 
 
 def test_regular_record_carries_the_threshold_systematic_and_a_bound_at_zero():
