@@ -348,7 +348,8 @@ def _analyze_cmeasure(study, grid_runs):
 
 
 def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> list:
-    """κ from the c-measure of one energy's run per start shift (:func:`cmeasure_run_rows` on its tables)."""
+    """κ from the c-measure of one energy's run per start shift
+    (:func:`~hhscatter.reproduction.fig2.cmeasure_run_rows` on its tables)."""
     from hhscatter.data.read import read_lifetimes, read_sections
 
     key = cm_key(energy)
@@ -379,8 +380,9 @@ def _record(study, rows) -> None:
 
 
 def _analyze_conventions(study, grid_runs):
-    """κ(E) under the 4 conventions of FIG2_CONVENTIONS (:func:`convention_analysis`): the Fig. 2b runs and the
-    square-IC runs; writes the table. Returns (table, stability, numbers)."""
+    """κ(E) under the 4 conventions of FIG2_CONVENTIONS
+    (:func:`~hhscatter.reproduction.fig2.convention_analysis`) of the Fig. 2b runs and the square-IC runs; writes
+    the table. Returns (table, stability, numbers)."""
     p = study.params
     runs = {}
     for energy in p.grid_energies:

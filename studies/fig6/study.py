@@ -217,7 +217,8 @@ def _setup(study) -> mt.ModelInputs:
 
 
 def _fit_pair(study, s: mt.ModelInputs, E0: float, g: float):
-    """One (E0, γ): its lifetimes and (on demand) snapshots read, the model fits of :func:`mt.pair_fits`."""
+    """One (E0, γ): its lifetimes and (on demand) snapshots read, the model fits of
+    :func:`~hhscatter.reproduction.model_tables.pair_fits`."""
     import pyarrow.dataset as pads
 
     from hhscatter.data.read import read_lifetimes, read_snapshots
@@ -253,7 +254,8 @@ def _fit_pair(study, s: mt.ModelInputs, E0: float, g: float):
 
 
 def _tau_predictions(study, s: mt.ModelInputs):
-    """τ1, τ2 vs γ at fig4's E0 (:func:`mt.tau_predictions` on fig4's published tables)."""
+    """τ1, τ2 vs γ at fig4's E0 (:func:`~hhscatter.reproduction.model_tables.tau_predictions` on fig4's
+    published tables)."""
     p = study.params
     ref = _fig4_reference(study, s.inputs, p.dt)
     return mt.tau_predictions(ref, s, dt=p.dt, fit_dt=p.fit_dt, min_count=p.min_count, alpha=p.alpha)
