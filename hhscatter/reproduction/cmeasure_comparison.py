@@ -31,15 +31,18 @@ from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import paired_distance as pdist
 
 __all__ = [
+    "DIFFERENCE_CONSTRUCTIONS",
     "ComparisonSettings",
     "cap_rows",
     "common_sample_size",
     "crossing_sets",
+    "difference_record",
     "distance_tables",
     "interval_record",
     "paired_differences",
     "paired_reference_distances",
     "paired_scale_curves",
+    "reference_record",
     "scale_of_curve",
     "within_radius",
 ]
@@ -530,4 +533,124 @@ def paired_scale_curves(sets_a: dict, t_star: dict, dtab: pd.DataFrame, ref: pd.
         "steps": steps,
         "method": "paired half-sampling over orbits: one draw of the ICs for every γ's run (one seed), one of the "
         "reference's, independent; debiased Hellinger averaged over grid placements; ε*_δ per replicate",
+    }
+
+
+#: the constructions of the 5b − 5a verdict (:func:`difference_record`): key, description, grid offsets k (k²
+#: placements of the box grid; None: ``verdict_offsets``)
+DIFFERENCE_CONSTRUCTIONS = (
+    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction this page used first)", 1),
+    ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
+    ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
+    ("cut_offsets_random", "r < 1 on every set, averaged over grid offsets, momenta in random directions", None),
+    (
+        "ours",
+        "our construction (disk ICs; 5a: first crossing after t*, 5b: those in the band; no cut on any set), "
+        "averaged over grid offsets",
+        None,
+    ),
+)
+
+
+def difference_record(reference, ours, authors, authors_random, s: ComparisonSettings, *, E1, momentum) -> dict:
+    """The 5b − 5a verdict in every construction of :data:`DIFFERENCE_CONSTRUCTIONS`, as a numbers-JSON record.
+
+    Debiased Hellinger distances to μ_c^{E1} at ``box_headline`` and their paired difference Δ = d(5b) − d(5a),
+    half-sampling the orbits of every set, the reference included (:func:`paired_differences`); the sets of one
+    comparison are cut alike. ``reference``: the c-measure points at ``E1`` (traj_id, x, y; not capped);
+    ``ours``: (5a, 5b) of our construction; ``authors``, ``authors_random``: (5a, 5b) of the authors' runs with
+    their tangential momenta and with the momenta ``momentum`` (a scene's momentum convention), already cut at
+    r < ``r_cut``. Rows with a note where the sets are too small.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> df = lambda n: pd.DataFrame({"traj_id": np.arange(n), "x": rng.uniform(-1, 1, n), "y": rng.uniform(-1, 1, n)})
+    >>> s = ComparisonSettings((-1, 1, -1, 1), (0.5,), 0.5, n_splits=2, n_boot=3, n_proj=4, z=2, delta=0.1,
+    ...                        noise_max=0.5, n_cap=10**4, m_min=5, seed=1, verdict_offsets=2, verdict_boot=10)
+    >>> rec = difference_record(df(300), (df(300), df(300)), (df(200), df(200)), (df(200), df(200)), s, E1=0.3,
+    ...                         momentum="random")
+    >>> [(r["construction"], r["offsets"]) for r in rec["rows"]]
+    [('old', 1), ('cut', 1), ('cut_offsets', 4), ('cut_offsets_random', 4), ('ours', 4)]
+    """
+    ref_all = cap_rows(reference, s.n_cap, s.seed)
+    ref_cut = cap_rows(within_radius(reference, s.r_cut), s.n_cap, s.seed)
+    sets = {
+        "old": (*authors, ref_all),
+        "cut": (*authors, ref_cut),
+        "cut_offsets": (*authors, ref_cut),
+        "cut_offsets_random": (*authors_random, ref_cut),
+        "ours": (*ours, ref_all),
+    }
+    rows = paired_differences([(key, label, offs, sets[key]) for key, label, offs in DIFFERENCE_CONSTRUCTIONS], s)
+    return {
+        "reference": f"μ_c^{E1:g} (fig1's sprinkler points)",
+        "level": s.verdict_level,
+        "n_boot": s.verdict_boot,
+        "method": "paired half-sampling over orbits of every set (reference included); H² debiased with the "
+        "complementary halves; averaged over offsets² placements of the box grid",
+        "like_for_like": "in every row but 'old' the three sets are cut alike (r < 1 for the authors' sets, "
+        "no cut for ours)",
+        "momentum_convention": "tangential, ṙ = 0 and φ̇ > 0: the authors' goodICs sets (dx, dy) = (−y, x)/|q|·"
+        "√(2(E − V)) (LnBn/DissipativeScattering@0868eff, "
+        "src/dissipative_scattering_functions.jl lines 421–422, in goodICs, line 410), "
+        "as region 'square' does here",
+        "sensitivity_momentum": f"row 'cut_offsets_random': the authors' two runs again with momentum = "
+        f"{momentum!r} (directions uniform on the circle, "
+        "|p| = √(2(E − V)), the same positions), cut and compared like 'cut_offsets'",
+        "rows": rows,
+    }
+
+
+def reference_record(references: dict, ours, authors, s: ComparisonSettings, *, E1, E2) -> dict:
+    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired, in two constructions, as a numbers-JSON record.
+
+    ``references``: {"E1", "E2": c-measure points (traj_id, x, y), not capped}; ``ours``: (5a, 5b) of our
+    construction (no cut); ``authors``: (5a, 5b) of the authors' runs (r < ``r_cut`` on every set, the
+    references too). :func:`paired_reference_distances` of both; the record holds its rows and curves (panel
+    (c)) with the settings they used.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> df = lambda n: pd.DataFrame({"traj_id": np.arange(n), "x": rng.uniform(-1, 1, n), "y": rng.uniform(-1, 1, n)})
+    >>> s = ComparisonSettings((-1, 1, -1, 1), (0.5, 1.0), 0.5, n_splits=2, n_boot=3, n_proj=4, z=2, delta=0.1,
+    ...                        noise_max=0.5, n_cap=10**4, m_min=5, seed=1, verdict_offsets=1, verdict_boot=10)
+    >>> rec = reference_record({"E1": df(300), "E2": df(300)}, (df(300), df(300)), (df(300), df(300)), s,
+    ...                        E1=0.3, E2=0.35)
+    >>> [(r["construction"], r["set"]) for r in rec["rows"]], rec["box"], rec["boxes"]
+    ([('ours', '5a'), ('ours', '5b'), ('authors', '5a'), ('authors', '5b')], 0.5, [1.0, 0.5])
+    """
+    cut = {k: cap_rows(within_radius(v, s.r_cut), s.n_cap, s.seed) for k, v in references.items()}
+    uncut = {k: cap_rows(v, s.n_cap, s.seed) for k, v in references.items()}
+    # one seed, one id space: 5a and 5b are the same orbits (ours: 5b ⊂ 5a; the authors': two runs of the same
+    # ICs), and so are the two references (the same positions at E1 and E2): each pair is drawn together
+    constructions = (
+        (
+            "ours",
+            "our construction (disk ICs, γ = gamma_main, 5b = 5a in the band), no cut on any set",
+            {"5a": ours[0], "5b": ours[1]},
+            uncut,
+        ),
+        (
+            "authors",
+            "the authors' 5a and 5b runs, r < 1 on every set (5a, 5b, μ_c^0.30, μ_c^0.35)",
+            {"5a": authors[0], "5b": authors[1]},
+            cut,
+        ),
+    )
+    rows, panel_c, box = paired_reference_distances(constructions, s)
+    return {
+        "box": box,
+        "offsets": s.verdict_offsets**2,
+        "level": s.verdict_level,
+        "n_boot": s.verdict_boot,
+        "E1": E1,
+        "E2": E2,
+        "boxes": sorted(map(float, s.boxes), reverse=True),
+        "curves": panel_c,
+        "method": "paired half-sampling over orbits: one draw of the run's orbits serves 5a, 5b and both "
+        "distances, one draw of fig1's orbits both references (one seed: the same positions at E1 and "
+        "E2), the two draws independent; debiased Hellinger averaged over grid placements",
+        "rows": rows,
     }

@@ -40,8 +40,10 @@ __all__ = [
     "channel_rows",
     "common_window",
     "criterion_numbers",
+    "follow_returns",
     "kappa_row",
     "lyapunov_table",
+    "paired_runs",
     "recommend_r_esc",
     "returns_row",
 ]
@@ -453,3 +455,59 @@ def criterion_numbers(energies, radii, r_ref, kap, ret, chan, lyap, *, r_in: flo
         "default_r_esc": recommend_r_esc(ret, lyap, r_ref),
     }
     return numbers, rows
+
+
+def paired_runs(read, radii, r_ref: float, E: float):
+    """({r: (t_end, observed)}, {r: exit channel}) of the runs at energy ``E``, which must hold the same orbits.
+
+    ``read(r)`` gives the run at r_esc = r as arrays (traj_id, t_end, observed, exit channel) sorted by traj_id;
+    the runs are read one at a time, r_ref first, and every one's traj_id must equal r_ref's, else ValueError.
+
+    Examples
+    --------
+    >>> runs = {1.5: (np.arange(3), np.ones(3), np.ones(3, bool), np.zeros(3)), 2.0: (np.arange(3),) + (None,) * 3}
+    >>> arrs, chans = paired_runs(runs.get, [2.0, 1.5], 1.5, 0.3)
+    >>> list(arrs), list(chans)
+    ([1.5, 2.0], [1.5, 2.0])
+    """
+    arrs, chans = {}, {}
+    ids_ref = None
+    for r in sorted(radii, key=lambda v: v != r_ref):
+        ids, t_, o_, chans[r] = read(r)
+        arrs[r] = (t_, o_)
+        if ids_ref is None:
+            ids_ref = ids
+        elif not np.array_equal(ids, ids_ref):
+            raise ValueError(f"E={E}: runs r_esc={r} and {r_ref} do not hold the same orbits")
+    return arrs, chans
+
+
+def follow_returns(crossings: pd.DataFrame, lifetimes: pd.DataFrame, radii, r_in: float):
+    """(lifetimes, {r: returns back inside r_in}, {r: back inside r itself}) of runs followed past their escape.
+
+    ``crossings``: the follow run's crossings (traj_id, t, radius, direction), with the exact radii r_in and
+    every r of ``radii``; ``lifetimes``: its traj_id, outcome, t_end, e0, e_end (an orbit that never escapes is
+    censored at t_max, its t_end). Per r: :func:`~hhscatter.analysis.geometry.channels.return_statistics` with
+    r_esc = r back inside ``r_in``, and whether the orbit comes back inside r itself after its first escape.
+    The lifetimes come back sorted by traj_id with ``energy_error`` = |e_end − e0| (energy units).
+
+    Examples
+    --------
+    >>> cross = pd.DataFrame({"traj_id": [0, 0, 0], "t": [1.0, 2.0, 3.0], "radius": [1.5, 1.0, 1.5],
+    ...                       "direction": [1, -1, 1]})
+    >>> ends = pd.DataFrame({"traj_id": [0], "outcome": ["escaped"], "t_end": [3.0], "e0": [0.3], "e_end": [0.3]})
+    >>> ends, rs, back = follow_returns(cross, ends, [1.5], 1.0)
+    >>> bool(rs[1.5]["returned"][0]), float(rs[1.5]["t_reesc"][0]), bool(back[1.5][0])
+    (True, 3.0, False)
+    """
+    from hhscatter.analysis.geometry.channels import return_statistics  # deferred: geometry loads on first use
+
+    cross = crossings.sort_values(["traj_id", "t"], kind="stable")
+    ends = lifetimes.sort_values("traj_id")
+    ends["energy_error"] = (ends["e_end"] - ends["e0"]).abs()
+    nf = len(ends)
+    cols = (cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(), cross.direction.to_numpy())
+    rs = {r: return_statistics(*cols, nf, r, r_in) for r in radii}
+    # broader: back inside r_esc itself (not necessarily inside r_in) after the first escape
+    recross = {r: return_statistics(*cols, nf, r, r)["returned"] for r in radii}
+    return ends, rs, recross

@@ -18,8 +18,16 @@ Examples
 
 from __future__ import annotations
 
+import pandas as pd
+
 from hhscatter.analysis.stats.verdicts import half_unit
-from hhscatter.analysis.survival.kappa_conventions import LAW_PARAMETERS
+from hhscatter.analysis.survival.kappa_conventions import (
+    LAW_PARAMETERS,
+    convention_rows,
+    fit_laws,
+    law_spread,
+    stable_energies,
+)
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.model import HenonHeiles
 from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
@@ -32,7 +40,9 @@ __all__ = [
     "PAPER_KAPPA",
     "FIG2_RULES",
     "cmeasure_comparisons",
+    "cmeasure_run_rows",
     "cmeasure_table_rows",
+    "convention_analysis",
     "convention_numbers",
     "law_comparisons",
     "paper_law_kappa",
@@ -366,3 +376,78 @@ def convention_numbers(table, stability, fit_info: dict, law: dict, *, p_levels,
         "fits": fit_info,
         "law": law,
     }
+
+
+def convention_analysis(runs: dict, *, E_c, p_levels, max_bias, rel_tol, n_boot, seed, min_survivors):
+    """κ(E) under the :data:`FIG2_CONVENTIONS`: the table, the stable energies and the numbers of every convention.
+
+    Parameters
+    ----------
+    runs : dict
+        {energy: {region ("disk", "square"): (lifetimes, rate)}}: each run's lifetimes (t_end, outcome) and its
+        escape-rate result (None: fitted here with ``min_survivors``, no tail detection).
+    E_c : float
+        The critical energy (x = E − E_c).
+    p_levels : (float, float)
+        The P levels (p_hi, p_lo) of the windows fixed by P; ``max_bias`` the largest bias of the slope at the
+        window end from the trapped plateau (beyond: κ ill-defined); ``rel_tol`` the relative spread of the
+        conventions' κ within which an energy is stable.
+    n_boot, seed : int
+        The bootstrap of the law fits (:func:`~hhscatter.analysis.survival.kappa_conventions.fit_laws`).
+
+    Returns
+    -------
+    (DataFrame, DataFrame, dict)
+        One row per (energy, convention) (energy, x, convention, region, the columns of
+        :func:`~hhscatter.analysis.survival.kappa_conventions.convention_rows`, stable); the stability per energy
+        (:func:`~hhscatter.analysis.survival.kappa_conventions.stable_energies`); :func:`convention_numbers`.
+    """
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes  # deferred: scipy on first use
+    from hhscatter.analysis.survival.fits import lifetimes_to_arrays  # deferred: as above
+
+    rows = []
+    for energy, by_region in runs.items():
+        for region, (lt, res) in by_region.items():
+            if res is None:
+                res = escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=min_survivors)
+            t_end, obs = lifetimes_to_arrays(lt)
+            for row in convention_rows(t_end, obs, res, p_hi=p_levels[0], p_lo=p_levels[1], max_bias=max_bias):
+                rows.append(
+                    {"energy": energy, "x": energy - E_c, "convention": f"{region}_{row['windows']}", "region": region}
+                    | row
+                )
+    table = pd.DataFrame(rows)
+    stab = stable_energies(table, rel_tol=rel_tol)
+    table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
+    stable = set(stab.loc[stab["stable"], "energy"])
+    names = [name for name, *_ in FIG2_CONVENTIONS]
+    fits, fit_info = fit_laws(table, names, stable, E_c, n_boot=n_boot, seed=seed)
+    law = law_spread(fits) if fits else {}
+    numbers = convention_numbers(table, stab, fit_info, law, p_levels=p_levels, max_bias=max_bias, rel_tol=rel_tol)
+    return table, stab, numbers
+
+
+def cmeasure_run_rows(
+    sections, lifetimes, choice: dict, section_window: dict, grid_rates: dict, *, label: str, **kw
+) -> list[dict]:
+    """κ from the c-measure of one section run per start shift, beside κ from P(t) (:func:`cmeasure_table_rows`).
+
+    ``choice``: the run's recorded window (t_rec, t_sample_end, t_record_end in time units, and the κ in 1/time
+    that set it); ``section_window``: the run's ``[sections]`` (t_from, t_to), which must be that window, else
+    RuntimeError naming the run ``label`` (it was made for another choice); ``grid_rates``: {energy: escape-rate result} of the
+    Fig. 2b runs, the one nearest ``kw["energy"]`` the reference; ``kw``: ``shifts`` and the keyword arguments of
+    :func:`cmeasure_table_rows`.
+    """
+    t_rec, t_samp, t_rec_end = choice["t_rec"], choice["t_sample_end"], choice["t_record_end"]
+    win = section_window
+    if abs(float(win["t_from"]) - t_rec) > 1e-9 or abs(float(win["t_to"]) - t_rec_end) > 1e-6:
+        raise RuntimeError(
+            f"{label}: raw run's section window {win} is not the recorded choice "
+            f"[{t_rec}, {t_rec_end}]; re-run the simulate stage"
+        )
+    energy = kw["energy"]
+    reference = grid_rates[min(grid_rates, key=lambda e: abs(e - energy))]
+    shifts = kw.pop("shifts")
+    return cmeasure_table_rows(
+        sections, lifetimes, (t_rec, t_samp, t_rec_end), shifts, choice["kappa"], reference, **kw
+    )

@@ -18,29 +18,35 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.dissipative.mixture import mixture_components
 from hhscatter.analysis.dissipative.model_comparison import (
     better_fit,
     compare_fits,
     fit_homogeneous_hazards,
+    fit_mixture_hazards,
     predict_tau1,
     survival_fit_points,
 )
-from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
 from hhscatter.analysis.survival.fits import survival_from_lifetimes
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 
 __all__ = [
     "PAPER_CONSTANTS",
+    "ModelInputs",
     "TauReference",
     "constants_record",
     "constants_row",
     "constants_taus",
     "fit_row",
     "kappa_from_constants",
+    "mixture_fits",
     "model_rows",
     "number_or_none",
+    "pair_fits",
     "survival_grid_curve",
     "tau2_curve",
+    "tau_predictions",
     "tau_vs_gamma",
     "value_and_err",
 ]
@@ -431,3 +437,136 @@ def constants_record(pc: dict, E_c: float, tau0: float, pcf: pd.DataFrame, pct: 
         "fits": pcf.to_dict(orient="records"),
         "tau_vs_gamma": pct.to_dict(orient="records"),
     }
+
+
+class ModelInputs(NamedTuple):
+    """What every fit of the survival model shares: the constants, the hazard forms and the mixture variants.
+
+    ``inputs``: where each constant came from ({name: {"source": ...}}); ``kappa``: κ0(E) (1/time); ``mu``,
+    ``mu_err``: the energy-decay exponent and its 1σ (dimensionless, NaN: unknown); ``tau0``: the start of the
+    fits (time); ``E_c``: the critical energy; ``pc``: the paper's constants (a, b, c, E_b, mu) and ``kappa_pc``
+    their κ0(E); ``hazards``: the hazard forms ("paper", "integrated"); ``mixtures``: the mixture variants, dicts
+    with name, by ("energy" or "rate"), t_ref ("tau0" or a time) and fne_mode ("shared" or "free").
+    """
+
+    inputs: dict
+    kappa: PiecewiseKappa
+    mu: float
+    mu_err: float
+    tau0: float
+    E_c: float
+    pc: dict
+    kappa_pc: PiecewiseKappa
+    hazards: list
+    mixtures: list
+
+
+def mixture_fits(snapshots: pd.DataFrame, points, s: ModelInputs, *, label, E0, gamma, n_components, fit_end, P_min):
+    """The mixture-model fits of one (E0, γ): sub-ensembles from the energy snapshots per mixture variant.
+
+    ``snapshots``: the run's energy snapshots (traj_id, t, E) from τ0 on; ``points``: (t, P) of the Kaplan–Meier
+    curve and (tf, Pf, sf) its fitted points (:func:`survival_fit_points`); per variant of ``s.mixtures``,
+    ``n_components`` sub-ensembles at t_ref (:func:`~hhscatter.analysis.dissipative.mixture.mixture_components`,
+    μ_i fitted on [τ0, ``fit_end``]) and the mixture model fitted in every hazard form
+    (:func:`~hhscatter.analysis.dissipative.model_comparison.fit_mixture_hazards`).
+
+    Returns
+    -------
+    (list of DataFrame, dict)
+        The components of each variant (columns of ``MixtureComponents.to_frame`` plus pair, E0, gamma, model),
+        and {variant name: {hazard: SurvivalFit}}.
+    """
+    t, P, tf, Pf, sf = points
+    comp_rows, mixes = [], {}
+    for var in s.mixtures:
+        t_ref = s.tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
+        comps = mixture_components(
+            snapshots, gamma=gamma, t_ref=t_ref, n_components=n_components, by=var["by"], fit_window=(s.tau0, fit_end)
+        )
+        comp_rows.append(comps.to_frame(s.E_c).assign(pair=label, E0=E0, gamma=gamma, model=var["name"]))
+        mixes[var["name"]] = fit_mixture_hazards(
+            t,
+            P,
+            tf,
+            Pf,
+            sf,
+            comps,
+            kappa=s.kappa,
+            tau0=s.tau0,
+            E_c=s.E_c,
+            hazards=s.hazards,
+            mode=var["fne_mode"],
+            P_min=P_min,
+        )
+    return comp_rows, mixes
+
+
+def pair_fits(
+    lifetimes: pd.DataFrame, snapshots, s: ModelInputs, *, label, E0, gamma, dt, fit_dt, min_count, fit_tau2, **mix
+):
+    """One (E0, γ): its Kaplan–Meier P(t), the homogeneous model with our constants and the paper's, the mixtures.
+
+    ``lifetimes``: DataFrame t_end, outcome of the run (N orbits); ``snapshots``: its energy snapshots from τ0 on,
+    or a function returning them (read only once the homogeneous fits are done); P(t) on a grid of step ``dt``,
+    fitted on points ``fit_dt`` apart from τ0 with N·P ≥ ``min_count``
+    (:func:`~hhscatter.analysis.dissipative.model_comparison.fit_homogeneous_hazards`, τ2 free if ``fit_tau2``);
+    ``mix``: ``n_components`` and ``fit_end`` of :func:`mixture_fits`.
+
+    Returns
+    -------
+    (DataFrame, tuple)
+        The curve (t, P, P_err, the model columns of :func:`model_rows`, pair, E0, gamma, N) and (fit rows,
+        component frames, compare frames, paper-constant rows).
+    """
+    n = len(lifetimes)
+    t, P, P_err = survival_grid_curve(lifetimes, dt)
+    tf, Pf, sf = survival_fit_points(t, P, P_err, s.tau0, fit_dt, n, min_count)
+    P_min = min_count / n * 0.999
+    common = dict(E0=E0, gamma=gamma, tau0=s.tau0, E_c=s.E_c, hazards=s.hazards, fit_tau2=fit_tau2, P_min=P_min)
+    homog = fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, kappa=s.kappa, mu=s.mu, **common)
+    # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
+    # so the two RMS log residuals compare the constants alone
+    homog_pc = fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, kappa=s.kappa_pc, mu=s.pc["mu"], **common)
+    snaps = snapshots() if callable(snapshots) else snapshots
+    comp_rows, mixes = mixture_fits(snaps, (t, P, tf, Pf, sf), s, label=label, E0=E0, gamma=gamma, P_min=P_min, **mix)
+    del snaps
+    extra = {
+        "E0": E0,
+        "gamma": gamma,
+        "N": n,
+        "tau2_eq": tau2_predicted(E0, s.E_c, s.mu, gamma),
+        "tau2_observed": tau2_observed(lifetimes),
+    }
+    cur = pd.DataFrame({"t": t, "P": P, "P_err": P_err})
+    fit_rows, cmp_rows, pc_rows = model_rows(
+        t, cur, label, homog, homog_pc, mixes, extra, E_c=s.E_c, mu=s.mu, mu_pc=s.pc["mu"]
+    )
+    return cur.assign(pair=label, E0=E0, gamma=gamma, N=n), (fit_rows, comp_rows, cmp_rows, pc_rows)
+
+
+def tau_predictions(ref: TauReference, s: ModelInputs, *, dt, fit_dt, min_count, alpha):
+    """Panel (b): τ1, τ2 against γ at ``ref.E0`` with our constants and with the paper's.
+
+    :func:`tau_vs_gamma` with each set of constants (the paper's μ without an error), the comparison of the two
+    (:func:`constants_taus`) and the τ2 band of Eq. (eq:tau2) (:func:`tau2_curve`).
+
+    Returns
+    -------
+    (DataFrame, DataFrame, DataFrame)
+        τ vs γ with our constants, the τ2 curve, the paper's constants beside ours.
+
+    Examples
+    --------
+    >>> ref = TauReference(pd.DataFrame({"gamma": [0.01], "tau1_observed": [None], "tau1_err": [None],
+    ...     "tau2_observed": [80.0], "tau2_err": [None]}), {}, None, 0.3)
+    >>> s = ModelInputs({}, None, 0.9, 0.09, 5.0, 1 / 6, {"mu": 0.91}, None, ["paper"], [])
+    >>> taus, curve, pct = tau_predictions(ref, s, dt=0.5, fit_dt=2.0, min_count=20, alpha=2.0)
+    >>> round(float(taus["tau2_predicted"][0]), 2), round(float(pct["tau2_predicted"][0]), 2)
+    (65.31, 64.59)
+    """
+    kw = {"tau0": s.tau0, "E_c": s.E_c, "hazards": s.hazards, "dt": dt, "fit_dt": fit_dt, "min_count": min_count}
+    taus, fits = tau_vs_gamma(ref, kappa=s.kappa, mu=s.mu, mu_err=s.mu_err, alpha=alpha, **kw)
+    taus_pc, fits_pc = tau_vs_gamma(ref, kappa=s.kappa_pc, mu=s.pc["mu"], mu_err=math.nan, alpha=alpha, **kw)
+    pct = constants_taus(taus, taus_pc, fits, fits_pc, s.hazards)
+    curve = tau2_curve(taus, ref.E0, s.E_c, s.mu, s.mu_err, s.pc["mu"])
+    return taus, curve, pct

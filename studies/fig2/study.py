@@ -33,12 +33,11 @@ from hhscatter.reproduction.escape_summaries import (
     survival_tables,
 )
 from hhscatter.reproduction.fig2 import (
-    FIG2_CONVENTIONS,
     FIG2_RULES,
     PAPER_FIG2,
     cmeasure_comparisons,
-    cmeasure_table_rows,
-    convention_numbers,
+    cmeasure_run_rows,
+    convention_analysis,
     law_comparisons,
     pt_comparisons,
 )
@@ -349,28 +348,23 @@ def _analyze_cmeasure(study, grid_runs):
 
 
 def _cmeasure_rows(study, energy: float, ch: dict, grid_runs, E_C: float) -> list:
-    """κ from the c-measure of one energy's run per start shift (bootstrap over orbits), with κ from P(t)."""
+    """κ from the c-measure of one energy's run per start shift
+    (:func:`~hhscatter.reproduction.fig2.cmeasure_run_rows` on its tables)."""
     from hhscatter.data.read import read_lifetimes, read_sections
 
     key = cm_key(energy)
-    t_rec, t_samp, t_rec_end = ch["t_rec"], ch["t_sample_end"], ch["t_record_end"]
     win = _scene_of(study.raw(key))["sections"]
-    if abs(float(win["t_from"]) - t_rec) > 1e-9 or abs(float(win["t_to"]) - t_rec_end) > 1e-6:
-        raise RuntimeError(
-            f"{key}: raw run's section window {win} is not the recorded choice "
-            f"[{t_rec}, {t_rec_end}]; re-run the simulate stage"
-        )
-    r = grid_runs[min(grid_runs, key=lambda e: abs(e - energy))][1]  # the Fig. 2b κ at this energy (a grid E)
     lt = read_lifetimes(study.raw(key), columns=["traj_id", "outcome", "t_end"], categorical=True)
     sec = read_sections(study.raw(key), columns=["traj_id", "t"])
     p = study.params
-    return cmeasure_table_rows(
+    return cmeasure_run_rows(
         sec,
         lt,
-        (t_rec, t_samp, t_rec_end),
-        p.cm_start_shifts,
-        ch["kappa"],
-        r,
+        ch,
+        win,
+        {e: r for e, (_, r) in grid_runs.items()},
+        label=key,
+        shifts=p.cm_start_shifts,
         energy=energy,
         E_c=E_C,
         min_survivors=p.min_survivors,
@@ -386,60 +380,30 @@ def _record(study, rows) -> None:
 
 
 def _analyze_conventions(study, grid_runs):
-    """κ(E) under the 4 conventions of FIG2_CONVENTIONS, the stable energies and the law per convention.
-
-    Returns (table, stability, numbers). Conventions: IC region (disk, the
-    authors' square) × window rule (our data-driven plateau, windows fixed by
-    P levels); κ is *ill-defined* where the trapped fraction biases the slope
-    at the window end by more than max_plateau_bias (kappa_conventions).
-    """
-    import pandas as pd
-
-    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
-    from hhscatter.analysis.survival.fits import lifetimes_to_arrays
-    from hhscatter.analysis.survival.kappa_conventions import (
-        convention_rows,
-        fit_laws,
-        law_spread,
-        stable_energies,
-    )
-
-    E_C, p = study.model.critical_energy, study.params
-    rows = []
+    """κ(E) under the 4 conventions of FIG2_CONVENTIONS
+    (:func:`~hhscatter.reproduction.fig2.convention_analysis`) of the Fig. 2b runs and the square-IC runs; writes
+    the table. Returns (table, stability, numbers)."""
+    p = study.params
+    runs = {}
     for energy in p.grid_energies:
-        runs = {"disk": grid_runs[energy]}  # the Fig. 2b run, already read and fitted
+        runs[energy] = {"disk": grid_runs[energy]}  # the Fig. 2b run, already read and fitted
         if any(np.isclose(energy, e) for e in p.square_energies):
-            lt = _lifetimes(study.raw(sq_key(energy)))
-            runs["square"] = (lt, escape_rate_from_lifetimes(lt, detect_tail=False, min_survivors=p.min_survivors))
-        for region, (lt, res) in runs.items():
-            t_end, obs = lifetimes_to_arrays(lt)
-            for row in convention_rows(
-                t_end, obs, res, p_hi=p.p_levels[0], p_lo=p.p_levels[1], max_bias=p.max_plateau_bias
-            ):
-                rows.append(
-                    {
-                        "energy": energy,
-                        "x": energy - E_C,
-                        "convention": f"{region}_{row['windows']}",
-                        "region": region,
-                        **row,
-                    }
-                )
-    table = pd.DataFrame(rows)
-    stab = stable_energies(table, rel_tol=p.stable_rel_tol)
-    table = table.merge(stab[["energy", "stable"]], on="energy", how="left")
+            runs[energy]["square"] = (_lifetimes(study.raw(sq_key(energy))), None)
+    table, stab, numbers = convention_analysis(
+        runs,
+        E_c=study.model.critical_energy,
+        p_levels=p.p_levels,
+        max_bias=p.max_plateau_bias,
+        rel_tol=p.stable_rel_tol,
+        n_boot=p.n_boot,
+        seed=p.fit_seed,
+        min_survivors=p.min_survivors,
+    )
     study.write_table(
         table,
         "kappa_conventions.parquet",
         description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
         "defined = False where the trapped plateau makes κ ill-defined",
-    )
-    stable = set(stab.loc[stab["stable"], "energy"])
-    names = [name for name, *_ in FIG2_CONVENTIONS]
-    fits, fit_info = fit_laws(table, names, stable, E_C, n_boot=p.n_boot, seed=p.fit_seed)
-    law = law_spread(fits) if fits else {}
-    numbers = convention_numbers(
-        table, stab, fit_info, law, p_levels=p.p_levels, max_bias=p.max_plateau_bias, rel_tol=p.stable_rel_tol
     )
     return table, stab, numbers
 

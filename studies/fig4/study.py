@@ -124,7 +124,7 @@ def analyze(study):
     paper comparison (:func:`~hhscatter.reproduction.transition_tables.transition_comparisons`) and
     the numbers (:func:`_numbers`).
     """
-    from hhscatter.analysis.dissipative.transitions import bootstrap_transition_times, survival_on_grid
+    from hhscatter.analysis.dissipative.transitions import subsample_bootstrap_transition_times, survival_on_grid
     from hhscatter.analysis.survival.fits import observed_from_outcome
 
     gs, mg = _gammas(study)
@@ -145,18 +145,17 @@ def analyze(study):
 
     # paired bootstrap on the orbits traj_id < K (all at quick scale); σ scaled by √(K/N) beyond
     nb = study.params.n_boot
-    K = min(study.params.n_boot_orbits, N)
-    boot = bootstrap_transition_times(
-        # slice before converting: a view of a converted 1e7 object array would keep all of it alive (690 MB per γ)
-        {g: (lts[g]["t_end"].iloc[:K].to_numpy(), lts[g]["outcome"].iloc[:K].to_numpy()) for g in gs},
+    sb = subsample_bootstrap_transition_times(
+        {g: lts[g] for g in gs},
         0.0,
         grid,
+        n_orbits=study.params.n_boot_orbits,
         tau0=_tau0_rule,
         alpha=alpha,
         n_boot=nb,
         seed=study.params.boot_seed + 1,
     )
-    bscale = float(np.sqrt(K / N))
+    boot, bscale, K = sb.replicates, sb.scale, sb.n_orbits
     taus = transition_table(
         lts,
         grid,
@@ -189,7 +188,7 @@ def analyze(study):
         "the same initial conditions for every γ; one row group per γ",
     )
 
-    tau0_err = float(boot["tau0"].std(ddof=1)) * bscale
+    tau0_err = sb.err("tau0")
     rows, exponents = transition_comparisons(
         taus,
         N=N,

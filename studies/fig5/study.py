@@ -209,106 +209,13 @@ def _authors_sets(study, keys=tuple(AUTHORS)):
     return out
 
 
-VERDICT_ROWS = (
-    ("old", "the authors' 5a/5b cut at r < 1, the references not cut (the construction this page used first)", 1),
-    ("cut", "r < 1 on every set (5a, 5b, μ_c^0.30)", 1),
-    ("cut_offsets", "r < 1 on every set, averaged over grid offsets", None),
-    ("cut_offsets_random", "r < 1 on every set, averaged over grid offsets, momenta in random directions", None),
-    (
-        "ours",
-        "our construction (disk ICs; 5a: first crossing after t*, 5b: those in the band; no cut on any set), "
-        "averaged over grid offsets",
-        None,
-    ),
-)
-
-
-def _verdict_5b(study, cm_full, E1, ours):
-    """The 5b − 5a verdict in every construction of VERDICT_ROWS: debiased Hellinger distances to μ_c^{E1} at
-    box_headline and their paired difference Δ = d(5b) − d(5a), half-sampling the orbits of every set, the
-    reference included (:func:`~hhscatter.reproduction.cmeasure_comparison.paired_differences`). Sets of one
-    comparison are cut alike. Returns the JSON record (rows with a note where the sets are too small)."""
-    s = cc.ComparisonSettings.from_params(study.params)
-    ref_all = cc.cap_rows(cm_full, s.n_cap, s.seed)
-    ref_cut = cc.cap_rows(cc.within_radius(cm_full, s.r_cut), s.n_cap, s.seed)
-    auth = _authors_sets(study, (*AUTHORS, *SENSITIVITY))
-    a_auth, b_auth = auth[("authors", "5a_authors")], auth[("authors", "5b_authors")]
-    a_rand, b_rand = auth[("authors", "5a_authors_random")], auth[("authors", "5b_authors_random")]
-    sets = {
-        "old": (a_auth, b_auth, ref_all),
-        "cut": (a_auth, b_auth, ref_cut),
-        "cut_offsets": (a_auth, b_auth, ref_cut),
-        "cut_offsets_random": (a_rand, b_rand, ref_cut),
-        "ours": (ours[0], ours[1], ref_all),
-    }
-    rows = cc.paired_differences([(key, label, offs, sets[key]) for key, label, offs in VERDICT_ROWS], s)
-    return {
-        "reference": f"μ_c^{E1:g} (fig1's sprinkler points)",
-        "level": s.verdict_level,
-        "n_boot": s.verdict_boot,
-        "method": "paired half-sampling over orbits of every set (reference included); H² debiased with the "
-        "complementary halves; averaged over offsets² placements of the box grid",
-        "like_for_like": "in every row but 'old' the three sets are cut alike (r < 1 for the authors' sets, "
-        "no cut for ours)",
-        "momentum_convention": "tangential, ṙ = 0 and φ̇ > 0: the authors' goodICs sets (dx, dy) = (−y, x)/|q|·"
-        "√(2(E − V)) (LnBn/DissipativeScattering@0868eff, "
-        "src/dissipative_scattering_functions.jl lines 421–422, in goodICs, line 410), "
-        "as region 'square' does here",
-        "sensitivity_momentum": f"row 'cut_offsets_random': the authors' two runs again with momentum = "
-        f"{study.params.sensitivity_momentum!r} (directions uniform on the circle, "
-        "|p| = √(2(E − V)), the same positions), cut and compared like 'cut_offsets'",
-        "rows": rows,
-    }
-
-
-def _refs_paired(study, cm_full, sets_ours, E1, E2):
-    """Fig. 5a/5b against μ_c^{E1} and μ_c^{E2}, paired
-    (:func:`~hhscatter.reproduction.cmeasure_comparison.paired_reference_distances`), in two constructions,
-    each cut alike: ours (γ = gamma_main, no cut) and the authors' (their two runs, r < r_cut on every set).
-    Returns the JSON record; the curves are panel (c)."""
-    s = cc.ComparisonSettings.from_params(study.params)
-    auth = _authors_sets(study)
-    cut = {k: cc.cap_rows(cc.within_radius(v, s.r_cut), s.n_cap, s.seed) for k, v in cm_full.items()}
-    uncut = {k: cc.cap_rows(v, s.n_cap, s.seed) for k, v in cm_full.items()}
-    # one seed, one id space: 5a and 5b are the same orbits (ours: 5b ⊂ 5a; the authors': two runs of the same
-    # ICs), and so are fig1's two references (the same positions at E1 and E2): each pair is drawn together
-    constructions = (
-        (
-            "ours",
-            "our construction (disk ICs, γ = gamma_main, 5b = 5a in the band), no cut on any set",
-            {"5a": sets_ours[0], "5b": sets_ours[1]},
-            uncut,
-        ),
-        (
-            "authors",
-            "the authors' 5a and 5b runs, r < 1 on every set (5a, 5b, μ_c^0.30, μ_c^0.35)",
-            {"5a": auth[("authors", "5a_authors")], "5b": auth[("authors", "5b_authors")]},
-            cut,
-        ),
-    )
-    rows, panel_c, box = cc.paired_reference_distances(constructions, s)
-    return {
-        "box": box,
-        "offsets": s.verdict_offsets**2,
-        "level": s.verdict_level,
-        "n_boot": s.verdict_boot,
-        "E1": E1,
-        "E2": E2,
-        "boxes": sorted(map(float, s.boxes), reverse=True),
-        "curves": panel_c,
-        "method": "paired half-sampling over orbits: one draw of the run's orbits serves 5a, 5b and both "
-        "distances, one draw of fig1's orbits both references (one seed: the same positions at E1 and "
-        "E2), the two draws independent; debiased Hellinger averaged over grid placements",
-        "rows": rows,
-    }
-
-
 def _authors_record(study, refs) -> dict:
     """The JSON record of the authors' own Fig. 5 convention (square ICs; 5a: first crossing with 17 < t < 30;
     5b: first crossing in the energy band at any time; r < 1): point counts and the summary rows of their 5a and
     5b sets (distances at the headline box to μ_c^{E1} and μ_c^{E2}, each at its own common sample size); rows
-    None if the sets are too small (tiny scale). Its paper-comparison rows are paired (:func:`_refs_paired`,
-    :func:`_verdict_5b`)."""
+    None if the sets are too small (tiny scale). Its paper-comparison rows are paired
+    (:func:`~hhscatter.reproduction.cmeasure_comparison.reference_record`,
+    :func:`~hhscatter.reproduction.cmeasure_comparison.difference_record`)."""
     sets = _authors_sets(study)
     out = {
         "convention": AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band)),
@@ -399,16 +306,22 @@ def analyze(study):
     rows, verdicts = cv.closer_comparisons(pg, stab, g_main, **mu_kw, E1=E1, paper=paper)
     authors = _authors_record(study, refs)
     main_sets = (sets[(g_main, "a")], sets[(g_main, "b")])
-    verdict = _verdict_5b(study, cm_full["E1"], E1, main_sets)
+    # the authors' runs, cut at r < r_cut like their plots (the sensitivity runs too)
+    auth = _authors_sets(study, (*AUTHORS, *SENSITIVITY))
+    auth_runs = (auth[("authors", "5a_authors")], auth[("authors", "5b_authors")])
+    auth_random = (auth[("authors", "5a_authors_random")], auth[("authors", "5b_authors_random")])
+    verdict = cc.difference_record(
+        cm_full["E1"], main_sets, auth_runs, auth_random, settings, E1=E1, momentum=study.params.sensitivity_momentum
+    )
     rows += cv.difference_comparisons(verdict, _conventions(study))
-    refs_paired = _refs_paired(study, cm_full, main_sets, E1, E2)
+    refs_paired = cc.reference_record(cm_full, main_sets, auth_runs, settings, E1=E1, E2=E2)
     rows += cv.reference_comparisons(refs_paired, _conventions(study)["cut"])
     t_star = pg.set_index("gamma")["t_star"]
     panel_d = cc.paired_scale_curves({g: sets[(g, "a")] for g in pg["gamma"]}, t_star, dtab, cm["E1"], settings)
     rows += cv.scale_comparisons(panel_d)
     for row in rows:
         study.compare(**row)
-    cv.qualify_our_5b(study.comparisons, dict((k, lab) for k, lab, _ in VERDICT_ROWS)["cut_offsets"])
+    cv.qualify_our_5b(study.comparisons, dict((k, lab) for k, lab, _ in cc.DIFFERENCE_CONSTRUCTIONS)["cut_offsets"])
     study.write_numbers(
         {
             "inputs": inputs,

@@ -46,15 +46,11 @@ independent (``absolute_sigma``); the points are positively correlated, so
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import pandas as pd
 
-from hhscatter.analysis.dissipative import mixture
-from hhscatter.analysis.dissipative import model_comparison as mc
-from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
+from hhscatter.analysis.dissipative.transitions import tau2_observed
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.reproduction import model_tables as mt
 from hhscatter.reproduction import model_verdicts as mv
 from hhscatter.scene.schema import Bool, Integer, Number, NumberLists, NumberOr, Numbers, OneOf, Text, Texts
@@ -211,124 +207,61 @@ def analyze(study):
     study.write_numbers(_numbers(s, fits, cmps, comps, taus, pcf, pct))
 
 
-class _Setup(NamedTuple):
-    """What every fit shares: the inputs (κ0(E), μ, τ0, E_c), the paper's constants, the hazards and mixtures."""
-
-    inputs: dict
-    kappa: PiecewiseKappa
-    mu: float
-    mu_err: float
-    tau0: float
-    E_c: float
-    pc: dict  # the paper's constants (paper_constants)
-    kappa_pc: PiecewiseKappa  # κ0(E) with the paper's constants
-    hazards: list
-    mixtures: list  # [study] mixtures, checked
-
-
-def _setup(study) -> _Setup:
+def _setup(study) -> mt.ModelInputs:
     """Read inputs: κ0(E), μ and τ0 of the upstream studies, the paper's constants, the model variants."""
     inputs, kappa, mu, mu_err, tau0, E_c = _inputs(study)
     pc = paper_constants(study)
     kappa_pc = mt.kappa_from_constants(pc, E_c)
     hazards = list(study.params.hazards)
-    return _Setup(inputs, kappa, mu, mu_err, tau0, E_c, pc, kappa_pc, hazards, _mixture_variants(study))
+    return mt.ModelInputs(inputs, kappa, mu, mu_err, tau0, E_c, pc, kappa_pc, hazards, _mixture_variants(study))
 
 
-def _fit_pair(study, s: _Setup, E0: float, g: float):
-    """One (E0, γ): Kaplan–Meier P(t) and the model fits; its curves and (fit, component, compare, pc) rows."""
-    from hhscatter.data.read import read_lifetimes
+def _fit_pair(study, s: mt.ModelInputs, E0: float, g: float):
+    """One (E0, γ): its lifetimes and (on demand) snapshots read, the model fits of
+    :func:`~hhscatter.reproduction.model_tables.pair_fits`."""
+    import pyarrow.dataset as pads
+
+    from hhscatter.data.read import read_lifetimes, read_snapshots
 
     label = pair_key(E0, g)
     raw = study.raw(label)
     lt = read_lifetimes(raw, columns=["t_end", "outcome"], categorical=True)  # 9 bytes per orbit
-    n = len(lt)
-    min_count = study.params.min_count
-    t, P, P_err = mt.survival_grid_curve(lt, study.params.dt)
-    tf, Pf, sf = mc.survival_fit_points(t, P, P_err, s.tau0, study.params.fit_dt, n, min_count)
-    P_min = min_count / n * 0.999
-    common = dict(
-        E0=E0, gamma=g, tau0=s.tau0, E_c=s.E_c, hazards=s.hazards, fit_tau2=study.params.fit_tau2, P_min=P_min
+
+    def snapshots():
+        # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
+        # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
+        cap = study.params.mixture_max_orbits
+        keep = pads.field("t") >= s.tau0
+        if cap is not None:
+            keep = keep & (pads.field("traj_id") < cap)
+        return read_snapshots(raw, filters=keep)
+
+    p = study.params
+    return mt.pair_fits(
+        lt,
+        snapshots,
+        s,
+        label=label,
+        E0=E0,
+        gamma=g,
+        dt=p.dt,
+        fit_dt=p.fit_dt,
+        min_count=p.min_count,
+        fit_tau2=p.fit_tau2,
+        n_components=p.n_components,
+        fit_end=p.mixture_fit_window[1],
     )
-    homog = mc.fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, kappa=s.kappa, mu=s.mu, **common)
-    # the same fit with the paper's κ0(E) and μ held instead of ours: same points, starts and free parameters,
-    # so the two RMS log residuals compare the constants alone
-    homog_pc = mc.fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, kappa=s.kappa_pc, mu=s.pc["mu"], **common)
-    comp_rows, mixes = _mixture_pair(study, s, raw, label, E0, g, (t, P, tf, Pf, sf), P_min)
-    extra = {
-        "E0": E0,
-        "gamma": g,
-        "N": n,
-        "tau2_eq": tau2_predicted(E0, s.E_c, s.mu, g),
-        "tau2_observed": tau2_observed(lt),
-    }
-    cur = pd.DataFrame({"t": t, "P": P, "P_err": P_err})
-    fit_rows, cmp_rows, pc_rows = mt.model_rows(
-        t, cur, label, homog, homog_pc, mixes, extra, E_c=s.E_c, mu=s.mu, mu_pc=s.pc["mu"]
-    )
-    return cur.assign(pair=label, E0=E0, gamma=g, N=n), (fit_rows, comp_rows, cmp_rows, pc_rows)
 
 
-def _mixture_pair(study, s: _Setup, raw, label, E0, g, points, P_min):
-    """The mixture fits of one pair: sub-ensembles from the snapshots per variant of [study] mixtures."""
-    import pyarrow.dataset as pads
-
-    from hhscatter.data.read import read_snapshots
-
-    t, P, tf, Pf, sf = points
-    # the mixture needs per-orbit energy records: at N = 1e7 they are ~1e8 rows, so it uses the first
-    # mixture_max_orbits orbits (a uniform random subset: the initial conditions are i.i.d. in traj_id)
-    cap = study.params.mixture_max_orbits
-    keep = pads.field("t") >= s.tau0
-    if cap is not None:
-        keep = keep & (pads.field("traj_id") < cap)
-    snaps = read_snapshots(raw, filters=keep)
-    w_hi = study.params.mixture_fit_window[1]
-    comp_rows, mixes = [], {}
-    for var in s.mixtures:
-        t_ref = s.tau0 if var["t_ref"] == "tau0" else float(var["t_ref"])
-        comps = mixture.mixture_components(
-            snaps, gamma=g, t_ref=t_ref, n_components=study.params.n_components, by=var["by"], fit_window=(s.tau0, w_hi)
-        )
-        comp_rows.append(comps.to_frame(s.E_c).assign(pair=label, E0=E0, gamma=g, model=var["name"]))
-        mixes[var["name"]] = mc.fit_mixture_hazards(
-            t,
-            P,
-            tf,
-            Pf,
-            sf,
-            comps,
-            kappa=s.kappa,
-            tau0=s.tau0,
-            E_c=s.E_c,
-            hazards=s.hazards,
-            mode=var["fne_mode"],
-            P_min=P_min,
-        )
-    return comp_rows, mixes
+def _tau_predictions(study, s: mt.ModelInputs):
+    """τ1, τ2 vs γ at fig4's E0 (:func:`~hhscatter.reproduction.model_tables.tau_predictions` on fig4's
+    published tables)."""
+    p = study.params
+    ref = _fig4_reference(study, s.inputs, p.dt)
+    return mt.tau_predictions(ref, s, dt=p.dt, fit_dt=p.fit_dt, min_count=p.min_count, alpha=p.alpha)
 
 
-def _tau_predictions(study, s: _Setup):
-    """τ1, τ2 vs γ at fig4's E0: the model fitted to fig4's P(t), with our constants and with the paper's."""
-    dt = study.params.dt
-    ref = _fig4_reference(study, s.inputs, dt)
-    tau_kw = {
-        "tau0": s.tau0,
-        "E_c": s.E_c,
-        "hazards": s.hazards,
-        "dt": dt,
-        "fit_dt": study.params.fit_dt,
-        "min_count": study.params.min_count,
-        "alpha": study.params.alpha,
-    }
-    taus, tau_fits = mt.tau_vs_gamma(ref, kappa=s.kappa, mu=s.mu, mu_err=s.mu_err, **tau_kw)
-    taus_pc, tau_fits_pc = mt.tau_vs_gamma(ref, kappa=s.kappa_pc, mu=s.pc["mu"], mu_err=math.nan, **tau_kw)
-    pct = mt.constants_taus(taus, taus_pc, tau_fits, tau_fits_pc, s.hazards)
-    tau_curves = mt.tau2_curve(taus, ref.E0, s.E_c, s.mu, s.mu_err, s.pc["mu"])
-    return taus, tau_curves, pct
-
-
-def _compare_with_paper(study, s: _Setup, fits, cmps, taus, pcf, pct) -> None:
+def _compare_with_paper(study, s: mt.ModelInputs, fits, cmps, taus, pcf, pct) -> None:
     """Compare with the paper: μ used, goodness of the homogeneous fits, the mixtures, τ1 and τ2, its constants."""
     kappa = s.kappa
     ours_const = {"a": kappa.a2, "b": kappa.a1, "c": kappa.slope, "E_b": kappa.E_switch, "mu": s.mu}
@@ -344,7 +277,7 @@ def _compare_with_paper(study, s: _Setup, fits, cmps, taus, pcf, pct) -> None:
         study.compare(**row)
 
 
-def _numbers(s: _Setup, fits, cmps, comps, taus, pcf, pct) -> dict:
+def _numbers(s: mt.ModelInputs, fits, cmps, comps, taus, pcf, pct) -> dict:
     """fig6.json: the inputs, κ0(E), μ, τ0, every fit and comparison, τ vs γ, the paper's constants."""
     kappa = s.kappa
     return {

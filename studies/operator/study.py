@@ -27,6 +27,7 @@ from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.reproduction.operator_cmeasure import measure_distances
+from hhscatter.reproduction.operator_records import dissipative_comparison, kappa_comparisons, kappa_records
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers
 from hhscatter.studies import _upstream as up
 from hhscatter.studies.params import StudyParams
@@ -295,49 +296,25 @@ def _cmeasure_convergence(study, results, cm, boxes, head):
 
 # -- the dissipative operator ----------------------------------------------------------------------
 def _dissipative(study, inputs):
-    """The dissipative comparison at (diss_energy, diss_gamma): P(t) of the operator on (box × E bin)
-    (:func:`~hhscatter.analysis.geometry.ulam.dissipative_operator`), of the reduced operator on ρ(E) and of
-    the simulated ensemble; the first crossing after t*. Returns (numbers, P(t) curves, t* points, distances)."""
+    """The dissipative comparison at (diss_energy, diss_gamma) on this study's runs
+    (:func:`~hhscatter.reproduction.operator_records.dissipative_comparison`). Returns (numbers, P(t) curves,
+    t* points, distances)."""
+    from hhscatter.data.read import read_lifetimes, read_sections
+
     p, sc, edges = study.params, _sim_scene(study), _diss_bins(study)
     if sc.region != "disk":
         raise ValueError(
             f"operator: the dissipative comparison needs region 'disk' (its initial density is the disk's), got {sc.region!r}"
         )
     tab = one_return_table(study, DISS_KEY, _diss_samples(study))
-    op = ulam.dissipative_operator(
-        tab, _extent(study), p.diss_box, edges, dt=p.dt, t_horizon=p.t_horizon, t_star=p.t_star,
-        max_return_time=p.max_return_time, radius=float(sc.radius),
-    )  # fmt: skip
-    sim = _simulated_survival(study, op["grid"])
-    dtab, j = ulam.t_star_distance(
-        op["pred"], sim["xy"], list(p.cm_boxes), _extent(study), p.n_splits, p.seed, p.cm_box_headline
-    )
-    t_sim = float(sim["lt"]["t_end"].sum())
-    numbers = ulam.dissipative_record(
-        op, edges, sim["P"], sim["N"], sim["pts"], t_sim, dtab, j, energy=p.diss_energy, gamma=p.diss_gamma,
-        dt=p.dt, t_star=p.t_star,
-    )  # fmt: skip
-    curves = pd.DataFrame({"t": op["grid"], "sim": sim["P"], "operator": op["P"], "reduced": op["P_reduced"]})
-    pts = pd.concat(
-        [op["pred"].assign(set="operator"), sim["pts"][["x", "y", "energy"]].assign(w=1.0, set="sim")],
-        ignore_index=True,
-    )
-    return numbers, curves, pts, dtab
-
-
-def _simulated_survival(study, grid):
-    """The simulated ensemble: its lifetimes, empirical P(t) on ``grid``, size N and first crossings after t*."""
-    from hhscatter.analysis.geometry import distance as dist
-    from hhscatter.analysis.survival.fits import observed_from_outcome
-    from hhscatter.data.read import read_lifetimes, read_sections
-
     raw = study.raw(SIM_KEY)
     lt = read_lifetimes(raw, columns=["traj_id", "outcome", "t_end"])
-    leaving = observed_from_outcome(lt["outcome"])
-    P_sim = ulam.empirical_survival(lt["t_end"].to_numpy(), leaving, grid)
     sec = read_sections(raw, columns=["traj_id", "t", "x", "y", "energy"])
-    sim_pts = dist.first_crossings(sec, study.params.t_star)
-    return {"lt": lt, "P": P_sim, "pts": sim_pts, "xy": dist.points(sim_pts), "N": len(lt)}
+    return dissipative_comparison(
+        tab, lt, sec, extent=_extent(study), box=p.diss_box, edges=edges, radius=float(sc.radius), dt=p.dt,
+        t_horizon=p.t_horizon, t_star=p.t_star, max_return_time=p.max_return_time, boxes=list(p.cm_boxes),
+        n_splits=p.n_splits, seed=p.seed, box_headline=p.cm_box_headline, energy=p.diss_energy, gamma=p.diss_gamma,
+    )  # fmt: skip
 
 
 # -- cost: orbit-time for κ at 1 % -----------------------------------------------------------------
@@ -373,45 +350,21 @@ def _fig2_kappa(study, inputs):
 
 
 def kappa_part(study, inputs):
-    """κ at every Ulam energy: {results per E, records (kappa_ulam), convergence (kappa_convergence), mixed
-    (mixed phase space), rows (κ per partition), grids (the extrapolation grids and their replicates), kappa0}."""
-    from hhscatter.analysis.stats.verdicts import verdict
+    """κ at every Ulam energy (:func:`~hhscatter.reproduction.operator_records.kappa_records` of
+    :func:`_ulam_energy`), its comparison with fig2's κ0 recorded: {results per E, records (kappa_ulam),
+    convergence (kappa_convergence), mixed (mixed phase space), rows (κ per partition), grids, kappa0}."""
     from hhscatter.reproduction.verdicts import SMOKE_SCALES
 
     kappa0, kappa_cm = _fig2_kappa(study, inputs)
-    not_smoke = study.scale not in SMOKE_SCALES  # a smoke-test scale states no verdicts
-    out = {"results": {}, "records": [], "convergence": [], "mixed": [], "rows": [], "grids": [], "kappa0": kappa0}
-    for E in _ulam_energies(study):
-        res = out["results"][E] = _ulam_energy(study, E)
-        k0, kc = kappa0.get(E), kappa_cm.get(E)
-        rec = uc.kappa_record(E, res, study.params.samples, study.params.box, k0, kc)
-        out["rows"].extend(res["rows"])
-        isl = res["islands"]
-        out["mixed"].append({"energy": E, **isl, "largest_classes": res["largest_classes"]})
-        if any(np.isclose(E, e) for e in study.params.energies):
-            out["records"].append(rec)
-            refs = {"kappa0": k0, "kappa_cm": kc}
-            conv = uc.convergence_record(E, res["grid"], res["boot_grid"], res["kappa"], refs)
-            if not not_smoke:  # a smoke-test scale states no verdict
-                conv = {k: v for k, v in conv.items() if not k.startswith("verdict_")}
-            out["convergence"].append({**conv, **res["cut_boxes"]})
-            out["grids"] += [
-                res["grid"].assign(energy=E, kind="estimate"),
-                res["boot_grid"].assign(energy=E, kind="bootstrap"),
-            ]
-        else:
-            out["mixed"][-1]["record"] = {**rec, "note": "mixed phase space (below the κ grid)"}
-    for r in out["convergence"]:
-        if r.get("kappa0") is not None and r.get("kappa_inf") is not None:
-            row = study.compare(
-                f"κ_Ulam({r['energy']:g}) extrapolated vs fig2's κ0",
-                r["kappa_inf"],
-                r["err"],
-                r["kappa0"],
-                verdict=verdict(r["kappa_inf"], r["err"], r["kappa0"], r["kappa0_err"]).text(),
-                note=f"fig2 ± {r['kappa0_err']:.2g}; finest boxes {study.params.box:g}: κ = {r['kappa_finest']:.4g}",
-            )
-            row["paper_err"] = r["kappa0_err"]  # the reference's own error: the rule takes both
+    results = {E: _ulam_energy(study, E) for E in _ulam_energies(study)}
+    p = study.params
+    out = kappa_records(
+        results, kappa0, kappa_cm, samples=p.samples, box=p.box, grid_energies=p.energies,
+        verdicts=study.scale not in SMOKE_SCALES,  # a smoke-test scale states no verdicts
+    )  # fmt: skip
+    for kw in kappa_comparisons(out["convergence"], p.box):
+        paper_err = kw.pop("paper_err")
+        study.compare(**kw)["paper_err"] = paper_err  # the reference's own error: the rule takes both
     return out
 
 

@@ -44,8 +44,10 @@ from hhscatter.reproduction.escape_criterion import (
     channel_rows,
     common_window,
     criterion_numbers,
+    follow_returns,
     kappa_row,
     lyapunov_table,
+    paired_runs,
     returns_row,
 )
 from hhscatter.scene.schema import Integer, Number, Numbers
@@ -133,8 +135,8 @@ def _lifetimes(study, E, r):
 def analyze(study):
     """analyze(study) -> None: derived tables and resc.json (see the module docstring).
 
-    Steps per energy: the paired runs (:func:`_paired_runs`), the common κ window, the follow runs' returns
-    (:func:`_follow_returns`), then per r_esc the κ row, the returns row and the exit channels; then the numbers
+    Steps per energy: the paired runs (:func:`~hhscatter.reproduction.escape_criterion.paired_runs`), the common
+    κ window, the follow runs' returns (:func:`~hhscatter.reproduction.escape_criterion.follow_returns`), then per r_esc the κ row, the returns row and the exit channels; then the numbers
     and the comparison (:mod:`hhscatter.reproduction.escape_criterion`).
     """
     energies, radii = _grid(study)
@@ -147,7 +149,7 @@ def analyze(study):
 
     k_rows, ret_rows, ch_rows = [], [], []
     for E in energies:
-        arrs, chans = _paired_runs(study, E, radii, r_ref)
+        arrs, chans = paired_runs(lambda r, E=E: _lifetimes(study, E, r), radii, r_ref, E)
         grid, own, win = common_window(arrs, radii, r_ref, p.p_start)
         ends, rs, recross = _follow_returns(study, E, radii)
         for r in radii:
@@ -171,38 +173,14 @@ def analyze(study):
     study.write_numbers(numbers)
 
 
-def _paired_runs(study, E, radii, r_ref):
-    """({r: (t_end, observed)}, {r: exit channel}) of the runs at energy E, which must hold the same orbits."""
-    arrs, chans = {}, {}
-    ids_ref = None
-    for r in sorted(radii, key=lambda v: v != r_ref):
-        ids, t_, o_, chans[r] = _lifetimes(study, E, r)
-        arrs[r] = (t_, o_)
-        if ids_ref is None:
-            ids_ref = ids
-        elif not np.array_equal(ids, ids_ref):
-            raise ValueError(f"E={E}: runs r_esc={r} and {r_ref} do not hold the same orbits")
-    return arrs, chans
-
-
 def _follow_returns(study, E, radii):
-    """(follow-run lifetimes, {r: return statistics back inside r_in}, {r: back inside r itself}) at energy E:
-    returns and flight times on identical trajectories (the follow runs' ``crossings``)."""
-    from hhscatter.analysis.geometry.channels import return_statistics
+    """The follow run at energy E read and its returns measured (:func:`follow_returns`)."""
     from hhscatter.data.read import read_crossings, read_lifetimes
 
-    r_in = study.params.r_in
     fdir = study.raw(_follow_key(E))
-    cross = read_crossings(fdir).sort_values(["traj_id", "t"], kind="stable")
-    ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"]).sort_values("traj_id")
-    # a followed orbit that never escapes is censored at t_max (its t_end)
-    ends["energy_error"] = (ends["e_end"] - ends["e0"]).abs()
-    nf = len(ends)
-    cols = (cross.traj_id.to_numpy(), cross.t.to_numpy(), cross.radius.to_numpy(), cross.direction.to_numpy())
-    rs = {r: return_statistics(*cols, nf, r, r_in) for r in radii}
-    # broader: back inside r_esc itself (not necessarily inside r_in) after the first escape
-    recross = {r: return_statistics(*cols, nf, r, r)["returned"] for r in radii}
-    return ends, rs, recross
+    cross = read_crossings(fdir)
+    ends = read_lifetimes(fdir, columns=["traj_id", "outcome", "t_end", "e0", "e_end"])
+    return follow_returns(cross, ends, radii, study.params.r_in)
 
 
 # -- plot -------------------------------------------------------------------

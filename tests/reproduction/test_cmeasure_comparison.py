@@ -13,11 +13,13 @@ from hhscatter.reproduction.cmeasure_comparison import (
     cap_rows,
     common_sample_size,
     crossing_sets,
+    difference_record,
     distance_tables,
     interval_record,
     paired_differences,
     paired_reference_distances,
     paired_scale_curves,
+    reference_record,
     scale_of_curve,
     within_radius,
 )
@@ -168,3 +170,39 @@ def test_paired_scale_curves_order_by_relaxation_time():
     assert paired_scale_curves({0.01: ref}, {0.01: 1.0}, dtab, ref, _settings()) is None
     # a reference of 3 orbits cannot be half-sampled
     assert "note" in paired_scale_curves({0.01: ref[:5], 0.02: ref[:5]}, t_star, dtab, ref[:3], _settings())
+
+
+def _in_disk(df):
+    return int(((df["x"] ** 2 + df["y"] ** 2) < 1.0).sum())
+
+
+def test_difference_record_cuts_the_reference_for_the_authors_constructions_only():
+    rng = np.random.default_rng(6)
+    ref = _uniform(rng, 800)
+    ours = (_uniform(rng, 500), _uniform(rng, 500, (0.0, 1.0)))
+    authors = (_uniform(rng, 300), _uniform(rng, 310))
+    random = (_uniform(rng, 320), _uniform(rng, 330))
+    rec = difference_record(ref, ours, authors, random, _settings(verdict_offsets=2), E1=0.3, momentum="random")
+    by = {r["construction"]: r for r in rec["rows"]}
+    assert list(by) == ["old", "cut", "cut_offsets", "cut_offsets_random", "ours"]
+    assert [by[k]["offsets"] for k in by] == [1, 1, 4, 4, 4]  # one placement, or verdict_offsets² of them
+    assert by["old"]["n_ref"] == by["ours"]["n_ref"] == 800
+    assert by["cut"]["n_ref"] == by["cut_offsets_random"]["n_ref"] == _in_disk(ref) < 800
+    assert (by["cut_offsets_random"]["n_5a"], by["cut_offsets_random"]["n_5b"]) == (320, 330)
+    assert (by["cut"]["n_5a"], by["ours"]["n_5b"]) == (300, 500)
+    assert by["ours"]["delta_interval"][0] > 0.3  # 5b on half of the reference's support: far farther than 5a
+    assert "momentum = 'random'" in rec["sensitivity_momentum"] and rec["level"] == 0.9 and rec["n_boot"] == 20
+
+
+def test_reference_record_pairs_both_constructions():
+    rng = np.random.default_rng(7)
+    refs = {"E1": _uniform(rng, 600), "E2": _uniform(rng, 600, (0.0, 1.0))}
+    ours = (_uniform(rng, 500), _uniform(rng, 500, (0.0, 1.0)))
+    rec = reference_record(refs, ours, (_uniform(rng, 400), _uniform(rng, 400)), _settings(), E1=0.3, E2=0.35)
+    by = {(r["construction"], r["set"]): r for r in rec["rows"]}
+    assert list(by) == [("ours", "5a"), ("ours", "5b"), ("authors", "5a"), ("authors", "5b")]
+    assert by[("ours", "5a")]["n_E1"] == 600 and by[("authors", "5a")]["n_E1"] == _in_disk(refs["E1"])
+    assert by[("ours", "5a")]["delta"]["interval"][0] > 0  # 5a drawn like E1: closer to E1
+    assert by[("ours", "5b")]["delta"]["interval"][1] < 0  # 5b drawn like E2: closer to E2
+    assert (rec["box"], rec["boxes"], rec["E1"], rec["E2"], rec["offsets"]) == (0.5, [1.0, 0.5], 0.3, 0.35, 1)
+    assert set(rec["curves"]) == {"ours", "authors"}

@@ -14,7 +14,9 @@ from hhscatter.reproduction.escape_criterion import (
     channel_rows,
     common_window,
     criterion_numbers,
+    follow_returns,
     kappa_row,
+    paired_runs,
     recommend_r_esc,
     returns_row,
 )
@@ -193,3 +195,41 @@ def test_the_lyapunov_table_spans_every_exit_of_the_system_it_is_given():
     (row,) = lyapunov_table([0.25], hh).itertuples()
     L0 = lyapunov_orbit(0.25, hh)
     assert row.n_exits == 3 and abs(row.r_max - L0.r_max) < 1e-9 and abs(row.period - L0.period) < 1e-9
+
+
+def test_paired_runs_read_the_reference_first_and_refuse_other_orbits():
+    ids = np.arange(4)
+    runs = {r: (ids, np.full(4, r), np.ones(4, bool), np.full(4, 1, np.int8)) for r in (1.5, 2.0)}
+    order = []
+
+    def read(r):
+        order.append(r)
+        return runs[r]
+
+    arrs, chans = paired_runs(read, [1.5, 2.0], 2.0, 0.3)
+    assert order == [2.0, 1.5] and arrs[1.5][0].tolist() == [1.5] * 4 and chans[2.0].tolist() == [1] * 4
+    runs[1.5] = (ids[::-1],) + runs[1.5][1:]
+    with pytest.raises(ValueError, match=r"E=0.3: runs r_esc=1.5 and 2.0 do not hold the same orbits"):
+        paired_runs(runs.get, [1.5, 2.0], 2.0, 0.3)
+
+
+def test_follow_returns_of_an_orbit_that_comes_back_and_one_that_leaves():
+    # orbit 1 (listed first, unsorted): out through 1.5 and 2.0 for good; orbit 0: out through 1.5, back inside
+    # r_in = 1 at t = 4, out again through 1.5 at t = 6 and 2.0 at t = 7
+    cross = pd.DataFrame(
+        {
+            "traj_id": [1, 1, 0, 0, 0, 0, 0, 0],
+            "t": [2.0, 3.0, 1.0, 4.0, 2.0, 6.0, 3.5, 7.0],
+            "radius": [1.5, 2.0, 1.5, 1.0, 1.5, 1.5, 1.0, 2.0],
+            "direction": [1, 1, 1, -1, -1, 1, 1, 1],
+        }
+    )
+    ends = pd.DataFrame(
+        {"traj_id": [1, 0], "outcome": "escaped", "t_end": [3.0, 7.0], "e0": [0.3, 0.3], "e_end": [0.31, 0.29]}
+    )
+    ends, rs, back = follow_returns(cross, ends, [1.5, 2.0], 1.0)
+    assert ends["traj_id"].tolist() == [0, 1]
+    np.testing.assert_allclose(ends["energy_error"], [0.01, 0.01])
+    assert rs[1.5]["returned"].tolist() == [True, False] and rs[1.5]["t_return"][0] == 4.0
+    assert rs[1.5]["t_reesc"][0] == 6.0 and rs[2.0]["returned"].tolist() == [False, False]
+    assert back[1.5].tolist() == [True, False] and back[2.0].tolist() == [False, False]

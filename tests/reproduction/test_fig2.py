@@ -6,11 +6,14 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from hhscatter.reproduction.fig2 import (
     cmeasure_comparisons,
+    cmeasure_run_rows,
+    convention_analysis,
     convention_numbers,
     law_comparisons,
     pt_comparisons,
@@ -114,3 +117,33 @@ def test_convention_numbers_list_the_ill_defined_points_with_their_reasons():
     assert (n["stable_energies"], n["unstable_energies"]) == ([0.3], [0.2])
     assert n["ill_defined"] == [{"energy": 0.2, "convention": "square_plevel", "reason": "trapped plateau"}]
     assert n["p_levels"] == [0.5, 0.01] and len(n["conventions"]) == 4
+
+
+def _exponential_lifetimes(rng, kappa, n=20000):
+    return pd.DataFrame({"t_end": rng.exponential(1.0 / kappa, n), "outcome": "escaped"})
+
+
+def test_convention_analysis_recovers_a_linear_law_in_every_convention():
+    """κ(E) = 1.4 (E − E_c) exactly, no trapped orbits: every convention defined and stable, the law's c ≈ 1.4."""
+    rng = np.random.default_rng(8)
+    energies = [0.20, 0.22, 0.24, 0.26, 0.28, 0.30]
+    runs = {
+        E: {"disk": (_exponential_lifetimes(rng, 1.4 * (E - E_C)), None)}
+        | ({"square": (_exponential_lifetimes(rng, 1.4 * (E - E_C)), None)} if E >= 0.26 else {})
+        for E in energies
+    }
+    table, stab, numbers = convention_analysis(
+        runs, E_c=E_C, p_levels=(0.5, 0.01), max_bias=0.1, rel_tol=0.1, n_boot=20, seed=1, min_survivors=50
+    )
+    assert len(table) == 2 * 6 + 2 * 3 and table["defined"].all() and stab["stable"].all()
+    assert sorted(set(table["convention"])) == ["disk_plateau", "disk_plevel", "square_plateau", "square_plevel"]
+    np.testing.assert_allclose(table["kappa"], 1.4 * (table["energy"] - E_C), rtol=0.05)
+    np.testing.assert_allclose(table["x"], table["energy"] - E_C)
+    assert numbers["stable_energies"] == energies and numbers["ill_defined"] == []
+    assert numbers["p_levels"] == [0.5, 0.01] and set(numbers["fits"]) >= {"disk_plateau", "disk_plevel"}
+
+
+def test_cmeasure_run_rows_refuse_a_run_made_for_another_window():
+    choice = {"t_rec": 10.0, "t_sample_end": 20.0, "t_record_end": 30.0, "kappa": 0.1}
+    with pytest.raises(RuntimeError, match=r"cm_E0.30: raw run's section window .* \[10.0, 30.0\]"):
+        cmeasure_run_rows(None, None, choice, {"t_from": 11.0, "t_to": 30.0}, {}, label="cm_E0.30", energy=0.3)

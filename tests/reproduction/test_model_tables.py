@@ -11,14 +11,17 @@ import pytest
 
 from hhscatter.reproduction.model_tables import (
     PAPER_CONSTANTS,
+    ModelInputs,
     TauReference,
     constants_row,
     constants_taus,
     fit_row,
     kappa_from_constants,
     model_rows,
+    pair_fits,
     survival_grid_curve,
     tau2_curve,
+    tau_predictions,
     tau_vs_gamma,
     value_and_err,
 )
@@ -152,3 +155,67 @@ def test_tau2_curve_band_and_range():
     assert c["tau2_predicted"].iloc[0] == pytest.approx(t2, rel=1e-12)
     assert (c["tau2_lo"].iloc[0], c["tau2_hi"].iloc[0]) == pytest.approx((t2 / 1.1, t2 / 0.9), rel=1e-12)
     assert c["tau2_predicted_paper_constants"].iloc[0] == pytest.approx(t2 * 0.9 / 0.91, rel=1e-12)
+
+
+PAPER = {"a": 13.63, "b": 0.03, "c": 1.41, "E_b": 0.27, "mu": 0.91}
+
+
+def _inputs(mixtures=(), mu=0.9, mu_err=0.05):
+    k = kappa_from_constants(PAPER, E_C)
+    return ModelInputs({}, k, mu, mu_err, 5.0, E_C, PAPER, k, ["paper", "integrated"], list(mixtures))
+
+
+def test_pair_fits_read_the_snapshots_once_and_split_them_into_sub_ensembles():
+    """Every orbit's energy decays as E_i(0) e^(−μγt) with μ = 0.9: each sub-ensemble's μ_k is 0.9."""
+    rng = np.random.default_rng(3)
+    n, E0, g = 600, 0.3, 0.01
+    t_end = 5.0 + np.concatenate([rng.exponential(8.0, n // 2), rng.uniform(20.0, 120.0, n - n // 2)])
+    lt = pd.DataFrame({"t_end": t_end, "outcome": ["escaped"] * (n // 2) + ["settled"] * (n - n // 2)})
+    ts = np.arange(5.0, 60.0, 5.0)
+    E_i = rng.uniform(0.25, 0.35, n)
+    snaps = pd.DataFrame(
+        {
+            "traj_id": np.repeat(np.arange(n), ts.size),
+            "t": np.tile(ts, n),
+            "energy": (E_i[:, None] * np.exp(-0.9 * g * ts[None, :])).ravel(),
+        }
+    )
+    calls = []
+
+    def read():
+        calls.append(1)
+        return snaps
+
+    mix = {"name": "mixture_e", "by": "energy", "t_ref": "tau0", "fne_mode": "shared"}
+    cur, (fits, comps, cmps, pcs) = pair_fits(
+        lt, read, _inputs([mix]), label="p", E0=E0, gamma=g, dt=1.0, fit_dt=2.0, min_count=5, fit_tau2=False,
+        n_components=3, fit_end=60.0,
+    )  # fmt: skip
+    assert calls == [1]
+    assert cur["P"].iloc[0] == 1.0 and (cur["N"] == n).all() and set(cur["pair"]) == {"p"}
+    assert [(f["model"], f["hazard"]) for f in fits] == [
+        ("homogeneous", "paper"),
+        ("mixture_e", "paper"),
+        ("homogeneous", "integrated"),
+        ("mixture_e", "integrated"),
+    ]
+    assert fits[0]["tau2_eq"] == pytest.approx(math.log(E0 / E_C) / (0.9 * g), rel=1e-12)
+    assert fits[0]["tau2_observed"] is None or math.isfinite(fits[0]["tau2_observed"])
+    (c,) = comps
+    assert len(c) == 3 and c["weight"].sum() == pytest.approx(1.0) and (c["model"] == "mixture_e").all()
+    np.testing.assert_allclose(c["mu"], 0.9, rtol=1e-9)
+    assert len(cmps) == 2 and [p["hazard"] for p in pcs] == ["paper", "integrated"]
+
+
+def test_tau_predictions_give_tau2_with_both_exponents():
+    obs = pd.DataFrame(
+        {"gamma": [0.01, 0.02], "tau1_observed": [None] * 2, "tau1_err": [None] * 2, "tau2_observed": [80.0, 40.0]}
+    ).assign(tau2_err=None)
+    taus, curve, pct = tau_predictions(
+        TauReference(obs, {}, None, 0.3), _inputs(), dt=0.5, fit_dt=2.0, min_count=20, alpha=2.0
+    )
+    gs = np.array([0.01, 0.02])
+    np.testing.assert_allclose(taus["tau2_predicted"], np.log(0.3 / E_C) / (0.9 * gs))
+    np.testing.assert_allclose(taus["tau2_predicted_err"], np.log(0.3 / E_C) / (0.9 * gs) * 0.05 / 0.9)
+    np.testing.assert_allclose(pct["tau2_predicted"], np.log(0.3 / E_C) / (0.91 * gs))
+    assert len(curve) > 0

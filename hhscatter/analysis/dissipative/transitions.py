@@ -37,7 +37,9 @@ from hhscatter.analysis.survival.fits import (
 from hhscatter.analysis.survival.kaplan_meier import survival_on_grid
 
 __all__ = [
+    "SubsampleBootstrap",
     "bootstrap_transition_times",
+    "subsample_bootstrap_transition_times",
     "settle_time_quantiles",
     "survival_on_grid",
     "power_law_exponent",
@@ -368,6 +370,56 @@ def bootstrap_transition_times(
             row.update(dict(zip(qcols, vals)))
             rows.append(row)
     return pd.DataFrame(rows, columns=["replicate", "label", "tau0", "tau1", "tau2_obs", *qcols])
+
+
+@dataclass(frozen=True)
+class SubsampleBootstrap:
+    """The paired bootstrap of :func:`bootstrap_transition_times` on the first ``n_orbits`` of ``n_total`` orbits.
+
+    ``replicates``: its DataFrame; ``scale`` = √(n_orbits/n_total), the factor that carries a standard deviation
+    of the subsample to the whole ensemble (σ ∝ 1/√N); :meth:`err` applies it.
+    """
+
+    replicates: pd.DataFrame
+    n_orbits: int
+    n_total: int
+
+    @property
+    def scale(self) -> float:
+        """√(n_orbits / n_total): σ of the subsample → σ of the whole ensemble."""
+        return float(np.sqrt(self.n_orbits / self.n_total))
+
+    def err(self, column: str) -> float:
+        """The whole ensemble's 1σ error of ``column`` (same unit): the replicates' standard deviation × scale."""
+        return float(self.replicates[column].std(ddof=1)) * self.scale
+
+
+def subsample_bootstrap_transition_times(
+    lifetimes: dict, reference, grid, *, n_orbits: int, **kw
+) -> SubsampleBootstrap:
+    """The paired bootstrap of τ0, τ1, τ2 on the first ``n_orbits`` orbits, its σ scaled to the whole ensemble.
+
+    ``lifetimes``: {label: DataFrame with t_end (time units) and outcome}, rows aligned by orbit (the same N for
+    every label); the bootstrap (:func:`bootstrap_transition_times` with ``reference``, ``grid`` and ``kw``) runs
+    on the first K = min(``n_orbits``, N) rows, and a standard deviation σ_K of its replicates stands for
+    σ_K √(K/N) over all N orbits (:class:`SubsampleBootstrap`). The rows are sliced before their conversion to
+    arrays, so a large table's outcome column is never converted whole.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> t = rng.exponential(10.0, 4000)
+    >>> lt = {0.0: pd.DataFrame({"t_end": t, "outcome": "escaped"}),
+    ...       0.01: pd.DataFrame({"t_end": 0.8 * t, "outcome": "escaped"})}
+    >>> b = subsample_bootstrap_transition_times(lt, 0.0, np.arange(0.0, 50.0, 0.5), n_orbits=1000, tau0=1.0,
+    ...                                          n_boot=20, seed=1)
+    >>> b.n_orbits, b.scale, len(b.replicates)
+    (1000, 0.5, 20)
+    """
+    N = len(next(iter(lifetimes.values())))
+    K = min(n_orbits, N)
+    curves = {g: (lt["t_end"].iloc[:K].to_numpy(), lt["outcome"].iloc[:K].to_numpy()) for g, lt in lifetimes.items()}
+    return SubsampleBootstrap(bootstrap_transition_times(curves, reference, grid, **kw), K, N)
 
 
 def power_law_exponent(gamma, tau, tau_err):
