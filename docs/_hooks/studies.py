@@ -65,6 +65,14 @@ def fmt_value(v) -> str:
     return format_value(v, html=True)
 
 
+def fmt_leaf(key: str, v) -> str:
+    """fmt_leaf(key, v) -> Markdown for one JSON leaf by its dotted key (a difference of the reference to itself:
+    "reference"; hhscatter.publish.formatting.format_leaf)."""
+    from hhscatter.publish.formatting import format_leaf
+
+    return format_leaf(key, v, html=True)
+
+
 def _cell(s) -> str:
     from hhscatter.publish.formatting import md_cell
 
@@ -263,7 +271,7 @@ class Renderer:
             body.append(record_table(recs))
         if scalars:
             body.append("| quantity | value |\n|---|---|")
-            body.extend(f"| `{_cell(k)}` | {_cell(fmt_value(v))} |" for k, v in scalars)
+            body.extend(f"| `{_cell(k)}` | {_cell(fmt_leaf(k, v))} |" for k, v in scalars)
             body.append("")
         if body:
             inner = "\n".join(body)

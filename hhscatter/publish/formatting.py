@@ -28,6 +28,7 @@ __all__ = [
     "comparison_table",
     "embed_markdown",
     "escape_table_bars",
+    "format_leaf",
     "format_number",
     "format_value",
     "format_value_err",
@@ -140,6 +141,36 @@ def format_value(v, *, html: bool = False) -> str:
     if isinstance(v, dict):
         return f"*({len(v)} fields; see the JSON)*"
     return format_number(v, html=html)
+
+
+REFERENCE = "reference"
+_DIFFERENCE_NAMES = ("_vs_ref", "_from_ref", "difference", "shift")
+
+
+def format_leaf(key: str, v, *, html: bool = False) -> str:
+    """format_leaf(dotted key, value) -> :func:`format_value` of one numbers-JSON leaf, except a difference to a
+    reference measured on the reference itself: a ``{value: 0, err: 0}`` whose name says it is a difference or
+    shift to a reference (ending ``_vs_ref`` or ``_from_ref``, or naming a ``difference`` or ``shift``) reads
+    "reference", never a measured 0.
+
+    >>> format_leaf("kappa.E=0.25.r_esc=1.03.shift_vs_ref", {"value": 0.0, "err": 0.0})
+    'reference'
+    >>> format_leaf("kappa.E=0.25.r_esc=1.1.shift_vs_ref", {"value": -0.00207, "err": 0.00118})
+    '-0.0021 ± 0.0012'
+    >>> format_leaf("returns.n_returned", {"value": 0.0, "err": 0.0})
+    '0'
+    """
+    name = str(key).rsplit(".", 1)[-1]
+    if (
+        isinstance(v, dict)
+        and v.get("value") == 0
+        and v.get("err") == 0
+        and _is_num(v.get("value"))
+        and _is_num(v.get("err"))
+        and any(part in name for part in _DIFFERENCE_NAMES)
+    ):
+        return REFERENCE
+    return format_value(v, html=html)
 
 
 def md_cell(s) -> str:

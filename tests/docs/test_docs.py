@@ -660,6 +660,23 @@ def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
     assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out
 
 
+def test_the_reference_radius_difference_to_itself_reads_reference(hook):
+    """The escape-criterion study's numbers at r_esc = r_ref: the differences of the reference run to itself
+    (κ shift, MLE difference, flight time, mean end time; exactly 0 ± 0 in the JSON) read "reference", never a
+    measured 0; the other radii keep their numbers."""
+    r = hook.Renderer(ROOT, DOCS, DOCS / "studies")
+    doc, _ = r._headline("resc")
+    ref = f"r_esc={doc['r_ref']:g}"
+    text = r.study_numbers("resc")
+    for leaf in ("shift_vs_ref", "mle_difference_vs_ref", "flight_time_from_ref", "mean_t_end_difference"):
+        for energy in doc["kappa"]:
+            row = f"| `kappa.{energy}.{ref}.{leaf}` |"
+            line = next(x for x in text.splitlines() if row in x)
+            assert line.split("|")[-2].strip() == "reference", line
+    other = next(x for x in text.splitlines() if "| `kappa.E=0.30.r_esc=1.5.shift_vs_ref` |" in x)
+    assert "±" in other, other
+
+
 def _studies_with_numbers():
     return sorted(p.stem for p in (DOCS / "studies" / "assets").glob("*.json") if not p.stem.endswith(".cost"))
 
