@@ -318,14 +318,6 @@ class Renderer:
                 )
         return "\n".join(out)
 
-    def _headline(self, name: str):
-        """(numbers JSON, scale) at the headline scale: paper when committed, else quick."""
-        for sc in ("paper", "quick"):
-            doc = self._numbers(name, sc)
-            if doc:
-                return doc, sc
-        return None, None
-
     def evidence_tables(self, name: str) -> str:
         """The evidence records of a numbers JSON (regular fraction, long-time fits, validity map, r_esc) as
         tables, at the headline scale."""
