@@ -320,12 +320,18 @@ class Renderer:
 
     def evidence_tables(self, name: str) -> str:
         """The evidence records of a numbers JSON (regular fraction, long-time fits, validity map, r_esc) as
-        tables, at the headline scale."""
+        tables, at the headline scale; below a paper-scale headline, the quick scale's folded."""
         doc, sc = self._headline(name)
         if not doc or "regular_fraction" not in doc:
             return self.missing(f"The evidence of study {name}", f"Run `make {name}`, then `make docs-assets`.")
         link = self._rel(self.study_asset(name, "json", sc))
-        return evidence_tables(doc) + f"\n*Scale **{sc}**: records of [{name}.json ({sc})]({link}).*\n"
+        out = evidence_tables(doc) + f"\n*Scale **{sc}**: records of [{name}.json ({sc})]({link}).*\n"
+        quick = self._numbers(name, "quick") if sc == "paper" else None
+        if quick and "regular_fraction" in quick:  # the quick scale's evidence, folded below the headline's
+            qlink = self._rel(self.study_asset(name, "json"))
+            body = evidence_tables(quick) + f"\n*Scale **quick**: records of [{name}.json (quick)]({qlink}).*\n"
+            out += '\n??? info "The evidence at the quick scale (click to open)"\n\n' + _indent(body) + "\n"
+        return out
 
     def study_figure_wide(self, name: str) -> str:
         """A further figure of a study (``<study>_<part>.png``) shown as hh:study-figure shows the main one (paper
@@ -1081,6 +1087,63 @@ def _ve_cell(d) -> str:
     )
 
 
+#: a validity-map cell of an energy of the claims' grid that a scale's evidence did not run
+NOT_RUN = "not run at this scale"
+
+
+def _validity_table(doc, vm, n_of) -> str:
+    """The validity map: per (system, E/E_c) the regular fraction's count, claim 1's κ0 with the numbers that decide
+    "defined" (by the record's stated rule, ``validity_rules``), claim 2, one exponential, the plateau; the energies
+    of the claims' grid (``config.study.ratios``) the record has no cell for are rows "not run at this scale"."""
+    yn = {True: "yes", False: "no", None: "—"}
+    rules = doc.get("validity_rules") or {}
+    out = [
+        "\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 with all orbits, the "
+        "paper's convention) and claim 2's where tested, and whether the non-regular orbits decay as one "
+        "exponential"
+        + (
+            f". Regular fraction: {rules['regular_fraction']}. κ0: {rules['kappa0_defined']} ({rules['kappa0_source']})"
+            if rules
+            else ""
+        )
+        + "\n",
+        "| system | E/E_c | regular fraction | κ0 (claim 1) | claim 2 | one exponential (non-regular) | "
+        "plateau P∞ > 3σ |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    grid = ((doc.get("config") or {}).get("study") or {}).get("ratios") or []
+    rows = [(v["label"], v["e_ratio"], v) for v in vm]
+    have = {(lab, round(r, 9)) for lab, r, _ in rows}
+    for lab in dict.fromkeys(lab for lab, _, _ in rows):
+        rows += [(lab, float(r), None) for r in grid if (lab, round(float(r), 9)) not in have]
+    order = {lab: i for i, lab in enumerate(dict.fromkeys(lab for lab, _, _ in rows))}
+    for lab, r, v in sorted(rows, key=lambda x: (order[x[0]], x[1])):
+        if v is None:
+            out.append(f"| {lab} | {r:g} | {NOT_RUN} | {NOT_RUN} | — | — | — |")
+            continue
+        regular = _bounded(
+            v["regular_fraction"],
+            v["regular_err"],
+            v.get("regular_fraction_upper"),
+            pct=True,
+            syst=v.get("regular_syst"),
+            n=n_of.get(v.get("id")),
+        )
+        if v.get("n_regular") is not None and v.get("n"):
+            regular = f"{v['n_regular']} of {v['n']}: {regular}"
+        if v.get("kappa0_verdict"):
+            k = v.get("kappa0") or {}
+            shown = _is_num(k.get("value")) and v["kappa0_defined"]
+            kappa = (f"{_ve_cell(k)}; " if shown else "") + v["kappa0_verdict"]
+        else:
+            kappa = NOT_RUN if v["kappa0_defined"] is None else yn[v["kappa0_defined"]]
+        exp = yn[v["exponential"]] if v["exponential"] is not None else v.get("exponential_verdict") or "—"
+        out.append(
+            f"| {lab} | {r:g} | {regular} | {_cell(kappa)} | {_cell(v['claim2'] or '—')} | {exp} | {yn[v['plateau']]} |"
+        )
+    return "\n".join(out)
+
+
 def evidence_tables(doc) -> str:
     """Markdown tables of a generality JSON's evidence: regular fraction (systems × E/E_c per IC convention),
     long-time escape (disk ICs), the validity map and the r_esc sensitivity."""
@@ -1150,25 +1213,7 @@ def evidence_tables(doc) -> str:
     vm = doc.get("validity_map", [])
     n_of = {r.get("id"): r.get("n") for r in reg}
     if vm:
-        yn = {True: "yes", False: "no", None: "—"}
-        out.append(
-            "\n**Validity map** (disk ICs): the regular fraction beside claim 1's verdict (κ0 defined with "
-            "all orbits, the paper's convention) and claim 2's where tested, and whether the non-regular "
-            "orbits decay as one exponential\n"
-        )
-        out.append(
-            "| system | E/E_c | regular fraction | κ0 defined (claim 1) | claim 2 | one exponential "
-            "(non-regular) | plateau P∞ > 3σ |"
-        )
-        out.append("|---|---|---|---|---|---|---|")
-        for v in vm:
-            out.append(
-                f"| {v['label']} | {v['e_ratio']:g} | "
-                f"{_bounded(v['regular_fraction'], v['regular_err'], v.get('regular_fraction_upper'), pct=True, n=n_of.get(v.get('id')))} | "
-                f"{yn[v['kappa0_defined']]} | {_cell(v['claim2'] or '—')} | "
-                f"{yn[v['exponential']] if v['exponential'] is not None else v.get('exponential_verdict') or '—'} | "
-                f"{yn[v['plateau']]} |"
-            )
+        out.append(_validity_table(doc, vm, n_of))
     rs = doc.get("resc", [])
     if rs:
         out.append("\n**r_esc sensitivity** (the same N and rules at each escape radius; windows of μ's fit)\n")
@@ -1179,9 +1224,26 @@ def evidence_tables(doc) -> str:
         out.append("|---|---|---|---|---|---|---|---|---|")
         for r in rs:
             out.append(
-                f"| {r['label']} | {r['r_esc']:g}{' (default)' if r['default'] else ''} | "
+                f"| {r['label']} | {r['r_esc']:.3g}{' (default)' if r['default'] else ''} | "
                 f"[{r['window'][0]:g}, {r['window'][1]:g}] | {_ve_cell(r['mu_measured'])} | "
                 f"{_ve_cell(r['mu_predicted'])} | {_ve_cell(r['mu_own_K'])} | {_ve_cell(r['moment_test'])} | "
                 f"{_ve_cell(r['kinetic_at_E0'])} | {fmt_num(r['kinetic_at_E0_interpolated_without_E0'])} |"
+            )
+    rk = doc.get("resc_kappa", [])
+    if rk:
+        out.append(
+            "\n**κ0 at two escape radii** (the same N, ICs and rules at each radius; κ0 of all orbits (plateau "
+            "windows, the paper's convention) and of the escaping orbits; shift = κ0(r_esc)/κ0(default) − 1, the two "
+            "errors in quadrature: the runs share their initial conditions, so this overstates the shift's error; "
+            "verdict against no shift by the one rule)\n"
+        )
+        out.append("| system | E/E_c | κ0 of | default r_esc | κ0 there | r_esc | κ0 there | shift | verdict |")
+        out.append("|---|---|---|---|---|---|---|---|---|")
+        for r in rk:
+            out.append(
+                f"| {r['label']} | {r['e_ratio']:g} | {'all orbits' if r['convention'] == 'plateau' else 'escaping'} "
+                f"| {r['r_esc_default']:.3g} | {_ve_cell(r['kappa_default'])} | "
+                f"{r['r_esc']:.3g} ({r['r_esc_over_saddle']:.3g} r_s) | {_ve_cell(r['kappa'])} | "
+                f"{_ve_cell(r['shift'])} | {_cell(r['verdict'])} |"
             )
     return "\n".join(out) + "\n"

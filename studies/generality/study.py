@@ -9,11 +9,12 @@ momenta), linear drag. Rules in the header of ``studies/generality/study.toml``;
 ``simulate`` — ``[study] parts``: "claims": per system the κ0(E) runs ``<label>_r<r>``, the probe runs
 ``<label>_probe_r<r>``, the dissipative runs ``<label>_g<γ>`` at E0, the section runs ``<label>_cm_r<r>`` and
 ``<label>_sec_g<γ>``; "evidence": the long runs ``<label>_ev_<ics>_r<r>`` and Poincaré runs ``<label>_ps_r<r>``,
-each with the shadow run of its orbits still inside near t_max (``…_shadow``), and the r_esc runs
-``<label>_resc<R>_…``.
+each with the shadow run of its orbits still inside near t_max (``…_shadow``), the κ0 runs ``<label>_map_r<r>`` at
+the validity map's energies off the claims' grid (the claims' scene) and the r_esc runs ``<label>_resc<R>_…``.
 
 ``analyze`` — claims 1–7 (records {claim, quantity, system, value, err, verdict, note}) and the evidence
-(regular_fraction, survival_long, long_time, validity_map, resc) in ``generality.json``; evidence alone merges
+(regular_fraction, survival_long, long_time, validity_map and its validity_rules, resc, resc_kappa, r_esc_rule) in
+``generality.json``; evidence alone merges
 into the generality.json already in the output folder.
 
 ``plot`` — ``generality.png`` (the claims) and ``generality_regular.png``, ``generality_sections.png``,
@@ -32,6 +33,8 @@ from hhscatter.reproduction.claims.keys import (
     diss_key,
     ev_key,
     grid_key,
+    map_key,
+    map_ratios,
     probe_key,
     ps_key,
     resc_key,
@@ -106,7 +109,7 @@ class Params(StudyParams):
     c5_level: Number = 0.95
     # the evidence behind the claims' readings (rules in study.toml): which parts a scale runs
     parts: list[OneOf("claims", "evidence")] = ["claims", "evidence"]
-    ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.9, 2.6, 3.5, 5.0]
+    ev_ratios: Numbers = [1.05, 1.1, 1.2, 1.35, 1.5, 1.7, 1.9, 2.2, 2.6, 3.5, 5.0]  # the claims' grid and beyond
     ev_ics: list[OneOf(*REGIONS)] = ["disk", "well"]  # disk: radius_frac·r_s, tangential; others: alt_momentum
     ev_n: Integer = 2000
     ev_t_max: Number = 2000.0
@@ -119,7 +122,7 @@ class Params(StudyParams):
     ps_ratios: Numbers = [1.05, 1.5]
     ps_n: Integer = 150
     ps_t_max: Number = 1000.0
-    resc_values: Numbers = [1.03]  # r_esc sensitivity: these beside the default, for systems where they are valid
+    resc_values: Numbers = [1.03]  # r_esc sensitivity: these × r_s beside the default, where beyond the saddle
     resc_ratios: Numbers = [1.2, 1.5, 1.8, 1.9, 2.6]
     resc_n: Integer = 2000
     resc_probe_n: Integer = 1000
@@ -335,6 +338,16 @@ def _simulate_evidence(study, workers, progress):
     p = study.params
     t_from = p.ev_t_max - p.ev_window
     sysl = _systems(study)
+    for label, spec, m in sysl:  # κ0 at the validity map's energies off the claims' grid: the claims' scene
+        for r in map_ratios(p):
+            sc = study.scene(
+                map_key(label, r),
+                system=spec,
+                energy=r * m.critical_energy,
+                n=p.grid_n,
+                radius=p.radius_frac * m.saddle_radius,
+            )
+            study.run(map_key(label, r), sc, workers=workers, progress=progress)
     for ics in p.ev_ics:  # the disk ICs of every system first: the record's core
         for label, spec, m in sysl:
             ec, radius = m.critical_energy, p.radius_frac * m.saddle_radius
@@ -376,7 +389,7 @@ def _simulate_evidence(study, workers, progress):
 
 
 def _simulate_resc(study, label, spec, m, workers, progress):
-    """κ0 (windows), probe and dissipative runs at every r_esc of :func:`_resc_values` (none with one value)."""
+    """κ0 (windows), probe and dissipative runs at every r_esc of :func:`resc_values` (none with one value)."""
     from hhscatter.analysis.dissipative.decay import snapshot_grid
 
     p = study.params

@@ -640,6 +640,45 @@ def test_evidence_tables_write_zero_counts_of_records_without_bounds_from_their_
     assert out.count("< 0.15 % (95 %)") == 2 and "| < 1.5e-3 (95 %) |" not in out and "| < 0.0015 (95 %) |" in out
 
 
+def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a_scale_did_not_run(hook):
+    """The validity map: a cell's regular count (k of n), κ0 with the numbers that decide "defined" and the stated
+    rule of the record; an energy of the claims' grid without a cell (a record made before the map covered it) is a
+    row "not run at this scale", never left out; κ0 at two escape radii with its shift and verdict."""
+    cell = {"label": "b", "regular_err": None, "claim2": None, "exponential": None, "plateau": None}
+    doc = {
+        "config": {"study": {"ratios": [1.9, 2.2]}},
+        "regular_fraction": [
+            {"id": "b-1.9-disk", "label": "b", "ics": "disk/tangential", "e_ratio": 1.9, "fraction": 0.0012}
+            | {"err": 0.0002, "n": 20000}
+        ],
+        "survival_long": [],
+        "long_time": [],
+        "validity_rules": {
+            "regular_fraction": "k of n regular",
+            "kappa0_defined": "κ0 defined iff f∞/P(t_hi) ≤ 10 %",
+            "kappa0_source": "the claims' run",
+        },
+        "validity_map": [
+            cell
+            | {"id": "b-1.9-disk", "e_ratio": 1.9, "regular_fraction": 0.0012, "regular_err": 0.0002}
+            | {"n": 20000, "n_regular": 24, "kappa0_defined": False, "kappa0": {"value": 0.021, "err": 0.001}}
+            | {"plateau_bias": 0.84, "kappa0_verdict": "ill-defined: f∞/P(t_hi) = 84 % > 10 %"}
+        ],
+        "resc_kappa": [
+            {"label": "b", "e_ratio": 1.8, "convention": "plateau", "r_esc_default": 2.598, "r_esc": 1.784}
+            | {"r_esc_over_saddle": 1.03, "kappa_default": {"value": 0.05, "err": 0.001}}
+            | {"kappa": {"value": 0.06, "err": 0.001}, "shift": {"value": 0.2, "err": 0.03}}
+            | {"verdict": "shifts (z = +6.7)"}
+        ],
+    }
+    out = hook.evidence_tables(doc)
+    assert "κ0: κ0 defined iff f∞/P(t_hi) ≤ 10 % (the claims' run)" in out
+    assert "| b | 1.9 | 24 of 20000: 0.120 ± 0.020 % | ill-defined: f∞/P(t_hi) = 84 % > 10 % |" in out
+    assert "| b | 2.2 | not run at this scale | not run at this scale |" in out
+    assert "| b | 1.8 | all orbits | 2.6 | 0.0500 ± 0.0010 | 1.78 (1.03 r_s) | 0.0600 ± 0.0010 | 0.20 ± 0.03 |" in out
+    assert "shifts (z = +6.7) |" in out
+
+
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
     """The hook's output writes a number's sign "−" (as the verdicts and the [[…]] numbers do); code spans, maths,
     HTML attributes, ranges and e-notation stay as written."""

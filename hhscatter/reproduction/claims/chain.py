@@ -15,10 +15,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 from hhscatter.reproduction.claims import cmeasure, dissipative, evidence, kappa, mu
-from hhscatter.reproduction.claims.keys import cm_ratios, ev_key, ps_key
+from hhscatter.reproduction.claims.keys import cm_ratios, ev_key, map_key, map_ratios, ps_key
 from hhscatter.reproduction.claims.records import RULES, Claims
-from hhscatter.reproduction.claims.resc import resc_rows
+from hhscatter.reproduction.claims.resc import r_esc_rule, resc_kappa_rows, resc_rows
 
 __all__ = ["analyze_claims", "analyze_evidence", "check_params"]
 
@@ -213,6 +214,60 @@ def _ensemble_evidence(runs, label, head, ics, r, t_from, grid):
     return reg, surv, {**at, **fit}, curves
 
 
+def _map_kappa_rows(runs, systems) -> list:
+    """κ0 of all orbits (plateau windows, the claims' rule and scene) at the map's energies off the claims' grid
+    (:func:`~hhscatter.reproduction.claims.keys.map_ratios`), as the claims' ``kappa`` rows (``source`` 'map')."""
+    p = runs.params
+    rows = []
+    for label, _spec, m in systems:
+        for r in map_ratios(p):
+            lt = runs.lifetimes(map_key(label, r))
+            obs = lifetimes_to_arrays(lt)[1]
+            c, _, why = kappa.window_rate(lt, p, "window rule failed")
+            row = {
+                "system": label,
+                "ratio": float(r),
+                "energy": r * m.critical_energy,
+                "convention": "plateau",
+                "n": int(obs.size),
+                "trapped_fraction": float((~obs).mean()),
+                "source": "map",
+            }
+            if c is None:
+                row.update(kappa=None, kappa_err=None, plateau_bias=None, defined=False, reason=why)
+            else:
+                bias = c.bias_at_end if np.isfinite(c.bias_at_end) else None
+                row.update(
+                    kappa=c.kappa,
+                    kappa_err=c.kappa_err,
+                    plateau_bias=bias,
+                    defined=bool(c.defined and c.kappa > 0),
+                    reason=c.reason,
+                )
+            rows.append(row)
+    return rows
+
+
+def validity_rules(p) -> dict:
+    """The rules of every validity-map cell, in words, from the study's parameters: how the regular fraction is
+    counted and what decides "κ0 defined" (:func:`~hhscatter.reproduction.claims.evidence.kappa0_rule`)."""
+    return {
+        "regular_fraction": (
+            f"n_regular of n orbits regular by the shadow indicator (growth < {p.ev_g_max:g} after "
+            f"t = {p.ev_t_max - p.ev_window:g}); orbits that left before, and those crossing the section in "
+            "neither run, count as not regular; ± its binomial 1σ, at a count of 0 its one-sided 95 % upper "
+            "bound instead; ± the threshold's systematic (the largest shift with the threshold a decade either side)"
+        ),
+        "kappa0_defined": evidence.kappa0_rule(p.max_plateau_bias, p.min_survivors),
+        "kappa0_source": (
+            f"the claims' κ0 run at that E/E_c ({p.grid_n} orbits to t_max, disk ICs); at the map's energies off "
+            "the claims' grid a κ0 run of the map with the same scene"
+        ),
+        "max_plateau_bias": float(p.max_plateau_bias),
+        "min_survivors": float(p.min_survivors),
+    }
+
+
 def analyze_evidence(runs, systems, claims_numbers: dict) -> tuple[dict, dict]:
     """The evidence behind the claims' readings: regular orbits counted, long-time escape resolved, where the claims
     hold, the r_esc sensitivity of claims 3 and 5.
@@ -227,7 +282,8 @@ def analyze_evidence(runs, systems, claims_numbers: dict) -> tuple[dict, dict]:
     Returns
     -------
     (dict, dict)
-        The numbers {regular_fraction, survival_long, long_time, validity_map, regular_below_1pc, resc} and the
+        The numbers {regular_fraction, survival_long, long_time, validity_map, validity_rules, regular_below_1pc,
+        resc, resc_kappa, r_esc_rule} and the
         tables {name: (DataFrame, description)}: sections_regular (where there are Poincaré runs), survival_long,
         long_time.
     """
@@ -263,15 +319,21 @@ def analyze_evidence(runs, systems, claims_numbers: dict) -> tuple[dict, dict]:
         pd.DataFrame(fits).drop(columns=["hazard_nonregular"]),
         "plateau-plus-exponential fits and the non-regular decay per system, E/E_c, ICs",
     )
+    kap = [{**k, "source": "claims"} for k in claims_numbers.get("kappa", [])] + _map_kappa_rows(runs, systems)
     vmap = evidence.validity_map(
-        reg, fits, claims_numbers.get("kappa", []), claims_numbers.get("claims", []), ics="disk/tangential"
+        reg, fits, kap, claims_numbers.get("claims", []), ics="disk/tangential", max_bias=p.max_plateau_bias
     )
     numbers = {
         "regular_fraction": reg,
         "survival_long": surv,
         "long_time": fits,
         "validity_map": vmap,
+        "validity_rules": validity_rules(p),
         "regular_below_1pc": evidence.first_below(reg, 0.01, ics="disk/tangential"),
         "resc": resc_rows(runs, systems),
+        "resc_kappa": resc_kappa_rows(runs, systems),
+        "r_esc_rule": {
+            label: r_esc_rule(m, sorted({*map(float, p.ratios), *map(float, p.ev_ratios)})) for label, _, m in systems
+        },
     }
     return numbers, tables

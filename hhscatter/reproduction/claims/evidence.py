@@ -184,14 +184,69 @@ def decay_curves(lifetimes, regular_ids, grid):
     return pd.concat(out, ignore_index=True)
 
 
-def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: str = "disk") -> list:
-    """validity_map(regular, fits, kappa, claims, ics='disk') -> one record per (system, e_ratio) of ``regular``.
+def kappa0_rule(max_bias: float, min_survivors: float) -> str:
+    """kappa0_rule(max_bias, min_survivors) -> the rule that decides "κ0 defined" in every cell of the validity map,
+    in words (the rule :func:`hhscatter.reproduction.claims.kappa.window_rate` applies, with the study's
+    ``max_plateau_bias`` and ``min_survivors``; :func:`kappa0_defined_by_rule` applies it to a cell's numbers).
 
-    Fields: regular_fraction (± err); kappa0_defined (claim 1: κ0 defined under the paper's convention, all orbits
-    with plateau windows, from the claims' ``kappa`` records at that E/E_c; None where that energy was not on the
-    claims' grid); claim2 (claim 2's verdict at that E/E_c, paper's convention, where tested); exponential (one
-    exponential describes the non-regular orbits from t0, from ``fits``; None with ``exponential_verdict`` 'too
-    few orbits' where the test has no degree of freedom); plateau (P∞ > 3σ, from ``fits``).
+    >>> kappa0_rule(0.1, 50).split("; ")[0][-19:]
+    '(f∞/P(t_hi) ≤ 10 %)'
+    """
+    return (
+        f"κ0 defined iff the plateau-window rule finds a window (at least {min_survivors:g} orbits left at its end) "
+        f"and the orbits still inside at t_max are at most {100 * max_bias:g} % of P(t) at the window's end "
+        f"(f∞/P(t_hi) ≤ {100 * max_bias:g} %); the regular fraction does not enter the rule"
+    )
+
+
+def kappa0_defined_by_rule(cell: dict, max_bias: float):
+    """kappa0_defined_by_rule(cell, max_bias) -> True, False, or None (no κ0 run at the cell's energy): the rule of
+    :func:`kappa0_rule` applied to the numbers a validity-map cell records (``kappa0``, ``plateau_bias``: None where
+    the window rule found no window).
+
+    >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.84}, 0.1)
+    False
+    >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.03}, 0.1)
+    True
+    """
+    if "kappa0" not in cell:
+        return None
+    k, bias = (cell.get("kappa0") or {}).get("value"), cell.get("plateau_bias")
+    return bool(k is not None and k > 0 and bias is not None and bias <= max_bias)
+
+
+def _kappa0_words(row: dict, max_bias: float) -> str:
+    """The κ0 verdict of one cell with the numbers that decide it."""
+    bias = _finite(row.get("plateau_bias"))
+    if bias is None:
+        return "ill-defined: " + (row.get("reason") or "no window")
+    cmp = "≤" if bias <= max_bias else ">"
+    word = "defined" if row["defined"] else "ill-defined"
+    pct = 100 * bias
+    return (
+        f"{word}: f∞/P(t_hi) = {pct:.3g} % {cmp} {100 * max_bias:g} %"
+        if pct < 1000
+        else (f"{word}: f∞/P(t_hi) = {pct:.0f} % {cmp} {100 * max_bias:g} %")
+    )
+
+
+def validity_map(
+    regular: list, fits: list, kappa: list, claims: list, *, ics: str = "disk", max_bias: float | None = None
+) -> list:
+    """validity_map(regular, fits, kappa, claims, ics='disk', max_bias=None) -> one record per (system, e_ratio) of
+    ``regular``.
+
+    Fields: the regular fraction's count (n_regular of n, regular_fraction ± err, its one-sided bound
+    ``regular_fraction_upper`` at a count of 0, the threshold systematic ``regular_syst``); claim 1's κ0 under the
+    paper's convention (all orbits, plateau windows) from the ``kappa`` records at that E/E_c (the claims' grid, or a
+    κ0 run of the map with the claims' scene: ``kappa0_source``): ``kappa0`` (value, err; 1/time), ``kappa0_n``,
+    ``trapped_fraction`` (still inside at t_max), ``plateau_bias`` (that fraction over P at the window's end; None
+    where no window), ``kappa0_defined`` (the code's decision; None where no κ0 run is at that energy),
+    ``kappa0_reason`` and, with ``max_bias`` (the study's ``max_plateau_bias``), ``kappa0_verdict`` (the decision with
+    the numbers that decide it, by :func:`kappa0_rule`); claim2 (claim 2's verdict at that E/E_c, paper's
+    convention, where tested); exponential (one exponential describes the non-regular orbits from t0, from ``fits``;
+    None with ``exponential_verdict`` 'too few orbits' where the test has no degree of freedom); plateau (P∞ > 3σ,
+    from ``fits``).
     """
     out = []
     fit_at = {(f["system"], round(f["e_ratio"], 6)): f for f in fits if f.get("ics") == ics}
@@ -213,6 +268,19 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
         ]
         f = fit_at.get(key, {})
         pinf, perr = f.get("P_inf"), f.get("P_inf_err")
+        kap = {}
+        if k:
+            row = k[0]
+            kap = {
+                "kappa0": {"value": _finite(row.get("kappa")), "err": _finite(row.get("kappa_err"))},
+                "kappa0_n": row.get("n"),
+                "kappa0_source": row.get("source", "claims"),
+                "trapped_fraction": _finite(row.get("trapped_fraction")),
+                "plateau_bias": _finite(row.get("plateau_bias")),
+                "kappa0_reason": row.get("reason") or "",
+            }
+            if max_bias is not None and "plateau_bias" in row:
+                kap["kappa0_verdict"] = _kappa0_words(row, max_bias)
         out.append(
             {
                 "id": r.get("id"),
@@ -220,11 +288,14 @@ def validity_map(regular: list, fits: list, kappa: list, claims: list, *, ics: s
                 "label": r["label"],
                 "e_ratio": r["e_ratio"],
                 "ics": ics,
+                "n": r.get("n"),
+                "n_regular": r.get("n_regular"),
                 "regular_fraction": r["fraction"],
                 "regular_err": r["err"],
                 **({"regular_fraction_upper": r["fraction_upper"]} if r.get("fraction_upper") is not None else {}),
                 "regular_syst": r.get("syst"),
                 "kappa0_defined": bool(k[0]["defined"]) if k else None,
+                **kap,
                 "claim2": c2[0]["verdict"] if c2 else None,
                 "exponential": f.get("exponential"),
                 "exponential_verdict": f.get("exponential_verdict"),

@@ -57,7 +57,8 @@ def window_rate(lifetimes, p, failure: str):
 
 def kappa_rows(runs, label, m):
     """kappa_rows(runs, label, system) -> (rows, fits): one row per (E/E_c, convention) with κ (1/time), its error,
-    τ0, window, trapped fraction, defined and the reason of that convention; fits {r: result of all orbits,
+    τ0, window, trapped fraction, plateau_bias (the trapped fraction over P at the window's end, which the plateau
+    check holds to ``p.max_plateau_bias``), defined and the reason of that convention; fits {r: result of all orbits,
     ('escaping', r): result of the escaping orbits}. Conventions: 'plateau' (all orbits), 'plevel' (P-level
     windows), 'escaping' (orbits still inside at t_max dropped) and ``p.alt_region`` (the other ICs)."""
     p = runs.params
@@ -101,6 +102,7 @@ def kappa_rows(runs, label, m):
                         "tau0": math.nan,
                         "t_lo": math.nan,
                         "t_hi": math.nan,
+                        "plateau_bias": math.nan,
                         "defined": False,
                         "reason": reasons[conv],
                     }
@@ -114,6 +116,7 @@ def kappa_rows(runs, label, m):
                     "tau0": c.t_lo,
                     "t_lo": c.t_lo,
                     "t_hi": c.t_hi,
+                    "plateau_bias": c.bias_at_end if math.isfinite(c.bias_at_end) else math.nan,
                     "defined": bool(c.defined and c.kappa > 0),
                     "reason": c.reason,
                 }

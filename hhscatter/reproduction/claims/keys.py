@@ -51,3 +51,20 @@ def ps_key(label: str, r: float) -> str:
 def resc_key(label: str, r_esc, kind: str) -> str:
     """resc_key('henon_heiles', 1.03, 'probe_r1.800') -> 'henon_heiles_resc1.03_probe_r1.800' (None: the default)."""
     return f"{label}_resc{'default' if r_esc is None else f'{r_esc:g}'}_{kind}"
+
+
+def map_key(label: str, r: float) -> str:
+    """map_key('barbanis', 5.0) -> 'barbanis_map_r5.000': the validity map's κ0 run at an energy off the claims' grid
+    (the claims' κ0 scene)."""
+    return f"{label}_map_r{r:.3f}"
+
+
+def map_ratios(p) -> list:
+    """The validity map's energies (E/E_c of ev_ratios) off the claims' grid (ratios): each gets a κ0 run of its own
+    with the claims' scene (:func:`map_key`).
+
+    >>> from types import SimpleNamespace as NS
+    >>> map_ratios(NS(ratios=[1.05, 1.5, 2.6], ev_ratios=[1.05, 1.7, 2.6, 5.0]))
+    [1.7, 5.0]
+    """
+    return [float(r) for r in p.ev_ratios if not any(abs(float(r) - float(x)) < 1e-9 for x in p.ratios)]

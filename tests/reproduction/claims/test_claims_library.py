@@ -10,7 +10,14 @@ import pytest
 
 from hhscatter.model.spec import system_from_spec
 from hhscatter.reproduction.claims.dissipative import claim6
-from hhscatter.reproduction.claims.evidence import first_below, long_time_record, regular_record, validity_map
+from hhscatter.reproduction.claims.evidence import (
+    first_below,
+    kappa0_defined_by_rule,
+    kappa0_rule,
+    long_time_record,
+    regular_record,
+    validity_map,
+)
 from hhscatter.reproduction.claims.kappa import kappa_rows
 from hhscatter.reproduction.claims.records import Claims
 
@@ -209,3 +216,60 @@ def test_a_claim_verdict_is_the_one_rule_written_as_every_verdict():
     assert z_verdict(1.0, 0.0, 1.0, "ok", "bad") == "ok"
     # the sign of z is written "−"; a label's own hyphens stay as written
     assert z_verdict(0.7, 0.1, 1.0, "the c-measure's", "not the c-measure's") == "not the c-measure's (z = −3.0)"
+
+
+def _plateau_cell(n_censored, regular_fraction, *, n=20000, kappa=0.05, t_max=800.0, seed=3):
+    """One validity-map cell made the way the study makes it: κ0 rows of a κ0 run (exponential escape at ``kappa``
+    plus ``n_censored`` orbits still inside at t_max) joined with a regular-fraction record at that energy."""
+    p = SimpleNamespace(ratios=[2.2], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01], alt_region=None)
+    t = np.minimum(np.random.default_rng(seed).exponential(1 / kappa, n), t_max)
+    t[:n_censored] = t_max
+    lt = _lt(t, censored=np.arange(n_censored))
+    rows, _ = kappa_rows(_Runs(p, {"b_r2.200": lt}), "b", system_from_spec({"name": "henon_heiles"}))
+    n_reg = round(regular_fraction * n)
+    reg = [
+        {
+            "id": "barbanis-2.2-disk",
+            "system": "barbanis",
+            "label": "b",
+            "e_ratio": 2.2,
+            "ics": "disk/tangential",
+            "fraction": n_reg / n,
+            "err": math.sqrt(n_reg / n * (1 - n_reg / n) / n),
+            "n": n,
+            "n_regular": n_reg,
+        }
+    ]
+    (cell,) = validity_map(reg, [], rows, [], ics="disk/tangential", max_bias=p.max_plateau_bias)
+    return cell
+
+
+def test_kappa0_defined_is_decided_by_the_plateau_share_not_by_the_regular_fraction():
+    """A cell like Barbanis at 2.2 E_c: 0.12 % of the orbits regular (below 1 %) and still inside at t_max. With
+    N·e^(−κ t_hi) ≈ 50 orbits left at the window's end, 24 trapped ones are ≈ 50 % of P there: κ0 is ill-defined,
+    whatever the regular fraction; without them it is defined. The map records the numbers that decide it."""
+    cell = _plateau_cell(24, 0.0012)
+    assert cell["regular_fraction"] < 0.01 and (cell["n_regular"], cell["n"]) == (24, 20000)
+    assert cell["kappa0_defined"] is False
+    assert cell["plateau_bias"] > 0.1
+    assert cell["trapped_fraction"] == pytest.approx(24 / 20000)
+    assert cell["kappa0_verdict"].startswith("ill-defined: f∞/P(t_hi) = ") and cell["kappa0_verdict"].endswith("> 10 %")
+    assert kappa0_defined_by_rule(cell, 0.1) is False
+    free = _plateau_cell(0, 0.0)
+    assert free["kappa0_defined"] is True and free["plateau_bias"] == 0.0
+    assert free["kappa0"]["value"] == pytest.approx(0.05, rel=0.05)
+    assert free["kappa0_verdict"] == "defined: f∞/P(t_hi) = 0 % ≤ 10 %"
+    assert "the regular fraction does not enter the rule" in kappa0_rule(0.1, 50.0)
+
+
+@pytest.mark.parametrize("n_censored", [0, 1, 2, 5, 24, 400])
+def test_the_stated_kappa0_rule_reproduces_the_codes_decision_in_every_cell(n_censored):
+    cell = _plateau_cell(n_censored, 0.0)
+    assert kappa0_defined_by_rule(cell, 0.1) is cell["kappa0_defined"]
+
+
+def test_a_map_cell_without_a_kappa0_run_has_no_verdict_and_the_rule_says_none():
+    reg = [{"system": "barbanis", "label": "b", "e_ratio": 5.0, "ics": "d", "fraction": 0.0, "err": None, "n": 10}]
+    (cell,) = validity_map(reg, [], [], [], ics="d", max_bias=0.1)
+    assert cell["kappa0_defined"] is None and "kappa0" not in cell
+    assert kappa0_defined_by_rule(cell, 0.1) is None
