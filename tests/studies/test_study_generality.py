@@ -277,6 +277,37 @@ class _TinyRuns:
         return iter_parts(self.raw / key, "snapshots", ["t", "energy"])
 
 
+@pytest.mark.parametrize("scale", ["quick", "paper"])
+def test_committed_validity_map_cells_follow_the_stated_kappa0_rule(scale):
+    """Every cell of the committed validity map (quick, paper) with a κ0 verdict: the rule the record states,
+    applied to the numbers of the cell (f∞/P(t_hi) against max_plateau_bias), gives the code's decision; a record
+    made before the cells carried those numbers: defined exactly where the claims' κ0 row gives no reason. A record
+    with the rule covers every energy of the claims' grid for every system."""
+    from hhscatter.reproduction.claims.evidence import kappa0_defined_by_rule
+
+    assets = ROOT / "docs" / "studies" / "assets"
+    doc = json.loads(((assets if scale == "quick" else assets / scale) / "generality.json").read_text())
+    rules = doc.get("validity_rules")
+    kappa = {(k["system"], round(k["ratio"], 6)): k for k in doc.get("kappa", []) if k["convention"] == "plateau"}
+    checked = 0
+    for cell in doc["validity_map"]:
+        if cell["kappa0_defined"] is None:
+            continue
+        if "plateau_bias" in cell:
+            assert kappa0_defined_by_rule(cell, rules["max_plateau_bias"]) is cell["kappa0_defined"], cell["id"]
+        else:
+            row = kappa[cell["label"], round(cell["e_ratio"], 6)]
+            assert cell["kappa0_defined"] is (not row["reason"]), cell["id"]
+        checked += 1
+    assert checked >= 10
+    if rules is not None:
+        grid = {round(r, 6) for r in doc["config"]["study"]["ratios"]}
+        for label in doc["systems"]:
+            got = {round(c["e_ratio"], 6) for c in doc["validity_map"] if c["label"] == label}
+            assert grid <= got, label
+            assert all(c["kappa0_defined"] is not None for c in doc["validity_map"] if c["label"] == label)
+
+
 def test_claims_do_not_depend_on_the_order_of_the_systems(tiny):
     """The claims analysed on the tiny runs with the systems in the study's order and in the reverse order: every
     record (verdict, value, error, reference, note) the same, claim 6 judged against Hénon–Heiles (last in the
