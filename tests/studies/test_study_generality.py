@@ -88,6 +88,27 @@ def test_trapped_fractions_are_the_censored_counts_of_the_raw_lifetimes(tiny):
         assert row.trapped_fraction == pytest.approx(float((oc["outcome"] == "censored").mean()), abs=1e-12)
 
 
+def test_validity_map_cells_off_the_claims_grid_have_their_own_kappa0_run(tiny):
+    """An energy of the evidence runs off the claims' grid (tiny: 1.05 E_c) gets a κ0 run of its own with the claims'
+    scene: its cell's trapped fraction is the censored share of that run's raw lifetimes, its N the claims' grid_n,
+    and its verdict the stated rule applied to its numbers."""
+    import pyarrow.parquet as pq
+
+    from hhscatter.reproduction.claims.evidence import kappa0_defined_by_rule
+
+    out, doc = tiny
+    grid = doc["config"]["study"]["ratios"]
+    off = [c for c in doc["validity_map"] if not any(abs(c["e_ratio"] - r) < 1e-9 for r in grid)]
+    assert {c["label"] for c in off} == SYSTEMS
+    for c in off:
+        raw = out / "raw" / f"{c['label']}_map_r{c['e_ratio']:.3f}" / "lifetimes"
+        oc = pd.concat([pq.read_table(p, columns=["outcome"]).to_pandas() for p in sorted(raw.glob("*.parquet"))])
+        assert c["kappa0_source"] == "map" and c["kappa0_n"] == len(oc) == doc["config"]["study"]["grid_n"]
+        assert c["trapped_fraction"] == pytest.approx(float((oc["outcome"] == "censored").mean()), abs=1e-12)
+        rule = kappa0_defined_by_rule(c, doc["validity_rules"]["max_plateau_bias"])
+        assert rule is c["kappa0_defined"]
+
+
 def test_mu_below_threshold_is_the_microcanonical_well_value_and_tends_to_one_at_the_bottom(tiny):
     """Near the minimum every built-in is harmonic with unit frequency: 2⟨K⟩/E → 1 (virial), and it decreases
     towards E_c where the cubic/quartic terms soften the well."""
