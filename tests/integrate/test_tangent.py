@@ -255,3 +255,20 @@ def test_tangent_is_refused_where_it_is_not_available(kw, key):
     kw = {"tangent": True, **kw}
     with pytest.raises(ConfigError, match=key):
         Scene(energy=0.2, n=10, **kw)
+
+
+def test_orbits_redone_on_the_reference_driver_and_escaped_at_the_start_keep_their_log_stretch():
+    from hhscatter.integrate.rerun import _redo_on_reference
+
+    scene = Scene(n=6, seed=3, energy=0.22, t_max=30.0, tangent=True)
+    sc, ics, ids = plan_of(scene), region_ics(scene, 0, scene.n), np.arange(scene.n, dtype=np.int64)
+    res = run_chunk(sc, ics, ids)
+    again = _redo_on_reference(sc, run_chunk(sc, ics, ids), ics, ids, np.array([1, 4]))
+    a, b = res.lifetimes["log_stretch"], again.lifetimes["log_stretch"]
+    assert np.array_equal(np.delete(a, [1, 4]), np.delete(b, [1, 4]))
+    assert np.allclose(a[[1, 4]], b[[1, 4]], rtol=0, atol=1e-9 * np.exp(np.abs(a[[1, 4]]).max()))
+    assert not np.array_equal(a[[1, 4]], b[[1, 4]])  # (long double: the redone rows are new numbers)
+    outside = np.vstack([ics[:2], [[1.2, 1.2, 0.0, 0.1]]])  # the third starts beyond r_esc: escaped at t = 0
+    lt = run_chunk(sc, outside, np.arange(3)).lifetimes
+    assert lt["t_end"][2] == 0.0 and lt["log_stretch"][2] == 0.0
+    assert np.array_equal(lt["log_stretch"][:2], a[:2])
