@@ -31,7 +31,10 @@ absolute times, are the result). Rows:
   whole process (the same ICs, the yardstick, one Parquet table of t_end;
   ``python -m benchmarks.engine --driver N SEED OUT``), in CPU time, the two
   run alternately ``--repeat`` times, the median of the pairs' ratios (target
-  ≤ 1.2). ``--only whole`` (or ``recording``) runs those rows alone.
+  ≤ 1.2). ``--only whole`` (or ``recording``) runs those rows alone;
+* **tangent** — the tangent dynamics (``tangent = true``: u and Λ integrated with every orbit) against the
+  same scene bare on the same ICs, conservative (E = 0.27) and dissipative (E0 = 0.3, γ = 0.01), alternated
+  in CPU time: CPU per orbit, steps per orbit and CPU per step; ``--only tangent`` runs these rows alone.
 
 Writes ``benchmarks/out/engine/<full|quick>/engine.csv`` and ``engine_summary.md``
 (``make docs-assets`` copies them to the benchmarks page). Not a
@@ -316,7 +319,7 @@ def main(argv=None):
     )
     ap.add_argument(
         "--only",
-        choices=("whole", "recording", "alternated"),
+        choices=("whole", "recording", "alternated", "tangent"),
         default=None,
         help="only the whole-process rows, the recording rows (and the bare row they are read with), or the "
         "in-process rows alternated in CPU time",
@@ -339,6 +342,9 @@ def main(argv=None):
     if a.only == "alternated":
         _alternated_rows(row, n, rep)
         return _write_outputs(rows, a.out, n, rep)
+    if a.only == "tangent":
+        _tangent_rows(row, n, rep)
+        return _write_outputs(rows, a.out, n, rep)
     _alternated_rows(row, n, rep)
     _bare_rows(row, n, rep)
     c3, ics3 = _dissipative_rows(row, n, rep)
@@ -347,6 +353,7 @@ def main(argv=None):
     _profile_row(row, rec, icr)
     _design_rows(row)
     _system_rows(row, n, rep)
+    _tangent_rows(row, n, rep)
     _whole_rows(row, a.whole_n, rep)
     _write_outputs(rows, a.out, n, rep)
 
@@ -406,6 +413,43 @@ def _alternated_rows(row, n, rep):
         base = "dissipative bare" if name != "noise" else "driver"
         v, note = ratio(name, base)
         row("alternated", f"{name} / {base}, CPU per orbit", v, goal, note)
+
+
+def _tangent_rows(row, n, rep):
+    """The tangent dynamics against the same scene bare on the same ICs (conservative E = 0.27, r_esc 1.03;
+    dissipative E0 = 0.3, γ = 0.01), alternated in CPU time (each round runs the four once, in turn): CPU per
+    orbit, steps per orbit, and their ratios (per orbit and per step)."""
+    from hhscatter.scene.ics import region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene  # deferred: pydantic loads on first use
+
+    m = min(n, 20_000)
+    scenes = {
+        "conservative": Scene(energy=0.27, n=m, seed=1, r_esc=1.03),
+        "dissipative": Scene(energy=0.3, gamma=0.01, n=m, seed=3, r_esc=1.03),
+    }
+    contenders, steps = {}, {}
+    for kind, sc in scenes.items():
+        ics = region_ics(sc, 0, m)
+        for tangent in (False, True):
+            contenders[(kind, tangent)] = _engine(sc.replace(tangent=tangent), ics)
+    for key, fn in contenders.items():
+        steps[key] = fn().n_steps  # JIT compilation and caches outside the measurement
+    cpu = {key: [] for key in contenders}
+    for _ in range(rep):
+        for key, fn in contenders.items():
+            t0 = time.process_time()
+            fn()
+            cpu[key].append(time.process_time() - t0)
+    for kind in scenes:
+        bare, tan = np.array(cpu[(kind, False)]), np.array(cpu[(kind, True)])
+        r = tan / bare
+        note = f"median of {rep} rounds ({r.min():.2f}-{r.max():.2f}); N = {m}"
+        s_b, s_t = steps[(kind, False)], steps[(kind, True)]
+        row("tangent", f"{kind} bare: CPU µs/orbit (median)", 1e6 * float(np.median(bare)) / m, "")
+        row("tangent", f"{kind} tangent: CPU µs/orbit (median)", 1e6 * float(np.median(tan)) / m, "")
+        row("tangent", f"{kind} tangent / bare, CPU per orbit", float(np.median(r)), "", note)
+        row("tangent", f"{kind} tangent / bare, steps per orbit", s_t / s_b, "", f"{s_b / m:.1f} -> {s_t / m:.1f}")
+        row("tangent", f"{kind} tangent / bare, CPU per step", float(np.median(r)) * s_b / s_t, "")
 
 
 def _bare_rows(row, n, rep):

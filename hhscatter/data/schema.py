@@ -60,6 +60,8 @@ lifetimes: traj_id int64, x0 y0 px0 py0 e0 gamma float64,
            time: root of E = E_c; or t_max), exit_channel int8 (null unless
            escaped; channel k is centred on the angle π/2 + 2πk/3),
            e_end float64 (energy at t_end)
+           [log_stretch float64: scenes with ``tangent = true`` only: Λ at t_end, the log-stretch of the
+           tangent vector (the finite-time Lyapunov exponent is log_stretch/t_end)]
 sections:  traj_id int64, t x y px py energy float64
 snapshots: traj_id int64, t energy float64 (with ``continue_settled``: also settled
            orbits after t_end)
@@ -91,6 +93,9 @@ META_KEY = b"hhscatter"
 
 
 TABLES = ("lifetimes", "sections", "snapshots", "crossings")
+
+#: columns a table has only when its scene asks for them (appended after the fixed ones, float64)
+OPTIONAL_COLUMNS = {"lifetimes": ("log_stretch",)}
 
 
 @functools.lru_cache(maxsize=1)
@@ -148,10 +153,11 @@ def provenance() -> dict:
 
 
 def to_arrow(name: str, columns: dict):
-    """to_arrow(name, columns) -> pyarrow.Table with the table's fixed schema."""
+    """to_arrow(name, columns) -> pyarrow.Table with the table's fixed schema (and those of its
+    :data:`OPTIONAL_COLUMNS` that ``columns`` holds)."""
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
-    schema = _schemas()[name]
+    schema = schema_of(name, optional=[c for c in OPTIONAL_COLUMNS.get(name, ()) if c in columns])
     arrays = []
     for field in schema:
         col = columns[field.name]
@@ -214,11 +220,14 @@ POINT_COLUMNS = {
 }
 
 
-def schema_of(name: str, grid: bool = False):
-    """schema_of(name, grid=False) -> pyarrow.Schema of a table (with the point columns of a grid run)."""
+def schema_of(name: str, grid: bool = False, optional=()):
+    """schema_of(name, grid=False, optional=()) -> pyarrow.Schema of a table (with the ``optional`` columns of
+    :data:`OPTIONAL_COLUMNS` it holds, then the point columns of a grid run)."""
     import pyarrow as pa  # deferred: pyarrow loads on first use
 
     schema = _schemas()[name]
+    if optional:
+        schema = pa.schema(list(schema) + [pa.field(c, pa.float64()) for c in optional])
     if grid:
         schema = pa.schema(list(schema) + [pa.field(c, pa.float64()) for c, _ in POINT_COLUMNS[name]])
     return schema

@@ -18,6 +18,7 @@ import numpy as np
 
 from hhscatter.data.schema import (
     META_KEY,
+    OPTIONAL_COLUMNS,
     POINT_COLUMNS,
     TABLES,
     legacy_point,
@@ -222,6 +223,20 @@ def _check_fragment(store, name, frag, point, chunk):
         )
 
 
+def _optional_columns(name, path, fs) -> list:
+    """The :data:`~hhscatter.data.schema.OPTIONAL_COLUMNS` of table ``name`` that its part file ``path`` holds (a
+    run's parts all have the same columns: they are of one scene)."""
+    if not OPTIONAL_COLUMNS.get(name):
+        return []
+    import pyarrow.parquet as pq  # deferred: pyarrow loads on first use
+
+    try:
+        names = pq.read_schema(path, filesystem=fs).names
+    except (OSError, ValueError):  # not readable: the dataset's own checks report it
+        return []
+    return [c for c in OPTIONAL_COLUMNS[name] if c in names]
+
+
 def verified_dataset(run_dir, name: str, *, one_by_one: bool = False, allow_partial: bool = False):
     """verified_dataset(run_dir, name) -> pyarrow.dataset of one table (a plain run or a grid run, either layout).
 
@@ -264,13 +279,13 @@ def verified_dataset(run_dir, name: str, *, one_by_one: bool = False, allow_part
             where = store.display(rel) if rel else f"{store.display()} (no {name}/ folder)"
             raise FileNotFoundError(f"no {name} table: no part files in {where}")
     grid = any("/" in f for f in files)
-    schema = schema_of(name, grid)
     paths = [store.path(rel, f) for f in files]
+    fs = store.filesystem or pafs.LocalFileSystem()
+    schema = schema_of(name, grid, _optional_columns(name, paths[0], fs))
     # every data page's CRC (written by write_part) is verified as it is read
     fmt = ds.ParquetFileFormat(
         default_fragment_scan_options=ds.ParquetFragmentScanOptions(page_checksum_verification=True)
     )
-    fs = store.filesystem or pafs.LocalFileSystem()
     legacy = [legacy_point(f) for f in files]
     if any(p is not None for p in legacy):
         # old hive layout: the point is in the folder names only (and the key 'gamma' clashes with the

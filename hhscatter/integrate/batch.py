@@ -9,7 +9,7 @@ import threading
 
 import numpy as np
 
-from hhscatter.integrate import integrators
+from hhscatter.integrate import events, integrators
 from hhscatter.integrate.lanes import CONTINUING, LaneRules, _Callback, _unbind
 from hhscatter.integrate.orbit_time import _orbit_times
 
@@ -101,6 +101,11 @@ class _BatchRules(LaneRules):
         self._p = memoryview(self.pars.reshape(-1)) if self.gate_live else None
         self._gate_at = layout.gate * self.B if self.gate_live else 0
         self._clock_at = layout.clock * self.B if layout.clock is not None else 0
+        # the tangent dynamics: each orbit's u(0) (k at 4k .. 4k + 3), the slots of u and Λ/S in the state
+        self.tan0 = None
+        if layout.tangent is not None:
+            self.tan0 = np.ascontiguousarray(events.tangent_start(scene, ics), dtype=float).reshape(-1)
+            self._tan_at, self._stretch_at = layout.tangent * self.B, layout.stretch * self.B
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
@@ -110,7 +115,17 @@ class _BatchRules(LaneRules):
         self._records(self.n)
 
     #: the per-orbit arrays an orbit's end is written into (a second phase shares its first phase's)
-    RECORDS = ("outcome", "t_end", "end_state", "lane_timed", "end_hi", "end_lo", "start_hi_of", "start_lo_of")
+    RECORDS = (
+        "outcome",
+        "t_end",
+        "end_state",
+        "end_stretch",
+        "lane_timed",
+        "end_hi",
+        "end_lo",
+        "start_hi_of",
+        "start_lo_of",
+    )
 
     def _records(self, n):
         """Preallocate what the chunk's orbits end with: ``outcome`` (int8, −1 until known), the end state
@@ -121,6 +136,7 @@ class _BatchRules(LaneRules):
         self.outcome = np.full(n, -1, dtype=np.int8)
         self.t_end = np.full(n, math.nan)
         self.end_state = np.zeros((n, 4))
+        self.end_stretch = np.zeros(n)  # Λ/S at the end (the tangent dynamics; 0 without)
         self.lane_timed = np.zeros(n, dtype=np.uint8)
         self.end_hi, self.end_lo = np.zeros(n), np.zeros(n)
         self.start_hi_of, self.start_lo_of = np.zeros(n), np.zeros(n)
@@ -144,12 +160,26 @@ class _BatchRules(LaneRules):
     def set_clock(self, lane, sigma):
         self._s[self._clock_at + lane] = sigma
 
-    def record(self, lane, outcome, t, state):
+    def stretch(self, lane):
+        return self._s[self._stretch_at + lane] if self.tan0 is not None else None
+
+    def record(self, lane, outcome, t, state, stretch=None):
         k = self.orbit[lane]
         self.outcome[k] = outcome
         self.t_end[k] = t
         self.lane_timed[k] = 0
         self.end_state[k] = state
+        if self.tan0 is not None:
+            self.end_stretch[k] = self.stretch(lane) if stretch is None else stretch
+
+    def load_tangent(self, lane, k):
+        """u(0) of orbit k and Λ = 0 into ``lane`` (the tangent dynamics)."""
+        s, t, B, j, a = self._s, self.tan0, self.B, 4 * k, self._tan_at
+        s[a + lane] = t[j]
+        s[a + B + lane] = t[j + 1]
+        s[a + 2 * B + lane] = t[j + 2]
+        s[a + 3 * B + lane] = t[j + 3]
+        s[self._stretch_at + lane] = 0.0
 
     def tick(self):
         """Report progress every PROGRESS_EVERY loaded orbits (``run_chunk(progress=...)``)."""
@@ -172,6 +202,8 @@ class _BatchRules(LaneRules):
         s[B + lane] = ic[j + 1]
         s[2 * B + lane] = ic[j + 2]
         s[3 * B + lane] = ic[j + 3]
+        if self.tan0 is not None:
+            self.load_tangent(lane, k)
         self.start_orbit(lane, k)
         self.ta.reset_cooldowns(lane)
 

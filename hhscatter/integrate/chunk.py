@@ -149,6 +149,8 @@ def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_step
         "exit_channel": channel.astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
+    if scene.layout.tangent is not None:  # Λ at t_end (carried as Λ/S, S a power of two: exact)
+        lifetimes["log_stretch"] = lanes.end_stretch * scene.layout.stretch_scale
     sections = _rows_to_columns(lanes.sec_rows, SECTION_COLUMNS, traj_ids)
     crossings = _rows_to_columns(lanes.cross_rows, CROSSING_COLUMNS, traj_ids)
     crossings["direction"] = crossings["direction"].astype(np.int8)
@@ -176,8 +178,10 @@ def _with_escaped_at_start(scene, ics, traj_ids, outside, res):
         "exit_channel": model.exit_channel(x, y).astype(np.int8),
         "e_end": model.energy(x, y, px, py),
     }
+    if scene.layout.tangent is not None:
+        lt["log_stretch"] = np.zeros(len(ics))
     if inside.any():
-        for col in ("outcome", "t_end", "exit_channel", "e_end"):
+        for col in [c for c in ("outcome", "t_end", "exit_channel", "e_end", "log_stretch") if c in lt]:
             lt[col][inside] = res.lifetimes[col]
     snaps = res.snapshots
     if scene.snapshots and scene.snapshots[0] == 0.0:  # a snapshot at t = 0 ≤ t_end of the escaped ones

@@ -127,7 +127,9 @@ class Layout:
 
     ``clock``: index of the clock variable σ in the state (None: no clock);
     ``gate``: index of the section gate in the runtime parameters (None: no
-    sections); ``gamma``: index of γ (None: conservative); ``clock_scale``: G.
+    sections); ``gamma``: index of γ (None: conservative); ``clock_scale``: G;
+    ``tangent``: index of the tangent vector's first component u_x in the state (u_x, u_y, u_px, u_py, then the
+    scaled log-stretch Λ/S; None: no tangent dynamics); ``stretch_scale``: S (:func:`stretch_scale`).
     """
 
     n_state: int
@@ -136,6 +138,13 @@ class Layout:
     gamma: int | None
     n_pars: int
     clock_scale: float
+    tangent: int | None = None
+    stretch_scale: float = 1.0
+
+    @property
+    def stretch(self) -> int | None:
+        """Index of the scaled log-stretch Λ/S in the state (None: no tangent dynamics)."""
+        return None if self.tangent is None else self.tangent + 4
 
 
 class Symbols:
@@ -291,7 +300,54 @@ def layout(scene) -> Layout:
     if scene.sections is not None:
         gate, n_pars = n_pars, n_pars + 1
     scale = max(1.0, max(t for t, _ in targets)) if targets else 1.0
-    return Layout(5 if clock is not None else 4, clock, gate, gamma, n_pars, scale)
+    n_state = 5 if clock is not None else 4
+    if not getattr(scene, "tangent", False):
+        return Layout(n_state, clock, gate, gamma, n_pars, scale)
+    return Layout(n_state + TANGENT_SLOTS, clock, gate, gamma, n_pars, scale, n_state, stretch_scale(scene.t_max))
+
+
+#: state slots of the tangent dynamics: the unit tangent vector u (4) and the scaled log-stretch Λ/S
+TANGENT_SLOTS = 5
+
+
+def stretch_scale(t_max: float) -> float:
+    """stretch_scale(t_max) -> S: the power of two ≥ max(1, t_max) by which the log-stretch is carried as Λ/S.
+
+    heyoka's step-size control weighs the largest state component: Λ ≈ λ t grows to hundreds over a long orbit
+    and would loosen the tolerance of x, y, p_x, p_y (as the orbit time would: the clock counts down in [0, 1]
+    for the same reason). Λ/S stays O(1) while the finite-time exponent is O(1); a power of two makes
+    Λ = S·(Λ/S) exact.
+
+    >>> stretch_scale(5000.0), stretch_scale(0.5)
+    (8192.0, 1.0)
+    """
+    return float(2.0 ** max(0, math.ceil(math.log2(max(1.0, float(t_max))))))
+
+
+def tangent_start(scene, ics) -> np.ndarray:
+    """tangent_start(plan, ics) -> (n, 4): the initial unit tangent vector u(0) of each orbit of ``ics`` (n, 4).
+
+    u(0) = (−F_y, F_x, −p_y, p_x)/|∇H| with F = −∇V the system's force and ∇H = (−F_x, −F_y, p_x, p_y): a unit
+    vector orthogonal to ∇H (it lies in the energy shell's tangent space: H is unchanged to first order along
+    it) and to the Hamiltonian flow J∇H = (p_x, p_y, F_x, F_y). It depends on the initial state alone (not on
+    the chunk, the lane or the seed). Where ∇H = 0 (a rest point) u(0) = (1, 0, 0, 0).
+
+    >>> import numpy as np
+    >>> from hhscatter.integrate.plan import plan_of
+    >>> from hhscatter.scene.scene import Scene
+    >>> u = tangent_start(plan_of(Scene(energy=0.2, n=1, tangent=True)), np.array([[0.1, 0.0, 0.0, 0.6]]))
+    >>> np.round(u, 6).tolist()   # F = (-0.1, -0.01): u ∝ (0.01, -0.1, -0.6, 0), |.| = √0.3701
+    [[0.016438, -0.164377, -0.986261, 0.0]]
+    """
+    ics = np.asarray(ics, dtype=float).reshape(-1, 4)
+    x, y, px, py = ics.T
+    fx, fy = scene.model.force(x, y)
+    u = np.column_stack([-np.asarray(fy, float) * np.ones_like(x), np.asarray(fx, float) * np.ones_like(x), -py, px])
+    norm = np.sqrt(np.sum(u * u, axis=1))
+    rest = ~(norm > 0)
+    u[~rest] /= norm[~rest, None]
+    u[rest] = (1.0, 0.0, 0.0, 0.0)
+    return u
 
 
 def scene_events(scene) -> tuple:
@@ -361,13 +417,43 @@ def _clock(s):
 
 
 def system(scene, lay: Layout):
-    """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock)."""
+    """system(scene, layout) -> heyoka ODE system: Hamilton's equations + drag (+ the clock) (+ the tangent
+    dynamics, :func:`tangent_equations`)."""
     import heyoka as hy  # deferred: heyoka loads on first use
 
     sys = scene.model.equations(hy, hy.par[lay.gamma] if lay.gamma is not None else None)
+    flow = list(sys)
     if lay.clock is not None:
         sys.append((hy.make_vars("sigma"), hy.expression(-1.0 / lay.clock_scale)))
+    if lay.tangent is not None:
+        sys.extend(tangent_equations(flow, lay.stretch_scale, hy))
     return sys
+
+
+def tangent_equations(flow, scale: float, hy) -> list:
+    """tangent_equations(flow, S, hy) -> heyoka system of the unit tangent vector u and the log-stretch Λ.
+
+    ``flow``: [(q_i, f_i), ...], the flow's variables and right-hand sides (drag included); A_ij = ∂f_i/∂q_j
+    (heyoka's ``diff``, any system). The variational equation δq̇ = A δq with u = δq/|δq| and Λ = ln|δq|:
+
+        u̇ = A u − (u·A u) u,        d(Λ/S)/dt = (u·A u)/S,
+
+    so |u| = 1 is conserved by the flow itself (no renormalisation) and Λ(t) = ln(|δq(t)|/|δq(0)|), the
+    finite-time Lyapunov exponent Λ/t. Λ is carried divided by S (:func:`stretch_scale`). The variables are
+    named ``u_<q>`` and ``log_stretch``.
+
+    >>> import heyoka as hy
+    >>> x, p = hy.make_vars("x", "p")
+    >>> [str(v) for v, _ in tangent_equations([(x, p), (p, x)], 1.0, hy)]   # the saddle ẋ = p, ṗ = x
+    ['u_x', 'u_p', 'log_stretch']
+    """
+    qs = [q for q, _ in flow]
+    us = hy.make_vars(*(f"u_{q}" for q in qs))
+    Au = [hy.sum([hy.diff(f, q) * u for q, u in zip(qs, us)]) for _, f in flow]
+    s = hy.sum([u * a for u, a in zip(us, Au)])
+    out = [(u, a - s * u) for u, a in zip(us, Au)]
+    out.append((hy.make_vars("log_stretch"), s / scale if scale != 1.0 else s))
+    return out
 
 
 #: the layout of Hamilton's equations alone (x, y, px, py: no clock, no parameters)
@@ -454,4 +540,8 @@ __all__ = [
     "section_accepts",
     "zero_power_start",
     "system",
+    "stretch_scale",
+    "tangent_equations",
+    "tangent_start",
+    "TANGENT_SLOTS",
 ]

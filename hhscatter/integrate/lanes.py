@@ -87,8 +87,13 @@ class LaneRules(abc.ABC):
         """Set the clock variable σ of ``lane`` (its root is the next clock target)."""
 
     @abc.abstractmethod
-    def record(self, lane: int, outcome: int, t: float, state) -> None:
-        """Record the orbit's outcome (a code of :mod:`hhscatter.outcomes`), its end time and end state."""
+    def record(self, lane: int, outcome: int, t: float, state, stretch=None) -> None:
+        """Record the orbit's outcome (a code of :mod:`hhscatter.outcomes`), its end time and end state; with the
+        tangent dynamics also its scaled log-stretch Λ/S there (``stretch``; None: the lane's now)."""
+
+    def stretch(self, lane: int):
+        """The scaled log-stretch Λ/S of ``lane`` now (None without the tangent dynamics)."""
+        return None
 
     @abc.abstractmethod
     def release(self, lane: int) -> bool:
@@ -143,7 +148,7 @@ class LaneRules(abc.ABC):
         self.open_late = None
 
     def last_out_of(self, lane):
-        """The last outward r_esc crossing of the orbit in ``lane``: (orbit time, state), or None."""
+        """The last outward r_esc crossing of the orbit in ``lane``: (orbit time, state, Λ/S or None), or None."""
         return self.last_out[lane]
 
     def start_orbit(self, lane, k):
@@ -180,9 +185,9 @@ class LaneRules(abc.ABC):
             self.cross_rows.extend(self.pending_cross[lane])
             self.pending_cross[lane] = []
 
-    def end(self, lane, outcome, t, state):
+    def end(self, lane, outcome, t, state, stretch=None):
         """The orbit's outcome is known: record it; release the lane unless the scene follows on."""
-        self.record(lane, outcome, t, state)
+        self.record(lane, outcome, t, state, stretch)
         if outcome == ESCAPED and self.follow:
             self.phase[lane] = FOLLOWING
             return True
@@ -221,7 +226,7 @@ class LaneRules(abc.ABC):
 
     def on_resc(self, lane, d):
         if self.orbit[lane] >= 0 and self.phase[lane] == LIVE:
-            self.last_out[lane] = (self.elapsed(lane), self.state4(lane)) if d > 0 else None
+            self.last_out[lane] = (self.elapsed(lane), self.state4(lane), self.stretch(lane)) if d > 0 else None
         return True
 
     def on_radius(self, k, lane, d):

@@ -41,6 +41,7 @@ SCENE_VALUES = (
     "continue_settled",
     "seed",
     "batch_size",
+    "tangent",
 )
 
 
@@ -51,7 +52,8 @@ class Plan:
     The first fields are the scene's values (:data:`SCENE_VALUES`: the system object, t_max and the tolerance,
     γ, r_esc and r_far, the section window, snapshot times, follow radii, noise, ...); ``scheduler`` names a
     registered scheduler (None: :func:`hhscatter.integrate.schedulers.select` picks one). The rest is derived
-    in construction: ``clock_targets`` ((orbit time, action), ...), ``far_radius``, ``follow_radii``,
+    in construction (``tangent``: the state carries the tangent dynamics,
+    :func:`hhscatter.integrate.events.tangent_equations`): ``clock_targets`` ((orbit time, action), ...), ``far_radius``, ``follow_radii``,
     ``layout`` (:class:`hhscatter.integrate.events.Layout`), ``events`` (the
     :class:`hhscatter.integrate.events.EventSpec` tuple, callback order), ``two_phase``. :meth:`replace` gives
     a plan with some values changed (derived again).
@@ -81,6 +83,7 @@ class Plan:
     continue_settled: bool = False
     seed: int = 0
     batch_size: int | None = None
+    tangent: bool = False
     scheduler: str | None = None
     clock_targets: tuple = field(init=False)
     far_radius: float = field(init=False)

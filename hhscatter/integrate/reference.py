@@ -25,6 +25,7 @@ class OrbitResult:
     snapshots: list = field(default_factory=list)  # (t, state)
     crossings: list = field(default_factory=list)  # (t, radius, direction)
     n_steps: int = 0
+    log_stretch: float | None = None  # Λ at t_end (a scene with the tangent dynamics; None without)
 
 
 class _Scalar(LaneRules):
@@ -50,8 +51,11 @@ class _Scalar(LaneRules):
     def set_clock(self, lane, sigma):
         self.ta.state[self.layout.clock] = self.fp(sigma)
 
-    def record(self, lane, outcome, t, state):
-        self.result = (outcome, t, np.array(state))
+    def stretch(self, lane):
+        return self.ta.state[self.layout.stretch] if self.layout.tangent is not None else None
+
+    def record(self, lane, outcome, t, state, stretch=None):
+        self.result = (outcome, t, np.array(state), self.stretch(lane) if stretch is None else stretch)
 
     def release(self, lane):
         self.commit(lane, self.result[1], self.phase[lane] == CONTINUING)
@@ -61,6 +65,8 @@ class _Scalar(LaneRules):
 
 def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     """simulate_orbit(scene, ic, fp_type=float, tol=None) -> OrbitResult.
+
+    With the tangent dynamics (``scene.tangent``) the result carries Λ at t_end (``log_stretch``).
 
     One orbit on heyoka's scalar integrator, time from 0, with the scene's
     events and outcome rules (:mod:`hhscatter.integrate.events`) and the t_max bound:
@@ -96,6 +102,8 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     cast = caster(fp_type)
     st = np.zeros(layout.n_state)
     st[:4] = np.asarray(ic, dtype=float)
+    if layout.tangent is not None:  # u(0) as the engine's (Λ = 0)
+        st[layout.tangent : layout.tangent + 4] = events.tangent_start(scene, ic[None, :4])[0]
     ta.state[:] = cast(st)
     rules.start_orbit(0, 0)
     ta.reset_cooldowns()
@@ -123,12 +131,13 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
             rules.release(0)
     finally:
         _unbind(ta)
-    outcome, t_end, state = rules.result
+    outcome, t_end, state, stretch = rules.result
     if scene.snapshots and not (outcome == SETTLED and scene.continue_settled):
         snaps = [s for s in snaps if s[0] <= t_end]
     secs = [r[1:] for r in rules.sec_rows]
     cross = [r[1:] for r in rules.cross_rows]
-    return OrbitResult(outcome, t_end, state, secs, snaps, cross, steps)
+    log_stretch = None if stretch is None else float(stretch) * layout.stretch_scale
+    return OrbitResult(outcome, t_end, state, secs, snaps, cross, steps, log_stretch)
 
 
 def state_at(scene, ic, t, *, fp_type=float, tol=None):

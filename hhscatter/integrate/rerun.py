@@ -76,7 +76,7 @@ def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
             )
         k = traj_ids[j]
         end = np.array([float(v) for v in o.state_end[:4]])
-        rows["lifetimes"].append((j, o.outcome, float(o.t_end), end))
+        rows["lifetimes"].append((j, o.outcome, float(o.t_end), end, o.log_stretch))
         rows["sections"] += [(k, *(float(v) for v in r)) for r in o.sections]
         rows["snapshots"] += [(k, float(t), *(float(v) for v in st[:4])) for t, st in o.snapshots]
         rows["crossings"] += [(k, float(t), float(R), int(d)) for t, R, d in o.crossings]
@@ -97,6 +97,8 @@ def _redo_on_reference(scene, res, ics, traj_ids, local) -> ChunkResult:
         "exit_channel": np.where(outcome == ESCAPED, model.exit_channel(end[:, 0], end[:, 1]), -1).astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
+    if scene.layout.tangent is not None:
+        lifetimes["log_stretch"] = np.array([r[4] for r in rows["lifetimes"]], dtype=float)
     snap = np.array(rows["snapshots"], dtype=float).reshape(-1, 6)
     snapshots = {
         "traj_id": snap[:, 0].astype(np.int64),

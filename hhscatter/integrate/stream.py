@@ -64,6 +64,7 @@ class _Stream(Scheduler):
         # one (``has_out``), its lane time (double-length) and its state (x, y, px, py of lane j at 4j..4j+3)
         self.has_out = np.zeros(self.B, dtype=np.uint8)
         self.out_hi, self.out_lo, self.out_state = np.zeros(self.B), np.zeros(self.B), np.zeros(4 * self.B)
+        self.out_stretch = np.zeros(self.B)  # ... and its Λ/S (the tangent dynamics)
         # bound of the running propagate_until call: none for live lanes (the clock censors at t_max)
         self.bound = np.zeros(self.B)
         if not any(a == "censor" for _, a in self.targets):
@@ -99,6 +100,12 @@ class _Stream(Scheduler):
         )
         end = memoryview(self.end_state.reshape(-1))  # end[4k + i]
         ics = memoryview(self.ics.reshape(-1))  # ics[4k + i]
+        # the tangent dynamics (None without): u(0) per orbit (tan[4k + i]), the slots of u_i (ua + i B) and
+        # Λ/S (sa) of a lane, Λ/S at each orbit's end (est) and at the lane's last outward r_esc crossing (ostr)
+        tan = memoryview(self.tan0) if self.tan0 is not None else None
+        ua, sa = (self._tan_at, self._stretch_at) if tan is not None else (0, 0)
+        ua1, ua2, ua3 = ua + B, ua + 2 * B, ua + 3 * B
+        est, ostr = memoryview(self.end_stretch), memoryview(self.out_stretch)
         b1, b2, b3 = B, 2 * B, 3 * B
         n, progress, reset = self.n, self.progress, self.ta.reset_cooldowns
         # a two-phase scene's first phase has the clock (to hand orbits on at t_from, and t_max)
@@ -129,6 +136,12 @@ class _Stream(Scheduler):
             s[b1 + lane] = ics[j + 1]
             s[b2 + lane] = ics[j + 2]
             s[b3 + lane] = ics[j + 3]
+            if tan is not None:
+                s[ua + lane] = tan[j]
+                s[ua1 + lane] = tan[j + 1]
+                s[ua2 + lane] = tan[j + 2]
+                s[ua3 + lane] = tan[j + 3]
+                s[sa + lane] = 0.0
             if clock is not None:
                 s[sc + lane] = sigma0
                 clock_i[lane] = 0
@@ -156,6 +169,8 @@ class _Stream(Scheduler):
             end[j + 1] = s[b1 + lane]
             end[j + 2] = s[b2 + lane]
             end[j + 3] = s[b3 + lane]
+            if tan is not None:
+                est[k] = s[sa + lane]
             return load_next_at(lane, a, el)  # the next orbit starts at the time this one ends
 
         def end_out(lane, code):
@@ -172,6 +187,8 @@ class _Stream(Scheduler):
             end[j + 1] = ost[q + 1]
             end[j + 2] = ost[q + 2]
             end[j + 3] = ost[q + 3]
+            if tan is not None:
+                est[k] = ostr[lane]
             return load_next(lane)
 
         def on_escape(ta, d, lane):
@@ -192,6 +209,8 @@ class _Stream(Scheduler):
             end[j + 1] = s[b1 + lane]
             end[j + 2] = s[b2 + lane]
             end[j + 3] = s[b3 + lane]
+            if tan is not None:
+                est[k] = s[sa + lane]
             k = nxt
             if k >= n:
                 orbit[lane] = -1
@@ -206,6 +225,12 @@ class _Stream(Scheduler):
             s[b1 + lane] = ics[j + 1]
             s[b2 + lane] = ics[j + 2]
             s[b3 + lane] = ics[j + 3]
+            if tan is not None:
+                s[ua + lane] = tan[j]
+                s[ua1 + lane] = tan[j + 1]
+                s[ua2 + lane] = tan[j + 2]
+                s[ua3 + lane] = tan[j + 3]
+                s[sa + lane] = 0.0
             if clock is not None:
                 s[sc + lane] = sigma0
                 clock_i[lane] = 0
@@ -226,6 +251,8 @@ class _Stream(Scheduler):
                     ost[q + 1] = s[b1 + lane]
                     ost[q + 2] = s[b2 + lane]
                     ost[q + 3] = s[b3 + lane]
+                    if tan is not None:
+                        ostr[lane] = s[sa + lane]
                 else:
                     has[lane] = 0
             return True
@@ -258,7 +285,8 @@ class _Stream(Scheduler):
         if not self.has_out[lane]:
             return None
         t = _orbit_time(*(float(a[lane]) for a in (self.out_hi, self.out_lo, self.start_hi, self.start_lo)))
-        return t, tuple(self.out_state[4 * lane : 4 * lane + 4].tolist())
+        stretch = float(self.out_stretch[lane]) if self.tan0 is not None else None
+        return t, tuple(self.out_state[4 * lane : 4 * lane + 4].tolist()), stretch
 
     def elapsed(self, lane):
         """Orbit time of ``lane`` now: the double nearest (hi + lo) − (hi0 + lo0), via TwoSum."""

@@ -150,6 +150,13 @@ class Scene:
         Random forces on the momenta (:class:`Noise`): a heat bath of temperature T with drag, a noise of
         strength σ without. Such a scene records lifetimes only; escape is the first outward r_esc crossing
         (settling below E_c is not an outcome: the noise lifts the orbit again), censoring at t_max.
+    tangent : bool
+        Integrate the tangent dynamics with each orbit (default false): a unit tangent vector u and its
+        log-stretch Λ (:func:`hhscatter.integrate.events.tangent_equations`; u(0) orthogonal to ∇H and to the
+        Hamiltonian flow, :func:`hhscatter.integrate.events.tangent_start`). The lifetimes table gains the
+        column ``log_stretch``, Λ at t_end (the finite-time Lyapunov exponent is Λ/t_end). Events and outcome
+        rules are those of the scene without it (its steps differ: heyoka's step-size control sees u too).
+        Not with snapshots, noise or a section window that opens after t = 0.
     name : str
         A label for progress lines and the tables' metadata.
 
@@ -191,6 +198,7 @@ class Scene:
     continue_settled: bool = False
     momentum: str = "tangential"
     noise: Noise | None = None
+    tangent: bool = False
     system: dict | None = field(default=None, hash=False)
     name: str = "scene"
     _model: System = field(default=None, init=False, repr=False, compare=False)
@@ -273,6 +281,24 @@ class Scene:
         self._check_energy(gamma)
         self._check_recording(gamma, t_max, r_esc)
         self._check_noise(gamma, t_max)
+        self._check_tangent()
+
+    def _check_tangent(self):
+        """tangent: a bool, on the stream scheduler's scenes (no snapshots, no noise, no late section window)."""
+        if not isinstance(self.tangent, bool):
+            raise ConfigError(f"tangent must be true or false, got {self.tangent!r}")
+        if not self.tangent:
+            return
+        for name, given in (
+            ("snapshots", bool(self.snapshots)),
+            ("noise", self.noise is not None),
+            ("sections.t_from > 0", self.sections is not None and self.sections.t_from > 0),
+        ):
+            if given:
+                raise ConfigError(
+                    f"tangent = true is not available with {name}: the tangent dynamics run in scenes without "
+                    "snapshots or noise whose section window (if any) opens at t = 0"
+                )
 
     def _check_noise(self, gamma, t_max):
         """noise: a heat bath needs linear drag, a noise strength none; the kick interval's bound; a noise scene
@@ -562,6 +588,8 @@ class Scene:
             d["noise"] = {k: v for k, v in dataclasses.asdict(self.noise).items() if v is not None}
         if self.momentum == "tangential":  # the default: left out of the hash, so older scenes keep theirs
             del d["momentum"]
+        if not self.tangent:  # the default: left out of the hash, so older scenes keep theirs
+            del d["tangent"]
         if self.system is None:  # Hénon–Heiles with linear drag, the default: left out of the hash
             del d["system"]
         else:  # ω and λ are Hénon–Heiles' keys: a system carries its own parameters

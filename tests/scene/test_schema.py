@@ -70,7 +70,7 @@ BAD_STUDY_FILES = [
         "fig3",
         lambda t: t.replace("[scale.tiny.scene]\nn = 1200", "[scale.tiny.scene]\nn = 1200\nchunk = 600", 1),
         "[scale.tiny.scene] unknown key 'chunk' (did you mean 'chunk_size'?); allowed keys: batch_size, chunk_size, continue_settled, energy, "
-        "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tol",
+        "gamma, ics, lam, momentum, n, name, omega, r_esc, r_far, radius, region, seed, t_max, tangent, tol",
     ),
     (
         "fig6",
