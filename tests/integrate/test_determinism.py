@@ -81,4 +81,4 @@ def test_epoch_scheduler_tables_do_not_depend_on_chunk_or_batch_size():
     assert len(whole["snapshots"]["t"]) > 5 * sc.n
     _assert_bitwise(whole, _split(sc, ics, ids, 8), "alone")  # each orbit alone in its lane from epoch 0
     _assert_bitwise(whole, _split(sc, ics, ids, 97, batch_size=4), "chunks of 97, 4 lanes")
-    _assert_bitwise(whole, _split(sc, ics, ids, 250, batch_size=16), "chunks of 250, 16 lanes")
+    _assert_bitwise(whole, _split(sc, ics, ids, 250, batch_size=8), "chunks of 250, 8 lanes")
