@@ -15,13 +15,13 @@ compiled part, ≈ 12 µs per orbit here, are to be won, and one more ``propagat
 steps by −lo to (hi, 0), which changes its time (and may change its state) in the last bits: the tables would no
 longer be bit-identical.
 
-Measured and not taken (heyoka 7.13, 8 lanes): continuous output (``propagate_until(P, c_output=True)``) gives the
-very values ``propagate_grid`` gives at the same times (0 of 36 000 differed), but every call compiles its evaluator
+Measured and not taken (heyoka 7.13): continuous output (``propagate_until(P, c_output=True)``) gives the very
+values ``propagate_grid`` gives at the same times (0 of 36 000 differed), but every call compiles its evaluator
 (1.4–8 ms, against ~0.25 ms for one epoch's ``propagate_grid``), and it stores the Taylor coefficients at ~650 B and
 ≈ 0.5 µs per lane-step (5–6× ``propagate_until`` on one long call). Shorter epochs (P = 4, 2, 1: 3.7×, 5.0×, 6.4×
-the bare scene against 3.3× at P = 8) lose more to the calls than they win from parked lanes; P = 12, 16 and 16 or
-32 lanes moved the ratio within the machine's noise (2.85–3.14×). Shorter or longer epochs change the tables in the
-last bits (at P = 4, 44 % of the t_end by ≥ 1 ulp).
+the bare scene against 3.3× at P = 8) lose more to the calls than they win from parked lanes; P = 12 and 16 moved
+the ratio within the machine's noise (2.85–3.14×); 16 and 32 lanes took 0.91–0.94× the CPU of 8 (hence 16). Shorter
+or longer epochs change the tables in the last bits (at P = 4, 44 % of the t_end by ≥ 1 ulp).
 """
 
 from __future__ import annotations
