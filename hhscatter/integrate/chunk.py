@@ -26,7 +26,7 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     is built here). ``ics``: array (n, 4) of initial states (x, y, px, py); ``traj_ids``: int64
     array (n,). Returns the table rows of this chunk, ordered by traj_id (and
     time). ``batch_size`` (default: the scene's, else 8 lanes for the stream
-    scheduler and 8 for epochs) has no effect on the results. ``count_steps``:
+    scheduler and 16 for epochs) has no effect on the results. ``count_steps``:
     fill ``ChunkResult.n_steps`` (the epoch scheduler otherwise skips reading
     heyoka's per-lane results every epoch; the stream scheduler always counts).
     ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time

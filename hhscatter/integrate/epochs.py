@@ -1,18 +1,32 @@
 """The epoch scheduler (scenes with energy snapshots): all lanes advance together; snapshots from ``propagate_grid``.
 
-Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5
-to t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch; 2.8–3.1× the
-dissipative scene on the stream in CPU per orbit): close to 60 % is heyoka's compiled propagation, the rest Python.
-heyoka's batch ``propagate_grid`` costs 1.5× ``propagate_until`` per lane-step with 2 grid points per epoch and
-1.9× with the 17 of snapshots every 0.5 (it writes the Taylor coefficients at every step and walks the grid lane
-by lane), and lanes parked until the epoch ends leave 28 % of the batch's lane-steps idle (1.44 lane-steps per
-step the same orbits take on the stream). Starting an orbit as soon as its lane is free would need a return per
-orbit end and per-lane grids: at most those 28 % of the compiled part, ≈ 12 µs per orbit here, are to be won,
-and one more ``propagate_grid`` call per orbit costs more (≈ 25 µs beyond its steps, measured with 8 lanes).
+Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5 to
+t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch; 2.8–3.3× the
+dissipative scene on the stream in CPU per orbit): about 60 % is inside ``propagate_grid`` (heyoka's compiled
+propagation and the event callbacks), the rest Python per epoch and per chunk (the epoch tables are built once per
+process, :func:`epoch_tables`; the snapshot rows are gathered in bulk). heyoka's batch ``propagate_grid`` costs 1.5×
+``propagate_until`` per lane-step with 2 grid points per epoch and 1.9× with the 17 of snapshots every 0.5 (it
+writes the Taylor coefficients at every step and walks the grid lane by lane), and lanes parked until the epoch ends
+leave 28 % of the batch's lane-steps idle (1.44 lane-steps per step the same orbits take on the stream). Starting an
+orbit as soon as its lane is free would need a return per orbit end and per-lane grids: at most those 28 % of the
+compiled part, ≈ 12 µs per orbit here, are to be won, and one more ``propagate_grid`` call per orbit costs more
+(≈ 25 µs beyond its steps, measured with 8 lanes). Nor can a call stop early and the lanes still mid-epoch go on:
+``propagate_grid`` starts by propagating each lane to its first grid point, a double, so a lane at (hi, lo) first
+steps by −lo to (hi, 0), which changes its time (and may change its state) in the last bits: the tables would no
+longer be bit-identical.
+
+Measured and not taken (heyoka 7.13): continuous output (``propagate_until(P, c_output=True)``) gives the very
+values ``propagate_grid`` gives at the same times (0 of 36 000 differed), but every call compiles its evaluator
+(1.4–8 ms, against ~0.25 ms for one epoch's ``propagate_grid``), and it stores the Taylor coefficients at ~650 B and
+≈ 0.5 µs per lane-step (5–6× ``propagate_until`` on one long call). Shorter epochs (P = 4, 2, 1: 3.7×, 5.0×, 6.4×
+the bare scene against 3.3× at P = 8) lose more to the calls than they win from parked lanes; P = 12 and 16 moved
+the ratio within the machine's noise (2.85–3.14×); 16 and 32 lanes took 0.91–0.94× the CPU of 8 (hence 16). Shorter
+or longer epochs change the tables in the last bits (at P = 4, 44 % of the t_end by ≥ 1 ulp).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -23,7 +37,7 @@ from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN
 from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
-EPOCH_BATCH = 8  # lanes of the epoch scheduler (measured: 8 ≤ 16, 32 at P = 8)
+EPOCH_BATCH = 16  # lanes of the epoch scheduler (measured on the recording scene: 16 and 32 took 0.93× the CPU of 8)
 
 
 @register
@@ -177,96 +191,71 @@ class _Epochs(Scheduler):
         super().close()
         self._handlers = {}  # the closures refer back to the lanes: free them now
 
-    def _tables(self):
-        """Per epoch index k of an orbit: its grid column and the orbit times of its snapshots.
-
-        Row k of ``grid_times`` holds the lane times of the snapshots s in [kP, (k+1)P)
-        (the last epoch before t_max also (k+1)P), padded with fillers (strictly
-        increasing, evaluated and discarded) to a common length; ``snap_times`` holds the
-        snapshot times, NaN at fillers. Row −1 (parked lanes) is all fillers.
-        Computed once per chunk, so an epoch's grid is a gather, not a loop.
-        """
-        P, S = self.P, self.snaps
-        K = self.n_epochs_max
-        rows = []
-        s_last = S[-1] if S.size else -math.inf
-        for k in range(K):
-            o = k * P
-            # a snapshot on an epoch boundary belongs to the later epoch's start, except the last
-            # snapshot (and t_max), which ends the earlier one: orbits that need nothing after
-            # them stop there
-            i0 = np.searchsorted(S, o, "right" if k and s_last <= o else "left")
-            i1 = np.searchsorted(S, o + P, "right" if k + 1 == K or s_last <= o + P else "left")
-            s = S[i0:i1]
-            rows.append((s - o, s))
-        m = max(int(((r[0] > 0) & (r[0] < P)).sum()) for r in rows)
-        n = m + 2
-        tau = np.empty((K + 1, n))
-        tt = np.full((K + 1, n), np.nan)
-        tau[:, 0], tau[:, -1] = 0.0, P
-        for k, (t, s) in enumerate(rows + [(np.empty(0), np.empty(0))]):
-            inner = (t > 0) & (t < P)
-            j = int(inner.sum())
-            tau[k, 1 : 1 + j] = t[inner]
-            tt[k, 1 : 1 + j] = s[inner]
-            a = t[inner][-1] if j else 0.0
-            tau[k, 1 + j : -1] = a + (P - a) * np.arange(1, m - j + 1) / (m - j + 1)
-            if len(t) and t[0] == 0.0:
-                tt[k, 0] = s[0]
-            if len(t) and t[-1] == P:
-                tt[k, -1] = s[-1]
-        self.grid_times, self.snap_times = tau, tt
-        self.has_snapshots = ~np.isnan(tt).all(axis=1)
+    def _epoch_tables(self):
+        """(grid, snap_times, has_snapshots) of :func:`epoch_tables` for this scene's P, epochs and snapshots."""
+        return epoch_tables(self.P, self.n_epochs_max, tuple(self.snaps.tolist()))
 
     def run(self):
-        B, ta, P, K = self.B, self.ta, self.P, self.n_epochs_max
-        self._tables()
-        grid_times, has_snapshots = self.grid_times, self.has_snapshots
-        orbit, phase, start_epoch = self.orbit, self.phase, self.start_epoch
-        s_last = self.s_last
-        buf, rows = [], []
+        B, ta, P = self.B, self.ta, self.P
+        grid, snap_times, has_snapshots = self._epoch_tables()
+        orbit, start_epoch, zeros = self.orbit, self.start_epoch, self.zeros
+        blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index (B,), orbit (B,))
         n_returns = n_steps = 0
-        lanes = range(B)
-        for lane in lanes:
+        for lane in range(B):
             self.load_next(lane)
-        while any(k >= 0 for k in orbit):
-            ta.set_time(self.zeros)
-            epoch = self.epoch
-            epoch_index = np.array([epoch - start_epoch[lane] if orbit[lane] >= 0 else -1 for lane in lanes])
+        while True:
+            ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
+            live = ids >= 0
+            if not live.any():
+                break
+            # the epoch of each lane's orbit (−1: a parked lane)
+            epoch_index = np.where(live, self.epoch - np.array(start_epoch), -1)
+            ta.set_time(zeros)
             if has_snapshots[epoch_index].any():
-                ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
-                out = ta.propagate_grid(np.ascontiguousarray(grid_times[epoch_index].T))[1]
-                buf.append((out[:, :4, :], epoch_index, ids))
-                if len(buf) >= 256:
-                    rows.append(self._snapshot_rows(buf))
-                    buf = []
+                blocks.append((ta.propagate_grid(grid[:, epoch_index])[1], epoch_index, ids))
+                if len(blocks) >= 256:
+                    rows.append(self._snapshot_rows(blocks, snap_times))
+                    blocks = []
             else:
                 ta.propagate_until(P)
             n_returns += 1
             n_steps += self._checked()
-            # orbits that need nothing after this epoch end here (k: epochs completed)
-            self._end_epoch(
-                [lane for lane in lanes if orbit[lane] >= 0],
-                lambda lane, k: k >= K or (phase[lane] == CONTINUING and k * P >= s_last),
-            )
-        if buf:
-            rows.append(self._snapshot_rows(buf))
+            self._next_epoch(epoch_index.tolist())
+        if blocks:
+            rows.append(self._snapshot_rows(blocks, snap_times))
         ids = np.concatenate([r[0] for r in rows]) if rows else np.empty(0, np.int64)
         t = np.concatenate([r[1] for r in rows]) if rows else np.empty(0)
         e = np.concatenate([r[2] for r in rows]) if rows else np.empty(0)
         # rows after an orbit's end belong to no table (settled orbits continued: all rows)
-        limit = np.where((np.array(self.outcome) == SETTLED) & self.continue_settled, np.inf, np.array(self.t_end))
+        limit = np.where((self.outcome == SETTLED) & self.continue_settled, np.inf, self.t_end)
         keep = t <= limit[ids]
         return n_returns, n_steps, (ids[keep], t[keep], e[keep])
 
     def _checked(self) -> int:
-        """After a propagation: the steps taken (when counted), the integrator's state checked (always when counted,
-        else when a lane is not finite)."""
-        if self.count_steps:
-            return _check(self.ta, self)
+        """After a propagation: the steps taken (when counted: heyoka's per-lane results read once), the
+        integrator's state checked (a non-finite lane raises, naming it)."""
+        steps = sum(r[3] for r in self.ta.propagate_res) if self.count_steps else 0
         if not np.isfinite(self.state).all():
             _check(self.ta, self)
-        return 0
+        return steps
+
+    def _next_epoch(self, epoch_index) -> None:
+        """Close the epoch (``epoch_index``: each lane's orbit's epoch in it, −1 for a parked lane): an orbit that
+        needs nothing after it (t_max reached, or a settled orbit continued past the last snapshot) is recorded as
+        censored at t_max if still live, and released; the next epoch begins with the free lanes refilled."""
+        orbit, phase = self.orbit, self.phase
+        K, P, s_last = self.n_epochs_max, self.P, self.s_last
+        for lane, k in enumerate(epoch_index):
+            if k >= 0 and orbit[lane] >= 0:
+                k += 1  # epochs completed
+                if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                    if phase[lane] == LIVE:
+                        self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                    self.release(lane)
+        self.epoch += 1
+        for lane, k in enumerate(orbit):
+            if k < 0:
+                self.load_next(lane)
 
     def _end_epoch(self, lanes, done) -> None:
         """Close the epoch: each lane of ``lanes`` whose orbit is done after it (``done(lane, k)``, k its epochs
@@ -283,15 +272,19 @@ class _Epochs(Scheduler):
             if self.orbit[lane] < 0:
                 self.load_next(lane)
 
-    def _snapshot_rows(self, buf):
-        """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows."""
-        out = np.stack([b[0] for b in buf])  # (epochs, n, 4, B)
-        epoch_index = np.stack([b[1] for b in buf])  # (epochs, B)
-        ids = np.stack([b[2] for b in buf])
-        tt = self.snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
-        ok = ~np.isnan(tt) & (ids >= 0)[:, None, :]
-        x, y, px, py = (out[:, :, i, :][ok] for i in range(4))
-        return (np.broadcast_to(ids[:, None, :], tt.shape)[ok], tt[ok], self.model.energy(x, y, px, py))
+    def _snapshot_rows(self, blocks, snap_times):
+        """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows, in (epoch, grid
+        point, lane) order; fillers and parked lanes are skipped by flat index, not copied."""
+        out = np.stack([b[0] for b in blocks])  # (epochs, n, dim, B)
+        epoch_index = np.stack([b[1] for b in blocks])  # (epochs, B)
+        ids = np.stack([b[2] for b in blocks])
+        _, n, dim, B = out.shape
+        tt = snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
+        e, j, b = np.nonzero(~np.isnan(tt) & (ids >= 0)[:, None, :])  # in (epoch, grid point, lane) order
+        at = ((e * n + j) * dim) * B + b  # variable 0 of (epoch e, grid point j, lane b) in ``out``
+        flat = out.reshape(-1)
+        x, y, px, py = (flat[at + i * B] for i in range(4))
+        return ids[e, b], tt[e, j, b], self.model.energy(x, y, px, py)
 
     def load_next(self, lane):
         k = self.next
@@ -301,3 +294,58 @@ class _Epochs(Scheduler):
         self.start_epoch[lane] = self.epoch
         self.has_out[lane] = 0
         self.load_orbit(lane, k)
+
+
+@functools.lru_cache(maxsize=8)
+def epoch_tables(P: float, K: int, snapshots: tuple) -> tuple:
+    """epoch_tables(P, K, snapshots) -> (grid, snap_times, has_snapshots): per epoch index k of an orbit (epochs of
+    length P, K of them to t_max; ``snapshots`` the sorted snapshot times), its grid column and the orbit times of
+    its snapshots. Built once per process and scene, not per chunk (~13 ms at K = 625; a chunk's plan is replaced
+    per chunk when the no-return rule moves its far radius, which the tables do not depend on).
+
+    Column k of ``grid`` (n, K + 1) holds the lane times of the snapshots s in [kP, (k+1)P) (the last epoch
+    before t_max also (k+1)P), padded with fillers (strictly increasing, evaluated and discarded) to a common
+    length n; row k of ``snap_times`` (K + 1, n) holds the snapshot times, NaN at fillers; index −1 (parked
+    lanes) is all fillers. An epoch's grid is then one gather, ``grid[:, epoch_index]``, already in the (n, B)
+    layout ``propagate_grid`` takes. The arrays are shared: read-only.
+
+    Examples
+    --------
+    >>> grid, snap_times, has = epoch_tables(8.0, 2, (0.0, 4.0, 8.0, 9.0))
+    >>> grid.T.tolist()  # lane times: epoch 0's snapshots 0, 4; epoch 1's 8, 9 at 0, 1; each epoch's end; parked
+    [[0.0, 4.0, 8.0], [0.0, 1.0, 8.0], [0.0, 4.0, 8.0]]
+    >>> snap_times.tolist()[:2], has.tolist()
+    ([[0.0, 4.0, nan], [8.0, 9.0, nan]], [True, True, False])
+    """
+    S = np.asarray(snapshots, dtype=float)
+    rows = []
+    s_last = S[-1] if S.size else -math.inf
+    for k in range(K):
+        o = k * P
+        # a snapshot on an epoch boundary belongs to the later epoch's start, except the last
+        # snapshot (and t_max), which ends the earlier one: orbits that need nothing after
+        # them stop there
+        i0 = np.searchsorted(S, o, "right" if k and s_last <= o else "left")
+        i1 = np.searchsorted(S, o + P, "right" if k + 1 == K or s_last <= o + P else "left")
+        s = S[i0:i1]
+        rows.append((s - o, s))
+    m = max(int(((r[0] > 0) & (r[0] < P)).sum()) for r in rows)
+    n = m + 2
+    tau = np.empty((K + 1, n))
+    tt = np.full((K + 1, n), np.nan)
+    tau[:, 0], tau[:, -1] = 0.0, P
+    for k, (t, s) in enumerate(rows + [(np.empty(0), np.empty(0))]):
+        inner = (t > 0) & (t < P)
+        j = int(inner.sum())
+        tau[k, 1 : 1 + j] = t[inner]
+        tt[k, 1 : 1 + j] = s[inner]
+        a = t[inner][-1] if j else 0.0
+        tau[k, 1 + j : -1] = a + (P - a) * np.arange(1, m - j + 1) / (m - j + 1)
+        if len(t) and t[0] == 0.0:
+            tt[k, 0] = s[0]
+        if len(t) and t[-1] == P:
+            tt[k, -1] = s[-1]
+    out = np.ascontiguousarray(tau.T), tt, ~np.isnan(tt).all(axis=1)
+    for a in out:
+        a.flags.writeable = False
+    return out

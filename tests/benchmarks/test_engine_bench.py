@@ -48,5 +48,5 @@ def test_driver_reads_an_ic_table_to_the_orbits_it_samples(tmp_path):
 
 def test_design_choices_run_every_way_of_recording():
     out = design_choices(batch_size=4, epochs=4, epoch=2.0)
-    assert set(out) == {"until", "grid2", "grid17", "step callback", "c_output"}
+    assert set(out) == {"until", "grid2", "grid17", "step callback", "c_output", "c_output long"}
     assert all(np.isfinite(v) and v > 0 for v in out.values())
