@@ -616,7 +616,7 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
     assert "| two | disk/tangential | 75.0 ± 1.0 ± 5.0 % | 10.0 ± 1.0 ± 5.0 % | < 0.15 % (95 %) |" in out
-    assert "| 0.800 ± 0.004 | < 3.0e-4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
+    assert "| 0.800 ± 0.004 | < 3.0e−4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
 
 
@@ -642,13 +642,13 @@ def test_evidence_tables_write_zero_counts_of_records_without_bounds_from_their_
 
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
     """The hook's output writes a number's sign "−" (as the verdicts and the [[…]] numbers do); code spans, maths,
-    HTML attributes, ranges and e-notation stay as written."""
+    HTML attributes and ranges stay as written; the exponent of e-notation is signed "−" too."""
     text = (
         "| -0.26 ± 0.19 | (z = -1.1) | [-0.015, +0.029] | 10<sup>-10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
     assert hook.typographic_minus(text) == (
-        "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
+        "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e−05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
 

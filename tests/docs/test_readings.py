@@ -22,12 +22,21 @@ from hhscatter.publish.readings import (
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "studies").glob("*/page.md"))
+#: the docs pages that report results beside the study pages: the home page's headline results, the studies index,
+#: the paper-scale page
+RESULT_PAGES = [
+    ROOT / "docs" / "index.md",
+    ROOT / "docs" / "studies" / "index.md",
+    ROOT / "docs" / "studies" / "paper-scale.md",
+]
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.parent.name)
+@pytest.mark.parametrize(
+    "page", PAGES + RESULT_PAGES, ids=lambda p: p.parent.name if p.name == "page.md" else p.relative_to(ROOT).as_posix()
+)
 def test_no_study_page_types_a_reading(page):
     found = typed_readings(page.read_text())
-    assert not found, f"{page.parent.name}: readings typed by hand (write [[reading:…]]): {found}"
+    assert not found, f"{page.relative_to(ROOT)}: readings typed by hand (write [[reading:…]]): {found}"
 
 
 def test_the_scan_finds_the_readings_that_were_typed():
@@ -238,6 +247,6 @@ def test_the_hh_1_05_reading_writes_a_hazard_bin_without_escape_as_its_bound():
         "config": {"scene": {"t_max": 800.0}},
     }
     text = READINGS["generality.hh_1_05"](_loader({"generality": doc}))
-    assert "no escape in [400, 800]: < 3.0e-4 (95 %)" in text
-    assert "[800, 1400]: < 2.0e-4 (95 %)" in text and "± 0 " not in text and "nan" not in text
+    assert "no escape in [400, 800]: < 3.0e−4 (95 %)" in text
+    assert "[800, 1400]: < 2.0e−4 (95 %)" in text and "± 0 " not in text and "nan" not in text
     assert "is constant within its errors (weighted mean 0.00300 ± 0.00021" in text
