@@ -22,9 +22,10 @@ from hhscatter.publish.readings import (
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "studies").glob("*/page.md"))
-#: the docs pages that report results beside the study pages: the home page's headline results, the studies index,
-#: the paper-scale page
+#: the pages that report results beside the study pages: the headline results of the README and the docs home (one
+#: template), the home page, the studies index, the paper-scale page
 RESULT_PAGES = [
+    ROOT / "tools" / "readme_results.md",
     ROOT / "docs" / "index.md",
     ROOT / "docs" / "studies" / "index.md",
     ROOT / "docs" / "studies" / "paper-scale.md",
