@@ -639,7 +639,7 @@ def study_conventions(root: Path, study: str) -> set[float]:
 #: the words of a comparative or qualitative reading of results
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
-    r"best|worst|consistent(?:ly)? with)\b",
+    r"best|worst|consistent(?:ly)? with|everywhere|at every (?:energy|scan energy|E))\b",
     re.I,
 )
 _PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)
