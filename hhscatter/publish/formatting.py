@@ -30,6 +30,7 @@ __all__ = [
     "escape_table_bars",
     "formula_stars",
     "format_leaf",
+    "keep_together",
     "format_number",
     "format_value",
     "format_value_err",
@@ -389,3 +390,30 @@ def formula_stars(text: str) -> str:
         out += [escape(text[last : m.start()]), m.group(0)]
         last = m.end()
     return "".join(out) + escape(text[last:])
+
+
+#: inside a table row: the space after "±" or a comparison sign before its number, and before the "%" of a number
+_GLUE = re.compile(r"(?<=[±<>≤≥]) (?=[\d−+.])|(?<=\d) (?=%)")
+_TABLE_ROW = re.compile(r"^[ \t]*\|.*$", re.M)
+
+
+def keep_together(text: str) -> str:
+    r"""keep_together(markdown) -> its table rows with a no-break space where a narrow column must not break a number
+    from its sign or unit: after "±" and after "<", ">", "≤", "≥" before a number, and between a number and "%". A
+    cell then wraps as "0.9338" / "± 0.0025" or "< 3.0e−4" / "(95 %)", never "± " / "0.0025" or "(95" / "%)". Code
+    and maths are left as written; prose outside tables too.
+
+    Examples
+    --------
+    >>> keep_together("| 0.9338 ± 0.0025 | < 3.0e−4 (95 %) | `a < 1` |\nx ± 1 %").replace("\u00a0", "~")
+    '| 0.9338 ±~0.0025 | <~3.0e−4 (95~%) | `a < 1` |\nx ± 1 %'
+    """
+
+    def row(m):
+        line, out, last = m.group(0), [], 0
+        for v in _VERBATIM.finditer(line):
+            out += [_GLUE.sub("\u00a0", line[last : v.start()]), v.group(0)]
+            last = v.end()
+        return "".join(out) + _GLUE.sub("\u00a0", line[last:])
+
+    return _TABLE_ROW.sub(row, text)

@@ -704,3 +704,24 @@ def test_no_built_number_reads_plus_minus_zero(hook, name):
         text += [f"{k}: {v}" for k, v in headline_numbers(doc, limit=10**6)]
     zero = [m.group(0) for t in text for m in re.finditer(r".{0,40}± 0(?![.,\d]).{0,10}", t)]
     assert not zero, zero[:5]
+
+
+def test_the_heads_of_the_study_tables_wrap_into_short_words(hook):
+    """A results table fits the text column by wrapping its heads: no head of the record tables the pages ask for
+    holds a word longer than 16 characters ("log10(measured/predicted)" kept the cut-off table's reading column
+    narrow)."""
+    long_words = [
+        (table, head)
+        for table, spec in hook.STUDY_TABLES.items()
+        for _, head, *_ in spec
+        if max(len(w) for w in head.split()) > 16
+    ]
+    assert not long_words, long_words
+
+
+def test_the_heads_of_the_study_tables_name_survivors_by_the_glossary(hook):
+    """Orbits still inside are regular, chaotic but confined or censored (the glossary): no head of a record table
+    says "trapped" (the operator's KAM-probe boxes are censored boxes, as its page says)."""
+    heads = [head for spec in hook.STUDY_TABLES.values() for _, head, *_ in spec]
+    assert not [h for h in heads if "trapped" in h.lower()]
+    assert "censored boxes" in heads
