@@ -375,8 +375,11 @@ def formula_stars(text: str) -> str:
 
     Examples
     --------
-    >>> print(formula_stars(r"E(t*) = E1; not τ*, the onset; *a caption*; **bold**; `t*x*`; E\*"))
-    E(t\*) = E1; not τ\*, the onset; *a caption*; **bold**; `t*x*`; E\*
+    >>> text = "E(t*) = E1; not τ*, the onset; *a caption*; **bold**; `t*x*`"
+    >>> print(formula_stars(text))
+    E(t\*) = E1; not τ\*, the onset; *a caption*; **bold**; `t*x*`
+    >>> formula_stars(formula_stars(text)) == formula_stars(text)  # an escaped star stays as it is
+    True
     >>> print(formula_stars("declared '0.5*(x**2 + y**2) - y**3/3'"))
     declared '0.5\*(x\*\*2 + y\*\*2) - y\*\*3/3'
     """
