@@ -15,6 +15,11 @@
   ``help()`` reads them) are set as superscripts and subscripts
   (``<sup>``/``<sub>``) by ``on_page_content``, outside maths and code: a
   reader never sees a brace of TeX (:func:`scripts_outside_math`).
+* **Signs and stars of formulas.** ``on_page_markdown`` writes a negative number's sign "−" on every page, as the
+  generated tables and the report do (:func:`hhscatter.publish.formatting.typographic_minus`), and escapes the
+  stars of plain-text formulas (``E(t*)``, ``τ*``, ``x**2``) so that two of them never become emphasis
+  (:func:`hhscatter.publish.formatting.formula_stars`); in a table a number stays with its "±", "<" or "%"
+  (:func:`hhscatter.publish.formatting.keep_together`). Code and maths are left as written.
 * **Footer.** ``on_config`` writes the commit (and date) the site was built
   from into the footer, so a page's numbers can be traced to their code.
 """
@@ -140,6 +145,12 @@ def on_files(files, config, **kwargs):
             rel = p.relative_to(es5).as_posix()
             files.append(File.generated(config, f"{MATHJAX_DEST}/{rel}", abs_src_path=str(p)))
     return files
+
+
+def on_page_markdown(markdown, page, config, files, **kwargs):
+    from hhscatter.publish.formatting import formula_stars, keep_together, typographic_minus
+
+    return keep_together(formula_stars(typographic_minus(markdown)))
 
 
 def on_page_content(html, page, config, files, **kwargs):

@@ -28,7 +28,9 @@ __all__ = [
     "comparison_table",
     "embed_markdown",
     "escape_table_bars",
+    "formula_stars",
     "format_leaf",
+    "keep_together",
     "format_number",
     "format_value",
     "format_value_err",
@@ -332,10 +334,12 @@ def scripts_to_html(text: str) -> str:
     return "".join(out)
 
 
-#: what typographic_minus leaves as written: fenced code, code spans, maths, HTML tags (their attributes)
-_VERBATIM = re.compile(r"```.*?```|`[^`\n]*`|\$\$.*?\$\$|\$[^$\n]*\$|\\\(.*?\\\)|<[^>\n]*>", re.S)
-#: a hyphen as the sign of a number: after a space, an opening bracket, "=", ":", ";", "(" or ">"; not "x-1", "E0-E_c"
-_SIGN = re.compile(r"(?<![\w.\-/])-(?=\.?\d)")
+#: what typographic_minus leaves as written: fenced code, code spans, maths, HTML comments and tags (their
+#: attributes); a tag opens with a name ("<span", "</td"), so that "r < 1 … 17 < t" is text, not a tag
+_VERBATIM = re.compile(r"```.*?```|`[^`\n]*`|\$\$.*?\$\$|\$[^$\n]*\$|\\\(.*?\\\)|<!--.*?-->|</?[A-Za-z][^<>\n]*>", re.S)
+#: a hyphen as the sign of a number: after a space, an opening bracket, "=", ":", ";", "(" or ">"; not "x-1",
+#: "E0-E_c"; and the sign of an exponent ("2.6e-05")
+_SIGN = re.compile(r"(?<![\w.\-/])-(?=\.?\d)|(?<=\d[eE])-(?=\d)")
 
 
 def typographic_minus(text: str) -> str:
@@ -347,9 +351,72 @@ def typographic_minus(text: str) -> str:
     --------
     >>> typographic_minus("| -0.26 ± 0.19 | (z = -1.1) | `grid[-1]` | x-1 | 10<sup>-10</sup> |")
     '| −0.26 ± 0.19 | (z = −1.1) | `grid[-1]` | x-1 | 10<sup>−10</sup> |'
+    >>> typographic_minus("| r < 1 | 2.6e-05 ± 4e-07 | -0.003 [-0.010, +0.002] | <span>-1.1</span> |")
+    '| r < 1 | 2.6e−05 ± 4e−07 | −0.003 [−0.010, +0.002] | <span>−1.1</span> |'
     """
     out, last = [], 0
     for m in _VERBATIM.finditer(text):
         out += [_SIGN.sub("−", text[last : m.start()]), m.group(0)]
         last = m.end()
     return "".join(out) + _SIGN.sub("−", text[last:])
+
+
+#: the stars of a plain-text formula: an operator between two terms ("0.5*(x**2", "x**2*y") …
+_OPERATOR_STAR = re.compile(r"(?<=[\w)])\*{1,2}(?=[\w(])")
+#: … and the mark of a one-letter symbol ("t*", "E(t*)", "τ*,"), not the closing star of an emphasised word
+_SYMBOL_STAR = re.compile(r"(?<![\w\\*])([^\W\d_])\*(?![\w*])")
+
+
+def formula_stars(text: str) -> str:
+    r"""formula_stars(markdown) -> the same Markdown with the stars of plain-text formulas escaped, so that a
+    Markdown parser shows them instead of reading two of them as emphasis: an operator star between two terms
+    (``0.5*(x**2 + y**2)``) and the star of a one-letter symbol (``E(t*)``, ``τ*``). Code, maths, HTML and
+    stars already escaped are left as written, and so is the emphasis of words (``*a caption*``, ``**bold**``).
+
+    Examples
+    --------
+    >>> text = "E(t*) = E1; not τ*, the onset; *a caption*; **bold**; `t*x*`"
+    >>> print(formula_stars(text))
+    E(t\*) = E1; not τ\*, the onset; *a caption*; **bold**; `t*x*`
+    >>> formula_stars(formula_stars(text)) == formula_stars(text)  # an escaped star stays as it is
+    True
+    >>> print(formula_stars("declared '0.5*(x**2 + y**2) - y**3/3'"))
+    declared '0.5\*(x\*\*2 + y\*\*2) - y\*\*3/3'
+    """
+
+    def escape(part: str) -> str:
+        part = _OPERATOR_STAR.sub(lambda m: m.group(0).replace("*", "\\*"), part)
+        return _SYMBOL_STAR.sub(lambda m: m.group(1) + "\\*", part)
+
+    out, last = [], 0
+    for m in _VERBATIM.finditer(text):
+        out += [escape(text[last : m.start()]), m.group(0)]
+        last = m.end()
+    return "".join(out) + escape(text[last:])
+
+
+#: inside a table row: the space after "±" or a comparison sign before its number, and before the "%" of a number
+_GLUE = re.compile(r"(?<=[±<>≤≥]) (?=[\d−+.])|(?<=\d) (?=%)")
+_TABLE_ROW = re.compile(r"^[ \t]*\|.*$", re.M)
+
+
+def keep_together(text: str) -> str:
+    r"""keep_together(markdown) -> its table rows with a no-break space where a narrow column must not break a number
+    from its sign or unit: after "±" and after "<", ">", "≤", "≥" before a number, and between a number and "%". A
+    cell then wraps as "0.9338" / "± 0.0025" or "< 3.0e−4" / "(95 %)", never "± " / "0.0025" or "(95" / "%)". Code
+    and maths are left as written; prose outside tables too.
+
+    Examples
+    --------
+    >>> keep_together("| 0.9338 ± 0.0025 | < 3.0e−4 (95 %) | `a < 1` |\nx ± 1 %").replace("\u00a0", "~")
+    '| 0.9338 ±~0.0025 | <~3.0e−4 (95~%) | `a < 1` |\nx ± 1 %'
+    """
+
+    def row(m):
+        line, out, last = m.group(0), [], 0
+        for v in _VERBATIM.finditer(line):
+            out += [_GLUE.sub("\u00a0", line[last : v.start()]), v.group(0)]
+            last = v.end()
+        return "".join(out) + _GLUE.sub("\u00a0", line[last:])
+
+    return _TABLE_ROW.sub(row, text)

@@ -52,6 +52,7 @@ import tomllib
 from functools import lru_cache
 from pathlib import Path
 
+from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.publish.formatting import format_bound, format_number, format_value_err, typographic_minus
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
@@ -376,7 +377,7 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
     f = (fmt or "").strip()
     if bound is not None and (f in ("", "pct", "value") or f.startswith(".")):
         # a count of 0 (or of all): its one-sided bound, never "0 ± 0"
-        return format_bound(**bound, pct=(fmt or "").strip() == "pct")
+        return typographic_minus(format_bound(**bound, pct=(fmt or "").strip() == "pct"))
     if (fmt or "").strip() == "verdict":  # a paper-vs-ours row: its verdict by the one rule
         if not isinstance(leaf, dict) or not ("ours" in leaf or "reference" in leaf):
             raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours') or a claim record")
@@ -410,8 +411,33 @@ def _bound_of(doc, path: str, leaf) -> dict | None:
         if _is_num(v):
             found[k] = v
     if ("upper" in found) == ("lower" in found):
-        return None
+        return _derived_bound(doc, path, leaf) if not found else None
     return {"cl": 0.95, **found}
+
+
+def _derived_bound(doc, path: str, leaf) -> dict | None:
+    """The 95 % one-sided bound of a fraction of 0 or 1 recorded without one (a record written before bounds were
+    recorded): from the number of orbits ``n`` of its record, by the estimator that records them
+    (:func:`hhscatter.analysis.stats.intervals.fraction_with_bound`); None for any other number.
+
+    >>> b = _derived_bound({"rows": [{"id": "a", "fraction": 0.0, "n": 10000}]}, "rows[id=a].fraction", 0.0)
+    >>> b["cl"], round(b["upper"], 7)  # 1 − 0.05^(1/10000)
+    (0.95, 0.0002995)
+    """
+    parts = _split(path)
+    name = parts[-1] if parts else ""
+    if leaf not in (0, 1) or not (name == "fraction" or name.endswith("_fraction")) or len(parts) < 2:
+        return None
+    parent = "".join(p if p.startswith("[") or i == 0 else f".{p}" for i, p in enumerate(parts[:-1]))
+    try:
+        n = resolve(doc, parent).get("n")
+    except (NumberRefError, AttributeError):
+        return None
+    if not isinstance(n, int) or isinstance(n, bool) or n <= 0:
+        return None
+    b = fraction_with_bound(round(leaf * n), n)
+    bound = {"upper": b.upper} if b.upper is not None else {"lower": b.lower}
+    return {"cl": b.cl, **bound}
 
 
 def _rule_verdict(row: dict, scale) -> str:
@@ -613,7 +639,7 @@ def study_conventions(root: Path, study: str) -> set[float]:
 #: the words of a comparative or qualitative reading of results
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
-    r"best|worst|consistent(?:ly)? with)\b",
+    r"best|worst|consistent(?:ly)? with|everywhere|at every (?:energy|scan energy|E))\b",
     re.I,
 )
 _PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)

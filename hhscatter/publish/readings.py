@@ -167,6 +167,36 @@ def _basins_cutoff(get: Loader) -> str:
     return f"{words} (the measured cut-off lies below the prediction in {s['n_below']} of {s['n_resolved']})"
 
 
+def _basins_energy_scan(get: Loader) -> str:
+    """The energy scan at γ = 0: the exits' Wada test and S_bb against ln 2 energy by energy (S_bb above ln 2 by more
+    than 2σ), α's trend with E (the study's weighted slope) and S_b's (a weighted straight line here)."""
+    doc = get("basins", None)
+    scan = sorted(doc["energy_scan"], key=lambda r: r["energy"])
+    span = f"E = {scan[0]['energy']:g} to {scan[-1]['energy']:g}"
+
+    def every(cells, holds, fails):
+        if all(ok for _, ok in cells):
+            return f"{holds} at all {len(cells)} scan energies ({span})"
+        return pass_fail_words(cells, holds, fails)
+
+    wada = every([(f"{r['energy']:g}", bool(r["wada_exits"])) for r in scan], "Wada", "not Wada")
+    ln2 = math.log(2)
+    fractal = every(
+        [(f"{r['energy']:g}", r["S_bb"] - ln2 > Z_RESOLVED * r["S_bb_err"]) for r in scan],
+        "S_bb above ln 2 by more than 2σ",
+        "S_bb not above ln 2 by 2σ",
+    )
+    a = doc["energy_trend"]["alpha_slope"]
+    alpha = trend_words({"slope": a["value"], "err": a["err"], "z": a["value"] / a["err"]}, "α", "E", "unit energy")
+    s_b = trend_words(
+        trend([r["energy"] for r in scan], [r["S_b"] for r in scan], [r["S_b_err"] for r in scan]),
+        "S_b",
+        "E",
+        "unit energy",
+    )
+    return f"the exit basins are {wada}; {fractal}; {alpha}; {s_b}"
+
+
 def _fig5_premise(get: Loader) -> str:
     d = get("fig5", None)
     g = d["gamma_main"]
@@ -555,6 +585,7 @@ def _noise_no_drag(get: Loader) -> str:
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
+    "basins.energy_scan": _basins_energy_scan,
     "fig5.premise": _fig5_premise,
     "generality.b_onset": _generality_b_onset,
     "generality.one_exponential": _generality_one_exponential,

@@ -30,6 +30,7 @@ from hhscatter.publish.formatting import (
     comparison_table,
     embed_markdown,
     format_value,
+    formula_stars,
     markdown_to_html,
     md_cell,
     scripts_to_html,
@@ -353,7 +354,7 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
                 lines += ["| number | value |", "|---|---|"]
                 lines += [f"| {md_cell(k)} | {md_cell(v)} |" for k, v in headline_numbers(s.numbers)]
                 lines.append("")
-    lines = [typographic_minus("\n".join(lines))]  # the studies' part: a negative number written "−"
+    lines = ["\n".join(lines)]
     for name, title in BENCH_PARTS:
         md, pngs = _bench(root, name)
         lines += [f"## {title}", ""]
@@ -363,7 +364,8 @@ def render_markdown(sections, scale, root, image, *, html_verdicts: bool = False
             lines += [f"![{p.stem}]({image(p, f'{name}-{p.name}')})\n" for p in pngs]
         else:
             lines += [f"*Not generated yet: run `make {name}`.*", ""]
-    return "\n".join(lines) + "\n"
+    # as the docs site writes them: a negative number with "−", the stars of a formula shown, not read as emphasis
+    return formula_stars(typographic_minus("\n".join(lines))) + "\n"
 
 
 _CSS = """

@@ -1,5 +1,6 @@
-"""The built site, once per test session: ``mkdocs build --strict`` into a temporary folder (the browser tests and
-the site checks read it)."""
+"""The built site and the paper-scale reproduction report, once per test session: ``mkdocs build --strict`` into a
+temporary folder (the browser tests and the site checks read it), and ``build_report("paper")`` from the committed
+results into another."""
 
 from __future__ import annotations
 
@@ -22,3 +23,12 @@ def built_site(tmp_path_factory):
     proc = subprocess.run(mkdocs, cwd=ROOT, env=env, capture_output=True, text=True, timeout=900, check=False)
     assert proc.returncode == 0, proc.stderr[-3000:]
     return out
+
+
+@pytest.fixture(scope="session")
+def paper_report_html(tmp_path_factory) -> str:
+    """The HTML of the paper-scale reproduction report, built from the committed results."""
+    from hhscatter.publish.report import build_report
+
+    out = tmp_path_factory.mktemp("report")
+    return build_report("paper", out=out, root=ROOT / "studies")["html"].read_text()

@@ -616,7 +616,7 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
     assert "| two | disk/tangential | 75.0 ± 1.0 ± 5.0 % | 10.0 ± 1.0 ± 5.0 % | < 0.15 % (95 %) |" in out
-    assert "| 0.800 ± 0.004 | < 3.0e-4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
+    assert "| 0.800 ± 0.004 | < 3.0e−4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
 
 
@@ -681,13 +681,13 @@ def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a
 
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
     """The hook's output writes a number's sign "−" (as the verdicts and the [[…]] numbers do); code spans, maths,
-    HTML attributes, ranges and e-notation stay as written."""
+    HTML attributes and ranges stay as written; the exponent of e-notation is signed "−" too."""
     text = (
         "| -0.26 ± 0.19 | (z = -1.1) | [-0.015, +0.029] | 10<sup>-10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
     assert hook.typographic_minus(text) == (
-        "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e-05 |"
+        "| −0.26 ± 0.19 | (z = −1.1) | [−0.015, +0.029] | 10<sup>−10</sup> | `grid[-1]` | $x^{-1}$ | 2.7e−05 |"
         ' <img width="-1"> | x-1 | 0.2-0.5 |'
     )
 
@@ -743,3 +743,24 @@ def test_no_built_number_reads_plus_minus_zero(hook, name):
         text += [f"{k}: {v}" for k, v in headline_numbers(doc, limit=10**6)]
     zero = [m.group(0) for t in text for m in re.finditer(r".{0,40}± 0(?![.,\d]).{0,10}", t)]
     assert not zero, zero[:5]
+
+
+def test_the_heads_of_the_study_tables_wrap_into_short_words(hook):
+    """A results table fits the text column by wrapping its heads: no head of the record tables the pages ask for
+    holds a word longer than 16 characters ("log10(measured/predicted)" kept the cut-off table's reading column
+    narrow)."""
+    long_words = [
+        (table, head)
+        for table, spec in hook.STUDY_TABLES.items()
+        for _, head, *_ in spec
+        if max(len(w) for w in head.split()) > 16
+    ]
+    assert not long_words, long_words
+
+
+def test_the_heads_of_the_study_tables_name_survivors_by_the_glossary(hook):
+    """Orbits still inside are regular, chaotic but confined or censored (the glossary): no head of a record table
+    says "trapped" (the operator's KAM-probe boxes are censored boxes, as its page says)."""
+    heads = [head for spec in hook.STUDY_TABLES.values() for _, head, *_ in spec]
+    assert not [h for h in heads if "trapped" in h.lower()]
+    assert "censored boxes" in heads

@@ -151,6 +151,45 @@ def test_no_panel_is_shown_wider_than_it_is(site, browser):
     assert not upscaled, "panels shown wider than their pixels:\n" + "\n".join(upscaled)
 
 
+#: the right edge of a results table's verdict column (the column headed "verdict…", else its last column: the
+#: reading) and of the box that clips it (the nearest ancestor that scrolls, the table itself included), at 1280 px;
+#: folded blocks are opened first; tables of raw JSON records (every head in code) are left out
+_VERDICT_EDGES = """() => {
+  document.querySelectorAll('article details').forEach(d => { d.open = true; });
+  const out = [];
+  document.querySelectorAll('article table').forEach((t, i) => {
+    const heads = Array.from(t.rows[0] ? t.rows[0].cells : []);
+    if (!heads.length || heads.every(h => h.querySelector('code'))) return;
+    let v = heads.findIndex(h => h.textContent.trim().toLowerCase().startsWith('verdict'));
+    if (v < 0) v = heads.length - 1;
+    let right = window.innerWidth;
+    for (let e = t; e && e !== document.body; e = e.parentElement) {
+      if (getComputedStyle(e).overflowX !== 'visible') right = Math.min(right, e.getBoundingClientRect().right);
+    }
+    out.push([i, heads[v].textContent.trim(), heads[v].getBoundingClientRect().right, right]);
+  });
+  return out;
+}"""
+
+
+def test_no_results_table_scrolls_its_verdict_out_of_view(site, browser):
+    """At 1280 px the verdict column of every results table on the home page, the studies index and the study pages
+    (the column headed "verdict", else the last one, where the tables put their reading) lies inside the viewport
+    and inside the box that would scroll it: the reader sees it without scrolling the table sideways."""
+    checked, hidden = 0, []
+    pages = [Path(site) / "index.html", *sorted((Path(site) / "studies").glob("*.html"))]
+    for path in pages:
+        page, _ = _open(browser, path)
+        page.set_viewport_size({"width": 1280, "height": 900})
+        for i, head, right, clip in page.evaluate(_VERDICT_EDGES):
+            checked += 1
+            if right > clip + 1:
+                hidden.append(f"{path.name} table {i} ({head!r}): ends at {right:.0f} px, visible to {clip:.0f} px")
+        page.close()
+    assert checked >= 40, f"only {checked} results tables measured"
+    assert not hidden, f"{len(hidden)} tables scroll their verdict out of view at 1280 px:\n" + "\n".join(hidden)
+
+
 def test_every_figure_on_every_page_loads(site, browser):
     checked, broken = 0, []
     for path in _pages(site):

@@ -223,7 +223,26 @@ def test_a_count_of_zero_is_written_as_its_one_sided_bound_never_zero_plus_minus
     from hhscatter.analysis.stats.intervals import fraction_with_bound
 
     doc = {"rows": [{"id": "a", **fraction_with_bound(0, 10000).record("P")}, {"id": "b", "P": 0.25, "P_err": 0.01}]}
-    assert nb.format_ref(doc, "rows[id=a].P", ".4f") == "< 3.0e-4 (95 %)"
+    assert nb.format_ref(doc, "rows[id=a].P", ".4f") == "< 3.0e−4 (95 %)"
     assert nb.format_ref(doc, "rows[id=a].P", "pct") == "< 0.030 % (95 %)"
-    assert nb.format_ref(doc, "rows[id=a].P") == "< 3.0e-4 (95 %)"
+    assert nb.format_ref(doc, "rows[id=a].P") == "< 3.0e−4 (95 %)"
     assert nb.format_ref(doc, "rows[id=b].P", ".2f") == "0.25"  # a nonzero count keeps its number
+
+
+def test_a_fraction_of_zero_recorded_without_its_bound_is_written_as_the_bound_from_n():
+    """A record written before bounds were recorded (the paper-scale regular fractions: fraction 0 with a binomial
+    err, no ``fraction_upper``) reads as the one-sided 95 % bound from its ``n``, never "0 %" or "0.00 %"; a
+    fraction of all, as its lower bound. The bounds here are 1 − 0.05^(1/n) and 0.05^(1/n), worked by hand."""
+    doc = {
+        "regular_fraction": [
+            {"id": "hh-1.5", "fraction": 0.0, "err": 5.0e-5, "n": 10000},
+            {"id": "hh-1.05", "fraction": 0.0048, "err": 6.9e-4, "n": 10000},
+            {"id": "all", "fraction": 1.0, "err": 0.0, "n": 20},
+        ],
+        "counts": {"n_regular": 0, "n": 10000},
+    }
+    assert nb.format_ref(doc, "regular_fraction[id=hh-1.5].fraction", "pct") == "< 0.030 % (95 %)"
+    assert nb.format_ref(doc, "regular_fraction[id=hh-1.5].fraction", ".2f") == "< 3.0e−4 (95 %)"
+    assert nb.format_ref(doc, "regular_fraction[id=all].fraction") == "> 0.86 (95 %)"
+    assert nb.format_ref(doc, "regular_fraction[id=hh-1.05].fraction", "pct") == "0.48 %"  # not 0: its number
+    assert nb.format_ref(doc, "counts.n_regular") == "0"  # a count is not a fraction: no bound made up for it

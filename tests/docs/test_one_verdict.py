@@ -100,11 +100,8 @@ def test_the_reader_sees_two_verdicts_of_one_number():
 
 
 @pytest.fixture(scope="module")
-def report_html(tmp_path_factory):
-    from hhscatter.publish.report import build_report
-
-    out = tmp_path_factory.mktemp("report")
-    return build_report("paper", out=out, root=ROOT / "studies")["html"].read_text()
+def report_html(paper_report_html):
+    return paper_report_html  # tests/docs/conftest.py: built once per session
 
 
 def test_a_number_has_one_verdict_on_the_site_and_in_the_report(built_site, report_html):

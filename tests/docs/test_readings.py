@@ -22,12 +22,22 @@ from hhscatter.publish.readings import (
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "studies").glob("*/page.md"))
+#: the pages that report results beside the study pages: the headline results of the README and the docs home (one
+#: template), the home page, the studies index, the paper-scale page
+RESULT_PAGES = [
+    ROOT / "tools" / "readme_results.md",
+    ROOT / "docs" / "index.md",
+    ROOT / "docs" / "studies" / "index.md",
+    ROOT / "docs" / "studies" / "paper-scale.md",
+]
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.parent.name)
+@pytest.mark.parametrize(
+    "page", PAGES + RESULT_PAGES, ids=lambda p: p.parent.name if p.name == "page.md" else p.relative_to(ROOT).as_posix()
+)
 def test_no_study_page_types_a_reading(page):
     found = typed_readings(page.read_text())
-    assert not found, f"{page.parent.name}: readings typed by hand (write [[reading:…]]): {found}"
+    assert not found, f"{page.relative_to(ROOT)}: readings typed by hand (write [[reading:…]]): {found}"
 
 
 def test_the_scan_finds_the_readings_that_were_typed():
@@ -38,6 +48,7 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "The non-regular orbits of Contopoulos and Barbanis never decay as one exponential below 2.6 E_c.",
         "the ratio approaches 1 from below as the barrier grows",
         "b = 0.08 ± 0.07, consistent with a quadratic onset",
+        "The exit basins are Wada at every energy and S_bb > ln 2 everywhere",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -238,6 +249,26 @@ def test_the_hh_1_05_reading_writes_a_hazard_bin_without_escape_as_its_bound():
         "config": {"scene": {"t_max": 800.0}},
     }
     text = READINGS["generality.hh_1_05"](_loader({"generality": doc}))
-    assert "no escape in [400, 800]: < 3.0e-4 (95 %)" in text
-    assert "[800, 1400]: < 2.0e-4 (95 %)" in text and "± 0 " not in text and "nan" not in text
+    assert "no escape in [400, 800]: < 3.0e−4 (95 %)" in text
+    assert "[800, 1400]: < 2.0e−4 (95 %)" in text and "± 0 " not in text and "nan" not in text
     assert "is constant within its errors (weighted mean 0.00300 ± 0.00021" in text
+
+
+def test_the_energy_scan_reading_says_every_energy_only_when_each_one_passes():
+    """Wada and S_bb > ln 2 (by 2σ) are "at all … scan energies" only when each energy says so; otherwise the energies
+    are named. α's trend is the study's weighted slope; S_b's a weighted line through the scan (here flat)."""
+
+    def row(e, wada, s_bb, s_b):
+        return {"energy": e, "wada_exits": wada, "S_bb": s_bb, "S_bb_err": 0.01, "S_b": s_b, "S_b_err": 0.01}
+
+    doc = {
+        "energy_scan": [row(0.2, True, 0.80, 0.50), row(0.3, True, 0.79, 0.51), row(0.4, True, 0.78, 0.50)],
+        "energy_trend": {"alpha_slope": {"value": 2.0, "err": 0.5}},
+    }
+    text = READINGS["basins.energy_scan"](_loader({"basins": doc}))
+    assert text.startswith("the exit basins are Wada at all 3 scan energies (E = 0.2 to 0.4); S_bb above ln 2")
+    assert "α rises with E (weighted slope 2.0 ± 0.5 per unit energy, z = +4.0)" in text
+    assert "S_b shows no trend in E resolved at 2σ" in text
+    doc["energy_scan"][1] = row(0.3, False, 0.70, 0.51)  # not Wada, and S_bb 0.70 within 2σ of ln 2 = 0.693
+    text = READINGS["basins.energy_scan"](_loader({"basins": doc}))
+    assert text.startswith("the exit basins are not Wada at 0.3; Wada at 0.2, 0.4; S_bb not above ln 2 by 2σ at 0.3")
