@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from hhscatter.analysis.geometry import ulam_convergence as uc
-from hhscatter.reproduction.operator_records import kappa_comparisons, kappa_records
+from hhscatter.reproduction.operator_records import cost_rows, kappa_comparisons, kappa_records, probe_islands
 
 EXACT = math.log(4 / 3) / 2  # a quarter of every box leaves per return of time 2: ¾ e^{2κ} = 1
 
@@ -71,3 +71,37 @@ def test_kappa_comparisons_only_where_both_numbers_are_there():
     assert (row["ours"], row["err"], row["paper"], row["paper_err"]) == (0.2, 0.01, 0.23, 0.01)
     assert row["verdict"].startswith("differs")  # |0.2 − 0.23| = 0.03 > 2 √(0.01² + 0.01²)
     assert row["note"] == "fig2 ± 0.01; finest boxes 0.01: κ = 0.19"
+
+
+def test_probe_islands_marks_the_boxes_of_the_censored_probes_only():
+    res = uc.energy_results(_samples(), (-1, 1, -1, 1), 0.5, [1], [16], 16, 0, 1, 1, 0.3)
+    cells = np.arange(16)
+    outcomes = np.array(["escaped"] * 16, dtype=object)
+    outcomes[[3, 7]] = "censored"
+    outcomes[11] = "stopped"  # a probe stopped early says nothing about its box
+    rec = probe_islands(cells, outcomes, res["tr"], res["ids"], res["keep"], res["sub"])
+    assert rec["probes"] == 16 and rec["trapped_boxes"] == 2
+    assert rec["trapped_share_of_saddle_class"] == pytest.approx(2 / 16)  # every box is on the saddle's class
+    assert "kappa_without_trapped_boxes" in rec and len(rec["modes_P"]) == 4
+    none = probe_islands(cells, ["escaped"] * 16, res["tr"], res["ids"], res["keep"], res["sub"])
+    assert none["trapped_boxes"] == 0 and none["trapped_share_of_saddle_class"] == 0.0
+    assert "kappa_without_trapped_boxes" not in none
+
+
+def test_cost_rows_scale_each_route_to_the_target_error():
+    rng = np.random.default_rng(7)
+    t = rng.exponential(1 / 0.05, 20000)
+    lt = pd.DataFrame({"outcome": np.where(t > 100.0, "censored", "escaped"), "t_end": np.minimum(t, 100.0)})
+    rec = {"energy": 0.3, "kappa": 0.05, "kappa_stat_err": 0.001, "discretisation_bias": -0.0005, "err": 0.0012,
+           "orbit_time": 1e5}  # fmt: skip
+    rows = cost_rows({0.3: lt, 0.4: lt}, [rec], {0.3: (0.049, 0.0005)}, 0.01)
+    assert [r["energy"] for r in rows] == [0.3, 0.4]
+    a, b = rows
+    assert abs(a["pt_kappa"] - 0.05) < 4 * a["pt_err"] and a["pt_err"] < 0.05 / 50
+    assert a["pt_orbits"] == 20000 and a["pt_orbit_time"] == pytest.approx(float(np.minimum(t, 100.0).sum()))
+    assert a["pt_orbit_time_1pct"] == pytest.approx(a["pt_orbit_time"] * (a["pt_rel"] / 0.01) ** 2)
+    assert (a["fig2_kappa"], a["fig2_err"]) == (0.049, 0.0005) and math.isnan(b["fig2_kappa"])
+    # the operator's route: statistics 2 % and bias 1 % against 0.71 % each: factors 8 and 2, the larger counts
+    assert a["op_rel"] == pytest.approx(0.024) and a["op_orbit_time_1pct"] == pytest.approx(8e5)
+    assert a["pt_rel_at_op_cost"] == pytest.approx(a["pt_rel"] * math.sqrt(a["pt_orbit_time"] / 1e5))
+    assert "op_kappa" not in b
