@@ -18,14 +18,17 @@ from hhscatter.analysis.stats.measured import Measured
 
 __all__ = [
     "cmeasure_windows",
+    "kappa_cmeasure_entry",
     "kappa_cmeasure_shifts",
     "kappa_cmeasure_z",
     "kappa_law_curves",
     "plot_grid",
+    "rate_row",
     "rate_summary",
     "recording_time",
     "sticky_tail_summary",
     "survival_tables",
+    "tau_star_estimate",
 ]
 
 
