@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import re
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction.verdicts import row_verdict
 
 __all__ = [
@@ -121,8 +122,15 @@ def format_bound(upper=None, lower=None, cl: float = 0.95, *, pct: bool = False)
 
 
 def format_value(v, *, html: bool = False) -> str:
-    """format_value(v) -> text of one numbers-JSON leaf: {value, err} → v ± err, {value, lo, hi} → v [lo, hi],
-    short lists element by element, longer lists and tables by their size."""
+    """format_value(v) -> text of one numbers-JSON leaf: {value, err} (or a
+    :class:`~hhscatter.analysis.stats.measured.Measured`) → v ± err, {value, lo, hi} → v [lo, hi], short lists
+    element by element, longer lists and tables by their size.
+
+    >>> format_value({"value": 0.9123, "err": 0.0031}), format_value(Measured(0.9123, 0.0031)), format_value(Measured(0.9123))
+    ('0.912 ± 0.003', '0.912 ± 0.003', '0.9123')
+    """
+    if isinstance(v, Measured):
+        v = v.to_dict()
     if isinstance(v, dict) and "value" in v:
         if v.get("value") is None:
             return "—"
@@ -163,6 +171,8 @@ def format_leaf(key: str, v, *, html: bool = False) -> str:
     '0'
     """
     name = str(key).rsplit(".", 1)[-1]
+    if isinstance(v, Measured):
+        v = v.to_dict()
     if (
         isinstance(v, dict)
         and v.get("value") == 0

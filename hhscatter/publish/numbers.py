@@ -53,6 +53,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from hhscatter.analysis.stats.intervals import fraction_with_bound
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.publish.formatting import format_bound, format_number, format_value_err, typographic_minus
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
@@ -261,30 +262,41 @@ def format_leaf(leaf, fmt: str | None = None) -> str:
     """format_leaf(JSON leaf, format) -> its text (see _format_leaf); a negative number with the minus sign "−"
     (:func:`hhscatter.publish.formatting.typographic_minus`, as the docs tables and the report write it)."""
     out = _format_leaf(leaf, fmt)
-    if isinstance(leaf, str) or (isinstance(leaf, dict) and isinstance(leaf.get("value"), str)):
+    value = leaf.value if isinstance(leaf, Measured) else leaf.get("value") if isinstance(leaf, dict) else None
+    if isinstance(leaf, str) or isinstance(value, str):
         return out
     return typographic_minus(out)
+
+
+def _measured(value, err) -> Measured:
+    """A leaf's value with its error as :class:`~hhscatter.analysis.stats.measured.Measured`: an error that is no
+    number (None, text) is NaN, not measured; the value is kept as it is (a number, or text to write as it is)."""
+    return Measured(value, err if _is_num(err) else math.nan)
 
 
 def _format_leaf(leaf, fmt: str | None = None) -> str:
     """format_leaf(JSON leaf, format) -> its text (see the module doc for the formats).
 
-    A ``{value, err}`` leaf is written ``value ± err`` with the error's
-    significant digits; ``{value, lo, hi}`` as ``value [lo, hi]``; a number
-    without error with 4 significant digits; text as it is. A missing value
-    (None, NaN) is an error, never "nan".
+    A ``{value, err}`` leaf (or a :class:`~hhscatter.analysis.stats.measured.Measured`) is written
+    ``value ± err`` with the error's significant digits, or ``value`` alone when its error is missing,
+    None, NaN or 0; ``{value, lo, hi}`` as ``value [lo, hi]``; a number without error with 4 significant
+    digits; text as it is. A missing value (None, NaN) is an error, never "nan".
 
     Examples
     --------
     >>> leaf = {"value": 1.4348590, "err": 0.0170464}
     >>> format_leaf(leaf), format_leaf(leaf, "value"), format_leaf(leaf, "err"), format_leaf(0.0623, "pct")
     ('1.435 ± 0.017', '1.435', '0.017', '6.23 %')
+    >>> format_leaf(Measured(0.0623, 0.0011), "pct"), format_leaf(Measured(0.0623), "pct")
+    ('6.23 ± 0.11 %', '6.23 %')
     """
     fmt = (fmt or "").strip()
     value, err = leaf, None
     if isinstance(leaf, dict) and "value" not in leaf and "ours" in leaf:  # a paper-vs-ours row: our number
-        leaf = {"value": leaf["ours"], "err": leaf.get("err")}
-    if isinstance(leaf, dict):
+        leaf = _measured(leaf["ours"], leaf.get("err"))
+    if isinstance(leaf, Measured):
+        value, err = leaf.value, leaf.err
+    elif isinstance(leaf, dict):
         if "value" not in leaf:
             raise NumberRefError(f"a mapping with keys {sorted(leaf)[:8]}: name one of them")
         value, err = leaf["value"], leaf.get("err")
@@ -303,7 +315,7 @@ def _format_leaf(leaf, fmt: str | None = None) -> str:
         value, fmt = abs(value), ""
     if fmt == "pct":
         value, err, fmt = 100 * value, (100 * err if has_err else err), ""
-        return _format_leaf({"value": value, "err": err}) + " %"
+        return _format_leaf(_measured(value, err)) + " %"
     if fmt == "":
         return format_value_err(value, err) if has_err else _num(value)
     if fmt in ("value", "err"):
@@ -383,7 +395,7 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
             raise NumberRefError("the format 'verdict' needs a paper-vs-ours row (with 'ours') or a claim record")
         return _rule_verdict(leaf, scale)
     if (fmt or "").strip() == "pm" and _is_num(leaf):  # a number beside its error <key>_err
-        return format_leaf({"value": leaf, "err": resolve(doc, path.strip() + "_err")})
+        return format_leaf(_measured(leaf, resolve(doc, path.strip() + "_err")))
     if (fmt or "").strip().startswith("ci") and _is_num(leaf):
         leaf = [leaf, resolve(doc, path.strip() + "_interval")]
     return format_leaf(leaf, fmt)

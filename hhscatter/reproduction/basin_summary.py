@@ -42,6 +42,7 @@ __all__ = [
     "energy_trend",
     "entropy_exponents",
     "SCAN_COLUMNS",
+    "comparison_rows",
     "kantz_grassberger",
     "map_measures",
     "outcome_codes",
@@ -506,6 +507,62 @@ def entropy_by_box_at(records, sides=(0.025, 0.05)) -> list:
     """
     keep = [r for r in records if any(abs(r["box_side"] - s) < 1e-9 for s in sides)]
     return sorted(keep, key=lambda r: (r["E0"], r["gamma"], r["box_side"], r["grid"]))
+
+
+def comparison_rows(per, hb) -> list[dict]:
+    """The comparison rows of the basin records ``per`` (:func:`point_record`), for a study's ``compare``: the
+    uncertainty exponent α, the boundary basin entropy S_bb at the headline box ``hb`` (against ln 2, sufficient
+    for a fractal boundary) and, for γ > 0, the cut-off ε_c of the power law f(ε) that the paper expects.
+
+    Each row holds quantity, ours, err and note (α and S_bb dimensionless, ε_c in position units); a record
+    without α, S_bb or a cut-off gives no such row.
+
+    Examples
+    --------
+    >>> rec = {"energy": 0.25, "gamma": 0.01, "alpha": {"value": 0.31, "err": 0.02}, "alpha_fit_range": [1e-6, 1e-3],
+    ...        "d": {"value": 1.69}, "S_bb": None, "cutoff": {"detected": False, "eps_c_hi": 2e-6}}
+    >>> [(r["quantity"], r["ours"]) for r in comparison_rows([rec], 10)]
+    [('uncertainty exponent α (E0=0.25, γ=0.01)', 0.31), ('cut-off ε_c of the power law f(ε) (E0=0.25, γ=0.01)', None)]
+    """
+    rows = []
+    for p in per:
+        tag = f"E0={p['energy']:g}, γ={p['gamma']:g}"
+        if p["alpha"]:
+            rows.append(
+                {
+                    "quantity": f"uncertainty exponent α ({tag})",
+                    "ours": p["alpha"]["value"],
+                    "err": p["alpha"]["err"],
+                    "note": f"f(ε) ∝ ε^α on ε ∈ [{p['alpha_fit_range'][0]:.0e}, {p['alpha_fit_range'][1]:.0e}];"
+                    f" d = 2 − α = {p['d']['value']:.3f}",
+                }
+            )
+        if p["S_bb"]:
+            rows.append(
+                {
+                    "quantity": f"boundary basin entropy S_bb ({tag}, box {hb})",
+                    "ours": p["S_bb"]["value"],
+                    "err": p["S_bb"]["err"],
+                    "note": "S_bb > ln 2 is sufficient for a fractal boundary: "
+                    + ("yes" if p["log2_fractal"] else "not shown"),
+                }
+            )
+        if p["cutoff"] is not None and p["gamma"] > 0:
+            c = p["cutoff"]
+            rows.append(
+                {
+                    "quantity": f"cut-off ε_c of the power law f(ε) ({tag})",
+                    "ours": c["eps_c"] if c["detected"] else None,
+                    "err": None,
+                    "note": (
+                        f"detected, 1σ [{c['eps_c_lo']:.2g}, {c['eps_c_hi']:.2g}]"
+                        if c["detected"]
+                        else f"none seen: ε_c < {c['eps_c_hi']:.2g}"
+                    )
+                    + " (paper: expected for γ > 0)",
+                }
+            )
+    return rows
 
 
 def point_table(per) -> list:

@@ -6,6 +6,7 @@ in an energy band around E1 (Fig. 5b), are compared with samples of the conserva
 μ_c^{E2}:
 
 * :func:`crossing_sets` — the Fig. 5a/5b sets of one run and their counts;
+* :func:`authors_record` — the summary rows of the authors' own 5a and 5b runs, in their convention;
 * :func:`distance_tables` — Hellinger and TV on box histograms against the box side ε with split-half noise
   floors, bootstrap errors and the agreement scales ε*_2σ and ε*_δ, and the sliced Wasserstein distance, at one
   common split-half sample size (:func:`common_sample_size`);
@@ -33,6 +34,7 @@ from hhscatter.analysis.geometry import paired_distance as pdist
 __all__ = [
     "DIFFERENCE_CONSTRUCTIONS",
     "ComparisonSettings",
+    "authors_record",
     "cap_rows",
     "common_sample_size",
     "crossing_sets",
@@ -270,6 +272,43 @@ def distance_tables(sets: dict, refs: dict, usable: dict, m_common: int, s: Comp
             }
         )
     return pd.concat(rows, ignore_index=True), pd.DataFrame(summary)
+
+
+def authors_record(sets: dict, refs: dict, convention: str, s: ComparisonSettings) -> dict:
+    """The record of a Fig. 5 construction other than ours (the authors' runs): point counts and summary rows.
+
+    ``sets`` {(group, label): DataFrame with x, y}: the sets of that construction, already cut and capped as it
+    plots them; ``refs`` {"E1", "E2": (n, 2) c-measure points}; ``convention`` the sentence that states the
+    construction. The rows are the summary of :func:`distance_tables` (distances at ``s.box_headline`` to μ_c^{E1}
+    and μ_c^{E2}, each set at its common split-half size against E1), without the μ_c^{E2}-against-μ_c^{E1} row;
+    None when no set has 2·``s.m_min`` points (:func:`common_sample_size`).
+
+    Returns
+    -------
+    dict
+        convention, n_points ({label: number of points}) and rows (list of dicts or None).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> s = ComparisonSettings((-1, 1, -1, 1), (1.0, 0.5), 0.5, n_splits=2, n_boot=3, n_proj=4, z=2, delta=0.1,
+    ...                        noise_max=0.5, n_cap=10**4, m_min=5, seed=1)
+    >>> pts = lambda n: pd.DataFrame(rng.uniform(-1, 1, (n, 2)), columns=["x", "y"])
+    >>> refs = {"E1": rng.uniform(-1, 1, (80, 2)), "E2": rng.uniform(-1, 1, (80, 2))}
+    >>> rec = authors_record({("authors", "5a"): pts(60), ("authors", "5b"): pts(30)}, refs, "their runs", s)
+    >>> rec["n_points"], [(r["set"], r["ref"], r["m"]) for r in rec["rows"]]
+    ({'5a': 60, '5b': 30}, [('5a', 'E1', 15), ('5a', 'E2', 30), ('5b', 'E1', 15), ('5b', 'E2', 15)])
+    >>> authors_record({("authors", "5a"): pts(6)}, refs, "their runs", s)["rows"] is None
+    True
+    """
+    out = {"convention": convention, "n_points": {k[1]: len(v) for k, v in sets.items()}, "rows": None}
+    try:
+        usable, m = common_sample_size(sets, refs["E1"], s.m_min)
+    except ValueError:
+        return out
+    _, stab = distance_tables(sets, refs, usable, m, s)
+    out["rows"] = stab[stab["set"] != "cm_E2"].reset_index(drop=True).to_dict(orient="records")
+    return out
 
 
 def interval_record(values, level: float) -> dict:

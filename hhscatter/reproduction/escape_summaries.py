@@ -18,13 +18,17 @@ from hhscatter.analysis.stats.measured import Measured
 
 __all__ = [
     "cmeasure_windows",
+    "kappa_cmeasure_entry",
     "kappa_cmeasure_shifts",
     "kappa_cmeasure_z",
     "kappa_law_curves",
     "plot_grid",
+    "rate_row",
     "rate_summary",
+    "recording_time",
     "sticky_tail_summary",
     "survival_tables",
+    "tau_star_estimate",
 ]
 
 
@@ -164,12 +168,29 @@ def kappa_law_curves(fits: dict, x_max: float, E_c: float) -> pd.DataFrame:
     return pd.concat(parts, ignore_index=True)
 
 
+def recording_time(kappa: float, tau0: float, rec_efolds: float) -> float:
+    """The time from which an ensemble's section crossings sample the c-measure: t_rec = ceil(τ0 + n/κ) (time units).
+
+    ``kappa`` the escape rate (1/time, finite and > 0, else ValueError), ``tau0`` the start of its exponential
+    regime (time units), ``rec_efolds`` the e-folds n of relaxation towards μ_c after it.
+
+    Examples
+    --------
+    >>> recording_time(0.2, 3.2, 2.0)
+    14.0
+    """
+    if not (math.isfinite(kappa) and kappa > 0):
+        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
+    return float(math.ceil(tau0 + rec_efolds / kappa))
+
+
 def cmeasure_windows(
     kappa: float, tau0: float, rec_efolds: float, sample_efolds: float, margin: float, max_shift_efolds: float = 0.0
 ) -> tuple[float, float, float]:
     """The sampling window of κ from the c-measure, (t_rec, t_sample_end, t_record_end) in time units.
 
-    t_rec = ceil(τ0 + n_rec/κ): the ensemble is in its exponential regime and relaxed towards μ_c; crossings are
+    t_rec = ceil(τ0 + n_rec/κ) (:func:`recording_time`): the ensemble is in its exponential regime and relaxed
+    towards μ_c; crossings are
     sampled in [t_rec, t_sample_end = t_rec + n_sample/κ]; the recording goes on to t_record_end = t_sample_end +
     max_shift/κ + margin, so that the same window started up to ``max_shift_efolds``/κ later (a convergence check)
     still sees every sampled crossing's next crossing or exit.
@@ -179,9 +200,7 @@ def cmeasure_windows(
     >>> cmeasure_windows(0.2, 3.2, 2.0, 4.0, 40.0)
     (14.0, 34.0, 74.0)
     """
-    if not (math.isfinite(kappa) and kappa > 0):
-        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
-    t_rec = float(math.ceil(tau0 + rec_efolds / kappa))
+    t_rec = recording_time(kappa, tau0, rec_efolds)
     t_sample_end = t_rec + sample_efolds / kappa
     return t_rec, float(t_sample_end), float(t_sample_end + max_shift_efolds / kappa + margin)
 

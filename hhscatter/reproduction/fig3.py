@@ -37,7 +37,9 @@ __all__ = [
     "add_bootstrap_errors",
     "authors_convention",
     "fit_windows",
+    "histogram_edges",
     "histogram_rows",
+    "mean_energy_table",
     "mu_table",
     "nearest_times",
     "paper_fit",
@@ -55,6 +57,43 @@ _WHO = {"inside": "every orbit inside Ω", "above": "orbits with E > E_c only"} 
 
 def _window_text(w) -> str:
     return f"[{w[0]:g}, {w[1]:g}]"
+
+
+def mean_energy_table(inside: pd.DataFrame, above: pd.DataFrame) -> pd.DataFrame:
+    """Fig. 3's ⟨E⟩(t) table: the mean over the orbits inside Ω with its ± 3 SEM band, beside the mean over those
+    above E_c.
+
+    ``inside`` and ``above``: :func:`~hhscatter.analysis.dissipative.decay.mean_energy` tables (t, n, mean_E,
+    sem_E, …) of the two selections (:func:`~hhscatter.analysis.dissipative.decay.inside_mean_energy`). Returns
+    ``inside`` with lo_3sem, hi_3sem = mean_E ∓ 3 sem_E and, per t, n_above (0 where no orbit is above E_c),
+    mean_E_above and sem_E_above (NaN there). Energies in model units, t in time units.
+
+    Examples
+    --------
+    >>> inside = pd.DataFrame({"t": [0.0, 10.0], "n": [4, 4], "mean_E": [0.3, 0.2], "sem_E": [0.0, 0.01]})
+    >>> above = pd.DataFrame({"t": [0.0], "n": [4], "mean_E": [0.3], "sem_E": [0.0]})
+    >>> me = mean_energy_table(inside, above)
+    >>> me[["lo_3sem", "hi_3sem", "n_above"]].round(6).values.tolist()
+    [[0.3, 0.3, 4.0], [0.17, 0.23, 0.0]]
+    """
+    me = inside.assign(lo_3sem=inside["mean_E"] - 3 * inside["sem_E"], hi_3sem=inside["mean_E"] + 3 * inside["sem_E"])
+    ma = above.rename(columns={"n": "n_above", "mean_E": "mean_E_above", "sem_E": "sem_E_above"})
+    me = me.merge(ma[["t", "n_above", "mean_E_above", "sem_E_above"]], on="t", how="left")
+    me["n_above"] = me["n_above"].fillna(0).astype(np.int64)
+    return me
+
+
+def histogram_edges(energies, E0: float, bins: int) -> np.ndarray:
+    """The energy bin edges of the inset's histograms: ``bins`` geometric bins from just below the lowest of
+    ``energies`` (floored at 1e-12) to just above the initial energy ``E0`` (energy units).
+
+    Examples
+    --------
+    >>> histogram_edges([0.05, 0.2], 0.3, 2).round(6).tolist()
+    [0.049, 0.121304, 0.3003]
+    """
+    lo = max(float(np.nanmin(energies)), 1e-12)
+    return np.geomspace(lo * 0.98, E0 * 1.001, bins + 1)
 
 
 def paper_fit(me: pd.DataFrame, E0: float, gamma: float, window):

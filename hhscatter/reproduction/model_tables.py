@@ -46,7 +46,9 @@ __all__ = [
     "pair_fits",
     "survival_grid_curve",
     "tau2_curve",
+    "tau2_reference",
     "tau_predictions",
+    "tau_reference",
     "tau_vs_gamma",
     "value_and_err",
 ]
@@ -265,6 +267,65 @@ def value_and_err(v):
     if isinstance(v, dict):
         return number_or_none(v.get("value")), number_or_none(v.get("err"))
     return number_or_none(v), None
+
+
+def tau_reference(rows, lifetimes: dict, *, E0: float, dt: float, fields=("gamma", "tau1", "tau2")) -> TauReference:
+    """The observed transition times of paired ensembles and their lifetimes, as panel (b)'s :class:`TauReference`.
+
+    ``rows``: the rows of a τ table (a list of dicts or a DataFrame) with the fields ``fields`` = (γ, τ1, τ2), the
+    times as numbers-JSON leaves ``{"value", "err"}`` or plain numbers (:func:`value_and_err`); ``lifetimes``:
+    {γ: DataFrame(t_end, outcome)} of the paired runs at initial energy ``E0``, γ = 0 among them (the
+    conservative reference, whose Kaplan–Meier P(t) on a grid of step ``dt`` becomes ``P_0``:
+    :func:`survival_grid_curve`). The runs of the table's γ > 0 are kept; a γ of the table without a run has no
+    lifetimes. Times in model time units.
+
+    Examples
+    --------
+    >>> rows = [{"gamma": 0.01, "tau1": {"value": 120.0, "err": 4.0}, "tau2": 300.0}]
+    >>> lt = pd.DataFrame({"t_end": [1.0, 2.0], "outcome": ["escaped", "escaped"]})
+    >>> ref = tau_reference(rows, {0.0: lt, 0.01: lt, 0.02: lt}, E0=0.3, dt=1.0)
+    >>> ref.obs.values.tolist(), sorted(ref.lifetimes), ref.P_0[1].tolist()
+    ([[0.01, 120.0, 4.0, 300.0, None]], [0.01], [1.0, 0.5, 0.0])
+    """
+    gcol, t1, t2 = fields
+    table = pd.DataFrame(rows)
+    obs = pd.DataFrame(
+        {
+            "gamma": table[gcol].astype(float),
+            "tau1_observed": [value_and_err(v)[0] for v in table[t1]],
+            "tau1_err": [value_and_err(v)[1] for v in table[t1]],
+            "tau2_observed": [value_and_err(v)[0] for v in table[t2]],
+            "tau2_err": [value_and_err(v)[1] for v in table[t2]],
+        }
+    )
+    t0c, P0c, _ = survival_grid_curve(lifetimes[0.0], dt)
+    kept = {g: lifetimes[g] for g in obs["gamma"] if g > 0 and g in lifetimes}
+    return TauReference(obs, kept, (t0c, P0c), E0)
+
+
+def tau2_reference(lifetimes: dict, E0: float) -> TauReference:
+    """Panel (b)'s :class:`TauReference` from dissipative runs alone: τ2 observed (:func:`~hhscatter.analysis.dissipative.transitions.tau2_observed`), no τ1.
+
+    ``lifetimes``: {γ > 0: DataFrame(t_end, outcome)} of runs at initial energy ``E0``; without a conservative
+    run there is no P_0 and no τ1 (their columns hold None). Times in model time units.
+
+    Examples
+    --------
+    >>> lt = pd.DataFrame({"t_end": [5.0, 3.0, 9.0], "outcome": ["escaped", "settled", "settled"]})
+    >>> ref = tau2_reference({0.01: lt}, 0.3)
+    >>> ref.obs.to_dict(orient="records"), ref.P_0
+    ([{'gamma': 0.01, 'tau1_observed': None, 'tau1_err': None, 'tau2_err': None, 'tau2_observed': 3.0}], None)
+    """
+    obs = pd.DataFrame(
+        {
+            "gamma": sorted(lifetimes),
+            "tau1_observed": None,
+            "tau1_err": None,
+            "tau2_err": None,
+            "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)],
+        }
+    )
+    return TauReference(obs, lifetimes, None, E0)
 
 
 def tau_vs_gamma(ref: TauReference, *, kappa, mu, mu_err, tau0, E_c, hazards, dt, fit_dt, min_count, alpha):

@@ -3,9 +3,10 @@
 :func:`kappa_records` turns the operator's results per energy
 (:func:`~hhscatter.analysis.geometry.ulam_convergence.energy_results`) into the records of κ, of its convergence
 and of the mixed phase space, with the comparison rows of the extrapolated κ against the reference κ0
-(:func:`kappa_comparisons`); :func:`dissipative_comparison` predicts P(t) and the first crossing after t* of a
-dissipative ensemble with the operator on (box × energy bin) and sets them beside the simulated ensemble. Nothing
-here reads a file. Units: κ in 1/time, times in time units, energies in energy units, box sides in the section's
+(:func:`kappa_comparisons`); :func:`probe_islands` marks the KAM boxes that probe orbits found;
+:func:`dissipative_comparison` predicts P(t) and the first crossing after t* of a dissipative ensemble with the
+operator on (box × energy bin) and sets them beside the simulated ensemble; :func:`cost_rows` sets the orbit-time
+of the operator's κ beside that of P(t)'s. Nothing here reads a file. Units: κ in 1/time, times in time units, energies in energy units, box sides in the section's
 units.
 """
 
@@ -18,9 +19,11 @@ from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.analysis.stats.verdicts import verdict
+from hhscatter.analysis.survival.escape_rate import escape_rate
 from hhscatter.analysis.survival.fits import observed_from_outcome
+from hhscatter.outcomes import CENSORED, OUTCOMES
 
-__all__ = ["dissipative_comparison", "kappa_comparisons", "kappa_records"]
+__all__ = ["cost_rows", "dissipative_comparison", "kappa_comparisons", "kappa_records", "probe_islands"]
 
 
 def kappa_records(results: dict, kappa0: dict, kappa_cm: dict, *, samples, box, grid_energies, verdicts: bool) -> dict:
@@ -136,3 +139,62 @@ def dissipative_comparison(tab, lifetimes, sections, *, extent, box, edges, radi
         ignore_index=True,
     )
     return numbers, curves, pts, dtab
+
+
+def probe_islands(cells, outcomes, tr, ids, keep, sub) -> dict:
+    """Mixed phase space from KAM probes: one probe orbit per finest box, trapped where it is still inside at its end.
+
+    ``cells`` are the probes' finest boxes and ``outcomes`` their outcome names, in the same order; a probe whose
+    outcome is ``censored`` marks its box trapped. The trapped boxes are set against the operator on the states
+    ``ids`` of ``tr`` (saddle class ``keep``, its matrix ``sub``) by
+    :func:`~hhscatter.analysis.geometry.ulam.islands_record`.
+
+    Returns
+    -------
+    dict
+        probes (their number) and the fields of :func:`~hhscatter.analysis.geometry.ulam.islands_record`.
+
+    Examples
+    --------
+    Two boxes (ids 5 and 9) that send half their samples to each other and lose the other half; the probe of box 9
+    stayed inside:
+
+    >>> import numpy as np
+    >>> from hhscatter.analysis.geometry import transfer as tf
+    >>> tr = tf.Transitions(np.array([0, 0, 1, 1]), np.array([1, -1, 0, -1]), np.ones(4), 2, np.ones(4))
+    >>> keep, sub = ulam.saddle_kappa(tr)[3:]
+    >>> rec = probe_islands([5, 9], ["escaped", "censored"], tr, np.array([5, 9]), keep, sub)
+    >>> rec["probes"], rec["trapped_boxes"], rec["trapped_share_of_saddle_class"]
+    (2, 1, 0.5)
+    """
+    cells = np.asarray(cells)
+    trapped = cells[np.asarray(outcomes).astype(str) == OUTCOMES[CENSORED]]
+    return {"probes": int(len(cells)), **ulam.islands_record(trapped, tr, ids, keep, sub)}
+
+
+def cost_rows(lifetimes: dict, records: list, kappa0: dict, target_rel: float) -> list[dict]:
+    """Orbit-time of each route to κ at the relative error ``target_rel``, one row per energy.
+
+    ``lifetimes``: {E: DataFrame(outcome, t_end)} of a plain P(t) run at each energy; its κ is the escape rate
+    of :func:`~hhscatter.analysis.survival.escape_rate.escape_rate` (no tail detection, windows kept where at
+    least 100 orbits survive), its cost the summed orbit time (time units). ``records``: the operator's κ records
+    (dicts with ``energy``; an energy without one gets the P(t) route only); ``kappa0``: {E: (κ0, err)} of the
+    reference. The row is :func:`~hhscatter.analysis.geometry.ulam.cost_row`'s.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> t = np.random.default_rng(1).exponential(1 / 0.05, 5000)
+    >>> (row,) = cost_rows({0.3: pd.DataFrame({"outcome": "escaped", "t_end": t})}, [], {}, 0.01)
+    >>> row["pt_orbits"], bool(abs(row["pt_kappa"] - 0.05) < 3 * row["pt_err"]), "op_kappa" in row
+    (5000, True, False)
+    """
+    rows = []
+    for E, lt in lifetimes.items():
+        r = escape_rate(
+            lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False, min_survivors=100.0
+        )
+        pt = {"kappa": r.kappa, "kappa_err": r.kappa_err, "orbits": len(lt), "orbit_time": float(lt["t_end"].sum())}
+        rec = next((x for x in records if np.isclose(x["energy"], E)), None)
+        rows.append(ulam.cost_row(E, pt, rec, kappa0, target_rel))
+    return rows

@@ -254,7 +254,8 @@ def analyze(study):
     trend = bs.energy_trend(scan, E_b)
     zooms, centre = _zoom_maps(study, extent, n)
     study.write_table(zooms, "basins_zooms.parquet", grid=study.params.zoom_grid)
-    _compare_with_paper(study, per, hb)
+    for row in bs.comparison_rows(per, hb):  # α, S_bb against ln 2, the paper's expected cut-off for γ > 0
+        study.compare(**row)
     study.write_numbers(
         {
             "codes": dict(zip(CODE_NAMES, CODES)),
@@ -331,41 +332,6 @@ def _zoom_maps(study, extent, n):
                 )
             )
     return pd.concat(zooms, ignore_index=True), centre
-
-
-def _compare_with_paper(study, per, hb):
-    """The comparisons of the report: α, S_bb against ln 2 and the paper's expected cut-off ε_c for γ > 0."""
-    for p in per:
-        tag = f"E0={p['energy']:g}, γ={p['gamma']:g}"
-        if p["alpha"]:
-            study.compare(
-                f"uncertainty exponent α ({tag})",
-                p["alpha"]["value"],
-                p["alpha"]["err"],
-                note=f"f(ε) ∝ ε^α on ε ∈ [{p['alpha_fit_range'][0]:.0e}, {p['alpha_fit_range'][1]:.0e}];"
-                f" d = 2 − α = {p['d']['value']:.3f}",
-            )
-        if p["S_bb"]:
-            study.compare(
-                f"boundary basin entropy S_bb ({tag}, box {hb})",
-                p["S_bb"]["value"],
-                p["S_bb"]["err"],
-                note="S_bb > ln 2 is sufficient for a fractal boundary: "
-                + ("yes" if p["log2_fractal"] else "not shown"),
-            )
-        if p["cutoff"] is not None and p["gamma"] > 0:
-            c = p["cutoff"]
-            study.compare(
-                f"cut-off ε_c of the power law f(ε) ({tag})",
-                c["eps_c"] if c["detected"] else None,
-                None,
-                note=(
-                    f"detected, 1σ [{c['eps_c_lo']:.2g}, {c['eps_c_hi']:.2g}]"
-                    if c["detected"]
-                    else f"none seen: ε_c < {c['eps_c_hi']:.2g}"
-                )
-                + " (paper: expected for γ > 0)",
-            )
 
 
 def _upstream_value(study, role, key_param):

@@ -37,11 +37,11 @@ gives t_rec per energy (``cmeasure_sample``).
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
 from hhscatter.analysis.stats.verdicts import half_unit
+from hhscatter.reproduction.escape_summaries import recording_time
 from hhscatter.reproduction.fig1 import energy_record
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.scene.schema import Integer, Number, Numbers
@@ -90,13 +90,6 @@ def _pilot_rate(pilot_dir):
 
     lt = read_lifetimes(pilot_dir, columns=["traj_id", "e0", "gamma", "outcome", "t_end"])
     return escape_rate_from_lifetimes(lt, detect_tail=False)
-
-
-def recording_time(kappa: float, tau0: float, rec_efolds: float) -> float:
-    """recording_time(κ, τ0, n) -> t_rec = ceil(τ0 + n/κ) (time units), the sprinkler rule."""
-    if not (math.isfinite(kappa) and kappa > 0):
-        raise ValueError(f"kappa must be finite and > 0, got {kappa}")
-    return float(math.ceil(tau0 + rec_efolds / kappa))
 
 
 def _main_scene(study, energy, t_rec):

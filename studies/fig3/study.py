@@ -56,7 +56,9 @@ from hhscatter.reproduction.fig3 import (
     add_bootstrap_errors,
     decay_results,
     fit_windows,
+    histogram_edges,
     histogram_rows,
+    mean_energy_table,
     mu_table,
     nearest_times,
     paper_fit,
@@ -161,20 +163,14 @@ def analyze(study):
 
 
 def _mean_energy(study, key: str, E_C: float):
-    """Read inputs: the ⟨E⟩(t) table (inside Ω and above E_c, ± 3 SEM), the continuation counts, the lifetimes."""
+    """Read inputs: the ⟨E⟩(t) table (:func:`~hhscatter.reproduction.fig3.mean_energy_table`), the continuation
+    counts, the lifetimes."""
     from hhscatter.analysis.dissipative.decay import inside_mean_energy
     from hhscatter.data.read import iter_parts, read_lifetimes
 
     ime = inside_mean_energy(iter_parts(study.raw(key), "snapshots", ["t", "energy"]), E_C)
-    me, ma, cont = ime.inside, ime.above, {"rows_below_ec": ime.rows_below_ec}
     lt = read_lifetimes(study.raw(key), columns=["outcome", "t_end"], categorical=True)
-
-    me["lo_3sem"] = me["mean_E"] - 3 * me["sem_E"]
-    me["hi_3sem"] = me["mean_E"] + 3 * me["sem_E"]
-    ma = ma.rename(columns={"n": "n_above", "mean_E": "mean_E_above", "sem_E": "sem_E_above"})
-    me = me.merge(ma[["t", "n_above", "mean_E_above", "sem_E_above"]], on="t", how="left")
-    me["n_above"] = me["n_above"].fillna(0).astype(np.int64)
-    return me, cont, lt
+    return mean_energy_table(ime.inside, ime.above), {"rows_below_ec": ime.rows_below_ec}, lt
 
 
 def _bootstrap_mu(study, key, n_orbits, E0, gamma, E_C, windows, window, alt):
@@ -207,8 +203,7 @@ def _histograms(study, key, me, E0: float):
 
     hist_times = list(study.params.hist_times)
     at = _snapshot_rows(study, key, filters=ds.field("t").isin(list(nearest_times(me["t"].to_numpy(), hist_times))))
-    lo = max(float(at["energy"].min()), 1e-12)
-    edges = np.geomspace(lo * 0.98, E0 * 1.001, study.params.hist_bins + 1)
+    edges = histogram_edges(at["energy"].to_numpy(), E0, study.params.hist_bins)
     h = energy_histograms(at, hist_times, bins=edges)
     return histogram_rows(h, edges), h
 

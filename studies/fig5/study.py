@@ -196,7 +196,7 @@ def simulate(study, workers=None, progress=True):
         study.run(key, _authors_scene(study, key), workers=workers, progress=progress)
 
 
-def _authors_sets(study, keys=tuple(AUTHORS)):
+def _authors_sets(study, keys):
     """{('authors', key): points}: the first crossing of each orbit of the authors' runs ``keys``, kept where
     r < r_cut (their plots), capped at n_cap points."""
     from hhscatter.data.read import read_sections
@@ -206,28 +206,6 @@ def _authors_sets(study, keys=tuple(AUTHORS)):
     for key in keys:
         sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "energy"])
         out[("authors", key)] = cc.cap_rows(cc.within_radius(sec, study.params.r_cut), n_cap, seed)
-    return out
-
-
-def _authors_record(study, refs) -> dict:
-    """The JSON record of the authors' own Fig. 5 convention (square ICs; 5a: first crossing with 17 < t < 30;
-    5b: first crossing in the energy band at any time; r < 1): point counts and the summary rows of their 5a and
-    5b sets (distances at the headline box to μ_c^{E1} and μ_c^{E2}, each at its own common sample size); rows
-    None if the sets are too small (tiny scale). Its paper-comparison rows are paired
-    (:func:`~hhscatter.reproduction.cmeasure_comparison.reference_record`,
-    :func:`~hhscatter.reproduction.cmeasure_comparison.difference_record`)."""
-    sets = _authors_sets(study)
-    out = {
-        "convention": AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band)),
-        "n_points": {k[1]: len(v) for k, v in sets.items()},
-        "rows": None,
-    }
-    try:
-        usable, m = cc.common_sample_size(sets, refs["E1"], study.params.m_min)
-    except ValueError:
-        return out
-    _, stab = cc.distance_tables(sets, refs, usable, m, cc.ComparisonSettings.from_params(study.params))
-    out["rows"] = stab[stab["set"] != "cm_E2"].reset_index(drop=True).to_dict(orient="records")
     return out
 
 
@@ -304,10 +282,17 @@ def analyze(study):
     paper = {"t_star": PAPER_T_STAR, "fraction": PAPER_N_PLOTTED / PAPER_N}
     mu_kw = {"mu": mu, "mu_err": mu_err, "mu_source": inputs["mu"]["source"]}
     rows, verdicts = cv.closer_comparisons(pg, stab, g_main, **mu_kw, E1=E1, paper=paper)
-    authors = _authors_record(study, refs)
-    main_sets = (sets[(g_main, "a")], sets[(g_main, "b")])
     # the authors' runs, cut at r < r_cut like their plots (the sensitivity runs too)
     auth = _authors_sets(study, (*AUTHORS, *SENSITIVITY))
+    # their own Fig. 5 convention (square ICs; 5a: first crossing with 17 < t < 30; 5b: first crossing in the
+    # energy band at any time; r < 1): its summary rows are None when the sets are too small (tiny scale)
+    authors = cc.authors_record(
+        {("authors", k): auth[("authors", k)] for k in AUTHORS},
+        refs,
+        AUTHORS_CONVENTION.format(w=study.params.authors_window, band=list(study.params.band)),
+        settings,
+    )
+    main_sets = (sets[(g_main, "a")], sets[(g_main, "b")])
     auth_runs = (auth[("authors", "5a_authors")], auth[("authors", "5b_authors")])
     auth_random = (auth[("authors", "5a_authors_random")], auth[("authors", "5b_authors_random")])
     verdict = cc.difference_record(

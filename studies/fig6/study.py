@@ -49,7 +49,6 @@ import math
 
 import pandas as pd
 
-from hhscatter.analysis.dissipative.transitions import tau2_observed
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction import model_tables as mt
 from hhscatter.reproduction import model_verdicts as mv
@@ -298,7 +297,8 @@ def _numbers(s: mt.ModelInputs, fits, cmps, comps, taus, pcf, pct) -> dict:
 # panel (b): τ1, τ2 against γ at fig4's E0
 # ---------------------------------------------------------------------------
 def _fig4_reference(study, inputs, dt) -> mt.TauReference:
-    """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)."""
+    """Observed τ1, τ2 from fig4's table and fig4's P(t) lifetimes (its published derived table)
+    (:func:`~hhscatter.reproduction.model_tables.tau_reference`)."""
     import pyarrow as pa
 
     from hhscatter.data.read import read_lifetimes
@@ -308,22 +308,13 @@ def _fig4_reference(study, inputs, dt) -> mt.TauReference:
     try:
         doc = up.numbers(study, other)
         table, _ = up.lookup(doc, study.params.tau_table_key, what=f"{other}.json")
-        obs = pd.DataFrame(table)
-        gcol, t1, t2 = (getattr(study.params, k) for k in ("tau_gamma_field", "tau1_field", "tau2_field"))
-        missing = {gcol, t1, t2} - set(obs.columns)
+        rows = pd.DataFrame(table)
+        fields = tuple(getattr(study.params, k) for k in ("tau_gamma_field", "tau1_field", "tau2_field"))
+        missing = set(fields) - set(rows.columns)
         if missing:
             raise up.UpstreamError(
-                f"{other}.json:{study.params.tau_table_key} rows lack {sorted(missing)}; have {sorted(obs.columns)}"
+                f"{other}.json:{study.params.tau_table_key} rows lack {sorted(missing)}; have {sorted(rows.columns)}"
             )
-        obs = pd.DataFrame(
-            {
-                "gamma": obs[gcol].astype(float),
-                "tau1_observed": [mt.value_and_err(v)[0] for v in obs[t1]],
-                "tau1_err": [mt.value_and_err(v)[1] for v in obs[t1]],
-                "tau2_observed": [mt.value_and_err(v)[0] for v in obs[t2]],
-                "tau2_err": [mt.value_and_err(v)[1] for v in obs[t2]],
-            }
-        )
         inputs["tau_table"] = {"source": f"{other}.json:{study.params.tau_table_key}"}
         # P(t) of the τ study's runs from its published lifetimes table (never its raw runs)
         tname = doc.get("tables", {}).get("lifetimes")
@@ -332,7 +323,7 @@ def _fig4_reference(study, inputs, dt) -> mt.TauReference:
         inputs["tau_lifetimes"] = {"source": f"{other}: derived/{tname}"}
         # one γ at a time (6 × 1e7 rows at paper scale): only the γ of the τ table and the reference γ = 0
         by_gamma = {}
-        for g in sorted({0.0, *(float(v) for v in obs["gamma"])}):
+        for g in sorted({0.0, *(float(v) for v in rows[fields[0]])}):
             d = up.table(study, other, tname, filters=[("gamma", "==", g)], columns=["t_end", "outcome"])
             if len(d):
                 by_gamma[g] = d.reset_index(drop=True)
@@ -340,9 +331,7 @@ def _fig4_reference(study, inputs, dt) -> mt.TauReference:
             pa.default_memory_pool().release_unused()
         if 0.0 not in by_gamma:
             raise up.UpstreamError(f"{other}'s {tname} has no γ = 0 rows (the conservative reference)")
-        t0c, P0c, _ = mt.survival_grid_curve(by_gamma[0.0], dt)
-        lifetimes = {g: by_gamma[g] for g in obs["gamma"] if g > 0 and g in by_gamma}
-        P_0 = (t0c, P0c)
+        return mt.tau_reference(rows, by_gamma, E0=E0, dt=dt, fields=fields)
     except up.UpstreamError:
         if not up.dev_fallback_enabled():
             raise
@@ -353,17 +342,7 @@ def _fig4_reference(study, inputs, dt) -> mt.TauReference:
             for e, g in _pairs(study)
             if abs(e - E0) < 1e-12
         }
-        obs = pd.DataFrame(
-            {
-                "gamma": sorted(lifetimes),
-                "tau1_observed": None,
-                "tau1_err": None,
-                "tau2_err": None,
-                "tau2_observed": [tau2_observed(lifetimes[g]) for g in sorted(lifetimes)],
-            }
-        )
-        P_0 = None
-    return mt.TauReference(obs, lifetimes, P_0, E0)
+        return mt.tau2_reference(lifetimes, E0)
 
 
 plot = figure_stage(

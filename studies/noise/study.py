@@ -40,6 +40,7 @@ import pandas as pd
 from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.keys import RunKeys, number_key
 from hhscatter.studies.params import StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 
 #: the turnover theory (Mel'nikov–Meshkov/PGH) assumes an underdamped barrier crossing: its ratios are read where
 #: γ/ω_b ≤ this (ω_b the saddles' unstable frequency)
@@ -350,16 +351,12 @@ def analyze(study):
 
 
 # -- plot -------------------------------------------------------------------
-def plot(study):
-    """plot(study) -> None: noise.png from the derived tables and noise.json."""
-    from .figure import plot_noise
-
-    d = study.out / "derived"
-    plot_noise(
-        rates=pd.read_parquet(d / "rates.parquet"),
-        reactivation=pd.read_parquet(d / "reactivation.parquet"),
-        no_drag=pd.read_parquet(d / "no_drag.parquet"),
-        numbers=study.read_numbers(),
-        path=study.figure_path,
-        scale=study.scale,
-    )
+plot = figure_stage(
+    "plot_noise",
+    rates="rates",
+    reactivation="reactivation",
+    no_drag="no_drag",
+    numbers=NUMBERS,
+    path=PATH,
+    scale=SCALE,
+)

@@ -27,7 +27,13 @@ from hhscatter.analysis.geometry import ulam
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.reproduction.operator_cmeasure import measure_distances
-from hhscatter.reproduction.operator_records import dissipative_comparison, kappa_comparisons, kappa_records
+from hhscatter.reproduction.operator_records import (
+    cost_rows,
+    dissipative_comparison,
+    kappa_comparisons,
+    kappa_records,
+    probe_islands,
+)
 from hhscatter.scene.schema import Integer, Integers, Number, Numbers
 from hhscatter.studies import _upstream as up
 from hhscatter.studies.params import StudyParams
@@ -243,14 +249,12 @@ def _ulam_energy(study, E):
 
 
 def _islands(study, E, df, tr, ids, keep, sub):
-    """Mixed phase space: the probes still inside at probe_t_max mark trapped (KAM) boxes; the leading modes
-    of P on the saddle's class with their mass on trapped boxes, and κ with the trapped boxes taken out."""
+    """Mixed phase space (:func:`~hhscatter.reproduction.operator_records.probe_islands`): the probes still inside at
+    probe_t_max mark trapped (KAM) boxes."""
     from hhscatter.data.read import read_lifetimes
 
-    pr = _probe_ics(df)
     lt = read_lifetimes(study.raw(probe_key(E)), columns=["traj_id", "outcome"]).sort_values("traj_id")
-    trapped_cells = pr["cell"].to_numpy()[lt["outcome"].astype(str).to_numpy() == "censored"]
-    return {"probes": int(len(pr)), **ulam.islands_record(trapped_cells, tr, ids, keep, sub)}
+    return probe_islands(_probe_ics(df)["cell"].to_numpy(), lt["outcome"].to_numpy(), tr, ids, keep, sub)
 
 
 # -- μ_c against fig1's sprinkler points -----------------------------------------------------------
@@ -319,21 +323,13 @@ def _dissipative(study, inputs):
 
 # -- cost: orbit-time for κ at 1 % -----------------------------------------------------------------
 def _cost(study, records, kappa0):
-    """Orbit-time of each route for κ at [study].target_rel (:func:`~hhscatter.analysis.geometry.ulam.cost_row`)."""
-    from hhscatter.analysis.survival.escape_rate import escape_rate
-    from hhscatter.analysis.survival.fits import observed_from_outcome
+    """Orbit-time of each route for κ at [study].target_rel (:func:`~hhscatter.reproduction.operator_records.cost_rows`)."""
     from hhscatter.data.read import read_lifetimes
 
-    rows = []
-    for E in list(study.params.cost_energies):
-        lt = read_lifetimes(study.raw(cost_key(E)), columns=["outcome", "t_end"])
-        r = escape_rate(
-            lt["t_end"].to_numpy(), observed_from_outcome(lt["outcome"]), detect_tail=False, min_survivors=100.0
-        )
-        pt = {"kappa": r.kappa, "kappa_err": r.kappa_err, "orbits": len(lt), "orbit_time": float(lt["t_end"].sum())}
-        rec = next((x for x in records if np.isclose(x["energy"], E)), None)
-        rows.append(ulam.cost_row(E, pt, rec, kappa0, study.params.target_rel))
-    return rows
+    lifetimes = {
+        E: read_lifetimes(study.raw(cost_key(E)), columns=["outcome", "t_end"]) for E in study.params.cost_energies
+    }
+    return cost_rows(lifetimes, records, kappa0, study.params.target_rel)
 
 
 # -- analyze ---------------------------------------------------------------------------------------

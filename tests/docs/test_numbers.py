@@ -246,3 +246,33 @@ def test_a_fraction_of_zero_recorded_without_its_bound_is_written_as_the_bound_f
     assert nb.format_ref(doc, "regular_fraction[id=all].fraction") == "> 0.86 (95 %)"
     assert nb.format_ref(doc, "regular_fraction[id=hh-1.05].fraction", "pct") == "0.48 %"  # not 0: its number
     assert nb.format_ref(doc, "counts.n_regular") == "0"  # a count is not a fraction: no bound made up for it
+
+
+@pytest.mark.parametrize(
+    "value, err, fmt, want",
+    [
+        (1.4348590349, 0.0170463952, "", "1.435 ± 0.017"),
+        (1.4348590349, 0.0170463952, "value", "1.435"),
+        (1.4348590349, 0.0170463952, "err", "0.017"),
+        (0.0623, 0.0012, "pct", "6.23 ± 0.12 %"),
+        (-0.00207, 0.00118, "", "\u22120.0021 ± 0.0012"),
+        (0.9123, float("nan"), "", "0.9123"),  # not measured: the value alone
+        (0.9123, float("nan"), "pct", "91.23 %"),
+        (0.5, 0.0, "", "0.5"),  # exact by construction: never "± 0"
+    ],
+)
+def test_a_measured_value_is_written_as_its_json_leaf(value, err, fmt, want):
+    from hhscatter.analysis.stats.measured import Measured
+
+    m = Measured(value, err, "MLE", 100)
+    assert nb.format_leaf(m, fmt) == want
+    leaf = m.to_dict() if err == err else {"value": value, "err": None}  # JSON writes a NaN error as null
+    assert nb.format_leaf(leaf, fmt) == want
+
+
+@pytest.mark.parametrize("err", [None, float("nan"), "n/a"])
+def test_a_number_beside_a_missing_or_unmeasured_error_is_written_alone(err):
+    doc = {"k": 0.0912, "k_err": err, "row": {"ours": -0.0912, "err": err}}
+    assert nb.format_ref(doc, "k", "pm") == "0.0912"
+    assert nb.format_ref(doc, "k", "pct") == "9.12 %"
+    assert nb.format_ref(doc, "row") == "\u22120.0912"

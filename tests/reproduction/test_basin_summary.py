@@ -312,3 +312,33 @@ def test_scan_row_reads_the_headline_box_and_the_trapped_share():
     # a headline box that is not on the list: the largest (4 × 4 boxes straddle two stripes: S_b > 0)
     wide = bs.scan_row(img, _unc(eps), eps, [np.array([1.0])] * 6, 0.2, 0.3, [2, 4], 3, **kw)
     assert not wide["above_E_b"] and wide["S_b"] > 0
+
+
+def test_comparison_rows_alpha_and_s_bb_of_every_record_and_the_cut_off_only_with_drag():
+    conservative = {
+        "energy": 0.25, "gamma": 0.0, "alpha": {"value": 0.2, "err": 0.01}, "alpha_fit_range": [1e-7, 1e-4],
+        "d": {"value": 1.8}, "S_bb": {"value": 0.8, "err": 0.02}, "log2_fractal": True,
+        "cutoff": {"detected": True, "eps_c": 1e-5, "eps_c_lo": 5e-6, "eps_c_hi": 2e-5},
+    }  # fmt: skip
+    detected = {
+        **conservative,
+        "gamma": 0.02,
+        "alpha": None,
+        "S_bb": {"value": 0.6, "err": 0.03},
+        "log2_fractal": False,
+    }
+    unseen = {**detected, "gamma": 0.05, "S_bb": None, "cutoff": {"detected": False, "eps_c_hi": 3e-6}}
+    no_cutoff = {**unseen, "cutoff": None}
+    rows = bs.comparison_rows([conservative, detected, unseen, no_cutoff], 16)
+    assert [(r["quantity"], r["ours"], r["err"]) for r in rows] == [
+        ("uncertainty exponent α (E0=0.25, γ=0)", 0.2, 0.01),
+        ("boundary basin entropy S_bb (E0=0.25, γ=0, box 16)", 0.8, 0.02),  # γ = 0: no cut-off row
+        ("boundary basin entropy S_bb (E0=0.25, γ=0.02, box 16)", 0.6, 0.03),
+        ("cut-off ε_c of the power law f(ε) (E0=0.25, γ=0.02)", 1e-5, None),
+        ("cut-off ε_c of the power law f(ε) (E0=0.25, γ=0.05)", None, None),
+    ]
+    notes = [r["note"] for r in rows]
+    assert notes[0] == "f(ε) ∝ ε^α on ε ∈ [1e-07, 1e-04]; d = 2 − α = 1.800"
+    assert notes[1].endswith(": yes") and notes[2].endswith(": not shown")
+    assert notes[3] == "detected, 1σ [5e-06, 2e-05] (paper: expected for γ > 0)"
+    assert notes[4] == "none seen: ε_c < 3e-06 (paper: expected for γ > 0)"

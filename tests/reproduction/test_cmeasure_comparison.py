@@ -10,6 +10,7 @@ import pytest
 
 from hhscatter.reproduction.cmeasure_comparison import (
     ComparisonSettings,
+    authors_record,
     cap_rows,
     common_sample_size,
     crossing_sets,
@@ -206,3 +207,28 @@ def test_reference_record_pairs_both_constructions():
     assert by[("ours", "5b")]["delta"]["interval"][1] < 0  # 5b drawn like E2: closer to E2
     assert (rec["box"], rec["boxes"], rec["E1"], rec["E2"], rec["offsets"]) == (0.5, [1.0, 0.5], 0.3, 0.35, 1)
     assert set(rec["curves"]) == {"ours", "authors"}
+
+
+def test_authors_record_rows_of_their_sets_at_one_common_size_without_the_reference_row():
+    rng = np.random.default_rng(2)
+    left, right = _uniform(rng, 300, (-1.0, 0.0)), _uniform(rng, 300, (0.0, 1.0))
+    refs = {"E1": left[["x", "y"]].to_numpy(), "E2": right[["x", "y"]].to_numpy()}
+    sets = {("authors", "5a_authors"): left.iloc[:100], ("authors", "5b_authors"): right.iloc[:40]}
+    rec = authors_record(sets, refs, "their square ICs", _settings())
+    assert rec["convention"] == "their square ICs" and rec["n_points"] == {"5a_authors": 100, "5b_authors": 40}
+    rows = {(r["set"], r["ref"]): r for r in rec["rows"]}
+    assert list(rows) == [("5a_authors", "E1"), ("5a_authors", "E2"), ("5b_authors", "E1"), ("5b_authors", "E2")]
+    # against E1 both at the smaller set's half, 40 // 2; against E2 each at its own half
+    assert [rows[k]["m"] for k in rows] == [20, 50, 20, 20]
+    # 5a: points on E1's side of x = 0 (a box edge), 5b: on E2's side: disjoint from the other reference
+    assert rows[("5a_authors", "E2")]["hellinger"] == pytest.approx(1.0)
+    assert rows[("5b_authors", "E1")]["hellinger"] == pytest.approx(1.0)
+    assert rows[("5a_authors", "E1")]["hellinger"] < 0.3 and rows[("5b_authors", "E2")]["hellinger"] < 0.3
+
+
+def test_authors_record_without_rows_when_no_set_is_large_enough():
+    rng = np.random.default_rng(3)
+    pts = _uniform(rng, 9)
+    refs = {"E1": pts[["x", "y"]].to_numpy(), "E2": pts[["x", "y"]].to_numpy()}
+    rec = authors_record({("authors", "5a_authors"): pts}, refs, "c", _settings(m_min=5))  # 9 // 2 = 4 < 5
+    assert rec == {"convention": "c", "n_points": {"5a_authors": 9}, "rows": None}

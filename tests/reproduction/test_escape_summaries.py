@@ -13,6 +13,7 @@ from hhscatter.reproduction.escape_summaries import (
     cmeasure_windows,
     kappa_cmeasure_z,
     kappa_law_curves,
+    recording_time,
     survival_tables,
     tau_star_estimate,
 )
@@ -79,6 +80,15 @@ def test_cmeasure_windows_by_hand():
     assert cmeasure_windows(0.25, 3.2, 2.0, 4.0, 40.0, 1.0) == (12.0, 28.0, 72.0)
     with pytest.raises(ValueError, match="kappa must be finite"):
         cmeasure_windows(0.0, 3.2, 2.0, 4.0, 40.0)
+
+
+def test_recording_time_is_the_ceiling_of_tau0_plus_n_efolds():
+    assert recording_time(0.2, 3.4, 4.0) == 24.0  # ceil(3.4 + 20)
+    assert recording_time(0.25, 3.0, 2.0) == 11.0  # ceil(11.0): an integer stays
+    assert cmeasure_windows(0.2, 3.4, 4.0, 1.0, 0.0)[0] == recording_time(0.2, 3.4, 4.0)  # one rule for both
+    for bad in (0.0, -0.1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="kappa must be finite"):
+            recording_time(bad, 1.0, 4.0)
 
 
 def test_kappa_law_curves_follow_each_law_on_its_side_of_the_break():

@@ -4,6 +4,7 @@ a known answer."""
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -147,3 +148,41 @@ def test_cmeasure_run_rows_refuse_a_run_made_for_another_window():
     choice = {"t_rec": 10.0, "t_sample_end": 20.0, "t_record_end": 30.0, "kappa": 0.1}
     with pytest.raises(RuntimeError, match=r"cm_E0.30: raw run's section window .* \[10.0, 30.0\]"):
         cmeasure_run_rows(None, None, choice, {"t_from": 11.0, "t_to": 30.0}, {}, label="cm_E0.30", energy=0.3)
+
+
+def _section_run():
+    """2^(10−j) orbits cross the section at t = 1, …, j and leave at j + 0.5 (j = 1 … 10), plus 3 orbits still inside
+    at t_max = 30 that cross at every t = 1 … 20 (KAM-trapped)."""
+    last = np.concatenate([np.full(2 ** (10 - j), j) for j in range(1, 11)] + [np.full(3, 20)])
+    n = len(last)
+    outcome = np.array(["escaped"] * (n - 3) + ["censored"] * 3)
+    lifetimes = pd.DataFrame(
+        {"traj_id": np.arange(n), "outcome": outcome, "t_end": np.where(outcome == "censored", 30.0, last + 0.5)}
+    )
+    ids = np.repeat(np.arange(n), last)
+    t = np.concatenate([np.arange(1, k + 1) for k in last]).astype(float)
+    return pd.DataFrame({"traj_id": ids, "t": t}), lifetimes
+
+
+def test_cmeasure_run_rows_kappa_of_the_crossings_in_each_window_beside_both_rates_from_p_of_t():
+    sections, lifetimes = _section_run()
+    choice = {"t_rec": 2.0, "t_sample_end": 4.0, "t_record_end": 20.0, "kappa": 0.7}
+    grid_rates = {0.25: _fit_result(0.1, 0.01), 0.3: _fit_result(0.2, 0.02)}
+    rows = cmeasure_run_rows(
+        sections, lifetimes, choice, {"t_from": 2.0, "t_to": 20.0}, grid_rates, label="cm_E0.29",
+        shifts=[0.0, 1.0], energy=0.29, E_c=E_C, min_survivors=10.0, n_boot=20, seed=1,
+    )  # fmt: skip
+    assert [r["shift_efolds"] for r in rows] == [0.0, 1.0]
+    a, b = rows
+    # crossings at t = k: 2^(11−k) − 1 orbits (the trapped ones dropped), of which 2^(10−k) leave after it;
+    # every return takes T = 1, so (1/M) Σ e^{κ} = 1 gives κ = ln(M / returns)
+    assert (a["t_from"], a["t_to"], a["n_samples"], a["n_exit"]) == (2.0, 4.0, 511 + 255 + 127, 256 + 128 + 64)
+    assert a["kappa_cm"] == pytest.approx(math.log((511 + 255 + 127) / (255 + 127 + 63)), rel=1e-9)
+    assert b["t_from"] == pytest.approx(2.0 + 1 / 0.7) and b["t_to"] == pytest.approx(4.0 + 1 / 0.7)
+    assert b["kappa_cm"] == pytest.approx(math.log((127 + 63) / (63 + 31)), rel=1e-9)  # crossings at t = 4, 5
+    for r in rows:
+        assert (r["energy"], r["x"]) == (0.29, pytest.approx(0.29 - E_C)) and r["n_trapped_dropped"] == 3
+        # the Fig. 2b run nearest in energy (0.3); the run's own P(t), a staircase that halves per unit time, fitted
+        # by one exponential on its window: κ near ln 2
+        assert (r["kappa_pt_grid"], r["kappa_pt_grid_err"]) == (0.2, 0.02)
+        assert r["kappa_pt_same_run"] == pytest.approx(math.log(2), rel=0.1)

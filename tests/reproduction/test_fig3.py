@@ -211,3 +211,34 @@ def test_decay_results_predict_tau2_count_settled_orbits_and_take_the_above_erro
     assert errs["above", (0.0, 200.0)] == pytest.approx(0.02 * 0.5)  # std of 0.90, 0.92, 0.94 times the scale
     assert errs["above", (0.0, 100.0)] == pytest.approx(0.04 * 0.5)  # std of 0.80, 0.84, 0.88
     assert r.ribbon["t"] == 100.0
+
+
+def test_mean_energy_table_band_and_the_orbits_above_the_critical_energy_per_time():
+    from hhscatter.analysis.dissipative.decay import inside_mean_energy
+
+    # three orbits at t = 0, 10, 20: one settles below E_c = 0.1 by t = 20, none is above E_c at t = 30
+    snaps = pd.DataFrame(
+        {
+            "t": [0.0] * 3 + [10.0] * 3 + [20.0] * 3 + [30.0] * 2,
+            "energy": [0.3, 0.3, 0.3, 0.2, 0.24, 0.16, 0.15, 0.13, 0.05, 0.08, 0.04],
+        }
+    )
+    ime = inside_mean_energy([snaps], 0.1)
+    me = mod.mean_energy_table(ime.inside, ime.above)
+    assert me["t"].tolist() == [0.0, 10.0, 20.0, 30.0]
+    assert me["n_above"].tolist() == [3, 3, 2, 0] and me["n_above"].dtype == np.int64
+    assert me["mean_E_above"].iloc[:3].tolist() == pytest.approx([0.3, 0.2, 0.14]) and np.isnan(
+        me["mean_E_above"].iloc[3]
+    )
+    sem_10 = np.std([0.2, 0.24, 0.16], ddof=1) / np.sqrt(3)
+    assert me["lo_3sem"].iloc[1] == pytest.approx(0.2 - 3 * sem_10) and me["hi_3sem"].iloc[1] == pytest.approx(
+        0.2 + 3 * sem_10
+    )
+    assert me["mean_E"].iloc[2] == pytest.approx(0.11)  # the settled orbit still counts inside Ω
+
+
+def test_histogram_edges_are_geometric_from_below_the_lowest_energy_to_above_e0():
+    edges = mod.histogram_edges(np.array([0.02, 0.2, 0.1]), 0.3, 4)
+    assert len(edges) == 5 and edges[0] == pytest.approx(0.0196) and edges[-1] == pytest.approx(0.3003)
+    assert np.diff(np.log(edges)) == pytest.approx(np.full(4, np.log(0.3003 / 0.0196) / 4))
+    assert mod.histogram_edges([0.0, 0.1], 0.3, 2)[0] == pytest.approx(0.98e-12)  # a zero energy: the floor

@@ -21,7 +21,9 @@ from hhscatter.reproduction.model_tables import (
     pair_fits,
     survival_grid_curve,
     tau2_curve,
+    tau2_reference,
     tau_predictions,
+    tau_reference,
     tau_vs_gamma,
     value_and_err,
 )
@@ -219,3 +221,39 @@ def test_tau_predictions_give_tau2_with_both_exponents():
     np.testing.assert_allclose(taus["tau2_predicted_err"], np.log(0.3 / E_C) / (0.9 * gs) * 0.05 / 0.9)
     np.testing.assert_allclose(pct["tau2_predicted"], np.log(0.3 / E_C) / (0.91 * gs))
     assert len(curve) > 0
+
+
+def test_tau_reference_reads_the_tau_table_and_keeps_the_runs_of_its_gammas():
+    rows = pd.DataFrame(
+        {
+            "g": [0.005, 0.01],
+            "t1": [{"value": 80.0, "err": 2.0}, None],  # τ1 not resolved at γ = 0.01
+            "t2": [{"value": 400.0, "err": 10.0}, 200.0],  # a plain number: no error
+        }
+    )
+    conservative = pd.DataFrame({"t_end": [1.0, 2.0, 3.0, 4.0], "outcome": ["escaped"] * 3 + ["censored"]})
+    dissipative = pd.DataFrame({"t_end": [1.0], "outcome": ["settled"]})
+    runs = {0.0: conservative, 0.005: dissipative, 0.02: dissipative}  # γ = 0.02 is not in the table
+    ref = tau_reference(rows, runs, E0=0.3, dt=1.0, fields=("g", "t1", "t2"))
+    assert ref.E0 == 0.3 and list(ref.lifetimes) == [0.005] and ref.lifetimes[0.005] is dissipative
+    obs = ref.obs.to_dict(orient="list")  # a missing time or error is NaN in its float column
+    assert list(obs) == ["gamma", "tau1_observed", "tau1_err", "tau2_observed", "tau2_err"]
+    assert obs["gamma"] == [0.005, 0.01] and obs["tau2_observed"] == [400.0, 200.0]
+    assert obs["tau1_observed"][0] == 80.0 and obs["tau1_err"][0] == 2.0 and obs["tau2_err"][0] == 10.0
+    assert all(math.isnan(obs[k][1]) for k in ("tau1_observed", "tau1_err", "tau2_err"))
+    t, P = ref.P_0
+    # Kaplan–Meier of three escapes at 1, 2, 3 among four orbits, the fourth censored at 4
+    assert t.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0] and P.tolist() == pytest.approx([1.0, 0.75, 0.5, 0.25, 0.25])
+    with pytest.raises(KeyError):
+        tau_reference(rows, {0.005: dissipative}, E0=0.3, dt=1.0, fields=("g", "t1", "t2"))
+
+
+def test_tau2_reference_has_the_first_settling_time_and_no_tau1():
+    lt = {
+        0.02: pd.DataFrame({"t_end": [7.0, 2.0, 5.0], "outcome": ["settled", "escaped", "settled"]}),
+        0.01: pd.DataFrame({"t_end": [9.0, 4.0], "outcome": ["censored", "settled"]}),
+    }
+    ref = tau2_reference(lt, 0.3)
+    assert ref.P_0 is None and ref.lifetimes is lt and ref.E0 == 0.3
+    assert ref.obs["gamma"].tolist() == [0.01, 0.02] and ref.obs["tau2_observed"].tolist() == [4.0, 5.0]
+    assert ref.obs[["tau1_observed", "tau1_err", "tau2_err"]].isna().all().all()

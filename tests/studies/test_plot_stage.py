@@ -121,7 +121,5 @@ def test_every_study_declares_its_plot_stage():
     from hhscatter.studies import stage_module, study_names
 
     for name in study_names():
-        if name == "noise":  # its plot stage is written out in its study.py
-            continue
         doc = stage_module(name).plot.__doc__
         assert doc.startswith("plot(study) -> None: ") and "figure.plot_" in doc, name

@@ -145,19 +145,11 @@ def test_lifetimes_to_arrays_accepts_rounding_in_e0_but_not_two_ensembles():
         lifetimes_to_arrays(base.assign(e0=[0.3, 0.3, 0.31]))
 
 
-def test_recording_rules_closed_form():
+def test_contour_levels_closed_form():
     from hhscatter.studies import stage_module
 
-    contour_levels, recording_time = stage_module("fig1").contour_levels, stage_module("fig1").recording_time
-    from hhscatter.reproduction.escape_summaries import cmeasure_windows
-
-    assert recording_time(0.2, 3.4, 4.0) == 24.0  # ceil(3.4 + 20)
-    t_rec, t_s, t_e = cmeasure_windows(0.25, 2.5, 2.0, 2.0, 40.0, 1.0)
-    assert (t_rec, t_s, t_e) == (11.0, 19.0, 63.0)
-    lv = contour_levels(20)
+    lv = stage_module("fig1").contour_levels(20)
     assert lv.size == 20 and 0 < lv.min() and lv.max() < 0.5 and np.isclose(lv, 1 / 6).sum() == 1
-    with pytest.raises(ValueError, match="kappa"):
-        recording_time(0.0, 1.0, 4.0)
 
 
 # ---------------------------------------------------------------------------
