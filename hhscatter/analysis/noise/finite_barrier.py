@@ -49,7 +49,7 @@ __all__ = [
     "FiniteBarrierFit",
     "TransitionStateCorrection",
     "finite_barrier_fit",
-    "laplace_coefficients",
+    "laplace_coefficient",
     "transition_state_correction",
 ]
 
@@ -154,8 +154,8 @@ def _tensors(model, x: float, y: float):
     return d3, d4
 
 
-def laplace_coefficients(model, x: float = 0.0, y: float = 0.0, direction=None) -> float:
-    """laplace_coefficients(model, x=0, y=0, direction=None) -> A (1/energy): the first correction of Laplace's
+def laplace_coefficient(model, x: float = 0.0, y: float = 0.0, direction=None) -> float:
+    """laplace_coefficient(model, x=0, y=0, direction=None) -> A (1/energy): the first correction of Laplace's
     expansion ∫ e^{−V/T} = (harmonic value)(1 + A T + O(T²)) about a nondegenerate minimum (x, y) of the system's
     potential (module docstring), over the plane, or, with a unit ``direction`` e, over the line (x, y) + s e
     (the dividing line through a saddle along its stable direction).
@@ -165,7 +165,7 @@ def laplace_coefficients(model, x: float = 0.0, y: float = 0.0, direction=None) 
     Hénon–Heiles: A = 4/3 at the well's minimum; along y = 1 through the saddle (0, 1) V is exactly quadratic:
 
     >>> from hhscatter.model import HenonHeiles
-    >>> round(laplace_coefficients(HenonHeiles()), 12), round(laplace_coefficients(HenonHeiles(), 0, 1, (1, 0)), 12)
+    >>> round(laplace_coefficient(HenonHeiles()), 12), round(laplace_coefficient(HenonHeiles(), 0, 1, (1, 0)), 12)
     (1.333333333333, 0.0)
     """
     d3, d4 = _tensors(model, float(x), float(y))
@@ -215,12 +215,12 @@ def transition_state_correction(model) -> TransitionStateCorrection:
     >>> round(c.slope, 12), round(-2 / 9, 12), c.lowest
     (-0.222222222222, -0.222222222222, (0, 1, 2))
     """
-    a_well = laplace_coefficients(model)
+    a_well = laplace_coefficient(model)
     kl = kramers_langer(model, 1.0, 1.0)
     a_s = []
     for e in model.exits:
         _, v = np.linalg.eigh(hessian(model, e.x, e.y))
-        a_s.append(laplace_coefficients(model, e.x, e.y, v[:, 1]))
+        a_s.append(laplace_coefficient(model, e.x, e.y, v[:, 1]))
     low = min(t.barrier for t in kl.terms)
     lowest = tuple(i for i, t in enumerate(kl.terms) if t.barrier - low <= 1e-9 * max(abs(low), 1.0))
     pref = np.array([kl.terms[i].prefactor for i in lowest])

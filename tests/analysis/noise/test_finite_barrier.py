@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from hhscatter.analysis.noise import finite_barrier_fit, laplace_coefficients, transition_state_correction
+from hhscatter.analysis.noise import finite_barrier_fit, laplace_coefficient, transition_state_correction
 from hhscatter.model import HenonHeiles, make_system
 
 QUARTIC = "x**2/2 + y**2/2 - x**4/4 - y**4/4"
@@ -73,7 +73,7 @@ def test_the_well_coefficient_against_a_quadrature_of_the_well():
         return (z / (2 * math.pi * T) - 1) / T
 
     a = 2 * a_of(0.002) - a_of(0.004)
-    assert a == pytest.approx(laplace_coefficients(m), rel=2e-3)
+    assert a == pytest.approx(laplace_coefficient(m), rel=2e-3)
 
 
 def test_the_line_coefficient_against_a_quadrature_of_the_line():
@@ -86,11 +86,11 @@ def test_the_line_coefficient_against_a_quadrature_of_the_line():
         return (z / math.sqrt(2 * math.pi * T) - 1) / T
 
     a = 2 * a_of(0.002) - a_of(0.004)
-    assert a == pytest.approx(laplace_coefficients(m, 1.0, 0.0, (0.0, 1.0)), rel=2e-3)
+    assert a == pytest.approx(laplace_coefficient(m, 1.0, 0.0, (0.0, 1.0)), rel=2e-3)
 
 
-def test_laplace_coefficients_refuses_a_point_that_is_not_a_minimum():
+def test_laplace_coefficient_refuses_a_point_that_is_not_a_minimum():
     with pytest.raises(ValueError, match="not a minimum"):
-        laplace_coefficients(HenonHeiles(), 0.0, 1.0)
+        laplace_coefficient(HenonHeiles(), 0.0, 1.0)
     with pytest.raises(ValueError, match="unit vector"):
-        laplace_coefficients(HenonHeiles(), 0.0, 1.0, (1.0, 1.0))
+        laplace_coefficient(HenonHeiles(), 0.0, 1.0, (1.0, 1.0))
