@@ -558,6 +558,8 @@ def analyze(study):
     study.write_table(react_table, "reactivation.parquet")
     study.write_table(_survival_tables(study, runs), "no_drag.parquet")
     study.write_table(pd.DataFrame(no_drag), "no_drag_rates.parquet")
+    absorbing = _absorbing_radius(study, runs, kramers)
+    saddles = _two_saddles(study, runs)
     hi = kramers[-1]
     study.compare(
         f"escape rate / Kramers–Langer at ΔE/T = {hi['barrier_over_T']:.3g}, γ = {hi['gamma']:g}",
@@ -571,8 +573,8 @@ def analyze(study):
         {
             "kramers": kramers,
             "finite_barrier": _finite_barrier(study, kramers),
-            "absorbing_radius": _absorbing_radius(study, runs, kramers),
-            "two_saddles": _two_saddles(study, runs),
+            "absorbing_radius": absorbing,
+            "two_saddles": saddles,
             "turnover": turnover,
             "reactivation": react,
             "no_drag": no_drag,
@@ -585,7 +587,10 @@ def analyze(study):
                 "relax_widths": p.relax_widths,
                 "window_rule": f"t ≥ {p.t_relax:g} + {p.relax_widths:g}/γ; constant when the halves agree within "
                 f"{p.constancy_z:g}σ",
-                "all_constant_in_window": all(r["constant_in_window"] for r in kramers + turnover),
+                # every heat-bath rate: Kramers, turnover, the second radius and the two-saddle system
+                "all_constant_in_window": all(
+                    r["constant_in_window"] for r in kramers + turnover + absorbing + saddles["records"]
+                ),
                 "seeds": "one per Kramers and turnover record, derived from the study's seed and the record's key",
                 "nodrag_window": list(p.nodrag_window),
                 "nodrag_times": _survivor_times(p),
