@@ -582,6 +582,158 @@ def _noise_no_drag(get: Loader) -> str:
     return "the rate over the window is " + "; ".join(out)
 
 
+def _against(value, err, ref, ref_name: str) -> str:
+    """ "agrees with NAME (z = …)" or "differs from NAME (z = …)" by the 2σ rule."""
+    v = verdict(value, err, ref)
+    if ref == 0:
+        return f"{'lies within 2σ of 0' if v.word == 'agrees' else 'is resolved from 0'} (z = {signed(v.z)})"
+    return f"{'agrees with' if v.word == 'agrees' else 'differs from'} {ref_name} (z = {signed(v.z)})"
+
+
+def _noise_finite_barrier(get: Loader) -> str:
+    d = get("noise", None)
+    f = d.get("finite_barrier")
+    if f is None:
+        return "the finite-barrier fit is not in this scale's numbers"
+    a, c, c1 = f["intercept"], f["slope"], f["slope_intercept_one"]
+    c_tst = f["transition_state_slope"]
+    lo, hi = f["T_over_barrier_range"]
+    out = (
+        f"the weighted fit of k/k_KL against T/ΔE ({lo:.3g} to {hi:.3g}) gives the intercept "
+        f"{_ve(a['value'], a['err'])}, which {_against(a['value'], a['err'], 1.0, '1')}, and the slope "
+        f"c = {_ve(c['value'], c['err'])} (χ² = {f['chi2']:.1f} for {f['dof']} dof, p = {f['p_value']:.2g}); with "
+        f"the intercept fixed at 1, c = {_ve(c1['value'], c1['err'])}. The transition-state part of the first "
+        f"correction is c_TST = {signed(c_tst, '+.3f')}: the free slope {_against(c['value'], c['err'], c_tst, 'it')} "
+        f"and {_against(c['value'], c['err'], 0.0, '0')}; the slope at intercept 1 "
+        f"{_against(c1['value'], c1['err'], c_tst, 'it')} and {_against(c1['value'], c1['err'], 0.0, '0')}"
+    )
+    if f["p_value"] < P_LEVEL:
+        out += (
+            f". The ratios scatter about the line by more than their errors (p < {P_LEVEL:g}): the slopes' errors "
+            f"are then understated by about √(χ²/dof) = {math.sqrt(f['chi2'] / f['dof']):.2g}"
+        )
+    return out
+
+
+def _unsigned_zero(text: str) -> str:
+    """A rendered value that rounds to zero without its sign ("−0 ± 5" → "0 ± 5")."""
+    return re.sub(r"^[−-](0(?:\.0+)?)(?![\d.])", r"\1", text)
+
+
+def _noise_absorbing_radius(get: Loader) -> str:
+    d = get("noise", None)
+    rows = d.get("absorbing_radius") or []
+    if not rows:
+        return "the rates at a second absorbing radius are not in this scale's numbers"
+    cells = []
+    for r in sorted(rows, key=lambda r: r["barrier_over_T"]):
+        q = r["rate_ratio"]
+        v = verdict(q["value"], q["err"], 1.0)
+        word = (
+            "no shift resolved at 2σ"
+            if v.word == "agrees"
+            else f"the larger radius {'lowers' if v.z < 0 else 'raises'} the rate"
+        )
+        cells.append(
+            f"at ΔE/T = {r['barrier_over_T']:g} the rate at r_esc = {r['r_esc']:g} is {_ve(q['value'], q['err'])} "
+            f"of that at {r['r_esc_default']:g} (shift {_unsigned_zero(_ve(100 * (q['value'] - 1), 100 * q['err']))} %, z = "
+            f"{signed(v.z)}: {word})"
+        )
+    return "; ".join(cells)
+
+
+def _noise_two_saddles(get: Loader) -> str:
+    d = get("noise", None).get("two_saddles") or {}
+    recs = sorted(d.get("records") or [], key=lambda r: r["barrier_over_T"])
+    if not recs:
+        return "the two-saddle system is not in this scale's numbers"
+    cells = []
+    for r in recs:
+        low = min(r["exit_shares"], key=lambda e: e["barrier"])
+        high = max(r["exit_shares"], key=lambda e: e["barrier"])
+        measured = (
+            _ve(high["measured"], high["measured_err"])
+            if high["measured_err"] is not None
+            else format_bound(high["measured_upper95"], high["measured_lower95"])
+        )
+        share = (
+            f"the higher saddle (ΔE = {high['barrier']:.3g}) takes {measured} of the escapes in the window, against its "
+            f"term's share {high['predicted']:.3f} of the sum"
+        )
+        if high["measured_err"] is not None:
+            share += f", which {_against(high['measured'], high['measured_err'], high['predicted'], 'it')}"
+        cells.append(
+            f"at ΔE/T = {r['barrier_over_T']:g} the rate over the two-saddle sum Σ_s k_KL,s is "
+            f"{_ve(r['ratio'], r['ratio_err'])}, which {_against(r['ratio'], r['ratio_err'], 1.0, '1')}, and over the "
+            f"lowest saddle's term alone (ΔE = {low['barrier']:.3g}) "
+            f"{_ve(r['ratio_lowest'], r['ratio_lowest_err'])}, which "
+            f"{_against(r['ratio_lowest'], r['ratio_lowest_err'], 1.0, '1')}; {share}"
+        )
+    return "; ".join(cells)
+
+
+def _pct(row, key) -> str:
+    """A fraction of a record as a percentage: value ± error, or its one-sided bound at 0 or 1."""
+    if row.get(f"{key}_err") is not None:
+        return f"{_ve(100 * row[key], 100 * row[key + '_err'])} %"
+    up, low = row.get(f"{key}_upper95"), row.get(f"{key}_lower95")
+    return format_bound(up, None, pct=True) if up is not None else format_bound(None, low * 100) + " %"
+
+
+def _noise_no_drag_survivors(get: Loader) -> str:
+    d = get("noise", None)
+    surv = d.get("no_drag_survivors")
+    if not surv:
+        return "the survivors' energies are not in this scale's numbers"
+    lo, hi = d["conventions"]["nodrag_window"]
+    rates = {(r["energy"], r["sigma"]): r for r in d["no_drag"]}
+    s_max = max(r["sigma"] for r in surv)
+    out, lost, fall = [], [], []
+    for E in sorted({r["energy"] for r in surv}, reverse=True):
+        rows = sorted((r for r in surv if r["energy"] == E and r["sigma"] == s_max), key=lambda r: r["t"])
+        with_e = [r for r in rows if r.get("mean_energy") is not None]
+        means = ", ".join(f"{_ve(r['mean_energy'], r['mean_energy_err'])} at t = {r['t']:g}" for r in with_e)
+        below = [r for r in with_e if verdict(r["mean_energy"], r["mean_energy_err"], E).word == "differs"]
+        below = [r for r in below if r["mean_energy"] < E]
+        where = (
+            "below E0 by more than 2σ at every one of these times"
+            if below and len(below) == len(with_e)
+            else "below E0 by more than 2σ at t = " + ", ".join(f"{r['t']:g}" for r in below)
+            if below
+            else "below E0 by more than 2σ at none of them"
+        )
+        end = next((r for r in reversed(with_e) if r["t"] <= hi), None)
+        cell = f"at E0 = {E:g} the mean energy of the orbits still inside is {means} ({where})"
+        if end is not None:
+            cell += (
+                f", while the whole ensemble's mean energy E0 + σ²t is {end['ensemble_mean_energy']:.3g} at t = "
+                f"{end['t']:g}; {_pct(end, 'below_ec')} of the {_int(end['n_alive'])} orbits inside at t = {end['t']:g} "
+                f"lie below E_c, where no exit is open"
+            )
+            if verdict(end["mean_energy"], end["mean_energy_err"], E).word == "differs" and end["mean_energy"] < E:
+                lost.append(f"{E:g}")
+        rate = rates.get((E, s_max))
+        if rate is not None and rate.get("halves_z") is not None and math.isfinite(rate["halves_z"]):
+            k1, k2 = rate["rate_first_half"], rate["rate_second_half"]
+            z = rate["halves_z"]
+            state = "constant within the halves' errors" if rate["constant_in_window"] else "not constant"
+            cell += (
+                f". Its escape rate on [{lo:g}, {hi:g}] is {state}: {_ve(k1, rate['rate_first_half_err'])} on the "
+                f"first half, {_ve(k2, rate['rate_second_half_err'])} on the second (z = {signed(z)})"
+            )
+            if not rate["constant_in_window"] and k2 < k1:
+                fall.append(f"{E:g}")
+        out.append(cell)
+    text = f"at σ = {s_max:g}: " + "; ".join(out)
+    if lost and fall and set(fall) <= set(lost):
+        text += (
+            f". At E0 = {', '.join(fall)} the orbits that stay have lost energy although the noise raises the "
+            "ensemble's mean, and the rate falls inside the window: the lower κ/κ0 on the window goes with survivors "
+            "that have fallen toward and below E_c, not with a gain of energy"
+        )
+    return text
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -594,6 +746,10 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.turnover": _noise_turnover,
     "noise.turnover_theory": _noise_turnover_theory,
     "noise.no_drag": _noise_no_drag,
+    "noise.no_drag_survivors": _noise_no_drag_survivors,
+    "noise.finite_barrier": _noise_finite_barrier,
+    "noise.absorbing_radius": _noise_absorbing_radius,
+    "noise.two_saddles": _noise_two_saddles,
     "b_relation": _b_relation,
     "fig5.tightening": _fig5_tightening,
     "fig5.shrink": _fig5_shrink,

@@ -9,8 +9,9 @@ from hhscatter.publish.figures import agg_pyplot, save_panels
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
 
-def _panel_arrhenius(ax, k):
-    """(a) rate against ΔE/T at one γ: measured and Kramers–Langer (log scale), ratio in an inset."""
+def _panel_arrhenius(ax, k, fb=None):
+    """(a) rate against ΔE/T at one γ: measured and Kramers–Langer (log scale), ratio in an inset with, where the
+    numbers carry it, the fitted first correction a + c T/ΔE and its transition-state part 1 + c_TST T/ΔE."""
     ax.errorbar(k.barrier_over_T, k.rate, k.rate_err, fmt="o", color=COLORS[1], ms=4, capsize=2, label="measured")
     b = np.linspace(k.barrier_over_T.min() - 0.3, k.barrier_over_T.max() + 0.3, 50)
     # Kramers–Langer ∝ e^{−ΔE/T}: its prefactor from the records (the same at every T for fixed γ)
@@ -24,6 +25,11 @@ def _panel_arrhenius(ax, k):
     ins = ax.inset_axes([0.58, 0.62, 0.38, 0.33])
     ins.errorbar(k.barrier_over_T, k.ratio, k.ratio_err, fmt="o", color=COLORS[1], ms=3, capsize=2)
     ins.axhline(1.0, color="k", lw=0.8)
+    if fb is not None:
+        a, c, c_tst = fb["intercept"]["value"], fb["slope"]["value"], fb["transition_state_slope"]
+        ins.plot(b, a + c / b, "-", color=COLORS[1], lw=0.9, label="fit")
+        ins.plot(b, 1 + c_tst / b, "--", color="0.4", lw=0.9, label=r"$1 + c_{TST}\,T/\Delta E$")
+        ins.legend(fontsize=5.5, loc="lower right")
     ins.set_ylabel(r"$k/k_{KL}$", fontsize=7)
     ins.tick_params(labelsize=7)
 
@@ -74,14 +80,88 @@ def _panel_no_drag(ax, nd):
     ax.legend(fontsize=6.5, loc="upper right", ncol=2)
 
 
+def _panel_survivors(ax, survivors, e_c):
+    """(e) the mean energy of the orbits still inside against t at the largest σ, each E0: against E0 + σ²t (the
+    whole ensemble's mean) and E_c."""
+    rows = [r for r in survivors if r.get("mean_energy") is not None]
+    s_max = max(r["sigma"] for r in survivors)
+    for i, E in enumerate(sorted({r["energy"] for r in survivors})):
+        c = COLORS[(i + 1) % len(COLORS)]
+        rs = sorted((r for r in rows if r["energy"] == E and r["sigma"] == s_max), key=lambda r: r["t"])
+        ax.errorbar(
+            [r["t"] for r in rs],
+            [r["mean_energy"] for r in rs],
+            [r["mean_energy_err"] for r in rs],
+            fmt="o-",
+            color=c,
+            ms=4,
+            lw=1,
+            capsize=2,
+            label=f"$E_0$ = {E:.2f}: orbits inside",
+        )
+        all_t = sorted({r["t"] for r in survivors})
+        ax.plot(
+            [0.0, *all_t],
+            [E + s_max**2 * t for t in (0.0, *all_t)],
+            ":",
+            color=c,
+            lw=1,
+            label=rf"$E_0 + \sigma^2 t$, $E_0$ = {E:.2f} (all orbits)",
+        )
+    if e_c is not None:
+        ax.axhline(e_c, color="k", lw=0.8, ls="--", label=r"$E_c$")
+    ax.set_xlabel("t")
+    ax.set_ylabel(r"mean energy $\langle E\rangle$")
+    ax.set_title(rf"(e) without drag, $\sigma$ = {s_max:g}: the orbits still inside", fontsize=10)
+    ax.legend(fontsize=6.5, loc="center right")
+
+
+def _panel_two_saddles(ax, d):
+    """(f) the two-saddle system: rate against ΔE/T, measured, the multi-saddle Kramers–Langer sum and its lowest
+    saddle's term alone."""
+    recs = sorted(d["records"], key=lambda r: r["barrier_over_T"])
+    b = np.array([r["barrier_over_T"] for r in recs])
+    ax.errorbar(
+        b,
+        [r["rate"] for r in recs],
+        [r["rate_err"] for r in recs],
+        fmt="o",
+        color=COLORS[4],
+        ms=4,
+        capsize=2,
+        label="measured",
+    )
+    ax.plot(b, [r["kramers_langer"] for r in recs], "s-", color="k", ms=3, lw=1, label=r"$\sum_s k_{KL,s}$")
+    ax.plot(b, [r["kramers_langer_lowest"] for r in recs], "^--", color="0.5", ms=3, lw=1, label="lowest saddle only")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$\Delta E/T$ (lowest saddle)")
+    ax.set_ylabel(r"escape rate $k$")
+    ax.set_title(f"(f) two saddles: V = {d['potential_text']}", fontsize=9)
+    ax.legend(fontsize=7, loc="lower left")
+
+
 def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
-    """plot_noise(...) -> None: the study's four panels in ``path``."""
+    """plot_noise(...) -> None: the study's panels in ``path``: four, and (e) the survivors' energies and (f) the
+    two-saddle system where the numbers carry them."""
     plt = agg_pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(10, 8))
-    _panel_arrhenius(axes[0, 0], rates[rates.set == "kramers"].sort_values("barrier_over_T"))
+    extra = (numbers.get("no_drag_survivors"), (numbers.get("two_saddles") or {}).get("records"))
+    cols = 3 if any(extra) else 2
+    fig, axes = plt.subplots(2, cols, figsize=(5 * cols, 8), squeeze=False)
+    _panel_arrhenius(
+        axes[0, 0], rates[rates.set == "kramers"].sort_values("barrier_over_T"), numbers.get("finite_barrier")
+    )
     _panel_turnover(axes[0, 1], rates[rates.set == "turnover"])
     _panel_reactivation(axes[1, 0], reactivation, numbers["reactivation"])
     _panel_no_drag(axes[1, 1], no_drag)
+    if cols == 3:
+        if numbers.get("no_drag_survivors"):
+            _panel_survivors(axes[0, 2], numbers["no_drag_survivors"], numbers["conventions"].get("E_c"))
+        else:
+            axes[0, 2].set_visible(False)
+        if (numbers.get("two_saddles") or {}).get("records"):
+            _panel_two_saddles(axes[1, 2], numbers["two_saddles"])
+        else:
+            axes[1, 2].set_visible(False)
     fig.suptitle(f"Hénon–Heiles in a heat bath and with noise ({scale} scale)", fontsize=11)
     fig.tight_layout()
     fig.savefig(path, dpi=130)

@@ -8,10 +8,15 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
 
     * ``kramers_b<b>``: γ = gamma_kramers, T = ΔE/b for each barrier b of ``barriers``, orbits started in the
       well at E0 = well_energy < E_c, t_max from ``kramers_t_max``;
+    * ``kramers_b<b>_r<r>``: the same for each barrier of ``resc_barriers`` with r_esc = resc_radius (its own seed);
+    * ``saddles_b<b>``: the declared system ``saddles_potential`` (two exit saddles of different heights) at
+      γ = gamma_kramers, T = ΔE/b (ΔE its lowest barrier) for each b of ``saddles_barriers``;
     * ``turnover_g<γ>``: T = ΔE/turnover_barrier for each γ of ``turnover_gammas``;
     * ``react_T0`` and ``react_T``: the paper's dissipative ensemble (E0 = react_energy, γ = react_gamma) without
       and with the heat bath T = ΔE/react_barrier; ``react_well``: the thermal rate at that (γ, T) from the well;
-    * ``nodrag_E<E>_s<σ>``: γ = 0, noise strength σ (σ = 0: the conservative κ0) at each E0 of nodrag_energies.
+    * ``nodrag_E<E>_s<σ>``: γ = 0, noise strength σ (σ = 0: the conservative κ0) at each E0 of nodrag_energies;
+      ``nodrag_E<E>_s<σ>_t<t>`` (σ > 0): the same orbits (seed, initial conditions, kicks) run to each t of
+      ``nodrag_times``, whose censored orbits' end energies are the survivors' energies at t.
 
 ``analyze(study)``
     Rates by the constant-hazard MLE on [t_relax + relax_widths/γ, t_max] (after relaxation;
@@ -22,8 +27,15 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     ``nodrag_window`` against κ0; each turnover rate against the Mel'nikov–Meshkov/Pollak–Grabert–Hänggi rate
     Υ(δ) k_KL (:func:`hhscatter.analysis.noise.turnover_rate`, δ = γS/T with S the action of the orbit at the
     saddle's energy through the well, :func:`hhscatter.analysis.noise.barrier_action`) and both Kramers limits,
-    the theory's range stated as γ/ω_b ≤ THEORY_GAMMA_MAX. Writes ``noise.json`` (keys ``kramers``,
-    ``turnover``, ``reactivation``, ``no_drag``) and the derived tables ``rates.parquet``, ``survival.parquet``.
+    the theory's range stated as γ/ω_b ≤ THEORY_GAMMA_MAX; the Kramers ratios against T/ΔE by the weighted fit of
+    their first correction, against its transition-state part (:func:`hhscatter.analysis.noise.finite_barrier_fit`,
+    :func:`hhscatter.analysis.noise.transition_state_correction`); the rate at r_esc = resc_radius over the rate
+    at the default radius, by the 2σ rule; the no-drag rate's halves and the survivors' energies at each time
+    (:func:`hhscatter.analysis.noise.survivor_energies`, the fraction below E_c); the two-saddle system's rates
+    against the multi-saddle Kramers–Langer sum and its lowest term, and the escapes' exit channels against each
+    term's share. Writes ``noise.json`` (keys
+    ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``reactivation``,
+    ``no_drag``, ``no_drag_survivors``) and the derived tables ``rates.parquet``, ``survival.parquet``.
 
 ``plot(study)``
     ``noise.png`` via ``plot_noise`` of the folder's ``figure.py``.
@@ -32,6 +44,7 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
 from __future__ import annotations
 
 import math
+import re
 import zlib
 
 import numpy as np
@@ -73,11 +86,21 @@ class Params(StudyParams):
     nodrag_n: Integer
     nodrag_t_max: Number
     nodrag_window: Numbers
+    nodrag_times: Numbers  # the survivors' energies are read at these times (each a run to that time)
+    resc_barriers: Numbers  # ΔE/T of the Kramers records measured again with r_esc = resc_radius
+    resc_radius: Number  # the larger absorbing radius (length)
+    saddles_potential: Text  # a declared system with two exit saddles of different barrier heights
+    saddles_barriers: Numbers  # ΔE/T (ΔE its lowest barrier) of its Kramers records at γ = gamma_kramers
+    saddles_t_max: Numbers
 
 
 def _barrier(study) -> float:
-    """ΔE = E_c − V(min) of the system (energy units): the lowest saddle above the well's minimum."""
-    m = study.model
+    """ΔE = E_c − V(min) of the study's system (energy units): the lowest saddle above the well's minimum."""
+    return _barrier_of(study.model)
+
+
+def _barrier_of(m) -> float:
+    """ΔE = E_c − V(min) of the system ``m`` (energy units)."""
     return m.critical_energy - float(m.potential(np.array(0.0), np.array(0.0)))
 
 
@@ -101,6 +124,31 @@ def _nodrag_key(E, s) -> str:
     return f"nodrag_E{number_key(E, '.2f')}_s{number_key(s, 'g')}"
 
 
+def _survivors_key(E, s, t) -> str:
+    return f"{_nodrag_key(E, s)}_t{number_key(t, 'g')}"
+
+
+def _saddles_key(b) -> str:
+    return f"saddles_b{number_key(b, 'g')}"
+
+
+def _saddles_system(p) -> dict:
+    """The ``[system]`` table of the two-saddle system."""
+    return {"potential": p.saddles_potential}
+
+
+def _resc_key(b, r) -> str:
+    return f"{_kramers_key(b)}_r{number_key(r, 'g')}"
+
+
+def _survivor_times(p) -> list:
+    """The times at which the no-drag survivors' energies are read: ``nodrag_times`` and the runs' t_max."""
+    bad = [t for t in p.nodrag_times if not 0 < t <= p.nodrag_t_max]
+    if bad:
+        raise ValueError(f"[study] nodrag_times: {bad} outside (0, nodrag_t_max = {p.nodrag_t_max:g}]")
+    return sorted({float(t) for t in p.nodrag_times} | {float(p.nodrag_t_max)})
+
+
 def _record_seed(seed: int, key: str) -> int:
     """The seed of the rate record ``key``: derived from the study's seed and the key, so that no two records share
     initial conditions or noise streams."""
@@ -121,6 +169,23 @@ def _runs(study):
         runs[_kramers_key(b)] = dict(
             energy=p.well_energy, gamma=p.gamma_kramers, t_max=t_max, noise={"temperature": dE / b, "flow": p.flow}
         )
+    t_max_of = dict(_pairs(study, "barriers", "kramers_t_max"))
+    for b in p.resc_barriers:
+        if b not in t_max_of:
+            raise ValueError(f"[study] resc_barriers: {b:g} is not one of barriers {list(p.barriers)}")
+        runs[_resc_key(b, p.resc_radius)] = dict(runs[_kramers_key(b)], r_esc=p.resc_radius)
+    if p.saddles_barriers:
+        from hhscatter.model import make_system
+
+        low = _barrier_of(make_system(**_saddles_system(p)))
+        for b, t_max in _pairs(study, "saddles_barriers", "saddles_t_max"):
+            runs[_saddles_key(b)] = dict(
+                energy=p.well_energy,
+                gamma=p.gamma_kramers,
+                t_max=t_max,
+                noise={"temperature": low / b, "flow": p.flow},
+                system=_saddles_system(p),
+            )
     for g, t_max in _pairs(study, "turnover_gammas", "turnover_t_max"):
         runs[_turnover_key(g)] = dict(
             energy=p.well_energy,
@@ -143,9 +208,11 @@ def _runs(study):
                 n=p.nodrag_n,
                 noise={"sigma": s, "flow": p.flow} if s > 0 else None,
             )
+            for t in _survivor_times(p)[:-1] if s > 0 else ():  # the same orbits, read at t (their energies)
+                runs[_survivors_key(E, s, t)] = dict(runs[_nodrag_key(E, s)], t_max=t)
     scenes = {k: study.scene(k, **kw) for k, kw in runs.items()}
     for k, sc in scenes.items():
-        if k.startswith(("kramers_", "turnover_")):
+        if k.startswith(("kramers_", "turnover_", "saddles_")):
             scenes[k] = sc.replace(seed=_record_seed(sc.seed, k))
     return scenes
 
@@ -173,8 +240,6 @@ def _rate_row(study, key, scene):
     t_start = _window_start(p, scene.gamma)
     t_end, escaped, _ = _lifetimes(study, key)
     r = thermal_rate(t_end, escaped, t_start, scene.t_max)
-    (k1, e1), (k2, e2) = r.halves
-    z = (k2 - k1) / math.hypot(e1, e2) if e1 > 0 and e2 > 0 else math.nan
     T = scene.noise.temperature
     kl = kramers_langer(scene.model, scene.gamma, T)
     return {
@@ -189,13 +254,9 @@ def _rate_row(study, key, scene):
         "n_events": r.n_events,
         "n": scene.n,
         "window": [t_start, scene.t_max],
-        "rate_first_half": r.halves[0][0],
-        "rate_second_half": r.halves[1][0],
-        "rate_first_half_err": e1,
-        "rate_second_half_err": e2,
         # the rate is constant inside the window: the halves' difference in standard errors
-        "halves_z": z,
-        "constant_in_window": bool(abs(z) < p.constancy_z),
+        **_halves(r, p.constancy_z),
+        "r_esc": scene.r_esc,
         "seed": scene.seed,
         # a window without an escape: no rate (NaN), its one-sided 95 % upper bound and the ratio's
         **({"rate_upper95": r.upper95, "ratio_upper95": r.upper95 / kl.rate} if r.is_bound else {}),
@@ -223,6 +284,173 @@ def _turnover_theory(study, row, scene) -> dict:
         out[f"ratio_{name}"] = row["rate"] / k
         out[f"ratio_{name}_err"] = row["rate_err"] / k
     return out
+
+
+def _two_saddles(study, runs) -> dict:
+    """The Kramers rate of the two-saddle system against the multi-saddle Kramers–Langer sum and its lowest term
+    alone, and the share of the escapes over each saddle against its term's share of the sum."""
+    from hhscatter.analysis.noise import kramers_langer
+    from hhscatter.analysis.stats.intervals import fraction_with_bound
+    from hhscatter.analysis.stats.verdicts import verdict
+    from hhscatter.data.read import read_by_orbit
+
+    p = study.params
+    rows, saddles = [], []
+    for b, _ in _pairs(study, "saddles_barriers", "saddles_t_max"):
+        key = _saddles_key(b)
+        sc = runs[key]
+        row = _rate_row(study, key, sc)
+        kl = kramers_langer(sc.model, sc.gamma, row["temperature"])
+        low = min(range(len(kl.terms)), key=lambda i: kl.terms[i].barrier)
+        k_low = kl.terms[low].rate
+        row["kramers_langer_lowest"] = k_low
+        row["ratio_lowest"] = row["rate"] / k_low
+        row["ratio_lowest_err"] = row["rate_err"] / k_low
+        c = read_by_orbit(study.raw(key), ["outcome", "t_end", "exit_channel"])
+        t_end = np.asarray(c["t_end"])
+        lo, hi = row["window"]
+        inside = (np.asarray(c["outcome"].astype(str)) == "escaped") & (t_end > lo) & (t_end <= hi)
+        channel = np.asarray(c["exit_channel"])[inside]
+        shares = []
+        for i, term in enumerate(kl.terms):
+            f = fraction_with_bound(int(np.count_nonzero(channel == i)), max(int(inside.sum()), 1))
+            pred = term.rate / kl.rate
+            v = verdict(f.value, f.err, pred)
+            shares.append(
+                {
+                    "exit": i,
+                    "barrier": term.barrier,
+                    "predicted": pred,
+                    "measured": f.value,
+                    "measured_err": f.err,
+                    "measured_upper95": f.upper,
+                    "measured_lower95": f.lower,
+                    "verdict": v.text(),
+                    "z": v.z,
+                }
+            )
+        row["exit_shares"] = shares
+        rows.append(row)
+        saddles = [
+            {"x": t.x, "y": t.y, "barrier": t.barrier, "omega_b": t.omega_b, "prefactor": t.prefactor} for t in kl.terms
+        ]
+    return {
+        "potential": p.saddles_potential,
+        "potential_text": _pretty(p.saddles_potential),
+        "saddles": saddles,
+        "records": rows,
+    }
+
+
+def _pretty(expr: str) -> str:
+    """A potential's text as pages print it: integer powers as superscripts, no ``*``, the minus sign.
+
+    >>> _pretty("(x**2 + y**2)/2 - 5*y**3/18")
+    '(x² + y²)/2 − 5y³/18'
+    """
+    sup = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+    out = re.sub(r"\*\*(\d+)", lambda m: m.group(1).translate(sup), expr)
+    return out.replace("*", "").replace("-", "−")
+
+
+def _finite_barrier(study, kramers) -> dict:
+    """The ratio k/k_KL against T/ΔE: the weighted fit of its first correction and the transition-state term."""
+    from hhscatter.analysis.noise import finite_barrier_fit, transition_state_correction
+
+    f = finite_barrier_fit(
+        [r["barrier_over_T"] for r in kramers], [r["ratio"] for r in kramers], [r["ratio_err"] for r in kramers]
+    )
+    c = transition_state_correction(study.model)
+    return {
+        "intercept": f.measured("intercept").to_dict(),
+        "slope": f.measured("slope").to_dict(),
+        "chi2": f.chi2,
+        "dof": f.dof,
+        "p_value": f.p_value,
+        "slope_intercept_one": f.measured("slope_unit").to_dict(),
+        "chi2_intercept_one": f.chi2_unit,
+        "dof_intercept_one": f.dof_unit,
+        "T_over_barrier_range": list(f.x_range),
+        "transition_state_slope": c.slope,
+        "laplace_well": c.well,
+        "laplace_saddles": list(c.saddles),
+        "fit": "k/k_KL = a + c T/ΔE, weights 1/σ² of the ratios; and k/k_KL − 1 = c T/ΔE (a = 1)",
+        "theory": "c_TST = ΔE (A_s − A_well): the first correction of k_TST from Laplace's expansion of the well's "
+        "and the dividing line's configuration integrals; the transmission factor's own correction is not included",
+    }
+
+
+def _absorbing_radius(study, runs, kramers) -> list:
+    """The Kramers rate at r_esc = resc_radius against the same record at the default radius (independent seeds)."""
+    from hhscatter.analysis.stats.measured import Measured
+    from hhscatter.analysis.stats.verdicts import verdict
+
+    p = study.params
+    by_b = {r["barrier_over_T"]: r for r in kramers}
+    out = []
+    for b in p.resc_barriers:
+        key = _resc_key(b, p.resc_radius)
+        far = _rate_row(study, key, runs[key])
+        near = by_b[far["barrier_over_T"]]
+        ratio = Measured(far["rate"], far["rate_err"]) / Measured(near["rate"], near["rate_err"])
+        v = verdict(ratio.value, ratio.err, 1.0)
+        out.append(
+            {
+                "barrier_over_T": far["barrier_over_T"],
+                "r_esc_default": near["r_esc"],
+                "r_esc": far["r_esc"],
+                "rate_default": {"value": near["rate"], "err": near["rate_err"]},
+                "rate": {"value": far["rate"], "err": far["rate_err"]},
+                "ratio_kramers_langer": {"value": far["ratio"], "err": far["ratio_err"]},
+                "rate_ratio": ratio.to_dict(),
+                "shift": {"value": ratio.value - 1.0, "err": ratio.err},
+                "verdict": v.text(),
+                "z": v.z,
+                "n_events": far["n_events"],
+                "window": far["window"],
+                "constant_in_window": far["constant_in_window"],
+                "seed": far["seed"],
+            }
+        )
+    return out
+
+
+def _no_drag_survivors(study, runs) -> list:
+    """The energies of the no-drag orbits still inside at each time of :func:`_survivor_times` (σ > 0)."""
+    from hhscatter.analysis.noise import survivor_energies
+    from hhscatter.data.read import read_by_orbit
+
+    p = study.params
+    e_c = study.model.critical_energy
+    times = _survivor_times(p)
+    rows = []
+    for E in p.nodrag_energies:
+        for s in p.nodrag_sigmas:
+            if s <= 0:
+                continue
+            for t in times:
+                key = _nodrag_key(E, s) if t == times[-1] else _survivors_key(E, s, t)
+                c = read_by_orbit(study.raw(key), ["outcome", "e_end"])
+                alive = np.asarray(c["outcome"].astype(str)) == "censored"
+                row = {"energy": E, "sigma": s, "t": t, "n": int(alive.size), "n_alive": int(alive.sum())}
+                # ⟨E⟩ of the whole ensemble, were every orbit kept: E0 + σ² t (two momenta)
+                row["ensemble_mean_energy"] = E + s * s * t
+                if alive.sum() >= 2:
+                    se = survivor_energies(np.asarray(c["e_end"])[alive], e_c)
+                    row.update(
+                        mean_energy=se.mean,
+                        mean_energy_err=se.mean_err,
+                        sd_energy=se.sd,
+                        energy_q10=se.quantiles[0.1],
+                        energy_q50=se.quantiles[0.5],
+                        energy_q90=se.quantiles[0.9],
+                        below_ec=se.below,
+                        below_ec_err=se.below_err,
+                        below_ec_upper95=se.below_upper,
+                        below_ec_lower95=se.below_lower,
+                    )
+                rows.append(row)
+    return rows
 
 
 def _reactivation(study, runs):
@@ -259,7 +487,22 @@ def _reactivation(study, runs):
     return numbers, c.table
 
 
+def _halves(r, constancy_z) -> dict:
+    """The rates on a window's two halves and whether they agree within ``constancy_z`` σ (``halves_z``)."""
+    (k1, e1), (k2, e2) = r.halves
+    z = (k2 - k1) / math.hypot(e1, e2) if e1 > 0 and e2 > 0 else math.nan
+    return {
+        "rate_first_half": k1,
+        "rate_second_half": k2,
+        "rate_first_half_err": e1,
+        "rate_second_half_err": e2,
+        "halves_z": z,
+        "constant_in_window": bool(abs(z) < constancy_z),
+    }
+
+
 def _no_drag(study, runs):
+    from hhscatter.analysis.noise import thermal_rate
     from hhscatter.analysis.survival.relative_rates import relative_rates
 
     p = study.params
@@ -269,9 +512,10 @@ def _no_drag(study, runs):
     rows = []
     for E in p.nodrag_energies:
         samples = [_lifetimes(study, _nodrag_key(E, s))[:2] for s in sigmas]
-        for s, rr in zip(sigmas, relative_rates(samples, lo, hi, ref)):
+        for s, rr, (t_end, esc) in zip(sigmas, relative_rates(samples, lo, hi, ref), samples):
             m = rr.rate
             row = {"energy": E, "sigma": s, "kappa": m.kappa, "kappa_err": m.kappa_err, "n_events": m.n_events}
+            row.update(_halves(thermal_rate(t_end, esc, lo, hi), p.constancy_z))
             if rr.ratio is not None:
                 row["kappa_over_kappa0"], row["kappa_over_kappa0_err"] = rr.ratio.value, rr.ratio.err
                 # energy gained by diffusion over the window: ⟨E⟩ grows by σ² t (two degrees of freedom)
@@ -308,12 +552,15 @@ def analyze(study):
         turnover.append({**row, **_turnover_theory(study, row, runs[_turnover_key(g)])})
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
+    survivors = _no_drag_survivors(study, runs)
     rates = pd.DataFrame([{"set": "kramers", **r} for r in kramers] + [{"set": "turnover", **r} for r in turnover])
     rates["window"] = rates["window"].map(lambda w: float(w[1]))
     study.write_table(rates.rename(columns={"window": "t_max"}), "rates.parquet")
     study.write_table(react_table, "reactivation.parquet")
     study.write_table(_survival_tables(study, runs), "no_drag.parquet")
     study.write_table(pd.DataFrame(no_drag), "no_drag_rates.parquet")
+    absorbing = _absorbing_radius(study, runs, kramers)
+    saddles = _two_saddles(study, runs)
     hi = kramers[-1]
     study.compare(
         f"escape rate / Kramers–Langer at ΔE/T = {hi['barrier_over_T']:.3g}, γ = {hi['gamma']:g}",
@@ -326,9 +573,13 @@ def analyze(study):
     study.write_numbers(
         {
             "kramers": kramers,
+            "finite_barrier": _finite_barrier(study, kramers),
+            "absorbing_radius": absorbing,
+            "two_saddles": saddles,
             "turnover": turnover,
             "reactivation": react,
             "no_drag": no_drag,
+            "no_drag_survivors": survivors,
             "conventions": {
                 "r_esc": runs["react_T"].r_esc,
                 "ic_region": "disk r < 0.5",
@@ -337,9 +588,15 @@ def analyze(study):
                 "relax_widths": p.relax_widths,
                 "window_rule": f"t ≥ {p.t_relax:g} + {p.relax_widths:g}/γ; constant when the halves agree within "
                 f"{p.constancy_z:g}σ",
-                "all_constant_in_window": all(r["constant_in_window"] for r in kramers + turnover),
+                # every heat-bath rate: Kramers, turnover, the second radius and the two-saddle system
+                "all_constant_in_window": all(
+                    r["constant_in_window"] for r in kramers + turnover + absorbing + saddles["records"]
+                ),
                 "seeds": "one per Kramers and turnover record, derived from the study's seed and the record's key",
                 "nodrag_window": list(p.nodrag_window),
+                "nodrag_times": _survivor_times(p),
+                "E_c": study.model.critical_energy,
+                "resc_radius": p.resc_radius,
                 "kick": "0.1 min(1/ω, 1/γ) (the scene default)",
                 "flow": p.flow,
                 "turnover_theory": "Mel'nikov–Meshkov/PGH k = Υ(δ) k_KL, δ = γS/T, S the action of the orbit at "

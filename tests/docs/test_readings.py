@@ -272,3 +272,125 @@ def test_the_energy_scan_reading_says_every_energy_only_when_each_one_passes():
     doc["energy_scan"][1] = row(0.3, False, 0.70, 0.51)  # not Wada, and S_bb 0.70 within 2σ of ln 2 = 0.693
     text = READINGS["basins.energy_scan"](_loader({"basins": doc}))
     assert text.startswith("the exit basins are not Wada at 0.3; Wada at 0.2, 0.4; S_bb not above ln 2 by 2σ at 0.3")
+
+
+def _finite_barrier_doc(slope, slope_err, unit, unit_err, p_value, chi2=3.0, dof=4):
+    return {
+        "finite_barrier": {
+            "intercept": {"value": 0.98, "err": 0.015},
+            "slope": {"value": slope, "err": slope_err},
+            "chi2": chi2,
+            "dof": dof,
+            "p_value": p_value,
+            "slope_intercept_one": {"value": unit, "err": unit_err},
+            "T_over_barrier_range": [0.125, 1 / 3],
+            "transition_state_slope": -2 / 9,
+        }
+    }
+
+
+def test_the_finite_barrier_reading_compares_the_slopes_with_the_theory_and_zero():
+    text = READINGS["noise.finite_barrier"](_loader({"noise": _finite_barrier_doc(-0.13, 0.07, -0.23, 0.02, 0.5)}))
+    assert "the intercept 0.980 ± 0.015, which agrees with 1 (z = -1.3)" in text.replace("−", "-")
+    assert "c_TST = −0.222: the free slope agrees with it (z = +1.3) and lies within 2σ of 0 (z = −1.9)" in text
+    assert "the slope at intercept 1 agrees with it (z = −0.4) and is resolved from 0 (z = −11.5)" in text
+    assert "scatter" not in text
+    far = READINGS["noise.finite_barrier"](_loader({"noise": _finite_barrier_doc(0.5, 0.1, 0.3, 0.02, 0.01, 12, 4)}))
+    assert "the free slope differs from it (z = +7.2) and is resolved from 0 (z = +5.0)" in far
+    assert "understated by about √(χ²/dof) = 1.7" in far
+
+
+def test_the_absorbing_radius_reading_says_a_shift_only_beyond_two_sigma():
+    def row(b, ratio, err):
+        return {"barrier_over_T": b, "r_esc": 3.0, "r_esc_default": 1.5, "rate_ratio": {"value": ratio, "err": err}}
+
+    text = READINGS["noise.absorbing_radius"](
+        _loader({"noise": {"absorbing_radius": [row(5, 0.9, 0.02), row(3, 0.98, 0.02)]}})
+    )
+    assert text == (
+        "at ΔE/T = 3 the rate at r_esc = 3 is 0.980 ± 0.020 of that at 1.5 (shift −2.0 ± 2.0 %, z = −1.0: no shift "
+        "resolved at 2σ); at ΔE/T = 5 the rate at r_esc = 3 is 0.900 ± 0.020 of that at 1.5 (shift −10.0 ± 2.0 %, "
+        "z = −5.0: the larger radius lowers the rate)"
+    )
+
+
+def _survivors_doc(means, halves):
+    """E0 = 0.3, σ = 0.02: the survivors' mean energies at t = 10, 55, 100 (error 0.002) and the rate's halves."""
+    surv = [
+        {
+            "energy": 0.3,
+            "sigma": 0.02,
+            "t": t,
+            "n_alive": 500,
+            "ensemble_mean_energy": 0.3 + 0.0004 * t,
+            "mean_energy": m,
+            "mean_energy_err": 0.002,
+            "below_ec": 0.74,
+            "below_ec_err": 0.02,
+        }
+        for t, m in zip((10.0, 55.0, 100.0), means)
+    ]
+    (k1, e1), (k2, e2) = halves
+    z = (k2 - k1) / (e1**2 + e2**2) ** 0.5
+    rate = {
+        "energy": 0.3,
+        "sigma": 0.02,
+        "rate_first_half": k1,
+        "rate_first_half_err": e1,
+        "rate_second_half": k2,
+        "rate_second_half_err": e2,
+        "halves_z": z,
+        "constant_in_window": abs(z) < 3,
+    }
+    return {"no_drag_survivors": surv, "no_drag": [rate], "conventions": {"nodrag_window": [10.0, 100.0]}}
+
+
+def test_the_survivors_reading_says_they_lost_energy_only_when_measured_so():
+    lost = READINGS["noise.no_drag_survivors"](
+        _loader({"noise": _survivors_doc((0.29, 0.194, 0.17), ((0.157, 0.004), (0.021, 0.003)))})
+    )
+    assert "0.2900 ± 0.0020 at t = 10, 0.1940 ± 0.0020 at t = 55, 0.1700 ± 0.0020 at t = 100" in lost
+    assert "(below E0 by more than 2σ at every one of these times)" in lost
+    assert "E0 + σ²t is 0.34 at t = 100; 74.0 ± 2.0 % of the 500 orbits inside at t = 100 lie below E_c" in lost
+    assert "is not constant: 0.157 ± 0.004 on the first half, 0.021 ± 0.003 on the second (z = −27.2)" in lost
+    assert "the orbits that stay have lost energy although the noise raises the ensemble's mean" in lost
+    kept = READINGS["noise.no_drag_survivors"](
+        _loader({"noise": _survivors_doc((0.299, 0.302, 0.301), ((0.157, 0.004), (0.150, 0.004)))})
+    )
+    assert "below E0 by more than 2σ at none of them" in kept and "constant within the halves' errors" in kept
+    assert "have lost energy" not in kept
+    assert "not in this scale's numbers" in READINGS["noise.no_drag_survivors"](_loader({"noise": {"no_drag": []}}))
+
+
+def test_the_two_saddles_reading_compares_the_sum_its_lowest_term_and_the_exit_shares():
+    def share(i, barrier, pred, meas, err):
+        return {
+            "exit": i,
+            "barrier": barrier,
+            "predicted": pred,
+            "measured": meas,
+            "measured_err": err,
+            "z": (meas - pred) / err,
+        }
+
+    rec = {
+        "barrier_over_T": 2.0,
+        "ratio": 0.97,
+        "ratio_err": 0.02,
+        "ratio_lowest": 1.40,
+        "ratio_lowest_err": 0.03,
+        "exit_shares": [share(0, 1 / 6, 0.71, 0.70, 0.01), share(1, 0.24, 0.29, 0.30, 0.01)],
+    }
+    text = READINGS["noise.two_saddles"](_loader({"noise": {"two_saddles": {"records": [rec]}}}))
+    assert text == (
+        "at ΔE/T = 2 the rate over the two-saddle sum Σ_s k_KL,s is 0.970 ± 0.020, which agrees with 1 (z = −1.5), "
+        "and over the lowest saddle's term alone (ΔE = 0.167) 1.40 ± 0.03, which differs from 1 (z = +13.3); the "
+        "higher saddle (ΔE = 0.24) takes 0.300 ± 0.010 of the escapes in the window, against its term's share 0.290 "
+        "of the sum, which agrees with it (z = +1.0)"
+    )
+
+
+def test_a_shift_that_rounds_to_zero_is_written_without_a_sign():
+    row = {"barrier_over_T": 3, "r_esc": 3.0, "r_esc_default": 1.5, "rate_ratio": {"value": 0.997, "err": 0.05}}
+    text = READINGS["noise.absorbing_radius"](_loader({"noise": {"absorbing_radius": [row]}}))
+    assert "(shift 0 ± 5 %, z = −0.1: no shift resolved at 2σ)" in text

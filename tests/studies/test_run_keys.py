@@ -47,9 +47,11 @@ def test_noise_study_makes_one_run_per_energy_of_a_close_pair():
     study = load_study("noise", "tiny")
     study.config["study"]["nodrag_energies"] = [0.30, 0.304]
     runs = stage_module("noise")._runs(study)
-    nodrag = {k: sc for k, sc in runs.items() if k.startswith("nodrag_")}
+    nodrag = {k: sc for k, sc in runs.items() if k.startswith("nodrag_") and "_t" not in k}  # not the survivors' runs
     sigmas = study.params.nodrag_sigmas
     assert len(nodrag) == 2 * len(sigmas)
+    survivors = [k for k in runs if k.startswith("nodrag_") and "_t" in k]
+    assert len(survivors) == 2 * sum(s > 0 for s in sigmas) * len(study.params.nodrag_times)
     assert sorted({sc.energy for sc in nodrag.values()}) == [0.30, 0.304]
     for key, sc in nodrag.items():  # the key names the scene's own energy
         assert float(key.split("_")[1][1:]) == sc.energy

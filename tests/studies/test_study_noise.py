@@ -51,3 +51,63 @@ def test_turnover_records_carry_the_theory_and_its_range(runs):
         assert th["ratio_ed_err"] / th["ratio_ed"] == pytest.approx(0.05, rel=1e-9)
         assert th["ratio_mm"] == pytest.approx(0.02 / th["melnikov_meshkov"], rel=1e-12)
         assert th["theory_assumptions_hold"] == holds  # γ = 0.3 is the range's edge, γ/ω_b ≤ 0.3 (ω_b = 1)
+
+
+def test_the_absorbing_radius_records_differ_from_their_kramers_record_in_radius_and_seed_only(runs):
+    study, scenes = runs
+    p = study.params
+    for b in p.resc_barriers:
+        base, far = scenes[f"kramers_b{b:g}"], scenes[f"kramers_b{b:g}_r{p.resc_radius:g}"]
+        assert far.r_esc == p.resc_radius > base.r_esc == 1.5
+        assert far.seed != base.seed
+        assert base.replace(r_esc=far.r_esc, seed=far.seed, name=far.name) == far
+
+
+def test_the_survivor_runs_are_the_no_drag_orbits_run_to_each_time(runs):
+    """Same seed, initial conditions and kick interval as the no-drag run; one run per time and σ > 0."""
+    from hhscatter.integrate.noise import kick_interval
+
+    study, scenes = runs
+    p = study.params
+    times = [t for t in p.nodrag_times if t < p.nodrag_t_max]
+    for E in p.nodrag_energies:
+        for s in p.nodrag_sigmas:
+            key = f"nodrag_E{E:.2f}_s{s:g}"
+            extra = sorted(k for k in scenes if k.startswith(key + "_t"))
+            if s == 0:
+                assert extra == []
+                continue
+            assert extra == sorted(f"{key}_t{t:g}" for t in times)
+            for t in times:
+                sc = scenes[f"{key}_t{t:g}"]
+                assert sc.replace(t_max=p.nodrag_t_max, name=scenes[key].name) == scenes[key] and sc.t_max == t
+                assert kick_interval(sc) == kick_interval(scenes[key])
+
+
+def test_survivor_times_outside_the_run_are_refused():
+    from types import SimpleNamespace
+
+    mod = stage_module("noise")
+    assert mod._survivor_times(SimpleNamespace(nodrag_times=[55.0, 10.0], nodrag_t_max=200.0)) == [10.0, 55.0, 200.0]
+    with pytest.raises(ValueError, match=r"nodrag_times: \[250.0\] outside \(0, nodrag_t_max = 200\]"):
+        mod._survivor_times(SimpleNamespace(nodrag_times=[10.0, 250.0], nodrag_t_max=200.0))
+
+
+def test_the_two_saddle_records_run_the_declared_system_at_its_lowest_barrier(runs):
+    """V = (x² + y²)/2 − x³/3 − 5y³/18: saddles (1, 0) at ΔE = 1/6 and (0, 6/5) at 36/50 − (5/18)(216/125) = 0.24;
+    T = (1/6)/b, γ = gamma_kramers, each record on its own seed."""
+    study, scenes = runs
+    p = study.params
+    keys = [f"saddles_b{b:g}" for b in p.saddles_barriers]
+    assert keys and len(
+        {scenes[k].seed for k in keys} | {sc.seed for k, sc in scenes.items() if k.startswith("kramers_")}
+    ) == len(keys) + sum(k.startswith("kramers_") for k in scenes)
+    for b, key in zip(p.saddles_barriers, keys):
+        sc = scenes[key]
+        exits = np.array(sorted((e.x, e.y, e.energy) for e in sc.model.exits))
+        assert np.abs(exits - [(0.0, 1.2, 0.24), (1.0, 0.0, 1 / 6)]).max() < 1e-12
+        assert sc.noise.temperature == pytest.approx(1 / 6 / b, rel=1e-12) and sc.gamma == p.gamma_kramers
+
+
+def test_the_potential_is_printed_with_superscripts_and_minus_signs():
+    assert stage_module("noise")._pretty("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18") == "(x² + y²)/2 − x³/3 − 5y³/18"
