@@ -1,0 +1,47 @@
+"""Figure of the chaotic-saddle study ``saddle`` (draws the numbers JSON; computes nothing)."""
+
+from __future__ import annotations
+
+from hhscatter.publish.figures import agg_pyplot, save_panels
+
+COLORS = {"henon_heiles": "#2166ac", "contopoulos": "#b2182b", "barbanis": "#1b7837"}
+MARKERS = {"henon_heiles": "o", "contopoulos": "s", "barbanis": "^"}
+
+
+def _done(records):
+    return [r for r in records if r.get("predicted") is not None]
+
+
+def plot_saddle(numbers, path):
+    """Two panels: (a) κ against λ̄(1 − d₁) per point; (b) the section's D₁ measured and implied, 2(1 − κ/λ̄)."""
+    plt = agg_pyplot()
+    recs = _done(numbers["saddle"])
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.2))
+    hi = 0.0
+    for label in dict.fromkeys(r["system"] for r in recs):
+        rs = [r for r in recs if r["system"] == label]
+        col, mk = COLORS.get(label, "k"), MARKERS.get(label, "o")
+        a.errorbar([r["predicted"] for r in rs], [r["kappa"] for r in rs], xerr=[r["predicted_err"] for r in rs],
+                   yerr=[r["kappa_err"] for r in rs], fmt=mk, color=col, capsize=3, label=label)  # fmt: skip
+        hi = max(hi, *(max(r["predicted"] + r["predicted_err"], r["kappa"]) for r in rs))
+        x = [r["ratio"] for r in rs]
+        b.errorbar(x, [r["d1_section"] for r in rs], [r["d1_section_err"] for r in rs], fmt=mk + "-", color=col,
+                   capsize=3, label=f"{label}: measured D₁")  # fmt: skip
+        b.errorbar(x, [2 * r["d1_implied"] for r in rs], [2 * r["d1_implied_err"] for r in rs], fmt=mk + "--",
+                   mfc="none", color=col, capsize=3, alpha=0.7, label=f"{label}: 2(1 − κ/λ̄)")  # fmt: skip
+    hi = 1.1 * hi if hi > 0 else 1.0
+    a.plot([0, hi], [0, hi], color="0.5", lw=1, label="κ = λ̄(1 − d₁)")
+    a.set_xlim(0, hi)
+    a.set_ylim(0, hi)
+    a.set_xlabel("λ̄ (1 − d₁)   (1/time)")
+    a.set_ylabel("κ   (1/time)")
+    a.set_title("(a) the Kantz–Grassberger relation")
+    a.legend(fontsize=8)
+    b.set_xlabel("E / E_c")
+    b.set_ylabel("information dimension D₁ = 2 d₁ on the section")
+    b.set_title("(b) D₁ measured and implied by κ and λ̄")
+    b.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    save_panels(fig, path, dpi=180)
+    plt.close(fig)

@@ -1,0 +1,317 @@
+"""Study saddle — the chaotic saddle measured and the Kantz–Grassberger relation κ = λ̄ (1 − d₁) (beyond the paper).
+
+Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|analyze|plot [--scale S]``):
+
+``simulate(study, workers=None, progress=True)``
+    Per system and E = r·E_c: the main run (raw key ``<label>_r<r>``: disk ICs, every section crossing to t_max),
+    its κ (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_from_lifetimes`) and t_min = tmin_efolds/κ,
+    and the tangent run (``<label>_r<r>_tangent``, ``[scene] tangent = true``) of the orbits that left at
+    t_end ≥ t_min, from their initial conditions. The κ and t_min used are written to ``raw/saddle_choices.json``.
+
+``analyze(study)``
+    ``saddle.json``: per point κ, λ̄ (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`,
+    :func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), d₁ on the section
+    (:func:`~hhscatter.analysis.geometry.saddle.saddle_points`,
+    :func:`~hhscatter.analysis.geometry.saddle.information_dimension`,
+    :func:`~hhscatter.analysis.geometry.saddle.window_dependence`) and the relation's verdict
+    (:func:`~hhscatter.analysis.geometry.saddle.kantz_grassberger`); derived table ``saddle_ftle.parquet`` (the
+    finite-time exponents Λ/T of the tangent runs).
+
+``plot(study)``
+    ``saddle.png`` via ``plot_saddle`` of the folder's ``figure.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from hhscatter.errors import ConfigError
+from hhscatter.scene.schema import Integer, Number, Numbers, Text
+from hhscatter.studies.params import StudyParams
+from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
+
+
+class SystemEntry(StudyParams):
+    """One entry of ``[study] systems``: a label, a built-in system with its parameters and its E/E_c."""
+
+    label: Text
+    name: Text
+    params: dict[str, Number] = None  # the built-in's defaults where absent
+    ratios: Numbers  # E/E_c of the points
+    t_max: Number = None  # the system's own t_max ([study] t_max where absent)
+
+
+class Params(StudyParams):
+    """``[study]`` of studies/saddle/study.toml (rules in its header comment)."""
+
+    systems: list[SystemEntry]
+    radius_frac: Number  # IC disk r < radius_frac·r_s
+    n: Integer  # orbits per main run
+    t_max: Number
+    tmin_efolds: Number  # t_min = tmin_efolds/κ
+    tmin_checks: Numbers  # d₁ also at t_min = c/κ for these c
+    window: Numbers  # (lo, hi): fractions of each orbit's lifetime
+    min_boxes: Number
+    min_occupancy: Number
+    n_bins: Integer  # λ̄(T) bins
+    n_boot: Integer
+
+
+FTLE_TABLE = "saddle_ftle.parquet"
+
+
+def _systems(study):
+    """[(label, spec, System, ratios, t_max)] of [study] systems."""
+    from hhscatter.model.spec import system_from_spec
+
+    out = []
+    for e in study.params.systems:  # typed entries read as dicts
+        spec = {"name": e["name"], "params": dict(e.get("params") or {})}
+        t_max = float(e.get("t_max") or study.params.t_max)
+        out.append((e["label"], spec, system_from_spec(spec), [float(r) for r in e["ratios"]], t_max))
+    return out
+
+
+def point_key(label: str, ratio: float) -> str:
+    """point_key(label, r) -> raw-run key 'henon_heiles_r1.50' of the main run at E = r·E_c."""
+    return f"{label}_r{ratio:.2f}"
+
+
+def _choices_path(study):
+    return study.out / "raw" / "saddle_choices.json"
+
+
+def _lifetimes(path, extra=()):
+    from hhscatter.data.read import read_lifetimes
+
+    return read_lifetimes(path, columns=["traj_id", "e0", "gamma", "outcome", "t_end", *extra], categorical=True)
+
+
+def _kappa(path):
+    """κ of the orbits that left by t_max (those trapped on tori to t_max are not on the saddle)."""
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
+    from hhscatter.outcomes import LEAVING_OUTCOMES
+
+    lt = _lifetimes(path)
+    return escape_rate_from_lifetimes(lt[lt["outcome"].astype(object).isin(LEAVING_OUTCOMES)], detect_tail=False)
+
+
+def _long_lived(lt, t_min):
+    """Rows of the orbits that left at t_end ≥ t_min."""
+    from hhscatter.outcomes import LEAVING_OUTCOMES
+
+    left = lt["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
+    return lt[left & (lt["t_end"].to_numpy() >= t_min)]
+
+
+# ---------------------------------------------------------------------------
+# simulate
+# ---------------------------------------------------------------------------
+def simulate(study, workers=None, progress=True):
+    """simulate(study, workers=None, progress=True) -> None: per point the main run and the tangent run."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from hhscatter.data.read import read_lifetimes
+    from hhscatter.studies import write_json_atomic
+
+    p, choices = study.params, {}
+    for label, spec, m, ratios, t_max in _systems(study):
+        for r in ratios:
+            key = point_key(label, r)
+            sc = study.scene(
+                key,
+                system=spec,
+                energy=r * m.critical_energy,
+                n=p.n,
+                radius=p.radius_frac * m.saddle_radius,
+                t_max=t_max,
+                sections={"t_from": 0.0},
+            )
+            study.run(key, sc, workers=workers, progress=progress)
+            k = _kappa(study.raw(key))
+            t_min = p.tmin_efolds / k.kappa
+            lt = read_lifetimes(study.raw(key), columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
+            sel = _long_lived(lt, t_min)
+            print(f"  saddle {key}: κ = {k.kappa:.4f} ± {k.kappa_err:.4f}, t_min = {t_min:.1f}, {len(sel)} orbits")
+            choices[key] = {"system": label, "ratio": r, "energy": r * m.critical_energy, "kappa": k.kappa,
+                            "kappa_err": k.kappa_err, "t_min": t_min, "n_tangent": len(sel), "r_esc": sc.r_esc}  # fmt: skip
+            if len(sel) == 0:
+                continue
+            path = study.derived(f"{key}_tangent_ics.parquet")
+            cols = {"traj_id": sel["traj_id"].to_numpy(), "x": sel["x0"].to_numpy(), "y": sel["y0"].to_numpy(),
+                    "px": sel["px0"].to_numpy(), "py": sel["py0"].to_numpy()}  # fmt: skip
+            pq.write_table(pa.table(cols), path)
+            tsc = study.scene(
+                key + "_tangent",
+                system=spec,
+                ics=str(path),
+                n=len(sel),
+                t_max=t_max,
+                r_esc=sc.r_esc,
+                sections=None,
+                tangent=True,
+            )
+            study.run(key + "_tangent", tsc, workers=workers, progress=progress)
+    write_json_atomic(_choices_path(study), choices)
+
+
+# ---------------------------------------------------------------------------
+# analyze
+# ---------------------------------------------------------------------------
+def _lyapunov(lt, t_min, p):
+    """λ̄ of the tangent run's orbits that left at t_end ≥ t_min: the record's value, error, rule and FTLE."""
+    from hhscatter.analysis.geometry.saddle import lyapunov_convergence, mean_lyapunov
+
+    lt = _long_lived(lt, t_min)
+    L, T = lt["log_stretch"].to_numpy(), lt["t_end"].to_numpy()
+    if L.size < 2:
+        return None
+    mean = mean_lyapunov(L, T, n_boot=p.n_boot, seed=0)
+    out = {"mean": mean.value, "mean_err": mean.err, "n_orbits": mean.n_orbits, "ftle_std": mean.ftle_std,
+           "ftle_q05": mean.ftle_quantiles[0.05], "ftle_q50": mean.ftle_quantiles[0.5],
+           "ftle_q95": mean.ftle_quantiles[0.95], "value": mean.value, "err": mean.err, "rule": "mean"}  # fmt: skip
+    try:
+        c = lyapunov_convergence(L, T, n_bins=p.n_bins, n_boot=p.n_boot, seed=0)
+    except ConfigError as exc:
+        out["convergence"] = str(exc)
+        return out, lt.assign(ftle=mean.ftle)
+    out.update({"extrapolated": c.extrapolated, "extrapolated_err": c.extrapolated_err, "slope": c.slope,
+                "slope_err": c.slope_err, "converged": c.converged})  # fmt: skip
+    out.update({"lambda_mean": {"value": mean.value, "err": mean.err},
+                "lambda_inf": {"value": c.extrapolated, "err": c.extrapolated_err},
+                "b": {"value": c.slope, "err": c.slope_err}})  # fmt: skip
+    if not c.converged:
+        out.update({"value": c.extrapolated, "err": c.extrapolated_err, "rule": "extrapolated (1/T drift resolved)"})
+    return out, lt.assign(ftle=mean.ftle)
+
+
+def _d1_estimator(p, lam):
+    """The section's information dimension of a SaddlePoints, eps_min from the points' distance to the saddle."""
+    from hhscatter.analysis.geometry.saddle import information_dimension
+
+    def est(sp):
+        P = sp.points[["x", "y"]].to_numpy()
+        extent = float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
+        eps_min = extent * math.exp(-lam * sp.window[0] * sp.t_min)
+        return information_dimension(P, groups=sp.points["traj_id"].to_numpy(), min_boxes=p.min_boxes,
+                                     min_occupancy=p.min_occupancy, eps_min=eps_min, n_boot=p.n_boot, seed=0)  # fmt: skip
+
+    return est
+
+
+def _point(study, key, ch):
+    """One point's record and its FTLE rows."""
+    from hhscatter.analysis.geometry.saddle import kantz_grassberger, saddle_points, window_dependence
+    from hhscatter.data.read import read_sections
+
+    p = study.params
+    k = _kappa(study.raw(key))
+    t_min = p.tmin_efolds / k.kappa
+    rec = {"id": f"{ch['system']}-{ch['ratio']:.2f}", "system": ch["system"], "ratio": ch["ratio"], "energy": ch["energy"], "kappa": k.kappa,
+           "kappa_err": k.kappa_err, "lyapunov": None, "lyapunov_err": None, "d0": None, "d0_err": None,
+           "d1": None, "d1_err": None, "t_min": t_min, "notes": []}  # fmt: skip
+    if abs(t_min - ch["t_min"]) > 1e-9 * t_min:
+        rec["notes"].append(f"t_min of the tangent run {ch['t_min']:.6g} differs from {t_min:.6g}: re-run simulate")
+    if ch["n_tangent"] == 0:
+        rec["notes"].append("no orbit left at t_end ≥ t_min")
+        return rec, None
+    lam = _lyapunov(_lifetimes(study.raw(key + "_tangent"), ("log_stretch",)), ch["t_min"], p)
+    if lam is None:
+        rec["notes"].append("fewer than 2 orbits of the tangent run left at t_end ≥ t_min")
+        return rec, None
+    lam, ftle = lam
+    rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
+    lt = _lifetimes(study.raw(key))
+    sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
+    est = _d1_estimator(p, lam["value"])
+    wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in (*p.tmin_checks, p.tmin_efolds)],
+                           windows=[tuple(p.window)], columns=["x", "y"])  # fmt: skip
+    rec["d1_by_t_min"] = [
+        {
+            "t_min_kappa": c,
+            "n_orbits": int(r.n_orbits),
+            "n_points": int(r.n_points),
+            "d1_section": None if math.isnan(r.value) else {"value": float(r.value), "err": float(r.err)},
+            "note": r.note,
+        }  # fmt: skip
+        for c, r in zip((*p.tmin_checks, p.tmin_efolds), wd.itertuples())
+    ]
+    try:
+        sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y"])
+        d = est(sp)
+    except ConfigError as exc:
+        rec["notes"].append(f"d1: {exc}")
+        return rec, ftle
+    try:
+        kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], d.value, d.err, dimension="section")
+    except ConfigError as exc:  # e.g. λ̄ ≤ 0: no lever arm in T for the 1/T extrapolation
+        rec["notes"].append(f"relation: {exc}")
+        return rec, ftle
+    rec.update({"d1": kg.d1, "d1_err": kg.d1_err, "d1_section": d.value, "d1_section_err": d.err,
+                "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points,
+                "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
+                "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
+    return rec, ftle
+
+
+def _relation_row(rec: dict) -> dict:
+    """A record's measured values as {value, err} pairs (rendered ``value ± err``), the ones it has."""
+    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"], "energy": rec["energy"]}
+    for name, err in (("kappa", "kappa_err"), ("lyapunov", "lyapunov_err"), ("d1_section", "d1_section_err"),
+                      ("d1", "d1_err"), ("predicted", "predicted_err"), ("d1_implied", "d1_implied_err")):  # fmt: skip
+        if rec.get(name) is not None and rec.get(err) is not None:
+            row[name] = {"value": rec[name], "err": rec[err]}
+    if rec.get("d1_implied") is not None:
+        row["d1_section_implied"] = {"value": 2 * rec["d1_implied"], "err": 2 * rec["d1_implied_err"]}
+    if rec.get("verdict") is not None:
+        row["z"], row["verdict"] = rec["z"], rec["verdict"]
+    return row
+
+
+def analyze(study):
+    """analyze(study) -> None; writes saddle.json and saddle_ftle.parquet."""
+    import pandas as pd
+
+    choices = json.loads(_choices_path(study).read_text())
+    records, ftles = [], []
+    for label, _spec, _m, ratios, _t_max in _systems(study):
+        for r in ratios:
+            key = point_key(label, r)
+            rec, ftle = _point(study, key, choices[key])
+            records.append(rec)
+            if ftle is not None:
+                ftles.append(ftle[["traj_id", "t_end", "ftle"]].assign(system=label, ratio=r))
+    cols = ["traj_id", "t_end", "ftle", "system", "ratio"]
+    study.write_table(
+        pd.concat(ftles, ignore_index=True) if ftles else pd.DataFrame(columns=cols),
+        FTLE_TABLE,
+        description="finite-time Lyapunov exponents Λ/t_end of the tangent runs (orbits left at t_end ≥ t_min)",
+    )
+    checked = [x for x in records if x.get("z") is not None]
+    relation = [_relation_row(x) for x in records]
+    study.write_numbers(
+        {
+            "saddle": records,
+            "relation": relation,
+            "summary": {
+                "n_points": len(records),
+                "n_checked": len(checked),
+                "n_within_2sigma": sum(abs(x["z"]) <= 2 for x in checked),
+            },
+            "d0_note": "d0 = 1 - alpha is not measured by this study (no lines of initial conditions are run): "
+            "d0 and d0_err are null",
+            "rules": {
+                "tmin_efolds": study.params.tmin_efolds,
+                "window": list(study.params.window),
+                "tmin_checks": list(study.params.tmin_checks),
+                "n_orbits_per_point": study.params.n,
+            },  # fmt: skip
+        }
+    )
+
+
+plot = figure_stage("plot_saddle", NUMBERS, PATH)
