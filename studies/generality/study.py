@@ -127,6 +127,7 @@ class Params(StudyParams):
     resc_n: Integer = 2000
     resc_probe_n: Integer = 1000
     resc_diss_n: Integer = 4000
+    resc_boot: Integer = 100  # replicates of the paired bootstrap of κ0's shift between the radii
 
 
 def _systems(study):

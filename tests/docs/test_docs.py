@@ -643,7 +643,8 @@ def test_evidence_tables_write_zero_counts_of_records_without_bounds_from_their_
 def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a_scale_did_not_run(hook):
     """The validity map: a cell's regular count (k of n), κ0 with the numbers that decide "defined" and the stated
     rule of the record; an energy of the claims' grid without a cell (a record made before the map covered it) is a
-    row "not run at this scale", never left out; κ0 at two escape radii with its shift and verdict."""
+    row "not run at this scale", never left out; κ0 at two escape radii with its shift, the shift's paired error and
+    the quadrature error beside it, and the verdict."""
     cell = {"label": "b", "regular_err": None, "claim2": None, "exponential": None, "plateau": None}
     doc = {
         "config": {"study": {"ratios": [1.9, 2.2]}},
@@ -668,7 +669,7 @@ def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a
             {"label": "b", "e_ratio": 1.8, "convention": "plateau", "r_esc_default": 2.598, "r_esc": 1.784}
             | {"r_esc_over_saddle": 1.03, "kappa_default": {"value": 0.05, "err": 0.001}}
             | {"kappa": {"value": 0.06, "err": 0.001}, "shift": {"value": 0.2, "err": 0.03}}
-            | {"verdict": "shifts (z = +6.7)"}
+            | {"shift_err_unpaired": 0.0283, "verdict": "shifts (z = +6.7)"}
         ],
     }
     out = hook.evidence_tables(doc)
@@ -676,7 +677,8 @@ def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a
     assert "| b | 1.9 | 24 of 20000: 0.120 ± 0.020 % | ill-defined: f∞/P(t_hi) = 84 % > 10 % |" in out
     assert "| b | 2.2 | not run at this scale | not run at this scale |" in out
     assert "| b | 1.8 | all orbits | 2.6 | 0.0500 ± 0.0010 | 1.78 (1.03 r_s) | 0.0600 ± 0.0010 | 0.20 ± 0.03 |" in out
-    assert "shifts (z = +6.7) |" in out
+    assert "| 0.20 ± 0.03 | 0.028 | shifts (z = +6.7) |" in out
+    assert "paired error: a bootstrap over the orbits" in out
 
 
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):

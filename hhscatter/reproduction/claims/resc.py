@@ -9,7 +9,11 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured
+from hhscatter.analysis.survival.escape_rate import escape_rate
+from hhscatter.analysis.survival.fits import lifetimes_to_arrays
+from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
 from hhscatter.reproduction.claims.kappa import rate_or_reason, window_rate
 from hhscatter.reproduction.claims.keys import resc_key
 from hhscatter.reproduction.claims.mu import (
@@ -83,11 +87,34 @@ def r_esc_rule(m, ratios) -> dict:
 SHIFT_WORDS = ("no shift resolved", "shifts")
 
 
-def _kappa_at(lt, p, convention: str):
-    """κ0 (Measured) of one run under one convention ('plateau': all orbits; 'escaping': censored dropped) and the
-    reason where it is ill-defined ('' where defined)."""
-    if convention == "escaping":
-        lt = lt[lt["outcome"] != "censored"]
+IC_COLUMNS = ("x0", "y0", "px0", "py0")
+
+
+def paired_lifetimes(lt_ref, lt_alt, what: str = "the two runs"):
+    """paired_lifetimes(lt_ref, lt_alt) -> the two lifetimes tables in one order of ``traj_id`` (row i of both is
+    orbit i), after checking they hold the same orbits: the same ``traj_id`` values and, where the tables have
+    them, the same initial conditions (``x0, y0, px0, py0``, exactly). ValueError naming ``what`` otherwise.
+
+    Examples
+    --------
+    >>> a = pd.DataFrame({"traj_id": [1, 0], "x0": [0.2, 0.1], "t_end": [5.0, 3.0]})
+    >>> b = pd.DataFrame({"traj_id": [0, 1], "x0": [0.1, 0.2], "t_end": [4.0, 6.0]})
+    >>> [x.t_end.tolist() for x in paired_lifetimes(a, b)]
+    [[3.0, 5.0], [4.0, 6.0]]
+    """
+    a = lt_ref.sort_values("traj_id", kind="stable").reset_index(drop=True)
+    b = lt_alt.sort_values("traj_id", kind="stable").reset_index(drop=True)
+    if len(a) != len(b) or not np.array_equal(a["traj_id"].to_numpy(), b["traj_id"].to_numpy()):
+        raise ValueError(f"{what} do not hold the same orbits (traj_id differs): no paired comparison")
+    for col in IC_COLUMNS:
+        if col in a.columns and col in b.columns and not np.array_equal(a[col].to_numpy(), b[col].to_numpy()):
+            raise ValueError(f"{what} hold different initial conditions ({col} differs): no paired comparison")
+    return a, b
+
+
+def _kappa_at(lt, p):
+    """κ0 (Measured) of one run by the claims' window rule and plateau check, and the reason where it is
+    ill-defined ('' where defined)."""
     c, _, why = window_rate(lt, p, "window rule failed")
     if c is None:
         return None, why
@@ -96,24 +123,46 @@ def _kappa_at(lt, p, convention: str):
     return Measured.of(c.kappa, c.kappa_err), ""
 
 
-def resc_kappa_rows(runs, systems) -> list:
+def _window_kappa(p):
+    """κ of the claims' window rule (:func:`rate_or_reason`: plateau windows, ``p.min_survivors``) as a function
+    of arrays, for the paired bootstrap."""
+
+    def kappa(t_end, observed):
+        return escape_rate(t_end, observed, detect_tail=False, min_survivors=p.min_survivors).kappa
+
+    return kappa
+
+
+def resc_kappa_rows(runs, systems, *, n_boot: int | None = None, seed: int = 0) -> list:
     """κ0 at the default r_esc and at each other radius of :func:`resc_values`, per system, E/E_c of ``resc_ratios``
-    and convention ('plateau': all orbits, the paper's; 'escaping': the orbits still inside at t_max dropped), the same
-    N and rules at each radius; the shift κ0(r_esc)/κ0(default) − 1 with its error (the two runs' errors in
-    quadrature: they share their initial conditions, so this overstates the error of the difference) and its
-    verdict by the one rule against no shift (|z| ≤ 2: 'no shift resolved'); "undetermined: …" where κ0 is
-    ill-defined at either radius."""
+    and convention ('plateau': all orbits, the paper's; 'escaping': the orbits escaping at both radii), by the
+    claims' window rule and plateau check at each radius; the shift κ0(r_esc)/κ0(default) − 1 with its paired
+    error: the runs at both radii hold the same orbits (:func:`paired_lifetimes`), so the error is a bootstrap over
+    the orbits drawing them alike at both radii and re-applying the window rule to each
+    (:func:`~hhscatter.analysis.survival.paired.paired_bootstrap_ratio`, ``n_boot`` replicates, default
+    ``p.resc_boot``; ``seed``); beside it ``shift_err_unpaired`` (the two errors in quadrature, which overstates
+    it), the correlation of the two κ0 over the replicates and ``n_boot``; the verdict by the one rule against no
+    shift on the paired error (|z| ≤ 2: 'no shift resolved'); "undetermined: …" where κ0 is ill-defined at either
+    radius."""
     p = runs.params
+    n_boot = p.resc_boot if n_boot is None else n_boot
+    kappa_fn = _window_kappa(p)
     out = []
     for label, spec, m in systems:
         Rs = resc_values(p, m)
         for r in p.resc_ratios if len(Rs) > 1 else ():
             E = r * m.critical_energy
             lts = {R: runs.lifetimes(resc_key(label, R, f"r{r:.3f}")) for R in Rs}
-            for conv in ("plateau", "escaping"):
-                base, why0 = _kappa_at(lts[None], p, conv)
-                for R in Rs[1:]:
-                    k, why = _kappa_at(lts[R], p, conv)
+            for R in Rs[1:]:
+                ref, alt = paired_lifetimes(lts[None], lts[R], f"the r_esc runs of {label} at {r:g} E_c")
+                for conv in ("plateau", "escaping"):
+                    if conv == "escaping":
+                        both = (ref["outcome"] != "censored").to_numpy() & (alt["outcome"] != "censored").to_numpy()
+                        ref_c, alt_c = ref[both], alt[both]
+                    else:
+                        ref_c, alt_c = ref, alt
+                    base, why0 = _kappa_at(ref_c, p)
+                    k, why = _kappa_at(alt_c, p)
                     row = {
                         "id": f"{label}-{r:g}-r{R:g}-{conv}",
                         "system": spec["name"],
@@ -123,7 +172,7 @@ def resc_kappa_rows(runs, systems) -> list:
                         "r_esc_default": float(m.default_escape_radius(E)),
                         "r_esc": float(R),
                         "r_esc_over_saddle": float(R / m.saddle_radius),
-                        "n": int(len(lts[R])),
+                        "n": int(len(ref_c)),
                         "kappa_default": (base or Measured.of(None, None)).to_dict(),
                         "kappa": (k or Measured.of(None, None)).to_dict(),
                     }
@@ -131,12 +180,35 @@ def resc_kappa_rows(runs, systems) -> list:
                         where = "; ".join(
                             f"at r_esc = {x:.3g}: {w}" for x, w in ((row["r_esc_default"], why0), (R, why)) if w
                         )
-                        row.update(shift={"value": None, "err": None}, verdict=f"undetermined: κ0 ill-defined {where}")
+                        row.update(
+                            shift={"value": None, "err": None},
+                            shift_err_unpaired=None,
+                            correlation=None,
+                            verdict=f"undetermined: κ0 ill-defined {where}",
+                        )
                     else:
-                        d = k.ratio(base).difference(1.0)
-                        row.update(shift=d.to_dict(), verdict=z_verdict(d.value, d.err, 0.0, *SHIFT_WORDS))
+                        with counted("claims.resc.paired_bootstrap"):
+                            pr = paired_bootstrap_ratio(
+                                *lifetimes_to_arrays(ref_c),
+                                *lifetimes_to_arrays(alt_c),
+                                kappa_fn,
+                                n_boot=n_boot,
+                                seed=seed,
+                            )
+                        d = Measured.of(k.value / base.value - 1.0, pr.shift_err)
+                        row.update(
+                            shift=d.to_dict(),
+                            shift_err_unpaired=float(k.ratio(base).err),
+                            correlation=_finite(pr.correlation),
+                            n_boot=pr.n_boot,
+                            verdict=z_verdict(d.value, d.err, 0.0, *SHIFT_WORDS),
+                        )
                     out.append(row)
     return out
+
+
+def _finite(x):
+    return float(x) if x is not None and math.isfinite(x) else None
 
 
 def resc_rows(runs, systems) -> list:
