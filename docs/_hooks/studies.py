@@ -1145,7 +1145,7 @@ def _validity_table(doc, vm, n_of) -> str:
 
 
 def evidence_tables(doc) -> str:
-    """Markdown tables of a generality JSON's evidence: regular fraction (systems × E/E_c per IC convention),
+    """Markdown tables of a generality JSON's evidence: regular fraction (E/E_c × systems per IC convention),
     long-time escape (disk ICs), the validity map and the r_esc sensitivity."""
     out = []
     reg = doc["regular_fraction"]
@@ -1155,23 +1155,25 @@ def evidence_tables(doc) -> str:
         "systematic of the threshold, the largest shift with the threshold a decade either side; where no orbit "
         "is regular, the one-sided 95 % upper bound)\n"
     )
-    out.append("| system | ICs | " + " | ".join(f"{r:g} E_c" for r in ratios) + " |")
-    out.append("|---|---|" + "---|" * len(ratios))
-    for lab, ics in dict.fromkeys((r["label"], r["ics"]) for r in reg):
-        cells = {
-            r["e_ratio"]: _bounded(
-                r["fraction"],
-                r["err"],
-                r.get("fraction_upper"),
-                r.get("fraction_cl", 0.95),
-                pct=True,
-                syst=r.get("syst"),
-                n=r.get("n"),
-            )
-            for r in reg
-            if r["label"] == lab and r["ics"] == ics
-        }
-        out.append(f"| {lab} | {ics} | " + " | ".join(cells.get(x, "—") for x in ratios) + " |")
+    # energies down, (system, ICs) across: the grid has as many energies as it likes and the table stays as wide as
+    # its systems (at 1280 px no column is scrolled out of view)
+    pairs = list(dict.fromkeys((r["label"], r["ics"]) for r in reg))
+    cells = {
+        (r["label"], r["ics"], r["e_ratio"]): _bounded(
+            r["fraction"],
+            r["err"],
+            r.get("fraction_upper"),
+            r.get("fraction_cl", 0.95),
+            pct=True,
+            syst=r.get("syst"),
+            n=r.get("n"),
+        )
+        for r in reg
+    }
+    out.append("| E/E_c | " + " | ".join(f"{lab}<br>{ics}" for lab, ics in pairs) + " |")
+    out.append("|---|" + "---|" * len(pairs))
+    for x in ratios:
+        out.append(f"| {x:g} | " + " | ".join(cells.get((lab, ics, x), "—") for lab, ics in pairs) + " |")
     P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
     ts = sorted({r["t"] for r in doc.get("survival_long", [])})
     out.append(

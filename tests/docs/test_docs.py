@@ -568,7 +568,7 @@ def test_the_outcomes_and_the_study_list_come_from_the_code(tmp_path, hook):
 
 
 def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook):
-    """hh:evidence-tables: the regular fraction as systems × E/E_c (per IC convention, in %), the long-time fits
+    """hh:evidence-tables: the regular fraction as E/E_c × systems (per IC convention, in %), the long-time fits
     and the r_esc rows, from the paper-scale JSON when committed."""
     assets = tmp_path / "docs" / "studies" / "assets"
     (assets / "paper").mkdir(parents=True)
@@ -615,7 +615,9 @@ def test_evidence_tables_render_the_records_at_the_headline_scale(tmp_path, hook
     }
     (assets / "paper" / "gx.json").write_text(json.dumps(sealed(doc)))
     out, _ = _page(tmp_path, hook, "<!-- hh:evidence-tables gx -->\n")
-    assert "| two | disk/tangential | 75.0 ± 1.0 ± 5.0 % | 10.0 ± 1.0 ± 5.0 % | < 0.15 % (95 %) |" in out
+    assert "| E/E_c | two<br>disk/tangential |" in out  # energies down, (system, ICs) across
+    assert "| 1.05 | 75.0 ± 1.0 ± 5.0 % |" in out and "| 1.5 | 10.0 ± 1.0 ± 5.0 % |" in out
+    assert "| 2 | < 0.15 % (95 %) |" in out
     assert "| 0.800 ± 0.004 | < 3.0e−4 (95 %) |" in out  # a P of 0: its bound, never 0 ± 0
     assert "0.751 ± 0.005" in out and "| 1.03 | [0, 200] |" in out and "Scale **paper**" in out
 
