@@ -10,5 +10,7 @@ report; imports ``model`` and ``analysis`` only.
 * ``transition_tables``, ``model_tables``, ``model_verdicts`` — τ1, τ2 and the survival models' tables and verdicts;
 * ``basin_summary`` — the records of a basin study: outcome codes, per-point records, trends, cut-off records;
 * ``cmeasure_comparison``, ``cmeasure_verdicts`` — section points against the conservative c-measure (Fig. 5);
+* ``noise_records`` — thermal and noisy escape rates against Kramers–Langer and the turnover theory, and their
+  checks (finite barrier, absorbing radius, two saddles, no drag, re-activation);
 * ``claims`` — the paper's claims tested on a system, and the evidence behind their readings.
 """

@@ -33,7 +33,8 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     at the default radius, by the 2σ rule; the no-drag rate's halves and the survivors' energies at each time
     (:func:`hhscatter.analysis.noise.survivor_energies`, the fraction below E_c); the two-saddle system's rates
     against the multi-saddle Kramers–Langer sum and its lowest term, and the escapes' exit channels against each
-    term's share. Writes ``noise.json`` (keys
+    term's share. The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
+    the runs and passes their arrays). Writes ``noise.json`` (keys
     ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``reactivation``,
     ``no_drag``, ``no_drag_survivors``) and the derived tables ``rates.parquet``, ``survival.parquet``.
 
@@ -43,8 +44,6 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
 
 from __future__ import annotations
 
-import math
-import re
 import zlib
 
 import numpy as np
@@ -96,12 +95,9 @@ class Params(StudyParams):
 
 def _barrier(study) -> float:
     """ΔE = E_c − V(min) of the study's system (energy units): the lowest saddle above the well's minimum."""
-    return _barrier_of(study.model)
+    from hhscatter.analysis.noise import well_barrier
 
-
-def _barrier_of(m) -> float:
-    """ΔE = E_c − V(min) of the system ``m`` (energy units)."""
-    return m.critical_energy - float(m.potential(np.array(0.0), np.array(0.0)))
+    return well_barrier(study.model)
 
 
 def _pairs(study, a, b):
@@ -175,9 +171,10 @@ def _runs(study):
             raise ValueError(f"[study] resc_barriers: {b:g} is not one of barriers {list(p.barriers)}")
         runs[_resc_key(b, p.resc_radius)] = dict(runs[_kramers_key(b)], r_esc=p.resc_radius)
     if p.saddles_barriers:
+        from hhscatter.analysis.noise import well_barrier
         from hhscatter.model import make_system
 
-        low = _barrier_of(make_system(**_saddles_system(p)))
+        low = well_barrier(make_system(**_saddles_system(p)))
         for b, t_max in _pairs(study, "saddles_barriers", "saddles_t_max"):
             runs[_saddles_key(b)] = dict(
                 energy=p.well_energy,
@@ -234,65 +231,23 @@ def _lifetimes(study, key):
 
 
 def _rate_row(study, key, scene):
-    from hhscatter.analysis.noise import kramers_langer, thermal_rate
+    """The rate record of raw run ``key`` (its scene ``scene``) against Kramers–Langer."""
+    from hhscatter.reproduction.noise_records import rate_record
 
-    p = study.params
-    t_start = _window_start(p, scene.gamma)
     t_end, escaped, _ = _lifetimes(study, key)
-    r = thermal_rate(t_end, escaped, t_start, scene.t_max)
+    window = (_window_start(study.params, scene.gamma), scene.t_max)
     T = scene.noise.temperature
-    kl = kramers_langer(scene.model, scene.gamma, T)
-    return {
-        "gamma": scene.gamma,
-        "temperature": T,
-        "barrier_over_T": kl.barrier_over_T,
-        "rate": r.rate,
-        "rate_err": r.rate_err,
-        "kramers_langer": kl.rate,
-        "ratio": r.rate / kl.rate,
-        "ratio_err": r.rate_err / kl.rate,
-        "n_events": r.n_events,
-        "n": scene.n,
-        "window": [t_start, scene.t_max],
-        # the rate is constant inside the window: the halves' difference in standard errors
-        **_halves(r, p.constancy_z),
-        "r_esc": scene.r_esc,
-        "seed": scene.seed,
-        # a window without an escape: no rate (NaN), its one-sided 95 % upper bound and the ratio's
-        **({"rate_upper95": r.upper95, "ratio_upper95": r.upper95 / kl.rate} if r.is_bound else {}),
-    }
-
-
-def _turnover_theory(study, row, scene) -> dict:
-    """The turnover record ``row`` against Mel'nikov–Meshkov/PGH and both Kramers limits (module docstring)."""
-    from hhscatter.analysis.noise import barrier_action, kramers_langer, turnover_rate
-
-    m = scene.model
-    kl = kramers_langer(m, scene.gamma, row["temperature"])
-    tr = turnover_rate(kl, [barrier_action(m, k) for k in range(len(m.exits))])
-    out = {
-        "action": barrier_action(m, 0),
-        "delta": tr.delta[0],
-        "upsilon": tr.upsilon[0],
-        "melnikov_meshkov": tr.rate,
-        "energy_diffusion": tr.energy_diffusion,
-        "gamma_over_omega_b": tr.gamma_over_omega_b,
-        # within rounding: ω_b comes from an eigenvalue of the Hessian
-        "theory_assumptions_hold": bool(tr.gamma_over_omega_b <= THEORY_GAMMA_MAX * (1 + 1e-9)),
-    }
-    for name, k in (("mm", tr.rate), ("ed", tr.energy_diffusion)):
-        out[f"ratio_{name}"] = row["rate"] / k
-        out[f"ratio_{name}_err"] = row["rate_err"] / k
-    return out
+    z_max = study.params.constancy_z
+    return rate_record(
+        t_end, escaped, scene.model, scene.gamma, T, window, n=scene.n, r_esc=scene.r_esc, seed=scene.seed, z_max=z_max
+    )
 
 
 def _two_saddles(study, runs) -> dict:
     """The Kramers rate of the two-saddle system against the multi-saddle Kramers–Langer sum and its lowest term
     alone, and the share of the escapes over each saddle against its term's share of the sum."""
-    from hhscatter.analysis.noise import kramers_langer
-    from hhscatter.analysis.stats.intervals import fraction_with_bound
-    from hhscatter.analysis.stats.verdicts import verdict
     from hhscatter.data.read import read_by_orbit
+    from hhscatter.reproduction.noise_records import pretty_potential, saddle_terms, two_saddle_record
 
     p = study.params
     rows, saddles = [], []
@@ -300,90 +255,21 @@ def _two_saddles(study, runs) -> dict:
         key = _saddles_key(b)
         sc = runs[key]
         row = _rate_row(study, key, sc)
-        kl = kramers_langer(sc.model, sc.gamma, row["temperature"])
-        low = min(range(len(kl.terms)), key=lambda i: kl.terms[i].barrier)
-        k_low = kl.terms[low].rate
-        row["kramers_langer_lowest"] = k_low
-        row["ratio_lowest"] = row["rate"] / k_low
-        row["ratio_lowest_err"] = row["rate_err"] / k_low
         c = read_by_orbit(study.raw(key), ["outcome", "t_end", "exit_channel"])
-        t_end = np.asarray(c["t_end"])
-        lo, hi = row["window"]
-        inside = (np.asarray(c["outcome"].astype(str)) == "escaped") & (t_end > lo) & (t_end <= hi)
-        channel = np.asarray(c["exit_channel"])[inside]
-        shares = []
-        for i, term in enumerate(kl.terms):
-            f = fraction_with_bound(int(np.count_nonzero(channel == i)), max(int(inside.sum()), 1))
-            pred = term.rate / kl.rate
-            v = verdict(f.value, f.err, pred)
-            shares.append(
-                {
-                    "exit": i,
-                    "barrier": term.barrier,
-                    "predicted": pred,
-                    "measured": f.value,
-                    "measured_err": f.err,
-                    "measured_upper95": f.upper,
-                    "measured_lower95": f.lower,
-                    "verdict": v.text(),
-                    "z": v.z,
-                }
-            )
-        row["exit_shares"] = shares
-        rows.append(row)
-        saddles = [
-            {"x": t.x, "y": t.y, "barrier": t.barrier, "omega_b": t.omega_b, "prefactor": t.prefactor} for t in kl.terms
-        ]
+        escaped = np.asarray(c["outcome"].astype(str)) == "escaped"
+        rows.append(two_saddle_record(row, c["exit_channel"], c["t_end"], escaped, sc.model))
+        saddles = saddle_terms(sc.model, sc.gamma, row["temperature"])
     return {
         "potential": p.saddles_potential,
-        "potential_text": _pretty(p.saddles_potential),
+        "potential_text": pretty_potential(p.saddles_potential),
         "saddles": saddles,
         "records": rows,
     }
 
 
-def _pretty(expr: str) -> str:
-    """A potential's text as pages print it: integer powers as superscripts, no ``*``, the minus sign.
-
-    >>> _pretty("(x**2 + y**2)/2 - 5*y**3/18")
-    '(x² + y²)/2 − 5y³/18'
-    """
-    sup = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
-    out = re.sub(r"\*\*(\d+)", lambda m: m.group(1).translate(sup), expr)
-    return out.replace("*", "").replace("-", "−")
-
-
-def _finite_barrier(study, kramers) -> dict:
-    """The ratio k/k_KL against T/ΔE: the weighted fit of its first correction and the transition-state term."""
-    from hhscatter.analysis.noise import finite_barrier_fit, transition_state_correction
-
-    f = finite_barrier_fit(
-        [r["barrier_over_T"] for r in kramers], [r["ratio"] for r in kramers], [r["ratio_err"] for r in kramers]
-    )
-    c = transition_state_correction(study.model)
-    return {
-        "intercept": f.measured("intercept").to_dict(),
-        "slope": f.measured("slope").to_dict(),
-        "chi2": f.chi2,
-        "dof": f.dof,
-        "p_value": f.p_value,
-        "slope_intercept_one": f.measured("slope_unit").to_dict(),
-        "chi2_intercept_one": f.chi2_unit,
-        "dof_intercept_one": f.dof_unit,
-        "T_over_barrier_range": list(f.x_range),
-        "transition_state_slope": c.slope,
-        "laplace_well": c.well,
-        "laplace_saddles": list(c.saddles),
-        "fit": "k/k_KL = a + c T/ΔE, weights 1/σ² of the ratios; and k/k_KL − 1 = c T/ΔE (a = 1)",
-        "theory": "c_TST = ΔE (A_s − A_well): the first correction of k_TST from Laplace's expansion of the well's "
-        "and the dividing line's configuration integrals; the transmission factor's own correction is not included",
-    }
-
-
 def _absorbing_radius(study, runs, kramers) -> list:
     """The Kramers rate at r_esc = resc_radius against the same record at the default radius (independent seeds)."""
-    from hhscatter.analysis.stats.measured import Measured
-    from hhscatter.analysis.stats.verdicts import verdict
+    from hhscatter.reproduction.noise_records import absorbing_radius_record
 
     p = study.params
     by_b = {r["barrier_over_T"]: r for r in kramers}
@@ -391,34 +277,14 @@ def _absorbing_radius(study, runs, kramers) -> list:
     for b in p.resc_barriers:
         key = _resc_key(b, p.resc_radius)
         far = _rate_row(study, key, runs[key])
-        near = by_b[far["barrier_over_T"]]
-        ratio = Measured(far["rate"], far["rate_err"]) / Measured(near["rate"], near["rate_err"])
-        v = verdict(ratio.value, ratio.err, 1.0)
-        out.append(
-            {
-                "barrier_over_T": far["barrier_over_T"],
-                "r_esc_default": near["r_esc"],
-                "r_esc": far["r_esc"],
-                "rate_default": {"value": near["rate"], "err": near["rate_err"]},
-                "rate": {"value": far["rate"], "err": far["rate_err"]},
-                "ratio_kramers_langer": {"value": far["ratio"], "err": far["ratio_err"]},
-                "rate_ratio": ratio.to_dict(),
-                "shift": {"value": ratio.value - 1.0, "err": ratio.err},
-                "verdict": v.text(),
-                "z": v.z,
-                "n_events": far["n_events"],
-                "window": far["window"],
-                "constant_in_window": far["constant_in_window"],
-                "seed": far["seed"],
-            }
-        )
+        out.append(absorbing_radius_record(by_b[far["barrier_over_T"]], far))
     return out
 
 
 def _no_drag_survivors(study, runs) -> list:
     """The energies of the no-drag orbits still inside at each time of :func:`_survivor_times` (σ > 0)."""
-    from hhscatter.analysis.noise import survivor_energies
     from hhscatter.data.read import read_by_orbit
+    from hhscatter.reproduction.noise_records import survivor_record
 
     p = study.params
     e_c = study.model.critical_energy
@@ -432,101 +298,51 @@ def _no_drag_survivors(study, runs) -> list:
                 key = _nodrag_key(E, s) if t == times[-1] else _survivors_key(E, s, t)
                 c = read_by_orbit(study.raw(key), ["outcome", "e_end"])
                 alive = np.asarray(c["outcome"].astype(str)) == "censored"
-                row = {"energy": E, "sigma": s, "t": t, "n": int(alive.size), "n_alive": int(alive.sum())}
-                # ⟨E⟩ of the whole ensemble, were every orbit kept: E0 + σ² t (two momenta)
-                row["ensemble_mean_energy"] = E + s * s * t
-                if alive.sum() >= 2:
-                    se = survivor_energies(np.asarray(c["e_end"])[alive], e_c)
-                    row.update(
-                        mean_energy=se.mean,
-                        mean_energy_err=se.mean_err,
-                        sd_energy=se.sd,
-                        energy_q10=se.quantiles[0.1],
-                        energy_q50=se.quantiles[0.5],
-                        energy_q90=se.quantiles[0.9],
-                        below_ec=se.below,
-                        below_ec_err=se.below_err,
-                        below_ec_upper95=se.below_upper,
-                        below_ec_lower95=se.below_lower,
-                    )
-                rows.append(row)
+                rows.append(survivor_record(E, s, t, alive, c["e_end"], e_c))
     return rows
 
 
 def _reactivation(study, runs):
     """P(t) with and without the heat bath, the extension's prediction, and their numbers."""
-    from hhscatter.analysis.noise import reactivation_check, thermal_rate
+    from hhscatter.reproduction.noise_records import reactivation_record
 
     p = study.params
-    t0, esc0, set0 = _lifetimes(study, "react_T0")
-    tT, escT, _ = _lifetimes(study, "react_T")
-    tw, escw, _ = _lifetimes(study, "react_well")
     sc = runs["react_T"]
-    k_well = thermal_rate(tw, escw, _window_start(p, sc.gamma), sc.t_max)
-    try:
-        c = reactivation_check(t0, esc0, set0, tT, escT, k_well.rate, sc.t_max, p.react_tail_start)
-    except ValueError as e:
-        raise ValueError(f"[study] react_tail_start: {e}") from None
-    numbers = {
+    about = {
         "energy": p.react_energy,
         "gamma": sc.gamma,
         "temperature": sc.noise.temperature,
         "barrier_over_T": p.react_barrier,
         "n": sc.n,
-        "settled_fraction_T0": c.settled_fraction,
-        "escaped_fraction_T0": c.escaped_fraction,
-        "t_settled_99": c.t_settled_99,
-        "tail_window": [p.react_tail_start, sc.t_max],
-        "tail_rate": c.tail.measured("rate").to_dict(),
-        "thermal_rate": k_well.measured("rate").to_dict(),
-        "tail_over_thermal": (c.tail.measured("rate") / k_well.measured("rate")).to_dict(),
-        "model_max_deviation": c.max_deviation,
-        "model_max_deviation_at": c.max_deviation_at,
-        "model_max_deviation_sigma": c.max_deviation_sigma,
     }
-    return numbers, c.table
-
-
-def _halves(r, constancy_z) -> dict:
-    """The rates on a window's two halves and whether they agree within ``constancy_z`` σ (``halves_z``)."""
-    (k1, e1), (k2, e2) = r.halves
-    z = (k2 - k1) / math.hypot(e1, e2) if e1 > 0 and e2 > 0 else math.nan
-    return {
-        "rate_first_half": k1,
-        "rate_second_half": k2,
-        "rate_first_half_err": e1,
-        "rate_second_half_err": e2,
-        "halves_z": z,
-        "constant_in_window": bool(abs(z) < constancy_z),
-    }
+    try:
+        return reactivation_record(
+            _lifetimes(study, "react_T0"),
+            _lifetimes(study, "react_T")[:2],
+            _lifetimes(study, "react_well")[:2],
+            t_max=sc.t_max,
+            tail_start=p.react_tail_start,
+            window_start=_window_start(p, sc.gamma),
+            about=about,
+        )
+    except ValueError as e:
+        raise ValueError(f"[study] react_tail_start: {e}") from None
 
 
 def _no_drag(study, runs):
-    from hhscatter.analysis.noise import thermal_rate
-    from hhscatter.analysis.survival.relative_rates import relative_rates
+    from hhscatter.reproduction.noise_records import no_drag_records
 
     p = study.params
-    lo, hi = p.nodrag_window
-    sigmas = list(p.nodrag_sigmas)
-    ref = sigmas.index(0) if 0 in sigmas else None
     rows = []
     for E in p.nodrag_energies:
-        samples = [_lifetimes(study, _nodrag_key(E, s))[:2] for s in sigmas]
-        for s, rr, (t_end, esc) in zip(sigmas, relative_rates(samples, lo, hi, ref), samples):
-            m = rr.rate
-            row = {"energy": E, "sigma": s, "kappa": m.kappa, "kappa_err": m.kappa_err, "n_events": m.n_events}
-            row.update(_halves(thermal_rate(t_end, esc, lo, hi), p.constancy_z))
-            if rr.ratio is not None:
-                row["kappa_over_kappa0"], row["kappa_over_kappa0_err"] = rr.ratio.value, rr.ratio.err
-                # energy gained by diffusion over the window: ⟨E⟩ grows by σ² t (two degrees of freedom)
-                row["energy_gain_at_window_end"] = s * s * hi
-            rows.append(row)
+        samples = [_lifetimes(study, _nodrag_key(E, s))[:2] for s in p.nodrag_sigmas]
+        rows += no_drag_records(E, p.nodrag_sigmas, samples, p.nodrag_window, p.constancy_z)
     return rows
 
 
 def _survival_tables(study, runs):
     """P(t) of every no-drag run on a common grid (the figure's panel)."""
-    from hhscatter.analysis.survival.kaplan_meier import survival_curve
+    from hhscatter.reproduction.noise_records import no_drag_survival
 
     p = study.params
     grid = np.linspace(0.0, p.nodrag_t_max, 301)
@@ -534,13 +350,14 @@ def _survival_tables(study, runs):
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
             t_end, esc, _ = _lifetimes(study, _nodrag_key(E, s))
-            c = survival_curve(t_end, esc, grid)
-            frames.append(pd.DataFrame({"energy": E, "sigma": s, "t": grid, "P": c.P, "P_err": c.P_err}))
+            frames.append(no_drag_survival(E, s, t_end, esc, grid))
     return pd.concat(frames, ignore_index=True)
 
 
 def analyze(study):
     """analyze(study) -> None: rates against Kramers–Langer, the heat-bath P(t), the no-drag rates; noise.json."""
+    from hhscatter.reproduction.noise_records import finite_barrier_record, turnover_record
+
     p = study.params
     runs = _runs(study)
     kramers = [
@@ -549,7 +366,7 @@ def analyze(study):
     turnover = []
     for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max"):
         row = _rate_row(study, _turnover_key(g), runs[_turnover_key(g)])
-        turnover.append({**row, **_turnover_theory(study, row, runs[_turnover_key(g)])})
+        turnover.append({**row, **turnover_record(row, runs[_turnover_key(g)].model, THEORY_GAMMA_MAX)})
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
     survivors = _no_drag_survivors(study, runs)
@@ -573,7 +390,7 @@ def analyze(study):
     study.write_numbers(
         {
             "kramers": kramers,
-            "finite_barrier": _finite_barrier(study, kramers),
+            "finite_barrier": finite_barrier_record(kramers, study.model),
             "absorbing_radius": absorbing,
             "two_saddles": saddles,
             "turnover": turnover,

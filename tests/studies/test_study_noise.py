@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hhscatter.reproduction.noise_records import pretty_potential, turnover_record
 from hhscatter.scene.ics import region_ics
 from hhscatter.studies import load_study, stage_module
 
@@ -42,8 +43,8 @@ def test_turnover_records_carry_the_theory_and_its_range(runs):
     for key, holds in (("turnover_g0.03", True), ("turnover_g0.3", True), ("turnover_g1", False)):
         sc = scenes[key]
         T = sc.noise.temperature
-        row = {"temperature": T, "rate": 0.02, "rate_err": 0.001}
-        th = mod._turnover_theory(study, row, sc)
+        row = {"gamma": sc.gamma, "temperature": T, "rate": 0.02, "rate_err": 0.001}
+        th = turnover_record(row, sc.model, mod.THEORY_GAMMA_MAX)
         tst = 3 / (2 * np.pi) / np.sqrt(3) * np.exp(-(1 / 6) / T)
         delta = sc.gamma * 1.2 / T
         assert th["action"] == pytest.approx(1.2, rel=1e-9) and th["delta"] == pytest.approx(delta, rel=1e-9)
@@ -110,4 +111,4 @@ def test_the_two_saddle_records_run_the_declared_system_at_its_lowest_barrier(ru
 
 
 def test_the_potential_is_printed_with_superscripts_and_minus_signs():
-    assert stage_module("noise")._pretty("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18") == "(x² + y²)/2 − x³/3 − 5y³/18"
+    assert pretty_potential("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18") == "(x² + y²)/2 − x³/3 − 5y³/18"

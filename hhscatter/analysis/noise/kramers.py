@@ -22,10 +22,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.analysis.stats.intervals import BoundedFraction, fraction_with_bound
+from hhscatter.analysis.stats.measured import Measured, WithErrors
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 
-__all__ = ["KramersLanger", "SaddleTerm", "ThermalRate", "hessian", "kramers_langer", "thermal_rate"]
+__all__ = [
+    "KramersLanger",
+    "SaddleTerm",
+    "ThermalRate",
+    "WindowConstancy",
+    "exit_fractions",
+    "hessian",
+    "kramers_langer",
+    "thermal_rate",
+    "well_barrier",
+    "window_constancy",
+]
 
 #: relative central-difference step of :func:`hessian` for a potential given as a function only: the step is
 #: this times the point's length scale max(|x|, |y|, the saddles' distance), so a rescaled system keeps the same
@@ -110,6 +122,21 @@ class KramersLanger:
     barrier: float
     barrier_over_T: float
     terms: tuple
+
+
+def well_barrier(model) -> float:
+    """well_barrier(model) -> ΔE = E_c − V(0, 0) (energy units): the lowest exit's energy above the well's minimum
+    at the origin (the System contract), the barrier a thermal rate's ΔE/T refers to.
+
+    Examples
+    --------
+    Hénon–Heiles: E_c = 1/6, V(0, 0) = 0:
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> well_barrier(HenonHeiles()) == 1 / 6
+    True
+    """
+    return model.critical_energy - float(model.potential(np.array(0.0), np.array(0.0)))
 
 
 def kramers_langer(model, gamma: float, temperature: float) -> KramersLanger:
@@ -219,3 +246,67 @@ def thermal_rate(t_end, escaped, t_start: float, t_stop: float) -> ThermalRate:
     return ThermalRate(
         whole.kappa, whole.kappa_err, whole.n_events, whole.exposure, t_start, t_stop, halves, whole.upper95
     )
+
+
+@dataclass(frozen=True)
+class WindowConstancy:
+    """Whether a rate is constant inside its window: the rates on the window's two halves ``first`` and ``second``
+    (:class:`~hhscatter.analysis.stats.measured.Measured`, 1/time), ``z`` = (k₂ − k₁)/√(σ₁² + σ₂²) (NaN when a
+    half has no error: no escape in it) and ``constant`` = |z| < ``z_max``."""
+
+    first: Measured
+    second: Measured
+    z: float
+    z_max: float
+    constant: bool
+
+
+def window_constancy(rate: ThermalRate, z_max: float) -> WindowConstancy:
+    """window_constancy(rate, z_max) -> WindowConstancy: the two halves of a :class:`ThermalRate`'s window compared.
+
+    ``rate``: a :func:`thermal_rate` result (its ``halves``); ``z_max``: the number of combined standard errors
+    within which the halves agree (a constant hazard gives |z| < z_max with the normal probability).
+
+    Examples
+    --------
+    Halves 0.012 ± 0.003 and 0.008 ± 0.004: z = −0.004/0.005 = −0.8, constant within 3σ but not within 0.5σ:
+
+    >>> r = ThermalRate(0.01, 0.002, 40, 4000.0, 0.0, 100.0, ((0.012, 0.003), (0.008, 0.004)))
+    >>> c = window_constancy(r, 3.0)
+    >>> round(c.z, 12), c.constant, window_constancy(r, 0.5).constant
+    (-0.8, True, False)
+    >>> c.second.to_dict()
+    {'value': 0.008, 'err': 0.004}
+    """
+    (k1, e1), (k2, e2) = rate.halves
+    first, second = Measured(k1, e1, rate.method), Measured(k2, e2, rate.method)
+    z = second.z(k1, e1) if e1 > 0 and e2 > 0 else math.nan
+    return WindowConstancy(first, second, z, z_max, bool(abs(z) < z_max))
+
+
+def exit_fractions(t_end, escaped, exit_channel, t_start: float, t_stop: float, n_exits: int) -> list[BoundedFraction]:
+    """exit_fractions(t_end, escaped, exit_channel, t_start, t_stop, n_exits) -> one fraction per exit: the share
+    of the escapes in (t_start, t_stop] (time units) through each exit 0 … n_exits − 1, with its binomial error or
+    its one-sided 95 % bound (:func:`~hhscatter.analysis.stats.intervals.fraction_with_bound`; a window without an
+    escape counts as one trial, so every share is 0 with its bound).
+
+    ``t_end``: each orbit's end time; ``escaped``: True where it escaped; ``exit_channel``: the exit it left by
+    (any value for the orbits that did not escape).
+
+    Examples
+    --------
+    Five escapes in (10, 100]: three through exit 0, two through exit 1, none through exit 2; the escape at t = 5
+    lies before the window:
+
+    >>> t = np.array([5.0, 20.0, 30.0, 40.0, 50.0, 60.0, 200.0])
+    >>> esc = np.array([True, True, True, True, True, True, False])
+    >>> ch = np.array([1, 0, 0, 1, 0, 1, -1])
+    >>> f = exit_fractions(t, esc, ch, 10.0, 100.0, 3)
+    >>> [x.value for x in f], round(f[0].err, 4), round(f[2].upper, 4)     # √(0.6 · 0.4 / 5); 1 − 0.05^(1/5)
+    ([0.6, 0.4, 0.0], 0.2191, 0.4507)
+    """
+    t_end = np.asarray(t_end, dtype=float)
+    inside = np.asarray(escaped, dtype=bool) & (t_end > t_start) & (t_end <= t_stop)
+    channel = np.asarray(exit_channel)[inside]
+    n = max(int(inside.sum()), 1)
+    return [fraction_with_bound(int(np.count_nonzero(channel == i)), n) for i in range(n_exits)]

@@ -16,7 +16,7 @@ import numpy as np
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import WithErrors
 
-__all__ = ["SurvivorEnergies", "survivor_energies"]
+__all__ = ["SurvivorEnergies", "noise_energy_gain", "survivor_energies"]
 
 
 @dataclass(frozen=True)
@@ -88,3 +88,18 @@ def survivor_energies(energies, threshold: float, quantiles=(0.1, 0.5, 0.9)) -> 
         below_upper=f.upper,
         below_lower=f.lower,
     )
+
+
+def noise_energy_gain(sigma, t):
+    """noise_energy_gain(σ, t) -> σ² t (energy units): the growth of the whole ensemble's mean energy ⟨E⟩ after a
+    time t of noise dp = σ dW on both momenta without drag (each momentum's variance grows by σ² t, ⟨p²/2⟩ by
+    σ² t/2); ``sigma`` in momentum/√time, ``t`` in time units, arrays broadcast.
+
+    Examples
+    --------
+    >>> noise_energy_gain(0.02, 100.0)
+    0.04
+    >>> noise_energy_gain(np.array([0.0, 0.1]), 50.0).tolist()
+    [0.0, 0.5000000000000001]
+    """
+    return sigma * sigma * t

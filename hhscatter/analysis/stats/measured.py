@@ -4,7 +4,8 @@
 written: ``.to_dict()`` gives ``{"value": v, "err": e}``, the shape of every numbers JSON, and
 :meth:`Measured.from_dict` reads it back. First-order (linear) error propagation for independent inputs:
 :meth:`~Measured.ratio`, :meth:`~Measured.product`, :meth:`~Measured.difference`, :meth:`~Measured.sum`,
-:meth:`~Measured.log` and :meth:`~Measured.scaled`; the operators ``/ * - +`` are the same operations.
+:meth:`~Measured.log`, :meth:`~Measured.scaled` and :meth:`~Measured.over`; the operators ``/ * - +`` are the same
+operations.
 """
 
 from __future__ import annotations
@@ -174,6 +175,20 @@ class Measured:
         Measured(value=-1.0, err=0.04, method='MLE', n=10)
         """
         return Measured(c * self.value, abs(c) * self.err, self.method, self.n)
+
+    def over(self, c: float) -> Measured:
+        """self / c for an exact number c (a theory's value, a unit): σ = σa/|c|; method and n are kept.
+
+        The same as ``self / c`` to first order, with one rounding per number (the ratio's σ is |a/c| · σa/|a|).
+
+        Examples
+        --------
+        >>> Measured(0.3, 0.06, "MLE", 50).over(-2.0)
+        Measured(value=-0.15, err=0.03, method='MLE', n=50)
+        >>> Measured(math.nan, math.nan).over(4.0).to_dict()
+        {'value': nan, 'err': nan}
+        """
+        return Measured(self.value / c, self.err / abs(c), self.method, self.n)
 
     def z(self, ref, ref_err: float = 0.0) -> float:
         """(value − ref) / √(err² + ref_err²): how many combined σ self lies from a reference.

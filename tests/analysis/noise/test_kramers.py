@@ -8,7 +8,16 @@ import math
 import numpy as np
 import pytest
 
-from hhscatter.analysis.noise import hessian, kramers_langer, reactivation_survival, thermal_rate
+from hhscatter.analysis.noise import (
+    ThermalRate,
+    exit_fractions,
+    hessian,
+    kramers_langer,
+    reactivation_survival,
+    thermal_rate,
+    well_barrier,
+    window_constancy,
+)
 from hhscatter.model import HenonHeiles
 
 
@@ -129,3 +138,36 @@ def test_difference_hessian_of_a_function_scales_its_step_with_the_point():
 
     # V_xx = 12e-20 x² = 12 at x = 1e10; a fixed step of 1e-4 there is lost in rounding
     np.testing.assert_allclose(hessian(Quartic(), 1e10, 0.0), [[12.0, 0.0], [0.0, 2.0]], rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("omega, lam", [(1.0, 1.0), (1.3, 0.7)])
+def test_well_barrier_of_henon_heiles_is_its_closed_form(omega, lam):
+    """Hénon–Heiles(ω, λ): E_c = ω⁶/(6λ²) above V(0, 0) = 0."""
+    assert well_barrier(HenonHeiles(omega, lam)) == pytest.approx(omega**6 / (6 * lam**2), rel=1e-12)
+
+
+def test_window_constancy_compares_the_halves_in_combined_sigma():
+    """Halves 0.02 ± 0.003 and 0.028 ± 0.004: z = 0.008/0.005 = 1.6; constant within 2σ, not within 1.5σ; a half
+    without an escape (NaN error) gives no z and is never constant."""
+    r = ThermalRate(0.024, 0.0025, 80, 3300.0, 10.0, 110.0, ((0.02, 0.003), (0.028, 0.004)))
+    c = window_constancy(r, 2.0)
+    assert c.z == pytest.approx(1.6, rel=1e-12) and c.constant
+    assert (c.first.value, c.first.err, c.second.value, c.second.err) == (0.02, 0.003, 0.028, 0.004)
+    assert not window_constancy(r, 1.5).constant
+    empty = ThermalRate(0.01, 0.005, 4, 400.0, 10.0, 110.0, ((0.02, 0.01), (math.nan, math.nan)))
+    e = window_constancy(empty, 3.0)
+    assert math.isnan(e.z) and not e.constant
+
+
+def test_exit_fractions_count_the_escapes_inside_the_window_by_exit():
+    """Escapes in (20, 80]: exits 0, 0, 1, 0 (the escape at t = 20 and the one at t = 90 lie outside, the censored
+    orbit does not count): shares 3/4 ± √(3/4 · 1/4 / 4) and 1/4, none through exit 2 (bound 1 − 0.05^(1/4))."""
+    t = np.array([20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 90.0])
+    esc = np.array([True, True, True, True, True, False, True])
+    ch = np.array([1, 0, 0, 1, 0, 2, 2])
+    f = exit_fractions(t, esc, ch, 20.0, 80.0, 3)
+    assert [x.value for x in f] == [0.75, 0.25, 0.0]
+    assert f[0].err == pytest.approx(math.sqrt(0.75 * 0.25 / 4), rel=1e-12)
+    assert f[2].err is None and f[2].upper == pytest.approx(1 - 0.05**0.25, rel=1e-12)
+    none = exit_fractions(t, np.zeros(7, bool), ch, 20.0, 80.0, 2)
+    assert [x.value for x in none] == [0.0, 0.0] and none[0].upper == pytest.approx(0.95, rel=1e-12)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from hhscatter.analysis.noise import survivor_energies
+from hhscatter.analysis.noise import noise_energy_gain, survivor_energies
 
 
 def test_two_energies_in_known_shares():
@@ -34,3 +34,9 @@ def test_all_below_is_a_lower_bound():
 def test_bad_input_is_refused(energies, threshold, match):
     with pytest.raises(ValueError, match=match):
         survivor_energies(energies, threshold)
+
+
+def test_noise_energy_gain_is_sigma_squared_t():
+    """dp = σ dW on two momenta: each ⟨p²⟩ grows by σ² t, ⟨(p_x² + p_y²)/2⟩ by σ² t (0.01² · 300 = 0.03)."""
+    assert noise_energy_gain(0.01, 300.0) == pytest.approx(0.03, rel=1e-12)
+    assert noise_energy_gain(np.array([0.0, 0.2]), 5.0) == pytest.approx([0.0, 0.2])

@@ -112,3 +112,14 @@ def test_a_result_without_that_estimate_is_refused():
     t = np.array([1.0, 2.0, 3.0])
     with pytest.raises(AttributeError, match="n_events"):
         escape_rate_mle(t, np.ones(3, bool), 0.0, 5.0).measured("n_events")
+
+
+def test_over_an_exact_number_divides_value_and_error_once():
+    """a/c ± σ/|c| with the method and n kept; one rounding each: σ/c itself, where the ratio's |a/c| · σ/|a| is
+    one unit in the last place off (a = 1.1, σ = 0.07, c = 0.3)."""
+    assert Measured(0.3, 0.06, "MLE", 50).over(-2.0) == Measured(-0.15, 0.03, "MLE", 50)
+    m = Measured(1.1, 0.07).over(0.3)
+    assert (m.value, m.err) == (1.1 / 0.3, 0.07 / 0.3)
+    assert m.err == pytest.approx((Measured(1.1, 0.07) / 0.3).err, rel=1e-15)
+    nan = Measured(math.nan, math.nan).over(4.0)
+    assert math.isnan(nan.value) and math.isnan(nan.err)
