@@ -32,7 +32,8 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     labels at a few pixels. Panel ``i`` goes to ``<stem>_panel_<letter>.png`` beside ``path`` (``a``, ``b``, …
     in the order of ``groups``), cropped from ``fig`` as drawn (same data and fonts; give the composite's ``dpi``): the
     tight box of the group's axes, their titles, labels and legends, ``pad`` inches around, the other panels hidden
-    (a neighbour's label that reaches into the box is not drawn). ``groups`` is a list
+    (a neighbour's label that reaches into the box is not drawn, nor the composite's suptitle and figure texts,
+    which a crop would cut through). ``groups`` is a list
     of lists of axes drawn on together (a panel and its colour bar); default: every visible axes of ``fig``
     except colour bars, one each, with each colour bar joined to the panel it sits beside and a twin axes
     (``ax.twinx()``: the same box) to the panel it twins; inset axes travel with their parent.
@@ -83,9 +84,14 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     inches = fig.dpi_scale_trans.inverted()
     boxes = [Bbox.union([ax.get_tightbbox(renderer) for ax in g]).transformed(inches).padded(pad) for g in groups]
     shown = {ax: ax.get_visible() for ax in fig.axes}
+    # the composite's own title and texts belong to no panel: a crop would cut through them
+    supers = [getattr(fig, k, None) for k in ("_suptitle", "_supxlabel", "_supylabel")]
+    texts = {t: t.get_visible() for t in [*supers, *fig.texts] if t is not None}
     engine = fig.get_layout_engine()
     fig.set_layout_engine("none")  # the layout as drawn: a layout engine would reflow around the hidden panels
     try:
+        for t in texts:
+            t.set_visible(False)
         for i, (group, box) in enumerate(zip(groups, boxes)):
             for ax in fig.axes:  # the other panels hidden: no neighbour's label reaches into the crop
                 ax.set_visible(shown[ax] and ax in group)
@@ -95,5 +101,7 @@ def save_panels(fig, path, groups=None, *, dpi=None, pad: float = 0.08) -> list:
     finally:
         for ax, vis in shown.items():
             ax.set_visible(vis)
+        for t, vis in texts.items():
+            t.set_visible(vis)
         fig.set_layout_engine(engine)
     return out

@@ -23,7 +23,7 @@ import math
 import re
 
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.reproduction.verdicts import row_verdict
+from hhscatter.reproduction.verdicts import row_bound, row_verdict
 
 __all__ = [
     "comparison_table",
@@ -198,9 +198,17 @@ def md_cell(s) -> str:
 
 
 def ours_cell(row) -> str:
-    """ours_cell(paper-vs-ours row) -> our number as printed: 'value ± err unit' (or the value as text)."""
+    """ours_cell(paper-vs-ours row) -> our number as printed: 'value ± err unit' (or the value as text); a fraction
+    counted at 0 or at all as its one-sided bound (:func:`hhscatter.reproduction.verdicts.row_bound`).
+
+    >>> ours_cell({"ours": 0.25, "err": 0.0137}), ours_cell({"ours": 0.0, "err": None, "n": 60000})
+    ('0.250 ± 0.014', '< 5.0e-5 (95 %)')
+    """
     unit = f" {row['unit']}" if row.get("unit") else ""
     ours = row.get("ours")
+    bound = row_bound(row)
+    if bound is not None:
+        return format_bound(**bound) + unit
     return (format_value_err(ours, row.get("err")) if _is_num(ours) else format_value(ours)) + unit
 
 

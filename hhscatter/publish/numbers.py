@@ -102,7 +102,8 @@ def _load(path: str) -> dict:
     """The numbers JSON at ``path``, refused when its content is not the one it was written with (its ``sha256``).
 
     Parsed once per content (the cache is keyed by the file's bytes, so a file rewritten within the clock's
-    resolution is read again)."""
+    resolution is read again). Rows written before they carried their count get it from the record itself
+    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound."""
     return _parse(path, Path(path).read_bytes())
 
 
@@ -114,7 +115,9 @@ def _parse(path: str, raw: bytes) -> dict:
             f"{path} is not as its study wrote it (no content hash, or another content than the hash it was written "
             "with): a page quotes no number from an edited file; make the study again and copy its results"
         )
-    return doc
+    from hhscatter.reproduction.escape_criterion import with_return_counts  # deferred: pandas loads on first use
+
+    return with_return_counts(doc)
 
 
 def read_numbers_file(path: Path) -> dict:

@@ -36,6 +36,7 @@ from hhscatter.publish.formatting import (
     scripts_to_html,
     typographic_minus,
 )
+from hhscatter.reproduction.escape_criterion import with_return_counts
 from hhscatter.reproduction.verdicts import RULE, row_verdict
 from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary, totals
@@ -138,6 +139,7 @@ def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
                 pick=lambda other: _study_files(root, other, scale)[1],
                 raw=nums.parent == root / info.name / "out" / scale,
             )
+            doc = with_return_counts(doc)  # rows written before they carried their count: from the record
         sec = Section(info.name, info.title, info.summary, fig, doc, info.paper)
         sec.cost = json.loads(cost.read_text()) if cost else None
         sections.append(sec)

@@ -45,7 +45,9 @@ __all__ = [
     "lyapunov_table",
     "paired_runs",
     "recommend_r_esc",
+    "return_quantity",
     "returns_row",
+    "with_return_counts",
 ]
 
 
@@ -390,18 +392,67 @@ def _returns_numbers(ret, r_in, fast):
             "reesc_fast": fast,
             "fraction_late": {"value": row.frac_late, "lo": row.lo_late, "hi": row.hi_late, "t_late": row.t_late},
         }
+        counted = row.n_returned == 0
         rows.append(
             {
-                "quantity": f"fraction returning inside r<{r_in:g} after crossing r_esc={row.r_esc:g} "
-                f"(E={row.energy:.2f})",
+                "quantity": return_quantity(r_in, row.r_esc, row.energy),
                 "ours": row.frac,
-                "err": 0.5 * (row.hi - row.lo),
+                # a count of 0 has no σ: the row states its one-sided 95 % bound from n (verdicts.row_bound)
+                "err": None if counted else 0.5 * (row.hi - row.lo),
                 "paper": 0.0,
+                "n": int(row.n_escaped),
                 "note": "paper: crossing r_esc slightly above 1 means the orbit has left Ω for good; "
-                "err = half the Wilson ±1σ interval",
+                + (
+                    "no return among n escaped orbits: the one-sided 95 % bound"
+                    if counted
+                    else "err = half the Wilson ±1σ interval"
+                ),
             }
         )
     return numbers, rows
+
+
+def return_quantity(r_in: float, r: float, E: float) -> str:
+    """The quantity of the returns row of cell (E, r) in the paper comparison.
+
+    >>> return_quantity(1.0, 1.5, 0.3)
+    'fraction returning inside r<1 after crossing r_esc=1.5 (E=0.30)'
+    """
+    return f"fraction returning inside r<{r_in:g} after crossing r_esc={r:g} (E={E:.2f})"
+
+
+def with_return_counts(numbers: dict) -> dict:
+    """with_return_counts(numbers JSON) -> the same numbers with each returns row of its ``paper_comparison`` given
+    its number of escaped orbits ``n`` from the numbers' own ``returns`` record, where the row does not state it
+    (a record written before the rows carried their count), so that a count of 0 is read as its one-sided bound
+    (:func:`hhscatter.reproduction.verdicts.row_bound`). Numbers of any other study come back unchanged.
+
+    Examples
+    --------
+    >>> doc = {"config": {"study": {"r_in": 1.0}}, "returns": {"E=0.30": {"r_esc=1.5": {"n_escaped": 60000}}},
+    ...        "paper_comparison": [{"quantity": return_quantity(1.0, 1.5, 0.3), "ours": 0.0, "paper": 0.0}]}
+    >>> with_return_counts(doc)["paper_comparison"][0]["n"]
+    60000
+    """
+    returns = numbers.get("returns")
+    r_in = ((numbers.get("config") or {}).get("study") or {}).get("r_in")
+    rows = numbers.get("paper_comparison")
+    if not isinstance(returns, dict) or not isinstance(r_in, (int, float)) or not rows:
+        return numbers
+    counts = {}
+    for e_key, cells in returns.items():
+        for r_key, cell in cells.items():
+            try:
+                E, r = float(e_key.partition("=")[2]), float(r_key.partition("=")[2])
+            except ValueError:
+                continue
+            if isinstance(cell, dict) and isinstance(cell.get("n_escaped"), int):
+                counts[return_quantity(r_in, r, E)] = cell["n_escaped"]
+    filled = [
+        {**row, "n": counts[row.get("quantity")]} if row.get("quantity") in counts and "n" not in row else row
+        for row in rows
+    ]
+    return {**numbers, "paper_comparison": filled}
 
 
 def criterion_numbers(energies, radii, r_ref, kap, ret, chan, lyap, *, r_in: float, fast: float):

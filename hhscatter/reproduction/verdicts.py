@@ -7,6 +7,8 @@ the smoke scale that states none. Pure functions of numbers (no I/O).
   :data:`NO_VERDICT`, :func:`without_verdicts`);
 * :data:`REFERENCE_KINDS`, :func:`reference_kind`, :func:`reference_err` — the reference's own uncertainty kind
   (printed, propagated, exact, or not the same quantity);
+* :func:`row_bound` — the one-sided bound of a row whose number is a fraction counted at 0 or at all (its
+  verdict: :data:`BOUND_INSIDE` when the reference lies inside the bound);
 * :func:`claim_verdict` — a claim record's verdict, by :func:`row_verdict`;
 * :func:`quoted_verdict` — 2σ, then the paper's printed precision (it gives no errors);
 * :func:`verdict_beside_authors` — the project's rule that "differs" is kept for a difference that
@@ -19,6 +21,7 @@ from __future__ import annotations
 import math
 import re
 
+from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.verdicts import half_unit, verdict
 
 
@@ -44,8 +47,14 @@ RULE = (
     "another measurement: its 1σ), **exact** (theory: an exponent 2, a limit 1, a predicted shift 0); "
     "**differs** otherwise; z = (ours − reference)/σ. A reference that is **not the same quantity** is shown "
     "side by side with why, and no verdict. A cell without a number or without our uncertainty says so "
-    "instead of a verdict; the tiny scale (a smoke test of a few hundred orbits) gives no verdicts."
+    "instead of a verdict; the tiny scale (a smoke test of a few hundred orbits) gives no verdicts. A fraction "
+    "counted at 0 (or at all) has no σ but its one-sided 95 % bound: **consistent (bound)** when the reference "
+    "lies inside the bound, **differs (outside the bound)** otherwise, no z."
 )
+#: the verdict of a bound (a fraction counted at 0 or at all) whose reference lies inside it
+BOUND_INSIDE = "consistent (bound)"
+#: the verdict of a bound whose reference lies outside it
+BOUND_OUTSIDE = "differs (outside the bound)"
 #: scales whose outputs are smoke tests: their rows carry no verdict
 SMOKE_SCALES = ("tiny",)
 #: what a smoke-scale output states in place of a verdict
@@ -106,6 +115,36 @@ def reference_err(row: dict, kind: str | None = None) -> float | None:
     return 0.0
 
 
+def row_bound(row: dict) -> dict | None:
+    """row_bound(paper-vs-ours row) -> {"upper" or "lower": bound, "cl": level} of a row whose ``ours`` is a
+    fraction counted at 0 (or at all), else None.
+
+    The bound is the row's own (``ours_upper`` / ``ours_lower`` with ``ours_cl``, as
+    :meth:`~hhscatter.analysis.stats.intervals.BoundedFraction.record` writes them), else derived from its
+    number of trials ``n`` by :func:`~hhscatter.analysis.stats.intervals.fraction_with_bound` (one-sided,
+    95 %): a count of 0 is never "0 ± σ".
+
+    Examples
+    --------
+    >>> row_bound({"ours": 0.0, "paper": 0.0, "n": 60000})  # 1 − 0.05^(1/60000)
+    {'upper': 4.9928e-05, 'cl': 0.95}
+    >>> row_bound({"ours": 0.0, "ours_upper": 3e-4, "ours_cl": 0.95}), row_bound({"ours": 0.2, "n": 10})
+    ({'upper': 0.0003, 'cl': 0.95}, None)
+    """
+    ours = row.get("ours")
+    if not _finite(ours):
+        return None
+    found = {k: float(row[f"ours_{k}"]) for k in ("upper", "lower") if _finite(row.get(f"ours_{k}"))}
+    if len(found) == 1:
+        return {**found, "cl": float(row.get("ours_cl") or 0.95)}
+    n = row.get("n")
+    if ours not in (0, 1) or not isinstance(n, int) or isinstance(n, bool) or n <= 0:
+        return None
+    b = fraction_with_bound(round(ours * n), n)
+    key, bound = ("upper", b.upper) if b.upper is not None else ("lower", b.lower)
+    return {key: float(f"{bound:.5g}"), "cl": b.cl}
+
+
 def row_verdict(row: dict, scale: str | None = None) -> str:
     """row_verdict(paper-vs-ours row, scale) -> the text of its verdict cell by :data:`RULE`: **the one function**
     every table, claim, report row and sentence takes its verdict from.
@@ -118,7 +157,10 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     rule ("recorded"); a qualitative row (text, or no reference) keeps the
     verdict its study wrote, or "—"; at a smoke scale (tiny) no verdict.
     A "differs" that the study qualified (e.g. "differs in our convention
-    only; agrees under the authors' …") keeps its qualification.
+    only; agrees under the authors' …") keeps its qualification. A fraction
+    counted at 0 or at all (:func:`row_bound`) has no σ and no z: the
+    reference inside its one-sided bound is :data:`BOUND_INSIDE`, outside
+    it :data:`BOUND_OUTSIDE`.
 
     Examples
     --------
@@ -130,6 +172,8 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     'not the same quantity: another window'
     >>> row_verdict({"ours": 0.2705, "err": 0.001, "paper": 0.27}, "tiny")
     'no verdict (tiny scale: a smoke test)'
+    >>> row_verdict({"ours": 0.0, "err": None, "paper": 0.0, "n": 60000})
+    'consistent (bound)'
     """
     if scale in SMOKE_SCALES:
         return NO_VERDICT
@@ -153,6 +197,11 @@ def row_verdict(row: dict, scale: str | None = None) -> str:
     ref_err = reference_err(row, kind)
     if ref_err is None:
         return "undetermined: the reference's propagated uncertainty is not recorded"
+    bound = row_bound(row)
+    if bound is not None:
+        # the reference (widened by its own 1σ) reaches inside the one-sided bound
+        inside = paper - ref_err <= bound["upper"] if "upper" in bound else paper + ref_err >= bound["lower"]
+        return BOUND_INSIDE if inside else BOUND_OUTSIDE
     v = verdict(ours, row.get("err"), paper, ref_err)
     if v.word == "differs" and stored.startswith("differs") and ";" in stored:
         return f"{v.text()}; {stored.split(';', 1)[1].strip()}"

@@ -22,7 +22,14 @@ from hhscatter.data.write import write_part, write_parts_streamed
 from hhscatter.errors import ConfigError, StudyError
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import system_from_spec
-from hhscatter.reproduction.verdicts import NO_VERDICT, REFERENCE_KINDS, SMOKE_SCALES, row_verdict, without_verdicts
+from hhscatter.reproduction.verdicts import (
+    NO_VERDICT,
+    REFERENCE_KINDS,
+    SMOKE_SCALES,
+    row_bound,
+    row_verdict,
+    without_verdicts,
+)
 from hhscatter.run.plan import SCENE_FILE
 from hhscatter.run.runner import simulate
 from hhscatter.scene.scene import Scene, scene_from_dict
@@ -270,6 +277,7 @@ class Study:
         reference: str | None = None,
         paper_err: float | None = None,
         why: str = "",
+        n: int | None = None,
     ) -> dict:
         """compare(quantity, ours, err=None, paper=None, *, convention=None, authors=False, ...) -> row dict.
 
@@ -282,8 +290,12 @@ class Study:
         *our* number was made (default: the study's setup, :attr:`convention_label`); ``authors=True`` marks a
         row computed in the authors' own convention (their IC region, window or selection rule), so that a
         "differs" can be checked against it. The paper's number is always in the authors' convention. At a smoke
-        scale (tiny) the row states no verdict (:data:`~hhscatter.reproduction.verdicts.NO_VERDICT`).
+        scale (tiny) the row states no verdict (:data:`~hhscatter.reproduction.verdicts.NO_VERDICT`). ``n``: the
+        number of trials when ``ours`` is a fraction of them; a fraction counted at 0 (or at all) is then judged and
+        shown by its one-sided 95 % bound (:func:`~hhscatter.reproduction.verdicts.row_bound`), not by a σ.
         """
+        if n is not None and (not isinstance(n, int) or isinstance(n, bool) or n <= 0):
+            raise StudyError(f"compare({quantity!r}): n must be a positive number of trials, got {n!r}")
         if self.scale in SMOKE_SCALES:
             verdict = NO_VERDICT
         elif verdict is None and paper is not None and ours is not None and err is not None:
@@ -315,7 +327,9 @@ class Study:
             row["paper_err"] = float(paper_err)
         if why:
             row["why"] = why
-        if reference is not None and self.scale not in SMOKE_SCALES:
+        if n is not None:
+            row["n"] = n
+        if (reference is not None or row_bound(row) is not None) and self.scale not in SMOKE_SCALES:
             row["verdict"] = row_verdict(row, self.scale)
         self.comparisons.append(row)
         return row

@@ -113,7 +113,7 @@ def _panel_a(ax, curves, lines, numbers):
             inset.tick_params(labelsize=7)
             inset.set_title(
                 f"$E_0={E:.2f}$: escaping orbits (solid), all (dashed;\n"
-                f"KAM-trapped fraction {info['trapped_fraction']:.1e})",
+                f"censored fraction {info['trapped_fraction']:.1e})",
                 fontsize=7,
             )
     ax.set_yscale("log")
@@ -260,7 +260,7 @@ def _panel_c(ax, conv_table, numbers):
         label=_paper_law_label(pp),
     )
     ax.plot(xs[xs >= xp], pp["c"] * xs[xs >= xp], ":", color="0.45", lw=1.0)
-    ax.plot([], [], "x", color="0.3", ms=7, mew=2, label="κ ill-defined (trapped plateau): excluded")
+    ax.plot([], [], "x", color="0.3", ms=7, mew=2, label="κ ill-defined (plateau of censored orbits): excluded")
     ax.fill_between([], [], color="0.85", label=f"unstable across conventions (> {conv['stable_rel_tol']:.0%})")
     ax.set_xlim(0, x_max + 0.006)
     ax.set_ylim(0, None)

@@ -293,7 +293,7 @@ def plot_regular(numbers, path):
     ax.set_ylabel("regular fraction of all orbits\n(bars: 1σ; at 0: 95 % upper bound)")
     r = d.iloc[0]
     ax.set_title(
-        f"Orbits on KAM tori (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "
+        f"Regular orbits (shadow FTLE: separation growth < {r['g_max']:.0e} at t ≥ {r['t_from']:g}; "
         f"N = {int(r['n'])} per point)",
         fontsize=10,
     )

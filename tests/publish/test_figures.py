@@ -59,3 +59,25 @@ def test_a_panel_of_a_constrained_layout_is_cropped_where_it_was_drawn(tmp_path)
         assert 0 < rows[0] and rows[-1] < h - 1 and rows[-1] - rows[0] > 0.3 * h, (p.name, rows[0], rows[-1], h)
     assert fig.get_layout_engine().__class__.__name__ == "ConstrainedLayoutEngine"  # given back
     plt.close(fig)
+
+
+def test_a_panel_shows_no_part_of_the_composites_suptitle(tmp_path):
+    """A two-line panel title right under the composite's suptitle (as the generality figure draws them): the crop of
+    the panel holds its own title and no cut strip of the suptitle; the composite keeps it."""
+    plt = agg_pyplot()
+    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3))
+    a.plot([0, 1], [0, 1], color="k")
+    b.plot([0, 1], [1, 0], color="k")
+    a.set_title("panel (a) title,\non two lines", fontsize=9)
+    fig.tight_layout(rect=(0, 0, 1, 0.85))
+    fig.canvas.draw()
+    top = a.title.get_window_extent().transformed(fig.transFigure.inverted()).y1
+    fig.suptitle("THE COMPOSITE'S TITLE", color="red", fontsize=14, y=top, va="bottom")  # within the pad
+    fig.savefig(tmp_path / "fig.png", dpi=80)
+    assert _red_pixels(tmp_path / "fig.png") > 50
+    pa, pb = save_panels(fig, tmp_path / "fig.png", dpi=80)
+    assert _red_pixels(pa) == 0 and _red_pixels(pb) == 0
+    assert fig._suptitle.get_visible()  # the figure is left as it was
+    fig.savefig(tmp_path / "again.png", dpi=80)
+    assert np.array_equal(plt.imread(tmp_path / "again.png"), plt.imread(tmp_path / "fig.png"))
+    plt.close(fig)

@@ -18,7 +18,9 @@ from hhscatter.reproduction.escape_criterion import (
     kappa_row,
     paired_runs,
     recommend_r_esc,
+    return_quantity,
     returns_row,
+    with_return_counts,
 )
 
 KAPPA = 0.1
@@ -233,3 +235,45 @@ def test_follow_returns_of_an_orbit_that_comes_back_and_one_that_leaves():
     assert rs[1.5]["returned"].tolist() == [True, False] and rs[1.5]["t_return"][0] == 4.0
     assert rs[1.5]["t_reesc"][0] == 6.0 and rs[2.0]["returned"].tolist() == [False, False]
     assert back[1.5].tolist() == [True, False] and back[2.0].tolist() == [False, False]
+
+
+def test_a_return_row_without_returns_states_its_count_and_no_sigma():
+    """No return among the n escaped orbits: the row carries n (for its one-sided bound) and no Wilson σ, so that it
+    is read as "< bound (95 %)" and judged by the bound, never as "0 ± σ" with a z-score."""
+    from hhscatter.publish.formatting import ours_cell
+    from hhscatter.reproduction.verdicts import row_verdict
+
+    kap, ret = _kappa_and_returns()
+    ret = ret.assign(n_escaped=[60000, 60000], n_returned=[3, 0], frac=[3 / 60000, 0.0], hi=[1e-4, 1.7e-5])
+    chan = pd.DataFrame(channel_rows(0.3, 1.5, np.array([0, 1, 2]), np.array([1.0, 2.0, 3.0]), (10.0, 20.0)))
+    lyap = pd.DataFrame({"energy": [0.3], "r_min": [1.0], "r_max": [1.2], "period": [6.0]})
+    _, rows = criterion_numbers([0.3], [1.5, 2.0], 1.5, kap, ret, chan, lyap, r_in=1.0, fast=10.0)
+    some, none = (next(row for row in rows if row["quantity"] == return_quantity(1.0, r, 0.3)) for r in (1.5, 2.0))
+    assert some["n"] == none["n"] == 60000
+    assert some["err"] == pytest.approx(0.5e-4) and none["err"] is None
+    assert ours_cell(none) == "< 5.0e-5 (95 %)"  # 1 − 0.05^(1/60000) = 4.99e-5
+    assert row_verdict(none) == "consistent (bound)" and row_verdict(some) == "agrees (z = +1.0)"  # 3 returns: a z
+
+
+def test_return_rows_written_without_their_count_take_it_from_the_returns_record():
+    """A record written before the rows carried n: its row "0 ± 5e-7" (half the Wilson 1σ interval at n = 10⁶) is
+    read as the bound 1 − 0.05^(1/10⁶) ≈ 3.0e-6 from the record's n_escaped; other rows and other studies' numbers
+    stay as they are."""
+    from hhscatter.publish.formatting import comparison_table
+
+    q = return_quantity(1.0, 1.5, 0.25)
+    doc = {
+        "config": {"study": {"r_in": 1.0}},
+        "returns": {"E=0.25": {"r_esc=1.5": {"n_escaped": 1000000, "n_returned": 0}}},
+        "paper_comparison": [
+            {"quantity": q, "ours": 0.0, "err": 4.999995e-07, "paper": 0.0, "verdict": "agrees within 2σ"},
+            {"quantity": "κ shift", "ours": 0.001, "err": 0.001, "paper": 0.0},
+        ],
+    }
+    rows = with_return_counts(doc)["paper_comparison"]
+    assert rows[0]["n"] == 1000000 and "n" not in rows[1]
+    table = comparison_table(rows, scale="paper")
+    assert "| < 3.0e-6 (95 %) |" in table and "| consistent (bound) |" in table
+    assert "± 5" not in table.splitlines()[2] and "z = +0.0" not in table
+    assert with_return_counts({"paper_comparison": rows[1:]}) == {"paper_comparison": rows[1:]}
+    assert "n" not in doc["paper_comparison"][0]  # the record itself is not changed

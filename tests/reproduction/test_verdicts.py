@@ -100,3 +100,23 @@ def test_a_study_row_records_its_reference_kind_and_the_rules_verdict():
         study.compare("x", 1.0, 0.1, 1.0, reference="guess")
     with pytest.raises(StudyError, match="paper_err"):
         study.compare("x", 1.0, 0.1, 1.0, reference="propagated")
+
+
+def test_a_count_of_zero_is_judged_by_its_one_sided_bound_not_a_z_score():
+    """No return among n orbits against the reference 0: the fraction has no σ, so no z; the bound
+    1 − 0.05^(1/n) (exact one-sided 95 %, computed here) contains 0: "consistent (bound)"."""
+    from hhscatter.reproduction.verdicts import row_bound
+
+    n = 60000
+    row = {"quantity": "fraction returning", "ours": 0.0, "err": None, "paper": 0.0, "n": n}
+    assert row_bound(row) == {"upper": pytest.approx(1 - 0.05 ** (1 / n), rel=1e-4), "cl": 0.95}
+    assert row_verdict(row) == "consistent (bound)"
+    assert verdict_class(row_verdict(row)) == "ok"
+    # a reference outside the bound: 10 orbits, none returns, against a reference fraction 0.5 > 1 − 0.05^(1/10)
+    assert row_verdict({**row, "n": 10, "paper": 0.5, "reference_kind": "exact"}) == "differs (outside the bound)"
+    # a count of all: the lower bound 0.05^(1/n) against a limit 1
+    assert row_verdict({**row, "ours": 1.0, "paper": 1.0}) == "consistent (bound)"
+    # a bound the row records itself
+    assert row_bound({"ours": 0.0, "ours_upper": 3e-4, "ours_cl": 0.9}) == {"upper": 3e-4, "cl": 0.9}
+    # a count between 0 and n keeps its σ and its z
+    assert row_verdict({**row, "ours": 0.5, "err": 0.1, "paper": 0.4, "reference_kind": "exact"}) == "agrees (z = +1.0)"
