@@ -388,3 +388,11 @@ def test_a_scale_running_the_evidence_alone_publishes_it_sealed_without_claims(t
     assert "claims" not in doc and "evidence_record" not in doc
     assert doc["regular_fraction"] == full["regular_fraction"]
     assert doc["survival_long"] == full["survival_long"]
+
+
+def test_an_empty_probe_window_is_counted_in_the_json_not_printed(tiny):
+    """At tiny scale the probe run of Contopoulos at 2.6 E_c has no snapshot inside its window: the reader's warning
+    is counted in the numbers JSON's ``library_warnings`` under the place that read it, not printed."""
+    _, doc = tiny
+    rec = [w for w in doc["library_warnings"] if w["where"] == "claims.mu.probe_window"]
+    assert rec and all(w["category"] == "UserWarning" and "nothing matched filters" in w["message"] for w in rec)

@@ -19,6 +19,7 @@ from hhscatter.analysis.dissipative.kinetic import (
     kinetic_fraction_from_energies,
     microcanonical_kinetic_fraction,
 )
+from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed
 from hhscatter.reproduction.claims.keys import diss_key, probe_key
@@ -45,7 +46,8 @@ def mu_conservative(runs, label, m, fits, keys=None):
         lt = runs.lifetimes(key)
         # only the rows the average uses (kinetic_fraction_from_energies keeps t_from ≤ t ≤ t_to): the same
         # result, without reading the sticky systems' whole probe tables (2.5e7 rows at paper scale)
-        sn = runs.snapshots(key, t_from=t0, t_to=t1)
+        with counted("claims.mu.probe_window"):  # an empty window (no snapshot in it) is counted, not printed
+            sn = runs.snapshots(key, t_from=t0, t_to=t1)
         escaping = lt.loc[lt["outcome"] != "censored", "traj_id"].to_numpy()
         for kind, keep in (("c-measure", escaping), ("all survivors", None)):
             k = kinetic_fraction_from_energies(
