@@ -5,7 +5,6 @@ saddle's eigenvalue, determinism, and scenes without it unchanged."""
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +12,7 @@ from pathlib import Path
 import heyoka as hy
 import numpy as np
 import pytest
+from old_code import code_at
 from scipy.integrate import solve_ivp
 
 from hhscatter.data.read import read_lifetimes
@@ -209,15 +209,7 @@ for kw in ({}, {"gamma": 0.01, "sections": SectionWindow()}):
 
 
 def test_scenes_without_tangent_keep_the_hashes_and_tables_of_the_code_before_the_option(tmp_path):
-    if (
-        shutil.which("git") is None
-        or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT, capture_output=True).returncode != 0
-    ):
-        pytest.skip(f"needs the git history with {BASE}")
-    old = tmp_path / "old"
-    old.mkdir()
-    archive = subprocess.run(["git", "archive", BASE, "hhscatter"], cwd=ROOT, capture_output=True, check=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
+    old = code_at(BASE, tmp_path / "old")
 
     def run(root):
         env = {**os.environ, "PYTHONPATH": str(root)}

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from old_code import code_at
 from scipy import stats
 
 from hhscatter.errors import ConfigError
@@ -89,15 +89,7 @@ for region in ("disk", "well", "square"):
 
 
 def test_default_scenes_give_the_ics_and_hashes_of_main_before_the_option(tmp_path):
-    if (
-        shutil.which("git") is None
-        or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT, capture_output=True).returncode != 0
-    ):
-        pytest.skip(f"needs the git history with {BASE}")
-    old = tmp_path / "old"
-    old.mkdir()
-    archive = subprocess.run(["git", "archive", BASE, "hhscatter"], cwd=ROOT, capture_output=True, check=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
+    old = code_at(BASE, tmp_path / "old")
 
     def run(root):
         env = {**os.environ, "PYTHONPATH": str(root)}

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 import pytest
+from old_code import code_at
 
 from hhscatter.cli import main
 
@@ -250,17 +250,7 @@ CONVENTION_CHANGED = {"fig5": {"r_esc": 1.03}, "fig6": {"r_esc": 1.03}}
 
 
 def test_scene_hashes_of_every_study_and_scale_are_those_of_main_before_the_checks(tmp_path):
-    if (
-        shutil.which("git") is None
-        or subprocess.run(["git", "cat-file", "-e", BASE], cwd=ROOT, capture_output=True).returncode != 0
-    ):
-        pytest.skip(f"needs the git history with {BASE}")
-    old = tmp_path / "old"
-    old.mkdir()
-    archive = subprocess.run(
-        ["git", "archive", BASE, "hhscatter", "studies"], cwd=ROOT, capture_output=True, check=True
-    ).stdout
-    subprocess.run(["tar", "-x", "-C", str(old)], input=archive, check=True)
+    old = code_at(BASE, tmp_path / "old", ("hhscatter", "studies"))
     before = _scene_hashes(old, old)
     # the studies that existed then (a study added since, e.g. basins, has no earlier hash to keep)
     then = sorted({k.split("/")[0] for k in before})
