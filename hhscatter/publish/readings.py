@@ -567,6 +567,118 @@ def _noise_turnover_theory(get: Loader) -> str:
     return "; ".join(out)
 
 
+#: the turnover theory is read as holding to this relative tolerance (a 2σ interval inside 1 ± this)
+TURNOVER_TOLERANCE = 0.15
+
+
+def _tolerance_class(ratio: float, err: float, tol: float) -> str:
+    """ "within" when the 2σ interval of ``ratio`` lies inside 1 ± tol, "beyond" when it lies outside, else
+    "undecided"."""
+    d = abs(ratio - 1.0)
+    return "within" if d + Z_RESOLVED * err <= tol else "beyond" if d - Z_RESOLVED * err > tol else "undecided"
+
+
+def _tolerance_words(rows: list[dict], key: str, tol: float) -> str:
+    """Where the ratios ``key`` of rows sorted by γ lie within 1 ± tol, from their 2σ intervals: the widest run of
+    consecutive γ that do, and the γ that do not or are undecided, with their ratios."""
+    cls = [_tolerance_class(r[key], r[f"{key}_err"], tol) for r in rows]
+    best, run = (0, 0), None
+    for i, c in enumerate(cls + ["end"]):
+        if c == "within" and run is None:
+            run = i
+        elif c != "within" and run is not None:
+            best = max(best, (i - run, run), key=lambda x: x[0])
+            run = None
+    n, start = best
+    if n == 0:
+        out = f"within {100 * tol:g} % at no γ"
+    elif n == 1:
+        out = f"within {100 * tol:g} % at γ = {rows[start]['gamma']:g} only"
+    else:
+        out = f"within {100 * tol:g} % from γ = {rows[start]['gamma']:g} to {rows[start + n - 1]['gamma']:g}"
+    rest = []
+    for word, what in (("beyond", f"beyond {100 * tol:g} %"), ("undecided", f"undecided at {100 * tol:g} %")):
+        cells = [
+            f"{r['gamma']:g} ({_ve(r[key], r[f'{key}_err'])})"
+            for i, (r, c) in enumerate(zip(rows, cls))
+            if c == word and not start <= i < start + n
+        ]
+        if cells:
+            rest.append(f"{what} at γ = {', '.join(cells)}")
+    stray = [
+        f"{r['gamma']:g}" for i, (r, c) in enumerate(zip(rows, cls)) if c == "within" and not start <= i < start + n
+    ]
+    if stray:
+        rest.append(f"within {100 * tol:g} % also at γ = {', '.join(stray)}")
+    return out + (f"; {'; '.join(rest)}" if rest else "")
+
+
+def _noise_turnover_barriers(get: Loader) -> str:
+    d = get("noise", None)
+    series = [
+        sorted((r for r in d.get(k) or [] if "ratio_mm" in r), key=lambda r: r["gamma"])
+        for k in ("turnover", "turnover_high")
+    ]
+    series = [s for s in series if s]
+    if len(series) < 2:
+        return "the turnover at a second barrier is not in this scale's numbers"
+    tol = TURNOVER_TOLERANCE
+    cells = []
+    for rows in series:
+        inside = [r for r in rows if r["theory_assumptions_hold"]]
+        where = f" (the theory's range: γ ≤ {inside[-1]['gamma']:g})" if inside else ""
+        cells.append(
+            f"at ΔE/T = {rows[0]['barrier_over_T']:.3g} the rate over Υ(δ) k_KL is "
+            f"{_tolerance_words(rows, 'ratio_mm', tol)}{where}"
+        )
+    (lo, hi) = series
+    common = sorted({r["gamma"] for r in lo} & {r["gamma"] for r in hi})
+    out = (
+        f"by the 2σ intervals (within {100 * tol:g} %: inside [{1 - tol:.2f}, {1 + tol:.2f}]; beyond: outside it; "
+        f"undecided: across its edge), {'; '.join(cells)}"
+    )
+    if common:
+        g = common[0]
+        a = next(r for r in lo if r["gamma"] == g)
+        b = next(r for r in hi if r["gamma"] == g)
+        ea, eb = a["ratio_mm"] - 1, b["ratio_mm"] - 1
+        sa, sb = a["ratio_mm_err"], b["ratio_mm_err"]
+        ba, bb = a["barrier_over_T"], b["barrier_over_T"]
+        change = verdict(eb, sb, ea, sa)
+        scaled, scaled_err = ea * ba / bb, sa * ba / bb
+        prop = verdict(eb, sb, scaled, scaled_err)
+        out += (
+            f". At the lowest γ = {g:g} the excess over the theory is {_ve(100 * ea, 100 * sa)} % at ΔE/T = {ba:.3g} "
+            f"and {_ve(100 * eb, 100 * sb)} % at {bb:.3g}: a change of {_ve(100 * (eb - ea), 100 * math.hypot(sa, sb))} "
+            f"points, {'resolved' if change.word == 'differs' else 'not resolved'} at 2σ (z = {signed(change.z)}); an "
+            f"excess ∝ T/ΔE would be {_ve(100 * scaled, 100 * scaled_err)} % at {bb:.3g}, which the measured one "
+            f"{'agrees with' if prop.word == 'agrees' else 'differs from'} (z = {signed(prop.z)})"
+        )
+    return out
+
+
+def _noise_saddles_turnover(get: Loader) -> str:
+    d = get("noise", None).get("two_saddles_turnover") or {}
+    rows = sorted((r for r in d.get("records") or [] if "ratio_mm" in r), key=lambda r: r["gamma"])
+    if not rows:
+        return "the two-saddle system's turnover is not in this scale's numbers"
+    lo, hi = rows[0], rows[-1]
+    tol = TURNOVER_TOLERANCE
+    higher = max(range(len(lo["saddles"])), key=lambda i: lo["saddles"][i]["barrier"])
+    share = [r["saddles"][higher]["melnikov_meshkov"] / r["melnikov_meshkov"] for r in rows]
+    return (
+        f"at ΔE/T = {d['barrier_over_T']:.3g} of the lowest saddle, from γ = {lo['gamma']:g} to {hi['gamma']:g}, the "
+        f"rate over the sum Σ_s Υ(δ_s) k_KL,s is {_tolerance_words(rows, 'ratio_mm', tol)}. At γ = {hi['gamma']:g} "
+        f"the rate over the Kramers–Langer sum is {_ve(hi['ratio'], hi['ratio_err'])}, which "
+        f"{_against(hi['ratio'], hi['ratio_err'], 1.0, '1')}; at γ = {lo['gamma']:g} it is "
+        f"{_ve(lo['ratio'], lo['ratio_err'])} of the Kramers–Langer sum and {_ve(lo['ratio_ed'], lo['ratio_ed_err'])} "
+        f"of the energy-diffusion limit Σ_s δ_s k_TST,s. The higher saddle's share of the theory's sum is "
+        f"{share[0]:.3f} at γ = {lo['gamma']:g} and {share[-1]:.3f} at {hi['gamma']:g} (its δ_s = "
+        f"{lo['saddles'][higher]['delta']:.3g} at γ = {lo['gamma']:g}, the lower saddle's "
+        f"{min(s['delta'] for s in lo['saddles']):.3g})"
+    )
+
+
 def _noise_no_drag(get: Loader) -> str:
     rows = [r for r in get("noise", None)["no_drag"] if r["sigma"] > 0]
     out = []
@@ -745,6 +857,8 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.kramers": _noise_kramers,
     "noise.turnover": _noise_turnover,
     "noise.turnover_theory": _noise_turnover_theory,
+    "noise.turnover_barriers": _noise_turnover_barriers,
+    "noise.saddles_turnover": _noise_saddles_turnover,
     "noise.no_drag": _noise_no_drag,
     "noise.no_drag_survivors": _noise_no_drag_survivors,
     "noise.finite_barrier": _noise_finite_barrier,

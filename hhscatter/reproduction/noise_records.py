@@ -2,7 +2,8 @@
 
 :func:`rate_record` sets a thermal rate measured on a window (:func:`~hhscatter.analysis.noise.kramers.thermal_rate`)
 beside the Kramers–Langer rate of the system at the same (γ, T), with the window's two halves compared;
-:func:`turnover_record` adds the Mel'nikov–Meshkov/PGH rate and both Kramers limits; :func:`two_saddle_record` the
+:func:`turnover_record` adds the Mel'nikov–Meshkov/PGH rate and both Kramers limits, :func:`saddle_turnover_terms`
+each saddle's part of them; :func:`two_saddle_record` the
 multi-saddle sum's lowest term and the escapes' exit shares against each term's share; :func:`saddle_terms` lists a
 system's saddles; :func:`finite_barrier_record` fits the ratios against T/ΔE beside the transition-state
 correction; :func:`absorbing_radius_record` compares a rate measured at two escape radii; :func:`no_drag_records`,
@@ -44,6 +45,7 @@ __all__ = [
     "rate_record",
     "reactivation_record",
     "saddle_terms",
+    "saddle_turnover_terms",
     "survivor_record",
     "turnover_record",
     "two_saddle_record",
@@ -175,6 +177,44 @@ def turnover_record(record: dict, model, gamma_max: float) -> dict:
     for name, k in (("mm", tr.rate), ("ed", tr.energy_diffusion)):
         out.update(_flat(f"ratio_{name}", rate.over(k)))
     return out
+
+
+def saddle_turnover_terms(model, gamma: float, temperature: float) -> list[dict]:
+    """Each saddle's part of the turnover theory at (γ, T) (1/time for the rates): its exit, barrier (energy) and
+    ω_b (1/time), the action S (energy·time) of the orbit at its energy through the well
+    (:func:`~hhscatter.analysis.noise.turnover.barrier_action`), δ = γS/T and Υ(δ), its Kramers–Langer term
+    k_KL,s, its Mel'nikov–Meshkov/PGH term Υ(δ) k_KL,s and its energy-diffusion term δ k_TST,s; the terms of all
+    saddles sum to the rates of :func:`turnover_record`.
+
+    Examples
+    --------
+    Hénon–Heiles' three equal saddles at γ = 0.1, ΔE/T = 3: S = 6/5, δ = 0.1 · 1.2 · 18 = 2.16, each term a third:
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> s = saddle_turnover_terms(HenonHeiles(), 0.1, 1 / 18)
+    >>> len(s), round(s[0]["action"], 10), round(s[0]["delta"], 10), round(s[0]["upsilon"], 4)
+    (3, 1.2, 2.16, 0.6634)
+    >>> t = turnover_record({"gamma": 0.1, "temperature": 1 / 18, "rate": 1.0, "rate_err": 0.1}, HenonHeiles(), 0.3)
+    >>> bool(abs(sum(x["melnikov_meshkov"] for x in s) - t["melnikov_meshkov"]) < 1e-15)
+    True
+    """
+    kl = kramers_langer(model, gamma, temperature)
+    actions = [barrier_action(model, k) for k in range(len(model.exits))]
+    tr = turnover_rate(kl, actions)
+    return [
+        {
+            "exit": i,
+            "barrier": t.barrier,
+            "omega_b": t.omega_b,
+            "action": a,
+            "delta": d,
+            "upsilon": u,
+            "kramers_langer": t.rate,
+            "melnikov_meshkov": u * t.rate,
+            "energy_diffusion": d * t.omega_b / t.lambda_plus * t.rate,
+        }
+        for i, (t, a, d, u) in enumerate(zip(kl.terms, actions, tr.delta, tr.upsilon))
+    ]
 
 
 def two_saddle_record(record: dict, exit_channel, t_end, escaped, model) -> dict:

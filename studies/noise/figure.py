@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from hhscatter.publish.figures import agg_pyplot, save_panels
+from hhscatter.publish.readings import TURNOVER_TOLERANCE
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
@@ -140,13 +141,54 @@ def _panel_two_saddles(ax, d):
     ax.legend(fontsize=7, loc="lower left")
 
 
+def _panel_theory_ratios(ax, series, tol):
+    """(g) the rate over the Mel'nikov–Meshkov/PGH rate against γ for each turnover series, the band 1 ± ``tol`` and
+    the theory's range (γ/ω_b up to its stated bound)."""
+    for (label, t), color, marker in zip(series, COLORS[2:], "osD"):
+        t = t.sort_values("gamma")
+        ax.errorbar(t.gamma, t.ratio_mm, 2 * t.ratio_mm_err, fmt=marker + "-", color=color, ms=4, capsize=2, lw=0.8,
+                    label=label)  # fmt: skip
+        inside = t[t.theory_assumptions_hold.astype(bool)]
+        if len(inside) and len(inside) < len(t):  # from half way (in log γ) past the range's last point
+            edge = np.sqrt(float(inside.gamma.max()) * float(t.gamma[t.gamma > inside.gamma.max()].min()))
+            ax.axvspan(edge, float(t.gamma.max()) * 1.5, color="0.93", zorder=0)
+    ax.axhspan(1 - tol, 1 + tol, color=COLORS[0], alpha=0.12, lw=0, label=rf"$1 \pm {tol:g}$")
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel(r"drag $\gamma$ (shaded: beyond the theory's range)")
+    ax.set_ylabel(r"$k / \Upsilon(\delta) k_{KL}$  (bars: 2σ)")
+    ax.set_title("(g) the turnover against Mel'nikov–Meshkov/PGH", fontsize=10)
+    ax.legend(fontsize=7, loc="lower left")
+
+
+def _panel_saddles_turnover(ax, t, barrier):
+    """(h) the two-saddle system's rate against γ: measured, the Kramers–Langer sum, the Mel'nikov–Meshkov/PGH sum
+    and the energy-diffusion limit."""
+    t = t.sort_values("gamma")
+    ax.errorbar(t.gamma, t.rate, t.rate_err, fmt="o", color=COLORS[4], ms=4, capsize=2, label="measured")
+    ax.plot(t.gamma, t.kramers_langer, "-", color="k", lw=1, label=r"$\sum_s k_{KL,s}$")
+    ax.plot(t.gamma, t.melnikov_meshkov, "-", color=COLORS[3], lw=1.2, label=r"$\sum_s \Upsilon(\delta_s) k_{KL,s}$")
+    ax.plot(t.gamma, t.energy_diffusion, ":", color="0.4", lw=1, label=r"$\sum_s \delta_s k_{TST,s}$")
+    ax.set_ylim(0.5 * float(t.rate.min()), 2 * float(t.kramers_langer.max()))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"drag $\gamma$")
+    ax.set_ylabel(r"escape rate $k$")
+    ax.set_title(rf"(h) two saddles: turnover, $\Delta E/T$ = {barrier:.3g} (lowest saddle)", fontsize=10)
+    ax.legend(fontsize=7, loc="lower right")
+
+
 def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
-    """plot_noise(...) -> None: the study's panels in ``path``: four, and (e) the survivors' energies and (f) the
-    two-saddle system where the numbers carry them."""
+    """plot_noise(...) -> None: the study's panels in ``path``: four, and (e) the survivors' energies, (f) the
+    two-saddle system, (g) the turnover series against the theory and (h) the two-saddle turnover where the numbers
+    carry them."""
     plt = agg_pyplot()
     extra = (numbers.get("no_drag_survivors"), (numbers.get("two_saddles") or {}).get("records"))
     cols = 3 if any(extra) else 2
-    fig, axes = plt.subplots(2, cols, figsize=(5 * cols, 8), squeeze=False)
+    high = rates[rates.set == "turnover_high"] if "set" in rates else rates.iloc[:0]
+    saddles = rates[rates.set == "saddles_turnover"] if "set" in rates else rates.iloc[:0]
+    rows = 3 if len(high) or len(saddles) else 2
+    fig, axes = plt.subplots(rows, cols, figsize=(5 * cols, 4 * rows), squeeze=False)
     _panel_arrhenius(
         axes[0, 0], rates[rates.set == "kramers"].sort_values("barrier_over_T"), numbers.get("finite_barrier")
     )
@@ -162,6 +204,18 @@ def plot_noise(*, rates, reactivation, no_drag, numbers, path, scale):
             _panel_two_saddles(axes[1, 2], numbers["two_saddles"])
         else:
             axes[1, 2].set_visible(False)
+    if rows == 3:
+        low = rates[rates.set == "turnover"]
+        series = [(rf"ΔE/T = {t.barrier_over_T.iloc[0]:.3g}", t) for t in (low, high) if len(t)]
+        if len(saddles):
+            series.append((rf"two saddles, ΔE/T = {saddles.barrier_over_T.iloc[0]:.3g}", saddles))
+        _panel_theory_ratios(axes[2, 0], series, TURNOVER_TOLERANCE)
+        if len(saddles):
+            _panel_saddles_turnover(axes[2, 1], saddles, (numbers.get("two_saddles_turnover") or {})["barrier_over_T"])
+        else:
+            axes[2, 1].set_visible(False)
+        for ax in axes[2, 2:]:
+            ax.set_visible(False)
     fig.suptitle(f"Hénon–Heiles in a heat bath and with noise ({scale} scale)", fontsize=11)
     fig.tight_layout()
     fig.savefig(path, dpi=130)

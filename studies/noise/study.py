@@ -12,6 +12,10 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     * ``saddles_b<b>``: the declared system ``saddles_potential`` (two exit saddles of different heights) at
       γ = gamma_kramers, T = ΔE/b (ΔE its lowest barrier) for each b of ``saddles_barriers``;
     * ``turnover_g<γ>``: T = ΔE/turnover_barrier for each γ of ``turnover_gammas``;
+    * ``turnover_b<b>_g<γ>``: the same gammas at T = ΔE/b, b = turnover_high_barrier (windows
+      ``turnover_high_t_max``, ``turnover_high_n`` orbits);
+    * ``saddles_turnover_g<γ>``: the two-saddle system at T = ΔE/saddles_turnover_barrier (ΔE its lowest barrier)
+      for each γ of ``saddles_turnover_gammas``;
     * ``react_T0`` and ``react_T``: the paper's dissipative ensemble (E0 = react_energy, γ = react_gamma) without
       and with the heat bath T = ΔE/react_barrier; ``react_well``: the thermal rate at that (γ, T) from the well;
     * ``nodrag_E<E>_s<σ>``: γ = 0, noise strength σ (σ = 0: the conservative κ0) at each E0 of nodrag_energies;
@@ -33,9 +37,12 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     at the default radius, by the 2σ rule; the no-drag rate's halves and the survivors' energies at each time
     (:func:`hhscatter.analysis.noise.survivor_energies`, the fraction below E_c); the two-saddle system's rates
     against the multi-saddle Kramers–Langer sum and its lowest term, and the escapes' exit channels against each
-    term's share. The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
+    term's share; the turnover at the second barrier like the first, and the two-saddle system's turnover against
+    the sums Σ_s k_KL,s, Σ_s Υ(δ_s) k_KL,s and Σ_s δ_s k_TST,s with each saddle's terms
+    (:func:`hhscatter.reproduction.noise_records.saddle_turnover_terms`). The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
     the runs and passes their arrays). Writes ``noise.json`` (keys
-    ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``reactivation``,
+    ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``turnover_high``,
+    ``two_saddles_turnover``, ``reactivation``,
     ``no_drag``, ``no_drag_survivors``) and the derived tables ``rates.parquet``, ``survival.parquet``.
 
 ``plot(study)``
@@ -91,6 +98,13 @@ class Params(StudyParams):
     saddles_potential: Text  # a declared system with two exit saddles of different barrier heights
     saddles_barriers: Numbers  # ΔE/T (ΔE its lowest barrier) of its Kramers records at γ = gamma_kramers
     saddles_t_max: Numbers
+    turnover_high_barrier: Number  # ΔE/T of the second turnover series, at the gammas of turnover_gammas
+    turnover_high_t_max: Numbers  # one per γ of turnover_gammas
+    turnover_high_n: Integer
+    saddles_turnover_barrier: Number  # ΔE/T (lowest saddle) of the two-saddle system's turnover
+    saddles_turnover_gammas: Numbers
+    saddles_turnover_t_max: Numbers
+    saddles_turnover_n: Integer
 
 
 def _barrier(study) -> float:
@@ -114,6 +128,14 @@ def _kramers_key(b) -> str:
 
 def _turnover_key(g) -> str:
     return f"turnover_g{number_key(g, 'g')}"
+
+
+def _turnover_high_key(g, b) -> str:
+    return f"turnover_b{number_key(b, 'g')}_g{number_key(g, 'g')}"
+
+
+def _saddles_turnover_key(g) -> str:
+    return f"saddles_turnover_g{number_key(g, 'g')}"
 
 
 def _nodrag_key(E, s) -> str:
@@ -191,6 +213,29 @@ def _runs(study):
             n=p.turnover_n,
             noise={"temperature": dE / p.turnover_barrier, "flow": p.flow},
         )
+    b_high = p.turnover_high_barrier
+    for g, t_max in _pairs(study, "turnover_gammas", "turnover_high_t_max"):
+        runs[_turnover_high_key(g, b_high)] = dict(
+            energy=p.well_energy,
+            gamma=g,
+            t_max=t_max,
+            n=p.turnover_high_n,
+            noise={"temperature": dE / b_high, "flow": p.flow},
+        )
+    if p.saddles_turnover_gammas:
+        from hhscatter.analysis.noise import well_barrier
+        from hhscatter.model import make_system
+
+        low = well_barrier(make_system(**_saddles_system(p)))
+        for g, t_max in _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max"):
+            runs[_saddles_turnover_key(g)] = dict(
+                energy=p.well_energy,
+                gamma=g,
+                t_max=t_max,
+                n=p.saddles_turnover_n,
+                noise={"temperature": low / p.saddles_turnover_barrier, "flow": p.flow},
+                system=_saddles_system(p),
+            )
     react = dict(energy=p.react_energy, gamma=p.react_gamma, t_max=p.react_t_max, n=p.react_n)
     runs["react_T0"] = react
     bath = {"temperature": dE / p.react_barrier, "flow": p.flow}
@@ -265,6 +310,29 @@ def _two_saddles(study, runs) -> dict:
         "saddles": saddles,
         "records": rows,
     }
+
+
+def _turnover_row(study, key, runs) -> dict:
+    """The rate record of turnover run ``key`` against the turnover theory (Mel'nikov–Meshkov/PGH, both limits)."""
+    from hhscatter.reproduction.noise_records import turnover_record
+
+    row = _rate_row(study, key, runs[key])
+    return {**row, **turnover_record(row, runs[key].model, THEORY_GAMMA_MAX)}
+
+
+def _saddles_turnover(study, runs) -> dict:
+    """The two-saddle system's rate against γ at one barrier: against the multi-saddle Kramers–Langer sum, the
+    Mel'nikov–Meshkov/PGH sum Σ_s Υ(δ_s) k_KL,s and the energy-diffusion limit Σ_s δ_s k_TST,s, each saddle's
+    terms beside."""
+    from hhscatter.reproduction.noise_records import saddle_turnover_terms
+
+    p = study.params
+    rows = []
+    for g, _ in _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max"):
+        key = _saddles_turnover_key(g)
+        row = _turnover_row(study, key, runs)
+        rows.append({**row, "saddles": saddle_turnover_terms(runs[key].model, row["gamma"], row["temperature"])})
+    return {"barrier_over_T": p.saddles_turnover_barrier, "potential": p.saddles_potential, "records": rows}
 
 
 def _absorbing_radius(study, runs, kramers) -> list:
@@ -356,21 +424,30 @@ def _survival_tables(study, runs):
 
 def analyze(study):
     """analyze(study) -> None: rates against Kramers–Langer, the heat-bath P(t), the no-drag rates; noise.json."""
-    from hhscatter.reproduction.noise_records import finite_barrier_record, turnover_record
+    from hhscatter.reproduction.noise_records import finite_barrier_record
 
     p = study.params
     runs = _runs(study)
     kramers = [
         _rate_row(study, _kramers_key(b), runs[_kramers_key(b)]) for b, _ in _pairs(study, "barriers", "kramers_t_max")
     ]
-    turnover = []
-    for g, _ in _pairs(study, "turnover_gammas", "turnover_t_max"):
-        row = _rate_row(study, _turnover_key(g), runs[_turnover_key(g)])
-        turnover.append({**row, **turnover_record(row, runs[_turnover_key(g)].model, THEORY_GAMMA_MAX)})
+    turnover = [_turnover_row(study, _turnover_key(g), runs) for g in p.turnover_gammas]
+    turnover_high = [
+        _turnover_row(study, _turnover_high_key(g, p.turnover_high_barrier), runs) for g in p.turnover_gammas
+    ]
+    saddles_turnover = _saddles_turnover(study, runs)
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
     survivors = _no_drag_survivors(study, runs)
-    rates = pd.DataFrame([{"set": "kramers", **r} for r in kramers] + [{"set": "turnover", **r} for r in turnover])
+    rates = pd.DataFrame(
+        [{"set": "kramers", **r} for r in kramers]
+        + [{"set": "turnover", **r} for r in turnover]
+        + [{"set": "turnover_high", **r} for r in turnover_high]
+        + [
+            {"set": "saddles_turnover", **{k: v for k, v in r.items() if k != "saddles"}}
+            for r in saddles_turnover["records"]
+        ]
+    )
     rates["window"] = rates["window"].map(lambda w: float(w[1]))
     study.write_table(rates.rename(columns={"window": "t_max"}), "rates.parquet")
     study.write_table(react_table, "reactivation.parquet")
@@ -394,6 +471,8 @@ def analyze(study):
             "absorbing_radius": absorbing,
             "two_saddles": saddles,
             "turnover": turnover,
+            "turnover_high": turnover_high,
+            "two_saddles_turnover": saddles_turnover,
             "reactivation": react,
             "no_drag": no_drag,
             "no_drag_survivors": survivors,

@@ -394,3 +394,48 @@ def test_a_shift_that_rounds_to_zero_is_written_without_a_sign():
     row = {"barrier_over_T": 3, "r_esc": 3.0, "r_esc_default": 1.5, "rate_ratio": {"value": 0.997, "err": 0.05}}
     text = READINGS["noise.absorbing_radius"](_loader({"noise": {"absorbing_radius": [row]}}))
     assert "(shift 0 ± 5 %, z = −0.1: no shift resolved at 2σ)" in text
+
+
+def _turnover_row(gamma, ratio, err, barrier, holds):
+    return {"gamma": gamma, "ratio_mm": ratio, "ratio_mm_err": err, "barrier_over_T": barrier,
+            "theory_assumptions_hold": holds}  # fmt: skip
+
+
+def test_the_turnover_barriers_reading_states_the_range_within_fifteen_percent_and_the_low_gamma_excess():
+    """A ratio is within 15 % when its 2σ interval lies inside [0.85, 1.15]: 1.167 ± 0.019 reaches 1.129 to 1.205
+    and 1.123 ± 0.017 reaches 1.089 to 1.157 (undecided), 0.700 ± 0.010 lies outside (beyond), 1.10 ± 0.02 inside.
+    The excess at γ = 0.003 falls from 16.7 % to 10.0 %: −6.7 ± √(1.9² + 2.0²) = −6.7 ± 2.8 points (z = −2.4);
+    scaled by 3/5 the first would be 10.0 ± 1.1 %, which 10.0 ± 2.0 % matches (z = 0)."""
+    lo = [_turnover_row(g, r, e, 3.0, g < 1) for g, r, e in
+          ((0.003, 1.167, 0.019), (0.01, 1.123, 0.017), (0.03, 1.045, 0.015), (0.1, 1.017, 0.014), (1.0, 0.70, 0.01))]  # fmt: skip
+    hi = [_turnover_row(g, r, 0.02, 5.0, g < 1) for g, r in ((0.003, 1.10), (0.01, 1.05), (0.03, 1.0), (0.1, 0.98), (1.0, 0.95))]  # fmt: skip
+    text = READINGS["noise.turnover_barriers"](_loader({"noise": {"turnover": lo, "turnover_high": hi}}))
+    assert (
+        "at ΔE/T = 3 the rate over Υ(δ) k_KL is within 15 % from γ = 0.03 to 0.1; beyond 15 % at γ = 1 "
+        "(0.700 ± 0.010); undecided at 15 % at γ = 0.003 (1.167 ± 0.019), 0.01 (1.123 ± 0.017)" in text
+    )
+    assert (
+        "at ΔE/T = 5 the rate over Υ(δ) k_KL is within 15 % from γ = 0.003 to 1 (the theory's range: γ ≤ 0.1)" in text
+    )
+    assert "16.7 ± 1.9 % at ΔE/T = 3 and 10.0 ± 2.0 % at 5: a change of −6.7 ± 2.8 points, resolved at 2σ" in text
+    assert "an excess ∝ T/ΔE would be 10.0 ± 1.1 % at 5" in text
+    one = READINGS["noise.turnover_barriers"](_loader({"noise": {"turnover": lo}}))
+    assert one == "the turnover at a second barrier is not in this scale's numbers"
+
+
+def test_the_two_saddle_turnover_reading_compares_each_end_with_its_limit():
+    def row(g, ratio, ratio_ed, ratio_mm, high_share):
+        saddles = [{"barrier": 1 / 6, "delta": 20 * g, "melnikov_meshkov": 1 - high_share},
+                   {"barrier": 0.24, "delta": 30 * g, "melnikov_meshkov": high_share}]  # fmt: skip
+        return {"gamma": g, "ratio": ratio, "ratio_err": 0.01, "ratio_ed": ratio_ed, "ratio_ed_err": 0.01,
+                "ratio_mm": ratio_mm, "ratio_mm_err": 0.02, "melnikov_meshkov": 1.0, "saddles": saddles}  # fmt: skip
+
+    doc = {"barrier_over_T": 3.0, "records": [row(3.0, 1.05, 9.0, 1.05, 0.05), row(0.01, 0.17, 0.70, 1.20, 0.2)]}
+    text = READINGS["noise.saddles_turnover"](_loader({"noise": {"two_saddles_turnover": doc}}))
+    assert "from γ = 0.01 to 3, the rate over the sum Σ_s Υ(δ_s) k_KL,s is within 15 % at γ = 3 only" in text
+    assert "beyond 15 % at γ = 0.01 (1.200 ± 0.020)" in text
+    assert "At γ = 3 the rate over the Kramers–Langer sum is 1.050 ± 0.010, which differs from 1 (z = +5.0)" in text
+    assert "0.700 ± 0.010 of the energy-diffusion limit" in text
+    assert "share of the theory's sum is 0.200 at γ = 0.01 and 0.050 at 3 (its δ_s = 0.3 at γ = 0.01" in text
+    empty = READINGS["noise.saddles_turnover"](_loader({"noise": {}}))
+    assert empty == "the two-saddle system's turnover is not in this scale's numbers"

@@ -17,6 +17,7 @@ from hhscatter.reproduction.noise_records import (
     pretty_potential,
     rate_record,
     reactivation_record,
+    saddle_turnover_terms,
     survivor_record,
     turnover_record,
     two_saddle_record,
@@ -177,3 +178,29 @@ def test_finite_barrier_record_fits_the_first_correction():
 
 def test_pretty_potential():
     assert pretty_potential("x**2/2 - 3*x*y**2 + y**10") == "x²/2 − 3xy² + y¹⁰"
+
+
+@pytest.mark.parametrize("gamma", [0.01, 0.3, 3.0])
+def test_saddle_turnover_terms_of_the_two_saddle_system_are_its_closed_forms(gamma):
+    """V = (x² + y²)/2 − x³/3 − 5y³/18: saddle (1, 0) at ΔE = 1/6 with S = 6/5 along y = 0 (Hénon–Heiles' line
+    orbit), saddle (0, 6/5) at ΔE = 0.24 with S = (6/5)³ (y = 6u/5 maps V(0, y) onto 36/25 (u²/2 − u³/3)); both
+    saddles have ω_b = 1 and Hessian diag(−1, 1), the well the identity: k_KL,s = (λ₊/2π) e^{−ΔE_s/T},
+    k_TST,s = e^{−ΔE_s/T}/2π, λ₊ = −γ/2 + √(γ²/4 + 1)."""
+    from hhscatter.analysis.noise import depopulation_factor
+    from hhscatter.model import make_system
+
+    T = 1 / 18
+    m = make_system(potential="(x**2 + y**2)/2 - x**3/3 - 5*y**3/18")
+    terms = sorted(saddle_turnover_terms(m, gamma, T), key=lambda s: s["barrier"])
+    lam = -gamma / 2 + math.sqrt(gamma**2 / 4 + 1)
+    for s, barrier, action in zip(terms, (1 / 6, 0.24), (1.2, 1.2**3)):
+        delta = gamma * action / T
+        k_kl = lam / (2 * math.pi) * math.exp(-barrier / T)
+        assert s["barrier"] == pytest.approx(barrier, rel=1e-9) and s["omega_b"] == pytest.approx(1.0, rel=1e-6)
+        assert s["action"] == pytest.approx(action, rel=1e-9) and s["delta"] == pytest.approx(delta, rel=1e-9)
+        assert s["kramers_langer"] == pytest.approx(k_kl, rel=1e-6)
+        assert s["melnikov_meshkov"] == pytest.approx(float(depopulation_factor(delta)) * k_kl, rel=1e-6)
+        assert s["energy_diffusion"] == pytest.approx(delta * math.exp(-barrier / T) / (2 * math.pi), rel=1e-6)
+    rec = turnover_record({"gamma": gamma, "temperature": T, "rate": 1e-3, "rate_err": 1e-4}, m, 0.3)
+    assert rec["melnikov_meshkov"] == pytest.approx(sum(s["melnikov_meshkov"] for s in terms), rel=1e-12)
+    assert rec["energy_diffusion"] == pytest.approx(sum(s["energy_diffusion"] for s in terms), rel=1e-12)

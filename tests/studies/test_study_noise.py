@@ -19,7 +19,7 @@ def runs():
 
 def test_rate_records_share_no_orbits(runs):
     _, scenes = runs
-    rated = {k: sc for k, sc in scenes.items() if k.startswith(("kramers_", "turnover_"))}
+    rated = {k: sc for k, sc in scenes.items() if k.startswith(("kramers_", "turnover_", "saddles_"))}
     assert len({sc.seed for sc in rated.values()}) == len(rated)
     # the turnover point γ = 1 is the Kramers point ΔE/T = 3 in all but its seed: other initial states
     kramers, turnover = scenes["kramers_b3"], scenes["turnover_g1"]
@@ -112,3 +112,43 @@ def test_the_two_saddle_records_run_the_declared_system_at_its_lowest_barrier(ru
 
 def test_the_potential_is_printed_with_superscripts_and_minus_signs():
     assert pretty_potential("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18") == "(x² + y²)/2 − x³/3 − 5y³/18"
+
+
+def test_the_second_turnover_series_is_the_first_at_the_higher_barrier(runs):
+    """The same gammas as ``turnover_gammas`` at T = ΔE/turnover_high_barrier (ΔE = 1/6), its own windows and N."""
+    study, scenes = runs
+    p = study.params
+    keys = sorted(k for k in scenes if k.startswith("turnover_b"))
+    assert keys == sorted(f"turnover_b{p.turnover_high_barrier:g}_g{g:g}" for g in p.turnover_gammas)
+    for g, t_max in zip(p.turnover_gammas, p.turnover_high_t_max):
+        sc, low = scenes[f"turnover_b{p.turnover_high_barrier:g}_g{g:g}"], scenes[f"turnover_g{g:g}"]
+        assert sc.noise.temperature == pytest.approx(1 / 6 / p.turnover_high_barrier, rel=1e-12)
+        assert (sc.gamma, sc.t_max, sc.n, sc.energy) == (g, t_max, p.turnover_high_n, low.energy)
+        assert sc.seed != low.seed
+
+
+def test_the_two_saddle_turnover_runs_the_declared_system_across_gamma(runs):
+    study, scenes = runs
+    p = study.params
+    keys = sorted(k for k in scenes if k.startswith("saddles_turnover_"))
+    assert keys == sorted(f"saddles_turnover_g{g:g}" for g in p.saddles_turnover_gammas)
+    assert max(p.saddles_turnover_gammas) / min(p.saddles_turnover_gammas) >= 100  # two decades of γ
+    for g, t_max in zip(p.saddles_turnover_gammas, p.saddles_turnover_t_max):
+        sc = scenes[f"saddles_turnover_g{g:g}"]
+        assert sc.model.critical_energy == pytest.approx(1 / 6, rel=1e-12) and len(sc.model.exits) == 2
+        assert sc.noise.temperature == pytest.approx(1 / 6 / p.saddles_turnover_barrier, rel=1e-12)
+        assert (sc.gamma, sc.t_max, sc.n) == (g, t_max, p.saddles_turnover_n)
+
+
+@pytest.mark.parametrize("gammas, t_max", [("turnover_gammas", "turnover_high_t_max"), ("saddles_turnover_gammas",
+                                                                                       "saddles_turnover_t_max")])  # fmt: skip
+def test_a_turnover_series_with_a_window_per_gamma_missing_is_refused(gammas, t_max):
+    import copy
+    import dataclasses
+
+    study = load_study("noise", "tiny")
+    config = copy.deepcopy(study.config)
+    config["study"][t_max] = config["study"][t_max][:-1]
+    study = dataclasses.replace(study, config=config)
+    with pytest.raises(ValueError, match=rf"\[study\] {gammas} and {t_max} must have the same length, got 2 and 1"):
+        stage_module("noise")._runs(study)
