@@ -649,8 +649,13 @@ def _noise_turnover_barriers(get: Loader) -> str:
         prop = verdict(eb, sb, scaled, scaled_err)
         out += (
             f". At the lowest γ = {g:g} the excess over the theory is {_ve(100 * ea, 100 * sa)} % at ΔE/T = {ba:.3g} "
-            f"and {_ve(100 * eb, 100 * sb)} % at {bb:.3g}: a change of {_ve(100 * (eb - ea), 100 * math.hypot(sa, sb))} "
-            f"points, {'resolved' if change.word == 'differs' else 'not resolved'} at 2σ (z = {signed(change.z)}); an "
+            f"and {_ve(100 * eb, 100 * sb)} % at {bb:.3g}: "
+            + (
+                f"{'it grows' if change.z > 0 else 'it shrinks'} by "
+                if change.word == "differs"
+                else "a change not resolved at 2σ, "
+            )
+            + f"{_ve(100 * abs(eb - ea), 100 * math.hypot(sa, sb))} points (z = {signed(change.z)}); an "
             f"excess ∝ T/ΔE would be {_ve(100 * scaled, 100 * scaled_err)} % at {bb:.3g}, which the measured one "
             f"{'agrees with' if prop.word == 'agrees' else 'differs from'} (z = {signed(prop.z)})"
         )

@@ -158,7 +158,7 @@ def _panel_theory_ratios(ax, series, tol):
     ax.set_xlabel(r"drag $\gamma$ (shaded: beyond the theory's range)")
     ax.set_ylabel(r"$k / \Upsilon(\delta) k_{KL}$  (bars: 2σ)")
     ax.set_title("(g) the turnover against Mel'nikov–Meshkov/PGH", fontsize=10)
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="upper right")
 
 
 def _panel_saddles_turnover(ax, t, barrier):

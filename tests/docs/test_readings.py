@@ -417,7 +417,7 @@ def test_the_turnover_barriers_reading_states_the_range_within_fifteen_percent_a
     assert (
         "at ΔE/T = 5 the rate over Υ(δ) k_KL is within 15 % from γ = 0.003 to 1 (the theory's range: γ ≤ 0.1)" in text
     )
-    assert "16.7 ± 1.9 % at ΔE/T = 3 and 10.0 ± 2.0 % at 5: a change of −6.7 ± 2.8 points, resolved at 2σ" in text
+    assert "16.7 ± 1.9 % at ΔE/T = 3 and 10.0 ± 2.0 % at 5: it shrinks by 6.7 ± 2.8 points (z = −2.4)" in text
     assert "an excess ∝ T/ΔE would be 10.0 ± 1.1 % at 5" in text
     one = READINGS["noise.turnover_barriers"](_loader({"noise": {"turnover": lo}}))
     assert one == "the turnover at a second barrier is not in this scale's numbers"
