@@ -42,14 +42,16 @@ T_START, T_MAX = 20.0, 150.0
 SEED = 3801
 ACCURACY = 0.01  # the rate accuracy at which the methods are compared
 
-#: (label, method, step, tolerance, orbits at scale 1); the first case is the reference
+#: (label, method, step, tolerance, orbits at scale 1); the first case is the reference. The reference and the
+#: cheap compiled cases have enough orbits (≈ 57 % escape in the window) that σ(bias) ≈ 0.3 %: a case whose bias is
+#: ≈ 0.3 % can pass the strict criterion |bias| + 2σ ≤ 1 %
 CASES = [
-    ("reference: BAOAB dt 0.02", "baoab", 0.02, None, 240_000),
+    ("reference: BAOAB dt 0.02", "baoab", 0.02, None, 480_000),
     ("BAOAB dt 0.05", "baoab", 0.05, None, 160_000),
-    ("BAOAB dt 0.1", "baoab", 0.1, None, 160_000),
-    ("BAOAB dt 0.2", "baoab", 0.2, None, 160_000),
+    ("BAOAB dt 0.1", "baoab", 0.1, None, 400_000),
+    ("BAOAB dt 0.2", "baoab", 0.2, None, 400_000),
     ("numpy OBABO dt 0.05", "obabo", 0.05, None, 40_000),
-    ("numpy OBABO dt 0.2", "obabo", 0.2, None, 160_000),
+    ("numpy OBABO dt 0.2", "obabo", 0.2, None, 400_000),
     ("engine h 0.05 tol 1e-12", "engine", 0.05, 1e-12, 2_000),
     ("engine h 0.05 tol 1e-9", "engine", 0.05, 1e-9, 2_000),
     ("engine h 0.1 tol 1e-12", "engine", 0.1, 1e-12, 8_000),
@@ -58,8 +60,8 @@ CASES = [
     ("engine h 0.2 tol 1e-9", "engine", 0.2, 1e-9, 16_000),
     ("engine h 0.5 tol 1e-12", "engine", 0.5, 1e-12, 40_000),
     ("engine h 0.5 tol 1e-8", "engine", 0.5, 1e-8, 160_000),
-    ("symplectic h 0.1", "symplectic", 0.1, None, 160_000),
-    ("symplectic h 0.2", "symplectic", 0.2, None, 160_000),
+    ("symplectic h 0.1", "symplectic", 0.1, None, 400_000),
+    ("symplectic h 0.2", "symplectic", 0.2, None, 400_000),
     ("symplectic h 0.25", "symplectic", 0.25, None, 160_000),
     ("symplectic h 0.5", "symplectic", 0.5, None, 160_000),
 ]
@@ -164,7 +166,7 @@ def _ratios(rows, best):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scale", type=float, default=1.0, help="fraction of each case's orbits (1: ≈ 10 CPU-min)")
+    ap.add_argument("--scale", type=float, default=1.0, help="fraction of each case's orbits (1: ≈ 16 CPU-min)")
     ap.add_argument("--rounds", type=int, default=4, help="alternating rounds (cost spread)")
     a = ap.parse_args(argv)
     rows = measure(a.scale, a.rounds)
