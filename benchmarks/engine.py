@@ -34,7 +34,13 @@ absolute times, are the result). Rows:
   ≤ 1.2). ``--only whole`` (or ``recording``) runs those rows alone;
 * **tangent** — the tangent dynamics (``tangent = true``: u and Λ integrated with every orbit) against the
   same scene bare on the same ICs, conservative (E = 0.27) and dissipative (E0 = 0.3, γ = 0.01), alternated
-  in CPU time: CPU per orbit, steps per orbit and CPU per step; ``--only tangent`` runs these rows alone.
+  in CPU time: CPU per orbit, steps per orbit and CPU per step; ``--only tangent`` runs these rows alone;
+* **saddle** — the CPU of one point of study saddle per estimator, at the precision it reaches there
+  (Hénon–Heiles E = 1.8 E_c, disk r < r_s/2, t_max 200, the study's rules, N orbits up to 2·10⁴): the saddle
+  points (main run with every section crossing, κ, the sprinkler selection), λ̄ with its 1/T convergence (the
+  tangent run of the selected orbits and both estimators), d₁ (box counting with its bootstrap) and d₀ (the lines
+  run, 7 ε × 4000 pairs, and the fit); each row the integration's CPU plus the estimator's, the precision in its
+  note. ``--only saddle`` runs these rows alone.
 
 Writes ``benchmarks/out/engine/<full|quick>/engine.csv`` and ``engine_summary.md``
 (``make docs-assets`` copies them to the benchmarks page). Not a
@@ -325,7 +331,7 @@ def main(argv=None):
     )
     ap.add_argument(
         "--only",
-        choices=("whole", "recording", "alternated", "tangent"),
+        choices=("whole", "recording", "alternated", "tangent", "saddle"),
         default=None,
         help="only the whole-process rows, the recording rows (and the bare row they are read with), or the "
         "in-process rows alternated in CPU time",
@@ -351,6 +357,9 @@ def main(argv=None):
     if a.only == "tangent":
         _tangent_rows(row, n, rep)
         return _write_outputs(rows, a.out, n, rep)
+    if a.only == "saddle":
+        _saddle_rows(row, n)
+        return _write_outputs(rows, a.out, n, rep)
     _alternated_rows(row, n, rep)
     _bare_rows(row, n, rep)
     c3, ics3 = _dissipative_rows(row, n, rep)
@@ -360,6 +369,7 @@ def main(argv=None):
     _design_rows(row)
     _system_rows(row, n, rep)
     _tangent_rows(row, n, rep)
+    _saddle_rows(row, n)
     _whole_rows(row, a.whole_n, rep)
     _write_outputs(rows, a.out, n, rep)
 
@@ -456,6 +466,107 @@ def _tangent_rows(row, n, rep):
         row("tangent", f"{kind} tangent / bare, CPU per orbit", float(np.median(r)), "", note)
         row("tangent", f"{kind} tangent / bare, steps per orbit", s_t / s_b, "", f"{s_b / m:.1f} -> {s_t / m:.1f}")
         row("tangent", f"{kind} tangent / bare, CPU per step", float(np.median(r)) * s_b / s_t, "")
+
+
+def _cpu(fn):
+    """(CPU seconds, result) of one call."""
+    t0 = time.process_time()
+    out = fn()
+    return time.process_time() - t0, out
+
+
+def _saddle_rows(row, n):
+    """CPU per point of each estimator of study saddle at the precision it reaches (module notes): one point,
+    Hénon–Heiles E = 1.8 E_c, the study's rules (t_min = 4/κ, window 0.4–0.6, min_boxes 4, min_occupancy 10,
+    n_boot 100; d₀ over ε = 1e-2 … 1e-8, 4000 pairs each, fitted where ≥ 10 pairs are uncertain). Each estimator
+    measured once after a warm-up run of the engine (JIT outside the measurement)."""
+    import math  # deferred: only these rows need it
+
+    import pandas as pd  # deferred: pandas loads on first use
+
+    from hhscatter.analysis.geometry.saddle import (  # deferred: the estimators load on first use
+        dimension_from_uncertainty,
+        information_dimension,
+        lyapunov_convergence,
+        mean_lyapunov,
+        saddle_points,
+    )
+    from hhscatter.analysis.geometry.uncertainty import uncertainty_fraction  # deferred: as above
+    from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes  # deferred: as above
+    from hhscatter.outcomes import LEAVING_OUTCOMES, OUTCOMES  # deferred: as above
+    from hhscatter.scene.ics import perturbed_on_section, region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.scene import Scene, SectionWindow  # deferred: pydantic loads on first use
+
+    m = min(n, 20_000)
+    probe = Scene(energy=0.3, n=m, seed=5252, t_max=200.0)
+    sc = probe.replace(radius=0.5 * probe.model.saddle_radius, sections=SectionWindow(t_from=0.0))
+    ics = region_ics(sc, 0, m)
+    run_chunk(sc, ics[:200], np.arange(200))  # JIT compilation outside the measurement
+
+    def frame(cols):
+        df = pd.DataFrame({k: np.asarray(v) for k, v in cols.items()})
+        if "outcome" in df and df["outcome"].dtype.kind in "iu":
+            df["outcome"] = np.asarray(OUTCOMES)[df["outcome"].to_numpy()]
+        return df
+
+    # saddle points: the main run, κ, the selection
+    t_run, res = _cpu(lambda: run_chunk(sc, ics, np.arange(m)))
+    lt, sec = frame(res.lifetimes), frame(res.sections)
+    left = lt[lt["outcome"].isin(LEAVING_OUTCOMES)]
+    t_k, k = _cpu(lambda: escape_rate_from_lifetimes(left, detect_tail=False))
+    t_min = 4.0 / k.kappa
+    t_sp, sp = _cpu(lambda: saddle_points(lt, sec, t_min=t_min, window=(0.4, 0.6), columns=["x", "y"]))
+    row("saddle", "saddle points: CPU s per point", t_run + t_k + t_sp, "",
+        f"main run {t_run:.1f} s + κ {t_k:.2f} s + selection {t_sp:.2f} s; N = {m}, κ = {k.kappa:.4f} ± "
+        f"{k.kappa_err:.4f}, {sp.n_orbits} orbits, {sp.n_points} points")  # fmt: skip
+    # λ̄ and its convergence: the tangent run of the selected orbits
+    sel = lt[lt["outcome"].isin(LEAVING_OUTCOMES) & (lt["t_end"] >= t_min)]
+    tics = sel[["x0", "y0", "px0", "py0"]].to_numpy()
+    tsc = sc.replace(n=len(tics), sections=None, tangent=True)
+    run_chunk(tsc, tics[:50], np.arange(min(50, len(tics))))  # JIT of the tangent system
+    t_tan, tres = _cpu(lambda: run_chunk(tsc, tics, np.arange(len(tics))))
+    tl = frame(tres.lifetimes)
+    tl = tl[tl["outcome"].isin(LEAVING_OUTCOMES) & (tl["t_end"] >= t_min)]
+    L, T = tl["log_stretch"].to_numpy(), tl["t_end"].to_numpy()
+    t_mean, lam = _cpu(lambda: mean_lyapunov(L, T, n_boot=100, seed=0))
+    t_conv, conv = _cpu(lambda: lyapunov_convergence(L, T, n_bins=5, n_boot=100, seed=0))
+    row("saddle", "λ̄ with its convergence: CPU s per point", t_tan + t_mean + t_conv, "",
+        f"tangent run {t_tan:.1f} s ({len(tics)} orbits) + estimators {t_mean + t_conv:.2f} s; λ̄ = "
+        f"{lam.value:.4f} ± {lam.err:.4f}, λ∞ = {conv.extrapolated:.3f} ± {conv.extrapolated_err:.3f}")  # fmt: skip
+    # d₁: box counting with the bootstrap over orbits
+    P = sp.points[["x", "y"]].to_numpy()
+    eps_min = float(np.max(P.max(axis=0) - P.min(axis=0))) * math.exp(-lam.value * 0.4 * t_min)
+    t_d1, d1 = _cpu(lambda: information_dimension(P, groups=sp.points["traj_id"].to_numpy(), min_boxes=4,
+                                                  min_occupancy=10.0, eps_min=eps_min, n_boot=100, seed=0))  # fmt: skip
+    row("saddle", "d₁ (section): CPU s per point", t_d1, "",
+        f"box counting on the saddle points above (their run counted there); D₁ = {d1.value:.3f} ± {d1.err:.3f}")  # fmt: skip
+    # d₀: the lines run and the fit
+    eps, n_pairs, refs, moved = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8], 4000, [], []
+    for i, e in enumerate(eps):
+        ref = region_ics(sc.replace(seed=5252 * 100 + 1 + i, n=n_pairs), 0, n_pairs)
+        mv, ok = perturbed_on_section(sc.model, ref, sc.energy, dx=e)
+        refs.append(ref[ok])
+        moved.append(mv[ok])
+    lines = np.concatenate([x for pair in zip(refs, moved) for x in pair])
+    lsc = sc.replace(n=len(lines), sections=None)
+    t_lines, lres = _cpu(lambda: run_chunk(lsc, lines, np.arange(len(lines))))
+
+    def fit():
+        out = lres.lifetimes["outcome"]
+        code = np.where(np.asarray(out) == OUTCOMES.index("escaped"), lres.lifetimes["exit_channel"], -1)
+        rows, at = [], 0
+        for e, r in zip(eps, refs):
+            u = uncertainty_fraction(code[at : at + len(r)], code[at + len(r) : at + 2 * len(r)], outside=-1)
+            rows.append((e, u.f, u.k, u.n))
+            at += 2 * len(r)
+        e_, f_, k_, n_ = (np.array(c) for c in zip(*rows))
+        ok = (k_ >= 10) & (k_ < n_)
+        return dimension_from_uncertainty(e_, f_, n_, eps_range=(e_[ok].min(), e_[ok].max()))
+
+    t_fit, d0 = _cpu(fit)
+    row("saddle", "d₀ = 1 − α (lines): CPU s per point", t_lines + t_fit, "",
+        f"lines run {t_lines:.1f} s ({len(lines)} orbits) + fit {t_fit:.2f} s; d₀ = {d0.value:.3f} ± {d0.err:.3f} "
+        f"over ε {d0.eps_range[0]:.0e}-{d0.eps_range[1]:.0e}")  # fmt: skip
 
 
 def _bare_rows(row, n, rep):

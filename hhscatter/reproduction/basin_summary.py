@@ -29,6 +29,7 @@ from hhscatter.analysis.geometry.uncertainty import (
     weighted_line,
 )
 from hhscatter.analysis.stats.measured import Measured
+from hhscatter.analysis.stats.verdicts import verdict
 
 __all__ = [
     "entropy_by_box_at",
@@ -39,6 +40,10 @@ __all__ = [
     "TRAPPED_CODE",
     "cutoff_records",
     "cutoff_summary",
+    "rate_table",
+    "saddle_cutoff_records",
+    "saddle_cutoff_summary",
+    "tangent_lambda",
     "energy_trend",
     "entropy_exponents",
     "SCAN_COLUMNS",
@@ -736,3 +741,190 @@ def scan_row(
         "lam": rate["value"] if rate else math.nan,
         "lam_err": rate["err"] if rate else math.nan,
     }
+
+
+# ---------------------------------------------------------------------------
+# the cut-off with the saddle's own λ̄ and the deciding orbits' own energy decay
+# ---------------------------------------------------------------------------
+#: intervals of measured and predicted ε_c closer than this factor count as "within a factor 1.5"
+WITHIN_FACTOR = 1.5
+
+
+def tangent_lambda(records, system: str) -> pd.DataFrame:
+    """λ̄(E) of a saddle study's records for one system: DataFrame(energy, lam, lam_err) sorted by energy.
+
+    ``records`` are dicts with system, energy, lyapunov and lyapunov_err (1/time); records without λ̄ are
+    left out.
+
+    Examples
+    --------
+    >>> recs = [{"system": "a", "energy": 0.3, "lyapunov": 0.5, "lyapunov_err": 0.01},
+    ...         {"system": "a", "energy": 0.2, "lyapunov": None, "lyapunov_err": None},
+    ...         {"system": "b", "energy": 0.2, "lyapunov": 0.4, "lyapunov_err": 0.01}]
+    >>> tangent_lambda(recs, "a").to_dict(orient="records")
+    [{'energy': 0.3, 'lam': 0.5, 'lam_err': 0.01}]
+    """
+    rows = [
+        {"energy": float(r["energy"]), "lam": float(r["lyapunov"]), "lam_err": float(r["lyapunov_err"])}
+        for r in records
+        if r.get("system") == system and r.get("lyapunov") is not None and r.get("lyapunov_err") is not None
+    ]
+    return pd.DataFrame(rows, columns=["energy", "lam", "lam_err"]).sort_values("energy", ignore_index=True)
+
+
+def rate_table(scan: pd.DataFrame, tangent: pd.DataFrame) -> list:
+    """The three estimates of the saddle's λ at each energy of ``tangent`` that the γ = 0 scan also has.
+
+    ``scan`` has columns energy, lam, lam_err (the decision rate of the pairs), lam_kg, lam_kg_err (κ/α);
+    ``tangent`` those of :func:`tangent_lambda` (λ̄ of the tangent dynamics). Each row: E0, decision,
+    tangent, kappa_over_alpha (each with its ``_err``), decision_over_tangent (with its error) and the verdicts
+    of the decision rate and of κ/α against λ̄ by the 2σ rule (both errors).
+
+    Examples
+    --------
+    >>> scan = pd.DataFrame({"energy": [0.2, 0.3], "lam": [0.3, 0.4], "lam_err": [0.01, 0.01],
+    ...                      "lam_kg": [0.5, 0.6], "lam_kg_err": [0.05, 0.05]})
+    >>> r = rate_table(scan, pd.DataFrame({"energy": [0.3], "lam": [0.6], "lam_err": [0.01]}))[0]
+    >>> r["E0"], round(r["decision_over_tangent"], 3), r["decision_vs_tangent"], r["kappa_over_alpha_vs_tangent"]
+    (0.3, 0.667, 'differs (z = −14.1)', 'agrees (z = +0.0)')
+    """
+    out = []
+    for t in tangent.itertuples():
+        hit = scan[np.isclose(scan["energy"].to_numpy(dtype=float), t.energy, rtol=0, atol=1e-9)]
+        if hit.empty:
+            continue
+        s = hit.iloc[0]
+        dec, kg = Measured(float(s["lam"]), float(s["lam_err"])), Measured(float(s["lam_kg"]), float(s["lam_kg_err"]))
+        tan = Measured(float(t.lam), float(t.lam_err))
+        ratio = dec / tan
+        out.append(
+            {
+                "E0": float(t.energy),
+                "decision": dec.value,
+                "decision_err": dec.err,
+                "tangent": tan.value,
+                "tangent_err": tan.err,
+                "kappa_over_alpha": kg.value,
+                "kappa_over_alpha_err": kg.err,
+                "decision_over_tangent": ratio.value,
+                "decision_over_tangent_err": ratio.err,
+                "decision_vs_tangent": verdict(dec.value, dec.err, tan.value, tan.err).text(),
+                "kappa_over_alpha_vs_tangent": verdict(kg.value, kg.err, tan.value, tan.err).text(),
+            }
+        )
+    return out
+
+
+def _log_verdict(c) -> str:
+    """The 2σ rule on log10 ε_c: measured against predicted, each with its interval's half-width on the facing
+    side (NaN when no cut-off is resolved)."""
+    if not math.isfinite(c.measured) or not c.predicted > 0:
+        return "no verdict: no cut-off resolved"
+    up = c.measured > c.predicted
+    lg = math.log10
+    sm = lg(c.measured) - lg(c.measured_lo) if up else lg(c.measured_hi) - lg(c.measured)
+    sp = lg(c.predicted_hi) - lg(c.predicted) if up else lg(c.predicted) - lg(c.predicted_lo)
+    return verdict(lg(c.measured), sm, lg(c.predicted), sp).text()
+
+
+def saddle_cutoff_records(per, tangent: pd.DataFrame, mu, mu_err, ec) -> list:
+    """The cut-off ε_c predicted with the saddle's own λ̄(E) (tangent dynamics) and, beside it, with the energy
+    decay of the orbits that decide the outcome, against the measured one; one record per (E0, γ > 0) of ``per``.
+
+    ``per`` are point records with energy, gamma, cutoff (detected, eps_c, eps_c_lo, eps_c_hi) and mu_own
+    ({value, err}: μ of the orbits of the pairs that changed outcome at the smallest resolved ε,
+    :func:`~hhscatter.analysis.dissipative.decay.orbit_decay_exponent`; None where not measured). ``tangent``:
+    :func:`tangent_lambda` (λ̄ interpolated linearly in E, held constant beyond its energies). μ ± ``mu_err``:
+    the ensemble's decay exponent. Each prediction (:func:`~hhscatter.analysis.geometry.cutoff.cutoff_comparison`)
+    has its interval over λ̄ ± σ and μ ± σ; ``within_1p5``: the measured and the predicted intervals come within a
+    factor 1.5 of each other; ``verdict``: the 2σ rule on log10 ε_c with both intervals' half-widths.
+    """
+    out = []
+    if tangent.empty:
+        return out
+    En, lam, lam_err = (tangent[c].to_numpy(dtype=float) for c in ("energy", "lam", "lam_err"))
+    for p in per:
+        if p["gamma"] <= 0:
+            continue
+        E0, g, c = p["energy"], p["gamma"], p["cutoff"]
+        det = bool(c and c["detected"])
+        meas = {"measured": c["eps_c"] if det else None, "measured_lo": c["eps_c_lo"] if c else None,
+                "measured_hi": c["eps_c_hi"] if c else None}  # fmt: skip
+        rec = {"E0": E0, "gamma": g, "eps_c": c["eps_c"] if det else None,
+               "eps_c_interval": [c["eps_c_lo"], c["eps_c_hi"]] if c else None, "detected": det}  # fmt: skip
+        own = p.get("mu_own")
+        variants = [("tangent", mu, mu_err)]
+        if own is not None:
+            rec["mu_own"], rec["mu_own_err"] = own["value"], own["err"]
+            variants.append(("tangent_own", own["value"], own["err"]))
+        for name, m, me in variants:
+            cmp = cutoff_comparison(E0, g, ec, m, me, En, lam, lam_err, **meas)
+            within = det and cmp.gap_decades <= math.log10(WITHIN_FACTOR) + 1e-12
+            rec.update(
+                {
+                    f"eps_c_{name}": cmp.predicted,
+                    f"eps_c_{name}_interval": [cmp.predicted_lo, cmp.predicted_hi],
+                    f"factor_{name}": cmp.factor if det else None,
+                    f"log10_ratio_{name}": cmp.log10_ratio if det else None,
+                    f"overlap_{name}": bool(det and cmp.overlap),
+                    f"within_1p5_{name}": bool(within),
+                    f"verdict_{name}": _log_verdict(cmp),
+                }
+            )
+        out.append(rec)
+    return out
+
+
+def saddle_cutoff_summary(records, rates, mu) -> dict:
+    """How close each prediction of :func:`saddle_cutoff_records` comes over the resolved cut-offs, and, where one
+    is not within a factor 1.5, the measured reasons: λ̄ against the decision rate (``rates``, rows of
+    :func:`rate_table`) and the deciding orbits' μ against the ensemble's ``mu``. Returns {n_resolved, per
+    variant n_within, n_overlap, factor_min, factor_max, n_below, and statement}.
+
+    Examples
+    --------
+    >>> recs = [{"detected": True, "factor_tangent": 1.2, "log10_ratio_tangent": -0.08, "within_1p5_tangent": True,
+    ...          "overlap_tangent": True}]
+    >>> saddle_cutoff_summary(recs, [], 0.9)["tangent"]["n_within"]
+    1
+    """
+    det = [r for r in records if r.get("detected")]
+    out = {"n_resolved": len(det)}
+    words = []
+    names = {"tangent": "with λ̄ of the tangent dynamics and the ensemble's μ",
+             "tangent_own": "with λ̄ and the deciding orbits' own μ"}  # fmt: skip
+    for name, label in names.items():
+        rs = [r for r in det if r.get(f"factor_{name}") is not None]
+        if not rs:
+            continue
+        fac = np.array([r[f"factor_{name}"] for r in rs])
+        n_w = sum(bool(r[f"within_1p5_{name}"]) for r in rs)
+        n_o = sum(bool(r[f"overlap_{name}"]) for r in rs)
+        n_b = sum(r[f"log10_ratio_{name}"] < 0 for r in rs)
+        out[name] = {"n": len(rs), "n_within": n_w, "n_overlap": n_o, "factor_min": float(fac.min()),
+                     "factor_max": float(fac.max()), "n_below": int(n_b)}  # fmt: skip
+        words.append(
+            f"{label}: off by a factor {fac.min():.2g} to {fac.max():.2g} (measured below it in {n_b} of {len(rs)}), "
+            f"within a factor {WITHIN_FACTOR:g} in {n_w} of {len(rs)}, intervals overlapping in {n_o} of {len(rs)}"
+        )
+    if not words:
+        out["statement"] = "no cut-off is resolved at these (E0, γ), or no λ̄ of the tangent dynamics is given"
+        return out
+    best = max(v["n_within"] for k, v in out.items() if k in names)
+    if best < len(det):
+        why = []
+        if rates:
+            q = np.array([r["decision_over_tangent"] for r in rates])
+            why.append(
+                f"the decision rate is {q.min():.2g}–{q.max():.2g} times λ̄ at the {len(rates)} energies both have "
+                "(a prediction's ln(1/ε_c) scales with λ)"
+            )
+        own = [r["mu_own"] for r in det if r.get("mu_own") is not None]
+        if own:
+            why.append(
+                f"the orbits that decide at the smallest resolved ε decay with μ = {min(own):.2g}–{max(own):.2g} "
+                f"against the ensemble's μ = {mu:.2g}"
+            )
+        words.append("not every cut-off comes within a factor 1.5; measured: " + "; ".join(why) if why else "")
+    out["statement"] = "; ".join(w for w in words if w)
+    return out

@@ -24,6 +24,10 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
    upper bound; and the lifetimes of the orbits that decide the outcome at
    the smallest ε, against τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1, the
    late-time exponent of study fig3).
+4. **The deciding orbits' own decay.** Per (E0, γ > 0), ``mu_own``: μ of the reference orbits of the pairs
+   whose outcome differs at the smallest resolved ε, from their own start and end energies
+   (:func:`~hhscatter.analysis.dissipative.decay.orbit_decay_exponent`); study saddle re-predicts the cut-off
+   with it and with the saddle's λ̄ of the tangent dynamics.
 
 Outcome codes: 0, 1, 2 exit channel (the 120° sector of the escape point);
 3 settled; 4 trapped (alive at t_max); −1 forbidden cell (V ≥ E0).
@@ -205,20 +209,42 @@ def simulate(study, workers=None, progress=True):
 
 
 # -- analyze ---------------------------------------------------------------------------
-def _uncertainty(study, E, g, eps, keys=None, times=None):
+def _uncertainty(study, E, g, eps, keys=None, times=None, deciders=None):
     """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
-    the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ)."""
+    the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ;
+    ``deciders``: a list that receives each ε's (e0, e_end, t_end) of the reference orbits of those pairs)."""
     from hhscatter.data.read import read_lifetimes
 
     rows = []
     keys = [unc_key(E, g, i) for i in range(len(eps))] if keys is None else keys
     for i, e in enumerate(eps):
-        lt = read_lifetimes(study.raw(keys[i]), columns=["traj_id", "outcome", "exit_channel", "t_end"])
-        row, t_dec = bs.uncertainty_row(outcome_codes(lt), lt.sort_values("traj_id")["t_end"].to_numpy(), E, g, e)
+        lt = read_lifetimes(study.raw(keys[i]), columns=["traj_id", "outcome", "exit_channel", "t_end", "e0", "e_end"])
+        lt_sorted = lt.sort_values("traj_id")
+        codes = outcome_codes(lt)
+        row, t_dec = bs.uncertainty_row(codes, lt_sorted["t_end"].to_numpy(), E, g, e)
         if times is not None:
             times.append(t_dec)
+        if deciders is not None:
+            m = len(codes) // 2
+            ref = lt_sorted.iloc[:m][codes[:m] != codes[m:]]
+            deciders.append(tuple(ref[c].to_numpy(dtype=float) for c in ("e0", "e_end", "t_end")))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _own_decay(g, ok, deciders):
+    """μ of the orbits that decide at the smallest resolved ε (their own start and end energies), or None."""
+    from hhscatter.analysis.dissipative.decay import orbit_decay_exponent
+
+    idx = np.flatnonzero(np.asarray(ok))
+    if g <= 0 or idx.size == 0:
+        return None
+    e0, e_end, t_end = deciders[idx[-1]]
+    keep = (e_end > 0) & (t_end > 0) & (e0 > e_end)
+    if keep.sum() < 2:
+        return None
+    r = orbit_decay_exponent(e0[keep], e_end[keep], t_end[keep], g, n_boot=200, seed=0)
+    return {**r.measured("mu").to_dict(), "n_orbits": r.n_orbits}
 
 
 def analyze(study):
@@ -239,7 +265,7 @@ def analyze(study):
             ent_rows.append(ent)
             unc_tabs.append(unc)
             loc_tabs.append(loc)
-            per.append(bs.point_record(E, g, hb, ec, ent, unc, loc, m))
+            per.append({**bs.point_record(E, g, hb, ec, ent, unc, loc, m), "mu_own": m["mu_own"]})
             by_box.extend(_entropy_by_box(study, img, E, g, extent))
             by_box.extend(_entropy_by_subgrid(study, img, E, g, extent))
     study.write_table(pd.concat(maps, ignore_index=True), "basins_maps.parquet", grid=n, extent=list(extent))
@@ -289,8 +315,8 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
     """
     img = basin_image(study, map_key(E, g), E, extent, n)
     gx, gy = _map_states(study, E, extent, n)[:2]
-    times = []
-    unc = _uncertainty(study, E, g, eps, times=times)
+    times, deciders = [], []
+    unc = _uncertainty(study, E, g, eps, times=times, deciders=deciders)
     p = study.params
     ent, loc, m = bs.map_measures(
         img,
@@ -306,6 +332,7 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
         symmetry_radius=p.symmetry_radius,
         fit_min_count=p.fit_min_count,
     )
+    m["mu_own"] = _own_decay(g, m["ok"], deciders)
     return img, ent, unc, loc, m
 
 

@@ -13,7 +13,8 @@ def _done(records):
 
 
 def plot_saddle(numbers, path):
-    """Two panels: (a) κ against λ̄(1 − d₁) per point; (b) the section's D₁ measured and implied, 2(1 − κ/λ̄)."""
+    """Two panels: (a) κ against λ̄(1 − d₁) per point; (b) the section's D₁ measured and implied, 2(1 − κ/λ̄), and its
+    D₀ = 2(1 − α) from the uncertainty exponent on lines."""
     plt = agg_pyplot()
     recs = _done(numbers["saddle"])
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.2))
@@ -29,6 +30,12 @@ def plot_saddle(numbers, path):
                    capsize=3, label=f"{label}: measured D₁")  # fmt: skip
         b.errorbar(x, [2 * r["d1_implied"] for r in rs], [2 * r["d1_implied_err"] for r in rs], fmt=mk + "--",
                    mfc="none", color=col, capsize=3, alpha=0.7, label=f"{label}: 2(1 − κ/λ̄)")  # fmt: skip
+    for label in dict.fromkeys(r["system"] for r in numbers["saddle"]):
+        rs = [r for r in numbers["saddle"] if r["system"] == label and r.get("d0") is not None]
+        if rs:
+            b.errorbar([r["ratio"] for r in rs], [2 * r["d0"] for r in rs], [2 * r["d0_err"] for r in rs],
+                       fmt=MARKERS.get(label, "o") + ":", mfc="white", color=COLORS.get(label, "k"), capsize=3,
+                       label=f"{label}: D₀ = 2(1 − α), lines")  # fmt: skip
     hi = 1.1 * hi if hi > 0 else 1.0
     a.plot([0, hi], [0, hi], color="0.5", lw=1, label="κ = λ̄(1 − d₁)")
     a.set_xlim(0, hi)
@@ -38,8 +45,8 @@ def plot_saddle(numbers, path):
     a.set_title("(a) the Kantz–Grassberger relation")
     a.legend(fontsize=8)
     b.set_xlabel("E / E_c")
-    b.set_ylabel("information dimension D₁ = 2 d₁ on the section")
-    b.set_title("(b) D₁ measured and implied by κ and λ̄")
+    b.set_ylabel("dimension on the section: D₁ = 2 d₁, D₀ = 2 d₀")
+    b.set_title("(b) D₁ measured and implied by κ and λ̄; D₀ from lines")
     b.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=150)

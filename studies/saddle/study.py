@@ -6,7 +6,9 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
     Per system and E = r·E_c: the main run (raw key ``<label>_r<r>``: disk ICs, every section crossing to t_max),
     its κ (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_from_lifetimes`) and t_min = tmin_efolds/κ,
     and the tangent run (``<label>_r<r>_tangent``, ``[scene] tangent = true``) of the orbits that left at
-    t_end ≥ t_min, from their initial conditions. The κ and t_min used are written to ``raw/saddle_choices.json``.
+    t_end ≥ t_min, from their initial conditions; the lines run (``<label>_r<r>_lines``): for each ε of d0_eps,
+    d0_n fresh initial conditions of the main run's disk and their copies moved by ε along x. The κ and t_min used
+    are written to ``raw/saddle_choices.json``.
 
 ``analyze(study)``
     ``saddle.json``: per point κ, λ̄ (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`,
@@ -15,7 +17,13 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
     :func:`~hhscatter.analysis.geometry.saddle.information_dimension`,
     :func:`~hhscatter.analysis.geometry.saddle.window_dependence`) and the relation's verdict
     (:func:`~hhscatter.analysis.geometry.saddle.kantz_grassberger`); derived table ``saddle_ftle.parquet`` (the
-    finite-time exponents Λ/T of the tangent runs).
+    finite-time exponents Λ/T of the tangent runs); d₀ = 1 − α of the lines run
+    (:func:`~hhscatter.analysis.geometry.uncertainty.uncertainty_fraction` per ε,
+    :func:`~hhscatter.analysis.geometry.saddle.dimension_from_uncertainty`) and d₀ ≥ d₁ − 2σ
+    (:func:`~hhscatter.analysis.geometry.saddle.dimension_order`); the exit basins' cut-off re-predicted from
+    study basins' numbers with λ̄ (:func:`~hhscatter.reproduction.basin_summary.rate_table`,
+    :func:`~hhscatter.reproduction.basin_summary.saddle_cutoff_records`,
+    :func:`~hhscatter.reproduction.basin_summary.saddle_cutoff_summary`).
 
 ``plot(study)``
     ``saddle.png`` via ``plot_saddle`` of the folder's ``figure.py``.
@@ -58,6 +66,10 @@ class Params(StudyParams):
     min_occupancy: Number
     n_bins: Integer  # λ̄(T) bins
     n_boot: Integer
+    d0_eps: Numbers  # ε of the uncertainty algorithm, decreasing (position units)
+    d0_n: Integer  # reference initial conditions per ε
+    d0_min_count: Integer  # an ε enters α's fit with ≥ this many uncertain pairs
+    basins_system: Text  # the label of the system of study basins (its points' λ̄ re-predict the cut-off)
 
 
 FTLE_TABLE = "saddle_ftle.parquet"
@@ -73,6 +85,15 @@ def _systems(study):
         t_max = float(e.get("t_max") or study.params.t_max)
         out.append((e["label"], spec, system_from_spec(spec), [float(r) for r in e["ratios"]], t_max))
     return out
+
+
+def _d0_eps(study):
+    eps = np.asarray(study.params.d0_eps, dtype=float)
+    if not (eps.size >= 3 and np.all(eps > 0) and np.all(np.diff(eps) < 0)):
+        raise ConfigError(f"saddle [study].d0_eps must be ≥ 3 decreasing positive numbers, got {list(eps)!r}")
+    if study.params.d0_n < 1 or study.params.d0_min_count < 1:
+        raise ConfigError("saddle [study].d0_n and d0_min_count must be integers ≥ 1")
+    return eps
 
 
 def point_key(label: str, ratio: float) -> str:
@@ -119,6 +140,7 @@ def simulate(study, workers=None, progress=True):
     from hhscatter.studies import write_json_atomic
 
     p, choices = study.params, {}
+    d0_eps = _d0_eps(study)
     for label, spec, m, ratios, t_max in _systems(study):
         for r in ratios:
             key = point_key(label, r)
@@ -139,6 +161,7 @@ def simulate(study, workers=None, progress=True):
             print(f"  saddle {key}: κ = {k.kappa:.4f} ± {k.kappa_err:.4f}, t_min = {t_min:.1f}, {len(sel)} orbits")
             choices[key] = {"system": label, "ratio": r, "energy": r * m.critical_energy, "kappa": k.kappa,
                             "kappa_err": k.kappa_err, "t_min": t_min, "n_tangent": len(sel), "r_esc": sc.r_esc}  # fmt: skip
+            _run_lines(study, key, sc, spec, d0_eps, workers, progress)
             if len(sel) == 0:
                 continue
             path = study.derived(f"{key}_tangent_ics.parquet")
@@ -157,6 +180,36 @@ def simulate(study, workers=None, progress=True):
             )
             study.run(key + "_tangent", tsc, workers=workers, progress=progress)
     write_json_atomic(_choices_path(study), choices)
+
+
+def _lines_path(study, key):
+    return study.derived(f"{key}_lines_ics.parquet")
+
+
+def _run_lines(study, key, sc, spec, eps, workers, progress):
+    """The lines run of a point: per ε, d0_n fresh ICs of the main run's disk (seed·100 + 1 + index) and their
+    copies moved by ε along x (tangential momenta at the same E), in one run; its layout in a derived table."""
+    import pandas as pd
+
+    from hhscatter.scene.ics import perturbed_on_section, region_ics
+
+    p, base, parts = study.params, int(study.config["scene"]["seed"]), []
+    for i, e in enumerate(eps):
+        ref = region_ics(sc.replace(seed=base * 100 + 1 + i, n=p.d0_n), 0, p.d0_n)
+        moved, ok = perturbed_on_section(sc.model, ref, sc.energy, dx=float(e))
+        m = int(ok.sum())
+        for states, is_moved in ((ref[ok], False), (moved[ok], True)):
+            part = pd.DataFrame(states, columns=["x", "y", "px", "py"])
+            parts.append(part.assign(eps=float(e), eps_index=i, pair=np.arange(m), moved=is_moved))
+    df = pd.concat(parts, ignore_index=True)
+    df.insert(0, "traj_id", np.arange(len(df), dtype=np.int64))
+    path = _lines_path(study, key)
+    # rewritten only when different: the scene's hash includes the file's, and resume relies on it
+    if not path.exists() or not pd.read_parquet(path).equals(df):
+        df.to_parquet(path, index=False)
+    lsc = study.scene(key + "_lines", system=spec, ics=str(path), n=len(df), t_max=sc.t_max, r_esc=sc.r_esc,
+                      sections=None)  # fmt: skip
+    study.run(key + "_lines", lsc, workers=workers, progress=progress)
 
 
 # ---------------------------------------------------------------------------
@@ -201,6 +254,116 @@ def _d1_estimator(p, lam):
                                      min_occupancy=p.min_occupancy, eps_min=eps_min, n_boot=p.n_boot, seed=0)  # fmt: skip
 
     return est
+
+
+def _d0(study, key):
+    """d₀ = 1 − α of the point's lines run: the record's keys (d0, d0_err, the section's D₀, the scaling range, the
+    fit's χ² and p, the f(ε) rows) or a note."""
+    import pandas as pd
+
+    from hhscatter.analysis.geometry.saddle import dimension_from_uncertainty
+    from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
+    from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
+
+    p = study.params
+    layout = pd.read_parquet(_lines_path(study, key)).sort_values("traj_id")
+    lt = _lifetimes(study.raw(key + "_lines"), ("exit_channel",))
+    codes = outcome_codes(lt)  # in traj_id order
+    codes[codes == TRAPPED_CODE] = OUTSIDE  # an orbit still inside at t_max: its pair is left out
+    rows = []
+    for e, g in layout.assign(code=codes).groupby("eps", sort=False):
+        ref, moved = (g[g["moved"] == m].sort_values("pair")["code"].to_numpy() for m in (False, True))
+        u = uncertainty_fraction(ref, moved, outside=OUTSIDE)
+        rows.append({"eps": float(e), "f": u.f, "k": u.k, "n": u.n, "n_excluded": u.n_excluded})
+    tab = pd.DataFrame(rows).sort_values("eps", ascending=False)
+    ok = (tab["k"] >= p.d0_min_count) & (tab["k"] < tab["n"])
+    out = {"d0_uncertainty": tab.to_dict(orient="records")}
+    if ok.sum() < 3:
+        return {**out, "note": f"d0: fewer than 3 values of ε with ≥ {p.d0_min_count} uncertain pairs"}
+    rng = (float(tab.loc[ok, "eps"].min()), float(tab.loc[ok, "eps"].max()))
+    try:
+        d = dimension_from_uncertainty(tab["eps"], tab["f"], tab["n"], eps_range=rng)
+        u = uncertainty_exponent(tab["eps"], tab["f"], tab["n"], eps_range=rng, dim=1.0)
+    except (ValueError, ConfigError) as exc:
+        return {**out, "note": f"d0: {exc}"}
+    return {**out, "d0": d.value, "d0_err": d.err, "d0_section": 2 * d.value, "d0_section_err": 2 * d.err,
+            "d0_eps_range": list(d.eps_range), "d0_n_eps": u.n_points, "d0_fit_chi2": u.chi2,
+            "d0_fit_dof": u.dof, "d0_fit_p": u.p_value}  # fmt: skip
+
+
+def _with_d0(rec, d0):
+    """The record with the d₀ keys of :func:`_d0` and, where both are measured, d₀ ≥ d₁ − 2σ."""
+    from hhscatter.analysis.geometry.saddle import dimension_order
+
+    note = d0.pop("note", None)
+    if note:
+        rec["notes"].append(note)
+    rec.update(d0)
+    if rec.get("d0") is not None and rec.get("d1") is not None:
+        o = dimension_order(rec["d0"], rec["d0_err"], rec["d1"], rec["d1_err"])
+        rec["d0_ge_d1"] = {"z": o.z, "holds": o.holds, "verdict": o.verdict}
+    return rec
+
+
+def _dimension_row(rec: dict) -> dict:
+    """A record's d₀ and d₁ (partial, along the unstable direction) with the scaling range of d₀ and the check."""
+    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
+    for name in ("d0", "d1", "d0_section", "d1_section"):
+        if rec.get(name) is not None:
+            row[name], row[name + "_err"] = rec[name], rec[name + "_err"]
+    if rec.get("d0_eps_range") is not None:
+        lo, hi = rec["d0_eps_range"]
+        row["d0_eps_range"] = f"{lo:.0e} – {hi:.0e} ({rec['d0_n_eps']} ε)"
+        row["d0_fit_p"] = rec["d0_fit_p"]
+    chk = rec.get("d0_ge_d1")
+    row["check"] = chk["verdict"] if chk else ("no d₁" if rec.get("d0") is not None else "no d₀")
+    return row
+
+
+def _dimension_summary(records) -> dict:
+    """How many points have d₀, how many both dimensions, and where d₀ ≥ d₁ − 2σ holds; its statement."""
+    both = [r for r in records if r.get("d0_ge_d1")]
+    held = [r for r in both if r["d0_ge_d1"]["holds"]]
+    failed = ", ".join(r["id"] for r in both if not r["d0_ge_d1"]["holds"])
+    n_d0 = sum(r.get("d0") is not None for r in records)
+    statement = (f"d₀ measured at {n_d0} of {len(records)} points; d₀ ≥ d₁ − 2σ (both partial, errors in "
+                 f"quadrature) holds at {len(held)} of the {len(both)} with both dimensions"
+                 + (f"; it fails at {failed}" if failed else ""))  # fmt: skip
+    return {"n_points": len(records), "n_d0": n_d0, "n_both": len(both), "n_holds": len(held),
+            "statement": statement}  # fmt: skip
+
+
+def _basins_cutoff(study, records) -> dict:
+    """The basins' cut-off re-predicted with λ̄ of the ``basins_system`` points: the JSON keys rate_table,
+    cutoff_saddle, cutoff_saddle_summary and lambda_tangent (with the sources)."""
+    import pandas as pd
+
+    from hhscatter.reproduction import basin_summary as bs
+    from hhscatter.reproduction.verdicts import NO_VERDICT, SMOKE_SCALES
+    from hhscatter.studies import _upstream as up
+
+    other = study.upstream("cutoff")
+    doc = up.numbers(study, other)
+    label = study.params.basins_system
+    ec = next(m for lab, _spec, m, _r, _t in _systems(study) if lab == label).critical_energy
+    tangent = bs.tangent_lambda(records, label)
+    rates = bs.rate_table(pd.DataFrame(doc["energy_scan"]), tangent)
+    mu = doc["mu"]
+    cut = bs.saddle_cutoff_records(doc["per_point"], tangent, mu["value"], mu["err"], ec)
+    summary = bs.saddle_cutoff_summary(cut, rates, mu["value"])
+    if study.scale in SMOKE_SCALES:  # a smoke test states no verdict (these verdicts are not under "verdict")
+        rates = [{k: NO_VERDICT if k.endswith("_vs_tangent") else v for k, v in r.items()} for r in rates]
+        cut = [{k: NO_VERDICT if k.startswith("verdict_") else v for k, v in r.items()} for r in cut]
+    return {
+        "lambda_tangent": {
+            "rows": tangent.to_dict(orient="records"),
+            "system": label,
+            "source": f"{other}.json energy_scan, per_point, mu",
+        },  # fmt: skip
+        "rate_table": rates,
+        "cutoff_saddle": cut,
+        "cutoff_saddle_summary": summary,
+    }
 
 
 def _point(study, key, ch):
@@ -276,13 +439,19 @@ def analyze(study):
     """analyze(study) -> None; writes saddle.json and saddle_ftle.parquet."""
     import pandas as pd
 
+    _d0_eps(study)  # refused before any work
+    if study.params.basins_system not in [x[0] for x in _systems(study)]:
+        raise ConfigError(
+            f"saddle [study].basins_system must be one of the labels of [study].systems, "
+            f"got {study.params.basins_system!r}"
+        )
     choices = json.loads(_choices_path(study).read_text())
     records, ftles = [], []
     for label, _spec, _m, ratios, _t_max in _systems(study):
         for r in ratios:
             key = point_key(label, r)
             rec, ftle = _point(study, key, choices[key])
-            records.append(rec)
+            records.append(_with_d0(rec, _d0(study, key)))
             if ftle is not None:
                 ftles.append(ftle[["traj_id", "t_end", "ftle"]].assign(system=label, ratio=r))
     cols = ["traj_id", "t_end", "ftle", "system", "ratio"]
@@ -293,6 +462,8 @@ def analyze(study):
     )
     checked = [x for x in records if x.get("z") is not None]
     relation = [_relation_row(x) for x in records]
+    dims = _dimension_summary(records)
+    basins = _basins_cutoff(study, records)
     study.write_numbers(
         {
             "saddle": records,
@@ -302,13 +473,17 @@ def analyze(study):
                 "n_checked": len(checked),
                 "n_within_2sigma": sum(abs(x["z"]) <= 2 for x in checked),
             },
-            "d0_note": "d0 = 1 - alpha is not measured by this study (no lines of initial conditions are run): "
-            "d0 and d0_err are null",
+            "dimensions": [_dimension_row(x) for x in records],
+            "dimensions_summary": dims,
+            **basins,
             "rules": {
                 "tmin_efolds": study.params.tmin_efolds,
                 "window": list(study.params.window),
                 "tmin_checks": list(study.params.tmin_checks),
                 "n_orbits_per_point": study.params.n,
+                "d0_eps": [float(e) for e in _d0_eps(study)],
+                "d0_n": study.params.d0_n,
+                "d0_min_count": study.params.d0_min_count,
             },  # fmt: skip
         }
     )

@@ -12,6 +12,7 @@ import sys
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
+import pytest
 
 from benchmarks.engine import design_choices, yardstick
 from hhscatter.integrate.engine import CENSORED, run_chunk
@@ -50,3 +51,20 @@ def test_design_choices_run_every_way_of_recording():
     out = design_choices(batch_size=4, epochs=4, epoch=2.0)
     assert set(out) == {"until", "grid2", "grid17", "step callback", "c_output", "c_output long"}
     assert all(np.isfinite(v) and v > 0 for v in out.values())
+
+
+@pytest.mark.slow
+def test_saddle_rows_report_each_estimator_with_its_precision():
+    """The saddle rows (``--only saddle``): one row per estimator, a CPU time > 0 and the precision it reached in
+    its note (the value ± error of κ, λ̄, D₁ and d₀ printed there)."""
+    from benchmarks.engine import _saddle_rows
+
+    rows = []
+    _saddle_rows(lambda target, what, value, goal, note="": rows.append((target, what, value, note)), 20_000)
+    assert [w.split(":")[0] for _, w, _, _ in rows] == [
+        "saddle points",
+        "λ̄ with its convergence",
+        "d₁ (section)",
+        "d₀ = 1 − α (lines)",
+    ]
+    assert all(t == "saddle" and v > 0 and "±" in n for t, _, v, n in rows)

@@ -342,3 +342,49 @@ def test_comparison_rows_alpha_and_s_bb_of_every_record_and_the_cut_off_only_wit
     assert notes[1].endswith(": yes") and notes[2].endswith(": not shown")
     assert notes[3] == "detected, 1σ [5e-06, 2e-05] (paper: expected for γ > 0)"
     assert notes[4] == "none seen: ε_c < 3e-06 (paper: expected for γ > 0)"
+
+
+def test_saddle_cutoff_records_against_the_closed_form():
+    """λ̄ = 0.5 at every energy: ln(1/ε_c) = λ̄ ln(E0/E_c)/(μγ); with the ensemble's μ = 1 and the deciding orbits'
+    μ = 0.5 (slower decay: a longer stay on the saddle, a smaller ε_c)."""
+    g, E0, ec = 0.05, 0.3, 0.15
+    pred = math.exp(-0.5 * math.log(2) / g)
+    pred_own = math.exp(-0.5 * math.log(2) / (0.5 * g))
+    per = [
+        {"energy": E0, "gamma": 0.0, "cutoff": None},
+        {"energy": E0, "gamma": g, "mu_own": {"value": 0.5, "err": 0.0},
+         "cutoff": {"detected": True, "eps_c": 1.2 * pred, "eps_c_lo": 1.1 * pred, "eps_c_hi": 1.3 * pred}},
+        {"energy": E0, "gamma": 2 * g, "mu_own": None,
+         "cutoff": {"detected": True, "eps_c": 1e-3, "eps_c_lo": 0.9e-3, "eps_c_hi": 1.1e-3}},
+    ]  # fmt: skip
+    tangent = pd.DataFrame({"energy": [0.2, 0.3], "lam": [0.5, 0.5], "lam_err": [0.0, 0.0]})
+    recs = bs.saddle_cutoff_records(per, tangent, 1.0, 0.0, ec)
+    assert [(r["E0"], r["gamma"]) for r in recs] == [(E0, g), (E0, 2 * g)]
+    a, b = recs
+    assert a["eps_c_tangent"] == pytest.approx(pred, rel=1e-6)
+    assert a["eps_c_tangent_own"] == pytest.approx(pred_own, rel=1e-6)
+    assert a["factor_tangent"] == pytest.approx(1.2, rel=1e-6) and a["within_1p5_tangent"]
+    assert a["factor_tangent_own"] == pytest.approx(1.2 * pred / pred_own, rel=1e-6) and not a["within_1p5_tangent_own"]
+    pred2 = math.exp(-0.5 * math.log(2) / (2 * g))  # 0.0313: measured 1e-3 is a factor 31 below
+    assert b["eps_c_tangent"] == pytest.approx(pred2, rel=1e-6) and "eps_c_tangent_own" not in b
+    assert not b["within_1p5_tangent"] and b["verdict_tangent"].startswith("differs")
+    rates = [{"decision_over_tangent": 0.8}, {"decision_over_tangent": 0.9}]
+    s = bs.saddle_cutoff_summary(recs, rates, 1.0)
+    assert s["n_resolved"] == 2 and s["tangent"]["n_within"] == 1 and s["tangent"]["n_below"] == 1
+    assert s["tangent_own"] == {"n": 1, "n_within": 0, "n_overlap": 0, "factor_min": pytest.approx(a["factor_tangent_own"]),
+                                "factor_max": pytest.approx(a["factor_tangent_own"]), "n_below": 0}  # fmt: skip
+    assert "within a factor 1.5 in 1 of 2" in s["statement"] and "0.8–0.9 times λ̄" in s["statement"]
+    assert "μ = 0.5–0.5 against the ensemble's μ = 1" in s["statement"]
+
+
+def test_rate_table_keeps_the_energies_both_have():
+    scan = pd.DataFrame({"energy": [0.2, 0.25, 0.3], "lam": [0.3, 0.35, 0.4], "lam_err": [0.01] * 3,
+                         "lam_kg": [0.5, 0.55, 0.6], "lam_kg_err": [0.05] * 3})  # fmt: skip
+    tangent = pd.DataFrame({"energy": [0.25, 0.5], "lam": [0.35, 0.7], "lam_err": [0.02, 0.02]})
+    rows = bs.rate_table(scan, tangent)
+    assert [r["E0"] for r in rows] == [0.25]
+    r = rows[0]
+    assert r["decision_over_tangent"] == pytest.approx(1.0) and r["decision_vs_tangent"] == "agrees (z = +0.0)"
+    z = (0.55 - 0.35) / math.hypot(0.05, 0.02)
+    assert r["kappa_over_alpha_vs_tangent"] == f"differs (z = +{z:.1f})"
+    assert r["decision_over_tangent_err"] == pytest.approx(math.hypot(0.01 / 0.35, 0.02 / 0.35), rel=1e-9)

@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pandas as pd
+import pytest
 from scipy import stats
 
 
@@ -92,3 +93,33 @@ def test_subgrid_cells_are_cells_of_the_map_and_their_entropies_are_the_subsampl
     assert [r["map"] for r in rows] == ["every 5th cell"] * 2  # 15: k = 4 is even; 7 does not divide 60
     assert [r["grid"] for r in rows] == [12, 12]
     assert np.allclose([r["S_b"] for r in rows], want["S_b"]) and np.allclose([r["S_bb"] for r in rows], want["S_bb"])
+
+
+def test_the_deciding_orbits_own_decay_is_counted_from_the_raw_runs(tiny_studies):
+    """mu_own: Σ ln(E0/E_end)/(γ Σ t) over the reference orbits whose outcome differs from their moved copy's at the
+    smallest resolved ε, counted here from the raw runs."""
+    from hhscatter.data.read import read_lifetimes
+
+    out = tiny_studies / "basins" / "out" / "tiny"
+    nums = json.loads((out / "basins.json").read_text())
+    cfg = nums["config"]["study"]
+    checked = 0
+    for p in nums["per_point"]:
+        if p["gamma"] == 0:
+            assert p["mu_own"] is None
+            continue
+        if p["mu_own"] is None:
+            continue
+        i = cfg["eps"].index(p["smallest_resolved_eps"])
+        lt = read_lifetimes(
+            out / "raw" / f"unc{i}_E{p['energy']:.2f}_g{p['gamma']:g}",
+            columns=["traj_id", "outcome", "exit_channel", "t_end", "e0", "e_end"],
+        ).sort_values("traj_id")
+        oc = lt["outcome"].astype(str).to_numpy()
+        code = np.where(oc == "escaped", lt["exit_channel"].astype(float).fillna(-1), np.where(oc == "settled", 3, 4))
+        m = len(lt) // 2
+        ref = lt.iloc[:m][code[:m] != code[m:]]
+        mu = np.log(ref["e0"] / ref["e_end"]).sum() / (p["gamma"] * ref["t_end"].sum())
+        assert p["mu_own"]["value"] == pytest.approx(mu, rel=1e-12) and p["mu_own"]["n_orbits"] == len(ref)
+        checked += 1
+    assert checked >= 1

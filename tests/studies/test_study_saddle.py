@@ -13,28 +13,70 @@ import math
 import numpy as np
 import pytest
 
-from tests.study_copy import copy_study_folder
-
 KEYS = {"system", "energy", "kappa", "kappa_err", "lyapunov", "lyapunov_err", "d0", "d0_err", "d1", "d1_err"}
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    from hhscatter.studies import run_stage
-
-    root = tmp_path_factory.mktemp("studies")
-    copy_study_folder("saddle", root)
-    run_stage("saddle", "all", "tiny", workers=1, progress=False, root=root)
-    return root / "saddle" / "out" / "tiny"
+def built(tiny_studies):
+    """The saddle study at the tiny scale, built with the studies it needs (basins, and fig2 and fig3 before it)."""
+    return tiny_studies / "saddle" / "out" / "tiny"
 
 
-def test_every_record_has_the_issue_s_keys_and_d0_is_stated_as_not_measured(built):
+def test_every_record_has_the_keys_and_d0_is_measured(built):
     doc = json.loads((built / "saddle.json").read_text())
     assert len(doc["saddle"]) == 3 and (built / "saddle.png").exists()
     for rec in doc["saddle"]:
         assert KEYS <= set(rec), rec["id"]
-        assert rec["d0"] is None and rec["d0_err"] is None
-    assert "not measured" in doc["d0_note"]
+        if rec["d0"] is None:  # a point without d₀ says why
+            assert any(n.startswith("d0: ") for n in rec["notes"]), rec["id"]
+        else:
+            assert 0 < rec["d0"] < 1 and rec["d0_err"] > 0, rec["id"]
+    rec = next(r for r in doc["saddle"] if r["id"] == "henon_heiles-1.80")
+    assert rec["d0"] is not None
+    assert doc["dimensions_summary"]["n_d0"] == sum(r["d0"] is not None for r in doc["saddle"])
+
+
+def test_the_lines_are_pairs_moved_by_eps_along_x_at_the_same_energy(built):
+    import pandas as pd
+
+    ics = pd.read_parquet(built / "derived" / "henon_heiles_r1.80_lines_ics.parquet")
+    eps = sorted(ics["eps"].unique(), reverse=True)
+    assert eps == pytest.approx([1e-2, 1e-3, 1e-4, 1e-5])
+    m = ics[~ics["moved"]].merge(ics[ics["moved"]], on=["eps", "pair"], suffixes=("", "_m"))
+    assert len(m) == (~ics["moved"]).sum() == ics["moved"].sum()
+    assert np.allclose(m["x_m"] - m["x"], m["eps"], rtol=1e-9, atol=1e-15) and np.array_equal(m["y_m"], m["y"])
+    for s in ("", "_m"):
+        x, y, px, py = (m[c + s].to_numpy() for c in ("x", "y", "px", "py"))
+        E = 0.5 * (px**2 + py**2) + 0.5 * (x**2 + y**2) + x**2 * y - y**3 / 3
+        assert np.allclose(E, 1.8 / 6, rtol=1e-12)  # E = 1.8 E_c, E_c = 1/6
+        assert np.allclose(x * px + y * py, 0, atol=1e-12)  # tangential: on the section ṙ = 0
+
+
+def test_d0_counts_the_pairs_with_different_exits_from_the_raw_run(built):
+    """k(ε): the pairs whose exit channels differ, counted by hand from the lines run (pairs with an orbit still
+    inside at t_max left out); d₀ ≥ d₁ − 2σ by hand."""
+    import pandas as pd
+
+    from hhscatter.data.read import read_lifetimes
+
+    doc = json.loads((built / "saddle.json").read_text())
+    rec = next(r for r in doc["saddle"] if r["id"] == "henon_heiles-1.80")
+    ics = pd.read_parquet(built / "derived" / "henon_heiles_r1.80_lines_ics.parquet")
+    lt = read_lifetimes(built / "raw" / "henon_heiles_r1.80_lines", columns=["traj_id", "outcome", "exit_channel"])
+    t = ics.merge(lt, on="traj_id")
+    t["ch"] = np.where(t["outcome"].astype(str) == "escaped", t["exit_channel"].astype(float), np.nan)
+    m = t[~t["moved"]].merge(t[t["moved"]], on=["eps", "pair"], suffixes=("", "_m"))
+    for row in rec["d0_uncertainty"]:
+        g = m[np.isclose(m["eps"], row["eps"]) & m["ch"].notna() & m["ch_m"].notna()]
+        assert row["n"] == len(g) and row["k"] == int((g["ch"] != g["ch_m"]).sum())
+    lo, hi = rec["d0_eps_range"]
+    fitted = [r for r in rec["d0_uncertainty"] if lo <= r["eps"] <= hi]
+    assert len(fitted) == rec["d0_n_eps"] >= 3 and all(r["k"] >= 2 for r in fitted)
+    assert rec["d0_section"] == pytest.approx(2 * rec["d0"], rel=1e-12)
+    if rec.get("d1") is not None:
+        z = (rec["d0"] - rec["d1"]) / math.hypot(rec["d0_err"], rec["d1_err"])
+        assert rec["d0_ge_d1"]["z"] == pytest.approx(z, rel=1e-12)
+        assert rec["d0_ge_d1"]["holds"] is (z >= -2)
 
 
 def test_the_lyapunov_exponent_is_the_tangent_run_s_stretch_over_time(built):
@@ -83,3 +125,31 @@ def test_the_tangent_runs_start_from_the_long_lived_orbits_initial_conditions(bu
     assert np.array_equal(m["x0"], m["x0_tan"]) and np.array_equal(m["y0"], m["y0_tan"])
     # the same orbit again (the tangent variables change only heyoka's steps): the same lifetime to roundoff growth
     assert np.max(np.abs(m["t_end"] - m["t_end_tan"])) < 1e-3
+
+
+def test_the_basins_cut_off_is_re_predicted_with_the_saddle_s_lambda(built):
+    """λ̄(E) of the Hénon–Heiles records beside the basins' decision rate and κ/α at the energies both have; the
+    predicted ε_c with λ̄ and the basins' μ equals λ̄'s closed form where λ̄ is one constant (one energy)."""
+    doc = json.loads((built / "saddle.json").read_text())
+    basins = json.loads((built.parents[2] / "basins" / "out" / "tiny" / "basins.json").read_text())
+    hh = sorted((r["energy"], r["lyapunov"], r["lyapunov_err"]) for r in doc["saddle"] if r["system"] == "henon_heiles")
+    hh = [x for x in hh if x[1] is not None]
+    assert [(r["energy"], r["lam"], r["lam_err"]) for r in doc["lambda_tangent"]["rows"]] == hh
+    scan = {round(r["energy"], 9): r for r in basins["energy_scan"]}
+    rows = doc["rate_table"]
+    assert [r["E0"] for r in rows] == [E for E, _, _ in hh if round(E, 9) in scan]
+    for r in rows:
+        s = scan[round(r["E0"], 9)]
+        assert (r["decision"], r["kappa_over_alpha"]) == (s["lam"], s["lam_kg"])
+        assert r["decision_over_tangent"] == pytest.approx(s["lam"] / r["tangent"], rel=1e-12)
+    cut = doc["cutoff_saddle"]
+    assert {(r["E0"], r["gamma"]) for r in cut} == {
+        (p["energy"], p["gamma"]) for p in basins["per_point"] if p["gamma"] > 0
+    }
+    ec, mu = 1 / 6, basins["mu"]["value"]
+    for r in cut:
+        grid = np.linspace(ec, r["E0"], 2001)
+        lam = np.interp(grid, [x[0] for x in hh], [x[1] for x in hh])
+        v = lam / grid
+        big = np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(grid)) / (mu * r["gamma"])  # ln(1/ε_c) = ∫λ/E dE / (μγ)
+        assert r["eps_c_tangent"] == pytest.approx(math.exp(-big), rel=1e-6)

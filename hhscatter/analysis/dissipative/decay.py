@@ -30,6 +30,8 @@ Functions here are pure (no file I/O, no plotting):
 * :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits),
   :func:`bootstrap_mu_first_orbits` on the first K orbits with errors scaled to N;
 * :func:`decay_exponent` — μ of ⟨E⟩(t) over every orbit not escaped, with its bootstrap error, in one call;
+* :func:`orbit_decay_exponent` — μ of a chosen set of orbits from their own start and end energies
+  (Σ ln(E0/E_end) / (γ Σ t)), not the ensemble mean;
 * :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
 
 Units: the model's natural units (unit mass); t in time units, E in energy
@@ -45,6 +47,7 @@ import pandas as pd
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "DecayExponent",
@@ -63,6 +66,8 @@ __all__ = [
     "mean_energy_arrays",
     "inside_mean_energy",
     "mu_by_window",
+    "OrbitDecay",
+    "orbit_decay_exponent",
     "pool_mean_energy",
     "snapshot_grid",
     "time_to_energy",
@@ -627,3 +632,58 @@ def decay_exponent(
     mu = fit_energy_decay(me["t"], me["mean_E"], E0, gamma, win).mu
     boot, scale = bootstrap_mu_first_orbits(rows, n_orbits, k, E0, gamma, [win], n_boot=n_boot, seed=seed)
     return DecayExponent(mu, float(boot["mu"].std(ddof=1)) * scale, ime.rows_below_ec, win)
+
+
+@dataclass(frozen=True)
+class OrbitDecay(WithErrors):
+    """Result of :func:`orbit_decay_exponent`: mu, mu_err (bootstrap over orbits, 1σ), n_orbits (dimensionless μ)."""
+
+    method = "Σ ln(E0/E_end) / (γ Σ t) over the orbits, bootstrap over orbits"
+    n_field = "n_orbits"
+
+    mu: float
+    mu_err: float
+    n_orbits: int
+
+
+def orbit_decay_exponent(e0, e_end, duration, gamma: float, *, n_boot: int = 200, seed: int = 0) -> OrbitDecay:
+    """orbit_decay_exponent(e0, e_end, duration, gamma, *, n_boot=200, seed=0) -> OrbitDecay(mu, mu_err, n_orbits).
+
+    The decay exponent μ of Eq. (eqn:energy_exp_decay), E(t) = E0 e^{−μγt}, of a chosen set of orbits from their
+    own start and end energies: μ = Σ ln(E0_i/E_end,i) / (γ Σ t_i), the time-weighted mean of the orbits' own
+    exponents ln(E0/E_end)/(γt) (each orbit from its start to its end, e.g. its escape or its settling at E_c),
+    not the fit to the ensemble's mean ⟨E⟩(t). The error is the bootstrap over orbits (0 replicates: NaN).
+    Energies in energy units (> 0), durations in time units (> 0), γ in 1/time (> 0).
+
+    Examples
+    --------
+    >>> t = np.array([10.0, 20.0, 40.0])
+    >>> r = orbit_decay_exponent(0.3 * np.ones(3), 0.3 * np.exp(-0.8 * 0.01 * t), t, 0.01, n_boot=20)
+    >>> round(r.mu, 12), round(r.mu_err, 12), r.n_orbits
+    (0.8, 0.0, 3)
+    """
+    arrays = {}
+    for name, v in (("e0", e0), ("e_end", e_end), ("duration", duration)):
+        try:
+            a = np.asarray(v, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise ConfigError(f"{name} must be an array of numbers") from None
+        if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
+            raise ConfigError(f"{name} must be a non-empty array of finite numbers > 0")
+        arrays[name] = a
+    if not arrays["e0"].shape == arrays["e_end"].shape == arrays["duration"].shape:
+        raise ConfigError("e0, e_end and duration must have one value per orbit")
+    if isinstance(gamma, bool) or not isinstance(gamma, (int, float, np.integer, np.floating)) or not gamma > 0:
+        raise ConfigError(f"gamma must be a number > 0 (the drag, 1/time), got {gamma!r}")
+    if isinstance(n_boot, bool) or int(n_boot) != n_boot or n_boot < 0:
+        raise ConfigError(f"n_boot must be an integer ≥ 0, got {n_boot!r}")
+    L = np.log(arrays["e0"] / arrays["e_end"])
+    T = float(gamma) * arrays["duration"]
+    mu = float(L.sum() / T.sum())
+    n = L.size
+    err = float("nan")
+    if n_boot and n >= 2:
+        rng = np.random.default_rng(seed)
+        idx = rng.integers(0, n, (int(n_boot), n))
+        err = float(np.std(L[idx].sum(axis=1) / T[idx].sum(axis=1), ddof=1))
+    return OrbitDecay(mu=mu, mu_err=err, n_orbits=int(n))

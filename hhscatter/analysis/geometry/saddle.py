@@ -22,6 +22,8 @@ Functions here are pure (arrays and DataFrames in, frozen results out; no file I
 * :func:`kantz_grassberger` — κ against λ̄(1 − d₁), both with errors, and the verdict of the project's one rule
   (:func:`hhscatter.analysis.stats.verdicts.verdict`, the 2σ comparison with both errors: the right-hand side is
   another measurement with its own 1σ).
+* :func:`dimension_order` — the inequality d₀ ≥ d₁ (capacity against information dimension of one measure)
+  checked at 2σ with both errors.
 
 Box counting
 ------------
@@ -68,8 +70,10 @@ __all__ = [
     "LyapunovMean",
     "SaddleDimension",
     "SaddlePoints",
+    "DimensionOrder",
     "capacity_dimension",
     "dimension_from_uncertainty",
+    "dimension_order",
     "information_dimension",
     "kantz_grassberger",
     "lyapunov_convergence",
@@ -788,3 +792,56 @@ def kantz_grassberger(
         z=float(z),
         verdict=verdict(k, sk, pred, spred).text(),
     )
+
+
+# ---------------------------------------------------------------------------
+# d₀ ≥ d₁
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DimensionOrder:
+    """Result of :func:`dimension_order`.
+
+    difference = d₀ − d₁ and difference_err (√(σ₀² + σ₁²), independent measurements), z = difference/difference_err,
+    holds (z ≥ −2: d₀ ≥ d₁ within 2σ), verdict (its text: "consistent …" or "not consistent …").
+    """
+
+    difference: float
+    difference_err: float
+    z: float
+    holds: bool
+    verdict: str
+
+
+def dimension_order(d0, d0_err, d1, d1_err) -> DimensionOrder:
+    """dimension_order(d0, d0_err, d1, d1_err) -> DimensionOrder(difference, difference_err, z, holds, verdict).
+
+    The inequality d₀ ≥ d₁ between the capacity and the information dimension of one measure (Lai and Tél 2011,
+    ch. 6: the generalised dimensions fall with their order, d₀ = d₁ for a uniform measure) checked with both
+    errors, taken as independent: it holds unless d₀ falls below d₁ by more than 2σ, σ = √(σ₀² + σ₁²) (one-sided:
+    the project's 2σ threshold on the side the inequality forbids). Both dimensions must be of the same kind
+    (both partial, or both of the section). Dimensionless.
+
+    Examples
+    --------
+    >>> dimension_order(0.86, 0.02, 0.82, 0.01).verdict
+    'consistent (d₀ − d₁ = +0.040 ± 0.022, +1.8σ ≥ −2σ)'
+    >>> r = dimension_order(0.70, 0.02, 0.82, 0.01)
+    >>> r.holds, r.verdict
+    (False, 'not consistent (d₀ − d₁ = −0.120 ± 0.022, −5.4σ < −2σ)')
+    """
+    vals = {}
+    for name, v in (("d0", d0), ("d0_err", d0_err), ("d1", d1), ("d1_err", d1_err)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+            raise ConfigError(f"{name} must be a finite number, got {v!r}")
+        vals[name] = float(v)
+    for name in ("d0_err", "d1_err"):
+        if vals[name] < 0:
+            raise ConfigError(f"{name} must be ≥ 0 (a 1σ error), got {vals[name]!r}")
+    diff = vals["d0"] - vals["d1"]
+    sig = math.hypot(vals["d0_err"], vals["d1_err"])
+    z = diff / sig if sig > 0 else (0.0 if diff == 0 else math.copysign(math.inf, diff))
+    holds = bool(z >= -2.0)
+    digits = max(0, 1 - math.floor(math.log10(sig))) if sig > 0 else 3
+    text = f"d₀ − d₁ = {diff:+.{digits}f} ± {sig:.{digits}f}, {z:+.1f}σ".replace("-", "−")
+    text = f"consistent ({text} ≥ −2σ)" if holds else f"not consistent ({text} < −2σ)"
+    return DimensionOrder(difference=diff, difference_err=sig, z=float(z), holds=holds, verdict=text)

@@ -49,3 +49,35 @@ def test_errors_of_the_first_k_orbits_are_scaled_to_all_of_them():
     assert b.mu_err == pytest.approx(a.mu_err * np.sqrt(4 / 16), rel=1e-12)
     with pytest.raises(ValueError, match="k must be in"):
         decay_exponent([rows], rows, 4, 5, 0.3, 0.01, 1 / 6, (0, 100))
+
+
+def test_orbit_decay_exponent_is_the_time_weighted_mean_of_the_orbits_own_exponents():
+    """Two orbits with their own μ (0.6 over t = 10, 1.2 over t = 30): the time-weighted mean (0.6·10 + 1.2·30)/40
+    = 1.05, not the plain mean 0.9; the bootstrap error is the spread of that ratio over resampled orbits."""
+    from hhscatter.analysis.dissipative.decay import orbit_decay_exponent
+
+    g, t = 0.02, np.array([10.0, 30.0])
+    e_end = 0.25 * np.exp(-np.array([0.6, 1.2]) * g * t)
+    r = orbit_decay_exponent([0.25, 0.25], e_end, t, g, n_boot=400, seed=3)
+    assert r.mu == pytest.approx(1.05, rel=1e-12) and r.n_orbits == 2
+    # resamples: both orbit 0 (0.6), both orbit 1 (1.2), or one of each (1.05): an error between 0.1 and 0.4
+    assert 0.1 < r.mu_err < 0.4
+    assert r.measured("mu").value == r.mu
+
+
+@pytest.mark.parametrize(
+    ("args", "name"),
+    [
+        (([0.3], [0.0], [1.0], 0.01), "e_end"),
+        (([0.3], [0.2], [1.0, 2.0], 0.01), "one value per orbit"),
+        (([0.3], [0.2], [1.0], 0.0), "gamma"),
+        (([], [], [], 0.01), "e0"),
+        ((["a"], [0.2], [1.0], 0.01), "e0"),
+    ],
+)
+def test_orbit_decay_exponent_refuses_bad_input(args, name):
+    from hhscatter.analysis.dissipative.decay import orbit_decay_exponent
+    from hhscatter.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=name):
+        orbit_decay_exponent(*args)

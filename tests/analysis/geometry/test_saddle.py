@@ -37,6 +37,7 @@ from scipy.optimize import brentq
 from hhscatter.analysis.geometry.saddle import (
     capacity_dimension,
     dimension_from_uncertainty,
+    dimension_order,
     information_dimension,
     kantz_grassberger,
     lyapunov_convergence,
@@ -169,6 +170,9 @@ def test_saddle_points_keep_the_mid_window_of_orbits_that_left_late():
         (lambda li, st: kantz_grassberger(0.1, 0.01, -1.0, 0.1, 0.5, 0.1), "lyapunov"),
         (lambda li, st: kantz_grassberger(0.1, -0.01, 1.0, 0.1, 0.5, 0.1), "kappa_err"),
         (lambda li, st: kantz_grassberger(0.1, 0.01, 1.0, 0.1, 0.5, 0.1, dimension="full"), "dimension"),
+        (lambda li, st: dimension_order(math.nan, 0.01, 0.5, 0.01), "d0"),
+        (lambda li, st: dimension_order(0.6, 0.01, 0.5, -0.01), "d1_err"),
+        (lambda li, st: dimension_order(0.6, 0.01, "0.5", 0.01), "d1"),
     ],
 )
 def test_bad_input_is_refused_naming_the_argument(call, names):
@@ -207,6 +211,26 @@ def test_two_scale_baker_information_dimension_is_below_the_capacity_dimension(t
     # told apart: the measured d₀ excludes d₁ along y, the measured d₁ excludes d₀ along x
     assert d0u.value - ref["d1u"] > 3 * d0u.err
     assert ref["d0s"] - d1s.value > 3 * d1s.err
+    # d₀ ≥ d₁ along the unstable direction, both measured: holds; the reverse order, d₁ of the stable direction
+    # against the unstable d₀ taken as d₁ (a larger number), is refused
+    assert dimension_order(d0u.value, d0u.err, d1u.value, d1u.err).holds
+    assert not dimension_order(d1s.value, d1s.err, d0u.value, d0u.err).holds
+
+
+@pytest.mark.parametrize(
+    ("d0", "d0_err", "d1", "d1_err", "z", "holds"),
+    [
+        (0.50, 0.03, 0.58, 0.04, -1.6, True),  # d₀ below d₁ by 1.6σ: within the 2σ allowance
+        (0.50, 0.03, 0.62, 0.04, -2.4, False),  # by 2.4σ: the inequality is violated
+        (0.90, 0.03, 0.50, 0.04, 8.0, True),  # far above: the inequality is one-sided
+        (0.70, 0.0, 0.70, 0.0, 0.0, True),  # equal exact numbers
+    ],
+)
+def test_dimension_order_is_one_sided_at_two_sigma(d0, d0_err, d1, d1_err, z, holds):
+    r = dimension_order(d0, d0_err, d1, d1_err)
+    assert r.z == pytest.approx(z, abs=1e-12) and r.holds is holds
+    assert r.difference == pytest.approx(d0 - d1, abs=1e-15)
+    assert r.verdict.startswith("consistent" if holds else "not consistent")
 
 
 def baker_uncertainty(a, seed, n=20_000, n_max=80):
