@@ -35,6 +35,7 @@ __all__ = [
     "format_number",
     "format_value",
     "format_value_err",
+    "leaf_bound",
     "markdown_to_html",
     "md_cell",
     "scripts_to_html",
@@ -121,19 +122,43 @@ def format_bound(upper=None, lower=None, cl: float = 0.95, *, pct: bool = False)
     return f"{sign} {text}{' %' if pct else ''} {level}"
 
 
+def leaf_bound(leaf) -> dict | None:
+    """leaf_bound(numbers-JSON leaf) -> {"upper" or "lower": bound, "cl": level} of a ``{value, …}`` leaf that is a
+    fraction counted at 0 (or at all): its own ``upper`` / ``lower`` and ``cl``
+    (:meth:`~hhscatter.analysis.stats.intervals.BoundedFraction.record`), else from its number of trials ``n``, by
+    the rule of the paper-vs-ours rows (:func:`hhscatter.reproduction.verdicts.row_bound`); None for any other leaf.
+
+    >>> leaf_bound({"value": 0.0, "lo": 0.0, "hi": 1.7e-5, "n": 60000})
+    {'upper': 4.9928e-05, 'cl': 0.95}
+    >>> leaf_bound({"value": 0.003, "lo": 0.0027, "hi": 0.0032, "n": 60000}) is None
+    True
+    """
+    if not isinstance(leaf, dict) or not _is_num(leaf.get("value")):
+        return None
+    row = {"ours": leaf["value"], "n": leaf.get("n")}
+    row.update({f"ours_{k}": leaf[k] for k in ("upper", "lower", "cl") if k in leaf})
+    return row_bound(row)
+
+
 def format_value(v, *, html: bool = False) -> str:
     """format_value(v) -> text of one numbers-JSON leaf: {value, err} (or a
-    :class:`~hhscatter.analysis.stats.measured.Measured`) → v ± err, {value, lo, hi} → v [lo, hi], short lists
-    element by element, longer lists and tables by their size.
+    :class:`~hhscatter.analysis.stats.measured.Measured`) → v ± err, {value, lo, hi} → v [lo, hi], a fraction
+    counted at 0 or at all (:func:`leaf_bound`) → its one-sided bound "< b (95 %)", short lists element by element,
+    longer lists and tables by their size.
 
     >>> format_value({"value": 0.9123, "err": 0.0031}), format_value(Measured(0.9123, 0.0031)), format_value(Measured(0.9123))
     ('0.912 ± 0.003', '0.912 ± 0.003', '0.9123')
+    >>> format_value({"value": 0.0, "lo": 0.0, "hi": 1.7e-5, "n": 60000})
+    '< 5.0e-5 (95 %)'
     """
     if isinstance(v, Measured):
         v = v.to_dict()
     if isinstance(v, dict) and "value" in v:
         if v.get("value") is None:
             return "—"
+        bound = leaf_bound(v)
+        if bound is not None:
+            return format_bound(**bound)
         if _is_num(v.get("lo")) and _is_num(v.get("hi")):
             return (
                 f"{format_number(v['value'], html=html)} [{format_number(v['lo'], html=html)}, "

@@ -54,7 +54,7 @@ from pathlib import Path
 
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.publish.formatting import format_bound, format_number, format_value_err, typographic_minus
+from hhscatter.publish.formatting import format_bound, format_number, format_value_err, leaf_bound, typographic_minus
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
@@ -407,14 +407,14 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
 def _bound_of(doc, path: str, leaf) -> dict | None:
     """The one-sided bound of a number recorded at a count of 0 or of all: {upper | lower, cl} from its siblings
     ``<key>_upper`` / ``<key>_lower`` and ``<key>_cl`` (:meth:`hhscatter.analysis.stats.intervals.BoundedFraction.record`),
-    or from the keys ``upper`` / ``lower`` of a ``{value, upper, cl}`` leaf; None when it has none.
+    or from a ``{value, upper, cl}`` or ``{value, lo, hi, n}`` leaf (:func:`hhscatter.publish.formatting.leaf_bound`);
+    None when it has none.
 
     >>> _bound_of({"r": {"P": 0.0, "P_upper": 3e-4, "P_cl": 0.95}}, "r.P", 0.0)
     {'cl': 0.95, 'upper': 0.0003}
     """
     if isinstance(leaf, dict):
-        found = {k: leaf[k] for k in ("upper", "lower") if _is_num(leaf.get(k))}
-        return {**found, "cl": leaf.get("cl", 0.95)} if len(found) == 1 else None
+        return leaf_bound(leaf)
     if not _is_num(leaf):
         return None
     found = {}
