@@ -55,6 +55,7 @@ from pathlib import Path
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.publish.formatting import format_bound, format_number, format_value_err, leaf_bound, typographic_minus
+from hhscatter.publish.words import in_glossary_words
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
@@ -103,7 +104,8 @@ def _load(path: str) -> dict:
 
     Parsed once per content (the cache is keyed by the file's bytes, so a file rewritten within the clock's
     resolution is read again). Rows written before they carried their count get it from the record itself
-    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound."""
+    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound; text
+    written before the studies used the glossary's words is read in them (:func:`hhscatter.publish.words.in_glossary_words`)."""
     return _parse(path, Path(path).read_bytes())
 
 
@@ -117,7 +119,7 @@ def _parse(path: str, raw: bytes) -> dict:
         )
     from hhscatter.reproduction.escape_criterion import with_return_counts  # deferred: pandas loads on first use
 
-    return with_return_counts(doc)
+    return in_glossary_words(with_return_counts(doc))
 
 
 def read_numbers_file(path: Path) -> dict:

@@ -109,7 +109,7 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
             False,
             bias,
             (
-                f"plateau: orbits still inside at t_max (KAM-trapped or sticky) are {f_trapped:.2%}, "
+                f"plateau: censored orbits (still inside at t_max) are {f_trapped:.2%}, "
                 f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined"
             ),
         )
@@ -153,7 +153,7 @@ def escape_rate_p_levels(
             f_inf,
             math.inf,
             False,
-            f"P(t) never falls to {p_lo:g} (trapped fraction {f_inf:.2%})",
+            f"P(t) never falls to {p_lo:g} (censored fraction {f_inf:.2%})",
         )
     defined, bias, reason = plateau_check(float(np.interp(wins[0][1], t, P)), f_inf, max_bias)
     kappa, spread, stat = _windows_rate(t, P, E, wins)

@@ -115,3 +115,11 @@ def test_quoted_verdict_uses_the_papers_printed_precision():
     assert quoted_verdict(0.2705, 0.001, 0.27, 0.005) == "agrees within 2σ"
     assert quoted_verdict(0.2750, 0.0021, 0.27, 0.005) == "agrees to the paper's quoted digits"
     assert quoted_verdict(0.2800, 0.0021, 0.27, 0.005) == "differs"
+
+
+def test_the_reasons_name_the_orbits_still_inside_at_t_max_censored():
+    """The reasons go into the studies' numbers and onto the pages: the glossary's "censored", never "trapped" or
+    "KAM" (a censored orbit may be regular, sticky or chaotic but confined)."""
+    ok, _, reason = plateau_check(0.1, 0.02)
+    assert not ok and reason.startswith("plateau: censored orbits (still inside at t_max) are 2.00%, 20% of P")
+    assert "trapped" not in reason and "KAM" not in reason
