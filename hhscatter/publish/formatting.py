@@ -39,6 +39,7 @@ __all__ = [
     "markdown_to_html",
     "md_cell",
     "scripts_to_html",
+    "split_wide_tables",
     "typographic_minus",
 ]
 
@@ -320,13 +321,99 @@ def _fence_plain_tables(text: str) -> str:
     return "\n".join(out) + "\n"
 
 
+_CELL_SPLIT = re.compile(r"(?<!\\)\|")
+_NUMERIC_CELL = re.compile(r"^[\s\d.,+−\-–×^()e%≤<>~]*$|^—$|^$")
+
+
+def _cells(line: str) -> list[str]:
+    return [c.strip() for c in _CELL_SPLIT.split(line.strip())[1:-1]]
+
+
+def _column_shares(head: list[str], keys: int, room: int) -> list[list[int]]:
+    """The other columns of a table (after ``keys``) in shares of at most ``room`` columns; a percentile column
+    ("p99", "p99 short") stays with the column before it, whose quantity it qualifies."""
+    groups: list[list[int]] = []
+    for j in range(keys, len(head)):
+        if groups and re.match(r"p\d+\b", head[j]):
+            groups[-1].append(j)
+        else:
+            groups.append([j])
+    shares: list[list[int]] = []
+    for g in groups:
+        if shares and len(shares[-1]) + len(g) <= room:
+            shares[-1] += g
+        else:
+            shares.append(list(g))
+    return shares
+
+
+def split_wide_tables(text: str, max_cols: int = 8) -> str:
+    """split_wide_tables(Markdown, max_cols=8) -> the text with every table of more than ``max_cols`` columns
+    written as several tables of the same rows, each with the table's leading label columns (those holding text,
+    at most 4) and a share of its other columns (a percentile column kept with the one before it), so that none
+    is wider than a page's text column.
+
+    Examples
+    --------
+    >>> t = "| a | b | c | d |\\n|---|---|---|---|\\n| x | 1 | 2 | 3 |"
+    >>> print(split_wide_tables(t, max_cols=3))
+    | a | b | c |
+    |---|---|---|
+    | x | 1 | 2 |
+    <BLANKLINE>
+    The same rows, further columns:
+    <BLANKLINE>
+    | a | d |
+    |---|---|
+    | x | 3 |
+    """
+    lines, out, i = text.split("\n"), [], 0
+    while i < len(lines):
+        j = i
+        while j < len(lines) and lines[j].lstrip().startswith("|"):
+            j += 1
+        block = lines[i:j]
+        if (
+            len(block) >= 2
+            and re.fullmatch(r"\s*\|(\s*:?-{3,}:?\s*\|)+\s*", block[1])
+            and len(_cells(block[0])) > max_cols
+        ):
+            rows = [_cells(r) for r in block]
+            n = len(rows[0])
+            data = [r for k, r in enumerate(rows) if k != 1]
+            keys = 0
+            while keys < min(4, n - 1) and any(not _NUMERIC_CELL.match(r[keys]) for r in data[1:] if keys < len(r)):
+                keys += 1
+            keys = max(keys, 1)
+            parts = []
+            for share in _column_shares(rows[0], keys, max(1, max_cols - keys)):
+                cols = list(range(keys)) + share
+                part = [
+                    "| " + " | ".join(r[c] if c < len(r) else "" for c in cols) + " |"
+                    if k != 1
+                    else "|---" * len(cols) + "|"
+                    for k, r in enumerate(rows)
+                ]
+                parts.append("\n".join(part))
+            out.append("\n\nThe same rows, further columns:\n\n".join(parts))
+            i = j
+            continue
+        if j > i:
+            out.extend(block)
+            i = j
+        else:
+            out.append(lines[i])
+            i += 1
+    return "\n".join(out)
+
+
 def embed_markdown(text: str, demote: int = 2) -> str:
     """embed_markdown(text, demote=2) -> a standalone Markdown document fit to be embedded in another.
 
-    Plain-text tables fenced, ``|x|`` inside table cells escaped, headings
-    (levels 1–4, outside code) demoted by ``demote`` levels.
+    Plain-text tables fenced, ``|x|`` inside table cells escaped, tables wider than a page's text column split
+    (:func:`split_wide_tables`), headings (levels 1–4, outside code) demoted by ``demote`` levels.
     """
-    text = escape_table_bars(_fence_plain_tables(text))
+    text = split_wide_tables(escape_table_bars(_fence_plain_tables(text)))
     out, in_fence = [], False
     for line in text.split("\n"):
         if line.lstrip().startswith(("```", "~~~")):

@@ -656,7 +656,8 @@ def study_conventions(root: Path, study: str) -> set[float]:
 #: the words of a comparative or qualitative reading of results
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
-    r"best|worst|consistent(?:ly)? with|everywhere|at every (?:energy|scan energy|E))\b",
+    r"best|worst|consistent(?:ly)? with|compatible with|in line with|as predicted|confirm(?:s|ed)?|match(?:es|ed)?|"
+    r"tracks?|parts? near|(?:over|under)estimat\w*|everywhere|at every (?:energy|scan energy|E))\b",
     re.I,
 )
 _PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)

@@ -32,6 +32,8 @@ def test_the_pattern_finds_what_it_looks_for():
 def test_no_count_of_zero_is_an_interval_on_the_site_or_in_the_report(built_site, paper_report_html):
     found = []
     for path in sorted(Path(built_site).rglob("*.html")):
+        if path.relative_to(built_site).parts[0] == "api":
+            continue  # the API reference explains the rule ("never 0 ± 0"), it prints no result
         found += [f"{path.relative_to(built_site)}: {c}" for c in zeros_written_as_intervals(path.read_text())]
     found += [f"report.html: {c}" for c in zeros_written_as_intervals(paper_report_html)]
     assert not found, "\n".join(found[:20])
