@@ -35,9 +35,11 @@ __all__ = [
     "format_number",
     "format_value",
     "format_value_err",
+    "leaf_bound",
     "markdown_to_html",
     "md_cell",
     "scripts_to_html",
+    "split_wide_tables",
     "typographic_minus",
 ]
 
@@ -121,19 +123,43 @@ def format_bound(upper=None, lower=None, cl: float = 0.95, *, pct: bool = False)
     return f"{sign} {text}{' %' if pct else ''} {level}"
 
 
+def leaf_bound(leaf) -> dict | None:
+    """leaf_bound(numbers-JSON leaf) -> {"upper" or "lower": bound, "cl": level} of a ``{value, …}`` leaf that is a
+    fraction counted at 0 (or at all): its own ``upper`` / ``lower`` and ``cl``
+    (:meth:`~hhscatter.analysis.stats.intervals.BoundedFraction.record`), else from its number of trials ``n``, by
+    the rule of the paper-vs-ours rows (:func:`hhscatter.reproduction.verdicts.row_bound`); None for any other leaf.
+
+    >>> leaf_bound({"value": 0.0, "lo": 0.0, "hi": 1.7e-5, "n": 60000})
+    {'upper': 4.9928e-05, 'cl': 0.95}
+    >>> leaf_bound({"value": 0.003, "lo": 0.0027, "hi": 0.0032, "n": 60000}) is None
+    True
+    """
+    if not isinstance(leaf, dict) or not _is_num(leaf.get("value")):
+        return None
+    row = {"ours": leaf["value"], "n": leaf.get("n")}
+    row.update({f"ours_{k}": leaf[k] for k in ("upper", "lower", "cl") if k in leaf})
+    return row_bound(row)
+
+
 def format_value(v, *, html: bool = False) -> str:
     """format_value(v) -> text of one numbers-JSON leaf: {value, err} (or a
-    :class:`~hhscatter.analysis.stats.measured.Measured`) → v ± err, {value, lo, hi} → v [lo, hi], short lists
-    element by element, longer lists and tables by their size.
+    :class:`~hhscatter.analysis.stats.measured.Measured`) → v ± err, {value, lo, hi} → v [lo, hi], a fraction
+    counted at 0 or at all (:func:`leaf_bound`) → its one-sided bound "< b (95 %)", short lists element by element,
+    longer lists and tables by their size.
 
     >>> format_value({"value": 0.9123, "err": 0.0031}), format_value(Measured(0.9123, 0.0031)), format_value(Measured(0.9123))
     ('0.912 ± 0.003', '0.912 ± 0.003', '0.9123')
+    >>> format_value({"value": 0.0, "lo": 0.0, "hi": 1.7e-5, "n": 60000})
+    '< 5.0e-5 (95 %)'
     """
     if isinstance(v, Measured):
         v = v.to_dict()
     if isinstance(v, dict) and "value" in v:
         if v.get("value") is None:
             return "—"
+        bound = leaf_bound(v)
+        if bound is not None:
+            return format_bound(**bound)
         if _is_num(v.get("lo")) and _is_num(v.get("hi")):
             return (
                 f"{format_number(v['value'], html=html)} [{format_number(v['lo'], html=html)}, "
@@ -295,13 +321,99 @@ def _fence_plain_tables(text: str) -> str:
     return "\n".join(out) + "\n"
 
 
+_CELL_SPLIT = re.compile(r"(?<!\\)\|")
+_NUMERIC_CELL = re.compile(r"^[\s\d.,+−\-–×^()e%≤<>~]*$|^—$|^$")
+
+
+def _cells(line: str) -> list[str]:
+    return [c.strip() for c in _CELL_SPLIT.split(line.strip())[1:-1]]
+
+
+def _column_shares(head: list[str], keys: int, room: int) -> list[list[int]]:
+    """The other columns of a table (after ``keys``) in shares of at most ``room`` columns; a percentile column
+    ("p99", "p99 short") stays with the column before it, whose quantity it qualifies."""
+    groups: list[list[int]] = []
+    for j in range(keys, len(head)):
+        if groups and re.match(r"p\d+\b", head[j]):
+            groups[-1].append(j)
+        else:
+            groups.append([j])
+    shares: list[list[int]] = []
+    for g in groups:
+        if shares and len(shares[-1]) + len(g) <= room:
+            shares[-1] += g
+        else:
+            shares.append(list(g))
+    return shares
+
+
+def split_wide_tables(text: str, max_cols: int = 8) -> str:
+    """split_wide_tables(Markdown, max_cols=8) -> the text with every table of more than ``max_cols`` columns
+    written as several tables of the same rows, each with the table's leading label columns (those holding text,
+    at most 4) and a share of its other columns (a percentile column kept with the one before it), so that none
+    is wider than a page's text column.
+
+    Examples
+    --------
+    >>> t = "| a | b | c | d |\\n|---|---|---|---|\\n| x | 1 | 2 | 3 |"
+    >>> print(split_wide_tables(t, max_cols=3))
+    | a | b | c |
+    |---|---|---|
+    | x | 1 | 2 |
+    <BLANKLINE>
+    The same rows, further columns:
+    <BLANKLINE>
+    | a | d |
+    |---|---|
+    | x | 3 |
+    """
+    lines, out, i = text.split("\n"), [], 0
+    while i < len(lines):
+        j = i
+        while j < len(lines) and lines[j].lstrip().startswith("|"):
+            j += 1
+        block = lines[i:j]
+        if (
+            len(block) >= 2
+            and re.fullmatch(r"\s*\|(\s*:?-{3,}:?\s*\|)+\s*", block[1])
+            and len(_cells(block[0])) > max_cols
+        ):
+            rows = [_cells(r) for r in block]
+            n = len(rows[0])
+            data = [r for k, r in enumerate(rows) if k != 1]
+            keys = 0
+            while keys < min(4, n - 1) and any(not _NUMERIC_CELL.match(r[keys]) for r in data[1:] if keys < len(r)):
+                keys += 1
+            keys = max(keys, 1)
+            parts = []
+            for share in _column_shares(rows[0], keys, max(1, max_cols - keys)):
+                cols = list(range(keys)) + share
+                part = [
+                    "| " + " | ".join(r[c] if c < len(r) else "" for c in cols) + " |"
+                    if k != 1
+                    else "|---" * len(cols) + "|"
+                    for k, r in enumerate(rows)
+                ]
+                parts.append("\n".join(part))
+            out.append("\n\nThe same rows, further columns:\n\n".join(parts))
+            i = j
+            continue
+        if j > i:
+            out.extend(block)
+            i = j
+        else:
+            out.append(lines[i])
+            i += 1
+    return "\n".join(out)
+
+
 def embed_markdown(text: str, demote: int = 2) -> str:
     """embed_markdown(text, demote=2) -> a standalone Markdown document fit to be embedded in another.
 
-    Plain-text tables fenced, ``|x|`` inside table cells escaped, headings
-    (levels 1–4, outside code) demoted by ``demote`` levels.
+    Plain-text tables fenced, ``|x|`` inside table cells escaped, tables wider than a page's text column split
+    (:func:`split_wide_tables`), headings (levels 1–4, outside code) demoted by ``demote`` levels.
     """
-    text = escape_table_bars(_fence_plain_tables(text))
+    text = split_wide_tables(escape_table_bars(_fence_plain_tables(text)))
     out, in_fence = [], False
     for line in text.split("\n"):
         if line.lstrip().startswith(("```", "~~~")):

@@ -54,7 +54,8 @@ from pathlib import Path
 
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.publish.formatting import format_bound, format_number, format_value_err, typographic_minus
+from hhscatter.publish.formatting import format_bound, format_number, format_value_err, leaf_bound, typographic_minus
+from hhscatter.publish.words import in_glossary_words
 from hhscatter.studies.provenance import SELF_KEY, content_sha256
 
 __all__ = [
@@ -103,7 +104,8 @@ def _load(path: str) -> dict:
 
     Parsed once per content (the cache is keyed by the file's bytes, so a file rewritten within the clock's
     resolution is read again). Rows written before they carried their count get it from the record itself
-    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound."""
+    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound; text
+    written before the studies used the glossary's words is read in them (:func:`hhscatter.publish.words.in_glossary_words`)."""
     return _parse(path, Path(path).read_bytes())
 
 
@@ -117,7 +119,7 @@ def _parse(path: str, raw: bytes) -> dict:
         )
     from hhscatter.reproduction.escape_criterion import with_return_counts  # deferred: pandas loads on first use
 
-    return with_return_counts(doc)
+    return in_glossary_words(with_return_counts(doc))
 
 
 def read_numbers_file(path: Path) -> dict:
@@ -407,14 +409,14 @@ def format_ref(doc, path: str, fmt: str | None = None) -> str:
 def _bound_of(doc, path: str, leaf) -> dict | None:
     """The one-sided bound of a number recorded at a count of 0 or of all: {upper | lower, cl} from its siblings
     ``<key>_upper`` / ``<key>_lower`` and ``<key>_cl`` (:meth:`hhscatter.analysis.stats.intervals.BoundedFraction.record`),
-    or from the keys ``upper`` / ``lower`` of a ``{value, upper, cl}`` leaf; None when it has none.
+    or from a ``{value, upper, cl}`` or ``{value, lo, hi, n}`` leaf (:func:`hhscatter.publish.formatting.leaf_bound`);
+    None when it has none.
 
     >>> _bound_of({"r": {"P": 0.0, "P_upper": 3e-4, "P_cl": 0.95}}, "r.P", 0.0)
     {'cl': 0.95, 'upper': 0.0003}
     """
     if isinstance(leaf, dict):
-        found = {k: leaf[k] for k in ("upper", "lower") if _is_num(leaf.get(k))}
-        return {**found, "cl": leaf.get("cl", 0.95)} if len(found) == 1 else None
+        return leaf_bound(leaf)
     if not _is_num(leaf):
         return None
     found = {}
@@ -654,7 +656,8 @@ def study_conventions(root: Path, study: str) -> set[float]:
 #: the words of a comparative or qualitative reading of results
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
-    r"best|worst|consistent(?:ly)? with|everywhere|at every (?:energy|scan energy|E))\b",
+    r"best|worst|consistent(?:ly)? with|compatible with|in line with|as predicted|confirm(?:s|ed)?|match(?:es|ed)?|"
+    r"tracks?|parts? near|(?:over|under)estimat\w*|everywhere|at every (?:energy|scan energy|E))\b",
     re.I,
 )
 _PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)

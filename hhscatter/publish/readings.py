@@ -197,6 +197,20 @@ def _basins_energy_scan(get: Loader) -> str:
     return f"the exit basins are {wada}; {fractal}; {alpha}; {s_b}"
 
 
+def _basins_kantz_grassberger(get: Loader) -> str:
+    """κ/α (Kantz–Grassberger: α = κ/λ on a hyperbolic saddle) against the decision rate λ, energy by energy of the
+    scan: within 2σ (their errors combined) or more than 2σ apart; energies without κ/α are left out."""
+    scan = sorted(get("basins", None)["energy_scan"], key=lambda r: r["energy"])
+    cells = []
+    for r in scan:
+        kg, lam = r.get("lam_kg"), r.get("lam")
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in (kg, lam)):
+            continue
+        sigma = math.hypot(r.get("lam_kg_err") or 0.0, r.get("lam_err") or 0.0)
+        cells.append((f"E = {r['energy']:g}", abs(kg - lam) <= Z_RESOLVED * sigma if sigma > 0 else None))
+    return pass_fail_words(cells, "κ/α lies within 2σ of λ", "κ/α and λ are more than 2σ apart", "no error")
+
+
 def _fig5_premise(get: Loader) -> str:
     d = get("fig5", None)
     g = d["gamma_main"]
@@ -855,6 +869,7 @@ def _noise_no_drag_survivors(get: Loader) -> str:
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
     "basins.energy_scan": _basins_energy_scan,
+    "basins.kantz_grassberger": _basins_kantz_grassberger,
     "fig5.premise": _fig5_premise,
     "generality.b_onset": _generality_b_onset,
     "generality.one_exponential": _generality_one_exponential,

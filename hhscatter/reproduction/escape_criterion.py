@@ -29,7 +29,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.analysis.stats.intervals import fraction_with_bound, wilson_interval
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import escape_rate, escape_rate_mle
@@ -185,7 +185,8 @@ def kappa_row(E, r, r_ref, arrs, own, win, returns=None, follow_t_end=None, *, n
 
 def returns_row(E, r, s, recrossed, win, kappa_ref, lyapunov, follow, *, z: float = 1.0, fast: float = 10.0) -> dict:
     """Row of the returns table of cell (E, r): the fraction of escapes that come back inside r_in (all, and after
-    the window start) with Wilson intervals at ``z`` σ (and the 95 % upper bound), how long the returned orbits stay
+    the window start) with Wilson intervals at ``z`` σ (and, for a count of 0, its one-sided 95 % upper bound
+    ``upper95``, by :func:`~hhscatter.analysis.stats.intervals.fraction_with_bound`), how long the returned orbits stay
     and the fraction of them escaping again within ``fast``, the Lyapunov orbit's extent.
 
     ``s``: :func:`~hhscatter.analysis.geometry.channels.return_statistics` back inside r_in; ``recrossed``: the
@@ -223,7 +224,8 @@ def returns_row(E, r, s, recrossed, win, kappa_ref, lyapunov, follow, *, z: floa
         "frac": float(p),
         "lo": float(lo),
         "hi": float(hi),
-        "upper95": float(wilson_interval(n_ret, n_esc, 1.96)[2]),
+        # a count of 0: the one-sided 95 % bound the tables print (NaN for a count above 0)
+        "upper95": float(fraction_with_bound(0, n_esc).upper) if n_ret == 0 and n_esc else math.nan,
         "n_recrossed": int(recrossed.sum()),
         "t_late": win[0],
         "n_escaped_late": n_late,
@@ -377,7 +379,8 @@ def _returns_numbers(ret, r_in, fast):
             "n_escaped": row.n_escaped,
             "n_returned": row.n_returned,
             "n_back_inside_r_esc": row.n_recrossed,
-            "fraction": {"value": row.frac, "lo": row.lo, "hi": row.hi, "upper95": row.upper95},
+            # each fraction states its number of trials n: a count of 0 is read as its one-sided bound
+            "fraction": {"value": row.frac, "lo": row.lo, "hi": row.hi, "upper95": row.upper95, "n": row.n_escaped},
             "returned_then_reescaped": row.n_reescaped,
             "stay_median": row.stay_median,
             "stay_mean": row.stay_mean,
@@ -386,11 +389,18 @@ def _returns_numbers(ret, r_in, fast):
                 "value": row.frac_fast,
                 "lo": row.frac_fast_lo,
                 "hi": row.frac_fast_hi,
+                "n": row.n_returned,
             },
             # the same for a typical survivor of the exponential regime: 1 − e^{−κ t_fast}
             "typical_survivor_fraction_within_reesc_fast": 1.0 - math.exp(-row.kappa_ref * fast),
             "reesc_fast": fast,
-            "fraction_late": {"value": row.frac_late, "lo": row.lo_late, "hi": row.hi_late, "t_late": row.t_late},
+            "fraction_late": {
+                "value": row.frac_late,
+                "lo": row.lo_late,
+                "hi": row.hi_late,
+                "t_late": row.t_late,
+                "n": getattr(row, "n_escaped_late", None),
+            },
         }
         counted = row.n_returned == 0
         rows.append(
@@ -422,10 +432,15 @@ def return_quantity(r_in: float, r: float, E: float) -> str:
 
 
 def with_return_counts(numbers: dict) -> dict:
-    """with_return_counts(numbers JSON) -> the same numbers with each returns row of its ``paper_comparison`` given
-    its number of escaped orbits ``n`` from the numbers' own ``returns`` record, where the row does not state it
-    (a record written before the rows carried their count), so that a count of 0 is read as its one-sided bound
-    (:func:`hhscatter.reproduction.verdicts.row_bound`). Numbers of any other study come back unchanged.
+    """with_return_counts(numbers JSON) -> the same numbers with each returns row of its ``paper_comparison`` and
+    each fraction of its ``returns`` record given its number of trials ``n`` where it does not state it (a record
+    written before they carried their count), so that a count of 0 is read as its one-sided bound
+    (:func:`hhscatter.reproduction.verdicts.row_bound`), never "0 [0, hi]". Numbers of any other study come back
+    unchanged.
+
+    The counts come from the record itself: ``n_escaped`` for ``fraction``, ``n_returned`` for the fraction
+    re-escaping fast; for ``fraction_late``, whose count of escapes after the window start older records do not
+    state, from its Wilson interval at the study's ``z``: at 0 of n the upper end is z²/(n + z²).
 
     Examples
     --------
@@ -433,26 +448,65 @@ def with_return_counts(numbers: dict) -> dict:
     ...        "paper_comparison": [{"quantity": return_quantity(1.0, 1.5, 0.3), "ours": 0.0, "paper": 0.0}]}
     >>> with_return_counts(doc)["paper_comparison"][0]["n"]
     60000
+    >>> cell = {"n_escaped": 60000, "n_returned": 0, "fraction": {"value": 0.0, "lo": 0.0, "hi": 1 / 60001},
+    ...         "fraction_late": {"value": 0.0, "lo": 0.0, "hi": 1 / 6394}}
+    >>> doc = {"config": {"study": {"r_in": 1.0, "z": 1.0}}, "returns": {"E=0.30": {"r_esc=1.5": cell}}}
+    >>> out = with_return_counts(doc)["returns"]["E=0.30"]["r_esc=1.5"]
+    >>> out["fraction"]["n"], out["fraction_late"]["n"]
+    (60000, 6393)
     """
     returns = numbers.get("returns")
-    r_in = ((numbers.get("config") or {}).get("study") or {}).get("r_in")
-    rows = numbers.get("paper_comparison")
-    if not isinstance(returns, dict) or not isinstance(r_in, (int, float)) or not rows:
+    study = (numbers.get("config") or {}).get("study") or {}
+    r_in = study.get("r_in")
+    if not isinstance(returns, dict) or not isinstance(r_in, (int, float)):
         return numbers
-    counts = {}
+    z = study.get("z", 1.0)
+    counts, cells_out = {}, {}
     for e_key, cells in returns.items():
+        cells_out[e_key] = cells
+        if not isinstance(cells, dict):
+            continue
+        filled_cells = {}
         for r_key, cell in cells.items():
+            filled_cells[r_key] = _cell_with_counts(cell, z) if isinstance(cell, dict) else cell
             try:
                 E, r = float(e_key.partition("=")[2]), float(r_key.partition("=")[2])
             except ValueError:
                 continue
             if isinstance(cell, dict) and isinstance(cell.get("n_escaped"), int):
                 counts[return_quantity(r_in, r, E)] = cell["n_escaped"]
-    filled = [
-        {**row, "n": counts[row.get("quantity")]} if row.get("quantity") in counts and "n" not in row else row
-        for row in rows
-    ]
-    return {**numbers, "paper_comparison": filled}
+        cells_out[e_key] = filled_cells
+    out = {**numbers, "returns": cells_out}
+    rows = numbers.get("paper_comparison")
+    if rows:
+        out["paper_comparison"] = [
+            {**row, "n": counts[row.get("quantity")]} if row.get("quantity") in counts and "n" not in row else row
+            for row in rows
+        ]
+    return out
+
+
+def _cell_with_counts(cell: dict, z) -> dict:
+    """One cell of a ``returns`` record with ``n`` in each of its fractions (see :func:`with_return_counts`)."""
+    out = dict(cell)
+    sources = {"fraction": cell.get("n_escaped"), "fraction_reescaping_within_reesc_fast": cell.get("n_returned")}
+    for key, n in sources.items():
+        frac = cell.get(key)
+        if isinstance(frac, dict) and "n" not in frac and isinstance(n, int) and not isinstance(n, bool):
+            out[key] = {**frac, "n": n}
+    late = cell.get("fraction_late")
+    hi = late.get("hi") if isinstance(late, dict) else None
+    if (
+        isinstance(late, dict)
+        and "n" not in late
+        and late.get("value") == 0
+        and isinstance(hi, (int, float))
+        and 0 < hi < 1
+        and isinstance(z, (int, float))
+        and z > 0
+    ):
+        out["fraction_late"] = {**late, "n": int(round(z * z * (1.0 - hi) / hi))}
+    return out
 
 
 def criterion_numbers(energies, radii, r_ref, kap, ret, chan, lyap, *, r_in: float, fast: float):

@@ -80,11 +80,11 @@ FIG2_RULES = {
     "least-squares fits of log P; err = sqrt(spread^2 + stat^2)",
     "t_max": "choose_t_max on a pilot: t_max = t_half + [ln(n/(2 min_survivors)) + margin_efolds]/kappa_pilot,"
     " clipped to [t_max_min, t_max_cap]",
-    "tail": "escaping_tail: orbits censored at t_max (KAM-trapped) removed; detect_power_law_tail after tau0 "
+    "tail": "escaping_tail: orbits censored at t_max removed; detect_power_law_tail after tau0 "
     "with floor tail_min_survivors; tau* = crossing of the exponential and power-law fits",
     "cmeasure": "every section crossing in [t_rec, t_rec + cm_sample_efolds/kappa], t_rec = ceil(tau0 + "
     "cm_rec_efolds/kappa) (kappa, tau0 of the grid run); next crossing or exit seen within "
-    "cm_margin; KAM-trapped orbits (censored at cm_t_max) dropped; kappa_from_cmeasure",
+    "cm_margin; orbits censored at cm_t_max dropped; kappa_from_cmeasure",
 }
 
 
@@ -176,7 +176,7 @@ def law_comparisons(continuous: dict, separate: dict, across: dict, ill, paper: 
     across : dict
         :func:`~hhscatter.analysis.survival.kappa_conventions.law_spread` over the conventions (may be empty).
     ill : DataFrame
-        The (energy, convention) rows where κ is ill-defined (the trapped plateau).
+        The (energy, convention) rows where κ is ill-defined (the plateau of censored orbits).
 
     Returns
     -------
@@ -233,7 +233,7 @@ def law_comparisons(continuous: dict, separate: dict, across: dict, ill, paper: 
         )
     rows.append(
         _row(
-            "κ(E) points ill-defined by the trapped plateau",
+            "κ(E) points ill-defined by the plateau of censored orbits",
             len(ill),
             convention="all 4 conventions",
             note="; ".join(f"E = {r.energy:g} {r.convention}" for r in ill.itertuples()) or "none",
@@ -346,7 +346,7 @@ def cmeasure_comparisons(table) -> tuple[list[dict], dict]:
 
 def convention_numbers(table, stability, fit_info: dict, law: dict, *, p_levels, max_bias, rel_tol) -> dict:
     """The numbers of κ(E) under the :data:`FIG2_CONVENTIONS`: the rules, the stable and unstable energies, the points
-    ill-defined by the trapped plateau (with their reasons), the law per convention and across them.
+    ill-defined by the plateau of censored orbits (with their reasons), the law per convention and across them.
 
     ``table``: one row per (energy, convention) with defined and reason; ``stability``:
     :func:`~hhscatter.analysis.survival.kappa_conventions.stable_energies`; ``fit_info`` and ``law``: the second
@@ -390,7 +390,7 @@ def convention_analysis(runs: dict, *, E_c, p_levels, max_bias, rel_tol, n_boot,
         The critical energy (x = E − E_c).
     p_levels : (float, float)
         The P levels (p_hi, p_lo) of the windows fixed by P; ``max_bias`` the largest bias of the slope at the
-        window end from the trapped plateau (beyond: κ ill-defined); ``rel_tol`` the relative spread of the
+        window end from the plateau of censored orbits (beyond: κ ill-defined); ``rel_tol`` the relative spread of the
         conventions' κ within which an energy is stable.
     n_boot, seed : int
         The bootstrap of the law fits (:func:`~hhscatter.analysis.survival.kappa_conventions.fit_laws`).

@@ -403,7 +403,7 @@ def _analyze_conventions(study, grid_runs):
         table,
         "kappa_conventions.parquet",
         description="κ0(E) per convention: IC region (disk, square) × windows (plateau, P levels); "
-        "defined = False where the trapped plateau makes κ ill-defined",
+        "defined = False where the plateau of censored orbits makes κ ill-defined",
     )
     return table, stab, numbers
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from hhscatter.publish.figures import agg_pyplot, save_panels
+from hhscatter.reproduction.verdicts import row_bound
 
 COLORS = ("#1b7837", "#2166ac", "#b2182b", "#762a83", "#e08214")
 
@@ -142,8 +143,14 @@ def _panel_time_shift(b, kappa, energies, radii, col, r_ref):
     b.grid(alpha=0.3)
 
 
+def zero_count_bounds(n_escaped) -> np.ndarray:
+    """The one-sided 95 % upper bounds drawn for return counts of 0 out of ``n_escaped`` escaped orbits: the bound
+    the comparison table prints (:func:`hhscatter.reproduction.verdicts.row_bound`), never a two-sided interval."""
+    return np.array([row_bound({"ours": 0.0, "n": int(n)})["upper"] for n in n_escaped], dtype=float)
+
+
 def _panel_returns(c, returns, lyapunov, energies, radii, col):
-    """Panel (c): share of escaped orbits returning inside r < 1 (95 % upper limits at zero counts)."""
+    """Panel (c): share of escaped orbits returning inside r < 1 (one-sided 95 % upper bounds at zero counts)."""
     dx = DX
     ymin = 1.0
     for i, E in enumerate(energies):
@@ -165,10 +172,11 @@ def _panel_returns(c, returns, lyapunov, energies, radii, col):
             ymin = min(ymin, float(rp.lo[rp.lo > 0].min()) if (rp.lo > 0).any() else ymin)
         z = r[~pos]
         if len(z):
+            bound = zero_count_bounds(z.n_escaped)
             c.errorbar(
                 _logx(z.r_esc, off),
-                z.upper95,
-                yerr=0.35 * z.upper95,
+                bound,
+                yerr=0.35 * bound,
                 uplims=True,
                 fmt="v",
                 color=col[E],
@@ -177,7 +185,7 @@ def _panel_returns(c, returns, lyapunov, energies, radii, col):
                 capsize=0,
                 label=None if pos.any() else f"E = {E:.2f}",
             )
-            ymin = min(ymin, float(z.upper95.min()) * 0.4)
+            ymin = min(ymin, float(bound.min()) * 0.4)
         ly = lyapunov[np.isclose(lyapunov.energy, E)]
         if len(ly):  # radial extent of the Lyapunov orbit (the exact boundary of Ω) as a bar at the top
             yb = 0.45 * 0.45**i
@@ -202,8 +210,8 @@ def _panel_returns(c, returns, lyapunov, energies, radii, col):
     _xaxis(c, radii)
     c.set_ylabel(r"fraction returning inside $r<1$ after escape")
     c.set_title("(c) returns after the first crossing of $r_{esc}$", fontsize=10)
-    c.plot([], [], "v", mfc="none", color="0.3", label="none seen: 95 % upper limit")
-    c.legend(fontsize=7.5, loc="center right")
+    c.plot([], [], "v", mfc="none", color="0.3", label="none seen: one-sided\n95 % upper bound (as the table)")
+    c.legend(fontsize=7.5, loc="center right", bbox_to_anchor=(1.0, 0.42))
     c.grid(alpha=0.3, which="both")
 
 
@@ -252,8 +260,8 @@ def plot_resc(kappa, returns, channels, lyapunov, path, *, r_ref=1.03, scale="")
     the paired log-survival ratio, ±1σ; open markers: difference of MLEs on
     the common window and the paper's rule with own windows); (b) mean
     flight time from r_ref to r_esc and the delay of P(t); (c) fraction of escaped orbits
-    that return inside r < 1 (Wilson ±1σ; zero counts drawn as 95 % upper
-    limits), with the radial extent of each energy's Lyapunov orbit;
+    that return inside r < 1 (Wilson ±1σ; a count of 0 drawn at its one-sided
+    95 % upper bound, the number the table prints), with the radial extent of each energy's Lyapunov orbit;
     (d) escape fraction per exit channel (all, early t ≤ τ0, late t > τ0) at
     r_ref with the 1/3 of the three-fold symmetry.  Inputs are the study's
     derived tables (pandas DataFrames).

@@ -173,11 +173,17 @@ _VERDICT_EDGES = """() => {
 
 
 def test_no_results_table_scrolls_its_verdict_out_of_view(site, browser):
-    """At 1280 px the verdict column of every results table on the home page, the studies index and the study pages
-    (the column headed "verdict", else the last one, where the tables put their reading) lies inside the viewport
-    and inside the box that would scroll it: the reader sees it without scrolling the table sideways."""
+    """At 1280 px the verdict column of every results table on the home page, the studies index, the study pages,
+    the benchmarks page and the tutorial's outputs (the column headed "verdict", else the last one, where the tables
+    put their reading) lies inside the viewport and inside the box that would scroll it: the reader sees it without
+    scrolling the table sideways."""
     checked, hidden = 0, []
-    pages = [Path(site) / "index.html", *sorted((Path(site) / "studies").glob("*.html"))]
+    pages = [
+        Path(site) / "index.html",
+        *sorted((Path(site) / "studies").glob("*.html")),
+        Path(site) / "benchmarks" / "index.html",
+        Path(site) / "tutorial.html",
+    ]
     for path in pages:
         page, _ = _open(browser, path)
         page.set_viewport_size({"width": 1280, "height": 900})

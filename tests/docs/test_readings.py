@@ -49,6 +49,9 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "the ratio approaches 1 from below as the barrier grows",
         "b = 0.08 ± 0.07, consistent with a quadratic onset",
         "The exit basins are Wada at every energy and S_bb > ln 2 everywhere",
+        "κ/α (column `lam_kg` of `energy_scan`) follows\n  the decision rate (`lam`) from 0.19 to 0.375; they part near E_c",
+        "the measured rate matches the prediction",
+        "the fit overestimates ⟨E⟩ at large t",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -439,3 +442,14 @@ def test_the_two_saddle_turnover_reading_compares_each_end_with_its_limit():
     assert "share of the theory's sum is 0.200 at γ = 0.01 and 0.050 at 3 (its δ_s = 0.3 at γ = 0.01" in text
     empty = READINGS["noise.saddles_turnover"](_loader({"noise": {}}))
     assert empty == "the two-saddle system's turnover is not in this scale's numbers"
+def test_kappa_over_alpha_against_the_decision_rate_by_energy():
+    """κ/α within 2σ (the 1σ of both combined) of λ or not, energy by energy; an energy without κ/α is left out."""
+    from hhscatter.publish.readings import reading
+
+    scan = [
+        {"energy": 0.19, "lam": 0.23, "lam_err": 0.01, "lam_kg": 0.19, "lam_kg_err": 0.01},  # 0.04 > 2·0.0141
+        {"energy": 0.25, "lam": 0.41, "lam_err": 0.01, "lam_kg": 0.40, "lam_kg_err": 0.01},  # 0.01 < 2·0.0141
+        {"energy": 0.5, "lam": 0.77, "lam_err": 0.01, "lam_kg": None, "lam_kg_err": None},
+    ]
+    text = reading(lambda study, scale: {"energy_scan": scan}, "basins.kantz_grassberger")
+    assert text == "κ/α and λ are more than 2σ apart at E = 0.19; κ/α lies within 2σ of λ at E = 0.25"

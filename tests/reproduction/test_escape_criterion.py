@@ -277,3 +277,43 @@ def test_return_rows_written_without_their_count_take_it_from_the_returns_record
     assert "± 5" not in table.splitlines()[2] and "z = +0.0" not in table
     assert with_return_counts({"paper_comparison": rows[1:]}) == {"paper_comparison": rows[1:]}
     assert "n" not in doc["paper_comparison"][0]  # the record itself is not changed
+
+
+def test_a_returns_record_states_the_count_of_each_fraction_so_a_zero_reads_as_its_bound():
+    """The folded numbers table writes each leaf by format_value: a fraction of 0 of n = 60 000 reads as the bound
+    1 − 0.05^(1/60000) ≈ 5.0e-5 of the comparison row, never "0 [0, 1.7e-05]". Records written before the fractions
+    carried n get it from n_escaped; the late fraction from its Wilson 1σ interval, whose upper end at 0 of n is
+    1/(n + 1)."""
+    from hhscatter.publish.formatting import format_value
+
+    cell = {
+        "n_escaped": 60000,
+        "n_returned": 0,
+        "fraction": {"value": 0.0, "lo": 0.0, "hi": 1 / 60001, "upper95": 6.4e-05},
+        "fraction_late": {"value": 0.0, "lo": 0.0, "hi": 1 / 6394, "t_late": 13.0},
+    }
+    doc = {"config": {"study": {"r_in": 1.0, "z": 1.0}}, "returns": {"E=0.30": {"r_esc=1.5": cell}}}
+    out = with_return_counts(doc)["returns"]["E=0.30"]["r_esc=1.5"]
+    assert format_value(out["fraction"]) == "< 5.0e-5 (95 %)"  # 1 − 0.05^(1/60000) = 4.99e-5
+    assert out["fraction_late"]["n"] == 6393
+    assert format_value(out["fraction_late"]) == "< 4.7e-4 (95 %)"  # 1 − 0.05^(1/6393) = 4.69e-4
+    assert "n" not in cell["fraction"]  # the record itself is not changed
+    some = {"value": 0.003, "lo": 0.0027, "hi": 0.0032, "n": 60000}
+    assert format_value(some) == "0.003 [0.0027, 0.0032]"
+
+
+def test_returns_row_writes_the_one_sided_bound_of_a_count_of_zero():
+    """``upper95`` of a cell without a return is 1 − 0.05^(1/n) (the tables' bound), not the two-sided 95 % Wilson
+    upper end 1.96²/(n + 1.96²)."""
+    from types import SimpleNamespace as NS
+
+    n = 500
+    s = {
+        "t_esc": np.arange(1.0, n + 1.0),
+        "returned": np.zeros(n, bool),
+        "t_return": np.full(n, np.nan),
+        "t_reesc": np.full(n, np.nan),
+    }
+    follow = pd.DataFrame({"outcome": ["escaped"] * n, "energy_error": [0.0] * n})
+    row = returns_row(0.3, 1.5, s, np.zeros(n, bool), (10.0, 50.0), 0.1, NS(r_min=1.1, r_max=1.3), follow)
+    assert row["upper95"] == pytest.approx(1 - 0.05 ** (1 / n), rel=1e-12)

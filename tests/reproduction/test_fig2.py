@@ -62,12 +62,12 @@ def test_law_comparisons_keep_a_difference_only_if_it_survives_the_spread_across
     assert rows["a (κ(E) law, continuous fit)"]["verdict"] == "agrees within 2σ"
     assert rows["c (κ(E) law across conventions)"]["authors"] is True
     assert "a (κ(E) law across conventions)" not in rows  # only the parameters the conventions fitted
-    ill_row = rows["κ(E) points ill-defined by the trapped plateau"]
+    ill_row = rows["κ(E) points ill-defined by the plateau of censored orbits"]
     assert (ill_row["ours"], ill_row["note"]) == (1, "E = 0.175 square_plevel")
     # 0.275 is 0.005 above the printed 0.27 (half a unit of its last digit) + 2σ = 0.025: agrees to the digits
     rows = {r["quantity"]: r for r in law_comparisons(_law(), _law(E_b=0.294), {}, ill.iloc[:0])}
     assert rows["E_b (κ(E) law, separate fits)"]["verdict"] == "agrees to the paper's quoted digits"
-    assert rows["κ(E) points ill-defined by the trapped plateau"]["note"] == "none"
+    assert rows["κ(E) points ill-defined by the plateau of censored orbits"]["note"] == "none"
 
 
 def test_law_comparisons_a_difference_that_survives_the_conventions_stays():

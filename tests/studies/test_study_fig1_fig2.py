@@ -270,7 +270,7 @@ def test_fig2_conventions_use_the_authors_square_ics_and_recompute_deterministic
     undefined = table[~table["defined"]]
     assert (undefined["reason"].str.len() > 0).all()
     rows = {r["quantity"]: r for r in doc["paper_comparison"]}
-    assert rows["κ(E) points ill-defined by the trapped plateau"]["ours"] == len(undefined)
+    assert rows["κ(E) points ill-defined by the plateau of censored orbits"]["ours"] == len(undefined)
     run_stage("fig2", "analyze", "tiny", root=tiny_root)
     assert json.loads(study.numbers_path.read_text())["kappa_conventions"] == conv
 

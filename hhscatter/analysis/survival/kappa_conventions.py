@@ -109,11 +109,37 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
             False,
             bias,
             (
-                f"plateau: orbits still inside at t_max (KAM-trapped or sticky) are {f_trapped:.2%}, "
+                f"plateau: censored orbits (still inside at t_max) are {f_trapped:.2%}, "
                 f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined"
             ),
         )
     return True, bias, ""
+
+
+def dead_time_check(tau0: float, t_first: float, kappa: float, max_dead: float = 0.5):
+    """dead_time_check(τ0, t_first, κ, max_dead=0.5) -> (defined, reason): whether a window starting at τ0 (time
+    units) holds the dead time before the first escape ``t_first`` (time units) for more than ``max_dead`` e-folds
+    of its κ (1/time), i.e. κ·(t_first − τ0) > ``max_dead``.
+
+    An exponential regime P ∝ e^{−κt} has no stretch without escapes. A window that starts in the flat start of
+    P(t), before any orbit has had time to reach the exit, is the prompt burst of escapes, not the regime: the
+    window rule picks it when the burst covers more e-folds of P above the counting floor than the regime after it
+    (a small ensemble, whose floor of ``min_survivors`` orbits sits high), and its κ then moves with N.
+
+    Examples
+    --------
+    >>> dead_time_check(0.0, 1.56, 1.257)[0], dead_time_check(0.0, 3.0, 0.01), dead_time_check(8.3, 1.56, 0.263)
+    (False, (True, ''), (True, ''))
+    >>> print(dead_time_check(0.0, 1.56, 1.257)[1])
+    window starts 1.6 time units (2 e-folds of κ) before the first escape: a prompt burst, not an exponential regime; κ ill-defined
+    """
+    dead = (t_first - tau0) * kappa
+    if math.isfinite(dead) and dead > max_dead:
+        return False, (
+            f"window starts {t_first - tau0:.2g} time units ({dead:.2g} e-folds of κ) before the first escape: "
+            "a prompt burst, not an exponential regime; κ ill-defined"
+        )
+    return True, ""
 
 
 def _windows_rate(t, P, E, windows):
@@ -153,7 +179,7 @@ def escape_rate_p_levels(
             f_inf,
             math.inf,
             False,
-            f"P(t) never falls to {p_lo:g} (trapped fraction {f_inf:.2%})",
+            f"P(t) never falls to {p_lo:g} (censored fraction {f_inf:.2%})",
         )
     defined, bias, reason = plateau_check(float(np.interp(wins[0][1], t, P)), f_inf, max_bias)
     kappa, spread, stat = _windows_rate(t, P, E, wins)

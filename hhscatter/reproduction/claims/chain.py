@@ -65,9 +65,7 @@ def check_params(p) -> None:
     if not np.isclose(p.resc_ratios, p.e0_ratio).any():
         raise ValueError(f"[study].resc_ratios must contain e0_ratio = {p.e0_ratio:g} (2⟨K⟩/E measured at E0)")
     if not p.cm_t_max > p.cm_t_to:
-        raise ValueError(
-            "[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max are dropped as KAM-trapped)"
-        )
+        raise ValueError("[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max, censored, are dropped)")
 
 
 def _system_claims(runs, claims, label, spec, m):

@@ -178,7 +178,7 @@ def claim5_distance(runs, claims, label, m, E0, mu, samples):
         "t_rec_star": ss["t_rec"],
         "t_rec_E0": s0["t_rec"],
     }
-    refs = {"c-measure": "μ_c: KAM-trapped orbits dropped", "all": "all conservative survivors, trapped kept"}
+    refs = {"c-measure": "μ_c: censored orbits dropped", "all": "all conservative survivors, censored kept"}
     qs = {k: f"Fig. 5's distance: d(μ_c^E0) − d(μ_c^E(t*)), E(t*) = {p.c5_ratio:g} E_c ({v})" for k, v in refs.items()}
     if not t_lo <= t_star <= t_hi - p.c5_pad:
         for q in qs.values():

@@ -196,7 +196,9 @@ def kappa0_rule(max_bias: float, min_survivors: float) -> str:
     return (
         f"κ0 defined iff the plateau-window rule finds a window (at least {min_survivors:g} orbits left at its end) "
         f"and the orbits still inside at t_max are at most {100 * max_bias:g} % of P(t) at the window's end "
-        f"(f∞/P(t_hi) ≤ {100 * max_bias:g} %); the regular fraction does not enter the rule"
+        f"(f∞/P(t_hi) ≤ {100 * max_bias:g} %); and its window starts less than half an e-fold of its κ before the "
+        "first escape (else it holds a prompt burst, not the exponential regime); the regular fraction does not "
+        "enter the rule"
     )
 
 

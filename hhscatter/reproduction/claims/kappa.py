@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from hhscatter.analysis.dissipative.transitions import power_law_exponent
@@ -10,6 +11,7 @@ from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
 from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 from hhscatter.analysis.survival.kappa_conventions import (
+    dead_time_check,
     escape_rate_p_levels,
     plateau_rate,
 )
@@ -45,14 +47,22 @@ def rate_or_reason(lifetimes, min_survivors: float):
 def window_rate(lifetimes, p, failure: str):
     """window_rate(lifetimes, p, failure) -> (ConventionRate | None, EscapeRateResult | None, reason).
 
-    κ of :func:`rate_or_reason` with the trapped-plateau check (``p.max_plateau_bias``); where the window rule
-    fails, None and ``failure`` followed by the rule's message: the reason of this convention alone.
+    κ of :func:`rate_or_reason` with the check for a plateau of censored orbits (``p.max_plateau_bias``) and the
+    check that the window does not hold the dead time before the first escape
+    (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`: a prompt burst taken for the regime
+    by a small ensemble); where the window rule fails, None and ``failure`` followed by the rule's message: the
+    reason of this convention alone.
     """
     t_end, obs = lifetimes_to_arrays(lifetimes)
     res, why = rate_or_reason(lifetimes, p.min_survivors)
     if res is None:
         return None, None, f"{failure}: {why}"
-    return plateau_rate(res, t_end, obs, max_bias=p.max_plateau_bias), res, ""
+    rate = plateau_rate(res, t_end, obs, max_bias=p.max_plateau_bias)
+    if rate.defined and obs.any():
+        ok, dead = dead_time_check(res.tau0, float(t_end[obs].min()), rate.kappa)
+        if not ok:
+            rate = dataclasses.replace(rate, defined=False, reason=dead)
+    return rate, res, ""
 
 
 def kappa_rows(runs, label, m):

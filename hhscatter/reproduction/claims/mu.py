@@ -182,7 +182,7 @@ def claim3(claims, label, meas, pred, wins, mu_c0, paper_mu, is_hh, relaxed):
             "study's setup (r_esc the system's default)",
             paper_mu if is_hh and wname == "paper" else None,
         )
-        for kind, name in (("c-measure", "c-measure: trapped orbits dropped"), ("all survivors", "all survivors")):
+        for kind, name in (("c-measure", "c-measure: censored orbits dropped"), ("all survivors", "all survivors")):
             v, e = pred[kind, wname]
             claims.add(
                 "3",

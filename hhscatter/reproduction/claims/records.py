@@ -100,12 +100,12 @@ def across(per: dict, key: str):
 RULES = {
     "energies": "E = r·E_c on the grid ratios, the same for every system",
     "ics": "uniform in the disk r < radius_frac·r_s, tangential momenta; r_esc the system's default",
-    "kappa": "escape_rate (plateau windows) and P-level windows, trapped-plateau check; law in ε = E/E_c − 1",
+    "kappa": "escape_rate (plateau windows) and P-level windows, check of the plateau of censored orbits; law in ε = E/E_c − 1",
     "mu_measured": "fig3's: <E>(t) of orbits not escaped, settled continued; fixed-intercept log fit",
     "mu_predicted": "2<K>/E of the conservative flow (probe drag, c-measure) above E_c, microcanonical "
     "well below; path dE/dt = -gamma mu(E) E fitted like the measured curve",
     "taus": "fig4's: tau0 choose_windows(P_0), tau1 P_g = alpha P_0, tau2 first settling, Eq. (eq:tau2)",
-    "kappa_cmeasure": "claim 2: every section crossing of a conservative run (KAM-trapped orbits dropped) on "
+    "kappa_cmeasure": "claim 2: every section crossing of a conservative run (censored orbits dropped) on "
     "[ceil(tau0 + cm_rec_efolds/kappa), cm_t_to - cm_margin], Eq. (eqn:kappa_cmeasure_"
     "truetime), bootstrap over orbits; against kappa0 of the claim-1 run at that E/E_c",
     "cmeasure_distance": "claim 5: first crossing after t* of the dissipative survivors vs the sprinkler "

@@ -115,3 +115,20 @@ def test_quoted_verdict_uses_the_papers_printed_precision():
     assert quoted_verdict(0.2705, 0.001, 0.27, 0.005) == "agrees within 2σ"
     assert quoted_verdict(0.2750, 0.0021, 0.27, 0.005) == "agrees to the paper's quoted digits"
     assert quoted_verdict(0.2800, 0.0021, 0.27, 0.005) == "differs"
+
+
+def test_the_reasons_name_the_orbits_still_inside_at_t_max_censored():
+    """The reasons go into the studies' numbers and onto the pages: the glossary's "censored", never "trapped" or
+    "KAM" (a censored orbit may be regular, sticky or chaotic but confined)."""
+    ok, _, reason = plateau_check(0.1, 0.02)
+    assert not ok and reason.startswith("plateau: censored orbits (still inside at t_max) are 2.00%, 20% of P")
+    assert "trapped" not in reason and "KAM" not in reason
+
+
+def test_a_window_holding_the_dead_time_before_the_first_escape_is_no_exponential_regime():
+    """κ·(t_first − τ0) > 0.5: half an e-fold of the window passes before anyone leaves."""
+    from hhscatter.analysis.survival.kappa_conventions import dead_time_check
+
+    assert not dead_time_check(0.0, 1.56, 1.257)[0]  # 1.96 e-folds without an escape
+    assert dead_time_check(0.0, 0.4, 1.0)[0]  # 0.4 e-fold: a flight time inside the regime
+    assert dead_time_check(8.3, 1.56, 0.263) == (True, "")  # the window starts after the first escape

@@ -273,3 +273,27 @@ def test_a_map_cell_without_a_kappa0_run_has_no_verdict_and_the_rule_says_none()
     (cell,) = validity_map(reg, [], [], [], ics="d", max_bias=0.1)
     assert cell["kappa0_defined"] is None and "kappa0" not in cell
     assert kappa0_defined_by_rule(cell, 0.1) is None
+
+
+def _prompt_then_slow(n, seed=3):
+    """Lifetimes of a fast-escaping ensemble: 95 % leave after a flight time of 0.8 at hazard 1.3, the other 5 %
+    from t = 6 at the rate κ = 0.26 of the exponential regime (the shape of P(t) of Contopoulos at 2.6 E_c)."""
+    rng = np.random.default_rng(seed)
+    fast = rng.random(n) < 0.95
+    t = np.where(fast, 0.8 + rng.exponential(1 / 1.3, n), 6.0 + rng.exponential(1 / 0.26, n))
+    return pd.DataFrame({"traj_id": np.arange(n), "t_end": t, "outcome": "escaped"})
+
+
+def test_kappa0_is_undefined_where_the_window_holds_the_dead_time_before_the_first_escape():
+    """With 2000 orbits the floor of 50 survivors sits at P = 0.025: the exponential regime (κ = 0.26) spans about
+    one e-fold above it and the prompt burst more, so the plateau rule takes the burst from t = 0 (κ ≈ 1.1, an
+    e-fold of it before anyone has left). That κ is not the regime's: κ0 is undefined and says why. With 20 000
+    orbits the same distribution gives the regime's κ = 0.26."""
+    from hhscatter.reproduction.claims.kappa import window_rate
+
+    p = SimpleNamespace(min_survivors=50.0, max_plateau_bias=0.1)
+    small, res, why = window_rate(_prompt_then_slow(2000), p, "window rule failed")
+    assert why == "" and res.tau0 == 0.0 and res.kappa > 0.8  # the burst, as the window rule finds it
+    assert not small.defined and "before the first escape" in small.reason
+    large, res, _ = window_rate(_prompt_then_slow(20000), p, "window rule failed")
+    assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0

@@ -1,0 +1,110 @@
+"""The words the studies write into their numbers for the orbits still inside at t_max: the glossary's "censored",
+never "KAM-trapped" or "trapped", in the text the code writes and in every committed record as the pages read it."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+from hhscatter.publish.numbers import read_numbers_file
+from hhscatter.publish.words import OLD_PHRASES, in_glossary_words
+
+ROOT = Path(__file__).resolve().parents[2]
+#: "trapped" or "KAM" said of an orbit; the dissipative mixture's "trapped fraction φ" / "trapped fractions f_ne,k"
+#: (the share of a sub-ensemble that settles instead of escaping, a parameter of the fit) is another quantity
+OLD = re.compile(r"\bKAM-trapped\b|\btrapped\b(?! fractions? (?:φ|f_ne))", re.I)
+#: the modules that write text into the numbers JSON: the estimators, what assembles the studies' numbers, the studies
+WRITERS = sorted(
+    [*(ROOT / "hhscatter" / "analysis").rglob("*.py"), *(ROOT / "hhscatter" / "reproduction").rglob("*.py")]
+    + list((ROOT / "studies").glob("*/study.py"))
+)
+#: a message about rows below E_c that never had an outcome ("trapped from t = 0"), not about a censored orbit
+ELSEWHERE = {"they are trapped from t = 0"}
+
+
+def _written_strings(path: Path) -> list[tuple[int, str]]:
+    """(line, text) of the literal strings and f-string parts of a module, except docstrings and bare identifiers
+    (a key such as ``trapped_fraction`` is read, not printed)."""
+    tree = ast.parse(path.read_text())
+    docs = {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef))
+        and node.body
+        and isinstance(node.body[0], ast.Expr)
+        and isinstance(node.body[0].value, ast.Constant)
+    }
+    return [
+        (node.lineno, node.value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant)
+        and isinstance(node.value, str)
+        and id(node) not in docs
+        and not re.fullmatch(r"\w+", node.value)
+    ]
+
+
+def test_the_writers_are_found():
+    names = {p.name for p in WRITERS}
+    assert {"kappa_conventions.py", "fig2.py", "cmeasure.py", "study.py"} <= names
+
+
+@pytest.mark.parametrize("path", WRITERS, ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_code_writes_censored_not_trapped(path):
+    bad = [
+        (line, text)
+        for line, text in _written_strings(path)
+        if OLD.search(text) and not any(e in text for e in ELSEWHERE)
+    ]
+    assert not bad, f"{path.relative_to(ROOT)} writes the old words: {bad}"
+
+
+def test_the_pattern_tells_a_censored_orbit_from_the_mixtures_fraction():
+    assert OLD.search("κ(E) points ill-defined by the trapped plateau")
+    assert OLD.search("μ_c: KAM-trapped orbits dropped")
+    assert not OLD.search("same number of free parameters (one trapped fraction φ)")
+    assert not OLD.search("K trapped fractions f_ne,k: K − 1 more parameters")
+
+
+COMMITTED = sorted(
+    p for p in (ROOT / "docs" / "studies" / "assets").rglob("*.json") if not p.name.endswith(".cost.json")
+)
+
+
+def _texts(doc):
+    if isinstance(doc, str):
+        yield doc
+    elif isinstance(doc, dict):
+        for v in doc.values():
+            yield from _texts(v)
+    elif isinstance(doc, list):
+        for v in doc:
+            yield from _texts(v)
+
+
+@pytest.mark.parametrize("path", COMMITTED, ids=lambda p: str(p.relative_to(ROOT / "docs" / "studies" / "assets")))
+def test_a_committed_record_reads_censored_on_the_pages(path):
+    """Records written before the studies said "censored" (the paper scale's, which a re-run would take hours to
+    remake) are read in the glossary's words; their keys stay."""
+    bad = sorted({t for t in _texts(read_numbers_file(path)) if OLD.search(t)})
+    assert not bad, bad[:5]
+
+
+def test_an_old_record_is_reworded_phrase_by_phrase_and_its_keys_stay():
+    doc = {
+        "trapped_fraction": 0.03,
+        "rows": [
+            {"quantity": "κ(E) points ill-defined by the trapped plateau", "ours": 2},
+            {"quantity": "Fig. 5's distance (all conservative survivors, trapped kept) — barbanis"},
+        ],
+        "reason": "plateau: orbits still inside at t_max (KAM-trapped or sticky) are 3.17%, 100% of P at the window end",
+    }
+    out = in_glossary_words(doc)
+    assert out["trapped_fraction"] == 0.03 and out["rows"][0]["ours"] == 2
+    assert out["rows"][0]["quantity"] == "κ(E) points ill-defined by the plateau of censored orbits"
+    assert out["rows"][1]["quantity"] == "Fig. 5's distance (all conservative survivors, censored kept) — barbanis"
+    assert out["reason"].startswith("plateau: censored orbits (still inside at t_max) are 3.17%")
+    assert all(not OLD.search(new) for _, new in OLD_PHRASES)
