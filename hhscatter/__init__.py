@@ -5,12 +5,13 @@ batch Taylor integrator.
 Public entry points (imported lazily, so ``import hhscatter`` is cheap and has
 no side effects; ``dir(hhscatter)`` lists them):
 
-- :class:`Scene`, :class:`SectionWindow`, :func:`load_scene`, :class:`Grid`,
-  :func:`load_run` — what to compute (one scene, or a grid over E0 and γ)
+- :class:`Scene`, :class:`SectionWindow`, :class:`Noise`, :func:`load_scene`, :class:`Grid`,
+  :func:`load_run` — what to compute (one scene, or a grid over E0 and γ; what it records, random forces)
 - :func:`simulate` — run a scene or a grid, write Parquet tables
 - :func:`read_lifetimes`, :func:`read_sections`, :func:`read_snapshots` — read them
 - :func:`survival`, :func:`escape_rates` — P(t) and κ per grid point of a
-  lifetimes DataFrame (results with ``.to_frame()`` and ``.plot(ax=)``, as for every function below)
+  lifetimes DataFrame (results :class:`SurvivalCurves`, :class:`EscapeRates` with ``.to_frame()`` and
+  ``.plot(ax=)``, as for every function below)
 - :func:`kappa_cmeasure` — κ from the c-measure of a run's section crossings, beside κ from P(t)
 - :func:`transition_times` — τ0, τ1, τ2 of each dissipative point against its γ = 0 partner
 - :func:`energy_decay` — ⟨E⟩(t) of the orbits inside and μ of E0·e^{−μγt}
@@ -34,8 +35,8 @@ from hhscatter._version import __version__ as __version__  # re-exported
 
 _EXPORTS = {
     "Scene": "scene.scene",
-    "SectionWindow": "scene.scene",
-    "Noise": "scene.scene",
+    "SectionWindow": "scene.recording",
+    "Noise": "scene.noise",
     "SceneError": "errors",
     "HHScatterError": "errors",
     "ConfigError": "errors",

@@ -110,6 +110,27 @@ def _snapshots(s):
     return {"times": v if isinstance(v, list) else [v]}
 
 
+class _SystemOption(argparse.Action):
+    """``--system NAME|EXPR``: stores the value; its help names the built-ins of the registry
+    (:data:`hhscatter.model.builtins.BUILTINS`), read only when the help is shown."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+
+    @property
+    def help(self) -> str:
+        from hhscatter.model.builtins import BUILTINS  # deferred: `hhscatter --help` starts without sympy
+
+        return (
+            f"a built-in ({', '.join(BUILTINS)}) "
+            "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'"
+        )
+
+    @help.setter
+    def help(self, value) -> None:  # argparse sets it; the text above is the one shown
+        pass
+
+
 def _system_flags(s) -> None:
     """--system, --param, --dissipation of ``simulate`` (hhscatter.model.spec)."""
     sy = s.add_argument_group(
@@ -119,8 +140,7 @@ def _system_flags(s) -> None:
     sy.add_argument(
         "--system",
         metavar="NAME|EXPR",
-        help="a built-in (henon_heiles, n_exit, contopoulos, barbanis) "
-        "or a potential V in x, y and parameters, e.g. '0.5*(x**2 + y**2) - eps*x**2*y**2'",
+        action=_SystemOption,
     )
     sy.add_argument(
         "--param",

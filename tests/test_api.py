@@ -48,6 +48,16 @@ def test_public_names_are_listed_and_version_comes_from_metadata():
     assert "version" not in dir(hhscatter)  # no helper names leak into the namespace
 
 
+def test_every_top_level_name_points_at_its_defining_module_and_the_docstring_lists_it():
+    """hhscatter._EXPORTS maps each lazy name to the module that defines it (or the package that exports it), and
+    the package docstring names every one of them, nothing else."""
+    for name, where in hhscatter._EXPORTS.items():
+        defined_in = getattr(hhscatter, name).__module__
+        assert defined_in == f"hhscatter.{where}" or defined_in.startswith(f"hhscatter.{where}."), (name, where)
+    listed = set(re.findall(r":(?:class|func):`(\w+)`", hhscatter.__doc__))
+    assert listed == set(hhscatter._EXPORTS)
+
+
 def test_points_are_grouped_by_energy_never_by_e0():
     from hhscatter.api import split_points
 

@@ -278,6 +278,22 @@ def test_the_command_starts_without_loading_the_study_framework():
     assert out[0] == "[]" and out[1] == "True", out
 
 
+def test_the_command_help_starts_without_the_system_registry():
+    """The --system help reads the built-ins' names only when shown: `hhscatter --help` loads neither the
+    registry nor sympy."""
+    import subprocess
+    import sys
+
+    code = (
+        "import contextlib, io, sys, hhscatter.cli as c\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    c.main(['--help'])\n"
+        "print(sorted(m for m in ('hhscatter.model.builtins', 'sympy') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out
+
+
 SIM = ["simulate", "--energy", "0.3", "-n", "10", "--t-max", "20", "--workers", "1", "--quiet"]
 
 

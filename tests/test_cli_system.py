@@ -6,6 +6,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from hhscatter.cli import main
+from hhscatter.model.builtins import BUILTINS
 
 
 def _cli(capsys, *args):
@@ -136,3 +137,13 @@ def test_declared_potential_runs_end_to_end_from_a_scene_file(tmp_path, capsys):
     lt = pd.read_parquet(out / "lifetimes")
     esc = lt[lt["outcome"] == "escaped"]
     assert len(esc) > 25 and set(esc["exit_channel"].astype(int)) <= {0, 1, 2, 3}
+
+
+def test_the_system_help_names_every_builtin_of_the_registry(capsys, monkeypatch):
+    monkeypatch.setitem(BUILTINS, "quartic_toy", BUILTINS["barbanis"])
+    with pytest.raises(SystemExit) as e:
+        main(["simulate", "--help"])
+    assert e.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"a built-in ({', '.join(BUILTINS)}) or a potential V" in text
+    assert "quartic_toy" in text

@@ -17,15 +17,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from hhscatter.model.builtins import BUILTINS  # noqa: E402
 from hhscatter.model.spec import system_from_spec  # noqa: E402
 
-#: the built-ins shown (n_exit with n = 4: n = 3 is Hénon–Heiles), the others at their default parameters
-GALLERY = (
-    {"name": "henon_heiles"},
-    {"name": "n_exit", "params": {"n": 4}},
-    {"name": "contopoulos"},
-    {"name": "barbanis"},
-)
+#: the parameters a built-in is shown with when not its defaults (n_exit with n = 4: n = 3 is Hénon–Heiles)
+SHOWN_WITH = {"n_exit": {"n": 4}}
+
+
+def gallery() -> list[dict]:
+    """The [system] spec of every built-in of the registry, in its order, at the parameters of SHOWN_WITH."""
+    return [{"name": name, **({"params": SHOWN_WITH[name]} if name in SHOWN_WITH else {})} for name in BUILTINS]
 
 
 def _num(v: float) -> str:
@@ -35,7 +36,7 @@ def _num(v: float) -> str:
 def table_rows():
     """(name, params, E_c, exits, omega_radius, R(1.5 E_c)) of every built-in, at its default parameters."""
     rows = []
-    for spec in GALLERY:
+    for spec in gallery():
         m = system_from_spec(spec)
         name = spec["name"]
         exits = "; ".join(f"({_num(e.x)}, {_num(e.y)})" for e in m.exits)
@@ -100,7 +101,7 @@ def figure(spec: dict, path: Path) -> None:
 def main() -> int:
     out = ROOT / "docs" / "concepts" / "systems"
     out.mkdir(parents=True, exist_ok=True)
-    for spec in GALLERY:
+    for spec in gallery():
         figure(spec, out / f"{spec['name']}.png")
     print(markdown_table())
     return 0

@@ -32,7 +32,7 @@ from hhscatter.model.henon_heiles import HenonHeiles
 
 #: the keys of a system spec (the [system] table): what each holds
 SYSTEM_KEYS = {
-    "name": "a built-in system's name (henon_heiles, n_exit, contopoulos, barbanis)",
+    "name": "a built-in system's name (a key of hhscatter.model.builtins.BUILTINS)",
     "potential": "V(x, y) as an expression in x, y and the parameters' names",
     "dissipation": "the drag law for γ > 0: 'linear' (−γp, default) or 'quadratic' (−γ|p|p)",
     "params": "the parameters' values, name = number",

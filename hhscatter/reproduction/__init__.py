@@ -3,14 +3,22 @@
 Above :mod:`hhscatter.analysis` (whose general estimators these modules call) and below the studies and the
 report; imports ``model`` and ``analysis`` only.
 
+* ``fig1`` — the paper's Fig. 1 in tables: the record of one energy's c-measure run and its points;
 * ``fig2`` — the paper's Fig. 2 values and ours beside them (κ of P(t), τ*, the κ(E) law, κ from the c-measure);
+* ``kappa_references`` — the κ references a study reads from the escape-rate study's numbers (κ0(E), κ_c);
 * ``escape_summaries`` — escape-rate results as numbers and plot tables (P(t), κ, the sticky tail, the κ(E) law);
 * ``escape_criterion`` — κ under several r_esc on the same orbits, returns, exit channels, the recommended r_esc;
 * ``fig3`` — μ on the paper's and other windows, the inset's histograms, μ in the authors' conventions;
 * ``transition_tables``, ``model_tables``, ``model_verdicts`` — τ1, τ2 and the survival models' tables and verdicts;
 * ``basin_summary`` — the records of a basin study: outcome codes, per-point records, trends, cut-off records;
 * ``cmeasure_comparison``, ``cmeasure_verdicts`` — section points against the conservative c-measure (Fig. 5);
+* ``operator_cmeasure``, ``operator_records`` — the transfer operator's measures against sprinkler points of the
+  c-measure, its κ beside the escape rate of P(t) and its dissipative survival beside a simulated one;
 * ``noise_records`` — thermal and noisy escape rates against Kramers–Langer and the turnover theory, and their
   checks (finite barrier, absorbing radius, two saddles, no drag, re-activation);
-* ``claims`` — the paper's claims tested on a system, and the evidence behind their readings.
+* ``claims`` — the paper's claims tested on a system, and the evidence behind their readings;
+* ``verdicts`` — the rule of every comparison with the paper, the kinds of reference, the smoke scale that states
+  none.
+
+Every module and subpackage of the package is in this list (a test checks it).
 """

@@ -36,6 +36,7 @@ import math
 
 import numpy as np
 
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.params import StudyParams
@@ -234,11 +235,12 @@ def _lyapunov(lt, t_min, p):
         return out, lt.assign(ftle=mean.ftle)
     out.update({"extrapolated": c.extrapolated, "extrapolated_err": c.extrapolated_err, "slope": c.slope,
                 "slope_err": c.slope_err, "converged": c.converged})  # fmt: skip
-    out.update({"lambda_mean": {"value": mean.value, "err": mean.err},
-                "lambda_inf": {"value": c.extrapolated, "err": c.extrapolated_err},
-                "b": {"value": c.slope, "err": c.slope_err}})  # fmt: skip
+    lam_inf = Measured(c.extrapolated, c.extrapolated_err, "1/T extrapolation", mean.n_orbits)
+    out.update({"lambda_mean": Measured(mean.value, mean.err, "mean", mean.n_orbits).to_dict(),
+                "lambda_inf": lam_inf.to_dict(),
+                "b": Measured(c.slope, c.slope_err, "1/T slope", mean.n_orbits).to_dict()})  # fmt: skip
     if not c.converged:
-        out.update({"value": c.extrapolated, "err": c.extrapolated_err, "rule": "extrapolated (1/T drift resolved)"})
+        out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
     return out, lt.assign(ftle=mean.ftle)
 
 
@@ -398,7 +400,7 @@ def _point(study, key, ch):
             "t_min_kappa": c,
             "n_orbits": int(r.n_orbits),
             "n_points": int(r.n_points),
-            "d1_section": None if math.isnan(r.value) else {"value": float(r.value), "err": float(r.err)},
+            "d1_section": None if math.isnan(r.value) else Measured.of(r.value, r.err, n=int(r.n_orbits)).to_dict(),
             "note": r.note,
         }  # fmt: skip
         for c, r in zip((*p.tmin_checks, p.tmin_efolds), wd.itertuples())
@@ -427,9 +429,9 @@ def _relation_row(rec: dict) -> dict:
     for name, err in (("kappa", "kappa_err"), ("lyapunov", "lyapunov_err"), ("d1_section", "d1_section_err"),
                       ("d1", "d1_err"), ("predicted", "predicted_err"), ("d1_implied", "d1_implied_err")):  # fmt: skip
         if rec.get(name) is not None and rec.get(err) is not None:
-            row[name] = {"value": rec[name], "err": rec[err]}
+            row[name] = Measured(rec[name], rec[err]).to_dict()
     if rec.get("d1_implied") is not None:
-        row["d1_section_implied"] = {"value": 2 * rec["d1_implied"], "err": 2 * rec["d1_implied_err"]}
+        row["d1_section_implied"] = Measured(rec["d1_implied"], rec["d1_implied_err"]).scaled(2).to_dict()
     if rec.get("verdict") is not None:
         row["z"], row["verdict"] = rec["z"], rec["verdict"]
     return row

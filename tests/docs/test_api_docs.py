@@ -6,6 +6,7 @@ this module checks that they and the sections are there, for every public object
 
 import inspect
 import re
+from pathlib import Path
 
 import pytest
 
@@ -102,3 +103,11 @@ def test_public_method_is_fully_typed(name):
     ]
     assert not untyped, f"{name}: parameters without a type hint: {untyped}"
     assert sig.return_annotation is not inspect.Signature.empty, f"{name}: no return type"
+
+
+def test_the_api_index_names_every_top_level_name():
+    """The API index's list of the names `import hhscatter` offers is hhscatter.__all__, nothing more or less."""
+    page = (Path(__file__).resolve().parents[2] / "docs" / "api" / "index.md").read_text()
+    listed = page.split("`import hhscatter` is cheap and has no side effects; the top-level names")[1]
+    listed = listed.split("are imported lazily")[0]
+    assert set(re.findall(r"`(\w+)`", listed)) == set(hhscatter.__all__)

@@ -150,7 +150,7 @@ def test_make_system_builtins_and_defaults():
     assert make_system() == HenonHeiles()
     assert make_system("henon_heiles", params={"omega": 1.3, "lam": 0.7}) == HenonHeiles(1.3, 0.7)
     assert make_system("henon_heiles", dissipation="quadratic").dissipation == "quadratic"
-    assert set(BUILTINS) == {"henon_heiles", "n_exit", "contopoulos", "barbanis"}
+    assert {"henon_heiles", "contopoulos", "barbanis"} <= set(BUILTINS)  # the built-ins the studies name
     s = make_system("n_exit", params={"n": 4.0})  # a TOML float that is an integer
     assert s.name == "n_exit" and len(s.exits) == 4
 
@@ -158,7 +158,7 @@ def test_make_system_builtins_and_defaults():
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        ({"name": "henon_heils"}, "unknown built-in 'henon_heils' .*henon_heiles, n_exit, contopoulos, barbanis"),
+        ({"name": "henon_heils"}, "unknown built-in 'henon_heils' .*" + ", ".join(BUILTINS)),
         ({"name": "contopoulos", "params": {"epsilon": 0.2}}, r"unknown parameter\(s\) \['epsilon'\] of 'contopoulos'"),
         ({"name": "contopoulos", "params": {"eps": -1}}, "eps must be a finite number > 0"),
         ({"name": "n_exit", "params": {"n": 2}}, "n must be an integer from 3 to 8"),

@@ -6,33 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from synthetic_operator import BOX, EXTENT, transition_table
 
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.operator_cmeasure import measure_distances
 
-EXTENT = (-1.0, 1.0, -1.0, 1.0)
-
 
 def _result():
-    """16 boxes of side 0.5, 16 samples each: a quarter escapes, a quarter returns into its own box and the rest
-    into the next box (cyclically) at time 2, so every measure is uniform over the 16 box centres."""
-    cell, rank = np.repeat(np.arange(16), 16), np.tile(np.arange(16), 16)
-    nxt = np.where(rank % 4 == 1, cell, (cell + 1) % 16)  # a quarter stays: the operator is aperiodic
-    tab = pd.DataFrame(
-        {
-            "cell": cell,
-            "rank": rank,
-            "w": 1.0,
-            "censored": False,
-            "ret": rank % 4 > 0,
-            "T": 2.0,
-            "t_end": 2.0,
-            "x1": -0.75 + 0.5 * (nxt % 4),
-            "y1": -0.75 + 0.5 * (nxt // 4),
-            "e1": 0.3,
-        }
-    )
-    return uc.energy_results(tab, EXTENT, 0.5, [1], [16], 16, 2, 2, 1, 0.3)
+    """The synthetic table's operator at E = 0.3: every measure is uniform over the 16 box centres."""
+    return uc.energy_results(transition_table(), EXTENT, BOX, [1], [16], 16, 2, 2, 1, 0.3)
 
 
 def _centres(n, energy, rng):

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from synthetic_operator import BOX, EXTENT, KAPPA, transition_table
 
 from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.operator_records import (
@@ -18,34 +19,11 @@ from hhscatter.reproduction.operator_records import (
     probe_islands,
 )
 
-EXACT = math.log(4 / 3) / 2  # a quarter of every box leaves per return of time 2: ¾ e^{2κ} = 1
-
-
-def _samples():
-    """16 boxes of side 0.5 over [−1, 1]², 16 samples each: a quarter escape, a quarter return into their own box,
-    the rest into the next box."""
-    cell, rank = np.repeat(np.arange(16), 16), np.tile(np.arange(16), 16)
-    nxt = np.where(rank % 4 == 1, cell, (cell + 1) % 16)
-    return pd.DataFrame(
-        {
-            "cell": cell,
-            "rank": rank,
-            "w": 1.0,
-            "censored": False,
-            "ret": rank % 4 > 0,
-            "T": 2.0,
-            "t_end": 2.0,
-            "x1": -0.75 + 0.5 * (nxt % 4),
-            "y1": -0.75 + 0.5 * (nxt // 4),
-            "e1": 0.3,
-        }
-    )
-
 
 def _results(energies):
     out = {}
     for E in energies:
-        res = uc.energy_results(_samples(), (-1, 1, -1, 1), 0.5, [1, 2], [4, 16], 16, 3, 2, 1, E)
+        res = uc.energy_results(transition_table(), EXTENT, BOX, [1, 2], [4, 16], 16, 3, 2, 1, E)
         res["islands"] = {"probes": 10, "trapped_boxes": 0}
         res["cut_boxes"] = uc.measure_on_cut_boxes(res, 16)
         out[E] = res
@@ -56,11 +34,11 @@ def _results(energies):
 def test_kappa_records_keep_the_grid_energies_and_mark_the_others_mixed(verdicts):
     res = _results([0.2, 0.3])
     out = kappa_records(
-        res, {0.3: (EXACT, 0.001)}, {}, samples=16, box=0.5, grid_energies=[0.30000000001], verdicts=verdicts
+        res, {0.3: (KAPPA, 0.001)}, {}, samples=16, box=0.5, grid_energies=[0.30000000001], verdicts=verdicts
     )
     assert [r["energy"] for r in out["records"]] == [0.3] and out["results"] is res
     (conv,) = out["convergence"]
-    assert conv["kappa_inf"] == pytest.approx(EXACT, rel=1e-9) and "cut_share" in conv
+    assert conv["kappa_inf"] == pytest.approx(KAPPA, rel=1e-9) and "cut_share" in conv
     assert ("verdict_kappa0" in conv) is verdicts and "residual_kappa0" in conv
     assert [m["energy"] for m in out["mixed"]] == [0.2, 0.3] and out["mixed"][0]["probes"] == 10
     assert out["mixed"][0]["record"]["note"].startswith("mixed phase space") and "record" not in out["mixed"][1]
@@ -80,7 +58,7 @@ def test_kappa_comparisons_only_where_both_numbers_are_there():
 
 
 def test_probe_islands_marks_the_boxes_of_the_censored_probes_only():
-    res = uc.energy_results(_samples(), (-1, 1, -1, 1), 0.5, [1], [16], 16, 0, 1, 1, 0.3)
+    res = uc.energy_results(transition_table(), EXTENT, BOX, [1], [16], 16, 0, 1, 1, 0.3)
     cells = np.arange(16)
     outcomes = np.array(["escaped"] * 16, dtype=object)
     outcomes[[3, 7]] = "censored"

@@ -5,6 +5,7 @@ follow) lists every public function and class it defines, so no assembly is defi
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -33,3 +34,18 @@ def test_every_public_function_and_class_is_declared(path):
 
 def test_the_check_sees_a_name_left_out():
     assert _declared_and_defined('__all__ = ["a"]\ndef a(): ...\ndef b(): ...\n') == ({"a"}, {"a", "b"})
+
+
+def _listed_in_the_package_docstring() -> set[str]:
+    doc = ast.get_docstring(ast.parse((ROOT / "__init__.py").read_text()))
+    listed = set()
+    for line in doc.splitlines():
+        if line.startswith("* "):
+            listed |= set(re.findall(r"``(\w+)``", line.split(" — ")[0]))
+    return listed
+
+
+def test_the_package_docstring_lists_every_module_of_reproduction():
+    modules = {p.stem for p in ROOT.glob("*.py") if p.name != "__init__.py"}
+    modules |= {p.parent.name for p in ROOT.glob("*/__init__.py")}
+    assert _listed_in_the_package_docstring() == modules

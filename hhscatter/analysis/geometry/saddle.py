@@ -210,7 +210,7 @@ def saddle_points(
         _columns(states, "states", columns)
     if not columns:
         raise ConfigError("states has no state column besides traj_id and t")
-    if not (isinstance(t_record_end, (int, float)) and t_record_end > 0):
+    if isinstance(t_record_end, bool) or not (isinstance(t_record_end, (int, float)) and t_record_end > 0):
         raise ConfigError(f"t_record_end must be a time > 0 (inf: recorded to the end), got {t_record_end!r}")
     life = lifetimes
     if "outcome" in life.columns:
@@ -346,6 +346,7 @@ def _box_counting(points, weights, groups, *, divisions, min_boxes, min_occupanc
     min_boxes = _positive(min_boxes, "min_boxes")
     min_occupancy = _positive(min_occupancy, "min_occupancy")
     n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
     if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
         raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
     lo_corner = P.min(axis=0)
@@ -616,6 +617,7 @@ def mean_lyapunov(log_stretch, duration, *, n_boot: int = 1000, seed: int = 0) -
     """
     L, T = _stretch_arrays(log_stretch, duration)
     n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
     value = float(L.sum() / T.sum())
     n = L.size
     if n_boot and n >= 2:
@@ -681,6 +683,8 @@ def lyapunov_convergence(
     """
     L, T = _stretch_arrays(log_stretch, duration)
     n_bins = _count(n_bins, "n_bins", 3)
+    _count(n_boot, "n_boot", 0)
+    _count(seed, "seed", 0)
     edges = np.unique(np.quantile(T, np.linspace(0, 1, n_bins + 1)))
     if edges.size < 4:
         raise ConfigError("duration: fewer than 3 distinct bins of T; the durations must differ between orbits")

@@ -70,8 +70,10 @@ import numpy as np
 import pandas as pd
 from scipy import optimize, stats
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "UncertaintyCutoff",
@@ -239,33 +241,37 @@ class UncertaintyExponent(WithErrors):
 
 def _uncertainty_counts(eps, f, n, eps_range):
     """Validated arrays (eps, f, k, n, mask of eps_range)."""
-    eps = np.asarray(eps, dtype=float).ravel()
-    f = np.asarray(f, dtype=float).ravel()
+    eps = check.numbers(eps, "eps", positive=True)
+    f = check.numbers(f, "f")
     if eps.size != f.size:
-        raise ValueError(f"eps and f differ in length: {eps.size} != {f.size}")
-    if not np.all(np.isfinite(eps)) or np.any(eps <= 0):
-        raise ValueError("eps must be finite and > 0")
-    if not np.all(np.isfinite(f)) or np.any((f < 0) | (f > 1)):
-        raise ValueError("f must be fractions in [0, 1]")
-    n = np.broadcast_to(np.asarray(n, dtype=float), f.shape).astype(float)
-    if np.any(n < 1) or np.any(n != np.round(n)):
-        raise ValueError("n must be whole counts ≥ 1 (initial conditions per ε)")
+        raise ConfigError(f"eps and f differ in length: {eps.size} != {f.size}")
+    if np.any((f < 0) | (f > 1)):
+        raise ConfigError("f must be fractions in [0, 1]")
+    n_given = check.numbers(n, "n", minimum=1.0)
+    if n_given.size not in (1, f.size):
+        raise ConfigError(f"n must be one count or one count per ε: {n_given.size} != {f.size}")
+    n = np.broadcast_to(n_given, f.shape).astype(float)
+    if np.any(n != np.round(n)):
+        raise ConfigError("n must be whole counts ≥ 1 (initial conditions per ε)")
     k = np.round(f * n)
     if np.any(np.abs(f * n - k) > 1e-6 * np.maximum(n, 1.0)):
-        raise ValueError("f·n must be whole counts (f = k/n with the n given)")
+        raise ConfigError("f·n must be whole counts (f = k/n with the n given)")
     if eps_range is None:
         use = np.ones(eps.size, dtype=bool)
     else:
-        lo, hi = (float(v) for v in eps_range)
+        try:
+            lo, hi = (check.number(v, "eps_range") for v in eps_range)
+        except (TypeError, ValueError):
+            raise ConfigError(f"eps_range must be (lo, hi) with 0 < lo < hi, got {eps_range!r}") from None
         if not 0 < lo < hi:
-            raise ValueError(f"eps_range must be (lo, hi) with 0 < lo < hi, got {eps_range!r}")
+            raise ConfigError(f"eps_range must be (lo, hi) with 0 < lo < hi, got {eps_range!r}")
         use = (eps >= lo) & (eps <= hi)
     if np.unique(eps[use]).size < 3:
-        raise ValueError("eps: need at least 3 distinct values of ε in the fitted range")
+        raise ConfigError("eps: need at least 3 distinct values of ε in the fitted range (eps_range)")
     if np.any(k[use] >= n[use]):
-        raise ValueError("f = 1 in the fitted range: saturated, outside the power-law regime; narrow eps_range")
+        raise ConfigError("f = 1 in the fitted range: saturated, outside the power-law regime; narrow eps_range")
     if np.count_nonzero(k[use]) < 2:
-        raise ValueError("f: need at least 2 values of ε with uncertain initial conditions")
+        raise ConfigError("f: need at least 2 values of ε with uncertain initial conditions")
     return eps, f, k, n, use
 
 

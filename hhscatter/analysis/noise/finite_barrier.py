@@ -42,8 +42,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from hhscatter.analysis.noise.kramers import _landscape, hessian, kramers_langer
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "FiniteBarrierFit",
@@ -99,15 +101,13 @@ def finite_barrier_fit(barrier_over_T, ratio, ratio_err) -> FiniteBarrierFit:
     """
     from scipy.stats import chi2 as chi2_dist  # deferred: scipy.stats loads on first use
 
-    b, y, e = (np.asarray(v, dtype=float).ravel() for v in (barrier_over_T, ratio, ratio_err))
+    b = check.numbers(barrier_over_T, "barrier_over_T", min_size=3, positive=True)
+    y = check.numbers(ratio, "ratio")
+    e = check.numbers(ratio_err, "ratio_err", positive=True)
     if not (b.size == y.size == e.size):
-        raise ValueError(
+        raise ConfigError(
             f"barrier_over_T, ratio and ratio_err must have one value each, got {b.size}, {y.size}, {e.size}"
         )
-    if b.size < 3:
-        raise ValueError(f"the fit needs at least 3 barriers (one degree of freedom), got {b.size}")
-    if not (np.all(np.isfinite(b) & (b > 0)) and np.all(np.isfinite(y)) and np.all(np.isfinite(e) & (e > 0))):
-        raise ValueError("barrier_over_T and ratio_err must be finite and > 0, ratio finite")
     x = 1.0 / b
     w = 1.0 / e**2
     free = weighted_least_squares(np.column_stack([np.ones_like(x), x]), y, w)
@@ -168,20 +168,25 @@ def laplace_coefficient(model, x: float = 0.0, y: float = 0.0, direction=None) -
     >>> round(laplace_coefficient(HenonHeiles()), 12), round(laplace_coefficient(HenonHeiles(), 0, 1, (1, 0)), 12)
     (1.333333333333, 0.0)
     """
-    d3, d4 = _tensors(model, float(x), float(y))
-    h = hessian(model, float(x), float(y))
+    check.system(model)
+    x, y = check.number(x, "x"), check.number(y, "y")
     if direction is not None:
-        e = np.asarray(direction, dtype=float)
+        e = check.numbers(direction, "direction")
         if e.shape != (2,) or not math.isclose(float(e @ e), 1.0, rel_tol=1e-9):
-            raise ValueError(f"direction must be a unit vector (2 components), got {direction!r}")
+            raise ConfigError(f"direction must be a unit vector (2 components), got {direction!r}")
+    d3, d4 = _tensors(model, x, y)
+    h = hessian(model, x, y)
+    if direction is not None:
         f2 = float(e @ h @ e)
         if not f2 > 0:
-            raise ValueError(f"V is not convex along {tuple(e)} at ({x:g}, {y:g}): f'' = {f2:g}")
+            raise ConfigError(f"direction: V is not convex along {tuple(e)} at ({x:g}, {y:g}): f'' = {f2:g}")
         f3 = float(np.einsum("ijk,i,j,k->", d3, e, e, e))
         f4 = float(np.einsum("ijkl,i,j,k,l->", d4, e, e, e, e))
         return -f4 / (8 * f2 * f2) + 5 * f3 * f3 / (24 * f2**3)
     if not np.all(np.linalg.eigvalsh(h) > 0):
-        raise ValueError(f"({x:g}, {y:g}) is not a minimum of V (Hessian eigenvalues {np.linalg.eigvalsh(h)})")
+        raise ConfigError(
+            f"(x, y) = ({x:g}, {y:g}) is not a minimum of V (Hessian eigenvalues {np.linalg.eigvalsh(h)})"
+        )
     g = np.linalg.inv(h)
     a4 = np.einsum("ijkl,ij,kl->", d4, g, g)
     a33 = np.einsum("ijk,lmn,ij,kl,mn->", d3, d3, g, g, g)
@@ -215,6 +220,7 @@ def transition_state_correction(model) -> TransitionStateCorrection:
     >>> round(c.slope, 12), round(-2 / 9, 12), c.lowest
     (-0.222222222222, -0.222222222222, (0, 1, 2))
     """
+    check.system(model)
     a_well = laplace_coefficient(model)
     kl = kramers_langer(model, 1.0, 1.0)
     a_s = []

@@ -22,9 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import BoundedFraction, fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured, WithErrors
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "KramersLanger",
@@ -136,6 +138,7 @@ def well_barrier(model) -> float:
     >>> well_barrier(HenonHeiles()) == 1 / 6
     True
     """
+    check.system(model)
     return model.critical_energy - float(model.potential(np.array(0.0), np.array(0.0)))
 
 
@@ -278,6 +281,9 @@ def window_constancy(rate: ThermalRate, z_max: float) -> WindowConstancy:
     >>> c.second.to_dict()
     {'value': 0.008, 'err': 0.004}
     """
+    if not isinstance(rate, ThermalRate):
+        raise ConfigError(f"rate must be a ThermalRate (thermal_rate's result), got {type(rate).__name__}")
+    z_max = check.number(z_max, "z_max", positive=True)
     (k1, e1), (k2, e2) = rate.halves
     first, second = Measured(k1, e1, rate.method), Measured(k2, e2, rate.method)
     z = second.z(k1, e1) if e1 > 0 and e2 > 0 else math.nan
@@ -305,8 +311,16 @@ def exit_fractions(t_end, escaped, exit_channel, t_start: float, t_stop: float, 
     >>> [x.value for x in f], round(f[0].err, 4), round(f[2].upper, 4)     # √(0.6 · 0.4 / 5); 1 − 0.05^(1/5)
     ([0.6, 0.4, 0.0], 0.2191, 0.4507)
     """
-    t_end = np.asarray(t_end, dtype=float)
-    inside = np.asarray(escaped, dtype=bool) & (t_end > t_start) & (t_end <= t_stop)
-    channel = np.asarray(exit_channel)[inside]
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    escaped = check.mask(escaped, "escaped", t_end.size)
+    t_start, t_stop = check.window(t_start, t_stop)
+    n_exits = check.count(n_exits, "n_exits", 1)
+    exit_channel = np.asarray(exit_channel).ravel()
+    if exit_channel.size != t_end.size:
+        raise ConfigError(f"exit_channel must have one value per orbit: {exit_channel.size} != {t_end.size}")
+    inside = escaped & (t_end > t_start) & (t_end <= t_stop)
+    channel = exit_channel[inside]
+    if channel.dtype.kind not in "iuf" or not np.all(np.isin(channel, np.arange(n_exits))):
+        raise ConfigError(f"exit_channel of an escape in the window must be an exit 0 … {n_exits - 1}")
     n = max(int(inside.sum()), 1)
     return [fraction_with_bound(int(np.count_nonzero(channel == i)), n) for i in range(n_exits)]

@@ -13,8 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = ["SurvivorEnergies", "noise_energy_gain", "survivor_energies"]
 
@@ -64,16 +66,11 @@ def survivor_energies(energies, threshold: float, quantiles=(0.1, 0.5, 0.9)) -> 
     >>> t.below, t.below_err, round(t.below_upper, 5)
     (0.0, None, 0.00744)
     """
-    e = np.asarray(energies, dtype=float).ravel()
-    if e.size < 2:
-        raise ValueError(f"energies: need at least 2 survivors, got {e.size}")
-    if not np.all(np.isfinite(e)):
-        raise ValueError("energies must be finite")
-    if not math.isfinite(threshold):
-        raise ValueError(f"threshold must be a finite energy, got {threshold!r}")
-    qs = tuple(float(q) for q in quantiles)
+    e = check.numbers(energies, "energies", min_size=2)
+    threshold = check.number(threshold, "threshold")
+    qs = tuple(check.numbers(quantiles, "quantiles").tolist())
     if not all(0 < q < 1 for q in qs):
-        raise ValueError(f"quantiles must lie in (0, 1), got {quantiles!r}")
+        raise ConfigError(f"quantiles must lie in (0, 1), got {quantiles!r}")
     sd = float(e.std(ddof=1))
     f = fraction_with_bound(int(np.count_nonzero(e < threshold)), e.size)
     return SurvivorEnergies(
@@ -102,4 +99,14 @@ def noise_energy_gain(sigma, t):
     >>> noise_energy_gain(np.array([0.0, 0.1]), 50.0).tolist()
     [0.0, 0.5000000000000001]
     """
+    sigma, t = (
+        np.reshape(check.numbers(v, name, minimum=0.0), np.shape(v))
+        if np.ndim(v)
+        else check.number(v, name, minimum=0.0)
+        for v, name in ((sigma, "sigma"), (t, "t"))
+    )
+    try:
+        np.broadcast_shapes(np.shape(sigma), np.shape(t))
+    except ValueError:
+        raise ConfigError(f"sigma and t must broadcast, got shapes {np.shape(sigma)} and {np.shape(t)}") from None
     return sigma * sigma * t

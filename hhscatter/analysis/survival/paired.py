@@ -20,9 +20,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.kaplan_meier import survival_curve
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "PairedRatio",
@@ -233,24 +235,25 @@ def paired_bootstrap_ratio(
     >>> round(r.shift, 4), r.shift_err < 1e-9 < r.shift_err_unpaired
     (0.1111, True)
     """
-    t_ref = np.asarray(t_ref, dtype=float).ravel()
-    t_alt = np.asarray(t_alt, dtype=float).ravel()
-    observed_ref = np.asarray(observed_ref, dtype=bool).ravel()
-    observed_alt = np.asarray(observed_alt, dtype=bool).ravel()
+    t_ref = check.numbers(t_ref, "t_ref", min_size=2, minimum=0.0)
     n = t_ref.size
-    if not (t_alt.size == n and observed_ref.size == n and observed_alt.size == n):
-        raise ValueError("paired samples must have the same length (one entry per orbit)")
-    if n < 2:
-        raise ValueError(f"need at least 2 orbits, got {n}")
-    if int(n_boot) < 2:
-        raise ValueError(f"n_boot must be ≥ 2, got {n_boot}")
+    t_alt = check.numbers(t_alt, "t_alt", minimum=0.0)
+    if t_alt.size != n:
+        raise ConfigError(
+            f"t_alt must have the same length as t_ref (paired samples, one entry per orbit): {t_alt.size} != {n}"
+        )
+    observed_ref = check.mask(observed_ref, "observed_ref", n)
+    observed_alt = check.mask(observed_alt, "observed_alt", n)
+    check.function(estimator, "estimator")
+    n_boot = check.count(n_boot, "n_boot", 2)
+    check.count(seed, "seed", 0)
     k0 = float(estimator(t_ref, observed_ref))
     k1 = float(estimator(t_alt, observed_alt))
     if not (math.isfinite(k0) and k0 != 0 and math.isfinite(k1)):
-        raise ValueError(f"the estimator gives κ_ref = {k0:g}, κ_alt = {k1:g} on the full samples: no ratio")
+        raise ConfigError(f"estimator gives κ_ref = {k0:g}, κ_alt = {k1:g} on the full samples: no ratio")
     rng = np.random.default_rng(seed)
     reps, failed = [], 0
-    for _ in range(int(n_boot)):
+    for _ in range(n_boot):
         i = rng.integers(0, n, n)
         try:
             reps.append((float(estimator(t_ref[i], observed_ref[i])), float(estimator(t_alt[i], observed_alt[i]))))

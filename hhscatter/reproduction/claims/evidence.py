@@ -34,6 +34,7 @@ import numpy as np
 from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
 from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.analysis.stats.intervals import fraction_with_bound
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
     hazard_profile,
@@ -275,7 +276,9 @@ def validity_map(
         if k:
             row = k[0]
             kap = {
-                "kappa0": {"value": _finite(row.get("kappa")), "err": _finite(row.get("kappa_err"))},
+                "kappa0": Measured.of(
+                    _finite(row.get("kappa")), _finite(row.get("kappa_err")), n=row.get("n")
+                ).to_dict(),
                 "kappa0_n": row.get("n"),
                 "kappa0_source": row.get("source", "claims"),
                 "trapped_fraction": _finite(row.get("trapped_fraction")),

@@ -181,7 +181,7 @@ def resc_kappa_rows(runs, systems, *, n_boot: int | None = None, seed: int = 0) 
                             f"at r_esc = {x:.3g}: {w}" for x, w in ((row["r_esc_default"], why0), (R, why)) if w
                         )
                         row.update(
-                            shift={"value": None, "err": None},
+                            shift=Measured.of(None, None).to_dict(),
                             shift_err_unpaired=None,
                             correlation=None,
                             verdict=f"undetermined: κ0 ill-defined {where}",

@@ -3,8 +3,10 @@ against a Monte-Carlo sample of independent Gaussian inputs."""
 
 from __future__ import annotations
 
+import ast
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,6 +29,28 @@ def test_the_json_writer_writes_a_measured_as_the_literal_dict(tmp_path):
     write_json_atomic(b, {"mu": {"value": 0.93, "err": float("nan")}, "k": [{"value": 1.0, "err": 0.1}]})
     assert a.read_bytes() == b.read_bytes()
     assert json.loads(a.read_text())["mu"] == {"value": 0.93, "err": None}
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _value_err_literals(path: Path) -> list[str]:
+    """Dict displays of ``path`` whose keys are exactly "value" and "err": a number with its error written by hand."""
+    hits = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Dict) and len(node.keys) == 2:
+            if {getattr(k, "value", None) for k in node.keys} == {"value", "err"}:
+                hits.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    return hits
+
+
+def test_product_code_writes_a_value_with_its_error_as_a_measured():
+    # Measured.to_dict is the one place that spells the shape; records with more fields (table rows) are not counted
+    files = sorted((ROOT / "hhscatter").rglob("*.py")) + sorted((ROOT / "studies").rglob("*.py"))
+    hits = [h for f in files for h in _value_err_literals(f)]
+    own = [h for h in hits if h.startswith("hhscatter/analysis/stats/measured.py:")]
+    assert len(own) == 1, own
+    assert [h for h in hits if h not in own] == []
 
 
 def test_is_frozen():

@@ -1,0 +1,96 @@
+"""Checks of an estimator's arguments, run before any work: each refuses with a ConfigError naming the argument.
+
+>>> numbers([1.0, 2.0], "t_end").tolist()
+[1.0, 2.0]
+>>> numbers([1.0, float("nan")], "t_end")
+Traceback (most recent call last):
+...
+hhscatter.errors.ConfigError: t_end must be finite (no NaN or inf)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from hhscatter.errors import ConfigError
+
+
+def numbers(a, name: str, *, min_size: int = 1, minimum: float | None = None, positive: bool = False) -> np.ndarray:
+    """``a`` as a 1-D float array of finite numbers (at least ``min_size``; ≥ ``minimum``, or > 0 if ``positive``)."""
+    if isinstance(a, (str, bytes, dict)) or a is None:
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
+    try:
+        arr = np.asarray(a)
+        if arr.dtype == bool or arr.dtype.kind not in "iuf":
+            raise TypeError
+        arr = arr.astype(float).ravel()
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+    if arr.size < min_size:
+        raise ConfigError(f"{name} must hold at least {min_size} value(s), got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ConfigError(f"{name} must be finite (no NaN or inf)")
+    if positive and not np.all(arr > 0):
+        raise ConfigError(f"{name} must be > 0")
+    if minimum is not None and not np.all(arr >= minimum):
+        raise ConfigError(f"{name} must be ≥ {minimum:g}")
+    return arr
+
+
+def mask(a, name: str, size: int) -> np.ndarray:
+    """``a`` as a 1-D boolean array of ``size`` values (booleans, or 0/1)."""
+    if isinstance(a, (str, bytes, dict)) or a is None:
+        raise ConfigError(f"{name} must be a boolean mask, got {type(a).__name__}")
+    arr = np.asarray(a).ravel()
+    if arr.dtype != bool:
+        if arr.dtype.kind not in "iuf" or not np.all(np.isin(arr, (0, 1))):
+            raise ConfigError(f"{name} must be a boolean mask (True/False or 1/0)")
+        arr = arr.astype(bool)
+    if arr.size != size:
+        raise ConfigError(f"{name} must have one value per orbit: {arr.size} != {size}")
+    return arr
+
+
+def number(v, name: str, *, minimum: float | None = None, positive: bool = False) -> float:
+    """``v`` as a finite float (≥ ``minimum``, or > 0 if ``positive``)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+        raise ConfigError(f"{name} must be a finite number, got {v!r}")
+    if positive and not v > 0:
+        raise ConfigError(f"{name} must be > 0, got {v!r}")
+    if minimum is not None and not v >= minimum:
+        raise ConfigError(f"{name} must be ≥ {minimum:g}, got {v!r}")
+    return float(v)
+
+
+def count(v, name: str, minimum: int) -> int:
+    """``v`` as an int ≥ ``minimum`` (an integer, not a bool or a float)."""
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < minimum:
+        raise ConfigError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
+    return int(v)
+
+
+def window(t_start, t_stop, names: tuple[str, str] = ("t_start", "t_stop")) -> tuple[float, float]:
+    """(t_start, t_stop) as finite times with 0 ≤ t_start < t_stop."""
+    a, b = number(t_start, names[0], minimum=0.0), number(t_stop, names[1])
+    if not a < b:
+        raise ConfigError(f"{names[0]} < {names[1]} is needed, got {a!r} and {b!r}")
+    return a, b
+
+
+def function(f, name: str) -> Callable:
+    """``f`` if it can be called."""
+    if not callable(f):
+        raise ConfigError(f"{name} must be a function, got {type(f).__name__}")
+    return f
+
+
+def system(model, name: str = "model"):
+    """``model`` if it is a :class:`~hhscatter.model.base.System`."""
+    from hhscatter.model.base import System  # deferred: the model loads only for the estimators that take one
+
+    if not isinstance(model, System):
+        raise ConfigError(f"{name} must be a System (hhscatter.model), got {type(model).__name__}")
+    return model

@@ -1,0 +1,283 @@
+"""Bad arguments to the estimators of the paired bootstrap, the noise studies and the chaotic saddle (hypothesis).
+
+Each call gets one argument replaced by a wrong thing (a wrong type, NaN, a negative time or count, an empty array,
+a mismatched length, a window outside the data) and must refuse with a ConfigError that names that argument,
+before any work. The profile is bounded and derandomized, as in tests/api/test_properties.py.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from hhscatter.analysis.geometry import saddle
+from hhscatter.analysis.noise import (
+    exit_fractions,
+    finite_barrier_fit,
+    laplace_coefficient,
+    noise_energy_gain,
+    survivor_energies,
+    thermal_rate,
+    transition_state_correction,
+    well_barrier,
+    window_constancy,
+)
+from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
+from hhscatter.errors import ConfigError
+from hhscatter.model import HenonHeiles
+
+PROFILE = settings(
+    max_examples=15,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+
+#: what is no array of numbers at all
+NOT_NUMBERS = st.one_of(
+    st.none(), st.booleans(), st.text(max_size=4), st.dictionaries(st.text(max_size=2), st.integers(), max_size=2)
+)
+#: what is no finite number
+NOT_A_NUMBER = st.one_of(
+    st.none(), st.booleans(), st.text(max_size=4), st.sampled_from([math.nan, math.inf, -math.inf]), st.just([1.0])
+)
+N = 12
+T = np.linspace(1.0, 12.0, N)
+OBS = np.arange(N) % 3 > 0
+
+
+def _mle(t, obs):
+    return obs.sum() / t.sum()
+
+
+def _bad_array(draw, good: np.ndarray, *, negative=True):
+    """A wrong thing in place of the numbers array ``good``: no numbers, empty, NaN/inf, negative, or one short."""
+    how = draw(st.sampled_from(["junk", "empty", "nan", "inf", "short"] + (["negative"] if negative else [])))
+    if how == "junk":
+        return draw(NOT_NUMBERS)
+    if how == "empty":
+        return np.array([])
+    if how == "short":
+        return good[:-1]
+    bad = good.astype(float).copy()
+    bad[draw(st.integers(0, good.size - 1))] = {"nan": math.nan, "inf": math.inf, "negative": -1.0}[how]
+    return bad
+
+
+def _refused(name, f, *args, **kwargs):
+    with pytest.raises(ConfigError, match=name):
+        f(*args, **kwargs)
+
+
+# -- paired bootstrap ---------------------------------------------------------------------------------------------
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["t_ref", "t_alt", "observed_ref", "observed_alt", "n_boot", "seed"]))
+def test_paired_bootstrap_ratio_names_the_bad_argument(data, which):
+    args = {"t_ref": T, "observed_ref": OBS, "t_alt": 0.9 * T, "observed_alt": OBS, "n_boot": 10, "seed": 0}
+    if which.startswith("t_"):
+        args[which] = _bad_array(data.draw, T)
+    elif which.startswith("observed"):
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 0.5))))
+    else:
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers(-5, 1 if which == "n_boot" else -1), st.just(2.5)))
+    kw = {k: args.pop(k) for k in ("n_boot", "seed")}
+    _refused(which, paired_bootstrap_ratio, args["t_ref"], args["observed_ref"], args["t_alt"], args["observed_alt"],
+             _mle, **kw)  # fmt: skip
+
+
+@PROFILE
+@given(f=st.one_of(NOT_A_NUMBER, st.integers()))
+def test_paired_bootstrap_ratio_needs_a_function(f):
+    _refused("estimator", paired_bootstrap_ratio, T, OBS, T, OBS, f)
+
+
+# -- noise --------------------------------------------------------------------------------------------------------
+X = np.array([4.0, 6.0, 8.0, 10.0])
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["barrier_over_T", "ratio", "ratio_err"]))
+def test_finite_barrier_fit_names_the_bad_argument(data, which):
+    args = {"barrier_over_T": X, "ratio": 1 - 0.2 / X, "ratio_err": np.full(4, 0.01)}
+    args[which] = _bad_array(data.draw, args[which], negative=which != "ratio")
+    _refused("barrier_over_T|ratio|ratio_err" if str(args[which]) == str(X[:-1]) else which, finite_barrier_fit,
+             **args)  # fmt: skip
+
+
+@PROFILE
+@given(model=st.one_of(NOT_A_NUMBER, st.integers(), st.just(object())))
+def test_the_noise_estimators_of_a_system_refuse_what_is_no_system(model):
+    for f in (well_barrier, transition_state_correction, laplace_coefficient):
+        _refused("model", f, model)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["x", "y", "direction"]))
+def test_laplace_coefficient_names_the_bad_point_or_direction(data, which):
+    kw = {which: data.draw(NOT_A_NUMBER if which != "direction" else st.one_of(NOT_NUMBERS, st.just([1.0, 1.0])))}
+    if which == "direction" and kw[which] is None:
+        return  # None is the default: the plane
+    _refused(which, laplace_coefficient, HenonHeiles(), **kw)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["energies", "threshold", "quantiles"]))
+def test_survivor_energies_names_the_bad_argument(data, which):
+    args = {"energies": np.linspace(0.1, 0.2, 10), "threshold": 0.15, "quantiles": (0.1, 0.5)}
+    if which == "energies":
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(np.array([0.1])), st.just(np.array([0.1, math.nan]))))
+    elif which == "threshold":
+        args[which] = data.draw(NOT_A_NUMBER)
+    else:
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just((0.0, 0.5)), st.just((0.5, 1.5))))
+    _refused(which, survivor_energies, **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["sigma", "t"]))
+def test_noise_energy_gain_names_the_bad_argument(data, which):
+    args = {"sigma": 0.02, "t": np.array([10.0, 20.0])}
+    bad = st.one_of(NOT_NUMBERS, st.sampled_from([math.nan, math.inf, -1.0]), st.just(np.array([1.0, math.nan])))
+    args[which] = data.draw(bad)
+    _refused(which, noise_energy_gain, **args)
+
+
+def test_noise_energy_gain_refuses_shapes_that_do_not_broadcast():
+    _refused("sigma and t", noise_energy_gain, np.ones(2), np.ones(3))
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["rate", "z_max"]))
+def test_window_constancy_names_the_bad_argument(data, which):
+    args = {"rate": thermal_rate(T, OBS, 0.0, 12.0), "z_max": 2.0}
+    args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-2.0), st.just(0.0)))
+    _refused(which, window_constancy, **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["t_end", "escaped", "exit_channel", "t_start", "t_stop", "n_exits"]))
+def test_exit_fractions_names_the_bad_argument(data, which):
+    args = {"t_end": T, "escaped": OBS, "exit_channel": np.arange(N) % 3, "t_start": 0.0, "t_stop": 12.0, "n_exits": 3}
+    if which == "t_end":
+        args[which] = _bad_array(data.draw, T)
+    elif which == "escaped":
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 2))))
+    elif which == "exit_channel":
+        args[which] = data.draw(st.sampled_from([np.arange(N - 1) % 3, np.full(N, 5), np.full(N, "a")]))
+    elif which == "n_exits":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers(-3, 0), st.just(2.5)))
+    elif which == "t_start":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0), st.just(12.0), st.just(20.0)))
+    else:
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(0.0)))
+    _refused("t_start" if which == "t_stop" and isinstance(args[which], float) and math.isfinite(args[which])
+             else which, exit_fractions, **args)  # fmt: skip
+
+
+# -- the chaotic saddle -------------------------------------------------------------------------------------------
+L = np.linspace(1.0, 40.0, 40)
+D = np.linspace(2.0, 80.0, 40)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["log_stretch", "duration", "n_boot", "seed"]))
+def test_mean_lyapunov_and_its_convergence_name_the_bad_argument(data, which):
+    args = {"log_stretch": L, "duration": D, "n_boot": 20, "seed": 0}
+    if which in ("log_stretch", "duration"):
+        args[which] = _bad_array(data.draw, args[which], negative=which == "duration")
+    else:
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers(-5, -1), st.just(2.5)))
+    kw = {k: args.pop(k) for k in ("n_boot", "seed")}
+    names = "log_stretch and duration" if which in ("log_stretch", "duration") else which
+    for f in (saddle.mean_lyapunov, saddle.lyapunov_convergence):
+        with pytest.raises(ConfigError, match=f"{which}|{names}"):
+            f(args["log_stretch"], args["duration"], **kw)
+
+
+P = np.random.default_rng(0).random((400, 2))
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["points", "weights", "groups", "min_boxes", "eps_min", "n_boot"]))
+def test_the_box_counting_dimensions_name_the_bad_argument(data, which):
+    kw = {"n_boot": 5}
+    if which == "points":
+        pts = data.draw(st.one_of(NOT_NUMBERS, st.just(np.empty((0, 2))), st.just(np.full((4, 2), math.nan))))
+    else:
+        pts = P
+        kw[which] = data.draw(
+            {
+                "weights": st.one_of(NOT_NUMBERS, st.just(np.ones(399)), st.just(-np.ones(400))),
+                "groups": st.just(np.zeros(399)),
+                "min_boxes": st.one_of(NOT_A_NUMBER, st.integers(-3, 1), st.just(2.5)),
+                "eps_min": st.one_of(NOT_A_NUMBER, st.just(-1.0)),
+                "n_boot": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+            }[which]
+        )
+    fs = [saddle.information_dimension] + ([saddle.capacity_dimension] if which != "weights" else [])
+    for f in fs:
+        with pytest.raises(ConfigError, match=which):
+            f(pts, **kw)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["eps", "f", "n", "eps_range"]))
+def test_dimension_from_uncertainty_names_the_bad_argument(data, which):
+    eps = np.logspace(-6, -2, 9)
+    args = {"eps": eps, "f": np.round(300 * eps**0.2) / 1000, "n": np.full(9, 1000), "eps_range": None}
+    if which == "eps_range":
+        bad = st.one_of(NOT_A_NUMBER, st.just((1e-2, 1e-6)), st.just((1.0, 2.0)))
+        args[which] = data.draw(bad.filter(lambda v: v is not None))  # None is the default: every ε
+    else:
+        args[which] = _bad_array(data.draw, np.asarray(args[which], dtype=float))
+    _refused(which, saddle.dimension_from_uncertainty, args["eps"], args["f"], args["n"], eps_range=args["eps_range"])
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["kappa", "kappa_err", "lyapunov", "lyapunov_err", "d1", "d1_err"]))
+def test_kantz_grassberger_names_the_bad_argument(data, which):
+    args = {"kappa": 0.1, "kappa_err": 0.01, "lyapunov": 0.5, "lyapunov_err": 0.02, "d1": 0.8, "d1_err": 0.05}
+    args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0)) if which.endswith("err") else NOT_A_NUMBER)
+    _refused(which, saddle.kantz_grassberger, *args.values())
+
+
+LT = pd.DataFrame({"traj_id": np.arange(4), "t_end": [10.0, 20.0, 30.0, 40.0], "outcome": "escaped"})
+STATES = pd.DataFrame({"traj_id": np.repeat(np.arange(4), 5), "t": np.tile(np.linspace(0, 40, 5), 4), "x": 0.1,
+                       "y": 0.2})  # fmt: skip
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["lifetimes", "states", "t_min", "window", "t_record_end"]))
+def test_saddle_points_names_the_bad_argument(data, which):
+    args = {"lifetimes": LT, "states": STATES, "t_min": 5.0, "window": (0.25, 0.75), "t_record_end": math.inf}
+    args[which] = data.draw(
+        {
+            "lifetimes": st.one_of(NOT_NUMBERS, st.just(LT.drop(columns="t_end"))),
+            "states": st.one_of(NOT_NUMBERS, st.just(STATES.drop(columns="t"))),
+            "t_min": st.one_of(NOT_A_NUMBER, st.just(-1.0), st.just(0.0)),
+            "window": st.one_of(NOT_A_NUMBER, st.just((0.75, 0.25)), st.just((-0.5, 0.5)), st.just((0.5, 1.5))),
+            "t_record_end": st.one_of(st.none(), st.booleans(), st.text(max_size=3), st.just(-1.0), st.just(0.0)),
+        }[which]
+    )
+    _refused(which, saddle.saddle_points, args.pop("lifetimes"), args.pop("states"), **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["estimator", "t_mins", "windows"]))
+def test_window_dependence_names_the_bad_argument(data, which):
+    args = {"estimator": lambda sp: (1.0, 0.1), "t_mins": [5.0], "windows": [(0.25, 0.75)]}
+    args[which] = data.draw(
+        {
+            "estimator": st.one_of(NOT_A_NUMBER, st.integers()),
+            "t_mins": st.one_of(st.just([]), st.just([-1.0]), st.just([math.nan])),
+            "windows": st.one_of(st.just([]), st.just([(0.75, 0.25)]), st.just([(0.5, 1.5)])),
+        }[which]
+    )
+    _refused(which if which != "windows" or args[which] == [] else "window", saddle.window_dependence, LT, STATES,
+             **args)  # fmt: skip
