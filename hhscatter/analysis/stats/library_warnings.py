@@ -16,16 +16,33 @@ Examples
 >>> warning_counts()
 [{'where': 'example.fit', 'category': 'RuntimeWarning', 'message': 'covariance could not be estimated', 'count': 2}]
 >>> reset_warning_counts()
+
+A message that names a file keeps the file's name, not the folders it lies in (the tally goes into a committed
+JSON; where the machine keeps its runs is not a result):
+
+>>> with counted("example.read"):
+...     warnings.warn("nothing matched in the table of /data/me/studies/out/raw/E0.30_r1.5 (its points: E = 0.3)")
+>>> warning_counts()[0]["message"]
+'nothing matched in the table of E0.30_r1.5 (its points: E = 0.3)'
+>>> reset_warning_counts()
 """
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections import Counter
 from contextlib import contextmanager
 
 _COUNTS: Counter = Counter()
 _MESSAGE_CHARS = 200  # a message is kept to its first line, at most this many characters
+# an absolute path (POSIX or Windows) in a message: the folders before its last component are dropped
+_FOLDERS = re.compile(r"(?:(?<![\w.])/|\b[A-Za-z]:[\\/])(?:[^\s/\\'\"()]+[/\\])+(?=[^\s/\\'\"()])")
+
+
+def _without_folders(text: str) -> str:
+    """``text`` with every absolute path reduced to its last component."""
+    return _FOLDERS.sub("", text)
 
 
 @contextmanager
@@ -39,7 +56,7 @@ def counted(where: str):
             yield
         finally:
             for w in caught:
-                text = str(w.message).strip()
+                text = _without_folders(str(w.message).strip())
                 _COUNTS[(where, w.category.__name__, text.splitlines()[0][:_MESSAGE_CHARS] if text else "")] += 1
 
 
