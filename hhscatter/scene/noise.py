@@ -52,10 +52,10 @@ class Noise:
     p ← e^{−γδ} p + √(T(1 − e^{−2γδ})) ξ (σ√δ ξ without drag), δ = h/2. Both parts preserve the Boltzmann
     density e^{−H/T} exactly, so the invariant measure carries no splitting error at any h; dynamical
     quantities (escape rates) carry a weak error O(h²). Measured (``make bench``, ``benchmarks/noise_rate.py``:
-    Hénon–Heiles, γ = 1, ΔE/T = 3, the rate on [20, 150] against a compiled BAOAB at dt = 0.02 with 240 000
-    orbits): the rate's bias is +1.5 % ± 0.4 % at h = 0.5, +0.8 % ± 0.7 % at h = 0.2 and −1.6 % ± 1.5 % at
-    the default h = 0.1 (the h² law from h = 0.5 gives ≈ +0.1 % there); with ``flow = "symplectic"`` +3.8 % ±
-    0.4 % at h = 0.5, +1.1 % ± 0.4 % at h = 0.25, +0.6 % ± 0.4 % at h = 0.2 and +0.3 % ± 0.4 % at the default
+    Hénon–Heiles, γ = 1, ΔE/T = 3, the rate on [20, 150] against a compiled BAOAB at dt = 0.02 with 480 000
+    orbits): the rate's bias is +1.4 % ± 0.4 % at h = 0.5, +0.6 % ± 0.7 % at h = 0.2 and −1.8 % ± 1.5 % at
+    the default h = 0.1 (the h² law from h = 0.5 gives ≈ +0.1 % there); with ``flow = "symplectic"`` +3.7 % ±
+    0.4 % at h = 0.5, +1.0 % ± 0.4 % at h = 0.25, +0.4 % ± 0.3 % at h = 0.2 and +0.3 % ± 0.3 % at the default
     h = 0.1 (≈ 15 h² %).
 
     Parameters
