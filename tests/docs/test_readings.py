@@ -442,6 +442,8 @@ def test_the_two_saddle_turnover_reading_compares_each_end_with_its_limit():
     assert "share of the theory's sum is 0.200 at γ = 0.01 and 0.050 at 3 (its δ_s = 0.3 at γ = 0.01" in text
     empty = READINGS["noise.saddles_turnover"](_loader({"noise": {}}))
     assert empty == "the two-saddle system's turnover is not in this scale's numbers"
+
+
 def test_kappa_over_alpha_against_the_decision_rate_by_energy():
     """κ/α within 2σ (the 1σ of both combined) of λ or not, energy by energy; an energy without κ/α is left out."""
     from hhscatter.publish.readings import reading
