@@ -32,11 +32,49 @@ def test_the_results_block_is_what_the_committed_json_renders():
     assert tool.current(README.read_text(), tool.render()), "README.md is stale: run python tools/readme_results.py"
 
 
+def test_the_targets_table_is_what_the_study_folders_render():
+    """A row per study folder from its [about] and its cost record: a study folder added, or a cost record re-made,
+    leaves the README stale until the tool runs."""
+    tool = _tool()
+    block = tool.render_targets()
+    assert tool.current(README.read_text(), block), "README.md is stale: run python tools/readme_results.py"
+    studies = sorted(p.parent.name for p in (ROOT / "studies").glob("*/study.toml"))
+    assert sorted(re.findall(r"^\| `make (\w+)` \|", block, flags=re.M)) == sorted([*studies, "studies"])
+
+
+def test_a_new_study_folder_is_a_new_row(tmp_path):
+    """The table is read from the folders: a copy of the tree with one more study gets one more row, with its
+    title, summary and CPU minutes, and a total that includes it."""
+    import json
+    import shutil
+
+    tool = _tool()
+    shutil.copytree(ROOT / "studies", tmp_path / "studies", ignore=shutil.ignore_patterns("out"))
+    shutil.copytree(ROOT / "docs" / "studies" / "assets", tmp_path / "docs" / "studies" / "assets",
+                    ignore=shutil.ignore_patterns("*.png", "paper"))  # fmt: skip
+    (tmp_path / "hhscatter").symlink_to(ROOT / "hhscatter")
+    new = tmp_path / "studies" / "zeta"
+    new.mkdir()
+    (new / "study.toml").write_text('[about]\ntitle = "Zeta"\npaper = ""\nsummary = "a check of its own"\n')
+    run = {"stage": "simulate", "wall_s": 90.0, "cpu_s": 90.0, "orbits": 1, "rss_self_mb": 1.0, "rss_children_mb": 1.0}
+    cost = {"simulate": [run], "analyze": []}
+    (tmp_path / "docs" / "studies" / "assets" / "zeta.cost.json").write_text(json.dumps(cost))
+    before, after = tool.render_targets(ROOT), tool.render_targets(tmp_path)
+    assert "| `make zeta` | beyond the paper: Zeta — a check of its own | 1.5 |" in after
+
+    def total(block):
+        return float(re.search(r"^\| `make studies` \|[^\n]*\| ([0-9.]+) \|$", block, flags=re.M).group(1))
+
+    assert abs(total(after) - total(before) - 1.5) <= 0.051  # each total rounded to 0.1
+
+
 def test_outside_its_generated_block_the_readme_types_no_undeclared_number():
     tool = _tool()
     text = README.read_text()
-    i, j = text.index(tool.BEGIN), text.index(tool.END)
-    rest = text[:i] + "\n" * text[i:j].count("\n") + text[j:]
+    for begin, end in ((tool.BEGIN, tool.END), (tool.TARGETS_BEGIN, tool.TARGETS_END)):
+        i, j = text.index(begin), text.index(end)
+        text = text[:i] + "\n" * text[i:j].count("\n") + text[j:]
+    rest = text
     studies = sorted(p.parent.name for p in (ROOT / "studies").glob("*/page.md"))
     allowed = set().union(*(nb.study_conventions(ROOT, s) for s in studies))
     assert nb.stray_numbers(rest, allowed) == []
