@@ -5,19 +5,10 @@ import json
 import re
 from pathlib import Path
 
+from strings_of import json_strings
+
 ASSETS = Path(__file__).resolve().parents[2] / "docs" / "studies" / "assets"
 ABSOLUTE = re.compile(r"(?:^|[\s'\"(=])(?:/[\w.+-]+){2,}|\b[A-Za-z]:\\[\w.+-]+\\")
-
-
-def _strings(node, where):
-    if isinstance(node, str):
-        yield where, node
-    elif isinstance(node, dict):
-        for k, v in node.items():
-            yield from _strings(v, f"{where}.{k}")
-    elif isinstance(node, list):
-        for i, v in enumerate(node):
-            yield from _strings(v, f"{where}[{i}]")
 
 
 def test_the_pattern_finds_an_absolute_path_and_nothing_else():
@@ -31,7 +22,7 @@ def test_no_committed_study_json_holds_an_absolute_path():
     found = [
         f"{path.relative_to(ASSETS)}:{where}: {text[:120]}"
         for path in sorted(ASSETS.rglob("*.json"))
-        for where, text in _strings(json.loads(path.read_text()), "")
+        for where, text in json_strings(json.loads(path.read_text()))
         if ABSOLUTE.search(text)
     ]
     assert not found, "\n".join(found)

@@ -3,11 +3,11 @@ never "KAM-trapped" or "trapped", in the text the code writes and in every commi
 
 from __future__ import annotations
 
-import ast
 import re
 from pathlib import Path
 
 import pytest
+from strings_of import json_strings, literal_strings
 
 from hhscatter.publish.numbers import read_numbers_file
 from hhscatter.publish.words import OLD_PHRASES, in_glossary_words
@@ -25,28 +25,6 @@ WRITERS = sorted(
 ELSEWHERE = {"they are trapped from t = 0"}
 
 
-def _written_strings(path: Path) -> list[tuple[int, str]]:
-    """(line, text) of the literal strings and f-string parts of a module, except docstrings and bare identifiers
-    (a key such as ``trapped_fraction`` is read, not printed)."""
-    tree = ast.parse(path.read_text())
-    docs = {
-        id(node.body[0].value)
-        for node in ast.walk(tree)
-        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef))
-        and node.body
-        and isinstance(node.body[0], ast.Expr)
-        and isinstance(node.body[0].value, ast.Constant)
-    }
-    return [
-        (node.lineno, node.value)
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Constant)
-        and isinstance(node.value, str)
-        and id(node) not in docs
-        and not re.fullmatch(r"\w+", node.value)
-    ]
-
-
 def test_the_writers_are_found():
     names = {p.name for p in WRITERS}
     assert {"kappa_conventions.py", "fig2.py", "cmeasure.py", "study.py"} <= names
@@ -56,7 +34,7 @@ def test_the_writers_are_found():
 def test_the_code_writes_censored_not_trapped(path):
     bad = [
         (line, text)
-        for line, text in _written_strings(path)
+        for line, text in literal_strings(path)
         if OLD.search(text) and not any(e in text for e in ELSEWHERE)
     ]
     assert not bad, f"{path.relative_to(ROOT)} writes the old words: {bad}"
@@ -74,22 +52,11 @@ COMMITTED = sorted(
 )
 
 
-def _texts(doc):
-    if isinstance(doc, str):
-        yield doc
-    elif isinstance(doc, dict):
-        for v in doc.values():
-            yield from _texts(v)
-    elif isinstance(doc, list):
-        for v in doc:
-            yield from _texts(v)
-
-
 @pytest.mark.parametrize("path", COMMITTED, ids=lambda p: str(p.relative_to(ROOT / "docs" / "studies" / "assets")))
 def test_a_committed_record_reads_censored_on_the_pages(path):
     """Records written before the studies said "censored" (the paper scale's, which a re-run would take hours to
     remake) are read in the glossary's words; their keys stay."""
-    bad = sorted({t for t in _texts(read_numbers_file(path)) if OLD.search(t)})
+    bad = sorted({t for _, t in json_strings(read_numbers_file(path)) if OLD.search(t)})
     assert not bad, bad[:5]
 
 
