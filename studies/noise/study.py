@@ -107,11 +107,13 @@ class Params(StudyParams):
     saddles_turnover_n: Integer
 
 
-def _barrier(study) -> float:
-    """ΔE = E_c − V(min) of the study's system (energy units): the lowest saddle above the well's minimum."""
+def _barrier(study, system: dict | None = None) -> float:
+    """ΔE = E_c − V(min) (energy units), the lowest saddle above the well's minimum, of the study's system or of
+    ``system`` (the keyword arguments of :func:`hhscatter.model.make_system`)."""
     from hhscatter.analysis.noise import well_barrier
+    from hhscatter.model import make_system
 
-    return well_barrier(study.model)
+    return well_barrier(study.model if system is None else make_system(**system))
 
 
 def _pairs(study, a, b):
@@ -192,50 +194,33 @@ def _runs(study):
         if b not in t_max_of:
             raise ValueError(f"[study] resc_barriers: {b:g} is not one of barriers {list(p.barriers)}")
         runs[_resc_key(b, p.resc_radius)] = dict(runs[_kramers_key(b)], r_esc=p.resc_radius)
-    if p.saddles_barriers:
-        from hhscatter.analysis.noise import well_barrier
-        from hhscatter.model import make_system
-
-        low = well_barrier(make_system(**_saddles_system(p)))
-        for b, t_max in _pairs(study, "saddles_barriers", "saddles_t_max"):
-            runs[_saddles_key(b)] = dict(
-                energy=p.well_energy,
-                gamma=p.gamma_kramers,
-                t_max=t_max,
-                noise={"temperature": low / b, "flow": p.flow},
-                system=_saddles_system(p),
-            )
-    for g, t_max in _pairs(study, "turnover_gammas", "turnover_t_max"):
-        runs[_turnover_key(g)] = dict(
+    low = _barrier(study, _saddles_system(p)) if p.saddles_barriers or p.saddles_turnover_gammas else None
+    for b, t_max in _pairs(study, "saddles_barriers", "saddles_t_max"):
+        runs[_saddles_key(b)] = dict(
             energy=p.well_energy,
-            gamma=g,
+            gamma=p.gamma_kramers,
             t_max=t_max,
-            n=p.turnover_n,
-            noise={"temperature": dE / p.turnover_barrier, "flow": p.flow},
+            noise={"temperature": low / b, "flow": p.flow},
+            system=_saddles_system(p),
         )
     b_high = p.turnover_high_barrier
-    for g, t_max in _pairs(study, "turnover_gammas", "turnover_high_t_max"):
-        runs[_turnover_high_key(g, b_high)] = dict(
+    for b, windows, n, key in (
+        (p.turnover_barrier, "turnover_t_max", p.turnover_n, _turnover_key),
+        (b_high, "turnover_high_t_max", p.turnover_high_n, lambda g: _turnover_high_key(g, b_high)),
+    ):
+        for g, t_max in _pairs(study, "turnover_gammas", windows):
+            runs[key(g)] = dict(
+                energy=p.well_energy, gamma=g, t_max=t_max, n=n, noise={"temperature": dE / b, "flow": p.flow}
+            )
+    for g, t_max in _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max"):
+        runs[_saddles_turnover_key(g)] = dict(
             energy=p.well_energy,
             gamma=g,
             t_max=t_max,
-            n=p.turnover_high_n,
-            noise={"temperature": dE / b_high, "flow": p.flow},
+            n=p.saddles_turnover_n,
+            noise={"temperature": low / p.saddles_turnover_barrier, "flow": p.flow},
+            system=_saddles_system(p),
         )
-    if p.saddles_turnover_gammas:
-        from hhscatter.analysis.noise import well_barrier
-        from hhscatter.model import make_system
-
-        low = well_barrier(make_system(**_saddles_system(p)))
-        for g, t_max in _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max"):
-            runs[_saddles_turnover_key(g)] = dict(
-                energy=p.well_energy,
-                gamma=g,
-                t_max=t_max,
-                n=p.saddles_turnover_n,
-                noise={"temperature": low / p.saddles_turnover_barrier, "flow": p.flow},
-                system=_saddles_system(p),
-            )
     react = dict(energy=p.react_energy, gamma=p.react_gamma, t_max=p.react_t_max, n=p.react_n)
     runs["react_T0"] = react
     bath = {"temperature": dE / p.react_barrier, "flow": p.flow}
@@ -431,10 +416,10 @@ def analyze(study):
     kramers = [
         _rate_row(study, _kramers_key(b), runs[_kramers_key(b)]) for b, _ in _pairs(study, "barriers", "kramers_t_max")
     ]
-    turnover = [_turnover_row(study, _turnover_key(g), runs) for g in p.turnover_gammas]
-    turnover_high = [
-        _turnover_row(study, _turnover_high_key(g, p.turnover_high_barrier), runs) for g in p.turnover_gammas
-    ]
+    turnover, turnover_high = (
+        [_turnover_row(study, key(g), runs) for g in p.turnover_gammas]
+        for key in (_turnover_key, lambda g: _turnover_high_key(g, p.turnover_high_barrier))
+    )
     saddles_turnover = _saddles_turnover(study, runs)
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
