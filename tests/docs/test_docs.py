@@ -6,13 +6,12 @@ runs in CI; these tests need no docs extra and take well under a second.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
-import sys
 from pathlib import Path
 
 import pytest
+from file_module import load_file
 
 from hhscatter.studies.provenance import sealed
 
@@ -20,12 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
 
-def _load(path: Path, name: str):
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+_load = load_file
 
 
 @pytest.fixture(scope="module")

@@ -107,9 +107,9 @@ def test_report_html_tables_have_as_many_cells_as_their_headers(tmp_path):
 def test_docs_pages_tables_have_as_many_cells_as_their_headers(tmp_path):
     markdown = pytest.importorskip("markdown")
     pytest.importorskip("pymdownx")
-    from test_docs import _load
+    from file_module import load_file
 
-    hook = _load(DOCS / "_hooks" / "studies.py", "hh_docs_hook_tables")
+    hook = load_file(DOCS / "_hooks" / "studies.py", "hh_docs_hook_tables")
     extensions = [
         "admonition",
         "attr_list",
