@@ -37,6 +37,7 @@ from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN
 from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
+SNAPSHOT_BLOCKS = 64  # epochs of grid values gathered into snapshot rows at once
 EPOCH_BATCH = 16  # lanes of the epoch scheduler (measured on the recording scene: 16 and 32 took 0.93× the CPU of 8)
 
 
@@ -74,17 +75,38 @@ class _Epochs(Scheduler):
 
     def release(self, lane):
         """Park the lane at the origin (a fixed point) until the epoch ends."""
-        if self.pending_sec[lane] or self.pending_cross[lane]:
-            self.commit_rows(lane)
-        self.orbit[lane] = -1
+        return self._parker()(lane)
+
+    def _parker(self):
+        """The lean :meth:`release` (a closure over the lanes' lists and flat memoryviews, no attribute lookup
+        or method call per orbit end), built on first use and kept as the instance's ``release``."""
+        orbit, pending_sec, pending_cross, commit_rows = (
+            self.orbit,
+            self.pending_sec,
+            self.pending_cross,
+            self.commit_rows,
+        )
         s, B = self._s, self.B
-        for i in range(self.layout.n_state):
-            s[i * B + lane] = 0.0
-        if self.layout.clock is not None:
-            self.set_clock(lane, 1.0)
-        if self.layout.gate is not None:
-            self.set_gate(lane, 0.0)
-        return True
+        slots = tuple(i * B for i in range(self.layout.n_state))
+        clock = self._clock_at if self.layout.clock is not None else None
+        p, gate = self._p, self._gate_at
+        if not (self.layout.gate is not None and self.gate_live):
+            p = None
+
+        def release(lane):
+            if pending_sec[lane] or pending_cross[lane]:
+                commit_rows(lane)
+            orbit[lane] = -1
+            for a in slots:
+                s[a + lane] = 0.0
+            if clock is not None:
+                s[clock + lane] = 1.0
+            if p is not None:
+                p[gate + lane] = 0.0
+            return True
+
+        self.release = release
+        return release
 
     @property
     def handlers(self):
@@ -109,7 +131,7 @@ class _Epochs(Scheduler):
         has, ot, ost = memoryview(self.has_out), memoryview(self.out_t), memoryview(self.out_state)
         b1, b2, b3 = B, 2 * B, 3 * B
         r_s2 = self.r_s * self.r_s
-        cont, late, release = self.continue_settled, self.late, self.release
+        cont, late, release = self.continue_settled, self.late, self._parker()
         escaped, settled, rerun, live, continuing = ESCAPED, SETTLED, RERUN, LIVE, CONTINUING
         lanes = self
 
@@ -190,37 +212,61 @@ class _Epochs(Scheduler):
     def close(self):
         super().close()
         self._handlers = {}  # the closures refer back to the lanes: free them now
+        self.__dict__.pop("release", None)  # (the lean release holds views of the integrator)
 
     def _epoch_tables(self):
         """(grid, snap_times, has_snapshots) of :func:`epoch_tables` for this scene's P, epochs and snapshots."""
         return epoch_tables(self.P, self.n_epochs_max, tuple(self.snaps.tolist()))
 
     def run(self):
-        B, ta, P = self.B, self.ta, self.P
+        B, ta, P, K, s_last = self.B, self.ta, self.P, self.n_epochs_max, self.s_last
         grid, snap_times, has_snapshots = self._epoch_tables()
-        orbit, start_epoch, zeros = self.orbit, self.start_epoch, self.zeros
-        blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index (B,), orbit (B,))
+        has = has_snapshots.tolist()
+        orbit, phase, start_epoch, zeros = self.orbit, self.phase, self.start_epoch, self.zeros
+        load, lanes = self.load_next, range(B)
+        blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index [B], orbit [B])
         n_returns = n_steps = 0
-        for lane in range(B):
-            self.load_next(lane)
-        while True:
-            ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
-            live = ids >= 0
-            if not live.any():
-                break
-            # the epoch of each lane's orbit (−1: a parked lane)
-            epoch_index = np.where(live, self.epoch - np.array(start_epoch), -1)
+        for lane in lanes:
+            load(lane)
+        # each lane's orbit's epoch in the coming epoch (−1: a parked lane); whether a lane is live, has snapshots
+        index, live, snap = [-1] * B, False, False
+        for lane in lanes:
+            if orbit[lane] >= 0:
+                index[lane] = k = self.epoch - start_epoch[lane]
+                live, snap = True, snap or has[k]
+        while live:
             ta.set_time(zeros)
-            if has_snapshots[epoch_index].any():
-                blocks.append((ta.propagate_grid(grid[:, epoch_index])[1], epoch_index, ids))
-                if len(blocks) >= 256:
+            if snap:
+                ids = orbit[:]  # before the call: orbits end during it
+                blocks.append((ta.propagate_grid(grid[:, index])[1], index[:], ids))
+                if len(blocks) >= SNAPSHOT_BLOCKS:
                     rows.append(self._snapshot_rows(blocks, snap_times))
                     blocks = []
             else:
                 ta.propagate_until(P)
             n_returns += 1
             n_steps += self._checked()
-            self._next_epoch(epoch_index.tolist())
+            # close the epoch, in one pass over the lanes (t_max reached, or a settled orbit continued past the last snapshot): an orbit that needs nothing after
+            # it is censored at t_max if still live and released; free lanes are refilled in lane order
+            self.epoch = epoch = self.epoch + 1
+            live = snap = False
+            for lane in lanes:
+                k = index[lane]
+                if k >= 0 and orbit[lane] >= 0:
+                    k += 1  # epochs completed
+                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                        if phase[lane] == LIVE:
+                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                        self.release(lane)
+                if orbit[lane] < 0:
+                    load(lane)
+                if orbit[lane] >= 0:
+                    index[lane] = k = epoch - start_epoch[lane]
+                    live = True
+                    if has[k]:
+                        snap = True
+                else:
+                    index[lane] = -1
         if blocks:
             rows.append(self._snapshot_rows(blocks, snap_times))
         ids = np.concatenate([r[0] for r in rows]) if rows else np.empty(0, np.int64)
@@ -233,29 +279,15 @@ class _Epochs(Scheduler):
 
     def _checked(self) -> int:
         """After a propagation: the steps taken (when counted: heyoka's per-lane results read once), the
-        integrator's state checked (a non-finite lane raises, naming it)."""
-        steps = sum(r[3] for r in self.ta.propagate_res) if self.count_steps else 0
-        if not np.isfinite(self.state).all():
+        integrator's state checked (a non-finite lane raises, naming it; one reduction: a non-finite value
+        makes the sum non-finite)."""
+        steps = 0
+        if self.count_steps:
+            for r in self.ta.propagate_res:
+                steps += r[3]
+        if not math.isfinite(self.state.sum()):
             _check(self.ta, self)
         return steps
-
-    def _next_epoch(self, epoch_index) -> None:
-        """Close the epoch (``epoch_index``: each lane's orbit's epoch in it, −1 for a parked lane): an orbit that
-        needs nothing after it (t_max reached, or a settled orbit continued past the last snapshot) is recorded as
-        censored at t_max if still live, and released; the next epoch begins with the free lanes refilled."""
-        orbit, phase = self.orbit, self.phase
-        K, P, s_last = self.n_epochs_max, self.P, self.s_last
-        for lane, k in enumerate(epoch_index):
-            if k >= 0 and orbit[lane] >= 0:
-                k += 1  # epochs completed
-                if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
-                    if phase[lane] == LIVE:
-                        self.record(lane, CENSORED, self.t_max, self.state4(lane))
-                    self.release(lane)
-        self.epoch += 1
-        for lane, k in enumerate(orbit):
-            if k < 0:
-                self.load_next(lane)
 
     def _end_epoch(self, lanes, done) -> None:
         """Close the epoch: each lane of ``lanes`` whose orbit is done after it (``done(lane, k)``, k its epochs
@@ -276,8 +308,8 @@ class _Epochs(Scheduler):
         """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows, in (epoch, grid
         point, lane) order; fillers and parked lanes are skipped by flat index, not copied."""
         out = np.stack([b[0] for b in blocks])  # (epochs, n, dim, B)
-        epoch_index = np.stack([b[1] for b in blocks])  # (epochs, B)
-        ids = np.stack([b[2] for b in blocks])
+        epoch_index = np.array([b[1] for b in blocks], dtype=np.int64)  # (epochs, B)
+        ids = np.array([b[2] for b in blocks], dtype=np.int64)
         _, n, dim, B = out.shape
         tt = snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
         e, j, b = np.nonzero(~np.isnan(tt) & (ids >= 0)[:, None, :])  # in (epoch, grid point, lane) order
