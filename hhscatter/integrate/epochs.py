@@ -31,9 +31,10 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate.batch import _check
+from hhscatter.integrate import events
+from hhscatter.integrate.batch import _BatchRules, _check
 from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
-from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN
+from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN, LaneRules
 from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
@@ -223,7 +224,7 @@ class _Epochs(Scheduler):
         grid, snap_times, has_snapshots = self._epoch_tables()
         has = has_snapshots.tolist()
         orbit, phase, start_epoch, zeros = self.orbit, self.phase, self.start_epoch, self.zeros
-        load, lanes = self.load_next, range(B)
+        load, lanes = self._loader(), range(B)
         blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index [B], orbit [B])
         n_returns = n_steps = 0
         for lane in lanes:
@@ -238,7 +239,7 @@ class _Epochs(Scheduler):
             ta.set_time(zeros)
             if snap:
                 ids = orbit[:]  # before the call: orbits end during it
-                blocks.append((ta.propagate_grid(grid[:, index])[1], index[:], ids))
+                blocks.append((ta.propagate_grid(grid.take(index, axis=1))[1], index[:], ids))
                 if len(blocks) >= SNAPSHOT_BLOCKS:
                     rows.append(self._snapshot_rows(blocks, snap_times))
                     blocks = []
@@ -326,6 +327,71 @@ class _Epochs(Scheduler):
         self.start_epoch[lane] = self.epoch
         self.has_out[lane] = 0
         self.load_orbit(lane, k)
+
+    def _loader(self):
+        """:meth:`load_next` as one closure (the initial condition, the rule state of
+        :meth:`hhscatter.integrate.lanes.LaneRules.start_orbit`, the gate and the clock written through flat
+        memoryviews: no method call but heyoka's cooldown reset per orbit), or :meth:`load_next` itself where a
+        subclass loads orbits its own way."""
+        cls = type(self)
+        if not (
+            cls.load_next is _Epochs.load_next
+            and cls.load_orbit is _BatchRules.load_orbit
+            and cls.start_orbit is LaneRules.start_orbit
+        ):
+            return self.load_next
+        B, n = self.B, self.n
+        s, ic = self._s, self._ic
+        b1, b2, b3 = B, 2 * B, 3 * B
+        orbit, phase, last_out, sec_found, clock_i = self.orbit, self.phase, self.last_out, self.sec_found, self.clock_i
+        pending_sec, pending_cross, start_epoch = self.pending_sec, self.pending_cross, self.start_epoch
+        has = memoryview(self.has_out)
+        load_tangent = self.load_tangent if self.tan0 is not None else None
+        p, gate_at = (self._p, self._gate_at) if self.gate_live else (None, 0)
+        gate0 = None if self.win is None or p is None else (1.0 if self.win.t_from <= 0 else 0.0)
+        clock_at = self._clock_at
+        sigma0 = self.targets[0][0] / self.clock_scale if self.targets else None
+        open_late = self.open_late
+        sigma_late = events.T_INITIAL / self.clock_scale if open_late is not None else None
+        progress, reset, lanes = self.progress, self.ta.reset_cooldowns, self
+
+        def load(lane):
+            k = lanes.next
+            if k >= n:
+                return
+            lanes.next = k + 1
+            start_epoch[lane] = lanes.epoch
+            has[lane] = 0
+            if progress is not None:
+                lanes.tick()
+            j = 4 * k
+            s[lane] = ic[j]
+            s[b1 + lane] = ic[j + 1]
+            s[b2 + lane] = ic[j + 2]
+            s[b3 + lane] = ic[j + 3]
+            if load_tangent is not None:
+                load_tangent(lane, k)
+            orbit[lane] = k
+            phase[lane] = LIVE
+            last_out[lane] = None
+            sec_found[lane] = False
+            clock_i[lane] = 0
+            if pending_sec[lane]:
+                pending_sec[lane] = []
+            if pending_cross[lane]:
+                pending_cross[lane] = []
+            if gate0 is not None:
+                p[gate_at + lane] = gate0
+            if sigma0 is not None:
+                s[clock_at + lane] = sigma0
+            if open_late is not None and open_late[k]:  # the clock opens the window at T_INITIAL
+                if p is not None:
+                    p[gate_at + lane] = 0.0
+                clock_i[lane] = -1
+                s[clock_at + lane] = sigma_late
+            reset(lane)
+
+        return load
 
 
 @functools.lru_cache(maxsize=8)
