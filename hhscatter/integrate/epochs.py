@@ -1,16 +1,22 @@
 """The epoch scheduler (scenes with energy snapshots): all lanes advance together; snapshots from ``propagate_grid``.
 
-Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5 to
-t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch; 2.8–3.3× the
-dissipative scene on the stream in CPU per orbit): about 60 % is inside ``propagate_grid`` (heyoka's compiled
-propagation and the event callbacks), the rest Python per epoch and per chunk (the epoch tables are built once per
-process, :func:`epoch_tables`; the snapshot rows are gathered in bulk). heyoka's batch ``propagate_grid`` costs 1.5×
-``propagate_until`` per lane-step with 2 grid points per epoch and 1.9× with the 17 of snapshots every 0.5 (it
-writes the Taylor coefficients at every step and walks the grid lane by lane), and lanes parked until the epoch ends
-leave 28 % of the batch's lane-steps idle (1.44 lane-steps per step the same orbits take on the stream). Starting an
-orbit as soon as its lane is free would need a return per orbit end and per-lane grids: at most those 28 % of the
-compiled part, ≈ 12 µs per orbit here, are to be won, and one more ``propagate_grid`` call per orbit costs more
-(≈ 25 µs beyond its steps, measured with 8 lanes). Nor can a call stop early and the lanes still mid-epoch go on:
+Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5
+to t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch of P = 8;
+CPU per orbit against the dissipative scene on the stream, thread CPU clocks around each phase): the
+``propagate_grid`` calls, heyoka's compiled propagation with the event callbacks, take 1.7–1.9× the whole bare
+scene's CPU by themselves. heyoka's batch ``propagate_grid`` costs 1.4× ``propagate_until`` per lane-step with 2
+grid points per epoch and 1.75× with the 17 of snapshots every 0.5 (it writes the Taylor coefficients at every step
+and walks the grid lane by lane), the gated section event and its clock 1.1–1.2× more (the first-section scene on
+the stream), and lanes parked until the epoch ends leave 28 % of the batch's lane-steps idle (1.44 lane-steps per
+step the same orbits take on the stream). Python's
+part, per epoch and per orbit, is the rest (≈ 25 % of the scene's CPU before it was trimmed, ≈ 15 % after): one
+pass over the lanes per epoch (epochs closed, lanes refilled, the next epoch's grid index; lists, not per-epoch
+numpy arrays), the next orbit loaded by one closure, the state checked by one reduction, the snapshot rows
+gathered every :data:`SNAPSHOT_BLOCKS` epochs in bulk (about a third of that is the model's energy, ``y**3``
+through ``pow``), and heyoka's per-lane results read once per epoch when steps are counted (``count_steps``).
+Starting an orbit as soon as its lane is free would need a return per orbit end and per-lane grids: at most those
+28 % of the compiled part are to be won, and one more ``propagate_grid`` call per orbit costs more (≈ 25 µs beyond
+its steps, measured with 8 lanes). Nor can a call stop early and the lanes still mid-epoch go on:
 ``propagate_grid`` starts by propagating each lane to its first grid point, a double, so a lane at (hi, lo) first
 steps by −lo to (hi, 0), which changes its time (and may change its state) in the last bits: the tables would no
 longer be bit-identical.
@@ -247,8 +253,9 @@ class _Epochs(Scheduler):
                 ta.propagate_until(P)
             n_returns += 1
             n_steps += self._checked()
-            # close the epoch, in one pass over the lanes (t_max reached, or a settled orbit continued past the last snapshot): an orbit that needs nothing after
-            # it is censored at t_max if still live and released; free lanes are refilled in lane order
+            # close the epoch in one pass over the lanes: an orbit that needs nothing after it (t_max reached, or a
+            # settled orbit continued past the last snapshot) is censored at t_max if still live and released; free
+            # lanes are refilled in lane order and the next epoch's index is taken
             self.epoch = epoch = self.epoch + 1
             live = snap = False
             for lane in lanes:
