@@ -3,13 +3,13 @@
 Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5
 to t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch of P = 8;
 CPU per orbit against the dissipative scene on the stream, thread CPU clocks around each phase): the
-``propagate_grid`` calls, heyoka's compiled propagation with the event callbacks, take 1.7–1.9× the whole bare
+``propagate_grid`` calls, heyoka's compiled propagation with the event callbacks, take 1.8–2.1× the whole bare
 scene's CPU by themselves. heyoka's batch ``propagate_grid`` costs 1.4× ``propagate_until`` per lane-step with 2
 grid points per epoch and 1.75× with the 17 of snapshots every 0.5 (it writes the Taylor coefficients at every step
 and walks the grid lane by lane), the gated section event and its clock 1.1–1.2× more (the first-section scene on
 the stream), and lanes parked until the epoch ends leave 28 % of the batch's lane-steps idle (1.44 lane-steps per
 step the same orbits take on the stream). Python's
-part, per epoch and per orbit, is the rest (≈ 25 % of the scene's CPU before it was trimmed, ≈ 15 % after): one
+part, per epoch and per orbit, is the rest (34–37 % of the scene's CPU before it was trimmed, 26–29 % after): one
 pass over the lanes per epoch (epochs closed, lanes refilled, the next epoch's grid index; lists, not per-epoch
 numpy arrays), the next orbit loaded by one closure, the state checked by one reduction, the snapshot rows
 gathered every :data:`SNAPSHOT_BLOCKS` epochs in bulk (about a third of that is the model's energy, ``y**3``
