@@ -1,6 +1,6 @@
 """``make bench-engine``: the engine's targets as ratios measured side by side in one run.
 
-    python -m benchmarks.engine [-n N] [--repeat R] [--out DIR]
+    python -m benchmarks.engine [-n N] [--repeat R] [--out DIR] [--only GROUP ...] [--update]
 
 One process, one core, the same initial conditions for every contender,
 best of ``--repeat`` timings each (the machine is shared: ratios, not
@@ -31,7 +31,8 @@ absolute times, are the result). Rows:
   whole process (the same ICs, the yardstick, one Parquet table of t_end;
   ``python -m benchmarks.engine --driver N SEED OUT``), in CPU time, the two
   run alternately ``--repeat`` times, the median of the pairs' ratios (target
-  ≤ 1.2). ``--only whole`` (or ``recording``) runs those rows alone;
+  ≤ 1.2). ``--only whole`` (or ``recording``) runs those rows alone; ``--only`` takes several groups
+  (``--only alternated recording``), and ``--update`` refreshes their rows in an existing ``engine.csv``;
 * **tangent** — the tangent dynamics (``tangent = true``: u and Λ integrated with every orbit) against the
   same scene bare on the same ICs, conservative (E = 0.27) and dissipative (E0 = 0.3, γ = 0.01), alternated
   in CPU time: CPU per orbit, steps per orbit and CPU per step; ``--only tangent`` runs these rows alone;
@@ -332,9 +333,16 @@ def main(argv=None):
     ap.add_argument(
         "--only",
         choices=("whole", "recording", "alternated", "tangent", "saddle"),
+        nargs="+",
         default=None,
-        help="only the whole-process rows, the recording rows (and the bare row they are read with), or the "
-        "in-process rows alternated in CPU time",
+        help="only these rows, in one run: the whole-process rows, the recording rows (and the bare row they are "
+        "read with), the in-process rows alternated in CPU time, the tangent or the saddle rows",
+    )
+    ap.add_argument(
+        "--update",
+        action="store_true",
+        help="with --only: replace the rows of the targets measured in the engine.csv already in the output folder "
+        "and keep its other rows (the summary then tells which rows came from which run)",
     )
     a = ap.parse_args(argv)
     n, rep = a.n, a.repeat
@@ -345,21 +353,17 @@ def main(argv=None):
         print(f"{target:16s} {what:58s} {value:10.3f}  {goal:>8s}  {note}", flush=True)
 
     print(f"# hhscatter engine benchmark: N = {n} per measurement, 1 core, best of {rep}")
-    if a.only == "whole":
-        _whole_rows(row, a.whole_n, rep)
-        return _write_outputs(rows, a.out, n, rep)
-    if a.only == "recording":
-        _recording_rows(row, n, rep)
-        return _write_outputs(rows, a.out, n, rep)
-    if a.only == "alternated":
-        _alternated_rows(row, n, rep)
-        return _write_outputs(rows, a.out, n, rep)
-    if a.only == "tangent":
-        _tangent_rows(row, n, rep)
-        return _write_outputs(rows, a.out, n, rep)
-    if a.only == "saddle":
-        _saddle_rows(row, n)
-        return _write_outputs(rows, a.out, n, rep)
+    if a.only:
+        groups = {
+            "whole": lambda: _whole_rows(row, a.whole_n, rep),
+            "recording": lambda: _recording_rows(row, n, rep),
+            "alternated": lambda: _alternated_rows(row, n, rep),
+            "tangent": lambda: _tangent_rows(row, n, rep),
+            "saddle": lambda: _saddle_rows(row, n),
+        }
+        for name in dict.fromkeys(a.only):
+            groups[name]()
+        return _write_outputs(rows, a.out, n, rep, update=a.update)
     _alternated_rows(row, n, rep)
     _bare_rows(row, n, rep)
     c3, ics3 = _dissipative_rows(row, n, rep)
@@ -733,20 +737,35 @@ def _design_rows(row):
         row("design", f"ns per lane-step: {label}", dc[kind], "", f"{dc[kind] / dc['until']:.2f}× propagate_until")
 
 
-def _write_outputs(rows, out, n, rep):
-    """engine.csv and engine_summary.md in ``out`` (default benchmarks/out/engine/full or quick)."""
+def _write_outputs(rows, out, n, rep, update=False):
+    """engine.csv and engine_summary.md in ``out`` (default benchmarks/out/engine/full or quick). ``update``: the
+    targets measured here replace theirs in the engine.csv already there, whose other rows are kept (targets new
+    to it come first)."""
     out = Path(out) if out else out_dir("engine", "full" if n >= 100_000 else "quick")
     out.mkdir(parents=True, exist_ok=True)
     import pandas as pd  # deferred: pandas loads on first use
 
     df = pd.DataFrame(rows)
+    header = (
+        f"Engine targets, N = {n} per measurement, 1 core, best of {rep}; every ratio is measured side by side in "
+        "one run."
+    )
+    if update and (out / "engine.csv").exists():
+        old = pd.read_csv(out / "engine.csv", keep_default_na=False)
+        measured = list(dict.fromkeys(df["target"]))
+        parts = [df[df["target"] == t] for t in measured if t not in set(old["target"])]
+        for t in dict.fromkeys(old["target"]):
+            parts.append(df[df["target"] == t] if t in measured else old[old["target"] == t])
+        df = pd.concat(parts, ignore_index=True)
+        header = (
+            "Engine targets, 1 core; every ratio is measured side by side in one run. The rows of "
+            f"{', '.join(measured)} are from a run with N = {n} per measurement, {rep} rounds or best of {rep}; "
+            "the other rows from an earlier run."
+        )
     df.to_csv(out / "engine.csv", index=False)
     lines = ["| target | measure | value | goal | note |", "|---|---|---|---|---|"]
     lines += [f"| {r.target} | {r.measure} | {r.value:.3g} | {r.goal} | {r.note} |" for r in df.itertuples()]
-    (out / "engine_summary.md").write_text(
-        f"Engine targets, N = {n} per measurement, 1 core, best of {rep}; every ratio is "
-        "measured side by side in one run.\n\n" + "\n".join(lines) + "\n"
-    )
+    (out / "engine_summary.md").write_text(header + "\n\n" + "\n".join(lines) + "\n")
     print(f"wrote {out / 'engine.csv'} and {out / 'engine_summary.md'}")
 
 

@@ -1,16 +1,22 @@
 """The epoch scheduler (scenes with energy snapshots): all lanes advance together; snapshots from ``propagate_grid``.
 
-Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5 to
-t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch; 2.8–3.3× the
-dissipative scene on the stream in CPU per orbit): about 60 % is inside ``propagate_grid`` (heyoka's compiled
-propagation and the event callbacks), the rest Python per epoch and per chunk (the epoch tables are built once per
-process, :func:`epoch_tables`; the snapshot rows are gathered in bulk). heyoka's batch ``propagate_grid`` costs 1.5×
-``propagate_until`` per lane-step with 2 grid points per epoch and 1.9× with the 17 of snapshots every 0.5 (it
-writes the Taylor coefficients at every step and walks the grid lane by lane), and lanes parked until the epoch ends
-leave 28 % of the batch's lane-steps idle (1.44 lane-steps per step the same orbits take on the stream). Starting an
-orbit as soon as its lane is free would need a return per orbit end and per-lane grids: at most those 28 % of the
-compiled part, ≈ 12 µs per orbit here, are to be won, and one more ``propagate_grid`` call per orbit costs more
-(≈ 25 µs beyond its steps, measured with 8 lanes). Nor can a call stop early and the lanes still mid-epoch go on:
+Where its time goes (measured on ``make bench-engine``'s recording scene: E0 = 0.3, γ = 0.01, snapshots every 0.5
+to t = 200 and the first section crossing after t = 17, orbits living 8.4 on average, about one epoch of P = 8;
+CPU per orbit against the dissipative scene on the stream, thread CPU clocks around each phase): the
+``propagate_grid`` calls, heyoka's compiled propagation with the event callbacks, take 1.8–2.1× the whole bare
+scene's CPU by themselves. heyoka's batch ``propagate_grid`` costs 1.4× ``propagate_until`` per lane-step with 2
+grid points per epoch and 1.75× with the 17 of snapshots every 0.5 (it writes the Taylor coefficients at every step
+and walks the grid lane by lane), the gated section event and its clock 1.1–1.2× more (the first-section scene on
+the stream), and lanes parked until the epoch ends leave 28 % of the batch's lane-steps idle (1.44 lane-steps per
+step the same orbits take on the stream). Python's
+part, per epoch and per orbit, is the rest (34–37 % of the scene's CPU before it was trimmed, 26–29 % after): one
+pass over the lanes per epoch (epochs closed, lanes refilled, the next epoch's grid index; lists, not per-epoch
+numpy arrays), the next orbit loaded by one closure, the state checked by one reduction, the snapshot rows
+gathered every :data:`SNAPSHOT_BLOCKS` epochs in bulk (about a third of that is the model's energy, ``y**3``
+through ``pow``), and heyoka's per-lane results read once per epoch when steps are counted (``count_steps``).
+Starting an orbit as soon as its lane is free would need a return per orbit end and per-lane grids: at most those
+28 % of the compiled part are to be won, and one more ``propagate_grid`` call per orbit costs more (≈ 25 µs beyond
+its steps, measured with 8 lanes). Nor can a call stop early and the lanes still mid-epoch go on:
 ``propagate_grid`` starts by propagating each lane to its first grid point, a double, so a lane at (hi, lo) first
 steps by −lo to (hi, 0), which changes its time (and may change its state) in the last bits: the tables would no
 longer be bit-identical.
@@ -31,12 +37,14 @@ import math
 
 import numpy as np
 
-from hhscatter.integrate.batch import _check
+from hhscatter.integrate import events
+from hhscatter.integrate.batch import _BatchRules, _check
 from hhscatter.integrate.events import CENSORED, ESCAPED, SETTLED
-from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN
+from hhscatter.integrate.lanes import CONTINUING, LIVE, RERUN, LaneRules
 from hhscatter.integrate.schedulers import Scheduler, register
 
 EPOCH = 8.0  # target epoch length P (time units) of the epoch scheduler
+SNAPSHOT_BLOCKS = 64  # epochs of grid values gathered into snapshot rows at once
 EPOCH_BATCH = 16  # lanes of the epoch scheduler (measured on the recording scene: 16 and 32 took 0.93× the CPU of 8)
 
 
@@ -74,17 +82,38 @@ class _Epochs(Scheduler):
 
     def release(self, lane):
         """Park the lane at the origin (a fixed point) until the epoch ends."""
-        if self.pending_sec[lane] or self.pending_cross[lane]:
-            self.commit_rows(lane)
-        self.orbit[lane] = -1
+        return self._parker()(lane)
+
+    def _parker(self):
+        """The lean :meth:`release` (a closure over the lanes' lists and flat memoryviews, no attribute lookup
+        or method call per orbit end), built on first use and kept as the instance's ``release``."""
+        orbit, pending_sec, pending_cross, commit_rows = (
+            self.orbit,
+            self.pending_sec,
+            self.pending_cross,
+            self.commit_rows,
+        )
         s, B = self._s, self.B
-        for i in range(self.layout.n_state):
-            s[i * B + lane] = 0.0
-        if self.layout.clock is not None:
-            self.set_clock(lane, 1.0)
-        if self.layout.gate is not None:
-            self.set_gate(lane, 0.0)
-        return True
+        slots = tuple(i * B for i in range(self.layout.n_state))
+        clock = self._clock_at if self.layout.clock is not None else None
+        p, gate = self._p, self._gate_at
+        if not (self.layout.gate is not None and self.gate_live):
+            p = None
+
+        def release(lane):
+            if pending_sec[lane] or pending_cross[lane]:
+                commit_rows(lane)
+            orbit[lane] = -1
+            for a in slots:
+                s[a + lane] = 0.0
+            if clock is not None:
+                s[clock + lane] = 1.0
+            if p is not None:
+                p[gate + lane] = 0.0
+            return True
+
+        self.release = release
+        return release
 
     @property
     def handlers(self):
@@ -109,7 +138,7 @@ class _Epochs(Scheduler):
         has, ot, ost = memoryview(self.has_out), memoryview(self.out_t), memoryview(self.out_state)
         b1, b2, b3 = B, 2 * B, 3 * B
         r_s2 = self.r_s * self.r_s
-        cont, late, release = self.continue_settled, self.late, self.release
+        cont, late, release = self.continue_settled, self.late, self._parker()
         escaped, settled, rerun, live, continuing = ESCAPED, SETTLED, RERUN, LIVE, CONTINUING
         lanes = self
 
@@ -190,37 +219,62 @@ class _Epochs(Scheduler):
     def close(self):
         super().close()
         self._handlers = {}  # the closures refer back to the lanes: free them now
+        self.__dict__.pop("release", None)  # (the lean release holds views of the integrator)
 
     def _epoch_tables(self):
         """(grid, snap_times, has_snapshots) of :func:`epoch_tables` for this scene's P, epochs and snapshots."""
         return epoch_tables(self.P, self.n_epochs_max, tuple(self.snaps.tolist()))
 
     def run(self):
-        B, ta, P = self.B, self.ta, self.P
+        B, ta, P, K, s_last = self.B, self.ta, self.P, self.n_epochs_max, self.s_last
         grid, snap_times, has_snapshots = self._epoch_tables()
-        orbit, start_epoch, zeros = self.orbit, self.start_epoch, self.zeros
-        blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index (B,), orbit (B,))
+        has = has_snapshots.tolist()
+        orbit, phase, start_epoch, zeros = self.orbit, self.phase, self.start_epoch, self.zeros
+        load, lanes = self._loader(), range(B)
+        blocks, rows = [], []  # per propagate_grid call: (its values (n, dim, B), epoch index [B], orbit [B])
         n_returns = n_steps = 0
-        for lane in range(B):
-            self.load_next(lane)
-        while True:
-            ids = np.array(orbit, dtype=np.int64)  # before the call: orbits end during it
-            live = ids >= 0
-            if not live.any():
-                break
-            # the epoch of each lane's orbit (−1: a parked lane)
-            epoch_index = np.where(live, self.epoch - np.array(start_epoch), -1)
+        for lane in lanes:
+            load(lane)
+        # each lane's orbit's epoch in the coming epoch (−1: a parked lane); whether a lane is live, has snapshots
+        index, live, snap = [-1] * B, False, False
+        for lane in lanes:
+            if orbit[lane] >= 0:
+                index[lane] = k = self.epoch - start_epoch[lane]
+                live, snap = True, snap or has[k]
+        while live:
             ta.set_time(zeros)
-            if has_snapshots[epoch_index].any():
-                blocks.append((ta.propagate_grid(grid[:, epoch_index])[1], epoch_index, ids))
-                if len(blocks) >= 256:
+            if snap:
+                ids = orbit[:]  # before the call: orbits end during it
+                blocks.append((ta.propagate_grid(grid.take(index, axis=1))[1], index[:], ids))
+                if len(blocks) >= SNAPSHOT_BLOCKS:
                     rows.append(self._snapshot_rows(blocks, snap_times))
                     blocks = []
             else:
                 ta.propagate_until(P)
             n_returns += 1
             n_steps += self._checked()
-            self._next_epoch(epoch_index.tolist())
+            # close the epoch in one pass over the lanes: an orbit that needs nothing after it (t_max reached, or a
+            # settled orbit continued past the last snapshot) is censored at t_max if still live and released; free
+            # lanes are refilled in lane order and the next epoch's index is taken
+            self.epoch = epoch = self.epoch + 1
+            live = snap = False
+            for lane in lanes:
+                k = index[lane]
+                if k >= 0 and orbit[lane] >= 0:
+                    k += 1  # epochs completed
+                    if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
+                        if phase[lane] == LIVE:
+                            self.record(lane, CENSORED, self.t_max, self.state4(lane))
+                        self.release(lane)
+                if orbit[lane] < 0:
+                    load(lane)
+                if orbit[lane] >= 0:
+                    index[lane] = k = epoch - start_epoch[lane]
+                    live = True
+                    if has[k]:
+                        snap = True
+                else:
+                    index[lane] = -1
         if blocks:
             rows.append(self._snapshot_rows(blocks, snap_times))
         ids = np.concatenate([r[0] for r in rows]) if rows else np.empty(0, np.int64)
@@ -233,29 +287,15 @@ class _Epochs(Scheduler):
 
     def _checked(self) -> int:
         """After a propagation: the steps taken (when counted: heyoka's per-lane results read once), the
-        integrator's state checked (a non-finite lane raises, naming it)."""
-        steps = sum(r[3] for r in self.ta.propagate_res) if self.count_steps else 0
-        if not np.isfinite(self.state).all():
+        integrator's state checked (a non-finite lane raises, naming it; one reduction: a non-finite value
+        makes the sum non-finite)."""
+        steps = 0
+        if self.count_steps:
+            for r in self.ta.propagate_res:
+                steps += r[3]
+        if not math.isfinite(self.state.sum()):
             _check(self.ta, self)
         return steps
-
-    def _next_epoch(self, epoch_index) -> None:
-        """Close the epoch (``epoch_index``: each lane's orbit's epoch in it, −1 for a parked lane): an orbit that
-        needs nothing after it (t_max reached, or a settled orbit continued past the last snapshot) is recorded as
-        censored at t_max if still live, and released; the next epoch begins with the free lanes refilled."""
-        orbit, phase = self.orbit, self.phase
-        K, P, s_last = self.n_epochs_max, self.P, self.s_last
-        for lane, k in enumerate(epoch_index):
-            if k >= 0 and orbit[lane] >= 0:
-                k += 1  # epochs completed
-                if k >= K or (phase[lane] == CONTINUING and k * P >= s_last):
-                    if phase[lane] == LIVE:
-                        self.record(lane, CENSORED, self.t_max, self.state4(lane))
-                    self.release(lane)
-        self.epoch += 1
-        for lane, k in enumerate(orbit):
-            if k < 0:
-                self.load_next(lane)
 
     def _end_epoch(self, lanes, done) -> None:
         """Close the epoch: each lane of ``lanes`` whose orbit is done after it (``done(lane, k)``, k its epochs
@@ -276,8 +316,8 @@ class _Epochs(Scheduler):
         """Energies at the snapshot grid points of buffered epochs, in bulk: (orbit, t, E) rows, in (epoch, grid
         point, lane) order; fillers and parked lanes are skipped by flat index, not copied."""
         out = np.stack([b[0] for b in blocks])  # (epochs, n, dim, B)
-        epoch_index = np.stack([b[1] for b in blocks])  # (epochs, B)
-        ids = np.stack([b[2] for b in blocks])
+        epoch_index = np.array([b[1] for b in blocks], dtype=np.int64)  # (epochs, B)
+        ids = np.array([b[2] for b in blocks], dtype=np.int64)
         _, n, dim, B = out.shape
         tt = snap_times[epoch_index].transpose(0, 2, 1)  # (epochs, n, B)
         e, j, b = np.nonzero(~np.isnan(tt) & (ids >= 0)[:, None, :])  # in (epoch, grid point, lane) order
@@ -294,6 +334,71 @@ class _Epochs(Scheduler):
         self.start_epoch[lane] = self.epoch
         self.has_out[lane] = 0
         self.load_orbit(lane, k)
+
+    def _loader(self):
+        """:meth:`load_next` as one closure (the initial condition, the rule state of
+        :meth:`hhscatter.integrate.lanes.LaneRules.start_orbit`, the gate and the clock written through flat
+        memoryviews: no method call but heyoka's cooldown reset per orbit), or :meth:`load_next` itself where a
+        subclass loads orbits its own way."""
+        cls = type(self)
+        if not (
+            cls.load_next is _Epochs.load_next
+            and cls.load_orbit is _BatchRules.load_orbit
+            and cls.start_orbit is LaneRules.start_orbit
+        ):
+            return self.load_next
+        B, n = self.B, self.n
+        s, ic = self._s, self._ic
+        b1, b2, b3 = B, 2 * B, 3 * B
+        orbit, phase, last_out, sec_found, clock_i = self.orbit, self.phase, self.last_out, self.sec_found, self.clock_i
+        pending_sec, pending_cross, start_epoch = self.pending_sec, self.pending_cross, self.start_epoch
+        has = memoryview(self.has_out)
+        load_tangent = self.load_tangent if self.tan0 is not None else None
+        p, gate_at = (self._p, self._gate_at) if self.gate_live else (None, 0)
+        gate0 = None if self.win is None or p is None else (1.0 if self.win.t_from <= 0 else 0.0)
+        clock_at = self._clock_at
+        sigma0 = self.targets[0][0] / self.clock_scale if self.targets else None
+        open_late = self.open_late
+        sigma_late = events.T_INITIAL / self.clock_scale if open_late is not None else None
+        progress, reset, lanes = self.progress, self.ta.reset_cooldowns, self
+
+        def load(lane):
+            k = lanes.next
+            if k >= n:
+                return
+            lanes.next = k + 1
+            start_epoch[lane] = lanes.epoch
+            has[lane] = 0
+            if progress is not None:
+                lanes.tick()
+            j = 4 * k
+            s[lane] = ic[j]
+            s[b1 + lane] = ic[j + 1]
+            s[b2 + lane] = ic[j + 2]
+            s[b3 + lane] = ic[j + 3]
+            if load_tangent is not None:
+                load_tangent(lane, k)
+            orbit[lane] = k
+            phase[lane] = LIVE
+            last_out[lane] = None
+            sec_found[lane] = False
+            clock_i[lane] = 0
+            if pending_sec[lane]:
+                pending_sec[lane] = []
+            if pending_cross[lane]:
+                pending_cross[lane] = []
+            if gate0 is not None:
+                p[gate_at + lane] = gate0
+            if sigma0 is not None:
+                s[clock_at + lane] = sigma0
+            if open_late is not None and open_late[k]:  # the clock opens the window at T_INITIAL
+                if p is not None:
+                    p[gate_at + lane] = 0.0
+                clock_i[lane] = -1
+                s[clock_at + lane] = sigma_late
+            reset(lane)
+
+        return load
 
 
 @functools.lru_cache(maxsize=8)

@@ -68,3 +68,28 @@ def test_saddle_rows_report_each_estimator_with_its_precision():
         "d₀ = 1 − α (lines)",
     ]
     assert all(t == "saddle" and v > 0 and "±" in n for t, _, v, n in rows)
+
+
+def test_update_replaces_the_measured_targets_rows_and_keeps_the_others(tmp_path):
+    """``--only ... --update``: the rows of the targets measured replace theirs in the engine.csv already there,
+    the other rows stay as they were (targets new to the file first), and the summary says which run each came
+    from."""
+    import pandas as pd
+
+    from benchmarks.engine import _write_outputs
+
+    def rows(*items):
+        return [{"target": t, "measure": m, "value": v, "goal": "", "note": ""} for t, m, v in items]
+
+    _write_outputs(rows(("bare", "a", 1.0), ("recording", "b", 2.0), ("recording", "c", 3.0), ("whole", "d", 4.0)),
+                   tmp_path, 100_000, 3)  # fmt: skip
+    _write_outputs(rows(("alternated", "e", 5.0), ("recording", "b", 6.0)), tmp_path, 20_000, 5, update=True)
+    df = pd.read_csv(tmp_path / "engine.csv", keep_default_na=False)
+    assert list(zip(df["target"], df["measure"], df["value"])) == [
+        ("alternated", "e", 5.0),
+        ("bare", "a", 1.0),
+        ("recording", "b", 6.0),
+        ("whole", "d", 4.0),
+    ]
+    head = (tmp_path / "engine_summary.md").read_text().splitlines()[0]
+    assert "alternated, recording" in head and "N = 20000" in head and "earlier run" in head
