@@ -776,6 +776,18 @@ STUDY_TABLES = {
         ("eps_c_tangent_own_interval", "its interval"),
         ("verdict_tangent_own", "measured against it"),
     ),
+    "saddle.saddle": (
+        ("system", "system"),
+        ("ratio", "E/E_c"),
+        ("kappa", "κ"),
+        ("lyapunov", "λ̄"),
+        ("d1_section", "D₁ (section)"),
+        ("d1_section_implied", "2(1 − κ/λ̄)"),
+        ("predicted", "λ̄ (1 − d₁)"),
+        ("verdict", "κ against λ̄ (1 − d₁)"),
+        ("d1_err_largest", "largest part of D₁'s error"),
+        ("d1_range_floor", "D₁'s range ended below by"),
+    ),
     "saddle.dimensions": (
         ("system", "system"),
         ("ratio", "E/E_c"),

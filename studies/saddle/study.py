@@ -14,7 +14,7 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
     ``saddle.json``: per point κ, λ̄ (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`,
     :func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), d₁ on the section
     (:func:`~hhscatter.analysis.geometry.saddle.saddle_points`,
-    :func:`~hhscatter.analysis.geometry.saddle.information_dimension`,
+    :func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours`,
     :func:`~hhscatter.analysis.geometry.saddle.window_dependence`) and the relation's verdict
     (:func:`~hhscatter.analysis.geometry.saddle.kantz_grassberger`); derived table ``saddle_ftle.parquet`` (the
     finite-time exponents Λ/T of the tangent runs); d₀ = 1 − α of the lines run
@@ -63,8 +63,8 @@ class Params(StudyParams):
     tmin_efolds: Number  # t_min = tmin_efolds/κ
     tmin_checks: Numbers  # d₁ also at t_min = c/κ for these c
     window: Numbers  # (lo, hi): fractions of each orbit's lifetime
-    min_boxes: Number
-    min_occupancy: Number
+    min_boxes: Number  # d₁'s largest scale: the points' extent/min_boxes
+    k_max: Integer  # d₁'s largest neighbour rank
     n_bins: Integer  # λ̄(T) bins
     n_boot: Integer
     d0_eps: Numbers  # ε of the uncertainty algorithm, decreasing (position units)
@@ -244,16 +244,60 @@ def _lyapunov(lt, t_min, p):
     return out, lt.assign(ftle=mean.ftle)
 
 
+def _d1_resolution(sp, lam):
+    """(extent, eps_min) of a SaddlePoints: the points' longest side and their distance to the saddle,
+    extent·e^{−λ̄·window[0]·t_min} (the smallest box fitted)."""
+    P = sp.points[["x", "y"]].to_numpy()
+    extent = float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
+    return extent, extent * math.exp(-lam * sp.window[0] * sp.t_min)
+
+
+ERR_PARTS = {"fit": "err_fit", "resample": "err_resample", "range": "err_range"}
+
+
+def _d1_error_record(d, extent, eps_min) -> dict:
+    """The record's keys of d₁'s error: its three parts (section units), the largest, the scaling range in units
+    of the points' extent and what ends it below (``resolution``: the points' distance to the saddle, eps_min;
+    ``points``: the nearest neighbours' distance, the number of points)."""
+    parts = {k: float(getattr(d, a)) for k, a in ERR_PARTS.items()}
+    floor = "resolution" if bool(np.any(d.table["eps"].to_numpy() < eps_min)) else "points"
+    lo, hi = d.eps_range
+    return {"d1_section_err_parts": parts, "d1_err_largest": max(parts, key=lambda k: parts[k] if math.isfinite(parts[k]) else -1.0),
+            "d1_eps_range_extent": [lo / extent, hi / extent], "d1_eps_min_extent": eps_min / extent,
+            "d1_range_floor": floor, "d1_rel_err": d.err / d.value if d.value else math.nan}  # fmt: skip
+
+
+def _d1_precision(records, target: float = 0.03) -> dict:
+    """How many points have d₁ to ≤ ``target`` (relative 1σ), which part of its error is the largest and what ends
+    the scaling range below; its statement."""
+    with_d1 = [r for r in records if r.get("d1_rel_err") is not None]
+    ok = [r for r in with_d1 if r["d1_rel_err"] <= target]
+    largest = {k: sum(r["d1_err_largest"] == k for r in with_d1) for k in ERR_PARTS}
+    floor = {k: sum(r["d1_range_floor"] == k for r in with_d1) for k in ("resolution", "points")}
+    decades = [math.log10(r["d1_eps_range_extent"][1] / r["d1_eps_range_extent"][0]) for r in with_d1]
+    names = {"fit": "the fit's residuals (lacunarity)", "resample": "the bootstrap over orbits",
+             "range": "the range part (the slope changes across the scaling range)"}  # fmt: skip
+    parts = "; ".join(f"{names[k]} at {v}" for k, v in largest.items() if v)
+    span = f"{min(decades):.1f}–{max(decades):.1f}" if decades else "no"
+    statement = (f"d₁ to ≤ {100 * target:.0f} % (1σ) at {len(ok)} of the {len(with_d1)} points with d₁"
+                 + (f" ({', '.join(r['id'] for r in ok)})" if ok else "")
+                 + f"; the largest part of its error: {parts}; the scaling ranges span {span} decades of ε, ended "
+                 f"below by the points' distance to the saddle at {floor['resolution']} points and by the "
+                 f"nearest neighbours' distance (the number of points) at {floor['points']}")  # fmt: skip
+    return {"target": target, "n_with_d1": len(with_d1), "n_within": len(ok), "largest_part": largest,
+            "range_floor": floor, "statement": statement}  # fmt: skip
+
+
 def _d1_estimator(p, lam):
     """The section's information dimension of a SaddlePoints, eps_min from the points' distance to the saddle."""
-    from hhscatter.analysis.geometry.saddle import information_dimension
+    from hhscatter.analysis.geometry.saddle import information_dimension_neighbours
 
     def est(sp):
         P = sp.points[["x", "y"]].to_numpy()
-        extent = float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
-        eps_min = extent * math.exp(-lam * sp.window[0] * sp.t_min)
-        return information_dimension(P, groups=sp.points["traj_id"].to_numpy(), min_boxes=p.min_boxes,
-                                     min_occupancy=p.min_occupancy, eps_min=eps_min, n_boot=p.n_boot, seed=0)  # fmt: skip
+        extent, eps_min = _d1_resolution(sp, lam)
+        return information_dimension_neighbours(P, groups=sp.points["traj_id"].to_numpy(), k_max=p.k_max,
+                                                eps_min=eps_min, eps_max=extent / p.min_boxes, n_boot=p.n_boot,
+                                                seed=0)  # fmt: skip
 
     return est
 
@@ -420,6 +464,8 @@ def _point(study, key, ch):
                 "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points,
                 "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
+    rec.update(_d1_error_record(d, *_d1_resolution(sp, lam["value"])))
+    rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
 
 
@@ -477,6 +523,7 @@ def analyze(study):
             },
             "dimensions": [_dimension_row(x) for x in records],
             "dimensions_summary": dims,
+            "d1_precision": _d1_precision(records),
             **basins,
             "rules": {
                 "tmin_efolds": study.params.tmin_efolds,

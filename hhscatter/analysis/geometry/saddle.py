@@ -75,6 +75,7 @@ __all__ = [
     "dimension_from_uncertainty",
     "dimension_order",
     "information_dimension",
+    "information_dimension_neighbours",
     "kantz_grassberger",
     "lyapunov_convergence",
     "mean_lyapunov",
@@ -499,6 +500,156 @@ def information_dimension(
     """
     return _box_counting(points, weights, groups, divisions=divisions, min_boxes=min_boxes,
                          min_occupancy=min_occupancy, eps_min=eps_min, n_boot=n_boot, seed=seed, kind="information")  # fmt: skip
+
+
+def information_dimension_neighbours(
+    points,
+    groups=None,
+    *,
+    k_max: int = 16,
+    eps_min: float = 0.0,
+    eps_max: float | None = None,
+    n_boot: int = 100,
+    seed: int = 0,
+) -> SaddleDimension:
+    """information_dimension_neighbours(points, groups=None, *, k_max=16, eps_min=0, eps_max=None, n_boot=100, seed=0) -> SaddleDimension.
+
+    d₁ of the measure that the points sample from their nearest-neighbour distances (the fixed-mass estimator:
+    Badii and Politi, J. Stat. Phys. 40, 725 (1985); Grassberger, Phys. Lett. A 107, 101 (1985)): the distance
+    r_k(i) from point i to its k-th neighbour among N points holds the mass fraction k/N, so
+    ⟨ln r_k⟩ = (ψ(k) − ln N)/d₁ + const, the average over the points (the measure) giving the information
+    dimension; ψ is the digamma function, exact for points spread uniformly at the scale r_k (no small-k bias).
+    Scales are spanned by k = 1 … ``k_max`` and by nested subsamples of the ``groups`` (N, N/2, N/4, … points, a
+    random half of the groups at each step, seeded), and d₁ is the least-squares slope of ψ(k) − ln N against
+    ⟨ln r_k⟩ over the pairs (subsample, k) whose scale e^⟨ln r_k⟩ lies in [``eps_min``, ``eps_max``] (at least four).
+    Every point has its own ball, so there is no grid: the lacunarity of box counting (the oscillation of I(ε) as
+    the grid cuts the set's gaps) and its bias from boxes that see the set's outline at the large sizes a few
+    thousand points allow are absent, and the scales reached are those of the neighbours, about (k_max/N)^{1/d₁}
+    of the extent. The error combines, in quadrature, *fit* (the slope's standard error from its residuals),
+    *resample* (bootstrap over ``groups``: each centre weighted by how often its group is drawn, the neighbour
+    distances held) and *range* (half the difference of the slopes on the upper and lower half of the scales).
+    On the area-preserving baker map's natural measure, 10⁴ points in 2000 orbits, the 2σ interval covers the
+    closed form in 19–20 of 20 seeds at relative errors of 0.6–3 % (tests/analysis/geometry/test_saddle.py),
+    where box counting with 4–50 boxes across reads 5–11 % high.
+
+    Parameters
+    ----------
+    points : array (n, D) or (n,)
+        The points (coordinates of comparable scale); no two may coincide.
+    groups : array (n,), optional
+        The independent unit of each point (e.g. its ``traj_id``): resampled by the bootstrap and halved by the
+        subsamples (default: each point).
+    k_max : int
+        The largest neighbour rank used (≥ 2).
+    eps_min, eps_max : float
+        The scaling range (the points' units): eps_min the points' resolution (e.g. how close sprinkler points are to
+        the saddle), eps_max the largest scale (default: an eighth of the points' longest side).
+    n_boot : int
+        Bootstrap replicates over ``groups`` (0: no resampling error).
+    seed : int
+        Seed of the subsamples and of the bootstrap.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(1)
+    >>> t = 2 * np.pi * rng.random(20000)
+    >>> d = information_dimension_neighbours(np.column_stack([np.cos(t), np.sin(t)]), n_boot=20)  # a circle: d₁ = 1
+    >>> bool(abs(d.value - 1) < 2 * d.err), bool(d.err < 0.01)
+    (True, True)
+
+    A set with edges (a filled square) reads low: the balls of points near an edge are cut, a bias that grows with
+    eps_max/extent (−0.03 for the unit square with the default eps_max and 20000 points).
+    """
+    from scipy.spatial import cKDTree  # deferred: scipy loads on first use
+    from scipy.special import digamma  # deferred: scipy loads on first use
+
+    P = _finite_array(points, "points", 2)
+    n = P.shape[0]
+    g = np.arange(n) if groups is None else np.asarray(groups)
+    if g.shape != (n,):
+        raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
+    _, g = np.unique(g, return_inverse=True)
+    g = g.ravel()
+    n_groups = int(g.max()) + 1
+    k_max = _count(k_max, "k_max", 2)
+    n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
+    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
+        raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
+    extent = float(np.max(P.max(axis=0) - P.min(axis=0)))
+    if not extent > 0:
+        raise ConfigError("points: all points coincide (no extent to cover)")
+    eps_max = extent / 8.0 if eps_max is None else _positive(eps_max, "eps_max")
+    if n < 20 * k_max:
+        raise ConfigError(f"points: {n} points, fewer than 20·k_max = {20 * k_max}: give more points or lower k_max")
+    rng = np.random.default_rng(seed)
+    rank = rng.permutation(n_groups)[g]  # the subsample of level j keeps the groups of rank < n_groups/2^j
+    levels = []  # (N, ln r_k of each kept point (N × k_max), their groups)
+    j = 0
+    while True:
+        keep = rank < n_groups / 2.0**j
+        m = int(np.count_nonzero(keep))
+        if m < 20 * k_max or (j and np.count_nonzero(np.bincount(rank[keep])) < 2):
+            break
+        Q = P[keep]
+        dist, _ = cKDTree(Q).query(Q, k=k_max + 1)
+        if not np.all(dist[:, 1] > 0):
+            raise ConfigError("points: some points coincide (a neighbour at distance 0); remove the duplicates")
+        levels.append((m, np.log(dist[:, 1:]), g[keep]))
+        j += 1
+    psi = digamma(np.arange(1, k_max + 1))
+
+    def scales(cnt=None):
+        out = []
+        for _m, lnr, gg in levels:
+            if cnt is None:
+                out.append(lnr.mean(axis=0))
+            else:
+                w = cnt[gg].astype(float)
+                out.append(w @ lnr / w.sum() if w.sum() > 0 else np.full(k_max, np.nan))
+        return np.concatenate(out)
+
+    x = scales()
+    y = np.concatenate([psi - math.log(m) for m, _l, _g in levels])
+    ks = np.tile(np.arange(1, k_max + 1), len(levels))
+    ns = np.repeat([m for m, _l, _g in levels], k_max)
+    use = (np.exp(x) >= eps_min) & (np.exp(x) <= eps_max)
+    if np.count_nonzero(use) < 4:
+        raise ConfigError(
+            f"points: fewer than 4 neighbour scales in [eps_min, eps_max] = [{eps_min:g}, {eps_max:g}] "
+            f"(the k-th neighbours of {n} points lie at {math.exp(x.min()):.3g} … {math.exp(x.max()):.3g}): "
+            f"give more points or widen the range"
+        )
+    b, err_fit = _slope(x[use], y[use])
+    order = np.argsort(-x[use])
+    xs, ys, mu = x[use][order], y[use][order], int(np.count_nonzero(use))
+    b_up = _slope(xs[: (mu + 1) // 2], ys[: (mu + 1) // 2])[0]
+    b_dn = _slope(xs[mu // 2 :], ys[mu // 2 :])[0]
+    err_range = abs(b_up - b_dn) / 2.0
+    if n_boot and n_groups >= 2:
+        reps = np.empty(n_boot)
+        for r in range(n_boot):
+            cnt = np.bincount(rng.integers(0, n_groups, n_groups), minlength=n_groups)
+            reps[r] = _slope(scales(cnt)[use], y[use])[0]
+        err_res = float(np.nanstd(reps, ddof=1))
+    else:
+        err_res = math.nan
+    parts = [e for e in (err_fit, err_res, err_range) if math.isfinite(e)]
+    eps = np.exp(x)
+    table = pd.DataFrame({"eps": eps, "n": ns, "k": ks, "log_mass": y, "fitted": use})
+    return SaddleDimension(
+        value=float(b),
+        err=float(math.sqrt(sum(e * e for e in parts))),
+        err_fit=float(err_fit),
+        err_resample=err_res,
+        err_range=float(err_range),
+        method=f"nearest-neighbour distances (k ≤ {k_max}, {len(levels)} nested subsamples)",
+        eps_range=(float(eps[use].min()), float(eps[use].max())),
+        n_points=int(n),
+        n_groups=n_groups,
+        table=table,
+    )
 
 
 def capacity_dimension(
