@@ -297,3 +297,21 @@ def test_kappa0_is_undefined_where_the_window_holds_the_dead_time_before_the_fir
     assert not small.defined and "before the first escape" in small.reason
     large, res, _ = window_rate(_prompt_then_slow(20000), p, "window rule failed")
     assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0
+
+
+def test_a_map_cell_undefined_by_the_dead_time_records_its_numbers_and_the_rule_gives_the_same_decision():
+    """A κ0 run whose plateau window is a prompt burst (2000 orbits: the window starts at 0, an e-fold of its κ before
+    anyone has left): the cell records the window's start and the first escape, the rule applied to the cell's
+    numbers gives the code's "undefined", and the verdict says why."""
+    p = SimpleNamespace(ratios=[2.6], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01], alt_region=None)
+    lt = _prompt_then_slow(2000)
+    rows, _ = kappa_rows(_Runs(p, {"b_r2.600": lt}), "b", system_from_spec({"name": "henon_heiles"}))
+    reg = [{"system": "barbanis", "label": "b", "e_ratio": 2.6, "ics": "d", "fraction": 0.0, "err": None, "n": 2000}]
+    (cell,) = validity_map(reg, [], rows, [], ics="d", max_bias=0.1)
+    assert cell["kappa0_defined"] is False and cell["plateau_bias"] == 0.0
+    assert cell["kappa0_tau0"] == 0.0 and cell["kappa0_t_first"] == pytest.approx(lt["t_end"].min())
+    assert kappa0_defined_by_rule(cell, 0.1) is False
+    assert cell["kappa0_verdict"].startswith("ill-defined: f∞/P(t_hi) = 0 % ≤ 10 %; window starts 0.8")
+    assert cell["kappa0_verdict"].endswith(
+        "before the first escape: a prompt burst, not an exponential regime; κ ill-defined"
+    )
