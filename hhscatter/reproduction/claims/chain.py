@@ -233,13 +233,16 @@ def _map_kappa_rows(runs, systems) -> list:
                 "source": "map",
             }
             if c is None:
-                row.update(kappa=None, kappa_err=None, tau0=None, plateau_bias=None, defined=False, reason=why)
+                row.update(
+                    kappa=None, kappa_err=None, tau0=None, t_hi=None, plateau_bias=None, defined=False, reason=why
+                )
             else:
                 bias = c.bias_at_end if np.isfinite(c.bias_at_end) else None
                 row.update(
                     kappa=c.kappa,
                     kappa_err=c.kappa_err,
                     tau0=c.t_lo,
+                    t_hi=c.t_hi,
                     plateau_bias=bias,
                     defined=bool(c.defined and c.kappa > 0),
                     reason=c.reason,

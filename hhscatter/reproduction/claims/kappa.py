@@ -58,9 +58,9 @@ def window_rate(lifetimes, p, failure: str):
     """window_rate(lifetimes, p, failure) -> (ConventionRate | None, EscapeRateResult | None, reason).
 
     κ of :func:`rate_or_reason` with the check for a plateau of censored orbits (``p.max_plateau_bias``) and the
-    check that the window does not hold the dead time before the first escape
-    (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`: a prompt burst taken for the regime
-    by a small ensemble); where the window rule fails, None and ``failure`` followed by the rule's message: the
+    check that the window neither holds the dead time before the first escape nor spans less than an e-fold of its
+    κ (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`: a prompt burst, or its hand-over to
+    the regime, taken for the regime by a small ensemble); where the window rule fails, None and ``failure`` followed by the rule's message: the
     reason of this convention alone.
     """
     t_end, obs = lifetimes_to_arrays(lifetimes)
@@ -69,7 +69,7 @@ def window_rate(lifetimes, p, failure: str):
         return None, None, f"{failure}: {why}"
     rate = plateau_rate(res, t_end, obs, max_bias=p.max_plateau_bias)
     if rate.defined and obs.any():
-        ok, dead = dead_time_check(res.tau0, first_escape(t_end[obs]), rate.kappa)
+        ok, dead = dead_time_check(res.tau0, first_escape(t_end[obs]), rate.kappa, t_hi=res.t_stop)
         if not ok:
             rate = dataclasses.replace(rate, defined=False, reason=dead)
     return rate, res, ""
