@@ -47,8 +47,8 @@ def rate_or_reason(lifetimes, min_survivors: float):
 def first_escape(observed_t_end) -> float:
     """first_escape(t_end of the orbits that left) -> the first escape time (time units); NaN where none left.
 
-    >>> first_escape([4.0, 1.5, 9.0]), first_escape([])
-    (1.5, nan)
+    >>> first_escape([4.0, 1.5, 9.0]), math.isnan(first_escape([]))
+    (1.5, True)
     """
     t = [float(x) for x in observed_t_end]
     return min(t) if t else math.nan
