@@ -199,8 +199,8 @@ def kappa0_rule(max_bias: float, min_survivors: float) -> str:
         f"κ0 defined iff the plateau-window rule finds a window (at least {min_survivors:g} orbits left at its end) "
         f"and the orbits still inside at t_max are at most {100 * max_bias:g} % of P(t) at the window's end "
         f"(f∞/P(t_hi) ≤ {100 * max_bias:g} %); and its window starts less than half an e-fold of its κ before the "
-        "first escape and spans at least one e-fold of its κ (else it holds a prompt burst, or the burst's hand-over "
-        "to the regime, not the exponential regime); the regular fraction does not enter the rule"
+        "first escape, and spans at least one e-fold of its κ or one period 2π (else it holds a prompt burst, or the "
+        "burst's hand-over to the regime, not the exponential regime); the regular fraction does not enter the rule"
     )
 
 

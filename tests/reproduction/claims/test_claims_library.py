@@ -303,7 +303,10 @@ def test_kappa0_is_undefined_where_the_window_holds_the_dead_time_before_the_fir
     ("seed", "why"),
     [
         (3, "; window starts 0.8 time units (0.91 e-folds of κ) before the first escape: a prompt burst"),
-        (5, "; window spans 0.32 e-folds of κ (< 1): the local slope where the prompt burst hands over"),
+        (
+            5,
+            "; window spans 0.32 e-folds of κ (< 1) in 0.48 time units (< 6.28): the local slope where the prompt burst",
+        ),
     ],
 )
 def test_a_map_cell_undefined_by_the_dead_time_records_its_numbers_and_the_rule_gives_the_same_decision(seed, why):
