@@ -653,11 +653,19 @@ def study_conventions(root: Path, study: str) -> set[float]:
 
 
 # -- readings typed by hand (hhscatter.publish.readings writes them) ---------------------------------------------------------------------------------------
-#: the words of a comparative or qualitative reading of results
+#: the words of a comparative or qualitative reading of results: verdicts and qualities (agrees, approaches,
+#: monotone, holds, never, …) and comparisons (closer, farther, lies below/above the …, twice as, larger than,
+#: exceeds, better, worse, differs from, only the … does, all within, none (…), consistent)
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
     r"best|worst|consistent(?:ly)? with|compatible with|in line with|as predicted|confirm(?:s|ed)?|match(?:es|ed)?|"
-    r"tracks?|parts? near|(?:over|under)estimat\w*|everywhere|at every (?:energy|scan energy|E))\b",
+    r"tracks?|parts? near|(?:over|under)estimat\w*|everywhere|at every (?:energy|scan energy|E)|"
+    r"closer|farther|further\s+from|(?:lies?|is|are|falls?|drops?|stays?|sits?)\s+(?:(?:well|far|just|slightly)\s+)?"
+    r"(?:below|above)\s+the|above\s+the\s+paper's|twice\s+as|half\s+as|"
+    r"(?:higher|lower|larger|smaller|greater|faster|slower|fewer)\s+than|exceed(?:s|ed|ing)?|better|worse|"
+    r"only\s+(?:as|the\s+\S+(?:\s+\S+)?\s+(?:does|do|is|are|holds?))|all\s+within|none\s+(?=\()|"
+    r"(?:in)?consistent(?:ly)?|differs?\s+from|no\s+[\w-]+(?:\s+[\w-]+)?\s+(?:row|point|cell|value)s?\s+differs?)"
+    r"(?!\w)",
     re.I,
 )
 _PROSE = re.compile(r"<!--\s*prose:(.*?)-->", re.S)

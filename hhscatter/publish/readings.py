@@ -29,6 +29,7 @@ __all__ = [
     "READINGS",
     "closer_words",
     "factor_words",
+    "interval_side",
     "pass_fail_words",
     "reading",
     "trend",
@@ -865,6 +866,166 @@ def _noise_no_drag_survivors(get: Loader) -> str:
     return text
 
 
+# -- comparisons on the study pages (closer, farther, below, differs, within) -------------------------------------
+#: the names the fig5 page gives the rows of its 5b − 5a table
+FIG5_ROW_NAMES = {
+    "old": "reference not cut",
+    "cut": "cut",
+    "cut_offsets": "placements",
+    "cut_offsets_random": "random momenta",
+    "ours": "ours",
+}
+
+
+def interval_side(lo, hi, level: float) -> str:
+    """interval_side(lo, hi, level) -> "below", "above" or "straddles": where an interval lies against a level.
+
+    >>> interval_side(0.02, 0.05, 0.1), interval_side(0.2, 0.3, 0.1), interval_side(0.05, 0.15, 0.1)
+    ('below', 'above', 'straddles')
+    """
+    if hi < level:
+        return "below"
+    if lo > level:
+        return "above"
+    return "straddles"
+
+
+def _ci(value, lo, hi) -> str:
+    return f"{signed(value, '+.3f')}, 95 % [{signed(lo, '+.3f')}, {signed(hi, '+.3f')}]"
+
+
+def _fig2_law_below_break(get: Loader) -> str:
+    """a and b of the κ(E) law below the break against the paper's, convention by convention: each convention's
+    value with the law's statistical error (the conventions share the orbits) against the paper's printed value and
+    its half-unit, by the 2σ rule."""
+    d = get("fig2", None)
+    law = d["kappa_conventions"]["law"]
+    rows = {r["quantity"]: r for r in d["paper_comparison"]}
+    out = []
+    for p in ("a", "b"):
+        ref = rows[f"{p} (κ(E) law across conventions)"]
+        cells = [
+            (conv, verdict(v, law[p]["err_stat"], ref["paper"], ref.get("paper_err") or 0.0).word == "agrees")
+            for conv, v in law[p]["per_convention"].items()
+        ]
+        if all(not ok for _, ok in cells):
+            out.append(
+                f"{p} differs from the paper's {ref['paper']:g} in every convention ({', '.join(c for c, _ in cells)})"
+            )
+        else:
+            out.append(f"{p} against the paper's {ref['paper']:g}: " + pass_fail_words(cells, "agrees", "differs"))
+    return "; ".join(out)
+
+
+def _fig5_ours_5b(get: Loader) -> str:
+    """Our construction's 5b − 5a: farther, closer or as close, from the 95 % interval of Δ = d(5b) − d(5a)."""
+    r = next(x for x in get("fig5", None)["verdict_5b"]["rows"] if x["construction"] == "ours")
+    lo, hi = r["delta_interval"]
+    side = interval_side(lo, hi, 0.0)
+    word = {
+        "above": "5b lies farther from μ_c^0.30 than 5a",
+        "below": "5b lies nearer to μ_c^0.30 than 5a",
+        "straddles": "5b and 5a are as near to μ_c^0.30 (the interval of Δ holds 0)",
+    }[side]
+    return f"{word}: Δ = d(5b) − d(5a) = {_ci(r['delta'], lo, hi)}"
+
+
+def _fig5_eps_first(get: Loader) -> str:
+    """The agreement scale ε*_δ at the largest γ of panel (d): its value and interval, or "none" with the reason
+    read from the curve (d > δ at every informative side, or no run of sides with d ≤ δ from the largest down)."""
+    pd_ = get("fig5", None)["panel_d"]
+    c = max(pd_["curves"], key=lambda x: x["gamma"])
+    if c.get("eps_delta") is not None:
+        lo, hi = c["eps_delta_interval"]
+        return f"{c['eps_delta']:g} [{lo:g}, {hi:g}]"
+    d = [v for v, ok in zip(c["d"], c["informative"], strict=True) if ok]
+    if all(v > pd_["delta"] for v in d):
+        return f"none (d > δ at all {len(d)} informative sides)"
+    return "none (d ≤ δ at no side from the largest down)"
+
+
+#: the 5b − 5a rows that compare like with like (the reference cut like 5a and 5b)
+FIG5_LIKE_FOR_LIKE = ("cut", "cut_offsets", "cut_offsets_random")
+
+
+def _fig5_rows_by_scale(get: Loader) -> str:
+    """The like-for-like 5b − 5a rows (:data:`FIG5_LIKE_FOR_LIKE`) at both scales: those whose 95 % interval of Δ
+    excludes 0, with their sign; and whether random momenta give Δ the other sign than tangential ones."""
+    parts = []
+    for scale, name in (("quick", "the quick scale"), (None, "the paper scale")):
+        rows = [r for r in get("fig5", scale)["verdict_5b"]["rows"] if r["construction"] in FIG5_LIKE_FOR_LIKE]
+        off = [
+            f"{FIG5_ROW_NAMES.get(r['construction'], r['construction'])} ({signed(r['delta'], '+.3f')})"
+            for r in rows
+            if interval_side(*r["delta_interval"], 0.0) != "straddles"
+        ]
+        part = f"at {name} Δ's 95 % interval excludes 0 in {len(off)} of the {len(rows)} like-for-like rows" + (
+            f": {', '.join(off)}" if off else ""
+        )
+        by = {r["construction"]: r for r in rows}
+        t, rnd = by.get("cut_offsets"), by.get("cut_offsets_random")
+        if t and rnd and np.sign(t["delta"]) != np.sign(rnd["delta"]):
+            resolved = [interval_side(*x["delta_interval"], 0.0) != "straddles" for x in (t, rnd)]
+            part += "; random momenta give Δ the other sign than tangential ones" + (
+                "" if any(resolved) else " (neither resolved from 0)"
+            )
+        parts.append(part)
+    return "; ".join(parts)
+
+
+def _noise_reactivation(get: Loader) -> str:
+    """The drag-only survival extended by re-activation against the heat-bath P(t): its largest deviation in units
+    of P's standard error (fails beyond 2), and the tail's rate against the thermal rate by the 2σ rule."""
+    r = get("noise", None)["reactivation"]
+    dev, at, sig = r["model_max_deviation"], r["model_max_deviation_at"], r["model_max_deviation_sigma"]
+    fit = (
+        f"fails in the transient: it differs from the measured P(t) by up to {dev:.3f} (at t = {at:.3g}, {sig:.3g} "
+        "standard errors)"
+        if sig > Z_RESOLVED
+        else f"holds within 2 standard errors (largest deviation {dev:.3f} at t = {at:.3g}, {sig:.3g} standard errors)"
+    )
+    q = r["tail_over_thermal"]
+    v = verdict(q["value"], q["err"], 1.0)
+    tail = (
+        "after it the measured tail decays at the thermal rate"
+        if v.word == "agrees"
+        else "after it the measured tail does not decay at the thermal rate"
+    )
+    return f"{fit}; {tail} (ratio {_ve(q['value'], q['err'])}, z = {signed(v.z)} against 1)"
+
+
+def _noise_window_halves(get: Loader) -> str:
+    """Whether the two halves of every heat-bath window give one rate within ``constancy_z`` σ (the study's flag)."""
+    d = get("noise", None)
+    z = d["config"]["study"]["constancy_z"]
+    if d["conventions"]["all_constant_in_window"]:
+        return f"in every heat-bath window the two halves give rates within {z:.3g}σ of each other"
+    return f"in at least one heat-bath window the two halves give rates more than {z:.3g}σ apart"
+
+
+def _operator_tolerance(get: Loader) -> str:
+    """The operator's three measures against fig1's c-measure at the same energy (E = 0.30): each debiased
+    Hellinger distance's interval against the tolerance δ of fig5's panel (d)."""
+    tol = get("fig5", None)["panel_d"]["delta"]
+    rows = [
+        r
+        for r in get("operator", None)["cmeasure_distances"]
+        if abs(r["fig1_energy"] - 0.3) < 1e-9 and abs(r["operator_energy"] - 0.3) < 1e-9
+    ]
+    groups: dict = {"below": [], "above": [], "straddles": []}
+    for r in rows:
+        lo, hi = r.get("hellinger_debiased_lo"), r.get("hellinger_debiased_hi")
+        side = interval_side(lo, hi, tol) if lo is not None and hi is not None else "straddles"
+        groups[side].append(f"{r['measure']} {r['hellinger_debiased']:.3f} [{lo:.3f}, {hi:.3f}]")
+    words = {
+        "below": f"below fig5's tolerance δ = {tol:g}",
+        "above": f"above δ = {tol:g}",
+        "straddles": f"with an interval that holds δ = {tol:g}",
+    }
+    parts = [f"{words[k]} for {', '.join(v)}" for k, v in groups.items() if v]
+    return "the debiased distance to fig1's c-measure at E = 0.30 (95 % interval) lies " + "; ".join(parts)
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -892,6 +1053,13 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.validity": _generality_validity,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
+    "fig2.law_below_break": _fig2_law_below_break,
+    "fig5.ours_5b": _fig5_ours_5b,
+    "fig5.eps_first": _fig5_eps_first,
+    "fig5.rows_by_scale": _fig5_rows_by_scale,
+    "noise.reactivation": _noise_reactivation,
+    "noise.window_halves": _noise_window_halves,
+    "operator.tolerance": _operator_tolerance,
 }
 
 

@@ -762,3 +762,13 @@ def test_the_heads_of_the_study_tables_name_survivors_by_the_glossary(hook):
     heads = [head for spec in hook.STUDY_TABLES.values() for _, head, *_ in spec]
     assert not [h for h in heads if "trapped" in h.lower()]
     assert "censored boxes" in heads
+
+
+def test_the_glossary_has_a_row_for_every_symbol_the_result_pages_define():
+    """The symbols the study pages use for their results each head a row of the glossary, with one meaning (or its
+    meanings told apart by where they appear)."""
+    text = (DOCS / "equations.md").read_text()
+    rows = text[text.index("## Glossary") :].splitlines()
+    heads = {h.strip() for r in rows if r.startswith("| ") for h in r.split("|")[1].split(",")}
+    wanted = {"κ∞", "P∞", "S_b", "S_bb", "SW1", "β", "t0", "q", "λ̄", "λ∞", "D₁", "d₁", "δ", "z", "t*", "T"}
+    assert wanted <= heads, sorted(wanted - heads)

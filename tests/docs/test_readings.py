@@ -455,3 +455,89 @@ def test_kappa_over_alpha_against_the_decision_rate_by_energy():
     ]
     text = reading(lambda study, scale: {"energy_scan": scan}, "basins.kantz_grassberger")
     assert text == "κ/α and λ are more than 2σ apart at E = 0.19; κ/α lies within 2σ of λ at E = 0.25"
+
+
+def test_the_scan_finds_the_comparisons_that_were_typed():
+    """The comparative sentences the study pages typed before their comparisons were generated are found."""
+    typed = [
+        "one plausible reason why the measured ε_c lies\n  below the prediction.",
+        "the κ(E) law still differs from the paper's below E_b in every\n      convention.",
+        "In our own construction (5b = 5a filtered to the band) 5b is clearly farther,",
+        "| none (d > δ at every scale) |",
+        "No like-for-like row differs\n      from zero at the quick scale; at the paper scale one does",
+        "The measured P(t) drops below the extension during the transient",
+        "the two halves of every heat-bath window are compared (all within",
+        "is below the 0.1 that fig5 uses as its tolerance. But only the *sprinkler* measure does.",
+        "its ε*_δ is twice as large, and its λ larger than κ/α; the quick fit is better, the paper's worse",
+        "the rate exceeds the prediction and is consistent",
+    ]
+    missed = [t for t in typed if not typed_readings(t)]
+    assert not missed, missed
+    # explanations and definitions that are no comparison of results stay free of the scan
+    assert typed_readings("the two halves of every window are compared; a ring of box sides below 1/16") == []
+
+
+def test_interval_side_reads_the_interval_not_the_value():
+    from hhscatter.publish.readings import interval_side
+
+    assert interval_side(0.046, 0.060, 0.0) == "above" and interval_side(-0.02, -0.001, 0.0) == "below"
+    assert interval_side(-0.01, 0.02, 0.0) == "straddles" and interval_side(0.032, 0.038, 0.1) == "below"
+
+
+def test_the_5b_reading_follows_the_sign_of_the_interval():
+    def doc(lo, hi):
+        return {"verdict_5b": {"rows": [{"construction": "ours", "delta": (lo + hi) / 2, "delta_interval": [lo, hi]}]}}
+
+    farther = READINGS["fig5.ours_5b"](_loader({"fig5": doc(0.04, 0.06)}))
+    assert farther.startswith("5b lies farther from μ_c^0.30 than 5a: Δ = d(5b) − d(5a) = +0.050")
+    assert READINGS["fig5.ours_5b"](_loader({"fig5": doc(-0.06, -0.04)})).startswith("5b lies nearer")
+    assert READINGS["fig5.ours_5b"](_loader({"fig5": doc(-0.01, 0.03)})).startswith("5b and 5a are as near")
+
+
+def test_the_law_reading_judges_every_convention_with_the_papers_half_unit():
+    """a = 13.0 ± 0.3 in one convention is 2.1σ from the paper's 13.63 (± 0.005): differs; 13.1 is 1.8σ: agrees."""
+    law = {
+        p: {"err_stat": e, "per_convention": {"one": v1, "two": v2}}
+        for p, e, v1, v2 in (("a", 0.3, 13.0, 13.1), ("b", 0.01, 0.2, 0.3))
+    }
+    comp = [
+        {"quantity": "a (κ(E) law across conventions)", "paper": 13.63, "paper_err": 0.005},
+        {"quantity": "b (κ(E) law across conventions)", "paper": 0.03, "paper_err": 0.005},
+    ]
+    text = READINGS["fig2.law_below_break"](
+        _loader({"fig2": {"kappa_conventions": {"law": law}, "paper_comparison": comp}})
+    )
+    assert text == (
+        "a against the paper's 13.63: differs at one; agrees at two; "
+        "b differs from the paper's 0.03 in every convention (one, two)"
+    )
+
+
+def test_the_reactivation_reading_fails_beyond_two_standard_errors_only():
+    def doc(sigma, ratio):
+        r = {"model_max_deviation": 0.2, "model_max_deviation_at": 25.0, "model_max_deviation_sigma": sigma}
+        return {"reactivation": {**r, "tail_over_thermal": {"value": ratio, "err": 0.02}}}
+
+    text = READINGS["noise.reactivation"](_loader({"noise": doc(43.8, 1.02)}))
+    assert text.startswith("fails in the transient: it differs from the measured P(t) by up to 0.200 (at t = 25")
+    assert "after it the measured tail decays at the thermal rate (ratio 1.020 ± 0.020, z = +1.0 against 1)" in text
+    text = READINGS["noise.reactivation"](_loader({"noise": doc(1.5, 1.10)}))
+    assert text.startswith("holds within 2 standard errors") and "does not decay at the thermal rate" in text
+
+
+def test_the_operator_reading_sorts_each_measure_by_its_interval_against_the_tolerance():
+    rows = [
+        {
+            "measure": m,
+            "fig1_energy": 0.3,
+            "operator_energy": 0.3,
+            "hellinger_debiased": (lo + hi) / 2,
+            "hellinger_debiased_lo": lo,
+            "hellinger_debiased_hi": hi,
+        }
+        for m, lo, hi in (("sprinkler", 0.03, 0.04), ("flux", 0.09, 0.12), ("map", 0.4, 0.5))
+    ]
+    docs = {"operator": {"cmeasure_distances": rows}, "fig5": {"panel_d": {"delta": 0.1}}}
+    text = READINGS["operator.tolerance"](_loader(docs))
+    assert "lies below fig5's tolerance δ = 0.1 for sprinkler 0.035 [0.030, 0.040]" in text
+    assert "above δ = 0.1 for map 0.450" in text and "with an interval that holds δ = 0.1 for flux" in text

@@ -116,15 +116,36 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     return True, bias, ""
 
 
-def dead_time_check(tau0: float, t_first: float, kappa: float, max_dead: float = 0.5):
-    """dead_time_check(τ0, t_first, κ, max_dead=0.5) -> (defined, reason): whether a window starting at τ0 (time
-    units) holds the dead time before the first escape ``t_first`` (time units) for more than ``max_dead`` e-folds
-    of its κ (1/time), i.e. κ·(t_first − τ0) > ``max_dead``.
+def dead_time_check(
+    tau0: float,
+    t_first: float,
+    kappa: float,
+    max_dead: float = 0.5,
+    *,
+    t_hi: float | None = None,
+    min_efolds: float = 1.0,
+    min_span: float = 2.0 * math.pi,
+):
+    """dead_time_check(τ0, t_first, κ, max_dead=0.5, *, t_hi=None, min_efolds=1.0, min_span=2π) -> (defined, reason):
+    whether a
+    window [τ0, t_hi] (time units) with rate κ (1/time) measures an exponential regime rather than the prompt burst
+    of escapes. Two conditions, each a reason for "κ ill-defined":
 
-    An exponential regime P ∝ e^{−κt} has no stretch without escapes. A window that starts in the flat start of
-    P(t), before any orbit has had time to reach the exit, is the prompt burst of escapes, not the regime: the
-    window rule picks it when the burst covers more e-folds of P above the counting floor than the regime after it
-    (a small ensemble, whose floor of ``min_survivors`` orbits sits high), and its κ then moves with N.
+    * *dead time*: the window starts before the first escape ``t_first`` (time units) by more than ``max_dead``
+      e-folds of its κ, i.e. κ·(t_first − τ0) > ``max_dead``;
+    * *inside the burst* (with ``t_hi``): the window spans less than ``min_efolds`` e-folds of its κ and is shorter
+      than ``min_span`` (time units; 2π, one period of the small oscillations for ω = 1, the plateau rule's
+      smallest smoothing width), i.e. κ·(t_hi − τ0) < ``min_efolds`` and t_hi − τ0 < ``min_span``: it averages
+      neither the decay nor the period-modulated escape, and its slope is the local slope of P where the burst
+      hands over to the regime, not a rate that holds. (A window of less than an e-fold that lasts many periods,
+      as near the threshold where κ is small, is not judged here.)
+
+    An exponential regime P ∝ e^{−κt} has no stretch without escapes, and it is measured over at least an e-fold.
+    A window that starts in the flat start of P(t), before any orbit has had time to reach the exit, is the prompt
+    burst of escapes, not the regime: the window rule picks it when the burst covers more e-folds of P above the
+    counting floor than the regime after it (a small ensemble, whose floor of ``min_survivors`` orbits sits high),
+    and its κ then moves with N. The same small ensemble can also give a short window at the burst's end, after
+    the first escape, whose escapes are all burst orbits: the second condition.
 
     Examples
     --------
@@ -132,12 +153,25 @@ def dead_time_check(tau0: float, t_first: float, kappa: float, max_dead: float =
     (False, (True, ''), (True, ''))
     >>> print(dead_time_check(0.0, 1.56, 1.257)[1])
     window starts 1.6 time units (2 e-folds of κ) before the first escape: a prompt burst, not an exponential regime; κ ill-defined
+    >>> dead_time_check(8.3, 1.56, 0.263, t_hi=14.6)     # 1.7 e-folds after the first escape
+    (True, '')
+    >>> print(dead_time_check(2.78, 0.8, 0.661, t_hi=3.26)[1])
+    window spans 0.32 e-folds of κ (< 1) in 0.48 time units (< 6.28): the local slope where the prompt burst hands over, not an exponential regime; κ ill-defined
+    >>> dead_time_check(169.0, 5.17, 0.00398, t_hi=369.0)      # 0.8 e-fold over 200 time units: not a burst
+    (True, '')
     """
     dead = (t_first - tau0) * kappa
     if math.isfinite(dead) and dead > max_dead:
         return False, (
             f"window starts {t_first - tau0:.2g} time units ({dead:.2g} e-folds of κ) before the first escape: "
             "a prompt burst, not an exponential regime; κ ill-defined"
+        )
+    length = math.nan if t_hi is None else t_hi - tau0
+    span = length * kappa
+    if math.isfinite(span) and span < min_efolds and length < min_span:
+        return False, (
+            f"window spans {span:.2g} e-folds of κ (< {min_efolds:g}) in {length:.2g} time units (< {min_span:.3g}): "
+            "the local slope where the prompt burst hands over, not an exponential regime; κ ill-defined"
         )
     return True, ""
 

@@ -220,7 +220,7 @@ def _map_kappa_rows(runs, systems) -> list:
     for label, _spec, m in systems:
         for r in map_ratios(p):
             lt = runs.lifetimes(map_key(label, r))
-            obs = lifetimes_to_arrays(lt)[1]
+            t_end, obs = lifetimes_to_arrays(lt)
             c, _, why = kappa.window_rate(lt, p, "window rule failed")
             row = {
                 "system": label,
@@ -229,15 +229,20 @@ def _map_kappa_rows(runs, systems) -> list:
                 "convention": "plateau",
                 "n": int(obs.size),
                 "trapped_fraction": float((~obs).mean()),
+                "t_first": kappa.first_escape(t_end[obs]),
                 "source": "map",
             }
             if c is None:
-                row.update(kappa=None, kappa_err=None, plateau_bias=None, defined=False, reason=why)
+                row.update(
+                    kappa=None, kappa_err=None, tau0=None, t_hi=None, plateau_bias=None, defined=False, reason=why
+                )
             else:
                 bias = c.bias_at_end if np.isfinite(c.bias_at_end) else None
                 row.update(
                     kappa=c.kappa,
                     kappa_err=c.kappa_err,
+                    tau0=c.t_lo,
+                    t_hi=c.t_hi,
                     plateau_bias=bias,
                     defined=bool(c.defined and c.kappa > 0),
                     reason=c.reason,

@@ -35,6 +35,7 @@ from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
 from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured
+from hhscatter.analysis.survival.kappa_conventions import dead_time_check
 from hhscatter.analysis.survival.long_time import (
     fit_plateau_exponential,
     hazard_profile,
@@ -198,25 +199,44 @@ def kappa0_rule(max_bias: float, min_survivors: float) -> str:
         f"κ0 defined iff the plateau-window rule finds a window (at least {min_survivors:g} orbits left at its end) "
         f"and the orbits still inside at t_max are at most {100 * max_bias:g} % of P(t) at the window's end "
         f"(f∞/P(t_hi) ≤ {100 * max_bias:g} %); and its window starts less than half an e-fold of its κ before the "
-        "first escape (else it holds a prompt burst, not the exponential regime); the regular fraction does not "
-        "enter the rule"
+        "first escape, and spans at least one e-fold of its κ or one period 2π (else it holds a prompt burst, or the "
+        "burst's hand-over to the regime, not the exponential regime); the regular fraction does not enter the rule"
     )
 
 
 def kappa0_defined_by_rule(cell: dict, max_bias: float):
     """kappa0_defined_by_rule(cell, max_bias) -> True, False, or None (no κ0 run at the cell's energy): the rule of
-    :func:`kappa0_rule` applied to the numbers a validity-map cell records (``kappa0``, ``plateau_bias``: None where
-    the window rule found no window).
+    :func:`kappa0_rule` applied to the numbers a validity-map cell records: ``kappa0`` (1/time), ``plateau_bias``
+    (None where the window rule found no window), and for the dead-time condition
+    (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`) the window's start and end
+    ``kappa0_tau0``, ``kappa0_t_hi`` and the first escape ``kappa0_t_first`` (time units). A record made before the
+    cells carried them is judged on the plateau condition alone.
 
     >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.84}, 0.1)
     False
     >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.03}, 0.1)
     True
+    >>> burst = {"kappa0": {"value": 1.26, "err": 0.29}, "plateau_bias": 0.0, "kappa0_tau0": 0.0, "kappa0_t_first": 1.56}
+    >>> kappa0_defined_by_rule(burst, 0.1)     # the window starts 2 e-folds of its κ before anyone has left
+    False
     """
     if "kappa0" not in cell:
         return None
     k, bias = (cell.get("kappa0") or {}).get("value"), cell.get("plateau_bias")
-    return bool(k is not None and k > 0 and bias is not None and bias <= max_bias)
+    if not (k is not None and k > 0 and bias is not None and bias <= max_bias):
+        return False
+    if "kappa0_tau0" not in cell:
+        return True
+    return _dead_time(cell, k)[0]
+
+
+def _dead_time(cell: dict, kappa: float) -> tuple:
+    """(ok, reason) of the dead-time conditions on a cell's window and first escape (no window start: ok)."""
+    tau0, t_first = _finite(cell.get("kappa0_tau0")), _finite(cell.get("kappa0_t_first"))
+    if tau0 is None:
+        return True, ""
+    t_hi = _finite(cell.get("kappa0_t_hi"))
+    return dead_time_check(tau0, math.nan if t_first is None else t_first, kappa, t_hi=t_hi)
 
 
 def _kappa0_words(row: dict, max_bias: float) -> str:
@@ -227,11 +247,18 @@ def _kappa0_words(row: dict, max_bias: float) -> str:
     cmp = "≤" if bias <= max_bias else ">"
     word = "defined" if row["defined"] else "ill-defined"
     pct = 100 * bias
-    return (
+    words = (
         f"{word}: f∞/P(t_hi) = {pct:.3g} % {cmp} {100 * max_bias:g} %"
         if pct < 1000
         else (f"{word}: f∞/P(t_hi) = {pct:.0f} % {cmp} {100 * max_bias:g} %")
     )
+    kappa = _finite(row.get("kappa"))
+    if bias <= max_bias and kappa is not None and kappa > 0:
+        window = {"kappa0_tau0": row.get("tau0"), "kappa0_t_hi": row.get("t_hi"), "kappa0_t_first": row.get("t_first")}
+        ok, dead = _dead_time(window, kappa)
+        if not ok:
+            words += "; " + dead
+    return words
 
 
 def validity_map(
@@ -245,7 +272,8 @@ def validity_map(
     paper's convention (all orbits, plateau windows) from the ``kappa`` records at that E/E_c (the claims' grid, or a
     κ0 run of the map with the claims' scene: ``kappa0_source``): ``kappa0`` (value, err; 1/time), ``kappa0_n``,
     ``trapped_fraction`` (still inside at t_max), ``plateau_bias`` (that fraction over P at the window's end; None
-    where no window), ``kappa0_defined`` (the code's decision; None where no κ0 run is at that energy),
+    where no window), ``kappa0_tau0``, ``kappa0_t_hi`` and ``kappa0_t_first`` (the window's start and end and the
+    run's first escape, time units: the dead-time conditions), ``kappa0_defined`` (the code's decision; None where no κ0 run is at that energy),
     ``kappa0_reason`` and, with ``max_bias`` (the study's ``max_plateau_bias``), ``kappa0_verdict`` (the decision with
     the numbers that decide it, by :func:`kappa0_rule`); claim2 (claim 2's verdict at that E/E_c, paper's
     convention, where tested); exponential (one exponential describes the non-regular orbits from t0, from ``fits``;
@@ -283,6 +311,9 @@ def validity_map(
                 "kappa0_source": row.get("source", "claims"),
                 "trapped_fraction": _finite(row.get("trapped_fraction")),
                 "plateau_bias": _finite(row.get("plateau_bias")),
+                "kappa0_tau0": _finite(row.get("tau0")),
+                "kappa0_t_hi": _finite(row.get("t_hi")),
+                "kappa0_t_first": _finite(row.get("t_first")),
                 "kappa0_reason": row.get("reason") or "",
             }
             if max_bias is not None and "plateau_bias" in row:

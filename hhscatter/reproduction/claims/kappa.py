@@ -44,13 +44,23 @@ def rate_or_reason(lifetimes, min_survivors: float):
         return None, str(exc)
 
 
+def first_escape(observed_t_end) -> float:
+    """first_escape(t_end of the orbits that left) -> the first escape time (time units); NaN where none left.
+
+    >>> first_escape([4.0, 1.5, 9.0]), math.isnan(first_escape([]))
+    (1.5, True)
+    """
+    t = [float(x) for x in observed_t_end]
+    return min(t) if t else math.nan
+
+
 def window_rate(lifetimes, p, failure: str):
     """window_rate(lifetimes, p, failure) -> (ConventionRate | None, EscapeRateResult | None, reason).
 
     κ of :func:`rate_or_reason` with the check for a plateau of censored orbits (``p.max_plateau_bias``) and the
-    check that the window does not hold the dead time before the first escape
-    (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`: a prompt burst taken for the regime
-    by a small ensemble); where the window rule fails, None and ``failure`` followed by the rule's message: the
+    check that the window neither holds the dead time before the first escape nor spans less than an e-fold of its
+    κ (:func:`~hhscatter.analysis.survival.kappa_conventions.dead_time_check`: a prompt burst, or its hand-over to
+    the regime, taken for the regime by a small ensemble); where the window rule fails, None and ``failure`` followed by the rule's message: the
     reason of this convention alone.
     """
     t_end, obs = lifetimes_to_arrays(lifetimes)
@@ -59,7 +69,7 @@ def window_rate(lifetimes, p, failure: str):
         return None, None, f"{failure}: {why}"
     rate = plateau_rate(res, t_end, obs, max_bias=p.max_plateau_bias)
     if rate.defined and obs.any():
-        ok, dead = dead_time_check(res.tau0, float(t_end[obs].min()), rate.kappa)
+        ok, dead = dead_time_check(res.tau0, first_escape(t_end[obs]), rate.kappa, t_hi=res.t_stop)
         if not ok:
             rate = dataclasses.replace(rate, defined=False, reason=dead)
     return rate, res, ""
@@ -68,7 +78,8 @@ def window_rate(lifetimes, p, failure: str):
 def kappa_rows(runs, label, m):
     """kappa_rows(runs, label, system) -> (rows, fits): one row per (E/E_c, convention) with κ (1/time), its error,
     τ0, window, trapped fraction, plateau_bias (the trapped fraction over P at the window's end, which the plateau
-    check holds to ``p.max_plateau_bias``), defined and the reason of that convention; fits {r: result of all orbits,
+    check holds to ``p.max_plateau_bias``), t_first (the first escape of the ensemble, which the dead-time check
+    compares with τ0), defined and the reason of that convention; fits {r: result of all orbits,
     ('escaping', r): result of the escaping orbits}. Conventions: 'plateau' (all orbits), 'plevel' (P-level
     windows), 'escaping' (orbits still inside at t_max dropped) and ``p.alt_region`` (the other ICs)."""
     p = runs.params
@@ -76,7 +87,7 @@ def kappa_rows(runs, label, m):
     for r in p.ratios:
         lt = runs.lifetimes(grid_key(label, r))
         t_end, obs = lifetimes_to_arrays(lt)
-        rates, reasons, trapped = {}, {}, {}
+        rates, reasons, trapped, first = {}, {}, {}, {}
         rates["plateau"], fits[r], reasons["plateau"] = window_rate(lt, p, "window rule failed")
         rates["plevel"] = escape_rate_p_levels(
             t_end, obs, p_hi=p.p_levels[0], p_lo=p.p_levels[1], max_bias=p.max_plateau_bias
@@ -91,7 +102,9 @@ def kappa_rows(runs, label, m):
             rates[p.alt_region], _, reasons[p.alt_region] = window_rate(
                 lt_a, p, f"window rule failed with {p.alt_region} ICs"
             )
-            trapped[p.alt_region] = float((~lifetimes_to_arrays(lt_a)[1]).mean())
+            t_a, obs_a = lifetimes_to_arrays(lt_a)
+            trapped[p.alt_region] = float((~obs_a).mean())
+            first[p.alt_region] = first_escape(t_a[obs_a])
         fits = {k: v for k, v in fits.items() if v is not None}
         for conv, c in rates.items():
             base = {
@@ -102,6 +115,7 @@ def kappa_rows(runs, label, m):
                 "convention": conv,
                 "n": int(t_end.size),
                 "trapped_fraction": trapped.get(conv, float((~obs).mean())),
+                "t_first": first.get(conv, first_escape(t_end[obs])),
             }
             if c is None:
                 rows.append(

@@ -132,3 +132,16 @@ def test_a_window_holding_the_dead_time_before_the_first_escape_is_no_exponentia
     assert not dead_time_check(0.0, 1.56, 1.257)[0]  # 1.96 e-folds without an escape
     assert dead_time_check(0.0, 0.4, 1.0)[0]  # 0.4 e-fold: a flight time inside the regime
     assert dead_time_check(8.3, 1.56, 0.263) == (True, "")  # the window starts after the first escape
+
+
+def test_a_window_shorter_than_an_e_fold_of_its_kappa_is_the_bursts_hand_over_not_a_regime():
+    """κ·(t_hi − τ0) < 1 within one period 2π: the window's slope is a local slope, whatever its start."""
+    from hhscatter.analysis.survival.kappa_conventions import dead_time_check
+
+    ok, why = dead_time_check(2.78, 0.8, 0.661, t_hi=3.26)  # 0.32 e-folds, after the first escape
+    assert not ok and why.startswith("window spans 0.32 e-folds of κ (< 1)")
+    assert dead_time_check(8.3, 1.56, 0.263, t_hi=14.6) == (True, "")  # 1.7 e-folds
+    assert dead_time_check(8.3, 1.56, 0.263, t_hi=14.6, min_efolds=2.0, min_span=10.0)[0] is False
+    # less than an e-fold but over many periods (near the threshold, κ small): not the burst's hand-over
+    assert dead_time_check(169.0, 5.17, 0.00398, t_hi=369.0) == (True, "")
+    assert dead_time_check(2.78, 0.8, 0.661) == (True, "")  # without the window's end only the start is judged

@@ -297,3 +297,59 @@ def test_kappa0_is_undefined_where_the_window_holds_the_dead_time_before_the_fir
     assert not small.defined and "before the first escape" in small.reason
     large, res, _ = window_rate(_prompt_then_slow(20000), p, "window rule failed")
     assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0
+
+
+@pytest.mark.parametrize(
+    ("seed", "why"),
+    [
+        (3, "; window starts 0.8 time units (0.91 e-folds of κ) before the first escape: a prompt burst"),
+        (
+            5,
+            "; window spans 0.32 e-folds of κ (< 1) in 0.48 time units (< 6.28): the local slope where the prompt burst",
+        ),
+    ],
+)
+def test_a_map_cell_undefined_by_the_dead_time_records_its_numbers_and_the_rule_gives_the_same_decision(seed, why):
+    """A κ0 run whose plateau window is the prompt burst (2000 orbits; seed 3: the window starts at 0, an e-fold of
+    its κ before anyone has left; seed 5: a third of an e-fold at the burst's end): the cell records the window and
+    the first escape, the rule applied to the cell's numbers gives the code's "undefined", and the verdict says
+    why."""
+    p = SimpleNamespace(ratios=[2.6], min_survivors=50.0, max_plateau_bias=0.1, p_levels=[0.5, 0.01], alt_region=None)
+    lt = _prompt_then_slow(2000, seed=seed)
+    rows, _ = kappa_rows(_Runs(p, {"b_r2.600": lt}), "b", system_from_spec({"name": "henon_heiles"}))
+    reg = [{"system": "barbanis", "label": "b", "e_ratio": 2.6, "ics": "d", "fraction": 0.0, "err": None, "n": 2000}]
+    (cell,) = validity_map(reg, [], rows, [], ics="d", max_bias=0.1)
+    assert cell["kappa0_defined"] is False and cell["plateau_bias"] == 0.0
+    assert cell["kappa0_t_first"] == pytest.approx(lt["t_end"].min())
+    assert 0.0 <= cell["kappa0_tau0"] < cell["kappa0_t_hi"] < 6.0
+    assert kappa0_defined_by_rule(cell, 0.1) is False
+    assert cell["kappa0_verdict"].startswith("ill-defined: f∞/P(t_hi) = 0 % ≤ 10 %" + why)
+    assert cell["kappa0_verdict"].endswith("not an exponential regime; κ ill-defined")
+
+
+def test_kappa0_is_undefined_where_a_short_window_lies_inside_the_prompt_burst():
+    """The same distribution, another draw of 2000 orbits (seed 5): the plateau rule takes a window after the first
+    escape, [2.8, 3.3], where every escape is a burst orbit (the slow 5 % leave only from t = 6): κ ≈ 0.66 against
+    the regime's 0.26, over a third of an e-fold. κ0 is undefined and says why; with 20 000 orbits of that seed the
+    window is the regime's, over more than an e-fold, and κ0 is defined and right."""
+    from hhscatter.reproduction.claims.kappa import window_rate
+
+    p = SimpleNamespace(min_survivors=50.0, max_plateau_bias=0.1)
+    lt = _prompt_then_slow(2000, seed=5)
+    small, res, why = window_rate(lt, p, "window rule failed")
+    assert why == "" and lt["t_end"].min() < res.tau0 < 6.0 and res.kappa > 0.5  # inside the burst, after t_first
+    assert not small.defined and "spans 0.3" in small.reason and "e-folds of κ (< 1)" in small.reason
+    large, res, _ = window_rate(_prompt_then_slow(20000, seed=5), p, "window rule failed")
+    assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_one_exponential_of_2000_orbits_keeps_kappa0_defined_under_the_burst_conditions(seed):
+    """A pure exponential (κ = 0.05 after a flight time of 2, no burst): the window spans several e-folds and starts
+    after the first escape, so neither dead-time condition fires."""
+    from hhscatter.reproduction.claims.kappa import window_rate
+
+    p = SimpleNamespace(min_survivors=50.0, max_plateau_bias=0.1)
+    t = 2.0 + np.random.default_rng(seed).exponential(1 / 0.05, 2000)
+    rate, _, why = window_rate(_lt(t), p, "window rule failed")
+    assert why == "" and rate.defined and abs(rate.kappa - 0.05) < 0.005
