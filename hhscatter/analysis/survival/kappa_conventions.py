@@ -41,6 +41,7 @@ from hhscatter.analysis.survival.fits import (
     survival_curve,
 )
 from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy, kappa_law_summary
+from hhscatter.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,7 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     falls to ``p_lo`` (e.g. a plateau of trapped orbits above it).
     """
     if not 0 < p_lo < p_hi < 1:
-        raise ValueError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
+        raise ConfigError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
     t = np.asarray(t, dtype=float)
     P = np.asarray(P, dtype=float)
     ia, ib = np.flatnonzero(P <= p_hi), np.flatnonzero(P <= p_lo)
