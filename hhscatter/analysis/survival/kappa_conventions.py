@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hhscatter.analysis.stats.library_warnings import counted
-from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.analysis.stats.measured import Measured, WithErrors
 from hhscatter.analysis.survival.fits import (
     fit_exponential,
     mean_kappa_stat_err,
@@ -240,6 +240,31 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
 LAW_PARAMETERS = ("a", "b", "c", "E_b")
 
 
+@dataclass(frozen=True)
+class ConventionSpread:
+    """One parameter across conventions: its :class:`~hhscatter.analysis.stats.measured.Measured` (the mean over
+    the conventions, error √(spread² + err_stat²)), ``err_stat`` (the largest statistical error of one convention),
+    ``spread`` (half the range across conventions) and ``per_convention`` {convention: value}; same unit as the
+    parameter.
+
+    Examples
+    --------
+    >>> ConventionSpread(Measured(12.0, 2.5), 1.5, 2.0, {"one": 10.0, "two": 14.0}).to_dict()["err"]
+    2.5
+    """
+
+    measured: Measured
+    err_stat: float
+    spread: float
+    per_convention: dict
+
+    def to_dict(self) -> dict:
+        """``{value, err_stat, spread, err, per_convention}``: the record as a numbers JSON holds it."""
+        m = self.measured
+        fields = ("value", "err_stat", "spread", "err", "per_convention")
+        return dict(zip(fields, (m.value, self.err_stat, self.spread, m.err, self.per_convention)))
+
+
 def law_spread(fits: dict) -> dict:
     """law_spread({convention: KappaEnergyFit}) -> {param: {value, err_stat, spread, err, per_convention}}.
 
@@ -255,13 +280,9 @@ def law_spread(fits: dict) -> dict:
         v = np.array(list(vals.values()))
         spread = float((v.max() - v.min()) / 2) if v.size else math.nan
         stat = float(np.nanmax(errs)) if errs and np.isfinite(errs).any() else math.nan
-        out[p] = {
-            "value": float(v.mean()) if v.size else math.nan,
-            "err_stat": stat,
-            "spread": spread,
-            "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
-            "per_convention": vals,
-        }
+        total = float(math.hypot(spread, stat)) if math.isfinite(stat) else spread
+        m = Measured(float(v.mean()) if v.size else math.nan, total, "mean over conventions", len(vals))
+        out[p] = ConventionSpread(m, stat, spread, vals).to_dict()
     return out
 
 
