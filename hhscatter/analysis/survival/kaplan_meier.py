@@ -34,6 +34,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = ["KaplanMeierGrid", "SurvivalCurve", "km_steps", "survival_curve", "survival_on_grid"]
@@ -73,7 +74,9 @@ def _std_err(S, var_log):
 
 
 def _check(t_end, observed, weights):
-    t_end = np.asarray(t_end, dtype=float).ravel()
+    t_end = check.numbers(t_end, "t_end", min_size=0)
+    if isinstance(observed, (str, bytes, dict)) or observed is None:
+        raise ConfigError(f"observed must be a boolean mask, got {type(observed).__name__}")
     observed = np.asarray(observed).ravel()
     if observed.dtype != bool:
         raise ConfigError(f"observed must be a boolean mask, got dtype {observed.dtype}")
@@ -84,7 +87,7 @@ def _check(t_end, observed, weights):
     if np.any(t_end < 0):
         raise ConfigError("t_end must be ≥ 0")
     if weights is not None:
-        weights = np.asarray(weights, dtype=float).ravel()
+        weights = check.numbers(weights, "weights", min_size=0)
         if weights.shape != t_end.shape or np.any(weights < 0) or not np.all(np.isfinite(weights)):
             raise ConfigError("weights must be finite, non-negative and as long as t_end")
     return t_end, observed, weights
