@@ -27,6 +27,7 @@ import pandas as pd
 
 from hhscatter.analysis.dissipative.decay import fit_energy_decay, mu_by_window
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.reproduction.verdicts import quoted_verdict, verdict_beside_authors
 
 __all__ = [
@@ -296,8 +297,7 @@ def authors_convention(
                         if is_ours
                         else f"μ on {_window_text(w)}, {_WHO[sel]}"
                     ),
-                    "value": f.mu,
-                    "err": err,
+                    **Measured(f.mu, err).to_dict(),
                     "fit_err": f.mu_err,
                     "n_points": f.n_points,
                     "t_last": t_last,

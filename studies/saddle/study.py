@@ -227,7 +227,7 @@ def _lyapunov(lt, t_min, p):
     mean = mean_lyapunov(L, T, n_boot=p.n_boot, seed=0)
     out = {"mean": mean.value, "mean_err": mean.err, "n_orbits": mean.n_orbits, "ftle_std": mean.ftle_std,
            "ftle_q05": mean.ftle_quantiles[0.05], "ftle_q50": mean.ftle_quantiles[0.5],
-           "ftle_q95": mean.ftle_quantiles[0.95], "value": mean.value, "err": mean.err, "rule": "mean"}  # fmt: skip
+           "ftle_q95": mean.ftle_quantiles[0.95], **Measured(mean.value, mean.err).to_dict(), "rule": "mean"}  # fmt: skip
     try:
         c = lyapunov_convergence(L, T, n_bins=p.n_bins, n_boot=p.n_boot, seed=0)
     except ConfigError as exc:

@@ -7,7 +7,9 @@ before any work. The profile is bounded and derandomized, as in tests/api/test_p
 
 from __future__ import annotations
 
+import ast
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -19,14 +21,19 @@ from hhscatter.analysis.geometry import saddle
 from hhscatter.analysis.noise import (
     exit_fractions,
     finite_barrier_fit,
+    kramers_langer,
     laplace_coefficient,
     noise_energy_gain,
+    reactivation_check,
+    reactivation_survival,
     survivor_energies,
     thermal_rate,
     transition_state_correction,
+    turnover_rate,
     well_barrier,
     window_constancy,
 )
+from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
@@ -281,3 +288,98 @@ def test_window_dependence_names_the_bad_argument(data, which):
     )
     _refused(which if which != "windows" or args[which] == [] else "window", saddle.window_dependence, LT, STATES,
              **args)  # fmt: skip
+
+
+# -- the estimators' own refusals ---------------------------------------------------------------------------------
+ANALYSIS = Path(__file__).resolve().parents[2] / "hhscatter" / "analysis"
+
+
+def _plain_raises(path: Path) -> list[str]:
+    """``raise ValueError(…)`` / ``raise TypeError(…)`` statements of one module, as 'module:line'."""
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Raise) and node.exc is not None:
+            exc = node.exc.func if isinstance(node.exc, ast.Call) else node.exc
+            if isinstance(exc, ast.Name) and exc.id in ("ValueError", "TypeError"):
+                out.append(f"{path.relative_to(ANALYSIS)}:{node.lineno}")
+    return out
+
+
+def test_the_estimators_refuse_with_the_projects_own_error():
+    """Every refusal of an estimator is a ConfigError (a ValueError too), never a plain ValueError or TypeError."""
+    plain = [hit for f in sorted(ANALYSIS.rglob("*.py")) if f.name != "_arguments.py" for hit in _plain_raises(f)]
+    assert plain == []
+
+
+def test_an_exception_class_of_the_estimators_is_the_projects():
+    tree = [ast.parse(f.read_text(encoding="utf-8")) for f in sorted(ANALYSIS.rglob("*.py"))]
+    bases = {b.id for t in tree for node in ast.walk(t) if isinstance(node, ast.ClassDef) for b in node.bases
+             if isinstance(b, ast.Name) and b.id.endswith(("Error", "Exception"))}  # fmt: skip
+    assert bases <= {"ConfigError", "HHScatterError"}
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["model", "gamma", "temperature"]))
+def test_kramers_langer_names_the_bad_argument(data, which):
+    args = {"model": HenonHeiles(), "gamma": 1.0, "temperature": 1 / 36}
+    args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0), st.just(0.0)))
+    _refused(which, kramers_langer, **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["kl", "actions"]))
+def test_turnover_rate_names_the_bad_argument(data, which):
+    args = {"kl": kramers_langer(HenonHeiles(), 1.0, 1 / 18), "actions": 0.5}
+    bad = {"kl": st.one_of(NOT_A_NUMBER, st.just(object())),
+           "actions": st.one_of(NOT_NUMBERS, st.just(np.array([])), st.just(np.ones(2)), st.just(-1.0),
+                                st.just(math.nan))}  # fmt: skip
+    args[which] = data.draw(bad[which])
+    _refused(which, turnover_rate, **args)
+
+
+R0 = {"t_end0": T, "escaped0": OBS, "settled0": ~OBS, "t_end": T, "escaped": OBS}
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["t", "t_end", "escaped", "settled", "rate"]))
+def test_reactivation_survival_names_the_bad_argument(data, which):
+    args = {"t": np.array([1.0, 2.0]), "t_end": T, "escaped": OBS, "settled": ~OBS, "rate": 0.1}
+    if which == "t":  # a grid of its own: any length
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.sampled_from([[], [1.0, math.nan], [math.inf], [-1.0]])))
+    elif which == "t_end":
+        args[which] = _bad_array(data.draw, args[which])
+    elif which == "rate":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0)))
+    else:
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 2))))
+    _refused(which, reactivation_survival, **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from([*R0, "rate", "t_max", "tail_start", "n_grid"]))
+def test_reactivation_check_names_the_bad_argument(data, which):
+    args = {**R0, "rate": 0.1, "t_max": 12.0, "tail_start": 6.0, "n_grid": 11}
+    if which.startswith("t_end"):
+        args[which] = _bad_array(data.draw, T)
+    elif which in R0:
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 2))))
+    elif which == "n_grid":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers(-3, 1), st.just(2.5)))
+    else:
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0)))
+    _refused(which, reactivation_check, **args)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["t_end", "observed", "t_start", "t_stop"]))
+def test_escape_rate_mle_names_the_bad_argument(data, which):
+    args = {"t_end": T, "observed": OBS, "t_start": 2.0, "t_stop": 10.0}
+    if which == "t_end":
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(T[:-1]), st.just(np.r_[T[:-1], math.nan])))
+    elif which == "observed":
+        args[which] = data.draw(st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 0.5))))
+    elif which == "t_start":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0)))
+    else:
+        args[which] = data.draw(NOT_A_NUMBER)
+    _refused(which, escape_rate_mle, **args)

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
+from hhscatter.errors import ConfigError
+
 __all__ = [
     "FitStats",
     "best_of",
@@ -41,7 +43,7 @@ def select_points(t, P, P_err, tau0, t_max, P_min):
     P = np.asarray(P, dtype=float).ravel()
     P_err = np.asarray(P_err, dtype=float).ravel()
     if not (t.shape == P.shape == P_err.shape):
-        raise ValueError("t, P and P_err must have the same length")
+        raise ConfigError("t, P and P_err must have the same length")
     sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
     if t_max is not None:
         sel &= t <= t_max
@@ -56,7 +58,7 @@ def p_at(t, P, P_err, t0):
     ok = np.isfinite(P) & (P > 0)
     t, P, E = t[ok], P[ok], E[ok]
     if t.size == 0 or t0 < t[0] or t0 > t[-1]:
-        raise ValueError("cannot interpolate P at tau0 from the data; pass P_tau0")
+        raise ConfigError("cannot interpolate P at tau0 from the data; pass P_tau0")
     return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
 
 
@@ -78,7 +80,7 @@ def residual_fn(curve, P, sig, space):
             return (np.where(np.isfinite(m), m, 0.0) - P) / sig
 
     else:
-        raise ValueError(f"space must be 'log' or 'linear', got {space!r}")
+        raise ConfigError(f"space must be 'log' or 'linear', got {space!r}")
     return res
 
 

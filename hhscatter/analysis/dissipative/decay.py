@@ -84,15 +84,15 @@ def snapshot_grid(pieces) -> np.ndarray:
     out = []
     for p in pieces:
         if len(p) != 3:
-            raise ValueError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
+            raise ConfigError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
         start, stop, step = (float(v) for v in p)
         if not step > 0 or stop < start:
-            raise ValueError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
+            raise ConfigError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
         k = np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
         out.append(np.round(start + step * k, 9))
     g = np.concatenate(out) if out else np.empty(0)
     if g.size == 0 or np.any(np.diff(g) <= 0):
-        raise ValueError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
+        raise ConfigError("snapshot_grid must give strictly increasing times (pieces in order, no overlap)")
     return g
 
 
@@ -113,9 +113,9 @@ def time_to_energy(E0, E1, mu, gamma):
     """
     E0, E1, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E1, mu, gamma)))
     if np.any(E1 <= 0) or np.any(E0 < E1):
-        raise ValueError("need E0 >= E1 > 0")
+        raise ConfigError("need E0 >= E1 > 0")
     if np.any(mu * gamma <= 0):
-        raise ValueError("need mu*gamma > 0")
+        raise ConfigError("need mu*gamma > 0")
     out = np.log(E0 / E1) / (mu * gamma)
     return float(out) if out.ndim == 0 else out
 
@@ -140,7 +140,7 @@ def mean_energy_arrays(t, energy) -> pd.DataFrame:
     t = np.asarray(t, dtype=float).ravel()
     e = np.asarray(energy, dtype=float).ravel()
     if t.shape != e.shape:
-        raise ValueError(f"t and energy differ in length: {t.size} != {e.size}")
+        raise ConfigError(f"t and energy differ in length: {t.size} != {e.size}")
     ok = np.isfinite(e) & np.isfinite(t)
     t, e = t[ok], e[ok]
     grid, inv = np.unique(t, return_inverse=True)
@@ -353,14 +353,14 @@ def _decay_window(t, mean_E, E0, gamma, window, weights):
     non-positive weight; ``weights`` None gives unit weights.
     """
     if not gamma > 0:
-        raise ValueError(f"gamma must be > 0, got {gamma!r}")
+        raise ConfigError(f"gamma must be > 0, got {gamma!r}")
     if not E0 > 0:
-        raise ValueError(f"E0 must be > 0, got {E0!r}")
+        raise ConfigError(f"E0 must be > 0, got {E0!r}")
     t = np.asarray(t, dtype=float).ravel()
     m = np.asarray(mean_E, dtype=float).ravel()
     w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
     if not (t.shape == m.shape == w.shape):
-        raise ValueError("t, mean_E and weights must have the same length")
+        raise ConfigError("t, mean_E and weights must have the same length")
     t_lo, t_hi = float(window[0]), float(window[1])
     sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
     return t[sel], np.log(m[sel]), w[sel], (t_lo, t_hi)
@@ -486,7 +486,7 @@ def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
     times = np.atleast_1d(np.asarray(times, dtype=float))
     grid = np.unique(t[np.isfinite(t)])
     if grid.size == 0:
-        raise ValueError("no snapshot times")
+        raise ConfigError("no snapshot times")
     idx = np.clip(np.searchsorted(grid, times), 1, grid.size - 1) if grid.size > 1 else np.zeros(times.size, int)
     if grid.size > 1:
         left, right = grid[idx - 1], grid[idx]
@@ -551,12 +551,12 @@ def bootstrap_mu(
     mu_free`` (dimensionless).
     """
     if n_boot < 1:
-        raise ValueError(f"n_boot must be ≥ 1, got {n_boot!r}")
+        raise ConfigError(f"n_boot must be ≥ 1, got {n_boot!r}")
     tid = np.asarray(traj_id).ravel()
     t = np.asarray(t, dtype=float).ravel()
     e = np.asarray(energy, dtype=float).ravel()
     if not (tid.shape == t.shape == e.shape):
-        raise ValueError("traj_id, t and energy must have the same length")
+        raise ConfigError("traj_id, t and energy must have the same length")
     ok = np.isfinite(t) & np.isfinite(e)
     tid, t, e = tid[ok], t[ok], e[ok]
     _, orb = np.unique(tid, return_inverse=True)
@@ -588,7 +588,7 @@ def bootstrap_mu_first_orbits(
     restricted to those orbits (e.g. by a filter pushed down to the reader).
     """
     if not 1 <= k <= n_orbits:
-        raise ValueError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
+        raise ConfigError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
     sub = rows[rows["traj_id"] < k]
     boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
     return boot, float(np.sqrt(k / n_orbits))

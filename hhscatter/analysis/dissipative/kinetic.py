@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.errors import ConfigError
+
 __all__ = [
     "KineticFraction",
     "decay_path",
@@ -57,9 +59,9 @@ def _checked_rows(traj_id, t, energy, gamma):
     t = np.asarray(t, dtype=float).ravel()
     e = np.asarray(energy, dtype=float).ravel()
     if not (ids.size == t.size == e.size):
-        raise ValueError("traj_id, t and energy differ in length")
+        raise ConfigError("traj_id, t and energy differ in length")
     if not (gamma > 0 and math.isfinite(gamma)):
-        raise ValueError(f"gamma must be finite and > 0, got {gamma}")
+        raise ConfigError(f"gamma must be finite and > 0, got {gamma}")
     return ids, t, e
 
 
@@ -86,7 +88,7 @@ def kinetic_fraction_from_energies(
     """
     ids, t, e = _checked_rows(traj_id, t, energy, gamma_probe)
     if not t_to > t_from:
-        raise ValueError(f"need t_to > t_from, got [{t_from}, {t_to}]")
+        raise ConfigError(f"need t_to > t_from, got [{t_from}, {t_to}]")
     sel = (t >= t_from) & (t <= t_to)
     if keep is not None:
         sel &= np.isin(ids, np.asarray(list(keep) if isinstance(keep, set) else keep, dtype=np.int64))
@@ -165,7 +167,7 @@ def microcanonical_kinetic_fraction(potential, energy: float, extent: float, *, 
     True
     """
     if not energy > 0:
-        raise ValueError(f"energy must be > 0, got {energy}")
+        raise ConfigError(f"energy must be > 0, got {energy}")
     h = 2.0 * extent / n_grid
     c = -extent + h * (np.arange(n_grid) + 0.5)
     X, Y = np.meshgrid(c, c, indexing="ij")
@@ -175,11 +177,11 @@ def microcanonical_kinetic_fraction(potential, energy: float, extent: float, *, 
     labels, _ = ndimage.label(V < energy)
     i0 = n_grid // 2 if n_grid % 2 else n_grid // 2 - 1
     if labels[i0, i0] == 0:
-        raise ValueError(f"the grid point next to the origin has V ≥ E = {energy}")
+        raise ConfigError(f"the grid point next to the origin has V ≥ E = {energy}")
     m = labels == labels[i0, i0]
     edge = m[0, :].any() or m[-1, :].any() or m[:, 0].any() or m[:, -1].any()
     if edge:
-        raise ValueError(f"the region V < E = {energy} reaches the edge of the square of half side {extent}")
+        raise ConfigError(f"the region V < E = {energy} reaches the edge of the square of half side {extent}")
     return float(2.0 * (1.0 - V[m].mean() / energy))
 
 
@@ -200,7 +202,7 @@ def decay_path(t, E0: float, gamma: float, mu_of_E) -> np.ndarray:
 
     t = np.asarray(t, dtype=float)
     if t.size == 0 or np.any(np.diff(t) < 0) or t[0] < 0:
-        raise ValueError("t must be non-empty, ≥ 0 and increasing")
+        raise ConfigError("t must be non-empty, ≥ 0 and increasing")
     sol = solve_ivp(
         lambda _, y: [-gamma * float(mu_of_E(np.exp(y[0])))],
         (0.0, float(t[-1]) or 1.0),

@@ -57,6 +57,7 @@ from hhscatter.analysis.dissipative.survival_model import (
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "MixtureComponents",
@@ -183,12 +184,12 @@ def mixture_components_arrays(
     t = np.asarray(t, dtype=float).ravel()
     e = np.asarray(energy, dtype=float).ravel()
     if not (ids.shape == t.shape == e.shape):
-        raise ValueError("traj_id, t and energy must have the same length")
+        raise ConfigError("traj_id, t and energy must have the same length")
     if by not in ("energy", "rate"):
-        raise ValueError("by must be 'energy' or 'rate'")
+        raise ConfigError("by must be 'energy' or 'rate'")
     K = int(n_components)
     if K < 1:
-        raise ValueError("n_components must be >= 1")
+        raise ConfigError("n_components must be >= 1")
     t_used, ids_ref, e_ref = _orbits_at(ids, t, e, t_ref)
     mu_i, a_ref = _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window)
     edges, comp, n_ref = _quantile_bins(e_ref if by == "energy" else mu_i, K, t_used)
@@ -236,13 +237,13 @@ def _quantile_bins(key, K, t_used):
     """Step 2, K quantile bins of ``key`` (E_i(t_ref) or μ_i): (edges (K+1,), bin of each orbit (−1: unusable), counts)."""
     use = np.isfinite(key)
     if use.sum() < K:
-        raise ValueError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
+        raise ConfigError(f"only {int(use.sum())} usable orbits alive at t_ref={t_used}")
     edges = np.quantile(key[use], np.linspace(0, 1, K + 1))
     comp = np.full(key.size, -1)
     comp[use] = np.clip(np.searchsorted(edges[1:-1], key[use], side="right"), 0, K - 1)
     n_ref = np.bincount(comp[use], minlength=K)
     if np.any(n_ref == 0):
-        raise ValueError("empty sub-ensemble (ties); use fewer components")
+        raise ConfigError("empty sub-ensemble (ties); use fewer components")
     return edges, comp, n_ref
 
 
@@ -254,7 +255,7 @@ def _sub_ensemble_paths(comp, e_ref, mu_i, a_ref, K):
         E_mean[k] = float(e_ref[sel].mean())
         good = sel & np.isfinite(mu_i)
         if not good.any():
-            raise ValueError(f"sub-ensemble {k}: no member with a defined decay exponent")
+            raise ConfigError(f"sub-ensemble {k}: no member with a defined decay exponent")
         mu[k] = float(mu_i[good].mean())
         mu_err[k] = float(mu_i[good].std(ddof=1) / np.sqrt(good.sum())) if good.sum() > 1 else np.nan
         A[k] = float(np.exp(a_ref[good].mean()))
@@ -410,9 +411,9 @@ def fit_mixture_model(
     """
     c = _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window)
     if fne_mode not in ("free", "shared"):
-        raise ValueError("fne_mode must be 'free' or 'shared'")
+        raise ConfigError("fne_mode must be 'free' or 'shared'")
     if hazard not in HAZARDS:
-        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
     fixed = dict(fixed or {})
     p0 = dict(p0 or {})
     P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
@@ -437,7 +438,7 @@ def _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window)
     """``components`` as given, or built from a snapshots DataFrame by :func:`mixture_components` (t_ref: τ0)."""
     if isinstance(components, pd.DataFrame):
         if gamma is None:
-            raise ValueError("gamma is needed to build the components from snapshots")
+            raise ConfigError("gamma is needed to build the components from snapshots")
         components = mixture_components(
             components,
             gamma=gamma,
@@ -455,7 +456,7 @@ def _mixture_parameters(K, fne_mode, fixed):
     names = fne_names + ["L", "b"]
     unknown = set(fixed) - set(names)
     if unknown:
-        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+        raise ConfigError(f"unknown parameters in fixed: {sorted(unknown)}")
     return names, [n for n in names if n not in fixed]
 
 

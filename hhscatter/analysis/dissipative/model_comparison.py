@@ -16,6 +16,7 @@ from hhscatter.analysis.dissipative.curve_fit import best_of
 from hhscatter.analysis.dissipative.mixture import fit_mixture_model
 from hhscatter.analysis.dissipative.survival_model import fit_survival_model
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "best_fit",
@@ -144,18 +145,18 @@ def better_fit(fits: dict) -> str | None:
     comparison means nothing: ValueError.
     """
     if len(fits) < 2:
-        raise ValueError("better_fit needs at least two fits")
+        raise ConfigError("better_fit needs at least two fits")
     items = list(fits.items())
     t_ref = np.asarray(items[0][1].t_fit)
     for name, f in items[1:]:
         if not np.array_equal(np.asarray(f.t_fit), t_ref):
-            raise ValueError(
+            raise ConfigError(
                 f"fit {name!r} was made on other points than {items[0][0]!r}; "
                 "compare fits on the same data selection only"
             )
     rms = np.array([f.rms_log_residual for _, f in items], dtype=float)
     if not np.isfinite(rms).all():
-        raise ValueError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
+        raise ConfigError(f"non-finite RMS log residual: {dict(zip(fits, rms))}")
     best = np.flatnonzero(rms == rms.min())
     return None if best.size > 1 else items[int(best[0])][0]
 

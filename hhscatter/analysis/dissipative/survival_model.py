@@ -54,6 +54,7 @@ from hhscatter.analysis.dissipative.curve_fit import (
 )
 from hhscatter.analysis.dissipative.decay import energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "HAZARDS",
@@ -96,7 +97,7 @@ def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
         k = np.asarray(kappa_of_E(energy_path(s, A, mu, gamma)), dtype=float)
         cum = np.concatenate([[0.0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
         return np.interp(t, s, cum)
-    raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
 
 
 def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard):
@@ -348,9 +349,9 @@ def _checked_fixed(fixed, hazard) -> dict:
     fixed = dict(fixed or {})
     unknown = set(fixed) - set(_HOMOG)
     if unknown:
-        raise ValueError(f"unknown parameters in fixed: {sorted(unknown)}")
+        raise ConfigError(f"unknown parameters in fixed: {sorted(unknown)}")
     if hazard not in HAZARDS:
-        raise ValueError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
     return fixed
 
 
@@ -366,7 +367,7 @@ def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
         P_tau0_err = 0.0
     tf, Pf, sf = select_points(t, P, P_err, tau0, t_max, P_min)
     if tf.size < 3:
-        raise ValueError("fewer than 3 data points selected")
+        raise ConfigError("fewer than 3 data points selected")
     return P_tau0, P_tau0_err, tf, Pf, sf
 
 

@@ -35,6 +35,7 @@ from hhscatter.analysis.survival.fits import (
     survival_from_lifetimes,
 )
 from hhscatter.analysis.survival.kaplan_meier import survival_on_grid
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "SubsampleBootstrap",
@@ -98,14 +99,14 @@ def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
     [τ0, t[-1]] (e.g. no escaping orbits left, Fig. 6b large γ).
     """
     if not alpha > 0:
-        raise ValueError(f"alpha must be > 0, got {alpha!r}")
+        raise ConfigError(f"alpha must be > 0, got {alpha!r}")
     t = np.asarray(t, dtype=float).ravel()
     Pg = np.asarray(P_gamma, dtype=float).ravel()
     P0 = np.asarray(P_0(t) if callable(P_0) else P_0, dtype=float).ravel()
     if not (t.shape == Pg.shape == P0.shape):
-        raise ValueError("t, P_gamma and P_0 must have the same length")
+        raise ConfigError("t, P_gamma and P_0 must have the same length")
     if t.size and np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+        raise ConfigError("t must be strictly increasing")
     D = _log_ratio(Pg, P0, alpha)
     keep = ~np.isnan(D)
     t, D = t[keep], D[keep]
@@ -234,7 +235,7 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
     x = np.sort(t_end[settled])
     n = int(t_end.size)
     if not 0 < p < 1 or n == 0:
-        raise ValueError(f"p must be in (0, 1) and the ensemble not empty, got p = {p}, N = {n}")
+        raise ConfigError(f"p must be in (0, 1) and the ensemble not empty, got p = {p}, N = {n}")
     pmf = stats.binom(n, p).pmf
     r = s = int(np.floor((n + 1) * p))  # the mode of C: the interval [X_(r), X_(r+1)] holds C = r
     s += 1
@@ -277,7 +278,7 @@ def tau2_predicted(E0, E_c, mu, gamma):
     E0, E_c, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E_c, mu, gamma)))
     rate = mu * gamma
     if np.any(rate < 0) or np.any(E_c <= 0):
-        raise ValueError("need mu*gamma >= 0 and E_c > 0")
+        raise ConfigError("need mu*gamma >= 0 and E_c > 0")
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.log(E0 / E_c) / rate
     out = np.where(E0 <= E_c, 0.0, np.where(rate == 0, np.inf, out))
@@ -335,9 +336,9 @@ def bootstrap_transition_times(
     tau0, tau1, tau2_obs, t_settle_q<q>...`` (NaN where undefined).
     """
     if reference not in curves:
-        raise ValueError(f"reference {reference!r} is not one of the curves {list(curves)}")
+        raise ConfigError(f"reference {reference!r} is not one of the curves {list(curves)}")
     if n_boot < 1:
-        raise ValueError(f"n_boot must be ≥ 1, got {n_boot!r}")
+        raise ConfigError(f"n_boot must be ≥ 1, got {n_boot!r}")
     arrs = {}
     n = None
     for lab, (t_end, outcome) in curves.items():
@@ -346,7 +347,7 @@ def bootstrap_transition_times(
         if n is None:
             n = t_end.size
         if t_end.size != n or outcome.size != n:
-            raise ValueError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
+            raise ConfigError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
         arrs[lab] = (t_end, outcome, observed_from_outcome(outcome))
     g = np.asarray(grid, dtype=float)
     rng = np.random.default_rng(seed)

@@ -95,6 +95,7 @@ from scipy import ndimage
 
 from hhscatter.analysis.geometry.uncertainty import _int_labels, _positive_int
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "BasinEntropy",
@@ -114,7 +115,7 @@ __all__ = [
 LOG2 = math.log(2.0)
 
 
-class _NoBoxes(ValueError):
+class _NoBoxes(ConfigError):
     """No box of the requested side has enough valid cells."""
 
 
@@ -156,12 +157,12 @@ def basin_fractions(labels, *, basins=None, outside: int = -1, z: float = 1.0) -
     else:
         keys = np.asarray(basins, dtype=np.int64).ravel()
         if keys.size == 0 or np.unique(keys).size != keys.size:
-            raise ValueError(f"basins must be distinct labels, got {basins!r}")
+            raise ConfigError(f"basins must be distinct labels, got {basins!r}")
         if np.any(keys == outside):
-            raise ValueError(f"basins must not contain the outside label {outside}")
+            raise ConfigError(f"basins must not contain the outside label {outside}")
     n = int(vals.size)
     if n == 0:
-        raise ValueError("labels has no valid cells (all are outside)")
+        raise ConfigError("labels has no valid cells (all are outside)")
     counts = np.array([np.count_nonzero(vals == k) for k in keys], dtype=np.int64)
     p, lo, hi = wilson_interval(counts, n, z)
     return BasinFractions(keys, counts, n, int(lab.size - n), p, lo, hi, float(z))
@@ -208,9 +209,9 @@ def basin_entropy(labels, box: int, *, outside: int = -1, min_valid: float = 1.0
     box = _positive_int(box, "box")
     H, W = lab.shape
     if box > min(H, W):
-        raise ValueError(f"box = {box} exceeds the map's shape {lab.shape}")
+        raise ConfigError(f"box = {box} exceeds the map's shape {lab.shape}")
     if not 0.0 < float(min_valid) <= 1.0:
-        raise ValueError(f"min_valid must be in (0, 1], got {min_valid}")
+        raise ConfigError(f"min_valid must be in (0, 1], got {min_valid}")
     nr, nc = H // box, W // box
     blocks = lab[: nr * box, : nc * box].reshape(nr, box, nc, box).transpose(0, 2, 1, 3).reshape(nr * nc, box * box)
     valid = blocks != outside
@@ -287,7 +288,7 @@ def basin_entropy_table(
             continue
         rows.append({k: getattr(r, k) for k in cols})
     if not rows:
-        raise ValueError(f"boxes: no box side ≤ the map's shape {lab.shape}")
+        raise ConfigError(f"boxes: no box side ≤ the map's shape {lab.shape}")
     return pd.DataFrame(rows)
 
 
@@ -367,16 +368,16 @@ def wada_merging(
     r_max = _positive_int(r_max, "r_max", 0)
     r_wada = _positive_int(r_wada, "r_wada", 0)
     if r_wada > r_max:
-        raise ValueError(f"r_wada = {r_wada} exceeds r_max = {r_max}")
+        raise ConfigError(f"r_wada = {r_wada} exceeds r_max = {r_max}")
     if not 0.0 <= float(tol) < 1.0:
-        raise ValueError(f"tol must be in [0, 1), got {tol}")
+        raise ConfigError(f"tol must be in [0, 1), got {tol}")
     st = sorted({_positive_int(s, "steps") for s in np.atleast_1d(steps)})
     if st[0] != 1:
-        raise ValueError(f"steps must include 1 (the full map), got {steps!r}")
+        raise ConfigError(f"steps must include 1 (the full map), got {steps!r}")
     present = np.unique(lab[lab != outside])
     keys = present if basins is None else np.asarray(basins, dtype=np.int64).ravel()
     if keys.size < 3 or np.unique(keys).size != keys.size or np.any(keys == outside):
-        raise ValueError(f"basins must be ≥ 3 distinct labels other than outside, got {keys.tolist()!r}")
+        raise ConfigError(f"basins must be ≥ 3 distinct labels other than outside, got {keys.tolist()!r}")
     # recode: basin j → j, anything else → −1
     code = np.full(lab.shape, -1, dtype=np.int64)
     for j, key in enumerate(keys):
@@ -390,7 +391,7 @@ def wada_merging(
         nb = int(bnd.sum())
         if nb == 0:
             if s == 1:
-                raise ValueError("labels: the map has no boundary between the basins tested")
+                raise ConfigError("labels: the map has no boundary between the basins tested")
             rows.append(
                 {"step": s, "shape": sub.shape, "n_boundary": 0, "wada_fraction": math.nan, "hausdorff": math.nan}
             )
@@ -453,19 +454,19 @@ def box_counting_dimension(labels, sizes=(2, 4, 8, 16, 32), *, outside: int = -1
     lab = _int_labels(labels, "labels", ndim=2)
     s = np.array(sorted({_positive_int(v, "sizes", 2) for v in np.atleast_1d(sizes)}))
     if s.size < 2:
-        raise ValueError("sizes: need at least 2 box sizes")
+        raise ConfigError("sizes: need at least 2 box sizes")
     counts = []
     for b in s:
         nr, nc = lab.shape[0] // b, lab.shape[1] // b
         if nr == 0 or nc == 0:
-            raise ValueError(f"sizes: box {b} exceeds the map {lab.shape}")
+            raise ConfigError(f"sizes: box {b} exceeds the map {lab.shape}")
         blk = lab[: nr * b, : nc * b].reshape(nr, b, nc, b).transpose(0, 2, 1, 3).reshape(nr, nc, -1)
         valid = (blk != outside).all(axis=-1)
         mixed = blk.min(axis=-1) != blk.max(axis=-1)
         counts.append(int(np.count_nonzero(valid & mixed)))
     counts = np.array(counts)
     if np.any(counts == 0):
-        raise ValueError("box_counting_dimension: no boundary at some box size")
+        raise ConfigError("box_counting_dimension: no boundary at some box size")
     x, y = np.log(1.0 / s), np.log(counts)
     (slope, _), cov = np.polyfit(x, y, 1, cov=True) if s.size > 2 else (np.polyfit(x, y, 1), np.zeros((2, 2)))
     return BoxCountingDimension(float(slope), float(math.sqrt(cov[0, 0])), s, counts)
@@ -494,7 +495,7 @@ def _cell_side(extent, n: int) -> float:
     n = _positive_int(n, "n")
     cx, cy = (x1 - x0) / n, (y1 - y0) / n
     if not (cx > 0 and abs(cx - cy) <= 1e-12 * cx):
-        raise ValueError(f"extent {tuple(extent)} with {n} cells per side does not give square cells")
+        raise ConfigError(f"extent {tuple(extent)} with {n} cells per side does not give square cells")
     return cx
 
 
@@ -521,14 +522,14 @@ def entropy_by_box(labels, extent, sides, *, outside: int = -1, min_valid: float
     """
     lab = _int_labels(labels, "labels", ndim=2)
     if lab.shape[0] != lab.shape[1]:
-        raise ValueError(f"labels must be a square map, got shape {lab.shape}")
+        raise ConfigError(f"labels must be a square map, got shape {lab.shape}")
     n = lab.shape[0]
     cell = _cell_side(extent, n)
     rows = []
     for s in np.atleast_1d(np.asarray(sides, dtype=float)):
         c = s / cell
         if not (abs(c - round(c)) <= 1e-9 * max(1.0, c) and round(c) >= 1):
-            raise ValueError(f"sides: {s:g} is {c:.4g} cells of the {n}² map, not a whole number")
+            raise ConfigError(f"sides: {s:g} is {c:.4g} cells of the {n}² map, not a whole number")
         r = basin_entropy(lab, int(round(c)), outside=outside, min_valid=min_valid)
         rows.append(
             {

@@ -37,6 +37,7 @@ from scipy import integrate, optimize, stats
 
 from hhscatter.analysis.noise.kramers import hessian
 from hhscatter.analysis.stats.intervals import wilson_interval
+from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles, System
 
 __all__ = [
@@ -81,7 +82,7 @@ def channel_fractions(channel, n_channels: int = 3, z: float = 1.0) -> ChannelFr
     c = np.asarray(channel)
     c = c[c >= 0].astype(np.int64)
     if c.size and c.max() >= n_channels:
-        raise ValueError(f"channel labels must be < n_channels = {n_channels}")
+        raise ConfigError(f"channel labels must be < n_channels = {n_channels}")
     counts = np.bincount(c, minlength=n_channels)
     n = int(counts.sum())
     p, lo, hi = wilson_interval(counts, n, z)
@@ -139,12 +140,12 @@ def _checked_energy(energy: float, system: System, k: int) -> float:
     """E as a float, after the checks of :func:`lyapunov_orbit`'s arguments (ValueError naming the value)."""
     exits = system.exits
     if not exits:
-        raise ValueError(f"the system {system.name!r} has no exit (no saddle of V): it has no Lyapunov orbit")
+        raise ConfigError(f"the system {system.name!r} has no exit (no saddle of V): it has no Lyapunov orbit")
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(exits):
-        raise ValueError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {k!r}")
+        raise ConfigError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {k!r}")
     E, e_s = float(energy), exits[k].energy
     if not (math.isfinite(E) and E > e_s):
-        raise ValueError(
+        raise ConfigError(
             f"energy must be > the saddle energy E_s = {e_s:.6g} of exit {k} (E_c = "
             f"{system.critical_energy:.6g}), got {energy!r}"
         )
@@ -164,7 +165,7 @@ class _Shooting:
         self.saddle, self.e_s = np.array([e.x, e.y]), e.energy
         eig, vec = np.linalg.eigh(hessian(system, e.x, e.y))
         if not eig[0] < 0 < eig[1]:
-            raise ValueError(f"exit {k} at ({e.x:.6g}, {e.y:.6g}) is not a saddle of V: Hessian eigenvalues {eig}")
+            raise ConfigError(f"exit {k} at ({e.x:.6g}, {e.y:.6g}) is not a saddle of V: Hessian eigenvalues {eig}")
         self.u = vec[:, 0] if vec[:, 0] @ self.saddle >= 0 else -vec[:, 0]
         self.v = np.array([self.u[1], -self.u[0]])
         self.omega_v = math.sqrt(eig[1])
@@ -344,9 +345,9 @@ def return_statistics(orbit, t, radius, direction, n_orbits: int, r_esc: float, 
     radius = np.asarray(radius, dtype=float)
     direction = np.asarray(direction)
     if not (orbit.shape == t.shape == radius.shape == direction.shape):
-        raise ValueError("orbit, t, radius and direction differ in length")
+        raise ConfigError("orbit, t, radius and direction differ in length")
     if orbit.size and (np.any(np.diff(orbit) < 0) or np.any((np.diff(orbit) == 0) & (np.diff(t) < 0))):
-        raise ValueError("crossings must be sorted by orbit, then time")
+        raise ConfigError("crossings must be sorted by orbit, then time")
     nan = np.full(n_orbits, np.nan)
     t_esc, t_ret, t_re = nan.copy(), nan.copy(), nan.copy()
 

@@ -28,6 +28,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry.uncertainty import weighted_line
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = ["CutoffComparison", "DecisionRate", "cutoff_comparison", "decision_rate", "predicted_cutoff"]
 
@@ -70,7 +71,7 @@ def decision_rate(eps, times) -> DecisionRate:
     """
     eps = np.asarray(eps, dtype=float).ravel()
     if len(times) != eps.size:
-        raise ValueError("times must hold one array per ε")
+        raise ConfigError("times must hold one array per ε")
     rows = []
     for e, t in zip(eps, times):
         t = np.asarray(t, dtype=float)
@@ -87,11 +88,11 @@ def decision_rate(eps, times) -> DecisionRate:
             )
     tab = pd.DataFrame(rows, columns=["eps", "x", "t_mean", "t_sem", "m"])
     if len(tab) < 2 or tab["x"].nunique() < 2:
-        raise ValueError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
+        raise ConfigError("decision_rate: need ≥ 2 values of ε with ≥ 3 decision times each")
     t0, slope, cov, chi2, dof = weighted_line(tab["x"], tab["t_mean"], np.maximum(tab["t_sem"], 1e-12))
     s_err = float(math.sqrt(cov[1, 1]))
     if not slope > 0:
-        raise ValueError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
+        raise ConfigError(f"decision_rate: decision times do not grow with ln(1/ε) (slope {slope:.3g})")
     return DecisionRate(
         lam=1.0 / slope,
         lam_err=s_err / slope**2,
@@ -125,14 +126,14 @@ def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: flo
     """
     E0, gamma, mu, e_c = float(E0), float(gamma), float(mu), float(e_c)
     if not (E0 > e_c > 0 and gamma >= 0 and mu > 0):
-        raise ValueError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
+        raise ConfigError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
     if gamma == 0:
         return 0.0
     En = np.asarray(energies, dtype=float).ravel()
     lam = np.asarray(lam, dtype=float).ravel()
     ok = np.isfinite(En) & np.isfinite(lam)
     if np.count_nonzero(ok) < 1:
-        raise ValueError("predicted_cutoff: no finite λ(E) given")
+        raise ConfigError("predicted_cutoff: no finite λ(E) given")
     o = np.argsort(En[ok])
     grid = np.linspace(e_c, E0, 2001)
     val = np.interp(grid, En[ok][o], lam[ok][o]) / grid
@@ -203,7 +204,7 @@ def cutoff_comparison(
     """
     E0, gamma, mu, mu_err = float(E0), float(gamma), float(mu), float(mu_err)
     if not gamma > 0:
-        raise ValueError(f"cutoff_comparison: γ must be > 0 (no cut-off at γ = {gamma})")
+        raise ConfigError(f"cutoff_comparison: γ must be > 0 (no cut-off at γ = {gamma})")
     En = np.asarray(energies, dtype=float)
     lam, lam_err = np.asarray(lam, dtype=float), np.asarray(lam_err, dtype=float)
     mus = [m for m in (mu - mu_err, mu, mu + mu_err) if m > 0] if math.isfinite(mu_err) else [mu]

@@ -79,6 +79,8 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
+from hhscatter.errors import ConfigError
+
 __all__ = [
     "BootstrapResult",
     "agreement_scale",
@@ -134,7 +136,7 @@ def first_crossings(
     """
     need = {"traj_id", "t"}
     if not need <= set(sections.columns):
-        raise ValueError(f"sections needs columns {sorted(need)}, has {sorted(sections.columns)}")
+        raise ConfigError(f"sections needs columns {sorted(need)}, has {sorted(sections.columns)}")
     s = sections[sections["t"] >= t_from]
     s = s.sort_values(["traj_id", "t"], kind="stable").drop_duplicates("traj_id", keep="first")
     if "energy" in s.columns and (np.isfinite(e_min) or np.isfinite(e_max)):
@@ -145,9 +147,9 @@ def first_crossings(
 def _as_points(X) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     if X.ndim != 2 or X.shape[1] != 2:
-        raise ValueError(f"expected an (n, 2) array of points, got shape {X.shape}")
+        raise ConfigError(f"expected an (n, 2) array of points, got shape {X.shape}")
     if X.shape[0] == 0:
-        raise ValueError("empty point set")
+        raise ConfigError("empty point set")
     return X
 
 
@@ -162,9 +164,9 @@ def _cells(X, box, extent):
     """Box index of each point; −1 for points outside ``extent`` (one overflow cell)."""
     x0, x1, y0, y1 = map(float, extent)
     if not (x1 > x0 and y1 > y0):
-        raise ValueError(f"bad extent {extent!r}")
+        raise ConfigError(f"bad extent {extent!r}")
     if not box > 0:
-        raise ValueError(f"box size must be > 0, got {box!r}")
+        raise ConfigError(f"box size must be > 0, got {box!r}")
     ny = int(np.floor((y1 - y0) / box)) + 1
     ix = np.floor((X[:, 0] - x0) / box)
     iy = np.floor((X[:, 1] - y0) / box)
@@ -219,7 +221,7 @@ def histogram_distance(
         return hellinger(p, q)
     if kind == "tv":
         return total_variation(p, q)
-    raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    raise ConfigError(f"kind must be one of {KINDS}, got {kind!r}")
 
 
 _DISTANCE = {"hellinger": hellinger, "tv": total_variation}
@@ -228,7 +230,7 @@ _DISTANCE = {"hellinger": hellinger, "tv": total_variation}
 def _check_kinds(kinds):
     for k in kinds:
         if k not in KINDS:
-            raise ValueError(f"kind must be one of {KINDS}, got {k!r}")
+            raise ConfigError(f"kind must be one of {KINDS}, got {k!r}")
 
 
 def box_distances(P, Q, boxes, extent=None, kinds=KINDS) -> np.ndarray:
@@ -258,11 +260,11 @@ def _split_halves(P, Q, m: int, n_splits: int, rng):
 def _common_m(P, Q, m):
     m_max = min(P.shape[0], Q.shape[0]) // 2
     if m_max < 1:
-        raise ValueError("need at least 2 points in each set for the split-half baseline")
+        raise ConfigError("need at least 2 points in each set for the split-half baseline")
     if m is None:
         return m_max
     if not 1 <= int(m) <= m_max:
-        raise ValueError(f"m must be in [1, {m_max}] = [1, ⌊min(n_P, n_Q)/2⌋], got {m!r}")
+        raise ConfigError(f"m must be in [1, {m_max}] = [1, ⌊min(n_P, n_Q)/2⌋], got {m!r}")
     return int(m)
 
 
@@ -343,7 +345,7 @@ def agreement_scale(table: pd.DataFrame, kind: str = "hellinger", z: float = 2.0
     """
     need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
     if not need <= set(table.columns):
-        raise ValueError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
+        raise ConfigError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
     tab = table.sort_values("box", ascending=False)
     tab = tab[tab[f"{kind}_noise"] <= noise_max]
     best = None
@@ -373,7 +375,7 @@ def debiased_distance(table: pd.DataFrame, kind: str = "hellinger"):
     """
     need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
     if not need <= set(table.columns):
-        raise ValueError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
+        raise ConfigError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
     pq, sp = table[f"{kind}_pq"].to_numpy(float), table[f"{kind}_pq_std"].to_numpy(float)
     nz, sn = table[f"{kind}_noise"].to_numpy(float), table[f"{kind}_noise_std"].to_numpy(float)
     d2 = pq**2 - nz**2
@@ -448,14 +450,14 @@ def sliced_wasserstein(
     P, Q = _as_points(P), _as_points(Q)
     n_proj = int(n_proj)
     if n_proj < 1:
-        raise ValueError("n_proj must be >= 1")
+        raise ConfigError("n_proj must be >= 1")
     rng = np.random.default_rng(seed)
     if directions == "stratified":
         ang = rng.uniform(0.0, np.pi / n_proj) + np.pi * np.arange(n_proj) / n_proj
     elif directions == "random":
         ang = rng.uniform(0.0, np.pi, n_proj)
     else:
-        raise ValueError("directions must be 'stratified' or 'random'")
+        raise ConfigError("directions must be 'stratified' or 'random'")
     dirs = np.column_stack([np.cos(ang), np.sin(ang)])
     total = 0.0
     chunk = max(1, int(4_000_000 // max(P.shape[0] + Q.shape[0], 1)))
@@ -487,7 +489,7 @@ def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> 
     """
     P, Q = _as_points(P), _as_points(Q)
     if int(n_boot) < 1:
-        raise ValueError(f"n_boot must be >= 1, got {n_boot!r}")
+        raise ConfigError(f"n_boot must be >= 1, got {n_boot!r}")
     rng = np.random.default_rng(seed)
     draws = [
         fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
@@ -525,7 +527,7 @@ def split_half_noise(P, Q, fn: Callable, m: int | None = None, n_splits: int = 8
     P, Q = _as_points(P), _as_points(Q)
     m = _common_m(P, Q, m)
     if int(n_splits) < 1:
-        raise ValueError(f"n_splits must be >= 1, got {n_splits!r}")
+        raise ConfigError(f"n_splits must be >= 1, got {n_splits!r}")
     rng = np.random.default_rng(seed)
     vals = [0.5 * (fn(P1, P2) + fn(Q1, Q2)) for P1, P2, Q1, Q2 in _split_halves(P, Q, m, int(n_splits), rng)]
     return _mean_std(vals)
@@ -547,7 +549,7 @@ def split_half_baseline(P, fn: Callable, n_splits: int = 20, seed: int = 0, size
     P = _as_points(P)
     h = P.shape[0] // 2 if size is None else int(size)
     if h < 1 or 2 * h > P.shape[0]:
-        raise ValueError(f"cannot split {P.shape[0]} points into two halves of {h}")
+        raise ConfigError(f"cannot split {P.shape[0]} points into two halves of {h}")
     rng = np.random.default_rng(seed)
     vals = np.empty(int(n_splits))
     for i in range(vals.size):

@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from hhscatter.analysis.geometry.distance import _as_points, _cells, box_histograms, hellinger
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "PairedDifference",
@@ -88,7 +89,7 @@ def percentile_interval(values, level: float = 0.95):
     """
     v = np.asarray(values, dtype=float)
     if not 0 < level < 1:
-        raise ValueError(f"level must be in (0, 1), got {level!r}")
+        raise ConfigError(f"level must be in (0, 1), got {level!r}")
     q = (1 - level) / 2
     m, lo, hi = v.mean(axis=0), np.quantile(v, q, axis=0), np.quantile(v, 1 - q, axis=0)
     return (float(m), float(lo), float(hi)) if v.ndim == 1 else (m, lo, hi)
@@ -183,19 +184,21 @@ def _checked_unit_sets(sets, pairs, boxes, offsets, n_boot):
     for name, s in sets.items():
         pts, un = _as_points(s.points), np.asarray(s.units)
         if un.shape[0] != pts.shape[0]:
-            raise ValueError(f"set {name!r}: the units must have one entry per point ({un.shape[0]} vs {pts.shape[0]})")
+            raise ConfigError(
+                f"set {name!r}: the units must have one entry per point ({un.shape[0]} vs {pts.shape[0]})"
+            )
         sets[name] = UnitSet(pts, un, s.group)
     missing = sorted({n for p in pairs for n in p} - set(sets))
     if missing or not pairs or any(len(p) != 2 for p in pairs):
-        raise ValueError(f"pairs must be (set, reference) names of sets; unknown: {missing}")
+        raise ConfigError(f"pairs must be (set, reference) names of sets; unknown: {missing}")
     if int(offsets) < 1 or int(n_boot) < 2 or not boxes or min(boxes) <= 0:
-        raise ValueError(f"need offsets ≥ 1, n_boot ≥ 2 and box sides > 0, got {offsets!r}, {n_boot!r}, {boxes!r}")
+        raise ConfigError(f"need offsets ≥ 1, n_boot ≥ 2 and box sides > 0, got {offsets!r}, {n_boot!r}, {boxes!r}")
     groups = {}
     for s in sets.values():
         groups.setdefault(s.group, []).append(s.units)
     group_units = {g: np.unique(np.concatenate(u)) for g, u in groups.items()}
     if any(u.size < 4 for u in group_units.values()):
-        raise ValueError("need at least 4 units in every group of sets")
+        raise ConfigError("need at least 4 units in every group of sets")
     return sets, pairs, boxes, group_units
 
 
@@ -203,7 +206,7 @@ def _half_counts(name, s, halves, cells, totals):
     """[box][offset] (counts of the half-sample, counts of its complement) of set ``s`` on every partition."""
     inh = np.isin(s.units, halves[s.group])
     if inh.all() or not inh.any():
-        raise ValueError(f"a half-sample of set {name!r} is empty: too few units")
+        raise ConfigError(f"a half-sample of set {name!r} is empty: too few units")
     out = []
     for row, trow in zip(cells, totals):
         half = [np.bincount(c[inh], minlength=k) for c, k in row]
@@ -277,7 +280,7 @@ def paired_hellinger_difference(
     """
     A, B, R = _as_points(A), _as_points(B), _as_points(R)
     if not 0 < level < 1:
-        raise ValueError(f"level must be in (0, 1), got {level!r}")
+        raise ConfigError(f"level must be in (0, 1), got {level!r}")
     sets = {"A": UnitSet(A, units_a, "run"), "B": UnitSet(B, units_b, "run"), "R": UnitSet(R, units_r, "ref")}
     reps = paired_hellinger_replicates(
         sets, [("A", "R"), ("B", "R")], [box], extent, offsets=offsets, n_boot=n_boot, seed=seed

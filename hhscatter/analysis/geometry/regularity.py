@@ -39,6 +39,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from hhscatter.errors import ConfigError
+
 SHADOW_DELTA = 1e-9  # initial displacement of the shadow orbit (length units)
 G_MAX = 1e4  # separation growth below which an orbit is called regular
 INDICATOR = "shadow FTLE"  # the indicator's name in records
@@ -70,7 +72,7 @@ def shadow_ics(states, potential, delta: float = SHADOW_DELTA) -> tuple[np.ndarr
     """
     s = np.asarray(states, dtype=float)
     if s.ndim != 2 or s.shape[1] != 4:
-        raise ValueError(f"states must be (n, 4) (x, y, px, py), got shape {s.shape}")
+        raise ConfigError(f"states must be (n, 4) (x, y, px, py), got shape {s.shape}")
     x, y, px, py = s.T
     K = 0.5 * (px**2 + py**2)
     E = K + potential(x, y)
@@ -83,7 +85,7 @@ def shadow_ics(states, potential, delta: float = SHADOW_DELTA) -> tuple[np.ndarr
         out[ok] = np.column_stack([xs, y, px * f, py * f])[ok]
     bad = ~np.isfinite(out[:, 0])
     if bad.any():
-        raise ValueError(f"no shadow on the energy shell for {int(bad.sum())} state(s) (no kinetic energy at x ± δ)")
+        raise ConfigError(f"no shadow on the energy shell for {int(bad.sum())} state(s) (no kinetic energy at x ± δ)")
     return out, np.linalg.norm(out - s, axis=1)
 
 
@@ -145,7 +147,7 @@ def regular_fraction(n_orbits: int, n_regular: int) -> tuple[float, float]:
     True
     """
     if n_orbits <= 0:
-        raise ValueError("n_orbits must be positive")
+        raise ConfigError("n_orbits must be positive")
     f = n_regular / n_orbits
     z = 1.0
     wilson = z * np.sqrt(f * (1 - f) / n_orbits + z**2 / (4 * n_orbits**2)) / (1 + z**2 / n_orbits)
@@ -171,7 +173,7 @@ def threshold_systematic(n_orbits: int, growth, g_max: float = G_MAX, others=G_M
     """
     g = np.asarray(growth, dtype=float)
     if n_orbits < g.size:
-        raise ValueError(f"n_orbits ({n_orbits}) is smaller than the orbits classified ({g.size})")
+        raise ConfigError(f"n_orbits ({n_orbits}) is smaller than the orbits classified ({g.size})")
     by = {float(x): int(np.sum(g < x)) / n_orbits for x in sorted({float(g_max), *map(float, others)})}
     value, stat = regular_fraction(n_orbits, int(np.sum(g < g_max)))
     return {

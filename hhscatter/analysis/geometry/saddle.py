@@ -60,6 +60,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
 from hhscatter.errors import ConfigError
 from hhscatter.outcomes import LEAVING_OUTCOMES
@@ -281,9 +282,9 @@ def window_dependence(
                 out = estimator(sp) if sp.n_points else (math.nan, math.nan)
             except ConfigError as exc:  # e.g. too few points for the estimator's rule: the row says so
                 out, note = (math.nan, math.nan), str(exc)
-            v, e = (out.value, out.err) if hasattr(out, "value") else out
+            m = Measured.of(out.value, out.err) if hasattr(out, "value") else Measured.of(*out)
             rows.append({"t_min": tm, "lo": w[0], "hi": w[1], "n_orbits": sp.n_orbits, "n_points": sp.n_points,
-                         "value": float(v), "err": float(e), "note": note})  # fmt: skip
+                         **m.to_dict(), "note": note})  # fmt: skip
     df = pd.DataFrame(rows)
     ref = df.iloc[-1]
     sig = np.sqrt(df["err"] ** 2 + float(ref["err"]) ** 2)
@@ -846,7 +847,7 @@ def lyapunov_convergence(
         if np.count_nonzero(m) < 2:
             continue
         r = mean_lyapunov(L[m], T[m], n_boot=n_boot, seed=seed + k)
-        rows.append({"T": float(T[m].sum() / m.sum()), "n_orbits": r.n_orbits, "value": r.value, "err": r.err})
+        rows.append({"T": float(T[m].sum() / m.sum()), "n_orbits": r.n_orbits, **Measured(r.value, r.err).to_dict()})
     tab = pd.DataFrame(rows)
     if len(tab) < 3:
         raise ConfigError("duration: fewer than 3 bins of T with 2 orbits or more")

@@ -62,6 +62,8 @@ from scipy import optimize
 from scipy.sparse import csgraph
 from scipy.sparse.linalg import eigs
 
+from hhscatter.errors import ConfigError
+
 __all__ = [
     "DENSE_MAX",
     "ClassInfo",
@@ -111,18 +113,18 @@ class Transitions:
         w = np.ones(src.size) if self.w is None else np.asarray(self.w, dtype=float).ravel()
         n = int(self.n_states)
         if not (src.size == dst.size == T.size == w.size):
-            raise ValueError(
+            raise ConfigError(
                 f"src, dst, T, w must have one entry per sample, got sizes {src.size}, {dst.size}, {T.size}, {w.size}"
             )
         if src.size and (src.min() < 0 or src.max() >= n):
-            raise ValueError(f"src must lie in [0, n_states = {n})")
+            raise ConfigError(f"src must lie in [0, n_states = {n})")
         if dst.size and dst.max() >= n:
-            raise ValueError(f"dst must be < n_states = {n} (negative: escaped)")
+            raise ConfigError(f"dst must be < n_states = {n} (negative: escaped)")
         if np.any(~np.isfinite(w)) or np.any(w < 0):
-            raise ValueError("weights w must be finite and ≥ 0")
+            raise ConfigError("weights w must be finite and ≥ 0")
         ret = dst >= 0
         if np.any(~np.isfinite(T[ret])) or np.any(T[ret] <= 0):
-            raise ValueError("return times T of returning samples must be finite and > 0")
+            raise ConfigError("return times T of returning samples must be finite and > 0")
         object.__setattr__(self, "src", src)
         object.__setattr__(self, "dst", np.where(dst < 0, -1, dst))
         object.__setattr__(self, "T", T)
@@ -203,7 +205,7 @@ def _arpack_leading(A, tol: float, *, vector: bool):
         try:
             out = eigs(At, ncv=min(n - 1, 64), **kw)
         except sp.linalg.ArpackNoConvergence as e:
-            raise ValueError(
+            raise ConfigError(
                 f"ARPACK found no Perron root of this {n}-state matrix (largest real part, "
                 "64 Lanczos vectors): its spectrum is too close to a circle"
             ) from e
@@ -225,9 +227,9 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     A = sp.csr_matrix(A)
     n = A.shape[0]
     if A.shape != (n, n):
-        raise ValueError(f"A must be square, got shape {A.shape}")
+        raise ConfigError(f"A must be square, got shape {A.shape}")
     if A.nnz and A.data.min() < 0:
-        raise ValueError("A must be non-negative")
+        raise ConfigError("A must be non-negative")
     if A.nnz == 0:
         return 0.0, np.full(n, 1.0 / n)
     if n <= DENSE_MAX:
@@ -235,13 +237,13 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     else:
         lam, v = _arpack_leading(A, tol, vector=True)
     if abs(lam.imag) > 1e-8 * max(abs(lam.real), 1e-300):
-        raise ValueError(f"leading eigenvalue {lam} is not real: A is not non-negative or ARPACK failed")
+        raise ConfigError(f"leading eigenvalue {lam} is not real: A is not non-negative or ARPACK failed")
     # a Perron vector has one phase: rotate it onto the positive reals
     j = int(np.argmax(np.abs(v)))
     v = (v * np.exp(-1j * np.angle(v[j]))).real
     v = np.where(np.abs(v) < 1e-14 * np.abs(v).max(), 0.0, v)
     if v.min() < -1e-8 * v.max():
-        raise ValueError(
+        raise ConfigError(
             "leading eigenvector has both signs: A is reducible with several Perron roots; "
             "restrict it to one communicating class (communicating_classes)"
         )
@@ -278,7 +280,7 @@ def true_time_kappa(tr: Transitions, *, xtol: float = 1e-13) -> float:
 
     h0 = h(0.0)
     if not h0 < -1e-12:
-        raise ValueError(
+        raise ConfigError(
             f"ρ(P) = {math.exp(h0):.12g} ≥ 1: no escape, no root κ > 0 (closed states: "
             "remove them with communicating_classes / saddle_class)"
         )
@@ -288,7 +290,7 @@ def true_time_kappa(tr: Transitions, *, xtol: float = 1e-13) -> float:
     while h(hi) <= 0:
         hi *= 2.0
         if hi > 1e6:
-            raise ValueError("no root of ρ(M(κ)) = 1 below κ = 1e6")
+            raise ConfigError("no root of ρ(M(κ)) = 1 below κ = 1e6")
     return float(optimize.brentq(h, 0.0, hi, xtol=xtol, rtol=1e-12))
 
 
@@ -367,7 +369,7 @@ def saddle_class(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]:
     labels, infos = communicating_classes(tr)
     open_ = sorted((c for c in infos if not c.closed and c.weight > 0), key=lambda c: (-c.size, -c.weight, c.label))
     if not open_:
-        raise ValueError("every communicating class is closed: no escape")
+        raise ConfigError("every communicating class is closed: no escape")
     return labels == open_[0].label, infos
 
 
@@ -465,9 +467,9 @@ def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -
     """
     t_end = np.asarray(t_end, dtype=float).ravel()
     if t_end.size != tr.src.size:
-        raise ValueError("t_end must give one time per sample")
+        raise ConfigError("t_end must give one time per sample")
     if not dt > 0:
-        raise ValueError(f"dt must be > 0, got {dt}")
+        raise ConfigError(f"dt must be > 0, got {dt}")
     n = tr.n_states
     rw = tr.row_weight
     inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)

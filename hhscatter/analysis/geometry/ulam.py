@@ -28,6 +28,7 @@ import pandas as pd
 from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.stats.intervals import fraction_with_bound
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "t_star_distance",
@@ -411,7 +412,7 @@ def one_return_samples(df, lt, sec, what="run"):
     (time of the crossing), ``t_end`` (time of the next event), ``x1, y1, e1`` (the crossing), ``censored``.
     ValueError (naming ``what``) if the run does not match the samples."""
     if len(lt) != len(df):
-        raise ValueError(f"{what}: {len(lt)} orbits in the run, {len(df)} samples: re-run `simulate`")
+        raise ConfigError(f"{what}: {len(lt)} orbits in the run, {len(df)} samples: re-run `simulate`")
     out = df.reset_index(drop=True).copy()
     oc = lt["outcome"].astype(str).to_numpy()
     out["t_end"] = lt["t_end"].to_numpy()
@@ -427,7 +428,7 @@ def one_return_samples(df, lt, sec, what="run"):
         sec["energy"].to_numpy(),
     )
     if not np.all(oc[idx] == "stopped"):
-        raise ValueError(f"{what}: a sample with a section crossing did not stop there")
+        raise ConfigError(f"{what}: a sample with a section crossing did not stop there")
     return out
 
 

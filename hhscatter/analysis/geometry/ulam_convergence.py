@@ -26,6 +26,7 @@ from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.geometry.ulam import saddle_kappa, sample_transitions
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "convergence_grid",
@@ -124,7 +125,7 @@ def kappa_convergence(
     """
     g = grid.dropna(subset=["kappa"])
     if len(g) < 4 or g["box"].nunique() < 2 or g["samples"].nunique() < 2:
-        raise ValueError("kappa_convergence: need ≥ 4 partitions with ≥ 2 box sides and ≥ 2 sample counts")
+        raise ConfigError("kappa_convergence: need ≥ 4 partitions with ≥ 2 box sides and ≥ 2 sample counts")
     b, M, k = (g[c].to_numpy(dtype=float) for c in ("box", "samples", "kappa"))
     k_inf, rms, X, coef = _fit_convergence(b, M, k, p_main)
     k_alt, _, _, _ = _fit_convergence(b, M, k, p_alt)

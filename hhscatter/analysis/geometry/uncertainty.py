@@ -95,21 +95,21 @@ def _int_labels(a, name: str, ndim: int | None = None) -> np.ndarray:
     """``a`` as an integer array (whole-valued floats accepted), else ValueError naming ``name``."""
     a = np.asarray(a)
     if ndim is not None and a.ndim != ndim:
-        raise ValueError(f"{name} must be a {ndim}-D array of labels, got shape {a.shape}")
+        raise ConfigError(f"{name} must be a {ndim}-D array of labels, got shape {a.shape}")
     if a.size == 0:
-        raise ValueError(f"{name} is empty")
+        raise ConfigError(f"{name} is empty")
     if a.dtype.kind in "iu":
         return a.astype(np.int64, copy=False)
     if a.dtype.kind == "b":
         return a.astype(np.int64)
     if a.dtype.kind == "f" and np.all(np.isfinite(a)) and np.all(a == np.round(a)):
         return a.astype(np.int64)
-    raise ValueError(f"{name} must hold integer labels, got dtype {a.dtype}")
+    raise ConfigError(f"{name} must hold integer labels, got dtype {a.dtype}")
 
 
 def _positive_int(v, name: str, minimum: int = 1) -> int:
     if isinstance(v, bool) or not float(v).is_integer() or int(v) < minimum:
-        raise ValueError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
+        raise ConfigError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
     return int(v)
 
 
@@ -148,12 +148,12 @@ def uncertainty_fraction(outcome_ref, outcome_perturbed, *, outside: int = -1, z
     if per.shape == ref.shape:
         per = per[None]
     elif per.shape[1:] != ref.shape:
-        raise ValueError(f"outcome_perturbed must have shape {ref.shape} or (m, *{ref.shape}), got {per.shape}")
+        raise ConfigError(f"outcome_perturbed must have shape {ref.shape} or (m, *{ref.shape}), got {per.shape}")
     ok = (ref != outside) & np.all(per != outside, axis=0)
     changed = np.any(per != ref[None], axis=0) & ok
     n = int(np.count_nonzero(ok))
     if n == 0:
-        raise ValueError("outcome_ref: no initial condition with every outcome inside")
+        raise ConfigError("outcome_ref: no initial condition with every outcome inside")
     k = int(np.count_nonzero(changed))
     p, lo, hi = wilson_interval(k, n, z)
     return UncertaintyFraction(float(p), float(lo), float(hi), k, n, int(ref.size - n))
@@ -302,7 +302,7 @@ def uncertainty_exponent(eps, f, n, *, eps_range=None, dim: float = 2.0) -> Unce
     are fitted (they carry information); f = 1 in the range is refused.
     """
     if not float(dim) > 0:
-        raise ValueError(f"dim must be > 0, got {dim}")
+        raise ConfigError(f"dim must be > 0, got {dim}")
     eps, f, k, n, use = _uncertainty_counts(eps, f, n, eps_range)
     b, cov, _, xm, p = _fit_single(np.log(eps[use]), k[use], n[use])
     chi2, dof, pv = _pearson(k[use], n[use], p, 2)
@@ -402,9 +402,9 @@ def uncertainty_cutoff(
     min_points = _positive_int(min_points, "min_points")
     n_grid = _positive_int(n_grid, "n_grid", 3)
     if beta is not None and not math.isfinite(float(beta)):
-        raise ValueError(f"beta must be a finite slope or None, got {beta!r}")
+        raise ConfigError(f"beta must be a finite slope or None, got {beta!r}")
     if not z > 0:
-        raise ValueError(f"z must be > 0, got {z}")
+        raise ConfigError(f"z must be > 0, got {z}")
     beta = None if beta is None else float(beta)
     single = uncertainty_exponent(eps, f, n, eps_range=eps_range, dim=dim)
     x, kk, nn = np.log(eps[use]), k[use], n[use]
@@ -554,11 +554,11 @@ def local_exponent(eps, k, n) -> pd.DataFrame:
     k = np.asarray(k, dtype=float).ravel()
     n = np.broadcast_to(np.asarray(n, dtype=float), k.shape).astype(float)
     if eps.size != k.size or eps.size < 2:
-        raise ValueError("eps and k must have the same length ≥ 2")
+        raise ConfigError("eps and k must have the same length ≥ 2")
     if np.any(eps <= 0) or not np.all(np.isfinite(eps)) or np.unique(eps).size != eps.size:
-        raise ValueError("eps must be distinct, finite and > 0")
+        raise ConfigError("eps must be distinct, finite and > 0")
     if np.any(k < 0) or np.any(k > n) or np.any(n < 1):
-        raise ValueError("need 0 ≤ k ≤ n and n ≥ 1")
+        raise ConfigError("need 0 ≤ k ≤ n and n ≥ 1")
     o = np.argsort(-eps)
     eps, k, n = eps[o], k[o], n[o]
     f = k / n

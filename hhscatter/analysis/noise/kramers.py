@@ -80,6 +80,11 @@ def hessian(model, x: float, y: float, step: float | None = None) -> np.ndarray:
     array([[ 3.,  0.],
            [ 0., -1.]])
     """
+    if not callable(getattr(model, "potential", None)):
+        raise ConfigError(f"model must be a System (hhscatter.model) or have a potential, got {type(model).__name__}")
+    x, y = check.number(x, "x"), check.number(y, "y")
+    if step is not None:
+        check.number(step, "step", positive=True)
     if step is None and hasattr(model, "potential_text") and hasattr(model, "params"):
         a, b, c = (float(v) for v in _landscape(model).hessian(float(x), float(y)))
         return np.array([[a, b], [b, c]])
@@ -166,19 +171,20 @@ def kramers_langer(model, gamma: float, temperature: float) -> KramersLanger:
     >>> round(kl.rate / (3 * (5**0.5 - 1) / 2 / (2 * math.pi) / 3**0.5 * math.exp(-6)), 6)
     1.0
     """
-    if not (gamma > 0 and temperature > 0):
-        raise ValueError(f"need γ > 0 and T > 0, got γ = {gamma}, T = {temperature}")
+    check.system(model)
+    gamma = check.number(gamma, "gamma", positive=True)
+    temperature = check.number(temperature, "temperature", positive=True)
     h_min = hessian(model, 0.0, 0.0)
     det_min = float(np.linalg.det(h_min))
     if not (det_min > 0 and np.all(np.linalg.eigvalsh(h_min) > 0)):
-        raise ValueError("the origin is not a minimum of V: Kramers–Langer needs a well there")
+        raise ConfigError("the origin is not a minimum of V: Kramers–Langer needs a well there")
     v_min = float(model.potential(np.array(0.0), np.array(0.0)))
     terms = []
     for e in model.exits:
         hs = hessian(model, e.x, e.y)
         ev = np.linalg.eigvalsh(hs)
         if not (ev[0] < 0 < ev[1]):
-            raise ValueError(f"exit ({e.x:g}, {e.y:g}) is not a saddle of V (Hessian eigenvalues {ev})")
+            raise ConfigError(f"exit ({e.x:g}, {e.y:g}) is not a saddle of V (Hessian eigenvalues {ev})")
         wb = math.sqrt(-ev[0])
         lam = -gamma / 2 + math.sqrt(gamma * gamma / 4 + wb * wb)
         pref = lam / (2 * math.pi) * math.sqrt(det_min / abs(float(np.linalg.det(hs))))
@@ -238,8 +244,9 @@ def thermal_rate(t_end, escaped, t_start: float, t_stop: float) -> ThermalRate:
     >>> b.is_bound, b.rate, round(b.upper95 * 1000 * 250.0, 4)     # −ln 0.05 over 2.5e5 orbit·time
     (True, nan, 2.9957)
     """
-    t_end = np.asarray(t_end, dtype=float)
-    escaped = np.asarray(escaped, dtype=bool)
+    t_end = check.numbers(t_end, "t_end", min_size=0)
+    escaped = check.mask(escaped, "escaped", t_end.size)
+    t_start, t_stop = check.window(t_start, t_stop)
     whole = escape_rate_mle(t_end, escaped, t_start, t_stop)
     mid = 0.5 * (t_start + t_stop)
     halves = tuple(

@@ -21,7 +21,9 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.noise.kramers import ThermalRate, thermal_rate
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.survival.kaplan_meier import survival_curve
+from hhscatter.errors import ConfigError
 
 __all__ = ["ReactivationCheck", "reactivation_check", "reactivation_survival"]
 
@@ -49,13 +51,14 @@ def reactivation_survival(t, t_end, escaped, settled, rate: float) -> np.ndarray
     >>> reactivation_survival([0.5, 2.0], [1.0, 0.0], [True, False], [False, True], 0.5).round(6)
     array([0.8894 , 0.18394])
     """
-    t = np.asarray(t, dtype=float)
-    t_end = np.asarray(t_end, dtype=float)
-    escaped = np.asarray(escaped, dtype=bool)
-    settled = np.asarray(settled, dtype=bool)
+    t = check.numbers(t, "t", minimum=0.0)
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    escaped = check.mask(escaped, "escaped", t_end.size)
+    settled = check.mask(settled, "settled", t_end.size)
+    rate = check.number(rate, "rate", minimum=0.0)
     censored = ~(escaped | settled)
     if censored.any() and t.size and t.max() > t_end[censored].min():
-        raise ValueError("times beyond the earliest censoring of the T = 0 ensemble: P_T is unknown there")
+        raise ConfigError("times beyond the earliest censoring of the T = 0 ensemble: P_T is unknown there")
     n = len(t_end)
     esc = np.sort(t_end[escaped])
     alive_esc = len(esc) - np.searchsorted(esc, t, side="right")
@@ -126,9 +129,14 @@ def reactivation_check(
     >>> c.settled_fraction, bool(c.max_deviation < 0.03), bool(abs(c.tail.rate - 0.05) < 3 * c.tail.rate_err)
     (1.0, True, True)
     """
-    t0, esc0, set0 = (np.asarray(a) for a in (t_end0, escaped0, settled0))
-    t0, esc0, set0 = t0.astype(float), esc0.astype(bool), set0.astype(bool)
-    tT, escT = np.asarray(t_end, dtype=float), np.asarray(escaped, dtype=bool)
+    t0 = check.numbers(t_end0, "t_end0", minimum=0.0)
+    esc0, set0 = check.mask(escaped0, "escaped0", t0.size), check.mask(settled0, "settled0", t0.size)
+    tT = check.numbers(t_end, "t_end", minimum=0.0)
+    escT = check.mask(escaped, "escaped", tT.size)
+    rate = check.number(rate, "rate", minimum=0.0)
+    t_max = check.number(t_max, "t_max", positive=True)
+    tail_start = check.number(tail_start, "tail_start", minimum=0.0)
+    n_grid = check.count(n_grid, "n_grid", 2)
     cens0 = ~(esc0 | set0)
     t_hi = min(t_max, float(t0[cens0].min()) if cens0.any() else t_max)
     grid = np.linspace(0.0, t_hi, n_grid)
@@ -141,7 +149,7 @@ def reactivation_check(
     # 99 % settling time is recorded beside it) and relaxed
     t_settled = float(np.quantile(t0[set0], 0.99)) if set0.any() else 0.0
     if tail_start < t_settled:
-        raise ValueError(
+        raise ConfigError(
             f"tail_start = {tail_start:g} is before the drag-only orbits have settled (99 % by t = {t_settled:g})"
         )
     tail = thermal_rate(tT, escT, tail_start, t_max)

@@ -28,6 +28,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate, optimize
 
+from hhscatter.analysis.noise.kramers import KramersLanger
+from hhscatter.analysis.stats import _arguments as check
+from hhscatter.errors import ConfigError
+
 __all__ = ["TurnoverRate", "barrier_action", "depopulation_factor", "energy_loss_parameter", "turnover_rate"]
 
 
@@ -58,9 +62,14 @@ def depopulation_factor(delta):
     >>> depopulation_factor([0.1, 1.0, 10.0]).round(4)
     array([0.0771, 0.443 , 0.9742])
     """
-    d = np.asarray(delta, dtype=float)
+    if isinstance(delta, (str, bytes, dict)) or delta is None:
+        raise ConfigError(f"delta must be a number or an array of numbers, got {type(delta).__name__}")
+    try:
+        d = np.asarray(delta, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"delta must be a number or an array of numbers, got {type(delta).__name__}") from None
     if not np.all(np.isfinite(d) & (d > 0)):
-        raise ValueError(f"delta must be finite and > 0 (the energy loss per period over T), got {delta!r}")
+        raise ConfigError(f"delta must be finite and > 0 (the energy loss per period over T), got {delta!r}")
     out = np.array([math.exp(_log_upsilon(float(v))) for v in d.ravel()]).reshape(d.shape)
     return out
 
@@ -74,9 +83,8 @@ def energy_loss_parameter(gamma: float, action: float, temperature: float) -> fl
     >>> energy_loss_parameter(0.1, 0.6, 1 / 18)     # γ = 0.1, S = 0.6, ΔE/T = 3 at ΔE = 1/6
     1.08
     """
-    for name, v in (("gamma", gamma), ("action", action), ("temperature", temperature)):
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+    gamma, action = check.number(gamma, "gamma", positive=True), check.number(action, "action", positive=True)
+    temperature = check.number(temperature, "temperature", positive=True)
     return round(gamma * action / temperature, 15)
 
 
@@ -97,9 +105,9 @@ def barrier_action(model, exit: int = 0) -> float:
     >>> round(barrier_action(HenonHeiles()), 10)
     1.2
     """
-    exits = model.exits
+    exits = check.system(model).exits
     if isinstance(exit, bool) or not isinstance(exit, (int, np.integer)) or not 0 <= exit < len(exits):
-        raise ValueError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {exit!r}")
+        raise ConfigError(f"exit must be a channel index from 0 to {len(exits) - 1}, got {exit!r}")
     e = exits[exit]
     xs, ys, e_s = float(e.x), float(e.y), float(e.energy)
     r_s = math.hypot(xs, ys)
@@ -109,12 +117,12 @@ def barrier_action(model, exit: int = 0) -> float:
         return e_s - float(model.potential(np.array(s * ux), np.array(s * uy)))
 
     if not gap(0.0) > 0:
-        raise ValueError("the origin is not below the saddle's energy: the system has no well there")
+        raise ConfigError("the origin is not below the saddle's energy: the system has no well there")
     lo = -r_s
     while gap(lo) > 0:  # the far turning point on V = E_s, across the well
         lo *= 2
         if lo < -1e6 * r_s:
-            raise ValueError(f"V stays below E_s along the line through exit {exit} and the minimum: no turning point")
+            raise ConfigError(f"V stays below E_s along the line through exit {exit} and the minimum: no turning point")
     s_turn = optimize.brentq(gap, lo, 0.0, xtol=1e-15 * r_s, rtol=1e-15)
     f = lambda s: math.sqrt(2.0 * max(gap(s), 0.0))
     val = integrate.quad(f, s_turn, 0.0, epsabs=0, epsrel=1e-12, limit=200)[0]
@@ -162,8 +170,13 @@ def turnover_rate(kl, actions) -> TurnoverRate:
     >>> round(weak.rate / weak.energy_diffusion, 3), weak.delta[0]
     (1.0, 9e-08)
     """
+    if not isinstance(kl, KramersLanger):
+        raise ConfigError(f"kl must be a KramersLanger (kramers_langer's result), got {type(kl).__name__}")
     terms = kl.terms
-    s = np.broadcast_to(np.asarray(actions, dtype=float), (len(terms),))
+    s = check.numbers(actions, "actions", positive=True)
+    if s.size not in (1, len(terms)):
+        raise ConfigError(f"actions must be one number or one per saddle ({len(terms)}), got {s.size}")
+    s = np.broadcast_to(s, (len(terms),))
     deltas = tuple(energy_loss_parameter(kl.gamma, float(a), kl.temperature) for a in s)
     ups = tuple(float(u) for u in depopulation_factor(np.array(deltas)))
     tst = [t.omega_b / t.lambda_plus * t.rate for t in terms]

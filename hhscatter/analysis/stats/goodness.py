@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.errors import ConfigError
+
 #: the smallest expected count of a pooled cell
 MIN_EXPECTED = 5.0
 #: the verdict of a goodness-of-fit test left without a degree of freedom by the pooling (``PooledPearson.too_few``)
@@ -67,11 +69,11 @@ def pool_cells(observed, expected, min_expected: float = MIN_EXPECTED) -> tuple[
     o = np.asarray(observed, dtype=float).ravel()
     e = np.asarray(expected, dtype=float).ravel()
     if o.shape != e.shape:
-        raise ValueError(f"observed and expected differ in length ({o.size} and {e.size})")
+        raise ConfigError(f"observed and expected differ in length ({o.size} and {e.size})")
     if (e < 0).any() or (o < 0).any():
-        raise ValueError("observed and expected counts must be ≥ 0")
+        raise ConfigError("observed and expected counts must be ≥ 0")
     if not min_expected > 0:
-        raise ValueError(f"min_expected must be > 0, got {min_expected}")
+        raise ConfigError(f"min_expected must be > 0, got {min_expected}")
     po, pe, acc_o, acc_e = [], [], 0.0, 0.0
     for a, b in zip(o, e):
         acc_o, acc_e = acc_o + a, acc_e + b

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.errors import ConfigError
+
 __all__ = ["BoundedFraction", "fraction_with_bound", "rate_upper_bound", "wilson_interval"]
 
 
@@ -24,9 +26,9 @@ def wilson_interval(k, n, z: float = 1.0):
     k = np.asarray(k, dtype=float)
     n = np.asarray(n, dtype=float)
     if np.any(k < 0) or np.any(k > n):
-        raise ValueError("need 0 ≤ k ≤ n")
+        raise ConfigError("need 0 ≤ k ≤ n")
     if not z > 0:
-        raise ValueError(f"z must be > 0, got {z}")
+        raise ConfigError(f"z must be > 0, got {z}")
     with np.errstate(divide="ignore", invalid="ignore"):
         p = k / n
         d = 1.0 + z * z / n
@@ -102,11 +104,11 @@ def fraction_with_bound(k: int, n: int, *, cl: float = 0.95) -> BoundedFraction:
     """
     k, n = int(k), int(n)
     if n <= 0:
-        raise ValueError(f"n must be a positive number of trials, got {n}")
+        raise ConfigError(f"n must be a positive number of trials, got {n}")
     if not 0 <= k <= n:
-        raise ValueError(f"k must lie in [0, n] = [0, {n}], got {k}")
+        raise ConfigError(f"k must lie in [0, n] = [0, {n}], got {k}")
     if not 0 < cl < 1:
-        raise ValueError(f"cl must lie in (0, 1), got {cl}")
+        raise ConfigError(f"cl must lie in (0, 1), got {cl}")
     f = k / n
     if k == 0:
         return BoundedFraction(k, n, 0.0, None, -math.expm1(math.log1p(-cl) / n), None, cl)
@@ -132,10 +134,10 @@ def rate_upper_bound(exposure, cl: float = 0.95):
     [0.03, inf]
     """
     if not 0 < cl < 1:
-        raise ValueError(f"cl must lie in (0, 1), got {cl}")
+        raise ConfigError(f"cl must lie in (0, 1), got {cl}")
     x = np.asarray(exposure, dtype=float)
     if np.any(x < 0):
-        raise ValueError("exposure must be ≥ 0")
+        raise ConfigError("exposure must be ≥ 0")
     with np.errstate(divide="ignore"):
         out = np.where(x > 0, -math.log1p(-cl) / np.where(x > 0, x, 1.0), np.inf)
     return float(out) if out.ndim == 0 else out

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.errors import ConfigError
+
 __all__ = ["LinearFit", "least_squares_operator", "weighted_least_squares"]
 
 ERRORS = ("absolute", "scaled", "inflated")
@@ -67,7 +69,7 @@ def _design(X, weights):
     n = X.shape[0]
     w = np.ones(n) if weights is None else np.asarray(weights, dtype=float).ravel()
     if w.size != n or np.any(~np.isfinite(w)) or np.any(w < 0):
-        raise ValueError("weights must be finite, non-negative and one per point")
+        raise ConfigError("weights must be finite, non-negative and one per point")
     return X, w
 
 
@@ -92,9 +94,9 @@ def weighted_least_squares(X, y, weights=None, *, errors: str = "absolute") -> L
     y = np.asarray(y, dtype=float).ravel()
     n, p = X.shape
     if y.size != n:
-        raise ValueError(f"X has {n} rows but y has {y.size} values")
+        raise ConfigError(f"X has {n} rows but y has {y.size} values")
     if errors not in ERRORS:
-        raise ValueError(f"errors must be one of {ERRORS}, got {errors!r}")
+        raise ConfigError(f"errors must be one of {ERRORS}, got {errors!r}")
     A, F = least_squares_operator(X, w)
     coef = A @ y
     resid = y - X @ coef

@@ -19,6 +19,7 @@ from scipy import optimize
 from scipy.special import logsumexp
 
 from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = ["CMeasureKappa", "cmeasure_sample_from_sections", "kappa_from_cmeasure"]
 
@@ -148,13 +149,13 @@ def _checked_sample(return_times, n_exit):
     """The checked c-measure sample: (return times T (time units), number of exits, sample size M)."""
     T = np.asarray(return_times, dtype=float).ravel()
     if np.any(~np.isfinite(T)) or np.any(T <= 0):
-        raise ValueError("return times must be finite and > 0")
+        raise ConfigError("return times must be finite and > 0")
     n_exit = int(n_exit)
     if n_exit < 0:
-        raise ValueError("n_exit must be ≥ 0")
+        raise ConfigError("n_exit must be ≥ 0")
     M = T.size + n_exit
     if M == 0:
-        raise ValueError("empty sample")
+        raise ConfigError("empty sample")
     return T, n_exit, M
 
 
@@ -183,7 +184,7 @@ def _orbit_bootstrap(T, n_exit, orbits, exit_orbits, n_boot, gen) -> np.ndarray:
     orbits = np.asarray([] if orbits is None else orbits).ravel()
     exit_orbits = np.asarray([] if exit_orbits is None else exit_orbits).ravel()
     if orbits.size != T.size or exit_orbits.size != n_exit:
-        raise ValueError(
+        raise ConfigError(
             f"orbits must give the orbit of each of the {T.size} return times and exit_orbits of "
             f"each of the {n_exit} exits, got {orbits.size} and {exit_orbits.size}"
         )
@@ -238,7 +239,7 @@ def cmeasure_sample_from_sections(
     lt["outcome"] = lt["outcome"].astype(object)
     last = last.merge(lt, on="traj_id", how="left")
     if last["outcome"].isna().any():
-        raise ValueError("sections refer to traj_ids missing from lifetimes")
+        raise ConfigError("sections refer to traj_ids missing from lifetimes")
     leaves = last["outcome"].isin(["escaped", "settled"]).to_numpy() & (last["t_end"].to_numpy() <= t_record_end)
     n_exit = int(np.count_nonzero(leaves))
     n_und = int(leaves.size - n_exit)

@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.stats.intervals import rate_upper_bound
+from hhscatter.errors import ConfigError
 
 __all__ = ["binned_hazard", "observed_over_expected"]
 
@@ -50,9 +51,9 @@ def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
     e = np.asarray(escaped, dtype=bool).ravel()
     edges = np.asarray(edges, dtype=float)
     if t.shape != e.shape:
-        raise ValueError("t_end and escaped differ in length")
+        raise ConfigError("t_end and escaped differ in length")
     if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0):
-        raise ValueError("edges must be increasing, at least 2 of them")
+        raise ConfigError("edges must be increasing, at least 2 of them")
     lo, hi = edges[:-1], edges[1:]
     ts = np.sort(t)
     # exposure = Σ_i clip(t_i − lo, 0, hi − lo) = ∫_lo^hi N(s > t) dt, by the sorted times' cumulative sums

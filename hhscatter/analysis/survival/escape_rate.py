@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import rate_upper_bound
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import WithErrors
@@ -50,6 +51,7 @@ from hhscatter.analysis.survival.fits import (
 )
 from hhscatter.analysis.survival.kappa_energy import KappaEnergyFit, fit_kappa_energy
 from hhscatter.analysis.survival.windows import WindowChoice, choose_windows
+from hhscatter.errors import ConfigError
 
 # the window choice, the κ(E) law and the c-measure estimator live in their own modules; their names stay
 # importable from here
@@ -131,12 +133,14 @@ def escape_rate_mle(t_end, observed, t_start, t_stop) -> MLERate:
     >>> m.is_bound, m.kappa, round(m.upper95, 4), m.exposure
     (True, nan, 0.2996, 10.0)
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed).ravel()
-    if observed.dtype != bool:
-        raise TypeError("observed must be a boolean mask")
-    if not t_stop > t_start:
-        raise ValueError("need t_start < t_stop")
+    t_end = check.numbers(t_end, "t_end", min_size=0)
+    observed = check.mask(observed, "observed", t_end.size)
+    t_start, t_stop = check.window(t_start, t_stop, ("t_start", "t_stop"))
+    return _constant_hazard_mle(t_end, observed, t_start, t_stop)
+
+
+def _constant_hazard_mle(t_end: np.ndarray, observed: np.ndarray, t_start: float, t_stop: float) -> MLERate:
+    """The MLE of :func:`escape_rate_mle` on checked arguments (any variable in place of the time)."""
     at_risk = t_end > t_start
     exposure = float(np.sum(np.minimum(t_end[at_risk], t_stop) - t_start))
     D = int(np.count_nonzero(observed & at_risk & (t_end <= t_stop)))
@@ -164,10 +168,12 @@ def power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate:
 
     The result's ``exposure`` is that sum (dimensionless).
     """
+    t_end = check.numbers(t_end, "t_end", min_size=0)
+    observed = check.mask(observed, "observed", t_end.size)
+    t_start, t_stop = check.window(t_start, t_stop, ("t_start", "t_stop"))
     if not t_start > 0:
-        raise ValueError(f"t_start must be > 0 for a power law, got {t_start}")
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    return escape_rate_mle(np.log(np.maximum(t_end, 1e-300)), observed, math.log(t_start), math.log(t_stop))
+        raise ConfigError(f"t_start must be > 0 for a power law, got {t_start}")
+    return _constant_hazard_mle(np.log(np.maximum(t_end, 1e-300)), observed, math.log(t_start), math.log(t_stop))
 
 
 @dataclass(frozen=True)
@@ -298,7 +304,7 @@ def escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=Fals
             " > 0); κ is the conservative escape rate and its exponential fit does not describe P(t) with drag"
         )
         if not allow_dissipative:
-            raise ValueError(msg + " (pass allow_dissipative=True to fit it anyway)")
+            raise ConfigError(msg + " (pass allow_dissipative=True to fit it anyway)")
         warnings.warn(msg, UserWarning, stacklevel=2)
     t_end, observed = lifetimes_to_arrays(lifetimes)
     return escape_rate(t_end, observed, t_grid, **kwargs)
@@ -366,9 +372,9 @@ def choose_t_max(
     t_end = np.asarray(t_end, dtype=float).ravel()
     observed = np.asarray(observed).ravel()
     if not (isinstance(n_main, (int, np.integer)) and n_main > 0):
-        raise ValueError(f"n_main must be an integer > 0, got {n_main!r}")
+        raise ConfigError(f"n_main must be an integer > 0, got {n_main!r}")
     if not (0 < t_min <= t_cap and step > 0 and margin_efolds >= 0 and min_survivors > 0):
-        raise ValueError("need 0 < t_min ≤ t_cap, step > 0, margin_efolds ≥ 0, min_survivors > 0")
+        raise ConfigError("need 0 < t_min ≤ t_cap, step > 0, margin_efolds ≥ 0, min_survivors > 0")
     curve = survival_curve(t_end, observed)
     t, P = curve.t, curve.P
 
@@ -441,10 +447,10 @@ def escaping_tail(
     t_end = np.asarray(t_end, dtype=float).ravel()
     observed = np.asarray(observed).ravel()
     if observed.dtype != bool:
-        raise TypeError("observed must be a boolean mask")
+        raise ConfigError("observed must be a boolean mask")
     t_esc = t_end[observed]
     if t_esc.size < 10:
-        raise ValueError(f"escaping_tail needs ≥ 10 escaping orbits, got {t_esc.size}")
+        raise ConfigError(f"escaping_tail needs ≥ 10 escaping orbits, got {t_esc.size}")
     grid = _default_grid(t_esc, n_grid) if t_grid is None else np.asarray(t_grid, dtype=float)
     curve = survival_curve(t_esc, np.ones(t_esc.size, dtype=bool), grid)
     ok = np.isfinite(curve.P)

@@ -57,6 +57,7 @@ from hhscatter.analysis.stats.least_squares import (
 )
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.analysis.survival.kaplan_meier import SurvivalCurve, survival_curve
+from hhscatter.errors import ConfigError
 from hhscatter.outcomes import CENSORED, CENSORING_OUTCOMES, LEAVING_OUTCOMES, OUTCOMES
 
 __all__ = [
@@ -101,14 +102,14 @@ def observed_from_outcome(outcome) -> np.ndarray:
         codes = np.asarray(cat.codes)
         if (codes < 0).any() or bad_c[codes].any():
             seen = {repr(v) for v in labels[np.unique(codes[codes >= 0])][bad_c[np.unique(codes[codes >= 0])]]}
-            raise ValueError(f"unknown outcome labels: {sorted(seen | ({'nan'} if (codes < 0).any() else set()))[:5]}")
+            raise ConfigError(f"unknown outcome labels: {sorted(seen | ({'nan'} if (codes < 0).any() else set()))[:5]}")
         return leaving_c[codes]
     o = np.asarray(outcome, dtype=object).ravel()
     leaving = np.isin(o, LEAVING_OUTCOMES)
     censored = np.isin(o, CENSORING_OUTCOMES)
     bad = ~(leaving | censored)
     if bad.any():
-        raise ValueError(f"unknown outcome labels: {sorted({repr(v) for v in o[bad]})[:5]}")
+        raise ConfigError(f"unknown outcome labels: {sorted({repr(v) for v in o[bad]})[:5]}")
     return leaving
 
 
@@ -130,7 +131,7 @@ def lifetimes_to_arrays(lifetimes, *, check_single_ensemble: bool = True):
             # last bits: compare with a relative tolerance, not by exact uniqueness
             v = lifetimes[col].to_numpy(dtype=float) if col in lifetimes.columns else np.zeros(0)
             if v.size and (np.isnan(v).any() or np.ptp(v) > 1e-9 * max(1.0, float(np.max(np.abs(v))))):
-                raise ValueError(
+                raise ConfigError(
                     f"lifetimes mixes several values of {col!r} (several grid points): use hhscatter.survival"
                     "(lifetimes) / hhscatter.escape_rates(lifetimes) for one result per point, or select one "
                     "point, e.g. lifetimes.groupby(['energy', 'gamma']) (not by 'e0', which differs per orbit)"
@@ -195,10 +196,10 @@ def _prepare(t, P, P_err, window, log_t):
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
     if t.shape != P.shape:
-        raise ValueError("t and P differ in length")
+        raise ConfigError("t and P differ in length")
     lo, hi = float(window[0]), float(window[1])
     if not hi > lo:
-        raise ValueError(f"window must satisfy t_lo < t_hi, got {window}")
+        raise ConfigError(f"window must satisfy t_lo < t_hi, got {window}")
     m = (t >= lo) & (t <= hi) & np.isfinite(t) & np.isfinite(P) & (P > 0)
     if log_t:
         m &= t > 0
@@ -206,14 +207,14 @@ def _prepare(t, P, P_err, window, log_t):
     if P_err is not None:
         P_err = np.asarray(P_err, dtype=float).ravel()
         if P_err.shape != P.shape:
-            raise ValueError("P_err and P differ in length")
+            raise ConfigError("P_err and P differ in length")
         m &= np.isfinite(P_err) & (P_err > 0)
     order = np.argsort(t[m], kind="stable")
     tt, PP = t[m][order], P[m][order]
     if P_err is not None:
         sig = P_err[m][order] / PP
     if tt.size < 3:
-        raise ValueError(
+        raise ConfigError(
             f"fewer than 3 usable points (P > 0{', P_err > 0' if P_err is not None else ''}) in window {window}"
         )
     return tt, PP, sig, (lo, hi)
@@ -240,7 +241,7 @@ def mean_kappa_stat_err(t, P, P_err, windows) -> float:
     for lo, hi in windows:
         m = (tv >= lo) & (tv <= hi)
         if np.count_nonzero(m) < 3:
-            raise ValueError(f"fewer than 3 usable points in window {(lo, hi)}")
+            raise ConfigError(f"fewer than 3 usable points in window {(lo, hi)}")
         X = np.column_stack([tv[m], np.ones(np.count_nonzero(m))])
         total[m] += least_squares_operator(X, 1.0 / sv[m] ** 2)[0][0]
     total /= len(windows)
@@ -427,7 +428,7 @@ def _resolve_n_total(P, P_err, n_total):
         return float(n_total)
     n = _n_total_from_errors(P, P_err)
     if n is None:
-        raise ValueError("n_total (the ensemble size N) is required when P_err cannot provide it")
+        raise ConfigError("n_total (the ensemble size N) is required when P_err cannot provide it")
     return n
 
 

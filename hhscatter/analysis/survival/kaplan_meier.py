@@ -34,6 +34,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
+from hhscatter.errors import ConfigError
+
 __all__ = ["KaplanMeierGrid", "SurvivalCurve", "km_steps", "survival_curve", "survival_on_grid"]
 
 
@@ -71,20 +74,22 @@ def _std_err(S, var_log):
 
 
 def _check(t_end, observed, weights):
-    t_end = np.asarray(t_end, dtype=float).ravel()
+    t_end = check.numbers(t_end, "t_end", min_size=0)
+    if isinstance(observed, (str, bytes, dict)) or observed is None:
+        raise ConfigError(f"observed must be a boolean mask, got {type(observed).__name__}")
     observed = np.asarray(observed).ravel()
     if observed.dtype != bool:
-        raise TypeError(f"observed must be a boolean mask, got dtype {observed.dtype}")
+        raise ConfigError(f"observed must be a boolean mask, got dtype {observed.dtype}")
     if t_end.shape != observed.shape:
-        raise ValueError(f"t_end and observed differ in length: {t_end.size} vs {observed.size}")
+        raise ConfigError(f"t_end and observed differ in length: {t_end.size} vs {observed.size}")
     if not np.all(np.isfinite(t_end)):
-        raise ValueError("t_end contains non-finite values")
+        raise ConfigError("t_end contains non-finite values")
     if np.any(t_end < 0):
-        raise ValueError("t_end must be ≥ 0")
+        raise ConfigError("t_end must be ≥ 0")
     if weights is not None:
-        weights = np.asarray(weights, dtype=float).ravel()
+        weights = check.numbers(weights, "weights", min_size=0)
         if weights.shape != t_end.shape or np.any(weights < 0) or not np.all(np.isfinite(weights)):
-            raise ValueError("weights must be finite, non-negative and as long as t_end")
+            raise ConfigError("weights must be finite, non-negative and as long as t_end")
     return t_end, observed, weights
 
 
@@ -97,7 +102,7 @@ def km_steps(t_end, observed, weights=None) -> KMSteps:
     """
     t_end, observed, weights = _check(t_end, observed, weights)
     if t_end.size == 0:
-        raise ValueError("empty sample: no lifetimes")
+        raise ConfigError("empty sample: no lifetimes")
     if weights is None:
         ev = np.sort(t_end[observed])
         ce = np.sort(t_end[~observed])
@@ -210,7 +215,7 @@ class KaplanMeierGrid:
     def __init__(self, grid):
         g = np.asarray(grid, dtype=float).ravel()
         if g.size == 0 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
-            raise ValueError("grid must be a non-empty, finite, strictly increasing 1-d array")
+            raise ConfigError("grid must be a non-empty, finite, strictly increasing 1-d array")
         self.grid = g
         self._d = np.zeros(g.size)
         self._c = np.zeros(g.size)
@@ -231,7 +236,7 @@ class KaplanMeierGrid:
 
     def curve(self) -> SurvivalCurve:
         if self.n_total <= 0:
-            raise ValueError("empty sample: no lifetimes")
+            raise ConfigError("empty sample: no lifetimes")
         at_risk = self.n_total - np.concatenate([[0.0], np.cumsum(self._d + self._c)[:-1]])
         S, var_log = _product(self._d, np.maximum(at_risk, 0.0))
         S = np.clip(S, 0.0, 1.0)

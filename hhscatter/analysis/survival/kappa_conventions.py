@@ -34,13 +34,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from hhscatter.analysis.stats.library_warnings import counted
-from hhscatter.analysis.stats.measured import WithErrors
+from hhscatter.analysis.stats.measured import Measured, WithErrors
 from hhscatter.analysis.survival.fits import (
     fit_exponential,
     mean_kappa_stat_err,
     survival_curve,
 )
 from hhscatter.analysis.survival.kappa_energy import fit_kappa_energy, kappa_law_summary
+from hhscatter.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,7 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     falls to ``p_lo`` (e.g. a plateau of trapped orbits above it).
     """
     if not 0 < p_lo < p_hi < 1:
-        raise ValueError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
+        raise ConfigError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
     t = np.asarray(t, dtype=float)
     P = np.asarray(P, dtype=float)
     ia, ib = np.flatnonzero(P <= p_hi), np.flatnonzero(P <= p_lo)
@@ -273,6 +274,31 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
 LAW_PARAMETERS = ("a", "b", "c", "E_b")
 
 
+@dataclass(frozen=True)
+class ConventionSpread:
+    """One parameter across conventions: its :class:`~hhscatter.analysis.stats.measured.Measured` (the mean over
+    the conventions, error √(spread² + err_stat²)), ``err_stat`` (the largest statistical error of one convention),
+    ``spread`` (half the range across conventions) and ``per_convention`` {convention: value}; same unit as the
+    parameter.
+
+    Examples
+    --------
+    >>> ConventionSpread(Measured(12.0, 2.5), 1.5, 2.0, {"one": 10.0, "two": 14.0}).to_dict()["err"]
+    2.5
+    """
+
+    measured: Measured
+    err_stat: float
+    spread: float
+    per_convention: dict
+
+    def to_dict(self) -> dict:
+        """``{value, err_stat, spread, err, per_convention}``: the record as a numbers JSON holds it."""
+        m = self.measured
+        fields = ("value", "err_stat", "spread", "err", "per_convention")
+        return dict(zip(fields, (m.value, self.err_stat, self.spread, m.err, self.per_convention)))
+
+
 def law_spread(fits: dict) -> dict:
     """law_spread({convention: KappaEnergyFit}) -> {param: {value, err_stat, spread, err, per_convention}}.
 
@@ -288,13 +314,9 @@ def law_spread(fits: dict) -> dict:
         v = np.array(list(vals.values()))
         spread = float((v.max() - v.min()) / 2) if v.size else math.nan
         stat = float(np.nanmax(errs)) if errs and np.isfinite(errs).any() else math.nan
-        out[p] = {
-            "value": float(v.mean()) if v.size else math.nan,
-            "err_stat": stat,
-            "spread": spread,
-            "err": float(math.hypot(spread, stat)) if math.isfinite(stat) else spread,
-            "per_convention": vals,
-        }
+        total = float(math.hypot(spread, stat)) if math.isfinite(stat) else spread
+        m = Measured(float(v.mean()) if v.size else math.nan, total, "mean over conventions", len(vals))
+        out[p] = ConventionSpread(m, stat, spread, vals).to_dict()
     return out
 
 

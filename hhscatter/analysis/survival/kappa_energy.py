@@ -18,6 +18,7 @@ from scipy import optimize
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured, WithErrors
+from hhscatter.errors import ConfigError
 
 __all__ = ["KappaEnergyFit", "fit_kappa_energy", "kappa_law_summary"]
 
@@ -90,7 +91,7 @@ def _continuous_profile(x, y, w, xb):
 def _fit_continuous(x, y, w, n_grid):
     xs = np.sort(np.unique(x))
     if xs.size < 4:
-        raise ValueError("need at least 4 distinct energies")
+        raise ConfigError("need at least 4 distinct energies")
     grid = np.linspace(xs[1], xs[-2], n_grid)
     chi2, _, _ = _continuous_profile(x, y, w, grid)
     i = int(np.nanargmin(chi2))
@@ -120,7 +121,7 @@ def _fit_discontinuous(x, y, w):
         if best is None or c1 + c2 < best[0]:
             best = (c1 + c2, k, p1, p2, F1, F2)
     if best is None:
-        raise ValueError("no admissible break between the energies")
+        raise ConfigError("no admissible break between the energies")
     chi2, k, p1, p2, F1, F2 = best
     xb = 0.5 * (xs[k - 1] + xs[k])
     var_xb = (xs[k] - xs[k - 1]) ** 2 / 12.0  # uniform over the gap where χ² is flat
@@ -201,14 +202,14 @@ def _kappa_points(E, kappa, kappa_err, E_c):
     E = np.asarray(E, dtype=float).ravel()
     y = np.asarray(kappa, dtype=float).ravel()
     if E.shape != y.shape:
-        raise ValueError("E and kappa differ in length")
+        raise ConfigError("E and kappa differ in length")
     x = E - E_c
     if np.any(x <= 0):
-        raise ValueError("all energies must exceed E_c (no escape below)")
+        raise ConfigError("all energies must exceed E_c (no escape below)")
     given = kappa_err is not None
     sig = np.asarray(kappa_err, dtype=float).ravel() if given else np.ones_like(y)
     if np.any(~(sig > 0)):
-        raise ValueError("kappa_err must be positive")
+        raise ConfigError("kappa_err must be positive")
     return x, y, 1.0 / sig**2, given
 
 

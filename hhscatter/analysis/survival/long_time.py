@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hhscatter.analysis.stats.goodness import TOO_FEW
+from hhscatter.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -149,11 +150,11 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
     t = np.asarray(t_end, dtype=float).ravel()
     obs = np.asarray(observed, dtype=bool).ravel()
     if t.shape != obs.shape:
-        raise ValueError("t_end and observed differ in length")
+        raise ConfigError("t_end and observed differ in length")
     risk = t > t0
     n = int(risk.sum())
     if n < 10 or obs[risk].sum() < 3:
-        raise ValueError(f"too few orbits inside at t0 = {t0:g} ({n}) or escapes after it ({int(obs[risk].sum())})")
+        raise ConfigError(f"too few orbits inside at t0 = {t0:g} ({n}) or escapes after it ({int(obs[risk].sum())})")
     s, esc = t[risk] - t0, obs[risk]
     from scipy.optimize import minimize  # deferred: scipy loads on first use
     from scipy.special import expit  # deferred: scipy loads on first use

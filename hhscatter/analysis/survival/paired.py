@@ -65,7 +65,7 @@ def _mle_terms(t_end, observed, t_start, t_stop):
     t_end = np.asarray(t_end, dtype=float).ravel()
     observed = np.asarray(observed).ravel()
     if observed.dtype != bool:
-        raise TypeError("observed must be a boolean mask")
+        raise ConfigError("observed must be a boolean mask")
     at_risk = t_end > t_start
     x = np.where(at_risk, np.minimum(t_end, t_stop) - t_start, 0.0)
     d = (observed & at_risk & (t_end <= t_stop)).astype(float)
@@ -92,12 +92,12 @@ def paired_mle_shift(t_ref, observed_ref, t_alt, observed_alt, t_start: float, t
     d0, x0 = _mle_terms(t_ref, observed_ref, t_start, t_stop)
     d1, x1 = _mle_terms(t_alt, observed_alt, t_start, t_stop)
     if d0.shape != d1.shape:
-        raise ValueError("paired samples must have the same length (one entry per orbit)")
+        raise ConfigError("paired samples must have the same length (one entry per orbit)")
     if not t_stop > t_start:
-        raise ValueError("need t_start < t_stop")
+        raise ConfigError("need t_start < t_stop")
     X0, X1 = x0.sum(), x1.sum()
     if not (X0 > 0 and X1 > 0):
-        raise ValueError("no exposure in the window")
+        raise ConfigError("no exposure in the window")
     k0, k1 = d0.sum() / X0, d1.sum() / X1
     u0 = (d0 - k0 * x0) / X0
     u1 = (d1 - k1 * x1) / X1
@@ -165,12 +165,12 @@ def survival_ratio_slope(
     observed_ref = np.asarray(observed_ref).ravel()
     observed_alt = np.asarray(observed_alt).ravel()
     if t_ref.shape != t_alt.shape:
-        raise ValueError("paired samples must have the same length (one entry per orbit)")
+        raise ConfigError("paired samples must have the same length (one entry per orbit)")
     lo, hi = float(window[0]), float(window[1])
     if not hi > lo:
-        raise ValueError(f"window must have t_lo < t_hi, got {window}")
+        raise ConfigError(f"window must have t_lo < t_hi, got {window}")
     if n_groups < 2:
-        raise ValueError(f"n_groups must be ≥ 2, got {n_groups}")
+        raise ConfigError(f"n_groups must be ≥ 2, got {n_groups}")
     grid = np.linspace(lo, hi, int(n_grid))
     shift, offset = _log_ratio_fit(t_ref, observed_ref, t_alt, observed_alt, grid)
     g = np.arange(t_ref.size) % n_groups

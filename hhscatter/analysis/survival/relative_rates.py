@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import MLERate, escape_rate_mle
+from hhscatter.errors import ConfigError
 
 __all__ = ["RelativeRate", "relative_rates"]
 
@@ -42,7 +43,7 @@ def relative_rates(samples, t_start: float, t_stop: float, ref: int | None = 0) 
     (1.0, True)
     """
     if ref is not None and not -len(samples) <= ref < len(samples):
-        raise ValueError(f"ref = {ref} is not the index of one of the {len(samples)} samples")
+        raise ConfigError(f"ref = {ref} is not the index of one of the {len(samples)} samples")
     rates = [escape_rate_mle(t_end, escaped, t_start, t_stop) for t_end, escaped in samples]
     base = None if ref is None else rates[ref].measured("kappa")
     return [RelativeRate(r, None if base is None else r.measured("kappa") / base) for r in rates]

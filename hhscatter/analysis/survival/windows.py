@@ -21,6 +21,7 @@ from hhscatter.analysis.survival.fits import (
     _floor_time,
     _resolve_n_total,
 )
+from hhscatter.errors import ConfigError
 
 __all__ = ["WindowChoice", "choose_windows"]
 
@@ -208,13 +209,13 @@ def _checked_curve(t, P, P_err, n_total, min_survivors):
     t = np.asarray(t, dtype=float).ravel()
     P = np.asarray(P, dtype=float).ravel()
     if t.shape != P.shape:
-        raise ValueError("t and P differ in length")
+        raise ConfigError("t and P differ in length")
     if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+        raise ConfigError("t must be strictly increasing")
     N = _resolve_n_total(P, P_err, n_total)
     t_floor = _floor_time(t, P, N, min_survivors)
     if t_floor is None or t_floor <= t[0]:
-        raise ValueError(f"fewer than {min_survivors} survivors at every grid time: nothing to fit")
+        raise ConfigError(f"fewer than {min_survivors} survivors at every grid time: nothing to fit")
     return t, P, N, t_floor
 
 
@@ -248,7 +249,7 @@ def _plateau_level(t, P, N, w, t_floor, kappa_p, rel_tol, n_sigma, n_levels):
     c, s, se = _local_slope(t, P, N, w, t_floor)
     fin = np.isfinite(s) & (s > 0)
     if not fin.any():
-        raise ValueError("the survival curve does not decay above the counting floor")
+        raise ConfigError("the survival curve does not decay above the counting floor")
     logPc = np.log(_step(t, P, c))
     best = (-1.0, kappa_p, 0, c.size - 1)
     for level in np.unique(np.quantile(s[fin], np.linspace(0.0, 1.0, n_levels))):
@@ -312,7 +313,7 @@ def _iterate_plateau(t, P, N, t_floor, w, kappa_ref, target, pilot, rel_tol, n_s
 def _fitting_windows(tau0, t_stop):
     """Rule step 6, the 4 fitting windows of [τ0, t_stop]: full, first half, second half, middle half (time units)."""
     if not t_stop > tau0:
-        raise ValueError(f"degenerate exponential range [{tau0}, {t_stop}]")
+        raise ConfigError(f"degenerate exponential range [{tau0}, {t_stop}]")
     L = t_stop - tau0
     return (
         (tau0, t_stop),

@@ -53,6 +53,22 @@ def test_product_code_writes_a_value_with_its_error_as_a_measured():
     assert [h for h in hits if h not in own] == []
 
 
+def _records_with_value_and_err(path: Path) -> list[str]:
+    """Dict displays of ``path`` with "value" and "err" among more keys: a table row or record spelling a measured
+    value by hand."""
+    hits = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Dict) and len(node.keys) > 2:
+            if {"value", "err"} <= {getattr(k, "value", None) for k in node.keys}:
+                hits.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    return hits
+
+
+def test_records_with_more_fields_take_their_value_and_error_from_a_measured():
+    files = sorted((ROOT / "hhscatter").rglob("*.py")) + sorted((ROOT / "studies").rglob("*.py"))
+    assert [h for f in files for h in _records_with_value_and_err(f)] == []
+
+
 def test_is_frozen():
     with pytest.raises(AttributeError):
         Measured(1.0, 0.1).value = 2.0

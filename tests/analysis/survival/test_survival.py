@@ -31,6 +31,7 @@ from hhscatter.analysis.survival.fits import (
     survival_curve,
     survival_from_lifetimes,
 )
+from hhscatter.errors import ConfigError
 
 E_C = 1.0 / 6.0
 
@@ -101,8 +102,8 @@ def test_survival_curve_all_leave_reaches_zero():
     t_end = np.array([1.0, 2.0, 2.0, 3.0])
     c = survival_curve(t_end, np.ones(4, bool), [0, 1, 1.5, 2, 2.5, 3, 10])
     np.testing.assert_allclose(c.P, [1, 0.75, 0.75, 0.25, 0.25, 0, 0])
-    with pytest.raises(TypeError):
-        survival_curve(t_end, np.ones(4))  # observed must be boolean
+    with pytest.raises(ConfigError, match="observed must be a boolean mask"):
+        survival_curve(t_end, np.ones(4))
 
 
 def test_kaplan_meier_handles_censoring_naive_does_not():
