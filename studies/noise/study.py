@@ -346,7 +346,20 @@ def _saddles_turnover(study, runs) -> dict:
         key = _saddles_turnover_key(g)
         row = _turnover_row(study, key, runs)
         rows.append({**row, "saddles": saddle_turnover_terms(runs[key].model, row["gamma"], row["temperature"])})
-    return {"barrier_over_T": p.saddles_turnover_barrier, "potential": p.saddles_potential, "records": rows}
+    return {
+        "barrier_over_T": p.saddles_turnover_barrier,
+        "potential": p.saddles_potential,
+        "separable": _separable(runs[key].model) if rows else None,
+        "records": rows,
+    }
+
+
+def _separable(model) -> bool:
+    """Whether ∂²V/∂x∂y = 0 at four points in general position (exact second derivatives): for a cubic potential
+    the mixed derivative is linear, so it is then zero everywhere and each degree of freedom keeps its energy."""
+    from hhscatter.analysis.noise import hessian
+
+    return all(abs(hessian(model, x, y)[0, 1]) < 1e-12 for x, y in ((0.3, -0.2), (-0.4, 0.5), (0.7, 0.6), (0.1, 0.9)))
 
 
 def _absorbing_radius(study, runs, kramers) -> list:

@@ -236,14 +236,19 @@ def test_the_low_gamma_theory_reading_names_the_theory_the_points_agree_with():
         "1.030 ± 0.020 (within 2σ of 1 at 2 of 2; |ratio − 1| at most 3.0%)" in text
     )
     assert "(within 2σ of 1 at 0 of 2; |ratio − 1| at most 20.0%)" in text
-    assert "The low-γ points agree at 2σ with the shells' energy diffusion with the flux over" in text
+    assert "By system, on Hénon–Heiles (2 points) they agree at 2σ with the shells' energy diffusion with the" in text
     assert "The absorbing closure's rate is 1.67 to 2.00 times the measured one" in text
+    assert "the largest deviation falls to 3.0% on Hénon–Heiles" in text and "separable" not in text
     doc["turnover"][0]["ratio_shell"] = 0.9
+    doc["two_saddles_turnover"] = {"barrier_over_T": 3.0, "separable": True, "records": [row(0.01, 0.7, 0.3, 0.5, 0.9)]}
     text = READINGS["noise.low_gamma_theory"](lambda study, scale: doc)
     assert (
-        "No theory agrees at 2σ at every low-γ point; the closest is the shells' energy diffusion with the "
-        "flux over the dividing lines above E_b, within 10.0% of every point (within 2σ at 1 of 2)" in text
-    )
+        "on Hénon–Heiles (2 points) no theory agrees at 2σ at every point; the closest is the shells' energy "
+        "diffusion with the flux over the dividing lines above E_b, within 10.0% of every point (within 2σ at 1 of 2)"
+    ) in text
+    assert "on the two-saddle system (1 points) no theory agrees at 2σ at every point; the closest is Υ(δ) k_KL" in text
+    assert "10.0% on Hénon–Heiles and 30.0% on the two-saddle system" in text
+    assert "The two-saddle potential is separable" in text
     doc["conventions"]["energy_diffusion_gamma_max"] = 0.001
     assert READINGS["noise.low_gamma_theory"](lambda study, scale: doc) == (
         "no turnover point at γ ≤ 0.001 is in this scale's numbers"
