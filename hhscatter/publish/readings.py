@@ -742,6 +742,7 @@ def _noise_low_gamma_theory(get: Loader) -> str:
         groups.setdefault(label.split(" at ΔE/T")[0], []).append(r)
     verdicts = []
     for system, rows in groups.items():
+        count = f"{len(rows)} point{'s' if len(rows) > 1 else ''}"
         agree, closest = [], None
         for key, name in _LOW_GAMMA_THEORIES:
             ok = [verdict(r[key], r[f"{key}_err"], 1.0).word != "differs" for r in rows]
@@ -751,10 +752,10 @@ def _noise_low_gamma_theory(get: Loader) -> str:
             if closest is None or dev < closest[1]:
                 closest = (name, dev, sum(ok))
         if agree:
-            verdicts.append(f"on {system} ({len(rows)} points) they agree at 2σ with {' and '.join(agree)}")
+            verdicts.append(f"on {system} ({count}) they agree at 2σ with {' and '.join(agree)}")
         else:
             verdicts.append(
-                f"on {system} ({len(rows)} points) no theory agrees at 2σ at every point; the closest is "
+                f"on {system} ({count}) no theory agrees at 2σ at every point; the closest is "
                 f"{closest[0]}, within {closest[1]:.1%} of every point (within 2σ at {closest[2]} of {len(rows)})"
             )
     text += ". By system, " + "; ".join(verdicts)

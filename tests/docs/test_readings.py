@@ -246,7 +246,7 @@ def test_the_low_gamma_theory_reading_names_the_theory_the_points_agree_with():
         "on Hénon–Heiles (2 points) no theory agrees at 2σ at every point; the closest is the shells' energy "
         "diffusion with the flux over the dividing lines above E_b, within 10.0% of every point (within 2σ at 1 of 2)"
     ) in text
-    assert "on the two-saddle system (1 points) no theory agrees at 2σ at every point; the closest is Υ(δ) k_KL" in text
+    assert "on the two-saddle system (1 point) no theory agrees at 2σ at every point; the closest is Υ(δ) k_KL" in text
     assert "10.0% on Hénon–Heiles and 30.0% on the two-saddle system" in text
     assert "The two-saddle potential is separable" in text
     doc["conventions"]["energy_diffusion_gamma_max"] = 0.001
