@@ -257,6 +257,7 @@ def well_energy_diffusion(
     >>> round(fast.rate / fast.transition_state, 3)
     1.0
     """
+    check.system(model)
     check.number(gamma, "gamma", positive=True)
     check.number(temperature, "temperature", positive=True)
     check.number(above, "above", positive=True)
