@@ -699,6 +699,87 @@ def _noise_saddles_turnover(get: Loader) -> str:
     )
 
 
+#: the theories of the low-γ turnover points: (the ratio's key, its name in the reading)
+_LOW_GAMMA_THEORIES = (
+    ("ratio_shell", "the shells' energy diffusion with the flux over the dividing lines above E_b"),
+    ("ratio_shell_absorbing", "the shells' energy diffusion absorbing at E_b"),
+    ("ratio_shell_turnover", "Υ(δ_shell) k_KL"),
+    ("ratio_mm", "Υ(δ) k_KL with the line orbit's action"),
+)
+
+
+def _noise_low_gamma_theory(get: Loader) -> str:
+    d = get("noise", None)
+    g_max = (d.get("conventions") or {}).get("energy_diffusion_gamma_max")
+    series = [
+        (f"Hénon–Heiles at ΔE/T = {rows[0]['barrier_over_T']:.3g}" if rows else "", rows)
+        for rows in (d.get("turnover") or [], d.get("turnover_high") or [])
+    ]
+    two = d.get("two_saddles_turnover") or {}
+    if two.get("records"):
+        series.append((f"the two-saddle system at ΔE/T = {two['barrier_over_T']:.3g}", two["records"]))
+    points = [
+        (label, r)
+        for label, rows in series
+        for r in sorted(rows, key=lambda r: r["gamma"])
+        if g_max is not None and r["gamma"] <= g_max and "ratio_shell" in r
+    ]
+    if not points:
+        return f"no turnover point at γ ≤ {g_max:g} is in this scale's numbers" if g_max else "not in these numbers"
+    labels = dict.fromkeys(lb for lb, _ in points)
+    where = "; ".join(f"{lb}, γ = " + ", ".join(f"{r['gamma']:g}" for b, r in points if b == lb) for lb in labels)
+    n = len(points)
+    out, summary = [], []
+    for key, name in _LOW_GAMMA_THEORIES:
+        vals = [(label, r, verdict(r[key], r[f"{key}_err"], 1.0)) for label, r in points]
+        agree = sum(v.word != "differs" for _, _, v in vals)
+        dev = max(abs(r[key] - 1) for _, r, _ in vals)
+        cells = ", ".join(f"{_ve(r[key], r[f'{key}_err'])}" for _, r, _ in vals)
+        out.append(f"over {name}: {cells} (within 2σ of 1 at {agree} of {n}; |ratio − 1| at most {dev:.1%})")
+        summary.append((key, name, agree, dev, [r[key] for _, r, _ in vals]))
+    text = f"at γ ≤ {g_max:g} ({n} points, in this order: {where}) the measured rate " + "; ".join(out)
+    groups = {}
+    for label, r in points:
+        groups.setdefault(label.split(" at ΔE/T")[0], []).append(r)
+    verdicts = []
+    for system, rows in groups.items():
+        count = f"{len(rows)} point{'s' if len(rows) > 1 else ''}"
+        agree, closest = [], None
+        for key, name in _LOW_GAMMA_THEORIES:
+            ok = [verdict(r[key], r[f"{key}_err"], 1.0).word != "differs" for r in rows]
+            dev = max(abs(r[key] - 1) for r in rows)
+            if all(ok):
+                agree.append(name)
+            if closest is None or dev < closest[1]:
+                closest = (name, dev, sum(ok))
+        if agree:
+            verdicts.append(f"on {system} ({count}) they agree at 2σ with {' and '.join(agree)}")
+        else:
+            verdicts.append(
+                f"on {system} ({count}) no theory agrees at 2σ at every point; the closest is "
+                f"{closest[0]}, within {closest[1]:.1%} of every point (within 2σ at {closest[2]} of {len(rows)})"
+            )
+    text += ". By system, " + "; ".join(verdicts)
+    flux = next(x for x in summary if x[0] == "ratio_shell")
+    absorbing = next(x for x in summary if x[0] == "ratio_shell_absorbing")
+    if all(v < 1 for v in absorbing[4]) and flux[3] < absorbing[3]:
+        text += (
+            f". The absorbing closure's rate is {1 / max(absorbing[4]):.2f} to {1 / min(absorbing[4]):.2f} times the "
+            "measured one: an orbit whose energy reaches E_b has not escaped yet; with the microcanonical flux over "
+            "the saddles above E_b as the closure the largest deviation falls to "
+            + " and ".join(
+                f"{max(abs(r['ratio_shell'] - 1) for r in rows):.1%} on {system}" for system, rows in groups.items()
+            )
+        )
+    if two.get("separable") and any(lb.startswith("the two-saddle") for lb, _ in points):
+        text += (
+            ". The two-saddle potential is separable (∂²V/∂x∂y = 0): each degree of freedom keeps its own energy, "
+            "the orbits do not explore the energy shell that the shells' theory averages over, and each line "
+            "orbit's δ_s is the exact one of its own degree of freedom"
+        )
+    return text
+
+
 def _noise_no_drag(get: Loader) -> str:
     rows = [r for r in get("noise", None)["no_drag"] if r["sigma"] > 0]
     out = []
@@ -1040,6 +1121,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.turnover_theory": _noise_turnover_theory,
     "noise.turnover_barriers": _noise_turnover_barriers,
     "noise.saddles_turnover": _noise_saddles_turnover,
+    "noise.low_gamma_theory": _noise_low_gamma_theory,
     "noise.no_drag": _noise_no_drag,
     "noise.no_drag_survivors": _noise_no_drag_survivors,
     "noise.finite_barrier": _noise_finite_barrier,

@@ -3,7 +3,7 @@
 :func:`rate_record` sets a thermal rate measured on a window (:func:`~hhscatter.analysis.noise.kramers.thermal_rate`)
 beside the Kramers–Langer rate of the system at the same (γ, T), with the window's two halves compared;
 :func:`turnover_record` adds the Mel'nikov–Meshkov/PGH rate and both Kramers limits, :func:`saddle_turnover_terms`
-each saddle's part of them; :func:`two_saddle_record` the
+each saddle's part of them, :func:`shell_theory_record` the energy-diffusion rates of the well's energy shells; :func:`two_saddle_record` the
 multi-saddle sum's lowest term and the escapes' exit shares against each term's share; :func:`saddle_terms` lists a
 system's saddles; :func:`finite_barrier_record` fits the ratios against T/ΔE beside the transition-state
 correction; :func:`absorbing_radius_record` compares a rate measured at two escape radii; :func:`no_drag_records`,
@@ -46,6 +46,7 @@ __all__ = [
     "reactivation_record",
     "saddle_terms",
     "saddle_turnover_terms",
+    "shell_theory_record",
     "survivor_record",
     "turnover_record",
     "two_saddle_record",
@@ -175,6 +176,39 @@ def turnover_record(record: dict, model, gamma_max: float) -> dict:
     }
     rate = Measured(record["rate"], record["rate_err"])
     for name, k in (("mm", tr.rate), ("ed", tr.energy_diffusion)):
+        out.update(_flat(f"ratio_{name}", rate.over(k)))
+    return out
+
+
+def shell_theory_record(record: dict, ed) -> dict:
+    """A :func:`rate_record` against the energy-diffusion theory of the well's energy shells (an
+    :class:`~hhscatter.analysis.noise.energy_diffusion.EnergyDiffusion` at the record's γ and T): the shell-averaged
+    δ, the rates (1/time) with the microcanonical flux above the barrier (``shell_energy_diffusion``), absorbing
+    at the barrier (``shell_absorbing``), Υ(δ) k_KL on the shell δ (``shell_turnover``), the anharmonic
+    transition-state rate, the shells' top energy, and the measured rate's ratios to the first three:
+    ratio_shell, ratio_shell_absorbing, ratio_shell_turnover with their errors.
+
+    Examples
+    --------
+    >>> from hhscatter.analysis.noise import EnergyDiffusion
+    >>> ed = EnergyDiffusion(0.01, 0.05, rate=2e-3, rate_absorbing=4e-3, absorbing_limit=5e-3,
+    ...                      transition_state=1e-2, delta=0.5, turnover=3e-3, phase_volume_barrier=0.6, top=0.8)
+    >>> r = shell_theory_record({"rate": 2.2e-3, "rate_err": 1e-4}, ed)
+    >>> round(r["ratio_shell"], 12), round(r["ratio_shell_err"], 12), round(r["ratio_shell_absorbing"], 12)
+    (1.1, 0.05, 0.55)
+    >>> r["shell_delta"], r["shell_top"]
+    (0.5, 0.8)
+    """
+    rate = Measured(record["rate"], record["rate_err"])
+    out = {
+        "shell_delta": ed.delta,
+        "shell_energy_diffusion": ed.rate,
+        "shell_absorbing": ed.rate_absorbing,
+        "shell_turnover": ed.turnover,
+        "shell_transition_state": ed.transition_state,
+        "shell_top": ed.top,
+    }
+    for name, k in (("shell", ed.rate), ("shell_absorbing", ed.rate_absorbing), ("shell_turnover", ed.turnover)):
         out.update(_flat(f"ratio_{name}", rate.over(k)))
     return out
 

@@ -35,6 +35,12 @@ def _panel_arrhenius(ax, k, fb=None):
     ins.tick_params(labelsize=7)
 
 
+def _shell_curve(ax, t):
+    """The energy-diffusion rate of the well's shells with the flux above E_b, where the records carry it."""
+    if "shell_energy_diffusion" in t:
+        ax.plot(t.gamma, t.shell_energy_diffusion, "--", color=COLORS[1], lw=1.1, label="energy diffusion, 2-D shells")
+
+
 def _panel_turnover(ax, t):
     """(b) rate against γ at fixed T: measured, Kramers–Langer (the spatial-diffusion branch) and, where the
     records carry them, Mel'nikov–Meshkov and the energy-diffusion limit."""
@@ -44,6 +50,7 @@ def _panel_turnover(ax, t):
     if "melnikov_meshkov" in t:  # the turnover theory at the measured γ and its energy-diffusion limit
         ax.plot(t.gamma, t.melnikov_meshkov, "-", color=COLORS[3], lw=1.2, label=r"Mel'nikov–Meshkov $\Upsilon k_{KL}$")
         ax.plot(t.gamma, t.energy_diffusion, ":", color="0.4", lw=1, label=r"energy diffusion $\delta k_{TST}$")
+        _shell_curve(ax, t)
         ax.set_ylim(0.5 * float(t.rate.min()), 2 * float(t.kramers_langer.max()))
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -169,6 +176,7 @@ def _panel_saddles_turnover(ax, t, barrier):
     ax.plot(t.gamma, t.kramers_langer, "-", color="k", lw=1, label=r"$\sum_s k_{KL,s}$")
     ax.plot(t.gamma, t.melnikov_meshkov, "-", color=COLORS[3], lw=1.2, label=r"$\sum_s \Upsilon(\delta_s) k_{KL,s}$")
     ax.plot(t.gamma, t.energy_diffusion, ":", color="0.4", lw=1, label=r"$\sum_s \delta_s k_{TST,s}$")
+    _shell_curve(ax, t)
     ax.set_ylim(0.5 * float(t.rate.min()), 2 * float(t.kramers_langer.max()))
     ax.set_xscale("log")
     ax.set_yscale("log")

@@ -39,7 +39,10 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
     against the multi-saddle Kramers–Langer sum and its lowest term, and the escapes' exit channels against each
     term's share; the turnover at the second barrier like the first, and the two-saddle system's turnover against
     the sums Σ_s k_KL,s, Σ_s Υ(δ_s) k_KL,s and Σ_s δ_s k_TST,s with each saddle's terms
-    (:func:`hhscatter.reproduction.noise_records.saddle_turnover_terms`). The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
+    (:func:`hhscatter.reproduction.noise_records.saddle_turnover_terms`); every turnover rate, at both barriers and
+    on the two-saddle system, against the energy-diffusion rates of the well's energy shells
+    (:func:`hhscatter.analysis.noise.well_energy_diffusion`: absorbing at E_b, with the microcanonical flux above
+    it, and Υ(δ_shell) k_KL), read at γ ≤ ENERGY_DIFFUSION_GAMMA_MAX. The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
     the runs and passes their arrays). Writes ``noise.json`` (keys
     ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``turnover_high``,
     ``two_saddles_turnover``, ``reactivation``,
@@ -64,6 +67,13 @@ from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
 #: the turnover theory (Mel'nikov–Meshkov/PGH) assumes an underdamped barrier crossing: its ratios are read where
 #: γ/ω_b ≤ this (ω_b the saddles' unstable frequency)
 THEORY_GAMMA_MAX = 0.3
+
+#: the low-γ points, compared with the energy-diffusion theories of the well's shells in the readings: γ ≤ this
+ENERGY_DIFFUSION_GAMMA_MAX = 0.01
+
+#: the well's energy shells reach E_b + this × T (where a dividing line does not spill first): the population
+#: above is e^{−12} of the barrier's
+SHELL_TOP_WIDTHS = 12.0
 
 
 class Params(StudyParams):
@@ -297,12 +307,31 @@ def _two_saddles(study, runs) -> dict:
     }
 
 
-def _turnover_row(study, key, runs) -> dict:
-    """The rate record of turnover run ``key`` against the turnover theory (Mel'nikov–Meshkov/PGH, both limits)."""
-    from hhscatter.reproduction.noise_records import turnover_record
+_SHELLS: dict = {}
 
-    row = _rate_row(study, key, runs[key])
-    return {**row, **turnover_record(row, runs[key].model, THEORY_GAMMA_MAX)}
+
+def _shells(model, temperature: float):
+    """The energy shells of ``model``'s well up to E_b + SHELL_TOP_WIDTHS T, once per (potential, T)."""
+    from hhscatter.analysis.noise import well_barrier, well_shells
+
+    key = (model.potential_text, tuple(sorted(dict(model.params).items())), float(temperature))
+    if key not in _SHELLS:
+        e_b = float(model.potential(np.array(0.0), np.array(0.0))) + well_barrier(model)
+        _SHELLS[key] = well_shells(model, e_b + SHELL_TOP_WIDTHS * temperature)
+    return _SHELLS[key]
+
+
+def _turnover_row(study, key, runs) -> dict:
+    """The rate record of turnover run ``key`` against the turnover theory (Mel'nikov–Meshkov/PGH, both limits) and
+    the energy-diffusion theories of the well's shells."""
+    from hhscatter.analysis.noise import well_energy_diffusion
+    from hhscatter.reproduction.noise_records import shell_theory_record, turnover_record
+
+    sc = runs[key]
+    row = _rate_row(study, key, sc)
+    T = row["temperature"]
+    ed = well_energy_diffusion(sc.model, row["gamma"], T, shells=_shells(sc.model, T))
+    return {**row, **turnover_record(row, sc.model, THEORY_GAMMA_MAX), **shell_theory_record(row, ed)}
 
 
 def _saddles_turnover(study, runs) -> dict:
@@ -317,7 +346,20 @@ def _saddles_turnover(study, runs) -> dict:
         key = _saddles_turnover_key(g)
         row = _turnover_row(study, key, runs)
         rows.append({**row, "saddles": saddle_turnover_terms(runs[key].model, row["gamma"], row["temperature"])})
-    return {"barrier_over_T": p.saddles_turnover_barrier, "potential": p.saddles_potential, "records": rows}
+    return {
+        "barrier_over_T": p.saddles_turnover_barrier,
+        "potential": p.saddles_potential,
+        "separable": _separable(runs[key].model) if rows else None,
+        "records": rows,
+    }
+
+
+def _separable(model) -> bool:
+    """Whether ∂²V/∂x∂y = 0 at four points in general position (exact second derivatives): for a cubic potential
+    the mixed derivative is linear, so it is then zero everywhere and each degree of freedom keeps its energy."""
+    from hhscatter.analysis.noise import hessian
+
+    return all(abs(hessian(model, x, y)[0, 1]) < 1e-12 for x, y in ((0.3, -0.2), (-0.4, 0.5), (0.7, 0.6), (0.1, 0.9)))
 
 
 def _absorbing_radius(study, runs, kramers) -> list:
@@ -483,6 +525,13 @@ def analyze(study):
                 "turnover_theory": "Mel'nikov–Meshkov/PGH k = Υ(δ) k_KL, δ = γS/T, S the action of the orbit at "
                 "the saddle's energy through the well; energy diffusion k_ED = δ k_TST",
                 "theory_range": f"γ/ω_b ≤ {THEORY_GAMMA_MAX:g}",
+                "shell_theory": "energy diffusion on the well's energy shells (two degrees of freedom, ergodic): "
+                "D(E) = γT⟨|p|²⟩_E, the lowest rate of the Fokker–Planck equation in E with the shells' phase "
+                "volume, absorbing at E_b or with the microcanonical flux over the saddles' dividing lines above "
+                f"it (shells up to E_b + {SHELL_TOP_WIDTHS:g} T); δ_shell = its absorbing large-barrier rate over "
+                "the shells' transition-state rate",
+                "energy_diffusion_gamma_max": ENERGY_DIFFUSION_GAMMA_MAX,
+                "shell_top_widths": SHELL_TOP_WIDTHS,
             },
         }
     )

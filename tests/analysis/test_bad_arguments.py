@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 from hhscatter.analysis.geometry import saddle
 from hhscatter.analysis.noise import (
+    energy_diffusion_rate,
     exit_fractions,
     finite_barrier_fit,
     kramers_langer,
@@ -31,6 +32,8 @@ from hhscatter.analysis.noise import (
     transition_state_correction,
     turnover_rate,
     well_barrier,
+    well_energy_diffusion,
+    well_shells,
     window_constancy,
 )
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
@@ -122,6 +125,21 @@ def test_finite_barrier_fit_names_the_bad_argument(data, which):
 def test_the_noise_estimators_of_a_system_refuse_what_is_no_system(model):
     for f in (well_barrier, transition_state_correction, laplace_coefficient):
         _refused("model", f, model)
+    _refused("model", well_shells, model, 1.0)
+    _refused("model", well_energy_diffusion, model, 0.1, 0.1)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["energies", "phase_volume", "flux", "gamma", "temperature", "dof"]))
+def test_energy_diffusion_rate_names_the_bad_argument(data, which):
+    e = np.linspace(0.0, 1.0, 6)
+    args = {"energies": e, "phase_volume": 2 * np.pi * e, "gamma": 0.1, "temperature": 0.2, "dof": 1}
+    args["flux"] = (e > 0.5).astype(float)
+    if which in ("gamma", "temperature", "dof"):
+        args[which] = data.draw(NOT_A_NUMBER)
+    else:
+        args[which] = _bad_array(data.draw, args[which], negative=which != "energies")
+    _refused(which, energy_diffusion_rate, **args)
 
 
 @PROFILE

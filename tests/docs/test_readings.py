@@ -214,6 +214,47 @@ def test_the_turnover_theory_reading_follows_the_ratios_and_the_range():
     )
 
 
+def test_the_low_gamma_theory_reading_names_the_theory_the_points_agree_with():
+    """Two low-γ points and one above the limit; the flux closure agrees with both at 2σ, the absorbing one is
+    below 1 at both (the measured rate 1/0.6 to 1/0.5 times smaller), the other two differ."""
+
+    def row(g, flux, absorbing, turnover, mm, b=3.0):
+        return (
+            {"gamma": g, "barrier_over_T": b, "ratio_shell": flux, "ratio_shell_err": 0.02}
+            | {"ratio_shell_absorbing": absorbing, "ratio_shell_absorbing_err": 0.01}
+            | {"ratio_shell_turnover": turnover, "ratio_shell_turnover_err": 0.01, "ratio_mm": mm, "ratio_mm_err": 0.01}
+        )
+
+    doc = {
+        "turnover": [row(0.003, 0.98, 0.5, 0.7, 1.2), row(0.01, 1.03, 0.6, 0.8, 1.1), row(0.1, 2.0, 0.1, 3.0, 3.0)],
+        "conventions": {"energy_diffusion_gamma_max": 0.01},
+    }
+    text = READINGS["noise.low_gamma_theory"](lambda study, scale: doc)
+    assert text.startswith("at γ ≤ 0.01 (2 points, in this order: Hénon–Heiles at ΔE/T = 3, γ = 0.003, 0.01)")
+    assert (
+        "over the shells' energy diffusion with the flux over the dividing lines above E_b: 0.980 ± 0.020, "
+        "1.030 ± 0.020 (within 2σ of 1 at 2 of 2; |ratio − 1| at most 3.0%)" in text
+    )
+    assert "(within 2σ of 1 at 0 of 2; |ratio − 1| at most 20.0%)" in text
+    assert "By system, on Hénon–Heiles (2 points) they agree at 2σ with the shells' energy diffusion with the" in text
+    assert "The absorbing closure's rate is 1.67 to 2.00 times the measured one" in text
+    assert "the largest deviation falls to 3.0% on Hénon–Heiles" in text and "separable" not in text
+    doc["turnover"][0]["ratio_shell"] = 0.9
+    doc["two_saddles_turnover"] = {"barrier_over_T": 3.0, "separable": True, "records": [row(0.01, 0.7, 0.3, 0.5, 0.9)]}
+    text = READINGS["noise.low_gamma_theory"](lambda study, scale: doc)
+    assert (
+        "on Hénon–Heiles (2 points) no theory agrees at 2σ at every point; the closest is the shells' energy "
+        "diffusion with the flux over the dividing lines above E_b, within 10.0% of every point (within 2σ at 1 of 2)"
+    ) in text
+    assert "on the two-saddle system (1 point) no theory agrees at 2σ at every point; the closest is Υ(δ) k_KL" in text
+    assert "10.0% on Hénon–Heiles and 30.0% on the two-saddle system" in text
+    assert "The two-saddle potential is separable" in text
+    doc["conventions"]["energy_diffusion_gamma_max"] = 0.001
+    assert READINGS["noise.low_gamma_theory"](lambda study, scale: doc) == (
+        "no turnover point at γ ≤ 0.001 is in this scale's numbers"
+    )
+
+
 def _prose(text: str) -> str:
     """A page's words without its code (fenced and inline) and its number references."""
     text = re.sub(r"```.*?```", " ", text, flags=re.S)

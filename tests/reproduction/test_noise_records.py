@@ -204,3 +204,21 @@ def test_saddle_turnover_terms_of_the_two_saddle_system_are_its_closed_forms(gam
     rec = turnover_record({"gamma": gamma, "temperature": T, "rate": 1e-3, "rate_err": 1e-4}, m, 0.3)
     assert rec["melnikov_meshkov"] == pytest.approx(sum(s["melnikov_meshkov"] for s in terms), rel=1e-12)
     assert rec["energy_diffusion"] == pytest.approx(sum(s["energy_diffusion"] for s in terms), rel=1e-12)
+
+
+def test_shell_theory_record_sets_the_rate_beside_each_shell_rate():
+    """Ratios to the three shell rates with the rate's relative error; the theory's values kept as they are."""
+    from hhscatter.analysis.noise import EnergyDiffusion
+    from hhscatter.reproduction.noise_records import shell_theory_record
+
+    ed = EnergyDiffusion(
+        0.003, 1 / 18, rate=8e-4, rate_absorbing=1.6e-3, absorbing_limit=1.8e-3, transition_state=1.5e-2,
+        delta=0.12, turnover=1.2e-3, phase_volume_barrier=0.61, top=0.83,
+    )  # fmt: skip
+    r = shell_theory_record({"rate": 8.4e-4, "rate_err": 4.2e-5}, ed)
+    assert r["ratio_shell"] == pytest.approx(1.05) and r["ratio_shell_err"] == pytest.approx(0.0525)
+    assert r["ratio_shell_absorbing"] == pytest.approx(0.525) and r["ratio_shell_absorbing_err"] == pytest.approx(
+        0.02625
+    )
+    assert r["ratio_shell_turnover"] == pytest.approx(0.7) and r["ratio_shell_turnover_err"] == pytest.approx(0.035)
+    assert (r["shell_delta"], r["shell_transition_state"], r["shell_top"]) == (0.12, 1.5e-2, 0.83)
