@@ -301,7 +301,8 @@ class _TinyRuns:
 @pytest.mark.parametrize("scale", ["quick", "paper"])
 def test_committed_validity_map_cells_follow_the_stated_kappa0_rule(scale):
     """Every cell of the committed validity map (quick, paper) with a κ0 verdict: the rule the record states,
-    applied to the numbers of the cell (f∞/P(t_hi) against max_plateau_bias), gives the code's decision; a record
+    applied to the numbers of the cell (f∞/P(t_hi) against max_plateau_bias; the window's start and the first
+    escape for the dead-time condition, which the quick record carries), gives the code's decision; a record
     made before the cells carried those numbers: defined exactly where the claims' κ0 row gives no reason. A record
     with the rule covers every energy of the claims' grid for every system."""
     from hhscatter.reproduction.claims.evidence import kappa0_defined_by_rule
@@ -314,6 +315,8 @@ def test_committed_validity_map_cells_follow_the_stated_kappa0_rule(scale):
     for cell in doc["validity_map"]:
         if cell["kappa0_defined"] is None:
             continue
+        if scale == "quick":  # the quick record carries the numbers of the dead-time condition too
+            assert {"kappa0_tau0", "kappa0_t_first"} <= set(cell), cell["id"]
         if "plateau_bias" in cell:
             assert kappa0_defined_by_rule(cell, rules["max_plateau_bias"]) is cell["kappa0_defined"], cell["id"]
         else:
