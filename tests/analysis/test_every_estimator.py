@@ -193,7 +193,6 @@ NOT_YET_CHECKED: frozenset[str] = frozenset(
         "geometry.true_time_kappa",
         "geometry.wasserstein_1d",
         "geometry.weighted_line",
-        "survival.binned_hazard",
         "survival.choose_t_max",
         "survival.choose_windows",
         "survival.cmeasure_sample_from_sections",
@@ -215,7 +214,6 @@ NOT_YET_CHECKED: frozenset[str] = frozenset(
         "survival.law_spread",
         "survival.lifetimes_to_arrays",
         "survival.mean_kappa_stat_err",
-        "survival.observed_over_expected",
         "survival.p_level_windows",
         "survival.paired_mle_shift",
         "survival.plateau_check",
@@ -224,7 +222,6 @@ NOT_YET_CHECKED: frozenset[str] = frozenset(
         "survival.stable_energies",
         "survival.survival_at",
         "survival.survival_from_lifetimes",
-        "survival.survival_on_grid",
         "survival.survival_ratio_slope",
     }
 )
