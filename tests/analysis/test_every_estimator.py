@@ -208,7 +208,6 @@ NOT_YET_CHECKED: frozenset[str] = frozenset(
         "survival.fit_laws",
         "survival.fit_plateau_exponential",
         "survival.fit_power_law_tail",
-        "survival.hazard_profile",
         "survival.kappa_from_cmeasure",
         "survival.kappa_law_summary",
         "survival.law_spread",
@@ -220,7 +219,6 @@ NOT_YET_CHECKED: frozenset[str] = frozenset(
         "survival.plateau_rate",
         "survival.rate_status",
         "survival.stable_energies",
-        "survival.survival_at",
         "survival.survival_from_lifetimes",
         "survival.survival_ratio_slope",
     }
