@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 #: the smallest expected count of a pooled cell
@@ -66,8 +67,9 @@ def pool_cells(observed, expected, min_expected: float = MIN_EXPECTED) -> tuple[
     >>> o.tolist(), e.round(5).tolist()
     ([10.0, 3.0, 9.0], [9.0, 5.5, 8.00001])
     """
-    o = np.asarray(observed, dtype=float).ravel()
-    e = np.asarray(expected, dtype=float).ravel()
+    o = check.numbers(observed, "observed", min_size=0)
+    e = check.numbers(expected, "expected", min_size=0)
+    check.number(min_expected, "min_expected")
     if o.shape != e.shape:
         raise ConfigError(f"observed and expected differ in length ({o.size} and {e.size})")
     if (e < 0).any() or (o < 0).any():
@@ -117,6 +119,8 @@ def pooled_pearson(
     >>> pooled_pearson([20, 20, 20], [20.0, 20.0, 20.0]).p_value
     1.0
     """
+    check.count(n_fitted, "n_fitted", 0)
+    check.count(min_dof, "min_dof", 0)
     from scipy.stats import chi2 as chi2_dist  # deferred: scipy loads on first use
 
     o, e = pool_cells(observed, expected, min_expected)

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = ["BoundedFraction", "fraction_with_bound", "rate_upper_bound", "wilson_interval"]
@@ -23,6 +24,9 @@ def wilson_interval(k, n, z: float = 1.0):
     zero width):  centre (p + z²/2n)/(1 + z²/n), half-width
     z√(p(1−p)/n + z²/4n²)/(1 + z²/n).
     """
+    check.numbers(k, "k", minimum=0.0)
+    check.numbers(n, "n", minimum=0.0)
+    check.number(z, "z", positive=True)
     k = np.asarray(k, dtype=float)
     n = np.asarray(n, dtype=float)
     if np.any(k < 0) or np.any(k > n):
@@ -102,7 +106,9 @@ def fraction_with_bound(k: int, n: int, *, cl: float = 0.95) -> BoundedFraction:
     >>> round(fraction_with_bound(20, 20).lower, 4)
     0.8609
     """
-    k, n = int(k), int(n)
+    k = int(check.number(k, "k", minimum=0.0))
+    n = int(check.number(n, "n", positive=True))
+    check.number(cl, "cl")
     if n <= 0:
         raise ConfigError(f"n must be a positive number of trials, got {n}")
     if not 0 <= k <= n:
@@ -133,7 +139,8 @@ def rate_upper_bound(exposure, cl: float = 0.95):
     >>> rate_upper_bound([100.0, 0.0]).round(4).tolist()
     [0.03, inf]
     """
-    if not 0 < cl < 1:
+    check.numbers(exposure, "exposure", minimum=0.0)
+    if not 0 < check.number(cl, "cl") < 1:
         raise ConfigError(f"cl must lie in (0, 1), got {cl}")
     x = np.asarray(exposure, dtype=float)
     if np.any(x < 0):

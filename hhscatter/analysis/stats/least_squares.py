@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = ["LinearFit", "least_squares_operator", "weighted_least_squares"]
@@ -63,7 +64,10 @@ class LinearFit:
 
 
 def _design(X, weights):
+    check.numbers(X, "X")
     X = np.asarray(X, dtype=float)
+    if X.ndim not in (1, 2):
+        raise ConfigError(f"X must be a design matrix (n, p) or one column (n,), got {X.ndim} dimension(s)")
     if X.ndim == 1:
         X = X[:, None]
     n = X.shape[0]
@@ -79,7 +83,12 @@ def least_squares_operator(X, weights=None):
     X, w = _design(X, weights)
     XtW = X.T * w
     F = XtW @ X
-    return np.linalg.solve(F, XtW), F
+    try:
+        return np.linalg.solve(F, XtW), F
+    except np.linalg.LinAlgError:
+        raise ConfigError(
+            f"X with these weights does not determine its {F.shape[0]} parameter(s) (XᵀWX is singular)"
+        ) from None
 
 
 def weighted_least_squares(X, y, weights=None, *, errors: str = "absolute") -> LinearFit:
@@ -91,7 +100,7 @@ def weighted_least_squares(X, y, weights=None, *, errors: str = "absolute") -> L
     than parameters + 1 the scaled readings are NaN.
     """
     X, w = _design(X, weights)
-    y = np.asarray(y, dtype=float).ravel()
+    y = check.numbers(y, "y")
     n, p = X.shape
     if y.size != n:
         raise ConfigError(f"X has {n} rows but y has {y.size} values")

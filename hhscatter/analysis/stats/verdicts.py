@@ -15,6 +15,11 @@ import re
 from dataclasses import dataclass
 from decimal import Decimal
 
+import numpy as np
+
+from hhscatter.analysis.stats import _arguments as check
+from hhscatter.errors import ConfigError
+
 
 @dataclass(frozen=True)
 class Verdict:
@@ -40,6 +45,10 @@ def signed(x: float, spec: str = "+.1f") -> str:
     >>> signed(-4.21), signed(1.25, "+.0f"), signed(-0.0071, "+.3f")
     ('−4.2', '+1', '−0.007')
     """
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"x must be a number, got {type(x).__name__}")
+    if not isinstance(spec, str):
+        raise ConfigError(f"spec must be a format specification (a string), got {type(spec).__name__}")
     return format(x, spec).replace("-", "−")
 
 
@@ -88,6 +97,8 @@ def verdict_class(text: str) -> str:
     ...  "not the same quantity: another window", "differs in our convention only; agrees under the authors' (x)")]
     ['bad', 'ok', 'meh', 'meh']
     """
+    if text is not None and not isinstance(text, str):
+        raise ConfigError(f"text must be a verdict's text (a string), got {type(text).__name__}")
     v = str(text or "").strip()
     low = v.lower()
     if not v:
@@ -107,6 +118,11 @@ def verdict_class(text: str) -> str:
 
 
 def half_unit(printed: float) -> float:
-    """half_unit(printed) -> half a unit of its last printed decimal: 0.005 for 0.27 or 13.63, 0.5 for 100."""
+    """half_unit(printed) -> half a unit of its last printed decimal: 0.005 for 0.27 or 13.63, 0.5 for 100.
+
+    >>> half_unit(13.63), half_unit(100.0)
+    (0.005, 0.5)
+    """
+    check.number(printed, "printed")
     exp = Decimal(repr(float(printed))).normalize().as_tuple().exponent
     return 0.5 * 10.0 ** min(int(exp), 0)

@@ -20,6 +20,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import rate_upper_bound
 from hhscatter.errors import ConfigError
 
@@ -47,13 +48,12 @@ def binned_hazard(t_end, escaped, edges) -> pd.DataFrame:
     >>> d["hazard_upper"].round(3).tolist()    # no escape in [4, 6): hazard < −ln(0.05)/1
     [nan, nan, 2.996]
     """
-    t = np.asarray(t_end, dtype=float).ravel()
-    e = np.asarray(escaped, dtype=bool).ravel()
-    edges = np.asarray(edges, dtype=float)
-    if t.shape != e.shape:
-        raise ConfigError("t_end and escaped differ in length")
-    if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0):
+    t = check.numbers(t_end, "t_end", min_size=0)
+    e = check.mask(escaped, "escaped", t.size)
+    edges_ = check.numbers(edges, "edges", min_size=2)
+    if np.ndim(edges) != 1 or np.any(np.diff(edges_) <= 0):
         raise ConfigError("edges must be increasing, at least 2 of them")
+    edges = edges_
     lo, hi = edges[:-1], edges[1:]
     ts = np.sort(t)
     # exposure = Σ_i clip(t_i − lo, 0, hi − lo) = ∫_lo^hi N(s > t) dt, by the sorted times' cumulative sums
@@ -96,7 +96,14 @@ def observed_over_expected(bins: pd.DataFrame, rate) -> tuple[float, float, floa
     >>> observed_over_expected(b, [0.1, 0.15])[:2]
     (1.0, 0.15811388300841897)
     """
-    r = np.asarray(rate, dtype=float)
+    if not isinstance(bins, pd.DataFrame) or not {"events", "exposure"} <= set(bins.columns):
+        raise ConfigError("bins must be a DataFrame with the columns events and exposure (binned_hazard)")
+    r = np.asarray(rate) if not isinstance(rate, (str, bytes, dict)) and rate is not None else np.array("x")
+    if r.dtype == bool or r.dtype.kind not in "iuf":
+        raise ConfigError(f"rate must be an array of numbers (one per bin), got {type(rate).__name__}")
+    if r.ndim > 1 or (r.ndim == 1 and r.size != len(bins)):
+        raise ConfigError(f"rate must hold one value per bin: {r.size} != {len(bins)}")
+    r = r.astype(float)
     ok = np.isfinite(r)
     exp_ = float(np.sum(r[ok] * bins["exposure"].to_numpy()[ok]))
     obs = float(np.sum(bins["events"].to_numpy()[ok]))

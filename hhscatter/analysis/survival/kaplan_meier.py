@@ -213,8 +213,8 @@ class KaplanMeierGrid:
     """
 
     def __init__(self, grid):
-        g = np.asarray(grid, dtype=float).ravel()
-        if g.size == 0 or not np.all(np.isfinite(g)) or np.any(np.diff(g) <= 0):
+        g = check.numbers(grid, "grid")
+        if np.ndim(grid) != 1 or np.any(np.diff(g) <= 0):
             raise ConfigError("grid must be a non-empty, finite, strictly increasing 1-d array")
         self.grid = g
         self._d = np.zeros(g.size)

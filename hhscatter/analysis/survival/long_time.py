@@ -44,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.errors import ConfigError
 
@@ -251,7 +252,10 @@ def survival_at(t_end, observed, times) -> tuple[np.ndarray, np.ndarray]:
     """
     from hhscatter.analysis.survival.kaplan_meier import survival_curve  # deferred: kept off import time
 
-    c = survival_curve(np.asarray(t_end, float), np.asarray(observed, bool), t_grid=np.asarray(times, float))
+    t = check.numbers(t_end, "t_end", min_size=0)
+    o = check.mask(observed, "observed", t.size)
+    check.numbers(times, "times")
+    c = survival_curve(t, o, t_grid=np.asarray(times, float))
     return np.asarray(c.P, float), np.asarray(c.P_err, float)
 
 
@@ -265,7 +269,7 @@ def hazard_profile(t_end, escaped, edges):
     """
     from hhscatter.analysis.survival.effective_rate import binned_hazard  # deferred: pandas loads on first use
 
-    return binned_hazard(np.asarray(t_end, float), np.asarray(escaped, bool), np.asarray(edges, float))
+    return binned_hazard(t_end, escaped, edges)  # its arguments checked there, before any work
 
 
 @dataclass(frozen=True)
