@@ -319,6 +319,23 @@ class SaddleDimension:
     n_groups: int
     table: pd.DataFrame = field(repr=False, default=None)
 
+    @classmethod
+    def _from_parts(cls, value, err_fit, err_res, err_range, method, eps, use, n_points, n_groups, table):
+        """The result of a scaling fit: its error the finite parts in quadrature, its range ``eps[use]``'s."""
+        parts = [e for e in (err_fit, err_res, err_range) if math.isfinite(e)]
+        return cls(
+            value=float(value),
+            err=float(math.sqrt(sum(e * e for e in parts))),
+            err_fit=float(err_fit),
+            err_resample=err_res,
+            err_range=float(err_range),
+            method=method,
+            eps_range=(float(eps[use].min()), float(eps[use].max())),
+            n_points=int(n_points),
+            n_groups=n_groups,
+            table=table,
+        )
+
 
 def _slope(x, y) -> tuple[float, float]:
     """Least-squares slope of y on x and its standard error from the residuals."""
@@ -430,22 +447,12 @@ def _box_counting(points, weights, groups, *, divisions, min_boxes, min_occupanc
         err_res = float(np.std(reps, ddof=1))
     else:
         err_res = math.nan
-    parts = [e for e in (err_fit, err_res, err_range) if math.isfinite(e)]
     local = np.full(eps.size, np.nan)
     local[1:] = -np.diff(y) / np.diff(np.log(eps))
     table = pd.DataFrame({"eps": eps, "divisions": divisions, "n_boxes": n_occ, kind: y, "occupancy": occupancy, "local_slope": local,
                           "fitted": use})  # fmt: skip
-    return SaddleDimension(
-        value=float(value),
-        err=float(math.sqrt(sum(e * e for e in parts))),
-        err_fit=float(err_fit),
-        err_resample=err_res,
-        err_range=float(err_range),
-        method=f"{kind} box counting",
-        eps_range=(float(eps[use].min()), float(eps[use].max())),
-        n_points=int(n),
-        n_groups=n_groups,
-        table=table,
+    return SaddleDimension._from_parts(
+        value, err_fit, err_res, err_range, f"{kind} box counting", eps, use, n, n_groups, table
     )
 
 
@@ -636,21 +643,10 @@ def information_dimension_neighbours(
         err_res = float(np.nanstd(reps, ddof=1))
     else:
         err_res = math.nan
-    parts = [e for e in (err_fit, err_res, err_range) if math.isfinite(e)]
     eps = np.exp(x)
     table = pd.DataFrame({"eps": eps, "n": ns, "k": ks, "log_mass": y, "fitted": use})
-    return SaddleDimension(
-        value=float(b),
-        err=float(math.sqrt(sum(e * e for e in parts))),
-        err_fit=float(err_fit),
-        err_resample=err_res,
-        err_range=float(err_range),
-        method=f"nearest-neighbour distances (k ≤ {k_max}, {len(levels)} nested subsamples)",
-        eps_range=(float(eps[use].min()), float(eps[use].max())),
-        n_points=int(n),
-        n_groups=n_groups,
-        table=table,
-    )
+    method = f"nearest-neighbour distances (k ≤ {k_max}, {len(levels)} nested subsamples)"
+    return SaddleDimension._from_parts(b, err_fit, err_res, err_range, method, eps, use, n, n_groups, table)
 
 
 def capacity_dimension(
