@@ -94,3 +94,24 @@ def system(model, name: str = "model"):
     if not isinstance(model, System):
         raise ConfigError(f"{name} must be a System (hhscatter.model), got {type(model).__name__}")
     return model
+
+
+def table(df, name: str, columns=(), *, min_rows: int = 1):
+    """``df`` if it is a DataFrame holding ``columns`` and at least ``min_rows`` rows.
+
+    >>> import pandas as pd
+    >>> table(pd.DataFrame({"t": [1.0]}), "sections", ("traj_id", "t"))
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: sections needs the columns ['t', 'traj_id'], has ['t']
+    """
+    import pandas as pd  # deferred: pandas loads only for the estimators that take a table
+
+    if not isinstance(df, pd.DataFrame):
+        raise ConfigError(f"{name} must be a table (pandas DataFrame), got {type(df).__name__}")
+    missing = set(columns) - set(df.columns)
+    if missing:
+        raise ConfigError(f"{name} needs the columns {sorted(columns)}, has {sorted(map(str, df.columns))}")
+    if len(df) < min_rows:
+        raise ConfigError(f"{name} must hold at least {min_rows} row(s), got {len(df)}")
+    return df
