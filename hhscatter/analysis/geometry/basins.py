@@ -93,7 +93,9 @@ import numpy as np
 import pandas as pd
 from scipy import ndimage
 
+from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry.uncertainty import _int_labels, _positive_int
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.errors import ConfigError
 
@@ -481,9 +483,13 @@ def commensurate_sides(sides, extent, n: int, *, min_cells: int = 2) -> list:
     >>> commensurate_sides([0.01, 0.025, 0.05], (-1, 1, -1, 1), 200)
     [0.05]
     """
+    sides = check.numbers(sides, "sides", positive=True)
+    _checks.extent(extent)
+    _checks.whole(n, "n")
+    _checks.whole(min_cells, "min_cells", 0)
     cell = _cell_side(extent, n)
     out = []
-    for s in np.atleast_1d(np.asarray(sides, dtype=float)):
+    for s in sides:
         c = s / cell
         if abs(c - round(c)) <= 1e-9 * max(1.0, c) and round(c) >= min_cells:
             out.append(float(s))
@@ -564,7 +570,10 @@ def every_kth_cell(labels, subgrids) -> list:
     >>> [(k, sub.tolist()) for k, sub in every_kth_cell(lab, [2, 4, 6])]
     [(3, [[7, 10], [25, 28]])]
     """
+    subgrids = [_checks.whole(m, "subgrids") for m in check.numbers(subgrids, "subgrids")]
     lab = np.asarray(labels)
+    if isinstance(labels, (str, bytes, dict)) or lab.dtype.kind not in "biuf" or lab.ndim != 2 or lab.size == 0:
+        raise ConfigError(f"labels must be a non-empty 2-D array (a map), got {type(labels).__name__}")
     out = []
     for m in subgrids:
         k, r = divmod(lab.shape[0], int(m))

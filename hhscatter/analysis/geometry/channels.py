@@ -36,6 +36,7 @@ import numpy as np
 from scipy import integrate, optimize, stats
 
 from hhscatter.analysis.noise.kramers import hessian
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles, System
@@ -79,7 +80,11 @@ def channel_fractions(channel, n_channels: int = 3, z: float = 1.0) -> ChannelFr
     escaped are ignored) with Wilson intervals, and the χ² test of the
     three-fold symmetry prediction 1/n_channels each.
     """
-    c = np.asarray(channel)
+    n_channels = check.count(n_channels, "n_channels", 1)
+    z = check.number(z, "z", positive=True)
+    c = check.numbers(channel, "channel", min_size=0)
+    if not np.all(c == np.round(c)):
+        raise ConfigError("channel must hold integer labels (negative: not escaped)")
     c = c[c >= 0].astype(np.int64)
     if c.size and c.max() >= n_channels:
         raise ConfigError(f"channel labels must be < n_channels = {n_channels}")
@@ -317,7 +322,10 @@ def lyapunov_orbit(
     >>> round(L.period, 4), L.states[0, 2:].tolist()
     (4.4408, [0.0, 0.0])
     """
-    system = HenonHeiles() if system is None else system
+    energy = check.number(energy, "energy")
+    system = HenonHeiles() if system is None else check.system(system, "system")
+    rtol = check.number(rtol, "rtol", positive=True)
+    n_samples = check.count(n_samples, "n_samples", 2)
     E = _checked_energy(energy, system, exit)
     return _Shooting(system, exit, rtol).orbit(E, n_samples)
 
@@ -340,6 +348,16 @@ def return_statistics(orbit, t, radius, direction, n_orbits: int, r_esc: float, 
     ``t_reesc``   first outward crossing of r_esc after t_return (NaN if none):
                   t_reesc − t_return is how long the returned orbit stays.
     """
+    n_orbits = check.count(n_orbits, "n_orbits", 1)
+    r_esc, r_in = check.number(r_esc, "r_esc", positive=True), check.number(r_in, "r_in", positive=True)
+    orbit_ = check.numbers(orbit, "orbit", min_size=0, minimum=0)
+    if not np.all(orbit_ == np.round(orbit_)) or (orbit_.size and orbit_.max() >= n_orbits):
+        raise ConfigError(f"orbit must hold orbit indices from 0 to n_orbits − 1 = {n_orbits - 1}")
+    t_ = check.numbers(t, "t", min_size=0)
+    radius_ = check.numbers(radius, "radius", min_size=0, positive=True)
+    check.numbers(direction, "direction", min_size=0)
+    if not (orbit_.size == t_.size == radius_.size == np.asarray(direction).size):
+        raise ConfigError("orbit, t, radius and direction must have one value per crossing (their lengths differ)")
     orbit = np.asarray(orbit, dtype=np.int64)
     t = np.asarray(t, dtype=float)
     radius = np.asarray(radius, dtype=float)

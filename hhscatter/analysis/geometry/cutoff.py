@@ -26,7 +26,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry.uncertainty import weighted_line
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.errors import ConfigError
 
@@ -69,9 +71,13 @@ def decision_rate(eps, times) -> DecisionRate:
     >>> round(decision_rate(eps, ts).lam, 2)
     0.5
     """
-    eps = np.asarray(eps, dtype=float).ravel()
+    eps = check.numbers(eps, "eps", positive=True)
+    if isinstance(times, (str, bytes, dict)) or not hasattr(times, "__len__"):
+        raise ConfigError(f"times must be a list of arrays of decision times, one per ε, got {type(times).__name__}")
     if len(times) != eps.size:
         raise ConfigError("times must hold one array per ε")
+    for t in times:
+        _checks.values(t, "times", min_size=0)
     rows = []
     for e, t in zip(eps, times):
         t = np.asarray(t, dtype=float)
@@ -124,7 +130,10 @@ def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: flo
     >>> round(math.log(1 / predicted_cutoff(0.3, 0.01, 1.0, [0.2, 0.3], [0.5, 0.5], 0.15)), 3)
     34.657
     """
-    E0, gamma, mu, e_c = float(E0), float(gamma), float(mu), float(e_c)
+    E0, gamma = check.number(E0, "E0"), check.number(gamma, "gamma", minimum=0.0)
+    mu, e_c = check.number(mu, "mu", positive=True), check.number(e_c, "e_c", positive=True)
+    n = _checks.values(energies, "energies").size
+    _checks.values(lam, "lam", size=n)
     if not (E0 > e_c > 0 and gamma >= 0 and mu > 0):
         raise ConfigError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
     if gamma == 0:
@@ -202,7 +211,19 @@ def cutoff_comparison(
     >>> c.overlap, round(c.log10_ratio, 2)
     (False, 2.09)
     """
-    E0, gamma, mu, mu_err = float(E0), float(gamma), float(mu), float(mu_err)
+    E0, gamma = check.number(E0, "E0"), check.number(gamma, "gamma")
+    e_c, mu = check.number(e_c, "e_c", positive=True), check.number(mu, "mu", positive=True)
+    if isinstance(mu_err, bool) or not isinstance(mu_err, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"mu_err must be a number (NaN: not known), got {mu_err!r}")
+    n = _checks.values(energies, "energies").size
+    _checks.values(lam, "lam", size=n)
+    _checks.values(lam_err, "lam_err", size=n)
+    if lam_alt is not None:
+        _checks.values(lam_alt, "lam_alt", size=n)
+    for name, v in (("measured", measured), ("measured_lo", measured_lo), ("measured_hi", measured_hi)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating))):
+            raise ConfigError(f"{name} must be a number or None, got {v!r}")
+    mu_err = float(mu_err)
     if not gamma > 0:
         raise ConfigError(f"cutoff_comparison: γ must be > 0 (no cut-off at γ = {gamma})")
     En = np.asarray(energies, dtype=float)

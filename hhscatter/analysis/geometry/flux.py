@@ -34,6 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
+from hhscatter.errors import ConfigError
+
 __all__ = ["FluxRate", "initial_escape_rate"]
 
 
@@ -68,7 +71,9 @@ def initial_escape_rate(model, energy: float, radius: float, *, n_phi: int = 409
     FluxRate
         flux Φ, shell volume Ω_E and rate Φ/Ω_E (module docstring).
     """
-    E, R = float(energy), float(radius)
+    model = check.system(model, "model")
+    E, R = check.number(energy, "energy"), check.number(radius, "radius", positive=True)
+    n_phi, n_r = check.count(n_phi, "n_phi", 1), check.count(n_r, "n_r", 1)
     phi = (np.arange(n_phi) + 0.5) * (2 * math.pi / n_phi)
     v_edge = model.potential(R * np.cos(phi), R * np.sin(phi))
     flux = float(np.sum(2.0 * np.sqrt(2.0 * np.clip(E - v_edge, 0.0, None))) * R * (2 * math.pi / n_phi))
@@ -77,4 +82,6 @@ def initial_escape_rate(model, energy: float, radius: float, *, n_phi: int = 409
     Y = r[None, :] * np.sin(phi)[:, None]
     area = float(np.sum((model.potential(X, Y) < E) * r[None, :]) * (R / n_r) * (2 * math.pi / n_phi))
     volume = 2 * math.pi * area
+    if not volume > 0:
+        raise ConfigError(f"energy {E!r} is below the potential everywhere in the disk r < radius = {R!r}")
     return FluxRate(E, R, flux, volume, flux / volume)
