@@ -11,7 +11,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from hhscatter.analysis.geometry.distance import _as_points, _cells, box_histograms, hellinger
+from hhscatter.analysis.geometry import _checks
+from hhscatter.analysis.geometry.distance import _cells, box_histograms, hellinger
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -87,8 +89,11 @@ def percentile_interval(values, level: float = 0.95):
     >>> [round(v, 9) for v in percentile_interval(np.arange(101.0), 0.9)]
     [50.0, 5.0, 95.0]
     """
+    check.numbers(values, "values")
     v = np.asarray(values, dtype=float)
-    if not 0 < level < 1:
+    if v.ndim == 0:
+        raise ConfigError(f"values must be an array of replicates (axis 0), got the single number {values!r}")
+    if not 0 < check.number(level, "level") < 1:
         raise ConfigError(f"level must be in (0, 1), got {level!r}")
     q = (1 - level) / 2
     m, lo, hi = v.mean(axis=0), np.quantile(v, q, axis=0), np.quantile(v, 1 - q, axis=0)
@@ -154,6 +159,8 @@ def paired_hellinger_replicates(
     True
     """
     sets, pairs, boxes, group_units = _checked_unit_sets(sets, pairs, boxes, offsets, n_boot)
+    _checks.extent(extent)
+    check.count(seed, "seed", 0)
     extents = [_offset_extents(extent, b, int(offsets)) for b in boxes]
     used = sorted({n for p in pairs for n in p}, key=list(sets).index)
     # dense cell ids of every point on every partition, computed once: a replicate only counts them
@@ -178,14 +185,27 @@ def paired_hellinger_replicates(
 
 def _checked_unit_sets(sets, pairs, boxes, offsets, n_boot):
     """(sets as UnitSets of (n, 2) points, pairs, box sides, {group: its units}), checked with the options."""
+    if not isinstance(sets, dict) or not sets:
+        raise ConfigError(f"sets must be a mapping name -> (points, units, group), got {type(sets).__name__}")
+    for k, v in sets.items():
+        if not isinstance(v, tuple) or len(v) != 3:
+            raise ConfigError(f"sets[{k!r}] must be a UnitSet or a (points, units, group) tuple, got {v!r:.60}")
+    if isinstance(pairs, (str, bytes, dict)) or not isinstance(pairs, (list, tuple)):
+        raise ConfigError(f"pairs must be a list of (set, reference) names, got {type(pairs).__name__}")
+    if not all(isinstance(p, (list, tuple)) for p in pairs):
+        raise ConfigError(f"pairs must be (set, reference) names of sets, got {pairs!r:.60}")
+    boxes = check.numbers(boxes, "boxes", positive=True).tolist()
+    check.count(offsets, "offsets", 1)
+    check.count(n_boot, "n_boot", 2)
     sets = {k: UnitSet(*v) for k, v in sets.items()}
     pairs = [tuple(p) for p in pairs]
-    boxes = [float(b) for b in np.atleast_1d(boxes)]
     for name, s in sets.items():
-        pts, un = _as_points(s.points), np.asarray(s.units)
+        pts = _checks.points(s.points, f"sets[{name!r}].points")
+        check.numbers(s.units, f"sets[{name!r}].units")
+        un = np.asarray(s.units)
         if un.shape[0] != pts.shape[0]:
             raise ConfigError(
-                f"set {name!r}: the units must have one entry per point ({un.shape[0]} vs {pts.shape[0]})"
+                f"sets[{name!r}]: the units must have one entry per point ({un.shape[0]} vs {pts.shape[0]})"
             )
         sets[name] = UnitSet(pts, un, s.group)
     missing = sorted({n for p in pairs for n in p} - set(sets))
@@ -278,8 +298,16 @@ def paired_hellinger_difference(
     >>> bool(r.lo < 0 < r.hi), bool(abs(r.delta) < 0.05)     # B is a random half of A: no difference
     (True, True)
     """
-    A, B, R = _as_points(A), _as_points(B), _as_points(R)
-    if not 0 < level < 1:
+    A, B, R = _checks.points(A, "A"), _checks.points(B, "B"), _checks.points(R, "R")
+    box = check.number(box, "box", positive=True)
+    _checks.extent(extent)
+    for name, units, pts in (("units_a", units_a, A), ("units_b", units_b, B), ("units_r", units_r, R)):
+        if check.numbers(units, name).size != pts.shape[0]:
+            raise ConfigError(f"{name} must have one entry per point of its set ({np.size(units)} vs {pts.shape[0]})")
+    check.count(offsets, "offsets", 1)
+    check.count(n_boot, "n_boot", 2)
+    check.count(seed, "seed", 0)
+    if not 0 < check.number(level, "level") < 1:
         raise ConfigError(f"level must be in (0, 1), got {level!r}")
     sets = {"A": UnitSet(A, units_a, "run"), "B": UnitSet(B, units_b, "run"), "R": UnitSet(R, units_r, "ref")}
     reps = paired_hellinger_replicates(

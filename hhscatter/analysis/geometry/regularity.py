@@ -39,6 +39,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.geometry import _checks
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 SHADOW_DELTA = 1e-9  # initial displacement of the shadow orbit (length units)
@@ -70,6 +72,9 @@ def shadow_ics(states, potential, delta: float = SHADOW_DELTA) -> tuple[np.ndarr
     >>> bool(abs(0.5 * (sh[0, 2]**2 + sh[0, 3]**2) + V(sh[0, 0], sh[0, 1]) - 0.07) < 1e-15)
     True
     """
+    check.numbers(states, "states")
+    check.function(potential, "potential")
+    delta = check.number(delta, "delta", positive=True)
     s = np.asarray(states, dtype=float)
     if s.ndim != 2 or s.shape[1] != 4:
         raise ConfigError(f"states must be (n, 4) (x, y, px, py), got shape {s.shape}")
@@ -115,6 +120,15 @@ def shadow_indicator(
     from hhscatter.analysis.geometry.distance import first_crossings  # deferred: pandas loads on first use
 
     cols = ["traj_id", "t", "x", "y", "px", "py"]
+    check.table(base_sections, "base_sections", cols, min_rows=0)
+    check.table(shadow_sections, "shadow_sections", cols, min_rows=0)
+    ids_ = check.numbers(traj_ids, "traj_ids", min_size=0, minimum=0)
+    if not np.all(ids_ == np.round(ids_)):
+        raise ConfigError("traj_ids must hold integer orbit ids")
+    if check.numbers(d0, "d0", positive=True).size not in (1, ids_.size):
+        raise ConfigError(f"d0 must be one separation or one per orbit of traj_ids ({np.size(d0)} vs {ids_.size})")
+    t_from = check.number(t_from, "t_from")
+    g_max = check.number(g_max, "g_max", positive=True)
     ids = np.asarray(traj_ids, dtype=np.int64)
     d0 = np.broadcast_to(np.asarray(d0, dtype=float), ids.shape)
     out = pd.DataFrame({"traj_id": ids, "d0": d0})
@@ -146,8 +160,10 @@ def regular_fraction(n_orbits: int, n_regular: int) -> tuple[float, float]:
     >>> regular_fraction(10000, 0)[1] > 0
     True
     """
-    if n_orbits <= 0:
-        raise ConfigError("n_orbits must be positive")
+    n_orbits = check.count(n_orbits, "n_orbits", 1)
+    n_regular = check.count(n_regular, "n_regular", 0)
+    if n_regular > n_orbits:
+        raise ConfigError(f"n_regular must be ≤ n_orbits = {n_orbits}, got {n_regular}")
     f = n_regular / n_orbits
     z = 1.0
     wilson = z * np.sqrt(f * (1 - f) / n_orbits + z**2 / (4 * n_orbits**2)) / (1 + z**2 / n_orbits)
@@ -171,7 +187,11 @@ def threshold_systematic(n_orbits: int, growth, g_max: float = G_MAX, others=G_M
     >>> r["value"], r["by_threshold"], r["syst"]      # 3 below 1e4, 2 below 1e3, 4 below 1e5
     (0.003, {1000.0: 0.002, 10000.0: 0.003, 100000.0: 0.004}, 0.001)
     """
+    n_orbits = check.count(n_orbits, "n_orbits", 1)
+    _checks.values(growth, "growth", min_size=0)
     g = np.asarray(growth, dtype=float)
+    g_max = check.number(g_max, "g_max", positive=True)
+    check.numbers(others, "others", positive=True)
     if n_orbits < g.size:
         raise ConfigError(f"n_orbits ({n_orbits}) is smaller than the orbits classified ({g.size})")
     by = {float(x): int(np.sum(g < x)) / n_orbits for x in sorted({float(g_max), *map(float, others)})}

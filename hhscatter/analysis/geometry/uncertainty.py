@@ -108,7 +108,9 @@ def _int_labels(a, name: str, ndim: int | None = None) -> np.ndarray:
 
 
 def _positive_int(v, name: str, minimum: int = 1) -> int:
-    if isinstance(v, bool) or not float(v).is_integer() or int(v) < minimum:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+        raise ConfigError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
+    if not float(v).is_integer() or int(v) < minimum:
         raise ConfigError(f"{name} must be an integer ≥ {minimum}, got {v!r}")
     return int(v)
 
@@ -514,6 +516,11 @@ def weighted_line(x, y, err):
     >>> round(b1, 6), dof
     (2.0, 1)
     """
+    xs = check.numbers(x, "x", min_size=2)
+    if check.numbers(y, "y").size != xs.size or check.numbers(err, "err", positive=True).size != xs.size:
+        raise ConfigError(f"x, y and err must have one value per point ({np.size(x)}, {np.size(y)}, {np.size(err)})")
+    if np.unique(xs).size < 2:
+        raise ConfigError("x must hold at least 2 distinct values (a line through one x is not determined)")
     x, y, err = (np.asarray(v, dtype=float).ravel() for v in (x, y, err))
     w = 1.0 / err**2
     X = np.column_stack([np.ones_like(x), x])
@@ -550,6 +557,10 @@ def local_exponent(eps, k, n) -> pd.DataFrame:
     >>> local_exponent([1e-2, 1e-4], [1000, 100], [10000, 10000]).alpha.round(3).tolist()
     [0.5]
     """
+    check.numbers(eps, "eps", positive=True)
+    check.numbers(k, "k", minimum=0.0)
+    if check.numbers(n, "n", minimum=1.0).size not in (1, np.size(k)):
+        raise ConfigError(f"n must be one sample size or one per ε ({np.size(n)} vs {np.size(k)})")
     eps = np.asarray(eps, dtype=float).ravel()
     k = np.asarray(k, dtype=float).ravel()
     n = np.broadcast_to(np.asarray(n, dtype=float), k.shape).astype(float)
@@ -599,6 +610,8 @@ def slim_fractal(local: pd.DataFrame, *, z: float = 3.0) -> dict:
     >>> slim_fractal(t)["slim"]
     False
     """
+    check.table(local, "local", ("eps_mid", "d", "d_err"), min_rows=0)
+    z = check.number(z, "z", positive=True)
     t = local[np.isfinite(local["d"]) & np.isfinite(local["d_err"]) & (local["d_err"] > 0)]
     out = {
         "slope": math.nan,

@@ -8,13 +8,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
-from hhscatter.analysis.geometry import basins, channels, cutoff, flux
+from hhscatter.analysis.geometry import basins, channels, cutoff, flux, paired_distance, regularity, uncertainty
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
 
 LAB = np.zeros((6, 6), int)
+RNG = np.random.default_rng(0)
+PTS = RNG.random((40, 2))
+IDS = np.arange(40)
+SECTIONS = pd.DataFrame({"traj_id": [0, 1], "t": [2.0, 3.0], "x": [0.1, 0.2], "y": [0.0, 0.1], "px": [0.1, 0.2],
+                         "py": [0.3, 0.1]})  # fmt: skip
 
 #: (function, valid keyword arguments)
 VALID = {
@@ -58,6 +64,47 @@ VALID = {
         flux.initial_escape_rate,
         {"model": HenonHeiles(), "energy": 0.1, "radius": 0.5, "n_phi": 64, "n_r": 32},
     ),
+    "percentile_interval": (paired_distance.percentile_interval, {"values": np.arange(10.0), "level": 0.9}),
+    "paired_hellinger_replicates": (
+        paired_distance.paired_hellinger_replicates,
+        {
+            "sets": {"A": (PTS, IDS, "a"), "R": (PTS[::-1], IDS, "r")},
+            "pairs": [("A", "R")],
+            "boxes": [0.5],
+            "extent": (0, 1, 0, 1),
+            "n_boot": 3,
+        },
+    ),  # fmt: skip
+    "paired_hellinger_difference": (
+        paired_distance.paired_hellinger_difference,
+        {
+            "A": PTS,
+            "B": PTS[:20],
+            "R": PTS[::-1],
+            "box": 0.5,
+            "extent": (0, 1, 0, 1),
+            "units_a": IDS,
+            "units_b": IDS[:20],
+            "units_r": IDS,
+            "n_boot": 3,
+        },
+    ),  # fmt: skip
+    "shadow_ics": (
+        regularity.shadow_ics,
+        {"states": np.array([[0.1, 0.0, 0.3, 0.2]]), "potential": lambda x, y: 0.5 * (x**2 + y**2)},
+    ),
+    "shadow_indicator": (
+        regularity.shadow_indicator,
+        {"base_sections": SECTIONS, "shadow_sections": SECTIONS, "traj_ids": [0, 1], "d0": [1e-9, 1e-9], "t_from": 1.0},
+    ),  # fmt: skip
+    "regular_fraction": (regularity.regular_fraction, {"n_orbits": 10, "n_regular": 2}),
+    "threshold_systematic": (regularity.threshold_systematic, {"n_orbits": 10, "growth": [10.0, np.inf, np.nan]}),
+    "weighted_line": (uncertainty.weighted_line, {"x": [0, 1, 2], "y": [1, 3, 5], "err": [0.1, 0.1, 0.1]}),
+    "local_exponent": (uncertainty.local_exponent, {"eps": [1e-2, 1e-4], "k": [1000, 100], "n": [10000, 10000]}),
+    "slim_fractal": (
+        uncertainty.slim_fractal,
+        {"local": pd.DataFrame({"eps_mid": [1e-2, 1e-4], "d": [1.8, 1.8], "d_err": [0.01, 0.01]})},
+    ),
 }
 
 #: (function, argument, wrong value)
@@ -90,6 +137,42 @@ WRONG = [
     ("initial_escape_rate", "model", "x"),
     ("initial_escape_rate", "radius", 0.0),
     ("initial_escape_rate", "n_phi", 1.5),
+    ("percentile_interval", "values", 1.0),
+    ("percentile_interval", "values", "x"),
+    ("percentile_interval", "level", math.nan),
+    ("paired_hellinger_replicates", "sets", [PTS]),
+    ("paired_hellinger_replicates", "sets", {"A": (PTS, IDS[:-1], "a"), "R": (PTS, IDS, "r")}),
+    ("paired_hellinger_replicates", "pairs", "AR"),
+    ("paired_hellinger_replicates", "boxes", [-0.5]),
+    ("paired_hellinger_replicates", "extent", None),
+    ("paired_hellinger_replicates", "n_boot", 1),
+    ("paired_hellinger_difference", "A", PTS[:, :1]),
+    ("paired_hellinger_difference", "R", np.full((3, 2), math.nan)),
+    ("paired_hellinger_difference", "box", "x"),
+    ("paired_hellinger_difference", "units_b", IDS),
+    ("paired_hellinger_difference", "level", 1.5),
+    ("shadow_ics", "states", "x"),
+    ("shadow_ics", "potential", 1.0),
+    ("shadow_ics", "delta", -1.0),
+    ("shadow_indicator", "base_sections", {"a": 1}),
+    ("shadow_indicator", "shadow_sections", SECTIONS.drop(columns="px")),
+    ("shadow_indicator", "traj_ids", [0.5, 1]),
+    ("shadow_indicator", "d0", [1e-9, 1e-9, 1e-9]),
+    ("shadow_indicator", "t_from", None),
+    ("regular_fraction", "n_orbits", 0),
+    ("regular_fraction", "n_regular", 11),
+    ("regular_fraction", "n_regular", "x"),
+    ("threshold_systematic", "n_orbits", math.nan),
+    ("threshold_systematic", "growth", "x"),
+    ("threshold_systematic", "g_max", -1.0),
+    ("weighted_line", "x", [1.0, 1.0]),
+    ("weighted_line", "y", [1.0]),
+    ("weighted_line", "err", [0.1, 0.0, 0.1]),
+    ("local_exponent", "eps", [0.0, 1e-4]),
+    ("local_exponent", "k", ["a", "b"]),
+    ("local_exponent", "n", [1, 2, 3]),
+    ("slim_fractal", "local", [1.0]),
+    ("slim_fractal", "z", "x"),
 ]
 
 

@@ -223,7 +223,7 @@ def test_replicates_pair_the_shared_set_and_reproduce_the_two_set_difference():
 
 def test_replicates_refuse_bad_input():
     P, ids = np.random.default_rng(0).random((10, 2)), np.arange(10)
-    with pytest.raises(ValueError, match="set 'A': the units must have one entry per point"):
+    with pytest.raises(ValueError, match=r"sets\['A'\]: the units must have one entry per point"):
         paired_hellinger_replicates({"A": (P, ids[:5], "a")}, [("A", "A")], [0.5], EXTENT)
     with pytest.raises(ValueError, match="unknown: \\['R'\\]"):
         paired_hellinger_replicates({"A": (P, ids, "a")}, [("A", "R")], [0.5], EXTENT)
