@@ -73,12 +73,15 @@ Outputs: dimensionless for TV/H, length units for SW.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.geometry import _checks
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -113,6 +116,9 @@ class BootstrapResult(NamedTuple):
 
 def points(df: pd.DataFrame, columns=("x", "y")) -> np.ndarray:
     """points(df, columns=("x", "y")) -> (n, 2) float array, e.g. from the engine's ``sections`` table."""
+    if isinstance(columns, (str, bytes)) or not hasattr(columns, "__iter__"):
+        raise ConfigError(f"columns must be a sequence of column names, got {columns!r}")
+    check.table(df, "df", tuple(columns), min_rows=0)
     return np.column_stack([df[c].to_numpy(dtype=float) for c in columns])
 
 
@@ -135,6 +141,11 @@ def first_crossings(
     start).  Rows sorted by traj_id.
     """
     need = {"traj_id", "t"}
+    check.table(sections, "sections", min_rows=0)
+    t_from = check.number(t_from, "t_from")
+    for name, v in (("e_min", e_min), ("e_max", e_max)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or math.isnan(v):
+            raise ConfigError(f"{name} must be a number (±inf: no bound), got {v!r}")
     if not need <= set(sections.columns):
         raise ConfigError(f"sections needs columns {sorted(need)}, has {sorted(sections.columns)}")
     s = sections[sections["t"] >= t_from]
@@ -144,13 +155,31 @@ def first_crossings(
     return s.reset_index(drop=True)
 
 
-def _as_points(X) -> np.ndarray:
-    X = np.asarray(X, dtype=float)
-    if X.ndim != 2 or X.shape[1] != 2:
-        raise ConfigError(f"expected an (n, 2) array of points, got shape {X.shape}")
-    if X.shape[0] == 0:
-        raise ConfigError("empty point set")
-    return X
+def _as_points(X, name: str = "points") -> np.ndarray:
+    return _checks.points(X, name)
+
+
+def _box(box, name: str = "box") -> float:
+    return check.number(box, name, positive=True)
+
+
+def _weights(w, n: int, name: str):
+    if w is None:
+        return None
+    if check.numbers(w, name, minimum=0.0).size != n or not np.sum(w) > 0:
+        raise ConfigError(f"{name} must be one weight ≥ 0 per point ({np.size(w)} vs {n}), not all 0")
+    return w
+
+
+def _kind(kind) -> str:
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise ConfigError(f"kind must be one of {KINDS}, got {kind!r}")
+    return kind
+
+
+def _distance_table(table, kind):
+    check.table(table, "table", ("box",))
+    _kind(kind)
 
 
 def _extent_of(*sets, pad=1e-9):
@@ -183,7 +212,12 @@ def box_histograms(P, Q, box: float, extent=None, weights_P=None, weights_Q=None
     no mass is lost.  Only boxes occupied by P or Q are returned (memory does
     not grow with 1/ε²).  Optional non-negative weights per point.
     """
-    P, Q = _as_points(P), _as_points(Q)
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    _box(box)
+    if extent is not None:
+        _checks.extent(extent)
+    _weights(weights_P, P.shape[0], "weights_P")
+    _weights(weights_Q, Q.shape[0], "weights_Q")
     if extent is None:
         extent = _extent_of(P, Q)
     cp, cq = _cells(P, box, extent), _cells(Q, box, extent)
@@ -195,13 +229,20 @@ def box_histograms(P, Q, box: float, extent=None, weights_P=None, weights_Q=None
     return p / p.sum(), q / q.sum()
 
 
+def _probabilities(p, q):
+    if check.numbers(p, "p", minimum=0.0).size != check.numbers(q, "q", minimum=0.0).size:
+        raise ConfigError(f"p and q must be probability vectors on the same boxes ({np.size(p)} vs {np.size(q)})")
+
+
 def total_variation(p, q) -> float:
     """total_variation(p, q) -> ½ Σ|p_i − q_i| ∈ [0, 1] for probability vectors."""
+    _probabilities(p, q)
     return float(0.5 * np.sum(np.abs(np.asarray(p) - np.asarray(q))))
 
 
 def hellinger(p, q) -> float:
     """hellinger(p, q) -> (½ Σ(√p_i − √q_i)²)^{1/2} ∈ [0, 1] for probability vectors."""
+    _probabilities(p, q)
     d = np.sqrt(np.asarray(p, dtype=float)) - np.sqrt(np.asarray(q, dtype=float))
     return float(np.sqrt(min(0.5 * np.sum(d * d), 1.0)))
 
@@ -216,6 +257,7 @@ def histogram_distance(
     arrays) on the common partition of ``extent`` into boxes of side ``box``
     (see :func:`box_histograms`).  Dimensionless; H² ≤ TV ≤ √2 H.
     """
+    _kind(kind)
     p, q = box_histograms(P, Q, box, extent, weights_P, weights_Q)
     if kind == "hellinger":
         return hellinger(p, q)
@@ -228,6 +270,8 @@ _DISTANCE = {"hellinger": hellinger, "tv": total_variation}
 
 
 def _check_kinds(kinds):
+    if isinstance(kinds, (str, bytes, dict)) or not isinstance(kinds, (list, tuple)) or not kinds:
+        raise ConfigError(f"kinds must be a non-empty sequence of {KINDS}, got {kinds!r}")
     for k in kinds:
         if k not in KINDS:
             raise ConfigError(f"kind must be one of {KINDS}, got {k!r}")
@@ -239,7 +283,10 @@ def box_distances(P, Q, boxes, extent=None, kinds=KINDS) -> np.ndarray:
     :func:`histogram_distance` of the point sets P, Q at every box side of
     ``boxes`` (in the given order), every kind from one histogram pair per box.
     """
-    P, Q = _as_points(P), _as_points(Q)
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    check.numbers(boxes, "boxes", positive=True)
+    if extent is not None:
+        _checks.extent(extent)
     _check_kinds(kinds)
     if extent is None:
         extent = _extent_of(P, Q)
@@ -299,7 +346,14 @@ def distance_vs_scale(
     ``extent`` defaults to the bounding box of P ∪ Q; the same partition is
     used for every comparison.  Deterministic for a given ``seed``.
     """
-    P, Q = _as_points(P), _as_points(Q)
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    check.numbers(boxes, "boxes", positive=True)
+    if extent is not None:
+        _checks.extent(extent)
+    n_splits = check.count(n_splits, "n_splits", 0)
+    check.count(seed, "seed", 0)
+    if m is not None:
+        check.count(m, "m", 1)
     if extent is None:
         extent = _extent_of(P, Q)
     boxes = np.sort(np.asarray(boxes, dtype=float).ravel())[::-1]
@@ -343,6 +397,8 @@ def agreement_scale(table: pd.DataFrame, kind: str = "hellinger", z: float = 2.0
     None if they already disagree at the coarsest informative scale (or no
     scale is informative).  Same units as the boxes.
     """
+    _distance_table(table, kind)
+    z, noise_max = check.number(z, "z", minimum=0.0), check.number(noise_max, "noise_max", minimum=0.0)
     need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
     if not need <= set(table.columns):
         raise ConfigError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
@@ -373,6 +429,7 @@ def debiased_distance(table: pd.DataFrame, kind: str = "hellinger"):
     carry no bias and d is slightly underestimated (by ≈ (B_noise − B_pq)/(4m)
     in H²).  Dimensionless.
     """
+    _distance_table(table, kind)
     need = {f"{kind}_pq", f"{kind}_pq_std", f"{kind}_noise", f"{kind}_noise_std"}
     if not need <= set(table.columns):
         raise ConfigError("table lacks the split-half columns; run distance_vs_scale with n_splits >= 2")
@@ -396,6 +453,8 @@ def agreement_scale_debiased(table: pd.DataFrame, delta: float = 0.1, kind: str 
     can be compared between data sets of different sizes.  None if already
     d > δ at the coarsest informative scale.  Units of the boxes.
     """
+    _distance_table(table, kind)
+    delta, noise_max = check.number(delta, "delta", minimum=0.0), check.number(noise_max, "noise_max", minimum=0.0)
     d, _, _ = debiased_distance(table, kind)
     order = np.argsort(-table["box"].to_numpy(float))
     noise = table[f"{kind}_noise"].to_numpy(float)
@@ -428,6 +487,9 @@ def _w1d_sorted(xs, ys, p):
 
 def wasserstein_1d(x, y, p: float = 1) -> float:
     """wasserstein_1d(x, y, p=1) -> W_p between two 1-D empirical distributions (exact, via quantile functions)."""
+    check.numbers(x, "x")
+    check.numbers(y, "y")
+    check.number(p, "p", minimum=1.0)
     xs = np.sort(np.asarray(x, dtype=float).ravel())[:, None]
     ys = np.sort(np.asarray(y, dtype=float).ravel())[:, None]
     return float(_w1d_sorted(xs, ys, p)[0] ** (1.0 / p))
@@ -447,10 +509,10 @@ def sliced_wasserstein(
     Units of the coordinates.  For Q = P + s (pure translation) and p = 1,
     SW_1 = E_θ|⟨s,θ⟩| = 2|s|/π; for p = 2, SW_2 = |s|/√2.
     """
-    P, Q = _as_points(P), _as_points(Q)
-    n_proj = int(n_proj)
-    if n_proj < 1:
-        raise ConfigError("n_proj must be >= 1")
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    n_proj = check.count(n_proj, "n_proj", 1)
+    check.count(seed, "seed", 0)
+    check.number(p, "p", minimum=1.0)
     rng = np.random.default_rng(seed)
     if directions == "stratified":
         ang = rng.uniform(0.0, np.pi / n_proj) + np.pi * np.arange(n_proj) / n_proj
@@ -487,9 +549,10 @@ def bootstrap_distance(P, Q, fn: Callable, n_boot: int = 100, seed: int = 0) -> 
     against :func:`split_half_baseline`, not against zero.  Deterministic for
     a given ``seed``.
     """
-    P, Q = _as_points(P), _as_points(Q)
-    if int(n_boot) < 1:
-        raise ConfigError(f"n_boot must be >= 1, got {n_boot!r}")
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    check.function(fn, "fn")
+    check.count(n_boot, "n_boot", 1)
+    check.count(seed, "seed", 0)
     rng = np.random.default_rng(seed)
     draws = [
         fn(P[rng.integers(0, P.shape[0], P.shape[0])], Q[rng.integers(0, Q.shape[0], Q.shape[0])])
@@ -524,10 +587,13 @@ def split_half_noise(P, Q, fn: Callable, m: int | None = None, n_splits: int = 8
     halves :func:`distance_vs_scale` compares. The splits are those of
     :func:`distance_vs_scale` with the same ``seed`` and ``m``.
     """
-    P, Q = _as_points(P), _as_points(Q)
+    P, Q = _as_points(P, "P"), _as_points(Q, "Q")
+    check.function(fn, "fn")
+    if m is not None:
+        check.count(m, "m", 1)
+    check.count(n_splits, "n_splits", 1)
+    check.count(seed, "seed", 0)
     m = _common_m(P, Q, m)
-    if int(n_splits) < 1:
-        raise ConfigError(f"n_splits must be >= 1, got {n_splits!r}")
     rng = np.random.default_rng(seed)
     vals = [0.5 * (fn(P1, P2) + fn(Q1, Q2)) for P1, P2, Q1, Q2 in _split_halves(P, Q, m, int(n_splits), rng)]
     return _mean_std(vals)
@@ -546,8 +612,11 @@ def split_half_baseline(P, fn: Callable, n_splits: int = 20, seed: int = 0, size
     (for Hellinger with well-filled boxes, E[H²] ≈ B/8 · (1/n_A + 1/n_B)).
     Deterministic for a given ``seed``.
     """
-    P = _as_points(P)
-    h = P.shape[0] // 2 if size is None else int(size)
+    P = _as_points(P, "P")
+    check.function(fn, "fn")
+    check.count(n_splits, "n_splits", 1)
+    check.count(seed, "seed", 0)
+    h = P.shape[0] // 2 if size is None else check.count(size, "size", 1)
     if h < 1 or 2 * h > P.shape[0]:
         raise ConfigError(f"cannot split {P.shape[0]} points into two halves of {h}")
     rng = np.random.default_rng(seed)

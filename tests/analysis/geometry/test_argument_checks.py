@@ -11,7 +11,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hhscatter.analysis.geometry import basins, channels, cutoff, flux, paired_distance, regularity, uncertainty
+from hhscatter.analysis.geometry import (
+    basins,
+    channels,
+    cutoff,
+    distance,
+    flux,
+    paired_distance,
+    regularity,
+    uncertainty,
+)
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
 
@@ -21,6 +30,8 @@ PTS = RNG.random((40, 2))
 IDS = np.arange(40)
 SECTIONS = pd.DataFrame({"traj_id": [0, 1], "t": [2.0, 3.0], "x": [0.1, 0.2], "y": [0.0, 0.1], "px": [0.1, 0.2],
                          "py": [0.3, 0.1]})  # fmt: skip
+TABLE = distance.distance_vs_scale(PTS, PTS[::-2], [0.5, 0.25], n_splits=3)
+DIST = lambda A, B: distance.sliced_wasserstein(A, B, 4)  # noqa: E731
 
 #: (function, valid keyword arguments)
 VALID = {
@@ -105,6 +116,22 @@ VALID = {
         uncertainty.slim_fractal,
         {"local": pd.DataFrame({"eps_mid": [1e-2, 1e-4], "d": [1.8, 1.8], "d_err": [0.01, 0.01]})},
     ),
+    "points": (distance.points, {"df": SECTIONS}),
+    "first_crossings": (distance.first_crossings, {"sections": SECTIONS, "t_from": 1.0}),
+    "hellinger": (distance.hellinger, {"p": [0.5, 0.5], "q": [1.0, 0.0]}),
+    "total_variation": (distance.total_variation, {"p": [0.5, 0.5], "q": [1.0, 0.0]}),
+    "box_histograms": (distance.box_histograms, {"P": PTS, "Q": PTS[::2], "box": 0.5}),
+    "histogram_distance": (distance.histogram_distance, {"P": PTS, "Q": PTS[::2], "box": 0.5}),
+    "box_distances": (distance.box_distances, {"P": PTS, "Q": PTS[::2], "boxes": [0.5, 0.25]}),
+    "distance_vs_scale": (distance.distance_vs_scale, {"P": PTS, "Q": PTS[::2], "boxes": [0.5], "n_splits": 2}),
+    "agreement_scale": (distance.agreement_scale, {"table": TABLE}),
+    "debiased_distance": (distance.debiased_distance, {"table": TABLE}),
+    "agreement_scale_debiased": (distance.agreement_scale_debiased, {"table": TABLE}),
+    "wasserstein_1d": (distance.wasserstein_1d, {"x": [0.0, 1.0], "y": [0.5]}),
+    "sliced_wasserstein": (distance.sliced_wasserstein, {"P": PTS, "Q": PTS[::2], "n_proj": 4}),
+    "bootstrap_distance": (distance.bootstrap_distance, {"P": PTS, "Q": PTS[::2], "fn": DIST, "n_boot": 3}),
+    "split_half_noise": (distance.split_half_noise, {"P": PTS, "Q": PTS[::2], "fn": DIST, "n_splits": 2}),
+    "split_half_baseline": (distance.split_half_baseline, {"P": PTS, "fn": DIST, "n_splits": 2}),
 }
 
 #: (function, argument, wrong value)
@@ -173,6 +200,42 @@ WRONG = [
     ("local_exponent", "n", [1, 2, 3]),
     ("slim_fractal", "local", [1.0]),
     ("slim_fractal", "z", "x"),
+    ("points", "df", PTS),
+    ("points", "columns", "xy"),
+    ("first_crossings", "sections", None),
+    ("first_crossings", "t_from", "x"),
+    ("first_crossings", "e_min", math.nan),
+    ("hellinger", "p", [0.5, -0.5]),
+    ("hellinger", "q", [1.0]),
+    ("total_variation", "p", "x"),
+    ("box_histograms", "P", PTS[:, 0]),
+    ("box_histograms", "Q", np.empty((0, 2))),
+    ("box_histograms", "box", 0.0),
+    ("box_histograms", "extent", (0, 1, 1, 0)),
+    ("box_histograms", "weights_P", np.ones(3)),
+    ("histogram_distance", "kind", "l2"),
+    ("box_distances", "boxes", [math.nan]),
+    ("box_distances", "kinds", "hellinger"),
+    ("distance_vs_scale", "n_splits", -1),
+    ("distance_vs_scale", "m", 0),
+    ("distance_vs_scale", "Q", [[math.inf, 0.0]]),
+    ("agreement_scale", "table", {"box": [1.0]}),
+    ("agreement_scale", "kind", None),
+    ("agreement_scale", "z", math.nan),
+    ("debiased_distance", "table", pd.DataFrame({"x": [1.0]})),
+    ("agreement_scale_debiased", "delta", "x"),
+    ("agreement_scale_debiased", "noise_max", -1.0),
+    ("wasserstein_1d", "x", []),
+    ("wasserstein_1d", "y", [math.nan]),
+    ("wasserstein_1d", "p", 0.5),
+    ("sliced_wasserstein", "n_proj", 0),
+    ("sliced_wasserstein", "seed", "x"),
+    ("bootstrap_distance", "fn", "x"),
+    ("bootstrap_distance", "n_boot", 0),
+    ("split_half_noise", "n_splits", 0),
+    ("split_half_baseline", "P", None),
+    ("split_half_baseline", "size", 0),
+    ("split_half_baseline", "n_splits", 0),
 ]
 
 
