@@ -62,6 +62,8 @@ from scipy import optimize
 from scipy.sparse import csgraph
 from scipy.sparse.linalg import eigs
 
+from hhscatter.analysis.geometry import _checks
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -154,12 +156,48 @@ class Transitions:
         return Transitions(new[self.src[s]], d, self.T[s], int(keep.sum()), self.w[s])
 
 
+def _transitions(tr, name: str = "tr") -> Transitions:
+    """``tr`` if it is a :class:`Transitions`."""
+    if not isinstance(tr, Transitions):
+        raise ConfigError(f"{name} must be Transitions (sampled one-step transitions), got {type(tr).__name__}")
+    return tr
+
+
+def _matrix(A, name: str = "A", *, square: bool = True):
+    """``A`` as a sparse matrix of finite numbers ≥ 0 (square if ``square``; at least one row)."""
+    if not sp.issparse(A):
+        values = check.numbers(A, name)
+        if np.ndim(A) != 2:
+            raise ConfigError(f"{name} must be a 2-D matrix, got {np.ndim(A)} dimension(s)")
+    elif A.shape[0] == 0 or not np.all(np.isfinite(A.data)):
+        raise ConfigError(f"{name} must be a non-empty matrix of finite numbers")
+    else:
+        values = A.data
+    if values.size and values.min() < 0:
+        raise ConfigError(f"{name} must be non-negative")
+    if square and A.shape[0] != A.shape[1]:
+        raise ConfigError(f"{name} must be square, got shape {A.shape}")
+    return A
+
+
+def _crossings(c, name: str = "crossings", n: int | None = None) -> np.ndarray:
+    """``c`` as a (steps, states) array of finite numbers ≥ 0 (``n`` states if given)."""
+    check.numbers(c, name, minimum=0.0)
+    c = np.asarray(c, dtype=float)
+    if c.ndim != 2 or (n is not None and c.shape[1] != n):
+        want = "states" if n is None else f"{n} states"
+        raise ConfigError(f"{name} must be a (steps, {want}) array, got shape {c.shape}")
+    return c
+
+
 def transfer_matrix(tr: Transitions, kappa: float = 0.0) -> sp.csr_matrix:
     """transfer_matrix(tr, kappa=0) -> csr M(κ), M_ij = Σ_{s: i→j} w_s e^{κT_s} / Σ_{s∈i} w_s (1/time: κ).
 
     κ = 0 gives Ulam's matrix P of the open map (sub-stochastic rows). States without samples have
     empty rows.
     """
+    _transitions(tr)
+    check.number(kappa, "kappa")
     ret = tr.dst >= 0
     rw = tr.row_weight
     inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)
@@ -224,6 +262,8 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     gives (0, uniform). Uses ARPACK (scipy.sparse.linalg.eigs, largest real part) above
     :data:`DENSE_MAX` states, dense LAPACK below.
     """
+    _matrix(A)
+    check.number(tol, "tol", positive=True)
     A = sp.csr_matrix(A)
     n = A.shape[0]
     if A.shape != (n, n):
@@ -253,6 +293,7 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
 
 def spectral_radius(A) -> float:
     """spectral_radius(A) -> ρ(A) of a non-negative square matrix (see :func:`leading_left`)."""
+    _matrix(A)
     A = sp.csr_matrix(A)
     if A.nnz == 0:
         return 0.0
@@ -263,6 +304,7 @@ def spectral_radius(A) -> float:
 
 def map_escape_rate(tr: Transitions) -> float:
     """map_escape_rate(tr) -> −ln ρ(P): the discrete map's escape rate per return, Eq. (eqn:kappa_cmeasure_discrete)."""
+    _transitions(tr)
     rho = spectral_radius(transfer_matrix(tr, 0.0))
     return -math.log(rho) if rho > 0 else math.inf
 
@@ -275,9 +317,14 @@ def true_time_kappa(tr: Transitions, *, xtol: float = 1e-13) -> float:
     (:func:`saddle_class`); ValueError otherwise.
     """
 
+    _transitions(tr)
+    check.number(xtol, "xtol", positive=True)
+
     def h(k):
         return math.log(spectral_radius(transfer_matrix(tr, k)))
 
+    if spectral_radius(transfer_matrix(tr, 0.0)) == 0:
+        raise ConfigError("tr: no sample returns to a state that is left again (ρ(P) = 0): κ is not finite")
     h0 = h(0.0)
     if not h0 < -1e-12:
         raise ConfigError(
@@ -302,6 +349,8 @@ def bootstrap_kappa(tr: Transitions, n_boot: int, rng=None) -> np.ndarray:
     replicate's saddle class (:func:`saddle_class`, :func:`true_time_kappa`). Their std is the statistical
     error of κ; the discretisation bias of the boxes is not in it.
     """
+    _transitions(tr)
+    check.count(n_boot, "n_boot", 1)
     gen = np.random.default_rng(rng)
     out = np.empty(int(n_boot))
     for b in range(int(n_boot)):
@@ -332,6 +381,7 @@ def communicating_classes(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]
     connection='strong'). A *closed* class keeps all its samples (an invariant set of the sampled map:
     ρ = 1 on it, e.g. a KAM island resolved by the boxes).
     """
+    _transitions(tr)
     P = transfer_matrix(tr, 0.0)
     _, labels = csgraph.connected_components(P, directed=True, connection="strong")
     ret = tr.dst >= 0
@@ -366,6 +416,7 @@ def saddle_class(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]:
     ``tr.subset(keep)``. (By states, not weight: a transient box whose few samples carry a large weight is
     a class of its own with ρ = 0.)
     """
+    _transitions(tr)
     labels, infos = communicating_classes(tr)
     open_ = sorted((c for c in infos if not c.closed and c.weight > 0), key=lambda c: (-c.size, -c.weight, c.label))
     if not open_:
@@ -381,7 +432,11 @@ def saddle_measure(tr: Transitions, kappa: float, keep) -> tuple[np.ndarray, flo
     would win with eigenvalue ≥ 1). At the root κ of the class, λ = 1. If a downstream class has a larger
     root (λ > 1: a sticky, nearly closed set), the vector is taken on ``keep`` alone and λ is reported.
     """
-    keep = np.asarray(keep, dtype=bool)
+    _transitions(tr)
+    check.number(kappa, "kappa")
+    keep = check.mask(keep, "keep", tr.n_states)
+    if not keep.any():
+        raise ConfigError("keep must select at least one state")
     labels, infos = communicating_classes(tr)
     closed = np.isin(labels, [c.label for c in infos if c.closed])
     A = (transfer_matrix(tr) > 0).astype(np.int8).T.tocsr()  # A[j, i] = 1: an edge i → j
@@ -408,6 +463,10 @@ def sprinkler_weights(tr: Transitions, nu: np.ndarray, kappa: float) -> np.ndarr
     rate ∝ ν(x) e^{−κt}, lands at h(x) with weight ν(x)·(e^{κT(x)} − 1)/κ (the crossing at x happened in
     [t − T(x), t)); per sample: ν_src · w_s/W_src · (e^{κT_s} − 1)/κ, 0 for escapes. κ = 0: the limit T.
     """
+    _transitions(tr)
+    if check.numbers(nu, "nu", minimum=0.0).size != tr.n_states:
+        raise ConfigError(f"nu must have one value per state: {np.size(nu)} != {tr.n_states}")
+    check.number(kappa, "kappa")
     nu = np.asarray(nu, dtype=float)
     rw = tr.row_weight
     inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)
@@ -427,6 +486,18 @@ def section_flux_density(model, x, y, energy, *, h: float = 1e-6):
     ∂_r V by a central difference of ``model.potential`` along the ray (relative step h): no model
     constants here. 0 where V ≥ E or r = 0.
     """
+    if not callable(getattr(model, "potential", None)):
+        raise ConfigError(f"model must be a system with a potential V(x, y), got {type(model).__name__}")
+    check.numbers(x, "x")
+    check.numbers(y, "y")
+    check.numbers(energy, "energy")
+    check.number(h, "h", positive=True)
+    try:
+        np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(energy))
+    except ValueError:
+        raise ConfigError(
+            f"x, y and energy must have one value per point (shapes {np.shape(x)}, {np.shape(y)}, {np.shape(energy)})"
+        ) from None
     x, y, E = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float), np.asarray(energy, float))
     r = np.hypot(x, y)
     V = model.potential(x, y)
@@ -443,6 +514,10 @@ def section_flux_density(model, x, y, energy, *, h: float = 1e-6):
 def box_index(x, y, extent, box: float) -> tuple[np.ndarray, int, int]:
     """box_index(x, y, extent, box) -> (flat index (−1 outside extent), nx, ny): squares of side ``box``
     anchored at (x0, y0) of ``extent`` = (x0, x1, y0, y1); index = iy·nx + ix."""
+    if check.numbers(x, "x", min_size=0).size != check.numbers(y, "y", min_size=0).size:
+        raise ConfigError(f"x and y must have one value per point ({np.size(x)} vs {np.size(y)})")
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
     x0, x1, y0, y1 = (float(v) for v in extent)
     nx, ny = int(math.ceil((x1 - x0) / box - 1e-9)), int(math.ceil((y1 - y0) / box - 1e-9))
     ix = np.floor((np.asarray(x, float) - x0) / box).astype(np.int64)
@@ -465,11 +540,15 @@ def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -
     state i's samples whose next event lies beyond lag ℓ, H_ℓ,i = Σ_{s ∈ i: t_end,s > ℓ dt} w_s / W_i
     (H has as many rows as the latest event needs; beyond them it is 0).
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
+    _transitions(tr)
+    t_end = _checks.values(t_end, "t_end", min_size=0)
     if t_end.size != tr.src.size:
         raise ConfigError("t_end must give one time per sample")
-    if not dt > 0:
-        raise ConfigError(f"dt must be > 0, got {dt}")
+    if not np.all(np.isfinite(t_end[tr.dst < 0])):
+        raise ConfigError("t_end must be finite for the samples that escape")
+    check.number(dt, "dt", positive=True)
+    if max_lag is not None:
+        _checks.whole(max_lag, "max_lag")
     n = tr.n_states
     rw = tr.row_weight
     inv = np.divide(1.0, rw, out=np.zeros_like(rw), where=rw > 0)
@@ -493,6 +572,9 @@ def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -
 
 def capped_share(tr: Transitions, dt: float, max_lag: int) -> float:
     """capped_share(tr, dt, max_lag) -> the share of the returning sample weight whose lag exceeds max_lag."""
+    _transitions(tr)
+    check.number(dt, "dt", positive=True)
+    check.number(max_lag, "max_lag", minimum=1.0)
     ret = tr.dst >= 0
     if not ret.any():
         return 0.0
@@ -506,8 +588,15 @@ def propagate(n0, K: sp.csr_matrix, L: int, n_steps: int) -> np.ndarray:
     n(0) = n0 (the initial ensemble, on the section at t = 0); n(k) = Σ_ℓ n(k − ℓ) K_ℓ, one sparse product
     per step (every lag at once).
     """
-    n0 = np.asarray(n0, dtype=float).ravel()
+    n0 = check.numbers(n0, "n0", minimum=0.0)
     n = n0.size
+    L = _checks.whole(L, "L")
+    n_steps = _checks.whole(n_steps, "n_steps", 0)
+    _matrix(K, "K", square=False)
+    if K.shape != (n, n * L):
+        raise ConfigError(
+            f"K must have shape (states, states × L) = ({n}, {n * L}) for the {n} states of n0, got {K.shape}"
+        )
     out = np.zeros((n_steps + L + 1, n))
     out[0] = n0
     Kt = K.T.tocsr()
@@ -527,7 +616,9 @@ def survival_from_crossings(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
     """
     from scipy.signal import fftconvolve  # deferred: scipy loads on first use
 
+    crossings = _crossings(crossings)
     steps, n = crossings.shape
+    H = _crossings(H, "H", n)
     Hs = np.zeros((steps, n))
     m = min(steps, H.shape[0])
     Hs[:m] = H[:m]
@@ -545,6 +636,12 @@ def first_crossing_weights(crossings: np.ndarray, tr: Transitions, dt: float, k_
     so that the images give the distribution below the box scale. Σ over samples into j = that function's
     entry j.
     """
+    _transitions(tr)
+    crossings = _crossings(crossings, n=tr.n_states)
+    check.number(dt, "dt", positive=True)
+    k_star = _checks.whole(k_star, "k_star", 0)
+    if k_star > crossings.shape[0]:
+        raise ConfigError(f"k_star must be at most the steps of crossings ({crossings.shape[0]}), got {k_star}")
     cs = np.vstack([np.zeros((1, crossings.shape[1])), np.cumsum(crossings[:k_star], axis=0)])
     ret = tr.dst >= 0
     lag = np.maximum(1, np.rint(np.where(ret, tr.T, dt) / dt).astype(np.int64))
@@ -558,7 +655,15 @@ def first_crossing_weights(crossings: np.ndarray, tr: Transitions, dt: float, k_
 def first_crossing_after(crossings: np.ndarray, K: sp.csr_matrix, L: int, k_star: int) -> np.ndarray:
     """first_crossing_after(crossings, K, L, k*) -> unnormalised distribution over states of the first crossing
     at or after step k* of every orbit alive then: Σ_ℓ Σ_{k* − ℓ ≤ k' < k*} n(k') K_ℓ."""
+    crossings = _crossings(crossings)
     n = crossings.shape[1]
+    L = _checks.whole(L, "L")
+    k_star = _checks.whole(k_star, "k_star", 0)
+    _matrix(K, "K", square=False)
+    if K.shape != (n, n * L):
+        raise ConfigError(
+            f"K must have shape (states, states × L) = ({n}, {n * L}) for the {n} states of crossings, got {K.shape}"
+        )
     out = np.zeros(n)
     Kt = K.T.tocsr()
     for kp in range(max(0, k_star - L), k_star):

@@ -19,6 +19,7 @@ from hhscatter.analysis.geometry import (
     flux,
     paired_distance,
     regularity,
+    transfer,
     uncertainty,
 )
 from hhscatter.errors import ConfigError
@@ -31,6 +32,11 @@ IDS = np.arange(40)
 SECTIONS = pd.DataFrame({"traj_id": [0, 1], "t": [2.0, 3.0], "x": [0.1, 0.2], "y": [0.0, 0.1], "px": [0.1, 0.2],
                          "py": [0.3, 0.1]})  # fmt: skip
 TABLE = distance.distance_vs_scale(PTS, PTS[::-2], [0.5, 0.25], n_splits=3)
+G = np.random.default_rng(1)
+TR = transfer.Transitions(src=G.integers(0, 3, 60), dst=G.integers(-1, 3, 60), T=G.uniform(0.5, 2, 60), n_states=3)
+T_END = G.uniform(0.5, 3, 60)
+KER, HOLD, LAG = transfer.lag_kernels(TR, T_END, 1.0)
+CROSS = transfer.propagate(np.ones(3), KER, LAG, 5)
 DIST = lambda A, B: distance.sliced_wasserstein(A, B, 4)  # noqa: E731
 
 #: (function, valid keyword arguments)
@@ -132,6 +138,30 @@ VALID = {
     "bootstrap_distance": (distance.bootstrap_distance, {"P": PTS, "Q": PTS[::2], "fn": DIST, "n_boot": 3}),
     "split_half_noise": (distance.split_half_noise, {"P": PTS, "Q": PTS[::2], "fn": DIST, "n_splits": 2}),
     "split_half_baseline": (distance.split_half_baseline, {"P": PTS, "fn": DIST, "n_splits": 2}),
+    "transfer_matrix": (transfer.transfer_matrix, {"tr": TR, "kappa": 0.1}),
+    "leading_left": (transfer.leading_left, {"A": np.array([[0.5, 0.5], [0.2, 0.3]])}),
+    "spectral_radius": (transfer.spectral_radius, {"A": np.array([[0.5, 0.5], [0.2, 0.3]])}),
+    "map_escape_rate": (transfer.map_escape_rate, {"tr": TR}),
+    "true_time_kappa": (transfer.true_time_kappa, {"tr": TR}),
+    "bootstrap_kappa": (transfer.bootstrap_kappa, {"tr": TR, "n_boot": 2, "rng": 0}),
+    "communicating_classes": (transfer.communicating_classes, {"tr": TR}),
+    "saddle_class": (transfer.saddle_class, {"tr": TR}),
+    "saddle_measure": (transfer.saddle_measure, {"tr": TR, "kappa": 0.1, "keep": [True, True, True]}),
+    "sprinkler_weights": (transfer.sprinkler_weights, {"tr": TR, "nu": [0.3, 0.3, 0.4], "kappa": 0.1}),
+    "section_flux_density": (
+        transfer.section_flux_density,
+        {"model": HenonHeiles(), "x": [0.1, 0.2], "y": [0.0, 0.1], "energy": 0.1},
+    ),
+    "box_index": (transfer.box_index, {"x": [0.1, 0.9], "y": [0.2, 0.5], "extent": (0, 1, 0, 1), "box": 0.5}),
+    "lag_kernels": (transfer.lag_kernels, {"tr": TR, "t_end": T_END, "dt": 1.0}),
+    "capped_share": (transfer.capped_share, {"tr": TR, "dt": 1.0, "max_lag": 1}),
+    "propagate": (transfer.propagate, {"n0": np.ones(3), "K": KER, "L": LAG, "n_steps": 5}),
+    "survival_from_crossings": (transfer.survival_from_crossings, {"crossings": CROSS, "H": HOLD}),
+    "first_crossing_weights": (
+        transfer.first_crossing_weights,
+        {"crossings": CROSS, "tr": TR, "dt": 1.0, "k_star": 2},
+    ),
+    "first_crossing_after": (transfer.first_crossing_after, {"crossings": CROSS, "K": KER, "L": LAG, "k_star": 2}),
 }
 
 #: (function, argument, wrong value)
@@ -236,6 +266,46 @@ WRONG = [
     ("split_half_baseline", "P", None),
     ("split_half_baseline", "size", 0),
     ("split_half_baseline", "n_splits", 0),
+    ("transfer_matrix", "tr", {"src": [0]}),
+    ("transfer_matrix", "kappa", "x"),
+    ("leading_left", "A", [[0.5, -0.5], [0.2, 0.3]]),
+    ("leading_left", "A", np.ones((2, 3))),
+    ("leading_left", "tol", 0.0),
+    ("spectral_radius", "A", "x"),
+    ("map_escape_rate", "tr", None),
+    ("true_time_kappa", "xtol", math.nan),
+    ("bootstrap_kappa", "n_boot", 0),
+    ("communicating_classes", "tr", np.array([])),
+    ("saddle_class", "tr", "x"),
+    ("saddle_measure", "keep", [True, True]),
+    ("saddle_measure", "keep", [False, False, False]),
+    ("saddle_measure", "kappa", None),
+    ("sprinkler_weights", "nu", [0.5, 0.5]),
+    ("sprinkler_weights", "nu", [0.5, -0.5, 1.0]),
+    ("section_flux_density", "model", "x"),
+    ("section_flux_density", "x", [math.nan, 0.1]),
+    ("section_flux_density", "energy", [0.1, 0.1, 0.1]),
+    ("section_flux_density", "h", -1.0),
+    ("box_index", "x", [0.1]),
+    ("box_index", "extent", [0, 1]),
+    ("box_index", "box", 0.0),
+    ("lag_kernels", "t_end", [1.0]),
+    ("lag_kernels", "t_end", np.where(TR.dst < 0, math.nan, T_END)),
+    ("lag_kernels", "dt", 0.0),
+    ("lag_kernels", "max_lag", 0),
+    ("capped_share", "dt", -1.0),
+    ("capped_share", "max_lag", "x"),
+    ("propagate", "n0", np.ones(2)),
+    ("propagate", "K", "x"),
+    ("propagate", "L", 0),
+    ("propagate", "n_steps", -1),
+    ("survival_from_crossings", "crossings", np.ones(3)),
+    ("survival_from_crossings", "H", np.ones((2, 2))),
+    ("first_crossing_weights", "crossings", np.ones((6, 2))),
+    ("first_crossing_weights", "k_star", 9),
+    ("first_crossing_weights", "dt", math.inf),
+    ("first_crossing_after", "K", np.ones((3, 3))),
+    ("first_crossing_after", "k_star", -1),
 ]
 
 
@@ -255,3 +325,9 @@ def test_a_wrong_argument_is_refused_naming_it(name, arg, bad):
 def test_an_energy_below_the_potential_in_the_whole_disk_is_refused():
     with pytest.raises(ConfigError, match="below the potential"):
         flux.initial_escape_rate(HenonHeiles(), energy=-1.0, radius=0.5, n_phi=16, n_r=8)
+
+
+def test_transitions_without_a_return_have_no_finite_kappa():
+    every_one_escapes = transfer.Transitions(src=[0, 1], dst=[-1, -1], T=[1.0, 1.0], n_states=2)
+    with pytest.raises(ConfigError, match="κ is not finite"):
+        transfer.true_time_kappa(every_one_escapes)
