@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -69,3 +70,25 @@ def values(a, name: str, *, size: int | None = None, min_size: int = 1) -> np.nd
     if arr.size < min_size:
         raise ConfigError(f"{name} must hold at least {min_size} value(s), got {arr.size}")
     return arr
+
+
+def mapping(m, name: str, keys=()) -> dict:
+    """``m`` if it is a mapping holding ``keys`` (a result or record of another estimator)."""
+    if not isinstance(m, Mapping):
+        raise ConfigError(f"{name} must be a mapping (a result or record), got {type(m).__name__}")
+    missing = [k for k in keys if k not in m]
+    if missing:
+        raise ConfigError(f"{name} lacks the keys {missing}")
+    return m
+
+
+def wholes(a, name: str, minimum: int = 1) -> list[int]:
+    """``a`` as a non-empty list of ints ≥ ``minimum`` (integers or whole-valued floats)."""
+    return [whole(v, name, minimum) for v in check.numbers(a, name)]
+
+
+def generator(rng, name: str = "rng"):
+    """``rng`` if it is a :class:`numpy.random.Generator`."""
+    if not isinstance(rng, np.random.Generator):
+        raise ConfigError(f"{name} must be a numpy.random.Generator, got {type(rng).__name__}")
+    return rng

@@ -350,7 +350,7 @@ def bootstrap_kappa(tr: Transitions, n_boot: int, rng=None) -> np.ndarray:
     error of κ; the discretisation bias of the boxes is not in it.
     """
     _transitions(tr)
-    check.count(n_boot, "n_boot", 1)
+    check.count(n_boot, "n_boot", 0)
     gen = np.random.default_rng(rng)
     out = np.empty(int(n_boot))
     for b in range(int(n_boot)):

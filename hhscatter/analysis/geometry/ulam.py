@@ -25,8 +25,10 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry import distance as dist
 from hhscatter.analysis.geometry import transfer as tf
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.errors import ConfigError
 
@@ -56,6 +58,25 @@ __all__ = [
     "t_star_energies",
 ]
 
+#: the columns of a table of one-return samples (:func:`one_return_samples`)
+_SAMPLE_COLUMNS = ("cell", "rank", "w", "censored", "ret", "T", "x1", "y1")
+
+
+def _sample_table(tab, name: str, ebins: bool = False, *, t_end: bool = False):
+    more = (("ebin", "e1") if ebins else ()) + (("t_end",) if t_end else ())
+    return check.table(tab, name, _SAMPLE_COLUMNS + more)
+
+
+def _transition_table(t, tr):
+    check.table(t, "t", ("t_end", "x1", "y1", "e1"), min_rows=0)
+    if len(t) != tr.src.size:
+        raise ConfigError(f"t must have one row per sample of tr ({len(t)} vs {tr.src.size})")
+
+
+def _state_ids(ids, tr):
+    if check.numbers(ids, "ids", min_size=0, minimum=0).size != tr.n_states:
+        raise ConfigError(f"ids must have one id per state of tr ({np.size(ids)} vs {tr.n_states})")
+
 
 def grid_shape(extent, box: float) -> tuple[int, int]:
     """Boxes per side (nx, ny) of side ``box`` covering ``extent`` = (x0, x1, y0, y1).
@@ -65,6 +86,8 @@ def grid_shape(extent, box: float) -> tuple[int, int]:
     >>> grid_shape((-1.03, 1.03, -1.03, 1.03), 0.1)
     (21, 21)
     """
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
     x0, x1, y0, y1 = extent
     return int(math.ceil((x1 - x0) / box - 1e-9)), int(math.ceil((y1 - y0) / box - 1e-9))
 
@@ -77,6 +100,11 @@ def coarse_index(cell, nx: int, c: int):
     >>> coarse_index(np.array([0, 1, 4, 5, 15]), 4, 2).tolist()
     [0, 0, 0, 0, 3]
     """
+    cell_ = check.numbers(cell, "cell", min_size=0, minimum=0)
+    if not np.all(cell_ == np.round(cell_)):
+        raise ConfigError("cell must hold box indices (integers ≥ 0)")
+    _checks.whole(nx, "nx")
+    _checks.whole(c, "c")
     ix, iy = cell % nx, cell // nx
     ncx = -(-nx // c)
     return (iy // c) * ncx + ix // c
@@ -90,6 +118,14 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
     ``ebin``) the states are (box, energy bin): id = bin·n_cells + box. Returns (Transitions, state ids,
     the samples used).
     """
+    _sample_table(tab, "tab", ebins is not None)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    _checks.whole(c, "c")
+    if m_max is not None:
+        _checks.whole(m_max, "m_max")
+    if ebins is not None:
+        check.numbers(ebins, "ebins", min_size=2)
     nx, _ = grid_shape(extent, box)
     mask = ~tab["censored"].to_numpy()
     if m_max is not None:
@@ -114,6 +150,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
 
 def saddle_kappa(tr):
     """κ on the chaotic saddle's class of ``tr``: (κ, κ per return, class info, keep mask, sub-Transitions)."""
+    tf._transitions(tr)
     keep, classes = tf.saddle_class(tr)
     sub = tr.subset(keep)
     kappa = tf.true_time_kappa(sub)
@@ -136,6 +173,9 @@ def leading_modes(sub, trapped_sub, k: int = 4):
     import scipy.linalg  # deferred: scipy loads on first use
     from scipy.sparse.linalg import eigs  # deferred: scipy loads on first use
 
+    tf._transitions(sub, "sub")
+    check.mask(trapped_sub, "trapped_sub", sub.n_states)
+    _checks.whole(k, "k")
     P = tf.transfer_matrix(sub)
     if sub.n_states <= tf.DENSE_MAX:
         vals, vecs = scipy.linalg.eig(P.toarray().T)
@@ -171,6 +211,11 @@ def measure_points(res, kind, n, rng):
     first crossing after a late time) or by the map's c-measure ("map": left vector of P). ``res`` holds t
     (the samples), tr, keep and kappa of :func:`saddle_kappa`'s partition.
     """
+    _checks.mapping(res, "res", ("t", "tr", "keep", "kappa"))
+    if not isinstance(kind, str) or kind not in ("map", "sprinkler", "flux"):
+        raise ConfigError(f"kind must be 'map', 'sprinkler' or 'flux', got {kind!r}")
+    _checks.whole(n, "n")
+    _checks.generator(rng)
     t, tr = res["t"], res["tr"]
     # the left Perron vectors of the *whole* matrix: the saddle's class and the boxes downstream of it (orbits
     # on their way out, which cross the section too); upstream boxes get 0
@@ -192,6 +237,10 @@ def reduced_operator(tr, ids, n_cells, n_bins):
     """The operator on ρ(E) alone: each energy bin's section distribution frozen to its c-measure ν_a (left
     vector of the bin's own box operator at its root κ_a). ``tr`` on (box × bin) states with ids
     bin·n_cells + box. Returns (Transitions over bins, per-bin κ_a)."""
+    tf._transitions(tr)
+    _state_ids(ids, tr)
+    _checks.whole(n_cells, "n_cells")
+    _checks.whole(n_bins, "n_bins")
     box_of = ids % n_cells
     bin_of = ids // n_cells
     w_red = np.zeros(tr.src.size)
@@ -228,6 +277,9 @@ def empirical_survival(t_end, leaving, grid):
     >>> empirical_survival([1.0, 2.0, 5.0], [True, True, False], [0.0, 1.5, 3.0]).tolist()
     [1.0, 0.6666666666666667, 0.33333333333333337]
     """
+    n = check.numbers(t_end, "t_end").size
+    check.mask(leaving, "leaving", n)
+    check.numbers(grid, "grid", min_size=0)
     te = np.sort(np.asarray(t_end)[np.asarray(leaving)])
     return 1.0 - np.searchsorted(te, grid, side="right") / len(t_end)
 
@@ -237,6 +289,13 @@ def survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
     |ln(P/P_sim)| where P_sim·N ≥ 30 (also the time up to which that holds). A simulated P of 0 (no orbit of N
     left) is written with its one-sided 95 % upper bound ``sim_upper`` and no error
     (:func:`~hhscatter.analysis.stats.intervals.fraction_with_bound`)."""
+    grid_ = check.numbers(grid, "grid", minimum=0.0)
+    check.number(dt, "dt", positive=True)
+    check.number(t_star, "t_star")
+    for name, P in (("P_sim", P_sim), ("P_op", P_op), ("P_red", P_red)):
+        if check.numbers(P, name, minimum=0.0).size != grid_.size:
+            raise ConfigError(f"{name} must have one value per time of grid ({np.size(P)} vs {grid_.size})")
+    _checks.whole(N, "N")
     ok = P_sim * N >= 30
     lr = np.log(np.where(ok, P_op, 1.0) / np.where(ok, P_sim, 1.0))
     lr2 = np.log(np.where(ok, np.maximum(P_red, 1e-300), 1.0) / np.where(ok, P_sim, 1.0))
@@ -269,6 +328,10 @@ def survival_agreement(grid, dt, t_star, P_sim, P_op, P_red, N):
 
 def t_star_energies(pred, sim_pts):
     """Mean and spread of the energy at the first crossing after t*: operator (weighted) and simulation."""
+    check.table(pred, "pred", ("w", "energy"))
+    if not np.sum(pred["w"]) > 0:
+        raise ConfigError("pred: the weights w must not all be 0")
+    check.table(sim_pts, "sim_pts", ("energy",), min_rows=0)
     wE = pred["w"] / pred["w"].sum()
     mE_pred = float(np.sum(wE * pred["energy"]))
     sE_pred = float(np.sqrt(np.sum(wE * (pred["energy"] - mE_pred) ** 2)))
@@ -294,6 +357,12 @@ def cost_row(E, pt, rec, kappa0, target):
     operator's is a lower bound: its bias ∝ box side (cost ∝ 1/b² at fixed samples per box) and its
     statistics ∝ 1/√(samples) — optimistic, since finer boxes raise the per-sample noise.
     """
+    check.number(E, "E")
+    _checks.mapping(pt, "pt", ("kappa", "kappa_err", "orbits", "orbit_time"))
+    if rec is not None:
+        _checks.mapping(rec, "rec", ("kappa", "kappa_stat_err", "discretisation_bias", "err", "orbit_time"))
+    _checks.mapping(kappa0, "kappa0")
+    check.number(target, "target", positive=True)
     rel = float(pt["kappa_err"] / pt["kappa"])
     ot = float(pt["orbit_time"])
     k0 = kappa0.get(E, (math.nan, math.nan))
@@ -334,6 +403,8 @@ def hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head):
     """Debiased Hellinger distance between point sets P and Q over box sizes
     (:func:`~hhscatter.analysis.geometry.distance.distance_vs_scale`): (table with hellinger_debiased, lo, hi;
     index of the box nearest ``head``)."""
+    check.count(n_splits, "n_splits", 1)
+    check.number(head, "head", positive=True)
     tab = dist.distance_vs_scale(P, Q, boxes, extent, n_splits=n_splits, seed=seed)
     d, lo, hi = dist.debiased_distance(tab, "hellinger")
     j = int(np.argmin(np.abs(tab["box"].to_numpy() - head)))
@@ -343,6 +414,13 @@ def hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head):
 def disk_density(radius, extent, box, ids, n_cells, top_bin, n_grid=600):
     """A density uniform in the disk r < ``radius`` on the section, on the (box × energy bin) states ``ids``
     (id = bin·n_cells + box) of the top energy bin: (n0 normalised, share of the disk on no state)."""
+    check.number(radius, "radius", positive=True)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    check.numbers(ids, "ids", minimum=0)
+    _checks.whole(n_cells, "n_cells")
+    _checks.whole(top_bin, "top_bin", 0)
+    _checks.whole(n_grid, "n_grid")
     g = (np.arange(n_grid) + 0.5) / n_grid * 2 * radius - radius
     X, Y = np.meshgrid(g, g)
     inside = np.hypot(X, Y) < radius
@@ -357,6 +435,8 @@ def disk_density(radius, extent, box, ids, n_cells, top_bin, n_grid=600):
 def operator_survival(tr, t, n0, dt, steps, k_star, max_lag):
     """The time-binned operator from the initial density ``n0``: (P(t) on steps+1 times, the image points of the
     first crossing after step ``k_star`` with their weights (x, y, energy, w > 0))."""
+    tf._transitions(tr)
+    _transition_table(t, tr)
     K, H, L = tf.lag_kernels(tr, t["t_end"].to_numpy(), dt, max_lag=max_lag)
     cross = tf.propagate(n0, K, L, steps)
     wfc = tf.first_crossing_weights(cross, tr, dt, k_star)
@@ -373,6 +453,15 @@ def stratified_section_points(model, energy, extent, box, k, r_esc, rng, *, e_wi
     [E − e_width/2, E + e_width/2]) and w, the flux density |ṗ_r|/v of the return map's invariant measure
     (:func:`~hhscatter.analysis.geometry.transfer.section_flux_density`).
     """
+    if not callable(getattr(model, "potential", None)):
+        raise ConfigError(f"model must be a system with a potential V(x, y), got {type(model).__name__}")
+    check.number(energy, "energy")
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    _checks.whole(k, "k")
+    check.number(r_esc, "r_esc", positive=True)
+    _checks.generator(rng)
+    check.number(e_width, "e_width", minimum=0.0)
     nx, ny = grid_shape(extent, box)
     x0, _, y0, _ = extent
     sub = (np.arange(k) + 0.0) / k
@@ -399,6 +488,11 @@ def stratified_section_points(model, energy, extent, box, k, r_esc, rng, *, e_wi
 def reduced_survival(tr, t, ids, n_cells, n_bins, dt, max_lag, steps):
     """P(t) of the operator on ρ(E) alone (:func:`reduced_operator`), started in the top energy bin, on
     steps+1 times of step ``dt``; and the per-bin κ_a."""
+    tf._transitions(tr)
+    _transition_table(t, tr)
+    _state_ids(ids, tr)
+    _checks.whole(n_cells, "n_cells")
+    _checks.whole(n_bins, "n_bins")
     tr_red, kappa_bins = reduced_operator(tr, ids, n_cells, n_bins)
     K2, H2, L2 = tf.lag_kernels(tr_red, t["t_end"].to_numpy(), dt, max_lag=max_lag)
     n0r = np.zeros(n_bins)
@@ -411,6 +505,11 @@ def one_return_samples(df, lt, sec, what="run"):
     outcome, t_end) and section crossings ``sec`` (traj_id, t, x, y, energy): ``ret`` (crossed again), ``T``
     (time of the crossing), ``t_end`` (time of the next event), ``x1, y1, e1`` (the crossing), ``censored``.
     ValueError (naming ``what``) if the run does not match the samples."""
+    check.table(df, "df", min_rows=0)
+    check.table(lt, "lt", ("outcome", "t_end"), min_rows=0)
+    check.table(sec, "sec", ("traj_id", "t", "x", "y", "energy"), min_rows=0)
+    if not isinstance(what, str):
+        raise ConfigError(f"what must be a name (a string), got {what!r}")
     if len(lt) != len(df):
         raise ConfigError(f"{what}: {len(lt)} orbits in the run, {len(df)} samples: re-run `simulate`")
     out = df.reset_index(drop=True).copy()
@@ -436,6 +535,16 @@ def eigenvector_convergence(tab, extent, box, coarsen, subsets, Q, boxes, n_spli
     """The debiased Hellinger distance (at the box nearest ``head``) between the operator's sprinkler measure and
     the reference points ``Q``, for boxes merged c × c and the first M' samples per finest box: records
     {box, samples_per_box, kappa, eps, hellinger_debiased, lo, hi}."""
+    _sample_table(tab, "tab")
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    _checks.wholes(coarsen, "coarsen")
+    _checks.wholes(subsets, "subsets")
+    _checks.points(Q, "Q")
+    check.numbers(boxes, "boxes", positive=True)
+    check.count(n_splits, "n_splits", 1)
+    check.count(seed, "seed", 0)
+    check.number(head, "head", positive=True)
     out = []
     for c in coarsen:
         for m in subsets:
@@ -461,6 +570,9 @@ def eigenvector_convergence(tab, extent, box, coarsen, subsets, Q, boxes, n_spli
 def hellinger_row(tab, j):
     """The record of a :func:`hellinger_by_box` table at its row ``j``: box, hellinger_debiased (lo, hi),
     hellinger_pq, hellinger_noise and the debiased agreement scale at 0.1."""
+    check.table(tab, "tab", ("box", "hellinger_debiased", "lo", "hi", "hellinger_pq", "hellinger_noise"))
+    if _checks.whole(j, "j", 0) >= len(tab):
+        raise ConfigError(f"j must be a row of tab (< {len(tab)}), got {j!r}")
     return {
         "box": float(tab["box"].iloc[j]),
         "hellinger_debiased": float(tab.hellinger_debiased.iloc[j]),
@@ -476,6 +588,11 @@ def islands_record(trapped_cells, tr, ids, keep, sub):
     """Mixed phase space: the finest boxes ``trapped_cells`` (a KAM probe still inside) against the operator on
     the states ``ids`` of ``tr`` (saddle class ``keep``, ``sub``): their number, their share of the saddle's
     class, the leading modes' mass on them (:func:`leading_modes`) and κ without them."""
+    tf._transitions(tr)
+    tf._transitions(sub, "sub")
+    _state_ids(ids, tr)
+    check.mask(keep, "keep", tr.n_states)
+    check.numbers(trapped_cells, "trapped_cells", min_size=0, minimum=0)
     trapped = np.isin(ids, trapped_cells)
     trapped_sub = trapped[keep]
     out = {
@@ -502,6 +619,14 @@ def dissipative_operator(tab, extent, box, edges, *, dt, t_horizon, t_star, max_
     t, n_cells, lost (share of the disk on no state), max_lag, steps, grid (times), P, P_reduced,
     kappa_bins, pred}.
     """
+    _sample_table(tab, "tab", True)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    check.numbers(edges, "edges", min_size=2)
+    check.number(dt, "dt", positive=True)
+    for name, v in (("t_horizon", t_horizon), ("t_star", t_star), ("max_return_time", max_return_time)):
+        check.number(v, name, positive=True)
+    check.number(radius, "radius", positive=True)
     n_bins = len(edges) - 1
     steps, k_star, max_lag = (int(round(v / dt)) for v in (t_horizon, t_star, max_return_time))
     tr, ids, t = sample_transitions(tab, extent, box, ebins=edges)
@@ -531,6 +656,10 @@ def t_star_distance(pred, sim_points, boxes, extent, n_splits, seed, head):
     """Debiased Hellinger distance over box sizes (:func:`hellinger_by_box`) between the operator's points of
     the first crossing after t* (``pred``: x, y, w; drawn by weight, as many as ``sim_points``, seeded by
     seed + 9) and the simulated ones (an (n, 2) array): (table, index of the box nearest ``head``)."""
+    check.table(pred, "pred", ("x", "y", "w"))
+    if not np.sum(pred["w"]) > 0:
+        raise ConfigError("pred: the weights w must not all be 0")
+    _checks.points(sim_points, "sim_points")
     rng = np.random.default_rng(seed + 9)
     draw = pred.iloc[rng.choice(len(pred), size=max(len(sim_points), 4), p=pred["w"] / pred["w"].sum())]
     return hellinger_by_box(draw[["x", "y"]].to_numpy(), sim_points, boxes, extent, n_splits, seed, head)
@@ -542,6 +671,16 @@ def dissipative_record(op, edges, P_sim, N, sim_pts, sim_orbit_time, dtab, j, *,
     crossings after t* ``sim_pts`` with x, y, energy, its orbit-time): :func:`survival_agreement`,
     :func:`t_star_energies` and the t* distance table ``dtab`` at row ``j`` (:func:`t_star_distance`), with
     (energy, gamma) of the ensemble, the step ``dt`` and ``t_star``."""
+    _checks.mapping(op, "op", ("grid", "P", "P_reduced", "pred", "tr", "lost", "kappa_bins", "steps"))
+    check.numbers(edges, "edges", min_size=2)
+    check.numbers(P_sim, "P_sim", minimum=0.0)
+    _checks.whole(N, "N")
+    check.table(sim_pts, "sim_pts", ("energy",), min_rows=0)
+    check.number(sim_orbit_time, "sim_orbit_time", minimum=0.0)
+    check.table(dtab, "dtab")
+    _checks.whole(j, "j", 0)
+    for name, v in (("energy", energy), ("gamma", gamma), ("dt", dt), ("t_star", t_star)):
+        check.number(v, name)
     return {
         "energy": energy,
         "gamma": gamma,

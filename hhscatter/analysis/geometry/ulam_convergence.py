@@ -22,8 +22,10 @@ import math
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry import transfer as tf
-from hhscatter.analysis.geometry.ulam import saddle_kappa, sample_transitions
+from hhscatter.analysis.geometry.ulam import _sample_table, saddle_kappa, sample_transitions
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
 from hhscatter.errors import ConfigError
@@ -40,6 +42,20 @@ __all__ = [
 ]
 
 
+def _grid_table(grid, name: str, more=()):
+    return check.table(grid, name, ("box", "samples", "kappa") + tuple(more), min_rows=0)
+
+
+def _reference(ref, name: str):
+    """``ref`` is None or (value, err), two numbers (NaN allowed: not measured)."""
+    if ref is None:
+        return
+    if isinstance(ref, (str, bytes, dict)) or not hasattr(ref, "__len__") or len(ref) != 2:
+        raise ConfigError(f"{name} must be (value, err) or None, got {ref!r}")
+    if any(isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) for v in ref):
+        raise ConfigError(f"{name} must be (value, err), two numbers (NaN: not measured), got {ref!r}")
+
+
 def kappa_record(E, res, samples, box, kappa0=None, kappa_cm=None):
     """The record of κ at one energy from the results ``res`` of the finest partition.
 
@@ -49,6 +65,12 @@ def kappa_record(E, res, samples, box, kappa0=None, kappa_cm=None):
     the P(t) route) and ``kappa_cm`` (κ from long-run crossings), each (value, err) or None, are recorded as
     fig2_kappa, fig2_err, fig2_kappa_cm, fig2_kappa_cm_err, with z_vs_fig2 against κ0 (both errors).
     """
+    check.number(E, "E")
+    _checks.mapping(res, "res", ("rows", "boot", "kappa", "kappa_map", "info", "sub", "cost"))
+    _checks.whole(samples, "samples")
+    check.number(box, "box", positive=True)
+    _reference(kappa0, "kappa0")
+    _reference(kappa_cm, "kappa_cm")
     rows = pd.DataFrame([r for r in res["rows"] if r["vary"] == "box"]).sort_values("box")
     fit = rows.head(3)
     slope, k_inf = (
@@ -123,6 +145,11 @@ def kappa_convergence(
     >>> round(kappa_convergence(g)["kappa_inf"], 10)
     0.2
     """
+    _grid_table(grid, "grid")
+    if boot_grid is not None:
+        _grid_table(boot_grid, "boot_grid", ("rep",))
+    check.number(p_main, "p_main", positive=True)
+    check.number(p_alt, "p_alt", positive=True)
     g = grid.dropna(subset=["kappa"])
     if len(g) < 4 or g["box"].nunique() < 2 or g["samples"].nunique() < 2:
         raise ConfigError("kappa_convergence: need ≥ 4 partitions with ≥ 2 box sides and ≥ 2 sample counts")
@@ -165,6 +192,11 @@ def residuals(value, err, ref, ref_err) -> dict:
     >>> round(r["residual"], 6), round(r["residual_err"], 6), round(r["z"], 6)
     (0.02, 0.050642, 0.4)
     """
+    check.number(value, "value")
+    check.number(err, "err", minimum=0.0)
+    if check.number(ref, "ref") == 0:
+        raise ConfigError("ref must not be 0 (the residual is κ/κ_ref − 1)")
+    check.number(ref_err, "ref_err", minimum=0.0)
     value, err, ref, ref_err = (float(v) for v in (value, err, ref, ref_err))
     res = value / ref - 1.0
     res_err = (Measured(value, err) / Measured(ref, ref_err)).err  # the error of r = κ/κ_ref
@@ -178,6 +210,14 @@ def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
     (keys residual_<name>, residual_<name>_err, z_<name> and verdict_<name>, the one verdict rule of
     :func:`hhscatter.analysis.stats.verdicts.verdict`). A grid too small for the fit gives kappa_inf None and the
     reason in ``note``."""
+    check.number(E, "E")
+    _grid_table(grid, "grid")
+    if boot_grid is not None:
+        _grid_table(boot_grid, "boot_grid", ("rep",))
+    check.number(kappa_finest, "kappa_finest")
+    _checks.mapping(refs, "refs")
+    for name, ref in refs.items():
+        _reference(ref, f"refs[{name!r}]")
     rec = {"energy": float(E), "kappa_finest": float(kappa_finest)}
     try:
         c = kappa_convergence(grid, boot_grid)
@@ -214,6 +254,13 @@ def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
     (:func:`kappa_convergence`). Returns (grid: box, samples, kappa; replicates: rep, box, samples, kappa —
     NaN where a replicate leaves no open class).
     """
+    _sample_table(tab, "tab")
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    _checks.wholes(coarsen, "coarsen")
+    _checks.wholes(subsets, "subsets")
+    _checks.whole(samples, "samples")
+    _checks.whole(n_boot, "n_boot", 0)
     parts = [(int(c), int(m)) for c in coarsen for m in subsets]
     trs = {(c, m): sample_transitions(tab, extent, box, c=c, m_max=None if m == samples else m)[0] for c, m in parts}
     grid = pd.DataFrame([{"box": box * c, "samples": m * c * c, "kappa": saddle_kappa(trs[c, m])[0]} for c, m in parts])
@@ -245,6 +292,11 @@ def convergence_summary(records, *, z_agree: float = 2.0) -> dict:
     >>> convergence_summary(recs)["kappa0"]["agree"]
     [0.3]
     """
+    if isinstance(records, (str, bytes)) or not isinstance(records, (list, tuple)):
+        raise ConfigError(f"records must be a list of records (mappings), got {type(records).__name__}")
+    for r in records:
+        _checks.mapping(r, "records", ("energy",))
+    check.number(z_agree, "z_agree", positive=True)
     out, words = {}, []
     names = {"kappa0": "fig2's κ0 from P(t)", "kappa_cm": "fig2's κ from long-run crossings"}
     for ref, label in names.items():
@@ -291,6 +343,16 @@ def energy_results(tab, extent, box, coarsen, subsets, samples, n_boot, n_boot_g
     >>> bool(abs(res["kappa"] - math.log(4 / 3) / 2) < 1e-9), len(res["rows"]), len(res["grid"])
     (True, 4, 4)
     """
+    _sample_table(tab, "tab", t_end=True)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    _checks.wholes(coarsen, "coarsen")
+    _checks.wholes(subsets, "subsets")
+    _checks.whole(samples, "samples")
+    _checks.whole(n_boot, "n_boot", 0)
+    _checks.whole(n_boot_grid, "n_boot_grid", 0)
+    check.count(seed, "seed", 0)
+    check.number(energy, "energy")
     rows = []
     for c in coarsen:
         tr, _, _ = sample_transitions(tab, extent, box, c=int(c))
@@ -361,6 +423,8 @@ def measure_on_cut_boxes(res, samples: int) -> dict:
     >>> r["cut_share"], round(r["cut_nu"], 6), r["cut_top_weight"], r["full_top_weight"]
     (0.0625, 0.0625, 0.25, 0.0625)
     """
+    _checks.mapping(res, "res", ("tab", "keep", "ids", "tr", "kappa"))
+    _checks.whole(samples, "samples")
     tab, keep, ids = res["tab"], np.asarray(res["keep"], dtype=bool), np.asarray(res["ids"])
     count = tab.groupby("cell").size().reindex(ids, fill_value=0).to_numpy()
     cut = count < int(samples)

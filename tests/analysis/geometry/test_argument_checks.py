@@ -20,6 +20,8 @@ from hhscatter.analysis.geometry import (
     paired_distance,
     regularity,
     transfer,
+    ulam,
+    ulam_convergence,
     uncertainty,
 )
 from hhscatter.errors import ConfigError
@@ -274,7 +276,7 @@ WRONG = [
     ("spectral_radius", "A", "x"),
     ("map_escape_rate", "tr", None),
     ("true_time_kappa", "xtol", math.nan),
-    ("bootstrap_kappa", "n_boot", 0),
+    ("bootstrap_kappa", "n_boot", -1),
     ("communicating_classes", "tr", np.array([])),
     ("saddle_class", "tr", "x"),
     ("saddle_measure", "keep", [True, True]),
@@ -331,3 +333,109 @@ def test_transitions_without_a_return_have_no_finite_kappa():
     every_one_escapes = transfer.Transitions(src=[0, 1], dst=[-1, -1], T=[1.0, 1.0], n_states=2)
     with pytest.raises(ConfigError, match="κ is not finite"):
         transfer.true_time_kappa(every_one_escapes)
+
+
+# -- Ulam's method: the one-return samples of the module's examples (16 boxes, κ = ln(4/3)/2) ----------------
+def _samples() -> pd.DataFrame:
+    cell, rank = np.repeat(np.arange(16), 16), np.tile(np.arange(16), 16)
+    nxt = np.where(rank % 4 == 1, cell, (cell + 1) % 16)
+    return pd.DataFrame({"cell": cell, "rank": rank, "w": 1.0, "censored": False, "ret": rank % 4 > 0, "T": 2.0,
+                         "t_end": 2.0, "x1": -0.75 + 0.5 * (nxt % 4), "y1": -0.75 + 0.5 * (nxt // 4), "e1": 0.3})  # fmt: skip
+
+
+SAMPLES = _samples()
+ULAM = dict(tab=SAMPLES, extent=(-1, 1, -1, 1), box=0.5)
+RES = ulam_convergence.energy_results(SAMPLES, (-1, 1, -1, 1), 0.5, [1, 2], [4, 16], 16, 3, 2, 1, 0.3)
+
+ULAM_VALID = {
+    "grid_shape": (ulam.grid_shape, {"extent": (-1, 1, -1, 1), "box": 0.5}),
+    "coarse_index": (ulam.coarse_index, {"cell": np.array([0, 1, 4]), "nx": 4, "c": 2}),
+    "sample_transitions": (ulam.sample_transitions, ULAM),
+    "saddle_kappa": (ulam.saddle_kappa, {"tr": RES["tr"]}),
+    "measure_points": (ulam.measure_points, {"res": RES, "kind": "flux", "n": 5, "rng": np.random.default_rng(0)}),
+    "empirical_survival": (ulam.empirical_survival, {"t_end": [1.0, 2.0], "leaving": [True, False], "grid": [1.5]}),
+    "hellinger_row": (
+        ulam.hellinger_row,
+        {"tab": ulam.hellinger_by_box(PTS, PTS[::-2], [0.5], None, 3, 0, 0.5)[0], "j": 0},
+    ),  # fmt: skip
+    "energy_results": (
+        ulam_convergence.energy_results,
+        {
+            **ULAM,
+            "coarsen": [1],
+            "subsets": [16],
+            "samples": 16,
+            "n_boot": 2,
+            "n_boot_grid": 0,
+            "seed": 1,
+            "energy": 0.3,
+        },
+    ),  # fmt: skip
+    "measure_on_cut_boxes": (ulam_convergence.measure_on_cut_boxes, {"res": RES, "samples": 16}),
+    "kappa_record": (ulam_convergence.kappa_record, {"E": 0.3, "res": RES, "samples": 16, "box": 0.5}),
+    "residuals": (ulam_convergence.residuals, {"value": 0.102, "err": 0.003, "ref": 0.1, "ref_err": 0.004}),
+    "convergence_summary": (
+        ulam_convergence.convergence_summary,
+        {"records": [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]},
+    ),
+    "convergence_record": (
+        ulam_convergence.convergence_record,
+        {"E": 0.3, "grid": RES["grid"], "boot_grid": None, "kappa_finest": 0.14, "refs": {"kappa0": (0.14, 0.01)}},
+    ),
+}
+
+ULAM_WRONG = [
+    ("grid_shape", "extent", "x"),
+    ("grid_shape", "box", -0.5),
+    ("coarse_index", "cell", [0.5]),
+    ("coarse_index", "nx", 0),
+    ("coarse_index", "c", None),
+    ("sample_transitions", "tab", SAMPLES.drop(columns="ret")),
+    ("sample_transitions", "c", 0),
+    ("sample_transitions", "m_max", "x"),
+    ("saddle_kappa", "tr", {"a": 1}),
+    ("measure_points", "res", {"t": 1}),
+    ("measure_points", "kind", "l2"),
+    ("measure_points", "n", 0),
+    ("measure_points", "rng", 0),
+    ("empirical_survival", "t_end", []),
+    ("empirical_survival", "leaving", [True]),
+    ("empirical_survival", "grid", [math.nan]),
+    ("hellinger_row", "tab", SAMPLES),
+    ("hellinger_row", "j", 5),
+    ("energy_results", "tab", SAMPLES.drop(columns="t_end")),
+    ("energy_results", "coarsen", []),
+    ("energy_results", "subsets", [0]),
+    ("energy_results", "n_boot", -1),
+    ("energy_results", "energy", "x"),
+    ("measure_on_cut_boxes", "res", None),
+    ("measure_on_cut_boxes", "samples", 0.5),
+    ("kappa_record", "res", {"rows": []}),
+    ("kappa_record", "kappa0", (0.1,)),
+    ("kappa_record", "box", 0.0),
+    ("residuals", "ref", 0.0),
+    ("residuals", "err", -1.0),
+    ("residuals", "value", "x"),
+    ("convergence_summary", "records", "x"),
+    ("convergence_summary", "records", [{"kappa_inf": 0.2}]),
+    ("convergence_summary", "z_agree", 0.0),
+    ("convergence_record", "grid", None),
+    ("convergence_record", "refs", [0.14]),
+    ("convergence_record", "refs", {"kappa0": "x"}),
+    ("convergence_record", "kappa_finest", math.nan),
+]
+
+
+@pytest.mark.parametrize("name", sorted(ULAM_VALID))
+def test_the_valid_call_of_ulams_method_runs(name):
+    f, kwargs = ULAM_VALID[name]
+    assert f(**kwargs) is not None
+
+
+@pytest.mark.parametrize(
+    ("name", "arg", "bad"), ULAM_WRONG, ids=[f"{n}-{a}-{i}" for i, (n, a, _) in enumerate(ULAM_WRONG)]
+)
+def test_a_wrong_argument_of_ulams_method_is_refused_naming_it(name, arg, bad):
+    f, kwargs = ULAM_VALID[name]
+    with pytest.raises(ConfigError, match=arg):
+        f(**{**kwargs, arg: bad})
