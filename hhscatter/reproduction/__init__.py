@@ -11,6 +11,8 @@ report; imports ``model`` and ``analysis`` only.
 * ``fig3`` — μ on the paper's and other windows, the inset's histograms, μ in the authors' conventions;
 * ``transition_tables``, ``model_tables``, ``model_verdicts`` — τ1, τ2 and the survival models' tables and verdicts;
 * ``basin_summary`` — the records of a basin study: outcome codes, per-point records, trends, cut-off records;
+* ``saddle_records`` — the records of a chaotic-saddle study: d₁'s error parts and range, d₀ beside d₁, the rows
+  and summaries of the Kantz–Grassberger relation and of the dimensions;
 * ``cmeasure_comparison``, ``cmeasure_verdicts`` — section points against the conservative c-measure (Fig. 5);
 * ``operator_cmeasure``, ``operator_records`` — the transfer operator's measures against sprinkler points of the
   c-measure, its κ beside the escape rate of P(t) and its dissipative survival beside a simulated one;

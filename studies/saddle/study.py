@@ -38,6 +38,7 @@ import numpy as np
 
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
+from hhscatter.reproduction import saddle_records as sr
 from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, figure_stage
@@ -51,6 +52,7 @@ class SystemEntry(StudyParams):
     params: dict[str, Number] = None  # the built-in's defaults where absent
     ratios: Numbers  # E/E_c of the points
     t_max: Number = None  # the system's own t_max ([study] t_max where absent)
+    tmin_efolds: Number = None  # the system's own t_min·κ ([study] tmin_efolds where absent)
 
 
 class Params(StudyParams):
@@ -86,6 +88,18 @@ def _systems(study):
         t_max = float(e.get("t_max") or study.params.t_max)
         out.append((e["label"], spec, system_from_spec(spec), [float(r) for r in e["ratios"]], t_max))
     return out
+
+
+def _tmin_efolds(study, label: str) -> float:
+    """t_min·κ of the system ``label``: its own ``tmin_efolds``, else [study] tmin_efolds."""
+    e = next(e for e in study.params.systems if e["label"] == label)
+    return float(e.get("tmin_efolds") or study.params.tmin_efolds)
+
+
+def _tmin_overrides(study) -> dict:
+    """{"tmin_efolds_by_system": {label: t_min·κ}} of the systems with their own tmin_efolds, else {}."""
+    own = {e["label"]: float(e["tmin_efolds"]) for e in study.params.systems if e.get("tmin_efolds")}
+    return {"tmin_efolds_by_system": own} if own else {}
 
 
 def _d0_eps(study):
@@ -156,7 +170,7 @@ def simulate(study, workers=None, progress=True):
             )
             study.run(key, sc, workers=workers, progress=progress)
             k = _kappa(study.raw(key))
-            t_min = p.tmin_efolds / k.kappa
+            t_min = _tmin_efolds(study, label) / k.kappa
             lt = read_lifetimes(study.raw(key), columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
             sel = _long_lived(lt, t_min)
             print(f"  saddle {key}: κ = {k.kappa:.4f} ± {k.kappa_err:.4f}, t_min = {t_min:.1f}, {len(sel)} orbits")
@@ -252,42 +266,6 @@ def _d1_resolution(sp, lam):
     return extent, extent * math.exp(-lam * sp.window[0] * sp.t_min)
 
 
-ERR_PARTS = {"fit": "err_fit", "resample": "err_resample", "range": "err_range"}
-
-
-def _d1_error_record(d, extent, eps_min) -> dict:
-    """The record's keys of d₁'s error: its three parts (section units), the largest, the scaling range in units
-    of the points' extent and what ends it below (``resolution``: the points' distance to the saddle, eps_min;
-    ``points``: the nearest neighbours' distance, the number of points)."""
-    parts = {k: float(getattr(d, a)) for k, a in ERR_PARTS.items()}
-    floor = "resolution" if bool(np.any(d.table["eps"].to_numpy() < eps_min)) else "points"
-    lo, hi = d.eps_range
-    return {"d1_section_err_parts": parts, "d1_err_largest": max(parts, key=lambda k: parts[k] if math.isfinite(parts[k]) else -1.0),
-            "d1_eps_range_extent": [lo / extent, hi / extent], "d1_eps_min_extent": eps_min / extent,
-            "d1_range_floor": floor, "d1_rel_err": d.err / d.value if d.value else math.nan}  # fmt: skip
-
-
-def _d1_precision(records, target: float = 0.03) -> dict:
-    """How many points have d₁ to ≤ ``target`` (relative 1σ), which part of its error is the largest and what ends
-    the scaling range below; its statement."""
-    with_d1 = [r for r in records if r.get("d1_rel_err") is not None]
-    ok = [r for r in with_d1 if r["d1_rel_err"] <= target]
-    largest = {k: sum(r["d1_err_largest"] == k for r in with_d1) for k in ERR_PARTS}
-    floor = {k: sum(r["d1_range_floor"] == k for r in with_d1) for k in ("resolution", "points")}
-    decades = [math.log10(r["d1_eps_range_extent"][1] / r["d1_eps_range_extent"][0]) for r in with_d1]
-    names = {"fit": "the fit's residuals (lacunarity)", "resample": "the bootstrap over orbits",
-             "range": "the range part (the slope changes across the scaling range)"}  # fmt: skip
-    parts = "; ".join(f"{names[k]} at {v}" for k, v in largest.items() if v)
-    span = f"{min(decades):.1f}–{max(decades):.1f}" if decades else "no"
-    statement = (f"d₁ to ≤ {100 * target:.0f} % (1σ) at {len(ok)} of the {len(with_d1)} points with d₁"
-                 + (f" ({', '.join(r['id'] for r in ok)})" if ok else "")
-                 + f"; the largest part of its error: {parts}; the scaling ranges span {span} decades of ε, ended "
-                 f"below by the points' distance to the saddle at {floor['resolution']} points and by the "
-                 f"nearest neighbours' distance (the number of points) at {floor['points']}")  # fmt: skip
-    return {"target": target, "n_with_d1": len(with_d1), "n_within": len(ok), "largest_part": largest,
-            "range_floor": floor, "statement": statement}  # fmt: skip
-
-
 def _d1_estimator(p, lam):
     """The section's information dimension of a SaddlePoints, eps_min from the points' distance to the saddle."""
     from hhscatter.analysis.geometry.saddle import information_dimension_neighbours
@@ -337,48 +315,6 @@ def _d0(study, key):
             "d0_fit_dof": u.dof, "d0_fit_p": u.p_value}  # fmt: skip
 
 
-def _with_d0(rec, d0):
-    """The record with the d₀ keys of :func:`_d0` and, where both are measured, d₀ ≥ d₁ − 2σ."""
-    from hhscatter.analysis.geometry.saddle import dimension_order
-
-    note = d0.pop("note", None)
-    if note:
-        rec["notes"].append(note)
-    rec.update(d0)
-    if rec.get("d0") is not None and rec.get("d1") is not None:
-        o = dimension_order(rec["d0"], rec["d0_err"], rec["d1"], rec["d1_err"])
-        rec["d0_ge_d1"] = {"z": o.z, "holds": o.holds, "verdict": o.verdict}
-    return rec
-
-
-def _dimension_row(rec: dict) -> dict:
-    """A record's d₀ and d₁ (partial, along the unstable direction) with the scaling range of d₀ and the check."""
-    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
-    for name in ("d0", "d1", "d0_section", "d1_section"):
-        if rec.get(name) is not None:
-            row[name], row[name + "_err"] = rec[name], rec[name + "_err"]
-    if rec.get("d0_eps_range") is not None:
-        lo, hi = rec["d0_eps_range"]
-        row["d0_eps_range"] = f"{lo:.0e} – {hi:.0e} ({rec['d0_n_eps']} ε)"
-        row["d0_fit_p"] = rec["d0_fit_p"]
-    chk = rec.get("d0_ge_d1")
-    row["check"] = chk["verdict"] if chk else ("no d₁" if rec.get("d0") is not None else "no d₀")
-    return row
-
-
-def _dimension_summary(records) -> dict:
-    """How many points have d₀, how many both dimensions, and where d₀ ≥ d₁ − 2σ holds; its statement."""
-    both = [r for r in records if r.get("d0_ge_d1")]
-    held = [r for r in both if r["d0_ge_d1"]["holds"]]
-    failed = ", ".join(r["id"] for r in both if not r["d0_ge_d1"]["holds"])
-    n_d0 = sum(r.get("d0") is not None for r in records)
-    statement = (f"d₀ measured at {n_d0} of {len(records)} points; d₀ ≥ d₁ − 2σ (both partial, errors in "
-                 f"quadrature) holds at {len(held)} of the {len(both)} with both dimensions"
-                 + (f"; it fails at {failed}" if failed else ""))  # fmt: skip
-    return {"n_points": len(records), "n_d0": n_d0, "n_both": len(both), "n_holds": len(held),
-            "statement": statement}  # fmt: skip
-
-
 def _basins_cutoff(study, records) -> dict:
     """The basins' cut-off re-predicted with λ̄ of the ``basins_system`` points: the JSON keys rate_table,
     cutoff_saddle, cutoff_saddle_summary and lambda_tangent (with the sources)."""
@@ -419,7 +355,8 @@ def _point(study, key, ch):
 
     p = study.params
     k = _kappa(study.raw(key))
-    t_min = p.tmin_efolds / k.kappa
+    efolds = _tmin_efolds(study, ch["system"])
+    t_min = efolds / k.kappa
     rec = {"id": f"{ch['system']}-{ch['ratio']:.2f}", "system": ch["system"], "ratio": ch["ratio"], "energy": ch["energy"], "kappa": k.kappa,
            "kappa_err": k.kappa_err, "lyapunov": None, "lyapunov_err": None, "d0": None, "d0_err": None,
            "d1": None, "d1_err": None, "t_min": t_min, "notes": []}  # fmt: skip
@@ -437,7 +374,7 @@ def _point(study, key, ch):
     lt = _lifetimes(study.raw(key))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
     est = _d1_estimator(p, lam["value"])
-    wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in (*p.tmin_checks, p.tmin_efolds)],
+    wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in (*p.tmin_checks, efolds)],
                            windows=[tuple(p.window)], columns=["x", "y"])  # fmt: skip
     rec["d1_by_t_min"] = [
         {
@@ -447,7 +384,7 @@ def _point(study, key, ch):
             "d1_section": None if math.isnan(r.value) else Measured.of(r.value, r.err, n=int(r.n_orbits)).to_dict(),
             "note": r.note,
         }  # fmt: skip
-        for c, r in zip((*p.tmin_checks, p.tmin_efolds), wd.itertuples())
+        for c, r in zip((*p.tmin_checks, efolds), wd.itertuples())
     ]
     try:
         sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y"])
@@ -464,23 +401,9 @@ def _point(study, key, ch):
                 "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points,
                 "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
-    rec.update(_d1_error_record(d, *_d1_resolution(sp, lam["value"])))
+    rec.update(sr.d1_error_record(d, *_d1_resolution(sp, lam["value"])))
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
-
-
-def _relation_row(rec: dict) -> dict:
-    """A record's measured values as {value, err} pairs (rendered ``value ± err``), the ones it has."""
-    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"], "energy": rec["energy"]}
-    for name, err in (("kappa", "kappa_err"), ("lyapunov", "lyapunov_err"), ("d1_section", "d1_section_err"),
-                      ("d1", "d1_err"), ("predicted", "predicted_err"), ("d1_implied", "d1_implied_err")):  # fmt: skip
-        if rec.get(name) is not None and rec.get(err) is not None:
-            row[name] = Measured(rec[name], rec[err]).to_dict()
-    if rec.get("d1_implied") is not None:
-        row["d1_section_implied"] = Measured(rec["d1_implied"], rec["d1_implied_err"]).scaled(2).to_dict()
-    if rec.get("verdict") is not None:
-        row["z"], row["verdict"] = rec["z"], rec["verdict"]
-    return row
 
 
 def analyze(study):
@@ -499,7 +422,7 @@ def analyze(study):
         for r in ratios:
             key = point_key(label, r)
             rec, ftle = _point(study, key, choices[key])
-            records.append(_with_d0(rec, _d0(study, key)))
+            records.append(sr.with_d0(rec, _d0(study, key)))
             if ftle is not None:
                 ftles.append(ftle[["traj_id", "t_end", "ftle"]].assign(system=label, ratio=r))
     cols = ["traj_id", "t_end", "ftle", "system", "ratio"]
@@ -508,25 +431,19 @@ def analyze(study):
         FTLE_TABLE,
         description="finite-time Lyapunov exponents Λ/t_end of the tangent runs (orbits left at t_end ≥ t_min)",
     )
-    checked = [x for x in records if x.get("z") is not None]
-    relation = [_relation_row(x) for x in records]
-    dims = _dimension_summary(records)
     basins = _basins_cutoff(study, records)
     study.write_numbers(
         {
             "saddle": records,
-            "relation": relation,
-            "summary": {
-                "n_points": len(records),
-                "n_checked": len(checked),
-                "n_within_2sigma": sum(abs(x["z"]) <= 2 for x in checked),
-            },
-            "dimensions": [_dimension_row(x) for x in records],
-            "dimensions_summary": dims,
-            "d1_precision": _d1_precision(records),
+            "relation": [sr.relation_row(x) for x in records],
+            "summary": sr.relation_summary(records),
+            "dimensions": [sr.dimension_row(x) for x in records],
+            "dimensions_summary": sr.dimension_summary(records),
+            "d1_precision": sr.d1_precision(records),
             **basins,
             "rules": {
                 "tmin_efolds": study.params.tmin_efolds,
+                **_tmin_overrides(study),
                 "window": list(study.params.window),
                 "tmin_checks": list(study.params.tmin_checks),
                 "n_orbits_per_point": study.params.n,

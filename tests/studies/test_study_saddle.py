@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from study_copy import REPO_STUDIES
 
 KEYS = {"system", "energy", "kappa", "kappa_err", "lyapunov", "lyapunov_err", "d0", "d0_err", "d1", "d1_err"}
 
@@ -178,3 +179,30 @@ def test_the_d1_estimator_covers_the_baker_natural_measure_at_a_quick_scale_samp
         d = est(sp)
         covered += abs(d.value - truth) <= 2 * d.err
     assert covered >= 9, covered
+
+
+def test_a_system_s_own_tmin_efolds_replaces_the_study_s(built):
+    """tiny: [study] tmin_efolds = 3, Barbanis' entry 2: its t_min is 2/κ of its main run, Hénon–Heiles' 3/κ, in the
+    record, in the tangent run's selection and in the d₁ convergence rows."""
+    from hhscatter.data.read import read_lifetimes
+
+    doc = json.loads((built / "saddle.json").read_text())
+    assert doc["rules"]["tmin_efolds"] == 3.0 and doc["rules"]["tmin_efolds_by_system"] == {"barbanis": 2.0}
+    for rid, efolds in (("henon_heiles-1.80", 3.0), ("henon_heiles-2.40", 3.0), ("barbanis-2.60", 2.0)):
+        rec = next(r for r in doc["saddle"] if r["id"] == rid)
+        assert rec["t_min"] * rec["kappa"] == pytest.approx(efolds, rel=1e-12), rid
+        if rec.get("d1_by_t_min"):
+            assert rec["d1_by_t_min"][-1]["t_min_kappa"] == efolds, rid
+    rec = next(r for r in doc["saddle"] if r["id"] == "barbanis-2.60")
+    main = read_lifetimes(built / "raw" / "barbanis_r2.60", columns=["traj_id", "outcome", "t_end"])
+    tan = read_lifetimes(built / "raw" / "barbanis_r2.60_tangent", columns=["traj_id"])
+    long = main[(main["outcome"].astype(str) == "escaped") & (main["t_end"] >= 2.0 / rec["kappa"])]
+    assert len(long) > len(main[(main["outcome"].astype(str) == "escaped") & (main["t_end"] >= 3.0 / rec["kappa"])])
+    assert sorted(tan["traj_id"]) == sorted(long["traj_id"])
+
+
+def test_the_study_module_stays_within_500_lines():
+    """The study orchestrates (runs, estimator calls, writes); the record assembly lives in
+    hhscatter.reproduction.saddle_records, so study.py stays short enough to read."""
+    n = len((REPO_STUDIES / "saddle" / "study.py").read_text().splitlines())
+    assert n <= 500, f"studies/saddle/study.py has {n} lines"
