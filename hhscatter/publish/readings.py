@@ -1107,6 +1107,63 @@ def _operator_tolerance(get: Loader) -> str:
     return "the debiased distance to fig1's c-measure at E = 0.30 (95 % interval) lies " + "; ".join(parts)
 
 
+def _ratios(xs) -> str:
+    return ", ".join(f"{x:g}" for x in xs) + " E_c"
+
+
+def _generality_resc_shift(get: Loader) -> str:
+    """κ0 at the second escape radius against the default, per system and convention, sorted by the rows' verdicts
+    (the verdicts the study wrote by the one rule: "shifts", "no shift resolved", "undetermined")."""
+    d = get("generality", None)
+    conventions = {"plateau": "all orbits", "escaping": "Escaping orbits"}
+    out = []
+    for label in d.get("systems") or {}:
+        parts = []
+        for conv, what in conventions.items():
+            rows = sorted(
+                (r for r in d["resc_kappa"] if r["label"] == label and r["convention"] == conv),
+                key=lambda r: r["e_ratio"],
+            )
+            if not rows:
+                continue
+            shifts = [r for r in rows if str(r["verdict"]).startswith("shifts")]
+            flat = [r["e_ratio"] for r in rows if str(r["verdict"]).startswith("no shift")]
+            none = [r["e_ratio"] for r in rows if r not in shifts and r["e_ratio"] not in flat]
+            words = (
+                [
+                    "shifts at "
+                    + ", ".join(f"{r['e_ratio']:g} E_c ({_ve(r['shift']['value'], r['shift']['err'])})" for r in shifts)
+                ]
+                if shifts
+                else []
+            )
+            words += [f"no shift resolved at {_ratios(flat)}"] if flat else []
+            words += [f"undetermined (κ0 ill-defined at a radius) at {_ratios(none)}"] if none else []
+            parts.append(f"{what}: " + "; ".join(words))
+        r0 = next((r for r in d["resc_kappa"] if r["label"] == label), None)
+        radius = f" (r_esc = {r0['r_esc']:.3g})" if r0 else ""
+        out.append(f"For {label}{radius}, " + ". ".join(parts))
+    return "κ0(1.03 r_s)/κ0(default) − 1 by system and convention. " + ". ".join(out)
+
+
+def _generality_map_coverage(get: Loader) -> str:
+    """The energies and systems the validity map has cells for, and where each cell's κ0 comes from."""
+    d = get("generality", None)
+    cells = d["validity_map"]
+    grid = sorted(set(d["config"]["study"]["ratios"]))
+    out = []
+    for label in d.get("systems") or {}:
+        mine = [c for c in cells if c["label"] == label]
+        have = sorted({c["e_ratio"] for c in mine})
+        missing = [x for x in grid if x not in have]
+        beyond = [x for x in have if x not in grid]
+        text = f"{label} {len(mine)} cells" + (
+            f", the claims' grid without {_ratios(missing)}" if missing else ", the whole claims' grid"
+        )
+        out.append(text + (f" and {_ratios(beyond)} beyond it" if beyond else ""))
+    return f"the map ({d.get('scale')} scale) has " + "; ".join(out)
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1135,6 +1192,8 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.validity": _generality_validity,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
+    "generality.resc_shift": _generality_resc_shift,
+    "generality.map_coverage": _generality_map_coverage,
     "fig2.law_below_break": _fig2_law_below_break,
     "fig5.ours_5b": _fig5_ours_5b,
     "fig5.eps_first": _fig5_eps_first,
