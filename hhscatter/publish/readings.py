@@ -1164,6 +1164,52 @@ def _generality_map_coverage(get: Loader) -> str:
     return f"the map ({d.get('scale')} scale) has " + "; ".join(out)
 
 
+def _resc_other_radii(d: dict) -> dict[str, list[tuple[str, dict]]]:
+    """{energy key: [(radius key, shift), …]} of the κ shifts against the reference radius, the reference left out."""
+    ref = f"r_esc={d['r_ref']:g}"
+    return {e: [(r, row["shift_vs_ref"]) for r, row in rows.items() if r != ref] for e, rows in d["kappa"].items()}
+
+
+def _resc_shifts(get: Loader) -> str:
+    """Per energy: whether the shifts of κ against the reference radius are resolved from zero (2σ) and whether the
+    radii's shifts agree with each other (2σ, their errors in quadrature)."""
+    out = []
+    for e, shifts in _resc_other_radii(get("resc", None)).items():
+        z = [abs(s["value"]) / s["err"] for _, s in shifts]
+        where = e.replace("E=", "E = ")
+        if min(z) >= Z_RESOLVED:
+            words = f"every shift lies {min(z):.1f}–{max(z):.1f}σ from zero"
+        elif max(z) < Z_RESOLVED:
+            words = f"no shift is resolved from zero (|z| ≤ {max(z):.1f})"
+        else:
+            words = f"{sum(x >= Z_RESOLVED for x in z)} of {len(z)} shifts are resolved from zero"
+        pair = max(
+            abs(a["value"] - b["value"]) / math.hypot(a["err"], b["err"])
+            for i, (_, a) in enumerate(shifts)
+            for _, b in shifts[i + 1 :]
+        )
+        same = "the radii's shifts agree within 2σ" if pair <= Z_RESOLVED else "the radii's shifts differ"
+        out.append(f"at {where} {words}, {same} (largest difference {pair:.1f}σ)")
+    return "; ".join(out)
+
+
+def _resc_scale_moves(get: Loader) -> str:
+    """How far the shifts moved from the quick to the paper scale, in units of their quick-scale errors."""
+    quick, paper = _resc_other_radii(get("resc", "quick")), _resc_other_radii(get("resc", "paper"))
+    moves = []
+    for e, shifts in paper.items():
+        q = dict(quick.get(e, []))
+        for r, s in shifts:
+            if r in q and q[r]["err"]:
+                moves.append((abs(s["value"] - q[r]["value"]) / q[r]["err"], e, r, q[r], s))
+    z, e, r, a, b = max(moves, key=lambda m: m[0])
+    where = f"{e.replace('E=', 'E = ')}, {r.replace('r_esc=', 'r_esc = ')}"
+    return (
+        f"the κ shifts moved by at most {z:.1f}σ of their quick-scale errors (the largest at {where}: "
+        f"{_ve(a['value'], a['err'])} → {_ve(b['value'], b['err'])})"
+    )
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1194,6 +1240,8 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.claims_by_system": _generality_claims_by_system,
     "generality.resc_shift": _generality_resc_shift,
     "generality.map_coverage": _generality_map_coverage,
+    "resc.shifts": _resc_shifts,
+    "resc.scale_moves": _resc_scale_moves,
     "fig2.law_below_break": _fig2_law_below_break,
     "fig5.ours_5b": _fig5_ours_5b,
     "fig5.eps_first": _fig5_eps_first,

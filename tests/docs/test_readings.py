@@ -52,6 +52,9 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "κ/α (column `lam_kg` of `energy_scan`) follows\n  the decision rate (`lam`) from 0.19 to 0.375; they part near E_c",
         "the measured rate matches the prediction",
         "the fit overestimates ⟨E⟩ at large t",
+        "At the paper scale every shift at\n      E ≥ 0.30 is several σ from zero and the same for r_esc = 1.1, 1.5 and 2",
+        "The κ shifts with r_esc move by up to about 2σ of their quick errors",
+        "The extrapolation in samples per box removes it within its\nerror",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -682,3 +685,26 @@ def test_the_map_coverage_reading_names_the_grid_energies_without_a_cell():
     doc["validity_map"] = [{"label": "hh", "e_ratio": x} for x in (1.05, 1.5, 1.7, 2.2)]
     text = READINGS["generality.map_coverage"](_loader({"generality": doc}))
     assert text == "the map (paper scale) has hh 4 cells, the whole claims' grid"
+
+
+def test_the_resc_readings_follow_the_shifts_and_their_errors():
+    def shift(v, e):
+        return {"shift_vs_ref": {"value": v, "err": e}}
+
+    ref = shift(0.0, 0.0)
+    paper = {
+        "r_ref": 1.03,
+        "kappa": {
+            "E=0.25": {"r_esc=1.03": ref, "r_esc=1.5": shift(-0.001, 0.001), "r_esc=2": shift(-0.0012, 0.001)},
+            "E=0.30": {"r_esc=1.03": ref, "r_esc=1.5": shift(-0.008, 0.001), "r_esc=2": shift(-0.002, 0.001)},
+        },
+    }
+    quick = copy.deepcopy(paper)
+    quick["kappa"]["E=0.30"]["r_esc=1.5"] = shift(-0.004, 0.002)
+    text = READINGS["resc.shifts"](_loader({"resc": paper}))
+    assert text.startswith("at E = 0.25 no shift is resolved from zero (|z| ≤ 1.2), the radii's shifts agree")
+    assert (
+        "at E = 0.30 every shift lies 2.0–8.0σ from zero, the radii's shifts differ (largest difference 4.2σ)" in text
+    )
+    moves = READINGS["resc.scale_moves"](lambda study, scale: quick if scale == "quick" else paper)
+    assert moves.startswith("the κ shifts moved by at most 2.0σ of their quick-scale errors (the largest at E = 0.30")
