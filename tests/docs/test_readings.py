@@ -140,6 +140,10 @@ def test_the_resc_page_names_the_tools_own_default():
     assert "default_r_esc.current" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
+    # the study's parameters, shown on the page with their comments, do not call it the default either
+    toml = (ROOT / "studies" / "resc" / "study.toml").read_text()
+    r_ref_line = next(line for line in toml.splitlines() if line.startswith("r_ref"))
+    assert "current default" not in r_ref_line and "not the tool's default" in r_ref_line
 
 
 def _beyond_the_paper():
