@@ -1220,7 +1220,7 @@ def evidence_tables(doc) -> str:
     P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
     ts = sorted({r["t"] for r in doc.get("survival_long", [])})
     out.append(
-        "\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ∞: plateau + exponential by "
+        "\n**Long-time escape** (disk ICs, γ = 0; P(t) Kaplan–Meier; P∞, κ_tail: plateau + exponential by "
         "maximum likelihood from t0, censored orbits as censored; κ of the non-regular orbits: one "
         "exponential from t0, p its χ² p-value over cells pooled to ≥ 5 expected orbits; a P of 0 as its "
         "one-sided 95 % upper bound)\n"
@@ -1228,7 +1228,7 @@ def evidence_tables(doc) -> str:
     out.append(
         "| system | E/E_c | "
         + " | ".join(f"P({t:g})" for t in ts)
-        + " | P∞ | κ∞ | regular share of the orbits inside at t_max | κ non-regular | p |"
+        + " | P∞ | κ_tail | regular share of the orbits inside at t_max | κ non-regular | p |"
     )
     out.append("|---|---|" + "---|" * (len(ts) + 5))
     for f in doc["long_time"]:

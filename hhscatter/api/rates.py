@@ -185,7 +185,7 @@ class EscapeRates:
     status : dict
         (energy, gamma) → :class:`~hhscatter.analysis.survival.long_time.RateStatus` of each fitted point:
         'exponential', 'trapped', 'non-exponential', 'too few orbits' (no verdict on one exponential) or 'empty'
-        (no orbit left after τ0), with P∞ and κ∞ of the plateau-plus-exponential fit.
+        (no orbit left after τ0), with P∞ and κ_tail of the plateau-plus-exponential fit.
 
     Examples
     --------

@@ -664,7 +664,9 @@ READING_WORDS = re.compile(
     r"(?:below|above)\s+the|above\s+the\s+paper's|twice\s+as|half\s+as|"
     r"(?:higher|lower|larger|smaller|greater|faster|slower|fewer)\s+than|exceed(?:s|ed|ing)?|better|worse|"
     r"only\s+(?:as|the\s+\S+(?:\s+\S+)?\s+(?:does|do|is|are|holds?))|all\s+within|none\s+(?=\()|"
-    r"(?:in)?consistent(?:ly)?|differs?\s+from|no\s+[\w-]+(?:\s+[\w-]+)?\s+(?:row|point|cell|value)s?\s+differs?)"
+    r"(?:in)?consistent(?:ly)?|differs?\s+from|no\s+[\w-]+(?:\s+[\w-]+)?\s+(?:row|point|cell|value)s?\s+differs?|"
+    r"(?:several|a\s+few|many)\s+σ|σ\s+from\s+zero|by\s+up\s+to(?:\s+about)?\s+\d+(?:\.\d+)?\s*σ|"
+    r"within\s+(?:its|their)\s+errors?|the\s+same\s+for\s+(?:r|E|γ|every|all\s+(?!systems))\S*)"
     r"(?!\w)",
     re.I,
 )

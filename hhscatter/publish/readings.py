@@ -1107,6 +1107,109 @@ def _operator_tolerance(get: Loader) -> str:
     return "the debiased distance to fig1's c-measure at E = 0.30 (95 % interval) lies " + "; ".join(parts)
 
 
+def _ratios(xs) -> str:
+    return ", ".join(f"{x:g}" for x in xs) + " E_c"
+
+
+def _generality_resc_shift(get: Loader) -> str:
+    """κ0 at the second escape radius against the default, per system and convention, sorted by the rows' verdicts
+    (the verdicts the study wrote by the one rule: "shifts", "no shift resolved", "undetermined")."""
+    d = get("generality", None)
+    conventions = {"plateau": "all orbits", "escaping": "Escaping orbits"}
+    out = []
+    for label in d.get("systems") or {}:
+        parts = []
+        for conv, what in conventions.items():
+            rows = sorted(
+                (r for r in d["resc_kappa"] if r["label"] == label and r["convention"] == conv),
+                key=lambda r: r["e_ratio"],
+            )
+            if not rows:
+                continue
+            shifts = [r for r in rows if str(r["verdict"]).startswith("shifts")]
+            flat = [r["e_ratio"] for r in rows if str(r["verdict"]).startswith("no shift")]
+            none = [r["e_ratio"] for r in rows if r not in shifts and r["e_ratio"] not in flat]
+            words = (
+                [
+                    "shifts at "
+                    + ", ".join(f"{r['e_ratio']:g} E_c ({_ve(r['shift']['value'], r['shift']['err'])})" for r in shifts)
+                ]
+                if shifts
+                else []
+            )
+            words += [f"no shift resolved at {_ratios(flat)}"] if flat else []
+            words += [f"undetermined (κ0 ill-defined at a radius) at {_ratios(none)}"] if none else []
+            parts.append(f"{what}: " + "; ".join(words))
+        r0 = next((r for r in d["resc_kappa"] if r["label"] == label), None)
+        radius = f" (r_esc = {r0['r_esc']:.3g})" if r0 else ""
+        out.append(f"For {label}{radius}, " + ". ".join(parts))
+    return "κ0(1.03 r_s)/κ0(default) − 1 by system and convention. " + ". ".join(out)
+
+
+def _generality_map_coverage(get: Loader) -> str:
+    """The energies and systems the validity map has cells for, and where each cell's κ0 comes from."""
+    d = get("generality", None)
+    cells = d["validity_map"]
+    grid = sorted(set(d["config"]["study"]["ratios"]))
+    out = []
+    for label in d.get("systems") or {}:
+        mine = [c for c in cells if c["label"] == label]
+        have = sorted({c["e_ratio"] for c in mine})
+        missing = [x for x in grid if x not in have]
+        beyond = [x for x in have if x not in grid]
+        text = f"{label} {len(mine)} cells" + (
+            f", the claims' grid without {_ratios(missing)}" if missing else ", the whole claims' grid"
+        )
+        out.append(text + (f" and {_ratios(beyond)} beyond it" if beyond else ""))
+    return f"the map ({d.get('scale')} scale) has " + "; ".join(out)
+
+
+def _resc_other_radii(d: dict) -> dict[str, list[tuple[str, dict]]]:
+    """{energy key: [(radius key, shift), …]} of the κ shifts against the reference radius, the reference left out."""
+    ref = f"r_esc={d['r_ref']:g}"
+    return {e: [(r, row["shift_vs_ref"]) for r, row in rows.items() if r != ref] for e, rows in d["kappa"].items()}
+
+
+def _resc_shifts(get: Loader) -> str:
+    """Per energy: whether the shifts of κ against the reference radius are resolved from zero (2σ) and whether the
+    radii's shifts agree with each other (2σ, their errors in quadrature)."""
+    out = []
+    for e, shifts in _resc_other_radii(get("resc", None)).items():
+        z = [abs(s["value"]) / s["err"] for _, s in shifts]
+        where = e.replace("E=", "E = ")
+        if min(z) >= Z_RESOLVED:
+            words = f"every shift lies {min(z):.1f}–{max(z):.1f}σ from zero"
+        elif max(z) < Z_RESOLVED:
+            words = f"no shift is resolved from zero (|z| ≤ {max(z):.1f})"
+        else:
+            words = f"{sum(x >= Z_RESOLVED for x in z)} of {len(z)} shifts are resolved from zero"
+        pair = max(
+            abs(a["value"] - b["value"]) / math.hypot(a["err"], b["err"])
+            for i, (_, a) in enumerate(shifts)
+            for _, b in shifts[i + 1 :]
+        )
+        same = "the radii's shifts agree within 2σ" if pair <= Z_RESOLVED else "the radii's shifts differ"
+        out.append(f"at {where} {words}, {same} (largest difference {pair:.1f}σ)")
+    return "; ".join(out)
+
+
+def _resc_scale_moves(get: Loader) -> str:
+    """How far the shifts moved from the quick to the paper scale, in units of their quick-scale errors."""
+    quick, paper = _resc_other_radii(get("resc", "quick")), _resc_other_radii(get("resc", "paper"))
+    moves = []
+    for e, shifts in paper.items():
+        q = dict(quick.get(e, []))
+        for r, s in shifts:
+            if r in q and q[r]["err"]:
+                moves.append((abs(s["value"] - q[r]["value"]) / q[r]["err"], e, r, q[r], s))
+    z, e, r, a, b = max(moves, key=lambda m: m[0])
+    where = f"{e.replace('E=', 'E = ')}, {r.replace('r_esc=', 'r_esc = ')}"
+    return (
+        f"the κ shifts moved by at most {z:.1f}σ of their quick-scale errors (the largest at {where}: "
+        f"{_ve(a['value'], a['err'])} → {_ve(b['value'], b['err'])})"
+    )
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1135,6 +1238,10 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.validity": _generality_validity,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
+    "generality.resc_shift": _generality_resc_shift,
+    "generality.map_coverage": _generality_map_coverage,
+    "resc.shifts": _resc_shifts,
+    "resc.scale_moves": _resc_scale_moves,
     "fig2.law_below_break": _fig2_law_below_break,
     "fig5.ours_5b": _fig5_ours_5b,
     "fig5.eps_first": _fig5_eps_first,

@@ -9,7 +9,7 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
 1. **Basin maps.** Initial conditions on the section ṙ = 0, φ̇ > 0 at E0
    (:func:`hhscatter.scene.ics.section_grid`, tangential velocities) on a regular
    grid over the authors' square [−1, 1]²; each cell coloured by its outcome
-   (exit channel 0/1/2, settled, trapped at t_max), from the engine's exact
+   (exit channel 0/1/2, settled, censored at t_max), from the engine's exact
    event outcomes with r_esc = 1.5 (beyond every exit's Lyapunov orbit, study
    resc). Two magnifications of one boundary region, centred on the most
    mixed cell of the γ = 0 map.
@@ -30,7 +30,7 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
    with it and with the saddle's λ̄ of the tangent dynamics.
 
 Outcome codes: 0, 1, 2 exit channel (the 120° sector of the escape point);
-3 settled; 4 trapped (alive at t_max); −1 forbidden cell (V ≥ E0).
+3 settled; 4 censored (still inside at t_max; code name ``trapped``); −1 forbidden cell (V ≥ E0).
 """
 
 from __future__ import annotations

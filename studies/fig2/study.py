@@ -4,7 +4,7 @@
 then the κ(E) run (``grid_E…``; the authors' square ICs too at ``square_energies``, ``sq_grid_E…``); the Fig. 2a
 runs (``pt_E…``, t_max = ``pt_t_max`` so that the sticky tail shows); the c-measure runs (``cm_E…``): every section
 crossing in the window :func:`~hhscatter.reproduction.escape_summaries.cmeasure_windows` makes of the grid run's κ
-and τ0, orbits run to ``cm_t_max`` so that KAM-trapped ones are recognised. The choices go to
+and τ0, orbits run to ``cm_t_max`` so that censored ones are recognised. The choices go to
 ``raw/fig2_choices.json``.
 
 ``analyze``: κ(E) and its law (``kappa_energy``, ``kappa_fit_curve``), κ(E) under four conventions
@@ -78,7 +78,7 @@ class Params(StudyParams):
     grid_n_by_energy: Integers = None  # orbits per grid energy (same order as grid_energies); None: grid_n for all
     square_energies: Numbers = []  # grid energies also run with the authors' square ICs (raw sq_grid_E…)
     p_levels: Numbers = [0.5, 0.01]  # [p_hi, p_lo] of the P-level windows
-    max_plateau_bias: Number = 0.1  # κ ill-defined when the trapped fraction is > this share of P at the window end
+    max_plateau_bias: Number = 0.1  # κ ill-defined when the censored fraction is > this share of P at the window end
     stable_rel_tol: Number = 0.1  # κ(E) stable: (max − min)/mean over the defined conventions ≤ this
 
 
@@ -191,7 +191,7 @@ def simulate(study, workers=None, progress=True):
         scene = study.scene(grid_key(energy), energy=energy, n=n, t_max=choice.t_max)
         study.run(grid_key(energy), scene, workers=workers, progress=progress)
         if any(np.isclose(energy, e) for e in study.params.square_energies):
-            # the authors' square ICs (goodICs), same n, seed and t_max: KAM-trapped orbits run to t_max
+            # the authors' square ICs (goodICs), same n, seed and t_max: censored orbits run to t_max
             sq = study.scene(sq_key(energy), energy=energy, n=n, t_max=choice.t_max, region="square")
             study.run(sq_key(energy), sq, workers=workers, progress=progress)
     for energy, n in zip(study.params.pt_energies, study.params.pt_n):

@@ -10,7 +10,7 @@ marked times.
 Which orbits count at time t.  An orbit is *inside Ω at t* unless it has
 escaped by t.  Escaped orbits leave the average at their escape time (the
 engine's t_end, the last outward crossing of r_esc).  Settled orbits
-(energy reached E_c inside Ω; trapped for ever) stay in it: the engine stops
+(energy reached E_c inside Ω; it can never leave) stay in it: the engine stops
 them at settling unless asked otherwise, so this study's scene sets
 ``continue_settled``: the engine integrates settled orbits on to the last
 grid time and writes their energies there as snapshot rows after t_end.  This is the only reading

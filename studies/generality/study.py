@@ -162,7 +162,7 @@ def simulate(study, workers=None, progress=True):
         for r in p.ratios:
             sc = study.scene(grid_key(label, r), system=spec, energy=r * ec, n=p.grid_n, radius=radius)
             study.run(grid_key(label, r), sc, workers=workers, progress=progress)
-        if p.alt_region is not None:  # the same grid with other ICs: is a trapped plateau the ICs' doing?
+        if p.alt_region is not None:  # the same grid with other ICs: is a plateau of censored orbits the ICs' doing?
             for r in p.ratios:
                 key = alt_key(label, r, p.alt_region)
                 sc = study.scene(

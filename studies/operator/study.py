@@ -174,7 +174,7 @@ def _probe_ics(df):
 
 def _probe_scene(study, E, df):
     """The probes of the KAM test: one orbit per finest box, no section, up to probe_t_max; still inside
-    then (censored) = trapped (fig2's rule for KAM-trapped orbits)."""
+    then (censored) = a KAM box (fig2's rule for censored orbits)."""
     path, n = _write_ics(study, probe_key(E), _probe_ics(df))
     return study.scene(probe_key(E), ics=str(path), n=n, t_max=study.params.probe_t_max)
 
@@ -250,7 +250,7 @@ def _ulam_energy(study, E):
 
 def _islands(study, E, df, tr, ids, keep, sub):
     """Mixed phase space (:func:`~hhscatter.reproduction.operator_records.probe_islands`): the probes still inside at
-    probe_t_max mark trapped (KAM) boxes."""
+    probe_t_max (censored) mark KAM boxes."""
     from hhscatter.data.read import read_lifetimes
 
     lt = read_lifetimes(study.raw(probe_key(E)), columns=["traj_id", "outcome"]).sort_values("traj_id")

@@ -127,7 +127,7 @@ def _lifetimes(path, extra=()):
 
 
 def _kappa(path):
-    """κ of the orbits that left by t_max (those trapped on tori to t_max are not on the saddle)."""
+    """κ of the orbits that left by t_max (those still inside at t_max, censored, are not on the saddle)."""
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes
     from hhscatter.outcomes import LEAVING_OUTCOMES
 

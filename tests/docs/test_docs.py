@@ -770,5 +770,15 @@ def test_the_glossary_has_a_row_for_every_symbol_the_result_pages_define():
     text = (DOCS / "equations.md").read_text()
     rows = text[text.index("## Glossary") :].splitlines()
     heads = {h.strip() for r in rows if r.startswith("| ") for h in r.split("|")[1].split(",")}
-    wanted = {"κ∞", "P∞", "S_b", "S_bb", "SW1", "β", "t0", "q", "λ̄", "λ∞", "D₁", "d₁", "δ", "z", "t*", "T"}
+    wanted = {"κ∞", "κ_tail", "P∞", "S_b", "S_bb", "SW1", "β", "t0", "q", "λ̄", "λ∞", "D₁", "d₁", "δ", "z", "t*", "T"}
     assert wanted <= heads, sorted(wanted - heads)
+
+
+def test_a_rate_symbol_of_one_study_is_not_reused_by_another():
+    """κ∞ is Ulam's extrapolated rate (operator) only; generality's long-time fit calls the rate of its non-plateau
+    orbits κ_tail, and the saddle's 1/T offset of λ̄ is Λ₀ (b is the paper's own symbol, in (19) and its κ(E) law)."""
+    text = (DOCS / "equations.md").read_text()
+    rows = {r.split("|")[1].strip(): r for r in text[text.index("## Glossary") :].splitlines() if r.startswith("| ")}
+    assert "generality" not in rows["κ∞"], rows["κ∞"]
+    assert "κ∞" not in (ROOT / "studies" / "generality" / "page.md").read_text()
+    assert "b/T" not in (ROOT / "studies" / "saddle" / "page.md").read_text()

@@ -52,6 +52,9 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "κ/α (column `lam_kg` of `energy_scan`) follows\n  the decision rate (`lam`) from 0.19 to 0.375; they part near E_c",
         "the measured rate matches the prediction",
         "the fit overestimates ⟨E⟩ at large t",
+        "At the paper scale every shift at\n      E ≥ 0.30 is several σ from zero and the same for r_esc = 1.1, 1.5 and 2",
+        "The κ shifts with r_esc move by up to about 2σ of their quick errors",
+        "The extrapolation in samples per box removes it within its\nerror",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -137,6 +140,10 @@ def test_the_resc_page_names_the_tools_own_default():
     assert "default_r_esc.current" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
+    # the study's parameters, shown on the page with their comments, do not call it the default either
+    toml = (ROOT / "studies" / "resc" / "study.toml").read_text()
+    r_ref_line = next(line for line in toml.splitlines() if line.startswith("r_ref"))
+    assert "current default" not in r_ref_line and "not the tool's default" in r_ref_line
 
 
 def _beyond_the_paper():
@@ -582,3 +589,126 @@ def test_the_operator_reading_sorts_each_measure_by_its_interval_against_the_tol
     text = READINGS["operator.tolerance"](_loader(docs))
     assert "lies below fig5's tolerance δ = 0.1 for sprinkler 0.035 [0.030, 0.040]" in text
     assert "above δ = 0.1 for map 0.450" in text and "with an interval that holds δ = 0.1 for flux" in text
+
+
+def _outside_scale_notes(text: str) -> str:
+    """A page without its folded "Quick scale vs paper scale" notes (the indented block under the note's line)."""
+    out, inside = [], False
+    for line in text.split("\n"):
+        if line.startswith("??? note") and "Quick scale" in line:
+            inside = True
+        elif inside and line.strip() and not line.startswith("    "):
+            inside = False
+        out.append("" if inside else line)
+    return "\n".join(out)
+
+
+def quick_quotes_the_headline_holds(text: str, holds) -> list[str]:
+    """The references of a page to its study's other scale (``[[study@quick:…]]``), outside the scale-change note,
+    whose number the headline scale holds too (``holds(study, path)``), unless their paragraph quotes it beside the
+    same number at the headline scale or beside a number that only the quick scale has (a comparison made at one
+    scale): such a number is read at the scale of the run that made the page's claims."""
+    from hhscatter.publish.numbers import REF
+
+    found = []
+    for para in re.split(r"\n\s*\n", _outside_scale_notes(text)):
+        refs = [m for m in REF.finditer(para)]
+        quick = [m for m in refs if m.group("scale") == "quick"]
+        only_quick = any(not holds(m.group("study"), m.group("path")) for m in quick)
+        for m in quick:
+            beside = any(
+                r.group("scale") != "quick"
+                and (r.group("study"), r.group("path")) == (m.group("study"), m.group("path"))
+                for r in refs
+            )
+            if holds(m.group("study"), m.group("path")) and not (beside or only_quick):
+                found.append(m.group(0))
+    return found
+
+
+def _headline_holds(study: str, path: str) -> bool:
+    from hhscatter.publish.numbers import NumberRefError, headline_scale, resolve
+
+    if headline_scale(ROOT, study) == "quick":
+        return False
+    try:
+        resolve(load_numbers(ROOT, study, "paper")[0], path)
+    except (NumberRefError, KeyError, IndexError, TypeError, ValueError, StopIteration):
+        return False
+    return True
+
+
+def test_the_scan_finds_a_quick_number_where_the_headline_scale_has_it():
+    have = {("g", "a"), ("g", "a.verdict"), ("g", "b")}
+
+    def holds(study, path):
+        return (study, path) in have
+
+    page = (
+        "The shift is [[g@quick:a]] ([[g@quick:a.verdict]]).\n\n"
+        "Quick [[g@quick:b]] against paper [[g:b]].\n\n"
+        "The other convention [[g@quick:c]] beside its disk value [[g@quick:a]].\n\n"
+        '??? note "Quick scale vs paper scale"\n\n    [[g@quick:a]] → [[g:a]]\n\nAfter [[g:a]].'
+    )
+    assert quick_quotes_the_headline_holds(page, holds) == ["[[g@quick:a]]", "[[g@quick:a.verdict]]"]
+
+
+@pytest.mark.parametrize("page", PAGES + RESULT_PAGES, ids=lambda p: p.parent.name if p.name == "page.md" else p.name)
+def test_a_page_reads_its_claims_at_the_headline_scale(page):
+    """A number the headline (paper-scale) record holds is not quoted from the quick scale, whose verdict may
+    differ (generality's r_esc shift of κ0: "no shift resolved" at the quick scale, "shifts" at the paper scale)."""
+    found = quick_quotes_the_headline_holds(page.read_text(), _headline_holds)
+    assert not found, f"{page.relative_to(ROOT)}: quick-scale numbers the paper scale holds: {found}"
+
+
+def test_the_resc_shift_reading_sorts_each_energy_by_its_verdict():
+    def row(ratio, conv, verdict, value=None, err=None):
+        shift = {"value": value, "err": err}
+        return {"label": "hh", "e_ratio": ratio, "convention": conv, "r_esc": 1.03, "verdict": verdict, "shift": shift}
+
+    doc = {
+        "systems": {"hh": {}},
+        "resc_kappa": [
+            row(1.8, "plateau", "shifts (z = +4.3)", 0.044, 0.010),
+            row(1.2, "plateau", "no shift resolved (z = +0.7)", 0.02, 0.03),
+            row(2.6, "plateau", "undetermined: κ0 ill-defined at r_esc = 1.5"),
+        ],
+    }
+    text = READINGS["generality.resc_shift"](_loader({"generality": doc}))
+    assert "For hh (r_esc = 1.03), all orbits: shifts at 1.8 E_c (0.044 ± 0.010)" in text
+    assert "no shift resolved at 1.2 E_c" in text and "undetermined (κ0 ill-defined at a radius) at 2.6 E_c" in text
+    assert "Escaping orbits" not in text  # no row of that convention
+
+
+def test_the_map_coverage_reading_names_the_grid_energies_without_a_cell():
+    cells = [{"label": "hh", "e_ratio": x} for x in (1.05, 1.5, 5.0)]
+    doc = {"scale": "paper", "systems": {"hh": {}}, "validity_map": cells}
+    doc["config"] = {"study": {"ratios": [1.05, 1.5, 1.7, 2.2]}}
+    text = READINGS["generality.map_coverage"](_loader({"generality": doc}))
+    assert text == "the map (paper scale) has hh 3 cells, the claims' grid without 1.7, 2.2 E_c and 5 E_c beyond it"
+    doc["validity_map"] = [{"label": "hh", "e_ratio": x} for x in (1.05, 1.5, 1.7, 2.2)]
+    text = READINGS["generality.map_coverage"](_loader({"generality": doc}))
+    assert text == "the map (paper scale) has hh 4 cells, the whole claims' grid"
+
+
+def test_the_resc_readings_follow_the_shifts_and_their_errors():
+    def shift(v, e):
+        return {"shift_vs_ref": {"value": v, "err": e}}
+
+    ref = shift(0.0, 0.0)
+    paper = {
+        "r_ref": 1.03,
+        "kappa": {
+            "E=0.25": {"r_esc=1.03": ref, "r_esc=1.5": shift(-0.001, 0.001), "r_esc=2": shift(-0.0012, 0.001)},
+            "E=0.30": {"r_esc=1.03": ref, "r_esc=1.5": shift(-0.008, 0.001), "r_esc=2": shift(-0.002, 0.001)},
+        },
+    }
+    quick = copy.deepcopy(paper)
+    quick["kappa"]["E=0.30"]["r_esc=1.5"] = shift(-0.004, 0.002)
+    text = READINGS["resc.shifts"](_loader({"resc": paper}))
+    assert text.startswith("at E = 0.25 no shift is resolved from zero (|z| ≤ 1.2), the radii's shifts agree")
+    assert (
+        "at E = 0.30 every shift lies 2.0–8.0σ from zero, the radii's shifts differ (largest difference 4.2σ)" in text
+    )
+    moves = READINGS["resc.scale_moves"](lambda study, scale: quick if scale == "quick" else paper)
+    assert moves.startswith("the κ shifts moved by at most 2.0σ of their quick-scale errors (the largest at E = 0.30")

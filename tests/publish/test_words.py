@@ -75,3 +75,30 @@ def test_an_old_record_is_reworded_phrase_by_phrase_and_its_keys_stay():
     assert out["rows"][1]["quantity"] == "Fig. 5's distance (all conservative survivors, censored kept) — barbanis"
     assert out["reason"].startswith("plateau: censored orbits (still inside at t_max) are 3.17%")
     assert all(not OLD.search(new) for _, new in OLD_PHRASES)
+
+
+#: a study's sources as its page shows them (the parameters with their comments, the module with its docstrings)
+SOURCES = sorted(p for name in ("study.toml", "study.py", "figure.py") for p in (ROOT / "studies").glob(f"*/{name}"))
+#: a key or code name the records keep (``trapped``, `trapped`, 'trapped', codes.trapped): named, not said
+KEY_NAME = re.compile(r"``trapped``|`trapped`|'trapped'|\"trapped\"|\.trapped\b")
+
+
+def words_of_a_source(text: str) -> list[str]:
+    """The lines of a source that say "trapped" (or "KAM-trapped") of an orbit, its key names left out."""
+    return [line.strip() for line in text.splitlines() if OLD.search(KEY_NAME.sub(" ", line))]
+
+
+def test_the_source_scan_tells_a_word_from_a_key_name():
+    assert words_of_a_source("3 settled; 4 trapped (alive at t_max)\n# orbits trapped on tori") == [
+        "3 settled; 4 trapped (alive at t_max)",
+        "# orbits trapped on tori",
+    ]
+    assert words_of_a_source("4 censored (code name ``trapped``); codes.trapped; n_trapped; trapped_fraction") == []
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_studies_sources_on_the_pages_say_censored(path):
+    """The comments of study.toml and the docstrings and comments of the study modules are shown on the study pages:
+    they name an orbit still inside at t_max as the glossary does."""
+    bad = words_of_a_source(path.read_text())
+    assert not bad, f"{path.relative_to(ROOT)}: {bad}"

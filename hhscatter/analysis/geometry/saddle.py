@@ -796,7 +796,7 @@ def mean_lyapunov(log_stretch, duration, *, n_boot: int = 1000, seed: int = 0) -
 class LyapunovConvergence:
     """Result of :func:`lyapunov_convergence` (1/time).
 
-    table (T, n_orbits, value, err per duration bin), extrapolated (λ∞ of λ̄(T) = λ∞ + b/T), extrapolated_err,
+    table (T, n_orbits, value, err per duration bin), extrapolated (λ∞ of λ̄(T) = λ∞ + Λ₀/T), extrapolated_err,
     slope (b, log-stretch units), slope_err, z_slope = b/σ_b, converged (|z_slope| ≤ 2: no 1/T drift resolved).
     """
 
@@ -815,7 +815,7 @@ def lyapunov_convergence(
     """lyapunov_convergence(log_stretch, duration, *, n_bins=5, n_boot=400, seed=0) -> LyapunovConvergence.
 
     λ̄ against the duration T of the stretches: the orbits are split into ``n_bins`` bins of T (quantiles of
-    ``duration``), λ̄ and its bootstrap error computed in each by :func:`mean_lyapunov`, and λ̄(T) = λ∞ + b/T fitted
+    ``duration``), λ̄ and its bootstrap error computed in each by :func:`mean_lyapunov`, and λ̄(T) = λ∞ + Λ₀/T fitted
     by weighted least squares (each bin's error floored at 10⁻⁹ of its λ̄, the rounding of identical exponents).
     A finite-time exponent carries a transient of the tangent vector's alignment (a
     constant offset of Λ, so b ≠ 0); ``converged`` says that no such drift is resolved (|b| ≤ 2σ_b), else λ∞ is

@@ -7,7 +7,7 @@ are described by
 
     P(t | t0) = q + (1 − q) e^{−κ (t − t0)},      t ≥ t0,
 
-q the fraction of them that never escapes (P∞ = q·P(t0) of all orbits) and κ the rate of the others (κ∞).
+q the fraction of them that never escapes (P∞ = q·P(t0) of all orbits) and κ the rate of the others (κ_tail).
 :func:`fit_plateau_exponential` fits (q, κ) by maximum likelihood on the individual lifetimes: an escape at t
 contributes the density (1 − q) κ e^{−κ(t − t0)}, an orbit still inside at its censoring time c the survival
 P(c | t0). Censored orbits enter the likelihood as what they are, so the rate is not conditioned on escaping
@@ -70,7 +70,7 @@ class PlateauFit:
     p_inf, p_inf_err : float
         P∞ = q·P(t0): the plateau as a fraction of all orbits, its error from q's and P(t0)'s.
     kappa, kappa_err : float
-        κ∞ (1/time) of the escaping part, and its 1σ error.
+        κ_tail (1/time) of the escaping part, and its 1σ error.
     chi2, dof : float, int
         Pearson χ² of the binned escapes and the orbits still inside against the model (cells pooled to expected
         counts ≥ 5), and its degrees of freedom after pooling; χ² NaN when ``too_few``.
@@ -317,7 +317,7 @@ def rate_status(
     no verdict (by the pooled χ²'s own rule, :func:`~hhscatter.analysis.stats.goodness.pooled_pearson`: no degree
     of freedom left once every cell expects 5 orbits; or too few orbits after τ0 to fit), 'empty' when no orbit
     was still inside after τ0, else 'exponential'. With no orbit still inside at the end there is no plateau. With a plateau,
-    the note gives P∞ and κ∞ of the plateau-plus-exponential fit.
+    the note gives P∞ and κ_tail of the plateau-plus-exponential fit.
 
     Examples
     --------
@@ -370,7 +370,7 @@ def rate_status(
         note = (
             f"not a rate of the whole population: {f_inf:.1%} of the orbits are still inside at t_max, "
             f"{bias:.0%} of P at the window end; the window's κ is the plateau's. Plateau-plus-exponential "
-            f"from τ0: P∞ = {plat[0]:.3g} ± {plat[1]:.2g}, κ∞ = {plat[2]:.3g} ± {plat[3]:.2g} (escaping part)"
+            f"from τ0: P∞ = {plat[0]:.3g} ± {plat[1]:.2g}, κ_tail = {plat[2]:.3g} ± {plat[3]:.2g} (escaping part)"
         )
     elif math.isfinite(p) and p < p_reject:
         status = "non-exponential"

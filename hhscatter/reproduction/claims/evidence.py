@@ -7,7 +7,7 @@ ensemble to t_max with the section recorded near its end and the shadow runs of 
 * :func:`regular_record` — the regular fraction of an ensemble: orbits the shadow indicator calls regular over all
   orbits (those that escaped before the indicator's window are not regular), binomial error;
 * :func:`long_time_record` — P(t) at chosen times (Kaplan–Meier, Greenwood errors), the plateau-plus-exponential
-  fit of all orbits from t0 (P∞, κ∞: :func:`hhscatter.analysis.survival.long_time.fit_plateau_exponential`),
+  fit of all orbits from t0 (P∞, κ_tail: :func:`hhscatter.analysis.survival.long_time.fit_plateau_exponential`),
   the single-exponential fit and the hazard of the non-regular orbits alone, and the fraction of the orbits still
   inside at t_max that the indicator calls regular (the only ones called "trapped");
 * :func:`validity_map` — per (system, E/E_c): the regular fraction beside claim 1's verdict (κ0 defined under the
