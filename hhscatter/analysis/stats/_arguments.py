@@ -6,6 +6,15 @@
 Traceback (most recent call last):
 ...
 hhscatter.errors.ConfigError: t_end must be finite (no NaN or inf)
+>>> import pandas as pd
+>>> frame(pd.DataFrame({"t_end": [1.0]}), "lifetimes", ["t_end", "outcome"])
+Traceback (most recent call last):
+...
+hhscatter.errors.ConfigError: lifetimes lacks the column(s) outcome
+>>> mapping([], "fits")
+Traceback (most recent call last):
+...
+hhscatter.errors.ConfigError: fits must be a dict, got list
 """
 
 from __future__ import annotations
@@ -94,3 +103,32 @@ def system(model, name: str = "model"):
     if not isinstance(model, System):
         raise ConfigError(f"{name} must be a System (hhscatter.model), got {type(model).__name__}")
     return model
+
+
+def frame(df, name: str, columns=()):
+    """``df`` if it is a pandas DataFrame holding ``columns`` (the missing ones are named)."""
+    import pandas as pd  # deferred: pandas loads only for the estimators that take a table
+
+    if not isinstance(df, pd.DataFrame):
+        raise ConfigError(f"{name} must be a pandas DataFrame, got {type(df).__name__}")
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise ConfigError(f"{name} lacks the column(s) {', '.join(missing)}")
+    return df
+
+
+def mapping(d, name: str, *, min_size: int = 0) -> dict:
+    """``d`` if it is a mapping (a dict) of at least ``min_size`` entries."""
+    if not isinstance(d, dict):
+        raise ConfigError(f"{name} must be a dict, got {type(d).__name__}")
+    if len(d) < min_size:
+        raise ConfigError(f"{name} must hold at least {min_size} entr{'y' if min_size == 1 else 'ies'}, got {len(d)}")
+    return d
+
+
+def instance(obj, name: str, kind: type | tuple[type, ...]):
+    """``obj`` if it is an instance of ``kind`` (a class, or a tuple of classes)."""
+    if not isinstance(obj, kind):
+        want = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise ConfigError(f"{name} must be a {want}, got {type(obj).__name__}")
+    return obj
