@@ -132,3 +132,19 @@ def instance(obj, name: str, kind: type | tuple[type, ...]):
         want = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
         raise ConfigError(f"{name} must be a {want}, got {type(obj).__name__}")
     return obj
+
+
+def floats(a, name: str, *, size: int | None = None, of: str = "orbit") -> np.ndarray:
+    """``a`` as a 1-D float array of numbers where NaN and inf may stand (the estimator drops them); ``size`` values."""
+    if isinstance(a, (str, bytes, dict)) or a is None:
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
+    try:
+        arr = np.asarray(a)
+        if arr.dtype == bool or arr.dtype.kind not in "iuf":
+            raise TypeError
+        arr = arr.astype(float).ravel()
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+    if size is not None and arr.size != size:
+        raise ConfigError(f"{name} must have one value per {of}: {arr.size} != {size}")
+    return arr
