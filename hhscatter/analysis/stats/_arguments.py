@@ -148,3 +148,16 @@ def floats(a, name: str, *, size: int | None = None, of: str = "orbit") -> np.nd
     if size is not None and arr.size != size:
         raise ConfigError(f"{name} must have one value per {of}: {arr.size} != {size}")
     return arr
+
+
+def interval(w, name: str, *, minimum: float | None = None, open_end: bool = False) -> tuple[float, float]:
+    """``w`` = (lo, hi) as two numbers with lo < hi (lo ≥ ``minimum``; hi may be +inf if ``open_end``)."""
+    if isinstance(w, (str, bytes, dict)) or not hasattr(w, "__len__") or len(w) != 2:
+        raise ConfigError(f"{name} must be a pair (lo, hi), got {w!r}")
+    lo = number(w[0], f"{name}[0]", minimum=minimum)
+    hi = w[1]
+    if not (open_end and isinstance(hi, (int, float, np.integer, np.floating)) and hi == math.inf):
+        hi = number(hi, f"{name}[1]")
+    if not lo < hi:
+        raise ConfigError(f"{name} must satisfy lo < hi, got {w!r}")
+    return lo, float(hi)
