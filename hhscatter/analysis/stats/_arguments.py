@@ -161,3 +161,10 @@ def interval(w, name: str, *, minimum: float | None = None, open_end: bool = Fal
     if not lo < hi:
         raise ConfigError(f"{name} must satisfy lo < hi, got {w!r}")
     return lo, float(hi)
+
+
+def real(v, name: str) -> float:
+    """``v`` as a float where NaN or inf may stand (a value not measured, a bound not set); never a word or None."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"{name} must be a number, got {v!r}")
+    return float(v)
