@@ -168,3 +168,11 @@ def real(v, name: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
         raise ConfigError(f"{name} must be a number, got {v!r}")
     return float(v)
+
+
+def having(obj, name: str, attributes: tuple[str, ...], kind: str):
+    """``obj`` if it has every one of ``attributes`` (a result of ``kind``); the first one lacking is named."""
+    lacking = [a for a in attributes if not hasattr(obj, a)]
+    if lacking:
+        raise ConfigError(f"{name} must be {kind}, got {type(obj).__name__} without {lacking[0]}")
+    return obj
