@@ -54,6 +54,7 @@ from hhscatter.analysis.dissipative.curve_fit import (
 )
 from hhscatter.analysis.dissipative.decay import energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -74,11 +75,27 @@ HAZARDS = ("paper", "integrated")
 # ---------------------------------------------------------------------------
 # building blocks
 # ---------------------------------------------------------------------------
+def _time_or_inf(v, name: str) -> float:
+    """``v`` as a time (time units) that may be +inf (never), not NaN."""
+    v = check.real(v, name)
+    if v != v:
+        raise ConfigError(f"{name} must be a time or inf, got nan")
+    return v
+
+
+def _optional_mapping(d, name: str) -> None:
+    if d is not None:
+        check.mapping(d, name)
+
+
 def settling_rate(t, tau2: float, L: float, b: float):
     """settling_rate(t, tau2, L, b) -> g(t) = L / (1 + exp(−b (t − τ2)))² (Eq. (eqn:surv_prob_model), t > τ2 branch).
 
     Increases monotonically from L/4 at t = τ2 to L; rate in 1/time.
     """
+    check.numbers(t, "t", min_size=0)
+    for value, name in ((tau2, "tau2"), (L, "L"), (b, "b")):
+        check.real(value, name)
     return L * special.expit(b * (np.asarray(t, dtype=float) - tau2)) ** 2
 
 
@@ -315,6 +332,17 @@ def fit_survival_model(
     Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
     AIC, ...).
     """
+    check.function(kappa_of_E, "kappa_of_E")
+    check.number(E0, "E0", positive=True)
+    check.number(mu, "mu")
+    check.number(gamma, "gamma", minimum=0.0)
+    if tau2 is not None:
+        _time_or_inf(tau2, "tau2")
+    check.number(E_c, "E_c", positive=True)
+    _optional_mapping(fixed, "fixed")
+    _optional_mapping(p0, "p0")
+    if space not in ("log", "linear"):
+        raise ConfigError(f"space must be 'log' or 'linear', got {space!r}")
     fixed = _checked_fixed(fixed, hazard)
     P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
     tau2_eq, fit_tau2 = _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2)
@@ -360,6 +388,15 @@ def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
 
     The points are those with τ0 ≤ t ≤ t_max (time units), P > P_min and a positive error; at least 3.
     """
+    size = check.floats(t, "t").size
+    check.floats(P, "P", size=size, of="time t")
+    check.floats(P_err, "P_err", size=size, of="time t")
+    check.number(tau0, "tau0")
+    if P_tau0 is not None:
+        check.number(P_tau0, "P_tau0", minimum=0.0)
+    if t_max is not None:
+        check.real(t_max, "t_max")
+    check.number(P_min, "P_min")
     t_all = np.asarray(t, dtype=float)
     if P_tau0 is None:
         P_tau0, P_tau0_err = p_at(t_all, P, P_err, tau0)
@@ -419,6 +456,14 @@ def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
     """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
     values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
     L ≈ the late log-slope of P, and three starts for b unless given."""
+    size = check.floats(tf, "tf").size
+    check.floats(Pf, "Pf", size=size, of="time tf")
+    if size == 0:
+        raise ConfigError("tf must hold at least one fitted point")
+    _time_or_inf(tau2, "tau2")
+    check.number(P_tau0, "P_tau0", minimum=0.0)
+    check.mapping(fixed, "fixed")
+    _optional_mapping(p0, "p0")
     p0 = dict(p0 or {})
 
     def p_near(tq):

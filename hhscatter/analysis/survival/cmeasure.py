@@ -224,10 +224,9 @@ def cmeasure_sample_from_sections(
     """
     check.frame(sections, "sections", ("traj_id", "t"))
     check.frame(lifetimes, "lifetimes", ("traj_id", "outcome", "t_end"))
-    check.number(t_from, "t_from")
-    check.number(t_to, "t_to")
-    if not t_from <= t_to:
-        raise ConfigError(f"t_from ≤ t_to is needed, got {t_from!r} and {t_to!r}")
+    check.real(t_from, "t_from")  # an empty window (t_from > t_to, or NaN) gives an empty sample
+    check.real(t_to, "t_to")
+    check.real(t_record_end, "t_record_end")
     if drop_censored:
         keep = lifetimes.loc[lifetimes["outcome"].astype(object) != "censored", "traj_id"]
         sections = sections[sections["traj_id"].isin(keep)]

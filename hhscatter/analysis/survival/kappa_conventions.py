@@ -63,14 +63,6 @@ class ConventionRate(WithErrors):
     reason: str = ""
 
 
-def _having(obj, name: str, attributes: tuple, kind: str):
-    """``obj`` if it has every one of ``attributes`` (a result of ``kind``); else a ConfigError naming the first lacking."""
-    lacking = [a for a in attributes if not hasattr(obj, a)]
-    if lacking:
-        raise ConfigError(f"{name} must be {kind}, got {type(obj).__name__} without {lacking[0]}")
-    return obj
-
-
 def _levels(p_hi, p_lo) -> None:
     check.number(p_hi, "p_hi")
     check.number(p_lo, "p_lo")
@@ -119,7 +111,7 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     tail starts early, the check also flags windows that reach into it
     (the decay there is no longer the exponential of κ either).
     """
-    check.number(P_end, "P_end", minimum=0.0)
+    check.real(P_end, "P_end")  # NaN (P not known at the window end) counts as no survivors: κ ill-defined
     check.number(f_trapped, "f_trapped", minimum=0.0)
     check.number(max_bias, "max_bias", positive=True)
     bias = f_trapped / P_end if P_end > 0 else math.inf
@@ -257,7 +249,7 @@ def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> Conventio
     The κ of :func:`hhscatter.analysis.survival.escape_rate.escape_rate` (data-driven
     plateau windows), with the plateau check at its window end t_stop.
     """
-    _having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
+    check.having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
     t_end = check.numbers(t_end, "t_end", minimum=0.0)
     observed = check.mask(observed, "observed", t_end.size)
     check.number(max_bias, "max_bias", positive=True)
@@ -344,7 +336,7 @@ def law_spread(fits: dict) -> dict:
     """
     check.mapping(fits, "fits", min_size=1)
     for name, f in fits.items():
-        _having(f, f"fits[{name!r}]", LAW_PARAMETERS, "a KappaEnergyFit (fit_kappa_energy)")
+        check.having(f, f"fits[{name!r}]", LAW_PARAMETERS, "a KappaEnergyFit (fit_kappa_energy)")
     out = {}
     for p in LAW_PARAMETERS:
         vals = {name: float(getattr(f, p)) for name, f in fits.items()}
@@ -377,7 +369,7 @@ def convention_rows(
     """
     t_end = check.numbers(t_end, "t_end", minimum=0.0)
     observed = check.mask(observed, "observed", t_end.size)
-    _having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
+    check.having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
     rates = {
         "plateau": plateau_rate(result, t_end, observed, max_bias=max_bias),
         "plevel": escape_rate_p_levels(t_end, observed, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias),

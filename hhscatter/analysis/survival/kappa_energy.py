@@ -290,11 +290,7 @@ def kappa_law_summary(fit) -> dict:
     (0.2, 0.02, 2.0)
     """
     needed = ("a", "b", "c", "E_b", "a_err", "b_err", "c_err", "E_b_err", "boot_err", "continuous", "chi2", "dof")
-    lacking = [n for n in needed if not hasattr(fit, n)]
-    if lacking:
-        raise ConfigError(
-            f"fit must be a KappaEnergyFit (fit_kappa_energy), got {type(fit).__name__} without {lacking[0]}"
-        )
+    check.having(fit, "fit", needed, "a KappaEnergyFit (fit_kappa_energy)")
     boot = fit.boot_err if fit.boot_err else (math.nan,) * 4
     out = {}
     for i, name in enumerate(("a", "b", "c", "E_b")):

@@ -338,7 +338,8 @@ def rate_status(
 
     t = check.numbers(t_end, "t_end", min_size=0, minimum=0.0)
     obs = check.mask(observed, "observed", t.size)
-    check.window(tau0, t_stop, ("tau0", "t_stop"))
+    check.number(tau0, "tau0", minimum=0.0)
+    check.number(t_stop, "t_stop")
     check.number(max_bias, "max_bias", positive=True)
     check.number(p_reject, "p_reject", positive=True)
     nan = math.nan
