@@ -125,6 +125,11 @@ def energy_path(t, E0: float, mu: float, gamma: float):
     check.numbers(t, "t", min_size=0)
     for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
         check.real(value, name)  # NaN (a value not measured) gives NaN, as the law does
+    return _energy_path(t, E0, mu, gamma)
+
+
+def _energy_path(t, E0, mu, gamma):
+    """:func:`energy_path` without its checks, for the models that evaluate it at every step of a fit."""
     return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
 
 

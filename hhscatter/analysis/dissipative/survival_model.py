@@ -52,7 +52,7 @@ from hhscatter.analysis.dissipative.curve_fit import (
     residual_fn,
     select_points,
 )
-from hhscatter.analysis.dissipative.decay import energy_path
+from hhscatter.analysis.dissipative.decay import _energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
@@ -96,6 +96,11 @@ def settling_rate(t, tau2: float, L: float, b: float):
     check.numbers(t, "t", min_size=0)
     for value, name in ((tau2, "tau2"), (L, "L"), (b, "b")):
         check.real(value, name)
+    return _settling_rate(t, tau2, L, b)
+
+
+def _settling_rate(t, tau2, L, b):
+    """:func:`settling_rate` without its checks, for the models that evaluate it at every step of a fit."""
     return L * special.expit(b * (np.asarray(t, dtype=float) - tau2)) ** 2
 
 
@@ -103,7 +108,7 @@ def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
     """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0), or ∫_{τ0}^t κ0(E(s))ds with hazard "integrated"."""
     t = np.asarray(t, dtype=float)
     if hazard == "paper":
-        return np.asarray(kappa_of_E(energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
+        return np.asarray(kappa_of_E(_energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
     if hazard == "integrated":
         if t.size == 0:
             return t.copy()
@@ -111,7 +116,7 @@ def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
         if t_hi <= tau0:
             return np.zeros_like(t)
         s = np.linspace(tau0, t_hi, n_int)
-        k = np.asarray(kappa_of_E(energy_path(s, A, mu, gamma)), dtype=float)
+        k = np.asarray(kappa_of_E(_energy_path(s, A, mu, gamma)), dtype=float)
         cum = np.concatenate([[0.0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
         return np.interp(t, s, cum)
     raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
@@ -127,7 +132,7 @@ def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
         out[mid] = f_ne + f_e * np.exp(-_escape_exponent(t[mid], kappa_of_E, A, mu, gamma, tau0, hazard))
     if late.any():
         tl = t[late]
-        out[late] = f_ne * np.exp(-settling_rate(tl, tau2, L, b) * (tl - tau2))
+        out[late] = f_ne * np.exp(-_settling_rate(tl, tau2, L, b) * (tl - tau2))
     return out
 
 

@@ -120,6 +120,11 @@ def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
     P0 = check.floats(P_0(t) if callable(P_0) else P_0, "P_0", size=t.size, of="t")
     if t.size and np.any(np.diff(t) <= 0):
         raise ConfigError("t must be strictly increasing")
+    return _tau1(t, Pg, P0, tau0, alpha)
+
+
+def _tau1(t, Pg, P0, tau0, alpha):
+    """:func:`tau1` on checked arrays (the strictly increasing grid ``t``, P_γ and P_0 on it)."""
     D = _log_ratio(Pg, P0, alpha)
     keep = ~np.isnan(D)
     t, D = t[keep], D[keep]
@@ -330,11 +335,17 @@ def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
     ensemble size N (the first of N·f_ne settlers).  None if nobody settled.
     """
     t_end = check.floats(t_end, "t_end")
-    s = outcome_is(_outcomes(outcome, "outcome", t_end.size), "settled")
+    _outcomes(outcome, "outcome", t_end.size)
     _quantiles(qs)
     if weights is not None:
         check.numbers(weights, "weights", min_size=0, minimum=0.0)
         check.floats(weights, "weights", size=t_end.size)
+    return _settle_time_quantiles(t_end, outcome, qs, weights)
+
+
+def _settle_time_quantiles(t_end, outcome, qs, weights):
+    """:func:`settle_time_quantiles` on checked arguments (``t_end`` a flat float array)."""
+    s = outcome_is(outcome, "settled")
     w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
     s &= w > 0
     if not s.any():
@@ -397,6 +408,8 @@ def bootstrap_transition_times(
             raise ConfigError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
         arrs[lab] = (t_end, outcome, observed_from_outcome(outcome))
     g = np.asarray(grid, dtype=float)
+    if len(curves) > 1 and g.size and np.any(np.diff(g.ravel()) <= 0):
+        raise ConfigError("grid must be strictly increasing")
     rng = np.random.default_rng(seed)
     qcols = [f"t_settle_q{q:g}" for q in settle_q]
     rows = []
@@ -409,10 +422,10 @@ def bootstrap_transition_times(
             if lab == reference:
                 continue
             Pg = survival_on_grid(t_end, obs, g, w)
-            t1 = tau1(g, Pg, P0, t0, alpha)
+            t1 = _tau1(g, Pg, P0, t0, alpha)
             sel = (outcome == "settled") & (w > 0)
             t2 = float(t_end[sel].min()) if sel.any() else np.nan
-            qv = settle_time_quantiles(t_end, outcome, settle_q, w)
+            qv = _settle_time_quantiles(t_end, outcome, settle_q, w)
             row = {"replicate": b, "label": lab, "tau0": t0, "tau1": np.nan if t1 is None else t1, "tau2_obs": t2}
             vals = [np.nan] * len(qcols) if qv is None else [float(v) for v in qv]
             row.update(dict(zip(qcols, vals)))
