@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -38,12 +39,18 @@ __all__ = [
 
 
 # ---------------------------------------------------------------------------
+def _data(t, P, P_err):
+    """(t, P, P_err) as flat float arrays of one length (NaN may stand in P and P_err: such points are dropped)."""
+    t = check.floats(t, "t")
+    return t, check.floats(P, "P", size=t.size, of="time t"), check.floats(P_err, "P_err", size=t.size, of="time t")
+
+
 def select_points(t, P, P_err, tau0, t_max, P_min):
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
-    P_err = np.asarray(P_err, dtype=float).ravel()
-    if not (t.shape == P.shape == P_err.shape):
-        raise ConfigError("t, P and P_err must have the same length")
+    t, P, P_err = _data(t, P, P_err)
+    check.number(tau0, "tau0")
+    if t_max is not None:
+        check.real(t_max, "t_max")
+    check.number(P_min, "P_min")
     sel = (t >= tau0) & np.isfinite(P) & np.isfinite(P_err) & (P_err > 0) & (P > P_min)
     if t_max is not None:
         sel &= t <= t_max
@@ -52,6 +59,8 @@ def select_points(t, P, P_err, tau0, t_max, P_min):
 
 def p_at(t, P, P_err, t0):
     """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
+    _data(t, P, P_err)
+    check.number(t0, "t0")
     t = np.asarray(t, dtype=float)
     P = np.asarray(P, dtype=float)
     E = np.asarray(P_err, dtype=float)
@@ -63,6 +72,8 @@ def p_at(t, P, P_err, t0):
 
 
 def residual_fn(curve, P, sig, space):
+    check.function(curve, "curve")
+    check.floats(sig, "sig", size=check.floats(P, "P").size, of="point of P")
     if space == "log":
         y, s = np.log(P), sig / P
 
@@ -87,6 +98,15 @@ def residual_fn(curve, P, sig, space):
 def best_of(fit_fn, starts, cost, errors, message):
     """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
     none left is a RuntimeError(``message``)."""
+    check.function(fit_fn, "fit_fn")
+    check.function(cost, "cost")
+    if isinstance(starts, (str, bytes, dict)) or starts is None or not hasattr(starts, "__iter__"):
+        raise ConfigError(f"starts must be a list of starting points, got {type(starts).__name__}")
+    kinds = errors if isinstance(errors, tuple) else (errors,)
+    if not all(isinstance(k, type) and issubclass(k, BaseException) for k in kinds):
+        raise ConfigError(f"errors must be an exception class or a tuple of them, got {errors!r}")
+    if not isinstance(message, str):
+        raise ConfigError(f"message must be a str, got {type(message).__name__}")
     best = None
     for x0 in starts:
         try:
@@ -102,6 +122,8 @@ def best_of(fit_fn, starts, cost, errors, message):
 
 def lsq(res, starts, lo, hi):
     """Best least_squares solution over several starting points."""
+    check.function(res, "res")
+    check.floats(hi, "hi", size=check.floats(lo, "lo").size, of="bound of lo")
 
     def solve(x0):
         x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-12 * (np.abs(lo) + 1), hi - 1e-12 * (np.abs(hi) + 1))
@@ -111,6 +133,9 @@ def lsq(res, starts, lo, hi):
 
 
 def covariance(J, chi2_red, absolute_sigma):
+    if np.ndim(J) != 2 or check.floats(J, "J").size == 0:
+        raise ConfigError("J must be a non-empty 2-D array (the Jacobian)")
+    check.real(chi2_red, "chi2_red")
     cov = np.linalg.pinv(J.T @ J)
     if not absolute_sigma:
         cov = cov * chi2_red
@@ -118,6 +143,11 @@ def covariance(J, chi2_red, absolute_sigma):
 
 
 def goodness(curve_vals, t, P, res_norm, k):
+    size = check.floats(t, "t").size
+    check.floats(curve_vals, "curve_vals", size=size, of="time t")
+    check.floats(P, "P", size=size, of="time t")
+    check.floats(res_norm, "res_norm")
+    check.count(k, "k", 0)
     n = t.size
     chi2 = float(np.sum(res_norm**2))
     dof = n - k
@@ -144,6 +174,11 @@ class FitStats:
 
 def fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> FitStats:
     """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
+    if sol is not None and not (hasattr(sol, "x") and hasattr(sol, "jac")):
+        raise ConfigError(f"sol must be a least-squares solution (with x and jac) or None, got {type(sol).__name__}")
+    check.number(P_tau0_err, "P_tau0_err", minimum=0.0)
+    if refit is not None:
+        check.function(refit, "refit")
     chi2, dof, chi2_red, rms, aic = goodness(curve_vals, t, P, r, k)
     cov_fit = covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
     sens = np.zeros(0 if sol is None else sol.x.size)
@@ -172,6 +207,17 @@ def profile_interval(
     not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
     the allowed range on that side: the data do not bound it).
     """
+    check.function(chi2_of, "chi2_of")
+    check.number(best, "best")
+    check.number(chi2_min, "chi2_min")
+    check.number(lo_edge, "lo_edge")
+    check.number(hi_edge, "hi_edge")
+    if not lo_edge < hi_edge:
+        raise ConfigError(f"lo_edge < hi_edge is needed, got {lo_edge!r} and {hi_edge!r}")
+    check.number(delta, "delta", positive=True)
+    if step is not None:
+        check.number(step, "step", positive=True)
+    check.number(xtol, "xtol", positive=True)
     target = float(chi2_min) + float(delta)
 
     def g(x):

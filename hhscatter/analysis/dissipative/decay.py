@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.errors import ConfigError
@@ -74,6 +75,22 @@ __all__ = [
 ]
 
 
+def _sequence(v, name: str):
+    """``v`` if it is a list, tuple, array or other iterable of items (not a word, a mapping or a number)."""
+    if isinstance(v, (str, bytes, dict, pd.DataFrame)) or v is None or not hasattr(v, "__iter__"):
+        raise ConfigError(f"{name} must be a list, got {type(v).__name__}")
+    return v
+
+
+def _windows(windows, name: str = "windows") -> list:
+    """``windows`` as a non-empty list of (t_lo, t_hi) pairs (time units, t_lo < t_hi)."""
+    _sequence(windows, name)
+    out = [check.interval(w, f"{name}[{i}]", open_end=True) for i, w in enumerate(windows)]
+    if not out:
+        raise ConfigError(f"{name} must hold at least one (t_lo, t_hi) window")
+    return out
+
+
 def snapshot_grid(pieces) -> np.ndarray:
     """snapshot_grid(pieces) -> increasing array of times from [[start, stop, step], ...].
 
@@ -81,10 +98,14 @@ def snapshot_grid(pieces) -> np.ndarray:
     rounded to 1e-9 so that equal times compare equal across tables).
     Pieces must not overlap.
     """
+    _sequence(pieces, "pieces")
+    for p in pieces:
+        if isinstance(p, (str, bytes, dict)) or not hasattr(p, "__len__") or len(p) != 3:
+            raise ConfigError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
+        for v in p:
+            check.number(v, "a snapshot_grid piece's start, stop and step")
     out = []
     for p in pieces:
-        if len(p) != 3:
-            raise ConfigError(f"snapshot_grid pieces must be [start, stop, step], got {p!r}")
         start, stop, step = (float(v) for v in p)
         if not step > 0 or stop < start:
             raise ConfigError(f"snapshot_grid piece needs step > 0 and stop ≥ start, got {p!r}")
@@ -101,6 +122,14 @@ def snapshot_grid(pieces) -> np.ndarray:
 # ---------------------------------------------------------------------------
 def energy_path(t, E0: float, mu: float, gamma: float):
     """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
+    check.numbers(t, "t", min_size=0)
+    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
+        check.real(value, name)  # NaN (a value not measured) gives NaN, as the law does
+    return _energy_path(t, E0, mu, gamma)
+
+
+def _energy_path(t, E0, mu, gamma):
+    """:func:`energy_path` without its checks, for the models that evaluate it at every step of a fit."""
     return E0 * np.exp(-mu * gamma * np.asarray(t, dtype=float))
 
 
@@ -111,6 +140,9 @@ def time_to_energy(E0, E1, mu, gamma):
     for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
     special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
     """
+    check.numbers(E1, "E1")
+    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
+        check.floats(value, name)  # NaN (a value not measured) gives NaN
     E0, E1, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E1, mu, gamma)))
     if np.any(E1 <= 0) or np.any(E0 < E1):
         raise ConfigError("need E0 >= E1 > 0")
@@ -137,10 +169,8 @@ def mean_energy_arrays(t, energy) -> pd.DataFrame:
 
     NaN energies are ignored.  Energy in model units, t in time units.
     """
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
-    if t.shape != e.shape:
-        raise ConfigError(f"t and energy differ in length: {t.size} != {e.size}")
+    t = check.floats(t, "t")
+    e = check.floats(energy, "energy", size=t.size, of="time t")
     ok = np.isfinite(e) & np.isfinite(t)
     t, e = t[ok], e[ok]
     grid, inv = np.unique(t, return_inverse=True)
@@ -173,6 +203,7 @@ def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
     ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
     Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
     """
+    check.frame(snapshots, "snapshots", ("t", "energy"))
     return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
 
 
@@ -186,6 +217,9 @@ def pool_mean_energy(tables) -> pd.DataFrame:
     pooled sum of squared deviations Σ [(n_i − 1) s_i² + n_i (m_i − mean)²]
     (Chan et al.'s parallel variance), so memory stays O(grid) for any N.
     """
+    tables = list(_sequence(tables, "tables"))
+    for i, t in enumerate(tables):
+        check.frame(t, f"tables[{i}]", ("t", "n", "mean_E", "std_E"))
     tabs = [t for t in tables if len(t)]
     cols = ["t", "n", "mean_E", "std_E", "sem_E", "lo_3sigma", "hi_3sigma"]
     if not tabs:
@@ -240,9 +274,12 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
     with E > E_c are those of orbits neither escaped nor settled. Memory stays
     O(grid + one part) for any N.
     """
+    _sequence(parts, "parts")
+    check.number(e_c, "e_c")
     inside, above = [], []
     n_below = 0
     for df in parts:
+        check.frame(df, "a table of parts", ("t", "energy"))
         up = df["energy"] > e_c
         inside.append(mean_energy(df))
         above.append(mean_energy(df[up]))
@@ -352,16 +389,12 @@ def _decay_window(t, mean_E, E0, gamma, window, weights):
     Drops points outside the inclusive window, with non-finite or non-positive ⟨E⟩, or with non-finite or
     non-positive weight; ``weights`` None gives unit weights.
     """
-    if not gamma > 0:
-        raise ConfigError(f"gamma must be > 0, got {gamma!r}")
-    if not E0 > 0:
-        raise ConfigError(f"E0 must be > 0, got {E0!r}")
-    t = np.asarray(t, dtype=float).ravel()
-    m = np.asarray(mean_E, dtype=float).ravel()
-    w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float).ravel()
-    if not (t.shape == m.shape == w.shape):
-        raise ConfigError("t, mean_E and weights must have the same length")
-    t_lo, t_hi = float(window[0]), float(window[1])
+    check.number(gamma, "gamma", positive=True)
+    check.number(E0, "E0", positive=True)
+    t = check.floats(t, "t")
+    m = check.floats(mean_E, "mean_E", size=t.size, of="time t")
+    w = np.ones_like(t) if weights is None else check.floats(weights, "weights", size=t.size, of="time t")
+    t_lo, t_hi = check.interval(window, "window", open_end=True)
     sel = (t >= t_lo) & (t <= t_hi) & np.isfinite(m) & (m > 0) & np.isfinite(w) & (w > 0)
     return t[sel], np.log(m[sel]), w[sel], (t_lo, t_hi)
 
@@ -402,6 +435,7 @@ def fit_energy_decay_table(
     log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
     unweighted log fit of Eq. (eqn:energy_exp_decay).
     """
+    check.frame(table, "table", ("t", "mean_E", "sem_E") if weighted else ("t", "mean_E"))
     weights = None
     if weighted:
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -432,6 +466,8 @@ def mu_by_window(
     to E0) is the cumulative mean exponent ln(E0/⟨E⟩)/(γt) weighted over the
     window and lags behind the local value.
     """
+    windows = _windows(windows)
+    _decay_window(t, mean_E, E0, gamma, windows[0], weights)  # the arguments checked before the first fit
     rows = []
     for lo, hi in windows:
         f = fit_energy_decay(t, mean_E, E0, gamma, (lo, hi), weights, absolute_sigma=absolute_sigma)
@@ -481,8 +517,13 @@ def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
     snapshot grid time.  ``bins`` is a number of bins (then common edges span
     the min..max energy over the selected times) or an array of edges.
     """
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
+    t = check.floats(t, "t")
+    e = check.floats(energy, "energy", size=t.size, of="time t")
+    check.numbers(times, "times")
+    if np.ndim(bins) == 0:
+        check.count(bins, "bins", 1)
+    elif np.any(np.diff(check.numbers(bins, "bins", min_size=2)) <= 0):
+        raise ConfigError("bins must be increasing edges")
     times = np.atleast_1d(np.asarray(times, dtype=float))
     grid = np.unique(t[np.isfinite(t)])
     if grid.size == 0:
@@ -517,6 +558,7 @@ def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistogra
     DataFrame wrapper of :func:`energy_histograms_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
     """
+    check.frame(snapshots, "snapshots", ("t", "energy"))
     return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)
 
 
@@ -550,13 +592,14 @@ def bootstrap_mu(
     Returns one row per (replicate, window): ``replicate, t_lo, t_hi, mu,
     mu_free`` (dimensionless).
     """
-    if n_boot < 1:
-        raise ConfigError(f"n_boot must be ≥ 1, got {n_boot!r}")
+    check.count(n_boot, "n_boot", 1)
+    t = check.floats(t, "t")
+    check.floats(traj_id, "traj_id", size=t.size, of="time t")
     tid = np.asarray(traj_id).ravel()
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
-    if not (tid.shape == t.shape == e.shape):
-        raise ConfigError("traj_id, t and energy must have the same length")
+    e = check.floats(energy, "energy", size=t.size, of="time t")
+    check.number(E0, "E0", positive=True)
+    check.number(gamma, "gamma", positive=True)
+    windows = _windows(windows)
     ok = np.isfinite(t) & np.isfinite(e)
     tid, t, e = tid[ok], t[ok], e[ok]
     _, orb = np.unique(tid, return_inverse=True)
@@ -576,6 +619,13 @@ def bootstrap_mu(
     return pd.DataFrame(rows, columns=["replicate", "t_lo", "t_hi", "mu", "mu_free"])
 
 
+def _first_orbits(n_orbits, k) -> None:
+    """``n_orbits`` an integer ≥ 1 and ``k`` an integer in [1, n_orbits]."""
+    check.count(n_orbits, "n_orbits", 1)
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= n_orbits:
+        raise ConfigError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
+
+
 def bootstrap_mu_first_orbits(
     rows: pd.DataFrame, n_orbits: int, k: int, E0: float, gamma: float, windows, *, n_boot: int = 200, seed: int = 0
 ):
@@ -587,8 +637,8 @@ def bootstrap_mu_first_orbits(
     keeps the bootstrap affordable at N = 10^7. ``rows`` may already be
     restricted to those orbits (e.g. by a filter pushed down to the reader).
     """
-    if not 1 <= k <= n_orbits:
-        raise ConfigError(f"k must be in [1, n_orbits = {n_orbits}], got {k!r}")
+    check.frame(rows, "rows", ("traj_id", "t", "energy"))
+    _first_orbits(n_orbits, k)
     sub = rows[rows["traj_id"] < k]
     boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
     return boot, float(np.sqrt(k / n_orbits))
@@ -626,6 +676,14 @@ def decay_exponent(
     >>> round(d.mu, 9), round(d.mu_err, 9), d.rows_below_ec
     (0.8, 0.0, 6)
     """
+    _sequence(parts, "parts")
+    check.frame(rows, "rows", ("traj_id", "t", "energy"))
+    _first_orbits(n_orbits, k)
+    check.number(E0, "E0", positive=True)
+    check.number(gamma, "gamma", positive=True)
+    check.number(e_c, "e_c")
+    check.interval(window, "window", open_end=True)
+    check.count(n_boot, "n_boot", 1)
     ime = inside_mean_energy(parts, e_c)
     me = ime.inside
     win = tuple(window)

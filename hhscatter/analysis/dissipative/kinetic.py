@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -55,11 +56,14 @@ class KineticFraction:
 
 def _checked_rows(traj_id, t, energy, gamma):
     """(traj_id, t, energy) as flat arrays of one length, and γ finite and > 0 (else ValueError)."""
+    check.numbers(traj_id, "traj_id", min_size=0)
     ids = np.asarray(traj_id, dtype=np.int64).ravel()
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
+    t = check.numbers(t, "t", min_size=0)
+    e = check.numbers(energy, "energy", min_size=0)
     if not (ids.size == t.size == e.size):
         raise ConfigError("traj_id, t and energy differ in length")
+    if isinstance(gamma, bool) or not isinstance(gamma, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"gamma must be finite and > 0, got {gamma!r}")
     if not (gamma > 0 and math.isfinite(gamma)):
         raise ConfigError(f"gamma must be finite and > 0, got {gamma}")
     return ids, t, e
@@ -87,6 +91,9 @@ def kinetic_fraction_from_energies(
     0.9
     """
     ids, t, e = _checked_rows(traj_id, t, energy, gamma_probe)
+    check.number(t_from, "t_from")
+    check.number(t_to, "t_to")
+    check.count(n_boot, "n_boot", 0)
     if not t_to > t_from:
         raise ConfigError(f"need t_to > t_from, got [{t_from}, {t_to}]")
     sel = (t >= t_from) & (t <= t_to)
@@ -166,6 +173,11 @@ def microcanonical_kinetic_fraction(potential, energy: float, extent: float, *, 
     >>> abs(f - 1.0) < 1e-3
     True
     """
+    check.function(potential, "potential")
+    check.number(extent, "extent", positive=True)
+    check.count(n_grid, "n_grid", 1)
+    if isinstance(energy, bool) or not isinstance(energy, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"energy must be > 0, got {energy!r}")
     if not energy > 0:
         raise ConfigError(f"energy must be > 0, got {energy}")
     h = 2.0 * extent / n_grid
@@ -200,6 +212,10 @@ def decay_path(t, E0: float, gamma: float, mu_of_E) -> np.ndarray:
     """
     from scipy.integrate import solve_ivp  # deferred: scipy loads on first use
 
+    check.numbers(t, "t")
+    check.number(E0, "E0", positive=True)
+    check.number(gamma, "gamma")
+    check.function(mu_of_E, "mu_of_E")
     t = np.asarray(t, dtype=float)
     if t.size == 0 or np.any(np.diff(t) < 0) or t[0] < 0:
         raise ConfigError("t must be non-empty, ≥ 0 and increasing")

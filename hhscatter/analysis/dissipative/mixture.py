@@ -57,6 +57,7 @@ from hhscatter.analysis.dissipative.survival_model import (
     _survival_fit,
 )
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -180,16 +181,20 @@ def mixture_components_arrays(
     decay settle, ⟨E⟩_k(t) over those still alive is pulled towards the slow
     ones and its slope underestimates the members' decay.
     """
+    t = check.floats(t, "t")
+    check.numbers(traj_id, "traj_id")
     ids = np.asarray(traj_id).ravel()
-    t = np.asarray(t, dtype=float).ravel()
-    e = np.asarray(energy, dtype=float).ravel()
-    if not (ids.shape == t.shape == e.shape):
-        raise ConfigError("traj_id, t and energy must have the same length")
+    if ids.size != t.size:
+        raise ConfigError(f"traj_id must have one value per time t: {ids.size} != {t.size}")
+    e = check.floats(energy, "energy", size=t.size, of="time t")
+    if not np.isfinite(t).any():
+        raise ConfigError("t must hold at least one finite snapshot time")
+    check.number(gamma, "gamma", positive=True)
+    check.number(t_ref, "t_ref")
+    check.interval(fit_window, "fit_window", open_end=True)
     if by not in ("energy", "rate"):
         raise ConfigError("by must be 'energy' or 'rate'")
-    K = int(n_components)
-    if K < 1:
-        raise ConfigError("n_components must be >= 1")
+    K = check.count(n_components, "n_components", 1)
     t_used, ids_ref, e_ref = _orbits_at(ids, t, e, t_ref)
     mu_i, a_ref = _member_decay_laws(ids, t, e, ids_ref, gamma, fit_window)
     edges, comp, n_ref = _quantile_bins(e_ref if by == "energy" else mu_i, K, t_used)
@@ -276,6 +281,7 @@ def mixture_components(
     DataFrame wrapper of :func:`mixture_components_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
     """
+    check.frame(snapshots, "snapshots", ("traj_id", "t", "energy"))
     return mixture_components_arrays(
         snapshots["traj_id"].to_numpy(),
         snapshots["t"].to_numpy(),
@@ -312,7 +318,18 @@ def mixture_survival_model(
     None, Eq. (eq:tau2) per sub-ensemble) and shared settling parameters L, b.
     NaN for t < τ0.
     """
-    c = components
+    check.numbers(t, "t", min_size=0)
+    check.function(kappa_of_E, "kappa_of_E")
+    c = check.instance(components, "components", MixtureComponents)
+    check.number(tau0, "tau0")
+    check.floats(f_ne, "f_ne")
+    for value, name in ((P_tau0, "P_tau0"), (L, "L"), (b, "b")):
+        check.real(value, name)
+    check.number(E_c, "E_c", positive=True)
+    if hazard not in HAZARDS:
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    if tau2 is not None:
+        check.floats(tau2, "tau2")
     f_ne = np.broadcast_to(np.asarray(f_ne, dtype=float), (c.K,))
     tau2_k = c.tau2(E_c) if tau2 is None else np.broadcast_to(np.asarray(tau2, dtype=float), (c.K,))
     f_e = c.weights * P_tau0 - f_ne
@@ -409,6 +426,16 @@ def fit_mixture_model(
     of the measured component paths (A_k, μ_k) is not propagated, and the
     error model (independent points) is that of :func:`fit_survival_model`.
     """
+    check.function(kappa_of_E, "kappa_of_E")
+    check.instance(components, "components", (MixtureComponents, pd.DataFrame))
+    check.number(tau0, "tau0")
+    check.number(E_c, "E_c", positive=True)
+    for d, name in ((fixed, "fixed"), (p0, "p0")):
+        if d is not None:
+            check.mapping(d, name)
+    if space not in ("log", "linear"):
+        raise ConfigError(f"space must be 'log' or 'linear', got {space!r}")
+    _fit_data_checked(t, P, P_err, P_tau0, t_max, P_min)
     c = _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window)
     if fne_mode not in ("free", "shared"):
         raise ConfigError("fne_mode must be 'free' or 'shared'")
@@ -434,6 +461,18 @@ def fit_mixture_model(
 
 
 # the steps of fit_mixture_model
+def _fit_data_checked(t, P, P_err, P_tau0, t_max, P_min) -> None:
+    """The data arguments of :func:`fit_mixture_model` checked before the components are built."""
+    size = check.floats(t, "t").size
+    check.floats(P, "P", size=size, of="time t")
+    check.floats(P_err, "P_err", size=size, of="time t")
+    if P_tau0 is not None:
+        check.number(P_tau0, "P_tau0", minimum=0.0)
+    if t_max is not None:
+        check.real(t_max, "t_max")
+    check.number(P_min, "P_min")
+
+
 def _components_of(components, gamma, tau0, t_ref, n_components, by, fit_window) -> MixtureComponents:
     """``components`` as given, or built from a snapshots DataFrame by :func:`mixture_components` (t_ref: τ0)."""
     if isinstance(components, pd.DataFrame):

@@ -13,9 +13,10 @@ import pandas as pd
 from scipy import optimize
 
 from hhscatter.analysis.dissipative.curve_fit import best_of
-from hhscatter.analysis.dissipative.mixture import fit_mixture_model
-from hhscatter.analysis.dissipative.survival_model import fit_survival_model
+from hhscatter.analysis.dissipative.mixture import MixtureComponents, fit_mixture_model
+from hhscatter.analysis.dissipative.survival_model import HAZARDS, fit_survival_model
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -33,6 +34,27 @@ __all__ = [
 # ---------------------------------------------------------------------------
 # τ1 from the model
 # ---------------------------------------------------------------------------
+def _curve(t, P, names=("t", "P")) -> None:
+    """A measured curve: increasing finite times ``t`` (at least one) and P with one value per time (NaN may stand)."""
+    if np.ndim(t) != 1:
+        raise ConfigError(f"{names[0]} must be a 1-D array of times, got {type(t).__name__}")
+    t = check.numbers(t, names[0])
+    check.floats(P, names[1], size=t.size, of=f"time {names[0]}")
+    if np.any(np.diff(t) < 0):
+        raise ConfigError(f"{names[0]} must be increasing")
+
+
+def _hazards(hazards) -> None:
+    if isinstance(hazards, (str, bytes, dict)) or not isinstance(hazards, (list, tuple)) or not hazards:
+        raise ConfigError(f"hazards must be a non-empty list of {HAZARDS}, got {hazards!r}")
+    for h in hazards:
+        if h not in HAZARDS:
+            raise ConfigError(f"hazards must be a non-empty list of {HAZARDS}, got {hazards!r}")
+
+
+_FIT_FIELDS = ("n_points", "free", "chi2", "dof", "chi2_red", "rms_log_residual", "aic")
+
+
 def _as_curve(P_0):
     if callable(P_0):
         return P_0
@@ -67,6 +89,16 @@ def predict_tau1(params, P_0, alpha: float = 2.0, *, t_max: float | None = None,
     """
     if hasattr(params, "params") and not hasattr(params, "tau0"):
         params = params.params
+    if not (callable(params) and hasattr(params, "tau0")):
+        raise ConfigError(f"params must be model parameters with tau0 that give P(t), got {type(params).__name__}")
+    if not callable(P_0):
+        if isinstance(P_0, (str, bytes, dict)) or not hasattr(P_0, "__len__") or len(P_0) != 2:
+            raise ConfigError(f"P_0 must be a function P_0(t) or a pair (t_grid, P0_values), got {P_0!r}")
+        _curve(P_0[0], P_0[1], ("P_0[0]", "P_0[1]"))
+    check.number(alpha, "alpha", positive=True)
+    if t_max is not None:
+        check.number(t_max, "t_max")
+    check.count(n_grid, "n_grid", 2)
     tau0 = float(params.tau0)
     f0 = _as_curve(P_0)
     if t_max is None:
@@ -115,6 +147,9 @@ def compare_fits(fits: dict) -> pd.DataFrame:
     The comparison is meaningful only for fits on the same data selection
     (equal n_points, same τ0, t_max, P_min and residual space).
     """
+    check.mapping(fits, "fits", min_size=1)
+    for name, f in fits.items():
+        check.having(f, f"fits[{name!r}]", _FIT_FIELDS, "a SurvivalFit")
     rows = []
     for name, f in fits.items():
         rows.append(
@@ -144,8 +179,11 @@ def better_fit(fits: dict) -> str | None:
     The fits must share their fitted points (same ``t_fit``), else the
     comparison means nothing: ValueError.
     """
+    check.mapping(fits, "fits")
     if len(fits) < 2:
         raise ConfigError("better_fit needs at least two fits")
+    for name, f in fits.items():
+        check.having(f, f"fits[{name!r}]", ("t_fit", "rms_log_residual"), "a SurvivalFit")
     items = list(fits.items())
     t_ref = np.asarray(items[0][1].t_fit)
     for name, f in items[1:]:
@@ -178,6 +216,12 @@ def survival_fit_points(t, P, P_err, tau0: float, fit_dt: float, n: int, min_cou
     >>> survival_fit_points(t, P, 0.01 * P, 1.0, 2.0, 1000, 20)[0].tolist()
     [1.0, 3.0, 5.0, 7.0, 9.0]
     """
+    _curve(t, P)
+    check.floats(P_err, "P_err", size=len(t), of="time t")
+    check.number(tau0, "tau0")
+    check.number(fit_dt, "fit_dt", positive=True)
+    check.number(n, "n", positive=True)
+    check.number(min_count, "min_count", minimum=0.0)
     grid = np.arange(tau0, t[-1] + 1e-9, fit_dt)
     idx = np.clip(np.searchsorted(t, grid), 0, t.size - 1)
     idx = np.unique(idx)
@@ -203,6 +247,8 @@ def best_fit(fit_fn: Callable, starts):
 def plateau_level(t, P, t_q: float) -> float:
     """plateau_level(t, P, t_q) -> P at time t_q (log-linear interpolation): the trapped fraction before settling
     starts, when t_q is late in the escape regime."""
+    _curve(t, P)
+    check.number(t_q, "t_q")
     return float(np.exp(np.interp(t_q, t, np.log(np.maximum(P, 1e-300)))))
 
 
@@ -216,6 +262,18 @@ def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, ta
     and f_ne = P at τ0 + 0.85 (τ2 − τ0) with (L, b) = (1, 1) and (3, 0.3)), the best χ² kept
     (:func:`best_fit`). Units: t in time units, E in energy units, γ in 1/time.
     """
+    _curve(t, P)
+    check.floats(P_err, "P_err", size=len(t), of="time t")
+    _curve(tf, Pf, ("tf", "Pf"))
+    check.floats(sf, "sf", size=len(tf), of="time tf")
+    check.function(kappa, "kappa")
+    check.number(E0, "E0", positive=True)
+    check.number(mu, "mu")
+    check.number(gamma, "gamma", minimum=0.0)
+    check.number(tau0, "tau0")
+    check.number(E_c, "E_c", positive=True)
+    _hazards(hazards)
+    check.number(P_min, "P_min")
     P_tau0 = plateau_level(t, P, tau0)
     tau2 = tau2_predicted(E0, E_c, mu, gamma)
     fne = min(plateau_level(t, P, tau0 + 0.85 * (tau2 - tau0)), 0.95 * P_tau0)
@@ -275,6 +333,17 @@ def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, m
     >>> sorted(fits), bool(np.isfinite(fits["paper"].chi2))
     (['paper'], True)
     """
+    _curve(t, P)
+    _curve(tf, Pf, ("tf", "Pf"))
+    check.floats(sf, "sf", size=len(tf), of="time tf")
+    check.instance(comps, "comps", MixtureComponents)
+    check.function(kappa, "kappa")
+    check.number(tau0, "tau0")
+    check.number(E_c, "E_c", positive=True)
+    _hazards(hazards)
+    if mode not in ("shared", "free"):
+        raise ConfigError(f"mode must be 'shared' or 'free', got {mode!r}")
+    check.number(P_min, "P_min")
     P_tau0 = plateau_level(t, P, tau0)
     t2 = float(np.min(comps.tau2(E_c)))
     fne = min(plateau_level(t, P, tau0 + 0.85 * max(t2 - tau0, 0.0)), 0.95 * P_tau0)

@@ -52,8 +52,9 @@ from hhscatter.analysis.dissipative.curve_fit import (
     residual_fn,
     select_points,
 )
-from hhscatter.analysis.dissipative.decay import energy_path
+from hhscatter.analysis.dissipative.decay import _energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
 __all__ = [
@@ -74,11 +75,32 @@ HAZARDS = ("paper", "integrated")
 # ---------------------------------------------------------------------------
 # building blocks
 # ---------------------------------------------------------------------------
+def _time_or_inf(v, name: str) -> float:
+    """``v`` as a time (time units) that may be +inf (never), not NaN."""
+    v = check.real(v, name)
+    if v != v:
+        raise ConfigError(f"{name} must be a time or inf, got nan")
+    return v
+
+
+def _optional_mapping(d, name: str) -> None:
+    if d is not None:
+        check.mapping(d, name)
+
+
 def settling_rate(t, tau2: float, L: float, b: float):
     """settling_rate(t, tau2, L, b) -> g(t) = L / (1 + exp(−b (t − τ2)))² (Eq. (eqn:surv_prob_model), t > τ2 branch).
 
     Increases monotonically from L/4 at t = τ2 to L; rate in 1/time.
     """
+    check.numbers(t, "t", min_size=0)
+    for value, name in ((tau2, "tau2"), (L, "L"), (b, "b")):
+        check.real(value, name)
+    return _settling_rate(t, tau2, L, b)
+
+
+def _settling_rate(t, tau2, L, b):
+    """:func:`settling_rate` without its checks, for the models that evaluate it at every step of a fit."""
     return L * special.expit(b * (np.asarray(t, dtype=float) - tau2)) ** 2
 
 
@@ -86,7 +108,7 @@ def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
     """X(t) for t ≥ τ0 along E(t) = A e^{−μγt}: κ0(E(t))(t−τ0), or ∫_{τ0}^t κ0(E(s))ds with hazard "integrated"."""
     t = np.asarray(t, dtype=float)
     if hazard == "paper":
-        return np.asarray(kappa_of_E(energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
+        return np.asarray(kappa_of_E(_energy_path(t, A, mu, gamma)), dtype=float) * (t - tau0)
     if hazard == "integrated":
         if t.size == 0:
             return t.copy()
@@ -94,7 +116,7 @@ def _escape_exponent(t, kappa_of_E, A, mu, gamma, tau0, hazard, n_int=4001):
         if t_hi <= tau0:
             return np.zeros_like(t)
         s = np.linspace(tau0, t_hi, n_int)
-        k = np.asarray(kappa_of_E(energy_path(s, A, mu, gamma)), dtype=float)
+        k = np.asarray(kappa_of_E(_energy_path(s, A, mu, gamma)), dtype=float)
         cum = np.concatenate([[0.0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
         return np.interp(t, s, cum)
     raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
@@ -110,7 +132,7 @@ def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
         out[mid] = f_ne + f_e * np.exp(-_escape_exponent(t[mid], kappa_of_E, A, mu, gamma, tau0, hazard))
     if late.any():
         tl = t[late]
-        out[late] = f_ne * np.exp(-settling_rate(tl, tau2, L, b) * (tl - tau2))
+        out[late] = f_ne * np.exp(-_settling_rate(tl, tau2, L, b) * (tl - tau2))
     return out
 
 
@@ -315,6 +337,17 @@ def fit_survival_model(
     Returns SurvivalFit (params, values, errors, χ²/dof, RMS log residual,
     AIC, ...).
     """
+    check.function(kappa_of_E, "kappa_of_E")
+    check.number(E0, "E0", positive=True)
+    check.number(mu, "mu")
+    check.number(gamma, "gamma", minimum=0.0)
+    if tau2 is not None:
+        _time_or_inf(tau2, "tau2")
+    check.number(E_c, "E_c", positive=True)
+    _optional_mapping(fixed, "fixed")
+    _optional_mapping(p0, "p0")
+    if space not in ("log", "linear"):
+        raise ConfigError(f"space must be 'log' or 'linear', got {space!r}")
     fixed = _checked_fixed(fixed, hazard)
     P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
     tau2_eq, fit_tau2 = _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2)
@@ -360,6 +393,15 @@ def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
 
     The points are those with τ0 ≤ t ≤ t_max (time units), P > P_min and a positive error; at least 3.
     """
+    size = check.floats(t, "t").size
+    check.floats(P, "P", size=size, of="time t")
+    check.floats(P_err, "P_err", size=size, of="time t")
+    check.number(tau0, "tau0")
+    if P_tau0 is not None:
+        check.number(P_tau0, "P_tau0", minimum=0.0)
+    if t_max is not None:
+        check.real(t_max, "t_max")
+    check.number(P_min, "P_min")
     t_all = np.asarray(t, dtype=float)
     if P_tau0 is None:
         P_tau0, P_tau0_err = p_at(t_all, P, P_err, tau0)
@@ -419,6 +461,14 @@ def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
     """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
     values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
     L ≈ the late log-slope of P, and three starts for b unless given."""
+    size = check.floats(tf, "tf").size
+    check.floats(Pf, "Pf", size=size, of="time tf")
+    if size == 0:
+        raise ConfigError("tf must hold at least one fitted point")
+    _time_or_inf(tau2, "tau2")
+    check.number(P_tau0, "P_tau0", minimum=0.0)
+    check.mapping(fixed, "fixed")
+    _optional_mapping(p0, "p0")
     p0 = dict(p0 or {})
 
     def p_near(tq):

@@ -24,11 +24,13 @@ Units: model time units for all times; energies in model units.
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.survival.fits import (
     observed_from_outcome,
@@ -73,6 +75,19 @@ def outcome_is(outcome, value: str) -> np.ndarray:
     return np.asarray(outcome).ravel() == value
 
 
+def _outcomes(outcome, name: str, size: int):
+    """``outcome`` if it is an array or Series of labels with one per orbit (``size``)."""
+    if isinstance(outcome, (str, bytes, dict)) or outcome is None or not hasattr(outcome, "__len__"):
+        raise ConfigError(f"{name} must be an array of outcome labels, got {type(outcome).__name__}")
+    if len(outcome) != size:
+        raise ConfigError(f"{name} must have one value per orbit: {len(outcome)} != {size}")
+    return outcome
+
+
+def _lifetimes(lifetimes, name: str = "lifetimes"):
+    return check.frame(lifetimes, name, ("t_end", "outcome"))
+
+
 def _log_ratio(P_gamma, P_0, alpha):
     """D = ln P_γ − ln(α P_0), with +inf where P_0 = 0 < P_γ and NaN where both vanish."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -98,15 +113,18 @@ def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
     censoring) are skipped.  Returns None if the condition is never met on
     [τ0, t[-1]] (e.g. no escaping orbits left, Fig. 6b large γ).
     """
-    if not alpha > 0:
-        raise ConfigError(f"alpha must be > 0, got {alpha!r}")
-    t = np.asarray(t, dtype=float).ravel()
-    Pg = np.asarray(P_gamma, dtype=float).ravel()
-    P0 = np.asarray(P_0(t) if callable(P_0) else P_0, dtype=float).ravel()
-    if not (t.shape == Pg.shape == P0.shape):
-        raise ConfigError("t, P_gamma and P_0 must have the same length")
+    check.number(alpha, "alpha", positive=True)
+    check.number(tau0, "tau0")
+    t = check.numbers(t, "t", min_size=0)
+    Pg = check.floats(P_gamma, "P_gamma", size=t.size, of="t")
+    P0 = check.floats(P_0(t) if callable(P_0) else P_0, "P_0", size=t.size, of="t")
     if t.size and np.any(np.diff(t) <= 0):
         raise ConfigError("t must be strictly increasing")
+    return _tau1(t, Pg, P0, tau0, alpha)
+
+
+def _tau1(t, Pg, P0, tau0, alpha):
+    """:func:`tau1` on checked arrays (the strictly increasing grid ``t``, P_γ and P_0 on it)."""
     D = _log_ratio(Pg, P0, alpha)
     keep = ~np.isnan(D)
     t, D = t[keep], D[keep]
@@ -150,7 +168,11 @@ def tau1_from_lifetimes(
     :func:`hhscatter.analysis.survival.fits.survival_from_lifetimes` (Kaplan–Meier;
     'escaped' and 'settled' leave, 'censored' is right-censored).
     """
-
+    _lifetimes(lifetimes_gamma, "lifetimes_gamma")
+    _lifetimes(lifetimes_0, "lifetimes_0")
+    check.numbers(t_grid, "t_grid", minimum=0.0)
+    check.number(tau0, "tau0")
+    check.number(alpha, "alpha", positive=True)
     Pg = survival_from_lifetimes(lifetimes_gamma, t_grid).P
     P0 = survival_from_lifetimes(lifetimes_0, t_grid).P
     return tau1(t_grid, Pg, P0, tau0, alpha)
@@ -169,8 +191,8 @@ def tau2_observed_arrays(t_end, outcome):
     Escaped orbits (whose energy also falls below E_c, but outside Ω) and
     censored orbits are not used.
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    settled = outcome_is(outcome, "settled") & np.isfinite(t_end)
+    t_end = check.floats(t_end, "t_end")
+    settled = outcome_is(_outcomes(outcome, "outcome", t_end.size), "settled") & np.isfinite(t_end)
     return float(t_end[settled].min()) if settled.any() else None
 
 
@@ -180,6 +202,7 @@ def tau2_observed(lifetimes: pd.DataFrame):
     The observed τ2 of the paper's Fig. 6b caption: "the first time at which
     the energy of a non-escaping orbit dropped below E_c".
     """
+    _lifetimes(lifetimes)
     return tau2_observed_arrays(lifetimes["t_end"].to_numpy(), lifetimes["outcome"])
 
 
@@ -230,7 +253,12 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
     """
     from scipy import stats  # deferred: scipy loads on first use
 
-    t_end = np.asarray(t_end, dtype=float).ravel()
+    t_end = check.floats(t_end, "t_end")
+    _outcomes(outcome, "outcome", t_end.size)
+    check.number(p, "p")
+    check.number(level, "level", positive=True)
+    if not level < 1:
+        raise ConfigError(f"level must be < 1, got {level!r}")
     settled = outcome_is(outcome, "settled") & np.isfinite(t_end)
     x = np.sort(t_end[settled])
     n = int(t_end.size)
@@ -262,6 +290,8 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
 def tau2_observed_interval(lifetimes: pd.DataFrame, level: float = 0.6826894921370859) -> OrderStatisticInterval:
     """tau2_observed_interval(lifetimes) -> :func:`settle_quantile_interval` at p = 1/N: the observed τ2 (first
     settling time) and the order-statistic interval of the quantile it estimates."""
+    if len(_lifetimes(lifetimes)) == 0:
+        raise ConfigError("lifetimes must hold at least one orbit")
     return settle_quantile_interval(lifetimes["t_end"].to_numpy(), lifetimes["outcome"], 1.0 / len(lifetimes), level)
 
 
@@ -275,6 +305,9 @@ def tau2_predicted(E0, E_c, mu, gamma):
     0 where E0 ≤ E_c (no escape regime at all) and +inf where μγ = 0 (< 0 is
     rejected).  Time in model units.
     """
+    check.numbers(E_c, "E_c")
+    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
+        check.floats(value, name)  # NaN (a value not measured) gives NaN
     E0, E_c, mu, gamma = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E0, E_c, mu, gamma)))
     rate = mu * gamma
     if np.any(rate < 0) or np.any(E_c <= 0):
@@ -288,6 +321,12 @@ def tau2_predicted(E0, E_c, mu, gamma):
 # ---------------------------------------------------------------------------
 # survival on a grid with orbit weights, and the bootstrap of τ0, τ1, τ2
 # ---------------------------------------------------------------------------
+def _quantiles(qs, name: str = "qs") -> None:
+    check.numbers(qs, name, minimum=0.0)
+    if not np.all(np.asarray(qs, dtype=float) <= 1.0):
+        raise ConfigError(f"{name} must lie in [0, 1], got {qs!r}")
+
+
 def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
     """settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None) -> array or None.
 
@@ -295,7 +334,17 @@ def settle_time_quantiles(t_end, outcome, qs=(0.01, 0.5), weights=None):
     a robust companion of the observed τ2, whose minimum depends on the
     ensemble size N (the first of N·f_ne settlers).  None if nobody settled.
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
+    t_end = check.floats(t_end, "t_end")
+    _outcomes(outcome, "outcome", t_end.size)
+    _quantiles(qs)
+    if weights is not None:
+        check.numbers(weights, "weights", min_size=0, minimum=0.0)
+        check.floats(weights, "weights", size=t_end.size)
+    return _settle_time_quantiles(t_end, outcome, qs, weights)
+
+
+def _settle_time_quantiles(t_end, outcome, qs, weights):
+    """:func:`settle_time_quantiles` on checked arguments (``t_end`` a flat float array)."""
     s = outcome_is(outcome, "settled")
     w = np.ones_like(t_end) if weights is None else np.asarray(weights, dtype=float).ravel()
     s &= w > 0
@@ -335,10 +384,19 @@ def bootstrap_transition_times(
     Returns one row per (replicate, label != reference): ``replicate, label,
     tau0, tau1, tau2_obs, t_settle_q<q>...`` (NaN where undefined).
     """
-    if reference not in curves:
+    check.mapping(curves, "curves", min_size=1)
+    if not isinstance(reference, Hashable) or reference not in curves:
         raise ConfigError(f"reference {reference!r} is not one of the curves {list(curves)}")
-    if n_boot < 1:
-        raise ConfigError(f"n_boot must be ≥ 1, got {n_boot!r}")
+    check.count(n_boot, "n_boot", 1)
+    check.numbers(grid, "grid", minimum=0.0)
+    if not callable(tau0):
+        check.number(tau0, "tau0")
+    check.number(alpha, "alpha", positive=True)
+    _quantiles(settle_q, "settle_q")
+    for lab, pair in curves.items():
+        if isinstance(pair, (str, bytes, dict)) or not hasattr(pair, "__len__") or len(pair) != 2:
+            raise ConfigError(f"curves[{lab!r}] must be a pair (t_end, outcome), got {type(pair).__name__}")
+        _outcomes(pair[1], f"curves[{lab!r}] outcome", check.numbers(pair[0], f"curves[{lab!r}] t_end").size)
     arrs = {}
     n = None
     for lab, (t_end, outcome) in curves.items():
@@ -350,6 +408,8 @@ def bootstrap_transition_times(
             raise ConfigError(f"curve {lab!r} has {t_end.size} orbits, expected {n} (paired ensembles)")
         arrs[lab] = (t_end, outcome, observed_from_outcome(outcome))
     g = np.asarray(grid, dtype=float)
+    if len(curves) > 1 and g.size and np.any(np.diff(g.ravel()) <= 0):
+        raise ConfigError("grid must be strictly increasing")
     rng = np.random.default_rng(seed)
     qcols = [f"t_settle_q{q:g}" for q in settle_q]
     rows = []
@@ -362,10 +422,10 @@ def bootstrap_transition_times(
             if lab == reference:
                 continue
             Pg = survival_on_grid(t_end, obs, g, w)
-            t1 = tau1(g, Pg, P0, t0, alpha)
+            t1 = _tau1(g, Pg, P0, t0, alpha)
             sel = (outcome == "settled") & (w > 0)
             t2 = float(t_end[sel].min()) if sel.any() else np.nan
-            qv = settle_time_quantiles(t_end, outcome, settle_q, w)
+            qv = _settle_time_quantiles(t_end, outcome, settle_q, w)
             row = {"replicate": b, "label": lab, "tau0": t0, "tau1": np.nan if t1 is None else t1, "tau2_obs": t2}
             vals = [np.nan] * len(qcols) if qv is None else [float(v) for v in qv]
             row.update(dict(zip(qcols, vals)))
@@ -417,6 +477,10 @@ def subsample_bootstrap_transition_times(
     >>> b.n_orbits, b.scale, len(b.replicates)
     (1000, 0.5, 20)
     """
+    check.mapping(lifetimes, "lifetimes", min_size=1)
+    for label, lt in lifetimes.items():
+        _lifetimes(lt, f"lifetimes[{label!r}]")
+    check.count(n_orbits, "n_orbits", 1)
     N = len(next(iter(lifetimes.values())))
     K = min(n_orbits, N)
     curves = {g: (lt["t_end"].iloc[:K].to_numpy(), lt["outcome"].iloc[:K].to_numpy()) for g, lt in lifetimes.items()}
@@ -432,7 +496,9 @@ def power_law_exponent(gamma, tau, tau_err):
     than their errors. With no usable error at all the fit is unweighted and
     σ_p comes from the residual scatter. E.g. τ2 ∝ 1/γ, Eq. (eq:tau2), is p = 1.
     """
-    g, t, e = (np.asarray(v, dtype=float) for v in (gamma, tau, tau_err))
+    g = check.floats(gamma, "gamma")
+    t = check.floats(tau, "tau", size=g.size, of="gamma")
+    e = check.floats(tau_err, "tau_err", size=g.size, of="gamma")
     ok = np.isfinite(t) & (t > 0) & (g > 0)
     if ok.sum() < 2:
         return None, None

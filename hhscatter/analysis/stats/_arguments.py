@@ -6,6 +6,15 @@
 Traceback (most recent call last):
 ...
 hhscatter.errors.ConfigError: t_end must be finite (no NaN or inf)
+>>> import pandas as pd
+>>> frame(pd.DataFrame({"t_end": [1.0]}), "lifetimes", ["t_end", "outcome"])
+Traceback (most recent call last):
+...
+hhscatter.errors.ConfigError: lifetimes lacks the column(s) outcome
+>>> mapping([], "fits")
+Traceback (most recent call last):
+...
+hhscatter.errors.ConfigError: fits must be a dict, got list
 """
 
 from __future__ import annotations
@@ -115,3 +124,76 @@ def table(df, name: str, columns=(), *, min_rows: int = 1):
     if len(df) < min_rows:
         raise ConfigError(f"{name} must hold at least {min_rows} row(s), got {len(df)}")
     return df
+
+
+def frame(df, name: str, columns=()):
+    """``df`` if it is a pandas DataFrame holding ``columns`` (the missing ones are named)."""
+    import pandas as pd  # deferred: pandas loads only for the estimators that take a table
+
+    if not isinstance(df, pd.DataFrame):
+        raise ConfigError(f"{name} must be a pandas DataFrame, got {type(df).__name__}")
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise ConfigError(f"{name} lacks the column(s) {', '.join(missing)}")
+    return df
+
+
+def mapping(d, name: str, *, min_size: int = 0) -> dict:
+    """``d`` if it is a mapping (a dict) of at least ``min_size`` entries."""
+    if not isinstance(d, dict):
+        raise ConfigError(f"{name} must be a dict, got {type(d).__name__}")
+    if len(d) < min_size:
+        raise ConfigError(f"{name} must hold at least {min_size} entr{'y' if min_size == 1 else 'ies'}, got {len(d)}")
+    return d
+
+
+def instance(obj, name: str, kind: type | tuple[type, ...]):
+    """``obj`` if it is an instance of ``kind`` (a class, or a tuple of classes)."""
+    if not isinstance(obj, kind):
+        want = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise ConfigError(f"{name} must be a {want}, got {type(obj).__name__}")
+    return obj
+
+
+def floats(a, name: str, *, size: int | None = None, of: str = "orbit") -> np.ndarray:
+    """``a`` as a 1-D float array of numbers where NaN and inf may stand (the estimator drops them); ``size`` values."""
+    if isinstance(a, (str, bytes, dict)) or a is None:
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
+    try:
+        arr = np.asarray(a)
+        if arr.dtype == bool or arr.dtype.kind not in "iuf":
+            raise TypeError
+        arr = arr.astype(float).ravel()
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+    if size is not None and arr.size != size:
+        raise ConfigError(f"{name} must have one value per {of}: {arr.size} != {size}")
+    return arr
+
+
+def interval(w, name: str, *, minimum: float | None = None, open_end: bool = False) -> tuple[float, float]:
+    """``w`` = (lo, hi) as two numbers with lo < hi (lo ≥ ``minimum``; hi may be +inf if ``open_end``)."""
+    if isinstance(w, (str, bytes, dict)) or not hasattr(w, "__len__") or len(w) != 2:
+        raise ConfigError(f"{name} must be a pair (lo, hi), got {w!r}")
+    lo = number(w[0], f"{name}[0]", minimum=minimum)
+    hi = w[1]
+    if not (open_end and isinstance(hi, (int, float, np.integer, np.floating)) and hi == math.inf):
+        hi = number(hi, f"{name}[1]")
+    if not lo < hi:
+        raise ConfigError(f"{name} must satisfy lo < hi, got {w!r}")
+    return lo, float(hi)
+
+
+def real(v, name: str) -> float:
+    """``v`` as a float where NaN or inf may stand (a value not measured, a bound not set); never a word or None."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        raise ConfigError(f"{name} must be a number, got {v!r}")
+    return float(v)
+
+
+def having(obj, name: str, attributes: tuple[str, ...], kind: str):
+    """``obj`` if it has every one of ``attributes`` (a result of ``kind``); the first one lacking is named."""
+    lacking = [a for a in attributes if not hasattr(obj, a)]
+    if lacking:
+        raise ConfigError(f"{name} must be {kind}, got {type(obj).__name__} without {lacking[0]}")
+    return obj

@@ -18,6 +18,7 @@ import numpy as np
 from scipy import optimize
 from scipy.special import logsumexp
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.errors import ConfigError
 
@@ -147,12 +148,8 @@ def kappa_from_cmeasure(
 # the steps of kappa_from_cmeasure
 def _checked_sample(return_times, n_exit):
     """The checked c-measure sample: (return times T (time units), number of exits, sample size M)."""
-    T = np.asarray(return_times, dtype=float).ravel()
-    if np.any(~np.isfinite(T)) or np.any(T <= 0):
-        raise ConfigError("return times must be finite and > 0")
-    n_exit = int(n_exit)
-    if n_exit < 0:
-        raise ConfigError("n_exit must be ≥ 0")
+    T = check.numbers(return_times, "return_times", min_size=0, positive=True)
+    n_exit = check.count(n_exit, "n_exit", 0)
     M = T.size + n_exit
     if M == 0:
         raise ConfigError("empty sample")
@@ -225,6 +222,11 @@ def cmeasure_sample_from_sections(
     time and of each exit, for the bootstrap over orbits of
     :func:`kappa_from_cmeasure`.
     """
+    check.frame(sections, "sections", ("traj_id", "t"))
+    check.frame(lifetimes, "lifetimes", ("traj_id", "outcome", "t_end"))
+    check.real(t_from, "t_from")  # an empty window (t_from > t_to, or NaN) gives an empty sample
+    check.real(t_to, "t_to")
+    check.real(t_record_end, "t_record_end")
     if drop_censored:
         keep = lifetimes.loc[lifetimes["outcome"].astype(object) != "censored", "traj_id"]
         sections = sections[sections["traj_id"].isin(keep)]

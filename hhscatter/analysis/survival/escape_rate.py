@@ -40,6 +40,7 @@ from hhscatter.analysis.survival.cmeasure import (
     kappa_from_cmeasure,
 )
 from hhscatter.analysis.survival.fits import (
+    ExponentialFit,
     PowerLawFit,
     SurvivalCurve,
     crossover_time,
@@ -298,6 +299,7 @@ def escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=Fals
     a dissipative ensemble (``gamma`` > 0), whose P(t) is not exponential, raises
     ValueError, or with ``allow_dissipative=True`` is fitted with a UserWarning.
     """
+    check.frame(lifetimes, "lifetimes", ("t_end", "outcome"))
     if "gamma" in lifetimes.columns and len(lifetimes) and float(lifetimes["gamma"].max()) > 0:
         msg = (
             f"escape_rate_from_lifetimes: this ensemble is dissipative (gamma = {float(lifetimes['gamma'].max()):g}"
@@ -369,10 +371,9 @@ def choose_t_max(
     windows simply end earlier: censoring at t_max is handled by Kaplan–Meier,
     never biasing P(t).
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed).ravel()
-    if not (isinstance(n_main, (int, np.integer)) and n_main > 0):
-        raise ConfigError(f"n_main must be an integer > 0, got {n_main!r}")
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    observed = check.mask(observed, "observed", t_end.size)
+    check.count(n_main, "n_main", 1)
     if not (0 < t_min <= t_cap and step > 0 and margin_efolds >= 0 and min_survivors > 0):
         raise ConfigError("need 0 < t_min ≤ t_cap, step > 0, margin_efolds ≥ 0, min_survivors > 0")
     curve = survival_curve(t_end, observed)
@@ -444,10 +445,13 @@ def escaping_tail(
     ``t_grid`` defaults to ``n_grid`` uniform points from 0 to the
     10th-largest escape time.
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed).ravel()
-    if observed.dtype != bool:
-        raise ConfigError("observed must be a boolean mask")
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    observed = check.mask(observed, "observed", t_end.size)
+    check.number(tau0, "tau0", minimum=0.0)
+    if exp_fit is not None:
+        check.instance(exp_fit, "exp_fit", ExponentialFit)
+    if t_grid is not None:
+        check.numbers(t_grid, "t_grid", minimum=0.0)
     t_esc = t_end[observed]
     if t_esc.size < 10:
         raise ConfigError(f"escaping_tail needs ≥ 10 escaping orbits, got {t_esc.size}")

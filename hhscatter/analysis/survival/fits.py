@@ -51,6 +51,7 @@ import numpy as np
 from scipy import optimize
 from scipy.special import xlogy
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import (
     least_squares_operator,
     weighted_least_squares,
@@ -125,6 +126,7 @@ def lifetimes_to_arrays(lifetimes, *, check_single_ensemble: bool = True):
     ``lifetimes.groupby(['energy', 'gamma'])`` (never by ``e0``, which
     differs from orbit to orbit in the last bits).
     """
+    check.frame(lifetimes, "lifetimes", ("t_end", "outcome"))
     if check_single_ensemble:
         for col in ("energy", "e0", "gamma"):
             # e0 is recomputed from each initial state, so one ensemble's values differ in the
@@ -193,13 +195,11 @@ def _fit_log_linear(x, y, sigma_y):
 
 
 def _prepare(t, P, P_err, window, log_t):
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
-    if t.shape != P.shape:
-        raise ConfigError("t and P differ in length")
-    lo, hi = float(window[0]), float(window[1])
-    if not hi > lo:
-        raise ConfigError(f"window must satisfy t_lo < t_hi, got {window}")
+    t = check.floats(t, "t")
+    P = check.floats(P, "P", size=t.size, of="t")
+    if P_err is not None:
+        check.floats(P_err, "P_err", size=t.size, of="t")
+    lo, hi = check.interval(window, "window")
     m = (t >= lo) & (t <= hi) & np.isfinite(t) & np.isfinite(P) & (P > 0)
     if log_t:
         m &= t > 0
@@ -230,9 +230,12 @@ def mean_kappa_stat_err(t, P, P_err, windows) -> float:
     log-survival estimates (module docstring), so the overlap of the windows
     (they share data) is accounted for exactly.
     """
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
-    E = np.asarray(P_err, dtype=float).ravel()
+    t = check.floats(t, "t")
+    P = check.floats(P, "P", size=t.size, of="t")
+    E = check.floats(P_err, "P_err", size=t.size, of="t")
+    if isinstance(windows, (str, bytes, dict)) or not hasattr(windows, "__len__") or len(windows) == 0:
+        raise ConfigError(f"windows must be a non-empty list of (lo, hi) pairs, got {windows!r}")
+    windows = [check.interval(w, "windows[i]") for w in windows]
     order = np.argsort(t, kind="stable")
     t, P, E = t[order], P[order], E[order]
     valid = np.isfinite(t) & np.isfinite(P) & (P > 0) & np.isfinite(E) & (E > 0)
@@ -385,7 +388,10 @@ def crossover_time(t, P, exp_fit, pow_fit) -> float:
     made on) only set the search scale and trigger a warning when τ* falls
     outside the data's time range.
     """
-    t = np.asarray(t, dtype=float)
+    t = check.floats(t, "t")
+    check.floats(P, "P", size=t.size, of="t")
+    check.instance(exp_fit, "exp_fit", ExponentialFit)
+    check.instance(pow_fit, "pow_fit", PowerLawFit)
     kappa, z = float(exp_fit.kappa), float(pow_fit.z)
     lf0, lfs = math.log(exp_fit.f0), math.log(pow_fit.f_star)
 
@@ -511,8 +517,15 @@ def detect_power_law_tail(
     rates also has β ≈ 1 and is reported as a tail; the answer is a statement
     about the observed range.
     """
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
+    t = check.floats(t, "t", size=None)
+    P = check.floats(P, "P", size=t.size, of="t")
+    if not np.isfinite(t).any():
+        raise ConfigError("t must hold at least one finite time")
+    check.number(tau0, "tau0")
+    if P_err is not None:
+        check.floats(P_err, "P_err", size=t.size, of="t")
+    if n_total is not None:
+        check.number(n_total, "n_total", positive=True)
     observed = _tail_range(t, P, tau0, P_err, n_total, min_survivors)
     if observed is None:
         return None

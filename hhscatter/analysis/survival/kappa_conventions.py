@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured, WithErrors
 from hhscatter.analysis.survival.fits import (
@@ -62,6 +63,13 @@ class ConventionRate(WithErrors):
     reason: str = ""
 
 
+def _levels(p_hi, p_lo) -> None:
+    check.number(p_hi, "p_hi")
+    check.number(p_lo, "p_lo")
+    if not 0 < p_lo < p_hi < 1:
+        raise ConfigError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
+
+
 def trapped_fraction(t_end, observed) -> float:
     """trapped_fraction(t_end, observed) -> fraction of orbits still inside at the end (censored), in [0, 1].
 
@@ -80,10 +88,9 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     :func:`hhscatter.analysis.survival.windows.choose_windows`). None when P never
     falls to ``p_lo`` (e.g. a plateau of trapped orbits above it).
     """
-    if not 0 < p_lo < p_hi < 1:
-        raise ConfigError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
-    t = np.asarray(t, dtype=float)
-    P = np.asarray(P, dtype=float)
+    t = check.floats(t, "t")
+    P = check.floats(P, "P", size=t.size, of="t")
+    _levels(p_hi, p_lo)
     ia, ib = np.flatnonzero(P <= p_hi), np.flatnonzero(P <= p_lo)
     if ia.size == 0 or ib.size == 0:
         return None
@@ -104,6 +111,9 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     tail starts early, the check also flags windows that reach into it
     (the decay there is no longer the exponential of κ either).
     """
+    check.real(P_end, "P_end")  # NaN (P not known at the window end) counts as no survivors: κ ill-defined
+    check.number(f_trapped, "f_trapped", minimum=0.0)
+    check.number(max_bias, "max_bias", positive=True)
     bias = f_trapped / P_end if P_end > 0 else math.inf
     if bias > max_bias:
         return (
@@ -161,6 +171,10 @@ def dead_time_check(
     >>> dead_time_check(169.0, 5.17, 0.00398, t_hi=369.0)      # 0.8 e-fold over 200 time units: not a burst
     (True, '')
     """
+    for value, name in ((tau0, "tau0"), (t_first, "t_first"), (kappa, "kappa"), (max_dead, "max_dead")):
+        check.real(value, name)
+    if t_hi is not None:
+        check.real(t_hi, "t_hi")
     dead = (t_first - tau0) * kappa
     if math.isfinite(dead) and dead > max_dead:
         return False, (
@@ -195,8 +209,11 @@ def escape_rate_p_levels(
     ``observed`` mask (False = censored). Undefined when P never reaches
     ``p_lo`` or the plateau check fails at the window end.
     """
-    t_end = np.asarray(t_end, dtype=float).ravel()
-    observed = np.asarray(observed, dtype=bool).ravel()
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    observed = check.mask(observed, "observed", t_end.size)
+    _levels(p_hi, p_lo)
+    check.number(max_bias, "max_bias", positive=True)
+    check.count(n_grid, "n_grid", 2)
     f_inf = trapped_fraction(t_end, observed)
     grid = np.linspace(0.0, float(t_end.max()) if t_end.size else 1.0, int(n_grid))
     curve = survival_curve(t_end, observed, grid)
@@ -223,12 +240,19 @@ def escape_rate_p_levels(
     )
 
 
+_RESULT_FIELDS = ("kappa", "kappa_err", "kappa_stat", "kappa_spread", "tau0", "t_stop", "curve")
+
+
 def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> ConventionRate:
     """plateau_rate(EscapeRateResult, t_end, observed, *, max_bias=0.1) -> ConventionRate of the window rule.
 
     The κ of :func:`hhscatter.analysis.survival.escape_rate.escape_rate` (data-driven
     plateau windows), with the plateau check at its window end t_stop.
     """
+    check.having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    observed = check.mask(observed, "observed", t_end.size)
+    check.number(max_bias, "max_bias", positive=True)
     f_inf = trapped_fraction(t_end, observed)
     P_end = float(np.interp(result.t_stop, result.curve.t, result.curve.P))
     defined, bias, reason = plateau_check(P_end, f_inf, max_bias)
@@ -256,6 +280,9 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
     """
     import pandas as pd  # deferred: pandas loads on first use
 
+    check.frame(table, "table", ("energy", "kappa", "defined"))
+    check.number(rel_tol, "rel_tol", minimum=0.0)
+    check.count(min_defined, "min_defined", 1)
     rows = []
     for energy, g in table.groupby("energy", sort=True):
         k = g.loc[g["defined"].astype(bool), "kappa"].to_numpy(float)
@@ -307,6 +334,9 @@ def law_spread(fits: dict) -> dict:
     ``err_stat`` = the largest statistical error of one convention's fit;
     ``err`` = √(spread² + err_stat²).
     """
+    check.mapping(fits, "fits", min_size=1)
+    for name, f in fits.items():
+        check.having(f, f"fits[{name!r}]", LAW_PARAMETERS, "a KappaEnergyFit (fit_kappa_energy)")
     out = {}
     for p in LAW_PARAMETERS:
         vals = {name: float(getattr(f, p)) for name, f in fits.items()}
@@ -337,7 +367,9 @@ def convention_rows(
     >>> [r["windows"] for r in convention_rows(t, obs, escape_rate(t, obs, detect_tail=False))]
     ['plateau', 'plevel']
     """
-    t_end, observed = np.asarray(t_end, dtype=float), np.asarray(observed, dtype=bool)
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
+    observed = check.mask(observed, "observed", t_end.size)
+    check.having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
     rates = {
         "plateau": plateau_rate(result, t_end, observed, max_bias=max_bias),
         "plevel": escape_rate_p_levels(t_end, observed, p_hi=p_hi, p_lo=p_lo, max_bias=max_bias),
@@ -370,6 +402,13 @@ def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_
     Returns (fits, info): fits {name: KappaEnergyFit} of the conventions with at least ``min_points`` energies (a,
     b and the break need points on both sides); info {name: {"energies": [...], "fit": its numbers or None}}.
     """
+    check.frame(table, "table", ("convention", "energy", "kappa", "kappa_err", "defined"))
+    if isinstance(names, (str, bytes, dict)) or not isinstance(names, (list, tuple)):
+        raise ConfigError(f"names must be a list of convention names, got {type(names).__name__}")
+    check.numbers(sorted(energies) if isinstance(energies, (set, frozenset)) else energies, "energies", min_size=0)
+    check.number(E_c, "E_c")
+    check.count(n_boot, "n_boot", 0)
+    check.count(min_points, "min_points", 1)
     fits, info = {}, {}
     for name in names:
         d = table[(table["convention"] == name) & table["defined"] & table["energy"].isin(energies)]

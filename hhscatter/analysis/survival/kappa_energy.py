@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.library_warnings import counted
 from hhscatter.analysis.stats.measured import Measured, WithErrors
@@ -199,10 +200,13 @@ def fit_kappa_energy(
 # the steps of fit_kappa_energy
 def _kappa_points(E, kappa, kappa_err, E_c):
     """The checked κ(E) points: (x = E − E_c (energy), κ (1/time), weights 1/σ², whether σ was given)."""
-    E = np.asarray(E, dtype=float).ravel()
-    y = np.asarray(kappa, dtype=float).ravel()
+    E = check.numbers(E, "E")
+    y = check.numbers(kappa, "kappa")
     if E.shape != y.shape:
         raise ConfigError("E and kappa differ in length")
+    if kappa_err is not None and check.numbers(kappa_err, "kappa_err").shape != E.shape:
+        raise ConfigError("kappa_err and kappa differ in length")
+    E_c = check.number(E_c, "E_c")
     x = E - E_c
     if np.any(x <= 0):
         raise ConfigError("all energies must exceed E_c (no escape below)")
@@ -285,6 +289,8 @@ def kappa_law_summary(fit) -> dict:
     >>> s["a"]["err"], s["E_b"]["err"], s["chi2_per_dof"]
     (0.2, 0.02, 2.0)
     """
+    needed = ("a", "b", "c", "E_b", "a_err", "b_err", "c_err", "E_b_err", "boot_err", "continuous", "chi2", "dof")
+    check.having(fit, "fit", needed, "a KappaEnergyFit (fit_kappa_energy)")
     boot = fit.boot_err if fit.boot_err else (math.nan,) * 4
     out = {}
     for i, name in enumerate(("a", "b", "c", "E_b")):

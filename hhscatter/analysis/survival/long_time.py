@@ -148,10 +148,10 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
     -------
     PlateauFit
     """
-    t = np.asarray(t_end, dtype=float).ravel()
-    obs = np.asarray(observed, dtype=bool).ravel()
-    if t.shape != obs.shape:
-        raise ConfigError("t_end and observed differ in length")
+    t = check.numbers(t_end, "t_end", min_size=0, minimum=0.0)
+    obs = check.mask(observed, "observed", t.size)
+    check.number(t0, "t0", minimum=0.0)
+    check.count(n_bins, "n_bins", 1)
     risk = t > t0
     n = int(risk.sum())
     if n < 10 or obs[risk].sum() < 3:
@@ -336,8 +336,12 @@ def rate_status(
     """
     from hhscatter.analysis.survival.kappa_conventions import plateau_check  # deferred: kept off import time
 
-    t = np.asarray(t_end, dtype=float).ravel()
-    obs = np.asarray(observed, dtype=bool).ravel()
+    t = check.numbers(t_end, "t_end", min_size=0, minimum=0.0)
+    obs = check.mask(observed, "observed", t.size)
+    check.number(tau0, "tau0", minimum=0.0)
+    check.number(t_stop, "t_stop")
+    check.number(max_bias, "max_bias", positive=True)
+    check.number(p_reject, "p_reject", positive=True)
     nan = math.nan
     f_inf = float((~obs).mean()) if obs.size else math.nan
     if not (t > tau0).any():  # the whole population left before the window: nothing to call trapped or a rate

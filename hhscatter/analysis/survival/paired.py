@@ -61,6 +61,17 @@ class PairedShift(WithErrors):
     correlation: float
 
 
+def _paired(t_ref, observed_ref, t_alt, observed_alt):
+    """The two samples of the same orbits, checked: (t_ref, observed_ref, t_alt, observed_alt) as arrays."""
+    t_ref = check.numbers(t_ref, "t_ref", min_size=0, minimum=0.0)
+    observed_ref = check.mask(observed_ref, "observed_ref", t_ref.size)
+    t_alt = check.numbers(t_alt, "t_alt", min_size=0, minimum=0.0)
+    if t_alt.size != t_ref.size:
+        raise ConfigError(f"t_alt must have one value per orbit of t_ref: {t_alt.size} != {t_ref.size}")
+    observed_alt = check.mask(observed_alt, "observed_alt", t_ref.size)
+    return t_ref, observed_ref, t_alt, observed_alt
+
+
 def _mle_terms(t_end, observed, t_start, t_stop):
     t_end = np.asarray(t_end, dtype=float).ravel()
     observed = np.asarray(observed).ravel()
@@ -89,6 +100,8 @@ def paired_mle_shift(t_ref, observed_ref, t_alt, observed_alt, t_start: float, t
     (strong when an escape criterion only adds a flight time).  For
     independent samples it reduces to σ_ref² + σ_alt² with σ² ≈ κ²/D.
     """
+    t_ref, observed_ref, t_alt, observed_alt = _paired(t_ref, observed_ref, t_alt, observed_alt)
+    check.window(t_start, t_stop)
     d0, x0 = _mle_terms(t_ref, observed_ref, t_start, t_stop)
     d1, x1 = _mle_terms(t_alt, observed_alt, t_start, t_stop)
     if d0.shape != d1.shape:
@@ -160,17 +173,10 @@ def survival_ratio_slope(
     Error: the estimate is repeated on ``n_groups`` disjoint groups of orbits
     (index mod n_groups); shift_err = std(group values)/√n_groups.
     """
-    t_ref = np.asarray(t_ref, dtype=float).ravel()
-    t_alt = np.asarray(t_alt, dtype=float).ravel()
-    observed_ref = np.asarray(observed_ref).ravel()
-    observed_alt = np.asarray(observed_alt).ravel()
-    if t_ref.shape != t_alt.shape:
-        raise ConfigError("paired samples must have the same length (one entry per orbit)")
-    lo, hi = float(window[0]), float(window[1])
-    if not hi > lo:
-        raise ConfigError(f"window must have t_lo < t_hi, got {window}")
-    if n_groups < 2:
-        raise ConfigError(f"n_groups must be ≥ 2, got {n_groups}")
+    t_ref, observed_ref, t_alt, observed_alt = _paired(t_ref, observed_ref, t_alt, observed_alt)
+    lo, hi = check.interval(window, "window")
+    check.count(n_groups, "n_groups", 2)
+    check.count(n_grid, "n_grid", 2)
     grid = np.linspace(lo, hi, int(n_grid))
     shift, offset = _log_ratio_fit(t_ref, observed_ref, t_alt, observed_alt, grid)
     g = np.arange(t_ref.size) % n_groups

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.survival.fits import (
     _floor_time,
     _resolve_n_total,
@@ -206,10 +207,15 @@ def choose_windows(
 # the steps of choose_windows (its docstring's rule, step by step)
 def _checked_curve(t, P, P_err, n_total, min_survivors):
     """Rule step 0, the floor: (t, P) as checked float arrays, the ensemble size N and t_floor (time units)."""
-    t = np.asarray(t, dtype=float).ravel()
-    P = np.asarray(P, dtype=float).ravel()
-    if t.shape != P.shape:
-        raise ConfigError("t and P differ in length")
+    t = check.floats(t, "t")
+    P = check.floats(P, "P", size=t.size, of="t")
+    if P_err is not None:
+        check.floats(P_err, "P_err", size=t.size, of="t")
+    if n_total is not None:
+        check.number(n_total, "n_total", positive=True)
+    check.number(min_survivors, "min_survivors", positive=True)
+    if t.size < 2 or not np.all(np.isfinite(t)):
+        raise ConfigError("t must hold at least 2 finite times")
     if np.any(np.diff(t) <= 0):
         raise ConfigError("t must be strictly increasing")
     N = _resolve_n_total(P, P_err, n_total)

@@ -33,7 +33,7 @@ def test_window_rejects_bad_constants(args, key):
 
 
 def test_window_rejects_mismatched_lengths():
-    with pytest.raises(ValueError, match="same length"):
+    with pytest.raises(ValueError, match="weights must have one value per time t"):
         decay._decay_window(np.arange(3.0), np.ones(3), E0, GAMMA, (0, 2), np.ones(2))
 
 
