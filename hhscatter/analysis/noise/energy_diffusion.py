@@ -344,8 +344,8 @@ def is_separable(model, *, span: float = 1.0, nodes: int = 5, rtol: float = 1e-1
     A decision, not a sample, for a polynomial potential of degree ≤ ``nodes`` + 1: its mixed derivative is then
     a polynomial of degree ≤ ``nodes`` − 1 in each variable, which is zero everywhere when it is zero on the
     lattice. For other potentials it is a necessary condition. Zero means |V_xy| ≤ ``rtol`` times the largest
-    |V_xx|, |V_yy| on the lattice (or 1). When V is separable, the drag and noise of each degree of freedom act on
-    its own energy: the energies of x and y diffuse apart.
+    |V_xx|, |V_yy| on the lattice (or 1). When V is separable, each degree of freedom keeps its own energy between
+    kicks: no orbit explores its whole energy shell (the ergodicity the shells' energy-diffusion theory assumes).
 
     Examples
     --------
