@@ -3,7 +3,9 @@
 :func:`rate_record` sets a thermal rate measured on a window (:func:`~hhscatter.analysis.noise.kramers.thermal_rate`)
 beside the Kramers–Langer rate of the system at the same (γ, T), with the window's two halves compared;
 :func:`turnover_record` adds the Mel'nikov–Meshkov/PGH rate and both Kramers limits, :func:`saddle_turnover_terms`
-each saddle's part of them, :func:`shell_theory_record` the energy-diffusion rates of the well's energy shells; :func:`two_saddle_record` the
+each saddle's part of them, :func:`shell_theory_record` the energy-diffusion rates of the well's energy shells,
+:func:`turnover_theories_record` both at once and :func:`two_saddle_turnover_record` a series of them on a system with
+several saddles, each saddle's terms beside; :func:`two_saddle_record` the
 multi-saddle sum's lowest term and the escapes' exit shares against each term's share; :func:`saddle_terms` lists a
 system's saddles; :func:`finite_barrier_record` fits the ratios against T/ΔE beside the transition-state
 correction; :func:`absorbing_radius_record` compares a rate measured at two escape radii; :func:`no_drag_records`,
@@ -21,6 +23,7 @@ import re
 import numpy as np
 import pandas as pd
 
+from hhscatter.analysis.noise.energy_diffusion import is_separable, thermal_well_shells, well_energy_diffusion
 from hhscatter.analysis.noise.finite_barrier import finite_barrier_fit, transition_state_correction
 from hhscatter.analysis.noise.kramers import (
     exit_fractions,
@@ -43,13 +46,17 @@ __all__ = [
     "no_drag_survival",
     "pretty_potential",
     "rate_record",
+    "rates_table",
     "reactivation_record",
     "saddle_terms",
     "saddle_turnover_terms",
     "shell_theory_record",
     "survivor_record",
+    "theory_conventions",
     "turnover_record",
+    "turnover_theories_record",
     "two_saddle_record",
+    "two_saddle_turnover_record",
 ]
 
 
@@ -136,6 +143,26 @@ def rate_record(
     }
 
 
+def rates_table(series: dict) -> pd.DataFrame:
+    """The rate records of every series as one table: ``series`` {name: list of rate records}; a row per record
+    with its series' name under ``set``, the window's end as ``t_max`` (time) in place of the window, and
+    without the nested per-saddle terms (``saddles``).
+
+    Examples
+    --------
+    >>> r = {"gamma": 1.0, "rate": 0.01, "window": (23.0, 150.0), "saddles": [{"exit": 0}]}
+    >>> t = rates_table({"kramers": [r], "turnover": [dict(r, gamma=0.1)]})
+    >>> t[["set", "gamma", "t_max"]].to_dict("records")
+    [{'set': 'kramers', 'gamma': 1.0, 't_max': 150.0}, {'set': 'turnover', 'gamma': 0.1, 't_max': 150.0}]
+    >>> "saddles" in t.columns
+    False
+    """
+    rows = [{"set": name, **{k: v for k, v in r.items() if k != "saddles"}} for name, rs in series.items() for r in rs]
+    rates = pd.DataFrame(rows)
+    rates["window"] = rates["window"].map(lambda w: float(w[1]))
+    return rates.rename(columns={"window": "t_max"})
+
+
 def turnover_record(record: dict, model, gamma_max: float) -> dict:
     """A :func:`rate_record` against the Mel'nikov–Meshkov/PGH rate Υ(δ) k_KL and the energy-diffusion limit.
 
@@ -211,6 +238,94 @@ def shell_theory_record(record: dict, ed) -> dict:
     for name, k in (("shell", ed.rate), ("shell_absorbing", ed.rate_absorbing), ("shell_turnover", ed.turnover)):
         out.update(_flat(f"ratio_{name}", rate.over(k)))
     return out
+
+
+def turnover_theories_record(
+    record: dict, model, *, gamma_max: float, shell_top_widths: float, shell_grid: int, shell_energies: int
+) -> dict:
+    """A :func:`rate_record` against every turnover theory: :func:`turnover_record` (Mel'nikov–Meshkov/PGH and both
+    Kramers limits, read where γ/ω_b ≤ ``gamma_max``) and :func:`shell_theory_record` (the energy-diffusion rates of
+    ``model``'s well at the record's γ and T, on the shells up to E_b + ``shell_top_widths`` T of
+    :func:`~hhscatter.analysis.noise.energy_diffusion.thermal_well_shells` on a ``shell_grid``² lattice and
+    ``shell_energies`` energies, computed once per system and T).
+
+    Examples
+    --------
+    Hénon–Heiles at γ = 0.01, ΔE/T = 3 (coarse shells): the rate over each theory, the keys of both records:
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> rec = {"gamma": 0.01, "temperature": 1 / 18, "rate": 1e-3, "rate_err": 1e-4}
+    >>> r = turnover_theories_record(rec, HenonHeiles(), gamma_max=0.3, shell_top_widths=6.0, shell_grid=201,
+    ...                              shell_energies=401)
+    >>> r["theory_assumptions_hold"], round(r["shell_top"], 6), round(r["ratio_shell"] * r["shell_energy_diffusion"], 9)
+    (True, 0.5, 0.001)
+    """
+    shells = thermal_well_shells(
+        model, record["temperature"], top_widths=shell_top_widths, grid=shell_grid, n_energies=shell_energies
+    )
+    ed = well_energy_diffusion(model, record["gamma"], record["temperature"], shells=shells)
+    return {**turnover_record(record, model, gamma_max), **shell_theory_record(record, ed)}
+
+
+def two_saddle_turnover_record(records: list[dict], model, *, barrier_over_T: float, potential: str) -> dict:
+    """A turnover series of a system with several saddles: each record (of :func:`turnover_theories_record`) with
+    its saddles' terms (:func:`saddle_turnover_terms`) under ``saddles``, beside the series' ΔE/T of the lowest
+    saddle (``barrier_over_T``), the system's ``potential`` and whether it is separable
+    (:func:`~hhscatter.analysis.noise.energy_diffusion.is_separable`: the drag then acts on the energy of each
+    degree of freedom apart; None without records).
+
+    Examples
+    --------
+    >>> from hhscatter.model import make_system
+    >>> v = "(x**2 + y**2)/2 - x**3/3 - 5*y**3/18"
+    >>> r = two_saddle_turnover_record([{"gamma": 0.1, "temperature": 1 / 18}], make_system(potential=v),
+    ...                                barrier_over_T=3.0, potential=v)
+    >>> r["separable"], len(r["records"][0]["saddles"]), r["barrier_over_T"]
+    (True, 2, 3.0)
+    """
+    rows = [{**r, "saddles": saddle_turnover_terms(model, r["gamma"], r["temperature"])} for r in records]
+    return {
+        "barrier_over_T": barrier_over_T,
+        "potential": potential,
+        "separable": is_separable(model) if rows else None,
+        "records": rows,
+    }
+
+
+def theory_conventions(
+    *,
+    gamma_max: float,
+    energy_diffusion_gamma_max: float,
+    shell_top_widths: float,
+    shell_grid: int,
+    shell_energies: int,
+) -> dict:
+    """The conventions of the turnover theories, as published beside the records: the theories in words, the
+    range of Mel'nikov–Meshkov/PGH (γ/ω_b ≤ ``gamma_max``), the γ up to which the shells' energy-diffusion
+    theories are read (``energy_diffusion_gamma_max``, 1/time) and the shells' settings
+    (:func:`turnover_theories_record`).
+
+    Examples
+    --------
+    >>> c = theory_conventions(gamma_max=0.3, energy_diffusion_gamma_max=0.01, shell_top_widths=12.0,
+    ...                        shell_grid=1201, shell_energies=4001)
+    >>> c["theory_range"], c["shell_grid"], "E_b + 12 T" in c["shell_theory"]
+    ('γ/ω_b ≤ 0.3', 1201, True)
+    """
+    return {
+        "turnover_theory": "Mel'nikov–Meshkov/PGH k = Υ(δ) k_KL, δ = γS/T, S the action of the orbit at "
+        "the saddle's energy through the well; energy diffusion k_ED = δ k_TST",
+        "theory_range": f"γ/ω_b ≤ {gamma_max:g}",
+        "shell_theory": "energy diffusion on the well's energy shells (two degrees of freedom, ergodic): "
+        "D(E) = γT⟨|p|²⟩_E, the lowest rate of the Fokker–Planck equation in E with the shells' phase "
+        "volume, absorbing at E_b or with the microcanonical flux over the saddles' dividing lines above "
+        f"it (shells up to E_b + {shell_top_widths:g} T); δ_shell = its absorbing large-barrier rate over "
+        "the shells' transition-state rate",
+        "energy_diffusion_gamma_max": energy_diffusion_gamma_max,
+        "shell_top_widths": shell_top_widths,
+        "shell_grid": shell_grid,
+        "shell_energies": shell_energies,
+    }
 
 
 def saddle_turnover_terms(model, gamma: float, temperature: float) -> list[dict]:

@@ -23,30 +23,20 @@ Stages (``hhscatter study noise simulate|analyze|plot [--scale S]``):
       ``nodrag_times``, whose censored orbits' end energies are the survivors' energies at t.
 
 ``analyze(study)``
-    Rates by the constant-hazard MLE on [t_relax + relax_widths/γ, t_max] (after relaxation;
-    :func:`hhscatter.analysis.noise.thermal_rate`, left-truncated and right-censored; the window's two halves
-    compared: ``halves_z``, ``constant_in_window``) against Kramers–Langer (:func:`hhscatter.analysis.noise.kramers_langer`,
-    saddles and Hessians from the system); P(t) of the heat-bath ensemble against the drag-only one extended
-    by re-activation (:func:`hhscatter.analysis.noise.reactivation_survival`); the no-drag rates on
-    ``nodrag_window`` against κ0; each turnover rate against the Mel'nikov–Meshkov/Pollak–Grabert–Hänggi rate
-    Υ(δ) k_KL (:func:`hhscatter.analysis.noise.turnover_rate`, δ = γS/T with S the action of the orbit at the
-    saddle's energy through the well, :func:`hhscatter.analysis.noise.barrier_action`) and both Kramers limits,
-    the theory's range stated as γ/ω_b ≤ THEORY_GAMMA_MAX; the Kramers ratios against T/ΔE by the weighted fit of
-    their first correction, against its transition-state part (:func:`hhscatter.analysis.noise.finite_barrier_fit`,
-    :func:`hhscatter.analysis.noise.transition_state_correction`); the rate at r_esc = resc_radius over the rate
-    at the default radius, by the 2σ rule; the no-drag rate's halves and the survivors' energies at each time
-    (:func:`hhscatter.analysis.noise.survivor_energies`, the fraction below E_c); the two-saddle system's rates
-    against the multi-saddle Kramers–Langer sum and its lowest term, and the escapes' exit channels against each
-    term's share; the turnover at the second barrier like the first, and the two-saddle system's turnover against
-    the sums Σ_s k_KL,s, Σ_s Υ(δ_s) k_KL,s and Σ_s δ_s k_TST,s with each saddle's terms
-    (:func:`hhscatter.reproduction.noise_records.saddle_turnover_terms`); every turnover rate, at both barriers and
-    on the two-saddle system, against the energy-diffusion rates of the well's energy shells
-    (:func:`hhscatter.analysis.noise.well_energy_diffusion`: absorbing at E_b, with the microcanonical flux above
-    it, and Υ(δ_shell) k_KL), read at γ ≤ ENERGY_DIFFUSION_GAMMA_MAX. The records are assembled by :mod:`hhscatter.reproduction.noise_records` (this module reads
-    the runs and passes their arrays). Writes ``noise.json`` (keys
-    ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``, ``turnover``, ``turnover_high``,
-    ``two_saddles_turnover``, ``reactivation``,
-    ``no_drag``, ``no_drag_survivors``) and the derived tables ``rates.parquet``, ``survival.parquet``.
+    Reads the runs and passes their arrays to :mod:`hhscatter.reproduction.noise_records`, which assembles the
+    records: rates by the constant-hazard MLE on [t_relax + relax_widths/γ, t_max] (left-truncated,
+    right-censored; the window's halves compared: ``halves_z``, ``constant_in_window``) against Kramers–Langer
+    from the system's saddles; the Kramers ratios against T/ΔE (the fit of their first correction beside its
+    transition-state part); the rate at r_esc = resc_radius over the rate at the default radius; every turnover
+    rate (both barriers and the two-saddle system, each saddle's terms beside) against Mel'nikov–Meshkov/PGH
+    Υ(δ) k_KL, read where γ/ω_b ≤ theory_gamma_max, both Kramers limits and the energy-diffusion rates of the
+    well's energy shells (up to E_b + shell_top_widths T on a shell_grid² lattice and shell_energies energies,
+    read at γ ≤ energy_diffusion_gamma_max); the two-saddle rates against the multi-saddle sum and the escapes'
+    exits against each term's share; the heat-bath P(t) against the drag-only one extended by re-activation;
+    the no-drag rates on ``nodrag_window`` against κ0, their halves and the survivors' energies at each time.
+    Writes ``noise.json`` (keys ``kramers``, ``finite_barrier``, ``absorbing_radius``, ``two_saddles``,
+    ``turnover``, ``turnover_high``, ``two_saddles_turnover``, ``reactivation``, ``no_drag``, ``no_drag_survivors``,
+    ``conventions``) and the derived tables ``rates``, ``reactivation``, ``no_drag`` and ``no_drag_rates``.
 
 ``plot(study)``
     ``noise.png`` via ``plot_noise`` of the folder's ``figure.py``.
@@ -63,17 +53,6 @@ from hhscatter.scene.schema import Integer, Number, Numbers, Text
 from hhscatter.studies.keys import RunKeys, number_key
 from hhscatter.studies.params import StudyParams
 from hhscatter.studies.plot_stage import NUMBERS, PATH, SCALE, figure_stage
-
-#: the turnover theory (Mel'nikov–Meshkov/PGH) assumes an underdamped barrier crossing: its ratios are read where
-#: γ/ω_b ≤ this (ω_b the saddles' unstable frequency)
-THEORY_GAMMA_MAX = 0.3
-
-#: the low-γ points, compared with the energy-diffusion theories of the well's shells in the readings: γ ≤ this
-ENERGY_DIFFUSION_GAMMA_MAX = 0.01
-
-#: the well's energy shells reach E_b + this × T (where a dividing line does not spill first): the population
-#: above is e^{−12} of the barrier's
-SHELL_TOP_WIDTHS = 12.0
 
 
 class Params(StudyParams):
@@ -115,6 +94,12 @@ class Params(StudyParams):
     saddles_turnover_gammas: Numbers
     saddles_turnover_t_max: Numbers
     saddles_turnover_n: Integer
+    theory_gamma_max: Number  # the turnover theory's ratios are read where γ/ω_b ≤ this (underdamped crossing)
+    energy_diffusion_gamma_max: Number  # the shells' energy-diffusion theories are read at γ ≤ this
+    shell_top_widths: Number  # the well's energy shells reach E_b + shell_top_widths T
+    shell_grid: Integer  # the shells' phase volume on a shell_grid × shell_grid lattice
+    shell_energies: Integer  # ... at shell_energies energies from V(min) to the top
+    nodrag_grid: Integer  # points of the no-drag P(t) table on [0, nodrag_t_max]
 
 
 def _barrier(study, system: dict | None = None) -> float:
@@ -307,59 +292,31 @@ def _two_saddles(study, runs) -> dict:
     }
 
 
-_SHELLS: dict = {}
-
-
-def _shells(model, temperature: float):
-    """The energy shells of ``model``'s well up to E_b + SHELL_TOP_WIDTHS T, once per (potential, T)."""
-    from hhscatter.analysis.noise import well_barrier, well_shells
-
-    key = (model.potential_text, tuple(sorted(dict(model.params).items())), float(temperature))
-    if key not in _SHELLS:
-        e_b = float(model.potential(np.array(0.0), np.array(0.0))) + well_barrier(model)
-        _SHELLS[key] = well_shells(model, e_b + SHELL_TOP_WIDTHS * temperature)
-    return _SHELLS[key]
-
-
 def _turnover_row(study, key, runs) -> dict:
     """The rate record of turnover run ``key`` against the turnover theory (Mel'nikov–Meshkov/PGH, both limits) and
     the energy-diffusion theories of the well's shells."""
-    from hhscatter.analysis.noise import well_energy_diffusion
-    from hhscatter.reproduction.noise_records import shell_theory_record, turnover_record
+    from hhscatter.reproduction.noise_records import turnover_theories_record
 
-    sc = runs[key]
+    p, sc = study.params, runs[key]
     row = _rate_row(study, key, sc)
-    T = row["temperature"]
-    ed = well_energy_diffusion(sc.model, row["gamma"], T, shells=_shells(sc.model, T))
-    return {**row, **turnover_record(row, sc.model, THEORY_GAMMA_MAX), **shell_theory_record(row, ed)}
+    shells = dict(shell_top_widths=p.shell_top_widths, shell_grid=p.shell_grid, shell_energies=p.shell_energies)
+    return {**row, **turnover_theories_record(row, sc.model, gamma_max=p.theory_gamma_max, **shells)}
 
 
 def _saddles_turnover(study, runs) -> dict:
     """The two-saddle system's rate against γ at one barrier: against the multi-saddle Kramers–Langer sum, the
     Mel'nikov–Meshkov/PGH sum Σ_s Υ(δ_s) k_KL,s and the energy-diffusion limit Σ_s δ_s k_TST,s, each saddle's
     terms beside."""
-    from hhscatter.reproduction.noise_records import saddle_turnover_terms
+    from hhscatter.model import make_system
+    from hhscatter.reproduction.noise_records import two_saddle_turnover_record
 
     p = study.params
-    rows = []
-    for g, _ in _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max"):
-        key = _saddles_turnover_key(g)
-        row = _turnover_row(study, key, runs)
-        rows.append({**row, "saddles": saddle_turnover_terms(runs[key].model, row["gamma"], row["temperature"])})
-    return {
-        "barrier_over_T": p.saddles_turnover_barrier,
-        "potential": p.saddles_potential,
-        "separable": _separable(runs[key].model) if rows else None,
-        "records": rows,
-    }
-
-
-def _separable(model) -> bool:
-    """Whether ∂²V/∂x∂y = 0 at four points in general position (exact second derivatives): for a cubic potential
-    the mixed derivative is linear, so it is then zero everywhere and each degree of freedom keeps its energy."""
-    from hhscatter.analysis.noise import hessian
-
-    return all(abs(hessian(model, x, y)[0, 1]) < 1e-12 for x, y in ((0.3, -0.2), (-0.4, 0.5), (0.7, 0.6), (0.1, 0.9)))
+    pairs = _pairs(study, "saddles_turnover_gammas", "saddles_turnover_t_max")
+    rows = [_turnover_row(study, _saddles_turnover_key(g), runs) for g, _ in pairs]
+    model = make_system(**_saddles_system(p))
+    return two_saddle_turnover_record(
+        rows, model, barrier_over_T=p.saddles_turnover_barrier, potential=p.saddles_potential
+    )
 
 
 def _absorbing_radius(study, runs, kramers) -> list:
@@ -440,7 +397,7 @@ def _survival_tables(study, runs):
     from hhscatter.reproduction.noise_records import no_drag_survival
 
     p = study.params
-    grid = np.linspace(0.0, p.nodrag_t_max, 301)
+    grid = np.linspace(0.0, p.nodrag_t_max, p.nodrag_grid)
     frames = []
     for E in p.nodrag_energies:
         for s in p.nodrag_sigmas:
@@ -451,7 +408,7 @@ def _survival_tables(study, runs):
 
 def analyze(study):
     """analyze(study) -> None: rates against Kramers–Langer, the heat-bath P(t), the no-drag rates; noise.json."""
-    from hhscatter.reproduction.noise_records import finite_barrier_record
+    from hhscatter.reproduction.noise_records import finite_barrier_record, rates_table, theory_conventions
 
     p = study.params
     runs = _runs(study)
@@ -466,17 +423,8 @@ def analyze(study):
     react, react_table = _reactivation(study, runs)
     no_drag = _no_drag(study, runs)
     survivors = _no_drag_survivors(study, runs)
-    rates = pd.DataFrame(
-        [{"set": "kramers", **r} for r in kramers]
-        + [{"set": "turnover", **r} for r in turnover]
-        + [{"set": "turnover_high", **r} for r in turnover_high]
-        + [
-            {"set": "saddles_turnover", **{k: v for k, v in r.items() if k != "saddles"}}
-            for r in saddles_turnover["records"]
-        ]
-    )
-    rates["window"] = rates["window"].map(lambda w: float(w[1]))
-    study.write_table(rates.rename(columns={"window": "t_max"}), "rates.parquet")
+    series = {"kramers": kramers, "turnover": turnover, "turnover_high": turnover_high}
+    study.write_table(rates_table({**series, "saddles_turnover": saddles_turnover["records"]}), "rates.parquet")
     study.write_table(react_table, "reactivation.parquet")
     study.write_table(_survival_tables(study, runs), "no_drag.parquet")
     study.write_table(pd.DataFrame(no_drag), "no_drag_rates.parquet")
@@ -522,16 +470,13 @@ def analyze(study):
                 "resc_radius": p.resc_radius,
                 "kick": "0.1 min(1/ω, 1/γ) (the scene default)",
                 "flow": p.flow,
-                "turnover_theory": "Mel'nikov–Meshkov/PGH k = Υ(δ) k_KL, δ = γS/T, S the action of the orbit at "
-                "the saddle's energy through the well; energy diffusion k_ED = δ k_TST",
-                "theory_range": f"γ/ω_b ≤ {THEORY_GAMMA_MAX:g}",
-                "shell_theory": "energy diffusion on the well's energy shells (two degrees of freedom, ergodic): "
-                "D(E) = γT⟨|p|²⟩_E, the lowest rate of the Fokker–Planck equation in E with the shells' phase "
-                "volume, absorbing at E_b or with the microcanonical flux over the saddles' dividing lines above "
-                f"it (shells up to E_b + {SHELL_TOP_WIDTHS:g} T); δ_shell = its absorbing large-barrier rate over "
-                "the shells' transition-state rate",
-                "energy_diffusion_gamma_max": ENERGY_DIFFUSION_GAMMA_MAX,
-                "shell_top_widths": SHELL_TOP_WIDTHS,
+                **theory_conventions(
+                    gamma_max=p.theory_gamma_max,
+                    energy_diffusion_gamma_max=p.energy_diffusion_gamma_max,
+                    shell_top_widths=p.shell_top_widths,
+                    shell_grid=p.shell_grid,
+                    shell_energies=p.shell_energies,
+                ),
             },
         }
     )

@@ -10,8 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from hhscatter.studies import load_study
 from hhscatter.studies.graph import studies
-from hhscatter.studies.provenance import content_sha256
+from hhscatter.studies.jsonio import _jsonable
+from hhscatter.studies.provenance import config_sha256, content_sha256
 
 ROOT = Path(__file__).resolve().parents[2]
 ASSETS = {"quick": ROOT / "docs" / "studies" / "assets", "paper": ROOT / "docs" / "studies" / "assets" / "paper"}
@@ -52,6 +54,17 @@ def test_each_committed_study_was_made_from_the_committed_upstream_numbers(scale
 def test_each_committed_numbers_file_carries_its_own_content_hash(scale):
     bad = [n for n, d in _numbers(scale).items() if d.get("sha256") != content_sha256(d)]
     assert not bad, f"scale {scale}: numbers edited after they were written: {bad}"
+
+
+@pytest.mark.parametrize("scale", sorted(ASSETS))
+def test_each_committed_study_was_made_from_its_configuration_now(scale):
+    """A study.toml changed (a key added, a value moved) after its committed numbers were made: they are stale."""
+    stale = [
+        name
+        for name, doc in _numbers(scale).items()
+        if (doc.get("made_from") or {}).get("config_sha256") != config_sha256(_jsonable(load_study(name, scale).config))
+    ]
+    assert not stale, f"scale {scale}: numbers made from another configuration than study.toml's now: {stale}"
 
 
 def test_the_check_finds_a_study_made_from_other_numbers():

@@ -222,3 +222,44 @@ def test_shell_theory_record_sets_the_rate_beside_each_shell_rate():
     )
     assert r["ratio_shell_turnover"] == pytest.approx(0.7) and r["ratio_shell_turnover_err"] == pytest.approx(0.035)
     assert (r["shell_delta"], r["shell_transition_state"], r["shell_top"]) == (0.12, 1.5e-2, 0.83)
+
+
+def test_turnover_theories_record_is_both_records_on_the_shells_of_its_settings():
+    """The shells up to E_b + w T on the given lattice: the same rates as the energy-diffusion theory computing its
+    own shells with those settings; Hénon–Heiles' top E_b + w T = 1/6 + 6/18 = 1/2."""
+    from hhscatter.analysis.noise import well_energy_diffusion
+    from hhscatter.reproduction.noise_records import shell_theory_record, turnover_theories_record
+
+    m, rec = HenonHeiles(), {"gamma": 0.01, "temperature": 1 / 18, "rate": 9e-4, "rate_err": 9e-5}
+    got = turnover_theories_record(rec, m, gamma_max=0.3, shell_top_widths=6.0, shell_grid=201, shell_energies=401)
+    ed = well_energy_diffusion(m, 0.01, 1 / 18, above=6.0, grid=201, n_energies=401)
+    assert got == {**turnover_record(rec, m, 0.3), **shell_theory_record(rec, ed)}
+    assert got["shell_top"] == pytest.approx(0.5, abs=1e-12)
+    finer = turnover_theories_record(rec, m, gamma_max=0.3, shell_top_widths=6.0, shell_grid=201, shell_energies=801)
+    assert finer["shell_energy_diffusion"] != got["shell_energy_diffusion"]  # the settings reach the result
+
+
+def test_two_saddle_turnover_record_adds_each_saddles_terms_and_separability():
+    from hhscatter.model import make_system
+    from hhscatter.reproduction.noise_records import two_saddle_turnover_record
+
+    v = "(x**2 + y**2)/2 - x**3/3 - 5*y**3/18"
+    m = make_system(potential=v)
+    rows = [{"gamma": g, "temperature": 1 / 18, "rate": 1e-3} for g in (0.1, 1.0)]
+    r = two_saddle_turnover_record(rows, m, barrier_over_T=3.0, potential=v)
+    assert (r["barrier_over_T"], r["potential"], r["separable"]) == (3.0, v, True)
+    for row, out in zip(rows, r["records"]):
+        assert out == {**row, "saddles": saddle_turnover_terms(m, row["gamma"], 1 / 18)}
+    assert two_saddle_turnover_record([], m, barrier_over_T=3.0, potential=v)["separable"] is None
+    assert two_saddle_turnover_record(rows[:1], HenonHeiles(), barrier_over_T=3.0, potential="")["separable"] is False
+
+
+def test_rates_table_has_a_row_per_record_with_its_series_and_window_end():
+    from hhscatter.reproduction.noise_records import rates_table
+
+    a = {"gamma": 1.0, "rate": 0.1, "window": [23.0, 150.0]}
+    b = {"gamma": 0.1, "rate": 0.02, "window": [50.0, 400.0], "saddles": [{"exit": 0}, {"exit": 1}]}
+    t = rates_table({"kramers": [a], "saddles_turnover": [b, dict(b, gamma=0.3)]})
+    assert list(t["set"]) == ["kramers", "saddles_turnover", "saddles_turnover"]
+    assert list(t["t_max"]) == [150.0, 400.0, 400.0] and list(t["gamma"]) == [1.0, 0.1, 0.3]
+    assert "saddles" not in t.columns and "window" not in t.columns

@@ -39,12 +39,11 @@ def test_turnover_records_carry_the_theory_and_its_range(runs):
     """Hénon–Heiles: S = 6/5 along x = 0, δ = γS/T; k_TST = 3 (1/2π)(1/√3) e^{−ΔE/T}; energy diffusion δ k_TST;
     the theory's range is γ/ω_b ≤ 0.3 (ω_b = 1)."""
     study, scenes = runs
-    mod = stage_module("noise")
     for key, holds in (("turnover_g0.03", True), ("turnover_g0.3", True), ("turnover_g1", False)):
         sc = scenes[key]
         T = sc.noise.temperature
         row = {"gamma": sc.gamma, "temperature": T, "rate": 0.02, "rate_err": 0.001}
-        th = turnover_record(row, sc.model, mod.THEORY_GAMMA_MAX)
+        th = turnover_record(row, sc.model, study.params.theory_gamma_max)
         tst = 3 / (2 * np.pi) / np.sqrt(3) * np.exp(-(1 / 6) / T)
         delta = sc.gamma * 1.2 / T
         assert th["action"] == pytest.approx(1.2, rel=1e-9) and th["delta"] == pytest.approx(delta, rel=1e-9)

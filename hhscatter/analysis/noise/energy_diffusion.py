@@ -40,7 +40,15 @@ from hhscatter.analysis.noise.turnover import depopulation_factor
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
-__all__ = ["EnergyDiffusion", "WellShells", "energy_diffusion_rate", "well_energy_diffusion", "well_shells"]
+__all__ = [
+    "EnergyDiffusion",
+    "WellShells",
+    "energy_diffusion_rate",
+    "is_separable",
+    "thermal_well_shells",
+    "well_energy_diffusion",
+    "well_shells",
+]
 
 
 def energy_diffusion_rate(energies, phase_volume, gamma: float, temperature: float, *, dof: int = 2, flux=None):
@@ -288,3 +296,75 @@ def well_energy_diffusion(
         phase_volume_barrier=om_b,
         top=shells.top,
     )
+
+
+_THERMAL_SHELLS: dict = {}
+
+
+def thermal_well_shells(
+    model, temperature: float, *, top_widths: float = 12.0, grid: int = 1201, n_energies: int = 4001
+) -> WellShells:
+    """thermal_well_shells(model, T, top_widths=12, grid=1201, n_energies=4001) -> WellShells: the energy shells of
+    ``model``'s well up to E_b + ``top_widths`` T (E_b the lowest saddle's energy, T the temperature in energy
+    units), by :func:`well_shells`, computed once per system, temperature and settings and kept for later calls.
+
+    The shells depend on the potential only; every rate of :func:`well_energy_diffusion` at that temperature
+    (any γ) reads the same ones. Above E_b + top_widths T the population is e^{−top_widths} of the barrier's.
+    The system is known by its potential expression and parameters (``model.potential_text``, ``model.params``).
+
+    Examples
+    --------
+    Hénon–Heiles at T = 1/18 (ΔE/T = 3): the shells reach E_b + 3T = 1/3, and a second call returns the same
+    object:
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> sh = thermal_well_shells(HenonHeiles(), 1 / 18, top_widths=3.0, grid=301, n_energies=201)
+    >>> round(sh.top, 12), round(sh.barrier, 12)
+    (0.333333333333, 0.166666666667)
+    >>> thermal_well_shells(HenonHeiles(), 1 / 18, top_widths=3.0, grid=301, n_energies=201) is sh
+    True
+    """
+    check.system(model)
+    temperature = check.number(temperature, "temperature", positive=True)
+    top_widths = check.number(top_widths, "top_widths", positive=True)
+    grid = check.count(grid, "grid", 51)
+    n_energies = check.count(n_energies, "n_energies", 3)
+    key = (model.potential_text, tuple(sorted(dict(model.params).items())), temperature, top_widths, grid, n_energies)
+    if key not in _THERMAL_SHELLS:
+        e_b = float(model.potential(np.array(0.0), np.array(0.0))) + well_barrier(model)
+        _THERMAL_SHELLS[key] = well_shells(model, e_b + top_widths * temperature, grid=grid, n_energies=n_energies)
+    return _THERMAL_SHELLS[key]
+
+
+def is_separable(model, *, span: float = 1.0, nodes: int = 5, rtol: float = 1e-12) -> bool:
+    """is_separable(model, span=1, nodes=5, rtol=1e-12) -> whether ``model``'s potential is a sum of a function
+    of x and a function of y: its mixed derivative ∂²V/∂x∂y vanishes on a ``nodes`` × ``nodes`` lattice of
+    [−span, span]² (``span`` in length units; the exact second derivatives of :func:`hessian`).
+
+    A decision, not a sample, for a polynomial potential of degree ≤ ``nodes`` + 1: its mixed derivative is then
+    a polynomial of degree ≤ ``nodes`` − 1 in each variable, which is zero everywhere when it is zero on the
+    lattice. For other potentials it is a necessary condition. Zero means |V_xy| ≤ ``rtol`` times the largest
+    |V_xx|, |V_yy| on the lattice (or 1). When V is separable, each degree of freedom keeps its own energy between
+    kicks: no orbit explores its whole energy shell (the ergodicity the shells' energy-diffusion theory assumes).
+
+    Examples
+    --------
+    A sum of two one-dimensional wells is separable; Hénon–Heiles (V_xy = 2x) is not:
+
+    >>> from hhscatter.model import HenonHeiles, make_system
+    >>> is_separable(make_system(potential="(x**2 + y**2)/2 - x**3/3 - 5*y**3/18"))
+    True
+    >>> is_separable(HenonHeiles())
+    False
+    """
+    check.system(model)
+    span = check.number(span, "span", positive=True)
+    nodes = check.count(nodes, "nodes", 2)
+    rtol = check.number(rtol, "rtol", minimum=0.0)
+    # distinct nodes (Chebyshev's, turned off the axes so that none is 0)
+    xs = span * np.cos(np.pi * (np.arange(nodes) + 0.5) / nodes + 0.1)
+    h = np.array([hessian(model, float(x), float(y)) for x in xs for y in xs])
+    if not np.all(np.isfinite(h)):
+        raise ConfigError(f"the potential's second derivatives are not finite on [−{span:g}, {span:g}]²: set span")
+    scale = max(1.0, float(np.max(np.abs(h[:, 0, 0]))), float(np.max(np.abs(h[:, 1, 1]))))
+    return bool(np.all(np.abs(h[:, 0, 1]) <= rtol * scale))

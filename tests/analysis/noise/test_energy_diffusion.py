@@ -1,6 +1,7 @@
 """hhscatter.analysis.noise.energy_diffusion: the energy-diffusion eigenvalue against the zero of a confluent
 hypergeometric function (the one-dimensional harmonic well), its flux closure against the harmonic transition-state
-rate, the well's shells of Hénon–Heiles against the exact integral over its triangle, and argument checks."""
+rate, the well's shells of Hénon–Heiles against the exact integral over its triangle, the shells kept per
+temperature, separability against potentials built as sums of one-dimensional ones, and argument checks."""
 
 from __future__ import annotations
 
@@ -11,7 +12,13 @@ import pytest
 import sympy as sp
 from scipy import optimize, special
 
-from hhscatter.analysis.noise import energy_diffusion_rate, well_energy_diffusion, well_shells
+from hhscatter.analysis.noise import (
+    energy_diffusion_rate,
+    is_separable,
+    thermal_well_shells,
+    well_energy_diffusion,
+    well_shells,
+)
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles, make_system
 
@@ -116,3 +123,71 @@ def test_bad_arguments_are_refused_by_name(kwargs, word):
 def test_shells_refuse_a_top_below_the_barrier():
     with pytest.raises(ConfigError, match="top"):
         well_shells(HenonHeiles(), 0.1)
+
+
+def test_thermal_shells_reach_the_barrier_plus_widths_of_t_and_are_kept_per_temperature():
+    m, T = HenonHeiles(), 0.04
+    sh = thermal_well_shells(m, T, top_widths=2.5, grid=201, n_energies=101)
+    # Hénon–Heiles: V(min) = 0, E_b = 1/6 (closed form)
+    assert sh.top == pytest.approx(1 / 6 + 2.5 * T, abs=1e-15)
+    assert sh.barrier == pytest.approx(1 / 6, abs=1e-15)
+    direct = well_shells(m, 1 / 6 + 2.5 * T, grid=201, n_energies=101)
+    np.testing.assert_array_equal(sh.phase_volume, direct.phase_volume)
+    np.testing.assert_array_equal(sh.flux, direct.flux)
+    assert thermal_well_shells(HenonHeiles(), T, top_widths=2.5, grid=201, n_energies=101) is sh
+    other = thermal_well_shells(m, 0.05, top_widths=2.5, grid=201, n_energies=101)
+    assert other is not sh and other.top == pytest.approx(1 / 6 + 2.5 * 0.05, abs=1e-15)
+    # another system with the same settings is another entry
+    wide = thermal_well_shells(HenonHeiles(lam=0.5), T, top_widths=2.5, grid=201, n_energies=101)
+    assert wide.barrier == pytest.approx(1 / 6 / 0.25, abs=1e-12)  # E_c = ω⁶/(6λ²)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "word"),
+    [
+        ({"temperature": 0.0}, "temperature"),
+        ({"temperature": math.nan}, "temperature"),
+        ({"top_widths": -1.0}, "top_widths"),
+        ({"grid": 10}, "grid"),
+        ({"n_energies": 2.5}, "n_energies"),
+        ({"model": "hh"}, "model"),
+    ],
+)
+def test_thermal_shells_refuse_bad_arguments_by_name(kwargs, word):
+    args = {"model": HenonHeiles(), "temperature": 0.05, **kwargs}
+    with pytest.raises(ConfigError, match=word):
+        thermal_well_shells(args.pop("model"), args.pop("temperature"), **args)
+
+
+@pytest.mark.parametrize(
+    ("potential", "separable"),
+    [
+        # sums of a function of x and a function of y (by construction)
+        ("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18", True),
+        ("x**2/2 - x**4/4 + y**2 - y**3", True),
+        # couplings: V_xy = 2x (Hénon–Heiles), y/5 and 1/10 (bilinear)
+        ("(x**2 + y**2)/2 + x**2*y - y**3/3", False),
+        ("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18 + x*y**2/10", False),
+        ("(x**2 + y**2)/2 - x**3/3 - 5*y**3/18 + x*y/10", False),
+    ],
+)
+def test_separability_against_potentials_built_as_sums(potential, separable):
+    assert is_separable(make_system(potential=potential)) is separable
+
+
+def test_hénon_heiles_is_not_separable_and_a_coupling_below_the_tolerance_counts_as_none():
+    assert is_separable(HenonHeiles()) is False
+    weak = make_system(potential="(x**2 + y**2)/2 - x**3/3 - 5*y**3/18 + 1e-15*x*y")
+    assert is_separable(weak) is True  # V_xy = 1e-15 ≤ 1e-12 × max(|V_xx|, |V_yy|, 1)
+    assert is_separable(weak, rtol=1e-16) is False
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "word"),
+    [({"span": 0.0}, "span"), ({"nodes": 1}, "nodes"), ({"rtol": -1.0}, "rtol"), ({"rtol": math.inf}, "rtol")],
+)
+def test_separability_refuses_bad_arguments_by_name(kwargs, word):
+    with pytest.raises(ConfigError, match=word):
+        is_separable(HenonHeiles(), **kwargs)
+    with pytest.raises(ConfigError, match="model"):
+        is_separable(None)
