@@ -17,6 +17,7 @@ from scipy import integrate, optimize
 from hhscatter.analysis.geometry.channels import channel_fractions, return_statistics
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.analysis.survival.paired import paired_mle_shift, survival_ratio_slope
+from hhscatter.errors import ConfigError
 from hhscatter.integrate.events import CENSORED, ESCAPED
 from hhscatter.scene.scene import SceneError
 
@@ -245,7 +246,7 @@ def test_paired_shift_independent_samples_error():
     ps = paired_mle_shift(t0, o0, t1, o1, 2.0, 20.0)
     assert ps.shift_err == pytest.approx(ps.shift_err_unpaired, rel=0.05)
     assert abs(ps.shift - 0.05) < 3 * ps.shift_err
-    with pytest.raises(ValueError, match="same length"):
+    with pytest.raises(ConfigError, match="t_alt must have one value per orbit of t_ref"):
         paired_mle_shift(t0, o0, t1[:10], o1[:10], 2.0, 20.0)
 
 
