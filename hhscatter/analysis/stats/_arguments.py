@@ -27,8 +27,8 @@ import numpy as np
 from hhscatter.errors import ConfigError
 
 
-def numbers(a, name: str, *, min_size: int = 1, minimum: float | None = None, positive: bool = False) -> np.ndarray:
-    """``a`` as a 1-D float array of finite numbers (at least ``min_size``; ≥ ``minimum``, or > 0 if ``positive``)."""
+def _float_array(a, name: str) -> np.ndarray:
+    """``a`` as a flat float array of numbers (NaN and inf kept); a word, a mapping, None or booleans refused."""
     if isinstance(a, (str, bytes, dict)) or a is None:
         raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
     try:
@@ -38,6 +38,12 @@ def numbers(a, name: str, *, min_size: int = 1, minimum: float | None = None, po
         arr = arr.astype(float).ravel()
     except (TypeError, ValueError):
         raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+    return arr
+
+
+def numbers(a, name: str, *, min_size: int = 1, minimum: float | None = None, positive: bool = False) -> np.ndarray:
+    """``a`` as a 1-D float array of finite numbers (at least ``min_size``; ≥ ``minimum``, or > 0 if ``positive``)."""
+    arr = _float_array(a, name)
     if arr.size < min_size:
         raise ConfigError(f"{name} must hold at least {min_size} value(s), got {arr.size}")
     if not np.all(np.isfinite(arr)):
@@ -157,15 +163,7 @@ def instance(obj, name: str, kind: type | tuple[type, ...]):
 
 def floats(a, name: str, *, size: int | None = None, of: str = "orbit") -> np.ndarray:
     """``a`` as a 1-D float array of numbers where NaN and inf may stand (the estimator drops them); ``size`` values."""
-    if isinstance(a, (str, bytes, dict)) or a is None:
-        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
-    try:
-        arr = np.asarray(a)
-        if arr.dtype == bool or arr.dtype.kind not in "iuf":
-            raise TypeError
-        arr = arr.astype(float).ravel()
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+    arr = _float_array(a, name)
     if size is not None and arr.size != size:
         raise ConfigError(f"{name} must have one value per {of}: {arr.size} != {size}")
     return arr
