@@ -30,7 +30,7 @@ data to decide; the fitting code supports both.
 Both fits return :class:`SurvivalFit` with the same goodness-of-fit measures
 (χ², dof, χ²/dof, RMS of log residuals, AIC) on the same data selection, so
 that :func:`~hhscatter.analysis.dissipative.model_comparison.compare_fits` can tabulate them side by side; the τ1 a fit
-predicts and the figure studies' fitting rule are in :mod:`hhscatter.analysis.dissipative.model_comparison`.
+predicts is in :mod:`hhscatter.analysis.dissipative.model_comparison`.
 
 Units: time in model units, energies in model units, rates in 1/time.
 """

@@ -87,6 +87,17 @@ def wholes(a, name: str, minimum: int = 1) -> list[int]:
     return [whole(v, name, minimum) for v in check.numbers(a, name)]
 
 
+def reference(ref, name: str):
+    """``ref`` if it is None or (value, err), two numbers (NaN allowed: not measured)."""
+    if ref is None:
+        return ref
+    if isinstance(ref, (str, bytes, dict)) or not hasattr(ref, "__len__") or len(ref) != 2:
+        raise ConfigError(f"{name} must be (value, err) or None, got {ref!r}")
+    if any(isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) for v in ref):
+        raise ConfigError(f"{name} must be (value, err), two numbers (NaN: not measured), got {ref!r}")
+    return ref
+
+
 def generator(rng, name: str = "rng"):
     """``rng`` if it is a :class:`numpy.random.Generator`."""
     if not isinstance(rng, np.random.Generator):

@@ -11,8 +11,8 @@ and turns their results into the records of an operator study:
   :mod:`hhscatter.analysis.geometry.ulam_convergence`);
 * :func:`leading_modes`, :func:`measure_points`, :func:`reduced_operator` — spectra, c-measure samples and the
   operator on ρ(E) alone;
-* :func:`empirical_survival`, :func:`survival_agreement`, :func:`t_star_energies`, :func:`cost_row` — the
-  comparisons with a simulated ensemble and the cost of each route.
+* :func:`empirical_survival`, :func:`survival_agreement`, :func:`t_star_energies` — the comparisons with a
+  simulated ensemble.
 
 Pure functions (tables and arrays in, records out). Units: box sides in position units, times in the
 Hamiltonian's time unit, κ in 1/time.
@@ -37,7 +37,6 @@ __all__ = [
     "dissipative_record",
     "dissipative_operator",
     "coarse_index",
-    "cost_row",
     "disk_density",
     "eigenvector_convergence",
     "empirical_survival",
@@ -347,56 +346,6 @@ def t_star_energies(pred, sim_pts):
             "sim": float(sim_pts["energy"].std()) if len(sim_pts) > 1 else math.nan,
         },
     }
-
-
-def cost_row(E, pt, rec, kappa0, target):
-    """Orbit-time of each route for κ at the relative error ``target``.
-
-    ``pt``: the P(t) route's result {kappa, kappa_err, orbits, orbit_time}; ``rec``: the operator's κ record
-    at E (or None); ``kappa0``: {E: (κ0, err)} of the reference. The P(t) route scales as 1/√N; the
-    operator's is a lower bound: its bias ∝ box side (cost ∝ 1/b² at fixed samples per box) and its
-    statistics ∝ 1/√(samples) — optimistic, since finer boxes raise the per-sample noise.
-    """
-    check.number(E, "E")
-    _checks.mapping(pt, "pt", ("kappa", "kappa_err", "orbits", "orbit_time"))
-    if rec is not None:
-        _checks.mapping(rec, "rec", ("kappa", "kappa_stat_err", "discretisation_bias", "err", "orbit_time"))
-    _checks.mapping(kappa0, "kappa0")
-    check.number(target, "target", positive=True)
-    rel = float(pt["kappa_err"] / pt["kappa"])
-    ot = float(pt["orbit_time"])
-    k0 = kappa0.get(E, (math.nan, math.nan))
-    row = {
-        "energy": E,
-        "pt_kappa": float(pt["kappa"]),
-        "pt_err": float(pt["kappa_err"]),
-        "pt_rel": rel,
-        "pt_orbits": int(pt["orbits"]),
-        "pt_orbit_time": ot,
-        "pt_orbit_time_1pct": ot * (rel / target) ** 2,
-        "fig2_kappa": k0[0],
-        "fig2_err": k0[1],
-    }
-    if rec is not None:
-        k = rec["kappa"]
-        st_rel = rec["kappa_stat_err"] / k
-        b_rel = abs(rec["discretisation_bias"]) / k
-        share = target / math.sqrt(2)  # half of the budget (in quadrature) to each part
-        f_bias = max(1.0, (b_rel / share) ** 2)
-        f_stat = max(1.0, (st_rel / share) ** 2)
-        row.update(
-            {
-                "op_kappa": k,
-                "op_err": rec["err"],
-                "op_rel": rec["err"] / k,
-                "op_stat_rel": st_rel,
-                "op_bias_rel": b_rel,
-                "op_orbit_time": rec["orbit_time"],
-                "op_orbit_time_1pct": rec["orbit_time"] * max(f_bias, f_stat),
-                "pt_rel_at_op_cost": rel * math.sqrt(ot / rec["orbit_time"]),
-            }
-        )
-    return row
 
 
 def hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head):

@@ -144,6 +144,17 @@ def frame(df, name: str, columns=()):
     return df
 
 
+def curve(t, P, names: tuple[str, str] = ("t", "P")) -> tuple[np.ndarray, np.ndarray]:
+    """A measured curve: increasing finite times ``t`` (at least one) and P with one value per time (NaN may stand)."""
+    if np.ndim(t) != 1:
+        raise ConfigError(f"{names[0]} must be a 1-D array of times, got {type(t).__name__}")
+    t = numbers(t, names[0])
+    P = floats(P, names[1], size=t.size, of=f"time {names[0]}")
+    if np.any(np.diff(t) < 0):
+        raise ConfigError(f"{names[0]} must be increasing")
+    return t, P
+
+
 def mapping(d, name: str, *, min_size: int = 0) -> dict:
     """``d`` if it is a mapping (a dict) of at least ``min_size`` entries."""
     if not isinstance(d, dict):
