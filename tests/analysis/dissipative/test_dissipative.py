@@ -595,7 +595,7 @@ def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
 
 def test_homogeneous_fit_steps_alone():
     """The steps of fit_survival_model (start values, bounds, parameters from θ, starts, one fit at fixed τ2)."""
-    from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, homogeneous_start
+    from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, _homogeneous_start
 
     t = np.arange(0.0, 301.0)
     P = model.survival_model(t, **KW, **TRUE, hazard="paper")
@@ -604,10 +604,10 @@ def test_homogeneous_fit_steps_alone():
     sf = 1e-3 * Pf
     P_tau0 = float(np.interp(KW["tau0"], t[np.isfinite(P)], P[np.isfinite(P)]))
     tau2 = transitions.tau2_predicted(KW["E0"], EC, KW["mu"], KW["gamma"])
-    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2, P_tau0, {}, None)
+    fne0, fe0, L0, b_starts = _homogeneous_start(tf, Pf, tau2, P_tau0, {}, None)
     assert 0 < fne0 <= 0.9 * P_tau0 and fe0 == pytest.approx(P_tau0 - fne0) and L0 > 0
     assert b_starts == (0.02, 0.1, 0.5)
-    assert homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
+    assert _homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
     prob = HomogeneousProblem(
         tf,
         Pf,
