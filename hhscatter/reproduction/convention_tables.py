@@ -34,7 +34,7 @@ def stable_energies(table, *, rel_tol: float = 0.1, min_defined: int = 2):
     ``min_defined`` conventions define it and (max − min)/mean of their κ is
     ≤ ``rel_tol``.
     """
-    check.frame(table, "table", ("energy", "kappa", "defined"))
+    check.table(table, "table", ("energy", "kappa", "defined"), min_rows=0)
     check.number(rel_tol, "rel_tol", minimum=0.0)
     check.count(min_defined, "min_defined", 1)
     rows = []
@@ -155,7 +155,7 @@ def fit_laws(table, names, energies, E_c: float, *, n_boot: int, seed: int, min_
     Returns (fits, info): fits {name: KappaEnergyFit} of the conventions with at least ``min_points`` energies (a,
     b and the break need points on both sides); info {name: {"energies": [...], "fit": its numbers or None}}.
     """
-    check.frame(table, "table", ("convention", "energy", "kappa", "kappa_err", "defined"))
+    check.table(table, "table", ("convention", "energy", "kappa", "kappa_err", "defined"), min_rows=0)
     if isinstance(names, (str, bytes, dict)) or not isinstance(names, (list, tuple)):
         raise ConfigError(f"names must be a list of convention names, got {type(names).__name__}")
     check.numbers(sorted(energies) if isinstance(energies, (set, frozenset)) else energies, "energies", min_size=0)

@@ -87,6 +87,13 @@ def wholes(a, name: str, minimum: int = 1) -> list[int]:
     return [whole(v, name, minimum) for v in check.numbers(a, name)]
 
 
+def potential(model, name: str = "model"):
+    """``model`` if it has a potential V(x, y) to call (a system)."""
+    if not callable(getattr(model, "potential", None)):
+        raise ConfigError(f"{name} must be a system with a potential V(x, y), got {type(model).__name__}")
+    return model
+
+
 def reference(ref, name: str):
     """``ref`` if it is None or (value, err), two numbers (NaN allowed: not measured)."""
     if ref is None:

@@ -66,6 +66,19 @@ def _sample_table(tab, name: str, ebins: bool = False, *, t_end: bool = False):
     return check.table(tab, name, _SAMPLE_COLUMNS + more)
 
 
+def _partitions(tab, extent, box, coarsen=None, subsets=None, *, ebins: bool = False, t_end: bool = False):
+    """The arguments that say which partitions of the one-return samples ``tab`` are built: the section's
+    ``extent``, the finest box side ``box`` and, when given, the merging factors ``coarsen`` and the sample counts
+    ``subsets``."""
+    _sample_table(tab, "tab", ebins, t_end=t_end)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    if coarsen is not None:
+        _checks.wholes(coarsen, "coarsen")
+    if subsets is not None:
+        _checks.wholes(subsets, "subsets")
+
+
 def _transition_table(t, tr):
     check.table(t, "t", ("t_end", "x1", "y1", "e1"), min_rows=0)
     if len(t) != tr.src.size:
@@ -117,9 +130,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
     ``ebin``) the states are (box, energy bin): id = bin·n_cells + box. Returns (Transitions, state ids,
     the samples used).
     """
-    _sample_table(tab, "tab", ebins is not None)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
+    _partitions(tab, extent, box, ebins=ebins is not None)
     _checks.whole(c, "c")
     if m_max is not None:
         _checks.whole(m_max, "m_max")
@@ -402,8 +413,7 @@ def stratified_section_points(model, energy, extent, box, k, r_esc, rng, *, e_wi
     [E − e_width/2, E + e_width/2]) and w, the flux density |ṗ_r|/v of the return map's invariant measure
     (:func:`~hhscatter.analysis.geometry.transfer.section_flux_density`).
     """
-    if not callable(getattr(model, "potential", None)):
-        raise ConfigError(f"model must be a system with a potential V(x, y), got {type(model).__name__}")
+    _checks.potential(model)
     check.number(energy, "energy")
     _checks.extent(extent)
     check.number(box, "box", positive=True)
@@ -484,11 +494,7 @@ def eigenvector_convergence(tab, extent, box, coarsen, subsets, Q, boxes, n_spli
     """The debiased Hellinger distance (at the box nearest ``head``) between the operator's sprinkler measure and
     the reference points ``Q``, for boxes merged c × c and the first M' samples per finest box: records
     {box, samples_per_box, kappa, eps, hellinger_debiased, lo, hi}."""
-    _sample_table(tab, "tab")
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets)
     _checks.points(Q, "Q")
     check.numbers(boxes, "boxes", positive=True)
     check.count(n_splits, "n_splits", 1)
@@ -568,9 +574,7 @@ def dissipative_operator(tab, extent, box, edges, *, dt, t_horizon, t_star, max_
     t, n_cells, lost (share of the disk on no state), max_lag, steps, grid (times), P, P_reduced,
     kappa_bins, pred}.
     """
-    _sample_table(tab, "tab", True)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
+    _partitions(tab, extent, box, ebins=True)
     check.numbers(edges, "edges", min_size=2)
     check.number(dt, "dt", positive=True)
     for name, v in (("t_horizon", t_horizon), ("t_star", t_star), ("max_return_time", max_return_time)):

@@ -23,7 +23,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry import transfer as tf
-from hhscatter.analysis.geometry.ulam import _sample_table, saddle_kappa, sample_transitions
+from hhscatter.analysis.geometry.ulam import _partitions, saddle_kappa, sample_transitions
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
@@ -191,11 +191,7 @@ def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
     (:func:`kappa_convergence`). Returns (grid: box, samples, kappa; replicates: rep, box, samples, kappa —
     NaN where a replicate leaves no open class).
     """
-    _sample_table(tab, "tab")
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets)
     _checks.whole(samples, "samples")
     _checks.whole(n_boot, "n_boot", 0)
     parts = [(int(c), int(m)) for c in coarsen for m in subsets]
@@ -241,11 +237,7 @@ def energy_results(tab, extent, box, coarsen, subsets, samples, n_boot, n_boot_g
     >>> bool(abs(res["kappa"] - math.log(4 / 3) / 2) < 1e-9), len(res["rows"]), len(res["grid"])
     (True, 4, 4)
     """
-    _sample_table(tab, "tab", t_end=True)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets, t_end=True)
     _checks.whole(samples, "samples")
     _checks.whole(n_boot, "n_boot", 0)
     _checks.whole(n_boot_grid, "n_boot_grid", 0)
