@@ -774,6 +774,41 @@ def test_the_glossary_has_a_row_for_every_symbol_the_result_pages_define():
     assert wanted <= heads, sorted(wanted - heads)
 
 
+#: Greek letters the study pages write as notation rather than as a symbol of their own, each with why it needs no row
+GREEK_NOTATION = {
+    "σ": "a standard error (a distance in σ), not a quantity",
+    "χ": "χ², the goodness-of-fit statistic, named where it is used",
+    "Σ": "a sum",
+    "Δ": "a difference (ΔE, Δ = d(5b) − d(5a)), defined where it is used",
+    "π": "the number π",
+    "ψ": "the digamma function of the nearest-neighbour dimension estimate, named where it is used",
+}
+
+
+def _greek_symbols(text: str) -> set[str]:
+    """Each Greek letter of ``text`` with the accents written on it (φ and φ̇ are two symbols)."""
+    return set(re.findall(r"[\u0370-\u03ff][\u0300-\u036f]*", text))
+
+
+def test_every_greek_symbol_of_the_study_pages_heads_a_glossary_row():
+    """Every Greek symbol a study page uses (its page.md and its study module's docstring, shown on the page) heads a
+    row of the glossary, unless it is notation (a sum, a difference, σ, χ², π, the digamma function): fig6's
+    mixture share φ, the operator's Perron vector ν, the noise study's Υ(δ) and the saddle's log-stretch Λ each have
+    their row."""
+    import ast
+
+    text = (DOCS / "equations.md").read_text()
+    rows = text[text.index("## Glossary") :].splitlines()
+    heads = set().union(*(_greek_symbols(r.split("|")[1]) for r in rows if r.startswith("| ")))
+    missing = {}
+    for folder in sorted(p for p in (ROOT / "studies").iterdir() if (p / "page.md").is_file()):
+        used = _greek_symbols((folder / "page.md").read_text())
+        used |= _greek_symbols(ast.get_docstring(ast.parse((folder / "study.py").read_text())) or "")
+        for sym in sorted(used - heads - set(GREEK_NOTATION)):
+            missing.setdefault(sym, []).append(folder.name)
+    assert not missing, missing
+
+
 def test_a_rate_symbol_of_one_study_is_not_reused_by_another():
     """κ∞ is Ulam's extrapolated rate (operator) only; generality's long-time fit calls the rate of its non-plateau
     orbits κ_tail, and the saddle's 1/T offset of λ̄ is Λ₀ (b is the paper's own symbol, in (19) and its κ(E) law)."""
