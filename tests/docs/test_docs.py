@@ -694,7 +694,35 @@ def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
     """A record with a sibling <key>_upper (a count of 0) shows its one-sided bound, never "0 ± 0"."""
     recs = [{"t": 80.0, "sim": 0.25, "sim_err": 0.01}, {"t": 100.0, "sim": 0.0, "sim_err": None, "sim_upper": 3e-4}]
     out = hook.spec_table(recs, (("t", "t"), ("sim", "simulated")))
-    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out
+    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0×10<sup>-4</sup> (95 %) |" in out
+
+
+def _notations(cell: str) -> set[str]:
+    """The notations of the numbers of a rendered cell: "e" (2.6e-06), "×10" (2.6×10<sup>-6</sup>)."""
+    out = {"e"} if re.search(r"(?<![\w.])\d+(?:\.\d+)?e[+-]?\d+", cell) else set()
+    return out | ({"×10"} if "×10<sup>" in cell else set())
+
+
+def test_a_rendered_study_table_writes_its_numbers_in_one_notation(hook):
+    """Every record table a page asks for, rendered from the committed numbers at both scales, writes a power of
+    ten one way: no table mixes e-notation (basins' cut-off table wrote "2.63e-06 ± 6.3e-08" and "ε_c < 1e-10" beside
+    "2.56×10<sup>-6</sup>") with a×10<sup>b</sup>, in a value ± error or in a text cell."""
+    mixed = []
+    for table, spec in hook.STUDY_TABLES.items():
+        name, key = table.split("@", 1)[0].split(".", 1)
+        for base in (DOCS / "studies" / "assets", DOCS / "studies" / "assets" / "paper"):
+            path = base / f"{name}.json"
+            recs = hook._dig(json.loads(path.read_text()), key) if path.is_file() else None
+            if not recs:
+                continue
+            rows = [r.split(" | ") for r in hook.spec_table(recs, spec).splitlines()[2:]]
+            used = set().union(*(_notations(c) for r in rows for c in r))
+            if len(used) > 1:
+                mixed.append((table, base.name, sorted(used)))
+    assert not mixed, mixed
+    # the renderer's notation, in a value ± error and in a text cell
+    out = hook.spec_table([{"x": 2.63e-6, "x_err": 6.3e-8, "s": "ε_c < 1e-10"}], (("x", "x"), ("s", "s")))
+    assert "| (2.63 ± 0.06)×10<sup>-6</sup> | ε_c < 1×10<sup>-10</sup> |" in out
 
 
 def test_the_reference_radius_difference_to_itself_reads_reference(hook):
