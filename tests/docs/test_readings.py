@@ -138,15 +138,19 @@ def test_the_resc_page_names_the_tools_own_default():
     and the page no longer calls the reference radius the default."""
     from hhscatter.model import HenonHeiles
 
+    for scale in ("quick", "paper"):
+        # the reference radius is recorded under what it is, the authors' value (the study's r_ref)
+        other, _ = load_numbers(ROOT, "resc", scale)
+        assert other["default_r_esc"]["authors"] == other["r_ref"] and "current" not in other["default_r_esc"]
     doc, _ = load_numbers(ROOT, "resc")
-    pick, ref = doc["default_r_esc"]["recommended"], doc["default_r_esc"]["current"]
+    pick, ref = doc["default_r_esc"]["recommended"], doc["default_r_esc"]["authors"]
     assert pick != ref
     for e in doc["energies"]:
         assert HenonHeiles().default_escape_radius(e) == pytest.approx(pick)
     page = (ROOT / "studies" / "resc" / "page.md").read_text()
     assert "[[resc:default_r_esc.recommended]]; that is the tool's own default" in page
     # the reference radius is read as what it is (the study's r_ref), not as a "current default"
-    assert "default_r_esc.current" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
+    assert "default_r_esc.authors" not in page and "r_esc = [[resc:r_ref]], the authors' value" in page
     rendered = render_refs(page, ROOT)
     assert f"the default r_esc = {ref:g}" not in rendered
     # the study's parameters, shown on the page with their comments, do not call it the default either
