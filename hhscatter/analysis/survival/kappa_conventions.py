@@ -154,7 +154,10 @@ def dead_time_check(
     burst of escapes, not the regime: the window rule picks it when the burst covers more e-folds of P above the
     counting floor than the regime after it (a small ensemble, whose floor of ``min_survivors`` orbits sits high),
     and its κ then moves with N. The same small ensemble can also give a short window at the burst's end, after
-    the first escape, whose escapes are all burst orbits: the second condition.
+    the first escape, whose escapes are all burst orbits: the second condition. A window of an e-fold or more
+    after the first escape passes, even within a fast population's decay that a slower regime follows: it is a
+    measured exponential stretch (far above threshold the regime's own windows are that short), and which of two
+    stretches is the regime is the window rule's choice over the orbits it has, not this check's.
 
     Examples
     --------
