@@ -788,6 +788,18 @@ STUDY_TABLES = {
         ("d1_err_largest", "largest part of D₁'s error"),
         ("d1_range_floor", "D₁'s range ended below by"),
     ),
+    "saddle.gap": (
+        ("system", "system"),
+        ("ratio", "E/E_c"),
+        ("gap", "1 − κ/λ̄ − d₁"),
+        ("z", "z"),
+        ("left_estimator", "left: fixed radius"),
+        ("share_estimator", "share"),
+        ("left_selection", "left: t_min → ∞"),
+        ("share_selection", "share"),
+        ("left_mid_life", "left: mid-life λ̄"),
+        ("share_mid_life", "share"),
+    ),
     "saddle.dimensions": (
         ("system", "system"),
         ("ratio", "E/E_c"),
