@@ -325,7 +325,9 @@ def with_gap(rec: dict) -> dict:
     checked, ``gap``: the gap d₁(implied) − d₁ = 1 − κ/λ̄ − d₁ and, per candidate of :data:`CANDIDATES` measured
     at the point, the gap left when its alternative replaces d₁ or λ̄ (``left``, errors in quadrature, the
     alternatives' correlation with the originals ignored: an upper bound on its error), ``z`` = left/err, the
-    share of the gap it explains (1 − left/gap) and ``closes`` (|z| ≤ 2).
+    share of the gap it explains (1 − left/gap), ``closes`` (|z| ≤ 2 left and a share ≥ 1/2: the candidate
+    accounts for the gap) and ``within_by_error`` (|z| ≤ 2 left with a share < 1/2: consistent only because the
+    candidate's own error is larger, not an explanation).
 
     Examples
     --------
@@ -362,8 +364,9 @@ def with_gap(rec: dict) -> dict:
     for name, (imp, d) in alt.items():
         left = imp.difference(d)
         z = left.value / left.err if left.err > 0 else math.copysign(math.inf, left.value)
+        share = 1.0 - left.value / gap.value if gap.value else math.nan
         out[name] = {"d1": d.to_dict(), "d1_implied": imp.to_dict(), "left": left.to_dict(), "z": z,
-                     "share": 1.0 - left.value / gap.value if gap.value else math.nan, "closes": abs(z) <= 2}  # fmt: skip
+                     "share": share, "closes": abs(z) <= 2 and share >= 0.5, "within_by_error": abs(z) <= 2 and not share >= 0.5}  # fmt: skip
     rec["gap"] = out
     return rec
 
@@ -393,8 +396,9 @@ def gap_row(rec: dict) -> dict:
 
 def gap_summary(records) -> dict:
     """gap_summary(records) -> where d₁ and 1 − κ/λ̄ differ by more than 2σ and, per candidate, at how many of those
-    points it closes the gap (|z| ≤ 2 left) and its median share of the gap, with the statement of the measured
-    reason ("not explained" where no candidate closes it).
+    points it closes the gap (|z| ≤ 2 left and at least half of it explained), at how many it is consistent only by
+    its larger error, and its median share of the gap, with the statement of the measured reason ("not explained"
+    where no candidate closes it).
 
     Examples
     --------
@@ -410,13 +414,15 @@ def gap_summary(records) -> dict:
     for name, what in CANDIDATES.items():
         at = [r for r in gaps if name in r["gap"]]
         closes = [r["id"] for r in at if r["gap"][name]["closes"]]
+        by_error = [r["id"] for r in at if r["gap"][name].get("within_by_error")]
         shares = [r["gap"][name]["share"] for r in at if math.isfinite(r["gap"][name]["share"])]
         med = float(np.median(shares)) if shares else None
         cands[name] = {"what": what, "n_measured": len(at), "n_closes": len(closes), "closes_at": closes,
-                       "median_share": med}  # fmt: skip
+                       "n_within_by_error": len(by_error), "within_by_error_at": by_error, "median_share": med}  # fmt: skip
         if at:
             parts.append(f"{what}: closes it at {len(closes)} of {len(at)}" + (f" ({', '.join(closes)})" if closes
-                         else "") + (f", median share of the gap {100 * med:.0f} %" if med is not None else ""))  # fmt: skip
+                         else "") + (f", consistent only by its larger error at {len(by_error)}" if by_error else "")
+                         + (f", median share of the gap {100 * med:.0f} %" if med is not None else ""))  # fmt: skip
     unexplained = [r["id"] for r in gaps if not any(r["gap"].get(n, {}).get("closes") for n in CANDIDATES)]
     statement = (f"d₁ and 1 − κ/λ̄ differ by more than 2σ at {len(gaps)} of the {sum(bool(r.get('gap')) for r in records)}"
                  f" points with both" + (f" ({', '.join(r['id'] for r in gaps)})" if gaps else "")

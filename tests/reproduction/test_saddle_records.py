@@ -108,6 +108,18 @@ def test_with_gap_measures_what_each_candidate_leaves_of_the_gap():
     assert "closes it at 1 of 1 (p)" in s["statement"]
 
 
+def test_a_candidate_consistent_only_by_its_larger_error_does_not_close_the_gap():
+    """A candidate that moves the gap the wrong way (share < 0) but whose own error is large enough to leave |z| ≤ 2
+    is not an explanation: counted apart, and the point stays unexplained."""
+    rec = sr.with_gap(_gap_record(d1_radius={"value": 0.66, "err": 0.06}))  # leaves 0.09 ± 0.06: z 1.5, share −0.8
+    g = rec["gap"]["estimator"]
+    assert abs(g["z"]) <= 2 and g["share"] == pytest.approx(-0.8)
+    assert not g["closes"] and g["within_by_error"]
+    s = sr.gap_summary([rec])
+    assert s["candidates"]["estimator"]["n_closes"] == 0 and s["candidates"]["estimator"]["within_by_error_at"] == ["p"]
+    assert s["not_explained"] == ["p"] and "consistent only by its larger error at 1" in s["statement"]
+
+
 def test_with_gap_without_a_check_or_enough_t_min_leaves_notes():
     rec = sr.with_gap({"id": "x", "z": None, "d1_trend_by_t_min": [{"t_min_kappa": 4.0, "d1_section": None}]})
     assert (
