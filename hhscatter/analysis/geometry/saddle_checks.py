@@ -29,7 +29,9 @@ from hhscatter.analysis.geometry.saddle import (
     LyapunovMean,
     SaddleDimension,
     _count,
+    _eps_min,
     _finite_array,
+    _group_labels,
     _positive,
     _slope,
     mean_lyapunov,
@@ -102,20 +104,14 @@ def information_dimension_radius(
 
     P = _finite_array(points, "points", 2)
     n = P.shape[0]
-    g = np.arange(n) if groups is None else np.asarray(groups)
-    if g.shape != (n,):
-        raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
-    _, g = np.unique(g, return_inverse=True)
-    g = g.ravel()
-    n_groups = int(g.max()) + 1
+    g, n_groups = _group_labels(groups, n)
     per_factor_two = _count(per_factor_two, "per_factor_two", 1)
     n_boot = _count(n_boot, "n_boot", 0)
     seed = _count(seed, "seed", 0)
     min_count = _positive(min_count, "min_count")
     if isinstance(max_empty, bool) or not isinstance(max_empty, (int, float)) or not 0 <= max_empty < 1:
         raise ConfigError(f"max_empty must be a share 0 ≤ max_empty < 1 of the points, got {max_empty!r}")
-    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
-        raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
+    _eps_min(eps_min)
     if n < 2:
         raise ConfigError(f"points: {n} point, at least 2 needed")
     extent = float(np.max(P.max(axis=0) - P.min(axis=0)))
