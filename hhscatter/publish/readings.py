@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed, verdict, verdict_class
 from hhscatter.publish.formatting import format_bound, format_value_err, typographic_minus
 from hhscatter.reproduction.verdicts import claim_verdict
@@ -526,12 +527,12 @@ def _operator_mixed_refinement(get: Loader) -> str:
     rows.sort(key=lambda sr: -sr[1]["box"])  # the coarser side first
     parts, z = [], []
     for scale, r in rows:
-        k, k0 = {"value": r["kappa"], "err": r["err"]}, {"value": r["fig2_kappa"], "err": r["fig2_err"]}
+        k, k0 = Measured(r["kappa"], r["err"]).to_dict(), Measured(r["fig2_kappa"], r["fig2_err"]).to_dict()
         z.append((k["value"] - k0["value"]) / math.hypot(k["err"], k0["err"]))
         side = _side(k, k0, "fig2's κ0")
         parts.append(f"{_ve(k['value'], k['err'])} on boxes of side {r['box']:g} ({scale} scale), {side}")
     (_, a), (_, b) = rows
-    moved, z_move = _move({"value": a["kappa"], "err": a["err"]}, {"value": b["kappa"], "err": b["err"]})
+    moved, z_move = _move(Measured(a["kappa"], a["err"]).to_dict(), Measured(b["kappa"], b["err"]).to_dict())
     change = (
         f"{'falls' if z_move < 0 else 'rises'} from side {a['box']:g} to {b['box']:g}"
         if abs(z_move) > Z_RESOLVED

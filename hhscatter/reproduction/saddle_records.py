@@ -340,7 +340,7 @@ def with_gap(rec: dict) -> dict:
     rec["d1_trend"] = _trend([{"t_min_kappa": r["t_min_kappa"], "d1": None if r["d1_section"] is None else
                                Measured(r["d1_section"]["value"], r["d1_section"]["err"]).scaled(0.5).to_dict()}
                               for r in rec.get("d1_trend_by_t_min", [])], "d1")  # fmt: skip
-    rec["lyapunov_trend"] = _trend([{"t_min_kappa": r["t_min_kappa"], "lam": {"value": r["value"], "err": r["err"]}}
+    rec["lyapunov_trend"] = _trend([{"t_min_kappa": r["t_min_kappa"], "lam": Measured(r["value"], r["err"]).to_dict()}
                                     for r in rec.get("lyapunov_by_t_min", [])], "lam")  # fmt: skip
     if rec.get("z") is None:
         return rec
