@@ -794,11 +794,8 @@ STUDY_TABLES = {
         ("gap", "1 − κ/λ̄ − d₁"),
         ("z", "z"),
         ("left_estimator", "left: fixed radius"),
-        ("share_estimator", "share"),
         ("left_selection", "left: t_min → ∞"),
-        ("share_selection", "share"),
         ("left_mid_life", "left: mid-life λ̄"),
-        ("share_mid_life", "share"),
     ),
     "saddle.dimensions": (
         ("system", "system"),
