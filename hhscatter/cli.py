@@ -613,6 +613,8 @@ def _on_signal(signum, frame):
     if runner is not None and runner.defer_signal(signum):  # a worker process is being started: raised at its end
         return
     _received.append(signum)
+    if runner is not None:  # the run stops after its chunk even if the exception below is lost on its way
+        runner.request_stop(signum)
     if len(_received) == 1:  # once: a second Ctrl-C must not break the cleanup of the first
         raise Interrupted(signum)
     if len(_received) >= 3:  # a third: the cleanup is not wanted, end now
@@ -623,6 +625,9 @@ def _catch_signals() -> dict:
     """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread (a no-op elsewhere); returns the handlers
     they had, for :func:`_restore_signals`."""
     _received.clear()
+    runner = sys.modules.get("hhscatter.run.runner")
+    if runner is not None:
+        runner.clear_stop()
     before = {}
     try:
         for sig in SIGNAL_EXIT:
@@ -672,7 +677,10 @@ def _main(argv):
     try:
         a = build_parser().parse_args(argv)
         _check_text(a)
-        return {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
+        rc = {"simulate": cmd_simulate, "survival": cmd_survival, "study": cmd_study}[a.command](a)
+        if _received:  # the signal's exception was lost on its way (a finaliser, a callback): it is still the news
+            return _interrupted(a)
+        return rc
     except HHScatterError as exc:  # bad input (2, before any work), or a run that could not complete (1)
         if _received:
             return _interrupted(a)

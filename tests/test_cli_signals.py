@@ -138,3 +138,31 @@ def test_study_simulate_terminated_says_how_to_continue(tmp_path):
     assert rc == 143
     line = _one_line(err)
     assert "run `hhscatter study slow simulate --scale quick` again" in line, line
+
+
+def test_a_signal_whose_exception_is_lost_still_stops_the_run(tmp_path, monkeypatch):
+    """A signal's exception raised where Python swallows it (a finaliser, a library's callback) must not let the
+    run go on to its end: the run stops after the chunk it is in, the command ends with the signal's line and 130."""
+    from hhscatter import cli
+    from hhscatter.run import runner
+
+    real = runner.run_one_chunk
+    calls = []
+
+    def chunk_where_the_signal_is_swallowed(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(2.0)  # the handler runs here and raises ...
+            except KeyboardInterrupt:
+                pass  # ... into code that swallows it
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(runner, "run_one_chunk", chunk_where_the_signal_is_swallowed)
+    out = tmp_path / "run"
+    args = ["simulate", "--energy", "0.3", "-n", "400", "--chunk-size", "50", "--t-max", "50", "--out", str(out)]
+    rc = cli.main([*args, "--workers", "1"])
+    assert rc == 130
+    assert len(calls) == 2  # stopped after the chunk in which the signal came, not at the end (8 chunks)
+    assert (out / "scene.json").exists()

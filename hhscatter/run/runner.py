@@ -295,6 +295,7 @@ def _simulate(
     def on_done(task, result):
         summary.add(result)
         bar.update(max(0, task.stop - task.start - reported.pop((task.partition, task.chunk), 0)))
+        _check_stop()  # a stop asked for while the chunk ran, its exception lost on the way
 
     def on_progress(key, k):
         reported[key] = reported.get(key, 0) + k
@@ -379,6 +380,25 @@ def _run_pool(workers, todo, args, on_done, on_progress=None):
 
 
 _HELD = {"depth": 0, "pending": []}  # sections that start a worker process, and the signals that came meanwhile
+_STOP: list[int] = []  # signals that asked the run in progress to stop (:func:`request_stop`)
+
+
+def request_stop(signum: int) -> None:
+    """request_stop(signum): the run in progress stops after the chunk it is in, whatever happens to the
+    exception the signal's handler raises. For a handler that stops the run (the CLI's): an exception raised in a
+    signal handler is lost when the signal lands while Python runs a finaliser or a library's callback that
+    swallows it; the run then checks this request after every finished chunk (``KeyboardInterrupt``)."""
+    _STOP.append(int(signum))
+
+
+def clear_stop() -> None:
+    """clear_stop(): forget the stop requests of an earlier command in this process."""
+    _STOP.clear()
+
+
+def _check_stop() -> None:
+    if _STOP:
+        raise KeyboardInterrupt(signal.Signals(_STOP[0]).name)
 
 
 def defer_signal(signum: int) -> bool:
