@@ -1300,6 +1300,57 @@ def _resc_scale_moves(get: Loader) -> str:
     )
 
 
+#: the systems' names as the pages write them (any other label is written as it is)
+_SYSTEM_NAMES = {"henon_heiles": "Hénon–Heiles", "contopoulos": "Contopoulos", "barbanis": "Barbanis"}
+
+
+def _saddle_t_max(d: dict, label: str) -> float:
+    """The t_max of a system's runs in the saddle study: the system's own, else the study's."""
+    study = d["config"]["study"]
+    system = next((s for s in study["systems"] if s["label"] == label), {})
+    return float(system.get("t_max", study["t_max"]))
+
+
+def _saddle_lambda_offset(get: Loader) -> str:
+    """λ∞ (the 1/T fit's intercept) against ΣΛ/ΣT per point, by the fit's 1/T term Λ₀ (``b``) and its σ: Λ₀ > 0
+    resolved at 2σ puts λ∞ below ΣΛ/ΣT, Λ₀ < 0 above; each point with its selection's t_min as a share of t_max
+    (the lifetimes fitted run from t_min to t_max: the fit's lever arm)."""
+    d = get("saddle", None)
+    above: dict[str, list[str]] = {}
+    below: dict[str, list[str]] = {}
+    flat = []
+    for p in d["saddle"]:
+        b = (p.get("lyapunov_detail") or {}).get("b")
+        if not b or b.get("value") is None or not b.get("err") or p.get("t_min") is None:
+            continue
+        share = p["t_min"] / _saddle_t_max(d, p["system"])
+        z = b["value"] / b["err"]
+        if abs(z) <= Z_RESOLVED:
+            flat.append(share)
+            continue
+        side = below if z > 0 else above
+        side.setdefault(_SYSTEM_NAMES.get(p["system"], p["system"]), []).append(
+            f"{p['ratio']:g} (Λ₀ = {_ve(b['value'], b['err'])}, t_min = {share:.2f} t_max)"
+        )
+
+    def points(side: dict[str, list[str]]) -> str:
+        return "; ".join(f"{name} E/E_c = {', '.join(cells)}" for name, cells in side.items())
+
+    parts = []
+    if below:
+        parts.append(f"Λ₀ > 0 by more than 2σ, λ∞ below ΣΛ/ΣT, at {points(below)}")
+    if above:
+        parts.append(f"Λ₀ < 0 by more than 2σ, λ∞ above ΣΛ/ΣT, at {points(above)}")
+    if flat:
+        rest = "the other" if below or above else "all"
+        which = (
+            f"{rest} {len(flat)} points" if len(flat) > 1 else ("the other point" if below or above else "the point")
+        )
+        span = f"{flat[0]:.2f}" if len(flat) == 1 else f"from {min(flat):.2f} to {max(flat):.2f}"
+        parts.append(f"Λ₀ within 2σ of 0 at {which} (t_min {span} t_max)")
+    return ". ".join(parts) if parts else "no point of this scale has a 1/T fit"
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1341,6 +1392,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.reactivation": _noise_reactivation,
     "noise.window_halves": _noise_window_halves,
     "operator.tolerance": _operator_tolerance,
+    "saddle.lambda_offset": _saddle_lambda_offset,
 }
 
 
