@@ -11,9 +11,9 @@ the escaping tail (Sec. II of arXiv:2308.13555).
 * :func:`~hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` (module ``kappa_energy``) — the
   piecewise κ(E) law of Fig. 2b with an estimated break energy;
 * :func:`choose_t_max` — a per-energy integration time t_max from a small pilot
-  ensemble, bounding the cost of long-lived and KAM-trapped orbits;
+  ensemble, bounding the cost of long-lived chaotic orbits and regular ones;
 * :func:`escaping_tail` — the power-law tail and τ* of Eq. (eqn:kappa_nonhyperbolic)
-  on the orbits that leave before t_max (KAM-trapped orbits removed);
+  on the orbits that leave before t_max (censored orbits removed);
 * :func:`~hhscatter.analysis.survival.cmeasure.kappa_from_cmeasure` (module ``cmeasure``) — κ from the
   c-measure of the true-time map, Eq. (eqn:kappa_cmeasure_truetime), and its input from the
   engine's ``sections`` table.
@@ -352,7 +352,7 @@ def choose_t_max(
     Maximum orbit time (time units) for a main run of ``n_main`` orbits at one
     energy, from the lifetimes of a small pilot ensemble at the same energy.
     It bounds the cost of the orbits that live long (near E_c) or never leave
-    (KAM-trapped orbits run to t_max) while keeping the whole range that the
+    (regular orbits on KAM tori run to t_max) while keeping the whole range that the
     κ fit of :func:`escape_rate` can use (it stops where fewer than
     ``min_survivors`` orbits are left, :func:`choose_windows` step 0).
 
