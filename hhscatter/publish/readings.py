@@ -266,6 +266,8 @@ def _b_relation(get: Loader) -> str:
     e_c = float(f2["E_c"])
     b = f2["kappa_fit"]["b"]
     rec = next(c for c in g["claims"] if c["id"] == "henon_heiles-1-5")
+    brk = next(c for c in g["claims"] if c["id"] == "henon_heiles-1-4")  # generality's break ε_b
+    e_b = f2["kappa_fit"]["E_b"]
     b_red, e_red = b["value"] * e_c, b["err"] * e_c
     v = verdict(rec["value"], rec["err"], b_red, e_red)
     f2_n = f2["config"]["study"]["grid_n"]
@@ -274,18 +276,26 @@ def _b_relation(get: Loader) -> str:
     ratio = rec["err"] / e_red
     z_f2, z_g = b["value"] / b["err"], rec["value"] / rec["err"]
     agree = "agree" if v.word == "agrees" else "differ"
+
+    def resolves(who: str, z: float) -> str:
+        if abs(z) > Z_RESOLVED:
+            return f"{who} resolves b from 0 ({abs(z):.0f}σ)"
+        return f"{who} does not resolve b from 0 ({abs(z):.1f}σ)"
+
     return (
         (
-            f"fig2's linear term b = {_ve(b['value'], b['err'])} is fitted to κ (1/time) against E − E_c on "
+            f"fig2's linear term b = {_ve(b['value'], b['err'])} is fitted to κ (1/time) against E − E_c below "
+            f"its break E_b = {_ve(e_b['value'], e_b['err'])} (ε_b = {(e_b['value'] - e_c) / e_c:.2f}), of "
             f"{len(f2_e)} energies from {min(f2_e):g} to {max(f2_e):g} (r_esc {f2['config']['scene']['r_esc']:g}, "
             f"{_int(f2_n)} orbits each, t_max up to {f2['config']['scene']['t_max']:g}); in generality's reduced units "
             f"(κ in well frequencies, which for Hénon–Heiles (ω = 1) is 1/time, against ε = E/E_c − 1) it is "
-            f"b·E_c = {_ve(b_red, e_red)}. Generality's b = {_ve(rec['value'], rec['err'])} is the mean over its "
+            f"b·E_c = {_ve(b_red, e_red)}. Generality's b = {_ve(rec['value'], rec['err'])}, fitted below its break "
+            f"ε_b = {_ve(brk['value'], brk['err'])}, is the mean over its "
             f"window and IC conventions on {len(g_st['ratios'])} energies from {min(g_st['ratios']):g} to "
             f"{max(g_st['ratios']):g} E_c (r_esc the system's default, {_int(g_st['grid_n'])} orbits each, t_max "
             f"{g['config']['scene']['t_max']:g}), its error widened by their spread. The two {agree} "
-            f"(z = {signed(v.z)}); generality's error is {ratio:.0f} times fig2's, so fig2 resolves b from 0 "
-            f"({abs(z_f2):.0f}σ) and generality does not ({abs(z_g):.1f}σ)"
+            f"(z = {signed(v.z)}); generality's error is {ratio:.2g} times fig2's: {resolves('fig2', z_f2)}, "
+            f"{resolves('generality', z_g)}"
         )
         .replace(",", "\u2009")
         .replace("\u2009 ", ", ")

@@ -822,3 +822,42 @@ def test_the_saddle_offset_reading_renders_at_both_scales(scale):
     doc = load_numbers(ROOT, "saddle", scale)[0]
     fitted = [p for p in doc["saddle"] if (p.get("lyapunov_detail") or {}).get("b")]
     assert text.count(" (Λ₀ = ") + int(re.search(r"at (?:the other|all) (\d+) points", text).group(1)) == len(fitted)
+
+
+def _b_docs(b_generality, err_generality):
+    """fig2 with b = 0.25 ± 0.025 against E − E_c (E_c = 0.2: b·E_c = 0.05 ± 0.005, 10σ from 0) below E_b = 0.3,
+    and generality's b in ε = E/E_c − 1 below ε_b = 0.6."""
+    fig2 = {
+        "E_c": 0.2,
+        "kappa_fit": {"b": {"value": 0.25, "err": 0.025}, "E_b": {"value": 0.3, "err": 0.003}},
+        "config": {
+            "study": {"grid_n": 1000, "grid_energies": [0.21, 0.3, 0.4]},
+            "scene": {"r_esc": 1.03, "t_max": 500},
+        },
+    }
+    claims = [
+        {"id": "henon_heiles-1-5", "value": b_generality, "err": err_generality},
+        {"id": "henon_heiles-1-4", "value": 0.6, "err": 0.1},
+    ]
+    generality = {
+        "claims": claims,
+        "config": {"study": {"ratios": [1.05, 2.0], "grid_n": 500}, "scene": {"t_max": 800}},
+    }
+    return {"fig2": fig2, "generality": generality}
+
+
+def test_the_b_relation_reading_compares_the_two_in_one_variable_and_says_resolved_only_beyond_two_sigma():
+    """0.08 ± 0.07 against b·E_c = 0.05 ± 0.005: z = 0.03/√(0.07² + 0.005²) = +0.4, generality 1.1σ from 0; 0.30 ±
+    0.02: z = 0.25/0.0206 = +12.1, 15σ from 0."""
+    text = READINGS["b_relation"](_loader(_b_docs(0.08, 0.07)))
+    assert "below its break E_b = 0.300 ± 0.003 (ε_b = 0.50), of 3 energies from 0.21 to 0.4" in text
+    assert "it is b·E_c = 0.050 ± 0.005" in text and "fitted below its break ε_b = 0.60 ± 0.10" in text
+    assert text.endswith(
+        "The two agree (z = +0.4); generality's error is 14 times fig2's: fig2 resolves b from 0 (10σ), "
+        "generality does not resolve b from 0 (1.1σ)"
+    )
+    text = READINGS["b_relation"](_loader(_b_docs(0.30, 0.02)))
+    assert text.endswith(
+        "The two differ (z = +12.1); generality's error is 4 times fig2's: fig2 resolves b from 0 (10σ), "
+        "generality resolves b from 0 (15σ)"
+    )
