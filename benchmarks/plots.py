@@ -84,7 +84,7 @@ def plot_energy_drift(csv_path, png_path):
     ax.set_yscale("log")
     ax.set_xlabel("t")
     ax.set_ylabel("|H(t) − H(0)| / H(0)")
-    ax.set_title("Energy drift of KAM-trapped orbits (engine)")
+    ax.set_title("Energy drift of censored orbits (engine)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()

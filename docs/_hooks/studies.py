@@ -451,7 +451,10 @@ class Renderer:
                 f"Run `make {_BENCH_TARGETS.get(which, which)}` and then `make docs-assets` "
                 f"to copy `studies/{which}/out/` here.",
             )
-        text = "\n\n".join(_embed_markdown(s.read_text(), assets, self._rel) for s in summaries)
+        from hhscatter.publish.words import in_glossary_words
+
+        # a summary written before the benchmarks used the glossary's words is read in them
+        text = "\n\n".join(_embed_markdown(in_glossary_words(s.read_text()), assets, self._rel) for s in summaries)
         # figures that no summary shows as an image are appended
         for png in sorted(assets.glob("*.png")):
             if f"]({self._rel(png)})" not in text:

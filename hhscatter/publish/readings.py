@@ -266,6 +266,8 @@ def _b_relation(get: Loader) -> str:
     e_c = float(f2["E_c"])
     b = f2["kappa_fit"]["b"]
     rec = next(c for c in g["claims"] if c["id"] == "henon_heiles-1-5")
+    brk = next(c for c in g["claims"] if c["id"] == "henon_heiles-1-4")  # generality's break ε_b
+    e_b = f2["kappa_fit"]["E_b"]
     b_red, e_red = b["value"] * e_c, b["err"] * e_c
     v = verdict(rec["value"], rec["err"], b_red, e_red)
     f2_n = f2["config"]["study"]["grid_n"]
@@ -274,18 +276,26 @@ def _b_relation(get: Loader) -> str:
     ratio = rec["err"] / e_red
     z_f2, z_g = b["value"] / b["err"], rec["value"] / rec["err"]
     agree = "agree" if v.word == "agrees" else "differ"
+
+    def resolves(who: str, z: float) -> str:
+        if abs(z) > Z_RESOLVED:
+            return f"{who} resolves b from 0 ({abs(z):.0f}σ)"
+        return f"{who} does not resolve b from 0 ({abs(z):.1f}σ)"
+
     return (
         (
-            f"fig2's linear term b = {_ve(b['value'], b['err'])} is fitted to κ (1/time) against E − E_c on "
+            f"fig2's linear term b = {_ve(b['value'], b['err'])} is fitted to κ (1/time) against E − E_c below "
+            f"its break E_b = {_ve(e_b['value'], e_b['err'])} (ε_b = {(e_b['value'] - e_c) / e_c:.2f}), of "
             f"{len(f2_e)} energies from {min(f2_e):g} to {max(f2_e):g} (r_esc {f2['config']['scene']['r_esc']:g}, "
             f"{_int(f2_n)} orbits each, t_max up to {f2['config']['scene']['t_max']:g}); in generality's reduced units "
             f"(κ in well frequencies, which for Hénon–Heiles (ω = 1) is 1/time, against ε = E/E_c − 1) it is "
-            f"b·E_c = {_ve(b_red, e_red)}. Generality's b = {_ve(rec['value'], rec['err'])} is the mean over its "
+            f"b·E_c = {_ve(b_red, e_red)}. Generality's b = {_ve(rec['value'], rec['err'])}, fitted below its break "
+            f"ε_b = {_ve(brk['value'], brk['err'])}, is the mean over its "
             f"window and IC conventions on {len(g_st['ratios'])} energies from {min(g_st['ratios']):g} to "
             f"{max(g_st['ratios']):g} E_c (r_esc the system's default, {_int(g_st['grid_n'])} orbits each, t_max "
             f"{g['config']['scene']['t_max']:g}), its error widened by their spread. The two {agree} "
-            f"(z = {signed(v.z)}); generality's error is {ratio:.0f} times fig2's, so fig2 resolves b from 0 "
-            f"({abs(z_f2):.0f}σ) and generality does not ({abs(z_g):.1f}σ)"
+            f"(z = {signed(v.z)}); generality's error is {ratio:.2g} times fig2's: {resolves('fig2', z_f2)}, "
+            f"{resolves('generality', z_g)}"
         )
         .replace(",", "\u2009")
         .replace("\u2009 ", ", ")
@@ -1300,6 +1310,57 @@ def _resc_scale_moves(get: Loader) -> str:
     )
 
 
+#: the systems' names as the pages write them (any other label is written as it is)
+_SYSTEM_NAMES = {"henon_heiles": "Hénon–Heiles", "contopoulos": "Contopoulos", "barbanis": "Barbanis"}
+
+
+def _saddle_t_max(d: dict, label: str) -> float:
+    """The t_max of a system's runs in the saddle study: the system's own, else the study's."""
+    study = d["config"]["study"]
+    system = next((s for s in study["systems"] if s["label"] == label), {})
+    return float(system.get("t_max", study["t_max"]))
+
+
+def _saddle_lambda_offset(get: Loader) -> str:
+    """λ∞ (the 1/T fit's intercept) against ΣΛ/ΣT per point, by the fit's 1/T term Λ₀ (``b``) and its σ: Λ₀ > 0
+    resolved at 2σ puts λ∞ below ΣΛ/ΣT, Λ₀ < 0 above; each point with its selection's t_min as a share of t_max
+    (the lifetimes fitted run from t_min to t_max: the fit's lever arm)."""
+    d = get("saddle", None)
+    above: dict[str, list[str]] = {}
+    below: dict[str, list[str]] = {}
+    flat = []
+    for p in d["saddle"]:
+        b = (p.get("lyapunov_detail") or {}).get("b")
+        if not b or b.get("value") is None or not b.get("err") or p.get("t_min") is None:
+            continue
+        share = p["t_min"] / _saddle_t_max(d, p["system"])
+        z = b["value"] / b["err"]
+        if abs(z) <= Z_RESOLVED:
+            flat.append(share)
+            continue
+        side = below if z > 0 else above
+        side.setdefault(_SYSTEM_NAMES.get(p["system"], p["system"]), []).append(
+            f"{p['ratio']:g} (Λ₀ = {_ve(b['value'], b['err'])}, t_min = {share:.2f} t_max)"
+        )
+
+    def points(side: dict[str, list[str]]) -> str:
+        return "; ".join(f"{name} E/E_c = {', '.join(cells)}" for name, cells in side.items())
+
+    parts = []
+    if below:
+        parts.append(f"Λ₀ > 0 by more than 2σ, λ∞ below ΣΛ/ΣT, at {points(below)}")
+    if above:
+        parts.append(f"Λ₀ < 0 by more than 2σ, λ∞ above ΣΛ/ΣT, at {points(above)}")
+    if flat:
+        rest = "the other" if below or above else "all"
+        which = (
+            f"{rest} {len(flat)} points" if len(flat) > 1 else ("the other point" if below or above else "the point")
+        )
+        span = f"{flat[0]:.2f}" if len(flat) == 1 else f"from {min(flat):.2f} to {max(flat):.2f}"
+        parts.append(f"Λ₀ within 2σ of 0 at {which} (t_min {span} t_max)")
+    return ". ".join(parts) if parts else "no point of this scale has a 1/T fit"
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1341,6 +1402,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.reactivation": _noise_reactivation,
     "noise.window_halves": _noise_window_halves,
     "operator.tolerance": _operator_tolerance,
+    "saddle.lambda_offset": _saddle_lambda_offset,
 }
 
 

@@ -5,7 +5,8 @@ run's t_max are *censored* (the glossary's word; *regular* and *chaotic but conf
 calls the survivors it classifies). Records written before the studies said so call them "KAM-trapped",
 "trapped" or "KAM-trapped or sticky": :func:`in_glossary_words` gives a record read for a page or the report the
 words the studies write now, so that a row keeps one name at every scale (the pages match the paper-scale and the
-quick-scale rows by name) and no page says "trapped" for a censored orbit. The JSON keys stay as they are
+quick-scale rows by name) and no page says "trapped" for a censored orbit. The benchmarks' summaries are read through
+it too (the stress cases' orbits still inside at t = 5000 were "KAM-trapped"). The JSON keys stay as they are
 (``trapped_fraction``, ``n_trapped`` …): readers use them.
 """
 
@@ -25,6 +26,7 @@ OLD_PHRASES: tuple[tuple[str, str], ...] = (
     ("all conservative survivors, trapped kept", "all conservative survivors, censored kept"),
     ("c-measure: trapped orbits dropped", "c-measure: censored orbits dropped"),
     ("(trapped fraction ", "(censored fraction "),
+    ("KAM-trapped orbits (E=", "censored orbits (E="),
 )
 
 

@@ -48,7 +48,6 @@ WITHOUT_EXAMPLE: frozenset[str] = frozenset(
         "survival.survival_from_lifetimes",
         "survival.survival_on_grid",
         "survival.survival_ratio_slope",
-        "survival.trapped_fraction",
         "dissipative.better_fit",
         "dissipative.bootstrap_mu",
         "dissipative.bootstrap_mu_first_orbits",

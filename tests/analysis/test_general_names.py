@@ -68,6 +68,16 @@ def test_no_module_name_or_first_docstring_line_names_a_figure_study_or_the_pape
     assert not bad, "\n".join(bad)
 
 
+def test_the_analysis_api_page_describes_each_module_by_what_it_estimates():
+    """The hand-written API page of the estimators' layer lists its modules with the equations they implement and
+    what they estimate, never the figure, study or paper they serve."""
+    page = ROOT.parents[1] / "docs" / "api" / "analysis" / "index.md"
+    rows = [line for line in page.read_text().splitlines() if line.startswith("| [`")]
+    assert len(rows) >= 30
+    bad = [row.split(" | ")[0] for row in rows if NAMES.search(row) or STUDIES.search(row)]
+    assert not bad, bad
+
+
 def test_the_study_check_knows_the_studies():
     assert STUDIES.search("fig2_kappa") and STUDIES.search("the resc record") and not STUDIES.search("κ(E) law")
     assert {"fig2", "generality"} <= set(study_names())

@@ -784,6 +784,14 @@ def test_the_heads_of_the_study_tables_wrap_into_short_words(hook):
     assert not long_words, long_words
 
 
+def test_the_stress_summary_names_the_orbits_still_inside_censored(hook):
+    """The energy-drift case runs orbits selected as still inside at t = 5000, not classified: the benchmarks page
+    calls them censored, also in a summary written before the benchmarks used the glossary's words."""
+    text = hook.Renderer(ROOT, DOCS, DOCS / "studies").bench("stress")
+    assert "censored orbits (E=0.2, inside at t=5000)" in text
+    assert not re.search(r"\bKAM-trapped\b", text)
+
+
 def test_the_heads_of_the_study_tables_name_survivors_by_the_glossary(hook):
     """Orbits still inside are regular, chaotic but confined or censored (the glossary): no head of a record table
     says "trapped" (the operator's KAM-probe boxes are censored boxes, as its page says)."""

@@ -79,7 +79,7 @@ def kinetic_fraction_from_energies(
     kinetic energy there, K̄ = −(E_k+1 − E_k)/(2γ_p (t_k+1 − t_k)), Eq. (eqn:energy_diffeq) (exact for linear
     drag); the result is Σ 2K̄ Δt/Ē over all pairs / Σ Δt with Ē = (E_k + E_k+1)/2 (a time average of 2K/E
     over the orbits alive in the window). ``keep``:
-    optional set/array of traj_ids to use (e.g. without the KAM-trapped orbits, for the c-measure proper).
+    optional set/array of traj_ids to use (e.g. without the censored orbits, for the c-measure proper).
     Error: bootstrap over orbits (the independent unit), ``n_boot`` replicates.
 
     Examples

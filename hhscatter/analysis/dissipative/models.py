@@ -1,6 +1,6 @@
 """The survival models of dissipative scattering, Eq. (eqn:surv_prob_model), by concept:
 
-* :mod:`hhscatter.analysis.survival.kappa_law` — κ0(E), the conservative escape-rate law (Fig. 2b);
+* :mod:`hhscatter.analysis.survival.kappa_law` — κ0(E), the conservative escape-rate law;
 * :mod:`hhscatter.analysis.dissipative.decay` — the energy path E(t) = E0 e^{−μγt} and its inverse t*;
 * :mod:`hhscatter.analysis.dissipative.survival_model` — the homogeneous model, its fit, the
   τ1 it predicts, and the comparison of fits;

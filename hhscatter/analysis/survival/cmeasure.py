@@ -4,8 +4,7 @@
 return times T of section crossings sampled from μ_c and the fraction that
 exits before returning; :func:`cmeasure_sample_from_sections` builds that
 sample from the engine's ``sections`` and ``lifetimes`` tables (as
-DataFrames: no I/O here). Beyond the paper: an estimator of κ independent of
-P(t) (study fig2).
+DataFrames: no I/O here): an estimator of κ independent of P(t).
 """
 
 from __future__ import annotations

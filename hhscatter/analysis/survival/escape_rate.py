@@ -4,16 +4,16 @@ the escaping tail (Sec. II of arXiv:2308.13555).
 * :func:`~hhscatter.analysis.survival.windows.choose_windows` (module ``windows``) — data-driven τ0 and the 4
   fitting windows of the exponential regime of Eq. (eqn:kappa_hyperbolic);
 * :func:`escape_rate` — κ as the mean of 4 least-squares fits of log P(t)
-  (Fig. 2b caption), with τ0, the windows, an MLE cross-check and the optional
+  on the windows of the exponential regime, with τ0, the windows, an MLE cross-check and the optional
   power-law tail / crossover time τ* of Eq. (eqn:kappa_nonhyperbolic);
 * :func:`escape_rate_mle` — constant-hazard maximum likelihood on [t_start, t_stop];
 * :func:`escape_rate_from_lifetimes` — DataFrame wrapper;
 * :func:`~hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` (module ``kappa_energy``) — the
-  piecewise κ(E) law of Fig. 2b with an estimated break energy;
+  piecewise κ(E) law (quadratic, then linear above a break) with an estimated break energy;
 * :func:`choose_t_max` — a per-energy integration time t_max from a small pilot
-  ensemble, bounding the cost of long-lived and KAM-trapped orbits;
+  ensemble, bounding the cost of long-lived chaotic orbits and regular ones;
 * :func:`escaping_tail` — the power-law tail and τ* of Eq. (eqn:kappa_nonhyperbolic)
-  on the orbits that leave before t_max (KAM-trapped orbits removed);
+  on the orbits that leave before t_max (censored orbits removed);
 * :func:`~hhscatter.analysis.survival.cmeasure.kappa_from_cmeasure` (module ``cmeasure``) — κ from the
   c-measure of the true-time map, Eq. (eqn:kappa_cmeasure_truetime), and its input from the
   engine's ``sections`` table.
@@ -352,7 +352,7 @@ def choose_t_max(
     Maximum orbit time (time units) for a main run of ``n_main`` orbits at one
     energy, from the lifetimes of a small pilot ensemble at the same energy.
     It bounds the cost of the orbits that live long (near E_c) or never leave
-    (KAM-trapped orbits run to t_max) while keeping the whole range that the
+    (regular orbits on KAM tori run to t_max) while keeping the whole range that the
     κ fit of :func:`escape_rate` can use (it stops where fewer than
     ``min_survivors`` orbits are left, :func:`choose_windows` step 0).
 

@@ -3,8 +3,9 @@
 The escape rate of Eq. (eqn:kappa_hyperbolic) near E_c depends on how it is
 defined: the IC region (disk r < 0.5, or the authors' square [−1, 1]² with
 V < E) and the fitting windows move κ at E ≤ 0.23 by more than the
-disagreement with the paper, and square ICs bring a plateau of KAM-trapped
-orbits (P∞ = 6.5 % at E = 0.18) on which a local-slope window rule locks,
+disagreement with the paper, and square ICs bring a plateau of orbits still
+inside at t_max (censored: regular orbits on KAM tori and chaotic ones not yet
+out; P∞ = 6.5 % at E = 0.18) on which a local-slope window rule locks,
 returning κ ≈ 0. This module holds the pure pieces (arrays and DataFrames in,
 results out):
 
@@ -15,7 +16,7 @@ results out):
 * :func:`escape_rate_p_levels` — κ = mean of the 4 least-squares fits of
   log P on those windows, error √(spread² + stat²), as
   :func:`hhscatter.analysis.survival.escape_rate.escape_rate`;
-* :func:`plateau_check` — whether the trapped fraction makes κ of a window
+* :func:`plateau_check` — whether the censored fraction makes κ of a window
   ill-defined: with a fraction f∞ of orbits that never escape, log P(t) of
   the Kaplan–Meier curve flattens and its slope underestimates κ by
   f∞/P(t) at time t; a window ending where this exceeds ``max_bias`` gives
@@ -68,13 +69,20 @@ def _levels(p_hi, p_lo) -> None:
         raise ConfigError(f"need 0 < p_lo < p_hi < 1, got p_hi={p_hi}, p_lo={p_lo}")
 
 
-def trapped_fraction(t_end, observed) -> float:
-    """trapped_fraction(t_end, observed) -> fraction of orbits still inside at the end (censored), in [0, 1].
+def censored_fraction(t_end, observed) -> float:
+    """censored_fraction(t_end, observed) -> fraction of orbits still inside at the end (censored), in [0, 1].
 
-    An upper bound of the KAM-trapped fraction P∞ (long sticky orbits censored
-    at t_max count too).
+    ``t_end`` are the lifetimes (time units) and ``observed`` the mask (False = censored: still inside at t_max),
+    one value per orbit. The censored orbits are not classified: the fraction is an upper bound of the regular
+    fraction P∞ (chaotic orbits still inside at t_max, sticky or confined, count too). 0 for no orbit.
+
+    Examples
+    --------
+    >>> censored_fraction([1.0, 2.5, 10.0, 10.0], [True, True, False, False])
+    0.5
     """
-    observed = np.asarray(observed, dtype=bool).ravel()
+    t_end = check.floats(t_end, "t_end")
+    observed = check.mask(observed, "observed", t_end.size)
     return float((~observed).sum() / max(observed.size, 1))
 
 
@@ -84,7 +92,7 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     t_a = first t with P ≤ ``p_hi``, t_b = first t with P ≤ ``p_lo``; windows
     [t_a, t_b], its halves and its middle half (the layout of
     :func:`hhscatter.analysis.survival.windows.choose_windows`). None when P never
-    falls to ``p_lo`` (e.g. a plateau of trapped orbits above it).
+    falls to ``p_lo`` (e.g. a plateau of censored orbits above it).
     """
     t = check.floats(t, "t")
     P = check.floats(P, "P", size=t.size, of="t")
@@ -215,7 +223,7 @@ def escape_rate_p_levels(
     _levels(p_hi, p_lo)
     check.number(max_bias, "max_bias", positive=True)
     check.count(n_grid, "n_grid", 2)
-    f_inf = trapped_fraction(t_end, observed)
+    f_inf = censored_fraction(t_end, observed)
     grid = np.linspace(0.0, float(t_end.max()) if t_end.size else 1.0, int(n_grid))
     curve = survival_curve(t_end, observed, grid)
     ok = np.isfinite(curve.P)
@@ -254,7 +262,7 @@ def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> Conventio
     t_end = check.numbers(t_end, "t_end", minimum=0.0)
     observed = check.mask(observed, "observed", t_end.size)
     check.number(max_bias, "max_bias", positive=True)
-    f_inf = trapped_fraction(t_end, observed)
+    f_inf = censored_fraction(t_end, observed)
     P_end = float(np.interp(result.t_stop, result.curve.t, result.curve.P))
     defined, bias, reason = plateau_check(P_end, f_inf, max_bias)
     return ConventionRate(

@@ -7,12 +7,13 @@ import pytest
 
 from hhscatter.analysis.survival.escape_rate import escape_rate
 from hhscatter.analysis.survival.kappa_conventions import (
+    censored_fraction,
     escape_rate_p_levels,
     p_level_windows,
     plateau_check,
     plateau_rate,
-    trapped_fraction,
 )
+from hhscatter.errors import ConfigError
 
 
 def _lifetimes(kappa, n, f_trapped=0.0, t_max=400.0, seed=0):
@@ -23,6 +24,15 @@ def _lifetimes(kappa, n, f_trapped=0.0, t_max=400.0, seed=0):
     t[trapped] = t_max
     obs = ~trapped & (t < t_max)
     return np.minimum(t, t_max), obs
+
+
+def test_the_censored_fraction_counts_the_orbits_still_inside_and_refuses_a_mask_of_another_size():
+    assert censored_fraction([1.0, 3.0, 9.0], [True, False, False]) == pytest.approx(2 / 3)
+    assert censored_fraction([], []) == 0.0
+    with pytest.raises(ConfigError, match="observed must have one value per orbit: 2 != 3"):
+        censored_fraction([1.0, 3.0, 9.0], [True, False])
+    with pytest.raises(ConfigError, match="t_end must be an array of numbers"):
+        censored_fraction("t", [True])
 
 
 def test_p_level_windows_of_an_exponential_are_at_its_levels():
@@ -57,14 +67,14 @@ def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
     flagged when its window ends on the plateau; without trapped orbits both are defined."""
     kappa = 0.1
     t, obs = _lifetimes(kappa, 20000, f_trapped=0.065, seed=3)
-    assert trapped_fraction(t, obs) == pytest.approx(0.065, abs=0.005)
+    assert censored_fraction(t, obs) == pytest.approx(0.065, abs=0.005)
     r = escape_rate_p_levels(t, obs)
     assert not r.defined and "never falls" in r.reason and math.isnan(r.kappa)
     res = escape_rate(t, obs, detect_tail=False)
     pr = plateau_rate(res, t, obs)
     P_end = float(np.interp(res.t_stop, res.curve.t, res.curve.P))
     assert pr.defined == (0.065 / P_end <= 0.1)
-    assert pr.bias_at_end == pytest.approx(trapped_fraction(t, obs) / P_end)
+    assert pr.bias_at_end == pytest.approx(censored_fraction(t, obs) / P_end)
     t0, obs0 = _lifetimes(kappa, 20000, seed=3)
     assert (
         escape_rate_p_levels(t0, obs0).defined
