@@ -16,12 +16,6 @@ from test_every_estimator import FUNCTIONS  # every exported function, by subpac
 #: exported functions without an example of their own yet (strict expected failures)
 WITHOUT_EXAMPLE: frozenset[str] = frozenset(
     {
-        "stats.counted",
-        "stats.least_squares_operator",
-        "stats.reset_warning_counts",
-        "stats.warning_counts",
-        "stats.weighted_least_squares",
-        "stats.wilson_interval",
         "survival.choose_t_max",
         "survival.choose_windows",
         "survival.cmeasure_sample_from_sections",
