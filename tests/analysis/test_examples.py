@@ -17,16 +17,6 @@ from test_every_estimator import FUNCTIONS  # every exported function, by subpac
 WITHOUT_EXAMPLE: frozenset[str] = frozenset(
     {
         "survival.trapped_fraction",
-        "dissipative.better_fit",
-        "dissipative.compare_fits",
-        "dissipative.fit_mixture_model",
-        "dissipative.fit_survival_model",
-        "dissipative.mixture_components",
-        "dissipative.mixture_components_arrays",
-        "dissipative.mixture_survival_model",
-        "dissipative.predict_tau1",
-        "dissipative.profile_interval",
-        "dissipative.settling_rate",
         "geometry.agreement_scale",
         "geometry.agreement_scale_debiased",
         "geometry.basin_entropy",
