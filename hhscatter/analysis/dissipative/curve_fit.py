@@ -209,6 +209,15 @@ def profile_interval(
     :func:`scipy.optimize.brentq` finds the crossing. A side whose profile does
     not reach it before ``lo_edge``/``hi_edge`` ends there (the interval is then
     the allowed range on that side: the data do not bound it).
+
+    Examples
+    --------
+    >>> lo, hi = profile_interval(lambda x: ((x - 2.0) / 0.5) ** 2, 2.0, 0.0, 0.0, 10.0)     # σ = 0.5: 2 ± 0.5
+    >>> round(lo, 9), round(hi, 9)
+    (1.5, 2.5)
+    >>> lo, hi = profile_interval(lambda x: (x - 2.0) ** 2, 2.0, 0.0, 1.5, 10.0)    # the allowed range ends at 1.5
+    >>> lo, round(hi, 9)
+    (1.5, 3.0)
     """
     check.function(chi2_of, "chi2_of")
     check.number(best, "best")

@@ -97,6 +97,11 @@ def snapshot_grid(pieces) -> np.ndarray:
     Each piece is the uniform grid start, start + step, ..., ≤ stop (values
     rounded to 1e-9 so that equal times compare equal across tables).
     Pieces must not overlap.
+
+    Examples
+    --------
+    >>> snapshot_grid([[0, 10, 5], [20, 100, 40]]).tolist()
+    [0.0, 5.0, 10.0, 20.0, 60.0, 100.0]
     """
     _sequence(pieces, "pieces")
     for p in pieces:
@@ -121,7 +126,13 @@ def snapshot_grid(pieces) -> np.ndarray:
 # the homogeneous law E(t) = E0 exp(−μγt)
 # ---------------------------------------------------------------------------
 def energy_path(t, E0: float, mu: float, gamma: float):
-    """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay)."""
+    """energy_path(t, E0, mu, gamma) -> E(t) = E0 exp(−μγt), Eq. (eqn:energy_exp_decay).
+
+    Examples
+    --------
+    >>> energy_path([0.0, 100.0], 0.3, 1.0, 0.01).round(4).tolist()      # one e-fold at t = 1/(μγ) = 100
+    [0.3, 0.1104]
+    """
     check.numbers(t, "t", min_size=0)
     for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
         check.real(value, name)  # NaN (a value not measured) gives NaN, as the law does
@@ -139,6 +150,13 @@ def time_to_energy(E0, E1, mu, gamma):
     Inverse of Eq. (eqn:energy_exp_decay); the paper's Fig. 5 time t* ≈ 17
     for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
     special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
+
+    Examples
+    --------
+    >>> round(time_to_energy(0.35, 0.30, 0.91, 0.01), 2)     # ln(0.35/0.30)/(0.91 · 0.01), the paper's t* ≈ 17
+    16.94
+    >>> time_to_energy([0.3, 0.4], 1 / 6, 1.0, 0.01).round(1).tolist()     # down to E_c = 1/6
+    [58.8, 87.5]
     """
     check.numbers(E1, "E1")
     for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma")):
@@ -168,6 +186,14 @@ def mean_energy_arrays(t, energy) -> pd.DataFrame:
     * ``lo_3sigma``, ``hi_3sigma``  ⟨E⟩ ∓ 3 std_E, the ribbon of Fig. 3.
 
     NaN energies are ignored.  Energy in model units, t in time units.
+
+    Examples
+    --------
+    >>> m = mean_energy_arrays([0.0, 0.0, 10.0, 10.0, 10.0], [0.3, 0.3, 0.2, 0.25, 0.3])
+    >>> m[["t", "n", "mean_E", "std_E"]].round(4).values.tolist()        # at t = 10: mean 0.25, std 0.05
+    [[0.0, 2.0, 0.3, 0.0], [10.0, 3.0, 0.25, 0.05]]
+    >>> round(float(m["sem_E"].iloc[1]), 4)                                 # 0.05/√3
+    0.0289
     """
     t = check.floats(t, "t")
     e = check.floats(energy, "energy", size=t.size, of="time t")
@@ -202,6 +228,14 @@ def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
     orbits still alive (neither escaped nor settled) at each grid time, so
     ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
     Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
+
+    Examples
+    --------
+    >>> snapshots = pd.DataFrame({"traj_id": [0, 1, 0, 1, 0], "t": [0.0, 0.0, 10.0, 10.0, 20.0],
+    ...                           "energy": [0.3, 0.3, 0.25, 0.27, 0.2]})
+    >>> m = mean_energy(snapshots)
+    >>> m["n"].tolist(), m["mean_E"].round(4).tolist()      # orbit 1 is gone by t = 20
+    ([2, 2, 1], [0.3, 0.26, 0.2])
     """
     check.table(snapshots, "snapshots", ("t", "energy"), min_rows=0)
     return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
@@ -216,6 +250,19 @@ def pool_mean_energy(tables) -> pd.DataFrame:
     concatenated rows: per grid time n = Σ n_i, mean = Σ n_i m_i / n and the
     pooled sum of squared deviations Σ [(n_i − 1) s_i² + n_i (m_i − mean)²]
     (Chan et al.'s parallel variance), so memory stays O(grid) for any N.
+
+    Examples
+    --------
+    Two parts of one snapshots table give, pooled, what the whole table gives:
+
+    >>> snapshots = pd.DataFrame({"traj_id": [0, 1, 0, 1, 0], "t": [0.0, 0.0, 10.0, 10.0, 20.0],
+    ...                           "energy": [0.3, 0.3, 0.25, 0.27, 0.2]})
+    >>> pooled = pool_mean_energy([mean_energy(snapshots.iloc[:3]), mean_energy(snapshots.iloc[3:])])
+    >>> whole = mean_energy(snapshots)
+    >>> pooled["n"].tolist(), pooled["mean_E"].round(4).tolist(), round(float(pooled["std_E"].iloc[1]), 4)
+    ([2, 2, 1], [0.3, 0.26, 0.2], 0.0141)
+    >>> bool(np.allclose(pooled["std_E"], whole["std_E"], equal_nan=True))
+    True
     """
     tables = list(_sequence(tables, "tables"))
     for i, t in enumerate(tables):
@@ -273,6 +320,16 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
     "inside Ω at time t"); E decreases monotonically for γ > 0, so the rows
     with E > E_c are those of orbits neither escaped nor settled. Memory stays
     O(grid + one part) for any N.
+
+    Examples
+    --------
+    Orbit 0 falls below E_c = 0.26 at t = 10 (settled, continued): it counts in ``inside``, not in ``above``.
+
+    >>> snapshots = pd.DataFrame({"traj_id": [0, 1, 0, 1, 0], "t": [0.0, 0.0, 10.0, 10.0, 20.0],
+    ...                           "energy": [0.3, 0.3, 0.25, 0.27, 0.2]})
+    >>> m = inside_mean_energy([snapshots.iloc[:3], snapshots.iloc[3:]], 0.26)
+    >>> m.inside["mean_E"].round(4).tolist(), m.above["mean_E"].round(4).tolist(), m.rows_below_ec
+    ([0.3, 0.26, 0.2], [0.3, 0.27], 2)
     """
     _sequence(parts, "parts")
     check.number(e_c, "e_c")
@@ -363,6 +420,20 @@ def fit_energy_decay(
     Returns
     -------
     EnergyDecayFit with μ and 1σ errors of both variants.
+
+    Examples
+    --------
+    ⟨E⟩ = 0.3 e^{−0.9 γ t}: both fits give μ = 0.9. ⟨E⟩ = 0.28 e^{−γ t} (an early drop, then μ = 1): the
+    free intercept finds μ = 1 and E(0) = 0.28, the intercept tied to E0 = 0.3 makes up for the drop with a larger
+    μ.
+
+    >>> t = np.arange(0.0, 201.0, 10.0)
+    >>> f = fit_energy_decay(t, 0.3 * np.exp(-0.9 * 0.01 * t), 0.3, 0.01)
+    >>> round(f.mu, 9), round(f.mu_free, 9)
+    (0.9, 0.9)
+    >>> f = fit_energy_decay(t, 0.28 * np.exp(-0.01 * t), 0.3, 0.01)
+    >>> round(f.mu, 3), round(f.mu_free, 9), round(f.E0_free, 9)
+    (1.05, 1.0, 0.28)
     """
     t, y, w, (t_lo, t_hi) = _decay_window(t, mean_E, E0, gamma, window, weights)
     n = t.size
@@ -434,6 +505,14 @@ def fit_energy_decay_table(
     ``weighted=True`` uses inverse-variance weights (mean_E / sem_E)² of
     log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
     unweighted log fit of Eq. (eqn:energy_exp_decay).
+
+    Examples
+    --------
+    >>> t = np.repeat([0.0, 50.0, 100.0], 2)
+    >>> snapshots = pd.DataFrame({"t": t, "energy": np.tile([0.29, 0.31], 3) * np.exp(-0.8 * 0.01 * t)})
+    >>> f = fit_energy_decay_table(mean_energy(snapshots), 0.3, 0.01, (0.0, 100.0))
+    >>> round(f.mu, 9), f.n_points               # ⟨E⟩ = 0.3 e^{−0.8 γ t}
+    (0.8, 3)
     """
     check.table(table, "table", ("t", "mean_E", "sem_E") if weighted else ("t", "mean_E"), min_rows=0)
     weights = None
@@ -465,6 +544,17 @@ def mu_by_window(
     (eqn:energy_exp_decay)) that μ → 1 at late times.  ``mu`` (intercept tied
     to E0) is the cumulative mean exponent ln(E0/⟨E⟩)/(γt) weighted over the
     window and lags behind the local value.
+
+    Examples
+    --------
+    A local exponent rising from 0.8 to 1, 1 − 0.2 e^{−t/100}: ``mu_free`` follows it (≈ 0.88 early, ≈ 1 late),
+    ``mu`` (tied to E0) lags behind.
+
+    >>> t = np.arange(0.0, 501.0, 10.0)
+    >>> mean_E = 0.3 * np.exp(-0.01 * (t - 20 * (1 - np.exp(-t / 100))))
+    >>> m = mu_by_window(t, mean_E, 0.3, 0.01, [(0, 100), (300, 500)])
+    >>> m[["t_lo", "n_points", "mu", "mu_free"]].round(3).values.tolist()
+    [[0.0, 11.0, 0.861, 0.875], [300.0, 21.0, 0.952, 0.996]]
     """
     windows = _windows(windows)
     _decay_window(t, mean_E, E0, gamma, windows[0], weights)  # the arguments checked before the first fit
@@ -516,6 +606,17 @@ def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
     (eqn:c-measure_model)).  Each requested time is mapped to the nearest
     snapshot grid time.  ``bins`` is a number of bins (then common edges span
     the min..max energy over the selected times) or an array of edges.
+
+    Examples
+    --------
+    The time 9 is read at the nearest snapshot time, 10:
+
+    >>> h = energy_histograms_arrays([0.0, 0.0, 0.0, 10.0, 10.0], [0.30, 0.31, 0.32, 0.25, 0.27], [0.0, 9.0],
+    ...                              bins=[0.2, 0.28, 0.36])
+    >>> h.t.tolist(), h.counts.tolist(), h.n_alive.tolist(), h.mean_E.round(4).tolist()
+    ([0.0, 10.0], [[0, 3], [2, 0]], [3, 2], [0.31, 0.26])
+    >>> h.density.round(4).tolist()             # each row integrates to 1: 3/(3 · 0.08)
+    [[0.0, 12.5], [12.5, 0.0]]
     """
     t = check.floats(t, "t")
     e = check.floats(energy, "energy", size=t.size, of="time t")
@@ -557,6 +658,14 @@ def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistogra
 
     DataFrame wrapper of :func:`energy_histograms_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
+
+    Examples
+    --------
+    >>> snapshots = pd.DataFrame({"traj_id": [0, 1, 2, 0, 1], "t": [0.0, 0.0, 0.0, 10.0, 10.0],
+    ...                           "energy": [0.30, 0.31, 0.32, 0.25, 0.27]})
+    >>> h = energy_histograms(snapshots, [0.0, 10.0], bins=2)       # 2 bins over the energies seen, 0.25 to 0.32
+    >>> h.edges.round(4).tolist(), h.counts.tolist()
+    ([0.25, 0.285, 0.32], [[0, 3], [2, 0]])
     """
     check.table(snapshots, "snapshots", ("t", "energy"), min_rows=0)
     return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)
@@ -591,6 +700,20 @@ def bootstrap_mu(
     (orbit id, grid time, energy); ``windows`` a list of (t_lo, t_hi).
     Returns one row per (replicate, window): ``replicate, t_lo, t_hi, mu,
     mu_free`` (dimensionless).
+
+    Examples
+    --------
+    200 orbits whose own exponents scatter by 0.1 about 0.9: the replicates' spread of μ is the statistical error of
+    the ensemble's μ, of the order of 0.1/√200 = 0.007.
+
+    >>> rng = np.random.default_rng(0)
+    >>> n, t = 200, np.arange(0.0, 101.0, 10.0)
+    >>> mu_i = rng.normal(0.9, 0.1, n)
+    >>> traj_id, times = np.repeat(np.arange(n), t.size), np.tile(t, n)
+    >>> energy = 0.3 * np.exp(-mu_i[traj_id] * 0.01 * times)
+    >>> b = bootstrap_mu(traj_id, times, energy, 0.3, 0.01, [(0.0, 100.0)], n_boot=50, seed=0)
+    >>> len(b), round(float(b["mu"].mean()), 2), round(float(b["mu"].std()), 4)
+    (50, 0.9, 0.0057)
     """
     check.count(n_boot, "n_boot", 1)
     t = check.floats(t, "t")
@@ -636,6 +759,19 @@ def bootstrap_mu_first_orbits(
     √(k/N) are those of the N orbits (i.i.d. orbits: errors ∝ 1/√N), which
     keeps the bootstrap affordable at N = 10^7. ``rows`` may already be
     restricted to those orbits (e.g. by a filter pushed down to the reader).
+
+    Examples
+    --------
+    The first 200 of 20000 orbits: their bootstrap spread times √(200/20000) = 0.1 is that of all the orbits.
+
+    >>> rng = np.random.default_rng(0)
+    >>> n, t = 200, np.arange(0.0, 101.0, 10.0)
+    >>> mu_i = rng.normal(0.9, 0.1, n)
+    >>> traj_id, times = np.repeat(np.arange(n), t.size), np.tile(t, n)
+    >>> rows = pd.DataFrame({"traj_id": traj_id, "t": times, "energy": 0.3 * np.exp(-mu_i[traj_id] * 0.01 * times)})
+    >>> b, scale = bootstrap_mu_first_orbits(rows, 20000, 200, 0.3, 0.01, [(0.0, 100.0)], n_boot=50, seed=0)
+    >>> scale, round(float(b["mu"].std()) * scale, 5)
+    (0.1, 0.00057)
     """
     check.table(rows, "rows", ("traj_id", "t", "energy"), min_rows=0)
     _first_orbits(n_orbits, k)

@@ -180,6 +180,20 @@ def mixture_components_arrays(
     mean energy ⟨E⟩_k(t), avoids survivor bias: as the members with fast
     decay settle, ⟨E⟩_k(t) over those still alive is pulled towards the slow
     ones and its slope underestimates the members' decay.
+
+    Examples
+    --------
+    Six orbits, three decaying with μ = 0.8 and three with μ = 1.2, split by their exponents into two sub-ensembles:
+
+    >>> t = np.arange(0.0, 51.0, 10.0)
+    >>> mu_i = np.array([0.8, 0.8, 0.8, 1.2, 1.2, 1.2])             # two kinds of orbits, from E = 0.3
+    >>> traj_id, times = np.repeat(np.arange(6), t.size), np.tile(t, 6)
+    >>> energy = 0.3 * np.exp(-mu_i[traj_id] * 0.01 * times)
+    >>> c = mixture_components_arrays(traj_id, times, energy, gamma=0.01, t_ref=10.0, n_components=2, by="rate")
+    >>> c.weights.tolist(), c.mu.round(9).tolist(), c.A.round(9).tolist()
+    ([0.5, 0.5], [0.8, 1.2], [0.3, 0.3])
+    >>> c.tau2(1 / 6).round(2).tolist()                             # ln(0.3/(1/6))/(μ γ)
+    [73.47, 48.98]
     """
     t = check.floats(t, "t")
     check.numbers(traj_id, "traj_id")
@@ -280,6 +294,19 @@ def mixture_components(
 
     DataFrame wrapper of :func:`mixture_components_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
+
+    Examples
+    --------
+    The same orbits split by their energy at t_ref = 10 (the faster decay has the lower energy):
+
+    >>> t = np.arange(0.0, 51.0, 10.0)
+    >>> mu_i = np.array([0.8, 0.8, 0.8, 1.2, 1.2, 1.2])             # two kinds of orbits, from E = 0.3
+    >>> traj_id, times = np.repeat(np.arange(6), t.size), np.tile(t, 6)
+    >>> energy = 0.3 * np.exp(-mu_i[traj_id] * 0.01 * times)
+    >>> snapshots = pd.DataFrame({"traj_id": traj_id, "t": times, "energy": energy})
+    >>> c = mixture_components(snapshots, gamma=0.01, t_ref=10.0, n_components=2)
+    >>> c.to_frame(1 / 6)[["weight", "E_ref", "mu", "tau2"]].round(4).values.tolist()
+    [[0.5, 0.2661, 1.2, 48.9822], [0.5, 0.2769, 0.8, 73.4733]]
     """
     check.table(snapshots, "snapshots", ("traj_id", "t", "energy"), min_rows=0)
     return mixture_components_arrays(
@@ -317,6 +344,23 @@ def mixture_survival_model(
     f_e,k = w_k P_tau0 − f_ne[k], settling time τ2,k (``tau2`` (K,) or, if
     None, Eq. (eq:tau2) per sub-ensemble) and shared settling parameters L, b.
     NaN for t < τ0.
+
+    Examples
+    --------
+    One sub-ensemble on the path E0 = 0.3, μ = 0.91 is the homogeneous model:
+
+    >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+    >>> one = MixtureComponents(t_ref=5.0, by="energy", edges=np.array([0.0, 1.0]), weights=np.array([1.0]),
+    ...                         n_ref=np.array([1]), E_ref=np.array([0.3]), A=np.array([0.3]), mu=np.array([0.91]),
+    ...                         mu_err=np.array([0.0]), fit_window=(0.0, np.inf), gamma=0.01)
+    >>> from hhscatter.analysis.dissipative.survival_model import survival_model
+    >>> t, kappa = np.array([10.0, 40.0, 100.0]), PiecewiseKappa(E_c=1 / 6)
+    >>> P = mixture_survival_model(t, kappa_of_E=kappa, components=one, tau0=5.0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2,
+    ...                            E_c=1 / 6)
+    >>> P_h = survival_model(t, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1, f_e=0.4, L=0.1,
+    ...                      b=0.2, E_c=1 / 6)
+    >>> P.round(4).tolist(), bool(np.allclose(P, P_h, rtol=1e-12))
+    ([0.2878, 0.2663, 0.0029], True)
     """
     check.numbers(t, "t", min_size=0)
     check.function(kappa_of_E, "kappa_of_E")
@@ -425,6 +469,24 @@ def fit_mixture_model(
     into the errors and ``cov`` by re-fitting at P(τ0) + σ.  The uncertainty
     of the measured component paths (A_k, μ_k) is not propagated, and the
     error model (independent points) is that of :func:`fit_survival_model`.
+
+    Examples
+    --------
+    With one sub-ensemble on the path E0 = 0.3, μ = 0.91 the mixture is the homogeneous model: fitted to a curve that
+    model made (f_ne = 0.1, L = 0.1, b = 0.2, 10⁵ orbits), it finds the parameters back.
+
+    >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+    >>> one = MixtureComponents(t_ref=5.0, by="energy", edges=np.array([0.0, 1.0]), weights=np.array([1.0]),
+    ...                         n_ref=np.array([1]), E_ref=np.array([0.3]), A=np.array([0.3]), mu=np.array([0.91]),
+    ...                         mu_err=np.array([0.0]), fit_window=(0.0, np.inf), gamma=0.01)
+    >>> from hhscatter.analysis.dissipative.survival_model import survival_model
+    >>> kappa, t, N = PiecewiseKappa(E_c=1 / 6), np.arange(0.0, 301.0), 100_000
+    >>> P_true = survival_model(t, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1, f_e=0.4, L=0.1,
+    ...                         b=0.2, E_c=1 / 6)
+    >>> P = np.random.default_rng(0).binomial(N, np.nan_to_num(P_true, nan=1.0)) / N
+    >>> f = fit_mixture_model(t, P, np.sqrt(P * (1 - P) / N), one, kappa_of_E=kappa, tau0=5.0, E_c=1 / 6, P_min=20 / N)
+    >>> f.free, {k: round(float(f.values[k]), 3) for k in ("f_ne", "f_e", "L", "b")}
+    (('f_ne_0', 'L', 'b'), {'f_ne': 0.099, 'f_e': 0.402, 'L': 0.1, 'b': 0.199})
     """
     check.function(kappa_of_E, "kappa_of_E")
     check.instance(components, "components", (MixtureComponents, pd.DataFrame))

@@ -23,6 +23,15 @@ def wilson_interval(k, n, z: float = 1.0):
     honest for k = 0 or k = n (where the Wald interval p ± z√(p(1−p)/n) has
     zero width):  centre (p + z²/2n)/(1 + z²/n), half-width
     z√(p(1−p)/n + z²/4n²)/(1 + z²/n).
+
+    Examples
+    --------
+    >>> p, lo, hi = wilson_interval(0, 10)      # no success in 10: the upper end is z²/(n + z²) = 1/11
+    >>> float(p), float(lo), round(float(hi), 4)
+    (0.0, 0.0, 0.0909)
+    >>> p, lo, hi = wilson_interval([5, 50], [10, 100])    # the same fraction, ten times the trials: ≈ √10 narrower
+    >>> p.tolist(), lo.round(4).tolist(), hi.round(4).tolist()
+    ([0.5, 0.5], [0.3492, 0.4502], [0.6508, 0.5498])
     """
     check.numbers(k, "k", minimum=0.0)
     check.numbers(n, "n", minimum=0.0)

@@ -49,7 +49,18 @@ def _without_folders(text: str) -> str:
 def counted(where: str):
     """counted(where) -> context manager: warnings raised in the block are recorded under ``where`` (the place in
     the analysis, e.g. ``"survival.kappa_energy.bootstrap"``), not shown; the count of each (category, message)
-    goes to the process's tally (:func:`warning_counts`). Errors pass through unchanged."""
+    goes to the process's tally (:func:`warning_counts`). Errors pass through unchanged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> reset_warning_counts()
+    >>> with counted("example.ratio"):
+    ...     ratio = np.float64(1.0) / 0.0        # numpy warns (divide by zero), the block goes on
+    >>> float(ratio), [(r["where"], r["category"], r["count"]) for r in warning_counts()]
+    (inf, [('example.ratio', 'RuntimeWarning', 1)])
+    >>> reset_warning_counts()
+    """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")  # every occurrence, not the first per place: they are counted
         try:
@@ -62,11 +73,36 @@ def counted(where: str):
 
 def warning_counts() -> list[dict]:
     """warning_counts() -> [{where, category, message, count}], one record per distinct warning counted by
-    :func:`counted` since the last :func:`reset_warning_counts`, sorted by place, then by count (largest first)."""
+    :func:`counted` since the last :func:`reset_warning_counts`, sorted by place, then by count (largest first).
+
+    Examples
+    --------
+    >>> import warnings
+    >>> reset_warning_counts()
+    >>> for where, n in (("b.fit", 1), ("a.fit", 3)):
+    ...     for _ in range(n):
+    ...         with counted(where):
+    ...             warnings.warn("overflow in exp", RuntimeWarning)
+    >>> [(r["where"], r["count"]) for r in warning_counts()]     # one record per place and message, by place
+    [('a.fit', 3), ('b.fit', 1)]
+    >>> reset_warning_counts()
+    """
     recs = [{"where": w, "category": c, "message": m, "count": int(n)} for (w, c, m), n in _COUNTS.items()]
     return sorted(recs, key=lambda r: (r["where"], -r["count"], r["category"], r["message"]))
 
 
 def reset_warning_counts() -> None:
-    """reset_warning_counts() -> None: empty the tally (before an analysis whose warnings are to be counted alone)."""
+    """reset_warning_counts() -> None: empty the tally (before an analysis whose warnings are to be counted alone).
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with counted("example.fit"):
+    ...     warnings.warn("covariance could not be estimated")
+    >>> len(warning_counts()) > 0
+    True
+    >>> reset_warning_counts()
+    >>> warning_counts()
+    []
+    """
     _COUNTS.clear()

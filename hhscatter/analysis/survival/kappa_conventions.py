@@ -93,6 +93,17 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     [t_a, t_b], its halves and its middle half (the layout of
     :func:`hhscatter.analysis.survival.windows.choose_windows`). None when P never
     falls to ``p_lo`` (e.g. a plateau of censored orbits above it).
+
+    Examples
+    --------
+    P = e^{−t/10} on a grid of step 1: it falls to 1/2 at 10 ln 2 = 6.9 (grid: 7) and to 1/100 at 10 ln 100 = 46.1
+    (grid: 47).
+
+    >>> t = np.linspace(0.0, 50.0, 51)
+    >>> p_level_windows(t, np.exp(-t / 10.0))
+    ((7.0, 47.0), (7.0, 27.0), (27.0, 47.0), (17.0, 37.0))
+    >>> p_level_windows(t, 0.5 + 0.5 * np.exp(-t / 10.0)) is None      # a plateau at 1/2: never reaches 1/100
+    True
     """
     t = check.floats(t, "t")
     P = check.floats(P, "P", size=t.size, of="t")
@@ -116,6 +127,16 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     inside at t_max, sticky ones included: near E_c, where the power-law
     tail starts early, the check also flags windows that reach into it
     (the decay there is no longer the exponential of κ either).
+
+    Examples
+    --------
+    >>> plateau_check(0.05, 0.001)          # 0.1 % censored against 5 % alive: a 2 % bias
+    (True, 0.02, '')
+    >>> defined, bias, reason = plateau_check(0.01, 0.003)
+    >>> defined, round(bias, 6)
+    (False, 0.3)
+    >>> print(reason)
+    plateau: censored orbits (still inside at t_max) are 0.30%, 30% of P at the window end (> 10%); κ ill-defined
     """
     check.real(P_end, "P_end")  # NaN (P not known at the window end) counts as no survivors: κ ill-defined
     check.number(f_trapped, "f_trapped", minimum=0.0)
@@ -217,6 +238,21 @@ def escape_rate_p_levels(
     (:func:`p_level_windows`), from lifetimes ``t_end`` (time units) and the
     ``observed`` mask (False = censored). Undefined when P never reaches
     ``p_lo`` or the plateau check fails at the window end.
+
+    Examples
+    --------
+    Exponential lifetimes of rate 0.1: the windows run from P = 1/2 (t ≈ 6.9) to P = 1/100 (t ≈ 46) and κ comes out
+    near 0.1; with 30 % of the orbits never escaping (censored at t_max) P never reaches 1/100 and κ is undefined.
+
+    >>> rng = np.random.default_rng(0)
+    >>> t = rng.exponential(10.0, 20000)
+    >>> r = escape_rate_p_levels(np.minimum(t, 100.0), t < 100.0)
+    >>> round(r.kappa, 3), round(r.kappa_err, 3), round(r.t_lo, 1), round(r.t_hi, 1), r.defined
+    (0.101, 0.002, 6.9, 45.5, True)
+    >>> t = np.where(rng.random(20000) < 0.3, np.inf, t)
+    >>> r = escape_rate_p_levels(np.minimum(t, 100.0), t < 100.0)
+    >>> r.defined, r.reason
+    (False, 'P(t) never falls to 0.01 (censored fraction 29.87%)')
     """
     t_end = check.numbers(t_end, "t_end", minimum=0.0)
     observed = check.mask(observed, "observed", t_end.size)
@@ -257,6 +293,19 @@ def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> Conventio
 
     The κ of :func:`hhscatter.analysis.survival.escape_rate.escape_rate` (data-driven
     plateau windows), with the plateau check at its window end t_stop.
+
+    Examples
+    --------
+    >>> from hhscatter.analysis.survival.escape_rate import escape_rate
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.where(rng.random(20000) < 0.3, np.inf, rng.exponential(10.0, 20000))    # 30 % never escape
+    >>> t_end, observed = np.minimum(t, 100.0), t < 100.0
+    >>> r = plateau_rate(escape_rate(t_end, observed), t_end, observed)
+    >>> round(r.kappa, 3), r.defined, r.trapped_fraction, round(r.bias_at_end, 2)
+    (0.029, False, 0.29245, 0.75)
+
+    The window rule found a "κ" far below 0.1 on the flattening P(t); the check refuses it: at the window's end the
+    censored orbits (never escaping) are 75 % of those still inside.
     """
     check.having(result, "result", _RESULT_FIELDS, "an EscapeRateResult (escape_rate)")
     t_end = check.numbers(t_end, "t_end", minimum=0.0)

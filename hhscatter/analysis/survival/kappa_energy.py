@@ -165,6 +165,19 @@ def fit_kappa_energy(
     Weights 1/kappa_err² (all 1 and covariance scaled by χ²/dof if omitted).
     ``boot_err`` comes from ``n_boot`` pairs-bootstrap refits over points
     (``rng``: seed or numpy Generator).
+
+    Examples
+    --------
+    Points on the paper's law (a = 13.63, b = 0.03, break at E_b = 0.27, E_c = 1/6) give it back, with
+    c = a (E_b − E_c) + b = 1.438 (the continuous law).
+
+    >>> E_c = 1 / 6
+    >>> E = np.linspace(0.18, 0.40, 12)
+    >>> x = E - E_c
+    >>> kappa = 0.03 * x + 13.63 * x * np.minimum(x, 0.27 - E_c)
+    >>> f = fit_kappa_energy(E, kappa, 0.01 * kappa, E_c, n_boot=0)
+    >>> round(f.a, 3), round(f.b, 3), round(f.c, 3), round(f.E_b, 3)
+    (13.63, 0.03, 1.438, 0.27)
     """
     x, y, w, given = _kappa_points(E, kappa, kappa_err, E_c)
     n = x.size

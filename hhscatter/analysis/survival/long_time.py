@@ -147,6 +147,19 @@ def fit_plateau_exponential(t_end, observed, t0: float, *, plateau: bool = True,
     Returns
     -------
     PlateauFit
+
+    Examples
+    --------
+    30 % of the orbits never leave, the others at rate 0.01; censored at t = 800: P∞ is the share drawn, κ near
+    0.01.
+
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.where(rng.random(2000) < 0.3, np.inf, rng.exponential(100.0, 2000))
+    >>> f = fit_plateau_exponential(np.minimum(t, 800.0), t < 800.0, 0.0)
+    >>> round(f.p_inf, 3), round(f.p_inf_err, 3), round(float(np.isinf(t).mean()), 3)
+    (0.302, 0.01, 0.302)
+    >>> round(f.kappa, 4), round(f.kappa_err, 4)
+    (0.0098, 0.0003)
     """
     t = check.numbers(t_end, "t_end", min_size=0, minimum=0.0)
     obs = check.mask(observed, "observed", t.size)

@@ -99,6 +99,24 @@ def paired_mle_shift(t_ref, observed_ref, t_alt, observed_alt, t_start: float, t
     which counts the correlation between the two lifetimes of each orbit
     (strong when an escape criterion only adds a flight time).  For
     independent samples it reduces to σ_ref² + σ_alt² with σ² ≈ κ²/D.
+
+    Examples
+    --------
+    The same orbits, every escape delayed by one time unit: the rate does not change, and pairing the orbits measures
+    that far more precisely than two independent samples would.
+
+    >>> rng = np.random.default_rng(0)
+    >>> t = rng.exponential(10.0, 20000)
+    >>> t_ref, observed = np.minimum(t, 100.0), t < 100.0
+    >>> s = paired_mle_shift(t_ref, observed, t_ref + 1.0, observed, 5.0, 50.0)
+    >>> abs(s.shift) < 2 * s.shift_err, round(s.shift_err, 4), round(s.shift_err_unpaired, 4)
+    (True, 0.0003, 0.0013)
+
+    Every lifetime shortened by 10 %: κ_alt = κ_ref/0.9, a shift of 0.1/0.9 − 0.1 = 0.0111.
+
+    >>> s = paired_mle_shift(t_ref, observed, np.minimum(0.9 * t, 100.0), 0.9 * t < 100.0, 5.0, 50.0)
+    >>> round(s.shift, 4), round(s.shift_err, 4)
+    (0.011, 0.0003)
     """
     t_ref, observed_ref, t_alt, observed_alt = _paired(t_ref, observed_ref, t_alt, observed_alt)
     check.window(t_start, t_stop)
@@ -172,6 +190,21 @@ def survival_ratio_slope(
 
     Error: the estimate is repeated on ``n_groups`` disjoint groups of orbits
     (index mod n_groups); shift_err = std(group values)/√n_groups.
+
+    Examples
+    --------
+    Every lifetime shortened by 10 %: κ_alt − κ_ref = 0.1/0.9 − 0.1 = 0.0111; a delay of one time unit moves only
+    the offset (log P_alt/P_ref = κ · 1 = 0.1), not the slope.
+
+    >>> rng = np.random.default_rng(0)
+    >>> t = rng.exponential(10.0, 20000)
+    >>> t_ref, observed = np.minimum(t, 100.0), t < 100.0
+    >>> r = survival_ratio_slope(t_ref, observed, np.minimum(0.9 * t, 100.0), 0.9 * t < 100.0, (5.0, 50.0))
+    >>> round(r.shift, 4), round(r.shift_err, 4)
+    (0.0109, 0.0012)
+    >>> r = survival_ratio_slope(t_ref, observed, t_ref + 1.0, observed, (5.0, 50.0))
+    >>> round(r.offset, 2), abs(r.shift) < 3 * r.shift_err
+    (0.1, True)
     """
     t_ref, observed_ref, t_alt, observed_alt = _paired(t_ref, observed_ref, t_alt, observed_alt)
     lo, hi = check.interval(window, "window")

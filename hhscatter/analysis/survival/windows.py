@@ -181,6 +181,21 @@ def choose_windows(
 
     The grid should resolve the decay (spacing ≪ w).  Warns, and returns the
     pilot range [t_a, t_b] as the window, if the band ever becomes empty.
+
+    Examples
+    --------
+    Exponential lifetimes of rate 0.1 censored at t = 100: no irregular start (τ0 = 0); the plateau ends where 100
+    orbits are left (20000 e^{−0.1 t} = 100 at t = 53).
+
+    >>> from hhscatter.analysis.survival.kaplan_meier import survival_curve
+    >>> rng = np.random.default_rng(0)
+    >>> t = rng.exponential(10.0, 20000)
+    >>> c = survival_curve(np.minimum(t, 100.0), t < 100.0, t_grid=np.linspace(0.0, 100.0, 1001))
+    >>> w = choose_windows(c.t, c.P, c.P_err, n_total=t.size)
+    >>> w.tau0, round(w.t_stop, 1), [tuple(round(x, 1) for x in win) for win in w.windows]
+    (0.0, 52.9, [(0.0, 52.9), (0.0, 26.5), (26.5, 52.9), (13.2, 39.7)])
+    >>> round(w.kappa_ref, 2)
+    0.1
     """
     t, P, N, t_floor = _checked_curve(t, P, P_err, n_total, min_survivors)
     t_a, t_b, kappa_p = _pilot_rate(t, P, N, t_floor, min_survivors, p_start, core_decades)

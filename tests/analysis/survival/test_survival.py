@@ -21,6 +21,7 @@ from hhscatter.analysis.survival.escape_rate import (
     escape_rate_mle,
     fit_kappa_energy,
     kappa_from_cmeasure,
+    power_law_exponent_mle,
 )
 from hhscatter.analysis.survival.fits import (
     crossover_time,
@@ -407,3 +408,14 @@ def test_observed_from_outcome_on_a_categorical_is_the_label_test():
         observed_from_outcome(pd.Series(["escaped", "bogus"]).astype("category"))
     with pytest.raises(ValueError, match="nan"):
         observed_from_outcome(pd.Categorical(["escaped", None]))
+
+
+def test_power_law_exponent_mle_reports_its_window_in_time_units():
+    # the MLE works in log t, but the result's window is the one asked for (time units), as escape_rate_mle's
+    t = np.array([2.0, 5.0, 20.0, 50.0])
+    r = power_law_exponent_mle(t, np.array([True, True, True, False]), 1.0, 40.0)
+    assert (r.t_start, r.t_stop) == (1.0, 40.0)
+    # and the exponent is D / Σ log(min(t, t_stop)/t_start), with a value worked out by hand
+    assert r.n_events == 3 and r.kappa == pytest.approx(
+        3 / (math.log(2.0) + math.log(5.0) + math.log(20.0) + math.log(40.0))
+    )
