@@ -230,8 +230,10 @@ def transfer_matrix(tr: Transitions, kappa: float = 0.0) -> sp.csr_matrix:
 
 
 def _dense_leading(A):
+    """(λ, left vector) of the Perron root of a non-negative matrix by LAPACK: the eigenvalue of largest real part,
+    as in :func:`_arpack_leading` (a cycle's eigenvalues ρ·e^{2πik/n} all have the largest modulus)."""
     vals, left = scipy.linalg.eig(np.asarray(A.todense() if sp.issparse(A) else A, dtype=float).T)
-    k = int(np.argmax(np.abs(vals)))
+    k = int(np.argmax(vals.real))
     return vals[k], left[:, k]
 
 
