@@ -102,3 +102,21 @@ def test_saddle_kappa_of_a_uniform_leak():
     kap, kmap, info, keep, sub = ulam.saddle_kappa(tr)
     assert kap == pytest.approx(-math.log(q) / T, rel=1e-10) and kmap == pytest.approx(-math.log(q), rel=1e-10)
     assert info["saddle_states"] == 1 and info["closed_classes"] == 0
+
+
+def test_sequences_are_taken_like_arrays():
+    """The state ids, the survival curves and the grid pass their checks as plain sequences: the estimators
+    give the same results for lists as for arrays."""
+    tr = tf.Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    tr_l, k_l = ulam.reduced_operator(tr, [0, 1], 2, 1)
+    tr_a, k_a = ulam.reduced_operator(tr, np.array([0, 1]), 2, 1)
+    np.testing.assert_array_equal(tr_l.w, tr_a.w)
+    assert k_l == k_a
+    n0_l, lost_l = ulam.disk_density(1.0, (-1, 1, -1, 1), 1.0, [0, 1, 2], 4, 0)
+    n0_a, lost_a = ulam.disk_density(1.0, (-1, 1, -1, 1), 1.0, np.array([0, 1, 2]), 4, 0)
+    np.testing.assert_array_equal(n0_l, n0_a)
+    assert lost_l == lost_a == pytest.approx(0.25, abs=1e-3)
+    grid = np.arange(11.0)
+    curves = [np.exp(-grid / 10), np.exp(-grid / 9), np.exp(-grid / 11)]
+    as_lists = ulam.survival_agreement(list(grid), 1.0, 5.0, *[list(c) for c in curves], 1000)
+    assert as_lists == ulam.survival_agreement(grid, 1.0, 5.0, *curves, 1000)
