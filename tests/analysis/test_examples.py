@@ -84,19 +84,6 @@ WITHOUT_EXAMPLE: frozenset[str] = frozenset(
         "dissipative.tau2_observed_interval",
         "dissipative.tau2_predicted",
         "dissipative.time_to_energy",
-        "geometry.basin_entropy",
-        "geometry.basin_entropy_table",
-        "geometry.basin_fractions",
-        "geometry.channel_fractions",
-        "geometry.convergence_grid",
-        "geometry.convergence_record",
-        "geometry.initial_escape_rate",
-        "geometry.return_statistics",
-        "geometry.shadow_indicator",
-        "geometry.uncertainty_cutoff",
-        "geometry.uncertainty_exponent",
-        "geometry.uncertainty_fraction",
-        "geometry.wada_merging",
     }
 )
 
