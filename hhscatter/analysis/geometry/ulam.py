@@ -160,7 +160,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
         _checks.whole(m_max, "m_max")
     if ebins is not None:
         check.numbers(ebins, "ebins", min_size=2)
-    nx, _ = grid_shape(extent, box)
+    nx, ny = grid_shape(extent, box)
     mask = ~tab["censored"].to_numpy()
     if m_max is not None:
         mask &= tab["rank"].to_numpy() < m_max
@@ -170,7 +170,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
     cell1, _, _ = tf.box_index(np.where(ret, t["x1"], 0.0), np.where(ret, t["y1"], 0.0), extent, box)
     dst = np.where(ret & (cell1 >= 0), coarse_index(np.maximum(cell1, 0), nx, c), -1)
     if ebins is not None:
-        n_cells = int(coarse_index(np.array([nx * nx - 1]), nx, c)[0]) + 1
+        n_cells = int(coarse_index(np.array([nx * ny - 1]), nx, c)[0]) + 1
         edges = ebins
         b1 = np.clip(np.searchsorted(edges, np.where(ret, t["e1"], edges[0]), side="right") - 1, 0, len(edges) - 2)
         src = t["ebin"].to_numpy() * n_cells + src
@@ -510,6 +510,8 @@ def disk_density(radius, extent, box, ids, n_cells, top_bin, n_grid=600):
     pos = np.searchsorted(ids, state)
     ok = (pos < ids.size) & (ids[np.minimum(pos, ids.size - 1)] == state)
     n0 = np.bincount(pos[ok], minlength=ids.size).astype(float)
+    if not n0.sum() > 0:
+        raise ConfigError(f"radius: the disk r < {radius} lies on no state of energy bin {top_bin} (ids)")
     return n0 / n0.sum(), float(1 - ok.mean())
 
 
@@ -812,8 +814,8 @@ def dissipative_operator(tab, extent, box, edges, *, dt, t_horizon, t_star, max_
     n_bins = len(edges) - 1
     steps, k_star, max_lag = (int(round(v / dt)) for v in (t_horizon, t_star, max_return_time))
     tr, ids, t = sample_transitions(tab, extent, box, ebins=edges)
-    nx, _ = grid_shape(extent, box)
-    n_cells = nx * nx
+    nx, ny = grid_shape(extent, box)
+    n_cells = nx * ny
     n0, lost = disk_density(radius, extent, box, ids, n_cells, n_bins - 1)
     P_op, pred = operator_survival(tr, t, n0, dt, steps, k_star, max_lag)
     P_red, kappa_bins = reduced_survival(tr, t, ids, n_cells, n_bins, dt, max_lag, steps)
