@@ -1,9 +1,7 @@
 """Every function the packages of ``hhscatter.analysis`` export shows a runnable example in its own docstring (the
 examples run as doctests in the suite).
 
-:data:`WITHOUT_EXAMPLE` lists the exported functions that have none yet; each is a strict expected failure here, so
-a function that gains an example fails the suite until it leaves the list, and a new function without one fails at
-once: the list only shrinks.
+A new exported function without one fails here at once.
 """
 
 from __future__ import annotations
@@ -12,78 +10,6 @@ import inspect
 
 import pytest
 from test_every_estimator import FUNCTIONS  # every exported function, by subpackage.name
-
-#: exported functions without an example of their own yet (strict expected failures)
-WITHOUT_EXAMPLE: frozenset[str] = frozenset(
-    {
-        "geometry.agreement_scale",
-        "geometry.agreement_scale_debiased",
-        "geometry.basin_entropy",
-        "geometry.basin_entropy_table",
-        "geometry.basin_fractions",
-        "geometry.bootstrap_distance",
-        "geometry.bootstrap_kappa",
-        "geometry.box_distances",
-        "geometry.box_histograms",
-        "geometry.box_index",
-        "geometry.capped_share",
-        "geometry.channel_fractions",
-        "geometry.communicating_classes",
-        "geometry.convergence_grid",
-        "geometry.convergence_record",
-        "geometry.debiased_distance",
-        "geometry.disk_density",
-        "geometry.dissipative_operator",
-        "geometry.dissipative_record",
-        "geometry.distance_vs_scale",
-        "geometry.eigenvector_convergence",
-        "geometry.first_crossing_after",
-        "geometry.first_crossing_weights",
-        "geometry.first_crossings",
-        "geometry.hellinger",
-        "geometry.hellinger_by_box",
-        "geometry.hellinger_row",
-        "geometry.histogram_distance",
-        "geometry.initial_escape_rate",
-        "geometry.islands_record",
-        "geometry.lag_kernels",
-        "geometry.leading_left",
-        "geometry.leading_modes",
-        "geometry.map_escape_rate",
-        "geometry.measure_points",
-        "geometry.one_return_samples",
-        "geometry.operator_survival",
-        "geometry.points",
-        "geometry.propagate",
-        "geometry.reduced_operator",
-        "geometry.reduced_survival",
-        "geometry.return_statistics",
-        "geometry.saddle_class",
-        "geometry.saddle_kappa",
-        "geometry.saddle_measure",
-        "geometry.sample_transitions",
-        "geometry.section_flux_density",
-        "geometry.shadow_indicator",
-        "geometry.sliced_wasserstein",
-        "geometry.spectral_radius",
-        "geometry.split_half_baseline",
-        "geometry.split_half_noise",
-        "geometry.sprinkler_weights",
-        "geometry.stratified_section_points",
-        "geometry.survival_agreement",
-        "geometry.survival_from_crossings",
-        "geometry.t_star_distance",
-        "geometry.t_star_energies",
-        "geometry.total_variation",
-        "geometry.transfer_matrix",
-        "geometry.true_time_kappa",
-        "geometry.uncertainty_cutoff",
-        "geometry.uncertainty_exponent",
-        "geometry.uncertainty_fraction",
-        "geometry.wada_merging",
-        "geometry.wasserstein_1d",
-    }
-)
 
 
 def has_example(f) -> bool:
@@ -105,16 +31,6 @@ def test_the_check_tells_an_example_from_prose():
     assert has_example(with_one) and not has_example(without)
 
 
-def test_the_list_names_exported_functions_only():
-    assert WITHOUT_EXAMPLE <= set(FUNCTIONS)
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="no example yet")) if n in WITHOUT_EXAMPLE else n
-        for n in sorted(FUNCTIONS)
-    ],
-)
+@pytest.mark.parametrize("name", sorted(FUNCTIONS))
 def test_every_exported_function_has_an_example(name):
     assert has_example(FUNCTIONS[name])

@@ -11,6 +11,7 @@ import pytest
 
 from hhscatter.analysis.geometry import transfer as tf
 from hhscatter.analysis.geometry import ulam
+from hhscatter.errors import ConfigError
 
 
 def test_survival_agreement_on_constructed_curves():
@@ -102,3 +103,56 @@ def test_saddle_kappa_of_a_uniform_leak():
     kap, kmap, info, keep, sub = ulam.saddle_kappa(tr)
     assert kap == pytest.approx(-math.log(q) / T, rel=1e-10) and kmap == pytest.approx(-math.log(q), rel=1e-10)
     assert info["saddle_states"] == 1 and info["closed_classes"] == 0
+
+
+def test_sequences_are_taken_like_arrays():
+    """The state ids, the survival curves and the grid pass their checks as plain sequences: the estimators
+    give the same results for lists as for arrays."""
+    tr = tf.Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    tr_l, k_l = ulam.reduced_operator(tr, [0, 1], 2, 1)
+    tr_a, k_a = ulam.reduced_operator(tr, np.array([0, 1]), 2, 1)
+    np.testing.assert_array_equal(tr_l.w, tr_a.w)
+    assert k_l == k_a
+    n0_l, lost_l = ulam.disk_density(1.0, (-1, 1, -1, 1), 1.0, [0, 1, 2], 4, 0)
+    n0_a, lost_a = ulam.disk_density(1.0, (-1, 1, -1, 1), 1.0, np.array([0, 1, 2]), 4, 0)
+    np.testing.assert_array_equal(n0_l, n0_a)
+    assert lost_l == lost_a == pytest.approx(0.25, abs=1e-3)
+    grid = np.arange(11.0)
+    curves = [np.exp(-grid / 10), np.exp(-grid / 9), np.exp(-grid / 11)]
+    as_lists = ulam.survival_agreement(list(grid), 1.0, 5.0, *[list(c) for c in curves], 1000)
+    assert as_lists == ulam.survival_agreement(grid, 1.0, 5.0, *curves, 1000)
+
+
+def test_energy_states_of_a_section_taller_than_wide():
+    """Boxes of side 1 on (−1, 1) × (−2, 2): 2 × 4 = 8 boxes, so the (box, energy bin) state ids are bin·8 + box.
+    A sample in box 2 of bin 1 lands in box 7 (x = 0.5, y = 1.5) at an energy of bin 0; one in box 6 of bin 0
+    lands in box 0 at an energy of bin 1. The disk r < 0.5 covers boxes 2 … 5 alike, and only box 2 is a state
+    of the top bin."""
+    tab = pd.DataFrame(
+        {
+            "cell": [2, 6],
+            "rank": [0, 0],
+            "w": 1.0,
+            "censored": False,
+            "ret": [True, True],
+            "T": 1.0,
+            "x1": [0.5, -0.5],
+            "y1": [1.5, -1.5],
+            "e1": [0.05, 0.15],
+            "ebin": [1, 0],
+            "t_end": 1.0,
+        }
+    )
+    tr, ids, _ = ulam.sample_transitions(tab, (-1, 1, -2, 2), 1.0, ebins=[0.0, 0.1, 0.2])
+    assert ids.tolist() == [6, 7, 8, 10]  # (bin 0, box 6), (bin 0, box 7), (bin 1, box 0), (bin 1, box 2)
+    assert ids[tr.src].tolist() == [10, 6] and ids[tr.dst].tolist() == [7, 8]
+    kw = dict(dt=1.0, t_horizon=2.0, t_star=1.0, max_return_time=2.0, radius=0.5)
+    op = ulam.dissipative_operator(tab, (-1, 1, -2, 2), 1.0, [0.0, 0.1, 0.2], **kw)
+    assert op["n_cells"] == 8
+    assert op["lost"] == pytest.approx(0.75, abs=1e-3)
+
+
+def test_a_disk_on_no_state_is_refused():
+    """No state of the top energy bin under the disk: refused, naming the radius (not a density of NaN)."""
+    with pytest.raises(ConfigError, match="radius"):
+        ulam.disk_density(0.5, (-1, 1, -1, 1), 1.0, np.array([0, 1]), 4, 1)

@@ -70,6 +70,17 @@ def initial_escape_rate(model, energy: float, radius: float, *, n_phi: int = 409
     -------
     FluxRate
         flux Φ, shell volume Ω_E and rate Φ/Ω_E (module docstring).
+
+    Examples
+    --------
+    The harmonic well V = r²/2 (Hénon–Heiles with λ → 0) at E = 1 inside R = 1: Φ = 2π · 2√(2 − 1) = 4π, Ω_E = 2π · π,
+    κ(0+) = 2/π = 0.6366 (module docstring). V < E on the whole disk and V is constant on its edge, so a coarse grid
+    is exact here.
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> r = initial_escape_rate(HenonHeiles(lam=1e-12), energy=1.0, radius=1.0, n_phi=64, n_r=64)
+    >>> round(r.flux / math.pi, 4), round(r.volume / math.pi**2, 3), round(r.rate, 4)
+    (4.0, 2.0, 0.6366)
     """
     model = check.system(model, "model")
     E, R = check.number(energy, "energy"), check.number(radius, "radius", positive=True)

@@ -116,6 +116,19 @@ def shadow_indicator(
         Time (time units) from which the first crossing is taken.
     g_max : float
         Separation growth below which an orbit is regular.
+
+    Examples
+    --------
+    Three orbits and their shadows started d0 = 1e-8 apart, first crossings after t = 5: orbit 0's pair is 1e-6
+    apart at t = 10 (G = 100, regular; ftle = ln 100 / 10 = 0.4605), orbit 1's 0.2 apart (G = 2e7, chaotic),
+    orbit 2 crosses only before t = 5.
+
+    >>> cols = {"traj_id": [0, 1, 2], "t": [10.0, 10.0, 2.0], "x": 0.1, "y": 0.0, "px": 0.0, "py": 0.5}
+    >>> base = pd.DataFrame(cols)
+    >>> shadow = pd.DataFrame(cols).assign(x=[0.1 + 1e-6, 0.3, 0.1])
+    >>> out = shadow_indicator(base, shadow, [0, 1, 2], 1e-8, t_from=5.0)
+    >>> out["kind"].tolist(), out["growth"].round(1).tolist(), round(float(out["ftle"][0]), 4)
+    (['regular', 'chaotic', 'none'], [100.0, 20000000.0, nan], 0.4605)
     """
     from hhscatter.analysis.geometry.distance import first_crossings  # deferred: pandas loads on first use
 

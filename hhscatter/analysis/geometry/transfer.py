@@ -205,6 +205,16 @@ def transfer_matrix(tr: Transitions, kappa: float = 0.0) -> sp.csr_matrix:
 
     κ = 0 gives Ulam's matrix P of the open map (sub-stochastic rows). States without samples have
     empty rows.
+
+    Examples
+    --------
+    Two boxes that send half their samples to each other (return times 1 and 2) and lose the other half:
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> transfer_matrix(tr).toarray().tolist()
+    [[0.0, 0.5], [0.5, 0.0]]
+    >>> np.round(transfer_matrix(tr, kappa=math.log(2)).toarray(), 6).tolist()  # × e^{κT} = 2 and 4
+    [[0.0, 1.0], [2.0, 0.0]]
     """
     _transitions(tr)
     check.number(kappa, "kappa")
@@ -220,8 +230,10 @@ def transfer_matrix(tr: Transitions, kappa: float = 0.0) -> sp.csr_matrix:
 
 
 def _dense_leading(A):
+    """(λ, left vector) of the Perron root of a non-negative matrix by LAPACK: the eigenvalue of largest real part,
+    as in :func:`_arpack_leading` (a cycle's eigenvalues ρ·e^{2πik/n} all have the largest modulus)."""
     vals, left = scipy.linalg.eig(np.asarray(A.todense() if sp.issparse(A) else A, dtype=float).T)
-    k = int(np.argmax(np.abs(vals)))
+    k = int(np.argmax(vals.real))
     return vals[k], left[:, k]
 
 
@@ -271,6 +283,14 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
     returns it with a tiny imaginary part, which is dropped (a sizable one is an error). A zero matrix
     gives (0, uniform). Uses ARPACK (scipy.sparse.linalg.eigs, largest real part) above
     :data:`DENSE_MAX` states, dense LAPACK below.
+
+    Examples
+    --------
+    A stochastic matrix: λ = 1 and v its stationary distribution, (2/7, 5/7) from 0.5 v_0 = 0.2 v_1.
+
+    >>> lam, v = leading_left(np.array([[0.5, 0.5], [0.2, 0.8]]))
+    >>> round(lam, 6), np.round(v, 4).tolist()
+    (1.0, [0.2857, 0.7143])
     """
     _matrix(A)
     check.number(tol, "tol", positive=True)
@@ -302,7 +322,15 @@ def leading_left(A, *, tol: float = 1e-12) -> tuple[float, np.ndarray]:
 
 
 def spectral_radius(A) -> float:
-    """spectral_radius(A) -> ρ(A) of a non-negative square matrix (see :func:`leading_left`)."""
+    """spectral_radius(A) -> ρ(A) of a non-negative square matrix (see :func:`leading_left`).
+
+    Examples
+    --------
+    The eigenvalues of [[0, 4], [1, 0]] are ±2:
+
+    >>> round(spectral_radius(np.array([[0.0, 4.0], [1.0, 0.0]])), 6)
+    2.0
+    """
     _matrix(A)
     A = sp.csr_matrix(A)
     if A.nnz == 0:
@@ -313,7 +341,16 @@ def spectral_radius(A) -> float:
 
 
 def map_escape_rate(tr: Transitions) -> float:
-    """map_escape_rate(tr) -> −ln ρ(P): the discrete map's escape rate per return, Eq. (eqn:kappa_cmeasure_discrete)."""
+    """map_escape_rate(tr) -> −ln ρ(P): the discrete map's escape rate per return, Eq. (eqn:kappa_cmeasure_discrete).
+
+    Examples
+    --------
+    Half of every box's samples return, half escape: ρ(P) = ½, a rate ln 2 = 0.6931 per return.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> round(map_escape_rate(tr), 4)
+    0.6931
+    """
     _transitions(tr)
     rho = spectral_radius(transfer_matrix(tr, 0.0))
     return -math.log(rho) if rho > 0 else math.inf
@@ -325,6 +362,14 @@ def true_time_kappa(tr: Transitions, *, xtol: float = 1e-13) -> float:
     ρ(M(κ)) grows monotonically with κ; a root κ > 0 exists iff ρ(P) < 1 (the states leak). A closed set
     of states (ρ(P) = 1, e.g. a KAM island) has no root: restrict ``tr`` to the saddle's class first
     (:func:`saddle_class`); ValueError otherwise.
+
+    Examples
+    --------
+    Half return, after T = 1 from box 0 and T = 2 from box 1: ρ(M(κ))² = ¼ e^{κ} e^{2κ} = 1 at κ = ln 4 / 3.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> round(true_time_kappa(tr), 6), round(math.log(4) / 3, 6)
+    (0.462098, 0.462098)
     """
 
     _transitions(tr)
@@ -358,6 +403,19 @@ def bootstrap_kappa(tr: Transitions, n_boot: int, rng=None) -> np.ndarray:
     multiplies every sample's weight by an independent Poisson(1) count and solves ρ(M(κ)) = 1 again on the
     replicate's saddle class (:func:`saddle_class`, :func:`true_time_kappa`). Their std is the statistical
     error of κ; the discretisation bias of the boxes is not in it.
+
+    Examples
+    --------
+    2000 samples of two boxes, each returning (T = 1) with probability ½; in this sample 52.7 % return, so
+    κ = −ln 0.527 = 0.64 (ln 2 = 0.69 for an infinite one), with a statistical error near
+    √((1 − p)/(p n)) = √(1/2000) = 0.022:
+
+    >>> rng = np.random.default_rng(0)
+    >>> src = rng.integers(0, 2, 2000)
+    >>> tr = Transitions(src, np.where(rng.random(2000) < 0.5, 1 - src, -1), np.ones(2000), n_states=2)
+    >>> k = bootstrap_kappa(tr, 20, rng=1)
+    >>> round(true_time_kappa(tr), 2), round(float(k.std()), 2)
+    (0.64, 0.02)
     """
     _transitions(tr)
     check.count(n_boot, "n_boot", 0)
@@ -390,6 +448,15 @@ def communicating_classes(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]
     The strongly connected components of the transition graph (scipy.sparse.csgraph.connected_components,
     connection='strong'). A *closed* class keeps all its samples (an invariant set of the sampled map:
     ρ = 1 on it, e.g. a KAM island resolved by the boxes).
+
+    Examples
+    --------
+    Boxes 0 and 1 exchange orbits and leak half of them; box 2 maps onto itself (an island):
+
+    >>> tr = Transitions([0, 0, 1, 1, 2], [1, -1, 0, -1, 2], np.ones(5), n_states=3)
+    >>> labels, classes = communicating_classes(tr)
+    >>> labels.tolist(), [(c.size, c.closed, c.leak) for c in classes]
+    ([0, 0, 1], [(2, False, 0.5), (1, True, 0.0)])
     """
     _transitions(tr)
     P = transfer_matrix(tr, 0.0)
@@ -425,6 +492,15 @@ def saddle_class(tr: Transitions) -> tuple[np.ndarray, list[ClassInfo]]:
     KAM islands, eigenvalue 1) are excluded; the escape rate of the saddle is :func:`true_time_kappa` of
     ``tr.subset(keep)``. (By states, not weight: a transient box whose few samples carry a large weight is
     a class of its own with ρ = 0.)
+
+    Examples
+    --------
+    The island (box 2) is left out; the saddle's κ = ln 2 per unit time (half return after T = 1):
+
+    >>> tr = Transitions([0, 0, 1, 1, 2], [1, -1, 0, -1, 2], np.ones(5), n_states=3)
+    >>> keep, classes = saddle_class(tr)
+    >>> keep.tolist(), round(true_time_kappa(tr.subset(keep)), 4)
+    ([True, True, False], 0.6931)
     """
     _transitions(tr)
     labels, infos = communicating_classes(tr)
@@ -441,6 +517,17 @@ def saddle_measure(tr: Transitions, kappa: float, keep) -> tuple[np.ndarray, flo
     from it: orbits on their way out cross the section too), closed classes left out (an island's vector
     would win with eigenvalue ≥ 1). At the root κ of the class, λ = 1. If a downstream class has a larger
     root (λ > 1: a sticky, nearly closed set), the vector is taken on ``keep`` alone and λ is reported.
+
+    Examples
+    --------
+    Boxes 0 and 1 form the saddle (κ = ln 2); box 1 also feeds box 2, which every orbit leaves: ν = ν M(κ) with
+    M(κ) = 2P gives ν_0 = ν_1 = ν_2 (orbits on their way out cross the section too).
+
+    >>> tr = Transitions([0, 0, 1, 1, 2], [1, -1, 0, 2, -1], np.ones(5), n_states=3)
+    >>> keep, _ = saddle_class(tr)
+    >>> nu, lam = saddle_measure(tr, math.log(2), keep)
+    >>> np.round(nu, 4).tolist(), round(lam, 6)
+    ([0.3333, 0.3333, 0.3333], 1.0)
     """
     _transitions(tr)
     check.number(kappa, "kappa")
@@ -472,6 +559,15 @@ def sprinkler_weights(tr: Transitions, nu: np.ndarray, kappa: float) -> np.ndarr
     The first crossing after a late time t of the surviving flow ensemble, whose crossings at x occur at
     rate ∝ ν(x) e^{−κt}, lands at h(x) with weight ν(x)·(e^{κT(x)} − 1)/κ (the crossing at x happened in
     [t − T(x), t)); per sample: ν_src · w_s/W_src · (e^{κT_s} − 1)/κ, 0 for escapes. κ = 0: the limit T.
+
+    Examples
+    --------
+    ν = (½, ½), half of each box's samples return after T = 1: each returning image weighs
+    ½ · ½ · (e^{κ} − 1)/κ = 1/(4 ln 2) = 0.3607 at κ = ln 2, escapes 0.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], np.ones(4), n_states=2)
+    >>> np.round(sprinkler_weights(tr, [0.5, 0.5], math.log(2)), 4).tolist()
+    [0.3607, 0.0, 0.3607, 0.0]
     """
     _transitions(tr)
     if check.numbers(nu, "nu", minimum=0.0).size != tr.n_states:
@@ -495,6 +591,15 @@ def section_flux_density(model, x, y, energy, *, h: float = 1e-6):
     map preserves (the symplectic form restricted to the section), so the boxes are sampled with it.
     ∂_r V by a central difference of ``model.potential`` along the ray (relative step h): no model
     constants here. 0 where V ≥ E or r = 0.
+
+    Examples
+    --------
+    The harmonic well V = r²/2 at E = 1, r = ½: v² = 2(1 − ⅛) = 7/4, |v²/r − r| / v = 3/√(7/4) = 2.2678; 0 where
+    V ≥ E.
+
+    >>> from hhscatter.model import HenonHeiles
+    >>> np.round(section_flux_density(HenonHeiles(lam=1e-12), [0.5, 2.0], [0.0, 0.0], 1.0), 4).tolist()
+    [2.2678, 0.0]
     """
     _checks.potential(model)
     check.numbers(x, "x")
@@ -522,7 +627,15 @@ def section_flux_density(model, x, y, energy, *, h: float = 1e-6):
 
 def box_index(x, y, extent, box: float) -> tuple[np.ndarray, int, int]:
     """box_index(x, y, extent, box) -> (flat index (−1 outside extent), nx, ny): squares of side ``box``
-    anchored at (x0, y0) of ``extent`` = (x0, x1, y0, y1); index = iy·nx + ix."""
+    anchored at (x0, y0) of ``extent`` = (x0, x1, y0, y1); index = iy·nx + ix.
+
+    Examples
+    --------
+    Boxes of side ½ on the unit square, numbered row by row (iy·nx + ix); −1 outside:
+
+    >>> box_index([0.6, 0.2, 1.5], [0.1, 0.7, 0.0], (0, 1, 0, 1), 0.5)
+    (array([ 1,  2, -1]), 2, 2)
+    """
     if check.numbers(x, "x", min_size=0).size != check.numbers(y, "y", min_size=0).size:
         raise ConfigError(f"x and y must have one value per point ({np.size(x)} vs {np.size(y)})")
     _checks.extent(extent)
@@ -548,6 +661,18 @@ def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -
     sample's time to its next event (return, escape, settling); H (L + 1, n) is the weighted share of
     state i's samples whose next event lies beyond lag ℓ, H_ℓ,i = Σ_{s ∈ i: t_end,s > ℓ dt} w_s / W_i
     (H has as many rows as the latest event needs; beyond them it is 0).
+
+    Examples
+    --------
+    Box 0 returns to box 1 after T = 1 or escapes at t = 2; box 1 returns to box 0 after T = 2 or escapes at t = 3
+    (dt = 1): K_1 holds 0 → 1, K_2 holds 1 → 0; H counts who is still on its way.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> K, H, L = lag_kernels(tr, [1.0, 2.0, 2.0, 3.0], dt=1.0)
+    >>> L, K.toarray().tolist()
+    (2, [[0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 0.5, 0.0]])
+    >>> H.T.tolist()  # box 0: all on their way at lag 0, half (the escapes at t = 2) at lag 1
+    [[1.0, 0.5, 0.0, 0.0], [1.0, 1.0, 0.5, 0.0]]
     """
     _transitions(tr)
     t_end = _checks.values(t_end, "t_end", min_size=0)
@@ -580,7 +705,16 @@ def lag_kernels(tr: Transitions, t_end, dt: float, max_lag: int | None = None) -
 
 
 def capped_share(tr: Transitions, dt: float, max_lag: int) -> float:
-    """capped_share(tr, dt, max_lag) -> the share of the returning sample weight whose lag exceeds max_lag."""
+    """capped_share(tr, dt, max_lag) -> the share of the returning sample weight whose lag exceeds max_lag.
+
+    Examples
+    --------
+    Of the two returns, the one after T = 2 exceeds a cap of one lag of dt = 1:
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> capped_share(tr, 1.0, 1), capped_share(tr, 1.0, 2)
+    (0.5, 0.0)
+    """
     _transitions(tr)
     check.number(dt, "dt", positive=True)
     check.number(max_lag, "max_lag", minimum=1.0)
@@ -596,6 +730,16 @@ def propagate(n0, K: sp.csr_matrix, L: int, n_steps: int) -> np.ndarray:
 
     n(0) = n0 (the initial ensemble, on the section at t = 0); n(k) = Σ_ℓ n(k − ℓ) K_ℓ, one sparse product
     per step (every lag at once).
+
+    Examples
+    --------
+    The two boxes of :func:`lag_kernels`, all orbits in box 0 at t = 0: half reach box 1 at step 1, a quarter
+    box 0 at step 3 (lag 2), an eighth box 1 at step 4.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> K, H, L = lag_kernels(tr, [1.0, 2.0, 2.0, 3.0], dt=1.0)
+    >>> propagate([1.0, 0.0], K, L, 4).tolist()
+    [[1.0, 0.0], [0.0, 0.5], [0.0, 0.0], [0.25, 0.0], [0.0, 0.125]]
     """
     n0 = check.numbers(n0, "n0", minimum=0.0)
     n = n0.size
@@ -618,6 +762,16 @@ def survival_from_crossings(crossings: np.ndarray, H: np.ndarray) -> np.ndarray:
     An orbit is alive at step k if its last crossing was at k' ≤ k and its next event lies beyond k − k':
     P(k) = Σ_{k' ≤ k} n(k') · H_{k − k'} (H beyond its last row: 0), one convolution per state
     (scipy.signal.fftconvolve).
+
+    Examples
+    --------
+    The two boxes of :func:`lag_kernels` from box 0: every orbit is on its way until t = 2, when half escape; at
+    t = 4 half of the rest have escaped from box 1 (t = 1 + 3) and a quarter are still alive.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> K, H, L = lag_kernels(tr, [1.0, 2.0, 2.0, 3.0], dt=1.0)
+    >>> np.round(survival_from_crossings(propagate([1.0, 0.0], K, L, 4), H), 6).tolist()
+    [1.0, 1.0, 0.5, 0.5, 0.25]
     """
     from scipy.signal import fftconvolve  # deferred: scipy loads on first use
 
@@ -640,6 +794,15 @@ def first_crossing_weights(crossings: np.ndarray, tr: Transitions, dt: float, k_
     crossing at or after step k* (0 for escapes): ν-weighted like :func:`first_crossing_after`, per sample,
     so that the images give the distribution below the box scale. Σ over samples into j = that function's
     entry j.
+
+    Examples
+    --------
+    The same as :func:`first_crossing_after`, per sample: the return of box 1 to box 0 (sample 2) carries it all.
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> K, H, L = lag_kernels(tr, [1.0, 2.0, 2.0, 3.0], dt=1.0)
+    >>> first_crossing_weights(propagate([1.0, 0.0], K, L, 4), tr, 1.0, 2).tolist()
+    [0.0, 0.0, 0.25, 0.0]
     """
     _transitions(tr)
     crossings = _crossings(crossings, n=tr.n_states)
@@ -659,7 +822,18 @@ def first_crossing_weights(crossings: np.ndarray, tr: Transitions, dt: float, k_
 
 def first_crossing_after(crossings: np.ndarray, K: sp.csr_matrix, L: int, k_star: int) -> np.ndarray:
     """first_crossing_after(crossings, K, L, k*) -> unnormalised distribution over states of the first crossing
-    at or after step k* of every orbit alive then: Σ_ℓ Σ_{k* − ℓ ≤ k' < k*} n(k') K_ℓ."""
+    at or after step k* of every orbit alive then: Σ_ℓ Σ_{k* − ℓ ≤ k' < k*} n(k') K_ℓ.
+
+    Examples
+    --------
+    The two boxes of :func:`lag_kernels` from box 0: the orbits alive at step 2 (the half in box 1 since step 1)
+    cross next in box 0, at step 3, a quarter of them returning:
+
+    >>> tr = Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], n_states=2)
+    >>> K, H, L = lag_kernels(tr, [1.0, 2.0, 2.0, 3.0], dt=1.0)
+    >>> first_crossing_after(propagate([1.0, 0.0], K, L, 4), K, L, 2).tolist()
+    [0.25, 0.0]
+    """
     crossings = _crossings(crossings)
     n = crossings.shape[1]
     L = _checks.whole(L, "L")

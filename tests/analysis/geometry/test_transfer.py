@@ -312,3 +312,23 @@ def test_three_block_cycle_matches_lapack():
     lam, v = tf.leading_left(S)
     assert lam == pytest.approx(vals[j].real, rel=1e-10)
     np.testing.assert_allclose(v, ref, rtol=1e-7, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [2, 3, 7])
+def test_short_cycle_has_its_perron_root_and_vector(n):
+    """The dense path (below DENSE_MAX states) on a cycle: its n eigenvalues 0.9·e^{2πik/n} share the largest
+    modulus, and the Perron root is the one of largest real part. Closed form as in the long cycle: ρ = 0.9,
+    left Perron vector ∝ diag(D)."""
+    C = sp.csr_matrix((np.full(n, 0.9), (np.arange(n), (np.arange(n) + 1) % n)), shape=(n, n))
+    d = np.exp(np.random.default_rng(n).normal(size=n))
+    A = (sp.diags(1.0 / d) @ C @ sp.diags(d)).tocsr()
+    assert A.shape[0] <= tf.DENSE_MAX
+    lam, v = tf.leading_left(A)
+    assert lam == pytest.approx(0.9, abs=1e-12)
+    np.testing.assert_allclose(v, d / d.sum(), rtol=1e-10)
+    M = tf.transfer_matrix(tf.Transitions([0, 0, 1, 1], [1, -1, 0, -1], [1.0, 1.0, 2.0, 2.0], 2), math.log(4) / 3)
+    lam, v = tf.leading_left(
+        M
+    )  # the two-state chain at its root: eigenvalues ±1, ν_1 = ν_0 · ½e^κ, ν = (1, 2^(-1/3))/Σ
+    assert lam == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(v, np.array([1.0, 2 ** (-1 / 3)]) / (1 + 2 ** (-1 / 3)), rtol=1e-10)
