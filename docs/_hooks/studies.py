@@ -788,6 +788,15 @@ STUDY_TABLES = {
         ("d1_err_largest", "largest part of D₁'s error"),
         ("d1_range_floor", "D₁'s range ended below by"),
     ),
+    "saddle.gap": (
+        ("system", "system"),
+        ("ratio", "E/E_c"),
+        ("gap", "1 − κ/λ̄ − d₁"),
+        ("z", "z"),
+        ("left_estimator", "left: fixed radius"),
+        ("left_selection", "left: t_min → ∞"),
+        ("left_mid_life", "left: mid-life λ̄"),
+    ),
     "saddle.dimensions": (
         ("system", "system"),
         ("ratio", "E/E_c"),
@@ -874,10 +883,19 @@ STUDY_TABLES = {
 }
 
 
+#: a number in e-notation inside a text cell ("ε_c < 1e-10"), written as the numbers of the table are
+_E_NOTATION = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)e([+-]?\d+)(?![\w.])")
+
+
+def _power_of_ten(m) -> str:
+    return f"{m.group(1)}×10<sup>{int(m.group(2))}</sup>"
+
+
 def spec_table(recs, spec=None) -> str:
     """Markdown table of records with the columns ``spec`` ((key, header[, error key]); default every key): a key
     with an error (default its sibling ``<key>_err``) as value ± error rounded to the error, a key with a sibling
-    ``<key>_upper`` (a count of 0) as its one-sided bound, None or NaN as "—"."""
+    ``<key>_upper`` (a count of 0) as its one-sided bound, None or NaN as "—". Every number in one notation: a
+    magnitude outside [1e-3, 1e5) as a×10<sup>b</sup>, in a value ± error and in a text cell alike."""
     import math
 
     if spec is None:
@@ -895,17 +913,20 @@ def spec_table(recs, spec=None) -> str:
         if _is_num(r.get(k + "_upper")) or _is_num(r.get(k + "_lower")):  # a count of 0 (or all): its bound
             from hhscatter.publish.formatting import format_bound
 
-            return format_bound(r.get(k + "_upper"), r.get(k + "_lower"), r.get(k + "_cl", 0.95))
+            bound = format_bound(r.get(k + "_upper"), r.get(k + "_lower"), r.get(k + "_cl", 0.95))
+            return _E_NOTATION.sub(_power_of_ten, bound)
         if k.startswith("z") and _is_num(v):  # a distance in σ
             return f"{v:+.1f}"
         if k.startswith("residual") and _is_num(v):  # a relative difference, in per cent
             ok = _is_num(e) and math.isfinite(e) and e > 0
             return (fmt_err(100 * v, 100 * e) if ok else f"{100 * v:+.2f}") + " %"
         if _is_num(v) and _is_num(e) and math.isfinite(e) and e > 0:
-            return fmt_err(v, e)
+            from hhscatter.publish.formatting import format_value_err
+
+            return format_value_err(v, e, html=True)  # a power of ten as the other cells write it
         if isinstance(v, list):
             return "[" + ", ".join(fmt_num(x, 3) if _is_num(x) else str(x) for x in v) + "]"
-        return fmt_num(v) if _is_num(v) else str(v)
+        return fmt_num(v) if _is_num(v) else _E_NOTATION.sub(_power_of_ten, str(v))
 
     out = ["| " + " | ".join(_cell(h) for _, h, _ in spec) + " |", "|" + "---|" * len(spec)]
     out.extend("| " + " | ".join(_cell(cell(r, k, ek)) for k, _, ek in spec) + " |" for r in recs)

@@ -76,12 +76,14 @@ def format_number(v, sig: int = 4, *, html: bool = False) -> str:
     return f"{v:.{sig}g}"
 
 
-def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
-    """format_value_err(v, err=None, *, sep=" ± ") -> "v ± err" rounded to the uncertainty.
+def format_value_err(v, err=None, *, sep: str = " ± ", html: bool = False) -> str:
+    """format_value_err(v, err=None, *, sep=" ± ", html=False) -> "v ± err" rounded to the uncertainty.
 
     One significant digit of ``err``, two when it starts with 1 or 2 (e.g.
     0.912 ± 0.003, 0.310 ± 0.012, 152 ± 7); v to the same decimal place.
-    Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15).
+    Very large or very small values: "v ± e" in e-notation (2.5e-14 ± 1.0e-15),
+    or with ``html`` (web pages) in the notation of :func:`format_number`'s
+    ``html``, one power of ten for both: (2.50 ± 0.10)×10<sup>-14</sup>.
     Without a usable error (None, NaN, < 0) the value alone; so with an error of
     exactly 0 (a number exact by construction, as a reference against itself,
     or a count of 0 recorded without its bound), never "± 0": a count of 0 with
@@ -90,13 +92,18 @@ def format_value_err(v, err=None, *, sep: str = " ± ") -> str:
 
     >>> format_value_err(0.0, 0.0), format_value_err(0.5, 0.0), format_value_err(0.912, 0.003)
     ('0', '0.5', '0.912 ± 0.003')
+    >>> format_value_err(2.63e-6, 6.3e-8), format_value_err(2.63e-6, 6.3e-8, html=True)
+    ('2.63e-06 ± 6.3e-08', '(2.63 ± 0.06)×10<sup>-6</sup>')
     """
     if not _is_num(v) or (isinstance(v, float) and not math.isfinite(v)):
-        return format_number(v)
+        return format_number(v, html=html)
     if not _is_num(err) or not math.isfinite(err) or err <= 0:  # no error to write (never "± 0")
-        return format_number(v)
+        return format_number(v, html=html)
     exp10 = int(math.floor(math.log10(err)))
     digits = max(0, -exp10 + (1 if err / 10.0**exp10 < 3 else 0))
+    if html and (abs(v) >= 1e4 or digits > 5):  # one power of ten, as format_number writes it on a page
+        k = int(math.floor(math.log10(abs(v) if v != 0 else err)))
+        return f"({format_value_err(v / 10.0**k, err / 10.0**k, sep=sep)})×10<sup>{k}</sup>"
     if abs(v) >= 1e4 or digits > 5:
         return f"{v:.3g}{sep}{err:.1e}" if v != 0 else f"0{sep}{err:.1e}"
     return f"{v:.{digits}f}{sep}{err:.{digits}f}"

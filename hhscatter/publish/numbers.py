@@ -655,7 +655,9 @@ def study_conventions(root: Path, study: str) -> set[float]:
 # -- readings typed by hand (hhscatter.publish.readings writes them) ---------------------------------------------------------------------------------------
 #: the words of a comparative or qualitative reading of results: verdicts and qualities (agrees, approaches,
 #: monotone, holds, never, …) and comparisons (closer, farther, lies below/above the …, twice as, larger than,
-#: exceeds, better, worse, differs from, only the … does, all within, none (…), consistent)
+#: exceeds, better, worse, differs from, only the … does, all within, none (…), consistent) and their hedges (hardly,
+#: roughly, nearly, essentially, clearly, slightly, close to, about the same, much or far below/above/larger …, well
+#: below/above; "crosses it": a value on both sides of another)
 READING_WORDS = re.compile(
     r"\b(?:agrees?|agreed|disagrees?|approach(?:es|ing)?|monoton\w*|within a factor|holds|never|always|"
     r"best|worst|consistent(?:ly)? with|compatible with|in line with|as predicted|confirm(?:s|ed)?|match(?:es|ed)?|"
@@ -666,7 +668,11 @@ READING_WORDS = re.compile(
     r"only\s+(?:as|the\s+\S+(?:\s+\S+)?\s+(?:does|do|is|are|holds?))|all\s+within|none\s+(?=\()|"
     r"(?:in)?consistent(?:ly)?|differs?\s+from|no\s+[\w-]+(?:\s+[\w-]+)?\s+(?:row|point|cell|value)s?\s+differs?|"
     r"(?:several|a\s+few|many)\s+σ|σ\s+from\s+zero|by\s+up\s+to(?:\s+about)?\s+\d+(?:\.\d+)?\s*σ|"
-    r"within\s+(?:its|their)\s+errors?|the\s+same\s+for\s+(?:r|E|γ|every|all\s+(?!systems))\S*)"
+    r"within\s+(?:its|their)\s+errors?|the\s+same\s+for\s+(?:r|E|γ|every|all\s+(?!systems))\S*|"
+    r"hardly|cross(?:es|ed)\s+(?:it|them|fig\d\S*|the\s+(?:measured|predicted|prediction|reference|paper's|fitted|other))|"
+    r"roughly|nearly|essentially|clearly|barely|almost|slightly|about\s+the\s+same|close\s+to|"
+    r"(?:much|far)\s+(?:below|above|closer|farther|wider|narrower|larger|smaller|longer|shorter|higher|lower|finer|"
+    r"coarser|deeper|better|worse|more|less|from|apart)|(?<!the\s)well\s+(?:below|above))"
     r"(?!\w)",
     re.I,
 )

@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
+from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import signed, verdict, verdict_class
 from hhscatter.publish.formatting import format_bound, format_value_err, typographic_minus
 from hhscatter.reproduction.verdicts import claim_verdict
@@ -564,6 +565,40 @@ def _operator_convergence(get: Loader) -> str:
             + (f" (not at E = {', '.join(miss)})" if miss else "")
         )
     return "; ".join(out)
+
+
+#: the energy of the operator study where κ does not converge with the box side (mixed phase space)
+OPERATOR_MIXED_ENERGY = 0.20
+
+
+def _operator_mixed_refinement(get: Loader) -> str:
+    """Ulam's κ on the finest boxes of each scale at :data:`OPERATOR_MIXED_ENERGY` against fig2's κ0 of that scale
+    (2σ, both errors), and its change from the coarser finest side to the finer one."""
+    rows = []
+    for scale in ("quick", "paper"):
+        row = next(r for r in get("operator", scale)["kappa_ulam"] if abs(r["energy"] - OPERATOR_MIXED_ENERGY) < 1e-9)
+        rows.append((scale, row))
+    rows.sort(key=lambda sr: -sr[1]["box"])  # the coarser side first
+    parts, z = [], []
+    for scale, r in rows:
+        k, k0 = Measured(r["kappa"], r["err"]).to_dict(), Measured(r["fig2_kappa"], r["fig2_err"]).to_dict()
+        z.append((k["value"] - k0["value"]) / math.hypot(k["err"], k0["err"]))
+        side = _side(k, k0, "fig2's κ0")
+        parts.append(f"{_ve(k['value'], k['err'])} on boxes of side {r['box']:g} ({scale} scale), {side}")
+    (_, a), (_, b) = rows
+    moved, z_move = _move(Measured(a["kappa"], a["err"]).to_dict(), Measured(b["kappa"], b["err"]).to_dict())
+    change = (
+        f"{'falls' if z_move < 0 else 'rises'} from side {a['box']:g} to {b['box']:g}"
+        if abs(z_move) > Z_RESOLVED
+        else f"does not change resolved at 2σ from side {a['box']:g} to {b['box']:g}"
+    )
+    crosses = min(abs(x) for x in z) > Z_RESOLVED and z[0] * z[1] < 0
+    return (
+        f"Ulam's κ on the finest boxes at E = {OPERATOR_MIXED_ENERGY:.2f} is "
+        + "; ".join(parts)
+        + f": it {change} ({moved})"
+        + (", from one side of fig2's κ0 to the other" if crosses else "")
+    )
 
 
 def _noise_turnover(get: Loader) -> str:
@@ -1218,6 +1253,61 @@ def _generality_map_coverage(get: Loader) -> str:
     return f"the map ({d.get('scale')} scale) has " + "; ".join(out)
 
 
+def _side(a: dict, b: dict, what: str) -> str:
+    """Where the value ``a`` lies against ``b`` by the verdict rule (2σ, their errors in quadrature), and its z."""
+    z = (a["value"] - b["value"]) / math.hypot(a["err"], b["err"])
+    side = f"within 2σ of {what}" if abs(z) <= Z_RESOLVED else f"{'above' if z > 0 else 'below'} {what}"
+    return f"{side} (z = {signed(z)})"
+
+
+def _move(a: dict, b: dict) -> tuple[str, float]:
+    """The difference b − a with its error (in quadrature) and z, in words, and the z."""
+    d, e = b["value"] - a["value"], math.hypot(a["err"], b["err"])
+    return f"{_ve(d, e)}, z = {signed(d / e)}", d / e
+
+
+def _generality_mu_radius(get: Loader) -> str:
+    """μ measured from ⟨E⟩(t) and μ predicted from the conservative ⟨K⟩ at the default escape radius and the second
+    one, per system, on the paper's window (``mu_by_window.paper``): whether the measured μ moves between the radii, where the prediction
+    lies against the measured μ at each radius (2σ), whether it moves, and at which radii the two agree."""
+    d = get("generality", None)
+    out, agree = [], []
+    for label, info in (d.get("systems") or {}).items():
+        window = list((info.get("mu_by_window") or {}).get("paper", {}).get("window") or [])
+        rows = [r for r in d["resc"] if r["label"] == label and r["window"] == window]
+        rows = sorted(
+            (r for r in rows if r.get("mu_measured") and r.get("mu_predicted")), key=lambda r: not r["default"]
+        )
+        if len(rows) != 2 or not rows[0]["default"] or rows[1]["default"]:
+            continue
+        (r0, r1), radii = rows, [f"{r['r_esc']:.3g}" for r in rows]
+        moved, z_m = _move(r0["mu_measured"], r1["mu_measured"])
+        measured = f"the measured μ {'moves' if abs(z_m) > Z_RESOLVED else 'does not move resolved at 2σ'} ({moved})"
+        sides = [_side(r["mu_predicted"], r["mu_measured"], "it") for r in rows]
+        shift, z_p = _move(r0["mu_predicted"], r1["mu_predicted"])
+        z0, z1 = (
+            (r["mu_predicted"]["value"] - r["mu_measured"]["value"])
+            / math.hypot(r["mu_predicted"]["err"], r["mu_measured"]["err"])
+            for r in rows
+        )
+        crosses = min(abs(z0), abs(z1)) > Z_RESOLVED and z0 * z1 < 0
+        predicted = (
+            f"the prediction from the conservative ⟨K⟩ lies {sides[0]} at r_esc = {radii[0]} (the default) and "
+            f"{sides[1]} at {radii[1]}"
+            + (": it crosses the measured μ between the radii" if crosses else "")
+            + f"; the prediction {'moves' if abs(z_p) > Z_RESOLVED else 'does not move resolved at 2σ'} ({shift})"
+        )
+        out.append(f"for {label} on [{window[0]:g}, {window[1]:g}] (the paper's window), {measured}; {predicted}")
+        ok = [radii[i] for i, z in enumerate((z0, z1)) if abs(z) <= Z_RESOLVED]
+        agree.append(f"{label} at {' and '.join(ok)}" if ok else f"{label} at neither radius")
+    return (
+        "μ between the default escape radius and the second one: "
+        + "; ".join(out)
+        + ". The prediction agrees with the measured μ within 2σ for "
+        + "; ".join(agree)
+    )
+
+
 def _resc_other_radii(d: dict) -> dict[str, list[tuple[str, dict]]]:
     """{energy key: [(radius key, shift), …]} of the κ shifts against the reference radius, the reference left out."""
     ref = f"r_esc={d['r_ref']:g}"
@@ -1289,12 +1379,14 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "fig5.shrink": _fig5_shrink,
     "operator.residuals": _operator_residuals,
     "operator.convergence": _operator_convergence,
+    "operator.mixed_refinement": _operator_mixed_refinement,
     "generality.validity": _generality_validity,
     "generality.indicator_systematic": _generality_indicator_systematic,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
     "generality.resc_shift": _generality_resc_shift,
     "generality.map_coverage": _generality_map_coverage,
+    "generality.mu_radius": _generality_mu_radius,
     "resc.shifts": _resc_shifts,
     "resc.scale_moves": _resc_scale_moves,
     "fig2.law_below_break": _fig2_law_below_break,

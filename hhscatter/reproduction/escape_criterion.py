@@ -323,11 +323,16 @@ def recommend_r_esc(returns: pd.DataFrame, lyapunov: pd.DataFrame, r_ref: float)
     energies considered (the exact no-return boundary of Ω) with no measured return at any energy; the largest
     tested one if none qualifies.
 
+    Returns ``recommended`` (that radius, length), ``authors`` (``r_ref``: the reference radius the shifts are
+    measured from, the authors' value in the study, not the tool's default), the largest Lyapunov-orbit extent
+    and its energy, and the ``rule`` in words.
+
     Examples
     --------
     >>> ret = pd.DataFrame({"r_esc": [1.03, 1.03, 1.5, 1.5], "n_returned": [3, 0, 0, 0]})
-    >>> recommend_r_esc(ret, pd.DataFrame({"energy": [0.3], "r_max": [1.2]}), 1.03)["recommended"]
-    1.5
+    >>> pick = recommend_r_esc(ret, pd.DataFrame({"energy": [0.3], "r_max": [1.2]}), 1.03)
+    >>> pick["recommended"], pick["authors"]
+    (1.5, 1.03)
     """
     radii = sorted(returns.r_esc.unique())
     r_lyap = float(lyapunov.r_max.max())
@@ -335,7 +340,7 @@ def recommend_r_esc(returns: pd.DataFrame, lyapunov: pd.DataFrame, r_ref: float)
     choice = ok[0] if ok else radii[-1]
     return {
         "recommended": float(choice),
-        "current": float(r_ref),
+        "authors": float(r_ref),
         "lyapunov_r_max_at_max_energy": float(lyapunov.r_max.max()),
         "lyapunov_energy_max": float(lyapunov.energy.max()),
         "rule": "smallest tested r_esc with zero measured returns at every energy; it must exceed the radial "

@@ -21,15 +21,15 @@ from __future__ import annotations
 import pandas as pd
 
 from hhscatter.analysis.stats.verdicts import half_unit
-from hhscatter.analysis.survival.kappa_conventions import (
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.model import HenonHeiles
+from hhscatter.reproduction.convention_tables import (
     LAW_PARAMETERS,
     convention_rows,
     fit_laws,
     law_spread,
     stable_energies,
 )
-from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-from hhscatter.model import HenonHeiles
 from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
 from hhscatter.reproduction.verdicts import quoted_verdict
 
@@ -174,7 +174,7 @@ def law_comparisons(continuous: dict, separate: dict, across: dict, ill, paper: 
         :func:`~hhscatter.analysis.survival.kappa_energy.kappa_law_summary` of the law continuous at E_b and of the
         two laws fitted independently ({name: {"value", "err"}}).
     across : dict
-        :func:`~hhscatter.analysis.survival.kappa_conventions.law_spread` over the conventions (may be empty).
+        :func:`~hhscatter.reproduction.convention_tables.law_spread` over the conventions (may be empty).
     ill : DataFrame
         The (energy, convention) rows where κ is ill-defined (the plateau of censored orbits).
 
@@ -349,9 +349,9 @@ def convention_numbers(table, stability, fit_info: dict, law: dict, *, p_levels,
     ill-defined by the plateau of censored orbits (with their reasons), the law per convention and across them.
 
     ``table``: one row per (energy, convention) with defined and reason; ``stability``:
-    :func:`~hhscatter.analysis.survival.kappa_conventions.stable_energies`; ``fit_info`` and ``law``: the second
-    result of :func:`~hhscatter.analysis.survival.kappa_conventions.fit_laws` and its
-    :func:`~hhscatter.analysis.survival.kappa_conventions.law_spread`.
+    :func:`~hhscatter.reproduction.convention_tables.stable_energies`; ``fit_info`` and ``law``: the second
+    result of :func:`~hhscatter.reproduction.convention_tables.fit_laws` and its
+    :func:`~hhscatter.reproduction.convention_tables.law_spread`.
 
     Examples
     --------
@@ -393,14 +393,14 @@ def convention_analysis(runs: dict, *, E_c, p_levels, max_bias, rel_tol, n_boot,
         window end from the plateau of censored orbits (beyond: κ ill-defined); ``rel_tol`` the relative spread of the
         conventions' κ within which an energy is stable.
     n_boot, seed : int
-        The bootstrap of the law fits (:func:`~hhscatter.analysis.survival.kappa_conventions.fit_laws`).
+        The bootstrap of the law fits (:func:`~hhscatter.reproduction.convention_tables.fit_laws`).
 
     Returns
     -------
     (DataFrame, DataFrame, dict)
         One row per (energy, convention) (energy, x, convention, region, the columns of
-        :func:`~hhscatter.analysis.survival.kappa_conventions.convention_rows`, stable); the stability per energy
-        (:func:`~hhscatter.analysis.survival.kappa_conventions.stable_energies`); :func:`convention_numbers`.
+        :func:`~hhscatter.reproduction.convention_tables.convention_rows`, stable); the stability per energy
+        (:func:`~hhscatter.reproduction.convention_tables.stable_energies`); :func:`convention_numbers`.
     """
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes  # deferred: scipy on first use
     from hhscatter.analysis.survival.fits import lifetimes_to_arrays  # deferred: as above

@@ -19,17 +19,11 @@ import numpy as np
 import pandas as pd
 
 from hhscatter.analysis.dissipative.mixture import mixture_components
-from hhscatter.analysis.dissipative.model_comparison import (
-    better_fit,
-    compare_fits,
-    fit_homogeneous_hazards,
-    fit_mixture_hazards,
-    predict_tau1,
-    survival_fit_points,
-)
+from hhscatter.analysis.dissipative.model_comparison import better_fit, compare_fits, predict_tau1
 from hhscatter.analysis.dissipative.transitions import tau2_observed, tau2_predicted
 from hhscatter.analysis.survival.fits import survival_from_lifetimes
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.reproduction.hazard_fits import fit_homogeneous_hazards, fit_mixture_hazards, survival_fit_points
 
 __all__ = [
     "PAPER_CONSTANTS",
@@ -332,7 +326,7 @@ def tau_vs_gamma(ref: TauReference, *, kappa, mu, mu_err, tau0, E_c, hazards, dt
     """Panel (b) with one set of constants (κ0(E), μ): observed τ1, τ2 beside the model's τ1 and Eq. (eq:tau2).
 
     Per γ > 0 of ``ref.obs``: τ2 predicted = ln(E0/E_c)/(μγ) (± its σ from ``mu_err``); where the lifetimes
-    are there and give ≥ 5 fitted points (:func:`~hhscatter.analysis.dissipative.model_comparison.survival_fit_points`
+    are there and give ≥ 5 fitted points (:func:`~hhscatter.reproduction.hazard_fits.survival_fit_points`
     on the Kaplan–Meier curve of step ``dt``, grid ``fit_dt``, N·P ≥ ``min_count``), the homogeneous model fitted
     in every hazard form and, with ``ref.P_0``, its τ1 (Eq. (eqn:tau1), P = α P_0, by
     :func:`~hhscatter.analysis.dissipative.model_comparison.predict_tau1`).
@@ -529,7 +523,7 @@ def mixture_fits(snapshots: pd.DataFrame, points, s: ModelInputs, *, label, E0, 
     curve and (tf, Pf, sf) its fitted points (:func:`survival_fit_points`); per variant of ``s.mixtures``,
     ``n_components`` sub-ensembles at t_ref (:func:`~hhscatter.analysis.dissipative.mixture.mixture_components`,
     μ_i fitted on [τ0, ``fit_end``]) and the mixture model fitted in every hazard form
-    (:func:`~hhscatter.analysis.dissipative.model_comparison.fit_mixture_hazards`).
+    (:func:`~hhscatter.reproduction.hazard_fits.fit_mixture_hazards`).
 
     Returns
     -------
@@ -570,7 +564,7 @@ def pair_fits(
     ``lifetimes``: DataFrame t_end, outcome of the run (N orbits); ``snapshots``: its energy snapshots from τ0 on,
     or a function returning them (read only once the homogeneous fits are done); P(t) on a grid of step ``dt``,
     fitted on points ``fit_dt`` apart from τ0 with N·P ≥ ``min_count``
-    (:func:`~hhscatter.analysis.dissipative.model_comparison.fit_homogeneous_hazards`, τ2 free if ``fit_tau2``);
+    (:func:`~hhscatter.reproduction.hazard_fits.fit_homogeneous_hazards`, τ2 free if ``fit_tau2``);
     ``mix``: ``n_components`` and ``fit_end`` of :func:`mixture_fits`.
 
     Returns

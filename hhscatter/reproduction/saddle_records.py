@@ -29,8 +29,10 @@ import math
 
 import numpy as np
 
-from hhscatter.analysis.geometry.saddle import dimension_order
+from hhscatter.analysis.geometry.saddle import dimension_order, mean_lyapunov
+from hhscatter.analysis.geometry.saddle_checks import interval_lyapunov, tmin_trend
 from hhscatter.analysis.stats.measured import Measured
+from hhscatter.errors import ConfigError
 
 __all__ = [
     "ERR_PARTS",
@@ -38,9 +40,14 @@ __all__ = [
     "d1_precision",
     "dimension_row",
     "dimension_summary",
+    "gap_row",
+    "gap_summary",
+    "lyapunov_by_t_min",
+    "mid_lyapunov_record",
     "relation_row",
     "relation_summary",
     "with_d0",
+    "with_gap",
 ]
 
 ERR_PARTS = {"fit": "err_fit", "resample": "err_resample", "range": "err_range"}
@@ -227,4 +234,199 @@ def dimension_summary(records) -> dict:
                  f"quadrature) holds at {len(held)} of the {len(both)} with both dimensions"
                  + (f"; it fails at {failed}" if failed else ""))  # fmt: skip
     return {"n_points": len(records), "n_d0": n_d0, "n_both": len(both), "n_holds": len(held),
+            "statement": statement}  # fmt: skip
+
+
+# ---------------------------------------------------------------------------
+# the gap between d₁ and 1 − κ/λ̄: the candidates measured
+# ---------------------------------------------------------------------------
+def mid_lyapunov_record(lo, hi, t_from: float, t_to: float, *, n_boot: int = 1000) -> dict:
+    """mid_lyapunov_record(lo, hi, t_from, t_to, *, n_boot=1000) -> {"lyapunov_mid": {value, err, n_orbits, n_left,
+    t_from, t_to}} or {"lyapunov_mid_note": why none}.
+
+    ``lo`` and ``hi`` are the lifetimes tables (``traj_id``, ``outcome``, ``log_stretch``) of the same orbits
+    integrated with the tangent dynamics to ``t_from`` and to ``t_to`` (time units): λ̄ between the two times
+    (:func:`~hhscatter.analysis.geometry.saddle_checks.interval_lyapunov`) of the orbits still inside at both
+    (outcome ``censored``); ``n_left`` counts the others.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> lo = pd.DataFrame({"traj_id": [0, 1, 2], "outcome": ["censored"] * 3, "log_stretch": [2.0, 3.0, 2.5]})
+    >>> hi = lo.assign(log_stretch=[6.0, 7.2, 1.0], outcome=["censored", "censored", "escaped"])
+    >>> r = mid_lyapunov_record(lo, hi, 10.0, 20.0, n_boot=10)["lyapunov_mid"]
+    >>> round(r["value"], 2), r["n_orbits"], r["n_left"]
+    (0.41, 2, 1)
+    """
+    a, b = (d.set_index("traj_id") for d in (lo, hi))
+    b = b.reindex(a.index)
+    inside = (a["outcome"].astype(object) == "censored").to_numpy() & (
+        b["outcome"].astype(object) == "censored"
+    ).to_numpy()
+    if np.count_nonzero(inside) < 2:
+        return {"lyapunov_mid_note": f"fewer than 2 orbits still inside at t = {t_to:.6g}"}
+    m = interval_lyapunov(a["log_stretch"].to_numpy()[inside], b["log_stretch"].to_numpy()[inside], t_from, t_to,
+                          n_boot=n_boot, seed=0)  # fmt: skip
+    return {"lyapunov_mid": {**Measured(m.value, m.err).to_dict(), "n_orbits": m.n_orbits,
+                             "n_left": int(np.count_nonzero(~inside)), "t_from": float(t_from), "t_to": float(t_to)}}  # fmt: skip
+
+
+def lyapunov_by_t_min(tangent, t_mins, kappa: float, *, n_boot: int = 1000) -> list:
+    """lyapunov_by_t_min(tangent, t_mins, kappa, *, n_boot=1000) -> rows {t_min_kappa, n_orbits, value, err}: λ̄ =
+    ΣΛ/ΣT (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`) of the orbits of ``tangent`` (``t_end``,
+    ``log_stretch``) with t_end ≥ t_min, for each t_min of ``t_mins`` (time units) with at least 2 orbits.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> tg = pd.DataFrame({"t_end": [10.0, 20.0, 40.0], "log_stretch": [3.0, 8.0, 18.0]})
+    >>> [(r["t_min_kappa"], r["n_orbits"], round(r["value"], 3)) for r in lyapunov_by_t_min(tg, [10, 20, 40], 0.1, n_boot=5)]
+    [(1.0, 3, 0.414), (2.0, 2, 0.433)]
+    """
+    rows = []
+    for t in t_mins:
+        sel = tangent[tangent["t_end"].to_numpy() >= t]
+        if len(sel) >= 2:
+            m = mean_lyapunov(sel["log_stretch"], sel["t_end"], n_boot=n_boot, seed=0)
+            rows.append({"t_min_kappa": float(t) * kappa, "n_orbits": m.n_orbits, **Measured(m.value, m.err).to_dict()})
+    return rows
+
+
+def _trend(rows, name):
+    """The t_min trend (:func:`~hhscatter.analysis.geometry.saddle_checks.tmin_trend`) of rows {t_min_kappa, name:
+    {value, err}} with a value, as a dict, or a note."""
+    ok = [r for r in rows if r.get(name) is not None and r[name]["err"] > 0]
+    if len(ok) < 3:
+        return {
+            "note": f"a trend needs at least 3 t_min with a value, got {len(ok)}",
+            "t_min_kappa": [r["t_min_kappa"] for r in ok],
+        }
+    try:
+        tr = tmin_trend([r["t_min_kappa"] for r in ok], [r[name]["value"] for r in ok], [r[name]["err"] for r in ok])
+    except ConfigError as exc:
+        return {"note": str(exc), "t_min_kappa": [r["t_min_kappa"] for r in ok]}
+    return {"t_min_kappa": [r["t_min_kappa"] for r in ok], "last": Measured(tr.last, tr.last_err).to_dict(),
+            "extrapolated": Measured(tr.extrapolated, tr.extrapolated_err).to_dict(),
+            "slope": Measured(tr.slope, tr.slope_err).to_dict(), "step_z": tr.step_z, "bound": tr.bound,
+            "converged": tr.converged}  # fmt: skip
+
+
+CANDIDATES = {
+    "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
+    "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
+    "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
+}
+"""The candidate reasons for a gap between d₁ and 1 − κ/λ̄ that :func:`with_gap` measures: name -> what it is."""
+
+
+def with_gap(rec: dict) -> dict:
+    """with_gap(rec) -> the record ``rec`` (updated in place) with ``d1_trend`` and ``lyapunov_trend`` (the t_min
+    trends of ``d1_trend_by_t_min``, partial d₁ = D₁/2, and of ``lyapunov_by_t_min``) and, where the relation was
+    checked, ``gap``: the gap d₁(implied) − d₁ = 1 − κ/λ̄ − d₁ and, per candidate of :data:`CANDIDATES` measured
+    at the point, the gap left when its alternative replaces d₁ or λ̄ (``left``, errors in quadrature, the
+    alternatives' correlation with the originals ignored: an upper bound on its error), ``z`` = left/err, the
+    share of the gap it explains (1 − left/gap), ``closes`` (|z| ≤ 2 left and a share ≥ 1/2: the candidate
+    accounts for the gap) and ``within_by_error`` (|z| ≤ 2 left with a share < 1/2: consistent only because the
+    candidate's own error is larger, not an explanation).
+
+    Examples
+    --------
+    >>> rec = {"kappa": 0.1, "kappa_err": 0.0, "lyapunov": 0.4, "lyapunov_err": 0.0, "d1": 0.70, "d1_err": 0.01,
+    ...        "d1_implied": 0.75, "d1_implied_err": 0.0, "z": -5.0, "d1_radius": {"value": 0.74, "err": 0.01}}
+    >>> g = with_gap(rec)["gap"]
+    >>> round(g["gap"]["value"], 3), round(g["estimator"]["share"], 3), g["estimator"]["closes"]
+    (0.05, 0.8, True)
+    """
+    rec["d1_trend"] = _trend([{"t_min_kappa": r["t_min_kappa"], "d1": None if r["d1_section"] is None else
+                               Measured(r["d1_section"]["value"], r["d1_section"]["err"]).scaled(0.5).to_dict()}
+                              for r in rec.get("d1_trend_by_t_min", [])], "d1")  # fmt: skip
+    rec["lyapunov_trend"] = _trend([{"t_min_kappa": r["t_min_kappa"], "lam": Measured(r["value"], r["err"]).to_dict()}
+                                    for r in rec.get("lyapunov_by_t_min", [])], "lam")  # fmt: skip
+    if rec.get("z") is None:
+        return rec
+    kappa = Measured(rec["kappa"], rec["kappa_err"])
+    d1, implied = Measured(rec["d1"], rec["d1_err"]), Measured(rec["d1_implied"], rec["d1_implied_err"])
+
+    def implied_by(lam):  # 1 − κ/λ̄ with another λ̄
+        r = kappa.ratio(Measured(lam["value"], lam["err"]))
+        return Measured(1.0 - r.value, r.err)
+
+    gap = implied.difference(d1)
+    alt = {}
+    if rec.get("d1_radius"):
+        alt["estimator"] = (implied, Measured(rec["d1_radius"]["value"], rec["d1_radius"]["err"]))
+    if "extrapolated" in rec["d1_trend"] and "extrapolated" in rec["lyapunov_trend"]:
+        d1x = rec["d1_trend"]["extrapolated"]
+        alt["selection"] = (implied_by(rec["lyapunov_trend"]["extrapolated"]), Measured(d1x["value"], d1x["err"]))
+    if rec.get("lyapunov_mid"):
+        alt["mid_life"] = (implied_by(rec["lyapunov_mid"]), d1)
+    out = {"gap": gap.to_dict(), "z": rec["z"]}
+    for name, (imp, d) in alt.items():
+        left = imp.difference(d)
+        z = left.value / left.err if left.err > 0 else math.copysign(math.inf, left.value)
+        share = 1.0 - left.value / gap.value if gap.value else math.nan
+        out[name] = {"d1": d.to_dict(), "d1_implied": imp.to_dict(), "left": left.to_dict(), "z": z,
+                     "share": share, "closes": abs(z) <= 2 and share >= 0.5, "within_by_error": abs(z) <= 2 and not share >= 0.5}  # fmt: skip
+    rec["gap"] = out
+    return rec
+
+
+def gap_row(rec: dict) -> dict:
+    """gap_row(rec) -> a record's gap d₁(implied) − d₁ and, per candidate measured, the gap it leaves and the share
+    it explains (the table of the candidates), or only the point's names where the relation was not checked.
+
+    Examples
+    --------
+    >>> gap_row({"id": "a", "system": "hh", "ratio": 1.5, "gap": {"gap": {"value": 0.05, "err": 0.01}, "z": -5.0,
+    ...          "estimator": {"left": {"value": 0.01, "err": 0.014}, "z": 0.7, "share": 0.8, "closes": True}}})
+    ... # doctest: +NORMALIZE_WHITESPACE
+    {'id': 'a', 'system': 'hh', 'ratio': 1.5, 'gap': {'value': 0.05, 'err': 0.01}, 'z': -5.0,
+     'left_estimator': {'value': 0.01, 'err': 0.014}, 'share_estimator': 0.8}
+    """
+    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
+    g = rec.get("gap")
+    if not g:
+        return row
+    row.update({"gap": g["gap"], "z": g["z"]})
+    for name in CANDIDATES:
+        if name in g:
+            row[f"left_{name}"], row[f"share_{name}"] = g[name]["left"], g[name]["share"]
+    return row
+
+
+def gap_summary(records) -> dict:
+    """gap_summary(records) -> where d₁ and 1 − κ/λ̄ differ by more than 2σ and, per candidate, at how many of those
+    points it closes the gap (|z| ≤ 2 left and at least half of it explained), at how many it is consistent only by
+    its larger error, and its median share of the gap, with the statement of the measured reason ("not explained"
+    where no candidate closes it).
+
+    Examples
+    --------
+    >>> recs = [{"id": "a", "gap": {"gap": {"value": 0.05, "err": 0.01}, "z": -5.0,
+    ...          "estimator": {"closes": False, "share": 0.1}, "mid_life": {"closes": False, "share": -0.2}}},
+    ...         {"id": "b", "gap": {"gap": {"value": 0.0, "err": 0.01}, "z": 0.1}}, {"id": "c"}]
+    >>> s = gap_summary(recs)
+    >>> s["n_gap"], s["candidates"]["estimator"]["n_closes"], s["not_explained"]
+    (1, 0, ['a'])
+    """
+    gaps = [r for r in records if r.get("gap") and abs(r["gap"]["z"]) > 2]
+    cands, parts = {}, []
+    for name, what in CANDIDATES.items():
+        at = [r for r in gaps if name in r["gap"]]
+        closes = [r["id"] for r in at if r["gap"][name]["closes"]]
+        by_error = [r["id"] for r in at if r["gap"][name].get("within_by_error")]
+        shares = [r["gap"][name]["share"] for r in at if math.isfinite(r["gap"][name]["share"])]
+        med = float(np.median(shares)) if shares else None
+        cands[name] = {"what": what, "n_measured": len(at), "n_closes": len(closes), "closes_at": closes,
+                       "n_within_by_error": len(by_error), "within_by_error_at": by_error, "median_share": med}  # fmt: skip
+        if at:
+            parts.append(f"{what}: closes it at {len(closes)} of {len(at)}" + (f" ({', '.join(closes)})" if closes
+                         else "") + (f", consistent only by its larger error at {len(by_error)}" if by_error else "")
+                         + (f", median share of the gap {100 * med:.0f} %" if med is not None else ""))  # fmt: skip
+    unexplained = [r["id"] for r in gaps if not any(r["gap"].get(n, {}).get("closes") for n in CANDIDATES)]
+    statement = (f"d₁ and 1 − κ/λ̄ differ by more than 2σ at {len(gaps)} of the {sum(bool(r.get('gap')) for r in records)}"
+                 f" points with both" + (f" ({', '.join(r['id'] for r in gaps)})" if gaps else "")
+                 + ("; " + "; ".join(parts) if parts else "")
+                 + (f"; not explained by any at {len(unexplained)} ({', '.join(unexplained)})" if unexplained else ""))  # fmt: skip
+    return {"n_gap": len(gaps), "gap_at": [r["id"] for r in gaps], "candidates": cands, "not_explained": unexplained,
             "statement": statement}  # fmt: skip

@@ -24,7 +24,7 @@ analyze    inputs (the studies of ``[needs]``, their published outputs only):
            hazard exp(−∫κ0) ("integrated") — free f_ne, L, b; f_e = P(τ0) − f_ne;
            τ2 from Eq. (eq:tau2) —, and of the mixture model with the same
            number of free parameters (K energy quantiles at t_ref = τ0,
-           per-orbit μ_i from the snapshots, one shared trapped fraction φ).
+           per-orbit μ_i from the snapshots, one never-escaping share φ for all).
            For fig4's γ values: the homogeneous fit and the model's τ1
            (:func:`hhscatter.analysis.dissipative.model_comparison.predict_tau1` against fig4's γ = 0
            curve), τ2 = ln(E0/E_c)/(μγ).  Writes derived tables and fig6.json.

@@ -28,6 +28,7 @@ from hhscatter.analysis.geometry import ulam_convergence as uc
 from hhscatter.reproduction.kappa_references import kappa_references
 from hhscatter.reproduction.operator_cmeasure import measure_distances
 from hhscatter.reproduction.operator_records import (
+    convergence_summary,
     cost_rows,
     dissipative_comparison,
     kappa_comparisons,
@@ -392,7 +393,7 @@ def analyze(study):
             "inputs": inputs,
             "kappa_ulam": k["records"],
             "kappa_convergence": k["convergence"],
-            "kappa_convergence_summary": uc.convergence_summary(k["convergence"]),
+            "kappa_convergence_summary": convergence_summary(k["convergence"]),
             "mixed_phase_space": k["mixed"],
             "cmeasure_distances": cm_rows,
             "cmeasure_convergence": cm_conv,

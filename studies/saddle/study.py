@@ -64,6 +64,7 @@ class Params(StudyParams):
     t_max: Number
     tmin_efolds: Number  # t_min = tmin_efolds/κ
     tmin_checks: Numbers  # d₁ also at t_min = c/κ for these c
+    tmin_trend: Numbers = (1.0, 2.0, 3.0)  # d₁ and λ̄ also at t_min·κ = tmin_efolds + s (their trend in t_min)
     window: Numbers  # (lo, hi): fractions of each orbit's lifetime
     min_boxes: Number  # d₁'s largest scale: the points' extent/min_boxes
     k_max: Integer  # d₁'s largest neighbour rank
@@ -194,6 +195,9 @@ def simulate(study, workers=None, progress=True):
                 tangent=True,
             )
             study.run(key + "_tangent", tsc, workers=workers, progress=progress)
+            for part, w in zip(("lo", "hi"), p.window):  # Λ at window·t_min (all still inside): the mid-life λ̄
+                study.run(f"{key}_tangent_{part}", tsc.replace(name=f"{study.name}/{key}_tangent_{part}",
+                          t_max=w * t_min), workers=workers, progress=progress)  # fmt: skip
     write_json_atomic(_choices_path(study), choices)
 
 
@@ -278,6 +282,28 @@ def _d1_estimator(p, lam):
                                                 seed=0)  # fmt: skip
 
     return est
+
+
+def _checks(study, key, tangent, t_min, efolds, kappa):
+    """λ̄ of the mid-life (the ``_lo``/``_hi`` tangent runs: Λ at window·t_min) and at the t_min of tmin_trend."""
+    p = study.params
+    lo, hi = (_lifetimes(study.raw(f"{key}_tangent_{s}"), ("log_stretch",)) for s in ("lo", "hi"))
+    ts = [c / kappa for c in (efolds, *(efolds + s for s in p.tmin_trend))]
+    return {**sr.mid_lyapunov_record(lo, hi, p.window[0] * t_min, p.window[1] * t_min, n_boot=p.n_boot),
+            "lyapunov_by_t_min": sr.lyapunov_by_t_min(_long_lived(tangent, ts[0]), ts, kappa, n_boot=p.n_boot)}  # fmt: skip
+
+
+def _d1_radius(sp, d, lam, p):
+    """d₁ of the same points by the fixed-radius mass (the second estimator), up to the largest scale d fitted."""
+    from hhscatter.analysis.geometry.saddle_checks import information_dimension_radius
+
+    try:
+        r = information_dimension_radius(sp.points[["x", "y"]].to_numpy(), groups=sp.points["traj_id"].to_numpy(),
+                                         eps_min=_d1_resolution(sp, lam)[1], eps_max=d.eps_range[1],
+                                         n_boot=p.n_boot, seed=0)  # fmt: skip
+    except ConfigError as exc:
+        return {"d1_radius_note": str(exc)}
+    return {"d1_radius": Measured(r.value, r.err).scaled(0.5).to_dict(), "d1_radius_eps_range": list(r.eps_range)}
 
 
 def _d0(study, key):
@@ -365,17 +391,20 @@ def _point(study, key, ch):
     if ch["n_tangent"] == 0:
         rec["notes"].append("no orbit left at t_end ≥ t_min")
         return rec, None
-    lam = _lyapunov(_lifetimes(study.raw(key + "_tangent"), ("log_stretch",)), ch["t_min"], p)
+    tangent = _lifetimes(study.raw(key + "_tangent"), ("log_stretch",))
+    lam = _lyapunov(tangent, ch["t_min"], p)
     if lam is None:
         rec["notes"].append("fewer than 2 orbits of the tangent run left at t_end ≥ t_min")
         return rec, None
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
+    rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k.kappa))
     lt = _lifetimes(study.raw(key))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
     est = _d1_estimator(p, lam["value"])
-    wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in (*p.tmin_checks, efolds)],
-                           windows=[tuple(p.window)], columns=["x", "y"])  # fmt: skip
+    cs = (*p.tmin_checks, efolds, *(efolds + s for s in p.tmin_trend))
+    wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in cs], windows=[tuple(p.window)],
+                           columns=["x", "y"])  # fmt: skip
     rec["d1_by_t_min"] = [
         {
             "t_min_kappa": c,
@@ -384,8 +413,10 @@ def _point(study, key, ch):
             "d1_section": None if math.isnan(r.value) else Measured.of(r.value, r.err, n=int(r.n_orbits)).to_dict(),
             "note": r.note,
         }  # fmt: skip
-        for c, r in zip((*p.tmin_checks, efolds), wd.itertuples())
+        for c, r in zip(cs, wd.itertuples())
     ]
+    rec["d1_by_t_min"], trend = rec["d1_by_t_min"][: len(p.tmin_checks) + 1], rec["d1_by_t_min"][len(p.tmin_checks) :]
+    rec["d1_trend_by_t_min"] = trend
     try:
         sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y"])
         d = est(sp)
@@ -402,6 +433,7 @@ def _point(study, key, ch):
                 "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
     rec.update(sr.d1_error_record(d, *_d1_resolution(sp, lam["value"])))
+    rec.update(_d1_radius(sp, d, lam["value"], p))
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
 
@@ -422,7 +454,7 @@ def analyze(study):
         for r in ratios:
             key = point_key(label, r)
             rec, ftle = _point(study, key, choices[key])
-            records.append(sr.with_d0(rec, _d0(study, key)))
+            records.append(sr.with_gap(sr.with_d0(rec, _d0(study, key))))
             if ftle is not None:
                 ftles.append(ftle[["traj_id", "t_end", "ftle"]].assign(system=label, ratio=r))
     cols = ["traj_id", "t_end", "ftle", "system", "ratio"]
@@ -440,12 +472,15 @@ def analyze(study):
             "dimensions": [sr.dimension_row(x) for x in records],
             "dimensions_summary": sr.dimension_summary(records),
             "d1_precision": sr.d1_precision(records),
+            "gap": [sr.gap_row(x) for x in records],
+            "gap_summary": sr.gap_summary(records),
             **basins,
             "rules": {
                 "tmin_efolds": study.params.tmin_efolds,
                 **_tmin_overrides(study),
                 "window": list(study.params.window),
                 "tmin_checks": list(study.params.tmin_checks),
+                "tmin_trend": list(study.params.tmin_trend),
                 "n_orbits_per_point": study.params.n,
                 "d0_eps": [float(e) for e in _d0_eps(study)],
                 "d0_n": study.params.d0_n,

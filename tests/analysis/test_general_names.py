@@ -5,17 +5,35 @@ What assembles a figure or compares with the paper lives in ``hhscatter.reproduc
 from __future__ import annotations
 
 import ast
+import importlib
 import re
 from pathlib import Path
 
 import pytest
 
 import hhscatter.analysis
+from hhscatter.studies import study_names
 
 ROOT = Path(hhscatter.analysis.__file__).parent
 #: a figure ("Fig. 2", "fig2", "figure 3"), a study or studies, the paper, its arXiv number
 NAMES = re.compile(r"\bpaper\b|\bfig(?:ure)?s?\.?\s*\d|fig\d|\bstud(?:y|ies)\b|arxiv|2308\.13555", re.IGNORECASE)
 MODULES = sorted(ROOT.rglob("*.py"))
+#: study names that are also the general concept an estimator measures (noise, basins, the chaotic saddle, the
+#: transfer operator): as words they say what is measured, not which study measures it
+CONCEPTS = {"noise", "basins", "saddle", "operator"}
+#: the other study names ("generality", "resc", …), as whole words or inside a name (``generality_rows``)
+STUDIES = re.compile("|".join(sorted(set(study_names()) - CONCEPTS)), re.IGNORECASE)
+#: the same inside an identifier, where ``_`` joins the words (``PAPER_KAPPA``, ``fig2_rows``)
+IN_A_NAME = re.compile(r"paper|fig(?:ure)?_?\d|stud(?:y|ies)|arxiv", re.IGNORECASE)
+SUBPACKAGES = ("stats", "survival", "dissipative", "noise", "geometry")
+
+
+def _exported_names() -> list[tuple[str, str]]:
+    out = []
+    for sub in SUBPACKAGES:
+        pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
+        out += [(sub, name) for name in pkg._EXPORTS]
+    return out
 
 
 def first_lines(source: str):
@@ -41,6 +59,54 @@ def test_the_check_finds_what_it_looks_for():
 @pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(ROOT)))
 def test_no_module_name_or_first_docstring_line_names_a_figure_study_or_the_paper(path):
     rel = path.relative_to(ROOT)
-    assert not any(NAMES.search(part) for part in rel.with_suffix("").parts), rel
-    bad = [f"{rel}:{n} {name}: {line}" for n, name, line in first_lines(path.read_text()) if NAMES.search(line)]
+    assert not any(NAMES.search(part) or STUDIES.search(part) for part in rel.with_suffix("").parts), rel
+    bad = [
+        f"{rel}:{n} {name}: {line}"
+        for n, name, line in first_lines(path.read_text())
+        if NAMES.search(line) or STUDIES.search(line)
+    ]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_study_check_knows_the_studies():
+    assert STUDIES.search("fig2_kappa") and STUDIES.search("the resc record") and not STUDIES.search("κ(E) law")
+    assert {"fig2", "generality"} <= set(study_names())
+    assert IN_A_NAME.search("PAPER_KAPPA") and IN_A_NAME.search("figure_2_rows") and not IN_A_NAME.search("fit_laws")
+
+
+def test_no_exported_name_names_a_figure_study_or_the_paper():
+    bad = [f"{sub}.{name}" for sub, name in _exported_names() if IN_A_NAME.search(name) or STUDIES.search(name)]
+    assert not bad, bad
+
+
+def _strings(source: str):
+    """(line number, text) of every string constant that is not a docstring."""
+    tree = ast.parse(source)
+    docs = {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+        and node.body
+        and isinstance(node.body[0], ast.Expr)
+        and isinstance(node.body[0].value, ast.Constant)
+    }
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
+            yield node.lineno, node.value
+
+
+#: a figure or a study in a key or a message an estimator writes ("fig2_kappa", "fig2's κ0"); the survival model's
+#: hazard named "paper" (its literal form, beside "integrated") is a value of the API, not a reference
+WRITTEN = re.compile(r"fig(?:ure)?s?\.?\s*_?\d|" + STUDIES.pattern, re.IGNORECASE)
+
+
+def test_the_written_check_finds_a_figure_key():
+    assert [
+        s for _, s in _strings('"""Doc of fig2."""\nrec = {"fig2_kappa": 1, "kappa": 2}\n') if WRITTEN.search(s)
+    ] == ["fig2_kappa"]
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_key_or_message_names_a_figure_or_a_study(path):
+    bad = [f"{path.relative_to(ROOT)}:{n} {s!r}" for n, s in _strings(path.read_text()) if WRITTEN.search(s)]
     assert not bad, "\n".join(bad)

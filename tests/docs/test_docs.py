@@ -716,7 +716,35 @@ def test_spec_tables_write_a_count_of_zero_as_its_bound(hook):
     """A record with a sibling <key>_upper (a count of 0) shows its one-sided bound, never "0 ± 0"."""
     recs = [{"t": 80.0, "sim": 0.25, "sim_err": 0.01}, {"t": 100.0, "sim": 0.0, "sim_err": None, "sim_upper": 3e-4}]
     out = hook.spec_table(recs, (("t", "t"), ("sim", "simulated")))
-    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0e-4 (95 %) |" in out
+    assert "| 80 | 0.250 ± 0.010 |" in out and "| 100 | < 3.0×10<sup>-4</sup> (95 %) |" in out
+
+
+def _notations(cell: str) -> set[str]:
+    """The notations of the numbers of a rendered cell: "e" (2.6e-06), "×10" (2.6×10<sup>-6</sup>)."""
+    out = {"e"} if re.search(r"(?<![\w.])\d+(?:\.\d+)?e[+-]?\d+", cell) else set()
+    return out | ({"×10"} if "×10<sup>" in cell else set())
+
+
+def test_a_rendered_study_table_writes_its_numbers_in_one_notation(hook):
+    """Every record table a page asks for, rendered from the committed numbers at both scales, writes a power of
+    ten one way: no table mixes e-notation (basins' cut-off table wrote "2.63e-06 ± 6.3e-08" and "ε_c < 1e-10" beside
+    "2.56×10<sup>-6</sup>") with a×10<sup>b</sup>, in a value ± error or in a text cell."""
+    mixed = []
+    for table, spec in hook.STUDY_TABLES.items():
+        name, key = table.split("@", 1)[0].split(".", 1)
+        for base in (DOCS / "studies" / "assets", DOCS / "studies" / "assets" / "paper"):
+            path = base / f"{name}.json"
+            recs = hook._dig(json.loads(path.read_text()), key) if path.is_file() else None
+            if not recs:
+                continue
+            rows = [r.split(" | ") for r in hook.spec_table(recs, spec).splitlines()[2:]]
+            used = set().union(*(_notations(c) for r in rows for c in r))
+            if len(used) > 1:
+                mixed.append((table, base.name, sorted(used)))
+    assert not mixed, mixed
+    # the renderer's notation, in a value ± error and in a text cell
+    out = hook.spec_table([{"x": 2.63e-6, "x_err": 6.3e-8, "s": "ε_c < 1e-10"}], (("x", "x"), ("s", "s")))
+    assert "| (2.63 ± 0.06)×10<sup>-6</sup> | ε_c < 1×10<sup>-10</sup> |" in out
 
 
 def test_the_reference_radius_difference_to_itself_reads_reference(hook):
@@ -794,6 +822,41 @@ def test_the_glossary_has_a_row_for_every_symbol_the_result_pages_define():
     heads = {h.strip() for r in rows if r.startswith("| ") for h in r.split("|")[1].split(",")}
     wanted = {"κ∞", "κ_tail", "P∞", "S_b", "S_bb", "SW1", "β", "t0", "q", "λ̄", "λ∞", "D₁", "d₁", "δ", "z", "t*", "T"}
     assert wanted <= heads, sorted(wanted - heads)
+
+
+#: Greek letters the study pages write as notation rather than as a symbol of their own, each with why it needs no row
+GREEK_NOTATION = {
+    "σ": "a standard error (a distance in σ), not a quantity",
+    "χ": "χ², the goodness-of-fit statistic, named where it is used",
+    "Σ": "a sum",
+    "Δ": "a difference (ΔE, Δ = d(5b) − d(5a)), defined where it is used",
+    "π": "the number π",
+    "ψ": "the digamma function of the nearest-neighbour dimension estimate, named where it is used",
+}
+
+
+def _greek_symbols(text: str) -> set[str]:
+    """Each Greek letter of ``text`` with the accents written on it (φ and φ̇ are two symbols)."""
+    return set(re.findall(r"[\u0370-\u03ff][\u0300-\u036f]*", text))
+
+
+def test_every_greek_symbol_of_the_study_pages_heads_a_glossary_row():
+    """Every Greek symbol a study page uses (its page.md and its study module's docstring, shown on the page) heads a
+    row of the glossary, unless it is notation (a sum, a difference, σ, χ², π, the digamma function): fig6's
+    mixture share φ, the operator's Perron vector ν, the noise study's Υ(δ) and the saddle's log-stretch Λ each have
+    their row."""
+    import ast
+
+    text = (DOCS / "equations.md").read_text()
+    rows = text[text.index("## Glossary") :].splitlines()
+    heads = set().union(*(_greek_symbols(r.split("|")[1]) for r in rows if r.startswith("| ")))
+    missing = {}
+    for folder in sorted(p for p in (ROOT / "studies").iterdir() if (p / "page.md").is_file()):
+        used = _greek_symbols((folder / "page.md").read_text())
+        used |= _greek_symbols(ast.get_docstring(ast.parse((folder / "study.py").read_text())) or "")
+        for sym in sorted(used - heads - set(GREEK_NOTATION)):
+            missing.setdefault(sym, []).append(folder.name)
+    assert not missing, missing
 
 
 def test_a_rate_symbol_of_one_study_is_not_reused_by_another():

@@ -153,6 +153,8 @@ def test_criterion_numbers_compare_shifts_returns_and_channels():
     ]
     assert rows[-1]["paper"] == pytest.approx(1 / 3) and rows[0]["paper"] == 0.0
     assert numbers["default_r_esc"]["recommended"] == 1.5
+    # the reference radius is recorded as the authors' value, not as a "current" default
+    assert numbers["default_r_esc"]["authors"] == 1.5 and "current" not in numbers["default_r_esc"]
     assert numbers["returns"]["E=0.30"]["r_esc=2"]["typical_survivor_fraction_within_reesc_fast"] == pytest.approx(
         1 - math.exp(-1.0)
     )

@@ -11,10 +11,14 @@ import pytest
 from synthetic_operator import BOX, EXTENT, KAPPA, transition_table
 
 from hhscatter.analysis.geometry import ulam_convergence as uc
+from hhscatter.errors import ConfigError
 from hhscatter.reproduction.operator_records import (
+    convergence_summary,
+    cost_row,
     cost_rows,
     dissipative_comparison,
     kappa_comparisons,
+    kappa_record,
     kappa_records,
     probe_islands,
 )
@@ -164,3 +168,36 @@ def test_dissipative_comparison_of_an_operator_and_an_ensemble_that_both_halve_p
     # both spread evenly over the four unit boxes: no distance at side 1 beyond the noise
     assert dtab["box"].tolist() == [1.0, 0.5] and dtab["hellinger_debiased"].iloc[0] == pytest.approx(0.0, abs=0.05)
     assert numbers["t_star_hellinger_debiased"]["box"] == 0.5
+
+
+# -- the pieces: each refuses a wrong argument before any work, naming it --------------------------------------
+PT = {"kappa": 0.05, "kappa_err": 0.001, "orbits": 5000, "orbit_time": 1e5}
+RECORDS = [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]
+PIECES = {
+    "kappa_record": (kappa_record, {"E": 0.3, "res": _results([0.3])[0.3], "samples": 16, "box": 0.5}),
+    "convergence_summary": (convergence_summary, {"records": RECORDS}),
+    "cost_row": (cost_row, {"E": 0.3, "pt": PT, "rec": None, "kappa0": {}, "target": 0.01}),
+}
+WRONG = [
+    ("kappa_record", "res", {"rows": []}),
+    ("kappa_record", "kappa0", (0.1,)),
+    ("kappa_record", "box", 0.0),
+    ("convergence_summary", "records", "x"),
+    ("convergence_summary", "records", [{"kappa_inf": 0.2}]),
+    ("convergence_summary", "z_agree", 0.0),
+    ("cost_row", "pt", {"kappa": 0.05}),
+    ("cost_row", "target", 0.0),
+]
+
+
+@pytest.mark.parametrize("name", sorted(PIECES))
+def test_the_valid_call_of_a_piece_runs(name):
+    f, kwargs = PIECES[name]
+    assert f(**kwargs)
+
+
+@pytest.mark.parametrize(("name", "arg", "bad"), WRONG, ids=[f"{n}-{a}-{i}" for i, (n, a, _) in enumerate(WRONG)])
+def test_a_wrong_argument_of_a_piece_is_refused_naming_it(name, arg, bad):
+    f, kwargs = PIECES[name]
+    with pytest.raises(ConfigError, match=arg):
+        f(**{**kwargs, arg: bad})

@@ -78,3 +78,71 @@ def test_the_rows_and_summaries_are_the_committed_quick_numbers(quick):
     assert [sr.dimension_row(r) for r in recs] == quick["dimensions"]
     assert sr.dimension_summary(recs) == quick["dimensions_summary"]
     assert sr.d1_precision(recs) == quick["d1_precision"]
+
+
+def _gap_record(**extra):
+    # κ = 0.1, λ̄ = 0.4 (exact): 1 − κ/λ̄ = 0.75; d₁ = 0.70 ± 0.01: the gap 0.05 ± 0.01, z = −5
+    return {"id": "p", "system": "hh", "ratio": 1.5, "kappa": 0.1, "kappa_err": 0.0, "lyapunov": 0.4, "lyapunov_err": 0.0, "d1": 0.70,
+            "d1_err": 0.01, "d1_implied": 0.75, "d1_implied_err": 0.0, "z": -5.0, **extra}  # fmt: skip
+
+
+def test_with_gap_measures_what_each_candidate_leaves_of_the_gap():
+    rec = sr.with_gap(_gap_record(
+        d1_radius={"value": 0.745, "err": 0.01},  # leaves 0.005 ± 0.01: closes it
+        lyapunov_mid={"value": 0.5, "err": 0.0},  # 1 − 0.1/0.5 = 0.8: leaves 0.10 ± 0.01, share −1
+        d1_trend_by_t_min=[{"t_min_kappa": c, "d1_section": {"value": 2 * (0.8 - 1 / c), "err": 0.02}} for c in (5, 10, 20)],
+        lyapunov_by_t_min=[{"t_min_kappa": c, "value": 0.4, "err": 0.001} for c in (5, 10, 20)],
+    ))  # fmt: skip
+    g = rec["gap"]
+    assert g["gap"]["value"] == pytest.approx(0.05) and g["gap"]["err"] == pytest.approx(0.01)
+    assert g["estimator"]["left"]["value"] == pytest.approx(0.005) and g["estimator"]["closes"]
+    assert g["estimator"]["share"] == pytest.approx(0.9)
+    assert g["mid_life"]["left"]["value"] == pytest.approx(0.1) and not g["mid_life"]["closes"]
+    assert g["mid_life"]["share"] == pytest.approx(-1.0)
+    # d₁ = 0.8 − 1/(t_min κ) exactly: extrapolated 0.8, λ̄ flat at 0.4: 0.75 − 0.8 = −0.05 left
+    assert rec["d1_trend"]["extrapolated"]["value"] == pytest.approx(0.8)
+    assert g["selection"]["left"]["value"] == pytest.approx(-0.05) and not rec["d1_trend"]["converged"]
+    assert sr.gap_row(rec)["share_estimator"] == pytest.approx(0.9)
+    s = sr.gap_summary([rec, sr.with_gap(_gap_record(id="q", z=1.0))])
+    assert s["n_gap"] == 1 and s["candidates"]["estimator"]["closes_at"] == ["p"] and s["not_explained"] == []
+    assert "closes it at 1 of 1 (p)" in s["statement"]
+
+
+def test_a_candidate_consistent_only_by_its_larger_error_does_not_close_the_gap():
+    """A candidate that moves the gap the wrong way (share < 0) but whose own error is large enough to leave |z| ≤ 2
+    is not an explanation: counted apart, and the point stays unexplained."""
+    rec = sr.with_gap(_gap_record(d1_radius={"value": 0.66, "err": 0.06}))  # leaves 0.09 ± 0.06: z 1.5, share −0.8
+    g = rec["gap"]["estimator"]
+    assert abs(g["z"]) <= 2 and g["share"] == pytest.approx(-0.8)
+    assert not g["closes"] and g["within_by_error"]
+    s = sr.gap_summary([rec])
+    assert s["candidates"]["estimator"]["n_closes"] == 0 and s["candidates"]["estimator"]["within_by_error_at"] == ["p"]
+    assert s["not_explained"] == ["p"] and "consistent only by its larger error at 1" in s["statement"]
+
+
+def test_with_gap_without_a_check_or_enough_t_min_leaves_notes():
+    rec = sr.with_gap({"id": "x", "z": None, "d1_trend_by_t_min": [{"t_min_kappa": 4.0, "d1_section": None}]})
+    assert (
+        "gap" not in rec and "at least 3" in rec["d1_trend"]["note"] and "at least 3" in rec["lyapunov_trend"]["note"]
+    )
+    s = sr.gap_summary([sr.with_gap(_gap_record())])
+    assert s["not_explained"] == ["p"] and s["statement"].endswith("not explained by any at 1 (p)")
+
+
+def test_mid_life_and_t_min_lyapunov_use_only_the_orbits_they_may():
+    lo = pd.DataFrame(
+        {"traj_id": [0, 1, 2], "outcome": ["censored", "censored", "censored"], "log_stretch": [1.0, 2.0, 3.0]}
+    )
+    hi = pd.DataFrame(
+        {"traj_id": [2, 1, 0], "outcome": ["escaped", "censored", "censored"], "log_stretch": [9.0, 6.0, 3.0]}
+    )
+    r = sr.mid_lyapunov_record(lo, hi, 10.0, 20.0, n_boot=5)["lyapunov_mid"]
+    assert r["value"] == pytest.approx((2.0 + 4.0) / 20.0) and (r["n_orbits"], r["n_left"]) == (
+        2,
+        1,
+    )  # matched by traj_id
+    assert "fewer than 2" in sr.mid_lyapunov_record(lo, hi.assign(outcome="escaped"), 10.0, 20.0)["lyapunov_mid_note"]
+    tg = pd.DataFrame({"t_end": [10.0, 20.0, 40.0], "log_stretch": [2.0, 6.0, 10.0]})
+    rows = sr.lyapunov_by_t_min(tg, [10.0, 20.0, 40.0], 0.1, n_boot=5)
+    assert [(r["t_min_kappa"], r["n_orbits"]) for r in rows] == [(1.0, 3), (2.0, 2)]
+    assert rows[1]["value"] == pytest.approx(16.0 / 60.0)

@@ -6,9 +6,6 @@ intervals. P is a survival probability (dimensionless), t in time units.
 
 Examples
 --------
->>> t = np.array([0.0, 1.0, 2.0, 3.0])
->>> select_points(t, np.exp(-t), np.full(4, 0.01), 1.0, None, 0.1)[0].tolist()
-[1.0, 2.0]
 >>> lo, hi = profile_interval(lambda x: (x - 2.0) ** 2, 2.0, 0.0, 0.0, 10.0)
 >>> round(lo, 6), round(hi, 6)
 (1.0, 3.0)
@@ -24,18 +21,7 @@ from scipy import optimize
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.errors import ConfigError
 
-__all__ = [
-    "FitStats",
-    "best_of",
-    "covariance",
-    "fit_stats",
-    "goodness",
-    "lsq",
-    "p_at",
-    "profile_interval",
-    "residual_fn",
-    "select_points",
-]
+__all__ = ["best_of", "profile_interval"]
 
 
 # ---------------------------------------------------------------------------
@@ -45,7 +31,7 @@ def _data(t, P, P_err):
     return t, check.floats(P, "P", size=t.size, of="time t"), check.floats(P_err, "P_err", size=t.size, of="time t")
 
 
-def select_points(t, P, P_err, tau0, t_max, P_min):
+def _select_points(t, P, P_err, tau0, t_max, P_min):
     t, P, P_err = _data(t, P, P_err)
     check.number(tau0, "tau0")
     if t_max is not None:
@@ -57,7 +43,7 @@ def select_points(t, P, P_err, tau0, t_max, P_min):
     return t[sel], P[sel], P_err[sel]
 
 
-def p_at(t, P, P_err, t0):
+def _p_at(t, P, P_err, t0):
     """(P(t0), σ_P(t0)) by log-linear interpolation of the data."""
     _data(t, P, P_err)
     check.number(t0, "t0")
@@ -71,7 +57,7 @@ def p_at(t, P, P_err, t0):
     return float(np.exp(np.interp(t0, t, np.log(P)))), float(np.interp(t0, t, E))
 
 
-def residual_fn(curve, P, sig, space):
+def _residual_fn(curve, P, sig, space):
     check.function(curve, "curve")
     check.floats(sig, "sig", size=check.floats(P, "P").size, of="point of P")
     if space == "log":
@@ -96,8 +82,25 @@ def residual_fn(curve, P, sig, space):
 
 
 def best_of(fit_fn, starts, cost, errors, message):
-    """The result of ``fit_fn(start)`` with the smallest ``cost(result)``; starts raising ``errors`` are skipped,
-    none left is a RuntimeError(``message``)."""
+    """The result of ``fit_fn(start)`` with the smallest ``cost(result)`` over several starting points.
+
+    A fit whose cost surface has local minima is run from each start of ``starts``; a start whose fit raises one of
+    ``errors`` (an exception class or a tuple of them) is skipped, and none left is a RuntimeError(``message``).
+    The cost is in the unit ``cost`` returns (a χ², a sum of squares: dimensionless for normalised residuals).
+
+    Examples
+    --------
+    >>> def fit(x0):
+    ...     if x0 < 0:
+    ...         raise ValueError("start outside the domain")
+    ...     return {"x": x0, "cost": (x0 - 2.0) ** 2}
+    >>> best_of(fit, [-1.0, 0.5, 2.5], lambda r: r["cost"], ValueError, "no start converged")["x"]
+    2.5
+    >>> best_of(fit, [-1.0], lambda r: r["cost"], ValueError, "no start converged")
+    Traceback (most recent call last):
+    ...
+    RuntimeError: no start converged
+    """
     check.function(fit_fn, "fit_fn")
     check.function(cost, "cost")
     if isinstance(starts, (str, bytes, dict)) or starts is None or not hasattr(starts, "__iter__"):
@@ -120,7 +123,7 @@ def best_of(fit_fn, starts, cost, errors, message):
     return best
 
 
-def lsq(res, starts, lo, hi):
+def _lsq(res, starts, lo, hi):
     """Best least_squares solution over several starting points."""
     check.function(res, "res")
     check.floats(hi, "hi", size=check.floats(lo, "lo").size, of="bound of lo")
@@ -132,7 +135,7 @@ def lsq(res, starts, lo, hi):
     return best_of(solve, starts, lambda r: r.cost, ValueError, "survival fit failed for all starting points")
 
 
-def covariance(J, chi2_red, absolute_sigma):
+def _covariance(J, chi2_red, absolute_sigma):
     if np.ndim(J) != 2 or check.floats(J, "J").size == 0:
         raise ConfigError("J must be a non-empty 2-D array (the Jacobian)")
     check.real(chi2_red, "chi2_red")
@@ -142,7 +145,7 @@ def covariance(J, chi2_red, absolute_sigma):
     return cov
 
 
-def goodness(curve_vals, t, P, res_norm, k):
+def _goodness(curve_vals, t, P, res_norm, k):
     size = check.floats(t, "t").size
     check.floats(curve_vals, "curve_vals", size=size, of="time t")
     check.floats(P, "P", size=size, of="time t")
@@ -159,7 +162,7 @@ def goodness(curve_vals, t, P, res_norm, k):
 
 
 @dataclass(frozen=True)
-class FitStats:
+class _FitStats:
     """Post-fit statistics shared by the homogeneous and the mixture fit."""
 
     chi2: float
@@ -172,19 +175,19 @@ class FitStats:
     cov: np.ndarray  # cov_fit plus the propagated error of the measured P(τ0)
 
 
-def fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> FitStats:
+def _fit_stats(sol, curve_vals, t, P, r, k, absolute_sigma, P_tau0_err, refit=None) -> _FitStats:
     """Goodness of fit, covariance and the P(τ0) sensitivity; ``refit(P_shift)`` -> solution or None."""
     if sol is not None and not (hasattr(sol, "x") and hasattr(sol, "jac")):
         raise ConfigError(f"sol must be a least-squares solution (with x and jac) or None, got {type(sol).__name__}")
     check.number(P_tau0_err, "P_tau0_err", minimum=0.0)
     if refit is not None:
         check.function(refit, "refit")
-    chi2, dof, chi2_red, rms, aic = goodness(curve_vals, t, P, r, k)
-    cov_fit = covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
+    chi2, dof, chi2_red, rms, aic = _goodness(curve_vals, t, P, r, k)
+    cov_fit = _covariance(sol.jac, chi2_red, absolute_sigma) if sol is not None else np.zeros((0, 0))
     sens = np.zeros(0 if sol is None else sol.x.size)
     if refit is not None and P_tau0_err > 0 and sol is not None:
         sens = (refit(P_tau0_err).x - sol.x) / P_tau0_err
-    return FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
+    return _FitStats(chi2, dof, chi2_red, rms, aic, cov_fit, sens, cov_fit + np.outer(sens, sens) * P_tau0_err**2)
 
 
 def profile_interval(

@@ -203,7 +203,7 @@ def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
     ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
     Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
     """
-    check.frame(snapshots, "snapshots", ("t", "energy"))
+    check.table(snapshots, "snapshots", ("t", "energy"), min_rows=0)
     return mean_energy_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy())
 
 
@@ -219,7 +219,7 @@ def pool_mean_energy(tables) -> pd.DataFrame:
     """
     tables = list(_sequence(tables, "tables"))
     for i, t in enumerate(tables):
-        check.frame(t, f"tables[{i}]", ("t", "n", "mean_E", "std_E"))
+        check.table(t, f"tables[{i}]", ("t", "n", "mean_E", "std_E"), min_rows=0)
     tabs = [t for t in tables if len(t)]
     cols = ["t", "n", "mean_E", "std_E", "sem_E", "lo_3sigma", "hi_3sigma"]
     if not tabs:
@@ -279,7 +279,7 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
     inside, above = [], []
     n_below = 0
     for df in parts:
-        check.frame(df, "a table of parts", ("t", "energy"))
+        check.table(df, "a table of parts", ("t", "energy"), min_rows=0)
         up = df["energy"] > e_c
         inside.append(mean_energy(df))
         above.append(mean_energy(df[up]))
@@ -435,7 +435,7 @@ def fit_energy_decay_table(
     log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
     unweighted log fit of Eq. (eqn:energy_exp_decay).
     """
-    check.frame(table, "table", ("t", "mean_E", "sem_E") if weighted else ("t", "mean_E"))
+    check.table(table, "table", ("t", "mean_E", "sem_E") if weighted else ("t", "mean_E"), min_rows=0)
     weights = None
     if weighted:
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -558,7 +558,7 @@ def energy_histograms(snapshots: pd.DataFrame, times, bins=50) -> EnergyHistogra
     DataFrame wrapper of :func:`energy_histograms_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
     """
-    check.frame(snapshots, "snapshots", ("t", "energy"))
+    check.table(snapshots, "snapshots", ("t", "energy"), min_rows=0)
     return energy_histograms_arrays(snapshots["t"].to_numpy(), snapshots["energy"].to_numpy(), times, bins)
 
 
@@ -637,7 +637,7 @@ def bootstrap_mu_first_orbits(
     keeps the bootstrap affordable at N = 10^7. ``rows`` may already be
     restricted to those orbits (e.g. by a filter pushed down to the reader).
     """
-    check.frame(rows, "rows", ("traj_id", "t", "energy"))
+    check.table(rows, "rows", ("traj_id", "t", "energy"), min_rows=0)
     _first_orbits(n_orbits, k)
     sub = rows[rows["traj_id"] < k]
     boot = bootstrap_mu(sub["traj_id"], sub["t"], sub["energy"], E0, gamma, windows, n_boot=n_boot, seed=seed)
@@ -677,7 +677,7 @@ def decay_exponent(
     (0.8, 0.0, 6)
     """
     _sequence(parts, "parts")
-    check.frame(rows, "rows", ("traj_id", "t", "energy"))
+    check.table(rows, "rows", ("traj_id", "t", "energy"), min_rows=0)
     _first_orbits(n_orbits, k)
     check.number(E0, "E0", positive=True)
     check.number(gamma, "gamma", positive=True)

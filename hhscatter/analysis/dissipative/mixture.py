@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.dissipative.curve_fit import fit_stats, lsq, residual_fn
+from hhscatter.analysis.dissipative.curve_fit import _fit_stats, _lsq, _residual_fn
 from hhscatter.analysis.dissipative.survival_model import (
     HAZARDS,
     SurvivalFit,
@@ -281,7 +281,7 @@ def mixture_components(
     DataFrame wrapper of :func:`mixture_components_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).
     """
-    check.frame(snapshots, "snapshots", ("traj_id", "t", "energy"))
+    check.table(snapshots, "snapshots", ("traj_id", "t", "energy"), min_rows=0)
     return mixture_components_arrays(
         snapshots["traj_id"].to_numpy(),
         snapshots["t"].to_numpy(),
@@ -453,7 +453,7 @@ def fit_mixture_model(
     model = prob.model(theta, P_tau0)
     r = res(theta)
     # propagate the error of the measured P(τ0) (linear sensitivity from a re-fit)
-    st = fit_stats(
+    st = _fit_stats(
         sol, model(tf), tf, Pf, r, len(free), absolute_sigma, P_tau0_err, lambda dP: prob.solve([sol.x], P_tau0 + dP)[0]
     )
     values, errors = _mixture_values_errors(prob, theta, names, st, P_tau0, P_tau0_err, tau2_k)
@@ -586,8 +586,8 @@ class _MixtureProblem:
 
     def solve(self, starts, P0):
         """(best solution over ``starts``, or None without free parameters; residual function)."""
-        res = residual_fn(lambda th: self.model(th, P0)(self.tf), self.Pf, self.sf, self.space)
-        return (lsq(res, starts, *self.bounds(P0)) if self.free else None), res
+        res = _residual_fn(lambda th: self.model(th, P0)(self.tf), self.Pf, self.sf, self.space)
+        return (_lsq(res, starts, *self.bounds(P0)) if self.free else None), res
 
 
 def _mixture_values_errors(prob: _MixtureProblem, theta, names, st, P_tau0, P_tau0_err, tau2_k):

@@ -30,7 +30,7 @@ data to decide; the fitting code supports both.
 Both fits return :class:`SurvivalFit` with the same goodness-of-fit measures
 (χ², dof, χ²/dof, RMS of log residuals, AIC) on the same data selection, so
 that :func:`~hhscatter.analysis.dissipative.model_comparison.compare_fits` can tabulate them side by side; the τ1 a fit
-predicts and the figure studies' fitting rule are in :mod:`hhscatter.analysis.dissipative.model_comparison`.
+predicts is in :mod:`hhscatter.analysis.dissipative.model_comparison`.
 
 Units: time in model units, energies in model units, rates in 1/time.
 """
@@ -44,13 +44,13 @@ import numpy as np
 from scipy import special
 
 from hhscatter.analysis.dissipative.curve_fit import (
-    FitStats,
-    fit_stats,
-    lsq,
-    p_at,
+    _fit_stats,
+    _FitStats,
+    _lsq,
+    _p_at,
+    _residual_fn,
+    _select_points,
     profile_interval,  # noqa: F401 - importable from here too
-    residual_fn,
-    select_points,
 )
 from hhscatter.analysis.dissipative.decay import _energy_path
 from hhscatter.analysis.dissipative.transitions import tau2_predicted
@@ -63,7 +63,6 @@ __all__ = [
     "SurvivalFit",
     "SurvivalModelParams",
     "fit_survival_model",
-    "homogeneous_start",
     "profile_interval",
     "settling_rate",
     "survival_model",
@@ -255,7 +254,7 @@ class SurvivalFit:
 _HOMOG = ("f_ne", "f_e", "L", "b", "tau2")
 
 
-def _survival_fit(model, values, errors, free, st: FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
+def _survival_fit(model, values, errors, free, st: _FitStats, t_fit, residuals, sol, space) -> SurvivalFit:
     return SurvivalFit(
         params=model,
         values=values,
@@ -352,7 +351,7 @@ def fit_survival_model(
     P_tau0, P_tau0_err, tf, Pf, sf = _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min)
     tau2_eq, fit_tau2 = _settling_time(E0, E_c, mu, gamma, tau2, fixed, fit_tau2)
     free = tuple(n for n in ("f_ne", "f_e", "L", "b") if n not in fixed and not (n == "f_e" and constrain_total))
-    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
+    fne0, fe0, L0, b_starts = _homogeneous_start(tf, Pf, tau2_eq, P_tau0, fixed, p0)
     prob = HomogeneousProblem(
         tf,
         Pf,
@@ -404,10 +403,10 @@ def _fit_data(t, P, P_err, tau0, P_tau0, t_max, P_min):
     check.number(P_min, "P_min")
     t_all = np.asarray(t, dtype=float)
     if P_tau0 is None:
-        P_tau0, P_tau0_err = p_at(t_all, P, P_err, tau0)
+        P_tau0, P_tau0_err = _p_at(t_all, P, P_err, tau0)
     else:
         P_tau0_err = 0.0
-    tf, Pf, sf = select_points(t, P, P_err, tau0, t_max, P_min)
+    tf, Pf, sf = _select_points(t, P, P_err, tau0, t_max, P_min)
     if tf.size < 3:
         raise ConfigError("fewer than 3 data points selected")
     return P_tau0, P_tau0_err, tf, Pf, sf
@@ -448,7 +447,7 @@ def _homogeneous_result(
     r = res(theta)
     # propagate the error of the measured P(τ0) through the constraint
     refit = (lambda dP: prob.fit_at(tau2_fit, sol.x, warm_only=True, P0=P_tau0 + dP)[0]) if prob.derive_fe else None
-    st = fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
+    st = _fit_stats(sol, curve_vals, tf, prob.Pf, r, k, absolute_sigma, P_tau0_err, refit)
     errors = _homogeneous_errors(free, st, prob.derive_fe, P_tau0_err)
     errors["tau2"] = tau2_err
     values = dict(v)
@@ -457,7 +456,7 @@ def _homogeneous_result(
     return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, prob.space)
 
 
-def homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
+def _homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
     """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
     values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
     L ≈ the late log-slope of P, and three starts for b unless given."""
@@ -574,11 +573,11 @@ class HomogeneousProblem:
     def fit_at(self, tau2, prev=None, warm_only: bool = False, P0=None):
         """(solution or None, χ², residual function) of the fit with τ2 held at ``tau2``."""
         curve = lambda th: self.model(self.values(th, tau2, P0))(self.tf)
-        res = residual_fn(curve, self.Pf, self.sf, self.space)
+        res = _residual_fn(curve, self.Pf, self.sf, self.space)
         if not self.free:
             r = res(np.array([]))
             return None, float(np.sum(r**2)), res
-        sol = lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
+        sol = _lsq(res, self.starts(prev, warm_only), *self.bounds(P0))
         return sol, float(2 * sol.cost), res
 
     def profile(self, taus):

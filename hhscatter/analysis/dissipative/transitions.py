@@ -85,7 +85,7 @@ def _outcomes(outcome, name: str, size: int):
 
 
 def _lifetimes(lifetimes, name: str = "lifetimes"):
-    return check.frame(lifetimes, name, ("t_end", "outcome"))
+    return check.table(lifetimes, name, ("t_end", "outcome"), min_rows=0)
 
 
 def _log_ratio(P_gamma, P_0, alpha):

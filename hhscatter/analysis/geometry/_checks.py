@@ -87,6 +87,24 @@ def wholes(a, name: str, minimum: int = 1) -> list[int]:
     return [whole(v, name, minimum) for v in check.numbers(a, name)]
 
 
+def potential(model, name: str = "model"):
+    """``model`` if it has a potential V(x, y) to call (a system)."""
+    if not callable(getattr(model, "potential", None)):
+        raise ConfigError(f"{name} must be a system with a potential V(x, y), got {type(model).__name__}")
+    return model
+
+
+def reference(ref, name: str):
+    """``ref`` if it is None or (value, err), two numbers (NaN allowed: not measured)."""
+    if ref is None:
+        return ref
+    if isinstance(ref, (str, bytes, dict)) or not hasattr(ref, "__len__") or len(ref) != 2:
+        raise ConfigError(f"{name} must be (value, err) or None, got {ref!r}")
+    if any(isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) for v in ref):
+        raise ConfigError(f"{name} must be (value, err), two numbers (NaN: not measured), got {ref!r}")
+    return ref
+
+
 def generator(rng, name: str = "rng"):
     """``rng`` if it is a :class:`numpy.random.Generator`."""
     if not isinstance(rng, np.random.Generator):

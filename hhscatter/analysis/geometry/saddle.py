@@ -337,6 +337,21 @@ class SaddleDimension:
         )
 
 
+def _group_labels(groups, n: int) -> tuple[np.ndarray, int]:
+    """(labels 0..n_groups−1 per point, n_groups) of ``groups`` (one label per point; None: every point its own)."""
+    g = np.arange(n) if groups is None else np.asarray(groups)
+    if g.shape != (n,):
+        raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
+    _, g = np.unique(g, return_inverse=True)
+    g = g.ravel()
+    return g, int(g.max()) + 1
+
+
+def _eps_min(eps_min) -> None:
+    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
+        raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
+
+
 def _slope(x, y) -> tuple[float, float]:
     """Least-squares slope of y on x and its standard error from the residuals."""
     xm = x - x.mean()
@@ -356,18 +371,12 @@ def _box_counting(points, weights, groups, *, divisions, min_boxes, min_occupanc
         raise ConfigError(f"weights must have one value per point: {w.shape[0]} != {n}")
     if np.any(w < 0) or not np.sum(w) > 0:
         raise ConfigError("weights must be ≥ 0 with a positive sum")
-    g = np.arange(n) if groups is None else np.asarray(groups)
-    if g.shape != (n,):
-        raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
-    _, g = np.unique(g, return_inverse=True)
-    g = g.ravel()
-    n_groups = int(g.max()) + 1
+    g, n_groups = _group_labels(groups, n)
     min_boxes = _positive(min_boxes, "min_boxes")
     min_occupancy = _positive(min_occupancy, "min_occupancy")
     n_boot = _count(n_boot, "n_boot", 0)
     seed = _count(seed, "seed", 0)
-    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
-        raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
+    _eps_min(eps_min)
     lo_corner = P.min(axis=0)
     sides = P.max(axis=0) - lo_corner
     extent = float(np.max(sides))
@@ -574,17 +583,11 @@ def information_dimension_neighbours(
 
     P = _finite_array(points, "points", 2)
     n = P.shape[0]
-    g = np.arange(n) if groups is None else np.asarray(groups)
-    if g.shape != (n,):
-        raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
-    _, g = np.unique(g, return_inverse=True)
-    g = g.ravel()
-    n_groups = int(g.max()) + 1
+    g, n_groups = _group_labels(groups, n)
     k_max = _count(k_max, "k_max", 2)
     n_boot = _count(n_boot, "n_boot", 0)
     seed = _count(seed, "seed", 0)
-    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
-        raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
+    _eps_min(eps_min)
     extent = float(np.max(P.max(axis=0) - P.min(axis=0)))
     if not extent > 0:
         raise ConfigError("points: all points coincide (no extent to cover)")

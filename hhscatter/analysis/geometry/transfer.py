@@ -180,6 +180,16 @@ def _matrix(A, name: str = "A", *, square: bool = True):
     return A
 
 
+def _lag_kernel(K, n: int, L: int, of: str) -> None:
+    """``K`` is the lag kernel of ``n`` states over ``L`` lags: a non-negative (n, n·L) matrix (``of``: the argument
+    that gave n)."""
+    _matrix(K, "K", square=False)
+    if K.shape != (n, n * L):
+        raise ConfigError(
+            f"K must have shape (states, states × L) = ({n}, {n * L}) for the {n} states of {of}, got {K.shape}"
+        )
+
+
 def _crossings(c, name: str = "crossings", n: int | None = None) -> np.ndarray:
     """``c`` as a (steps, states) array of finite numbers ≥ 0 (``n`` states if given)."""
     check.numbers(c, name, minimum=0.0)
@@ -486,8 +496,7 @@ def section_flux_density(model, x, y, energy, *, h: float = 1e-6):
     ∂_r V by a central difference of ``model.potential`` along the ray (relative step h): no model
     constants here. 0 where V ≥ E or r = 0.
     """
-    if not callable(getattr(model, "potential", None)):
-        raise ConfigError(f"model must be a system with a potential V(x, y), got {type(model).__name__}")
+    _checks.potential(model)
     check.numbers(x, "x")
     check.numbers(y, "y")
     check.numbers(energy, "energy")
@@ -592,11 +601,7 @@ def propagate(n0, K: sp.csr_matrix, L: int, n_steps: int) -> np.ndarray:
     n = n0.size
     L = _checks.whole(L, "L")
     n_steps = _checks.whole(n_steps, "n_steps", 0)
-    _matrix(K, "K", square=False)
-    if K.shape != (n, n * L):
-        raise ConfigError(
-            f"K must have shape (states, states × L) = ({n}, {n * L}) for the {n} states of n0, got {K.shape}"
-        )
+    _lag_kernel(K, n, L, "n0")
     out = np.zeros((n_steps + L + 1, n))
     out[0] = n0
     Kt = K.T.tocsr()
@@ -659,11 +664,7 @@ def first_crossing_after(crossings: np.ndarray, K: sp.csr_matrix, L: int, k_star
     n = crossings.shape[1]
     L = _checks.whole(L, "L")
     k_star = _checks.whole(k_star, "k_star", 0)
-    _matrix(K, "K", square=False)
-    if K.shape != (n, n * L):
-        raise ConfigError(
-            f"K must have shape (states, states × L) = ({n}, {n * L}) for the {n} states of crossings, got {K.shape}"
-        )
+    _lag_kernel(K, n, L, "crossings")
     out = np.zeros(n)
     Kt = K.T.tocsr()
     for kp in range(max(0, k_star - L), k_star):

@@ -11,8 +11,8 @@ and turns their results into the records of an operator study:
   :mod:`hhscatter.analysis.geometry.ulam_convergence`);
 * :func:`leading_modes`, :func:`measure_points`, :func:`reduced_operator` — spectra, c-measure samples and the
   operator on ρ(E) alone;
-* :func:`empirical_survival`, :func:`survival_agreement`, :func:`t_star_energies`, :func:`cost_row` — the
-  comparisons with a simulated ensemble and the cost of each route.
+* :func:`empirical_survival`, :func:`survival_agreement`, :func:`t_star_energies` — the comparisons with a
+  simulated ensemble.
 
 Pure functions (tables and arrays in, records out). Units: box sides in position units, times in the
 Hamiltonian's time unit, κ in 1/time.
@@ -37,7 +37,6 @@ __all__ = [
     "dissipative_record",
     "dissipative_operator",
     "coarse_index",
-    "cost_row",
     "disk_density",
     "eigenvector_convergence",
     "empirical_survival",
@@ -65,6 +64,19 @@ _SAMPLE_COLUMNS = ("cell", "rank", "w", "censored", "ret", "T", "x1", "y1")
 def _sample_table(tab, name: str, ebins: bool = False, *, t_end: bool = False):
     more = (("ebin", "e1") if ebins else ()) + (("t_end",) if t_end else ())
     return check.table(tab, name, _SAMPLE_COLUMNS + more)
+
+
+def _partitions(tab, extent, box, coarsen=None, subsets=None, *, ebins: bool = False, t_end: bool = False):
+    """The arguments that say which partitions of the one-return samples ``tab`` are built: the section's
+    ``extent``, the finest box side ``box`` and, when given, the merging factors ``coarsen`` and the sample counts
+    ``subsets``."""
+    _sample_table(tab, "tab", ebins, t_end=t_end)
+    _checks.extent(extent)
+    check.number(box, "box", positive=True)
+    if coarsen is not None:
+        _checks.wholes(coarsen, "coarsen")
+    if subsets is not None:
+        _checks.wholes(subsets, "subsets")
 
 
 def _transition_table(t, tr):
@@ -118,9 +130,7 @@ def sample_transitions(tab: pd.DataFrame, extent, box: float, c: int = 1, m_max=
     ``ebin``) the states are (box, energy bin): id = bin·n_cells + box. Returns (Transitions, state ids,
     the samples used).
     """
-    _sample_table(tab, "tab", ebins is not None)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
+    _partitions(tab, extent, box, ebins=ebins is not None)
     _checks.whole(c, "c")
     if m_max is not None:
         _checks.whole(m_max, "m_max")
@@ -349,56 +359,6 @@ def t_star_energies(pred, sim_pts):
     }
 
 
-def cost_row(E, pt, rec, kappa0, target):
-    """Orbit-time of each route for κ at the relative error ``target``.
-
-    ``pt``: the P(t) route's result {kappa, kappa_err, orbits, orbit_time}; ``rec``: the operator's κ record
-    at E (or None); ``kappa0``: {E: (κ0, err)} of the reference. The P(t) route scales as 1/√N; the
-    operator's is a lower bound: its bias ∝ box side (cost ∝ 1/b² at fixed samples per box) and its
-    statistics ∝ 1/√(samples) — optimistic, since finer boxes raise the per-sample noise.
-    """
-    check.number(E, "E")
-    _checks.mapping(pt, "pt", ("kappa", "kappa_err", "orbits", "orbit_time"))
-    if rec is not None:
-        _checks.mapping(rec, "rec", ("kappa", "kappa_stat_err", "discretisation_bias", "err", "orbit_time"))
-    _checks.mapping(kappa0, "kappa0")
-    check.number(target, "target", positive=True)
-    rel = float(pt["kappa_err"] / pt["kappa"])
-    ot = float(pt["orbit_time"])
-    k0 = kappa0.get(E, (math.nan, math.nan))
-    row = {
-        "energy": E,
-        "pt_kappa": float(pt["kappa"]),
-        "pt_err": float(pt["kappa_err"]),
-        "pt_rel": rel,
-        "pt_orbits": int(pt["orbits"]),
-        "pt_orbit_time": ot,
-        "pt_orbit_time_1pct": ot * (rel / target) ** 2,
-        "fig2_kappa": k0[0],
-        "fig2_err": k0[1],
-    }
-    if rec is not None:
-        k = rec["kappa"]
-        st_rel = rec["kappa_stat_err"] / k
-        b_rel = abs(rec["discretisation_bias"]) / k
-        share = target / math.sqrt(2)  # half of the budget (in quadrature) to each part
-        f_bias = max(1.0, (b_rel / share) ** 2)
-        f_stat = max(1.0, (st_rel / share) ** 2)
-        row.update(
-            {
-                "op_kappa": k,
-                "op_err": rec["err"],
-                "op_rel": rec["err"] / k,
-                "op_stat_rel": st_rel,
-                "op_bias_rel": b_rel,
-                "op_orbit_time": rec["orbit_time"],
-                "op_orbit_time_1pct": rec["orbit_time"] * max(f_bias, f_stat),
-                "pt_rel_at_op_cost": rel * math.sqrt(ot / rec["orbit_time"]),
-            }
-        )
-    return row
-
-
 def hellinger_by_box(P, Q, boxes, extent, n_splits, seed, head):
     """Debiased Hellinger distance between point sets P and Q over box sizes
     (:func:`~hhscatter.analysis.geometry.distance.distance_vs_scale`): (table with hellinger_debiased, lo, hi;
@@ -453,8 +413,7 @@ def stratified_section_points(model, energy, extent, box, k, r_esc, rng, *, e_wi
     [E − e_width/2, E + e_width/2]) and w, the flux density |ṗ_r|/v of the return map's invariant measure
     (:func:`~hhscatter.analysis.geometry.transfer.section_flux_density`).
     """
-    if not callable(getattr(model, "potential", None)):
-        raise ConfigError(f"model must be a system with a potential V(x, y), got {type(model).__name__}")
+    _checks.potential(model)
     check.number(energy, "energy")
     _checks.extent(extent)
     check.number(box, "box", positive=True)
@@ -535,11 +494,7 @@ def eigenvector_convergence(tab, extent, box, coarsen, subsets, Q, boxes, n_spli
     """The debiased Hellinger distance (at the box nearest ``head``) between the operator's sprinkler measure and
     the reference points ``Q``, for boxes merged c × c and the first M' samples per finest box: records
     {box, samples_per_box, kappa, eps, hellinger_debiased, lo, hi}."""
-    _sample_table(tab, "tab")
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets)
     _checks.points(Q, "Q")
     check.numbers(boxes, "boxes", positive=True)
     check.count(n_splits, "n_splits", 1)
@@ -619,9 +574,7 @@ def dissipative_operator(tab, extent, box, edges, *, dt, t_horizon, t_star, max_
     t, n_cells, lost (share of the disk on no state), max_lag, steps, grid (times), P, P_reduced,
     kappa_bins, pred}.
     """
-    _sample_table(tab, "tab", True)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
+    _partitions(tab, extent, box, ebins=True)
     check.numbers(edges, "edges", min_size=2)
     check.number(dt, "dt", positive=True)
     for name, v in (("t_horizon", t_horizon), ("t_star", t_star), ("max_return_time", max_return_time)):

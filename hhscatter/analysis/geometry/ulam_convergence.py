@@ -4,11 +4,10 @@ Built on :mod:`hhscatter.analysis.geometry.ulam` (the samples as transitions, κ
 
 * :func:`energy_results` — κ at every box side and sample count of one energy's one-return samples, the
   extrapolation grid with its bootstrap replicates, the bootstrap of the finest partition and the cost;
-* :func:`kappa_record` — the record of the finest partition (with the straight-line box bias);
 * :func:`kappa_convergence` — κ extrapolated to infinitely many samples per box and to box side 0, with the
   statistical and model errors (see its notes); :func:`convergence_grid` the grid it is fitted on;
-* :func:`residuals`, :func:`convergence_record`, :func:`convergence_summary` — κ_Ulam/κ_ref − 1 with both
-  errors against each reference, per energy and in one sentence;
+* :func:`residuals`, :func:`convergence_record` — κ_Ulam/κ_ref − 1 with both errors against each reference,
+  per energy;
 * :func:`measure_on_cut_boxes` — where the c-measure lives against the partition: its share on the boxes cut
   by the section's boundary (V = E or r = r_esc), where the flux weights |ṗ_r|/v are heavy-tailed;
 
@@ -24,7 +23,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry import transfer as tf
-from hhscatter.analysis.geometry.ulam import _sample_table, saddle_kappa, sample_transitions
+from hhscatter.analysis.geometry.ulam import _partitions, saddle_kappa, sample_transitions
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.stats.verdicts import verdict
@@ -33,10 +32,8 @@ from hhscatter.errors import ConfigError
 __all__ = [
     "convergence_grid",
     "convergence_record",
-    "convergence_summary",
     "energy_results",
     "kappa_convergence",
-    "kappa_record",
     "measure_on_cut_boxes",
     "residuals",
 ]
@@ -44,66 +41,6 @@ __all__ = [
 
 def _grid_table(grid, name: str, more=()):
     return check.table(grid, name, ("box", "samples", "kappa") + tuple(more), min_rows=0)
-
-
-def _reference(ref, name: str):
-    """``ref`` is None or (value, err), two numbers (NaN allowed: not measured)."""
-    if ref is None:
-        return
-    if isinstance(ref, (str, bytes, dict)) or not hasattr(ref, "__len__") or len(ref) != 2:
-        raise ConfigError(f"{name} must be (value, err) or None, got {ref!r}")
-    if any(isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) for v in ref):
-        raise ConfigError(f"{name} must be (value, err), two numbers (NaN: not measured), got {ref!r}")
-
-
-def kappa_record(E, res, samples, box, kappa0=None, kappa_cm=None):
-    """The record of κ at one energy from the results ``res`` of the finest partition.
-
-    ``res`` holds rows (κ per box side, ``vary`` = "box"), boot (bootstrap replicates), kappa, kappa_map,
-    info, sub, cost. κ on the finest boxes; the linear discretisation bias from a straight line κ(b) through
-    the three finest box sides (κ at b → 0); err = √(σ_boot² + bias²). The references ``kappa0`` (fig2's κ0,
-    the P(t) route) and ``kappa_cm`` (κ from long-run crossings), each (value, err) or None, are recorded as
-    fig2_kappa, fig2_err, fig2_kappa_cm, fig2_kappa_cm_err, with z_vs_fig2 against κ0 (both errors).
-    """
-    check.number(E, "E")
-    _checks.mapping(res, "res", ("rows", "boot", "kappa", "kappa_map", "info", "sub", "cost"))
-    _checks.whole(samples, "samples")
-    check.number(box, "box", positive=True)
-    _reference(kappa0, "kappa0")
-    _reference(kappa_cm, "kappa_cm")
-    rows = pd.DataFrame([r for r in res["rows"] if r["vary"] == "box"]).sort_values("box")
-    fit = rows.head(3)
-    slope, k_inf = (
-        np.polyfit(fit["box"].to_numpy(), fit["kappa"].to_numpy(), 1) if len(fit) >= 2 else (0.0, res["kappa"])
-    )
-    boot = res["boot"]
-    stat = float(np.std(boot, ddof=1)) if boot.size > 1 else math.nan
-    bias = float(k_inf - res["kappa"])
-    rec = {
-        "energy": E,
-        "kappa": res["kappa"],
-        "err": float(math.hypot(stat, bias)),
-        "boxes": int(res["sub"].n_states),
-        "samples": samples,
-        "box": box,
-        "kappa_stat_err": stat,
-        "discretisation_bias": bias,
-        "kappa_extrapolated": float(k_inf),
-        "bias_slope": float(slope),
-        "kappa_map_per_return": res["kappa_map"],
-        "mean_return_time": res["cost"]["mean_return_time"],
-        "orbit_time": res["cost"]["orbit_time"],
-        "orbits": res["cost"]["orbits"],
-        "censored": res["cost"]["censored"],
-        **{f"class_{k}": v for k, v in res["info"].items()},
-        "fig2_kappa": kappa0[0] if kappa0 else None,
-        "fig2_err": kappa0[1] if kappa0 else None,
-        "fig2_kappa_cm": kappa_cm[0] if kappa_cm else None,
-        "fig2_kappa_cm_err": kappa_cm[1] if kappa_cm else None,
-    }
-    if kappa0:
-        rec["z_vs_fig2"] = (rec["kappa"] - kappa0[0]) / math.hypot(rec["err"], kappa0[1])
-    return rec
 
 
 def _fit_convergence(b, M, k, p):
@@ -217,7 +154,7 @@ def convergence_record(E, grid, boot_grid, kappa_finest, refs) -> dict:
     check.number(kappa_finest, "kappa_finest")
     _checks.mapping(refs, "refs")
     for name, ref in refs.items():
-        _reference(ref, f"refs[{name!r}]")
+        _checks.reference(ref, f"refs[{name!r}]")
     rec = {"energy": float(E), "kappa_finest": float(kappa_finest)}
     try:
         c = kappa_convergence(grid, boot_grid)
@@ -254,11 +191,7 @@ def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
     (:func:`kappa_convergence`). Returns (grid: box, samples, kappa; replicates: rep, box, samples, kappa —
     NaN where a replicate leaves no open class).
     """
-    _sample_table(tab, "tab")
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets)
     _checks.whole(samples, "samples")
     _checks.whole(n_boot, "n_boot", 0)
     parts = [(int(c), int(m)) for c in coarsen for m in subsets]
@@ -278,45 +211,6 @@ def convergence_grid(tab, extent, box, coarsen, subsets, samples, n_boot, rng):
                 kap = math.nan
             reps.append({"rep": r, "box": box * c, "samples": m * c * c, "kappa": kap})
     return grid, pd.DataFrame(reps, columns=["rep", "box", "samples", "kappa"])
-
-
-def convergence_summary(records, *, z_agree: float = 2.0) -> dict:
-    """How the extrapolated κ∞ of :func:`convergence_record` compares with the references, in words and numbers.
-
-    For each reference (kappa0, kappa_cm): the energies where |z| ≤ ``z_agree`` (both errors), the largest
-    |κ∞/κ_ref − 1| and the mean residual; ``statement`` says it in one sentence per reference.
-
-    Examples
-    --------
-    >>> recs = [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]
-    >>> convergence_summary(recs)["kappa0"]["agree"]
-    [0.3]
-    """
-    if isinstance(records, (str, bytes)) or not isinstance(records, (list, tuple)):
-        raise ConfigError(f"records must be a list of records (mappings), got {type(records).__name__}")
-    for r in records:
-        _checks.mapping(r, "records", ("energy",))
-    check.number(z_agree, "z_agree", positive=True)
-    out, words = {}, []
-    names = {"kappa0": "fig2's κ0 from P(t)", "kappa_cm": "fig2's κ from long-run crossings"}
-    for ref, label in names.items():
-        rs = [r for r in records if r.get("kappa_inf") is not None and r.get(f"z_{ref}") is not None]
-        if not rs:
-            continue
-        agree = [r["energy"] for r in rs if abs(r[f"z_{ref}"]) <= z_agree]
-        res = np.array([r[f"residual_{ref}"] for r in rs])
-        out[ref] = {
-            "energies": [r["energy"] for r in rs],
-            "agree": agree,
-            "max_abs_residual": float(np.max(np.abs(res))),
-            "mean_residual": float(res.mean()),
-        }
-        words.append(
-            f"against {label}, κ∞ agrees within {z_agree:g}σ (both errors) at {len(agree)} of {len(rs)} "
-            f"energies; |κ∞/κ_ref − 1| ≤ {100 * np.max(np.abs(res)):.2g} %, mean {100 * res.mean():+.2g} %"
-        )
-    out["statement"] = "; ".join(words) if words else "no reference to compare with"
-    return out
 
 
 def energy_results(tab, extent, box, coarsen, subsets, samples, n_boot, n_boot_grid, seed, energy) -> dict:
@@ -343,11 +237,7 @@ def energy_results(tab, extent, box, coarsen, subsets, samples, n_boot, n_boot_g
     >>> bool(abs(res["kappa"] - math.log(4 / 3) / 2) < 1e-9), len(res["rows"]), len(res["grid"])
     (True, 4, 4)
     """
-    _sample_table(tab, "tab", t_end=True)
-    _checks.extent(extent)
-    check.number(box, "box", positive=True)
-    _checks.wholes(coarsen, "coarsen")
-    _checks.wholes(subsets, "subsets")
+    _partitions(tab, extent, box, coarsen, subsets, t_end=True)
     _checks.whole(samples, "samples")
     _checks.whole(n_boot, "n_boot", 0)
     _checks.whole(n_boot_grid, "n_boot_grid", 0)

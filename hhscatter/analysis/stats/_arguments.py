@@ -7,10 +7,10 @@ Traceback (most recent call last):
 ...
 hhscatter.errors.ConfigError: t_end must be finite (no NaN or inf)
 >>> import pandas as pd
->>> frame(pd.DataFrame({"t_end": [1.0]}), "lifetimes", ["t_end", "outcome"])
+>>> table(pd.DataFrame({"t_end": [1.0]}), "lifetimes", ["t_end", "outcome"])
 Traceback (most recent call last):
 ...
-hhscatter.errors.ConfigError: lifetimes lacks the column(s) outcome
+hhscatter.errors.ConfigError: lifetimes lacks the column(s) outcome; it has t_end
 >>> mapping([], "fits")
 Traceback (most recent call last):
 ...
@@ -112,36 +112,36 @@ def system(model, name: str = "model"):
 
 
 def table(df, name: str, columns=(), *, min_rows: int = 1):
-    """``df`` if it is a DataFrame holding ``columns`` and at least ``min_rows`` rows.
+    """``df`` if it is a DataFrame holding ``columns`` (the missing ones are named) and at least ``min_rows`` rows.
 
     >>> import pandas as pd
     >>> table(pd.DataFrame({"t": [1.0]}), "sections", ("traj_id", "t"))
     Traceback (most recent call last):
     ...
-    hhscatter.errors.ConfigError: sections needs the columns ['t', 'traj_id'], has ['t']
+    hhscatter.errors.ConfigError: sections lacks the column(s) traj_id; it has t
     """
-    import pandas as pd  # deferred: pandas loads only for the estimators that take a table
-
-    if not isinstance(df, pd.DataFrame):
-        raise ConfigError(f"{name} must be a table (pandas DataFrame), got {type(df).__name__}")
-    missing = set(columns) - set(df.columns)
-    if missing:
-        raise ConfigError(f"{name} needs the columns {sorted(columns)}, has {sorted(map(str, df.columns))}")
-    if len(df) < min_rows:
-        raise ConfigError(f"{name} must hold at least {min_rows} row(s), got {len(df)}")
-    return df
-
-
-def frame(df, name: str, columns=()):
-    """``df`` if it is a pandas DataFrame holding ``columns`` (the missing ones are named)."""
     import pandas as pd  # deferred: pandas loads only for the estimators that take a table
 
     if not isinstance(df, pd.DataFrame):
         raise ConfigError(f"{name} must be a pandas DataFrame, got {type(df).__name__}")
     missing = [c for c in columns if c not in df.columns]
     if missing:
-        raise ConfigError(f"{name} lacks the column(s) {', '.join(missing)}")
+        have = ", ".join(map(str, df.columns)) or "no column"
+        raise ConfigError(f"{name} lacks the column(s) {', '.join(missing)}; it has {have}")
+    if len(df) < min_rows:
+        raise ConfigError(f"{name} must hold at least {min_rows} row(s), got {len(df)}")
     return df
+
+
+def curve(t, P, names: tuple[str, str] = ("t", "P")) -> tuple[np.ndarray, np.ndarray]:
+    """A measured curve: increasing finite times ``t`` (at least one) and P with one value per time (NaN may stand)."""
+    if np.ndim(t) != 1:
+        raise ConfigError(f"{names[0]} must be a 1-D array of times, got {type(t).__name__}")
+    t = numbers(t, names[0])
+    P = floats(P, names[1], size=t.size, of=f"time {names[0]}")
+    if np.any(np.diff(t) < 0):
+        raise ConfigError(f"{names[0]} must be increasing")
+    return t, P
 
 
 def mapping(d, name: str, *, min_size: int = 0) -> dict:

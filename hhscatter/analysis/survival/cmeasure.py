@@ -222,8 +222,8 @@ def cmeasure_sample_from_sections(
     time and of each exit, for the bootstrap over orbits of
     :func:`kappa_from_cmeasure`.
     """
-    check.frame(sections, "sections", ("traj_id", "t"))
-    check.frame(lifetimes, "lifetimes", ("traj_id", "outcome", "t_end"))
+    check.table(sections, "sections", ("traj_id", "t"), min_rows=0)
+    check.table(lifetimes, "lifetimes", ("traj_id", "outcome", "t_end"), min_rows=0)
     check.real(t_from, "t_from")  # an empty window (t_from > t_to, or NaN) gives an empty sample
     check.real(t_to, "t_to")
     check.real(t_record_end, "t_record_end")

@@ -299,7 +299,7 @@ def escape_rate_from_lifetimes(lifetimes, t_grid=None, *, allow_dissipative=Fals
     a dissipative ensemble (``gamma`` > 0), whose P(t) is not exponential, raises
     ValueError, or with ``allow_dissipative=True`` is fitted with a UserWarning.
     """
-    check.frame(lifetimes, "lifetimes", ("t_end", "outcome"))
+    check.table(lifetimes, "lifetimes", ("t_end", "outcome"), min_rows=0)
     if "gamma" in lifetimes.columns and len(lifetimes) and float(lifetimes["gamma"].max()) > 0:
         msg = (
             f"escape_rate_from_lifetimes: this ensemble is dissipative (gamma = {float(lifetimes['gamma'].max()):g}"

@@ -126,7 +126,7 @@ def lifetimes_to_arrays(lifetimes, *, check_single_ensemble: bool = True):
     ``lifetimes.groupby(['energy', 'gamma'])`` (never by ``e0``, which
     differs from orbit to orbit in the last bits).
     """
-    check.frame(lifetimes, "lifetimes", ("t_end", "outcome"))
+    check.table(lifetimes, "lifetimes", ("t_end", "outcome"), min_rows=0)
     if check_single_ensemble:
         for col in ("energy", "e0", "gamma"):
             # e0 is recomputed from each initial state, so one ensemble's values differ in the

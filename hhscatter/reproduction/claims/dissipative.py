@@ -7,10 +7,6 @@ import math
 import numpy as np
 import pandas as pd
 
-from hhscatter.analysis.dissipative.model_comparison import (
-    fit_homogeneous_hazards,
-    survival_fit_points,
-)
 from hhscatter.analysis.dissipative.transitions import (
     bootstrap_transition_times,
     power_law_exponent,
@@ -35,6 +31,7 @@ from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.analysis.survival.windows import choose_windows
 from hhscatter.reproduction.claims.keys import diss_key
 from hhscatter.reproduction.claims.records import z_verdict
+from hhscatter.reproduction.hazard_fits import fit_homogeneous_hazards, survival_fit_points
 
 
 def taus(runs, label, m, E0, mu, mu_err):

@@ -595,7 +595,7 @@ def test_bootstrap_mu_first_orbits_uses_the_first_k_orbits_and_scales_errors():
 
 def test_homogeneous_fit_steps_alone():
     """The steps of fit_survival_model (start values, bounds, parameters from θ, starts, one fit at fixed τ2)."""
-    from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, homogeneous_start
+    from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, _homogeneous_start
 
     t = np.arange(0.0, 301.0)
     P = model.survival_model(t, **KW, **TRUE, hazard="paper")
@@ -604,10 +604,10 @@ def test_homogeneous_fit_steps_alone():
     sf = 1e-3 * Pf
     P_tau0 = float(np.interp(KW["tau0"], t[np.isfinite(P)], P[np.isfinite(P)]))
     tau2 = transitions.tau2_predicted(KW["E0"], EC, KW["mu"], KW["gamma"])
-    fne0, fe0, L0, b_starts = homogeneous_start(tf, Pf, tau2, P_tau0, {}, None)
+    fne0, fe0, L0, b_starts = _homogeneous_start(tf, Pf, tau2, P_tau0, {}, None)
     assert 0 < fne0 <= 0.9 * P_tau0 and fe0 == pytest.approx(P_tau0 - fne0) and L0 > 0
     assert b_starts == (0.02, 0.1, 0.5)
-    assert homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
+    assert _homogeneous_start(tf, Pf, tau2, P_tau0, {"f_ne": 0.01}, {"b": 2.0})[0::3] == (0.01, (2.0,))
     prob = HomogeneousProblem(
         tf,
         Pf,
@@ -637,26 +637,3 @@ def test_homogeneous_fit_steps_alone():
     for name in ("f_ne", "L", "b"):
         assert fitted[name] == pytest.approx(TRUE[name], rel=1e-4), name
     assert chi2 < 1e-6 and np.allclose(prob.model(fitted)(tf), Pf, rtol=1e-6)
-
-
-def test_fit_homogeneous_hazards_by_the_figure_rule_recovers_the_model_it_sampled():
-    """fig6's rule (coarse points, P(τ0) held, three starts, best χ²), now shared: a binomial sample of the model
-    with known f_ne, L, b gives them back within 3σ for both hazards, and P(τ0) is read off the curve."""
-    from hhscatter.analysis.dissipative import model_comparison as mc
-
-    for hazard, seed in (("paper", 11), ("integrated", 12)):
-        t = np.arange(0.0, 301.0, 0.5)
-        rng = np.random.default_rng(seed)
-        P, P_err = binomial_sample(model.survival_model(t, **KW, **TRUE, hazard=hazard), N_ORBITS, rng)
-        P = np.where(t < TAU0, 1.0, P)  # the irregular regime is not modelled: any curve before τ0
-        P_err = np.where(t < TAU0, 1e-3, P_err)
-        tf, Pf, sf = mc.survival_fit_points(t, P, P_err, TAU0, 2.0, N_ORBITS, 20)
-        assert np.all(np.diff(tf) >= 1.5) and tf[0] >= TAU0 and np.all(Pf * N_ORBITS >= 20)
-        kw = {("kappa" if k == "kappa_of_E" else k): v for k, v in KW.items()}
-        fits = mc.fit_homogeneous_hazards(
-            t, P, P_err, tf, Pf, sf, **kw, hazards=[hazard], fit_tau2=False, P_min=20 / N_ORBITS
-        )
-        f = fits[hazard]
-        assert f.values["P_tau0"] == pytest.approx(mc.plateau_level(t, P, TAU0))
-        for name in ("f_ne", "L", "b"):
-            assert abs(f.values[name] - TRUE[name]) < 3 * f.errors[name], (hazard, name, f.values[name])

@@ -41,9 +41,6 @@ VALID = {
     "decay_path": {"t": [0.0, 1.0], "E0": 0.3, "gamma": 0.01, "mu_of_E": np.sqrt},
     "time_to_energy": {"E0": 0.35, "E1": 0.3, "mu": 0.91, "gamma": 0.01},
     "settling_rate": {"t": T, "tau2": 5.0, "L": 1.0, "b": 0.5},
-    "survival_fit_points": {"t": T, "P": P, "P_err": 0.01 * P, "tau0": 1.0, "fit_dt": 2.0, "n": 1000, "min_count": 20},
-    "plateau_level": {"t": T, "P": P, "t_q": 5.0},
-    "select_points": {"t": T, "P": P, "P_err": 0.01 * P, "tau0": 1.0, "t_max": None, "P_min": 0.0},
     "profile_interval": {"chi2_of": np.square, "best": 0.0, "chi2_min": 0.0, "lo_edge": -3.0, "hi_edge": 3.0},
     "mixture_components": {"snapshots": SNAPSHOTS, "gamma": 0.01, "t_ref": 1.0},
 }

@@ -372,12 +372,7 @@ ULAM_VALID = {
         },
     ),  # fmt: skip
     "measure_on_cut_boxes": (ulam_convergence.measure_on_cut_boxes, {"res": RES, "samples": 16}),
-    "kappa_record": (ulam_convergence.kappa_record, {"E": 0.3, "res": RES, "samples": 16, "box": 0.5}),
     "residuals": (ulam_convergence.residuals, {"value": 0.102, "err": 0.003, "ref": 0.1, "ref_err": 0.004}),
-    "convergence_summary": (
-        ulam_convergence.convergence_summary,
-        {"records": [{"energy": 0.3, "kappa_inf": 0.2, "z_kappa0": 0.5, "residual_kappa0": 0.01}]},
-    ),
     "convergence_record": (
         ulam_convergence.convergence_record,
         {"E": 0.3, "grid": RES["grid"], "boot_grid": None, "kappa_finest": 0.14, "refs": {"kappa0": (0.14, 0.01)}},
@@ -410,15 +405,9 @@ ULAM_WRONG = [
     ("energy_results", "energy", "x"),
     ("measure_on_cut_boxes", "res", None),
     ("measure_on_cut_boxes", "samples", 0.5),
-    ("kappa_record", "res", {"rows": []}),
-    ("kappa_record", "kappa0", (0.1,)),
-    ("kappa_record", "box", 0.0),
     ("residuals", "ref", 0.0),
     ("residuals", "err", -1.0),
     ("residuals", "value", "x"),
-    ("convergence_summary", "records", "x"),
-    ("convergence_summary", "records", [{"kappa_inf": 0.2}]),
-    ("convergence_summary", "z_agree", 0.0),
     ("convergence_record", "grid", None),
     ("convergence_record", "refs", [0.14]),
     ("convergence_record", "refs", {"kappa0": "x"}),

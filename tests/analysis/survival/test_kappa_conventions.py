@@ -1,20 +1,16 @@
 """κ(E) under several conventions (hhscatter.analysis.survival.kappa_conventions), on synthetic lifetimes with a known κ."""
 
 import math
-from types import SimpleNamespace
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from hhscatter.analysis.survival.escape_rate import escape_rate
 from hhscatter.analysis.survival.kappa_conventions import (
     escape_rate_p_levels,
-    law_spread,
     p_level_windows,
     plateau_check,
     plateau_rate,
-    stable_energies,
     trapped_fraction,
 )
 
@@ -80,30 +76,6 @@ def test_plateau_check_threshold():
     assert plateau_check(0.1, 0.005)[0] and not plateau_check(0.1, 0.02)[0]
     assert plateau_check(0.1, 0.02)[1] == pytest.approx(0.2)
     assert not plateau_check(0.0, 0.0)[0]
-
-
-def test_stable_energies_need_agreement_of_the_defined_conventions():
-    rows = []
-    for e, ks, defined in (
-        (0.2, [0.020, 0.021, 0.030, 0.0], [1, 1, 1, 0]),  # 40 % range: unstable
-        (0.3, [0.200, 0.205, 0.198, 0.0], [1, 1, 1, 0]),  # 3.5 %: stable (undefined one ignored)
-        (0.4, [0.3, 0.0, 0.0, 0.0], [1, 0, 0, 0]),
-    ):  # one convention only: unstable
-        rows += [{"energy": e, "kappa": k, "defined": bool(d)} for k, d in zip(ks, defined)]
-    s = stable_energies(pd.DataFrame(rows), rel_tol=0.1).set_index("energy")
-    assert list(s["stable"]) == [False, True, False]
-    assert s.loc[0.3, "rel_range"] == pytest.approx((0.205 - 0.198) / np.mean([0.2, 0.205, 0.198]))
-    assert list(s["n_defined"]) == [3, 3, 1]
-
-
-def test_law_spread_is_half_the_range_across_conventions():
-    def fit(a, err):
-        return SimpleNamespace(a=a, b=0.1, c=1.4, E_b=0.27, a_err=err, b_err=0.01, c_err=0.02, E_b_err=0.005)
-
-    out = law_spread({"one": fit(10.0, 1.0), "two": fit(14.0, 2.0)})
-    assert out["a"]["value"] == 12.0 and out["a"]["spread"] == 2.0 and out["a"]["err_stat"] == 2.0
-    assert out["a"]["err"] == pytest.approx(math.hypot(2.0, 2.0))
-    assert out["c"]["spread"] == 0.0 and out["a"]["per_convention"] == {"one": 10.0, "two": 14.0}
 
 
 def test_quoted_verdict_uses_the_papers_printed_precision():

@@ -58,10 +58,8 @@ VALID = {
     "dead_time_check": {"tau0": 1.0, "t_first": 1.5, "kappa": 0.2},
     "lifetimes_to_arrays": {"lifetimes": LIFETIMES},
     "survival_from_lifetimes": {"lifetimes": LIFETIMES},
-    "stable_energies": {"table": pd.DataFrame({"energy": [0.3], "kappa": [0.2], "defined": [True]})},
-    "law_spread": {"fits": {}},
 }
-CASES = [(name, arg) for name, kwargs in VALID.items() for arg in kwargs if name != "law_spread"]
+CASES = [(name, arg) for name, kwargs in VALID.items() for arg in kwargs]
 
 
 @pytest.mark.parametrize(("name", "arg"), CASES)
@@ -80,11 +78,6 @@ def test_a_mask_one_short_is_refused_naming_it(name):
 def test_a_table_without_its_columns_is_refused_naming_them():
     with pytest.raises(ConfigError, match="lifetimes lacks the column"):
         survival.lifetimes_to_arrays(LIFETIMES.drop(columns="outcome"))
-
-
-def test_no_fits_to_spread_are_refused():
-    with pytest.raises(ConfigError, match="fits must hold at least 1"):
-        survival.law_spread({})
 
 
 def test_no_windows_are_refused():

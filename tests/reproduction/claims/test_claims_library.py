@@ -398,6 +398,31 @@ def test_kappa0_is_undefined_where_a_short_window_lies_inside_the_prompt_burst()
     assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0
 
 
+def test_a_window_of_more_than_an_e_fold_in_the_fast_decay_passes_the_burst_conditions():
+    """Seed 0 of the same distribution: the plateau rule takes [1.47, 2.77], after the first escape (0.8), where the
+    fast 95 % decay over their 5 % floor: κ ≈ 1.0 over 1.3 e-folds of it in 1.3 time units. Neither condition of
+    the dead-time check holds (it starts after the first escape; it spans more than an e-fold), so κ0 is defined:
+    a window of an e-fold or more is a measured exponential stretch, whatever follows it, as in the short windows
+    far above threshold whose κ holds with N (Hénon–Heiles and Contopoulos at 5 E_c: 1.4–2.1 e-folds in 2.2–4.3 time
+    units with 2000 orbits). Which stretch is the regime is the window rule's choice over the orbits it has: with
+    20 000 orbits of that seed it is the slow one, κ = 0.26."""
+    from hhscatter.analysis.survival.kappa_conventions import dead_time_check
+    from hhscatter.reproduction.claims.kappa import window_rate
+
+    p = SimpleNamespace(min_survivors=50.0, max_plateau_bias=0.1)
+    lt = _prompt_then_slow(2000, seed=0)
+    small, res, why = window_rate(lt, p, "window rule failed")
+    t_first = lt["t_end"].min()
+    assert why == "" and t_first < res.tau0 < res.t_stop < 6.0  # inside the fast decay, after the first escape
+    efolds = small.kappa * (res.t_stop - res.tau0)
+    assert 1.0 < efolds and res.t_stop - res.tau0 < 2 * np.pi and 0.8 < small.kappa < 1.3
+    assert small.defined and dead_time_check(res.tau0, t_first, small.kappa, t_hi=res.t_stop) == (True, "")
+    # one e-fold less and the same window is the burst's hand-over (the second condition)
+    assert not dead_time_check(res.tau0, t_first, small.kappa, t_hi=res.t_stop, min_efolds=efolds + 0.01)[0]
+    large, res, _ = window_rate(_prompt_then_slow(20000, seed=0), p, "window rule failed")
+    assert large.defined and abs(large.kappa - 0.26) < 0.03 and res.tau0 > 5.0
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_one_exponential_of_2000_orbits_keeps_kappa0_defined_under_the_burst_conditions(seed):
     """A pure exponential (κ = 0.05 after a flight time of 2, no burst): the window spans several e-folds and starts
