@@ -124,8 +124,8 @@ class Params(StudyParams):
     # the labelled set: per disk ensemble with a regular fraction neither 0 nor 1, up to lab_band_n orbits whose shadow
     # growth lies in lab_band and lab_side_n either side, run again with the tangent dynamics to lab_t_max
     lab_band: Numbers = [10.0, 1e7]
-    lab_band_n: Integer = 200
-    lab_side_n: Integer = 25
+    lab_band_n: Integer = 400
+    lab_side_n: Integer = 50
     lab_seed: Integer = 47
     lab_t_max: Number = 3000.0
     lab_ftle_regular: Number = 0.003
