@@ -1128,9 +1128,9 @@ def _pct(v, e=None) -> str:
     return fmt_err(100 * v, 100 * e) + " %" if _is_num(e) else f"{fmt_num(100 * v, 3)} %"
 
 
-def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None, n=None) -> str:
-    """A fraction as value ± stat (± syst), or, at a count of 0, its one-sided bound "< b (95 %)" (a record written
-    before bounds were recorded: from its number of orbits ``n``, by the same estimator)."""
+def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None, syst2=None, n=None) -> str:
+    """A fraction as value ± stat (± syst (± syst2)), or, at a count of 0, its one-sided bound "< b (95 %)" (a record
+    written before bounds were recorded: from its number of orbits ``n``, by the same estimator)."""
     from hhscatter.analysis.stats.intervals import fraction_with_bound
     from hhscatter.publish.formatting import format_bound
 
@@ -1140,8 +1140,9 @@ def _bounded(v, e, upper=None, cl=0.95, *, pct=False, syst=None, n=None) -> str:
         return format_bound(upper, cl=cl, pct=pct)
     if pct:
         out = _pct(v, e)
-        if _is_num(syst) and syst > 0 and _is_num(e) and e > 0:
-            out = out[: -len(" %")] + f" ± {fmt_err(100 * syst, 100 * e).split(' ± ')[0]} %"  # stat's decimals
+        for x in (syst, syst2):
+            if _is_num(x) and x > 0 and _is_num(e) and e > 0:
+                out = out[: -len(" %")] + f" ± {fmt_err(100 * x, 100 * e).split(' ± ')[0]} %"  # stat's decimals
         return out
     return _ve_cell({"value": v, "err": e})
 
@@ -1188,13 +1189,18 @@ def _validity_table(doc, vm, n_of) -> str:
         if v is None:
             out.append(f"| {lab} | {r:g} | {NOT_RUN} | {NOT_RUN} | — | — | — |")
             continue
-        regular = _bounded(
-            v["regular_fraction"],
-            v["regular_err"],
-            v.get("regular_fraction_upper"),
-            pct=True,
-            syst=v.get("regular_syst"),
-            n=n_of.get(v.get("id")),
+        total = v.get("regular_err_total")
+        regular = (
+            _bounded(v["regular_fraction"], total, v.get("regular_fraction_upper"), pct=True, n=n_of.get(v.get("id")))
+            if _is_num(total)
+            else _bounded(
+                v["regular_fraction"],
+                v["regular_err"],
+                v.get("regular_fraction_upper"),
+                pct=True,
+                syst=v.get("regular_syst"),
+                n=n_of.get(v.get("id")),
+            )
         )
         if v.get("n_regular") is not None and v.get("n"):
             regular = f"{v['n_regular']} of {v['n']}: {regular}"
@@ -1219,8 +1225,9 @@ def evidence_tables(doc) -> str:
     ratios = sorted({r["e_ratio"] for r in reg})
     out.append(
         "**Regular fraction** (orbits the shadow indicator calls regular, of all orbits; ± binomial 1σ ± the "
-        "systematic of the threshold, the largest shift with the threshold a decade either side; where no orbit "
-        "is regular, the one-sided 95 % upper bound)\n"
+        "systematic of the threshold, the largest shift with the threshold a decade either side, ± the indicator's "
+        "systematic where a labelled set was run (the share of all orbits the variational FTLE would move across "
+        "the class line); where no orbit is regular, the one-sided 95 % upper bound)\n"
     )
     # energies down, (system, ICs) across: the grid has as many energies as it likes and the table stays as wide as
     # its systems (at 1280 px no column is scrolled out of view)
@@ -1233,6 +1240,7 @@ def evidence_tables(doc) -> str:
             r.get("fraction_cl", 0.95),
             pct=True,
             syst=r.get("syst"),
+            syst2=r.get("syst_indicator"),
             n=r.get("n"),
         )
         for r in reg

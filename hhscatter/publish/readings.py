@@ -444,6 +444,18 @@ def _operator_residuals(get: Loader) -> str:
     )
 
 
+def _regular_side(v: dict, level: float = 0.01) -> str:
+    """'below', 'above' (at or above) or 'near' ``level``: a cell's regular fraction with its total error (stat ⊕
+    threshold ⊕ indicator; a count of 0 by its one-sided bound), 'near' where the error reaches across the level."""
+    f = v["regular_fraction"]
+    if v.get("regular_fraction_upper") is not None:
+        return "below" if v["regular_fraction_upper"] < level else "near"
+    err = v.get("regular_err_total")
+    if err is None:
+        err = math.hypot(v.get("regular_err") or 0.0, v.get("regular_syst") or 0.0)
+    return "below" if f + err < level else ("above" if f - err >= level else "near")
+
+
 def _generality_validity(get: Loader) -> str:
     d = get("generality", None)
     cells = [v for v in d["validity_map"] if v["kappa0_defined"] is not None]
@@ -451,16 +463,20 @@ def _generality_validity(get: Loader) -> str:
     def name(v):
         return f"{v['label']} {v['e_ratio']:g}"
 
-    low = [v for v in cells if v["regular_fraction"] < 0.01]
+    side = {id(v): _regular_side(v) for v in cells}
+    low = [v for v in cells if side[id(v)] == "below"]
+    high = [v for v in cells if side[id(v)] == "above"]
+    near = [name(v) for v in cells if side[id(v)] == "near"]
     low_ill = [name(v) for v in low if not v["kappa0_defined"]]
-    high_def = [name(v) for v in cells if v["regular_fraction"] >= 0.01 and v["kappa0_defined"]]
-    n_high = sum(v["regular_fraction"] >= 0.01 for v in cells)
+    high_def = [name(v) for v in high if v["kappa0_defined"]]
     out = (
-        f"of the {len(cells)} cells of the map with a κ0 verdict, {len(low)} have a regular fraction below 1 %; "
+        f"of the {len(cells)} cells of the map with a κ0 verdict, {len(low)} have a regular fraction below 1 % "
+        "with its total error; "
         f"κ0 is defined at {len(low) - len(low_ill)} of them"
         + (f" and ill-defined at {', '.join(low_ill)}" if low_ill else "")
-        + f". Of the {n_high} cells at or above 1 %, κ0 is defined at {len(high_def)}"
+        + f". Of the {len(high)} cells at or above 1 % with it, κ0 is defined at {len(high_def)}"
         + (f" ({', '.join(high_def)})" if high_def else "")
+        + (f"; the total error reaches across 1 % at {', '.join(near)}" if near else "")
     )
     both: dict[str, list[str]] = {}
     for v in low:
@@ -468,6 +484,44 @@ def _generality_validity(get: Loader) -> str:
             both.setdefault(v["label"], []).append(f"{v['e_ratio']:g}")
     where = "; ".join(f"{k} at {', '.join(x)} E_c" for k, x in both.items())
     return out + f". Both conditions are met for {where}" if where else out
+
+
+def _pc(x: float) -> str:
+    """A fraction in per cent with two significant digits (0 as 0)."""
+    return "0 %" if x == 0 else f"{100 * x:.2g} %"
+
+
+def _generality_indicator_systematic(get: Loader) -> str:
+    """Per disk cell with a labelled set: what was labelled, the two indicators' disagreements, and the indicator
+    systematic beside the threshold's; then in how many cells the one is the larger."""
+    d = get("generality", None)
+    cells = [r for r in d["regular_fraction"] if r.get("labelled")]
+    if not cells:
+        return "no cell of this record has a labelled set (every regular fraction is 0 or 1)"
+    lab0 = cells[0]["labelled"]
+    out = []
+    for r in cells:
+        L = r["labelled"]
+        shift = typographic_minus(f"{100 * L['shift']:+.2g}")
+        out.append(
+            f"{r['label']} {r['e_ratio']:g} E_c: {_int(L['n_labelled'])} labelled ({_int(L['n_band_labelled'])} of "
+            f"the {_int(L['n_band'])} orbits of the band), {_int(L['n_undecided'])} undecided; in the band "
+            f"{L['disagree_to_chaotic']} regular by the shadow and chaotic by the FTLE, {L['disagree_to_regular']} "
+            f"the reverse ({L['disagree_outside']} disagreement{'' if L['disagree_outside'] == 1 else 's'} outside it): "
+            "indicator systematic "
+            f"{_pc(r['syst_indicator'])} (a shift of the fraction by {shift} %), "
+            f"threshold systematic {_pc(r['syst'])}"
+        )
+    larger = [r for r in cells if r["syst_indicator"] > r["syst"]]
+    worst = max(cells, key=lambda r: r["err_total"] or 0.0)
+    return (
+        f"Labelled at t = {lab0['t_label']:g} (regular below λ_T = {lab0['ftle_regular']:g}, chaotic above "
+        f"{lab0['ftle_chaotic']:g}), by cell: "
+        + "; ".join(out)
+        + f". The indicator systematic is the larger of the two in {len(larger)} of {len(cells)} cells; the largest "
+        f"total error is at {worst['label']} {worst['e_ratio']:g} E_c, "
+        f"{_pc(worst['fraction'])} ± {_pc(worst['err_total'])} (stat ⊕ threshold ⊕ indicator)"
+    )
 
 
 def _generality_resc_rule(get: Loader) -> str:
@@ -1388,6 +1442,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.convergence": _operator_convergence,
     "operator.mixed_refinement": _operator_mixed_refinement,
     "generality.validity": _generality_validity,
+    "generality.indicator_systematic": _generality_indicator_systematic,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
     "generality.resc_shift": _generality_resc_shift,

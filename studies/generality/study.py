@@ -9,7 +9,8 @@ momenta), linear drag. Rules in the header of ``studies/generality/study.toml``;
 ``simulate`` — ``[study] parts``: "claims": per system the κ0(E) runs ``<label>_r<r>``, the probe runs
 ``<label>_probe_r<r>``, the dissipative runs ``<label>_g<γ>`` at E0, the section runs ``<label>_cm_r<r>`` and
 ``<label>_sec_g<γ>``; "evidence": the long runs ``<label>_ev_<ics>_r<r>`` and Poincaré runs ``<label>_ps_r<r>``,
-each with the shadow run of its orbits still inside near t_max (``…_shadow``), the κ0 runs ``<label>_map_r<r>`` at
+each with the shadow run of its orbits still inside near t_max (``…_shadow``), the labelled sets
+``<label>_ev_disk_r<r>_label`` (the disk ensembles' ambiguous band run again with the tangent dynamics), the κ0 runs ``<label>_map_r<r>`` at
 the validity map's energies off the claims' grid (the claims' scene) and the r_esc runs ``<label>_resc<R>_…``.
 
 ``analyze`` — claims 1–7 (records {claim, quantity, system, value, err, verdict, note}) and the evidence
@@ -33,6 +34,7 @@ from hhscatter.reproduction.claims.keys import (
     diss_key,
     ev_key,
     grid_key,
+    lab_key,
     map_key,
     map_ratios,
     probe_key,
@@ -119,6 +121,15 @@ class Params(StudyParams):
     ev_times: Numbers = [100.0, 200.0, 400.0, 800.0, 2000.0]
     ev_fit_t0: Number = 100.0
     ev_hazard_edges: Numbers = [100.0, 200.0, 400.0, 800.0, 1400.0, 2000.0]
+    # the labelled set: per disk ensemble with a regular fraction neither 0 nor 1, up to lab_band_n orbits whose shadow
+    # growth lies in lab_band and lab_side_n either side, run again with the tangent dynamics to lab_t_max
+    lab_band: Numbers = [10.0, 1e7]
+    lab_band_n: Integer = 400
+    lab_side_n: Integer = 50
+    lab_seed: Integer = 47
+    lab_t_max: Number = 3000.0
+    lab_ftle_regular: Number = 0.003
+    lab_ftle_chaotic: Number = 0.005
     ps_ratios: Numbers = [1.05, 1.5]
     ps_n: Integer = 150
     ps_t_max: Number = 1000.0
@@ -253,6 +264,25 @@ class _Runs:
         path = self.study.derived(f"{key}_shadow_ics.parquet")
         return pq.read_table(path).to_pandas() if path.exists() else None
 
+    def initial_states(self, key):
+        """traj_id, x0, y0, px0, py0 of every orbit of run ``key``."""
+        from hhscatter.data.read import read_lifetimes
+
+        return read_lifetimes(self.study.raw(key), columns=["traj_id", "x0", "y0", "px0", "py0"])
+
+    def labelled(self, key):
+        """(selection, lifetimes with log_stretch) of the labelled run ``key``; None where none was run."""
+        import pyarrow.parquet as pq
+
+        from hhscatter.data.read import read_lifetimes
+
+        path = self.study.derived(f"{key}_ics.parquet")
+        if not path.exists():
+            return None
+        sel = pq.read_table(path, columns=["traj_id", "growth", "in_band"]).to_pandas()
+        lt = read_lifetimes(self.study.raw(key), columns=["traj_id", "outcome", "t_end", "log_stretch"])
+        return sel, lt
+
     def snapshots(self, key, *, t_from=None, t_to=None, max_id=None):
         import pyarrow.dataset as pads
 
@@ -369,6 +399,8 @@ def _simulate_evidence(study, workers, progress):
                 )
         if ics != p.ev_ics[0]:
             continue
+        if ics == "disk":
+            _simulate_labelled(study, sysl, workers, progress)
         for label, spec, m in sysl:
             _simulate_resc(study, label, spec, m, workers, progress)
         for label, spec, m in sysl:
@@ -387,6 +419,31 @@ def _simulate_evidence(study, workers, progress):
                     sections={"t_from": 0.0, "t_to": p.ps_t_max},
                     radius=p.radius_frac * m.saddle_radius,
                 )
+
+
+def _simulate_labelled(study, sysl, workers, progress):
+    """The labelled sets: per disk ensemble whose regular fraction is neither 0 nor 1, the orbits of its shadow
+    band and a sample either side (:func:`hhscatter.reproduction.claims.chain.labelled_set`) run again from their
+    initial conditions with the tangent dynamics to lab_t_max (raw key ``<label>_ev_disk_r<r>_label``)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from hhscatter.reproduction.claims.chain import labelled_set
+
+    p, runs = study.params, _Runs(study)
+    for label, spec, m in sysl:
+        for r in p.ev_ratios:
+            sel = labelled_set(runs, label, r)
+            if sel is None:
+                continue
+            key = lab_key(label, r)
+            path = study.derived(f"{key}_ics.parquet")
+            pq.write_table(pa.Table.from_pandas(sel, preserve_index=False), path)
+            base = study.scene(ev_key(label, "disk", r), system=spec, energy=r * m.critical_energy, n=p.ev_n)
+            sc = study.scene(
+                key, system=spec, ics=str(path), n=len(sel), t_max=p.lab_t_max, r_esc=base.r_esc, tangent=True
+            )
+            study.run(key, sc, workers=workers, progress=progress)
 
 
 def _simulate_resc(study, label, spec, m, workers, progress):

@@ -677,6 +677,28 @@ def test_validity_map_states_each_cells_count_and_kappa0_rule_and_the_energies_a
     assert "paired error: a bootstrap over the orbits" in out
 
 
+def test_the_regular_fraction_shows_both_systematics_and_the_validity_map_its_total_error(hook):
+    """A record with a labelled set: the regular-fraction table writes value ± stat ± threshold ± indicator, the
+    validity map the value ± the three in quadrature (its rule's error)."""
+    doc = {
+        "config": {"study": {"ratios": [1.05]}},
+        "regular_fraction": [
+            {"id": "b-1.05-disk", "label": "b", "ics": "disk/tangential", "e_ratio": 1.05, "fraction": 0.638}
+            | {"err": 0.005, "syst": 0.03, "syst_indicator": 0.04, "err_total": 0.0502, "n": 10000}
+        ],
+        "survival_long": [],
+        "long_time": [],
+        "validity_map": [
+            {"id": "b-1.05-disk", "label": "b", "e_ratio": 1.05, "regular_fraction": 0.638, "regular_err": 0.005}
+            | {"regular_syst": 0.03, "regular_syst_indicator": 0.04, "regular_err_total": 0.0502, "n": 10000}
+            | {"n_regular": 6380, "kappa0_defined": None, "claim2": None, "exponential": None, "plateau": None}
+        ],
+    }
+    out = hook.evidence_tables(doc)
+    assert "| 1.05 | 63.8 ± 0.5 ± 3.0 ± 4.0 % |" in out
+    assert "| b | 1.05 | 6380 of 10000: 64 ± 5 % |" in out
+
+
 def test_generated_text_writes_a_negative_number_with_the_minus_sign(hook):
     """The hook's output writes a number's sign "−" (as the verdicts and the [[…]] numbers do); code spans, maths,
     HTML attributes and ranges stay as written; the exponent of e-notation is signed "−" too."""

@@ -5,6 +5,7 @@ uncertainties (the inputs here are built by hand, so the expected words are know
 from __future__ import annotations
 
 import copy
+import math
 import re
 from pathlib import Path
 
@@ -733,6 +734,38 @@ def test_the_resc_readings_follow_the_shifts_and_their_errors():
     )
     moves = READINGS["resc.scale_moves"](lambda study, scale: quick if scale == "quick" else paper)
     assert moves.startswith("the κ shifts moved by at most 2.0σ of their quick-scale errors (the largest at E = 0.30")
+
+
+def test_the_validity_reading_splits_the_cells_at_1_percent_by_the_total_error():
+    cells = [
+        {"label": "a", "e_ratio": 1.1, "kappa0_defined": True, "regular_fraction": 0.008, "regular_err_total": 0.004},
+        {"label": "a", "e_ratio": 1.5, "kappa0_defined": True, "regular_fraction": 0.002, "regular_err_total": 0.001},
+        {"label": "a", "e_ratio": 1.05, "kappa0_defined": False, "regular_fraction": 0.3, "regular_err_total": 0.05},
+    ]
+    text = READINGS["generality.validity"](_loader({"generality": {"validity_map": cells}}))
+    assert "of the 3 cells of the map with a κ0 verdict, 1 have a regular fraction below 1 % with its total" in text
+    assert "Of the 1 cells at or above 1 % with it, κ0 is defined at 0" in text
+    assert "the total error reaches across 1 % at a 1.1" in text and "Both conditions are met for a at 1.5 E_c" in text
+
+
+def test_the_indicator_systematic_reading_states_each_labelled_cell_from_its_record():
+    def rec(label, n_band, to_chaotic, to_regular, syst_ind, syst):
+        L = {"t_label": 3000.0, "ftle_regular": 0.003, "ftle_chaotic": 0.005, "n_labelled": 450, "n_band": n_band}
+        L |= {"n_band_labelled": 400, "n_undecided": 12, "disagree_to_chaotic": to_chaotic}
+        L |= {"disagree_to_regular": to_regular, "disagree_outside": 1, "shift": 0.0, "syst": syst_ind}
+        return {"label": label, "e_ratio": 1.05, "fraction": 0.6, "syst": syst, "syst_indicator": syst_ind} | {
+            "err_total": math.hypot(0.005, syst, syst_ind),
+            "labelled": L,
+        }
+
+    doc = {"regular_fraction": [rec("b", 5754, 7, 3, 0.0144, 0.043), rec("c", 8237, 20, 2, 0.045, 0.01)]}
+    doc["regular_fraction"].append({"label": "h", "e_ratio": 2.0, "fraction": 0.0, "labelled": None})
+    text = READINGS["generality.indicator_systematic"](_loader({"generality": doc}))
+    assert "b 1.05 E_c: 450 labelled (400 of the 5\u2009754 orbits of the band), 12 undecided" in text
+    assert "7 regular by the shadow and chaotic by the FTLE, 3 the reverse (1 disagreement outside it)" in text
+    assert "indicator systematic 1.4 %" in text and "threshold systematic 4.3 %" in text
+    assert "the larger of the two in 1 of 2 cells" in text and "largest total error is at c 1.05 E_c" in text
+    assert " h " not in text
 
 
 def _mu_rows(pred_default, pred_second):

@@ -109,6 +109,37 @@ def test_validity_map_cells_off_the_claims_grid_have_their_own_kappa0_run(tiny):
         assert rule is c["kappa0_defined"]
 
 
+def test_labelled_sets_are_run_where_the_regular_fraction_is_neither_0_nor_1(tiny):
+    """Every disk cell with a regular fraction strictly between 0 and 1 has a labelled set, run by the engine with
+    the tangent dynamics (its raw run holds the selected orbits, each with its log-stretch, to lab_t_max or its
+    escape); its record carries the counts and the indicator systematic, and the total error is the three errors in
+    quadrature. The other cells have none."""
+    from hhscatter.data.read import read_lifetimes
+    from hhscatter.reproduction.claims.keys import lab_key
+
+    out, doc = tiny
+    p = doc["config"]["study"]
+    labelled = 0
+    for r in (x for x in doc["regular_fraction"] if x["ics"].startswith("disk")):
+        L = r["labelled"]
+        if not 0 < r["n_regular"] < r["n"]:
+            assert L is None and r["syst_indicator"] is None
+            total = None if r["err"] is None else pytest.approx(math.hypot(r["err"], r["syst"]))
+            assert r["err_total"] == total
+            continue
+        labelled += 1
+        lt = read_lifetimes(out / "raw" / lab_key(r["label"], r["e_ratio"]), columns=["t_end", "log_stretch"])
+        assert len(lt) == L["n_labelled"] and lt["log_stretch"].notna().all() and lt["t_end"].max() <= p["lab_t_max"]
+        assert L["n_band_labelled"] <= min(L["n_band"], p["lab_band_n"]) and L["n_undecided"] <= L["n_labelled"]
+        assert {c["g_max"] for c in L["confusion"]} == {1e3, 1e4, 1e5}
+        assert all(sum(v for k, v in c.items() if k != "g_max") == L["n_labelled"] for c in L["confusion"])
+        assert r["syst_indicator"] == L["syst"] >= abs(L["shift"])
+        assert r["err_total"] == pytest.approx(math.hypot(r["err"], r["syst"], r["syst_indicator"]))
+        (v,) = [c for c in doc["validity_map"] if c["id"] == r["id"]]
+        assert v["regular_err_total"] == r["err_total"] and v["regular_syst_indicator"] == r["syst_indicator"]
+    assert labelled >= 1
+
+
 def test_mu_below_threshold_is_the_microcanonical_well_value_and_tends_to_one_at_the_bottom(tiny):
     """Near the minimum every built-in is harmonic with unit frequency: 2⟨K⟩/E → 1 (virial), and it decreases
     towards E_c where the cubic/quartic terms soften the well."""

@@ -18,6 +18,14 @@ renormalised tangent vector) fixes, among them orbits at island edges whose grow
 saturated sea's: tests/analysis/geometry/test_regularity.py. :func:`threshold_systematic` gives the systematic of
 the threshold choice (the fraction's largest shift with the threshold a decade either side).
 
+A second, independent indicator is the variational FTLE (:func:`variational_indicator`): the log-stretch Λ of a
+tangent vector carried along the orbit by the linearised flow (the engine's tangent dynamics, a scene with
+``tangent = true``), λ_T = Λ(T)/T over [0, T]. On a torus Λ grows like ln t (the shear), so λ_T → 0 like
+ln(t)/t; in the chaotic sea λ_T → λ. An orbit is labelled regular below ``ftle_regular``, chaotic above
+``ftle_chaotic`` (or when it escapes before T: no torus leaves), undecided between.
+:func:`indicator_systematic` compares the two indicators on a labelled subset of the orbits whose shadow growth
+lies in the band between tori and the saturated sea, and scales the disagreements to the whole band.
+
 Conventions: the separation is Euclidean in (x, y, p_x, p_y) (length and momentum units alike: ω = 1); the
 shadow differs by +d0 in x with both momenta scaled by one factor that keeps H(x, y, p_x, p_y) = E (−d0 where
 +d0 leaves no kinetic energy). Every integration is the engine's (a run from an IC table); this module only
@@ -183,6 +191,12 @@ def regular_fraction(n_orbits: int, n_regular: int) -> tuple[float, float]:
     return float(f), float(max(np.sqrt(f * (1 - f) / n_orbits), wilson))
 
 
+#: variational FTLE (1/time) below which an orbit is labelled regular, above which chaotic (undecided between): at
+#: T = 3000 a stretch below e⁹ ≈ 8·10³ (a torus' shear) and above e¹⁵ ≈ 3·10⁶
+FTLE_REGULAR, FTLE_CHAOTIC = 0.003, 0.005
+VARIATIONAL = "variational FTLE"  # the second indicator's name in records
+
+
 #: the thresholds of the systematic: a decade either side of :data:`G_MAX`
 G_MAX_RANGE = (1e3, 1e5)
 
@@ -214,4 +228,119 @@ def threshold_systematic(n_orbits: int, growth, g_max: float = G_MAX, others=G_M
         "stat": stat,
         "syst": float(max(abs(v - value) for v in by.values())),
         "by_threshold": by,
+    }
+
+
+def variational_indicator(
+    lifetimes: pd.DataFrame, t_min: float, *, ftle_regular: float = FTLE_REGULAR, ftle_chaotic: float = FTLE_CHAOTIC
+) -> pd.DataFrame:
+    """variational_indicator(lifetimes, t_min, ftle_regular=0.003, ftle_chaotic=0.005) -> DataFrame per orbit.
+
+    Each orbit's label by its variational finite-time Lyapunov exponent λ_T = Λ/t_end (1/time), Λ the log-stretch
+    of its tangent vector at t_end (the engine's tangent dynamics: the lifetimes table of a scene with
+    ``tangent = true``). An orbit still inside at t_end ≥ ``t_min`` is 'regular' when λ_T < ``ftle_regular``,
+    'chaotic' when λ_T > ``ftle_chaotic``, 'undecided' between; an orbit that escaped (left before t_max) is
+    'chaotic' whatever its λ_T (an orbit on a torus never leaves). Columns: traj_id, t_end, ftle, label.
+
+    Parameters
+    ----------
+    lifetimes : DataFrame
+        traj_id, outcome, t_end (time units), log_stretch of a run with the tangent dynamics (conservative).
+    t_min : float
+        The time (time units) the exponent must span: an orbit censored before ``t_min`` is refused.
+    ftle_regular, ftle_chaotic : float
+        Thresholds on λ_T (1/time), ``ftle_regular`` ≤ ``ftle_chaotic``.
+
+    Raises
+    ------
+    ConfigError
+        A missing column, an orbit still inside that stopped before ``t_min``, thresholds out of order.
+
+    Examples
+    --------
+    >>> lt = pd.DataFrame({"traj_id": [0, 1, 2, 3], "t_end": [3000.0, 3000.0, 3000.0, 120.0],
+    ...                    "outcome": ["censored", "censored", "censored", "escaped"],
+    ...                    "log_stretch": [8.0, 60.0, 12.0, 3.0]})
+    >>> variational_indicator(lt, 3000.0)["label"].tolist()
+    ['regular', 'chaotic', 'undecided', 'chaotic']
+    """
+    check.table(lifetimes, "lifetimes", ["traj_id", "outcome", "t_end", "log_stretch"], min_rows=0)
+    t_min = check.number(t_min, "t_min", positive=True)
+    lo = check.number(ftle_regular, "ftle_regular", positive=True)
+    hi = check.number(ftle_chaotic, "ftle_chaotic", positive=True)
+    if hi < lo:
+        raise ConfigError(f"ftle_chaotic must be ≥ ftle_regular = {lo:g}, got {hi:g}")
+    t = lifetimes["t_end"].to_numpy(float)
+    lam = lifetimes["log_stretch"].to_numpy(float)
+    escaped = (lifetimes["outcome"].astype(str) != "censored").to_numpy()
+    short = ~escaped & (t < t_min)
+    if short.any():
+        raise ConfigError(
+            f"lifetimes: {int(short.sum())} orbit(s) still inside stopped before t_min = {t_min:g}: "
+            "their exponent does not span the time asked"
+        )
+    if not np.isfinite(lam[~escaped]).all():
+        raise ConfigError("lifetimes: log_stretch must be finite (a run with the tangent dynamics)")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ftle = np.where(t > 0, lam / t, np.nan)
+    label = np.where(escaped | (ftle > hi), "chaotic", np.where(ftle < lo, "regular", "undecided"))
+    return pd.DataFrame({"traj_id": lifetimes["traj_id"].to_numpy(np.int64), "t_end": t, "ftle": ftle, "label": label})
+
+
+def indicator_systematic(n_orbits: int, n_band: int, shadow_regular, label, in_band) -> dict:
+    """indicator_systematic(n_orbits, n_band, shadow_regular, label, in_band) -> the second indicator's systematic.
+
+    The labelled orbits (one entry each: ``shadow_regular`` the shadow indicator's verdict at its threshold,
+    ``label`` 'regular', 'chaotic' or 'undecided' by :func:`variational_indicator`, ``in_band`` whether its shadow
+    growth lies in the band between tori and the saturated sea) are compared: a decided label that differs from
+    the shadow's verdict is a disagreement. Those of the band's labelled orbits are scaled to the whole band
+    (``n_band`` orbits of ``n_orbits``: × n_band / n labelled in the band) and give ``syst``, the fraction of all
+    orbits that would change class were the band labelled by the second indicator, and ``shift``, the signed
+    change of the regular fraction (to regular minus to chaotic). Undecided orbits change nothing and are counted.
+    The labelled orbits outside the band (a sample either side) check that the indicators agree there
+    (``disagree_outside``).
+
+    Returns {n_labelled, n_band_labelled, n_undecided, disagree_to_regular, disagree_to_chaotic,
+    disagree_outside, scale, shift, syst} (counts of the labelled orbits; shift and syst fractions of ``n_orbits``).
+
+    >>> r = indicator_systematic(1000, 200, [True, True, True, False, False, True],
+    ...                          ["regular", "chaotic", "undecided", "regular", "chaotic", "chaotic"],
+    ...                          [True, True, True, True, True, False])
+    >>> r["scale"], r["syst"], r["shift"]      # 5 of 200 labelled: ×40; 2 flips → 80 orbits of 1000
+    (40.0, 0.08, 0.0)
+    """
+    n_orbits = check.count(n_orbits, "n_orbits", 1)
+    n_band = check.count(n_band, "n_band", 0)
+    if n_band > n_orbits:
+        raise ConfigError(f"n_band must be ≤ n_orbits = {n_orbits}, got {n_band}")
+    reg = np.asarray(shadow_regular)
+    lab = np.asarray(label, dtype=object)
+    band = np.asarray(in_band)
+    if reg.dtype != bool or band.dtype != bool:
+        raise ConfigError("shadow_regular and in_band must be booleans, one per labelled orbit")
+    if not (reg.shape == lab.shape == band.shape) or reg.ndim != 1:
+        raise ConfigError(
+            f"shadow_regular, label and in_band must have one entry per labelled orbit, got "
+            f"{reg.shape}, {lab.shape}, {band.shape}"
+        )
+    bad = set(lab.tolist()) - {"regular", "chaotic", "undecided"}
+    if bad:
+        raise ConfigError(f"label must hold 'regular', 'chaotic' or 'undecided', got {sorted(map(str, bad))}")
+    n_band_lab = int(band.sum())
+    if n_band_lab > n_band:
+        raise ConfigError(f"in_band marks {n_band_lab} labelled orbits, more than n_band = {n_band}")
+    to_reg = ~reg & (lab == "regular")
+    to_cha = reg & (lab == "chaotic")
+    scale = n_band / n_band_lab if n_band_lab else 0.0
+    up, down = int((to_reg & band).sum()), int((to_cha & band).sum())
+    return {
+        "n_labelled": int(lab.size),
+        "n_band_labelled": n_band_lab,
+        "n_undecided": int((lab == "undecided").sum()),
+        "disagree_to_regular": up,
+        "disagree_to_chaotic": down,
+        "disagree_outside": int(((to_reg | to_cha) & ~band).sum()),
+        "scale": float(scale),
+        "shift": float(scale * (up - down) / n_orbits),
+        "syst": float(scale * (up + down) / n_orbits),
     }

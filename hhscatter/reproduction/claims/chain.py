@@ -17,7 +17,7 @@ import pandas as pd
 
 from hhscatter.analysis.survival.fits import lifetimes_to_arrays
 from hhscatter.reproduction.claims import cmeasure, dissipative, evidence, kappa, mu
-from hhscatter.reproduction.claims.keys import cm_ratios, ev_key, map_key, map_ratios, ps_key
+from hhscatter.reproduction.claims.keys import cm_ratios, ev_key, lab_key, map_key, map_ratios, ps_key
 from hhscatter.reproduction.claims.records import RULES, Claims
 from hhscatter.reproduction.claims.resc import r_esc_rule, resc_kappa_rows, resc_rows
 
@@ -35,7 +35,9 @@ def check_params(p) -> None:
     ValueError
         probe_ratios, cm_ratios not among ratios; gammas not increasing or without 0 and mu_gamma; ratios not above
         1 or mc_ratios not below; c5_ratio not among cm_ratios or outside (1, e0_ratio); ev_times beyond ev_t_max
-        or ev_window outside (0, min(ev_t_max, ps_t_max)); resc_ratios without e0_ratio; cm_t_max ≤ cm_t_to.
+        or ev_window outside (0, min(ev_t_max, ps_t_max)); resc_ratios without e0_ratio; cm_t_max ≤ cm_t_to;
+        lab_t_max below 1.5 ev_t_max, lab_band not (lo, hi) with 0 < lo < hi, lab_ftle_regular not in
+        (0, lab_ftle_chaotic].
 
     Examples
     --------
@@ -66,6 +68,15 @@ def check_params(p) -> None:
         raise ValueError(f"[study].resc_ratios must contain e0_ratio = {p.e0_ratio:g} (2⟨K⟩/E measured at E0)")
     if not p.cm_t_max > p.cm_t_to:
         raise ValueError("[study].cm_t_max must exceed cm_t_to (orbits still inside at t_max, censored, are dropped)")
+    if not p.lab_t_max >= 1.5 * p.ev_t_max:
+        raise ValueError(
+            f"[study].lab_t_max = {p.lab_t_max:g} must be at least 1.5 ev_t_max = {1.5 * p.ev_t_max:g} (the labels "
+            "come from a longer run than the indicator's)"
+        )
+    if len(p.lab_band) != 2 or not 0 < p.lab_band[0] < p.lab_band[1]:
+        raise ValueError(f"[study].lab_band must be (lo, hi) with 0 < lo < hi, got {list(p.lab_band)}")
+    if not 0 < p.lab_ftle_regular <= p.lab_ftle_chaotic:
+        raise ValueError("[study].lab_ftle_regular must be positive and at most lab_ftle_chaotic")
 
 
 def _system_claims(runs, claims, label, spec, m):
@@ -205,11 +216,54 @@ def _ensemble_evidence(runs, label, head, ics, r, t_from, grid):
         "g_max": p.ev_g_max,
         "delta": p.ev_delta,
     }
+    reg.update(_labelled_evidence(runs, label, ics, r, len(lt), ind, reg))
     regular = ind.loc[ind["regular"].astype(bool), "traj_id"]
     rows, fit = evidence.long_time_record(lt, regular, p.ev_times, p.ev_fit_t0, p.ev_hazard_edges)
     surv = [{**at, **row, "id": f"{at['id']}-t{row['t']:g}"} for row in rows] if ics == "disk" else []
     curves = evidence.decay_curves(lt, regular, grid).assign(label=label, e_ratio=r, ics=ics)
     return reg, surv, {**at, **fit}, curves
+
+
+def labelled_set(runs, label, r):
+    """The orbits of the disk ensemble at E = r·E_c to label by the variational FTLE (traj_id, growth, in_band and
+    their initial states x, y, px, py), or None where its regular fraction is 0 or 1
+    (:func:`~hhscatter.reproduction.claims.evidence.labelled_selection`; the study's lab_* parameters)."""
+    p = runs.params
+    key = ev_key(label, "disk", r)
+    lt, ind = _indicator(runs, key, p.ev_t_max - p.ev_window)
+    sel = evidence.labelled_selection(ind, len(lt), p.lab_band, p.lab_band_n, p.lab_side_n, p.lab_seed)
+    if sel is None:
+        return None
+    ics = runs.initial_states(key).set_index("traj_id").loc[sel["traj_id"]]
+    return sel.assign(**{q: ics[f"{q}0"].to_numpy() for q in ("x", "y", "px", "py")})
+
+
+def _labelled_evidence(runs, label, ics, r, n, ind, reg) -> dict:
+    """The indicator systematic of one ensemble's record: {syst_indicator, err_total, labelled} (syst_indicator and
+    labelled None where no labelled set was run: other ICs, or a regular fraction of 0 or 1; err_total, the binomial
+    error and both systematics in quadrature, None at a count of 0, where the fraction is a one-sided bound)."""
+    from hhscatter.analysis.geometry.regularity import G_MAX_RANGE  # deferred: scipy loads on first use
+
+    p = runs.params
+    got = runs.labelled(lab_key(label, r)) if ics == "disk" else None
+    rec = None
+    if got is not None:
+        sel, lt = got
+        rec = evidence.indicator_record(
+            n,
+            ind,
+            sel,
+            lt,
+            p.lab_t_max,
+            band=p.lab_band,
+            ftle_regular=p.lab_ftle_regular,
+            ftle_chaotic=p.lab_ftle_chaotic,
+            thresholds=[p.ev_g_max, *sorted(set(map(float, G_MAX_RANGE)) - {float(p.ev_g_max)})],
+        )
+    syst = None if rec is None else rec["syst"]
+    # at a count of 0 the fraction is a one-sided bound, no error to add to
+    total = None if reg["err"] is None else evidence.total_error(reg["err"], reg["syst"], syst)
+    return {"syst_indicator": syst, "err_total": total, "labelled": rec}
 
 
 def _map_kappa_rows(runs, systems) -> list:
@@ -259,7 +313,13 @@ def validity_rules(p) -> dict:
             f"n_regular of n orbits regular by the shadow indicator (growth < {p.ev_g_max:g} after "
             f"t = {p.ev_t_max - p.ev_window:g}); orbits that left before, and those crossing the section in "
             "neither run, count as not regular; ± its binomial 1σ, at a count of 0 its one-sided 95 % upper "
-            "bound instead; ± the threshold's systematic (the largest shift with the threshold a decade either side)"
+            "bound instead; ± the threshold's systematic (the largest shift with the threshold a decade either side); "
+            "± the indicator's systematic where the fraction is neither 0 nor 1 (the share of all orbits that would "
+            f"change class were the orbits with a shadow growth in ({p.lab_band[0]:g}, {p.lab_band[1]:g}) labelled "
+            f"by their variational FTLE over [0, {p.lab_t_max:g}]: regular below {p.lab_ftle_regular:g}, chaotic "
+            f"above {p.lab_ftle_chaotic:g} or when the orbit leaves, undecided between; measured on up to "
+            f"{p.lab_band_n} of them and scaled to the whole band); the map's error is the total, the three in "
+            "quadrature"
         ),
         "kappa0_defined": evidence.kappa0_rule(p.max_plateau_bias, p.min_survivors),
         "kappa0_source": (

@@ -10,6 +10,9 @@ ensemble to t_max with the section recorded near its end and the shadow runs of 
   fit of all orbits from t0 (P∞, κ_tail: :func:`hhscatter.analysis.survival.long_time.fit_plateau_exponential`),
   the single-exponential fit and the hazard of the non-regular orbits alone, and the fraction of the orbits still
   inside at t_max that the indicator calls regular (the only ones called "trapped");
+* :func:`labelled_selection` and :func:`indicator_record` — the orbits of an ensemble's ambiguous band (and a
+  sample either side) that are labelled by a second indicator, the variational FTLE of a longer run, and the
+  regular fraction's indicator systematic from the two indicators' disagreements;
 * :func:`validity_map` — per (system, E/E_c): the regular fraction beside claim 1's verdict (κ0 defined under the
   paper's convention), claim 2's where measured, and whether one exponential describes the non-regular orbits.
 
@@ -30,8 +33,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 
-from hhscatter.analysis.geometry.regularity import G_MAX, threshold_systematic
+from hhscatter.analysis.geometry.regularity import (
+    G_MAX,
+    indicator_systematic,
+    threshold_systematic,
+    variational_indicator,
+)
 from hhscatter.analysis.stats.goodness import TOO_FEW
 from hhscatter.analysis.stats.intervals import fraction_with_bound
 from hhscatter.analysis.stats.measured import Measured
@@ -79,6 +88,95 @@ def regular_record(lifetimes, indicator, g_max: float = G_MAX) -> dict:
         "n_none": int((indicator["kind"] == "none").sum()),
         "n_escaped_before": int(n - len(indicator)),
     }
+
+
+def labelled_selection(indicator, n: int, band, n_band: int, n_side: int, seed: int):
+    """labelled_selection(indicator, n, band, n_band, n_side, seed) -> DataFrame[traj_id, growth, in_band] or None.
+
+    The orbits of an ensemble of ``n`` orbits to label by a second indicator: None where the regular fraction (by
+    the shadow indicator's frame ``indicator``: traj_id, regular, growth) is 0 or 1 (no ambiguity to resolve);
+    else the orbits whose shadow growth lies in the open ``band`` (lo, hi) — at most ``n_band`` of them, drawn
+    without replacement — and ``n_side`` orbits drawn from those below lo and from those at or above hi (an
+    infinite growth: one of the pair escaped), all draws from ``seed`` (the same orbits at every run).
+
+    >>> ind = pd.DataFrame({"traj_id": range(6), "regular": [True] * 3 + [False] * 3,
+    ...                     "growth": [2.0, 50.0, 3e3, 1e5, 1e9, np.inf]})
+    >>> sel = labelled_selection(ind, 10, (10.0, 1e7), 10, 1, 0)
+    >>> sel["in_band"].tolist(), len(sel)
+    ([False, True, True, True, False], 5)
+    """
+    n_reg = int(indicator["regular"].sum()) if len(indicator) else 0
+    if n_reg == 0 or n_reg == n:
+        return None
+    lo, hi = (float(x) for x in band)
+    g = indicator["growth"].to_numpy(float)
+    ids = indicator["traj_id"].to_numpy(np.int64)
+    rng = np.random.default_rng(seed)
+    inside = (g > lo) & (g < hi)
+    below, above = ~np.isnan(g) & (g <= lo), ~np.isnan(g) & (g >= hi)
+
+    def draw(mask, k):
+        pick = np.flatnonzero(mask)
+        return np.sort(rng.choice(pick, size=min(k, pick.size), replace=False)) if pick.size else pick
+
+    rows = np.concatenate([draw(below, n_side), draw(inside, n_band), draw(above, n_side)])
+    rows = np.sort(rows)
+    return pd.DataFrame({"traj_id": ids[rows], "growth": g[rows], "in_band": inside[rows]})
+
+
+def indicator_record(
+    n: int, indicator, selection, labelled_lifetimes, t_min: float, *, band, ftle_regular, ftle_chaotic, thresholds
+) -> dict:
+    """indicator_record(n, indicator, selection, labelled_lifetimes, t_min, band=, ftle_regular=, ftle_chaotic=,
+    thresholds=) -> the labelled set's record of one ensemble of ``n`` orbits.
+
+    ``indicator``: the shadow indicator's frame (traj_id, growth); ``selection``: :func:`labelled_selection`'s
+    frame; ``labelled_lifetimes``: the lifetimes (with log_stretch) of the selection run again with the tangent
+    dynamics to ``t_min`` or beyond. Labels by
+    :func:`~hhscatter.analysis.geometry.regularity.variational_indicator`; per shadow threshold of ``thresholds``
+    (the first the indicator's own) the confusion against the labels (``confusion``: rows {g_max, regular_regular,
+    regular_chaotic, chaotic_regular, chaotic_chaotic, regular_undecided, chaotic_undecided}, shadow verdict first)
+    and at the first threshold the systematic
+    (:func:`~hhscatter.analysis.geometry.regularity.indicator_systematic`): n_band (the band's orbits in the
+    ensemble), n_labelled, n_undecided, the disagreements, shift and syst (fractions of all n orbits).
+    """
+    lab = variational_indicator(labelled_lifetimes, t_min, ftle_regular=ftle_regular, ftle_chaotic=ftle_chaotic)
+    sel = selection.merge(lab[["traj_id", "label", "ftle"]], on="traj_id", how="inner")
+    if len(sel) != len(selection):
+        raise ValueError(f"the labelled run holds {len(sel)} of the {len(selection)} selected orbits")
+    g_all = indicator["growth"].to_numpy(float)
+    lo, hi = (float(x) for x in band)
+    n_band = int(((g_all > lo) & (g_all < hi)).sum())
+    g, label = sel["growth"].to_numpy(float), sel["label"].to_numpy(object)
+    confusion = []
+    for gm in thresholds:
+        reg = g < gm
+        row = {"g_max": float(gm)}
+        for shadow, s_mask in (("regular", reg), ("chaotic", ~reg)):
+            for lb in ("regular", "chaotic", "undecided"):
+                row[f"{shadow}_{lb}"] = int((s_mask & (label == lb)).sum())
+        confusion.append(row)
+    ind = indicator_systematic(n, n_band, g < float(thresholds[0]), label, sel["in_band"].to_numpy(bool))
+    return {
+        "indicator": "variational FTLE",
+        "t_label": float(t_min),
+        "ftle_regular": float(ftle_regular),
+        "ftle_chaotic": float(ftle_chaotic),
+        "band": [lo, hi],
+        "n_band": n_band,
+        **ind,
+        "confusion": confusion,
+    }
+
+
+def total_error(*parts) -> float | None:
+    """total_error(stat, syst, …) -> √(Σ parts²), the parts that are None left out (None when all are).
+
+    >>> total_error(0.003, 0.004, None)
+    0.005
+    """
+    xs = [float(x) for x in parts if x is not None]
+    return round(math.sqrt(sum(x * x for x in xs)), 12) if xs else None
 
 
 def long_time_record(lifetimes, regular_ids, times, t0: float, hazard_edges) -> tuple[list, dict]:
@@ -268,7 +366,9 @@ def validity_map(
     ``regular``.
 
     Fields: the regular fraction's count (n_regular of n, regular_fraction ± err, its one-sided bound
-    ``regular_fraction_upper`` at a count of 0, the threshold systematic ``regular_syst``); claim 1's κ0 under the
+    ``regular_fraction_upper`` at a count of 0, the threshold systematic ``regular_syst``, the indicator systematic
+    ``regular_syst_indicator`` where a labelled set was run, and ``regular_err_total``, the three in quadrature:
+    the error the map's rule uses); claim 1's κ0 under the
     paper's convention (all orbits, plateau windows) from the ``kappa`` records at that E/E_c (the claims' grid, or a
     κ0 run of the map with the claims' scene: ``kappa0_source``): ``kappa0`` (value, err; 1/time), ``kappa0_n``,
     ``trapped_fraction`` (still inside at t_max), ``plateau_bias`` (that fraction over P at the window's end; None
@@ -331,6 +431,8 @@ def validity_map(
                 "regular_err": r["err"],
                 **({"regular_fraction_upper": r["fraction_upper"]} if r.get("fraction_upper") is not None else {}),
                 "regular_syst": r.get("syst"),
+                "regular_syst_indicator": r.get("syst_indicator"),
+                "regular_err_total": r.get("err_total"),
                 "kappa0_defined": bool(k[0]["defined"]) if k else None,
                 **kap,
                 "claim2": c2[0]["verdict"] if c2 else None,

@@ -68,3 +68,9 @@ def map_ratios(p) -> list:
     [1.7, 5.0]
     """
     return [float(r) for r in p.ev_ratios if not any(abs(float(r) - float(x)) < 1e-9 for x in p.ratios)]
+
+
+def lab_key(label: str, r: float) -> str:
+    """lab_key('barbanis', 1.05) -> 'barbanis_ev_disk_r1.050_label': the labelled set of the disk ensemble at
+    E = r·E_c (its band's orbits and a sample either side, run again with the tangent dynamics to a longer time)."""
+    return f"{ev_key(label, 'disk', r)}_label"

@@ -12,11 +12,14 @@ from scipy.integrate import solve_ivp
 
 from hhscatter.analysis.geometry.regularity import (
     G_MAX,
+    indicator_systematic,
     regular_fraction,
     shadow_ics,
     shadow_indicator,
+    variational_indicator,
 )
 from hhscatter.integrate.engine import run_chunk
+from hhscatter.outcomes import OUTCOMES
 from hhscatter.scene.scene import Scene, SectionWindow
 
 E = 0.125
@@ -131,3 +134,70 @@ def test_threshold_agrees_with_a_long_reference_on_orbits_spanning_the_ambiguous
     for g_max in (G_MAX / 10, G_MAX, G_MAX * 10):
         called = np.where(g < g_max, "regular", "chaotic")
         assert (called[decided] == label[decided]).all(), (g_max, list(zip(BAND_YS, ref, g)))
+
+
+def _tangent_lifetimes(ics, T):
+    """The engine's tangent run of ``ics`` to T (Hénon–Heiles, bounded at E = 1/8: every orbit censored at T)."""
+    lt = run_chunk(Scene(energy=0.2, n=len(ics), t_max=T, tangent=True), ics, np.arange(len(ics))).lifetimes
+    out = pd.DataFrame({k: lt[k] for k in ("traj_id", "t_end", "log_stretch")})
+    return out.assign(outcome=np.asarray(OUTCOMES)[np.asarray(lt["outcome"])])
+
+
+def test_variational_indicator_labels_tori_and_the_sea_as_an_independent_integration_does():
+    T = 600.0
+    ics = _section_ics(np.array([-0.35, -0.30, -0.20, -0.10]))
+    ref = np.array([_ftle_reference(z, T) for z in ics])
+    assert (ref[:2] < 1e-3).all() and (ref[2:] > 0.02).all()  # two tori, two chaotic orbits (the reference says)
+    lab = variational_indicator(_tangent_lifetimes(ics, T), T)
+    assert lab["label"].tolist() == ["regular", "regular", "chaotic", "chaotic"]
+    # the chaotic sea: the engine's exponent is the reference's λ_T (the same orbit, independent integrators;
+    # after e^{λT} ≈ e^{30} the two trajectories differ, their exponents over the sea do not by much)
+    np.testing.assert_allclose(lab["ftle"][2:], ref[2:], rtol=0.35)
+    # the tori: both exponents are those of a linear shear, Λ = λ_T·T of order ln(shear·T), far below the sea's
+    assert (np.abs(lab["ftle"][:2] * T - ref[:2] * T) < 3.0).all()
+
+
+def test_variational_ftle_of_a_torus_falls_like_ln_t_over_t_and_the_sea_keeps_its_lambda():
+    ics = _section_ics(np.array([-0.35, -0.10]))
+    ftle = {T: variational_indicator(_tangent_lifetimes(ics, T), T)["ftle"].to_numpy() for T in (300.0, 2400.0)}
+    # the torus: its stretch stays within ln(1 + t) + O(1) (a shear at most: u(0) need not lie across the tori), so
+    # λ_T falls at least like ln(t)/t and is far below the labels' threshold
+    for T in (300.0, 2400.0):
+        assert abs(ftle[T][0] * T) < np.log1p(T) + 1.0, (T, ftle[T][0] * T)
+    assert abs(ftle[2400.0][0]) < (np.log1p(2400.0) + 1.0) / 2400.0 < 0.005
+    # the sea: over the long time λ_T is the independent integration's λ (within the finite-time spread), far
+    # above the torus' λ_T
+    assert ftle[2400.0][1] == pytest.approx(_ftle_reference(ics[1], 2400.0), rel=0.35)
+    assert ftle[2400.0][1] > 20 * ftle[2400.0][0]
+
+
+def test_variational_indicator_calls_an_escaped_orbit_chaotic_and_refuses_bad_tables():
+    lt = pd.DataFrame(
+        {"traj_id": [0, 1], "outcome": ["censored", "escaped"], "t_end": [3000.0, 50.0], "log_stretch": [3.0, 0.1]}
+    )
+    assert variational_indicator(lt, 3000.0)["label"].tolist() == ["regular", "chaotic"]
+    with pytest.raises(ValueError, match="t_min"):
+        variational_indicator(lt.assign(t_end=[1000.0, 50.0]), 3000.0)
+    with pytest.raises(ValueError, match="log_stretch"):
+        variational_indicator(lt.drop(columns="log_stretch"), 3000.0)
+    with pytest.raises(ValueError, match="ftle_chaotic"):
+        variational_indicator(lt, 3000.0, ftle_regular=0.01, ftle_chaotic=0.005)
+
+
+def test_indicator_systematic_scales_the_bands_disagreements_to_the_whole_band():
+    # 500 orbits, 60 in the band, 6 of them labelled: ×10. In the band: two called chaotic by the shadow are
+    # regular by the label, one called regular is chaotic, one undecided, two agree; outside: one disagreement.
+    shadow = [False, False, True, True, True, False, True, False]
+    label = ["regular", "regular", "chaotic", "undecided", "regular", "chaotic", "chaotic", "chaotic"]
+    band = [True, True, True, True, True, True, False, False]
+    r = indicator_systematic(500, 60, shadow, label, band)
+    assert r["scale"] == 10.0
+    assert (r["disagree_to_regular"], r["disagree_to_chaotic"], r["disagree_outside"]) == (2, 1, 1)
+    assert r["n_labelled"] == 8 and r["n_band_labelled"] == 6 and r["n_undecided"] == 1
+    assert r["syst"] == pytest.approx(30 / 500) and r["shift"] == pytest.approx(10 / 500)
+    with pytest.raises(ValueError, match="n_band"):
+        indicator_systematic(500, 5, shadow, label, band)
+    with pytest.raises(ValueError, match="label"):
+        indicator_systematic(500, 60, shadow, ["maybe"] * 8, band)
+    with pytest.raises(ValueError, match="one entry per labelled orbit"):
+        indicator_systematic(500, 60, shadow[:-1], label, band)

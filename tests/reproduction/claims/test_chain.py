@@ -26,6 +26,10 @@ GOOD = dict(
     resc_ratios=[1.2, 1.8],
     cm_t_to=200.0,
     cm_t_max=300.0,
+    lab_t_max=600.0,
+    lab_band=[10.0, 1e7],
+    lab_ftle_regular=0.003,
+    lab_ftle_chaotic=0.005,
 )
 
 
@@ -48,6 +52,10 @@ def test_consistent_parameters_pass():
         ({"ev_window": 300.0}, "ev_window"),
         ({"resc_ratios": [1.2]}, "resc_ratios"),
         ({"cm_t_max": 200.0}, "cm_t_max"),
+        ({"lab_t_max": 500.0}, "lab_t_max"),
+        ({"lab_band": [1e7, 10.0]}, "lab_band"),
+        ({"lab_band": [10.0]}, "lab_band"),
+        ({"lab_ftle_regular": 0.01}, "lab_ftle_regular"),
     ],
 )
 def test_contradicting_parameters_are_refused_naming_the_key(change, key):

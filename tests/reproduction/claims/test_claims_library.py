@@ -12,10 +12,13 @@ from hhscatter.model.spec import system_from_spec
 from hhscatter.reproduction.claims.dissipative import claim6
 from hhscatter.reproduction.claims.evidence import (
     first_below,
+    indicator_record,
     kappa0_defined_by_rule,
     kappa0_rule,
+    labelled_selection,
     long_time_record,
     regular_record,
+    total_error,
     validity_map,
 )
 from hhscatter.reproduction.claims.kappa import kappa_rows
@@ -149,6 +152,58 @@ def test_validity_map_joins_claims_and_evidence_by_system_and_energy():
         "barbanis": {"from": 2.0, "text": "from 2 E_c on"}
     }
     assert first_below(reg, ics="disk/tangential")["barbanis"]["from"] is None
+
+
+def test_labelled_selection_takes_the_band_and_a_sample_either_side_and_skips_a_fraction_of_0_or_1():
+    g = np.array([1.0, 2.0, 3.0, 20.0, 300.0, 4e3, 5e4, 6e5, 1e8, 2e8, np.inf, np.nan])
+    ind = pd.DataFrame({"traj_id": np.arange(100, 112), "growth": g, "regular": g < 1e4})
+    sel = labelled_selection(ind, 1000, (10.0, 1e7), 3, 2, 5)
+    band = sel[sel["in_band"]]
+    assert len(band) == 3 and ((band["growth"] > 10) & (band["growth"] < 1e7)).all()
+    assert (sel["growth"] <= 10).sum() == 2 and (sel["growth"] >= 1e7).sum() == 2 and sel["growth"].notna().all()
+    again = labelled_selection(ind, 1000, (10.0, 1e7), 3, 2, 5)
+    assert sel.equals(again)  # the same seed: the same orbits
+    assert labelled_selection(ind.assign(regular=False), 1000, (10.0, 1e7), 3, 2, 5) is None
+    assert labelled_selection(ind.assign(regular=True), 12, (10.0, 1e7), 3, 2, 5) is None
+
+
+def test_indicator_record_carries_the_confusion_per_threshold_and_the_scaled_systematic():
+    ids = np.arange(6)
+    ind = pd.DataFrame({"traj_id": np.arange(50), "growth": np.r_[[5.0, 50.0, 2e3, 2e4, 3e5, 1e9], np.full(44, 40.0)]})
+    sel = pd.DataFrame({"traj_id": ids, "growth": ind["growth"][:6], "in_band": [False, True, True, True, True, False]})
+    lt = pd.DataFrame(  # labels at T = 3000: regular (Λ < 9), chaotic (Λ > 15 or escaped), undecided between
+        {
+            "traj_id": ids,
+            "outcome": ["censored"] * 5 + ["escaped"],
+            "t_end": [3000.0] * 5 + [700.0],
+            "log_stretch": [2.0, 40.0, 12.0, 5.0, 30.0, 1.0],
+        }
+    )
+    rec = indicator_record(
+        200, ind, sel, lt, 3000.0, band=(10.0, 1e7), ftle_regular=0.003, ftle_chaotic=0.005, thresholds=[1e4, 1e3, 1e5]
+    )
+    # band of the ensemble: 4 of the first 6 and the 44 at G = 40 → 48; labelled in the band: 4 → ×12.
+    # At 1e4 in the band: 50 (regular) is chaotic, 2e3 (regular) undecided, 2e4 (chaotic) regular, 3e5 agrees.
+    assert rec["n_band"] == 48 and rec["n_labelled"] == 6 and rec["n_band_labelled"] == 4 and rec["n_undecided"] == 1
+    assert (rec["disagree_to_regular"], rec["disagree_to_chaotic"], rec["disagree_outside"]) == (1, 1, 0)
+    assert rec["syst"] == pytest.approx(2 * 12 / 200) and rec["shift"] == 0.0
+    c = {row["g_max"]: row for row in rec["confusion"]}
+    assert [c[1e4][k] for k in ("regular_regular", "regular_chaotic", "regular_undecided")] == [1, 1, 1]
+    assert [c[1e4][k] for k in ("chaotic_regular", "chaotic_chaotic", "chaotic_undecided")] == [1, 2, 0]
+    assert c[1e3]["chaotic_undecided"] == 1 and c[1e5]["regular_regular"] == 2  # 2e3 above 1e3; 2e4 below 1e5
+    with pytest.raises(ValueError, match="labelled run"):
+        indicator_record(
+            200, ind, sel, lt.iloc[:5], 3000.0, band=(10.0, 1e7), ftle_regular=0.003, ftle_chaotic=0.005,
+            thresholds=[1e4],
+        )  # fmt: skip
+
+
+def test_validity_map_carries_the_total_error_of_the_regular_fraction():
+    reg = {"system": "barbanis", "label": "b", "e_ratio": 1.05, "ics": "disk/tangential", "fraction": 0.6}
+    r = {**reg, "err": 0.003, "syst": 0.004, "syst_indicator": 0.012, "err_total": total_error(0.003, 0.004, 0.012)}
+    (v,) = validity_map([r], [], [], [], ics="disk/tangential")
+    assert v["regular_err_total"] == pytest.approx(0.013) and v["regular_syst_indicator"] == 0.012
+    assert total_error(0.003, 0.004, None) == pytest.approx(0.005) and total_error(None) is None
 
 
 def _taus(obs, lo, hi, pred, pred_err):
