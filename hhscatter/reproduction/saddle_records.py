@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from hhscatter.analysis.geometry.saddle import dimension_order, mean_lyapunov
-from hhscatter.analysis.geometry.saddle_checks import interval_lyapunov, tmin_trend
+from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_lyapunov, low_ftle_share, tmin_trend
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 
@@ -40,7 +40,9 @@ __all__ = [
     "d1_precision",
     "dimension_row",
     "dimension_summary",
+    "fluctuation_record",
     "gap_row",
+    "hyperbolic_record",
     "gap_summary",
     "lyapunov_by_t_min",
     "mid_lyapunov_record",
@@ -311,10 +313,103 @@ def _trend(rows, name):
             "converged": tr.converged}  # fmt: skip
 
 
+def fluctuation_record(tangent, kappa: float, kappa_err: float, *, n_boot: int = 1000) -> dict:
+    """fluctuation_record(tangent, kappa, kappa_err, *, n_boot=1000) -> {"ftle_fluctuation": {...}} or
+    {"ftle_fluctuation_note": why none}.
+
+    ``tangent`` holds the selected orbits' ``log_stretch`` and ``t_end`` (time units) over their whole lives; κ
+    and its error in 1/time. The keys: ``d2`` (d₂ implied by κ and the orbits' finite-time exponents, the
+    partition form of :func:`~hhscatter.analysis.geometry.saddle_checks.ftle_dimension`), ``shift`` (d₂ − (1 −
+    κ/λ̄) with λ̄ = ΣΛ/ΣT: the fluctuations' part, an upper bound as it includes the way in and out),
+    ``shift_cumulant`` (the same in the Gaussian form, or why it has none), ``diffusion`` (D = Σ(Λ − λ̄T)²/ΣT, 1/time), ``n_orbits``.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> rng = np.random.default_rng(0)
+    >>> T = rng.uniform(50.0, 150.0, 2000)
+    >>> tg = pd.DataFrame({"t_end": T, "log_stretch": 0.5 * T + np.sqrt(0.1 * T) * rng.normal(size=T.size)})
+    >>> r = fluctuation_record(tg, 0.15, 0.001, n_boot=20)["ftle_fluctuation"]
+    >>> round(r["shift"]["value"], 3), round(r["shift_cumulant"]["value"], 3), round(r["diffusion"]["value"], 2)
+    (-0.009, -0.01, 0.1)
+    """
+    L, T = tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy()
+    out = {}
+    for form in ("partition", "cumulant"):
+        try:
+            out[form] = ftle_dimension(L, T, kappa, kappa_err, q=2.0, form=form, n_boot=n_boot, seed=0)
+        except ConfigError as exc:
+            out[form] = f"{form} form: {exc}"
+    e, c = out["partition"], out["cumulant"]
+    if isinstance(e, str):
+        return {"ftle_fluctuation_note": e}
+    return {"ftle_fluctuation": {"q": e.q, "d2": Measured(e.value, e.err).to_dict(),
+                                 "shift": Measured(e.shift, e.shift_err).to_dict(),
+                                 "shift_cumulant": c if isinstance(c, str) else Measured(c.shift, c.shift_err).to_dict(),
+                                 "diffusion": Measured(e.diffusion, e.diffusion_err).to_dict(),
+                                 "n_orbits": e.n_orbits}}  # fmt: skip
+
+
+def hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot: int = 1000) -> dict:
+    """hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot=1000) ->
+    {"hyperbolic": {...}} or {"hyperbolic_note": why none}.
+
+    The selected orbits whose finite-time exponent Λ/T lies below a fraction of λ̄
+    (:func:`~hhscatter.analysis.geometry.saddle_checks.low_ftle_share`), at each of ``thresholds`` (the middle one
+    the stated rule, the others its systematic), and the relation's inputs from the other orbits, the hyperbolic
+    part, at the middle threshold. ``tangent`` holds the orbits' ``traj_id``, ``log_stretch`` and ``t_end`` (time
+    units), ``points`` the saddle points (``traj_id`` and coordinates) of the same orbits, ``d1_of`` a function of
+    a subset of ``points`` returning its section dimension (a
+    :class:`~hhscatter.analysis.geometry.saddle.SaddleDimension`, the estimator of the whole set) and ``d1_all``
+    that dimension on all of ``points`` (used where no orbit is left out). Keys: ``shares`` ([{threshold, share:
+    {value, err}, n_low}]), ``threshold``, ``n_low``, ``lyapunov_shift`` (λ̄ = ΣΛ/ΣT of the hyperbolic part minus
+    that of all, 1/time, its bootstrap error), ``d1`` (partial, D₁/2, of the hyperbolic part's points), ``n_orbits``.
+
+    Examples
+    --------
+    >>> import dataclasses, pandas as pd
+    >>> from hhscatter.analysis.geometry.saddle import SaddleDimension
+    >>> tg = pd.DataFrame({"traj_id": [1, 2, 3, 4], "t_end": [100.0] * 4, "log_stretch": [2.0, 40.0, 42.0, 38.0]})
+    >>> pts = pd.DataFrame({"traj_id": [1, 2, 3, 4], "x": [0.0, 0.1, 0.2, 0.3]})
+    >>> d = SaddleDimension(value=1.2, err=0.02, err_fit=0.0, err_resample=0.0, err_range=0.0, method="",
+    ...                     eps_range=(0.01, 0.1), n_points=4, n_groups=4, table=None)
+    >>> h = hyperbolic_record(tg, pts, lambda p: dataclasses.replace(d, value=len(p) / 2.5), d, n_boot=10)
+    >>> h = h["hyperbolic"]   # orbit 1 stretches at 0.02 against λ̄ = 0.305: left out at every threshold
+    >>> [s["n_low"] for s in h["shares"]], round(h["lyapunov_shift"]["value"], 3), h["d1"]["value"]
+    ([1, 1, 1], 0.095, 0.6)
+    """
+    L, T = tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy()
+    ths = sorted(float(t) for t in thresholds)
+    if not ths:
+        raise ConfigError("thresholds must name at least one fraction of λ̄")
+    try:
+        res = [low_ftle_share(L, T, threshold=t, n_boot=n_boot, seed=0) for t in ths]
+    except ConfigError as exc:
+        return {"hyperbolic_note": str(exc)}
+    mid = res[len(res) // 2]
+    if mid.rest is None:
+        return {"hyperbolic_note": f"fewer than 2 orbits with Λ/T ≥ {mid.threshold:g}·λ̄"}
+    low_ids = tangent["traj_id"].to_numpy()[~mid.hyperbolic]
+    if low_ids.size:
+        try:
+            d = d1_of(points[~points["traj_id"].isin(low_ids)])
+        except ConfigError as exc:
+            return {"hyperbolic_note": f"d1 of the hyperbolic part: {exc}"}
+    else:
+        d = d1_all
+    return {"hyperbolic": {"shares": [{"threshold": r.threshold, "share": Measured(r.share, r.share_err).to_dict(),
+                                       "n_low": r.n_low} for r in res],
+                           "threshold": mid.threshold, "n_low": mid.n_low, "n_orbits": mid.n_orbits,
+                           "lyapunov_shift": Measured(mid.rest.value - mid.lyapunov, mid.rest.err).to_dict(),
+                           "d1": Measured(d.value, d.err).scaled(0.5).to_dict()}}  # fmt: skip
+
+
 CANDIDATES = {
     "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
     "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
+    "fluctuation": "1 − κ/λ̄ moved to the d₂ that κ and the finite-time exponents' fluctuations imply (an upper bound)",
+    "hyperbolic": "d₁ and λ̄ of the hyperbolic part (the orbits with finite-time exponent not near 0)",
 }
 """The candidate reasons for a gap between d₁ and 1 − κ/λ̄ that :func:`with_gap` measures: name -> what it is."""
 
@@ -360,6 +455,13 @@ def with_gap(rec: dict) -> dict:
         alt["selection"] = (implied_by(rec["lyapunov_trend"]["extrapolated"]), Measured(d1x["value"], d1x["err"]))
     if rec.get("lyapunov_mid"):
         alt["mid_life"] = (implied_by(rec["lyapunov_mid"]), d1)
+    if rec.get("ftle_fluctuation"):
+        sh = rec["ftle_fluctuation"]["shift"]
+        alt["fluctuation"] = (Measured(implied.value + sh["value"], math.hypot(implied.err, sh["err"])), d1)
+    if rec.get("hyperbolic"):
+        h = rec["hyperbolic"]
+        lam_h = {"value": rec["lyapunov"] + h["lyapunov_shift"]["value"], "err": h["lyapunov_shift"]["err"]}
+        alt["hyperbolic"] = (implied_by(lam_h), Measured(h["d1"]["value"], h["d1"]["err"]))
     out = {"gap": gap.to_dict(), "z": rec["z"]}
     for name, (imp, d) in alt.items():
         left = imp.difference(d)

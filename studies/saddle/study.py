@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -74,6 +75,7 @@ class Params(StudyParams):
     d0_n: Integer  # reference initial conditions per ε
     d0_min_count: Integer  # an ε enters α's fit with ≥ this many uncertain pairs
     basins_system: Text  # the label of the system of study basins (its points' λ̄ re-predict the cut-off)
+    ftle_low: Numbers = (0.25, 0.5, 0.75)  # Λ/T < this·λ̄ is near 0 (the middle one for the hyperbolic part)
 
 
 FTLE_TABLE = "saddle_ftle.parquet"
@@ -434,6 +436,9 @@ def _point(study, key, ch):
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
     rec.update(sr.d1_error_record(d, *_d1_resolution(sp, lam["value"])))
     rec.update(_d1_radius(sp, d, lam["value"], p))
+    sel = _long_lived(tangent, ch["t_min"])  # the fluctuations' d₂ and the hyperbolic part
+    rec.update(sr.fluctuation_record(sel, k.kappa, k.kappa_err, n_boot=p.n_boot))
+    rec.update(sr.hyperbolic_record(sel, sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
 
@@ -481,6 +486,7 @@ def analyze(study):
                 "window": list(study.params.window),
                 "tmin_checks": list(study.params.tmin_checks),
                 "tmin_trend": list(study.params.tmin_trend),
+                "ftle_low": list(study.params.ftle_low),
                 "n_orbits_per_point": study.params.n,
                 "d0_eps": [float(e) for e in _d0_eps(study)],
                 "d0_n": study.params.d0_n,
