@@ -260,11 +260,7 @@ def mid_lyapunov_record(lo, hi, t_from: float, t_to: float, *, n_boot: int = 100
     >>> round(r["value"], 2), r["n_orbits"], r["n_left"]
     (0.41, 2, 1)
     """
-    a, b = (d.set_index("traj_id") for d in (lo, hi))
-    b = b.reindex(a.index)
-    inside = (a["outcome"].astype(object) == "censored").to_numpy() & (
-        b["outcome"].astype(object) == "censored"
-    ).to_numpy()
+    a, b, inside = _inside_at_both(lo, hi)
     if np.count_nonzero(inside) < 2:
         return {"lyapunov_mid_note": f"fewer than 2 orbits still inside at t = {t_to:.6g}"}
     m = interval_lyapunov(a["log_stretch"].to_numpy()[inside], b["log_stretch"].to_numpy()[inside], t_from, t_to,
@@ -313,15 +309,29 @@ def _trend(rows, name):
             "converged": tr.converged}  # fmt: skip
 
 
-def fluctuation_record(tangent, kappa: float, kappa_err: float, *, n_boot: int = 1000) -> dict:
-    """fluctuation_record(tangent, kappa, kappa_err, *, n_boot=1000) -> {"ftle_fluctuation": {...}} or
+def _inside_at_both(lo, hi):
+    """(a, b, inside): ``lo`` and ``hi`` indexed by traj_id in lo's order and the mask of the orbits censored (still
+    inside) in both."""
+    a, b = (d.set_index("traj_id") for d in (lo, hi))
+    b = b.reindex(a.index)
+    inside = (a["outcome"].astype(object) == "censored").to_numpy() & (
+        b["outcome"].astype(object) == "censored"
+    ).to_numpy()
+    return a, b, inside
+
+
+def fluctuation_record(tangent, kappa: float, kappa_err: float, mid=None, *, n_boot: int = 1000) -> dict:
+    """fluctuation_record(tangent, kappa, kappa_err, mid=None, *, n_boot=1000) -> {"ftle_fluctuation": {...}} or
     {"ftle_fluctuation_note": why none}.
 
-    ``tangent`` holds the selected orbits' ``log_stretch`` and ``t_end`` (time units) over their whole lives; κ
-    and its error in 1/time. The keys: ``d2`` (d₂ implied by κ and the orbits' finite-time exponents, the
-    partition form of :func:`~hhscatter.analysis.geometry.saddle_checks.ftle_dimension`), ``shift`` (d₂ − (1 −
-    κ/λ̄) with λ̄ = ΣΛ/ΣT: the fluctuations' part, an upper bound as it includes the way in and out),
-    ``shift_cumulant`` (the same in the Gaussian form, or why it has none), ``diffusion`` (D = Σ(Λ − λ̄T)²/ΣT, 1/time), ``n_orbits``.
+    d₂ implied by κ (and its error, 1/time) and the selected orbits' log-stretches (the partition form of
+    :func:`~hhscatter.analysis.geometry.saddle_checks.ftle_dimension`, q = 2) and its distance from 1 − κ/λ̄ with
+    the same λ̄ = ΣΛ/ΣT, the fluctuations' part (``shift``). ``mid`` = (lo, hi, t_from, t_to): the lifetimes tables
+    (``traj_id``, ``outcome``, ``log_stretch``) of the same orbits run to t_from and to t_to (time units); the
+    stretch between the two times of the orbits inside at both is the one on the saddle, and gives ``shift`` (with
+    ``d2``, ``diffusion`` and ``shift_cumulant``, the Gaussian form). ``tangent`` (``log_stretch``, ``t_end`` over
+    the whole lives) gives ``shift_whole_life``: its scatter includes the way in and out, so it bounds the
+    fluctuations' part from above; without ``mid`` it is ``shift``. D = Σ(Λ − λ̄T)²/ΣT in 1/time.
 
     Examples
     --------
@@ -333,19 +343,35 @@ def fluctuation_record(tangent, kappa: float, kappa_err: float, *, n_boot: int =
     >>> round(r["shift"]["value"], 3), round(r["shift_cumulant"]["value"], 3), round(r["diffusion"]["value"], 2)
     (-0.009, -0.01, 0.1)
     """
-    L, T = tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy()
-    out = {}
-    for form in ("partition", "cumulant"):
-        try:
-            out[form] = ftle_dimension(L, T, kappa, kappa_err, q=2.0, form=form, n_boot=n_boot, seed=0)
-        except ConfigError as exc:
-            out[form] = f"{form} form: {exc}"
-    e, c = out["partition"], out["cumulant"]
+
+    def fit(L, T):
+        out = {}
+        for form in ("partition", "cumulant"):
+            try:
+                out[form] = ftle_dimension(L, T, kappa, kappa_err, q=2.0, form=form, n_boot=n_boot, seed=0)
+            except ConfigError as exc:
+                out[form] = f"{form} form: {exc}"
+        return out["partition"], out["cumulant"]
+
+    def shift(r):
+        return r if isinstance(r, str) else Measured(r.shift, r.shift_err).to_dict()
+
+    whole = fit(tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy())[0]
+    source = "whole life"
+    if mid is None:
+        e, c = fit(tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy())
+    else:
+        lo, hi, t_from, t_to = mid
+        a, b, inside = _inside_at_both(lo, hi)
+        if np.count_nonzero(inside) < 2:
+            return {"ftle_fluctuation_note": f"fewer than 2 orbits still inside at t = {t_to:.6g}"}
+        dL = b["log_stretch"].to_numpy()[inside] - a["log_stretch"].to_numpy()[inside]
+        e, c = fit(dL, np.full(dL.size, float(t_to) - float(t_from)))
+        source = f"mid-life, t = {t_from:.6g} to {t_to:.6g}"
     if isinstance(e, str):
         return {"ftle_fluctuation_note": e}
-    return {"ftle_fluctuation": {"q": e.q, "d2": Measured(e.value, e.err).to_dict(),
-                                 "shift": Measured(e.shift, e.shift_err).to_dict(),
-                                 "shift_cumulant": c if isinstance(c, str) else Measured(c.shift, c.shift_err).to_dict(),
+    return {"ftle_fluctuation": {"q": e.q, "stretch": source, "d2": Measured(e.value, e.err).to_dict(),
+                                 "shift": shift(e), "shift_cumulant": shift(c), "shift_whole_life": shift(whole),
                                  "diffusion": Measured(e.diffusion, e.diffusion_err).to_dict(),
                                  "n_orbits": e.n_orbits}}  # fmt: skip
 
@@ -408,7 +434,7 @@ CANDIDATES = {
     "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
     "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
-    "fluctuation": "1 − κ/λ̄ moved to the d₂ that κ and the finite-time exponents' fluctuations imply (an upper bound)",
+    "fluctuation": "1 − κ/λ̄ moved to the d₂ that κ and the mid-life exponents' fluctuations imply",
     "hyperbolic": "d₁ and λ̄ of the hyperbolic part (the orbits with finite-time exponent not near 0)",
 }
 """The candidate reasons for a gap between d₁ and 1 − κ/λ̄ that :func:`with_gap` measures: name -> what it is."""

@@ -198,3 +198,31 @@ def test_hyperbolic_record_leaves_out_the_sticky_orbits_points_and_reuses_d1_whe
     seen.clear()
     h = sr.hyperbolic_record(tg.iloc[1:], pts, lambda p: seen.append(1) or d, d, n_boot=5)["hyperbolic"]
     assert seen == [] and h["n_low"] == 0 and h["lyapunov_shift"]["value"] == 0.0
+
+
+def test_fluctuation_record_takes_the_mid_life_stretch_of_the_orbits_inside_at_both_times():
+    """Mid-life stretches Λ(t_to) − Λ(t_from) with λ̄ = 0.5 and D = 0.2 over t_to − t_from = 40 (two orbits of
+    2002 leave before t_to and are left out, matched by traj_id); the whole lives carry an offset scattered per
+    orbit (the way in and out): their shift is larger, the bound."""
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    n = 2002
+    ids = rng.permutation(n) + 100
+    la = 0.5 * 20 + rng.normal(0, 1.0, n)
+    lb = la + 0.5 * 40 + np.sqrt(0.2 * 40) * rng.normal(size=n)
+    lo = pd.DataFrame({"traj_id": ids, "outcome": "censored", "log_stretch": la})
+    hi = pd.DataFrame(
+        {"traj_id": ids[::-1], "outcome": ["escaped"] * 2 + ["censored"] * (n - 2), "log_stretch": lb[::-1]}
+    )
+    T = rng.uniform(80.0, 120.0, n)
+    tg = pd.DataFrame(
+        {"t_end": T, "log_stretch": 0.5 * T + np.sqrt(0.2 * T) * rng.normal(size=n) + rng.normal(0, 4.0, n)}
+    )
+    r = sr.fluctuation_record(tg, 0.15, 0.0, (lo, hi, 20.0, 60.0), n_boot=50)["ftle_fluctuation"]
+    truth = 1 - 2 * 0.15 / (0.5 + math.sqrt(0.25 - 2 * 0.2 * 0.15)) - 0.7
+    assert r["n_orbits"] == n - 2 and r["stretch"] == "mid-life, t = 20 to 60"
+    assert abs(r["shift"]["value"] - truth) <= 3 * r["shift"]["err"] and abs(r["diffusion"]["value"] - 0.2) < 0.03
+    assert r["shift_whole_life"]["value"] < r["shift"]["value"] - 5 * r["shift"]["err"]
+    gone = sr.fluctuation_record(tg, 0.15, 0.0, (lo, hi.assign(outcome="escaped"), 20.0, 60.0), n_boot=5)
+    assert "fewer than 2" in gone["ftle_fluctuation_note"]
