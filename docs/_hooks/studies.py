@@ -796,8 +796,6 @@ STUDY_TABLES = {
         ("left_estimator", "left: fixed radius"),
         ("left_selection", "left: t_min → ∞"),
         ("left_mid_life", "left: mid-life λ̄"),
-        ("left_fluctuation", "left: d₂"),
-        ("left_hyperbolic", "left: hyperbolic part"),
     ),
     "saddle.dimensions": (
         ("system", "system"),
