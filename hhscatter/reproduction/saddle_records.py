@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from hhscatter.analysis.geometry.saddle import dimension_order, mean_lyapunov
-from hhscatter.analysis.geometry.saddle_checks import interval_lyapunov, tmin_trend
+from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_lyapunov, low_ftle_share, tmin_trend
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 
@@ -40,7 +40,9 @@ __all__ = [
     "d1_precision",
     "dimension_row",
     "dimension_summary",
+    "fluctuation_record",
     "gap_row",
+    "hyperbolic_record",
     "gap_summary",
     "lyapunov_by_t_min",
     "mid_lyapunov_record",
@@ -258,11 +260,7 @@ def mid_lyapunov_record(lo, hi, t_from: float, t_to: float, *, n_boot: int = 100
     >>> round(r["value"], 2), r["n_orbits"], r["n_left"]
     (0.41, 2, 1)
     """
-    a, b = (d.set_index("traj_id") for d in (lo, hi))
-    b = b.reindex(a.index)
-    inside = (a["outcome"].astype(object) == "censored").to_numpy() & (
-        b["outcome"].astype(object) == "censored"
-    ).to_numpy()
+    a, b, inside = _inside_at_both(lo, hi)
     if np.count_nonzero(inside) < 2:
         return {"lyapunov_mid_note": f"fewer than 2 orbits still inside at t = {t_to:.6g}"}
     m = interval_lyapunov(a["log_stretch"].to_numpy()[inside], b["log_stretch"].to_numpy()[inside], t_from, t_to,
@@ -311,10 +309,133 @@ def _trend(rows, name):
             "converged": tr.converged}  # fmt: skip
 
 
+def _inside_at_both(lo, hi):
+    """(a, b, inside): ``lo`` and ``hi`` indexed by traj_id in lo's order and the mask of the orbits censored (still
+    inside) in both."""
+    a, b = (d.set_index("traj_id") for d in (lo, hi))
+    b = b.reindex(a.index)
+    inside = (a["outcome"].astype(object) == "censored").to_numpy() & (
+        b["outcome"].astype(object) == "censored"
+    ).to_numpy()
+    return a, b, inside
+
+
+def fluctuation_record(tangent, kappa: float, kappa_err: float, mid=None, *, n_boot: int = 1000) -> dict:
+    """fluctuation_record(tangent, kappa, kappa_err, mid=None, *, n_boot=1000) -> {"ftle_fluctuation": {...}} or
+    {"ftle_fluctuation_note": why none}.
+
+    d₂ implied by κ (and its error, 1/time) and the selected orbits' log-stretches (the partition form of
+    :func:`~hhscatter.analysis.geometry.saddle_checks.ftle_dimension`, q = 2) and its distance from 1 − κ/λ̄ with
+    the same λ̄ = ΣΛ/ΣT, the fluctuations' part (``shift``). ``mid`` = (lo, hi, t_from, t_to): the lifetimes tables
+    (``traj_id``, ``outcome``, ``log_stretch``) of the same orbits run to t_from and to t_to (time units); the
+    stretch between the two times of the orbits inside at both is the one on the saddle, and gives ``shift`` (with
+    ``d2``, ``diffusion`` and ``shift_cumulant``, the Gaussian form). ``tangent`` (``log_stretch``, ``t_end`` over
+    the whole lives) gives ``shift_whole_life``: its scatter includes the way in and out, so it bounds the
+    fluctuations' part from above; without ``mid`` it is ``shift``. D = Σ(Λ − λ̄T)²/ΣT in 1/time.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> rng = np.random.default_rng(0)
+    >>> T = rng.uniform(50.0, 150.0, 2000)
+    >>> tg = pd.DataFrame({"t_end": T, "log_stretch": 0.5 * T + np.sqrt(0.1 * T) * rng.normal(size=T.size)})
+    >>> r = fluctuation_record(tg, 0.15, 0.001, n_boot=20)["ftle_fluctuation"]
+    >>> round(r["shift"]["value"], 3), round(r["shift_cumulant"]["value"], 3), round(r["diffusion"]["value"], 2)
+    (-0.009, -0.01, 0.1)
+    """
+
+    def fit(L, T):
+        out = {}
+        for form in ("partition", "cumulant"):
+            try:
+                out[form] = ftle_dimension(L, T, kappa, kappa_err, q=2.0, form=form, n_boot=n_boot, seed=0)
+            except ConfigError as exc:
+                out[form] = f"{form} form: {exc}"
+        return out["partition"], out["cumulant"]
+
+    def shift(r):
+        return r if isinstance(r, str) else Measured(r.shift, r.shift_err).to_dict()
+
+    whole = fit(tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy())[0]
+    source = "whole life"
+    if mid is None:
+        e, c = fit(tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy())
+    else:
+        lo, hi, t_from, t_to = mid
+        a, b, inside = _inside_at_both(lo, hi)
+        if np.count_nonzero(inside) < 2:
+            return {"ftle_fluctuation_note": f"fewer than 2 orbits still inside at t = {t_to:.6g}"}
+        dL = b["log_stretch"].to_numpy()[inside] - a["log_stretch"].to_numpy()[inside]
+        e, c = fit(dL, np.full(dL.size, float(t_to) - float(t_from)))
+        source = f"mid-life, t = {t_from:.6g} to {t_to:.6g}"
+    if isinstance(e, str):
+        return {"ftle_fluctuation_note": e}
+    return {"ftle_fluctuation": {"q": e.q, "stretch": source, "d2": Measured(e.value, e.err).to_dict(),
+                                 "shift": shift(e), "shift_cumulant": shift(c), "shift_whole_life": shift(whole),
+                                 "diffusion": Measured(e.diffusion, e.diffusion_err).to_dict(),
+                                 "n_orbits": e.n_orbits}}  # fmt: skip
+
+
+def hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot: int = 1000) -> dict:
+    """hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot=1000) ->
+    {"hyperbolic": {...}} or {"hyperbolic_note": why none}.
+
+    The selected orbits whose finite-time exponent Λ/T lies below a fraction of λ̄
+    (:func:`~hhscatter.analysis.geometry.saddle_checks.low_ftle_share`), at each of ``thresholds`` (the middle one
+    the stated rule, the others its systematic), and the relation's inputs from the other orbits, the hyperbolic
+    part, at the middle threshold. ``tangent`` holds the orbits' ``traj_id``, ``log_stretch`` and ``t_end`` (time
+    units), ``points`` the saddle points (``traj_id`` and coordinates) of the same orbits, ``d1_of`` a function of
+    a subset of ``points`` returning its section dimension (a
+    :class:`~hhscatter.analysis.geometry.saddle.SaddleDimension`, the estimator of the whole set) and ``d1_all``
+    that dimension on all of ``points`` (used where no orbit is left out). Keys: ``shares`` ([{threshold, share:
+    {value, err}, n_low}]), ``threshold``, ``n_low``, ``lyapunov_shift`` (λ̄ = ΣΛ/ΣT of the hyperbolic part minus
+    that of all, 1/time, its bootstrap error), ``d1`` (partial, D₁/2, of the hyperbolic part's points), ``n_orbits``.
+
+    Examples
+    --------
+    >>> import dataclasses, pandas as pd
+    >>> from hhscatter.analysis.geometry.saddle import SaddleDimension
+    >>> tg = pd.DataFrame({"traj_id": [1, 2, 3, 4], "t_end": [100.0] * 4, "log_stretch": [2.0, 40.0, 42.0, 38.0]})
+    >>> pts = pd.DataFrame({"traj_id": [1, 2, 3, 4], "x": [0.0, 0.1, 0.2, 0.3]})
+    >>> d = SaddleDimension(value=1.2, err=0.02, err_fit=0.0, err_resample=0.0, err_range=0.0, method="",
+    ...                     eps_range=(0.01, 0.1), n_points=4, n_groups=4, table=None)
+    >>> h = hyperbolic_record(tg, pts, lambda p: dataclasses.replace(d, value=len(p) / 2.5), d, n_boot=10)
+    >>> h = h["hyperbolic"]   # orbit 1 stretches at 0.02 against λ̄ = 0.305: left out at every threshold
+    >>> [s["n_low"] for s in h["shares"]], round(h["lyapunov_shift"]["value"], 3), h["d1"]["value"]
+    ([1, 1, 1], 0.095, 0.6)
+    """
+    L, T = tangent["log_stretch"].to_numpy(), tangent["t_end"].to_numpy()
+    ths = sorted(float(t) for t in thresholds)
+    if not ths:
+        raise ConfigError("thresholds must name at least one fraction of λ̄")
+    try:
+        res = [low_ftle_share(L, T, threshold=t, n_boot=n_boot, seed=0) for t in ths]
+    except ConfigError as exc:
+        return {"hyperbolic_note": str(exc)}
+    mid = res[len(res) // 2]
+    if mid.rest is None:
+        return {"hyperbolic_note": f"fewer than 2 orbits with Λ/T ≥ {mid.threshold:g}·λ̄"}
+    low_ids = tangent["traj_id"].to_numpy()[~mid.hyperbolic]
+    if low_ids.size:
+        try:
+            d = d1_of(points[~points["traj_id"].isin(low_ids)])
+        except ConfigError as exc:
+            return {"hyperbolic_note": f"d1 of the hyperbolic part: {exc}"}
+    else:
+        d = d1_all
+    return {"hyperbolic": {"shares": [{"threshold": r.threshold, "share": Measured(r.share, r.share_err).to_dict(),
+                                       "n_low": r.n_low} for r in res],
+                           "threshold": mid.threshold, "n_low": mid.n_low, "n_orbits": mid.n_orbits,
+                           "lyapunov_shift": Measured(mid.rest.value - mid.lyapunov, mid.rest.err).to_dict(),
+                           "d1": Measured(d.value, d.err).scaled(0.5).to_dict()}}  # fmt: skip
+
+
 CANDIDATES = {
     "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
     "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
+    "fluctuation": "1 − κ/λ̄ moved to the d₂ that κ and the mid-life exponents' fluctuations imply",
+    "hyperbolic": "d₁ and λ̄ of the hyperbolic part (the orbits with finite-time exponent not near 0)",
 }
 """The candidate reasons for a gap between d₁ and 1 − κ/λ̄ that :func:`with_gap` measures: name -> what it is."""
 
@@ -360,6 +481,13 @@ def with_gap(rec: dict) -> dict:
         alt["selection"] = (implied_by(rec["lyapunov_trend"]["extrapolated"]), Measured(d1x["value"], d1x["err"]))
     if rec.get("lyapunov_mid"):
         alt["mid_life"] = (implied_by(rec["lyapunov_mid"]), d1)
+    if rec.get("ftle_fluctuation"):
+        sh = rec["ftle_fluctuation"]["shift"]
+        alt["fluctuation"] = (Measured(implied.value + sh["value"], math.hypot(implied.err, sh["err"])), d1)
+    if rec.get("hyperbolic"):
+        h = rec["hyperbolic"]
+        lam_h = {"value": rec["lyapunov"] + h["lyapunov_shift"]["value"], "err": h["lyapunov_shift"]["err"]}
+        alt["hyperbolic"] = (implied_by(lam_h), Measured(h["d1"]["value"], h["d1"]["err"]))
     out = {"gap": gap.to_dict(), "z": rec["z"]}
     for name, (imp, d) in alt.items():
         left = imp.difference(d)

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -74,6 +75,7 @@ class Params(StudyParams):
     d0_n: Integer  # reference initial conditions per ε
     d0_min_count: Integer  # an ε enters α's fit with ≥ this many uncertain pairs
     basins_system: Text  # the label of the system of study basins (its points' λ̄ re-predict the cut-off)
+    ftle_low: Numbers = (0.25, 0.5, 0.75)  # Λ/T < this·λ̄ is near 0 (the middle one for the hyperbolic part)
 
 
 FTLE_TABLE = "saddle_ftle.parquet"
@@ -284,12 +286,14 @@ def _d1_estimator(p, lam):
     return est
 
 
-def _checks(study, key, tangent, t_min, efolds, kappa):
-    """λ̄ of the mid-life (the ``_lo``/``_hi`` tangent runs: Λ at window·t_min) and at the t_min of tmin_trend."""
-    p = study.params
+def _checks(study, key, tangent, t_min, efolds, k):
+    """λ̄ and the fluctuations' d₂ of the mid-life (the ``_lo``/``_hi`` tangent runs: Λ at window·t_min) and λ̄ at
+    the t_min of tmin_trend."""
+    p, kappa = study.params, k.kappa
     lo, hi = (_lifetimes(study.raw(f"{key}_tangent_{s}"), ("log_stretch",)) for s in ("lo", "hi"))
-    ts = [c / kappa for c in (efolds, *(efolds + s for s in p.tmin_trend))]
-    return {**sr.mid_lyapunov_record(lo, hi, p.window[0] * t_min, p.window[1] * t_min, n_boot=p.n_boot),
+    ts, mid = [c / kappa for c in (efolds, *(efolds + s for s in p.tmin_trend))], (p.window[0] * t_min, p.window[1] * t_min)  # fmt: skip
+    return {**sr.mid_lyapunov_record(lo, hi, *mid, n_boot=p.n_boot),
+            **sr.fluctuation_record(_long_lived(tangent, t_min), kappa, k.kappa_err, (lo, hi, *mid), n_boot=p.n_boot),
             "lyapunov_by_t_min": sr.lyapunov_by_t_min(_long_lived(tangent, ts[0]), ts, kappa, n_boot=p.n_boot)}  # fmt: skip
 
 
@@ -398,7 +402,7 @@ def _point(study, key, ch):
         return rec, None
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
-    rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k.kappa))
+    rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k))
     lt = _lifetimes(study.raw(key))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
     est = _d1_estimator(p, lam["value"])
@@ -434,6 +438,7 @@ def _point(study, key, ch):
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
     rec.update(sr.d1_error_record(d, *_d1_resolution(sp, lam["value"])))
     rec.update(_d1_radius(sp, d, lam["value"], p))
+    rec.update(sr.hyperbolic_record(_long_lived(tangent, ch["t_min"]), sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
 
@@ -481,6 +486,7 @@ def analyze(study):
                 "window": list(study.params.window),
                 "tmin_checks": list(study.params.tmin_checks),
                 "tmin_trend": list(study.params.tmin_trend),
+                "ftle_low": list(study.params.ftle_low),
                 "n_orbits_per_point": study.params.n,
                 "d0_eps": [float(e) for e in _d0_eps(study)],
                 "d0_n": study.params.d0_n,

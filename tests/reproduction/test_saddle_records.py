@@ -146,3 +146,83 @@ def test_mid_life_and_t_min_lyapunov_use_only_the_orbits_they_may():
     rows = sr.lyapunov_by_t_min(tg, [10.0, 20.0, 40.0], 0.1, n_boot=5)
     assert [(r["t_min_kappa"], r["n_orbits"]) for r in rows] == [(1.0, 3), (2.0, 2)]
     assert rows[1]["value"] == pytest.approx(16.0 / 60.0)
+
+
+def test_the_fluctuation_and_hyperbolic_candidates_replace_the_implied_d1_and_both_inputs():
+    """κ = 0.1, λ̄ = 0.4, d₁ = 0.70 ± 0.01: the fluctuations move 1 − κ/λ̄ by −0.04 ± 0.01 (leaves 0.01, share 0.8:
+    closes it); the hyperbolic part has λ̄ higher by 0.1 (1 − 0.1/0.5 = 0.8) and d₁ = 0.72 ± 0.01: leaves 0.08."""
+    rec = sr.with_gap(_gap_record(
+        ftle_fluctuation={"shift": {"value": -0.04, "err": 0.01}},
+        hyperbolic={"lyapunov_shift": {"value": 0.1, "err": 0.0}, "d1": {"value": 0.72, "err": 0.01}},
+    ))  # fmt: skip
+    g = rec["gap"]
+    assert g["fluctuation"]["d1_implied"]["value"] == pytest.approx(0.71)
+    assert g["fluctuation"]["left"]["value"] == pytest.approx(0.01) and g["fluctuation"]["share"] == pytest.approx(0.8)
+    assert g["fluctuation"]["left"]["err"] == pytest.approx(math.hypot(0.01, 0.01)) and g["fluctuation"]["closes"]
+    assert g["hyperbolic"]["d1_implied"]["value"] == pytest.approx(0.8) and g["hyperbolic"]["d1"]["value"] == 0.72
+    assert g["hyperbolic"]["left"]["value"] == pytest.approx(0.08) and not g["hyperbolic"]["closes"]
+    row = sr.gap_row(rec)
+    assert row["left_fluctuation"]["value"] == pytest.approx(0.01) and row["share_hyperbolic"] == pytest.approx(-0.6)
+    s = sr.gap_summary([rec])
+    assert s["candidates"]["fluctuation"]["closes_at"] == ["p"] and s["candidates"]["hyperbolic"]["n_closes"] == 0
+
+
+def test_fluctuation_record_reads_the_stretches_of_the_selected_orbits():
+    """Gaussian stretches, λ̄ = 0.5, D = 0.2, κ = 0.15: the shift d₂ − (1 − κ/λ̄) is −0.0206 in closed form; its 2σ
+    interval covers it in at least 6 of 8 seeds (an exponential average: its bootstrap error is itself noisy)."""
+    import numpy as np
+
+    shift = 1 - 2 * 0.15 / (0.5 + math.sqrt(0.25 - 2 * 0.2 * 0.15)) - 0.7
+    hits = 0
+    for seed in range(8):
+        rng = np.random.default_rng(seed)
+        T = rng.uniform(50.0, 150.0, 4000)
+        tg = pd.DataFrame({"t_end": T, "log_stretch": 0.5 * T + np.sqrt(0.2 * T) * rng.normal(size=T.size)})
+        r = sr.fluctuation_record(tg, 0.15, 0.0, n_boot=50)["ftle_fluctuation"]
+        hits += abs(r["shift"]["value"] - shift) <= 2 * r["shift"]["err"]
+        assert r["shift"]["err"] < 0.002 and r["n_orbits"] == 4000 and r["q"] == 2.0
+    assert hits >= 6
+    bad = sr.fluctuation_record(tg.assign(log_stretch=-tg["log_stretch"]), 0.15, 0.0, n_boot=5)
+    assert "not > 0" in bad["ftle_fluctuation_note"]
+
+
+def test_hyperbolic_record_leaves_out_the_sticky_orbits_points_and_reuses_d1_when_none():
+    tg = pd.DataFrame({"traj_id": [7, 8, 9, 10], "t_end": [100.0] * 4, "log_stretch": [1.0, 40.0, 41.0, 39.0]})
+    pts = pd.DataFrame({"traj_id": [7, 7, 8, 9, 10], "x": [0.0, 0.1, 0.2, 0.3, 0.4]})
+    d = _dim(1.4, (0.01, 0.01, 0.01), (0.01, 0.1), [0.01])
+    seen = []
+    h = sr.hyperbolic_record(tg, pts, lambda p: seen.append(sorted(set(p["traj_id"]))) or d, d, n_boot=5)["hyperbolic"]
+    assert seen == [[8, 9, 10]] and h["n_low"] == 1 and h["threshold"] == 0.5 and h["d1"]["value"] == 0.7
+    assert [s["threshold"] for s in h["shares"]] == [0.25, 0.5, 0.75]
+    assert h["shares"][1]["share"]["value"] == 0.25
+    seen.clear()
+    h = sr.hyperbolic_record(tg.iloc[1:], pts, lambda p: seen.append(1) or d, d, n_boot=5)["hyperbolic"]
+    assert seen == [] and h["n_low"] == 0 and h["lyapunov_shift"]["value"] == 0.0
+
+
+def test_fluctuation_record_takes_the_mid_life_stretch_of_the_orbits_inside_at_both_times():
+    """Mid-life stretches Λ(t_to) − Λ(t_from) with λ̄ = 0.5 and D = 0.2 over t_to − t_from = 40 (two orbits of
+    2002 leave before t_to and are left out, matched by traj_id); the whole lives carry an offset scattered per
+    orbit (the way in and out): their shift is larger, the bound."""
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    n = 2002
+    ids = rng.permutation(n) + 100
+    la = 0.5 * 20 + rng.normal(0, 1.0, n)
+    lb = la + 0.5 * 40 + np.sqrt(0.2 * 40) * rng.normal(size=n)
+    lo = pd.DataFrame({"traj_id": ids, "outcome": "censored", "log_stretch": la})
+    hi = pd.DataFrame(
+        {"traj_id": ids[::-1], "outcome": ["escaped"] * 2 + ["censored"] * (n - 2), "log_stretch": lb[::-1]}
+    )
+    T = rng.uniform(80.0, 120.0, n)
+    tg = pd.DataFrame(
+        {"t_end": T, "log_stretch": 0.5 * T + np.sqrt(0.2 * T) * rng.normal(size=n) + rng.normal(0, 4.0, n)}
+    )
+    r = sr.fluctuation_record(tg, 0.15, 0.0, (lo, hi, 20.0, 60.0), n_boot=50)["ftle_fluctuation"]
+    truth = 1 - 2 * 0.15 / (0.5 + math.sqrt(0.25 - 2 * 0.2 * 0.15)) - 0.7
+    assert r["n_orbits"] == n - 2 and r["stretch"] == "mid-life, t = 20 to 60"
+    assert abs(r["shift"]["value"] - truth) <= 3 * r["shift"]["err"] and abs(r["diffusion"]["value"] - 0.2) < 0.03
+    assert r["shift_whole_life"]["value"] < r["shift"]["value"] - 5 * r["shift"]["err"]
+    gone = sr.fluctuation_record(tg, 0.15, 0.0, (lo, hi.assign(outcome="escaped"), 20.0, 60.0), n_boot=5)
+    assert "fewer than 2" in gone["ftle_fluctuation_note"]

@@ -20,7 +20,7 @@ dimensions none.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -34,11 +34,22 @@ from hhscatter.analysis.geometry.saddle import (
     _group_labels,
     _positive,
     _slope,
+    _stretch_arrays,
     mean_lyapunov,
 )
 from hhscatter.errors import ConfigError
 
-__all__ = ["TminTrend", "information_dimension_radius", "interval_lyapunov", "tmin_trend"]
+__all__ = [
+    "FTLE_FORMS",
+    "FtleDimension",
+    "LowFtleShare",
+    "TminTrend",
+    "ftle_dimension",
+    "information_dimension_radius",
+    "interval_lyapunov",
+    "low_ftle_share",
+    "tmin_trend",
+]
 
 _CENTRES_PER_PASS = 2000  # centres whose pairs within eps_max are held at once (memory ∝ their neighbours)
 
@@ -284,3 +295,239 @@ def interval_lyapunov(log_stretch_a, log_stretch_b, t_a, t_b, *, n_boot: int = 1
     if np.any(ta < 0) or np.any(tb <= ta):
         raise ConfigError("t_a and t_b must be times with 0 ≤ t_a < t_b")
     return mean_lyapunov(lb - la, tb - ta, n_boot=n_boot, seed=seed)
+
+
+@dataclass(frozen=True)
+class FtleDimension:
+    """Result of :func:`ftle_dimension`.
+
+    q, form, value (d_q implied), err (1σ: bootstrap over orbits and κ's error in quadrature), lyapunov,
+    lyapunov_err (λ̄ = ΣΛ/ΣT, 1/time), diffusion, diffusion_err (D = Σ(Λ − λ̄T)²/ΣT, 1/time), d1 (1 − κ/λ̄, the
+    q = 1 value), shift, shift_err (``value − d1``, the fluctuations' part, and its 1σ: the bootstrap of the
+    difference, so the errors the two share cancel), n_orbits.
+    """
+
+    q: float
+    form: str
+    value: float
+    err: float
+    lyapunov: float
+    lyapunov_err: float
+    diffusion: float
+    diffusion_err: float
+    d1: float
+    shift: float
+    shift_err: float
+    n_orbits: int
+
+
+FTLE_FORMS = ("partition", "cumulant")
+"""The forms of :func:`ftle_dimension`: the partition function averaged over the orbits, or its cumulant expansion."""
+
+
+def _x_cumulant(L, T, kappa: float, q: float) -> float:
+    """x = 1 − d_q, the root of κ = λ̄x − ½(q − 1)D x² continuous with κ/λ̄ at D = 0 (NaN where none)."""
+    lam = float(L.sum() / T.sum())
+    diff = float(((L - lam * T) ** 2).sum() / T.sum())
+    disc = lam * lam - 2.0 * (q - 1.0) * diff * kappa
+    if disc < 0 or lam + math.sqrt(disc) <= 0:
+        return math.nan
+    return 2.0 * kappa / (lam + math.sqrt(disc))
+
+
+def _x_partition(L, T, kappa: float, q: float) -> float:
+    """x = 1 − d_q, the root of g(x) = ln⟨e^{−(q−1)(xΛ − κT)}⟩ = 0 over the orbits (NaN where none): Newton's
+    steps from x = 0 (g is convex in x, so they converge monotonically after the first)."""
+    if q == 1.0:
+        return float(kappa * T.sum() / L.sum())
+    s, x = q - 1.0, 0.0
+    for _ in range(200):
+        a = -s * (x * L - kappa * T)
+        m = float(a.max())
+        w = np.exp(a - m)
+        sw = float(w.sum())
+        g = m + math.log(sw) - math.log(L.size)
+        dg = -s * float((w * L).sum()) / sw
+        if not dg or not math.isfinite(g):
+            return math.nan
+        step = g / dg
+        x -= step
+        if abs(step) <= 1e-13 * max(1.0, abs(x)):
+            return x
+    return math.nan
+
+
+def ftle_dimension(
+    log_stretch,
+    duration,
+    kappa: float,
+    kappa_err: float = 0.0,
+    *,
+    q: float = 2.0,
+    form: str = "partition",
+    n_boot: int = 1000,
+    seed: int = 0,
+) -> FtleDimension:
+    """ftle_dimension(log_stretch, duration, kappa, kappa_err=0, *, q=2, form="partition", n_boot=1000, seed=0) -> FtleDimension.
+
+    The partial dimension d_q (along the unstable direction) of a hyperbolic saddle's natural measure that the
+    escape rate κ (1/time) and the finite-time Lyapunov exponents of orbits sampling that measure imply. The
+    orbits that stay near the saddle for a time t (the sprinkler selection) are sampled with the weight of their
+    survival, e^{−Λ_t + κt} against the uniform measure of initial conditions, so their log-stretches Λ_t are those
+    of the natural measure; the Lyapunov partition function of that measure (Grassberger, Badii and Politi,
+    J. Stat. Phys. 51, 135 (1988); Ott, *Chaos in Dynamical Systems*, 2nd ed., 2002, ch. 9: the pieces of measure
+    μ_i = e^{−Λ_i + κt} and length e^{−Λ_i} give Σ μ_i^q ℓ_i^{(1−q)d_q} = 1) is
+
+        ⟨e^{−(q−1)[(1−d_q) Λ_t − κt]}⟩ = 1,
+
+    so for q = 2 κ = −(1/t) ln⟨e^{−(1−d₂) Λ_t}⟩. ``form="partition"`` solves it with the average over the orbits,
+    each with its own Λ_i and duration T_i; ``form="cumulant"`` uses its Gaussian (second-cumulant) expansion
+    with ⟨Λ_t⟩ = λ̄t and Var Λ_t = Dt, κ = λ̄(1 − d_q) − ½(q − 1) D (1 − d_q)², λ̄ = ΣΛ_i/ΣT_i and
+    D = Σ(Λ_i − λ̄T_i)²/ΣT_i. At q = 1 the fluctuations drop out (the Kantz–Grassberger relation κ = λ̄(1 − d₁));
+    q = 0 is Bowen's equation of d₀; d₂ lies below d₁ by about ½ D (1 − d₁)²/λ̄. The log-stretches include the
+    way in and out (an offset per orbit), whose scatter adds to the fluctuations: ``value − d1`` is then an upper
+    bound of the fluctuations' part on the saddle. The error is the bootstrap over orbits with κ's error
+    propagated in quadrature. On the open baker map's natural measure (Bernoulli stretches, d₂ in closed form)
+    the partition form's 2σ interval covers d₂; on Gaussian stretches both forms do
+    (tests/analysis/geometry/test_saddle_checks.py).
+
+    Parameters
+    ----------
+    log_stretch, duration : arrays (n,)
+        Λ_i (dimensionless) and T_i > 0 (time units) of each orbit.
+    kappa, kappa_err : float
+        The escape rate and its 1σ error (1/time), κ > 0.
+    q : float
+        The order of the dimension (2: the correlation dimension; 1 returns 1 − κ/λ̄).
+    form : str
+        "partition" or "cumulant" (above).
+    n_boot : int
+        Bootstrap replicates over orbits (0: no resampling error).
+    seed : int
+        Seed of the bootstrap.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> T = rng.uniform(50.0, 150.0, 4000)
+    >>> L = 0.5 * T + np.sqrt(0.1 * T) * rng.normal(size=T.size)   # λ̄ = 0.5, D = 0.1
+    >>> r = ftle_dimension(L, T, 0.15, n_boot=200)   # closed form: 1 − 2·0.15/(0.5 + √(0.25 − 0.03)) = 0.6904
+    >>> bool(abs(r.value - 0.6904) < 2 * r.err), round(r.d1, 2), bool(r.value < r.d1)
+    (True, 0.7, True)
+    """
+    L, T = _stretch_arrays(log_stretch, duration)
+    kappa = _positive(kappa, "kappa")
+    if isinstance(kappa_err, bool) or not isinstance(kappa_err, (int, float)) or not kappa_err >= 0:
+        raise ConfigError(f"kappa_err must be a 1σ error ≥ 0 (1/time), got {kappa_err!r}")
+    if isinstance(q, bool) or not isinstance(q, (int, float)) or not math.isfinite(q):
+        raise ConfigError(f"q must be a finite number (the dimension's order), got {q!r}")
+    if form not in FTLE_FORMS:
+        raise ConfigError(f"form must be one of {', '.join(FTLE_FORMS)}, got {form!r}")
+    n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
+    if L.size < 2:
+        raise ConfigError(f"log_stretch: {L.size} orbit, at least 2 needed")
+    lam = float(L.sum() / T.sum())
+    if not lam > 0:
+        raise ConfigError(f"log_stretch: the mean exponent ΣΛ/ΣT = {lam:.4g} is not > 0 (no unstable direction)")
+    solve = _x_partition if form == "partition" else _x_cumulant
+    x = solve(L, T, kappa, float(q))
+    if math.isnan(x):
+        raise ConfigError(
+            f"kappa = {kappa:g}: the {form} form has no root 1 − d_q for q = {q:g} over these orbits "
+            "(the fluctuations are too large for it)"
+        )
+    dx = 1e-6 * kappa  # κ's error: the derivatives in κ, by central differences
+
+    def d_kappa(f):
+        return kappa_err * abs(f(kappa + dx) - f(kappa - dx)) / (2 * dx)
+
+    err_kappa = d_kappa(lambda k: solve(L, T, k, float(q)))
+    shift_kappa = d_kappa(lambda k: k / lam - solve(L, T, k, float(q)))
+    diff = float(((L - lam * T) ** 2).sum() / T.sum())
+    if n_boot:
+        rng = np.random.default_rng(seed)
+        reps = np.full((n_boot, 4), math.nan)
+        for k in range(n_boot):
+            i = rng.integers(0, L.size, L.size)
+            lb = float(L[i].sum() / T[i].sum())
+            xb = solve(L[i], T[i], kappa, float(q)) if lb > 0 else math.nan
+            reps[k] = lb, float(((L[i] - lb * T[i]) ** 2).sum() / T[i].sum()), 1.0 - xb, kappa / lb - xb
+        lam_err, diff_err, err_res, shift_res = (float(np.nanstd(reps[:, j], ddof=1)) for j in range(4))
+        err, shift_err = math.hypot(err_res, err_kappa), math.hypot(shift_res, shift_kappa)
+    else:
+        lam_err = diff_err = err = shift_err = math.nan
+    return FtleDimension(q=float(q), form=form, value=1.0 - x, err=err, lyapunov=lam, lyapunov_err=lam_err,
+                         diffusion=diff, diffusion_err=diff_err, d1=1.0 - kappa / lam, shift=kappa / lam - x,
+                         shift_err=shift_err, n_orbits=int(L.size))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class LowFtleShare:
+    """Result of :func:`low_ftle_share`.
+
+    threshold (the fraction of λ̄ below which an orbit's exponent counts as near 0), lyapunov (λ̄ of all orbits,
+    1/time), share, share_err (the share of orbits below threshold·λ̄ and its binomial 1σ), n_low, n_orbits,
+    hyperbolic (boolean mask of the other orbits, in the input's order) and rest (the
+    :class:`~hhscatter.analysis.geometry.saddle.LyapunovMean` of those, or None where fewer than 2).
+    """
+
+    threshold: float
+    lyapunov: float
+    share: float
+    share_err: float
+    n_low: int
+    n_orbits: int
+    hyperbolic: np.ndarray = field(repr=False)
+    rest: LyapunovMean | None = field(repr=False)
+
+
+def low_ftle_share(log_stretch, duration, *, threshold: float = 0.5, n_boot: int = 1000, seed: int = 0) -> LowFtleShare:
+    """low_ftle_share(log_stretch, duration, *, threshold=0.5, n_boot=1000, seed=0) -> LowFtleShare.
+
+    The orbits whose finite-time Lyapunov exponent Λ_i/T_i lies near 0 — below ``threshold``·λ̄, λ̄ = ΣΛ/ΣT of all
+    orbits (Λ_i dimensionless, T_i time units) — and λ̄ of the rest. On a hyperbolic saddle the finite-time
+    exponents of long lives gather around λ̄ with a spread ~ 1/√T; an orbit that sticks to the edge of a regular
+    island stretches slowly for a long time, and a tail of exponents towards 0 marks the non-hyperbolic part
+    (Lai and Tél, *Transient Chaos*, 2011, ch. 6; Altmann, Portela and Tél, Rev. Mod. Phys. 85, 869 (2013)).
+    The threshold is a choice: move it to see how much the share depends on it. The share's error is binomial,
+    √(p(1 − p)/n); λ̄ of the rest is :func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov` (bootstrap over
+    its orbits), whose selection mask ``hyperbolic`` picks the same orbits' other measurements (e.g. their
+    section points, for d₁ of the hyperbolic part).
+
+    Parameters
+    ----------
+    log_stretch, duration : arrays (n,)
+        Λ_i and T_i > 0 of each orbit.
+    threshold : float
+        0 < threshold < 1: the fraction of λ̄ below which an exponent counts as near 0.
+    n_boot, seed : int
+        Bootstrap of λ̄ of the rest.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(2)
+    >>> T = np.full(1000, 100.0)
+    >>> ftle = np.where(np.arange(1000) < 100, 0.02, 0.4) + rng.normal(0, 0.02, 1000)   # 10 % sticky orbits
+    >>> s = low_ftle_share(ftle * T, T, n_boot=50)
+    >>> s.share, round(s.share_err, 4), round(s.rest.value, 2), s.n_low
+    (0.1, 0.0095, 0.4, 100)
+    """
+    L, T = _stretch_arrays(log_stretch, duration)
+    if isinstance(threshold, bool) or not isinstance(threshold, (int, float)) or not 0 < threshold < 1:
+        raise ConfigError(f"threshold must be a fraction 0 < threshold < 1 of λ̄, got {threshold!r}")
+    n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
+    if L.size < 2:
+        raise ConfigError(f"log_stretch: {L.size} orbit, at least 2 needed")
+    lam = float(L.sum() / T.sum())
+    if not lam > 0:
+        raise ConfigError(f"log_stretch: the mean exponent ΣΛ/ΣT = {lam:.4g} is not > 0 (no unstable direction)")
+    hyp = L / T >= threshold * lam
+    n, n_low = L.size, int(np.count_nonzero(~hyp))
+    p = n_low / n
+    rest = mean_lyapunov(L[hyp], T[hyp], n_boot=n_boot, seed=seed) if np.count_nonzero(hyp) >= 2 else None
+    return LowFtleShare(threshold=float(threshold), lyapunov=lam, share=p, share_err=math.sqrt(p * (1 - p) / n),
+                        n_low=n_low, n_orbits=int(n), hyperbolic=hyp, rest=rest)  # fmt: skip
