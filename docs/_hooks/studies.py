@@ -1249,6 +1249,27 @@ def evidence_tables(doc) -> str:
     out.append("|---|" + "---|" * len(pairs))
     for x in ratios:
         out.append(f"| {x:g} | " + " | ".join(cells.get((lab, ics, x), "—") for lab, ics in pairs) + " |")
+    lab = [r for r in reg if r.get("labelled")]
+    if lab:
+        L0 = lab[0]["labelled"]
+        out.append(
+            f"\n**Labelled sets** (the band's orbits and a sample either side, run again with the tangent dynamics to "
+            f"t = {L0['t_label']:g} and labelled by the variational FTLE λ_T: regular below {L0['ftle_regular']:g}, "
+            f"chaotic above {L0['ftle_chaotic']:g} or when the orbit leaves; disagreements in the band: regular by the "
+            "shadow and chaotic by λ_T, and the reverse; the indicator systematic scales them to the band)\n"
+        )
+        out.append(
+            "| system | E/E_c | labelled | of the band | undecided | shadow regular, λ_T chaotic | the reverse "
+            "| outside the band | indicator syst. | threshold syst. |"
+        )
+        out.append("|---|---|---|---|---|---|---|---|---|---|")
+        for r in lab:
+            L = r["labelled"]
+            out.append(
+                f"| {r['label']} | {r['e_ratio']:g} | {L['n_labelled']} | {L['n_band_labelled']} of {L['n_band']} "
+                f"| {L['n_undecided']} | {L['disagree_to_chaotic']} | {L['disagree_to_regular']} "
+                f"| {L['disagree_outside']} | {_pct(r.get('syst_indicator'))} | {_pct(r.get('syst'))} |"
+            )
     P = {(r["label"], r["e_ratio"], r["t"]): r for r in doc.get("survival_long", [])}
     ts = sorted({r["t"] for r in doc.get("survival_long", [])})
     out.append(

@@ -492,35 +492,28 @@ def _pc(x: float) -> str:
 
 
 def _generality_indicator_systematic(get: Loader) -> str:
-    """Per disk cell with a labelled set: what was labelled, the two indicators' disagreements, and the indicator
-    systematic beside the threshold's; then in how many cells the one is the larger."""
+    """The labelled sets in one sentence (each cell's counts are in the evidence's table of labelled sets): how
+    many cells and orbits, how many undecided and how many disagreements in the bands, in how many cells the
+    indicator systematic is the larger of the two systematics and where it is largest; the largest total error."""
     d = get("generality", None)
     cells = [r for r in d["regular_fraction"] if r.get("labelled")]
     if not cells:
-        return "no cell of this record has a labelled set (every regular fraction is 0 or 1)"
-    lab0 = cells[0]["labelled"]
-    out = []
-    for r in cells:
-        L = r["labelled"]
-        shift = typographic_minus(f"{100 * L['shift']:+.2g}")
-        out.append(
-            f"{r['label']} {r['e_ratio']:g} E_c: {_int(L['n_labelled'])} labelled ({_int(L['n_band_labelled'])} of "
-            f"the {_int(L['n_band'])} orbits of the band), {_int(L['n_undecided'])} undecided; in the band "
-            f"{L['disagree_to_chaotic']} regular by the shadow and chaotic by the FTLE, {L['disagree_to_regular']} "
-            f"the reverse ({L['disagree_outside']} disagreement{'' if L['disagree_outside'] == 1 else 's'} outside it): "
-            "indicator systematic "
-            f"{_pc(r['syst_indicator'])} (a shift of the fraction by {shift} %), "
-            f"threshold systematic {_pc(r['syst'])}"
-        )
+        return "No cell of this record has a labelled set (every regular fraction is 0 or 1)"
+    n_lab = sum(r["labelled"]["n_labelled"] for r in cells)
+    n_und = sum(r["labelled"]["n_undecided"] for r in cells)
+    to_c = sum(r["labelled"]["disagree_to_chaotic"] for r in cells)
+    to_r = sum(r["labelled"]["disagree_to_regular"] for r in cells)
     larger = [r for r in cells if r["syst_indicator"] > r["syst"]]
+    top = max(cells, key=lambda r: r["syst_indicator"])
     worst = max(cells, key=lambda r: r["err_total"] or 0.0)
     return (
-        f"Labelled at t = {lab0['t_label']:g} (regular below λ_T = {lab0['ftle_regular']:g}, chaotic above "
-        f"{lab0['ftle_chaotic']:g}), by cell: "
-        + "; ".join(out)
-        + f". The indicator systematic is the larger of the two in {len(larger)} of {len(cells)} cells; the largest "
-        f"total error is at {worst['label']} {worst['e_ratio']:g} E_c, "
-        f"{_pc(worst['fraction'])} ± {_pc(worst['err_total'])} (stat ⊕ threshold ⊕ indicator)"
+        f"The labelled sets: {len(cells)} cells, {_int(n_lab)} orbits, {_int(n_und)} of them undecided; in the bands"
+        f" {to_c} orbits are regular by the shadow and chaotic by the FTLE and {to_r} the reverse (each "
+        "cell in the table of labelled sets below). The indicator systematic is the larger of the two in "
+        f"{len(larger)} of {len(cells)} cells and largest at {top['label']} {top['e_ratio']:g} E_c "
+        f"({_pc(top['syst_indicator'])}, threshold systematic {_pc(top['syst'])}); the largest total error is at "
+        f"{worst['label']} {worst['e_ratio']:g} E_c, {_pc(worst['fraction'])} ± {_pc(worst['err_total'])} "
+        "(stat ⊕ threshold ⊕ indicator)"
     )
 
 

@@ -696,6 +696,7 @@ def test_the_regular_fraction_shows_both_systematics_and_the_validity_map_its_to
     }
     out = hook.evidence_tables(doc)
     assert "| 1.05 | 63.8 ± 0.5 ± 3.0 ± 4.0 % |" in out
+    assert "Labelled sets" not in out  # no labelled set in the record: no table of them
     assert "| b | 1.05 | 6380 of 10000: 64 ± 5 % |" in out
 
 
@@ -875,3 +876,22 @@ def test_a_rate_symbol_of_one_study_is_not_reused_by_another():
     assert "generality" not in rows["κ∞"], rows["κ∞"]
     assert "κ∞" not in (ROOT / "studies" / "generality" / "page.md").read_text()
     assert "b/T" not in (ROOT / "studies" / "saddle" / "page.md").read_text()
+
+
+def test_the_labelled_sets_have_a_table_of_their_own_counts(hook):
+    """Each cell with a labelled set is one row: its counts as the record holds them and both systematics."""
+    L = {"t_label": 3000.0, "ftle_regular": 0.003, "ftle_chaotic": 0.005, "n_labelled": 500, "n_band": 5754}
+    L |= {"n_band_labelled": 400, "n_undecided": 30, "disagree_to_chaotic": 10, "disagree_to_regular": 0}
+    L |= {"disagree_outside": 2, "shift": -0.0144, "syst": 0.0144}
+    doc = {
+        "config": {"study": {"ratios": [1.05]}},
+        "regular_fraction": [
+            {"id": "b-1.05-disk", "label": "b", "ics": "disk/tangential", "e_ratio": 1.05, "fraction": 0.638}
+            | {"err": 0.005, "syst": 0.043, "syst_indicator": 0.0144, "err_total": 0.046, "n": 10000, "labelled": L}
+        ],
+        "survival_long": [],
+        "long_time": [],
+    }
+    out = hook.evidence_tables(doc)
+    assert "to t = 3000 and labelled by the variational FTLE λ_T: regular below 0.003, chaotic above 0.005" in out
+    assert "| b | 1.05 | 500 | 400 of 5754 | 30 | 10 | 0 | 2 | 1.44 % | 4.3 % |" in out

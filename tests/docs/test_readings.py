@@ -748,7 +748,11 @@ def test_the_validity_reading_splits_the_cells_at_1_percent_by_the_total_error()
     assert "the total error reaches across 1 % at a 1.1" in text and "Both conditions are met for a at 1.5 E_c" in text
 
 
-def test_the_indicator_systematic_reading_states_each_labelled_cell_from_its_record():
+def test_the_indicator_systematic_reading_sums_the_labelled_cells_and_names_the_largest():
+    """Two labelled cells (b: indicator 1.44 % below threshold 4.3 %; c: indicator 4.5 % above threshold 1 %) and one
+    without: 900 orbits, 24 undecided, 27 and 5 disagreements; the indicator the larger in 1 of 2 cells, largest at
+    c; the largest total error hypot(0.5, 1, 4.5) % = 4.6 % at c (b: hypot(0.5, 4.3, 1.44) % = 4.56 %)."""
+
     def rec(label, n_band, to_chaotic, to_regular, syst_ind, syst):
         L = {"t_label": 3000.0, "ftle_regular": 0.003, "ftle_chaotic": 0.005, "n_labelled": 450, "n_band": n_band}
         L |= {"n_band_labelled": 400, "n_undecided": 12, "disagree_to_chaotic": to_chaotic}
@@ -761,11 +765,13 @@ def test_the_indicator_systematic_reading_states_each_labelled_cell_from_its_rec
     doc = {"regular_fraction": [rec("b", 5754, 7, 3, 0.0144, 0.043), rec("c", 8237, 20, 2, 0.045, 0.01)]}
     doc["regular_fraction"].append({"label": "h", "e_ratio": 2.0, "fraction": 0.0, "labelled": None})
     text = READINGS["generality.indicator_systematic"](_loader({"generality": doc}))
-    assert "b 1.05 E_c: 450 labelled (400 of the 5\u2009754 orbits of the band), 12 undecided" in text
-    assert "7 regular by the shadow and chaotic by the FTLE, 3 the reverse (1 disagreement outside it)" in text
-    assert "indicator systematic 1.4 %" in text and "threshold systematic 4.3 %" in text
-    assert "the larger of the two in 1 of 2 cells" in text and "largest total error is at c 1.05 E_c" in text
+    assert text.startswith("The labelled sets: 2 cells, 900 orbits, 24 of them undecided; in the bands 27")
+    assert "27 orbits are regular by the shadow and chaotic by the FTLE and 5 the reverse" in text
+    assert "the larger of the two in 1 of 2 cells and largest at c 1.05 E_c (4.5 %, threshold systematic 1 %)" in text
+    assert "the largest total error is at c 1.05 E_c, 60 % ± 4.6 %" in text
     assert " h " not in text
+    doc["regular_fraction"] = doc["regular_fraction"][2:]
+    assert READINGS["generality.indicator_systematic"](_loader({"generality": doc})).startswith("No cell")
 
 
 def _mu_rows(pred_default, pred_second):
