@@ -10,13 +10,12 @@ momenta), linear drag. Rules in the header of ``studies/generality/study.toml``;
 ``<label>_probe_r<r>``, the dissipative runs ``<label>_g<γ>`` at E0, the section runs ``<label>_cm_r<r>`` and
 ``<label>_sec_g<γ>``; "evidence": the long runs ``<label>_ev_<ics>_r<r>`` and Poincaré runs ``<label>_ps_r<r>``,
 each with the shadow run of its orbits still inside near t_max (``…_shadow``), the labelled sets
-``<label>_ev_disk_r<r>_label`` (the disk ensembles' ambiguous band run again with the tangent dynamics), the κ0 runs ``<label>_map_r<r>`` at
-the validity map's energies off the claims' grid (the claims' scene) and the r_esc runs ``<label>_resc<R>_…``.
+``<label>_ev_disk_r<r>_label`` (the disk ensembles' ambiguous band again with the tangent dynamics), the κ0 runs
+``<label>_map_r<r>`` at the validity map's energies off the claims' grid and the r_esc runs ``<label>_resc<R>_…``.
 
 ``analyze`` — claims 1–7 (records {claim, quantity, system, value, err, verdict, note}) and the evidence
 (regular_fraction, survival_long, long_time, validity_map and its validity_rules, resc, resc_kappa, r_esc_rule) in
-``generality.json``; evidence alone merges
-into the generality.json already in the output folder.
+``generality.json``; evidence alone merges into the generality.json already in the output folder.
 
 ``plot`` — ``generality.png`` (the claims) and ``generality_regular.png``, ``generality_sections.png``,
 ``generality_decay.png`` (the evidence), figure.py.
@@ -121,8 +120,6 @@ class Params(StudyParams):
     ev_times: Numbers = [100.0, 200.0, 400.0, 800.0, 2000.0]
     ev_fit_t0: Number = 100.0
     ev_hazard_edges: Numbers = [100.0, 200.0, 400.0, 800.0, 1400.0, 2000.0]
-    # the labelled set: per disk ensemble with a regular fraction neither 0 nor 1, up to lab_band_n orbits whose shadow
-    # growth lies in lab_band and lab_side_n either side, run again with the tangent dynamics to lab_t_max
     lab_band: Numbers = [10.0, 1e7]
     lab_band_n: Integer = 400
     lab_side_n: Integer = 50
@@ -422,9 +419,8 @@ def _simulate_evidence(study, workers, progress):
 
 
 def _simulate_labelled(study, sysl, workers, progress):
-    """The labelled sets: per disk ensemble whose regular fraction is neither 0 nor 1, the orbits of its shadow
-    band and a sample either side (:func:`hhscatter.reproduction.claims.chain.labelled_set`) run again from their
-    initial conditions with the tangent dynamics to lab_t_max (raw key ``<label>_ev_disk_r<r>_label``)."""
+    """The labelled sets (:func:`~hhscatter.reproduction.claims.chain.labelled_set`): per disk ensemble of regular
+    fraction neither 0 nor 1, its shadow band and a sample either side, again with the tangent dynamics."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
