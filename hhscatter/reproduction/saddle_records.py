@@ -486,7 +486,7 @@ def with_gap(rec: dict) -> dict:
         alt["fluctuation"] = (Measured(implied.value + sh["value"], math.hypot(implied.err, sh["err"])), d1)
     if rec.get("hyperbolic"):
         h = rec["hyperbolic"]
-        lam_h = {"value": rec["lyapunov"] + h["lyapunov_shift"]["value"], "err": h["lyapunov_shift"]["err"]}
+        lam_h = Measured(rec["lyapunov"] + h["lyapunov_shift"]["value"], h["lyapunov_shift"]["err"]).to_dict()
         alt["hyperbolic"] = (implied_by(lam_h), Measured(h["d1"]["value"], h["d1"]["err"]))
     out = {"gap": gap.to_dict(), "z": rec["z"]}
     for name, (imp, d) in alt.items():

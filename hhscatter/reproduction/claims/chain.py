@@ -21,7 +21,7 @@ from hhscatter.reproduction.claims.keys import cm_ratios, ev_key, lab_key, map_k
 from hhscatter.reproduction.claims.records import RULES, Claims
 from hhscatter.reproduction.claims.resc import r_esc_rule, resc_kappa_rows, resc_rows
 
-__all__ = ["analyze_claims", "analyze_evidence", "check_params", "validity_rules"]
+__all__ = ["analyze_claims", "analyze_evidence", "check_params", "labelled_set", "validity_rules"]
 
 #: the system whose fits are claim 6's reference (the paper's system)
 REFERENCE_SYSTEM = "henon_heiles"
