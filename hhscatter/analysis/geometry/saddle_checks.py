@@ -357,6 +357,18 @@ def _x_partition(L, T, kappa: float, q: float) -> float:
     return math.nan
 
 
+def _resampling_and_mean(L, T, n_boot, seed) -> tuple[int, int, float]:
+    """The checked bootstrap count and seed, and λ̄ = ΣΛ/ΣT of at least 2 orbits, refused unless > 0."""
+    n_boot = _count(n_boot, "n_boot", 0)
+    seed = _count(seed, "seed", 0)
+    if L.size < 2:
+        raise ConfigError(f"log_stretch: {L.size} orbit, at least 2 needed")
+    lam = float(L.sum() / T.sum())
+    if not lam > 0:
+        raise ConfigError(f"log_stretch: the mean exponent ΣΛ/ΣT = {lam:.4g} is not > 0 (no unstable direction)")
+    return n_boot, seed, lam
+
+
 def ftle_dimension(
     log_stretch,
     duration,
@@ -424,13 +436,7 @@ def ftle_dimension(
         raise ConfigError(f"q must be a finite number (the dimension's order), got {q!r}")
     if form not in FTLE_FORMS:
         raise ConfigError(f"form must be one of {', '.join(FTLE_FORMS)}, got {form!r}")
-    n_boot = _count(n_boot, "n_boot", 0)
-    seed = _count(seed, "seed", 0)
-    if L.size < 2:
-        raise ConfigError(f"log_stretch: {L.size} orbit, at least 2 needed")
-    lam = float(L.sum() / T.sum())
-    if not lam > 0:
-        raise ConfigError(f"log_stretch: the mean exponent ΣΛ/ΣT = {lam:.4g} is not > 0 (no unstable direction)")
+    n_boot, seed, lam = _resampling_and_mean(L, T, n_boot, seed)
     solve = _x_partition if form == "partition" else _x_cumulant
     x = solve(L, T, kappa, float(q))
     if math.isnan(x):
@@ -518,13 +524,7 @@ def low_ftle_share(log_stretch, duration, *, threshold: float = 0.5, n_boot: int
     L, T = _stretch_arrays(log_stretch, duration)
     if isinstance(threshold, bool) or not isinstance(threshold, (int, float)) or not 0 < threshold < 1:
         raise ConfigError(f"threshold must be a fraction 0 < threshold < 1 of λ̄, got {threshold!r}")
-    n_boot = _count(n_boot, "n_boot", 0)
-    seed = _count(seed, "seed", 0)
-    if L.size < 2:
-        raise ConfigError(f"log_stretch: {L.size} orbit, at least 2 needed")
-    lam = float(L.sum() / T.sum())
-    if not lam > 0:
-        raise ConfigError(f"log_stretch: the mean exponent ΣΛ/ΣT = {lam:.4g} is not > 0 (no unstable direction)")
+    n_boot, seed, lam = _resampling_and_mean(L, T, n_boot, seed)
     hyp = L / T >= threshold * lam
     n, n_low = L.size, int(np.count_nonzero(~hyp))
     p = n_low / n
