@@ -154,7 +154,7 @@ def format_value(v, *, html: bool = False) -> str:
     counted at 0 or at all (:func:`leaf_bound`) → its one-sided bound "< b (95 %)", short lists element by element,
     longer lists and tables by their size.
 
-    >>> format_value({"value": 0.9123, "err": 0.0031}), format_value(Measured(0.9123, 0.0031)), format_value(Measured(0.9123))
+    >>> format_value(Measured(0.9123, 0.0031).to_dict()), format_value(Measured(0.9123, 0.0031)), format_value(Measured(0.9123))
     ('0.912 ± 0.003', '0.912 ± 0.003', '0.9123')
     >>> format_value({"value": 0.0, "lo": 0.0, "hi": 1.7e-5, "n": 60000})
     '< 5.0e-5 (95 %)'
@@ -196,11 +196,11 @@ def format_leaf(key: str, v, *, html: bool = False) -> str:
     shift to a reference (ending ``_vs_ref`` or ``_from_ref``, or naming a ``difference`` or ``shift``) reads
     "reference", never a measured 0.
 
-    >>> format_leaf("kappa.E=0.25.r_esc=1.03.shift_vs_ref", {"value": 0.0, "err": 0.0})
+    >>> format_leaf("kappa.E=0.25.r_esc=1.03.shift_vs_ref", Measured(0.0, 0.0))
     'reference'
-    >>> format_leaf("kappa.E=0.25.r_esc=1.1.shift_vs_ref", {"value": -0.00207, "err": 0.00118})
+    >>> format_leaf("kappa.E=0.25.r_esc=1.1.shift_vs_ref", Measured(-0.00207, 0.00118))
     '-0.0021 ± 0.0012'
-    >>> format_leaf("returns.n_returned", {"value": 0.0, "err": 0.0})
+    >>> format_leaf("returns.n_returned", Measured(0.0, 0.0).to_dict())
     '0'
     """
     name = str(key).rsplit(".", 1)[-1]

@@ -182,7 +182,7 @@ def resolve(doc, path: str):
 
     Examples
     --------
-    >>> doc = {"fit": {"c": {"value": 1.43, "err": 0.02}}, "E0.30": {"n": 7}, "rows": [{"E": 0.25, "k": 0.09}]}
+    >>> doc = {"fit": {"c": Measured(1.43, 0.02).to_dict()}, "E0.30": {"n": 7}, "rows": [{"E": 0.25, "k": 0.09}]}
     >>> resolve(doc, "fit.c"), resolve(doc, "E0.30.n"), resolve(doc, "rows[E=0.25].k")
     ({'value': 1.43, 'err': 0.02}, 7, 0.09)
     """
@@ -289,7 +289,7 @@ def _format_leaf(leaf, fmt: str | None = None) -> str:
 
     Examples
     --------
-    >>> leaf = {"value": 1.4348590, "err": 0.0170464}
+    >>> leaf = Measured(1.4348590, 0.0170464).to_dict()
     >>> format_leaf(leaf), format_leaf(leaf, "value"), format_leaf(leaf, "err"), format_leaf(0.0623, "pct")
     ('1.435 ± 0.017', '1.435', '0.017', '6.23 %')
     >>> format_leaf(Measured(0.0623, 0.0011), "pct"), format_leaf(Measured(0.0623), "pct")

@@ -524,7 +524,7 @@ def comparison_rows(per, hb) -> list[dict]:
 
     Examples
     --------
-    >>> rec = {"energy": 0.25, "gamma": 0.01, "alpha": {"value": 0.31, "err": 0.02}, "alpha_fit_range": [1e-6, 1e-3],
+    >>> rec = {"energy": 0.25, "gamma": 0.01, "alpha": Measured(0.31, 0.02).to_dict(), "alpha_fit_range": [1e-6, 1e-3],
     ...        "d": {"value": 1.69}, "S_bb": None, "cutoff": {"detected": False, "eps_c_hi": 2e-6}}
     >>> [(r["quantity"], r["ours"]) for r in comparison_rows([rec], 10)]
     [('uncertainty exponent α (E0=0.25, γ=0.01)', 0.31), ('cut-off ε_c of the power law f(ε) (E0=0.25, γ=0.01)', None)]

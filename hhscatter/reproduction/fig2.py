@@ -187,7 +187,8 @@ def law_comparisons(continuous: dict, separate: dict, across: dict, ill, paper: 
     Examples
     --------
     >>> import pandas as pd
-    >>> fit = {k: {"value": v, "err": 0.01} for k, v in PAPER_FIG2.items()}
+    >>> from hhscatter.analysis.stats import Measured
+    >>> fit = {k: Measured(v, 0.01).to_dict() for k, v in PAPER_FIG2.items()}
     >>> rows = law_comparisons(fit, fit, {}, pd.DataFrame({"energy": [], "convention": []}))
     >>> len(rows), rows[0]["verdict"]
     (9, 'agrees within 2σ')

@@ -15,8 +15,9 @@ def kappa_references(doc: dict) -> tuple[dict, dict]:
 
     Examples
     --------
+    >>> from hhscatter.analysis.stats import Measured
     >>> doc = {"kappa_energy": [{"energy": 0.3, "kappa": 0.2, "kappa_err": 0.01}],
-    ...        "cmeasure": {"a": {"energy": 0.3, "kappa_cm": {"value": 0.19, "err": 0.001}}}}
+    ...        "cmeasure": {"a": {"energy": 0.3, "kappa_cm": Measured(0.19, 0.001).to_dict()}}}
     >>> kappa_references(doc)
     ({0.3: (0.2, 0.01)}, {0.3: (0.19, 0.001)})
     """

@@ -255,7 +255,8 @@ def value_and_err(v):
 
     Examples
     --------
-    >>> value_and_err({"value": 3.0, "err": 0.5}), value_and_err(4)
+    >>> from hhscatter.analysis.stats import Measured
+    >>> value_and_err(Measured(3.0, 0.5).to_dict()), value_and_err(4)
     ((3.0, 0.5), (4.0, None))
     """
     if isinstance(v, dict):
@@ -275,7 +276,8 @@ def tau_reference(rows, lifetimes: dict, *, E0: float, dt: float, fields=("gamma
 
     Examples
     --------
-    >>> rows = [{"gamma": 0.01, "tau1": {"value": 120.0, "err": 4.0}, "tau2": 300.0}]
+    >>> from hhscatter.analysis.stats import Measured
+    >>> rows = [{"gamma": 0.01, "tau1": Measured(120.0, 4.0).to_dict(), "tau2": 300.0}]
     >>> lt = pd.DataFrame({"t_end": [1.0, 2.0], "outcome": ["escaped", "escaped"]})
     >>> ref = tau_reference(rows, {0.0: lt, 0.01: lt, 0.02: lt}, E0=0.3, dt=1.0)
     >>> ref.obs.values.tolist(), sorted(ref.lifetimes), ref.P_0[1].tolist()

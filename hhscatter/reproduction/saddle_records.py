@@ -453,7 +453,7 @@ def with_gap(rec: dict) -> dict:
     Examples
     --------
     >>> rec = {"kappa": 0.1, "kappa_err": 0.0, "lyapunov": 0.4, "lyapunov_err": 0.0, "d1": 0.70, "d1_err": 0.01,
-    ...        "d1_implied": 0.75, "d1_implied_err": 0.0, "z": -5.0, "d1_radius": {"value": 0.74, "err": 0.01}}
+    ...        "d1_implied": 0.75, "d1_implied_err": 0.0, "z": -5.0, "d1_radius": Measured(0.74, 0.01).to_dict()}
     >>> g = with_gap(rec)["gap"]
     >>> round(g["gap"]["value"], 3), round(g["estimator"]["share"], 3), g["estimator"]["closes"]
     (0.05, 0.8, True)
@@ -505,8 +505,8 @@ def gap_row(rec: dict) -> dict:
 
     Examples
     --------
-    >>> gap_row({"id": "a", "system": "hh", "ratio": 1.5, "gap": {"gap": {"value": 0.05, "err": 0.01}, "z": -5.0,
-    ...          "estimator": {"left": {"value": 0.01, "err": 0.014}, "z": 0.7, "share": 0.8, "closes": True}}})
+    >>> gap_row({"id": "a", "system": "hh", "ratio": 1.5, "gap": {"gap": Measured(0.05, 0.01).to_dict(), "z": -5.0,
+    ...          "estimator": {"left": Measured(0.01, 0.014).to_dict(), "z": 0.7, "share": 0.8, "closes": True}}})
     ... # doctest: +NORMALIZE_WHITESPACE
     {'id': 'a', 'system': 'hh', 'ratio': 1.5, 'gap': {'value': 0.05, 'err': 0.01}, 'z': -5.0,
      'left_estimator': {'value': 0.01, 'err': 0.014}, 'share_estimator': 0.8}
@@ -530,9 +530,9 @@ def gap_summary(records) -> dict:
 
     Examples
     --------
-    >>> recs = [{"id": "a", "gap": {"gap": {"value": 0.05, "err": 0.01}, "z": -5.0,
+    >>> recs = [{"id": "a", "gap": {"gap": Measured(0.05, 0.01).to_dict(), "z": -5.0,
     ...          "estimator": {"closes": False, "share": 0.1}, "mid_life": {"closes": False, "share": -0.2}}},
-    ...         {"id": "b", "gap": {"gap": {"value": 0.0, "err": 0.01}, "z": 0.1}}, {"id": "c"}]
+    ...         {"id": "b", "gap": {"gap": Measured(0.0, 0.01).to_dict(), "z": 0.1}}, {"id": "c"}]
     >>> s = gap_summary(recs)
     >>> s["n_gap"], s["candidates"]["estimator"]["n_closes"], s["not_explained"]
     (1, 0, ['a'])

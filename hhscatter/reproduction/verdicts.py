@@ -214,7 +214,8 @@ def claim_verdict(rec: dict, scale: str | None = None) -> str:
 
     Examples
     --------
-    >>> claim_verdict({"claim": "1", "quantity": "κ0", "system": "hh", "value": 0.2, "err": 0.01, "reference": 0.27,
+    >>> from hhscatter.analysis.stats import Measured
+    >>> claim_verdict({"claim": "1", "quantity": "κ0", "system": "hh", **Measured(0.2, 0.01).to_dict(), "reference": 0.27,
     ...                "verdict": "differs from the paper's 0.27 (z = −7.0)"})
     'differs (z = −6.3)'
     """

@@ -22,8 +22,9 @@ docs/studies/assets/ have none, and are checked for everything else.
 
 Examples
 --------
+>>> from hhscatter.analysis.stats import Measured
 >>> config = {"study": {"fit_window": [0.0, 200.0]}}
->>> doc = sealed({"mu": {"value": 0.9287, "err": 0.001}, "config": config,
+>>> doc = sealed({"mu": Measured(0.9287, 0.001).to_dict(), "config": config,
 ...               "made_from": {"config_sha256": config_sha256(config), "upstream": {}, "raw_runs": {}}})
 >>> verify_numbers(Path("fig3.json"), doc, config=config, scale="quick", upstream={})   # as written: passes
 >>> doc["mu"]["value"] = 0.91                                                            # edited by hand

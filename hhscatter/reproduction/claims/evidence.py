@@ -310,11 +310,11 @@ def kappa0_defined_by_rule(cell: dict, max_bias: float):
     ``kappa0_tau0``, ``kappa0_t_hi`` and the first escape ``kappa0_t_first`` (time units). A record made before the
     cells carried them is judged on the plateau condition alone.
 
-    >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.84}, 0.1)
+    >>> kappa0_defined_by_rule({"kappa0": Measured(0.02, 0.001).to_dict(), "plateau_bias": 0.84}, 0.1)
     False
-    >>> kappa0_defined_by_rule({"kappa0": {"value": 0.02, "err": 0.001}, "plateau_bias": 0.03}, 0.1)
+    >>> kappa0_defined_by_rule({"kappa0": Measured(0.02, 0.001).to_dict(), "plateau_bias": 0.03}, 0.1)
     True
-    >>> burst = {"kappa0": {"value": 1.26, "err": 0.29}, "plateau_bias": 0.0, "kappa0_tau0": 0.0, "kappa0_t_first": 1.56}
+    >>> burst = {"kappa0": Measured(1.26, 0.29).to_dict(), "plateau_bias": 0.0, "kappa0_tau0": 0.0, "kappa0_t_first": 1.56}
     >>> kappa0_defined_by_rule(burst, 0.1)     # the window starts 2 e-folds of its κ before anyone has left
     False
     """

@@ -4,6 +4,7 @@ against a Monte-Carlo sample of independent Gaussian inputs."""
 from __future__ import annotations
 
 import ast
+import doctest
 import json
 import math
 from pathlib import Path
@@ -67,6 +68,30 @@ def _records_with_value_and_err(path: Path) -> list[str]:
 def test_records_with_more_fields_take_their_value_and_error_from_a_measured():
     files = sorted((ROOT / "hhscatter").rglob("*.py")) + sorted((ROOT / "studies").rglob("*.py"))
     assert [h for f in files for h in _records_with_value_and_err(f)] == []
+
+
+def _doctest_inputs_with_value_and_err(path: Path) -> list[str]:
+    """Docstring examples of ``path`` whose input (a ``>>>`` line, not the expected output) spells a dict with
+    "value" and "err" keys: a measured value a reader should see as a Measured."""
+    parser = doctest.DocTestParser()
+    hits = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if not (isinstance(node, ast.Constant) and isinstance(node.value, str) and ">>>" in node.value):
+            continue
+        for ex in parser.get_examples(node.value):
+            for sub in ast.walk(ast.parse(ex.source)):
+                if isinstance(sub, ast.Dict) and {"value", "err"} <= {getattr(k, "value", None) for k in sub.keys}:
+                    hits.append(f"{path.relative_to(ROOT)}:{node.lineno + ex.lineno}")
+    return hits
+
+
+def test_docstring_examples_write_a_value_with_its_error_as_a_measured():
+    # Measured.from_dict's own examples read the literal shape back; every other example builds it from a Measured
+    files = sorted((ROOT / "hhscatter").rglob("*.py")) + sorted((ROOT / "studies").rglob("*.py"))
+    hits = [h for f in files for h in _doctest_inputs_with_value_and_err(f)]
+    own = [h for h in hits if h.startswith("hhscatter/analysis/stats/measured.py:")]
+    assert len(own) == 2, own
+    assert [h for h in hits if h not in own] == []
 
 
 def test_is_frozen():
