@@ -1,6 +1,6 @@
 """Energy decay of a dissipative ensemble: E(t), the decay exponent μ, energy histograms.
 
-Reference: Sec. III.A.1 and fig:energy_decay of arXiv:2308.13555.
+Reference: Sec. III.A.1 of Burton, Dullin & Altmann (2023).
 
 With linear drag the energy of every orbit decays as dE/dt = −γ v², Eq.
 (eqn:energy_diffeq).  Approximating the potential, on average along an orbit,
@@ -9,30 +9,30 @@ by V = (μ/2) E gives the homogeneous law, Eq. (eqn:energy_exp_decay),
     E(t) = E0 exp(−μ γ t),
 
 with μ ≈ 1 (exactly 1 for damped oscillations about the stable fixed point).
-The paper fits ⟨E⟩(t), the mean over orbits still inside Ω at t, by least
-squares on log⟨E⟩ and reports μ = 0.91 on t ∈ [0, 200] for (E0, γ) =
-(0.3, 0.01), arguing that the local exponent tends to 1 at late times.
+μ is fitted to ⟨E⟩(t), the mean over orbits still inside Ω at t, by least
+squares on log⟨E⟩; the local exponent on a late window tests whether it
+tends to 1 at late times.
 
 Functions here are pure (no file I/O, no plotting):
 
 * :func:`energy_path`, :func:`time_to_energy` — the law itself and its
-  inverse (t* of Fig. 5; τ2 of Eq. (eq:tau2) is the case E1 = E_c);
+  inverse (the time t* to reach E1; τ2 of Eq. (eq:tau2) is the case E1 = E_c);
 * :func:`mean_energy` / :func:`mean_energy_arrays` — ⟨E⟩, σ_E and its standard
-  error per snapshot grid time (the Fig. 3 curve and its 3σ ribbon);
+  error per snapshot grid time (the mean curve and its 3σ ribbon);
 * :func:`pool_mean_energy` — the same statistics pooled over several tables
   (e.g. one per part file, so that N = 10^7 never sits in memory at once);
 * :func:`inside_mean_energy` — ⟨E⟩(t) of every orbit not escaped by t and of
   those still above E_c, pooled over the part tables of one run;
-* :func:`snapshot_grid` — the snapshot times of a study, from [start, stop, step] pieces;
-* :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the paper's
-  model) and with a free intercept (the local exponent);
+* :func:`snapshot_grid` — the snapshot times of a run, from [start, stop, step] pieces;
+* :func:`fit_energy_decay` — μ with the intercept fixed at log E0 (the
+  homogeneous law) and with a free intercept (the local exponent);
 * :func:`mu_by_window` — the same fits over a list of windows (μ → 1 test);
 * :func:`bootstrap_mu` — statistical errors of those fits (bootstrap over orbits),
   :func:`bootstrap_mu_first_orbits` on the first K orbits with errors scaled to N;
 * :func:`decay_exponent` — μ of ⟨E⟩(t) over every orbit not escaped, with its bootstrap error, in one call;
 * :func:`orbit_decay_exponent` — μ of a chosen set of orbits from their own start and end energies
   (Σ ln(E0/E_end) / (γ Σ t)), not the ensemble mean;
-* :func:`energy_histograms` — energy distributions at chosen times (Fig. 3 inset).
+* :func:`energy_histograms` — energy distributions at chosen times.
 
 Units: the model's natural units (unit mass); t in time units, E in energy
 units, γ in 1/time; μ is dimensionless.
@@ -147,13 +147,13 @@ def _energy_path(t, E0, mu, gamma):
 def time_to_energy(E0, E1, mu, gamma):
     """time_to_energy(E0, E1, mu, gamma) -> t* with E0 exp(−μγt*) = E1, i.e. ln(E0/E1)/(μγ).
 
-    Inverse of Eq. (eqn:energy_exp_decay); the paper's Fig. 5 time t* ≈ 17
-    for (E0, E1, μ, γ) = (0.35, 0.30, 0.91, 0.01).  Eq. (eq:tau2) is the
+    Inverse of Eq. (eqn:energy_exp_decay): the time t* at which the law
+    reaches E1 from E0.  Eq. (eq:tau2) is the
     special case E1 = E_c.  Broadcasts; needs E0 ≥ E1 > 0 and μγ > 0.
 
     Examples
     --------
-    >>> round(time_to_energy(0.35, 0.30, 0.91, 0.01), 2)     # ln(0.35/0.30)/(0.91 · 0.01), the paper's t* ≈ 17
+    >>> round(time_to_energy(0.35, 0.30, 0.91, 0.01), 2)     # ln(0.35/0.30)/(0.91 · 0.01)
     16.94
     >>> time_to_energy([0.3, 0.4], 1 / 6, 1.0, 0.01).round(1).tolist()     # down to E_c = 1/6
     [58.8, 87.5]
@@ -183,7 +183,7 @@ def mean_energy_arrays(t, energy) -> pd.DataFrame:
     * ``mean_E``   ⟨E⟩(t), the ensemble mean energy,
     * ``std_E``    sample standard deviation of E (ddof = 1; NaN when n = 1),
     * ``sem_E``    standard error of the mean, std_E / √n,
-    * ``lo_3sigma``, ``hi_3sigma``  ⟨E⟩ ∓ 3 std_E, the ribbon of Fig. 3.
+    * ``lo_3sigma``, ``hi_3sigma``  ⟨E⟩ ∓ 3 std_E, the spread's ribbon.
 
     NaN energies are ignored.  Energy in model units, t in time units.
 
@@ -226,8 +226,8 @@ def mean_energy(snapshots: pd.DataFrame) -> pd.DataFrame:
     DataFrame wrapper of :func:`mean_energy_arrays` for the engine's
     ``snapshots`` table (columns ``traj_id, t, energy``).  The table holds only
     orbits still alive (neither escaped nor settled) at each grid time, so
-    ``mean_E`` is the ⟨E⟩(t) "over orbits still inside Ω at t" of the paper's
-    Fig. 3 and ``n`` is N·P(t) on the snapshot grid.
+    ``mean_E`` is the ⟨E⟩(t) over orbits still inside Ω at t
+    and ``n`` is N·P(t) on the snapshot grid.
 
     Examples
     --------
@@ -316,8 +316,8 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
     """inside_mean_energy(parts, e_c) -> InsideMeanEnergy pooled over snapshot tables (columns t, energy).
 
     ``parts``: an iterable of DataFrames, e.g. one per part file of a run
-    whose settled orbits were continued (paper Fig. 3: ⟨E⟩ over the orbits
-    "inside Ω at time t"); E decreases monotonically for γ > 0, so the rows
+    whose settled orbits were continued (⟨E⟩ over the orbits
+    inside Ω at time t); E decreases monotonically for γ > 0, so the rows
     with E > E_c are those of orbits neither escaped nor settled. Memory stays
     O(grid + one part) for any N.
 
@@ -351,7 +351,7 @@ def inside_mean_energy(parts, e_c: float) -> InsideMeanEnergy:
 class EnergyDecayFit(WithErrors):
     """Result of :func:`fit_energy_decay` (all μ dimensionless).
 
-    Fixed intercept, the paper's Eq. (eqn:energy_exp_decay) with E(0) = E0:
+    Fixed intercept, Eq. (eqn:energy_exp_decay) with E(0) = E0:
         ``mu``, ``mu_err``, ``rms_log_residual``.
     Free intercept, log⟨E⟩ = a − μ γ t (the local decay exponent):
         ``mu_free``, ``mu_free_err``, ``log_E0_free``, ``log_E0_free_err``,
@@ -395,7 +395,7 @@ def fit_energy_decay(
     Weighted least squares of the log-transformed mean energy against the
     exponential law of Eq. (eqn:energy_exp_decay):
 
-    * fixed intercept (the paper's fit):  log⟨E⟩ − log E0 = −μ γ t,
+    * fixed intercept (homogeneous law): log⟨E⟩ − log E0 = −μ γ t,
     * free intercept (local exponent):    log⟨E⟩ = a − μ γ t.
 
     Parameters
@@ -408,10 +408,10 @@ def fit_energy_decay(
     gamma : float
         Drag coefficient γ > 0; μ is the fitted slope divided by −γ.
     window : (t_lo, t_hi)
-        Inclusive time window of the fit.  Paper: (0, 200) gives μ = 0.91.
+        Inclusive time window of the fit.
     weights : array or None
         Inverse variances of log⟨E⟩ per point, e.g. (mean_E / sem_E)²;
-        None = unit weights (ordinary least squares, as in the paper).
+        None = unit weights (ordinary least squares).
     absolute_sigma : bool
         If True (only meaningful with ``weights``) the errors use the weights
         as absolute variances; otherwise (default) the covariance is scaled
@@ -472,7 +472,7 @@ def _decay_window(t, mean_E, E0, gamma, window, weights):
 
 def _fit_fixed_intercept(t, y, w, E0, gamma, errors):
     """The fit with the intercept fixed at log E0, y − log E0 = −μ γ t: (μ, σ_μ, rms log residual); NaN without a
-    usable point (the fit of arXiv:2308.13555)."""
+    usable point (the fit of Burton, Dullin & Altmann (2023))."""
     nan = float("nan")
     if t.size >= 1 and np.sum(w * t * t) > 0:
         fit = weighted_least_squares(-t, y - np.log(E0), w, errors=errors)
@@ -503,7 +503,7 @@ def fit_energy_decay_table(
 
     Wrapper of :func:`fit_energy_decay` for the output of :func:`mean_energy`.
     ``weighted=True`` uses inverse-variance weights (mean_E / sem_E)² of
-    log⟨E⟩ (rows with n < 2 are then dropped); False reproduces the paper's
+    log⟨E⟩ (rows with n < 2 are then dropped); False gives the
     unweighted log fit of Eq. (eqn:energy_exp_decay).
 
     Examples
@@ -540,8 +540,8 @@ def mu_by_window(
     mu_err, mu_free, mu_free_err``.
 
     ``mu_free`` is the local exponent on the window, −d log⟨E⟩/d(γt); it is
-    the quantity for testing the paper's claim (Sec. III.A.1, below Eq.
-    (eqn:energy_exp_decay)) that μ → 1 at late times.  ``mu`` (intercept tied
+    the quantity for testing whether μ → 1 at late times (Sec. III.A.1 of
+    Burton, Dullin & Altmann (2023), below Eq. (eqn:energy_exp_decay)).  ``mu`` (intercept tied
     to E0) is the cumulative mean exponent ln(E0/⟨E⟩)/(γt) weighted over the
     window and lags behind the local value.
 
@@ -601,8 +601,8 @@ class EnergyHistograms:
 def energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms:
     """energy_histograms_arrays(t, energy, times, bins=50) -> EnergyHistograms.
 
-    Histograms of the energies of orbits alive at each requested time (the
-    inset of the paper's Fig. 3; they estimate the density ρ(E(t)) of Eq.
+    Histograms of the energies of orbits alive at each requested time (they
+    estimate the density ρ(E(t)) of Eq.
     (eqn:c-measure_model)).  Each requested time is mapped to the nearest
     snapshot grid time.  ``bins`` is a number of bins (then common edges span
     the min..max energy over the selected times) or an array of edges.

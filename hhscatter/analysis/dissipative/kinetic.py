@@ -2,7 +2,7 @@
 
 With linear drag ṗ = −∇V − γp the energy of an orbit obeys dE/dt = −γ|p|² = −2γK, Eq.
 (eqn:energy_diffeq). If the survivors at energy E are spread like a measure ν_E of the conservative flow
-(the c-measure, paper Sec. III.B), the ensemble's energy decays as dE/dt = −γ μ(E) E with
+(the c-measure, Sec. III.B of Burton, Dullin & Altmann (2023)), the ensemble's energy decays as dE/dt = −γ μ(E) E with
 
     μ(E) = 2⟨K⟩_ν_E / E,
 
@@ -19,7 +19,7 @@ for a homogeneous V ∝ r^k, by the virial theorem). Pure functions (no I/O):
 * :func:`microcanonical_kinetic_fraction` — the same for the microcanonical measure on
   {V < E} ∩ region: in two degrees of freedom its configuration density is uniform in area, so
   2⟨K⟩/E = 2(1 − ⟨V⟩_area/E);
-* :func:`decay_path` — E(t) from dE/dt = −γ μ(E) E for a given μ(E) (the homogeneous law of the paper
+* :func:`decay_path` — E(t) from dE/dt = −γ μ(E) E for a given μ(E) (the homogeneous law
   is μ constant).
 
 Units: energies in energy units, t in time units, γ in 1/time; μ dimensionless.

@@ -1,6 +1,6 @@
 """Mixture survival model: sub-ensembles of a dissipative ensemble, each with its own energy decay.
 
-Reference: the extension proposed at the end of Sec. III.B.3 of arXiv:2308.13555:
+Reference: the extension proposed at the end of Sec. III.B.3 of Burton, Dullin & Altmann (2023):
 "An improved agreement would be obtained by avoiding the approximation of
 homogeneous energy decay ... a mixture model for P(t) involving multiple
 sub-ensembles, each with their own energy decay exponent μ."  Design:
@@ -446,7 +446,7 @@ def fit_mixture_model(
 ) -> SurvivalFit:
     """fit_mixture_model(t, P, P_err, components, *, kappa_of_E, tau0, ...) -> SurvivalFit.
 
-    The mixture model the paper proposes at the end of Sec. III.B.3: sub-ensembles
+    The mixture model proposed at the end of Sec. III.B.3 of Burton, Dullin & Altmann (2023): sub-ensembles
     with their own energy-decay exponent μ, each following Eq. (eqn:surv_prob_model).
 
     Weighted least-squares fit of the mixture model (module docstring,

@@ -42,7 +42,7 @@ def _as_curve(P_0):
 def predict_tau1(params, P_0, alpha: float = 2.0, *, t_max: float | None = None, n_grid: int = 20001):
     """predict_tau1(params, P_0, alpha=2.0, *, t_max=None) -> float or None.
 
-    Predicted τ1 (Fig. 6b dashed line): solves Eq. (eqn:tau1),
+    Predicted τ1: solves Eq. (eqn:tau1),
     min{t ≥ τ0 : P_model(t) = α P_0(t)}, with P_model given by ``params``
     (a :class:`SurvivalModelParams`, :class:`MixtureModelParams`, a
     :class:`SurvivalFit`, or any object with ``tau0`` that is callable on t).
@@ -170,8 +170,8 @@ def better_fit(fits: dict) -> str | None:
     """better_fit({name: SurvivalFit, ...}) -> name of the fit with the smallest RMS log residual (None on a tie).
 
     For the same model, Eq. (eqn:surv_prob_model), fitted with different
-    fixed inputs (e.g. the κ0(E) law and μ fitted by us or stated by the
-    paper): the RMS of ln P_model − ln P (dimensionless) says which inputs
+    fixed inputs (e.g. the κ0(E) law and μ fitted from the data or taken from
+    a reference): the RMS of ln P_model − ln P (dimensionless) says which inputs
     reproduce the simulated P(t) better.  The RMS rather than χ² because the
     Kaplan–Meier points are correlated and χ² is only indicative (see
     :class:`SurvivalFit`); both fits have the same free parameters here.

@@ -5,7 +5,7 @@
 * :mod:`hhscatter.analysis.dissipative.survival_model` — the homogeneous model, its fit, the
   τ1 it predicts, and the comparison of fits;
 * :mod:`hhscatter.analysis.dissipative.mixture` — the mixture of sub-ensembles with their own
-  measured energy paths (the paper's proposed extension).
+  measured energy paths (the extension proposed by Burton, Dullin & Altmann (2023)).
 
 This module only gathers their names (``from hhscatter.analysis.dissipative import models``).
 """

@@ -1,13 +1,12 @@
 """The homogeneous survival model of dissipative scattering, Eq. (eqn:surv_prob_model), its fit
 and the τ1 it predicts; the sub-ensemble version is :mod:`hhscatter.analysis.dissipative.mixture`.
 
-Homogeneous model (the paper's)
--------------------------------
+Homogeneous model
+-----------------
 All orbits are assumed to share the energy path of Eq. (eqn:energy_exp_decay),
 E(t) = E0 e^{−μγt}, and hence the time-dependent escape rate
-κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate (paper Fig. 2b = fig:kappa-E-dependence:
-κ0 = 13.63 ΔE² + 0.03 ΔE for E < 0.27 and 1.41 ΔE above, ΔE = E − E_c,
-zero for E ≤ E_c; :class:`~hhscatter.analysis.survival.kappa_law.PiecewiseKappa`).  Then, Eq. (eqn:surv_prob_model),
+κ_γ(t) = κ0(E(t)), where κ0(E) is the conservative escape rate as a function of the energy (zero
+for E ≤ E_c; e.g. the piecewise law :class:`~hhscatter.analysis.survival.kappa_law.PiecewiseKappa`).  Then, Eq. (eqn:surv_prob_model),
 
     P_γ(t) = NaN ("irregular")                          t < τ0
            = f_ne + f_e exp(−κ_γ(t) (t − τ0))             τ0 ≤ t ≤ τ2
@@ -24,7 +23,7 @@ to μ by Eq. (eq:tau2), E(τ2) = E_c exactly).  A survival function cannot
 increase; the physically consistent reading of "exponential decay with a
 time-dependent rate", Eq. (eqn:Pt_escape_generic), is the cumulative hazard
 exp(−∫_{τ0}^{t} κ0(E(s)) ds), selected with ``hazard="integrated"``.  Both
-coincide for constant κ.  Which one reproduces the paper's Fig. 6a is for the
+coincide for constant κ.  Which one describes a measured P(t) is for the
 data to decide; the fitting code supports both.
 
 Both fits return :class:`SurvivalFit` with the same goodness-of-fit measures
@@ -161,7 +160,7 @@ def survival_model(
 ):
     """survival_model(t, *, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard) -> P(t).
 
-    The paper's survival model, Eq. (eqn:surv_prob_model), with
+    The homogeneous survival model, Eq. (eqn:surv_prob_model), with
     κ_γ(t) = κ0(E(t)) and E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)):
 
         t < τ0        NaN  (the "irregular" initial regime is not modelled)
@@ -311,9 +310,9 @@ def fit_survival_model(
 
     Parameters: f_ne, f_e, L, b and τ2.  The energy path (E0, μ, γ) and κ0(E)
     are inputs (measured elsewhere: :func:`~hhscatter.analysis.dissipative.decay.fit_energy_decay`
-    and the conservative study).
+    and the conservative escape rate).
 
-    * ``constrain_total`` (default True): f_e = P(τ0) − f_ne as in the paper;
+    * ``constrain_total`` (default True): f_e = P(τ0) − f_ne, Eq. (eqn:surv_prob_model);
       P(τ0) is ``P_tau0`` (taken as exact) or, if None, log-linearly
       interpolated from the data; its error is then propagated into the
       errors and ``cov`` by re-fitting at P(τ0) + σ (linear sensitivity).

@@ -1,18 +1,18 @@
 """Transition times τ1, τ2 of a dissipative ensemble: the start of enhanced trapping and the end of the escapes.
 
-Sections III.A.2, III.B.1 and the model-data comparison of arXiv:2308.13555 define them:
+Sections III.A.2, III.B.1 and the model-data comparison of Burton, Dullin & Altmann (2023) define them:
 
 * τ0 — end of the irregular, ensemble-dependent initial decay; independent of
   γ, an input here.
 * τ1 — start of enhanced trapping, Eq. (eqn:tau1):
-      τ1 = min{ t ≥ τ0 : P_γ(t) = α P_0(t) },  α > 1 (paper: α = 2).
+      τ1 = min{ t ≥ τ0 : P_γ(t) = α P_0(t) },  α > 1 (α = 2 by default).
 * τ2 — end of the escape regime.  Predicted, Eq. (eq:tau2):
       τ2 = ln(E0/E_c) / (μ γ);
-  observed (Fig. 6b caption): "the first time at which the energy of a
-  non-escaping orbit dropped below E_c", i.e. the smallest settling time.
+  observed: the first time at which the energy of a non-escaping orbit
+  dropped below E_c, i.e. the smallest settling time.
 
 The survival probability P(t) counts both ways of leaving: escape through a
-channel and settling (E(t) reaching E_c inside Ω), as in the paper's Fig. 4 (fig:survprob);
+channel and settling (E(t) reaching E_c inside Ω);
 survival curves themselves come from :mod:`hhscatter.analysis.survival.fits`;
 :func:`survival_on_grid` is a weighted, binned variant used by
 :func:`bootstrap_transition_times` (paired bootstrap over orbits of τ0, τ1,
@@ -118,7 +118,7 @@ def tau1(t, P_gamma, P_0, tau0: float, alpha: float = 2.0):
     D(τ0) ≥ 0 the result is τ0.  Where P_0 = 0 < P_γ the condition counts as
     met and the crossing is put at that grid point; NaN points (e.g. beyond
     censoring) are skipped.  Returns None if the condition is never met on
-    [τ0, t[-1]] (e.g. no escaping orbits left, Fig. 6b large γ).
+    [τ0, t[-1]] (e.g. no escaping orbits left at large γ).
 
     Examples
     --------
@@ -179,7 +179,7 @@ def tau1_from_lifetimes(
 ):
     """tau1_from_lifetimes(lifetimes_gamma, lifetimes_0, t_grid, tau0, alpha=2.0) -> float or None.
 
-    Observed τ1 (Fig. 6b symbols): :func:`tau1` applied to the survival
+    Observed τ1: :func:`tau1` applied to the survival
     curves of a dissipative (γ > 0) and the conservative (γ = 0) ensemble,
     both estimated on ``t_grid`` by
     :func:`hhscatter.analysis.survival.fits.survival_from_lifetimes` (Kaplan–Meier;
@@ -212,7 +212,7 @@ def tau1_from_lifetimes(
 def tau2_observed_arrays(t_end, outcome):
     """tau2_observed_arrays(t_end, outcome) -> float or None.
 
-    Observed τ2 (paper Fig. 6b caption): the first time at which the energy
+    Observed τ2: the first time at which the energy
     of a non-escaping orbit dropped below E_c.  The engine records for a
     settled orbit the time at which E(t) reaches E_c (``t_end``), so this is
     min t_end over orbits with outcome 'settled'.  None if no orbit settled.
@@ -237,8 +237,8 @@ def tau2_observed_arrays(t_end, outcome):
 def tau2_observed(lifetimes: pd.DataFrame):
     """tau2_observed(lifetimes) -> float or None: min ``t_end`` over settled orbits, see :func:`tau2_observed_arrays`.
 
-    The observed τ2 of the paper's Fig. 6b caption: "the first time at which
-    the energy of a non-escaping orbit dropped below E_c".
+    The observed τ2: the first time at which the energy of a non-escaping orbit
+    dropped below E_c.
 
     Examples
     --------
@@ -289,7 +289,7 @@ def settle_quantile_interval(t_end, outcome, p: float, level: float = 0.68268949
     the side that adds more probability until the coverage reaches ``level``
     (1σ: 0.6827), so the interval covers at least that.
 
-    For p = 1/N this is the interval of the first settling time (the paper's
+    For p = 1/N this is the interval of the first settling time (the
     observed τ2, a sample minimum, which estimates the quantile t_{1/N} and
     therefore depends on N): with C ≈ Poisson(1) it is [0, X_(2)], 74 % —
     the first settling time bounds the low tail from above and nothing more.
@@ -452,7 +452,7 @@ def bootstrap_transition_times(
 
     Paired bootstrap over orbits of τ0, τ1 (Eq. (eqn:tau1)) and the observed τ2
     for ensembles that share their initial conditions (the same seed for
-    every γ, as in the paper's Fig. 4): each replicate gives orbit i the same
+    every γ): each replicate gives orbit i the same
     Poisson(1) multiplicity in every ensemble, so the correlation between
     P_γ and P_0 built from the same orbits is kept.
 

@@ -1,12 +1,12 @@
 """Exit channels of an open system: channel fractions, Lyapunov orbits, returns after an escape (r > r_esc).
 
-Reference: App. "Escape Condition" of arXiv:2308.13555.
+Reference: App. "Escape Condition" of Burton, Dullin & Altmann (2023).
 
-The paper deems an orbit escaped when r = √(x² + y²) first exceeds a radius
+That reference deems an orbit escaped when r = √(x² + y²) first exceeds a radius
 r_esc "slightly larger than 1" (the saddle distance), and states that
 "various specific values of r_esc ... all [lead] to the same observations".
 The exact criterion is the outward crossing of the Lyapunov orbit that
-straddles each exit channel (paper Sec. II, "Scattering dynamics"); this
+straddles each exit channel (ibid., Sec. II, "Scattering dynamics"); this
 module measures how well r_esc approximates it:
 
 * :func:`lyapunov_orbit` — the Lyapunov (brake) orbit of an exit at energy E
@@ -282,7 +282,7 @@ def lyapunov_orbit(
 
     The Lyapunov orbit of an exit at energy E above its saddle's energy E_s: the unstable periodic orbit that
     oscillates across the exit channel through the saddle; the exits' Lyapunov orbits bound the scattering
-    region Ω (paper Sec. II, "Scattering dynamics": an orbit that crosses one outward never returns). Any
+    region Ω (an orbit that crosses one outward never returns). Any
     two-degree-of-freedom system: the saddle, E_s and V come from the system object.
 
     Method: at the saddle V's Hessian has one negative eigenvalue (direction u, along the channel) and one
@@ -298,7 +298,7 @@ def lyapunov_orbit(
     energy : float
         E > E_s of the exit (energy).
     system : System, optional
-        The system (:mod:`hhscatter.model`); the paper's Hénon–Heiles (ω = λ = 1) if None. The second
+        The system (:mod:`hhscatter.model`); the default system of :mod:`hhscatter.model` if None. The second
         positional argument (formerly ``model``).
     exit : int
         The exit's channel index, 0 ≤ exit < len(system.exits).

@@ -113,7 +113,7 @@ def decision_rate(eps, times) -> DecisionRate:
 def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: float) -> float:
     """predicted_cutoff(E0, γ, μ, energies, λ(energies), E_c) -> ε_c predicted by the probabilistic description.
 
-    The paper's description (Eqs. (eqn:energy_exp_decay), (eq:tau2)): the
+    The probabilistic description (Eqs. (eqn:energy_exp_decay), (eq:tau2)): the
     energy of a surviving orbit decays as E(t) = E0 e^{−μγt} and scattering
     ends at τ2 = ln(E0/E_c)/(μγ), when E(t) = E_c; meanwhile the orbit follows
     the conservative saddle of energy E(t), where nearby orbits separate at

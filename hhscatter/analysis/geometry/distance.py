@@ -1,8 +1,8 @@
 """Distances between point sets on the surface of section.
 
-Reference: Sec. III.B.2 and fig:um_comparison of arXiv:2308.13555.
+Reference: Sec. III.B.2 of Burton, Dullin & Altmann (2023).
 
-The paper compares, by eye, the section crossings (x, y) of dissipative orbits
+That reference compares, by eye, the section crossings (x, y) of dissipative orbits
 alive at t* with the conservative c-measure μ_c^{E1}, and claims that "the
 agreement is expected to hold up to a finite spatial scale, which becomes
 increasingly small as the time for the distributions to relax increases"
@@ -25,7 +25,7 @@ Distances provided
 
 Which distance to headline
 --------------------------
-**Hellinger on box histograms, as a function of ε.**  The paper's claim is
+**Hellinger on box histograms, as a function of ε.**  The claim is
 scale-resolved — agreement "up to a finite spatial scale" — and so is
 H(ε): at box side ε it is blind to structure finer than ε and sensitive to
 everything coarser, so the curve H(ε) against its noise floor yields the
@@ -43,7 +43,7 @@ largest difference in probability of any set of boxes).
 The sliced Wasserstein distance is scale-free: one number in units of
 length, dominated by where the bulk of the mass is, and nearly insensitive to
 fine filaments (moving mass by δ costs only ~δ).  It is a good global check
-(e.g. that μ_c^{E1} is closer than μ_c^{E2}, Fig. 5a vs Fig. 1b) but cannot
+(e.g. that one c-measure is closer than another to a set) but cannot
 by itself say down to which scale two sets agree.
 
 Finite-sample baseline and the agreement scale
@@ -137,12 +137,12 @@ def first_crossings(
     For each ``traj_id`` of the engine's ``sections`` table (columns traj_id,
     t, x, y, px, py, energy), its first crossing of the section ṙ = 0, φ̇ > 0
     at orbit time t ≥ ``t_from``; orbits without such a crossing (escaped or
-    settled before it) are absent.  This is the sprinkler sample of the paper's
-    Fig. 1b (t_from = recording time) and the "first intersection for
-    t ≥ t*" of Fig. 5a (t_from = t*).  The energy filter is applied *after*
-    choosing the first crossing (Fig. 5b keeps "only the surviving points
-    whose energy at time of crossing t ≥ t* was in the interval"), so it
-    selects among the rows of Fig. 5a, it does not look further in time.
+    settled before it) are absent.  This is the sprinkler sample
+    (t_from = recording time) and the first intersection for t ≥ t*
+    (t_from = t*).  The energy filter is applied *after* choosing the first
+    crossing (it keeps only the surviving points whose energy at the time of
+    the crossing is in the interval), so it selects among the rows without
+    the filter, it does not look further in time.
     Requires every crossing after ``t_from`` to be in the table (a section
     window starting at or before ``t_from``, not ``first_only`` with a later
     start).  Rows sorted by traj_id.
@@ -396,7 +396,7 @@ def distance_vs_scale(
     ``m`` fixes the common sample size of the split-half comparison (default
     ⌊min(n_P, n_Q)/2⌋; it must not exceed that).  Since the noise floor and
     hence the agreement scale depend on the sample size, comparisons of
-    several pairs of sets (e.g. several dissipation rates, Fig. 5) must use
+    several pairs of sets (e.g. several dissipation rates) must use
     one common ``m`` to be comparable.
 
     ``extent`` defaults to the bounding box of P ∪ Q; the same partition is

@@ -251,8 +251,8 @@ def paired_hellinger_difference(
 ) -> PairedDifference:
     """Δ = H(B, R) − H(A, R) with a paired interval that resamples the independent unit of every set.
 
-    The question of Fig. 5 is whether a set B (e.g. 5b, the crossings in an energy band) lies closer to a
-    reference R (the c-measure μ_c^{E1}) than a set A (5a). Points are not independent: one orbit may give
+    The question is whether a set B (e.g. the crossings in an energy band) lies closer to a
+    reference R (e.g. a c-measure) than a set A (e.g. every crossing). Points are not independent: one orbit may give
     several crossings, and B may share orbits with A. So the *units* (orbit ids) are resampled, never the
     points, and A and B are resampled together (one draw of the dissipative run's orbits serves both),
     while R's units are drawn once per replicate and serve both distances: the interval of Δ is paired.

@@ -1,9 +1,8 @@
 """Transfer operators from sampled transitions: Ulam's method for open maps and true-time maps.
 
-The paper's open question (Sec. "Discussion and Conclusion"): "spectral approaches considering
+An open question of Burton, Dullin & Altmann (2023) (Sec. "Discussion and Conclusion"): "spectral approaches considering
 Perron–Frobenius (or similar) operators acting on these densities". This module holds the pure
-functions (no I/O, no integration): the study ``operator`` feeds them sample transitions that the engine
-computed.
+functions (no I/O, no integration): they take sample transitions that the engine computed.
 
 Ulam's method
 -------------
@@ -23,8 +22,8 @@ rate κ (1/time) is the root of
 the discretised true-time relation Eq. (eqn:kappa_cmeasure_truetime), ∫_{Ω∖𝓔} e^{κT} dμ_c = 1 (escaping
 points carry T = 0 there, which adds μ_c(𝓔) to both sides). Its left eigenvector ν (ν M(κ) = ν, Σν = 1) is the
 *flux* c-measure of the flow on the section: the distribution of all section crossings of the surviving
-ensemble in the asymptotic regime (:mod:`hhscatter.analysis.survival.cmeasure`). The sprinkler sample of the paper's
-Fig. 1b (the *first* crossing after a late time t) is ν pushed forward with the weight (e^{κT} − 1)/κ
+ensemble in the asymptotic regime (:mod:`hhscatter.analysis.survival.cmeasure`). The sprinkler sample
+(the *first* crossing after a late time t) is ν pushed forward with the weight (e^{κT} − 1)/κ
 (:func:`sprinkler_weights`); the left eigenvector of P is the c-measure of the discrete map (every return
 weighted alike), a third measure. The three coincide only when T is constant.
 
@@ -36,7 +35,7 @@ escape rate of the chaotic saddle is the root on the largest *open* class (:func
 Dissipative ensembles: states are (box, energy bin) and the return times are binned into lags of ``dt``
 (:func:`lag_kernels`); :func:`propagate` carries the crossing density n(t) forward return by return,
 :func:`survival_from_crossings` gives P(t) from it and the probability that the next event lies beyond a lag, and
-:func:`first_crossing_after` the distribution of the first crossing after a time t* (paper Fig. 5).
+:func:`first_crossing_after` the distribution of the first crossing after a time t*.
 
 Eigenvalues: scipy.sparse.linalg.eigs (ARPACK) for the leading eigenpair of a sparse matrix, dense LAPACK
 (scipy.linalg.eig) below :data:`DENSE_MAX` states; roots by scipy.optimize.brentq. No hand-written solver.

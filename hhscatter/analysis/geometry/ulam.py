@@ -3,7 +3,7 @@
 The operators themselves are in :mod:`hhscatter.analysis.geometry.transfer`; this module builds them from a
 table of one-return samples (one row per sample point: its finest box ``cell``, stratum ``rank``, weight
 ``w``, whether it returned (``ret``), the return time ``T``, the image point ``x1, y1, e1`` and ``censored``)
-and turns their results into the records of an operator study:
+and turns their results into records:
 
 * :func:`sample_transitions` — the samples on boxes merged c × c, optionally the first M' per box, optionally
   on (box × energy bin) states;

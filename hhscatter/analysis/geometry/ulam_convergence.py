@@ -58,12 +58,12 @@ def kappa_convergence(
     """κ of Ulam's method extrapolated to infinitely many samples per box and to box side 0.
 
     ``grid`` holds κ of one energy on a grid of partitions: columns box (side, position units), samples
-    (sample points per box, M) and kappa. Two effects move κ, and both are seen in the study: the box side b
+    (sample points per box, M) and kappa. Two effects move κ: the box side b
     (coarse boxes smear the hole's edges: κ(b) = κ∞ + a·b to first order) and the samples per box M (the
     flux weights |ṗ_r|/v are heavy-tailed — 1/v at V = E — and the Perron root of a matrix estimated from M
     samples per row is biased, falling as M grows). The model κ(b, M) = κ∞ + a·b + β·M^(−p) is fitted by
     least squares with p = ``p_main`` (½, the decay of the bias of a ratio estimator with heavy-tailed
-    weights that the study's grids show) and, as the model systematic, with p = ``p_alt`` (1, the decay of a
+    weights) and, as the model systematic, with p = ``p_alt`` (1, the decay of a
     finite-variance ratio estimator's bias): κ∞ is the first fit, its model error the difference of the two.
 
     ``boot_grid`` (optional) holds bootstrap replicates on the same grid (columns rep, box, samples, kappa):

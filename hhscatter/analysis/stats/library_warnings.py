@@ -3,7 +3,7 @@
 A fit run a thousand times in a bootstrap may warn on a few replicates (an overflow in ``exp``, a covariance that
 cannot be estimated); the analysis already handles those replicates (a NaN, a failed fit it counts), so the warning
 is not shown, but it is not lost either: :func:`counted` records each warning raised in its block under the name of
-the place that called it, and :func:`warning_counts` returns the tally. A study's analyze stage writes the tally into
+the place that called it, and :func:`warning_counts` returns the tally. An analysis writes the tally into
 its numbers JSON (key ``library_warnings``) and prints its total.
 
 Examples
@@ -21,7 +21,7 @@ A message that names a file keeps the file's name, not the folders it lies in (t
 JSON; where the machine keeps its runs is not a result):
 
 >>> with counted("example.read"):
-...     warnings.warn("nothing matched in the table of /data/me/studies/out/raw/E0.30_r1.5 (its points: E = 0.3)")
+...     warnings.warn("nothing matched in the table of /data/me/runs/out/raw/E0.30_r1.5 (its points: E = 0.3)")
 >>> warning_counts()[0]["message"]
 'nothing matched in the table of E0.30_r1.5 (its points: E = 0.3)'
 >>> reset_warning_counts()

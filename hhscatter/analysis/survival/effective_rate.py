@@ -1,7 +1,7 @@
 """The effective escape rate of a dissipative ensemble against κ0 at the decayed energy.
 
-For small γ the paper describes escape from the dissipative system by the conservative rate at the current
-energy, κγ(t) = κ0(E(t)), E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)); this is what its survival model,
+For small γ, Burton, Dullin & Altmann (2023) describe escape from the dissipative system by the conservative rate at the current
+energy, κγ(t) = κ0(E(t)), E(t) = E0 e^{−μγt} (Eq. (eqn:energy_exp_decay)); this is what their survival model,
 Eq. (eqn:surv_prob_model), integrates. Pure functions (no I/O):
 
 * :func:`binned_hazard` — the escape hazard in time bins: escapes in the bin over the time the orbits spent

@@ -1,5 +1,5 @@
 """Escape rate κ of an open conservative system from its orbits' lifetimes: window fits of log P(t), the MLE,
-the escaping tail (Sec. II of arXiv:2308.13555).
+the escaping tail (Sec. II of Burton, Dullin & Altmann (2023)).
 
 * :func:`~hhscatter.analysis.survival.windows.choose_windows` (module ``windows``) — data-driven τ0 and the 4
   fitting windows of the exponential regime of Eq. (eqn:kappa_hyperbolic);
@@ -193,7 +193,7 @@ def power_law_exponent_mle(t_end, observed, t_start, t_stop) -> MLERate:
 class EscapeRateResult(WithErrors):
     """Result of :func:`escape_rate` (κ in 1/time, times in time units).
 
-    kappa           mean of the 4 window fits (Fig. 2b caption)
+    kappa           mean of the 4 window fits
     kappa_err       √(spread² + stat²) (conservative: the spread also contains noise)
     kappa_spread    sample std (ddof=1) of the 4 window estimates (systematics)
     kappa_stat      statistical error of the mean of the 4 fits (correlation-aware,
@@ -254,7 +254,7 @@ def escape_rate(
        uniform grid of ``n_grid`` points from 0 to the 10th-largest t_end);
     2. τ0 and 4 windows by :func:`choose_windows` (``window_kwargs`` go there);
     3. κ_i by weighted least squares of log P on each window
-       (:func:`fit_exponential`); κ = mean of the 4 (paper, Fig. 2b caption);
+       (:func:`fit_exponential`); κ = mean of the 4 (the rule of Burton, Dullin & Altmann (2023));
        kappa_err = √(std(κ_i)² + σ_stat²), σ_stat the statistical error of
        that mean (Kaplan–Meier correlations and window overlaps included);
     4. cross-check :func:`escape_rate_mle` on [τ0, t_stop];

@@ -1,6 +1,6 @@
 """Survival probability P(t) and its exponential / power-law regimes.
 
-Sec. II of arXiv:2308.13555 (the paper) describes the survival probability of an ensemble started in the
+Sec. II of Burton, Dullin & Altmann (2023) describes the survival probability of an ensemble started in the
 scattering region Ω as
 
 * Eq. (eqn:kappa_hyperbolic), hyperbolic saddles:
@@ -24,7 +24,7 @@ Functions here are pure (no file I/O, no plotting) and vectorised:
   tail after τ0?", returning the tail fit or None.
 
 Conventions.  An orbit *leaves* Ω at ``t_end`` if its outcome is 'escaped' or
-'settled' (both count as leaving, as in the paper's dissipative section);
+'settled' (both count as leaving);
 'censored' orbits were still inside at ``t_end`` = t_max and are right-censored.
 P(t) = Pr(lifetime > t) is right-continuous.  Times are in the model's natural
 time units (unit mass, ω = λ = 1); κ is in 1/time; z, f0 are dimensionless and
@@ -164,8 +164,8 @@ def survival_from_lifetimes(lifetimes, t_grid=None) -> SurvivalCurve:
 
     DataFrame wrapper of :func:`survival_curve` for one ensemble of the engine's
     ``lifetimes`` table ('escaped' and 'settled' leave, 'censored' is censored):
-    the paper's P(t), the fraction of the ensemble still inside Ω at t (Sec.
-    II.A.2; with drag, settling also ends a lifetime, Sec. III.A.2, Fig. 4).
+    P(t), the fraction of the ensemble still inside Ω at t (with drag, settling
+    also ends a lifetime).
 
     Examples
     --------
@@ -445,7 +445,7 @@ def crossover_time(t, P, exp_fit, pow_fit) -> float:
     g(τ) = log f0 − κτ − log f* + z log τ (concave for z > 0, maximal at τ = z/κ)
     there are in general two intersections; τ* is the *last* one, where g
     changes sign from + to − and the power law dominates for all later times
-    (paper: E0 = 0.23 gives τ* ≈ 100).  ``t``/``P`` (the data both fits were
+    ``t``/``P`` (the data both fits were
     made on) only set the search scale and trigger a warning when τ* falls
     outside the data's time range.
 

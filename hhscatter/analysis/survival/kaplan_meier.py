@@ -1,6 +1,6 @@
 """Kaplan–Meier: the one estimator of the survival probability P(t) = Pr(lifetime > t) in hhscatter.
 
-P(t) is the paper's survival probability, Eqs. (eqn:kappa_hyperbolic) /
+P(t) is the survival probability of Eqs. (eqn:kappa_hyperbolic) /
 (eqn:kappa_nonhyperbolic): the fraction of the ensemble still inside Ω at t
 (with drag, settling also ends a lifetime). An orbit that *left* at t_end
 (escaped or settled) is an event; one censored at t_end (still inside at

@@ -2,8 +2,7 @@
 
 The escape rate of Eq. (eqn:kappa_hyperbolic) near E_c depends on how it is
 defined: the IC region (disk r < 0.5, or the authors' square [−1, 1]² with
-V < E) and the fitting windows move κ at E ≤ 0.23 by more than the
-disagreement with the paper, and square ICs bring a plateau of orbits still
+V < E) and the fitting windows move κ at E ≤ 0.23, and square ICs bring a plateau of orbits still
 inside at t_max (censored: regular orbits on KAM tori and chaotic ones not yet
 out; P∞ = 6.5 % at E = 0.18) on which a local-slope window rule locks,
 returning κ ≈ 0. This module holds the pure pieces (arrays and DataFrames in,

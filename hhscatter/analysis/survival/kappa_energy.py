@@ -2,7 +2,7 @@
 
 :func:`fit_kappa_energy` fits the piecewise law to κ(E) points with their
 errors, continuous at E_b (the break estimated by profiling χ² over E_b) or
-as two separate laws on either side of the best partition (as the paper),
+as two separate laws on either side of the best partition (as Burton, Dullin & Altmann (2023)),
 with covariance and bootstrap errors. E_c comes from the system
 (``scene.model.critical_energy``, :class:`hhscatter.model.System`); no default. Pure functions.
 """
@@ -142,17 +142,15 @@ def fit_kappa_energy(
 ) -> KappaEnergyFit:
     """fit_kappa_energy(E, kappa, kappa_err, E_c, *, continuous=True, n_boot=200, rng=None) -> KappaEnergyFit.
 
-    Piecewise fit of the escape rate against energy (paper Fig. 2b, x = E − E_c,
+    Piecewise fit of the escape rate against energy (x = E − E_c,
     energies in energy units, κ in 1/time):
 
         κ = a x² + b x  (E < E_b),     κ = c x  (E ≥ E_b).
 
-    Paper values for ω = λ = 1: a = 13.63, b = 0.03, c = 1.41, E_b ≈ 0.27.
     The break E_b is estimated, not imposed:
 
     * ``continuous=True`` (default): κ(x) = b x + a x·min(x, x_b), i.e. the two
-      laws are forced to meet at the break (c = a x_b + b; the paper's separate
-      fits meet within 2 % at 0.27).  For each x_b the model is linear in
+      laws are forced to meet at the break (c = a x_b + b).  For each x_b the model is linear in
       (a, b), so the weighted χ² is profiled over x_b on a fine grid between
       the second and second-to-last energy, refined by bounded minimisation;
       covariance of (a, b, x_b) from the Gauss–Newton matrix (JᵀWJ)⁻¹ and
@@ -168,7 +166,7 @@ def fit_kappa_energy(
 
     Examples
     --------
-    Points on the paper's law (a = 13.63, b = 0.03, break at E_b = 0.27, E_c = 1/6) give it back, with
+    Points on a known law (a = 13.63, b = 0.03, break at E_b = 0.27, E_c = 1/6) give it back, with
     c = a (E_b − E_c) + b = 1.438 (the continuous law).
 
     >>> E_c = 1 / 6

@@ -27,7 +27,7 @@ class PiecewiseKappa:
         κ0 = 0                for E ≤ E_c              (no escape)
 
     E_c is the system's (``scene.model.critical_energy``; no default: it comes from the system). Defaults of
-    the coefficients are the fits of arXiv:2308.13555 for Hénon–Heiles.  Calling it on an array returns an array
+    the coefficients are the fits of Burton, Dullin & Altmann (2023).  Calling it on an array returns an array
     (rates in 1/time).  Note the two branches do not join exactly at
     E_switch (0.1486 vs 0.1457 with the defaults).
     """

@@ -1,6 +1,6 @@
 """Long-time escape: a plateau plus an exponential, fitted on the lifetimes with censoring, and the hazard.
 
-Beyond the paper (which fits log P(t) on a window, Eq. (eqn:kappa_hyperbolic)): a population with orbits that
+Beyond a window fit of log P(t) (Eq. (eqn:kappa_hyperbolic)): a population with orbits that
 never leave (KAM tori) or leave very late (stickiness) has a survival probability that flattens, and a window fit
 of log P then returns the plateau's slope, not a rate. Here, from a time t0 on, the orbits still inside at t0
 are described by

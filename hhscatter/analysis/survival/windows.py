@@ -1,6 +1,6 @@
 """The exponential regime of a survival curve: τ0 and the fitting windows.
 
-The rule of Sec. II and the Fig. 2b caption of arXiv:2308.13555, from the data.
+The rule of Sec. II of Burton, Dullin & Altmann (2023), from the data.
 
 :func:`choose_windows` finds, from the data alone, the end τ0 of the irregular
 initial regime of Eq. (eqn:kappa_hyperbolic) (the first time after which the
