@@ -1,7 +1,8 @@
-"""Every function the packages of ``hhscatter.analysis`` export shows a runnable example in its own docstring (the
-examples run as doctests in the suite).
+"""Every public function of the modules of ``hhscatter.analysis`` (exported by its package or not: a function
+named as its module is reached through the module) shows a runnable example in its own docstring (the examples run
+as doctests in the suite).
 
-A new exported function without one fails here at once.
+A new public function without one fails here at once.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from __future__ import annotations
 import inspect
 
 import pytest
-from test_every_estimator import FUNCTIONS  # every exported function, by subpackage.name
+from test_every_estimator import FUNCTIONS  # every public function, by subpackage[.module].name
 
 
 def has_example(f) -> bool:
@@ -32,5 +33,9 @@ def test_the_check_tells_an_example_from_prose():
 
 
 @pytest.mark.parametrize("name", sorted(FUNCTIONS))
-def test_every_exported_function_has_an_example(name):
+def test_every_public_function_has_an_example(name):
     assert has_example(FUNCTIONS[name])
+
+
+def test_the_functions_named_as_their_module_are_seen():
+    assert {"survival.escape_rate.escape_rate", "dissipative.survival_model.survival_model"} <= set(FUNCTIONS)

@@ -172,7 +172,29 @@ def survival_model(
     ``tau2=None`` uses Eq. (eq:tau2), ln(E0/E_c)/(μγ).  See the module
     docstring for why the literal ("paper") escape factor is non-monotone.
     Returns an array shaped like ``t`` (float if ``t`` is scalar).
+
+    Examples
+    --------
+    A constant κ0 = 0.05 (1/time): between τ0 and τ2 (here ln(0.3 · 6)/(0.91 · 0.01) ≈ 64.6) the model is
+    f_ne + f_e e^{−κ0 (t − τ0)} with either escape factor; before τ0 it is not modelled (NaN).
+
+    >>> kw = dict(kappa_of_E=lambda E: np.full(np.shape(E), 0.05), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0,
+    ...           f_ne=0.1, f_e=0.4, L=0.1, b=0.2, E_c=1 / 6)
+    >>> t = np.array([2.0, 5.0, 25.0, 60.0])
+    >>> P, P_int = survival_model(t, **kw), survival_model(t, **kw, hazard="integrated")
+    >>> bool(np.isnan(P[0])), bool(np.allclose(P[1:], 0.1 + 0.4 * np.exp(-0.05 * (t[1:] - 5.0)))), bool(np.allclose(P_int[1:], P[1:]))
+    (True, True, True)
     """
+    check.numbers(t, "t", min_size=0)
+    check.function(kappa_of_E, "kappa_of_E")
+    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma"), (f_ne, "f_ne"), (f_e, "f_e"), (L, "L"), (b, "b")):
+        check.real(value, name)
+    check.number(tau0, "tau0")
+    if tau2 is not None:
+        check.real(tau2, "tau2")
+    check.number(E_c, "E_c", positive=True)
+    if hazard not in HAZARDS:
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
     if tau2 is None:
         tau2 = tau2_predicted(E0, E_c, mu, gamma)
     out = _component(t, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)

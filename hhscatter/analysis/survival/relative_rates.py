@@ -9,6 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.analysis.survival.escape_rate import MLERate, escape_rate_mle
 from hhscatter.errors import ConfigError
@@ -42,6 +45,14 @@ def relative_rates(samples, t_start: float, t_stop: float, ref: int | None = 0) 
     >>> rows[0].ratio.value, bool(abs(rows[1].ratio.value - 1.5) < 3 * rows[1].ratio.err)
     (1.0, True)
     """
+    if not isinstance(samples, (list, tuple)) or not samples:
+        raise ConfigError(f"samples must be a non-empty list of (t_end, escaped) pairs, got {type(samples).__name__}")
+    for i, pair in enumerate(samples):
+        if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+            raise ConfigError(f"samples[{i}] must be a pair (t_end, escaped), got {type(pair).__name__}")
+    check.window(t_start, t_stop)
+    if ref is not None and (isinstance(ref, bool) or not isinstance(ref, (int, np.integer))):
+        raise ConfigError(f"ref must be an index (an integer) or None, got {ref!r}")
     if ref is not None and not -len(samples) <= ref < len(samples):
         raise ConfigError(f"ref = {ref} is not the index of one of the {len(samples)} samples")
     rates = [escape_rate_mle(t_end, escaped, t_start, t_stop) for t_end, escaped in samples]
