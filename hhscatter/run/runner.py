@@ -387,12 +387,40 @@ def request_stop(signum: int) -> None:
     """request_stop(signum): the run in progress stops after the chunk it is in, whatever happens to the
     exception the signal's handler raises. For a handler that stops the run (the CLI's): an exception raised in a
     signal handler is lost when the signal lands while Python runs a finaliser or a library's callback that
-    swallows it; the run then checks this request after every finished chunk (``KeyboardInterrupt``)."""
+    swallows it; the run then checks this request after every finished chunk (``KeyboardInterrupt``). ``signum``
+    is the number of a named signal of this platform (an int, e.g. ``signal.SIGTERM``: :class:`signal.Signals`).
+
+    Examples
+    --------
+    >>> import signal
+    >>> request_stop(signal.SIGTERM)
+    >>> try:
+    ...     _check_stop()
+    ... except KeyboardInterrupt as stop:
+    ...     print("stopped by", stop)
+    stopped by SIGTERM
+    >>> clear_stop()
+    >>> _check_stop()      # nothing requested any more: the run goes on
+    """
+    if isinstance(signum, bool) or not isinstance(signum, int):
+        raise ConfigError(f"signum must be a signal number (an int), got {signum!r}")
+    try:
+        signal.Signals(signum)
+    except ValueError:
+        raise ConfigError(f"signum = {signum} is the number of no named signal of this platform") from None
     _STOP.append(int(signum))
 
 
 def clear_stop() -> None:
-    """clear_stop(): forget the stop requests of an earlier command in this process."""
+    """clear_stop(): forget the stop requests of an earlier command in this process (it takes no argument).
+
+    Examples
+    --------
+    >>> import signal
+    >>> request_stop(signal.SIGINT); request_stop(signal.SIGTERM)
+    >>> clear_stop()
+    >>> _check_stop()      # both forgotten
+    """
     _STOP.clear()
 
 

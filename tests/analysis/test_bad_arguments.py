@@ -1,4 +1,5 @@
-"""Bad arguments to the estimators of the paired bootstrap, the noise studies and the chaotic saddle (hypothesis).
+"""Bad arguments to the estimators of the paired bootstrap, noise, the chaotic saddle and its checks, and censoring
+(hypothesis).
 
 Each call gets one argument replaced by a wrong thing (a wrong type, NaN, a negative time or count, an empty array,
 a mismatched length, a window outside the data) and must refuse with a ConfigError that names that argument,
@@ -17,7 +18,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from hhscatter.analysis.geometry import saddle
+from hhscatter.analysis.geometry import saddle, saddle_checks
 from hhscatter.analysis.noise import (
     energy_diffusion_rate,
     exit_fractions,
@@ -37,6 +38,7 @@ from hhscatter.analysis.noise import (
     window_constancy,
 )
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+from hhscatter.analysis.survival.kappa_conventions import censored_fraction
 from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
@@ -309,6 +311,154 @@ def test_window_dependence_names_the_bad_argument(data, which):
 
 
 # -- the estimators' own refusals ---------------------------------------------------------------------------------
+# -- the saddle's checks: FTLE dimensions, the low-FTLE share, d₁ by radius, t_min trends, interval λ̄ -------------
+#: booleans where numbers belong, as an array
+BOOLS = st.just(np.ones(40, bool))
+#: these estimators refuse before any work: every (argument, wrong thing) pair is cheap, so the profile draws more
+EVERY = settings(PROFILE, max_examples=100)
+RNG = np.random.default_rng(3)
+TT = RNG.uniform(50.0, 150.0, 40)
+LL = 0.5 * TT + np.sqrt(0.1 * TT) * RNG.normal(size=40)
+
+
+def _names(which, f, *args, **kwargs):
+    """f refuses with a ConfigError whose message names ``which`` as a word (``err``, not ``error``)."""
+    with pytest.raises(ConfigError, match=rf"(?<![\w]){which}(?![\w])"):
+        f(*args, **kwargs)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["log_stretch", "duration", "kappa", "kappa_err", "q", "form", "n_boot",
+                                               "seed"]))  # fmt: skip
+def test_ftle_dimension_names_the_bad_argument(data, which):
+    args = {"log_stretch": LL, "duration": TT, "kappa": 0.15, "kappa_err": 0.01, "q": 2.0, "form": "partition",
+            "n_boot": 5, "seed": 0}  # fmt: skip
+    args[which] = data.draw(
+        {
+            "log_stretch": st.one_of(
+                st.just(LL[:-1]), st.just(np.array([])), BOOLS, NOT_NUMBERS, st.just(np.r_[LL[:-1], math.nan])
+            ),  # fmt: skip
+            "duration": st.one_of(
+                st.just(TT[:-1]), st.just(-TT), BOOLS, NOT_NUMBERS, st.just(np.r_[TT[:-1], math.inf])
+            ),
+            "kappa": st.one_of(NOT_A_NUMBER, st.just(0.0), st.just(-0.1)),
+            "kappa_err": st.one_of(NOT_A_NUMBER, st.just(-0.01)),
+            "q": NOT_A_NUMBER,
+            "form": st.one_of(NOT_A_NUMBER, st.just("gaussian")),
+            "n_boot": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+            "seed": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+        }[which]
+    )
+    _names(which, saddle_checks.ftle_dimension, **args)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["log_stretch", "duration", "threshold", "n_boot", "seed"]))
+def test_low_ftle_share_names_the_bad_argument(data, which):
+    args = {"log_stretch": LL, "duration": TT, "threshold": 0.5, "n_boot": 5, "seed": 0}
+    args[which] = data.draw(
+        {
+            "log_stretch": st.one_of(
+                st.just(LL[:-1]), st.just(np.array([])), BOOLS, NOT_NUMBERS, st.just(np.r_[LL[:-1], -math.inf])
+            ),  # fmt: skip
+            "duration": st.one_of(
+                st.just(TT[:-1]), st.just(0 * TT), BOOLS, NOT_NUMBERS, st.just(np.r_[TT[:-1], math.nan])
+            ),
+            "threshold": st.one_of(NOT_A_NUMBER, st.just(0.0), st.just(1.0), st.just(-0.5)),
+            "n_boot": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+            "seed": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+        }[which]
+    )
+    _names(which, saddle_checks.low_ftle_share, **args)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["points", "groups", "eps_min", "eps_max", "per_factor_two", "min_count",
+                                               "max_empty", "n_boot", "seed"]))  # fmt: skip
+def test_information_dimension_radius_names_the_bad_argument(data, which):
+    args = {"points": P, "groups": np.arange(400) // 4, "eps_min": 0.0, "eps_max": 0.1, "per_factor_two": 4,
+            "min_count": 10.0, "max_empty": 0.01, "n_boot": 5, "seed": 0}  # fmt: skip
+    args[which] = data.draw(
+        {
+            "points": st.one_of(
+                NOT_NUMBERS,
+                st.just(np.empty((0, 2))),
+                st.just(np.full((4, 2), math.nan)),
+                st.just(np.ones((400, 2), bool)),
+            ),  # fmt: skip
+            "groups": st.one_of(
+                st.just(np.zeros(399)),
+                st.just(np.full(400, math.nan)),
+                st.just("x"),
+                st.just({}),
+                st.just(np.array([None, 1] * 200, dtype=object)),
+            ),  # fmt: skip
+            "eps_min": st.one_of(NOT_A_NUMBER, st.just(-1.0)),
+            "eps_max": st.one_of(NOT_A_NUMBER, st.just(0.0), st.just(-0.1)),
+            "per_factor_two": st.one_of(NOT_A_NUMBER, st.integers(-3, 0), st.just(2.5)),
+            "min_count": st.one_of(NOT_A_NUMBER, st.just(0.0)),
+            "max_empty": st.one_of(NOT_A_NUMBER, st.just(1.0), st.just(-0.1)),
+            "n_boot": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+            "seed": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+        }[which]
+    )
+    _names(which, saddle_checks.information_dimension_radius, args.pop("points"), **args)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["t_min", "value", "err"]))
+def test_tmin_trend_names_the_bad_argument(data, which):
+    good = {"t_min": np.array([20.0, 40.0, 80.0]), "value": np.array([0.5, 0.55, 0.575]), "err": np.full(3, 0.01)}
+    bad = st.one_of(NOT_NUMBERS, st.just(np.array([])), st.just(good[which][:-1]), st.just(np.ones(3, bool)),
+                    st.just(np.r_[good[which][:-1], math.nan]), st.just(np.r_[good[which][:-1], math.inf]))  # fmt: skip
+    if which == "t_min":
+        bad = st.one_of(bad, st.just(np.array([80.0, 40.0, 20.0])), st.just(np.array([-20.0, 40.0, 80.0])))
+    if which == "err":
+        bad = st.one_of(bad, st.just(np.array([0.01, 0.0, 0.01])))
+    args = {**good, which: data.draw(bad)}
+    _names(which, saddle_checks.tmin_trend, **args)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["log_stretch_a", "log_stretch_b", "t_a", "t_b", "n_boot", "seed"]))
+def test_interval_lyapunov_names_the_bad_argument(data, which):
+    la = 0.5 + 0.3 * 20 + RNG.normal(0, 0.5, 40)
+    args = {"log_stretch_a": la, "log_stretch_b": la + 12.0, "t_a": 20.0, "t_b": 60.0, "n_boot": 5, "seed": 0}
+    args[which] = data.draw(
+        {
+            "log_stretch_a": st.one_of(
+                NOT_NUMBERS, st.just(la[:-1]), st.just(np.array([])), BOOLS, st.just(np.r_[la[:-1], math.nan])
+            ),  # fmt: skip
+            "log_stretch_b": st.one_of(NOT_NUMBERS, st.just(la[:-1]), BOOLS, st.just(np.r_[la[:-1], math.inf])),
+            "t_a": st.one_of(NOT_A_NUMBER, st.just(-1.0), st.just(np.full(39, 20.0)), st.just(np.array([]))),
+            "t_b": st.one_of(NOT_A_NUMBER, st.just(10.0), st.just(np.full(39, 60.0))),
+            "n_boot": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+            "seed": st.one_of(NOT_A_NUMBER, st.integers(-3, -1), st.just(2.5)),
+        }[which]
+    )
+    _names(which, saddle_checks.interval_lyapunov, **args)
+
+
+@EVERY
+@given(data=st.data(), which=st.sampled_from(["t_end", "observed"]))
+def test_censored_fraction_names_the_bad_argument(data, which):
+    args = {"t_end": T, "observed": OBS}
+    args[which] = data.draw(
+        {
+            "t_end": st.one_of(
+                NOT_NUMBERS,
+                st.just(np.array([])),
+                st.just(np.ones(N, bool)),
+                st.just(np.r_[T[:-1], math.nan]),
+                st.just(np.r_[T[:-1], math.inf]),
+                st.just(-T),
+            ),  # fmt: skip
+            "observed": st.one_of(NOT_NUMBERS, st.just(OBS[:-1]), st.just(np.full(N, 0.5))),
+        }[which]
+    )
+    _names(which, censored_fraction, **args)
+
+
 ANALYSIS = Path(__file__).resolve().parents[2] / "hhscatter" / "analysis"
 
 

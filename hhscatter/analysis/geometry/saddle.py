@@ -125,9 +125,13 @@ def _window(window) -> tuple[float, float]:
 
 def _finite_array(a, name: str, ndim: int) -> np.ndarray:
     try:
-        a = np.asarray(a, dtype=float)
+        ok = not (isinstance(a, (str, bytes, dict)) or a is None) and np.asarray(a).dtype != bool  # no bools
+        arr = np.asarray(a, dtype=float) if ok else None
     except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}") from None
+        arr = None
+    if arr is None:
+        raise ConfigError(f"{name} must be an array of numbers, got {type(a).__name__}")
+    a = arr
     if ndim == 2 and a.ndim == 1:
         a = a[:, None]
     if a.ndim != ndim:
@@ -342,13 +346,22 @@ def _group_labels(groups, n: int) -> tuple[np.ndarray, int]:
     g = np.arange(n) if groups is None else np.asarray(groups)
     if g.shape != (n,):
         raise ConfigError(f"groups must have one label per point: shape {g.shape} != ({n},)")
-    _, g = np.unique(g, return_inverse=True)
+    if g.dtype.kind == "f" and not np.all(np.isfinite(g)):
+        raise ConfigError("groups must be labels (no NaN or inf)")
+    try:
+        _, g = np.unique(g, return_inverse=True)
+    except TypeError:
+        raise ConfigError(f"groups must be labels of one kind (numbers or words), got {g.dtype} values") from None
     g = g.ravel()
     return g, int(g.max()) + 1
 
 
 def _eps_min(eps_min) -> None:
-    if isinstance(eps_min, bool) or not isinstance(eps_min, (int, float)) or not 0 <= eps_min < math.inf:
+    if (
+        isinstance(eps_min, bool)
+        or not isinstance(eps_min, (int, float, np.integer, np.floating))
+        or not 0 <= eps_min < math.inf
+    ):
         raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
 
 

@@ -51,6 +51,7 @@ __all__ = [
     "tmin_trend",
 ]
 
+_NUMBER = (int, float, np.integer, np.floating)  # a number, numpy's too (a bool is refused apart)
 _CENTRES_PER_PASS = 2000  # centres whose pairs within eps_max are held at once (memory ∝ their neighbours)
 
 
@@ -120,7 +121,7 @@ def information_dimension_radius(
     n_boot = _count(n_boot, "n_boot", 0)
     seed = _count(seed, "seed", 0)
     min_count = _positive(min_count, "min_count")
-    if isinstance(max_empty, bool) or not isinstance(max_empty, (int, float)) or not 0 <= max_empty < 1:
+    if isinstance(max_empty, bool) or not isinstance(max_empty, _NUMBER) or not 0 <= max_empty < 1:
         raise ConfigError(f"max_empty must be a share 0 ≤ max_empty < 1 of the points, got {max_empty!r}")
     _eps_min(eps_min)
     if n < 2:
@@ -430,9 +431,9 @@ def ftle_dimension(
     """
     L, T = _stretch_arrays(log_stretch, duration)
     kappa = _positive(kappa, "kappa")
-    if isinstance(kappa_err, bool) or not isinstance(kappa_err, (int, float)) or not kappa_err >= 0:
+    if isinstance(kappa_err, bool) or not isinstance(kappa_err, _NUMBER) or not 0 <= kappa_err < math.inf:
         raise ConfigError(f"kappa_err must be a 1σ error ≥ 0 (1/time), got {kappa_err!r}")
-    if isinstance(q, bool) or not isinstance(q, (int, float)) or not math.isfinite(q):
+    if isinstance(q, bool) or not isinstance(q, _NUMBER) or not math.isfinite(q):
         raise ConfigError(f"q must be a finite number (the dimension's order), got {q!r}")
     if form not in FTLE_FORMS:
         raise ConfigError(f"form must be one of {', '.join(FTLE_FORMS)}, got {form!r}")
@@ -522,7 +523,7 @@ def low_ftle_share(log_stretch, duration, *, threshold: float = 0.5, n_boot: int
     (0.1, 0.0095, 0.4, 100)
     """
     L, T = _stretch_arrays(log_stretch, duration)
-    if isinstance(threshold, bool) or not isinstance(threshold, (int, float)) or not 0 < threshold < 1:
+    if isinstance(threshold, bool) or not isinstance(threshold, _NUMBER) or not 0 < threshold < 1:
         raise ConfigError(f"threshold must be a fraction 0 < threshold < 1 of λ̄, got {threshold!r}")
     n_boot, seed, lam = _resampling_and_mean(L, T, n_boot, seed)
     hyp = L / T >= threshold * lam

@@ -73,16 +73,16 @@ def censored_fraction(t_end, observed) -> float:
 
     ``t_end`` are the lifetimes (time units) and ``observed`` the mask (False = censored: still inside at t_max),
     one value per orbit. The censored orbits are not classified: the fraction is an upper bound of the regular
-    fraction P∞ (chaotic orbits still inside at t_max, sticky or confined, count too). 0 for no orbit.
+    fraction P∞ (chaotic orbits still inside at t_max, sticky or confined, count too). At least one orbit.
 
     Examples
     --------
     >>> censored_fraction([1.0, 2.5, 10.0, 10.0], [True, True, False, False])
     0.5
     """
-    t_end = check.floats(t_end, "t_end")
+    t_end = check.numbers(t_end, "t_end", minimum=0.0)
     observed = check.mask(observed, "observed", t_end.size)
-    return float((~observed).sum() / max(observed.size, 1))
+    return float((~observed).sum() / observed.size)
 
 
 def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):

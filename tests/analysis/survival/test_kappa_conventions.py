@@ -28,7 +28,8 @@ def _lifetimes(kappa, n, f_trapped=0.0, t_max=400.0, seed=0):
 
 def test_the_censored_fraction_counts_the_orbits_still_inside_and_refuses_a_mask_of_another_size():
     assert censored_fraction([1.0, 3.0, 9.0], [True, False, False]) == pytest.approx(2 / 3)
-    assert censored_fraction([], []) == 0.0
+    with pytest.raises(ConfigError, match="t_end must hold at least 1 value"):  # a share of no orbit is none
+        censored_fraction([], [])
     with pytest.raises(ConfigError, match="observed must have one value per orbit: 2 != 3"):
         censored_fraction([1.0, 3.0, 9.0], [True, False])
     with pytest.raises(ConfigError, match="t_end must be an array of numbers"):
