@@ -479,12 +479,11 @@ def fit_mixture_model(
     >>> one = MixtureComponents(t_ref=5.0, by="energy", edges=np.array([0.0, 1.0]), weights=np.array([1.0]),
     ...                         n_ref=np.array([1]), E_ref=np.array([0.3]), A=np.array([0.3]), mu=np.array([0.91]),
     ...                         mu_err=np.array([0.0]), fit_window=(0.0, np.inf), gamma=0.01)
-    >>> from hhscatter.analysis.dissipative.survival_model import survival_model
+    >>> from hhscatter.analysis.dissipative.survival_model import survival_model_sample
     >>> kappa, t, N = PiecewiseKappa(E_c=1 / 6), np.arange(0.0, 301.0), 100_000
-    >>> P_true = survival_model(t, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1, f_e=0.4, L=0.1,
-    ...                         b=0.2, E_c=1 / 6)
-    >>> P = np.random.default_rng(0).binomial(N, np.nan_to_num(P_true, nan=1.0)) / N
-    >>> f = fit_mixture_model(t, P, np.sqrt(P * (1 - P) / N), one, kappa_of_E=kappa, tau0=5.0, E_c=1 / 6, P_min=20 / N)
+    >>> P, P_err = survival_model_sample(t, N, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1,
+    ...                                  f_e=0.4, L=0.1, b=0.2, E_c=1 / 6)
+    >>> f = fit_mixture_model(t, P, P_err, one, kappa_of_E=kappa, tau0=5.0, E_c=1 / 6, P_min=20 / N)
     >>> f.free, {k: round(float(f.values[k]), 3) for k in ("f_ne", "f_e", "L", "b")}
     (('f_ne_0', 'L', 'b'), {'f_ne': 0.099, 'f_e': 0.402, 'L': 0.1, 'b': 0.199})
     """

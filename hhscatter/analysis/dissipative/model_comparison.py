@@ -133,14 +133,12 @@ def compare_fits(fits: dict) -> pd.DataFrame:
     The same data fitted with the literal ("paper") and the integrated escape factor; the data were made with the
     first, whose χ²/dof is near 1.
 
-    >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model
+    >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
 
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
     >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
-    >>> P_true = survival_model(t, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)
-    >>> P = np.random.default_rng(0).binomial(N, np.nan_to_num(P_true, nan=1.0)) / N      # N orbits, binomial noise
-    >>> P_err = np.sqrt(P * (1 - P) / N)
+    >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
     >>> fits = {h: fit_survival_model(t, P, P_err, **kw, P_min=20 / N, hazard=h) for h in ("paper", "integrated")}
     >>> table = compare_fits(fits)
     >>> table[["n_points", "n_free", "dof"]].values.tolist(), table["chi2_red"].round(1).tolist()
@@ -182,14 +180,12 @@ def better_fit(fits: dict) -> str | None:
     --------
     Data made with one κ0(E) law; the same model fitted with it and with another law: the first fits better.
 
-    >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model
+    >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
 
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
     >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
-    >>> P_true = survival_model(t, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)
-    >>> P = np.random.default_rng(0).binomial(N, np.nan_to_num(P_true, nan=1.0)) / N      # N orbits, binomial noise
-    >>> P_err = np.sqrt(P * (1 - P) / N)
+    >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
     >>> other = dict(kw, kappa_of_E=PiecewiseKappa(E_c=1 / 6, a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709))
     >>> fits = {"generating": fit_survival_model(t, P, P_err, **kw, P_min=20 / N),
     ...         "other": fit_survival_model(t, P, P_err, **other, P_min=20 / N)}

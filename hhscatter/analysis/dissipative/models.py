@@ -29,6 +29,7 @@ from hhscatter.analysis.dissipative.survival_model import (
     fit_survival_model,
     settling_rate,
     survival_model,
+    survival_model_sample,
 )
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 
@@ -50,5 +51,6 @@ __all__ = [
     "predict_tau1",
     "settling_rate",
     "survival_model",
+    "survival_model_sample",
     "time_to_energy",
 ]

@@ -65,6 +65,7 @@ __all__ = [
     "profile_interval",
     "settling_rate",
     "survival_model",
+    "survival_model_sample",
 ]
 
 HAZARDS = ("paper", "integrated")
@@ -199,6 +200,38 @@ def survival_model(
         tau2 = tau2_predicted(E0, E_c, mu, gamma)
     out = _component(t, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
     return float(out) if np.ndim(t) == 0 else out
+
+
+def survival_model_sample(t, n_orbits: int, *, seed: int = 0, **model) -> tuple[np.ndarray, np.ndarray]:
+    """survival_model_sample(t, n_orbits, *, seed=0, **model) -> (P, P_err): :func:`survival_model` as measured
+    on ``n_orbits`` orbits, a curve whose parameters are known (to test a fit).
+
+    At each time of ``t`` (time units) the number of orbits still inside is a binomial draw of ``n_orbits`` trials
+    with the model's P(t) (``model``: the keyword arguments of :func:`survival_model`), each time independently of
+    the others (the points of a measured survival curve are correlated; these are not). Before τ0, where the model
+    is NaN, every orbit is inside (P = 1). ``P_err`` is the binomial 1σ √(P(1 − P)/N) of the drawn P
+    (dimensionless, as P). ``seed`` seeds the draws.
+
+    Examples
+    --------
+    A constant κ0 = 0.05 (1/time) and 10⁶ orbits: 1 before τ0 with no error, then the closed form
+    f_ne + f_e e^{−κ0 (t − τ0)} within 5σ of the binomial noise.
+
+    >>> kw = dict(kappa_of_E=lambda E: np.full(np.shape(E), 0.05), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0,
+    ...           f_ne=0.1, f_e=0.4, L=0.1, b=0.2, E_c=1 / 6)
+    >>> t = np.array([0.0, 5.0, 25.0, 60.0])
+    >>> P, P_err = survival_model_sample(t, 10**6, **kw)
+    >>> float(P[0]), float(P_err[0]), bool(np.all(np.abs(P[1:] - (0.1 + 0.4 * np.exp(-0.05 * (t[1:] - 5.0)))) < 5 * P_err[1:]))
+    (1.0, 0.0, True)
+    """
+    t = check.numbers(t, "t", min_size=0)
+    n = check.count(n_orbits, "n_orbits", 1)
+    rng = np.random.default_rng(check.count(seed, "seed", 0))
+    P_true = np.nan_to_num(survival_model(t, **model), nan=1.0)
+    if not np.all((P_true >= 0) & (P_true <= 1)):
+        raise ConfigError("model: its P(t) leaves [0, 1] (f_ne + f_e ≤ 1 and both ≥ 0 are needed)")
+    P = rng.binomial(n, P_true) / n
+    return P, np.sqrt(P * (1 - P) / n)
 
 
 @dataclass(frozen=True)
@@ -370,9 +403,7 @@ def fit_survival_model(
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
     >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
-    >>> P_true = survival_model(t, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)
-    >>> P = np.random.default_rng(0).binomial(N, np.nan_to_num(P_true, nan=1.0)) / N      # N orbits, binomial noise
-    >>> P_err = np.sqrt(P * (1 - P) / N)
+    >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
     >>> f = fit_survival_model(t, P, P_err, **kw, P_min=20 / N)
     >>> f.free, {k: round(float(f.values[k]), 3) for k in ("f_ne", "f_e", "L", "b", "tau2")}
     (('f_ne', 'L', 'b'), {'f_ne': 0.099, 'f_e': 0.402, 'L': 0.1, 'b': 0.199, 'tau2': 64.592})

@@ -25,6 +25,10 @@ TS = np.tile(np.arange(5.0), 2)
 ES = 0.3 * np.exp(-0.01 * TS)
 SNAPSHOTS = pd.DataFrame({"traj_id": IDS, "t": TS, "energy": ES})
 
+#: the keyword arguments of the homogeneous survival model (a constant κ0, 1/time)
+MODEL = {"kappa_of_E": lambda E: np.full(np.shape(E), 0.05), "E0": 0.3, "mu": 0.91, "gamma": 0.01, "tau0": 1.0,
+         "f_ne": 0.1, "f_e": 0.4, "L": 0.1, "b": 0.2, "E_c": 1 / 6, "hazard": "integrated"}  # fmt: skip
+
 #: {function: valid keyword arguments}
 VALID = {
     "tau1": {"t": T, "P_gamma": 0.5 * P, "P_0": P, "tau0": 1.0},
@@ -43,6 +47,7 @@ VALID = {
     "settling_rate": {"t": T, "tau2": 5.0, "L": 1.0, "b": 0.5},
     "profile_interval": {"chi2_of": np.square, "best": 0.0, "chi2_min": 0.0, "lo_edge": -3.0, "hi_edge": 3.0},
     "mixture_components": {"snapshots": SNAPSHOTS, "gamma": 0.01, "t_ref": 1.0},
+    "survival_model_sample": {"t": T, "n_orbits": 100, "seed": 0, **MODEL},
 }
 CASES = [(name, arg) for name, kwargs in VALID.items() for arg, v in kwargs.items() if v is not None]
 
@@ -67,3 +72,9 @@ def test_no_windows_are_refused():
 def test_a_snapshots_table_without_energy_is_refused_naming_the_column():
     with pytest.raises(ConfigError, match="snapshots lacks the column"):
         dissipative.mean_energy(SNAPSHOTS.drop(columns="energy"))
+
+
+@pytest.mark.parametrize(("f_ne", "f_e"), [(0.8, 0.4), (-0.5, 0.4), (0.1, -0.5)])
+def test_a_sample_of_a_model_whose_p_leaves_0_1_is_refused(f_ne, f_e):
+    with pytest.raises(ConfigError, match=r"^model: its P\(t\) leaves \[0, 1\]"):
+        dissipative.survival_model_sample(T, 100, **{**MODEL, "f_ne": f_ne, "f_e": f_e})
