@@ -588,6 +588,48 @@ def _regular_side(v: dict, level: float = 0.01) -> str:
     return "below" if f + err < level else ("above" if f - err >= level else "near")
 
 
+def _generality_regular_majority(get: Loader) -> str:
+    """Per system, the energies (disk ICs) at which more than half of the orbits are regular by the indicator: the
+    regular fraction 2σ of its total error (stat ⊕ threshold ⊕ indicator) above 1/2; those within 2σ of 1/2
+    named apart; a count of 0 is below."""
+    d = get("generality", None)
+    above, near, none = [], [], []
+    by: dict[str, dict[str, list[str]]] = {}
+    for v in d["validity_map"]:
+        system, ratio, ic = v["id"].rsplit("-", 2)
+        if ic != "disk":
+            continue
+        side = by.setdefault(system, {"above": [], "near": []})
+        if v.get("regular_fraction_upper") is not None:
+            continue
+        f, err = v["regular_fraction"], v.get("regular_err_total")
+        if err is None:
+            err = math.hypot(v.get("regular_err") or 0.0, v.get("regular_syst") or 0.0)
+        if f - Z_RESOLVED * err > 0.5:
+            side["above"].append(ratio)
+        elif f + Z_RESOLVED * err >= 0.5:
+            side["near"].append(ratio)
+    for system, side in by.items():
+        name = _SYSTEM_NAMES.get(system, system)
+        if side["above"]:
+            above.append(f"{name} at {', '.join(side['above'])} E_c")
+        if side["near"]:
+            near.append(f"{name} at {', '.join(side['near'])} E_c")
+        if not side["above"] and not side["near"]:
+            none.append(name)
+    parts = []
+    if above:
+        parts.append(
+            "more than half of the orbits are regular by the indicator (the fraction 2σ of its total error above "
+            f"one half) for {'; '.join(above)}"
+        )
+    if near:
+        parts.append(f"about half, within 2σ of one half, for {'; '.join(near)}")
+    if none:
+        parts.append(f"less than half at every energy for {' and '.join(none)}")
+    return "; ".join(parts)
+
+
 def _generality_validity(get: Loader) -> str:
     d = get("generality", None)
     cells = [v for v in d["validity_map"] if v["kappa0_defined"] is not None]
@@ -1278,6 +1320,32 @@ def _fig5_rows_by_scale(get: Loader) -> str:
     return "; ".join(parts)
 
 
+def _fig5_intervals_by_scale(get: Loader) -> str:
+    """The 5b − 5a rows at both scales, matched by construction: how many times narrower the paper-scale 95 %
+    intervals of Δ are than the quick ones (the range over the rows), how many quick values lie inside their
+    paper-scale interval, and whether every pair of intervals overlaps (the move is then read as statistics)."""
+    quick = {r["construction"]: r for r in get("fig5", "quick")["verdict_5b"]["rows"]}
+    paper = {r["construction"]: r for r in get("fig5", None)["verdict_5b"]["rows"]}
+    both = [c for c in paper if c in quick]
+    if not both:
+        return "no 5b − 5a row is at both scales"
+    ratios, inside, apart = [], 0, []
+    for c in both:
+        (ql, qh), (pl, ph) = quick[c]["delta_interval"], paper[c]["delta_interval"]
+        ratios.append((qh - ql) / (ph - pl))
+        inside += pl <= quick[c]["delta"] <= ph
+        if qh < pl or ql > ph:
+            apart.append(FIG5_ROW_NAMES.get(c, c))
+    span = f"{min(ratios):.1f} to {max(ratios):.1f}" if len(ratios) > 1 else f"{ratios[0]:.1f}"
+    head = (
+        f"the paper-scale 95 % intervals are {span} times narrower than the quick ones; {inside} of {len(both)} "
+        "quick values lie inside their paper-scale interval"
+    )
+    if apart:
+        return f"{head}, and the two intervals do not overlap for {', '.join(apart)}: not statistics alone there"
+    return f"{head}, and every quick interval overlaps its paper-scale one: statistics"
+
+
 def _noise_reactivation(get: Loader) -> str:
     """The drag-only survival extended by re-activation against the heat-bath P(t): its largest deviation in units
     of P's standard error (fails beyond 2), and the tail's rate against the thermal rate by the 2σ rule."""
@@ -1571,6 +1639,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.convergence": _operator_convergence,
     "operator.mixed_refinement": _operator_mixed_refinement,
     "generality.validity": _generality_validity,
+    "generality.regular_majority": _generality_regular_majority,
     "generality.indicator_systematic": _generality_indicator_systematic,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
@@ -1583,6 +1652,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "fig5.ours_5b": _fig5_ours_5b,
     "fig5.eps_first": _fig5_eps_first,
     "fig5.rows_by_scale": _fig5_rows_by_scale,
+    "fig5.intervals_by_scale": _fig5_intervals_by_scale,
     "noise.reactivation": _noise_reactivation,
     "noise.window_halves": _noise_window_halves,
     "operator.tolerance": _operator_tolerance,

@@ -59,6 +59,7 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "its a ε² and b ε terms are of similar size, so its local\n  slope lies between 1 and 2",
         "At the smallest γ Hénon–Heiles escapes\n  1.08 times as often as κ0 predicts",
         "It changes the numbers, not the picture: at 1.05 E_c",
+        "The paper-scale intervals are about three times\n      narrower and every quick value lies inside",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -1016,3 +1017,58 @@ def test_the_smooth_order_reading_places_the_change_on_the_scan_grid_and_against
     assert READINGS["basins.smooth_order"](_loader(_smooth_docs(0.22, 0.24, 0.2755, 0.0026))).startswith("below the")
     assert READINGS["basins.smooth_order"](_loader(_smooth_docs(0.275, 0.24, 0.2755, 0.0026))).endswith("within 2σ")
     assert "above fig2's break" in READINGS["basins.smooth_order"](_loader(_smooth_docs(0.3, 0.24, 0.2755, 0.0026)))
+
+
+def _f5_docs(quick_rows, paper_rows):
+    def rows(rs):
+        return {
+            "verdict_5b": {"rows": [{"construction": c, "delta": d, "delta_interval": [lo, hi]} for c, d, lo, hi in rs]}
+        }
+
+    docs = {"quick": rows(quick_rows), None: rows(paper_rows)}
+    return lambda study, scale: docs[scale]
+
+
+def test_the_fig5_intervals_reading_gives_the_width_ratios_and_calls_statistics_only_when_every_pair_overlaps():
+    """cut: quick [−0.03, 0.03] (width 0.06) against paper [0.00, 0.02] (0.02): 3.0 times, value 0.0 inside; ours:
+    quick [0.04, 0.08] against [0.05, 0.07]: 2.0 times, value 0.06 inside; with ours' paper interval moved to
+    [0.09, 0.11] the two do not overlap."""
+    text = READINGS["fig5.intervals_by_scale"](
+        _f5_docs(
+            [("cut", 0.0, -0.03, 0.03), ("ours", 0.06, 0.04, 0.08)],
+            [("cut", 0.01, 0.0, 0.02), ("ours", 0.06, 0.05, 0.07)],
+        )
+    )
+    assert text == (
+        "the paper-scale 95 % intervals are 2.0 to 3.0 times narrower than the quick ones; 2 of 2 quick values lie "
+        "inside their paper-scale interval, and every quick interval overlaps its paper-scale one: statistics"
+    )
+    text = READINGS["fig5.intervals_by_scale"](
+        _f5_docs(
+            [("cut", 0.0, -0.03, 0.03), ("ours", 0.06, 0.04, 0.08)],
+            [("cut", 0.01, 0.0, 0.02), ("ours", 0.1, 0.09, 0.11)],
+        )
+    )
+    assert "1 of 2 quick values" in text and text.endswith("do not overlap for ours: not statistics alone there")
+
+
+def test_the_regular_majority_reading_says_more_than_half_only_two_sigma_above_one_half():
+    """0.64 ± 0.04 (0.56 > 0.5): more than half; 0.51 ± 0.03: within 2σ of one half; a count of 0 (its bound) and
+    0.40 ± 0.01: less than half; the well ICs are not read."""
+
+    def cell(cid, f, err=None, upper=None):
+        return {"id": cid, "regular_fraction": f, "regular_err_total": err, "regular_fraction_upper": upper}
+
+    cells = [
+        cell("a-1.05-disk", 0.64, 0.04),
+        cell("a-1.1-disk", 0.51, 0.03),
+        cell("a-1.05-well", 0.9, 0.01),
+        cell("b-1.05-disk", 0.0, upper=3e-4),
+        cell("b-1.1-disk", 0.40, 0.01),
+    ]
+    text = READINGS["generality.regular_majority"](_loader({"generality": {"validity_map": cells}}))
+    assert text == (
+        "more than half of the orbits are regular by the indicator (the fraction 2σ of its total error above one "
+        "half) for a at 1.05 E_c; about half, within 2σ of one half, for a at 1.1 E_c; less than half at every "
+        "energy for b"
+    )
