@@ -1346,6 +1346,31 @@ def _fig5_intervals_by_scale(get: Loader) -> str:
     return f"{head}, and every quick interval overlaps its paper-scale one: statistics"
 
 
+def _resc_paper_radius(get: Loader) -> str:
+    """The paper's escape radius (the smallest the study tests) against the exits' Lyapunov orbits, energy by
+    energy: beyond each orbit
+    (r_esc > its largest radius: an orbit crossing r_esc has passed the saddle), cutting it, or inside it (r_esc
+    below its smallest radius: an orbit crossing r_esc may still come back), the energies of each class named."""
+    d = get("resc", None)
+    r = min(d["r_esc"])
+    groups: dict[str, list[str]] = {"beyond": [], "cuts": [], "inside": []}
+    for key, orbit in sorted(d["lyapunov"].items(), key=lambda kv: float(kv[0].split("=")[1])):
+        e = key.split("=")[1]
+        if r > orbit["r_max"]:
+            groups["beyond"].append(e)
+        elif r < orbit["r_min"]:
+            groups["inside"].append(e)
+        else:
+            groups["cuts"].append(e)
+    words = {
+        "inside": "lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = ",
+        "cuts": "cuts them at E = ",
+        "beyond": "lies beyond them at E = ",
+    }
+    parts = [words[k] + ", ".join(groups[k]) for k in ("inside", "cuts", "beyond") if groups[k]]
+    return f"r_esc = {r:g} " + "; ".join(parts)
+
+
 def _noise_reactivation(get: Loader) -> str:
     """The drag-only survival extended by re-activation against the heat-bath P(t): its largest deviation in units
     of P's standard error (fails beyond 2), and the tail's rate against the thermal rate by the 2σ rule."""
@@ -1647,6 +1672,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.map_coverage": _generality_map_coverage,
     "generality.mu_radius": _generality_mu_radius,
     "resc.shifts": _resc_shifts,
+    "resc.paper_radius": _resc_paper_radius,
     "resc.scale_moves": _resc_scale_moves,
     "fig2.law_below_break": _fig2_law_below_break,
     "fig5.ours_5b": _fig5_ours_5b,

@@ -1072,3 +1072,17 @@ def test_the_regular_majority_reading_says_more_than_half_only_two_sigma_above_o
         "half) for a at 1.05 E_c; about half, within 2σ of one half, for a at 1.1 E_c; less than half at every "
         "energy for b"
     )
+
+
+def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_against_each_lyapunov_orbit():
+    """r_esc = 1.03 against orbits spanning [1.001, 1.002] (beyond), [1.02, 1.05] (cuts) and [1.04, 1.09] (inside)."""
+    lyap = {
+        "E=0.30": {"r_min": 1.04, "r_max": 1.09},
+        "E=0.17": {"r_min": 1.001, "r_max": 1.002},
+        "E=0.25": {"r_min": 1.02, "r_max": 1.05},
+    }
+    text = READINGS["resc.paper_radius"](_loader({"resc": {"r_esc": [1.5, 1.03], "lyapunov": lyap}}))
+    assert text == (
+        "r_esc = 1.03 lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = 0.30; "
+        "cuts them at E = 0.25; lies beyond them at E = 0.17"
+    )
