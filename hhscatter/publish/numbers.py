@@ -669,6 +669,8 @@ READING_WORDS = re.compile(
     r"(?:in)?consistent(?:ly)?|differs?\s+from|no\s+[\w-]+(?:\s+[\w-]+)?\s+(?:row|point|cell|value)s?\s+differs?|"
     r"(?:several|a\s+few|many)\s+σ|σ\s+from\s+zero|by\s+up\s+to(?:\s+about)?\s+\d+(?:\.\d+)?\s*σ|"
     r"within\s+(?:its|their)\s+errors?|the\s+same\s+for\s+(?:r|E|γ|every|all\s+(?!systems))\S*|"
+    r"times\s+as\s+(?:often|many|much|large|fast)|of\s+similar\s+size|"
+    r"not\s+the\s+picture|times\s+(?:narrower|wider)|"
     r"hardly|cross(?:es|ed)\s+(?:it|them|fig\d\S*|the\s+(?:measured|predicted|prediction|reference|paper's|fitted|other))|"
     r"roughly|nearly|essentially|clearly|barely|almost|slightly|about\s+the\s+same|close\s+to|"
     r"(?:much|far)\s+(?:below|above|closer|farther|wider|narrower|larger|smaller|longer|shorter|higher|lower|finer|"

@@ -199,6 +199,31 @@ def _basins_energy_scan(get: Loader) -> str:
     return f"the exit basins are {wada}; {fractal}; {alpha}; {s_b}"
 
 
+def _basins_smooth_order(get: Loader) -> str:
+    """Where S_b(E) turns smooth (E*, a scan energy) against the scan energy from which no orbit is left censored
+    at t_max (the same grid: above, at or below it) and against fig2's break energy E_b (below or above it where
+    E* lies beyond E_b's 2σ interval, else at it within 2σ)."""
+    d = get("basins", None)
+    t, eb = d["energy_trend"], d["E_b"]
+    e_s, e_n = t["E_smooth_S_b"], t["E_no_trapped"]
+    if e_s is None or e_n is None or eb is None:
+        return "S_b(E) has no smooth part or every scan energy keeps censored orbits: no order to state"
+    ebv, ebe = (eb["value"], eb["err"]) if isinstance(eb, dict) else (float(eb), 0.0)
+    censored = "the energy from which no orbit is left censored at t_max"
+    first = (
+        f"above {censored} ({e_n:g})"
+        if e_s > e_n
+        else (f"at {censored} ({e_n:g})" if e_s == e_n else f"below {censored} ({e_n:g})")
+    )
+    if e_s < ebv - Z_RESOLVED * ebe:
+        second = f"below fig2's break energy E_b = {_ve(ebv, ebe)} by more than 2σ"
+    elif e_s > ebv + Z_RESOLVED * ebe:
+        second = f"above fig2's break energy E_b = {_ve(ebv, ebe)} by more than 2σ"
+    else:
+        second = f"at fig2's break energy E_b = {_ve(ebv, ebe)} within 2σ"
+    return f"{first} and {second}"
+
+
 def _basins_kantz_grassberger(get: Loader) -> str:
     """κ/α (Kantz–Grassberger: α = κ/λ on a hyperbolic saddle) against the decision rate λ, energy by energy of the
     scan: within 2σ (their errors combined) or more than 2σ apart; energies without κ/α are left out."""
@@ -259,6 +284,113 @@ def _generality_b_onset(get: Loader) -> str:
     if cls == "bad":
         return f"a linear onset, b resolved from 0 {z.group(0) if z else ''}".strip()
     return f"not judged against b = 0 ({v})"
+
+
+def _generality_law_slope(get: Loader) -> str:
+    """The law a ε² + b ε of the first system's κ0 over each convention's fitted range (its lowest defined ε to its
+    break ε_b): the linear term over the quadratic one, b/(a ε), and the local slope d ln κ0/d ln ε =
+    (2aε + b)/(aε + b) at both ends, and whether the claims' β below the break lies in the range of those slopes
+    (its 2σ interval overlapping it)."""
+    d = get("generality", None)
+    system = next(iter(d["systems"]))
+    beta = next((c for c in d["claims"] if c["id"] == f"{system}-1-2"), None)
+    parts, slopes = [], []
+    for conv, law in d["systems"][system]["kappa_law"].items():
+        if not law or not law.get("a") or not law.get("b") or not law.get("eps_b"):
+            continue
+        a, b, eps_b = law["a"]["value"], law["b"]["value"], law["eps_b"]["value"]
+        eps = [r["eps"] for r in d["kappa"] if r["system"] == system and r["convention"] == conv and r["defined"]]
+        if not eps or a <= 0 or min(eps) >= eps_b:
+            continue
+        ends = (min(eps), eps_b)
+        s = [(2 * a * e + b) / (a * e + b) for e in ends]
+        slopes += s
+        parts.append(
+            f"{conv} (ε {ends[0]:.2f} to {ends[1]:.2f}): b/(a ε) {b / (a * ends[0]):.2g} → {b / (a * ends[1]):.2g},"
+            f" slope {s[0]:.2f} → {s[1]:.2f}"
+        )
+    if not parts:
+        return "no convention has a law a ε² + b ε with a > 0 below its break"
+    lo, hi = min(slopes), max(slopes)
+    out = (
+        "per convention, the linear term over the quadratic one and the law's local slope d ln κ0/d ln ε = "
+        f"(2aε + b)/(aε + b) from the lowest fitted ε to the break: {'; '.join(parts)}"
+    )
+    if not beta or beta.get("value") is None or not beta.get("err"):
+        return out
+    v, e = beta["value"], beta["err"]
+    if v + Z_RESOLVED * e < lo:
+        side = f"lies below these slopes ({lo:.2f} to {hi:.2f}) by more than 2σ"
+    elif v - Z_RESOLVED * e > hi:
+        side = f"lies above these slopes ({lo:.2f} to {hi:.2f}) by more than 2σ"
+    elif lo <= v <= hi:
+        side = f"lies inside the range of these slopes ({lo:.2f} to {hi:.2f}): the two fits do not contradict"
+    else:
+        side = f"lies within 2σ of the range of these slopes ({lo:.2f} to {hi:.2f}): the two fits do not contradict"
+    return f"{out}. The power law's β = {_ve(v, e)} {side}"
+
+
+def _generality_escape_excess(get: Loader) -> str:
+    """κγ(t)/κ0(E(t)) at the smallest γ per system (claim 7), with the verdict of the one rule: more or fewer escapes
+    than κ0 at the mean energy predicts only where the ratio differs from 1; the mechanism (a convex κ0 averaged
+    over the energy spread exceeds κ0 at the mean energy) stated only for an excess; the undetermined named."""
+    d = get("generality", None)
+    said, undetermined = [], []
+    for system in d["systems"]:
+        rec = next((c for c in d["claims"] if c["id"] == f"{system}-7-0"), None)
+        name = _SYSTEM_NAMES.get(system, system)
+        if rec is None:
+            continue
+        if rec.get("value") is None or not rec.get("err"):
+            undetermined.append(name)
+            continue
+        v = claim_verdict(rec, d.get("scale"))
+        text = f"{name} escapes {_ve(rec['value'], rec['err'])} times as often as κ0 at E0 e^(−μγt) predicts ({v})"
+        if verdict_class(v) == "bad" and rec["value"] > 1:
+            text += ": more often, as the energy spread makes the mean of a convex κ0(E_i) exceed κ0 at the mean energy"
+        elif verdict_class(v) == "bad":
+            text += ": less often than κ0 at the mean energy predicts"
+        said.append(text)
+    if undetermined:
+        said.append(
+            f"undetermined for {' and '.join(undetermined)} (τ0 comes after E(t) has reached the lowest energy with "
+            "a defined κ0; the claims' table gives the times)"
+        )
+    return "; ".join(said)
+
+
+def _generality_mu_gap(get: Loader) -> str:
+    """The share of the gap between the paper's μ and the measured μ on fig3's window that the prediction from the
+    conservative ⟨K⟩ covers, (μ_pred − μ_paper)/(μ_meas − μ_paper), its error propagated from the three (the paper's
+    μ carries half a unit of its last printed digit), worded by its 2σ interval against 1/2 and 1."""
+    from hhscatter.analysis.stats.verdicts import half_unit  # the paper's printed precision
+
+    d = get("generality", None)
+    system = next(iter(d["systems"]))
+    win = d["systems"][system]["mu_by_window"]["paper"]
+    ref = next(c for c in d["claims"] if c["id"] == f"{system}-3-0")["reference"]
+    p, dp = win["predicted_c_measure"]["value"], win["predicted_c_measure"]["err"]
+    m, dm = win["measured"]["value"], win["measured"]["err"]
+    dr = half_unit(ref)
+    gap = m - ref
+    f = (p - ref) / gap
+    err = math.hypot(dp / gap, f * dm / gap, (p - m) / gap**2 * dr)
+    lo_w, hi_w = win["window"]
+    head = (
+        f"on [{lo_w:g}, {hi_w:g}] the prediction from the conservative ⟨K⟩ covers {_ve(f, err)} of the gap between "
+        f"the paper's {ref:g} (± {dr:g}, half its last digit) and the measured μ"
+    )
+    if abs(f - 1) <= Z_RESOLVED * err:
+        return f"{head}: all of it within 2σ"
+    if f - Z_RESOLVED * err > 1:
+        return f"{head}: more than the gap, by more than 2σ"
+    if f - Z_RESOLVED * err > 0.5:
+        return f"{head}: more than half of it, by more than 2σ"
+    if f + Z_RESOLVED * err < 0:
+        return f"{head}: none of it (the prediction lies on the other side of the paper's value by more than 2σ)"
+    if f + Z_RESOLVED * err < 0.5:
+        return f"{head}: less than half of it, by more than 2σ"
+    return f"{head}: a share not resolved from one half at 2σ"
 
 
 def _b_relation(get: Loader) -> str:
@@ -454,6 +586,48 @@ def _regular_side(v: dict, level: float = 0.01) -> str:
     if err is None:
         err = math.hypot(v.get("regular_err") or 0.0, v.get("regular_syst") or 0.0)
     return "below" if f + err < level else ("above" if f - err >= level else "near")
+
+
+def _generality_regular_majority(get: Loader) -> str:
+    """Per system, the energies (disk ICs) at which more than half of the orbits are regular by the indicator: the
+    regular fraction 2σ of its total error (stat ⊕ threshold ⊕ indicator) above 1/2; those within 2σ of 1/2
+    named apart; a count of 0 is below."""
+    d = get("generality", None)
+    above, near, none = [], [], []
+    by: dict[str, dict[str, list[str]]] = {}
+    for v in d["validity_map"]:
+        system, ratio, ic = v["id"].rsplit("-", 2)
+        if ic != "disk":
+            continue
+        side = by.setdefault(system, {"above": [], "near": []})
+        if v.get("regular_fraction_upper") is not None:
+            continue
+        f, err = v["regular_fraction"], v.get("regular_err_total")
+        if err is None:
+            err = math.hypot(v.get("regular_err") or 0.0, v.get("regular_syst") or 0.0)
+        if f - Z_RESOLVED * err > 0.5:
+            side["above"].append(ratio)
+        elif f + Z_RESOLVED * err >= 0.5:
+            side["near"].append(ratio)
+    for system, side in by.items():
+        name = _SYSTEM_NAMES.get(system, system)
+        if side["above"]:
+            above.append(f"{name} at {', '.join(side['above'])} E_c")
+        if side["near"]:
+            near.append(f"{name} at {', '.join(side['near'])} E_c")
+        if not side["above"] and not side["near"]:
+            none.append(name)
+    parts = []
+    if above:
+        parts.append(
+            "more than half of the orbits are regular by the indicator (the fraction 2σ of its total error above "
+            f"one half) for {'; '.join(above)}"
+        )
+    if near:
+        parts.append(f"about half, within 2σ of one half, for {'; '.join(near)}")
+    if none:
+        parts.append(f"less than half at every energy for {' and '.join(none)}")
+    return "; ".join(parts)
 
 
 def _generality_validity(get: Loader) -> str:
@@ -1146,6 +1320,57 @@ def _fig5_rows_by_scale(get: Loader) -> str:
     return "; ".join(parts)
 
 
+def _fig5_intervals_by_scale(get: Loader) -> str:
+    """The 5b − 5a rows at both scales, matched by construction: how many times narrower the paper-scale 95 %
+    intervals of Δ are than the quick ones (the range over the rows), how many quick values lie inside their
+    paper-scale interval, and whether every pair of intervals overlaps (the move is then read as statistics)."""
+    quick = {r["construction"]: r for r in get("fig5", "quick")["verdict_5b"]["rows"]}
+    paper = {r["construction"]: r for r in get("fig5", None)["verdict_5b"]["rows"]}
+    both = [c for c in paper if c in quick]
+    if not both:
+        return "no 5b − 5a row is at both scales"
+    ratios, inside, apart = [], 0, []
+    for c in both:
+        (ql, qh), (pl, ph) = quick[c]["delta_interval"], paper[c]["delta_interval"]
+        ratios.append((qh - ql) / (ph - pl))
+        inside += pl <= quick[c]["delta"] <= ph
+        if qh < pl or ql > ph:
+            apart.append(FIG5_ROW_NAMES.get(c, c))
+    span = f"{min(ratios):.1f} to {max(ratios):.1f}" if len(ratios) > 1 else f"{ratios[0]:.1f}"
+    head = (
+        f"the paper-scale 95 % intervals are {span} times narrower than the quick ones; {inside} of {len(both)} "
+        "quick values lie inside their paper-scale interval"
+    )
+    if apart:
+        return f"{head}, and the two intervals do not overlap for {', '.join(apart)}: not statistics alone there"
+    return f"{head}, and every quick interval overlaps its paper-scale one: statistics"
+
+
+def _resc_paper_radius(get: Loader) -> str:
+    """The paper's escape radius (the smallest the study tests) against the exits' Lyapunov orbits, energy by
+    energy: beyond each orbit
+    (r_esc > its largest radius: an orbit crossing r_esc has passed the saddle), cutting it, or inside it (r_esc
+    below its smallest radius: an orbit crossing r_esc may still come back), the energies of each class named."""
+    d = get("resc", None)
+    r = min(d["r_esc"])
+    groups: dict[str, list[str]] = {"beyond": [], "cuts": [], "inside": []}
+    for key, orbit in sorted(d["lyapunov"].items(), key=lambda kv: float(kv[0].split("=")[1])):
+        e = key.split("=")[1]
+        if r > orbit["r_max"]:
+            groups["beyond"].append(e)
+        elif r < orbit["r_min"]:
+            groups["inside"].append(e)
+        else:
+            groups["cuts"].append(e)
+    words = {
+        "inside": "lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = ",
+        "cuts": "cuts them at E = ",
+        "beyond": "lies beyond them at E = ",
+    }
+    parts = [words[k] + ", ".join(groups[k]) for k in ("inside", "cuts", "beyond") if groups[k]]
+    return f"r_esc = {r:g} " + "; ".join(parts)
+
+
 def _noise_reactivation(get: Loader) -> str:
     """The drag-only survival extended by re-activation against the heat-bath P(t): its largest deviation in units
     of P's standard error (fails beyond 2), and the tail's rate against the thermal rate by the 2σ rule."""
@@ -1413,8 +1638,12 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
     "basins.energy_scan": _basins_energy_scan,
     "basins.kantz_grassberger": _basins_kantz_grassberger,
+    "basins.smooth_order": _basins_smooth_order,
     "fig5.premise": _fig5_premise,
     "generality.b_onset": _generality_b_onset,
+    "generality.law_slope": _generality_law_slope,
+    "generality.escape_excess": _generality_escape_excess,
+    "generality.mu_gap": _generality_mu_gap,
     "generality.one_exponential": _generality_one_exponential,
     "generality.hh_1_05": _generality_hh_1_05,
     "noise.kramers": _noise_kramers,
@@ -1435,6 +1664,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.convergence": _operator_convergence,
     "operator.mixed_refinement": _operator_mixed_refinement,
     "generality.validity": _generality_validity,
+    "generality.regular_majority": _generality_regular_majority,
     "generality.indicator_systematic": _generality_indicator_systematic,
     "generality.resc_rule": _generality_resc_rule,
     "generality.claims_by_system": _generality_claims_by_system,
@@ -1442,11 +1672,13 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "generality.map_coverage": _generality_map_coverage,
     "generality.mu_radius": _generality_mu_radius,
     "resc.shifts": _resc_shifts,
+    "resc.paper_radius": _resc_paper_radius,
     "resc.scale_moves": _resc_scale_moves,
     "fig2.law_below_break": _fig2_law_below_break,
     "fig5.ours_5b": _fig5_ours_5b,
     "fig5.eps_first": _fig5_eps_first,
     "fig5.rows_by_scale": _fig5_rows_by_scale,
+    "fig5.intervals_by_scale": _fig5_intervals_by_scale,
     "noise.reactivation": _noise_reactivation,
     "noise.window_halves": _noise_window_halves,
     "operator.tolerance": _operator_tolerance,

@@ -6,7 +6,9 @@ calls the survivors it classifies). Records written before the studies said so c
 "trapped" or "KAM-trapped or sticky": :func:`in_glossary_words` gives a record read for a page or the report the
 words the studies write now, so that a row keeps one name at every scale (the pages match the paper-scale and the
 quick-scale rows by name) and no page says "trapped" for a censored orbit. The benchmarks' summaries are read through
-it too (the stress cases' orbits still inside at t = 5000 were "KAM-trapped"). The JSON keys stay as they are
+it too (the stress cases' orbits still inside at t = 5000 were "KAM-trapped"). The dissipative mixture's share of
+a sub-ensemble that never escapes (it settles) was its "trapped fraction φ" (or "trapped fractions f_ne,k"); it is
+read as the glossary names φ and f_ne, the never-escaping share. The JSON keys stay as they are
 (``trapped_fraction``, ``n_trapped`` …): readers use them.
 """
 
@@ -27,6 +29,8 @@ OLD_PHRASES: tuple[tuple[str, str], ...] = (
     ("c-measure: trapped orbits dropped", "c-measure: censored orbits dropped"),
     ("(trapped fraction ", "(censored fraction "),
     ("KAM-trapped orbits (E=", "censored orbits (E="),
+    ("(one trapped fraction φ)", "(one never-escaping share φ)"),
+    ("K trapped fractions f_ne,k", "K never-escaping fractions f_ne,k"),
 )
 
 

@@ -64,7 +64,7 @@ def survival_fit_points(t, P, P_err, tau0: float, fit_dt: float, n: int, min_cou
 def best_fit(fit_fn: Callable, starts):
     """best_fit(fit_fn, starts) -> the fit with the smallest χ² over several starting-value dicts.
 
-    The χ² surface has local minima (the settling branch can be traded for a lower trapped fraction);
+    The χ² surface has local minima (the settling branch can be traded for a lower never-escaping fraction);
     starts whose fit raises RuntimeError or ValueError are skipped; none left is a RuntimeError.
 
     Examples
@@ -87,7 +87,7 @@ def best_fit(fit_fn: Callable, starts):
 
 
 def plateau_level(t, P, t_q: float) -> float:
-    """plateau_level(t, P, t_q) -> P at time t_q (log-linear interpolation): the trapped fraction before settling
+    """plateau_level(t, P, t_q) -> P at time t_q (log-linear interpolation): the never-escaping fraction before settling
     starts, when t_q is late in the escape regime. Times in time units.
 
     Examples
@@ -105,7 +105,7 @@ def fit_homogeneous_hazards(t, P, P_err, tf, Pf, sf, *, kappa, E0, mu, gamma, ta
     -> {hazard: SurvivalFit}: the homogeneous model, Eq. (eqn:surv_prob_model), fitted on the points of
     :func:`survival_fit_points`.
 
-    ``t, P, P_err``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fraction are read from it);
+    ``t, P, P_err``: the whole Kaplan–Meier curve (P(τ0) and the starting never-escaping fraction are read from it);
     ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`). P(τ0) is held; three starts (data-driven,
     and f_ne = P at τ0 + 0.85 (τ2 − τ0) with (L, b) = (1, 1) and (3, 0.3)), the best χ² kept
     (:func:`best_fit`). Units: t in time units, E in energy units, γ in 1/time.
@@ -154,11 +154,11 @@ def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, m
     """{hazard: MixtureFit}: the mixture model of sub-ensembles fitted on the points of
     :func:`survival_fit_points`.
 
-    ``t, P``: the whole Kaplan–Meier curve (P(τ0) and the starting trapped fractions are read from it);
+    ``t, P``: the whole Kaplan–Meier curve (P(τ0) and the starting never-escaping fractions are read from it);
     ``tf, Pf, sf``: the fitted points (:func:`survival_fit_points`); ``comps`` the sub-ensembles
     (:func:`~hhscatter.analysis.dissipative.mixture.mixture_components`); ``kappa`` κ0(E) (1/time); ``mode``
-    "shared" (one trapped fraction φ of P(τ0)) or "free" (one f_ne,k per sub-ensemble). P(τ0) is held; three
-    starts (data-driven, and the trapped fraction P at τ0 + 0.85 (τ2,min − τ0) — shared, or handed to the
+    "shared" (one never-escaping share φ of P(τ0)) or "free" (one f_ne,k per sub-ensemble). P(τ0) is held; three
+    starts (data-driven, and the never-escaping fraction P at τ0 + 0.85 (τ2,min − τ0) — shared, or handed to the
     low-energy sub-ensembles first, which reach E_c first — with (L, b) = (1, 1) and (3, 0.3)), the best χ²
     kept (:func:`best_fit`). Eq. (eqn:surv_prob_model) per sub-ensemble, τ2,k of Eq. (eq:tau2) with its own
     μ_k. Units: t in time units, E in energy units.
@@ -197,7 +197,7 @@ def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, m
     fne = min(plateau_level(t, P, tau0 + 0.85 * max(t2 - tau0, 0.0)), 0.95 * P_tau0)
     if mode == "shared":
         alt = {"phi": fne / P_tau0}
-    else:  # trapped orbits first assigned to the low-energy sub-ensembles (they reach E_c first)
+    else:  # never-escaping orbits first assigned to the low-energy sub-ensembles (they reach E_c first)
         alt, left = {}, fne
         for k in np.argsort(comps.E_ref):
             cap = 0.99 * comps.weights[k] * P_tau0

@@ -119,9 +119,9 @@ def mixture_comparisons(cmps: pd.DataFrame, hazards, mixtures) -> list:
                     note=(
                         f"components by {var['by']} at t_ref = {var['t_ref']}; same data selection; "
                         + (
-                            "same number of free parameters (one trapped fraction φ)"
+                            "same number of free parameters (one never-escaping share φ)"
                             if mode == "shared"
-                            else "K trapped fractions f_ne,k: K − 1 more parameters"
+                            else "K never-escaping fractions f_ne,k: K − 1 more parameters"
                         )
                         + "; rms "
                         + ", ".join(f"{p}: {c.loc[p, 'homogeneous']:.3f} → {c.loc[p, name]:.3f}" for p in c.index)

@@ -56,6 +56,10 @@ def test_the_scan_finds_the_readings_that_were_typed():
         "At the paper scale every shift at\n      E ≥ 0.30 is several σ from zero and the same for r_esc = 1.1, 1.5 and 2",
         "The κ shifts with r_esc move by up to about 2σ of their quick errors",
         "The extrapolation in samples per box removes it within its\nerror",
+        "its a ε² and b ε terms are of similar size, so its local\n  slope lies between 1 and 2",
+        "At the smallest γ Hénon–Heiles escapes\n  1.08 times as often as κ0 predicts",
+        "It changes the numbers, not the picture: at 1.05 E_c",
+        "The paper-scale intervals are about three times\n      narrower and every quick value lies inside",
     ]
     assert all(typed_readings(t) for t in typed)
     assert typed_readings('the paper says "μ approaches 1"') == []
@@ -899,4 +903,186 @@ def test_the_b_relation_reading_compares_the_two_in_one_variable_and_says_resolv
     assert text.endswith(
         "The two differ (z = +12.1); generality's error is 4 times fig2's: fig2 resolves b from 0 (10σ), "
         "generality resolves b from 0 (15σ)"
+    )
+
+
+def _law_docs(beta, beta_err):
+    """One system, two conventions: "p" with a = 1, b = 0.1, break 0.5, defined at ε = 0.1 and 0.3 (slope
+    (2aε + b)/(aε + b) = 1.5 at 0.1 and 1.1/0.6 = 1.83 at 0.5; b/(aε) = 1 and 0.2); "q" with a ≤ 0 (no slope)."""
+    law = {"a": {"value": 1.0, "err": 0.1}, "b": {"value": 0.1, "err": 0.01}, "eps_b": {"value": 0.5, "err": 0.1}}
+    kappa = [
+        {"system": "s", "convention": "p", "eps": e, "defined": ok}
+        for e, ok in ((0.05, False), (0.1, True), (0.3, True))
+    ]
+    return {
+        "generality": {
+            "systems": {"s": {"kappa_law": {"p": law, "q": {**law, "a": {"value": -1.0, "err": 0.1}}}}},
+            "kappa": kappa,
+            "claims": [{"id": "s-1-2", "value": beta, "err": beta_err, "reference": 2.0}],
+        }
+    }
+
+
+def test_the_law_slope_reading_computes_the_local_slope_at_both_ends_and_places_beta_by_two_sigma():
+    text = READINGS["generality.law_slope"](_loader(_law_docs(1.6, 0.05)))
+    assert "p (ε 0.10 to 0.50): b/(a ε) 1 → 0.2, slope 1.50 → 1.83" in text and "q (" not in text
+    assert (
+        "β = 1.60 ± 0.05 lies inside the range of these slopes (1.50 to 1.83): the two fits do not contradict" in text
+    )
+    assert "lies within 2σ of the range" in READINGS["generality.law_slope"](_loader(_law_docs(1.45, 0.05)))
+    assert "lies below these slopes (1.50 to 1.83) by more than 2σ" in READINGS["generality.law_slope"](
+        _loader(_law_docs(1.2, 0.05))
+    )
+    assert "lies above these slopes" in READINGS["generality.law_slope"](_loader(_law_docs(2.2, 0.1)))
+
+
+def _excess_docs(value, err):
+    claims = [
+        {"id": "a-7-0", "claim": "7", "quantity": "ratio", "system": "a", "value": value, "err": err, "reference": 1.0},
+        {
+            "id": "b-7-0",
+            "claim": "7",
+            "quantity": "ratio",
+            "system": "b",
+            "value": None,
+            "err": None,
+            "reference": None,
+        },
+    ]
+    return {"generality": {"systems": {"a": {}, "b": {}}, "claims": claims}}
+
+
+def test_the_escape_excess_reading_names_the_mechanism_only_for_an_excess_beyond_two_sigma():
+    """1.08 ± 0.002 is 40σ above 1 (more often, the convex κ0's mechanism); 1.002 ± 0.002 is 1σ (no side); 0.9 ±
+    0.01 is 10σ below (less often); a record without a value is undetermined."""
+    text = READINGS["generality.escape_excess"](_loader(_excess_docs(1.08, 0.002)))
+    assert text.startswith(
+        "a escapes 1.0800 ± 0.0020 times as often as κ0 at E0 e^(−μγt) predicts (differs (z = +40.0))"
+    )
+    assert ": more often, as the energy spread makes the mean of a convex κ0(E_i) exceed" in text
+    assert text.endswith(
+        "; undetermined for b (τ0 comes after E(t) has reached the lowest energy with a defined κ0; "
+        "the claims' table gives the times)"
+    )
+    text = READINGS["generality.escape_excess"](_loader(_excess_docs(1.002, 0.002)))
+    assert "(agrees (z = +1.0))" in text and "more often" not in text and "less often" not in text
+    assert ": less often" in READINGS["generality.escape_excess"](_loader(_excess_docs(0.9, 0.01)))
+
+
+def _gap_docs(predicted):
+    win = {
+        "window": [0.0, 200.0],
+        "measured": {"value": 0.95, "err": 0.0001},
+        "predicted_c_measure": {"value": predicted, "err": 0.0001},
+    }
+    return {
+        "generality": {
+            "systems": {"s": {"mu_by_window": {"paper": win}}},
+            "claims": [{"id": "s-3-0", "value": 0.95, "err": 0.0001, "reference": 0.91}],
+        }
+    }
+
+
+def test_the_mu_gap_reading_propagates_the_papers_last_digit_and_words_the_share_by_two_sigma():
+    """Paper 0.91 (± 0.005), measured 0.95: the gap is 0.04. Predicted 0.94 covers 0.75 of it, σ ≈ 0.005·0.01/0.04²
+    = 0.031 (the paper's digit dominates): more than half. 0.95 covers all of it; 0.925 covers 0.375 ± 0.078, not
+    resolved from one half; 0.89 lies on the other side of 0.91 (−0.5 ± 0.16): none of it."""
+    text = READINGS["generality.mu_gap"](_loader(_gap_docs(0.94)))
+    assert text.startswith("on [0, 200] the prediction from the conservative ⟨K⟩ covers 0.75 ± 0.03 of the gap")
+    assert "the paper's 0.91 (± 0.005, half its last digit)" in text
+    assert text.endswith(": more than half of it, by more than 2σ")
+    assert READINGS["generality.mu_gap"](_loader(_gap_docs(0.95))).endswith(": all of it within 2σ")
+    assert READINGS["generality.mu_gap"](_loader(_gap_docs(0.925))).endswith(
+        ": a share not resolved from one half at 2σ"
+    )
+    assert READINGS["generality.mu_gap"](_loader(_gap_docs(0.89))).endswith(
+        ": none of it (the prediction lies on the other side of the paper's value by more than 2σ)"
+    )
+
+
+def _smooth_docs(e_smooth, e_none, eb, eb_err):
+    trend = {"E_smooth_S_b": e_smooth, "E_no_trapped": e_none}
+    return {"basins": {"energy_trend": trend, "E_b": {"value": eb, "err": eb_err}}}
+
+
+def test_the_smooth_order_reading_places_the_change_on_the_scan_grid_and_against_the_break_by_two_sigma():
+    """E* = 0.26 against the last censored energy 0.24 (above) and E_b = 0.2755 ± 0.0026 (0.26 < 0.2703: below);
+    E* = 0.24 = 0.24 (at, as the quick scale has it); E* = 0.275 within 2σ of 0.2755 (0.2703 to 0.2807)."""
+    text = READINGS["basins.smooth_order"](_loader(_smooth_docs(0.26, 0.24, 0.2755, 0.0026)))
+    assert text == (
+        "above the energy from which no orbit is left censored at t_max (0.24) and below fig2's break energy "
+        "E_b = 0.2755 ± 0.0026 by more than 2σ"
+    )
+    assert READINGS["basins.smooth_order"](_loader(_smooth_docs(0.24, 0.24, 0.2755, 0.0026))).startswith("at the")
+    assert READINGS["basins.smooth_order"](_loader(_smooth_docs(0.22, 0.24, 0.2755, 0.0026))).startswith("below the")
+    assert READINGS["basins.smooth_order"](_loader(_smooth_docs(0.275, 0.24, 0.2755, 0.0026))).endswith("within 2σ")
+    assert "above fig2's break" in READINGS["basins.smooth_order"](_loader(_smooth_docs(0.3, 0.24, 0.2755, 0.0026)))
+
+
+def _f5_docs(quick_rows, paper_rows):
+    def rows(rs):
+        return {
+            "verdict_5b": {"rows": [{"construction": c, "delta": d, "delta_interval": [lo, hi]} for c, d, lo, hi in rs]}
+        }
+
+    docs = {"quick": rows(quick_rows), None: rows(paper_rows)}
+    return lambda study, scale: docs[scale]
+
+
+def test_the_fig5_intervals_reading_gives_the_width_ratios_and_calls_statistics_only_when_every_pair_overlaps():
+    """cut: quick [−0.03, 0.03] (width 0.06) against paper [0.00, 0.02] (0.02): 3.0 times, value 0.0 inside; ours:
+    quick [0.04, 0.08] against [0.05, 0.07]: 2.0 times, value 0.06 inside; with ours' paper interval moved to
+    [0.09, 0.11] the two do not overlap."""
+    text = READINGS["fig5.intervals_by_scale"](
+        _f5_docs(
+            [("cut", 0.0, -0.03, 0.03), ("ours", 0.06, 0.04, 0.08)],
+            [("cut", 0.01, 0.0, 0.02), ("ours", 0.06, 0.05, 0.07)],
+        )
+    )
+    assert text == (
+        "the paper-scale 95 % intervals are 2.0 to 3.0 times narrower than the quick ones; 2 of 2 quick values lie "
+        "inside their paper-scale interval, and every quick interval overlaps its paper-scale one: statistics"
+    )
+    text = READINGS["fig5.intervals_by_scale"](
+        _f5_docs(
+            [("cut", 0.0, -0.03, 0.03), ("ours", 0.06, 0.04, 0.08)],
+            [("cut", 0.01, 0.0, 0.02), ("ours", 0.1, 0.09, 0.11)],
+        )
+    )
+    assert "1 of 2 quick values" in text and text.endswith("do not overlap for ours: not statistics alone there")
+
+
+def test_the_regular_majority_reading_says_more_than_half_only_two_sigma_above_one_half():
+    """0.64 ± 0.04 (0.56 > 0.5): more than half; 0.51 ± 0.03: within 2σ of one half; a count of 0 (its bound) and
+    0.40 ± 0.01: less than half; the well ICs are not read."""
+
+    def cell(cid, f, err=None, upper=None):
+        return {"id": cid, "regular_fraction": f, "regular_err_total": err, "regular_fraction_upper": upper}
+
+    cells = [
+        cell("a-1.05-disk", 0.64, 0.04),
+        cell("a-1.1-disk", 0.51, 0.03),
+        cell("a-1.05-well", 0.9, 0.01),
+        cell("b-1.05-disk", 0.0, upper=3e-4),
+        cell("b-1.1-disk", 0.40, 0.01),
+    ]
+    text = READINGS["generality.regular_majority"](_loader({"generality": {"validity_map": cells}}))
+    assert text == (
+        "more than half of the orbits are regular by the indicator (the fraction 2σ of its total error above one "
+        "half) for a at 1.05 E_c; about half, within 2σ of one half, for a at 1.1 E_c; less than half at every "
+        "energy for b"
+    )
+
+
+def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_against_each_lyapunov_orbit():
+    """r_esc = 1.03 against orbits spanning [1.001, 1.002] (beyond), [1.02, 1.05] (cuts) and [1.04, 1.09] (inside)."""
+    lyap = {
+        "E=0.30": {"r_min": 1.04, "r_max": 1.09},
+        "E=0.17": {"r_min": 1.001, "r_max": 1.002},
+        "E=0.25": {"r_min": 1.02, "r_max": 1.05},
+    }
+    text = READINGS["resc.paper_radius"](_loader({"resc": {"r_esc": [1.5, 1.03], "lyapunov": lyap}}))
+    assert text == (
+        "r_esc = 1.03 lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = 0.30; "
+        "cuts them at E = 0.25; lies beyond them at E = 0.17"
     )

@@ -13,9 +13,9 @@ from hhscatter.publish.numbers import read_numbers_file
 from hhscatter.publish.words import OLD_PHRASES, in_glossary_words
 
 ROOT = Path(__file__).resolve().parents[2]
-#: "trapped" or "KAM" said of an orbit; the dissipative mixture's "trapped fraction φ" / "trapped fractions f_ne,k"
-#: (the share of a sub-ensemble that settles instead of escaping, a parameter of the fit) is another quantity
-OLD = re.compile(r"\bKAM-trapped\b|\btrapped\b(?! fractions? (?:φ|f_ne))", re.I)
+#: "trapped" or "KAM-trapped", said of an orbit still inside at t_max or of the dissipative mixture's share that
+#: settles instead of escaping (the glossary's never-escaping share φ, fractions f_ne,k): "trapped" has no meaning left
+OLD = re.compile(r"\bKAM-trapped\b|\btrapped\b", re.I)
 #: the modules that write text into the numbers JSON: the estimators, what assembles the studies' numbers, the studies
 WRITERS = sorted(
     [*(ROOT / "hhscatter" / "analysis").rglob("*.py"), *(ROOT / "hhscatter" / "reproduction").rglob("*.py")]
@@ -40,11 +40,31 @@ def test_the_code_writes_censored_not_trapped(path):
     assert not bad, f"{path.relative_to(ROOT)} writes the old words: {bad}"
 
 
-def test_the_pattern_tells_a_censored_orbit_from_the_mixtures_fraction():
+def test_the_pattern_finds_trapped_for_a_censored_orbit_and_for_the_mixtures_share():
     assert OLD.search("κ(E) points ill-defined by the trapped plateau")
     assert OLD.search("μ_c: KAM-trapped orbits dropped")
-    assert not OLD.search("same number of free parameters (one trapped fraction φ)")
-    assert not OLD.search("K trapped fractions f_ne,k: K − 1 more parameters")
+    assert OLD.search("same number of free parameters (one trapped fraction φ)")
+    assert not OLD.search("4 censored; n_trapped, trapped_fraction")
+
+
+def test_the_mixtures_share_that_never_escapes_is_named_as_the_glossary_names_phi():
+    """fig6's mixture rows written before say "one trapped fraction φ" / "K trapped fractions f_ne,k"; the glossary
+    names φ and f_ne the share that never escapes (settles), so the rows are read in those words."""
+    doc = {
+        "note": "same data selection; same number of free parameters (one trapped fraction φ); rms a: 1.0 → 2.0",
+        "other": "same data selection; K trapped fractions f_ne,k: K − 1 more parameters; rms a: 1.0 → 2.0",
+    }
+    out = in_glossary_words(doc)
+    assert (
+        out["note"]
+        == "same data selection; same number of free parameters (one never-escaping share φ); rms a: 1.0 → 2.0"
+    )
+    assert (
+        out["other"]
+        == "same data selection; K never-escaping fractions f_ne,k: K − 1 more parameters; rms a: 1.0 → 2.0"
+    )
+    glossary = (ROOT / "docs" / "equations.md").read_text()
+    assert "| φ | the share of each sub-ensemble that never escapes" in glossary
 
 
 COMMITTED = sorted(

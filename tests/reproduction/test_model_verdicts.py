@@ -55,7 +55,7 @@ def test_compare_mixtures_counts_pairs_where_the_mixture_fits_better():
     rows = mixture_comparisons(cmps, ["paper", "integrated"], mixtures)
     assert [(r["ours"], r["verdict"]) for r in rows] == [("1 (1) of 2", "differs"), ("2 (1) of 2", "agrees")]
     assert "A: 0.200 → 0.100, B: 0.100 → 0.300" in rows[0]["note"]
-    assert "one trapped fraction" in rows[0]["note"]
+    assert "one never-escaping share φ" in rows[0]["note"]
     free = mixture_comparisons(cmps, ["paper"], [{**mixtures[0], "fne_mode": "free"}])
     assert "K − 1 more parameters" in free[0]["note"]
 

@@ -25,8 +25,8 @@ sub-ensembles, each with their own energy decay exponent μ."  Design:
        f_ne,k + f_e,k = w_k P(τ0),   g_k = L/(1 + e^{−b(t−τ2,k)})²,
 
    with X_k the (instantaneous or integrated) escape exponent along E_k(t).
-   Free parameters: the K trapped fractions f_ne,k (``fne_mode="free"``) or a
-   single trapped fraction φ with f_ne,k = φ w_k P(τ0) (``fne_mode="shared"``,
+   Free parameters: the K never-escaping fractions f_ne,k (``fne_mode="free"``) or a
+   single never-escaping share φ with f_ne,k = φ w_k P(τ0) (``fne_mode="shared"``,
    as many free parameters as the homogeneous model), and the shared L, b.
    The component paths (A_k, μ_k) are measured, not fitted to P(t).
 
@@ -340,7 +340,7 @@ def mixture_survival_model(
     Mixture generalisation of Eq. (eqn:surv_prob_model):
     P(t) = Σ_k P_k(t), each sub-ensemble k following the homogeneous model
     along its own energy path E_k(t) = A_k e^{−μ_k γ t} (rate κ0(E_k(t))),
-    with trapped fraction ``f_ne[k]``, escaping fraction
+    with never-escaping fraction ``f_ne[k]``, escaping fraction
     f_e,k = w_k P_tau0 − f_ne[k], settling time τ2,k (``tau2`` (K,) or, if
     None, Eq. (eq:tau2) per sub-ensemble) and shared settling parameters L, b.
     NaN for t < τ0.
@@ -561,7 +561,7 @@ def _mixture_parameters(K, fne_mode, fixed):
 
 
 def _mixture_start(tf, Pf, tau2_k, weights, P_tau0, p0):
-    """Starting values (``p0`` wins): trapped share φ ≈ P(first τ2,k)/P(τ0), L ≈ late log-slope of P (1/time).
+    """Starting values (``p0`` wins): never-escaping share φ ≈ P(first τ2,k)/P(τ0), L ≈ late log-slope of P (1/time).
 
     Returns (guess dict of phi, L and every f_ne_k = φ w_k P(τ0); the starts for b).
     """
@@ -618,7 +618,7 @@ class _MixtureProblem:
         return lo_b, np.array([bound(n)[1] for n in self.free], dtype=float)
 
     def unpack(self, theta, P0):
-        """(all parameter values, the trapped fractions f_ne,k (K,)) from θ: guess, then ``fixed``, then θ."""
+        """(all parameter values, the never-escaping fractions f_ne,k (K,)) from θ: guess, then ``fixed``, then θ."""
         c = self.components
         v = dict(self.guess)
         v["b"] = self.b_starts[0]
@@ -674,7 +674,7 @@ def _mixture_values_errors(prob: _MixtureProblem, theta, names, st, P_tau0, P_ta
 
 
 def _total_fraction_errors(free, fne_mode, v, st, P_tau0, P_tau0_err):
-    """1σ errors of the total trapped fraction f_ne = Σ f_ne,k and of f_e = P(τ0) − f_ne (fit and P(τ0) parts)."""
+    """1σ errors of the total never-escaping fraction f_ne = Σ f_ne,k and of f_e = P(τ0) − f_ne (fit and P(τ0) parts)."""
     cov_fit, sens = st.cov_fit, st.sens
     k_free = len(free)
     grad = np.zeros(k_free)
@@ -691,7 +691,7 @@ def _total_fraction_errors(free, fne_mode, v, st, P_tau0, P_tau0_err):
 
 
 def _component_fraction_errors(free, fne_mode, v, errors, weights, st, P_tau0, P_tau0_err):
-    """(K,) 1σ errors of the trapped fractions f_ne,k: their own ("free") or φ w_k P(τ0)'s ("shared")."""
+    """(K,) 1σ errors of the never-escaping fractions f_ne,k: their own ("free") or φ w_k P(τ0)'s ("shared")."""
     cov_fit, sens = st.cov_fit, st.sens
     K = weights.size
     fk_err = np.zeros(K)

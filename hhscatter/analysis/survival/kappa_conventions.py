@@ -117,7 +117,7 @@ def p_level_windows(t, P, p_hi: float = 0.5, p_lo: float = 1e-2):
     return ((ta, tb), (ta, ta + L / 2), (ta + L / 2, tb), (ta + L / 4, ta + 3 * L / 4))
 
 
-def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
+def plateau_check(P_end: float, f_censored: float, max_bias: float = 0.1):
     """plateau_check(P(t_hi), f∞, max_bias=0.1) -> (defined, bias, reason).
 
     bias = f∞/P(t_hi): at the window end that share of the survivors never
@@ -138,15 +138,15 @@ def plateau_check(P_end: float, f_trapped: float, max_bias: float = 0.1):
     plateau: censored orbits (still inside at t_max) are 0.30%, 30% of P at the window end (> 10%); κ ill-defined
     """
     check.real(P_end, "P_end")  # NaN (P not known at the window end) counts as no survivors: κ ill-defined
-    check.number(f_trapped, "f_trapped", minimum=0.0)
+    check.number(f_censored, "f_censored", minimum=0.0)
     check.number(max_bias, "max_bias", positive=True)
-    bias = f_trapped / P_end if P_end > 0 else math.inf
+    bias = f_censored / P_end if P_end > 0 else math.inf
     if bias > max_bias:
         return (
             False,
             bias,
             (
-                f"plateau: censored orbits (still inside at t_max) are {f_trapped:.2%}, "
+                f"plateau: censored orbits (still inside at t_max) are {f_censored:.2%}, "
                 f"{bias:.0%} of P at the window end (> {max_bias:.0%}); κ ill-defined"
             ),
         )

@@ -16,13 +16,13 @@ from hhscatter.analysis.survival.kappa_conventions import (
 from hhscatter.errors import ConfigError
 
 
-def _lifetimes(kappa, n, f_trapped=0.0, t_max=400.0, seed=0):
-    """Exponential lifetimes (rate κ) and a fraction f_trapped that never escapes (censored at t_max)."""
+def _lifetimes(kappa, n, f_censored=0.0, t_max=400.0, seed=0):
+    """Exponential lifetimes (rate κ) and a fraction f_censored that never escapes (censored at t_max)."""
     rng = np.random.default_rng(seed)
     t = rng.exponential(1 / kappa, n)
-    trapped = rng.random(n) < f_trapped
-    t[trapped] = t_max
-    obs = ~trapped & (t < t_max)
+    censored = rng.random(n) < f_censored
+    t[censored] = t_max
+    obs = ~censored & (t < t_max)
     return np.minimum(t, t_max), obs
 
 
@@ -67,7 +67,7 @@ def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
     """With 6.5 % never escaping (square ICs at E = 0.18) P never reaches 1 %: no κ; our window rule's κ is
     flagged when its window ends on the plateau; without trapped orbits both are defined."""
     kappa = 0.1
-    t, obs = _lifetimes(kappa, 20000, f_trapped=0.065, seed=3)
+    t, obs = _lifetimes(kappa, 20000, f_censored=0.065, seed=3)
     assert censored_fraction(t, obs) == pytest.approx(0.065, abs=0.005)
     r = escape_rate_p_levels(t, obs)
     assert not r.defined and "never falls" in r.reason and math.isnan(r.kappa)

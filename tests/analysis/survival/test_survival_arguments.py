@@ -54,7 +54,7 @@ VALID = {
     },  # fmt: skip
     "kappa_from_cmeasure": {"return_times": np.linspace(1.0, 5.0, 20), "n_exit": 4},
     "p_level_windows": {"t": T, "P": P},
-    "plateau_check": {"P_end": 0.2, "f_trapped": 0.01},
+    "plateau_check": {"P_end": 0.2, "f_censored": 0.01},
     "dead_time_check": {"tau0": 1.0, "t_first": 1.5, "kappa": 0.2},
     "lifetimes_to_arrays": {"lifetimes": LIFETIMES},
     "survival_from_lifetimes": {"lifetimes": LIFETIMES},
