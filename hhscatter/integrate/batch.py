@@ -101,11 +101,13 @@ class _BatchRules(LaneRules):
         self._p = memoryview(self.pars.reshape(-1)) if self.gate_live else None
         self._gate_at = layout.gate * self.B if self.gate_live else 0
         self._clock_at = layout.clock * self.B if layout.clock is not None else 0
-        # the tangent dynamics: each orbit's u(0) (k at 4k .. 4k + 3), the slots of u and Λ/S in the state
+        # the tangent dynamics: each orbit's δq(0) = ν u(0) (k at 4k .. 4k + 3), the slots of δq in the state
         self.tan0 = None
         if layout.tangent is not None:
-            self.tan0 = np.ascontiguousarray(events.tangent_start(scene, ics), dtype=float).reshape(-1)
-            self._tan_at, self._stretch_at = layout.tangent * self.B, layout.stretch * self.B
+            self.tan0 = np.ascontiguousarray(
+                events.tangent_start(scene, ics) * events.TANGENT_NORM, dtype=float
+            ).reshape(-1)
+            self._tan_at = layout.tangent * self.B
         self.n = len(ics)
         self.next = 0
         self.t_max = scene.t_max
@@ -136,7 +138,7 @@ class _BatchRules(LaneRules):
         self.outcome = np.full(n, -1, dtype=np.int8)
         self.t_end = np.full(n, math.nan)
         self.end_state = np.zeros((n, 4))
-        self.end_stretch = np.zeros(n)  # Λ/S at the end (the tangent dynamics; 0 without)
+        self.end_stretch = np.zeros(n)  # Λ at the end (the tangent dynamics; 0 without)
         self.lane_timed = np.zeros(n, dtype=np.uint8)
         self.end_hi, self.end_lo = np.zeros(n), np.zeros(n)
         self.start_hi_of, self.start_lo_of = np.zeros(n), np.zeros(n)
@@ -161,7 +163,10 @@ class _BatchRules(LaneRules):
         self._s[self._clock_at + lane] = sigma
 
     def stretch(self, lane):
-        return self._s[self._stretch_at + lane] if self.tan0 is not None else None
+        if self.tan0 is None:
+            return None
+        s, a, B = self._s, self._tan_at + lane, self.B
+        return events.log_stretch(s[a], s[a + B], s[a + 2 * B], s[a + 3 * B])
 
     def record(self, lane, outcome, t, state, stretch=None):
         k = self.orbit[lane]
@@ -173,13 +178,12 @@ class _BatchRules(LaneRules):
             self.end_stretch[k] = self.stretch(lane) if stretch is None else stretch
 
     def load_tangent(self, lane, k):
-        """u(0) of orbit k and Λ = 0 into ``lane`` (the tangent dynamics)."""
+        """δq(0) = ν u(0) of orbit k (Λ = 0) into ``lane`` (the tangent dynamics)."""
         s, t, B, j, a = self._s, self.tan0, self.B, 4 * k, self._tan_at
         s[a + lane] = t[j]
         s[a + B + lane] = t[j + 1]
         s[a + 2 * B + lane] = t[j + 2]
         s[a + 3 * B + lane] = t[j + 3]
-        s[self._stretch_at + lane] = 0.0
 
     def tick(self):
         """Report progress every PROGRESS_EVERY loaded orbits (``run_chunk(progress=...)``)."""

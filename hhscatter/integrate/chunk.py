@@ -149,8 +149,8 @@ def _chunk_result(scene, lanes, ics, traj_ids, outcome, snaps, n_returns, n_step
         "exit_channel": channel.astype(np.int8),
         "e_end": model.energy(end[:, 0], end[:, 1], end[:, 2], end[:, 3]),
     }
-    if scene.layout.tangent is not None:  # Λ at t_end (carried as Λ/S, S a power of two: exact)
-        lifetimes["log_stretch"] = lanes.end_stretch * scene.layout.stretch_scale
+    if scene.layout.tangent is not None:  # Λ at t_end
+        lifetimes["log_stretch"] = lanes.end_stretch.copy()
     sections = _rows_to_columns(lanes.sec_rows, SECTION_COLUMNS, traj_ids)
     crossings = _rows_to_columns(lanes.cross_rows, CROSSING_COLUMNS, traj_ids)
     crossings["direction"] = crossings["direction"].astype(np.int8)

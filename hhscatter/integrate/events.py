@@ -128,8 +128,8 @@ class Layout:
     ``clock``: index of the clock variable σ in the state (None: no clock);
     ``gate``: index of the section gate in the runtime parameters (None: no
     sections); ``gamma``: index of γ (None: conservative); ``clock_scale``: G;
-    ``tangent``: index of the tangent vector's first component u_x in the state (u_x, u_y, u_px, u_py, then the
-    scaled log-stretch Λ/S; None: no tangent dynamics); ``stretch_scale``: S (:func:`stretch_scale`).
+    ``tangent``: index of the tangent vector's first component δx in the state (δx, δy, δp_x, δp_y; None: no
+    tangent dynamics), carried at the norm ν e^Λ (:data:`TANGENT_NORM`, :func:`log_stretch`).
     """
 
     n_state: int
@@ -139,12 +139,6 @@ class Layout:
     n_pars: int
     clock_scale: float
     tangent: int | None = None
-    stretch_scale: float = 1.0
-
-    @property
-    def stretch(self) -> int | None:
-        """Index of the scaled log-stretch Λ/S in the state (None: no tangent dynamics)."""
-        return None if self.tangent is None else self.tangent + 4
 
 
 class Symbols:
@@ -303,25 +297,32 @@ def layout(scene) -> Layout:
     n_state = 5 if clock is not None else 4
     if not getattr(scene, "tangent", False):
         return Layout(n_state, clock, gate, gamma, n_pars, scale)
-    return Layout(n_state + TANGENT_SLOTS, clock, gate, gamma, n_pars, scale, n_state, stretch_scale(scene.t_max))
+    return Layout(n_state + TANGENT_SLOTS, clock, gate, gamma, n_pars, scale, n_state)
 
 
-#: state slots of the tangent dynamics: the unit tangent vector u (4) and the scaled log-stretch Λ/S
-TANGENT_SLOTS = 5
+#: state slots of the tangent dynamics: the tangent vector δq (δx, δy, δp_x, δp_y)
+TANGENT_SLOTS = 4
+
+#: ν = 2⁻⁹⁶⁰, the norm the tangent vector starts at: δq(0) = ν u(0). heyoka's step-size control takes the largest
+#: state component and the largest Taylor coefficients over the whole state; the linear equation δq̇ = A δq has
+#: the flow's own radius of convergence, so its coefficients stay ν e^Λ times the flow's and never set a step
+#: while ν e^Λ ≪ 1 (Λ ≤ 600: ν e^Λ < 10⁻¹⁰). An orbit's steps, events and end are then those of the same scene
+#: without the tangent dynamics, bit for bit: the stretches belong to the very orbits a run without them follows.
+#: δq's Taylor coefficients stay normal doubles (ν ≈ 10⁻²⁸⁹); a power of two makes e^Λ = |δq|/ν exact.
+TANGENT_NORM = 2.0**-960
+
+#: the largest log-stretch Λ an orbit may accumulate with its steps still those of the flow alone
+MAX_LOG_STRETCH = 600.0
 
 
-def stretch_scale(t_max: float) -> float:
-    """stretch_scale(t_max) -> S: the power of two ≥ max(1, t_max) by which the log-stretch is carried as Λ/S.
+def log_stretch(dx, dy, dpx, dpy) -> float:
+    """log_stretch(δx, δy, δp_x, δp_y) -> Λ = ln(|δq|/ν), the log-stretch of a tangent vector started at the norm
+    ν = :data:`TANGENT_NORM` (any float type; the result a float).
 
-    heyoka's step-size control weighs the largest state component: Λ ≈ λ t grows to hundreds over a long orbit
-    and would loosen the tolerance of x, y, p_x, p_y (as the orbit time would: the clock counts down in [0, 1]
-    for the same reason). Λ/S stays O(1) while the finite-time exponent is O(1); a power of two makes
-    Λ = S·(Λ/S) exact.
-
-    >>> stretch_scale(5000.0), stretch_scale(0.5)
-    (8192.0, 1.0)
+    >>> log_stretch(TANGENT_NORM, 0.0, 0.0, 0.0), round(log_stretch(0.0, 3 * TANGENT_NORM, 0.0, 4 * TANGENT_NORM), 12)
+    (0.0, 1.609437912434)
     """
-    return float(2.0 ** max(0, math.ceil(math.log2(max(1.0, float(t_max))))))
+    return math.log(math.hypot(float(dx), float(dy), float(dpx), float(dpy)) / TANGENT_NORM)
 
 
 def tangent_start(scene, ics) -> np.ndarray:
@@ -426,34 +427,27 @@ def system(scene, lay: Layout):
     if lay.clock is not None:
         sys.append((hy.make_vars("sigma"), hy.expression(-1.0 / lay.clock_scale)))
     if lay.tangent is not None:
-        sys.extend(tangent_equations(flow, lay.stretch_scale, hy))
+        sys.extend(tangent_equations(flow, hy))
     return sys
 
 
-def tangent_equations(flow, scale: float, hy) -> list:
-    """tangent_equations(flow, S, hy) -> heyoka system of the unit tangent vector u and the log-stretch Λ.
+def tangent_equations(flow, hy) -> list:
+    """tangent_equations(flow, hy) -> heyoka system of the tangent vector δq (the variational equation).
 
     ``flow``: [(q_i, f_i), ...], the flow's variables and right-hand sides (drag included); A_ij = ∂f_i/∂q_j
-    (heyoka's ``diff``, any system). The variational equation δq̇ = A δq with u = δq/|δq| and Λ = ln|δq|:
-
-        u̇ = A u − (u·A u) u,        d(Λ/S)/dt = (u·A u)/S,
-
-    so |u| = 1 is conserved by the flow itself (no renormalisation) and Λ(t) = ln(|δq(t)|/|δq(0)|), the
-    finite-time Lyapunov exponent Λ/t. Λ is carried divided by S (:func:`stretch_scale`). The variables are
-    named ``u_<q>`` and ``log_stretch``.
+    (heyoka's ``diff``, any system). The variational equation δq̇ = A δq, linear: its solution is analytic
+    wherever the flow's is (the same radius of convergence of its Taylor series, so the same steps serve both).
+    Started at δq(0) = ν u(0) (:data:`TANGENT_NORM`), Λ(t) = ln(|δq(t)|/ν) (:func:`log_stretch`) is the
+    log-stretch and Λ/t the finite-time Lyapunov exponent. The variables are named ``d_<q>``.
 
     >>> import heyoka as hy
     >>> x, p = hy.make_vars("x", "p")
-    >>> [str(v) for v, _ in tangent_equations([(x, p), (p, x)], 1.0, hy)]   # the saddle ẋ = p, ṗ = x
-    ['u_x', 'u_p', 'log_stretch']
+    >>> [(str(v), str(f)) for v, f in tangent_equations([(x, p), (p, x)], hy)]   # the saddle ẋ = p, ṗ = x
+    [('d_x', 'd_p'), ('d_p', 'd_x')]
     """
     qs = [q for q, _ in flow]
-    us = hy.make_vars(*(f"u_{q}" for q in qs))
-    Au = [hy.sum([hy.diff(f, q) * u for q, u in zip(qs, us)]) for _, f in flow]
-    s = hy.sum([u * a for u, a in zip(us, Au)])
-    out = [(u, a - s * u) for u, a in zip(us, Au)]
-    out.append((hy.make_vars("log_stretch"), s / scale if scale != 1.0 else s))
-    return out
+    ds = hy.make_vars(*(f"d_{q}" for q in qs))
+    return [(d, hy.sum([hy.diff(f, q) * e for q, e in zip(qs, ds)])) for d, (_, f) in zip(ds, flow)]
 
 
 #: the layout of Hamilton's equations alone (x, y, px, py: no clock, no parameters)
@@ -540,8 +534,10 @@ __all__ = [
     "section_accepts",
     "zero_power_start",
     "system",
-    "stretch_scale",
+    "log_stretch",
     "tangent_equations",
     "tangent_start",
+    "MAX_LOG_STRETCH",
+    "TANGENT_NORM",
     "TANGENT_SLOTS",
 ]

@@ -89,10 +89,10 @@ class LaneRules(abc.ABC):
     @abc.abstractmethod
     def record(self, lane: int, outcome: int, t: float, state, stretch=None) -> None:
         """Record the orbit's outcome (a code of :mod:`hhscatter.outcomes`), its end time and end state; with the
-        tangent dynamics also its scaled log-stretch Λ/S there (``stretch``; None: the lane's now)."""
+        tangent dynamics also its log-stretch Λ there (``stretch``; None: the lane's now)."""
 
     def stretch(self, lane: int):
-        """The scaled log-stretch Λ/S of ``lane`` now (None without the tangent dynamics)."""
+        """The log-stretch Λ of ``lane`` now (None without the tangent dynamics)."""
         return None
 
     @abc.abstractmethod
@@ -148,7 +148,7 @@ class LaneRules(abc.ABC):
         self.open_late = None
 
     def last_out_of(self, lane):
-        """The last outward r_esc crossing of the orbit in ``lane``: (orbit time, state, Λ/S or None), or None."""
+        """The last outward r_esc crossing of the orbit in ``lane``: (orbit time, state, Λ or None), or None."""
         return self.last_out[lane]
 
     def start_orbit(self, lane, k):

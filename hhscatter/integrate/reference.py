@@ -52,7 +52,9 @@ class _Scalar(LaneRules):
         self.ta.state[self.layout.clock] = self.fp(sigma)
 
     def stretch(self, lane):
-        return self.ta.state[self.layout.stretch] if self.layout.tangent is not None else None
+        if self.layout.tangent is None:
+            return None
+        return events.log_stretch(*self.ta.state[self.layout.tangent : self.layout.tangent + 4])
 
     def record(self, lane, outcome, t, state, stretch=None):
         self.result = (outcome, t, np.array(state), self.stretch(lane) if stretch is None else stretch)
@@ -102,8 +104,8 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
     cast = caster(fp_type)
     st = np.zeros(layout.n_state)
     st[:4] = np.asarray(ic, dtype=float)
-    if layout.tangent is not None:  # u(0) as the engine's (Λ = 0)
-        st[layout.tangent : layout.tangent + 4] = events.tangent_start(scene, ic[None, :4])[0]
+    if layout.tangent is not None:  # δq(0) = ν u(0) as the engine's (Λ = 0)
+        st[layout.tangent : layout.tangent + 4] = events.tangent_start(scene, ic[None, :4])[0] * events.TANGENT_NORM
     ta.state[:] = cast(st)
     rules.start_orbit(0, 0)
     ta.reset_cooldowns()
@@ -136,7 +138,7 @@ def simulate_orbit(scene, ic, *, fp_type=float, tol=None) -> OrbitResult:
         snaps = [s for s in snaps if s[0] <= t_end]
     secs = [r[1:] for r in rules.sec_rows]
     cross = [r[1:] for r in rules.cross_rows]
-    log_stretch = None if stretch is None else float(stretch) * layout.stretch_scale
+    log_stretch = None if stretch is None else float(stretch)
     return OrbitResult(outcome, t_end, state, secs, snaps, cross, steps, log_stretch)
 
 

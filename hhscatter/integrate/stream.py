@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from hhscatter.integrate.batch import _batch_integrator, _check, _no_snapshots
-from hhscatter.integrate.events import ESCAPED, SETTLED
+from hhscatter.integrate.events import ESCAPED, SETTLED, log_stretch
 from hhscatter.integrate.lanes import LIVE, RERUN, _bind
 from hhscatter.integrate.orbit_time import _orbit_time
 from hhscatter.integrate.schedulers import Scheduler, register
@@ -64,7 +64,7 @@ class _Stream(Scheduler):
         # one (``has_out``), its lane time (double-length) and its state (x, y, px, py of lane j at 4j..4j+3)
         self.has_out = np.zeros(self.B, dtype=np.uint8)
         self.out_hi, self.out_lo, self.out_state = np.zeros(self.B), np.zeros(self.B), np.zeros(4 * self.B)
-        self.out_stretch = np.zeros(self.B)  # ... and its Λ/S (the tangent dynamics)
+        self.out_stretch = np.zeros(self.B)  # ... and its Λ (the tangent dynamics)
         # bound of the running propagate_until call: none for live lanes (the clock censors at t_max)
         self.bound = np.zeros(self.B)
         if not any(a == "censor" for _, a in self.targets):
@@ -100,10 +100,10 @@ class _Stream(Scheduler):
         )
         end = memoryview(self.end_state.reshape(-1))  # end[4k + i]
         ics = memoryview(self.ics.reshape(-1))  # ics[4k + i]
-        # the tangent dynamics (None without): u(0) per orbit (tan[4k + i]), the slots of u_i (ua + i B) and
-        # Λ/S (sa) of a lane, Λ/S at each orbit's end (est) and at the lane's last outward r_esc crossing (ostr)
+        # the tangent dynamics (None without): δq(0) per orbit (tan[4k + i]), the slots of δq_i (ua + i B) of a
+        # lane, Λ (lnorm of δq) at each orbit's end (est) and at the lane's last outward r_esc crossing (ostr)
         tan = memoryview(self.tan0) if self.tan0 is not None else None
-        ua, sa = (self._tan_at, self._stretch_at) if tan is not None else (0, 0)
+        ua, lnorm = (self._tan_at, log_stretch) if tan is not None else (0, None)
         ua1, ua2, ua3 = ua + B, ua + 2 * B, ua + 3 * B
         est, ostr = memoryview(self.end_stretch), memoryview(self.out_stretch)
         b1, b2, b3 = B, 2 * B, 3 * B
@@ -141,7 +141,6 @@ class _Stream(Scheduler):
                 s[ua1 + lane] = tan[j + 1]
                 s[ua2 + lane] = tan[j + 2]
                 s[ua3 + lane] = tan[j + 3]
-                s[sa + lane] = 0.0
             if clock is not None:
                 s[sc + lane] = sigma0
                 clock_i[lane] = 0
@@ -170,7 +169,7 @@ class _Stream(Scheduler):
             end[j + 2] = s[b2 + lane]
             end[j + 3] = s[b3 + lane]
             if tan is not None:
-                est[k] = s[sa + lane]
+                est[k] = lnorm(s[ua + lane], s[ua1 + lane], s[ua2 + lane], s[ua3 + lane])
             return load_next_at(lane, a, el)  # the next orbit starts at the time this one ends
 
         def end_out(lane, code):
@@ -210,7 +209,7 @@ class _Stream(Scheduler):
             end[j + 2] = s[b2 + lane]
             end[j + 3] = s[b3 + lane]
             if tan is not None:
-                est[k] = s[sa + lane]
+                est[k] = lnorm(s[ua + lane], s[ua1 + lane], s[ua2 + lane], s[ua3 + lane])
             k = nxt
             if k >= n:
                 orbit[lane] = -1
@@ -230,7 +229,6 @@ class _Stream(Scheduler):
                 s[ua1 + lane] = tan[j + 1]
                 s[ua2 + lane] = tan[j + 2]
                 s[ua3 + lane] = tan[j + 3]
-                s[sa + lane] = 0.0
             if clock is not None:
                 s[sc + lane] = sigma0
                 clock_i[lane] = 0
@@ -252,7 +250,7 @@ class _Stream(Scheduler):
                     ost[q + 2] = s[b2 + lane]
                     ost[q + 3] = s[b3 + lane]
                     if tan is not None:
-                        ostr[lane] = s[sa + lane]
+                        ostr[lane] = lnorm(s[ua + lane], s[ua1 + lane], s[ua2 + lane], s[ua3 + lane])
                 else:
                     has[lane] = 0
             return True

@@ -151,12 +151,13 @@ class Scene:
         strength σ without. Such a scene records lifetimes only; escape is the first outward r_esc crossing
         (settling below E_c is not an outcome: the noise lifts the orbit again), censoring at t_max.
     tangent : bool
-        Integrate the tangent dynamics with each orbit (default false): a unit tangent vector u and its
-        log-stretch Λ (:func:`hhscatter.integrate.events.tangent_equations`; u(0) orthogonal to ∇H and to the
+        Integrate the tangent dynamics with each orbit (default false): a tangent vector δq and its
+        log-stretch Λ (:func:`hhscatter.integrate.events.tangent_equations`; δq(0) orthogonal to ∇H and to the
         Hamiltonian flow, :func:`hhscatter.integrate.events.tangent_start`). The lifetimes table gains the
-        column ``log_stretch``, Λ at t_end (the finite-time Lyapunov exponent is Λ/t_end). Events and outcome
-        rules are those of the scene without it (its steps differ: heyoka's step-size control sees u too).
-        Not with snapshots, noise or a section window that opens after t = 0.
+        column ``log_stretch``, Λ at t_end (the finite-time Lyapunov exponent is Λ/t_end). Events, outcome
+        rules, steps and so every orbit are those of the scene without it, bit for bit (δq, carried at a tiny
+        norm, never sets a step: :data:`hhscatter.integrate.events.TANGENT_NORM`; Λ ≤ 600). Not with
+        snapshots, noise or a section window that opens after t = 0.
     name : str
         A label for progress lines and the tables' metadata.
 

@@ -5,8 +5,8 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
 ``simulate(study, workers=None, progress=True)``
     Per system and E = r·E_c: the main run (raw key ``<label>_r<r>``: disk ICs, every section crossing to t_max),
     its κ (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_from_lifetimes`) and t_min = tmin_efolds/κ,
-    and the tangent run (``<label>_r<r>_tangent``, ``[scene] tangent = true``) of the orbits that left at
-    t_end ≥ t_min, from their initial conditions; the lines run (``<label>_r<r>_lines``): for each ε of d0_eps,
+    and the tangent run (``<label>_r<r>_tangent``, ``[scene] tangent = true``, the main run's events: the same
+    orbits) of the orbits that left at t_end ≥ t_min, from their initial conditions; the lines run (``<label>_r<r>_lines``): for each ε of d0_eps,
     d0_n fresh initial conditions of the main run's disk and their copies moved by ε along x. The κ and t_min used
     are written to ``raw/saddle_choices.json``.
 
@@ -186,16 +186,10 @@ def simulate(study, workers=None, progress=True):
             cols = {"traj_id": sel["traj_id"].to_numpy(), "x": sel["x0"].to_numpy(), "y": sel["y0"].to_numpy(),
                     "px": sel["px0"].to_numpy(), "py": sel["py0"].to_numpy()}  # fmt: skip
             pq.write_table(pa.table(cols), path)
-            tsc = study.scene(
-                key + "_tangent",
-                system=spec,
-                ics=str(path),
-                n=len(sel),
-                t_max=t_max,
-                r_esc=sc.r_esc,
-                sections=None,
-                tangent=True,
-            )
+            # the main run's events (its sections too): the tangent dynamics never set a step, so these are the
+            # very orbits selected, bit for bit (their t_end checked in analyze)
+            tsc = study.scene(key + "_tangent", system=spec, ics=str(path), n=len(sel), t_max=t_max, r_esc=sc.r_esc,
+                              sections={"t_from": 0.0}, tangent=True)  # fmt: skip
             study.run(key + "_tangent", tsc, workers=workers, progress=progress)
             for part, w in zip(("lo", "hi"), p.window):  # Λ at window·t_min (all still inside): the mid-life λ̄
                 study.run(f"{key}_tangent_{part}", tsc.replace(name=f"{study.name}/{key}_tangent_{part}",
@@ -264,12 +258,18 @@ def _lyapunov(lt, t_min, p):
     return out, lt.assign(ftle=mean.ftle)
 
 
-def _d1_resolution(sp, lam):
+def _d1_resolution(sp, lam, min_boxes=None):
     """(extent, eps_min) of a SaddlePoints: the points' longest side and their distance to the saddle,
-    extent·e^{−λ̄·window[0]·t_min} (the smallest box fitted)."""
+    extent·e^{−λ̄·window[0]·t_min} (the smallest scale fitted); refused, in words, where it is not below the largest
+    scale extent/min_boxes."""
     P = sp.points[["x", "y"]].to_numpy()
     extent = float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
-    return extent, extent * math.exp(-lam * sp.window[0] * sp.t_min)
+    eps_min = extent * math.exp(-lam * sp.window[0] * sp.t_min)
+    if min_boxes is not None and not eps_min < extent / min_boxes:
+        raise ConfigError(f"the points' distance to the saddle, extent·e^(−λ̄·{sp.window[0]:g}·t_min) = {eps_min:.3g} "
+                          f"(λ̄ = {lam:.3g} per time unit, t_min = {sp.t_min:.4g}; position units), is not below the "
+                          f"largest scale extent/{min_boxes:g} = {extent / min_boxes:.3g}: no scaling range for d₁")  # fmt: skip
+    return extent, eps_min
 
 
 def _d1_estimator(p, lam):
@@ -278,7 +278,7 @@ def _d1_estimator(p, lam):
 
     def est(sp):
         P = sp.points[["x", "y"]].to_numpy()
-        extent, eps_min = _d1_resolution(sp, lam)
+        extent, eps_min = _d1_resolution(sp, lam, p.min_boxes)
         return information_dimension_neighbours(P, groups=sp.points["traj_id"].to_numpy(), k_max=p.k_max,
                                                 eps_min=eps_min, eps_max=extent / p.min_boxes, n_boot=p.n_boot,
                                                 seed=0)  # fmt: skip
@@ -395,7 +395,14 @@ def _point(study, key, ch):
     if ch["n_tangent"] == 0:
         rec["notes"].append("no orbit left at t_end ≥ t_min")
         return rec, None
-    tangent = _lifetimes(study.raw(key + "_tangent"), ("log_stretch",))
+    tangent, lt = _lifetimes(study.raw(key + "_tangent"), ("log_stretch",)), _lifetimes(study.raw(key))
+    main = _long_lived(lt, ch["t_min"]).set_index("traj_id")["t_end"]  # one integration: the same orbits, same ends
+    same = int((tangent.set_index("traj_id")["t_end"].reindex(main.index) == main).sum())
+    rec["tangent_same_orbits"] = {"same_t_end": same, "selected": len(main)}
+    if same < len(main):
+        rec["notes"].append(
+            f"the tangent run ends {len(main) - same} of {len(main)} orbits elsewhere than the main run"
+        )
     lam = _lyapunov(tangent, ch["t_min"], p)
     if lam is None:
         rec["notes"].append("fewer than 2 orbits of the tangent run left at t_end ≥ t_min")
@@ -403,22 +410,14 @@ def _point(study, key, ch):
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
     rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k))
-    lt = _lifetimes(study.raw(key))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
     est = _d1_estimator(p, lam["value"])
     cs = (*p.tmin_checks, efolds, *(efolds + s for s in p.tmin_trend))
     wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in cs], windows=[tuple(p.window)],
                            columns=["x", "y"])  # fmt: skip
-    rec["d1_by_t_min"] = [
-        {
-            "t_min_kappa": c,
-            "n_orbits": int(r.n_orbits),
-            "n_points": int(r.n_points),
-            "d1_section": None if math.isnan(r.value) else Measured.of(r.value, r.err, n=int(r.n_orbits)).to_dict(),
-            "note": r.note,
-        }  # fmt: skip
-        for c, r in zip(cs, wd.itertuples())
-    ]
+    rec["d1_by_t_min"] = [{"t_min_kappa": c, "n_orbits": int(r.n_orbits), "n_points": int(r.n_points), "note": r.note,
+                           "d1_section": None if math.isnan(r.value) else Measured.of(r.value, r.err, n=int(r.n_orbits)).to_dict()}
+                          for c, r in zip(cs, wd.itertuples())]  # fmt: skip
     rec["d1_by_t_min"], trend = rec["d1_by_t_min"][: len(p.tmin_checks) + 1], rec["d1_by_t_min"][len(p.tmin_checks) :]
     rec["d1_trend_by_t_min"] = trend
     try:

@@ -123,8 +123,10 @@ def test_the_tangent_runs_start_from_the_long_lived_orbits_initial_conditions(bu
     m = long.merge(tan, on="traj_id", suffixes=("", "_tan"))
     assert len(m) == len(long) == len(tan)
     assert np.array_equal(m["x0"], m["x0_tan"]) and np.array_equal(m["y0"], m["y0_tan"])
-    # the same orbit again (the tangent variables change only heyoka's steps): the same lifetime to roundoff growth
-    assert np.max(np.abs(m["t_end"] - m["t_end_tan"])) < 1e-3
+    # the same orbits, one integration: the tangent dynamics never set a step and the events are the main run's, so
+    # every selected orbit ends at the main run's t_end, bit for bit (a rounding apart would be another orbit)
+    assert m["t_end"].to_numpy().tobytes() == m["t_end_tan"].to_numpy().tobytes()
+    assert rec["tangent_same_orbits"] == {"same_t_end": len(long), "selected": len(long)}
 
 
 def test_the_basins_cut_off_is_re_predicted_with_the_saddle_s_lambda(built):
@@ -198,3 +200,31 @@ def test_a_system_s_own_tmin_efolds_replaces_the_study_s(built):
     long = main[(main["outcome"].astype(str) == "escaped") & (main["t_end"] >= 2.0 / rec["kappa"])]
     assert len(long) > len(main[(main["outcome"].astype(str) == "escaped") & (main["t_end"] >= 3.0 / rec["kappa"])])
     assert sorted(tan["traj_id"]) == sorted(long["traj_id"])
+
+
+@pytest.mark.parametrize("lam", [-0.0077, 0.01])
+def test_d1_without_a_scaling_range_says_why_in_words_with_units(lam):
+    """λ̄ ≤ 0, or too small for t_min: the points' distance to the saddle, extent·e^(−λ̄·window[0]·t_min), is not
+    below the largest scale extent/min_boxes (λ̄ = −0.0077 at t_min = 372.5 puts it at 3.15 × the extent): the
+    estimator is not run, and the reason names both scales, λ̄, t_min and the units."""
+    import pandas as pd
+
+    from hhscatter.analysis.geometry.saddle import SaddlePoints
+    from hhscatter.errors import ConfigError
+    from hhscatter.studies import load_study, stage_module
+
+    study = load_study("saddle", "quick")
+    est = stage_module("saddle")._d1_estimator(study.params, lam=lam)
+    P = np.random.default_rng(0).random((2000, 2)) * [3.0, 1.0]  # extent 3 (the longest side)
+    pts = pd.DataFrame({"traj_id": np.arange(2000), "t": 0.0, "x": P[:, 0], "y": P[:, 1]})
+    sp = SaddlePoints(points=pts, t_min=372.5, window=(0.4, 0.6), n_long=2000, n_orbits=2000, n_points=2000,
+                      n_beyond_record=0)  # fmt: skip
+    extent = float(np.ptp(P, axis=0).max())
+    eps_min = extent * math.exp(-lam * 0.4 * 372.5)
+    with pytest.raises(ConfigError) as exc:
+        est(sp)
+    msg = str(exc.value)
+    assert f"= {eps_min:.3g} " in msg and f"{extent / study.params.min_boxes:.3g}" in msg and "position units" in msg
+    assert f"λ̄ = {lam:.3g} per time unit" in msg and "no scaling range for d₁" in msg
+    # with λ̄ large enough the same points have a scaling range (the check refuses only an empty one)
+    assert stage_module("saddle")._d1_resolution(sp, 0.05, study.params.min_boxes)[1] < extent / study.params.min_boxes

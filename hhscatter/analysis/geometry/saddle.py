@@ -365,6 +365,15 @@ def _eps_min(eps_min) -> None:
         raise ConfigError(f"eps_min must be a finite length ≥ 0 (the points' units), got {eps_min!r}")
 
 
+def _scale_range(eps_min, eps_max) -> None:
+    """The scaling range [eps_min, eps_max] must not be empty (a lower end above the upper: no scale to fit)."""
+    if not eps_min < eps_max:
+        raise ConfigError(
+            f"eps_min must be below eps_max (the points' units): [eps_min, eps_max] = [{eps_min:g}, {eps_max:g}] "
+            "holds no scale"
+        )
+
+
 def _slope(x, y) -> tuple[float, float]:
     """Least-squares slope of y on x and its standard error from the residuals."""
     xm = x - x.mean()
@@ -605,6 +614,7 @@ def information_dimension_neighbours(
     if not extent > 0:
         raise ConfigError("points: all points coincide (no extent to cover)")
     eps_max = extent / 8.0 if eps_max is None else _positive(eps_max, "eps_max")
+    _scale_range(eps_min, eps_max)
     if n < 20 * k_max:
         raise ConfigError(f"points: {n} points, fewer than 20·k_max = {20 * k_max}: give more points or lower k_max")
     rng = np.random.default_rng(seed)

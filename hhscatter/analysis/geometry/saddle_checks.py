@@ -33,6 +33,7 @@ from hhscatter.analysis.geometry.saddle import (
     _finite_array,
     _group_labels,
     _positive,
+    _scale_range,
     _slope,
     _stretch_arrays,
     mean_lyapunov,
@@ -130,6 +131,7 @@ def information_dimension_radius(
     if not extent > 0:
         raise ConfigError("points: all points coincide (no extent to cover)")
     eps_max = extent / 8.0 if eps_max is None else _positive(eps_max, "eps_max")
+    _scale_range(eps_min, eps_max)
     tree = cKDTree(P)
     nearest = tree.query(P, k=2)[0][:, 1]  # below the (1 − max_empty) quantile of these, too many points are empty
     floor = max(eps_min, float(np.quantile(nearest, 1.0 - max_empty)))

@@ -403,7 +403,9 @@ def test_box_counting_of_few_points_reads_the_baker_measure_high():
         (lambda P: information_dimension_neighbours(P, groups=np.zeros(3)), "groups"),
         (lambda P: information_dimension_neighbours(P[:100]), "points"),
         (lambda P: information_dimension_neighbours(np.vstack([P, P[:1]])), "coincide"),
-        (lambda P: information_dimension_neighbours(P, eps_min=10.0), "fewer than 4"),
+        (lambda P: information_dimension_neighbours(P, eps_min=0.1), "fewer than 4"),
+        # a range whose lower end lies above its upper one (eps_max: an eighth of the unit square's side)
+        (lambda P: information_dimension_neighbours(P, eps_min=10.0), r"below eps_max .*\[10, 0.12"),
     ],
 )
 def test_neighbour_dimension_refuses_bad_input_naming_it(call, name):

@@ -68,6 +68,7 @@ def test_radius_and_neighbour_estimators_agree_on_the_same_points():
         (lambda P: information_dimension_radius(P, n_boot=-1), "n_boot"),
         (lambda P: information_dimension_radius(P[:1]), "at least 2"),
         (lambda P: information_dimension_radius(P, eps_min=0.1), "fewer than 4 radii"),
+        (lambda P: information_dimension_radius(P, eps_min=0.2, eps_max=0.1), r"below eps_max .*\[0.2, 0.1\]"),
     ],
 )
 def test_radius_dimension_refuses_bad_input_naming_it(call, name):
