@@ -1,6 +1,20 @@
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 from study_copy import REPO_STUDIES, copy_study_folder
+
+#: The one profile of the property tests: the same examples on every run (derandomized, no example database), no
+#: deadline (the machines are shared, timings vary), and the health checks that fail a slow or fixture-using but
+#: correct test turned off. A module sets only its number of examples: ``settings(max_examples=n)`` inherits the
+#: rest from this profile.
+settings.register_profile(
+    "hhscatter",
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large],
+)
+settings.load_profile("hhscatter")
 
 EPS = np.finfo(float).eps
 

@@ -37,5 +37,5 @@ The life of an orbit in a lane, in one vocabulary (the method names of the modul
 The engine reads a scene only through its plan (:func:`hhscatter.integrate.plan.plan_of`); it imports neither
 :mod:`hhscatter.scene` nor :mod:`hhscatter.model` (the plan holds the system object), and it is the only part of
 the package that imports heyoka (the system builds its expressions with the heyoka module the engine hands it).
-Both rules are checked by ``tests/test_layers.py``.
+Both rules are checked on the package's import graph, read from the source.
 """

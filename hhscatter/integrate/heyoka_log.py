@@ -11,7 +11,8 @@ every other line back to the real standard output, so nothing heyoka says is los
 The redirection is process-wide: captures are serialised by a lock and nest (an inner capture adds its count to
 the outer one's and passes its other lines on to it).
 
-Example (the test suite provokes real failures: tests/integrate/test_event_failures.py)::
+Example (lines that are not heyoka's pass through and count no failure; the count is checked on integrations
+that provoke real event failures)::
 
 >>> with capture() as log:
 ...     print("not heyoka's")

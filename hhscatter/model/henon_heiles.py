@@ -227,7 +227,7 @@ def equations(model: System, hy, gamma_par=None):
     The right-hand side is written in simplified form (−ω²x − 2λxy, ...):
     ``hy.diff(H, x)`` yields the same functions with redundant constant
     products such as ``0.5*(2*px)`` that would cost operations on every
-    Taylor step; ``tests/test_model.py`` checks both agree.
+    Taylor step; the two forms are checked to be the same functions.
     """
     return model.equations(hy, gamma_par)
 

@@ -176,7 +176,8 @@ def fit_mixture_hazards(t, P, tf, Pf, sf, comps, *, kappa, tau0, E_c, hazards, m
     >>> comps = mixture_components(snaps, gamma=0.01, t_ref=5.0, n_components=2, fit_window=(5.0, 100.0))
     >>> t = np.arange(0.0, 200.0, 0.5); P = 0.2 + 0.8 * np.exp(-0.15 * t)
     >>> tf, Pf, sf = survival_fit_points(t, P, 0.01 * P, 5.0, 2.0, 10**5, 20)
-    >>> fits = fit_mixture_hazards(t, P, tf, Pf, sf, comps, kappa=PiecewiseKappa(E_c=1 / 6), tau0=5.0,
+    >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
+    >>> fits = fit_mixture_hazards(t, P, tf, Pf, sf, comps, kappa=kappa, tau0=5.0,
     ...                            E_c=1 / 6, hazards=["paper"], mode="shared", P_min=1e-4)
     >>> sorted(fits), bool(np.isfinite(fits["paper"].chi2))
     (['paper'], True)

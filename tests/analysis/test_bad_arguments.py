@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hhscatter.analysis.geometry import saddle, saddle_checks
@@ -43,13 +43,7 @@ from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
 
-PROFILE = settings(
-    max_examples=15,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+PROFILE = settings(max_examples=15)  # the rest from the suite's profile (conftest.py)
 
 #: what is no array of numbers at all
 NOT_NUMBERS = st.one_of(

@@ -20,18 +20,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hhscatter.errors import HHScatterError
 
-PROFILE = settings(
-    max_examples=12,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+PROFILE = settings(max_examples=12)  # the rest from the suite's profile (conftest.py)
 SUBPACKAGES = ("stats", "survival", "dissipative", "noise", "geometry")
 
 #: the wrong things put in place of every required argument

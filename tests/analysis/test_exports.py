@@ -56,3 +56,28 @@ def test_every_public_function_of_a_module_is_exported():
 
     assert survival._EXPORTS["kappa_law_summary"] == "kappa_energy"
     assert survival._EXPORTS["binned_hazard"] == "effective_rate"
+
+
+def test_the_survival_models_module_gathers_every_public_name_of_its_modules():
+    """``dissipative.models`` gathers the public names its modules define (read from their source, not from a
+    list): κ0(E), the homogeneous model, the mixture, the comparison of fits, and the energy path's two functions;
+    each is the object its module defines, and nothing is gathered twice."""
+    from pathlib import Path
+
+    from hhscatter._exports import defined_names
+    from hhscatter.analysis.dissipative import models
+
+    gathered = [
+        "hhscatter.analysis.survival.kappa_law",
+        "hhscatter.analysis.dissipative.survival_model",
+        "hhscatter.analysis.dissipative.mixture",
+        "hhscatter.analysis.dissipative.model_comparison",
+    ]
+    expected = {"energy_path", "time_to_energy"}
+    for name in gathered:
+        module = importlib.import_module(name)
+        for public in defined_names(Path(module.__file__).read_text()):
+            expected.add(public)
+            assert getattr(models, public) is getattr(module, public), public
+    assert {"profile_interval", "HomogeneousProblem"} <= set(models.__all__)
+    assert expected <= set(models.__all__) and len(models.__all__) == len(set(models.__all__))

@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import hhscatter
@@ -21,13 +21,7 @@ from hhscatter.analysis.survival.escape_rate import escape_rate_mle
 from hhscatter.analysis.survival.long_time import fit_plateau_exponential, rate_status
 from hhscatter.errors import HHScatterError
 
-PROFILE = settings(
-    max_examples=30,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
-)
+PROFILE = settings(max_examples=30)  # the rest from the suite's profile (conftest.py)
 OUTCOMES = ["escaped", "settled", "censored"]
 
 

@@ -9,19 +9,13 @@ import signal
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hhscatter.errors import ConfigError
 from hhscatter.run import runner
 
-PROFILE = settings(
-    max_examples=40,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
+PROFILE = settings(max_examples=40)  # the rest from the suite's profile (conftest.py)
 SIGNALS = st.sampled_from(list(signal.Signals))
 #: what is no signal's number: no int, a bool, or an int no named signal of this platform has
 NOT_A_SIGNAL = st.one_of(

@@ -354,7 +354,7 @@ def mixture_survival_model(
     ...                         n_ref=np.array([1]), E_ref=np.array([0.3]), A=np.array([0.3]), mu=np.array([0.91]),
     ...                         mu_err=np.array([0.0]), fit_window=(0.0, np.inf), gamma=0.01)
     >>> from hhscatter.analysis.dissipative.survival_model import survival_model
-    >>> t, kappa = np.array([10.0, 40.0, 100.0]), PiecewiseKappa(E_c=1 / 6)
+    >>> t, kappa = np.array([10.0, 40.0, 100.0]), PiecewiseKappa(1 / 6, 13.63, 0.03, 1.41, 0.27)
     >>> P = mixture_survival_model(t, kappa_of_E=kappa, components=one, tau0=5.0, f_ne=0.1, P_tau0=0.5, L=0.1, b=0.2,
     ...                            E_c=1 / 6)
     >>> P_h = survival_model(t, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1, f_e=0.4, L=0.1,
@@ -480,7 +480,7 @@ def fit_mixture_model(
     ...                         n_ref=np.array([1]), E_ref=np.array([0.3]), A=np.array([0.3]), mu=np.array([0.91]),
     ...                         mu_err=np.array([0.0]), fit_window=(0.0, np.inf), gamma=0.01)
     >>> from hhscatter.analysis.dissipative.survival_model import survival_model_sample
-    >>> kappa, t, N = PiecewiseKappa(E_c=1 / 6), np.arange(0.0, 301.0), 100_000
+    >>> kappa, t, N = PiecewiseKappa(1 / 6, 13.63, 0.03, 1.41, 0.27), np.arange(0.0, 301.0), 100_000
     >>> P, P_err = survival_model_sample(t, N, kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, f_ne=0.1,
     ...                                  f_e=0.4, L=0.1, b=0.2, E_c=1 / 6)
     >>> f = fit_mixture_model(t, P, P_err, one, kappa_of_E=kappa, tau0=5.0, E_c=1 / 6, P_min=20 / N)

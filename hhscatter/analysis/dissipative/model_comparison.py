@@ -61,7 +61,7 @@ def predict_tau1(params, P_0, alpha: float = 2.0, *, t_max: float | None = None,
 
     >>> from hhscatter.analysis.dissipative.survival_model import SurvivalModelParams
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-    >>> kappa = PiecewiseKappa(E_c=1 / 6)
+    >>> kappa = PiecewiseKappa(1 / 6, 13.63, 0.03, 1.41, 0.27)
     >>> params = SurvivalModelParams(kappa, 0.3, 0.91, 0.01, 5.0, 64.59, 0.1, 0.4, 0.1, 0.2, 1 / 6)
     >>> P_0 = lambda t: 0.5 * np.exp(-float(kappa(0.3)) * (np.asarray(t) - 5.0))
     >>> tau1 = predict_tau1(params, P_0, t_max=200.0)
@@ -136,7 +136,8 @@ def compare_fits(fits: dict) -> pd.DataFrame:
     >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
 
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-    >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
+    >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
+    >>> kw = dict(kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
     >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
     >>> fits = {h: fit_survival_model(t, P, P_err, **kw, P_min=20 / N, hazard=h) for h in ("paper", "integrated")}
@@ -183,10 +184,11 @@ def better_fit(fits: dict) -> str | None:
     >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
 
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-    >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
+    >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
+    >>> kw = dict(kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
     >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
-    >>> other = dict(kw, kappa_of_E=PiecewiseKappa(E_c=1 / 6, a2=10.69, a1=0.282, slope=1.396, E_switch=0.2709))
+    >>> other = dict(kw, kappa_of_E=PiecewiseKappa(1 / 6, 10.69, 0.282, 1.396, 0.2709))
     >>> fits = {"generating": fit_survival_model(t, P, P_err, **kw, P_min=20 / N),
     ...         "other": fit_survival_model(t, P, P_err, **other, P_min=20 / N)}
     >>> better_fit(fits), round(fits["generating"].rms_log_residual, 3), round(fits["other"].rms_log_residual, 3)

@@ -7,50 +7,31 @@
 * :mod:`hhscatter.analysis.dissipative.mixture` — the mixture of sub-ensembles with their own
   measured energy paths (the extension proposed by Burton, Dullin & Altmann (2023)).
 
-This module only gathers their names (``from hhscatter.analysis.dissipative import models``).
+This module only gathers their names (``from hhscatter.analysis.dissipative import models``): every public name
+(``__all__``) of the modules of κ0(E), of the homogeneous model, of the mixture and of the comparison of fits, and
+of the energy path its two functions; a name added to one of these modules is gathered with it. Each name is
+documented in the module that defines it.
 """
 
 from __future__ import annotations
 
+import hhscatter.analysis.dissipative.mixture as _mixture
+import hhscatter.analysis.dissipative.model_comparison as _model_comparison
+import hhscatter.analysis.dissipative.survival_model as _survival_model
+import hhscatter.analysis.survival.kappa_law as _kappa_law
 from hhscatter.analysis.dissipative.decay import energy_path, time_to_energy
-from hhscatter.analysis.dissipative.mixture import (
-    MixtureComponents,
-    MixtureModelParams,
-    fit_mixture_model,
-    mixture_components,
-    mixture_components_arrays,
-    mixture_survival_model,
-)
-from hhscatter.analysis.dissipative.model_comparison import better_fit, compare_fits, predict_tau1
-from hhscatter.analysis.dissipative.survival_model import (
-    HAZARDS,
-    SurvivalFit,
-    SurvivalModelParams,
-    fit_survival_model,
-    settling_rate,
-    survival_model,
-    survival_model_sample,
-)
-from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.analysis.dissipative.mixture import *  # noqa: F403
+from hhscatter.analysis.dissipative.model_comparison import *  # noqa: F403
+from hhscatter.analysis.dissipative.survival_model import *  # noqa: F403
+from hhscatter.analysis.survival.kappa_law import *  # noqa: F403
+
+#: of the energy path's module, its two functions: the path E(t) and its inverse t*
+_ENERGY_PATH = (energy_path, time_to_energy)
 
 __all__ = [
-    "HAZARDS",
-    "MixtureComponents",
-    "MixtureModelParams",
-    "PiecewiseKappa",
-    "SurvivalFit",
-    "SurvivalModelParams",
-    "better_fit",
-    "compare_fits",
-    "energy_path",
-    "fit_mixture_model",
-    "fit_survival_model",
-    "mixture_components",
-    "mixture_components_arrays",
-    "mixture_survival_model",
-    "predict_tau1",
-    "settling_rate",
-    "survival_model",
-    "survival_model_sample",
-    "time_to_energy",
+    *(f.__name__ for f in _ENERGY_PATH),
+    *_kappa_law.__all__,
+    *_survival_model.__all__,
+    *_mixture.__all__,
+    *_model_comparison.__all__,
 ]

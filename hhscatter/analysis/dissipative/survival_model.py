@@ -401,7 +401,8 @@ def fit_survival_model(
     finds its parameters back within their errors (f_e = P(τ0) − f_ne, τ2 from Eq. (eq:tau2): 64.59).
 
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
-    >>> kw = dict(kappa_of_E=PiecewiseKappa(E_c=1 / 6), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
+    >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
+    >>> kw = dict(kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
     >>> t, N = np.arange(0.0, 301.0), 100_000
     >>> P, P_err = survival_model_sample(t, N, **kw, f_ne=0.1, f_e=0.4, L=0.1, b=0.2)      # N orbits, binomial noise
     >>> f = fit_survival_model(t, P, P_err, **kw, P_min=20 / N)

@@ -1,8 +1,8 @@
 """Measures of exit-basin maps: fractions, basin entropy, Wada test.
 
 A *basin map* is a 2-D integer array of outcome labels on a regular grid of
-initial conditions (for Hénon–Heiles: exit channel 0/1/2, settled, or still
-inside at t_max: censored), one cell per initial condition.  One label value, ``outside``
+initial conditions (e.g. the exit channel, settled, or still inside at
+t_max: censored), one cell per initial condition.  One label value, ``outside``
 (default −1), marks cells outside the energetically allowed region; those cells
 are excluded from every measure here.  Cell (i, j) is row i, column j; lengths
 are in cells unless stated.

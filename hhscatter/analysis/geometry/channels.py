@@ -23,8 +23,7 @@ module measures how well r_esc approximates it:
 
 The paired κ shifts between two criteria are in :mod:`hhscatter.analysis.survival.paired`.
 
-Units: the system's (unit mass; Hénon–Heiles with ω = λ = 1 has saddle
-distance 1, E_c = 1/6); times in time units, κ in 1/time.
+Units: the system's (unit mass): lengths, energies; times in time units, κ in 1/time.
 """
 
 from __future__ import annotations
@@ -39,7 +38,7 @@ from hhscatter.analysis.noise.kramers import hessian
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.errors import ConfigError
-from hhscatter.model import HenonHeiles, System
+from hhscatter.model.base import System
 
 __all__ = [
     "ChannelFractions",
@@ -276,9 +275,9 @@ class _Shooting:
 
 
 def lyapunov_orbit(
-    energy: float, system: System | None = None, *, exit: int = 0, rtol: float = 1e-12, n_samples: int = 400
+    energy: float, system: System, *, exit: int = 0, rtol: float = 1e-12, n_samples: int = 400
 ) -> LyapunovOrbit:
-    """lyapunov_orbit(energy, system=None, *, exit=0) -> LyapunovOrbit(r_min, r_max, period, ...).
+    """lyapunov_orbit(energy, system, *, exit=0) -> LyapunovOrbit(r_min, r_max, period, ...).
 
     The Lyapunov orbit of an exit at energy E above its saddle's energy E_s: the unstable periodic orbit that
     oscillates across the exit channel through the saddle; the exits' Lyapunov orbits bound the scattering
@@ -297,9 +296,9 @@ def lyapunov_orbit(
     ----------
     energy : float
         E > E_s of the exit (energy).
-    system : System, optional
-        The system (:mod:`hhscatter.model`); the default system of :mod:`hhscatter.model` if None. The second
-        positional argument (formerly ``model``).
+    system : System
+        The system (:mod:`hhscatter.model`), required: the saddles, E_s and V are its. The second positional
+        argument (formerly ``model``).
     exit : int
         The exit's channel index, 0 ≤ exit < len(system.exits).
     rtol : float
@@ -314,15 +313,15 @@ def lyapunov_orbit(
     Raises
     ------
     ValueError
-        Before any integration: E not finite or ≤ E_s, an exit index out of range, a system without exits,
-        an exit that is not a saddle of V.
+        Before any integration (a :class:`~hhscatter.errors.ConfigError` naming the argument): E not finite or
+        ≤ E_s, ``system`` not a System, an exit index out of range, a system without exits, an exit that is not
+        a saddle of V.
     RuntimeError
         No Lyapunov orbit found at E.
 
     Notes
     -----
-    As E → E_s the orbit shrinks to the saddle and its period tends to 2π/ω_v (2π/(√3 ω) at Hénon–Heiles'
-    saddles). Units: the system's (unit mass): lengths, energies, times.
+    As E → E_s the orbit shrinks to the saddle and its period tends to 2π/ω_v. Units: the system's (unit mass): lengths, energies, times.
 
     Examples
     --------
@@ -332,7 +331,7 @@ def lyapunov_orbit(
     (4.4408, [0.0, 0.0])
     """
     energy = check.number(energy, "energy")
-    system = HenonHeiles() if system is None else check.system(system, "system")
+    system = check.system(system, "system")
     rtol = check.number(rtol, "rtol", positive=True)
     n_samples = check.count(n_samples, "n_samples", 2)
     E = _checked_energy(energy, system, exit)

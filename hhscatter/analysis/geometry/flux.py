@@ -12,7 +12,7 @@ t → 0+, is the outward phase-space flux through that circle over the shell's v
 using ∫ d²p δ(E − V − p²/2) (p·n)₊ = ∫ dθ |p| cos₊θ = 2|p| with |p| = √(2(E − V)). For the disk r < R
 entirely accessible (V < E on it) Ω_E = 2π²R². The identity holds for every potential (and with drag, for
 the first crossings): with a conservative scene's escape at r_esc = R it checks the initial conditions, the
-escape event and the system's potential together (tests/integrate/test_flux_identity.py).
+escape event and the system's potential together.
 
 Units: κ in 1/time, Φ in (energy·length)/… — only their ratio has a meaning here.
 

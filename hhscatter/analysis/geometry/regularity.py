@@ -15,7 +15,7 @@ called regular when G < ``g_max`` (default 10⁴: ln G = 9.2, so a chaotic orbit
 λ ≳ 0.005 at t = 1900). An orbit whose shadow leaves (escapes) while it stays, or the reverse, is chaotic. The
 threshold is validated against orbits whose type an independent integration (scipy, variational equations,
 renormalised tangent vector) fixes, among them orbits at island edges whose growth lies between a torus' and the
-saturated sea's: tests/analysis/geometry/test_regularity.py. :func:`threshold_systematic` gives the systematic of
+saturated sea's. :func:`threshold_systematic` gives the systematic of
 the threshold choice (the fraction's largest shift with the threshold a decade either side).
 
 A second, independent indicator is the variational FTLE (:func:`variational_indicator`): the log-stretch Λ of a

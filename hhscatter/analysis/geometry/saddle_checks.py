@@ -83,7 +83,7 @@ def information_dimension_radius(
     standard error from its residuals), *resample* (bootstrap over ``groups``: each centre weighted by how often
     its group is drawn, the counts held) and *range* (half the difference of the slopes on the upper and lower half
     of the radii). On the area-preserving baker map's natural measure, 10⁴ points in 2000 orbits, the 2σ interval
-    covers the closed form in at least 9 of 10 seeds (tests/analysis/geometry/test_saddle_checks.py).
+    is checked to cover the closed form in at least 9 of 10 seeds.
 
     Parameters
     ----------
@@ -403,8 +403,7 @@ def ftle_dimension(
     way in and out (an offset per orbit), whose scatter adds to the fluctuations: ``value − d1`` is then an upper
     bound of the fluctuations' part on the saddle. The error is the bootstrap over orbits with κ's error
     propagated in quadrature. On the open baker map's natural measure (Bernoulli stretches, d₂ in closed form)
-    the partition form's 2σ interval covers d₂; on Gaussian stretches both forms do
-    (tests/analysis/geometry/test_saddle_checks.py).
+    the partition form's 2σ interval is checked to cover d₂; on Gaussian stretches both forms are.
 
     Parameters
     ----------

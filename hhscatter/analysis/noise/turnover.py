@@ -94,8 +94,8 @@ def barrier_action(model, exit: int = 0) -> float:
     turns on V = E_s across the well and comes back: S = 2 ∫ √(2 (E_s − V)) ds along that line (unit mass).
 
     It is the orbit whose energy loss per period, γ S, sets δ = γ S/T (:func:`energy_loss_parameter`). The
-    orbit stays on the line when the line is invariant (the force along it is parallel to it: the symmetry
-    axes of Hénon–Heiles); otherwise S is the one-dimensional estimate along it.
+    orbit stays on the line when the line is invariant (the force along it is parallel to it: a symmetry
+    axis of V); otherwise S is the one-dimensional estimate along it.
 
     Examples
     --------

@@ -1,12 +1,13 @@
 """κ0(E) under several conventions, and the κ(E) law with its spread across them.
 
 The escape rate of Eq. (eqn:kappa_hyperbolic) near E_c depends on how it is
-defined: the IC region (disk r < 0.5, or the authors' square [−1, 1]² with
-V < E) and the fitting windows move κ at E ≤ 0.23, and square ICs bring a plateau of orbits still
-inside at t_max (censored: regular orbits on KAM tori and chaotic ones not yet
-out; P∞ = 6.5 % at E = 0.18) on which a local-slope window rule locks,
-returning κ ≈ 0. This module holds the pure pieces (arrays and DataFrames in,
-results out):
+defined: the region of the initial conditions and the fitting windows move κ
+where the escape is slow, and a region that reaches regular orbits brings a
+plateau of orbits still inside at t_max (censored: regular orbits on KAM tori
+and chaotic ones not yet out) on which a local-slope window rule locks,
+returning κ near 0. How large these effects are is a property of a run: it is
+measured on the run and written with it, not here. This module holds the pure
+pieces (arrays and DataFrames in, results out):
 
 * :func:`p_level_windows` — the 4 windows (full, halves, middle) between the
   times where P(t) first falls to ``p_hi`` and to ``p_lo``: a rule fixed by

@@ -2,8 +2,9 @@
 
 :class:`PiecewiseKappa` holds the piecewise law κ0 = a2 ΔE² + a1 ΔE below
 E_switch and slope·ΔE above (ΔE = E − E_c, zero below E_c); the coefficients
-are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` or given. E_c comes from
-the model.
+are fitted by :func:`hhscatter.analysis.survival.kappa_energy.fit_kappa_energy` or given by the caller. E_c
+comes from the system. No coefficient has a default: a law is the data of a fit or of a reference, not of this
+module.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ __all__ = ["PiecewiseKappa"]
 
 @dataclass(frozen=True)
 class PiecewiseKappa:
-    """PiecewiseKappa(E_c, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27) -> callable κ0(E).
+    """PiecewiseKappa(E_c, a2, a1, slope, E_switch) -> callable κ0(E).
 
     Conservative escape rate as a function of energy, with
     ΔE = E − E_c:
@@ -26,17 +27,27 @@ class PiecewiseKappa:
         κ0 = slope · ΔE       for E ≥ E_switch         (hyperbolic, linear regime)
         κ0 = 0                for E ≤ E_c              (no escape)
 
-    E_c is the system's (``scene.model.critical_energy``; no default: it comes from the system). Defaults of
-    the coefficients are the fits of Burton, Dullin & Altmann (2023).  Calling it on an array returns an array
-    (rates in 1/time).  Note the two branches do not join exactly at
-    E_switch (0.1486 vs 0.1457 with the defaults).
+    E_c (energy) is the system's (``scene.model.critical_energy``); a2 (1/(time·energy²)), a1 and slope
+    (1/(time·energy)) and E_switch (energy) are the coefficients of a fit
+    (:func:`~hhscatter.analysis.survival.kappa_energy.fit_kappa_energy`) or of a reference; all are required.
+    Calling it on an array returns an array (rates in 1/time).  The two branches need not join at E_switch:
+    E_switch belongs to the linear branch.
+
+    Examples
+    --------
+    E_c = 0.25, E_switch = 0.4: at E = 0.3 (ΔE = 0.05) κ0 = 2 · 0.05² + 0.5 · 0.05 = 0.03; at E = 0.5 (ΔE = 0.25)
+    κ0 = 3 · 0.25 = 0.75; below E_c no escape.
+
+    >>> law = PiecewiseKappa(E_c=0.25, a2=2.0, a1=0.5, slope=3.0, E_switch=0.4)
+    >>> law([0.2, 0.3, 0.5]).round(12).tolist()
+    [0.0, 0.03, 0.75]
     """
 
     E_c: float
-    a2: float = 13.63
-    a1: float = 0.03
-    slope: float = 1.41
-    E_switch: float = 0.27
+    a2: float
+    a1: float
+    slope: float
+    E_switch: float
 
     def __call__(self, E):
         E = np.asarray(E, dtype=float)

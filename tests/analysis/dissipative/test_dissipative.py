@@ -203,7 +203,7 @@ def test_integrated_hazard_closed_forms():
     for hz in ("paper", "integrated"):
         P = model.survival_model(t, **const, **TRUE, tau2=100.0, hazard=hz)
         np.testing.assert_allclose(P, 0.1 + 0.4 * np.exp(-0.07 * (t - TAU0)), rtol=1e-9)
-    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41, E_c=PAPER_KAPPA.E_c)  # κ = 1.41 (E − E_c)
+    lin = model.PiecewiseKappa(a2=0.0, a1=1.41, slope=1.41, E_switch=0.27, E_c=PAPER_KAPPA.E_c)  # κ = 1.41 (E − E_c)
     beta = MU * GAMMA
     K = 1.41 * (E0 * (np.exp(-beta * TAU0) - np.exp(-beta * t)) / beta - EC * (t - TAU0))
     P = model.survival_model(t, **dict(KW, kappa_of_E=lin), **TRUE, hazard="integrated")

@@ -141,7 +141,7 @@ def test_henon_heiles_orbits_scale_with_omega_and_lambda():
     ],
 )
 def test_henon_heiles_matches_the_symmetric_shooting(E, r_min, r_max, period):
-    L = lyapunov_orbit(E)
+    L = lyapunov_orbit(E, HenonHeiles())
     assert (L.r_min, L.r_max, L.period) == (
         pytest.approx(r_min, rel=1e-10),
         pytest.approx(r_max, rel=1e-10),
@@ -172,13 +172,15 @@ def test_bad_input_is_refused_before_any_integration(systems, monkeypatch):
     monkeypatch.setattr(channels.integrate, "solve_ivp", no_work)
     hh, barb = HenonHeiles(), systems["barbanis"]
     with pytest.raises(ValueError, match=r"E_s = 0\.166667.*got 0\.1"):
-        lyapunov_orbit(0.1)
+        lyapunov_orbit(0.1, hh)
     with pytest.raises(ValueError, match=r"got 0\.16666666666666666"):
         lyapunov_orbit(1 / 6, hh)
     with pytest.raises(ValueError, match=r"E_s = 0\.5 of exit 1.*got 0\.5"):
         lyapunov_orbit(0.5, barb, exit=1)
     with pytest.raises(ValueError, match="got nan"):
-        lyapunov_orbit(math.nan)
+        lyapunov_orbit(math.nan, hh)
+    with pytest.raises(ValueError, match="system must be a System"):  # no default system: the caller names it
+        lyapunov_orbit(0.3, None)
     for bad in (3, -1, True, 1.0):
         with pytest.raises(ValueError, match=rf"exit must be a channel index from 0 to 2, got {bad!r}"):
             lyapunov_orbit(0.3, hh, exit=bad)

@@ -37,7 +37,7 @@ def test_paper_law_at_known_energies():
 
 
 def test_the_two_branches_do_not_join_at_the_switch():
-    """The docstring's numbers: 0.1486 (quadratic branch) and 0.1457 (linear branch) at E_switch = 0.27."""
+    """The reference law's branches at E_switch = 0.27: 0.1486 (quadratic, just below) and 0.1457 (linear, at it)."""
     just_below = float(PAPER_KAPPA(0.27 - 1e-12))
     at = float(PAPER_KAPPA(0.27))
     assert just_below == pytest.approx(0.1486, abs=5e-5)
