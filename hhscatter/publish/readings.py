@@ -1578,6 +1578,30 @@ def _operator_finest(get: Loader) -> str:
     return "; ".join(out)
 
 
+def _fig6_fit_range(get: Loader) -> str:
+    """fig6's fits at the quick and the paper scale, matched by (pair, model, hazard): the ratio of their orbits
+    per pair, the points each fit gains, and in how many fits the rms log residual grows (the ones where it does
+    not, named)."""
+    quick = {(r["pair"], r["model"], r["hazard"]): r for r in get("fig6", "quick")["fits"]}
+    pairs = [
+        (quick[k], r) for r in get("fig6", "paper")["fits"] if (k := (r["pair"], r["model"], r["hazard"])) in quick
+    ]
+    if not pairs:
+        return "no fit is made at both scales"
+    ratios = sorted({p["N"] / q["N"] for q, p in pairs})
+    ratio = f"{ratios[0]:g}" if len(ratios) == 1 else f"{ratios[0]:g} to {ratios[-1]:g}"
+    gained = [p["n_points"] - q["n_points"] for q, p in pairs]
+    not_up = [
+        f"{p['pair']} {p['model']} ({p['hazard']})" for q, p in pairs if p["rms_log_residual"] <= q["rms_log_residual"]
+    ]
+    grows = len(pairs) - len(not_up)
+    text = (
+        f"with {ratio} times the orbits per pair the fits take {min(gained)} to {max(gained)} more points each, and "
+        f"the rms log residual grows in {grows} of the {len(pairs)} fits (pair × model × hazard)"
+    )
+    return text + (f"; it does not grow in {', '.join(not_up)}" if not_up else "")
+
+
 def _ratios(xs) -> str:
     return ", ".join(f"{x:g}" for x in xs) + " E_c"
 
@@ -1842,6 +1866,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.t_star_spread": _operator_t_star_spread,
     "operator.cost": _operator_cost,
     "operator.finest": _operator_finest,
+    "fig6.fit_range": _fig6_fit_range,
     "saddle.lambda_offset": _saddle_lambda_offset,
 }
 
