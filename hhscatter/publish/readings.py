@@ -22,7 +22,7 @@ import numpy as np
 
 from hhscatter.analysis.stats.least_squares import weighted_least_squares
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.analysis.stats.verdicts import signed, verdict, verdict_class
+from hhscatter.analysis.stats.verdicts import half_unit, signed, verdict, verdict_class
 from hhscatter.publish.formatting import format_bound, format_value_err, typographic_minus
 from hhscatter.reproduction.verdicts import claim_verdict
 
@@ -363,7 +363,6 @@ def _generality_mu_gap(get: Loader) -> str:
     """The share of the gap between the paper's μ and the measured μ on fig3's window that the prediction from the
     conservative ⟨K⟩ covers, (μ_pred − μ_paper)/(μ_meas − μ_paper), its error propagated from the three (the paper's
     μ carries half a unit of its last printed digit), worded by its 2σ interval against 1/2 and 1."""
-    from hhscatter.analysis.stats.verdicts import half_unit  # the paper's printed precision
 
     d = get("generality", None)
     system = next(iter(d["systems"]))
