@@ -1521,8 +1521,9 @@ def _operator_t_star_spread(get: Loader) -> str:
         side = "within 2σ of the simulated spread"
     else:
         side = f"{'wider' if z > 0 else 'narrower'} than the simulated spread by more than 2σ"
+    d = max(0, 1 - math.floor(math.log10(err))) if err > 0 else 4  # two significant digits of the error
     return (
-        f"its spread is {s_op:.4f} against {_ve(s_sim, err)} simulated ({n} survivors; the error of a sample "
+        f"its spread is {s_op:.{d}f} against {s_sim:.{d}f} ± {err:.{d}f} simulated ({_int(n)} survivors; the error of a sample "
         f"standard deviation, normal approximation): {side} (ratio {s_op / s_sim:.2f}, z = {signed(z)})"
     )
 
