@@ -181,11 +181,12 @@ class EscapeRates:
         (energy, gamma) → number of orbits N.
     notes : dict
         (energy, gamma) → why a point has no κ (dissipative, too few orbits, …), or why its κ is not the rate of
-        the population (a trapped plateau, a non-exponential decay).
+        the population (a plateau of censored orbits, a non-exponential decay).
     status : dict
         (energy, gamma) → :class:`~hhscatter.analysis.survival.long_time.RateStatus` of each fitted point:
-        'exponential', 'trapped', 'non-exponential', 'too few orbits' (no verdict on one exponential) or 'empty'
-        (no orbit left after τ0), with P∞ and κ_tail of the plateau-plus-exponential fit.
+        'exponential', 'trapped' (a legacy value: censored orbits bias the window, see the glossary),
+        'non-exponential', 'too few orbits' (no verdict on one exponential) or 'empty' (no orbit left after τ0),
+        with P∞ and κ_tail of the plateau-plus-exponential fit.
 
     Examples
     --------
@@ -212,7 +213,8 @@ class EscapeRates:
         fits and statistics), kappa_stat, kappa_spread, tau0, t_stop, windows
         (the 4 (t_lo, t_hi) fit windows), kappa_mle, kappa_mle_err (maximum
         likelihood on [tau0, t_stop]), tau_star (NaN without power-law tail),
-        status ('exponential', 'trapped', 'non-exponential', 'too few orbits', 'empty'; "" where not fitted), p_inf, kappa_inf (the
+        status ('exponential', 'trapped' (legacy value: censored orbits bias the window), 'non-exponential',
+        'too few orbits', 'empty'; "" where not fitted), p_inf, kappa_inf (the
         plateau-plus-exponential fit from τ0), note (why κ is NaN or not the population's rate, else empty).
         """
         import pandas as pd  # deferred: pandas loads on first use
@@ -289,7 +291,7 @@ def escape_rates(lifetimes: pandas.DataFrame, t_grid: ArrayLike | None = None, *
     EscapeRates
         ``.to_frame()`` one row per point (energy, gamma, n, kappa, kappa_err, tau0, windows, tau_star,
         status, p_inf, kappa_inf, note), ``.plot(ax=)`` κ against E. A point whose orbits still inside at t_max
-        bias the window (status 'trapped'), whose decay is not one exponential ('non-exponential') or has too
+        (censored) bias the window (status 'trapped', a legacy value), whose decay is not one exponential ('non-exponential') or has too
         few orbits to tell ('too few orbits') says so in
         ``status`` and ``note`` (:func:`~hhscatter.analysis.survival.long_time.rate_status`); its κ is then not
         the population's escape rate.

@@ -104,7 +104,9 @@ def _load(path: str) -> dict:
 
     Parsed once per content (the cache is keyed by the file's bytes, so a file rewritten within the clock's
     resolution is read again). Rows written before they carried their count get it from the record itself
-    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound; text
+    (:func:`hhscatter.reproduction.escape_criterion.with_return_counts`): a count of 0 reads as its bound; rows of
+    κ from the c-measure written before they carried their reference get it from the record
+    (:func:`hhscatter.reproduction.fig2.with_cmeasure_references`); text
     written before the studies used the glossary's words is read in them (:func:`hhscatter.publish.words.in_glossary_words`)."""
     return _parse(path, Path(path).read_bytes())
 
@@ -118,8 +120,9 @@ def _parse(path: str, raw: bytes) -> dict:
             "with): a page quotes no number from an edited file; make the study again and copy its results"
         )
     from hhscatter.reproduction.escape_criterion import with_return_counts  # deferred: pandas loads on first use
+    from hhscatter.reproduction.fig2 import with_cmeasure_references  # deferred: pandas loads on first use
 
-    return in_glossary_words(with_return_counts(doc))
+    return in_glossary_words(with_cmeasure_references(with_return_counts(doc)))
 
 
 def read_numbers_file(path: Path) -> dict:
@@ -670,7 +673,8 @@ READING_WORDS = re.compile(
     r"(?:several|a\s+few|many)\s+σ|σ\s+from\s+zero|by\s+up\s+to(?:\s+about)?\s+\d+(?:\.\d+)?\s*σ|"
     r"within\s+(?:its|their)\s+errors?|the\s+same\s+for\s+(?:r|E|γ|every|all\s+(?!systems))\S*|"
     r"times\s+as\s+(?:often|many|much|large|fast)|of\s+similar\s+size|"
-    r"not\s+the\s+picture|times\s+(?:narrower|wider)|"
+    r"not\s+the\s+picture|times\s+(?:narrower|wider)|(?:is|are)\s+(?:narrower|wider)|cheaper|costlier|"
+    r"explains?\s+most|"
     r"hardly|cross(?:es|ed)\s+(?:it|them|fig\d\S*|the\s+(?:measured|predicted|prediction|reference|paper's|fitted|other))|"
     r"roughly|nearly|essentially|clearly|barely|almost|slightly|about\s+the\s+same|close\s+to|"
     r"(?:much|far)\s+(?:below|above|closer|farther|wider|narrower|larger|smaller|longer|shorter|higher|lower|finer|"

@@ -363,6 +363,10 @@ def _generality_mu_gap(get: Loader) -> str:
     """The share of the gap between the paper's μ and the measured μ on fig3's window that the prediction from the
     conservative ⟨K⟩ covers, (μ_pred − μ_paper)/(μ_meas − μ_paper), its error propagated from the three (the paper's
     μ carries half a unit of its last printed digit), worded by its 2σ interval against 1/2 and 1."""
+<<<<<<< HEAD
+=======
+
+>>>>>>> s10-h47b
     d = get("generality", None)
     system = next(iter(d["systems"]))
     win = d["systems"][system]["mu_by_window"]["paper"]
@@ -1422,6 +1426,185 @@ def _operator_tolerance(get: Loader) -> str:
     return "the debiased distance to fig1's c-measure at E = 0.30 (95 % interval) lies " + "; ".join(parts)
 
 
+def _operator_grid_fit(rows: list[dict]) -> dict:
+    """The fit ln κ = a + s·ln M + t·ln b over the (box side b, samples per box M) grid of the eigenvector
+    convergence table, with equal weights and the errors scaled by the scatter about the fit (χ²/dof): the
+    grid's κ carry no error of their own. Returns {s, s_err, t, t_err, dof, n}."""
+    k = np.log([r["kappa"] for r in rows])
+    m = np.log([r["samples_per_box"] for r in rows])
+    b = np.log([r["box"] for r in rows])
+    if len(rows) < 4:
+        raise ValueError(f"the (b, M) grid needs at least 4 points for 3 parameters and an error, got {len(rows)}")
+    fit = weighted_least_squares(np.column_stack([np.ones_like(k), m, b]), k, errors="scaled")
+    return {
+        "s": float(fit.coef[1]),
+        "s_err": float(math.sqrt(fit.cov[1, 1])),
+        "t": float(fit.coef[2]),
+        "t_err": float(math.sqrt(fit.cov[2, 2])),
+        "dof": fit.dof,
+        "n": len(rows),
+    }
+
+
+def _exponent_words(slope: float, err: float, rises: str, falls: str, flat: str, law: str) -> str:
+    z = slope / err
+    fit = f"{law}, exponent {_ve(slope, err)}, z = {signed(z)}"
+    if abs(z) > Z_RESOLVED:
+        return f"{rises if slope > 0 else falls} ({fit})"
+    return f"{flat} resolved at 2σ ({fit})"
+
+
+def _operator_grid_rows(get: Loader) -> list[dict]:
+    rows = get("operator", None)["cmeasure_convergence"]
+    e = sorted({r["energy"] for r in rows})[0]
+    return [r for r in rows if r["energy"] == e]
+
+
+def _operator_samples_trend(get: Loader) -> str:
+    """κ against the samples per box M at fixed box side b, from the fit ln κ = a + s·ln M + t·ln b over the (b, M)
+    grid of the eigenvector convergence table (equal weights, errors from the scatter): "κ falls as M grows" only
+    when s < 0 by more than 2σ."""
+    rows = _operator_grid_rows(get)
+    f = _operator_grid_fit(rows)
+    words = _exponent_words(
+        f["s"],
+        f["s_err"],
+        "at fixed box side κ rises as M grows",
+        "at fixed box side κ falls as M grows",
+        "at fixed box side κ shows no trend in M",
+        "κ ∝ M^s",
+    )
+    return (
+        f"{words}; the fit of ln κ on ln M and ln b over the {f['n']} partitions of the grid at "
+        f"E = {rows[0]['energy']:g}, equal weights, errors from the scatter about the fit ({f['dof']} dof)"
+    )
+
+
+def _operator_box_trend(get: Loader) -> str:
+    """κ against the box side b at fixed samples per box, from the same fit as :func:`_operator_samples_trend`:
+    "κ rises as the boxes shrink" only when t < 0 by more than 2σ."""
+    f = _operator_grid_fit(_operator_grid_rows(get))
+    return _exponent_words(
+        f["t"],
+        f["t_err"],
+        "at fixed samples per box κ falls as the boxes shrink",
+        "at fixed samples per box κ rises as the boxes shrink",
+        "at fixed samples per box κ shows no trend in b",
+        "κ ∝ b^t",
+    )
+
+
+def _operator_reduced(get: Loader) -> str:
+    """The operator on ρ(E) alone against the simulated P(t): its rms of ln(P_op/P_sim) over the compared times
+    against the spread of ln P_sim over the same times (the share of ln P_sim's variance it leaves, 1 − rms²/var,
+    from the P(t) rows up to the compared time), and against the full operator's rms."""
+    d = get("operator", None)["dissipative"]
+    pts = [r for r in d["P_at"] if r["t"] <= d["compared_until"] and r.get("sim") and r["sim"] > 0]
+    ln = np.log([r["sim"] for r in pts])
+    red, full = d["lnP_rms_reduced"], d["lnP_rms_operator"]
+    decades = (ln.max() - ln.min()) / math.log(10)
+    share = 1 - red**2 / float(np.var(ln)) if len(pts) > 1 and np.var(ln) > 0 else float("nan")
+    vs = "above" if red > full else "below" if red < full else "equal to"
+    return (
+        f"ρ(E) alone follows ln P(t) to an rms of {red:.2f}, {vs} the full operator's {full:.2f}, while P_sim "
+        f"falls by {decades:.1f} decades over t = {pts[0]['t']:g} to {pts[-1]['t']:g}: its mean square is "
+        f"{100 * (1 - share):.1f} % of the variance of ln P_sim at the table's times up to t = {pts[-1]['t']:g}"
+    )
+
+
+def _operator_t_star_spread(get: Loader) -> str:
+    """The operator's spread of the survivors' energy at t* against the simulated one; the simulated spread's error
+    is that of a sample standard deviation of N normal points, s/√(2(N − 1)) (the operator's is not recorded)."""
+    d = get("operator", None)["dissipative"]
+    s_op, s_sim = d["t_star_std_energy"]["operator"], d["t_star_std_energy"]["sim"]
+    n = d["t_star_points_sim"]
+    err = s_sim / math.sqrt(2 * (n - 1))
+    z = (s_op - s_sim) / err
+    if abs(z) <= Z_RESOLVED:
+        side = "within 2σ of the simulated spread"
+    else:
+        side = f"{'wider' if z > 0 else 'narrower'} than the simulated spread by more than 2σ"
+    d = max(0, 1 - math.floor(math.log10(err))) if err > 0 else 4  # two significant digits of the error
+    return (
+        f"its spread is {s_op:.{d}f} against {s_sim:.{d}f} ± {err:.{d}f} simulated ({_int(n)} survivors; the error of a sample "
+        f"standard deviation, normal approximation): {side} (ratio {s_op / s_sim:.2f}, z = {signed(z)})"
+    )
+
+
+def _operator_cost(get: Loader) -> str:
+    """The orbit-time for κ at 1 % of the P(t) route against the operator's lower bound, energy by energy: the P(t)
+    route needs less where its cost lies below the operator's lower bound; where it does not, the bound decides
+    nothing."""
+    rows = sorted(get("operator", None)["cost"], key=lambda r: r["energy"])
+    less = [r for r in rows if r["pt_orbit_time_1pct"] < r["op_orbit_time_1pct"]]
+    ratios = [r["op_orbit_time_1pct"] / r["pt_orbit_time_1pct"] for r in less]
+    es = ", ".join(f"{r['energy']:g}" for r in less)
+    if len(less) == len(rows):
+        head = f"for κ alone the P(t) route needs less orbit-time at all {len(rows)} cost energies ({es})"
+    elif less:
+        rest = ", ".join(f"{r['energy']:g}" for r in rows if r not in less)
+        head = (
+            f"for κ alone the P(t) route needs less orbit-time at E = {es}; at E = {rest} the operator's lower "
+            "bound lies under the P(t) route's cost, which does not decide the order there"
+        )
+    else:
+        return (
+            "for κ alone the operator's lower bound lies under the P(t) route's cost at every cost energy, which "
+            "does not decide which route is cheaper"
+        )
+    return head + f" (the operator's lower bound over the P(t) route's: {min(ratios):.1f} to {max(ratios):.1f})"
+
+
+#: the energy at which the README quotes the finest partition's κ
+OPERATOR_HEADLINE_ENERGY = 0.30
+
+
+def _operator_finest(get: Loader) -> str:
+    """Ulam's κ on the finest boxes (its statistical error) against fig2's κ0 at each energy, by the verdict rule:
+    at :data:`OPERATOR_HEADLINE_ENERGY` with its verdict, and the energies where it differs."""
+    rows = sorted(get("operator", None)["kappa_ulam"], key=lambda r: r["energy"])
+    cells = [(r, verdict(r["kappa"], r["kappa_stat_err"], r["fig2_kappa"], r["fig2_err"])) for r in rows]
+    head = next((c for c in cells if abs(c[0]["energy"] - OPERATOR_HEADLINE_ENERGY) < 1e-9), None)
+    differ = [f"{r['energy']:g} (z = {signed(v.z)})" for r, v in cells if v.word == "differs"]
+    out = []
+    if head is not None:
+        r, v = head
+        out.append(
+            f"the finest boxes alone give {_ve(r['kappa'], r['kappa_stat_err'])} at E = {r['energy']:g} "
+            f"(statistical error), against fig2's κ0: {v.text()}"
+        )
+    out.append(
+        f"of the {len(cells)} energies, they differ from it at E = {', '.join(differ)}"
+        if differ
+        else f"they differ from it at none of the {len(cells)} energies"
+    )
+    return "; ".join(out)
+
+
+def _fig6_fit_range(get: Loader) -> str:
+    """fig6's fits at the quick and the paper scale, matched by (pair, model, hazard): the ratio of their orbits
+    per pair, the points each fit gains, and in how many fits the rms log residual grows (the ones where it does
+    not, named)."""
+    quick = {(r["pair"], r["model"], r["hazard"]): r for r in get("fig6", "quick")["fits"]}
+    pairs = [
+        (quick[k], r) for r in get("fig6", "paper")["fits"] if (k := (r["pair"], r["model"], r["hazard"])) in quick
+    ]
+    if not pairs:
+        return "no fit is made at both scales"
+    ratios = sorted({p["N"] / q["N"] for q, p in pairs})
+    ratio = f"{ratios[0]:g}" if len(ratios) == 1 else f"{ratios[0]:g} to {ratios[-1]:g}"
+    gained = [p["n_points"] - q["n_points"] for q, p in pairs]
+    not_up = [
+        f"{p['pair']} {p['model']} ({p['hazard']})" for q, p in pairs if p["rms_log_residual"] <= q["rms_log_residual"]
+    ]
+    grows = len(pairs) - len(not_up)
+    text = (
+        f"with {ratio} times the orbits per pair the fits take {min(gained)} to {max(gained)} more points each, and "
+        f"the rms log residual grows in {grows} of the {len(pairs)} fits (pair × model × hazard)"
+    )
+    return text + (f"; it does not grow in {', '.join(not_up)}" if not_up else "")
+
+
 def _ratios(xs) -> str:
     return ", ".join(f"{x:g}" for x in xs) + " E_c"
 
@@ -1680,6 +1863,13 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "noise.reactivation": _noise_reactivation,
     "noise.window_halves": _noise_window_halves,
     "operator.tolerance": _operator_tolerance,
+    "operator.samples_trend": _operator_samples_trend,
+    "operator.box_trend": _operator_box_trend,
+    "operator.reduced": _operator_reduced,
+    "operator.t_star_spread": _operator_t_star_spread,
+    "operator.cost": _operator_cost,
+    "operator.finest": _operator_finest,
+    "fig6.fit_range": _fig6_fit_range,
     "saddle.lambda_offset": _saddle_lambda_offset,
 }
 

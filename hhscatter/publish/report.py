@@ -38,6 +38,7 @@ from hhscatter.publish.formatting import (
 )
 from hhscatter.publish.words import in_glossary_words
 from hhscatter.reproduction.escape_criterion import with_return_counts
+from hhscatter.reproduction.fig2 import with_cmeasure_references
 from hhscatter.reproduction.verdicts import RULE, row_verdict
 from hhscatter.studies import load_study, studies_root
 from hhscatter.studies.cost import summary, totals
@@ -141,6 +142,7 @@ def collect(scale: str = "quick", root: Path | None = None) -> list[Section]:
                 raw=nums.parent == root / info.name / "out" / scale,
             )
             doc = with_return_counts(doc)  # rows written before they carried their count: from the record
+            doc = with_cmeasure_references(doc)  # rows written before they carried their reference: from the record
             doc = in_glossary_words(doc)  # text written before the studies said "censored"
         sec = Section(info.name, info.title, info.summary, fig, doc, info.paper)
         sec.cost = json.loads(cost.read_text()) if cost else None

@@ -22,6 +22,7 @@ import pandas as pd
 
 from hhscatter.analysis.stats.verdicts import half_unit
 from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
+from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
 from hhscatter.reproduction.convention_tables import (
     LAW_PARAMETERS,
@@ -31,7 +32,7 @@ from hhscatter.reproduction.convention_tables import (
     stable_energies,
 )
 from hhscatter.reproduction.escape_summaries import kappa_cmeasure_entry, kappa_cmeasure_shifts, tau_star_estimate
-from hhscatter.reproduction.verdicts import quoted_verdict
+from hhscatter.reproduction.verdicts import quoted_verdict, row_verdict
 
 __all__ = [
     "FIG2_CONVENTIONS",
@@ -47,6 +48,7 @@ __all__ = [
     "law_comparisons",
     "paper_law_kappa",
     "pt_comparisons",
+    "with_cmeasure_references",
 ]
 
 #: the paper's Fig. 2 values: the κ(E) law κ = a x² + b x (E < E_b), c x (E ≥ E_b), x = E − E_c, and τ*
@@ -322,27 +324,68 @@ def cmeasure_comparisons(table) -> tuple[list[dict], dict]:
     Returns
     -------
     (rows, entries)
-        Comparison rows (consistent where |z| ≤ 2) and {energy: numbers entry} with the later starts beside
+        Comparison rows against κ from P(t) (its 1σ: another measurement, verdicts by the one rule) and
+        {energy: numbers entry} with the later starts beside
         (:func:`~hhscatter.reproduction.escape_summaries.kappa_cmeasure_entry`).
     """
     rows, entries = [], {}
     for _, row in table[table["shift_efolds"] == 0.0].iterrows():
         z = row["z_vs_grid"]
-        rows.append(
-            _row(
-                f"κ from the c-measure (E={row['energy']:.2f})",
-                row["kappa_cm"],
-                row["kappa_cm_err"],
-                None,
-                unit="1/time",
-                verdict="consistent with P(t) (|z| ≤ 2)" if abs(z) <= 2 else "differs from P(t)",
-                note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
-                f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
-            )
+        out = _row(
+            f"κ from the c-measure (E={row['energy']:.2f})",
+            row["kappa_cm"],
+            row["kappa_cm_err"],
+            row["kappa_pt_grid"],
+            paper_err=row["kappa_pt_grid_err"],
+            reference_kind="propagated",
+            unit="1/time",
+            note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
+            f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
         )
+        rows.append({**out, "verdict": row_verdict(out)})
         later = table[(table["energy"] == row["energy"]) & (table["shift_efolds"] > 0)]
         entries[row["energy"]] = kappa_cmeasure_entry(row, later)
     return rows, entries
+
+
+#: the quantity of a row of κ from the c-measure (its energy in the parentheses)
+_CM_QUANTITY = "κ from the c-measure (E="
+
+
+def with_cmeasure_references(numbers: dict) -> dict:
+    """with_cmeasure_references(numbers JSON) -> the same numbers with each row "κ from the c-measure (E=…)" of its
+    ``paper_comparison`` given its reference, κ from P(t) with its 1σ (``paper``, ``paper_err``, ``reference_kind``
+    "propagated"), from the ``cmeasure`` record of that energy where the row does not state it (a record written
+    before the rows carried it, whose verdict was not in the one rule's words), so that its verdict comes from
+    :func:`~hhscatter.reproduction.verdicts.row_verdict`. Numbers of any other study come back unchanged.
+
+    Examples
+    --------
+    >>> doc = {"cmeasure": {"cm_E0.27": {"energy": 0.27, "kappa_pt_grid": {"value": 0.145, "err": 0.002}}},
+    ...        "paper_comparison": [{"quantity": "κ from the c-measure (E=0.27)", "ours": 0.146, "err": 0.001,
+    ...                              "paper": None, "verdict": "consistent with P(t) (|z| ≤ 2)"}]}
+    >>> row = with_cmeasure_references(doc)["paper_comparison"][0]
+    >>> row["paper"], row["paper_err"], row_verdict(row)
+    (0.145, 0.002, 'agrees (z = +0.4)')
+    """
+    if not isinstance(numbers, dict):
+        raise ConfigError(f"numbers must be a study's numbers JSON (a dict), got {type(numbers).__name__}")
+    records, rows = numbers.get("cmeasure"), numbers.get("paper_comparison")
+    if not isinstance(records, dict) or not isinstance(rows, list):
+        return numbers
+    refs = {}
+    for rec in records.values():
+        ref = rec.get("kappa_pt_grid") if isinstance(rec, dict) else None
+        if isinstance(ref, dict) and isinstance(rec.get("energy"), (int, float)):
+            refs[f"{_CM_QUANTITY}{rec['energy']:.2f})"] = ref
+    out = []
+    for row in rows:
+        ref = refs.get(row.get("quantity")) if isinstance(row, dict) else None
+        if ref is not None and row.get("paper") is None:
+            row = {**row, "paper": ref["value"], "paper_err": ref["err"], "reference_kind": "propagated"}
+            row["verdict"] = row_verdict(row)
+        out.append(row)
+    return {**numbers, "paper_comparison": out}
 
 
 def convention_numbers(table, stability, fit_info: dict, law: dict, *, p_levels, max_bias, rel_tol) -> dict:

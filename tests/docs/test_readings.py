@@ -1086,3 +1086,106 @@ def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_ag
         "r_esc = 1.03 lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = 0.30; "
         "cuts them at E = 0.25; lies beyond them at E = 0.17"
     )
+
+
+def _grid(kappa):
+    """The eigenvector convergence grid of the operator study: three box sides × three samples per box."""
+    cells = [(0.0125, 4), (0.0125, 16), (0.0125, 64), (0.025, 16), (0.025, 64), (0.025, 256), (0.05, 64)]
+    cells += [(0.05, 256), (0.05, 1024)]
+    return [{"energy": 0.3, "box": b, "samples_per_box": m, "kappa": kappa(b, m, i)} for i, (b, m) in enumerate(cells)]
+
+
+def test_the_operator_trends_state_the_fitted_exponents_and_resolve_them_at_two_sigma():
+    """κ = 0.2·M^(−0.05)·b^0 with a ±0.1 % wobble: the M exponent −0.050 is resolved (falls), the b exponent 0 is
+    not; κ = 0.2·b^(−0.05) gives the mirror words."""
+    wobble = (1, -1, 0, 1, -1, 0, -1, 1, 0)
+
+    def docs(kappa):
+        return _loader({"operator": {"cmeasure_convergence": _grid(kappa)}})
+
+    g = docs(lambda b, m, i: 0.2 * m**-0.05 * math.exp(1e-3 * wobble[i]))
+    text = READINGS["operator.samples_trend"](g)
+    assert text.startswith("at fixed box side κ falls as M grows (κ ∝ M^s, exponent −0.050")
+    assert READINGS["operator.box_trend"](g).startswith("at fixed samples per box κ shows no trend in b resolved at 2σ")
+    g = docs(lambda b, m, i: 0.2 * b**-0.05 * math.exp(1e-3 * wobble[i]))
+    assert READINGS["operator.box_trend"](g).startswith("at fixed samples per box κ rises as the boxes shrink")
+    assert "κ shows no trend in M resolved at 2σ" in READINGS["operator.samples_trend"](g)
+
+
+def test_the_operator_reduced_reading_states_the_rms_against_the_spread_of_ln_p():
+    """P_sim = 1, 0.1, 0.01 (t = 1, 2, 3; t = 4 past the compared time): ln P's variance is 2·ln(10)²/3 = 3.534,
+    an rms of 0.30 is 0.09/3.534 = 2.5 % of it, over 2.0 decades."""
+    rows = [{"t": t, "sim": p} for t, p in ((1.0, 1.0), (2.0, 0.1), (3.0, 0.01), (4.0, 0.001))]
+    d = {"P_at": rows, "compared_until": 3.0, "lnP_rms_reduced": 0.30, "lnP_rms_operator": 0.20}
+    text = READINGS["operator.reduced"](_loader({"operator": {"dissipative": d}}))
+    assert text == (
+        "ρ(E) alone follows ln P(t) to an rms of 0.30, above the full operator's 0.20, while P_sim falls by 2.0 "
+        "decades over t = 1 to 3: its mean square is 2.5 % of the variance of ln P_sim at the table's times up to t = 3"
+    )
+
+
+def test_the_operator_spread_reading_is_wider_only_beyond_two_sigma_of_the_simulated_spread():
+    """N = 5001 survivors with spread 0.01: its error is 0.01/√10000 = 0.0001; 0.0103 is +3σ (wider), 0.0101 +1σ."""
+
+    def text(op):
+        d = {"t_star_std_energy": {"operator": op, "sim": 0.01}, "t_star_points_sim": 5001}
+        return READINGS["operator.t_star_spread"](_loader({"operator": {"dissipative": d}}))
+
+    assert text(0.0103).endswith("wider than the simulated spread by more than 2σ (ratio 1.03, z = +3.0)")
+    assert text(0.0101).endswith("within 2σ of the simulated spread (ratio 1.01, z = +1.0)")
+    assert "narrower" in text(0.0096)
+
+
+def test_the_operator_cost_reading_orders_the_routes_only_where_the_lower_bound_decides():
+    def row(e, pt, op):
+        return {"energy": e, "pt_orbit_time_1pct": pt, "op_orbit_time_1pct": op}
+
+    def text(rows):
+        return READINGS["operator.cost"](_loader({"operator": {"cost": rows}}))
+
+    assert text([row(0.3, 1.0, 4.0), row(0.25, 2.0, 3.0)]) == (
+        "for κ alone the P(t) route needs less orbit-time at all 2 cost energies (0.25, 0.3) (the operator's lower "
+        "bound over the P(t) route's: 1.5 to 4.0)"
+    )
+    mixed = text([row(0.25, 1.0, 4.0), row(0.3, 5.0, 3.0)])
+    assert "at E = 0.25;" in mixed and "at E = 0.3 the operator's lower bound lies under" in mixed
+    assert "does not decide which route is cheaper" in text([row(0.25, 5.0, 3.0)])
+
+
+def test_the_operator_finest_reading_takes_its_verdicts_from_the_one_rule():
+    """0.21 ± 0.003 against 0.20 ± 0.004 is z = +2.0 (agrees, at the rule's edge); 0.15 ± 0.001 against 0.10 ± 0.001
+    differs (z = +35.4)."""
+
+    def row(e, k, ke, f, fe):
+        return {"energy": e, "kappa": k, "kappa_stat_err": ke, "fig2_kappa": f, "fig2_err": fe}
+
+    rows = [row(0.3, 0.21, 0.003, 0.20, 0.004), row(0.25, 0.15, 0.001, 0.10, 0.001)]
+    text = READINGS["operator.finest"](_loader({"operator": {"kappa_ulam": rows}}))
+    assert text == (
+        "the finest boxes alone give 0.210 ± 0.003 at E = 0.3 (statistical error), against fig2's κ0: agrees "
+        "(z = +2.0); of the 2 energies, they differ from it at E = 0.25 (z = +35.4)"
+    )
+
+
+def test_the_fig6_scale_reading_counts_the_fits_whose_residual_grows_from_the_two_scales():
+    """10⁵ → 10⁶ orbits is 10 times; 20 → 23 and 30 → 31 points gain 1 to 3; the rms grows in one fit of two."""
+
+    def fit(pair, n, points, rms):
+        return {
+            "pair": pair,
+            "model": "homogeneous",
+            "hazard": "paper",
+            "N": n,
+            "n_points": points,
+            "rms_log_residual": rms,
+        }
+
+    docs = {
+        "quick": {"fits": [fit("a", 100_000, 20, 0.5), fit("b", 100_000, 30, 2.0)]},
+        "paper": {"fits": [fit("a", 1_000_000, 23, 0.9), fit("b", 1_000_000, 31, 1.5)]},
+    }
+    text = READINGS["fig6.fit_range"](lambda study, scale: docs[scale])
+    assert text == (
+        "with 10 times the orbits per pair the fits take 1 to 3 more points each, and the rms log residual grows in 1 "
+        "of the 2 fits (pair × model × hazard); it does not grow in b homogeneous (paper)"
+    )

@@ -99,7 +99,12 @@ def test_cmeasure_comparisons_judge_the_unshifted_window_and_keep_the_later_star
         }
     )
     rows, entries = cmeasure_comparisons(table)
-    assert [r["verdict"] for r in rows] == ["consistent with P(t) (|z| ≤ 2)", "differs from P(t)"]
+    # 0.20 ± 0.01 against 0.19 ± 0.01: z = 0.01/√2·100 = 0.71; 0.30 against 0.25: z = 3.54 (the one rule's words)
+    assert [r["verdict"] for r in rows] == ["agrees (z = +0.7)", "differs (z = +3.5)"]
+    assert [(r["paper"], r["paper_err"], r["reference_kind"]) for r in rows] == [
+        (0.19, 0.01, "propagated"),
+        (0.25, 0.01, "propagated"),
+    ]
     assert [r["quantity"] for r in rows] == ["κ from the c-measure (E=0.25)", "κ from the c-measure (E=0.30)"]
     assert entries[0.25]["kappa_cm_later_starts"] == {"+1/kappa": 0.21} and entries[0.30]["kappa_cm_later_starts"] == {}
 
@@ -186,3 +191,24 @@ def test_cmeasure_run_rows_kappa_of_the_crossings_in_each_window_beside_both_rat
         # by one exponential on its window: κ near ln 2
         assert (r["kappa_pt_grid"], r["kappa_pt_grid_err"]) == (0.2, 0.02)
         assert r["kappa_pt_same_run"] == pytest.approx(math.log(2), rel=0.1)
+
+
+def test_rows_of_kappa_from_the_cmeasure_written_before_get_their_reference_and_the_rules_verdict():
+    """A row written with no reference and the old words takes κ from P(t) of its energy's record: 0.150 ± 0.001
+    against 0.145 ± 0.002 is z = 0.005/0.002236 = +2.2 (differs); a row that has its reference is left alone."""
+    from hhscatter.reproduction.fig2 import with_cmeasure_references
+    from hhscatter.reproduction.verdicts import row_verdict
+
+    old = {"quantity": "κ from the c-measure (E=0.27)", "ours": 0.150, "err": 0.001, "paper": None}
+    new = {"quantity": "κ from the c-measure (E=0.30)", "ours": 0.2, "err": 0.01, "paper": 0.21, "paper_err": 0.01}
+    doc = {
+        "cmeasure": {
+            "cm_E0.27": {"energy": 0.27, "kappa_pt_grid": {"value": 0.145, "err": 0.002}},
+            "cm_E0.30": {"energy": 0.30, "kappa_pt_grid": {"value": 9.0, "err": 1.0}},
+        },
+        "paper_comparison": [{**old, "verdict": "consistent with P(t) (|z| ≤ 2)"}, new],
+    }
+    rows = with_cmeasure_references(doc)["paper_comparison"]
+    assert row_verdict(rows[0]) == rows[0]["verdict"] == "differs (z = +2.2)"
+    assert rows[1] == new
+    assert with_cmeasure_references({"paper_comparison": [old]}) == {"paper_comparison": [old]}

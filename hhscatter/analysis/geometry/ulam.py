@@ -214,7 +214,8 @@ def saddle_kappa(tr):
 
 def leading_modes(sub, trapped_sub, k: int = 4):
     """The ``k`` leading eigenvalues of P on the saddle's class and each mode's mass on the boxes
-    ``trapped_sub`` (bool over sub's states): [{eigenvalue, eigenvalue_arg, mass_on_trapped_boxes}].
+    ``trapped_sub`` (bool over sub's states: the censored boxes, whose KAM probe is still inside at its t_max):
+    [{eigenvalue, eigenvalue_arg, mass_on_trapped_boxes}] (the key names the censored boxes as records always have).
 
     Examples
     --------
@@ -742,14 +743,17 @@ def hellinger_row(tab, j):
 
 
 def islands_record(trapped_cells, tr, ids, keep, sub):
-    """Mixed phase space: the finest boxes ``trapped_cells`` (a KAM probe still inside) against the operator on
+    """Mixed phase space: the censored boxes ``trapped_cells`` (finest boxes whose KAM probe is still inside at its
+    t_max, not classified further) against the operator on
     the states ``ids`` of ``tr`` (saddle class ``keep``, ``sub``): their number, their share of the saddle's
-    class, the leading modes' mass on them (:func:`leading_modes`) and κ without them.
+    class, the leading modes' mass on them (:func:`leading_modes`) and κ without them (the keys ``trapped_boxes``,
+    ``trapped_share_of_saddle_class``, ``kappa_without_trapped_boxes`` name the censored boxes, as records always
+    have).
 
     Examples
     --------
-    Boxes 0 and 1 form the saddle (κ = ln 2); box 2 maps onto itself (a KAM island, marked trapped): none of the
-    saddle's class is trapped, and κ without the island is the same.
+    Boxes 0 and 1 form the saddle (κ = ln 2); box 2 maps onto itself (a KAM island, its probe censored): none of the
+    saddle's class is censored, and κ without the island is the same.
 
     >>> tr = tf.Transitions([0, 0, 1, 1, 2], [1, -1, 0, -1, 2], np.ones(5), n_states=3)
     >>> kappa, _, _, keep, sub = saddle_kappa(tr)

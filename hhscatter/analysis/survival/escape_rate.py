@@ -460,7 +460,8 @@ class EscapingTail:
 
     tail        :class:`PowerLawFit` of the algebraic tail of P_esc (None if not detected)
     tau_star    crossover time τ* (time units) of ``exp_fit`` and the tail (NaN without either)
-    n_escaping  orbits that left before t_max;  n_trapped  orbits still inside at t_max
+    n_escaping  orbits that left before t_max;  n_trapped  orbits still inside at t_max (censored; the field keeps
+                its name ``n_trapped``)
     curve       the :class:`SurvivalCurve` P_esc(t) on the analysis grid
     """
 
@@ -506,8 +507,8 @@ def escaping_tail(
 
     Examples
     --------
-    10 % of the orbits never leave (KAM-trapped), 20 % are sticky (P ∝ 5/t after t = 5), the others leave at rate
-    0.5: the trapped ones are set aside and the tail of the escaping ones has z ≈ 1.
+    10 % of the orbits never leave (regular, on KAM tori), 20 % are sticky (P ∝ 5/t after t = 5), the others leave at
+    rate 0.5: the censored ones (still inside at t_max) are set aside and the tail of the escaping ones has z ≈ 1.
 
     >>> rng = np.random.default_rng(0)
     >>> n, t_max = 100_000, 2000.0
@@ -516,7 +517,7 @@ def escaping_tail(
     >>> e = escaping_tail(np.minimum(t, t_max), t < t_max, 1.0)
     >>> round(e.tail.z, 1), e.n_escaping, e.n_trapped
     (1.1, 89758, 10242)
-    >>> int(np.isinf(t).sum()), int(np.sum(np.isfinite(t) & (t >= t_max)))     # trapped, and sticky past t_max
+    >>> int(np.isinf(t).sum()), int(np.sum(np.isfinite(t) & (t >= t_max)))     # never leaving, and sticky past t_max
     (10176, 66)
     """
     t_end = check.numbers(t_end, "t_end", minimum=0.0)

@@ -293,8 +293,9 @@ class RateStatus:
     ----------
     status : str
         'exponential' (one exponential from τ0 on, with the orbits still inside at t_max a negligible share),
-        'trapped' (orbits still inside at t_max are more than ``max_bias`` of P at the window end: the window
-        measures the plateau), 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``),
+        'trapped' (a legacy value, kept because tables and records written before read it: the censored orbits,
+        still inside at t_max, are more than ``max_bias`` of P at the window end: the window measures the
+        plateau), 'non-exponential' (one exponential from τ0 is rejected, p < ``p_reject``),
         'too few orbits' (one exponential from τ0 can be neither accepted nor rejected: the pooled χ² has no
         degree of freedom, :data:`hhscatter.analysis.stats.goodness.TOO_FEW`, or too few orbits to fit it), or
         'empty' (no orbit was still inside after τ0: every one left before the window, which holds no rate).
@@ -323,8 +324,8 @@ def rate_status(
 ) -> RateStatus:
     """rate_status(t_end, observed, tau0, t_stop, max_bias=0.1, p_reject=1e-3) -> RateStatus.
 
-    Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' when
-    the orbits still inside at t_max are more than ``max_bias`` of P(t_stop)
+    Says whether the κ fitted on [τ0, t_stop] (time units) is the escape rate of the population: 'trapped' (the
+    status's legacy value, see the glossary) when the censored orbits, still inside at t_max, are more than ``max_bias`` of P(t_stop)
     (:func:`hhscatter.analysis.survival.kappa_conventions.plateau_check`), 'non-exponential' when one exponential
     from τ0 is rejected (censoring-aware fit, Pearson χ² p < ``p_reject``), 'too few orbits' when that test has
     no verdict (by the pooled χ²'s own rule, :func:`~hhscatter.analysis.stats.goodness.pooled_pearson`: no degree
@@ -357,7 +358,7 @@ def rate_status(
     check.number(p_reject, "p_reject", positive=True)
     nan = math.nan
     f_inf = float((~obs).mean()) if obs.size else math.nan
-    if not (t > tau0).any():  # the whole population left before the window: nothing to call trapped or a rate
+    if not (t > tau0).any():  # the whole population left before the window: no plateau and no rate
         return RateStatus(
             "empty",
             f_inf,

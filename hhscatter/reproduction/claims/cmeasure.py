@@ -31,7 +31,7 @@ def c5_window(p, ec):
 
 
 def cm_sample(runs, label, r):
-    """The c-measure of the conservative run at E = r·E_c (orbits still inside at cm_t_max dropped: KAM-trapped):
+    """The c-measure of the conservative run at E = r·E_c (orbits still inside at cm_t_max, censored, dropped):
     its recording time t_rec = ⌈τ0 + cm_rec_efolds/κ⌉ (κ, τ0 of the run's escaping orbits, fig1's sprinkler rule),
     the return-time sample of Eq. (eqn:kappa_cmeasure_truetime) on [t_rec, cm_t_to − cm_margin] and the first
     crossing at t ≥ t_rec of each orbit (sprinkler points). Returns a dict (κ_cm None with a reason where not)."""
@@ -73,7 +73,7 @@ def cm_sample(runs, label, r):
     # reader drops the rest (the sticky systems' tables are ~10⁷ rows at paper scale)
     sec = runs.sections(key, t_rec)
     out["points"] = first_crossings(sec[sec["traj_id"].isin(esc["traj_id"])], t_rec)
-    out["points_all"] = first_crossings(sec, t_rec)  # the trapped orbits kept: all conservative survivors
+    out["points_all"] = first_crossings(sec, t_rec)  # the censored orbits kept: all conservative survivors
     if not t_to > t_rec:
         out["reason"] = (
             f"t_rec = {t_rec:g} ≥ cm_t_to − cm_margin = {t_to:g} (escaping orbits' τ0 = {res.tau0:.0f}, "
@@ -97,7 +97,7 @@ def cm_sample(runs, label, r):
 def claim2(runs, claims, label, table, samples):
     """κ_cm/κ0 − 1 per cm ratio against κ0 of the claim-1 grid run at that energy (independent orbits), in the
     paper's convention (all orbits, plateau windows) and with the escaping orbits only (like for like with the
-    c-measure, whose KAM-trapped orbits are dropped). Returns the JSON rows."""
+    c-measure, whose censored orbits are dropped). Returns the JSON rows."""
     rows = []
     for r in runs.params.cm_ratios:
         s = samples[r]
@@ -163,7 +163,7 @@ def claim5_distance(runs, claims, label, m, E0, mu, samples):
     dissipative survivors against the c-measures μ_c^{E(t*)} and μ_c^{E0} (sprinkler points of the conservative
     runs: the first crossing after t_rec), paired debiased Hellinger at one box side, half-sampling the orbits of
     every set (one group: the runs share the seed, hence the id space); no cut on any set. Two references: the
-    c-measure proper (orbits still inside at cm_t_max dropped: KAM-trapped) and all conservative survivors (kept).
+    c-measure proper (orbits still inside at cm_t_max, censored, dropped) and all conservative survivors (kept).
     Δ = d(μ_c^{E0}) − d(μ_c^{E(t*)}) > 0: closer to μ_c^{E(t*)}. Returns the JSON record."""
     p = runs.params
     ec = m.critical_energy

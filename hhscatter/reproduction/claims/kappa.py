@@ -77,7 +77,8 @@ def window_rate(lifetimes, p, failure: str):
 
 def kappa_rows(runs, label, m):
     """kappa_rows(runs, label, system) -> (rows, fits): one row per (E/E_c, convention) with κ (1/time), its error,
-    τ0, window, trapped fraction, plateau_bias (the trapped fraction over P at the window's end, which the plateau
+    τ0, window, censored fraction (key ``trapped_fraction``), plateau_bias (the censored fraction over P at the
+    window's end, which the plateau
     check holds to ``p.max_plateau_bias``), t_first (the first escape of the ensemble, which the dead-time check
     compares with τ0), defined and the reason of that convention; fits {r: result of all orbits,
     ('escaping', r): result of the escaping orbits}. Conventions: 'plateau' (all orbits), 'plevel' (P-level
@@ -92,7 +93,7 @@ def kappa_rows(runs, label, m):
         rates["plevel"] = escape_rate_p_levels(
             t_end, obs, p_hi=p.p_levels[0], p_lo=p.p_levels[1], max_bias=p.max_plateau_bias
         )
-        # the escaping orbits only (those still inside at t_max dropped: KAM-trapped, or sticky beyond t_max)
+        # the escaping orbits only (the censored ones dropped: regular, chaotic but confined, or sticky beyond t_max)
         esc = lt[lt["outcome"] != "censored"]
         rates["escaping"], fits["escaping", r], reasons["escaping"] = window_rate(
             esc, p, "window rule failed on the escaping orbits"
