@@ -363,10 +363,6 @@ def _generality_mu_gap(get: Loader) -> str:
     """The share of the gap between the paper's μ and the measured μ on fig3's window that the prediction from the
     conservative ⟨K⟩ covers, (μ_pred − μ_paper)/(μ_meas − μ_paper), its error propagated from the three (the paper's
     μ carries half a unit of its last printed digit), worded by its 2σ interval against 1/2 and 1."""
-<<<<<<< HEAD
-=======
-
->>>>>>> s10-h47b
     d = get("generality", None)
     system = next(iter(d["systems"]))
     win = d["systems"][system]["mu_by_window"]["paper"]
