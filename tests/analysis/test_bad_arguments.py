@@ -1,5 +1,5 @@
 """Bad arguments to the estimators of the paired bootstrap, noise, the chaotic saddle and its checks, and censoring,
-and to the classes of analysis built from numbers (the κ0(E) law, the survival model's parameters, the Kaplan–Meier
+and to the classes of analysis built from numbers (the κ0(E) law, the survival models' parameters, the Kaplan–Meier
 grid) (hypothesis).
 
 Each call gets one argument replaced by a wrong thing (a wrong type, NaN, a negative time or count, an empty array,
@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hhscatter.analysis.dissipative.mixture import MixtureComponents, MixtureModelParams
 from hhscatter.analysis.dissipative.survival_model import SurvivalModelParams
 from hhscatter.analysis.geometry import saddle, saddle_checks
 from hhscatter.analysis.noise import (
@@ -593,3 +594,22 @@ def test_survival_model_params_names_the_bad_argument(data, which):
 @given(grid=st.one_of(NOT_NUMBERS, st.sampled_from([[], [1.0, math.nan], [math.inf], [2.0, 1.0], [1.0, 1.0]])))
 def test_kaplan_meier_grid_names_the_bad_grid(grid):
     _refused("grid", KaplanMeierGrid, grid)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["kappa_of_E", "components", "tau0", "f_ne_k", "P_tau0", "L", "b", "E_c"]))
+def test_mixture_model_params_names_the_bad_argument(data, which):
+    one = np.array([1.0])
+    components = MixtureComponents(5.0, "energy", np.array([0.2, 0.4]), one, one, 0.3 * one, 0.3 * one, 0.9 * one,
+                                   0.01 * one, (5.0, 30.0), 0.01)  # fmt: skip
+    args = {"kappa_of_E": lambda E: np.full(np.shape(E), 0.05), "components": components, "tau0": 5.0,
+            "f_ne_k": 0.1 * one, "P_tau0": 0.5, "L": 0.1, "b": 0.2, "E_c": 1 / 6}  # fmt: skip
+    if which in ("kappa_of_E", "components"):
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers()))
+    elif which == "f_ne_k":
+        args[which] = data.draw(NOT_NUMBERS)
+    elif which in ("tau0", "E_c"):
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(0.0) if which == "E_c" else st.nothing()))
+    else:
+        args[which] = data.draw(NO_NUMBER)
+    _refused(which, MixtureModelParams, **args)
