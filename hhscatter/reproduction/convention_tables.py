@@ -109,7 +109,7 @@ def convention_rows(
 ) -> list[dict]:
     """κ of one run under the two window rules, one row each: ``plateau`` (the windows of ``result``, the run's
     :func:`~hhscatter.analysis.survival.escape_rate.escape_rate`) and ``plevel`` (windows fixed by the P levels
-    p_hi, p_lo); κ is ill-defined (``defined`` False, with its ``reason``) where the trapped fraction biases the slope
+    p_hi, p_lo); κ is ill-defined (``defined`` False, with its ``reason``) where the censored fraction biases the slope
     at the window end by more than ``max_bias``. Rows: windows, n, n_escaped_at_start, kappa (1/time), kappa_err,
     kappa_stat, kappa_spread, t_lo, t_hi, trapped_fraction, bias_at_end, defined, reason.
 
@@ -138,7 +138,7 @@ def convention_rows(
             "kappa_spread": r.kappa_spread,
             "t_lo": r.t_lo,
             "t_hi": r.t_hi,
-            "trapped_fraction": r.trapped_fraction,
+            "trapped_fraction": r.censored_fraction,  # the key of the tables written before
             "bias_at_end": r.bias_at_end,
             "defined": bool(r.defined),
             "reason": r.reason,

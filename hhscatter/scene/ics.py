@@ -184,9 +184,9 @@ def _column(table, name, kind) -> np.ndarray:
 def check_ics(scene: Scene, states: np.ndarray) -> None:
     """check_ics(scene, states) -> None; ConfigError before any work if a table row cannot be run honestly.
 
-    Bounds (the reasons of :mod:`hhscatter.scene.scene`): every row's position within R_ESC_MAX ω²/λ of the
-    origin and energy H = |p|²/2 + V ≤ E0_MAX·E_c (energy conservation, overflow). Rows below E_c inside
-    Ω (r < r_esc) in a dissipative scene are refused: drag only lowers the energy, so such an orbit can
+    Bounds (the reasons of :mod:`hhscatter.scene.scene`): every row's position within R_ESC_MAX r_s of the
+    origin (r_s the system's saddle radius) and energy H = |p|²/2 + V ≤ E0_MAX·E_c (energy conservation,
+    overflow). Rows below E_c inside Ω (r < r_esc) in a dissipative scene are refused: drag only lowers the energy, so such an orbit can
     neither escape nor cross E = E_c from above: it has "settled" before it starts, and none of the
     outcomes (whose settling time is the root of E = E_c) describes it. Conservative rows below E_c are
     fine: they stay inside Ω and are censored at t_max, which is the correct outcome.
@@ -199,8 +199,8 @@ def check_ics(scene: Scene, states: np.ndarray) -> None:
     if far.any():
         i = int(np.argmax(far))
         raise ConfigError(
-            f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} ω²/λ (first: row {i}, "
-            f"r = {r[i]:.3g}); energy conservation fails that far out"
+            f"ics: {int(far.sum())} row(s) start beyond r = {R_ESC_MAX:g} r_s = {R_ESC_MAX * m.saddle_radius:g} "
+            f"(first: row {i}, r = {r[i]:.3g}); energy conservation fails that far out"
         )
     with np.errstate(over="ignore", invalid="ignore"):
         e = m.energy(x, y, px, py)

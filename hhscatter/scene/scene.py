@@ -37,8 +37,9 @@ from hhscatter.scene.recording import (
 TOL_RANGE = (1e-18, 1e-6)
 
 # Upper bounds, each with its reason (checked before any work; hhscatter.scene.scene.Scene._validate):
-#: r_esc ≤ R_ESC_MAX · r_s (r_s the saddle distance, ω²/λ for Hénon–Heiles): far out |V| ≈ λr³/3 ≫ E, and the energy error of the escape decision grows like
-#: tol·λr³/E (cancellation between kinetic and potential energy): 2e-4 at r = 1e4 already.
+#: r_esc ≤ R_ESC_MAX · r_s (r_s the system's saddle distance): far out |V| ≫ E, and the energy error of the escape
+#: decision grows like tol·|V|/E (cancellation between kinetic and potential energy): for a cubic |V| ≈ r³/3 at
+#: E ≈ 0.2, 2e-4 at r = 1e4 already.
 #: r_far ≤ R_FAR_MAX · r_s: an escaped orbit is only followed on towards its blow-up; outcomes and times are
 #: checked not to change up to r_far = 1e8 (a stress benchmark), not beyond
 R_ESC_MAX, R_FAR_MAX = 100.0, 1e8

@@ -1,5 +1,6 @@
-"""Bad arguments to the estimators of the paired bootstrap, noise, the chaotic saddle and its checks, and censoring
-(hypothesis).
+"""Bad arguments to the estimators of the paired bootstrap, noise, the chaotic saddle and its checks, and censoring,
+and to the classes of analysis built from numbers (the κ0(E) law, the survival models' parameters, the Kaplan–Meier
+grid) (hypothesis).
 
 Each call gets one argument replaced by a wrong thing (a wrong type, NaN, a negative time or count, an empty array,
 a mismatched length, a window outside the data) and must refuse with a ConfigError that names that argument,
@@ -18,6 +19,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hhscatter.analysis.dissipative.mixture import MixtureComponents, MixtureModelParams
+from hhscatter.analysis.dissipative.survival_model import SurvivalModelParams
 from hhscatter.analysis.geometry import saddle, saddle_checks
 from hhscatter.analysis.noise import (
     energy_diffusion_rate,
@@ -38,7 +41,9 @@ from hhscatter.analysis.noise import (
     window_constancy,
 )
 from hhscatter.analysis.survival.escape_rate import escape_rate_mle
+from hhscatter.analysis.survival.kaplan_meier import KaplanMeierGrid
 from hhscatter.analysis.survival.kappa_conventions import censored_fraction
+from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
 from hhscatter.analysis.survival.paired import paired_bootstrap_ratio
 from hhscatter.errors import ConfigError
 from hhscatter.model import HenonHeiles
@@ -545,3 +550,66 @@ def test_escape_rate_mle_names_the_bad_argument(data, which):
     else:
         args[which] = data.draw(NOT_A_NUMBER)
     _refused(which, escape_rate_mle, **args)
+
+
+# -- classes built from numbers -----------------------------------------------------------------------------------
+LAW = {"E_c": 0.25, "a2": 2.0, "a1": 0.5, "slope": 3.0, "E_switch": 0.4}
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(sorted(LAW)))
+def test_piecewise_kappa_names_the_bad_argument(data, which):
+    args = dict(LAW, **{which: data.draw(NOT_A_NUMBER)})
+    _refused(which, PiecewiseKappa, **args)
+
+
+@PROFILE
+@given(E_switch=st.floats(-1.0, 0.25))
+def test_piecewise_kappa_needs_a_switch_above_the_critical_energy(E_switch):
+    _refused("E_switch", PiecewiseKappa, **dict(LAW, E_switch=E_switch))
+
+
+#: the survival model's parameters (a constant κ0); NaN may stand where the model lets it (a value not measured)
+MODEL = {"E0": 0.3, "mu": 0.91, "gamma": 0.01, "tau0": 5.0, "tau2": 30.0, "f_ne": 0.1, "f_e": 0.4, "L": 0.1, "b": 0.2,
+         "E_c": 1 / 6}  # fmt: skip
+NO_NUMBER = st.one_of(st.none(), st.booleans(), st.text(max_size=4), st.just([1.0]))
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["kappa_of_E", *MODEL, "hazard"]))
+def test_survival_model_params_names_the_bad_argument(data, which):
+    args = dict(MODEL, kappa_of_E=lambda E: np.full(np.shape(E), 0.05))
+    if which == "kappa_of_E":
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers()))
+    elif which == "hazard":
+        args[which] = data.draw(st.one_of(st.none(), st.text(max_size=4), st.integers()))
+    elif which in ("tau0", "E_c"):
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(0.0) if which == "E_c" else st.nothing()))
+    else:  # tau2 = None stands for the predicted τ2
+        args[which] = data.draw(NO_NUMBER.filter(lambda v: v is not None) if which == "tau2" else NO_NUMBER)
+    _refused(which, SurvivalModelParams, **args)
+
+
+@PROFILE
+@given(grid=st.one_of(NOT_NUMBERS, st.sampled_from([[], [1.0, math.nan], [math.inf], [2.0, 1.0], [1.0, 1.0]])))
+def test_kaplan_meier_grid_names_the_bad_grid(grid):
+    _refused("grid", KaplanMeierGrid, grid)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["kappa_of_E", "components", "tau0", "f_ne_k", "P_tau0", "L", "b", "E_c"]))
+def test_mixture_model_params_names_the_bad_argument(data, which):
+    one = np.array([1.0])
+    components = MixtureComponents(5.0, "energy", np.array([0.2, 0.4]), one, one, 0.3 * one, 0.3 * one, 0.9 * one,
+                                   0.01 * one, (5.0, 30.0), 0.01)  # fmt: skip
+    args = {"kappa_of_E": lambda E: np.full(np.shape(E), 0.05), "components": components, "tau0": 5.0,
+            "f_ne_k": 0.1 * one, "P_tau0": 0.5, "L": 0.1, "b": 0.2, "E_c": 1 / 6}  # fmt: skip
+    if which in ("kappa_of_E", "components"):
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.integers()))
+    elif which == "f_ne_k":
+        args[which] = data.draw(NOT_NUMBERS)
+    elif which in ("tau0", "E_c"):
+        args[which] = data.draw(st.one_of(NOT_A_NUMBER, st.just(0.0) if which == "E_c" else st.nothing()))
+    else:
+        args[which] = data.draw(NO_NUMBER)
+    _refused(which, MixtureModelParams, **args)

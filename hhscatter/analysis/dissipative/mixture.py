@@ -321,6 +321,20 @@ def mixture_components(
     )
 
 
+def _check_mixture(kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c, hazard, f_ne_name="f_ne"):
+    """The checks of the mixture model's parameters (a ConfigError naming the first wrong one); the components."""
+    check.function(kappa_of_E, "kappa_of_E")
+    c = check.instance(components, "components", MixtureComponents)
+    check.number(tau0, "tau0")
+    check.floats(f_ne, f_ne_name)
+    for value, name in ((P_tau0, "P_tau0"), (L, "L"), (b, "b")):
+        check.real(value, name)
+    check.number(E_c, "E_c", positive=True)
+    if hazard not in HAZARDS:
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    return c
+
+
 def mixture_survival_model(
     t,
     *,
@@ -363,15 +377,7 @@ def mixture_survival_model(
     ([0.2878, 0.2663, 0.0029], True)
     """
     check.numbers(t, "t", min_size=0)
-    check.function(kappa_of_E, "kappa_of_E")
-    c = check.instance(components, "components", MixtureComponents)
-    check.number(tau0, "tau0")
-    check.floats(f_ne, "f_ne")
-    for value, name in ((P_tau0, "P_tau0"), (L, "L"), (b, "b")):
-        check.real(value, name)
-    check.number(E_c, "E_c", positive=True)
-    if hazard not in HAZARDS:
-        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    c = _check_mixture(kappa_of_E, components, tau0, f_ne, P_tau0, L, b, E_c, hazard)
     if tau2 is not None:
         check.floats(tau2, "tau2")
     f_ne = np.broadcast_to(np.asarray(f_ne, dtype=float), (c.K,))
@@ -388,7 +394,9 @@ def mixture_survival_model(
 
 @dataclass(frozen=True)
 class MixtureModelParams:
-    """All inputs of :func:`mixture_survival_model`; calling it evaluates P(t)."""
+    """All inputs of :func:`mixture_survival_model`; calling it evaluates P(t). The inputs are checked as
+    :func:`mixture_survival_model` checks them, when the parameters are built: a wrong one is refused with a
+    ConfigError naming it."""
 
     kappa_of_E: Callable
     components: MixtureComponents
@@ -399,6 +407,10 @@ class MixtureModelParams:
     b: float
     E_c: float
     hazard: str = "paper"
+
+    def __post_init__(self):
+        _check_mixture(self.kappa_of_E, self.components, self.tau0, self.f_ne_k, self.P_tau0, self.L, self.b,
+                       self.E_c, self.hazard, f_ne_name="f_ne_k")  # fmt: skip
 
     @property
     def tau2_k(self):

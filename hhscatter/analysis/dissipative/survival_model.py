@@ -143,6 +143,19 @@ def _component(t, kappa_of_E, A, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
 # ---------------------------------------------------------------------------
 # homogeneous model
 # ---------------------------------------------------------------------------
+def _check_model(kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard) -> None:
+    """The checks of the homogeneous model's parameters (a ConfigError naming the first wrong one)."""
+    check.function(kappa_of_E, "kappa_of_E")
+    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma"), (f_ne, "f_ne"), (f_e, "f_e"), (L, "L"), (b, "b")):
+        check.real(value, name)
+    check.number(tau0, "tau0")
+    if tau2 is not None:
+        check.real(tau2, "tau2")
+    check.number(E_c, "E_c", positive=True)
+    if hazard not in HAZARDS:
+        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+
+
 def survival_model(
     t,
     *,
@@ -187,15 +200,7 @@ def survival_model(
     (True, True, True)
     """
     check.numbers(t, "t", min_size=0)
-    check.function(kappa_of_E, "kappa_of_E")
-    for value, name in ((E0, "E0"), (mu, "mu"), (gamma, "gamma"), (f_ne, "f_ne"), (f_e, "f_e"), (L, "L"), (b, "b")):
-        check.real(value, name)
-    check.number(tau0, "tau0")
-    if tau2 is not None:
-        check.real(tau2, "tau2")
-    check.number(E_c, "E_c", positive=True)
-    if hazard not in HAZARDS:
-        raise ConfigError(f"hazard must be one of {HAZARDS}, got {hazard!r}")
+    _check_model(kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, E_c, hazard)
     if tau2 is None:
         tau2 = tau2_predicted(E0, E_c, mu, gamma)
     out = _component(t, kappa_of_E, E0, mu, gamma, tau0, tau2, f_ne, f_e, L, b, hazard)
@@ -236,7 +241,25 @@ def survival_model_sample(t, n_orbits: int, *, seed: int = 0, **model) -> tuple[
 
 @dataclass(frozen=True)
 class SurvivalModelParams:
-    """All inputs of :func:`survival_model`; calling it evaluates P(t)."""
+    """All inputs of :func:`survival_model`; calling it evaluates P(t).
+
+    The inputs are checked as :func:`survival_model` checks them, when the parameters are built: a wrong one is
+    refused with a ConfigError naming it.
+
+    Examples
+    --------
+    A constant κ0 = 0.05 (1/time) with τ2 = 30: at τ0 = 5 the model is f_ne + f_e = 0.5.
+
+    >>> params = SurvivalModelParams(lambda E: np.full(np.shape(E), 0.05), E0=0.3, mu=0.91, gamma=0.01, tau0=5.0,
+    ...                              tau2=30.0, f_ne=0.1, f_e=0.4, L=0.1, b=0.2, E_c=1 / 6)
+    >>> round(float(params(5.0)), 12)
+    0.5
+    >>> SurvivalModelParams(lambda E: E, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, tau2=30.0, f_ne=0.1, f_e=0.4,
+    ...                     L=0.1, b=0.2, E_c=True)
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: E_c must be a finite number, got True
+    """
 
     kappa_of_E: Callable
     E0: float
@@ -250,6 +273,10 @@ class SurvivalModelParams:
     b: float
     E_c: float
     hazard: str = "paper"
+
+    def __post_init__(self):
+        _check_model(self.kappa_of_E, self.E0, self.mu, self.gamma, self.tau0, self.tau2, self.f_ne, self.f_e,
+                     self.L, self.b, self.E_c, self.hazard)  # fmt: skip
 
     def __call__(self, t):
         return survival_model(

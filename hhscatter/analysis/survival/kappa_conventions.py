@@ -46,7 +46,11 @@ from hhscatter.errors import ConfigError
 
 @dataclass(frozen=True)
 class ConventionRate(WithErrors):
-    """κ of one convention at one energy (1/time); ``defined`` False with a ``reason`` when ill-defined."""
+    """κ of one convention at one energy (1/time); ``defined`` False with a ``reason`` when ill-defined.
+
+    ``censored_fraction`` is the fraction of orbits still inside at the end (censored: regular, or chaotic but
+    not yet out; not classified), of all.
+    """
 
     method = "plateau windows of one convention"
 
@@ -56,10 +60,16 @@ class ConventionRate(WithErrors):
     kappa_spread: float
     t_lo: float
     t_hi: float
-    trapped_fraction: float
+    censored_fraction: float
     bias_at_end: float  # f∞/P(t_hi): relative underestimate of the local slope at the window end
     defined: bool
     reason: str = ""
+
+    @property
+    def trapped_fraction(self) -> float:
+        """The name of :attr:`censored_fraction` before the survivors' vocabulary (kept so that callers do not
+        break)."""
+        return self.censored_fraction
 
 
 def _levels(p_hi, p_lo) -> None:
@@ -301,7 +311,7 @@ def plateau_rate(result, t_end, observed, *, max_bias: float = 0.1) -> Conventio
     >>> t = np.where(rng.random(20000) < 0.3, np.inf, rng.exponential(10.0, 20000))    # 30 % never escape
     >>> t_end, observed = np.minimum(t, 100.0), t < 100.0
     >>> r = plateau_rate(escape_rate(t_end, observed), t_end, observed)
-    >>> round(r.kappa, 3), r.defined, r.trapped_fraction, round(r.bias_at_end, 2)
+    >>> round(r.kappa, 3), r.defined, r.censored_fraction, round(r.bias_at_end, 2)
     (0.029, False, 0.29245, 0.75)
 
     The window rule found a "κ" far below 0.1 on the flattening P(t); the check refuses it: at the window's end the

@@ -13,6 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hhscatter.analysis.stats import _arguments as check
+from hhscatter.errors import ConfigError
+
 __all__ = ["PiecewiseKappa"]
 
 
@@ -31,7 +34,9 @@ class PiecewiseKappa:
     (1/(time·energy)) and E_switch (energy) are the coefficients of a fit
     (:func:`~hhscatter.analysis.survival.kappa_energy.fit_kappa_energy`) or of a reference; all are required.
     Calling it on an array returns an array (rates in 1/time).  The two branches need not join at E_switch:
-    E_switch belongs to the linear branch.
+    E_switch belongs to the linear branch, and E_switch > E_c is required (else the quadratic branch is empty).
+    Every argument must be a finite number (no bool, NaN or inf); a wrong one is refused with a ConfigError naming
+    it.
 
     Examples
     --------
@@ -41,6 +46,10 @@ class PiecewiseKappa:
     >>> law = PiecewiseKappa(E_c=0.25, a2=2.0, a1=0.5, slope=3.0, E_switch=0.4)
     >>> law([0.2, 0.3, 0.5]).round(12).tolist()
     [0.0, 0.03, 0.75]
+    >>> PiecewiseKappa(E_c=0.25, a2=2.0, a1=0.5, slope=3.0, E_switch=0.2)
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: E_switch must be > E_c (the quadratic branch lies between them), got 0.2 ≤ 0.25
     """
 
     E_c: float
@@ -48,6 +57,14 @@ class PiecewiseKappa:
     a1: float
     slope: float
     E_switch: float
+
+    def __post_init__(self):
+        for name in ("E_c", "a2", "a1", "slope", "E_switch"):
+            check.number(getattr(self, name), name)
+        if not self.E_switch > self.E_c:
+            raise ConfigError(
+                f"E_switch must be > E_c (the quadratic branch lies between them), got {self.E_switch!r} ≤ {self.E_c!r}"
+            )
 
     def __call__(self, E):
         E = np.asarray(E, dtype=float)

@@ -299,8 +299,8 @@ class RateStatus:
         'too few orbits' (one exponential from τ0 can be neither accepted nor rejected: the pooled χ² has no
         degree of freedom, :data:`hhscatter.analysis.stats.goodness.TOO_FEW`, or too few orbits to fit it), or
         'empty' (no orbit was still inside after τ0: every one left before the window, which holds no rate).
-    trapped_fraction : float
-        Orbits still inside at the end (censored), of all.
+    censored_fraction : float
+        Orbits still inside at the end (censored), of all (``trapped_fraction``, its name before, reads it too).
     p_inf, p_inf_err, kappa_inf, kappa_inf_err : float
         The plateau-plus-exponential fit from τ0 (:func:`fit_plateau_exponential`); NaN where it fails.
     p_value : float
@@ -310,13 +310,19 @@ class RateStatus:
     """
 
     status: str
-    trapped_fraction: float
+    censored_fraction: float
     p_inf: float
     p_inf_err: float
     kappa_inf: float
     kappa_inf_err: float
     p_value: float
     note: str
+
+    @property
+    def trapped_fraction(self) -> float:
+        """The name of :attr:`censored_fraction` before the survivors' vocabulary (kept so that callers do not
+        break)."""
+        return self.censored_fraction
 
 
 def rate_status(

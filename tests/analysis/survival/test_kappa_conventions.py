@@ -63,9 +63,9 @@ def test_p_level_rate_covers_the_true_kappa():
     assert abs(hits - p * n_rep) <= 3 * math.sqrt(n_rep * p * (1 - p)) + 1
 
 
-def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
+def test_a_censored_plateau_makes_kappa_ill_defined_instead_of_small():
     """With 6.5 % never escaping (square ICs at E = 0.18) P never reaches 1 %: no κ; our window rule's κ is
-    flagged when its window ends on the plateau; without trapped orbits both are defined."""
+    flagged when its window ends on the plateau; without censored orbits both are defined."""
     kappa = 0.1
     t, obs = _lifetimes(kappa, 20000, f_censored=0.065, seed=3)
     assert censored_fraction(t, obs) == pytest.approx(0.065, abs=0.005)
@@ -76,6 +76,8 @@ def test_a_trapped_plateau_makes_kappa_ill_defined_instead_of_small():
     P_end = float(np.interp(res.t_stop, res.curve.t, res.curve.P))
     assert pr.defined == (0.065 / P_end <= 0.1)
     assert pr.bias_at_end == pytest.approx(censored_fraction(t, obs) / P_end)
+    # the fraction is the censored one, under its name and under the name before (callers of that name still read it)
+    assert pr.censored_fraction == pr.trapped_fraction == censored_fraction(t, obs) == r.censored_fraction
     t0, obs0 = _lifetimes(kappa, 20000, seed=3)
     assert (
         escape_rate_p_levels(t0, obs0).defined

@@ -101,7 +101,7 @@ def test_nothing_censored_gives_the_single_exponential_without_overflow():
 def test_rate_status_of_uncensored_exponentials_is_exponential(seed):
     t = np.random.default_rng(seed).exponential(5.0, 600)
     st = rate_status(t, np.ones(t.size, bool), 1.0, 15.0)
-    assert st.status == "exponential" and st.trapped_fraction == 0.0 and st.note == ""
+    assert st.status == "exponential" and st.censored_fraction == 0.0 and st.note == ""
     assert st.p_inf == 0.0 and math.isfinite(st.kappa_inf)
 
 
