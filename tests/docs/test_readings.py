@@ -1086,3 +1086,19 @@ def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_ag
         "r_esc = 1.03 lies inside the exits' Lyapunov orbits (an orbit crossing it may come back) at E = 0.30; "
         "cuts them at E = 0.25; lies beyond them at E = 0.17"
     )
+
+
+def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_run():
+    """With the key at every point: the counts summed (1 590 + 10 of 1 590 + 12); without it: the earlier run and
+    the orbits λ̄ rests on, from the smallest count to the largest."""
+
+    def point(same=None, sel=None, n=None):
+        p = {"lyapunov": 0.2, "lyapunov_detail": {"n_orbits": n}}
+        return p | ({"tangent_same_orbits": {"same_t_end": same, "selected": sel}} if sel is not None else {})
+
+    new = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(1590, 1590), point(10, 12)]}}))
+    assert new == "the tangent run ended 1 600 of 1 602 selected orbits at the main run's t_end (over its 2 points)"
+    old = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(n=18), point(n=1500)]}}))
+    assert old.startswith("these numbers come from an earlier tangent run") and old.endswith(
+        "from 18 to 1 500 per point"
+    )
