@@ -1646,15 +1646,15 @@ def _saddle_tangent_orbits(get: Loader) -> str:
     if len(checked) == len(pts):
         same, sel = sum(c["same_t_end"] for c in checked), sum(c["selected"] for c in checked)
         where = "" if len(pts) == 1 else f" (over its {len(pts)} points)"
-        return f"the tangent run ended {same:,} of {sel:,} selected orbits at the main run's t_end{where}".replace(
+        return f"at this scale the tangent run ended {same:,} of {sel:,} selected orbits at the main run's t_end{where}".replace(
             ",", " "
         )
     kept = [int((p.get("lyapunov_detail") or {}).get("n_orbits") or 0) for p in pts]
     lo, hi = (f"{k:,}".replace(",", " ") for k in (min(kept), max(kept)))
     span = lo if lo == hi else f"from {lo} to {hi}"
     return (
-        "these numbers come from an earlier tangent run, whose tangent vector entered the step-size control and "
-        f"so followed other orbits than the selected ones: λ̄ rests on the orbits that run kept, {span} per point"
+        "this scale's numbers come from an earlier tangent run, whose tangent vector entered the step-size control "
+        f"and so followed other orbits than the selected ones; λ̄ rests on the orbits that run kept, {span} per point"
     )
 
 

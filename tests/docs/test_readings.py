@@ -1097,8 +1097,11 @@ def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_ru
         return p | ({"tangent_same_orbits": {"same_t_end": same, "selected": sel}} if sel is not None else {})
 
     new = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(1590, 1590), point(10, 12)]}}))
-    assert new == "the tangent run ended 1 600 of 1 602 selected orbits at the main run's t_end (over its 2 points)"
+    assert (
+        new
+        == "at this scale the tangent run ended 1 600 of 1 602 selected orbits at the main run's t_end (over its 2 points)"
+    )
     old = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(n=18), point(n=1500)]}}))
-    assert old.startswith("these numbers come from an earlier tangent run") and old.endswith(
+    assert old.startswith("this scale's numbers come from an earlier tangent run") and old.endswith(
         "from 18 to 1 500 per point"
     )
