@@ -330,7 +330,7 @@ def stretch_beyond(log_stretch) -> int:
     """stretch_beyond(log_stretch) -> how many of the log-stretches Λ (array, any shape) exceed
     :data:`MAX_LOG_STRETCH` (600) or are not finite: the orbits whose steps the tangent vector may have set.
 
-    >>> stretch_beyond([0.0, 599.9, 600.5, float("nan")])
+    >>> stretch_beyond([0.0, 599.9, 600.5, 1e400])   # 1e400: an overflowed Λ
     2
     """
     a = np.asarray(log_stretch, dtype=float)
