@@ -224,6 +224,14 @@ def _check(ta, rules):
     for lane, res in enumerate(ta.propagate_res):
         steps += res[3]
         if res[0] == hy.taylor_outcome.err_nf_state:
+            if rules.tan0 is not None and not np.all(
+                np.isfinite(np.asarray(rules._s)[rules._tan_at + lane :: rules.B][:4])
+            ):
+                raise FloatingPointError(
+                    f"the tangent vector of the orbit in lane {lane} overflowed a double: its log-stretch Λ passed "
+                    f"≈ 1375 (Λ is guaranteed to leave the orbit unchanged up to {events.MAX_LOG_STRETCH:g}); "
+                    "a shorter t_max keeps it below"
+                )
             raise FloatingPointError(
                 f"non-finite state in lane {lane}; this is a bug: escaping orbits must be stopped by the "
                 "engine's events"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from hhscatter.integrate import events, heyoka_log
@@ -32,6 +34,12 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     ``progress``: a callable f(k), called with k = PROGRESS_EVERY each time
     that many more orbits of the chunk have started, so long chunks show
     progress.
+
+    With the tangent dynamics, the orbits whose log-stretch Λ at t_end exceeds
+    :data:`hhscatter.integrate.events.MAX_LOG_STRETCH` are counted (``ChunkResult.tangent_beyond``) and warned of
+    (:class:`hhscatter.integrate.events.TangentStretchWarning`): a finite Λ is kept, a non-finite one (the vector
+    overflowed) is written as NaN; a tangent vector that makes heyoka's state non-finite stops the chunk with a
+    FloatingPointError that says so.
 
     heyoka's log is captured while the chunk runs (:mod:`hhscatter.integrate.heyoka_log`): an event whose root
     finding failed in a step is ignored there by heyoka, so every such failure is counted
@@ -69,6 +77,20 @@ def run_chunk(scene, ics, traj_ids, *, batch_size=None, count_steps=False, progr
     if outside.any():  # region 'square' (or an IC table): escaped at t = 0, not integrated
         res = _with_escaped_at_start(scene, ics, traj_ids, outside, res)
     res.event_failures, res.redone = failures, redone
+    if "log_stretch" in res.lifetimes:  # the tangent dynamics: orbits whose Λ passed MAX_LOG_STRETCH, counted
+        lam = res.lifetimes["log_stretch"]
+        bad = ~np.isfinite(lam)
+        lam[bad] = np.nan  # a tangent vector that overflowed: no log-stretch
+        res.tangent_beyond = events.stretch_beyond(lam)
+        if res.tangent_beyond:
+            warnings.warn(
+                f"{res.tangent_beyond} of {len(ics)} orbit(s) reached a log-stretch Λ above "
+                f"{events.MAX_LOG_STRETCH:g} ({int(bad.sum())} of them not finite, written as NaN): their tangent "
+                "vector may have set steps, their orbits are not guaranteed to be those of the scene without the "
+                "tangent dynamics (a shorter t_max keeps Λ below it)",
+                events.TangentStretchWarning,
+                stacklevel=2,
+            )
     return res
 
 

@@ -311,18 +311,49 @@ TANGENT_SLOTS = 4
 #: δq's Taylor coefficients stay normal doubles (ν ≈ 10⁻²⁸⁹); a power of two makes e^Λ = |δq|/ν exact.
 TANGENT_NORM = 2.0**-960
 
-#: the largest log-stretch Λ an orbit may accumulate with its steps still those of the flow alone
+#: the largest log-stretch Λ an orbit may accumulate with its steps still those of the flow alone. Beyond it
+#: δq starts to enter the step control (the orbit is no longer guaranteed to be the one of the scene without the
+#: tangent dynamics): such orbits are counted and warned of (:func:`stretch_beyond`, :class:`TangentStretchWarning`).
+#: Near Λ ≈ 1374 ν e^Λ overflows a double: the integration stops there with a FloatingPointError that says so.
 MAX_LOG_STRETCH = 600.0
+
+#: the scale by which a tangent vector whose norm overflows a double is read (a power of two: exact)
+_READ_SCALE = 2.0**-64
+
+
+class TangentStretchWarning(RuntimeWarning):
+    """Orbits whose log-stretch Λ passed :data:`MAX_LOG_STRETCH`: their Λ is kept, but their steps are no longer
+    guaranteed to be those of the scene without the tangent dynamics."""
+
+
+def stretch_beyond(log_stretch) -> int:
+    """stretch_beyond(log_stretch) -> how many of the log-stretches Λ (array, any shape) exceed
+    :data:`MAX_LOG_STRETCH` (600) or are not finite: the orbits whose steps the tangent vector may have set.
+
+    >>> stretch_beyond([0.0, 599.9, 600.5, 1e400])   # 1e400: an overflowed Λ
+    2
+    """
+    a = np.asarray(log_stretch, dtype=float)
+    return int(np.count_nonzero(~(a <= MAX_LOG_STRETCH)))
 
 
 def log_stretch(dx, dy, dpx, dpy) -> float:
     """log_stretch(δx, δy, δp_x, δp_y) -> Λ = ln(|δq|/ν), the log-stretch of a tangent vector started at the norm
-    ν = :data:`TANGENT_NORM` (any float type; the result a float).
+    ν = :data:`TANGENT_NORM` (any float type; the result a float). Finite components give a finite Λ, even where
+    |δq| itself would overflow a double (Λ up to ≈ 1375).
 
     >>> log_stretch(TANGENT_NORM, 0.0, 0.0, 0.0), round(log_stretch(0.0, 3 * TANGENT_NORM, 0.0, 4 * TANGENT_NORM), 12)
     (0.0, 1.609437912434)
+    >>> big = 1.5e308   # |δq| = √2·1.5e308 overflows; Λ = ln(√2·1.5e308) + 960 ln 2
+    >>> round(log_stretch(big, big, 0.0, 0.0) - (math.log(math.sqrt(2) * 1.5) + 308 * math.log(10) + 960 * math.log(2)), 9)
+    0.0
     """
-    return math.log(math.hypot(float(dx), float(dy), float(dpx), float(dpy)) / TANGENT_NORM)
+    r = math.hypot(float(dx), float(dy), float(dpx), float(dpy))
+    if math.isinf(r):  # components finite, the norm beyond the largest double: read at a scale
+        s = _READ_SCALE
+        h = math.hypot(float(dx) * s, float(dy) * s, float(dpx) * s, float(dpy) * s)
+        return math.log(h) - math.log(s) - math.log(TANGENT_NORM)
+    return math.log(r / TANGENT_NORM)
 
 
 def tangent_start(scene, ics) -> np.ndarray:
@@ -538,6 +569,8 @@ __all__ = [
     "tangent_equations",
     "tangent_start",
     "MAX_LOG_STRETCH",
+    "stretch_beyond",
+    "TangentStretchWarning",
     "TANGENT_NORM",
     "TANGENT_SLOTS",
 ]

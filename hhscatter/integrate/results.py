@@ -24,6 +24,7 @@ class ChunkResult:
     n_steps: int = 0
     event_failures: int = 0  # heyoka's event-detection failures logged while the chunk ran (each one redone)
     redone: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))  # traj_ids redone on the reference
+    tangent_beyond: int = 0  # orbits whose log-stretch Λ passed events.MAX_LOG_STRETCH (the tangent dynamics)
 
     def tables(self) -> dict:
         return {

@@ -1810,6 +1810,31 @@ def _saddle_lambda_offset(get: Loader) -> str:
     return ". ".join(parts) if parts else "no point of this scale has a 1/T fit"
 
 
+def _saddle_tangent_orbits(get: Loader) -> str:
+    """Whether λ̄'s tangent run followed the selected orbits: with the key ``tangent_same_orbits`` (per point: the
+    selected orbits and those the tangent run ended at the main run's t_end) the counts summed over the points;
+    without it (a scale made before that check) the tangent run was the earlier one, which followed other
+    orbits, and λ̄ rests on the orbits it kept (``lyapunov_detail.n_orbits`` per point)."""
+    d = get("saddle", None)
+    pts = [p for p in d["saddle"] if p.get("lyapunov") is not None]
+    if not pts:
+        return "no point of this scale has λ̄"
+    checked = [p["tangent_same_orbits"] for p in pts if p.get("tangent_same_orbits")]
+    if len(checked) == len(pts):
+        same, sel = sum(c["same_t_end"] for c in checked), sum(c["selected"] for c in checked)
+        where = "" if len(pts) == 1 else f" (over its {len(pts)} points)"
+        return f"at this scale the tangent run ended {same:,} of {sel:,} selected orbits at the main run's t_end{where}".replace(
+            ",", " "
+        )
+    kept = [int((p.get("lyapunov_detail") or {}).get("n_orbits") or 0) for p in pts]
+    lo, hi = (f"{k:,}".replace(",", " ") for k in (min(kept), max(kept)))
+    span = lo if lo == hi else f"from {lo} to {hi}"
+    return (
+        "this scale's numbers come from an earlier tangent run, whose tangent vector entered the step-size control "
+        f"and so followed other orbits than the selected ones; λ̄ rests on the orbits that run kept, {span} per point"
+    )
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1867,6 +1892,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.finest": _operator_finest,
     "fig6.fit_range": _fig6_fit_range,
     "saddle.lambda_offset": _saddle_lambda_offset,
+    "saddle.tangent_orbits": _saddle_tangent_orbits,
 }
 
 

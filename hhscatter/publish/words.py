@@ -8,11 +8,15 @@ words the studies write now, so that a row keeps one name at every scale (the pa
 quick-scale rows by name) and no page says "trapped" for a censored orbit. The benchmarks' summaries are read through
 it too (the stress cases' orbits still inside at t = 5000 were "KAM-trapped"). The dissipative mixture's share of
 a sub-ensemble that never escapes (it settles) was its "trapped fraction φ" (or "trapped fractions f_ne,k"); it is
-read as the glossary names φ and f_ne, the never-escaping share. The JSON keys stay as they are
+read as the glossary names φ and f_ne, the never-escaping share. The neighbour dimension estimator's refusal of a
+scaling range ("fewer than 4 neighbour scales in [eps_min, eps_max] = [..]") is read as a point's reason for no d₁,
+with units and what the range is (:func:`hhscatter.reproduction.saddle_records.d1_refusal_words`). The JSON keys stay as they are
 (``trapped_fraction``, ``n_trapped`` …): readers use them.
 """
 
 from __future__ import annotations
+
+from hhscatter.reproduction.saddle_records import d1_refusal_words
 
 __all__ = ["OLD_PHRASES", "in_glossary_words"]
 
@@ -38,7 +42,7 @@ def _reworded(text: str) -> str:
     for old, new in OLD_PHRASES:
         if old in text:
             text = text.replace(old, new)
-    return text
+    return d1_refusal_words(text)  # the neighbour estimator's raw refusal, said as a point's reason for no d₁
 
 
 def in_glossary_words(doc):

@@ -26,6 +26,7 @@ Examples
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from hhscatter.errors import ConfigError
 __all__ = [
     "ERR_PARTS",
     "d1_error_record",
+    "d1_refusal_words",
     "d1_precision",
     "dimension_row",
     "dimension_summary",
@@ -558,3 +560,50 @@ def gap_summary(records) -> dict:
                  + (f"; not explained by any at {len(unexplained)} ({', '.join(unexplained)})" if unexplained else ""))  # fmt: skip
     return {"n_gap": len(gaps), "gap_at": [r["id"] for r in gaps], "candidates": cands, "not_explained": unexplained,
             "statement": statement}  # fmt: skip
+
+
+#: the neighbour estimator's refusal of a scaling range with fewer than 4 of its scales
+_FEW_SCALES = re.compile(
+    r"points: fewer than 4 neighbour scales in \[eps_min, eps_max\] = \[(?P<lo>[^,\]]+), (?P<hi>[^\]]+)\] "
+    r"\(the k-th neighbours of (?P<n>\d+) points lie at (?P<a>\S+) … (?P<b>[^)]+)\): give more points or widen the range"
+)
+
+
+def d1_refusal_words(text: str) -> str:
+    """d1_refusal_words(text) -> ``text`` with the neighbour estimator's refusal "fewer than 4 neighbour scales in
+    [eps_min, eps_max] = [..]" said as a point's reason for no d₁: the range of scales the fit may use (position
+    units, from the points' distance to the saddle to the largest scale), where the section points' k-th neighbour
+    distances lie, or a range whose lower end lies above its upper end. Any other text is returned unchanged.
+
+    Examples
+    --------
+    >>> d1_refusal_words("d1: points: fewer than 4 neighbour scales in [eps_min, eps_max] = [0.0913179, 0.294261] "
+    ...                  "(the k-th neighbours of 3749 points lie at 0.00184 … 0.11): give more points or widen the range")
+    "d1: no scaling range for d₁: the fit's scales run from the points' distance to the saddle, eps_min = 0.0913, to \
+the largest scale, eps_max = 0.294 (position units), and hold fewer than 4 of the k-th neighbour distances of the \
+3749 section points, which lie at 0.00184 … 0.11"
+    >>> d1_refusal_words("d1: points: fewer than 4 neighbour scales in [eps_min, eps_max] = [220.287, 0.493901] "
+    ...                  "(the k-th neighbours of 35172 points lie at 0.000499 … 0.13): give more points or widen the range")
+    "d1: no scaling range for d₁: the points' distance to the saddle, eps_min = 220, lies above the largest scale, \
+eps_max = 0.494 (position units)"
+    >>> d1_refusal_words("d1: something else")
+    'd1: something else'
+    """
+    if not isinstance(text, str):
+        raise ConfigError(f"text must be a string, got {type(text).__name__}")
+
+    def said(m: re.Match) -> str:
+        lo, hi = float(m["lo"]), float(m["hi"])
+        head = "no scaling range for d₁: "
+        if not lo < hi:
+            return head + (
+                f"the points' distance to the saddle, eps_min = {lo:.3g}, lies above the largest scale, "
+                f"eps_max = {hi:.3g} (position units)"
+            )
+        return head + (
+            f"the fit's scales run from the points' distance to the saddle, eps_min = {lo:.3g}, to the largest scale, "
+            f"eps_max = {hi:.3g} (position units), and hold fewer than 4 of the k-th neighbour distances of the "
+            f"{m['n']} section points, which lie at {m['a']} … {m['b']}"
+        )
+
+    return _FEW_SCALES.sub(said, text)

@@ -32,9 +32,21 @@ class RunSummary:
     #: {'<partition>/<chunk>' ('<chunk>' for a single scene): {"failures": n, "orbits_redone": m}}; every orbit
     #: they hit was redone on the reference driver
     event_failures: dict = field(default_factory=dict)
+    #: orbits whose log-stretch Λ passed MAX_LOG_STRETCH (the tangent dynamics; chunks run now)
+    tangent_beyond: int = 0
 
     def add(self, other: RunSummary):
-        for k in ("n", "escaped", "settled", "censored", "stopped", "n_sections", "n_snapshots", "compute_seconds"):
+        for k in (
+            "n",
+            "escaped",
+            "settled",
+            "censored",
+            "stopped",
+            "n_sections",
+            "n_snapshots",
+            "compute_seconds",
+            "tangent_beyond",
+        ):
             setattr(self, k, getattr(self, k) + getattr(other, k))
         self.event_failures.update(other.event_failures)
         self.chunks_done += 1
@@ -65,6 +77,12 @@ class RunSummary:
                 f"{len(self.event_failures)} chunk(s); {self.event_failures_record()['orbits_redone']} orbit(s) redone "
                 "on the long-double reference driver (scene.json: event_failures)"
                 if self.event_failures
+                else ""
+            )
+            + (
+                f"\n{self.tangent_beyond} orbit(s) with a log-stretch Λ above the tangent dynamics' 600: not "
+                "guaranteed to be the orbits of the scene without them (scene.json: tangent_beyond)"
+                if self.tangent_beyond
                 else ""
             )
         )

@@ -246,6 +246,8 @@ def _record_event_failures(store, summary) -> None:
     """Write the run's heyoka event-detection failures (per chunk, and the orbits redone) into its scene.json."""
     doc = json.loads(store.read_text(SCENE_FILE))
     doc["event_failures"] = summary.event_failures_record()
+    if summary.tangent_beyond:  # orbits whose log-stretch passed the tangent dynamics' MAX_LOG_STRETCH
+        doc["tangent_beyond"] = summary.tangent_beyond
     store.write_json(SCENE_FILE, doc)
 
 

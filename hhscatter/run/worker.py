@@ -106,6 +106,8 @@ def run_one_chunk(
     key = f"{partition}/{chunk}" if partition else str(chunk)
     if res.event_failures:  # heyoka ignored an event in some step: counted, and the orbits hit were redone
         meta["event_failures"] = {"count": res.event_failures, "redone": [int(k) for k in res.redone]}
+    if res.tangent_beyond:  # orbits whose log-stretch passed MAX_LOG_STRETCH (the tangent dynamics), counted
+        meta["tangent_beyond"] = res.tangent_beyond
     if scene.system is not None:  # which system, as text (Hénon–Heiles with linear drag: ω, λ in the scene)
         meta["system"] = scene.model.provenance()
     rows = res.tables()
@@ -133,6 +135,7 @@ def run_one_chunk(
         event_failures={key: {"failures": res.event_failures, "orbits_redone": len(res.redone)}}
         if res.event_failures
         else {},
+        tangent_beyond=res.tangent_beyond,
     )
 
 

@@ -157,7 +157,8 @@ class Scene:
         Hamiltonian flow, :func:`hhscatter.integrate.events.tangent_start`). The lifetimes table gains the
         column ``log_stretch``, Λ at t_end (the finite-time Lyapunov exponent is Λ/t_end). Events, outcome
         rules, steps and so every orbit are those of the scene without it, bit for bit (δq, carried at a tiny
-        norm, never sets a step: :data:`hhscatter.integrate.events.TANGENT_NORM`; Λ ≤ 600). Not with
+        norm, never sets a step: :data:`hhscatter.integrate.events.TANGENT_NORM`; Λ ≤ 600: orbits beyond
+        it are counted and warned of, :data:`hhscatter.integrate.events.MAX_LOG_STRETCH`). Not with
         snapshots, noise or a section window that opens after t = 0.
     name : str
         A label for progress lines and the tables' metadata.

@@ -424,7 +424,7 @@ def _point(study, key, ch):
         sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y"])
         d = est(sp)
     except ConfigError as exc:
-        rec["notes"].append(f"d1: {exc}")
+        rec["notes"].append(sr.d1_refusal_words(f"d1: {exc}"))
         return rec, ftle
     try:
         kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], d.value, d.err, dimension="section")

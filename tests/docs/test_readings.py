@@ -1088,6 +1088,7 @@ def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_ag
     )
 
 
+<<<<<<< HEAD
 def _grid(kappa):
     """The eigenvector convergence grid of the operator study: three box sides × three samples per box."""
     cells = [(0.0125, 4), (0.0125, 16), (0.0125, 64), (0.025, 16), (0.025, 64), (0.025, 256), (0.05, 64)]
@@ -1188,4 +1189,22 @@ def test_the_fig6_scale_reading_counts_the_fits_whose_residual_grows_from_the_tw
     assert text == (
         "with 10 times the orbits per pair the fits take 1 to 3 more points each, and the rms log residual grows in 1 "
         "of the 2 fits (pair × model × hazard); it does not grow in b homogeneous (paper)"
+=======
+def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_run():
+    """With the key at every point: the counts summed (1 590 + 10 of 1 590 + 12); without it: the earlier run and
+    the orbits λ̄ rests on, from the smallest count to the largest."""
+
+    def point(same=None, sel=None, n=None):
+        p = {"lyapunov": 0.2, "lyapunov_detail": {"n_orbits": n}}
+        return p | ({"tangent_same_orbits": {"same_t_end": same, "selected": sel}} if sel is not None else {})
+
+    new = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(1590, 1590), point(10, 12)]}}))
+    assert (
+        new
+        == "at this scale the tangent run ended 1 600 of 1 602 selected orbits at the main run's t_end (over its 2 points)"
+    )
+    old = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(n=18), point(n=1500)]}}))
+    assert old.startswith("this scale's numbers come from an earlier tangent run") and old.endswith(
+        "from 18 to 1 500 per point"
+>>>>>>> s10-saddle2
     )

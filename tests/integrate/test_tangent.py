@@ -301,3 +301,18 @@ def test_orbits_redone_on_the_reference_driver_and_escaped_at_the_start_keep_the
     lt = run_chunk(sc, outside, np.arange(3)).lifetimes
     assert lt["t_end"][2] == 0.0 and lt["log_stretch"][2] == 0.0
     assert np.array_equal(lt["log_stretch"][:2], a[:2])
+
+
+def test_a_log_stretch_beyond_its_bound_is_counted_and_warned_of():
+    """Two confined orbits at E = 0.16 < E_c (x = 0, p_x = 0.25): y = 0.45 in the chaotic sea (λ ≈ 0.13) passes
+    Λ = 600 before t = 5000, y = −0.25 on an invariant torus (Λ grows like ln t) does not; the chunk counts the
+    first alone and warns of it."""
+    e, px0 = 0.16, 0.25
+    ics = np.array([[0.0, y, px0, np.sqrt(2 * (e - y * y / 2 + y**3 / 3 - px0 * px0 / 2))] for y in (0.45, -0.25)])
+    sc = Scene(energy=0.17, n=2, t_max=5000.0, tangent=True)
+    with pytest.warns(events.TangentStretchWarning, match="1 of 2 orbit"):
+        res = run_chunk(sc, ics, np.arange(2))
+    lam = res.lifetimes["log_stretch"]
+    assert list(res.lifetimes["outcome"]) == [CENSORED, CENSORED]
+    assert lam[0] > events.MAX_LOG_STRETCH > 100.0 > lam[1], lam
+    assert res.tangent_beyond == 1

@@ -122,3 +122,31 @@ def test_the_studies_sources_on_the_pages_say_censored(path):
     they name an orbit still inside at t_max as the glossary does."""
     bad = words_of_a_source(path.read_text())
     assert not bad, f"{path.relative_to(ROOT)}: {bad}"
+
+
+def test_the_neighbour_estimators_refusal_reads_as_a_reason_with_units_and_what_the_range_is():
+    """A range [0.09, 0.29] above most neighbour distances (0.0018 … 0.11), and an empty range [220, 0.49]: each said
+    as the point's reason for no d₁ with the units and what its ends are; other text untouched."""
+    few = (
+        "d1: points: fewer than 4 neighbour scales in [eps_min, eps_max] = [0.0913179, 0.294261] (the k-th "
+        "neighbours of 3749 points lie at 0.00184 … 0.11): give more points or widen the range"
+    )
+    empty = few.replace("0.0913179", "220.287")
+    doc = in_glossary_words({"notes": [few, empty, "d1: other"]})
+    assert doc["notes"][0] == (
+        "d1: no scaling range for d₁: the fit's scales run from the points' distance to the saddle, eps_min = "
+        "0.0913, to the largest scale, eps_max = 0.294 (position units), and hold fewer than 4 of the k-th neighbour "
+        "distances of the 3749 section points, which lie at 0.00184 … 0.11"
+    )
+    assert doc["notes"][1] == (
+        "d1: no scaling range for d₁: the points' distance to the saddle, eps_min = 220, lies above the largest "
+        "scale, eps_max = 0.294 (position units)"
+    )
+    assert doc["notes"][2] == "d1: other"
+
+
+@pytest.mark.parametrize("scale", ["", "paper/"])
+def test_no_committed_saddle_note_prints_the_estimators_raw_refusal(scale):
+    """Read as the pages read them (the paper scale's notes were written before the study said them so)."""
+    doc = read_numbers_file(ROOT / "docs" / "studies" / "assets" / f"{scale}saddle.json")
+    assert not [t for _, t in json_strings(doc) if "fewer than 4 neighbour scales in [" in t]
