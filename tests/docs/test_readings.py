@@ -1088,7 +1088,6 @@ def test_the_paper_radius_reading_sorts_the_energies_by_where_the_radius_lies_ag
     )
 
 
-<<<<<<< HEAD
 def _grid(kappa):
     """The eigenvector convergence grid of the operator study: three box sides × three samples per box."""
     cells = [(0.0125, 4), (0.0125, 16), (0.0125, 64), (0.025, 16), (0.025, 64), (0.025, 256), (0.05, 64)]
@@ -1189,7 +1188,9 @@ def test_the_fig6_scale_reading_counts_the_fits_whose_residual_grows_from_the_tw
     assert text == (
         "with 10 times the orbits per pair the fits take 1 to 3 more points each, and the rms log residual grows in 1 "
         "of the 2 fits (pair × model × hazard); it does not grow in b homogeneous (paper)"
-=======
+    )
+
+
 def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_run():
     """With the key at every point: the counts summed (1 590 + 10 of 1 590 + 12); without it: the earlier run and
     the orbits λ̄ rests on, from the smallest count to the largest."""
@@ -1206,5 +1207,4 @@ def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_ru
     old = READINGS["saddle.tangent_orbits"](_loader({"saddle": {"saddle": [point(n=18), point(n=1500)]}}))
     assert old.startswith("this scale's numbers come from an earlier tangent run") and old.endswith(
         "from 18 to 1 500 per point"
->>>>>>> s10-saddle2
     )
