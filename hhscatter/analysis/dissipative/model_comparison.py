@@ -134,7 +134,6 @@ def compare_fits(fits: dict) -> pd.DataFrame:
     first, whose χ²/dof is near 1.
 
     >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
-
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
     >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
     >>> kw = dict(kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
@@ -182,7 +181,6 @@ def better_fit(fits: dict) -> str | None:
     Data made with one κ0(E) law; the same model fitted with it and with another law: the first fits better.
 
     >>> from hhscatter.analysis.dissipative.survival_model import fit_survival_model, survival_model_sample
-
     >>> from hhscatter.analysis.survival.kappa_law import PiecewiseKappa
     >>> kappa = PiecewiseKappa(E_c=1 / 6, a2=13.63, a1=0.03, slope=1.41, E_switch=0.27)
     >>> kw = dict(kappa_of_E=kappa, E0=0.3, mu=0.91, gamma=0.01, tau0=5.0, E_c=1 / 6)
