@@ -337,12 +337,12 @@ def cmeasure_comparisons(table) -> tuple[list[dict], dict]:
             row["kappa_cm_err"],
             row["kappa_pt_grid"],
             paper_err=row["kappa_pt_grid_err"],
-            reference_kind="propagated",
+            reference="propagated",
             unit="1/time",
             note=f"∫e^(κT)dμ_c = 1 + μ_c(ℰ) vs κ from P(t) of Fig. 2b {row['kappa_pt_grid']:.4f} ± "
             f"{row['kappa_pt_grid_err']:.4f} (z = {z:+.2f}); not in the paper",
         )
-        rows.append({**out, "verdict": row_verdict(out)})
+        rows.append({**out, "verdict": row_verdict({**out, "reference_kind": out["reference"]})})
         later = table[(table["energy"] == row["energy"]) & (table["shift_efolds"] > 0)]
         entries[row["energy"]] = kappa_cmeasure_entry(row, later)
     return rows, entries
@@ -361,7 +361,8 @@ def with_cmeasure_references(numbers: dict) -> dict:
 
     Examples
     --------
-    >>> doc = {"cmeasure": {"cm_E0.27": {"energy": 0.27, "kappa_pt_grid": {"value": 0.145, "err": 0.002}}},
+    >>> from hhscatter.analysis.stats.measured import Measured
+    >>> doc = {"cmeasure": {"cm_E0.27": {"energy": 0.27, "kappa_pt_grid": Measured(0.145, 0.002).to_dict()}},
     ...        "paper_comparison": [{"quantity": "κ from the c-measure (E=0.27)", "ours": 0.146, "err": 0.001,
     ...                              "paper": None, "verdict": "consistent with P(t) (|z| ≤ 2)"}]}
     >>> row = with_cmeasure_references(doc)["paper_comparison"][0]

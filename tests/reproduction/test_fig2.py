@@ -101,7 +101,7 @@ def test_cmeasure_comparisons_judge_the_unshifted_window_and_keep_the_later_star
     rows, entries = cmeasure_comparisons(table)
     # 0.20 ± 0.01 against 0.19 ± 0.01: z = 0.01/√2·100 = 0.71; 0.30 against 0.25: z = 3.54 (the one rule's words)
     assert [r["verdict"] for r in rows] == ["agrees (z = +0.7)", "differs (z = +3.5)"]
-    assert [(r["paper"], r["paper_err"], r["reference_kind"]) for r in rows] == [
+    assert [(r["paper"], r["paper_err"], r["reference"]) for r in rows] == [
         (0.19, 0.01, "propagated"),
         (0.25, 0.01, "propagated"),
     ]
