@@ -78,6 +78,7 @@ __all__ = [
     "information_dimension",
     "information_dimension_neighbours",
     "kantz_grassberger",
+    "neighbour_floor_scan",
     "lyapunov_convergence",
     "mean_lyapunov",
     "saddle_points",
@@ -374,6 +375,13 @@ def _scale_range(eps_min, eps_max) -> None:
         )
 
 
+def _floor(floor) -> float:
+    """A floor of the scaling range as a fraction of the points' extent: a number in (0, 1)."""
+    if isinstance(floor, bool) or not isinstance(floor, (int, float, np.integer, np.floating)) or not 0 < floor < 1:
+        raise ConfigError(f"floor must be a fraction of the points' longest side, 0 < floor < 1, got {floor!r}")
+    return float(floor)
+
+
 def _slope(x, y) -> tuple[float, float]:
     """Least-squares slope of y on x and its standard error from the residuals."""
     xm = x - x.mean()
@@ -548,10 +556,11 @@ def information_dimension_neighbours(
     k_max: int = 16,
     eps_min: float = 0.0,
     eps_max: float | None = None,
+    floor: float | None = None,
     n_boot: int = 100,
     seed: int = 0,
 ) -> SaddleDimension:
-    """information_dimension_neighbours(points, groups=None, *, k_max=16, eps_min=0, eps_max=None, n_boot=100, seed=0) -> SaddleDimension.
+    """information_dimension_neighbours(points, groups=None, *, k_max=16, eps_min=0, eps_max=None, floor=None, n_boot=100, seed=0) -> SaddleDimension.
 
     d₁ of the measure that the points sample from their nearest-neighbour distances (the fixed-mass estimator:
     Badii and Politi, J. Stat. Phys. 40, 725 (1985); Grassberger, Phys. Lett. A 107, 101 (1985)): the distance
@@ -583,6 +592,13 @@ def information_dimension_neighbours(
     eps_min, eps_max : float
         The scaling range (the points' units): eps_min the points' resolution (e.g. how close sprinkler points are to
         the saddle), eps_max the largest scale (default: an eighth of the points' longest side).
+    floor : float, optional
+        The scaling range's lower end as a fraction of the points' longest side, eps_min = floor · extent (0 <
+        floor < 1; give it or eps_min, not both). A rule that needs the points alone: sprinkler points lie within
+        ~e^{−λ̄·lo·t_min} of the saddle, but a floor computed from λ̄ ties d₁ to the λ̄ it is compared with in
+        κ = λ̄(1 − d₁), so that the two sides of the relation are no longer independent measurements. Below the
+        points' true scatter about the set the local slope rises towards the embedding dimension: check a floor
+        with :func:`neighbour_floor_scan` (d₁ at multiples of it).
     n_boot : int
         Bootstrap replicates over ``groups`` (0: no resampling error).
     seed : int
@@ -595,6 +611,9 @@ def information_dimension_neighbours(
     >>> t = 2 * np.pi * rng.random(20000)
     >>> d = information_dimension_neighbours(np.column_stack([np.cos(t), np.sin(t)]), n_boot=20)  # a circle: d₁ = 1
     >>> bool(abs(d.value - 1) < 2 * d.err), bool(d.err < 0.01)
+    (True, True)
+    >>> f = information_dimension_neighbours(np.column_stack([np.cos(t), np.sin(t)]), floor=1 / 64, n_boot=20)
+    >>> bool(abs(f.value - 1) < 2 * f.err), bool(f.eps_range[0] >= 2 / 64)   # the circle's extent is 2
     (True, True)
 
     A set with edges (a filled square) reads low: the balls of points near an edge are cut, a bias that grows with
@@ -614,6 +633,10 @@ def information_dimension_neighbours(
     if not extent > 0:
         raise ConfigError("points: all points coincide (no extent to cover)")
     eps_max = extent / 8.0 if eps_max is None else _positive(eps_max, "eps_max")
+    if floor is not None:
+        if eps_min:
+            raise ConfigError(f"floor and eps_min both set ({floor!r}, {eps_min!r}): give the scaling range's lower end once")
+        eps_min = _floor(floor) * extent
     _scale_range(eps_min, eps_max)
     if n < 20 * k_max:
         raise ConfigError(f"points: {n} points, fewer than 20·k_max = {20 * k_max}: give more points or lower k_max")
@@ -673,6 +696,70 @@ def information_dimension_neighbours(
     table = pd.DataFrame({"eps": eps, "n": ns, "k": ks, "log_mass": y, "fitted": use})
     method = f"nearest-neighbour distances (k ≤ {k_max}, {len(levels)} nested subsamples)"
     return SaddleDimension._from_parts(b, err_fit, err_res, err_range, method, eps, use, n, n_groups, table)
+
+
+def neighbour_floor_scan(
+    points,
+    groups=None,
+    *,
+    floor: float,
+    factors=(0.25, 0.5, 1.0, 2.0, 4.0),
+    k_max: int = 16,
+    eps_max: float | None = None,
+    n_boot: int = 100,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """neighbour_floor_scan(points, groups=None, *, floor, factors=(0.25, 0.5, 1, 2, 4), k_max=16, eps_max=None, n_boot=100, seed=0) -> DataFrame.
+
+    The convergence of :func:`information_dimension_neighbours` in its scaling range's lower end: the same
+    estimate (same points, groups, k_max, eps_max, n_boot and seed) with the floor ``floor`` (a fraction of the
+    points' longest side) multiplied by each of ``factors``. A d₁ that moves with the floor beyond its error says
+    that the local slope is not constant over the scales the floors cut off: below the points' scatter about the set
+    it rises (the scatter fills the set's gaps), and a set that is not self-similar over the range has no single
+    slope. The rows share their points, so their differences are correlated: comparing them with both errors in
+    quadrature is a loose test.
+
+    Rows, in the order of ``factors``: factor, floor (factor·floor, a fraction of the extent), eps_min (the points'
+    units), value, err (:class:`SaddleDimension`'s), eps_lo and eps_hi (the scales fitted, the points' units) and
+    note (why a row has no value: the estimator's refusal, e.g. fewer than four scales above that floor; value and
+    err NaN there).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(1)
+    >>> t = 2 * np.pi * rng.random(20000)
+    >>> circle = np.column_stack([np.cos(t), np.sin(t)])                                # d₁ = 1
+    >>> s = neighbour_floor_scan(circle, floor=1 / 512, factors=(0.25, 0.5, 1, 2), n_boot=10)
+    >>> s["floor"].tolist() == [1 / 2048, 1 / 1024, 1 / 512, 1 / 256], bool(np.all(s["eps_lo"] >= s["eps_min"]))
+    (True, True)
+    >>> bool(np.all(np.abs(s["value"] - 1) < 2 * s["err"]))
+    True
+    >>> neighbour_floor_scan(circle, floor=1 / 32, factors=(1,), n_boot=0)["note"][0][:38]  # no scale left above
+    'points: fewer than 4 neighbour scales '
+    """
+    floor = _floor(floor)
+    try:
+        fs = [float(v) for v in np.atleast_1d(np.asarray(factors, dtype=float))]
+    except (TypeError, ValueError):
+        raise ConfigError(f"factors must be numbers > 0 (multiples of floor), got {factors!r}") from None
+    if not fs or not all(math.isfinite(v) and v > 0 for v in fs):
+        raise ConfigError(f"factors must be at least one number > 0 (multiples of floor), got {factors!r}")
+    P = _finite_array(points, "points", 2)
+    extent = float(np.max(P.max(axis=0) - P.min(axis=0)))
+    rows = []
+    for fac in fs:
+        row = {"factor": fac, "floor": fac * floor, "eps_min": fac * floor * extent}
+        try:
+            if not fac * floor < 1:
+                raise ConfigError(f"floor × {fac:g} = {fac * floor:g} is not below the extent")
+            d = information_dimension_neighbours(P, groups, k_max=k_max, eps_max=eps_max, floor=fac * floor,
+                                                 n_boot=n_boot, seed=seed)  # fmt: skip
+            row.update({"value": d.value, "err": d.err, "eps_lo": d.eps_range[0], "eps_hi": d.eps_range[1], "note": ""})
+        except ConfigError as exc:
+            row.update({"value": math.nan, "err": math.nan, "eps_lo": math.nan, "eps_hi": math.nan, "note": str(exc)})
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def capacity_dimension(
