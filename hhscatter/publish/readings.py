@@ -1835,6 +1835,40 @@ def _saddle_tangent_orbits(get: Loader) -> str:
     )
 
 
+def _saddle_floor_scan(get: Loader) -> str:
+    """Whether d₁ moves with the floor of its scaling range: per point with ``d1_floor_scan``, d₁ at each other
+    floor (the rule's floor times ``rules.d1_floor_factors``) against d₁ at the rule's floor (factor 1) by the
+    verdict rule (within 2σ, both errors; the floors share their points, so the test is loose); a point fails where
+    some floor moves d₁ beyond 2σ (those floors named with z), is untested without d₁ at the rule's floor."""
+    d = get("saddle", None)
+    cells = []
+    for p in d["saddle"]:
+        scan = p.get("d1_floor_scan")
+        if not scan:
+            continue
+        name = f"{_SYSTEM_NAMES.get(p['system'], p['system'])} {p['ratio']:g}"
+        ref = next((r["d1"] for r in scan["rows"] if r["factor"] == 1.0 and r["d1"]), None)
+        if ref is None:
+            cells.append((name, None))
+            continue
+        moved = []
+        for r in scan["rows"]:
+            if r["factor"] != 1.0 and r["d1"]:
+                v = verdict(r["d1"]["value"], r["d1"]["err"], ref["value"], ref["err"])
+                if v.word != "agrees":
+                    moved.append(f"×{r['factor']:g}, d₁ = {_ve(r['d1']['value'], r['d1']['err'])}, z = {signed(v.z)}")
+        cells.append((name + (f" ({'; '.join(moved)})" if moved else ""), not moved))
+    if not cells:
+        return "no point of this scale has d₁'s floor scan"
+    factors = ", ".join(f"{f:g}" for f in d["rules"]["d1_floor_factors"] if f != 1.0)
+    return pass_fail_words(
+        cells,
+        f"d₁ stays within 2σ with the floor × {factors}",
+        "d₁ moves beyond 2σ with the floor",
+        "no d₁ at the floor",
+    )
+
+
 #: the readings a page may name: ``[[reading:<name>]]``
 READINGS: dict[str, Callable[[Loader], str]] = {
     "basins.cutoff": _basins_cutoff,
@@ -1891,6 +1925,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "operator.cost": _operator_cost,
     "operator.finest": _operator_finest,
     "fig6.fit_range": _fig6_fit_range,
+    "saddle.floor_scan": _saddle_floor_scan,
     "saddle.lambda_offset": _saddle_lambda_offset,
     "saddle.tangent_orbits": _saddle_tangent_orbits,
 }

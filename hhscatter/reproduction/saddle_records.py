@@ -42,6 +42,7 @@ __all__ = [
     "d1_precision",
     "dimension_row",
     "dimension_summary",
+    "floor_scan_record",
     "fluctuation_record",
     "gap_row",
     "hyperbolic_record",
@@ -63,12 +64,11 @@ def d1_error_record(d, extent: float, eps_min: float) -> dict:
 
     ``d`` is the section's information dimension (a
     :class:`~hhscatter.analysis.geometry.saddle.SaddleDimension` with its ``table`` of ε), ``extent`` the saddle
-    points' longest side and ``eps_min`` their distance to the saddle, extent·e^{−λ̄·window[0]·t_min} (length
-    units). Keys: ``d1_section_err_parts`` (the three parts, section units), ``d1_err_largest`` (the largest finite
-    part), ``d1_eps_range_extent`` (the fitted ε range in units of the extent), ``d1_eps_min_extent``,
-    ``d1_range_floor`` (what ends the range below: ``resolution``, the points' distance to the saddle, when the
-    table has ε below eps_min; else ``points``, the nearest neighbours' distance, the number of points) and
-    ``d1_rel_err`` (err/value).
+    points' longest side and ``eps_min`` the floor of the scaling range (length units). Keys:
+    ``d1_section_err_parts`` (the three parts, section units), ``d1_err_largest`` (the largest finite part),
+    ``d1_eps_range_extent`` (the fitted ε range in units of the extent), ``d1_eps_min_extent``, ``d1_range_floor``
+    (what ends the range below: ``floor``, the floor eps_min, when the table has ε below it; else ``points``, the
+    nearest neighbours' distance, the number of points) and ``d1_rel_err`` (err/value).
 
     Examples
     --------
@@ -79,14 +79,44 @@ def d1_error_record(d, extent: float, eps_min: float) -> dict:
     ...                     table=pd.DataFrame({"eps": [0.005, 0.01, 0.1]}))
     >>> r = d1_error_record(d, extent=1.0, eps_min=0.008)
     >>> r["d1_err_largest"], r["d1_range_floor"], round(r["d1_rel_err"], 4)
-    ('range', 'resolution', 0.0417)
+    ('range', 'floor', 0.0417)
     """
     parts = {k: float(getattr(d, a)) for k, a in ERR_PARTS.items()}
-    floor = "resolution" if bool(np.any(d.table["eps"].to_numpy() < eps_min)) else "points"
+    floor = "floor" if bool(np.any(d.table["eps"].to_numpy() < eps_min)) else "points"
     lo, hi = d.eps_range
     return {"d1_section_err_parts": parts, "d1_err_largest": max(parts, key=lambda k: parts[k] if math.isfinite(parts[k]) else -1.0),
             "d1_eps_range_extent": [lo / extent, hi / extent], "d1_eps_min_extent": eps_min / extent,
             "d1_range_floor": floor, "d1_rel_err": d.err / d.value if d.value else math.nan}  # fmt: skip
+
+
+def floor_scan_record(scan, scatter: float) -> dict:
+    """floor_scan_record(scan, scatter) -> the record's ``d1_floor_scan``: d₁ (partial, D₁/2) at each floor of a
+    :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan` of the section points.
+
+    ``scatter`` is the points' estimated distance to the saddle in units of their extent, e^{−λ̄·window[0]·t_min}
+    (stated beside the floors, not used by the fit). Keys: ``floor`` (the rule's, the row with factor 1; a fraction
+    of the extent), ``scatter_extent`` and ``rows`` ([{factor, floor, d1: {value, err} or None, eps_range_extent
+    (the scales fitted, fractions of the extent) or None, note}]).
+
+    Examples
+    --------
+    >>> import math, pandas as pd
+    >>> scan = pd.DataFrame({"factor": [0.5, 1.0], "floor": [0.004, 0.008], "eps_min": [0.008, 0.016],
+    ...                      "value": [1.30, 1.24], "err": [0.04, 0.06], "eps_lo": [0.0081, 0.0162],
+    ...                      "eps_hi": [0.12, 0.12], "note": ["", ""]})
+    >>> r = floor_scan_record(scan, 1e-3)
+    >>> r["floor"], r["rows"][0]["d1"], [round(v, 4) for v in r["rows"][1]["eps_range_extent"]]
+    (0.008, {'value': 0.65, 'err': 0.02}, [0.0081, 0.06])
+    """
+    rows = []
+    for r in scan.itertuples():
+        ok = math.isfinite(r.value)
+        extent = r.eps_min / r.floor
+        rows.append({"factor": float(r.factor), "floor": float(r.floor),
+                     "d1": Measured(r.value, r.err).scaled(0.5).to_dict() if ok else None,
+                     "eps_range_extent": [r.eps_lo / extent, r.eps_hi / extent] if ok else None, "note": r.note})  # fmt: skip
+    ref = next((r["floor"] for r in rows if r["factor"] == 1.0), None)
+    return {"floor": ref, "scatter_extent": float(scatter), "rows": rows}
 
 
 def d1_precision(records, target: float = 0.03) -> dict:
@@ -101,18 +131,18 @@ def d1_precision(records, target: float = 0.03) -> dict:
     --------
     >>> recs = [{"id": "a", "d1_rel_err": 0.02, "d1_err_largest": "resample", "d1_range_floor": "points",
     ...          "d1_eps_range_extent": [0.001, 0.1]},
-    ...         {"id": "b", "d1_rel_err": 0.07, "d1_err_largest": "range", "d1_range_floor": "resolution",
+    ...         {"id": "b", "d1_rel_err": 0.07, "d1_err_largest": "range", "d1_range_floor": "floor",
     ...          "d1_eps_range_extent": [0.03, 0.1]}, {"id": "c"}]
     >>> p = d1_precision(recs)
     >>> p["n_with_d1"], p["n_within"], p["largest_part"], p["range_floor"]
-    (2, 1, {'fit': 0, 'resample': 1, 'range': 1}, {'resolution': 1, 'points': 1})
+    (2, 1, {'fit': 0, 'resample': 1, 'range': 1}, {'floor': 1, 'points': 1})
     >>> p["statement"].split(";")[0]
     'd₁ to ≤ 3 % (1σ) at 1 of the 2 points with d₁ (a)'
     """
     with_d1 = [r for r in records if r.get("d1_rel_err") is not None]
     ok = [r for r in with_d1 if r["d1_rel_err"] <= target]
     largest = {k: sum(r["d1_err_largest"] == k for r in with_d1) for k in ERR_PARTS}
-    floor = {k: sum(r["d1_range_floor"] == k for r in with_d1) for k in ("resolution", "points")}
+    floor = {k: sum(r["d1_range_floor"] == k for r in with_d1) for k in ("floor", "points")}
     decades = [math.log10(r["d1_eps_range_extent"][1] / r["d1_eps_range_extent"][0]) for r in with_d1]
     names = {"fit": "the fit's residuals (lacunarity)", "resample": "the bootstrap over orbits",
              "range": "the range part (the slope changes across the scaling range)"}  # fmt: skip
@@ -121,7 +151,7 @@ def d1_precision(records, target: float = 0.03) -> dict:
     statement = (f"d₁ to ≤ {100 * target:.0f} % (1σ) at {len(ok)} of the {len(with_d1)} points with d₁"
                  + (f" ({', '.join(r['id'] for r in ok)})" if ok else "")
                  + f"; the largest part of its error: {parts}; the scaling ranges span {span} decades of ε, ended "
-                 f"below by the points' distance to the saddle at {floor['resolution']} points and by the "
+                 f"below by the floor (a fixed fraction of the points' extent) at {floor['floor']} points and by the "
                  f"nearest neighbours' distance (the number of points) at {floor['points']}")  # fmt: skip
     return {"target": target, "n_with_d1": len(with_d1), "n_within": len(ok), "largest_part": largest,
             "range_floor": floor, "statement": statement}  # fmt: skip
@@ -572,19 +602,19 @@ _FEW_SCALES = re.compile(
 def d1_refusal_words(text: str) -> str:
     """d1_refusal_words(text) -> ``text`` with the neighbour estimator's refusal "fewer than 4 neighbour scales in
     [eps_min, eps_max] = [..]" said as a point's reason for no d₁: the range of scales the fit may use (position
-    units, from the points' distance to the saddle to the largest scale), where the section points' k-th neighbour
+    units, from the range's floor to the largest scale), where the section points' k-th neighbour
     distances lie, or a range whose lower end lies above its upper end. Any other text is returned unchanged.
 
     Examples
     --------
     >>> d1_refusal_words("d1: points: fewer than 4 neighbour scales in [eps_min, eps_max] = [0.0913179, 0.294261] "
     ...                  "(the k-th neighbours of 3749 points lie at 0.00184 … 0.11): give more points or widen the range")
-    "d1: no scaling range for d₁: the fit's scales run from the points' distance to the saddle, eps_min = 0.0913, to \
+    "d1: no scaling range for d₁: the fit's scales run from the range's floor, eps_min = 0.0913, to \
 the largest scale, eps_max = 0.294 (position units), and hold fewer than 4 of the k-th neighbour distances of the \
 3749 section points, which lie at 0.00184 … 0.11"
     >>> d1_refusal_words("d1: points: fewer than 4 neighbour scales in [eps_min, eps_max] = [220.287, 0.493901] "
     ...                  "(the k-th neighbours of 35172 points lie at 0.000499 … 0.13): give more points or widen the range")
-    "d1: no scaling range for d₁: the points' distance to the saddle, eps_min = 220, lies above the largest scale, \
+    "d1: no scaling range for d₁: the range's floor, eps_min = 220, lies above the largest scale, \
 eps_max = 0.494 (position units)"
     >>> d1_refusal_words("d1: something else")
     'd1: something else'
@@ -597,11 +627,11 @@ eps_max = 0.494 (position units)"
         head = "no scaling range for d₁: "
         if not lo < hi:
             return head + (
-                f"the points' distance to the saddle, eps_min = {lo:.3g}, lies above the largest scale, "
+                f"the range's floor, eps_min = {lo:.3g}, lies above the largest scale, "
                 f"eps_max = {hi:.3g} (position units)"
             )
         return head + (
-            f"the fit's scales run from the points' distance to the saddle, eps_min = {lo:.3g}, to the largest scale, "
+            f"the fit's scales run from the range's floor, eps_min = {lo:.3g}, to the largest scale, "
             f"eps_max = {hi:.3g} (position units), and hold fewer than 4 of the k-th neighbour distances of the "
             f"{m['n']} section points, which lie at {m['a']} … {m['b']}"
         )

@@ -37,6 +37,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from hhscatter.analysis.geometry.saddle import neighbour_floor_scan
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 from hhscatter.reproduction import saddle_records as sr
@@ -68,6 +69,8 @@ class Params(StudyParams):
     tmin_trend: Numbers = (1.0, 2.0, 3.0)  # d₁ and λ̄ also at t_min·κ = tmin_efolds + s (their trend in t_min)
     window: Numbers  # (lo, hi): fractions of each orbit's lifetime
     min_boxes: Number  # d₁'s largest scale: the points' extent/min_boxes
+    d1_floor: Number  # d₁'s smallest scale: this fraction of the points' extent
+    d1_floor_factors: Numbers  # d₁ also with the floor times these (its convergence in the floor)
     k_max: Integer  # d₁'s largest neighbour rank
     n_bins: Integer  # λ̄(T) bins
     n_boot: Integer
@@ -258,32 +261,23 @@ def _lyapunov(lt, t_min, p):
     return out, lt.assign(ftle=mean.ftle)
 
 
-def _d1_resolution(sp, lam, min_boxes=None):
-    """(extent, eps_min) of a SaddlePoints: the points' longest side and their distance to the saddle,
-    extent·e^{−λ̄·window[0]·t_min} (the smallest scale fitted); refused, in words, where it is not below the largest
-    scale extent/min_boxes."""
+def _extent(sp) -> float:
+    """The saddle points' longest side (position units)."""
     P = sp.points[["x", "y"]].to_numpy()
-    extent = float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
-    eps_min = extent * math.exp(-lam * sp.window[0] * sp.t_min)
-    if min_boxes is not None and not eps_min < extent / min_boxes:
-        raise ConfigError(f"the points' distance to the saddle, extent·e^(−λ̄·{sp.window[0]:g}·t_min) = {eps_min:.3g} "
-                          f"(λ̄ = {lam:.3g} per time unit, t_min = {sp.t_min:.4g}; position units), is not below the "
-                          f"largest scale extent/{min_boxes:g} = {extent / min_boxes:.3g}: no scaling range for d₁")  # fmt: skip
-    return extent, eps_min
+    return float(np.max(P.max(axis=0) - P.min(axis=0))) if len(P) else 0.0
 
 
-def _d1_estimator(p, lam):
-    """The section's information dimension of a SaddlePoints, eps_min from the points' distance to the saddle."""
+def _d1_args(sp, p) -> dict:
+    """The neighbour estimator's arguments for a SaddlePoints: the points, their orbits and the study's rules."""
+    return {"points": sp.points[["x", "y"]].to_numpy(), "groups": sp.points["traj_id"].to_numpy(), "k_max": p.k_max,
+            "eps_max": _extent(sp) / p.min_boxes, "n_boot": p.n_boot, "seed": 0}  # fmt: skip
+
+
+def _d1_estimator(p):
+    """The section's information dimension of a SaddlePoints over the scales d1_floor·extent … extent/min_boxes."""
     from hhscatter.analysis.geometry.saddle import information_dimension_neighbours
 
-    def est(sp):
-        P = sp.points[["x", "y"]].to_numpy()
-        extent, eps_min = _d1_resolution(sp, lam, p.min_boxes)
-        return information_dimension_neighbours(P, groups=sp.points["traj_id"].to_numpy(), k_max=p.k_max,
-                                                eps_min=eps_min, eps_max=extent / p.min_boxes, n_boot=p.n_boot,
-                                                seed=0)  # fmt: skip
-
-    return est
+    return lambda sp: information_dimension_neighbours(**_d1_args(sp, p), floor=p.d1_floor)
 
 
 def _checks(study, key, tangent, t_min, efolds, k):
@@ -297,13 +291,13 @@ def _checks(study, key, tangent, t_min, efolds, k):
             "lyapunov_by_t_min": sr.lyapunov_by_t_min(_long_lived(tangent, ts[0]), ts, kappa, n_boot=p.n_boot)}  # fmt: skip
 
 
-def _d1_radius(sp, d, lam, p):
+def _d1_radius(sp, d, p):
     """d₁ of the same points by the fixed-radius mass (the second estimator), up to the largest scale d fitted."""
     from hhscatter.analysis.geometry.saddle_checks import information_dimension_radius
 
     try:
         r = information_dimension_radius(sp.points[["x", "y"]].to_numpy(), groups=sp.points["traj_id"].to_numpy(),
-                                         eps_min=_d1_resolution(sp, lam)[1], eps_max=d.eps_range[1],
+                                         eps_min=p.d1_floor * _extent(sp), eps_max=d.eps_range[1],
                                          n_boot=p.n_boot, seed=0)  # fmt: skip
     except ConfigError as exc:
         return {"d1_radius_note": str(exc)}
@@ -411,7 +405,7 @@ def _point(study, key, ch):
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
     rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
-    est = _d1_estimator(p, lam["value"])
+    est = _d1_estimator(p)
     cs = (*p.tmin_checks, efolds, *(efolds + s for s in p.tmin_trend))
     wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in cs], windows=[tuple(p.window)],
                            columns=["x", "y"])  # fmt: skip
@@ -435,8 +429,10 @@ def _point(study, key, ch):
                 "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points,
                 "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
                 "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
-    rec.update(sr.d1_error_record(d, *_d1_resolution(sp, lam["value"])))
-    rec.update(_d1_radius(sp, d, lam["value"], p))
+    rec.update(sr.d1_error_record(d, _extent(sp), p.d1_floor * _extent(sp)))
+    scan = neighbour_floor_scan(**_d1_args(sp, p), floor=p.d1_floor, factors=p.d1_floor_factors)
+    rec["d1_floor_scan"] = sr.floor_scan_record(scan, math.exp(-lam["value"] * sp.window[0] * sp.t_min))
+    rec.update(_d1_radius(sp, d, p))
     rec.update(sr.hyperbolic_record(_long_lived(tangent, ch["t_min"]), sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
@@ -447,6 +443,8 @@ def analyze(study):
     import pandas as pd
 
     _d0_eps(study)  # refused before any work
+    if not 0 < study.params.d1_floor < 1 / study.params.min_boxes:
+        raise ConfigError(f"saddle [study].d1_floor must lie in (0, 1/min_boxes), got {study.params.d1_floor!r}")
     if study.params.basins_system not in [x[0] for x in _systems(study)]:
         raise ConfigError(
             f"saddle [study].basins_system must be one of the labels of [study].systems, "
@@ -486,6 +484,8 @@ def analyze(study):
                 "tmin_checks": list(study.params.tmin_checks),
                 "tmin_trend": list(study.params.tmin_trend),
                 "ftle_low": list(study.params.ftle_low),
+                "d1_floor": study.params.d1_floor,
+                "d1_floor_factors": list(study.params.d1_floor_factors),
                 "n_orbits_per_point": study.params.n,
                 "d0_eps": [float(e) for e in _d0_eps(study)],
                 "d0_n": study.params.d0_n,

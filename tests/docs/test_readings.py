@@ -1208,3 +1208,35 @@ def test_the_tangent_orbits_reading_counts_the_same_ends_or_names_the_earlier_ru
     assert old.startswith("this scale's numbers come from an earlier tangent run") and old.endswith(
         "from 18 to 1 500 per point"
     )
+
+
+def test_the_floor_scan_reading_tests_each_floor_against_the_rule_s_by_the_verdict_rule():
+    """Hand-built scans: at the first point the floor × 0.25 moves d₁ by 0.05 with σ = √(0.01² + 0.01²) = 0.0141
+    (z = +3.5, beyond 2σ) and × 4 by 0.01 (z = −0.7); at the second every floor is within 2σ (and × 4 has no d₁);
+    the third has no d₁ at the rule's floor (untested); a point without a scan is not a cell."""
+
+    def row(factor, value=None, err=0.01):
+        return {"factor": factor, "d1": None if value is None else {"value": value, "err": err}}
+
+    points = [
+        {
+            "system": "henon_heiles",
+            "ratio": 1.5,
+            "d1_floor_scan": {"rows": [row(0.25, 0.74), row(1.0, 0.69), row(4.0, 0.68)]},
+        },
+        {"system": "barbanis", "ratio": 2.6, "d1_floor_scan": {"rows": [row(0.25, 0.60), row(1.0, 0.59), row(4.0)]}},
+        {"system": "contopoulos", "ratio": 1.7, "d1_floor_scan": {"rows": [row(0.25, 0.6), row(1.0)]}},
+        {"system": "henon_heiles", "ratio": 3.0},
+    ]
+    doc = {"saddle": {"saddle": points, "rules": {"d1_floor_factors": [0.25, 1.0, 4.0]}}}
+    text = READINGS["saddle.floor_scan"](_loader(doc))
+    assert text == (
+        "d₁ moves beyond 2σ with the floor at Hénon–Heiles 1.5 (×0.25, d₁ = 0.740 ± 0.010, z = +3.5); d₁ stays "
+        "within 2σ with the floor × 0.25, 4 at Barbanis 2.6; no d₁ at the floor at Contopoulos 1.7"
+    )
+    every = {"saddle": {"saddle": points[1:2], "rules": {"d1_floor_factors": [0.5, 1.0, 2.0]}}}
+    assert READINGS["saddle.floor_scan"](_loader(every)) == (
+        "d₁ stays within 2σ with the floor × 0.5, 2 at every tested cell (Barbanis 2.6)"
+    )
+    none = {"saddle": {"saddle": points[3:], "rules": {"d1_floor_factors": [1.0]}}}
+    assert READINGS["saddle.floor_scan"](_loader(none)) == "no point of this scale has d₁'s floor scan"

@@ -134,12 +134,12 @@ def test_the_neighbour_estimators_refusal_reads_as_a_reason_with_units_and_what_
     empty = few.replace("0.0913179", "220.287")
     doc = in_glossary_words({"notes": [few, empty, "d1: other"]})
     assert doc["notes"][0] == (
-        "d1: no scaling range for d₁: the fit's scales run from the points' distance to the saddle, eps_min = "
+        "d1: no scaling range for d₁: the fit's scales run from the range's floor, eps_min = "
         "0.0913, to the largest scale, eps_max = 0.294 (position units), and hold fewer than 4 of the k-th neighbour "
         "distances of the 3749 section points, which lie at 0.00184 … 0.11"
     )
     assert doc["notes"][1] == (
-        "d1: no scaling range for d₁: the points' distance to the saddle, eps_min = 220, lies above the largest "
+        "d1: no scaling range for d₁: the range's floor, eps_min = 220, lies above the largest "
         "scale, eps_max = 0.294 (position units)"
     )
     assert doc["notes"][2] == "d1: other"

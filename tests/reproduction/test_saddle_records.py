@@ -31,7 +31,7 @@ def test_d1_error_record_names_the_largest_finite_part_and_what_ends_the_range()
     assert r["d1_err_largest"] == "range"
     assert r["d1_section_err_parts"]["fit"] == 0.03 and math.isnan(r["d1_section_err_parts"]["resample"])
     assert r["d1_eps_range_extent"] == [0.01, 0.1] and r["d1_eps_min_extent"] == 0.0075
-    assert r["d1_range_floor"] == "resolution"  # the table has ε = 0.01 below eps_min = 0.015
+    assert r["d1_range_floor"] == "floor"  # the table has ε = 0.01 below eps_min = 0.015
     assert r["d1_rel_err"] == pytest.approx(0.05 / 1.25, rel=1e-12)
     # no ε below eps_min: the range ends at the nearest neighbours' distance; the bootstrap part the largest
     r = sr.d1_error_record(_dim(1.0, (0.01, 0.02, 0.0), (0.02, 0.2), [0.02, 0.2]), extent=1.0, eps_min=0.01)
@@ -39,18 +39,34 @@ def test_d1_error_record_names_the_largest_finite_part_and_what_ends_the_range()
     assert math.isnan(sr.d1_error_record(_dim(0.0, (0.01, 0.0, 0.0), (0.1, 1), [0.1]), 1.0, 0.01)["d1_rel_err"])
 
 
+def test_floor_scan_record_halves_the_section_dimension_and_keeps_the_refusals():
+    """Two floors of a scan with a value (D₁ = 1.30 ± 0.04 and 1.24 ± 0.06: d₁ = D₁/2) and one the estimator refused
+    (no value, its note kept); the points' extent, 2, from eps_min/floor: the range in units of the extent."""
+    scan = pd.DataFrame({"factor": [0.5, 1.0, 2.0], "floor": [0.004, 0.008, 0.016], "eps_min": [0.008, 0.016, 0.032],
+                         "value": [1.30, 1.24, math.nan], "err": [0.04, 0.06, math.nan],
+                         "eps_lo": [0.0082, 0.0164, math.nan], "eps_hi": [0.1, 0.1, math.nan],
+                         "note": ["", "", "points: fewer than 4 neighbour scales"]})  # fmt: skip
+    r = sr.floor_scan_record(scan, 0.02)
+    assert r["floor"] == 0.008 and r["scatter_extent"] == 0.02
+    assert [x["factor"] for x in r["rows"]] == [0.5, 1.0, 2.0]
+    assert r["rows"][0]["d1"] == {"value": 0.65, "err": 0.02} and r["rows"][1]["d1"]["value"] == pytest.approx(0.62)
+    assert r["rows"][1]["eps_range_extent"] == pytest.approx([0.0082, 0.05])
+    assert r["rows"][2]["d1"] is None and r["rows"][2]["note"].startswith("points: fewer")
+    assert sr.floor_scan_record(scan.iloc[[0, 2]], 0.02)["floor"] is None  # no factor 1: no rule's floor
+
+
 def test_d1_precision_counts_the_points_within_the_target():
     recs = [
         {"id": "a", "d1_rel_err": 0.03, "d1_err_largest": "fit", "d1_range_floor": "points",
          "d1_eps_range_extent": [0.001, 0.1]},
-        {"id": "b", "d1_rel_err": 0.031, "d1_err_largest": "range", "d1_range_floor": "resolution",
+        {"id": "b", "d1_rel_err": 0.031, "d1_err_largest": "range", "d1_range_floor": "floor",
          "d1_eps_range_extent": [0.01, 0.1]},
         {"id": "c", "d1": None},
     ]  # fmt: skip
     p = sr.d1_precision(recs)
     assert (p["n_with_d1"], p["n_within"]) == (2, 1)  # 3 % is within, 3.1 % not
     assert p["largest_part"] == {"fit": 1, "resample": 0, "range": 1}
-    assert p["range_floor"] == {"resolution": 1, "points": 1}
+    assert p["range_floor"] == {"floor": 1, "points": 1}
     assert "at 1 of the 2 points with d₁ (a)" in p["statement"] and "span 1.0–2.0 decades" in p["statement"]
     assert sr.d1_precision(recs, target=0.05)["n_within"] == 2
 

@@ -168,7 +168,7 @@ def test_the_d1_estimator_covers_the_baker_natural_measure_at_a_quick_scale_samp
     from tests.analysis.geometry.test_saddle import closed_forms, natural_measure
 
     study = load_study("saddle", "quick")
-    est = stage_module("saddle")._d1_estimator(study.params, lam=1.0)
+    est = stage_module("saddle")._d1_estimator(study.params)
     a = (0.45, 0.45)
     truth = 2 * closed_forms(a, a)["d1u"]
     covered = 0
@@ -202,29 +202,46 @@ def test_a_system_s_own_tmin_efolds_replaces_the_study_s(built):
     assert sorted(tan["traj_id"]) == sorted(long["traj_id"])
 
 
-@pytest.mark.parametrize("lam", [-0.0077, 0.01])
-def test_d1_without_a_scaling_range_says_why_in_words_with_units(lam):
-    """λ̄ ≤ 0, or too small for t_min: the points' distance to the saddle, extent·e^(−λ̄·window[0]·t_min), is not
-    below the largest scale extent/min_boxes (λ̄ = −0.0077 at t_min = 372.5 puts it at 3.15 × the extent): the
-    estimator is not run, and the reason names both scales, λ̄, t_min and the units."""
+def test_d1_s_floor_is_a_fraction_of_the_extent_and_its_scan_holds_the_rule_s_d1(built):
+    """d₁'s scaling range starts at d1_floor × the points' extent or above (never at a scale set by λ̄), and the
+    floor scan's row with factor 1 is the record's d₁ itself (the same points, rule and seed); its floors are the
+    rule's times d1_floor_factors."""
+    doc = json.loads((built / "saddle.json").read_text())
+    rules, checked = doc["rules"], 0
+    for rec in doc["saddle"]:
+        if rec.get("d1") is None:
+            continue
+        assert rec["d1_eps_min_extent"] == rules["d1_floor"] and rec["d1_eps_range_extent"][0] >= rules["d1_floor"]
+        scan = rec["d1_floor_scan"]
+        assert [r["factor"] for r in scan["rows"]] == rules["d1_floor_factors"]
+        assert [r["floor"] for r in scan["rows"]] == pytest.approx(
+            [f * rules["d1_floor"] for f in rules["d1_floor_factors"]]
+        )
+        one = next(r for r in scan["rows"] if r["factor"] == 1.0)
+        assert one["d1"]["value"] == pytest.approx(rec["d1"], rel=1e-12)
+        assert one["d1"]["err"] == pytest.approx(rec["d1_err"], rel=1e-12)
+        assert 0 < scan["scatter_extent"] < 1
+        checked += 1
+    assert checked >= 1
+
+
+def test_d1_s_estimator_takes_no_lyapunov_exponent():
+    """The same points give the same d₁ whatever λ̄ and t_min: the estimator is a function of the points and the
+    rules alone (its range d1_floor·extent … extent/min_boxes)."""
+    import inspect
+
     import pandas as pd
 
     from hhscatter.analysis.geometry.saddle import SaddlePoints
-    from hhscatter.errors import ConfigError
     from hhscatter.studies import load_study, stage_module
 
     study = load_study("saddle", "quick")
-    est = stage_module("saddle")._d1_estimator(study.params, lam=lam)
-    P = np.random.default_rng(0).random((2000, 2)) * [3.0, 1.0]  # extent 3 (the longest side)
-    pts = pd.DataFrame({"traj_id": np.arange(2000), "t": 0.0, "x": P[:, 0], "y": P[:, 1]})
-    sp = SaddlePoints(points=pts, t_min=372.5, window=(0.4, 0.6), n_long=2000, n_orbits=2000, n_points=2000,
-                      n_beyond_record=0)  # fmt: skip
-    extent = float(np.ptp(P, axis=0).max())
-    eps_min = extent * math.exp(-lam * 0.4 * 372.5)
-    with pytest.raises(ConfigError) as exc:
-        est(sp)
-    msg = str(exc.value)
-    assert f"= {eps_min:.3g} " in msg and f"{extent / study.params.min_boxes:.3g}" in msg and "position units" in msg
-    assert f"λ̄ = {lam:.3g} per time unit" in msg and "no scaling range for d₁" in msg
-    # with λ̄ large enough the same points have a scaling range (the check refuses only an empty one)
-    assert stage_module("saddle")._d1_resolution(sp, 0.05, study.params.min_boxes)[1] < extent / study.params.min_boxes
+    make = stage_module("saddle")._d1_estimator
+    assert list(inspect.signature(make).parameters) == ["p"]
+    rng = np.random.default_rng(0)
+    t = 2 * np.pi * rng.random(4000)
+    pts = pd.DataFrame({"traj_id": np.arange(4000), "t": 0.0, "x": np.cos(t), "y": np.sin(t)})
+    d = [make(study.params)(SaddlePoints(points=pts, t_min=tm, window=(0.4, 0.6), n_long=4000, n_orbits=4000,
+                                         n_points=4000, n_beyond_record=0)) for tm in (10.0, 1000.0)]  # fmt: skip
+    assert (d[0].value, d[0].err, d[0].eps_range) == (d[1].value, d[1].err, d[1].eps_range)
+    assert d[0].eps_range[0] >= study.params.d1_floor * 2.0  # the circle's extent is 2

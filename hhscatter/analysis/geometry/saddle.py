@@ -635,7 +635,9 @@ def information_dimension_neighbours(
     eps_max = extent / 8.0 if eps_max is None else _positive(eps_max, "eps_max")
     if floor is not None:
         if eps_min:
-            raise ConfigError(f"floor and eps_min both set ({floor!r}, {eps_min!r}): give the scaling range's lower end once")
+            raise ConfigError(
+                f"floor and eps_min both set ({floor!r}, {eps_min!r}): give the scaling range's lower end once"
+            )
         eps_min = _floor(floor) * extent
     _scale_range(eps_min, eps_max)
     if n < 20 * k_max:
