@@ -1835,38 +1835,59 @@ def _saddle_tangent_orbits(get: Loader) -> str:
     )
 
 
+def _by_system(cells: list[tuple[str, str]]) -> str:
+    """[(system label, cell)] as "Hénon–Heiles E/E_c = a, b; Barbanis E/E_c = c", systems in their first order."""
+    groups: dict[str, list[str]] = {}
+    for label, cell in cells:
+        groups.setdefault(_SYSTEM_NAMES.get(label, label), []).append(cell)
+    return "; ".join(f"{name} E/E_c = {', '.join(cs)}" for name, cs in groups.items())
+
+
 def _saddle_floor_scan(get: Loader) -> str:
     """Whether d₁ moves with the floor of its scaling range: per point with ``d1_floor_scan``, d₁ at each other
     floor (the rule's floor times ``rules.d1_floor_factors``) against d₁ at the rule's floor (factor 1) by the
-    verdict rule (within 2σ, both errors; the floors share their points, so the test is loose); a point fails where
-    some floor moves d₁ beyond 2σ (those floors named with z), is untested without d₁ at the rule's floor."""
+    verdict rule (within 2σ, both errors; the floors share their points, so the test is loose). The points where
+    some floor moves d₁ beyond 2σ (those floors named with d₁ and z), those where none does, those without d₁ at
+    the rule's floor, and the floors without d₁ (the estimator refused them: fewer than four scales above)."""
     d = get("saddle", None)
-    cells = []
+    moved, still, untested, refused = [], [], [], {}
     for p in d["saddle"]:
         scan = p.get("d1_floor_scan")
         if not scan:
             continue
-        name = f"{_SYSTEM_NAMES.get(p['system'], p['system'])} {p['ratio']:g}"
+        where = (p["system"], f"{p['ratio']:g}")
         ref = next((r["d1"] for r in scan["rows"] if r["factor"] == 1.0 and r["d1"]), None)
         if ref is None:
-            cells.append((name, None))
+            untested.append(where)
             continue
-        moved = []
+        out = []
         for r in scan["rows"]:
-            if r["factor"] != 1.0 and r["d1"]:
-                v = verdict(r["d1"]["value"], r["d1"]["err"], ref["value"], ref["err"])
-                if v.word != "agrees":
-                    moved.append(f"×{r['factor']:g}, d₁ = {_ve(r['d1']['value'], r['d1']['err'])}, z = {signed(v.z)}")
-        cells.append((name + (f" ({'; '.join(moved)})" if moved else ""), not moved))
-    if not cells:
+            if r["factor"] == 1.0:
+                continue
+            if not r["d1"]:
+                refused.setdefault(f"{r['factor']:g}", []).append(where)
+                continue
+            v = verdict(r["d1"]["value"], r["d1"]["err"], ref["value"], ref["err"])
+            if v.word != "agrees":
+                out.append(f"×{r['factor']:g}: d₁ = {_ve(r['d1']['value'], r['d1']['err'])}, z = {signed(v.z)}")
+        if out:
+            moved.append((where[0], f"{where[1]} ({'; '.join(out)})"))
+        else:
+            still.append(where)
+    if not (moved or still or untested):
         return "no point of this scale has d₁'s floor scan"
     factors = ", ".join(f"{f:g}" for f in d["rules"]["d1_floor_factors"] if f != 1.0)
-    return pass_fail_words(
-        cells,
-        f"d₁ stays within 2σ with the floor × {factors}",
-        "d₁ moves beyond 2σ with the floor",
-        "no d₁ at the floor",
-    )
+    parts = []
+    if moved:
+        parts.append(f"d₁ moves beyond 2σ with the floor at {_by_system(moved)}")
+    if still:
+        head = "at every other point" if moved or untested else "at every point"
+        parts.append(f"d₁ stays within 2σ with the floor × {factors} {head} ({_by_system(still)})")
+    if untested:
+        parts.append(f"no d₁ at the floor at {_by_system(untested)}")
+    for fac, where in refused.items():
+        parts.append(f"no d₁ with the floor × {fac} (fewer than four scales above it) at {_by_system(where)}")
+    return "; ".join(parts)
 
 
 #: the readings a page may name: ``[[reading:<name>]]``

@@ -1231,12 +1231,14 @@ def test_the_floor_scan_reading_tests_each_floor_against_the_rule_s_by_the_verdi
     doc = {"saddle": {"saddle": points, "rules": {"d1_floor_factors": [0.25, 1.0, 4.0]}}}
     text = READINGS["saddle.floor_scan"](_loader(doc))
     assert text == (
-        "d₁ moves beyond 2σ with the floor at Hénon–Heiles 1.5 (×0.25, d₁ = 0.740 ± 0.010, z = +3.5); d₁ stays "
-        "within 2σ with the floor × 0.25, 4 at Barbanis 2.6; no d₁ at the floor at Contopoulos 1.7"
+        "d₁ moves beyond 2σ with the floor at Hénon–Heiles E/E_c = 1.5 (×0.25: d₁ = 0.740 ± 0.010, z = +3.5); d₁ stays "
+        "within 2σ with the floor × 0.25, 4 at every other point (Barbanis E/E_c = 2.6); no d₁ at the floor at "
+        "Contopoulos E/E_c = 1.7; no d₁ with the floor × 4 (fewer than four scales above it) at Barbanis E/E_c = 2.6"
     )
-    every = {"saddle": {"saddle": points[1:2], "rules": {"d1_floor_factors": [0.5, 1.0, 2.0]}}}
+    every = {"saddle": {"saddle": points[1:2], "rules": {"d1_floor_factors": [0.25, 1.0, 4.0]}}}
     assert READINGS["saddle.floor_scan"](_loader(every)) == (
-        "d₁ stays within 2σ with the floor × 0.5, 2 at every tested cell (Barbanis 2.6)"
+        "d₁ stays within 2σ with the floor × 0.25, 4 at every point (Barbanis E/E_c = 2.6); no d₁ with the floor × 4 "
+        "(fewer than four scales above it) at Barbanis E/E_c = 2.6"
     )
     none = {"saddle": {"saddle": points[3:], "rules": {"d1_floor_factors": [1.0]}}}
     assert READINGS["saddle.floor_scan"](_loader(none)) == "no point of this scale has d₁'s floor scan"
