@@ -14,7 +14,8 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
     ``saddle.json``: per point κ, λ̄ (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`,
     :func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), d₁ on the section
     (:func:`~hhscatter.analysis.geometry.saddle.saddle_points`,
-    :func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours`,
+    :func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours` over scales from a fixed fraction of
+    the points' extent, :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan` at multiples of it,
     :func:`~hhscatter.analysis.geometry.saddle.window_dependence`) and the relation's verdict
     (:func:`~hhscatter.analysis.geometry.saddle.kantz_grassberger`); derived table ``saddle_ftle.parquet`` (the
     finite-time exponents Λ/T of the tangent runs); d₀ = 1 − α of the lines run
@@ -37,7 +38,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from hhscatter.analysis.geometry.saddle import neighbour_floor_scan
+from hhscatter.analysis.geometry.saddle import information_dimension_neighbours, neighbour_floor_scan
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 from hhscatter.reproduction import saddle_records as sr
@@ -275,8 +276,6 @@ def _d1_args(sp, p) -> dict:
 
 def _d1_estimator(p):
     """The section's information dimension of a SaddlePoints over the scales d1_floor·extent … extent/min_boxes."""
-    from hhscatter.analysis.geometry.saddle import information_dimension_neighbours
-
     return lambda sp: information_dimension_neighbours(**_d1_args(sp, p), floor=p.d1_floor)
 
 
