@@ -101,9 +101,8 @@ def floor_scan_record(scan, scatter: float) -> dict:
     Examples
     --------
     >>> import math, pandas as pd
-    >>> scan = pd.DataFrame({"factor": [0.5, 1.0], "floor": [0.004, 0.008], "eps_min": [0.008, 0.016],
-    ...                      "value": [1.30, 1.24], "err": [0.04, 0.06], "eps_lo": [0.0081, 0.0162],
-    ...                      "eps_hi": [0.12, 0.12], "note": ["", ""]})
+    >>> scan = pd.DataFrame({"factor": [0.5, 1.0], "floor": [0.004, 0.008], "eps_min": [0.008, 0.016]})
+    >>> scan = scan.assign(value=[1.30, 1.24], err=[0.04, 0.06], eps_lo=[0.0081, 0.0162], eps_hi=0.12, note="")
     >>> r = floor_scan_record(scan, 1e-3)
     >>> r["floor"], r["rows"][0]["d1"], [round(v, 4) for v in r["rows"][1]["eps_range_extent"]]
     (0.008, {'value': 0.65, 'err': 0.02}, [0.0081, 0.06])

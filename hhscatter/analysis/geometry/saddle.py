@@ -757,9 +757,11 @@ def neighbour_floor_scan(
                 raise ConfigError(f"floor × {fac:g} = {fac * floor:g} is not below the extent")
             d = information_dimension_neighbours(P, groups, k_max=k_max, eps_max=eps_max, floor=fac * floor,
                                                  n_boot=n_boot, seed=seed)  # fmt: skip
-            row.update({"value": d.value, "err": d.err, "eps_lo": d.eps_range[0], "eps_hi": d.eps_range[1], "note": ""})
+            row.update({**Measured(d.value, d.err).to_dict(), "eps_lo": d.eps_range[0], "eps_hi": d.eps_range[1]})
+            row["note"] = ""
         except ConfigError as exc:
-            row.update({"value": math.nan, "err": math.nan, "eps_lo": math.nan, "eps_hi": math.nan, "note": str(exc)})
+            row.update({**Measured.of(math.nan, math.nan).to_dict(), "eps_lo": math.nan, "eps_hi": math.nan})
+            row["note"] = str(exc)
         rows.append(row)
     return pd.DataFrame(rows)
 
