@@ -326,8 +326,8 @@ def window_constancy(rate: ThermalRate, z_max: float) -> WindowConstancy:
     >>> c = window_constancy(r, 3.0)
     >>> round(c.z, 12), c.constant, window_constancy(r, 0.5).constant
     (-0.8, True, False)
-    >>> c.second.to_dict()
-    {'value': 0.008, 'err': 0.004}
+    >>> c.second.value, c.second.err
+    (0.008, 0.004)
     """
     if not isinstance(rate, ThermalRate):
         raise ConfigError(f"rate must be a ThermalRate (thermal_rate's result), got {type(rate).__name__}")
