@@ -32,7 +32,8 @@ class RunSummary:
     #: {'<partition>/<chunk>' ('<chunk>' for a single scene): {"failures": n, "orbits_redone": m}}; every orbit
     #: they hit was redone on the reference driver
     event_failures: dict = field(default_factory=dict)
-    #: orbits whose log-stretch Λ passed MAX_LOG_STRETCH (the tangent dynamics; chunks run now)
+    #: orbits whose log-stretch Λ passed MAX_LOG_STRETCH (the tangent dynamics): in the chunks run now and, on a
+    #: resume, in those kept (from their parts' metadata)
     tangent_beyond: int = 0
 
     def add(self, other: RunSummary):

@@ -73,7 +73,14 @@ from hhscatter.run.dask_backend import check_scheduler, dask_client
 from hhscatter.run.output import discard_failed_start, prepare_output
 from hhscatter.run.plan import SCENE_FILE, RunSummary, plan_chunks, points_of
 from hhscatter.run.progress import progress_bar
-from hhscatter.run.worker import chunk_complete, default_workers, die_with_parent, pack_point, run_one_chunk
+from hhscatter.run.worker import (
+    chunk_complete,
+    default_workers,
+    die_with_parent,
+    kept_tangent_beyond,
+    pack_point,
+    run_one_chunk,
+)
 from hhscatter.scene.grid import Grid
 from hhscatter.scene.ics import check_ics, read_ics_table
 from hhscatter.scene.scene import Scene
@@ -248,6 +255,8 @@ def _record_event_failures(store, summary) -> None:
     doc["event_failures"] = summary.event_failures_record()
     if summary.tangent_beyond:  # orbits whose log-stretch passed the tangent dynamics' MAX_LOG_STRETCH
         doc["tangent_beyond"] = summary.tangent_beyond
+    else:  # none in the chunks run or kept: a count from before a resume that redid its chunks goes
+        doc.pop("tangent_beyond", None)
     store.write_json(SCENE_FILE, doc)
 
 
@@ -268,6 +277,7 @@ def _simulate(
             for chunk, start, stop in plan_chunks(scene):
                 if chunk_complete(scene, store, chunk, start, stop, partition, want=h):
                     summary.chunks_skipped += 1
+                    summary.tangent_beyond += kept_tangent_beyond(store, chunk, partition)
                     continue
                 todo.append(ChunkTask(scene_json, chunk, start, stop, partition, h, packed.get(partition)))
         done_orbits = n_total - sum(t.stop - t.start for t in todo)

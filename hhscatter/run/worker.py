@@ -193,6 +193,15 @@ def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partiti
     return True
 
 
+def kept_tangent_beyond(out, chunk: int, partition: str = "") -> int:
+    """kept_tangent_beyond(out, chunk, partition='') -> int: the orbits of a kept (complete) chunk whose log-stretch
+    passed :data:`~hhscatter.integrate.events.MAX_LOG_STRETCH`, as its lifetimes part's metadata records them (0 when
+    it records none), so that a resumed run's total counts the chunks it keeps as well as those it runs."""
+    store = Store(out)
+    meta = read_meta(store.path(part_rel("lifetimes", partition, chunk)), filesystem=store.filesystem)
+    return int(meta.get("tangent_beyond", 0))
+
+
 def die_with_parent(parent_pid: int) -> None:
     """die_with_parent(parent_pid) -> None: make this (worker) process die when its parent does.
 

@@ -46,8 +46,11 @@ R_ESC_MAX, R_FAR_MAX = 100.0, 1e8
 #: E0 ≤ E0_MAX · E_c: far above the saddle every orbit leaves within a fraction of a period (nothing to
 #: scatter), and p² = 2(E − V) overflows float64 near 1e308
 E0_MAX = 1000.0
-#: γ ≤ GAMMA_MAX · ω: beyond, the motion is overdamped (an orbit loses its energy above E_c within a small
-#: fraction of an oscillation period) and the equations only become stiff
+#: γ ≤ GAMMA_MAX · ω, ω the system's frequency (``model.frequency``: the square root of the largest eigenvalue of
+#: V's Hessian at the well's minimum, its fastest small oscillation). With the linear drag −γp the small
+#: oscillations are overdamped from γ = 2ω on; at GAMMA_MAX · ω the momentum relaxes within 1/γ, under 2 % of a
+#: period 2π/ω, so a larger γ studies nothing new and only makes the equations stiff. The quadratic drag −γ|p|p
+#: has the same bound on the number γ, as a guard in the system's units rather than the onset of overdamping.
 GAMMA_MAX = 10.0
 #: n ≤ N_MAX orbits per run: a lifetimes table of 1e9 orbits is ≈ 90 GB when read into memory; split larger
 #: ensembles into several runs (other seeds)
@@ -360,8 +363,9 @@ class Scene:
             raise ConfigError(f"gamma must be ≥ 0 (γ = 0 is conservative), got {gamma}")
         if gamma > GAMMA_MAX * m.frequency:
             raise ConfigError(
-                f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.frequency:g}, got {gamma:g} (beyond, "
-                "the motion is overdamped: orbits settle within a fraction of a period)"
+                f"gamma must be ≤ {GAMMA_MAX:g} ω = {GAMMA_MAX * m.frequency:g} (ω the system's frequency), got "
+                f"{gamma:g} (with the linear drag the motion is overdamped from γ = 2 ω on; above the bound orbits "
+                "settle within a fraction of a period)"
             )
         if not isinstance(self.n, (int, np.integer)) or isinstance(self.n, bool) or self.n <= 0:
             raise ConfigError(f"n (number of orbits) must be an integer > 0, got {self.n!r}")

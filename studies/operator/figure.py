@@ -84,7 +84,7 @@ def _panel_kappa(a, nums, recs, E):
         ms=5,
         capsize=2,
         alpha=0.6,
-        label=f"Ulam, finest box {recs[0]['box']:g} (biased; err: stat ⊕ bias)",
+        label=f"Ulam, finest box {recs[0]['box']:g} (err: stat ⊕ linear box-side bias)",
     )
     inf = [(r["energy"], r["kappa_inf"], r["err"]) for r in nums.get("kappa_convergence", []) if r.get("kappa_inf")]
     if inf:

@@ -1,6 +1,6 @@
 """Bad arguments to the estimators of the paired bootstrap, noise, the chaotic saddle and its checks, and censoring,
-and to the classes of analysis built from numbers (the κ0(E) law, the survival models' parameters, the Kaplan–Meier
-grid) (hypothesis).
+and to the classes of analysis built from numbers (the κ0(E) law, the survival models' parameters and sub-ensembles,
+the homogeneous fit's problem, the Kaplan–Meier grid, the Kramers–Langer rate and its saddles' terms) (hypothesis).
 
 Each call gets one argument replaced by a wrong thing (a wrong type, NaN, a negative time or count, an empty array,
 a mismatched length, a window outside the data) and must refuse with a ConfigError that names that argument,
@@ -20,9 +20,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hhscatter.analysis.dissipative.mixture import MixtureComponents, MixtureModelParams
-from hhscatter.analysis.dissipative.survival_model import SurvivalModelParams
+from hhscatter.analysis.dissipative.survival_model import HomogeneousProblem, SurvivalModelParams
 from hhscatter.analysis.geometry import saddle, saddle_checks
 from hhscatter.analysis.noise import (
+    KramersLanger,
+    SaddleTerm,
     energy_diffusion_rate,
     exit_fractions,
     finite_barrier_fit,
@@ -613,3 +615,114 @@ def test_mixture_model_params_names_the_bad_argument(data, which):
     else:
         args[which] = data.draw(NO_NUMBER)
     _refused(which, MixtureModelParams, **args)
+
+
+def _refused_first(name, f, **kwargs):
+    """f(**kwargs) refused with a ConfigError whose message begins with ``name``."""
+    with pytest.raises(ConfigError, match=f"^{name}"):
+        f(**kwargs)
+
+
+#: two sub-ensembles, as :func:`~hhscatter.analysis.dissipative.mixture.mixture_components` builds them (the second
+#: has one member: its mu_err is NaN)
+COMPONENTS = {"t_ref": 5.0, "by": "rate", "edges": np.array([0.7, 1.0, 1.3]), "weights": np.array([0.75, 0.25]),
+              "n_ref": np.array([3, 1]), "E_ref": np.array([0.29, 0.28]), "A": np.array([0.3, 0.3]),
+              "mu": np.array([0.8, 1.2]), "mu_err": np.array([0.01, math.nan]), "fit_window": (0.0, math.inf),
+              "gamma": 0.01}  # fmt: skip
+#: a wrong thing in place of each array of the components, besides those of _bad_array
+WRONG_COMPONENT = {
+    "edges": [np.array([1.3, 1.0, 0.7])],
+    "weights": [np.array([0.5, 0.25]), np.array([1.25, -0.25])],
+    "n_ref": [np.array([2.5, 1.0]), np.array([True, True])],
+    "A": [np.array([0.3, 0.0])],
+    "mu_err": [np.array([0.01, -0.01]), np.array([0.01, math.inf])],
+}
+
+
+def test_the_components_as_built_are_accepted():
+    c = MixtureComponents(**COMPONENTS)
+    assert c.K == 2 and c.n_ref.dtype == np.int64 and c.fit_window == (0.0, math.inf)
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(sorted(COMPONENTS)))
+def test_mixture_components_name_the_bad_argument(data, which):
+    good = COMPONENTS[which]
+    if which in ("t_ref", "gamma"):
+        bad = data.draw(st.one_of(NOT_A_NUMBER, st.sampled_from([0.0, -0.01]) if which == "gamma" else st.nothing()))
+    elif which == "by":
+        bad = data.draw(st.one_of(st.none(), st.integers(), st.text(max_size=4).filter(lambda w: w != "rate")))
+    elif which == "fit_window":
+        bad = data.draw(st.one_of(NOT_A_NUMBER, st.sampled_from([(1.0, 0.0), (math.nan, 1.0), (0.0,), (0.0, True)])))
+    elif data.draw(st.booleans()):
+        bad = data.draw(st.sampled_from([good[None, :], *WRONG_COMPONENT.get(which, [])]))
+    else:
+        bad = _bad_array(data.draw, good, negative=which in ("weights", "n_ref", "A", "mu_err"))
+        if which == "mu_err" and bad.size == good.size and not (np.isinf(bad) | (bad < 0)).any():
+            bad = good[:-1]  # NaN stands where a sub-ensemble has one member: a wrong length instead
+    _refused_first(which, MixtureComponents, **dict(COMPONENTS, **{which: bad}))
+
+
+#: the homogeneous fit's problem on three points (a constant κ0)
+PROBLEM = {"tf": np.array([5.0, 10.0, 20.0]), "Pf": np.array([0.5, 0.4, 0.3]), "sf": np.full(3, 0.01),
+           "kappa_of_E": lambda E: np.full(np.shape(E), 0.05), "E0": 0.3, "mu": 0.91, "gamma": 0.01, "tau0": 5.0,
+           "E_c": 0.2, "hazard": "paper", "space": "log", "free": ("f_ne", "L", "b"), "fixed": {},
+           "start": {"f_ne": 0.1, "f_e": 0.4, "L": 0.05}, "b_starts": (0.02, 0.1), "constrain_total": True,
+           "P_tau0": 0.5}  # fmt: skip
+#: a wrong thing in place of each argument of the problem that is no number or array of numbers
+WRONG_IN_PROBLEM = {
+    "free": [None, "f_ne", ("f_ne", "f_ne"), ("f_ne", "tau2"), 3],
+    "fixed": [None, [("L", 0.1)], {"tau2": 30.0}, {"L": math.nan}, {"L": True}, {"b": "x"}],
+    "start": [None, {}, {"f_ne": 0.1, "f_e": 0.4}, {"f_ne": math.inf, "f_e": 0.4, "L": 0.05}],
+    "b_starts": [None, (), (0.0,), (0.1, math.nan), (True,), "b", (-1.0,)],
+    "constrain_total": [None, 1, "yes", 1.0],
+    "hazard": [None, 3, "x", "Paper"],
+    "space": [None, 3, "x", "Log"],
+}
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(sorted(PROBLEM)))
+def test_homogeneous_problem_names_the_bad_argument(data, which):
+    good = PROBLEM[which]
+    if which in WRONG_IN_PROBLEM:
+        bad = data.draw(st.sampled_from(WRONG_IN_PROBLEM[which]))
+    elif which == "kappa_of_E":
+        bad = data.draw(st.one_of(NOT_A_NUMBER, st.integers()))
+    elif which in ("tf", "Pf", "sf"):
+        if data.draw(st.booleans()):
+            bad = data.draw(st.sampled_from([good[None, :]] + ([] if which == "tf" else [np.array([0.5, 0.0, 0.3])])))
+        else:
+            bad = _bad_array(data.draw, good, negative=which != "tf")
+        if which == "tf" and bad.ndim == 1 and bad.size == 2:  # one short: Pf no longer matches tf
+            _refused("Pf must have one value per time tf", HomogeneousProblem, **dict(PROBLEM, tf=bad))
+            return
+    else:
+        positive = which in ("E0", "E_c", "P_tau0", "gamma")
+        bad = data.draw(st.one_of(NOT_A_NUMBER, st.just(-1.0) if positive else st.nothing()))
+    _refused_first(which, HomogeneousProblem, **dict(PROBLEM, **{which: bad}))
+
+
+#: a saddle's term: ΔE = 1/6, ω_b = 1, λ₊ at γ = 1, its prefactor and its rate at ΔE/T = 6
+TERM = {"x": 0.0, "y": 1.0, "barrier": 1 / 6, "omega_b": 1.0, "lambda_plus": 0.618, "prefactor": 0.057,
+        "rate": 0.057 * math.exp(-6)}  # fmt: skip
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(sorted(TERM)))
+def test_saddle_term_names_the_bad_argument(data, which):
+    out_of_range = {"x": [], "y": [], "rate": [-1e-3]}.get(which, [0.0, -1.0])
+    bad = data.draw(st.one_of(NOT_A_NUMBER, st.sampled_from(out_of_range) if out_of_range else st.nothing()))
+    _refused_first(which, SaddleTerm, **dict(TERM, **{which: bad}))
+
+
+@PROFILE
+@given(data=st.data(), which=st.sampled_from(["gamma", "temperature", "rate", "barrier", "barrier_over_T", "terms"]))
+def test_the_kramers_langer_record_names_the_bad_argument(data, which):
+    args = {"gamma": 1.0, "temperature": 1 / 36, "rate": TERM["rate"], "barrier": 1 / 6, "barrier_over_T": 6.0,
+            "terms": (SaddleTerm(**TERM),)}  # fmt: skip
+    if which == "terms":
+        bad = data.draw(st.sampled_from([None, (), [SaddleTerm(**TERM)], (TERM,), (SaddleTerm(**TERM), 1.0)]))
+    else:
+        bad = data.draw(st.one_of(NOT_A_NUMBER, st.sampled_from([-1e-3] if which == "rate" else [0.0, -1.0])))
+    _refused_first(which, KramersLanger, **dict(args, **{which: bad}))

@@ -12,21 +12,19 @@ expected failure here (strict: a function that starts checking its arguments fai
 
 from __future__ import annotations
 
-import importlib
 import inspect
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _walk import public_callables
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hhscatter.errors import HHScatterError
 
 PROFILE = settings(max_examples=12)  # the rest from the suite's profile (conftest.py)
-SUBPACKAGES = ("stats", "survival", "dissipative", "noise", "geometry")
 
 #: the wrong things put in place of every required argument
 WRONG = st.sampled_from(
@@ -39,17 +37,10 @@ def _public_functions() -> dict[str, object]:
     package exports it, ``sub.module.name`` where it does not (a function named as its module, whose name the
     package gives to the module: ``survival.escape_rate.escape_rate``)."""
     out = {}
-    for sub in SUBPACKAGES:
-        pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
-        for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
-            if path.name.startswith("_"):
-                continue
-            module = importlib.import_module(f"{pkg.__name__}.{path.stem}")
-            for name, obj in vars(module).items():
-                if name.startswith("_") or not inspect.isfunction(obj) or obj.__module__ != module.__name__:
-                    continue
-                exported = pkg._EXPORTS.get(name) == path.stem
-                out[f"{sub}.{name}" if exported else f"{sub}.{path.stem}.{name}"] = obj
+    for sub, pkg, stem, name, obj in public_callables():
+        if inspect.isfunction(obj):
+            exported = pkg._EXPORTS.get(name) == stem
+            out[f"{sub}.{name}" if exported else f"{sub}.{stem}.{name}"] = obj
     return out
 
 

@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 import pytest
+from _walk import SUBPACKAGES, docstring_ids
 
 import hhscatter.analysis
 from hhscatter.studies import study_names
@@ -26,7 +27,6 @@ CONCEPTS = {"noise", "basins", "saddle", "operator"}
 STUDIES = re.compile("|".join(sorted(set(study_names()) - CONCEPTS)), re.IGNORECASE)
 #: the same inside an identifier, where ``_`` joins the words (``PAPER_KAPPA``, ``fig2_rows``)
 IN_A_NAME = re.compile(r"paper|fig(?:ure)?_?\d|stud(?:y|ies)|arxiv", re.IGNORECASE)
-SUBPACKAGES = ("stats", "survival", "dissipative", "noise", "geometry")
 
 
 def _exported_names() -> list[tuple[str, str]]:
@@ -139,14 +139,7 @@ def test_no_exported_name_names_a_figure_study_or_the_paper():
 def _strings(source: str):
     """(line number, text) of every string constant that is not a docstring."""
     tree = ast.parse(source)
-    docs = {
-        id(node.body[0].value)
-        for node in ast.walk(tree)
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
-        and node.body
-        and isinstance(node.body[0], ast.Expr)
-        and isinstance(node.body[0].value, ast.Constant)
-    }
+    docs = docstring_ids(tree)
     for node in ast.walk(tree):
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
             yield node.lineno, node.value

@@ -11,18 +11,17 @@ that is a use of the estimator, not knowledge inside it.
 from __future__ import annotations
 
 import ast
-import importlib
 import inspect
 import math
 from pathlib import Path
 
 import pytest
+from _walk import docstring_ids, public_callables
 
 import hhscatter.analysis
 
 ROOT = Path(hhscatter.analysis.__file__).parent
 MODULES = sorted(ROOT.rglob("*.py"))
-SUBPACKAGES = ("stats", "survival", "dissipative", "noise", "geometry")
 
 #: what of hhscatter.model an estimator may import: the contract of a system and the generic reading of a potential
 ALLOWED_MODULES = {"hhscatter.model.base", "hhscatter.model.landscape", "hhscatter.model.parse"}
@@ -50,23 +49,12 @@ def model_imports(source: str) -> list[tuple[int, str]]:
     return bad
 
 
-def _docstrings(tree) -> set[int]:
-    return {
-        id(node.body[0].value)
-        for node in ast.walk(tree)
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
-        and node.body
-        and isinstance(node.body[0], ast.Expr)
-        and isinstance(node.body[0].value, ast.Constant)
-    }
-
-
 def system_values(source: str) -> list[tuple[int, str]]:
     """(line, what) of every Hénon–Heiles value or name the code writes: a number equal to one of
     :data:`SYSTEM_VALUES`, the quotient 1/6 of two literals, a name or a string (docstrings aside) that says
     Hénon–Heiles."""
     tree = ast.parse(source)
-    docs = _docstrings(tree)
+    docs = docstring_ids(tree)
     hits = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Constant) and id(node) not in docs:
@@ -134,24 +122,10 @@ def test_no_estimator_writes_a_henon_heiles_value(path):
     assert not bad, "\n".join(bad)
 
 
-def _public_callables():
-    for sub in SUBPACKAGES:
-        pkg = importlib.import_module(f"hhscatter.analysis.{sub}")
-        for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
-            if path.name.startswith("_"):
-                continue
-            module = importlib.import_module(f"{pkg.__name__}.{path.stem}")
-            for name, obj in vars(module).items():
-                if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
-                    continue
-                if inspect.isfunction(obj) or inspect.isclass(obj):
-                    yield f"{sub}.{path.stem}.{name}", obj
-
-
 def test_no_public_estimator_defaults_its_system():
     """A parameter that takes a system (``system``, ``model``) has no default: the caller names the system."""
     seen, bad = 0, []
-    for name, obj in _public_callables():
+    for sub, _, stem, name, obj in public_callables():
         try:
             params = inspect.signature(obj).parameters
         except (TypeError, ValueError):
@@ -160,7 +134,7 @@ def test_no_public_estimator_defaults_its_system():
             if p.name in ("system", "model"):
                 seen += 1
                 if p.default is not p.empty:
-                    bad.append(f"{name}({p.name}={p.default!r})")
+                    bad.append(f"{sub}.{stem}.{name}({p.name}={p.default!r})")
     assert seen >= 10  # the check reads the estimators that take a system
     assert not bad, bad
 

@@ -359,7 +359,10 @@ def test_8_ics_below_ec_with_drag_are_refused(tmp_path, capsys):
         (["--r-esc", "1e50"], "r_esc must be ≤ 100 r_s = 100, got 1e+50 (energy conservation"),
         (["--radius", "1e300"], "radius must be ≤ r_esc = 1.5, got 1e+300"),
         (["--energy", "1e300"], "energy must be ≤ 1000 E_c = 166.667, got 1e+300"),
-        (["--gamma", "1e300"], "gamma must be ≤ 10 ω = 10, got 1e+300 (beyond, the motion is overdamped"),
+        (
+            ["--gamma", "1e300"],
+            "gamma must be ≤ 10 ω = 10 (ω the system's frequency), got 1e+300 (with the linear drag the motion is overdamped",
+        ),
         (["--snapshots", "0:5000:1e-6"], "snapshots: 0:5000:1e-06 gives 5000000001 times, more than 100000"),
         (["-n", "1e12"], "n must be ≤ 1e+09 per run, got 1e+12"),
         (["-n", "1e8", "--chunk-size", "10"], "gives 10000000 chunks for n = 100000000, more than 100000 part files"),

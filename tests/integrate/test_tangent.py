@@ -5,9 +5,11 @@ without it unchanged."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import heyoka as hy
@@ -316,3 +318,31 @@ def test_a_log_stretch_beyond_its_bound_is_counted_and_warned_of():
     assert list(res.lifetimes["outcome"]) == [CENSORED, CENSORED]
     assert lam[0] > events.MAX_LOG_STRETCH > 100.0 > lam[1], lam
     assert res.tangent_beyond == 1
+
+
+def test_a_resumed_run_counts_the_log_stretches_beyond_its_bound_in_the_chunks_it_keeps(tmp_path):
+    """Three chunks, each of the two confined orbits above (one passes Λ = 600, one does not). The run is then
+    stopped after its first chunk as an interruption leaves it (the other chunks' parts not written, scene.json
+    without the closing counts) and resumed: the resumed run's total of orbits beyond the bound, in its summary and
+    its scene.json, is the uninterrupted run's, 3, the kept chunk's orbit included."""
+    e, px0 = 0.16, 0.25
+    rows = [[0.0, y, px0, np.sqrt(2 * (e - y * y / 2 + y**3 / 3 - px0 * px0 / 2))] for y in (0.45, -0.25)] * 3
+    table = tmp_path / "ics.csv"
+    table.write_text("x,y,px,py\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n")
+    sc = Scene(energy=None, n=6, ics=str(table), t_max=5000.0, tangent=True, chunk_size=2)
+    out = tmp_path / "run"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", events.TangentStretchWarning)
+        whole = simulate(sc, out, workers=1, progress=False)
+        for part in out.glob("*/part-00000[12].parquet"):
+            part.unlink()
+        doc = json.loads((out / "scene.json").read_text())
+        for key in ("tangent_beyond", "event_failures"):
+            doc.pop(key, None)
+        (out / "scene.json").write_text(json.dumps(doc))
+        resumed = simulate(sc, out, workers=1, resume=True, progress=False)
+    assert whole.tangent_beyond == 3  # the chaotic orbit of each chunk
+    assert (resumed.chunks_skipped, resumed.chunks_done) == (1, 2)
+    assert resumed.tangent_beyond == whole.tangent_beyond
+    assert json.loads((out / "scene.json").read_text())["tangent_beyond"] == 3
+    assert "3 orbit(s) with a log-stretch" in resumed.line()

@@ -85,6 +85,30 @@ class MixtureComponents:
     ``A, mu, mu_err``  (K,) paths E_k(t) = A_k exp(−μ_k γ t);
     ``fit_window`` time window of the per-orbit fits; ``gamma`` the drag.
     Build with :func:`mixture_components`, or directly for known paths.
+
+    Units: t_ref and fit_window in time, E_ref and A in energy, gamma in 1/time; mu and weights dimensionless.
+    The arguments are checked when the components are built: t_ref a finite number, ``by`` "energy" or "rate",
+    K ≥ 1 weights ≥ 0 summing to 1, K + 1 non-decreasing edges, K whole counts n_ref ≥ 0, K finite E_ref and mu,
+    K amplitudes A > 0, K errors mu_err ≥ 0 (NaN where a sub-ensemble has one member), fit_window a pair lo < hi
+    (hi may be inf) and gamma > 0; a wrong one (a word, a bool, NaN or inf, a wrong length or a value out of range)
+    is refused with a ConfigError naming it. The arrays are kept as float arrays (n_ref as integers).
+
+    Examples
+    --------
+    Two sub-ensembles on paths E_k(t) = A_k e^{−μ_k γ t} from A = 0.3 with μ = 0.8 and 1.2 at γ = 0.01: at t = 50
+    their energies are 0.3 e^{−0.4} and 0.3 e^{−0.6}.
+
+    >>> c = MixtureComponents(t_ref=5.0, by="rate", edges=[0.7, 1.0, 1.3], weights=[0.5, 0.5], n_ref=[3, 3],
+    ...                       E_ref=[0.29, 0.28], A=[0.3, 0.3], mu=[0.8, 1.2], mu_err=[0.0, 0.0],
+    ...                       fit_window=(0.0, np.inf), gamma=0.01)
+    >>> c.K, np.allclose(c.energy(50.0)[:, 0], 0.3 * np.exp([-0.4, -0.6]))
+    (2, True)
+    >>> MixtureComponents(t_ref=5.0, by="rate", edges=[0.7, 1.0, 1.3], weights=[0.5, 0.4], n_ref=[3, 3],
+    ...                   E_ref=[0.29, 0.28], A=[0.3, 0.3], mu=[0.8, 1.2], mu_err=[0.0, 0.0],
+    ...                   fit_window=(0.0, np.inf), gamma=0.01)
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: weights must sum to 1 (fractions of the orbits alive at t_ref), got 0.9
     """
 
     t_ref: float
@@ -98,6 +122,37 @@ class MixtureComponents:
     mu_err: np.ndarray
     fit_window: tuple
     gamma: float
+
+    def __post_init__(self):
+        check.number(self.t_ref, "t_ref")
+        if not isinstance(self.by, str) or self.by not in ("energy", "rate"):
+            raise ConfigError(f"by must be 'energy' or 'rate', got {self.by!r}")
+        weights = _per_component(self.weights, "weights", None, minimum=0.0)
+        if abs(weights.sum() - 1.0) > 1e-9:
+            raise ConfigError(
+                f"weights must sum to 1 (fractions of the orbits alive at t_ref), got {weights.sum():.6g}"
+            )
+        K = weights.size
+        edges = _per_component(self.edges, "edges", K + 1)
+        if np.any(np.diff(edges) < 0):
+            raise ConfigError("edges must be non-decreasing (the quantile edges of the bins)")
+        n_ref = _per_component(self.n_ref, "n_ref", K, minimum=0.0)
+        if np.any(n_ref != np.round(n_ref)):
+            raise ConfigError("n_ref must hold whole counts of orbits")
+        arrays = {"weights": weights, "edges": edges, "n_ref": n_ref.astype(np.int64)}
+        arrays["E_ref"] = _per_component(self.E_ref, "E_ref", K)
+        arrays["A"] = _per_component(self.A, "A", K, positive=True)
+        arrays["mu"] = _per_component(self.mu, "mu", K)
+        if np.ndim(self.mu_err) != 1:
+            raise ConfigError(f"mu_err must be a 1-D array of numbers, got {type(self.mu_err).__name__}")
+        mu_err = check.floats(self.mu_err, "mu_err", size=K, of="sub-ensemble")
+        if np.any(np.isinf(mu_err)) or np.any(mu_err < 0):
+            raise ConfigError("mu_err must be ≥ 0 and finite (NaN where a sub-ensemble has one member)")
+        arrays["mu_err"] = mu_err
+        window = check.interval(self.fit_window, "fit_window", open_end=True)
+        check.number(self.gamma, "gamma", positive=True)
+        for name, value in {**arrays, "fit_window": window}.items():
+            object.__setattr__(self, name, value)
 
     @property
     def K(self) -> int:
@@ -128,6 +183,22 @@ class MixtureComponents:
                 "tau2": self.tau2(E_c),
             }
         )
+
+
+def _per_component(a, name: str, size: int | None, *, minimum: float | None = None, positive: bool = False):
+    """``a`` as a 1-D float array of finite numbers with ``size`` values (one per sub-ensemble, or K + 1 edges)."""
+    try:
+        flat = np.ndim(a) == 1
+    except ValueError:  # a ragged nesting
+        flat = False
+    if not flat:
+        raise ConfigError(f"{name} must be a 1-D array of numbers, got {type(a).__name__}")
+    arr = check.numbers(a, name, minimum=minimum, positive=positive)
+    if size is not None and arr.size != size:
+        raise ConfigError(
+            f"{name} must have {size} values (K = {size - 1 if name == 'edges' else size}), got {arr.size}"
+        )
+    return arr
 
 
 def _per_orbit_decay(ids, t, e, lo, hi):

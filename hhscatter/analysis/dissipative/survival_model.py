@@ -558,6 +558,19 @@ def _homogeneous_result(
     return _survival_fit(model, values, errors, free + (("tau2",) if fit_tau2 else ()), st, tf, r, sol, prob.space)
 
 
+def _parameter_values(d, name: str, names: tuple, required: tuple) -> None:
+    """``d`` a dict of parameter names among ``names`` (holding every one of ``required``) to finite numbers."""
+    check.mapping(d, name)
+    unknown = sorted(set(d) - set(names))
+    if unknown:
+        raise ConfigError(f"{name} names unknown parameters {unknown}; they are among {names}")
+    missing = [n for n in required if n not in d]
+    if missing:
+        raise ConfigError(f"{name} lacks {', '.join(missing)}")
+    for key, value in d.items():
+        check.number(value, f"{name}[{key!r}]")
+
+
 def _homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None):
     """homogeneous_start(tf, Pf, tau2, P_tau0, fixed, p0=None) -> (f_ne, f_e, L, b starts): data-driven starting
     values of the homogeneous fit (``p0`` and ``fixed`` win): f_ne ≈ P(τ2) (below 0.9 P(τ0)), f_e = P(τ0) − f_ne,
@@ -596,6 +609,34 @@ class HomogeneousProblem:
     ``start`` the starting f_ne, f_e, L and ``b_starts`` the starts for b;
     with ``constrain_total`` (and f_e not fixed) f_e = P(τ0) − f_ne. Each step
     of the fit is a method, testable alone.
+
+    The arguments are checked when the problem is built, a wrong one refused with a ConfigError naming it: tf
+    (time), Pf and sf one finite value per time (at least one; Pf ≥ 0, and > 0 in the "log" ``space``; sf > 0), the
+    energy path and law as :func:`survival_model` takes them (E0 > 0 (energy), mu, gamma ≥ 0 (1/time), tau0 (time),
+    E_c > 0 (energy), ``hazard``), ``space`` "log" or "linear", ``free`` distinct names among f_ne, f_e, L, b,
+    ``fixed`` and ``start`` (f_ne, f_e, L) dicts of those names to finite numbers, ``b_starts`` at least one
+    b > 0, ``constrain_total`` a bool and P_tau0 ≥ 0. The arrays are kept as float arrays, free and b_starts as
+    tuples.
+
+    Examples
+    --------
+    A constant κ0 = 0.05 with f_e = P(τ0) − f_ne derived: θ = (f_ne, L, b) = (0.1, 0.2, 0.3) at τ2 = 30 gives
+    f_e = 0.5 − 0.1.
+
+    >>> prob = HomogeneousProblem(tf=[5.0, 10.0, 20.0], Pf=[0.5, 0.4, 0.3], sf=[0.01, 0.01, 0.01],
+    ...                           kappa_of_E=lambda E: np.full(np.shape(E), 0.05), E0=0.3, mu=0.91, gamma=0.01,
+    ...                           tau0=5.0, E_c=0.2, hazard="paper", space="log", free=("f_ne", "L", "b"), fixed={},
+    ...                           start={"f_ne": 0.1, "f_e": 0.4, "L": 0.05}, b_starts=(0.1,), constrain_total=True,
+    ...                           P_tau0=0.5)
+    >>> {k: round(v, 12) for k, v in prob.values([0.1, 0.2, 0.3], tau2=30.0).items()}
+    {'f_ne': 0.1, 'f_e': 0.4, 'L': 0.2, 'b': 0.3, 'tau2': 30.0}
+    >>> HomogeneousProblem(tf=[5.0, 10.0], Pf=[0.5, 0.4], sf=[0.01, 0.01], kappa_of_E=lambda E: E, E0=0.3,
+    ...                    mu=0.91, gamma=0.01, tau0=5.0, E_c=0.2, hazard="paper", space="log", free=("f_ne", "tau2"),
+    ...                    fixed={}, start={"f_ne": 0.1, "f_e": 0.4, "L": 0.05}, b_starts=(0.1,),
+    ...                    constrain_total=True, P_tau0=0.5)
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: free must name distinct parameters among ('f_ne', 'f_e', 'L', 'b'), got ('f_ne', 'tau2')
     """
 
     tf: np.ndarray
@@ -615,6 +656,45 @@ class HomogeneousProblem:
     b_starts: tuple
     constrain_total: bool
     P_tau0: float
+
+    def __post_init__(self):
+        for name in ("tf", "Pf", "sf"):
+            if np.ndim(getattr(self, name)) != 1:
+                raise ConfigError(f"{name} must be a 1-D array of numbers, got {type(getattr(self, name)).__name__}")
+        tf = check.numbers(self.tf, "tf")
+        Pf = check.numbers(self.Pf, "Pf", minimum=0.0)
+        sf = check.numbers(self.sf, "sf", positive=True)
+        for arr, name in ((Pf, "Pf"), (sf, "sf")):
+            if arr.size != tf.size:
+                raise ConfigError(f"{name} must have one value per time tf: {arr.size} != {tf.size}")
+        if self.space not in ("log", "linear"):
+            raise ConfigError(f"space must be 'log' or 'linear', got {self.space!r}")
+        if self.space == "log" and not np.all(Pf > 0):
+            raise ConfigError("Pf must be > 0 in the log space (its residuals take ln P)")
+        check.function(self.kappa_of_E, "kappa_of_E")
+        check.number(self.E0, "E0", positive=True)
+        check.number(self.mu, "mu")
+        check.number(self.gamma, "gamma", minimum=0.0)
+        check.number(self.tau0, "tau0")
+        check.number(self.E_c, "E_c", positive=True)
+        if self.hazard not in HAZARDS:
+            raise ConfigError(f"hazard must be one of {HAZARDS}, got {self.hazard!r}")
+        names = _HOMOG[:4]
+        free = tuple(self.free) if isinstance(self.free, (tuple, list)) else None
+        if free is None or len(set(free)) != len(free) or not set(free) <= set(names):
+            raise ConfigError(f"free must name distinct parameters among {names}, got {self.free!r}")
+        _parameter_values(self.fixed, "fixed", names, ())
+        _parameter_values(self.start, "start", names, ("f_ne", "f_e", "L"))
+        b_starts = tuple(self.b_starts) if isinstance(self.b_starts, (tuple, list)) else ()
+        if not b_starts:
+            raise ConfigError(f"b_starts must be a tuple of at least one start for b, got {self.b_starts!r}")
+        for i, b in enumerate(b_starts):
+            check.number(b, f"b_starts[{i}]", positive=True)
+        if not isinstance(self.constrain_total, (bool, np.bool_)):
+            raise ConfigError(f"constrain_total must be True or False, got {self.constrain_total!r}")
+        check.number(self.P_tau0, "P_tau0", minimum=0.0)
+        for name, value in (("tf", tf), ("Pf", Pf), ("sf", sf), ("free", free), ("b_starts", b_starts)):
+            object.__setattr__(self, name, value)
 
     @property
     def derive_fe(self) -> bool:

@@ -107,6 +107,20 @@ class SaddleTerm:
     x, y (length), barrier ΔE = V(s) − V(min) (energy), omega_b (1/time, the unstable frequency),
     lambda_plus (1/time, the growth rate with drag), prefactor (λ₊/2π)√(det H_min/|det H_s|) (1/time), rate
     (1/time, prefactor · e^{−ΔE/T}).
+
+    The numbers are checked when the term is built: x, y finite, barrier, omega_b, lambda_plus and prefactor
+    finite and > 0 (a saddle above the well's minimum, an unstable direction), rate finite and ≥ 0 (e^{−ΔE/T} may
+    underflow); a wrong one (a word, a bool, NaN or inf, a value out of range) is refused with a ConfigError naming
+    it.
+
+    Examples
+    --------
+    :func:`kramers_langer` builds one per exit; a saddle below the well's minimum is no barrier:
+
+    >>> SaddleTerm(x=0.0, y=1.0, barrier=-0.1, omega_b=1.0, lambda_plus=0.6, prefactor=0.057, rate=0.001)
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: barrier must be > 0, got -0.1
     """
 
     x: float
@@ -117,11 +131,27 @@ class SaddleTerm:
     prefactor: float
     rate: float
 
+    def __post_init__(self):
+        check.number(self.x, "x")
+        check.number(self.y, "y")
+        for name in ("barrier", "omega_b", "lambda_plus", "prefactor"):
+            check.number(getattr(self, name), name, positive=True)
+        check.number(self.rate, "rate", minimum=0.0)
+
 
 @dataclass(frozen=True)
 class KramersLanger:
     """The Kramers–Langer rate of a system at (γ, T): ``rate`` (1/time), the lowest ``barrier`` ΔE (energy),
-    ``barrier_over_T`` = ΔE/T, and the per-saddle ``terms`` (:class:`SaddleTerm`)."""
+    ``barrier_over_T`` = ΔE/T, and the per-saddle ``terms`` (:class:`SaddleTerm`).
+
+    Checked when built: gamma, temperature, barrier and barrier_over_T finite and > 0, rate finite and ≥ 0, terms
+    a tuple of at least one SaddleTerm; a wrong one is refused with a ConfigError naming it.
+
+    >>> KramersLanger(gamma=1.0, temperature=0.0, rate=0.001, barrier=1 / 6, barrier_over_T=6.0, terms=())
+    Traceback (most recent call last):
+    ...
+    hhscatter.errors.ConfigError: temperature must be > 0, got 0.0
+    """
 
     gamma: float
     temperature: float
@@ -129,6 +159,17 @@ class KramersLanger:
     barrier: float
     barrier_over_T: float
     terms: tuple
+
+    def __post_init__(self):
+        for name in ("gamma", "temperature", "barrier", "barrier_over_T"):
+            check.number(getattr(self, name), name, positive=True)
+        check.number(self.rate, "rate", minimum=0.0)
+        if (
+            not isinstance(self.terms, tuple)
+            or not self.terms
+            or not all(isinstance(t, SaddleTerm) for t in self.terms)
+        ):
+            raise ConfigError(f"terms must be a tuple of at least one SaddleTerm, got {self.terms!r}")
 
 
 def well_barrier(model) -> float:
@@ -285,8 +326,8 @@ def window_constancy(rate: ThermalRate, z_max: float) -> WindowConstancy:
     >>> c = window_constancy(r, 3.0)
     >>> round(c.z, 12), c.constant, window_constancy(r, 0.5).constant
     (-0.8, True, False)
-    >>> c.second.to_dict()
-    {'value': 0.008, 'err': 0.004}
+    >>> c.second.value, c.second.err
+    (0.008, 0.004)
     """
     if not isinstance(rate, ThermalRate):
         raise ConfigError(f"rate must be a ThermalRate (thermal_rate's result), got {type(rate).__name__}")

@@ -149,8 +149,8 @@ class Measured:
 
         Examples
         --------
-        >>> Measured(5.0, 0.3).sum(Measured(2.0, 0.4)).to_dict()
-        {'value': 7.0, 'err': 0.5}
+        >>> Measured(5.0, 0.3).sum(Measured(2.0, 0.4))
+        Measured(value=7.0, err=0.5, method='sum', n=None)
         """
         o = _as_measured(other)
         return Measured(self.value + o.value, math.hypot(self.err, o.err), "sum")
@@ -185,8 +185,8 @@ class Measured:
         --------
         >>> Measured(0.3, 0.06, "MLE", 50).over(-2.0)
         Measured(value=-0.15, err=0.03, method='MLE', n=50)
-        >>> Measured(math.nan, math.nan).over(4.0).to_dict()
-        {'value': nan, 'err': nan}
+        >>> Measured(math.nan, math.nan).over(4.0)
+        Measured(value=nan, err=nan, method='', n=None)
         """
         return Measured(self.value / c, self.err / abs(c), self.method, self.n)
 
