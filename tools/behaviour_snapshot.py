@@ -7,6 +7,13 @@ moved::
     python tools/behaviour_snapshot.py record before.json            # scenes + tables (~1 min)
     python tools/behaviour_snapshot.py record before.json --numbers  # plus `make studies SCALE=tiny` JSONs
     python tools/behaviour_snapshot.py compare before.json after.json   # exit 1 on any difference
+    python tools/behaviour_snapshot.py numbers old.json --checkout DIR   # only the tiny JSONs present in DIR
+
+The code recorded is this checkout's (``ROOT`` first on the import path of the script and of every command it
+starts), not the one an editable install of a shared virtual environment points at; ``make`` runs with the
+environment's install stamp taken as up to date, so it never reinstalls. ``numbers`` reads another checkout's
+outputs (an older commit, its studies run with its own code) with this version of the tool, so that both sides of
+a comparison are read alike.
 
 What is recorded:
 
@@ -37,6 +44,7 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's hhscatter, before any editable install of a shared environment
 VOLATILE = {
     "git_commit",
     "heyoka",
@@ -77,6 +85,15 @@ def _strip(obj):
     return obj
 
 
+def _env() -> dict:
+    """The environment of a command the script starts: this checkout's code first on its import path."""
+    import os
+
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
+    return env
+
+
 def _sha(b: bytes) -> str:
     return hashlib.sha256(b).hexdigest()[:16]
 
@@ -109,7 +126,7 @@ def record_tables(hh: Path) -> dict:
             args = [str(hh), "simulate", *flags.split(), "--out", str(run), "--workers", "1", "--no-progress"]
             if name == "ics":
                 args += ["--ics", str(tmp / "ics.csv")]
-            p = subprocess.run(args, capture_output=True, text=True)
+            p = subprocess.run(args, capture_output=True, text=True, env=_env())
             if p.returncode:
                 out[name] = {"error": f"exit {p.returncode}: {p.stderr.strip()[-300:]}"}
                 continue
@@ -177,11 +194,13 @@ def numeric_leaves(obj, prefix=""):
         yield prefix, obj
 
 
-def record_numbers(make: bool) -> dict:
-    if make:
-        subprocess.run(["make", "studies", "SCALE=tiny"], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+def record_numbers(make: bool, checkout: Path = ROOT) -> dict:
+    """Every leaf of the tiny-scale numbers JSON of each study of ``checkout`` (its ``studies/<name>/out/tiny/``)."""
+    if make:  # the install stamp taken as up to date: never a reinstall into the (perhaps shared) environment
+        cmd = ["make", "-o", ".venv/.installed-stamp", "studies", "SCALE=tiny"]
+        subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL, env=_env())
     out = {}
-    for f in sorted((ROOT / "studies").glob("*/out/tiny/*.json")):
+    for f in sorted((Path(checkout) / "studies").glob("*/out/tiny/*.json")):
         if f.name.endswith(".cost.json") or f.parent.parent.parent.name != f.stem:
             continue
         out[f.stem] = dict(numeric_leaves(json.loads(f.read_text())))
@@ -197,9 +216,16 @@ def compare(a: dict, b: dict, path="") -> list[str]:
             diffs.append(f"{p}: only in {'after' if k not in a else 'before'}")
         elif isinstance(a[k], dict) and isinstance(b[k], dict):
             diffs += compare(a[k], b[k], p)
-        elif a[k] != b[k]:
+        elif not _same(a[k], b[k]):
             diffs.append(f"{p}: {a[k]!r} -> {b[k]!r}")
     return diffs
+
+
+def _same(x, y) -> bool:
+    """Leaves equal exactly: the same type, and a float bit for bit (NaN equals NaN, -0.0 differs from 0.0)."""
+    if type(x) is not type(y):
+        return False
+    return repr(x) == repr(y) if isinstance(x, float) else x == y
 
 
 def main(argv=None) -> int:
@@ -211,6 +237,9 @@ def main(argv=None) -> int:
     r.add_argument(
         "--numbers-only-existing", action="store_true", help="record the tiny JSONs already present (no make)"
     )
+    n = sub.add_parser("numbers", help="record only the tiny-scale numbers already present (no make, no scenes)")
+    n.add_argument("out", type=Path)
+    n.add_argument("--checkout", type=Path, default=ROOT, help="the checkout whose outputs to read (default: this)")
     c = sub.add_parser("compare")
     c.add_argument("before", type=Path)
     c.add_argument("after", type=Path)
@@ -224,6 +253,15 @@ def main(argv=None) -> int:
         print(
             f"wrote {a.out}: {n} scene hashes, {len(snap['tables'])} table runs, "
             f"{sum(len(v) for v in snap.get('numbers', {}).values())} numbers"
+        )
+        return 0
+    if a.cmd == "numbers":
+        if not (a.checkout / "studies").is_dir():
+            ap.error(f"--checkout {a.checkout}: no studies/ folder there")
+        snap = {"numbers": record_numbers(make=False, checkout=a.checkout)}
+        a.out.write_text(json.dumps(snap, indent=1, sort_keys=True))
+        print(
+            f"wrote {a.out}: {sum(len(v) for v in snap['numbers'].values())} numbers of {len(snap['numbers'])} studies"
         )
         return 0
     before, after = (json.loads(p.read_text()) for p in (a.before, a.after))
