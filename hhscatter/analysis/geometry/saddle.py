@@ -377,9 +377,10 @@ def _scale_range(eps_min, eps_max) -> None:
 
 def _floor(floor) -> float:
     """A floor of the scaling range as a fraction of the points' extent: a number in (0, 1)."""
-    if isinstance(floor, bool) or not isinstance(floor, (int, float, np.integer, np.floating)) or not 0 < floor < 1:
+    v = _positive(floor, "floor")
+    if not v < 1:
         raise ConfigError(f"floor must be a fraction of the points' longest side, 0 < floor < 1, got {floor!r}")
-    return float(floor)
+    return v
 
 
 def _slope(x, y) -> tuple[float, float]:
