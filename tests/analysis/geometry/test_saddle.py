@@ -425,11 +425,12 @@ def _weighted_cantor(n, p, seed, depth=20):
     return x, -(p * np.log(p) + (1 - p) * np.log(1 - p)) / np.log(3)
 
 
-@pytest.mark.parametrize("p", [0.5, 2 / 3, 0.85])
-def test_neighbour_dimension_of_blocks_covers_the_weighted_cantor_set(p):
+@pytest.mark.parametrize(("p", "max_err"), [(0.5, 0.02), (2 / 3, 0.025), (0.85, 0.12)])
+def test_neighbour_dimension_of_blocks_covers_the_weighted_cantor_set(p, max_err):
     """Points on 8 separate lines (blocks: neighbours within a line only, the mass fraction over the line's points),
     each line a weighted Cantor set, 1250 points a line: the 2σ interval covers the closed form in at least 9 of 10
-    seeds, from the uniform weights (d₁ = d₀ = ln 2/ln 3) to strongly non-uniform ones (d₁ = 0.38 at p = 0.85). The
+    seeds, from the uniform weights (d₁ = d₀ = ln 2/ln 3) to strongly non-uniform ones (d₁ = 0.38 at p = 0.85, whose
+    rare pieces hold few points: errors up to 0.1 there, 0.012–0.014 for the others). The
     same points as one line (a single block) give another estimate from the same mass fractions: blocks do not
     reduce to relabelling."""
     covered = 0
@@ -437,7 +438,7 @@ def test_neighbour_dimension_of_blocks_covers_the_weighted_cantor_set(p):
         x, truth = _weighted_cantor(10000, p, seed)
         d = information_dimension_neighbours(x, blocks=np.arange(10000) % 8, floor=1e-4, n_boot=20, seed=seed)
         covered += abs(d.value - truth) <= 2 * d.err
-        assert d.err < 0.1 and "8 blocks" in d.method
+        assert d.err < max_err and "8 blocks" in d.method
     assert covered >= 9, (p, covered)
     one = information_dimension_neighbours(x, floor=1e-4, n_boot=0)
     assert one.value != d.value and "blocks" not in one.method
