@@ -47,6 +47,9 @@ __all__ = [
     "gap_row",
     "hyperbolic_record",
     "gap_summary",
+    "lines_record",
+    "lines_row",
+    "lines_summary",
     "lyapunov_by_t_min",
     "mid_lyapunov_record",
     "relation_row",
@@ -461,7 +464,128 @@ def hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.7
                            "d1": Measured(d.value, d.err).scaled(0.5).to_dict()}}  # fmt: skip
 
 
+def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: float) -> dict:
+    """lines_record(by_t_min, chosen, scan, kg, *, n_lines, scatter) -> the record's keys of d₁ on lines.
+
+    d₁ measured on lines of initial conditions: the orbits of a line that leave after t_min start within
+    ~e^{−λ̄ t_min} of the saddle's stable manifold, and the measure they carry along the line (Lebesgue, normalised
+    over the survivors) tends to the stable manifold's natural measure, whose information dimension along the
+    line is the partial d₁ of the relation: the weight of a surviving interval of length ε_i is ε_i e^{κt}, so its
+    information over the scale ln(1/ε) ≈ λ̄t is (λ̄ − κ)t/(λ̄t) = 1 − κ/λ̄ (Kantz and Grassberger 1985). No section
+    points, no doubling of a section dimension: an independent measurement of the same d₁.
+
+    ``by_t_min`` is a list of (t_min·κ, number of survivors, SaddleDimension or the refusal's text), ``chosen`` the
+    t_min·κ of the rule (one of them), ``scan`` the :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan`
+    of the chosen survivors, ``kg`` the :class:`~hhscatter.analysis.geometry.saddle.KantzGrassberger` of κ, λ̄ and
+    that d₁ (or None), ``scatter`` e^{−λ̄ t_min}: the survivors' distance from the stable manifold in units of a
+    line's extent (stated, not used). Keys: ``d1_lines`` ({value, err}, None where refused) and
+    ``d1_lines_detail`` (t_min_kappa, n_points, n_lines, eps_range, scatter_extent, floor_scan rows, by_t_min rows,
+    and the relation with this d₁: predicted, z, verdict).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from hhscatter.analysis.geometry.saddle import kantz_grassberger
+    >>> class D: value, err, eps_range = 0.77, 0.005, (1e-4, 0.02)
+    >>> scan = pd.DataFrame({"factor": [1.0], "floor": [1e-4], "eps_min": [1e-4], "value": [0.77], "err": [0.005],
+    ...                      "eps_lo": [1e-4], "eps_hi": [0.02], "note": [""]})
+    >>> kg = kantz_grassberger(0.0953, 0.0004, 0.412, 0.0017, 0.77, 0.005)
+    >>> r = lines_record([(5.0, 5000, D), (6.0, 1650, "too few")], 5.0, scan, kg, n_lines=16, scatter=1e-9)
+    >>> r["d1_lines"], r["d1_lines_detail"]["verdict"], r["d1_lines_detail"]["by_t_min"][1]["d1"]
+    ({'value': 0.77, 'err': 0.005}, 'agrees (z = +0.3)', None)
+    """
+    rows, chosen_row = [], None
+    for c, n, d in by_t_min:
+        ok = not isinstance(d, str)
+        row = {"t_min_kappa": float(c), "n_points": int(n), "d1": Measured(d.value, d.err).to_dict() if ok else None,
+               "eps_range": list(d.eps_range) if ok else None, "note": "" if ok else str(d)}  # fmt: skip
+        rows.append(row)
+        if c == chosen:
+            chosen_row = row
+    if chosen_row is None:
+        raise ConfigError(f"chosen t_min·κ {chosen!r} is not among the t_min of by_t_min")
+    scan_rows = [{"factor": float(r.factor), "floor": float(r.floor),
+                  "d1": Measured(r.value, r.err).to_dict() if math.isfinite(r.value) else None,
+                  "eps_range": [float(r.eps_lo), float(r.eps_hi)] if math.isfinite(r.value) else None,
+                  "note": r.note} for r in scan.itertuples()]  # fmt: skip
+    detail = {"t_min_kappa": float(chosen), "n_points": chosen_row["n_points"], "n_lines": int(n_lines),
+              "eps_range": chosen_row["eps_range"], "scatter_extent": float(scatter), "floor_scan": scan_rows,
+              "by_t_min": rows}  # fmt: skip
+    if kg is not None:
+        detail.update({"predicted": Measured(kg.predicted, kg.predicted_err).to_dict(), "z": kg.z,
+                       "verdict": kg.verdict})  # fmt: skip
+    return {"d1_lines": chosen_row["d1"], "d1_lines_detail": detail}
+
+
+def lines_row(rec: dict) -> dict:
+    """lines_row(rec) -> a record's d₁ on the section (D₁/2), d₁ on lines, 1 − κ/λ̄ and the relation with d₁ on lines
+    (the table beside the section's), the ones it has.
+
+    Examples
+    --------
+    >>> lines_row({"id": "a", "system": "hh", "ratio": 1.5, "d1": 0.70, "d1_err": 0.005,
+    ...            "d1_implied": 0.769, "d1_implied_err": 0.001, "d1_lines": {"value": 0.77, "err": 0.005},
+    ...            "d1_lines_detail": {"n_points": 5000, "eps_range": [1e-4, 0.02], "z": -0.3,
+    ...                                "verdict": "agrees (z = −0.3)"}})  # doctest: +NORMALIZE_WHITESPACE
+    {'id': 'a', 'system': 'hh', 'ratio': 1.5, 'd1': {'value': 0.7, 'err': 0.005},
+     'd1_implied': {'value': 0.769, 'err': 0.001}, 'd1_lines': {'value': 0.77, 'err': 0.005}, 'n_points': 5000,
+     'eps_range': [0.0001, 0.02], 'z': -0.3, 'verdict': 'agrees (z = −0.3)'}
+    """
+    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
+    for name in ("d1", "d1_implied"):
+        if rec.get(name) is not None and rec.get(name + "_err") is not None:
+            row[name] = Measured(rec[name], rec[name + "_err"]).to_dict()
+    if rec.get("d1_lines"):
+        det = rec["d1_lines_detail"]
+        row.update({"d1_lines": rec["d1_lines"], "n_points": det["n_points"], "eps_range": det["eps_range"]})
+        if "z" in det:
+            row.update({"z": det["z"], "verdict": det["verdict"]})
+    return row
+
+
+def lines_summary(records) -> dict:
+    """lines_summary(records) -> the relation with d₁ on lines (checked, within 2σ, per system) and d₁ on the section
+    against d₁ on lines (z of their difference, both errors; where it exceeds 2 and by how much), with the statement.
+
+    Examples
+    --------
+    >>> recs = [{"id": "a", "system": "hh", "d1": 0.70, "d1_err": 0.005, "d1_lines": {"value": 0.77, "err": 0.005},
+    ...          "d1_lines_detail": {"z": -0.3}},
+    ...         {"id": "b", "system": "hh", "d1": 0.61, "d1_err": 0.007, "d1_lines": {"value": 0.64, "err": 0.009},
+    ...          "d1_lines_detail": {"z": 2.4}}, {"id": "c", "system": "hh"}]
+    >>> s = lines_summary(recs)
+    >>> s["n_checked"], s["n_within_2sigma"], s["section_below_at"]
+    (2, 1, ['a', 'b'])
+    >>> print(s["statement"])
+    With d₁ on lines, κ = λ̄(1 − d₁) holds within 2σ at 1 of the 2 points checked (hh: 1 of 2); the section points' d₁ lies more than 2σ below d₁ on lines at 2 of 2, by 0.030–0.070
+    """
+    checked = [r for r in records if r.get("d1_lines") and "z" in r.get("d1_lines_detail", {})]
+    within = [r for r in checked if abs(r["d1_lines_detail"]["z"]) <= 2]
+    by_system = {}
+    for r in checked:
+        s = by_system.setdefault(r["system"], {"n_checked": 0, "n_within_2sigma": 0})
+        s["n_checked"] += 1
+        s["n_within_2sigma"] += abs(r["d1_lines_detail"]["z"]) <= 2
+    both = [r for r in records if r.get("d1_lines") and r.get("d1") is not None and r.get("d1_err") is not None]
+    diffs = []
+    for r in both:
+        diff = Measured(r["d1"], r["d1_err"]).difference(Measured(r["d1_lines"]["value"], r["d1_lines"]["err"]))
+        diffs.append((r["id"], diff.value, diff.value / diff.err if diff.err > 0 else math.copysign(math.inf, diff.value)))
+    below = [(i, v) for i, v, z in diffs if z < -2]
+    above = [i for i, _v, z in diffs if z > 2]
+    statement = (f"With d₁ on lines, κ = λ̄(1 − d₁) holds within 2σ at {len(within)} of the {len(checked)} points "
+                 f"checked" + (" (" + ", ".join(f"{k}: {v['n_within_2sigma']} of {v['n_checked']}"
+                                                for k, v in by_system.items()) + ")" if by_system else "")
+                 + f"; the section points' d₁ lies more than 2σ below d₁ on lines at {len(below)} of {len(both)}"
+                 + (f", by {min(-v for _i, v in below):.3f}–{max(-v for _i, v in below):.3f}" if below else "")
+                 + (f", more than 2σ above at {len(above)}" if above else ""))  # fmt: skip
+    return {"n_checked": len(checked), "n_within_2sigma": len(within), "by_system": by_system,
+            "section_minus_lines": [{"id": i, "value": v, "z": z} for i, v, z in diffs],
+            "section_below_at": [i for i, _v in below], "section_above_at": above, "statement": statement}  # fmt: skip
+
+
 CANDIDATES = {
+    "lines": "d₁ on lines of initial conditions (the measure of the survivors along the stable direction)",
     "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
     "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
@@ -505,6 +629,8 @@ def with_gap(rec: dict) -> dict:
 
     gap = implied.difference(d1)
     alt = {}
+    if rec.get("d1_lines"):
+        alt["lines"] = (implied, Measured(rec["d1_lines"]["value"], rec["d1_lines"]["err"]))
     if rec.get("d1_radius"):
         alt["estimator"] = (implied, Measured(rec["d1_radius"]["value"], rec["d1_radius"]["err"]))
     if "extrapolated" in rec["d1_trend"] and "extrapolated" in rec["lyapunov_trend"]:

@@ -80,6 +80,11 @@ class Params(StudyParams):
     d0_min_count: Integer  # an ε enters α's fit with ≥ this many uncertain pairs
     basins_system: Text  # the label of the system of study basins (its points' λ̄ re-predict the cut-off)
     ftle_low: Numbers = (0.25, 0.5, 0.75)  # Λ/T < this·λ̄ is near 0 (the middle one for the hyperbolic part)
+    lines_count: Integer  # d₁ on lines: lines y = const through the IC disk
+    lines_n: Integer  # initial conditions per line
+    lines_efolds: Number  # d₁ on lines: the orbits that left at t_end ≥ lines_efolds/κ
+    lines_checks: Numbers  # d₁ on lines also at these t_min·κ (its convergence in the selection)
+    lines_floor: Number  # d₁ on lines: scales down to this fraction of a line's extent
 
 
 FTLE_TABLE = "saddle_ftle.parquet"
@@ -184,6 +189,7 @@ def simulate(study, workers=None, progress=True):
             choices[key] = {"system": label, "ratio": r, "energy": r * m.critical_energy, "kappa": k.kappa,
                             "kappa_err": k.kappa_err, "t_min": t_min, "n_tangent": len(sel), "r_esc": sc.r_esc}  # fmt: skip
             _run_lines(study, key, sc, spec, d0_eps, workers, progress)
+            _run_dense_lines(study, key, sc, spec, k.kappa, workers, progress)
             if len(sel) == 0:
                 continue
             path = study.derived(f"{key}_tangent_ics.parquet")
@@ -231,9 +237,88 @@ def _run_lines(study, key, sc, spec, eps, workers, progress):
     study.run(key + "_lines", lsc, workers=workers, progress=progress)
 
 
+def _dense_lines_path(study, key):
+    return study.derived(f"{key}_dlines_ics.parquet")
+
+
+def _lines_t_max(study, kappa: float, t_max: float) -> float:
+    """t_max of the dense lines: a few e-folds after the latest t_min·κ used, at most the main run's t_max (regular
+    orbits, which never leave, run to it: a shorter run costs them less and selects no other orbit)."""
+    p = study.params
+    return min(t_max, (max(p.lines_efolds, *p.lines_checks) + 3.0) / kappa)
+
+
+def _run_dense_lines(study, key, sc, spec, kappa, workers, progress):
+    """The dense lines of a point (raw key ``<key>_dlines``): lines_count lines y = const evenly across the main run's
+    disk (within 0.8 of its radius), lines_n positions uniform on each chord (seeded by the point's key),
+    tangential momenta at E; run to :func:`_lines_t_max` with the main run's r_esc. Its layout in a derived table."""
+    import zlib
+
+    import pandas as pd
+
+    from hhscatter.scene.ics import section_velocities
+
+    p, m = study.params, sc.model
+    rng = np.random.default_rng([int(study.config["scene"]["seed"]), 52, zlib.crc32(key.encode())])
+    R, parts = float(sc.radius), []
+    for j in range(p.lines_count):
+        c = 0.8 * R * (2.0 * (j + 0.5) / p.lines_count - 1.0)
+        half = math.sqrt(R * R - c * c)
+        x = rng.uniform(-half, half, p.lines_n)
+        y = np.full(p.lines_n, c)
+        ok = (m.potential(x, y) < sc.energy) & ((x != 0) | (y != 0))
+        px, py = section_velocities(m, x[ok], y[ok], sc.energy)
+        parts.append(pd.DataFrame({"x": x[ok], "y": y[ok], "px": px, "py": py, "line": j}))
+    df = pd.concat(parts, ignore_index=True)
+    df.insert(0, "traj_id", np.arange(len(df), dtype=np.int64))
+    path = _dense_lines_path(study, key)
+    if not path.exists() or not pd.read_parquet(path).equals(df):  # the scene's hash includes the file's
+        df.to_parquet(path, index=False)
+    lsc = study.scene(key + "_dlines", system=spec, ics=str(path), n=len(df), r_esc=sc.r_esc, sections=None,
+                      t_max=_lines_t_max(study, kappa, sc.t_max))  # fmt: skip
+    study.run(key + "_dlines", lsc, workers=workers, progress=progress)
+
+
 # ---------------------------------------------------------------------------
 # analyze
 # ---------------------------------------------------------------------------
+def _d1_lines(study, key, k, lam, t_max):
+    """d₁ on the point's dense lines: the survivors' positions along their lines (blocks: one a line), with the
+    floor lines_floor of a line's extent, at t_min·κ = lines_efolds and lines_checks, its floor scan and the
+    relation with it (:func:`~hhscatter.reproduction.saddle_records.lines_record`)."""
+    import pandas as pd
+
+    from hhscatter.analysis.geometry.saddle import kantz_grassberger
+
+    p = study.params
+    layout = pd.read_parquet(_dense_lines_path(study, key), columns=["traj_id", "x", "line"])
+    rows = layout.merge(_lifetimes(study.raw(key + "_dlines")), on="traj_id")
+    t_lines = _lines_t_max(study, k.kappa, t_max)
+
+    def args(c):
+        sel = _long_lived(rows, c / k.kappa)
+        return {"points": sel["x"].to_numpy(), "blocks": sel["line"].to_numpy(), "k_max": p.k_max,
+                "n_boot": p.n_boot, "seed": 0}, len(sel)  # fmt: skip
+
+    by = []
+    for c in sorted({p.lines_efolds, *p.lines_checks}):
+        a, n = args(c)
+        try:
+            if c / k.kappa >= t_lines:
+                raise ConfigError(f"t_min = {c / k.kappa:.4g} is not before the lines' t_max {t_lines:.4g}")
+            by.append((c, n, information_dimension_neighbours(**a, floor=p.lines_floor)))
+        except ConfigError as exc:
+            by.append((c, n, str(exc)))
+    chosen = next(d for c, _n, d in by if c == p.lines_efolds)
+    if isinstance(chosen, str):
+        return {"notes_lines": f"d1 on lines: {chosen}"}
+    a, _n = args(p.lines_efolds)
+    scan = neighbour_floor_scan(**a, floor=p.lines_floor, factors=p.d1_floor_factors)
+    kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], chosen.value, chosen.err)
+    scatter = math.exp(-lam["value"] * p.lines_efolds / k.kappa)
+    return sr.lines_record(by, p.lines_efolds, scan, kg, n_lines=p.lines_count, scatter=scatter)
+
+
 def _lyapunov(lt, t_min, p):
     """λ̄ of the tangent run's orbits that left at t_end ≥ t_min: the record's value, error, rule and FTLE."""
     from hhscatter.analysis.geometry.saddle import lyapunov_convergence, mean_lyapunov
@@ -402,6 +487,11 @@ def _point(study, key, ch):
         return rec, None
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
+    t_max = next(t for label, _s, _m, _r, t in _systems(study) if label == ch["system"])
+    lines = _d1_lines(study, key, k, lam, t_max)
+    if "notes_lines" in lines:
+        rec["notes"].append(lines.pop("notes_lines"))
+    rec.update(lines)
     rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k))
     sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
     est = _d1_estimator(p)
@@ -473,6 +563,8 @@ def analyze(study):
             "dimensions": [sr.dimension_row(x) for x in records],
             "dimensions_summary": sr.dimension_summary(records),
             "d1_precision": sr.d1_precision(records),
+            "lines": [sr.lines_row(x) for x in records],
+            "lines_summary": sr.lines_summary(records),
             "gap": [sr.gap_row(x) for x in records],
             "gap_summary": sr.gap_summary(records),
             **basins,
@@ -489,6 +581,11 @@ def analyze(study):
                 "d0_eps": [float(e) for e in _d0_eps(study)],
                 "d0_n": study.params.d0_n,
                 "d0_min_count": study.params.d0_min_count,
+                "lines_count": study.params.lines_count,
+                "lines_n": study.params.lines_n,
+                "lines_efolds": study.params.lines_efolds,
+                "lines_checks": list(study.params.lines_checks),
+                "lines_floor": study.params.lines_floor,
             },  # fmt: skip
         }
     )
