@@ -245,3 +245,51 @@ def test_d1_s_estimator_takes_no_lyapunov_exponent():
                                          n_points=4000, n_beyond_record=0)) for tm in (10.0, 1000.0)]  # fmt: skip
     assert (d[0].value, d[0].err, d[0].eps_range) == (d[1].value, d[1].err, d[1].eps_range)
     assert d[0].eps_range[0] >= study.params.d1_floor * 2.0  # the circle's extent is 2
+
+
+def test_the_dense_lines_lie_on_lines_across_the_disk_at_the_energy(built):
+    """lines_count lines y = const within 0.8 of the disk's radius, lines_n positions a line (fewer where V ≥ E),
+    tangential momenta at E = 1.8 E_c: the initial conditions of d₁ on lines."""
+    import pandas as pd
+
+    doc = json.loads((built / "saddle.json").read_text())
+    rules = doc["rules"]
+    ics = pd.read_parquet(built / "derived" / "henon_heiles_r1.80_dlines_ics.parquet")
+    assert sorted(ics["line"].unique()) == list(range(rules["lines_count"]))
+    per = ics.groupby("line")
+    assert per["y"].nunique().eq(1).all() and per.size().le(rules["lines_n"]).all()
+    assert per.size().sum() > 0.9 * rules["lines_count"] * rules["lines_n"]
+    assert np.all(np.abs(per["y"].first()) <= 0.8 * 0.5) and np.all(np.hypot(ics["x"], ics["y"]) < 0.5)
+    x, y, px, py = (ics[c].to_numpy() for c in ("x", "y", "px", "py"))
+    E = 0.5 * (px**2 + py**2) + 0.5 * (x**2 + y**2) + x**2 * y - y**3 / 3
+    assert np.allclose(E, 1.8 / 6, rtol=1e-12) and np.allclose(x * px + y * py, 0, atol=1e-12)
+
+
+def test_d1_on_lines_is_the_survivors_dimension_and_the_relation_is_done_with_it(built):
+    """d₁ on lines recomputed from the raw run: the positions along their lines of the orbits that left at
+    t_end ≥ lines_efolds/κ, each line a block, floor lines_floor; the relation κ against λ̄(1 − d₁) with it by hand."""
+    import pandas as pd
+
+    from hhscatter.analysis.geometry.saddle import information_dimension_neighbours
+    from hhscatter.data.read import read_lifetimes
+
+    doc = json.loads((built / "saddle.json").read_text())
+    rules = doc["rules"]
+    rec = next(r for r in doc["saddle"] if r["id"] == "henon_heiles-1.80")
+    det = rec["d1_lines_detail"]
+    ics = pd.read_parquet(built / "derived" / "henon_heiles_r1.80_dlines_ics.parquet")
+    lt = read_lifetimes(built / "raw" / "henon_heiles_r1.80_dlines", columns=["traj_id", "outcome", "t_end"])
+    m = ics.merge(lt, on="traj_id")
+    sel = m[(m["outcome"].astype(str) == "escaped") & (m["t_end"] >= rules["lines_efolds"] / rec["kappa"])]
+    assert det["n_points"] == len(sel) and det["n_lines"] == rules["lines_count"]
+    d = information_dimension_neighbours(sel["x"].to_numpy(), blocks=sel["line"].to_numpy(), k_max=16,
+                                         floor=rules["lines_floor"], n_boot=10, seed=0)  # fmt: skip
+    assert rec["d1_lines"] == {"value": pytest.approx(d.value, rel=1e-12), "err": pytest.approx(d.err, rel=1e-12)}
+    lam, d1 = rec["lyapunov"], rec["d1_lines"]["value"]
+    assert det["predicted"]["value"] == pytest.approx(lam * (1 - d1), rel=1e-12)
+    sig = math.hypot(rec["kappa_err"], det["predicted"]["err"])
+    assert det["z"] == pytest.approx((rec["kappa"] - lam * (1 - d1)) / sig, rel=1e-9)
+    assert det["scatter_extent"] == pytest.approx(math.exp(-lam * rules["lines_efolds"] / rec["kappa"]), rel=1e-12)
+    assert [r["t_min_kappa"] for r in det["by_t_min"]] == sorted({rules["lines_efolds"], *rules["lines_checks"]})
+    if rec.get("gap"):  # the gap's candidates include d₁ on lines
+        assert "lines" in rec["gap"]
