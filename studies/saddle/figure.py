@@ -12,19 +12,46 @@ def _done(records):
     return [r for r in records if r.get("predicted") is not None]
 
 
+def _lines(records):
+    return [r for r in records if r.get("d1_lines") and "predicted" in r.get("d1_lines_detail", {})]
+
+
 def plot_saddle(numbers, path):
-    """Two panels: (a) κ against λ̄(1 − d₁) per point; (b) the section's D₁ measured and implied, 2(1 − κ/λ̄), and its
-    D₀ = 2(1 − α) from the uncertainty exponent on lines."""
+    """Three panels: (a) κ against λ̄(1 − d₁) per point, d₁ from the section points (filled) and on lines (open);
+    (b) the section's D₁ measured and implied, 2(1 − κ/λ̄), and its D₀ = 2(1 − α) from the uncertainty exponent on
+    lines; (c) d₁ from the section points (D₁/2), d₁ on lines and 1 − κ/λ̄ against E/E_c."""
     plt = agg_pyplot()
     recs = _done(numbers["saddle"])
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.2))
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(17, 5.2))
+    for label in dict.fromkeys(r["system"] for r in numbers["saddle"]):
+        col, mk = COLORS.get(label, "k"), MARKERS.get(label, "o")
+        rs = [r for r in _lines(numbers["saddle"]) if r["system"] == label]
+        if rs:
+            p = [r["d1_lines_detail"]["predicted"] for r in rs]
+            a.errorbar([q["value"] for q in p], [r["kappa"] for r in rs], xerr=[q["err"] for q in p],
+                       yerr=[r["kappa_err"] for r in rs], fmt=mk, mfc="white", color=col, capsize=3,
+                       label=f"{label}: d₁ on lines")  # fmt: skip
+            c.errorbar([r["ratio"] for r in rs], [r["d1_lines"]["value"] for r in rs],
+                       [r["d1_lines"]["err"] for r in rs], fmt=mk + ":", mfc="white", color=col, capsize=3,
+                       label=f"{label}: d₁ on lines")  # fmt: skip
+        rs = [r for r in recs if r["system"] == label]
+        if rs:
+            x = [r["ratio"] for r in rs]
+            c.errorbar(x, [r["d1"] for r in rs], [r["d1_err"] for r in rs], fmt=mk + "-", color=col, capsize=3,
+                       label=f"{label}: D₁/2, section points")  # fmt: skip
+            c.errorbar(x, [r["d1_implied"] for r in rs], [r["d1_implied_err"] for r in rs], fmt="--", color=col,
+                       alpha=0.6, label=f"{label}: 1 − κ/λ̄")  # fmt: skip
     hi = 0.0
     for label in dict.fromkeys(r["system"] for r in recs):
         rs = [r for r in recs if r["system"] == label]
         col, mk = COLORS.get(label, "k"), MARKERS.get(label, "o")
         a.errorbar([r["predicted"] for r in rs], [r["kappa"] for r in rs], xerr=[r["predicted_err"] for r in rs],
-                   yerr=[r["kappa_err"] for r in rs], fmt=mk, color=col, capsize=3, label=label)  # fmt: skip
+                   yerr=[r["kappa_err"] for r in rs], fmt=mk, color=col, capsize=3,
+                   label=f"{label}: d₁ = D₁/2")  # fmt: skip
         hi = max(hi, *(max(r["predicted"] + r["predicted_err"], r["kappa"]) for r in rs))
+        for r in _lines(rs):
+            q = r["d1_lines_detail"]["predicted"]
+            hi = max(hi, q["value"] + q["err"])
         x = [r["ratio"] for r in rs]
         b.errorbar(x, [r["d1_section"] for r in rs], [r["d1_section_err"] for r in rs], fmt=mk + "-", color=col,
                    capsize=3, label=f"{label}: measured D₁")  # fmt: skip
@@ -48,6 +75,10 @@ def plot_saddle(numbers, path):
     b.set_ylabel("dimension on the section: D₁ = 2 d₁, D₀ = 2 d₀")
     b.set_title("(b) D₁ measured and implied by κ and λ̄; D₀ from lines")
     b.legend(fontsize=7)
+    c.set_xlabel("E / E_c")
+    c.set_ylabel("partial dimension d₁")
+    c.set_title("(c) d₁: section points, lines, and 1 − κ/λ̄")
+    c.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     save_panels(fig, path, dpi=180)
