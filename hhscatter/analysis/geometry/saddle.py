@@ -692,7 +692,8 @@ def information_dimension_neighbours(
             dist[at] = cKDTree(Q[at]).query(Q[at], k=k_max + 1)[0]
         if not np.all(dist[:, 1] > 0):
             raise ConfigError("points: some points coincide (a neighbour at distance 0); remove the duplicates")
-        levels.append((m, np.log(dist[:, 1:]), g[keep], float(np.mean(np.log(sizes[bq])))))
+        ln_nb = math.log(m) if n_blocks == 1 else float(np.mean(np.log(sizes[bq])))
+        levels.append((m, np.log(dist[:, 1:]), g[keep], ln_nb))
         j += 1
     psi = digamma(np.arange(1, k_max + 1))
 
