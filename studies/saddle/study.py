@@ -314,8 +314,11 @@ def _d1_lines(study, key, k, lam, t_max):
         return {"notes_lines": f"d1 on lines: {chosen}"}
     a, _n = args(p.lines_efolds)
     scan = neighbour_floor_scan(**a, floor=p.lines_floor, factors=p.d1_floor_factors)
-    kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], chosen.value, chosen.err)
-    scatter = math.exp(-lam["value"] * p.lines_efolds / k.kappa)
+    try:
+        kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], chosen.value, chosen.err)
+    except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)
+        kg = None
+    scatter = math.exp(-max(lam["value"], 0.0) * p.lines_efolds / k.kappa)
     return sr.lines_record(by, p.lines_efolds, scan, kg, n_lines=p.lines_count, scatter=scatter)
 
 
