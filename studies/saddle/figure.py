@@ -74,6 +74,12 @@ def plot_saddle(numbers, path):
     b.set_xlabel("E / E_c")
     b.set_ylabel("dimension on the section: D₁ = 2 d₁, D₀ = 2 d₀")
     b.set_title("(b) D₁ measured and implied by κ and λ̄; D₀ from lines")
+    for ax, scale in ((b, 2.0), (c, 1.0)):  # a dimension below 0 (λ̄ < κ: 1 − κ/λ̄ < 0) is named, not drawn
+        off = [f"{r['system']} {r['ratio']:g}: {scale * r['d1_implied']:.2f}" for r in recs if r["d1_implied"] < 0]
+        if off:  # an empty handle: the note sits in the legend
+            ax.set_ylim(bottom=0.0)
+            ax.plot([], [], " ", label=("2(1 − κ/λ̄)" if scale == 2 else "1 − κ/λ̄") + " < 0 (λ̄ < κ), off the axis: "
+                    + "; ".join(off))  # fmt: skip
     b.legend(fontsize=7)
     c.set_xlabel("E / E_c")
     c.set_ylabel("partial dimension d₁")
