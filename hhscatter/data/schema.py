@@ -80,7 +80,7 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from hhscatter._version import __version__
+from hhscatter._version import ENGINE_REVISION, __version__
 from hhscatter.outcomes import OUTCOMES, TABLE_COLUMNS
 
 if TYPE_CHECKING:  # annotations only
@@ -145,6 +145,7 @@ def provenance() -> dict:
     commit = git_commit(Path(__file__).resolve().parent)
     return {
         "hhscatter": __version__,
+        "engine_revision": ENGINE_REVISION,
         "heyoka": importlib.metadata.version("heyoka"),  # the installed distribution's: heyoka is the engine's
         "numpy": np.__version__,
         "pyarrow": pyarrow.__version__,

@@ -7,6 +7,7 @@ import json
 import os
 import shutil
 
+from hhscatter._version import ENGINE_REVISION
 from hhscatter.data.schema import TABLES
 from hhscatter.data.store import LOCK_FILE, TMP_MARK, LockedError, Store
 from hhscatter.errors import ConfigError, OutputError
@@ -80,7 +81,7 @@ def prepare_output(run, out, *, overwrite: bool, resume: bool, points=None):
             store.remove(probe)
         except OSError as exc:
             raise OutputError(f"out: {store.display()} is not writable ({exc.strerror or exc})") from None
-        doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash()}
+        doc = {"scene": json.loads(run.to_json()), "scene_hash": run.result_hash(), "engine_revision": ENGINE_REVISION}
 
         if isinstance(run, Grid):
             doc["grid"] = {"energy": list(run.energies), "gamma": list(run.gammas)}
@@ -130,6 +131,12 @@ def _check_and_clear(run, store, points, *, overwrite, resume):
         old = json.loads(store.read_text(SCENE_FILE))
         if old.get("scene_hash") != run.result_hash():
             what = _diff(old.get("scene", {}), json.loads(run.to_json()))
+            made = old.get("engine_revision", 1)  # a run from before the revision was recorded: revision 1
+            if not what and made != ENGINE_REVISION:
+                raise OutputError(
+                    f"cannot resume into {store.display()}: its run was made by engine revision {made} (this "
+                    f"engine: {ENGINE_REVISION}), whose tables may differ; use --overwrite or another --out"
+                )
             raise OutputError(
                 f"cannot resume into {store.display()}: it holds a different scene"
                 f"{' (' + what + ')' if what else ''}; use --overwrite or another --out"

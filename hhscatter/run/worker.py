@@ -15,6 +15,7 @@ import time
 
 import numpy as np
 
+from hhscatter._version import ENGINE_REVISION
 from hhscatter.data.schema import add_point_columns, provenance, to_arrow
 from hhscatter.data.store import Store
 from hhscatter.data.verify import read_meta, verify_part
@@ -175,8 +176,14 @@ def chunk_complete(scene: Scene, out, chunk: int, start: int, stop: int, partiti
         except Exception:  # noqa: BLE001 - a damaged file is redone, whatever the damage
             return False
         if meta.get("scene_hash") != want:
+            made = meta.get("engine_revision", 1)  # a part from before the revision was recorded: revision 1
+            why = (
+                f"by engine revision {made} (this engine: {ENGINE_REVISION})"
+                if made != ENGINE_REVISION
+                else "by a different scene"
+            )
             raise RunIntegrityError(
-                f"cannot resume: {store.display(rel)} was made by a different scene (hash "
+                f"cannot resume: {store.display(rel)} was made {why} (hash "
                 f"{str(meta.get('scene_hash', '?'))[:12]}…, this scene {want[:12]}…); "
                 "use --overwrite or another --out"
             )

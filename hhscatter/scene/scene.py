@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from hhscatter._version import ENGINE_REVISION
 from hhscatter.errors import ConfigError, SceneError  # noqa: F401 (SceneError: the old name of ConfigError)
 from hhscatter.model import HenonHeiles, System
 from hhscatter.model.spec import resolve
@@ -609,7 +610,8 @@ class Scene:
         return json.dumps(_clean(self.to_dict()), sort_keys=True, allow_nan=False, default=_json_default)
 
     def result_hash(self) -> str:
-        """sha256 of everything that determines the tables (not name, batch size)."""
+        """sha256 of everything that determines the tables (not name, batch size): the scene and, from revision 2
+        on, the engine's revision (:data:`hhscatter._version.ENGINE_REVISION`)."""
         d = self.to_dict()
         for k in ("name", "batch_size"):
             d.pop(k)
@@ -617,6 +619,8 @@ class Scene:
             d.update(omega=1.0, lam=1.0)
         if self.ics is not None:
             d["ics"] = file_sha256(self.ics)
+        if ENGINE_REVISION > 1:  # another engine's run is another result (revision 1: hashes as before)
+            d["engine_revision"] = ENGINE_REVISION
         return hashlib.sha256(json.dumps(_clean(d), sort_keys=True, default=_json_default).encode()).hexdigest()
 
     def replace(self, **changes: Any) -> Scene:
