@@ -487,8 +487,8 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
     >>> import pandas as pd
     >>> from hhscatter.analysis.geometry.saddle import kantz_grassberger
     >>> class D: value, err, eps_range = 0.77, 0.005, (1e-4, 0.02)
-    >>> scan = pd.DataFrame({"factor": [1.0], "floor": [1e-4], "eps_min": [1e-4], "value": [0.77], "err": [0.005],
-    ...                      "eps_lo": [1e-4], "eps_hi": [0.02], "note": [""]})
+    >>> scan = pd.DataFrame({"factor": [1.0], "floor": [1e-4], "eps_min": [1e-4]})
+    >>> scan = scan.assign(value=[0.77], err=[0.005], eps_lo=[1e-4], eps_hi=[0.02], note=[""])
     >>> kg = kantz_grassberger(0.0953, 0.0004, 0.412, 0.0017, 0.77, 0.005)
     >>> r = lines_record([(5.0, 5000, D), (6.0, 1650, "too few")], 5.0, scan, kg, n_lines=16, scatter=1e-9)
     >>> r["d1_lines"], r["d1_lines_detail"]["verdict"], r["d1_lines_detail"]["by_t_min"][1]["d1"]
@@ -524,7 +524,7 @@ def lines_row(rec: dict) -> dict:
     Examples
     --------
     >>> lines_row({"id": "a", "system": "hh", "ratio": 1.5, "d1": 0.70, "d1_err": 0.005,
-    ...            "d1_implied": 0.769, "d1_implied_err": 0.001, "d1_lines": {"value": 0.77, "err": 0.005},
+    ...            "d1_implied": 0.769, "d1_implied_err": 0.001, "d1_lines": Measured(0.77, 0.005).to_dict(),
     ...            "d1_lines_detail": {"n_points": 5000, "eps_range": [1e-4, 0.02], "z": -0.3,
     ...                                "verdict": "agrees (z = −0.3)"}})  # doctest: +NORMALIZE_WHITESPACE
     {'id': 'a', 'system': 'hh', 'ratio': 1.5, 'd1': {'value': 0.7, 'err': 0.005},
@@ -549,9 +549,9 @@ def lines_summary(records) -> dict:
 
     Examples
     --------
-    >>> recs = [{"id": "a", "system": "hh", "d1": 0.70, "d1_err": 0.005, "d1_lines": {"value": 0.77, "err": 0.005},
+    >>> recs = [{"id": "a", "system": "hh", "d1": 0.70, "d1_err": 0.005, "d1_lines": Measured(0.77, 0.005).to_dict(),
     ...          "d1_lines_detail": {"z": -0.3}},
-    ...         {"id": "b", "system": "hh", "d1": 0.61, "d1_err": 0.007, "d1_lines": {"value": 0.64, "err": 0.009},
+    ...         {"id": "b", "system": "hh", "d1": 0.61, "d1_err": 0.007, "d1_lines": Measured(0.64, 0.009).to_dict(),
     ...          "d1_lines_detail": {"z": 2.4}}, {"id": "c", "system": "hh"}]
     >>> s = lines_summary(recs)
     >>> s["n_checked"], s["n_within_2sigma"], s["section_below_at"]
@@ -570,7 +570,9 @@ def lines_summary(records) -> dict:
     diffs = []
     for r in both:
         diff = Measured(r["d1"], r["d1_err"]).difference(Measured(r["d1_lines"]["value"], r["d1_lines"]["err"]))
-        diffs.append((r["id"], diff.value, diff.value / diff.err if diff.err > 0 else math.copysign(math.inf, diff.value)))
+        diffs.append(
+            (r["id"], diff.value, diff.value / diff.err if diff.err > 0 else math.copysign(math.inf, diff.value))
+        )
     below = [(i, v) for i, v, z in diffs if z < -2]
     above = [i for i, _v, z in diffs if z > 2]
     statement = (f"With d₁ on lines, κ = λ̄(1 − d₁) holds within 2σ at {len(within)} of the {len(checked)} points "

@@ -187,13 +187,7 @@ class MixtureComponents:
 
 def _per_component(a, name: str, size: int | None, *, minimum: float | None = None, positive: bool = False):
     """``a`` as a 1-D float array of finite numbers with ``size`` values (one per sub-ensemble, or K + 1 edges)."""
-    try:
-        flat = np.ndim(a) == 1
-    except ValueError:  # a ragged nesting
-        flat = False
-    if not flat:
-        raise ConfigError(f"{name} must be a 1-D array of numbers, got {type(a).__name__}")
-    arr = check.numbers(a, name, minimum=minimum, positive=positive)
+    arr = check.numbers(a, name, minimum=minimum, positive=positive, flat=True)
     if size is not None and arr.size != size:
         raise ConfigError(
             f"{name} must have {size} values (K = {size - 1 if name == 'edges' else size}), got {arr.size}"

@@ -658,12 +658,9 @@ class HomogeneousProblem:
     P_tau0: float
 
     def __post_init__(self):
-        for name in ("tf", "Pf", "sf"):
-            if np.ndim(getattr(self, name)) != 1:
-                raise ConfigError(f"{name} must be a 1-D array of numbers, got {type(getattr(self, name)).__name__}")
-        tf = check.numbers(self.tf, "tf")
-        Pf = check.numbers(self.Pf, "Pf", minimum=0.0)
-        sf = check.numbers(self.sf, "sf", positive=True)
+        tf = check.numbers(self.tf, "tf", flat=True)
+        Pf = check.numbers(self.Pf, "Pf", minimum=0.0, flat=True)
+        sf = check.numbers(self.sf, "sf", positive=True, flat=True)
         for arr, name in ((Pf, "Pf"), (sf, "sf")):
             if arr.size != tf.size:
                 raise ConfigError(f"{name} must have one value per time tf: {arr.size} != {tf.size}")

@@ -735,7 +735,8 @@ def information_dimension_neighbours(
     eps = np.exp(x)
     table = pd.DataFrame({"eps": eps, "n": ns, "k": ks, "log_mass": y, "fitted": use})
     method = f"nearest-neighbour distances (k ≤ {k_max}, {len(levels)} nested subsamples" + (
-        f", {n_blocks} blocks)" if n_blocks > 1 else ")")
+        f", {n_blocks} blocks)" if n_blocks > 1 else ")"
+    )
     return SaddleDimension._from_parts(b, err_fit, err_res, err_range, method, eps, use, n, n_groups, table)
 
 

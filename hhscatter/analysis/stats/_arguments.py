@@ -41,8 +41,18 @@ def _float_array(a, name: str) -> np.ndarray:
     return arr
 
 
-def numbers(a, name: str, *, min_size: int = 1, minimum: float | None = None, positive: bool = False) -> np.ndarray:
-    """``a`` as a 1-D float array of finite numbers (at least ``min_size``; ≥ ``minimum``, or > 0 if ``positive``)."""
+def numbers(
+    a, name: str, *, min_size: int = 1, minimum: float | None = None, positive: bool = False, flat: bool = False
+) -> np.ndarray:
+    """``a`` as a 1-D float array of finite numbers (at least ``min_size``; ≥ ``minimum``, or > 0 if ``positive``);
+    ``flat``: ``a`` itself must be one-dimensional (a nesting or a single number refused, not flattened)."""
+    if flat:
+        try:
+            one_d = np.ndim(a) == 1
+        except ValueError:  # a ragged nesting
+            one_d = False
+        if not one_d:
+            raise ConfigError(f"{name} must be a 1-D array of numbers, got {type(a).__name__}")
     arr = _float_array(a, name)
     if arr.size < min_size:
         raise ConfigError(f"{name} must hold at least {min_size} value(s), got {arr.size}")
