@@ -478,7 +478,7 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
     t_min·κ of the rule (one of them), ``scan`` the :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan`
     of the chosen survivors, ``kg`` the :class:`~hhscatter.analysis.geometry.saddle.KantzGrassberger` of κ, λ̄ and
     that d₁ (or None), ``scatter`` e^{−λ̄ t_min}: the survivors' distance from the stable manifold in units of a
-    line's extent (stated, not used). Keys: ``d1_lines`` ({value, err}, None where refused) and
+    line's extent (stated, not used; None where λ̄ ≤ 0). Keys: ``d1_lines`` ({value, err}, None where refused) and
     ``d1_lines_detail`` (t_min_kappa, n_points, n_lines, eps_range, scatter_extent, floor_scan rows, by_t_min rows,
     and the relation with this d₁: predicted, z, verdict).
 
@@ -509,7 +509,8 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
                   "eps_range": [float(r.eps_lo), float(r.eps_hi)] if math.isfinite(r.value) else None,
                   "note": r.note} for r in scan.itertuples()]  # fmt: skip
     detail = {"t_min_kappa": float(chosen), "n_points": chosen_row["n_points"], "n_lines": int(n_lines),
-              "eps_range": chosen_row["eps_range"], "scatter_extent": float(scatter), "floor_scan": scan_rows,
+              "eps_range": chosen_row["eps_range"], "scatter_extent": None if scatter is None else float(scatter),
+              "floor_scan": scan_rows,
               "by_t_min": rows}  # fmt: skip
     if kg is not None:
         detail.update({"predicted": Measured(kg.predicted, kg.predicted_err).to_dict(), "z": kg.z,

@@ -318,7 +318,7 @@ def _d1_lines(study, key, k, lam, t_max):
         kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], chosen.value, chosen.err)
     except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)
         kg = None
-    scatter = math.exp(-max(lam["value"], 0.0) * p.lines_efolds / k.kappa)
+    scatter = math.exp(-lam["value"] * p.lines_efolds / k.kappa) if lam["value"] > 0 else None
     return sr.lines_record(by, p.lines_efolds, scan, kg, n_lines=p.lines_count, scatter=scatter)
 
 
