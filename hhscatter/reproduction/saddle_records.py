@@ -544,6 +544,15 @@ def lines_row(rec: dict) -> dict:
     return row
 
 
+def _by(gaps) -> str:
+    """ ", by a" or ", by a–b" of sorted gaps."""
+    return (
+        f", by {gaps[0]:.3f}"
+        if len(gaps) == 1 or f"{gaps[0]:.3f}" == f"{gaps[-1]:.3f}"
+        else (f", by {gaps[0]:.3f}–{gaps[-1]:.3f}")
+    )
+
+
 def lines_summary(records) -> dict:
     """lines_summary(records) -> the relation with d₁ on lines (checked, within 2σ, per system) and d₁ on the section
     against d₁ on lines (z of their difference, both errors; where it exceeds 2 and by how much), with the statement.
@@ -580,7 +589,7 @@ def lines_summary(records) -> dict:
                  f"checked" + (" (" + ", ".join(f"{k}: {v['n_within_2sigma']} of {v['n_checked']}"
                                                 for k, v in by_system.items()) + ")" if by_system else "")
                  + f"; the section points' d₁ lies more than 2σ below d₁ on lines at {len(below)} of {len(both)}"
-                 + (f", by {min(-v for _i, v in below):.3f}–{max(-v for _i, v in below):.3f}" if below else "")
+                 + (_by(sorted(-v for _i, v in below)) if below else "")
                  + (f", more than 2σ above at {len(above)}" if above else ""))  # fmt: skip
     return {"n_checked": len(checked), "n_within_2sigma": len(within), "by_system": by_system,
             "section_minus_lines": [{"id": i, "value": v, "z": z} for i, v, z in diffs],
