@@ -809,7 +809,6 @@ STUDY_TABLES = {
         ("left_lines", "left: d₁ on lines"),
         ("left_estimator", "left: fixed radius"),
         ("left_selection", "left: t_min → ∞"),
-        ("left_mid_life", "left: mid-life λ̄"),
     ),
     "saddle.dimensions": (
         ("system", "system"),

@@ -47,6 +47,9 @@ __all__ = [
     "gap_row",
     "hyperbolic_record",
     "gap_summary",
+    "d0_record",
+    "lines_measurement",
+    "lyapunov_record",
     "lines_record",
     "lines_row",
     "lines_summary",
@@ -516,6 +519,125 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
         detail.update({"predicted": Measured(kg.predicted, kg.predicted_err).to_dict(), "z": kg.z,
                        "verdict": kg.verdict})  # fmt: skip
     return {"d1_lines": chosen_row["d1"], "d1_lines_detail": detail}
+
+
+def lines_measurement(
+    rows, kappa, kappa_err, lam, lam_err, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines
+) -> dict:
+    """lines_measurement(rows, κ, σ_κ, λ̄, σ_λ, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines) -> dict.
+
+    d₁ on lines: ``rows`` holds one row per initial condition of the lines (``x`` its position along its line,
+    ``line``, ``outcome``, ``t_end``); the orbits that left at t_end ≥ c/κ, for c of ``efolds`` and ``checks``, are
+    the survivors whose positions sample the stable manifold's measure, one block a line
+    (:func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours` with ``floor`` of a line's
+    extent); at ``efolds`` its floor scan (× ``factors``) and the relation κ = λ̄(1 − d₁) with it. A t_min not
+    before the lines' ``t_max`` is refused; λ̄ ≤ 0 gives no relation. Returns :func:`lines_record`'s keys, or
+    ``{"notes_lines": why}`` where d₁ at ``efolds`` is refused.
+    """
+    from hhscatter.analysis.geometry.saddle import (
+        information_dimension_neighbours,
+        kantz_grassberger,
+        neighbour_floor_scan,
+    )
+    from hhscatter.outcomes import LEAVING_OUTCOMES
+
+    left = rows["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
+
+    def args(c):
+        sel = rows[left & (rows["t_end"].to_numpy() >= c / kappa)]
+        return {"points": sel["x"].to_numpy(), "blocks": sel["line"].to_numpy(), "k_max": k_max, "n_boot": n_boot,
+                "seed": 0}, len(sel)  # fmt: skip
+
+    by = []
+    for c in sorted({efolds, *checks}):
+        a, n = args(c)
+        try:
+            if c / kappa >= t_max:
+                raise ConfigError(f"t_min = {c / kappa:.4g} is not before the lines' t_max {t_max:.4g}")
+            by.append((c, n, information_dimension_neighbours(**a, floor=floor)))
+        except ConfigError as exc:
+            by.append((c, n, str(exc)))
+    chosen = next(d for c, _n, d in by if c == efolds)
+    if isinstance(chosen, str):
+        return {"notes_lines": f"d1 on lines: {chosen}"}
+    scan = neighbour_floor_scan(**args(efolds)[0], floor=floor, factors=factors)
+    try:
+        kg = kantz_grassberger(kappa, kappa_err, lam, lam_err, chosen.value, chosen.err)
+    except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)
+        kg = None
+    scatter = math.exp(-lam * efolds / kappa) if lam > 0 else None
+    return lines_record(by, efolds, scan, kg, n_lines=n_lines, scatter=scatter)
+
+
+def lyapunov_record(lt, *, n_bins: int, n_boot: int):
+    """lyapunov_record(lt, *, n_bins, n_boot) -> (the record's λ̄: value, error, rule, the FTLE quantiles and the 1/T
+    extrapolation, the rows of ``lt`` with their FTLE), or None with fewer than 2 orbits.
+
+    ``lt``: the selected orbits of a tangent run (``log_stretch`` Λ, ``t_end`` T). λ̄ = ΣΛ/ΣT
+    (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`); λ̄(T) = λ∞ + Λ₀/T over ``n_bins`` bins of T
+    (:func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), λ∞ taken where the drift Λ₀ is resolved.
+    """
+    from hhscatter.analysis.geometry.saddle import lyapunov_convergence
+
+    L, T = lt["log_stretch"].to_numpy(), lt["t_end"].to_numpy()
+    if L.size < 2:
+        return None
+    mean = mean_lyapunov(L, T, n_boot=n_boot, seed=0)
+    out = {"mean": mean.value, "mean_err": mean.err, "n_orbits": mean.n_orbits, "ftle_std": mean.ftle_std,
+           "ftle_q05": mean.ftle_quantiles[0.05], "ftle_q50": mean.ftle_quantiles[0.5],
+           "ftle_q95": mean.ftle_quantiles[0.95], **Measured(mean.value, mean.err).to_dict(), "rule": "mean"}  # fmt: skip
+    try:
+        c = lyapunov_convergence(L, T, n_bins=n_bins, n_boot=n_boot, seed=0)
+    except ConfigError as exc:
+        out["convergence"] = str(exc)
+        return out, lt.assign(ftle=mean.ftle)
+    out.update({"extrapolated": c.extrapolated, "extrapolated_err": c.extrapolated_err, "slope": c.slope,
+                "slope_err": c.slope_err, "converged": c.converged})  # fmt: skip
+    lam_inf = Measured(c.extrapolated, c.extrapolated_err, "1/T extrapolation", mean.n_orbits)
+    out.update({"lambda_mean": Measured(mean.value, mean.err, "mean", mean.n_orbits).to_dict(),
+                "lambda_inf": lam_inf.to_dict(),
+                "b": Measured(c.slope, c.slope_err, "1/T slope", mean.n_orbits).to_dict()})  # fmt: skip
+    if not c.converged:
+        out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
+    return out, lt.assign(ftle=mean.ftle)
+
+
+def d0_record(layout, lifetimes, *, min_count: int) -> dict:
+    """d0_record(layout, lifetimes, *, min_count) -> d₀ = 1 − α of a lines run: the record's keys (d0, d0_err, the
+    section's D₀, the scaling range, the fit's χ² and p, the f(ε) rows) or a note.
+
+    ``layout`` (sorted by traj_id) gives each orbit's ``eps``, ``pair`` and ``moved``; ``lifetimes`` the run's
+    lifetimes in the same order (outcome and exit channel). A pair is uncertain when its exits differ; a pair
+    with an orbit still inside at t_max is left out; α by binomial maximum likelihood over the ε with ≥
+    ``min_count`` uncertain pairs (and not all).
+    """
+    import pandas as pd
+
+    from hhscatter.analysis.geometry.saddle import dimension_from_uncertainty
+    from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
+    from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
+
+    codes = outcome_codes(lifetimes)
+    codes[codes == TRAPPED_CODE] = OUTSIDE  # an orbit still inside at t_max: its pair is left out
+    rows = []
+    for e, g in layout.assign(code=codes).groupby("eps", sort=False):
+        ref, moved = (g[g["moved"] == m].sort_values("pair")["code"].to_numpy() for m in (False, True))
+        u = uncertainty_fraction(ref, moved, outside=OUTSIDE)
+        rows.append({"eps": float(e), "f": u.f, "k": u.k, "n": u.n, "n_excluded": u.n_excluded})
+    tab = pd.DataFrame(rows).sort_values("eps", ascending=False)
+    ok = (tab["k"] >= min_count) & (tab["k"] < tab["n"])
+    out = {"d0_uncertainty": tab.to_dict(orient="records")}
+    if ok.sum() < 3:
+        return {**out, "note": f"d0: fewer than 3 values of ε with ≥ {min_count} uncertain pairs"}
+    rng = (float(tab.loc[ok, "eps"].min()), float(tab.loc[ok, "eps"].max()))
+    try:
+        d = dimension_from_uncertainty(tab["eps"], tab["f"], tab["n"], eps_range=rng)
+        u = uncertainty_exponent(tab["eps"], tab["f"], tab["n"], eps_range=rng, dim=1.0)
+    except (ValueError, ConfigError) as exc:
+        return {**out, "note": f"d0: {exc}"}
+    return {**out, "d0": d.value, "d0_err": d.err, "d0_section": 2 * d.value, "d0_section_err": 2 * d.err,
+            "d0_eps_range": list(d.eps_range), "d0_n_eps": u.n_points, "d0_fit_chi2": u.chi2,
+            "d0_fit_dof": u.dof, "d0_fit_p": u.p_value}  # fmt: skip
 
 
 def lines_row(rec: dict) -> dict:

@@ -52,6 +52,23 @@ def section_velocities(model, x, y, energy):
     return -y / r * v, x / r * v
 
 
+def chord_lines(model, energy: float, radius: float, n_lines: int, n_per_line: int, rng):
+    """chord_lines(model, E, radius, n_lines, n_per_line, rng) -> (states (m, 4), line (m,)): ``n_lines`` lines
+    y = const evenly across the disk r < ``radius`` (within 0.8 of it), ``n_per_line`` positions uniform on each
+    chord (drawn from ``rng``), tangential momenta at E; the positions where V ≥ E or r = 0 are left out."""
+    states, lines = [], []
+    for j in range(n_lines):
+        c = 0.8 * radius * (2.0 * (j + 0.5) / n_lines - 1.0)
+        half = np.sqrt(radius * radius - c * c)
+        x = rng.uniform(-half, half, n_per_line)
+        y = np.full(n_per_line, c)
+        ok = (model.potential(x, y) < energy) & ((x != 0) | (y != 0))
+        px, py = section_velocities(model, x[ok], y[ok], energy)
+        states.append(np.column_stack([x[ok], y[ok], px, py]))
+        lines.append(np.full(int(ok.sum()), j))
+    return np.concatenate(states), np.concatenate(lines)
+
+
 def random_momenta(model, x, y, energy, theta):
     """random_momenta(model, x, y, E, θ) -> (px, py): direction θ (radians), |p|² = 2(E − V(x, y)).
 

@@ -6,25 +6,15 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
     Per system and E = r·E_c: the main run (raw key ``<label>_r<r>``: disk ICs, every section crossing to t_max),
     its κ (:func:`~hhscatter.analysis.survival.escape_rate.escape_rate_from_lifetimes`) and t_min = tmin_efolds/κ,
     and the tangent run (``<label>_r<r>_tangent``, ``[scene] tangent = true``, the main run's events: the same
-    orbits) of the orbits that left at t_end ≥ t_min, from their initial conditions; the lines run (``<label>_r<r>_lines``): for each ε of d0_eps,
-    d0_n fresh initial conditions of the main run's disk and their copies moved by ε along x. The κ and t_min used
-    are written to ``raw/saddle_choices.json``.
+    orbits) of the orbits that left at t_end ≥ t_min; the lines run (``_lines``: pairs moved by each ε of d0_eps)
+    and the dense lines (``_dlines``). κ and t_min are written to ``raw/saddle_choices.json``.
 
 ``analyze(study)``
-    ``saddle.json``: per point κ, λ̄ (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`,
-    :func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), d₁ on the section
-    (:func:`~hhscatter.analysis.geometry.saddle.saddle_points`,
-    :func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours` over scales from a fixed fraction of
-    the points' extent, :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan` at multiples of it,
-    :func:`~hhscatter.analysis.geometry.saddle.window_dependence`) and the relation's verdict
-    (:func:`~hhscatter.analysis.geometry.saddle.kantz_grassberger`); derived table ``saddle_ftle.parquet`` (the
-    finite-time exponents Λ/T of the tangent runs); d₀ = 1 − α of the lines run
-    (:func:`~hhscatter.analysis.geometry.uncertainty.uncertainty_fraction` per ε,
-    :func:`~hhscatter.analysis.geometry.saddle.dimension_from_uncertainty`) and d₀ ≥ d₁ − 2σ
-    (:func:`~hhscatter.analysis.geometry.saddle.dimension_order`); the exit basins' cut-off re-predicted from
-    study basins' numbers with λ̄ (:func:`~hhscatter.reproduction.basin_summary.rate_table`,
-    :func:`~hhscatter.reproduction.basin_summary.saddle_cutoff_records`,
-    :func:`~hhscatter.reproduction.basin_summary.saddle_cutoff_summary`).
+    ``saddle.json``: per point κ, λ̄, d₁ on the section and on lines, d₀ = 1 − α of the lines run, the relation's
+    verdicts and the exit basins' cut-off re-predicted from study basins' numbers (the estimators of
+    :mod:`hhscatter.analysis.geometry.saddle`, assembled by :mod:`hhscatter.reproduction.saddle_records` and
+    :mod:`hhscatter.reproduction.basin_summary`); derived table ``saddle_ftle.parquet`` (the finite-time exponents
+    Λ/T of the tangent runs).
 
 ``plot(study)``
     ``saddle.png`` via ``plot_saddle`` of the folder's ``figure.py``.
@@ -242,35 +232,24 @@ def _dense_lines_path(study, key):
 
 
 def _lines_t_max(study, kappa: float, t_max: float) -> float:
-    """t_max of the dense lines: a few e-folds after the latest t_min·κ used, at most the main run's t_max (regular
-    orbits, which never leave, run to it: a shorter run costs them less and selects no other orbit)."""
+    """t_max of the dense lines: 3 e-folds after the latest t_min·κ used, at most the main run's (a cheaper end)."""
     p = study.params
     return min(t_max, (max(p.lines_efolds, *p.lines_checks) + 3.0) / kappa)
 
 
 def _run_dense_lines(study, key, sc, spec, kappa, workers, progress):
-    """The dense lines of a point (raw key ``<key>_dlines``): lines_count lines y = const evenly across the main run's
-    disk (within 0.8 of its radius), lines_n positions uniform on each chord (seeded by the point's key),
-    tangential momenta at E; run to :func:`_lines_t_max` with the main run's r_esc. Its layout in a derived table."""
+    """The dense lines of a point (``<key>_dlines``): lines_count × lines_n ICs of ``scene.ics.chord_lines`` across
+    the disk (seeded by the key), run to :func:`_lines_t_max` with the main run's r_esc; the layout derived."""
     import zlib
 
     import pandas as pd
 
-    from hhscatter.scene.ics import section_velocities
+    from hhscatter.scene.ics import chord_lines
 
-    p, m = study.params, sc.model
     rng = np.random.default_rng([int(study.config["scene"]["seed"]), 52, zlib.crc32(key.encode())])
-    R, parts = float(sc.radius), []
-    for j in range(p.lines_count):
-        c = 0.8 * R * (2.0 * (j + 0.5) / p.lines_count - 1.0)
-        half = math.sqrt(R * R - c * c)
-        x = rng.uniform(-half, half, p.lines_n)
-        y = np.full(p.lines_n, c)
-        ok = (m.potential(x, y) < sc.energy) & ((x != 0) | (y != 0))
-        px, py = section_velocities(m, x[ok], y[ok], sc.energy)
-        parts.append(pd.DataFrame({"x": x[ok], "y": y[ok], "px": px, "py": py, "line": j}))
-    df = pd.concat(parts, ignore_index=True)
-    df.insert(0, "traj_id", np.arange(len(df), dtype=np.int64))
+    st, line = chord_lines(sc.model, sc.energy, float(sc.radius), study.params.lines_count, study.params.lines_n, rng)
+    df = pd.DataFrame({"traj_id": np.arange(len(st), dtype=np.int64), "x": st[:, 0], "y": st[:, 1], "px": st[:, 2],
+                       "py": st[:, 3], "line": line})  # fmt: skip
     path = _dense_lines_path(study, key)
     if not path.exists() or not pd.read_parquet(path).equals(df):  # the scene's hash includes the file's
         df.to_parquet(path, index=False)
@@ -283,71 +262,21 @@ def _run_dense_lines(study, key, sc, spec, kappa, workers, progress):
 # analyze
 # ---------------------------------------------------------------------------
 def _d1_lines(study, key, k, lam, t_max):
-    """d₁ on the point's dense lines: the survivors' positions along their lines (blocks: one a line), with the
-    floor lines_floor of a line's extent, at t_min·κ = lines_efolds and lines_checks, its floor scan and the
-    relation with it (:func:`~hhscatter.reproduction.saddle_records.lines_record`)."""
+    """d₁ on the point's dense lines (:func:`~hhscatter.reproduction.saddle_records.lines_measurement`)."""
     import pandas as pd
-
-    from hhscatter.analysis.geometry.saddle import kantz_grassberger
 
     p = study.params
     layout = pd.read_parquet(_dense_lines_path(study, key), columns=["traj_id", "x", "line"])
     rows = layout.merge(_lifetimes(study.raw(key + "_dlines")), on="traj_id")
-    t_lines = _lines_t_max(study, k.kappa, t_max)
-
-    def args(c):
-        sel = _long_lived(rows, c / k.kappa)
-        return {"points": sel["x"].to_numpy(), "blocks": sel["line"].to_numpy(), "k_max": p.k_max,
-                "n_boot": p.n_boot, "seed": 0}, len(sel)  # fmt: skip
-
-    by = []
-    for c in sorted({p.lines_efolds, *p.lines_checks}):
-        a, n = args(c)
-        try:
-            if c / k.kappa >= t_lines:
-                raise ConfigError(f"t_min = {c / k.kappa:.4g} is not before the lines' t_max {t_lines:.4g}")
-            by.append((c, n, information_dimension_neighbours(**a, floor=p.lines_floor)))
-        except ConfigError as exc:
-            by.append((c, n, str(exc)))
-    chosen = next(d for c, _n, d in by if c == p.lines_efolds)
-    if isinstance(chosen, str):
-        return {"notes_lines": f"d1 on lines: {chosen}"}
-    a, _n = args(p.lines_efolds)
-    scan = neighbour_floor_scan(**a, floor=p.lines_floor, factors=p.d1_floor_factors)
-    try:
-        kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], chosen.value, chosen.err)
-    except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)
-        kg = None
-    scatter = math.exp(-lam["value"] * p.lines_efolds / k.kappa) if lam["value"] > 0 else None
-    return sr.lines_record(by, p.lines_efolds, scan, kg, n_lines=p.lines_count, scatter=scatter)
+    return sr.lines_measurement(rows, k.kappa, k.kappa_err, lam["value"], lam["err"], efolds=p.lines_efolds,
+                                checks=p.lines_checks, floor=p.lines_floor, factors=p.d1_floor_factors,
+                                k_max=p.k_max, n_boot=p.n_boot, t_max=_lines_t_max(study, k.kappa, t_max),
+                                n_lines=p.lines_count)  # fmt: skip
 
 
 def _lyapunov(lt, t_min, p):
-    """λ̄ of the tangent run's orbits that left at t_end ≥ t_min: the record's value, error, rule and FTLE."""
-    from hhscatter.analysis.geometry.saddle import lyapunov_convergence, mean_lyapunov
-
-    lt = _long_lived(lt, t_min)
-    L, T = lt["log_stretch"].to_numpy(), lt["t_end"].to_numpy()
-    if L.size < 2:
-        return None
-    mean = mean_lyapunov(L, T, n_boot=p.n_boot, seed=0)
-    out = {"mean": mean.value, "mean_err": mean.err, "n_orbits": mean.n_orbits, "ftle_std": mean.ftle_std,
-           "ftle_q05": mean.ftle_quantiles[0.05], "ftle_q50": mean.ftle_quantiles[0.5],
-           "ftle_q95": mean.ftle_quantiles[0.95], **Measured(mean.value, mean.err).to_dict(), "rule": "mean"}  # fmt: skip
-    try:
-        c = lyapunov_convergence(L, T, n_bins=p.n_bins, n_boot=p.n_boot, seed=0)
-    except ConfigError as exc:
-        out["convergence"] = str(exc)
-        return out, lt.assign(ftle=mean.ftle)
-    out.update({"extrapolated": c.extrapolated, "extrapolated_err": c.extrapolated_err, "slope": c.slope,
-                "slope_err": c.slope_err, "converged": c.converged})  # fmt: skip
-    lam_inf = Measured(c.extrapolated, c.extrapolated_err, "1/T extrapolation", mean.n_orbits)
-    out.update({"lambda_mean": Measured(mean.value, mean.err, "mean", mean.n_orbits).to_dict(),
-                "lambda_inf": lam_inf.to_dict(),
-                "b": Measured(c.slope, c.slope_err, "1/T slope", mean.n_orbits).to_dict()})  # fmt: skip
-    if not c.converged:
-        out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
-    return out, lt.assign(ftle=mean.ftle)
+    """λ̄ of the tangent run's orbits that left at t_end ≥ t_min (saddle_records.lyapunov_record)."""
+    return sr.lyapunov_record(_long_lived(lt, t_min), n_bins=p.n_bins, n_boot=p.n_boot)
 
 
 def _extent(sp) -> float:
@@ -392,38 +321,12 @@ def _d1_radius(sp, d, p):
 
 
 def _d0(study, key):
-    """d₀ = 1 − α of the point's lines run: the record's keys (d0, d0_err, the section's D₀, the scaling range, the
-    fit's χ² and p, the f(ε) rows) or a note."""
+    """d₀ = 1 − α of the point's lines run (:func:`~hhscatter.reproduction.saddle_records.d0_record`)."""
     import pandas as pd
 
-    from hhscatter.analysis.geometry.saddle import dimension_from_uncertainty
-    from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
-    from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
-
-    p = study.params
     layout = pd.read_parquet(_lines_path(study, key)).sort_values("traj_id")
-    lt = _lifetimes(study.raw(key + "_lines"), ("exit_channel",))
-    codes = outcome_codes(lt)  # in traj_id order
-    codes[codes == TRAPPED_CODE] = OUTSIDE  # an orbit still inside at t_max: its pair is left out
-    rows = []
-    for e, g in layout.assign(code=codes).groupby("eps", sort=False):
-        ref, moved = (g[g["moved"] == m].sort_values("pair")["code"].to_numpy() for m in (False, True))
-        u = uncertainty_fraction(ref, moved, outside=OUTSIDE)
-        rows.append({"eps": float(e), "f": u.f, "k": u.k, "n": u.n, "n_excluded": u.n_excluded})
-    tab = pd.DataFrame(rows).sort_values("eps", ascending=False)
-    ok = (tab["k"] >= p.d0_min_count) & (tab["k"] < tab["n"])
-    out = {"d0_uncertainty": tab.to_dict(orient="records")}
-    if ok.sum() < 3:
-        return {**out, "note": f"d0: fewer than 3 values of ε with ≥ {p.d0_min_count} uncertain pairs"}
-    rng = (float(tab.loc[ok, "eps"].min()), float(tab.loc[ok, "eps"].max()))
-    try:
-        d = dimension_from_uncertainty(tab["eps"], tab["f"], tab["n"], eps_range=rng)
-        u = uncertainty_exponent(tab["eps"], tab["f"], tab["n"], eps_range=rng, dim=1.0)
-    except (ValueError, ConfigError) as exc:
-        return {**out, "note": f"d0: {exc}"}
-    return {**out, "d0": d.value, "d0_err": d.err, "d0_section": 2 * d.value, "d0_section_err": 2 * d.err,
-            "d0_eps_range": list(d.eps_range), "d0_n_eps": u.n_points, "d0_fit_chi2": u.chi2,
-            "d0_fit_dof": u.dof, "d0_fit_p": u.p_value}  # fmt: skip
+    lt = _lifetimes(study.raw(key + "_lines"), ("exit_channel",))  # in traj_id order, as the layout
+    return sr.d0_record(layout, lt, min_count=study.params.d0_min_count)
 
 
 def _basins_cutoff(study, records) -> dict:
