@@ -30,10 +30,21 @@ import re
 
 import numpy as np
 
-from hhscatter.analysis.geometry.saddle import dimension_order, mean_lyapunov
+from hhscatter.analysis.geometry.saddle import (
+    dimension_from_uncertainty,
+    dimension_order,
+    information_dimension_neighbours,
+    kantz_grassberger,
+    lyapunov_convergence,
+    mean_lyapunov,
+    neighbour_floor_scan,
+)
 from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_lyapunov, low_ftle_share, tmin_trend
+from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
+from hhscatter.outcomes import LEAVING_OUTCOMES
+from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
 
 __all__ = [
     "ERR_PARTS",
@@ -534,13 +545,6 @@ def lines_measurement(
     before the lines' ``t_max`` is refused; λ̄ ≤ 0 gives no relation. Returns :func:`lines_record`'s keys, or
     ``{"notes_lines": why}`` where d₁ at ``efolds`` is refused.
     """
-    from hhscatter.analysis.geometry.saddle import (
-        information_dimension_neighbours,
-        kantz_grassberger,
-        neighbour_floor_scan,
-    )
-    from hhscatter.outcomes import LEAVING_OUTCOMES
-
     left = rows["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
 
     def args(c):
@@ -577,8 +581,6 @@ def lyapunov_record(lt, *, n_bins: int, n_boot: int):
     (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`); λ̄(T) = λ∞ + Λ₀/T over ``n_bins`` bins of T
     (:func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), λ∞ taken where the drift Λ₀ is resolved.
     """
-    from hhscatter.analysis.geometry.saddle import lyapunov_convergence
-
     L, T = lt["log_stretch"].to_numpy(), lt["t_end"].to_numpy()
     if L.size < 2:
         return None
@@ -611,11 +613,7 @@ def d0_record(layout, lifetimes, *, min_count: int) -> dict:
     with an orbit still inside at t_max is left out; α by binomial maximum likelihood over the ε with ≥
     ``min_count`` uncertain pairs (and not all).
     """
-    import pandas as pd
-
-    from hhscatter.analysis.geometry.saddle import dimension_from_uncertainty
-    from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
-    from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
+    import pandas as pd  # deferred: pandas loads on first use
 
     codes = outcome_codes(lifetimes)
     codes[codes == TRAPPED_CODE] = OUTSIDE  # an orbit still inside at t_max: its pair is left out
