@@ -5,8 +5,10 @@ statements the page shows.
 A point's record is a dict with at least ``id``, ``system``, ``ratio``, ``energy``, ``kappa``/``kappa_err`` and,
 where measured, ``lyapunov``, ``d1_section`` (the section's D₁ = 2 d₁), ``d1``, ``predicted`` (λ̄(1 − d₁)),
 ``d1_implied`` (1 − κ/λ̄), ``z`` and ``verdict`` (:func:`hhscatter.analysis.geometry.saddle.kantz_grassberger`),
-``d0`` (1 − α of the exits on lines) and the keys :func:`d1_error_record` adds. The functions here read those keys
-only; they run no estimator but :func:`hhscatter.analysis.geometry.saddle.dimension_order` (in :func:`with_d0`).
+``d0`` (1 − α of the exits on lines) and the keys :func:`d1_error_record` adds. Most functions here read those keys
+only; :func:`lines_measurement`, :func:`lyapunov_record`, :func:`d0_record`, :func:`mid_lyapunov_record`,
+:func:`fluctuation_record` and :func:`hyperbolic_record` run the estimators of
+:mod:`hhscatter.analysis.geometry.saddle` on a run's tables and assemble their records.
 
 Units: κ and λ̄ in 1/time, d₀ and d₁ dimensionless (partial dimensions along the unstable direction, the section's
 D = 2 d), ε in the section's length units.
