@@ -554,9 +554,11 @@ def lines_measurement(
         return {"points": sel["x"].to_numpy(), "blocks": sel["line"].to_numpy(), "k_max": k_max, "n_boot": n_boot,
                 "seed": 0}, len(sel)  # fmt: skip
 
-    by = []
+    by, chosen_args = [], None
     for c in sorted({efolds, *checks}):
         a, n = args(c)
+        if c == efolds:
+            chosen_args = a
         try:
             if c / kappa >= t_max:
                 raise ConfigError(f"t_min = {c / kappa:.4g} is not before the lines' t_max {t_max:.4g}")
@@ -566,7 +568,7 @@ def lines_measurement(
     chosen = next(d for c, _n, d in by if c == efolds)
     if isinstance(chosen, str):
         return {"notes_lines": f"d1 on lines: {chosen}"}
-    scan = neighbour_floor_scan(**args(efolds)[0], floor=floor, factors=factors)
+    scan = neighbour_floor_scan(**chosen_args, floor=floor, factors=factors)
     try:
         kg = kantz_grassberger(kappa, kappa_err, lam, lam_err, chosen.value, chosen.err)
     except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)

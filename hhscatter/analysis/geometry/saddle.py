@@ -342,11 +342,11 @@ class SaddleDimension:
         )
 
 
-def _group_labels(groups, n: int, name: str = "groups") -> tuple[np.ndarray, int]:
-    """(labels 0..n_groups−1 per point, n_groups) of ``groups`` (one label per point; None: every point its own,
-    or, for ``name`` 'blocks', all in one)."""
+def _group_labels(groups, n: int, name: str = "groups", *, alone: bool = True) -> tuple[np.ndarray, int]:
+    """(labels 0..n_groups−1 per point, n_groups) of ``groups`` (one label per point; None: every point its own
+    with ``alone``, else all in one)."""
     if groups is None:
-        return (np.zeros(n, dtype=np.int64), 1) if name == "blocks" else (np.arange(n), n)
+        return (np.arange(n), n) if alone else (np.zeros(n, dtype=np.int64), 1)
     g = np.asarray(groups)
     if g.shape != (n,):
         raise ConfigError(f"{name} must have one label per point: shape {g.shape} != ({n},)")
@@ -657,7 +657,7 @@ def information_dimension_neighbours(
     n_boot = _count(n_boot, "n_boot", 0)
     seed = _count(seed, "seed", 0)
     _eps_min(eps_min)
-    b, n_blocks = _group_labels(blocks, n, "blocks")
+    b, n_blocks = _group_labels(blocks, n, "blocks", alone=False)
     extent = _extent(P, b, n_blocks)
     if not extent > 0:
         raise ConfigError("points: all points coincide (no extent to cover)")
@@ -789,7 +789,7 @@ def neighbour_floor_scan(
     if not fs or not all(math.isfinite(v) and v > 0 for v in fs):
         raise ConfigError(f"factors must be at least one number > 0 (multiples of floor), got {factors!r}")
     P = _finite_array(points, "points", 2)
-    extent = _extent(P, *_group_labels(blocks, P.shape[0], "blocks"))
+    extent = _extent(P, *_group_labels(blocks, P.shape[0], "blocks", alone=False))
     rows = []
     for fac in fs:
         row = {"factor": fac, "floor": fac * floor, "eps_min": fac * floor * extent}
