@@ -59,9 +59,11 @@ __all__ = [
     "fluctuation_record",
     "gap_row",
     "hyperbolic_record",
+    "sheets_record",
     "gap_summary",
     "d0_record",
     "lines_measurement",
+    "long_lived",
     "lyapunov_record",
     "lines_record",
     "lines_row",
@@ -426,6 +428,66 @@ def fluctuation_record(tangent, kappa: float, kappa_err: float, mid=None, *, n_b
                                  "n_orbits": e.n_orbits}}  # fmt: skip
 
 
+def sheets_record(points, force, *, floor: float, k_max: int, n_boot: int, min_boxes: float = 8.0) -> dict:
+    """sheets_record(points, force, *, floor, k_max, n_boot, min_boxes=8) -> dict.
+
+    The section ṙ = 0, φ̇ > 0 one sheet at a time and in a second chart. ``points`` holds section points
+    (``traj_id``, ``x``, ``y``, ``px``, ``py``; positions in length units, momenta per unit mass) of a conservative
+    flow with the force ``force(x, y) -> (F_x, F_y)``. The section is the union of two sheets that meet where the
+    flow grazes it: the radial maxima (r̈ < 0) and the radial minima (r̈ > 0), with r̈ = (p² + r·F)/r at ṙ = 0.
+    Each sheet's D₁ is measured by the neighbour estimator in two charts, the positions (x, y) and the canonical
+    pair (φ, p_φ) (p_φ = x p_y − y p_x; the return map preserves dφ ∧ dp_φ), each axis scaled to the unit
+    interval, fitted from ``floor`` up to 1/``min_boxes``. Returns ``sheets``: per sheet (``r_max``, ``r_min``) its
+    number of points and d₁ = D₁/2 in each chart (``xy``, ``canonical``), or its ``note`` where the estimator
+    refuses; and, where both sheets have one, ``d1_sheets`` and ``d1_chart``: the mean of the two sheets' d₁ in
+    (x, y) and in (φ, p_φ), errors in quadrature (the gap candidates "sheets" and "chart").
+
+    Examples
+    --------
+    Points filling a square of positions and a range of tangential speeds under a harmonic force (r̈ < 0 where
+    the speed is below r): each sheet fills an area in both charts, d₁ = 1 up to the square's edges.
+
+    >>> import numpy as np, pandas as pd
+    >>> rng = np.random.default_rng(0)
+    >>> x, y, v = 2 + rng.random(8000), rng.random(8000) - 0.5, 4 * rng.random(8000)
+    >>> phi = np.arctan2(y, x)
+    >>> pts = pd.DataFrame({"traj_id": np.arange(8000), "x": x, "y": y, "px": -v * np.sin(phi), "py": v * np.cos(phi)})
+    >>> rec = sheets_record(pts, lambda x, y: (-x, -y), floor=1 / 128, k_max=8, n_boot=10)
+    >>> rec["sheets"]["r_max"]["n_points"] == int((v < np.hypot(x, y)).sum())
+    True
+    >>> bool(abs(rec["d1_sheets"]["value"] - 1) < 0.05), bool(abs(rec["d1_chart"]["value"] - 1) < 0.05)
+    (True, True)
+    """
+    x, y, px, py = (points[c].to_numpy(dtype=float) for c in ("x", "y", "px", "py"))
+    g = points["traj_id"].to_numpy()
+    fx, fy = force(x, y)
+    r = np.hypot(x, y)
+    rdd = (px**2 + py**2 + x * np.asarray(fx) + y * np.asarray(fy)) / r
+    charts = {"xy": (x, y), "canonical": (np.arctan2(y, x), x * py - y * px)}
+    out, means = {}, {}
+    for sheet, at in (("r_max", rdd < 0), ("r_min", rdd > 0)):
+        row = {"n_points": int(np.count_nonzero(at))}
+        for chart, (a, b) in charts.items():
+            P = np.column_stack([a[at], b[at]])
+            try:
+                span = np.ptp(P, axis=0)
+                if not np.all(span > 0):
+                    raise ConfigError("the sheet's points span no area")
+                d = information_dimension_neighbours((P - P.min(axis=0)) / span, g[at], k_max=k_max,
+                                                     eps_max=1.0 / min_boxes, floor=floor, n_boot=n_boot, seed=0)  # fmt: skip
+            except ConfigError as exc:
+                row[f"{chart}_note"] = str(exc)
+                continue
+            row[chart] = Measured(d.value, d.err).scaled(0.5).to_dict()
+            means.setdefault(chart, []).append(Measured(d.value, d.err).scaled(0.5))
+        out[sheet] = row
+    rec = {"sheets": out}
+    for chart, key in (("xy", "d1_sheets"), ("canonical", "d1_chart")):
+        if len(means.get(chart, [])) == 2:
+            rec[key] = means[chart][0].sum(means[chart][1]).scaled(0.5).to_dict()
+    return rec
+
+
 def hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot: int = 1000) -> dict:
     """hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.75), *, n_boot=1000) ->
     {"hyperbolic": {...}} or {"hyperbolic_note": why none}.
@@ -534,6 +596,23 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
     return {"d1_lines": chosen_row["d1"], "d1_lines_detail": detail}
 
 
+def long_lived(lifetimes, t_min: float):
+    """long_lived(lifetimes, t_min) -> the rows of ``lifetimes`` (``outcome``, ``t_end``) of the orbits that left
+    (escaped or settled) at t_end ≥ ``t_min`` (time units): the orbits that stayed near the saddle; an orbit still
+    inside at the end of its run (censored) is not one of them.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> lt = pd.DataFrame({"traj_id": [0, 1, 2, 3], "outcome": ["escaped", "censored", "settled", "escaped"],
+    ...                    "t_end": [5.0, 50.0, 20.0, 30.0]})
+    >>> long_lived(lt, 10.0)["traj_id"].tolist()
+    [2, 3]
+    """
+    left = lifetimes["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
+    return lifetimes[left & (lifetimes["t_end"].to_numpy() >= t_min)]
+
+
 def lines_measurement(
     rows, kappa, kappa_err, lam, lam_err, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines
 ) -> dict:
@@ -547,10 +626,9 @@ def lines_measurement(
     before the lines' ``t_max`` is refused; λ̄ ≤ 0 gives no relation. Returns :func:`lines_record`'s keys, or
     ``{"notes_lines": why}`` where d₁ at ``efolds`` is refused.
     """
-    left = rows["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
 
     def args(c):
-        sel = rows[left & (rows["t_end"].to_numpy() >= c / kappa)]
+        sel = long_lived(rows, c / kappa)
         return {"points": sel["x"].to_numpy(), "blocks": sel["line"].to_numpy(), "k_max": k_max, "n_boot": n_boot,
                 "seed": 0}, len(sel)  # fmt: skip
 
@@ -727,6 +805,8 @@ CANDIDATES = {
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
     "fluctuation": "1 − κ/λ̄ moved to the d₂ that κ and the mid-life exponents' fluctuations imply",
     "hyperbolic": "d₁ and λ̄ of the hyperbolic part (the orbits with finite-time exponent not near 0)",
+    "sheets": "d₁ of the section's two sheets (radial maxima, radial minima) one at a time, their mean",
+    "chart": "d₁ of the two sheets in the canonical chart (φ, p_φ), their mean",
 }
 """The candidate reasons for a gap between d₁ and 1 − κ/λ̄ that :func:`with_gap` measures: name -> what it is."""
 
@@ -777,6 +857,9 @@ def with_gap(rec: dict) -> dict:
     if rec.get("ftle_fluctuation"):
         sh = rec["ftle_fluctuation"]["shift"]
         alt["fluctuation"] = (Measured(implied.value + sh["value"], math.hypot(implied.err, sh["err"])), d1)
+    for name, key in (("sheets", "d1_sheets"), ("chart", "d1_chart")):
+        if rec.get(key):
+            alt[name] = (implied, Measured(rec[key]["value"], rec[key]["err"]))
     if rec.get("hyperbolic"):
         h = rec["hyperbolic"]
         lam_h = Measured(rec["lyapunov"] + h["lyapunov_shift"]["value"], h["lyapunov_shift"]["err"]).to_dict()

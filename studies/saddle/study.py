@@ -137,14 +137,6 @@ def _kappa(path):
     return escape_rate_from_lifetimes(lt[lt["outcome"].astype(object).isin(LEAVING_OUTCOMES)], detect_tail=False)
 
 
-def _long_lived(lt, t_min):
-    """Rows of the orbits that left at t_end ≥ t_min."""
-    from hhscatter.outcomes import LEAVING_OUTCOMES
-
-    left = lt["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
-    return lt[left & (lt["t_end"].to_numpy() >= t_min)]
-
-
 # ---------------------------------------------------------------------------
 # simulate
 # ---------------------------------------------------------------------------
@@ -174,7 +166,7 @@ def simulate(study, workers=None, progress=True):
             k = _kappa(study.raw(key))
             t_min = _tmin_efolds(study, label) / k.kappa
             lt = read_lifetimes(study.raw(key), columns=["traj_id", "x0", "y0", "px0", "py0", "outcome", "t_end"])
-            sel = _long_lived(lt, t_min)
+            sel = sr.long_lived(lt, t_min)
             print(f"  saddle {key}: κ = {k.kappa:.4f} ± {k.kappa_err:.4f}, t_min = {t_min:.1f}, {len(sel)} orbits")
             choices[key] = {"system": label, "ratio": r, "energy": r * m.critical_energy, "kappa": k.kappa,
                             "kappa_err": k.kappa_err, "t_min": t_min, "n_tangent": len(sel), "r_esc": sc.r_esc}  # fmt: skip
@@ -276,7 +268,7 @@ def _d1_lines(study, key, k, lam, t_max):
 
 def _lyapunov(lt, t_min, p):
     """λ̄ of the tangent run's orbits that left at t_end ≥ t_min (saddle_records.lyapunov_record)."""
-    return sr.lyapunov_record(_long_lived(lt, t_min), n_bins=p.n_bins, n_boot=p.n_boot)
+    return sr.lyapunov_record(sr.long_lived(lt, t_min), n_bins=p.n_bins, n_boot=p.n_boot)
 
 
 def _extent(sp) -> float:
@@ -303,8 +295,8 @@ def _checks(study, key, tangent, t_min, efolds, k):
     lo, hi = (_lifetimes(study.raw(f"{key}_tangent_{s}"), ("log_stretch",)) for s in ("lo", "hi"))
     ts, mid = [c / kappa for c in (efolds, *(efolds + s for s in p.tmin_trend))], (p.window[0] * t_min, p.window[1] * t_min)  # fmt: skip
     return {**sr.mid_lyapunov_record(lo, hi, *mid, n_boot=p.n_boot),
-            **sr.fluctuation_record(_long_lived(tangent, t_min), kappa, k.kappa_err, (lo, hi, *mid), n_boot=p.n_boot),
-            "lyapunov_by_t_min": sr.lyapunov_by_t_min(_long_lived(tangent, ts[0]), ts, kappa, n_boot=p.n_boot)}  # fmt: skip
+            **sr.fluctuation_record(sr.long_lived(tangent, t_min), kappa, k.kappa_err, (lo, hi, *mid), n_boot=p.n_boot),
+            "lyapunov_by_t_min": sr.lyapunov_by_t_min(sr.long_lived(tangent, ts[0]), ts, kappa, n_boot=p.n_boot)}  # fmt: skip
 
 
 def _d1_radius(sp, d, p):
@@ -380,7 +372,7 @@ def _point(study, key, ch):
         rec["notes"].append("no orbit left at t_end ≥ t_min")
         return rec, None
     tangent, lt = _lifetimes(study.raw(key + "_tangent"), ("log_stretch",)), _lifetimes(study.raw(key))
-    main = _long_lived(lt, ch["t_min"]).set_index("traj_id")["t_end"]  # one integration: the same orbits, same ends
+    main = sr.long_lived(lt, ch["t_min"]).set_index("traj_id")["t_end"]  # one integration: the same orbits, same ends
     same = int((tangent.set_index("traj_id")["t_end"].reindex(main.index) == main).sum())
     rec["tangent_same_orbits"] = {"same_t_end": same, "selected": len(main)}
     if same < len(main):
@@ -393,13 +385,13 @@ def _point(study, key, ch):
         return rec, None
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
-    t_max = next(t for label, _s, _m, _r, t in _systems(study) if label == ch["system"])
+    _label, _spec, model, _ratios, t_max = next(s for s in _systems(study) if s[0] == ch["system"])
     lines = _d1_lines(study, key, k, lam, t_max)
     if "notes_lines" in lines:
         rec["notes"].append(lines.pop("notes_lines"))
     rec.update(lines)
     rec.update(_checks(study, key, tangent, ch["t_min"], efolds, k))
-    sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y"])
+    sec = read_sections(study.raw(key), columns=["traj_id", "t", "x", "y", "px", "py"])
     est = _d1_estimator(p)
     cs = (*p.tmin_checks, efolds, *(efolds + s for s in p.tmin_trend))
     wd = window_dependence(lt, sec, est, t_mins=[c / k.kappa for c in cs], windows=[tuple(p.window)],
@@ -410,7 +402,7 @@ def _point(study, key, ch):
     rec["d1_by_t_min"], trend = rec["d1_by_t_min"][: len(p.tmin_checks) + 1], rec["d1_by_t_min"][len(p.tmin_checks) :]
     rec["d1_trend_by_t_min"] = trend
     try:
-        sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y"])
+        sp = saddle_points(lt, sec, t_min=t_min, window=tuple(p.window), columns=["x", "y", "px", "py"])
         d = est(sp)
     except ConfigError as exc:
         rec["notes"].append(sr.d1_refusal_words(f"d1: {exc}"))
@@ -428,7 +420,9 @@ def _point(study, key, ch):
     scan = neighbour_floor_scan(**_d1_args(sp, p), floor=p.d1_floor, factors=p.d1_floor_factors)
     rec["d1_floor_scan"] = sr.floor_scan_record(scan, math.exp(-lam["value"] * sp.window[0] * sp.t_min))
     rec.update(_d1_radius(sp, d, p))
-    rec.update(sr.hyperbolic_record(_long_lived(tangent, ch["t_min"]), sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
+    rec.update(sr.sheets_record(sp.points, model.force, floor=p.d1_floor, k_max=p.k_max, n_boot=p.n_boot,
+                                min_boxes=p.min_boxes))  # fmt: skip
+    rec.update(sr.hyperbolic_record(sr.long_lived(tangent, ch["t_min"]), sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
     rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
     return rec, ftle
 

@@ -416,6 +416,26 @@ def test_the_floor_scan_covers_the_baker_natural_measure_at_every_floor():
     assert np.all(covered[:4] >= 4) and covered[4] >= 3, covered
 
 
+def test_neighbour_dimension_at_the_paper_sections_settings_is_unbiased_on_the_baker_measure():
+    """The estimate of a Hénon–Heiles section's d₁ at paper scale, reproduced on a measure of known D₁: about 8 600
+    points of 1 900 orbits (4–5 iterates each), fitted from extent/512 (the paper's floor) up to extent/8 (8
+    boxes), on the natural measure of the area-preserving baker map with a = (0.6, 0.25) (d₁ᵘ = 0.789, near the
+    0.77 that 1 − κ/λ̄ gives at 1.5 E_c). Over 10 seeds the 2σ interval covers D₁ = 2d₁ᵘ in at least 9, and the
+    mean of D₁/2 lies within 0.01 of d₁ᵘ: at that sample size and range the estimator is not the reason a section's
+    D₁/2 reads 0.07 below 1 − κ/λ̄."""
+    a = (0.6, 0.25)
+    truth = 2 * closed_forms(a, a)["d1u"]
+    covered, values = 0, []
+    for seed in range(10):
+        P, orbits = natural_measure(a, 1900, 4 + seed % 2, seed)
+        extent = float(np.ptp(P, axis=0).max())
+        d = information_dimension_neighbours(P, orbits, eps_max=extent / 8, floor=1 / 512, n_boot=20, seed=seed)
+        covered += abs(d.value - truth) <= 2 * d.err
+        values.append(d.value)
+    assert covered >= 9, covered
+    assert abs(np.mean(values) / 2 - truth / 2) < 0.01, (np.mean(values) / 2, truth / 2)
+
+
 def _weighted_cantor(n, p, seed, depth=20):
     """n points of the middle-thirds Cantor set whose right third carries the weight p at every level (uniform
     below 3⁻ᵈᵉᵖᵗʰ, so that no two coincide): d₁ = h(p)/ln 3, h the weights' entropy."""
