@@ -43,6 +43,7 @@ from hhscatter.analysis.geometry.saddle import (
 )
 from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_lyapunov, low_ftle_share, tmin_trend
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
+from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
 from hhscatter.errors import ConfigError
 from hhscatter.outcomes import LEAVING_OUTCOMES
@@ -458,6 +459,10 @@ def sheets_record(points, force, *, floor: float, k_max: int, n_boot: int, min_b
     >>> bool(abs(rec["d1_sheets"]["value"] - 1) < 0.05), bool(abs(rec["d1_chart"]["value"] - 1) < 0.05)
     (True, True)
     """
+    check.table(points, "points", ("traj_id", "x", "y", "px", "py"))
+    check.function(force, "force")
+    floor, k_max = check.number(floor, "floor", positive=True), check.count(k_max, "k_max", 1)
+    n_boot, min_boxes = check.count(n_boot, "n_boot", 0), check.number(min_boxes, "min_boxes", positive=True)
     x, y, px, py = (points[c].to_numpy(dtype=float) for c in ("x", "y", "px", "py"))
     g = points["traj_id"].to_numpy()
     fx, fy = force(x, y)
@@ -470,6 +475,8 @@ def sheets_record(points, force, *, floor: float, k_max: int, n_boot: int, min_b
         for chart, (a, b) in charts.items():
             P = np.column_stack([a[at], b[at]])
             try:
+                if len(P) < 2:
+                    raise ConfigError(f"the sheet holds {len(P)} point(s)")
                 span = np.ptp(P, axis=0)
                 if not np.all(span > 0):
                     raise ConfigError("the sheet's points span no area")
@@ -609,6 +616,8 @@ def long_lived(lifetimes, t_min: float):
     >>> long_lived(lt, 10.0)["traj_id"].tolist()
     [2, 3]
     """
+    check.table(lifetimes, "lifetimes", ("outcome", "t_end"), min_rows=0)
+    t_min = check.number(t_min, "t_min")
     left = lifetimes["outcome"].astype(object).isin(LEAVING_OUTCOMES).to_numpy()
     return lifetimes[left & (lifetimes["t_end"].to_numpy() >= t_min)]
 

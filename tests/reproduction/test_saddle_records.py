@@ -242,3 +242,70 @@ def test_fluctuation_record_takes_the_mid_life_stretch_of_the_orbits_inside_at_b
     assert r["shift_whole_life"]["value"] < r["shift"]["value"] - 5 * r["shift"]["err"]
     gone = sr.fluctuation_record(tg, 0.15, 0.0, (lo, hi.assign(outcome="escaped"), 20.0, 60.0), n_boot=5)
     assert "fewer than 2" in gone["ftle_fluctuation_note"]
+
+
+def _sheet_points(n=6000, seed=0):
+    """Positions filling a square beside the origin, tangential speeds 0 … 4, a harmonic force: r̈ = (v² − r²)/r."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    x, y, v = 2 + rng.random(n), rng.random(n) - 0.5, 4 * rng.random(n)
+    phi = np.arctan2(y, x)
+    return pd.DataFrame({"traj_id": np.arange(n), "x": x, "y": y, "px": -v * np.sin(phi), "py": v * np.cos(phi)})
+
+
+def test_sheets_record_splits_by_the_sign_of_the_radial_acceleration_and_feeds_two_gap_candidates():
+    import numpy as np
+
+    pts = _sheet_points()
+    v, r = np.hypot(pts["px"], pts["py"]), np.hypot(pts["x"], pts["y"])
+    rec = sr.sheets_record(pts, lambda x, y: (-x, -y), floor=1 / 128, k_max=8, n_boot=10)
+    assert rec["sheets"]["r_max"]["n_points"] == int((v < r).sum())
+    assert rec["sheets"]["r_min"]["n_points"] == int((v > r).sum())
+    for s in ("r_max", "r_min"):  # each sheet fills an area in both charts: d₁ = 1 up to the square's edges
+        for chart in ("xy", "canonical"):
+            assert abs(rec["sheets"][s][chart]["value"] - 1) < 0.06, (s, chart, rec["sheets"][s][chart])
+    mean = (rec["sheets"]["r_max"]["xy"]["value"] + rec["sheets"]["r_min"]["xy"]["value"]) / 2
+    assert rec["d1_sheets"]["value"] == pytest.approx(mean, rel=1e-12)
+    # a force that pulls harder empties the r-minimum sheet: its refusal is kept, no mean is formed
+    few = sr.sheets_record(pts, lambda x, y: (-100 * x, -100 * y), floor=1 / 128, k_max=8, n_boot=10)
+    assert few["sheets"]["r_min"]["n_points"] == 0 and "xy_note" in few["sheets"]["r_min"]
+    assert "d1_sheets" not in few and "d1_chart" not in few
+    # the gap's candidates take the mean in place of d₁
+    base = {"kappa": 0.1, "kappa_err": 0.0, "lyapunov": 0.4, "lyapunov_err": 0.0, "d1": 0.70, "d1_err": 0.01,
+            "d1_implied": 0.75, "d1_implied_err": 0.0, "z": -5.0}  # fmt: skip
+    g = sr.with_gap({**base, "d1_sheets": {"value": 0.70, "err": 0.01}, "d1_chart": {"value": 0.745, "err": 0.01}})
+    assert g["gap"]["sheets"]["closes"] is False and g["gap"]["chart"]["closes"] is True
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"points": [[0.0, 1.0]]}, "points"),
+        ({"points": _sheet_points(100).drop(columns="py")}, "py"),
+        ({"force": 3.0}, "force"),
+        ({"floor": 0.0}, "floor"),
+        ({"k_max": 2.5}, "k_max"),
+        ({"n_boot": -1}, "n_boot"),
+        ({"min_boxes": float("nan")}, "min_boxes"),
+    ],
+)
+def test_sheets_record_refuses_bad_input_naming_it(kwargs, name):
+    from hhscatter.errors import ConfigError
+
+    args = {"points": _sheet_points(100), "force": lambda x, y: (-x, -y), "floor": 0.01, "k_max": 4, "n_boot": 0,
+            **kwargs}  # fmt: skip
+    with pytest.raises(ConfigError, match=name):
+        sr.sheets_record(args.pop("points"), args.pop("force"), **args)
+
+
+def test_long_lived_keeps_the_orbits_that_left_late_and_refuses_a_table_without_its_columns():
+    from hhscatter.errors import ConfigError
+
+    lt = pd.DataFrame({"traj_id": [0, 1, 2], "outcome": ["escaped", "censored", "settled"], "t_end": [5.0, 50.0, 20.0]})
+    assert sr.long_lived(lt, 5.0)["traj_id"].tolist() == [0, 2]
+    assert sr.long_lived(lt.iloc[:0], 1.0).empty
+    with pytest.raises(ConfigError, match="outcome"):
+        sr.long_lived(lt.drop(columns="outcome"), 1.0)
+    with pytest.raises(ConfigError, match="t_min"):
+        sr.long_lived(lt, float("inf"))
