@@ -10,6 +10,8 @@ at ε_c = e^{−Λ}, Λ = ∫_0^τ2 λ(E(t)) dt.
 * :func:`decision_rate` — λ from the decision times of pairs of initial
   conditions with different outcomes, against ln(1/ε);
 * :func:`predicted_cutoff` — ε_c from λ(E), μ, γ, E0 and E_c;
+* :func:`orbit_stretch` — Λ of single orbits along their own energy histories (start and end energy, lifetime),
+  in place of the ensemble's mean decay;
 * :func:`cutoff_comparison` — measured against predicted ε_c, with the
   systematic of λ(E) (two estimators) in the predicted interval, and a plain
   statement of how far they differ.
@@ -32,7 +34,14 @@ from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.errors import ConfigError
 
-__all__ = ["CutoffComparison", "DecisionRate", "cutoff_comparison", "decision_rate", "predicted_cutoff"]
+__all__ = [
+    "CutoffComparison",
+    "DecisionRate",
+    "cutoff_comparison",
+    "decision_rate",
+    "orbit_stretch",
+    "predicted_cutoff",
+]
 
 
 @dataclass(frozen=True)
@@ -148,6 +157,55 @@ def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: flo
     val = np.interp(grid, En[ok][o], lam[ok][o]) / grid
     big_lambda = float(np.sum(0.5 * (val[1:] + val[:-1]) * np.diff(grid))) / (mu * gamma)
     return float(math.exp(-big_lambda))
+
+
+def orbit_stretch(e0, e_end, t_end, energies, lam) -> np.ndarray:
+    """orbit_stretch(e0, e_end, t_end, energies, λ(energies)) -> Λ of each orbit (dimensionless).
+
+    The stretching an orbit accumulates on the conservative saddle along its own energy history, in place of the
+    ensemble's mean decay that :func:`predicted_cutoff` uses: an orbit that starts at ``e0``, ends at ``e_end``
+    after ``t_end`` (energies in the Hamiltonian's units, time units) and decays exponentially in between, E(t) =
+    e0 (e_end/e0)^{t/t_end}, gathers Λ = ∫_0^{t_end} λ(E(t)) dt = t_end · ⟨λ⟩, the mean of λ over ln E between its
+    end energies (λ(e0) when they coincide). Two initial conditions ε apart that follow it can part only if ε >
+    e^{−Λ}: the distribution of e^{−Λ} over the orbits that decide an outcome is the spread of the cut-off that
+    the mean history's ε_c stands for. λ(E) is interpolated linearly between ``energies`` (held constant beyond
+    them), as in :func:`predicted_cutoff`; the mean uses the trapezoidal rule on 513 points in ln E. An orbit that
+    ends at E_c after exactly τ2 of the mean decay has Λ = −ln ε_c of :func:`predicted_cutoff`.
+
+    Examples
+    --------
+    >>> lam = orbit_stretch([0.3, 0.3], [0.3, 0.15], [10.0, 20.0], [0.1, 0.4], [0.5, 0.5])   # λ constant: λ·t_end
+    >>> [round(float(v), 10) for v in lam]
+    [5.0, 10.0]
+    >>> mu, g = 1.0, 0.01                       # the mean history: ends at E_c = 0.15 after τ2 = ln 2/(μγ)
+    >>> L = orbit_stretch([0.3], [0.15], [math.log(2) / (mu * g)], [0.2, 0.3], [0.4, 0.6])[0]
+    >>> round(float(L), 4), round(-math.log(predicted_cutoff(0.3, g, mu, [0.2, 0.3], [0.4, 0.6], 0.15)), 4)
+    (31.5073, 31.5073)
+    """
+    e0 = check.floats(e0, "e0", of="orbit")
+    e_end = check.floats(e_end, "e_end", size=e0.size, of="orbit")
+    t_end = check.floats(t_end, "t_end", size=e0.size, of="orbit")
+    n = _checks.values(energies, "energies").size
+    lam = _checks.values(lam, "lam", size=n)
+    En, lv = np.asarray(energies, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel()
+    ok = np.isfinite(En) & np.isfinite(lv)
+    if not np.any(ok):
+        raise ConfigError("orbit_stretch: no finite λ(E) given")
+    for name, v, low in (("e0", e0, 0.0), ("e_end", e_end, 0.0), ("t_end", t_end, None)):
+        bad = ~np.isfinite(v) | ((v <= low) if low is not None else (v < 0))
+        if np.any(bad):
+            need = "finite and > 0 (an energy above the potential's floor)" if low is not None else "finite and ≥ 0"
+            raise ConfigError(
+                f"{name} must be {need} for every orbit, got {v[bad][0]!r} at orbit {np.flatnonzero(bad)[0]}"
+            )
+    o = np.argsort(En[ok])
+    u = np.linspace(0.0, 1.0, 513)
+    out = np.empty(e0.size)
+    for s in range(0, e0.size, 4096):  # (orbits × 513) at a time
+        a, b = e0[s : s + 4096, None], e_end[s : s + 4096, None]
+        vals = np.interp(a * (b / a) ** u, En[ok][o], lv[ok][o])
+        out[s : s + 4096] = t_end[s : s + 4096] * np.trapezoid(vals, u, axis=1)
+    return out
 
 
 @dataclass(frozen=True)

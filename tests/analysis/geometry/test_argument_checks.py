@@ -66,6 +66,10 @@ VALID = {
         cutoff.predicted_cutoff,
         {"E0": 0.3, "gamma": 0.01, "mu": 1.0, "energies": [0.2, 0.3], "lam": [0.5, 0.5], "e_c": 0.15},
     ),
+    "orbit_stretch": (
+        cutoff.orbit_stretch,
+        {"e0": [0.3, 0.3], "e_end": [0.2, 0.15], "t_end": [10.0, 20.0], "energies": [0.2, 0.3], "lam": [0.4, 0.6]},
+    ),
     "cutoff_comparison": (
         cutoff.cutoff_comparison,
         {
@@ -190,6 +194,13 @@ WRONG = [
     ("predicted_cutoff", "mu", -1.0),
     ("predicted_cutoff", "energies", {"a": 1}),
     ("predicted_cutoff", "lam", [0.5]),
+    ("orbit_stretch", "e0", [0.3, -0.1]),
+    ("orbit_stretch", "e_end", [0.2, math.nan]),
+    ("orbit_stretch", "e_end", [0.2]),
+    ("orbit_stretch", "t_end", [10.0, -1.0]),
+    ("orbit_stretch", "t_end", "x"),
+    ("orbit_stretch", "lam", [0.5]),
+    ("orbit_stretch", "energies", {"a": 1}),
     ("cutoff_comparison", "mu_err", "x"),
     ("cutoff_comparison", "lam_err", [0.01]),
     ("cutoff_comparison", "e_c", math.inf),

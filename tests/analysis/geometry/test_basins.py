@@ -643,3 +643,21 @@ def test_zoom_extent_keeps_the_centre_and_divides_the_sides():
     x0, x1, y0, y1 = zoom_extent((-1.0, 1.0, -0.5, 0.5), (0.2, -0.1), 4)
     assert (x1 - x0, y1 - y0) == pytest.approx((0.5, 0.25))
     assert ((x0 + x1) / 2, (y0 + y1) / 2) == pytest.approx((0.2, -0.1))
+
+
+def test_orbit_stretch_is_the_closed_form_of_a_linear_rate_and_the_mean_history_of_predicted_cutoff():
+    """Λ = t_end·⟨λ⟩ over ln E: for λ(E) = a + bE, ⟨λ⟩ = a + b(e0 − e_end)/ln(e0/e_end) exactly (the rate is linear
+    inside the interpolation's nodes); an orbit with the mean history (ends at E_c after τ2) gives −ln ε_c of
+    predicted_cutoff; an orbit that does not lose energy gathers λ(e0)·t_end."""
+    from hhscatter.analysis.geometry.cutoff import orbit_stretch, predicted_cutoff
+
+    a, b = 0.1, 1.5
+    E = np.linspace(0.1, 0.4, 7)
+    e0, e_end, t_end = np.array([0.35, 0.3, 0.25]), np.array([0.15, 0.29, 0.25]), np.array([40.0, 3.0, 7.0])
+    got = orbit_stretch(e0, e_end, t_end, E, a + b * E)
+    mean = np.where(e0 > e_end, a + b * (e0 - e_end) / np.log(e0 / np.where(e0 > e_end, e_end, 1)), a + b * e0)
+    np.testing.assert_allclose(got, t_end * mean, rtol=1e-6)
+    for mu, g, E0 in ((0.94, 0.01, 0.3), (0.6, 0.05, 0.25)):
+        tau2 = math.log(E0 / 0.15) / (mu * g)
+        lam = orbit_stretch([E0], [0.15], [tau2], E, a + b * E)[0]
+        assert lam == pytest.approx(-math.log(predicted_cutoff(E0, g, mu, E, a + b * E, 0.15)), rel=1e-6)
