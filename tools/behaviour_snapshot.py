@@ -1,4 +1,4 @@
-"""Behaviour snapshot for refactors: scene hashes, table contents and tiny-scale numbers.
+"""Behaviour snapshot for refactors: scene hashes, table contents and study numbers (tiny scale, or another).
 
 A refactor must leave every scene hash, every table byte and every study number unchanged. This tool
 records the three in one JSON file, so that the same command before and after a change shows what
@@ -8,6 +8,7 @@ moved::
     python tools/behaviour_snapshot.py record before.json --numbers  # plus `make studies SCALE=tiny` JSONs
     python tools/behaviour_snapshot.py compare before.json after.json   # exit 1 on any difference
     python tools/behaviour_snapshot.py numbers old.json --checkout DIR   # only the tiny JSONs present in DIR
+    python tools/behaviour_snapshot.py numbers q.json --checkout DIR --scale quick   # the quick JSONs there
 
 The code recorded is this checkout's (``ROOT`` first on the import path of the script and of every command it
 starts), not the one an editable install of a shared virtual environment points at; ``make`` runs with the
@@ -24,8 +25,8 @@ What is recorded:
 - ``tables``: for a fixed set of small ``hhscatter simulate`` runs (plain, sections + snapshots, a grid,
   drag, an IC table), a SHA-256 of every part's data (Arrow IPC of the table without its metadata) and
   of its metadata without the version and commit keys, and the run's ``scene.json`` without them.
-- ``numbers`` (``--numbers``): every numeric leaf of the tiny-scale study JSONs made by
-  ``make studies SCALE=tiny``, without ``provenance`` and ``cost``; floats compared exactly.
+- ``numbers`` (``--numbers``): every numeric leaf of the study JSONs made by ``make studies SCALE=tiny``
+  (``--scale`` another scale), without ``provenance`` and ``cost``; floats compared exactly.
 
 The script uses the public CLI for the tables and ``hhscatter.studies`` (``study_names``, ``load_study``,
 ``stage_module``, ``Study.run``) for the scenes: adapt those four names if the refactor moves them.
@@ -194,13 +195,13 @@ def numeric_leaves(obj, prefix=""):
         yield prefix, obj
 
 
-def record_numbers(make: bool, checkout: Path = ROOT) -> dict:
-    """Every leaf of the tiny-scale numbers JSON of each study of ``checkout`` (its ``studies/<name>/out/tiny/``)."""
+def record_numbers(make: bool, checkout: Path = ROOT, scale: str = "tiny") -> dict:
+    """Every leaf of the numbers JSON at ``scale`` of each study of ``checkout`` (its ``studies/<name>/out/<scale>/``)."""
     if make:  # the install stamp taken as up to date: never a reinstall into the (perhaps shared) environment
-        cmd = ["make", "-o", ".venv/.installed-stamp", "studies", "SCALE=tiny"]
+        cmd = ["make", "-o", ".venv/.installed-stamp", "studies", f"SCALE={scale}"]
         subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL, env=_env())
     out = {}
-    for f in sorted((Path(checkout) / "studies").glob("*/out/tiny/*.json")):
+    for f in sorted((Path(checkout) / "studies").glob(f"*/out/{scale}/*.json")):
         if f.name.endswith(".cost.json") or f.parent.parent.parent.name != f.stem:
             continue
         out[f.stem] = dict(numeric_leaves(json.loads(f.read_text())))
@@ -240,6 +241,8 @@ def main(argv=None) -> int:
     n = sub.add_parser("numbers", help="record only the tiny-scale numbers already present (no make, no scenes)")
     n.add_argument("out", type=Path)
     n.add_argument("--checkout", type=Path, default=ROOT, help="the checkout whose outputs to read (default: this)")
+    for p in (r, n):
+        p.add_argument("--scale", default="tiny", choices=SCALES, help="the studies' scale whose JSONs to record")
     c = sub.add_parser("compare")
     c.add_argument("before", type=Path)
     c.add_argument("after", type=Path)
@@ -247,7 +250,7 @@ def main(argv=None) -> int:
     if a.cmd == "record":
         snap = {"scenes": record_scenes(), "tables": record_tables(ROOT / ".venv" / "bin" / "hhscatter")}
         if a.numbers or a.numbers_only_existing:
-            snap["numbers"] = record_numbers(make=a.numbers)
+            snap["numbers"] = record_numbers(make=a.numbers, scale=a.scale)
         a.out.write_text(json.dumps(snap, indent=1, sort_keys=True))
         n = sum(len(v.get("hashes", {})) for v in snap["scenes"].values())
         print(
@@ -258,7 +261,7 @@ def main(argv=None) -> int:
     if a.cmd == "numbers":
         if not (a.checkout / "studies").is_dir():
             ap.error(f"--checkout {a.checkout}: no studies/ folder there")
-        snap = {"numbers": record_numbers(make=False, checkout=a.checkout)}
+        snap = {"numbers": record_numbers(make=False, checkout=a.checkout, scale=a.scale)}
         a.out.write_text(json.dumps(snap, indent=1, sort_keys=True))
         print(
             f"wrote {a.out}: {sum(len(v) for v in snap['numbers'].values())} numbers of {len(snap['numbers'])} studies"

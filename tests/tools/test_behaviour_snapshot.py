@@ -74,6 +74,9 @@ def test_numbers_reads_another_checkouts_tiny_outputs_only(tmp_path):
     snap = tmp_path / "n.json"
     assert bs.main(["numbers", str(snap), "--checkout", str(tmp_path / "old")]) == 0
     assert json.loads(snap.read_text()) == {"numbers": {"fig9": {"kappa.value": 0.5, "kappa.err": 0.25}}}
+    # another scale: its folder alone
+    assert bs.main(["numbers", str(snap), "--checkout", str(tmp_path / "old"), "--scale", "quick"]) == 0
+    assert json.loads(snap.read_text()) == {"numbers": {"fig9": {"b": 1}}}
 
 
 def test_commands_started_import_this_checkouts_code_first():
