@@ -485,8 +485,9 @@ def sheets_record(points, force, *, floor: float, k_max: int, n_boot: int, min_b
             except ConfigError as exc:
                 row[f"{chart}_note"] = str(exc)
                 continue
-            row[chart] = Measured(d.value, d.err).scaled(0.5).to_dict()
-            means.setdefault(chart, []).append(Measured(d.value, d.err).scaled(0.5))
+            half = Measured(d.value, d.err).scaled(0.5)
+            row[chart] = half.to_dict()
+            means.setdefault(chart, []).append(half)
         out[sheet] = row
     rec = {"sheets": out}
     for chart, key in (("xy", "d1_sheets"), ("canonical", "d1_chart")):

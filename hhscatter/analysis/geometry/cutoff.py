@@ -119,6 +119,16 @@ def decision_rate(eps, times) -> DecisionRate:
     )
 
 
+def _rate_nodes(energies, lam, who: str) -> tuple[np.ndarray, np.ndarray]:
+    """The finite (E, λ(E)) nodes in increasing E, the interpolation nodes of λ(E); refused when there are none."""
+    En, lv = np.asarray(energies, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel()
+    ok = np.isfinite(En) & np.isfinite(lv)
+    if not np.any(ok):
+        raise ConfigError(f"{who}: no finite λ(E) given")
+    o = np.argsort(En[ok])
+    return En[ok][o], lv[ok][o]
+
+
 def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: float) -> float:
     """predicted_cutoff(E0, γ, μ, energies, λ(energies), E_c) -> ε_c predicted by the probabilistic description.
 
@@ -147,14 +157,9 @@ def predicted_cutoff(E0: float, gamma: float, mu: float, energies, lam, e_c: flo
         raise ConfigError(f"need E0 > E_c > 0, γ ≥ 0, μ > 0 (got E0={E0}, E_c={e_c}, γ={gamma}, μ={mu})")
     if gamma == 0:
         return 0.0
-    En = np.asarray(energies, dtype=float).ravel()
-    lam = np.asarray(lam, dtype=float).ravel()
-    ok = np.isfinite(En) & np.isfinite(lam)
-    if np.count_nonzero(ok) < 1:
-        raise ConfigError("predicted_cutoff: no finite λ(E) given")
-    o = np.argsort(En[ok])
+    En, lam = _rate_nodes(energies, lam, "predicted_cutoff")
     grid = np.linspace(e_c, E0, 2001)
-    val = np.interp(grid, En[ok][o], lam[ok][o]) / grid
+    val = np.interp(grid, En, lam) / grid
     big_lambda = float(np.sum(0.5 * (val[1:] + val[:-1]) * np.diff(grid))) / (mu * gamma)
     return float(math.exp(-big_lambda))
 
@@ -187,10 +192,7 @@ def orbit_stretch(e0, e_end, t_end, energies, lam) -> np.ndarray:
     t_end = check.floats(t_end, "t_end", size=e0.size, of="orbit")
     n = _checks.values(energies, "energies").size
     lam = _checks.values(lam, "lam", size=n)
-    En, lv = np.asarray(energies, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel()
-    ok = np.isfinite(En) & np.isfinite(lv)
-    if not np.any(ok):
-        raise ConfigError("orbit_stretch: no finite λ(E) given")
+    En, lv = _rate_nodes(energies, lam, "orbit_stretch")
     for name, v, low in (("e0", e0, 0.0), ("e_end", e_end, 0.0), ("t_end", t_end, None)):
         bad = ~np.isfinite(v) | ((v <= low) if low is not None else (v < 0))
         if np.any(bad):
@@ -198,12 +200,11 @@ def orbit_stretch(e0, e_end, t_end, energies, lam) -> np.ndarray:
             raise ConfigError(
                 f"{name} must be {need} for every orbit, got {v[bad][0]!r} at orbit {np.flatnonzero(bad)[0]}"
             )
-    o = np.argsort(En[ok])
     u = np.linspace(0.0, 1.0, 513)
     out = np.empty(e0.size)
     for s in range(0, e0.size, 4096):  # (orbits × 513) at a time
         a, b = e0[s : s + 4096, None], e_end[s : s + 4096, None]
-        vals = np.interp(a * (b / a) ** u, En[ok][o], lv[ok][o])
+        vals = np.interp(a * (b / a) ** u, En, lv)
         out[s : s + 4096] = t_end[s : s + 4096] * np.trapezoid(vals, u, axis=1)
     return out
 
