@@ -757,7 +757,7 @@ STUDY_TABLES = {
         ("log10_ratio", "log₁₀ (measured / predicted)"),
         ("statement", "how far apart"),
     ),
-    "saddle.rate_table": (
+    "basins.rate_table": (
         ("E0", "E0"),
         ("decision", "decision rate λ"),
         ("tangent", "λ̄ (tangent dynamics, saddle)"),
@@ -766,7 +766,18 @@ STUDY_TABLES = {
         ("decision_vs_tangent", "λ against λ̄"),
         ("kappa_over_alpha_vs_tangent", "κ/α against λ̄"),
     ),
-    "saddle.cutoff_saddle": (
+    "basins.stretch_table": (
+        ("E0", "E0"),
+        ("gamma", "γ"),
+        ("ln_inv_eps_c", "ln(1/ε_c) measured"),
+        ("S_cutoff", "S: share of orbits with Λ > ln(1/ε_c)"),
+        ("S_cutoff_range", "S over ε_c's interval"),
+        ("stretch_mean_history", "Λ of the mean history"),
+        ("S_mean_history", "S there"),
+        ("stretch_own_history", "Λ of the own-μ history"),
+        ("S_own_history", "S there"),
+    ),
+    "basins.cutoff_saddle": (
         ("E0", "E0"),
         ("gamma", "γ"),
         ("eps_c", "measured ε_c"),

@@ -19,7 +19,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry.basins import basin_entropy, basin_entropy_table, basin_fractions, wada_merging
 from hhscatter.analysis.geometry.channels import channel_fractions
-from hhscatter.analysis.geometry.cutoff import cutoff_comparison, decision_rate
+from hhscatter.analysis.geometry.cutoff import cutoff_comparison, decision_rate, stretch_tail
 from hhscatter.analysis.geometry.uncertainty import (
     local_exponent,
     slim_fractal,
@@ -43,6 +43,9 @@ __all__ = [
     "rate_table",
     "saddle_cutoff_records",
     "saddle_cutoff_summary",
+    "stretch_record",
+    "stretch_summary",
+    "stretch_table",
     "tangent_lambda",
     "energy_trend",
     "entropy_exponents",
@@ -927,4 +930,112 @@ def saddle_cutoff_summary(records, rates, mu) -> dict:
             )
         words.append("not every cut-off comes within a factor 1.5; measured: " + "; ".join(why) if why else "")
     out["statement"] = "; ".join(w for w in words if w)
+    return out
+
+
+def _share(t, i) -> dict:
+    """{share, lo, hi, k} of entry ``i`` of a :class:`~hhscatter.analysis.geometry.cutoff.StretchTail`."""
+    return {"share": float(t.share[i]), "lo": float(t.lo[i]), "hi": float(t.hi[i]), "k": int(t.k[i])}
+
+
+def stretch_record(point: dict, unc: pd.DataFrame, stretch, cut: dict | None, *, min_count: int) -> dict:
+    """Where f(ε) and the measured cut-off lie in the distribution of each orbit's own stretch Λ, for one (E0, γ).
+
+    ``point``: the point's record (energy, gamma, cutoff); ``unc``: its f(ε) rows (eps, f, k, n); ``stretch``:
+    Λ of every reference orbit of its uncertainty runs
+    (:func:`~hhscatter.analysis.geometry.cutoff.orbit_stretch`); ``cut``: its record of
+    :func:`saddle_cutoff_records` (None at γ = 0). Returns energy, gamma, n_orbits, ``rows`` (per ε: S(ln 1/ε)
+    with its Wilson bounds and f/S, None where S has no orbit) and the ε with at least ``min_count`` changed pairs;
+    ``at_cutoff`` (S at ln(1/ε_c), and at both ends of ε_c's interval), ``at_mean_history`` and ``at_own_history``
+    (S at the Λ of the two predictions of ``cut``, with that Λ), each None when not defined.
+
+    Examples
+    --------
+    >>> unc = pd.DataFrame({"eps": [0.1, 0.01], "f": [0.3, 0.2], "k": [300, 200], "n": [1000, 1000]})
+    >>> r = stretch_record({"energy": 0.3, "gamma": 0.0, "cutoff": None}, unc, [1.0, 3.0, 5.0, 6.0], None, min_count=10)
+    >>> [(row["S"], round(row["f_over_S"], 6)) for row in r["rows"]]    # Λ > ln 10 = 2.3: 3 of 4; > ln 100: 2 of 4
+    [(0.75, 0.4), (0.5, 0.4)]
+    """
+    unc = unc.sort_values("eps", ascending=False)
+    eps = unc["eps"].to_numpy(dtype=float)
+    t = stretch_tail(stretch, eps)
+    rows = []
+    for i, (e, f, k) in enumerate(zip(eps, unc["f"].to_numpy(dtype=float), unc["k"].to_numpy())):
+        S = float(t.share[i])
+        rows.append({"eps": float(e), "f": float(f), "S": S, "S_lo": float(t.lo[i]), "S_hi": float(t.hi[i]),
+                     "f_over_S": float(f / S) if t.k[i] > 0 else None, "resolved": bool(k >= min_count)})  # fmt: skip
+    out = {"energy": point["energy"], "gamma": point["gamma"], "n_orbits": t.n, "rows": rows,
+           "at_cutoff": None, "at_mean_history": None, "at_own_history": None}  # fmt: skip
+    c = point.get("cutoff")
+    if c and c.get("detected"):
+        at = stretch_tail(stretch, [c["eps_c"], c["eps_c_hi"], c["eps_c_lo"]])
+        out["at_cutoff"] = {"ln_inv_eps_c": math.log(1.0 / c["eps_c"]), **_share(at, 0),
+                            "share_range": [float(at.share[1]), float(at.share[2])]}  # fmt: skip
+    for key, name in (("at_mean_history", "eps_c_tangent"), ("at_own_history", "eps_c_tangent_own")):
+        e = (cut or {}).get(name)
+        if e is not None and e > 0:
+            out[key] = {"stretch": math.log(1.0 / e), **_share(stretch_tail(stretch, [e]), 0)}
+    return out
+
+
+def stretch_summary(records) -> dict:
+    """The statement of :func:`stretch_record` over the points: f/S over the resolved ε without drag, and the
+    share of orbits beyond the measured cut-off's ln(1/ε_c) against those beyond the two predictions' Λ.
+
+    Examples
+    --------
+    >>> rec = {"gamma": 0.0, "rows": [{"eps": 0.1, "f_over_S": 0.7, "resolved": True},
+    ...                              {"eps": 1e-4, "f_over_S": 0.74, "resolved": True}], "at_cutoff": None}
+    >>> stretch_summary([rec])["conservative"]["f_over_S"]
+    [0.7, 0.74]
+    """
+    out = {}
+    words = []
+    cons = [r["f_over_S"] for p in records if p["gamma"] == 0 for r in p["rows"]
+            if r["resolved"] and r["f_over_S"] is not None]  # fmt: skip
+    if cons:
+        e = [r["eps"] for p in records if p["gamma"] == 0 for r in p["rows"] if r["resolved"] and r["f_over_S"]]
+        out["conservative"] = {"f_over_S": [float(min(cons)), float(max(cons))], "eps": [min(e), max(e)]}
+        words.append(
+            f"without drag f(ε) = c·S(ln 1/ε) with c = {min(cons):.2g}–{max(cons):.2g} over ε = {max(e):.0e} to "
+            f"{min(e):.0e} (S: the share of orbits whose own stretch Λ exceeds ln(1/ε))"
+        )
+    det = [p for p in records if p.get("at_cutoff")]
+    if det:
+        sh = np.array([p["at_cutoff"]["share"] for p in det])
+        out["at_cutoff"] = [float(sh.min()), float(sh.max())]
+        w = f"the measured cut-off lies where S = {sh.min():.2g} to {sh.max():.2g} at the {len(det)} resolved cut-offs"
+        for key, label in (("at_mean_history", "the mean energy history's Λ"),
+                           ("at_own_history", "the deciding orbits' own-μ history's Λ")):  # fmt: skip
+            v = np.array([p[key]["share"] for p in det if p.get(key)])
+            if v.size:
+                out[key] = [float(v.min()), float(v.max())]
+                w += f"; {label} at S = {v.min():.2g} to {v.max():.2g}"
+        words.append(w)
+    out["statement"] = "; ".join(words) if words else "no point with a stretch distribution"
+    return out
+
+
+def stretch_table(records) -> list:
+    """One flat row per resolved cut-off of :func:`stretch_record`'s records (the page's table): E0, γ, ln(1/ε_c),
+    S there and over ε_c's interval, and Λ and S of the two predictions' histories (None where not defined).
+
+    Examples
+    --------
+    >>> rec = {"energy": 0.3, "gamma": 0.02, "at_cutoff": {"ln_inv_eps_c": 10.8, "share": 0.02,
+    ...        "share_range": [0.019, 0.021]}, "at_mean_history": {"stretch": 10.1, "share": 0.1},
+    ...        "at_own_history": None}
+    >>> stretch_table([rec])[0]["S_mean_history"]
+    0.1
+    """
+    out = []
+    for p in records:
+        c = p.get("at_cutoff")
+        if not c:
+            continue
+        mh, oh = p.get("at_mean_history") or {}, p.get("at_own_history") or {}
+        out.append({"E0": p["energy"], "gamma": p["gamma"], "ln_inv_eps_c": c["ln_inv_eps_c"], "S_cutoff": c["share"],
+                    "S_cutoff_range": c["share_range"], "stretch_mean_history": mh.get("stretch"),
+                    "S_mean_history": mh.get("share"), "stretch_own_history": oh.get("stretch"),
+                    "S_own_history": oh.get("share")})  # fmt: skip
     return out

@@ -24,10 +24,9 @@ PRE 64, 066208 (2001); Daza et al., Sci. Rep. 6, 31416 (2016)):
    upper bound; and the lifetimes of the orbits that decide the outcome at
    the smallest ε, against τ2 = ln(E0/E_c)/γ (Eq. (eq:tau2) with μ = 1, the
    late-time exponent of study fig3).
-4. **The deciding orbits' own decay.** Per (E0, γ > 0), ``mu_own``: μ of the reference orbits of the pairs
-   whose outcome differs at the smallest resolved ε, from their own start and end energies
-   (:func:`~hhscatter.analysis.dissipative.decay.orbit_decay_exponent`); study saddle re-predicts the cut-off
-   with it and with the saddle's λ̄ of the tangent dynamics.
+4. **The cut-off re-predicted** with study saddle's λ̄(E) of the tangent dynamics, with the ensemble's μ and
+   with ``mu_own``, μ of the orbits that decide at the smallest resolved ε (their own start and end energies);
+   and ``stretch``: where f(ε) and ε_c lie in the distribution of every orbit's own stretch Λ (``orbit_stretch``).
 
 Outcome codes: 0, 1, 2 exit channel (the 120° sector of the escape point);
 3 settled; 4 censored (still inside at t_max; code name ``trapped``); −1 forbidden cell (V ≥ E0).
@@ -209,10 +208,11 @@ def simulate(study, workers=None, progress=True):
 
 
 # -- analyze ---------------------------------------------------------------------------
-def _uncertainty(study, E, g, eps, keys=None, times=None, deciders=None):
+def _uncertainty(study, E, g, eps, keys=None, times=None, deciders=None, refs=None):
     """f(ε) rows and the lifetimes of the pairs whose outcome changed, per ε (``keys``: the run per ε, default
     the main runs; ``times``: a list that receives each ε's decision times, for the decision rate λ;
-    ``deciders``: a list that receives each ε's (e0, e_end, t_end) of the reference orbits of those pairs)."""
+    ``deciders``: a list that receives each ε's (e0, e_end, t_end) of the reference orbits of those pairs;
+    ``refs``: a list that receives each ε's (e0, e_end, t_end) of every reference orbit)."""
     from hhscatter.data.read import read_lifetimes
 
     rows = []
@@ -224,10 +224,12 @@ def _uncertainty(study, E, g, eps, keys=None, times=None, deciders=None):
         row, t_dec = bs.uncertainty_row(codes, lt_sorted["t_end"].to_numpy(), E, g, e)
         if times is not None:
             times.append(t_dec)
+        m = len(codes) // 2
         if deciders is not None:
-            m = len(codes) // 2
             ref = lt_sorted.iloc[:m][codes[:m] != codes[m:]]
             deciders.append(tuple(ref[c].to_numpy(dtype=float) for c in ("e0", "e_end", "t_end")))
+        if refs is not None:
+            refs.append(tuple(lt_sorted.iloc[:m][c].to_numpy(dtype=float) for c in ("e0", "e_end", "t_end")))
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -258,9 +260,12 @@ def analyze(study):
     maps, ent_rows, unc_tabs, per, loc_tabs, by_box = [], [], [], [], [], []
     E_b, E_b_err = _upstream_value(study, "kappa", "E_b_key")
     mu, mu_err = _upstream_value(study, "mu", "mu_key")
+    tangent, lam_source = _tangent(study)
+    stretches = []
     for E in study.params.energies:
         for g in study.params.gammas:
-            img, ent, unc, loc, m = _measure_point(study, E, g, eps, extent, n, boxes)
+            img, ent, unc, loc, m = _measure_point(study, E, g, eps, extent, n, boxes, tangent)
+            stretches.append(m.pop("stretch"))
             maps.append(pd.DataFrame({"energy": E, "gamma": g, "label": img.ravel()}))
             ent_rows.append(ent)
             unc_tabs.append(unc)
@@ -277,6 +282,12 @@ def analyze(study):
     study.write_table(scan, "basins_energy_scan.parquet")
     study.write_table(scan_unc, "basins_energy_scan_uncertainty.parquet")
     cut_pred = bs.cutoff_records(per, scan, mu, mu_err, ec)
+    saddle = _saddle_cutoff(study, per, scan, tangent, mu, mu_err, lam_source)
+    by_point = {(r["E0"], r["gamma"]): r for r in saddle["cutoff_saddle"]}
+    stretch = [
+        bs.stretch_record(p, u, L, by_point.get((p["energy"], p["gamma"])), min_count=study.params.fit_min_count)
+        for p, u, L in zip(per, unc_tabs, stretches)
+    ]
     trend = bs.energy_trend(scan, E_b)
     zooms, centre = _zoom_maps(study, extent, n)
     study.write_table(zooms, "basins_zooms.parquet", grid=study.params.zoom_grid)
@@ -303,20 +314,27 @@ def analyze(study):
             "entropy_exponent_by_grid": bs.entropy_exponents(by_box),
             "energy_scan": scan.to_dict(orient="records"),
             "energy_trend": trend,
+            **saddle,
+            "stretch": stretch,
+            "stretch_table": bs.stretch_table(stretch),
+            "stretch_summary": bs.stretch_summary(stretch),
             "convention": "square [−1, 1]² on the section ṙ = 0, φ̇ > 0 (forbidden cells blank); r_esc = 1.5",
         }
     )
 
 
-def _measure_point(study, E, g, eps, extent, n, boxes):
+def _measure_point(study, E, g, eps, extent, n, boxes, tangent):
     """One (E0, γ) map and its measures (:func:`~hhscatter.reproduction.basin_summary.map_measures`).
 
-    Returns (labels image, entropy table, f(ε) table, local-exponent table, dict of the other measures).
+    Returns (labels image, entropy table, f(ε) table, local-exponent table, dict of the other measures, with
+    ``stretch``: Λ of every reference orbit along its own energy history, with λ̄(E) of ``tangent``).
     """
+    from hhscatter.analysis.geometry.cutoff import orbit_stretch
+
     img = basin_image(study, map_key(E, g), E, extent, n)
     gx, gy = _map_states(study, E, extent, n)[:2]
-    times, deciders = [], []
-    unc = _uncertainty(study, E, g, eps, times=times, deciders=deciders)
+    times, deciders, refs = [], [], []
+    unc = _uncertainty(study, E, g, eps, times=times, deciders=deciders, refs=refs)
     p = study.params
     ent, loc, m = bs.map_measures(
         img,
@@ -333,6 +351,9 @@ def _measure_point(study, E, g, eps, extent, n, boxes):
         fit_min_count=p.fit_min_count,
     )
     m["mu_own"] = _own_decay(g, m["ok"], deciders)
+    e0, e_end, t_end = (np.concatenate([r[i] for r in refs]) for i in range(3))  # e_end kept > 0 for ln E
+    E_lam = (tangent[c].to_numpy() for c in ("energy", "lam"))
+    m["stretch"] = orbit_stretch(e0, np.maximum(e_end, study.model.critical_energy * 1e-9), t_end, *E_lam)
     return img, ent, unc, loc, m
 
 
@@ -359,6 +380,40 @@ def _zoom_maps(study, extent, n):
                 )
             )
     return pd.concat(zooms, ignore_index=True), centre
+
+
+def _tangent(study):
+    """(λ̄(E) DataFrame of the saddle study's points at this study's system, its source): the system is found by
+    its full spec among the saddle's [study].systems, never by its name alone."""
+    from hhscatter.model.spec import resolve
+    from hhscatter.studies import _upstream as up
+
+    other = study.upstream("lyapunov")
+    doc = up.numbers(study, other)
+    mine = resolve(study.model)[1]
+    labels = [e["label"] for e in doc["config"]["study"]["systems"]
+              if resolve({"name": e["name"], "params": dict(e.get("params") or {})})[1] == mine]  # fmt: skip
+    if len(labels) != 1:
+        raise ValueError(f"basins: {other}.json has {len(labels)} systems with this study's spec {mine} (need 1)")
+    tangent = bs.tangent_lambda(doc["saddle"], labels[0])
+    if tangent.empty:
+        raise ValueError(f"basins: {other}.json has no λ̄ of the tangent dynamics for system {labels[0]!r}")
+    return tangent, f"{other}.json saddle (system {labels[0]})"
+
+
+def _saddle_cutoff(study, per, scan, tangent, mu, mu_err, source) -> dict:
+    """The cut-off re-predicted with λ̄ of the tangent dynamics (the JSON keys lambda_tangent, rate_table,
+    cutoff_saddle and cutoff_saddle_summary)."""
+    from hhscatter.reproduction.verdicts import NO_VERDICT, SMOKE_SCALES
+
+    rates = bs.rate_table(scan, tangent)
+    cut = bs.saddle_cutoff_records(per, tangent, mu, mu_err, study.model.critical_energy)
+    summary = bs.saddle_cutoff_summary(cut, rates, mu)
+    if study.scale in SMOKE_SCALES:  # a smoke test states no verdict (these verdicts are not under "verdict")
+        rates = [{k: NO_VERDICT if k.endswith("_vs_tangent") else v for k, v in r.items()} for r in rates]
+        cut = [{k: NO_VERDICT if k.startswith("verdict_") else v for k, v in r.items()} for r in cut]
+    lam = {"rows": tangent.to_dict(orient="records"), "source": source}
+    return {"lambda_tangent": lam, "rate_table": rates, "cutoff_saddle": cut, "cutoff_saddle_summary": summary}
 
 
 def _upstream_value(study, role, key_param):

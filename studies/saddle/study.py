@@ -11,9 +11,9 @@ Rules: the header of ``study.toml``. Stages (``hhscatter study saddle simulate|a
 
 ``analyze(study)``
     ``saddle.json``: per point κ, λ̄, d₁ on the section and on lines, d₀ = 1 − α of the lines run, the relation's
-    verdicts and the exit basins' cut-off re-predicted from study basins' numbers (the estimators of
-    :mod:`hhscatter.analysis.geometry.saddle`, assembled by :mod:`hhscatter.reproduction.saddle_records` and
-    :mod:`hhscatter.reproduction.basin_summary`); derived table ``saddle_ftle.parquet`` (the finite-time exponents
+    verdicts (the estimators of :mod:`hhscatter.analysis.geometry.saddle`, assembled by
+    :mod:`hhscatter.reproduction.saddle_records`; study basins re-predicts its cut-off with λ̄); derived table
+    ``saddle_ftle.parquet`` (the finite-time exponents
     Λ/T of the tangent runs).
 
 ``plot(study)``
@@ -68,7 +68,6 @@ class Params(StudyParams):
     d0_eps: Numbers  # ε of the uncertainty algorithm, decreasing (position units)
     d0_n: Integer  # reference initial conditions per ε
     d0_min_count: Integer  # an ε enters α's fit with ≥ this many uncertain pairs
-    basins_system: Text  # the label of the system of study basins (its points' λ̄ re-predict the cut-off)
     ftle_low: Numbers = (0.25, 0.5, 0.75)  # Λ/T < this·λ̄ is near 0 (the middle one for the hyperbolic part)
     lines_count: Integer  # d₁ on lines: lines y = const through the IC disk
     lines_n: Integer  # initial conditions per line
@@ -321,39 +320,6 @@ def _d0(study, key):
     return sr.d0_record(layout, lt, min_count=study.params.d0_min_count)
 
 
-def _basins_cutoff(study, records) -> dict:
-    """The basins' cut-off re-predicted with λ̄ of the ``basins_system`` points: the JSON keys rate_table,
-    cutoff_saddle, cutoff_saddle_summary and lambda_tangent (with the sources)."""
-    import pandas as pd
-
-    from hhscatter.reproduction import basin_summary as bs
-    from hhscatter.reproduction.verdicts import NO_VERDICT, SMOKE_SCALES
-    from hhscatter.studies import _upstream as up
-
-    other = study.upstream("cutoff")
-    doc = up.numbers(study, other)
-    label = study.params.basins_system
-    ec = next(m for lab, _spec, m, _r, _t in _systems(study) if lab == label).critical_energy
-    tangent = bs.tangent_lambda(records, label)
-    rates = bs.rate_table(pd.DataFrame(doc["energy_scan"]), tangent)
-    mu = doc["mu"]
-    cut = bs.saddle_cutoff_records(doc["per_point"], tangent, mu["value"], mu["err"], ec)
-    summary = bs.saddle_cutoff_summary(cut, rates, mu["value"])
-    if study.scale in SMOKE_SCALES:  # a smoke test states no verdict (these verdicts are not under "verdict")
-        rates = [{k: NO_VERDICT if k.endswith("_vs_tangent") else v for k, v in r.items()} for r in rates]
-        cut = [{k: NO_VERDICT if k.startswith("verdict_") else v for k, v in r.items()} for r in cut]
-    return {
-        "lambda_tangent": {
-            "rows": tangent.to_dict(orient="records"),
-            "system": label,
-            "source": f"{other}.json energy_scan, per_point, mu",
-        },  # fmt: skip
-        "rate_table": rates,
-        "cutoff_saddle": cut,
-        "cutoff_saddle_summary": summary,
-    }
-
-
 def _point(study, key, ch):
     """One point's record and its FTLE rows."""
     from hhscatter.analysis.geometry.saddle import kantz_grassberger, saddle_points, window_dependence
@@ -434,11 +400,6 @@ def analyze(study):
     _d0_eps(study)  # refused before any work
     if not 0 < study.params.d1_floor < 1 / study.params.min_boxes:
         raise ConfigError(f"saddle [study].d1_floor must lie in (0, 1/min_boxes), got {study.params.d1_floor!r}")
-    if study.params.basins_system not in [x[0] for x in _systems(study)]:
-        raise ConfigError(
-            f"saddle [study].basins_system must be one of the labels of [study].systems, "
-            f"got {study.params.basins_system!r}"
-        )
     choices = json.loads(_choices_path(study).read_text())
     records, ftles = [], []
     for label, _spec, _m, ratios, _t_max in _systems(study):
@@ -454,7 +415,6 @@ def analyze(study):
         FTLE_TABLE,
         description="finite-time Lyapunov exponents Λ/t_end of the tangent runs (orbits left at t_end ≥ t_min)",
     )
-    basins = _basins_cutoff(study, records)
     study.write_numbers(
         {
             "saddle": records,
@@ -467,7 +427,6 @@ def analyze(study):
             "lines_summary": sr.lines_summary(records),
             "gap": [sr.gap_row(x) for x in records],
             "gap_summary": sr.gap_summary(records),
-            **basins,
             "rules": {
                 "tmin_efolds": study.params.tmin_efolds,
                 **_tmin_overrides(study),

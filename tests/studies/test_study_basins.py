@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pandas as pd
@@ -123,3 +124,62 @@ def test_the_deciding_orbits_own_decay_is_counted_from_the_raw_runs(tiny_studies
         assert p["mu_own"]["value"] == pytest.approx(mu, rel=1e-12) and p["mu_own"]["n_orbits"] == len(ref)
         checked += 1
     assert checked >= 1
+
+
+def test_the_cut_off_is_re_predicted_with_the_saddle_s_lambda(tiny_studies):
+    """λ̄(E) of the Hénon–Heiles records beside the basins' decision rate and κ/α at the energies both have; the
+    predicted ε_c with λ̄ and the basins' μ equals λ̄'s closed form where λ̄ is one constant (one energy)."""
+    saddle = json.loads((tiny_studies / "saddle" / "out" / "tiny" / "saddle.json").read_text())
+    doc = basins = json.loads((tiny_studies / "basins" / "out" / "tiny" / "basins.json").read_text())
+    hh = sorted(
+        (r["energy"], r["lyapunov"], r["lyapunov_err"]) for r in saddle["saddle"] if r["system"] == "henon_heiles"
+    )
+    hh = [x for x in hh if x[1] is not None]
+    assert [(r["energy"], r["lam"], r["lam_err"]) for r in doc["lambda_tangent"]["rows"]] == hh
+    scan = {round(r["energy"], 9): r for r in basins["energy_scan"]}
+    rows = doc["rate_table"]
+    assert [r["E0"] for r in rows] == [E for E, _, _ in hh if round(E, 9) in scan]
+    for r in rows:
+        s = scan[round(r["E0"], 9)]
+        assert (r["decision"], r["kappa_over_alpha"]) == (s["lam"], s["lam_kg"])
+        assert r["decision_over_tangent"] == pytest.approx(s["lam"] / r["tangent"], rel=1e-12)
+    cut = doc["cutoff_saddle"]
+    assert {(r["E0"], r["gamma"]) for r in cut} == {
+        (p["energy"], p["gamma"]) for p in basins["per_point"] if p["gamma"] > 0
+    }
+    ec, mu = 1 / 6, basins["mu"]["value"]
+    for r in cut:
+        grid = np.linspace(ec, r["E0"], 2001)
+        lam = np.interp(grid, [x[0] for x in hh], [x[1] for x in hh])
+        v = lam / grid
+        big = np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(grid)) / (mu * r["gamma"])  # ln(1/ε_c) = ∫λ/E dE / (μγ)
+        assert r["eps_c_tangent"] == pytest.approx(math.exp(-big), rel=1e-6)
+
+
+def test_each_orbit_s_stretch_is_counted_from_the_raw_runs(tiny_studies):
+    """S(ln 1/ε) of a point: the reference orbits of its uncertainty runs whose Λ = ∫λ̄(E(t))dt, integrated here in
+    time along E(t) = e0 (e_end/e0)^{t/t_end} with λ̄ of the saddle's Hénon–Heiles records, exceeds ln(1/ε)."""
+    from hhscatter.data.read import read_lifetimes
+
+    out = tiny_studies / "basins" / "out" / "tiny"
+    doc = json.loads((out / "basins.json").read_text())
+    rows = doc["lambda_tangent"]["rows"]
+    En, lam = np.array([r["energy"] for r in rows]), np.array([r["lam"] for r in rows])
+    rec = next(r for r in doc["stretch"] if r["gamma"] > 0)
+    E, g = rec["energy"], rec["gamma"]
+    L = []
+    for i, _eps in enumerate(doc["eps"]):
+        lt = read_lifetimes(out / "raw" / f"unc{i}_E{E:.2f}_g{g:g}", columns=["traj_id", "t_end", "e0", "e_end"])
+        ref = lt.sort_values("traj_id").iloc[: len(lt) // 2]
+        e0, e1, T = (ref[c].to_numpy(dtype=float) for c in ("e0", "e_end", "t_end"))
+        u = np.linspace(0.0, 1.0, 4001)[None, :]
+        Et = e0[:, None] * (np.maximum(e1, 1e-12)[:, None] / e0[:, None]) ** u
+        v = np.interp(Et, En, lam)
+        L.append(T * np.sum(0.5 * (v[:, 1:] + v[:, :-1]), axis=1) / (u.size - 1))
+    L = np.concatenate(L)
+    assert rec["n_orbits"] == L.size
+    for r in rec["rows"]:
+        k = np.count_nonzero(L > math.log(1 / r["eps"]))
+        assert r["S"] == pytest.approx(k / L.size, abs=2 / L.size)  # an orbit at the threshold may round either way
+        assert (r["f_over_S"] is None) == (k == 0)
+    assert doc["stretch_summary"]["statement"]

@@ -18,7 +18,7 @@ KEYS = {"system", "energy", "kappa", "kappa_err", "lyapunov", "lyapunov_err", "d
 
 @pytest.fixture(scope="module")
 def built(tiny_studies):
-    """The saddle study at the tiny scale, built with the studies it needs (basins, and fig2 and fig3 before it)."""
+    """The saddle study at the tiny scale (built with every study, in the order of the graph)."""
     return tiny_studies / "saddle" / "out" / "tiny"
 
 
@@ -127,34 +127,6 @@ def test_the_tangent_runs_start_from_the_long_lived_orbits_initial_conditions(bu
     # every selected orbit ends at the main run's t_end, bit for bit (a rounding apart would be another orbit)
     assert m["t_end"].to_numpy().tobytes() == m["t_end_tan"].to_numpy().tobytes()
     assert rec["tangent_same_orbits"] == {"same_t_end": len(long), "selected": len(long)}
-
-
-def test_the_basins_cut_off_is_re_predicted_with_the_saddle_s_lambda(built):
-    """λ̄(E) of the Hénon–Heiles records beside the basins' decision rate and κ/α at the energies both have; the
-    predicted ε_c with λ̄ and the basins' μ equals λ̄'s closed form where λ̄ is one constant (one energy)."""
-    doc = json.loads((built / "saddle.json").read_text())
-    basins = json.loads((built.parents[2] / "basins" / "out" / "tiny" / "basins.json").read_text())
-    hh = sorted((r["energy"], r["lyapunov"], r["lyapunov_err"]) for r in doc["saddle"] if r["system"] == "henon_heiles")
-    hh = [x for x in hh if x[1] is not None]
-    assert [(r["energy"], r["lam"], r["lam_err"]) for r in doc["lambda_tangent"]["rows"]] == hh
-    scan = {round(r["energy"], 9): r for r in basins["energy_scan"]}
-    rows = doc["rate_table"]
-    assert [r["E0"] for r in rows] == [E for E, _, _ in hh if round(E, 9) in scan]
-    for r in rows:
-        s = scan[round(r["E0"], 9)]
-        assert (r["decision"], r["kappa_over_alpha"]) == (s["lam"], s["lam_kg"])
-        assert r["decision_over_tangent"] == pytest.approx(s["lam"] / r["tangent"], rel=1e-12)
-    cut = doc["cutoff_saddle"]
-    assert {(r["E0"], r["gamma"]) for r in cut} == {
-        (p["energy"], p["gamma"]) for p in basins["per_point"] if p["gamma"] > 0
-    }
-    ec, mu = 1 / 6, basins["mu"]["value"]
-    for r in cut:
-        grid = np.linspace(ec, r["E0"], 2001)
-        lam = np.interp(grid, [x[0] for x in hh], [x[1] for x in hh])
-        v = lam / grid
-        big = np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(grid)) / (mu * r["gamma"])  # ln(1/ε_c) = ∫λ/E dE / (μγ)
-        assert r["eps_c_tangent"] == pytest.approx(math.exp(-big), rel=1e-6)
 
 
 def test_the_d1_estimator_covers_the_baker_natural_measure_at_a_quick_scale_sample():

@@ -12,6 +12,8 @@ at ε_c = e^{−Λ}, Λ = ∫_0^τ2 λ(E(t)) dt.
 * :func:`predicted_cutoff` — ε_c from λ(E), μ, γ, E0 and E_c;
 * :func:`orbit_stretch` — Λ of single orbits along their own energy histories (start and end energy, lifetime),
   in place of the ensemble's mean decay;
+* :func:`stretch_tail` — the share of orbits whose own stretch exceeds ln(1/ε), per ε: without drag the
+  uncertainty fraction f(ε) is a constant times it, and under drag it shows where the stretch runs out;
 * :func:`cutoff_comparison` — measured against predicted ε_c, with the
   systematic of λ(E) (two estimators) in the predicted interval, and a plain
   statement of how far they differ.
@@ -31,6 +33,7 @@ import pandas as pd
 from hhscatter.analysis.geometry import _checks
 from hhscatter.analysis.geometry.uncertainty import weighted_line
 from hhscatter.analysis.stats import _arguments as check
+from hhscatter.analysis.stats.intervals import wilson_interval
 from hhscatter.analysis.stats.measured import WithErrors
 from hhscatter.errors import ConfigError
 
@@ -41,6 +44,8 @@ __all__ = [
     "decision_rate",
     "orbit_stretch",
     "predicted_cutoff",
+    "StretchTail",
+    "stretch_tail",
 ]
 
 
@@ -207,6 +212,54 @@ def orbit_stretch(e0, e_end, t_end, energies, lam) -> np.ndarray:
         vals = np.interp(a * (b / a) ** u, En, lv)
         out[s : s + 4096] = t_end[s : s + 4096] * np.trapezoid(vals, u, axis=1)
     return out
+
+
+@dataclass(frozen=True)
+class StretchTail:
+    """Result of :func:`stretch_tail`, one entry per ε (arrays): ``share`` S(ln 1/ε) of the orbits with Λ > ln(1/ε),
+    its Wilson 1σ bounds ``lo``, ``hi``, the count ``k`` and the number of orbits ``n``."""
+
+    method = "share of orbits whose stretch exceeds ln(1/ε), Wilson 1σ interval"
+
+    eps: np.ndarray
+    share: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    k: np.ndarray
+    n: int
+
+
+def stretch_tail(stretch, eps) -> StretchTail:
+    """stretch_tail(Λ of each orbit, ε) -> StretchTail(eps, share, lo, hi, k, n): S(ln 1/ε) = share of Λ > ln(1/ε).
+
+    ``stretch``: each orbit's Λ (dimensionless, e.g. :func:`orbit_stretch`); ``eps``: one or more scales ε > 0 in
+    the position units of the initial conditions. A pair of initial conditions ε apart that follows an orbit can
+    reach different outcomes only if the orbit stretches it to O(1), that is if Λ > ln(1/ε): where that is the
+    only way to part, the uncertainty fraction f(ε) is a constant times S(ln 1/ε) (for a hyperbolic saddle without
+    drag, Λ = λ t and S = e^{−κ ln(1/ε)/λ} = ε^{κ/λ}, the uncertainty exponent α = κ/λ). The ratio f/S shows
+    where that holds and where pairs part otherwise. NaN stretches are refused; the share has Wilson 1σ bounds
+    over the orbits.
+
+    Examples
+    --------
+    >>> L = np.log(1 / np.random.default_rng(0).uniform(size=100_000)) / 0.25    # S(x) = e^{−x/4}: S(ln 1/ε) = ε^{1/4}
+    >>> r = stretch_tail(L, [1e-2, 1e-4])
+    >>> r.k.tolist(), r.n, bool(np.all(np.abs(r.share - np.array([1e-2, 1e-4]) ** 0.25) < 3 * (r.hi - r.lo)))
+    ([31474, 10176], 100000, True)
+    """
+    lam = check.floats(stretch, "stretch", of="orbit")
+    if lam.size == 0:
+        raise ConfigError("stretch_tail: stretch needs at least one orbit")
+    if not np.all(np.isfinite(lam)):
+        bad = np.flatnonzero(~np.isfinite(lam))[0]
+        raise ConfigError(f"stretch must be finite for every orbit, got {float(lam[bad])!r} at orbit {bad}")
+    e = check.numbers(eps, "eps", positive=True)
+    srt = np.sort(lam)
+    x = np.log(1.0 / e)
+    k = srt.size - np.searchsorted(srt, x, side="right")  # Λ > x
+    share, lo, hi = wilson_interval(k, np.full(k.shape, srt.size))
+    return StretchTail(e, np.asarray(share, dtype=float), np.asarray(lo, dtype=float), np.asarray(hi, dtype=float),
+                       k.astype(np.int64), int(srt.size))  # fmt: skip
 
 
 @dataclass(frozen=True)

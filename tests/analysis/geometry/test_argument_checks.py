@@ -70,6 +70,7 @@ VALID = {
         cutoff.orbit_stretch,
         {"e0": [0.3, 0.3], "e_end": [0.2, 0.15], "t_end": [10.0, 20.0], "energies": [0.2, 0.3], "lam": [0.4, 0.6]},
     ),
+    "stretch_tail": (cutoff.stretch_tail, {"stretch": [1.0, 5.0, 12.0], "eps": [1e-2, 1e-4]}),
     "cutoff_comparison": (
         cutoff.cutoff_comparison,
         {
