@@ -997,8 +997,8 @@ def stretch_summary(records) -> dict:
         e = [r["eps"] for p in records if p["gamma"] == 0 for r in p["rows"] if r["resolved"] and r["f_over_S"]]
         out["conservative"] = {"f_over_S": [float(min(cons)), float(max(cons))], "eps": [min(e), max(e)]}
         words.append(
-            f"without drag f(ε) = c·S(ln 1/ε) with c = {min(cons):.2g}–{max(cons):.2g} over ε = {max(e):.0e} to "
-            f"{min(e):.0e} (S: the share of orbits whose own stretch Λ exceeds ln(1/ε))"
+            f"without drag f(ε)/S(ln 1/ε) = {min(cons):.2g}–{max(cons):.2g} over ε = {max(e):.0e} to {min(e):.0e} "
+            "(S: the share of orbits whose own stretch Λ exceeds ln(1/ε))"
         )
     det = [p for p in records if p.get("at_cutoff")]
     if det:
