@@ -958,7 +958,12 @@ def stretch_record(point: dict, unc: pd.DataFrame, stretch, cut: dict | None, *,
     """
     unc = unc.sort_values("eps", ascending=False)
     eps = unc["eps"].to_numpy(dtype=float)
-    t = stretch_tail(stretch, eps)
+    c = point.get("cutoff")
+    at_cut = [c["eps_c"], c["eps_c_hi"], c["eps_c_lo"]] if c and c.get("detected") else []
+    hist = {key: (cut or {}).get(name) for key, name in (("at_mean_history", "eps_c_tangent"),
+                                                          ("at_own_history", "eps_c_tangent_own"))}  # fmt: skip
+    hist = {key: e for key, e in hist.items() if e is not None and e > 0}
+    t = stretch_tail(stretch, [*eps, *at_cut, *hist.values()])  # one sort of the stretches for every ε asked
     rows = []
     for i, (e, f, k) in enumerate(zip(eps, unc["f"].to_numpy(dtype=float), unc["k"].to_numpy())):
         S = float(t.share[i])
@@ -966,15 +971,14 @@ def stretch_record(point: dict, unc: pd.DataFrame, stretch, cut: dict | None, *,
                      "f_over_S": float(f / S) if t.k[i] > 0 else None, "resolved": bool(k >= min_count)})  # fmt: skip
     out = {"energy": point["energy"], "gamma": point["gamma"], "n_orbits": t.n, "rows": rows,
            "at_cutoff": None, "at_mean_history": None, "at_own_history": None}  # fmt: skip
-    c = point.get("cutoff")
-    if c and c.get("detected"):
-        at = stretch_tail(stretch, [c["eps_c"], c["eps_c_hi"], c["eps_c_lo"]])
-        out["at_cutoff"] = {"ln_inv_eps_c": math.log(1.0 / c["eps_c"]), **_share(at, 0),
-                            "share_range": [float(at.share[1]), float(at.share[2])]}  # fmt: skip
-    for key, name in (("at_mean_history", "eps_c_tangent"), ("at_own_history", "eps_c_tangent_own")):
-        e = (cut or {}).get(name)
-        if e is not None and e > 0:
-            out[key] = {"stretch": math.log(1.0 / e), **_share(stretch_tail(stretch, [e]), 0)}
+    i = eps.size
+    if at_cut:
+        out["at_cutoff"] = {"ln_inv_eps_c": math.log(1.0 / c["eps_c"]), **_share(t, i),
+                            "share_range": [float(t.share[i + 1]), float(t.share[i + 2])]}  # fmt: skip
+        i += 3
+    for key, e in hist.items():
+        out[key] = {"stretch": math.log(1.0 / e), **_share(t, i)}
+        i += 1
     return out
 
 
