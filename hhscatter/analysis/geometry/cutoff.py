@@ -129,7 +129,7 @@ def _rate_nodes(energies, lam, who: str) -> tuple[np.ndarray, np.ndarray]:
     En, lv = np.asarray(energies, dtype=float).ravel(), np.asarray(lam, dtype=float).ravel()
     ok = np.isfinite(En) & np.isfinite(lv)
     if not np.any(ok):
-        raise ConfigError(f"{who}: no finite λ(E) given")
+        raise ConfigError(f"{who}: no finite λ(E) given (no energy where both energies and lam are finite)")
     o = np.argsort(En[ok])
     return En[ok][o], lv[ok][o]
 
@@ -208,8 +208,8 @@ def orbit_stretch(e0, e_end, t_end, energies, lam) -> np.ndarray:
     u = np.linspace(0.0, 1.0, 513)
     out = np.empty(e0.size)
     for s in range(0, e0.size, 4096):  # (orbits × 513) at a time
-        a, b = e0[s : s + 4096, None], e_end[s : s + 4096, None]
-        vals = np.interp(a * (b / a) ** u, En, lv)
+        a, b = np.log(e0[s : s + 4096, None]), np.log(e_end[s : s + 4096, None])
+        vals = np.interp(np.exp(a + u * (b - a)), En, lv)  # in ln E: no overflow of e_end/e0 for far-apart ends
         out[s : s + 4096] = t_end[s : s + 4096] * np.trapezoid(vals, u, axis=1)
     return out
 
@@ -255,7 +255,9 @@ def stretch_tail(stretch, eps) -> StretchTail:
         raise ConfigError(f"stretch must be finite for every orbit, got {float(lam[bad])!r} at orbit {bad}")
     e = check.numbers(eps, "eps", positive=True)
     srt = np.sort(lam)
-    x = np.log(1.0 / e)
+    with np.errstate(over="ignore"):
+        x = np.log(1.0 / e)
+    x = np.where(np.isinf(x), -np.log(e), x)  # 1/ε overflows below ε ≈ 5.6e-309: ln(1/ε) = −ln ε there
     k = srt.size - np.searchsorted(srt, x, side="right")  # Λ > x
     share, lo, hi = wilson_interval(k, np.full(k.shape, srt.size))
     return StretchTail(e, np.asarray(share, dtype=float), np.asarray(lo, dtype=float), np.asarray(hi, dtype=float),
