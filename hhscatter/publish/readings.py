@@ -1810,6 +1810,37 @@ def _saddle_lambda_offset(get: Loader) -> str:
     return ". ".join(parts) if parts else "no point of this scale has a 1/T fit"
 
 
+def _saddle_no_lyapunov(get: Loader) -> str:
+    """The points without λ̄ (``lyapunov`` None with a 1/T fit, ``lyapunov_detail.by_T``): per point λ̄(T) in the
+    first and last bins of T, whether it falls, stays or rises between them by the verdict rule (2σ, both errors),
+    λ∞ of the fit, and the share of the selected orbits whose finite-time exponent lies below the stated fraction
+    of ΣΛ/ΣT (``hyperbolic``), with d₁ of the section and on lines where measured."""
+    d = get("saddle", None)
+    cells = []
+    for p in d["saddle"]:
+        det = p.get("lyapunov_detail") or {}
+        if p.get("lyapunov") is not None or len(det.get("by_T") or []) < 2:
+            continue
+        a, b = det["by_T"][0], det["by_T"][-1]
+        v = verdict(b["value"], b["err"], a["value"], a["err"])
+        move = "stays at" if v.word == "agrees" else ("falls to" if b["value"] < a["value"] else "rises to")
+        text = (f"{p['ratio']:g} (λ̄(T) = {_ve(a['value'], a['err'])} at T = {a['T']:.0f} {move} "
+                f"{_ve(b['value'], b['err'])} at T = {b['T']:.0f}, z = {signed(v.z)}; λ∞ = "
+                f"{_ve(det['extrapolated'], det['extrapolated_err'])}")  # fmt: skip
+        h = p.get("hyperbolic")
+        if h:
+            mid = next(s for s in h["shares"] if s["threshold"] == h["threshold"])
+            text += f"; Λ/T below {h['threshold']:g}·ΣΛ/ΣT at a share {_ve(mid['share']['value'], mid['share']['err'])} of the orbits"
+        if p.get("d1") is not None:
+            text += f"; d₁ = {_ve(p['d1'], p['d1_err'])} on the section"
+        if p.get("d1_lines"):
+            text += f", {_ve(p['d1_lines']['value'], p['d1_lines']['err'])} on lines"
+        cells.append((p["system"], text + ")"))
+    if not cells:
+        return "every point of this scale with a 1/T fit has λ̄"
+    return f"no λ̄ at {_by_system(cells)}"
+
+
 def _saddle_tangent_orbits(get: Loader) -> str:
     """Whether λ̄'s tangent run followed the selected orbits: with the key ``tangent_same_orbits`` (per point: the
     selected orbits and those the tangent run ended at the main run's t_end) the counts summed over the points;
@@ -1948,6 +1979,7 @@ READINGS: dict[str, Callable[[Loader], str]] = {
     "fig6.fit_range": _fig6_fit_range,
     "saddle.floor_scan": _saddle_floor_scan,
     "saddle.lambda_offset": _saddle_lambda_offset,
+    "saddle.no_lyapunov": _saddle_no_lyapunov,
     "saddle.tangent_orbits": _saddle_tangent_orbits,
 }
 

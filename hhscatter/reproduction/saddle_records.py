@@ -40,6 +40,7 @@ from hhscatter.analysis.geometry.saddle import (
     lyapunov_convergence,
     mean_lyapunov,
     neighbour_floor_scan,
+    neighbour_scale_bands,
 )
 from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_lyapunov, low_ftle_share, tmin_trend
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
@@ -71,8 +72,11 @@ __all__ = [
     "lines_summary",
     "lyapunov_by_t_min",
     "mid_lyapunov_record",
+    "no_lyapunov_words",
     "relation_row",
     "relation_summary",
+    "scales_row",
+    "scales_summary",
     "with_d0",
     "with_gap",
 ]
@@ -116,7 +120,7 @@ def floor_scan_record(scan, scatter: float) -> dict:
     :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan` of the section points.
 
     ``scatter`` is the points' estimated distance to the saddle in units of their extent, e^{−λ̄·window[0]·t_min}
-    (stated beside the floors, not used by the fit). Keys: ``floor`` (the rule's, the row with factor 1; a fraction
+    (stated beside the floors, not used by the fit; None where there is no λ̄). Keys: ``floor`` (the rule's, the row with factor 1; a fraction
     of the extent), ``scatter_extent`` and ``rows`` ([{factor, floor, d1: {value, err} or None, eps_range_extent
     (the scales fitted, fractions of the extent) or None, note}]).
 
@@ -137,7 +141,7 @@ def floor_scan_record(scan, scatter: float) -> dict:
                      "d1": Measured(r.value, r.err).scaled(0.5).to_dict() if ok else None,
                      "eps_range_extent": [r.eps_lo / extent, r.eps_hi / extent] if ok else None, "note": r.note})  # fmt: skip
     ref = next((r["floor"] for r in rows if r["factor"] == 1.0), None)
-    return {"floor": ref, "scatter_extent": float(scatter), "rows": rows}
+    return {"floor": ref, "scatter_extent": None if scatter is None else float(scatter), "rows": rows}
 
 
 def d1_precision(records, target: float = 0.03) -> dict:
@@ -624,17 +628,37 @@ def long_lived(lifetimes, t_min: float):
 
 
 def lines_measurement(
-    rows, kappa, kappa_err, lam, lam_err, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines
+    rows,
+    kappa,
+    kappa_err,
+    lam,
+    lam_err,
+    *,
+    efolds,
+    checks,
+    floor,
+    factors,
+    k_max,
+    n_boot,
+    t_max,
+    n_lines,
+    bands=(),
+    section_band=None,
 ) -> dict:
-    """lines_measurement(rows, κ, σ_κ, λ̄, σ_λ, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines) -> dict.
+    """lines_measurement(rows, κ, σ_κ, λ̄, σ_λ, *, efolds, checks, floor, factors, k_max, n_boot, t_max, n_lines,
+    bands=(), section_band=None) -> dict.
 
     d₁ on lines: ``rows`` holds one row per initial condition of the lines (``x`` its position along its line,
     ``line``, ``outcome``, ``t_end``); the orbits that left at t_end ≥ c/κ, for c of ``efolds`` and ``checks``, are
     the survivors whose positions sample the stable manifold's measure, one block a line
     (:func:`~hhscatter.analysis.geometry.saddle.information_dimension_neighbours` with ``floor`` of a line's
     extent); at ``efolds`` its floor scan (× ``factors``) and the relation κ = λ̄(1 − d₁) with it. A t_min not
-    before the lines' ``t_max`` is refused; λ̄ ≤ 0 gives no relation. Returns :func:`lines_record`'s keys, or
-    ``{"notes_lines": why}`` where d₁ at ``efolds`` is refused.
+    before the lines' ``t_max`` is refused; no λ̄ (None) or λ̄ ≤ 0 gives no relation. ``bands`` ((lo, hi) pairs,
+    fractions of a line's extent): the local slope band by band
+    (:func:`~hhscatter.analysis.geometry.saddle.neighbour_scale_bands`) at every t_min, in ``d1_lines_detail.bands``;
+    ``section_band`` (lo, hi): d₁ on lines over the section's own range of scales (the same fractions of the
+    extent as its rule), at ``efolds``, in ``d1_lines_detail.at_section_scales``. Returns :func:`lines_record`'s
+    keys, or ``{"notes_lines": why}`` where d₁ at ``efolds`` is refused.
     """
 
     def args(c):
@@ -661,8 +685,26 @@ def lines_measurement(
         kg = kantz_grassberger(kappa, kappa_err, lam, lam_err, chosen.value, chosen.err)
     except ConfigError:  # λ̄ ≤ 0: no relation to check (the record's own note says why)
         kg = None
-    scatter = math.exp(-lam * efolds / kappa) if lam > 0 else None
-    return lines_record(by, efolds, scan, kg, n_lines=n_lines, scatter=scatter)
+    scatter = math.exp(-lam * efolds / kappa) if lam is not None and lam > 0 else None
+    out = lines_record(by, efolds, scan, kg, n_lines=n_lines, scatter=scatter)
+
+    def band_rows(a, bs, c):
+        tab = neighbour_scale_bands(a["points"], blocks=a["blocks"], bands=bs, k_max=k_max, n_boot=n_boot, seed=0)
+        return [{"t_min_kappa": float(c), "lo": float(r.lo), "hi": float(r.hi),
+                 "d1": Measured(r.value, r.err).to_dict() if math.isfinite(r.value) else None,
+                 "eps_range": [float(r.eps_lo), float(r.eps_hi)] if math.isfinite(r.value) else None,
+                 "note": r.note} for r in tab.itertuples()]  # fmt: skip
+
+    detail = out["d1_lines_detail"]
+    if bands:
+        detail["bands"] = []
+        for c, _n, d in by:
+            if isinstance(d, str):  # refused at this t_min: no bands either
+                continue
+            detail["bands"].extend(band_rows(args(c)[0], list(bands), c))
+    if section_band is not None:
+        detail["at_section_scales"] = band_rows(chosen_args, [tuple(section_band)], efolds)[0]
+    return out
 
 
 def lyapunov_record(lt, *, n_bins: int, n_boot: int):
@@ -671,7 +713,22 @@ def lyapunov_record(lt, *, n_bins: int, n_boot: int):
 
     ``lt``: the selected orbits of a tangent run (``log_stretch`` Λ, ``t_end`` T). λ̄ = ΣΛ/ΣT
     (:func:`~hhscatter.analysis.geometry.saddle.mean_lyapunov`); λ̄(T) = λ∞ + Λ₀/T over ``n_bins`` bins of T
-    (:func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`), λ∞ taken where the drift Λ₀ is resolved.
+    (:func:`~hhscatter.analysis.geometry.saddle.lyapunov_convergence`, its bins in ``by_T``: mean T, orbits, λ̄ and
+    its error), λ∞ taken where the drift Λ₀ is resolved (|Λ₀| > 2σ). An offset of Λ per orbit (the way in to the
+    saddle and out) leaves λ∞ the saddle's positive exponent; where the drift is resolved and λ∞ is not above 0 by
+    2σ, λ̄(T) is not of that form (it falls with T more than an offset allows, or the lifetimes span too little to
+    tell), and the record has no λ̄: ``value`` and ``err`` None, ``rule`` "none (…)".
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> T = np.repeat([100.0, 120.0, 140.0, 160.0, 180.0], 50)
+    >>> lam, _ = lyapunov_record(pd.DataFrame({"log_stretch": 0.2 * T + 3.0, "t_end": T}), n_bins=5, n_boot=20)
+    >>> round(lam["value"], 6), lam["rule"]                # an offset Λ₀ = 3: λ∞ = 0.2
+    (0.2, 'extrapolated (1/T drift resolved)')
+    >>> lam, _ = lyapunov_record(pd.DataFrame({"log_stretch": 20.0 - 0.05 * T, "t_end": T}), n_bins=5, n_boot=20)
+    >>> lam["value"], lam["rule"][:4], round(lam["extrapolated"], 6)   # Λ/T falls to 0.06: λ∞ = −0.05
+    (None, 'none', -0.05)
     """
     L, T = lt["log_stretch"].to_numpy(), lt["t_end"].to_numpy()
     if L.size < 2:
@@ -686,14 +743,50 @@ def lyapunov_record(lt, *, n_bins: int, n_boot: int):
         out["convergence"] = str(exc)
         return out, lt.assign(ftle=mean.ftle)
     out.update({"extrapolated": c.extrapolated, "extrapolated_err": c.extrapolated_err, "slope": c.slope,
-                "slope_err": c.slope_err, "converged": c.converged})  # fmt: skip
+                "slope_err": c.slope_err, "converged": c.converged,
+                "by_T": [{"T": float(r.T), "n_orbits": int(r.n_orbits), **Measured(r.value, r.err).to_dict()}
+                         for r in c.table.itertuples()]})  # fmt: skip
     lam_inf = Measured(c.extrapolated, c.extrapolated_err, "1/T extrapolation", mean.n_orbits)
     out.update({"lambda_mean": Measured(mean.value, mean.err, "mean", mean.n_orbits).to_dict(),
                 "lambda_inf": lam_inf.to_dict(),
                 "b": Measured(c.slope, c.slope_err, "1/T slope", mean.n_orbits).to_dict()})  # fmt: skip
     if not c.converged:
-        out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
+        if c.extrapolated > 2.0 * c.extrapolated_err:
+            out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
+        else:
+            out.update({"value": None, "err": None, "rule": "none (1/T drift resolved, λ∞ not above 0 by 2σ)"})
     return out, lt.assign(ftle=mean.ftle)
+
+
+def no_lyapunov_words(lam: dict) -> str:
+    """no_lyapunov_words(lam) -> a point's note where :func:`lyapunov_record` gives no λ̄: the 1/T extrapolation,
+    λ̄(T) in the first and last bins of T and ΣΛ/ΣT, and that the relation is not checked (1/time; T in time units).
+
+    Examples
+    --------
+    >>> lam = {"extrapolated": -0.02, "extrapolated_err": 0.005, "mean": 0.057, "mean_err": 0.001, "n_orbits": 1160,
+    ...        "by_T": [{"T": 385.0, "value": 0.074, "err": 0.002}, {"T": 562.0, "value": 0.044, "err": 0.001}]}
+    >>> print(no_lyapunov_words(lam))  # doctest: +NORMALIZE_WHITESPACE
+    λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = −0.0200 ± 0.0050, not above 0 by 2σ; λ̄(T) = 0.0740 ± 0.0020
+    at T = 385 to 0.0440 ± 0.0010 at T = 562 (ΣΛ/ΣT = 0.0570 ± 0.0010 over 1160 orbits); the relation is not checked
+    """
+    for key in ("extrapolated", "extrapolated_err", "mean", "mean_err", "n_orbits", "by_T"):
+        if key not in lam:
+            raise ConfigError(f"lam: no key {key!r} (a record of lyapunov_record with its 1/T extrapolation)")
+    if len(lam["by_T"]) < 2:
+        raise ConfigError(f"lam['by_T'] must hold at least 2 bins of T, got {len(lam['by_T'])}")
+    a, b = lam["by_T"][0], lam["by_T"][-1]
+
+    def pm(v, e):  # v ± e, one or two significant digits of e (as the verdicts), the minus sign U+2212
+        digits = max(0, 1 - math.floor(math.log10(e))) if e > 0 else 3
+        return f"{v:.{digits}f} ± {e:.{digits}f}".replace("-", "−")
+
+    return (
+        f"λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = {pm(lam['extrapolated'], lam['extrapolated_err'])}, "
+        f"not above 0 by 2σ; λ̄(T) = {pm(a['value'], a['err'])} at T = {a['T']:.0f} to "
+        f"{pm(b['value'], b['err'])} at T = {b['T']:.0f} (ΣΛ/ΣT = {pm(lam['mean'], lam['mean_err'])} over "
+        f"{int(lam['n_orbits'])} orbits); the relation is not checked"
+    )
 
 
 def d0_record(layout, lifetimes, *, min_count: int) -> dict:
@@ -808,8 +901,106 @@ def lines_summary(records) -> dict:
             "section_below_at": [i for i, _v in below], "section_above_at": above, "statement": statement}  # fmt: skip
 
 
+def _lowest_band(det: dict, c: float):
+    """The row of ``det["bands"]`` with the smallest scales at t_min·κ = c that has a d₁, or None."""
+    rows = [r for r in det.get("bands", []) if r["t_min_kappa"] == c and r["d1"]]
+    return min(rows, key=lambda r: r["lo"]) if rows else None
+
+
+def _z(a: dict, b: dict) -> float:
+    """z of a − b, {value, err} each, errors in quadrature."""
+    diff = Measured(a["value"], a["err"]).difference(Measured(b["value"], b["err"]))
+    return diff.value / diff.err if diff.err > 0 else math.copysign(math.inf, diff.value) if diff.value else 0.0
+
+
+def scales_row(rec: dict) -> dict:
+    """scales_row(rec) -> a record's d₁ across scales: the section's d₁ (D₁/2), d₁ on lines over the section's band
+    of scales and per band (``band_<lo>``: the bands of ``d1_lines_detail.bands`` at the rule's t_min, lo as a
+    fraction of a line's extent), 1 − κ/λ̄, and the z of: the lines over the section's band against the section
+    (``z_section``), the lowest band against the section's band on lines (``z_rise``), the lowest band against
+    1 − κ/λ̄ (``z_implied``) and the lowest band at the latest t_min against the rule's (``z_t_min``).
+
+    Examples
+    --------
+    >>> det = {"t_min_kappa": 6.0, "at_section_scales": {"lo": 0.002, "hi": 0.125, "d1": {"value": 0.72, "err": 0.01}},
+    ...        "bands": [{"t_min_kappa": 6.0, "lo": 1e-4, "hi": 1e-3, "d1": {"value": 0.77, "err": 0.015}},
+    ...                  {"t_min_kappa": 6.0, "lo": 1e-3, "hi": 1e-2, "d1": {"value": 0.75, "err": 0.01}},
+    ...                  {"t_min_kappa": 7.0, "lo": 1e-4, "hi": 1e-3, "d1": {"value": 0.77, "err": 0.02}}]}
+    >>> r = scales_row({"id": "a", "system": "hh", "ratio": 1.5, "d1": 0.70, "d1_err": 0.005, "d1_implied": 0.769,
+    ...                 "d1_implied_err": 0.001, "d1_lines_detail": det})
+    >>> r["band_0.0001"], round(r["z_rise"], 2), round(r["z_implied"], 2), r["z_t_min"]
+    ({'value': 0.77, 'err': 0.015}, 2.77, 0.07, 0.0)
+    """
+    row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
+    if rec.get("d1") is not None:
+        row["d1"] = Measured(rec["d1"], rec["d1_err"]).to_dict()
+    det = rec.get("d1_lines_detail") or {}
+    sec = (det.get("at_section_scales") or {}).get("d1")
+    if sec:
+        row["d1_section_scales"] = sec
+        if "d1" in row:
+            row["z_section"] = _z(sec, row["d1"])
+    c = det.get("t_min_kappa")
+    for r in det.get("bands", []):
+        if r["t_min_kappa"] == c and r["d1"]:
+            row[f"band_{r['lo']:g}"] = r["d1"]
+    low = _lowest_band(det, c) if c is not None else None
+    if rec.get("d1_implied") is not None:
+        row["d1_implied"] = Measured(rec["d1_implied"], rec["d1_implied_err"]).to_dict()
+    if low:
+        row["lowest_band"] = [low["lo"], low["hi"]]
+        if sec:
+            row["z_rise"] = _z(low["d1"], sec)
+        if "d1_implied" in row:
+            row["z_implied"] = _z(low["d1"], row["d1_implied"])
+        later = [r for r in det.get("bands", []) if r["t_min_kappa"] > c and r["lo"] == low["lo"] and r["d1"]]
+        if later:
+            row["z_t_min"] = _z(max(later, key=lambda r: r["t_min_kappa"])["d1"], low["d1"])
+    return row
+
+
+def scales_summary(records) -> dict:
+    """scales_summary(records) -> how d₁ on lines changes with the scale, over the points with its bands: where the
+    lowest band exceeds the section's band by more than 2σ (the slope rises towards the small scales) and where
+    it lies below; where d₁ on lines over the section's band meets the section's d₁ within 2σ; where the lowest
+    band meets 1 − κ/λ̄ within 2σ; and where the lowest band moves beyond 2σ from the rule's t_min to the latest
+    (the survivors' scatter about the manifold reaching into it), with the statement.
+
+    Examples
+    --------
+    >>> rows = [{"id": "a", "z_rise": 2.8, "z_section": 1.0, "z_implied": 0.1, "z_t_min": 0.0},
+    ...         {"id": "b", "z_rise": 0.5, "z_section": -0.4, "z_implied": 3.1, "z_t_min": -2.5}, {"id": "c"}]
+    >>> s = scales_summary(rows)
+    >>> s["rise_at"], s["section_agrees_at"], s["implied_agrees_at"], s["t_min_moves_at"]
+    (['a'], ['a', 'b'], ['a'], ['b'])
+    """
+
+    def where(key, test):
+        return [r["id"] for r in records if r.get(key) is not None and test(r[key])]
+
+    has = [r["id"] for r in records if r.get("z_rise") is not None]
+    rise, fall = where("z_rise", lambda z: z > 2), where("z_rise", lambda z: z < -2)
+    sec_n, sec_ok = where("z_section", lambda z: True), where("z_section", lambda z: abs(z) <= 2)
+    imp_n, imp_ok = where("z_implied", lambda z: True), where("z_implied", lambda z: abs(z) <= 2)
+    t_n, moves = where("z_t_min", lambda z: True), where("z_t_min", lambda z: abs(z) > 2)
+
+    def ids(xs):
+        return f" ({', '.join(xs)})" if xs else ""
+
+    statement = (f"On lines, d₁ over the smallest scales exceeds d₁ over the section's band of scales by more than 2σ at "
+                 f"{len(rise)} of {len(has)} points{ids(rise)}" + (f" and lies below it at {len(fall)}{ids(fall)}" if fall else "")
+                 + f"; over the section's band, d₁ on lines meets the section's d₁ within 2σ at {len(sec_ok)} of "
+                 f"{len(sec_n)}; over the smallest scales it meets 1 − κ/λ̄ within 2σ at {len(imp_ok)} of {len(imp_n)}"
+                 f"{ids(imp_ok)}, and it moves beyond 2σ from the rule's t_min to the latest at {len(moves)} of "
+                 f"{len(t_n)}{ids(moves)}")  # fmt: skip
+    return {"n_points": len(has), "rise_at": rise, "fall_at": fall, "n_section": len(sec_n),
+            "section_agrees_at": sec_ok, "n_implied": len(imp_n), "implied_agrees_at": imp_ok, "n_t_min": len(t_n),
+            "t_min_moves_at": moves, "statement": statement}  # fmt: skip
+
+
 CANDIDATES = {
     "lines": "d₁ on lines of initial conditions (the measure of the survivors along the stable direction)",
+    "small_scales": "d₁ on lines over the smallest band of scales alone (the slope's small-scale end)",
     "estimator": "d₁ by a second estimator (fixed-radius mass) on the same points",
     "selection": "d₁ and λ̄ extrapolated in 1/t_min (the selection's convergence)",
     "mid_life": "λ̄ of the mid-life only (window·t_min), without the way in and out",
@@ -857,6 +1048,10 @@ def with_gap(rec: dict) -> dict:
     alt = {}
     if rec.get("d1_lines"):
         alt["lines"] = (implied, Measured(rec["d1_lines"]["value"], rec["d1_lines"]["err"]))
+        det = rec.get("d1_lines_detail") or {}
+        low = _lowest_band(det, det.get("t_min_kappa"))
+        if low:
+            alt["small_scales"] = (implied, Measured(low["d1"]["value"], low["d1"]["err"]))
     if rec.get("d1_radius"):
         alt["estimator"] = (implied, Measured(rec["d1_radius"]["value"], rec["d1_radius"]["err"]))
     if "extrapolated" in rec["d1_trend"] and "extrapolated" in rec["lyapunov_trend"]:

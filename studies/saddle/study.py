@@ -46,6 +46,8 @@ class SystemEntry(StudyParams):
     ratios: Numbers  # E/E_c of the points
     t_max: Number = None  # the system's own t_max ([study] t_max where absent)
     tmin_efolds: Number = None  # the system's own t_min·κ ([study] tmin_efolds where absent)
+    lines_efolds: Number = None  # the system's own t_min·κ of d₁ on lines (at most [study]'s; theirs where absent)
+    lines_checks: Numbers = None  # the system's own lines_checks (each at most the latest of [study]'s)
 
 
 class Params(StudyParams):
@@ -98,9 +100,27 @@ def _tmin_efolds(study, label: str) -> float:
 
 
 def _tmin_overrides(study) -> dict:
-    """{"tmin_efolds_by_system": {label: t_min·κ}} of the systems with their own tmin_efolds, else {}."""
+    """{"tmin_efolds_by_system": {label: t_min·κ}} of the systems with their own tmin_efolds and
+    {"lines_by_system": {label: {lines_efolds, lines_checks}}} of those with their own lines rules, where any."""
     own = {e["label"]: float(e["tmin_efolds"]) for e in study.params.systems if e.get("tmin_efolds")}
-    return {"tmin_efolds_by_system": own} if own else {}
+    lines = {e["label"]: dict(zip(("lines_efolds", "lines_checks"), _lines_rules(study, e["label"])))
+             for e in study.params.systems if e.get("lines_efolds") or e.get("lines_checks")}  # fmt: skip
+    return {**({"tmin_efolds_by_system": own} if own else {}), **({"lines_by_system": lines} if lines else {})}
+
+
+def _lines_rules(study, label: str) -> tuple:
+    """(lines_efolds, [lines_checks]) of the system ``label``: its own where given, else [study]'s. A system's own
+    may not lie after the latest of [study]'s (the lines run to 3 e-folds after that, the same run for every system):
+    refused, naming the key."""
+    p = study.params
+    e = next(e for e in study.params.systems if e["label"] == label)
+    efolds = float(e.get("lines_efolds") or p.lines_efolds)
+    checks = [float(c) for c in (e.get("lines_checks") or p.lines_checks)]
+    latest = max(p.lines_efolds, *p.lines_checks)
+    if max(efolds, *checks) > latest:
+        raise ConfigError(f"saddle [study].systems[{label}] lines_efolds/lines_checks must be ≤ {latest:g} (the latest "
+                          f"of [study] lines_efolds and lines_checks), got {efolds:g} and {checks!r}")  # fmt: skip
+    return efolds, checks
 
 
 def _d0_eps(study):
@@ -148,7 +168,7 @@ def simulate(study, workers=None, progress=True):
     from hhscatter.studies import write_json_atomic
 
     p, choices = study.params, {}
-    d0_eps = _d0_eps(study)
+    d0_eps, _ = _d0_eps(study), _tmin_overrides(study)  # refused before any work (the lines rules with them)
     for label, spec, m, ratios, t_max in _systems(study):
         for r in ratios:
             key = point_key(label, r)
@@ -223,7 +243,8 @@ def _dense_lines_path(study, key):
 
 
 def _lines_t_max(study, kappa: float, t_max: float) -> float:
-    """t_max of the dense lines: 3 e-folds after the latest t_min·κ used, at most the main run's (a cheaper end)."""
+    """t_max of the dense lines: 3 e-folds after the latest t_min·κ of [study] (a system's own lie before it), at
+    most the main run's (a cheaper end)."""
     p = study.params
     return min(t_max, (max(p.lines_efolds, *p.lines_checks) + 3.0) / kappa)
 
@@ -252,15 +273,19 @@ def _run_dense_lines(study, key, sc, spec, kappa, workers, progress):
 # ---------------------------------------------------------------------------
 # analyze
 # ---------------------------------------------------------------------------
-def _d1_lines(study, key, k, lam, t_max):
+def _d1_lines(study, key, label, k, lam, t_max):
     """d₁ on the point's dense lines (:func:`~hhscatter.reproduction.saddle_records.lines_measurement`)."""
     import pandas as pd
 
     p = study.params
+    efolds, checks = _lines_rules(study, label)
     layout = pd.read_parquet(_dense_lines_path(study, key), columns=["traj_id", "x", "line"])
     rows = layout.merge(_lifetimes(study.raw(key + "_dlines")), on="traj_id")
-    return sr.lines_measurement(rows, k.kappa, k.kappa_err, lam["value"], lam["err"], efolds=p.lines_efolds,
-                                checks=p.lines_checks, floor=p.lines_floor, factors=p.d1_floor_factors,
+    decades = [(p.lines_floor * 10.0**j, min(p.lines_floor * 10.0 ** (j + 1), 1.0 / p.min_boxes))
+               for j in range(12) if p.lines_floor * 10.0**j < 1.0 / p.min_boxes]  # fmt: skip
+    return sr.lines_measurement(rows, k.kappa, k.kappa_err, lam["value"], lam["err"], efolds=efolds,
+                                checks=checks, floor=p.lines_floor, bands=decades,
+                                section_band=(p.d1_floor, 1.0 / p.min_boxes), factors=p.d1_floor_factors,
                                 k_max=p.k_max, n_boot=p.n_boot, t_max=_lines_t_max(study, k.kappa, t_max),
                                 n_lines=p.lines_count)  # fmt: skip
 
@@ -351,8 +376,10 @@ def _point(study, key, ch):
         return rec, None
     lam, ftle = lam
     rec.update({"lyapunov": lam["value"], "lyapunov_err": lam["err"], "lyapunov_detail": lam})
+    if lam["value"] is None:
+        rec["notes"].append(sr.no_lyapunov_words(lam))
     _label, _spec, model, _ratios, t_max = next(s for s in _systems(study) if s[0] == ch["system"])
-    lines = _d1_lines(study, key, k, lam, t_max)
+    lines = _d1_lines(study, key, ch["system"], k, lam, t_max)
     if "notes_lines" in lines:
         rec["notes"].append(lines.pop("notes_lines"))
     rec.update(lines)
@@ -373,23 +400,29 @@ def _point(study, key, ch):
     except ConfigError as exc:
         rec["notes"].append(sr.d1_refusal_words(f"d1: {exc}"))
         return rec, ftle
-    try:
-        kg = kantz_grassberger(k.kappa, k.kappa_err, lam["value"], lam["err"], d.value, d.err, dimension="section")
-    except ConfigError as exc:  # e.g. λ̄ ≤ 0: no lever arm in T for the 1/T extrapolation
-        rec["notes"].append(f"relation: {exc}")
-        return rec, ftle
-    rec.update({"d1": kg.d1, "d1_err": kg.d1_err, "d1_section": d.value, "d1_section_err": d.err,
-                "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points,
-                "predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
-                "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict})  # fmt: skip
+    # d₁ does not depend on λ̄: measured at every point with section points, the relation only where λ̄ is
+    rec.update({"d1": 0.5 * float(d.value), "d1_err": 0.5 * float(d.err), "d1_section": d.value, "d1_section_err": d.err,
+                "d1_eps_range": list(d.eps_range), "d1_n_orbits": sp.n_orbits, "d1_n_points": sp.n_points})  # fmt: skip
     rec.update(sr.d1_error_record(d, _extent(sp), p.d1_floor * _extent(sp)))
     scan = neighbour_floor_scan(**_d1_args(sp, p), floor=p.d1_floor, factors=p.d1_floor_factors)
-    rec["d1_floor_scan"] = sr.floor_scan_record(scan, math.exp(-lam["value"] * sp.window[0] * sp.t_min))
+    lam_v = lam["value"]
+    rec["d1_floor_scan"] = sr.floor_scan_record(
+        scan, None if lam_v is None else math.exp(-lam_v * sp.window[0] * sp.t_min)
+    )
     rec.update(_d1_radius(sp, d, p))
     rec.update(sr.sheets_record(sp.points, model.force, floor=p.d1_floor, k_max=p.k_max, n_boot=p.n_boot,
                                 min_boxes=p.min_boxes))  # fmt: skip
     rec.update(sr.hyperbolic_record(sr.long_lived(tangent, ch["t_min"]), sp.points, lambda pts: est(replace(sp, points=pts)), d, p.ftle_low, n_boot=p.n_boot))  # fmt: skip
-    rec.update({"d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})
+    if lam_v is None:  # no λ̄: the record's note says why
+        return rec, ftle
+    try:
+        kg = kantz_grassberger(k.kappa, k.kappa_err, lam_v, lam["err"], d.value, d.err, dimension="section")
+    except ConfigError as exc:
+        rec["notes"].append(f"relation: {exc}")
+        return rec, ftle
+    rec.update({"predicted": kg.predicted, "predicted_err": kg.predicted_err, "d1_implied": kg.d1_implied,
+                "d1_implied_err": kg.d1_implied_err, "z": kg.z, "verdict": kg.verdict,
+                "d1_section_implied": 2 * kg.d1_implied, "d1_section_implied_err": 2 * kg.d1_implied_err})  # fmt: skip
     return rec, ftle
 
 
@@ -397,7 +430,7 @@ def analyze(study):
     """analyze(study) -> None; writes saddle.json and saddle_ftle.parquet."""
     import pandas as pd
 
-    _d0_eps(study)  # refused before any work
+    _d0_eps(study), _tmin_overrides(study)  # refused before any work (the lines rules with them)
     if not 0 < study.params.d1_floor < 1 / study.params.min_boxes:
         raise ConfigError(f"saddle [study].d1_floor must lie in (0, 1/min_boxes), got {study.params.d1_floor!r}")
     choices = json.loads(_choices_path(study).read_text())
@@ -425,6 +458,8 @@ def analyze(study):
             "d1_precision": sr.d1_precision(records),
             "lines": [sr.lines_row(x) for x in records],
             "lines_summary": sr.lines_summary(records),
+            "scales": [sr.scales_row(x) for x in records],
+            "scales_summary": sr.scales_summary([sr.scales_row(x) for x in records]),
             "gap": [sr.gap_row(x) for x in records],
             "gap_summary": sr.gap_summary(records),
             "rules": {

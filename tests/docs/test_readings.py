@@ -867,6 +867,41 @@ def test_the_saddle_offset_reading_renders_at_both_scales(scale):
     assert text.count(" (Λ₀ = ") + int(re.search(r"at (?:the other|all) (\d+) points", text).group(1)) == len(fitted)
 
 
+def test_the_saddle_no_lyapunov_reading_tests_how_the_exponents_move_with_the_lifetime():
+    """A point without λ̄: λ̄(T) 0.074 ± 0.002 → 0.044 ± 0.001 (z = −13.4) "falls to"; 0.060 ± 0.002 → 0.061 ± 0.002
+    "stays at"; a point with λ̄ or without bins of T is not named; with none left the reading says so."""
+
+    def pt(system, ratio, a, b, lam=None, **kw):
+        det = {"by_T": [{"T": 380.0, **a}, {"T": 560.0, **b}], "extrapolated": -0.02, "extrapolated_err": 0.005}
+        return {"system": system, "ratio": ratio, "lyapunov": lam, "lyapunov_detail": det, **kw}
+
+    hyp = {"threshold": 0.5, "shares": [{"threshold": 0.5, "share": {"value": 0.12, "err": 0.01}}]}
+    points = [
+        pt(
+            "barbanis",
+            1.9,
+            {"value": 0.074, "err": 0.002},
+            {"value": 0.044, "err": 0.001},
+            hyperbolic=hyp,
+            d1=0.70,
+            d1_err=0.02,
+            d1_lines={"value": 0.75, "err": 0.02},
+        ),
+        pt("contopoulos", 1.7, {"value": 0.060, "err": 0.002}, {"value": 0.061, "err": 0.002}),
+        pt("henon_heiles", 1.5, {"value": 0.41, "err": 0.002}, {"value": 0.40, "err": 0.002}, lam=0.41),
+        {"system": "henon_heiles", "ratio": 3.0, "lyapunov": None, "lyapunov_detail": {}},
+    ]
+    text = READINGS["saddle.no_lyapunov"](_loader({"saddle": {"saddle": points}}))
+    assert text == (
+        "no λ̄ at Barbanis E/E_c = 1.9 (λ̄(T) = 0.0740 ± 0.0020 at T = 380 falls to 0.0440 ± 0.0010 at T = 560, "
+        "z = −13.4; λ∞ = −0.020 ± 0.005; Λ/T below 0.5·ΣΛ/ΣT at a share 0.120 ± 0.010 of the orbits; "
+        "d₁ = 0.700 ± 0.020 on the section, 0.750 ± 0.020 on lines); Contopoulos E/E_c = 1.7 (λ̄(T) = 0.0600 ± "
+        "0.0020 at T = 380 stays at 0.0610 ± 0.0020 at T = 560, z = +0.4; λ∞ = −0.020 ± 0.005)"
+    )
+    text = READINGS["saddle.no_lyapunov"](_loader({"saddle": {"saddle": points[2:]}}))
+    assert text == "every point of this scale with a 1/T fit has λ̄"
+
+
 def _b_docs(b_generality, err_generality):
     """fig2 with b = 0.25 ± 0.025 against E − E_c (E_c = 0.2: b·E_c = 0.05 ± 0.005, 10σ from 0) below E_b = 0.3,
     and generality's b in ε = E/E_c − 1 below ε_b = 0.6."""

@@ -309,3 +309,48 @@ def test_long_lived_keeps_the_orbits_that_left_late_and_refuses_a_table_without_
         sr.long_lived(lt.drop(columns="outcome"), 1.0)
     with pytest.raises(ConfigError, match="t_min"):
         sr.long_lived(lt, float("inf"))
+
+
+def _stretches(lam_of_T, offset=0.0, n=60, seed=0):
+    """n orbits in each of 5 lifetimes 200 … 400, Λ = λ(T)·T + offset with a small scatter (a tangent run's table)."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    T = np.repeat([200.0, 250.0, 300.0, 350.0, 400.0], n)
+    L = lam_of_T(T) * T + offset + rng.normal(0.0, 0.05, T.size)
+    return pd.DataFrame({"log_stretch": L, "t_end": T})
+
+
+def test_lyapunov_record_takes_a_positive_intercept_and_gives_none_where_the_exponents_fall_to_zero():
+    """An offset of 4 e-folds per orbit on λ∞ = 0.3: λ̄(T) = 0.3 + 4/T, λ∞ extrapolated to within 2σ of 0.3. Λ/T that
+    falls linearly from 0.10 at T = 200 to 0.04 at T = 400 (the longer-lived stretching less, as orbits that stick
+    to islands): the 1/T fit meets 0 or below, no λ̄, its bins and ΣΛ/ΣT kept, and the note says so. No drift at all:
+    ΣΛ/ΣT, the rule "mean"."""
+    lam, _ = sr.lyapunov_record(_stretches(lambda T: 0.3 + 0 * T, offset=4.0), n_bins=5, n_boot=50)
+    assert lam["rule"].startswith("extrapolated") and abs(lam["value"] - 0.3) <= 2 * lam["err"]
+    assert [round(r["T"]) for r in lam["by_T"]] == [200, 250, 300, 350, 400]
+    assert lam["by_T"][0]["value"] == pytest.approx(0.3 + 4.0 / 200.0, abs=1e-3)
+    falling, _ = sr.lyapunov_record(_stretches(lambda T: 0.10 - 0.06 * (T - 200.0) / 200.0), n_bins=5, n_boot=50)
+    assert falling["value"] is None and falling["err"] is None and falling["rule"].startswith("none")
+    assert not falling["converged"] and falling["extrapolated"] <= 2 * falling["extrapolated_err"]
+    T = _stretches(lambda T: 0.1 + 0 * T)["t_end"]
+    assert falling["mean"] == pytest.approx(float((0.10 - 0.06 * (T - 200.0) / 200.0).mul(T).sum() / T.sum()), abs=1e-3)
+    note = sr.no_lyapunov_words(falling)
+    assert note.startswith("λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = −") and "at T = 200 to" in note
+    assert note.endswith("over 300 orbits); the relation is not checked")
+    flat, _ = sr.lyapunov_record(_stretches(lambda T: 0.3 + 0 * T), n_bins=5, n_boot=50)
+    assert flat["rule"] == "mean" and flat["converged"] and flat["value"] == pytest.approx(0.3, abs=1e-3)
+
+
+@pytest.mark.parametrize(
+    "lam, name",
+    [
+        ({"extrapolated": 0.1, "extrapolated_err": 0.1, "mean": 0.1, "mean_err": 0.01, "n_orbits": 5}, "by_T"),
+        ({"extrapolated": 0.1, "extrapolated_err": 0.1, "mean": 0.1, "mean_err": 0.01, "n_orbits": 5,
+          "by_T": [{"T": 1.0, "value": 0.1, "err": 0.01}]}, "by_T"),
+        ({"extrapolated_err": 0.1, "mean": 0.1, "mean_err": 0.01, "n_orbits": 5, "by_T": []}, "extrapolated"),
+    ],
+)  # fmt: skip
+def test_no_lyapunov_words_refuses_a_record_without_its_fit_naming_the_key(lam, name):
+    with pytest.raises(sr.ConfigError, match=name):
+        sr.no_lyapunov_words(lam)

@@ -174,6 +174,26 @@ def test_a_system_s_own_tmin_efolds_replaces_the_study_s(built):
     assert sorted(tan["traj_id"]) == sorted(long["traj_id"])
 
 
+def test_a_system_s_own_lines_rules_replace_the_study_s_and_may_not_lie_after_them():
+    """The paper scale: Barbanis' entry has lines_efolds 4 and lines_checks [3, 5], the others [study]'s 6 and
+    [5, 7]; a system's own later than [study]'s latest (the lines run to 3 e-folds after it) is refused by name."""
+    from types import SimpleNamespace
+
+    from hhscatter.errors import ConfigError
+    from hhscatter.studies import load_study, stage_module
+
+    mod, study = stage_module("saddle"), load_study("saddle", "paper")
+    assert mod._lines_rules(study, "barbanis") == (4.0, [3.0, 5.0])
+    assert mod._lines_rules(study, "henon_heiles") == (6.0, [5.0, 7.0])
+    assert mod._tmin_overrides(study)["lines_by_system"] == {
+        "barbanis": {"lines_efolds": 4.0, "lines_checks": [3.0, 5.0]}
+    }
+    late = SimpleNamespace(params=SimpleNamespace(lines_efolds=6.0, lines_checks=[5.0, 7.0],
+                                                  systems=[{"label": "b", "lines_efolds": 8.0}]))  # fmt: skip
+    with pytest.raises(ConfigError, match=r"systems\[b\] lines_efolds/lines_checks must be ≤ 7"):
+        mod._lines_rules(late, "b")
+
+
 def test_d1_s_floor_is_a_fraction_of_the_extent_and_its_scan_holds_the_rule_s_d1(built):
     """d₁'s scaling range starts at d1_floor × the points' extent or above (never at a scale set by λ̄), and the
     floor scan's row with factor 1 is the record's d₁ itself (the same points, rule and seed); its floors are the
@@ -265,3 +285,18 @@ def test_d1_on_lines_is_the_survivors_dimension_and_the_relation_is_done_with_it
     assert [r["t_min_kappa"] for r in det["by_t_min"]] == sorted({rules["lines_efolds"], *rules["lines_checks"]})
     if rec.get("gap"):  # the gap's candidates include d₁ on lines
         assert "lines" in rec["gap"]
+    # the bands: the same survivors, the estimator over each decade of a line's extent and the section's band alone
+    from hhscatter.analysis.geometry.saddle import neighbour_scale_bands
+
+    rows = [r for r in det["bands"] if r["t_min_kappa"] == rules["lines_efolds"]]
+    decades = [(r["lo"], r["hi"]) for r in rows]
+    assert decades[0][0] == rules["lines_floor"] and decades[-1][1] == pytest.approx(0.125)
+    assert all(hi == pytest.approx(min(10 * lo, 0.125)) for lo, hi in decades)
+    tab = neighbour_scale_bands(sel["x"].to_numpy(), blocks=sel["line"].to_numpy(), bands=decades, k_max=16,
+                                n_boot=10, seed=0)  # fmt: skip
+    for r, t in zip(rows, tab.itertuples()):
+        assert (r["d1"] is None) == (not math.isfinite(t.value))
+        if r["d1"]:
+            assert r["d1"]["value"] == pytest.approx(t.value, rel=1e-12)
+    sec = det["at_section_scales"]
+    assert (sec["lo"], sec["hi"]) == (rules["d1_floor"], 0.125)

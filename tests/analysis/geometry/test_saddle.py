@@ -44,6 +44,7 @@ from hhscatter.analysis.geometry.saddle import (
     lyapunov_convergence,
     mean_lyapunov,
     neighbour_floor_scan,
+    neighbour_scale_bands,
     saddle_points,
     window_dependence,
 )
@@ -471,6 +472,26 @@ def test_blocks_far_apart_give_what_one_set_of_them_gives_offset():
     assert abs(d.value - far.value) < 0.01 and d.value != far.value
 
 
+def test_scale_bands_find_each_regime_of_a_measure_whose_slope_changes_with_scale():
+    """Uniform over 1024 cells at the large scales, a weighted Cantor set inside each cell (weights ⅓, ⅔ on its outer
+    thirds: d₁ = h/ln 3 = 0.579): the band 10⁻⁶ … 10⁻⁵ of the extent reads the Cantor set's d₁ and the band
+    2/1024 … 1/20 reads 1, each within 2σ in at least 9 of 10 seeds, and the fit over all the scales lies between."""
+    w = 1 / 3
+    d_cantor = -(w * math.log(w) + (1 - w) * math.log(1 - w)) / math.log(3)
+    covered, between = 0, 0
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        digits = rng.random((60000, 16)) < 1 - w
+        cantor = (2 * digits) @ (3.0 ** -np.arange(1, 17)) + 3.0**-16 * rng.random(60000)
+        x = (rng.integers(0, 1024, 60000) + cantor) / 1024
+        b = neighbour_scale_bands(x, bands=[(1e-6, 1e-5), (2 / 1024, 1 / 20)], n_boot=10, seed=seed)
+        lo, hi = b.iloc[0], b.iloc[1]
+        covered += abs(lo["value"] - d_cantor) <= 2 * lo["err"] and abs(hi["value"] - 1.0) <= 2 * hi["err"]
+        whole = information_dimension_neighbours(x, eps_min=1e-6, eps_max=1 / 20, n_boot=0, seed=seed)
+        between += d_cantor < whole.value < 1.0
+    assert covered >= 9 and between == 10, (covered, between)
+
+
 @pytest.mark.parametrize(
     ("call", "name"),
     [
@@ -495,6 +516,15 @@ def test_blocks_far_apart_give_what_one_set_of_them_gives_offset():
         (lambda P: information_dimension_neighbours(P, blocks=np.full(1000, np.nan)), "blocks must be labels"),
         (lambda P: information_dimension_neighbours(P, blocks=np.arange(1000) % 40), "a block holds no more than"),
         (lambda P: neighbour_floor_scan(P, floor=0.01, blocks=np.zeros(3)), "blocks must have one label per point"),
+        (lambda P: neighbour_scale_bands(P, bands=[]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=[(0.1, 0.01)]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=[(0.0, 0.1)]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=[(0.01, 2.0)]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=[(0.01, math.nan)]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=0.1), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=["ab"]), "bands"),
+        (lambda P: neighbour_scale_bands(P, bands=[(0.01, 0.1)], blocks=np.zeros(3)), "blocks must have one label"),
+        (lambda P: neighbour_scale_bands(np.zeros((100, 2)), bands=[(0.01, 0.1)]), "coincide"),
     ],
 )
 def test_neighbour_dimension_refuses_bad_input_naming_it(call, name):
