@@ -961,8 +961,9 @@ def scales_row(rec: dict) -> dict:
 
 def scales_summary(records) -> dict:
     """scales_summary(records) -> how d₁ on lines changes with the scale, over the points with its bands: where the
-    lowest band exceeds the section's band by more than 2σ (the slope rises towards the small scales) and where
-    it lies below; where d₁ on lines over the section's band meets the section's d₁ within 2σ; where the lowest
+    lowest band lies above the section's band (with the one-sided sign test over the points: each an independent
+    run, the chance of so many above if either side were as likely), where by more than 2σ (the slope rises
+    towards the small scales) and where it lies more than 2σ below; where d₁ on lines over the section's band meets the section's d₁ within 2σ; where the lowest
     band meets 1 − κ/λ̄ within 2σ; and where the lowest band moves beyond 2σ from the rule's t_min to the latest
     (the survivors' scatter about the manifold reaching into it), with the statement.
 
@@ -973,6 +974,8 @@ def scales_summary(records) -> dict:
     >>> s = scales_summary(rows)
     >>> s["rise_at"], s["section_agrees_at"], s["implied_agrees_at"], s["t_min_moves_at"]
     (['a'], ['a', 'b'], ['a'], ['b'])
+    >>> s["above_at"], s["p_sign"]                     # 2 of 2 above: (1/2)² one-sided
+    (['a', 'b'], 0.25)
     """
 
     def where(key, test):
@@ -980,6 +983,9 @@ def scales_summary(records) -> dict:
 
     has = [r["id"] for r in records if r.get("z_rise") is not None]
     rise, fall = where("z_rise", lambda z: z > 2), where("z_rise", lambda z: z < -2)
+    above = where("z_rise", lambda z: z > 0)
+    # one-sided sign test over the points (independent runs): P(≥ len(above) of len(has) above | each side ½)
+    p_sign = sum(math.comb(len(has), k) for k in range(len(above), len(has) + 1)) / 2.0 ** len(has) if has else None
     sec_n, sec_ok = where("z_section", lambda z: True), where("z_section", lambda z: abs(z) <= 2)
     imp_n, imp_ok = where("z_implied", lambda z: True), where("z_implied", lambda z: abs(z) <= 2)
     t_n, moves = where("z_t_min", lambda z: True), where("z_t_min", lambda z: abs(z) > 2)
@@ -987,13 +993,14 @@ def scales_summary(records) -> dict:
     def ids(xs):
         return f" ({', '.join(xs)})" if xs else ""
 
-    statement = (f"On lines, d₁ over the smallest scales exceeds d₁ over the section's band of scales by more than 2σ at "
-                 f"{len(rise)} of {len(has)} points{ids(rise)}" + (f" and lies below it at {len(fall)}{ids(fall)}" if fall else "")
+    statement = (f"On lines, d₁ over the smallest scales lies above d₁ over the section's band of scales at {len(above)} "
+                 f"of {len(has)} points" + (f" (one-sided sign test p = {p_sign:.2g})" if has else "")
+                 + f", by more than 2σ at {len(rise)}{ids(rise)}" + (f", more than 2σ below it at {len(fall)}{ids(fall)}" if fall else "")
                  + f"; over the section's band, d₁ on lines meets the section's d₁ within 2σ at {len(sec_ok)} of "
                  f"{len(sec_n)}; over the smallest scales it meets 1 − κ/λ̄ within 2σ at {len(imp_ok)} of {len(imp_n)}"
                  f"{ids(imp_ok)}, and it moves beyond 2σ from the rule's t_min to the latest at {len(moves)} of "
                  f"{len(t_n)}{ids(moves)}")  # fmt: skip
-    return {"n_points": len(has), "rise_at": rise, "fall_at": fall, "n_section": len(sec_n),
+    return {"n_points": len(has), "above_at": above, "p_sign": p_sign, "rise_at": rise, "fall_at": fall, "n_section": len(sec_n),
             "section_agrees_at": sec_ok, "n_implied": len(imp_n), "implied_agrees_at": imp_ok, "n_t_min": len(t_n),
             "t_min_moves_at": moves, "statement": statement}  # fmt: skip
 

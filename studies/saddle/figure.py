@@ -16,13 +16,54 @@ def _lines(records):
     return [r for r in records if r.get("d1_lines") and "predicted" in r.get("d1_lines_detail", {})]
 
 
+def _banded(records):
+    """The points with d₁ on lines band by band (at the rule's t_min) of the system that has the most of them."""
+
+    def bands(r):
+        det = r.get("d1_lines_detail") or {}
+        return [b for b in det.get("bands", []) if b["t_min_kappa"] == det.get("t_min_kappa") and b["d1"]]
+
+    rs = [r for r in records if bands(r)]
+    if not rs:
+        return None, []
+    label = max(dict.fromkeys(r["system"] for r in rs), key=lambda s: sum(r["system"] == s for r in rs))
+    return label, [(r, bands(r)) for r in rs if r["system"] == label]
+
+
+def _scales_panel(ax, numbers, plt):
+    """(d) d₁ on lines over each band of scales (its geometric middle, fractions of a line's extent) per energy of
+    one system, the section's d₁ at the middle of its own band (filled) and 1 − κ/λ̄ (dashed)."""
+    label, pts = _banded(numbers["saddle"])
+    cmap = plt.get_cmap("viridis")
+    for i, (r, bs) in enumerate(pts):
+        col = cmap(i / max(len(pts) - 1, 1))
+        x = [(b["lo"] * b["hi"]) ** 0.5 for b in bs]
+        ax.errorbar(x, [b["d1"]["value"] for b in bs], [b["d1"]["err"] for b in bs], fmt="o:", mfc="white",
+                    color=col, capsize=3, label=f"E/E_c = {r['ratio']:g}: lines")  # fmt: skip
+        sec = r["d1_lines_detail"].get("at_section_scales") or {}
+        if r.get("d1") is not None and sec:
+            mid = 1.25 * (sec["lo"] * sec["hi"]) ** 0.5  # set off to the right of the lines' band there
+            ax.errorbar([mid], [r["d1"]], [r["d1_err"]], fmt="s", color=col, capsize=3)
+        if r.get("d1_implied") is not None:
+            ax.axhline(r["d1_implied"], color=col, ls="--", lw=1, alpha=0.7)
+    ax.set_xscale("log")
+    ax.set_xlabel("scale (fraction of the extent: a line's, or the section points')")
+    ax.set_ylabel("partial dimension d₁ over the band")
+    ax.set_title(f"(d) d₁ across scales, {label or 'no point with bands'}: lines (open), section (filled), "
+                 "1 − κ/λ̄ (dashed)", fontsize=10)  # fmt: skip
+    if pts:
+        ax.legend(fontsize=7)
+
+
 def plot_saddle(numbers, path):
-    """Three panels: (a) κ against λ̄(1 − d₁) per point, d₁ from the section points (filled) and on lines (open);
+    """Four panels: (a) κ against λ̄(1 − d₁) per point, d₁ from the section points (filled) and on lines (open);
     (b) the section's D₁ measured and implied, 2(1 − κ/λ̄), and its D₀ = 2(1 − α) from the uncertainty exponent on
-    lines; (c) d₁ from the section points (D₁/2), d₁ on lines and 1 − κ/λ̄ against E/E_c."""
+    lines; (c) d₁ from the section points (D₁/2), d₁ on lines and 1 − κ/λ̄ against E/E_c; (d) d₁ on lines band by
+    band of scales, with the section's d₁ on its own band and 1 − κ/λ̄."""
     plt = agg_pyplot()
     recs = _done(numbers["saddle"])
-    fig, (a, b, c) = plt.subplots(1, 3, figsize=(17, 5.2))
+    fig, ((a, b), (c, d)) = plt.subplots(2, 2, figsize=(14, 10.4))
+    _scales_panel(d, numbers, plt)
     for label in dict.fromkeys(r["system"] for r in numbers["saddle"]):
         col, mk = COLORS.get(label, "k"), MARKERS.get(label, "o")
         rs = [r for r in _lines(numbers["saddle"]) if r["system"] == label]
