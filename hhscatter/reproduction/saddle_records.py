@@ -918,7 +918,8 @@ def scales_row(rec: dict) -> dict:
     of scales and per band (``band_<lo>``: the bands of ``d1_lines_detail.bands`` at the rule's t_min, lo as a
     fraction of a line's extent), 1 − κ/λ̄, and the z of: the lines over the section's band against the section
     (``z_section``), the lowest band against the section's band on lines (``z_rise``), the lowest band against
-    1 − κ/λ̄ (``z_implied``) and the lowest band at the latest t_min against the rule's (``z_t_min``).
+    1 − κ/λ̄ (``z_implied``) and the lowest band at the latest t_min against the rule's (``z_t_min``); the scales
+    fitted, fractions of the extent: ``section_eps`` (the section's fit) and ``lowest_eps`` (the lowest band's).
 
     Examples
     --------
@@ -947,8 +948,10 @@ def scales_row(rec: dict) -> dict:
     low = _lowest_band(det, c) if c is not None else None
     if rec.get("d1_implied") is not None:
         row["d1_implied"] = Measured(rec["d1_implied"], rec["d1_implied_err"]).to_dict()
+    if rec.get("d1_eps_range_extent"):  # the scales the section's fit reached, fractions of its points' extent
+        row["section_eps"] = rec["d1_eps_range_extent"]
     if low:
-        row["lowest_band"] = [low["lo"], low["hi"]]
+        row["lowest_band"], row["lowest_eps"] = [low["lo"], low["hi"]], low.get("eps_range")
         if sec:
             row["z_rise"] = _z(low["d1"], sec)
         if "d1_implied" in row:
