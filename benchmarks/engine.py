@@ -39,8 +39,10 @@ absolute times, are the result). Rows:
 * **saddle** — the CPU of one point of study saddle per estimator, at the precision it reaches there
   (Hénon–Heiles E = 1.8 E_c, disk r < r_s/2, t_max 200, the study's rules, N orbits up to 2·10⁴): the saddle
   points (main run with every section crossing, κ, the sprinkler selection), λ̄ with its 1/T convergence (the
-  tangent run of the selected orbits and both estimators), d₁ (box counting with its bootstrap) and d₀ (the lines
-  run, 7 ε × 4000 pairs, and the fit); each row the integration's CPU plus the estimator's, the precision in its
+  tangent run of the selected orbits and both estimators), d₁ of the section points (nearest-neighbour distances,
+  floor extent/128, bootstrap over orbits), d₁ on lines (8 lines × 50 000 initial conditions run to 3 e-folds
+  after t_min = 6/κ, the estimator with each line a block, and its bands of scales) and d₀ (the lines run,
+  7 ε × 4000 pairs, and the fit); each row the integration's CPU plus the estimator's, the precision in its
   note. ``--only saddle`` runs these rows alone.
 
 Writes ``benchmarks/out/engine/<full|quick>/engine.csv`` and ``engine_summary.md``
@@ -481,11 +483,10 @@ def _cpu(fn):
 
 def _saddle_rows(row, n):
     """CPU per point of each estimator of study saddle at the precision it reaches (module notes): one point,
-    Hénon–Heiles E = 1.8 E_c, the study's rules (t_min = 4/κ, window 0.4–0.6, min_boxes 8, k_max 16,
-    n_boot 100; d₀ over ε = 1e-2 … 1e-8, 4000 pairs each, fitted where ≥ 10 pairs are uncertain). Each estimator
-    measured once after a warm-up run of the engine (JIT outside the measurement)."""
-    import math  # deferred: only these rows need it
-
+    Hénon–Heiles E = 1.8 E_c, the study's quick rules (t_min = 4/κ, window 0.4–0.6, d₁ from extent/128 to
+    extent/8, k_max 16, n_boot 100; d₁ on lines: 8 × 50 000 ICs, t_min = 6/κ, floor 10⁻⁴ of a line's extent, its
+    decades of scales; d₀ over ε = 1e-2 … 1e-8, 4000 pairs each, fitted where ≥ 10 pairs are uncertain). Each
+    estimator measured once after a warm-up run of the engine (JIT outside the measurement)."""
     import pandas as pd  # deferred: pandas loads on first use
 
     from hhscatter.analysis.geometry.saddle import (  # deferred: the estimators load on first use
@@ -493,12 +494,17 @@ def _saddle_rows(row, n):
         information_dimension_neighbours,
         lyapunov_convergence,
         mean_lyapunov,
+        neighbour_scale_bands,
         saddle_points,
     )
     from hhscatter.analysis.geometry.uncertainty import uncertainty_fraction  # deferred: as above
     from hhscatter.analysis.survival.escape_rate import escape_rate_from_lifetimes  # deferred: as above
     from hhscatter.outcomes import LEAVING_OUTCOMES, OUTCOMES  # deferred: as above
-    from hhscatter.scene.ics import perturbed_on_section, region_ics  # deferred: pydantic loads on first use
+    from hhscatter.scene.ics import (  # deferred: pydantic loads on first use
+        chord_lines,
+        perturbed_on_section,
+        region_ics,
+    )
     from hhscatter.scene.scene import Scene, SectionWindow  # deferred: pydantic loads on first use
 
     m = min(n, 20_000)
@@ -539,14 +545,27 @@ def _saddle_rows(row, n):
         f"{lam.value:.4f} ± {lam.err:.4f}, λ∞ = {conv.extrapolated:.3f} ± {conv.extrapolated_err:.3f}")  # fmt: skip
     # d₁: nearest-neighbour distances with the bootstrap over orbits
     P = sp.points[["x", "y"]].to_numpy()
-    extent = float(np.max(P.max(axis=0) - P.min(axis=0)))
-    eps_min = extent * math.exp(-lam.value * 0.4 * t_min)
     t_d1, d1 = _cpu(lambda: information_dimension_neighbours(P, groups=sp.points["traj_id"].to_numpy(), k_max=16,
-                                                             eps_min=eps_min, eps_max=extent / 8, n_boot=100,
-                                                             seed=0))  # fmt: skip
+                                                             floor=1 / 128, n_boot=100, seed=0))  # fmt: skip
     row("saddle", "d₁ (section): CPU s per point", t_d1, "",
         f"nearest-neighbour distances of the saddle points above (their run counted there); D₁ = {d1.value:.3f} ± "
         f"{d1.err:.3f}")  # fmt: skip
+    # d₁ on lines: the dense lines' run, the survivors after 6/κ, the estimator with each line a block and its bands
+    st, on_line = chord_lines(sc.model, sc.energy, float(sc.radius), 8, 50_000, np.random.default_rng([5252, 52]))
+    dsc = sc.replace(n=len(st), sections=None, t_max=min(sc.t_max, 9.0 / k.kappa))
+    t_dl, dres = _cpu(lambda: run_chunk(dsc, st, np.arange(len(st))))
+    dl = frame(dres.lifetimes)
+    keep = dl["outcome"].isin(LEAVING_OUTCOMES).to_numpy() & (dl["t_end"].to_numpy() >= 6.0 / k.kappa)
+    xs, blocks = st[keep, 0], on_line[keep]
+    t_l1, l1 = _cpu(lambda: information_dimension_neighbours(xs, blocks=blocks, k_max=16, floor=1e-4, n_boot=100,
+                                                             seed=0))  # fmt: skip
+    decades = [(1e-4, 1e-3), (1e-3, 1e-2), (1e-2, 0.125)]
+    t_b, bands = _cpu(lambda: neighbour_scale_bands(xs, blocks=blocks, bands=decades, k_max=16, n_boot=100, seed=0))
+    low = bands.iloc[0]
+    row("saddle", "d₁ on lines (with its bands): CPU s per point", t_dl + t_l1 + t_b, "",
+        f"lines run {t_dl:.1f} s ({len(st)} orbits) + estimator {t_l1:.2f} s + bands {t_b:.2f} s; d₁ = "
+        f"{l1.value:.3f} ± {l1.err:.3f} ({int(keep.sum())} survivors), over 10⁻⁴–10⁻³ of a line's extent "
+        f"{low['value']:.3f} ± {low['err']:.3f}")  # fmt: skip
     # d₀: the lines run and the fit
     eps, n_pairs, refs, moved = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8], 4000, [], []
     for i, e in enumerate(eps):
