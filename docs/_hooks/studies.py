@@ -815,14 +815,11 @@ STUDY_TABLES = {
     "saddle.scales": (
         ("system", "system"),
         ("ratio", "E/E_c"),
-        ("d1", "d₁ = D₁/2 (section)"),
-        ("d1_section_scales", "d₁ on lines, the section's band"),
-        ("band_0.01", "lines, 10⁻² … ⅛"),
-        ("band_0.001", "lines, 10⁻³ … 10⁻²"),
-        ("band_0.0001", "lines, 10⁻⁴ … 10⁻³"),
+        ("d1", "section D₁/2"),
+        ("d1_section_scales", "lines, section's band"),
+        ("band_0.0001", "lines 10⁻⁴–10⁻³"),
         ("d1_implied", "1 − κ/λ̄"),
-        ("z_implied", "z: smallest band − (1 − κ/λ̄)"),
-        ("z_t_min", "z: smallest band, latest t_min − rule's"),
+        ("z_implied", "z (smallest band)"),
     ),
     "saddle.gap": (
         ("system", "system"),
@@ -832,7 +829,6 @@ STUDY_TABLES = {
         ("left_lines", "left: d₁ on lines"),
         ("left_small_scales", "left: lines, smallest band"),
         ("left_estimator", "left: fixed radius"),
-        ("left_selection", "left: t_min → ∞"),
     ),
     "saddle.dimensions": (
         ("system", "system"),

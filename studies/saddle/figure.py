@@ -51,8 +51,10 @@ def _scales_panel(ax, numbers, plt):
     ax.set_ylabel("partial dimension d₁ over the band")
     ax.set_title(f"(d) d₁ across scales, {label or 'no point with bands'}: lines (open), section (filled), "
                  "1 − κ/λ̄ (dashed)", fontsize=10)  # fmt: skip
-    if pts:
-        ax.legend(fontsize=7)
+    if pts:  # the legend in a band of its own above the points
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.12 * (hi - lo))
+        ax.legend(fontsize=7, ncol=4, loc="upper center")
 
 
 def plot_saddle(numbers, path):
