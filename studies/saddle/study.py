@@ -281,8 +281,9 @@ def _d1_lines(study, key, label, k, lam, t_max):
     efolds, checks = _lines_rules(study, label)
     layout = pd.read_parquet(_dense_lines_path(study, key), columns=["traj_id", "x", "line"])
     rows = layout.merge(_lifetimes(study.raw(key + "_dlines")), on="traj_id")
-    decades = [(p.lines_floor * 10.0**j, min(p.lines_floor * 10.0 ** (j + 1), 1.0 / p.min_boxes))
-               for j in range(12) if p.lines_floor * 10.0**j < 1.0 / p.min_boxes]  # fmt: skip
+    top = 1.0 / p.min_boxes  # decades from the floor; the last one ends at the top scale (at least an octave wide)
+    edges = [e for e in (p.lines_floor * 10.0**j for j in range(12)) if e < top / 2] + [top]
+    decades = list(zip(edges[:-1], edges[1:]))
     return sr.lines_measurement(rows, k.kappa, k.kappa_err, lam["value"], lam["err"], efolds=efolds,
                                 checks=checks, floor=p.lines_floor, bands=decades,
                                 section_band=(p.d1_floor, 1.0 / p.min_boxes), factors=p.d1_floor_factors,

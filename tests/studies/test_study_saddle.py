@@ -291,7 +291,8 @@ def test_d1_on_lines_is_the_survivors_dimension_and_the_relation_is_done_with_it
     rows = [r for r in det["bands"] if r["t_min_kappa"] == rules["lines_efolds"]]
     decades = [(r["lo"], r["hi"]) for r in rows]
     assert decades[0][0] == rules["lines_floor"] and decades[-1][1] == pytest.approx(0.125)
-    assert all(hi == pytest.approx(min(10 * lo, 0.125)) for lo, hi in decades)
+    assert [hi for _lo, hi in decades[:-1]] == pytest.approx([10 * lo for lo, _hi in decades[:-1]])
+    assert decades[-1][1] == pytest.approx(0.125) and all(hi >= 2 * lo for lo, hi in decades)  # no sliver at the top
     tab = neighbour_scale_bands(sel["x"].to_numpy(), blocks=sel["line"].to_numpy(), bands=decades, k_max=16,
                                 n_boot=10, seed=0)  # fmt: skip
     for r, t in zip(rows, tab.itertuples()):
