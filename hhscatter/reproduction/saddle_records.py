@@ -754,7 +754,8 @@ def lyapunov_record(lt, *, n_bins: int, n_boot: int):
         if c.extrapolated > 2.0 * c.extrapolated_err:
             out.update({**lam_inf.to_dict(), "rule": "extrapolated (1/T drift resolved)"})
         else:
-            out.update({"value": None, "err": None, "rule": "none (1/T drift resolved, λ∞ not above 0 by 2σ)"})
+            # no value and no error: not a measurement, so no Measured
+            out.update({**dict.fromkeys(("value", "err")), "rule": "none (1/T drift resolved, λ∞ not above 0 by 2σ)"})
     return out, lt.assign(ftle=mean.ftle)
 
 
@@ -765,7 +766,7 @@ def no_lyapunov_words(lam: dict) -> str:
     Examples
     --------
     >>> lam = {"extrapolated": -0.02, "extrapolated_err": 0.005, "mean": 0.057, "mean_err": 0.001, "n_orbits": 1160,
-    ...        "by_T": [{"T": 385.0, "value": 0.074, "err": 0.002}, {"T": 562.0, "value": 0.044, "err": 0.001}]}
+    ...        "by_T": [{"T": 385.0, **Measured(0.074, 0.002).to_dict()}, {"T": 562.0, **Measured(0.044, 0.001).to_dict()}]}
     >>> print(no_lyapunov_words(lam))  # doctest: +NORMALIZE_WHITESPACE
     λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = −0.0200 ± 0.0050, not above 0 by 2σ; λ̄(T) = 0.0740 ± 0.0020
     at T = 385 to 0.0440 ± 0.0010 at T = 562 (ΣΛ/ΣT = 0.0570 ± 0.0010 over 1160 orbits); the relation is not checked
@@ -923,10 +924,11 @@ def scales_row(rec: dict) -> dict:
 
     Examples
     --------
-    >>> det = {"t_min_kappa": 6.0, "at_section_scales": {"lo": 0.002, "hi": 0.125, "d1": {"value": 0.72, "err": 0.01}},
-    ...        "bands": [{"t_min_kappa": 6.0, "lo": 1e-4, "hi": 1e-3, "d1": {"value": 0.77, "err": 0.015}},
-    ...                  {"t_min_kappa": 6.0, "lo": 1e-3, "hi": 1e-2, "d1": {"value": 0.75, "err": 0.01}},
-    ...                  {"t_min_kappa": 7.0, "lo": 1e-4, "hi": 1e-3, "d1": {"value": 0.77, "err": 0.02}}]}
+    >>> m = lambda v, e: Measured(v, e).to_dict()
+    >>> det = {"t_min_kappa": 6.0, "at_section_scales": {"lo": 0.002, "hi": 0.125, "d1": m(0.72, 0.01)},
+    ...        "bands": [{"t_min_kappa": 6.0, "lo": 1e-4, "hi": 1e-3, "d1": m(0.77, 0.015)},
+    ...                  {"t_min_kappa": 6.0, "lo": 1e-3, "hi": 1e-2, "d1": m(0.75, 0.01)},
+    ...                  {"t_min_kappa": 7.0, "lo": 1e-4, "hi": 1e-3, "d1": m(0.77, 0.02)}]}
     >>> r = scales_row({"id": "a", "system": "hh", "ratio": 1.5, "d1": 0.70, "d1_err": 0.005, "d1_implied": 0.769,
     ...                 "d1_implied_err": 0.001, "d1_lines_detail": det})
     >>> r["band_0.0001"], round(r["z_rise"], 2), round(r["z_implied"], 2), r["z_t_min"]
