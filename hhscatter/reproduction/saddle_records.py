@@ -46,6 +46,7 @@ from hhscatter.analysis.geometry.saddle_checks import ftle_dimension, interval_l
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent, uncertainty_fraction
 from hhscatter.analysis.stats import _arguments as check
 from hhscatter.analysis.stats.measured import Measured
+from hhscatter.analysis.stats.verdicts import value_err
 from hhscatter.errors import ConfigError
 from hhscatter.outcomes import LEAVING_OUTCOMES
 from hhscatter.reproduction.basin_summary import OUTSIDE, TRAPPED_CODE, outcome_codes
@@ -554,6 +555,15 @@ def hyperbolic_record(tangent, points, d1_of, d1_all, thresholds=(0.25, 0.5, 0.7
                            "d1": Measured(d.value, d.err).scaled(0.5).to_dict()}}  # fmt: skip
 
 
+def _fit_cells(r) -> dict:
+    """A row of :func:`~hhscatter.analysis.geometry.saddle.neighbour_floor_scan` or
+    :func:`~hhscatter.analysis.geometry.saddle.neighbour_scale_bands` (value, err, eps_lo, eps_hi, note) as a record's
+    cells: d1 ({value, err}) and eps_range, None where the estimator refused the row, and its note."""
+    ok = math.isfinite(r.value)
+    return {"d1": Measured(r.value, r.err).to_dict() if ok else None,
+            "eps_range": [float(r.eps_lo), float(r.eps_hi)] if ok else None, "note": r.note}  # fmt: skip
+
+
 def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: float) -> dict:
     """lines_record(by_t_min, chosen, scan, kg, *, n_lines, scatter) -> the record's keys of d₁ on lines.
 
@@ -594,10 +604,7 @@ def lines_record(by_t_min, chosen: float, scan, kg, *, n_lines: int, scatter: fl
             chosen_row = row
     if chosen_row is None:
         raise ConfigError(f"chosen t_min·κ {chosen!r} is not among the t_min of by_t_min")
-    scan_rows = [{"factor": float(r.factor), "floor": float(r.floor),
-                  "d1": Measured(r.value, r.err).to_dict() if math.isfinite(r.value) else None,
-                  "eps_range": [float(r.eps_lo), float(r.eps_hi)] if math.isfinite(r.value) else None,
-                  "note": r.note} for r in scan.itertuples()]  # fmt: skip
+    scan_rows = [{"factor": float(r.factor), "floor": float(r.floor), **_fit_cells(r)} for r in scan.itertuples()]
     detail = {"t_min_kappa": float(chosen), "n_points": chosen_row["n_points"], "n_lines": int(n_lines),
               "eps_range": chosen_row["eps_range"], "scatter_extent": None if scatter is None else float(scatter),
               "floor_scan": scan_rows,
@@ -690,10 +697,8 @@ def lines_measurement(
 
     def band_rows(a, bs, c):
         tab = neighbour_scale_bands(a["points"], blocks=a["blocks"], bands=bs, k_max=k_max, n_boot=n_boot, seed=0)
-        return [{"t_min_kappa": float(c), "lo": float(r.lo), "hi": float(r.hi),
-                 "d1": Measured(r.value, r.err).to_dict() if math.isfinite(r.value) else None,
-                 "eps_range": [float(r.eps_lo), float(r.eps_hi)] if math.isfinite(r.value) else None,
-                 "note": r.note} for r in tab.itertuples()]  # fmt: skip
+        return [{"t_min_kappa": float(c), "lo": float(r.lo), "hi": float(r.hi), **_fit_cells(r)}
+                for r in tab.itertuples()]  # fmt: skip
 
     detail = out["d1_lines_detail"]
     if bands:
@@ -777,16 +782,11 @@ def no_lyapunov_words(lam: dict) -> str:
     if len(lam["by_T"]) < 2:
         raise ConfigError(f"lam['by_T'] must hold at least 2 bins of T, got {len(lam['by_T'])}")
     a, b = lam["by_T"][0], lam["by_T"][-1]
-
-    def pm(v, e):  # v ± e, one or two significant digits of e (as the verdicts), the minus sign U+2212
-        digits = max(0, 1 - math.floor(math.log10(e))) if e > 0 else 3
-        return f"{v:.{digits}f} ± {e:.{digits}f}".replace("-", "−")
-
     return (
-        f"λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = {pm(lam['extrapolated'], lam['extrapolated_err'])}, "
-        f"not above 0 by 2σ; λ̄(T) = {pm(a['value'], a['err'])} at T = {a['T']:.0f} to "
-        f"{pm(b['value'], b['err'])} at T = {b['T']:.0f} (ΣΛ/ΣT = {pm(lam['mean'], lam['mean_err'])} over "
-        f"{int(lam['n_orbits'])} orbits); the relation is not checked"
+        f"λ̄: none; λ̄(T) = λ∞ + Λ₀/T extrapolates to λ∞ = {value_err(lam['extrapolated'], lam['extrapolated_err'])}, "
+        f"not above 0 by 2σ; λ̄(T) = {value_err(a['value'], a['err'])} at T = {a['T']:.0f} to "
+        f"{value_err(b['value'], b['err'])} at T = {b['T']:.0f} (ΣΛ/ΣT = {value_err(lam['mean'], lam['mean_err'])} "
+        f"over {int(lam['n_orbits'])} orbits); the relation is not checked"
     )
 
 
@@ -931,8 +931,8 @@ def scales_row(rec: dict) -> dict:
     ...                  {"t_min_kappa": 7.0, "lo": 1e-4, "hi": 1e-3, "d1": m(0.77, 0.02)}]}
     >>> r = scales_row({"id": "a", "system": "hh", "ratio": 1.5, "d1": 0.70, "d1_err": 0.005, "d1_implied": 0.769,
     ...                 "d1_implied_err": 0.001, "d1_lines_detail": det})
-    >>> r["band_0.0001"], round(r["z_rise"], 2), round(r["z_implied"], 2), r["z_t_min"]
-    ({'value': 0.77, 'err': 0.015}, 2.77, 0.07, 0.0)
+    >>> r["band_0.0001"] == m(0.77, 0.015), round(r["z_rise"], 2), round(r["z_implied"], 2), r["z_t_min"]
+    (True, 2.77, 0.07, 0.0)
     """
     row = {"id": rec["id"], "system": rec["system"], "ratio": rec["ratio"]}
     if rec.get("d1") is not None:

@@ -443,6 +443,7 @@ def analyze(study):
             records.append(sr.with_gap(sr.with_d0(rec, _d0(study, key))))
             if ftle is not None:
                 ftles.append(ftle[["traj_id", "t_end", "ftle"]].assign(system=label, ratio=r))
+    scales = [sr.scales_row(x) for x in records]
     cols = ["traj_id", "t_end", "ftle", "system", "ratio"]
     study.write_table(
         pd.concat(ftles, ignore_index=True) if ftles else pd.DataFrame(columns=cols),
@@ -459,8 +460,8 @@ def analyze(study):
             "d1_precision": sr.d1_precision(records),
             "lines": [sr.lines_row(x) for x in records],
             "lines_summary": sr.lines_summary(records),
-            "scales": [sr.scales_row(x) for x in records],
-            "scales_summary": sr.scales_summary([sr.scales_row(x) for x in records]),
+            "scales": scales,
+            "scales_summary": sr.scales_summary(scales),
             "gap": [sr.gap_row(x) for x in records],
             "gap_summary": sr.gap_summary(records),
             "rules": {

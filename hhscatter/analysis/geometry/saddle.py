@@ -61,7 +61,7 @@ import pandas as pd
 
 from hhscatter.analysis.geometry.uncertainty import uncertainty_exponent
 from hhscatter.analysis.stats.measured import Measured
-from hhscatter.analysis.stats.verdicts import verdict
+from hhscatter.analysis.stats.verdicts import signed, value_err, verdict
 from hhscatter.errors import ConfigError
 from hhscatter.outcomes import LEAVING_OUTCOMES
 
@@ -1216,7 +1216,6 @@ def dimension_order(d0, d0_err, d1, d1_err) -> DimensionOrder:
     sig = math.hypot(vals["d0_err"], vals["d1_err"])
     z = diff / sig if sig > 0 else (0.0 if diff == 0 else math.copysign(math.inf, diff))
     holds = bool(z >= -2.0)
-    digits = max(0, 1 - math.floor(math.log10(sig))) if sig > 0 else 3
-    text = f"d₀ − d₁ = {diff:+.{digits}f} ± {sig:.{digits}f}, {z:+.1f}σ".replace("-", "−")
+    text = f"d₀ − d₁ = {value_err(diff, sig, '+')}, {signed(z)}σ"
     text = f"consistent ({text} ≥ −2σ)" if holds else f"not consistent ({text} < −2σ)"
     return DimensionOrder(difference=diff, difference_err=sig, z=float(z), holds=holds, verdict=text)

@@ -4,6 +4,7 @@
   "differs" otherwise, "undetermined" (with why) without a value, a reference or an uncertainty; z = Δ/σ;
 * :func:`verdict_class` — agrees, differs or neither, from a verdict's text;
 * :func:`signed` — a signed number as verdicts print it ("−");
+* :func:`value_err` — "value ± error" as verdicts print it: two significant digits of the error, "−";
 * :func:`half_unit` — half a unit of the last digit of a printed number (the uncertainty a number printed
   without an error carries).
 """
@@ -115,6 +116,23 @@ def verdict_class(text: str) -> str:
     if low.startswith(("differ", "not")):
         return "bad"
     return "meh"
+
+
+def value_err(value: float, err: float, sign: str = "") -> str:
+    """value_err(value, err, sign="") -> "value ± err" as verdicts print it: both to the decimal of the error's second
+    significant digit (three decimals where the error is 0), the minus sign "−" (U+2212); ``sign`` "+" writes the
+    value's sign always.
+
+    Examples
+    --------
+    >>> value_err(-0.02, 0.005), value_err(0.035, 0.023, "+"), value_err(0.5, 0.0)
+    ('−0.0200 ± 0.0050', '+0.035 ± 0.023', '0.500 ± 0.000')
+    """
+    v, e = check.number(value, "value"), check.number(err, "err", minimum=0.0)
+    if sign not in ("", "+"):
+        raise ConfigError(f"sign must be '' or '+', got {sign!r}")
+    digits = max(0, 1 - math.floor(math.log10(e))) if e > 0 else 3
+    return f"{v:{sign}.{digits}f} ± {e:.{digits}f}".replace("-", "−")
 
 
 def half_unit(printed: float) -> float:
