@@ -941,6 +941,8 @@ def spec_table(recs, spec=None) -> str:
 
     def cell(r, k, ek):
         v, e = r.get(k), r.get(ek)
+        if isinstance(v, dict) and "value" in v:  # a measured value as the JSON writes it: {value, err}
+            v, e = v["value"], v.get("err")
         if v is None or (isinstance(v, float) and math.isnan(v)):
             return "—"
         if _is_num(r.get(k + "_upper")) or _is_num(r.get(k + "_lower")):  # a count of 0 (or all): its bound
